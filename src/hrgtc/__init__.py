@@ -1,0 +1,25 @@
+"""hrgtc: temperature-drift compensation of hemispherical resonator gyros.
+
+The method is that of [1]: the resonator's natural frequency is a thermometer
+(Eq. 16-18, Tables 1-2) and the gyro bias is modelled from the frequency change
+and its rate by stepwise linear regression (Eq. 19-22).
+
+[1] X. Wang, W. Wu, Z. Fang, B. Luo, Y. Li, Q. Jiang, "Temperature Drift
+    Compensation for Hemispherical Resonator Gyro Based on Natural Frequency",
+    Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
+"""
+
+from importlib.metadata import PackageNotFoundError, version
+
+try:
+    __version__ = version("hrgtc")
+except PackageNotFoundError:  # pragma: no cover - running from a source tree
+    __version__ = "0.0.0"
+
+PAPER_REFERENCE = (
+    "X. Wang, W. Wu, Z. Fang, B. Luo, Y. Li, Q. Jiang, 'Temperature Drift Compensation for "
+    "Hemispherical Resonator Gyro Based on Natural Frequency', Sensors 12(5), 6434-6446, 2012. "
+    "doi:10.3390/s120506434"
+)
+
+__all__ = ["PAPER_REFERENCE", "__version__"]

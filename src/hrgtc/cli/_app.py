@@ -1,0 +1,101 @@
+"""The Typer application object and the helpers every command shares.
+
+Commands live in their own modules of this package and register themselves on
+:data:`app`; library errors are turned into a one-line message and exit code 2.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from typing import Any
+
+import typer
+from rich.console import Console
+from rich.progress import (
+    BarColumn,
+    MofNCompleteColumn,
+    Progress,
+    TextColumn,
+    TimeElapsedColumn,
+    TimeRemainingColumn,
+)
+
+from hrgtc.errors import HrgtcError
+
+app = typer.Typer(
+    name="hrgtc",
+    help="Temperature-drift compensation of hemispherical resonator gyros from the "
+    "resonator's natural frequency (Wang et al., Sensors 2012, doi:10.3390/s120506434).",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+
+console = Console(highlight=False)
+error_console = Console(stderr=True, highlight=False)
+
+
+def print_json(data: Any) -> None:
+    """Write ``data`` as JSON to standard output (machine readable, nothing else)."""
+    sys.stdout.write(json.dumps(data, indent=2, allow_nan=False) + "\n")
+
+
+def fail(message: str, code: int = 2) -> typer.Exit:
+    """Print ``message`` as an error and return the Exit to raise."""
+    error_console.print(f"[bold red]error:[/] {message}")
+    return typer.Exit(code)
+
+
+@contextmanager
+def library_errors() -> Iterator[None]:
+    """Turn hrgtc errors (and missing files) into a clear message and exit code 2."""
+    try:
+        yield
+    except HrgtcError as exc:
+        raise fail(str(exc)) from exc
+    except FileNotFoundError as exc:
+        raise fail(f"{exc.filename or exc}: no such file") from exc
+
+
+@contextmanager
+def progress_bar(
+    description: str, enabled: bool = True
+) -> Iterator[Callable[[float, float], None]]:
+    """A rich progress bar as a ``callback(done, total)`` for library functions.
+
+    The bar is drawn on standard error so ``--json`` output stays clean.
+    """
+    if not enabled:
+        yield lambda done, total: None
+        return
+    progress = Progress(
+        TextColumn("{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        TimeRemainingColumn(),
+        console=error_console,
+        transient=True,
+    )
+    with progress:
+        task = progress.add_task(description, total=None)
+
+        def callback(done: float, total: float) -> None:
+            progress.update(task, completed=done, total=total)
+
+        yield callback
+
+
+@app.callback()
+def _root(
+    version: bool = typer.Option(False, "--version", help="Print the version and exit."),
+) -> None:
+    """Temperature-drift compensation of HRGs from the resonator's natural frequency."""
+    if version:
+        from hrgtc import __version__
+
+        console.print(f"hrgtc {__version__}")
+        raise typer.Exit()
