@@ -1,0 +1,99 @@
+"""Tests of hrgtc.drift: the stepwise drift model of Eq. (21)-(22) of [1]."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from hrgtc import drift
+from hrgtc.errors import CalibrationError, InputError
+from hrgtc.recording import Metadata, Recording
+
+from synthetic import THERMOMETER, block_std, ramp_run
+
+
+@pytest.fixture(scope="module")
+def cooldown():
+    return ramp_run(seed=1)
+
+
+@pytest.fixture(scope="module")
+def model(cooldown):
+    return drift.fit([cooldown], THERMOMETER)
+
+
+def test_history_adds_the_terms_that_carry_the_law(model):
+    added = [s.term for s in model.history if s.action == "added"]
+    # the law is 1.5 + 0.4 f + 0.02 f^2 + 3000 df
+    assert {"f", "df"} <= set(added[:3])
+    assert "f^2" in added
+    assert model.coefficients["df"] == pytest.approx(3000.0, rel=0.15)
+
+
+def test_model_compensates_a_warmup_with_another_seed(model):
+    warm = ramp_run(seed=2, start_c=-20.0, end_c=20.0)
+    predicted = model.predict_recording(warm)
+    raw = warm.rate_dph - warm.metadata.input_rate_dph
+    rows = int(10 * warm.sample_rate_hz)
+    skip = int(model.settings.warmup_s * warm.sample_rate_hz)
+    before = block_std(raw[skip:], rows)
+    after = block_std((raw - predicted)[skip:], rows)
+    assert before / after > 3.0
+    # against the known truth: the residual is close to the noise floor of 10 s means
+    residual = block_std((warm["bias_dph"] - predicted)[skip:], rows)
+    assert residual < 0.5 * after + 0.2
+
+
+def test_chunked_runs_give_the_same_model(cooldown, model):
+    def chunks():
+        for start in range(0, len(cooldown), 12_345):
+            yield cooldown.slice(start, start + 12_345)
+
+    chunked = drift.fit([chunks], THERMOMETER)
+    assert chunked.selected == model.selected
+    for name in model.selected:
+        assert chunked.coefficients[name] == pytest.approx(model.coefficients[name], rel=1e-9)
+
+
+def test_scaling_does_not_change_the_model_only_its_conditioning(cooldown, model):
+    # The reported coefficients are in user units: predicting from them by hand agrees.
+    values = {"f": np.array([-5.0, 3.0]), "df": np.array([1e-4, -2e-4])}
+    by_hand = model.intercept_dph + sum(
+        model.coefficients[t.name] * t.evaluate(values) for t in model._terms
+    )
+    np.testing.assert_allclose(model.predict(values), by_hand, rtol=1e-12)
+
+
+def test_json_round_trip(model, cooldown):
+    again = drift.DriftModel.from_dict(json.loads(json.dumps(model.to_dict())))
+    assert again.selected == model.selected
+    np.testing.assert_array_equal(
+        again.predict_recording(cooldown), model.predict_recording(cooldown)
+    )
+    assert "B = " in again.summary()
+
+
+def test_constant_temperature_run_is_refused():
+    n = 20 * 3600
+    rng = np.random.default_rng(0)
+    flat = Recording(
+        {
+            "time_s": np.arange(n) / 10.0,
+            "freq_hz": 4432.07 + rng.normal(0, 0.002, n),
+            "rate_dph": 10 + rng.normal(0, 2, n),
+        },
+        Metadata(sample_rate_hz=10.0, input_rate_dph=10.0),
+    )
+    with pytest.raises(CalibrationError, match=r"span only .* °C of resonator temperature"):
+        drift.fit([flat], THERMOMETER)
+    with pytest.raises(CalibrationError, match="no df/dt variation"):
+        drift.fit([flat], THERMOMETER, terms=["df"])
+
+
+def test_bad_arguments():
+    with pytest.raises(InputError, match="no drift runs"):
+        drift.fit([], THERMOMETER)
+    with pytest.raises(InputError, match="unknown variable"):
+        drift.fit([ramp_run(seed=3, hours=1.0)], THERMOMETER, terms=["q"])
