@@ -1,0 +1,184 @@
+"""The model file: one JSON document holding everything a unit's compensation needs.
+
+Thermometer (Eq. 18 form), feature settings (reference, causal df/dt filter,
+scales), drift model (Eq. 22 form), the optional classical housing-thermistor
+baseline, the unit's plateau table, and provenance (input files with SHA-256,
+settings, package version, time). The schema is versioned: a file of a newer
+schema, a foreign JSON document or a corrupt one gets a clear error.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import tempfile
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+from hrgtc.drift import DriftModel
+from hrgtc.errors import HrgtcError, ModelFileError, OutputExistsError
+from hrgtc.thermometry import Thermometer
+
+SCHEMA_NAME = "hrgtc.model"
+SCHEMA_VERSION = 1
+
+
+@dataclass(frozen=True)
+class UnitModel:
+    """A calibrated unit: thermometer, drift model and where they came from.
+
+    Attributes
+    ----------
+    thermometer
+        f(T) and its inverse.
+    drift
+        Bias model in f and df/dt.
+    housing
+        Classical baseline: bias model in housing temperature (None when the
+        training runs had no ``housing_c``).
+    unit
+        Serial or name of the gyro.
+    plateaus
+        The unit's Table 1: one record per soak plateau (plain JSON).
+    provenance
+        Inputs with SHA-256, settings, package version, creation time.
+    """
+
+    thermometer: Thermometer
+    drift: DriftModel
+    housing: DriftModel | None = None
+    unit: str = "unknown"
+    plateaus: tuple[dict[str, Any], ...] = ()
+    provenance: dict[str, Any] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The model file's JSON document."""
+        return {
+            "schema": SCHEMA_NAME,
+            "schema_version": SCHEMA_VERSION,
+            "unit": self.unit,
+            "thermometer": self.thermometer.to_dict(),
+            "drift": self.drift.to_dict(),
+            "housing": None if self.housing is None else self.housing.to_dict(),
+            "plateaus": list(self.plateaus),
+            "provenance": dict(self.provenance),
+        }
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any], source: str = "model") -> UnitModel:
+        """Inverse of :meth:`to_dict`, with schema checks."""
+        if not isinstance(data, Mapping) or data.get("schema") != SCHEMA_NAME:
+            found = data.get("schema") if isinstance(data, Mapping) else type(data).__name__
+            raise ModelFileError(
+                f"{source}: not an hrgtc model file (schema {found!r}, expected "
+                f"{SCHEMA_NAME!r}); create one with 'hrgtc calibrate'"
+            )
+        version = data.get("schema_version")
+        if not isinstance(version, int):
+            raise ModelFileError(f"{source}: schema_version {version!r} is not an integer")
+        if version > SCHEMA_VERSION:
+            raise ModelFileError(
+                f"{source}: model schema version {version} is newer than this hrgtc "
+                f"understands ({SCHEMA_VERSION}); upgrade hrgtc"
+            )
+        try:
+            housing = data.get("housing")
+            return cls(
+                thermometer=Thermometer.from_dict(data["thermometer"]),
+                drift=DriftModel.from_dict(data["drift"]),
+                housing=None if housing is None else DriftModel.from_dict(housing),
+                unit=str(data.get("unit", "unknown")),
+                plateaus=tuple(data.get("plateaus", ())),
+                provenance=dict(data.get("provenance", {})),
+            )
+        except KeyError as exc:
+            raise ModelFileError(f"{source}: model file is missing {exc}; it is corrupt") from exc
+        except HrgtcError as exc:
+            raise ModelFileError(f"{source}: model file is corrupt: {exc}") from exc
+
+
+def file_sha256(path: str | os.PathLike[str], block_bytes: int = 1 << 20) -> str:
+    """SHA-256 of a file, read in blocks."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as handle:
+        while block := handle.read(block_bytes):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def provenance(inputs: Mapping[str, list[str]], settings: Mapping[str, Any]) -> dict[str, Any]:
+    """Provenance record: input files (role, path, SHA-256), settings, version, UTC time."""
+    from hrgtc import __version__
+
+    files = []
+    for role, paths in inputs.items():
+        for path in paths:
+            files.append({"role": role, "path": str(path), "sha256": file_sha256(path)})
+    return {
+        "inputs": files,
+        "settings": dict(settings),
+        "hrgtc_version": __version__,
+        "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
+    }
+
+
+def write_text_atomic(path: str | os.PathLike[str], text: str, force: bool = False) -> Path:
+    """Write ``text`` to ``path`` via a temporary file and rename; never half-written.
+
+    Raises
+    ------
+    OutputExistsError
+        When ``path`` exists and ``force`` is False.
+    """
+    target = Path(path)
+    if target.exists() and not force:
+        raise OutputExistsError(f"{target} exists; pass --force (force=True) to overwrite it")
+    target.parent.mkdir(parents=True, exist_ok=True)
+    handle, temporary = tempfile.mkstemp(
+        dir=target.parent, prefix=f".{target.name}.", suffix=".tmp"
+    )
+    try:
+        with os.fdopen(handle, "w", encoding="utf-8") as stream:
+            stream.write(text)
+            stream.flush()
+            os.fsync(stream.fileno())
+        os.replace(temporary, target)
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise
+    return target
+
+
+def save_model(model: UnitModel, path: str | os.PathLike[str], force: bool = False) -> Path:
+    """Write the model file atomically (refuses to overwrite without ``force``)."""
+    text = json.dumps(model.to_dict(), indent=2, allow_nan=True)
+    return write_text_atomic(path, text + "\n", force=force)
+
+
+def load_model(path: str | os.PathLike[str]) -> UnitModel:
+    """Read a model file written by :func:`save_model` (or ``hrgtc calibrate``).
+
+    Raises
+    ------
+    ModelFileError
+        Unreadable, not JSON, foreign, corrupt, or of a newer schema.
+    """
+    source = str(path)
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ModelFileError(f"{source}: no such model file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ModelFileError(f"{source}: cannot read model file: {exc}") from exc
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise ModelFileError(
+            f"{source}: not a JSON document (line {exc.lineno}, column {exc.colno}: {exc.msg}); "
+            "is it an hrgtc model file?"
+        ) from exc
+    return UnitModel.from_dict(data, source=source)

@@ -1,0 +1,77 @@
+"""Tests of hrgtc.model: the versioned model file."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from hrgtc import drift
+from hrgtc.errors import ModelFileError, OutputExistsError
+from hrgtc.model import SCHEMA_VERSION, UnitModel, load_model, provenance, save_model
+
+from synthetic import THERMOMETER, ramp_run
+
+
+@pytest.fixture(scope="module")
+def unit_model():
+    return UnitModel(
+        thermometer=THERMOMETER,
+        drift=drift.fit([ramp_run(seed=11, hours=3.0)], THERMOMETER),
+        unit="SN-001",
+    )
+
+
+def test_round_trip_is_exact(tmp_path, unit_model):
+    path = save_model(unit_model, tmp_path / "unit.json")
+    again = load_model(path)
+    assert again.thermometer == unit_model.thermometer
+    assert again.drift.selected == unit_model.drift.selected
+    values = {"f": np.linspace(-10, 5, 7), "df": np.linspace(-1e-3, 1e-3, 7)}
+    np.testing.assert_array_equal(again.drift.predict(values), unit_model.drift.predict(values))
+    assert again.unit == "SN-001"
+
+
+def test_never_overwrites_without_force(tmp_path, unit_model):
+    path = save_model(unit_model, tmp_path / "unit.json")
+    before = path.read_text()
+    with pytest.raises(OutputExistsError, match=r"unit.json exists; pass --force"):
+        save_model(unit_model, path)
+    assert path.read_text() == before
+    save_model(unit_model, path, force=True)
+    assert list(tmp_path.iterdir()) == [path]  # no temporary file left behind
+
+
+def test_foreign_corrupt_and_newer_files(tmp_path, unit_model):
+    foreign = tmp_path / "foreign.json"
+    foreign.write_text(json.dumps({"hello": "world"}))
+    with pytest.raises(ModelFileError, match=r"foreign.json: not an hrgtc model file"):
+        load_model(foreign)
+    garbage = tmp_path / "garbage.json"
+    garbage.write_text("{not json")
+    with pytest.raises(ModelFileError, match=r"garbage.json: not a JSON document \(line 1"):
+        load_model(garbage)
+    data = unit_model.to_dict()
+    newer = tmp_path / "newer.json"
+    newer.write_text(json.dumps({**data, "schema_version": SCHEMA_VERSION + 1}))
+    with pytest.raises(ModelFileError, match=r"version 2 is newer than .* \(1\); upgrade"):
+        load_model(newer)
+    broken = tmp_path / "broken.json"
+    del data["drift"]["selected"]
+    broken.write_text(json.dumps(data))
+    with pytest.raises(ModelFileError, match=r"broken.json: model file is corrupt"):
+        load_model(broken)
+    with pytest.raises(ModelFileError, match="no such model file"):
+        load_model(tmp_path / "missing.json")
+
+
+def test_provenance_hashes_inputs(tmp_path):
+    data = tmp_path / "run.csv"
+    data.write_bytes(b"abc")
+    record = provenance({"drift": [str(data)]}, {"window_s": 10})
+    # SHA-256 of b"abc" (FIPS 180-2, appendix B.1)
+    assert record["inputs"][0]["sha256"] == (
+        "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"
+    )
+    assert record["settings"] == {"window_s": 10}
