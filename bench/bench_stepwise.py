@@ -1,0 +1,156 @@
+"""Stepwise regression over 10 candidate columns: sufficient statistics vs naive refits.
+
+Ours: the rows are generated in chunks of one million and fed to
+:class:`hrgtc.stepwise.GramAccumulator` (the full matrix is never held), then
+:func:`hrgtc.stepwise.stepwise_from_accumulator` selects the terms from the
+statistics alone. Naive: the same rows in one matrix and the same MATLAB
+``stepwisefit`` rules, but a statsmodels OLS refit for every candidate at every
+step. The naive run happens in its own subprocess so that its memory (the full
+25M x 10 matrix and statsmodels' copies) does not count against ours.
+
+Timed: ours = accumulation + selection (data generation reported apart);
+naive = the selection on data already in memory.
+"""
+
+from __future__ import annotations
+
+import json
+import resource
+import subprocess
+import sys
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+
+from hrgtc.stepwise import GramAccumulator, stepwise_from_accumulator
+
+FULL_ROWS = 25_000_000
+QUICK_ROWS = 1_000_000
+CHUNK_ROWS = 1_000_000
+SEED = 20120515
+NAMES = tuple(f"x{k + 1}" for k in range(10))
+# y depends on four of the ten columns; columns have offsets, scales and correlations.
+TRUE_COEFFICIENTS = {0: 0.8, 2: -0.5, 5: 0.05, 8: 1.2}
+SCALES = np.array([1.0, 2.0, 0.5, 10.0, 1.0, 30.0, 0.1, 1.0, 3.0, 1.0])
+OFFSETS = np.array([0.0, 5.0, -2.0, 100.0, 0.0, 1e3, 4425.0, 0.0, -7.0, 1.0])
+NOISE_STD = 2.0
+PENTER, PREMOVE = 0.05, 0.10
+
+
+def _peak_rss_mb() -> float:
+    return round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, 1)
+
+
+def chunk(index: int, rows: int) -> tuple[np.ndarray, np.ndarray]:
+    """Rows of chunk ``index``: deterministic, independent of how chunks are grouped."""
+    rng = np.random.default_rng([SEED, index])
+    X = rng.standard_normal((rows, len(NAMES)))
+    X[:, 1] += 0.6 * X[:, 0]  # correlated candidates
+    X[:, 4] += 0.8 * X[:, 2]
+    X *= SCALES
+    X += OFFSETS
+    y = 3.0 + NOISE_STD * rng.standard_normal(rows)
+    for column, coefficient in TRUE_COEFFICIENTS.items():
+        y += coefficient * X[:, column]
+    return X, y
+
+
+def chunks(n: int) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+    """All n rows, one chunk at a time."""
+    for index, start in enumerate(range(0, n, CHUNK_ROWS)):
+        yield chunk(index, min(CHUNK_ROWS, n - start))
+
+
+def run_ours(n: int) -> dict:
+    """Chunked accumulation, then stepwise from the statistics."""
+    acc = GramAccumulator(NAMES)
+    fit_seconds = generate_seconds = 0.0
+    t0 = time.perf_counter()
+    for X, y in chunks(n):
+        t1 = time.perf_counter()
+        generate_seconds += t1 - t0
+        acc.partial_fit(X, y)
+        t0 = time.perf_counter()
+        fit_seconds += t0 - t1
+    t1 = time.perf_counter()
+    result = stepwise_from_accumulator(acc, penter=PENTER, premove=PREMOVE)
+    fit_seconds += time.perf_counter() - t1
+    return {"seconds": fit_seconds, "generate_seconds": generate_seconds,
+            "peak_rss_mb": _peak_rss_mb(), "selected": list(result.selected),
+            "params": result.result.params.tolist(),
+            "steps": [f"{s.action} {s.term}" for s in result.history]}
+
+
+def naive_stepwise(X: np.ndarray, y: np.ndarray) -> dict:
+    """MATLAB stepwisefit rules with a statsmodels OLS refit for every candidate."""
+    import statsmodels.api as sm
+
+    included: list[int] = []
+    steps, fits = [], 0
+    while True:
+        best: tuple[int, float] | None = None
+        for j in (j for j in range(X.shape[1]) if j not in included):
+            cols = sorted([*included, j])
+            fit = sm.OLS(y, sm.add_constant(X[:, cols], has_constant="add")).fit()
+            fits += 1
+            p = float(fit.pvalues[cols.index(j) + 1])
+            if best is None or p < best[1]:
+                best = (j, p)
+        if best is not None and best[1] < PENTER:
+            included.append(best[0])
+            steps.append(f"added {NAMES[best[0]]}")
+            continue
+        cols = sorted(included)
+        final = sm.OLS(y, sm.add_constant(X[:, cols], has_constant="add")).fit()
+        fits += 1
+        if not cols or final.pvalues[1:].max() <= PREMOVE:
+            break
+        worst = cols[int(np.argmax(final.pvalues[1:]))]
+        included.remove(worst)
+        steps.append(f"removed {NAMES[worst]}")
+    return {"selected": [NAMES[j] for j in cols], "params": final.params.tolist(),
+            "steps": steps, "fits": fits}
+
+
+def _naive_main(n: int) -> None:
+    X = np.empty((n, len(NAMES)))
+    y = np.empty(n)
+    for index, start in enumerate(range(0, n, CHUNK_ROWS)):
+        X[start:start + CHUNK_ROWS], y[start:start + CHUNK_ROWS] = \
+            chunk(index, min(CHUNK_ROWS, n - start))
+    t0 = time.perf_counter()
+    out = naive_stepwise(X, y)
+    out["seconds"] = time.perf_counter() - t0
+    out["peak_rss_mb"] = _peak_rss_mb()
+    print(json.dumps(out), flush=True)
+
+
+def run(quick: bool = False) -> list[dict]:
+    """Ours vs naive on 25M rows (1M with ``quick``); one result dict."""
+    n = QUICK_ROWS if quick else FULL_ROWS
+    ours = run_ours(n)
+    proc = subprocess.run([sys.executable, str(Path(__file__).resolve()), "--naive", str(n)],
+                          capture_output=True, text=True, check=True)
+    naive = json.loads(proc.stdout.strip().splitlines()[-1])
+    same = ours["selected"] == naive["selected"]
+    a, b = np.array(ours["params"]), np.array(naive["params"])
+    rel = float(np.max(np.abs(a - b) / np.abs(b))) if same else float("nan")
+    return [{"name": "stepwise_10col", "n": n, "columns": len(NAMES),
+             "seconds": round(ours["seconds"], 3), "rate": round(n / ours["seconds"]),
+             "peak_rss_mb": ours["peak_rss_mb"],
+             "generate_seconds": round(ours["generate_seconds"], 3),
+             "naive_seconds": round(naive["seconds"], 3),
+             "naive_peak_rss_mb": naive["peak_rss_mb"], "naive_fits": naive["fits"],
+             "speedup": round(naive["seconds"] / ours["seconds"], 1),
+             "same_selected": same, "max_rel_coef_diff": rel,
+             "selected": ours["selected"], "steps": ours["steps"],
+             "naive_steps": naive["steps"]}]
+
+
+if __name__ == "__main__":
+    if len(sys.argv) == 3 and sys.argv[1] == "--naive":
+        _naive_main(int(sys.argv[2]))
+    else:
+        print(json.dumps(run(quick="--quick" in sys.argv)))
