@@ -14,7 +14,7 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 demo: $(STAMP)
-	$(BIN)/hrgtc demo
+	$(BIN)/hrgtc paper
 
 test: $(STAMP)
 	$(BIN)/ruff check .

@@ -86,7 +86,7 @@ def test_constant_temperature_run_is_refused():
         },
         Metadata(sample_rate_hz=10.0, input_rate_dph=10.0),
     )
-    with pytest.raises(CalibrationError, match=r"span only .* °C of resonator temperature"):
+    with pytest.raises(CalibrationError, match=r"spans only .* °C of resonator temperature"):
         drift.fit([flat], THERMOMETER)
     with pytest.raises(CalibrationError, match="no df/dt variation"):
         drift.fit([flat], THERMOMETER, terms=["df"])

@@ -30,10 +30,13 @@ Progress = Callable[[float, float], None]
 OUTPUT_COLUMNS = ("rate_comp_dph", "bias_model_dph", "resonator_c_est", "in_range")
 
 
-def _in_training_range(model: DriftModel, values: Mapping[str, np.ndarray]) -> np.ndarray:
+def _in_training_range(
+    model: DriftModel, values: Mapping[str, np.ndarray], variables: tuple[str, ...]
+) -> np.ndarray:
     mask = np.ones(next(iter(values.values())).shape[0], dtype=bool)
-    for variable, (low, high) in model.ranges.items():
-        if variable in values:
+    for variable in variables:
+        if variable in model.ranges and variable in values:
+            low, high = model.ranges[variable]
             x = values[variable]
             mask &= (x >= low) & (x <= high)
     return mask
@@ -77,20 +80,29 @@ class Compensator:
         self._stream = FeatureStream(self.drift.settings, self._variables)
         self.samples = 0
         self.out_of_range = 0
+        self.rate_out_of_range = 0
 
     def process(self, chunk: Recording) -> Recording:
         """The chunk with ``rate_comp_dph``, ``bias_model_dph``, ``resonator_c_est`` and
-        ``in_range`` (1.0 inside the calibrated frequency and training ranges, else 0.0) added.
+        ``in_range`` added: 1.0 where the frequency is inside the thermometer's calibrated
+        range and the drift model's training range of f (and of h), else 0.0. Rates of
+        change outside their training range are counted separately
+        (:attr:`rate_out_of_range_fraction`): a model trained on a cool-down only has
+        seen negative df/dt.
         """
         if self.samples == 0:
             self.drift.settings.check_sample_rate(chunk)
         values = self._stream.process(chunk)
         bias = self.drift.predict(values)
         thermometer = self.model.thermometer
-        in_range = thermometer.in_range(chunk.freq_hz) & _in_training_range(self.drift, values)
+        in_range = thermometer.in_range(chunk.freq_hz) & _in_training_range(
+            self.drift, values, ("f", "h")
+        )
+        rate_in_range = _in_training_range(self.drift, values, ("df", "dh"))
         temperature = thermometer.temperature(chunk.freq_hz, warn=False)
         self.samples += len(chunk)
         self.out_of_range += int(np.count_nonzero(~in_range))
+        self.rate_out_of_range += int(np.count_nonzero(~rate_in_range))
         return chunk.with_columns(
             rate_comp_dph=chunk.rate_dph - bias,
             bias_model_dph=bias,
@@ -100,8 +112,13 @@ class Compensator:
 
     @property
     def out_of_range_fraction(self) -> float:
-        """Share of the samples so far outside the calibrated ranges."""
+        """Share of the samples so far outside the calibrated temperature ranges."""
         return self.out_of_range / self.samples if self.samples else 0.0
+
+    @property
+    def rate_out_of_range_fraction(self) -> float:
+        """Share of the samples so far whose df/dt (dh/dt) is outside its training range."""
+        return self.rate_out_of_range / self.samples if self.samples else 0.0
 
 
 def compensate(recording: Recording, model: UnitModel, drift: str = "frequency") -> Recording:
@@ -117,6 +134,7 @@ class CompensationSummary:
     output: str
     rows: int
     out_of_range_fraction: float
+    rate_out_of_range_fraction: float
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -124,6 +142,7 @@ class CompensationSummary:
             "output": self.output,
             "rows": self.rows,
             "out_of_range_fraction": self.out_of_range_fraction,
+            "rate_out_of_range_fraction": self.rate_out_of_range_fraction,
         }
 
 
@@ -157,5 +176,6 @@ def compensate_file(
             if progress is not None:
                 progress(compensator.samples, total)
     return CompensationSummary(str(source), str(output), compensator.samples,
-                               compensator.out_of_range_fraction)
+                               compensator.out_of_range_fraction,
+                               compensator.rate_out_of_range_fraction)
 

@@ -31,14 +31,17 @@ import numpy as np
 from hrgtc.errors import CalibrationError, InputError
 from hrgtc.features import (
     EQ21,
+    VARIABLES,
     FeatureSettings,
     FeatureStream,
     Term,
     design_matrix,
+    hierarchy,
     parse_terms,
     variables_for,
 )
 from hrgtc.recording import Recording
+from hrgtc.regression import newey_west_inflation
 from hrgtc.stepwise import StepwiseResult, stepwise
 from hrgtc.thermometry import Thermometer
 
@@ -69,6 +72,8 @@ class TrainingWindows:
         Window means of each variable (f [Hz], df [Hz/s], ...).
     n_samples
         Samples that went into the windows.
+    sources
+        Name (file) of each run, in run order.
     """
 
     time_s: np.ndarray
@@ -77,6 +82,7 @@ class TrainingWindows:
     bias_dph: np.ndarray
     variables: dict[str, np.ndarray]
     n_samples: int
+    sources: tuple[str, ...] = ()
 
 
 class _WindowMeans:
@@ -140,6 +146,7 @@ def window_means(
     out_terms, out_bias, out_time, out_run = [], [], [], []
     out_vars: dict[str, list[np.ndarray]] = {v: [] for v in variables}
     total = 0
+    sources: list[str] = []
     for index, source in enumerate(runs):
         stream = FeatureStream(settings, variables)
         averager = _WindowMeans(window_rows, skip)
@@ -148,6 +155,7 @@ def window_means(
             settings.check_sample_rate(chunk)
             if input_rate is None:
                 input_rate = chunk.metadata.input_rate_dph
+                sources.append(chunk.source or f"run {index}")
             values = stream.process(chunk)
             block = np.column_stack(
                 [
@@ -180,6 +188,7 @@ def window_means(
         bias_dph=np.concatenate(out_bias),
         variables={v: np.concatenate(x) for v, x in out_vars.items()},
         n_samples=total,
+        sources=tuple(sources),
     )
 
 
@@ -213,6 +222,9 @@ class DriftModel:
         Size of the training set.
     residual_std_dph, rsquared
         Fit quality on window means. [°/h]
+    variance_inflation, bandwidth_windows
+        Newey-West correction of the F-tests for autocorrelated window residuals
+        (1 and 0 when switched off).
     """
 
     settings: FeatureSettings
@@ -230,6 +242,8 @@ class DriftModel:
     n_samples: int
     residual_std_dph: float
     rsquared: float
+    variance_inflation: float = 1.0
+    bandwidth_windows: int = 0
     _terms: tuple[Term, ...] = field(default=(), repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -266,7 +280,8 @@ class DriftModel:
             value = self.coefficients[name]
             sign = "-" if value < 0 else "+"
             parts.append(f" {sign} {abs(value):.6g}·{name}")
-        return "".join(parts) + "   [°/h; f in Hz, df = df/dt in Hz/s]"
+        units = ", ".join(f"{v} in {VARIABLES[v][0]}" for v in self.variables)
+        return "".join(parts) + f"   [°/h; {units}]"
 
     def summary(self) -> str:
         """Stepwise history, coefficient table and fit statistics as text."""
@@ -292,6 +307,12 @@ class DriftModel:
             f"residual std {self.residual_std_dph:.4g} °/h on {self.window_s:g} s means, "
             f"R² {self.rsquared:.6f}"
         )
+        if self.variance_inflation > 1.0 or self.bandwidth_windows:
+            lines.append(
+                f"F-tests corrected for autocorrelated residuals (Newey-West, "
+                f"{self.bandwidth_windows} windows): variance inflation "
+                f"{self.variance_inflation:.3g}"
+            )
         lines.append(self.equation())
         return "\n".join(lines)
 
@@ -314,6 +335,8 @@ class DriftModel:
             "n_samples": self.n_samples,
             "residual_std_dph": self.residual_std_dph,
             "rsquared": self.rsquared,
+            "variance_inflation": self.variance_inflation,
+            "bandwidth_windows": self.bandwidth_windows,
         }
 
     @classmethod
@@ -336,30 +359,34 @@ class DriftModel:
                 n_samples=int(data["n_samples"]),
                 residual_std_dph=float(data["residual_std_dph"]),
                 rsquared=float(data["rsquared"]),
+                variance_inflation=float(data.get("variance_inflation", 1.0)),
+                bandwidth_windows=int(data.get("bandwidth_windows", 0)),
             )
         except (KeyError, TypeError, ValueError, IndexError) as exc:
             raise InputError(f"not a valid drift-model record: {exc!r}") from exc
 
 
 def _check_excitation(windows: TrainingWindows, thermometer: Thermometer,
-                      variables: Sequence[str]) -> None:
-    """Refuse training data that cannot identify a thermal model."""
+                      variables: Sequence[str], run: int | None = None) -> None:
+    """Refuse training data (all runs, or run ``run``) that cannot identify a thermal model."""
     slope = float(np.max(np.abs(thermometer.slope_hz_per_c(thermometer.temperature_range_c))))
+    mask = slice(None) if run is None else windows.run == run
+    what = "the drift runs" if run is None else f"drift run {windows.sources[run]}"
     if "f" in variables:
-        f = windows.variables["f"]
+        f = windows.variables["f"][mask]
         span_c = (float(f.max()) - float(f.min())) / slope
         if span_c < MIN_TEMPERATURE_SPAN_C:
             raise CalibrationError(
-                f"the drift runs span only {span_c:.3g} °C of resonator temperature "
+                f"{what} spans only {span_c:.3g} °C of resonator temperature "
                 f"({float(f.max() - f.min()):.3g} Hz); a drift model needs a temperature "
                 f"change of at least {MIN_TEMPERATURE_SPAN_C:g} °C: use a cool-down or warm-up run"
             )
     if "df" in variables:
-        df = windows.variables["df"]
+        df = windows.variables["df"][mask]
         span_c_per_h = (float(df.max()) - float(df.min())) / slope * 3600.0
         if span_c_per_h < MIN_RATE_SPAN_C_PER_H:
             raise CalibrationError(
-                f"the drift runs show no df/dt variation (span {span_c_per_h:.3g} °C/h, "
+                f"{what} shows no df/dt variation (span {span_c_per_h:.3g} °C/h, "
                 f"{float(df.max() - df.min()):.3g} Hz/s); the rate terms cannot be identified: "
                 "train on a ramp (cool-down or warm-up), not on a soak or constant temperature, "
                 "or drop the df terms"
@@ -376,8 +403,11 @@ def fit(
     *,
     initial: Iterable[str] | None = None,
     reference_c: float = 20.0,
-    rate_tau_s: float = 60.0,
+    rate_tau_s: float = 10.0,
     warmup_s: float | None = None,
+    autocorrelation: str = "newey-west",
+    hierarchical: bool = False,
+    excitation_runs: int = 0,
     progress: Progress | None = None,
 ) -> DriftModel:
     """Fit the drift model of Eq. (21)-(22) of [1] by stepwise regression on window means.
@@ -403,6 +433,16 @@ def fit(
         Time constant of each stage of the causal df/dt filter. [s]
     warmup_s
         Start of each run left out while the filter settles; default 5 tau. [s]
+    excitation_runs
+        How many leading runs must each show a temperature change and df/dt
+        variation on their own (the user's drift runs, when soaks follow them);
+        the runs together are always checked.
+    autocorrelation
+        ``"newey-west"`` (default): divide the stepwise F statistics by the
+        long-run/plain variance ratio of the full candidate model's window
+        residuals (bandwidth n^(1/3) windows), because bias instability and rate
+        random walk keep 10 s means correlated and plain F-tests then admit terms
+        that fit noise and extrapolate badly. ``"none"``: plain ``stepwisefit``.
     progress
         Optional ``callback(samples_done, 0)``.
 
@@ -427,6 +467,8 @@ def fit(
     )
     windows = window_means(runs, settings, candidates, window_s, progress)
     variables = variables_for(candidates)
+    for run in range(min(excitation_runs, len(windows.sources))):
+        _check_excitation(windows, thermometer, variables, run)
     _check_excitation(windows, thermometer, variables)
     scales = {}
     for v in variables:
@@ -435,8 +477,19 @@ def fit(
     settings = FeatureSettings(**{**settings.to_dict(), "scales": scales})
     factors = np.array([t.scale_factor(scales) for t in candidates])
     x_scaled = windows.terms / factors
+    if autocorrelation == "newey-west":
+        design = np.column_stack([np.ones(x_scaled.shape[0]), x_scaled])
+        solution = np.linalg.lstsq(design, windows.bias_dph, rcond=None)[0]
+        inflation, bandwidth = newey_west_inflation(windows.bias_dph - design @ solution)
+    elif autocorrelation == "none":
+        inflation, bandwidth = 1.0, 0
+    else:
+        raise InputError(
+            f"autocorrelation must be 'newey-west' or 'none', got {autocorrelation!r}"
+        )
     result = stepwise(x_scaled, windows.bias_dph, names=names, penter=penter, premove=premove,
-                      initial=initial)
+                      initial=initial, variance_inflation=inflation,
+                      parents=hierarchy(candidates) if hierarchical else None)
     ols = result.result
     selected = result.selected
     selected_factor = {t.name: t.scale_factor(scales) for t in candidates}
@@ -466,4 +519,6 @@ def fit(
         n_samples=windows.n_samples,
         residual_std_dph=float(ols.residual_std),
         rsquared=float(ols.rsquared) if math.isfinite(ols.rsquared) else float("nan"),
+        variance_inflation=float(inflation),
+        bandwidth_windows=int(bandwidth),
     )

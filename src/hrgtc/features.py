@@ -97,6 +97,23 @@ class Term:
         assert out is not None
         return out
 
+    def parents(self) -> tuple[Term, ...]:
+        """The terms one power lower, e.g. ``f^2*df`` -> ``f*df``, ``f^2``."""
+        out = []
+        for k, (v, p) in enumerate(self.powers):
+            powers = list(self.powers)
+            if p == 1:
+                del powers[k]
+            else:
+                powers[k] = (v, p - 1)
+            if powers:
+                out.append(Term(tuple(powers)))
+        return tuple(out)
+
+    def power_of(self, variable: str) -> int:
+        """Power of ``variable`` in the term (0 when absent)."""
+        return dict(self.powers).get(variable, 0)
+
     def scale_factor(self, scales: Mapping[str, float]) -> float:
         """prod(scale_v ** p): a term of scaled variables times this is the raw term."""
         return math.prod(scales[v] ** p for v, p in self.powers)
@@ -149,6 +166,12 @@ def parse_terms(texts: Iterable[str]) -> tuple[Term, ...]:
 
 #: The nine candidate terms of Eq. (21) of [1].
 EQ21 = parse_terms(EQ21_TERMS)
+
+
+def hierarchy(terms: Sequence[Term]) -> dict[str, list[str]]:
+    """Term name -> names of its parents among ``terms`` (the marginality principle)."""
+    names = {t.name for t in terms}
+    return {t.name: [p.name for p in t.parents() if p.name in names] for t in terms}
 
 
 def required_columns(terms: Sequence[Term]) -> tuple[str, ...]:
@@ -244,7 +267,7 @@ class FeatureSettings:
     reference_freq_hz: float
     sample_rate_hz: float
     reference_c: float = 20.0
-    rate_tau_s: float = 60.0
+    rate_tau_s: float = 10.0
     warmup_s: float = 600.0
     scales: dict[str, float] = field(default_factory=dict)
 
@@ -352,7 +375,7 @@ def design_matrix(
         Shape (n_samples, n_terms), float64.
     """
     if scales:
-        values = {v: x / scales[v] for v, x in values.items()}
+        values = {v: values[v] / scales[v] for v in variables_for(terms)}
     columns = [np.asarray(t.evaluate(values), dtype=np.float64) for t in terms]
     n = next(iter(values.values())).shape[0] if values else 0
     return np.column_stack(columns) if columns else np.empty((n, 0))

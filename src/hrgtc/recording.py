@@ -9,13 +9,27 @@ simulator) and metadata (``unit``, ``sample_rate_hz``, ``input_rate_dph``,
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from hrgtc.errors import RecordingError
+
+if TYPE_CHECKING:  # re-exported lazily at the end of this module
+    from hrgtc.recording_info import RecordingInfo, describe
+    from hrgtc.recording_io import RecordingWriter, count_rows, iter_chunks, read, write
+    from hrgtc.recording_mapping import parse_columns, parse_unit, parse_units
+    from hrgtc.recording_validation import (
+        Gap,
+        Problem,
+        RecordingValidator,
+        ValidationReport,
+        split_at_gaps,
+        validate,
+    )
 
 SCHEMA_VERSION = 1
 
@@ -60,6 +74,27 @@ class Metadata:
     schema: int = SCHEMA_VERSION
     extra: dict[str, Any] = field(default_factory=dict)
 
+    def __post_init__(self) -> None:
+        rate = self.sample_rate_hz
+        try:
+            usable = math.isfinite(rate) and rate > 0
+        except TypeError:
+            usable = False
+        if not usable:
+            raise RecordingError(
+                f"metadata sample_rate_hz must be a positive number of Hz, got {rate!r}; "
+                "give the logger's rate (e.g. --rate-hz 200)"
+            )
+        try:
+            usable = math.isfinite(self.input_rate_dph)
+        except TypeError:
+            usable = False
+        if not usable:
+            raise RecordingError(
+                f"metadata input_rate_dph must be a finite number of °/h, got "
+                f"{self.input_rate_dph!r}; give it with --input-rate-dph"
+            )
+
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types."""
         return asdict(self)
@@ -72,12 +107,24 @@ class Metadata:
         extra.update({k: v for k, v in data.items() if k not in known})
         if "sample_rate_hz" not in data:
             raise RecordingError("metadata has no 'sample_rate_hz'; give it (e.g. --rate-hz 200)")
+        values: dict[str, Any] = {}
+        for key, convert, default, option in (
+            ("sample_rate_hz", float, None, "--rate-hz"),
+            ("input_rate_dph", float, 0.0, "--input-rate-dph"),
+            ("schema", int, SCHEMA_VERSION, None),
+        ):
+            raw = data.get(key, default)
+            try:
+                values[key] = convert(raw)
+            except (TypeError, ValueError):
+                fix = f"; override it with {option}" if option else ""
+                raise RecordingError(f"metadata {key} is {raw!r}, not a number{fix}") from None
         return cls(
-            sample_rate_hz=float(data["sample_rate_hz"]),
+            sample_rate_hz=values["sample_rate_hz"],
             unit=str(data.get("unit", "unknown")),
-            input_rate_dph=float(data.get("input_rate_dph", 0.0)),
+            input_rate_dph=values["input_rate_dph"],
             profile=str(data.get("profile", "")),
-            schema=int(data.get("schema", SCHEMA_VERSION)),
+            schema=values["schema"],
             extra=extra,
         )
 
@@ -205,3 +252,61 @@ def concatenate(recordings: list[Recording]) -> Recording:
         first.metadata,
         first.source,
     )
+
+
+# -- reading, writing and validation live in their own modules ------------------
+_REEXPORTS = {
+    "read": "hrgtc.recording_io",
+    "write": "hrgtc.recording_io",
+    "iter_chunks": "hrgtc.recording_io",
+    "count_rows": "hrgtc.recording_io",
+    "RecordingWriter": "hrgtc.recording_io",
+    "parse_unit": "hrgtc.recording_mapping",
+    "parse_units": "hrgtc.recording_mapping",
+    "parse_columns": "hrgtc.recording_mapping",
+    "validate": "hrgtc.recording_validation",
+    "split_at_gaps": "hrgtc.recording_validation",
+    "ValidationReport": "hrgtc.recording_validation",
+    "Problem": "hrgtc.recording_validation",
+    "Gap": "hrgtc.recording_validation",
+    "RecordingValidator": "hrgtc.recording_validation",
+    "describe": "hrgtc.recording_info",
+    "RecordingInfo": "hrgtc.recording_info",
+}
+
+__all__ = [
+    "COLUMNS",
+    "REQUIRED_COLUMNS",
+    "SCHEMA_VERSION",
+    "Gap",
+    "Metadata",
+    "Problem",
+    "Recording",
+    "RecordingInfo",
+    "RecordingValidator",
+    "RecordingWriter",
+    "ValidationReport",
+    "concatenate",
+    "count_rows",
+    "describe",
+    "iter_chunks",
+    "parse_columns",
+    "parse_unit",
+    "parse_units",
+    "read",
+    "split_at_gaps",
+    "validate",
+    "write",
+]
+
+
+def __getattr__(name: str) -> Any:
+    """Re-export the I/O and validation API (imported lazily: they import this module)."""
+    module = _REEXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'hrgtc.recording' has no attribute {name!r}")
+    import importlib
+
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value

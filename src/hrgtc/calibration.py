@@ -1,0 +1,237 @@
+"""Calibrate a gyro from its recordings: Sections 3 and 4 of [1] run on files.
+
+Soak recordings -> plateaus -> the unit's Table 1 -> thermometer (Eq. 18 form)
+-> its Table 2; ramp recordings -> stepwise drift model (Eq. 22 form); held-out
+runs -> bias stability raw and compensated. Everything is gathered into one
+:class:`~hrgtc.model.UnitModel` with provenance.
+
+Files are streamed chunk by chunk for the drift fit and the validation, so
+memory stays bounded whatever their length; each soak file is read whole
+(one soak at a time).
+
+[1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
+"""
+
+from __future__ import annotations
+
+import os
+import warnings
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+from functools import partial
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from hrgtc import drift as drift_model
+from hrgtc import recording as rec
+from hrgtc.errors import CalibrationError, ExtrapolationWarning, InputError
+from hrgtc.evaluation import Evaluation, evaluate_chunks
+from hrgtc.features import EQ21
+from hrgtc.model import UnitModel, provenance
+from hrgtc.plateaus import Plateau, find_plateaus, plateau_table
+from hrgtc.thermometry import fit as fit_thermometer
+
+PathLike = str | os.PathLike[str]
+Progress = Callable[[str, float, float], None]
+
+#: Classical baseline: cubic in housing temperature.
+HOUSING_TERMS = ("h", "h^2", "h^3")
+
+
+@dataclass(frozen=True)
+class ReadOptions:
+    """How to read the user's files: column mapping, units, metadata overrides."""
+
+    columns: Mapping[str, str] | None = None
+    units: Mapping[str, str] | None = None
+    metadata: Mapping[str, Any] | None = None
+    chunk_rows: int = 1_000_000
+
+    def read(self, path: PathLike) -> rec.Recording:
+        return rec.read(path, columns=self.columns, units=self.units, metadata=self.metadata)
+
+    def chunks(self, path: PathLike, rows: int | None = None) -> Iterator[rec.Recording]:
+        return rec.iter_chunks(path, rows=rows or self.chunk_rows, columns=self.columns,
+                               units=self.units, metadata=self.metadata)
+
+
+@dataclass(frozen=True)
+class CalibrationResult:
+    """What :func:`calibrate` produced: the model and the evidence.
+
+    Attributes
+    ----------
+    model
+        Thermometer, drift model, housing baseline, provenance.
+    plateaus
+        One per soak, in input order.
+    table
+        The unit's Tables 1 and 2: chamber_c, freq_hz, temperature_from_freq_c,
+        error_c (= temperature from frequency minus chamber temperature).
+    validation
+        One :class:`~hrgtc.evaluation.Evaluation` per held-out run.
+    """
+
+    model: UnitModel
+    plateaus: tuple[Plateau, ...]
+    table: tuple[dict[str, float], ...]
+    validation: tuple[Evaluation, ...] = field(default=())
+
+    def to_dict(self) -> dict[str, Any]:
+        """The layout of ``hrgtc calibrate --json``."""
+        d = self.model.drift
+        return {
+            "thermometer": {
+                "coefficients_high_first": list(self.model.thermometer.coefficients_high_first),
+                "standard_errors_high_first": [
+                    None if not np.isfinite(v) else v
+                    for v in reversed(self.model.thermometer.standard_errors)
+                ],
+                "table": [dict(row) for row in self.table],
+            },
+            "drift": {
+                "selected_terms": list(d.selected),
+                "history": [s.to_dict() for s in d.history],
+                "intercept_dph": d.intercept_dph,
+                "coefficients": dict(d.coefficients),
+                "standard_errors": dict(d.standard_errors),
+                "pvalues": dict(d.pvalues),
+                "window_s": d.window_s,
+                "n_windows": d.n_windows,
+            },
+            "housing": None if self.model.housing is None else {
+                "selected_terms": list(self.model.housing.selected),
+                "coefficients": dict(self.model.housing.coefficients),
+            },
+            "validation": [v.to_dict() for v in self.validation],
+        }
+
+
+def _report(progress: Progress | None, stage: str) -> Callable[[float, float], None] | None:
+    return None if progress is None else partial(progress, stage)
+
+
+def calibrate(
+    soaks: Sequence[PathLike],
+    drifts: Sequence[PathLike],
+    validate: Sequence[PathLike] = (),
+    *,
+    order: int = 3,
+    terms: Iterable[str] = tuple(t.name for t in EQ21),
+    window_s: float = 10.0,
+    penter: float = 0.05,
+    premove: float | None = None,
+    reference_c: float = 20.0,
+    rate_tau_s: float = 10.0,
+    housing_terms: Iterable[str] | None = HOUSING_TERMS,
+    plateau_options: Mapping[str, Any] | None = None,
+    drift_from_soaks: bool = True,
+    read_options: ReadOptions | None = None,
+    progress: Progress | None = None,
+) -> CalibrationResult:
+    """Calibrate a unit: thermometer from soaks, drift model from ramps, held-out validation.
+
+    Parameters
+    ----------
+    soaks
+        Soak recordings (one per set-point, or files holding several).
+    drifts
+        Ramp recordings to fit the drift model on (cool-down, warm-up).
+    validate
+        Held-out runs: bias stability raw and compensated is reported for each.
+    order
+        Order of the thermometer polynomial (3 in [1]).
+    terms
+        Candidate terms of the drift model (Eq. 21 by default).
+    window_s, penter, premove
+        Drift fit on ``window_s`` means with these stepwise thresholds.
+    reference_c
+        Reference temperature of the frequency change f. [°C]
+    rate_tau_s
+        Time constant of the causal df/dt filter stages. [s]
+    housing_terms
+        Terms of the classical housing-thermistor baseline, fitted when every
+        drift run has ``housing_c``; None to skip.
+    plateau_options
+        Keyword arguments of :func:`hrgtc.plateaus.find_plateaus`.
+    drift_from_soaks
+        Also fit the drift model on the soak recordings (default). A single
+        cool-down covers one curve in the (temperature, rate) plane, along which
+        the polynomial in f and the df/dt terms are confounded; the soaks' warming
+        and cooling transients add curves of both signs of df/dt, without which a
+        cool-down model extrapolates badly to a warm-up.
+    read_options
+        Column mapping, units and metadata overrides for every file.
+    progress
+        Optional ``callback(stage, done, total)``.
+    """
+    options = read_options or ReadOptions()
+    if not soaks:
+        raise InputError("no soak recordings given; pass --soak FILE for each soak")
+    if not drifts:
+        raise InputError("no drift recordings given; pass --drift FILE (a cool-down or warm-up)")
+
+    plateaus: list[Plateau] = []
+    for number, path in enumerate(soaks):
+        plateaus.extend(find_plateaus(options.read(path), **dict(plateau_options or {})))
+        if progress is not None:
+            progress("soaks", number + 1, len(soaks))
+    temperatures, frequencies = plateau_table(plateaus)
+    thermometer = fit_thermometer(temperatures, frequencies, order=order)
+    if not thermometer.is_monotonic:
+        thermometer.temperature(frequencies)  # raises the explanatory CalibrationError
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ExtrapolationWarning)
+        from_freq = thermometer.temperature(frequencies)
+    table = tuple(
+        {"chamber_c": float(t), "freq_hz": float(f), "temperature_from_freq_c": float(e),
+         "error_c": float(e - t)}
+        for t, f, e in zip(temperatures, frequencies, from_freq, strict=True)
+    )
+
+    training = [*drifts, *(soaks if drift_from_soaks else ())]
+    runs = [partial(options.chunks, path) for path in training]
+    model = drift_model.fit(
+        runs, thermometer, terms=terms, window_s=window_s, penter=penter, premove=premove,
+        reference_c=reference_c, rate_tau_s=rate_tau_s, excitation_runs=len(drifts),
+        progress=_report(progress, "drift"),
+    )
+    housing = None
+    if housing_terms is not None and all(
+        "housing_c" in next(options.chunks(path, rows=100_000)) for path in training
+    ):
+        try:
+            housing = drift_model.fit(
+                runs, thermometer, terms=housing_terms, window_s=window_s, penter=penter,
+                premove=premove, reference_c=reference_c, rate_tau_s=rate_tau_s,
+                progress=_report(progress, "housing baseline"),
+            )
+        except CalibrationError:
+            housing = None
+    unit = next(options.chunks(drifts[0], rows=100_000)).metadata.unit
+    settings = {
+        "order": order, "terms": list(terms), "window_s": window_s, "penter": penter,
+        "premove": premove, "reference_c": reference_c, "rate_tau_s": rate_tau_s,
+        "housing_terms": None if housing_terms is None else list(housing_terms),
+        "plateau_options": dict(plateau_options or {}), "drift_from_soaks": drift_from_soaks,
+        "columns": dict(options.columns or {}), "units": dict(options.units or {}),
+    }
+    unit_model = UnitModel(
+        thermometer=thermometer,
+        drift=model,
+        housing=housing,
+        unit=unit,
+        plateaus=tuple(p.to_dict() for p in plateaus),
+        provenance=provenance(
+            {"soak": [str(p) for p in soaks], "drift": [str(p) for p in drifts],
+             "validate": [str(p) for p in validate]},
+            settings,
+        ),
+    )
+    validation = tuple(
+        evaluate_chunks(unit_model, options.chunks(path), Path(path).name, allan=False)
+        for path in validate
+    )
+    return CalibrationResult(unit_model, tuple(plateaus), table, validation)

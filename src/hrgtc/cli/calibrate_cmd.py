@@ -1,0 +1,131 @@
+"""``hrgtc calibrate``: soaks -> thermometer, ramps -> drift model, one model file."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+from rich.table import Table
+
+from hrgtc.calibration import HOUSING_TERMS, CalibrationResult, ReadOptions, calibrate
+from hrgtc.cli._app import app, console, error_console, library_errors, print_json
+from hrgtc.cli.options import (
+    ColumnsOption,
+    ForceOption,
+    FreqUnitOption,
+    InputRateOption,
+    JsonOption,
+    RateHzOption,
+    RateUnitOption,
+    TimeUnitOption,
+    UnitNameOption,
+    recording_input,
+)
+from hrgtc.errors import OutputExistsError
+from hrgtc.model import save_model
+from hrgtc.paper import EQ21_TERMS
+
+
+def render(result: CalibrationResult) -> None:
+    """Print the unit's Table 1, Eq. 18 form, Table 2 form, steps and Eq. 22 form."""
+    th = result.model.thermometer
+    table = Table(title="The unit's Table 1 (plateaus) and Table 2 (temperature from frequency)")
+    for column in ("chamber (°C)", "settled freq (Hz)", "method", "unsettled (°C)",
+                   "T from freq (°C)", "error (°C)"):
+        table.add_column(column, justify="right")
+    for row, plateau in zip(result.table, result.plateaus, strict=True):
+        table.add_row(
+            f"{row['chamber_c']:.3f}", f"{row['freq_hz']:.4f}", plateau.method,
+            f"{plateau.residual_unsettled_c:+.4f}", f"{row['temperature_from_freq_c']:.4f}",
+            f"{row['error_c']:+.4f}",
+        )
+    console.print(table)
+    if th.order == 3:
+        c3, c2, c1, c0 = th.coefficients_high_first
+        console.print(
+            f"Eq. (18) form: f = {c3:.4e}·T³ {c2:+.4e}·T² {c1:+.6f}·T {c0:+.4f}  [Hz, T in °C]"
+        )
+    else:
+        console.print(th.summary().splitlines()[-1])
+    console.print(result.model.drift.summary())
+    if result.model.housing is not None:
+        console.print("Housing-thermistor baseline: " + result.model.housing.equation())
+    if result.validation:
+        val = Table(title="Held-out validation: 10 s bias stability (°/h)")
+        for column in ("file", "raw", "compensated", "improvement", "out of range"):
+            val.add_column(column, justify="right")
+        for v in result.validation:
+            val.add_row(v.file, f"{v.raw_10s:.4f}", f"{v.compensated_10s:.4f}",
+                        f"{v.raw_10s / v.compensated_10s:.2f}×", f"{v.out_of_range_fraction:.1%}")
+        console.print(val)
+
+
+@app.command("calibrate")
+def calibrate_command(
+    extra_soaks: list[Path] = typer.Argument(
+        None, metavar="[SOAK_FILES]...",
+        help="More soak files (so a shell glob after --soak works: --soak soaks/*.parquet).",
+    ),
+    soak: list[Path] = typer.Option(
+        None, "--soak", help="Soak recording (one per set-point, or one holding several)."),
+    drift: list[Path] = typer.Option(
+        ..., "--drift", help="Ramp recording to fit the drift model on (repeat for more)."),
+    validate: list[Path] = typer.Option(
+        None, "--validate", help="Held-out run: bias stability raw vs compensated."),
+    output: Path = typer.Option(..., "-o", "--output", help="Model file to write (JSON)."),
+    order: int = typer.Option(3, help="Order of the thermometer polynomial f(T)."),
+    terms: str = typer.Option(
+        ",".join(EQ21_TERMS), help="Candidate drift terms, comma separated (Eq. 21 default)."),
+    window_s: float = typer.Option(10.0, "--window-s", help="Averaging window of the fit [s]."),
+    penter: float = typer.Option(0.05, help="Stepwise p-value to enter."),
+    premove: float = typer.Option(
+        None, help="Stepwise p-value to remove [default max(penter, 0.10)]."),
+    reference_c: float = typer.Option(
+        20.0, "--reference-c", help="Reference temperature of f [°C]."),
+    drift_from_soaks: bool = typer.Option(
+        True, "--drift-from-soaks/--no-drift-from-soaks",
+        help="Also fit the drift model on the soaks' warming and cooling transients."),
+    rate_tau_s: float = typer.Option(
+        10.0, "--rate-tau-s", help="Time constant of each stage of the causal df/dt filter [s]."),
+    col: ColumnsOption = None,
+    time_unit: TimeUnitOption = None,
+    freq_unit: FreqUnitOption = None,
+    rate_unit: RateUnitOption = None,
+    rate_hz: RateHzOption = None,
+    unit_name: UnitNameOption = None,
+    input_rate_dph: InputRateOption = None,
+    force: ForceOption = False,
+    json_output: JsonOption = False,
+) -> None:
+    """Calibrate a gyro: soak plateaus -> thermometer (Eq. 18), ramps -> drift model (Eq. 22).
+
+    Example: hrgtc calibrate --soak soaks/*.parquet --drift cooldown.parquet
+    --validate warmup.parquet -o unit.json
+    """
+    soaks = [*(soak or []), *(extra_soaks or [])]
+    inputs = recording_input(col, time_unit, freq_unit, rate_unit, rate_hz, unit_name,
+                             input_rate_dph)
+    with library_errors():
+        if output.exists() and not force:
+            raise OutputExistsError(f"{output} exists; pass --force to overwrite it")
+        stages: dict[str, object] = {}
+
+        def progress(stage: str, done: float, total: float) -> None:
+            if not json_output and stage not in stages:
+                stages[stage] = True
+                error_console.print(f"[dim]… {stage}[/]")
+
+        result = calibrate(
+            soaks, drift, validate or (), order=order,
+            terms=[t.strip() for t in terms.split(",") if t.strip()],
+            window_s=window_s, penter=penter, premove=premove, reference_c=reference_c,
+            rate_tau_s=rate_tau_s, housing_terms=HOUSING_TERMS,
+            drift_from_soaks=drift_from_soaks,
+            read_options=ReadOptions(**inputs.read_kwargs()), progress=progress,
+        )
+        save_model(result.model, output, force=force)
+    if json_output:
+        print_json({**result.to_dict(), "model_file": str(output)})
+        return
+    render(result)
+    console.print(f"Model written to {output}")

@@ -1,0 +1,127 @@
+"""``hrgtc compensate`` and ``hrgtc evaluate``: apply a model to a run, and measure the gain."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+from rich.table import Table
+
+from hrgtc import paper
+from hrgtc.cli._app import app, console, library_errors, print_json, progress_bar
+from hrgtc.cli.options import (
+    ColumnsOption,
+    ForceOption,
+    FreqUnitOption,
+    InputRateOption,
+    JsonOption,
+    RateHzOption,
+    RateUnitOption,
+    TimeUnitOption,
+    UnitNameOption,
+    recording_input,
+)
+from hrgtc.compensate import compensate_file
+from hrgtc.evaluation import Evaluation, evaluate
+from hrgtc.model import load_model
+
+
+@app.command("compensate")
+def compensate_command(
+    run: Path = typer.Argument(..., help="Recording to compensate (.parquet, .csv, .h5)."),
+    model_path: Path = typer.Option(..., "--model", "-m", help="Model file from 'calibrate'."),
+    output: Path = typer.Option(..., "-o", "--output", help="Output recording (format by suffix)."),
+    chunk_rows: int = typer.Option(1_000_000, "--chunk-rows", help="Rows per processing chunk."),
+    col: ColumnsOption = None,
+    time_unit: TimeUnitOption = None,
+    freq_unit: FreqUnitOption = None,
+    rate_unit: RateUnitOption = None,
+    rate_hz: RateHzOption = None,
+    unit_name: UnitNameOption = None,
+    input_rate_dph: InputRateOption = None,
+    force: ForceOption = False,
+    json_output: JsonOption = False,
+) -> None:
+    """Compensate a run file to file: adds rate_comp_dph, bias_model_dph, resonator_c_est
+    and in_range, chunk by chunk (memory bounded whatever the file size).
+
+    Example: hrgtc compensate warmup.parquet --model unit.json -o warmup_comp.parquet
+    """
+    inputs = recording_input(col, time_unit, freq_unit, rate_unit, rate_hz, unit_name,
+                             input_rate_dph)
+    with library_errors(), progress_bar("compensating", enabled=not json_output) as progress:
+        model = load_model(model_path)
+        summary = compensate_file(run, output, model, force=force, chunk_rows=chunk_rows,
+                                  progress=progress, **inputs.read_kwargs())
+    if json_output:
+        print_json(summary.to_dict())
+        return
+    console.print(
+        f"wrote {summary.output}: {summary.rows} rows; "
+        f"{summary.out_of_range_fraction:.2%} outside the calibrated temperature range, "
+        f"{summary.rate_out_of_range_fraction:.2%} with df/dt beyond its training range"
+    )
+
+
+def render_evaluation(result: Evaluation) -> None:
+    """Bias stability table raw / compensated / housing, beside the paper's figures."""
+    table = Table(title=f"Bias stability of {result.file} (1σ of τ-s means, °/h)")
+    table.add_column("output")
+    taus = list(result.bias_stability_dph["raw"])
+    for tau in taus:
+        table.add_column(f"τ = {tau} s", justify="right")
+    labels = {"raw": "raw", "compensated": "compensated (frequency, Eq. 22)",
+              "housing": "compensated (housing thermistor)"}
+    for name, row in result.bias_stability_dph.items():
+        table.add_row(labels.get(name, name),
+                      *("-" if row[t] is None else f"{row[t]:.4f}" for t in taus))
+    table.add_row("paper, Section 4.2 (10 s)", *(
+        f"{paper.BIAS_STABILITY_RAW_DPH} → {paper.BIAS_STABILITY_COMPENSATED_DPH}"
+        if t == "10" else "" for t in taus))
+    console.print(table)
+    if result.allan:
+        allan = Table(title="Allan noise terms (IEEE Std 952)")
+        for column in ("output", "ARW (°/√h)", "bias instability (°/h)", "RRW (°/h/√h)"):
+            allan.add_column(column, justify="right")
+        for name, terms in result.allan.items():
+            def fmt(v: float | None) -> str:
+                return "-" if v is None else f"{v:.4g}"
+
+            allan.add_row(labels.get(name, name), fmt(terms["arw_deg_per_rt_h"]),
+                          fmt(terms["bias_instability_dph"]), fmt(terms["rrw_dph_per_rt_h"]))
+        console.print(allan)
+    console.print(
+        f"improvement at 10 s: {result.improvement_10s:.2f}×; outside the calibrated range: "
+        f"{result.out_of_range_fraction:.2%}; df/dt beyond training: "
+        f"{result.rate_out_of_range_fraction:.2%}"
+    )
+    if result.residual_rms_dph is not None:
+        console.print(f"RMS of true bias minus model: {result.residual_rms_dph:.4f} °/h")
+
+
+@app.command("evaluate")
+def evaluate_command(
+    run: Path = typer.Argument(..., help="Recording to evaluate."),
+    model_path: Path = typer.Option(..., "--model", "-m", help="Model file from 'calibrate'."),
+    col: ColumnsOption = None,
+    time_unit: TimeUnitOption = None,
+    freq_unit: FreqUnitOption = None,
+    rate_unit: RateUnitOption = None,
+    rate_hz: RateHzOption = None,
+    unit_name: UnitNameOption = None,
+    input_rate_dph: InputRateOption = None,
+    json_output: JsonOption = False,
+) -> None:
+    """Bias stability at 1, 10, 100 s and Allan noise terms, raw vs compensated (and vs the
+    housing-thermistor baseline when the run has housing_c).
+
+    Example: hrgtc evaluate warmup.parquet --model unit.json --json
+    """
+    inputs = recording_input(col, time_unit, freq_unit, rate_unit, rate_hz, unit_name,
+                             input_rate_dph)
+    with library_errors(), progress_bar("evaluating", enabled=not json_output) as progress:
+        result = evaluate(run, load_model(model_path), progress=progress, **inputs.read_kwargs())
+    if json_output:
+        print_json(result.to_dict())
+        return
+    render_evaluation(result)

@@ -1,0 +1,209 @@
+"""Options shared by the ``hrgtc`` commands, defined once.
+
+Use the ``Annotated`` aliases as parameter types and turn the reading options
+into keyword arguments of :func:`hrgtc.recording.read` /
+:func:`~hrgtc.recording.iter_chunks` / :func:`~hrgtc.recording.describe`
+with :func:`recording_input`::
+
+    @app.command()
+    def calibrate(
+        files: list[Path],
+        col: ColumnsOption = None,
+        time_unit: TimeUnitOption = None,
+        freq_unit: FreqUnitOption = None,
+        rate_unit: RateUnitOption = None,
+        rate_hz: RateHzOption = None,
+        unit_name: UnitNameOption = None,
+        input_rate_dph: InputRateOption = None,
+        gaps: GapsOption = GapPolicy.error,
+        force: ForceOption = False,
+        json_output: JsonOption = False,
+    ) -> None:
+        inputs = recording_input(
+            col, time_unit, freq_unit, rate_unit, rate_hz, unit_name, input_rate_dph
+        )
+        with library_errors():
+            recording = read(files[0], **inputs.read_kwargs(), gaps=gaps.value)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import StrEnum
+from typing import Annotated, Any
+
+import typer
+
+from hrgtc.errors import InputError
+from hrgtc.recording_formats import FORMAT_SUFFIXES
+from hrgtc.recording_mapping import parse_columns, parse_unit
+
+
+def _columns_callback(value: list[str] | None) -> list[str] | None:
+    try:
+        parse_columns(value)
+    except InputError as exc:
+        raise typer.BadParameter(str(exc)) from None
+    return value
+
+
+def _unit_callback(kind: str) -> Any:
+    def callback(value: str | None) -> str | None:
+        if value is None:
+            return None
+        try:
+            return parse_unit(kind, value)
+        except InputError as exc:
+            raise typer.BadParameter(str(exc)) from None
+
+    return callback
+
+
+class GapPolicy(StrEnum):
+    """What to do with gaps longer than 2 sample periods."""
+
+    error = "error"
+    split = "split"
+    ignore = "ignore"
+
+
+class OutputFormat(StrEnum):
+    """Output file format (suffixes .parquet, .csv, .h5)."""
+
+    parquet = "parquet"
+    csv = "csv"
+    h5 = "h5"
+
+    @property
+    def suffix(self) -> str:
+        """File suffix of the format, e.g. ``".parquet"``."""
+        return FORMAT_SUFFIXES[self.value]
+
+
+_INPUT = "Input recordings"
+
+ColumnsOption = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--col",
+        metavar="NAME=THEIRS",
+        help="Map a recording column to your file's column, e.g. --col freq_hz=f_res "
+        "(repeat, or separate with commas). Names: time_s, freq_hz, rate_dph, chamber_c, "
+        "housing_c, resonator_c, bias_dph.",
+        callback=_columns_callback,
+        rich_help_panel=_INPUT,
+    ),
+]
+TimeUnitOption = Annotated[
+    str | None,
+    typer.Option(
+        "--time-unit",
+        metavar="s|ms|timestamp",
+        help="Unit of the time column: seconds, milliseconds or ISO 8601 timestamps "
+        "(converted to seconds since the first sample); default s.",
+        callback=_unit_callback("time"),
+        rich_help_panel=_INPUT,
+    ),
+]
+FreqUnitOption = Annotated[
+    str | None,
+    typer.Option(
+        "--freq-unit",
+        metavar="Hz|kHz",
+        help="Unit of the frequency column; default Hz.",
+        callback=_unit_callback("freq"),
+        rich_help_panel=_INPUT,
+    ),
+]
+RateUnitOption = Annotated[
+    str | None,
+    typer.Option(
+        "--rate-unit",
+        metavar="dph|dps|radps",
+        help="Unit of the gyro rate column: °/h (dph), °/s (dps) or rad/s (radps); default dph.",
+        callback=_unit_callback("rate"),
+        rich_help_panel=_INPUT,
+    ),
+]
+RateHzOption = Annotated[
+    float | None,
+    typer.Option(
+        "--rate-hz",
+        help="Sample rate of the input [Hz], overriding the file's metadata "
+        "(inferred from the time steps when the file has none).",
+        rich_help_panel=_INPUT,
+    ),
+]
+UnitNameOption = Annotated[
+    str | None,
+    typer.Option(
+        "--unit-name",
+        help="Gyro serial / name, overriding the file's metadata.",
+        rich_help_panel=_INPUT,
+    ),
+]
+InputRateOption = Annotated[
+    float | None,
+    typer.Option(
+        "--input-rate-dph",
+        help="Known rate on the sensitive axis during the test [°/h] (e.g. the Earth-rate "
+        "component), overriding the file's metadata.",
+        rich_help_panel=_INPUT,
+    ),
+]
+GapsOption = Annotated[
+    GapPolicy,
+    typer.Option(
+        "--gaps",
+        help="Gaps longer than 2 sample periods: fail (error), process the segments "
+        "separately (split), or accept them (ignore).",
+        rich_help_panel=_INPUT,
+    ),
+]
+ForceOption = Annotated[bool, typer.Option("--force", help="Overwrite existing output files.")]
+JsonOption = Annotated[
+    bool, typer.Option("--json", help="Print machine-readable JSON on standard output.")
+]
+FormatOption = Annotated[OutputFormat, typer.Option("--format", help="Output file format.")]
+
+
+@dataclass(frozen=True)
+class RecordingInput:
+    """The reading options of a command, ready for :func:`hrgtc.recording.read`.
+
+    Parameters
+    ----------
+    columns
+        Recording column -> the file's column.
+    units
+        ``{"time"|"freq"|"rate": unit}``.
+    metadata
+        Metadata overrides (``sample_rate_hz``, ``unit``, ``input_rate_dph``).
+    """
+
+    columns: dict[str, str] | None = None
+    units: dict[str, str] | None = None
+    metadata: dict[str, Any] | None = None
+
+    def read_kwargs(self) -> dict[str, Any]:
+        """``columns=``, ``units=`` and ``metadata=`` keyword arguments."""
+        return {"columns": self.columns, "units": self.units, "metadata": self.metadata}
+
+
+def recording_input(
+    col: list[str] | None = None,
+    time_unit: str | None = None,
+    freq_unit: str | None = None,
+    rate_unit: str | None = None,
+    rate_hz: float | None = None,
+    unit_name: str | None = None,
+    input_rate_dph: float | None = None,
+) -> RecordingInput:
+    """Gather the values of the shared reading options into a :class:`RecordingInput`."""
+    units = {"time": time_unit, "freq": freq_unit, "rate": rate_unit}
+    overrides = {"sample_rate_hz": rate_hz, "unit": unit_name, "input_rate_dph": input_rate_dph}
+    return RecordingInput(
+        columns=parse_columns(col) or None,
+        units={k: v for k, v in units.items() if v is not None} or None,
+        metadata={k: v for k, v in overrides.items() if v is not None} or None,
+    )

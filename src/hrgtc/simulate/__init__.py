@@ -1,0 +1,89 @@
+"""Chamber-campaign simulator with ground truth.
+
+Simulated recordings follow the recording contract (``time_s``, ``freq_hz``,
+``rate_dph``, ``chamber_c``, ``housing_c``) and add the ground truth
+``resonator_c`` and ``bias_dph``. The parts, one module each:
+
+- :mod:`~hrgtc.simulate.profiles`: the chamber program type and its JSON/YAML files;
+- :mod:`~hrgtc.simulate.standard_profiles`: soaks, ramps, cool-down, warm-up, constant;
+- :mod:`~hrgtc.simulate.thermal`: chamber -> housing -> resonator network;
+- :mod:`~hrgtc.simulate.laws`: frequency law (Table 1 / Eq. 18 of [1], or the
+  shell model) and bias law in physical variables;
+- :mod:`~hrgtc.simulate.noise`: ARW, bias instability, rate random walk;
+- :mod:`~hrgtc.simulate.units`: named simulated gyros (``paper-unit``, ``unit-b``);
+- :mod:`~hrgtc.simulate.campaign`: runs in chunks, with ground truth;
+- :mod:`~hrgtc.simulate.output`: runs written to files, atomically.
+
+Examples
+--------
+>>> from hrgtc import simulate
+>>> rec = simulate.simulate_run(simulate.constant(20.0, 0.1), rate_hz=10.0, seed=0)
+>>> rec.names
+('time_s', 'freq_hz', 'rate_dph', 'chamber_c', 'housing_c', 'resonator_c', 'bias_dph')
+
+[1] X. Wang, W. Wu, Z. Fang, B. Luo, Y. Li, Q. Jiang, "Temperature Drift
+    Compensation for Hemispherical Resonator Gyro Based on Natural Frequency",
+    Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
+"""
+
+from __future__ import annotations
+
+from hrgtc.simulate import profiles, standard_profiles, units
+from hrgtc.simulate.campaign import (
+    COLUMNS,
+    DEFAULT_INPUT_RATE_DPH,
+    iter_run_chunks,
+    run_metadata,
+    simulate_run,
+)
+from hrgtc.simulate.laws import (
+    BiasLaw,
+    PolynomialFrequencyLaw,
+    ShellFrequencyLaw,
+    table1_frequency_law,
+)
+from hrgtc.simulate.noise import GyroNoise
+from hrgtc.simulate.output import WrittenFile, output_paths, simulate_files, simulate_to_file
+from hrgtc.simulate.profiles import Profile, Segment
+from hrgtc.simulate.standard_profiles import (
+    constant,
+    cooldown,
+    ramp,
+    soak,
+    soak_campaign,
+    soak_series,
+    warmup,
+)
+from hrgtc.simulate.thermal import ThermalNetwork
+from hrgtc.simulate.units import Unit
+
+__all__ = [
+    "COLUMNS",
+    "DEFAULT_INPUT_RATE_DPH",
+    "BiasLaw",
+    "GyroNoise",
+    "PolynomialFrequencyLaw",
+    "Profile",
+    "Segment",
+    "ShellFrequencyLaw",
+    "ThermalNetwork",
+    "Unit",
+    "WrittenFile",
+    "constant",
+    "cooldown",
+    "iter_run_chunks",
+    "output_paths",
+    "profiles",
+    "ramp",
+    "run_metadata",
+    "simulate_files",
+    "simulate_run",
+    "simulate_to_file",
+    "soak",
+    "soak_campaign",
+    "soak_series",
+    "standard_profiles",
+    "table1_frequency_law",
+    "units",
+    "warmup",
+]

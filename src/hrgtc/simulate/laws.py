@@ -1,0 +1,235 @@
+"""Frequency and bias laws of a simulated gyro, in physical variables.
+
+Frequency: the natural frequency as a function of the resonator temperature,
+either a polynomial (by default the cubic of Eq. (17)-(18) of [1] fitted to
+Table 1 at full precision, :func:`table1_frequency_law`) or the shell model of
+Eq. (15) of [1] with material temperature coefficients (:class:`ShellFrequencyLaw`).
+
+Bias: the simulator's own law in resonator temperature ``T_r`` and the
+housing - resonator gradient ``G = T_h - T_r`` (:class:`BiasLaw`), not Eq. (21)
+of [1]: since ``f`` is a smooth monotonic function of ``T_r`` (Eq. 18) and
+``df/dt = f'(T_r) dT_r/dt = f'(T_r) G / tau_r`` (:mod:`hrgtc.simulate.thermal`),
+the paper's polynomial in ``f`` and ``df/dt`` (Eq. 21-22) can fit it closely
+but not exactly.
+
+[1] X. Wang, W. Wu, Z. Fang, B. Luo, Y. Li, Q. Jiang, "Temperature Drift
+    Compensation for Hemispherical Resonator Gyro Based on Natural Frequency",
+    Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+import numpy as np
+from numpy.polynomial import Polynomial
+
+from hrgtc.errors import InputError
+from hrgtc.shell import Shell
+
+__all__ = [
+    "BiasLaw",
+    "FrequencyLaw",
+    "PolynomialFrequencyLaw",
+    "ShellFrequencyLaw",
+    "table1_frequency_law",
+]
+
+
+class FrequencyLaw(Protocol):
+    """Natural frequency of the resonator as a function of its temperature."""
+
+    def frequency_hz(self, temperature_c: np.ndarray) -> np.ndarray:
+        """Natural frequency. [Hz]"""
+        ...
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types."""
+        ...
+
+
+@dataclass(frozen=True)
+class PolynomialFrequencyLaw:
+    """``f(T) = sum_k c_k T^k``, the Taylor form of Eq. (17) of [1].
+
+    Parameters
+    ----------
+    coefficients
+        Coefficients in ascending powers of T: ``(c0, c1, c2, c3)`` in Hz,
+        Hz/°C, Hz/°C², Hz/°C³. [Hz/°C^k]
+    source
+        Where the coefficients come from.
+    """
+
+    coefficients: tuple[float, ...]
+    source: str = ""
+
+    def __post_init__(self) -> None:
+        coefficients = tuple(float(c) for c in self.coefficients)
+        if not coefficients or not all(math.isfinite(c) for c in coefficients):
+            raise InputError(f"coefficients must be finite numbers, got {self.coefficients!r}")
+        object.__setattr__(self, "coefficients", coefficients)
+
+    def frequency_hz(self, temperature_c: np.ndarray) -> np.ndarray:
+        """Natural frequency at a resonator temperature (Horner). [Hz]"""
+        t = np.asarray(temperature_c, dtype=np.float64)
+        out = np.full(t.shape, self.coefficients[-1])
+        for c in self.coefficients[-2::-1]:
+            out *= t
+            out += c
+        return out
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types."""
+        return {
+            "kind": "polynomial",
+            "coefficients": list(self.coefficients),
+            "source": self.source,
+        }
+
+
+def table1_frequency_law() -> PolynomialFrequencyLaw:
+    """Eq. (18) of [1] at full precision: the least-squares cubic through Table 1.
+
+    Examples
+    --------
+    >>> law = table1_frequency_law()
+    >>> [round(c, 9) for c in law.coefficients]
+    [4424.900952381, 0.371555556, -0.000970238, 1.5278e-05]
+    """
+    from hrgtc.paper import TABLE1_FREQUENCY_HZ, TABLE1_TEMPERATURE_C
+
+    poly = Polynomial.fit(TABLE1_TEMPERATURE_C, TABLE1_FREQUENCY_HZ, 3).convert()
+    return PolynomialFrequencyLaw(
+        tuple(float(c) for c in poly.coef), source="Eq. (18) of [1]: cubic fit to Table 1"
+    )
+
+
+@dataclass(frozen=True)
+class ShellFrequencyLaw:
+    """Natural frequency from the shell model, Eq. (15) of [1] (:class:`hrgtc.shell.Shell`).
+
+    Parameters
+    ----------
+    shell
+        Geometry and material (with its temperature coefficients).
+    """
+
+    shell: Shell
+
+    def frequency_hz(self, temperature_c: np.ndarray) -> np.ndarray:
+        """Natural frequency at a resonator temperature, Eq. (15) of [1]. [Hz]"""
+        return np.asarray(self.shell.frequency_hz(np.asarray(temperature_c, dtype=np.float64)))
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types."""
+        return {"kind": "shell", "shell": self.shell.to_dict()}
+
+
+@dataclass(frozen=True)
+class BiasLaw:
+    """Thermal bias in resonator temperature and housing - resonator gradient.
+
+    .. math::
+
+        B = B_0 + \\sum_{k=1}^{3} c_k (T_r - T_0)^k + g\\,G + g_T (T_r - T_0)\\,G
+            + h \\tanh(G / G_h), \\qquad G = T_h - T_r
+
+    The gradient terms make the bias depend on the rate of change of the
+    resonator temperature (``G = tau_r dT_r/dt``); the tanh term is a
+    heating/cooling hysteresis (a different offset while warming, G > 0, than
+    while cooling, G < 0).
+
+    Parameters
+    ----------
+    bias0_dph
+        Constant bias B0 at the reference temperature, no gradient. [°/h]
+    reference_c
+        Reference temperature T0. [°C]
+    temperature_dph
+        ``(c1, c2, c3)``: coefficients of (T_r - T0)^k. [°/h/°C^k]
+    gradient_dph_per_c
+        g: sensitivity to the gradient. [°/h/°C]
+    gradient_temperature_dph_per_c2
+        g_T: change of the gradient sensitivity with temperature. [°/h/°C²]
+    hysteresis_dph
+        h: half the heating - cooling offset. [°/h]
+    hysteresis_width_c
+        G_h: gradient over which the hysteresis switches. [°C]
+    """
+
+    bias0_dph: float
+    reference_c: float = 20.0
+    temperature_dph: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    gradient_dph_per_c: float = 0.0
+    gradient_temperature_dph_per_c2: float = 0.0
+    hysteresis_dph: float = 0.0
+    hysteresis_width_c: float = 1.0
+
+    def __post_init__(self) -> None:
+        temperature = tuple(float(c) for c in self.temperature_dph)
+        if len(temperature) != 3:
+            raise InputError(
+                f"temperature_dph must be (c1, c2, c3), got {self.temperature_dph!r}"
+            )
+        object.__setattr__(self, "temperature_dph", temperature)
+        values = (
+            self.bias0_dph,
+            self.reference_c,
+            self.gradient_dph_per_c,
+            self.gradient_temperature_dph_per_c2,
+            self.hysteresis_dph,
+            *temperature,
+        )
+        if not all(math.isfinite(float(v)) for v in values):
+            raise InputError(f"BiasLaw coefficients must be finite, got {self!r}")
+        if not (math.isfinite(self.hysteresis_width_c) and self.hysteresis_width_c > 0):
+            raise InputError(
+                f"hysteresis_width_c must be > 0 [°C], got {self.hysteresis_width_c!r}"
+            )
+
+    def bias_dph(self, resonator_c: np.ndarray, housing_c: np.ndarray) -> np.ndarray:
+        """Thermal bias (noise-free), B0 included. [°/h]
+
+        Parameters
+        ----------
+        resonator_c
+            Resonator temperature. [°C]
+        housing_c
+            Housing temperature. [°C]
+        """
+        dt = np.asarray(resonator_c, dtype=np.float64) - self.reference_c
+        gradient = np.asarray(housing_c, dtype=np.float64) - resonator_c
+        # ((c3 dt + c2) dt + c1 + g_T G) dt, skipping zero terms (runs on every sample).
+        c1, c2, c3 = self.temperature_dph
+        if c3:
+            out = c3 * dt
+            out += c2
+            out *= dt
+        else:
+            out = c2 * dt
+        out += c1
+        if self.gradient_temperature_dph_per_c2:
+            out += self.gradient_temperature_dph_per_c2 * gradient
+        out *= dt
+        if self.gradient_dph_per_c:
+            out += self.gradient_dph_per_c * gradient
+        out += self.bias0_dph
+        if self.hysteresis_dph:
+            gradient /= self.hysteresis_width_c
+            out += self.hysteresis_dph * np.tanh(gradient, out=gradient)
+        return out
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types."""
+        return {
+            "bias0_dph": self.bias0_dph,
+            "reference_c": self.reference_c,
+            "temperature_dph": list(self.temperature_dph),
+            "gradient_dph_per_c": self.gradient_dph_per_c,
+            "gradient_temperature_dph_per_c2": self.gradient_temperature_dph_per_c2,
+            "hysteresis_dph": self.hysteresis_dph,
+            "hysteresis_width_c": self.hysteresis_width_c,
+        }

@@ -1,0 +1,273 @@
+"""Simulated runs written to files: one file per run, chunk by chunk, atomically.
+
+The recording files follow the recording contract of :mod:`hrgtc.recording`
+(Parquet, CSV or HDF5 by suffix) with the simulator's ground truth columns and
+metadata (:func:`hrgtc.simulate.campaign.run_metadata`). Nothing is
+overwritten without ``force``; a campaign checks all its targets first.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Sequence
+from concurrent.futures import Future, ThreadPoolExecutor
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from hrgtc.errors import InputError, OutputExistsError
+from hrgtc.recording import RecordingWriter
+from hrgtc.recording_formats import FORMAT_SUFFIXES, SUFFIXES
+from hrgtc.simulate import units as _units
+from hrgtc.simulate.campaign import (
+    COLUMNS,
+    DEFAULT_CHUNK_ROWS,
+    DEFAULT_INPUT_RATE_DPH,
+    Progress,
+    Seed,
+    check_rate,
+    check_seed,
+    iter_run_chunks,
+    row_count,
+    run_metadata,
+)
+from hrgtc.simulate.profiles import Profile
+from hrgtc.simulate.units import Unit
+
+__all__ = ["WrittenFile", "output_paths", "simulate_files", "simulate_to_file"]
+
+
+@dataclass(frozen=True)
+class WrittenFile:
+    """A recording written by the simulator.
+
+    Attributes
+    ----------
+    path
+        File written.
+    rows
+        Number of samples.
+    profile
+        The profile's description.
+    """
+
+    path: str
+    rows: int
+    profile: str
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types."""
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> WrittenFile:
+        """Inverse of :meth:`to_dict`."""
+        return cls(path=str(data["path"]), rows=int(data["rows"]), profile=str(data["profile"]))
+
+    def summary(self) -> str:
+        """One line."""
+        return f"{self.path}: {self.rows} rows ({self.profile})"
+
+
+def simulate_to_file(
+    profile: Profile,
+    path: str | Path,
+    unit: str | Unit = _units.DEFAULT_UNIT,
+    rate_hz: float = 200.0,
+    seed: Seed = 0,
+    input_rate_dph: float = DEFAULT_INPUT_RATE_DPH,
+    chunk_rows: int = DEFAULT_CHUNK_ROWS,
+    force: bool = False,
+    progress: Progress | None = None,
+) -> WrittenFile:
+    """Simulate a run straight to a file (format from the suffix), chunk by chunk, atomically.
+
+    Parameters
+    ----------
+    profile
+        The chamber program.
+    path
+        Output file, ``.parquet``, ``.csv`` or ``.h5``; its directory must exist.
+    unit, rate_hz, seed, input_rate_dph, chunk_rows, progress
+        As for :func:`hrgtc.simulate.campaign.iter_run_chunks`.
+    force
+        Overwrite ``path`` if it exists.
+
+    Returns
+    -------
+    WrittenFile
+        The path and the number of rows written.
+
+    Raises
+    ------
+    OutputExistsError
+        If ``path`` exists and ``force`` is False.
+    """
+    path = Path(path)
+    if path.exists() and not force:
+        raise OutputExistsError(f"{path} exists; pass force=True (--force) to overwrite it")
+    metadata = run_metadata(profile, unit, rate_hz, seed, input_rate_dph)
+    rows = 0
+    chunks = iter_run_chunks(profile, unit, rate_hz, seed, input_rate_dph, chunk_rows, progress)
+    # Encode and write chunk k in a worker thread while chunk k+1 is generated
+    # (numpy, scipy and pyarrow release the GIL in their loops).
+    with (
+        RecordingWriter(path, metadata, COLUMNS, force=force) as writer,
+        ThreadPoolExecutor(max_workers=1, thread_name_prefix="hrgtc-writer") as pool,
+    ):
+        pending: Future[None] | None = None
+        for chunk in chunks:
+            if pending is not None:
+                pending.result()
+            pending = pool.submit(writer.write, chunk)
+            rows += len(chunk)
+        if pending is not None:
+            pending.result()
+    return WrittenFile(path=str(path), rows=rows, profile=profile.description)
+
+
+def output_paths(
+    profiles: Sequence[Profile], output: str | Path, file_format: str | None = None
+) -> list[Path]:
+    """Where :func:`simulate_files` writes each profile.
+
+    ``output`` with a recording suffix (``.parquet``, ``.csv``, ``.h5``) is the
+    file itself (one profile only); otherwise it is a directory and each file
+    is named ``<profile.name><suffix>``, the suffix from ``file_format``
+    (default Parquet).
+    """
+    output = Path(output)
+    if file_format is not None and file_format not in FORMAT_SUFFIXES:
+        raise InputError(
+            f"unknown format {file_format!r}; choose one of {', '.join(FORMAT_SUFFIXES)}"
+        )
+    suffix = output.suffix.lower()
+    by_suffix = {s: "h5" if f == "hdf5" else f for s, f in SUFFIXES.items()}
+    if suffix in by_suffix:
+        if len(profiles) != 1:
+            raise InputError(
+                f"output {output} is a file but {len(profiles)} runs are to be written; give a "
+                "directory, or --single-file for one file holding all set-points"
+            )
+        if file_format is not None and by_suffix[suffix] != file_format:
+            raise InputError(
+                f"output {output} has suffix {suffix!r} but the format is {file_format!r}; "
+                "make them agree or drop --format"
+            )
+        return [output]
+    chosen = FORMAT_SUFFIXES[file_format or "parquet"]
+    names = [p.name for p in profiles]
+    unsafe = [n for n in names if Path(n).name != n or n in ("", ".", "..")]
+    if unsafe:
+        raise InputError(f"profile name(s) {unsafe} cannot be file names; rename the profile(s)")
+    duplicates = sorted({n for n in names if names.count(n) > 1})
+    if duplicates:
+        raise InputError(
+            f"two runs would write the same file(s) {duplicates}; give distinct set-points"
+        )
+    return [output / f"{name}{chosen}" for name in names]
+
+
+def simulate_files(
+    profiles: Sequence[Profile],
+    output: str | Path,
+    file_format: str | None = None,
+    unit: str | Unit = _units.DEFAULT_UNIT,
+    rate_hz: float = 200.0,
+    seed: int = 0,
+    input_rate_dph: float = DEFAULT_INPUT_RATE_DPH,
+    chunk_rows: int = DEFAULT_CHUNK_ROWS,
+    force: bool = False,
+    progress: Progress | None = None,
+    workers: int = 2,
+) -> list[WrittenFile]:
+    """Simulate one file per profile (a soak campaign, a cool-down, ...).
+
+    Run ``k`` uses the seed ``SeedSequence(seed, spawn_key=(k,))`` (kept in its
+    metadata), so the runs are independent and each is reproducible alone.
+    Every target is checked before anything is written: with ``force`` False
+    an existing file stops the whole campaign. Up to ``workers`` files are
+    simulated and written at once (threads; the files do not depend on it).
+
+    Parameters
+    ----------
+    profiles
+        The runs.
+    output
+        A directory (created if missing), or a file for a single run.
+    file_format
+        ``"parquet"``, ``"csv"`` or ``"h5"``; None: from ``output``'s suffix, else Parquet.
+    unit, rate_hz, input_rate_dph, chunk_rows
+        As for :func:`iter_run_chunks`.
+    seed
+        Non-negative integer seed of the campaign.
+    force
+        Overwrite existing files.
+    progress
+        Called as ``progress(rows_done, rows_total)`` over all runs (from worker threads).
+    workers
+        Number of files in flight at once (each holds a few chunks in memory).
+
+    Returns
+    -------
+    list of WrittenFile
+        Path and row count of each file, in the order of ``profiles``.
+
+    Raises
+    ------
+    OutputExistsError
+        If a target exists and ``force`` is False (nothing is written).
+    """
+    if not profiles:
+        raise InputError("no runs to simulate; give at least one profile")
+    unit = unit if isinstance(unit, Unit) else _units.get(unit)
+    fs = check_rate(rate_hz)
+    seed = check_seed(seed)
+    if not isinstance(seed, int):
+        raise InputError(f"a campaign's seed must be a non-negative integer, got {seed!r}")
+    paths = output_paths(profiles, output, file_format)
+    existing = [str(p) for p in paths if p.exists()]
+    if existing and not force:
+        raise OutputExistsError(
+            f"{len(existing)} output file(s) exist: {', '.join(existing)}; nothing was written; "
+            "pass --force (force=True) to overwrite"
+        )
+    paths[0].parent.mkdir(parents=True, exist_ok=True)
+    counts = [row_count(p, fs) for p in profiles]
+    total = float(sum(counts))
+    done = [0.0] * len(profiles)
+    lock = threading.Lock()
+
+    def reporter(k: int) -> Progress:
+        def report(rows: float, _total: float) -> None:
+            with lock:  # one call at a time, rows_done never decreasing
+                done[k] = rows
+                if progress is not None:
+                    progress(sum(done), total)
+
+        return report
+
+    with ThreadPoolExecutor(max_workers=max(1, min(int(workers), len(profiles)))) as pool:
+        futures = [
+            pool.submit(
+                simulate_to_file,
+                profile,
+                path,
+                unit,
+                fs,
+                np.random.SeedSequence(seed, spawn_key=(k,)),
+                input_rate_dph,
+                chunk_rows,
+                force,
+                reporter(k),
+            )
+            for k, (profile, path) in enumerate(zip(profiles, paths, strict=True))
+        ]
+        try:
+            return [future.result() for future in futures]
+        except BaseException:
+            for future in futures:
+                future.cancel()
+            raise

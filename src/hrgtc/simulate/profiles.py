@@ -1,0 +1,354 @@
+"""Chamber set-point profiles: the program type and its JSON/YAML file schema.
+
+A profile is the program of a thermal chamber: a start temperature (the unit
+and the chamber are in equilibrium there when the run starts) and a list of
+segments, each either
+
+* a **hold**: the chamber moves to ``setpoint_c`` at its maximum rate
+  (``chamber_max_c_per_min``, 2 °C/min by default) and then holds it; the
+  segment lasts ``hold_h`` hours in total, slewing included; or
+* a **ramp**: the chamber moves to ``setpoint_c`` at ``ramp_c_per_min``
+  (at most the chamber's maximum rate); the segment lasts as long as the ramp.
+
+The chamber air temperature is therefore piecewise linear in time
+(:meth:`Profile.breakpoints`), which the thermal network integrates exactly.
+A profile starts with chamber, housing and resonator in equilibrium at ``start_c``.
+
+The standard runs (soaks, cool-down, warm-up, ramp, constant) are built in
+:mod:`hrgtc.simulate.standard_profiles`.
+
+Profile files (JSON or YAML) hold either a list of segments or a mapping::
+
+    # my-profile.yaml
+    name: cold-cycle            # optional; default: the file's stem
+    start_c: 20                 # optional; default 20 (room temperature) [°C]
+    chamber_max_c_per_min: 2    # optional; default 2 [°C/min]
+    segments:
+      - {setpoint_c: -20, ramp_c_per_min: 1.0}   # ramp to -20 °C at 1 °C/min
+      - {setpoint_c: -20, hold_h: 2}             # hold for 2 h
+      - {setpoint_c: 40, ramp_c_per_min: 0.5}
+      - {setpoint_c: 40, hold_h: 3}
+
+Each segment has ``setpoint_c`` and exactly one of ``hold_h`` and ``ramp_c_per_min``.
+
+[1] X. Wang, W. Wu, Z. Fang, B. Luo, Y. Li, Q. Jiang, "Temperature Drift
+    Compensation for Hemispherical Resonator Gyro Based on Natural Frequency",
+    Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from hrgtc.errors import InputError
+
+__all__ = [
+    "CHAMBER_MAX_C_PER_MIN",
+    "DEFAULT_RAMP_C_PER_MIN",
+    "ROOM_TEMPERATURE_C",
+    "Profile",
+    "Segment",
+    "from_mapping",
+    "load",
+]
+
+#: Room temperature at which soaks start, as in Fig. 3 of [1]. [°C]
+ROOM_TEMPERATURE_C = 20.0
+#: Default maximum rate of change of the chamber air temperature. [°C/min]
+CHAMBER_MAX_C_PER_MIN = 2.0
+#: Default ramp rate of the cool-down and warm-up runs (Fig. 6 of [1]). [°C/min]
+DEFAULT_RAMP_C_PER_MIN = 1.0
+
+
+def finite_number(name: str, value: Any, unit: str, where: str = "") -> float:
+    try:
+        out = float(value)
+    except (TypeError, ValueError):
+        out = math.nan
+    if not math.isfinite(out):
+        raise InputError(f"{where}{name} must be a finite number [{unit}], got {value!r}")
+    return out
+
+
+def format_temperature(value: float) -> str:
+    return f"{value:g}"
+
+
+@dataclass(frozen=True)
+class Segment:
+    """One step of a chamber program: hold a set-point, or ramp to it.
+
+    Parameters
+    ----------
+    setpoint_c
+        Chamber set-point at the end of the segment. [°C]
+    hold_h
+        Duration of a hold segment, slewing at the chamber's maximum rate
+        included; None for a ramp. [h]
+    ramp_c_per_min
+        Ramp rate of a ramp segment; None for a hold. [°C/min]
+    """
+
+    setpoint_c: float
+    hold_h: float | None = None
+    ramp_c_per_min: float | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "setpoint_c", finite_number("setpoint_c", self.setpoint_c, "°C"))
+        if (self.hold_h is None) == (self.ramp_c_per_min is None):
+            raise InputError(
+                "a segment needs exactly one of hold_h and ramp_c_per_min, got "
+                f"hold_h={self.hold_h!r}, ramp_c_per_min={self.ramp_c_per_min!r}"
+            )
+        if self.hold_h is not None:
+            hold = finite_number("hold_h", self.hold_h, "h")
+            if hold <= 0.0:
+                raise InputError(f"hold_h must be > 0 [h], got {hold!r}")
+            object.__setattr__(self, "hold_h", hold)
+        else:
+            rate = finite_number("ramp_c_per_min", self.ramp_c_per_min, "°C/min")
+            if rate <= 0.0:
+                raise InputError(
+                    f"ramp_c_per_min must be > 0 [°C/min], got {rate!r}; the direction "
+                    "follows from the set-point"
+                )
+            object.__setattr__(self, "ramp_c_per_min", rate)
+
+    def to_dict(self) -> dict[str, float]:
+        """Plain JSON types, the schema of profile files."""
+        out: dict[str, float] = {"setpoint_c": self.setpoint_c}
+        if self.hold_h is not None:
+            out["hold_h"] = self.hold_h
+        else:
+            assert self.ramp_c_per_min is not None
+            out["ramp_c_per_min"] = self.ramp_c_per_min
+        return out
+
+
+@dataclass(frozen=True)
+class Profile:
+    """A chamber program: start temperature, segments, chamber rate limit.
+
+    Parameters
+    ----------
+    segments
+        The program, in order.
+    start_c
+        Temperature of chamber, housing and resonator at time 0 (equilibrium). [°C]
+    chamber_max_c_per_min
+        Maximum rate of change of the chamber air temperature. [°C/min]
+    name
+        Short name used for file names, e.g. ``"soak_-10C"``.
+    description
+        Free text for the recording's ``profile`` metadata, e.g. ``"soak -10 C, 5 h"``.
+    setpoint_c
+        The set-point a soak calibrates (None for other profiles). [°C]
+    """
+
+    segments: tuple[Segment, ...]
+    start_c: float = ROOM_TEMPERATURE_C
+    chamber_max_c_per_min: float = CHAMBER_MAX_C_PER_MIN
+    name: str = "profile"
+    description: str = ""
+    setpoint_c: float | None = field(default=None)
+
+    def __post_init__(self) -> None:
+        segments = tuple(self.segments)
+        if not segments:
+            raise InputError("a profile needs at least one segment")
+        for index, segment in enumerate(segments):
+            if not isinstance(segment, Segment):
+                raise InputError(
+                    f"segment {index} must be a Segment, got {type(segment).__name__}"
+                )
+        object.__setattr__(self, "segments", segments)
+        object.__setattr__(self, "start_c", finite_number("start_c", self.start_c, "°C"))
+        rate = finite_number("chamber_max_c_per_min", self.chamber_max_c_per_min, "°C/min")
+        if rate <= 0.0:
+            raise InputError(f"chamber_max_c_per_min must be > 0 [°C/min], got {rate!r}")
+        object.__setattr__(self, "chamber_max_c_per_min", rate)
+        for index, segment in enumerate(segments):
+            if segment.ramp_c_per_min is not None and segment.ramp_c_per_min > rate:
+                raise InputError(
+                    f"segment {index}: ramp_c_per_min={segment.ramp_c_per_min:g} exceeds the "
+                    f"chamber's maximum rate {rate:g} °C/min; lower the ramp rate or raise "
+                    "chamber_max_c_per_min"
+                )
+        if not self.description:
+            object.__setattr__(self, "description", self._default_description())
+
+    def _default_description(self) -> str:
+        parts = [
+            f"hold {format_temperature(s.setpoint_c)} C {s.hold_h:g} h"
+            if s.hold_h is not None
+            else f"ramp to {format_temperature(s.setpoint_c)} C at {s.ramp_c_per_min:g} C/min"
+            for s in self.segments
+        ]
+        return f"from {format_temperature(self.start_c)} C: " + ", ".join(parts)
+
+    def breakpoints(self) -> tuple[np.ndarray, np.ndarray]:
+        """Corners of the piecewise-linear chamber air temperature.
+
+        Returns
+        -------
+        time_s : numpy.ndarray
+            Times of the corners, starting at 0, non-decreasing. [s]
+        chamber_c : numpy.ndarray
+            Chamber temperature at the corners. [°C]
+        """
+        max_rate = self.chamber_max_c_per_min / 60.0
+        times, temps = [0.0], [self.start_c]
+        t, temp = 0.0, self.start_c
+        for segment in self.segments:
+            delta = segment.setpoint_c - temp
+            if segment.hold_h is not None:
+                duration = segment.hold_h * 3600.0
+                slew = abs(delta) / max_rate
+                if slew >= duration:  # the chamber does not reach the set-point in time
+                    temp += math.copysign(max_rate * duration, delta)
+                    t += duration
+                    times.append(t)
+                    temps.append(temp)
+                    continue
+                if slew > 0.0:
+                    times.append(t + slew)
+                    temps.append(segment.setpoint_c)
+                t += duration
+                temp = segment.setpoint_c
+            else:
+                assert segment.ramp_c_per_min is not None
+                t += abs(delta) / (segment.ramp_c_per_min / 60.0)
+                temp = segment.setpoint_c
+            times.append(t)
+            temps.append(temp)
+        return np.array(times), np.array(temps)
+
+    @property
+    def duration_s(self) -> float:
+        """Total duration of the program. [s]"""
+        return float(self.breakpoints()[0][-1])
+
+    def chamber_c(self, time_s: Any) -> np.ndarray:
+        """Chamber air temperature at the given times (held after the end). [°C]"""
+        times, temps = self.breakpoints()
+        return np.interp(np.asarray(time_s, dtype=np.float64), times, temps)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types; :func:`from_mapping` reads it back."""
+        return {
+            "name": self.name,
+            "description": self.description,
+            "start_c": self.start_c,
+            "chamber_max_c_per_min": self.chamber_max_c_per_min,
+            "setpoint_c": self.setpoint_c,
+            "segments": [s.to_dict() for s in self.segments],
+        }
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> Profile:
+        """Inverse of :meth:`to_dict`."""
+        return from_mapping(data)
+
+    def summary(self) -> str:
+        """One line per segment, as text."""
+        times, temps = self.breakpoints()
+        lines = [f"profile {self.name}: {self.description}", f"  duration {times[-1]:.0f} s"]
+        lines += [
+            f"  t = {t:9.0f} s  chamber {c:8.3f} °C" for t, c in zip(times, temps, strict=True)
+        ]
+        return "\n".join(lines)
+
+
+def from_mapping(data: Any, source: str = "profile", name: str = "profile") -> Profile:
+    """A profile from the file schema of the module docstring (a list or a mapping).
+
+    Parameters
+    ----------
+    data
+        A list of segment mappings, or a mapping with ``segments`` and the
+        optional keys ``name``, ``description``, ``start_c``,
+        ``chamber_max_c_per_min``, ``setpoint_c``.
+    source
+        Where the data came from, for error messages (a file name).
+    name
+        Default profile name.
+    """
+    if isinstance(data, Mapping):
+        allowed = {
+            "segments", "name", "description", "start_c", "chamber_max_c_per_min", "setpoint_c"
+        }
+        unknown = sorted(set(map(str, data)) - allowed)
+        if unknown:
+            raise InputError(f"{source}: unknown key(s) {unknown}; allowed: {sorted(allowed)}")
+        if "segments" not in data:
+            raise InputError(f"{source}: no 'segments' list; see the schema in the README")
+        segments_data = data["segments"]
+        options = {k: data[k] for k in data if k != "segments" and data[k] is not None}
+    else:
+        segments_data, options = data, {}
+    if not isinstance(segments_data, Sequence) or isinstance(segments_data, str | bytes):
+        raise InputError(
+            f"{source}: segments must be a list of {{setpoint_c, hold_h | ramp_c_per_min}} "
+            f"mappings, got {type(segments_data).__name__}"
+        )
+    segments = []
+    for index, item in enumerate(segments_data):
+        where = f"{source}: segment {index}: "
+        if not isinstance(item, Mapping):
+            raise InputError(f"{where}expected a mapping, got {item!r}")
+        unknown = sorted(set(map(str, item)) - {"setpoint_c", "hold_h", "ramp_c_per_min"})
+        if unknown:
+            raise InputError(
+                f"{where}unknown key(s) {unknown}; use setpoint_c and one of hold_h, "
+                "ramp_c_per_min"
+            )
+        if "setpoint_c" not in item:
+            raise InputError(f"{where}missing setpoint_c [°C]")
+        try:
+            segments.append(
+                Segment(item["setpoint_c"], item.get("hold_h"), item.get("ramp_c_per_min"))
+            )
+        except InputError as exc:
+            raise InputError(f"{where}{exc}") from None
+    if not segments:
+        raise InputError(f"{source}: the profile has no segments")
+    try:
+        return Profile(
+            tuple(segments),
+            start_c=options.get("start_c", ROOM_TEMPERATURE_C),
+            chamber_max_c_per_min=options.get("chamber_max_c_per_min", CHAMBER_MAX_C_PER_MIN),
+            name=_slug(str(options.get("name", name))),
+            description=str(options.get("description", "")),
+            setpoint_c=options.get("setpoint_c"),
+        )
+    except InputError as exc:
+        raise InputError(f"{source}: {exc}") from None
+
+
+def load(path: str | Path) -> Profile:
+    """Read a profile file (``.json``, ``.yaml`` or ``.yml``), schema in the module docstring."""
+    path = Path(path)
+    text = path.read_text(encoding="utf-8")
+    suffix = path.suffix.lower()
+    if suffix not in (".json", ".yaml", ".yml"):
+        raise InputError(f"{path}: unknown profile file type {suffix!r}; use .json, .yaml or .yml")
+    try:
+        data = json.loads(text) if suffix == ".json" else yaml.safe_load(text)
+    except (ValueError, yaml.YAMLError) as exc:  # json.JSONDecodeError is a ValueError
+        raise InputError(f"{path}: cannot parse the profile: {exc}") from None
+    return from_mapping(data, source=str(path), name=path.stem)
+
+
+def _slug(name: str) -> str:
+    """A profile name safe as a file name (letters, digits, ``_.+-``)."""
+    slug = re.sub(r"[^A-Za-z0-9_.+-]+", "_", name).strip(".")
+    return slug or "profile"

@@ -1,0 +1,388 @@
+"""The standard runs of a chamber campaign, and the runs of one command line.
+
+* soaks (Section 3 of [1], Fig. 3): each soak starts with the unit in
+  equilibrium at room temperature, 20 °C, and the chamber slews to the
+  set-point at its maximum rate: :func:`soak_campaign` gives one profile per
+  set-point (one file per soak); :func:`soak_series` one profile visiting the
+  set-points in sequence, each soak starting from the previous set-point;
+* cool-down and warm-up like the run of Fig. 6 of [1] (:func:`cooldown`,
+  :func:`warmup`): ramp, then hold until the end of the run;
+* a ramp between two temperatures (:func:`ramp`) and a constant temperature
+  (:func:`constant`);
+* :func:`build` turns the ``hrgtc simulate`` options (or a profile file, see
+  :mod:`hrgtc.simulate.profiles`) into the list of runs.
+
+[1] X. Wang, W. Wu, Z. Fang, B. Luo, Y. Li, Q. Jiang, "Temperature Drift
+    Compensation for Hemispherical Resonator Gyro Based on Natural Frequency",
+    Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+from hrgtc.errors import InputError
+from hrgtc.simulate.profiles import (
+    CHAMBER_MAX_C_PER_MIN,
+    DEFAULT_RAMP_C_PER_MIN,
+    ROOM_TEMPERATURE_C,
+    Profile,
+    Segment,
+    finite_number,
+    format_temperature,
+    load,
+)
+
+__all__ = [
+    "KINDS",
+    "build",
+    "constant",
+    "cooldown",
+    "ramp",
+    "soak",
+    "soak_campaign",
+    "soak_series",
+    "warmup",
+]
+
+
+def _check_hours(hours: float) -> float:
+    value = finite_number("hours", hours, "h")
+    if value <= 0.0:
+        raise InputError(f"hours must be > 0 [h], got {value!r}")
+    return value
+
+
+def soak(
+    setpoint_c: float,
+    hours: float,
+    start_c: float = ROOM_TEMPERATURE_C,
+    chamber_max_c_per_min: float = CHAMBER_MAX_C_PER_MIN,
+) -> Profile:
+    """A soak at one set-point from equilibrium at ``start_c``, as in Fig. 3 of [1].
+
+    Parameters
+    ----------
+    setpoint_c
+        Chamber set-point. [°C]
+    hours
+        Duration of the soak, the chamber's slew included. [h]
+    start_c
+        Temperature of the unit and the chamber at the start. [°C]
+    chamber_max_c_per_min
+        Rate at which the chamber slews to the set-point. [°C/min]
+
+    Examples
+    --------
+    >>> soak(-10.0, 5.0).description
+    'soak -10 C, 5 h from 20 C'
+    """
+    hours = _check_hours(hours)
+    setpoint = finite_number("setpoint_c", setpoint_c, "°C")
+    start_c = finite_number("start_c", start_c, "°C")
+    return Profile(
+        (Segment(setpoint, hold_h=hours),),
+        start_c=start_c,
+        chamber_max_c_per_min=chamber_max_c_per_min,
+        name=f"soak_{format_temperature(setpoint)}C",
+        description=f"soak {format_temperature(setpoint)} C, {hours:g} h from "
+        f"{format_temperature(start_c)} C",
+        setpoint_c=setpoint,
+    )
+
+
+def soak_campaign(
+    setpoints_c: Sequence[float],
+    hours: float,
+    start_c: float = ROOM_TEMPERATURE_C,
+    chamber_max_c_per_min: float = CHAMBER_MAX_C_PER_MIN,
+) -> list[Profile]:
+    """One soak profile per set-point, each from equilibrium at ``start_c`` (Section 3 of [1]).
+
+    Parameters
+    ----------
+    setpoints_c
+        Chamber set-points, one run each. [°C]
+    hours
+        Duration of each soak. [h]
+    start_c
+        Temperature of the unit and the chamber at the start of every soak. [°C]
+    chamber_max_c_per_min
+        Rate at which the chamber slews to the set-point. [°C/min]
+
+    Examples
+    --------
+    >>> [p.name for p in soak_campaign([-20, -10], 5)]
+    ['soak_-20C', 'soak_-10C']
+    """
+    points = _check_setpoints(setpoints_c)
+    return [soak(s, hours, start_c, chamber_max_c_per_min) for s in points]
+
+
+def soak_series(
+    setpoints_c: Sequence[float],
+    hours: float,
+    start_c: float = ROOM_TEMPERATURE_C,
+    chamber_max_c_per_min: float = CHAMBER_MAX_C_PER_MIN,
+) -> Profile:
+    """One profile visiting the set-points in sequence, ``hours`` each.
+
+    The first soak starts from equilibrium at ``start_c``, each later one from
+    the previous set-point.
+
+    Parameters
+    ----------
+    setpoints_c
+        Chamber set-points, in order. [°C]
+    hours
+        Duration of each soak, the chamber's slew included. [h]
+    start_c
+        Temperature of the unit and the chamber at the start. [°C]
+    chamber_max_c_per_min
+        Rate at which the chamber slews between set-points. [°C/min]
+    """
+    points = _check_setpoints(setpoints_c)
+    hours = _check_hours(hours)
+    start_c = finite_number("start_c", start_c, "°C")
+    label = ", ".join(format_temperature(s) for s in points)
+    return Profile(
+        tuple(Segment(s, hold_h=hours) for s in points),
+        start_c=start_c,
+        chamber_max_c_per_min=chamber_max_c_per_min,
+        name=f"soaks_{format_temperature(points[0])}C_to_{format_temperature(points[-1])}C",
+        description=f"soaks {label} C, {hours:g} h each from {format_temperature(start_c)} C",
+    )
+
+
+def _check_setpoints(setpoints_c: Sequence[float]) -> list[float]:
+    points = [finite_number(f"setpoints_c[{i}]", s, "°C") for i, s in enumerate(setpoints_c)]
+    if not points:
+        raise InputError("setpoints_c is empty; give at least one set-point, e.g. -20,-10,0")
+    return points
+
+
+def ramp(
+    start_c: float,
+    end_c: float,
+    rate_c_per_min: float,
+    hold_h: float = 0.0,
+    chamber_max_c_per_min: float = CHAMBER_MAX_C_PER_MIN,
+) -> Profile:
+    """A ramp from equilibrium at ``start_c`` to ``end_c``, then an optional hold.
+
+    Parameters
+    ----------
+    start_c, end_c
+        Start and end temperatures. [°C]
+    rate_c_per_min
+        Ramp rate, at most ``chamber_max_c_per_min``. [°C/min]
+    hold_h
+        Hold at ``end_c`` after the ramp (0 for none). [h]
+    chamber_max_c_per_min
+        Maximum rate of the chamber. [°C/min]
+    """
+    end = finite_number("end_c", end_c, "°C")
+    start = finite_number("start_c", start_c, "°C")
+    if end == start:
+        raise InputError(f"ramp start_c and end_c are both {start:g} °C; use constant() instead")
+    segments = [Segment(end, ramp_c_per_min=rate_c_per_min)]
+    hold = finite_number("hold_h", hold_h, "h")
+    if hold < 0.0:
+        raise InputError(f"hold_h must be >= 0 [h], got {hold!r}")
+    if hold > 0.0:
+        segments.append(Segment(end, hold_h=hold))
+    rate = segments[0].ramp_c_per_min
+    return Profile(
+        tuple(segments),
+        start_c=start,
+        chamber_max_c_per_min=chamber_max_c_per_min,
+        name=f"ramp_{format_temperature(start)}C_to_{format_temperature(end)}C",
+        description=f"ramp {format_temperature(start)} C to {format_temperature(end)} C at "
+        f"{rate:g} C/min" + (f", hold {hold:g} h" if hold > 0 else ""),
+    )
+
+
+def _ramp_then_hold(
+    kind: str,
+    start_c: float,
+    end_c: float,
+    hours: float,
+    ramp_c_per_min: float,
+    chamber_max_c_per_min: float,
+) -> Profile:
+    hours = _check_hours(hours)
+    start = finite_number("start_c", start_c, "°C")
+    end = finite_number("end_c", end_c, "°C")
+    rate = finite_number("ramp_c_per_min", ramp_c_per_min, "°C/min")
+    if rate <= 0.0:
+        raise InputError(f"ramp_c_per_min must be > 0 [°C/min], got {rate!r}")
+    ramp_h = abs(end - start) / rate / 60.0
+    if ramp_h >= hours:
+        raise InputError(
+            f"the {kind} ramp {format_temperature(start)} -> {format_temperature(end)} C at "
+            f"{rate:g} C/min takes {ramp_h:.3g} h, not less than hours={hours:g}; give more "
+            "hours or a faster ramp"
+        )
+    segments = [Segment(end, hold_h=hours - ramp_h)]
+    if end != start:
+        segments.insert(0, Segment(end, ramp_c_per_min=rate))
+    return Profile(
+        tuple(segments),
+        start_c=start,
+        chamber_max_c_per_min=chamber_max_c_per_min,
+        name=f"{kind}_{format_temperature(start)}C_to_{format_temperature(end)}C",
+        description=f"{kind} {format_temperature(start)} C to {format_temperature(end)} C at "
+        f"{rate:g} C/min, {hours:g} h",
+    )
+
+
+def cooldown(
+    start_c: float = ROOM_TEMPERATURE_C,
+    end_c: float = -20.0,
+    hours: float = 5.0,
+    ramp_c_per_min: float = DEFAULT_RAMP_C_PER_MIN,
+    chamber_max_c_per_min: float = CHAMBER_MAX_C_PER_MIN,
+) -> Profile:
+    """A cool-down like the run of Fig. 6 of [1]: ramp from ``start_c`` to ``end_c``, then hold.
+
+    The unit starts in equilibrium at ``start_c``; the whole run lasts ``hours``.
+
+    Examples
+    --------
+    >>> p = cooldown(20, -20, 5)
+    >>> p.chamber_c([0.0, 1200.0, 2400.0, 18000.0]).tolist()
+    [20.0, 0.0, -20.0, -20.0]
+    """
+    if finite_number("end_c", end_c, "°C") >= finite_number("start_c", start_c, "°C"):
+        raise InputError(
+            f"a cool-down needs end_c < start_c, got {start_c!r} -> {end_c!r}; use warmup()"
+        )
+    return _ramp_then_hold("cooldown", start_c, end_c, hours, ramp_c_per_min, chamber_max_c_per_min)
+
+
+def warmup(
+    start_c: float = -20.0,
+    end_c: float = ROOM_TEMPERATURE_C,
+    hours: float = 5.0,
+    ramp_c_per_min: float = DEFAULT_RAMP_C_PER_MIN,
+    chamber_max_c_per_min: float = CHAMBER_MAX_C_PER_MIN,
+) -> Profile:
+    """A warm-up, the mirror of :func:`cooldown`: the unit starts soaked at ``start_c``."""
+    if finite_number("end_c", end_c, "°C") <= finite_number("start_c", start_c, "°C"):
+        raise InputError(
+            f"a warm-up needs end_c > start_c, got {start_c!r} -> {end_c!r}; use cooldown()"
+        )
+    return _ramp_then_hold("warmup", start_c, end_c, hours, ramp_c_per_min, chamber_max_c_per_min)
+
+
+def constant(temperature_c: float, hours: float) -> Profile:
+    """Constant temperature: unit and chamber in equilibrium at ``temperature_c`` throughout."""
+    hours = _check_hours(hours)
+    temp = finite_number("temperature_c", temperature_c, "°C")
+    return Profile(
+        (Segment(temp, hold_h=hours),),
+        start_c=temp,
+        name=f"constant_{format_temperature(temp)}C",
+        description=f"constant {format_temperature(temp)} C, {hours:g} h",
+        setpoint_c=temp,
+    )
+
+
+#: Profile kinds known to :func:`build` (besides a path to a profile file).
+KINDS = ("soak", "cooldown", "warmup", "constant", "ramp")
+
+
+def build(
+    kind: str,
+    *,
+    setpoints_c: Sequence[float] | None = None,
+    hours: float | None = None,
+    start_c: float | None = None,
+    end_c: float | None = None,
+    temperature_c: float | None = None,
+    ramp_c_per_min: float | None = None,
+    single_file: bool = False,
+) -> list[Profile]:
+    """The runs of one command line: a kind of profile (or a profile file) and its options.
+
+    Parameters
+    ----------
+    kind
+        ``"soak"``, ``"cooldown"``, ``"warmup"``, ``"constant"``, ``"ramp"``, or
+        the path of a JSON/YAML profile file.
+    setpoints_c
+        Soak set-points (soak only; default -20, -10, ..., 40 as in Table 1 of [1]). [°C]
+    hours
+        Hours per soak, or duration of a cool-down/warm-up/constant run
+        (default 5); hold after a ramp (default 0). [h]
+    start_c, end_c
+        Start and end temperatures of a cool-down (default 20, -20), warm-up
+        (-20, 20) or ramp (required). [°C]
+    temperature_c
+        Temperature of a constant run (default 20). [°C]
+    ramp_c_per_min
+        Ramp rate of a cool-down, warm-up or ramp (default 1). [°C/min]
+    single_file
+        Soaks: one run visiting all set-points instead of one run per set-point.
+
+    Returns
+    -------
+    list of Profile
+        One profile per output file.
+    """
+    given = {
+        "setpoints_c": setpoints_c,
+        "start_c": start_c,
+        "end_c": end_c,
+        "temperature_c": temperature_c,
+        "ramp_c_per_min": ramp_c_per_min,
+    }
+    allowed = {
+        "soak": {"setpoints_c"},
+        "cooldown": {"start_c", "end_c", "ramp_c_per_min"},
+        "warmup": {"start_c", "end_c", "ramp_c_per_min"},
+        "constant": {"temperature_c"},
+        "ramp": {"start_c", "end_c", "ramp_c_per_min"},
+    }
+    if kind not in KINDS:
+        path = Path(kind)
+        if path.suffix.lower() not in (".json", ".yaml", ".yml"):
+            raise InputError(
+                f"unknown profile {kind!r}; choose one of {', '.join(KINDS)} or give a "
+                ".json/.yaml profile file"
+            )
+        if not path.is_file():
+            raise InputError(f"profile file {kind} not found")
+        allowed[kind] = set()
+    extra = sorted(k for k, v in given.items() if v is not None and k not in allowed[kind])
+    if extra or (single_file and kind != "soak"):
+        names = extra + (["single_file"] if single_file and kind != "soak" else [])
+        raise InputError(f"option(s) {names} do not apply to profile {kind!r}")
+    if kind == "soak":
+        points = list(setpoints_c) if setpoints_c is not None else [-20, -10, 0, 10, 20, 30, 40]
+        hold = 5.0 if hours is None else hours
+        return [soak_series(points, hold)] if single_file else soak_campaign(points, hold)
+    if kind in ("cooldown", "warmup"):
+        function = cooldown if kind == "cooldown" else warmup
+        room = ROOM_TEMPERATURE_C
+        defaults = (room, -20.0) if kind == "cooldown" else (-20.0, room)
+        return [
+            function(
+                defaults[0] if start_c is None else start_c,
+                defaults[1] if end_c is None else end_c,
+                5.0 if hours is None else hours,
+                DEFAULT_RAMP_C_PER_MIN if ramp_c_per_min is None else ramp_c_per_min,
+            )
+        ]
+    if kind == "constant":
+        temp = ROOM_TEMPERATURE_C if temperature_c is None else temperature_c
+        return [constant(temp, 5.0 if hours is None else hours)]
+    if kind == "ramp":
+        if start_c is None or end_c is None:
+            raise InputError("a ramp needs start_c and end_c (--start, --end)")
+        rate = DEFAULT_RAMP_C_PER_MIN if ramp_c_per_min is None else ramp_c_per_min
+        return [ramp(start_c, end_c, rate, 0.0 if hours is None else hours)]
+    if hours is not None:
+        raise InputError(f"option hours does not apply to the profile file {kind}")
+    return [load(kind)]

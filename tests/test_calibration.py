@@ -1,0 +1,173 @@
+"""Tests of hrgtc.calibration and ``hrgtc calibrate`` on simulated campaigns of both units."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from hrgtc import recording
+from hrgtc.calibration import calibrate
+from hrgtc.cli import app
+from hrgtc.errors import CalibrationError, InputError
+from hrgtc.evaluation import evaluate
+from hrgtc.model import load_model
+from hrgtc.plateaus import find_plateaus
+from hrgtc.recording import Metadata, Recording
+from hrgtc.thermometry import fit
+
+from campaign import SETPOINTS_C, make_campaign
+from synthetic import ramp_run
+
+UNITS = ("paper-unit", "unit-b")
+
+
+@pytest.fixture(scope="module", params=UNITS)
+def campaign(request, tmp_path_factory):
+    return request.param, make_campaign(tmp_path_factory.mktemp(request.param), request.param)
+
+
+@pytest.fixture(scope="module")
+def calibrated(campaign):
+    unit, files = campaign
+    return unit, files, calibrate(files.soaks, [files.cooldown], [files.warmup])
+
+
+def test_thermometer_reads_held_out_soaks(campaign):
+    """Fit on four soaks, read the true resonator temperature of the other three."""
+    _, files = campaign
+    plateaus = {p.chamber_c: p for path in files.soaks for p in find_plateaus(recording.read(path))}
+    used = (-20.0, 0.0, 20.0, 40.0)
+    thermometer = fit(used, [plateaus[t].settled_freq_hz for t in used], order=3)
+    for setpoint in set(SETPOINTS_C) - set(used):
+        run = recording.read(files.soaks[SETPOINTS_C.index(setpoint)])
+        last = run.time_s > run.time_s[-1] - 1800.0  # the last 30 min
+        estimate = np.mean(thermometer.temperature(run.freq_hz[last]))
+        assert abs(estimate - np.mean(run["resonator_c"][last])) < 0.02
+
+
+def test_table_two_of_the_unit(calibrated):
+    _, _, result = calibrated
+    assert [row["chamber_c"] for row in result.table] == list(SETPOINTS_C)
+    assert max(abs(row["error_c"]) for row in result.table) < 0.02
+
+
+def test_cooldown_model_cuts_warmup_bias_stability_threefold(calibrated):
+    _, _, result = calibrated
+    (validation,) = result.validation
+    assert validation.raw_10s / validation.compensated_10s >= 3.0
+
+
+def test_housing_baseline_is_kept(calibrated):
+    _, _, result = calibrated
+    assert result.model.housing is not None
+    assert result.model.housing.selected[0] == "h"
+
+
+def test_validation_of_the_training_run_is_the_papers_shape(calibrated):
+    unit, files, result = calibrated
+    run = evaluate(files.cooldown, result.model)
+    if unit == "paper-unit":  # built to look like Section 4.2 of [1]: 3.0143 -> 0.5848 °/h
+        assert 2.5 < run.raw_10s < 3.5
+        assert run.compensated_10s < 0.8
+    assert run.residual_rms_dph is not None and run.residual_rms_dph < run.raw_10s
+
+
+def _cli(args):
+    return CliRunner().invoke(app, ["calibrate", *map(str, args)])
+
+
+def test_calibrate_command_json(tmp_path, campaign):
+    _, files = campaign
+    out = tmp_path / "unit.json"
+    soak_options = [item for path in files.soaks for item in ("--soak", path)]
+    result = _cli([*soak_options, "--drift", files.cooldown,
+                   "--validate", files.warmup, "-o", out, "--json"])
+    assert result.exit_code == 0, result.output
+    data = json.loads(result.stdout)
+    assert len(data["thermometer"]["coefficients_high_first"]) == 4
+    assert {"chamber_c", "freq_hz", "temperature_from_freq_c", "error_c"} == set(
+        data["thermometer"]["table"][0]
+    )
+    assert data["drift"]["selected_terms"] and data["drift"]["history"][0]["action"] == "added"
+    (validation,) = data["validation"]
+    assert validation["bias_stability_10s_dph"]["raw"] > validation["bias_stability_10s_dph"][
+        "compensated"
+    ]
+    model = load_model(out)
+    assert model.drift.selected == tuple(data["drift"]["selected_terms"])
+    assert [i["role"] for i in model.provenance["inputs"]].count("soak") == 7
+    again = _cli(["--soak", files.soaks[0], "--drift", files.cooldown, "-o", out])
+    assert again.exit_code == 2 and "exists; pass --force" in again.output
+
+
+def test_glob_after_soak_and_tables(tmp_path, campaign):
+    _, files = campaign
+    out = tmp_path / "unit.json"
+    result = _cli(["--soak", *files.soaks, "--drift", files.cooldown, "-o", out])
+    assert result.exit_code == 0, result.output
+    assert "Eq. (18) form" in result.stdout and "B = " in result.stdout
+
+
+# -- bad inputs: a clear error and nothing written --------------------------------------------
+def _soak_file(path, setpoint_c, freq_hz, hours=2.0, rate_hz=1.0):
+    n = int(hours * 3600 * rate_hz)
+    rng = np.random.default_rng(int(setpoint_c) + 100)
+    rec = Recording(
+        {"time_s": np.arange(n) / rate_hz, "freq_hz": freq_hz + rng.normal(0, 1e-3, n),
+         "rate_dph": 10 + rng.normal(0, 1, n), "chamber_c": np.full(n, setpoint_c)},
+        Metadata(sample_rate_hz=rate_hz, input_rate_dph=10.0),
+    )
+    recording.write(rec, path)
+    return path
+
+
+def _assert_refused(tmp_path, args, message):
+    out = tmp_path / "unit.json"
+    result = _cli([*args, "-o", out])
+    assert result.exit_code == 2, result.output
+    assert message in " ".join(result.output.split())
+    assert not out.exists()
+
+
+def test_two_soaks_cannot_make_a_cubic(tmp_path):
+    a = _soak_file(tmp_path / "a.parquet", 0.0, 4424.9)
+    b = _soak_file(tmp_path / "b.parquet", 20.0, 4432.07)
+    _assert_refused(tmp_path, ["--soak", a, "--soak", b, "--drift", a],
+                    "cannot determine an order-3 polynomial")
+
+
+def test_non_monotonic_frequency_is_refused(tmp_path):
+    soaks = [_soak_file(tmp_path / f"s{t:g}.parquet", t, 4425.0 + 0.001 * (t - 10.0) ** 2)
+             for t in (-20.0, -5.0, 10.0, 25.0, 40.0)]
+    _assert_refused(tmp_path, ["--soak", *soaks, "--drift", soaks[0]], "not monotonic")
+
+
+def test_soak_that_never_settles(tmp_path):
+    run = ramp_run(seed=5, hours=3.0, ramp_hours=3.0, rate_hz=1.0)
+    path = tmp_path / "ramp.parquet"
+    recording.write(run, path)
+    soaks = [_soak_file(tmp_path / f"s{t:g}.parquet", t, 4424.9 + 0.37 * t) for t in (0, 10, 20)]
+    with pytest.raises(CalibrationError):
+        calibrate([path, *soaks], [path])
+
+
+def test_drift_run_without_temperature_change(tmp_path):
+    soaks = [_soak_file(tmp_path / f"s{t:g}.parquet", t, 4424.9 + 0.37 * t + 1e-4 * t**2)
+             for t in (-20.0, 0.0, 20.0, 40.0, 10.0)]
+    _assert_refused(tmp_path, ["--soak", *soaks, "--drift", soaks[2]], "spans only")
+
+
+def test_frequency_in_khz_is_caught(tmp_path):
+    soaks = [_soak_file(tmp_path / f"s{t:g}.parquet", t, (4424.9 + 0.37 * t) / 1000.0)
+             for t in (-20.0, 0.0, 20.0, 40.0)]
+    _assert_refused(tmp_path, ["--soak", *soaks, "--drift", soaks[0]], "kHz")
+
+
+def test_library_refuses_empty_inputs():
+    with pytest.raises(InputError, match="no soak recordings"):
+        calibrate([], ["x.parquet"])
+    with pytest.raises(InputError, match="no drift recordings"):
+        calibrate(["x.parquet"], [])

@@ -1,0 +1,149 @@
+"""``hrgtc info``: in-process runs with Typer's CliRunner, checked through --json.
+
+Truth: the numbers the test put into the files (row count, duration n/fs,
+column ranges from numpy) and the corruptions it made.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from hrgtc.cli import app
+from hrgtc.recording import Metadata, Recording, write
+
+runner = CliRunner()
+RATE_HZ = 200.0
+
+
+def recording(n: int = 1000, seed: int = 0) -> Recording:
+    rng = np.random.default_rng(seed)
+    return Recording(
+        {
+            "time_s": np.arange(n) / RATE_HZ,
+            "freq_hz": 4425.0 + 0.3 * np.linspace(-1, 1, n) + 0.01 * rng.standard_normal(n),
+            "rate_dph": 12.0 + 2.0 * rng.standard_normal(n),
+            "chamber_c": np.linspace(20.0, -5.0, n),
+            "housing_c": np.linspace(20.0, -3.0, n),
+        },
+        Metadata(sample_rate_hz=RATE_HZ, unit="SN-3", input_rate_dph=9.67, profile="ramp"),
+    )
+
+
+def info_json(*args: str) -> tuple[int, dict, str]:
+    result = runner.invoke(app, ["info", *args, "--json"])
+    return result.exit_code, json.loads(result.stdout), result.stderr
+
+
+@pytest.mark.parametrize("suffix", [".parquet", ".csv", ".h5"])
+def test_info_reports_a_good_file(tmp_path, suffix):
+    rec = recording()
+    path = write(rec, tmp_path / f"run{suffix}")
+    code, data, _ = info_json(str(path))
+    assert code == 0
+    assert data["rows"] == 1000
+    assert data["duration_s"] == pytest.approx(1000 / RATE_HZ)
+    assert data["sample_rate_hz"] == RATE_HZ and data["sample_rate_inferred"] is False
+    assert data["measured_sample_rate_hz"] == pytest.approx(RATE_HZ, rel=1e-9)
+    units = {c["name"]: c["unit"] for c in data["columns"]}
+    assert units == {
+        "time_s": "s",
+        "freq_hz": "Hz",
+        "rate_dph": "deg/h",
+        "chamber_c": "degC",
+        "housing_c": "degC",
+    }
+    assert data["spans"]["chamber_c"] == [-5.0, 20.0]
+    assert data["spans"]["housing_c"] == [-3.0, 20.0]
+    assert data["spans"]["freq_hz"] == [rec.freq_hz.min(), rec.freq_hz.max()]
+    assert data["validation"]["ok"] is True and data["validation"]["n_gaps"] == 0
+    assert data["metadata"]["unit"] == "SN-3"
+    text = runner.invoke(app, ["info", str(path)])
+    assert text.exit_code == 0
+    assert "chamber_c" in text.stdout and "[degC]" in text.stdout and "ok" in text.stdout
+
+
+def test_bad_file_exits_2_with_message_and_json_problems(tmp_path):
+    rec = recording()
+    rate = rec.rate_dph.copy()
+    rate[321] = np.nan
+    path = write(rec.with_columns(rate_dph=rate), tmp_path / "bad.parquet")
+    result = runner.invoke(app, ["info", str(path)])
+    assert result.exit_code == 2
+    assert "column 'rate_dph', row 321: value nan is not finite" in " ".join(result.stderr.split())
+    code, data, _ = info_json(str(path))
+    assert code == 2
+    assert data["rows"] == 1000
+    assert data["validation"]["ok"] is False
+    problem = data["validation"]["problems"][0]
+    assert (problem["kind"], problem["column"], problem["row"]) == ("not_finite", "rate_dph", 321)
+
+
+def test_unreadable_file_is_reported_in_json(tmp_path):
+    path = write(recording(n=50), tmp_path / "run.csv")
+    lines = path.read_text(encoding="utf-8").splitlines()
+    lines[-5] = lines[-5][:8]
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    code, data, _ = info_json(str(path))
+    assert code == 2
+    assert data["validation"]["ok"] is False
+    assert data["validation"]["problems"][0]["kind"] == "unreadable"
+    assert "expected 5 fields" in data["validation"]["problems"][0]["message"]
+
+
+def test_column_and_unit_options_map_a_foreign_file(tmp_path):
+    n = 600
+    rng = np.random.default_rng(5)
+    rows = np.column_stack(
+        [np.arange(n) * 5.0, 4.425 + 1e-5 * rng.standard_normal(n), 0.003 + 5e-4 * rng.random(n)]
+    )
+    path = tmp_path / "logger.csv"
+    np.savetxt(path, rows, delimiter=",", header="t,f,w", comments="", fmt="%.17g")
+    result = runner.invoke(app, ["info", str(path)])
+    assert result.exit_code == 2 and "--col time_s=" in result.stderr.replace("\n", "")
+    options = ["--col", "time_s=t", "--col", "freq_hz=f,rate_dph=w"]
+    options += ["--time-unit", "ms", "--freq-unit", "kHz", "--rate-unit", "°/s"]
+    code, data, _ = info_json(str(path), *options)
+    assert code == 0, data["validation"]
+    assert data["duration_s"] == pytest.approx(n * 0.005)
+    assert data["sample_rate_inferred"] is True
+    assert data["sample_rate_hz"] == pytest.approx(200.0)
+    assert data["spans"]["freq_hz"] == pytest.approx(
+        [rows[:, 1].min() * 1000, rows[:, 1].max() * 1000]
+    )
+    code, data, _ = info_json(str(path), *options, "--rate-hz", "100", "--unit-name", "X1")
+    assert code == 2
+    assert data["metadata"]["unit"] == "X1"
+    assert [p["kind"] for p in data["validation"]["problems"]] == ["sample_rate"]
+
+
+def test_gap_option_and_bad_options(tmp_path):
+    rec = recording()
+    time = rec.time_s.copy()
+    time[700:] += 3.0
+    path = write(rec.with_columns(time_s=time), tmp_path / "gap.h5")
+    code, data, _ = info_json(str(path))
+    assert code == 2 and data["validation"]["problems"][0]["kind"] == "gap"
+    code, data, _ = info_json(str(path), "--gaps", "split")
+    assert code == 0 and data["validation"]["n_gaps"] == 1
+    assert data["validation"]["gaps"][0]["row"] == 700
+    bad_unit = runner.invoke(app, ["info", str(path), "--freq-unit", "MHz"])
+    assert bad_unit.exit_code == 2 and "unknown freq unit" in bad_unit.stderr
+    bad_col = runner.invoke(app, ["info", str(path), "--col", "freq"])
+    assert bad_col.exit_code == 2 and "NAME=THEIRS" in bad_col.stderr
+    missing = runner.invoke(app, ["info", str(tmp_path / "nope.parquet")])
+    assert missing.exit_code == 2 and "no such file" in missing.stderr
+
+
+def test_json_stays_valid_with_infinite_times(tmp_path):
+    rec = recording()
+    time = rec.time_s.copy()
+    time[10] = np.inf
+    path = write(rec.with_columns(time_s=time), tmp_path / "inf.parquet")
+    code, data, _ = info_json(str(path))
+    assert code == 2
+    kinds = {p["kind"] for p in data["validation"]["problems"]}
+    assert {"not_finite", "time_order"} <= kinds
