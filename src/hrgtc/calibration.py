@@ -14,6 +14,7 @@ memory stays bounded whatever their length; each soak file is read whole
 
 from __future__ import annotations
 
+import math
 import os
 import warnings
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
@@ -26,7 +27,7 @@ import numpy as np
 
 from hrgtc import drift as drift_model
 from hrgtc import recording as rec
-from hrgtc.errors import CalibrationError, ExtrapolationWarning, InputError
+from hrgtc.errors import CalibrationError, ExtrapolationWarning, HrgtcWarning, InputError
 from hrgtc.evaluation import Evaluation, evaluate_chunks
 from hrgtc.features import EQ21
 from hrgtc.model import UnitModel, provenance
@@ -36,6 +37,8 @@ from hrgtc.thermometry import fit as fit_thermometer
 PathLike = str | os.PathLike[str]
 Progress = Callable[[str, float, float], None]
 
+#: Columns plateau detection needs from a soak.
+SOAK_COLUMNS = ("time_s", "freq_hz", "chamber_c")
 #: Classical baseline: cubic in housing temperature.
 HOUSING_TERMS = ("h", "h^2", "h^3")
 
@@ -49,8 +52,13 @@ class ReadOptions:
     metadata: Mapping[str, Any] | None = None
     chunk_rows: int = 1_000_000
 
-    def read(self, path: PathLike) -> rec.Recording:
-        return rec.read(path, columns=self.columns, units=self.units, metadata=self.metadata)
+    def read(self, path: PathLike, keep: Sequence[str] | None = None) -> rec.Recording:
+        """The whole file; with ``keep``, streamed keeping only those columns (less memory)."""
+        if keep is None:
+            return rec.read(path, columns=self.columns, units=self.units, metadata=self.metadata)
+        parts = [rec.Recording({k: c[k] for k in keep if k in c}, c.metadata, c.source)
+                 for c in self.chunks(path)]
+        return rec.concatenate(parts)
 
     def chunks(self, path: PathLike, rows: int | None = None) -> Iterator[rec.Recording]:
         return rec.iter_chunks(path, rows=rows or self.chunk_rows, columns=self.columns,
@@ -174,8 +182,11 @@ def calibrate(
         raise InputError("no drift recordings given; pass --drift FILE (a cool-down or warm-up)")
 
     plateaus: list[Plateau] = []
+    soak_rates: list[float] = []
     for number, path in enumerate(soaks):
-        plateaus.extend(find_plateaus(options.read(path), **dict(plateau_options or {})))
+        soak = options.read(path, keep=SOAK_COLUMNS)
+        soak_rates.append(soak.metadata.sample_rate_hz)
+        plateaus.extend(find_plateaus(soak, **dict(plateau_options or {})))
         if progress is not None:
             progress("soaks", number + 1, len(soaks))
     temperatures, frequencies = plateau_table(plateaus)
@@ -191,7 +202,16 @@ def calibrate(
         for t, f, e in zip(temperatures, frequencies, from_freq, strict=True)
     )
 
-    training = [*drifts, *(soaks if drift_from_soaks else ())]
+    drift_rate = next(options.chunks(drifts[0], rows=100_000)).metadata.sample_rate_hz
+    extra = [p for p, r in zip(soaks, soak_rates, strict=True) if math.isclose(r, drift_rate)]
+    if drift_from_soaks and len(extra) < len(soaks):
+        warnings.warn(
+            f"{len(soaks) - len(extra)} soak file(s) are not at the drift runs' "
+            f"{drift_rate:g} Hz and are left out of the drift fit (the df/dt filter is "
+            "defined per sample); they still calibrate the thermometer",
+            HrgtcWarning, stacklevel=2,
+        )
+    training = [*drifts, *(extra if drift_from_soaks else ())]
     runs = [partial(options.chunks, path) for path in training]
     model = drift_model.fit(
         runs, thermometer, terms=terms, window_s=window_s, penter=penter, premove=premove,

@@ -37,6 +37,7 @@ from hrgtc.features import (
     Term,
     design_matrix,
     hierarchy,
+    linear_combination,
     parse_terms,
     variables_for,
 )
@@ -264,8 +265,8 @@ class DriftModel:
         if not self._terms:
             n = next(iter(values.values())).shape[0]
             return np.full(n, self.intercept_dph)
-        x = design_matrix(self._terms, values, self.settings.scales)
-        return self.intercept_dph + x @ np.asarray(self.scaled_coefficients)
+        return linear_combination(self._terms, self.scaled_coefficients, values,
+                                  self.settings.scales, self.intercept_dph)
 
     def predict_recording(self, recording: Recording) -> np.ndarray:
         """Bias of a whole recording, filter started at its first sample. [°/h]"""

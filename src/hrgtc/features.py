@@ -87,12 +87,20 @@ class Term:
             parts.append(unit if p == 1 else f"({unit})^{p}")
         return "·".join(parts)
 
-    def evaluate(self, values: Mapping[str, np.ndarray]) -> np.ndarray:
-        """The term's value from variable arrays."""
+    def evaluate(
+        self,
+        values: Mapping[str, np.ndarray],
+        powers: dict[tuple[str, int], np.ndarray] | None = None,
+    ) -> np.ndarray:
+        """The term's value from variable arrays.
+
+        ``powers`` is an optional cache of x**p shared between terms (products,
+        not ``**``: both faster and exact for small integer powers).
+        """
+        cache = {} if powers is None else powers
         out = None
         for v, p in self.powers:
-            x = values[v]
-            factor = x if p == 1 else x**p
+            factor = _power(values, v, p, cache)
             out = factor if out is None else out * factor
         assert out is not None
         return out
@@ -120,6 +128,16 @@ class Term:
 
     def __str__(self) -> str:
         return self.name
+
+
+def _power(values: Mapping[str, np.ndarray], variable: str, power: int,
+           cache: dict[tuple[str, int], np.ndarray]) -> np.ndarray:
+    if power == 1:
+        return values[variable]
+    key = (variable, power)
+    if key not in cache:
+        cache[key] = _power(values, variable, power - 1, cache) * values[variable]
+    return cache[key]
 
 
 def parse_term(text: str) -> Term:
@@ -356,6 +374,23 @@ def compute_variables(
     return FeatureStream(settings, variables).process(recording)
 
 
+def linear_combination(
+    terms: Sequence[Term],
+    coefficients: Sequence[float],
+    values: Mapping[str, np.ndarray],
+    scales: Mapping[str, float],
+    intercept: float = 0.0,
+) -> np.ndarray:
+    """intercept + sum_k c_k term_k(values / scales), without building the design matrix."""
+    scaled = {v: values[v] / scales[v] for v in variables_for(terms)}
+    n = next(iter(values.values())).shape[0]
+    out = np.full(n, intercept, dtype=np.float64)
+    cache: dict[tuple[str, int], np.ndarray] = {}
+    for term, c in zip(terms, coefficients, strict=True):
+        out += c * term.evaluate(scaled, cache)
+    return out
+
+
 def variables_for(terms: Sequence[Term]) -> tuple[str, ...]:
     """Variables the terms use, in grammar order."""
     used = {v for t in terms for v in t.variables}
@@ -376,6 +411,7 @@ def design_matrix(
     """
     if scales:
         values = {v: values[v] / scales[v] for v in variables_for(terms)}
-    columns = [np.asarray(t.evaluate(values), dtype=np.float64) for t in terms]
+    cache: dict[tuple[str, int], np.ndarray] = {}
+    columns = [np.asarray(t.evaluate(values, cache), dtype=np.float64) for t in terms]
     n = next(iter(values.values())).shape[0] if values else 0
     return np.column_stack(columns) if columns else np.empty((n, 0))

@@ -18,9 +18,11 @@ safeguarded Newton iteration on a bracket.
 
 from __future__ import annotations
 
+import math
 import warnings
 from dataclasses import dataclass
 from fractions import Fraction
+from functools import cached_property
 from math import comb
 from typing import Any
 
@@ -31,6 +33,20 @@ from hrgtc.errors import CalibrationError, ExtrapolationWarning, InputError
 
 _GRID_POINTS = 2049
 _NEWTON_MAX_ITER = 60
+_CHEBYSHEV_DEGREE = 9
+
+
+@dataclass(frozen=True)
+class _InverseTable:
+    t_bracket: tuple[float, float]
+    f_bracket: tuple[float, float]
+    f_calibrated: tuple[float, float]
+    grid_t: np.ndarray
+    grid_f: np.ndarray
+    start_coefficients: np.ndarray  # Chebyshev series of T in u = offset + scale * f
+    start_map: tuple[float, float]
+    tolerance: float
+    one_step_limit: float  # a Newton step smaller than this leaves an error below tolerance
 
 
 def _scaled_to_raw_matrix(order: int, centre: float, scale: float) -> list[list[Fraction]]:
@@ -46,6 +62,16 @@ def _scaled_to_raw_matrix(order: int, centre: float, scale: float) -> list[list[
         for j in range(k + 1):
             matrix[j][k] = comb(k, j) * (-m) ** (k - j) * inv
     return matrix
+
+
+def _clenshaw(coefficients: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """Evaluate sum_k c_k T_k(u) (Chebyshev polynomials) by Clenshaw's recurrence."""
+    b1 = np.zeros_like(u)
+    b2 = np.zeros_like(u)
+    two_u = 2.0 * u
+    for c in coefficients[:0:-1]:
+        b1, b2 = two_u * b1 - b2 + c, b1
+    return u * b1 - b2 + coefficients[0]
 
 
 def _horner(coefficients: np.ndarray, z: np.ndarray) -> np.ndarray:
@@ -110,9 +136,7 @@ class Thermometer:
     @property
     def frequency_range_hz(self) -> tuple[float, float]:
         """(min, max) of f(T) over the calibrated temperature range. [Hz]"""
-        grid = np.linspace(*self.temperature_range_c, _GRID_POINTS)
-        values = self.frequency(grid)
-        return float(values.min()), float(values.max())
+        return self._inverse.f_calibrated
 
     @property
     def is_monotonic(self) -> bool:
@@ -183,28 +207,89 @@ class Thermometer:
         if violation is not None:
             raise CalibrationError(violation)
         f = np.asarray(frequency_hz, dtype=np.float64)
+        inverse = self._inverse
         t_low, t_high = self.temperature_range_c
-        span = t_high - t_low
-        lo, hi = self._monotonic_extension(t_low, t_high, span)
+        f_low_cal, f_high_cal = inverse.f_calibrated
+        flat = f.ravel()
+        beyond = ~((flat >= inverse.f_bracket[0]) & (flat <= inverse.f_bracket[1]))
+        if warn:
+            n_out = int(np.count_nonzero(((flat < f_low_cal) | (flat > f_high_cal))
+                                         & np.isfinite(flat)))
+            if n_out:
+                warnings.warn(
+                    f"{n_out} of {flat.size} frequencies ({n_out / flat.size:.2%}) are outside "
+                    f"the calibrated range {f_low_cal:.4f}-{f_high_cal:.4f} Hz "
+                    f"({t_low:g} to {t_high:g} °C); their temperatures are extrapolated",
+                    ExtrapolationWarning,
+                    stacklevel=2,
+                )
+        # Start from a Chebyshev approximation of T(f) (~1e-6 °C), polish by Newton.
+        clipped = np.clip(flat, *inverse.f_bracket)
+        offset, scale = inverse.start_map
+        t = _clenshaw(inverse.start_coefficients, offset + scale * clipped)
+        np.clip(t, inverse.t_bracket[0], inverse.t_bracket[1], out=t)
+        step = np.full_like(t, np.inf)
+        limit = inverse.one_step_limit
+        for _ in range(4):
+            step = (self.frequency(t) - clipped) / self.slope_hz_per_c(t)
+            t -= step
+            # Newton's error after a step is at most max|f''|/(2 min|f'|) * step^2.
+            if not np.max(np.abs(step), initial=0.0) > limit:
+                break
+            limit = inverse.tolerance
+        lost = ~beyond & ~((np.abs(step) <= limit) & (t >= inverse.t_bracket[0])
+                           & (t <= inverse.t_bracket[1]))
+        if np.any(lost):
+            t[lost] = self._bracketed_newton(flat[lost], inverse)
+        t = np.where(beyond, np.nan, t)
+        return t.reshape(f.shape) if f.ndim else t.reshape(())[()]
+
+    @cached_property
+    def _inverse(self) -> _InverseTable:
+        """Bracket, dense table, Chebyshev start and tolerance of the inverse (cached)."""
+        t_low, t_high = self.temperature_range_c
+        lo, hi = self._monotonic_extension(t_low, t_high, t_high - t_low)
         grid_t = np.linspace(lo, hi, _GRID_POINTS)
         grid_f = self.frequency(grid_t)
-        increasing = grid_f[-1] > grid_f[0]
-        if not increasing:
+        if grid_f[-1] < grid_f[0]:
             grid_t, grid_f = grid_t[::-1], grid_f[::-1]
-        f_low_cal, f_high_cal = self.frequency_range_hz
-        flat = f.ravel()
-        outside = (flat < f_low_cal) | (flat > f_high_cal)
-        beyond = (flat < grid_f[0]) | (flat > grid_f[-1]) | ~np.isfinite(flat)
-        n_out = int(np.count_nonzero(outside & np.isfinite(flat)))
-        if warn and n_out:
-            warnings.warn(
-                f"{n_out} of {flat.size} frequencies ({n_out / flat.size:.2%}) are outside the "
-                f"calibrated range {f_low_cal:.4f}-{f_high_cal:.4f} Hz "
-                f"({t_low:g} to {t_high:g} °C); their temperatures are extrapolated",
-                ExtrapolationWarning,
-                stacklevel=2,
-            )
-        # Bracket of each sample from the dense table, then Newton inside it.
+        eps = np.finfo(np.float64).eps
+        slope_min = float(np.min(np.abs(np.diff(grid_f) / np.diff(grid_t))))
+        f_max = float(np.max(np.abs(grid_f)))
+        # Converged iterates still move by the rounding of f (|f| eps) over the slope.
+        tolerance = max(4 * eps * max(abs(lo), abs(hi), hi - lo), 16 * eps * f_max / slope_min)
+        # The start only needs to be good where the samples are: the calibrated range
+        # and a margin; beyond it Newton takes a few more steps.
+        margin = 0.1 * (t_high - t_low)
+        near = (grid_t >= t_low - margin) & (grid_t <= t_high + margin)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", np.exceptions.RankWarning)
+            chebyshev = np.polynomial.Chebyshev.fit(grid_f[near], grid_t[near],
+                                                    deg=_CHEBYSHEV_DEGREE)
+
+        calibrated = self.frequency(np.linspace(t_low, t_high, _GRID_POINTS))
+        a = np.asarray(self.scaled_coefficients)
+        second = a[2:] * np.arange(2, a.size) * np.arange(1, a.size - 1) if a.size > 2 else a[:0]
+        curvature = (float(np.max(np.abs(_horner(second, (grid_t - self.centre_c) / self.scale_c))))
+                     / self.scale_c**2 if second.size else 0.0)
+        one_step_limit = (math.sqrt(tolerance * 2.0 * slope_min / curvature)
+                          if curvature > 0 else math.inf)
+        return _InverseTable(
+            t_bracket=(float(lo), float(hi)),
+            f_bracket=(float(grid_f[0]), float(grid_f[-1])),
+            f_calibrated=(float(calibrated.min()), float(calibrated.max())),
+            grid_t=grid_t,
+            grid_f=grid_f,
+            start_coefficients=chebyshev.coef,
+            start_map=tuple(float(v) for v in chebyshev.mapparms()),
+            tolerance=tolerance,
+            one_step_limit=min(one_step_limit, 1e-3 * (hi - lo)),
+        )
+
+    def _bracketed_newton(self, flat: np.ndarray, inverse: _InverseTable) -> np.ndarray:
+        """Safeguarded Newton inside the dense-table bracket of each sample (slow path)."""
+        grid_t, grid_f = inverse.grid_t, inverse.grid_f
+        increasing = grid_t[-1] > grid_t[0]
         index = np.clip(np.searchsorted(grid_f, flat), 1, grid_f.size - 1)
         f0, f1 = grid_f[index - 1], grid_f[index]
         t0, t1 = grid_t[index - 1], grid_t[index]
@@ -213,13 +298,10 @@ class Thermometer:
         lower = np.minimum(t0, t1)
         upper = np.maximum(t0, t1)
         t = np.clip(np.nan_to_num(t, nan=0.5 * (t0[0] + t1[0])), lower, upper)
-        tolerance = 4 * np.finfo(np.float64).eps * max(abs(lo), abs(hi), span)
         for _ in range(_NEWTON_MAX_ITER):
             residual = self.frequency(t) - flat
-            slope = self.slope_hz_per_c(t)
-            step = residual / slope
-            candidate = t - step
-            # Keep the bracket: residual sign tells which side the root is on.
+            candidate = t - residual / self.slope_hz_per_c(t)
+            # Keep the bracket: the residual's sign tells which side the root is on.
             above = (residual > 0) == increasing
             upper = np.where(above, np.minimum(upper, t), upper)
             lower = np.where(above, lower, np.maximum(lower, t))
@@ -227,10 +309,9 @@ class Thermometer:
             candidate = np.where(bad, 0.5 * (lower + upper), candidate)
             change = np.abs(candidate - t)
             t = candidate
-            if not np.any(change[~beyond] > tolerance):
+            if not np.any(change > inverse.tolerance):
                 break
-        t = np.where(beyond, np.nan, t)
-        return t.reshape(f.shape) if f.ndim else t.reshape(())[()]
+        return t
 
     # -- monotonicity --------------------------------------------------------------
     def _critical_points(self) -> np.ndarray:

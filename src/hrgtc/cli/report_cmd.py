@@ -1,0 +1,62 @@
+"""``hrgtc report``: one self-contained HTML file with the unit's Figs. 3-6 and tables."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from hrgtc.cli._app import app, console, library_errors, print_json, progress_bar
+from hrgtc.cli.options import (
+    ColumnsOption,
+    ForceOption,
+    FreqUnitOption,
+    InputRateOption,
+    JsonOption,
+    RateHzOption,
+    RateUnitOption,
+    TimeUnitOption,
+    UnitNameOption,
+    recording_input,
+)
+from hrgtc.report import build_report
+
+
+@app.command("report")
+def report_command(
+    runs: list[Path] = typer.Argument(
+        ..., metavar="RUN...", help="Runs to compensate and show (Fig. 6), one section each."),
+    model: Path = typer.Option(..., "--model", help="Model file written by 'hrgtc calibrate'."),
+    output: Path = typer.Option(..., "-o", "--output", help="HTML file to write."),
+    soak: list[Path] = typer.Option(
+        None, "--soak", help="Soak recording for Figs. 3 and 5 (repeat); default: the soaks "
+        "named in the model file, where they still exist."),
+    title: str = typer.Option(None, "--title", help="Page title (default: names the unit)."),
+    max_points: int = typer.Option(
+        20_000, "--max-points", help="Most points per plotted curve (block means >= 10 s)."),
+    col: ColumnsOption = None,
+    time_unit: TimeUnitOption = None,
+    freq_unit: FreqUnitOption = None,
+    rate_unit: RateUnitOption = None,
+    rate_hz: RateHzOption = None,
+    unit_name: UnitNameOption = None,
+    input_rate_dph: InputRateOption = None,
+    force: ForceOption = False,
+    json_output: JsonOption = False,
+) -> None:
+    """Write the HTML report: settling of the soaks (Fig. 3), T-f fit (Fig. 4, Table 1),
+    temperature from frequency (Fig. 5, Table 2), raw and compensated output with bias
+    stability and Allan deviation (Fig. 6), and the stepwise drift model (Eq. 22).
+
+    Example: hrgtc report --model unit.json cooldown.parquet warmup.parquet -o report.html
+    """
+    inputs = recording_input(col, time_unit, freq_unit, rate_unit, rate_hz, unit_name,
+                             input_rate_dph)
+    with library_errors(), progress_bar("report", enabled=not json_output) as progress:
+        path = build_report(model, runs, output, soaks=soak or None, title=title, force=force,
+                            max_points=max_points, progress=progress, **inputs.read_kwargs())
+    size = path.stat().st_size
+    if json_output:
+        print_json({"report": str(path), "bytes": size, "runs": [str(r) for r in runs]})
+        return
+    console.print(f"Report written to {path} ({size / 1e6:.2f} MB)", soft_wrap=True)
