@@ -14,7 +14,7 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 demo: $(STAMP)
-	$(BIN)/hrgtc paper
+	$(BIN)/hrgtc demo -o demo-out --force
 
 test: $(STAMP)
 	$(BIN)/ruff check .

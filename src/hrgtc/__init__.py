@@ -9,7 +9,14 @@ and its rate by stepwise linear regression (Eq. 19-22).
     Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
 """
 
+from __future__ import annotations
+
+import os
 from importlib.metadata import PackageNotFoundError, version
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from hrgtc.model import UnitModel
 
 try:
     __version__ = version("hrgtc")
@@ -22,4 +29,11 @@ PAPER_REFERENCE = (
     "doi:10.3390/s120506434"
 )
 
-__all__ = ["PAPER_REFERENCE", "__version__"]
+__all__ = ["PAPER_REFERENCE", "__version__", "load_model"]
+
+
+def load_model(path: str | os.PathLike[str]) -> UnitModel:
+    """Read a model file: :func:`hrgtc.model.load_model` (imported lazily)."""
+    from hrgtc.model import load_model as _load_model
+
+    return _load_model(path)

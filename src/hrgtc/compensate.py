@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from hrgtc import recording as rec_io
 from hrgtc.drift import DriftModel
 from hrgtc.errors import InputError
 from hrgtc.features import FeatureStream
@@ -154,6 +155,7 @@ def compensate_file(
     force: bool = False,
     columns: Mapping[str, str] | None = None,
     units: Mapping[str, str] | None = None,
+    metadata: Mapping[str, Any] | None = None,
     chunk_rows: int = 1_000_000,
     drift: str = "frequency",
     progress: Progress | None = None,
@@ -161,15 +163,15 @@ def compensate_file(
     """Compensate a recording file into a new file, chunk by chunk (bounded memory).
 
     The output is written atomically in the format of its suffix; it is never
-    overwritten without ``force``.
+    overwritten without ``force``. ``columns``, ``units`` and ``metadata`` are the
+    reading options of :func:`hrgtc.recording.read`.
     """
-    from hrgtc import recording as rec_io
-
     compensator = Compensator(model, drift)
-    chunks = rec_io.iter_chunks(source, rows=chunk_rows, columns=columns, units=units)
+    chunks = rec_io.iter_chunks(source, rows=chunk_rows, columns=columns, units=units,
+                                metadata=metadata)
     first = next(chunks)
     names = (*first.names, *OUTPUT_COLUMNS)
-    total = rec_io.count_rows(source) if hasattr(rec_io, "count_rows") else 0
+    total = rec_io.count_rows(source)
     with rec_io.RecordingWriter(output, first.metadata, names, force=force) as writer:
         for chunk in itertools.chain([first], chunks):
             writer.write(compensator.process(chunk))

@@ -554,3 +554,12 @@ def coefficient_pvalues(thermometer: Thermometer) -> tuple[float, ...]:
         else:
             out.append(float(2 * stats.t.sf(abs(c / se), dof)))
     return tuple(out)
+
+
+def __getattr__(name: str) -> Any:
+    """``thermometry.find_plateaus`` and friends live in :mod:`hrgtc.plateaus` (lazy)."""
+    if name in ("find_plateaus", "plateau_table", "plateaus_from_recordings", "Plateau"):
+        from hrgtc import plateaus
+
+        return getattr(plateaus, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
