@@ -75,3 +75,14 @@ def test_provenance_hashes_inputs(tmp_path):
         "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"
     )
     assert record["settings"] == {"window_s": 10}
+
+
+def test_written_file_has_ordinary_permissions(tmp_path, unit_model):
+    import os
+
+    old = os.umask(0o022)
+    try:
+        path = save_model(unit_model, tmp_path / "unit.json")
+    finally:
+        os.umask(old)
+    assert path.stat().st_mode & 0o777 == 0o644

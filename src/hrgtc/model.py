@@ -21,6 +21,7 @@ from typing import Any
 
 from hrgtc.drift import DriftModel
 from hrgtc.errors import HrgtcError, ModelFileError, OutputExistsError
+from hrgtc.recording_io import current_umask
 from hrgtc.thermometry import Thermometer
 
 SCHEMA_NAME = "hrgtc.model"
@@ -146,6 +147,7 @@ def write_text_atomic(path: str | os.PathLike[str], text: str, force: bool = Fal
             stream.write(text)
             stream.flush()
             os.fsync(stream.fileno())
+        os.chmod(temporary, 0o666 & ~current_umask())  # mkstemp makes 0600 files
         os.replace(temporary, target)
     except BaseException:
         Path(temporary).unlink(missing_ok=True)

@@ -296,7 +296,8 @@ def iter_chunks(
 
 
 # -- writing -------------------------------------------------------------------
-def _umask() -> int:
+def current_umask() -> int:
+    """The process's file-creation mask (read by setting and restoring it)."""
     mask = os.umask(0)
     os.umask(mask)
     return mask
@@ -363,7 +364,7 @@ class RecordingWriter:
         self._tmp = tmp
         self._cleanup = weakref.finalize(self, _remove, tmp)
         try:
-            os.chmod(tmp, 0o666 & ~_umask())
+            os.chmod(tmp, 0o666 & ~current_umask())
             self._sink: Sink | None = SINKS[fmt](Path(tmp), metadata, self.columns)
         except BaseException:
             self._cleanup()
