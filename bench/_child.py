@@ -9,12 +9,28 @@ from collections.abc import Callable
 from typing import Any
 
 
+def peak_rss_mb() -> float:
+    """This process's peak resident set size. [MB]
+
+    ``VmHWM`` of /proc/self/status belongs to the current address space, so it
+    starts afresh in a spawned child; ``ru_maxrss`` survives fork + exec on
+    Linux and would report the parent's peak.
+    """
+    try:
+        with open("/proc/self/status", encoding="ascii") as status:
+            for line in status:
+                if line.startswith("VmHWM:"):
+                    return round(int(line.split()[1]) / 1024.0, 1)
+    except OSError:
+        pass
+    return round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, 1)
+
+
 def _target(queue: Any, function: Callable[..., Any], args: tuple[Any, ...]) -> None:
     start = time.perf_counter()
     value = function(*args)
     seconds = time.perf_counter() - start
-    peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
-    queue.put((value, seconds, round(peak_mb, 1)))
+    queue.put((value, seconds, peak_rss_mb()))
 
 
 def measure(function: Callable[..., Any], *args: Any) -> tuple[Any, float, float]:

@@ -44,6 +44,7 @@ def _run_child(name: str, quick: bool) -> int:
     spec = importlib.util.spec_from_file_location(f"bench_{name}", path)
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # so functions it hands to child processes pickle
     spec.loader.exec_module(module)
     for result in module.run(quick=quick):
         result.setdefault("peak_rss_mb", peak_rss_mb())

@@ -50,7 +50,7 @@ class ReadOptions:
     columns: Mapping[str, str] | None = None
     units: Mapping[str, str] | None = None
     metadata: Mapping[str, Any] | None = None
-    chunk_rows: int = 1_000_000
+    chunk_rows: int = 250_000
 
     def read(self, path: PathLike, keep: Sequence[str] | None = None) -> rec.Recording:
         """The whole file; with ``keep``, streamed keeping only those columns (less memory)."""

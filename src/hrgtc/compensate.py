@@ -13,6 +13,7 @@ from __future__ import annotations
 import itertools
 import os
 from collections.abc import Callable, Mapping
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Any
 
@@ -27,6 +28,8 @@ from hrgtc.recording import Recording
 
 Progress = Callable[[float, float], None]
 
+#: Rows worked on at once: small enough for the temporaries to stay in cache.
+BLOCK_ROWS = 1 << 17
 #: Columns added by compensation.
 OUTPUT_COLUMNS = ("rate_comp_dph", "bias_model_dph", "resonator_c_est", "in_range")
 
@@ -84,15 +87,25 @@ class Compensator:
         self.rate_out_of_range = 0
 
     def process(self, chunk: Recording) -> Recording:
-        """The chunk with ``rate_comp_dph``, ``bias_model_dph``, ``resonator_c_est`` and
-        ``in_range`` added: 1.0 where the frequency is inside the thermometer's calibrated
+        """The next chunk of the run with the :data:`OUTPUT_COLUMNS` added.
+
+        ``in_range`` is 1.0 where the frequency is inside the thermometer's calibrated
         range and the drift model's training range of f (and of h), else 0.0. Rates of
         change outside their training range are counted separately
         (:attr:`rate_out_of_range_fraction`): a model trained on a cool-down only has
-        seen negative df/dt.
+        seen negative df/dt. Large chunks are worked through in blocks of
+        :data:`BLOCK_ROWS` rows, which keeps the temporaries in cache.
         """
         if self.samples == 0:
             self.drift.settings.check_sample_rate(chunk)
+        n = len(chunk)
+        out = {name: np.empty(n) for name in OUTPUT_COLUMNS}
+        for start in range(0, n, BLOCK_ROWS):
+            self._block(chunk.slice(start, start + BLOCK_ROWS), out, start)
+        return chunk.with_columns(**out)
+
+    def _block(self, chunk: Recording, out: dict[str, np.ndarray], start: int) -> None:
+        stop = start + len(chunk)
         values = self._stream.process(chunk)
         bias = self.drift.predict(values)
         thermometer = self.model.thermometer
@@ -100,16 +113,13 @@ class Compensator:
             self.drift, values, ("f", "h")
         )
         rate_in_range = _in_training_range(self.drift, values, ("df", "dh"))
-        temperature = thermometer.temperature(chunk.freq_hz, warn=False)
+        np.subtract(chunk.rate_dph, bias, out=out["rate_comp_dph"][start:stop])
+        out["bias_model_dph"][start:stop] = bias
+        out["resonator_c_est"][start:stop] = thermometer.temperature(chunk.freq_hz, warn=False)
+        out["in_range"][start:stop] = in_range
         self.samples += len(chunk)
         self.out_of_range += int(np.count_nonzero(~in_range))
         self.rate_out_of_range += int(np.count_nonzero(~rate_in_range))
-        return chunk.with_columns(
-            rate_comp_dph=chunk.rate_dph - bias,
-            bias_model_dph=bias,
-            resonator_c_est=temperature,
-            in_range=in_range.astype(np.float64),
-        )
 
     @property
     def out_of_range_fraction(self) -> float:
@@ -172,11 +182,20 @@ def compensate_file(
     first = next(chunks)
     names = (*first.names, *OUTPUT_COLUMNS)
     total = rec_io.count_rows(source)
-    with rec_io.RecordingWriter(output, first.metadata, names, force=force) as writer:
+    # Writing overlaps with reading and computing the next chunk (pyarrow and h5py
+    # release the GIL); at most one chunk waits to be written.
+    with rec_io.RecordingWriter(output, first.metadata, names, force=force) as writer, \
+            ThreadPoolExecutor(max_workers=1) as pool:
+        pending = None
         for chunk in itertools.chain([first], chunks):
-            writer.write(compensator.process(chunk))
+            result = compensator.process(chunk)
+            if pending is not None:
+                pending.result()
+            pending = pool.submit(writer.write, result)
             if progress is not None:
                 progress(compensator.samples, total)
+        if pending is not None:
+            pending.result()
     return CompensationSummary(str(source), str(output), compensator.samples,
                                compensator.out_of_range_fraction,
                                compensator.rate_out_of_range_fraction)
