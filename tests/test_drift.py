@@ -63,7 +63,8 @@ def test_scaling_does_not_change_the_model_only_its_conditioning(cooldown, model
     by_hand = model.intercept_dph + sum(
         model.coefficients[t.name] * t.evaluate(values) for t in model._terms
     )
-    np.testing.assert_allclose(model.predict(values), by_hand, rtol=1e-12)
+    np.testing.assert_allclose(model.predict(values, extrapolation="polynomial"), by_hand,
+                               rtol=1e-12)
 
 
 def test_json_round_trip(model, cooldown):
@@ -97,3 +98,25 @@ def test_bad_arguments():
         drift.fit([], THERMOMETER)
     with pytest.raises(InputError, match="unknown variable"):
         drift.fit([ramp_run(seed=3, hours=1.0)], THERMOMETER, terms=["q"])
+
+
+def test_tangent_extension_beyond_the_training_range(model):
+    low, high = model.ranges["df"]
+    f = np.full(5, -3.0)
+    inside = {"f": f, "df": np.linspace(low, high, 5)}
+    np.testing.assert_array_equal(model.predict(inside),
+                                  model.predict(inside, extrapolation="polynomial"))
+    # beyond the range: the tangent at the edge, checked by a central difference
+    step = 1e-6 * (high - low)
+    edge = {"f": f[:1], "df": np.array([high])}
+    left = {"f": f[:1], "df": np.array([high - step])}
+    right = {"f": f[:1], "df": np.array([high + step])}
+    slope = (model.predict(right, extrapolation="polynomial")
+             - model.predict(left, extrapolation="polynomial")) / (2 * step)
+    far = {"f": f[:1], "df": np.array([high + 0.5 * (high - low)])}
+    expected = model.predict(edge) + slope * 0.5 * (high - low)
+    np.testing.assert_allclose(model.predict(far), expected, rtol=1e-6)
+    clamped = model.predict(far, extrapolation="clamp")
+    np.testing.assert_array_equal(clamped, model.predict(edge))
+    with pytest.raises(InputError, match="extrapolation must be"):
+        model.predict(far, extrapolation="cubic")

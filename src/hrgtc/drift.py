@@ -39,6 +39,7 @@ from hrgtc.features import (
     hierarchy,
     linear_combination,
     parse_terms,
+    tangent_extension,
     variables_for,
 )
 from hrgtc.recording import Recording
@@ -260,13 +261,32 @@ class DriftModel:
         """Variables the selected terms need (at least f and df for compensation)."""
         return variables_for(self._terms) if self._terms else ("f",)
 
-    def predict(self, values: Mapping[str, np.ndarray]) -> np.ndarray:
-        """Bias from variable arrays (f [Hz], df [Hz/s], ...), Eq. (22) of [1]. [°/h]"""
+    def predict(self, values: Mapping[str, np.ndarray],
+                extrapolation: str = "tangent") -> np.ndarray:
+        """Bias from variable arrays (f [Hz], df [Hz/s], ...), Eq. (22) of [1]. [°/h]
+
+        Inside the training ranges this is the fitted polynomial. Beyond them,
+        ``extrapolation="tangent"`` (default) continues it along its tangent at the
+        edge of the range: a law linear in df/dt stays exact, while the cubic terms of
+        a model fitted on a cool-down do not run away on a faster warm-up.
+        ``"polynomial"`` evaluates the polynomial anyway; ``"clamp"`` holds each
+        variable at the edge (as PX4's thermal calibration holds temperature).
+        Samples beyond the ranges are counted by the compensator.
+        """
         if not self._terms:
             n = next(iter(values.values())).shape[0]
             return np.full(n, self.intercept_dph)
-        return linear_combination(self._terms, self.scaled_coefficients, values,
-                                  self.settings.scales, self.intercept_dph)
+        args = (self._terms, self.scaled_coefficients)
+        if extrapolation == "tangent":
+            return tangent_extension(*args, values, self.settings.scales, self.ranges,
+                                     self.intercept_dph)
+        if extrapolation == "clamp":
+            values = {v: (np.clip(x, *self.ranges[v]) if v in self.ranges else x)
+                      for v, x in values.items()}
+        elif extrapolation != "polynomial":
+            raise InputError(f"extrapolation must be 'tangent', 'polynomial' or 'clamp', "
+                             f"got {extrapolation!r}")
+        return linear_combination(*args, values, self.settings.scales, self.intercept_dph)
 
     def predict_recording(self, recording: Recording) -> np.ndarray:
         """Bias of a whole recording, filter started at its first sample. [°/h]"""

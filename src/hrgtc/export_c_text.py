@@ -131,7 +131,9 @@ def readme(model: UnitModel, plan: dict[str, Any], prefix: str, origin: str,
                      "same filter   [degC, degC/s]")
     lines += [
         "  The code evaluates B on the scaled variables v/scale_v with the exact (%.17g)",
-        "  coefficients of the model file; algebraically the same polynomial.",
+        "  coefficients of the model file; algebraically the same polynomial. Beyond a",
+        "  variable's training range B continues along its tangent at the range's edge",
+        "  (a law linear in df/dt stays exact; cubic terms do not run away).",
         "  rate_comp_dph = rate_dph - B",
         f"  Thermometer (Eq. (18) form): freq = {th}   [Hz, T in degC]",
         "  resonator_c_est = the T with freq(T) = freq_hz (Newton iteration on a bracket);",
@@ -273,13 +275,32 @@ def _bias_function(model: UnitModel, plan: dict[str, Any], prefix: str) -> str:
         if v not in used:
             body.append(f"    (void){names[v]};")
     for v in used:
-        body.append(f"    const double x_{v} = {names[v]} / SCALE_{v.upper()};")
+        # held at the edge of the training range; the tangent there continues the model
+        # beyond it, as DriftModel.predict(extrapolation="tangent")
+        u = v.upper()
+        body.append(f"    const double c_{v} = {names[v]} < CLAMP_{u}_LOW ? CLAMP_{u}_LOW : "
+                    f"({names[v]} > CLAMP_{u}_HIGH ? CLAMP_{u}_HIGH : {names[v]});")
+        body.append(f"    const double x_{v} = c_{v} / SCALE_{u};")
     body.append("    double sum = 0.0;")
     body.append("    double term;")
     for k, term in enumerate(drift._terms):
         body.append(f"    term = {_term_expression(term)};  /* {term.name} */")
         body.append(f"    term = COEFFICIENTS[{k}] * term;")
         body.append("    sum = sum + term;")
+    for v in used:
+        u = v.upper()
+        body.append(f"    if ({names[v]} < CLAMP_{u}_LOW || {names[v]} > CLAMP_{u}_HIGH) {{"
+                    f"  /* beyond the training range of {v} */")
+        body.append("        double gradient = 0.0;")
+        for k, term in enumerate(drift._terms):
+            multiplier, rest = term.derivative(v)
+            if not multiplier:
+                continue
+            factor = f"COEFFICIENTS[{k}] * {multiplier}.0 / SCALE_{u}"
+            expression = factor if rest is None else f"{factor} * {_term_expression(rest)}"
+            body.append(f"        gradient = gradient + {expression};  /* d({term.name})/d{v} */")
+        body.append(f"        sum = sum + gradient * ({names[v]} - c_{v});")
+        body.append("    }")
     body.append("    return INTERCEPT_DPH + sum;")
     if not drift._terms:
         body = [line for line in body if "term" not in line]
@@ -289,6 +310,11 @@ def _bias_function(model: UnitModel, plan: dict[str, Any], prefix: str) -> str:
     for v in used:
         constants.append(f"static const double SCALE_{v.upper()} = "
                          f"{_literal(drift.settings.scales[v], f'scales[{v}]')};")
+        low, high = drift.ranges[v]
+        constants.append(f"static const double CLAMP_{v.upper()}_LOW = "
+                         f"{_literal(low, f'ranges[{v}][0]')};")
+        constants.append(f"static const double CLAMP_{v.upper()}_HIGH = "
+                         f"{_literal(high, f'ranges[{v}][1]')};")
     if drift._terms:
         listed = ", ".join(drift.selected)
         constants.append(f"/* Coefficients on scaled variables, in this order: {listed} */")

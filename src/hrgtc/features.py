@@ -118,6 +118,18 @@ class Term:
                 out.append(Term(tuple(powers)))
         return tuple(out)
 
+    def derivative(self, variable: str) -> tuple[int, Term | None]:
+        """d(term)/d(variable) as ``(multiplier, term)``; term None means the constant 1.
+
+        Returns ``(0, None)`` when the term does not contain the variable.
+        """
+        power = self.power_of(variable)
+        if power == 0:
+            return 0, None
+        rest = tuple((v, p - 1 if v == variable else p) for v, p in self.powers)
+        rest = tuple((v, p) for v, p in rest if p > 0)
+        return power, (Term(rest) if rest else None)
+
     def power_of(self, variable: str) -> int:
         """Power of ``variable`` in the term (0 when absent)."""
         return dict(self.powers).get(variable, 0)
@@ -388,6 +400,40 @@ def linear_combination(
     cache: dict[tuple[str, int], np.ndarray] = {}
     for term, c in zip(terms, coefficients, strict=True):
         out += c * term.evaluate(scaled, cache)
+    return out
+
+
+def tangent_extension(
+    terms: Sequence[Term],
+    coefficients: Sequence[float],
+    values: Mapping[str, np.ndarray],
+    scales: Mapping[str, float],
+    ranges: Mapping[str, tuple[float, float]],
+    intercept: float = 0.0,
+) -> np.ndarray:
+    """The model inside the ranges, continued along its tangent plane outside them.
+
+    Each variable is held at the edge of its range, the model evaluated there,
+    and its first-order Taylor term added: B(c) + sum_v dB/dv(c) (v - c). Inside the
+    ranges this is exactly :func:`linear_combination`; outside, a law linear in a
+    variable is still exact while cubic terms no longer run away.
+    """
+    used = variables_for(terms)
+    held = {v: (np.clip(values[v], *ranges[v]) if v in ranges else values[v]) for v in used}
+    out = linear_combination(terms, coefficients, held, scales, intercept)
+    outside = {v: values[v] - held[v] for v in used if v in ranges}
+    if not any(np.any(d != 0.0) for d in outside.values()):
+        return out
+    scaled = {v: held[v] / scales[v] for v in used}
+    cache: dict[tuple[str, int], np.ndarray] = {}
+    for v, delta in outside.items():
+        gradient = np.zeros_like(delta)
+        for term, c in zip(terms, coefficients, strict=True):
+            multiplier, rest = term.derivative(v)
+            if multiplier:
+                factor = c * multiplier / scales[v]
+                gradient += factor if rest is None else factor * rest.evaluate(scaled, cache)
+        out += gradient * delta
     return out
 
 
