@@ -1,0 +1,443 @@
+"""Allan deviation of gyro rate data and the noise terms read off it.
+
+- :func:`allan_deviation`: overlapping or normal Allan deviation of rate
+  (frequency-type) data, numerically equal to ``allantools.oadev`` /
+  ``allantools.adev`` with ``data_type="freq"`` [3], in O(N) per τ.
+- :func:`noise_terms`: angle random walk, bias instability and rate random walk
+  read off the Allan deviation with the conventions of IEEE Std 952-1997,
+  Annex C [2].
+
+References
+----------
+[1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
+[2] IEEE Std 952-1997, "IEEE Standard Specification Format Guide and Test
+    Procedure for Single-Axis Interferometric Fiber Optic Gyros", Annex C
+    (Allan variance method of fiber optic gyro data reduction).
+[3] W. J. Riley, "Handbook of Frequency Stability Analysis", NIST Special
+    Publication 1065, 2008, Eq. (6)-(11); allantools, https://github.com/aewallin/allantools
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import asdict, dataclass, fields
+from typing import Any
+
+import numpy as np
+
+from hrgtc.errors import InputError
+
+#: σ_min = 0.664·B at the flat minimum of a flicker (bias instability) floor;
+#: 0.664 ≈ sqrt(2·ln 2 / π), IEEE Std 952-1997 Annex C [2].
+FLICKER_FLOOR_FACTOR = 0.664
+#: Seconds per hour: τ = 1 h is where ARW is read, τ = 3 h where RRW is read.
+SECONDS_PER_HOUR = 3600.0
+#: Default averaging times of the bias-stability table (DESIGN.md, "Metrics"). [s]
+DEFAULT_TAUS_S = (1.0, 10.0, 100.0)
+#: Named τ spacings accepted by :func:`allan_deviation` (those of allantools).
+TAU_SPACINGS = ("octave", "decade", "all")
+
+_CHUNK = 8192  # samples per block of the second-difference loop (stays in L2 cache)
+
+
+# --------------------------------------------------------------------------- input checks
+def _as_rate(values: Any, name: str, minimum: int = 2) -> np.ndarray:
+    """``values`` as a finite 1-D float64 array of at least ``minimum`` samples."""
+    array = np.asarray(values, dtype=np.float64)
+    if array.ndim != 1:
+        raise InputError(
+            f"{name} must be 1-D (one value per sample), got shape {array.shape}; "
+            "pass a single column"
+        )
+    if array.size < minimum:
+        raise InputError(f"{name} has {array.size} samples; at least {minimum} are needed")
+    finite = np.isfinite(array)
+    if not finite.all():
+        bad = np.flatnonzero(~finite)
+        raise InputError(
+            f"{name} has {bad.size} non-finite values (first at index {bad[0]}: "
+            f"{array[bad[0]]}); remove or interpolate them first"
+        )
+    return array
+
+
+def _check_sample_rate(sample_rate_hz: float) -> float:
+    rate = float(sample_rate_hz)
+    if not (math.isfinite(rate) and rate > 0.0):
+        raise InputError(f"sample_rate_hz must be a positive number, got {sample_rate_hz!r}")
+    return rate
+
+
+def _block_length(tau_s: float, sample_rate_hz: float) -> int:
+    """Samples per τ-block: τ·fs rounded to an integer (as allantools rounds τ)."""
+    tau = float(tau_s)
+    if not (math.isfinite(tau) and tau > 0.0):
+        raise InputError(f"tau_s must be a positive number of seconds, got {tau_s!r}")
+    m = round(tau * sample_rate_hz)
+    if m < 1:
+        raise InputError(
+            f"tau_s={tau:g} s is shorter than one sample at {sample_rate_hz:g} Hz; "
+            f"use tau_s >= {1.0 / sample_rate_hz:g} s"
+        )
+    return m
+
+
+# --------------------------------------------------------------------------- Allan deviation
+@dataclass(frozen=True, eq=False)
+class AllanResult:
+    """Allan deviation of a rate record.
+
+    Attributes
+    ----------
+    taus_s
+        Averaging times, integer multiples of the sample period. [s]
+    deviation
+        Allan deviation at each τ, in the unit of the rate (°/h for ``rate_dph``).
+    counts
+        Number of second-difference terms averaged at each τ (allantools' ``ns``).
+    overlapping
+        True for the overlapping estimator (SP 1065 Eq. 11), False for the
+        normal, non-overlapping one (Eq. 6-7).
+    sample_rate_hz
+        Sample rate of the data. [Hz]
+    n_samples
+        Number of rate samples.
+    """
+
+    taus_s: np.ndarray
+    deviation: np.ndarray
+    counts: np.ndarray
+    overlapping: bool
+    sample_rate_hz: float
+    n_samples: int
+
+    def __post_init__(self) -> None:
+        for name, dtype in (("taus_s", np.float64), ("deviation", np.float64), ("counts", int)):
+            array = np.array(getattr(self, name), dtype=dtype)
+            array.setflags(write=False)
+            object.__setattr__(self, name, array)
+
+    @property
+    def blocks(self) -> np.ndarray:
+        """Number of whole, non-overlapping τ-blocks in the record at each τ."""
+        m = np.rint(self.taus_s * self.sample_rate_hz).astype(np.int64)
+        return self.n_samples // np.maximum(m, 1)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types (arrays as lists)."""
+        return {k: v.tolist() if isinstance(v, np.ndarray) else v for k, v in asdict(self).items()}
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> AllanResult:
+        """Inverse of :meth:`to_dict`."""
+        return cls(**{f.name: data[f.name] for f in fields(cls)})
+
+    def summary(self) -> str:
+        """A text table of τ, deviation and the number of terms."""
+        kind = "overlapping" if self.overlapping else "normal (non-overlapping)"
+        lines = [
+            f"Allan deviation, {kind}; {self.n_samples} samples at {self.sample_rate_hz:g} Hz",
+            f"{'tau [s]':>12}  {'deviation':>12}  {'terms':>10}",
+        ]
+        lines += [
+            f"{t:12.6g}  {d:12.6g}  {c:10d}"
+            for t, d, c in zip(self.taus_s, self.deviation, self.counts, strict=True)
+        ]
+        return "\n".join(lines)
+
+
+def _averaging_factors(taus: str | Sequence[float] | np.ndarray, n: int, fs: float) -> np.ndarray:
+    """Integer averaging factors m (τ = m / fs) the way ``allantools.tau_generator`` makes them.
+
+    ``n`` is the number of phase points (rate samples + 1).
+    """
+    if isinstance(taus, str):
+        if taus == "octave":
+            factors = 2.0 ** np.arange(math.floor(math.log2(n)) + 1)
+        elif taus == "decade":
+            decades = 10.0 ** np.arange(math.floor(math.log10(n)) + 1)
+            factors = np.outer(decades, [1.0, 2.0, 4.0]).ravel()
+        elif taus == "all":
+            factors = np.arange(1.0, n + 1.0)
+        else:
+            raise InputError(
+                f"taus={taus!r} is not a known spacing; use one of {TAU_SPACINGS} "
+                "or an array of averaging times in seconds"
+            )
+    else:
+        taus_s = np.asarray(taus, dtype=np.float64).ravel()
+        if taus_s.size == 0 or not np.all(np.isfinite(taus_s)):
+            raise InputError(f"taus must be finite averaging times in seconds, got {taus!r}")
+        factors = np.round(taus_s * fs)
+    factors = factors[(factors > 0) & (factors < n)]
+    return np.unique(factors).astype(np.int64)
+
+
+def _sum_squared_second_differences(phase: np.ndarray, m: int, buffer: np.ndarray) -> float:
+    """Σ (x[i+2m] − 2x[i+m] + x[i])² over all i, block-wise so temporaries stay in cache."""
+    count = phase.size - 2 * m
+    total = 0.0
+    for start in range(0, count, buffer.size):
+        stop = min(start + buffer.size, count)
+        work = buffer[: stop - start]
+        np.subtract(phase[start + 2 * m : stop + 2 * m], phase[start + m : stop + m], out=work)
+        work -= phase[start + m : stop + m]
+        work += phase[start:stop]
+        total += float(np.einsum("i,i->", work, work))  # no BLAS: no thread start-up
+    return total
+
+
+def allan_deviation(
+    rate: Any,
+    sample_rate_hz: float,
+    taus: str | Sequence[float] | np.ndarray = "octave",
+    overlapping: bool = True,
+    *,
+    progress: Callable[[float, float], None] | None = None,
+) -> AllanResult:
+    """Allan deviation of rate (frequency-type) data, NIST SP 1065 Eq. (6)-(11) [3].
+
+    The rate, mean removed, is summed into an angle ("phase") series
+    ``x[0] = 0, x[k] = Σ_{i<k} (rate[i] − mean)`` in float64 (this is
+    ``allantools.frequency2phase``); then for each averaging factor m
+
+        σ²(m·τ0) = Σ_i (x[i+2m] − 2x[i+m] + x[i])² / (2·n·m²),
+
+    with i running over every sample (``overlapping=True``, Eq. 11, n = N+1−2m
+    terms) or every m-th (``overlapping=False``, Eq. 6-7, n = floor(N/m)−1
+    terms). Each τ costs one vectorised pass, so 25 M samples take seconds; the
+    values equal ``allantools.oadev`` / ``allantools.adev`` with
+    ``data_type="freq"`` to ~1e-12 relative. As in allantools, τ with fewer than
+    two terms are dropped.
+
+    Parameters
+    ----------
+    rate
+        Rate samples, e.g. gyro output. [°/h] (any unit; the deviation has the same)
+    sample_rate_hz
+        Sample rate. [Hz]
+    taus
+        ``"octave"`` (m = 1, 2, 4, ...), ``"decade"`` (m = 1, 2, 4, 10, 20, 40, ...),
+        ``"all"`` (every m; O(N²), for short records only) or an array of
+        averaging times, rounded to integer multiples of the sample period and
+        de-duplicated as allantools does. [s]
+    overlapping
+        Overlapping (default) or normal Allan deviation.
+    progress
+        Optional callback ``progress(done, total)`` called after each τ.
+
+    Returns
+    -------
+    AllanResult
+        Averaging times, deviations and term counts.
+
+    Raises
+    ------
+    InputError
+        Non-finite or non-1-D input, fewer than 3 samples, an unknown spacing,
+        or no τ in ``taus`` that the record can resolve.
+
+    Examples
+    --------
+    >>> result = allan_deviation([1.0, 2.0, 1.0, 2.0, 1.0, 2.0, 1.0], sample_rate_hz=1.0)
+    >>> [round(float(d), 6) for d in result.deviation]  # 1/sqrt(2) at 1 s, 0 at 2 s
+    [0.707107, 0.0]
+    """
+    fs = _check_sample_rate(sample_rate_hz)
+    values = _as_rate(rate, "rate", minimum=3)
+    n = values.size
+    phase = np.empty(n + 1, dtype=np.float64)
+    phase[0] = 0.0
+    np.subtract(values, values.mean(), out=phase[1:])
+    np.cumsum(phase[1:], out=phase[1:])
+
+    factors = _averaging_factors(taus, n + 1, fs)
+    buffer = np.empty(_CHUNK, dtype=np.float64)
+    kept_m: list[int] = []
+    deviations: list[float] = []
+    counts: list[int] = []
+    for done, m in enumerate(factors.tolist(), start=1):
+        if overlapping:
+            count = n + 1 - 2 * m
+            total = _sum_squared_second_differences(phase, m, buffer) if count > 1 else 0.0
+        else:
+            sub = np.ascontiguousarray(phase[::m])
+            count = sub.size - 2
+            total = _sum_squared_second_differences(sub, 1, buffer) if count > 1 else 0.0
+        if count > 1:
+            kept_m.append(m)
+            counts.append(count)
+            deviations.append(math.sqrt(total / (2.0 * count)) / m)
+        if progress is not None:
+            progress(float(done), float(factors.size))
+    if not kept_m:
+        raise InputError(
+            f"no averaging time in taus={taus!r} fits a record of {n} samples at {fs:g} Hz "
+            f"with at least 2 terms; use taus between {1.0 / fs:g} s and {(n - 1) / (2 * fs):g} s"
+        )
+    return AllanResult(
+        taus_s=np.asarray(kept_m, dtype=np.float64) / fs,
+        deviation=np.asarray(deviations),
+        counts=np.asarray(counts),
+        overlapping=overlapping,
+        sample_rate_hz=fs,
+        n_samples=n,
+    )
+
+
+# --------------------------------------------------------------------------- noise terms
+@dataclass(frozen=True)
+class NoiseTerms:
+    """Allan noise terms of a gyro, IEEE Std 952-1997 Annex C conventions [2].
+
+    Attributes
+    ----------
+    arw_deg_per_rt_h
+        Angle random walk N: the −½-slope line σ(τ) = N/√τ read at τ = 1 h.
+        None if no −½ region was found. [°/√h]
+    bias_instability_dph
+        Bias instability B = σ_min / 0.664 at the minimum of the deviation. [°/h]
+    rrw_dph_per_rt_h
+        Rate random walk K: the +½-slope line σ(τ) = K·√(τ/3) read at τ = 3 h.
+        None if the record is too short to show a +½ region. [°/h/√h]
+    arw_taus_s, rrw_taus_s
+        First and last τ of the points each line was fitted to, or None. [s]
+    bias_instability_tau_s
+        τ of the minimum. [s]
+    floor_reached
+        False if the minimum is the longest usable τ, i.e. the deviation was
+        still falling and B is only an upper bound.
+    """
+
+    arw_deg_per_rt_h: float | None
+    bias_instability_dph: float
+    rrw_dph_per_rt_h: float | None
+    arw_taus_s: tuple[float, float] | None
+    bias_instability_tau_s: float
+    rrw_taus_s: tuple[float, float] | None
+    floor_reached: bool
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types (τ ranges as lists)."""
+        return {k: list(v) if isinstance(v, tuple) else v for k, v in asdict(self).items()}
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> NoiseTerms:
+        """Inverse of :meth:`to_dict`."""
+        names = {f.name for f in fields(cls)}
+        return cls(
+            **{k: tuple(v) if isinstance(v, list) else v for k, v in data.items() if k in names}
+        )
+
+    def summary(self) -> str:
+        """Three lines, one per noise term, with the τ range each was read from."""
+
+        def fmt(value: float | None, taus: tuple[float, float] | None, unit: str) -> str:
+            if value is None:
+                return "n/a (no such slope region in the data)"
+            return f"{value:.4g} {unit}  (fit over tau {taus[0]:g}-{taus[1]:g} s)"
+
+        bound = "" if self.floor_reached else "  (upper bound: no minimum reached)"
+        return "\n".join(
+            [
+                f"angle random walk  {fmt(self.arw_deg_per_rt_h, self.arw_taus_s, 'deg/rt-h')}",
+                f"bias instability   {self.bias_instability_dph:.4g} deg/h  "
+                f"(minimum at tau {self.bias_instability_tau_s:g} s){bound}",
+                f"rate random walk   {fmt(self.rrw_dph_per_rt_h, self.rrw_taus_s, 'deg/h/rt-h')}",
+            ]
+        )
+
+
+def noise_terms(
+    allan: AllanResult,
+    *,
+    slope_tolerance: float = 0.15,
+    min_blocks: int = 8,
+    min_points: int = 2,
+) -> NoiseTerms:
+    """Angle random walk, bias instability and rate random walk, IEEE 952 Annex C [2].
+
+    The Allan deviation of a rate in °/h against τ in s is read with the
+    conventions of Annex C of [2]:
+
+    - ARW: σ(τ) = N/√τ. A line of slope −½ is fitted (in log-log, weighted by
+      the number of τ-blocks) to the points left of the minimum whose local
+      slope is within ``slope_tolerance`` of −½, and read at τ = 1 h:
+      ``ARW [°/√h] = σ(3600 s) = N[°/h·√s] / 60``.
+    - Bias instability: ``B = σ_min / 0.664`` (0.664 ≈ √(2 ln 2 / π), flicker floor).
+    - RRW: σ(τ) = K·√(τ/3). A line of slope +½ is fitted to the points right of
+      the minimum with local slope within the tolerance of +½ and read at
+      τ = 3 h: ``K [°/h/√h] = σ(10800 s)``.
+
+    Only τ with at least ``min_blocks`` whole τ-blocks in the record are used
+    (longer τ are too uncertain). A term is None when fewer than ``min_points``
+    points qualify, e.g. RRW on a record too short to show the +½ region.
+
+    Parameters
+    ----------
+    allan
+        Allan deviation of a rate in °/h, from :func:`allan_deviation`.
+    slope_tolerance
+        Accepted distance of the local log-log slope from ∓½.
+    min_blocks
+        Minimum number of non-overlapping τ-blocks for a τ to be used.
+    min_points
+        Minimum number of points for the ARW and RRW lines.
+
+    Returns
+    -------
+    NoiseTerms
+        The three terms and the τ ranges they were read from.
+
+    Raises
+    ------
+    InputError
+        If fewer than 3 usable τ remain or the deviation is not positive.
+    """
+    usable = allan.blocks >= min_blocks
+    taus = allan.taus_s[usable]
+    dev = allan.deviation[usable]
+    if taus.size < 3:
+        raise InputError(
+            f"noise terms need at least 3 averaging times with >= {min_blocks} blocks each, "
+            f"got {taus.size} (record of {allan.n_samples} samples); use a longer record "
+            "or more taus"
+        )
+    if not np.all(dev > 0.0):
+        raise InputError(
+            "the Allan deviation has zero values (constant rate?); noise terms need a noisy record"
+        )
+    log_tau, log_dev = np.log(taus), np.log(dev)
+    slope = np.gradient(log_dev, log_tau)
+    weights = allan.blocks[usable].astype(np.float64)
+    i_min = int(np.argmin(dev))
+    index = np.arange(taus.size)
+
+    arw = None
+    arw_taus = None
+    pick = (index <= i_min) & (np.abs(slope + 0.5) <= slope_tolerance)
+    if pick.sum() >= min_points:
+        log_n = np.average(log_dev[pick] + 0.5 * log_tau[pick], weights=weights[pick])
+        # weighted least squares of ln σ = ln N − ½ ln τ; ARW = σ(1 h) = N/60
+        arw = math.exp(log_n) / math.sqrt(SECONDS_PER_HOUR)
+        arw_taus = (float(taus[pick][0]), float(taus[pick][-1]))
+
+    rrw = None
+    rrw_taus = None
+    pick = (index > i_min) & (np.abs(slope - 0.5) <= slope_tolerance)
+    if pick.sum() >= min_points:
+        # ln σ = ln(K_s/√3) + ½ ln τ, K in °/h/√s; σ at τ = 3 h equals K_s·60.
+        log_k = np.average(log_dev[pick] - 0.5 * log_tau[pick], weights=weights[pick])
+        rrw = math.exp(log_k) * math.sqrt(3.0 * SECONDS_PER_HOUR)
+        rrw_taus = (float(taus[pick][0]), float(taus[pick][-1]))
+
+    return NoiseTerms(
+        arw_deg_per_rt_h=arw,
+        bias_instability_dph=float(dev[i_min]) / FLICKER_FLOOR_FACTOR,
+        rrw_dph_per_rt_h=rrw,
+        arw_taus_s=arw_taus,
+        bias_instability_tau_s=float(taus[i_min]),
+        rrw_taus_s=rrw_taus,
+        floor_reached=i_min < taus.size - 1,
+    )
