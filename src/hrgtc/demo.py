@@ -21,6 +21,7 @@ from hrgtc.errors import OutputExistsError
 from hrgtc.evaluation import Evaluation, evaluate
 from hrgtc.export_c import export_c
 from hrgtc.model import save_model
+from hrgtc.report import build_report
 from hrgtc.simulate import simulate_files
 from hrgtc.simulate import standard_profiles as profiles
 
@@ -54,7 +55,7 @@ class DemoResult:
     validation: Evaluation
     compensated: CompensationSummary
     model_file: Path
-    report_file: Path | None
+    report_file: Path
     c_files: tuple[Path, ...]
 
 
@@ -108,16 +109,10 @@ def run_demo(
     )
     training = evaluate(cool.path, result.model, progress=stage("evaluate cool-down"))
     validation = evaluate(warm.path, result.model, progress=stage("evaluate warm-up"))
-    report_file = None
-    try:
-        from hrgtc.report import build_report
-    except ImportError:  # pragma: no cover - report module not installed
-        build_report = None
-    if build_report is not None:
-        report_file = build_report(
-            result.model, [cool.path, warm.path], root / "report.html", soaks=soak_paths,
-            force=force, progress=stage("report"),
-        )
+    report_file = build_report(
+        result.model, [cool.path, warm.path], root / "report.html", soaks=soak_paths,
+        force=force, progress=stage("report"),
+    )
     c_files = tuple(export_c(result.model, root / "c", force=force))
     return DemoResult(root, result, training, validation, compensated, model_file,
                       report_file, c_files)

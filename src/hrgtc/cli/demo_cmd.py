@@ -47,7 +47,7 @@ def demo_command(
             "training": result.training.to_dict(),
             "validation": result.validation.to_dict(),
             "model_file": str(result.model_file),
-            "report_file": None if result.report_file is None else str(result.report_file),
+            "report_file": str(result.report_file),
             "c_files": [str(p) for p in result.c_files],
         })
         return
@@ -66,6 +66,5 @@ def demo_command(
                       f"{ev.improvement_10s:.2f}×")
     console.print(table)
     console.print(f"model: {result.model_file}")
-    if result.report_file is not None:
-        console.print(f"report: {result.report_file}")
+    console.print(f"report: {result.report_file}")
     console.print("C: " + ", ".join(str(p) for p in result.c_files))
