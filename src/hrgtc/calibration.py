@@ -60,6 +60,16 @@ class ReadOptions:
                  for c in self.chunks(path)]
         return rec.concatenate(parts)
 
+    def head(self, path: PathLike, rows: int = 10_000) -> rec.Recording:
+        """The first ``rows`` rows of a file (its columns and metadata), file closed after."""
+        chunks = self.chunks(path, rows=rows)
+        try:
+            return next(chunks)
+        except StopIteration:
+            raise InputError(f"{path}: the recording holds no rows") from None
+        finally:
+            chunks.close()
+
     def chunks(self, path: PathLike, rows: int | None = None) -> Iterator[rec.Recording]:
         return rec.iter_chunks(path, rows=rows or self.chunk_rows, columns=self.columns,
                                units=self.units, metadata=self.metadata)
@@ -202,7 +212,8 @@ def calibrate(
         for t, f, e in zip(temperatures, frequencies, from_freq, strict=True)
     )
 
-    drift_rate = next(options.chunks(drifts[0], rows=100_000)).metadata.sample_rate_hz
+    heads = {str(path): options.head(path) for path in (*drifts, *soaks)}
+    drift_rate = heads[str(drifts[0])].metadata.sample_rate_hz
     extra = [p for p, r in zip(soaks, soak_rates, strict=True) if math.isclose(r, drift_rate)]
     if drift_from_soaks and len(extra) < len(soaks):
         warnings.warn(
@@ -219,18 +230,16 @@ def calibrate(
         progress=_report(progress, "drift"),
     )
     housing = None
-    if housing_terms is not None and all(
-        "housing_c" in next(options.chunks(path, rows=100_000)) for path in training
-    ):
+    if housing_terms is not None and all("housing_c" in heads[str(p)] for p in training):
         try:
             housing = drift_model.fit(
                 runs, thermometer, terms=housing_terms, window_s=window_s, penter=penter,
                 premove=premove, reference_c=reference_c, rate_tau_s=rate_tau_s,
                 progress=_report(progress, "housing baseline"),
             )
-        except CalibrationError:
-            housing = None
-    unit = next(options.chunks(drifts[0], rows=100_000)).metadata.unit
+        except CalibrationError as exc:  # the baseline is optional: say why it is missing
+            warnings.warn(f"no housing-thermistor baseline: {exc}", HrgtcWarning, stacklevel=2)
+    unit = heads[str(drifts[0])].metadata.unit
     settings = {
         "order": order, "terms": list(terms), "window_s": window_s, "penter": penter,
         "premove": premove, "reference_c": reference_c, "rate_tau_s": rate_tau_s,

@@ -478,7 +478,13 @@ def fit(
     runs = list(runs)
     if not runs:
         raise InputError("no drift runs given; pass at least one ramp recording")
-    first = next(_iter_run(runs[0]))
+    head = _iter_run(runs[0])
+    try:
+        first = next(head)
+    except StopIteration:
+        raise InputError("the first drift run holds no samples") from None
+    finally:
+        head.close()
     settings = FeatureSettings(
         reference_freq_hz=float(thermometer.frequency(reference_c)),
         sample_rate_hz=first.metadata.sample_rate_hz,
