@@ -299,7 +299,9 @@ def test_stepwise_recovers_true_subset(subset, coefficients, signs, seed):
     y = 2.0 + X @ beta + rng.normal(0.0, 1e-3, 150)
     res = stepwise(X, y, penter=1e-6, premove=1e-5)
     assert set(res.selected) == {f"x{j + 1}" for j in subset}
-    np.testing.assert_allclose(res.result.params[1:], beta[sorted(subset)], rtol=1e-4)
+    # within 6 standard errors of the truth (noise 1e-3: a fixed rtol would be flaky)
+    error = np.abs(res.result.params[1:] - beta[sorted(subset)])
+    np.testing.assert_array_less(error, 6.0 * res.result.bse[1:])
 
 
 def test_collinear_candidate_is_skipped_not_fatal():
