@@ -5,23 +5,11 @@ The paper [1] judges a compensation by the bias stability of the gyro output
 and the three noise terms that gyro data sheets quote.
 
 - :func:`bias_stability`: 1σ of non-overlapping τ-second means, in °/h.
-- :func:`allan_deviation`: overlapping or normal Allan deviation of rate
-  (frequency-type) data, numerically equal to ``allantools.oadev`` /
-  ``allantools.adev`` with ``data_type="freq"`` [3], in O(N) per τ.
-- :func:`noise_terms`: angle random walk, bias instability and rate random walk
-  read off the Allan deviation with the conventions of IEEE Std 952-1997,
-  Annex C [2].
+- :func:`allan_deviation`, :func:`noise_terms`: from :mod:`hrgtc.allan`.
 - :func:`residual_against_truth`: how well a bias model tracks the simulator's
   true bias.
 
-References
-----------
 [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
-[2] IEEE Std 952-1997, "IEEE Standard Specification Format Guide and Test
-    Procedure for Single-Axis Interferometric Fiber Optic Gyros", Annex C
-    (Allan variance method of fiber optic gyro data reduction).
-[3] W. J. Riley, "Handbook of Frequency Stability Analysis", NIST Special
-    Publication 1065, 2008, Eq. (6)-(11); allantools, https://github.com/aewallin/allantools
 """
 
 from __future__ import annotations

@@ -10,16 +10,10 @@ from rich.table import Table
 from hrgtc.calibration import HOUSING_TERMS, CalibrationResult, ReadOptions, calibrate
 from hrgtc.cli._app import app, console, error_console, library_errors, print_json
 from hrgtc.cli.options import (
-    ColumnsOption,
     ForceOption,
-    FreqUnitOption,
-    InputRateOption,
     JsonOption,
-    RateHzOption,
-    RateUnitOption,
-    TimeUnitOption,
-    UnitNameOption,
-    recording_input,
+    RecordingInput,
+    reading_options,
 )
 from hrgtc.errors import OutputExistsError
 from hrgtc.model import save_model
@@ -61,6 +55,7 @@ def render(result: CalibrationResult) -> None:
 
 
 @app.command("calibrate")
+@reading_options
 def calibrate_command(
     extra_soaks: list[Path] = typer.Argument(
         None, metavar="[SOAK_FILES]...",
@@ -87,15 +82,9 @@ def calibrate_command(
         help="Also fit the drift model on the soaks' warming and cooling transients."),
     rate_tau_s: float = typer.Option(
         10.0, "--rate-tau-s", help="Time constant of each stage of the causal df/dt filter [s]."),
-    col: ColumnsOption = None,
-    time_unit: TimeUnitOption = None,
-    freq_unit: FreqUnitOption = None,
-    rate_unit: RateUnitOption = None,
-    rate_hz: RateHzOption = None,
-    unit_name: UnitNameOption = None,
-    input_rate_dph: InputRateOption = None,
     force: ForceOption = False,
     json_output: JsonOption = False,
+    inputs: RecordingInput = RecordingInput(),
 ) -> None:
     """Calibrate a gyro: soak plateaus -> thermometer (Eq. 18), ramps -> drift model (Eq. 22).
 
@@ -103,8 +92,6 @@ def calibrate_command(
     --validate warmup.parquet -o unit.json
     """
     soaks = [*(soak or []), *(extra_soaks or [])]
-    inputs = recording_input(col, time_unit, freq_unit, rate_unit, rate_hz, unit_name,
-                             input_rate_dph)
     with library_errors():
         if output.exists() and not force:
             raise OutputExistsError(f"{output} exists; pass --force to overwrite it")

@@ -10,16 +10,10 @@ from rich.table import Table
 from hrgtc import paper
 from hrgtc.cli._app import app, console, library_errors, print_json, progress_bar
 from hrgtc.cli.options import (
-    ColumnsOption,
     ForceOption,
-    FreqUnitOption,
-    InputRateOption,
     JsonOption,
-    RateHzOption,
-    RateUnitOption,
-    TimeUnitOption,
-    UnitNameOption,
-    recording_input,
+    RecordingInput,
+    reading_options,
 )
 from hrgtc.compensate import compensate_file
 from hrgtc.evaluation import Evaluation, evaluate
@@ -27,28 +21,21 @@ from hrgtc.model import load_model
 
 
 @app.command("compensate")
+@reading_options
 def compensate_command(
     run: Path = typer.Argument(..., help="Recording to compensate (.parquet, .csv, .h5)."),
     model_path: Path = typer.Option(..., "--model", "-m", help="Model file from 'calibrate'."),
     output: Path = typer.Option(..., "-o", "--output", help="Output recording (format by suffix)."),
     chunk_rows: int = typer.Option(1_000_000, "--chunk-rows", help="Rows per processing chunk."),
-    col: ColumnsOption = None,
-    time_unit: TimeUnitOption = None,
-    freq_unit: FreqUnitOption = None,
-    rate_unit: RateUnitOption = None,
-    rate_hz: RateHzOption = None,
-    unit_name: UnitNameOption = None,
-    input_rate_dph: InputRateOption = None,
     force: ForceOption = False,
     json_output: JsonOption = False,
+    inputs: RecordingInput = RecordingInput(),
 ) -> None:
     """Compensate a run file to file: adds rate_comp_dph, bias_model_dph, resonator_c_est
     and in_range, chunk by chunk (memory bounded whatever the file size).
 
     Example: hrgtc compensate warmup.parquet --model unit.json -o warmup_comp.parquet
     """
-    inputs = recording_input(col, time_unit, freq_unit, rate_unit, rate_hz, unit_name,
-                             input_rate_dph)
     with library_errors(), progress_bar("compensating", enabled=not json_output) as progress:
         model = load_model(model_path)
         summary = compensate_file(run, output, model, force=force, chunk_rows=chunk_rows,
@@ -100,25 +87,18 @@ def render_evaluation(result: Evaluation) -> None:
 
 
 @app.command("evaluate")
+@reading_options
 def evaluate_command(
     run: Path = typer.Argument(..., help="Recording to evaluate."),
     model_path: Path = typer.Option(..., "--model", "-m", help="Model file from 'calibrate'."),
-    col: ColumnsOption = None,
-    time_unit: TimeUnitOption = None,
-    freq_unit: FreqUnitOption = None,
-    rate_unit: RateUnitOption = None,
-    rate_hz: RateHzOption = None,
-    unit_name: UnitNameOption = None,
-    input_rate_dph: InputRateOption = None,
     json_output: JsonOption = False,
+    inputs: RecordingInput = RecordingInput(),
 ) -> None:
     """Bias stability at 1, 10, 100 s and Allan noise terms, raw vs compensated (and vs the
     housing-thermistor baseline when the run has housing_c).
 
     Example: hrgtc evaluate warmup.parquet --model unit.json --json
     """
-    inputs = recording_input(col, time_unit, freq_unit, rate_unit, rate_hz, unit_name,
-                             input_rate_dph)
     with library_errors(), progress_bar("evaluating", enabled=not json_output) as progress:
         result = evaluate(run, load_model(model_path), progress=progress, **inputs.read_kwargs())
     if json_output:

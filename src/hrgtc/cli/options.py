@@ -1,33 +1,26 @@
 """Options shared by the ``hrgtc`` commands, defined once.
 
-Use the ``Annotated`` aliases as parameter types and turn the reading options
-into keyword arguments of :func:`hrgtc.recording.read` /
-:func:`~hrgtc.recording.iter_chunks` / :func:`~hrgtc.recording.describe`
-with :func:`recording_input`::
+Use the ``Annotated`` aliases as parameter types. Commands that read
+recordings get the seven reading options (column mapping, units, sample rate,
+unit name, input rate) from :func:`reading_options` and receive them as one
+:class:`RecordingInput`::
 
     @app.command()
-    def calibrate(
-        files: list[Path],
-        col: ColumnsOption = None,
-        time_unit: TimeUnitOption = None,
-        freq_unit: FreqUnitOption = None,
-        rate_unit: RateUnitOption = None,
-        rate_hz: RateHzOption = None,
-        unit_name: UnitNameOption = None,
-        input_rate_dph: InputRateOption = None,
-        gaps: GapsOption = GapPolicy.error,
+    @reading_options
+    def compensate(
+        run: Path,
         force: ForceOption = False,
-        json_output: JsonOption = False,
+        inputs: RecordingInput = RecordingInput(),
     ) -> None:
-        inputs = recording_input(
-            col, time_unit, freq_unit, rate_unit, rate_hz, unit_name, input_rate_dph
-        )
         with library_errors():
-            recording = read(files[0], **inputs.read_kwargs(), gaps=gaps.value)
+            recording = read(run, **inputs.read_kwargs())
 """
 
 from __future__ import annotations
 
+import functools
+import inspect
+from collections.abc import Callable
 from dataclasses import dataclass
 from enum import StrEnum
 from typing import Annotated, Any
@@ -207,3 +200,44 @@ def recording_input(
         units={k: v for k, v in units.items() if v is not None} or None,
         metadata={k: v for k, v in overrides.items() if v is not None} or None,
     )
+
+
+#: The shared reading options, in the order they appear in ``--help``.
+_READING_OPTIONS: tuple[tuple[str, Any], ...] = (
+    ("col", ColumnsOption),
+    ("time_unit", TimeUnitOption),
+    ("freq_unit", FreqUnitOption),
+    ("rate_unit", RateUnitOption),
+    ("rate_hz", RateHzOption),
+    ("unit_name", UnitNameOption),
+    ("input_rate_dph", InputRateOption),
+)
+
+
+def reading_options(command: Callable[..., Any]) -> Callable[..., Any]:
+    """Give a command the shared reading options, defined once here.
+
+    The decorated function takes ``inputs: RecordingInput`` (as its last
+    parameter) instead of the seven options; the command line still shows
+    ``--col``, ``--time-unit``, ``--freq-unit``, ``--rate-unit``, ``--rate-hz``,
+    ``--unit-name`` and ``--input-rate-dph``.
+    """
+    signature = inspect.signature(command, eval_str=True)
+    own = [p for name, p in signature.parameters.items() if name != "inputs"]
+    added = [
+        inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=None, annotation=kind)
+        for name, kind in _READING_OPTIONS
+    ]
+
+    @functools.wraps(command)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        values = {name: kwargs.pop(name, None) for name, _ in _READING_OPTIONS}
+        return command(*args, inputs=recording_input(**values), **kwargs)
+
+    parameters = [
+        p.replace(kind=inspect.Parameter.KEYWORD_ONLY) for p in own
+    ] + added
+    wrapper.__signature__ = signature.replace(parameters=parameters)  # type: ignore[attr-defined]
+    wrapper.__annotations__ = {p.name: p.annotation for p in parameters}
+    del wrapper.__wrapped__  # Typer must see the new signature, not the wrapped one
+    return wrapper

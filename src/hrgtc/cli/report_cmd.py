@@ -8,21 +8,16 @@ import typer
 
 from hrgtc.cli._app import app, console, library_errors, print_json, progress_bar
 from hrgtc.cli.options import (
-    ColumnsOption,
     ForceOption,
-    FreqUnitOption,
-    InputRateOption,
     JsonOption,
-    RateHzOption,
-    RateUnitOption,
-    TimeUnitOption,
-    UnitNameOption,
-    recording_input,
+    RecordingInput,
+    reading_options,
 )
 from hrgtc.report import build_report
 
 
 @app.command("report")
+@reading_options
 def report_command(
     runs: list[Path] = typer.Argument(
         ..., metavar="RUN...", help="Runs to compensate and show (Fig. 6), one section each."),
@@ -34,15 +29,9 @@ def report_command(
     title: str = typer.Option(None, "--title", help="Page title (default: names the unit)."),
     max_points: int = typer.Option(
         20_000, "--max-points", help="Most points per plotted curve (block means >= 10 s)."),
-    col: ColumnsOption = None,
-    time_unit: TimeUnitOption = None,
-    freq_unit: FreqUnitOption = None,
-    rate_unit: RateUnitOption = None,
-    rate_hz: RateHzOption = None,
-    unit_name: UnitNameOption = None,
-    input_rate_dph: InputRateOption = None,
     force: ForceOption = False,
     json_output: JsonOption = False,
+    inputs: RecordingInput = RecordingInput(),
 ) -> None:
     """Write the HTML report: settling of the soaks (Fig. 3), T-f fit (Fig. 4, Table 1),
     temperature from frequency (Fig. 5, Table 2), raw and compensated output with bias
@@ -50,8 +39,6 @@ def report_command(
 
     Example: hrgtc report --model unit.json cooldown.parquet warmup.parquet -o report.html
     """
-    inputs = recording_input(col, time_unit, freq_unit, rate_unit, rate_hz, unit_name,
-                             input_rate_dph)
     with library_errors(), progress_bar("report", enabled=not json_output) as progress:
         path = build_report(model, runs, output, soaks=soak or None, title=title, force=force,
                             max_points=max_points, progress=progress, **inputs.read_kwargs())
