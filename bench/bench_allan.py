@@ -1,6 +1,6 @@
 """Overlapping Allan deviation (octave taus) of 25 M rate samples: hrgtc vs allantools.
 
-Ours: :func:`hrgtc.metrics.allan_deviation` (cumulative sum, then one cache-blocked
+Ours: :func:`hrgtc.evaluation.metrics.allan_deviation` (cumulative sum, then one cache-blocked
 pass per τ). Reference: ``allantools.oadev(data, rate=fs, data_type="freq",
 taus="octave")``, run in its own subprocess on the same deterministic data so
 that its memory does not count against ours. Reported: seconds, samples per
@@ -67,7 +67,7 @@ def _allantools_child(n: int) -> None:
 
 def run(quick: bool = False) -> list[dict]:
     """One result: ours vs allantools on the same record."""
-    from hrgtc.metrics import allan_deviation
+    from hrgtc.evaluation.metrics import allan_deviation
 
     n = QUICK_SAMPLES if quick else FULL_SAMPLES
     t0 = time.perf_counter()

@@ -1,8 +1,8 @@
 """Stepwise regression over 10 candidate columns: sufficient statistics vs naive refits.
 
 Ours: the rows are generated in chunks of one million and fed to
-:class:`hrgtc.stepwise.GramAccumulator` (the full matrix is never held), then
-:func:`hrgtc.stepwise.stepwise_from_accumulator` selects the terms from the
+:class:`hrgtc.drift.stepwise.GramAccumulator` (the full matrix is never held), then
+:func:`hrgtc.drift.stepwise.stepwise_from_accumulator` selects the terms from the
 statistics alone. Naive: the same rows in one matrix and the same MATLAB
 ``stepwisefit`` rules, but a statsmodels OLS refit for every candidate at every
 step. The naive run happens in its own subprocess so that its memory (the full
@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from hrgtc.stepwise import GramAccumulator, stepwise_from_accumulator
+from hrgtc.drift.stepwise import GramAccumulator, stepwise_from_accumulator
 
 FULL_ROWS = 25_000_000
 QUICK_ROWS = 1_000_000

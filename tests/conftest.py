@@ -1,9 +1,3 @@
-import sys
-from pathlib import Path
-
-# Test helpers (exact reference solvers) live beside the tests.
-sys.path.insert(0, str(Path(__file__).parent))
-
 from hypothesis import settings
 
 # The same examples on every run (CI must not flake); no example database between runs.

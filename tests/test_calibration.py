@@ -14,9 +14,9 @@ from hrgtc.cli import app
 from hrgtc.errors import CalibrationError, InputError
 from hrgtc.evaluation import evaluate
 from hrgtc.model import load_model
-from hrgtc.plateaus import find_plateaus
 from hrgtc.recording import Metadata, Recording
 from hrgtc.thermometry import fit
+from hrgtc.thermometry.plateaus import find_plateaus
 
 from campaign import SETPOINTS_C, make_campaign
 from synthetic import ramp_run

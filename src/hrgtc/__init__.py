@@ -4,6 +4,14 @@ The method is that of [1]: the resonator's natural frequency is a thermometer
 (Eq. 16-18, Tables 1-2) and the gyro bias is modelled from the frequency change
 and its rate by stepwise linear regression (Eq. 19-22).
 
+The pipeline, one package per stage, imports flowing one way::
+
+    recording -> thermometry, drift -> model -> compensate -> evaluation -> report
+              -> calibration, demo -> cli
+
+Importing ``hrgtc`` itself loads none of the stages (the command line starts fast);
+import the stage you need, e.g. ``from hrgtc.calibration import calibrate``.
+
 [1] X. Wang, W. Wu, Z. Fang, B. Luo, Y. Li, Q. Jiang, "Temperature Drift
     Compensation for Hemispherical Resonator Gyro Based on Natural Frequency",
     Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
@@ -12,28 +20,18 @@ and its rate by stepwise linear regression (Eq. 19-22).
 from __future__ import annotations
 
 import os
-from importlib.metadata import PackageNotFoundError, version
 from typing import TYPE_CHECKING
+
+from hrgtc._meta import PAPER_REFERENCE, __version__
 
 if TYPE_CHECKING:
     from hrgtc.model import UnitModel
-
-try:
-    __version__ = version("hrgtc")
-except PackageNotFoundError:  # pragma: no cover - running from a source tree
-    __version__ = "0.0.0"
-
-PAPER_REFERENCE = (
-    "X. Wang, W. Wu, Z. Fang, B. Luo, Y. Li, Q. Jiang, 'Temperature Drift Compensation for "
-    "Hemispherical Resonator Gyro Based on Natural Frequency', Sensors 12(5), 6434-6446, 2012. "
-    "doi:10.3390/s120506434"
-)
 
 __all__ = ["PAPER_REFERENCE", "__version__", "load_model"]
 
 
 def load_model(path: str | os.PathLike[str]) -> UnitModel:
-    """Read a model file: :func:`hrgtc.model.load_model` (imported lazily)."""
+    """Read a model file: :func:`hrgtc.model.load_model`, imported when first called."""
     from hrgtc.model import load_model as _load_model
 
     return _load_model(path)

@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 import os
 import warnings
-from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import partial
 from pathlib import Path
@@ -27,15 +27,15 @@ import numpy as np
 
 from hrgtc import drift as drift_model
 from hrgtc import recording as rec
+from hrgtc.drift.features import EQ21
 from hrgtc.errors import CalibrationError, ExtrapolationWarning, HrgtcWarning, InputError
 from hrgtc.evaluation import Evaluation, evaluate_chunks
-from hrgtc.features import EQ21
 from hrgtc.model import UnitModel, provenance
-from hrgtc.plateaus import Plateau, find_plateaus, plateau_table
+from hrgtc.progress import StageProgress, for_stage
 from hrgtc.thermometry import fit as fit_thermometer
+from hrgtc.thermometry.plateaus import Plateau, find_plateaus, plateau_table
 
 PathLike = str | os.PathLike[str]
-Progress = Callable[[str, float, float], None]
 
 #: Columns plateau detection needs from a soak.
 SOAK_COLUMNS = ("time_s", "freq_hz", "chamber_c")
@@ -127,10 +127,6 @@ class CalibrationResult:
         }
 
 
-def _report(progress: Progress | None, stage: str) -> Callable[[float, float], None] | None:
-    return None if progress is None else partial(progress, stage)
-
-
 def calibrate(
     soaks: Sequence[PathLike],
     drifts: Sequence[PathLike],
@@ -147,7 +143,7 @@ def calibrate(
     plateau_options: Mapping[str, Any] | None = None,
     drift_from_soaks: bool = True,
     read_options: ReadOptions | None = None,
-    progress: Progress | None = None,
+    progress: StageProgress | None = None,
 ) -> CalibrationResult:
     """Calibrate a unit: thermometer from soaks, drift model from ramps, held-out validation.
 
@@ -173,7 +169,7 @@ def calibrate(
         Terms of the classical housing-thermistor baseline, fitted when every
         drift run has ``housing_c``; None to skip.
     plateau_options
-        Keyword arguments of :func:`hrgtc.plateaus.find_plateaus`.
+        Keyword arguments of :func:`hrgtc.thermometry.plateaus.find_plateaus`.
     drift_from_soaks
         Also fit the drift model on the soak recordings (default). A single
         cool-down covers one curve in the (temperature, rate) plane, along which
@@ -227,7 +223,7 @@ def calibrate(
     model = drift_model.fit(
         runs, thermometer, terms=terms, window_s=window_s, penter=penter, premove=premove,
         reference_c=reference_c, rate_tau_s=rate_tau_s, excitation_runs=len(drifts),
-        progress=_report(progress, "drift"),
+        progress=for_stage(progress, "drift"),
     )
     housing = None
     if housing_terms is not None and all("housing_c" in heads[str(p)] for p in training):
@@ -235,7 +231,7 @@ def calibrate(
             housing = drift_model.fit(
                 runs, thermometer, terms=housing_terms, window_s=window_s, penter=penter,
                 premove=premove, reference_c=reference_c, rate_tau_s=rate_tau_s,
-                progress=_report(progress, "housing baseline"),
+                progress=for_stage(progress, "housing baseline"),
             )
         except CalibrationError as exc:  # the baseline is optional: say why it is missing
             warnings.warn(f"no housing-thermistor baseline: {exc}", HrgtcWarning, stacklevel=2)

@@ -11,21 +11,19 @@ and the C files into one folder. What ``hrgtc demo`` and ``make demo`` run.
 from __future__ import annotations
 
 import os
-from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
 from hrgtc.calibration import CalibrationResult, calibrate
 from hrgtc.compensate import CompensationSummary, compensate_file
-from hrgtc.errors import OutputExistsError
+from hrgtc.compensate.export_c import export_c
 from hrgtc.evaluation import Evaluation, evaluate
-from hrgtc.export_c import export_c
+from hrgtc.files import refuse_existing
 from hrgtc.model import save_model
+from hrgtc.progress import StageProgress, for_stage
 from hrgtc.report import build_report
 from hrgtc.simulate import simulate_files
 from hrgtc.simulate import standard_profiles as profiles
-
-Progress = Callable[[str, float, float], None]
 
 SETPOINTS_C = (-20.0, -10.0, 0.0, 10.0, 20.0, 30.0, 40.0)  # Section 3 of [1]
 
@@ -64,7 +62,7 @@ def run_demo(
     settings: DemoSettings | None = None,
     *,
     force: bool = False,
-    progress: Progress | None = None,
+    progress: StageProgress | None = None,
 ) -> DemoResult:
     """Simulate, calibrate, compensate, evaluate, report and export, into ``folder``.
 
@@ -76,25 +74,20 @@ def run_demo(
     s = settings or DemoSettings()
     root = Path(folder)
     model_file = root / "paper-unit.json"
-    if model_file.exists() and not force:
-        raise OutputExistsError(f"{root} already holds a demo; pass --force to redo it")
+    refuse_existing(model_file, force, f"{root} already holds a demo")
 
-    def stage(name: str) -> Callable[[float, float], None] | None:
-        return None if progress is None else (lambda done, total: progress(name, done, total))
 
-    unit = "paper-unit"
-    soaks = simulate_files(
-        [profiles.soak(t, s.soak_hours) for t in SETPOINTS_C], root / "soaks", "parquet",
-        unit=unit, rate_hz=s.rate_hz, seed=s.seed, force=force, progress=stage("simulate soaks"),
-    )
-    cool = simulate_files(
-        [profiles.cooldown(20.0, -20.0, s.ramp_hours)], root / "runs", "parquet", unit=unit,
-        rate_hz=s.rate_hz, seed=s.seed + 1, force=force, progress=stage("simulate cool-down"),
-    )[0]
-    warm = simulate_files(
-        [profiles.warmup(-20.0, 20.0, s.ramp_hours)], root / "runs", "parquet", unit=unit,
-        rate_hz=s.rate_hz, seed=s.seed + 2, force=force, progress=stage("simulate warm-up"),
-    )[0]
+    def simulate(runs: list, folder: str, seed: int, stage: str) -> list:
+        return simulate_files(runs, root / folder, "parquet", unit="paper-unit",
+                              rate_hz=s.rate_hz, seed=seed, force=force,
+                              progress=for_stage(progress, f"simulate {stage}"))
+
+    soaks = simulate([profiles.soak(t, s.soak_hours) for t in SETPOINTS_C], "soaks", s.seed,
+                     "soaks")
+    cool = simulate([profiles.cooldown(20.0, -20.0, s.ramp_hours)], "runs", s.seed + 1,
+                    "cool-down")[0]
+    warm = simulate([profiles.warmup(-20.0, 20.0, s.ramp_hours)], "runs", s.seed + 2,
+                    "warm-up")[0]
     soak_paths = [Path(w.path) for w in soaks]
     def calibration_stage(name: str, done: float, total: float) -> None:
         if progress is not None:
@@ -105,13 +98,13 @@ def run_demo(
     save_model(result.model, model_file, force=force)
     compensated = compensate_file(
         warm.path, root / "runs" / "warmup_compensated.parquet", result.model, force=force,
-        progress=stage("compensate warm-up"),
+        progress=for_stage(progress, "compensate warm-up"),
     )
-    training = evaluate(cool.path, result.model, progress=stage("evaluate cool-down"))
-    validation = evaluate(warm.path, result.model, progress=stage("evaluate warm-up"))
+    training = evaluate(cool.path, result.model, progress=for_stage(progress, "evaluate cool-down"))
+    validation = evaluate(warm.path, result.model, progress=for_stage(progress, "evaluate warm-up"))
     report_file = build_report(
         result.model, [cool.path, warm.path], root / "report.html", soaks=soak_paths,
-        force=force, progress=stage("report"),
+        force=force, progress=for_stage(progress, "report"),
     )
     c_files = tuple(export_c(result.model, root / "c", force=force))
     return DemoResult(root, result, training, validation, compensated, model_file,

@@ -9,10 +9,8 @@ schema, a foreign JSON document or a corrupt one gets a clear error.
 
 from __future__ import annotations
 
-import hashlib
 import json
 import os
-import tempfile
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
@@ -20,8 +18,8 @@ from pathlib import Path
 from typing import Any
 
 from hrgtc.drift import DriftModel
-from hrgtc.errors import HrgtcError, ModelFileError, OutputExistsError
-from hrgtc.recording_io import current_umask
+from hrgtc.errors import HrgtcError, ModelFileError
+from hrgtc.files import file_sha256, write_text_atomic
 from hrgtc.thermometry import Thermometer
 
 SCHEMA_NAME = "hrgtc.model"
@@ -102,18 +100,9 @@ class UnitModel:
             raise ModelFileError(f"{source}: model file is corrupt: {exc}") from exc
 
 
-def file_sha256(path: str | os.PathLike[str], block_bytes: int = 1 << 20) -> str:
-    """SHA-256 of a file, read in blocks."""
-    digest = hashlib.sha256()
-    with open(path, "rb") as handle:
-        while block := handle.read(block_bytes):
-            digest.update(block)
-    return digest.hexdigest()
-
-
 def provenance(inputs: Mapping[str, list[str]], settings: Mapping[str, Any]) -> dict[str, Any]:
     """Provenance record: input files (role, path, SHA-256), settings, version, UTC time."""
-    from hrgtc import __version__
+    from hrgtc._meta import __version__
 
     files = []
     for role, paths in inputs.items():
@@ -125,34 +114,6 @@ def provenance(inputs: Mapping[str, list[str]], settings: Mapping[str, Any]) -> 
         "hrgtc_version": __version__,
         "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
     }
-
-
-def write_text_atomic(path: str | os.PathLike[str], text: str, force: bool = False) -> Path:
-    """Write ``text`` to ``path`` via a temporary file and rename; never half-written.
-
-    Raises
-    ------
-    OutputExistsError
-        When ``path`` exists and ``force`` is False.
-    """
-    target = Path(path)
-    if target.exists() and not force:
-        raise OutputExistsError(f"{target} exists; pass --force (force=True) to overwrite it")
-    target.parent.mkdir(parents=True, exist_ok=True)
-    handle, temporary = tempfile.mkstemp(
-        dir=target.parent, prefix=f".{target.name}.", suffix=".tmp"
-    )
-    try:
-        with os.fdopen(handle, "w", encoding="utf-8") as stream:
-            stream.write(text)
-            stream.flush()
-            os.fsync(stream.fileno())
-        os.chmod(temporary, 0o666 & ~current_umask())  # mkstemp makes 0600 files
-        os.replace(temporary, target)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
-    return target
 
 
 def save_model(model: UnitModel, path: str | os.PathLike[str], force: bool = False) -> Path:

@@ -33,9 +33,6 @@ TABLE2_ACTUAL_C = TABLE1_TEMPERATURE_C
 TABLE2_CALCULATED_C = np.array([-19.976, -10.058, -0.0026, 10.070, 20.011, 29.924, 40.031])
 TABLE2_ERROR_C = np.array([-0.024, 0.0578, 0.0026, -0.070, -0.011, 0.076, -0.031])
 
-# Eq. (21) of [1]: the nine candidate terms of the drift model, f = frequency
-# change, df = its rate of change df/dt.
-EQ21_TERMS = ("f", "f^2", "f^3", "df", "df^2", "df^3", "f*df", "f^2*df", "f*df^2")
 # Eq. (22) of [1]: the terms stepwise regression kept.
 EQ22_TERMS = ("f", "f^2", "f^3", "df", "df^2", "df^3", "f*df")
 

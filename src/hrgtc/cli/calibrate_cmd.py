@@ -15,9 +15,9 @@ from hrgtc.cli.options import (
     RecordingInput,
     reading_options,
 )
-from hrgtc.errors import OutputExistsError
+from hrgtc.drift.features import EQ21_TERMS
+from hrgtc.files import refuse_existing
 from hrgtc.model import save_model
-from hrgtc.paper import EQ21_TERMS
 
 
 def render(result: CalibrationResult) -> None:
@@ -93,8 +93,7 @@ def calibrate_command(
     """
     soaks = [*(soak or []), *(extra_soaks or [])]
     with library_errors():
-        if output.exists() and not force:
-            raise OutputExistsError(f"{output} exists; pass --force to overwrite it")
+        refuse_existing(output, force)
         stages: dict[str, object] = {}
 
         def progress(stage: str, done: float, total: float) -> None:

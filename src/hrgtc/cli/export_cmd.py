@@ -8,7 +8,7 @@ import typer
 
 from hrgtc.cli._app import app, console, library_errors, print_json
 from hrgtc.cli.options import ForceOption, JsonOption
-from hrgtc.export_c import export_c
+from hrgtc.compensate.export_c import export_c
 
 
 @app.command("export-c")

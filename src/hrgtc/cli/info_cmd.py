@@ -15,7 +15,7 @@ from hrgtc.cli.options import (
     RecordingInput,
     reading_options,
 )
-from hrgtc.recording_info import describe
+from hrgtc.recording.info import describe
 
 
 @app.command("info")

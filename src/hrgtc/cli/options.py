@@ -28,8 +28,8 @@ from typing import Annotated, Any
 import typer
 
 from hrgtc.errors import InputError
-from hrgtc.recording_formats import FORMAT_SUFFIXES
-from hrgtc.recording_mapping import parse_columns, parse_unit
+from hrgtc.recording.formats import FORMAT_SUFFIXES
+from hrgtc.recording.mapping import parse_columns, parse_unit
 
 
 def _columns_callback(value: list[str] | None) -> list[str] | None:

@@ -28,13 +28,14 @@ files: :mod:`hrgtc.simulate.output`.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 import numpy as np
 
 from hrgtc.errors import InputError
+from hrgtc.progress import Progress
 from hrgtc.recording import Metadata, Recording, concatenate
 from hrgtc.simulate import units as _units
 from hrgtc.simulate.noise import WhiteNoiseStream
@@ -45,7 +46,6 @@ __all__ = [
     "COLUMNS",
     "DEFAULT_CHUNK_ROWS",
     "DEFAULT_INPUT_RATE_DPH",
-    "Progress",
     "Seed",
     "check_rate",
     "check_seed",
@@ -63,7 +63,6 @@ DEFAULT_CHUNK_ROWS = 1 << 19
 DEFAULT_INPUT_RATE_DPH = 10.0
 
 Seed = int | np.random.SeedSequence | np.random.Generator
-Progress = Callable[[float, float], None]
 
 
 def _resolve_unit(unit: str | Unit) -> Unit:

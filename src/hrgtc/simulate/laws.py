@@ -27,7 +27,7 @@ import numpy as np
 from numpy.polynomial import Polynomial
 
 from hrgtc.errors import InputError
-from hrgtc.shell import Shell
+from hrgtc.simulate.shell import Shell
 
 __all__ = [
     "BiasLaw",
@@ -109,7 +109,7 @@ def table1_frequency_law() -> PolynomialFrequencyLaw:
 
 @dataclass(frozen=True)
 class ShellFrequencyLaw:
-    """Natural frequency from the shell model, Eq. (15) of [1] (:class:`hrgtc.shell.Shell`).
+    """Natural frequency from the shell model, Eq. (15) of [1] (:class:`~.shell.Shell`).
 
     Parameters
     ----------

@@ -17,15 +17,16 @@ from typing import Any
 
 import numpy as np
 
-from hrgtc.errors import InputError, OutputExistsError
+from hrgtc.errors import InputError
+from hrgtc.files import refuse_existing
+from hrgtc.progress import Progress
 from hrgtc.recording import RecordingWriter
-from hrgtc.recording_formats import FORMAT_SUFFIXES, SUFFIXES
+from hrgtc.recording.formats import FORMAT_SUFFIXES, SUFFIXES
 from hrgtc.simulate import units as _units
 from hrgtc.simulate.campaign import (
     COLUMNS,
     DEFAULT_CHUNK_ROWS,
     DEFAULT_INPUT_RATE_DPH,
-    Progress,
     Seed,
     check_rate,
     check_seed,
@@ -106,8 +107,7 @@ def simulate_to_file(
         If ``path`` exists and ``force`` is False.
     """
     path = Path(path)
-    if path.exists() and not force:
-        raise OutputExistsError(f"{path} exists; pass force=True (--force) to overwrite it")
+    refuse_existing(path, force)
     metadata = run_metadata(profile, unit, rate_hz, seed, input_rate_dph)
     rows = 0
     chunks = iter_run_chunks(profile, unit, rate_hz, seed, input_rate_dph, chunk_rows, progress)
@@ -228,12 +228,7 @@ def simulate_files(
     if not isinstance(seed, int):
         raise InputError(f"a campaign's seed must be a non-negative integer, got {seed!r}")
     paths = output_paths(profiles, output, file_format)
-    existing = [str(p) for p in paths if p.exists()]
-    if existing and not force:
-        raise OutputExistsError(
-            f"{len(existing)} output file(s) exist: {', '.join(existing)}; nothing was written; "
-            "pass --force (force=True) to overwrite"
-        )
+    refuse_existing(paths, force, "nothing was written")
     paths[0].parent.mkdir(parents=True, exist_ok=True)
     counts = [row_count(p, fs) for p in profiles]
     total = float(sum(counts))

@@ -18,7 +18,7 @@
 
 ``unit-b`` differs in every part, so that nothing downstream is tuned to one
 unit: a smaller shell (r = 13 mm, h = 0.75 mm, ~5.7 kHz) whose frequency comes
-from the shell model of :mod:`hrgtc.shell` (Eq. 15 of [1]) with fused-quartz
+from the shell model of :mod:`hrgtc.simulate.shell` (Eq. 15 of [1]) with fused-quartz
 temperature coefficients, faster thermal constants (housing 7 min, resonator
 30 min: within 0.1 °C ~11,000 s after a 30 °C step), a bias rising as the
 unit cools and with the opposite gradient sign, a temperature-dependent
@@ -39,9 +39,9 @@ from functools import cache
 from typing import Any
 
 from hrgtc.errors import InputError
-from hrgtc.shell import FUSED_QUARTZ, Shell
 from hrgtc.simulate.laws import BiasLaw, FrequencyLaw, ShellFrequencyLaw, table1_frequency_law
 from hrgtc.simulate.noise import GyroNoise
+from hrgtc.simulate.shell import FUSED_QUARTZ, Shell
 from hrgtc.simulate.thermal import ThermalNetwork
 
 __all__ = ["DEFAULT_UNIT", "Unit", "get", "names"]

@@ -1,0 +1,20 @@
+"""What this package is: its version and the paper it implements.
+
+Imports nothing of hrgtc, so any module may take ``__version__`` from here
+without importing the package's stages.
+"""
+
+from importlib.metadata import PackageNotFoundError, version
+
+try:
+    __version__ = version("hrgtc")
+except PackageNotFoundError:  # pragma: no cover - running from a source tree
+    __version__ = "0.0.0"
+
+PAPER_REFERENCE = (
+    "X. Wang, W. Wu, Z. Fang, B. Luo, Y. Li, Q. Jiang, 'Temperature Drift Compensation for "
+    "Hemispherical Resonator Gyro Based on Natural Frequency', Sensors 12(5), 6434-6446, 2012. "
+    "doi:10.3390/s120506434"
+)
+#: DOI of the paper. [1]
+PAPER_DOI = "10.3390/s120506434"

@@ -1,0 +1,18 @@
+"""Compensation: stage 4, a unit model applied to any later run.
+
+Takes a :class:`~hrgtc.model.UnitModel` and a recording and gives the
+compensated output: batch or streaming (``compensator``: :class:`Compensator`
+keeps the df/dt filter state across chunks; :func:`compensate_file` works file
+to file in bounded memory), or dependency-free C99 for on-board use
+(``export_c``, its text in ``c_text``).
+"""
+
+from hrgtc.compensate.compensator import (
+    CompensationSummary,
+    Compensator,
+    compensate,
+    compensate_file,
+)
+from hrgtc.compensate.export_c import export_c
+
+__all__ = ["CompensationSummary", "Compensator", "compensate", "compensate_file", "export_c"]

@@ -1,0 +1,551 @@
+"""The drift model: bias from frequency change and its rate by stepwise regression.
+
+Eq. (21)-(22) of [1]: B = B0 + sum_k k_i term_i(f, df/dt), the terms chosen
+from candidates by stepwise linear regression (Section 4.1).
+
+Fitting works run by run and chunk by chunk: each chunk's variables are
+computed by a causal :class:`~hrgtc.drift.features.FeatureStream` that keeps its
+state across chunks, the candidate terms and the measured bias are averaged
+into non-overlapping windows (10 s by default), and the regression runs on the
+window means. Raw 200 Hz residuals are strongly autocorrelated, so F-tests on
+samples would call every term significant; on 10 s means they are much closer
+to independent. Memory is bounded by one chunk plus the window means
+(1/2000 of the samples at 200 Hz and 10 s).
+
+Variables are scaled internally (f by its largest training magnitude, df/dt
+likewise) so every candidate column is of order one; coefficients are
+reported in the user's units.
+
+[1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from hrgtc.drift.features import (
+    EQ21,
+    VARIABLES,
+    FeatureSettings,
+    FeatureStream,
+    Term,
+    design_matrix,
+    hierarchy,
+    linear_combination,
+    parse_terms,
+    tangent_extension,
+    variables_for,
+)
+from hrgtc.drift.regression import newey_west_inflation
+from hrgtc.drift.stepwise import StepwiseResult, stepwise
+from hrgtc.errors import CalibrationError, InputError
+from hrgtc.progress import Progress
+from hrgtc.recording import Recording
+from hrgtc.thermometry import Thermometer
+
+RunSource = Recording | Callable[[], Iterator[Recording]]
+
+#: Smallest training spread of df/dt, as a resonator temperature rate, for a drift model. [°C/h]
+MIN_RATE_SPAN_C_PER_H = 0.5
+#: Smallest training spread of the resonator temperature for a drift model. [°C]
+MIN_TEMPERATURE_SPAN_C = 1.0
+
+
+@dataclass(frozen=True)
+class TrainingWindows:
+    """Window means used to fit a drift model, one row per window.
+
+    Attributes
+    ----------
+    time_s
+        Window centre times, per run. [s]
+    run
+        Index of the run each window came from.
+    terms
+        Raw (unscaled) window means of each candidate term, shape (windows, terms).
+    bias_dph
+        Window means of the measured bias (rate minus input rate). [°/h]
+    variables
+        Window means of each variable (f [Hz], df [Hz/s], ...).
+    n_samples
+        Samples that went into the windows.
+    sources
+        Name (file) of each run, in run order.
+    """
+
+    time_s: np.ndarray
+    run: np.ndarray
+    terms: np.ndarray
+    bias_dph: np.ndarray
+    variables: dict[str, np.ndarray]
+    n_samples: int
+    sources: tuple[str, ...] = ()
+
+
+class _WindowMeans:
+    """Means of non-overlapping windows of ``rows`` samples over consecutive chunks."""
+
+    def __init__(self, rows: int, skip: int) -> None:
+        self.rows = rows
+        self.skip = skip
+        self._carry: np.ndarray | None = None
+
+    def push(self, block: np.ndarray) -> np.ndarray:
+        if self.skip:
+            dropped = min(self.skip, block.shape[0])
+            block = block[dropped:]
+            self.skip -= dropped
+        if self._carry is not None and self._carry.shape[0]:
+            block = np.concatenate([self._carry, block])
+        complete = block.shape[0] // self.rows
+        self._carry = block[complete * self.rows :].copy()
+        if complete == 0:
+            return np.empty((0, block.shape[1]))
+        used = block[: complete * self.rows]
+        return used.reshape(complete, self.rows, block.shape[1]).mean(axis=1)
+
+
+def _iter_run(source: RunSource) -> Iterator[Recording]:
+    if isinstance(source, Recording):
+        yield source
+    else:
+        yield from source()
+
+
+def window_means(
+    runs: Sequence[RunSource],
+    settings: FeatureSettings,
+    terms: Sequence[Term],
+    window_s: float = 10.0,
+    progress: Progress | None = None,
+) -> TrainingWindows:
+    """Window means of candidate terms and measured bias over training runs.
+
+    Parameters
+    ----------
+    runs
+        Each a :class:`Recording`, or a callable returning an iterator of
+        consecutive chunks of one run (e.g. ``lambda: recording.iter_chunks(path)``).
+    settings
+        Feature settings (reference frequency, rate filter, warm-up).
+    terms
+        Candidate terms.
+    window_s
+        Window length. [s]
+    progress
+        Optional ``callback(samples_done, samples_total_or_0)``.
+    """
+    variables = variables_for(terms)
+    window_rows = round(window_s * settings.sample_rate_hz)
+    if window_rows < 1:
+        raise InputError(f"window_s={window_s} s holds no sample at {settings.sample_rate_hz} Hz")
+    skip = round(settings.warmup_s * settings.sample_rate_hz)
+    out_terms, out_bias, out_time, out_run = [], [], [], []
+    out_vars: dict[str, list[np.ndarray]] = {v: [] for v in variables}
+    total = 0
+    sources: list[str] = []
+    for index, source in enumerate(runs):
+        stream = FeatureStream(settings, variables)
+        averager = _WindowMeans(window_rows, skip)
+        input_rate = None
+        for chunk in _iter_run(source):
+            settings.check_sample_rate(chunk)
+            if input_rate is None:
+                input_rate = chunk.metadata.input_rate_dph
+                sources.append(chunk.source or f"run {index}")
+            values = stream.process(chunk)
+            block = np.column_stack(
+                [
+                    chunk.time_s,
+                    chunk.rate_dph - input_rate,
+                    *(values[v] for v in variables),
+                    design_matrix(terms, values),
+                ]
+            )
+            means = averager.push(block)
+            if means.shape[0]:
+                out_time.append(means[:, 0])
+                out_bias.append(means[:, 1])
+                for k, v in enumerate(variables):
+                    out_vars[v].append(means[:, 2 + k])
+                out_terms.append(means[:, 2 + len(variables) :])
+                out_run.append(np.full(means.shape[0], index))
+            total += len(chunk)
+            if progress is not None:
+                progress(total, 0)
+    if not out_time:
+        raise CalibrationError(
+            f"the drift runs hold no complete {window_s:g} s window after the "
+            f"{settings.warmup_s:g} s filter warm-up; give longer runs"
+        )
+    return TrainingWindows(
+        time_s=np.concatenate(out_time),
+        run=np.concatenate(out_run),
+        terms=np.concatenate(out_terms),
+        bias_dph=np.concatenate(out_bias),
+        variables={v: np.concatenate(x) for v, x in out_vars.items()},
+        n_samples=total,
+        sources=tuple(sources),
+    )
+
+
+@dataclass(frozen=True)
+class DriftModel:
+    """A fitted bias model B = B0 + sum k_i term_i (Eq. 22 of [1]).
+
+    Attributes
+    ----------
+    settings
+        How the variables are computed (reference, rate filter, scales).
+    candidates
+        All candidate terms considered (Eq. 21 by default).
+    selected
+        Terms kept by the stepwise regression, in candidate order.
+    intercept_dph
+        B0. [°/h]
+    coefficients
+        Term name -> coefficient in user units (°/h per term unit).
+    standard_errors, pvalues
+        Term name -> standard error (user units) and p-value, intercept under ``"const"``.
+    scaled_coefficients
+        Coefficients on scaled variables, in ``selected`` order (what predict uses).
+    stepwise
+        The stepwise regression on scaled window means (steps, final fit).
+    ranges
+        Variable -> (min, max) of its training window means.
+    window_s
+        Window length of the fit. [s]
+    n_windows, n_samples
+        Size of the training set.
+    residual_std_dph, rsquared
+        Fit quality on window means. [°/h]
+    variance_inflation, bandwidth_windows
+        Newey-West correction of the F-tests for autocorrelated window residuals
+        (1 and 0 when switched off).
+    """
+
+    settings: FeatureSettings
+    candidates: tuple[str, ...]
+    selected: tuple[str, ...]
+    intercept_dph: float
+    coefficients: dict[str, float]
+    standard_errors: dict[str, float]
+    pvalues: dict[str, float]
+    scaled_coefficients: tuple[float, ...]
+    stepwise: StepwiseResult
+    ranges: dict[str, tuple[float, float]]
+    window_s: float
+    n_windows: int
+    n_samples: int
+    residual_std_dph: float
+    rsquared: float
+    variance_inflation: float = 1.0
+    bandwidth_windows: int = 0
+    _terms: tuple[Term, ...] = field(default=(), repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "_terms", parse_terms(self.selected) if self.selected else ())
+
+    @property
+    def history(self) -> tuple[Any, ...]:
+        """Steps of the stepwise regression."""
+        return self.stepwise.history
+
+    @property
+    def variables(self) -> tuple[str, ...]:
+        """Variables the selected terms need (at least f and df for compensation)."""
+        return variables_for(self._terms) if self._terms else ("f",)
+
+    def predict(self, values: Mapping[str, np.ndarray],
+                extrapolation: str = "tangent") -> np.ndarray:
+        """Bias from variable arrays (f [Hz], df [Hz/s], ...), Eq. (22) of [1]. [°/h]
+
+        Inside the training ranges this is the fitted polynomial. Beyond them,
+        ``extrapolation="tangent"`` (default) continues it along its tangent at the
+        edge of the range: a law linear in df/dt stays exact, while the cubic terms of
+        a model fitted on a cool-down do not run away on a faster warm-up.
+        ``"polynomial"`` evaluates the polynomial anyway; ``"clamp"`` holds each
+        variable at the edge (as PX4's thermal calibration holds temperature).
+        Samples beyond the ranges are counted by the compensator.
+        """
+        if not self._terms:
+            n = next(iter(values.values())).shape[0]
+            return np.full(n, self.intercept_dph)
+        args = (self._terms, self.scaled_coefficients)
+        if extrapolation == "tangent":
+            return tangent_extension(*args, values, self.settings.scales, self.ranges,
+                                     self.intercept_dph)
+        if extrapolation == "clamp":
+            values = {v: (np.clip(x, *self.ranges[v]) if v in self.ranges else x)
+                      for v, x in values.items()}
+        elif extrapolation != "polynomial":
+            raise InputError(f"extrapolation must be 'tangent', 'polynomial' or 'clamp', "
+                             f"got {extrapolation!r}")
+        return linear_combination(*args, values, self.settings.scales, self.intercept_dph)
+
+    def predict_recording(self, recording: Recording) -> np.ndarray:
+        """Bias of a whole recording, filter started at its first sample. [°/h]"""
+        self.settings.check_sample_rate(recording)
+        stream = FeatureStream(self.settings, self.variables)
+        return self.predict(stream.process(recording))
+
+    def equation(self) -> str:
+        """The model in Eq. (22) form with numbers, e.g. ``B = 1.2 + 0.3·f - ...``."""
+        parts = [f"B = {self.intercept_dph:.6g}"]
+        for name in self.selected:
+            value = self.coefficients[name]
+            sign = "-" if value < 0 else "+"
+            parts.append(f" {sign} {abs(value):.6g}·{name}")
+        units = ", ".join(f"{v} in {VARIABLES[v][0]}" for v in self.variables)
+        return "".join(parts) + f"   [°/h; {units}]"
+
+    def summary(self) -> str:
+        """Stepwise history, coefficient table and fit statistics as text."""
+        lines = [
+            f"Drift model: {len(self.selected)} of {len(self.candidates)} candidate terms, "
+            f"{self.n_windows} windows of {self.window_s:g} s ({self.n_samples} samples)",
+            "Steps:",
+        ]
+        for n, step in enumerate(self.history, start=1):
+            lines.append(f"  {n:>2}. {step.action:<8} {step.term:<10} F = {step.fstat:<12.5g} "
+                         f"p = {step.pvalue:.3g}")
+        lines.append(f"{'term':<10}{'coefficient':>16}{'std error':>14}{'p-value':>11}")
+        lines.append(
+            f"{'const':<10}{self.intercept_dph:>16.6g}{self.standard_errors['const']:>14.4g}"
+            f"{self.pvalues['const']:>11.3g}"
+        )
+        for name in self.selected:
+            lines.append(
+                f"{name:<10}{self.coefficients[name]:>16.6g}{self.standard_errors[name]:>14.4g}"
+                f"{self.pvalues[name]:>11.3g}"
+            )
+        lines.append(
+            f"residual std {self.residual_std_dph:.4g} °/h on {self.window_s:g} s means, "
+            f"R² {self.rsquared:.6f}"
+        )
+        if self.variance_inflation > 1.0 or self.bandwidth_windows:
+            lines.append(
+                f"F-tests corrected for autocorrelated residuals (Newey-West, "
+                f"{self.bandwidth_windows} windows): variance inflation "
+                f"{self.variance_inflation:.3g}"
+            )
+        lines.append(self.equation())
+        return "\n".join(lines)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types."""
+        return {
+            "kind": "hrgtc.DriftModel",
+            "settings": self.settings.to_dict(),
+            "candidates": list(self.candidates),
+            "selected": list(self.selected),
+            "intercept_dph": self.intercept_dph,
+            "coefficients": dict(self.coefficients),
+            "standard_errors": dict(self.standard_errors),
+            "pvalues": dict(self.pvalues),
+            "scaled_coefficients": list(self.scaled_coefficients),
+            "stepwise": self.stepwise.to_dict(),
+            "ranges": {k: list(v) for k, v in self.ranges.items()},
+            "window_s": self.window_s,
+            "n_windows": self.n_windows,
+            "n_samples": self.n_samples,
+            "residual_std_dph": self.residual_std_dph,
+            "rsquared": self.rsquared,
+            "variance_inflation": self.variance_inflation,
+            "bandwidth_windows": self.bandwidth_windows,
+        }
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> DriftModel:
+        """Inverse of :meth:`to_dict`."""
+        try:
+            return cls(
+                settings=FeatureSettings.from_dict(data["settings"]),
+                candidates=tuple(data["candidates"]),
+                selected=tuple(data["selected"]),
+                intercept_dph=float(data["intercept_dph"]),
+                coefficients={k: float(v) for k, v in data["coefficients"].items()},
+                standard_errors={k: float(v) for k, v in data["standard_errors"].items()},
+                pvalues={k: float(v) for k, v in data["pvalues"].items()},
+                scaled_coefficients=tuple(float(v) for v in data["scaled_coefficients"]),
+                stepwise=StepwiseResult.from_dict(data["stepwise"]),
+                ranges={k: (float(v[0]), float(v[1])) for k, v in data["ranges"].items()},
+                window_s=float(data["window_s"]),
+                n_windows=int(data["n_windows"]),
+                n_samples=int(data["n_samples"]),
+                residual_std_dph=float(data["residual_std_dph"]),
+                rsquared=float(data["rsquared"]),
+                variance_inflation=float(data.get("variance_inflation", 1.0)),
+                bandwidth_windows=int(data.get("bandwidth_windows", 0)),
+            )
+        except (KeyError, TypeError, ValueError, IndexError) as exc:
+            raise InputError(f"not a valid drift-model record: {exc!r}") from exc
+
+
+def _check_excitation(windows: TrainingWindows, thermometer: Thermometer,
+                      variables: Sequence[str], run: int | None = None) -> None:
+    """Refuse training data (all runs, or run ``run``) that cannot identify a thermal model."""
+    slope = float(np.max(np.abs(thermometer.slope_hz_per_c(thermometer.temperature_range_c))))
+    mask = slice(None) if run is None else windows.run == run
+    what = "the drift runs" if run is None else f"drift run {windows.sources[run]}"
+    if "f" in variables:
+        f = windows.variables["f"][mask]
+        span_c = (float(f.max()) - float(f.min())) / slope
+        if span_c < MIN_TEMPERATURE_SPAN_C:
+            raise CalibrationError(
+                f"{what} spans only {span_c:.3g} °C of resonator temperature "
+                f"({float(f.max() - f.min()):.3g} Hz); a drift model needs a temperature "
+                f"change of at least {MIN_TEMPERATURE_SPAN_C:g} °C: use a cool-down or warm-up run"
+            )
+    if "df" in variables:
+        df = windows.variables["df"][mask]
+        span_c_per_h = (float(df.max()) - float(df.min())) / slope * 3600.0
+        if span_c_per_h < MIN_RATE_SPAN_C_PER_H:
+            raise CalibrationError(
+                f"{what} shows no df/dt variation (span {span_c_per_h:.3g} °C/h, "
+                f"{float(df.max() - df.min()):.3g} Hz/s); the rate terms cannot be identified: "
+                "train on a ramp (cool-down or warm-up), not on a soak or constant temperature, "
+                "or drop the df terms"
+            )
+
+
+def fit(
+    runs: Sequence[RunSource],
+    thermometer: Thermometer,
+    terms: Iterable[str | Term] = EQ21,
+    window_s: float = 10.0,
+    penter: float = 0.05,
+    premove: float | None = None,
+    *,
+    initial: Iterable[str] | None = None,
+    reference_c: float = 20.0,
+    rate_tau_s: float = 10.0,
+    warmup_s: float | None = None,
+    autocorrelation: str = "newey-west",
+    hierarchical: bool = False,
+    excitation_runs: int = 0,
+    progress: Progress | None = None,
+) -> DriftModel:
+    """Fit the drift model of Eq. (21)-(22) of [1] by stepwise regression on window means.
+
+    Parameters
+    ----------
+    runs
+        Training runs: :class:`Recording` objects or callables yielding chunks
+        of one run each (for files larger than memory).
+    thermometer
+        The unit's thermometer; gives f_ref = f(reference_c).
+    terms
+        Candidate terms (Eq. 21's nine by default).
+    window_s
+        Length of the averaging windows the regression runs on. [s]
+    penter, premove
+        Stepwise thresholds (MATLAB ``stepwisefit`` semantics).
+    initial
+        Terms in the starting model.
+    reference_c
+        Reference temperature of f. [°C]
+    rate_tau_s
+        Time constant of each stage of the causal df/dt filter. [s]
+    warmup_s
+        Start of each run left out while the filter settles; default 5 tau. [s]
+    excitation_runs
+        How many leading runs must each show a temperature change and df/dt
+        variation on their own (the user's drift runs, when soaks follow them);
+        the runs together are always checked.
+    autocorrelation
+        ``"newey-west"`` (default): divide the stepwise F statistics by the
+        long-run/plain variance ratio of the full candidate model's window
+        residuals (bandwidth n^(1/3) windows), because bias instability and rate
+        random walk keep 10 s means correlated and plain F-tests then admit terms
+        that fit noise and extrapolate badly. ``"none"``: plain ``stepwisefit``.
+    progress
+        Optional ``callback(samples_done, 0)``.
+
+    Returns
+    -------
+    DriftModel
+    """
+    candidates = tuple(t if isinstance(t, Term) else parse_terms([t])[0] for t in terms)
+    names = tuple(t.name for t in candidates)
+    if len(set(names)) != len(names):
+        raise InputError(f"candidate terms listed twice: {names}")
+    runs = list(runs)
+    if not runs:
+        raise InputError("no drift runs given; pass at least one ramp recording")
+    head = _iter_run(runs[0])
+    try:
+        first = next(head)
+    except StopIteration:
+        raise InputError("the first drift run holds no samples") from None
+    finally:
+        head.close()
+    settings = FeatureSettings(
+        reference_freq_hz=float(thermometer.frequency(reference_c)),
+        sample_rate_hz=first.metadata.sample_rate_hz,
+        reference_c=reference_c,
+        rate_tau_s=rate_tau_s,
+        warmup_s=5.0 * rate_tau_s if warmup_s is None else warmup_s,
+    )
+    windows = window_means(runs, settings, candidates, window_s, progress)
+    variables = variables_for(candidates)
+    for run in range(min(excitation_runs, len(windows.sources))):
+        _check_excitation(windows, thermometer, variables, run)
+    _check_excitation(windows, thermometer, variables)
+    scales = {}
+    for v in variables:
+        magnitude = float(np.max(np.abs(windows.variables[v])))
+        scales[v] = magnitude if magnitude > 0 else 1.0
+    settings = FeatureSettings(**{**settings.to_dict(), "scales": scales})
+    factors = np.array([t.scale_factor(scales) for t in candidates])
+    x_scaled = windows.terms / factors
+    if autocorrelation == "newey-west":
+        design = np.column_stack([np.ones(x_scaled.shape[0]), x_scaled])
+        solution = np.linalg.lstsq(design, windows.bias_dph, rcond=None)[0]
+        inflation, bandwidth = newey_west_inflation(windows.bias_dph - design @ solution)
+    elif autocorrelation == "none":
+        inflation, bandwidth = 1.0, 0
+    else:
+        raise InputError(
+            f"autocorrelation must be 'newey-west' or 'none', got {autocorrelation!r}"
+        )
+    result = stepwise(x_scaled, windows.bias_dph, names=names, penter=penter, premove=premove,
+                      initial=initial, variance_inflation=inflation,
+                      parents=hierarchy(candidates) if hierarchical else None)
+    ols = result.result
+    selected = result.selected
+    selected_factor = {t.name: t.scale_factor(scales) for t in candidates}
+    params = np.asarray(ols.params)
+    bse = np.asarray(ols.bse)
+    pvalues = np.asarray(ols.pvalues)
+    coefficients = {n: float(params[k + 1] / selected_factor[n]) for k, n in enumerate(selected)}
+    errors = {"const": float(bse[0])}
+    errors.update({n: float(bse[k + 1] / selected_factor[n]) for k, n in enumerate(selected)})
+    pv = {"const": float(pvalues[0])}
+    pv.update({n: float(pvalues[k + 1]) for k, n in enumerate(selected)})
+    ranges = {v: (float(windows.variables[v].min()), float(windows.variables[v].max()))
+              for v in variables}
+    return DriftModel(
+        settings=settings,
+        candidates=names,
+        selected=tuple(selected),
+        intercept_dph=float(params[0]),
+        coefficients=coefficients,
+        standard_errors=errors,
+        pvalues=pv,
+        scaled_coefficients=tuple(float(p) for p in params[1:]),
+        stepwise=result,
+        ranges=ranges,
+        window_s=float(window_s),
+        n_windows=int(windows.bias_dph.size),
+        n_samples=windows.n_samples,
+        residual_std_dph=float(ols.residual_std),
+        rsquared=float(ols.rsquared) if math.isfinite(ols.rsquared) else float("nan"),
+        variance_inflation=float(inflation),
+        bandwidth_windows=int(bandwidth),
+    )

@@ -1,0 +1,465 @@
+"""Drift-model inputs: the frequency change f, its rate df/dt, and the term grammar.
+
+Section 4.2 of [1] models the bias from "the frequency change" f and "the
+frequency change rate" df/dt (Eq. 21). Here f = freq_hz - f_ref, with f_ref the
+thermometer's frequency at a reference temperature (20 °C by default), and
+df/dt comes from a causal filter whose settings are stored in the model file,
+so deployment computes the same numbers sample by sample as training did.
+
+The rate filter is the derivative of a twice low-passed signal,
+D(s) = s / (tau s + 1)^2: y1 follows f through the exact one-step update of a
+first-order lag with time constant tau, y2 follows y1 likewise, and the rate
+is (y1 - y2) divided by the stages' ramp lag (tau in the continuous limit).
+Two state variables per input, no differencing of noisy samples. The gain is
+set so that the steady response to a ramp is exactly its slope; the group
+delay at low frequency is 2 tau.
+
+Variables of the grammar (all relative to the reference point):
+
+=========  ====================================================  ========
+name       meaning                                                unit
+=========  ====================================================  ========
+``f``      frequency change freq_hz - f_ref                       Hz
+``df``     causal rate of ``f``                                   Hz/s
+``h``      housing temperature change housing_c - reference_c     °C
+``dh``     causal rate of ``h``                                   °C/s
+=========  ====================================================  ========
+
+A term is a product of powers: ``f``, ``f^2``, ``f*df``, ``f^2*df``, ``h^3``.
+
+[1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from scipy import signal
+
+from hrgtc.errors import InputError
+from hrgtc.recording import Recording
+
+#: Variable name -> (unit, description).
+VARIABLES: dict[str, tuple[str, str]] = {
+    "f": ("Hz", "frequency change freq_hz - f_ref"),
+    "df": ("Hz/s", "causal rate of the frequency change"),
+    "h": ("°C", "housing temperature change housing_c - reference_c"),
+    "dh": ("°C/s", "causal rate of the housing temperature change"),
+}
+_SOURCE_COLUMN = {"f": "freq_hz", "h": "housing_c"}
+_TERM_FACTOR = re.compile(r"^\s*([a-z]+)\s*(?:\^\s*(\d+))?\s*$")
+
+
+# -- terms ---------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Term:
+    """A product of powers of variables, e.g. ``f^2*df``.
+
+    Attributes
+    ----------
+    powers
+        ((variable, power), ...) in canonical variable order.
+    """
+
+    powers: tuple[tuple[str, int], ...]
+
+    @property
+    def name(self) -> str:
+        """Canonical text, e.g. ``f^2*df``."""
+        return "*".join(v if p == 1 else f"{v}^{p}" for v, p in self.powers)
+
+    @property
+    def variables(self) -> tuple[str, ...]:
+        return tuple(v for v, _ in self.powers)
+
+    @property
+    def unit(self) -> str:
+        """Unit of the term's value, e.g. ``Hz^2·Hz/s``."""
+        parts = []
+        for v, p in self.powers:
+            unit = VARIABLES[v][0]
+            parts.append(unit if p == 1 else f"({unit})^{p}")
+        return "·".join(parts)
+
+    def evaluate(
+        self,
+        values: Mapping[str, np.ndarray],
+        powers: dict[tuple[str, int], np.ndarray] | None = None,
+    ) -> np.ndarray:
+        """The term's value from variable arrays.
+
+        ``powers`` is an optional cache of x**p shared between terms (products,
+        not ``**``: both faster and exact for small integer powers).
+        """
+        cache = {} if powers is None else powers
+        out = None
+        for v, p in self.powers:
+            factor = _power(values, v, p, cache)
+            out = factor if out is None else out * factor
+        assert out is not None
+        return out
+
+    def parents(self) -> tuple[Term, ...]:
+        """The terms one power lower, e.g. ``f^2*df`` -> ``f*df``, ``f^2``."""
+        out = []
+        for k, (v, p) in enumerate(self.powers):
+            powers = list(self.powers)
+            if p == 1:
+                del powers[k]
+            else:
+                powers[k] = (v, p - 1)
+            if powers:
+                out.append(Term(tuple(powers)))
+        return tuple(out)
+
+    def derivative(self, variable: str) -> tuple[int, Term | None]:
+        """d(term)/d(variable) as ``(multiplier, term)``; term None means the constant 1.
+
+        Returns ``(0, None)`` when the term does not contain the variable.
+        """
+        power = self.power_of(variable)
+        if power == 0:
+            return 0, None
+        rest = tuple((v, p - 1 if v == variable else p) for v, p in self.powers)
+        rest = tuple((v, p) for v, p in rest if p > 0)
+        return power, (Term(rest) if rest else None)
+
+    def power_of(self, variable: str) -> int:
+        """Power of ``variable`` in the term (0 when absent)."""
+        return dict(self.powers).get(variable, 0)
+
+    def scale_factor(self, scales: Mapping[str, float]) -> float:
+        """prod(scale_v ** p): a term of scaled variables times this is the raw term."""
+        return math.prod(scales[v] ** p for v, p in self.powers)
+
+    def __str__(self) -> str:
+        return self.name
+
+
+def _power(values: Mapping[str, np.ndarray], variable: str, power: int,
+           cache: dict[tuple[str, int], np.ndarray]) -> np.ndarray:
+    if power == 1:
+        return values[variable]
+    key = (variable, power)
+    if key not in cache:
+        cache[key] = _power(values, variable, power - 1, cache) * values[variable]
+    return cache[key]
+
+
+def parse_term(text: str) -> Term:
+    """Parse ``"f^2*df"`` into a :class:`Term`.
+
+    Examples
+    --------
+    >>> parse_term("df * f^2").name
+    'f^2*df'
+    """
+    if not isinstance(text, str) or not text.strip():
+        raise InputError(f"empty term {text!r}; write terms like 'f', 'f^2', 'f*df'")
+    powers: dict[str, int] = {}
+    for factor in text.split("*"):
+        match = _TERM_FACTOR.match(factor)
+        if match is None:
+            raise InputError(
+                f"cannot read term {text!r} at {factor.strip()!r}; write products of powers "
+                "like 'f^2*df'"
+            )
+        name, power = match.group(1), int(match.group(2) or 1)
+        if name not in VARIABLES:
+            raise InputError(
+                f"unknown variable {name!r} in term {text!r}; known: {', '.join(VARIABLES)}"
+            )
+        if power < 1:
+            raise InputError(f"power must be at least 1 in term {text!r}")
+        powers[name] = powers.get(name, 0) + power
+    order = list(VARIABLES)
+    return Term(tuple(sorted(powers.items(), key=lambda item: order.index(item[0]))))
+
+
+def parse_terms(texts: Iterable[str]) -> tuple[Term, ...]:
+    """Parse several terms; duplicates are an error."""
+    terms = tuple(parse_term(t) for t in texts)
+    names = [t.name for t in terms]
+    duplicates = sorted({n for n in names if names.count(n) > 1})
+    if duplicates:
+        raise InputError(f"term(s) listed twice: {', '.join(duplicates)}")
+    if not terms:
+        raise InputError("no terms given")
+    return terms
+
+
+#: Eq. (21) of [1]: the nine candidate terms of the drift model, f = frequency
+#: change, df = its rate of change df/dt.
+EQ21_TERMS = ("f", "f^2", "f^3", "df", "df^2", "df^3", "f*df", "f^2*df", "f*df^2")
+#: The nine candidate terms of Eq. (21) of [1], parsed.
+EQ21 = parse_terms(EQ21_TERMS)
+
+
+def hierarchy(terms: Sequence[Term]) -> dict[str, list[str]]:
+    """Term name -> names of its parents among ``terms`` (the marginality principle)."""
+    names = {t.name for t in terms}
+    return {t.name: [p.name for p in t.parents() if p.name in names] for t in terms}
+
+
+def required_columns(terms: Sequence[Term]) -> tuple[str, ...]:
+    """Recording columns the terms need (``freq_hz`` and/or ``housing_c``)."""
+    needed = []
+    for term in terms:
+        for v in term.variables:
+            column = _SOURCE_COLUMN[v.removeprefix("d")]
+            if column not in needed:
+                needed.append(column)
+    return tuple(needed)
+
+
+# -- the causal rate filter -------------------------------------------------------------
+def rate_filter_coefficients(tau_s: float, sample_rate_hz: float) -> tuple[float, float]:
+    """(alpha, beta) of one exact first-order low-pass step y += alpha (x - y)."""
+    if not (tau_s > 0 and np.isfinite(tau_s)):
+        raise InputError(f"rate filter time constant must be positive, got {tau_s} s")
+    if not (sample_rate_hz > 0 and np.isfinite(sample_rate_hz)):
+        raise InputError(f"sample rate must be positive, got {sample_rate_hz} Hz")
+    alpha = -math.expm1(-1.0 / (tau_s * sample_rate_hz))
+    return alpha, 1.0 - alpha
+
+
+@dataclass
+class RateFilterState:
+    """State of :func:`causal_rate` for one signal: the two low-pass outputs."""
+
+    y1: float | None = None
+    y2: float | None = None
+
+
+def causal_rate(
+    x: np.ndarray, tau_s: float, sample_rate_hz: float, state: RateFilterState | None = None
+) -> tuple[np.ndarray, np.ndarray, RateFilterState]:
+    """Causal rate of ``x`` by a twice low-passed exact derivative, D(s) = s/(tau s + 1)^2.
+
+    Parameters
+    ----------
+    x
+        Signal sampled at ``sample_rate_hz``. [unit]
+    tau_s
+        Time constant of each low-pass stage. [s]
+    sample_rate_hz
+        Sample rate. [Hz]
+    state
+        Filter state from the previous chunk; ``None`` starts at rest on the
+        first sample (rate 0).
+
+    Returns
+    -------
+    rate, smoothed, state
+        The rate [unit/s], the once-smoothed signal y1 [unit] and the new state.
+    """
+    x = np.asarray(x, dtype=np.float64)
+    state = RateFilterState() if state is None else RateFilterState(state.y1, state.y2)
+    if x.size == 0:
+        return np.empty(0), np.empty(0), state
+    alpha, beta = rate_filter_coefficients(tau_s, sample_rate_hz)
+    if state.y1 is None or state.y2 is None:
+        state.y1 = state.y2 = float(x[0])
+    b, a = [alpha], [1.0, -beta]
+    y1, _ = signal.lfilter(b, a, x, zi=[beta * state.y1])
+    y2, _ = signal.lfilter(b, a, y1, zi=[beta * state.y2])
+    # For a ramp of slope s the discrete stages lag by s·dt·beta/alpha (= s·tau in the
+    # continuous limit), so this gain makes the steady ramp response exactly s.
+    rate = (y1 - y2) * (alpha * sample_rate_hz / beta)
+    state.y1, state.y2 = float(y1[-1]), float(y2[-1])
+    return rate, y1, state
+
+
+# -- feature settings and computation ---------------------------------------------------
+@dataclass(frozen=True)
+class FeatureSettings:
+    """Everything needed to compute the drift-model variables from a recording.
+
+    Attributes
+    ----------
+    reference_freq_hz
+        f_ref: frequency at the reference temperature. [Hz]
+    reference_c
+        Reference temperature (also the origin of ``h``). [°C]
+    sample_rate_hz
+        Sample rate the filter was designed for. [Hz]
+    rate_tau_s
+        Time constant of each stage of the rate filter. [s]
+    warmup_s
+        Start of each run discarded in training while the filter settles. [s]
+    scales
+        Variable -> scale used internally so every variable is of order one.
+    """
+
+    reference_freq_hz: float
+    sample_rate_hz: float
+    reference_c: float = 20.0
+    rate_tau_s: float = 10.0
+    warmup_s: float = 600.0
+    scales: dict[str, float] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "reference_freq_hz": self.reference_freq_hz,
+            "sample_rate_hz": self.sample_rate_hz,
+            "reference_c": self.reference_c,
+            "rate_tau_s": self.rate_tau_s,
+            "warmup_s": self.warmup_s,
+            "scales": dict(self.scales),
+        }
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> FeatureSettings:
+        try:
+            return cls(
+                reference_freq_hz=float(data["reference_freq_hz"]),
+                sample_rate_hz=float(data["sample_rate_hz"]),
+                reference_c=float(data["reference_c"]),
+                rate_tau_s=float(data["rate_tau_s"]),
+                warmup_s=float(data["warmup_s"]),
+                scales={str(k): float(v) for k, v in dict(data.get("scales", {})).items()},
+            )
+        except (KeyError, TypeError, ValueError) as exc:
+            raise InputError(f"not a valid feature-settings record: {exc!r}") from exc
+
+    def check_sample_rate(self, recording: Recording) -> None:
+        """Raise when a recording's rate differs from the one the filter was built for."""
+        rate = recording.metadata.sample_rate_hz
+        if not math.isclose(rate, self.sample_rate_hz, rel_tol=1e-6):
+            where = f"{recording.source}: " if recording.source else ""
+            raise InputError(
+                f"{where}sample rate {rate:g} Hz differs from the model's {self.sample_rate_hz:g} "
+                "Hz; the df/dt filter is defined per sample, so resample the recording or "
+                "calibrate at this rate"
+            )
+
+
+class FeatureStream:
+    """Sample-by-sample computation of f, df, h, dh over consecutive chunks of one run.
+
+    The batch computation is "reset, then one chunk", so any chunking gives
+    the same numbers (to rounding of the filter's state hand-over).
+    """
+
+    def __init__(self, settings: FeatureSettings, variables: Iterable[str] = ("f", "df")):
+        self.settings = settings
+        self.variables = tuple(variables)
+        unknown = [v for v in self.variables if v not in VARIABLES]
+        if unknown:
+            raise InputError(f"unknown variable(s) {unknown}; known: {', '.join(VARIABLES)}")
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget the filter state (start of a new run)."""
+        self._states: dict[str, RateFilterState] = {}
+        self.samples_seen = 0
+
+    def process(self, chunk: Recording) -> dict[str, np.ndarray]:
+        """Variables of the next chunk of the run, keyed by variable name."""
+        s = self.settings
+        base: dict[str, np.ndarray] = {}
+        if any(v in ("f", "df") for v in self.variables):
+            base["f"] = chunk["freq_hz"] - s.reference_freq_hz
+        if any(v in ("h", "dh") for v in self.variables):
+            base["h"] = chunk["housing_c"] - s.reference_c
+        out: dict[str, np.ndarray] = {}
+        for v in self.variables:
+            if v in base:
+                out[v] = base[v]
+            else:
+                source = v.removeprefix("d")
+                rate, _, self._states[source] = causal_rate(
+                    base[source], s.rate_tau_s, s.sample_rate_hz, self._states.get(source)
+                )
+                out[v] = rate
+        self.samples_seen += len(chunk)
+        return out
+
+
+def compute_variables(
+    recording: Recording, settings: FeatureSettings, variables: Iterable[str] = ("f", "df")
+) -> dict[str, np.ndarray]:
+    """Batch form of :class:`FeatureStream`: the variables of a whole run."""
+    return FeatureStream(settings, variables).process(recording)
+
+
+def linear_combination(
+    terms: Sequence[Term],
+    coefficients: Sequence[float],
+    values: Mapping[str, np.ndarray],
+    scales: Mapping[str, float],
+    intercept: float = 0.0,
+) -> np.ndarray:
+    """intercept + sum_k c_k term_k(values / scales), without building the design matrix."""
+    scaled = {v: values[v] / scales[v] for v in variables_for(terms)}
+    n = next(iter(values.values())).shape[0]
+    out = np.full(n, intercept, dtype=np.float64)
+    cache: dict[tuple[str, int], np.ndarray] = {}
+    for term, c in zip(terms, coefficients, strict=True):
+        out += c * term.evaluate(scaled, cache)
+    return out
+
+
+def tangent_extension(
+    terms: Sequence[Term],
+    coefficients: Sequence[float],
+    values: Mapping[str, np.ndarray],
+    scales: Mapping[str, float],
+    ranges: Mapping[str, tuple[float, float]],
+    intercept: float = 0.0,
+) -> np.ndarray:
+    """The model inside the ranges, continued along its tangent plane outside them.
+
+    Each variable is held at the edge of its range, the model evaluated there,
+    and its first-order Taylor term added: B(c) + sum_v dB/dv(c) (v - c). Inside the
+    ranges this is exactly :func:`linear_combination`; outside, a law linear in a
+    variable is still exact while cubic terms no longer run away.
+    """
+    used = variables_for(terms)
+    held = {v: (np.clip(values[v], *ranges[v]) if v in ranges else values[v]) for v in used}
+    out = linear_combination(terms, coefficients, held, scales, intercept)
+    outside = {v: values[v] - held[v] for v in used if v in ranges}
+    if not any(np.any(d != 0.0) for d in outside.values()):
+        return out
+    scaled = {v: held[v] / scales[v] for v in used}
+    cache: dict[tuple[str, int], np.ndarray] = {}
+    for v, delta in outside.items():
+        gradient = np.zeros_like(delta)
+        for term, c in zip(terms, coefficients, strict=True):
+            multiplier, rest = term.derivative(v)
+            if multiplier:
+                factor = c * multiplier / scales[v]
+                gradient += factor if rest is None else factor * rest.evaluate(scaled, cache)
+        out += gradient * delta
+    return out
+
+
+def variables_for(terms: Sequence[Term]) -> tuple[str, ...]:
+    """Variables the terms use, in grammar order."""
+    used = {v for t in terms for v in t.variables}
+    return tuple(v for v in VARIABLES if v in used)
+
+
+def design_matrix(
+    terms: Sequence[Term],
+    values: Mapping[str, np.ndarray],
+    scales: Mapping[str, float] | None = None,
+) -> np.ndarray:
+    """Columns of term values, on scaled variables when ``scales`` is given.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (n_samples, n_terms), float64.
+    """
+    if scales:
+        values = {v: values[v] / scales[v] for v in variables_for(terms)}
+    cache: dict[tuple[str, int], np.ndarray] = {}
+    columns = [np.asarray(t.evaluate(values, cache), dtype=np.float64) for t in terms]
+    n = next(iter(values.values())).shape[0] if values else 0
+    return np.column_stack(columns) if columns else np.empty((n, 0))

@@ -1,0 +1,35 @@
+"""Evaluation: stage 5, how much better the gyro got.
+
+Takes a unit model and a run and gives, in one pass (``run_pass``), the raw
+and compensated bias stability (Section 4.2 of [1]: 3.0143 -> 0.5848 °/h),
+Allan deviations and noise terms (``allan``), the out-of-range shares and the
+residual against the simulator's true bias; ``metrics`` holds the figures of
+merit themselves.
+
+[1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
+"""
+
+from hrgtc.evaluation.allan import AllanResult, NoiseTerms, allan_deviation, noise_terms
+from hrgtc.evaluation.metrics import (
+    DEFAULT_TAUS_S,
+    ResidualResult,
+    bias_stability,
+    bias_stability_table,
+    residual_against_truth,
+)
+from hrgtc.evaluation.run_pass import Evaluation, evaluate, evaluate_chunks
+
+__all__ = [
+    "DEFAULT_TAUS_S",
+    "AllanResult",
+    "Evaluation",
+    "NoiseTerms",
+    "ResidualResult",
+    "allan_deviation",
+    "bias_stability",
+    "bias_stability_table",
+    "evaluate",
+    "evaluate_chunks",
+    "noise_terms",
+    "residual_against_truth",
+]

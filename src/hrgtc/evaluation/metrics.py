@@ -1,0 +1,213 @@
+"""Evaluation metrics: bias stability, Allan deviation and the Allan noise terms.
+
+The paper [1] judges a compensation by the bias stability of the gyro output
+(Section 4.2 of [1]: 3.0143 -> 0.5848 °/h); DESIGN.md adds the Allan deviation
+and the three noise terms that gyro data sheets quote.
+
+- :func:`bias_stability`: 1σ of non-overlapping τ-second means, in °/h.
+- :func:`allan_deviation`, :func:`noise_terms`: from :mod:`hrgtc.evaluation.allan`.
+- :func:`residual_against_truth`: how well a bias model tracks the simulator's
+  true bias.
+
+[1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping
+from dataclasses import asdict, dataclass
+from typing import Any
+
+import numpy as np
+
+from hrgtc.errors import InputError
+from hrgtc.evaluation.allan import (
+    DEFAULT_TAUS_S,
+    FLICKER_FLOOR_FACTOR,
+    SECONDS_PER_HOUR,
+    TAU_SPACINGS,
+    AllanResult,
+    NoiseTerms,
+    _as_rate,
+    _block_length,
+    _check_sample_rate,
+    allan_deviation,
+    noise_terms,
+)
+
+__all__ = [
+    "DEFAULT_TAUS_S", "FLICKER_FLOOR_FACTOR", "SECONDS_PER_HOUR", "TAU_SPACINGS",
+    "AllanResult", "NoiseTerms", "ResidualResult", "allan_deviation", "bias_stability",
+    "bias_stability_table", "noise_terms", "residual_against_truth",
+]
+
+# --------------------------------------------------------------------------- bias stability
+def _bias_stability(rate: np.ndarray, m: int) -> float:
+    blocks = rate.size // m
+    if blocks < 2:
+        return math.nan
+    means = rate[: blocks * m].reshape(blocks, m).mean(axis=1)
+    return float(np.std(means, ddof=1))
+
+
+def bias_stability(rate_dph: Any, sample_rate_hz: float, tau_s: float = 10.0) -> float:
+    """Bias stability: 1σ of non-overlapping τ-second means of the rate.
+
+    The figure of merit of Section 4.2 of [1] (3.0143 -> 0.5848 °/h at 10 s);
+    definition of DESIGN.md: the record is cut into ``floor(N / m)`` blocks of
+    ``m = round(tau_s * sample_rate_hz)`` samples (the incomplete last block is
+    dropped), each block is averaged, and the sample standard deviation
+    (``ddof=1``) of the block means is returned. A constant input rate does not
+    change the result.
+
+    Parameters
+    ----------
+    rate_dph
+        Gyro output or bias, one value per sample. [°/h]
+    sample_rate_hz
+        Sample rate. [Hz]
+    tau_s
+        Averaging time. [s]
+
+    Returns
+    -------
+    float
+        Bias stability (1σ). [°/h]
+
+    Raises
+    ------
+    InputError
+        If fewer than two whole blocks fit in the record, or the input is not
+        finite and 1-D.
+
+    Examples
+    --------
+    >>> bias_stability([1.0, 3.0, 5.0, 7.0, 9.0, 11.0, 99.0], sample_rate_hz=1.0, tau_s=2.0)
+    4.0
+    """
+    fs = _check_sample_rate(sample_rate_hz)
+    rate = _as_rate(rate_dph, "rate_dph")
+    m = _block_length(tau_s, fs)
+    if rate.size // m < 2:
+        raise InputError(
+            f"bias stability at tau_s={tau_s:g} s needs at least 2 blocks of {m} samples, but "
+            f"rate_dph has only {rate.size} samples ({rate.size / fs:g} s); use a shorter "
+            "tau_s or a longer record"
+        )
+    return _bias_stability(rate, m)
+
+
+def bias_stability_table(
+    rate_dph: Any, sample_rate_hz: float, taus_s: Iterable[float] = DEFAULT_TAUS_S
+) -> dict[float, float]:
+    """Bias stability ``{tau_s: value}`` at several averaging times [s] -> [°/h].
+
+    As :func:`bias_stability` (same arguments, ``taus_s`` in [s]), except that a
+    τ for which fewer than two blocks fit gives NaN instead of an error (render
+    it as "n/a" or JSON null).
+    """
+    fs = _check_sample_rate(sample_rate_hz)
+    rate = _as_rate(rate_dph, "rate_dph")
+    return {float(tau): _bias_stability(rate, _block_length(tau, fs)) for tau in taus_s}
+
+
+# --------------------------------------------------------------------------- residual vs truth
+@dataclass(frozen=True)
+class ResidualResult:
+    """Error of a bias model against the true bias (simulator ground truth).
+
+    Attributes
+    ----------
+    rms_dph
+        Root mean square of ``bias_model − true_bias``. [°/h]
+    mean_dph
+        Mean of the residual. [°/h]
+    max_abs_dph
+        Largest absolute residual. [°/h]
+    bias_stability_dph
+        Bias stability of the residual at each τ (NaN where < 2 blocks fit). [s] -> [°/h]
+    n_samples
+        Number of samples.
+    """
+
+    rms_dph: float
+    mean_dph: float
+    max_abs_dph: float
+    bias_stability_dph: dict[float, float]
+    n_samples: int
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types; τ keys become strings and NaN becomes None."""
+        table = {f"{t:g}": None if math.isnan(v) else v for t, v in self.bias_stability_dph.items()}
+        return {**asdict(self), "bias_stability_dph": table}
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> ResidualResult:
+        """Inverse of :meth:`to_dict`."""
+        table = {
+            float(t): math.nan if v is None else v for t, v in data["bias_stability_dph"].items()
+        }
+        return cls(**{**data, "bias_stability_dph": table})
+
+    def summary(self) -> str:
+        """One line with RMS, mean and maximum, one with the bias stabilities."""
+        stability = ", ".join(
+            f"{tau:g} s: {value:.4g}" for tau, value in self.bias_stability_dph.items()
+        )
+        return (
+            f"model - true bias over {self.n_samples} samples: rms {self.rms_dph:.4g} deg/h, "
+            f"mean {self.mean_dph:.4g} deg/h, max |.| {self.max_abs_dph:.4g} deg/h\n"
+            f"bias stability of the residual [deg/h]: {stability}"
+        )
+
+
+def residual_against_truth(
+    *,
+    bias_model_dph: Any,
+    true_bias_dph: Any,
+    sample_rate_hz: float,
+    taus_s: Iterable[float] = DEFAULT_TAUS_S,
+) -> ResidualResult:
+    """How well a bias model tracks the true bias: statistics of ``bias_model − true_bias``.
+
+    With ``compensated = rate − bias_model`` (Section 4.2 of [1]) and
+    ``rate = input_rate + true_bias (+ noise)``, the bias left in the compensated
+    output is ``compensated − input_rate = true_bias − bias_model (+ noise)``,
+    the negative of this residual. Pass the ``bias_model_dph`` column of a
+    compensated recording and the simulator's ``bias_dph`` column; keyword-only,
+    so the two cannot be swapped. If the true bias excludes the noise, the
+    residual is the pure model error.
+
+    Parameters
+    ----------
+    bias_model_dph
+        Bias predicted by the model. [°/h]
+    true_bias_dph
+        True bias (simulator ground truth, column ``bias_dph``). [°/h]
+    sample_rate_hz
+        Sample rate. [Hz]
+    taus_s
+        Averaging times of the bias-stability table. [s]
+
+    Returns
+    -------
+    ResidualResult
+        RMS, mean, maximum and bias stabilities of the residual.
+    """
+    fs = _check_sample_rate(sample_rate_hz)
+    model = _as_rate(bias_model_dph, "bias_model_dph")
+    truth = _as_rate(true_bias_dph, "true_bias_dph")
+    if model.shape != truth.shape:
+        raise InputError(
+            f"bias_model_dph has {model.size} samples but true_bias_dph has {truth.size}; "
+            "pass the two columns of the same recording"
+        )
+    residual = model - truth
+    return ResidualResult(
+        rms_dph=float(np.sqrt(np.mean(residual * residual))),
+        mean_dph=float(residual.mean()),
+        max_abs_dph=float(np.max(np.abs(residual))),
+        bias_stability_dph=bias_stability_table(residual, fs, taus_s),
+        n_samples=int(residual.size),
+    )

@@ -1,0 +1,65 @@
+"""Recordings: stage 1 of the pipeline.
+
+Takes a user's file (Parquet, CSV or HDF5, with their column names and units)
+and gives a validated :class:`Recording` in the contract of DESIGN.md — whole
+(:func:`read`) or in chunks of bounded memory (:func:`iter_chunks`) — or a
+description of it (:func:`describe`). :class:`RecordingWriter` and :func:`write`
+write recordings atomically.
+
+Modules: ``schema`` (the type and its columns), ``formats`` and ``csv`` (file
+formats), ``mapping`` (user columns and units), ``validation`` (the contract's
+checks), ``io`` (reading and writing), ``info`` (what is in a file).
+"""
+
+from hrgtc.recording.info import RecordingInfo, describe
+from hrgtc.recording.io import (
+    RecordingWriter,
+    count_rows,
+    iter_chunks,
+    open_source,
+    read,
+    write,
+)
+from hrgtc.recording.mapping import parse_columns, parse_unit, parse_units
+from hrgtc.recording.schema import (
+    COLUMNS,
+    REQUIRED_COLUMNS,
+    SCHEMA_VERSION,
+    Metadata,
+    Recording,
+    concatenate,
+)
+from hrgtc.recording.validation import (
+    Gap,
+    Problem,
+    RecordingValidator,
+    ValidationReport,
+    split_at_gaps,
+    validate,
+)
+
+__all__ = [
+    "COLUMNS",
+    "REQUIRED_COLUMNS",
+    "SCHEMA_VERSION",
+    "Gap",
+    "Metadata",
+    "Problem",
+    "Recording",
+    "RecordingInfo",
+    "RecordingValidator",
+    "RecordingWriter",
+    "ValidationReport",
+    "concatenate",
+    "count_rows",
+    "describe",
+    "iter_chunks",
+    "open_source",
+    "parse_columns",
+    "parse_unit",
+    "parse_units",
+    "read",
+    "split_at_gaps",
+    "validate",
+    "write",
+]

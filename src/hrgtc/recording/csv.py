@@ -1,0 +1,312 @@
+"""CSV recordings: ``# key: value`` metadata header (or a JSON sidecar) and a fast parser.
+
+Reading uses pyarrow's multi-threaded CSV parser (whole files) or its streaming
+reader (chunks), the columns forced to float64, so millions of rows take
+seconds; its errors are translated into messages that name the file, column,
+line or row, the bad value and the fix. Writing uses pyarrow's CSV writer, whose
+floats are the shortest strings that round-trip (as exact as ``%.17g``).
+
+Layout written by hrgtc::
+
+    # hrgtc recording (schema 1)
+    # sample_rate_hz: 200.0
+    # unit: paper-unit
+    # input_rate_dph: 9.67
+    # profile: soak -10 C
+    # schema: 1
+    # extra: {"seed": 1}
+    time_s,freq_hz,rate_dph
+    0,4424.9,9.71
+    ...
+
+Strings are written bare when that reads back unchanged, else as JSON. Foreign
+files: comment lines of other forms are ignored, ``key: value`` lines of other
+keys go to ``extra``, the delimiter (``,``, ``;`` or tab) is sniffed from the
+header, and a file without a header gets columns ``column_1``, ``column_2``, ...
+A sidecar ``<file>.json`` (e.g. ``run.csv.json``) adds to or overrides the header.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from collections.abc import Iterator, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.csv as pa_csv
+
+from hrgtc.errors import RecordingError
+from hrgtc.recording.formats import (
+    Sink,
+    Source,
+    first_failing,
+    kind_of,
+    loads_json,
+    metadata_json,
+)
+from hrgtc.recording.schema import Metadata
+
+CSV_BLOCK_BYTES = 8 << 20
+_STRING_KEYS = ("unit", "profile")
+
+
+class CsvSource(Source):
+    format = "csv"
+
+    def __init__(self, path: Path) -> None:
+        super().__init__(path)
+        self._offset, header, comments = _csv_head(path)
+        self.metadata = _parse_comment_metadata(comments)
+        self.delimiter = _sniff_delimiter(header)
+        fields = [f.strip().strip('"').strip() for f in header.split(self.delimiter)]
+        self._header_rows = 1
+        if header and all(_is_number(f) for f in fields):
+            fields = [f"column_{i + 1}" for i in range(len(fields))]
+            self._header_rows = 0
+        duplicated = sorted({f for f in fields if fields.count(f) > 1})
+        if not header or duplicated:
+            what = f"duplicate column names {duplicated}" if header else "no header line"
+            raise RecordingError(f"{path}: {what}; give every column a unique name")
+        self.names = fields
+        sidecar = Path(f"{path}.json")
+        if sidecar.exists():
+            try:
+                extra = loads_json(sidecar.read_text(encoding="utf-8"))
+            except (ValueError, UnicodeDecodeError) as exc:
+                raise RecordingError(f"{sidecar}: not valid JSON ({exc})") from None
+            if not isinstance(extra, dict):
+                raise RecordingError(f"{sidecar}: expected a JSON object of metadata")
+            self.metadata.update(extra)
+        self._size = path.stat().st_size
+        self._streams: list[pa.NativeFile] = []
+        self._rows_done = 0
+        with open(path, "rb") as handle:  # bytes per row from the first MiB, for progress
+            handle.seek(self._offset)
+            sample = handle.read(1 << 20)
+        self._bytes_per_row = len(sample) / max(sample.count(b"\n"), 1)
+
+    def _options(self, names: Sequence[str], as_text: set[str], block: int) -> dict[str, Any]:
+        types = {n: pa.string() if n in as_text else pa.float64() for n in names}
+        return {
+            "read_options": pa_csv.ReadOptions(
+                column_names=self.names, skip_rows=self._header_rows, block_size=block
+            ),
+            "parse_options": pa_csv.ParseOptions(delimiter=self.delimiter),
+            "convert_options": pa_csv.ConvertOptions(
+                include_columns=list(names), column_types=types
+            ),
+        }
+
+    def _open(self) -> pa.NativeFile:
+        stream = pa.OSFile(str(self.path))  # not a memory map: its pages would count as RSS
+        stream.seek(self._offset)
+        self._streams.append(stream)
+        return stream
+
+    def kinds(self) -> dict[str, str]:
+        options = {
+            "read_options": pa_csv.ReadOptions(
+                column_names=self.names, skip_rows=self._header_rows, block_size=1 << 16
+            ),
+            "parse_options": pa_csv.ParseOptions(delimiter=self.delimiter),
+        }
+        try:
+            reader = pa_csv.open_csv(self._open(), **options)
+        except pa.ArrowInvalid as exc:
+            raise self._translate(exc, set()) from None
+        return {f.name: kind_of(f.type) for f in reader.schema}
+
+    def read(self, names: Sequence[str], as_text: set[str]) -> pa.Table:
+        try:
+            return pa_csv.read_csv(self._open(), **self._options(names, as_text, CSV_BLOCK_BYTES))
+        except pa.ArrowInvalid as exc:
+            raise self._translate(exc, as_text) from None
+
+    def iter_tables(self, names: Sequence[str], as_text: set[str], rows: int) -> Iterator[pa.Table]:
+        try:
+            reader = pa_csv.open_csv(self._open(), **self._options(names, as_text, CSV_BLOCK_BYTES))
+            for batch in reader:
+                self._rows_done += batch.num_rows
+                yield pa.Table.from_batches([batch])
+        except pa.ArrowInvalid as exc:
+            raise self._translate(exc, as_text) from None
+
+    def count_rows(self) -> int:
+        rows, last = 0, b"\n"  # non-empty lines; "\r" is not content
+        with open(self.path, "rb") as handle:
+            handle.seek(self._offset)
+            while block := handle.read(4 << 20):
+                block = block.replace(b"\r", b"")
+                if not block:
+                    continue
+                newline = np.frombuffer(block, np.uint8) == 10
+                empty = np.count_nonzero(newline[1:] & newline[:-1])
+                empty += bool(newline[0]) and last == b"\n"
+                rows += int(np.count_nonzero(newline)) - int(empty)
+                last = block[-1:]
+        return rows + (last != b"\n") - self._header_rows
+
+    def position(self) -> tuple[float, float]:
+        done = self._offset + self._rows_done * self._bytes_per_row
+        return (float(min(done, self._size)), float(self._size))
+
+    def close(self) -> None:
+        for stream in self._streams:
+            stream.close()
+        self._streams = []
+
+    # -- errors: name the file, column, row, value and the fix -----------------
+    def _translate(self, exc: Exception, as_text: set[str]) -> RecordingError:
+        text = str(exc)
+        conversion = re.search(r"CSV column #(\d+): CSV conversion error to \w+", text)
+        if conversion:
+            name = self.names[int(conversion.group(1))]
+            row, value = self._locate_bad_value(name)
+            return RecordingError(
+                f"{self.path}: column '{name}', row {row}: {value!r} is not a number; "
+                f"{bad_number_hint(value)}"
+            )
+        fields = re.search(r"Expected (\d+) columns, got (\d+)", text)
+        if fields:
+            line, row, got = self._locate_bad_line()
+            return RecordingError(
+                f"{self.path}: line {line} (row {row}): expected {fields.group(1)} fields, got "
+                f"{got}; the line is truncated or malformed, repair or delete it"
+            )
+        return RecordingError(f"{self.path}: cannot parse the CSV ({text})")
+
+    def _locate_bad_value(self, name: str) -> tuple[int | str, str]:
+        options = self._options([name], {name}, CSV_BLOCK_BYTES)
+        offset = 0
+        for batch in pa_csv.open_csv(self._open(), **options):
+            column = batch.column(0)
+            try:
+                column.cast(pa.float64())
+            except (pa.ArrowInvalid, pa.ArrowTypeError):
+                i = first_failing(column, lambda a: a.cast(pa.float64()))
+                return offset + i, str(column[i].as_py())
+            offset += batch.num_rows
+        return "?", "?"
+
+    def _locate_bad_line(self) -> tuple[int | str, int | str, int | str]:
+        expected = len(self.names)
+        line_no = 0
+        row = -self._header_rows
+        with open(self.path, "rb") as handle:
+            handle.seek(self._offset)
+            line_no = _count_lines(self.path, self._offset)
+            for raw in handle:
+                line_no += 1
+                if not raw.strip():
+                    continue
+                got = raw.count(self.delimiter.encode()) + 1
+                if row >= 0 and got != expected:
+                    return line_no, row, got
+                row += 1
+        return "?", "?", "?"
+
+
+def _csv_head(path: Path) -> tuple[int, str, list[str]]:
+    """Byte offset of the header line, the header line and the comment lines."""
+    comments: list[str] = []
+    offset = 0
+    with open(path, "rb") as handle:
+        for raw in handle:
+            text = raw.decode("utf-8", "replace")
+            if offset == 0 and text.startswith("\ufeff"):
+                text = text[1:]
+            stripped = text.strip()
+            if stripped.startswith("#"):
+                comments.append(stripped[1:].strip())
+            elif stripped:
+                return offset, stripped, comments
+            offset += len(raw)
+    return offset, "", comments
+
+
+def _count_lines(path: Path, offset: int) -> int:
+    with open(path, "rb") as handle:
+        return handle.read(offset).count(b"\n")
+
+
+def _sniff_delimiter(header: str) -> str:
+    counts = {d: header.count(d) for d in (",", ";", "\t")}
+    best = max(counts, key=counts.__getitem__)
+    return best if counts[best] else ","
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def bad_number_hint(text: str) -> str:
+    """How to fix a value that should be a number."""
+    if re.match(r"^\s*\d{4}-\d{2}-\d{2}([T ]\d{1,2}:\d{2}.*)?$", text):
+        return "if the column holds dates and times pass --time-unit timestamp"
+    return "fix or remove that row"
+
+
+def _parse_comment_metadata(lines: Sequence[str]) -> dict[str, Any]:
+    metadata: dict[str, Any] = {}
+    for line in lines:
+        key, sep, raw = line.partition(":")
+        key = key.strip()
+        if not sep or not re.fullmatch(r"[A-Za-z_][\w .\-]*", key):
+            continue
+        metadata[key] = _header_value(key, raw.strip())
+    return metadata
+
+
+def _header_value(key: str, raw: str) -> Any:
+    if key in _STRING_KEYS and not raw.startswith('"'):
+        return raw
+    try:
+        return loads_json(raw)
+    except ValueError:
+        return raw
+
+
+def csv_header(metadata: Metadata, names: Sequence[str]) -> bytes:
+    """Comment lines with the metadata and the column header line."""
+    metadata_json(metadata)  # fail early on non-JSON extra
+    lines = [f"# hrgtc recording (schema {metadata.schema})"]
+    for key, value in metadata.to_dict().items():
+        text = value if isinstance(value, str) else json.dumps(value)
+        if _header_value(key, text) != value or "\n" in text:
+            text = json.dumps(value)
+        lines.append(f"# {key}: {text}")
+    quoted = [f'"{n}"' if any(c in n for c in ',;\t"') else n for n in names]
+    lines.append(",".join(quoted))
+    return ("\n".join(lines) + "\n").encode("utf-8")
+
+
+class CsvSink(Sink):
+    def __init__(self, path: Path, metadata: Metadata, names: Sequence[str]) -> None:
+        super().__init__(path, metadata, names)
+        self._handle = open(path, "wb")  # closed in close() / abort()
+        self._handle.write(csv_header(metadata, names))
+        self._schema = pa.schema([pa.field(n, pa.float64()) for n in names])
+        self._writer = pa_csv.CSVWriter(
+            self._handle, self._schema, write_options=pa_csv.WriteOptions(include_header=False)
+        )
+
+    def write(self, columns: Mapping[str, np.ndarray]) -> None:
+        arrays = [pa.array(columns[n]) for n in self.names]
+        self._writer.write_table(pa.Table.from_arrays(arrays, schema=self._schema))
+
+    def close(self) -> None:
+        self._writer.close()
+        self._handle.close()
+
+    def abort(self) -> None:
+        try:
+            self._writer.close()
+        finally:
+            self._handle.close()

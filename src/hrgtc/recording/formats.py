@@ -1,0 +1,372 @@
+"""File formats of recordings: the source and sink interfaces, Parquet and HDF5.
+
+A *source* opens a file, lists its columns and raw metadata, and reads the
+columns asked for as :class:`pyarrow.Table` objects, whole or in batches, without
+loading more than a batch. A *sink* writes float64 columns chunk by chunk to a
+(temporary) path; :mod:`hrgtc.recording.io` makes that atomic.
+
+Layouts written by hrgtc:
+
+* Parquet: one float64 column per recording column; the metadata as JSON in the
+  schema metadata under the key ``b"hrgtc"``; each field's unit in the field
+  metadata (``b"unit"``).
+* CSV: see :mod:`hrgtc.recording.csv`.
+* HDF5: a group ``/recording`` with one 1-D float64 dataset per column (its unit
+  in the attribute ``unit``) and the metadata as attributes of the group
+  (``extra`` as a JSON string). Foreign files: the group ``recording`` if
+  present, else the root if it holds 1-D datasets, else the only group.
+"""
+
+from __future__ import annotations
+
+import bisect
+import json
+import math
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+from hrgtc.errors import RecordingError
+from hrgtc.recording.schema import COLUMNS, Metadata
+
+SUFFIXES: dict[str, str] = {
+    ".parquet": "parquet",
+    ".pq": "parquet",
+    ".csv": "csv",
+    ".h5": "hdf5",
+    ".hdf5": "hdf5",
+}
+#: Output format name (CLI ``--format``) -> suffix.
+FORMAT_SUFFIXES: dict[str, str] = {"parquet": ".parquet", "csv": ".csv", "h5": ".h5"}
+METADATA_KEY = b"hrgtc"
+HDF5_GROUP = "recording"
+PARQUET_ROW_GROUP_ROWS = 1 << 20
+HDF5_CHUNK_ROWS = 1 << 16
+
+
+def format_of(path: str | Path) -> str:
+    """``"parquet"``, ``"csv"`` or ``"hdf5"`` from the suffix of ``path``."""
+    suffix = Path(path).suffix.lower()
+    if suffix not in SUFFIXES:
+        known = ", ".join(SUFFIXES)
+        raise RecordingError(
+            f"{path}: unknown file type {suffix or '(no suffix)'!r}; use one of {known}"
+        )
+    return SUFFIXES[suffix]
+
+
+def kind_of(dtype: pa.DataType) -> str:
+    """``"numeric"``, ``"string"``, ``"timestamp"`` or ``"other"`` for an Arrow type."""
+    if (
+        pa.types.is_integer(dtype)
+        or pa.types.is_floating(dtype)
+        or pa.types.is_boolean(dtype)
+        or pa.types.is_decimal(dtype)
+        or pa.types.is_null(dtype)
+    ):
+        return "numeric"
+    if pa.types.is_string(dtype) or pa.types.is_large_string(dtype):
+        return "string"
+    if pa.types.is_timestamp(dtype) or pa.types.is_date(dtype):
+        return "timestamp"
+    return "other"
+
+
+def metadata_json(metadata: Metadata) -> str:
+    """The metadata as JSON text (RecordingError if ``extra`` is not JSON)."""
+    try:
+        return json.dumps(metadata.to_dict(), allow_nan=False)
+    except (TypeError, ValueError) as exc:
+        raise RecordingError(f"metadata cannot be stored as JSON ({exc}); use JSON types") from None
+
+
+def _reject_constant(name: str) -> Any:
+    raise ValueError(f"{name} is not allowed in hrgtc metadata")
+
+
+def loads_json(text: str | bytes) -> Any:
+    """``json.loads`` that refuses NaN and Infinity (metadata must stay strict JSON)."""
+    return json.loads(text, parse_constant=_reject_constant)
+
+
+def first_failing(array: pa.Array | pa.ChunkedArray, convert: Callable[[Any], Any]) -> int:
+    """Index of the first element for which ``convert`` raises (bisection on prefixes)."""
+    low, high = 0, len(array)  # prefix [:low] converts, [:high] fails
+
+    def fails(n: int) -> bool:
+        try:
+            convert(array.slice(0, n))
+        except (pa.ArrowInvalid, pa.ArrowTypeError, ValueError):
+            return True
+        return False
+
+    return bisect.bisect_left(range(low, high + 1), True, key=fails) - 1
+
+
+# -- sources -------------------------------------------------------------------
+class Source:
+    """An open recording file: column names, raw metadata and batched reading."""
+
+    format = ""
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+        self.names: list[str] = []
+        self.metadata: dict[str, Any] = {}
+        self.total_rows: int | None = None
+
+    def kinds(self) -> dict[str, str]:
+        """Column name -> kind (see :func:`kind_of`)."""
+        raise NotImplementedError
+
+    def read(self, names: Sequence[str], as_text: set[str]) -> pa.Table:
+        """The columns ``names`` (those in ``as_text`` as text where that matters)."""
+        raise NotImplementedError
+
+    def iter_tables(self, names: Sequence[str], as_text: set[str], rows: int) -> Iterator[pa.Table]:
+        """The same, in consecutive tables of at most about ``rows`` rows."""
+        raise NotImplementedError
+
+    def count_rows(self) -> int:
+        """Number of data rows."""
+        return int(self.total_rows or 0)
+
+    def position(self) -> tuple[float, float]:
+        """(done, total) of the reading so far, for progress callbacks."""
+        return (0.0, float(self.total_rows or 0))
+
+    def close(self) -> None:
+        """Release the file."""
+
+    def __enter__(self) -> Source:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+class ParquetSource(Source):
+    format = "parquet"
+
+    def __init__(self, path: Path) -> None:
+        super().__init__(path)
+        try:
+            self._file = pq.ParquetFile(path, pre_buffer=False)  # keeps batch reads small
+        except (pa.ArrowInvalid, OSError) as exc:
+            if isinstance(exc, FileNotFoundError):
+                raise
+            raise RecordingError(f"{path}: not a readable Parquet file ({exc})") from None
+        schema = self._file.schema_arrow
+        self.names = list(schema.names)
+        self.total_rows = self._file.metadata.num_rows
+        raw = (schema.metadata or {}).get(METADATA_KEY)
+        if raw is not None:
+            try:
+                self.metadata = dict(loads_json(raw))
+            except (ValueError, TypeError):
+                raise RecordingError(f"{path}: the hrgtc metadata is not valid JSON") from None
+        self._done = 0
+
+    def kinds(self) -> dict[str, str]:
+        return {f.name: kind_of(f.type) for f in self._file.schema_arrow}
+
+    def read(self, names: Sequence[str], as_text: set[str]) -> pa.Table:
+        return self._file.read(columns=list(names))
+
+    def iter_tables(self, names: Sequence[str], as_text: set[str], rows: int) -> Iterator[pa.Table]:
+        for batch in self._file.iter_batches(batch_size=rows, columns=list(names)):
+            self._done += batch.num_rows
+            yield pa.Table.from_batches([batch])
+
+    def position(self) -> tuple[float, float]:
+        return (float(self._done), float(self.total_rows or 0))
+
+    def close(self) -> None:
+        self._file.close()
+
+
+class Hdf5Source(Source):
+    format = "hdf5"
+
+    def __init__(self, path: Path) -> None:
+        import h5py
+
+        super().__init__(path)
+        if not path.exists():
+            raise FileNotFoundError(2, "No such file or directory", str(path))
+        try:
+            self._file = h5py.File(path, "r")
+        except OSError as exc:
+            raise RecordingError(f"{path}: not a readable HDF5 file ({exc})") from None
+        group = self._pick_group(h5py)
+        self._datasets = {
+            name: obj
+            for name, obj in group.items()
+            if isinstance(obj, h5py.Dataset) and obj.ndim == 1
+        }
+        self.names = list(self._datasets)
+        lengths = {name: ds.shape[0] for name, ds in self._datasets.items()}
+        if len(set(lengths.values())) > 1:
+            self._file.close()
+            raise RecordingError(f"{path}: datasets of different lengths {lengths}")
+        self.total_rows = next(iter(lengths.values()), 0)
+        self.metadata = {k: _attr_value(v) for k, v in group.attrs.items()}
+        if isinstance(self.metadata.get("extra"), str):
+            try:
+                self.metadata["extra"] = loads_json(self.metadata["extra"])
+            except ValueError:
+                pass
+        self._done = 0
+
+    def _pick_group(self, h5py: Any) -> Any:
+        root = self._file
+        if HDF5_GROUP in root and isinstance(root[HDF5_GROUP], h5py.Group):
+            return root[HDF5_GROUP]
+        if any(isinstance(o, h5py.Dataset) and o.ndim == 1 for o in root.values()):
+            return root
+        groups = [name for name, o in root.items() if isinstance(o, h5py.Group)]
+        if len(groups) == 1:
+            return root[groups[0]]
+        self._file.close()
+        raise RecordingError(
+            f"{self.path}: no group {HDF5_GROUP!r} and no 1-D datasets at the root "
+            f"(groups: {groups}); store one dataset per column in a group {HDF5_GROUP!r}"
+        )
+
+    def kinds(self) -> dict[str, str]:
+        kinds = {}
+        for name, ds in self._datasets.items():
+            char = ds.dtype.kind
+            kinds[name] = "numeric" if char in "fiub" else "string" if char in "SUO" else "other"
+        return kinds
+
+    def _table(self, names: Sequence[str], start: int, stop: int) -> pa.Table:
+        arrays = {}
+        for name in names:
+            values = self._datasets[name][start:stop]
+            if values.dtype.kind in "SO":
+                values = [
+                    v.decode("utf-8", "replace") if isinstance(v, bytes) else v for v in values
+                ]
+            arrays[name] = pa.array(values)
+        return pa.table(arrays)
+
+    def read(self, names: Sequence[str], as_text: set[str]) -> pa.Table:
+        return self._table(names, 0, self.total_rows)
+
+    def iter_tables(self, names: Sequence[str], as_text: set[str], rows: int) -> Iterator[pa.Table]:
+        for start in range(0, self.total_rows, rows):
+            stop = min(start + rows, self.total_rows)
+            self._done = stop
+            yield self._table(names, start, stop)
+
+    def position(self) -> tuple[float, float]:
+        return (float(self._done), float(self.total_rows or 0))
+
+    def close(self) -> None:
+        self._file.close()
+
+
+def _attr_value(value: Any) -> Any:
+    if isinstance(value, bytes):
+        return value.decode("utf-8", "replace")
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return str(value)
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    return value
+
+
+# -- sinks ---------------------------------------------------------------------
+def _field_metadata(name: str) -> dict[bytes, bytes] | None:
+    return {b"unit": COLUMNS[name][0].encode()} if name in COLUMNS else None
+
+
+class Sink:
+    """Writes float64 columns chunk by chunk to ``path``."""
+
+    def __init__(self, path: Path, metadata: Metadata, names: Sequence[str]) -> None:
+        self.path = path
+        self.names = list(names)
+
+    def write(self, columns: Mapping[str, np.ndarray]) -> None:
+        raise NotImplementedError
+
+    def close(self) -> None:
+        raise NotImplementedError
+
+
+class ParquetSink(Sink):
+    def __init__(self, path: Path, metadata: Metadata, names: Sequence[str]) -> None:
+        super().__init__(path, metadata, names)
+        fields = [pa.field(n, pa.float64(), metadata=_field_metadata(n)) for n in names]
+        self._schema = pa.schema(fields, metadata={METADATA_KEY: metadata_json(metadata)})
+        # Float gyro data does not compress (snappy saved 0 % on simulated runs and cost a
+        # third of the write speed), so pages are written plain.
+        self._writer = pq.ParquetWriter(str(path), self._schema, use_dictionary=False,
+                                        compression="none")
+        self._pending: list[pa.Table] = []
+        self._pending_rows = 0
+
+    def write(self, columns: Mapping[str, np.ndarray]) -> None:
+        arrays = [pa.array(columns[n]) for n in self.names]
+        table = pa.Table.from_arrays(arrays, schema=self._schema)
+        self._pending.append(table)
+        self._pending_rows += table.num_rows
+        if self._pending_rows >= PARQUET_ROW_GROUP_ROWS:
+            self._flush()
+
+    def _flush(self) -> None:
+        if self._pending:
+            self._writer.write_table(
+                pa.concat_tables(self._pending), row_group_size=PARQUET_ROW_GROUP_ROWS
+            )
+        self._pending, self._pending_rows = [], 0
+
+    def close(self) -> None:
+        self._flush()
+        self._writer.close()
+
+    def abort(self) -> None:
+        self._pending = []
+        self._writer.close()
+
+
+class Hdf5Sink(Sink):
+    def __init__(self, path: Path, metadata: Metadata, names: Sequence[str]) -> None:
+        import h5py
+
+        super().__init__(path, metadata, names)
+        metadata_json(metadata)
+        self._file = h5py.File(path, "w")
+        group = self._file.create_group(HDF5_GROUP, track_order=True)
+        for key, value in metadata.to_dict().items():
+            group.attrs[key] = json.dumps(value) if key == "extra" else value
+        self._datasets = {}
+        for name in names:
+            ds = group.create_dataset(
+                name, shape=(0,), maxshape=(None,), dtype="f8", chunks=(HDF5_CHUNK_ROWS,)
+            )
+            if name in COLUMNS:
+                ds.attrs["unit"] = COLUMNS[name][0]
+            self._datasets[name] = ds
+        self._rows = 0
+
+    def write(self, columns: Mapping[str, np.ndarray]) -> None:
+        n = len(columns[self.names[0]]) if self.names else 0
+        for name, ds in self._datasets.items():
+            ds.resize((self._rows + n,))
+            ds[self._rows :] = columns[name]
+        self._rows += n
+
+    def close(self) -> None:
+        self._file.close()
+
+    def abort(self) -> None:
+        self._file.close()

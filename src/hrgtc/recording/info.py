@@ -1,0 +1,283 @@
+"""A summary of a recording file: size, rates, spans and validation, in one pass.
+
+:func:`describe` streams the file chunk by chunk, so it works on files larger
+than memory, and never raises on a bad file: the problem is reported in the
+validation part of the result (``ok=False``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from hrgtc.errors import RecordingError
+from hrgtc.progress import Progress
+from hrgtc.recording.formats import format_of
+from hrgtc.recording.io import iter_chunks
+from hrgtc.recording.schema import COLUMNS, Metadata
+from hrgtc.recording.validation import (
+    GapPolicy,
+    Problem,
+    RecordingValidator,
+    ValidationReport,
+    check_gap_policy,
+)
+
+TEMPERATURE_COLUMNS = ("chamber_c", "housing_c", "resonator_c")
+
+
+@dataclass(frozen=True)
+class ColumnSummary:
+    """Name, unit and range of the finite values of one column.
+
+    Parameters
+    ----------
+    name
+        Column name in the recording.
+    unit
+        Unit of the recording contract (``""`` for a column outside it).
+    minimum, maximum
+        Smallest and largest finite value, None if there is none. [unit]
+    """
+
+    name: str
+    unit: str
+    minimum: float | None
+    maximum: float | None
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types."""
+        return {"name": self.name, "unit": self.unit, "min": self.minimum, "max": self.maximum}
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> ColumnSummary:
+        """Inverse of :meth:`to_dict`."""
+        return cls(str(data["name"]), str(data["unit"]), data.get("min"), data.get("max"))
+
+
+@dataclass(frozen=True)
+class RecordingInfo:
+    """What :func:`describe` found in a recording file.
+
+    Parameters
+    ----------
+    path
+        The file.
+    format
+        ``"parquet"``, ``"csv"`` or ``"hdf5"``.
+    rows
+        Rows read (up to the first unreadable one).
+    start_time_s, end_time_s
+        First and last finite time, None without any. [s]
+    duration_s
+        ``end - start + 1/sample_rate``, None if unknown. [s]
+    sample_rate_hz
+        Sample rate of the metadata (or inferred). [Hz]
+    sample_rate_inferred
+        True when the file had no sample rate and it was inferred from the times.
+    measured_sample_rate_hz
+        Reciprocal of the median time step (first 100,000 rows). [Hz]
+    columns
+        Summary of each column, in order.
+    metadata
+        The metadata as a dict, None if unreadable.
+    validation
+        The validation report (``ok=False`` with an ``"unreadable"`` problem when
+        the file could not be read to the end).
+    """
+
+    path: str
+    format: str | None
+    rows: int
+    start_time_s: float | None
+    end_time_s: float | None
+    duration_s: float | None
+    sample_rate_hz: float | None
+    sample_rate_inferred: bool
+    measured_sample_rate_hz: float | None
+    columns: tuple[ColumnSummary, ...]
+    metadata: dict[str, Any] | None
+    validation: ValidationReport
+
+    @property
+    def ok(self) -> bool:
+        """True when the recording passed validation."""
+        return self.validation.ok
+
+    def column(self, name: str) -> ColumnSummary | None:
+        """The summary of column ``name``, None if absent."""
+        return next((c for c in self.columns if c.name == name), None)
+
+    def summary(self) -> str:
+        """Human-readable text (does not print)."""
+        lines = [f"{self.path} ({self.format or 'unknown format'})"]
+        meta = self.metadata or {}
+        if meta:
+            lines.append(
+                f"  unit {meta.get('unit')!s}, profile {meta.get('profile')!r}, "
+                f"input rate {_num(meta.get('input_rate_dph'))} °/h"
+            )
+        lines.append(f"  rows: {self.rows}")
+        lines.append(f"  duration: {_num(self.duration_s)} s ({_hours(self.duration_s)})")
+        inferred = " (inferred from the time steps)" if self.sample_rate_inferred else ""
+        lines.append(
+            f"  sample rate: {_num(self.sample_rate_hz)} Hz in the metadata{inferred}, "
+            f"{_num(self.measured_sample_rate_hz)} Hz measured"
+        )
+        lines.append("  columns:")
+        for col in self.columns:
+            unit = f"[{col.unit}]" if col.unit else "[?]"
+            lines.append(f"    {col.name:<12} {unit:<8} {_num(col.minimum)} .. {_num(col.maximum)}")
+        for name in (*TEMPERATURE_COLUMNS, "freq_hz"):
+            col = self.column(name)
+            if col is not None and col.minimum is not None:
+                unit = "°C" if name != "freq_hz" else "Hz"
+                lines.append(f"  {name} span: {col.maximum - col.minimum:.6g} {unit}")
+        lines.append(self.validation.summary().replace("\n", "\n  ").join(["  ", ""]))
+        return "\n".join(lines)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types."""
+        spans = {
+            name: [col.minimum, col.maximum]
+            for name in (*TEMPERATURE_COLUMNS, "freq_hz")
+            if (col := self.column(name)) is not None
+        }
+        return {
+            "path": self.path,
+            "format": self.format,
+            "rows": self.rows,
+            "start_time_s": self.start_time_s,
+            "end_time_s": self.end_time_s,
+            "duration_s": self.duration_s,
+            "sample_rate_hz": self.sample_rate_hz,
+            "sample_rate_inferred": self.sample_rate_inferred,
+            "measured_sample_rate_hz": self.measured_sample_rate_hz,
+            "columns": [c.to_dict() for c in self.columns],
+            "spans": spans,
+            "metadata": self.metadata,
+            "validation": self.validation.to_dict(),
+        }
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> RecordingInfo:
+        """Inverse of :meth:`to_dict` (``spans`` are derived, not read)."""
+        return cls(
+            path=str(data["path"]),
+            format=data.get("format"),
+            rows=int(data["rows"]),
+            start_time_s=data.get("start_time_s"),
+            end_time_s=data.get("end_time_s"),
+            duration_s=data.get("duration_s"),
+            sample_rate_hz=data.get("sample_rate_hz"),
+            sample_rate_inferred=bool(data.get("sample_rate_inferred", False)),
+            measured_sample_rate_hz=data.get("measured_sample_rate_hz"),
+            columns=tuple(ColumnSummary.from_dict(c) for c in data["columns"]),
+            metadata=data.get("metadata"),
+            validation=ValidationReport.from_dict(data["validation"]),
+        )
+
+
+def _num(value: Any) -> str:
+    return "?" if value is None else f"{value:.6g}"
+
+
+def _hours(seconds: float | None) -> str:
+    return "?" if seconds is None else f"{seconds / 3600.0:.3g} h"
+
+
+def describe(
+    path: str | Path,
+    columns: Mapping[str, str] | Iterable[str] | None = None,
+    units: Mapping[str, str] | None = None,
+    metadata: Mapping[str, Any] | Metadata | None = None,
+    gaps: GapPolicy | str = "error",
+    rows: int = 1_000_000,
+    progress: Progress | None = None,
+) -> RecordingInfo:
+    """Summarise and validate a recording file in one streaming pass.
+
+    Parameters
+    ----------
+    path, columns, units, metadata, gaps
+        As for :func:`hrgtc.recording.read`.
+    rows
+        Rows per chunk read.
+    progress
+        Optional ``progress(done, total)`` callback.
+
+    Returns
+    -------
+    RecordingInfo
+        Never raises on a bad or unreadable file (except a missing file): the
+        problem is in ``validation`` with ``ok=False``.
+    """
+    check_gap_policy(gaps)
+    validator = RecordingValidator(gaps)
+    ranges: dict[str, list[float]] = {}
+    first_time: float | None = None
+    last_time: float | None = None
+    meta: Metadata | None = None
+    unreadable: str | None = None
+    fmt: str | None = None
+    names: list[str] = []
+    try:
+        fmt = format_of(path)
+        for chunk in iter_chunks(
+            path, rows, columns, units, validate=False, metadata=metadata, progress=progress
+        ):
+            meta = chunk.metadata
+            names = names or list(chunk.names)
+            validator.update(chunk)
+            for name in chunk.names:
+                values = chunk[name]
+                finite = values[np.isfinite(values)]
+                if finite.size:
+                    low, high = float(finite.min()), float(finite.max())
+                    old = ranges.setdefault(name, [low, high])
+                    old[0], old[1] = min(old[0], low), max(old[1], high)
+            if "time_s" in chunk:
+                finite = chunk.time_s[np.isfinite(chunk.time_s)]
+                if finite.size:
+                    first_time = float(finite[0]) if first_time is None else first_time
+                    last_time = float(finite[-1])
+    except RecordingError as exc:
+        unreadable = str(exc).removeprefix(f"{Path(path)}: ")
+    report = validator.finish()
+    if unreadable is not None:
+        so_far = tuple(p for p in report.problems if p.kind != "empty")
+        report = ValidationReport(
+            ok=False,
+            problems=(Problem("unreadable", unreadable), *so_far),
+            gaps=report.gaps,
+            n_gaps=report.n_gaps,
+            rows=report.rows,
+            source=str(path),
+            measured_sample_rate_hz=report.measured_sample_rate_hz,
+            gap_policy=report.gap_policy,
+        )
+    duration = None
+    if first_time is not None and meta is not None:
+        duration = last_time - first_time + 1.0 / meta.sample_rate_hz
+    return RecordingInfo(
+        path=str(path),
+        format=fmt,
+        rows=validator.rows,
+        start_time_s=first_time,
+        end_time_s=last_time,
+        duration_s=duration if duration is None or math.isfinite(duration) else None,
+        sample_rate_hz=None if meta is None else meta.sample_rate_hz,
+        sample_rate_inferred=bool(meta is not None and meta.extra.get("sample_rate_inferred")),
+        measured_sample_rate_hz=report.measured_sample_rate_hz,
+        columns=tuple(
+            ColumnSummary(n, COLUMNS[n][0] if n in COLUMNS else "", *ranges.get(n, (None, None)))
+            for n in names
+        ),
+        metadata=None if meta is None else meta.to_dict(),
+        validation=report,
+    )

@@ -1,0 +1,558 @@
+"""Validation of recordings against the recording contract of DESIGN.md.
+
+One place checks every recording that enters hrgtc, whole or chunk by chunk:
+
+* the required columns ``time_s``, ``freq_hz`` and ``rate_dph`` are present;
+* no value is NaN or infinite;
+* ``time_s`` is strictly increasing (no duplicates, no steps back);
+* no time step is longer than :data:`GAP_PERIODS` sample periods (a gap); gaps
+  are listed, and the caller chooses to treat them as an error or to split the
+  recording into segments (:func:`split_at_gaps`);
+* the median time step agrees with the metadata's sample rate within
+  :data:`SAMPLE_RATE_TOLERANCE`;
+* the units look right (heuristics on the first :data:`HEURISTIC_ROWS` rows):
+
+  - ``freq_hz``: the n = 2 mode of an HRG lies between a few hundred Hz and a few
+    tens of kHz (≈ 4425 Hz for the unit of [1]); a median below
+    :data:`KHZ_BELOW_HZ` means the column is in kHz, a median above
+    :data:`FREQ_MAX_HZ` (or not positive) is implausible;
+  - ``rate_dph``: a gyro on a bench recorded in °/h reads the Earth-rate component
+    (up to ≈ 15 °/h) plus its bias (up to ±100 °/h), with white noise of
+    ≈ 0.01–5 °/h per sample at 1–200 Hz. The same data in °/s are 3600 times
+    smaller, in rad/s ≈ 206,265 times. The column is flagged when both its median
+    magnitude is below :data:`RATE_LEVEL_DPH` (1 °/h) *and* its per-sample noise,
+    estimated as ``std(diff(rate)) / sqrt(2)`` (insensitive to slow drift), is
+    below :data:`RATE_NOISE_DPH` (1e-3 °/h). With a large known input rate
+    (``|input_rate_dph| >= 3600``, a rate table) the column is also flagged when
+    its median is the input rate divided by 3600 or by 206,265 (within a factor
+    of 2). Real °/h data (and the simulator's output, whose noise is ≈ 1–5 °/h
+    per sample at 200 Hz) never trip these rules.
+
+Rows are numbered from 0 (the first data row), over the whole file also when it
+is validated chunk by chunk.
+
+[1] X. Wang et al., "Temperature Drift Compensation for Hemispherical Resonator
+    Gyro Based on Natural Frequency", Sensors 12(5), 6434-6446, 2012.
+    doi:10.3390/s120506434
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass
+from typing import Any, Literal
+
+import numpy as np
+
+from hrgtc.errors import RecordingError
+from hrgtc.recording.schema import REQUIRED_COLUMNS, Metadata, Recording
+
+GapPolicy = Literal["error", "split", "ignore"]
+GAP_POLICIES: tuple[str, ...] = ("error", "split", "ignore")
+
+GAP_PERIODS = 2.0  # a time step longer than this many sample periods is a gap
+SAMPLE_RATE_TOLERANCE = 0.01  # relative disagreement of measured and nominal rate
+HEURISTIC_ROWS = 100_000  # rows used for the sample-rate and unit heuristics
+KHZ_BELOW_HZ = 100.0
+FREQ_MAX_HZ = 1e6
+RATE_LEVEL_DPH = 1.0
+RATE_NOISE_DPH = 1e-3
+RATE_TABLE_DPH = 3600.0
+DEG_PER_RAD_X3600 = 180.0 / math.pi * 3600.0  # °/h per rad/s
+MAX_LISTED_GAPS = 1000
+
+
+@dataclass(frozen=True)
+class Problem:
+    """One way in which a recording breaks the contract.
+
+    Parameters
+    ----------
+    kind
+        One of ``"empty"``, ``"missing_column"``, ``"not_finite"``, ``"time_order"``,
+        ``"gap"``, ``"sample_rate"``, ``"freq_unit"``, ``"rate_unit"``.
+    message
+        Full sentence naming column, row, value and the fix.
+    column
+        Column concerned, if any.
+    row
+        First bad row (0 = first data row), if any.
+    value
+        The bad value as text, if any.
+    count
+        Number of rows (or gaps) with this problem found.
+    """
+
+    kind: str
+    message: str
+    column: str | None = None
+    row: int | None = None
+    value: str | None = None
+    count: int = 1
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types."""
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> Problem:
+        """Inverse of :meth:`to_dict`."""
+        return cls(**dict(data))
+
+
+@dataclass(frozen=True)
+class Gap:
+    """A time step longer than :data:`GAP_PERIODS` sample periods.
+
+    Parameters
+    ----------
+    start_time_s
+        Time of the last sample before the gap. [s]
+    duration_s
+        Time between the samples on either side of the gap. [s]
+    row
+        First row after the gap (0 = first data row).
+    """
+
+    start_time_s: float
+    duration_s: float
+    row: int
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types."""
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> Gap:
+        """Inverse of :meth:`to_dict`."""
+        return cls(**dict(data))
+
+
+@dataclass(frozen=True)
+class ValidationReport:
+    """Outcome of validating a recording.
+
+    Parameters
+    ----------
+    ok
+        True when there is no problem.
+    problems
+        The problems found, in the order of the checks.
+    gaps
+        Gaps found (at most :data:`MAX_LISTED_GAPS` listed), whatever the policy.
+    n_gaps
+        Number of gaps found.
+    rows
+        Rows checked.
+    source
+        File the recording came from.
+    measured_sample_rate_hz
+        Reciprocal of the median time step of the first :data:`HEURISTIC_ROWS`
+        rows, None with fewer than 2 rows. [Hz]
+    gap_policy
+        ``"error"``, ``"split"`` or ``"ignore"``.
+    """
+
+    ok: bool
+    problems: tuple[Problem, ...]
+    gaps: tuple[Gap, ...]
+    n_gaps: int
+    rows: int
+    source: str | None
+    measured_sample_rate_hz: float | None
+    gap_policy: str = "error"
+
+    @property
+    def message(self) -> str:
+        """All problems as one message that names the file ("" when ok)."""
+        return problems_message(self.source, self.problems)
+
+    def raise_for_problems(self) -> None:
+        """Raise :class:`~hrgtc.errors.RecordingError` with :attr:`message` unless ok."""
+        if self.problems:
+            raise RecordingError(self.message)
+
+    def summary(self) -> str:
+        """Human-readable text (does not print)."""
+        where = self.source or "recording"
+        lines = [f"validation of {where}: {'ok' if self.ok else 'FAILED'} ({self.rows} rows)"]
+        if self.measured_sample_rate_hz is not None:
+            lines.append(f"  measured sample rate: {self.measured_sample_rate_hz:.6g} Hz")
+        lines += [f"  problem: {p.message}" for p in self.problems]
+        if self.n_gaps:
+            lines.append(f"  gaps: {self.n_gaps} (policy {self.gap_policy})")
+            lines += [
+                f"    row {g.row}: {g.duration_s:.6g} s without samples after t = "
+                f"{g.start_time_s:.6g} s"
+                for g in self.gaps[:10]
+            ]
+            if self.n_gaps > 10:
+                lines.append(f"    ... {self.n_gaps - 10} more")
+        return "\n".join(lines)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types."""
+        data = asdict(self)
+        return {**data, "problems": list(data["problems"]), "gaps": list(data["gaps"])}
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> ValidationReport:
+        """Inverse of :meth:`to_dict`."""
+        problems = tuple(Problem.from_dict(p) for p in data["problems"])
+        gaps = tuple(Gap.from_dict(g) for g in data["gaps"])
+        return cls(**{**data, "problems": problems, "gaps": gaps})
+
+
+def problems_message(source: str | None, problems: tuple[Problem, ...] | list[Problem]) -> str:
+    """One message for ``problems`` that starts with the file name."""
+    where = source or "recording"
+    if not problems:
+        return ""
+    if len(problems) == 1:
+        return f"{where}: {problems[0].message}"
+    items = "\n".join(f"  - {p.message}" for p in problems)
+    return f"{where}: {len(problems)} problems:\n{items}"
+
+
+def check_gap_policy(gaps: str) -> str:
+    """Return ``gaps`` if it is a known gap policy, else raise InputError."""
+    if gaps not in GAP_POLICIES:
+        raise RecordingError(f"gaps must be one of {list(GAP_POLICIES)}, got {gaps!r}")
+    return gaps
+
+
+class RecordingValidator:
+    """Validate a recording chunk by chunk, carrying state across chunks.
+
+    Time continuity and row numbers run over the whole recording; the unit and
+    sample-rate heuristics look at its first :data:`HEURISTIC_ROWS` rows.
+    ``validate(recording)`` is "a new validator, one update, finish".
+
+    Parameters
+    ----------
+    gaps
+        ``"error"``: gaps are problems; ``"split"`` / ``"ignore"``: gaps are only
+        listed (split the recording with :func:`split_at_gaps`).
+    """
+
+    def __init__(self, gaps: GapPolicy | str = "error") -> None:
+        self.gaps = check_gap_policy(gaps)
+        self.rows = 0
+        self.source: str | None = None
+        self.metadata: Metadata | None = None
+        self._missing: tuple[str, ...] = ()
+        self._last_time: float | None = None
+        self._not_finite: dict[str, list[Any]] = {}  # column -> [row, value, count]
+        self._time_order: tuple[int, float, float] | None = None
+        self._time_order_count = 0
+        self._gaps: list[Gap] = []
+        self._n_gaps = 0
+        self._sample: dict[str, list[np.ndarray]] = {name: [] for name in REQUIRED_COLUMNS}
+        self._sample_rows = 0
+        self._heuristics: list[Problem] | None = None
+        self.measured_sample_rate_hz: float | None = None
+
+    # -- feeding -------------------------------------------------------------
+    def update(self, chunk: Recording) -> None:
+        """Check the next chunk (rows continue from the previous chunk)."""
+        if self.metadata is None:
+            self.metadata = chunk.metadata
+            self.source = chunk.source
+            self._missing = tuple(c for c in REQUIRED_COLUMNS if c not in chunk)
+        offset, n = self.rows, len(chunk)
+        for name in chunk.names:
+            values = chunk[name]
+            bad = ~np.isfinite(values)
+            if bad.any():
+                state = self._not_finite.get(name)
+                if state is None:
+                    first = int(np.argmax(bad))
+                    self._not_finite[name] = [offset + first, values[first], int(bad.sum())]
+                else:
+                    state[2] += int(bad.sum())
+        if "time_s" in chunk and n:
+            self._check_time(chunk.time_s, offset)
+        if self._heuristics is None:
+            self._collect_sample(chunk)
+        self.rows += n
+
+    def _check_time(self, time: np.ndarray, offset: int) -> None:
+        previous = np.empty_like(time)
+        previous[0] = np.nan if self._last_time is None else self._last_time
+        previous[1:] = time[:-1]
+        self._last_time = float(time[-1])
+        with np.errstate(invalid="ignore"):
+            step = time - previous
+            backwards = step <= 0
+        if backwards.any():
+            self._time_order_count += int(backwards.sum())
+            if self._time_order is None:
+                i = int(np.argmax(backwards))
+                self._time_order = (offset + i, float(time[i]), float(previous[i]))
+        period = 1.0 / self.metadata.sample_rate_hz
+        with np.errstate(invalid="ignore"):
+            long = np.flatnonzero((step > GAP_PERIODS * period) & np.isfinite(step))
+        self._n_gaps += long.size
+        room = MAX_LISTED_GAPS - len(self._gaps)
+        self._gaps += [
+            Gap(float(previous[i]), float(step[i]), offset + int(i)) for i in long[:room]
+        ]
+
+    def _collect_sample(self, chunk: Recording) -> None:
+        take = min(len(chunk), HEURISTIC_ROWS - self._sample_rows)
+        for name in REQUIRED_COLUMNS:
+            if name in chunk:
+                self._sample[name].append(np.array(chunk[name][:take]))
+        self._sample_rows += take
+        if self._sample_rows >= HEURISTIC_ROWS:
+            self._run_heuristics()
+
+    @property
+    def heuristics_done(self) -> bool:
+        """True once the unit and sample-rate heuristics have run."""
+        return self._heuristics is not None
+
+    # -- results -------------------------------------------------------------
+    @property
+    def problems(self) -> list[Problem]:
+        """Problems found so far (heuristic ones once :attr:`heuristics_done`)."""
+        problems: list[Problem] = []
+        if self.metadata is not None and self.rows == 0:
+            problems.append(Problem("empty", "the recording has no rows"))
+        if self._missing:
+            columns = "', '".join(self._missing)
+            problems.append(
+                Problem(
+                    "missing_column",
+                    f"required column(s) '{columns}' missing; map your names with "
+                    f"--col {self._missing[0]}=<your column name> "
+                    f"(columns={{'{self._missing[0]}': ...}})",
+                    column=self._missing[0],
+                )
+            )
+        for name, (row, value, count) in self._not_finite.items():
+            problems.append(
+                Problem(
+                    "not_finite",
+                    f"column '{name}', row {row}: value {value} is not finite "
+                    f"(first of {count} such rows); remove or interpolate those rows",
+                    column=name,
+                    row=row,
+                    value=str(value),
+                    count=count,
+                )
+            )
+        if self._time_order is not None:
+            row, now, before = self._time_order
+            what = "a duplicate time" if now == before else "a step back in time"
+            problems.append(
+                Problem(
+                    "time_order",
+                    f"column 'time_s', row {row}: {now!r} s after {before!r} s is {what} "
+                    f"(time must increase strictly; {self._time_order_count} bad step(s)); "
+                    "sort the file by time and drop duplicate rows",
+                    column="time_s",
+                    row=row,
+                    value=repr(now),
+                    count=self._time_order_count,
+                )
+            )
+        if self._n_gaps and self.gaps == "error":
+            first = self._gaps[0]
+            period = 1.0 / self.metadata.sample_rate_hz
+            problems.append(
+                Problem(
+                    "gap",
+                    f"column 'time_s', row {first.row}: {self._n_gaps} gap(s) longer than "
+                    f"{GAP_PERIODS:g} sample periods ({GAP_PERIODS * period:.6g} s), the first "
+                    f"{first.duration_s:.6g} s after t = {first.start_time_s:.6g} s; "
+                    "pass --gaps split to process the segments separately (or --gaps ignore)",
+                    column="time_s",
+                    row=first.row,
+                    value=f"{first.duration_s:.6g}",
+                    count=self._n_gaps,
+                )
+            )
+        problems += self._heuristics or []
+        return problems
+
+    def raise_for_problems(self) -> None:
+        """Raise :class:`~hrgtc.errors.RecordingError` if a problem was found so far."""
+        problems = self.problems
+        if problems:
+            raise RecordingError(problems_message(self.source, problems))
+
+    def finish(self) -> ValidationReport:
+        """Run the heuristics if still pending and return the report."""
+        if self._heuristics is None:
+            self._run_heuristics()
+        problems = tuple(self.problems)
+        if self.metadata is None:
+            problems = (Problem("empty", "the recording has no rows"),)
+        return ValidationReport(
+            ok=not problems,
+            problems=problems,
+            gaps=tuple(self._gaps),
+            n_gaps=self._n_gaps,
+            rows=self.rows,
+            source=self.source,
+            measured_sample_rate_hz=self.measured_sample_rate_hz,
+            gap_policy=self.gaps,
+        )
+
+    # -- heuristics ----------------------------------------------------------
+    def _run_heuristics(self) -> None:
+        sample = {name: np.concatenate(parts) for name, parts in self._sample.items() if parts}
+        self._sample = {}
+        problems: list[Problem] = []
+        if "time_s" in sample and self.metadata is not None:
+            self.measured_sample_rate_hz = measured_sample_rate(sample["time_s"])
+            problem = _check_sample_rate(self.metadata.sample_rate_hz, self.measured_sample_rate_hz)
+            if problem:
+                problems.append(problem)
+        if "freq_hz" in sample:
+            problem = _check_freq_unit(sample["freq_hz"])
+            if problem:
+                problems.append(problem)
+        if "rate_dph" in sample and self.metadata is not None:
+            problem = _check_rate_unit(sample["rate_dph"], self.metadata.input_rate_dph)
+            if problem:
+                problems.append(problem)
+        self._heuristics = problems
+
+
+def measured_sample_rate(time_s: np.ndarray) -> float | None:
+    """Reciprocal of the median positive finite time step, None if there is none.
+
+    Parameters
+    ----------
+    time_s
+        Sample times. [s]
+
+    Returns
+    -------
+    float or None
+        Sample rate. [Hz]
+    """
+    step = np.diff(np.asarray(time_s, dtype=np.float64))
+    step = step[np.isfinite(step) & (step > 0)]
+    if step.size == 0:
+        return None
+    return float(1.0 / np.median(step))
+
+
+def _check_sample_rate(nominal_hz: float, measured_hz: float | None) -> Problem | None:
+    if measured_hz is None or abs(measured_hz / nominal_hz - 1.0) <= SAMPLE_RATE_TOLERANCE:
+        return None
+    fix = f"fix the metadata (--rate-hz {measured_hz:.6g})"
+    if abs(measured_hz * 1000.0 / nominal_hz - 1.0) <= 0.05:
+        fix = "the time column looks like milliseconds: pass --time-unit ms"
+    return Problem(
+        "sample_rate",
+        f"column 'time_s': the median time step {1.0 / measured_hz:.6g} s means "
+        f"{measured_hz:.6g} Hz but the metadata says sample_rate_hz = {nominal_hz:g}; {fix}",
+        column="time_s",
+        value=f"{measured_hz:.6g}",
+    )
+
+
+def _check_freq_unit(freq: np.ndarray) -> Problem | None:
+    freq = freq[np.isfinite(freq)]
+    if freq.size == 0:
+        return None
+    median = float(np.median(freq))
+    if 0 < median < KHZ_BELOW_HZ and KHZ_BELOW_HZ <= median * 1000.0 <= FREQ_MAX_HZ:
+        message = f"freq_hz looks like kHz (median {median:.6g}); pass --freq-unit kHz"
+    elif median <= 0 or median < KHZ_BELOW_HZ or median > FREQ_MAX_HZ:
+        message = (
+            f"freq_hz is implausible (median {median:.6g} Hz; the resonator frequency of an "
+            "HRG is a few hundred Hz to a few tens of kHz); check the column mapping "
+            "(--col freq_hz=<your column>) and the unit (--freq-unit Hz|kHz)"
+        )
+    else:
+        return None
+    return Problem("freq_unit", message, column="freq_hz", value=f"{median:.6g}")
+
+
+def _check_rate_unit(rate: np.ndarray, input_rate_dph: float) -> Problem | None:
+    rate = rate[np.isfinite(rate)]
+    if rate.size < 2:
+        return None
+    level = float(np.median(np.abs(rate)))
+    noise = float(np.std(np.diff(rate)) / math.sqrt(2.0))
+    quiet_and_small = level < RATE_LEVEL_DPH and noise < RATE_NOISE_DPH
+    scaled_input = False
+    if abs(input_rate_dph) >= RATE_TABLE_DPH:
+        ratio = float(np.median(rate)) / input_rate_dph
+        scaled_input = any(0.5 <= ratio * factor <= 2.0 for factor in (3600.0, DEG_PER_RAD_X3600))
+    if not (quiet_and_small or scaled_input):
+        return None
+    options = ["--rate-unit dps (°/s)", "--rate-unit radps (rad/s)"]
+    if level * 3600.0 < 0.5:
+        options.reverse()  # below 0.5 °/h even if it were °/s: rad/s is more likely
+    return Problem(
+        "rate_unit",
+        f"rate_dph looks like °/s or rad/s, not °/h (median |rate| {level:.3g}, per-sample "
+        f"noise {noise:.3g}; a gyro recorded in °/h reads ≳ {RATE_LEVEL_DPH:g} °/h with "
+        f"≳ {RATE_NOISE_DPH:g} °/h noise per sample); pass {' or '.join(options)}",
+        column="rate_dph",
+        value=f"{level:.3g}",
+    )
+
+
+def validate(
+    recording: Recording, gaps: GapPolicy | str = "error", *, raise_errors: bool = True
+) -> ValidationReport:
+    """Check a recording against the recording contract (see the module docstring).
+
+    Parameters
+    ----------
+    recording
+        The recording to check.
+    gaps
+        ``"error"``: gaps longer than :data:`GAP_PERIODS` sample periods are
+        problems; ``"split"``: they are listed and the caller splits the recording
+        with :func:`split_at_gaps`; ``"ignore"``: they are only listed.
+    raise_errors
+        Raise :class:`~hrgtc.errors.RecordingError` on a problem (default) rather
+        than return a report with ``ok=False``.
+
+    Returns
+    -------
+    ValidationReport
+
+    Raises
+    ------
+    RecordingError
+        Message names the file, column, first bad row, the bad value and the fix.
+    """
+    validator = RecordingValidator(gaps)
+    validator.update(recording)
+    report = validator.finish()
+    if raise_errors:
+        report.raise_for_problems()
+    return report
+
+
+def split_at_gaps(recording: Recording, max_gap_periods: float = GAP_PERIODS) -> list[Recording]:
+    """Cut a recording into gap-free segments.
+
+    Parameters
+    ----------
+    recording
+        Recording with strictly increasing ``time_s``.
+    max_gap_periods
+        A time step longer than this many sample periods (of the metadata's
+        sample rate) starts a new segment.
+
+    Returns
+    -------
+    list of Recording
+        Views of consecutive rows, same metadata; times are not shifted.
+    """
+    period = 1.0 / recording.metadata.sample_rate_hz
+    starts = np.flatnonzero(np.diff(recording.time_s) > max_gap_periods * period) + 1
+    bounds = [0, *starts.tolist(), len(recording)]
+    return [recording.slice(a, b) for a, b in itertools.pairwise(bounds)]

@@ -1,0 +1,13 @@
+"""Report: stage 6, one self-contained HTML file with the paper's figures.
+
+Takes a unit model, its soaks and runs, and gives the report (``html``): the
+settling of each soak (Fig. 3 of [1]), the T-f fit (Fig. 4), temperature from
+frequency (Fig. 5, Table 2), raw and compensated output (Fig. 6), Allan
+deviations, the stepwise table and the final model; ``figures`` draws them.
+
+[1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
+"""
+
+from hrgtc.report.html import build_report
+
+__all__ = ["build_report"]

@@ -1,0 +1,558 @@
+"""Figures of the HTML report and the decimated data they draw, after Figs. 3-6 of [1].
+
+:func:`trace_soak` and :func:`trace_run` stream a recording chunk by chunk and
+reduce it to plotting blocks (block means of at least 10 s); a run is also
+compensated (Eq. 22 of [1]) and its bias stability and Allan deviation computed
+at the full rate. One function per figure turns that data (or the model) into a
+:class:`matplotlib.figure.Figure`; :func:`svg_data_uri` makes it an ``<img>``
+source. Figures are built on ``Figure`` objects directly with the Agg backend,
+never through ``pyplot``, so no global figure state is shared between them.
+
+[1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
+"""
+
+from __future__ import annotations
+
+import base64
+import io
+import math
+import os
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+from hrgtc import paper
+from hrgtc import recording as rec
+from hrgtc.compensate import Compensator
+from hrgtc.errors import HrgtcError
+from hrgtc.evaluation import metrics
+from hrgtc.evaluation.metrics import FLICKER_FLOOR_FACTOR, AllanResult, NoiseTerms
+from hrgtc.model import UnitModel
+from hrgtc.thermometry import Thermometer
+from hrgtc.thermometry.plateaus import Plateau
+
+PathLike = str | os.PathLike[str]
+#: Averaging times of the bias-stability tables (DESIGN.md, "Metrics"). [s]
+TAUS_S = (1.0, 10.0, 100.0)
+#: Shortest plotting block. [s]
+BLOCK_S = 10.0
+#: Rows per chunk read (unless ``read_kwargs`` sets ``rows``): bounds the memory of a pass.
+CHUNK_ROWS = 250_000
+#: Colours: the paper's Fig. 6 draws the output blue and the model red.
+RAW, MODEL, COMPENSATED, HOUSING, TRUTH, CHAMBER = (
+    "#1f5fa8", "#d62728", "#2b8a3e", "#e8890c", "#222222", "#8c8c8c")
+_STYLE = {
+    "svg.fonttype": "path",
+    "svg.hashsalt": "hrgtc",  # deterministic element ids
+    "font.size": 9.0,
+    "axes.grid": True,
+    "grid.color": "#dddddd",
+    "grid.linewidth": 0.6,
+    "axes.spines.top": False,
+    "axes.spines.right": False,
+    "legend.fontsize": 8.0,
+    "legend.frameon": False,
+    "lines.linewidth": 1.1,
+}
+_PANEL_WIDTH_IN = 3.3
+#: Decorator: build (and save) a figure under the report's style, restoring rcParams after.
+_styled = matplotlib.rc_context(_STYLE)
+
+
+@_styled
+def svg_data_uri(figure: Figure) -> str:
+    """The figure as an SVG ``data:`` URI (self-contained: glyphs as paths)."""
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="svg", metadata={"Date": None})
+    return "data:image/svg+xml;base64," + base64.b64encode(buffer.getvalue()).decode("ascii")
+
+
+def _figure(width_in: float, height_in: float) -> Figure:
+    return Figure(figsize=(width_in, height_in), layout="constrained")
+
+
+def _grid(count: int, height_in: float = 2.4, columns: int = 3) -> tuple[Figure, list[Axes]]:
+    columns = max(1, min(columns, count))
+    rows = -(-count // columns)
+    figure = _figure(_PANEL_WIDTH_IN * columns, height_in * rows)
+    axes = figure.subplots(rows, columns, squeeze=False).ravel()
+    for extra in axes[count:]:
+        extra.set_visible(False)
+    return figure, list(axes[:count])
+
+
+def _plain(ax: Axes) -> None:
+    """No offset notation on the y axis (frequencies read in Hz)."""
+    ax.ticklabel_format(axis="y", useOffset=False, style="plain")
+
+
+def _legend_below(figure: Figure, axes: Sequence[Axes]) -> None:
+    """One legend under a grid of panels, each label once."""
+    entries: dict[str, Any] = {}
+    for ax in axes:
+        for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
+            entries.setdefault(label, handle)
+    if entries:
+        figure.legend(list(entries.values()), list(entries), loc="outside lower center",
+                      ncols=min(len(entries), 5))
+
+
+def _hours(time_s: Any) -> np.ndarray:
+    return np.asarray(time_s, dtype=np.float64) / 3600.0
+
+
+# -- data passes --------------------------------------------------------------------------
+class _BlockMeans:
+    """Means of consecutive blocks of ``rows`` samples, fed chunk by chunk."""
+
+    def __init__(self, rows: int) -> None:
+        self.rows = rows
+        self.offset = 0
+        self._parts: dict[str, list[tuple[int, np.ndarray]]] = {}
+
+    def push(self, columns: Mapping[str, np.ndarray]) -> None:
+        n = len(next(iter(columns.values())))
+        index = (self.offset + np.arange(n)) // self.rows
+        first = int(index[0])
+        for name, values in {"_count": np.ones(n), **columns}.items():
+            sums = np.bincount(index - first, weights=np.asarray(values, dtype=np.float64))
+            self._parts.setdefault(name, []).append((first, sums))
+        self.offset += n
+
+    def means(self) -> dict[str, np.ndarray]:
+        blocks = -(-self.offset // self.rows)
+        totals = {}
+        for name, parts in self._parts.items():
+            total = np.zeros(blocks)
+            for first, sums in parts:
+                total[first : first + sums.size] += sums
+            totals[name] = total
+        count = totals.pop("_count")
+        return {name: total / count for name, total in totals.items()}
+
+
+def _block_rows(path: PathLike, sample_rate_hz: float, max_points: int) -> int:
+    """Rows per plotting block: at least 10 s, at most ``max_points`` blocks in the file."""
+    rows = rec.count_rows(path)
+    return max(round(BLOCK_S * sample_rate_hz), -(-rows // max(int(max_points), 1)), 1)
+
+
+@dataclass(frozen=True, eq=False)
+class SoakTrace:
+    """Block means of one soak recording, for Fig. 3 and Fig. 5 of [1].
+
+    Attributes
+    ----------
+    source, name
+        The file and its name.
+    block_s
+        Length of the plotting blocks. [s]
+    time_s, freq_hz
+        Block-mean time [s] and frequency [Hz].
+    temperature_c
+        Resonator temperature from the block-mean frequency (inverse of Eq. 18). [°C]
+    chamber_c, resonator_c
+        Block means of the chamber and (simulator) true resonator temperature, if recorded. [°C]
+    """
+
+    source: str
+    name: str
+    block_s: float
+    time_s: np.ndarray
+    freq_hz: np.ndarray
+    temperature_c: np.ndarray
+    chamber_c: np.ndarray | None
+    resonator_c: np.ndarray | None
+
+
+@dataclass(frozen=True, eq=False)
+class RunTrace:
+    """One run compensated: block means for Fig. 6 of [1] and full-rate statistics.
+
+    Attributes
+    ----------
+    source, name, unit
+        The file, its name and the gyro named in its metadata.
+    sample_rate_hz, input_rate_dph
+        From the metadata. [Hz], [°/h]
+    n_samples, duration_s
+        Size of the run. [s]
+    block_s
+        Length of the plotting blocks. [s]
+    blocks
+        Block means: ``time_s``, ``raw_dph`` (output − input rate), ``model_dph``,
+        ``comp_dph``, ``temperature_c`` (from frequency), ``in_range`` (share of the
+        block inside the calibrated range), and where available ``comp_housing_dph``,
+        ``true_dph``, ``resonator_c``, ``housing_c``, ``chamber_c``.
+    bias_stability_dph
+        ``raw``/``compensated``/``housing`` -> τ (``"1"``, ``"10"``, ``"100"``) -> 1σ of
+        τ-second means, None where the run is shorter than two blocks; ``housing`` is
+        None without the baseline. [°/h]
+    allan, noise
+        Allan deviation (overlapping, octave τ) and its noise terms, same keys.
+    out_of_range_fraction, rate_out_of_range_fraction
+        Shares of samples outside the calibrated range (f, T) and the training range of df/dt.
+    residual_rms_dph
+        RMS of the model minus the true bias (simulated runs), else None. [°/h]
+    """
+
+    source: str
+    name: str
+    unit: str
+    sample_rate_hz: float
+    input_rate_dph: float
+    n_samples: int
+    duration_s: float
+    block_s: float
+    blocks: dict[str, np.ndarray]
+    bias_stability_dph: dict[str, dict[str, float | None] | None]
+    allan: dict[str, AllanResult]
+    noise: dict[str, NoiseTerms]
+    out_of_range_fraction: float
+    rate_out_of_range_fraction: float
+    residual_rms_dph: float | None
+
+
+def trace_soak(
+    path: PathLike, thermometer: Thermometer, *, max_points: int = 20_000,
+    read_kwargs: Mapping[str, Any] | None = None, on_chunk: Callable[[int], None] | None = None,
+) -> SoakTrace:
+    """Block means of a soak recording, streamed (blocks of >= 10 s, at most ``max_points``)."""
+    means: _BlockMeans | None = None
+    for chunk in rec.iter_chunks(path, **{"rows": CHUNK_ROWS, **(read_kwargs or {})}):
+        if means is None:
+            means = _BlockMeans(_block_rows(path, chunk.sample_rate_hz, max_points))
+            block_s = means.rows / chunk.sample_rate_hz
+        means.push({k: chunk[k] for k in ("time_s", "freq_hz", "chamber_c", "resonator_c")
+                     if k in chunk})
+        if on_chunk is not None:
+            on_chunk(len(chunk))
+    assert means is not None  # iter_chunks raises on an empty file
+    b = means.means()
+    return SoakTrace(str(path), Path(path).name, block_s, b["time_s"], b["freq_hz"],
+                     thermometer.temperature(b["freq_hz"], warn=False),
+                     b.get("chamber_c"), b.get("resonator_c"))
+
+
+def _stability(values: np.ndarray, rate_hz: float) -> dict[str, float | None]:
+    return {f"{tau:g}": metrics.bias_stability(values, rate_hz, tau)
+            if values.size >= 2 * round(tau * rate_hz) else None for tau in TAUS_S}
+
+
+def _allan(values: np.ndarray, rate_hz: float) -> tuple[AllanResult | None, NoiseTerms | None]:
+    try:
+        allan = metrics.allan_deviation(values, rate_hz, "octave")
+    except HrgtcError:
+        return None, None
+    try:
+        return allan, metrics.noise_terms(allan)
+    except HrgtcError:
+        return allan, None
+
+
+def trace_run(
+    path: PathLike, model: UnitModel, *, max_points: int = 20_000,
+    read_kwargs: Mapping[str, Any] | None = None, on_chunk: Callable[[int], None] | None = None,
+) -> RunTrace:
+    """Compensate one run chunk by chunk (Eq. 22 of [1] as in Fig. 6) and gather its evidence.
+
+    The full-rate raw and compensated bias are kept for the bias stability and
+    the Allan deviation (three float64 arrays, ~29 MB each for 5 h at 200 Hz);
+    everything else is reduced to plotting blocks on the fly.
+    """
+    compensator = Compensator(model)
+    housing: Compensator | None = None
+    means: _BlockMeans | None = None
+    full: dict[str, list[np.ndarray]] = {"raw": [], "compensated": [], "housing": []}
+    squared_error = 0.0
+    truth = False
+    for chunk in rec.iter_chunks(path, **{"rows": CHUNK_ROWS, **(read_kwargs or {})}):
+        if means is None:
+            meta = chunk.metadata
+            means = _BlockMeans(_block_rows(path, chunk.sample_rate_hz, max_points))
+            truth = "bias_dph" in chunk
+            if model.housing is not None and "housing_c" in chunk:
+                housing = Compensator(model, drift="housing")
+        out = compensator.process(chunk)
+        raw = chunk.rate_dph - meta.input_rate_dph
+        comp = out["rate_comp_dph"] - meta.input_rate_dph
+        full["raw"].append(raw)
+        full["compensated"].append(comp)
+        columns = {"time_s": chunk.time_s, "raw_dph": raw, "model_dph": out["bias_model_dph"],
+                   "comp_dph": comp, "temperature_c": out["resonator_c_est"],
+                   "in_range": out["in_range"]}
+        if housing is not None:
+            comp_h = housing.process(chunk)["rate_comp_dph"] - meta.input_rate_dph
+            full["housing"].append(comp_h)
+            columns["comp_housing_dph"] = comp_h
+        if truth:
+            columns["true_dph"] = chunk["bias_dph"]
+            squared_error += float(np.sum((out["bias_model_dph"] - chunk["bias_dph"]) ** 2))
+        columns.update({k: chunk[k] for k in ("resonator_c", "housing_c", "chamber_c")
+                        if k in chunk})
+        means.push(columns)
+        if on_chunk is not None:
+            on_chunk(len(chunk))
+    assert means is not None  # iter_chunks raises on an empty file
+    fs = meta.sample_rate_hz
+    stability: dict[str, dict[str, float | None] | None] = {"housing": None}
+    allan: dict[str, AllanResult] = {}
+    noise: dict[str, NoiseTerms] = {}
+    for key, parts in full.items():
+        if not parts:
+            continue
+        values = np.concatenate(parts)
+        parts.clear()
+        stability[key] = _stability(values, fs)
+        deviation, terms = _allan(values, fs)
+        if deviation is not None:
+            allan[key] = deviation
+        if terms is not None:
+            noise[key] = terms
+    n = compensator.samples
+    return RunTrace(
+        str(path), Path(path).name, meta.unit, fs, meta.input_rate_dph, n, n / fs,
+        means.rows / fs, means.means(), stability, allan, noise,
+        compensator.out_of_range_fraction, compensator.rate_out_of_range_fraction,
+        math.sqrt(squared_error / n) if truth else None,
+    )
+
+
+# -- Fig. 3: settling of the soaks -----------------------------------------------------
+def _draw_plateau(ax: Axes, plateau: Plateau, data_end_s: float) -> None:
+    ax.axvspan(plateau.start_s / 3600, plateau.end_s / 3600, color="#f3e3b5", alpha=0.6, lw=0,
+               label="final stretch")
+    fit = plateau.fit
+    if fit is not None:  # a "constant" fit (no transient) draws as a flat line
+        end = max(data_end_s, fit.end_s, fit.start_s + 4.0 * max(fit.tau_s, default=0.0))
+        inside = np.linspace(fit.start_s, fit.end_s, 300)
+        ax.plot(_hours(inside), fit.evaluate(inside), color=MODEL, lw=0.9,
+                label="settling-curve fit")
+        if end > fit.end_s and fit.tau_s:
+            beyond = np.linspace(fit.end_s, end, 100)
+            ax.plot(_hours(beyond), fit.evaluate(beyond), color=MODEL, lw=0.9, ls="--",
+                    label="extrapolation")
+    ax.axhline(plateau.settled_freq_hz, color=TRUTH, lw=0.8, ls=":",
+               label="settled frequency (Table 1)")
+
+
+@_styled
+def settling_figure(
+    traces: Sequence[SoakTrace], plateaus: Sequence[Sequence[Plateau]]
+) -> Figure:
+    """Frequency of each soak against time, its settled value and the settling-curve fit.
+
+    Mirrors Fig. 3 of [1] (frequency from room temperature to the set-point; the
+    resonator in vacuum settles after ~15,000 s). ``plateaus[k]`` are the plateaus
+    found in ``traces[k]``; a trace may be None to draw the stored fit alone.
+    """
+    figure, axes = _grid(len(plateaus))
+    for ax, trace, found in zip(axes, traces, plateaus, strict=True):
+        end = 0.0
+        if trace is not None:
+            ax.plot(_hours(trace.time_s), trace.freq_hz, color=RAW, label="frequency")
+            end = float(trace.time_s[-1])
+        for plateau in found:
+            _draw_plateau(ax, plateau, end)
+        low, high = ax.dataLim.intervaly
+        if high - low < 0.01:  # a flat stored fit: show ±10 mHz, not ±0.1 % of 4.4 kHz
+            ax.set_ylim(0.5 * (low + high) - 0.01, 0.5 * (low + high) + 0.01)
+        setpoints = ", ".join(f"{p.chamber_c:.0f}" for p in found)
+        name = trace.name if trace is not None else "stored fit"
+        ax.set_title(f"{name} — chamber {setpoints or '?'} °C", fontsize=8.5)
+        ax.set_xlabel("time [h]")
+        ax.set_ylabel("frequency [Hz]")
+        _plain(ax)
+    _legend_below(figure, axes)
+    return figure
+
+
+# -- Fig. 4: frequency-temperature fit ---------------------------------------------------
+@_styled
+def thermometer_figure(
+    thermometer: Thermometer, chamber_c: Sequence[float], freq_hz: Sequence[float],
+    freq_std_hz: Sequence[float],
+) -> Figure:
+    """The unit's plateau points, the fitted polynomial and its residuals.
+
+    Mirrors Fig. 4 of [1] (the cubic of Eq. 18 through Table 1); the residual
+    panel gives f − f_fit in mHz and, on the right axis, the equivalent
+    temperature error through the linear coefficient.
+    """
+    t = np.asarray(chamber_c, dtype=np.float64)
+    f = np.asarray(freq_hz, dtype=np.float64)
+    figure = _figure(3 * _PANEL_WIDTH_IN, 3.3)
+    fit_ax, res_ax = figure.subplots(1, 2)
+    low, high = thermometer.temperature_range_c
+    grid = np.linspace(low - 0.05 * (high - low), high + 0.05 * (high - low), 300)
+    fit_ax.plot(grid, thermometer.frequency(grid), color=MODEL,
+                label=f"order-{thermometer.order} fit (Eq. 18 form)")
+    fit_ax.plot(t, f, "o", color=RAW, ms=4, label="plateaus (Table 1)")
+    fit_ax.set_xlabel("temperature [°C]")
+    fit_ax.set_ylabel("frequency [Hz]")
+    fit_ax.legend(loc="upper left")
+    _plain(fit_ax)
+    residual_mhz = 1e3 * (f - thermometer.frequency(t))
+    res_ax.axhline(0.0, color=CHAMBER, lw=0.8)
+    res_ax.errorbar(t, residual_mhz, yerr=1e3 * np.asarray(freq_std_hz, dtype=np.float64),
+                    fmt="o", color=RAW, ms=4, capsize=2)
+    res_ax.set_xlabel("temperature [°C]")
+    res_ax.set_ylabel("residual f − f_fit [mHz]")
+    slope = float(thermometer.coefficients[1]) if thermometer.order >= 1 else 0.0
+    if slope:  # mHz -> °C, or m°C when the residuals are that small
+        milli = np.max(np.abs(residual_mhz), initial=0.0) / (1e3 * abs(slope)) < 0.05
+        per_mhz = (1.0 if milli else 1e-3) / slope
+        second = res_ax.secondary_yaxis(
+            "right", functions=(lambda m: m * per_mhz, lambda c: c / per_mhz))
+        second.yaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
+        unit = "m°C" if milli else "°C"
+        second.set_ylabel(f"≈ temperature error [{unit}] (÷ {slope:.4g} Hz/°C)")
+    return figure
+
+
+# -- Fig. 5: temperature from frequency ---------------------------------------------------
+@_styled
+def temperature_error_figure(table: Sequence[Mapping[str, float]]) -> Figure:
+    """Error of the temperature from frequency at each plateau; mirrors Fig. 5(a) of [1]."""
+    t = np.array([row["chamber_c"] for row in table])
+    error = np.array([row["error_c"] for row in table])
+    figure = _figure(2 * _PANEL_WIDTH_IN, 2.9)
+    ax = figure.subplots()
+    width = 0.6 * float(np.min(np.diff(np.sort(t)))) if t.size > 1 else 1.0
+    ax.bar(t, error, width=width, color=RAW, label="this unit")
+    ax.plot(paper.TABLE2_ACTUAL_C, paper.TABLE2_ERROR_C, "o", mfc="none", color=CHAMBER,
+            label="paper's unit (Table 2 of [1])")
+    ax.axhspan(-0.1, 0.1, color="#e9f3e9", zorder=0, label="±0.1 °C (paper's tolerance)")
+    ax.axhline(0.0, color=CHAMBER, lw=0.8)
+    ax.set_xlabel("chamber temperature [°C]")
+    ax.set_ylabel("T from frequency − chamber [°C]")
+    ax.legend(loc="best")
+    return figure
+
+
+@_styled
+def soak_temperature_figure(traces: Sequence[SoakTrace]) -> Figure:
+    """Temperature from frequency against time for each soak; mirrors Fig. 5(b) of [1].
+
+    The chamber temperature and, for simulated soaks, the true resonator
+    temperature are drawn beside it.
+    """
+    figure, axes = _grid(len(traces))
+    for ax, trace in zip(axes, traces, strict=True):
+        if trace.chamber_c is not None:
+            ax.plot(_hours(trace.time_s), trace.chamber_c, color=CHAMBER, lw=0.9, label="chamber")
+        ax.plot(_hours(trace.time_s), trace.temperature_c, color=RAW,
+                label="resonator, from frequency")
+        if trace.resonator_c is not None:
+            ax.plot(_hours(trace.time_s), trace.resonator_c, color=TRUTH, lw=0.9, ls="--",
+                    label="resonator, true (simulator)")
+        ax.set_title(trace.name, fontsize=8.5)
+        ax.set_xlabel("time [h]")
+        ax.set_ylabel("temperature [°C]")
+        _plain(ax)
+    _legend_below(figure, axes)
+    return figure
+
+
+# -- Fig. 6: raw and compensated output ---------------------------------------------------
+def _spans(mask: np.ndarray) -> list[tuple[int, int]]:
+    """(start, stop) index pairs of the True runs of ``mask``."""
+    edges = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
+    return list(zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1), strict=True))
+
+
+@_styled
+def run_figure(run: RunTrace) -> Figure:
+    """Raw output with the model, compensated output and temperatures of one run.
+
+    Mirrors Fig. 6(a) (output, blue, and model, red) and Fig. 6(b) (compensated
+    output) of [1]; a third panel shows the resonator temperature from frequency.
+    Stretches with samples outside the calibrated range are shaded.
+    """
+    b = run.blocks
+    hours = _hours(b["time_s"])
+    figure = _figure(3 * _PANEL_WIDTH_IN, 7.2)
+    raw_ax, comp_ax, temp_ax = figure.subplots(3, 1, sharex=True, height_ratios=(1.2, 1.2, 0.8))
+    stability = run.bias_stability_dph
+    raw_ax.plot(hours, b["raw_dph"], color=RAW,
+                label=f"output − input rate ({_at10(stability['raw'])})")
+    raw_ax.plot(hours, b["model_dph"], color=MODEL, label="drift model (Eq. 22 form)")
+    if "true_dph" in b:
+        raw_ax.plot(hours, b["true_dph"], color=TRUTH, lw=0.8, ls="--",
+                    label="true bias (simulator)")
+    raw_ax.set_ylabel("bias [°/h]")
+    raw_ax.set_title(f"(a) raw output and model, {run.block_s:g} s means", fontsize=9)
+    comp_ax.plot(hours, b["comp_dph"], color=COMPENSATED,
+                 label=f"compensated, frequency model ({_at10(stability['compensated'])})")
+    if "comp_housing_dph" in b:
+        comp_ax.plot(hours, b["comp_housing_dph"], color=HOUSING, lw=0.9,
+                     label=f"compensated, housing thermistor ({_at10(stability['housing'])})")
+    comp_ax.set_ylabel("bias [°/h]")
+    comp_ax.set_title("(b) compensated output", fontsize=9)
+    temp_ax.plot(hours, b["temperature_c"], color=RAW, label="resonator, from frequency")
+    for key, label, colour, style in (
+        ("resonator_c", "resonator, true", TRUTH, "--"),
+        ("housing_c", "housing thermistor", HOUSING, "-"),
+        ("chamber_c", "chamber", CHAMBER, "-"),
+    ):
+        if key in b:
+            temp_ax.plot(hours, b[key], color=colour, lw=0.9, ls=style, label=label)
+    temp_ax.set_ylabel("temperature [°C]")
+    temp_ax.set_xlabel("time [h]")
+    out = b["in_range"] < 1.0
+    if np.any(out):
+        edges = np.concatenate([hours, [hours[-1] + run.block_s / 3600]])
+        for ax in (raw_ax, comp_ax, temp_ax):
+            for start, stop in _spans(out):
+                ax.axvspan(edges[start], edges[stop], color="#f6d5d5", lw=0, zorder=0)
+        temp_ax.plot([], [], color="#f6d5d5", lw=6, label="outside calibrated range")
+    for ax in (raw_ax, comp_ax, temp_ax):
+        ax.legend(loc="best")
+    return figure
+
+
+def _at10(table: Mapping[str, float | None] | None) -> str:
+    value = None if table is None else table.get("10")
+    return "10 s stability n/a" if value is None else f"10 s stability {value:.4g} °/h"
+
+
+@_styled
+def allan_figure(run: RunTrace) -> Figure:
+    """Allan deviation of the raw and compensated output (log-log), minima marked."""
+    figure = _figure(2 * _PANEL_WIDTH_IN, 3.6)
+    ax = figure.subplots()
+    colours = {"raw": RAW, "compensated": COMPENSATED, "housing": HOUSING}
+    labels = {"raw": "raw", "compensated": "compensated (frequency)",
+              "housing": "compensated (housing thermistor)"}
+    for key, allan in run.allan.items():
+        ax.loglog(allan.taus_s, allan.deviation, "-o", ms=2.5, color=colours[key],
+                  label=labels[key])
+        terms = run.noise.get(key)
+        if terms is not None:
+            tau = terms.bias_instability_tau_s
+            minimum = terms.bias_instability_dph * FLICKER_FLOOR_FACTOR
+            ax.plot([tau], [minimum], "s", mfc="none", ms=7, color=colours[key])
+    ax.set_xlabel("averaging time τ [s]")
+    ax.set_ylabel("Allan deviation [°/h]")
+    plain = FuncFormatter(lambda value, _: f"{value:g}")
+    ax.xaxis.set_major_formatter(plain)
+    ax.yaxis.set_major_formatter(plain)
+    low, high = ax.get_ylim()
+    if high / low < 100.0:  # under two decades: label 2 and 5 between the powers of ten
+        ax.yaxis.set_minor_locator(LogLocator(subs=(2.0, 5.0)))
+        ax.yaxis.set_minor_formatter(plain)
+    else:
+        ax.yaxis.set_minor_formatter(NullFormatter())
+    ax.legend(loc="best")
+    ax.grid(True, which="minor", color="#f0f0f0", lw=0.4)
+    return figure

@@ -1,0 +1,505 @@
+"""The HTML report: one self-contained file with the evidence of a calibration, like [1].
+
+:func:`build_report` reads the unit's soaks and any number of runs chunk by
+chunk (:func:`trace_soak`, :func:`trace_run`), decimates them to block means for
+plotting, compensates each run with the unit's model (and with the
+housing-thermistor baseline when there is one), and writes one HTML document:
+the settling of each soak (Fig. 3 of [1]), the frequency-temperature fit (Fig. 4,
+Table 1, Eq. 18), the temperature from frequency (Fig. 5, Table 2), raw and
+compensated output of each run (Fig. 6) with bias stability and Allan deviation,
+and the stepwise drift model (Eq. 21-22). Figures (:mod:`hrgtc.report.figures`)
+are embedded as SVG ``data:`` URIs; the page loads no external resource.
+
+[1] X. Wang, W. Wu, Z. Fang, B. Luo, Y. Li, Q. Jiang, "Temperature Drift
+    Compensation for Hemispherical Resonator Gyro Based on Natural Frequency",
+    Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Iterable, Mapping, Sequence
+from datetime import UTC, datetime
+from html import escape
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+import hrgtc.report.figures as figures
+from hrgtc import paper
+from hrgtc import recording as rec
+from hrgtc.drift.features import parse_terms
+from hrgtc.files import file_sha256, refuse_existing, write_text_atomic
+from hrgtc.model import UnitModel, load_model
+from hrgtc.progress import Progress
+from hrgtc.report.figures import TAUS_S, RunTrace, SoakTrace, trace_run, trace_soak
+from hrgtc.thermometry import coefficient_pvalues
+from hrgtc.thermometry.plateaus import Plateau
+
+__all__ = ["RunTrace", "SoakTrace", "build_report", "trace_run", "trace_soak"]
+
+PathLike = str | os.PathLike[str]
+
+REFERENCE = (
+    "X. Wang, W. Wu, Z. Fang, B. Luo, Y. Li, Q. Jiang, “Temperature Drift Compensation for "
+    "Hemispherical Resonator Gyro Based on Natural Frequency”, <i>Sensors</i> 12(5), "
+    "6434–6446, 2012"
+)
+DOI = "10.3390/s120506434"
+
+
+# -- HTML pieces ----------------------------------------------------------------------------
+_CSS = """
+body{font:15px/1.5 system-ui,-apple-system,"Segoe UI",Roboto,"DejaVu Sans",sans-serif;
+color:#1d1d1f;background:#fff;margin:0 auto;max-width:1120px;padding:1.2em 2em 3em}
+h1{font-size:1.7em;margin:.2em 0}h2{font-size:1.3em;margin-top:2em;border-bottom:2px solid #ddd;
+padding-bottom:.2em}h3{font-size:1.08em;margin-top:1.6em}
+figure{margin:1.2em 0;padding:.6em;border:1px solid #e4e4e4;border-radius:4px;background:#fcfcfc}
+figure img{display:block;max-width:100%;height:auto;margin:0 auto}
+figcaption{font-size:.9em;color:#444;margin-top:.5em}
+table{border-collapse:collapse;margin:.8em 0;font-size:.9em}
+caption{caption-side:top;text-align:left;font-weight:600;padding-bottom:.3em}
+th,td{border:1px solid #d6d6d6;padding:.25em .6em;white-space:nowrap}
+th{background:#f1f3f5;text-align:center;white-space:normal}.scroll{overflow-x:auto}
+td.n{text-align:right;font-variant-numeric:tabular-nums}
+code,.eq{font-family:ui-monospace,"DejaVu Sans Mono",Menlo,Consolas,monospace;font-size:.92em}
+.eq{background:#f5f7fa;border-left:3px solid #8aa4c8;padding:.5em .8em;overflow-x:auto}
+.note{background:#fff7e0;border-left:3px solid #e0b040;padding:.4em .8em}
+nav ol{columns:2;font-size:.92em}.muted{color:#666;font-size:.9em}
+"""
+
+
+def _number(value: Any, digits: int = 4, fixed: int | None = None, sign: bool = False) -> str:
+    """A number for a table: ``fixed`` decimals or ``digits`` significant; "–" if missing."""
+    if value is None or not math.isfinite(float(value)):
+        return "–"
+    plus = "+" if sign else ""
+    if fixed is not None:
+        return f"{float(value):{plus}.{fixed}f}"
+    return f"{float(value):{plus}.{digits}g}"
+
+
+def _pvalue(value: float | None) -> str:
+    """A p-value, with underflow shown as a bound."""
+    if value is None or not math.isfinite(value):
+        return "–"
+    return "< 1e-300" if value == 0 else f"{value:.3g}"
+
+
+def _table(headers: Sequence[str], rows: Iterable[Sequence[Any]], caption: str = "") -> str:
+    """A table; cells are escaped text, numbers (from :func:`_number`) right aligned."""
+    head = "".join(f"<th>{escape(h)}</th>" for h in headers)
+    body = []
+    for row in rows:
+        cells = []
+        for cell in row:
+            raw = str(cell)
+            numeric = raw[:1] in "+-–<0123456789"
+            text = escape(raw)
+            cells.append(f'<td class="n">{text}</td>' if numeric else f"<td>{text}</td>")
+        body.append("<tr>" + "".join(cells) + "</tr>")
+    cap = f"<caption>{escape(caption)}</caption>" if caption else ""
+    return (f'<div class="scroll"><table>{cap}<thead><tr>{head}</tr></thead>'
+            f"<tbody>{''.join(body)}</tbody></table></div>")
+
+
+class _Page:
+    """Numbers figures as they are added."""
+
+    def __init__(self) -> None:
+        self.parts: list[str] = []
+        self.count = 0
+
+    def add(self, *html: str) -> None:
+        self.parts.extend(html)
+
+    def figure(self, figure: Any, caption: str, alt: str) -> None:
+        self.count += 1
+        self.add(f'<figure><img src="{figures.svg_data_uri(figure)}" alt="{escape(alt)}">'
+                 f"<figcaption><b>Figure {self.count}.</b> {caption}</figcaption></figure>")
+
+    def note(self, text: str) -> None:
+        self.add(f'<p class="note">{text}</p>')
+
+
+# -- sections --------------------------------------------------------------------------------
+def _header(page: _Page, model: UnitModel, title: str, model_path: str | None) -> None:
+    prov = model.provenance
+    page.add(f"<header><h1>{escape(title)}</h1>",
+             f"<p>Unit <b>{escape(model.unit)}</b>. Model file "
+             f"<code>{escape(model_path or '(in memory)')}</code>, written by hrgtc "
+             f"{escape(str(prov.get('hrgtc_version', '?')))} on "
+             f"{escape(str(prov.get('created_utc', '?')))}. Report generated "
+             f"{datetime.now(UTC).isoformat(timespec='seconds')}.</p>",
+             f'<p class="muted">Method and figures after [1] {REFERENCE}, doi:'
+             f'<a href="https://doi.org/{DOI}">{DOI}</a>.</p></header>')
+    rows = []
+    for item in prov.get("inputs", []):
+        path = Path(str(item.get("path", "")))
+        digest = str(item.get("sha256", ""))
+        state = "missing" if not path.is_file() else (
+            "unchanged" if file_sha256(path) == digest else "CHANGED since calibration")
+        rows.append((item.get("role", "?"), str(path), digest[:12], state))
+    if rows:
+        page.add(_table(("role", "file", "SHA-256 (first 12)", "on disk now"), rows,
+                            "Model inputs (provenance)"))
+    page.add('<nav><ol><li><a href="#settling">Settling of the soaks (Fig. 3)</a></li>'
+             '<li><a href="#thermometer">Frequency–temperature fit (Fig. 4, Table 1, Eq. 18)'
+             '</a></li><li><a href="#temperature">Temperature from frequency (Fig. 5, '
+             'Table 2)</a></li><li><a href="#runs">Runs: raw and compensated output (Fig. 6),'
+             ' Allan deviation</a></li><li><a href="#model">Drift model: stepwise regression '
+             '(Eq. 21–22)</a></li></ol></nav>')
+
+
+def _summary(page: _Page, runs: Sequence[RunTrace]) -> None:
+    """The result at a glance: 10 s bias stability of each run beside the paper's."""
+    if not runs:
+        return
+    rows = [(r.name, _number(r.bias_stability_dph["raw"]["10"]),
+             _number(r.bias_stability_dph["compensated"]["10"]),
+             _number(_ratio(r.bias_stability_dph, "10"), 3),
+             _number((r.bias_stability_dph["housing"] or {}).get("10")),
+             f"{r.out_of_range_fraction:.1%}") for r in runs]
+    rows.append(("paper [1], Section 4.2 (its cool-down)", _number(paper.BIAS_STABILITY_RAW_DPH,
+                 5), _number(paper.BIAS_STABILITY_COMPENSATED_DPH, 4), _number(
+                 paper.BIAS_STABILITY_RAW_DPH / paper.BIAS_STABILITY_COMPENSATED_DPH, 3), "–",
+                 "–"))
+    page.add(_table(("run", "raw [°/h]", "compensated [°/h]", "improvement [×]",
+                     "housing baseline [°/h]", "outside calibrated range"), rows,
+                    "At a glance: 10 s bias stability, raw and compensated"))
+
+
+def _ratio(stability: Mapping[str, Any], tau: str) -> float | None:
+    raw, comp = stability["raw"][tau], stability["compensated"][tau]
+    return raw / comp if raw is not None and comp else None
+
+
+def _match(plateaus: Sequence[Plateau], source: str) -> list[Plateau]:
+    """Plateaus found in ``source``: the same file, else the same file name."""
+    same = [p for p in plateaus if p.source and os.path.realpath(p.source)
+            == os.path.realpath(source)]
+    return same or [p for p in plateaus if p.source and Path(p.source).name == Path(source).name]
+
+
+def _settling(page: _Page, plateaus: Sequence[Plateau], traces: Sequence[SoakTrace],
+              missing: Sequence[str]) -> None:
+    page.add('<section id="settling"><h2>1. Settling of the soaks</h2>')
+    if missing:
+        page.note("Soak recordings not found: " + ", ".join(
+            f"<code>{escape(m)}</code>" for m in missing)
+            + ". Pass them with --soak (soaks= in Python).")
+    caption = ("Resonator frequency during each chamber soak, {} means, mirrors <b>Fig. 3</b> "
+               "of [1] (the paper's resonator settled after ~15,000 s). Red: settling-curve "
+               "fit; dashed: its extrapolation; dotted: the settled frequency used for Table 1; "
+               "shaded: the final stretch of the soak.")
+    if traces:
+        panels = [_match(plateaus, t.source) for t in traces]
+        page.figure(figures.settling_figure(traces, panels),
+                    caption.format(f"{traces[0].block_s:g} s"), "frequency of each soak vs time")
+    elif any(p.fit is not None for p in plateaus):
+        with_fit = [p for p in plateaus if p.fit is not None]
+        page.figure(figures.settling_figure([None] * len(with_fit), [[p] for p in with_fit]),
+                    "No soak recordings on disk: the settling-curve fits stored in the model, "
+                    "mirrors <b>Fig. 3</b> of [1].", "stored settling fits of each soak")
+    else:
+        page.note("No soak recordings and no stored settling fits: the settling figure "
+                  "cannot be drawn.")
+    rows = [(_number(p.chamber_c, fixed=3), _number(p.settled_freq_hz, fixed=5),
+             _number(1e3 * p.settled_freq_std_hz, 2), p.method, "yes" if p.settled else "no",
+             _number(p.slope_hz_per_h, 3, sign=True), _number(p.residual_unsettled_c, fixed=4,
+                                                           sign=True),
+             Path(p.source).name if p.source else "–") for p in plateaus]
+    page.add(_table(("chamber [°C]", "settled frequency [Hz]", "std error [mHz]", "from",
+                         "settled by slope", "final slope [Hz/h]", "unsettled at end [°C]",
+                         "soak file"), rows, "Plateaus of the unit (from the model file)"),
+             "</section>")
+
+
+def _power(symbol: str, n: int) -> str:
+    """``T³`` style powers (plain text, for tables and equations)."""
+    digits = str.maketrans("0123456789", "⁰¹²³⁴⁵⁶⁷⁸⁹")
+    return "" if n == 0 else symbol if n == 1 else symbol + str(n).translate(digits)
+
+
+def _table_rows(model: UnitModel, plateaus: Sequence[Plateau]) -> list[dict[str, float]]:
+    t = np.array([p.chamber_c for p in plateaus])
+    f = np.array([p.settled_freq_hz for p in plateaus])
+    estimate = model.thermometer.temperature(f, warn=False) if f.size else f
+    return [{"chamber_c": a, "freq_hz": b, "temperature_c": c, "error_c": c - a}
+            for a, b, c in zip(t, f, estimate, strict=True)]
+
+
+def _thermometer(page: _Page, model: UnitModel, plateaus: Sequence[Plateau],
+                 table: Sequence[Mapping[str, float]]) -> None:
+    th = model.thermometer
+    page.add('<section id="thermometer"><h2>2. Frequency–temperature fit</h2>')
+    if plateaus:
+        page.figure(figures.thermometer_figure(
+            th, [r["chamber_c"] for r in table], [r["freq_hz"] for r in table],
+            [p.settled_freq_std_hz for p in plateaus]),
+            "Left: the unit's plateau points (Table 1) and the fitted polynomial, mirrors "
+            "<b>Fig. 4</b> of [1]. Right: residuals f − f<sub>fit</sub> in mHz (error bars: "
+            "standard error of each settled frequency) and their equivalent in °C.",
+            "frequency-temperature fit and residuals")
+    rows = [(_number(r["chamber_c"], fixed=3), _number(r["freq_hz"], fixed=5),
+             _number(1e3 * (r["freq_hz"] - th.frequency(r["chamber_c"])), fixed=3, sign=True))
+            for r in table]
+    page.add(_table(("temperature [°C]", "natural frequency [Hz]", "residual [mHz]"),
+                        rows, "The unit's Table 1"))
+    high = th.coefficients_high_first
+    pvals = tuple(reversed(coefficient_pvalues(th)))
+    printed = dict(enumerate(reversed(paper.EQ18_PRINTED_HIGH_FIRST)))
+    powers = range(th.order, -1, -1)
+    rows = [(_power("T", n) or "const", "Hz" + (f"/{_power('°C', n)}" if n else ""),
+             _number(c, 10), _number(se, 3), _pvalue(p), _number(printed.get(n), 7))
+            for n, c, se, p in zip(powers, high, reversed(th.standard_errors), pvals,
+                                   strict=True)]
+    page.add(_table(("term", "unit", "coefficient", "std error", "p-value",
+                         "Eq. 18 of [1]"), rows, "Coefficients, highest power first"))
+    terms = " ".join(f"{'−' if c < 0 else '+'} {abs(c):.7g}" + (f"·{_power('T', n)}" if n else "")
+                     for n, c in zip(powers, high, strict=True))
+    page.add(f'<p class="eq">f = {terms.lstrip("+ ")} &nbsp;[Hz, T in °C]</p>',
+             f'<p class="muted">Eq. (18) form. Residual std {_number(1e3 * th.residual_std, 3)} '
+             f"mHz, R² {th.rsquared:.10f}, {th.n_points} points, calibrated "
+             f"{th.temperature_range_c[0]:g} to {th.temperature_range_c[1]:g} °C. The paper's "
+             "unit: f = 1.528e−5·T³ − 9.702e−4·T² + 0.3716·T + 4424.901.</p></section>")
+
+
+def _temperature(page: _Page, table: Sequence[Mapping[str, float]],
+                 traces: Sequence[SoakTrace]) -> None:
+    page.add('<section id="temperature"><h2>3. Temperature from frequency</h2>')
+    if table:
+        page.figure(figures.temperature_error_figure(table),
+                    "Temperature from frequency (inverse of Eq. 18) minus the chamber "
+                    "temperature at each plateau, mirrors <b>Fig. 5(a)</b> of [1]; open circles: "
+                    "the paper's unit (Table 2 of [1]).", "temperature error at each plateau")
+    rows = [(_number(r["freq_hz"], fixed=5), _number(r["chamber_c"], fixed=3),
+             _number(r["temperature_c"], fixed=4), _number(r["error_c"], fixed=4, sign=True))
+            for r in table]
+    page.add(_table(("frequency [Hz]", "chamber temperature [°C]",
+                         "temperature from frequency [°C]", "error [°C]"), rows,
+                        "The unit's Table 2"))
+    if traces:
+        page.figure(figures.soak_temperature_figure(traces),
+                    "Resonator temperature from frequency during each soak, mirrors "
+                    "<b>Fig. 5(b)</b> of [1], beside the chamber and (simulated soaks) the true "
+                    "resonator temperature.", "temperature from frequency during each soak")
+        rows = []
+        for t in traces:
+            if t.resonator_c is not None:
+                error = t.temperature_c - t.resonator_c
+                last = t.time_s >= t.time_s[-1] - 3600.0
+                rows.append((t.name, _number(np.sqrt(np.nanmean(error**2)), 3),
+                             _number(np.nanmax(np.abs(error)), 3),
+                             _number(np.nanmax(np.abs(error[last])), 3)))
+        if rows:
+            page.add(_table(("soak", "rms error [°C]", "max |error| [°C]",
+                                 "max |error|, last hour [°C]"), rows,
+                                "Temperature from frequency minus the true resonator "
+                                "temperature (block means)"))
+    else:
+        page.note("No soak recordings: the temperature-vs-time figure (Fig. 5(b)) needs them.")
+    page.add("</section>")
+
+
+def _run(page: _Page, k: int, run: RunTrace, model: UnitModel) -> None:
+    page.add(f'<section id="run-{k}"><h3>4.{k} Run <code>{escape(run.name)}</code></h3>',
+             f'<p class="muted">{escape(run.source)}: unit {escape(run.unit)}, {run.n_samples} '
+             f"samples at {run.sample_rate_hz:g} Hz ({run.duration_s / 3600:.2f} h), input "
+             f"rate {run.input_rate_dph:g} °/h.</p>")
+    page.figure(figures.run_figure(run),
+                f"(a) Gyro output minus the input rate with the drift model (red), mirrors "
+                f"<b>Fig. 6(a)</b> of [1]; (b) compensated output, mirrors <b>Fig. 6(b)</b>; "
+                f"(c) temperatures. {run.block_s:g} s means; red shading: samples outside the "
+                f"calibrated range.", f"raw and compensated output of {run.name}")
+    s = run.bias_stability_dph
+    housing = s["housing"]
+    rows = []
+    for tau in (f"{t:g}" for t in TAUS_S):
+        rows.append((tau, _number(s["raw"][tau]), _number(s["compensated"][tau]),
+                     _number(_ratio(s, tau), 3),
+                     *([_number(housing[tau])] if housing is not None else []),
+                     *((_number(paper.BIAS_STABILITY_RAW_DPH, 5),
+                        _number(paper.BIAS_STABILITY_COMPENSATED_DPH, 4)) if tau == "10"
+                       else ("–", "–"))))
+    headers = ["τ [s]", "raw [°/h]", "compensated [°/h]", "improvement [×]",
+               *(["housing baseline [°/h]"] if housing is not None else []),
+               "paper raw [°/h]", "paper compensated [°/h]"]
+    page.add(_table(headers, rows, f"Bias stability of {run.name}: 1σ of τ-second means "
+                        "of output − input rate (paper [1], Section 4.2: 3.0143 → 0.5848 °/h "
+                        "on its cool-down)"))
+    facts = [("samples outside the calibrated range (f, T)", f"{run.out_of_range_fraction:.2%}"),
+             ("samples with df/dt outside its training range",
+              f"{run.rate_out_of_range_fraction:.2%}")]
+    if run.residual_rms_dph is not None:
+        facts.append(("RMS of model − true bias (simulator) [°/h]",
+                      _number(run.residual_rms_dph)))
+    if model.housing is not None and housing is None:
+        facts.append(("housing baseline", "not applied: the run has no housing_c column"))
+    page.add(_table(("quantity", "value"), facts, f"Range and residual of {run.name}"))
+    if run.allan:
+        page.figure(figures.allan_figure(run),
+                    "Overlapping Allan deviation of the output before and after compensation "
+                    "(octave τ); squares mark the bias-instability minimum.",
+                    f"Allan deviation of {run.name}")
+        names = {"raw": "raw", "compensated": "compensated", "housing": "housing baseline"}
+        rows = [(names[key], _number(n.arw_deg_per_rt_h), _number(n.bias_instability_dph)
+                 + ("" if n.floor_reached else " (bound)"), _number(n.rrw_dph_per_rt_h))
+                for key, n in run.noise.items()]
+        page.add(_table(("output", "ARW [°/√h]", "bias instability [°/h]",
+                             "RRW [°/h/√h]"), rows,
+                            f"Allan noise terms of {run.name} (IEEE Std 952-1997, Annex C)"))
+    page.add("</section>")
+
+
+def _excluded(d: Any) -> str:
+    names = [c for c in d.candidates if c not in d.selected]
+    if not names:
+        return ""
+    pairs = zip(names, d.stepwise.excluded_pvalues, strict=True)
+    return " Not in the model (p-value if added): " + ", ".join(
+        f"<code>{escape(n)}</code> {_pvalue(p) if math.isfinite(p) else 'n/a'}"
+        for n, p in pairs) + "."
+
+
+def _drift_model(page: _Page, model: UnitModel) -> None:
+    d = model.drift
+    page.add('<section id="model"><h2>5. Drift model: stepwise regression</h2>',
+             f"<p>Candidates (Eq. 21 of [1] by default): <code>{escape(', '.join(d.candidates))}"
+             f"</code>. Fitted on {d.n_windows} means of {d.window_s:g} s ({d.n_samples} "
+             f"samples); p-to-enter {d.stepwise.penter:g}, p-to-remove {d.stepwise.premove:g}; "
+             f"stopped: {escape(d.stepwise.stop_reason)}.{_excluded(d)}</p>")
+    rows = [(n, s.action, s.term, _number(s.fstat, 5), _pvalue(s.pvalue))
+            for n, s in enumerate(d.history, start=1)]
+    page.add(_table(("step", "action", "term", "F", "p-value"), rows, "Stepwise steps"))
+    rows = [("B0 (const)", "°/h", _number(d.intercept_dph, 6), _number(d.standard_errors["const"],
+             3), _pvalue(d.pvalues["const"]), "yes")]
+    for name in d.selected:
+        unit = parse_terms([name])[0].unit
+        rows.append((name, f"°/h per {unit}", _number(d.coefficients[name], 6),
+                     _number(d.standard_errors[name], 3), _pvalue(d.pvalues[name]),
+                     "yes" if name in paper.EQ22_TERMS else "no"))
+    page.add(_table(("term", "coefficient unit", "coefficient", "std error", "p-value",
+                         "kept in Eq. 22 of [1]"), rows, "The final model"),
+             f'<p class="eq">{escape(d.equation())}</p>',
+             f'<p class="muted">Eq. (22) form. Residual std {_number(d.residual_std_dph)} °/h on '
+             f"{d.window_s:g} s means, R² {d.rsquared:.6f}.</p>")
+    if d.variance_inflation > 1.0:
+        page.note(f"F-tests and standard errors corrected for autocorrelated window residuals "
+                  f"(Newey–West, {d.bandwidth_windows} windows): variance inflation "
+                  f"{d.variance_inflation:.3g}.")
+    if model.housing is not None:
+        page.add(f'<p>Classical baseline (housing thermistor): </p><p class="eq">'
+                 f"{escape(model.housing.equation())}</p>")
+    page.add("</section>")
+
+
+# -- the report --------------------------------------------------------------------------------
+def _soak_files(model: UnitModel) -> tuple[list[str], list[str]]:
+    """(existing, missing) soak files named in the model's provenance."""
+    paths = [str(i["path"]) for i in model.provenance.get("inputs", [])
+             if i.get("role") == "soak" and i.get("path")]
+    return [p for p in paths if Path(p).is_file()], [p for p in paths if not Path(p).is_file()]
+
+
+def build_report(
+    model: UnitModel | PathLike,
+    runs: Sequence[PathLike],
+    output: PathLike,
+    *,
+    soaks: Sequence[PathLike] | None = None,
+    title: str | None = None,
+    force: bool = False,
+    max_points: int = 20_000,
+    columns: Mapping[str, str] | None = None,
+    units: Mapping[str, str] | None = None,
+    metadata: Mapping[str, Any] | None = None,
+    progress: Progress | None = None,
+) -> Path:
+    """Write the unit's report: one self-contained HTML file with Figs. 3-6 and Tables 1-2 of [1].
+
+    Parameters
+    ----------
+    model
+        The unit's model, or the path of its model file.
+    runs
+        Recordings to compensate and evaluate (Fig. 6 of [1]), one section each.
+    output
+        The HTML file; written atomically, never overwritten without ``force``.
+    soaks
+        Soak recordings for Figs. 3 and 5(b); default: the model's soak inputs that
+        still exist on disk (read with the column mapping stored in the model).
+    title
+        Page title (default names the unit).
+    max_points
+        Most points per plotted curve; plots use block means of at least 10 s.
+    columns, units, metadata
+        Reading options of :func:`hrgtc.recording.read` for the runs and given soaks.
+    progress
+        Optional ``callback(rows_done, rows_total)``.
+
+    Returns
+    -------
+    pathlib.Path
+        The written file.
+
+    Raises
+    ------
+    OutputExistsError
+        ``output`` exists and ``force`` is False (checked before any work).
+    """
+    target = Path(output)
+    refuse_existing(target, force)
+    model_path = None
+    if not isinstance(model, UnitModel):
+        model_path, model = str(model), load_model(model)
+    read = {"columns": columns, "units": units, "metadata": metadata}
+    missing: list[str] = []
+    if soaks is None:
+        soak_paths, missing = _soak_files(model)
+        settings = model.provenance.get("settings", {})
+        soak_read = {"columns": settings.get("columns") or None,
+                     "units": settings.get("units") or None}
+    else:
+        soak_paths, soak_read = [str(p) for p in soaks], read
+    total = sum(rec.count_rows(p) for p in [*soak_paths, *runs])
+    done = 0
+
+    def advance(rows: int) -> None:
+        nonlocal done
+        done += rows
+        if progress is not None:
+            progress(done, total)
+
+    plateaus = [Plateau.from_dict(p) for p in model.plateaus]
+    table = _table_rows(model, plateaus)
+    traces = [trace_soak(p, model.thermometer, max_points=max_points, read_kwargs=soak_read,
+                         on_chunk=advance) for p in soak_paths]
+    run_traces = [trace_run(p, model, max_points=max_points, read_kwargs=read, on_chunk=advance)
+                  for p in runs]
+    title = title or f"Temperature compensation report — unit {model.unit}"
+    page = _Page()
+    _header(page, model, title, model_path)
+    _summary(page, run_traces)
+    _settling(page, plateaus, traces, missing)
+    _thermometer(page, model, plateaus, table)
+    _temperature(page, table, traces)
+    page.add('<section id="runs"><h2>4. Runs: raw and compensated output</h2>')
+    if not runs:
+        page.note("No runs given.")
+    for k, run in enumerate(run_traces, start=1):
+        _run(page, k, run, model)
+    page.add("</section>")
+    _drift_model(page, model)
+    body = "\n".join(page.parts)
+    html = (f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
+            f'<meta name="viewport" content="width=device-width, initial-scale=1">'
+            f"<title>{escape(title)}</title>"
+            f"<style>{_CSS}</style></head><body>\n{body}\n<footer class=\"muted\"><p>[1] "
+            f"{REFERENCE}. doi:{DOI}. Generated by hrgtc.</p></footer></body></html>\n")
+    written = write_text_atomic(target, html, force=force)
+    if progress is not None:
+        progress(total, total)
+    return written

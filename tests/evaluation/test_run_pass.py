@@ -1,0 +1,92 @@
+"""Tests of hrgtc.evaluation and the compensate / evaluate / demo commands."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from hrgtc import load_model, recording
+from hrgtc.calibration import calibrate
+from hrgtc.cli import app
+from hrgtc.evaluation import evaluate
+from hrgtc.evaluation.metrics import bias_stability
+from hrgtc.model import save_model
+
+from campaign import make_campaign
+
+
+@pytest.fixture(scope="module")
+def setup(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("evaluation")
+    files = make_campaign(folder, "paper-unit", rate_hz=2.0)
+    model = calibrate(files.soaks, [files.cooldown]).model
+    model_path = save_model(model, folder / "unit.json")
+    return files, model, model_path
+
+
+def test_evaluation_against_metrics_by_hand(setup):
+    files, model, _ = setup
+    result = evaluate(files.warmup, model)
+    run = recording.read(files.warmup)
+    raw = run.rate_dph - run.metadata.input_rate_dph
+    assert result.raw_10s == pytest.approx(bias_stability(raw, run.sample_rate_hz, 10.0), rel=1e-12)
+    predicted = model.drift.predict_recording(run)
+    assert result.compensated_10s == pytest.approx(
+        bias_stability(raw - predicted, run.sample_rate_hz, 10.0), rel=1e-12)
+    truth = np.sqrt(np.mean((run["bias_dph"] - predicted) ** 2))
+    assert result.residual_rms_dph == pytest.approx(truth, rel=1e-12)
+    assert result.improvement_10s == pytest.approx(result.raw_10s / result.compensated_10s)
+    assert set(result.bias_stability_dph) == {"raw", "compensated", "housing"}
+
+
+def test_evaluate_command_json_layout(setup):
+    files, _, model_path = setup
+    result = CliRunner().invoke(app, ["evaluate", str(files.warmup), "--model", str(model_path),
+                                      "--json"])
+    assert result.exit_code == 0, result.output
+    data = json.loads(result.stdout)
+    for name in ("raw", "compensated", "housing"):
+        assert set(data["bias_stability_dph"][name]) == {"1", "10", "100"}
+    assert data["improvement_10s"] > 1.0
+    assert 0.0 <= data["out_of_range_fraction"] <= 1.0
+    assert set(data["allan"]["raw"]) >= {"arw_deg_per_rt_h", "bias_instability_dph"}
+    text = CliRunner().invoke(app, ["evaluate", str(files.warmup), "--model", str(model_path)])
+    assert text.exit_code == 0 and "3.0143 → 0.5848" in text.stdout
+
+
+def test_compensate_command_file_to_file(setup, tmp_path):
+    files, model, model_path = setup
+    out = tmp_path / "comp.h5"
+    args = ["compensate", str(files.warmup), "--model", str(model_path), "-o", str(out), "--json"]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 0, result.output
+    assert json.loads(result.stdout)["rows"] == len(recording.read(files.warmup))
+    written = recording.read(out)
+    run = recording.read(files.warmup)
+    np.testing.assert_array_equal(written["bias_model_dph"], model.drift.predict_recording(run))
+    np.testing.assert_array_equal(written["rate_comp_dph"],
+                                  run.rate_dph - written["bias_model_dph"])
+    assert set(np.unique(written["in_range"])) <= {0.0, 1.0}
+    again = CliRunner().invoke(app, args)
+    assert again.exit_code == 2 and "--force" in again.output
+    assert load_model(model_path).drift.selected == model.drift.selected
+
+
+def test_demo_quick_end_to_end(tmp_path):
+    result = CliRunner().invoke(app, ["demo", "--quick", "-o", str(tmp_path / "demo"), "--json"])
+    assert result.exit_code == 0, result.output
+    data = json.loads(result.stdout)
+    # the unit's Table 2: every soak read back within 0.02 °C
+    assert max(abs(r["error_c"]) for r in data["calibration"]["thermometer"]["table"]) < 0.02
+    # the cool-down the paper shows: ~3 °/h raw (3.0143 in [1]) and much better compensated
+    training = data["training"]["bias_stability_dph"]
+    assert 2.5 < training["raw"]["10"] < 3.5
+    assert training["compensated"]["10"] < 0.8
+    for key in ("model_file", "report_file"):
+        assert (tmp_path / "demo" / data[key].split("/")[-1]).exists()
+    assert len(data["c_files"]) == 2
+    again = CliRunner().invoke(app, ["demo", "--quick", "-o", str(tmp_path / "demo")])
+    assert again.exit_code == 2 and "--force" in again.output
