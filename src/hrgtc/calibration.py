@@ -17,21 +17,20 @@ from __future__ import annotations
 import math
 import os
 import warnings
-from collections.abc import Iterable, Iterator, Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import partial
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from hrgtc import drift as drift_model
-from hrgtc import recording as rec
 from hrgtc.drift.features import EQ21
 from hrgtc.errors import CalibrationError, ExtrapolationWarning, HrgtcWarning, InputError
-from hrgtc.evaluation import Evaluation, evaluate_chunks
+from hrgtc.evaluation import Evaluation, evaluate
 from hrgtc.model import UnitModel, provenance
 from hrgtc.progress import StageProgress, for_stage
+from hrgtc.recording import ReadOptions
 from hrgtc.thermometry import fit as fit_thermometer
 from hrgtc.thermometry.plateaus import Plateau, find_plateaus, plateau_table
 
@@ -41,38 +40,6 @@ PathLike = str | os.PathLike[str]
 SOAK_COLUMNS = ("time_s", "freq_hz", "chamber_c")
 #: Classical baseline: cubic in housing temperature.
 HOUSING_TERMS = ("h", "h^2", "h^3")
-
-
-@dataclass(frozen=True)
-class ReadOptions:
-    """How to read the user's files: column mapping, units, metadata overrides."""
-
-    columns: Mapping[str, str] | None = None
-    units: Mapping[str, str] | None = None
-    metadata: Mapping[str, Any] | None = None
-    chunk_rows: int = 250_000
-
-    def read(self, path: PathLike, keep: Sequence[str] | None = None) -> rec.Recording:
-        """The whole file; with ``keep``, streamed keeping only those columns (less memory)."""
-        if keep is None:
-            return rec.read(path, columns=self.columns, units=self.units, metadata=self.metadata)
-        parts = [rec.Recording({k: c[k] for k in keep if k in c}, c.metadata, c.source)
-                 for c in self.chunks(path)]
-        return rec.concatenate(parts)
-
-    def head(self, path: PathLike, rows: int = 10_000) -> rec.Recording:
-        """The first ``rows`` rows of a file (its columns and metadata), file closed after."""
-        chunks = self.chunks(path, rows=rows)
-        try:
-            return next(chunks)
-        except StopIteration:
-            raise InputError(f"{path}: the recording holds no rows") from None
-        finally:
-            chunks.close()
-
-    def chunks(self, path: PathLike, rows: int | None = None) -> Iterator[rec.Recording]:
-        return rec.iter_chunks(path, rows=rows or self.chunk_rows, columns=self.columns,
-                               units=self.units, metadata=self.metadata)
 
 
 @dataclass(frozen=True)
@@ -256,7 +223,7 @@ def calibrate(
         ),
     )
     validation = tuple(
-        evaluate_chunks(unit_model, options.chunks(path), Path(path).name, allan=False)
+        evaluate(path, unit_model, allan=False, read_options=options)
         for path in validate
     )
     return CalibrationResult(unit_model, tuple(plateaus), table, validation)

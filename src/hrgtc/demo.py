@@ -11,21 +11,24 @@ and the C files into one folder. What ``hrgtc demo`` and ``make demo`` run.
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from hrgtc.calibration import CalibrationResult, calibrate
-from hrgtc.compensate import CompensationSummary, compensate_file
+from hrgtc.compensate import OUTPUT_COLUMNS, CompensationSummary
 from hrgtc.compensate.export_c import export_c
 from hrgtc.evaluation import Evaluation, evaluate
 from hrgtc.files import refuse_existing
 from hrgtc.model import save_model
 from hrgtc.progress import StageProgress, for_stage
+from hrgtc.recording import ReadOptions, RecordingWriter
 from hrgtc.report import build_report
 from hrgtc.simulate import simulate_files
 from hrgtc.simulate import standard_profiles as profiles
 
 SETPOINTS_C = (-20.0, -10.0, 0.0, 10.0, 20.0, 30.0, 40.0)  # Section 3 of [1]
+#: Most points per curve in the report's figures.
+REPORT_POINTS = 20_000
 
 
 @dataclass(frozen=True)
@@ -89,21 +92,30 @@ def run_demo(
     warm = simulate([profiles.warmup(-20.0, 20.0, s.ramp_hours)], "runs", s.seed + 2,
                     "warm-up")[0]
     soak_paths = [Path(w.path) for w in soaks]
+
     def calibration_stage(name: str, done: float, total: float) -> None:
         if progress is not None:
             progress(f"calibrate: {name}", done, total)
 
-    result = calibrate(soak_paths, [Path(cool.path)], [Path(warm.path)],
-                       progress=calibration_stage)
+    result = calibrate(soak_paths, [Path(cool.path)], progress=calibration_stage)
     save_model(result.model, model_file, force=force)
-    compensated = compensate_file(
-        warm.path, root / "runs" / "warmup_compensated.parquet", result.model, force=force,
-        progress=for_stage(progress, "compensate warm-up"),
-    )
-    training = evaluate(cool.path, result.model, progress=for_stage(progress, "evaluate cool-down"))
-    validation = evaluate(warm.path, result.model, progress=for_stage(progress, "evaluate warm-up"))
+    # Each run is compensated once: the pass that evaluates the warm-up also writes its
+    # compensated file, and both passes keep the plotting blocks the report draws.
+    training = evaluate(cool.path, result.model, max_points=REPORT_POINTS,
+                        progress=for_stage(progress, "evaluate cool-down"))
+    compensated_path = root / "runs" / "warmup_compensated.parquet"
+    head = ReadOptions().head(warm.path, rows=1)
+    names = (*head.names, *OUTPUT_COLUMNS)
+    with RecordingWriter(compensated_path, head.metadata, names, force=force) as writer:
+        validation = evaluate(warm.path, result.model, max_points=REPORT_POINTS,
+                              on_output=writer.write,
+                              progress=for_stage(progress, "compensate and evaluate warm-up"))
+    compensated = CompensationSummary(
+        str(warm.path), str(compensated_path), validation.n_samples,
+        validation.out_of_range_fraction, validation.rate_out_of_range_fraction)
+    result = replace(result, validation=(validation,))
     report_file = build_report(
-        result.model, [cool.path, warm.path], root / "report.html", soaks=soak_paths,
+        result.model, [training, validation], root / "report.html", soaks=soak_paths,
         force=force, progress=for_stage(progress, "report"),
     )
     c_files = tuple(export_c(result.model, root / "c", force=force))

@@ -23,7 +23,6 @@ from hrgtc.compensate import compensate
 from hrgtc.errors import OutputExistsError
 from hrgtc.model import save_model
 from hrgtc.report import build_report
-from hrgtc.report.figures import trace_run
 
 from campaign import SETPOINTS_C, make_campaign
 
@@ -186,8 +185,11 @@ def test_numbers_agree_with_hrgtc_evaluate(unit, report):
 
 
 def test_block_means_do_not_depend_on_chunking(unit):
+    from hrgtc.evaluation import evaluate
+
     files, model, _ = unit
-    trace = trace_run(files.cooldown, model, max_points=500, read_kwargs={"rows": 777})
+    trace = evaluate(files.cooldown, model, max_points=500,
+                     read_options=recording.ReadOptions(chunk_rows=777))
     run = recording.read(files.cooldown)
     rows = len(run) // 500  # 72 rows (36 s) per block: more than 10 s, 500 blocks
     assert trace.block_s == pytest.approx(rows / run.sample_rate_hz)

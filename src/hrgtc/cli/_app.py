@@ -31,6 +31,8 @@ app = typer.Typer(
     "resonator's natural frequency (Wang et al., Sensors 2012, doi:10.3390/s120506434).",
     no_args_is_help=True,
     add_completion=False,
+    # Help texts are plain text: with Rich markup, units like "[s]" and "[°C]" vanish.
+    rich_markup_mode=None,
     pretty_exceptions_enable=False,
 )
 
@@ -89,13 +91,17 @@ def progress_bar(
         yield callback
 
 
-@app.callback()
+@app.callback(invoke_without_command=True)
 def _root(
+    context: typer.Context,
     version: bool = typer.Option(False, "--version", help="Print the version and exit."),
 ) -> None:
     """Temperature-drift compensation of HRGs from the resonator's natural frequency."""
     if version:
-        from hrgtc import __version__
+        from hrgtc._meta import __version__
 
         console.print(f"hrgtc {__version__}")
         raise typer.Exit()
+    if context.invoked_subcommand is None:
+        console.print(context.get_help())
+        raise typer.Exit(2)

@@ -3,21 +3,21 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 from rich.table import Table
 
-from hrgtc.calibration import HOUSING_TERMS, CalibrationResult, ReadOptions, calibrate
 from hrgtc.cli._app import app, console, error_console, library_errors, print_json
-from hrgtc.cli.options import (
-    ForceOption,
-    JsonOption,
-    RecordingInput,
-    reading_options,
-)
-from hrgtc.drift.features import EQ21_TERMS
-from hrgtc.files import refuse_existing
-from hrgtc.model import save_model
+from hrgtc.cli.options import ForceOption, JsonOption, reading_options
+
+if TYPE_CHECKING:
+    from hrgtc.calibration import CalibrationResult
+    from hrgtc.recording import ReadOptions
+
+#: The nine candidate terms of Eq. (21) of [1], as the default of --terms (written out so
+#: that --help needs no import of the library; a test holds it equal to drift.EQ21_TERMS).
+EQ21_DEFAULT = "f,f^2,f^3,df,df^2,df^3,f*df,f^2*df,f*df^2"
 
 
 def render(result: CalibrationResult) -> None:
@@ -70,7 +70,7 @@ def calibrate_command(
     output: Path = typer.Option(..., "-o", "--output", help="Model file to write (JSON)."),
     order: int = typer.Option(3, help="Order of the thermometer polynomial f(T)."),
     terms: str = typer.Option(
-        ",".join(EQ21_TERMS), help="Candidate drift terms, comma separated (Eq. 21 default)."),
+        EQ21_DEFAULT, help="Candidate drift terms, comma separated (Eq. 21 default)."),
     window_s: float = typer.Option(10.0, "--window-s", help="Averaging window of the fit [s]."),
     penter: float = typer.Option(0.05, help="Stepwise p-value to enter."),
     premove: float = typer.Option(
@@ -84,13 +84,17 @@ def calibrate_command(
         10.0, "--rate-tau-s", help="Time constant of each stage of the causal df/dt filter [s]."),
     force: ForceOption = False,
     json_output: JsonOption = False,
-    inputs: RecordingInput = RecordingInput(),
+    inputs: ReadOptions | None = None,
 ) -> None:
     """Calibrate a gyro: soak plateaus -> thermometer (Eq. 18), ramps -> drift model (Eq. 22).
 
     Example: hrgtc calibrate --soak soaks/*.parquet --drift cooldown.parquet
     --validate warmup.parquet -o unit.json
     """
+    from hrgtc.calibration import HOUSING_TERMS, calibrate
+    from hrgtc.files import refuse_existing
+    from hrgtc.model import save_model
+
     soaks = [*(soak or []), *(extra_soaks or [])]
     with library_errors():
         refuse_existing(output, force)
@@ -107,7 +111,7 @@ def calibrate_command(
             window_s=window_s, penter=penter, premove=premove, reference_c=reference_c,
             rate_tau_s=rate_tau_s, housing_terms=HOUSING_TERMS,
             drift_from_soaks=drift_from_soaks,
-            read_options=ReadOptions(**inputs.read_kwargs()), progress=progress,
+            read_options=inputs, progress=progress,
         )
         save_model(result.model, output, force=force)
     if json_output:

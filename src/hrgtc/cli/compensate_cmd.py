@@ -2,22 +2,19 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 from rich.table import Table
 
-from hrgtc import paper
 from hrgtc.cli._app import app, console, library_errors, print_json, progress_bar
-from hrgtc.cli.options import (
-    ForceOption,
-    JsonOption,
-    RecordingInput,
-    reading_options,
-)
-from hrgtc.compensate import compensate_file
-from hrgtc.evaluation import Evaluation, evaluate
-from hrgtc.model import load_model
+from hrgtc.cli.options import ForceOption, JsonOption, reading_options
+
+if TYPE_CHECKING:
+    from hrgtc.evaluation import Evaluation
+    from hrgtc.recording import ReadOptions
 
 
 @app.command("compensate")
@@ -29,17 +26,20 @@ def compensate_command(
     chunk_rows: int = typer.Option(1_000_000, "--chunk-rows", help="Rows per processing chunk."),
     force: ForceOption = False,
     json_output: JsonOption = False,
-    inputs: RecordingInput = RecordingInput(),
+    inputs: ReadOptions | None = None,
 ) -> None:
     """Compensate a run file to file: adds rate_comp_dph, bias_model_dph, resonator_c_est
     and in_range, chunk by chunk (memory bounded whatever the file size).
 
     Example: hrgtc compensate warmup.parquet --model unit.json -o warmup_comp.parquet
     """
+    from hrgtc.compensate import compensate_file
+    from hrgtc.model import load_model
+
     with library_errors(), progress_bar("compensating", enabled=not json_output) as progress:
         model = load_model(model_path)
         summary = compensate_file(run, output, model, force=force, chunk_rows=chunk_rows,
-                                  progress=progress, **inputs.read_kwargs())
+                                  progress=progress, read_options=inputs)
     if json_output:
         print_json(summary.to_dict())
         return
@@ -52,30 +52,32 @@ def compensate_command(
 
 def render_evaluation(result: Evaluation) -> None:
     """Bias stability table raw / compensated / housing, beside the paper's figures."""
+    from hrgtc import paper
+
     table = Table(title=f"Bias stability of {result.file} (1σ of τ-s means, °/h)")
     table.add_column("output")
     taus = list(result.bias_stability_dph["raw"])
     for tau in taus:
-        table.add_column(f"τ = {tau} s", justify="right")
+        table.add_column(f"τ = {tau:g} s", justify="right")
     labels = {"raw": "raw", "compensated": "compensated (frequency, Eq. 22)",
               "housing": "compensated (housing thermistor)"}
     for name, row in result.bias_stability_dph.items():
         table.add_row(labels.get(name, name),
-                      *("-" if row[t] is None else f"{row[t]:.4f}" for t in taus))
+                      *("-" if math.isnan(row[t]) else f"{row[t]:.4f}" for t in taus))
     table.add_row("paper, Section 4.2 (10 s)", *(
         f"{paper.BIAS_STABILITY_RAW_DPH} → {paper.BIAS_STABILITY_COMPENSATED_DPH}"
-        if t == "10" else "" for t in taus))
+        if t == 10.0 else "" for t in taus))
     console.print(table)
-    if result.allan:
+    if result.noise:
         allan = Table(title="Allan noise terms (IEEE Std 952)")
         for column in ("output", "ARW (°/√h)", "bias instability (°/h)", "RRW (°/h/√h)"):
             allan.add_column(column, justify="right")
-        for name, terms in result.allan.items():
+        for name, terms in result.noise.items():
             def fmt(v: float | None) -> str:
-                return "-" if v is None else f"{v:.4g}"
+                return "-" if v is None or not math.isfinite(v) else f"{v:.4g}"
 
-            allan.add_row(labels.get(name, name), fmt(terms["arw_deg_per_rt_h"]),
-                          fmt(terms["bias_instability_dph"]), fmt(terms["rrw_dph_per_rt_h"]))
+            allan.add_row(labels.get(name, name), fmt(terms.arw_deg_per_rt_h),
+                          fmt(terms.bias_instability_dph), fmt(terms.rrw_dph_per_rt_h))
         console.print(allan)
     console.print(
         f"improvement at 10 s: {result.improvement_10s:.2f}×; outside the calibrated range: "
@@ -92,15 +94,18 @@ def evaluate_command(
     run: Path = typer.Argument(..., help="Recording to evaluate."),
     model_path: Path = typer.Option(..., "--model", "-m", help="Model file from 'calibrate'."),
     json_output: JsonOption = False,
-    inputs: RecordingInput = RecordingInput(),
+    inputs: ReadOptions | None = None,
 ) -> None:
     """Bias stability at 1, 10, 100 s and Allan noise terms, raw vs compensated (and vs the
     housing-thermistor baseline when the run has housing_c).
 
     Example: hrgtc evaluate warmup.parquet --model unit.json --json
     """
+    from hrgtc.evaluation import evaluate
+    from hrgtc.model import load_model
+
     with library_errors(), progress_bar("evaluating", enabled=not json_output) as progress:
-        result = evaluate(run, load_model(model_path), progress=progress, **inputs.read_kwargs())
+        result = evaluate(run, load_model(model_path), progress=progress, read_options=inputs)
     if json_output:
         print_json(result.to_dict())
         return

@@ -7,12 +7,10 @@ from pathlib import Path
 import typer
 from rich.table import Table
 
-from hrgtc import paper
 from hrgtc.cli._app import app, console, error_console, library_errors, print_json
 from hrgtc.cli.calibrate_cmd import render
 from hrgtc.cli.compensate_cmd import render_evaluation
 from hrgtc.cli.options import ForceOption, JsonOption
-from hrgtc.demo import DemoSettings, run_demo
 
 
 @app.command("demo")
@@ -29,6 +27,9 @@ def demo_command(
 
     Example: hrgtc demo -o demo-out --force
     """
+    from hrgtc import paper
+    from hrgtc.demo import DemoSettings, run_demo
+
     settings = DemoSettings.quick() if quick else DemoSettings()
     settings = DemoSettings(settings.rate_hz, settings.soak_hours, settings.ramp_hours, seed)
     seen: set[str] = set()

@@ -8,7 +8,6 @@ import typer
 
 from hrgtc.cli._app import app, console, library_errors, print_json
 from hrgtc.cli.options import ForceOption, JsonOption
-from hrgtc.compensate.export_c import export_c
 
 
 @app.command("export-c")
@@ -26,6 +25,8 @@ def export_c_command(
 
     Example: hrgtc export-c unit.json -o firmware/
     """
+    from hrgtc.compensate import export_c
+
     with library_errors():
         files = export_c(model, output, prefix=prefix, force=force)
     if json_output:

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
@@ -12,10 +12,11 @@ from hrgtc.cli.options import (
     GapPolicy,
     GapsOption,
     JsonOption,
-    RecordingInput,
     reading_options,
 )
-from hrgtc.recording.info import describe
+
+if TYPE_CHECKING:
+    from hrgtc.recording import ReadOptions
 
 
 @app.command("info")
@@ -24,15 +25,17 @@ def info(
     file: Annotated[Path, typer.Argument(help="Recording (.parquet, .pq, .csv, .h5, .hdf5).")],
     gaps: GapsOption = GapPolicy.error,
     json_output: JsonOption = False,
-    inputs: RecordingInput = RecordingInput(),
+    inputs: ReadOptions | None = None,
 ) -> None:
     """Duration, sample rate, columns, temperature and frequency spans, gaps, validation.
 
     Exits with code 2 and the validation message when the recording is bad (with
     --json the report, ok=false and its problems, is printed first).
     """
+    from hrgtc.recording import describe
+
     with library_errors():
-        result = describe(file, **inputs.read_kwargs(), gaps=gaps.value)
+        result = describe(file, **{**inputs.keywords(), "gaps": gaps.value})
     if json_output:
         print_json(result.to_dict())
     else:

@@ -3,17 +3,20 @@
 Use the ``Annotated`` aliases as parameter types. Commands that read
 recordings get the seven reading options (column mapping, units, sample rate,
 unit name, input rate) from :func:`reading_options` and receive them as one
-:class:`RecordingInput`::
+:class:`hrgtc.recording.ReadOptions`, the type the library takes::
 
     @app.command()
     @reading_options
     def compensate(
         run: Path,
         force: ForceOption = False,
-        inputs: RecordingInput = RecordingInput(),
+        inputs: ReadOptions | None = None,
     ) -> None:
         with library_errors():
-            recording = read(run, **inputs.read_kwargs())
+            recording = inputs.read(run)
+
+Nothing here imports the library's stages at import time (``hrgtc --help`` must
+start at once): the parsers of the reading options are imported when called.
 """
 
 from __future__ import annotations
@@ -21,18 +24,20 @@ from __future__ import annotations
 import functools
 import inspect
 from collections.abc import Callable
-from dataclasses import dataclass
 from enum import StrEnum
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
 from hrgtc.errors import InputError
-from hrgtc.recording.formats import FORMAT_SUFFIXES
-from hrgtc.recording.mapping import parse_columns, parse_unit
+
+if TYPE_CHECKING:
+    from hrgtc.recording import ReadOptions
 
 
 def _columns_callback(value: list[str] | None) -> list[str] | None:
+    from hrgtc.recording.mapping import parse_columns
+
     try:
         parse_columns(value)
     except InputError as exc:
@@ -44,6 +49,8 @@ def _unit_callback(kind: str) -> Any:
     def callback(value: str | None) -> str | None:
         if value is None:
             return None
+        from hrgtc.recording.mapping import parse_unit
+
         try:
             return parse_unit(kind, value)
         except InputError as exc:
@@ -70,6 +77,8 @@ class OutputFormat(StrEnum):
     @property
     def suffix(self) -> str:
         """File suffix of the format, e.g. ``".parquet"``."""
+        from hrgtc.recording.formats import FORMAT_SUFFIXES
+
         return FORMAT_SUFFIXES[self.value]
 
 
@@ -160,29 +169,6 @@ JsonOption = Annotated[
 FormatOption = Annotated[OutputFormat, typer.Option("--format", help="Output file format.")]
 
 
-@dataclass(frozen=True)
-class RecordingInput:
-    """The reading options of a command, ready for :func:`hrgtc.recording.read`.
-
-    Parameters
-    ----------
-    columns
-        Recording column -> the file's column.
-    units
-        ``{"time"|"freq"|"rate": unit}``.
-    metadata
-        Metadata overrides (``sample_rate_hz``, ``unit``, ``input_rate_dph``).
-    """
-
-    columns: dict[str, str] | None = None
-    units: dict[str, str] | None = None
-    metadata: dict[str, Any] | None = None
-
-    def read_kwargs(self) -> dict[str, Any]:
-        """``columns=``, ``units=`` and ``metadata=`` keyword arguments."""
-        return {"columns": self.columns, "units": self.units, "metadata": self.metadata}
-
-
 def recording_input(
     col: list[str] | None = None,
     time_unit: str | None = None,
@@ -191,11 +177,14 @@ def recording_input(
     rate_hz: float | None = None,
     unit_name: str | None = None,
     input_rate_dph: float | None = None,
-) -> RecordingInput:
-    """Gather the values of the shared reading options into a :class:`RecordingInput`."""
+) -> ReadOptions:
+    """Gather the values of the shared reading options into a :class:`ReadOptions`."""
+    from hrgtc.recording import ReadOptions
+    from hrgtc.recording.mapping import parse_columns
+
     units = {"time": time_unit, "freq": freq_unit, "rate": rate_unit}
     overrides = {"sample_rate_hz": rate_hz, "unit": unit_name, "input_rate_dph": input_rate_dph}
-    return RecordingInput(
+    return ReadOptions(
         columns=parse_columns(col) or None,
         units={k: v for k, v in units.items() if v is not None} or None,
         metadata={k: v for k, v in overrides.items() if v is not None} or None,
@@ -217,13 +206,16 @@ _READING_OPTIONS: tuple[tuple[str, Any], ...] = (
 def reading_options(command: Callable[..., Any]) -> Callable[..., Any]:
     """Give a command the shared reading options, defined once here.
 
-    The decorated function takes ``inputs: RecordingInput`` (as its last
+    The decorated function takes ``inputs: ReadOptions`` (as its last
     parameter) instead of the seven options; the command line still shows
     ``--col``, ``--time-unit``, ``--freq-unit``, ``--rate-unit``, ``--rate-hz``,
     ``--unit-name`` and ``--input-rate-dph``.
     """
-    signature = inspect.signature(command, eval_str=True)
-    own = [p for name, p in signature.parameters.items() if name != "inputs"]
+    signature = inspect.signature(command)
+    namespace = command.__globals__
+    own = [p.replace(annotation=eval(p.annotation, namespace))
+           if isinstance(p.annotation, str) else p
+           for name, p in signature.parameters.items() if name != "inputs"]
     added = [
         inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=None, annotation=kind)
         for name, kind in _READING_OPTIONS

@@ -5,7 +5,6 @@ from __future__ import annotations
 import typer
 from rich.table import Table
 
-from hrgtc import paper
 from hrgtc.cli._app import app, console, library_errors, print_json
 
 
@@ -17,6 +16,8 @@ def paper_command(
 
     Example: hrgtc paper --json
     """
+    from hrgtc import paper
+
     with library_errors():
         result = paper.reproduce()
     if json_output:

@@ -3,17 +3,15 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
 from hrgtc.cli._app import app, console, library_errors, print_json, progress_bar
-from hrgtc.cli.options import (
-    ForceOption,
-    JsonOption,
-    RecordingInput,
-    reading_options,
-)
-from hrgtc.report import build_report
+from hrgtc.cli.options import ForceOption, JsonOption, reading_options
+
+if TYPE_CHECKING:
+    from hrgtc.recording import ReadOptions
 
 
 @app.command("report")
@@ -31,7 +29,7 @@ def report_command(
         20_000, "--max-points", help="Most points per plotted curve (block means >= 10 s)."),
     force: ForceOption = False,
     json_output: JsonOption = False,
-    inputs: RecordingInput = RecordingInput(),
+    inputs: ReadOptions | None = None,
 ) -> None:
     """Write the HTML report: settling of the soaks (Fig. 3), T-f fit (Fig. 4, Table 1),
     temperature from frequency (Fig. 5, Table 2), raw and compensated output with bias
@@ -39,9 +37,11 @@ def report_command(
 
     Example: hrgtc report --model unit.json cooldown.parquet warmup.parquet -o report.html
     """
+    from hrgtc.report import build_report
+
     with library_errors(), progress_bar("report", enabled=not json_output) as progress:
         path = build_report(model, runs, output, soaks=soak or None, title=title, force=force,
-                            max_points=max_points, progress=progress, **inputs.read_kwargs())
+                            max_points=max_points, progress=progress, read_options=inputs)
     size = path.stat().st_size
     if json_output:
         print_json({"report": str(path), "bytes": size, "runs": [str(r) for r in runs]})

@@ -10,7 +10,13 @@ from rich.table import Table
 
 from hrgtc.cli._app import app, console, library_errors, print_json, progress_bar
 from hrgtc.cli.options import ForceOption, JsonOption, OutputFormat
-from hrgtc.simulate import DEFAULT_INPUT_RATE_DPH, simulate_files, standard_profiles, units
+
+# Written out so that --help needs no import of the simulator (it starts at once); a test
+# holds them equal to hrgtc.simulate's KINDS, unit names, DEFAULT_UNIT and input rate.
+PROFILE_KINDS = ("soak", "cooldown", "warmup", "constant", "ramp")
+UNIT_NAMES = ("paper-unit", "unit-b")
+DEFAULT_UNIT = "paper-unit"
+DEFAULT_INPUT_RATE_DPH = 10.0
 
 _PROFILE = "Profile"
 _RUN = "Run"
@@ -33,7 +39,7 @@ def simulate_command(
         str,
         typer.Option(
             "--profile",
-            metavar="|".join(standard_profiles.KINDS) + "|FILE.yaml",
+            metavar="|".join(PROFILE_KINDS) + "|FILE.yaml",
             help="Chamber program: soak (one run per set-point), cooldown, warmup, constant, "
             "ramp, or a JSON/YAML profile file (list of {setpoint_c, hold_h | "
             "ramp_c_per_min} segments).",
@@ -95,9 +101,9 @@ def simulate_command(
     unit: Annotated[
         str,
         typer.Option(
-            help=f"Simulated gyro: {', '.join(units.names())}.", rich_help_panel=_RUN
+            help=f"Simulated gyro: {', '.join(UNIT_NAMES)}.", rich_help_panel=_RUN
         ),
-    ] = units.DEFAULT_UNIT,
+    ] = DEFAULT_UNIT,
     rate_hz: Annotated[
         float, typer.Option("--rate-hz", help="Sample rate [Hz].", rich_help_panel=_RUN)
     ] = 200.0,
@@ -139,6 +145,8 @@ def simulate_command(
     A cool-down like Fig. 6 of the paper: hrgtc simulate --profile cooldown --start 20
     --end -20 --hours 5 -o runs/
     """
+    from hrgtc.simulate import simulate_files, standard_profiles
+
     with library_errors():
         runs = standard_profiles.build(
             profile,

@@ -8,6 +8,7 @@ to file in bounded memory), or dependency-free C99 for on-board use
 """
 
 from hrgtc.compensate.compensator import (
+    OUTPUT_COLUMNS,
     CompensationSummary,
     Compensator,
     compensate,
@@ -15,4 +16,6 @@ from hrgtc.compensate.compensator import (
 )
 from hrgtc.compensate.export_c import export_c
 
-__all__ = ["CompensationSummary", "Compensator", "compensate", "compensate_file", "export_c"]
+__all__ = [
+    "OUTPUT_COLUMNS",
+    "CompensationSummary", "Compensator", "compensate", "compensate_file", "export_c"]

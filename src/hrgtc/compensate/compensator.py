@@ -162,9 +162,7 @@ def compensate_file(
     model: UnitModel,
     *,
     force: bool = False,
-    columns: Mapping[str, str] | None = None,
-    units: Mapping[str, str] | None = None,
-    metadata: Mapping[str, Any] | None = None,
+    read_options: rec_io.ReadOptions | None = None,
     chunk_rows: int = 1_000_000,
     drift: str = "frequency",
     progress: Progress | None = None,
@@ -172,12 +170,11 @@ def compensate_file(
     """Compensate a recording file into a new file, chunk by chunk (bounded memory).
 
     The output is written atomically in the format of its suffix; it is never
-    overwritten without ``force``. ``columns``, ``units`` and ``metadata`` are the
-    reading options of :func:`hrgtc.recording.read`.
+    overwritten without ``force``. ``read_options`` says how to read ``source``
+    (column mapping, units, metadata).
     """
     compensator = Compensator(model, drift)
-    chunks = rec_io.iter_chunks(source, rows=chunk_rows, columns=columns, units=units,
-                                metadata=metadata)
+    chunks = (read_options or rec_io.ReadOptions()).chunks(source, rows=chunk_rows)
     first = next(chunks)
     names = (*first.names, *OUTPUT_COLUMNS)
     total = rec_io.count_rows(source)

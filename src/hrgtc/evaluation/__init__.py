@@ -17,19 +17,21 @@ from hrgtc.evaluation.metrics import (
     bias_stability_table,
     residual_against_truth,
 )
-from hrgtc.evaluation.run_pass import Evaluation, evaluate, evaluate_chunks
+from hrgtc.evaluation.run_pass import BlockMeans, Evaluation, block_rows, evaluate, run_pass
 
 __all__ = [
     "DEFAULT_TAUS_S",
     "AllanResult",
+    "BlockMeans",
     "Evaluation",
     "NoiseTerms",
     "ResidualResult",
     "allan_deviation",
     "bias_stability",
     "bias_stability_table",
+    "block_rows",
     "evaluate",
-    "evaluate_chunks",
     "noise_terms",
     "residual_against_truth",
+    "run_pass",
 ]

@@ -34,7 +34,6 @@ FLICKER_FLOOR_FACTOR = 0.664
 #: Seconds per hour: τ = 1 h is where ARW is read, τ = 3 h where RRW is read.
 SECONDS_PER_HOUR = 3600.0
 #: Default averaging times of the bias-stability table (DESIGN.md, "Metrics"). [s]
-DEFAULT_TAUS_S = (1.0, 10.0, 100.0)
 #: Named τ spacings accepted by :func:`allan_deviation` (those of allantools).
 TAU_SPACINGS = ("octave", "decade", "all")
 

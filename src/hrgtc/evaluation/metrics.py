@@ -23,7 +23,6 @@ import numpy as np
 
 from hrgtc.errors import InputError
 from hrgtc.evaluation.allan import (
-    DEFAULT_TAUS_S,
     FLICKER_FLOOR_FACTOR,
     SECONDS_PER_HOUR,
     TAU_SPACINGS,
@@ -39,8 +38,13 @@ from hrgtc.evaluation.allan import (
 __all__ = [
     "DEFAULT_TAUS_S", "FLICKER_FLOOR_FACTOR", "SECONDS_PER_HOUR", "TAU_SPACINGS",
     "AllanResult", "NoiseTerms", "ResidualResult", "allan_deviation", "bias_stability",
-    "bias_stability_table", "noise_terms", "residual_against_truth",
+    "bias_stability_table", "noise_terms", "residual_against_truth", "table_from_json",
+    "table_to_json",
 ]
+
+#: Averaging times of every bias-stability table (DESIGN.md, "Metrics"). [s]
+DEFAULT_TAUS_S = (1.0, 10.0, 100.0)
+
 
 # --------------------------------------------------------------------------- bias stability
 def _bias_stability(rate: np.ndarray, m: int) -> float:
@@ -112,6 +116,16 @@ def bias_stability_table(
     return {float(tau): _bias_stability(rate, _block_length(tau, fs)) for tau in taus_s}
 
 
+def table_to_json(table: Mapping[float, float]) -> dict[str, float | None]:
+    """A bias-stability table as JSON: τ keys as text (``"10"``), NaN as None."""
+    return {f"{tau:g}": None if math.isnan(v) else float(v) for tau, v in table.items()}
+
+
+def table_from_json(data: Mapping[str, float | None]) -> dict[float, float]:
+    """Inverse of :func:`table_to_json`."""
+    return {float(tau): math.nan if v is None else float(v) for tau, v in data.items()}
+
+
 # --------------------------------------------------------------------------- residual vs truth
 @dataclass(frozen=True)
 class ResidualResult:
@@ -139,16 +153,12 @@ class ResidualResult:
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types; τ keys become strings and NaN becomes None."""
-        table = {f"{t:g}": None if math.isnan(v) else v for t, v in self.bias_stability_dph.items()}
-        return {**asdict(self), "bias_stability_dph": table}
+        return {**asdict(self), "bias_stability_dph": table_to_json(self.bias_stability_dph)}
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> ResidualResult:
         """Inverse of :meth:`to_dict`."""
-        table = {
-            float(t): math.nan if v is None else v for t, v in data["bias_stability_dph"].items()
-        }
-        return cls(**{**data, "bias_stability_dph": table})
+        return cls(**{**data, "bias_stability_dph": table_from_json(data["bias_stability_dph"])})
 
     def summary(self) -> str:
         """One line with RMS, mean and maximum, one with the bias stabilities."""

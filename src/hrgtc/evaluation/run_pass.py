@@ -1,13 +1,16 @@
-"""How much better the gyro got: bias stability and Allan noise terms, raw vs compensated.
+"""How much better the gyro got: one pass over a run, raw vs compensated.
 
 Section 4.2 of [1] reports the 1-sigma bias stability of a cool-down run before
-(3.0143 °/h) and after (0.5848 °/h) compensation. :func:`evaluate` computes the
-same figure at 1, 10 and 100 s for any run and model, the Allan noise terms
-before and after, the share of samples outside the calibrated ranges, and,
-where the run has a housing thermistor and the model keeps the classical
-baseline, the same figures for compensation by housing temperature, so the
-frequency method can be compared with the thermistor method. Simulated runs
-carry the true bias; the model's residual against it is reported too.
+(3.0143 °/h) and after (0.5848 °/h) compensation. :func:`run_pass` compensates
+a run chunk by chunk once and measures it: the same figure at 1, 10 and 100 s,
+the Allan deviation and noise terms before and after, the share of samples
+outside the calibrated ranges, and, where the run has a housing thermistor and
+the model keeps the classical baseline, the same figures for compensation by
+housing temperature (so the frequency method can be compared with the
+thermistor method). Simulated runs carry the true bias; the model's residual
+against it is reported too. On request the pass also keeps block means for
+plotting (the report's Fig. 6) and hands each compensated chunk to a writer.
+``hrgtc evaluate``, ``calibrate --validate``, the report and the demo all use it.
 
 [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
 """
@@ -16,83 +19,136 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from hrgtc import recording as rec
 from hrgtc.compensate import Compensator
-from hrgtc.errors import InputError
-from hrgtc.evaluation.metrics import allan_deviation, bias_stability, noise_terms
+from hrgtc.errors import HrgtcError, InputError
+from hrgtc.evaluation.allan import AllanResult, NoiseTerms, allan_deviation, noise_terms
+from hrgtc.evaluation.metrics import DEFAULT_TAUS_S, bias_stability_table, table_to_json
 from hrgtc.model import UnitModel
 from hrgtc.progress import Progress
+from hrgtc.recording import ReadOptions, Recording, count_rows
 
-DEFAULT_TAUS_S = (1.0, 10.0, 100.0)
-
-
-def _clean(value: float | None) -> float | None:
-    return None if value is None or not math.isfinite(value) else float(value)
-
-
-def _stability_table(rate_dph: np.ndarray, rate_hz: float, taus_s: Sequence[float]
-                     ) -> dict[str, float | None]:
-    """Bias stability at each tau; None where fewer than two blocks fit."""
-    out: dict[str, float | None] = {}
-    for tau in taus_s:
-        blocks = rate_dph.size // max(1, round(tau * rate_hz))
-        out[f"{tau:g}"] = bias_stability(rate_dph, rate_hz, tau) if blocks >= 2 else None
-    return out
+#: Series measured by a pass: output minus input rate, compensated by the
+#: frequency model, and by the housing-thermistor baseline.
+SERIES = ("raw", "compensated", "housing")
+#: Shortest plotting block. [s]
+BLOCK_S = 10.0
 
 
-def _noise(rate_dph: np.ndarray, rate_hz: float) -> dict[str, Any]:
-    terms = noise_terms(allan_deviation(rate_dph, rate_hz, taus="octave"))
-    return {k: (_clean(v) if isinstance(v, float) else v) for k, v in terms.to_dict().items()}
+class BlockMeans:
+    """Means of consecutive blocks of ``rows`` samples, fed chunk by chunk."""
+
+    def __init__(self, rows: int) -> None:
+        self.rows = rows
+        self.offset = 0
+        self._parts: dict[str, list[tuple[int, np.ndarray]]] = {}
+
+    def push(self, columns: Mapping[str, np.ndarray]) -> None:
+        """Add the next rows (every column of one length)."""
+        n = len(next(iter(columns.values())))
+        index = (self.offset + np.arange(n)) // self.rows
+        first = int(index[0])
+        for name, values in {"_count": np.ones(n), **columns}.items():
+            sums = np.bincount(index - first, weights=np.asarray(values, dtype=np.float64))
+            self._parts.setdefault(name, []).append((first, sums))
+        self.offset += n
+
+    def means(self) -> dict[str, np.ndarray]:
+        """Block means of every column (the last block may be shorter)."""
+        blocks = -(-self.offset // self.rows)
+        totals = {}
+        for name, parts in self._parts.items():
+            total = np.zeros(blocks)
+            for first, sums in parts:
+                total[first : first + sums.size] += sums
+            totals[name] = total
+        count = totals.pop("_count")
+        return {name: total / count for name, total in totals.items()}
 
 
-@dataclass(frozen=True)
+def block_rows(rows: int, sample_rate_hz: float, max_points: int) -> int:
+    """Rows per plotting block: at least :data:`BLOCK_S`, at most ``max_points`` blocks."""
+    return max(round(BLOCK_S * sample_rate_hz), -(-rows // max(int(max_points), 1)), 1)
+
+
+@dataclass(frozen=True, eq=False)
 class Evaluation:
-    """Raw vs compensated performance of one run.
+    """One run compensated and measured (the result of :func:`run_pass`).
 
     Attributes
     ----------
-    file
-        Name of the run.
-    n_samples, sample_rate_hz
-        Size and rate of the run. [-, Hz]
+    file, source, unit
+        The run's name, where it came from, and the gyro named in its metadata.
+    n_samples, sample_rate_hz, input_rate_dph
+        Size and rate of the run and the known input rate subtracted. [-, Hz, °/h]
     bias_stability_dph
-        ``{"raw"|"compensated"|"housing": {"1": ..., "10": ..., "100": ...}}``
-        (``"housing"`` only with a housing baseline and ``housing_c``). [°/h]
-    allan
-        Noise terms (ARW, bias instability, RRW) of the same series, or empty.
+        ``{"raw"|"compensated"|"housing": {tau_s: 1σ of τ-second means}}``, NaN where
+        fewer than two blocks fit (``"housing"`` only with a housing baseline and
+        ``housing_c``). [s] -> [°/h]
+    allan, noise
+        Allan deviation (overlapping, octave τ) and its noise terms, same keys (empty
+        when not computed or when the series is too short; see ``notes``).
     out_of_range_fraction
         Share of samples outside the calibrated temperature ranges.
     rate_out_of_range_fraction
         Share of samples whose df/dt is outside its training range.
     residual_rms_dph
-        RMS of true bias minus model bias (simulated runs only). [°/h]
+        RMS of model bias minus true bias (simulated runs only). [°/h]
+    block_s, blocks
+        Plotting blocks (length [s] and block means of ``time_s``, ``raw_dph``,
+        ``model_dph``, ``comp_dph``, ``temperature_c``, ``in_range`` and where recorded
+        ``comp_housing_dph``, ``true_dph``, ``resonator_c``, ``housing_c``,
+        ``chamber_c``), or None when the pass kept none.
+    notes
+        Why a figure is missing (e.g. a run too short for the Allan deviation).
     """
 
     file: str
     n_samples: int
     sample_rate_hz: float
-    bias_stability_dph: dict[str, dict[str, float | None]]
-    allan: dict[str, dict[str, Any]]
+    bias_stability_dph: dict[str, dict[float, float]]
+    allan: dict[str, AllanResult]
+    noise: dict[str, NoiseTerms]
     out_of_range_fraction: float
     rate_out_of_range_fraction: float
     residual_rms_dph: float | None = None
+    source: str = ""
+    unit: str = ""
+    input_rate_dph: float = 0.0
+    block_s: float | None = None
+    blocks: dict[str, np.ndarray] | None = None
+    notes: tuple[str, ...] = field(default=())
+
+    @property
+    def name(self) -> str:
+        """The run's file name."""
+        return self.file
+
+    @property
+    def duration_s(self) -> float:
+        """Length of the run. [s]"""
+        return self.n_samples / self.sample_rate_hz
+
+    def stability(self, series: str, tau_s: float) -> float | None:
+        """Bias stability of one series at one τ, None where it is not available. [°/h]"""
+        value = self.bias_stability_dph.get(series, {}).get(float(tau_s), math.nan)
+        return None if math.isnan(value) else value
 
     @property
     def raw_10s(self) -> float:
         """10 s bias stability of the raw output. [°/h]"""
-        return float(self.bias_stability_dph["raw"]["10"])  # type: ignore[arg-type]
+        return self.bias_stability_dph["raw"][10.0]
 
     @property
     def compensated_10s(self) -> float:
         """10 s bias stability of the compensated output. [°/h]"""
-        return float(self.bias_stability_dph["compensated"]["10"])  # type: ignore[arg-type]
+        return self.bias_stability_dph["compensated"][10.0]
 
     @property
     def improvement_10s(self) -> float:
@@ -101,29 +157,34 @@ class Evaluation:
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types (the layout of ``hrgtc evaluate --json``)."""
-        table = {k: dict(v) for k, v in self.bias_stability_dph.items()}
-        table.setdefault("housing", None)  # type: ignore[arg-type]
+        table: dict[str, Any] = {k: table_to_json(v) for k, v in self.bias_stability_dph.items()}
+        table.setdefault("housing", None)
+        noise = {k: {name: (_finite(value) if isinstance(value, float) else value)
+                     for name, value in terms.to_dict().items()}
+                 for k, terms in self.noise.items()}
         return {
             "file": self.file,
             "n_samples": self.n_samples,
             "sample_rate_hz": self.sample_rate_hz,
             "bias_stability_dph": table,
-            "bias_stability_10s_dph": {"raw": self.raw_10s, "compensated": self.compensated_10s},
-            "improvement_10s": self.improvement_10s,
-            "allan": self.allan,
+            "bias_stability_10s_dph": {"raw": _finite(self.raw_10s),
+                                       "compensated": _finite(self.compensated_10s)},
+            "improvement_10s": _finite(self.improvement_10s),
+            "allan": noise,
             "out_of_range_fraction": self.out_of_range_fraction,
             "rate_out_of_range_fraction": self.rate_out_of_range_fraction,
             "residual_rms_dph": self.residual_rms_dph,
+            "notes": list(self.notes),
         }
 
     def summary(self) -> str:
         """A small text table."""
-        def fmt(v: float | None) -> str:
-            return "    -   " if v is None else f"{v:8.4f}"
+        def fmt(v: float) -> str:
+            return "    -   " if math.isnan(v) else f"{v:8.4f}"
 
         taus = list(self.bias_stability_dph["raw"])
         lines = [f"{self.file}: {self.n_samples} samples at {self.sample_rate_hz:g} Hz",
-                 "bias stability [°/h]  " + "".join(f"{t + ' s':>9}" for t in taus)]
+                 "bias stability [°/h]  " + "".join(f"{f'{t:g} s':>9}" for t in taus)]
         for name, row in self.bias_stability_dph.items():
             lines.append(f"  {name:<19}" + "".join(f" {fmt(row[t])}" for t in taus))
         lines.append(f"improvement at 10 s: {self.improvement_10s:.2f}×; out of calibrated range: "
@@ -131,65 +192,138 @@ class Evaluation:
                      f"{self.rate_out_of_range_fraction:.1%})")
         if self.residual_rms_dph is not None:
             lines.append(f"RMS of true bias minus model: {self.residual_rms_dph:.4f} °/h")
+        lines.extend(self.notes)
         return "\n".join(lines)
 
 
-def evaluate_chunks(
+def _finite(value: float | None) -> float | None:
+    return None if value is None or not math.isfinite(value) else float(value)
+
+
+def run_pass(
     model: UnitModel,
-    chunks: Iterable[rec.Recording],
+    chunks: Iterable[Recording],
     name: str,
     *,
+    source: str = "",
     taus_s: Sequence[float] = DEFAULT_TAUS_S,
     allan: bool = True,
+    block_rows: int | None = None,
+    on_output: Callable[[Recording], None] | None = None,
     progress: Progress | None = None,
+    total_rows: int = 0,
 ) -> Evaluation:
-    """Evaluate one run given as consecutive chunks (see :func:`evaluate`)."""
+    """Compensate one run given as consecutive chunks, once, and measure it.
+
+    Parameters
+    ----------
+    model
+        The unit's model.
+    chunks
+        The run, as consecutive chunks (e.g. :func:`hrgtc.recording.iter_chunks`).
+    name
+        The run's name in the results.
+    source
+        Where the run came from (a path), kept in the result.
+    taus_s
+        Averaging times of the bias stability (Section 4.2 of [1] uses 10 s). [s]
+    allan
+        Also compute the Allan deviations and noise terms (ARW, bias instability, RRW).
+    block_rows
+        Keep block means of this many rows for plotting (None: keep none).
+    on_output
+        Called with every compensated chunk (the input columns plus
+        ``rate_comp_dph``, ``bias_model_dph``, ``resonator_c_est``, ``in_range``), e.g.
+        a :class:`~hrgtc.recording.RecordingWriter`'s ``write``.
+    progress
+        ``progress(samples done, total_rows)``.
+    total_rows
+        Rows of the run, for the progress callback (0 when not known).
+
+    Raises
+    ------
+    InputError
+        The run holds no samples, or is shorter than two 10 s blocks.
+    """
     frequency = Compensator(model)
-    housing = Compensator(model, "housing") if model.housing is not None else None
-    raw, compensated, by_housing, truth = [], [], [], []
-    rate_hz: float | None = None
-    input_rate = 0.0
+    housing: Compensator | None = None
+    means = BlockMeans(block_rows) if block_rows else None
+    full: dict[str, list[np.ndarray]] = {key: [] for key in SERIES}
+    squared_error = 0.0
+    truth = False
+    metadata = None
     for chunk in chunks:
-        if rate_hz is None:
-            rate_hz = chunk.metadata.sample_rate_hz
-            input_rate = chunk.metadata.input_rate_dph
-            if housing is not None and "housing_c" not in chunk:
-                housing = None
+        if metadata is None:
+            metadata = chunk.metadata
+            truth = "bias_dph" in chunk
+            if model.housing is not None and "housing_c" in chunk:
+                housing = Compensator(model, "housing")
         out = frequency.process(chunk)
-        raw.append(chunk.rate_dph - input_rate)
-        compensated.append(out["rate_comp_dph"] - input_rate)
+        if on_output is not None:
+            on_output(out)
+        raw = chunk.rate_dph - metadata.input_rate_dph
+        comp = out["rate_comp_dph"] - metadata.input_rate_dph
+        full["raw"].append(raw)
+        full["compensated"].append(comp)
+        columns = {"time_s": chunk.time_s, "raw_dph": raw, "model_dph": out["bias_model_dph"],
+                   "comp_dph": comp, "temperature_c": out["resonator_c_est"],
+                   "in_range": out["in_range"]}
         if housing is not None:
-            by_housing.append(housing.process(chunk)["rate_comp_dph"] - input_rate)
-        if "bias_dph" in chunk:
-            truth.append(chunk["bias_dph"] - out["bias_model_dph"])
+            comp_h = housing.process(chunk)["rate_comp_dph"] - metadata.input_rate_dph
+            full["housing"].append(comp_h)
+            columns["comp_housing_dph"] = comp_h
+        if truth:
+            columns["true_dph"] = chunk["bias_dph"]
+            squared_error += float(np.sum((out["bias_model_dph"] - chunk["bias_dph"]) ** 2))
+        if means is not None:
+            columns.update({k: chunk[k] for k in ("resonator_c", "housing_c", "chamber_c")
+                            if k in chunk})
+            means.push(columns)
         if progress is not None:
-            progress(frequency.samples, 0)
-    if rate_hz is None:
+            progress(frequency.samples, total_rows)
+    if metadata is None:
         raise InputError(f"{name}: the run holds no samples")
-    series = {"raw": np.concatenate(raw), "compensated": np.concatenate(compensated)}
-    if by_housing:
-        series["housing"] = np.concatenate(by_housing)
-    n = series["raw"].size
-    if n < 2 * round(10.0 * rate_hz):
-        raise InputError(f"{name}: {n / rate_hz:.1f} s is too short for a 10 s bias stability "
+    fs = metadata.sample_rate_hz
+    n = frequency.samples
+    if n < 2 * round(10.0 * fs):
+        raise InputError(f"{name}: {n / fs:.1f} s is too short for a 10 s bias stability "
                          "(it needs at least 20 s)")
-    table = {k: _stability_table(v, rate_hz, taus_s) for k, v in series.items()}
-    noise = {k: _noise(v, rate_hz) for k, v in series.items()} if allan else {}
-    residual = float(np.sqrt(np.mean(np.concatenate(truth) ** 2))) if truth else None
-    return Evaluation(name, n, float(rate_hz), table, noise, frequency.out_of_range_fraction,
-                      frequency.rate_out_of_range_fraction, residual)
+    stability: dict[str, dict[float, float]] = {}
+    deviations: dict[str, AllanResult] = {}
+    terms: dict[str, NoiseTerms] = {}
+    notes: list[str] = []
+    for key, parts in full.items():
+        if not parts:
+            continue
+        values = np.concatenate(parts)
+        parts.clear()
+        stability[key] = bias_stability_table(values, fs, taus_s)
+        if not allan:
+            continue
+        try:
+            deviations[key] = allan_deviation(values, fs, taus="octave")
+            terms[key] = noise_terms(deviations[key])
+        except HrgtcError as exc:
+            notes.append(f"{key}: no Allan noise terms ({exc})")
+    return Evaluation(
+        name, n, float(fs), stability, deviations, terms, frequency.out_of_range_fraction,
+        frequency.rate_out_of_range_fraction,
+        math.sqrt(squared_error / n) if truth else None,
+        source=source, unit=metadata.unit, input_rate_dph=metadata.input_rate_dph,
+        block_s=None if means is None else means.rows / fs,
+        blocks=None if means is None else means.means(), notes=tuple(notes),
+    )
 
 
 def evaluate(
-    run: rec.Recording | str | os.PathLike[str],
+    run: Recording | str | os.PathLike[str],
     model: UnitModel,
     *,
     taus_s: Sequence[float] = DEFAULT_TAUS_S,
     allan: bool = True,
-    columns: Any = None,
-    units: Any = None,
-    metadata: Any = None,
-    chunk_rows: int = 1_000_000,
+    read_options: ReadOptions | None = None,
+    max_points: int | None = None,
+    on_output: Callable[[Recording], None] | None = None,
     progress: Progress | None = None,
 ) -> Evaluation:
     """Raw vs compensated bias stability, Allan noise terms and range shares of one run.
@@ -204,13 +338,27 @@ def evaluate(
         Averaging times of the bias stability (Section 4.2 of [1] uses 10 s). [s]
     allan
         Also compute the Allan noise terms (ARW, bias instability, RRW).
-    columns, units, metadata
-        Reading options for files (see :func:`hrgtc.recording.read`).
+    read_options
+        How to read a file (column mapping, units, metadata, chunk size).
+    max_points
+        Keep at most this many plotting blocks (of at least 10 s); None keeps none.
+    on_output, progress
+        As for :func:`run_pass`.
     """
-    if isinstance(run, rec.Recording):
-        return evaluate_chunks(model, [run], Path(run.source or "recording").name,
-                               taus_s=taus_s, allan=allan, progress=progress)
-    chunks = rec.iter_chunks(run, rows=chunk_rows, columns=columns, units=units,
-                             metadata=metadata)
-    return evaluate_chunks(model, chunks, Path(run).name, taus_s=taus_s, allan=allan,
-                           progress=progress)
+    if isinstance(run, Recording):
+        rows = len(run)
+        name, source, chunks = Path(run.source or "recording").name, run.source or "", [run]
+        fs = run.sample_rate_hz
+    else:
+        options = read_options or ReadOptions()
+        rows = count_rows(run) if progress is not None or max_points is not None else 0
+        name, source, chunks = Path(run).name, str(run), options.chunks(run)
+        fs = None
+    blocks = None
+    if max_points is not None:
+        if fs is None:
+            fs = options.head(run, rows=2).sample_rate_hz
+        blocks = block_rows(rows, fs, max_points)
+    return run_pass(model, chunks, name, source=source, taus_s=taus_s, allan=allan,
+                    block_rows=blocks, on_output=on_output, progress=progress,
+                    total_rows=rows)

@@ -13,6 +13,7 @@ checks), ``io`` (reading and writing), ``info`` (what is in a file).
 
 from hrgtc.recording.info import RecordingInfo, describe
 from hrgtc.recording.io import (
+    ReadOptions,
     RecordingWriter,
     count_rows,
     iter_chunks,
@@ -45,6 +46,7 @@ __all__ = [
     "Gap",
     "Metadata",
     "Problem",
+    "ReadOptions",
     "Recording",
     "RecordingInfo",
     "RecordingValidator",

@@ -20,6 +20,7 @@ from __future__ import annotations
 import os
 import weakref
 from collections.abc import Iterable, Iterator, Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -47,7 +48,7 @@ from hrgtc.recording.mapping import (
     plan_columns,
     table_columns,
 )
-from hrgtc.recording.schema import SCHEMA_VERSION, Metadata, Recording
+from hrgtc.recording.schema import SCHEMA_VERSION, Metadata, Recording, concatenate
 from hrgtc.recording.validation import (
     HEURISTIC_ROWS,
     GapPolicy,
@@ -61,6 +62,7 @@ SOURCES: dict[str, type[Source]] = {"parquet": ParquetSource, "csv": CsvSource, 
 SINKS: dict[str, type[Sink]] = {"parquet": ParquetSink, "csv": CsvSink, "hdf5": Hdf5Sink}
 
 __all__ = [
+    "ReadOptions",
     "RecordingWriter",
     "count_rows",
     "iter_chunks",
@@ -293,6 +295,63 @@ def iter_chunks(
             total = source.position()[1]
             progress(total, total)
         yield from pending
+
+
+@dataclass(frozen=True)
+class ReadOptions:
+    """How to read a user's files: the reading options of every command, as one value.
+
+    The command line's ``--col``, ``--time-unit``, ``--freq-unit``, ``--rate-unit``,
+    ``--rate-hz``, ``--unit-name``, ``--input-rate-dph`` and ``--gaps`` become one
+    ``ReadOptions``, which the library's functions that read runs take as
+    ``read_options=``.
+
+    Parameters
+    ----------
+    columns
+        Recording column -> the file's column (see :func:`read`).
+    units
+        ``{"time"|"freq"|"rate": unit}`` of the file's columns.
+    metadata
+        Metadata overrides (``sample_rate_hz``, ``unit``, ``input_rate_dph``).
+    gaps
+        ``"error"``, ``"split"`` or ``"ignore"`` (see :func:`read`).
+    chunk_rows
+        Rows per chunk when a file is streamed.
+    """
+
+    columns: Mapping[str, str] | None = None
+    units: Mapping[str, str] | None = None
+    metadata: Mapping[str, Any] | None = None
+    gaps: str = "error"
+    chunk_rows: int = 250_000
+
+    def keywords(self) -> dict[str, Any]:
+        """The options as keyword arguments of :func:`read` and :func:`iter_chunks`."""
+        return {"columns": self.columns, "units": self.units, "metadata": self.metadata,
+                "gaps": self.gaps}
+
+    def read(self, path: str | Path, keep: Sequence[str] | None = None) -> Recording:
+        """The whole file; with ``keep``, streamed keeping only those columns (less memory)."""
+        if keep is None:
+            return read(path, **self.keywords())
+        parts = [Recording({k: c[k] for k in keep if k in c}, c.metadata, c.source)
+                 for c in self.chunks(path)]
+        return concatenate(parts)
+
+    def head(self, path: str | Path, rows: int = 10_000) -> Recording:
+        """The first ``rows`` rows of a file (its columns and metadata), file closed after."""
+        chunks = self.chunks(path, rows=rows)
+        try:
+            return next(chunks)
+        except StopIteration:
+            raise InputError(f"{path}: the recording holds no rows") from None
+        finally:
+            chunks.close()
+
+    def chunks(self, path: str | Path, rows: int | None = None) -> Iterator[Recording]:
+        """Stream the file in chunks (:func:`iter_chunks`)."""
+        return iter_chunks(path, rows=rows or self.chunk_rows, **self.keywords())
 
 
 # -- writing -------------------------------------------------------------------

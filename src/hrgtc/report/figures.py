@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import base64
 import io
-import math
 import os
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
@@ -32,22 +31,13 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
 from hrgtc import paper
-from hrgtc import recording as rec
-from hrgtc.compensate import Compensator
-from hrgtc.errors import HrgtcError
-from hrgtc.evaluation import metrics
-from hrgtc.evaluation.metrics import FLICKER_FLOOR_FACTOR, AllanResult, NoiseTerms
-from hrgtc.model import UnitModel
+from hrgtc.evaluation import BlockMeans, Evaluation, block_rows
+from hrgtc.evaluation.allan import FLICKER_FLOOR_FACTOR
+from hrgtc.recording import ReadOptions, count_rows
 from hrgtc.thermometry import Thermometer
 from hrgtc.thermometry.plateaus import Plateau
 
 PathLike = str | os.PathLike[str]
-#: Averaging times of the bias-stability tables (DESIGN.md, "Metrics"). [s]
-TAUS_S = (1.0, 10.0, 100.0)
-#: Shortest plotting block. [s]
-BLOCK_S = 10.0
-#: Rows per chunk read (unless ``read_kwargs`` sets ``rows``): bounds the memory of a pass.
-CHUNK_ROWS = 250_000
 #: Colours: the paper's Fig. 6 draws the output blue and the model red.
 RAW, MODEL, COMPENSATED, HOUSING, TRUTH, CHAMBER = (
     "#1f5fa8", "#d62728", "#2b8a3e", "#e8890c", "#222222", "#8c8c8c")
@@ -112,41 +102,6 @@ def _hours(time_s: Any) -> np.ndarray:
 
 
 # -- data passes --------------------------------------------------------------------------
-class _BlockMeans:
-    """Means of consecutive blocks of ``rows`` samples, fed chunk by chunk."""
-
-    def __init__(self, rows: int) -> None:
-        self.rows = rows
-        self.offset = 0
-        self._parts: dict[str, list[tuple[int, np.ndarray]]] = {}
-
-    def push(self, columns: Mapping[str, np.ndarray]) -> None:
-        n = len(next(iter(columns.values())))
-        index = (self.offset + np.arange(n)) // self.rows
-        first = int(index[0])
-        for name, values in {"_count": np.ones(n), **columns}.items():
-            sums = np.bincount(index - first, weights=np.asarray(values, dtype=np.float64))
-            self._parts.setdefault(name, []).append((first, sums))
-        self.offset += n
-
-    def means(self) -> dict[str, np.ndarray]:
-        blocks = -(-self.offset // self.rows)
-        totals = {}
-        for name, parts in self._parts.items():
-            total = np.zeros(blocks)
-            for first, sums in parts:
-                total[first : first + sums.size] += sums
-            totals[name] = total
-        count = totals.pop("_count")
-        return {name: total / count for name, total in totals.items()}
-
-
-def _block_rows(path: PathLike, sample_rate_hz: float, max_points: int) -> int:
-    """Rows per plotting block: at least 10 s, at most ``max_points`` blocks in the file."""
-    rows = rec.count_rows(path)
-    return max(round(BLOCK_S * sample_rate_hz), -(-rows // max(int(max_points), 1)), 1)
-
-
 @dataclass(frozen=True, eq=False)
 class SoakTrace:
     """Block means of one soak recording, for Fig. 3 and Fig. 5 of [1].
@@ -175,63 +130,16 @@ class SoakTrace:
     resonator_c: np.ndarray | None
 
 
-@dataclass(frozen=True, eq=False)
-class RunTrace:
-    """One run compensated: block means for Fig. 6 of [1] and full-rate statistics.
-
-    Attributes
-    ----------
-    source, name, unit
-        The file, its name and the gyro named in its metadata.
-    sample_rate_hz, input_rate_dph
-        From the metadata. [Hz], [°/h]
-    n_samples, duration_s
-        Size of the run. [s]
-    block_s
-        Length of the plotting blocks. [s]
-    blocks
-        Block means: ``time_s``, ``raw_dph`` (output − input rate), ``model_dph``,
-        ``comp_dph``, ``temperature_c`` (from frequency), ``in_range`` (share of the
-        block inside the calibrated range), and where available ``comp_housing_dph``,
-        ``true_dph``, ``resonator_c``, ``housing_c``, ``chamber_c``.
-    bias_stability_dph
-        ``raw``/``compensated``/``housing`` -> τ (``"1"``, ``"10"``, ``"100"``) -> 1σ of
-        τ-second means, None where the run is shorter than two blocks; ``housing`` is
-        None without the baseline. [°/h]
-    allan, noise
-        Allan deviation (overlapping, octave τ) and its noise terms, same keys.
-    out_of_range_fraction, rate_out_of_range_fraction
-        Shares of samples outside the calibrated range (f, T) and the training range of df/dt.
-    residual_rms_dph
-        RMS of the model minus the true bias (simulated runs), else None. [°/h]
-    """
-
-    source: str
-    name: str
-    unit: str
-    sample_rate_hz: float
-    input_rate_dph: float
-    n_samples: int
-    duration_s: float
-    block_s: float
-    blocks: dict[str, np.ndarray]
-    bias_stability_dph: dict[str, dict[str, float | None] | None]
-    allan: dict[str, AllanResult]
-    noise: dict[str, NoiseTerms]
-    out_of_range_fraction: float
-    rate_out_of_range_fraction: float
-    residual_rms_dph: float | None
-
-
 def trace_soak(
     path: PathLike, thermometer: Thermometer, *, max_points: int = 20_000,
-    read_kwargs: Mapping[str, Any] | None = None, on_chunk: Callable[[int], None] | None = None,
+    read_options: ReadOptions | None = None, on_chunk: Callable[[int], None] | None = None,
 ) -> SoakTrace:
     """Block means of a soak recording, streamed (blocks of >= 10 s, at most ``max_points``)."""
-    means: _BlockMeans | None = None
-    for chunk in rec.iter_chunks(path, **{"rows": CHUNK_ROWS, **(read_kwargs or {})}):
+    means: BlockMeans | None = None
+    rows = count_rows(path)
+    for chunk in (read_options or ReadOptions()).chunks(path):
         if means is None:
-            means = _BlockMeans(_block_rows(path, chunk.sample_rate_hz, max_points))
+            means = BlockMeans(block_rows(rows, chunk.sample_rate_hz, max_points))
             block_s = means.rows / chunk.sample_rate_hz
         means.push({k: chunk[k] for k in ("time_s", "freq_hz", "chamber_c", "resonator_c")
                      if k in chunk})
@@ -242,90 +150,6 @@ def trace_soak(
     return SoakTrace(str(path), Path(path).name, block_s, b["time_s"], b["freq_hz"],
                      thermometer.temperature(b["freq_hz"], warn=False),
                      b.get("chamber_c"), b.get("resonator_c"))
-
-
-def _stability(values: np.ndarray, rate_hz: float) -> dict[str, float | None]:
-    return {f"{tau:g}": metrics.bias_stability(values, rate_hz, tau)
-            if values.size >= 2 * round(tau * rate_hz) else None for tau in TAUS_S}
-
-
-def _allan(values: np.ndarray, rate_hz: float) -> tuple[AllanResult | None, NoiseTerms | None]:
-    try:
-        allan = metrics.allan_deviation(values, rate_hz, "octave")
-    except HrgtcError:
-        return None, None
-    try:
-        return allan, metrics.noise_terms(allan)
-    except HrgtcError:
-        return allan, None
-
-
-def trace_run(
-    path: PathLike, model: UnitModel, *, max_points: int = 20_000,
-    read_kwargs: Mapping[str, Any] | None = None, on_chunk: Callable[[int], None] | None = None,
-) -> RunTrace:
-    """Compensate one run chunk by chunk (Eq. 22 of [1] as in Fig. 6) and gather its evidence.
-
-    The full-rate raw and compensated bias are kept for the bias stability and
-    the Allan deviation (three float64 arrays, ~29 MB each for 5 h at 200 Hz);
-    everything else is reduced to plotting blocks on the fly.
-    """
-    compensator = Compensator(model)
-    housing: Compensator | None = None
-    means: _BlockMeans | None = None
-    full: dict[str, list[np.ndarray]] = {"raw": [], "compensated": [], "housing": []}
-    squared_error = 0.0
-    truth = False
-    for chunk in rec.iter_chunks(path, **{"rows": CHUNK_ROWS, **(read_kwargs or {})}):
-        if means is None:
-            meta = chunk.metadata
-            means = _BlockMeans(_block_rows(path, chunk.sample_rate_hz, max_points))
-            truth = "bias_dph" in chunk
-            if model.housing is not None and "housing_c" in chunk:
-                housing = Compensator(model, drift="housing")
-        out = compensator.process(chunk)
-        raw = chunk.rate_dph - meta.input_rate_dph
-        comp = out["rate_comp_dph"] - meta.input_rate_dph
-        full["raw"].append(raw)
-        full["compensated"].append(comp)
-        columns = {"time_s": chunk.time_s, "raw_dph": raw, "model_dph": out["bias_model_dph"],
-                   "comp_dph": comp, "temperature_c": out["resonator_c_est"],
-                   "in_range": out["in_range"]}
-        if housing is not None:
-            comp_h = housing.process(chunk)["rate_comp_dph"] - meta.input_rate_dph
-            full["housing"].append(comp_h)
-            columns["comp_housing_dph"] = comp_h
-        if truth:
-            columns["true_dph"] = chunk["bias_dph"]
-            squared_error += float(np.sum((out["bias_model_dph"] - chunk["bias_dph"]) ** 2))
-        columns.update({k: chunk[k] for k in ("resonator_c", "housing_c", "chamber_c")
-                        if k in chunk})
-        means.push(columns)
-        if on_chunk is not None:
-            on_chunk(len(chunk))
-    assert means is not None  # iter_chunks raises on an empty file
-    fs = meta.sample_rate_hz
-    stability: dict[str, dict[str, float | None] | None] = {"housing": None}
-    allan: dict[str, AllanResult] = {}
-    noise: dict[str, NoiseTerms] = {}
-    for key, parts in full.items():
-        if not parts:
-            continue
-        values = np.concatenate(parts)
-        parts.clear()
-        stability[key] = _stability(values, fs)
-        deviation, terms = _allan(values, fs)
-        if deviation is not None:
-            allan[key] = deviation
-        if terms is not None:
-            noise[key] = terms
-    n = compensator.samples
-    return RunTrace(
-        str(path), Path(path).name, meta.unit, fs, meta.input_rate_dph, n, n / fs,
-        means.rows / fs, means.means(), stability, allan, noise,
-        compensator.out_of_range_fraction, compensator.rate_out_of_range_fraction,
-        math.sqrt(squared_error / n) if truth else None,
-    )
 
 
 # -- Fig. 3: settling of the soaks -----------------------------------------------------
@@ -472,7 +296,7 @@ def _spans(mask: np.ndarray) -> list[tuple[int, int]]:
 
 
 @_styled
-def run_figure(run: RunTrace) -> Figure:
+def run_figure(run: Evaluation) -> Figure:
     """Raw output with the model, compensated output and temperatures of one run.
 
     Mirrors Fig. 6(a) (output, blue, and model, red) and Fig. 6(b) (compensated
@@ -483,9 +307,8 @@ def run_figure(run: RunTrace) -> Figure:
     hours = _hours(b["time_s"])
     figure = _figure(3 * _PANEL_WIDTH_IN, 7.2)
     raw_ax, comp_ax, temp_ax = figure.subplots(3, 1, sharex=True, height_ratios=(1.2, 1.2, 0.8))
-    stability = run.bias_stability_dph
     raw_ax.plot(hours, b["raw_dph"], color=RAW,
-                label=f"output − input rate ({_at10(stability['raw'])})")
+                label=f"output − input rate ({_at10(run, 'raw')})")
     raw_ax.plot(hours, b["model_dph"], color=MODEL, label="drift model (Eq. 22 form)")
     if "true_dph" in b:
         raw_ax.plot(hours, b["true_dph"], color=TRUTH, lw=0.8, ls="--",
@@ -493,10 +316,10 @@ def run_figure(run: RunTrace) -> Figure:
     raw_ax.set_ylabel("bias [°/h]")
     raw_ax.set_title(f"(a) raw output and model, {run.block_s:g} s means", fontsize=9)
     comp_ax.plot(hours, b["comp_dph"], color=COMPENSATED,
-                 label=f"compensated, frequency model ({_at10(stability['compensated'])})")
+                 label=f"compensated, frequency model ({_at10(run, 'compensated')})")
     if "comp_housing_dph" in b:
         comp_ax.plot(hours, b["comp_housing_dph"], color=HOUSING, lw=0.9,
-                     label=f"compensated, housing thermistor ({_at10(stability['housing'])})")
+                     label=f"compensated, housing thermistor ({_at10(run, 'housing')})")
     comp_ax.set_ylabel("bias [°/h]")
     comp_ax.set_title("(b) compensated output", fontsize=9)
     temp_ax.plot(hours, b["temperature_c"], color=RAW, label="resonator, from frequency")
@@ -521,13 +344,13 @@ def run_figure(run: RunTrace) -> Figure:
     return figure
 
 
-def _at10(table: Mapping[str, float | None] | None) -> str:
-    value = None if table is None else table.get("10")
+def _at10(run: Evaluation, series: str) -> str:
+    value = run.stability(series, 10.0)
     return "10 s stability n/a" if value is None else f"10 s stability {value:.4g} °/h"
 
 
 @_styled
-def allan_figure(run: RunTrace) -> Figure:
+def allan_figure(run: Evaluation) -> Figure:
     """Allan deviation of the raw and compensated output (log-log), minima marked."""
     figure = _figure(2 * _PANEL_WIDTH_IN, 3.6)
     ax = figure.subplots()

@@ -1,9 +1,10 @@
 """The HTML report: one self-contained file with the evidence of a calibration, like [1].
 
 :func:`build_report` reads the unit's soaks and any number of runs chunk by
-chunk (:func:`trace_soak`, :func:`trace_run`), decimates them to block means for
-plotting, compensates each run with the unit's model (and with the
-housing-thermistor baseline when there is one), and writes one HTML document:
+chunk (:func:`~hrgtc.report.figures.trace_soak`, and the one run pass of
+:func:`hrgtc.evaluation.evaluate`), decimates them to block means for plotting,
+compensates each run with the unit's model (and with the housing-thermistor
+baseline when there is one), and writes one HTML document:
 the settling of each soak (Fig. 3 of [1]), the frequency-temperature fit (Fig. 4,
 Table 1, Eq. 18), the temperature from frequency (Fig. 5, Table 2), raw and
 compensated output of each run (Fig. 6) with bias stability and Allan deviation,
@@ -19,7 +20,7 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from datetime import UTC, datetime
 from html import escape
 from pathlib import Path
@@ -29,16 +30,18 @@ import numpy as np
 
 import hrgtc.report.figures as figures
 from hrgtc import paper
-from hrgtc import recording as rec
 from hrgtc.drift.features import parse_terms
+from hrgtc.errors import InputError
+from hrgtc.evaluation import Evaluation, evaluate
 from hrgtc.files import file_sha256, refuse_existing, write_text_atomic
 from hrgtc.model import UnitModel, load_model
 from hrgtc.progress import Progress
-from hrgtc.report.figures import TAUS_S, RunTrace, SoakTrace, trace_run, trace_soak
+from hrgtc.recording import ReadOptions, count_rows
+from hrgtc.report.figures import SoakTrace, trace_soak
 from hrgtc.thermometry import coefficient_pvalues
 from hrgtc.thermometry.plateaus import Plateau
 
-__all__ = ["RunTrace", "SoakTrace", "build_report", "trace_run", "trace_soak"]
+__all__ = ["build_report"]
 
 PathLike = str | os.PathLike[str]
 
@@ -153,14 +156,14 @@ def _header(page: _Page, model: UnitModel, title: str, model_path: str | None) -
              '(Eq. 21–22)</a></li></ol></nav>')
 
 
-def _summary(page: _Page, runs: Sequence[RunTrace]) -> None:
+def _summary(page: _Page, runs: Sequence[Evaluation]) -> None:
     """The result at a glance: 10 s bias stability of each run beside the paper's."""
     if not runs:
         return
-    rows = [(r.name, _number(r.bias_stability_dph["raw"]["10"]),
-             _number(r.bias_stability_dph["compensated"]["10"]),
-             _number(_ratio(r.bias_stability_dph, "10"), 3),
-             _number((r.bias_stability_dph["housing"] or {}).get("10")),
+    rows = [(r.name, _number(r.stability("raw", 10.0)),
+             _number(r.stability("compensated", 10.0)),
+             _number(_ratio(r, 10.0), 3),
+             _number(r.stability("housing", 10.0)),
              f"{r.out_of_range_fraction:.1%}") for r in runs]
     rows.append(("paper [1], Section 4.2 (its cool-down)", _number(paper.BIAS_STABILITY_RAW_DPH,
                  5), _number(paper.BIAS_STABILITY_COMPENSATED_DPH, 4), _number(
@@ -171,8 +174,8 @@ def _summary(page: _Page, runs: Sequence[RunTrace]) -> None:
                     "At a glance: 10 s bias stability, raw and compensated"))
 
 
-def _ratio(stability: Mapping[str, Any], tau: str) -> float | None:
-    raw, comp = stability["raw"][tau], stability["compensated"][tau]
+def _ratio(run: Evaluation, tau_s: float) -> float | None:
+    raw, comp = run.stability("raw", tau_s), run.stability("compensated", tau_s)
     return raw / comp if raw is not None and comp else None
 
 
@@ -304,7 +307,7 @@ def _temperature(page: _Page, table: Sequence[Mapping[str, float]],
     page.add("</section>")
 
 
-def _run(page: _Page, k: int, run: RunTrace, model: UnitModel) -> None:
+def _run(page: _Page, k: int, run: Evaluation, model: UnitModel) -> None:
     page.add(f'<section id="run-{k}"><h3>4.{k} Run <code>{escape(run.name)}</code></h3>',
              f'<p class="muted">{escape(run.source)}: unit {escape(run.unit)}, {run.n_samples} '
              f"samples at {run.sample_rate_hz:g} Hz ({run.duration_s / 3600:.2f} h), input "
@@ -314,18 +317,17 @@ def _run(page: _Page, k: int, run: RunTrace, model: UnitModel) -> None:
                 f"<b>Fig. 6(a)</b> of [1]; (b) compensated output, mirrors <b>Fig. 6(b)</b>; "
                 f"(c) temperatures. {run.block_s:g} s means; red shading: samples outside the "
                 f"calibrated range.", f"raw and compensated output of {run.name}")
-    s = run.bias_stability_dph
-    housing = s["housing"]
+    housing = "housing" in run.bias_stability_dph
     rows = []
-    for tau in (f"{t:g}" for t in TAUS_S):
-        rows.append((tau, _number(s["raw"][tau]), _number(s["compensated"][tau]),
-                     _number(_ratio(s, tau), 3),
-                     *([_number(housing[tau])] if housing is not None else []),
+    for tau in run.bias_stability_dph["raw"]:
+        rows.append((f"{tau:g}", _number(run.stability("raw", tau)),
+                     _number(run.stability("compensated", tau)), _number(_ratio(run, tau), 3),
+                     *([_number(run.stability("housing", tau))] if housing else []),
                      *((_number(paper.BIAS_STABILITY_RAW_DPH, 5),
-                        _number(paper.BIAS_STABILITY_COMPENSATED_DPH, 4)) if tau == "10"
+                        _number(paper.BIAS_STABILITY_COMPENSATED_DPH, 4)) if tau == 10.0
                        else ("–", "–"))))
     headers = ["τ [s]", "raw [°/h]", "compensated [°/h]", "improvement [×]",
-               *(["housing baseline [°/h]"] if housing is not None else []),
+               *(["housing baseline [°/h]"] if housing else []),
                "paper raw [°/h]", "paper compensated [°/h]"]
     page.add(_table(headers, rows, f"Bias stability of {run.name}: 1σ of τ-second means "
                         "of output − input rate (paper [1], Section 4.2: 3.0143 → 0.5848 °/h "
@@ -336,7 +338,7 @@ def _run(page: _Page, k: int, run: RunTrace, model: UnitModel) -> None:
     if run.residual_rms_dph is not None:
         facts.append(("RMS of model − true bias (simulator) [°/h]",
                       _number(run.residual_rms_dph)))
-    if model.housing is not None and housing is None:
+    if model.housing is not None and not housing:
         facts.append(("housing baseline", "not applied: the run has no housing_c column"))
     page.add(_table(("quantity", "value"), facts, f"Range and residual of {run.name}"))
     if run.allan:
@@ -406,16 +408,14 @@ def _soak_files(model: UnitModel) -> tuple[list[str], list[str]]:
 
 def build_report(
     model: UnitModel | PathLike,
-    runs: Sequence[PathLike],
+    runs: Sequence[PathLike | Evaluation],
     output: PathLike,
     *,
     soaks: Sequence[PathLike] | None = None,
     title: str | None = None,
     force: bool = False,
     max_points: int = 20_000,
-    columns: Mapping[str, str] | None = None,
-    units: Mapping[str, str] | None = None,
-    metadata: Mapping[str, Any] | None = None,
+    read_options: ReadOptions | None = None,
     progress: Progress | None = None,
 ) -> Path:
     """Write the unit's report: one self-contained HTML file with Figs. 3-6 and Tables 1-2 of [1].
@@ -425,7 +425,9 @@ def build_report(
     model
         The unit's model, or the path of its model file.
     runs
-        Recordings to compensate and evaluate (Fig. 6 of [1]), one section each.
+        Recordings to compensate and evaluate (Fig. 6 of [1]), one section each, or
+        evaluations already made with plotting blocks (:func:`hrgtc.evaluation.evaluate`
+        with ``max_points``), which are not computed again.
     output
         The HTML file; written atomically, never overwritten without ``force``.
     soaks
@@ -435,8 +437,8 @@ def build_report(
         Page title (default names the unit).
     max_points
         Most points per plotted curve; plots use block means of at least 10 s.
-    columns, units, metadata
-        Reading options of :func:`hrgtc.recording.read` for the runs and given soaks.
+    read_options
+        How to read the runs and the given soaks (column mapping, units, metadata).
     progress
         Optional ``callback(rows_done, rows_total)``.
 
@@ -449,22 +451,29 @@ def build_report(
     ------
     OutputExistsError
         ``output`` exists and ``force`` is False (checked before any work).
+    InputError
+        An evaluation given in ``runs`` kept no plotting blocks.
     """
     target = Path(output)
     refuse_existing(target, force)
     model_path = None
     if not isinstance(model, UnitModel):
         model_path, model = str(model), load_model(model)
-    read = {"columns": columns, "units": units, "metadata": metadata}
+    options = read_options or ReadOptions()
     missing: list[str] = []
     if soaks is None:
         soak_paths, missing = _soak_files(model)
         settings = model.provenance.get("settings", {})
-        soak_read = {"columns": settings.get("columns") or None,
-                     "units": settings.get("units") or None}
+        soak_options = ReadOptions(columns=settings.get("columns") or None,
+                                   units=settings.get("units") or None)
     else:
-        soak_paths, soak_read = [str(p) for p in soaks], read
-    total = sum(rec.count_rows(p) for p in [*soak_paths, *runs])
+        soak_paths, soak_options = [str(p) for p in soaks], options
+    for run in runs:
+        if isinstance(run, Evaluation) and run.blocks is None:
+            raise InputError(f"{run.file}: the evaluation kept no plotting blocks; "
+                             "evaluate it with max_points, or pass the file")
+    files = [run for run in runs if not isinstance(run, Evaluation)]
+    total = sum(count_rows(p) for p in [*soak_paths, *files])
     done = 0
 
     def advance(rows: int) -> None:
@@ -475,21 +484,21 @@ def build_report(
 
     plateaus = [Plateau.from_dict(p) for p in model.plateaus]
     table = _table_rows(model, plateaus)
-    traces = [trace_soak(p, model.thermometer, max_points=max_points, read_kwargs=soak_read,
+    traces = [trace_soak(p, model.thermometer, max_points=max_points, read_options=soak_options,
                          on_chunk=advance) for p in soak_paths]
-    run_traces = [trace_run(p, model, max_points=max_points, read_kwargs=read, on_chunk=advance)
-                  for p in runs]
+    evaluations = [run if isinstance(run, Evaluation) else
+                   _evaluate_run(run, model, options, max_points, advance) for run in runs]
     title = title or f"Temperature compensation report — unit {model.unit}"
     page = _Page()
     _header(page, model, title, model_path)
-    _summary(page, run_traces)
+    _summary(page, evaluations)
     _settling(page, plateaus, traces, missing)
     _thermometer(page, model, plateaus, table)
     _temperature(page, table, traces)
     page.add('<section id="runs"><h2>4. Runs: raw and compensated output</h2>')
     if not runs:
         page.note("No runs given.")
-    for k, run in enumerate(run_traces, start=1):
+    for k, run in enumerate(evaluations, start=1):
         _run(page, k, run, model)
     page.add("</section>")
     _drift_model(page, model)
@@ -503,3 +512,16 @@ def build_report(
     if progress is not None:
         progress(total, total)
     return written
+
+
+def _evaluate_run(path: PathLike, model: UnitModel, options: ReadOptions, max_points: int,
+                  advance: Callable[[int], None]) -> Evaluation:
+    """The one run pass of :func:`hrgtc.evaluation.evaluate`, with plotting blocks."""
+    seen = 0
+
+    def progress(done: float, _total: float) -> None:
+        nonlocal seen
+        advance(int(done) - seen)
+        seen = int(done)
+
+    return evaluate(path, model, read_options=options, max_points=max_points, progress=progress)
