@@ -19,13 +19,13 @@ class Campaign:
     warmup: Path
 
 
-def make_campaign(folder: Path, unit: str, rate_hz: float = RATE_HZ, hours: float = 5.0,
+def make_campaign(folder: Path, unit: str, sample_rate_hz: float = RATE_HZ, hours: float = 5.0,
                   seed: int = 1) -> Campaign:
     """Seven soaks, a cool-down (training) and a warm-up with another seed (validation)."""
     soaks = simulate_files([profiles.soak(sp, hours) for sp in SETPOINTS_C], folder / "soaks",
-                           "parquet", unit=unit, rate_hz=rate_hz, seed=seed)
+                           "parquet", unit=unit, sample_rate_hz=sample_rate_hz, seed=seed)
     cool = simulate_files([profiles.cooldown(20.0, -20.0, 5.0)], folder / "cool", "parquet",
-                          unit=unit, rate_hz=rate_hz, seed=seed + 1)
+                          unit=unit, sample_rate_hz=sample_rate_hz, seed=seed + 1)
     warm = simulate_files([profiles.warmup(-20.0, 20.0, 5.0)], folder / "warm", "parquet",
-                          unit=unit, rate_hz=rate_hz, seed=seed + 2)
+                          unit=unit, sample_rate_hz=sample_rate_hz, seed=seed + 2)
     return Campaign([Path(w.path) for w in soaks], Path(cool[0].path), Path(warm[0].path))

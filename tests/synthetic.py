@@ -19,14 +19,14 @@ def law(f_hz, df_hz_per_s):
     return 1.5 + 0.4 * f_hz + 0.02 * f_hz**2 + 3000.0 * df_hz_per_s
 
 
-def ramp_run(seed, start_c=20.0, end_c=-20.0, hours=5.0, rate_hz=10.0, noise_dph=2.0,
+def ramp_run(seed, start_c=20.0, end_c=-20.0, hours=5.0, sample_rate_hz=10.0, noise_dph=2.0,
              tau_s=2600.0, ramp_hours=2.0, input_rate_dph=10.0):
     """Chamber ramp then hold; resonator a first-order lag; bias = :func:`law` + white noise."""
     rng = np.random.default_rng(seed)
-    t = np.arange(0.0, hours * 3600.0, 1.0 / rate_hz)
+    t = np.arange(0.0, hours * 3600.0, 1.0 / sample_rate_hz)
     chamber = np.clip(start_c + (end_c - start_c) * t / (ramp_hours * 3600.0),
                       min(start_c, end_c), max(start_c, end_c))
-    a = -np.expm1(-1.0 / (tau_s * rate_hz))
+    a = -np.expm1(-1.0 / (tau_s * sample_rate_hz))
     resonator = signal.lfilter([a], [1.0, a - 1.0], chamber, zi=[(1.0 - a) * start_c])[0]
     rate_c_per_s = (chamber - resonator) / tau_s
     f = THERMOMETER.frequency(resonator) - THERMOMETER.frequency(20.0)
@@ -41,7 +41,7 @@ def ramp_run(seed, start_c=20.0, end_c=-20.0, hours=5.0, rate_hz=10.0, noise_dph
             "resonator_c": resonator,
             "bias_dph": bias,
         },
-        Metadata(sample_rate_hz=rate_hz, input_rate_dph=input_rate_dph, unit="synthetic"),
+        Metadata(sample_rate_hz=sample_rate_hz, input_rate_dph=input_rate_dph, unit="synthetic"),
         source=f"synthetic-{seed}",
     )
 

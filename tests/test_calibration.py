@@ -112,13 +112,13 @@ def test_glob_after_soak_and_tables(tmp_path, campaign):
 
 
 # -- bad inputs: a clear error and nothing written --------------------------------------------
-def _soak_file(path, setpoint_c, freq_hz, hours=2.0, rate_hz=1.0):
-    n = int(hours * 3600 * rate_hz)
+def _soak_file(path, setpoint_c, freq_hz, hours=2.0, sample_rate_hz=1.0):
+    n = int(hours * 3600 * sample_rate_hz)
     rng = np.random.default_rng(int(setpoint_c) + 100)
     rec = Recording(
-        {"time_s": np.arange(n) / rate_hz, "freq_hz": freq_hz + rng.normal(0, 1e-3, n),
+        {"time_s": np.arange(n) / sample_rate_hz, "freq_hz": freq_hz + rng.normal(0, 1e-3, n),
          "rate_dph": 10 + rng.normal(0, 1, n), "chamber_c": np.full(n, setpoint_c)},
-        Metadata(sample_rate_hz=rate_hz, input_rate_dph=10.0),
+        Metadata(sample_rate_hz=sample_rate_hz, input_rate_dph=10.0),
     )
     recording.write(rec, path)
     return path
@@ -146,7 +146,7 @@ def test_non_monotonic_frequency_is_refused(tmp_path):
 
 
 def test_soak_that_never_settles(tmp_path):
-    run = ramp_run(seed=5, hours=3.0, ramp_hours=3.0, rate_hz=1.0)
+    run = ramp_run(seed=5, hours=3.0, ramp_hours=3.0, sample_rate_hz=1.0)
     path = tmp_path / "ramp.parquet"
     recording.write(run, path)
     soaks = [_soak_file(tmp_path / f"s{t:g}.parquet", t, 4424.9 + 0.37 * t) for t in (0, 10, 20)]

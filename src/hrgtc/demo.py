@@ -35,7 +35,7 @@ REPORT_POINTS = 20_000
 class DemoSettings:
     """Sample rate and durations of the simulated campaign."""
 
-    rate_hz: float = 200.0  # Section 3 of [1]: 200 Hz
+    sample_rate_hz: float = 200.0  # Section 3 of [1]: 200 Hz
     soak_hours: float = 5.0  # "4-5 h" per soak
     ramp_hours: float = 5.0
     seed: int = 2012
@@ -43,7 +43,7 @@ class DemoSettings:
     @classmethod
     def quick(cls) -> DemoSettings:
         """Lower rate and shorter soaks (settled-value extrapolation does the rest)."""
-        return cls(rate_hz=5.0, soak_hours=3.0, ramp_hours=5.0)
+        return cls(sample_rate_hz=5.0, soak_hours=3.0, ramp_hours=5.0)
 
 
 @dataclass(frozen=True)
@@ -82,7 +82,7 @@ def run_demo(
 
     def simulate(runs: list, folder: str, seed: int, stage: str) -> list:
         return simulate_files(runs, root / folder, "parquet", unit="paper-unit",
-                              rate_hz=s.rate_hz, seed=seed, force=force,
+                              sample_rate_hz=s.sample_rate_hz, seed=seed, force=force,
                               progress=for_stage(progress, f"simulate {stage}"))
 
     soaks = simulate([profiles.soak(t, s.soak_hours) for t in SETPOINTS_C], "soaks", s.seed,

@@ -43,7 +43,8 @@ def test_soaks_one_file_per_set_point_and_no_overwrite_without_force(tmp_path):
     assert rec["chamber_c"][0] == 20.0
     assert rec["chamber_c"][-1] == pytest.approx(20.0 - 179.9 / 30.0, rel=1e-12)
     library = simulate.simulate_run(
-        simulate.soak(-20.0, 0.05), rate_hz=10.0, seed=np.random.SeedSequence(1, spawn_key=(0,))
+        simulate.soak(-20.0, 0.05), sample_rate_hz=10.0,
+        seed=np.random.SeedSequence(1, spawn_key=(0,))
     )
     assert np.array_equal(rec.rate_dph, library.rate_dph)
 

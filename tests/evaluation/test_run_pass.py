@@ -21,7 +21,7 @@ from campaign import make_campaign
 @pytest.fixture(scope="module")
 def setup(tmp_path_factory):
     folder = tmp_path_factory.mktemp("evaluation")
-    files = make_campaign(folder, "paper-unit", rate_hz=2.0)
+    files = make_campaign(folder, "paper-unit", sample_rate_hz=2.0)
     model = calibrate(files.soaks, [files.cooldown]).model
     model_path = save_model(model, folder / "unit.json")
     return files, model, model_path

@@ -86,7 +86,7 @@ def _number(cell: str) -> float:
 @pytest.fixture(scope="module")
 def unit(tmp_path_factory):
     folder = tmp_path_factory.mktemp("report-unit")
-    files = make_campaign(folder, "paper-unit", rate_hz=RATE_HZ, hours=2.5)
+    files = make_campaign(folder, "paper-unit", sample_rate_hz=RATE_HZ, hours=2.5)
     result = calibrate(files.soaks, [files.cooldown], [files.warmup])
     return files, result.model, save_model(result.model, folder / "unit.json")
 

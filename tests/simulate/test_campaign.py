@@ -41,8 +41,8 @@ def collect(profile, columns, **kwargs):
     return {name: np.concatenate(values) for name, values in parts.items()}
 
 
-def block_means(values, rate_hz, tau_s=10.0):
-    m = round(tau_s * rate_hz)
+def block_means(values, sample_rate_hz, tau_s=10.0):
+    m = round(tau_s * sample_rate_hz)
     n = values.size // m
     return values[: n * m].reshape(n, m).mean(axis=1)
 
@@ -179,7 +179,7 @@ def test_thermal_network_matches_an_independent_ode_solver():
 def test_resonator_settles_within_0p1_c_after_12000_to_18000_s(start_c, setpoint_c):
     # Section 3 of [1]: after ~15,000 s the frequency (resonator) no longer changes.
     p = simulate.soak(setpoint_c, 6.0, start_c=start_c)
-    truth = collect(p, ["time_s", "resonator_c"], rate_hz=10.0)
+    truth = collect(p, ["time_s", "resonator_c"], sample_rate_hz=10.0)
     outside = np.flatnonzero(np.abs(truth["resonator_c"] - setpoint_c) > 0.1)
     settled_at = truth["time_s"][outside[-1] + 1]
     assert 12_000.0 <= settled_at <= 18_000.0
@@ -191,11 +191,11 @@ def test_soak_frequencies_reproduce_table1():
     # Eq. (18) of [1] at full precision, and its slope.
     eq18 = np.polynomial.Polynomial.fit(TABLE1_TEMPERATURE_C, TABLE1_FREQUENCY_HZ, 3).convert()
     slope = eq18.deriv()
-    rate_hz = 10.0
+    sample_rate_hz = 10.0
     for k, p in enumerate(simulate.soak_campaign(TABLE1_TEMPERATURE_C, 5.0)):
         table_hz = TABLE1_FREQUENCY_HZ[k]
-        run = collect(p, ["freq_hz", "resonator_c"], rate_hz=rate_hz, seed=k)
-        last = slice(-int(1800 * rate_hz), None)  # last 30 min of the 5 h soak
+        run = collect(p, ["freq_hz", "resonator_c"], sample_rate_hz=sample_rate_hz, seed=k)
+        last = slice(-int(1800 * sample_rate_hz), None)  # last 30 min of the 5 h soak
         settled = run["freq_hz"][last].mean()
         # Table 2 of [1]: Eq. (18) turns the settled frequency back into the set-point
         # within 0.1 °C.
@@ -213,7 +213,7 @@ def test_soak_frequencies_reproduce_table1():
 def test_unit_b_frequency_follows_the_shell_model():
     unit = units.get("unit-b")
     shell = Shell(13.0e-3, 0.75e-3, FUSED_QUARTZ)  # the documented geometry of unit-b
-    run = collect(simulate.constant(0.0, 0.1), ["freq_hz"], unit="unit-b", rate_hz=10.0)
+    run = collect(simulate.constant(0.0, 0.1), ["freq_hz"], unit="unit-b", sample_rate_hz=10.0)
     assert 5000.0 < run["freq_hz"].mean() < 7000.0
     noise = unit.frequency_noise_hz / np.sqrt(run["freq_hz"].size)
     assert abs(run["freq_hz"].mean() - shell.frequency_hz(0.0)) < 5 * noise
@@ -223,7 +223,8 @@ def test_unit_b_frequency_follows_the_shell_model():
 def test_allan_analysis_recovers_configured_arw_and_bias_instability():
     # 200 h at 1 Hz: many blocks at the flicker floor (~1,000-4,000 s).
     noise = units.get("paper-unit").gyro_noise
-    rate = collect(simulate.constant(20.0, 200.0), ["rate_dph"], rate_hz=1.0, seed=3)["rate_dph"]
+    rate = collect(simulate.constant(20.0, 200.0), ["rate_dph"], sample_rate_hz=1.0,
+                   seed=3)["rate_dph"]
     allan = allan_deviation(rate, 1.0)
     terms = noise_terms(allan)
     assert terms.arw_deg_per_rt_h == pytest.approx(noise.arw_deg_per_sqrt_h, rel=0.15)
@@ -237,12 +238,13 @@ def test_allan_analysis_recovers_configured_arw_and_bias_instability():
 def test_paper_unit_bias_stability_raw_and_at_constant_temperature():
     # Section 4.2 of [1]: 3.0143 °/h raw over the cool-down, 0.5848 °/h compensated,
     # "basically the constant temperature precision".
-    cool = collect(simulate.cooldown(20.0, -20.0, 5.0), ["rate_dph"], rate_hz=200.0, seed=1)
+    cool = collect(simulate.cooldown(20.0, -20.0, 5.0), ["rate_dph"], sample_rate_hz=200.0, seed=1)
     raw = bias_stability(cool["rate_dph"], 200.0, 10.0)
     assert PAPER_RAW_BIAS_STABILITY_RANGE[0] <= raw <= PAPER_RAW_BIAS_STABILITY_RANGE[1]
     flat = {
         rate: bias_stability(
-            collect(simulate.constant(20.0, 5.0), ["rate_dph"], rate_hz=rate, seed=1)["rate_dph"],
+            collect(simulate.constant(20.0, 5.0), ["rate_dph"], sample_rate_hz=rate,
+                    seed=1)["rate_dph"],
             rate,
             10.0,
         )
@@ -258,7 +260,7 @@ def test_paper_unit_bias_stability_raw_and_at_constant_temperature():
 
 # ----------------------------------------------------------------------------- truth
 def test_output_is_input_rate_plus_true_bias_plus_noise():
-    rec = simulate.simulate_run(simulate.constant(20.0, 1.0), rate_hz=20.0, seed=2)
+    rec = simulate.simulate_run(simulate.constant(20.0, 1.0), sample_rate_hz=20.0, seed=2)
     law = units.get("paper-unit").bias_law
     # No gradient, at the reference temperature: B0 alone.
     assert np.allclose(rec["bias_dph"], law.bias0_dph, rtol=0.0, atol=1e-9)
@@ -277,7 +279,8 @@ def test_the_papers_drift_model_can_fit_the_paper_unit_bias():
     # f and df/dt must be able to fit it (fitted on 10 s means, as DESIGN.md says).
     unit = units.get("paper-unit")
     run = collect(
-        simulate.cooldown(20.0, -20.0, 5.0), ["resonator_c", "bias_dph"], rate_hz=10.0, seed=1
+        simulate.cooldown(20.0, -20.0, 5.0), ["resonator_c", "bias_dph"], sample_rate_hz=10.0,
+        seed=1
     )
     temp, bias = block_means(run["resonator_c"], 10.0), block_means(run["bias_dph"], 10.0)
     f = unit.frequency_law.frequency_hz(temp) - unit.frequency_law.frequency_hz(np.array(20.0))
@@ -298,7 +301,8 @@ def test_unit_b_differs_from_paper_unit():
     assert other.frequency_law.to_dict()["kind"] == "shell"
     slopes = {}
     for name in ("paper-unit", "unit-b"):
-        run = collect(simulate.cooldown(20.0, -20.0, 5.0), ["bias_dph"], unit=name, rate_hz=1.0)
+        run = collect(simulate.cooldown(20.0, -20.0, 5.0), ["bias_dph"], unit=name,
+                      sample_rate_hz=1.0)
         slopes[name] = run["bias_dph"][-600:].mean() - run["bias_dph"][:600].mean()
     assert slopes["paper-unit"] < -5.0 and slopes["unit-b"] > 2.0  # opposite trends
 
@@ -312,15 +316,15 @@ def test_unknown_unit_lists_the_names():
 # ----------------------------------------------------------------------------- determinism
 def test_same_seed_same_arrays_whatever_the_chunk_size():
     p = simulate.soak(-10.0, 0.05)
-    a = simulate.simulate_run(p, rate_hz=200.0, seed=7)
-    b = simulate.simulate_run(p, rate_hz=200.0, seed=7, chunk_rows=997)
-    c = simulate.simulate_run(p, rate_hz=200.0, seed=8)
+    a = simulate.simulate_run(p, sample_rate_hz=200.0, seed=7)
+    b = simulate.simulate_run(p, sample_rate_hz=200.0, seed=7, chunk_rows=997)
+    c = simulate.simulate_run(p, sample_rate_hz=200.0, seed=8)
     for name in simulate.COLUMNS:
         assert np.array_equal(a[name], b[name]), name
     assert not np.array_equal(a.rate_dph, c.rate_dph)
     assert not np.array_equal(a.freq_hz, c.freq_hz)
-    gen = simulate.simulate_run(p, rate_hz=200.0, seed=np.random.default_rng(7))
-    again = simulate.simulate_run(p, rate_hz=200.0, seed=np.random.default_rng(7))
+    gen = simulate.simulate_run(p, sample_rate_hz=200.0, seed=np.random.default_rng(7))
+    again = simulate.simulate_run(p, sample_rate_hz=200.0, seed=np.random.default_rng(7))
     assert np.array_equal(gen.rate_dph, again.rate_dph)
 
 
@@ -328,8 +332,8 @@ def test_bad_arguments():
     p = simulate.constant(20.0, 0.01)
     with pytest.raises(InputError, match="seed must be a non-negative integer"):
         simulate.simulate_run(p, seed=-1)
-    with pytest.raises(InputError, match="rate_hz must be finite and > 0"):
-        simulate.simulate_run(p, rate_hz=0.0)
+    with pytest.raises(InputError, match="sample_rate_hz must be finite and > 0"):
+        simulate.simulate_run(p, sample_rate_hz=0.0)
 
 
 # ----------------------------------------------------------------------------- files
@@ -337,7 +341,7 @@ def test_campaign_files_round_trip_and_refuse_to_overwrite(tmp_path):
     runs = simulate.soak_campaign([-20.0, 40.0], 0.05)
     calls = []
     written = simulate.simulate_files(
-        runs, tmp_path / "soaks", rate_hz=10.0, seed=4, chunk_rows=500,
+        runs, tmp_path / "soaks", sample_rate_hz=10.0, seed=4, chunk_rows=500,
         progress=lambda done, total: calls.append((done, total)),
     )
     assert calls[-1] == (3600.0, 3600.0)
@@ -349,7 +353,7 @@ def test_campaign_files_round_trip_and_refuse_to_overwrite(tmp_path):
     assert [w.rows for w in written] == [1800, 1800]
     back = read(written[1].path)
     expected = simulate.simulate_run(
-        runs[1], rate_hz=10.0, seed=np.random.SeedSequence(4, spawn_key=(1,))
+        runs[1], sample_rate_hz=10.0, seed=np.random.SeedSequence(4, spawn_key=(1,))
     )
     for name in simulate.COLUMNS:
         assert np.array_equal(back[name], expected[name]), name
@@ -357,20 +361,20 @@ def test_campaign_files_round_trip_and_refuse_to_overwrite(tmp_path):
     assert back.metadata.extra["spawn_key"] == [1]
     before = (tmp_path / "soaks" / "soak_40C.parquet").stat().st_mtime_ns
     with pytest.raises(OutputExistsError, match=r"exist: .*soak_-20C\.parquet.*--force"):
-        simulate.simulate_files(runs, tmp_path / "soaks", rate_hz=10.0, seed=5)
+        simulate.simulate_files(runs, tmp_path / "soaks", sample_rate_hz=10.0, seed=5)
     assert (tmp_path / "soaks" / "soak_40C.parquet").stat().st_mtime_ns == before
-    simulate.simulate_files(runs, tmp_path / "soaks", rate_hz=10.0, seed=5, force=True)
+    simulate.simulate_files(runs, tmp_path / "soaks", sample_rate_hz=10.0, seed=5, force=True)
     assert not np.array_equal(read(written[1].path).rate_dph, back.rate_dph)
 
 
 @pytest.mark.parametrize("file_format", ["csv", "h5"])
 def test_other_formats(tmp_path, file_format):
     runs = [simulate.constant(20.0, 0.01)]
-    (written,) = simulate.simulate_files(runs, tmp_path, file_format, rate_hz=10.0)
+    (written,) = simulate.simulate_files(runs, tmp_path, file_format, sample_rate_hz=10.0)
     assert written.path.endswith("constant_20C." + file_format)
     back = read(written.path)
     seed = np.random.SeedSequence(0, spawn_key=(0,))
-    expected = simulate.simulate_run(runs[0], rate_hz=10.0, seed=seed)
+    expected = simulate.simulate_run(runs[0], sample_rate_hz=10.0, seed=seed)
     for name in simulate.COLUMNS:
         assert np.allclose(back[name], expected[name], rtol=1e-15, atol=0.0), name
 

@@ -130,8 +130,8 @@ def test_fit_transient_rejects_bad_input():
 
 
 # -- plateaus on synthetic recordings ------------------------------------------------
-def settled_soak(hours=3.0, rate_hz=2.0, seed=0, chamber_c=-10.0):
-    t = np.arange(0.0, hours * 3600.0, 1.0 / rate_hz)
+def settled_soak(hours=3.0, sample_rate_hz=2.0, seed=0, chamber_c=-10.0):
+    t = np.arange(0.0, hours * 3600.0, 1.0 / sample_rate_hz)
     freq = 4421.05 + 0.8 * np.exp(-t / 600.0)
     freq = freq + np.random.default_rng(seed).normal(0.0, 2e-3, t.size)
     return synthetic(t, freq, chamber_c)
@@ -249,7 +249,7 @@ def c_error(freq_hz, truth_hz):
 
 def test_simulated_5h_soak_to_minus_10_gives_eq18_within_the_noise():
     unit = units.get("paper-unit")
-    rec = simulate.simulate_run(simulate.soak(-10.0, 5.0), rate_hz=SIM_RATE_HZ, seed=11)
+    rec = simulate.simulate_run(simulate.soak(-10.0, 5.0), sample_rate_hz=SIM_RATE_HZ, seed=11)
     (plateau,) = find_plateaus(rec)
     assert plateau.chamber_c == pytest.approx(-10.0, abs=1e-9)
     # within the per-sample frequency noise (2 mHz, ~0.005 °C)
@@ -270,7 +270,7 @@ def test_simulated_5h_soak_to_minus_10_gives_eq18_within_the_noise():
 def campaign():
     """Seven soaks of 5 h (Section 3 of [1]) and the same soaks cut to 2.5 h."""
     recordings = [
-        simulate.simulate_run(profile, rate_hz=SIM_RATE_HZ, seed=20 + i)
+        simulate.simulate_run(profile, sample_rate_hz=SIM_RATE_HZ, seed=20 + i)
         for i, profile in enumerate(simulate.soak_campaign(SETPOINTS_C, 5.0))
     ]
     cut = [rec.slice(0, round(2.5 * 3600.0 * SIM_RATE_HZ)) for rec in recordings]
@@ -303,7 +303,7 @@ def test_soaks_cut_to_2_5h_give_the_5h_table_within_0_02_c(campaign):
 def test_one_file_with_many_setpoints_gives_one_plateau_each():
     setpoints = [-20.0, 0.0, 40.0, 10.0]
     profile = simulate.soak_series(setpoints, 3.0)
-    rec = simulate.simulate_run(profile, rate_hz=SIM_RATE_HZ, seed=31)
+    rec = simulate.simulate_run(profile, sample_rate_hz=SIM_RATE_HZ, seed=31)
     plateaus = find_plateaus(rec)
     assert [p.chamber_c for p in plateaus] == pytest.approx(setpoints, abs=1e-3)
     assert np.max(c_error([p.settled_freq_hz for p in plateaus], EQ18(setpoints))) < 0.02
@@ -320,7 +320,7 @@ def test_unit_b_soaks_cut_to_2_5h():
     unit = units.get("unit-b")
     setpoints = [-20.0, 10.0, 40.0]
     recordings = [
-        simulate.simulate_run(p, unit="unit-b", rate_hz=SIM_RATE_HZ, seed=40 + i)
+        simulate.simulate_run(p, unit="unit-b", sample_rate_hz=SIM_RATE_HZ, seed=40 + i)
         for i, p in enumerate(simulate.soak_campaign(setpoints, 2.5))
     ]
     plateaus = find_plateaus(recordings)

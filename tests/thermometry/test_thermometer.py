@@ -12,7 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from hrgtc.errors import CalibrationError, ExtrapolationWarning, InputError
-from hrgtc.thermometry import Thermometer, coefficient_pvalues, fit
+from hrgtc.thermometry import Thermometer, fit
 
 from exact import exact_polynomial_fit
 
@@ -62,9 +62,9 @@ def test_standard_errors_equal_statsmodels_on_the_raw_design():
     th = fit(TABLE1_T, TABLE1_F, order=3)
     model = sm.OLS(np.array(TABLE1_F), np.vander(np.array(TABLE1_T), 4, increasing=True)).fit()
     np.testing.assert_allclose(th.standard_errors, model.bse, rtol=1e-9)
-    np.testing.assert_allclose(th.residual_std, np.sqrt(model.scale), rtol=1e-9)
+    np.testing.assert_allclose(th.residual_std_hz, np.sqrt(model.scale), rtol=1e-9)
     np.testing.assert_allclose(th.rsquared, model.rsquared, rtol=1e-12)
-    np.testing.assert_allclose(coefficient_pvalues(th), model.pvalues, rtol=1e-7)
+    np.testing.assert_allclose(th.pvalues, model.pvalues, rtol=1e-7)
 
 
 @settings(max_examples=40, deadline=None)

@@ -31,7 +31,7 @@ def demo_command(
     from hrgtc.demo import DemoSettings, run_demo
 
     settings = DemoSettings.quick() if quick else DemoSettings()
-    settings = DemoSettings(settings.rate_hz, settings.soak_hours, settings.ramp_hours, seed)
+    settings = DemoSettings(settings.sample_rate_hz, settings.soak_hours, settings.ramp_hours, seed)
     seen: set[str] = set()
 
     def progress(stage: str, done: float, total: float) -> None:

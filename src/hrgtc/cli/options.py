@@ -127,9 +127,10 @@ RateUnitOption = Annotated[
         rich_help_panel=_INPUT,
     ),
 ]
-RateHzOption = Annotated[
+SampleRateOption = Annotated[
     float | None,
     typer.Option(
+        "--sample-rate-hz",
         "--rate-hz",
         help="Sample rate of the input [Hz], overriding the file's metadata "
         "(inferred from the time steps when the file has none).",
@@ -174,7 +175,7 @@ def recording_input(
     time_unit: str | None = None,
     freq_unit: str | None = None,
     rate_unit: str | None = None,
-    rate_hz: float | None = None,
+    sample_rate_hz: float | None = None,
     unit_name: str | None = None,
     input_rate_dph: float | None = None,
 ) -> ReadOptions:
@@ -183,7 +184,8 @@ def recording_input(
     from hrgtc.recording.mapping import parse_columns
 
     units = {"time": time_unit, "freq": freq_unit, "rate": rate_unit}
-    overrides = {"sample_rate_hz": rate_hz, "unit": unit_name, "input_rate_dph": input_rate_dph}
+    overrides = {"sample_rate_hz": sample_rate_hz, "unit": unit_name,
+                 "input_rate_dph": input_rate_dph}
     return ReadOptions(
         columns=parse_columns(col) or None,
         units={k: v for k, v in units.items() if v is not None} or None,
@@ -197,7 +199,7 @@ _READING_OPTIONS: tuple[tuple[str, Any], ...] = (
     ("time_unit", TimeUnitOption),
     ("freq_unit", FreqUnitOption),
     ("rate_unit", RateUnitOption),
-    ("rate_hz", RateHzOption),
+    ("sample_rate_hz", SampleRateOption),
     ("unit_name", UnitNameOption),
     ("input_rate_dph", InputRateOption),
 )
@@ -208,7 +210,7 @@ def reading_options(command: Callable[..., Any]) -> Callable[..., Any]:
 
     The decorated function takes ``inputs: ReadOptions`` (as its last
     parameter) instead of the seven options; the command line still shows
-    ``--col``, ``--time-unit``, ``--freq-unit``, ``--rate-unit``, ``--rate-hz``,
+    ``--col``, ``--time-unit``, ``--freq-unit``, ``--rate-unit``, ``--sample-rate-hz``,
     ``--unit-name`` and ``--input-rate-dph``.
     """
     signature = inspect.signature(command)

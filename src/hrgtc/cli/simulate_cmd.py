@@ -104,8 +104,9 @@ def simulate_command(
             help=f"Simulated gyro: {', '.join(UNIT_NAMES)}.", rich_help_panel=_RUN
         ),
     ] = DEFAULT_UNIT,
-    rate_hz: Annotated[
-        float, typer.Option("--rate-hz", help="Sample rate [Hz].", rich_help_panel=_RUN)
+    sample_rate_hz: Annotated[
+        float, typer.Option("--sample-rate-hz", "--rate-hz", help="Sample rate [Hz].",
+                            rich_help_panel=_RUN)
     ] = 200.0,
     seed: Annotated[
         int, typer.Option(min=0, help="Random seed; the same seed gives the same files.",
@@ -164,7 +165,7 @@ def simulate_command(
                 output,
                 None if file_format is None else file_format.value,
                 unit=unit,
-                rate_hz=rate_hz,
+                sample_rate_hz=sample_rate_hz,
                 seed=seed,
                 input_rate_dph=input_rate_dph,
                 force=force,
@@ -173,7 +174,7 @@ def simulate_command(
     if json_output:
         print_json([w.to_dict() for w in written])
         return
-    table = Table(title=f"simulated {unit}, {rate_hz:g} Hz, seed {seed}")
+    table = Table(title=f"simulated {unit}, {sample_rate_hz:g} Hz, seed {seed}")
     for column in ("file", "rows", "profile"):
         table.add_column(column, justify="right" if column == "rows" else "left")
     for w in written:

@@ -17,12 +17,11 @@ import textwrap
 from pathlib import Path
 from typing import Any
 
+from hrgtc.compensate.c_plan import TABLE_POINTS, CPlan
 from hrgtc.drift.features import Term
 from hrgtc.errors import InputError
 from hrgtc.model import UnitModel
 
-#: Points of the embedded table that starts the thermometer's Newton iteration.
-TABLE_POINTS = 33
 #: Iteration cap of the thermometer inverse (as :meth:`Thermometer.temperature`).
 NEWTON_MAX_ITER = 60
 _WIDTH = 92
@@ -70,7 +69,7 @@ def _term_expression(term: Term) -> str:
 
 
 
-def readme(model: UnitModel, plan: dict[str, Any], prefix: str, origin: str,
+def readme(model: UnitModel, plan: CPlan, prefix: str, origin: str,
             sha256: str) -> str:
     """The README comment block at the top of the header: what, provenance, Eq. (22), units, use."""
     from hrgtc._meta import PAPER_REFERENCE, __version__
@@ -104,17 +103,17 @@ def readme(model: UnitModel, plan: dict[str, Any], prefix: str, origin: str,
         f" {'-' if drift.coefficients[n] < 0 else '+'} {abs(drift.coefficients[n]):.10g}*{n}"
         for n in drift.selected
     )
-    f_low, f_high = plan["f_range"]
+    f_low, f_high = plan.f_range
     th = " ".join(
         f"{c:+.10g}" + ("" if k == 0 else ("*T" if k == 1 else f"*T^{k}"))
         for k, c in reversed(list(enumerate(thermometer.coefficients)))
     )
     def ranges(kind: tuple[str, ...]) -> str:
         return ", ".join(f"{v} in [{drift.ranges[v][0]:.6g}, {drift.ranges[v][1]:.6g}]"
-                         for v in plan["computed"] if v in drift.ranges and v in kind) or "none"
+                         for v in plan.computed if v in drift.ranges and v in kind) or "none"
 
-    housing_arg = "double housing_c, " if plan["housing"] else ""
-    housing_use = "housing_c, " if plan["housing"] else ""
+    housing_arg = "double housing_c, " if plan.housing else ""
+    housing_use = "housing_c, " if plan.housing else ""
     lines += [
         "",
         "THE MODEL (Eq. (22) form of [1]; coefficients rounded here for reading)",
@@ -126,7 +125,7 @@ def readme(model: UnitModel, plan: dict[str, Any], prefix: str, origin: str,
         "         y1 = a*f + b*y1;  y2 = a*y1 + b*y2;  df = (y1 - y2)*a*fs/b,",
         "         a = 1 - exp(-1/(tau*fs)), b = 1 - a, y1 = y2 = f at the first sample   [Hz/s]",
     ]
-    if plan["housing"]:
+    if plan.housing:
         lines.append(f"  h  = housing_c - {settings.reference_c:g} degC, dh = its rate by the "
                      "same filter   [degC, degC/s]")
     lines += [
@@ -137,8 +136,8 @@ def readme(model: UnitModel, plan: dict[str, Any], prefix: str, origin: str,
         "  rate_comp_dph = rate_dph - B",
         f"  Thermometer (Eq. (18) form): freq = {th}   [Hz, T in degC]",
         "  resonator_c_est = the T with freq(T) = freq_hz (Newton iteration on a bracket);",
-        f"  NaN beyond the monotonic extension {plan['extension'][0]:g} to "
-        f"{plan['extension'][1]:g} degC.",
+        f"  NaN beyond the monotonic extension {plan.extension[0]:g} to "
+        f"{plan.extension[1]:g} degC.",
         f"  in_range = 1 when freq_hz is in the calibrated range [{f_low:.10g}, {f_high:.10g}] "
         f"Hz ({thermometer.temperature_range_c[0]:g} to {thermometer.temperature_range_c[1]:g} "
         f"degC) and the training ranges of the levels hold: {ranges(('f', 'h'))}; else 0.",
@@ -149,7 +148,7 @@ def readme(model: UnitModel, plan: dict[str, Any], prefix: str, origin: str,
         "UNITS",
         "  inputs:  freq_hz [Hz] resonator natural frequency; rate_dph [deg/h] gyro output "
         "(input rate included)"
-        + ("; housing_c [degC] housing thermistor" if plan["housing"] else "")
+        + ("; housing_c [degC] housing thermistor" if plan.housing else "")
         + f". One call per sample at exactly {up}_SAMPLE_RATE_HZ "
         f"({settings.sample_rate_hz:g} Hz): the filter is defined per sample.",
         "  outputs: rate_comp_dph, bias_model_dph [deg/h]; resonator_c_est [degC];",
@@ -183,11 +182,11 @@ def readme(model: UnitModel, plan: dict[str, Any], prefix: str, origin: str,
     return "/*\n" + "\n".join((" * " + line).rstrip() for line in wrapped) + "\n */\n"
 
 
-def header(model: UnitModel, plan: dict[str, Any], prefix: str, origin: str,
+def header(model: UnitModel, plan: CPlan, prefix: str, origin: str,
             sha256: str) -> str:
     """Text of ``<prefix>_model.h``: README block, state and output structs, prototypes."""
     p, up = prefix, prefix.upper()
-    housing = plan["housing"]
+    housing = plan.housing
     state_h = "    double h_y1;                /* first low-pass stage of h [degC] */\n" \
               "    double h_y2;                /* second low-pass stage of h [degC] */\n" \
         if housing else ""
@@ -196,8 +195,8 @@ def header(model: UnitModel, plan: dict[str, Any], prefix: str, origin: str,
         if housing else ""
     arg_h = ", double housing_c" if housing else ""
     bias_h = ", double h_c, double dh_c_per_s" if housing else ""
-    levels = " and ".join(v for v in plan["computed"] if v in ("f", "h"))
-    rates = " and ".join(v for v in plan["computed"] if v in ("df", "dh"))
+    levels = " and ".join(v for v in plan.computed if v in ("f", "h"))
+    rates = " and ".join(v for v in plan.computed if v in ("df", "dh"))
     return f"""{readme(model, plan, prefix, origin, sha256)}
 #ifndef {up}_MODEL_H
 #define {up}_MODEL_H
@@ -264,9 +263,9 @@ int {p}_frequency_in_range(double freq_hz);
 """
 
 
-def _bias_function(model: UnitModel, plan: dict[str, Any], prefix: str) -> str:
+def _bias_function(model: UnitModel, plan: CPlan, prefix: str) -> str:
     drift = model.drift
-    housing = plan["housing"]
+    housing = plan.housing
     params = ["f_hz", "df_hz_per_s"] + (["h_c", "dh_c_per_s"] if housing else [])
     names = dict(zip(("f", "df", "h", "dh"), params, strict=False))
     used = [v for v in ("f", "df", "h", "dh") if v in drift.variables and drift.selected]
@@ -283,7 +282,7 @@ def _bias_function(model: UnitModel, plan: dict[str, Any], prefix: str) -> str:
         body.append(f"    const double x_{v} = c_{v} / SCALE_{u};")
     body.append("    double sum = 0.0;")
     body.append("    double term;")
-    for k, term in enumerate(drift._terms):
+    for k, term in enumerate(drift.terms):
         body.append(f"    term = {_term_expression(term)};  /* {term.name} */")
         body.append(f"    term = COEFFICIENTS[{k}] * term;")
         body.append("    sum = sum + term;")
@@ -292,7 +291,7 @@ def _bias_function(model: UnitModel, plan: dict[str, Any], prefix: str) -> str:
         body.append(f"    if ({names[v]} < CLAMP_{u}_LOW || {names[v]} > CLAMP_{u}_HIGH) {{"
                     f"  /* beyond the training range of {v} */")
         body.append("        double gradient = 0.0;")
-        for k, term in enumerate(drift._terms):
+        for k, term in enumerate(drift.terms):
             multiplier, rest = term.derivative(v)
             if not multiplier:
                 continue
@@ -302,7 +301,7 @@ def _bias_function(model: UnitModel, plan: dict[str, Any], prefix: str) -> str:
         body.append(f"        sum = sum + gradient * ({names[v]} - c_{v});")
         body.append("    }")
     body.append("    return INTERCEPT_DPH + sum;")
-    if not drift._terms:
+    if not drift.terms:
         body = [line for line in body if "term" not in line]
     signature = ", ".join(f"double {name}" for name in params)
     constants = [f"static const double INTERCEPT_DPH = "
@@ -315,10 +314,10 @@ def _bias_function(model: UnitModel, plan: dict[str, Any], prefix: str) -> str:
                          f"{_literal(low, f'ranges[{v}][0]')};")
         constants.append(f"static const double CLAMP_{v.upper()}_HIGH = "
                          f"{_literal(high, f'ranges[{v}][1]')};")
-    if drift._terms:
+    if drift.terms:
         listed = ", ".join(drift.selected)
         constants.append(f"/* Coefficients on scaled variables, in this order: {listed} */")
-        constants.append(f"static const double COEFFICIENTS[{len(drift._terms)}] = "
+        constants.append(f"static const double COEFFICIENTS[{len(drift.terms)}] = "
                          f"{_array(drift.scaled_coefficients, 'scaled_coefficients')};")
     return "\n".join(constants) + f"""
 
@@ -327,13 +326,13 @@ double {prefix}_bias_dph({signature})
 """ + "\n".join(body) + "\n}\n"
 
 
-def source(model: UnitModel, plan: dict[str, Any], prefix: str) -> str:
+def source(model: UnitModel, plan: CPlan, prefix: str) -> str:
     """Text of ``<prefix>_model.c``: filter, drift model, thermometer inverse, step()."""
     p = prefix
     drift, th = model.drift, model.thermometer
     settings = drift.settings
     ranges = []
-    for v in plan["computed"]:
+    for v in plan.computed:
         if v in drift.ranges:
             low, high = drift.ranges[v]
             ranges.append((v, _literal(low, f"ranges[{v}][0]"), _literal(high, f"ranges[{v}][1]")))
@@ -348,7 +347,7 @@ def source(model: UnitModel, plan: dict[str, Any], prefix: str) -> str:
         f"static const double RANGE_{v.upper()}_HIGH = {high};\n"
         for v, low, high in ranges
     )
-    above = "residual > 0.0" if plan["increasing"] else "!(residual > 0.0)"
+    above = "residual > 0.0" if plan.increasing else "!(residual > 0.0)"
     # the housing thermistor's pieces, empty when the terms do not use h or dh
     reference_c = _literal(settings.reference_c, "reference_c")
     h = {
@@ -361,9 +360,9 @@ def source(model: UnitModel, plan: dict[str, Any], prefix: str) -> str:
         "bias": ", h_value, dh_value",
         "reset": "    state->h_y1 = 0.0;\n    state->h_y2 = 0.0;\n",
     }
-    if not plan["housing"]:
+    if not plan.housing:
         h = dict.fromkeys(h, "")
-    n_th = len(plan["th_coefficients"])
+    n_th = len(plan.th_coefficients)
     return f"""/* {p}_model.c -- generated by hrgtc export-c for unit {_comment(model.unit)};
  * see {p}_model.h for what it computes, its provenance and its use. Do not edit.
  * Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
@@ -375,9 +374,9 @@ def source(model: UnitModel, plan: dict[str, Any], prefix: str) -> str:
 /* ---- frequency change and the causal df/dt filter (hrgtc.drift.features.causal_rate) ---- */
 static const double REFERENCE_FREQ_HZ = \
 {_literal(settings.reference_freq_hz, 'reference_freq_hz')};
-{h['constants']}static const double RATE_ALPHA = {_literal(plan['alpha'], 'alpha')};
-static const double RATE_BETA = {_literal(plan['beta'], 'beta')};
-static const double RATE_GAIN = {_literal(plan['gain'], 'gain')};  /* alpha * fs / beta */
+{h['constants']}static const double RATE_ALPHA = {_literal(plan.alpha, 'alpha')};
+static const double RATE_BETA = {_literal(plan.beta, 'beta')};
+static const double RATE_GAIN = {_literal(plan.gain, 'gain')};  /* alpha * fs / beta */
 
 /* One sample of two exact first-order lags; returns the rate. Separate statements keep
    the rounding identical to hrgtc (no fused multiply-add within an expression). */
@@ -400,17 +399,17 @@ static const double TH_CENTRE_C = {_literal(th.centre_c, 'centre_c')};
 static const double TH_SCALE_C = {_literal(th.scale_c, 'scale_c')};
 /* f(T) = sum_k TH_COEFFICIENTS[k] z^k, z = (T - TH_CENTRE_C) / TH_SCALE_C [Hz] */
 static const double TH_COEFFICIENTS[{n_th}] = \
-{_array(plan['th_coefficients'], 'scaled_coefficients')};
+{_array(plan.th_coefficients, 'scaled_coefficients')};
 /* d f / d z, ascending */
-static const double TH_DERIVATIVE[{n_th - 1}] = {_array(plan['th_derivative'], 'derivative')};
+static const double TH_DERIVATIVE[{n_th - 1}] = {_array(plan.th_derivative, 'derivative')};
 /* calibrated frequency range [Hz] */
-static const double TH_F_LOW_HZ = {_literal(plan['f_range'][0], 'f_low')};
-static const double TH_F_HIGH_HZ = {_literal(plan['f_range'][1], 'f_high')};
+static const double TH_F_LOW_HZ = {_literal(plan.f_range[0], 'f_low')};
+static const double TH_F_HIGH_HZ = {_literal(plan.f_range[1], 'f_high')};
 /* table of f(T) over the monotonic extension, ascending in f: starts the Newton iteration */
 #define TH_TABLE_POINTS {TABLE_POINTS}
-static const double TH_TABLE_F[TH_TABLE_POINTS] = {_array(plan['grid_f'], 'table_f')};
-static const double TH_TABLE_T[TH_TABLE_POINTS] = {_array(plan['grid_t'], 'table_t')};
-static const double TH_TOLERANCE_C = {_literal(plan['tolerance'], 'tolerance')};
+static const double TH_TABLE_F[TH_TABLE_POINTS] = {_array(plan.grid_f, 'table_f')};
+static const double TH_TABLE_T[TH_TABLE_POINTS] = {_array(plan.grid_t, 'table_t')};
+static const double TH_TOLERANCE_C = {_literal(plan.tolerance, 'tolerance')};
 #define TH_MAX_ITER {NEWTON_MAX_ITER}
 
 static double horner(const double *c, int n, double z)

@@ -33,73 +33,14 @@ import json
 import os
 import re
 from pathlib import Path
-from typing import Any
 
-import numpy as np
-
-from hrgtc.compensate.c_text import TABLE_POINTS, header, source
-from hrgtc.drift.features import rate_filter_coefficients
-from hrgtc.errors import CalibrationError, InputError
+from hrgtc.compensate.c_plan import plan_for
+from hrgtc.compensate.c_text import header, source
+from hrgtc.errors import InputError
 from hrgtc.files import file_sha256, refuse_existing, write_text_atomic
 from hrgtc.model import UnitModel, load_model
 
 _PREFIX = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,31}$")
-
-
-def _plan(model: UnitModel) -> dict[str, Any]:
-    """The numbers the C code needs beyond the model's own, computed as hrgtc computes them.
-
-    Raises
-    ------
-    CalibrationError
-        A thermometer that is not monotonic over its calibrated range.
-    """
-    thermometer, drift = model.thermometer, model.drift
-    if not thermometer.is_monotonic:
-        t_low, t_high = thermometer.temperature_range_c
-        raise CalibrationError(
-            f"the thermometer's f(T) is not monotonic over {t_low:g} to {t_high:g} °C, so "
-            "frequency cannot be turned into temperature; recalibrate with a lower order"
-        )
-    settings = drift.settings
-    used = set(drift.variables)
-    housing = bool(used & {"h", "dh"})
-    # The compensator computes f and df (and h, dh when the terms use them); in_range checks
-    # the levels (f, h), rate_in_range the rates of change (df, dh), each where computed.
-    computed = ["f", "df"] + [v for v in ("h", "dh") if v in used]
-    alpha, beta = rate_filter_coefficients(settings.rate_tau_s, settings.sample_rate_hz)
-    gain = alpha * settings.sample_rate_hz / beta  # the factor causal_rate applies
-    for v in used:
-        if v not in settings.scales:
-            raise InputError(f"the drift model has no scale for variable {v!r}; it is corrupt")
-    # Thermometer inverse: same extension and tolerance as Thermometer.temperature.
-    t_low, t_high = thermometer.temperature_range_c
-    span = t_high - t_low
-    lo, hi = thermometer._monotonic_extension(t_low, t_high, span)
-    grid_t = np.linspace(lo, hi, TABLE_POINTS)
-    grid_f = thermometer.frequency(grid_t)
-    increasing = bool(grid_f[-1] > grid_f[0])
-    if not increasing:
-        grid_t, grid_f = grid_t[::-1], grid_f[::-1]
-    a = np.asarray(thermometer.scaled_coefficients, dtype=np.float64)
-    derivative = a[1:] * np.arange(1, a.size)
-    f_low, f_high = thermometer.frequency_range_hz
-    return {
-        "housing": housing,
-        "computed": computed,
-        "alpha": alpha,
-        "beta": beta,
-        "gain": gain,
-        "increasing": increasing,
-        "grid_t": grid_t,
-        "grid_f": grid_f,
-        "th_coefficients": a,
-        "th_derivative": derivative,
-        "f_range": (f_low, f_high),
-        "tolerance": 4 * np.finfo(np.float64).eps * max(abs(lo), abs(hi), span),
-        "extension": (lo, hi),
-    }
-
 
 
 # -- public API ---------------------------------------------------------------------------
@@ -166,7 +107,7 @@ def export_c(
     header_path = folder / f"{prefix}_model.h"
     source_path = folder / f"{prefix}_model.c"
     refuse_existing((header_path, source_path), force)
-    plan = _plan(model)
+    plan = plan_for(model)
     header_text = header(model, plan, prefix, origin, sha256)
     code = source(model, plan, prefix)
     return [

@@ -252,6 +252,11 @@ class DriftModel:
         object.__setattr__(self, "_terms", parse_terms(self.selected) if self.selected else ())
 
     @property
+    def terms(self) -> tuple[Term, ...]:
+        """The selected terms, parsed (in ``selected`` order)."""
+        return self._terms
+
+    @property
     def history(self) -> tuple[Any, ...]:
         """Steps of the stepwise regression."""
         return self.stepwise.history

@@ -38,7 +38,6 @@ from hrgtc.model import UnitModel, load_model
 from hrgtc.progress import Progress
 from hrgtc.recording import ReadOptions, count_rows
 from hrgtc.report.figures import SoakTrace, trace_soak
-from hrgtc.thermometry import coefficient_pvalues
 from hrgtc.thermometry.plateaus import Plateau
 
 __all__ = ["build_report"]
@@ -252,7 +251,7 @@ def _thermometer(page: _Page, model: UnitModel, plateaus: Sequence[Plateau],
     page.add(_table(("temperature [°C]", "natural frequency [Hz]", "residual [mHz]"),
                         rows, "The unit's Table 1"))
     high = th.coefficients_high_first
-    pvals = tuple(reversed(coefficient_pvalues(th)))
+    pvals = tuple(reversed(th.pvalues))
     printed = dict(enumerate(reversed(paper.EQ18_PRINTED_HIGH_FIRST)))
     powers = range(th.order, -1, -1)
     rows = [(_power("T", n) or "const", "Hz" + (f"/{_power('°C', n)}" if n else ""),
@@ -264,7 +263,7 @@ def _thermometer(page: _Page, model: UnitModel, plateaus: Sequence[Plateau],
     terms = " ".join(f"{'−' if c < 0 else '+'} {abs(c):.7g}" + (f"·{_power('T', n)}" if n else "")
                      for n, c in zip(powers, high, strict=True))
     page.add(f'<p class="eq">f = {terms.lstrip("+ ")} &nbsp;[Hz, T in °C]</p>',
-             f'<p class="muted">Eq. (18) form. Residual std {_number(1e3 * th.residual_std, 3)} '
+             f'<p class="muted">Eq. (18) form. Residual std {_number(1e3 * th.residual_std_hz, 3)} '
              f"mHz, R² {th.rsquared:.10f}, {th.n_points} points, calibrated "
              f"{th.temperature_range_c[0]:g} to {th.temperature_range_c[1]:g} °C. The paper's "
              "unit: f = 1.528e−5·T³ − 9.702e−4·T² + 0.3716·T + 4424.901.</p></section>")

@@ -17,7 +17,7 @@ Simulated recordings follow the recording contract (``time_s``, ``freq_hz``,
 Examples
 --------
 >>> from hrgtc import simulate
->>> rec = simulate.simulate_run(simulate.constant(20.0, 0.1), rate_hz=10.0, seed=0)
+>>> rec = simulate.simulate_run(simulate.constant(20.0, 0.1), sample_rate_hz=10.0, seed=0)
 >>> rec.names
 ('time_s', 'freq_hz', 'rate_dph', 'chamber_c', 'housing_c', 'resonator_c', 'bias_dph')
 

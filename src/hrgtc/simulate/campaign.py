@@ -69,14 +69,14 @@ def _resolve_unit(unit: str | Unit) -> Unit:
     return unit if isinstance(unit, Unit) else _units.get(unit)
 
 
-def check_rate(rate_hz: float) -> float:
-    """``rate_hz`` as float if finite and positive, else InputError. [Hz]"""
+def check_rate(sample_rate_hz: float) -> float:
+    """``sample_rate_hz`` as float if finite and positive, else InputError. [Hz]"""
     try:
-        value = float(rate_hz)
+        value = float(sample_rate_hz)
     except (TypeError, ValueError):
         value = math.nan
     if not (math.isfinite(value) and value > 0.0):
-        raise InputError(f"rate_hz must be finite and > 0 [Hz], got {rate_hz!r}")
+        raise InputError(f"sample_rate_hz must be finite and > 0 [Hz], got {sample_rate_hz!r}")
     return value
 
 
@@ -108,15 +108,15 @@ def _seed_record(seed: Seed) -> dict[str, Any]:
     return {"seed": int(seed)}
 
 
-def row_count(profile: Profile, rate_hz: float) -> int:
-    """Number of samples of a run: one every ``1 / rate_hz`` over the profile's duration."""
-    return max(1, round(profile.duration_s * check_rate(rate_hz)))
+def row_count(profile: Profile, sample_rate_hz: float) -> int:
+    """Number of samples of a run: one every ``1 / sample_rate_hz`` over the profile's duration."""
+    return max(1, round(profile.duration_s * check_rate(sample_rate_hz)))
 
 
 def run_metadata(
     profile: Profile,
     unit: str | Unit = _units.DEFAULT_UNIT,
-    rate_hz: float = 200.0,
+    sample_rate_hz: float = 200.0,
     seed: Seed = 0,
     input_rate_dph: float = DEFAULT_INPUT_RATE_DPH,
 ) -> Metadata:
@@ -131,7 +131,7 @@ def run_metadata(
     extra["chamber_program"] = profile.to_dict()
     extra["unit_parameters"] = unit.to_dict()
     return Metadata(
-        sample_rate_hz=check_rate(rate_hz),
+        sample_rate_hz=check_rate(sample_rate_hz),
         unit=unit.name,
         input_rate_dph=float(input_rate_dph),
         profile=profile.description,
@@ -142,7 +142,7 @@ def run_metadata(
 def iter_run_chunks(
     profile: Profile,
     unit: str | Unit = _units.DEFAULT_UNIT,
-    rate_hz: float = 200.0,
+    sample_rate_hz: float = 200.0,
     seed: Seed = 0,
     input_rate_dph: float = DEFAULT_INPUT_RATE_DPH,
     chunk_rows: int = DEFAULT_CHUNK_ROWS,
@@ -156,7 +156,7 @@ def iter_run_chunks(
         The chamber program.
     unit
         A unit name (:func:`hrgtc.simulate.units.names`) or a :class:`Unit`.
-    rate_hz
+    sample_rate_hz
         Sample rate. [Hz]
     seed
         Non-negative integer, :class:`numpy.random.SeedSequence` or
@@ -174,7 +174,7 @@ def iter_run_chunks(
         Consecutive chunks with the columns of :data:`COLUMNS` and the run's metadata.
     """
     unit = _resolve_unit(unit)
-    fs = check_rate(rate_hz)
+    fs = check_rate(sample_rate_hz)
     if int(chunk_rows) < 1:
         raise InputError(f"chunk_rows must be >= 1, got {chunk_rows!r}")
     metadata = run_metadata(profile, unit, fs, seed, input_rate_dph)
@@ -224,7 +224,7 @@ def iter_run_chunks(
 def simulate_run(
     profile: Profile,
     unit: str | Unit = _units.DEFAULT_UNIT,
-    rate_hz: float = 200.0,
+    sample_rate_hz: float = 200.0,
     seed: Seed = 0,
     input_rate_dph: float = DEFAULT_INPUT_RATE_DPH,
     chunk_rows: int = DEFAULT_CHUNK_ROWS,
@@ -235,10 +235,11 @@ def simulate_run(
     Examples
     --------
     >>> from hrgtc.simulate.standard_profiles import soak
-    >>> rec = simulate_run(soak(-10.0, 0.5), rate_hz=1.0, seed=1)
+    >>> rec = simulate_run(soak(-10.0, 0.5), sample_rate_hz=1.0, seed=1)
     >>> len(rec), rec.metadata.unit, rec.metadata.profile
     (1800, 'paper-unit', 'soak -10 C, 0.5 h from 20 C')
     """
     return concatenate(
-        list(iter_run_chunks(profile, unit, rate_hz, seed, input_rate_dph, chunk_rows, progress))
+        list(iter_run_chunks(profile, unit, sample_rate_hz, seed, input_rate_dph, chunk_rows,
+                             progress))
     )

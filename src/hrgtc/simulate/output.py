@@ -76,7 +76,7 @@ def simulate_to_file(
     profile: Profile,
     path: str | Path,
     unit: str | Unit = _units.DEFAULT_UNIT,
-    rate_hz: float = 200.0,
+    sample_rate_hz: float = 200.0,
     seed: Seed = 0,
     input_rate_dph: float = DEFAULT_INPUT_RATE_DPH,
     chunk_rows: int = DEFAULT_CHUNK_ROWS,
@@ -91,7 +91,7 @@ def simulate_to_file(
         The chamber program.
     path
         Output file, ``.parquet``, ``.csv`` or ``.h5``; its directory must exist.
-    unit, rate_hz, seed, input_rate_dph, chunk_rows, progress
+    unit, sample_rate_hz, seed, input_rate_dph, chunk_rows, progress
         As for :func:`hrgtc.simulate.campaign.iter_run_chunks`.
     force
         Overwrite ``path`` if it exists.
@@ -108,9 +108,10 @@ def simulate_to_file(
     """
     path = Path(path)
     refuse_existing(path, force)
-    metadata = run_metadata(profile, unit, rate_hz, seed, input_rate_dph)
+    metadata = run_metadata(profile, unit, sample_rate_hz, seed, input_rate_dph)
     rows = 0
-    chunks = iter_run_chunks(profile, unit, rate_hz, seed, input_rate_dph, chunk_rows, progress)
+    chunks = iter_run_chunks(profile, unit, sample_rate_hz, seed, input_rate_dph, chunk_rows,
+                             progress)
     # Encode and write chunk k in a worker thread while chunk k+1 is generated
     # (numpy, scipy and pyarrow release the GIL in their loops).
     with (
@@ -175,7 +176,7 @@ def simulate_files(
     output: str | Path,
     file_format: str | None = None,
     unit: str | Unit = _units.DEFAULT_UNIT,
-    rate_hz: float = 200.0,
+    sample_rate_hz: float = 200.0,
     seed: int = 0,
     input_rate_dph: float = DEFAULT_INPUT_RATE_DPH,
     chunk_rows: int = DEFAULT_CHUNK_ROWS,
@@ -199,7 +200,7 @@ def simulate_files(
         A directory (created if missing), or a file for a single run.
     file_format
         ``"parquet"``, ``"csv"`` or ``"h5"``; None: from ``output``'s suffix, else Parquet.
-    unit, rate_hz, input_rate_dph, chunk_rows
+    unit, sample_rate_hz, input_rate_dph, chunk_rows
         As for :func:`iter_run_chunks`.
     seed
         Non-negative integer seed of the campaign.
@@ -223,7 +224,7 @@ def simulate_files(
     if not profiles:
         raise InputError("no runs to simulate; give at least one profile")
     unit = unit if isinstance(unit, Unit) else _units.get(unit)
-    fs = check_rate(rate_hz)
+    fs = check_rate(sample_rate_hz)
     seed = check_seed(seed)
     if not isinstance(seed, int):
         raise InputError(f"a campaign's seed must be a non-negative integer, got {seed!r}")

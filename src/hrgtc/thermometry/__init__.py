@@ -16,14 +16,13 @@ from hrgtc.thermometry.plateaus import (
     plateaus_from_recordings,
 )
 from hrgtc.thermometry.settling import TransientFit, fit_transient
-from hrgtc.thermometry.thermometer import Thermometer, coefficient_pvalues, fit
+from hrgtc.thermometry.thermometer import Thermometer, fit
 
 __all__ = [
     "DEFAULT_HZ_PER_C",
     "Plateau",
     "Thermometer",
     "TransientFit",
-    "coefficient_pvalues",
     "find_plateaus",
     "fit",
     "fit_transient",

@@ -371,7 +371,7 @@ def find_plateaus(
     curve gives Eq. (18) of [1] at -10 °C (4421.0731 Hz) within ~0.01 °C:
 
     >>> from hrgtc import simulate
-    >>> rec = simulate.simulate_run(simulate.soak(-10.0, 2.5), rate_hz=1.0, seed=0)
+    >>> rec = simulate.simulate_run(simulate.soak(-10.0, 2.5), sample_rate_hz=1.0, seed=0)
     >>> (plateau,) = find_plateaus(rec)
     >>> plateau.settled, plateau.method, plateau.chamber_c
     (False, 'transient fit', -10.0)

@@ -97,7 +97,7 @@ class Thermometer:
     standard_errors
         Standard error of each coefficient, same order (NaN when the fit has
         no residual degrees of freedom). [Hz/°C^k]
-    residual_std
+    residual_std_hz
         Residual standard deviation sqrt(RSS / (n - order - 1)). [Hz]
     rsquared
         Coefficient of determination.
@@ -117,7 +117,7 @@ class Thermometer:
 
     coefficients: tuple[float, ...]
     standard_errors: tuple[float, ...]
-    residual_std: float
+    residual_std_hz: float
     rsquared: float
     temperature_range_c: tuple[float, float]
     order: int
@@ -128,6 +128,31 @@ class Thermometer:
     scaled_covariance: tuple[tuple[float, ...], ...] | None = None
 
     # -- derived -------------------------------------------------------------------
+    @property
+    def pvalues(self) -> tuple[float, ...]:
+        """Two-sided t-test p-value of each coefficient being zero, ascending powers.
+
+        NaN where the fit has no residual degrees of freedom (as ``standard_errors``).
+        """
+        dof = self.n_points - self.order - 1
+        out = []
+        for c, se in zip(self.coefficients, self.standard_errors, strict=True):
+            if dof <= 0 or not np.isfinite(se) or se == 0:
+                out.append(float("nan"))
+            else:
+                out.append(float(2 * stats.t.sf(abs(c / se), dof)))
+        return tuple(out)
+
+    @property
+    def inverse_range_c(self) -> tuple[float, float]:
+        """Temperatures over which :meth:`temperature` inverts f(T). [°C]
+
+        The calibrated range extended by at most one span each side, and only as far
+        as f(T) stays monotonic; beyond it the inverse returns NaN.
+        """
+        t_low, t_high = self.temperature_range_c
+        return self._monotonic_extension(t_low, t_high, t_high - t_low)
+
     @property
     def coefficients_high_first(self) -> tuple[float, ...]:
         """Coefficients with the highest power first, as Eq. (18) prints them."""
@@ -354,11 +379,12 @@ class Thermometer:
         lines = [
             f"Thermometer: order-{self.order} polynomial f(T) from {self.n_points} points, "
             f"{self.temperature_range_c[0]:g} to {self.temperature_range_c[1]:g} °C",
-            f"{'power':>6} {'coefficient':>18} {'std error':>12}",
+            f"{'power':>6} {'coefficient':>18} {'std error':>12} {'p-value':>10}",
         ]
-        for k, (c, se) in enumerate(zip(self.coefficients, self.standard_errors, strict=True)):
-            lines.append(f"{'T^' + str(k):>6} {c:>18.10g} {se:>12.4g}")
-        lines.append(f"residual std {self.residual_std:.4g} Hz, R² {self.rsquared:.10f}")
+        rows = zip(self.coefficients, self.standard_errors, self.pvalues, strict=True)
+        for k, (c, se, pvalue) in enumerate(rows):
+            lines.append(f"{'T^' + str(k):>6} {c:>18.10g} {se:>12.4g} {pvalue:>10.3g}")
+        lines.append(f"residual std {self.residual_std_hz:.4g} Hz, R² {self.rsquared:.10f}")
         terms = []
         for k, c in reversed(list(enumerate(self.coefficients))):
             power = "" if k == 0 else ("·T" if k == 1 else f"·T^{k}")
@@ -378,7 +404,8 @@ class Thermometer:
             "n_points": self.n_points,
             "coefficients": list(self.coefficients),
             "standard_errors": clean(self.standard_errors),
-            "residual_std": None if not np.isfinite(self.residual_std) else self.residual_std,
+            "residual_std_hz": (None if not np.isfinite(self.residual_std_hz)
+                                else self.residual_std_hz),
             "rsquared": self.rsquared,
             "temperature_range_c": list(self.temperature_range_c),
             "centre_c": self.centre_c,
@@ -403,9 +430,7 @@ class Thermometer:
             return cls(
                 coefficients=tuple(float(c) for c in data["coefficients"]),
                 standard_errors=restore(data["standard_errors"]),
-                residual_std=(
-                    float("nan") if data["residual_std"] is None else float(data["residual_std"])
-                ),
+                residual_std_hz=_optional(data.get("residual_std_hz", data.get("residual_std"))),
                 rsquared=float(data["rsquared"]),
                 temperature_range_c=(
                     float(data["temperature_range_c"][0]),
@@ -532,7 +557,7 @@ def fit(temperatures_c: Any, frequencies_hz: Any, order: int = 3) -> Thermometer
     return Thermometer(
         coefficients=raw,
         standard_errors=standard_errors,
-        residual_std=residual_std,
+        residual_std_hz=residual_std,
         rsquared=rsquared,
         temperature_range_c=(t_low, t_high),
         order=order,
@@ -544,13 +569,6 @@ def fit(temperatures_c: Any, frequencies_hz: Any, order: int = 3) -> Thermometer
     )
 
 
-def coefficient_pvalues(thermometer: Thermometer) -> tuple[float, ...]:
-    """Two-sided t-test p-value of each coefficient being zero (NaN without dof)."""
-    dof = thermometer.n_points - thermometer.order - 1
-    out = []
-    for c, se in zip(thermometer.coefficients, thermometer.standard_errors, strict=True):
-        if dof <= 0 or not np.isfinite(se) or se == 0:
-            out.append(float("nan"))
-        else:
-            out.append(float(2 * stats.t.sf(abs(c / se), dof)))
-    return tuple(out)
+def _optional(value: Any) -> float:
+    """A number from a model file; None (JSON null) is NaN."""
+    return float("nan") if value is None else float(value)

@@ -1,0 +1,116 @@
+"""The numbers the C export needs beyond the model's own, as one typed value.
+
+:func:`plan_for` computes them exactly as the Python compensator does (the df/dt
+filter's coefficients, the thermometer's inverse table and tolerance), so the C
+code and :class:`hrgtc.compensate.Compensator` agree sample by sample.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from hrgtc.drift.features import rate_filter_coefficients
+from hrgtc.errors import CalibrationError, InputError
+from hrgtc.model import UnitModel
+
+#: Points of the embedded table that starts the thermometer's Newton iteration.
+TABLE_POINTS = 33
+
+
+@dataclass(frozen=True, eq=False)
+class CPlan:
+    """What the C source is written from.
+
+    Attributes
+    ----------
+    housing
+        The drift terms use the housing thermistor (h, dh/dt).
+    computed
+        Variables the compensator computes: f and df, and h and dh where used.
+    alpha, beta, gain
+        Coefficients of each first-order stage of the causal df/dt filter and its
+        ramp gain (``alpha * fs / beta``).
+    increasing
+        f(T) increases with temperature.
+    grid_t, grid_f
+        The inverse's table: temperatures [°C] and frequencies [Hz], f increasing.
+    th_coefficients, th_derivative
+        The thermometer's scaled coefficients and those of its derivative.
+    f_range
+        Calibrated frequency range. [Hz]
+    tolerance
+        Newton tolerance of the inverse. [°C]
+    extension
+        Temperatures over which the inverse is defined. [°C]
+    """
+
+    housing: bool
+    computed: list[str]
+    alpha: float
+    beta: float
+    gain: float
+    increasing: bool
+    grid_t: np.ndarray
+    grid_f: np.ndarray
+    th_coefficients: np.ndarray
+    th_derivative: np.ndarray
+    f_range: tuple[float, float]
+    tolerance: float
+    extension: tuple[float, float]
+
+
+def plan_for(model: UnitModel) -> CPlan:
+    """The numbers the C code needs beyond the model's own, computed as hrgtc computes them.
+
+    Raises
+    ------
+    CalibrationError
+        A thermometer that is not monotonic over its calibrated range.
+    """
+    thermometer, drift = model.thermometer, model.drift
+    if not thermometer.is_monotonic:
+        t_low, t_high = thermometer.temperature_range_c
+        raise CalibrationError(
+            f"the thermometer's f(T) is not monotonic over {t_low:g} to {t_high:g} °C, so "
+            "frequency cannot be turned into temperature; recalibrate with a lower order"
+        )
+    settings = drift.settings
+    used = set(drift.variables)
+    housing = bool(used & {"h", "dh"})
+    # The compensator computes f and df (and h, dh when the terms use them); in_range checks
+    # the levels (f, h), rate_in_range the rates of change (df, dh), each where computed.
+    computed = ["f", "df"] + [v for v in ("h", "dh") if v in used]
+    alpha, beta = rate_filter_coefficients(settings.rate_tau_s, settings.sample_rate_hz)
+    gain = alpha * settings.sample_rate_hz / beta  # the factor causal_rate applies
+    for v in used:
+        if v not in settings.scales:
+            raise InputError(f"the drift model has no scale for variable {v!r}; it is corrupt")
+    # Thermometer inverse: same extension and tolerance as Thermometer.temperature.
+    t_low, t_high = thermometer.temperature_range_c
+    span = t_high - t_low
+    lo, hi = thermometer.inverse_range_c
+    grid_t = np.linspace(lo, hi, TABLE_POINTS)
+    grid_f = thermometer.frequency(grid_t)
+    increasing = bool(grid_f[-1] > grid_f[0])
+    if not increasing:
+        grid_t, grid_f = grid_t[::-1], grid_f[::-1]
+    a = np.asarray(thermometer.scaled_coefficients, dtype=np.float64)
+    derivative = a[1:] * np.arange(1, a.size)
+    f_low, f_high = thermometer.frequency_range_hz
+    return CPlan(
+        housing=housing,
+        computed=computed,
+        alpha=alpha,
+        beta=beta,
+        gain=gain,
+        increasing=increasing,
+        grid_t=grid_t,
+        grid_f=grid_f,
+        th_coefficients=a,
+        th_derivative=derivative,
+        f_range=(f_low, f_high),
+        tolerance=4 * np.finfo(np.float64).eps * max(abs(lo), abs(hi), span),
+        extension=(lo, hi),
+    )
