@@ -18,15 +18,15 @@ from hrgtc.recording import Metadata, Recording
 from hrgtc.thermometry import fit
 from hrgtc.thermometry.plateaus import find_plateaus
 
-from campaign import SETPOINTS_C, make_campaign
+from campaign import SETPOINTS_C
 from synthetic import ramp_run
 
 UNITS = ("paper-unit", "unit-b")
 
 
 @pytest.fixture(scope="module", params=UNITS)
-def campaign(request, tmp_path_factory):
-    return request.param, make_campaign(tmp_path_factory.mktemp(request.param), request.param)
+def campaign(request, campaign_factory):
+    return request.param, campaign_factory(request.param)
 
 
 @pytest.fixture(scope="module")

@@ -15,13 +15,11 @@ from hrgtc.evaluation import evaluate
 from hrgtc.evaluation.metrics import bias_stability
 from hrgtc.model import save_model
 
-from campaign import make_campaign
-
 
 @pytest.fixture(scope="module")
-def setup(tmp_path_factory):
+def setup(tmp_path_factory, paper_campaign):
     folder = tmp_path_factory.mktemp("evaluation")
-    files = make_campaign(folder, "paper-unit", sample_rate_hz=2.0)
+    files = paper_campaign
     model = calibrate(files.soaks, [files.cooldown]).model
     model_path = save_model(model, folder / "unit.json")
     return files, model, model_path

@@ -24,9 +24,7 @@ from hrgtc.errors import OutputExistsError
 from hrgtc.model import save_model
 from hrgtc.report import build_report
 
-from campaign import SETPOINTS_C, make_campaign
-
-RATE_HZ = 2.0  # the report does not depend on the rate; keeps the module fast
+from campaign import SETPOINTS_C
 
 
 class _Page(HTMLParser):
@@ -84,9 +82,9 @@ def _number(cell: str) -> float:
 
 
 @pytest.fixture(scope="module")
-def unit(tmp_path_factory):
+def unit(tmp_path_factory, paper_campaign):
     folder = tmp_path_factory.mktemp("report-unit")
-    files = make_campaign(folder, "paper-unit", sample_rate_hz=RATE_HZ, hours=2.5)
+    files = paper_campaign
     result = calibrate(files.soaks, [files.cooldown], [files.warmup])
     return files, result.model, save_model(result.model, folder / "unit.json")
 
