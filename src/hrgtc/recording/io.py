@@ -42,9 +42,6 @@ from hrgtc.recording.formats import (
 from hrgtc.recording.mapping import (
     ColumnPlan,
     convert_columns,
-    parse_columns,
-    parse_unit,
-    parse_units,
     plan_columns,
     table_columns,
 )
@@ -61,18 +58,8 @@ from hrgtc.recording.validation import validate as validate_recording
 SOURCES: dict[str, type[Source]] = {"parquet": ParquetSource, "csv": CsvSource, "hdf5": Hdf5Source}
 SINKS: dict[str, type[Sink]] = {"parquet": ParquetSink, "csv": CsvSink, "hdf5": Hdf5Sink}
 
-__all__ = [
-    "ReadOptions",
-    "RecordingWriter",
-    "count_rows",
-    "iter_chunks",
-    "open_source",
-    "parse_columns",
-    "parse_unit",
-    "parse_units",
-    "read",
-    "write",
-]
+__all__ = ["ReadOptions", "RecordingWriter", "count_rows", "iter_chunks", "open_source", "read",
+           "write"]
 
 
 def open_source(path: str | Path) -> Source:
