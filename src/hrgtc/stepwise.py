@@ -4,8 +4,10 @@ Stepwise selection follows MATLAB's ``stepwisefit``: the constant is always in;
 each step adds the excluded term with the smallest partial-F p-value if it is
 below ``penter``, otherwise removes the included term with the largest p-value
 if it is above ``premove``; it stops when neither applies. Every candidate fit
-is a small solve on the statistics of :class:`~hrgtc.regression.GramAccumulator`
-(re-exported here with :func:`ols`), so the selection never touches the rows.
+is a small QR of the columns it uses of the triangular factor R of [1, X, y]
+held by :class:`~hrgtc.regression.GramAccumulator` (re-exported here with
+:func:`ols`), so the selection never touches the rows and never forms normal
+equations.
 
 ``variance_inflation`` (default 1, i.e. ``stepwisefit`` exactly) divides every
 F statistic by a factor c >= 1 and multiplies the standard errors by sqrt(c):
@@ -26,13 +28,11 @@ from typing import Any
 import numpy as np
 
 from hrgtc.errors import HrgtcWarning, InputError, RankDeficientError
+from hrgtc.qr_accumulator import _check_names, _resolve_terms, _solve
 from hrgtc.regression import (
     COLLINEARITY_TOL,
     GramAccumulator,
     OLSResult,
-    _check_names,
-    _resolve_terms,
-    _solve,
     ols,
     ols_from_accumulator,
 )
@@ -211,7 +211,7 @@ def stepwise_from_accumulator(acc: GramAccumulator, names: Sequence[str] | None 
     For data too large to hold: feed the rows chunk by chunk (or per file, per
     worker) into :class:`GramAccumulator` with ``partial_fit``, combine partial
     accumulators with ``merge``, then call this. Every candidate fit is a small
-    p-by-p solve on the stored statistics, so the selection costs nothing
+    QR and triangular solve on the stored factor, so the selection costs nothing
     compared with the one pass over the rows; the result equals :func:`stepwise`
     on the concatenated rows. Rules and parameters as in :func:`stepwise`.
 
