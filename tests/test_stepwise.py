@@ -362,3 +362,39 @@ def test_variance_inflation_scales_errors_and_f_statistics():
     assert stepwise(X, y, variance_inflation=25.0).selected == ("x1",)
     with pytest.raises(InputError, match="variance_inflation must be a finite number >= 1"):
         acc.fit(variance_inflation=0.5)
+
+
+@settings(max_examples=25, deadline=None, derandomize=True)
+@given(cuts=st.lists(st.integers(1, 299), min_size=1, max_size=6, unique=True),
+       weighted=st.booleans())
+def test_merged_factors_equal_sequential_factor(cuts, weighted):
+    # TSQR: merging the R factors of any split equals factoring the rows in one go
+    X, y = _random_problem(13, n=300)
+    w = np.random.default_rng(1).uniform(0.5, 2.0, 300) if weighted else None
+    pieces = np.split(np.arange(300), sorted(cuts))
+    sequential, merged = GramAccumulator(), None
+    for rows in pieces:
+        part_w = None if w is None else w[rows]
+        sequential.partial_fit(X[rows], y[rows], part_w)
+        part = GramAccumulator().partial_fit(X[rows], y[rows], part_w)
+        merged = part if merged is None else merged.merge(part)
+    np.testing.assert_allclose(merged.r_, sequential.r_, rtol=0,
+                               atol=1e-12 * np.abs(sequential.r_).max())
+    one = ols(X, y, weights=w)
+    for acc in (merged, sequential):
+        fit = acc.fit()
+        np.testing.assert_allclose(fit.params, one.params, rtol=1e-12)
+        np.testing.assert_allclose(fit.bse, one.bse, rtol=1e-12)
+    assert merged.n_ == sequential.n_ == 300
+
+
+def test_accumulator_pickles_and_survives_json():
+    import pickle
+
+    X, y = _random_problem(14, n=500)
+    acc = GramAccumulator(["a", "b", "c", "d"]).partial_fit(X, y)
+    for back in (pickle.loads(pickle.dumps(acc)),
+                 GramAccumulator.from_dict(json.loads(json.dumps(acc.to_dict())))):
+        np.testing.assert_array_equal(back.r_, acc.r_)
+        np.testing.assert_array_equal(back.fit().params, acc.fit().params)
+        assert back.names_ == acc.names_ and back.n_ == acc.n_

@@ -36,10 +36,11 @@ from scipy import linalg, stats
 
 from hrgtc.errors import InputError, RankDeficientError
 
-COLLINEARITY_TOL = 1e-10
+COLLINEARITY_TOL = 1e-12
 """Default ``tol``: smallest allowed reciprocal condition number (2-norm) of the
-centred, column-equilibrated triangular factor of the fitted columns. NIST's
-Filip polynomial (about 1.7e-8) passes; exactly collinear columns (about 1e-16) do not."""
+centred, column-equilibrated triangular factor of the fitted columns (the square
+root of the eigenvalue ratio of their correlation matrix). NIST's Filip
+polynomial (2.6e-10) passes; exactly collinear columns (about 1e-16) do not."""
 
 _BLOCK_ROWS = 65_536
 """Rows of a chunk shifted, scaled and factored at a time (a few MB: stays in cache)."""
