@@ -32,7 +32,8 @@ from dataclasses import dataclass, fields
 from typing import Any
 
 import numpy as np
-from scipy import linalg, stats
+from scipy import stats
+from scipy.linalg import lapack
 
 from hrgtc.errors import InputError, RankDeficientError
 
@@ -71,8 +72,22 @@ def _check_names(names: Sequence[str] | None, p: int) -> tuple[str, ...]:
 
 
 def _r_factor(z: np.ndarray) -> np.ndarray:
-    """Upper-triangular R (columns x columns) of the rows of ``z`` (rows >= columns)."""
-    return np.linalg.qr(z, mode="r")[: z.shape[1]]
+    """Upper-triangular R (columns x columns) of the rows of ``z``, by a TSQR tree.
+
+    Blocks of ``_QR_ROWS`` rows are factored in one batched LAPACK call, their
+    R factors stacked and factored again until one block is left; small batched
+    QRs avoid the threading overhead of BLAS on tall, narrow matrices.
+    """
+    n = z.shape[1]
+    q = max(_QR_ROWS, 2 * n)
+    while z.shape[0] > q:
+        blocks = -(-z.shape[0] // q)
+        padded = np.zeros((blocks * q, n))
+        padded[:z.shape[0]] = z
+        z = np.linalg.qr(padded.reshape(blocks, q, n), mode="r").reshape(-1, n)
+    if z.shape[0] < n:
+        z = np.vstack([z, np.zeros((n - z.shape[0], n))])
+    return np.linalg.qr(z, mode="r")[:n]
 
 
 def _canonical(r: np.ndarray) -> np.ndarray:
@@ -165,20 +180,15 @@ class QRAccumulator:
         """R of one block's shifted, scaled and weighted rows [1, X, y]."""
         assert self.shift_ is not None and self.scale_ is not None
         rows, p = X.shape
-        q = max(_QR_ROWS, p + 2)
-        small = -(-rows // q)
-        z = np.zeros((small * q, p + 2))
-        z[:rows, 0] = 1.0
-        z[:rows, 1:-1] = X
-        z[:rows, -1] = y
-        z[:rows, 1:] -= self.shift_
-        z[:rows, 1:] *= 1.0 / self.scale_  # powers of two: exact
+        z = np.empty((rows, p + 2))
+        z[:, 0] = 1.0
+        z[:, 1:-1] = X
+        z[:, -1] = y
+        z[:, 1:] -= self.shift_
+        z[:, 1:] *= 1.0 / self.scale_  # powers of two: exact
         if w is not None:
-            z[:rows] *= np.sqrt(w)[:, None]
-        if small == 1:
-            return _r_factor(z)
-        stacked = np.linalg.qr(z.reshape(small, q, p + 2), mode="r")
-        return _r_factor(stacked.reshape(-1, p + 2))
+            z *= np.sqrt(w)[:, None]
+        return _r_factor(z)
 
     def merge(self, other: QRAccumulator) -> QRAccumulator:
         """A new accumulator holding the rows of both (same columns); inputs unchanged."""
@@ -426,9 +436,11 @@ def _solve(acc: QRAccumulator, idx: list[int], names: tuple[str, ...], tol: floa
                 f"columns {involved} are collinear: condition number of their centred, "
                 f"equilibrated triangular factor {cond:.3g} exceeds {1 / tol:.3g}; drop one "
                 "of them or combine them")
-    tri = rs[:k + 1, :k + 1]
-    a = linalg.solve_triangular(tri, rs[:k + 1, k + 1])
-    tri_inv = linalg.solve_triangular(tri, np.eye(k + 1))
+    tri_inv, info = lapack.dtrtri(rs[:k + 1, :k + 1])  # small: LAPACK directly, no BLAS threads
+    if info != 0:
+        raise RankDeficientError(f"the triangular factor of columns {[names[j] for j in idx]} "
+                                 "is singular; drop collinear columns")
+    a = tri_inv @ rs[:k + 1, k + 1]
     sy = scale[p]
     slopes = sy * a[1:] / scale[idx]
     intercept = shift[p] + sy * a[0] - slopes @ shift[idx]
