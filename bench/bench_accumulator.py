@@ -3,8 +3,12 @@
 The drift fit's use: many rows, about ten candidate columns, fed in chunks of
 one million rows. Both accumulators see the same chunks in the same run
 (:class:`hrgtc.regression.GramAccumulator`, now the TSQR factor, and the former
-co-moment accumulator kept in ``gram_accumulator.py``); ``ratio`` is QR time
-over Gram time. A third line times the whole selection (accumulation plus
+co-moment accumulator kept in ``gram_accumulator.py``). Each chunk is generated
+once and fed to ``REPEATS`` independent pairs of accumulators, the order QR/Gram
+alternating from one feed to the next, so every repetition sees the same data
+in the same process; ``seconds`` is the median over the repetitions of the
+total time per side (``runs_seconds`` lists them) and ``ratio`` is QR over Gram.
+A third line times the whole selection (accumulation plus
 :func:`hrgtc.stepwise.stepwise_from_accumulator`) against the user's
 alternative, a statsmodels OLS refit for every candidate at every step on the
 rows held in memory (run in a subprocess by ``bench_stepwise.py``), at a
@@ -31,6 +35,7 @@ FULL_ROWS = 25_000_000
 QUICK_ROWS = 2_000_000
 NAIVE_FULL_ROWS = 2_000_000
 NAIVE_QUICK_ROWS = 500_000
+REPEATS = 3
 
 
 def _peak_rss_mb() -> float:
@@ -41,24 +46,29 @@ def _peak_rss_mb() -> float:
     return float("nan")
 
 
-def accumulate_both(n: int) -> dict:
-    """Feed the same chunks to both accumulators; alternate which goes first."""
-    qr, gram = GramAccumulator(NAMES), OldGramAccumulator()
-    seconds = {"qr": 0.0, "gram": 0.0}
+def accumulate_both(n: int, repeats: int = REPEATS) -> dict:
+    """Feed the same chunks to ``repeats`` pairs of accumulators, alternating the order."""
+    pairs = [(GramAccumulator(NAMES), OldGramAccumulator()) for _ in range(repeats)]
+    seconds = {"qr": [0.0] * repeats, "gram": [0.0] * repeats}
     generate = 0.0
+    feed = 0
     t0 = time.perf_counter()
-    for index, (X, y) in enumerate(chunks(n)):
+    for X, y in chunks(n):
         generate += time.perf_counter() - t0
-        order = [("qr", qr), ("gram", gram)] if index % 2 == 0 else [("gram", gram), ("qr", qr)]
-        for name, acc in order:
-            t1 = time.perf_counter()
-            acc.partial_fit(X, y)
-            seconds[name] += time.perf_counter() - t1
+        for rep, (qr, gram) in enumerate(pairs):
+            order = [("qr", qr), ("gram", gram)] if feed % 2 == 0 else [("gram", gram),
+                                                                         ("qr", qr)]
+            feed += 1
+            for name, acc in order:
+                t1 = time.perf_counter()
+                acc.partial_fit(X, y)
+                seconds[name][rep] += time.perf_counter() - t1
         t0 = time.perf_counter()
     t1 = time.perf_counter()
-    result = stepwise_from_accumulator(qr, penter=PENTER, premove=PREMOVE)
+    result = stepwise_from_accumulator(pairs[0][0], penter=PENTER, premove=PREMOVE)
     select = time.perf_counter() - t1
-    return {"qr": seconds["qr"], "gram": seconds["gram"], "select": select,
+    return {"qr": float(np.median(seconds["qr"])), "gram": float(np.median(seconds["gram"])),
+            "qr_runs": seconds["qr"], "gram_runs": seconds["gram"], "select": select,
             "generate": generate, "selected": list(result.selected),
             "steps": [f"{s.action} {s.term}" for s in result.history],
             "params": result.result.params.tolist()}
@@ -69,11 +79,14 @@ def run(quick: bool = False) -> list[dict]:
     n = QUICK_ROWS if quick else FULL_ROWS
     both = accumulate_both(n)
     peak = _peak_rss_mb()
-    common = {"n": n, "columns": len(NAMES), "chunk_rows": 1_000_000, "peak_rss_mb": peak}
+    common = {"n": n, "columns": len(NAMES), "chunk_rows": 1_000_000, "peak_rss_mb": peak,
+              "repeats": REPEATS}
     lines = [
         {"name": "accumulate_gram_10col", **common, "seconds": round(both["gram"], 3),
-         "rate": round(n / both["gram"])},
+         "rate": round(n / both["gram"]),
+         "runs_seconds": [round(t, 3) for t in both["gram_runs"]]},
         {"name": "accumulate_qr_10col", **common, "seconds": round(both["qr"], 3),
+         "runs_seconds": [round(t, 3) for t in both["qr_runs"]],
          "rate": round(n / both["qr"]), "ratio": round(both["qr"] / both["gram"], 3),
          "generate_seconds": round(both["generate"], 3)},
     ]

@@ -398,3 +398,26 @@ def test_accumulator_pickles_and_survives_json():
         np.testing.assert_array_equal(back.r_, acc.r_)
         np.testing.assert_array_equal(back.fit().params, acc.fit().params)
         assert back.names_ == acc.names_ and back.n_ == acc.n_
+
+
+@pytest.mark.parametrize("weighted", [False, True])
+def test_blocks_folded_by_dtpqrt_equal_one_householder_qr(weighted):
+    # Many blocks of rows (the last one short) folded into R one after another give
+    # the R of a single Householder QR of all the shifted, scaled rows.
+    from hrgtc.qr_accumulator import _BLOCK_ROWS
+
+    n = 2 * _BLOCK_ROWS + _BLOCK_ROWS // 2 + 17
+    rng = np.random.default_rng(21)
+    X = rng.normal(size=(n, 4)) * [1.0, 10.0, 1e3, 0.1] + [0.0, 5.0, 1e4, -3.0]
+    y = 1.0 + X @ [0.2, 0.02, 1e-4, 1.0] + rng.normal(size=n)
+    w = rng.uniform(0.0, 2.0, n) if weighted else np.ones(n)
+    acc = GramAccumulator().partial_fit(X, y, w if weighted else None)
+    z = np.column_stack([np.ones(n), (np.column_stack([X, y]) - acc.shift_) / acc.scale_])
+    z *= np.sqrt(w)[:, None]
+    reference = np.linalg.qr(z, mode="r")
+    reference *= np.where(np.diag(reference) < 0, -1.0, 1.0)[:, None]
+    np.testing.assert_allclose(acc.r_, reference, rtol=0, atol=1e-12 * np.abs(reference).max())
+    ref = sm.WLS(y, sm.add_constant(X), weights=w).fit()
+    fit = acc.fit()
+    np.testing.assert_allclose(fit.params, ref.params, rtol=1e-9)
+    np.testing.assert_allclose(fit.bse, ref.bse, rtol=1e-9)

@@ -3,8 +3,9 @@
 One pass over the rows reduces the design [1, X, y] to the upper-triangular
 factor R of its QR decomposition, chunk by chunk (tall-skinny QR: Demmel,
 Grigori, Hoemmen & Langou, SIAM J. Sci. Comput. 34(1), A206-A239, 2012,
-doi:10.1137/080731992). The R of a chunk is the R of many small blocks, each
-factored by LAPACK in one batched call, stacked and factored again; two
+doi:10.1137/080731992). Each block of rows is shifted and scaled into a small
+column-major buffer that stays in cache and folded into the running R by
+LAPACK's triangular-pentagonal QR ``dtpqrt`` (the QR of [R; block]); two
 accumulators are merged by a QR of their two stacked factors. Memory is
 O(p^2), independent of the number of rows, and any subset of columns is fitted
 from R alone by one more small QR of R's selected columns (plus y): the
@@ -43,10 +44,13 @@ centred, column-equilibrated triangular factor of the fitted columns (the square
 root of the eigenvalue ratio of their correlation matrix). NIST's Filip
 polynomial (2.6e-10) passes; exactly collinear columns (about 1e-16) do not."""
 
-_BLOCK_ROWS = 65_536
-"""Rows of a chunk shifted, scaled and factored at a time (a few MB: stays in cache)."""
+_BLOCK_ROWS = 8_192
+"""Rows of a chunk shifted, scaled and folded into R at a time (under 1 MB for a dozen
+columns: the buffer stays in cache through the Householder passes)."""
+_PANEL_COLUMNS = 4
+"""Block size ``nb`` of ``dtpqrt``: columns per panel of its compact-WY updates."""
 _QR_ROWS = 256
-"""Rows of each small QR within a block (all factored by one batched LAPACK call)."""
+"""Rows of each small QR within the TSQR tree of :func:`_r_factor` (merges and fits)."""
 
 
 def _readonly(values: Any) -> np.ndarray:
@@ -109,6 +113,13 @@ class QRAccumulator:
     This is the class the library calls ``GramAccumulator`` (its former,
     normal-equations implementation had that name).
 
+    The accumulator keeps no rows, so its fits are those of the factor alone:
+    on an ill-conditioned problem whose residual is large next to its fit their
+    coefficients carry the eps * cond^2 * tan(theta) error of any float64 QR
+    (NIST's Wampler5: LRE 5.6). :func:`hrgtc.regression.ols` and
+    :func:`hrgtc.stepwise.stepwise`, which have the rows, refine them in extended
+    precision (:func:`hrgtc.regression.refine`).
+
     Parameters
     ----------
     names
@@ -164,31 +175,43 @@ class QRAccumulator:
             return self
         if self.r_ is None:
             self.shift_, self.scale_ = _shift_and_scale(X, y, w)
-        factors = [] if self.r_ is None else [self.r_]
-        for start in range(0, X.shape[0], _BLOCK_ROWS):
-            stop = start + _BLOCK_ROWS
-            factors.append(self._block_factor(X[start:stop], y[start:stop],
-                                              None if w is None else w[start:stop]))
-        self.r_ = _canonical(_r_factor(np.vstack(factors)))
+        self.r_ = _canonical(self._fold_rows(X, y, w))
         self.n_ += X.shape[0]
         self.sum_weights_ += float(X.shape[0]) if w is None else float(w.sum())
         return self
 
     update = partial_fit
 
-    def _block_factor(self, X: np.ndarray, y: np.ndarray, w: np.ndarray | None) -> np.ndarray:
-        """R of one block's shifted, scaled and weighted rows [1, X, y]."""
+    def _fold_rows(self, X: np.ndarray, y: np.ndarray, w: np.ndarray | None) -> np.ndarray:
+        """R of the stored factor stacked on the shifted, scaled, weighted rows [1, X, y].
+
+        Block by block: the rows are written transposed into a (p + 2, rows) C-order
+        buffer, i.e. a column-major rows-by-(p + 2) matrix that LAPACK reads in
+        place, and ``dtpqrt`` replaces R by the R of [R; block]. Starting from
+        R = 0 gives the R of the first block.
+        """
         assert self.shift_ is not None and self.scale_ is not None
         rows, p = X.shape
-        z = np.empty((rows, p + 2))
-        z[:, 0] = 1.0
-        z[:, 1:-1] = X
-        z[:, -1] = y
-        z[:, 1:] -= self.shift_
-        z[:, 1:] *= 1.0 / self.scale_  # powers of two: exact
-        if w is not None:
-            z *= np.sqrt(w)[:, None]
-        return _r_factor(z)
+        inverse = 1.0 / self.scale_  # powers of two: exact
+        r = np.zeros((p + 2, p + 2), order="F") if self.r_ is None \
+            else np.array(self.r_, order="F")
+        buffer = np.empty((p + 2, min(rows, _BLOCK_ROWS)))
+        root_w = None if w is None else np.sqrt(w)
+        for start in range(0, rows, _BLOCK_ROWS):
+            stop = min(start + _BLOCK_ROWS, rows)
+            z = buffer if stop - start == buffer.shape[1] else np.empty((p + 2, stop - start))
+            z[0] = 1.0  # dtpqrt overwrites the block with its Householder vectors
+            np.subtract(X[start:stop].T, self.shift_[:p, None], out=z[1:p + 1])
+            z[1:p + 1] *= inverse[:p, None]
+            np.subtract(y[start:stop], self.shift_[p], out=z[p + 1])
+            z[p + 1] *= inverse[p]
+            if root_w is not None:
+                z *= root_w[start:stop]
+            r, _, _, info = lapack.dtpqrt(0, min(_PANEL_COLUMNS, p + 2), r, z.T,
+                                          overwrite_a=1, overwrite_b=1)
+            if info != 0:  # pragma: no cover - LAPACK argument error
+                raise RuntimeError(f"LAPACK dtpqrt failed with info={info}")
+        return np.triu(r)
 
     def merge(self, other: QRAccumulator) -> QRAccumulator:
         """A new accumulator holding the rows of both (same columns); inputs unchanged."""
