@@ -16,7 +16,7 @@ import pytest
 import statsmodels.api as sm
 
 import nist_strd_data as nist
-from hrgtc.errors import RankDeficientError
+from hrgtc.errors import InputError, PrecisionWarning, RankDeficientError
 from hrgtc.regression import EXTENDED_PRECISION, GramAccumulator, ols, refine
 from hrgtc.stepwise import stepwise
 
@@ -148,10 +148,20 @@ def test_stepwise_refines_the_selected_model():
     assert found.history == stepwise(X, y, refine=False).history
 
 
+def test_refine_without_long_double_keeps_the_fit_and_warns(monkeypatch):
+    import hrgtc.regression
+
+    X, y, *_ = PROBLEMS["Wampler5"]
+    monkeypatch.setattr(hrgtc.regression, "EXTENDED_PRECISION", False)
+    with pytest.warns(PrecisionWarning, match="numpy.longdouble is float64"):
+        result = ols(X, y)
+    np.testing.assert_array_equal(result.params, ols(X, y, refine=False).params)
+
+
 def test_refine_rejects_rows_that_are_not_those_of_the_fit():
     X, y, *_ = PROBLEMS["Longley"]
     result = ols(X, y, refine=False)
-    with pytest.raises(Exception, match=r"X has 15 rows with positive weight but the fit used 16"):
+    with pytest.raises(InputError, match=r"X has 15 rows with positive weight but the fit used 16"):
         refine(result, X[1:], y[1:])
 
 
