@@ -41,3 +41,7 @@ class HrgtcWarning(UserWarning):
 
 class ExtrapolationWarning(HrgtcWarning):
     """Input is valid but outside the range a model was calibrated on."""
+
+
+class PrecisionWarning(HrgtcWarning):
+    """A computation ran at lower precision than asked (no extended-precision type here)."""

@@ -346,7 +346,7 @@ def test_variance_inflation_scales_errors_and_f_statistics():
     rng = np.random.default_rng(5)
     X = rng.normal(size=(400, 3))
     y = 1 + 0.6 * X[:, 0] + 0.15 * X[:, 2] + rng.normal(size=400)
-    plain = ols(X, y)
+    plain = ols(X, y, refine=False)  # both from the factor
     acc = GramAccumulator().partial_fit(X, y)
     inflated = acc.fit(variance_inflation=4.0)
     np.testing.assert_allclose(inflated.bse, 2.0 * plain.bse, rtol=1e-13)
@@ -362,3 +362,62 @@ def test_variance_inflation_scales_errors_and_f_statistics():
     assert stepwise(X, y, variance_inflation=25.0).selected == ("x1",)
     with pytest.raises(InputError, match="variance_inflation must be a finite number >= 1"):
         acc.fit(variance_inflation=0.5)
+
+
+@settings(max_examples=25, deadline=None, derandomize=True)
+@given(cuts=st.lists(st.integers(1, 299), min_size=1, max_size=6, unique=True),
+       weighted=st.booleans())
+def test_merged_factors_equal_sequential_factor(cuts, weighted):
+    # TSQR: merging the R factors of any split equals factoring the rows in one go
+    X, y = _random_problem(13, n=300)
+    w = np.random.default_rng(1).uniform(0.5, 2.0, 300) if weighted else None
+    pieces = np.split(np.arange(300), sorted(cuts))
+    sequential, merged = GramAccumulator(), None
+    for rows in pieces:
+        part_w = None if w is None else w[rows]
+        sequential.partial_fit(X[rows], y[rows], part_w)
+        part = GramAccumulator().partial_fit(X[rows], y[rows], part_w)
+        merged = part if merged is None else merged.merge(part)
+    np.testing.assert_allclose(merged.r_, sequential.r_, rtol=0,
+                               atol=1e-12 * np.abs(sequential.r_).max())
+    one = ols(X, y, weights=w)
+    for acc in (merged, sequential):
+        fit = acc.fit()
+        np.testing.assert_allclose(fit.params, one.params, rtol=1e-12)
+        np.testing.assert_allclose(fit.bse, one.bse, rtol=1e-12)
+    assert merged.n_ == sequential.n_ == 300
+
+
+def test_accumulator_pickles_and_survives_json():
+    import pickle
+
+    X, y = _random_problem(14, n=500)
+    acc = GramAccumulator(["a", "b", "c", "d"]).partial_fit(X, y)
+    for back in (pickle.loads(pickle.dumps(acc)),
+                 GramAccumulator.from_dict(json.loads(json.dumps(acc.to_dict())))):
+        np.testing.assert_array_equal(back.r_, acc.r_)
+        np.testing.assert_array_equal(back.fit().params, acc.fit().params)
+        assert back.names_ == acc.names_ and back.n_ == acc.n_
+
+
+@pytest.mark.parametrize("weighted", [False, True])
+def test_blocks_folded_by_dtpqrt_equal_one_householder_qr(weighted):
+    # Many blocks of rows (the last one short) folded into R one after another give
+    # the R of a single Householder QR of all the shifted, scaled rows.
+    from hrgtc.drift.qr_accumulator import _BLOCK_ROWS
+
+    n = 2 * _BLOCK_ROWS + _BLOCK_ROWS // 2 + 17
+    rng = np.random.default_rng(21)
+    X = rng.normal(size=(n, 4)) * [1.0, 10.0, 1e3, 0.1] + [0.0, 5.0, 1e4, -3.0]
+    y = 1.0 + X @ [0.2, 0.02, 1e-4, 1.0] + rng.normal(size=n)
+    w = rng.uniform(0.0, 2.0, n) if weighted else np.ones(n)
+    acc = GramAccumulator().partial_fit(X, y, w if weighted else None)
+    z = np.column_stack([np.ones(n), (np.column_stack([X, y]) - acc.shift_) / acc.scale_])
+    z *= np.sqrt(w)[:, None]
+    reference = np.linalg.qr(z, mode="r")
+    reference *= np.where(np.diag(reference) < 0, -1.0, 1.0)[:, None]
+    np.testing.assert_allclose(acc.r_, reference, rtol=0, atol=1e-12 * np.abs(reference).max())
+    ref = sm.WLS(y, sm.add_constant(X), weights=w).fit()
+    fit = acc.fit()
+    np.testing.assert_allclose(fit.params, ref.params, rtol=1e-9)
+    np.testing.assert_allclose(fit.bse, ref.bse, rtol=1e-9)

@@ -3,8 +3,8 @@
 Takes drift runs (recordings with temperature change) and gives a
 :class:`DriftModel`: ``features`` turns frequency into the candidate terms of
 Eq. 21 (f, df/dt from a causal filter, the term grammar), ``regression`` and
-``stepwise`` select and fit them from one-pass sufficient statistics (MATLAB
-``stepwisefit`` semantics), ``drift_model`` holds the fitted model (Eq. 22).
+``stepwise`` select and fit them from a one-pass, mergeable QR factor
+(``qr_accumulator``; MATLAB ``stepwisefit`` semantics), ``drift_model`` holds the fitted model (Eq. 22).
 
 [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
 """
@@ -20,7 +20,8 @@ from hrgtc.drift.features import (
     parse_term,
     parse_terms,
 )
-from hrgtc.drift.regression import GramAccumulator, OLSResult, ols, ols_from_accumulator
+from hrgtc.drift.qr_accumulator import QRAccumulator
+from hrgtc.drift.regression import GramAccumulator, OLSResult, ols, ols_from_accumulator, refine
 from hrgtc.drift.stepwise import Step, StepwiseResult, stepwise, stepwise_from_accumulator
 
 __all__ = [
@@ -31,6 +32,7 @@ __all__ = [
     "FeatureStream",
     "GramAccumulator",
     "OLSResult",
+    "QRAccumulator",
     "Step",
     "StepwiseResult",
     "Term",
@@ -41,6 +43,7 @@ __all__ = [
     "ols_from_accumulator",
     "parse_term",
     "parse_terms",
+    "refine",
     "stepwise",
     "stepwise_from_accumulator",
     "window_means",

@@ -10,7 +10,9 @@ into non-overlapping windows (10 s by default), and the regression runs on the
 window means. Raw 200 Hz residuals are strongly autocorrelated, so F-tests on
 samples would call every term significant; on 10 s means they are much closer
 to independent. Memory is bounded by one chunk plus the window means
-(1/2000 of the samples at 200 Hz and 10 s).
+(1/2000 of the samples at 200 Hz and 10 s). The window means are in memory,
+so the selected model's coefficients are refined in extended precision
+(:func:`hrgtc.drift.regression.refine`) where ``numpy.longdouble`` is wider than float64.
 
 Variables are scaled internally (f by its largest training magnitude, df/dt
 likewise) so every candidate column is of order one; coefficients are
@@ -41,7 +43,7 @@ from hrgtc.drift.features import (
     tangent_extension,
     variables_for,
 )
-from hrgtc.drift.regression import newey_west_inflation
+from hrgtc.drift.regression import EXTENDED_PRECISION, newey_west_inflation
 from hrgtc.drift.stepwise import StepwiseResult, stepwise
 from hrgtc.errors import CalibrationError, InputError
 from hrgtc.progress import Progress
@@ -521,7 +523,8 @@ def fit(
         )
     result = stepwise(x_scaled, windows.bias_dph, names=names, penter=penter, premove=premove,
                       initial=initial, variance_inflation=inflation,
-                      parents=hierarchy(candidates) if hierarchical else None)
+                      parents=hierarchy(candidates) if hierarchical else None,
+                      refine=EXTENDED_PRECISION)  # quietly unrefined without long double
     ols = result.result
     selected = result.selected
     selected_factor = {t.name: t.scale_factor(scales) for t in candidates}

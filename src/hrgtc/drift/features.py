@@ -42,7 +42,7 @@ import numpy as np
 from scipy import signal
 
 from hrgtc.errors import InputError
-from hrgtc.recording import Recording
+from hrgtc.recording.schema import Recording
 
 #: Variable name -> (unit, description).
 VARIABLES: dict[str, tuple[str, str]] = {

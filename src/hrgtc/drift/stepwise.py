@@ -4,8 +4,13 @@ Stepwise selection follows MATLAB's ``stepwisefit``: the constant is always in;
 each step adds the excluded term with the smallest partial-F p-value if it is
 below ``penter``, otherwise removes the included term with the largest p-value
 if it is above ``premove``; it stops when neither applies. Every candidate fit
-is a small solve on the statistics of :class:`~hrgtc.drift.regression.GramAccumulator`
-(re-exported here with :func:`ols`), so the selection never touches the rows.
+is a small QR of the columns it uses of the triangular factor R of [1, X, y]
+held by :class:`~hrgtc.drift.regression.GramAccumulator` (re-exported here with
+:func:`ols`), so the selection never touches the rows and never forms normal
+equations. On rows held in memory, :func:`stepwise` then refines the
+coefficients of the selected model in extended precision
+(:func:`hrgtc.drift.regression.refine`); :func:`stepwise_from_accumulator` has no rows
+and reports the fit of the factor.
 
 ``variance_inflation`` (default 1, i.e. ``stepwisefit`` exactly) divides every
 F statistic by a factor c >= 1 and multiplies the standard errors by sqrt(c):
@@ -17,6 +22,7 @@ times their variance (see :func:`hrgtc.drift.fit`).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import warnings
 from collections.abc import Iterable, Mapping, Sequence
@@ -25,15 +31,14 @@ from typing import Any
 
 import numpy as np
 
+from hrgtc.drift.qr_accumulator import _check_names, _resolve_terms, _solve
 from hrgtc.drift.regression import (
     COLLINEARITY_TOL,
     GramAccumulator,
     OLSResult,
-    _check_names,
-    _resolve_terms,
-    _solve,
     ols,
     ols_from_accumulator,
+    refine,
 )
 from hrgtc.errors import HrgtcWarning, InputError, RankDeficientError
 
@@ -141,7 +146,8 @@ def stepwise(X: Any, y: Any, names: Sequence[str] | None = None, penter: float =
              max_steps: int | None = None, *, weights: Any = None,
              tol: float = COLLINEARITY_TOL,
              variance_inflation: float = 1.0,
-             parents: Mapping[str, Iterable[str]] | None = None) -> StepwiseResult:
+             parents: Mapping[str, Iterable[str]] | None = None,
+             refine: bool = True) -> StepwiseResult:
     """Stepwise linear regression with MATLAB ``stepwisefit`` semantics, Section 4.1 of [1].
 
     Parameters
@@ -177,6 +183,11 @@ def stepwise(X: Any, y: Any, names: Sequence[str] | None = None, penter: float =
         terms it contains (``"f^2*df"`` -> ``["f*df", "f^2"]``). A term may enter
         only when all its parents are in, and may leave only when none of its
         children is in. None (default) gives ``stepwisefit`` exactly.
+    refine
+        Polish the coefficients of the selected model by extended-precision
+        refinement of the augmented system on the rows
+        (:func:`hrgtc.drift.regression.refine`); the selection itself, the standard
+        errors and the p-values of the steps come from the QR factor either way.
 
     Returns
     -------
@@ -194,9 +205,17 @@ def stepwise(X: Any, y: Any, names: Sequence[str] | None = None, penter: float =
     X = np.asarray(X, dtype=np.float64)
     acc = GramAccumulator(_check_names(names, X.shape[1]) if X.ndim == 2 else names)
     acc.partial_fit(X, y, weights)
-    return stepwise_from_accumulator(acc, penter=penter, premove=premove, initial=initial,
-                                     max_steps=max_steps, tol=tol,
-                                     variance_inflation=variance_inflation, parents=parents)
+    found = stepwise_from_accumulator(acc, penter=penter, premove=premove, initial=initial,
+                                      max_steps=max_steps, tol=tol,
+                                      variance_inflation=variance_inflation, parents=parents)
+    if not refine:
+        return found
+    columns = [found.candidates.index(name) for name in found.selected]
+    polished = _refine(found.result, X[:, columns], y, weights)
+    return dataclasses.replace(found, result=polished)
+
+
+_refine = refine  # ``stepwise`` has a parameter of the same name
 
 
 def stepwise_from_accumulator(acc: GramAccumulator, names: Sequence[str] | None = None,
@@ -211,7 +230,7 @@ def stepwise_from_accumulator(acc: GramAccumulator, names: Sequence[str] | None 
     For data too large to hold: feed the rows chunk by chunk (or per file, per
     worker) into :class:`GramAccumulator` with ``partial_fit``, combine partial
     accumulators with ``merge``, then call this. Every candidate fit is a small
-    p-by-p solve on the stored statistics, so the selection costs nothing
+    QR and triangular solve on the stored factor, so the selection costs nothing
     compared with the one pass over the rows; the result equals :func:`stepwise`
     on the concatenated rows. Rules and parameters as in :func:`stepwise`.
 
