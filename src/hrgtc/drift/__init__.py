@@ -4,7 +4,8 @@ Takes drift runs (recordings with temperature change) and gives a
 :class:`DriftModel`: ``features`` turns frequency into the candidate terms of
 Eq. 21 (f, df/dt from a causal filter, the term grammar), ``regression`` and
 ``stepwise`` select and fit them from a one-pass, mergeable QR factor
-(``qr_accumulator``; MATLAB ``stepwisefit`` semantics), ``drift_model`` holds the fitted model (Eq. 22).
+(``qr_accumulator``; MATLAB ``stepwisefit`` semantics), ``drift_model`` holds the
+fitted model (Eq. 22).
 
 [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
 """
