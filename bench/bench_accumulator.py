@@ -8,11 +8,8 @@ once and fed to ``REPEATS`` independent pairs of accumulators, the order QR/Gram
 alternating from one feed to the next, so every repetition sees the same data
 in the same process; ``seconds`` is the median over the repetitions of the
 total time per side (``runs_seconds`` lists them) and ``ratio`` is QR over Gram.
-A third line times the whole selection (accumulation plus
-:func:`hrgtc.drift.stepwise.stepwise_from_accumulator`) against the user's
-alternative, a statsmodels OLS refit for every candidate at every step on the
-rows held in memory (run in a subprocess by ``bench_stepwise.py``), at a
-smaller size so the benchmark takes well under two minutes.
+The whole selection against the user's alternative (a statsmodels refit for
+every candidate at every step) is ``bench_stepwise.py``.
 
 Timed: accumulation (and selection) only; data generation is reported apart.
 """
@@ -20,10 +17,8 @@ Timed: accumulation (and selection) only; data generation is reported apart.
 from __future__ import annotations
 
 import json
-import subprocess
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
 
@@ -33,8 +28,6 @@ from hrgtc.drift.stepwise import GramAccumulator, stepwise_from_accumulator
 
 FULL_ROWS = 25_000_000
 QUICK_ROWS = 2_000_000
-NAIVE_FULL_ROWS = 2_000_000
-NAIVE_QUICK_ROWS = 500_000
 REPEATS = 3
 
 
@@ -75,7 +68,7 @@ def accumulate_both(n: int, repeats: int = REPEATS) -> dict:
 
 
 def run(quick: bool = False) -> list[dict]:
-    """One line per figure: Gram accumulation, QR accumulation (with ratio), selection."""
+    """One line per figure: Gram accumulation, QR accumulation (with the ratio)."""
     n = QUICK_ROWS if quick else FULL_ROWS
     both = accumulate_both(n)
     peak = _peak_rss_mb()
@@ -90,24 +83,6 @@ def run(quick: bool = False) -> list[dict]:
          "rate": round(n / both["qr"]), "ratio": round(both["qr"] / both["gram"], 3),
          "generate_seconds": round(both["generate"], 3)},
     ]
-    n_naive = NAIVE_QUICK_ROWS if quick else NAIVE_FULL_ROWS
-    small = accumulate_both(n_naive)
-    ours = small["qr"] + small["select"]
-    proc = subprocess.run([sys.executable, str(Path(__file__).resolve().parent
-                                               / "bench_stepwise.py"), "--naive", str(n_naive)],
-                          capture_output=True, text=True, check=True)
-    naive = json.loads(proc.stdout.strip().splitlines()[-1])
-    a, b = np.array(small["params"]), np.array(naive["params"])
-    same = small["selected"] == naive["selected"]
-    lines.append({"name": "stepwise_qr_vs_statsmodels_loop", "n": n_naive,
-                  "columns": len(NAMES), "seconds": round(ours, 3), "rate": round(n_naive / ours),
-                  "peak_rss_mb": _peak_rss_mb(), "select_seconds": round(small["select"], 4),
-                  "statsmodels_seconds": round(naive["seconds"], 3),
-                  "statsmodels_peak_rss_mb": naive["peak_rss_mb"],
-                  "statsmodels_fits": naive["fits"],
-                  "speedup": round(naive["seconds"] / ours, 1), "same_selected": same,
-                  "max_rel_coef_diff": float(np.max(np.abs(a - b) / np.abs(b))) if same
-                  else float("nan"), "steps": small["steps"]})
     return lines
 
 
