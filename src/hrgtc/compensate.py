@@ -5,6 +5,12 @@ between chunks, so a file of any size is compensated in bounded memory and
 any chunking gives the batch result. The batch :func:`compensate` is "reset,
 then one chunk". Eq. (22) of [1] applied as in Section 4.2 (Fig. 6).
 
+Two engines compute the same numbers: ``"fused"`` (default) runs one compiled
+pass per chunk (:mod:`hrgtc._compensate_kernel`, numba, imported on first use);
+``"numpy"`` composes :mod:`hrgtc.features`, :mod:`hrgtc.drift` and
+:mod:`hrgtc.thermometry` array by array and is the reference the tests hold the
+fused one to.
+
 [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
 """
 
@@ -21,7 +27,7 @@ import numpy as np
 
 from hrgtc import recording as rec_io
 from hrgtc.drift import DriftModel
-from hrgtc.errors import InputError
+from hrgtc.errors import CalibrationError, InputError
 from hrgtc.features import FeatureStream
 from hrgtc.model import UnitModel
 from hrgtc.recording import Recording
@@ -32,6 +38,8 @@ Progress = Callable[[float, float], None]
 BLOCK_ROWS = 1 << 17
 #: Columns added by compensation.
 OUTPUT_COLUMNS = ("rate_comp_dph", "bias_model_dph", "resonator_c_est", "in_range")
+#: Ways of computing them (see the module docstring).
+ENGINES = ("fused", "numpy")
 
 
 def _in_training_range(
@@ -56,6 +64,9 @@ class Compensator:
     drift
         Which drift model to apply: ``"frequency"`` (the paper's, default) or
         ``"housing"`` (the classical thermistor baseline kept in the model file).
+    engine
+        ``"fused"`` (one compiled pass per chunk, default) or ``"numpy"`` (the
+        array-by-array reference); both give the same numbers to rounding.
 
     Examples
     --------
@@ -63,7 +74,9 @@ class Compensator:
     >>> # for chunk in iter_chunks("run.parquet"): out = comp.process(chunk)
     """
 
-    def __init__(self, model: UnitModel, drift: str = "frequency") -> None:
+    def __init__(self, model: UnitModel, drift: str = "frequency", engine: str = "fused") -> None:
+        if engine not in ENGINES:
+            raise InputError(f"engine must be 'fused' or 'numpy', got {engine!r}")
         if drift == "frequency":
             self.drift = model.drift
         elif drift == "housing":
@@ -76,12 +89,15 @@ class Compensator:
         else:
             raise InputError(f"drift must be 'frequency' or 'housing', got {drift!r}")
         self.model = model
+        self.engine = engine
+        self._plan: Any = None
         self._variables = tuple(dict.fromkeys(("f", "df", *self.drift.variables)))
         self.reset()
 
     def reset(self) -> None:
         """Start a new run: the df/dt filter restarts at rest on the next sample."""
         self._stream = FeatureStream(self.drift.settings, self._variables)
+        self._state = np.zeros(6)  # the fused engine's filter state (_compensate_kernel)
         self.samples = 0
         self.out_of_range = 0
         self.rate_out_of_range = 0
@@ -100,9 +116,33 @@ class Compensator:
             self.drift.settings.check_sample_rate(chunk)
         n = len(chunk)
         out = {name: np.empty(n) for name in OUTPUT_COLUMNS}
+        if self.engine == "fused":
+            self._fused(chunk, out)
+            return chunk.with_columns(**out)
         for start in range(0, n, BLOCK_ROWS):
             self._block(chunk.slice(start, start + BLOCK_ROWS), out, start)
         return chunk.with_columns(**out)
+
+    def _fused(self, chunk: Recording, out: dict[str, np.ndarray]) -> None:
+        from hrgtc import _compensate_kernel as kernel
+
+        thermometer = self.model.thermometer
+        if self._plan is None:
+            violation = thermometer._monotonic_violation()
+            if violation is not None:
+                raise CalibrationError(violation)
+            self._plan = kernel.plan(self.drift, thermometer, self._variables)
+        counts = np.zeros(3, dtype=np.int64)
+        freq = chunk.freq_hz
+        housing = chunk["housing_c"] if self._plan.uses_housing else None
+        kernel.run(self._plan, self._state, freq, chunk.rate_dph, housing, out, counts)
+        if counts[kernel.NOT_CONVERGED]:  # rare: the bracketed slow path, as temperature() does
+            low, high = thermometer._inverse.f_bracket
+            lost = np.isnan(out["resonator_c_est"]) & (freq >= low) & (freq <= high)
+            out["resonator_c_est"][lost] = thermometer.temperature(freq[lost], warn=False)
+        self.samples += len(chunk)
+        self.out_of_range += int(counts[kernel.OUT_OF_RANGE])
+        self.rate_out_of_range += int(counts[kernel.RATE_OUT_OF_RANGE])
 
     def _block(self, chunk: Recording, out: dict[str, np.ndarray], start: int) -> None:
         stop = start + len(chunk)
@@ -132,9 +172,10 @@ class Compensator:
         return self.rate_out_of_range / self.samples if self.samples else 0.0
 
 
-def compensate(recording: Recording, model: UnitModel, drift: str = "frequency") -> Recording:
+def compensate(recording: Recording, model: UnitModel, drift: str = "frequency",
+               engine: str = "fused") -> Recording:
     """Batch compensation of a whole run: a new :class:`Compensator`, one chunk."""
-    return Compensator(model, drift).process(recording)
+    return Compensator(model, drift, engine).process(recording)
 
 
 @dataclass(frozen=True)
