@@ -167,46 +167,80 @@ def new_state() -> np.ndarray:
 
 
 # -- the kernel -------------------------------------------------------------------------
+#: Samples worked on together: the kernel's scratch rows (about 20 x TILE doubles) stay in
+#: the L1/L2 cache, and every inner loop runs over samples, so it vectorises.
+TILE = 256
+
+
 @njit(cache=True, nogil=True)
-def _term(exponents, k, x):  # pragma: no cover - compiled
-    """Product of powers x_v ** p_v of row k, as features.Term.evaluate multiplies."""
-    out = 1.0
+def _term(exponents, k, x, m, out, factor):  # pragma: no cover - compiled
+    """out[:m] = row k's product of powers of the rows of x, as features.Term.evaluate.
+
+    Each factor x_v ** p is x_v * x_v * ... (left to right), and the factors are
+    multiplied in variable order, so the rounding is that of the numpy path.
+    """
     first = True
     for v in range(4):
         p = exponents[k, v]
-        if p > 0:
-            factor = x[v]
-            for _ in range(p - 1):
-                factor = factor * x[v]
-            if first:
-                out = factor
-                first = False
-            else:
-                out = out * factor
-    return out
+        if p == 0:
+            continue
+        xv = x[v]
+        target = out if first else factor
+        for i in range(m):
+            target[i] = xv[i]
+        for _ in range(p - 1):
+            for i in range(m):
+                target[i] = target[i] * xv[i]
+        if not first:
+            for i in range(m):
+                out[i] = out[i] * factor[i]
+        first = False
 
 
 @njit(cache=True, nogil=True)
-def _horner(c, z):  # pragma: no cover - compiled
-    result = c[c.size - 1]
-    for i in range(c.size - 2, -1, -1):
-        result = result * z
-        result = result + c[i]
-    return result
+def _horner(c, z, m, out):  # pragma: no cover - compiled
+    """out[:m] = sum_j c_j z^j by Horner's rule, as thermometry._horner."""
+    last = c[c.size - 1]
+    for i in range(m):
+        out[i] = last
+    for j in range(c.size - 2, -1, -1):
+        cj = c[j]
+        for i in range(m):
+            out[i] = out[i] * z[i] + cj
 
 
 @njit(cache=True, nogil=True)
-def _filter(x, alpha, beta, state, i1, i2, started):  # pragma: no cover - compiled
-    """One sample of the two low-pass stages; returns y1 - y2."""
-    if state[started] == 0.0:
-        state[i1] = x
-        state[i2] = x
-        state[started] = 1.0
-    y1 = beta * state[i1] + alpha * x
-    y2 = beta * state[i2] + alpha * y1
-    state[i1] = y1
-    state[i2] = y2
-    return y1 - y2
+def _clenshaw(c, u, m, b1, b2):  # pragma: no cover - compiled
+    """b1, b2 of Clenshaw's recurrence for sum_j c_j T_j(u), as thermometry._clenshaw."""
+    for i in range(m):
+        b1[i] = 0.0
+        b2[i] = 0.0
+    for j in range(c.size - 1, 0, -1):
+        cj = c[j]
+        for i in range(m):
+            previous = b1[i]
+            b1[i] = 2.0 * u[i] * b1[i] - b2[i] + cj
+            b2[i] = previous
+
+
+@njit(cache=True, nogil=True)
+def _newton_scalar(t, clipped, poly, slope, centre, scale_c, tolerance):  # pragma: no cover
+    """Up to three more Newton steps of one sample whose first step was above the limit."""
+    step = np.inf
+    limit = tolerance
+    for _ in range(3):
+        z = (t - centre) / scale_c
+        value = poly[poly.size - 1]
+        for j in range(poly.size - 2, -1, -1):
+            value = value * z + poly[j]
+        derivative = slope[slope.size - 1]
+        for j in range(slope.size - 2, -1, -1):
+            derivative = derivative * z + slope[j]
+        step = (value - clipped) / (derivative / scale_c)
+        t -= step
+        if not abs(step) > limit:
+            break
+    return t, step, limit
 
 
 @njit(cache=True, nogil=True)
@@ -223,95 +257,159 @@ def compensate_block(freq_hz, rate_dph, housing_c, filt, uses_housing, state,
     t_low, t_high, f_low, f_high = therm[4], therm[5], therm[6], therm[7]
     f_cal_low, f_cal_high, one_step_limit, tolerance = therm[8], therm[9], therm[10], therm[11]
     n_terms = coefficients.size
-    n_cheb = chebyshev.size
-    value = np.zeros(4)
-    held = np.zeros(4)
-    scaled = np.zeros(4)
-    delta = np.zeros(4)
-    for i in range(freq_hz.size):
-        # variables f, df (h, dh): features.FeatureStream
-        value[0] = freq_hz[i] - ref_f
-        value[1] = _filter(value[0], alpha, beta, state, 0, 1, 4) * gain
+    value = np.zeros((4, TILE))
+    scaled = np.zeros((4, TILE))
+    delta = np.zeros((4, TILE))
+    term = np.empty(TILE)
+    factor = np.empty(TILE)
+    bias = np.empty(TILE)
+    gradient = np.empty(TILE)
+    t = np.empty(TILE)
+    clipped = np.empty(TILE)
+    b1 = np.empty(TILE)
+    b2 = np.empty(TILE)
+    z = np.empty(TILE)
+    fz = np.empty(TILE)
+    sz = np.empty(TILE)
+    step = np.empty(TILE)
+    ok = np.empty(TILE)
+    limit = np.empty(TILE)
+    rate_ok = np.empty(TILE)
+    y1f, y2f, y1h, y2h = state[0], state[1], state[2], state[3]
+    n = freq_hz.size
+    for start in range(0, n, TILE):
+        m = min(TILE, n - start)
+        freq = freq_hz[start:start + m]
+        # variables f, df (h, dh): features.FeatureStream; the filter is the only serial loop
+        f, df = value[0], value[1]
+        for i in range(m):
+            f[i] = freq[i] - ref_f
+        if state[4] == 0.0:
+            y1f = y2f = f[0]
+            state[4] = 1.0
+        for i in range(m):
+            y1f = beta * y1f + alpha * f[i]
+            y2f = beta * y2f + alpha * y1f
+            df[i] = (y1f - y2f) * gain
         if uses_housing:
-            value[2] = housing_c[i] - ref_h
-            value[3] = _filter(value[2], alpha, beta, state, 2, 3, 5) * gain
-        # drift model: features.tangent_extension
+            housing = housing_c[start:start + m]
+            h, dh = value[2], value[3]
+            for i in range(m):
+                h[i] = housing[i] - ref_h
+            if state[5] == 0.0:
+                y1h = y2h = h[0]
+                state[5] = 1.0
+            for i in range(m):
+                y1h = beta * y1h + alpha * h[i]
+                y2h = beta * y2h + alpha * y1h
+                dh[i] = (y1h - y2h) * gain
+        # drift model: features.tangent_extension (linear_combination at the held point)
         outside = False
         for v in range(4):
-            x = value[v]
+            x, sv, dv = value[v], scaled[v], delta[v]
+            lo, hi, scale = low[v], high[v], scales[v]
             if tangent[v]:
-                if x < low[v]:
-                    x = low[v]
-                elif x > high[v]:
-                    x = high[v]
-            held[v] = x
-            delta[v] = value[v] - x
-            outside = outside or (tangent[v] and delta[v] != 0.0)
-            scaled[v] = x / scales[v]
-        bias = intercept
+                count = 0
+                for i in range(m):
+                    held = x[i]
+                    held = lo if held < lo else held
+                    held = hi if held > hi else held
+                    dv[i] = x[i] - held
+                    sv[i] = held / scale
+                    count += dv[i] != 0.0
+                outside = outside or count > 0
+            else:
+                for i in range(m):
+                    sv[i] = x[i] / scale
+        for i in range(m):
+            bias[i] = intercept
         for k in range(n_terms):
-            bias += coefficients[k] * _term(exponents, k, scaled)
+            _term(exponents, k, scaled, m, term, factor)
+            c = coefficients[k]
+            for i in range(m):
+                bias[i] += c * term[i]
         if outside:
             for v in range(4):
-                if tangent[v] and delta[v] != 0.0:
-                    gradient = 0.0
-                    for k in range(n_terms):
-                        if d_factor[v, k] != 0.0:
-                            if d_constant[v, k]:
-                                gradient += d_factor[v, k]
-                            else:
-                                gradient += d_factor[v, k] * _term(d_exponents[v], k, scaled)
-                    bias += gradient * delta[v]
-        out_bias[i] = bias
-        out_rate[i] = rate_dph[i] - bias
-        # thermometer inverse: Thermometer.temperature
-        f = freq_hz[i]
-        clipped = f
-        if clipped < f_low:
-            clipped = f_low
-        elif clipped > f_high:
-            clipped = f_high
-        u = map_offset + map_scale * clipped
-        two_u = 2.0 * u
-        b1 = 0.0
-        b2 = 0.0
-        for j in range(n_cheb - 1, 0, -1):
-            b1, b2 = two_u * b1 - b2 + chebyshev[j], b1
-        t = u * b1 - b2 + chebyshev[0]
-        if t < t_low:
-            t = t_low
-        elif t > t_high:
-            t = t_high
-        limit = one_step_limit
-        step = np.inf
-        for _ in range(4):
-            z = (t - centre) / scale_c
-            step = (_horner(poly, z) - clipped) / (_horner(slope, z) / scale_c)
-            t -= step
-            if not abs(step) > limit:
-                break
-            limit = tolerance
-        if not (f >= f_low and f <= f_high):
-            t = np.nan
-        elif not (abs(step) <= limit and t >= t_low and t <= t_high):
-            t = np.nan
-            counts[2] += 1
-        out_temp[i] = t
-        # flags: Compensator._block
-        ok = f >= f_cal_low and f <= f_cal_high
-        rate_ok = True
+                if not tangent[v]:
+                    continue
+                for i in range(m):
+                    gradient[i] = 0.0
+                for k in range(n_terms):
+                    fk = d_factor[v, k]
+                    if fk == 0.0:
+                        continue
+                    if d_constant[v, k]:
+                        for i in range(m):
+                            gradient[i] += fk
+                    else:
+                        _term(d_exponents[v], k, scaled, m, term, factor)
+                        for i in range(m):
+                            gradient[i] += fk * term[i]
+                dv = delta[v]
+                for i in range(m):
+                    bias[i] += gradient[i] * dv[i]
+        rate = rate_dph[start:start + m]
+        for i in range(m):
+            out_bias[start + i] = bias[i]
+            out_rate[start + i] = rate[i] - bias[i]
+        # thermometer inverse: Thermometer.temperature (Chebyshev start, Newton)
+        for i in range(m):
+            c = freq[i]
+            c = f_low if c < f_low else c
+            c = f_high if c > f_high else c
+            clipped[i] = c
+            t[i] = map_offset + map_scale * c  # u, the Chebyshev variable
+        _clenshaw(chebyshev, t, m, b1, b2)
+        c0 = chebyshev[0]
+        for i in range(m):
+            u = t[i] * b1[i] - b2[i] + c0
+            u = t_low if u < t_low else u
+            u = t_high if u > t_high else u
+            t[i] = u
+            z[i] = (u - centre) / scale_c
+        _horner(poly, z, m, fz)
+        _horner(slope, z, m, sz)
+        for i in range(m):
+            step[i] = (fz[i] - clipped[i]) / (sz[i] / scale_c)
+            t[i] -= step[i]
+        n_more = 0
+        for i in range(m):
+            limit[i] = one_step_limit
+            n_more += abs(step[i]) > one_step_limit
+        if n_more:  # rare: a poor start, Newton goes on for those samples (one by one)
+            for i in range(m):
+                if abs(step[i]) > one_step_limit:
+                    t[i], step[i], limit[i] = _newton_scalar(
+                        t[i], clipped[i], poly, slope, centre, scale_c, tolerance)
+        n_lost = 0
+        for i in range(m):
+            fi = freq[i]
+            ti = t[i]
+            inside = (fi >= f_low) & (fi <= f_high)
+            converged = (abs(step[i]) <= limit[i]) & (ti >= t_low) & (ti <= t_high)
+            out_temp[start + i] = ti if inside & converged else np.nan
+            n_lost += inside & (not converged)
+        counts[2] += n_lost
+        # flags: Compensator._block (1.0 inside, 0.0 outside; NaN is outside)
+        for i in range(m):
+            fi = freq[i]
+            ok[i] = 1.0 if (fi >= f_cal_low) & (fi <= f_cal_high) else 0.0
+            rate_ok[i] = 1.0
         for v in range(4):
             if flagged[v]:
-                inside = value[v] >= low[v] and value[v] <= high[v]
-                if v == 0 or v == 2:
-                    ok = ok and inside
-                else:
-                    rate_ok = rate_ok and inside
-        out_in_range[i] = 1.0 if ok else 0.0
-        if not ok:
-            counts[0] += 1
-        if not rate_ok:
-            counts[1] += 1
+                flag = ok if v == 0 or v == 2 else rate_ok
+                x, lo, hi = value[v], low[v], high[v]
+                for i in range(m):
+                    flag[i] = flag[i] if (x[i] >= lo) & (x[i] <= hi) else 0.0
+        n_ok = 0.0
+        n_rate_ok = 0.0
+        for i in range(m):
+            out_in_range[start + i] = ok[i]
+            n_ok += ok[i]
+            n_rate_ok += rate_ok[i]
+        counts[0] += m - int(n_ok)
+        counts[1] += m - int(n_rate_ok)
+    state[0], state[1], state[2], state[3] = y1f, y2f, y1h, y2h
 
 
 def run(block_plan: KernelPlan, state: np.ndarray, freq_hz: np.ndarray, rate_dph: np.ndarray,
