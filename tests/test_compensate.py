@@ -13,9 +13,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy import signal
 
-from hrgtc import drift
-from hrgtc.compensate import Compensator, compensate
-from hrgtc.errors import InputError
+from hrgtc import drift, recording_io
+from hrgtc.compensate import OUTPUT_COLUMNS, Compensator, compensate, compensate_file
+from hrgtc.errors import InputError, RecordingError
 from hrgtc.model import UnitModel
 from hrgtc.recording import concatenate
 
@@ -170,3 +170,35 @@ def test_import_loads_neither_numba_nor_scipy_signal():
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                             check=True)
     assert result.stdout.strip() == "[]"
+
+
+# -- file to file ------------------------------------------------------------------------
+def test_file_to_file_equals_batch_and_leaves_no_temporary(unit_model, run, tmp_path):
+    source = recording_io.write(run, tmp_path / "run.parquet")
+    output = tmp_path / "out.parquet"
+    summary = compensate_file(source, output, unit_model, chunk_rows=7_001)
+    batch = compensate(run, unit_model)
+    written = recording_io.read(output)
+    assert written.names == (*run.names, *OUTPUT_COLUMNS)
+    for name in written.names:
+        np.testing.assert_array_equal(written[name], batch[name])
+    compensator = Compensator(unit_model)
+    compensator.process(run)
+    assert (summary.rows, summary.out_of_range_fraction, summary.rate_out_of_range_fraction) == (
+        len(run), compensator.out_of_range_fraction, compensator.rate_out_of_range_fraction)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.parquet", "run.parquet"]
+
+
+def test_file_to_file_bad_row_late_in_the_file_leaves_nothing(unit_model, tmp_path):
+    # past the validator's first 100 000 rows: rejected by the read-ahead thread while
+    # earlier chunks are already compensated and written
+    long_run = ramp_run(seed=26, hours=5.0)
+    rate = long_run.rate_dph.copy()
+    rate[150_000] = np.nan
+    source = recording_io.write(long_run.with_columns(rate_dph=rate), tmp_path / "bad.parquet")
+    written = []
+    with pytest.raises(RecordingError, match="rate_dph"):
+        compensate_file(source, tmp_path / "out.parquet", unit_model, chunk_rows=20_000,
+                        progress=lambda done, total: written.append(done))
+    assert written and max(written) >= 120_000
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.parquet"]

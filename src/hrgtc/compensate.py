@@ -16,7 +16,6 @@ fused one to.
 
 from __future__ import annotations
 
-import itertools
 import os
 from collections.abc import Callable, Mapping
 from concurrent.futures import ThreadPoolExecutor
@@ -36,6 +35,9 @@ Progress = Callable[[float, float], None]
 
 #: Rows worked on at once: small enough for the temporaries to stay in cache.
 BLOCK_ROWS = 1 << 17
+#: Rows per chunk of :func:`compensate_file`: one Parquet row group, so chunks are read
+#: without joining batches and written without waiting for the next chunk.
+FILE_CHUNK_ROWS = 1 << 20
 #: Columns added by compensation.
 OUTPUT_COLUMNS = ("rate_comp_dph", "bias_model_dph", "resonator_c_est", "in_range")
 #: Ways of computing them (see the module docstring).
@@ -207,7 +209,7 @@ def compensate_file(
     columns: Mapping[str, str] | None = None,
     units: Mapping[str, str] | None = None,
     metadata: Mapping[str, Any] | None = None,
-    chunk_rows: int = 1_000_000,
+    chunk_rows: int = FILE_CHUNK_ROWS,
     drift: str = "frequency",
     progress: Progress | None = None,
 ) -> CompensationSummary:
@@ -216,28 +218,46 @@ def compensate_file(
     The output is written atomically in the format of its suffix; it is never
     overwritten without ``force``. ``columns``, ``units`` and ``metadata`` are the
     reading options of :func:`hrgtc.recording.read`.
+
+    Three stages overlap, each one chunk ahead of the next (pyarrow, h5py and the
+    fused kernel release the GIL): a thread reads and validates the next chunk,
+    this thread compensates the current one, and a writer thread writes the previous
+    one and starts its write-back to disk, so that the fsync before the atomic
+    rename finds little left to wait for. At most three chunks are held at a time.
     """
     compensator = Compensator(model, drift)
     chunks = rec_io.iter_chunks(source, rows=chunk_rows, columns=columns, units=units,
                                 metadata=metadata)
-    first = next(chunks)
-    names = (*first.names, *OUTPUT_COLUMNS)
-    total = rec_io.count_rows(source)
-    # Writing overlaps with reading and computing the next chunk (pyarrow and h5py
-    # release the GIL); at most one chunk waits to be written.
-    with rec_io.RecordingWriter(output, first.metadata, names, force=force) as writer, \
-            ThreadPoolExecutor(max_workers=1) as pool:
-        pending = None
-        for chunk in itertools.chain([first], chunks):
-            result = compensator.process(chunk)
+    try:
+        first = next(chunks)
+        names = (*first.names, *OUTPUT_COLUMNS)
+        total = rec_io.count_rows(source)
+        with rec_io.RecordingWriter(output, first.metadata, names, force=force) as writer, \
+                ThreadPoolExecutor(max_workers=1) as reading, \
+                ThreadPoolExecutor(max_workers=1) as writing:
+            ahead = reading.submit(next, chunks, None)
+            pending = None
+            chunk: Recording | None = first
+            while chunk is not None:
+                result = compensator.process(chunk)
+                if pending is not None:
+                    pending.result()
+                pending = writing.submit(_write, writer, result)
+                if progress is not None:
+                    progress(compensator.samples, total)
+                chunk = ahead.result()
+                if chunk is not None:
+                    ahead = reading.submit(next, chunks, None)
             if pending is not None:
                 pending.result()
-            pending = pool.submit(writer.write, result)
-            if progress is not None:
-                progress(compensator.samples, total)
-        if pending is not None:
-            pending.result()
+    finally:
+        chunks.close()
     return CompensationSummary(str(source), str(output), compensator.samples,
                                compensator.out_of_range_fraction,
                                compensator.rate_out_of_range_fraction)
+
+
+def _write(writer: rec_io.RecordingWriter, chunk: Recording) -> None:
+    writer.write(chunk)
+    writer.start_writeback()
 
