@@ -202,3 +202,26 @@ def test_file_to_file_bad_row_late_in_the_file_leaves_nothing(unit_model, tmp_pa
                         progress=lambda done, total: written.append(done))
     assert written and max(written) >= 120_000
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.parquet"]
+
+
+def test_two_threads_give_the_bits_of_one_call(unit_model, monkeypatch):
+    # a chunk long enough to be split in halves (filter advanced over the first half)
+    from hrgtc import _compensate_kernel as kernel
+
+    long_run = housing_run(seed=27, start_c=25.0, end_c=-25.0, hours=5.0)
+    assert len(long_run) >= 2 * kernel.PARALLEL_ROWS
+    fitted = dataclasses.replace(unit_model.drift, selected=("f", "df", "h", "dh", "f*dh"),
+                                 scaled_coefficients=(0.4, 2.0, -0.3, 1.5, 0.2),
+                                 settings=dataclasses.replace(
+                                     unit_model.drift.settings,
+                                     scales={"f": 10.0, "df": 1e-3, "h": 20.0, "dh": 1e-2}))
+    model = UnitModel(THERMOMETER, fitted)
+    split = assert_engines_agree(model, long_run)
+    a = Compensator(model).process(long_run)
+    monkeypatch.setattr(kernel, "PARALLEL_ROWS", len(long_run) + 1)
+    whole = Compensator(model)
+    b = whole.process(long_run)
+    for name in OUTPUT_COLUMNS:
+        np.testing.assert_array_equal(a[name], b[name])
+    assert (split.out_of_range, split.rate_out_of_range) == (whole.out_of_range,
+                                                             whole.rate_out_of_range)

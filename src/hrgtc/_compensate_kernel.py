@@ -18,9 +18,16 @@ and order as the numpy reference path (so results agree to rounding):
 
 The term grammar is not hard-coded: terms come in as an exponent matrix over
 the variables ``(f, df, h, dh)`` and their derivatives as precomputed
-(factor, exponents) tables, built by :func:`plan` from a fitted model. Compiled
-with ``cache=True`` (first call compiles, later processes load the cache) and
-``nogil=True`` (a writer thread runs beside it); no fastmath, so no
+(factor, exponents) tables, built by :func:`plan` from a fitted model.
+
+Speed: the block is worked through in tiles of :data:`TILE` samples whose
+scratch rows stay in cache, every inner loop runs over samples (the filter is
+the only serial one) and the thermometer's series have fixed, zero-padded
+lengths, so LLVM vectorises the loops; :func:`run` compensates the two halves of
+a long chunk on two threads. Compiled with ``cache=True`` (the first call
+compiles, later processes load the cache), ``nogil=True`` and
+``error_model="numpy"`` (IEEE division, as numpy, instead of Python's
+ZeroDivisionError check, which also blocks vectorisation); no fastmath, so no
 reassociation or fused multiply-add changes the numbers.
 
 [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
@@ -28,6 +35,8 @@ reassociation or fused multiply-add changes the numbers.
 
 from __future__ import annotations
 
+import os
+import threading
 from dataclasses import dataclass
 
 import numpy as np
@@ -42,6 +51,11 @@ ORDER = tuple(VARIABLES)
 #: Slots of ``counts``: samples outside the f/h ranges, outside the df/dh ranges,
 #: and samples whose Newton iteration did not converge (left NaN).
 OUT_OF_RANGE, RATE_OUT_OF_RANGE, NOT_CONVERGED = 0, 1, 2
+#: Lengths of the thermometer's series in the kernel (zero-padded at the high-order end,
+#: which leaves Horner's and Clenshaw's arithmetic unchanged): f(z) up to order 5 and
+#: the Chebyshev start of :mod:`hrgtc.thermometry` (degree 9).
+POLY_SIZE = 6
+CHEBYSHEV_SIZE = 10
 
 
 @dataclass(frozen=True)
@@ -155,10 +169,24 @@ def plan(drift: DriftModel, thermometer: Thermometer, variables: tuple[str, ...]
         thermometer=np.array([thermometer.centre_c, thermometer.scale_c, *inverse.start_map,
                               *inverse.t_bracket, *inverse.f_bracket, *inverse.f_calibrated,
                               inverse.one_step_limit, inverse.tolerance], dtype=np.float64),
-        poly=a,
-        slope=a[1:] * np.arange(1, a.size),  # as Thermometer.slope_hz_per_c
-        chebyshev=np.asarray(inverse.start_coefficients, dtype=np.float64),
+        poly=_padded(a, POLY_SIZE),
+        slope=_padded(a[1:] * np.arange(1, a.size), POLY_SIZE - 1),  # as slope_hz_per_c
+        chebyshev=_padded(np.asarray(inverse.start_coefficients, dtype=np.float64),
+                          CHEBYSHEV_SIZE),
     )
+
+
+def supports(thermometer: Thermometer) -> bool:
+    """Whether the kernel's fixed-length series hold this thermometer's (order <= 5)."""
+    return (len(thermometer.scaled_coefficients) <= POLY_SIZE
+            and len(thermometer._inverse.start_coefficients) <= CHEBYSHEV_SIZE)
+
+
+def _padded(coefficients: np.ndarray, size: int) -> np.ndarray:
+    """Ascending coefficients with zeros appended up to ``size``."""
+    out = np.zeros(size)
+    out[: coefficients.size] = coefficients
+    return out
 
 
 def new_state() -> np.ndarray:
@@ -172,7 +200,7 @@ def new_state() -> np.ndarray:
 TILE = 256
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, error_model="numpy")
 def _term(exponents, k, x, m, out, factor):  # pragma: no cover - compiled
     """out[:m] = row k's product of powers of the rows of x, as features.Term.evaluate.
 
@@ -197,33 +225,34 @@ def _term(exponents, k, x, m, out, factor):  # pragma: no cover - compiled
         first = False
 
 
-@njit(cache=True, nogil=True)
-def _horner(c, z, m, out):  # pragma: no cover - compiled
-    """out[:m] = sum_j c_j z^j by Horner's rule, as thermometry._horner."""
-    last = c[c.size - 1]
-    for i in range(m):
-        out[i] = last
-    for j in range(c.size - 2, -1, -1):
-        cj = c[j]
-        for i in range(m):
-            out[i] = out[i] * z[i] + cj
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _start_and_step(f, f_low, f_high, map_offset, map_scale, chebyshev, t_low, t_high, centre,
+                    scale_c, poly, slope):  # pragma: no cover - compiled
+    """Chebyshev start and one Newton step of one sample: (t after the step, the step)."""
+    c = f
+    c = f_low if c < f_low else c
+    c = f_high if c > f_high else c
+    u = map_offset + map_scale * c
+    two_u = 2.0 * u
+    b1 = 0.0
+    b2 = 0.0
+    for j in range(CHEBYSHEV_SIZE - 1, 0, -1):
+        b1, b2 = two_u * b1 - b2 + chebyshev[j], b1
+    t = u * b1 - b2 + chebyshev[0]
+    t = t_low if t < t_low else t
+    t = t_high if t > t_high else t
+    z = (t - centre) / scale_c
+    value = poly[POLY_SIZE - 1]
+    for j in range(POLY_SIZE - 2, -1, -1):
+        value = value * z + poly[j]
+    derivative = slope[POLY_SIZE - 2]
+    for j in range(POLY_SIZE - 3, -1, -1):
+        derivative = derivative * z + slope[j]
+    step = (value - c) / (derivative / scale_c)
+    return t - step, step
 
 
-@njit(cache=True, nogil=True)
-def _clenshaw(c, u, m, b1, b2):  # pragma: no cover - compiled
-    """b1, b2 of Clenshaw's recurrence for sum_j c_j T_j(u), as thermometry._clenshaw."""
-    for i in range(m):
-        b1[i] = 0.0
-        b2[i] = 0.0
-    for j in range(c.size - 1, 0, -1):
-        cj = c[j]
-        for i in range(m):
-            previous = b1[i]
-            b1[i] = 2.0 * u[i] * b1[i] - b2[i] + cj
-            b2[i] = previous
-
-
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, error_model="numpy")
 def _newton_scalar(t, clipped, poly, slope, centre, scale_c, tolerance):  # pragma: no cover
     """Up to three more Newton steps of one sample whose first step was above the limit."""
     step = np.inf
@@ -243,7 +272,7 @@ def _newton_scalar(t, clipped, poly, slope, centre, scale_c, tolerance):  # prag
     return t, step, limit
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, error_model="numpy")
 def compensate_block(freq_hz, rate_dph, housing_c, filt, uses_housing, state,
                      exponents, coefficients, intercept, scales, tangent, low, high, flagged,
                      d_factor, d_exponents, d_constant, therm, poly, slope, chebyshev,
@@ -264,16 +293,7 @@ def compensate_block(freq_hz, rate_dph, housing_c, filt, uses_housing, state,
     factor = np.empty(TILE)
     bias = np.empty(TILE)
     gradient = np.empty(TILE)
-    t = np.empty(TILE)
-    clipped = np.empty(TILE)
-    b1 = np.empty(TILE)
-    b2 = np.empty(TILE)
-    z = np.empty(TILE)
-    fz = np.empty(TILE)
-    sz = np.empty(TILE)
-    step = np.empty(TILE)
     ok = np.empty(TILE)
-    limit = np.empty(TILE)
     rate_ok = np.empty(TILE)
     y1f, y2f, y1h, y2h = state[0], state[1], state[2], state[3]
     n = freq_hz.size
@@ -352,43 +372,33 @@ def compensate_block(freq_hz, rate_dph, housing_c, filt, uses_housing, state,
         for i in range(m):
             out_bias[start + i] = bias[i]
             out_rate[start + i] = rate[i] - bias[i]
-        # thermometer inverse: Thermometer.temperature (Chebyshev start, Newton)
-        for i in range(m):
-            c = freq[i]
-            c = f_low if c < f_low else c
-            c = f_high if c > f_high else c
-            clipped[i] = c
-            t[i] = map_offset + map_scale * c  # u, the Chebyshev variable
-        _clenshaw(chebyshev, t, m, b1, b2)
-        c0 = chebyshev[0]
-        for i in range(m):
-            u = t[i] * b1[i] - b2[i] + c0
-            u = t_low if u < t_low else u
-            u = t_high if u > t_high else u
-            t[i] = u
-            z[i] = (u - centre) / scale_c
-        _horner(poly, z, m, fz)
-        _horner(slope, z, m, sz)
-        for i in range(m):
-            step[i] = (fz[i] - clipped[i]) / (sz[i] / scale_c)
-            t[i] -= step[i]
+        # thermometer inverse: Thermometer.temperature (Chebyshev start, one Newton step);
+        # the series have a fixed length (zero-padded), so this loop unrolls and vectorises
         n_more = 0
-        for i in range(m):
-            limit[i] = one_step_limit
-            n_more += abs(step[i]) > one_step_limit
-        if n_more:  # rare: a poor start, Newton goes on for those samples (one by one)
-            for i in range(m):
-                if abs(step[i]) > one_step_limit:
-                    t[i], step[i], limit[i] = _newton_scalar(
-                        t[i], clipped[i], poly, slope, centre, scale_c, tolerance)
         n_lost = 0
         for i in range(m):
             fi = freq[i]
-            ti = t[i]
+            t, step = _start_and_step(fi, f_low, f_high, map_offset, map_scale, chebyshev,
+                                      t_low, t_high, centre, scale_c, poly, slope)
             inside = (fi >= f_low) & (fi <= f_high)
-            converged = (abs(step[i]) <= limit[i]) & (ti >= t_low) & (ti <= t_high)
-            out_temp[start + i] = ti if inside & converged else np.nan
-            n_lost += inside & (not converged)
+            more = abs(step) > one_step_limit
+            converged = (abs(step) <= one_step_limit) & (t >= t_low) & (t <= t_high)
+            out_temp[start + i] = t if inside & converged else np.nan
+            n_more += more
+            n_lost += inside & (not converged) & (not more)
+        if n_more:  # rare: a poor start, Newton goes on for those samples (one by one)
+            for i in range(m):
+                fi = freq[i]
+                t, step = _start_and_step(fi, f_low, f_high, map_offset, map_scale,
+                                          chebyshev, t_low, t_high, centre, scale_c, poly, slope)
+                if abs(step) > one_step_limit:
+                    clipped = min(max(fi, f_low), f_high)
+                    t, step, limit = _newton_scalar(t, clipped, poly, slope, centre, scale_c,
+                                                    tolerance)
+                    inside = (fi >= f_low) & (fi <= f_high)
+                    converged = (abs(step) <= limit) & (t >= t_low) & (t <= t_high)
+                    out_temp[start + i] = t if inside & converged else np.nan
+                    n_lost += inside & (not converged)
         counts[2] += n_lost
         # flags: Compensator._block (1.0 inside, 0.0 outside; NaN is outside)
         for i in range(m):
@@ -412,14 +422,76 @@ def compensate_block(freq_hz, rate_dph, housing_c, filt, uses_housing, state,
     state[0], state[1], state[2], state[3] = y1f, y2f, y1h, y2h
 
 
+@njit(cache=True, nogil=True, error_model="numpy")
+def advance_filter(freq_hz, housing_c, filt, uses_housing, state):  # pragma: no cover
+    """Run only the rate filter over a block: ``state`` becomes the state at its end.
+
+    The same operations as :func:`compensate_block`'s filter, so the state is the same
+    bits; it lets the second half of a chunk start on another thread.
+    """
+    alpha, beta, ref_f, ref_h = filt[0], filt[1], filt[3], filt[4]
+    if freq_hz.size == 0:
+        return
+    y1, y2 = state[0], state[1]
+    if state[4] == 0.0:
+        y1 = y2 = freq_hz[0] - ref_f
+        state[4] = 1.0
+    for i in range(freq_hz.size):
+        y1 = beta * y1 + alpha * (freq_hz[i] - ref_f)
+        y2 = beta * y2 + alpha * y1
+    state[0], state[1] = y1, y2
+    if uses_housing:
+        y1, y2 = state[2], state[3]
+        if state[5] == 0.0:
+            y1 = y2 = housing_c[0] - ref_h
+            state[5] = 1.0
+        for i in range(housing_c.size):
+            y1 = beta * y1 + alpha * (housing_c[i] - ref_h)
+            y2 = beta * y2 + alpha * y1
+        state[2], state[3] = y1, y2
+
+
+#: Chunks of at least this many rows are split in two halves compensated on two threads.
+PARALLEL_ROWS = 1 << 16
+
+
 def run(block_plan: KernelPlan, state: np.ndarray, freq_hz: np.ndarray, rate_dph: np.ndarray,
         housing_c: np.ndarray | None, out: dict[str, np.ndarray], counts: np.ndarray) -> None:
-    """Call :func:`compensate_block` with a plan's arrays (outputs in ``out``)."""
-    p = block_plan
+    """Compensate a chunk with a plan's arrays (outputs in ``out``, ``state`` advanced).
+
+    A long chunk is cut in two: the filter alone runs over the first half to give the
+    state at the cut, then both halves are compensated at once on two threads (the
+    kernel releases the GIL). Results are the same bits as one call.
+    """
+    housing = freq_hz if housing_c is None else housing_c
+    n = freq_hz.size
+    if n < PARALLEL_ROWS or (os.cpu_count() or 1) < 2:
+        _call(block_plan, state, freq_hz, rate_dph, housing, out, counts, 0, n)
+        return
+    middle = n // 2
+    second = state.copy()
+    advance_filter(freq_hz[:middle], housing[:middle], block_plan.filter,
+                   block_plan.uses_housing, second)
+    second_counts = np.zeros_like(counts)
+    worker = threading.Thread(target=_call, args=(block_plan, second, freq_hz, rate_dph, housing,
+                                                  out, second_counts, middle, n))
+    worker.start()
+    try:
+        _call(block_plan, state, freq_hz, rate_dph, housing, out, counts, 0, middle)
+    finally:
+        worker.join()
+    state[:] = second
+    counts += second_counts
+
+
+def _call(p: KernelPlan, state: np.ndarray, freq_hz: np.ndarray, rate_dph: np.ndarray,
+          housing_c: np.ndarray, out: dict[str, np.ndarray], counts: np.ndarray, start: int,
+          stop: int) -> None:
+    part = slice(start, stop)
     compensate_block(
-        freq_hz, rate_dph, freq_hz if housing_c is None else housing_c, p.filter,
-        p.uses_housing, state, p.exponents, p.coefficients, p.intercept, p.scales, p.tangent,
-        p.low, p.high, p.flagged, p.d_factor, p.d_exponents, p.d_constant, p.thermometer,
-        p.poly, p.slope, p.chebyshev, out["rate_comp_dph"], out["bias_model_dph"],
-        out["resonator_c_est"], out["in_range"], counts,
+        freq_hz[part], rate_dph[part], housing_c[part], p.filter, p.uses_housing, state,
+        p.exponents, p.coefficients, p.intercept, p.scales, p.tangent, p.low, p.high,
+        p.flagged, p.d_factor, p.d_exponents, p.d_constant, p.thermometer, p.poly, p.slope,
+        p.chebyshev, out["rate_comp_dph"][part], out["bias_model_dph"][part],
+        out["resonator_c_est"][part], out["in_range"][part], counts,
     )

@@ -118,14 +118,14 @@ class Compensator:
             self.drift.settings.check_sample_rate(chunk)
         n = len(chunk)
         out = {name: np.empty(n) for name in OUTPUT_COLUMNS}
-        if self.engine == "fused":
-            self._fused(chunk, out)
+        if self.engine == "fused" and self._fused(chunk, out):
             return chunk.with_columns(**out)
         for start in range(0, n, BLOCK_ROWS):
             self._block(chunk.slice(start, start + BLOCK_ROWS), out, start)
         return chunk.with_columns(**out)
 
-    def _fused(self, chunk: Recording, out: dict[str, np.ndarray]) -> None:
+    def _fused(self, chunk: Recording, out: dict[str, np.ndarray]) -> bool:
+        """Compensate ``chunk`` into ``out`` with the kernel; False if it cannot (order > 5)."""
         from hrgtc import _compensate_kernel as kernel
 
         thermometer = self.model.thermometer
@@ -133,6 +133,8 @@ class Compensator:
             violation = thermometer._monotonic_violation()
             if violation is not None:
                 raise CalibrationError(violation)
+            if not kernel.supports(thermometer):
+                return False
             self._plan = kernel.plan(self.drift, thermometer, self._variables)
         counts = np.zeros(3, dtype=np.int64)
         freq = chunk.freq_hz
@@ -145,6 +147,7 @@ class Compensator:
         self.samples += len(chunk)
         self.out_of_range += int(counts[kernel.OUT_OF_RANGE])
         self.rate_out_of_range += int(counts[kernel.RATE_OUT_OF_RANGE])
+        return True
 
     def _block(self, chunk: Recording, out: dict[str, np.ndarray], start: int) -> None:
         stop = start + len(chunk)
