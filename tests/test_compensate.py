@@ -225,3 +225,14 @@ def test_two_threads_give_the_bits_of_one_call(unit_model, monkeypatch):
         np.testing.assert_array_equal(a[name], b[name])
     assert (split.out_of_range, split.rate_out_of_range) == (whole.out_of_range,
                                                              whole.rate_out_of_range)
+
+
+def test_thermometer_beyond_the_kernel_series_falls_back_to_numpy(unit_model, run, monkeypatch):
+    from hrgtc import _compensate_kernel as kernel
+
+    monkeypatch.setattr(kernel, "POLY_SIZE", 3)  # as if the order-3 fit were order 5+
+    assert not kernel.supports(THERMOMETER)
+    out = compensate(run, unit_model)
+    reference = compensate(run, unit_model, engine="numpy")
+    for name in OUTPUT_COLUMNS:
+        np.testing.assert_array_equal(out[name], reference[name])
