@@ -452,7 +452,7 @@ def advance_filter(freq_hz, housing_c, filt, uses_housing, state):  # pragma: no
 
 
 #: Chunks of at least this many rows are split in two halves compensated on two threads.
-PARALLEL_ROWS = 1 << 16
+PARALLEL_ROWS = 1 << 18
 
 
 def run(block_plan: KernelPlan, state: np.ndarray, freq_hz: np.ndarray, rate_dph: np.ndarray,
