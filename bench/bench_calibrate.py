@@ -30,14 +30,14 @@ def run(quick: bool = False) -> list[dict]:
     from hrgtc.simulate import simulate_files
     from hrgtc.simulate import standard_profiles as profiles
 
-    rate_hz = 20.0 if quick else 200.0
+    sample_rate_hz = 20.0 if quick else 200.0
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
         soaks = simulate_files([profiles.soak(t, 5.0) for t in SETPOINTS_C], folder / "soaks",
-                               "parquet", rate_hz=rate_hz, seed=1)
+                               "parquet", sample_rate_hz=sample_rate_hz, seed=1)
         ramps = simulate_files([profiles.cooldown(20.0, -20.0, 5.0),
                                 profiles.warmup(-20.0, 20.0, 5.0)], folder / "ramps",
-                               "parquet", rate_hz=rate_hz, seed=2)
+                               "parquet", sample_rate_hz=sample_rate_hz, seed=2)
         n = sum(w.rows for w in soaks) + sum(w.rows for w in ramps)
         value, seconds, peak = measure(_calibrate, [w.path for w in soaks],
                                        [w.path for w in ramps])

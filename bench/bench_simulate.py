@@ -34,7 +34,7 @@ def run(quick: bool = False) -> list[dict]:
     runs = simulate.soak_campaign(SETPOINTS_C[:1] if quick else SETPOINTS_C, 0.5 if quick else 5.0)
     with tempfile.TemporaryDirectory(prefix="hrgtc-bench-") as directory:
         start = time.perf_counter()
-        written = simulate.simulate_files(runs, directory, rate_hz=RATE_HZ, seed=SEED)
+        written = simulate.simulate_files(runs, directory, sample_rate_hz=RATE_HZ, seed=SEED)
         seconds = time.perf_counter() - start
         size = sum(Path(w.path).stat().st_size for w in written)
     n = sum(w.rows for w in written)

@@ -2,16 +2,21 @@
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
+import subprocess
+import sys
 
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from scipy import signal
 
 from hrgtc import drift
-from hrgtc.compensate import Compensator, compensate
-from hrgtc.errors import InputError
+from hrgtc import recording as recording_io
+from hrgtc.compensate import OUTPUT_COLUMNS, Compensator, compensate, compensate_file
+from hrgtc.errors import InputError, RecordingError
 from hrgtc.model import UnitModel
 from hrgtc.recording import concatenate
 
@@ -59,3 +64,176 @@ def test_out_of_range_samples_are_counted(unit_model):
 def test_housing_baseline_missing_is_a_clear_error(unit_model):
     with pytest.raises(InputError, match="no housing-thermistor baseline"):
         Compensator(unit_model, drift="housing")
+
+
+# -- the fused engine against the numpy reference ------------------------------------------
+def housing_run(seed, **kwargs):
+    """A ramp with a housing thermistor lagging the chamber by 900 s."""
+    run = ramp_run(seed, **kwargs)
+    a = -np.expm1(-1.0 / (900.0 * run.sample_rate_hz))
+    housing = signal.lfilter([a], [1.0, a - 1.0], run["chamber_c"],
+                             zi=[(1.0 - a) * run["chamber_c"][0]])[0]
+    return run.with_columns(housing_c=housing)
+
+
+def assert_engines_agree(model, recording, drift_kind="frequency"):
+    fused, numpy_ = Compensator(model, drift_kind), Compensator(model, drift_kind, "numpy")
+    a, b = fused.process(recording), numpy_.process(recording)
+    for name in ("rate_comp_dph", "bias_model_dph"):
+        np.testing.assert_allclose(a[name], b[name], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(a["resonator_c_est"], b["resonator_c_est"], rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(a["in_range"], b["in_range"])
+    assert (fused.samples, fused.out_of_range, fused.rate_out_of_range) == (
+        numpy_.samples, numpy_.out_of_range, numpy_.rate_out_of_range)
+    return fused
+
+
+@pytest.mark.parametrize("start_c, end_c", [(-15.0, 15.0), (20.0, 60.0), (25.0, -25.0)],
+                         ids=["inside", "hot", "deep-cooldown"])
+def test_fused_engine_equals_numpy_reference(unit_model, start_c, end_c):
+    run = ramp_run(seed=24, start_c=start_c, end_c=end_c, hours=1.0)
+    assert_engines_agree(unit_model, run)
+
+
+GRAMMAR = ("f", "f^2", "f^3", "df", "f*df", "f^2*df", "h", "h^2", "h^3", "dh", "f*dh",
+           "f^4*dh", "h*df", "df^2", "f*h*dh")
+
+
+@settings(max_examples=20, deadline=None)
+@given(selected=st.lists(st.sampled_from(GRAMMAR), max_size=6, unique=True),
+       coefficients=st.lists(st.floats(-3.0, 3.0), min_size=6, max_size=6),
+       quantiles=st.tuples(st.floats(0.0, 0.4), st.floats(0.6, 1.0)))
+def test_fused_engine_is_generic_over_the_term_grammar(unit_model, hot_housing_run, selected,
+                                                       coefficients, quantiles):
+    # any terms of the grammar, ranges cut inside the data: the tangent extension is exercised
+    from hrgtc.drift.features import compute_variables
+
+    values = compute_variables(hot_housing_run, unit_model.drift.settings, ("f", "df", "h", "dh"))
+    ranges = {v: tuple(float(q) for q in np.quantile(x, quantiles)) for v, x in values.items()}
+    scales = {"f": 10.0, "df": 1e-3, "h": 20.0, "dh": 1e-2}
+    settings_ = dataclasses.replace(unit_model.drift.settings, scales=scales)
+    fitted = dataclasses.replace(
+        unit_model.drift, selected=tuple(selected), settings=settings_, ranges=ranges,
+        scaled_coefficients=tuple(coefficients[: len(selected)]),
+        coefficients=dict.fromkeys(selected, 1.0))
+    assert_engines_agree(UnitModel(THERMOMETER, fitted), hot_housing_run)
+
+
+@pytest.fixture(scope="module")
+def hot_housing_run():
+    return housing_run(seed=25, start_c=30.0, end_c=-25.0, hours=0.5)
+
+
+@settings(max_examples=25, deadline=None)
+@given(cuts=st.lists(st.integers(1, 17_999), min_size=1, max_size=8, unique=True))
+def test_fused_streaming_is_exact_across_any_chunk_boundaries(unit_model, hot_housing_run, cuts):
+    # the filter state is handed over exactly: any chunking gives the batch's bits
+    fitted = dataclasses.replace(unit_model.drift, selected=("f", "df", "h", "dh"),
+                                 scaled_coefficients=(0.4, 2.0, -0.3, 1.5),
+                                 settings=dataclasses.replace(
+                                     unit_model.drift.settings,
+                                     scales={"f": 10.0, "df": 1e-3, "h": 20.0, "dh": 1e-2}))
+    model = UnitModel(THERMOMETER, fitted)
+    batch = compensate(hot_housing_run, model)
+    compensator = Compensator(model)
+    bounds = [0, *sorted(cuts), len(hot_housing_run)]
+    streamed = concatenate([compensator.process(hot_housing_run.slice(a, b))
+                            for a, b in itertools.pairwise(bounds)])
+    for name in ("rate_comp_dph", "bias_model_dph", "resonator_c_est", "in_range"):
+        np.testing.assert_array_equal(streamed[name], batch[name])
+
+
+def test_fused_slow_path_of_the_thermometer(unit_model, run):
+    # with a zero tolerance (almost) no Newton step "converges": the samples take the slow
+    # path; the few whose step rounds to exactly 0 stop a step earlier than the numpy path's
+    # block-wide iteration does, a difference far below the inverse's own tolerance (5e-11 °C)
+    from hrgtc.compensate import _kernel as kernel
+
+    compensator = Compensator(unit_model)
+    plan = kernel.plan(unit_model.drift, THERMOMETER, compensator._variables)
+    strict = plan.thermometer.copy()
+    strict[10:12] = 0.0  # one_step_limit, tolerance
+    compensator._plan = dataclasses.replace(plan, thermometer=strict)
+    out = compensator.process(run.slice(0, 2000))
+    np.testing.assert_allclose(out["resonator_c_est"],
+                               THERMOMETER.temperature(run.freq_hz[:2000], warn=False),
+                               rtol=0, atol=1e-11)
+
+
+def test_unknown_engine_is_a_clear_error(unit_model):
+    with pytest.raises(InputError, match="engine must be 'fused' or 'numpy', got 'c'"):
+        Compensator(unit_model, engine="c")
+
+
+def test_import_loads_neither_numba_nor_scipy_signal():
+    code = ("import sys, hrgtc.compensate; "
+            "print(sorted({'numba', 'scipy.signal'} & set(sys.modules)))")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                            check=True)
+    assert result.stdout.strip() == "[]"
+
+
+# -- file to file ------------------------------------------------------------------------
+def test_file_to_file_equals_batch_and_leaves_no_temporary(unit_model, run, tmp_path):
+    source = recording_io.write(run, tmp_path / "run.parquet")
+    output = tmp_path / "out.parquet"
+    summary = compensate_file(source, output, unit_model, chunk_rows=7_001)
+    batch = compensate(run, unit_model)
+    written = recording_io.read(output)
+    assert written.names == (*run.names, *OUTPUT_COLUMNS)
+    for name in written.names:
+        np.testing.assert_array_equal(written[name], batch[name])
+    compensator = Compensator(unit_model)
+    compensator.process(run)
+    assert (summary.rows, summary.out_of_range_fraction, summary.rate_out_of_range_fraction) == (
+        len(run), compensator.out_of_range_fraction, compensator.rate_out_of_range_fraction)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.parquet", "run.parquet"]
+
+
+def test_file_to_file_bad_row_late_in_the_file_leaves_nothing(unit_model, tmp_path):
+    # past the validator's first 100 000 rows: rejected by the read-ahead thread while
+    # earlier chunks are already compensated and written
+    long_run = ramp_run(seed=26, hours=5.0)
+    rate = long_run.rate_dph.copy()
+    rate[150_000] = np.nan
+    source = recording_io.write(long_run.with_columns(rate_dph=rate), tmp_path / "bad.parquet")
+    written = []
+    with pytest.raises(RecordingError, match="rate_dph"):
+        compensate_file(source, tmp_path / "out.parquet", unit_model, chunk_rows=20_000,
+                        progress=lambda done, total: written.append(done))
+    assert written and max(written) >= 120_000
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.parquet"]
+
+
+def test_two_threads_give_the_bits_of_one_call(unit_model, monkeypatch):
+    # a chunk long enough to be split in halves (filter advanced over the first half)
+    from hrgtc.compensate import _kernel as kernel
+
+    long_run = housing_run(seed=27, start_c=25.0, end_c=-25.0, hours=5.0)
+    monkeypatch.setattr(kernel, "PARALLEL_ROWS", 1 << 15)
+    fitted = dataclasses.replace(unit_model.drift, selected=("f", "df", "h", "dh", "f*dh"),
+                                 scaled_coefficients=(0.4, 2.0, -0.3, 1.5, 0.2),
+                                 settings=dataclasses.replace(
+                                     unit_model.drift.settings,
+                                     scales={"f": 10.0, "df": 1e-3, "h": 20.0, "dh": 1e-2}))
+    model = UnitModel(THERMOMETER, fitted)
+    split = assert_engines_agree(model, long_run)
+    a = Compensator(model).process(long_run)
+    monkeypatch.setattr(kernel, "PARALLEL_ROWS", len(long_run) + 1)
+    whole = Compensator(model)
+    b = whole.process(long_run)
+    for name in OUTPUT_COLUMNS:
+        np.testing.assert_array_equal(a[name], b[name])
+    assert (split.out_of_range, split.rate_out_of_range) == (whole.out_of_range,
+                                                             whole.rate_out_of_range)
+
+
+def test_thermometer_beyond_the_kernel_series_falls_back_to_numpy(unit_model, run, monkeypatch):
+    from hrgtc.compensate import _kernel as kernel
+
+    monkeypatch.setattr(kernel, "POLY_SIZE", 3)  # as if the order-3 fit were order 5+
+    assert not kernel.supports(THERMOMETER)
+    out = compensate(run, unit_model)
+    reference = compensate(run, unit_model, engine="numpy")
+    for name in OUTPUT_COLUMNS:
+        np.testing.assert_array_equal(out[name], reference[name])

@@ -23,7 +23,7 @@ def compensate_command(
     run: Path = typer.Argument(..., help="Recording to compensate (.parquet, .csv, .h5)."),
     model_path: Path = typer.Option(..., "--model", "-m", help="Model file from 'calibrate'."),
     output: Path = typer.Option(..., "-o", "--output", help="Output recording (format by suffix)."),
-    chunk_rows: int = typer.Option(1_000_000, "--chunk-rows", help="Rows per processing chunk."),
+    chunk_rows: int = typer.Option(1 << 20, "--chunk-rows", help="Rows per processing chunk."),
     force: ForceOption = False,
     json_output: JsonOption = False,
     inputs: ReadOptions | None = None,

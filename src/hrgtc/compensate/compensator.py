@@ -5,12 +5,17 @@ between chunks, so a file of any size is compensated in bounded memory and
 any chunking gives the batch result. The batch :func:`compensate` is "reset,
 then one chunk". Eq. (22) of [1] applied as in Section 4.2 (Fig. 6).
 
+Two engines compute the same numbers: ``"fused"`` (default) runs one compiled
+pass per chunk (:mod:`hrgtc.compensate._kernel`, numba, imported on first use);
+``"numpy"`` composes :mod:`hrgtc.drift.features`, :mod:`hrgtc.drift` and
+:mod:`hrgtc.thermometry` array by array and is the reference the tests hold the
+fused one to.
+
 [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
 """
 
 from __future__ import annotations
 
-import itertools
 import os
 from collections.abc import Mapping
 from concurrent.futures import ThreadPoolExecutor
@@ -22,15 +27,20 @@ import numpy as np
 from hrgtc import recording as rec_io
 from hrgtc.drift import DriftModel
 from hrgtc.drift.features import FeatureStream
-from hrgtc.errors import InputError
+from hrgtc.errors import CalibrationError, InputError
 from hrgtc.model import UnitModel
 from hrgtc.progress import Progress
 from hrgtc.recording import Recording
 
 #: Rows worked on at once: small enough for the temporaries to stay in cache.
 BLOCK_ROWS = 1 << 17
+#: Rows per chunk of :func:`compensate_file`: one Parquet row group, so chunks are read
+#: without joining batches and written without waiting for the next chunk.
+FILE_CHUNK_ROWS = 1 << 20
 #: Columns added by compensation.
 OUTPUT_COLUMNS = ("rate_comp_dph", "bias_model_dph", "resonator_c_est", "in_range")
+#: Ways of computing them (see the module docstring).
+ENGINES = ("fused", "numpy")
 
 
 def _in_training_range(
@@ -55,6 +65,9 @@ class Compensator:
     drift
         Which drift model to apply: ``"frequency"`` (the paper's, default) or
         ``"housing"`` (the classical thermistor baseline kept in the model file).
+    engine
+        ``"fused"`` (one compiled pass per chunk, default) or ``"numpy"`` (the
+        array-by-array reference); both give the same numbers to rounding.
 
     Examples
     --------
@@ -62,7 +75,9 @@ class Compensator:
     >>> # for chunk in iter_chunks("run.parquet"): out = comp.process(chunk)
     """
 
-    def __init__(self, model: UnitModel, drift: str = "frequency") -> None:
+    def __init__(self, model: UnitModel, drift: str = "frequency", engine: str = "fused") -> None:
+        if engine not in ENGINES:
+            raise InputError(f"engine must be 'fused' or 'numpy', got {engine!r}")
         if drift == "frequency":
             self.drift = model.drift
         elif drift == "housing":
@@ -75,12 +90,15 @@ class Compensator:
         else:
             raise InputError(f"drift must be 'frequency' or 'housing', got {drift!r}")
         self.model = model
+        self.engine = engine
+        self._plan: Any = None
         self._variables = tuple(dict.fromkeys(("f", "df", *self.drift.variables)))
         self.reset()
 
     def reset(self) -> None:
         """Start a new run: the df/dt filter restarts at rest on the next sample."""
         self._stream = FeatureStream(self.drift.settings, self._variables)
+        self._state = np.zeros(6)  # the fused engine's filter state (compensate._kernel)
         self.samples = 0
         self.out_of_range = 0
         self.rate_out_of_range = 0
@@ -99,9 +117,36 @@ class Compensator:
             self.drift.settings.check_sample_rate(chunk)
         n = len(chunk)
         out = {name: np.empty(n) for name in OUTPUT_COLUMNS}
+        if self.engine == "fused" and self._fused(chunk, out):
+            return chunk.with_columns(**out)
         for start in range(0, n, BLOCK_ROWS):
             self._block(chunk.slice(start, start + BLOCK_ROWS), out, start)
         return chunk.with_columns(**out)
+
+    def _fused(self, chunk: Recording, out: dict[str, np.ndarray]) -> bool:
+        """Compensate ``chunk`` into ``out`` with the kernel; False if it cannot (order > 5)."""
+        from hrgtc.compensate import _kernel as kernel
+
+        thermometer = self.model.thermometer
+        if self._plan is None:
+            violation = thermometer._monotonic_violation()
+            if violation is not None:
+                raise CalibrationError(violation)
+            if not kernel.supports(thermometer):
+                return False
+            self._plan = kernel.plan(self.drift, thermometer, self._variables)
+        counts = np.zeros(3, dtype=np.int64)
+        freq = chunk.freq_hz
+        housing = chunk["housing_c"] if self._plan.uses_housing else None
+        kernel.run(self._plan, self._state, freq, chunk.rate_dph, housing, out, counts)
+        if counts[kernel.NOT_CONVERGED]:  # rare: the bracketed slow path, as temperature() does
+            low, high = thermometer._inverse.f_bracket
+            lost = np.isnan(out["resonator_c_est"]) & (freq >= low) & (freq <= high)
+            out["resonator_c_est"][lost] = thermometer.temperature(freq[lost], warn=False)
+        self.samples += len(chunk)
+        self.out_of_range += int(counts[kernel.OUT_OF_RANGE])
+        self.rate_out_of_range += int(counts[kernel.RATE_OUT_OF_RANGE])
+        return True
 
     def _block(self, chunk: Recording, out: dict[str, np.ndarray], start: int) -> None:
         stop = start + len(chunk)
@@ -131,9 +176,10 @@ class Compensator:
         return self.rate_out_of_range / self.samples if self.samples else 0.0
 
 
-def compensate(recording: Recording, model: UnitModel, drift: str = "frequency") -> Recording:
+def compensate(recording: Recording, model: UnitModel, drift: str = "frequency",
+               engine: str = "fused") -> Recording:
     """Batch compensation of a whole run: a new :class:`Compensator`, one chunk."""
-    return Compensator(model, drift).process(recording)
+    return Compensator(model, drift, engine).process(recording)
 
 
 @dataclass(frozen=True)
@@ -163,7 +209,7 @@ def compensate_file(
     *,
     force: bool = False,
     read_options: rec_io.ReadOptions | None = None,
-    chunk_rows: int = 1_000_000,
+    chunk_rows: int = FILE_CHUNK_ROWS,
     drift: str = "frequency",
     progress: Progress | None = None,
 ) -> CompensationSummary:
@@ -172,27 +218,45 @@ def compensate_file(
     The output is written atomically in the format of its suffix; it is never
     overwritten without ``force``. ``read_options`` says how to read ``source``
     (column mapping, units, metadata).
+
+    Three stages overlap, each one chunk ahead of the next (pyarrow, h5py and the
+    fused kernel release the GIL): a thread reads and validates the next chunk,
+    this thread compensates the current one, and a writer thread writes the previous
+    one and starts its write-back to disk, so that the fsync before the atomic
+    rename finds little left to wait for. At most three chunks are held at a time.
     """
     compensator = Compensator(model, drift)
     chunks = (read_options or rec_io.ReadOptions()).chunks(source, rows=chunk_rows)
-    first = next(chunks)
-    names = (*first.names, *OUTPUT_COLUMNS)
-    total = rec_io.count_rows(source)
-    # Writing overlaps with reading and computing the next chunk (pyarrow and h5py
-    # release the GIL); at most one chunk waits to be written.
-    with rec_io.RecordingWriter(output, first.metadata, names, force=force) as writer, \
-            ThreadPoolExecutor(max_workers=1) as pool:
-        pending = None
-        for chunk in itertools.chain([first], chunks):
-            result = compensator.process(chunk)
+    try:
+        first = next(chunks)
+        names = (*first.names, *OUTPUT_COLUMNS)
+        total = rec_io.count_rows(source)
+        with rec_io.RecordingWriter(output, first.metadata, names, force=force) as writer, \
+                ThreadPoolExecutor(max_workers=1) as reading, \
+                ThreadPoolExecutor(max_workers=1) as writing:
+            ahead = reading.submit(next, chunks, None)
+            pending = None
+            chunk: Recording | None = first
+            while chunk is not None:
+                result = compensator.process(chunk)
+                if pending is not None:
+                    pending.result()
+                pending = writing.submit(_write, writer, result)
+                if progress is not None:
+                    progress(compensator.samples, total)
+                chunk = ahead.result()
+                if chunk is not None:
+                    ahead = reading.submit(next, chunks, None)
             if pending is not None:
                 pending.result()
-            pending = pool.submit(writer.write, result)
-            if progress is not None:
-                progress(compensator.samples, total)
-        if pending is not None:
-            pending.result()
+    finally:
+        chunks.close()
     return CompensationSummary(str(source), str(output), compensator.samples,
                                compensator.out_of_range_fraction,
                                compensator.rate_out_of_range_fraction)
+
+
+def _write(writer: rec_io.RecordingWriter, chunk: Recording) -> None:
+    writer.write(chunk)
+    writer.start_writeback()
 

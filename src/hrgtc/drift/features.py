@@ -39,7 +39,6 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy import signal
 
 from hrgtc.errors import InputError
 from hrgtc.recording.schema import Recording
@@ -258,6 +257,8 @@ def causal_rate(
     rate, smoothed, state
         The rate [unit/s], the once-smoothed signal y1 [unit] and the new state.
     """
+    from scipy import signal  # imported on use: it costs the CLI's start half a second
+
     x = np.asarray(x, dtype=np.float64)
     state = RateFilterState() if state is None else RateFilterState(state.y1, state.y2)
     if x.size == 0:

@@ -1,0 +1,497 @@
+"""Fused compensation kernel: one pass over a block, sample by sample (numba, private).
+
+:class:`hrgtc.compensate.Compensator` calls :func:`compensate_block` instead of a
+dozen numpy passes. Per sample it does, in the same floating-point operations
+and order as the numpy reference path (so results agree to rounding):
+
+* the causal df/dt (dh/dt) filter of :func:`hrgtc.drift.features.causal_rate`, two
+  exact first-order stages ``y = z + alpha x; z = beta y`` (scipy's ``lfilter``
+  in transposed direct form II), state carried across calls;
+* the drift model of :func:`hrgtc.drift.features.tangent_extension`: each term a
+  product of powers of the scaled variables, summed in term order, and beyond
+  the training ranges the gradient at the clipped point times the excess;
+* the thermometer inverse of :meth:`hrgtc.thermometry.Thermometer.temperature`:
+  the Chebyshev start, clipped to the bracket, then Newton steps until one is
+  below the one-step limit; a sample that does not converge is marked NaN and
+  counted, and the caller hands it to the bracketed slow path;
+* the range flags and out-of-range counts of the compensator.
+
+The term grammar is not hard-coded: terms come in as an exponent matrix over
+the variables ``(f, df, h, dh)`` and their derivatives as precomputed
+(factor, exponents) tables, built by :func:`plan` from a fitted model.
+
+Speed: the block is worked through in tiles of :data:`TILE` samples whose
+scratch rows stay in cache, every inner loop runs over samples (the filter is
+the only serial one) and the thermometer's series have fixed, zero-padded
+lengths, so LLVM vectorises the loops; :func:`run` compensates the two halves of
+a long chunk on two threads. Compiled with ``cache=True`` (the first call
+compiles, later processes load the cache), ``nogil=True`` and
+``error_model="numpy"`` (IEEE division, as numpy, instead of Python's
+ZeroDivisionError check, which also blocks vectorisation); no fastmath, so no
+reassociation or fused multiply-add changes the numbers.
+
+[1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from hrgtc.drift import DriftModel
+from hrgtc.drift.features import VARIABLES, rate_filter_coefficients
+from hrgtc.thermometry import Thermometer
+
+#: Variable order of the exponent matrices: the grammar's order (f, df, h, dh).
+ORDER = tuple(VARIABLES)
+#: Slots of ``counts``: samples outside the f/h ranges, outside the df/dh ranges,
+#: and samples whose Newton iteration did not converge (left NaN).
+OUT_OF_RANGE, RATE_OUT_OF_RANGE, NOT_CONVERGED = 0, 1, 2
+#: Lengths of the thermometer's series in the kernel (zero-padded at the high-order end,
+#: which leaves Horner's and Clenshaw's arithmetic unchanged): f(z) up to order 5 and
+#: the Chebyshev start of :mod:`hrgtc.thermometry` (degree 9).
+POLY_SIZE = 6
+CHEBYSHEV_SIZE = 10
+
+
+@dataclass(frozen=True)
+class KernelPlan:
+    """A fitted model laid out as the arrays :func:`compensate_block` reads.
+
+    Attributes
+    ----------
+    filter
+        ``[alpha, beta, gain, reference_freq_hz, reference_c]`` of the rate filter
+        (gain ``alpha * sample_rate_hz / beta`` turns y1 - y2 into a rate).
+    uses_housing
+        Whether h/dh are computed (the recording then needs ``housing_c``).
+    exponents
+        (n_terms, 4) powers of (f, df, h, dh) in each term. ``int64``
+    coefficients
+        Scaled coefficients, term order; ``intercept`` is B0. [°/h]
+    scales
+        Scale of each variable (1 where unused).
+    tangent, low, high
+        Per variable: continue along the tangent beyond [low, high] (a used
+        variable with a training range).
+    flagged
+        Per variable: counted in ``in_range`` (f, h) or the rate count (df, dh).
+    d_factor, d_exponents, d_constant
+        Derivative of term k by variable v: ``d_factor[v, k] * rest``, rest the
+        term of exponents ``d_exponents[v, k]`` or 1 when ``d_constant[v, k]``;
+        ``d_factor`` is 0 where the term lacks v.
+    thermometer
+        ``[centre_c, scale_c, map offset, map scale, t_low, t_high, f_low, f_high,
+        f_cal_low, f_cal_high, one_step_limit, tolerance]`` of the inverse.
+    poly, slope, chebyshev
+        Scaled f(z) coefficients, their derivative, the Chebyshev start series.
+    """
+
+    filter: np.ndarray
+    uses_housing: bool
+    exponents: np.ndarray
+    coefficients: np.ndarray
+    intercept: float
+    scales: np.ndarray
+    tangent: np.ndarray
+    low: np.ndarray
+    high: np.ndarray
+    flagged: np.ndarray
+    d_factor: np.ndarray
+    d_exponents: np.ndarray
+    d_constant: np.ndarray
+    thermometer: np.ndarray
+    poly: np.ndarray
+    slope: np.ndarray
+    chebyshev: np.ndarray
+
+
+def plan(drift: DriftModel, thermometer: Thermometer, variables: tuple[str, ...]) -> KernelPlan:
+    """Lay out a drift model and thermometer for the kernel.
+
+    Parameters
+    ----------
+    drift
+        The drift model applied (frequency or housing).
+    thermometer
+        The unit's thermometer (must be monotonic; the caller checks).
+    variables
+        Variables the compensator computes (``f``, ``df`` and the model's).
+    """
+    s = drift.settings
+    alpha, beta = rate_filter_coefficients(s.rate_tau_s, s.sample_rate_hz)
+    terms = drift._terms
+    used = {v for t in terms for v in t.variables}
+    n = len(terms)
+    exponents = np.zeros((n, 4), dtype=np.int64)
+    d_factor = np.zeros((4, n))
+    d_exponents = np.zeros((4, n, 4), dtype=np.int64)
+    d_constant = np.zeros((4, n), dtype=np.bool_)
+    scales = np.ones(4)
+    for j, v in enumerate(ORDER):
+        if v in used:
+            scales[j] = s.scales[v]
+    for k, (term, c) in enumerate(zip(terms, drift.scaled_coefficients, strict=True)):
+        for v, p in term.powers:
+            exponents[k, ORDER.index(v)] = p
+        for j, v in enumerate(ORDER):
+            multiplier, rest = term.derivative(v)
+            if multiplier and v in used:
+                d_factor[j, k] = c * multiplier / s.scales[v]  # as tangent_extension
+                d_constant[j, k] = rest is None
+                for w, p in () if rest is None else rest.powers:
+                    d_exponents[j, k, ORDER.index(w)] = p
+    low = np.array([drift.ranges.get(v, (-np.inf, np.inf))[0] for v in ORDER], dtype=float)
+    high = np.array([drift.ranges.get(v, (-np.inf, np.inf))[1] for v in ORDER], dtype=float)
+    tangent = np.array([v in used and v in drift.ranges for v in ORDER])
+    flagged = np.array([v in drift.ranges and v in variables for v in ORDER])
+    inverse = thermometer._inverse
+    a = np.asarray(thermometer.scaled_coefficients, dtype=np.float64)
+    return KernelPlan(
+        filter=np.array([alpha, beta, alpha * s.sample_rate_hz / beta, s.reference_freq_hz,
+                         s.reference_c]),
+        uses_housing=any(v in ("h", "dh") for v in variables),
+        exponents=exponents,
+        coefficients=np.asarray(drift.scaled_coefficients, dtype=np.float64).reshape(n),
+        intercept=float(drift.intercept_dph),
+        scales=scales,
+        tangent=tangent,
+        low=low,
+        high=high,
+        flagged=flagged,
+        d_factor=d_factor,
+        d_exponents=d_exponents,
+        d_constant=d_constant,
+        thermometer=np.array([thermometer.centre_c, thermometer.scale_c, *inverse.start_map,
+                              *inverse.t_bracket, *inverse.f_bracket, *inverse.f_calibrated,
+                              inverse.one_step_limit, inverse.tolerance], dtype=np.float64),
+        poly=_padded(a, POLY_SIZE),
+        slope=_padded(a[1:] * np.arange(1, a.size), POLY_SIZE - 1),  # as slope_hz_per_c
+        chebyshev=_padded(np.asarray(inverse.start_coefficients, dtype=np.float64),
+                          CHEBYSHEV_SIZE),
+    )
+
+
+def supports(thermometer: Thermometer) -> bool:
+    """Whether the kernel's fixed-length series hold this thermometer's (order <= 5)."""
+    return (len(thermometer.scaled_coefficients) <= POLY_SIZE
+            and len(thermometer._inverse.start_coefficients) <= CHEBYSHEV_SIZE)
+
+
+def _padded(coefficients: np.ndarray, size: int) -> np.ndarray:
+    """Ascending coefficients with zeros appended up to ``size``."""
+    out = np.zeros(size)
+    out[: coefficients.size] = coefficients
+    return out
+
+
+def new_state() -> np.ndarray:
+    """Filter state at rest: ``[y1_f, y2_f, y1_h, y2_h, started_f, started_h]``."""
+    return np.zeros(6)
+
+
+# -- the kernel -------------------------------------------------------------------------
+#: Samples worked on together: the kernel's scratch rows (about 20 x TILE doubles) stay in
+#: the L1/L2 cache, and every inner loop runs over samples, so it vectorises.
+TILE = 256
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _term(exponents, k, x, m, out, factor):  # pragma: no cover - compiled
+    """out[:m] = row k's product of powers of the rows of x, as features.Term.evaluate.
+
+    Each factor x_v ** p is x_v * x_v * ... (left to right), and the factors are
+    multiplied in variable order, so the rounding is that of the numpy path.
+    """
+    first = True
+    for v in range(4):
+        p = exponents[k, v]
+        if p == 0:
+            continue
+        xv = x[v]
+        target = out if first else factor
+        for i in range(m):
+            target[i] = xv[i]
+        for _ in range(p - 1):
+            for i in range(m):
+                target[i] = target[i] * xv[i]
+        if not first:
+            for i in range(m):
+                out[i] = out[i] * factor[i]
+        first = False
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _start_and_step(f, f_low, f_high, map_offset, map_scale, chebyshev, t_low, t_high, centre,
+                    scale_c, poly, slope):  # pragma: no cover - compiled
+    """Chebyshev start and one Newton step of one sample: (t after the step, the step)."""
+    c = f
+    c = f_low if c < f_low else c
+    c = f_high if c > f_high else c
+    u = map_offset + map_scale * c
+    two_u = 2.0 * u
+    b1 = 0.0
+    b2 = 0.0
+    for j in range(CHEBYSHEV_SIZE - 1, 0, -1):
+        b1, b2 = two_u * b1 - b2 + chebyshev[j], b1
+    t = u * b1 - b2 + chebyshev[0]
+    t = t_low if t < t_low else t
+    t = t_high if t > t_high else t
+    z = (t - centre) / scale_c
+    value = poly[POLY_SIZE - 1]
+    for j in range(POLY_SIZE - 2, -1, -1):
+        value = value * z + poly[j]
+    derivative = slope[POLY_SIZE - 2]
+    for j in range(POLY_SIZE - 3, -1, -1):
+        derivative = derivative * z + slope[j]
+    step = (value - c) / (derivative / scale_c)
+    return t - step, step
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _newton_scalar(t, clipped, poly, slope, centre, scale_c, tolerance):  # pragma: no cover
+    """Up to three more Newton steps of one sample whose first step was above the limit."""
+    step = np.inf
+    limit = tolerance
+    for _ in range(3):
+        z = (t - centre) / scale_c
+        value = poly[poly.size - 1]
+        for j in range(poly.size - 2, -1, -1):
+            value = value * z + poly[j]
+        derivative = slope[slope.size - 1]
+        for j in range(slope.size - 2, -1, -1):
+            derivative = derivative * z + slope[j]
+        step = (value - clipped) / (derivative / scale_c)
+        t -= step
+        if not abs(step) > limit:
+            break
+    return t, step, limit
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def compensate_block(freq_hz, rate_dph, housing_c, filt, uses_housing, state,
+                     exponents, coefficients, intercept, scales, tangent, low, high, flagged,
+                     d_factor, d_exponents, d_constant, therm, poly, slope, chebyshev,
+                     out_rate, out_bias, out_temp, out_in_range, counts):  # pragma: no cover
+    """Compensate one block in place; see the module docstring for what is computed.
+
+    ``state`` (filter) and ``counts`` (int64, see :data:`OUT_OF_RANGE`) are updated.
+    """
+    alpha, beta, gain, ref_f, ref_h = filt[0], filt[1], filt[2], filt[3], filt[4]
+    centre, scale_c, map_offset, map_scale = therm[0], therm[1], therm[2], therm[3]
+    t_low, t_high, f_low, f_high = therm[4], therm[5], therm[6], therm[7]
+    f_cal_low, f_cal_high, one_step_limit, tolerance = therm[8], therm[9], therm[10], therm[11]
+    n_terms = coefficients.size
+    value = np.zeros((4, TILE))
+    scaled = np.zeros((4, TILE))
+    delta = np.zeros((4, TILE))
+    term = np.empty(TILE)
+    factor = np.empty(TILE)
+    bias = np.empty(TILE)
+    gradient = np.empty(TILE)
+    ok = np.empty(TILE)
+    rate_ok = np.empty(TILE)
+    y1f, y2f, y1h, y2h = state[0], state[1], state[2], state[3]
+    n = freq_hz.size
+    for start in range(0, n, TILE):
+        m = min(TILE, n - start)
+        freq = freq_hz[start:start + m]
+        # variables f, df (h, dh): features.FeatureStream; the filter is the only serial loop
+        f, df = value[0], value[1]
+        for i in range(m):
+            f[i] = freq[i] - ref_f
+        if state[4] == 0.0:
+            y1f = y2f = f[0]
+            state[4] = 1.0
+        for i in range(m):
+            y1f = beta * y1f + alpha * f[i]
+            y2f = beta * y2f + alpha * y1f
+            df[i] = (y1f - y2f) * gain
+        if uses_housing:
+            housing = housing_c[start:start + m]
+            h, dh = value[2], value[3]
+            for i in range(m):
+                h[i] = housing[i] - ref_h
+            if state[5] == 0.0:
+                y1h = y2h = h[0]
+                state[5] = 1.0
+            for i in range(m):
+                y1h = beta * y1h + alpha * h[i]
+                y2h = beta * y2h + alpha * y1h
+                dh[i] = (y1h - y2h) * gain
+        # drift model: features.tangent_extension (linear_combination at the held point)
+        outside = False
+        for v in range(4):
+            x, sv, dv = value[v], scaled[v], delta[v]
+            lo, hi, scale = low[v], high[v], scales[v]
+            if tangent[v]:
+                count = 0
+                for i in range(m):
+                    held = x[i]
+                    held = lo if held < lo else held
+                    held = hi if held > hi else held
+                    dv[i] = x[i] - held
+                    sv[i] = held / scale
+                    count += dv[i] != 0.0
+                outside = outside or count > 0
+            else:
+                for i in range(m):
+                    sv[i] = x[i] / scale
+        for i in range(m):
+            bias[i] = intercept
+        for k in range(n_terms):
+            _term(exponents, k, scaled, m, term, factor)
+            c = coefficients[k]
+            for i in range(m):
+                bias[i] += c * term[i]
+        if outside:
+            for v in range(4):
+                if not tangent[v]:
+                    continue
+                for i in range(m):
+                    gradient[i] = 0.0
+                for k in range(n_terms):
+                    fk = d_factor[v, k]
+                    if fk == 0.0:
+                        continue
+                    if d_constant[v, k]:
+                        for i in range(m):
+                            gradient[i] += fk
+                    else:
+                        _term(d_exponents[v], k, scaled, m, term, factor)
+                        for i in range(m):
+                            gradient[i] += fk * term[i]
+                dv = delta[v]
+                for i in range(m):
+                    bias[i] += gradient[i] * dv[i]
+        rate = rate_dph[start:start + m]
+        for i in range(m):
+            out_bias[start + i] = bias[i]
+            out_rate[start + i] = rate[i] - bias[i]
+        # thermometer inverse: Thermometer.temperature (Chebyshev start, one Newton step);
+        # the series have a fixed length (zero-padded), so this loop unrolls and vectorises
+        n_more = 0
+        n_lost = 0
+        for i in range(m):
+            fi = freq[i]
+            t, step = _start_and_step(fi, f_low, f_high, map_offset, map_scale, chebyshev,
+                                      t_low, t_high, centre, scale_c, poly, slope)
+            inside = (fi >= f_low) & (fi <= f_high)
+            more = abs(step) > one_step_limit
+            converged = (abs(step) <= one_step_limit) & (t >= t_low) & (t <= t_high)
+            out_temp[start + i] = t if inside & converged else np.nan
+            n_more += more
+            n_lost += inside & (not converged) & (not more)
+        if n_more:  # rare: a poor start, Newton goes on for those samples (one by one)
+            for i in range(m):
+                fi = freq[i]
+                t, step = _start_and_step(fi, f_low, f_high, map_offset, map_scale,
+                                          chebyshev, t_low, t_high, centre, scale_c, poly, slope)
+                if abs(step) > one_step_limit:
+                    clipped = min(max(fi, f_low), f_high)
+                    t, step, limit = _newton_scalar(t, clipped, poly, slope, centre, scale_c,
+                                                    tolerance)
+                    inside = (fi >= f_low) & (fi <= f_high)
+                    converged = (abs(step) <= limit) & (t >= t_low) & (t <= t_high)
+                    out_temp[start + i] = t if inside & converged else np.nan
+                    n_lost += inside & (not converged)
+        counts[2] += n_lost
+        # flags: Compensator._block (1.0 inside, 0.0 outside; NaN is outside)
+        for i in range(m):
+            fi = freq[i]
+            ok[i] = 1.0 if (fi >= f_cal_low) & (fi <= f_cal_high) else 0.0
+            rate_ok[i] = 1.0
+        for v in range(4):
+            if flagged[v]:
+                flag = ok if v == 0 or v == 2 else rate_ok
+                x, lo, hi = value[v], low[v], high[v]
+                for i in range(m):
+                    flag[i] = flag[i] if (x[i] >= lo) & (x[i] <= hi) else 0.0
+        n_ok = 0.0
+        n_rate_ok = 0.0
+        for i in range(m):
+            out_in_range[start + i] = ok[i]
+            n_ok += ok[i]
+            n_rate_ok += rate_ok[i]
+        counts[0] += m - int(n_ok)
+        counts[1] += m - int(n_rate_ok)
+    state[0], state[1], state[2], state[3] = y1f, y2f, y1h, y2h
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def advance_filter(freq_hz, housing_c, filt, uses_housing, state):  # pragma: no cover
+    """Run only the rate filter over a block: ``state`` becomes the state at its end.
+
+    The same operations as :func:`compensate_block`'s filter, so the state is the same
+    bits; it lets the second half of a chunk start on another thread.
+    """
+    alpha, beta, ref_f, ref_h = filt[0], filt[1], filt[3], filt[4]
+    if freq_hz.size == 0:
+        return
+    y1, y2 = state[0], state[1]
+    if state[4] == 0.0:
+        y1 = y2 = freq_hz[0] - ref_f
+        state[4] = 1.0
+    for i in range(freq_hz.size):
+        y1 = beta * y1 + alpha * (freq_hz[i] - ref_f)
+        y2 = beta * y2 + alpha * y1
+    state[0], state[1] = y1, y2
+    if uses_housing:
+        y1, y2 = state[2], state[3]
+        if state[5] == 0.0:
+            y1 = y2 = housing_c[0] - ref_h
+            state[5] = 1.0
+        for i in range(housing_c.size):
+            y1 = beta * y1 + alpha * (housing_c[i] - ref_h)
+            y2 = beta * y2 + alpha * y1
+        state[2], state[3] = y1, y2
+
+
+#: Chunks of at least this many rows are split in two halves compensated on two threads.
+PARALLEL_ROWS = 1 << 18
+
+
+def run(block_plan: KernelPlan, state: np.ndarray, freq_hz: np.ndarray, rate_dph: np.ndarray,
+        housing_c: np.ndarray | None, out: dict[str, np.ndarray], counts: np.ndarray) -> None:
+    """Compensate a chunk with a plan's arrays (outputs in ``out``, ``state`` advanced).
+
+    A long chunk is cut in two: the filter alone runs over the first half to give the
+    state at the cut, then both halves are compensated at once on two threads (the
+    kernel releases the GIL). Results are the same bits as one call.
+    """
+    housing = freq_hz if housing_c is None else housing_c
+    n = freq_hz.size
+    if n < PARALLEL_ROWS or (os.cpu_count() or 1) < 2:
+        _call(block_plan, state, freq_hz, rate_dph, housing, out, counts, 0, n)
+        return
+    middle = n // 2
+    second = state.copy()
+    advance_filter(freq_hz[:middle], housing[:middle], block_plan.filter,
+                   block_plan.uses_housing, second)
+    second_counts = np.zeros_like(counts)
+    worker = threading.Thread(target=_call, args=(block_plan, second, freq_hz, rate_dph, housing,
+                                                  out, second_counts, middle, n))
+    worker.start()
+    try:
+        _call(block_plan, state, freq_hz, rate_dph, housing, out, counts, 0, middle)
+    finally:
+        worker.join()
+    state[:] = second
+    counts += second_counts
+
+
+def _call(p: KernelPlan, state: np.ndarray, freq_hz: np.ndarray, rate_dph: np.ndarray,
+          housing_c: np.ndarray, out: dict[str, np.ndarray], counts: np.ndarray, start: int,
+          stop: int) -> None:
+    part = slice(start, stop)
+    compensate_block(
+        freq_hz[part], rate_dph[part], housing_c[part], p.filter, p.uses_housing, state,
+        p.exponents, p.coefficients, p.intercept, p.scales, p.tangent, p.low, p.high,
+        p.flagged, p.d_factor, p.d_exponents, p.d_constant, p.thermometer, p.poly, p.slope,
+        p.chebyshev, out["rate_comp_dph"][part], out["bias_model_dph"][part],
+        out["resonator_c_est"][part], out["in_range"][part], counts,
+    )
