@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import json
 import sys
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
 
@@ -24,6 +24,7 @@ from rich.progress import (
 )
 
 from hrgtc.errors import HrgtcError
+from hrgtc.progress import Progress as ProgressCallback
 
 app = typer.Typer(
     name="hrgtc",
@@ -65,7 +66,7 @@ def library_errors() -> Iterator[None]:
 @contextmanager
 def progress_bar(
     description: str, enabled: bool = True
-) -> Iterator[Callable[[float, float], None]]:
+) -> Iterator[ProgressCallback]:
     """A rich progress bar as a ``callback(done, total)`` for library functions.
 
     The bar is drawn on standard error so ``--json`` output stays clean.

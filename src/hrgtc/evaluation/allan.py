@@ -25,7 +25,7 @@ References
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass, fields
 from typing import Any
 
@@ -38,6 +38,7 @@ from hrgtc.evaluation._allan_edf import (
     confidence_interval,
     equivalent_degrees_of_freedom,
 )
+from hrgtc.progress import Progress
 
 __all__ = [
     "KINDS", "NOISE_ALPHAS", "ONE_SIGMA", "AllanResult", "NoiseTerms", "allan_deviation",
@@ -237,7 +238,7 @@ _TERMS = {"allan": (1, 2), "hadamard": (1, 3), "modified": (2, 3), "time": (2, 3
 
 def _overlapping_deviation(
     values: np.ndarray, kind: str, factors: np.ndarray, fs: float,
-    progress: Callable[[float, float], None] | None,
+    progress: Progress | None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Kept factors, deviations and term counts of an overlapping statistic (numba kernels)."""
     from hrgtc.evaluation import _allan_kernels  # numba is imported on first use only
@@ -273,7 +274,7 @@ def _overlapping_deviation(
 
 def _normal_allan(
     values: np.ndarray, factors: np.ndarray,
-    progress: Callable[[float, float], None] | None,
+    progress: Progress | None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Non-overlapping Allan deviation, SP 1065 Eq. (6)-(7), on the float64 phase."""
     n = values.size
@@ -307,7 +308,7 @@ def allan_deviation(
     kind: str = "allan",
     confidence: float | None = None,
     noise_alpha: int = 0,
-    progress: Callable[[float, float], None] | None = None,
+    progress: Progress | None = None,
 ) -> AllanResult:
     """Allan deviation of rate (frequency-type) data, NIST SP 1065 Eq. (6)-(11) [3].
 

@@ -33,7 +33,7 @@ the mean of the settled stretch; with ``extrapolate=False`` always that mean.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass
 from typing import Any
 
@@ -41,6 +41,7 @@ import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
 from hrgtc.errors import CalibrationError, InputError, RecordingError
+from hrgtc.progress import Progress
 from hrgtc.recording import Recording
 from hrgtc.thermometry.settling import MIN_FIT_POINTS, TransientFit, fit_transient
 
@@ -317,7 +318,7 @@ def find_plateaus(
     extrapolate: bool = True,
     hz_per_c: float = DEFAULT_HZ_PER_C,
     max_fit_std_c: float = DEFAULT_MAX_FIT_STD_C,
-    progress: Callable[[float, float], None] | None = None,
+    progress: Progress | None = None,
 ) -> list[Plateau]:
     """Settled plateaus of chamber soaks: the rows of Table 1 of [1] (Section 3).
 
@@ -471,7 +472,7 @@ def _segment_plateau(
 def plateaus_from_recordings(
     recordings: Sequence[Recording],
     *,
-    progress: Callable[[float, float], None] | None = None,
+    progress: Progress | None = None,
     **options: Any,
 ) -> list[Plateau]:
     """:func:`find_plateaus` of each recording (e.g. one file per soak), concatenated.
