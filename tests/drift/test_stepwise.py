@@ -85,20 +85,14 @@ def test_weighted_ols_matches_statsmodels_wls():
 
 def test_longley_nist_certified_values():
     # NIST StRD Longley, certified values (https://www.itl.nist.gov/div898/strd/lls/data/Longley.shtml)
-    certified_params = [-3482258.63459582, 15.0618722713733, -0.358191792925910e-01,
-                        -2.02022980381683, -1.03322686717359, -0.511041056535807e-01,
-                        1829.15146461355]
-    certified_bse = [890420.383607373, 84.9149257747669, 0.334910077722432e-01,
-                     0.488399681651699, 0.214274163161675, 0.226073200069370,
-                     455.478499142212]
-    certified_residual_sd = 304.854073561965
-    certified_rsquared = 0.995479004577296
+    from nist_strd_data import LONGLEY_BSE, LONGLEY_PARAMS, LONGLEY_RESIDUAL_SD, LONGLEY_RSQUARED
+
     data = sm.datasets.longley.load()
     result = ols(np.asarray(data.exog, float), np.asarray(data.endog, float))
-    np.testing.assert_allclose(result.params, certified_params, rtol=1e-9)  # NIST asks >= 7
-    np.testing.assert_allclose(result.bse, certified_bse, rtol=1e-9)
-    assert result.residual_std == pytest.approx(certified_residual_sd, rel=1e-10)
-    assert result.rsquared == pytest.approx(certified_rsquared, rel=1e-12)
+    np.testing.assert_allclose(result.params, LONGLEY_PARAMS, rtol=1e-9)  # NIST asks >= 7
+    np.testing.assert_allclose(result.bse, LONGLEY_BSE, rtol=1e-9)
+    assert result.residual_std == pytest.approx(LONGLEY_RESIDUAL_SD, rel=1e-10)
+    assert result.rsquared == pytest.approx(LONGLEY_RSQUARED, rel=1e-12)
 
 
 def _exact_least_squares(X: np.ndarray, y: np.ndarray) -> list[Fraction]:
