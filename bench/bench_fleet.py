@@ -1,0 +1,51 @@
+"""A 64-unit fleet at 10 Hz calibrated on a local Dask cluster of 1 and of 2 workers.
+
+Each unit: 7 soaks of 5 h, a 5 h cool-down and a 5 h warm-up (1.62 M samples, the
+paper's campaign at 10 Hz). The fleet is simulated first (not timed, 2 workers);
+``hrgtc fleet calibrate`` (:func:`hrgtc.fleet.calibrate_fleet`) then runs with 1 and
+with 2 worker processes. Reported: wall time (cluster start included), the
+speed-up, units per hour and the peak RSS of each worker process. ``--quick``: 8
+units at 2 Hz.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+
+def run(quick: bool = False) -> list[dict]:
+    from hrgtc.fleet import calibrate_fleet, simulate_fleet
+
+    units, rate_hz = (8, 2.0) if quick else (64, 10.0)
+    results = []
+    with tempfile.TemporaryDirectory() as tmp:
+        root = Path(tmp)
+        simulated = simulate_fleet(root / "fleet", units, seed=1, sample_rate_hz=rate_hz,
+                                   workers=2)
+        rows = sum(o.row["rows"] for o in simulated.outcomes)
+        seconds = {}
+        for workers in (1, 2):
+            run = calibrate_fleet(root / "fleet", root / f"models-{workers}", workers=workers)
+            assert not run.failed, run.failed
+            seconds[workers] = run.seconds
+            peaks = sorted(run.worker_peak_rss_mb.values())
+            results.append({
+                "name": f"fleet_calibrate_{units}units_{workers}workers", "n": units,
+                "samples": rows, "sample_rate_hz": rate_hz, "workers": workers,
+                "seconds": round(run.seconds, 2), "rate": round(units / run.seconds * 3600.0),
+                "units_per_hour": round(units / run.seconds * 3600.0),
+                "peak_rss_mb": max(peaks), "peak_rss_mb_per_worker": peaks,
+                "cores": os.cpu_count(),
+            })
+        results[-1]["speedup_vs_1_worker"] = round(seconds[1] / seconds[2], 2)
+    return results
+
+
+if __name__ == "__main__":
+    import json
+
+    for line in run(quick="--quick" in sys.argv):
+        print(json.dumps(line))
