@@ -6,6 +6,10 @@ paper's campaign at 10 Hz). The fleet is simulated first (not timed, 2 workers);
 with 2 worker processes. Reported: wall time (cluster start included), the
 speed-up, units per hour and the peak RSS of each worker process. ``--quick``: 8
 units at 2 Hz.
+
+A last line measures what the machine itself allows: the same unit calibrated
+``2 x REPEATS`` times by one plain process, then by two processes at once
+(``multiprocessing``, no Dask). Its speed-up is the ceiling for the Dask one.
 """
 
 from __future__ import annotations
@@ -14,6 +18,39 @@ import os
 import sys
 import tempfile
 from pathlib import Path
+
+REPEATS = 4
+
+
+def _calibrate_repeatedly(soaks: list[str], drifts: list[str], validate: list[str],
+                          times: int) -> None:
+    import warnings
+
+    from hrgtc.calibration import calibrate
+
+    warnings.simplefilter("ignore")
+    for _ in range(times):
+        calibrate(soaks, drifts, validate)
+
+
+def _machine_ceiling(unit) -> dict:
+    import multiprocessing
+    import time
+
+    context = multiprocessing.get_context("spawn")
+    args = (list(unit.soaks), list(unit.drifts), list(unit.validate))
+    seconds = {}
+    for processes in (1, 2):
+        with context.Pool(processes) as pool:
+            pool.starmap(_calibrate_repeatedly, [(*args, 1)] * processes)  # warm up
+            start = time.perf_counter()
+            pool.starmap(_calibrate_repeatedly, [(*args, 2 * REPEATS // processes)] * processes)
+            seconds[processes] = time.perf_counter() - start
+    return {"name": "machine_ceiling_plain_processes", "n": 2 * REPEATS,
+            "seconds": round(seconds[2], 2), "seconds_1_process": round(seconds[1], 2),
+            "rate": round(2 * REPEATS / seconds[2] * 3600.0),
+            "speedup_2_vs_1_process": round(seconds[1] / seconds[2], 2),
+            "cores": os.cpu_count()}
 
 
 def run(quick: bool = False) -> list[dict]:
@@ -41,6 +78,9 @@ def run(quick: bool = False) -> list[dict]:
                 "cores": os.cpu_count(),
             })
         results[-1]["speedup_vs_1_worker"] = round(seconds[1] / seconds[2], 2)
+        from hrgtc.fleet import load_fleet
+
+        results.append(_machine_ceiling(load_fleet(root / "fleet")[0]))
     return results
 
 

@@ -102,3 +102,17 @@ def test_robust_z_flags_the_odd_unit():
     z = robust_z([r["relative_coefficients"][0] for r in rows])
     assert abs(z[-1]) > 3.5 and max(abs(z[:-1])) < 3.5
     assert [(f["unit"], f["quantity"]) for f in outliers(rows)] == [("odd", "b1")]
+
+
+def test_an_existing_cluster_from_the_environment_runs_the_same_code(fleet_root, tmp_path,
+                                                                     monkeypatch):
+    from distributed import LocalCluster
+
+    sequential = calibrate_fleet(fleet_root, tmp_path / "seq", workers=0)
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
+                      dashboard_address=None, host="127.0.0.1") as cluster:
+        monkeypatch.setenv("DASK_SCHEDULER_ADDRESS", cluster.scheduler_address)
+        remote = calibrate_fleet(fleet_root, tmp_path / "remote")
+    assert remote.where == cluster.scheduler_address
+    assert remote.counts() == sequential.counts()
+    assert _models(tmp_path / "remote") == _models(tmp_path / "seq")

@@ -162,9 +162,9 @@ def run_tasks(tasks: Sequence[Task], *, scheduler: str | None = None, workers: i
     start = time.perf_counter()
     if workers is not None and workers < 0:
         raise InputError(f"workers must be >= 0, got {workers}")
-    address = scheduler_address(scheduler)
+    address = None if workers == 0 and not scheduler else scheduler_address(scheduler)
     peaks: dict[str, float] = {}
-    if workers == 0 and address is None:
+    if address is None and workers == 0:
         outcomes, where = _sequential(tasks, progress), "sequential"
     elif not tasks:
         outcomes, where = [], "nothing to do"

@@ -38,9 +38,10 @@ SUBSETS: dict[int, tuple[float, ...]] = {2: (-10.0, 30.0), 3: (-20.0, 10.0, 40.0
 
 
 def soak_points(seed: int, index: int, sample_rate_hz: float, soak_hours: float,
-                setpoints_c: Sequence[float] = SETPOINTS_C) -> dict[str, Any]:
+                setpoints_c: Sequence[float] = SETPOINTS_C,
+                spread: dict[str, float] | None = None) -> dict[str, Any]:
     """Simulate one unit's soaks and find their plateaus: temperatures, frequencies, errors."""
-    unit, draw = draw_unit(seed, index)
+    unit, draw = draw_unit(seed, index, spread)
     temperatures, frequencies, stds = [], [], []
     for k, setpoint in enumerate(setpoints_c):
         recording = simulate_run(profiles.soak(setpoint, soak_hours), unit=unit,
@@ -60,8 +61,12 @@ def _max_error(thermometer: Any, record: dict, grid: np.ndarray) -> float:
 
 
 def measure_prior(n_prior: int, n_held_out: int, seed: int = 1, sample_rate_hz: float = 1.0,
-                  soak_hours: float = 5.0) -> dict[str, Any]:
+                  soak_hours: float = 5.0, spread: dict[str, float] | None = None
+                  ) -> dict[str, Any]:
     """Max temperature error over -20...40 °C of held-out units with 2, 3 and 7 soaks.
+
+    ``spread`` overrides entries of :data:`hrgtc.fleet.population.SPREAD` (to see how
+    the saving depends on the assumed population).
 
     Returns
     -------
@@ -70,7 +75,8 @@ def measure_prior(n_prior: int, n_held_out: int, seed: int = 1, sample_rate_hz: 
         unit [°C]; ``band_c``: the prior fits' largest 1-sigma temperature
         uncertainty per unit, same keys; and the prior's summary.
     """
-    prior_units = [soak_points(seed, k, sample_rate_hz, soak_hours) for k in range(n_prior)]
+    prior_units = [soak_points(seed, k, sample_rate_hz, soak_hours, spread=spread)
+                    for k in range(n_prior)]
     thermometers = [fit(u["temperatures_c"], u["frequencies_hz"]) for u in prior_units]
     prior = ThermometerPrior.from_thermometers(
         thermometers, [u["truth"]["unit"]["name"] for u in prior_units])
@@ -78,7 +84,7 @@ def measure_prior(n_prior: int, n_held_out: int, seed: int = 1, sample_rate_hz: 
     errors: dict[int, list[float]] = {2: [], 3: [], 7: []}
     band: dict[int, list[float]] = {2: [], 3: []}
     for k in range(n_prior, n_prior + n_held_out):  # units not in the prior
-        unit = soak_points(seed, k, sample_rate_hz, soak_hours)
+        unit = soak_points(seed, k, sample_rate_hz, soak_hours, spread=spread)
         t, f, s = unit["temperatures_c"], unit["frequencies_hz"], unit["std_hz"]
         errors[7].append(_max_error(fit(t, f), unit["truth"], grid))
         for n, subset in SUBSETS.items():
