@@ -7,6 +7,8 @@ with 2 worker processes. Reported: wall time (cluster start included), the
 speed-up, units per hour and the peak RSS of each worker process. ``--quick``: 8
 units at 2 Hz.
 
+``cpu_seconds_per_unit`` (CPU time of the tasks) does not depend on what else the
+machine runs; wall time and speed-up do (``load_average_1min`` says how busy it was).
 A last line measures what the machine itself allows: the same unit calibrated
 ``2 x REPEATS`` times by one plain process, then by two processes at once
 (``multiprocessing``, no Dask). Its speed-up is the ceiling for the Dask one.
@@ -50,7 +52,7 @@ def _machine_ceiling(unit) -> dict:
             "seconds": round(seconds[2], 2), "seconds_1_process": round(seconds[1], 2),
             "rate": round(2 * REPEATS / seconds[2] * 3600.0),
             "speedup_2_vs_1_process": round(seconds[1] / seconds[2], 2),
-            "cores": os.cpu_count()}
+            "cores": os.cpu_count(), "load_average_1min": round(os.getloadavg()[0], 2)}
 
 
 def run(quick: bool = False) -> list[dict]:
@@ -69,12 +71,16 @@ def run(quick: bool = False) -> list[dict]:
             assert not run.failed, run.failed
             seconds[workers] = run.seconds
             peaks = sorted(run.worker_peak_rss_mb.values())
+            cpu = sum(o.cpu_seconds for o in run.outcomes)
             results.append({
                 "name": f"fleet_calibrate_{units}units_{workers}workers", "n": units,
                 "samples": rows, "sample_rate_hz": rate_hz, "workers": workers,
                 "seconds": round(run.seconds, 2), "rate": round(units / run.seconds * 3600.0),
                 "units_per_hour": round(units / run.seconds * 3600.0),
                 "peak_rss_mb": max(peaks), "peak_rss_mb_per_worker": peaks,
+                "cpu_seconds_per_unit": round(cpu / units, 3),
+                "units_per_core_hour": round(units / cpu * 3600.0),
+                "load_average_1min": round(os.getloadavg()[0], 2),
                 "cores": os.cpu_count(),
             })
         results[-1]["speedup_vs_1_worker"] = round(seconds[1] / seconds[2], 2)

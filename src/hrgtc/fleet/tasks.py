@@ -48,6 +48,9 @@ class UnitOutcome:
         ``{"type", "message", "file", "column", "row"}`` for a failed unit.
     seconds
         Wall time of the task. [s]
+    cpu_seconds
+        CPU time of the task's process while it ran (tasks are single-threaded, so
+        the work itself, whatever else the machine runs). [s]
     """
 
     unit: str
@@ -55,6 +58,7 @@ class UnitOutcome:
     row: dict[str, Any] = field(default_factory=dict)
     error: dict[str, Any] | None = None
     seconds: float = 0.0
+    cpu_seconds: float = 0.0
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types."""
@@ -64,7 +68,8 @@ class UnitOutcome:
     def from_dict(cls, data: Mapping[str, Any]) -> UnitOutcome:
         """Inverse of :meth:`to_dict`."""
         return cls(str(data["unit"]), str(data["status"]), dict(data.get("row") or {}),
-                   data.get("error"), float(data.get("seconds", 0.0)))
+                   data.get("error"), float(data.get("seconds", 0.0)),
+                   float(data.get("cpu_seconds", 0.0)))
 
 
 def error_record(exc: BaseException, paths: tuple[str, ...] = ()) -> dict[str, Any]:
@@ -134,7 +139,7 @@ def calibrate_unit(files: UnitFiles, output_dir: str, settings: Mapping[str, Any
     With ``resume``, a unit whose model exists and whose inputs' SHA-256 equal
     those in the model's provenance is skipped (its stored row returned).
     """
-    start = time.perf_counter()
+    start, cpu = time.perf_counter(), time.process_time()
     try:
         if resume:
             previous = _resumable(files, output_dir)
@@ -153,7 +158,7 @@ def calibrate_unit(files: UnitFiles, output_dir: str, settings: Mapping[str, Any
         target = model_path(output_dir, files.unit)
         save_model(result.model, target, force=True)
         outcome = UnitOutcome(files.unit, "ok", calibration_row(result, str(target)), None,
-                              time.perf_counter() - start)
+                              time.perf_counter() - start, time.process_time() - cpu)
         _write_outcome(output_dir, outcome)
         return outcome
     except Exception as exc:
