@@ -32,6 +32,7 @@ STAGES: list[set[str]] = [
     {"hrgtc.evaluation"},
     {"hrgtc.report"},
     {"hrgtc.calibration"},
+    {"hrgtc.fleet"},
     {"hrgtc.demo"},
     {"hrgtc.cli", "hrgtc"},
 ]

@@ -33,6 +33,7 @@ from hrgtc.progress import StageProgress, for_stage
 from hrgtc.recording import ReadOptions
 from hrgtc.thermometry import fit as fit_thermometer
 from hrgtc.thermometry.plateaus import Plateau, find_plateaus, plateau_table
+from hrgtc.thermometry.prior import PriorFit, ThermometerPrior, fit_with_prior, load_prior
 
 PathLike = str | os.PathLike[str]
 
@@ -63,6 +64,7 @@ class CalibrationResult:
     plateaus: tuple[Plateau, ...]
     table: tuple[dict[str, float], ...]
     validation: tuple[Evaluation, ...] = field(default=())
+    prior_fit: PriorFit | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """The layout of ``hrgtc calibrate --json``."""
@@ -91,6 +93,7 @@ class CalibrationResult:
                 "coefficients": dict(self.model.housing.coefficients),
             },
             "validation": [v.to_dict() for v in self.validation],
+            "prior": None if self.prior_fit is None else self.prior_fit.to_dict(),
         }
 
 
@@ -111,6 +114,7 @@ def calibrate(
     drift_from_soaks: bool = True,
     read_options: ReadOptions | None = None,
     progress: StageProgress | None = None,
+    prior: ThermometerPrior | PathLike | None = None,
 ) -> CalibrationResult:
     """Calibrate a unit: thermometer from soaks, drift model from ramps, held-out validation.
 
@@ -147,6 +151,12 @@ def calibrate(
         Column mapping, units and metadata overrides for every file.
     progress
         Optional ``callback(stage, done, total)``.
+    prior
+        A population prior (:class:`~hrgtc.thermometry.prior.ThermometerPrior` or
+        its file, ``hrgtc fleet prior``): the thermometer is then the posterior of
+        the prior and the soaks (two or three suffice), valid over the prior's
+        range, and ``order`` is the prior's. A prior of units of another kind is
+        refused.
     """
     options = read_options or ReadOptions()
     if not soaks:
@@ -163,7 +173,15 @@ def calibrate(
         if progress is not None:
             progress("soaks", number + 1, len(soaks))
     temperatures, frequencies = plateau_table(plateaus)
-    thermometer = fit_thermometer(temperatures, frequencies, order=order)
+    prior_fit = None
+    if prior is None:
+        thermometer = fit_thermometer(temperatures, frequencies, order=order)
+    else:
+        if not isinstance(prior, ThermometerPrior):
+            prior = load_prior(prior)
+        prior_fit = fit_with_prior(temperatures, frequencies, prior,
+                                   [p.settled_freq_std_hz for p in plateaus])
+        thermometer, order = prior_fit.thermometer, prior.order
     if not thermometer.is_monotonic:
         thermometer.temperature(frequencies)  # raises the explanatory CalibrationError
     with warnings.catch_warnings():
@@ -210,6 +228,10 @@ def calibrate(
         "plateau_options": dict(plateau_options or {}), "drift_from_soaks": drift_from_soaks,
         "columns": dict(options.columns or {}), "units": dict(options.units or {}),
     }
+    if prior_fit is not None:
+        settings["prior"] = {"units": prior_fit.prior.n_units,
+                             "range_c": list(prior_fit.prior.temperature_range_c),
+                             "max_temperature_std_c": prior_fit.max_temperature_std_c}
     unit_model = UnitModel(
         thermometer=thermometer,
         drift=model,
@@ -226,4 +248,4 @@ def calibrate(
         evaluate(path, unit_model, allan=False, read_options=options)
         for path in validate
     )
-    return CalibrationResult(unit_model, tuple(plateaus), table, validation)
+    return CalibrationResult(unit_model, tuple(plateaus), table, validation, prior_fit)

@@ -10,6 +10,7 @@ from hrgtc.cli import (
     compensate_cmd,  # noqa: F401
     demo_cmd,  # noqa: F401
     export_cmd,  # noqa: F401
+    fleet_cmd,  # noqa: F401
     info_cmd,  # noqa: F401
     paper_cmd,  # noqa: F401  (registers commands)
     report_cmd,  # noqa: F401

@@ -41,6 +41,12 @@ def render(result: CalibrationResult) -> None:
         )
     else:
         console.print(th.summary().splitlines()[-1])
+    if result.prior_fit is not None:
+        fit = result.prior_fit
+        low, high = th.temperature_range_c
+        console.print(f"Thermometer from the prior of {fit.prior.n_units} units: temperature "
+                      f"uncertainty ≤ {fit.max_temperature_std_c:.4f} °C (1σ) over {low:g} to "
+                      f"{high:g} °C")
     console.print(result.model.drift.summary())
     if result.model.housing is not None:
         console.print("Housing-thermistor baseline: " + result.model.housing.equation())
@@ -82,6 +88,9 @@ def calibrate_command(
         help="Also fit the drift model on the soaks' warming and cooling transients."),
     rate_tau_s: float = typer.Option(
         10.0, "--rate-tau-s", help="Time constant of each stage of the causal df/dt filter [s]."),
+    prior: Path = typer.Option(
+        None, "--prior", help="Population prior (hrgtc fleet prior): a Bayesian thermometer "
+        "fit, so that 2 or 3 soaks suffice."),
     force: ForceOption = False,
     json_output: JsonOption = False,
     inputs: ReadOptions | None = None,
@@ -90,6 +99,9 @@ def calibrate_command(
 
     Example: hrgtc calibrate --soak soaks/*.parquet --drift cooldown.parquet
     --validate warmup.parquet -o unit.json
+
+    With a population prior, 2 or 3 soaks: hrgtc calibrate --prior prior.json
+    --soak soak_-20C.parquet --soak soak_40C.parquet --drift cooldown.parquet -o unit.json
     """
     from hrgtc.calibration import HOUSING_TERMS, calibrate
     from hrgtc.files import refuse_existing
@@ -111,7 +123,7 @@ def calibrate_command(
             window_s=window_s, penter=penter, premove=premove, reference_c=reference_c,
             rate_tau_s=rate_tau_s, housing_terms=HOUSING_TERMS,
             drift_from_soaks=drift_from_soaks,
-            read_options=inputs, progress=progress,
+            read_options=inputs, progress=progress, prior=prior,
         )
         save_model(result.model, output, force=force)
     if json_output:

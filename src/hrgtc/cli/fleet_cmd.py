@@ -1,0 +1,236 @@
+"""``hrgtc fleet ...``: simulate, calibrate, evaluate and report many units on Dask; the prior.
+
+The commands run one task per unit: on a local Dask cluster (``--workers N``),
+on an existing one (``--scheduler tcp://HOST:8786`` or ``DASK_SCHEDULER_ADDRESS``),
+or here one after the other (``--workers 0``). A unit that fails is listed with
+its file, column and row; the others complete, and the exit code is 1.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated
+
+import typer
+from rich.table import Table
+
+from hrgtc.cli._app import app, console, error_console, library_errors, print_json, progress_bar
+from hrgtc.cli.calibrate_cmd import EQ21_DEFAULT
+from hrgtc.cli.options import ForceOption, JsonOption, OutputFormat, reading_options
+
+if TYPE_CHECKING:
+    from hrgtc.fleet import FleetRun
+    from hrgtc.recording import ReadOptions
+
+fleet_app = typer.Typer(
+    name="fleet", no_args_is_help=True, rich_markup_mode=None,
+    help="Many units: simulate, calibrate, evaluate and report them as tasks on Dask, and "
+    "build the population prior that cuts chamber time.")
+app.add_typer(fleet_app)
+
+_CLUSTER = "Cluster"
+SchedulerOption = Annotated[
+    str | None,
+    typer.Option("--scheduler", metavar="tcp://HOST:8786",
+                 help="Address of an existing Dask scheduler (default: DASK_SCHEDULER_ADDRESS, "
+                 "else a local cluster on this machine).", rich_help_panel=_CLUSTER)]
+WorkersOption = Annotated[
+    int | None,
+    typer.Option("--workers", min=0,
+                 help="Worker processes of the local cluster [default: one per core]; 0 runs "
+                 "the units here, one after the other.", rich_help_panel=_CLUSTER)]
+#: Chamber set-points of the paper (Table 1), written out for --help.
+SETPOINTS_DEFAULT = "-20,-10,0,10,20,30,40"
+
+
+def _finish(run: FleetRun, json_output: bool, written: str) -> None:
+    """Print the outcome per unit (or JSON) and exit 1 when some units failed."""
+    if json_output:
+        print_json({"summary": run.summary(), "counts": run.counts(), "seconds": run.seconds,
+                    "where": run.where, "written": written,
+                    "units": [{"unit": o.unit, "status": o.status, "error": o.error,
+                               "seconds": o.seconds} for o in run.outcomes]})
+    else:
+        if run.failed:
+            table = Table(title="Failed units")
+            for column in ("unit", "error", "file", "column", "row", "message"):
+                table.add_column(column)
+            for o in run.failed:
+                e = o.error or {}
+                table.add_row(o.unit, str(e.get("type")), str(e.get("file") or "–"),
+                              str(e.get("column") or "–"), str(e.get("row") or "–"),
+                              str(e.get("message", "")).splitlines()[0][:200])
+            console.print(table)
+        console.print(run.summary())
+        console.print(f"Written: {written}")
+    if run.failed:
+        raise typer.Exit(1)
+
+
+@fleet_app.command("simulate")
+def simulate_command(
+    units: Annotated[int, typer.Option("--units", min=1, help="Number of units.")] = 32,
+    seed: Annotated[int, typer.Option(min=0, help="Seed of the population.")] = 1,
+    output: Annotated[Path, typer.Option("-o", "--output", help="Fleet folder to write.")] = Path(
+        "fleet"),
+    sample_rate_hz: Annotated[float, typer.Option("--sample-rate-hz", "--rate-hz",
+                                                  help="Sample rate [Hz].")] = 10.0,
+    soak_hours: Annotated[float, typer.Option("--soak-hours", help="Length of each soak [h].")
+                          ] = 5.0,
+    ramp_hours: Annotated[float, typer.Option("--ramp-hours",
+                                              help="Length of the cool-down and warm-up [h].")
+                          ] = 5.0,
+    setpoints: Annotated[str, typer.Option(help="Soak set-points, comma separated [°C].")
+                         ] = SETPOINTS_DEFAULT,
+    file_format: Annotated[OutputFormat, typer.Option("--format", help="File format.")
+                           ] = OutputFormat.parquet,
+    scheduler: SchedulerOption = None,
+    workers: WorkersOption = None,
+    force: ForceOption = False,
+    json_output: JsonOption = False,
+) -> None:
+    """Simulate a population of units, each with its truth (truth.json) beside its files.
+
+    Example: hrgtc fleet simulate --units 32 --seed 1 -o fleet/
+    """
+    from hrgtc.fleet import simulate_fleet
+
+    with library_errors():
+        points = [float(v) for v in setpoints.split(",") if v.strip()]
+        with progress_bar("units", enabled=not json_output) as progress:
+            run = simulate_fleet(output, units, seed, sample_rate_hz=sample_rate_hz,
+                                 soak_hours=soak_hours, ramp_hours=ramp_hours,
+                                 setpoints_c=points, file_format=file_format.value, force=force,
+                                 scheduler=scheduler, workers=workers, progress=progress)
+    _finish(run, json_output, str(output))
+
+
+@fleet_app.command("calibrate")
+@reading_options
+def calibrate_command(
+    root: Annotated[Path, typer.Argument(
+        help="Fleet folder (ROOT/<unit>/{soaks,drift,validate}/) or manifest (.csv, .yaml).")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="Models folder.")] = Path(
+        "models"),
+    order: Annotated[int, typer.Option(help="Order of the thermometer polynomial f(T).")] = 3,
+    terms: Annotated[str, typer.Option(help="Candidate drift terms (Eq. 21 default).")
+                     ] = EQ21_DEFAULT,
+    prior: Annotated[Path | None, typer.Option(
+        "--prior", help="Population prior (hrgtc fleet prior): fit each thermometer with it.")
+    ] = None,
+    unit: Annotated[list[str] | None, typer.Option(
+        "--unit", help="Only this unit (repeat for more).")] = None,
+    resume: Annotated[bool, typer.Option(
+        "--resume", help="Skip units whose model exists and whose inputs are unchanged "
+        "(SHA-256).")] = False,
+    scheduler: SchedulerOption = None,
+    workers: WorkersOption = None,
+    force: ForceOption = False,
+    json_output: JsonOption = False,
+    inputs: ReadOptions | None = None,
+) -> None:
+    """Calibrate every unit of a fleet: a model per unit and the fleet table (fleet.parquet).
+
+    Example: hrgtc fleet calibrate fleet/ -o models/ --workers 4
+    """
+    from hrgtc.fleet import calibrate_fleet, load_fleet
+
+    settings = {"order": order, "terms": [t.strip() for t in terms.split(",") if t.strip()]}
+    with library_errors():
+        fleet = load_fleet(root, unit)
+        with progress_bar("units", enabled=not json_output) as progress:
+            run = calibrate_fleet(fleet, output, settings=settings, read_options=inputs,
+                                  resume=resume, force=force, prior=prior, scheduler=scheduler,
+                                  workers=workers, progress=progress)
+    _finish(run, json_output, f"{output}/<unit>.json, {output}/fleet.parquet")
+
+
+@fleet_app.command("evaluate")
+@reading_options
+def evaluate_command(
+    root: Annotated[Path, typer.Argument(help="Fleet folder or manifest.")],
+    models: Annotated[Path, typer.Option("--models", help="Models folder.")] = Path("models"),
+    output: Annotated[Path | None, typer.Option(
+        "-o", "--output", help="Evaluation table [default: MODELS/evaluation.parquet].")] = None,
+    allan: Annotated[bool, typer.Option("--allan/--no-allan",
+                                        help="Also compute the Allan noise terms.")] = True,
+    scheduler: SchedulerOption = None,
+    workers: WorkersOption = None,
+    force: ForceOption = False,
+    json_output: JsonOption = False,
+    inputs: ReadOptions | None = None,
+) -> None:
+    """Evaluate each unit's held-out runs (validate/, else drift/) with its model.
+
+    Example: hrgtc fleet evaluate fleet/ --models models/
+    """
+    from hrgtc.fleet import evaluate_fleet
+
+    with library_errors():
+        with progress_bar("units", enabled=not json_output) as progress:
+            run = evaluate_fleet(root, models, output, read_options=inputs, allan=allan,
+                                 force=force, scheduler=scheduler, workers=workers,
+                                 progress=progress)
+    _finish(run, json_output, str(output or models / "evaluation.parquet"))
+
+
+@fleet_app.command("report")
+@reading_options
+def report_command(
+    models: Annotated[Path, typer.Argument(help="Models folder (with fleet.parquet).")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="Fleet report (HTML).")] = Path(
+        "fleet.html"),
+    unit_reports: Annotated[Path | None, typer.Option(
+        "--unit-reports", help="Also write each unit's report into this folder (needs --root)."
+    )] = None,
+    root: Annotated[Path | None, typer.Option(
+        "--root", help="Fleet folder or manifest (for --unit-reports).")] = None,
+    scheduler: SchedulerOption = None,
+    workers: WorkersOption = None,
+    force: ForceOption = False,
+    json_output: JsonOption = False,
+    inputs: ReadOptions | None = None,
+) -> None:
+    """Write the fleet report: distributions, outliers (robust z), failed units with reasons.
+
+    Example: hrgtc fleet report models/ -o fleet.html
+    """
+    from hrgtc.fleet import report_fleet
+
+    with library_errors():
+        with progress_bar("units", enabled=not json_output and unit_reports is not None) as bar:
+            path, run = report_fleet(models, output, source=root, unit_reports=unit_reports,
+                                     read_options=inputs, force=force, scheduler=scheduler,
+                                     workers=workers, progress=bar)
+    if run is not None:
+        _finish(run, json_output, f"{path}, {unit_reports}/<unit>.html")
+    elif json_output:
+        print_json({"written": str(path)})
+    else:
+        console.print(f"Fleet report written to {path}")
+
+
+@fleet_app.command("prior")
+def prior_command(
+    models: Annotated[Path, typer.Argument(help="Models folder of calibrated units.")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="Prior file (JSON).")] = Path(
+        "prior.json"),
+    exclude: Annotated[list[str] | None, typer.Option(
+        "--exclude", help="Leave this unit out (repeat for more).")] = None,
+    force: ForceOption = False,
+    json_output: JsonOption = False,
+) -> None:
+    """Population prior of the thermometer: mean and covariance of the relative coefficients.
+
+    Example: hrgtc fleet prior models/ -o prior.json, then
+    hrgtc calibrate --prior prior.json --soak s-20.parquet --soak s40.parquet --drift ...
+    """
+    from hrgtc.fleet import build_prior
+
+    with library_errors():
+        prior = build_prior(models, output, force=force, exclude=exclude or ())
+    if json_output:
+        print_json(prior.to_dict())
+        return
+    console.print(prior.summary())
+    error_console.print(f"Prior written to {output}")

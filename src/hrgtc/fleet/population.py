@@ -1,0 +1,150 @@
+"""A simulated production population: units that differ the way real ones of one design do.
+
+Each unit is :func:`hrgtc.simulate.units.get` ``("paper-unit")`` with every part
+drawn around it. The spread (1 sigma, :data:`SPREAD`) and where each number
+comes from:
+
+* **f at 20 °C**: 4432.07 Hz (Table 1 of [1]) ± 18 Hz (0.4 %). Eq. (13)-(15) of
+  [1]: f ∝ (h / R²) sqrt(E / ρ(1+μ)), so a 0.3 % tolerance on the shell thickness
+  (± 2.5 µm on ~0.8 mm, a figure of a good lapping process; our assumption) and
+  0.1 % on the mean radius give ~0.4 %: tens of Hz, as the issue states;
+* **relative temperature coefficient** (the law f/f20 - 1 of Eq. 18 of [1]):
+  scaled as a whole by 1 ± 3 %, the temperature coefficient of Young's modulus
+  of fused quartz varying between melts (OH content, annealing) by a few %
+  (the issue's figure; we know of no published spread, so this is an assumption),
+  plus an independent ± 1 % on the quadratic and ± 2 % on the cubic term: the
+  curvature comes from the same material law, so most of it moves with the
+  linear term. The independent part is what two or three soaks cannot see; the
+  2/3-soak errors of the prior (bench/bench_prior.py) scale with it;
+* **thermal constants**: housing 720 s and resonator 2400 s (``paper-unit``,
+  from the ~15,000 s settling of Section 3 of [1]) each × lognormal(10 %):
+  mounting, getter and vacuum differ from unit to unit;
+* **bias law**: B0 -1.5 ± 1.0 °/h (turn-on bias of tactical HRGs is of the order
+  of 1 °/h), each temperature and gradient coefficient × (1 ± 20 %);
+* **noise**: ARW, bias instability, RRW and frequency noise each × lognormal(20 %).
+
+Each unit's draw is seeded by ``SeedSequence(seed, spawn_key=(k,))``, so unit k
+is the same whatever the size of the fleet.
+
+[1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+from numpy.polynomial import Polynomial
+
+from hrgtc.errors import InputError
+from hrgtc.simulate import units as simulated_units
+from hrgtc.simulate.laws import BiasLaw, PolynomialFrequencyLaw, table1_frequency_law
+from hrgtc.simulate.noise import GyroNoise
+from hrgtc.simulate.thermal import ThermalNetwork
+from hrgtc.simulate.units import Unit
+
+__all__ = ["SPREAD", "draw_unit", "draw_units", "relative_law"]
+
+#: 1-sigma unit-to-unit spread (module docstring for the sources).
+SPREAD: dict[str, float] = {
+    "f20_hz": 18.0,
+    "tc_scale": 0.03,
+    "tc_quadratic": 0.01,
+    "tc_cubic": 0.02,
+    "thermal_log": 0.10,
+    "bias0_dph": 1.0,
+    "bias_coefficients": 0.20,
+    "noise_log": 0.20,
+}
+#: f at 20 °C of the unit of [1] (Table 1). [Hz]
+F20_HZ = 4432.07
+REFERENCE_C = 20.0
+
+
+def relative_law() -> np.ndarray:
+    """(r1, r2, r3) of f/f(20 °C) = 1 + r1 x + r2 x² + r3 x³, x = T - 20 °C (Eq. 18 of [1])."""
+    law = Polynomial(table1_frequency_law().coefficients)
+    shifted = law(Polynomial([REFERENCE_C, 1.0])).coef
+    return shifted[1:] / shifted[0]
+
+
+def draw_unit(seed: int, k: int, spread: dict[str, float] | None = None) -> tuple[Unit, dict]:
+    """Unit ``k`` of the population of ``seed``: ``(unit, draw)``, the draw in plain JSON."""
+    if not isinstance(seed, int) or seed < 0 or not isinstance(k, int) or k < 0:
+        raise InputError(f"seed and unit index must be non-negative integers, got {seed}, {k}")
+    s = {**SPREAD, **(spread or {})}
+    rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(k,)))
+    base = simulated_units.get("paper-unit")
+    f20 = F20_HZ + s["f20_hz"] * rng.standard_normal()
+    scale = 1.0 + s["tc_scale"] * rng.standard_normal()
+    quad = 1.0 + s["tc_quadratic"] * rng.standard_normal()
+    cubic = 1.0 + s["tc_cubic"] * rng.standard_normal()
+    r1, r2, r3 = relative_law()
+    relative = np.array([1.0, scale * r1, scale * r2 * quad, scale * r3 * cubic])
+    # f(T) = f20 (1 + r(T - 20)): to ascending powers of T.
+    coefficients = f20 * Polynomial(relative)(Polynomial([-REFERENCE_C, 1.0])).coef
+    thermal = ThermalNetwork(
+        tau_housing_s=base.thermal.tau_housing_s * float(np.exp(s["thermal_log"]
+                                                              * rng.standard_normal())),
+        tau_resonator_s=base.thermal.tau_resonator_s * float(np.exp(s["thermal_log"]
+                                                                  * rng.standard_normal())))
+    law = base.bias_law
+
+    def vary(value: float) -> float:
+        return float(value * (1.0 + s["bias_coefficients"] * rng.standard_normal()))
+
+    bias = BiasLaw(
+        bias0_dph=float(law.bias0_dph + s["bias0_dph"] * rng.standard_normal()),
+        reference_c=law.reference_c,
+        temperature_dph=tuple(vary(c) for c in law.temperature_dph),
+        gradient_dph_per_c=vary(law.gradient_dph_per_c),
+        gradient_temperature_dph_per_c2=law.gradient_temperature_dph_per_c2,
+        hysteresis_dph=law.hysteresis_dph,
+    )
+    noise = base.gyro_noise
+
+    def lognormal() -> float:
+        return float(np.exp(s["noise_log"] * rng.standard_normal()))
+
+    gyro_noise = GyroNoise(arw_deg_per_sqrt_h=noise.arw_deg_per_sqrt_h * lognormal(),
+                           bias_instability_dph=noise.bias_instability_dph * lognormal(),
+                           rrw_dph_per_sqrt_h=noise.rrw_dph_per_sqrt_h * lognormal())
+    name = f"s{seed}-u{k:04d}"
+    unit = replace(
+        base, name=name,
+        description=f"unit {k} of the simulated population of seed {seed}",
+        thermal=thermal,
+        frequency_law=PolynomialFrequencyLaw(
+            tuple(float(c) for c in coefficients),
+            source=f"population draw around Eq. (18) of [1] (seed {seed}, unit {k})"),
+        bias_law=bias, gyro_noise=gyro_noise,
+        frequency_noise_hz=base.frequency_noise_hz * lognormal(),
+    )
+    draw: dict[str, Any] = {"seed": seed, "index": k, "f20_hz": float(f20),
+                            "tc_scale": float(scale), "tc_quadratic": float(quad),
+                            "tc_cubic": float(cubic),
+                            "relative_law_x_minus_20": [float(v) for v in relative[1:]],
+                            "spread": s}
+    return unit, draw
+
+
+def draw_units(n: int, seed: int, first: int = 0,
+               spread: dict[str, float] | None = None) -> list[tuple[Unit, dict]]:
+    """Units ``first .. first + n - 1`` of the population of ``seed``."""
+    if not isinstance(n, int) or n < 1:
+        raise InputError(f"the number of units must be a positive integer, got {n!r}")
+    return [draw_unit(seed, k, spread) for k in range(first, first + n)]
+
+
+def truth(unit: Unit, draw: dict) -> dict[str, Any]:
+    """The unit's ground truth as written beside its files (``truth.json``)."""
+    return {"schema": "hrgtc.fleet-truth", "unit": unit.to_dict(), "draw": draw}
+
+
+def true_frequency_hz(truth_record: dict[str, Any], temperature_c: Any) -> np.ndarray:
+    """The true f(T) of a unit from its ``truth.json`` record. [Hz]"""
+    law = truth_record["unit"]["frequency_law"]
+    if law.get("kind") != "polynomial":
+        raise InputError("truth record without a polynomial frequency law")
+    return Polynomial(law["coefficients"])(np.asarray(temperature_c, dtype=np.float64))

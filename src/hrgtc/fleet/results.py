@@ -1,0 +1,140 @@
+"""The fleet table: one Parquet row per unit.
+
+A row holds the unit's thermometer (coefficients, Eq. 18 form of [1], and the
+relative scaled coefficients a prior is built from), its Table 1 (soak
+temperatures and settled frequencies), the temperature coefficient of frequency
+at 20 °C, the drift terms kept (Eq. 22 form), the raw and compensated 10 s bias
+stability of each held-out run with the shares of samples out of the calibrated
+ranges, and the status with, for a failed unit, the error and where it was.
+
+[1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+from hrgtc.errors import InputError
+from hrgtc.files import publish, refuse_existing, temporary_beside
+
+if TYPE_CHECKING:
+    from hrgtc.calibration import CalibrationResult
+    from hrgtc.evaluation import Evaluation
+    from hrgtc.fleet.tasks import UnitOutcome
+
+__all__ = ["SCHEMA", "calibration_row", "evaluation_row", "read_table", "table", "write_table"]
+
+_F = pa.float64()
+_LF = pa.list_(pa.float64())
+_LS = pa.list_(pa.string())
+SCHEMA = pa.schema([
+    ("unit", pa.string()), ("status", pa.string()), ("seconds", _F),
+    ("error_type", pa.string()), ("error_message", pa.string()), ("error_file", pa.string()),
+    ("error_column", pa.string()), ("error_row", pa.int64()),
+    ("model_file", pa.string()), ("n_soaks", pa.int64()),
+    ("temperature_low_c", _F), ("temperature_high_c", _F),
+    ("centre_c", _F), ("scale_c", _F),
+    ("coefficients_high_first", _LF), ("freq_centre_hz", _F), ("relative_coefficients", _LF),
+    ("f20_hz", _F), ("tcf_ppm_per_c", _F),
+    ("soak_temperatures_c", _LF), ("settled_freqs_hz", _LF), ("table_max_error_c", _F),
+    ("terms_kept", _LS), ("n_terms", pa.int64()),
+    ("runs", _LS), ("raw_10s_dph", _LF), ("compensated_10s_dph", _LF),
+    ("improvement_10s", _LF), ("out_of_range_fraction", _LF),
+    ("rate_out_of_range_fraction", _LF), ("median_improvement_10s", _F),
+])
+
+
+def _num(value: Any) -> float | None:
+    return None if value is None or not math.isfinite(float(value)) else float(value)
+
+
+def evaluation_row(evaluations: Sequence[Evaluation]) -> dict[str, Any]:
+    """Per-run bias stability and range shares of a unit's held-out runs."""
+    improvements = [_num(v.improvement_10s) for v in evaluations]
+    finite = sorted(v for v in improvements if v is not None)
+    median = None if not finite else (finite[(len(finite) - 1) // 2]
+                                      + finite[len(finite) // 2]) / 2
+    return {
+        "runs": [v.file for v in evaluations],
+        "raw_10s_dph": [_num(v.raw_10s) for v in evaluations],
+        "compensated_10s_dph": [_num(v.compensated_10s) for v in evaluations],
+        "improvement_10s": improvements,
+        "out_of_range_fraction": [float(v.out_of_range_fraction) for v in evaluations],
+        "rate_out_of_range_fraction": [float(v.rate_out_of_range_fraction) for v in evaluations],
+        "median_improvement_10s": median,
+    }
+
+
+def calibration_row(result: CalibrationResult, model_file: str) -> dict[str, Any]:
+    """A calibrated unit's row (thermometer, Table 1, drift terms, validation)."""
+    from hrgtc.thermometry.prior import relative_coefficients
+
+    model = result.model
+    th = model.thermometer
+    a0, relative = relative_coefficients(th, th.centre_c, th.scale_c)
+    f20 = float(th.frequency(20.0))
+    return {
+        "unit": model.unit, "model_file": model_file, "n_soaks": len(result.plateaus),
+        "temperature_low_c": th.temperature_range_c[0],
+        "temperature_high_c": th.temperature_range_c[1],
+        "centre_c": th.centre_c, "scale_c": th.scale_c,
+        "coefficients_high_first": list(th.coefficients_high_first),
+        "freq_centre_hz": a0, "relative_coefficients": [float(v) for v in relative],
+        "f20_hz": f20, "tcf_ppm_per_c": float(th.slope_hz_per_c(20.0)) / f20 * 1e6,
+        "soak_temperatures_c": [r["chamber_c"] for r in result.table],
+        "settled_freqs_hz": [r["freq_hz"] for r in result.table],
+        "table_max_error_c": max((abs(r["error_c"]) for r in result.table), default=None),
+        "terms_kept": list(model.drift.selected), "n_terms": len(model.drift.selected),
+        **evaluation_row(result.validation),
+    }
+
+
+def table(outcomes: Sequence[UnitOutcome]) -> pa.Table:
+    """The fleet table of some outcomes, a row per unit in name order."""
+    rows = []
+    for outcome in sorted(outcomes, key=lambda o: o.unit):
+        error = outcome.error or {}
+        row = {name: None for name in SCHEMA.names}
+        row.update({k: v for k, v in outcome.row.items() if k in row})
+        row.update(unit=outcome.unit, status=outcome.status, seconds=outcome.seconds,
+                   error_type=error.get("type"), error_message=error.get("message"),
+                   error_file=error.get("file"), error_column=error.get("column"),
+                   error_row=error.get("row"))
+        rows.append(row)
+    return pa.Table.from_pylist(rows, schema=SCHEMA)
+
+
+def write_table(outcomes: Sequence[UnitOutcome], path: str | os.PathLike[str],
+                force: bool = False) -> Path:
+    """Write the fleet table to Parquet atomically."""
+    target = Path(path)
+    refuse_existing(target, force)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    temporary = temporary_beside(target)
+    try:
+        pq.write_table(table(outcomes), temporary)
+        publish(temporary, target, force)
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise
+    return target
+
+
+def read_table(path: str | os.PathLike[str]) -> list[dict[str, Any]]:
+    """The rows of a fleet table (plain Python values)."""
+    try:
+        data = pq.read_table(path)
+    except FileNotFoundError:
+        raise InputError(f"{path}: no such fleet table; run 'hrgtc fleet calibrate'") from None
+    except (OSError, pa.ArrowException) as exc:
+        raise InputError(f"{path}: not a readable fleet table: {exc}") from exc
+    if "unit" not in data.column_names or "status" not in data.column_names:
+        raise InputError(f"{path}: not a fleet table (no unit and status columns)")
+    return data.to_pylist()

@@ -1,0 +1,198 @@
+"""The fleet driver: one task per unit on Dask, a local cluster or an existing one.
+
+Where the tasks run:
+
+* ``workers=0``: in this process, one unit after the other (no Dask; the
+  reference the parallel runs are tested against, bit for bit);
+* ``scheduler="tcp://host:8786"`` (or the ``DASK_SCHEDULER_ADDRESS``
+  environment variable, Dask's ``scheduler-address`` setting): an existing
+  Dask cluster, unchanged; its workers need hrgtc installed and the unit files
+  at the same paths (a shared file system);
+* otherwise an in-process :class:`distributed.LocalCluster` on this machine,
+  ``workers`` processes of one thread each (default: one per core, at most one
+  per unit), started and stopped around the run.
+
+Only paths, settings and the small outcomes cross between the client and the
+workers; the workers read the data. Tasks never raise (:mod:`hrgtc.fleet.tasks`);
+a worker that dies (out of memory, killed) fails its unit, not the run.
+Dask is imported only here and only when a cluster is used.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+import uuid
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+from hrgtc.fleet.tasks import UnitOutcome, error_record
+from hrgtc.progress import Progress
+
+__all__ = ["FleetRun", "Task", "run_tasks", "scheduler_address"]
+
+#: ``(unit, function, args)``: one unit's task.
+Task = tuple[str, Callable[..., UnitOutcome], tuple[Any, ...]]
+
+
+@dataclass(frozen=True)
+class FleetRun:
+    """Outcomes of a fleet run and how it ran.
+
+    Attributes
+    ----------
+    outcomes
+        One per unit, in name order.
+    seconds
+        Wall time, cluster start included. [s]
+    where
+        ``"sequential"``, ``"local cluster of N workers"`` or the scheduler address.
+    worker_peak_rss_mb
+        Peak resident set size of each worker process (local cluster only). [MB]
+    """
+
+    outcomes: tuple[UnitOutcome, ...]
+    seconds: float
+    where: str
+    worker_peak_rss_mb: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def failed(self) -> list[UnitOutcome]:
+        """The units that failed."""
+        return [o for o in self.outcomes if o.status == "failed"]
+
+    def counts(self) -> dict[str, int]:
+        """Units per status."""
+        out: dict[str, int] = {"ok": 0, "skipped": 0, "failed": 0}
+        for o in self.outcomes:
+            out[o.status] = out.get(o.status, 0) + 1
+        return out
+
+    def summary(self) -> str:
+        """One line."""
+        c = self.counts()
+        return (f"{len(self.outcomes)} units in {self.seconds:.1f} s ({self.where}): "
+                f"{c['ok']} done, {c['skipped']} skipped (unchanged), {c['failed']} failed")
+
+
+def scheduler_address(scheduler: str | None = None) -> str | None:
+    """The scheduler to use: ``scheduler``, else ``DASK_SCHEDULER_ADDRESS`` / Dask's config."""
+    if scheduler:
+        return scheduler
+    if os.environ.get("DASK_SCHEDULER_ADDRESS"):
+        return os.environ["DASK_SCHEDULER_ADDRESS"]
+    try:
+        import dask
+
+        return dask.config.get("scheduler-address", None) or None
+    except ImportError:  # pragma: no cover - dask is a dependency
+        return None
+
+
+def _peak_rss_mb() -> float:
+    """This process's peak resident set size (VmHWM). [MB]"""
+    try:
+        with open("/proc/self/status", encoding="ascii") as status:
+            for line in status:
+                if line.startswith("VmHWM:"):
+                    return round(int(line.split()[1]) / 1024.0, 1)
+    except OSError:
+        pass
+    import resource
+
+    return round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, 1)
+
+
+def _sequential(tasks: Sequence[Task], progress: Progress | None) -> list[UnitOutcome]:
+    outcomes = []
+    for done, (_unit, function, args) in enumerate(tasks, start=1):
+        outcomes.append(function(*args))
+        if progress is not None:
+            progress(done, len(tasks))
+    return outcomes
+
+
+def _on_cluster(client: Any, tasks: Sequence[Task], progress: Progress | None,
+                label: str) -> list[UnitOutcome]:
+    from distributed import as_completed
+
+    run_id = uuid.uuid4().hex[:8]
+    futures = {
+        client.submit(function, *args, key=f"hrgtc-{label}-{unit}-{run_id}", pure=False,
+                      retries=0): unit
+        for unit, function, args in tasks
+    }
+    outcomes = []
+    for done, future in enumerate(as_completed(futures), start=1):
+        unit = futures[future]
+        start = time.perf_counter()
+        try:
+            outcomes.append(future.result())
+        except Exception as exc:  # the worker died (memory, signal): this unit fails
+            outcomes.append(UnitOutcome(unit, "failed", {}, error_record(exc),
+                                        time.perf_counter() - start))
+        future.release()
+        if progress is not None:
+            progress(done, len(tasks))
+    return outcomes
+
+
+def run_tasks(tasks: Sequence[Task], *, scheduler: str | None = None, workers: int | None = None,
+              progress: Progress | None = None, label: str = "unit") -> FleetRun:
+    """Run one task per unit (module docstring for where) and gather the outcomes.
+
+    Parameters
+    ----------
+    tasks
+        ``(unit, function, args)`` each; ``function(*args)`` returns a
+        :class:`~hrgtc.fleet.tasks.UnitOutcome` and must be importable by the workers.
+    scheduler
+        Address of an existing Dask scheduler (default ``DASK_SCHEDULER_ADDRESS``).
+    workers
+        Local cluster size (default: cores, at most one per unit); 0 runs the tasks
+        here, one after the other.
+    progress
+        ``progress(units_done, units_total)``.
+    label
+        Part of the Dask task keys (what the dashboard shows).
+    """
+    from hrgtc.errors import InputError
+
+    start = time.perf_counter()
+    if workers is not None and workers < 0:
+        raise InputError(f"workers must be >= 0, got {workers}")
+    address = None if workers == 0 and not scheduler else scheduler_address(scheduler)
+    peaks: dict[str, float] = {}
+    if address is None and workers == 0:
+        outcomes, where = _sequential(tasks, progress), "sequential"
+    elif not tasks:
+        outcomes, where = [], "nothing to do"
+    elif address is not None:
+        from distributed import Client
+
+        try:
+            client = Client(address, timeout="20s")
+        except OSError as exc:
+            raise InputError(f"cannot reach the Dask scheduler at {address}: {exc}; start it "
+                             "(dask scheduler) or drop --scheduler / DASK_SCHEDULER_ADDRESS")\
+                from exc
+        with client:
+            outcomes, where = _on_cluster(client, tasks, progress, label), address
+    else:
+        import logging
+
+        from distributed import Client, LocalCluster
+
+        n = max(1, min(workers or (os.cpu_count() or 1), len(tasks)))
+        with (
+            LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                         dashboard_address=None, silence_logs=logging.ERROR,
+                         host="127.0.0.1") as cluster,
+            Client(cluster) as client,
+        ):
+            outcomes = _on_cluster(client, tasks, progress, label)
+            peaks = {str(k): float(v) for k, v in client.run(_peak_rss_mb).items()}
+        where = f"local cluster of {n} worker{'s' if n > 1 else ''}"
+    return FleetRun(tuple(sorted(outcomes, key=lambda o: o.unit)),
+                    time.perf_counter() - start, where, peaks)

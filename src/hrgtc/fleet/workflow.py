@@ -1,0 +1,198 @@
+"""Fleet workflows: simulate, calibrate, evaluate, report and build a prior over many units.
+
+Each function builds one task per unit (:mod:`hrgtc.fleet.tasks`), runs them
+with :func:`hrgtc.fleet.run.run_tasks` (sequentially, on a local Dask cluster
+or on an existing one) and writes the fleet's outputs: the models and the
+fleet table (``fleet.parquet``), the evaluation table, the fleet report, the
+prior.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+from hrgtc.errors import InputError
+from hrgtc.files import refuse_existing
+from hrgtc.fleet import tasks
+from hrgtc.fleet.manifest import UnitFiles, load_fleet
+from hrgtc.fleet.results import read_table, write_table
+from hrgtc.fleet.run import FleetRun, run_tasks
+from hrgtc.progress import Progress
+from hrgtc.recording import ReadOptions
+
+__all__ = ["FLEET_TABLE", "build_prior", "calibrate_fleet", "evaluate_fleet", "report_fleet",
+           "simulate_fleet"]
+
+PathLike = str | os.PathLike[str]
+#: The fleet table written beside the models.
+FLEET_TABLE = "fleet.parquet"
+#: The evaluation table written beside the models by ``fleet evaluate``.
+EVALUATION_TABLE = "evaluation.parquet"
+#: Chamber set-points of the paper's soaks (Table 1 of [1]). [°C]
+SETPOINTS_C = (-20.0, -10.0, 0.0, 10.0, 20.0, 30.0, 40.0)
+
+
+def _fleet(source: PathLike | Sequence[UnitFiles]) -> list[UnitFiles]:
+    return list(source) if not isinstance(source, str | os.PathLike) else load_fleet(source)
+
+
+def simulate_fleet(output: PathLike, units: int, seed: int = 1, *,
+                   sample_rate_hz: float = 10.0, soak_hours: float = 5.0,
+                   ramp_hours: float = 5.0, setpoints_c: Sequence[float] = SETPOINTS_C,
+                   file_format: str = "parquet", force: bool = False,
+                   scheduler: str | None = None, workers: int | None = None,
+                   progress: Progress | None = None) -> FleetRun:
+    """Simulate ``units`` units of the population of ``seed`` under ``output/<unit>/``.
+
+    Unit k gets soaks at ``setpoints_c`` (``soaks/``), a cool-down (``drift/``),
+    a warm-up (``validate/``) and its ground truth (``truth.json``): the drawn
+    frequency law, thermal constants, bias law and noise
+    (:mod:`hrgtc.fleet.population`).
+    """
+    if not isinstance(units, int) or units < 1:
+        raise InputError(f"--units must be a positive integer, got {units!r}")
+    root = Path(output)
+    if not force and root.is_dir() and any(root.iterdir()):
+        raise InputError(f"{root} is not empty; pass --force to overwrite or give a new folder")
+    root.mkdir(parents=True, exist_ok=True)
+    work = [(f"s{seed}-u{k:04d}", tasks.simulate_unit,
+             (seed, k, str(root), sample_rate_hz, soak_hours,
+              tuple(float(t) for t in setpoints_c), ramp_hours, file_format, force))
+            for k in range(units)]
+    return run_tasks(work, scheduler=scheduler, workers=workers, progress=progress,
+                     label="simulate")
+
+
+def calibrate_fleet(source: PathLike | Sequence[UnitFiles], output: PathLike, *,
+                    settings: Mapping[str, Any] | None = None,
+                    read_options: ReadOptions | None = None, resume: bool = False,
+                    force: bool = False, prior: PathLike | None = None,
+                    scheduler: str | None = None, workers: int | None = None,
+                    progress: Progress | None = None) -> FleetRun:
+    """Calibrate every unit (:func:`hrgtc.calibration.calibrate` as one task per unit).
+
+    Writes ``output/<unit>.json`` (models), ``output/<unit>.outcome.json`` and the
+    fleet table ``output/fleet.parquet``. Existing models are refused unless
+    ``force`` (recalibrate all) or ``resume`` (skip units whose model exists and
+    whose inputs' SHA-256 are unchanged, recalibrate the others).
+
+    Parameters
+    ----------
+    source
+        A manifest, a fleet folder, or the units' files.
+    settings
+        Keyword arguments of :func:`~hrgtc.calibration.calibrate` (order, terms, ...).
+    prior
+        A prior file: every unit is calibrated with it (:mod:`hrgtc.thermometry.prior`).
+    """
+    fleet = _fleet(source)
+    out = Path(output)
+    models = [tasks.model_path(out, u.unit) for u in fleet]
+    if not resume:
+        refuse_existing([*models, out / FLEET_TABLE], force,
+                        "nothing was calibrated; --resume skips unchanged units")
+    out.mkdir(parents=True, exist_ok=True)
+    work = [(u.unit, tasks.calibrate_unit,
+             (u, str(out), dict(settings or {}), read_options, resume,
+              None if prior is None else str(prior)))
+            for u in fleet]
+    run = run_tasks(work, scheduler=scheduler, workers=workers, progress=progress,
+                    label="calibrate")
+    write_table(run.outcomes, out / FLEET_TABLE, force=True)
+    return run
+
+
+def evaluate_fleet(source: PathLike | Sequence[UnitFiles], models: PathLike,
+                   output: PathLike | None = None, *, read_options: ReadOptions | None = None,
+                   allan: bool = True, force: bool = False, scheduler: str | None = None,
+                   workers: int | None = None, progress: Progress | None = None) -> FleetRun:
+    """Evaluate each unit's held-out runs with its model; write the evaluation table.
+
+    ``output`` defaults to ``<models>/evaluation.parquet``.
+    """
+    fleet = _fleet(source)
+    target = Path(output) if output is not None else Path(models) / EVALUATION_TABLE
+    refuse_existing(target, force)
+    work = [(u.unit, tasks.evaluate_unit, (u, str(models), read_options, allan)) for u in fleet]
+    run = run_tasks(work, scheduler=scheduler, workers=workers, progress=progress,
+                    label="evaluate")
+    write_table(run.outcomes, target, force=force)
+    return run
+
+
+def report_fleet(models: PathLike, output: PathLike, *, table: PathLike | None = None,
+                 source: PathLike | Sequence[UnitFiles] | None = None,
+                 unit_reports: PathLike | None = None,
+                 read_options: ReadOptions | None = None, force: bool = False,
+                 scheduler: str | None = None, workers: int | None = None,
+                 progress: Progress | None = None) -> tuple[Path, FleetRun | None]:
+    """Write the fleet report from the fleet table; optionally each unit's report as tasks.
+
+    Parameters
+    ----------
+    models
+        The models folder (holding ``fleet.parquet``).
+    output
+        The fleet report (HTML).
+    table
+        Another fleet table (default ``<models>/fleet.parquet``).
+    source, unit_reports
+        With both, each calibrated unit's HTML report (:func:`hrgtc.report.build_report`)
+        is written to ``unit_reports/<unit>.html`` as one task per unit.
+    """
+    from hrgtc.fleet.report import build_fleet_report
+
+    rows = read_table(table or Path(models) / FLEET_TABLE)
+    refuse_existing(output, force)
+    run = None
+    if unit_reports is not None:
+        if source is None:
+            raise InputError("unit reports need the fleet's files: give the fleet ROOT")
+        done = {r["unit"] for r in rows if r["status"] in ("ok", "skipped")}
+        fleet = [u for u in _fleet(source) if u.unit in done]
+        Path(unit_reports).mkdir(parents=True, exist_ok=True)
+        work = [(u.unit, tasks.report_unit, (u, str(models), str(unit_reports), read_options,
+                                              force)) for u in fleet]
+        run = run_tasks(work, scheduler=scheduler, workers=workers, progress=progress,
+                        label="report")
+    return build_fleet_report(rows, output, force=force), run
+
+
+def build_prior(models: PathLike, output: PathLike | None = None, *, force: bool = False,
+                exclude: Sequence[str] = ()) -> Any:
+    """The population prior of a models folder (every ``<unit>.json`` model file).
+
+    Units whose model was fitted with a prior themselves are left out (they would
+    feed the prior back into itself), as are those in ``exclude``.
+    """
+    from hrgtc.model import load_model
+    from hrgtc.thermometry.prior import ThermometerPrior, save_prior
+
+    folder = Path(models)
+    if not folder.is_dir():
+        raise InputError(f"{folder}: no such models folder")
+    thermometers, names = [], []
+    for path in sorted(folder.glob("*.json")):
+        if path.name.endswith(".outcome.json"):
+            continue
+        try:
+            head = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, json.JSONDecodeError):
+            continue
+        if not isinstance(head, dict) or head.get("schema") != "hrgtc.model":
+            continue
+        model = load_model(path)
+        if model.unit in exclude or "prior" in model.provenance.get("settings", {}):
+            continue
+        thermometers.append(model.thermometer)
+        names.append(model.unit)
+    if not thermometers:
+        raise InputError(f"{folder}: no model files; run 'hrgtc fleet calibrate' first")
+    prior = ThermometerPrior.from_thermometers(thermometers, names)
+    if output is not None:
+        save_prior(prior, output, force=force)
+    return prior
