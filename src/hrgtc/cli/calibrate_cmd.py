@@ -91,6 +91,10 @@ def calibrate_command(
         help="Also fit the drift model on the soaks' warming and cooling transients."),
     rate_tau_s: float = typer.Option(
         10.0, "--rate-tau-s", help="Time constant of each stage of the causal df/dt filter [s]."),
+    select: str = typer.Option(
+        "stepwise", "--select",
+        help="Term selection: 'stepwise' (F-tests) or 'cv' (leave-one-run-out "
+        "cross-validated bias stability; needs two training runs or more)."),
     force: ForceOption = False,
     strict: StrictOption = False,
     json_output: JsonOption = False,
@@ -120,7 +124,7 @@ def calibrate_command(
             terms=[t.strip() for t in terms.split(",") if t.strip()],
             window_s=window_s, penter=penter, premove=premove, reference_c=reference_c,
             rate_tau_s=rate_tau_s, housing_terms=HOUSING_TERMS,
-            drift_from_soaks=drift_from_soaks,
+            drift_from_soaks=drift_from_soaks, select=select,
             read_options=inputs, progress=progress,
         )
         save_model(result.model, output, force=force)
