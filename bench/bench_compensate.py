@@ -64,14 +64,15 @@ def plain_script(model_path: str, source: str, output: str, rows: int = 1 << 20)
     model = load_model(model_path)
     variables = tuple(dict.fromkeys(("f", "df", *model.drift.variables)))
     plan = kernel.plan(model.drift, model.thermometer, variables)
-    state, counts = kernel.new_state(), np.zeros(3, dtype=np.int64)
+    state, counts = kernel.new_state(), np.zeros(4, dtype=np.int64)
+    extremes = kernel.new_extremes()
     writer = None
     done = 0
     for batch in pq.ParquetFile(source).iter_batches(batch_size=rows):
         out = {name: np.empty(batch.num_rows) for name in OUTPUT_COLUMNS}
         housing = batch.column("housing_c").to_numpy() if plan.uses_housing else None
         kernel.run(plan, state, batch.column("freq_hz").to_numpy(),
-                   batch.column("rate_dph").to_numpy(), housing, out, counts)
+                   batch.column("rate_dph").to_numpy(), housing, out, counts, extremes)
         table = pa.Table.from_batches([batch])
         for name in OUTPUT_COLUMNS:
             table = table.append_column(name, pa.array(out[name]))

@@ -87,6 +87,9 @@ class CalibrationResult:
                 "pvalues": dict(d.pvalues),
                 "window_s": d.window_s,
                 "n_windows": d.n_windows,
+                "selection": d.selection,
+                "cross_validation": None if d.cross_validation is None
+                else d.cross_validation.to_dict(),
             },
             "housing": None if self.model.housing is None else {
                 "selected_terms": list(self.model.housing.selected),
@@ -112,6 +115,7 @@ def calibrate(
     housing_terms: Iterable[str] | None = HOUSING_TERMS,
     plateau_options: Mapping[str, Any] | None = None,
     drift_from_soaks: bool = True,
+    select: str = "stepwise",
     read_options: ReadOptions | None = None,
     progress: StageProgress | None = None,
     prior: ThermometerPrior | PathLike | None = None,
@@ -123,7 +127,9 @@ def calibrate(
     soaks
         Soak recordings (one per set-point, or files holding several).
     drifts
-        Ramp recordings to fit the drift model on (cool-down, warm-up).
+        Ramp recordings to fit the drift model on (cool-down, warm-up, cycles); with
+        two training runs or more (the soaks count) the fit reports each run's
+        leave-one-run-out cross-validated bias stability, heating and cooling apart.
     validate
         Held-out runs: bias stability raw and compensated is reported for each.
     order
@@ -147,6 +153,9 @@ def calibrate(
         the polynomial in f and the df/dt terms are confounded; the soaks' warming
         and cooling transients add curves of both signs of df/dt, without which a
         cool-down model extrapolates badly to a warm-up.
+    select
+        ``"stepwise"`` (F-tests, default) or ``"cv"`` (forward selection by
+        leave-one-run-out cross-validated bias stability), see :func:`hrgtc.drift.fit`.
     read_options
         Column mapping, units and metadata overrides for every file.
     progress
@@ -208,7 +217,7 @@ def calibrate(
     model = drift_model.fit(
         runs, thermometer, terms=terms, window_s=window_s, penter=penter, premove=premove,
         reference_c=reference_c, rate_tau_s=rate_tau_s, excitation_runs=len(drifts),
-        progress=for_stage(progress, "drift"),
+        select=select, progress=for_stage(progress, "drift"),
     )
     housing = None
     if housing_terms is not None and all("housing_c" in heads[str(p)] for p in training):
@@ -226,6 +235,7 @@ def calibrate(
         "premove": premove, "reference_c": reference_c, "rate_tau_s": rate_tau_s,
         "housing_terms": None if housing_terms is None else list(housing_terms),
         "plateau_options": dict(plateau_options or {}), "drift_from_soaks": drift_from_soaks,
+        "select": select,
         "columns": dict(options.columns or {}), "units": dict(options.units or {}),
     }
     if prior_fit is not None:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
+import json
 import subprocess
 import sys
 
@@ -57,8 +58,31 @@ def test_out_of_range_samples_are_counted(unit_model):
     hot = ramp_run(seed=23, start_c=20.0, end_c=60.0, hours=1.0)
     compensator = Compensator(unit_model)
     out = compensator.process(hot)
-    assert compensator.out_of_range_fraction == pytest.approx(1 - out["in_range"].mean())
     assert compensator.out_of_range_fraction > 0.2
+    assert compensator.settling == round(unit_model.drift.settings.warmup_s * hot.sample_rate_hz)
+    # in_range is 0 beyond the trained temperature, beyond the trained df/dt, and while
+    # the filter settles; the kinds are counted apart
+    assert 1 - out["in_range"].mean() >= max(compensator.out_of_range_fraction,
+                                             compensator.rate_out_of_range_fraction)
+    assert not out["in_range"][: compensator.settling].any()
+    report = compensator.ranges()
+    assert report.temperature_fraction == compensator.out_of_range_fraction
+    assert report.seen_c[1] > 25.0 and report.temperature_excess_c > 5.0
+    assert any("beyond the trained temperature" in line for line in report.warnings())
+
+
+@pytest.mark.parametrize("engine", ["fused", "numpy"])
+def test_range_report_says_how_far_df_dt_went(unit_model, engine):
+    """A warm-up at 4x the training rate: in_range 0 there, the ratio of rates reported."""
+    fast = ramp_run(seed=24, start_c=0.0, end_c=10.0, hours=1.0, ramp_hours=0.1)
+    compensator = Compensator(unit_model, engine=engine)
+    out = compensator.process(fast)
+    report = compensator.ranges()
+    assert report.rate_fraction > 0.0
+    assert report.rate_excess_ratio > 1.0
+    assert (out["in_range"] == 0).mean() >= report.rate_fraction
+    assert any("beyond the trained df/dt" in line for line in report.warnings())
+    assert json.loads(json.dumps(report.to_dict()))["rate_fraction"] == report.rate_fraction
 
 
 def test_housing_baseline_missing_is_a_clear_error(unit_model):

@@ -120,3 +120,15 @@ def test_tangent_extension_beyond_the_training_range(model):
     np.testing.assert_array_equal(clamped, model.predict(edge))
     with pytest.raises(InputError, match="extrapolation must be"):
         model.predict(far, extrapolation="cubic")
+
+
+def test_hierarchical_fit_keeps_every_parent(cooldown, model):
+    """drift.fit(hierarchical=True): each kept term's lower-order parents are kept too."""
+    from hrgtc.drift.features import EQ21, hierarchy
+
+    parents = hierarchy(EQ21)
+    marginal = drift.fit([cooldown], THERMOMETER, hierarchical=True)
+    for name in marginal.selected:
+        assert set(parents[name]) <= set(marginal.selected), (name, marginal.selected)
+    orphans = [n for n in model.selected if not set(parents[n]) <= set(model.selected)]
+    assert orphans or marginal.selected == model.selected  # the option changed the fit, or needn't

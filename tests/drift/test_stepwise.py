@@ -15,7 +15,9 @@ import pytest
 import statsmodels.api as sm
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from scipy import signal
 
+from hrgtc.drift.regression import newey_west_inflation
 from hrgtc.drift.stepwise import (
     GramAccumulator,
     OLSResult,
@@ -415,3 +417,68 @@ def test_blocks_folded_by_dtpqrt_equal_one_householder_qr(weighted):
     fit = acc.fit()
     np.testing.assert_allclose(fit.params, ref.params, rtol=1e-9)
     np.testing.assert_allclose(fit.bse, ref.bse, rtol=1e-9)
+
+
+# -- Newey-West long-run variance and the hierarchy option --------------------------------------
+def _ar1(phi, n, seed):
+    rng = np.random.default_rng(seed)
+    return signal.lfilter([1.0], [1.0, -phi], rng.normal(0.0, 1.0, n))
+
+
+@pytest.mark.parametrize("phi", [0.0, 0.3, 0.6, -0.4])
+@pytest.mark.parametrize("bandwidth", [1, 4, 20])
+def test_newey_west_equals_statsmodels_hac(phi, bandwidth):
+    """The inflation is statsmodels' Bartlett HAC variance of the mean over the plain variance."""
+    from statsmodels.regression.linear_model import OLS
+    from statsmodels.stats.sandwich_covariance import cov_hac
+
+    e = _ar1(phi, 5000, seed=31)
+    fit = OLS(e, np.ones(e.size)).fit()
+    hac = float(cov_hac(fit, nlags=bandwidth, use_correction=False)[0, 0]) * e.size
+    plain = float(np.mean(fit.resid ** 2))
+    inflation, used = newey_west_inflation(e, bandwidth)
+    assert used == bandwidth
+    assert inflation == pytest.approx(max(1.0, hac / plain), rel=1e-10)
+
+
+@pytest.mark.parametrize("phi", [0.3, 0.6, 0.8])
+def test_newey_west_recovers_the_ar1_long_run_variance(phi):
+    """AR(1): long-run variance sigma^2/(1-phi)^2 over variance sigma^2/(1-phi^2) = (1+phi)/(1-phi).
+
+    With bandwidth L the Bartlett estimator's expectation is 1 + 2 sum (1 - k/(L+1)) phi^k
+    (Newey & West 1987); at L = 400 that is within 2 % of the limit for phi <= 0.8.
+    """
+    e = _ar1(phi, 2_000_000, seed=32)
+    bandwidth = 400
+    expected = 1.0 + 2.0 * sum((1.0 - k / (bandwidth + 1.0)) * phi ** k
+                               for k in range(1, bandwidth + 1))
+    limit = (1.0 + phi) / (1.0 - phi)
+    assert expected == pytest.approx(limit, rel=0.02)
+    inflation, _ = newey_west_inflation(e, bandwidth)
+    assert inflation == pytest.approx(expected, rel=0.05)
+    # white noise: no inflation (the factor never falls below 1)
+    assert newey_west_inflation(_ar1(0.0, 100_000, seed=33))[0] == pytest.approx(1.0, abs=0.03)
+
+
+def test_hierarchy_keeps_parents_in_and_changes_the_selection():
+    """y = x^2 (+ x z) with x symmetric: x alone explains nothing, so under the marginality
+    constraint x^2 cannot enter before x; without it, x^2 enters first."""
+    from hrgtc.drift.features import hierarchy, parse_terms
+
+    rng = np.random.default_rng(34)
+    n = 4000
+    x, z = rng.uniform(-1.0, 1.0, n), rng.uniform(-1.0, 1.0, n)
+    terms = parse_terms(["f", "f^2", "df", "f*df"])
+    names = [t.name for t in terms]
+    X = np.column_stack([x, x * x, z, x * z])
+    y = 2.0 * x * x + 1.5 * x * z + 0.5 * z + rng.normal(0.0, 0.05, n)
+    parents = hierarchy(terms)
+    assert {k: set(v) for k, v in parents.items()} == {
+        "f": set(), "f^2": {"f"}, "df": set(), "f*df": {"f", "df"}}
+    free = stepwise(X, y, names=names)
+    assert "f^2" in free.selected and "f*df" in free.selected and "f" not in free.selected
+    marginal = stepwise(X, y, names=names, parents=parents)
+    for name in marginal.selected:
+        assert set(parents[name]) <= set(marginal.selected), (name, marginal.selected)
+    assert marginal.selected != free.selected
+    assert marginal.history[0].term in ("df", "f")  # a parent comes first

@@ -30,10 +30,13 @@ def test_evaluation_against_metrics_by_hand(setup):
     result = evaluate(files.warmup, model)
     run = recording.read(files.warmup)
     raw = run.rate_dph - run.metadata.input_rate_dph
-    assert result.raw_10s == pytest.approx(bias_stability(raw, run.sample_rate_hz, 10.0), rel=1e-12)
+    settle = round(model.drift.settings.warmup_s * run.sample_rate_hz)  # left out, as in training
+    assert settle > 0 and result.ranges.settling_fraction == pytest.approx(settle / len(run))
+    assert result.raw_10s == pytest.approx(
+        bias_stability(raw[settle:], run.sample_rate_hz, 10.0), rel=1e-12)
     predicted = model.drift.predict_recording(run)
     assert result.compensated_10s == pytest.approx(
-        bias_stability(raw - predicted, run.sample_rate_hz, 10.0), rel=1e-12)
+        bias_stability((raw - predicted)[settle:], run.sample_rate_hz, 10.0), rel=1e-12)
     truth = np.sqrt(np.mean((run["bias_dph"] - predicted) ** 2))
     assert result.residual_rms_dph == pytest.approx(truth, rel=1e-12)
     assert result.improvement_10s == pytest.approx(result.raw_10s / result.compensated_10s)
@@ -88,3 +91,29 @@ def test_demo_quick_end_to_end(tmp_path):
     assert len(data["c_files"]) == 2
     again = CliRunner().invoke(app, ["demo", "--quick", "-o", str(tmp_path / "demo")])
     assert again.exit_code == 2 and "--force" in again.output
+
+
+@pytest.mark.parametrize("command", ["evaluate", "compensate"])
+def test_range_warnings_in_plain_output_and_strict_exit(setup, tmp_path, command):
+    """A warm-up beyond the cool-down model's df/dt: the plain output says so; --strict exits 3."""
+    files, _, model_path = setup
+    args = [command, str(files.warmup), "--model", str(model_path)]
+    if command == "compensate":
+        args += ["-o", str(tmp_path / "out.parquet")]
+    plain = CliRunner().invoke(app, args)
+    assert plain.exit_code == 0, plain.output
+    text = " ".join(plain.stdout.split())
+    assert "beyond the trained df/dt" in text and "× the largest trained" in text
+    strict = CliRunner().invoke(app, [*args, "--strict", "--force"] if command == "compensate"
+                                else [*args, "--strict"])
+    assert strict.exit_code == 3, strict.output
+
+
+def test_evaluation_ranges_cover_temperature_and_df_dt(setup):
+    files, model, _ = setup
+    result = evaluate(files.warmup, model, allan=False)
+    data = result.to_dict()["ranges"]
+    assert data["rate_fraction"] == pytest.approx(result.rate_out_of_range_fraction)
+    assert data["rate_fraction"] > 0.0 and data["rate_excess_ratio"] > 1.0
+    assert data["seen_rate_c_per_h"][1] > 0.0 >= data["trained_rate_c_per_h"][0]
+    assert any("df/dt" in line for line in result.summary().splitlines())

@@ -153,10 +153,11 @@ def test_bias_stability_table_against_numpy(unit, report):
     run = recording.read(files.cooldown)
     compensated = compensate(run, model)
     m = round(10 * run.sample_rate_hz)
-    n = len(run) // m
+    settle = round(model.drift.settings.warmup_s * run.sample_rate_hz)  # the filter settling
+    n = (len(run) - settle) // m
 
     def stability(rate):
-        return np.std(rate[: n * m].reshape(n, m).mean(axis=1), ddof=1)
+        return np.std(rate[settle: settle + n * m].reshape(n, m).mean(axis=1), ddof=1)
 
     row10 = next(row for row in page.table(f"Bias stability of {files.cooldown.name}")
                  if row[0] == "10")

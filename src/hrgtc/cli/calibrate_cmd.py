@@ -9,7 +9,14 @@ import typer
 from rich.table import Table
 
 from hrgtc.cli._app import app, console, error_console, library_errors, print_json
-from hrgtc.cli.options import ForceOption, JsonOption, reading_options
+from hrgtc.cli.compensate_cmd import warn_ranges
+from hrgtc.cli.options import (
+    STRICT_EXIT,
+    ForceOption,
+    JsonOption,
+    StrictOption,
+    reading_options,
+)
 
 if TYPE_CHECKING:
     from hrgtc.calibration import CalibrationResult
@@ -52,11 +59,13 @@ def render(result: CalibrationResult) -> None:
         console.print("Housing-thermistor baseline: " + result.model.housing.equation())
     if result.validation:
         val = Table(title="Held-out validation: 10 s bias stability (°/h)")
-        for column in ("file", "raw", "compensated", "improvement", "out of range"):
+        for column in ("file", "raw", "compensated", "improvement", "beyond T",
+                       "beyond df/dt"):
             val.add_column(column, justify="right")
         for v in result.validation:
             val.add_row(v.file, f"{v.raw_10s:.4f}", f"{v.compensated_10s:.4f}",
-                        f"{v.raw_10s / v.compensated_10s:.2f}×", f"{v.out_of_range_fraction:.1%}")
+                        f"{v.raw_10s / v.compensated_10s:.2f}×", f"{v.out_of_range_fraction:.1%}",
+                        f"{v.rate_out_of_range_fraction:.1%}")
         console.print(val)
 
 
@@ -91,7 +100,12 @@ def calibrate_command(
     prior: Path = typer.Option(
         None, "--prior", help="Population prior (hrgtc fleet prior): a Bayesian thermometer "
         "fit, so that 2 or 3 soaks suffice."),
+    select: str = typer.Option(
+        "stepwise", "--select",
+        help="Term selection: 'stepwise' (F-tests) or 'cv' (leave-one-run-out "
+        "cross-validated bias stability; needs two training runs or more)."),
     force: ForceOption = False,
+    strict: StrictOption = False,
     json_output: JsonOption = False,
     inputs: ReadOptions | None = None,
 ) -> None:
@@ -122,12 +136,20 @@ def calibrate_command(
             terms=[t.strip() for t in terms.split(",") if t.strip()],
             window_s=window_s, penter=penter, premove=premove, reference_c=reference_c,
             rate_tau_s=rate_tau_s, housing_terms=HOUSING_TERMS,
-            drift_from_soaks=drift_from_soaks,
+            drift_from_soaks=drift_from_soaks, select=select,
             read_options=inputs, progress=progress, prior=prior,
         )
         save_model(result.model, output, force=force)
     if json_output:
         print_json({**result.to_dict(), "model_file": str(output)})
-        return
-    render(result)
-    console.print(f"Model written to {output}")
+    else:
+        render(result)
+        console.print(f"Model written to {output}")
+    beyond = False
+    for v in result.validation:  # held-out runs beyond the trained ranges (--strict: exit 3)
+        if v.range_warnings():
+            beyond = True
+            (error_console if json_output else console).print(f"{v.file}:")
+            warn_ranges([v.ranges], json_output, strict=False)
+    if strict and beyond:
+        raise typer.Exit(STRICT_EXIT)

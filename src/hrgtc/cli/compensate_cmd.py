@@ -9,12 +9,29 @@ from typing import TYPE_CHECKING
 import typer
 from rich.table import Table
 
-from hrgtc.cli._app import app, console, library_errors, print_json, progress_bar
-from hrgtc.cli.options import ForceOption, JsonOption, reading_options
+from hrgtc.cli._app import (
+    app,
+    console,
+    error_console,
+    library_errors,
+    print_json,
+    progress_bar,
+)
+from hrgtc.cli.options import STRICT_EXIT, ForceOption, JsonOption, StrictOption, reading_options
 
 if TYPE_CHECKING:
+    from hrgtc.compensate.ranges import RangeReport
     from hrgtc.evaluation import Evaluation
     from hrgtc.recording import ReadOptions
+
+
+def warn_ranges(reports: list[RangeReport | None], json_output: bool, strict: bool) -> None:
+    """Print the range warnings (on stderr beside --json); with ``strict`` exit 3 if any."""
+    lines = [line for report in reports if report is not None for line in report.warnings()]
+    for line in lines:
+        (error_console if json_output else console).print(f"[yellow]{line}[/]")
+    if strict and lines:
+        raise typer.Exit(STRICT_EXIT)
 
 
 @app.command("compensate")
@@ -25,6 +42,7 @@ def compensate_command(
     output: Path = typer.Option(..., "-o", "--output", help="Output recording (format by suffix)."),
     chunk_rows: int = typer.Option(1 << 20, "--chunk-rows", help="Rows per processing chunk."),
     force: ForceOption = False,
+    strict: StrictOption = False,
     json_output: JsonOption = False,
     inputs: ReadOptions | None = None,
 ) -> None:
@@ -42,12 +60,13 @@ def compensate_command(
                                   progress=progress, read_options=inputs)
     if json_output:
         print_json(summary.to_dict())
-        return
-    console.print(
-        f"wrote {summary.output}: {summary.rows} rows; "
-        f"{summary.out_of_range_fraction:.2%} outside the calibrated temperature range, "
-        f"{summary.rate_out_of_range_fraction:.2%} with df/dt beyond its training range"
-    )
+    else:
+        console.print(
+            f"wrote {summary.output}: {summary.rows} rows; "
+            f"{summary.out_of_range_fraction:.2%} outside the calibrated temperature range, "
+            f"{summary.rate_out_of_range_fraction:.2%} with df/dt beyond its training range"
+        )
+    warn_ranges([summary.ranges], json_output, strict)
 
 
 def render_evaluation(result: Evaluation) -> None:
@@ -93,6 +112,7 @@ def render_evaluation(result: Evaluation) -> None:
 def evaluate_command(
     run: Path = typer.Argument(..., help="Recording to evaluate."),
     model_path: Path = typer.Option(..., "--model", "-m", help="Model file from 'calibrate'."),
+    strict: StrictOption = False,
     json_output: JsonOption = False,
     inputs: ReadOptions | None = None,
 ) -> None:
@@ -108,5 +128,6 @@ def evaluate_command(
         result = evaluate(run, load_model(model_path), progress=progress, read_options=inputs)
     if json_output:
         print_json(result.to_dict())
-        return
-    render_evaluation(result)
+    else:
+        render_evaluation(result)
+    warn_ranges([result.ranges], json_output, strict)

@@ -164,6 +164,11 @@ GapsOption = Annotated[
     ),
 ]
 ForceOption = Annotated[bool, typer.Option("--force", help="Overwrite existing output files.")]
+#: Exit status of --strict when samples went beyond the trained ranges.
+STRICT_EXIT = 3
+StrictOption = Annotated[bool, typer.Option(
+    "--strict", help="Exit with status 3 when samples went beyond the trained temperature or "
+    "df/dt ranges (the warnings are printed either way).")]
 JsonOption = Annotated[
     bool, typer.Option("--json", help="Print machine-readable JSON on standard output.")
 ]

@@ -43,14 +43,17 @@ import numpy as np
 from numba import njit
 
 from hrgtc.drift import DriftModel
-from hrgtc.drift.features import VARIABLES, rate_filter_coefficients
+from hrgtc.drift.features import VARIABLES, rate_filter_coefficients, settle_rows
 from hrgtc.thermometry import Thermometer
 
 #: Variable order of the exponent matrices: the grammar's order (f, df, h, dh).
 ORDER = tuple(VARIABLES)
 #: Slots of ``counts``: samples outside the f/h ranges, outside the df/dh ranges,
-#: and samples whose Newton iteration did not converge (left NaN).
-OUT_OF_RANGE, RATE_OUT_OF_RANGE, NOT_CONVERGED = 0, 1, 2
+#: samples whose Newton iteration did not converge (left NaN), and samples of the
+#: filter's settling time at the start of the run.
+OUT_OF_RANGE, RATE_OUT_OF_RANGE, NOT_CONVERGED, SETTLING = 0, 1, 2, 3
+#: Slots of ``extremes``: the smallest and largest f and df/dt seen. [Hz, Hz/s]
+F_MIN, F_MAX, DF_MIN, DF_MAX = 0, 1, 2, 3
 #: Lengths of the thermometer's series in the kernel (zero-padded at the high-order end,
 #: which leaves Horner's and Clenshaw's arithmetic unchanged): f(z) up to order 5 and
 #: the Chebyshev start of :mod:`hrgtc.thermometry` (degree 9).
@@ -65,8 +68,9 @@ class KernelPlan:
     Attributes
     ----------
     filter
-        ``[alpha, beta, gain, reference_freq_hz, reference_c]`` of the rate filter
-        (gain ``alpha * sample_rate_hz / beta`` turns y1 - y2 into a rate).
+        ``[alpha, beta, gain, reference_freq_hz, reference_c, settle_rows]`` of the rate
+        filter (gain ``alpha * sample_rate_hz / beta`` turns y1 - y2 into a rate;
+        ``settle_rows`` samples at the start of a run are flagged, as training skips them).
     uses_housing
         Whether h/dh are computed (the recording then needs ``housing_c``).
     exponents
@@ -153,7 +157,7 @@ def plan(drift: DriftModel, thermometer: Thermometer, variables: tuple[str, ...]
     a = np.asarray(thermometer.scaled_coefficients, dtype=np.float64)
     return KernelPlan(
         filter=np.array([alpha, beta, alpha * s.sample_rate_hz / beta, s.reference_freq_hz,
-                         s.reference_c]),
+                         s.reference_c, float(settle_rows(s))]),
         uses_housing=any(v in ("h", "dh") for v in variables),
         exponents=exponents,
         coefficients=np.asarray(drift.scaled_coefficients, dtype=np.float64).reshape(n),
@@ -190,8 +194,13 @@ def _padded(coefficients: np.ndarray, size: int) -> np.ndarray:
 
 
 def new_state() -> np.ndarray:
-    """Filter state at rest: ``[y1_f, y2_f, y1_h, y2_h, started_f, started_h]``."""
-    return np.zeros(6)
+    """Filter state at rest: ``[y1_f, y2_f, y1_h, y2_h, started_f, started_h, samples]``."""
+    return np.zeros(7)
+
+
+def new_extremes() -> np.ndarray:
+    """``extremes`` before the first sample: [+inf, -inf, +inf, -inf]."""
+    return np.array([np.inf, -np.inf, np.inf, -np.inf])
 
 
 # -- the kernel -------------------------------------------------------------------------
@@ -276,10 +285,12 @@ def _newton_scalar(t, clipped, poly, slope, centre, scale_c, tolerance):  # prag
 def compensate_block(freq_hz, rate_dph, housing_c, filt, uses_housing, state,
                      exponents, coefficients, intercept, scales, tangent, low, high, flagged,
                      d_factor, d_exponents, d_constant, therm, poly, slope, chebyshev,
-                     out_rate, out_bias, out_temp, out_in_range, counts):  # pragma: no cover
+                     out_rate, out_bias, out_temp, out_in_range, counts,
+                     extremes):  # pragma: no cover
     """Compensate one block in place; see the module docstring for what is computed.
 
-    ``state`` (filter) and ``counts`` (int64, see :data:`OUT_OF_RANGE`) are updated.
+    ``state`` (filter, samples seen), ``counts`` (int64, see :data:`OUT_OF_RANGE`) and
+    ``extremes`` (see :data:`F_MIN`) are updated.
     """
     alpha, beta, gain, ref_f, ref_h = filt[0], filt[1], filt[2], filt[3], filt[4]
     centre, scale_c, map_offset, map_scale = therm[0], therm[1], therm[2], therm[3]
@@ -413,13 +424,26 @@ def compensate_block(freq_hz, rate_dph, housing_c, filt, uses_housing, state,
                     flag[i] = flag[i] if (x[i] >= lo) & (x[i] <= hi) else 0.0
         n_ok = 0.0
         n_rate_ok = 0.0
+        first = state[6] + start  # samples of the run before this tile
+        n_settling = 0
         for i in range(m):
-            out_in_range[start + i] = ok[i]
+            settled = 1.0 if first + i >= filt[5] else 0.0
+            out_in_range[start + i] = ok[i] * rate_ok[i] * settled
             n_ok += ok[i]
             n_rate_ok += rate_ok[i]
+            n_settling += settled == 0.0
         counts[0] += m - int(n_ok)
         counts[1] += m - int(n_rate_ok)
+        counts[3] += n_settling
+        for v in range(2):  # extremes of f and df/dt (the range warnings say how far)
+            x = value[v]
+            lo, hi = extremes[2 * v], extremes[2 * v + 1]
+            for i in range(m):
+                lo = x[i] if x[i] < lo else lo
+                hi = x[i] if x[i] > hi else hi
+            extremes[2 * v], extremes[2 * v + 1] = lo, hi
     state[0], state[1], state[2], state[3] = y1f, y2f, y1h, y2h
+    state[6] += n
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
@@ -449,6 +473,7 @@ def advance_filter(freq_hz, housing_c, filt, uses_housing, state):  # pragma: no
             y1 = beta * y1 + alpha * (housing_c[i] - ref_h)
             y2 = beta * y2 + alpha * y1
         state[2], state[3] = y1, y2
+    state[6] += freq_hz.size
 
 
 #: Chunks of at least this many rows are split in two halves compensated on two threads.
@@ -456,7 +481,8 @@ PARALLEL_ROWS = 1 << 18
 
 
 def run(block_plan: KernelPlan, state: np.ndarray, freq_hz: np.ndarray, rate_dph: np.ndarray,
-        housing_c: np.ndarray | None, out: dict[str, np.ndarray], counts: np.ndarray) -> None:
+        housing_c: np.ndarray | None, out: dict[str, np.ndarray], counts: np.ndarray,
+        extremes: np.ndarray | None = None) -> None:
     """Compensate a chunk with a plan's arrays (outputs in ``out``, ``state`` advanced).
 
     A long chunk is cut in two: the filter alone runs over the first half to give the
@@ -464,34 +490,38 @@ def run(block_plan: KernelPlan, state: np.ndarray, freq_hz: np.ndarray, rate_dph
     kernel releases the GIL). Results are the same bits as one call.
     """
     housing = freq_hz if housing_c is None else housing_c
+    extremes = new_extremes() if extremes is None else extremes
     n = freq_hz.size
     if n < PARALLEL_ROWS or (os.cpu_count() or 1) < 2:
-        _call(block_plan, state, freq_hz, rate_dph, housing, out, counts, 0, n)
+        _call(block_plan, state, freq_hz, rate_dph, housing, out, counts, extremes, 0, n)
         return
     middle = n // 2
     second = state.copy()
     advance_filter(freq_hz[:middle], housing[:middle], block_plan.filter,
                    block_plan.uses_housing, second)
     second_counts = np.zeros_like(counts)
+    second_extremes = new_extremes()
     worker = threading.Thread(target=_call, args=(block_plan, second, freq_hz, rate_dph, housing,
-                                                  out, second_counts, middle, n))
+                                                  out, second_counts, second_extremes, middle, n))
     worker.start()
     try:
-        _call(block_plan, state, freq_hz, rate_dph, housing, out, counts, 0, middle)
+        _call(block_plan, state, freq_hz, rate_dph, housing, out, counts, extremes, 0, middle)
     finally:
         worker.join()
     state[:] = second
     counts += second_counts
+    extremes[0::2] = np.minimum(extremes[0::2], second_extremes[0::2])
+    extremes[1::2] = np.maximum(extremes[1::2], second_extremes[1::2])
 
 
 def _call(p: KernelPlan, state: np.ndarray, freq_hz: np.ndarray, rate_dph: np.ndarray,
-          housing_c: np.ndarray, out: dict[str, np.ndarray], counts: np.ndarray, start: int,
-          stop: int) -> None:
+          housing_c: np.ndarray, out: dict[str, np.ndarray], counts: np.ndarray,
+          extremes: np.ndarray, start: int, stop: int) -> None:
     part = slice(start, stop)
     compensate_block(
         freq_hz[part], rate_dph[part], housing_c[part], p.filter, p.uses_housing, state,
         p.exponents, p.coefficients, p.intercept, p.scales, p.tangent, p.low, p.high,
         p.flagged, p.d_factor, p.d_exponents, p.d_constant, p.thermometer, p.poly, p.slope,
         p.chebyshev, out["rate_comp_dph"][part], out["bias_model_dph"][part],
-        out["resonator_c_est"][part], out["in_range"][part], counts,
+        out["resonator_c_est"][part], out["in_range"][part], counts, extremes,
     )

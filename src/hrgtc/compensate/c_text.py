@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from hrgtc.compensate.c_plan import TABLE_POINTS, CPlan
-from hrgtc.drift.features import Term
+from hrgtc.drift.features import Term, settle_rows
 from hrgtc.errors import InputError
 from hrgtc.model import UnitModel
 
@@ -140,7 +140,9 @@ def readme(model: UnitModel, plan: CPlan, prefix: str, origin: str,
         f"{plan.extension[1]:g} degC.",
         f"  in_range = 1 when freq_hz is in the calibrated range [{f_low:.10g}, {f_high:.10g}] "
         f"Hz ({thermometer.temperature_range_c[0]:g} to {thermometer.temperature_range_c[1]:g} "
-        f"degC) and the training ranges of the levels hold: {ranges(('f', 'h'))}; else 0.",
+        f"degC), the training ranges of the levels hold: {ranges(('f', 'h'))}, rate_in_range "
+        f"is 1 and the filter has settled (the first {settle_rows(settings)} samples of a run, "
+        "which training leaves out too, are 0); else 0.",
         f"  rate_in_range = 1 when the rates are in their training ranges: "
         f"{ranges(('df', 'dh'))}; else 0 (a model trained on a cool-down has seen only "
         "negative df/dt).",
@@ -196,6 +198,7 @@ def header(model: UnitModel, plan: CPlan, prefix: str, origin: str,
     arg_h = ", double housing_c" if housing else ""
     bias_h = ", double h_c, double dh_c_per_s" if housing else ""
     levels = " and ".join(v for v in plan.computed if v in ("f", "h"))
+    settle = settle_rows(model.drift.settings)
     rates = " and ".join(v for v in plan.computed if v in ("df", "dh"))
     return f"""{readme(model, plan, prefix, origin, sha256)}
 #ifndef {up}_MODEL_H
@@ -207,6 +210,9 @@ extern "C" {{
 
 /* Sample rate the df/dt filter was designed for: call {p}_step() at exactly this rate. [Hz] */
 #define {up}_SAMPLE_RATE_HZ {_literal(model.drift.settings.sample_rate_hz, "sample_rate_hz")}
+/* Samples at the start of a run flagged (in_range 0) while the df/dt filter settles,
+   as training leaves them out. */
+#define {up}_SETTLE_ROWS {settle}UL
 /* 1 when {p}_step() takes the housing temperature (the model uses h or dh terms). */
 #define {up}_USES_HOUSING {1 if housing else 0}
 /* SHA-256 of the model this code was generated from. */
@@ -218,7 +224,7 @@ typedef struct {p}_state {{
     double f_y2;                /* second low-pass stage of f [Hz] */
 {state_h}    int started;                /* 0 until the first sample after init/reset */
     unsigned long samples;      /* samples since init/reset */
-    unsigned long out_of_range; /* of which with in_range == 0 */
+    unsigned long out_of_range; /* of which outside the calibrated temperature */
     unsigned long rate_out_of_range; /* of which with rate_in_range == 0 */
 }} {p}_state;
 
@@ -229,7 +235,8 @@ typedef struct {p}_output {{
     double resonator_c_est;     /* resonator temperature from frequency [degC] (NaN: beyond) */
     double f_hz;                /* frequency change f = freq_hz - f_ref [Hz] */
     double df_hz_per_s;         /* its causal rate df/dt [Hz/s] */
-{out_h}    int in_range;               /* 1: frequency calibrated, {levels} in training range */
+{out_h}    int in_range;               /* 1: frequency calibrated, {levels} and rates in training
+                                   range, filter settled */
     int rate_in_range;          /* 1: {rates} in training range (else extrapolated in time) */
 }} {p}_output;
 
@@ -328,7 +335,7 @@ double {prefix}_bias_dph({signature})
 
 def source(model: UnitModel, plan: CPlan, prefix: str) -> str:
     """Text of ``<prefix>_model.c``: filter, drift model, thermometer inverse, step()."""
-    p = prefix
+    p, up = prefix, prefix.upper()
     drift, th = model.drift, model.thermometer
     settings = drift.settings
     ranges = []
@@ -501,7 +508,7 @@ double {p}_step({p}_state *state, double freq_hz, double rate_dph{h['arg']}, \
 {{
     const double f_value = freq_hz - REFERENCE_FREQ_HZ;
 {h['values']}    double df_value, bias, compensated, temperature;
-    int in_range, rate_in_range;
+    int in_range, rate_in_range, level_in_range;
     if (!state->started) {{  /* the filter starts at rest on the first sample */
         state->f_y1 = f_value;
         state->f_y2 = f_value;
@@ -511,10 +518,12 @@ double {p}_step({p}_state *state, double freq_hz, double rate_dph{h['arg']}, \
 {h['rate']}    bias = {p}_bias_dph(f_value, df_value{h['bias']});
     compensated = rate_dph - bias;
     temperature = {p}_temperature_c(freq_hz);
-    in_range = {p}_frequency_in_range(freq_hz){checks(("f", "h"))};
+    level_in_range = {p}_frequency_in_range(freq_hz){checks(("f", "h"))};
     rate_in_range = 1{checks(("df", "dh"))};
+    /* in_range: calibrated temperature, trained df/dt, and the filter settled */
+    in_range = level_in_range && rate_in_range && state->samples >= {up}_SETTLE_ROWS;
     state->samples += 1UL;
-    state->out_of_range += in_range ? 0UL : 1UL;
+    state->out_of_range += level_in_range ? 0UL : 1UL;
     state->rate_out_of_range += rate_in_range ? 0UL : 1UL;
     if (out) {{
         out->rate_comp_dph = compensated;

@@ -25,8 +25,9 @@ from typing import Any
 import numpy as np
 
 from hrgtc import recording as rec_io
+from hrgtc.compensate.ranges import RangeReport, range_report
 from hrgtc.drift import DriftModel
-from hrgtc.drift.features import FeatureStream
+from hrgtc.drift.features import FeatureStream, settle_rows
 from hrgtc.errors import CalibrationError, InputError
 from hrgtc.model import UnitModel
 from hrgtc.progress import Progress
@@ -98,20 +99,26 @@ class Compensator:
     def reset(self) -> None:
         """Start a new run: the df/dt filter restarts at rest on the next sample."""
         self._stream = FeatureStream(self.drift.settings, self._variables)
-        self._state = np.zeros(6)  # the fused engine's filter state (compensate._kernel)
+        self._state = np.zeros(7)  # the fused engine's filter state (compensate._kernel)
+        self._extremes = np.array([np.inf, -np.inf, np.inf, -np.inf])  # f, df min/max
+        self._settle_rows = settle_rows(self.drift.settings)
         self.samples = 0
         self.out_of_range = 0
         self.rate_out_of_range = 0
+        self.settling = 0
 
     def process(self, chunk: Recording) -> Recording:
         """The next chunk of the run with the :data:`OUTPUT_COLUMNS` added.
 
         ``in_range`` is 1.0 where the frequency is inside the thermometer's calibrated
-        range and the drift model's training range of f (and of h), else 0.0. Rates of
-        change outside their training range are counted separately
-        (:attr:`rate_out_of_range_fraction`): a model trained on a cool-down only has
-        seen negative df/dt. Large chunks are worked through in blocks of
-        :data:`BLOCK_ROWS` rows, which keeps the temporaries in cache.
+        range and the drift model's training range of f (and of h), df/dt (and dh/dt)
+        is inside its training range (a model trained on a cool-down has seen only
+        negative df/dt), and the df/dt filter has settled (the first ``warmup_s`` of the
+        run, which training leaves out too); else 0.0. The three are counted separately
+        (:attr:`out_of_range_fraction`, :attr:`rate_out_of_range_fraction`,
+        :attr:`settling`) and :meth:`ranges` says how far the run went. Large chunks
+        are worked through in blocks of :data:`BLOCK_ROWS` rows, which keeps the
+        temporaries in cache.
         """
         if self.samples == 0:
             self.drift.settings.check_sample_rate(chunk)
@@ -135,10 +142,11 @@ class Compensator:
             if not kernel.supports(thermometer):
                 return False
             self._plan = kernel.plan(self.drift, thermometer, self._variables)
-        counts = np.zeros(3, dtype=np.int64)
+        counts = np.zeros(4, dtype=np.int64)
         freq = chunk.freq_hz
         housing = chunk["housing_c"] if self._plan.uses_housing else None
-        kernel.run(self._plan, self._state, freq, chunk.rate_dph, housing, out, counts)
+        kernel.run(self._plan, self._state, freq, chunk.rate_dph, housing, out, counts,
+                   self._extremes)
         if counts[kernel.NOT_CONVERGED]:  # rare: the bracketed slow path, as temperature() does
             low, high = thermometer._inverse.f_bracket
             lost = np.isnan(out["resonator_c_est"]) & (freq >= low) & (freq <= high)
@@ -146,6 +154,7 @@ class Compensator:
         self.samples += len(chunk)
         self.out_of_range += int(counts[kernel.OUT_OF_RANGE])
         self.rate_out_of_range += int(counts[kernel.RATE_OUT_OF_RANGE])
+        self.settling += int(counts[kernel.SETTLING])
         return True
 
     def _block(self, chunk: Recording, out: dict[str, np.ndarray], start: int) -> None:
@@ -157,13 +166,20 @@ class Compensator:
             self.drift, values, ("f", "h")
         )
         rate_in_range = _in_training_range(self.drift, values, ("df", "dh"))
+        settled = self.samples + np.arange(len(chunk)) >= self._settle_rows
         np.subtract(chunk.rate_dph, bias, out=out["rate_comp_dph"][start:stop])
         out["bias_model_dph"][start:stop] = bias
         out["resonator_c_est"][start:stop] = thermometer.temperature(chunk.freq_hz, warn=False)
-        out["in_range"][start:stop] = in_range
+        out["in_range"][start:stop] = in_range & rate_in_range & settled
         self.samples += len(chunk)
         self.out_of_range += int(np.count_nonzero(~in_range))
         self.rate_out_of_range += int(np.count_nonzero(~rate_in_range))
+        self.settling += int(np.count_nonzero(~settled))
+        if len(chunk):
+            e = self._extremes
+            for k, v in enumerate(("f", "df")):
+                e[2 * k] = min(e[2 * k], float(np.min(values[v])))
+                e[2 * k + 1] = max(e[2 * k + 1], float(np.max(values[v])))
 
     @property
     def out_of_range_fraction(self) -> float:
@@ -174,6 +190,12 @@ class Compensator:
     def rate_out_of_range_fraction(self) -> float:
         """Share of the samples so far whose df/dt (dh/dt) is outside its training range."""
         return self.rate_out_of_range / self.samples if self.samples else 0.0
+
+    def ranges(self) -> RangeReport:
+        """Shares of the samples so far beyond the trained temperature and df/dt, how far."""
+        counts = np.array([self.out_of_range, self.rate_out_of_range, 0, self.settling])
+        return range_report(self.drift, self.model.thermometer, self.samples, counts,
+                            self._extremes)
 
 
 def compensate(recording: Recording, model: UnitModel, drift: str = "frequency",
@@ -191,6 +213,7 @@ class CompensationSummary:
     rows: int
     out_of_range_fraction: float
     rate_out_of_range_fraction: float
+    ranges: RangeReport | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -199,6 +222,7 @@ class CompensationSummary:
             "rows": self.rows,
             "out_of_range_fraction": self.out_of_range_fraction,
             "rate_out_of_range_fraction": self.rate_out_of_range_fraction,
+            "ranges": None if self.ranges is None else self.ranges.to_dict(),
         }
 
 
@@ -253,7 +277,7 @@ def compensate_file(
         chunks.close()
     return CompensationSummary(str(source), str(output), compensator.samples,
                                compensator.out_of_range_fraction,
-                               compensator.rate_out_of_range_fraction)
+                               compensator.rate_out_of_range_fraction, compensator.ranges())
 
 
 def _write(writer: rec_io.RecordingWriter, chunk: Recording) -> None:

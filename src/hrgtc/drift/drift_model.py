@@ -24,19 +24,19 @@ reported in the user's units.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
+from hrgtc.drift.cross_validation import CrossValidation, cross_validate, select_terms
 from hrgtc.drift.features import (
     EQ21,
     VARIABLES,
     FeatureSettings,
     FeatureStream,
     Term,
-    design_matrix,
     hierarchy,
     linear_combination,
     parse_terms,
@@ -45,155 +45,16 @@ from hrgtc.drift.features import (
 )
 from hrgtc.drift.regression import EXTENDED_PRECISION, newey_west_inflation
 from hrgtc.drift.stepwise import StepwiseResult, stepwise
+from hrgtc.drift.windows import RunSource, TrainingWindows, _iter_run, window_means
 from hrgtc.errors import CalibrationError, InputError
 from hrgtc.progress import Progress
 from hrgtc.recording import Recording
 from hrgtc.thermometry import Thermometer
 
-RunSource = Recording | Callable[[], Iterator[Recording]]
-
 #: Smallest training spread of df/dt, as a resonator temperature rate, for a drift model. [°C/h]
 MIN_RATE_SPAN_C_PER_H = 0.5
 #: Smallest training spread of the resonator temperature for a drift model. [°C]
 MIN_TEMPERATURE_SPAN_C = 1.0
-
-
-@dataclass(frozen=True)
-class TrainingWindows:
-    """Window means used to fit a drift model, one row per window.
-
-    Attributes
-    ----------
-    time_s
-        Window centre times, per run. [s]
-    run
-        Index of the run each window came from.
-    terms
-        Raw (unscaled) window means of each candidate term, shape (windows, terms).
-    bias_dph
-        Window means of the measured bias (rate minus input rate). [°/h]
-    variables
-        Window means of each variable (f [Hz], df [Hz/s], ...).
-    n_samples
-        Samples that went into the windows.
-    sources
-        Name (file) of each run, in run order.
-    """
-
-    time_s: np.ndarray
-    run: np.ndarray
-    terms: np.ndarray
-    bias_dph: np.ndarray
-    variables: dict[str, np.ndarray]
-    n_samples: int
-    sources: tuple[str, ...] = ()
-
-
-class _WindowMeans:
-    """Means of non-overlapping windows of ``rows`` samples over consecutive chunks."""
-
-    def __init__(self, rows: int, skip: int) -> None:
-        self.rows = rows
-        self.skip = skip
-        self._carry: np.ndarray | None = None
-
-    def push(self, block: np.ndarray) -> np.ndarray:
-        if self.skip:
-            dropped = min(self.skip, block.shape[0])
-            block = block[dropped:]
-            self.skip -= dropped
-        if self._carry is not None and self._carry.shape[0]:
-            block = np.concatenate([self._carry, block])
-        complete = block.shape[0] // self.rows
-        self._carry = block[complete * self.rows :].copy()
-        if complete == 0:
-            return np.empty((0, block.shape[1]))
-        used = block[: complete * self.rows]
-        return used.reshape(complete, self.rows, block.shape[1]).mean(axis=1)
-
-
-def _iter_run(source: RunSource) -> Iterator[Recording]:
-    if isinstance(source, Recording):
-        yield source
-    else:
-        yield from source()
-
-
-def window_means(
-    runs: Sequence[RunSource],
-    settings: FeatureSettings,
-    terms: Sequence[Term],
-    window_s: float = 10.0,
-    progress: Progress | None = None,
-) -> TrainingWindows:
-    """Window means of candidate terms and measured bias over training runs.
-
-    Parameters
-    ----------
-    runs
-        Each a :class:`Recording`, or a callable returning an iterator of
-        consecutive chunks of one run (e.g. ``lambda: recording.iter_chunks(path)``).
-    settings
-        Feature settings (reference frequency, rate filter, warm-up).
-    terms
-        Candidate terms.
-    window_s
-        Window length. [s]
-    progress
-        Optional ``callback(samples_done, samples_total_or_0)``.
-    """
-    variables = variables_for(terms)
-    window_rows = round(window_s * settings.sample_rate_hz)
-    if window_rows < 1:
-        raise InputError(f"window_s={window_s} s holds no sample at {settings.sample_rate_hz} Hz")
-    skip = round(settings.warmup_s * settings.sample_rate_hz)
-    out_terms, out_bias, out_time, out_run = [], [], [], []
-    out_vars: dict[str, list[np.ndarray]] = {v: [] for v in variables}
-    total = 0
-    sources: list[str] = []
-    for index, source in enumerate(runs):
-        stream = FeatureStream(settings, variables)
-        averager = _WindowMeans(window_rows, skip)
-        input_rate = None
-        for chunk in _iter_run(source):
-            settings.check_sample_rate(chunk)
-            if input_rate is None:
-                input_rate = chunk.metadata.input_rate_dph
-                sources.append(chunk.source or f"run {index}")
-            values = stream.process(chunk)
-            block = np.column_stack(
-                [
-                    chunk.time_s,
-                    chunk.rate_dph - input_rate,
-                    *(values[v] for v in variables),
-                    design_matrix(terms, values),
-                ]
-            )
-            means = averager.push(block)
-            if means.shape[0]:
-                out_time.append(means[:, 0])
-                out_bias.append(means[:, 1])
-                for k, v in enumerate(variables):
-                    out_vars[v].append(means[:, 2 + k])
-                out_terms.append(means[:, 2 + len(variables) :])
-                out_run.append(np.full(means.shape[0], index))
-            total += len(chunk)
-            if progress is not None:
-                progress(total, 0)
-    if not out_time:
-        raise CalibrationError(
-            f"the drift runs hold no complete {window_s:g} s window after the "
-            f"{settings.warmup_s:g} s filter warm-up; give longer runs"
-        )
-    return TrainingWindows(
-        time_s=np.concatenate(out_time),
-        run=np.concatenate(out_run),
-        terms=np.concatenate(out_terms),
-        bias_dph=np.concatenate(out_bias),
-        variables={v: np.concatenate(x) for v, x in out_vars.items()},
-        n_samples=total,
-        sources=tuple(sources),
-    )
 
 
 @dataclass(frozen=True)
@@ -229,6 +90,10 @@ class DriftModel:
     variance_inflation, bandwidth_windows
         Newey-West correction of the F-tests for autocorrelated window residuals
         (1 and 0 when switched off).
+    selection
+        How the terms were chosen: ``"stepwise"`` (F-tests) or ``"cv"``.
+    cross_validation
+        Leave-one-run-out cross-validation of the selected terms (None with one run).
     """
 
     settings: FeatureSettings
@@ -248,6 +113,8 @@ class DriftModel:
     rsquared: float
     variance_inflation: float = 1.0
     bandwidth_windows: int = 0
+    selection: str = "stepwise"
+    cross_validation: CrossValidation | None = None
     _terms: tuple[Term, ...] = field(default=(), repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -341,6 +208,8 @@ class DriftModel:
                 f"{self.bandwidth_windows} windows): variance inflation "
                 f"{self.variance_inflation:.3g}"
             )
+        if self.cross_validation is not None:
+            lines.append(self.cross_validation.summary())
         lines.append(self.equation())
         return "\n".join(lines)
 
@@ -365,6 +234,9 @@ class DriftModel:
             "rsquared": self.rsquared,
             "variance_inflation": self.variance_inflation,
             "bandwidth_windows": self.bandwidth_windows,
+            "selection": self.selection,
+            "cross_validation": None if self.cross_validation is None
+            else self.cross_validation.to_dict(),
         }
 
     @classmethod
@@ -389,6 +261,9 @@ class DriftModel:
                 rsquared=float(data["rsquared"]),
                 variance_inflation=float(data.get("variance_inflation", 1.0)),
                 bandwidth_windows=int(data.get("bandwidth_windows", 0)),
+                selection=str(data.get("selection", "stepwise")),
+                cross_validation=None if data.get("cross_validation") is None
+                else CrossValidation.from_dict(data["cross_validation"]),
             )
         except (KeyError, TypeError, ValueError, IndexError) as exc:
             raise InputError(f"not a valid drift-model record: {exc!r}") from exc
@@ -436,6 +311,7 @@ def fit(
     autocorrelation: str = "newey-west",
     hierarchical: bool = False,
     excitation_runs: int = 0,
+    select: str = "stepwise",
     progress: Progress | None = None,
 ) -> DriftModel:
     """Fit the drift model of Eq. (21)-(22) of [1] by stepwise regression on window means.
@@ -471,6 +347,11 @@ def fit(
         residuals (bandwidth n^(1/3) windows), because bias instability and rate
         random walk keep 10 s means correlated and plain F-tests then admit terms
         that fit noise and extrapolate badly. ``"none"``: plain ``stepwisefit``.
+    select
+        ``"stepwise"`` (default): terms by the stepwise F-tests. ``"cv"``: forward
+        selection by leave-one-run-out cross-validated bias stability
+        (:mod:`hrgtc.drift.cross_validation`; needs two runs or more). Either way the
+        selected model is cross-validated when there are two runs or more.
     progress
         Optional ``callback(samples_done, 0)``.
 
@@ -521,10 +402,24 @@ def fit(
         raise InputError(
             f"autocorrelation must be 'newey-west' or 'none', got {autocorrelation!r}"
         )
+    if select not in ("stepwise", "cv"):
+        raise InputError(f"select must be 'stepwise' or 'cv', got {select!r}")
+    n_runs = len(windows.sources)
+    if select == "cv" and n_runs < 2:
+        raise InputError("select='cv' needs two training runs or more (leave-one-run-out)")
+    slope_sign = 1.0 if thermometer.slope_hz_per_c(reference_c) >= 0 else -1.0
+    rate = windows.variables.get("df", np.zeros(windows.bias_dph.size))
+    cv_args = (x_scaled, windows.bias_dph, windows.run, names)
+    parents = hierarchy(candidates) if hierarchical else None
     result = stepwise(x_scaled, windows.bias_dph, names=names, penter=penter, premove=premove,
-                      initial=initial, variance_inflation=inflation,
-                      parents=hierarchy(candidates) if hierarchical else None,
+                      initial=initial, variance_inflation=inflation, parents=parents,
                       refine=EXTENDED_PRECISION)  # quietly unrefined without long double
+    if select == "cv":  # from the stepwise terms, one-term changes that cross-validate better
+        chosen = select_terms(*cv_args, windows.sources, rate, slope_sign, parents=parents,
+                              initial=result.selected)
+        result = stepwise(x_scaled, windows.bias_dph, names=names, penter=penter,
+                          premove=premove, initial=chosen, variance_inflation=inflation,
+                          max_steps=0, refine=EXTENDED_PRECISION)
     ols = result.result
     selected = result.selected
     selected_factor = {t.name: t.scale_factor(scales) for t in candidates}
@@ -556,4 +451,7 @@ def fit(
         rsquared=float(ols.rsquared) if math.isfinite(ols.rsquared) else float("nan"),
         variance_inflation=float(inflation),
         bandwidth_windows=int(bandwidth),
+        selection=select,
+        cross_validation=cross_validate(*cv_args, selected, windows.sources, rate, slope_sign)
+        if n_runs >= 2 else None,
     )

@@ -340,6 +340,17 @@ class FeatureSettings:
             )
 
 
+def settle_rows(settings: FeatureSettings) -> int:
+    """Samples at the start of a run left out while the df/dt filter settles.
+
+    Training skips them (``warmup_s``, 5 tau by default); the compensator flags them
+    (``in_range`` 0) and the evaluation leaves them out of its figures, the same way.
+    The filter starts at rest on the first sample, whose noise then reads as a rate
+    for a few tau.
+    """
+    return max(round(settings.warmup_s * settings.sample_rate_hz), 0)
+
+
 class FeatureStream:
     """Sample-by-sample computation of f, df, h, dh over consecutive chunks of one run.
 

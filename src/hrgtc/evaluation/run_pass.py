@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 
 from hrgtc.compensate import Compensator
+from hrgtc.compensate.ranges import RangeReport
 from hrgtc.errors import HrgtcError, InputError
 from hrgtc.evaluation.allan import AllanResult, NoiseTerms, allan_deviation, noise_terms
 from hrgtc.evaluation.metrics import DEFAULT_TAUS_S, bias_stability_table, table_to_json
@@ -107,6 +108,10 @@ class Evaluation:
         ``chamber_c``), or None when the pass kept none.
     notes
         Why a figure is missing (e.g. a run too short for the Allan deviation).
+    ranges
+        Shares of samples beyond the trained temperature and df/dt, and how far. The
+        figures leave out the first ``warmup_s`` of the run (the df/dt filter settling),
+        as training does.
     """
 
     file: str
@@ -124,6 +129,7 @@ class Evaluation:
     block_s: float | None = None
     blocks: dict[str, np.ndarray] | None = None
     notes: tuple[str, ...] = field(default=())
+    ranges: RangeReport | None = None
 
     @property
     def name(self) -> str:
@@ -174,8 +180,13 @@ class Evaluation:
             "out_of_range_fraction": self.out_of_range_fraction,
             "rate_out_of_range_fraction": self.rate_out_of_range_fraction,
             "residual_rms_dph": self.residual_rms_dph,
+            "ranges": None if self.ranges is None else self.ranges.to_dict(),
             "notes": list(self.notes),
         }
+
+    def range_warnings(self) -> list[str]:
+        """Lines on samples beyond the trained temperature and df/dt (empty if none)."""
+        return [] if self.ranges is None else self.ranges.warnings()
 
     def summary(self) -> str:
         """A small text table."""
@@ -192,6 +203,7 @@ class Evaluation:
                      f"{self.rate_out_of_range_fraction:.1%})")
         if self.residual_rms_dph is not None:
             lines.append(f"RMS of true bias minus model: {self.residual_rms_dph:.4f} °/h")
+        lines.extend(self.range_warnings())
         lines.extend(self.notes)
         return "\n".join(lines)
 
@@ -292,10 +304,11 @@ def run_pass(
     deviations: dict[str, AllanResult] = {}
     terms: dict[str, NoiseTerms] = {}
     notes: list[str] = []
+    settling = min(frequency.settling, max(n - 2 * round(10.0 * fs), 0))
     for key, parts in full.items():
         if not parts:
             continue
-        values = np.concatenate(parts)
+        values = np.concatenate(parts)[settling:]  # the filter's settling time, as in training
         parts.clear()
         stability[key] = bias_stability_table(values, fs, taus_s)
         if not allan:
@@ -312,6 +325,7 @@ def run_pass(
         source=source, unit=metadata.unit, input_rate_dph=metadata.input_rate_dph,
         block_s=None if means is None else means.rows / fs,
         blocks=None if means is None else means.means(), notes=tuple(notes),
+        ranges=frequency.ranges(),
     )
 
 

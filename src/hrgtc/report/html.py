@@ -69,6 +69,7 @@ td.n{text-align:right;font-variant-numeric:tabular-nums}
 code,.eq{font-family:ui-monospace,"DejaVu Sans Mono",Menlo,Consolas,monospace;font-size:.92em}
 .eq{background:#f5f7fa;border-left:3px solid #8aa4c8;padding:.5em .8em;overflow-x:auto}
 .note{background:#fff7e0;border-left:3px solid #e0b040;padding:.4em .8em}
+.warning{background:#fdecea;border-left:3px solid #c0392b;padding:.4em .8em}
 nav ol{columns:2;font-size:.92em}.muted{color:#666;font-size:.9em}
 """
 
@@ -340,6 +341,9 @@ def _run(page: _Page, k: int, run: Evaluation, model: UnitModel) -> None:
     if model.housing is not None and not housing:
         facts.append(("housing baseline", "not applied: the run has no housing_c column"))
     page.add(_table(("quantity", "value"), facts, f"Range and residual of {run.name}"))
+    for line in run.range_warnings():  # where the reader looks, not only in the JSON
+        page.add(f'<p class="warning"><b>Beyond the calibration.</b> '
+                 f"{escape(line.removeprefix('warning: '))}</p>")
     if run.allan:
         page.figure(figures.allan_figure(run),
                     "Overlapping Allan deviation of the output before and after compensation "

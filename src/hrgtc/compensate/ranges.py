@@ -1,0 +1,185 @@
+"""How far a compensated run went beyond what the model was trained on.
+
+The drift model is a regression on the temperatures and df/dt of its training
+runs. Beyond them it continues along its tangent (see
+:func:`hrgtc.drift.features.tangent_extension`), which keeps a law linear in
+df/dt exact but is a guess otherwise; samples beyond the trained temperature or
+df/dt carry 2-3x the model error in held-out tests. :class:`RangeReport` gives
+the share of such samples and how far they went, in units a user reads
+(°C beyond the trained temperatures; df/dt as a multiple of the largest trained
+one and as a resonator temperature rate in °C/h), and says it in one line per
+kind for the command line (``--strict`` turns it into an exit status).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from hrgtc.drift import DriftModel
+from hrgtc.errors import ExtrapolationWarning
+from hrgtc.thermometry import Thermometer
+
+
+@dataclass(frozen=True)
+class RangeReport:
+    """Shares of samples beyond the trained ranges, and how far (one run).
+
+    Attributes
+    ----------
+    samples
+        Samples seen.
+    temperature_fraction
+        Share outside the calibrated temperature range (thermometer and drift training).
+    rate_fraction
+        Share whose df/dt is outside its training range.
+    settling_fraction
+        Share in the filter's settling time at the start (flagged, left out of figures).
+    trained_c, seen_c
+        (min, max) trained and seen resonator temperature. [°C]
+    trained_rate_c_per_h, seen_rate_c_per_h
+        (min, max) trained and seen df/dt as a resonator temperature rate. [°C/h]
+    """
+
+    samples: int
+    temperature_fraction: float
+    rate_fraction: float
+    settling_fraction: float
+    trained_c: tuple[float, float]
+    seen_c: tuple[float, float]
+    trained_rate_c_per_h: tuple[float, float]
+    seen_rate_c_per_h: tuple[float, float]
+
+    @property
+    def temperature_excess_c(self) -> float:
+        """Farthest seen temperature beyond the trained range (0 inside). [°C]"""
+        low, high = self.trained_c
+        return max(0.0, low - self.seen_c[0], self.seen_c[1] - high)
+
+    @property
+    def rate_excess_ratio(self) -> float:
+        """Largest seen |df/dt| beyond the range over the trained one on its side (0 inside)."""
+        low, high = self.trained_rate_c_per_h
+        ratios = [0.0]
+        if self.seen_rate_c_per_h[1] > high:
+            ratios.append(self.seen_rate_c_per_h[1] / high if high > 0 else math.inf)
+        if self.seen_rate_c_per_h[0] < low:
+            ratios.append(self.seen_rate_c_per_h[0] / low if low < 0 else math.inf)
+        return max(ratios)
+
+    @property
+    def beyond(self) -> bool:
+        """Whether any sample after the settling time was beyond a trained range."""
+        return self.temperature_fraction > 0.0 or self.rate_fraction > 0.0
+
+    def warnings(self) -> list[str]:
+        """One line per kind of excursion (empty when the run stayed inside)."""
+        lines = []
+        if self.temperature_fraction > 0.0:
+            low, high = self.trained_c
+            lines.append(
+                f"warning: {self.temperature_fraction:.1%} of samples beyond the trained "
+                f"temperature {low:.2f} to {high:.2f} °C, up to {self.temperature_excess_c:.2f} "
+                f"°C beyond (seen {self.seen_c[0]:.2f} to {self.seen_c[1]:.2f} °C)"
+            )
+        if self.rate_fraction > 0.0:
+            low, high = self.trained_rate_c_per_h
+            ratio = self.rate_excess_ratio
+            how_far = "" if not math.isfinite(ratio) else f", up to {ratio:.2f}× the largest " \
+                "trained on that side"
+            lines.append(
+                f"warning: {self.rate_fraction:.1%} of samples beyond the trained df/dt "
+                f"{low:+.1f} to {high:+.1f} °C/h (seen {self.seen_rate_c_per_h[0]:+.1f} to "
+                f"{self.seen_rate_c_per_h[1]:+.1f} °C/h{how_far}); train on runs this fast "
+                "(calibrate --drift takes several)"
+            )
+        return lines
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types."""
+        def pair(values: tuple[float, float]) -> list[float | None]:
+            return [v if math.isfinite(v) else None for v in values]
+
+        ratio = self.rate_excess_ratio
+        return {
+            "samples": self.samples,
+            "temperature_fraction": self.temperature_fraction,
+            "rate_fraction": self.rate_fraction,
+            "settling_fraction": self.settling_fraction,
+            "trained_c": pair(self.trained_c),
+            "seen_c": pair(self.seen_c),
+            "temperature_excess_c": self.temperature_excess_c,
+            "trained_rate_c_per_h": pair(self.trained_rate_c_per_h),
+            "seen_rate_c_per_h": pair(self.seen_rate_c_per_h),
+            "rate_excess_ratio": ratio if math.isfinite(ratio) else None,
+        }
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> RangeReport:
+        def pair(key: str) -> tuple[float, float]:
+            low, high = data[key]
+            return (math.nan if low is None else float(low), math.nan if high is None
+                    else float(high))
+
+        return cls(int(data["samples"]), float(data["temperature_fraction"]),
+                   float(data["rate_fraction"]), float(data["settling_fraction"]),
+                   pair("trained_c"), pair("seen_c"), pair("trained_rate_c_per_h"),
+                   pair("seen_rate_c_per_h"))
+
+
+def _temperature(thermometer: Thermometer, freq_hz: np.ndarray) -> np.ndarray:
+    """T(f), continued linearly beyond the thermometer's extension (no NaN). [°C]"""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ExtrapolationWarning)
+        t = np.asarray(thermometer.temperature(freq_hz, warn=False), dtype=float)
+    low, high = thermometer.temperature_range_c
+    f_low, f_high = thermometer.frequency(low), thermometer.frequency(high)
+    slope = (f_high - f_low) / (high - low)
+    lost = ~np.isfinite(t)
+    t[lost] = low + (freq_hz[lost] - f_low) / slope
+    return t
+
+
+def range_report(drift: DriftModel, thermometer: Thermometer, samples: int, counts: np.ndarray,
+                 extremes: np.ndarray) -> RangeReport:
+    """A :class:`RangeReport` from the compensator's counts and extremes of f and df/dt.
+
+    ``counts`` are (outside temperature, outside df/dt, -, settling) and ``extremes``
+    (f min, f max, df min, df max) [Hz, Hz/s], as kept by the compensator.
+    """
+    s = drift.settings
+    f_ref = s.reference_freq_hz
+    cal_low, cal_high = thermometer.temperature_range_c
+    f_trained = drift.ranges.get("f", (-math.inf, math.inf))
+    trained = _temperature(thermometer, np.array([max(f_trained[0], -1e300),
+                                                  min(f_trained[1], 1e300)]) + f_ref)
+    trained_c = (max(float(trained[0]), cal_low), min(float(trained[1]), cal_high))
+    if samples and np.isfinite(extremes[:2]).all():
+        seen = _temperature(thermometer, np.asarray(extremes[:2], dtype=float) + f_ref)
+        seen_c = (float(seen[0]), float(seen[1]))
+    else:
+        seen_c = (math.nan, math.nan)
+    reference_c = 0.5 * (trained_c[0] + trained_c[1])
+    slope = float(thermometer.slope_hz_per_c(reference_c))  # Hz/°C
+
+    def per_hour(values: tuple[float, float]) -> tuple[float, float]:
+        low, high = sorted((values[0] / slope * 3600.0, values[1] / slope * 3600.0))
+        return (low, high)
+
+    df_trained = drift.ranges.get("df", (-math.inf, math.inf))
+    share = (lambda k: counts[k] / samples if samples else 0.0)  # noqa: E731
+    return RangeReport(
+        samples=int(samples),
+        temperature_fraction=float(share(0)),
+        rate_fraction=float(share(1)),
+        settling_fraction=float(share(3)),
+        trained_c=trained_c,
+        seen_c=seen_c,
+        trained_rate_c_per_h=per_hour(df_trained),
+        seen_rate_c_per_h=per_hour((float(extremes[2]), float(extremes[3]))),
+    )

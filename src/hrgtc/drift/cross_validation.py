@@ -1,0 +1,193 @@
+"""Leave-one-run-out cross-validation of a drift model, and term selection by it.
+
+A drift model is trained on several runs (cool-down, warm-up, cycles, the soaks'
+transients) and used on runs it has not seen. In-sample F-tests say how well a
+term fits the training runs; they do not say whether it carries over. Here each
+run in turn is left out, the model's terms are refitted by OLS on the window
+means of the other runs, and the left-out run's window residuals are measured:
+their standard deviation is the run's cross-validated bias stability at the
+window length (10 s by default, the figure of Section 4.2 of [1]). The residuals
+of all left-out windows are also split into heating and cooling (sign of the
+resonator temperature rate, from df/dt and the thermometer's slope), because HRG
+bias behaves differently in the two (Li et al., Sci. Rep. 13:6019, 2023).
+
+:func:`select_terms` searches by that figure: starting from the stepwise
+selection, the one-term change (a term in or out) that lowers the root mean
+square of the per-run cross-validated stabilities most is made, until none
+lowers it by more than ``min_gain``.
+
+[1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+#: Windows whose |df/dt| is below this share of the largest are neither heating nor cooling.
+RATE_DEADBAND = 0.05
+
+
+@dataclass(frozen=True)
+class CrossValidation:
+    """Leave-one-run-out residuals of one term set.
+
+    Attributes
+    ----------
+    terms
+        The terms refitted on each fold.
+    sources
+        Name of each run, in run order.
+    per_run_dph
+        Run name -> standard deviation of its held-out window residuals (its
+        cross-validated bias stability at the window length), NaN where the run
+        could not be left out. [°/h]
+    heating_dph, cooling_dph
+        The same over all held-out windows while heating / cooling. [°/h]
+    score_dph
+        Root mean square of the finite per-run values (what :func:`select_terms` lowers).
+    """
+
+    terms: tuple[str, ...]
+    sources: tuple[str, ...]
+    per_run_dph: dict[str, float]
+    heating_dph: float
+    cooling_dph: float
+    score_dph: float
+
+    def to_dict(self) -> dict[str, Any]:
+        def clean(v: float) -> float | None:
+            return v if math.isfinite(v) else None
+
+        return {"terms": list(self.terms), "per_run_dph": {k: clean(v) for k, v in
+                                                            self.per_run_dph.items()},
+                "heating_dph": clean(self.heating_dph), "cooling_dph": clean(self.cooling_dph),
+                "score_dph": clean(self.score_dph)}
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> CrossValidation:
+        def value(v: Any) -> float:
+            return math.nan if v is None else float(v)
+
+        per_run = {str(k): value(v) for k, v in data["per_run_dph"].items()}
+        return cls(tuple(data["terms"]), tuple(per_run), per_run, value(data["heating_dph"]),
+                   value(data["cooling_dph"]), value(data["score_dph"]))
+
+    def summary(self) -> str:
+        """The per-run table as text."""
+        lines = [f"Leave-one-run-out cross-validation ({len(self.terms)} terms): "
+                 "std of held-out window residuals [°/h]"]
+        width = max((len(s) for s in self.sources), default=4)
+        for name, value in self.per_run_dph.items():
+            lines.append(f"  {name:<{width}}  {value:8.4f}")
+        lines.append(f"  heating {self.heating_dph:.4f}, cooling {self.cooling_dph:.4f}, "
+                     f"RMS over runs {self.score_dph:.4f}")
+        return "\n".join(lines)
+
+
+def _std(values: np.ndarray) -> float:
+    return float(np.std(values, ddof=1)) if values.size > 2 else math.nan
+
+
+def heating_mask(rate: np.ndarray, slope_sign: float) -> tuple[np.ndarray, np.ndarray]:
+    """(heating, cooling) masks of windows from df/dt and the sign of df/dT."""
+    temperature_rate = np.asarray(rate) * slope_sign
+    band = RATE_DEADBAND * float(np.max(np.abs(temperature_rate))) if rate.size else 0.0
+    return temperature_rate > band, temperature_rate < -band
+
+
+def _held_out_residuals(x: np.ndarray, y: np.ndarray, run: np.ndarray,
+                        columns: Sequence[int]) -> np.ndarray:
+    """Residual of every window when its own run is left out of the fit (NaN: not possible)."""
+    out = np.full(y.size, np.nan)
+    design = np.column_stack([np.ones(y.size), x[:, list(columns)]])
+    for r in np.unique(run):
+        test = run == r
+        train = ~test
+        if np.count_nonzero(train) <= design.shape[1] + 1:
+            continue
+        solution = np.linalg.lstsq(design[train], y[train], rcond=None)[0]
+        out[test] = y[test] - design[test] @ solution
+    return out
+
+
+def cross_validate(x_scaled: np.ndarray, bias_dph: np.ndarray, run: np.ndarray,
+                   names: Sequence[str], terms: Sequence[str], sources: Sequence[str],
+                   rate: np.ndarray, slope_sign: float = 1.0) -> CrossValidation:
+    """Leave-one-run-out cross-validation of the model with ``terms`` (a subset of ``names``).
+
+    Parameters
+    ----------
+    x_scaled
+        Window means of the candidate terms (scaled), shape (windows, candidates).
+    bias_dph
+        Window means of the measured bias. [°/h]
+    run
+        Run index of each window.
+    names
+        Candidate names (columns of ``x_scaled``).
+    terms
+        The terms to refit on each fold.
+    sources
+        Run names, by run index.
+    rate
+        Window means of df/dt (heating/cooling split). [Hz/s]
+    slope_sign
+        Sign of df/dT of the thermometer (+1 when frequency rises with temperature).
+    """
+    columns = [list(names).index(t) for t in terms]
+    residual = _held_out_residuals(x_scaled, bias_dph, run, columns)
+    per_run = {}
+    for r, source in enumerate(sources):
+        per_run[source] = _std(residual[(run == r) & np.isfinite(residual)])
+    heating, cooling = heating_mask(rate, slope_sign)
+    finite = np.isfinite(residual)
+    values = np.array([v for v in per_run.values() if math.isfinite(v)])
+    score = float(np.sqrt(np.mean(values ** 2))) if values.size else math.nan
+    return CrossValidation(tuple(terms), tuple(sources), per_run,
+                           _std(residual[heating & finite]), _std(residual[cooling & finite]),
+                           score)
+
+
+def select_terms(x_scaled: np.ndarray, bias_dph: np.ndarray, run: np.ndarray,
+                 names: Sequence[str], sources: Sequence[str], rate: np.ndarray,
+                 slope_sign: float = 1.0, min_gain: float = 0.01,
+                 parents: Mapping[str, Sequence[str]] | None = None,
+                 initial: Sequence[str] = ()) -> tuple[str, ...]:
+    """Terms chosen by leave-one-run-out cross-validated bias stability.
+
+    From ``initial`` (e.g. the stepwise selection), the move that lowers
+    :attr:`CrossValidation.score_dph` the most, adding one candidate or removing one
+    term, is taken while it lowers it by more than ``min_gain`` (relative); with
+    ``parents``, a term enters only once its parents are in and a parent stays while a
+    child is in. The result is never worse by this figure than ``initial``. Needs at
+    least two runs. Returns the terms in candidate order.
+    """
+    def score(terms: Sequence[str]) -> float:
+        value = cross_validate(x_scaled, bias_dph, run, names, terms, sources, rate,
+                               slope_sign).score_dph
+        return value if math.isfinite(value) else math.inf
+
+    chosen = [n for n in names if n in set(initial)]
+    best = score(chosen)
+    for _ in range(4 * len(names)):  # a bound; each accepted move lowers the score
+        trial = {}
+        for name in names:
+            if name in chosen:
+                children = [c for c in chosen if name in (parents or {}).get(c, ())]
+                if not children:
+                    trial[name] = score([n for n in chosen if n != name])
+            elif not parents or set(parents.get(name, ())) <= set(chosen):
+                trial[name] = score([n for n in names if n in chosen or n == name])
+        if not trial:
+            break
+        name = min(trial, key=trial.__getitem__)
+        if not trial[name] < best * (1.0 - min_gain):
+            break
+        chosen = [n for n in chosen if n != name] if name in chosen else [*chosen, name]
+        best = trial[name]
+    return tuple(n for n in names if n in chosen)

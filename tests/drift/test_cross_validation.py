@@ -1,0 +1,76 @@
+"""Tests of hrgtc.drift.cross_validation: leave-one-run-out residuals and selection by them."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from hrgtc import drift
+from hrgtc.drift.cross_validation import CrossValidation, cross_validate, select_terms
+from hrgtc.drift.stepwise import stepwise
+from hrgtc.errors import InputError
+
+from synthetic import THERMOMETER, ramp_run
+
+NAMES = ("a", "b", "c")
+
+
+def _runs(seed=41, n=300, runs=4):
+    rng = np.random.default_rng(seed)
+    run = np.repeat(np.arange(runs), n)
+    x = rng.normal(size=(run.size, 3))
+    y = 1.0 + 2.0 * x[:, 0] - 0.5 * x[:, 1] + rng.normal(0.0, 0.1, run.size)
+    rate = np.where(np.arange(run.size) % 2 == 0, 1.0, -1.0)  # heating, cooling alternately
+    return x, y, run, rate
+
+
+def test_cross_validation_equals_refits_by_hand():
+    x, y, run, rate = _runs()
+    sources = tuple(f"run{r}" for r in range(4))
+    cv = cross_validate(x, y, run, NAMES, ("a", "b"), sources, rate)
+    held = np.empty(y.size)
+    for r in range(4):
+        test = run == r
+        design = np.column_stack([np.ones(y.size), x[:, :2]])
+        beta = np.linalg.lstsq(design[~test], y[~test], rcond=None)[0]
+        held[test] = y[test] - design[test] @ beta
+        assert cv.per_run_dph[f"run{r}"] == pytest.approx(np.std(held[test], ddof=1), rel=1e-12)
+    assert cv.heating_dph == pytest.approx(np.std(held[rate > 0], ddof=1), rel=1e-12)
+    assert cv.cooling_dph == pytest.approx(np.std(held[rate < 0], ddof=1), rel=1e-12)
+    values = np.array(list(cv.per_run_dph.values()))
+    assert cv.score_dph == pytest.approx(np.sqrt(np.mean(values ** 2)))
+    again = CrossValidation.from_dict(json.loads(json.dumps(cv.to_dict())))
+    assert again.per_run_dph == cv.per_run_dph and again.score_dph == cv.score_dph
+
+
+def test_selection_by_cross_validation_finds_the_law():
+    x, y, run, rate = _runs(seed=42)
+    assert select_terms(x, y, run, NAMES, ("r0", "r1", "r2", "r3"), rate) == ("a", "b")
+    # a slope that only run 0 shows does not carry over to the others: the F-test keeps
+    # it (in-sample), cross-validation does not
+    y2 = y + np.where(run == 0, 3.0 * x[:, 2], 0.0)
+    assert "c" in stepwise(x, y2, names=NAMES).selected
+    assert "c" not in select_terms(x, y2, run, NAMES, ("r0", "r1", "r2", "r3"), rate,
+                                   initial=("a", "b", "c"))
+
+
+def test_drift_fit_reports_cross_validation_per_run():
+    cool = ramp_run(seed=43, hours=3.0)
+    warm = ramp_run(seed=44, start_c=-20.0, end_c=20.0, hours=3.0)
+    model = drift.fit([cool, warm], THERMOMETER)
+    cv = model.cross_validation
+    assert cv is not None and len(cv.per_run_dph) == 2
+    assert all(np.isfinite(v) and v > 0 for v in cv.per_run_dph.values())
+    assert np.isfinite(cv.heating_dph) and np.isfinite(cv.cooling_dph)
+    assert "cross-validation" in model.summary()
+    by_cv = drift.fit([cool, warm], THERMOMETER, select="cv")
+    assert by_cv.selection == "cv" and by_cv.selected
+    assert by_cv.cross_validation.score_dph <= cv.score_dph  # never worse than stepwise
+    restored = drift.DriftModel.from_dict(json.loads(json.dumps(by_cv.to_dict())))
+    assert restored.cross_validation.per_run_dph == by_cv.cross_validation.per_run_dph
+    with pytest.raises(InputError, match="two training runs"):
+        drift.fit([cool], THERMOMETER, select="cv")
+    with pytest.raises(InputError, match="select must be"):
+        drift.fit([cool, warm], THERMOMETER, select="lasso")
