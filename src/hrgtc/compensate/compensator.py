@@ -16,6 +16,7 @@ fused one to.
 
 from __future__ import annotations
 
+import itertools
 import os
 from collections.abc import Mapping
 from concurrent.futures import ThreadPoolExecutor
@@ -28,9 +29,11 @@ from hrgtc import recording as rec_io
 from hrgtc.drift import DriftModel
 from hrgtc.drift.features import FeatureStream
 from hrgtc.errors import CalibrationError, InputError
+from hrgtc.files import check_writable
 from hrgtc.model import UnitModel
 from hrgtc.progress import Progress
 from hrgtc.recording import Recording
+from hrgtc.recording.validation import GAP_PERIODS, check_gap_policy
 
 #: Rows worked on at once: small enough for the temporaries to stay in cache.
 BLOCK_ROWS = 1 << 17
@@ -68,6 +71,11 @@ class Compensator:
     engine
         ``"fused"`` (one compiled pass per chunk, default) or ``"numpy"`` (the
         array-by-array reference); both give the same numbers to rounding.
+    gaps
+        ``"split"``: the df/dt filter restarts at rest after every gap (a time step
+        longer than :data:`~hrgtc.recording.validation.GAP_PERIODS` sample periods),
+        as if each segment were its own run; ``"error"`` / ``"ignore"`` (default):
+        the chunks are taken as one continuous run.
 
     Examples
     --------
@@ -75,7 +83,9 @@ class Compensator:
     >>> # for chunk in iter_chunks("run.parquet"): out = comp.process(chunk)
     """
 
-    def __init__(self, model: UnitModel, drift: str = "frequency", engine: str = "fused") -> None:
+    def __init__(self, model: UnitModel, drift: str = "frequency", engine: str = "fused",
+                 gaps: str = "ignore") -> None:
+        self.gaps = check_gap_policy(gaps)
         if engine not in ENGINES:
             raise InputError(f"engine must be 'fused' or 'numpy', got {engine!r}")
         if drift == "frequency":
@@ -97,11 +107,29 @@ class Compensator:
 
     def reset(self) -> None:
         """Start a new run: the df/dt filter restarts at rest on the next sample."""
-        self._stream = FeatureStream(self.drift.settings, self._variables)
-        self._state = np.zeros(6)  # the fused engine's filter state (compensate._kernel)
+        self.restart()
         self.samples = 0
         self.out_of_range = 0
         self.rate_out_of_range = 0
+        self.segments = 1
+        self._last_time: float | None = None
+
+    def restart(self) -> None:
+        """Restart the df/dt filter at rest on the next sample (after a gap); counts stay."""
+        self._stream = FeatureStream(self.drift.settings, self._variables)
+        self._state = np.zeros(6)  # the fused engine's filter state (compensate._kernel)
+
+    def _gap_rows(self, chunk: Recording) -> list[int]:
+        """Rows of ``chunk`` that start a new segment (``gaps="split"``)."""
+        time = chunk.time_s
+        if not len(time):
+            return []
+        limit = GAP_PERIODS / chunk.metadata.sample_rate_hz
+        rows = (np.flatnonzero(np.diff(time) > limit) + 1).tolist()
+        if self._last_time is not None and time[0] - self._last_time > limit:
+            rows.insert(0, 0)
+        self._last_time = float(time[-1])
+        return rows
 
     def process(self, chunk: Recording) -> Recording:
         """The next chunk of the run with the :data:`OUTPUT_COLUMNS` added.
@@ -115,6 +143,21 @@ class Compensator:
         """
         if self.samples == 0:
             self.drift.settings.check_sample_rate(chunk)
+        if self.gaps == "split" and "time_s" in chunk:
+            cuts = self._gap_rows(chunk)
+            if cuts:
+                bounds = [0, *[c for c in cuts if c > 0], len(chunk)]
+                pieces = []
+                for k, (start, stop) in enumerate(itertools.pairwise(bounds)):
+                    if k > 0 or cuts[0] == 0:
+                        self.restart()
+                        self.segments += 1
+                    pieces.append(self._process(chunk.slice(start, stop)))
+                return chunk.with_columns(**{
+                    name: np.concatenate([p[name] for p in pieces]) for name in OUTPUT_COLUMNS})
+        return self._process(chunk)
+
+    def _process(self, chunk: Recording) -> Recording:
         n = len(chunk)
         out = {name: np.empty(n) for name in OUTPUT_COLUMNS}
         if self.engine == "fused" and self._fused(chunk, out):
@@ -225,8 +268,10 @@ def compensate_file(
     one and starts its write-back to disk, so that the fsync before the atomic
     rename finds little left to wait for. At most three chunks are held at a time.
     """
-    compensator = Compensator(model, drift)
-    chunks = (read_options or rec_io.ReadOptions()).chunks(source, rows=chunk_rows)
+    options = read_options or rec_io.ReadOptions()
+    compensator = Compensator(model, drift, gaps=options.gaps)
+    check_writable(output, estimated_output_bytes(source, output, len(OUTPUT_COLUMNS)))
+    chunks = options.chunks(source, rows=chunk_rows)
     try:
         first = next(chunks)
         names = (*first.names, *OUTPUT_COLUMNS)
@@ -254,6 +299,23 @@ def compensate_file(
     return CompensationSummary(str(source), str(output), compensator.samples,
                                compensator.out_of_range_fraction,
                                compensator.rate_out_of_range_fraction)
+
+
+def estimated_output_bytes(source: str | os.PathLike[str], output: str | os.PathLike[str],
+                           added_columns: int) -> float:
+    """Rough size of ``output``, a copy of ``source`` with ``added_columns`` more columns.
+
+    Counted as 8-byte floats (Parquet, HDF5) or about 20 characters (CSV) per value;
+    used to refuse a run that would fill the disk before it starts.
+    """
+    try:
+        with rec_io.open_source(source) as opened:
+            columns = len(opened.names) + added_columns
+        rows = rec_io.count_rows(source)
+    except (InputError, OSError):
+        return 0.0
+    per_value = 20.0 if str(output).lower().endswith(".csv") else 8.0
+    return rows * columns * per_value
 
 
 def _write(writer: rec_io.RecordingWriter, chunk: Recording) -> None:

@@ -27,7 +27,13 @@ from typing import Any
 import numpy as np
 
 from hrgtc.errors import InputError, RecordingError
-from hrgtc.files import fsync_file, publish, refuse_existing, temporary_beside
+from hrgtc.files import (
+    forget_temporary,
+    fsync_file,
+    publish,
+    refuse_existing,
+    temporary_beside,
+)
 from hrgtc.progress import Progress
 from hrgtc.recording.csv import CsvSink, CsvSource
 from hrgtc.recording.formats import (
@@ -347,6 +353,7 @@ def _remove(path: str) -> None:
         os.unlink(path)
     except FileNotFoundError:
         pass
+    forget_temporary(path)
 
 
 class RecordingWriter:
