@@ -57,8 +57,27 @@ def test_out_of_range_samples_are_counted(unit_model):
     hot = ramp_run(seed=23, start_c=20.0, end_c=60.0, hours=1.0)
     compensator = Compensator(unit_model)
     out = compensator.process(hot)
-    assert compensator.out_of_range_fraction == pytest.approx(1 - out["in_range"].mean())
-    assert compensator.out_of_range_fraction > 0.2
+    # in_range = 0 where f or df is outside its range: at least the f count
+    assert 1 - out["in_range"].mean() >= compensator.out_of_range_fraction > 0.2
+    assert 1 - out["in_range"].mean() <= (compensator.out_of_range_fraction
+                                          + compensator.rate_out_of_range_fraction)
+
+
+@pytest.mark.parametrize("engine", ["fused", "numpy"])
+def test_samples_beyond_the_df_range_are_never_in_range(unit_model, engine):
+    # issue 11: a faster warm-up leaves the training range of df/dt (the model was fitted
+    # on a cool-down); those samples are extrapolated and must not be flagged in range
+    fast = ramp_run(seed=29, start_c=-10.0, end_c=15.0, hours=0.5)
+    compensator = Compensator(unit_model, engine=engine)
+    out = compensator.process(fast)
+    low, high = unit_model.drift.ranges["df"]
+    from hrgtc.drift.features import FeatureStream
+
+    values = FeatureStream(unit_model.drift.settings, ("f", "df")).process(fast)
+    beyond = (values["df"] < low) | (values["df"] > high)
+    assert beyond.mean() > 0.5
+    assert compensator.rate_out_of_range == int(beyond.sum())
+    assert not np.any(out["in_range"][beyond])
 
 
 def test_housing_baseline_missing_is_a_clear_error(unit_model):

@@ -414,7 +414,7 @@ def compensate_block(freq_hz, rate_dph, housing_c, filt, uses_housing, state,
         n_ok = 0.0
         n_rate_ok = 0.0
         for i in range(m):
-            out_in_range[start + i] = ok[i]
+            out_in_range[start + i] = ok[i] * rate_ok[i]  # in range: f (h) and df (dh)
             n_ok += ok[i]
             n_rate_ok += rate_ok[i]
         counts[0] += m - int(n_ok)

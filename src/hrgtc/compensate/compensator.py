@@ -16,6 +16,7 @@ fused one to.
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import os
 from collections.abc import Mapping
@@ -33,6 +34,7 @@ from hrgtc.files import check_writable
 from hrgtc.model import UnitModel
 from hrgtc.progress import Progress
 from hrgtc.recording import Recording
+from hrgtc.recording.marks import COMPENSATED_KEY, mark, refuse_compensated
 from hrgtc.recording.validation import GAP_PERIODS, check_gap_policy
 
 #: Rows worked on at once: small enough for the temporaries to stay in cache.
@@ -135,10 +137,11 @@ class Compensator:
         """The next chunk of the run with the :data:`OUTPUT_COLUMNS` added.
 
         ``in_range`` is 1.0 where the frequency is inside the thermometer's calibrated
-        range and the drift model's training range of f (and of h), else 0.0. Rates of
-        change outside their training range are counted separately
-        (:attr:`rate_out_of_range_fraction`): a model trained on a cool-down only has
-        seen negative df/dt. Large chunks are worked through in blocks of
+        range and the drift model's training ranges of f and df (and of h, dh), else 0.0:
+        a sample the model extrapolates to is never marked in range. The two causes are
+        counted separately (:attr:`out_of_range_fraction` for f and h,
+        :attr:`rate_out_of_range_fraction` for df and dh: a model trained on a cool-down
+        only has seen negative df/dt). Large chunks are worked through in blocks of
         :data:`BLOCK_ROWS` rows, which keeps the temporaries in cache.
         """
         if self.samples == 0:
@@ -203,7 +206,7 @@ class Compensator:
         np.subtract(chunk.rate_dph, bias, out=out["rate_comp_dph"][start:stop])
         out["bias_model_dph"][start:stop] = bias
         out["resonator_c_est"][start:stop] = thermometer.temperature(chunk.freq_hz, warn=False)
-        out["in_range"][start:stop] = in_range
+        out["in_range"][start:stop] = in_range & rate_in_range
         self.samples += len(chunk)
         self.out_of_range += int(np.count_nonzero(~in_range))
         self.rate_out_of_range += int(np.count_nonzero(~rate_in_range))
@@ -270,13 +273,15 @@ def compensate_file(
     """
     options = read_options or rec_io.ReadOptions()
     compensator = Compensator(model, drift, gaps=options.gaps)
+    refuse_compensated(source)
     check_writable(output, estimated_output_bytes(source, output, len(OUTPUT_COLUMNS)))
     chunks = options.chunks(source, rows=chunk_rows)
     try:
         first = next(chunks)
         names = (*first.names, *OUTPUT_COLUMNS)
         total = rec_io.count_rows(source)
-        with rec_io.RecordingWriter(output, first.metadata, names, force=force) as writer, \
+        metadata = compensated_metadata(first.metadata, model, drift)
+        with rec_io.RecordingWriter(output, metadata, names, force=force) as writer, \
                 ThreadPoolExecutor(max_workers=1) as reading, \
                 ThreadPoolExecutor(max_workers=1) as writing:
             ahead = reading.submit(next, chunks, None)
@@ -299,6 +304,13 @@ def compensate_file(
     return CompensationSummary(str(source), str(output), compensator.samples,
                                compensator.out_of_range_fraction,
                                compensator.rate_out_of_range_fraction)
+
+
+def compensated_metadata(metadata: rec_io.Metadata, model: UnitModel,
+                         drift: str = "frequency") -> rec_io.Metadata:
+    """``metadata`` with the mark of compensation by ``model`` (:mod:`hrgtc.recording.marks`)."""
+    extra = {**metadata.extra, COMPENSATED_KEY: mark(model.sha256, model.unit, drift)}
+    return dataclasses.replace(metadata, extra=extra)
 
 
 def estimated_output_bytes(source: str | os.PathLike[str], output: str | os.PathLike[str],

@@ -27,12 +27,13 @@ from typing import Any
 import numpy as np
 
 from hrgtc.compensate import Compensator
-from hrgtc.errors import HrgtcError, InputError
+from hrgtc.errors import HrgtcError, InputError, RecordingError
 from hrgtc.evaluation.allan import AllanResult, NoiseTerms, allan_deviation, noise_terms
 from hrgtc.evaluation.metrics import DEFAULT_TAUS_S, bias_stability_table, table_to_json
 from hrgtc.model import UnitModel
 from hrgtc.progress import Progress
 from hrgtc.recording import ReadOptions, Recording, count_rows
+from hrgtc.recording.marks import compensation_mark, describe_mark, refuse_compensated
 
 #: Series measured by a pass: output minus input rate, compensated by the
 #: frequency model, and by the housing-thermistor baseline.
@@ -346,11 +347,16 @@ def evaluate(
         As for :func:`run_pass`.
     """
     if isinstance(run, Recording):
+        found = compensation_mark(run.metadata.to_dict(), list(run.names))
+        if found is not None:
+            raise RecordingError(f"{run.source or 'recording'} is already compensated, by "
+                                 f"{describe_mark(found)}; evaluate the original recording")
         rows = len(run)
         name, source, chunks = Path(run.source or "recording").name, run.source or "", [run]
         fs = run.sample_rate_hz
     else:
         options = read_options or ReadOptions()
+        refuse_compensated(run)
         rows = count_rows(run) if progress is not None or max_points is not None else 0
         name, source, chunks = Path(run).name, str(run), options.chunks(run)
         fs = None
