@@ -271,7 +271,7 @@ def compensate_file(
     one and starts its write-back to disk, so that the fsync before the atomic
     rename finds little left to wait for. At most three chunks are held at a time.
     """
-    options = read_options or rec_io.ReadOptions()
+    options = with_model_band(read_options or rec_io.ReadOptions(), model)
     compensator = Compensator(model, drift, gaps=options.gaps)
     refuse_compensated(source)
     check_writable(output, estimated_output_bytes(source, output, len(OUTPUT_COLUMNS)))
@@ -304,6 +304,40 @@ def compensate_file(
     return CompensationSummary(str(source), str(output), compensator.samples,
                                compensator.out_of_range_fraction,
                                compensator.rate_out_of_range_fraction)
+
+
+#: Frequencies farther than this beyond the calibrated span are errors, not extrapolation. [°C]
+PLAUSIBLE_MARGIN_C = 100.0
+
+
+def frequency_span(model: UnitModel) -> tuple[float, float]:
+    """The frequencies the model was calibrated on: thermometer and drift training ranges. [Hz]"""
+    low, high = model.thermometer.frequency_range_hz
+    if "f" in model.drift.ranges:
+        reference = model.drift.settings.reference_freq_hz
+        f_low, f_high = model.drift.ranges["f"]
+        low, high = min(low, reference + f_low), max(high, reference + f_high)
+    return float(low), float(high)
+
+
+def plausible_frequency_band(model: UnitModel,
+                             margin_c: float = PLAUSIBLE_MARGIN_C) -> tuple[float, float]:
+    """The calibrated span widened by ``margin_c`` of temperature at the steepest slope. [Hz]
+
+    A sample outside it is no temperature this unit can reach in a test: a glitch,
+    another unit's file or a wrong column, reported as an error on reading.
+    """
+    low, high = frequency_span(model)
+    t_low, t_high = model.thermometer.temperature_range_c
+    slope = float(np.max(np.abs(model.thermometer.slope_hz_per_c(np.array([t_low, t_high])))))
+    margin = margin_c * max(slope, 1e-6 * high)
+    return low - margin, high + margin
+
+
+def with_model_band(options: rec_io.ReadOptions, model: UnitModel) -> rec_io.ReadOptions:
+    """``options`` that check every frequency against the model's plausible band."""
+    return dataclasses.replace(options, freq_band_hz=plausible_frequency_band(model),
+                               freq_span_hz=frequency_span(model))
 
 
 def compensated_metadata(metadata: rec_io.Metadata, model: UnitModel,

@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 
 from hrgtc.compensate import Compensator
+from hrgtc.compensate.compensator import with_model_band
 from hrgtc.errors import HrgtcError, InputError, RecordingError
 from hrgtc.evaluation.allan import AllanResult, NoiseTerms, allan_deviation, noise_terms
 from hrgtc.evaluation.metrics import DEFAULT_TAUS_S, bias_stability_table, table_to_json
@@ -355,7 +356,7 @@ def evaluate(
         name, source, chunks = Path(run.source or "recording").name, run.source or "", [run]
         fs = run.sample_rate_hz
     else:
-        options = read_options or ReadOptions()
+        options = with_model_band(read_options or ReadOptions(), model)
         refuse_compensated(run)
         rows = count_rows(run) if progress is not None or max_points is not None else 0
         name, source, chunks = Path(run).name, str(run), options.chunks(run)

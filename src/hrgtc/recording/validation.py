@@ -62,6 +62,25 @@ RATE_NOISE_DPH = 1e-3
 RATE_TABLE_DPH = 3600.0
 DEG_PER_RAD_X3600 = 180.0 / math.pi * 3600.0  # °/h per rad/s
 MAX_LISTED_GAPS = 1000
+#: Physical bounds of every sample (outside: an error naming the first row).
+FREQ_SAMPLE_RANGE_HZ = (100.0, 1e5)  # n = 2 mode of any HRG: a few 100 Hz .. tens of kHz
+FREQ_JUMP_FRACTION = 0.05  # 84 ppm/°C over 300 °C is 2.5 %: more than 5 % off is a glitch
+RATE_MAX_DPH = 3.6e6  # 1000 °/s: beyond any rate table and the rebalance loop of an HRG
+TEMPERATURE_RANGE_C = (-200.0, 500.0)  # chambers, housings, resonators
+#: Rows per block of the sample-rate check that runs through the whole file.
+RATE_CHECK_ROWS = 1000
+#: Scale of 1 s block means below which a rate column is not in °/h (see the docstring).
+RATE_BLOCK_NOISE_DPH = 1e-2
+#: Below this inferred sample rate the time column is suspected to be in milliseconds.
+SLOW_SAMPLE_RATE_HZ = 0.5
+_BOUNDS: dict[str, tuple[float, float, str]] = {
+    "freq_hz": (*FREQ_SAMPLE_RANGE_HZ, "Hz"),
+    "rate_dph": (-RATE_MAX_DPH, RATE_MAX_DPH, "°/h"),
+    "bias_dph": (-RATE_MAX_DPH, RATE_MAX_DPH, "°/h"),
+    "chamber_c": (*TEMPERATURE_RANGE_C, "°C"),
+    "housing_c": (*TEMPERATURE_RANGE_C, "°C"),
+    "resonator_c": (*TEMPERATURE_RANGE_C, "°C"),
+}
 
 
 @dataclass(frozen=True)
@@ -237,8 +256,21 @@ class RecordingValidator:
         listed (split the recording with :func:`split_at_gaps`).
     """
 
-    def __init__(self, gaps: GapPolicy | str = "error") -> None:
+    def __init__(self, gaps: GapPolicy | str = "error",
+                 freq_band_hz: tuple[float, float] | None = None,
+                 freq_span_hz: tuple[float, float] | None = None) -> None:
         self.gaps = check_gap_policy(gaps)
+        self.freq_band_hz = freq_band_hz
+        self.freq_span_hz = freq_span_hz
+        self._bounds = dict(_BOUNDS)
+        if freq_band_hz is not None:
+            self._bounds["freq_hz"] = (float(freq_band_hz[0]), float(freq_band_hz[1]), "Hz")
+        self._out_of_bounds: dict[str, list[Any]] = {}  # column -> [row, value, count]
+        self._freq_reference: float | None = None
+        self._jump: list[Any] | None = None  # [row, value, count]
+        self._steps = np.empty(0)
+        self._steps_start = 0
+        self._rate_change: tuple[int, float] | None = None
         self.rows = 0
         self.source: str | None = None
         self.metadata: Metadata | None = None
@@ -272,11 +304,62 @@ class RecordingValidator:
                     self._not_finite[name] = [offset + first, values[first], int(bad.sum())]
                 else:
                     state[2] += int(bad.sum())
+            if name in self._bounds:
+                self._check_bounds(name, values, offset)
+        if "freq_hz" in chunk and self._freq_reference is not None:
+            self._check_jumps(chunk.freq_hz, offset)
         if "time_s" in chunk and n:
             self._check_time(chunk.time_s, offset)
         if self._heuristics is None:
             self._collect_sample(chunk)
         self.rows += n
+
+    def _check_bounds(self, name: str, values: np.ndarray, offset: int) -> None:
+        low, high, _ = self._bounds[name]
+        with np.errstate(invalid="ignore"):
+            bad = ((values < low) | (values > high)) & np.isfinite(values)
+        if bad.any():
+            state = self._out_of_bounds.get(name)
+            if state is None:
+                first = int(np.argmax(bad))
+                self._out_of_bounds[name] = [offset + first, float(values[first]),
+                                             int(bad.sum())]
+            else:
+                state[2] += int(bad.sum())
+
+    def _check_jumps(self, freq: np.ndarray, offset: int) -> None:
+        reference = self._freq_reference
+        with np.errstate(invalid="ignore"):
+            bad = (np.abs(freq - reference) > FREQ_JUMP_FRACTION * reference) & np.isfinite(freq)
+        if bad.any():
+            if self._jump is None:
+                first = int(np.argmax(bad))
+                self._jump = [offset + first, float(freq[first]), int(bad.sum())]
+            else:
+                self._jump[2] += int(bad.sum())
+
+    def _check_rate_throughout(self, step: np.ndarray, offset: int) -> None:
+        """Mean time step of every block of :data:`RATE_CHECK_ROWS` rows (gaps left out)."""
+        if self._rate_change is not None:
+            return
+        if self._steps.size:
+            step = np.concatenate([self._steps, step])
+            offset = self._steps_start
+        blocks = step.size // RATE_CHECK_ROWS
+        period = 1.0 / self.metadata.sample_rate_hz
+        for k in range(blocks):
+            part = step[k * RATE_CHECK_ROWS:(k + 1) * RATE_CHECK_ROWS]
+            with np.errstate(invalid="ignore"):
+                usable = part[np.isfinite(part) & (part > 0) & (part <= GAP_PERIODS * period)]
+            if usable.size < RATE_CHECK_ROWS // 2:
+                continue  # mostly gaps or disorder: reported by those checks
+            measured = 1.0 / float(np.mean(usable))
+            if abs(measured * period - 1.0) > SAMPLE_RATE_TOLERANCE:
+                self._rate_change = (offset + k * RATE_CHECK_ROWS, measured)
+                self._steps = np.empty(0)
+                return
+        self._steps = step[blocks * RATE_CHECK_ROWS:].copy()
+        self._steps_start = offset + blocks * RATE_CHECK_ROWS
 
     def _check_time(self, time: np.ndarray, offset: int) -> None:
         previous = np.empty_like(time)
@@ -295,6 +378,7 @@ class RecordingValidator:
         with np.errstate(invalid="ignore"):
             long = np.flatnonzero((step > GAP_PERIODS * period) & np.isfinite(step))
         self._n_gaps += long.size
+        self._check_rate_throughout(step, offset)
         room = MAX_LISTED_GAPS - len(self._gaps)
         self._gaps += [
             Gap(float(previous[i]), float(step[i]), offset + int(i)) for i in long[:room]
@@ -344,6 +428,30 @@ class RecordingValidator:
                     count=count,
                 )
             )
+        unit_problem = any(p.kind == "freq_unit" for p in self._heuristics or [])
+        for name, (row, value, count) in self._out_of_bounds.items():
+            if name == "freq_hz" and (self._heuristics is None or unit_problem):
+                continue  # the unit heuristic (e.g. "looks like kHz") says it better
+            problems.append(self._bounds_problem(name, row, value, count))
+        if self._jump is not None:
+            row, value, count = self._jump
+            problems.append(Problem(
+                "implausible",
+                f"column 'freq_hz', row {row}: {value:.6g} Hz is more than "
+                f"{FREQ_JUMP_FRACTION:.0%} away from the run's median "
+                f"{self._freq_reference:.6g} Hz (a resonator moves ≈ 0.01 %/°C; first of "
+                f"{count} such rows): a glitch or two files joined; remove those rows",
+                column="freq_hz", row=row, value=f"{value:.6g}", count=count))
+        if self._rate_change is not None:
+            row, measured = self._rate_change
+            nominal = self.metadata.sample_rate_hz
+            problems.append(Problem(
+                "sample_rate",
+                f"column 'time_s', rows {row} to {row + RATE_CHECK_ROWS - 1}: the time step "
+                f"means {measured:.6g} Hz but the metadata (and the start of the file) say "
+                f"{nominal:g} Hz; the sample rate changes within the file: split it at row "
+                f"{row} and process the parts separately (or resample)",
+                column="time_s", row=row, value=f"{measured:.6g}"))
         if self._time_order is not None:
             row, now, before = self._time_order
             what = "a duplicate time" if now == before else "a step back in time"
@@ -378,6 +486,30 @@ class RecordingValidator:
         problems += self._heuristics or []
         return problems
 
+    def _bounds_problem(self, name: str, row: int, value: float, count: int) -> Problem:
+        low, high, unit = self._bounds[name]
+        if name == "freq_hz" and self.freq_band_hz is not None:
+            span = self.freq_span_hz or self.freq_band_hz
+            why = (f"far outside the model's calibrated span {span[0]:.6g} to {span[1]:.6g} Hz "
+                   f"(more than the frequency of 100 °C beyond it: {low:.6g} to {high:.6g} Hz)")
+            fix = ("a glitch, another unit's recording, or the wrong column? remove the row or "
+                   "check --col freq_hz=... and --freq-unit")
+        elif name == "freq_hz":
+            why = (f"outside {low:g} to {high:g} Hz, where the resonator frequency of any HRG "
+                   "lies")
+            fix = "a glitch or the wrong column: remove the row or check --col/--freq-unit"
+        elif name in ("rate_dph", "bias_dph"):
+            why = f"beyond ±{high:g} °/h (1000 °/s), more than any HRG measures"
+            fix = "a glitch or the wrong column: remove the row or check --col/--rate-unit"
+        else:
+            why = f"outside {low:g} to {high:g} °C"
+            fix = "a glitch or not a temperature in °C: remove the row or check the mapping"
+        return Problem(
+            "implausible",
+            f"column '{name}', row {row}: {value:.6g} {unit} is {why} (first of {count} such "
+            f"rows); {fix}",
+            column=name, row=row, value=f"{value:.6g}", count=count)
+
     def raise_for_problems(self) -> None:
         """Raise :class:`~hrgtc.errors.RecordingError` if a problem was found so far."""
         problems = self.problems
@@ -410,14 +542,22 @@ class RecordingValidator:
         if "time_s" in sample and self.metadata is not None:
             self.measured_sample_rate_hz = measured_sample_rate(sample["time_s"])
             problem = _check_sample_rate(self.metadata.sample_rate_hz, self.measured_sample_rate_hz)
+            if problem is None and self.metadata.extra.get("sample_rate_inferred"):
+                problem = _check_time_unit(self.measured_sample_rate_hz, sample["time_s"])
             if problem:
                 problems.append(problem)
         if "freq_hz" in sample:
             problem = _check_freq_unit(sample["freq_hz"])
             if problem:
                 problems.append(problem)
+            else:
+                finite = sample["freq_hz"][np.isfinite(sample["freq_hz"])]
+                if finite.size:
+                    self._freq_reference = float(np.median(finite))
+                    self._check_jumps(sample["freq_hz"], 0)
         if "rate_dph" in sample and self.metadata is not None:
-            problem = _check_rate_unit(sample["rate_dph"], self.metadata.input_rate_dph)
+            problem = _check_rate_unit(sample["rate_dph"], self.metadata.input_rate_dph,
+                                       self.metadata.sample_rate_hz)
             if problem:
                 problems.append(problem)
         self._heuristics = problems
@@ -458,6 +598,32 @@ def _check_sample_rate(nominal_hz: float, measured_hz: float | None) -> Problem 
     )
 
 
+def _check_time_unit(measured_hz: float | None, time_s: np.ndarray) -> Problem | None:
+    """A sample rate inferred below :data:`SLOW_SAMPLE_RATE_HZ`: time in ms, most likely."""
+    if measured_hz is None or measured_hz >= SLOW_SAMPLE_RATE_HZ:
+        return None
+    hours = (float(time_s[-1]) - float(time_s[0])) / 3600.0
+    return Problem(
+        "time_unit",
+        f"column 'time_s': the time steps ({1.0 / measured_hz:.6g}) taken as seconds mean "
+        f"{measured_hz:.6g} Hz ({hours:.4g} h in the first {time_s.size} rows), slower than "
+        f"any gyro logger; if the time column is in milliseconds pass --time-unit ms "
+        f"(that is {measured_hz * 1000.0:.6g} Hz); if the rate really is {measured_hz:.6g} Hz "
+        f"confirm it with --rate-hz {measured_hz:.6g}",
+        column="time_s", value=f"{measured_hz:.6g}")
+
+
+def _block_noise(rate: np.ndarray, sample_rate_hz: float) -> float:
+    """Robust scale of 1 s block means (MAD of their differences / √2): any sample rate."""
+    rows = max(1, round(sample_rate_hz))
+    blocks = rate.size // rows
+    if blocks < 3:
+        return math.nan
+    means = rate[: blocks * rows].reshape(blocks, rows).mean(axis=1)
+    step = np.diff(means)
+    return float(1.4826 * np.median(np.abs(step - np.median(step))) / math.sqrt(2.0))
+
+
 def _check_freq_unit(freq: np.ndarray) -> Problem | None:
     freq = freq[np.isfinite(freq)]
     if freq.size == 0:
@@ -476,13 +642,16 @@ def _check_freq_unit(freq: np.ndarray) -> Problem | None:
     return Problem("freq_unit", message, column="freq_hz", value=f"{median:.6g}")
 
 
-def _check_rate_unit(rate: np.ndarray, input_rate_dph: float) -> Problem | None:
+def _check_rate_unit(rate: np.ndarray, input_rate_dph: float,
+                     sample_rate_hz: float = 1.0) -> Problem | None:
     rate = rate[np.isfinite(rate)]
     if rate.size < 2:
         return None
     level = float(np.median(np.abs(rate)))
     noise = float(np.std(np.diff(rate)) / math.sqrt(2.0))
-    quiet_and_small = level < RATE_LEVEL_DPH and noise < RATE_NOISE_DPH
+    block_noise = _block_noise(rate, sample_rate_hz)
+    quiet_and_small = level < RATE_LEVEL_DPH and (
+        noise < RATE_NOISE_DPH or 0.0 < block_noise < RATE_BLOCK_NOISE_DPH)
     scaled_input = False
     if abs(input_rate_dph) >= RATE_TABLE_DPH:
         ratio = float(np.median(rate)) / input_rate_dph
@@ -494,16 +663,19 @@ def _check_rate_unit(rate: np.ndarray, input_rate_dph: float) -> Problem | None:
         options.reverse()  # below 0.5 °/h even if it were °/s: rad/s is more likely
     return Problem(
         "rate_unit",
-        f"rate_dph looks like °/s or rad/s, not °/h (median |rate| {level:.3g}, per-sample "
-        f"noise {noise:.3g}; a gyro recorded in °/h reads ≳ {RATE_LEVEL_DPH:g} °/h with "
-        f"≳ {RATE_NOISE_DPH:g} °/h noise per sample); pass {' or '.join(options)}",
+        f"rate_dph looks like °/s or rad/s, not °/h (median |rate| {level:.3g}, noise of "
+        f"1 s means {block_noise:.3g}; a gyro recorded in °/h reads ≳ {RATE_LEVEL_DPH:g} °/h "
+        f"with ≳ {RATE_BLOCK_NOISE_DPH:g} °/h noise in 1 s means); pass "
+        f"{' or '.join(options)}",
         column="rate_dph",
         value=f"{level:.3g}",
     )
 
 
 def validate(
-    recording: Recording, gaps: GapPolicy | str = "error", *, raise_errors: bool = True
+    recording: Recording, gaps: GapPolicy | str = "error", *, raise_errors: bool = True,
+    freq_band_hz: tuple[float, float] | None = None,
+    freq_span_hz: tuple[float, float] | None = None,
 ) -> ValidationReport:
     """Check a recording against the recording contract (see the module docstring).
 
@@ -518,6 +690,9 @@ def validate(
     raise_errors
         Raise :class:`~hrgtc.errors.RecordingError` on a problem (default) rather
         than return a report with ``ok=False``.
+    freq_band_hz, freq_span_hz
+        Plausible frequencies given a model (every sample must lie in the band;
+        without a model :data:`FREQ_SAMPLE_RANGE_HZ`) and its calibrated span.
 
     Returns
     -------
@@ -528,7 +703,7 @@ def validate(
     RecordingError
         Message names the file, column, first bad row, the bad value and the fix.
     """
-    validator = RecordingValidator(gaps)
+    validator = RecordingValidator(gaps, freq_band_hz, freq_span_hz)
     validator.update(recording)
     report = validator.finish()
     if raise_errors:
