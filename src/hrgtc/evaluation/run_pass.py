@@ -29,8 +29,9 @@ import numpy as np
 from hrgtc.compensate import Compensator
 from hrgtc.compensate.compensator import with_model_band
 from hrgtc.errors import HrgtcError, InputError, RecordingError
-from hrgtc.evaluation.allan import AllanResult, NoiseTerms, allan_deviation, noise_terms
-from hrgtc.evaluation.metrics import DEFAULT_TAUS_S, bias_stability_table, table_to_json
+from hrgtc.evaluation.allan import AllanResult, NoiseTerms, noise_terms
+from hrgtc.evaluation.metrics import DEFAULT_TAUS_S, table_to_json
+from hrgtc.evaluation.series_stats import SeriesStatistics
 from hrgtc.model import UnitModel
 from hrgtc.progress import Progress
 from hrgtc.recording import ReadOptions, Recording, count_rows
@@ -214,8 +215,12 @@ def run_pass(
     on_output: Callable[[Recording], None] | None = None,
     progress: Progress | None = None,
     total_rows: int = 0,
+    gaps: str = "ignore",
 ) -> Evaluation:
     """Compensate one run given as consecutive chunks, once, and measure it.
+
+    Memory stays bounded whatever the run's length: the statistics are streamed
+    (:class:`~hrgtc.evaluation.series_stats.SeriesStatistics`), no series is held.
 
     Parameters
     ----------
@@ -241,16 +246,20 @@ def run_pass(
         ``progress(samples done, total_rows)``.
     total_rows
         Rows of the run, for the progress callback (0 when not known).
+    gaps
+        ``"split"``: the df/dt filter restarts after each gap (see
+        :class:`~hrgtc.compensate.Compensator`); the statistics run over the joined
+        segments.
 
     Raises
     ------
     InputError
         The run holds no samples, or is shorter than two 10 s blocks.
     """
-    frequency = Compensator(model)
+    frequency = Compensator(model, gaps=gaps)
     housing: Compensator | None = None
     means = BlockMeans(block_rows) if block_rows else None
-    full: dict[str, list[np.ndarray]] = {key: [] for key in SERIES}
+    full: dict[str, SeriesStatistics] = {}
     squared_error = 0.0
     truth = False
     metadata = None
@@ -259,20 +268,24 @@ def run_pass(
             metadata = chunk.metadata
             truth = "bias_dph" in chunk
             if model.housing is not None and "housing_c" in chunk:
-                housing = Compensator(model, "housing")
+                housing = Compensator(model, "housing", gaps=gaps)
+            keys = SERIES if housing is not None else SERIES[:2]
+            full = {key: SeriesStatistics(metadata.sample_rate_hz, taus_s, allan,
+                                          expected_samples=total_rows)
+                    for key in keys}
         out = frequency.process(chunk)
         if on_output is not None:
             on_output(out)
         raw = chunk.rate_dph - metadata.input_rate_dph
         comp = out["rate_comp_dph"] - metadata.input_rate_dph
-        full["raw"].append(raw)
-        full["compensated"].append(comp)
+        full["raw"].push(raw)
+        full["compensated"].push(comp)
         columns = {"time_s": chunk.time_s, "raw_dph": raw, "model_dph": out["bias_model_dph"],
                    "comp_dph": comp, "temperature_c": out["resonator_c_est"],
                    "in_range": out["in_range"]}
         if housing is not None:
             comp_h = housing.process(chunk)["rate_comp_dph"] - metadata.input_rate_dph
-            full["housing"].append(comp_h)
+            full["housing"].push(comp_h)
             columns["comp_housing_dph"] = comp_h
         if truth:
             columns["true_dph"] = chunk["bias_dph"]
@@ -294,16 +307,12 @@ def run_pass(
     deviations: dict[str, AllanResult] = {}
     terms: dict[str, NoiseTerms] = {}
     notes: list[str] = []
-    for key, parts in full.items():
-        if not parts:
-            continue
-        values = np.concatenate(parts)
-        parts.clear()
-        stability[key] = bias_stability_table(values, fs, taus_s)
+    for key, series in full.items():
+        stability[key] = series.bias_stability()
         if not allan:
             continue
         try:
-            deviations[key] = allan_deviation(values, fs, taus="octave")
+            deviations[key] = series.allan_deviation()
             terms[key] = noise_terms(deviations[key])
         except HrgtcError as exc:
             notes.append(f"{key}: no Allan noise terms ({exc})")
@@ -347,6 +356,7 @@ def evaluate(
     on_output, progress
         As for :func:`run_pass`.
     """
+    gaps = (read_options or ReadOptions()).gaps
     if isinstance(run, Recording):
         found = compensation_mark(run.metadata.to_dict(), list(run.names))
         if found is not None:
@@ -358,7 +368,7 @@ def evaluate(
     else:
         options = with_model_band(read_options or ReadOptions(), model)
         refuse_compensated(run)
-        rows = count_rows(run) if progress is not None or max_points is not None else 0
+        rows = count_rows(run)  # cheap (metadata, or a scan of a CSV's bytes); plans the pass
         name, source, chunks = Path(run).name, str(run), options.chunks(run)
         fs = None
     blocks = None
@@ -368,4 +378,4 @@ def evaluate(
         blocks = block_rows(rows, fs, max_points)
     return run_pass(model, chunks, name, source=source, taus_s=taus_s, allan=allan,
                     block_rows=blocks, on_output=on_output, progress=progress,
-                    total_rows=rows)
+                    total_rows=rows, gaps=gaps)
