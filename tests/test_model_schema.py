@@ -151,3 +151,24 @@ def test_a_model_that_cannot_be_valid_is_never_saved(tmp_path, unit_model):
     with pytest.raises(ModelFileError, match=r"drift.intercept_dph: None is not of type"):
         save_model(broken, tmp_path / "unit.json")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_file_changed_after_writing_is_refused_unless_the_checksum_line_goes(tmp_path,
+                                                                              unit_model):
+    path = save_model(unit_model, tmp_path / "unit.json")
+    data = json.loads(path.read_text())
+    assert data["parameters_sha256"] == unit_model.sha256
+    low, high = data["drift"]["ranges"]["f"]
+    data["drift"]["ranges"]["f"] = [low, high + 0.5]  # still a valid model: wrong numbers
+    edited = _write(tmp_path, data, "edited.json")
+    with pytest.raises(ModelFileError, match=r"edited.json: model file was changed after it was "
+                                             r"written"):
+        load_model(edited)
+    del data["parameters_sha256"]  # a deliberate edit
+    assert load_model(_write(tmp_path, data, "deliberate.json")).drift.ranges["f"][1] == high + 0.5
+
+
+def test_reference_frequency_must_match_the_thermometer(tmp_path, document):
+    document["drift"]["settings"]["reference_freq_hz"] *= 1.5
+    with pytest.raises(ModelFileError, match=r"reference_freq_hz: .* is not the thermometer's"):
+        load_model(_write(tmp_path, document))

@@ -31,6 +31,7 @@ from hrgtc.model_schema import (
     SCHEMA_NAME,
     SCHEMA_VERSION,
     check_document,
+    parameters_sha256,
     parse_model_json,
     strict,
 )
@@ -125,13 +126,12 @@ class UnitModel:
 
 
 def model_sha256(model: UnitModel) -> str:
-    """SHA-256 of the model's parameters as canonical JSON (sorted keys, strict)."""
-    import hashlib
+    """SHA-256 of the model's parameters as canonical JSON (sorted keys, strict, no provenance).
 
-    document = strict(model.to_dict())
-    document.pop("provenance", None)
-    text = json.dumps(document, sort_keys=True, separators=(",", ":"), allow_nan=False)
-    return hashlib.sha256(text.encode("utf-8")).hexdigest()
+    Written into the model file as ``parameters_sha256`` and into the mark of every
+    output compensated with the model.
+    """
+    return parameters_sha256(model.to_dict())
 
 
 def provenance(inputs: Mapping[str, list[str]], settings: Mapping[str, Any]) -> dict[str, Any]:
@@ -160,6 +160,7 @@ def save_model(model: UnitModel, path: str | os.PathLike[str], force: bool = Fal
         not finite): such a file is never written.
     """
     document = strict(model.to_dict())
+    document["parameters_sha256"] = parameters_sha256(document)
     check_document(document, str(path))
     text = json.dumps(document, indent=2, allow_nan=False)
     return write_text_atomic(path, text + "\n", force=force)

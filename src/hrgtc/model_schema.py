@@ -14,6 +14,13 @@ are read through :func:`parse_model_json`, which turns ``NaN`` and ``Infinity``
 into the strings ``"NaN"`` / ``"Infinity"`` so that the schema names them where
 they are not allowed.
 
+Integrity: a file of version 2 carries ``parameters_sha256``, the SHA-256 of its
+canonical JSON without provenance (:func:`parameters_sha256`); a file whose
+content no longer matches it was changed after it was written (a flipped digit
+in a coefficient or a range is otherwise a valid model with wrong numbers) and is
+refused. A deliberate hand edit removes that line. The same hash names the model
+in the mark of a compensated output.
+
 One source of truth for coefficients: prediction uses ``scaled_coefficients``
 (coefficients of the centred and scaled variables, what the fit produced); the
 readable ``coefficients`` in user units are derived from them. On loading, the
@@ -123,8 +130,20 @@ MODEL_SCHEMA: dict[str, Any] = {
         "housing": {"anyOf": [{"type": "null"}, _DRIFT]},
         "plateaus": {"type": "array", "items": {"type": "object"}},
         "provenance": {"type": "object"},
+        "parameters_sha256": {"type": "string", "pattern": "^[0-9a-f]{64}$"},
     },
 }
+#: Keys left out of :func:`parameters_sha256`.
+UNHASHED = ("provenance", "parameters_sha256")
+
+
+def parameters_sha256(document: Mapping[str, Any]) -> str:
+    """SHA-256 of a model document's canonical JSON (sorted keys), provenance left out."""
+    import hashlib
+
+    content = {k: v for k, v in strict(dict(document)).items() if k not in UNHASHED}
+    text = json.dumps(content, sort_keys=True, separators=(",", ":"), allow_nan=False)
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()
 
 
 def parse_model_json(text: str) -> tuple[Any, bool]:
@@ -261,6 +280,20 @@ def derived_coefficients(drift: Mapping[str, Any]) -> dict[str, float]:
             for t, c in zip(terms, drift["scaled_coefficients"], strict=True)}
 
 
+def _check_reference(drift: Mapping[str, Any], therm: Mapping[str, Any], where: str,
+                     source: str) -> None:
+    """f_ref must be the thermometer's frequency at the reference temperature."""
+    import numpy as np
+
+    settings = drift["settings"]
+    u = (settings["reference_c"] - therm["centre_c"]) / therm["scale_c"]
+    expected = float(np.polynomial.polynomial.polyval(u, therm["scaled_coefficients"]))
+    if not _agree(settings["reference_freq_hz"], expected, expected * 1e-3):
+        raise _fail(source, f"{where}.settings.reference_freq_hz",
+                    f"{settings['reference_freq_hz']!r} Hz is not the thermometer's frequency "
+                    f"{expected!r} Hz at the reference {settings['reference_c']!r} °C")
+
+
 def _check_drift(drift: Mapping[str, Any], where: str, source: str) -> dict[str, float]:
     for name in ("candidates", "selected"):
         try:
@@ -326,9 +359,17 @@ def check_document(data: Any, source: str, non_standard: bool = False) -> dict[s
                              f"(schema version {version} is strict JSON); it is corrupt or was "
                              "edited: recreate it with 'hrgtc calibrate'")
     check_schema(data, source)
+    stored = data.get("parameters_sha256")
+    if stored is not None and stored != parameters_sha256(data):
+        raise ModelFileError(
+            f"{source}: model file was changed after it was written (its content no longer "
+            "matches its parameters_sha256): damaged or edited; recreate it with 'hrgtc "
+            "calibrate' (after a deliberate edit, delete the parameters_sha256 line)")
     _check_thermometer(data["thermometer"], source)
     restored = restore_statistics(data)
     restored["drift"]["coefficients"] = _check_drift(data["drift"], "drift", source)
+    _check_reference(data["drift"], data["thermometer"], "drift", source)
     if data.get("housing") is not None:
         restored["housing"]["coefficients"] = _check_drift(data["housing"], "housing", source)
+    restored.pop("parameters_sha256", None)
     return restored

@@ -159,12 +159,23 @@ class CsvSource(Source):
         self._streams = []
 
     # -- errors: name the file, column, row, value and the fix -----------------
+    def _invalid_utf8(self) -> RecordingError:
+        found = _first_invalid_utf8(self.path, self._offset)
+        where = "" if found is None else f"row {max(found[0], 0)} holds byte {found[1]:#04x}, "
+        return RecordingError(f"{self.path}: {where}not valid UTF-8 text; save the file as "
+                              "UTF-8 (or remove the damaged row)")
+
     def _translate(self, exc: Exception, as_text: set[str]) -> RecordingError:
         text = str(exc)
+        if "invalid UTF8" in text or "invalid utf8" in text.lower():
+            return self._invalid_utf8()
         conversion = re.search(r"CSV column #(\d+): CSV conversion error to \w+", text)
         if conversion:
             name = self.names[int(conversion.group(1))]
-            row, value = self._locate_bad_value(name)
+            try:
+                row, value = self._locate_bad_value(name)
+            except pa.ArrowInvalid:  # the bad value is not even text
+                return self._invalid_utf8()
             return RecordingError(
                 f"{self.path}: column '{name}', row {row}: {value!r} is not a number; "
                 f"{bad_number_hint(value)}"
@@ -209,13 +220,30 @@ class CsvSource(Source):
         return "?", "?", "?"
 
 
+def _first_invalid_utf8(path: Path, offset: int) -> tuple[int, int] | None:
+    """(data row, byte) of the first line after ``offset`` that is not UTF-8, or None."""
+    with open(path, "rb") as handle:
+        handle.seek(offset)
+        for row, raw in enumerate(handle, start=-1):
+            try:
+                raw.decode("utf-8")
+            except UnicodeDecodeError as exc:
+                return row, raw[exc.start]
+    return None
+
+
 def _csv_head(path: Path) -> tuple[int, str, list[str]]:
     """Byte offset of the header line, the header line and the comment lines."""
     comments: list[str] = []
     offset = 0
     with open(path, "rb") as handle:
-        for raw in handle:
-            text = raw.decode("utf-8", "replace")
+        for line, raw in enumerate(handle, start=1):
+            try:
+                text = raw.decode("utf-8")
+            except UnicodeDecodeError as exc:
+                raise RecordingError(
+                    f"{path}: line {line} is not valid UTF-8 (byte {raw[exc.start]:#04x} at "
+                    f"column {exc.start + 1}); save the file as UTF-8") from None
             if offset == 0 and text.startswith("\ufeff"):
                 text = text[1:]
             stripped = text.strip()

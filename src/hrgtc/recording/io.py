@@ -92,6 +92,9 @@ def _metadata(
         return override
     data = dict(plan.source.metadata)
     data.update({k: v for k, v in (override or {}).items() if v is not None})
+    if not isinstance(data.get("extra") or {}, Mapping):
+        raise RecordingError(f"{path}: metadata extra is {data.get('extra')!r}, not a JSON "
+                             "object of key/value pairs; fix or remove it")
     extra = dict(data.get("extra") or {})
     if (override or {}).get("sample_rate_hz") is not None:
         extra.pop("sample_rate_inferred", None)
