@@ -647,9 +647,10 @@ def _check_rate_unit(rate: np.ndarray, input_rate_dph: float,
     rate = rate[np.isfinite(rate)]
     if rate.size < 2:
         return None
-    level = float(np.median(np.abs(rate)))
-    noise = float(np.std(np.diff(rate)) / math.sqrt(2.0))
-    block_noise = _block_noise(rate, sample_rate_hz)
+    with np.errstate(over="ignore", invalid="ignore"):  # 1e300 is reported by the bounds
+        level = float(np.median(np.abs(rate)))
+        noise = float(np.std(np.diff(rate)) / math.sqrt(2.0))
+        block_noise = _block_noise(rate, sample_rate_hz)
     quiet_and_small = level < RATE_LEVEL_DPH and (
         noise < RATE_NOISE_DPH or 0.0 < block_noise < RATE_BLOCK_NOISE_DPH)
     scaled_input = False
