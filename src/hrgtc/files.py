@@ -243,8 +243,6 @@ def check_writable(target: PathLike, expected_bytes: float = 0.0) -> None:
     if not os.access(directory, os.W_OK | os.X_OK):
         raise InputError(f"{target}: directory {directory} is not writable; choose another "
                          "output path or fix its permissions")
-    if target.exists() and not os.access(target, os.W_OK) and not os.access(directory, os.W_OK):
-        raise InputError(f"{target} is not writable")
     if expected_bytes > 0:
         try:
             free = shutil.disk_usage(directory).free
