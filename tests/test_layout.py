@@ -27,6 +27,7 @@ STAGES: list[set[str]] = [
     {"hrgtc.recording"},
     {"hrgtc.thermometry"},
     {"hrgtc.drift"},
+    {"hrgtc.model_schema"},
     {"hrgtc.model", "hrgtc.paper"},
     {"hrgtc.compensate", "hrgtc.simulate"},
     {"hrgtc.evaluation"},

@@ -55,12 +55,14 @@ def test_foreign_corrupt_and_newer_files(tmp_path, unit_model):
     data = unit_model.to_dict()
     newer = tmp_path / "newer.json"
     newer.write_text(json.dumps({**data, "schema_version": SCHEMA_VERSION + 1}))
-    with pytest.raises(ModelFileError, match=r"version 2 is newer than .* \(1\); upgrade"):
+    with pytest.raises(ModelFileError, match=rf"version {SCHEMA_VERSION + 1} is newer than .* "
+                       rf"\({SCHEMA_VERSION}\); upgrade"):
         load_model(newer)
     broken = tmp_path / "broken.json"
     del data["drift"]["selected"]
     broken.write_text(json.dumps(data))
-    with pytest.raises(ModelFileError, match=r"broken.json: model file is corrupt"):
+    with pytest.raises(ModelFileError, match=r"broken.json: model file is invalid at drift: "
+                       r"'selected' is a required property"):
         load_model(broken)
     with pytest.raises(ModelFileError, match="no such model file"):
         load_model(tmp_path / "missing.json")

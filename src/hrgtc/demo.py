@@ -16,6 +16,7 @@ from pathlib import Path
 
 from hrgtc.calibration import CalibrationResult, calibrate
 from hrgtc.compensate import OUTPUT_COLUMNS, CompensationSummary
+from hrgtc.compensate.compensator import compensated_metadata
 from hrgtc.compensate.export_c import export_c
 from hrgtc.evaluation import Evaluation, evaluate
 from hrgtc.files import refuse_existing
@@ -106,7 +107,8 @@ def run_demo(
     compensated_path = root / "runs" / "warmup_compensated.parquet"
     head = ReadOptions().head(warm.path, rows=1)
     names = (*head.names, *OUTPUT_COLUMNS)
-    with RecordingWriter(compensated_path, head.metadata, names, force=force) as writer:
+    with RecordingWriter(compensated_path, compensated_metadata(head.metadata, result.model),
+                         names, force=force) as writer:
         validation = evaluate(warm.path, result.model, max_points=REPORT_POINTS,
                               on_output=writer.write,
                               progress=for_stage(progress, "compensate and evaluate warm-up"))

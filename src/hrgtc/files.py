@@ -9,13 +9,21 @@ synced and renamed into place (so a reader never sees half a file), and
 
 from __future__ import annotations
 
+import errno
 import hashlib
 import os
+import re
+import shutil
+import signal
 import tempfile
-from collections.abc import Iterable
+import threading
+import warnings
+from collections.abc import Iterable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
+from typing import Any
 
-from hrgtc.errors import OutputExistsError
+from hrgtc.errors import HrgtcWarning, InputError, OutputExistsError
 
 PathLike = str | os.PathLike[str]
 
@@ -56,13 +64,77 @@ def current_umask() -> int:
     return mask
 
 
+def _pid_alive(pid: int) -> bool:
+    """True if a process ``pid`` exists (or may exist: it belongs to another user)."""
+    if pid <= 0:
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def clean_stale_temporaries(target: PathLike) -> list[Path]:
+    """Remove the temporary files an earlier, dead writer of ``target`` left behind.
+
+    A temporary file ``.<name>.<pid>.<random>.tmp`` whose process no longer runs is
+    removed. Those of a running process are left alone; those without a PID in their
+    name (older hrgtc) are only reported, with a :class:`StaleTemporaryWarning`.
+
+    Returns
+    -------
+    list of Path
+        The files removed.
+    """
+    target = Path(target)
+    pattern = re.compile(re.escape(f".{target.name}.") + r"(?:(\d+)\.)?[^/]*\.tmp$")
+    removed: list[Path] = []
+    unknown: list[str] = []
+    try:
+        entries = list(target.parent.iterdir())
+    except OSError:
+        return removed
+    for entry in entries:
+        match = pattern.fullmatch(entry.name)
+        if match is None or str(entry) in _ACTIVE:
+            continue
+        pid = match.group(1)
+        if pid is None:
+            unknown.append(entry.name)
+        elif int(pid) != os.getpid() and not _pid_alive(int(pid)):
+            try:
+                entry.unlink()
+            except OSError:
+                unknown.append(entry.name)
+            else:
+                removed.append(entry)
+    if unknown:
+        warnings.warn(
+            f"{target.parent}: {len(unknown)} temporary file(s) of an interrupted earlier "
+            f"write of {target.name} remain ({', '.join(unknown[:3])}); remove them if no "
+            "other program is writing that file",
+            StaleTemporaryWarning, stacklevel=2)
+    return removed
+
+
+class StaleTemporaryWarning(HrgtcWarning):
+    """Temporary files of an earlier, interrupted write remain next to an output."""
+
+
 def temporary_beside(target: Path) -> str:
     """An empty hidden temporary file next to ``target``, with ordinary permissions.
 
     ``mkstemp`` makes 0600 files; the file gets ``0666 & ~umask`` like any other
-    file the user creates. The caller removes it (or :func:`publish` renames it).
+    file the user creates. Its name carries this process's PID, and stale ones
+    of dead processes are removed first (:func:`clean_stale_temporaries`). Until
+    the caller removes it (or :func:`publish` renames it), a SIGTERM or SIGINT
+    removes it (:func:`removed_on_signal`).
     """
-    fd, temporary = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.",
+    clean_stale_temporaries(target)
+    fd, temporary = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.{os.getpid()}.",
                                      suffix=".tmp")
     os.close(fd)
     try:
@@ -70,7 +142,128 @@ def temporary_beside(target: Path) -> str:
     except BaseException:
         os.unlink(temporary)
         raise
+    _register(temporary)
     return temporary
+
+
+# -- temporary files removed on SIGTERM / SIGINT -------------------------------------------
+_ACTIVE: set[str] = set()
+_LOCK = threading.Lock()
+_PREVIOUS: dict[int, Any] = {}
+_SIGNALS = (signal.SIGTERM, signal.SIGINT)
+
+
+def _on_signal(signum: int, frame: Any) -> None:
+    """Remove every registered temporary file, then do what the previous handler did."""
+    for path in list(_ACTIVE):
+        try:
+            os.unlink(path)
+        except OSError:
+            pass
+    _ACTIVE.clear()
+    previous = _PREVIOUS.get(signum, signal.SIG_DFL)
+    _restore_handlers()
+    if callable(previous):
+        previous(signum, frame)  # e.g. Python's SIGINT handler: KeyboardInterrupt
+    elif previous == signal.SIG_DFL:
+        os.kill(os.getpid(), signum)  # die of the signal, as without us
+
+
+def _install_handlers() -> None:
+    if _PREVIOUS or threading.current_thread() is not threading.main_thread():
+        return
+    for signum in _SIGNALS:
+        previous = signal.getsignal(signum)
+        if previous == signal.SIG_IGN or previous is None:
+            continue  # ignored (e.g. nohup) or set outside Python: leave it
+        _PREVIOUS[signum] = previous
+        signal.signal(signum, _on_signal)
+
+
+def _restore_handlers() -> None:
+    if threading.current_thread() is not threading.main_thread():
+        return
+    for signum, previous in list(_PREVIOUS.items()):
+        if signal.getsignal(signum) is _on_signal:
+            signal.signal(signum, previous)
+    _PREVIOUS.clear()
+
+
+def _register(path: str) -> None:
+    with _LOCK:
+        _ACTIVE.add(str(path))
+        _install_handlers()
+
+
+def forget_temporary(path: PathLike) -> None:
+    """The temporary file ``path`` was renamed or removed: stop watching it."""
+    with _LOCK:
+        _ACTIVE.discard(str(path))
+        if not _ACTIVE:
+            _restore_handlers()
+
+
+@contextmanager
+def removed_on_signal(path: PathLike) -> Iterator[None]:
+    """Remove ``path`` if a SIGTERM or SIGINT arrives inside the block.
+
+    The handlers are installed in the main thread only (Python delivers signals
+    there) and the previous ones are restored when no watched file remains; after
+    removing the file the previous handler runs (SIGINT raises KeyboardInterrupt,
+    a default SIGTERM ends the process).
+    """
+    _register(str(path))
+    try:
+        yield
+    finally:
+        forget_temporary(path)
+
+
+def check_writable(target: PathLike, expected_bytes: float = 0.0) -> None:
+    """Refuse early an output that cannot be written: before the long work, not after it.
+
+    Parameters
+    ----------
+    target
+        Output file.
+    expected_bytes
+        Estimate of its size; the free space must exceed it (with 5 % to spare). [B]
+
+    Raises
+    ------
+    InputError
+        The directory is missing, not writable, or has too little free space.
+    """
+    target = Path(target)
+    directory = target.parent if str(target.parent) else Path(".")
+    if target.is_dir():
+        raise InputError(f"{target} is a directory; give a file name")
+    if not directory.is_dir():
+        raise InputError(f"{target}: directory {directory} does not exist; create it first")
+    if not os.access(directory, os.W_OK | os.X_OK):
+        raise InputError(f"{target}: directory {directory} is not writable; choose another "
+                         "output path or fix its permissions")
+    if expected_bytes > 0:
+        try:
+            free = shutil.disk_usage(directory).free
+        except OSError:
+            return
+        if free < 1.05 * expected_bytes:
+            raise InputError(
+                f"{target}: {free / 1e6:.1f} MB free in {directory} but the output needs about "
+                f"{expected_bytes / 1e6:.1f} MB; free some space or write elsewhere")
+
+
+def describe_os_error(exc: OSError, what: str = "") -> str:
+    """One line for an operating-system error while writing or reading ``what``."""
+    name = exc.filename or what or "file"
+    if exc.errno == errno.ENOSPC:
+        return f"{name}: the disk is full (no space left on device); free some space"
+    if exc.errno in (errno.EACCES, errno.EPERM):
+        return f"{name}: permission denied; choose another path or fix its permissions"
+    if exc.errno == errno.EROFS:
+        return f"{name}: read-only file system; write elsewhere"
+    return f"{name}: {exc.strerror or exc}"
 
 
 def fsync_file(path: PathLike) -> None:
@@ -117,6 +310,7 @@ def publish(temporary: str, target: Path, force: bool) -> None:
             os.replace(temporary, target)
         else:
             os.unlink(temporary)
+    forget_temporary(temporary)
     sync_directory(target.parent)
 
 
@@ -140,6 +334,7 @@ def write_text_atomic(path: PathLike, text: str, force: bool = False) -> Path:
         publish(temporary, target, force)
     except BaseException:
         Path(temporary).unlink(missing_ok=True)
+        forget_temporary(temporary)
         raise
     return target
 

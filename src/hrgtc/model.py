@@ -5,6 +5,13 @@ scales), drift model (Eq. 22 form), the optional classical housing-thermistor
 baseline, the unit's plateau table, and provenance (input files with SHA-256,
 settings, package version, time). The schema is versioned: a file of a newer
 schema, a foreign JSON document or a corrupt one gets a clear error.
+
+Every file is validated on loading against the JSON Schema of
+:mod:`hrgtc.model_schema` plus the checks a schema cannot express (finite
+parameters, ordered ranges, known terms, coefficients that agree with the scaled
+ones prediction uses). Files are written as strict JSON (schema version 2:
+statistics that are not finite become ``null``); version 1 files, whose
+statistics may hold a bare ``NaN``, still load when they are otherwise valid.
 """
 
 from __future__ import annotations
@@ -20,10 +27,18 @@ from typing import Any
 from hrgtc.drift import DriftModel
 from hrgtc.errors import HrgtcError, ModelFileError
 from hrgtc.files import file_sha256, write_text_atomic
+from hrgtc.model_schema import (
+    SCHEMA_NAME,
+    SCHEMA_VERSION,
+    check_document,
+    parameters_sha256,
+    parse_model_json,
+    strict,
+)
 from hrgtc.thermometry import Thermometer
 
-SCHEMA_NAME = "hrgtc.model"
-SCHEMA_VERSION = 1
+__all__ = ["SCHEMA_NAME", "SCHEMA_VERSION", "UnitModel", "load_model", "model_sha256",
+           "provenance", "save_model"]
 
 
 @dataclass(frozen=True)
@@ -68,8 +83,12 @@ class UnitModel:
         }
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any], source: str = "model") -> UnitModel:
-        """Inverse of :meth:`to_dict`, with schema checks."""
+    def from_dict(cls, data: Mapping[str, Any], source: str = "model",
+                  non_standard: bool = False) -> UnitModel:
+        """Inverse of :meth:`to_dict`, with schema checks (:func:`model_schema.check_document`).
+
+        ``non_standard``: the document's text held ``NaN``/``Infinity``.
+        """
         if not isinstance(data, Mapping) or data.get("schema") != SCHEMA_NAME:
             found = data.get("schema") if isinstance(data, Mapping) else type(data).__name__
             raise ModelFileError(
@@ -84,6 +103,7 @@ class UnitModel:
                 f"{source}: model schema version {version} is newer than this hrgtc "
                 f"understands ({SCHEMA_VERSION}); upgrade hrgtc"
             )
+        data = check_document(strict(dict(data)), source, non_standard)
         try:
             housing = data.get("housing")
             return cls(
@@ -98,6 +118,20 @@ class UnitModel:
             raise ModelFileError(f"{source}: model file is missing {exc}; it is corrupt") from exc
         except HrgtcError as exc:
             raise ModelFileError(f"{source}: model file is corrupt: {exc}") from exc
+
+    @property
+    def sha256(self) -> str:
+        """SHA-256 of the model's canonical JSON (independent of file layout and provenance)."""
+        return model_sha256(self)
+
+
+def model_sha256(model: UnitModel) -> str:
+    """SHA-256 of the model's parameters as canonical JSON (sorted keys, strict, no provenance).
+
+    Written into the model file as ``parameters_sha256`` and into the mark of every
+    output compensated with the model.
+    """
+    return parameters_sha256(model.to_dict())
 
 
 def provenance(inputs: Mapping[str, list[str]], settings: Mapping[str, Any]) -> dict[str, Any]:
@@ -117,8 +151,18 @@ def provenance(inputs: Mapping[str, list[str]], settings: Mapping[str, Any]) -> 
 
 
 def save_model(model: UnitModel, path: str | os.PathLike[str], force: bool = False) -> Path:
-    """Write the model file atomically (refuses to overwrite without ``force``)."""
-    text = json.dumps(model.to_dict(), indent=2, allow_nan=True)
+    """Write the model file atomically as strict JSON (refuses to overwrite without ``force``).
+
+    Raises
+    ------
+    ModelFileError
+        The model does not pass the checks of loading (e.g. a coefficient that is
+        not finite): such a file is never written.
+    """
+    document = strict(model.to_dict())
+    document["parameters_sha256"] = parameters_sha256(document)
+    check_document(document, str(path))
+    text = json.dumps(document, indent=2, allow_nan=False)
     return write_text_atomic(path, text + "\n", force=force)
 
 
@@ -138,10 +182,12 @@ def load_model(path: str | os.PathLike[str]) -> UnitModel:
     except (OSError, UnicodeDecodeError) as exc:
         raise ModelFileError(f"{source}: cannot read model file: {exc}") from exc
     try:
-        data = json.loads(text)
+        data, non_standard = parse_model_json(text)
     except json.JSONDecodeError as exc:
         raise ModelFileError(
             f"{source}: not a JSON document (line {exc.lineno}, column {exc.colno}: {exc.msg}); "
             "is it an hrgtc model file?"
         ) from exc
-    return UnitModel.from_dict(data, source=source)
+    except RecursionError:
+        raise ModelFileError(f"{source}: not a model file (nested too deeply)") from None
+    return UnitModel.from_dict(data, source=source, non_standard=non_standard)

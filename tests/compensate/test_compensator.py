@@ -85,6 +85,23 @@ def test_range_report_says_how_far_df_dt_went(unit_model, engine):
     assert json.loads(json.dumps(report.to_dict()))["rate_fraction"] == report.rate_fraction
 
 
+@pytest.mark.parametrize("engine", ["fused", "numpy"])
+def test_samples_beyond_the_df_range_are_never_in_range(unit_model, engine):
+    # issue 11: a faster warm-up leaves the training range of df/dt (the model was fitted
+    # on a cool-down); those samples are extrapolated and must not be flagged in range
+    fast = ramp_run(seed=29, start_c=-10.0, end_c=15.0, hours=0.5)
+    compensator = Compensator(unit_model, engine=engine)
+    out = compensator.process(fast)
+    low, high = unit_model.drift.ranges["df"]
+    from hrgtc.drift.features import FeatureStream
+
+    values = FeatureStream(unit_model.drift.settings, ("f", "df")).process(fast)
+    beyond = (values["df"] < low) | (values["df"] > high)
+    assert beyond.mean() > 0.5
+    assert compensator.rate_out_of_range == int(beyond.sum())
+    assert not np.any(out["in_range"][beyond])
+
+
 def test_housing_baseline_missing_is_a_clear_error(unit_model):
     with pytest.raises(InputError, match="no housing-thermistor baseline"):
         Compensator(unit_model, drift="housing")

@@ -187,7 +187,7 @@ def test_c_matches_the_python_compensator(kind, request, tmp_path):
     in_range = expected["in_range"]
     assert 0.05 < in_range.mean() < 0.95  # both branches of the flag are exercised
     assert 0 < compensator.rate_out_of_range < len(recording)
-    np.testing.assert_array_equal(out[:, 3], in_range)
+    np.testing.assert_array_equal(out[:, 3] * out[:, 7], in_range)  # the file's flag: both
     assert set(np.unique(out[:, 7])) <= {0.0, 1.0}
     assert int(np.count_nonzero(out[:, 7] == 0.0)) == compensator.rate_out_of_range
     np.testing.assert_allclose(out[:, 0], expected["rate_comp_dph"], rtol=0, atol=1e-9)
@@ -218,7 +218,7 @@ def test_edge_models_compile_cleanly_and_agree(selected, housing_model, tmp_path
     out, counters = run_driver(build(model, tmp_path, "edge"), columns, tmp_path, "run")
     assert counters == [compensator.samples, compensator.out_of_range,
                         compensator.rate_out_of_range]
-    np.testing.assert_array_equal(out[:, 3], expected["in_range"])
+    np.testing.assert_array_equal(out[:, 3] * out[:, 7], expected["in_range"])
     np.testing.assert_allclose(out[:, 0], expected["rate_comp_dph"], rtol=0, atol=1e-9)
 
 

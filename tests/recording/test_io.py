@@ -80,7 +80,7 @@ def test_round_trip_is_bit_exact_with_metadata(tmp_path, suffix):
     column[: awkward.size] = awkward
     recording = recording.with_columns(chamber_c=column)
     path = write(recording, tmp_path / f"run{suffix}")
-    back = read(path)
+    back = read(path, validate=False)  # 1.8e308 °C is kept bit-exact, though implausible
     assert back.names == recording.names
     for name in recording.names:
         assert same_bits(back[name], recording[name]), name

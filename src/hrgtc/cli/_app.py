@@ -52,15 +52,45 @@ def fail(message: str, code: int = 2) -> typer.Exit:
     return typer.Exit(code)
 
 
+def _first_line(exc: BaseException) -> str:
+    text = str(exc).strip()
+    return text.splitlines()[0] if text else type(exc).__name__
+
+
 @contextmanager
 def library_errors() -> Iterator[None]:
-    """Turn hrgtc errors (and missing files) into a clear message and exit code 2."""
+    """Turn every error into a clear message and exit code 2, never a traceback.
+
+    hrgtc's own errors carry the file, column, row and fix; missing files, full disks
+    and refused permissions are named with their file; corrupt files that a reader
+    library rejects (pyarrow, h5py) are named by that library's message; anything
+    else is reported as an internal error (a bug to report) on one line.
+    """
     try:
         yield
+    except typer.Exit:
+        raise
     except HrgtcError as exc:
         raise fail(str(exc)) from exc
     except FileNotFoundError as exc:
         raise fail(f"{exc.filename or exc}: no such file") from exc
+    except OSError as exc:
+        from hrgtc.files import describe_os_error
+
+        raise fail(describe_os_error(exc)) from exc
+    except UnicodeError as exc:
+        raise fail(f"a file is not valid UTF-8 text ({_first_line(exc)}); save it as UTF-8") \
+            from exc
+    except MemoryError as exc:
+        raise fail("out of memory; process the file in smaller chunks (--chunk-rows)") from exc
+    except KeyboardInterrupt:
+        raise fail("interrupted; nothing was written", 130) from None
+    except Exception as exc:
+        module = type(exc).__module__.split(".")[0]
+        if module in ("pyarrow", "h5py"):
+            raise fail(f"{module} cannot read or write a file: {_first_line(exc)}") from exc
+        raise fail(f"internal error {type(exc).__name__}: {_first_line(exc)} "
+                   "(a bug in hrgtc; please report it with the command line)") from exc
 
 
 @contextmanager

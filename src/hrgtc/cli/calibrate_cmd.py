@@ -118,12 +118,13 @@ def calibrate_command(
     --soak soak_-20C.parquet --soak soak_40C.parquet --drift cooldown.parquet -o unit.json
     """
     from hrgtc.calibration import HOUSING_TERMS, calibrate
-    from hrgtc.files import refuse_existing
+    from hrgtc.files import check_writable, refuse_existing
     from hrgtc.model import save_model
 
     soaks = [*(soak or []), *(extra_soaks or [])]
     with library_errors():
         refuse_existing(output, force)
+        check_writable(output, 1e6)  # before the fit, not after it
         stages: dict[str, object] = {}
 
         def progress(stage: str, done: float, total: float) -> None:

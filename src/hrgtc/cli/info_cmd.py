@@ -8,12 +8,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from hrgtc.cli._app import app, console, fail, library_errors, print_json
-from hrgtc.cli.options import (
-    GapPolicy,
-    GapsOption,
-    JsonOption,
-    reading_options,
-)
+from hrgtc.cli.options import JsonOption, reading_options
 
 if TYPE_CHECKING:
     from hrgtc.recording import ReadOptions
@@ -23,7 +18,6 @@ if TYPE_CHECKING:
 @reading_options
 def info(
     file: Annotated[Path, typer.Argument(help="Recording (.parquet, .pq, .csv, .h5, .hdf5).")],
-    gaps: GapsOption = GapPolicy.error,
     json_output: JsonOption = False,
     inputs: ReadOptions | None = None,
 ) -> None:
@@ -35,7 +29,7 @@ def info(
     from hrgtc.recording import describe
 
     with library_errors():
-        result = describe(file, **{**inputs.keywords(), "gaps": gaps.value})
+        result = describe(file, **inputs.keywords())
     if json_output:
         print_json(result.to_dict())
     else:

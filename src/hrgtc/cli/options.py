@@ -1,8 +1,8 @@
 """Options shared by the ``hrgtc`` commands, defined once.
 
 Use the ``Annotated`` aliases as parameter types. Commands that read
-recordings get the seven reading options (column mapping, units, sample rate,
-unit name, input rate) from :func:`reading_options` and receive them as one
+recordings get the eight reading options (column mapping, units, sample rate,
+unit name, input rate, gap policy) from :func:`reading_options` and receive them as one
 :class:`hrgtc.recording.ReadOptions`, the type the library takes::
 
     @app.command()
@@ -163,6 +163,16 @@ GapsOption = Annotated[
         rich_help_panel=_INPUT,
     ),
 ]
+_ReadingGapsOption = Annotated[
+    GapPolicy | None,
+    typer.Option(
+        "--gaps",
+        help="Gaps longer than 2 sample periods: fail (error, default), process the segments "
+        "separately (split: the df/dt filter restarts after each gap), or accept them "
+        "(ignore).",
+        rich_help_panel=_INPUT,
+    ),
+]
 ForceOption = Annotated[bool, typer.Option("--force", help="Overwrite existing output files.")]
 #: Exit status of --strict when samples went beyond the trained ranges.
 STRICT_EXIT = 3
@@ -183,6 +193,7 @@ def recording_input(
     sample_rate_hz: float | None = None,
     unit_name: str | None = None,
     input_rate_dph: float | None = None,
+    gaps: GapPolicy | str | None = None,
 ) -> ReadOptions:
     """Gather the values of the shared reading options into a :class:`ReadOptions`."""
     from hrgtc.recording import ReadOptions
@@ -195,6 +206,7 @@ def recording_input(
         columns=parse_columns(col) or None,
         units={k: v for k, v in units.items() if v is not None} or None,
         metadata={k: v for k, v in overrides.items() if v is not None} or None,
+        gaps=str(getattr(gaps, "value", gaps) or "error"),
     )
 
 
@@ -207,6 +219,7 @@ _READING_OPTIONS: tuple[tuple[str, Any], ...] = (
     ("sample_rate_hz", SampleRateOption),
     ("unit_name", UnitNameOption),
     ("input_rate_dph", InputRateOption),
+    ("gaps", _ReadingGapsOption),
 )
 
 
@@ -214,9 +227,9 @@ def reading_options(command: Callable[..., Any]) -> Callable[..., Any]:
     """Give a command the shared reading options, defined once here.
 
     The decorated function takes ``inputs: ReadOptions`` (as its last
-    parameter) instead of the seven options; the command line still shows
+    parameter) instead of the eight options; the command line still shows
     ``--col``, ``--time-unit``, ``--freq-unit``, ``--rate-unit``, ``--sample-rate-hz``,
-    ``--unit-name`` and ``--input-rate-dph``.
+    ``--unit-name``, ``--input-rate-dph`` and ``--gaps``.
     """
     signature = inspect.signature(command)
     namespace = command.__globals__

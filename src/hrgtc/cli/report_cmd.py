@@ -37,9 +37,12 @@ def report_command(
 
     Example: hrgtc report --model unit.json cooldown.parquet warmup.parquet -o report.html
     """
+    from hrgtc.files import check_writable, refuse_existing
     from hrgtc.report import build_report
 
     with library_errors(), progress_bar("report", enabled=not json_output) as progress:
+        refuse_existing(output, force)
+        check_writable(output, 20e6)  # before the passes over the runs
         path = build_report(model, runs, output, soaks=soak or None, title=title, force=force,
                             max_points=max_points, progress=progress, read_options=inputs)
     size = path.stat().st_size

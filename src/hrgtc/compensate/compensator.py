@@ -16,6 +16,8 @@ fused one to.
 
 from __future__ import annotations
 
+import dataclasses
+import itertools
 import os
 from collections.abc import Mapping
 from concurrent.futures import ThreadPoolExecutor
@@ -29,9 +31,12 @@ from hrgtc.compensate.ranges import RangeReport, range_report
 from hrgtc.drift import DriftModel
 from hrgtc.drift.features import FeatureStream, settle_rows
 from hrgtc.errors import CalibrationError, InputError
+from hrgtc.files import check_writable
 from hrgtc.model import UnitModel
 from hrgtc.progress import Progress
 from hrgtc.recording import Recording
+from hrgtc.recording.marks import COMPENSATED_KEY, mark, refuse_compensated
+from hrgtc.recording.validation import GAP_PERIODS, check_gap_policy
 
 #: Rows worked on at once: small enough for the temporaries to stay in cache.
 BLOCK_ROWS = 1 << 17
@@ -69,6 +74,11 @@ class Compensator:
     engine
         ``"fused"`` (one compiled pass per chunk, default) or ``"numpy"`` (the
         array-by-array reference); both give the same numbers to rounding.
+    gaps
+        ``"split"``: the df/dt filter restarts at rest after every gap (a time step
+        longer than :data:`~hrgtc.recording.validation.GAP_PERIODS` sample periods),
+        as if each segment were its own run; ``"error"`` / ``"ignore"`` (default):
+        the chunks are taken as one continuous run.
 
     Examples
     --------
@@ -76,7 +86,9 @@ class Compensator:
     >>> # for chunk in iter_chunks("run.parquet"): out = comp.process(chunk)
     """
 
-    def __init__(self, model: UnitModel, drift: str = "frequency", engine: str = "fused") -> None:
+    def __init__(self, model: UnitModel, drift: str = "frequency", engine: str = "fused",
+                 gaps: str = "ignore") -> None:
+        self.gaps = check_gap_policy(gaps)
         if engine not in ENGINES:
             raise InputError(f"engine must be 'fused' or 'numpy', got {engine!r}")
         if drift == "frequency":
@@ -98,14 +110,37 @@ class Compensator:
 
     def reset(self) -> None:
         """Start a new run: the df/dt filter restarts at rest on the next sample."""
-        self._stream = FeatureStream(self.drift.settings, self._variables)
-        self._state = np.zeros(7)  # the fused engine's filter state (compensate._kernel)
+        self.restart()
         self._extremes = np.array([np.inf, -np.inf, np.inf, -np.inf])  # f, df min/max
         self._settle_rows = settle_rows(self.drift.settings)
         self.samples = 0
         self.out_of_range = 0
         self.rate_out_of_range = 0
         self.settling = 0
+        self.segments = 1
+        self._last_time: float | None = None
+
+    def restart(self) -> None:
+        """Restart the df/dt filter at rest on the next sample (after a gap); counts stay.
+
+        The filter settles again: the first ``warmup_s`` after a restart are flagged
+        ``in_range`` 0, as at the start of a run.
+        """
+        self._stream = FeatureStream(self.drift.settings, self._variables)
+        self._state = np.zeros(7)  # the fused engine's filter state (compensate._kernel)
+        self._segment_samples = 0  # samples since the filter (re)started
+
+    def _gap_rows(self, chunk: Recording) -> list[int]:
+        """Rows of ``chunk`` that start a new segment (``gaps="split"``)."""
+        time = chunk.time_s
+        if not len(time):
+            return []
+        limit = GAP_PERIODS / chunk.metadata.sample_rate_hz
+        rows = (np.flatnonzero(np.diff(time) > limit) + 1).tolist()
+        if self._last_time is not None and time[0] - self._last_time > limit:
+            rows.insert(0, 0)
+        self._last_time = float(time[-1])
+        return rows
 
     def process(self, chunk: Recording) -> Recording:
         """The next chunk of the run with the :data:`OUTPUT_COLUMNS` added.
@@ -122,6 +157,21 @@ class Compensator:
         """
         if self.samples == 0:
             self.drift.settings.check_sample_rate(chunk)
+        if self.gaps == "split" and "time_s" in chunk:
+            cuts = self._gap_rows(chunk)
+            if cuts:
+                bounds = [0, *[c for c in cuts if c > 0], len(chunk)]
+                pieces = []
+                for k, (start, stop) in enumerate(itertools.pairwise(bounds)):
+                    if k > 0 or cuts[0] == 0:
+                        self.restart()
+                        self.segments += 1
+                    pieces.append(self._process(chunk.slice(start, stop)))
+                return chunk.with_columns(**{
+                    name: np.concatenate([p[name] for p in pieces]) for name in OUTPUT_COLUMNS})
+        return self._process(chunk)
+
+    def _process(self, chunk: Recording) -> Recording:
         n = len(chunk)
         out = {name: np.empty(n) for name in OUTPUT_COLUMNS}
         if self.engine == "fused" and self._fused(chunk, out):
@@ -152,6 +202,7 @@ class Compensator:
             lost = np.isnan(out["resonator_c_est"]) & (freq >= low) & (freq <= high)
             out["resonator_c_est"][lost] = thermometer.temperature(freq[lost], warn=False)
         self.samples += len(chunk)
+        self._segment_samples += len(chunk)
         self.out_of_range += int(counts[kernel.OUT_OF_RANGE])
         self.rate_out_of_range += int(counts[kernel.RATE_OUT_OF_RANGE])
         self.settling += int(counts[kernel.SETTLING])
@@ -166,7 +217,8 @@ class Compensator:
             self.drift, values, ("f", "h")
         )
         rate_in_range = _in_training_range(self.drift, values, ("df", "dh"))
-        settled = self.samples + np.arange(len(chunk)) >= self._settle_rows
+        settled = self._segment_samples + np.arange(len(chunk)) >= self._settle_rows
+        self._segment_samples += len(chunk)
         np.subtract(chunk.rate_dph, bias, out=out["rate_comp_dph"][start:stop])
         out["bias_model_dph"][start:stop] = bias
         out["resonator_c_est"][start:stop] = thermometer.temperature(chunk.freq_hz, warn=False)
@@ -249,13 +301,17 @@ def compensate_file(
     one and starts its write-back to disk, so that the fsync before the atomic
     rename finds little left to wait for. At most three chunks are held at a time.
     """
-    compensator = Compensator(model, drift)
-    chunks = (read_options or rec_io.ReadOptions()).chunks(source, rows=chunk_rows)
+    options = with_model_band(read_options or rec_io.ReadOptions(), model)
+    compensator = Compensator(model, drift, gaps=options.gaps)
+    refuse_compensated(source)
+    check_writable(output, estimated_output_bytes(source, output, len(OUTPUT_COLUMNS)))
+    chunks = options.chunks(source, rows=chunk_rows)
     try:
         first = next(chunks)
         names = (*first.names, *OUTPUT_COLUMNS)
         total = rec_io.count_rows(source)
-        with rec_io.RecordingWriter(output, first.metadata, names, force=force) as writer, \
+        metadata = compensated_metadata(first.metadata, model, drift)
+        with rec_io.RecordingWriter(output, metadata, names, force=force) as writer, \
                 ThreadPoolExecutor(max_workers=1) as reading, \
                 ThreadPoolExecutor(max_workers=1) as writing:
             ahead = reading.submit(next, chunks, None)
@@ -278,6 +334,64 @@ def compensate_file(
     return CompensationSummary(str(source), str(output), compensator.samples,
                                compensator.out_of_range_fraction,
                                compensator.rate_out_of_range_fraction, compensator.ranges())
+
+
+#: Frequencies farther than this beyond the calibrated span are errors, not extrapolation. [°C]
+PLAUSIBLE_MARGIN_C = 100.0
+
+
+def frequency_span(model: UnitModel) -> tuple[float, float]:
+    """The frequencies the model was calibrated on: thermometer and drift training ranges. [Hz]"""
+    low, high = model.thermometer.frequency_range_hz
+    if "f" in model.drift.ranges:
+        reference = model.drift.settings.reference_freq_hz
+        f_low, f_high = model.drift.ranges["f"]
+        low, high = min(low, reference + f_low), max(high, reference + f_high)
+    return float(low), float(high)
+
+
+def plausible_frequency_band(model: UnitModel,
+                             margin_c: float = PLAUSIBLE_MARGIN_C) -> tuple[float, float]:
+    """The calibrated span widened by ``margin_c`` of temperature at the steepest slope. [Hz]
+
+    A sample outside it is no temperature this unit can reach in a test: a glitch,
+    another unit's file or a wrong column, reported as an error on reading.
+    """
+    low, high = frequency_span(model)
+    t_low, t_high = model.thermometer.temperature_range_c
+    slope = float(np.max(np.abs(model.thermometer.slope_hz_per_c(np.array([t_low, t_high])))))
+    margin = margin_c * max(slope, 1e-6 * high)
+    return low - margin, high + margin
+
+
+def with_model_band(options: rec_io.ReadOptions, model: UnitModel) -> rec_io.ReadOptions:
+    """``options`` that check every frequency against the model's plausible band."""
+    return dataclasses.replace(options, freq_band_hz=plausible_frequency_band(model),
+                               freq_span_hz=frequency_span(model))
+
+
+def compensated_metadata(metadata: rec_io.Metadata, model: UnitModel,
+                         drift: str = "frequency") -> rec_io.Metadata:
+    """``metadata`` with the mark of compensation by ``model`` (:mod:`hrgtc.recording.marks`)."""
+    extra = {**metadata.extra, COMPENSATED_KEY: mark(model.sha256, model.unit, drift)}
+    return dataclasses.replace(metadata, extra=extra)
+
+
+def estimated_output_bytes(source: str | os.PathLike[str], output: str | os.PathLike[str],
+                           added_columns: int) -> float:
+    """Rough size of ``output``, a copy of ``source`` with ``added_columns`` more columns.
+
+    Counted as 8-byte floats (Parquet, HDF5) or about 20 characters (CSV) per value;
+    used to refuse a run that would fill the disk before it starts.
+    """
+    try:
+        with rec_io.open_source(source) as opened:
+            columns = len(opened.names) + added_columns
+        rows = rec_io.count_rows(source)
+    except (InputError, OSError):
+        return 0.0
+    per_value = 20.0 if str(output).lower().endswith(".csv") else 8.0
+    return rows * columns * per_value
 
 
 def _write(writer: rec_io.RecordingWriter, chunk: Recording) -> None:

@@ -27,13 +27,17 @@ from typing import Any
 import numpy as np
 
 from hrgtc.compensate import Compensator
+from hrgtc.compensate.compensator import with_model_band
 from hrgtc.compensate.ranges import RangeReport
-from hrgtc.errors import HrgtcError, InputError
-from hrgtc.evaluation.allan import AllanResult, NoiseTerms, allan_deviation, noise_terms
-from hrgtc.evaluation.metrics import DEFAULT_TAUS_S, bias_stability_table, table_to_json
+from hrgtc.drift.features import settle_rows
+from hrgtc.errors import HrgtcError, InputError, RecordingError
+from hrgtc.evaluation.allan import AllanResult, NoiseTerms, noise_terms
+from hrgtc.evaluation.metrics import DEFAULT_TAUS_S, table_to_json
+from hrgtc.evaluation.series_stats import SeriesStatistics
 from hrgtc.model import UnitModel
 from hrgtc.progress import Progress
 from hrgtc.recording import ReadOptions, Recording, count_rows
+from hrgtc.recording.marks import compensation_mark, describe_mark, refuse_compensated
 
 #: Series measured by a pass: output minus input rate, compensated by the
 #: frequency model, and by the housing-thermistor baseline.
@@ -212,6 +216,52 @@ def _finite(value: float | None) -> float | None:
     return None if value is None or not math.isfinite(value) else float(value)
 
 
+class _SettlingCut:
+    """Series statistics fed after the df/dt filter's settling time at the start of a run.
+
+    Training leaves out the first ``settle`` samples of a run (the filter starts at rest),
+    and so does the evaluation. A run shorter than ``settle + minimum`` keeps its last
+    ``minimum`` samples (two 10 s blocks) instead. Until that is decided the first
+    ``settle + minimum`` samples are held back; then they are fed in order.
+    """
+
+    def __init__(self, series: dict[str, SeriesStatistics], settle: int, minimum: int) -> None:
+        self.series = series
+        self.settle = settle
+        self.hold = settle + minimum
+        self.minimum = minimum
+        self.held: dict[str, list[np.ndarray]] = {key: [] for key in series}
+        self.rows = 0
+        self.flushed = False
+
+    def push(self, values: dict[str, np.ndarray]) -> None:
+        """The next rows of every series (one length)."""
+        if self.flushed:
+            for key, array in values.items():
+                self.series[key].push(array)
+            return
+        for key, array in values.items():
+            self.held[key].append(array)
+        self.rows += len(next(iter(values.values())))
+        if self.rows > self.hold:
+            self._flush(self.settle)
+
+    def finish(self) -> int:
+        """Feed what is still held back; the number of samples left out at the start."""
+        if not self.flushed:
+            self._flush(max(self.rows - self.minimum, 0))
+        return self.cut
+
+    def _flush(self, cut: int) -> None:
+        self.cut = cut
+        for key, parts in self.held.items():
+            rest = np.concatenate(parts)[cut:] if parts else np.empty(0)
+            if rest.size:
+                self.series[key].push(rest)
+        self.held = {}
+        self.flushed = True
+
+
 def run_pass(
     model: UnitModel,
     chunks: Iterable[Recording],
@@ -224,8 +274,12 @@ def run_pass(
     on_output: Callable[[Recording], None] | None = None,
     progress: Progress | None = None,
     total_rows: int = 0,
+    gaps: str = "ignore",
 ) -> Evaluation:
     """Compensate one run given as consecutive chunks, once, and measure it.
+
+    Memory stays bounded whatever the run's length: the statistics are streamed
+    (:class:`~hrgtc.evaluation.series_stats.SeriesStatistics`), no series is held.
 
     Parameters
     ----------
@@ -251,16 +305,20 @@ def run_pass(
         ``progress(samples done, total_rows)``.
     total_rows
         Rows of the run, for the progress callback (0 when not known).
+    gaps
+        ``"split"``: the df/dt filter restarts after each gap (see
+        :class:`~hrgtc.compensate.Compensator`); the statistics run over the joined
+        segments.
 
     Raises
     ------
     InputError
         The run holds no samples, or is shorter than two 10 s blocks.
     """
-    frequency = Compensator(model)
+    frequency = Compensator(model, gaps=gaps)
     housing: Compensator | None = None
     means = BlockMeans(block_rows) if block_rows else None
-    full: dict[str, list[np.ndarray]] = {key: [] for key in SERIES}
+    full: dict[str, SeriesStatistics] = {}
     squared_error = 0.0
     truth = False
     metadata = None
@@ -269,21 +327,27 @@ def run_pass(
             metadata = chunk.metadata
             truth = "bias_dph" in chunk
             if model.housing is not None and "housing_c" in chunk:
-                housing = Compensator(model, "housing")
+                housing = Compensator(model, "housing", gaps=gaps)
+            keys = SERIES if housing is not None else SERIES[:2]
+            full = {key: SeriesStatistics(metadata.sample_rate_hz, taus_s, allan,
+                                          expected_samples=total_rows)
+                    for key in keys}
+            cut = _SettlingCut(full, settle_rows(model.drift.settings),
+                               2 * round(10.0 * metadata.sample_rate_hz))
         out = frequency.process(chunk)
         if on_output is not None:
             on_output(out)
         raw = chunk.rate_dph - metadata.input_rate_dph
         comp = out["rate_comp_dph"] - metadata.input_rate_dph
-        full["raw"].append(raw)
-        full["compensated"].append(comp)
+        pushed = {"raw": raw, "compensated": comp}
         columns = {"time_s": chunk.time_s, "raw_dph": raw, "model_dph": out["bias_model_dph"],
                    "comp_dph": comp, "temperature_c": out["resonator_c_est"],
                    "in_range": out["in_range"]}
         if housing is not None:
             comp_h = housing.process(chunk)["rate_comp_dph"] - metadata.input_rate_dph
-            full["housing"].append(comp_h)
+            pushed["housing"] = comp_h
             columns["comp_housing_dph"] = comp_h
+        cut.push(pushed)
         if truth:
             columns["true_dph"] = chunk["bias_dph"]
             squared_error += float(np.sum((out["bias_model_dph"] - chunk["bias_dph"]) ** 2))
@@ -296,6 +360,7 @@ def run_pass(
     if metadata is None:
         raise InputError(f"{name}: the run holds no samples")
     fs = metadata.sample_rate_hz
+    cut.finish()
     n = frequency.samples
     if n < 2 * round(10.0 * fs):
         raise InputError(f"{name}: {n / fs:.1f} s is too short for a 10 s bias stability "
@@ -304,17 +369,12 @@ def run_pass(
     deviations: dict[str, AllanResult] = {}
     terms: dict[str, NoiseTerms] = {}
     notes: list[str] = []
-    settling = min(frequency.settling, max(n - 2 * round(10.0 * fs), 0))
-    for key, parts in full.items():
-        if not parts:
-            continue
-        values = np.concatenate(parts)[settling:]  # the filter's settling time, as in training
-        parts.clear()
-        stability[key] = bias_stability_table(values, fs, taus_s)
+    for key, series in full.items():
+        stability[key] = series.bias_stability()
         if not allan:
             continue
         try:
-            deviations[key] = allan_deviation(values, fs, taus="octave")
+            deviations[key] = series.allan_deviation()
             terms[key] = noise_terms(deviations[key])
         except HrgtcError as exc:
             notes.append(f"{key}: no Allan noise terms ({exc})")
@@ -359,13 +419,19 @@ def evaluate(
     on_output, progress
         As for :func:`run_pass`.
     """
+    gaps = (read_options or ReadOptions()).gaps
     if isinstance(run, Recording):
+        found = compensation_mark(run.metadata.to_dict(), list(run.names))
+        if found is not None:
+            raise RecordingError(f"{run.source or 'recording'} is already compensated, by "
+                                 f"{describe_mark(found)}; evaluate the original recording")
         rows = len(run)
         name, source, chunks = Path(run.source or "recording").name, run.source or "", [run]
         fs = run.sample_rate_hz
     else:
-        options = read_options or ReadOptions()
-        rows = count_rows(run) if progress is not None or max_points is not None else 0
+        options = with_model_band(read_options or ReadOptions(), model)
+        refuse_compensated(run)
+        rows = count_rows(run)  # cheap (metadata, or a scan of a CSV's bytes); plans the pass
         name, source, chunks = Path(run).name, str(run), options.chunks(run)
         fs = None
     blocks = None
@@ -375,4 +441,4 @@ def evaluate(
         blocks = block_rows(rows, fs, max_points)
     return run_pass(model, chunks, name, source=source, taus_s=taus_s, allan=allan,
                     block_rows=blocks, on_output=on_output, progress=progress,
-                    total_rows=rows)
+                    total_rows=rows, gaps=gaps)

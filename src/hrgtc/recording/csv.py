@@ -81,6 +81,7 @@ class CsvSource(Source):
                 raise RecordingError(f"{sidecar}: expected a JSON object of metadata")
             self.metadata.update(extra)
         self._size = path.stat().st_size
+        _refuse_cut_tail(path, self.delimiter, self._offset)
         self._streams: list[pa.NativeFile] = []
         self._rows_done = 0
         with open(path, "rb") as handle:  # bytes per row from the first MiB, for progress
@@ -159,12 +160,23 @@ class CsvSource(Source):
         self._streams = []
 
     # -- errors: name the file, column, row, value and the fix -----------------
+    def _invalid_utf8(self) -> RecordingError:
+        found = _first_invalid_utf8(self.path, self._offset)
+        where = "" if found is None else f"row {max(found[0], 0)} holds byte {found[1]:#04x}, "
+        return RecordingError(f"{self.path}: {where}not valid UTF-8 text; save the file as "
+                              "UTF-8 (or remove the damaged row)")
+
     def _translate(self, exc: Exception, as_text: set[str]) -> RecordingError:
         text = str(exc)
+        if "invalid UTF8" in text or "invalid utf8" in text.lower():
+            return self._invalid_utf8()
         conversion = re.search(r"CSV column #(\d+): CSV conversion error to \w+", text)
         if conversion:
             name = self.names[int(conversion.group(1))]
-            row, value = self._locate_bad_value(name)
+            try:
+                row, value = self._locate_bad_value(name)
+            except pa.ArrowInvalid:  # the bad value is not even text
+                return self._invalid_utf8()
             return RecordingError(
                 f"{self.path}: column '{name}', row {row}: {value!r} is not a number; "
                 f"{bad_number_hint(value)}"
@@ -209,13 +221,72 @@ class CsvSource(Source):
         return "?", "?", "?"
 
 
+#: Lines before the last one compared with it by :func:`_refuse_cut_tail`.
+TAIL_LINES = 20
+
+
+def _refuse_cut_tail(path: Path, delimiter: str, offset: int) -> None:
+    """Refuse a file whose last line has no line end and a number shorter than the lines before.
+
+    A logger killed mid-write leaves a last line like ``12.3,4428.5`` where ``4428.53112``
+    was being written: a valid number, and a wrong one. A last line without a line end
+    whose last field has fewer than half the characters of the same field in the lines
+    before is taken as cut.
+    """
+    size = path.stat().st_size
+    with open(path, "rb") as handle:
+        start = max(offset, size - 64 * 1024)
+        handle.seek(start)
+        tail = handle.read()
+    if not tail or tail.endswith((b"\n", b"\r")):
+        return
+    lines = tail.decode("utf-8", "replace").splitlines()
+    last, before = lines[-1], [line for line in lines[-1 - TAIL_LINES:-1] if line.strip()]
+    if start > offset:
+        before = before[1:]  # the first line of the window may itself be cut
+    if len(before) < 3:
+        return
+    field = last.split(delimiter)[-1].strip()
+    lengths = sorted(len(line.split(delimiter)[-1].strip()) for line in before)
+    typical = lengths[len(lengths) // 2]
+    if len(field) * 2 < typical:
+        row = _count_data_rows_before_end(path, offset)
+        raise RecordingError(
+            f"{path}: row {row}, the last line, ends without a line end and its last field "
+            f"{field!r} is much shorter than in the lines before (typically {typical} "
+            "characters): the file looks cut while it was written; remove the last line")
+
+
+def _count_data_rows_before_end(path: Path, offset: int) -> int:
+    with open(path, "rb") as handle:
+        handle.seek(offset)
+        return max(handle.read().count(b"\n") - 1, 0)
+
+
+def _first_invalid_utf8(path: Path, offset: int) -> tuple[int, int] | None:
+    """(data row, byte) of the first line after ``offset`` that is not UTF-8, or None."""
+    with open(path, "rb") as handle:
+        handle.seek(offset)
+        for row, raw in enumerate(handle, start=-1):
+            try:
+                raw.decode("utf-8")
+            except UnicodeDecodeError as exc:
+                return row, raw[exc.start]
+    return None
+
+
 def _csv_head(path: Path) -> tuple[int, str, list[str]]:
     """Byte offset of the header line, the header line and the comment lines."""
     comments: list[str] = []
     offset = 0
     with open(path, "rb") as handle:
-        for raw in handle:
-            text = raw.decode("utf-8", "replace")
+        for line, raw in enumerate(handle, start=1):
+            try:
+                text = raw.decode("utf-8")
+            except UnicodeDecodeError as exc:
+                raise RecordingError(
+                    f"{path}: line {line} is not valid UTF-8 (byte {raw[exc.start]:#04x} at "
+                    f"column {exc.start + 1}); save the file as UTF-8") from None
             if offset == 0 and text.startswith("\ufeff"):
                 text = text[1:]
             stripped = text.strip()

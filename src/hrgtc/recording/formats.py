@@ -155,7 +155,9 @@ class ParquetSource(Source):
     def __init__(self, path: Path) -> None:
         super().__init__(path)
         try:
-            self._file = pq.ParquetFile(path, pre_buffer=False)  # keeps batch reads small
+            # pre_buffer off keeps batch reads small; page CRCs (written by ParquetSink) are
+            # verified, so a flipped bit is an error rather than a wrong number
+            self._file = pq.ParquetFile(path, pre_buffer=False, page_checksum_verification=True)
         except (pa.ArrowInvalid, OSError) as exc:
             if isinstance(exc, FileNotFoundError):
                 raise
@@ -175,12 +177,28 @@ class ParquetSource(Source):
         return {f.name: kind_of(f.type) for f in self._file.schema_arrow}
 
     def read(self, names: Sequence[str], as_text: set[str]) -> pa.Table:
-        return self._file.read(columns=list(names))
+        try:
+            return self._file.read(columns=list(names))
+        except (pa.ArrowException, OSError) as exc:
+            raise self._corrupt(exc) from None
 
     def iter_tables(self, names: Sequence[str], as_text: set[str], rows: int) -> Iterator[pa.Table]:
-        for batch in self._file.iter_batches(batch_size=rows, columns=list(names)):
+        batches = self._file.iter_batches(batch_size=rows, columns=list(names))
+        while True:
+            try:
+                batch = next(batches)
+            except StopIteration:
+                return
+            except (pa.ArrowException, OSError) as exc:
+                raise self._corrupt(exc) from None
             self._done += batch.num_rows
             yield pa.Table.from_batches([batch])
+
+    def _corrupt(self, exc: Exception) -> RecordingError:
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        return RecordingError(
+            f"{self.path}: the Parquet data are corrupt near row {self._done} ({first}); "
+            "the file was damaged after it was written: restore it from its source")
 
     def position(self) -> tuple[float, float]:
         return (float(self._done), float(self.total_rows or 0))
@@ -309,8 +327,9 @@ class ParquetSink(Sink):
         self._schema = pa.schema(fields, metadata={METADATA_KEY: metadata_json(metadata)})
         # Float gyro data does not compress (snappy saved 0 % on simulated runs and cost a
         # third of the write speed), so pages are written plain.
+        # Page checksums (CRC32) let every reader detect a flipped bit.
         self._writer = pq.ParquetWriter(str(path), self._schema, use_dictionary=False,
-                                        compression="none")
+                                        compression="none", write_page_checksum=True)
         self._pending: list[pa.Table] = []
         self._pending_rows = 0
 

@@ -27,7 +27,13 @@ from typing import Any
 import numpy as np
 
 from hrgtc.errors import InputError, RecordingError
-from hrgtc.files import fsync_file, publish, refuse_existing, temporary_beside
+from hrgtc.files import (
+    forget_temporary,
+    fsync_file,
+    publish,
+    refuse_existing,
+    temporary_beside,
+)
 from hrgtc.progress import Progress
 from hrgtc.recording.csv import CsvSink, CsvSource
 from hrgtc.recording.formats import (
@@ -86,6 +92,9 @@ def _metadata(
         return override
     data = dict(plan.source.metadata)
     data.update({k: v for k, v in (override or {}).items() if v is not None})
+    if not isinstance(data.get("extra") or {}, Mapping):
+        raise RecordingError(f"{path}: metadata extra is {data.get('extra')!r}, not a JSON "
+                             "object of key/value pairs; fix or remove it")
     extra = dict(data.get("extra") or {})
     if (override or {}).get("sample_rate_hz") is not None:
         extra.pop("sample_rate_inferred", None)
@@ -131,6 +140,8 @@ def read(
     validate: bool = True,
     gaps: GapPolicy | str = "error",
     metadata: Mapping[str, Any] | Metadata | None = None,
+    freq_band_hz: tuple[float, float] | None = None,
+    freq_span_hz: tuple[float, float] | None = None,
 ) -> Recording:
     """Read a whole recording from Parquet, CSV or HDF5 (by suffix).
 
@@ -150,6 +161,9 @@ def read(
     metadata
         Keys that complete or override the file's metadata (e.g.
         ``{"sample_rate_hz": 200, "unit": "SN 12"}``), or a whole :class:`Metadata`.
+    freq_band_hz, freq_span_hz
+        With a model: frequencies outside ``freq_band_hz`` are errors (instead of the
+        physical range), ``freq_span_hz`` (the calibrated span) is named in the message.
 
     Returns
     -------
@@ -170,7 +184,7 @@ def read(
         meta = _metadata(plan, metadata, arrays.get("time_s"))
     recording = Recording(arrays, meta, source=str(path))
     if validate:
-        validate_recording(recording, gaps)
+        validate_recording(recording, gaps, freq_band_hz=freq_band_hz, freq_span_hz=freq_span_hz)
     return recording
 
 
@@ -209,6 +223,8 @@ def iter_chunks(
     gaps: GapPolicy | str = "error",
     metadata: Mapping[str, Any] | Metadata | None = None,
     progress: Progress | None = None,
+    freq_band_hz: tuple[float, float] | None = None,
+    freq_span_hz: tuple[float, float] | None = None,
 ) -> Iterator[Recording]:
     """Stream a recording in chunks of ``rows`` rows without loading the file.
 
@@ -233,7 +249,7 @@ def iter_chunks(
     if int(rows) < 1:
         raise InputError(f"rows must be a positive number of rows per chunk, got {rows!r}")
     rows = int(rows)
-    validator = RecordingValidator(gaps) if validate else None
+    validator = (RecordingValidator(gaps, freq_band_hz, freq_span_hz) if validate else None)
     with open_source(path) as source:
         plan = plan_columns(source, columns, units)
         offset = 0
@@ -305,6 +321,9 @@ class ReadOptions:
         ``"error"``, ``"split"`` or ``"ignore"`` (see :func:`read`).
     chunk_rows
         Rows per chunk when a file is streamed.
+    freq_band_hz, freq_span_hz
+        Plausible frequencies and the calibrated span of the model the run is
+        compensated with (set by compensation and evaluation, see :func:`read`).
     """
 
     columns: Mapping[str, str] | None = None
@@ -312,11 +331,16 @@ class ReadOptions:
     metadata: Mapping[str, Any] | None = None
     gaps: str = "error"
     chunk_rows: int = 250_000
+    freq_band_hz: tuple[float, float] | None = None
+    freq_span_hz: tuple[float, float] | None = None
 
     def keywords(self) -> dict[str, Any]:
         """The options as keyword arguments of :func:`read` and :func:`iter_chunks`."""
-        return {"columns": self.columns, "units": self.units, "metadata": self.metadata,
-                "gaps": self.gaps}
+        words = {"columns": self.columns, "units": self.units, "metadata": self.metadata,
+                 "gaps": self.gaps}
+        if self.freq_band_hz is not None:
+            words.update(freq_band_hz=self.freq_band_hz, freq_span_hz=self.freq_span_hz)
+        return words
 
     def read(self, path: str | Path, keep: Sequence[str] | None = None) -> Recording:
         """The whole file; with ``keep``, streamed keeping only those columns (less memory)."""
@@ -347,6 +371,7 @@ def _remove(path: str) -> None:
         os.unlink(path)
     except FileNotFoundError:
         pass
+    forget_temporary(path)
 
 
 class RecordingWriter:

@@ -90,6 +90,9 @@ class Metadata:
     def from_dict(cls, data: Mapping[str, Any]) -> Metadata:
         """Inverse of :meth:`to_dict`; unknown keys go into ``extra``."""
         known = {"sample_rate_hz", "unit", "input_rate_dph", "profile", "schema", "extra"}
+        if not isinstance(data.get("extra") or {}, Mapping):
+            raise RecordingError(f"metadata extra is {data.get('extra')!r}, not a JSON object "
+                                 "of key/value pairs; fix or remove it")
         extra = dict(data.get("extra") or {})
         extra.update({k: v for k, v in data.items() if k not in known})
         if "sample_rate_hz" not in data:

@@ -20,13 +20,27 @@ One place checks every recording that enters hrgtc, whole or chunk by chunk:
     (up to ≈ 15 °/h) plus its bias (up to ±100 °/h), with white noise of
     ≈ 0.01–5 °/h per sample at 1–200 Hz. The same data in °/s are 3600 times
     smaller, in rad/s ≈ 206,265 times. The column is flagged when both its median
-    magnitude is below :data:`RATE_LEVEL_DPH` (1 °/h) *and* its per-sample noise,
-    estimated as ``std(diff(rate)) / sqrt(2)`` (insensitive to slow drift), is
-    below :data:`RATE_NOISE_DPH` (1e-3 °/h). With a large known input rate
-    (``|input_rate_dph| >= 3600``, a rate table) the column is also flagged when
-    its median is the input rate divided by 3600 or by 206,265 (within a factor
-    of 2). Real °/h data (and the simulator's output, whose noise is ≈ 1–5 °/h
-    per sample at 200 Hz) never trip these rules.
+    magnitude is below :data:`RATE_LEVEL_DPH` (1 °/h) *and* either its per-sample
+    noise, ``std(diff(rate)) / sqrt(2)``, is below :data:`RATE_NOISE_DPH` (1e-3 °/h)
+    or the robust scale of its 1 s block means (MAD of their differences / √2,
+    insensitive to slow drift and independent of the sample rate: 0.06–6 °/h for
+    an HRG in °/h, 3600 times less in °/s) is below :data:`RATE_BLOCK_NOISE_DPH`
+    (0.01 °/h). With a large known input rate (``|input_rate_dph| >= 3600``, a rate
+    table) the column is also flagged when its median is the input rate divided by
+    3600 or by 206,265 (within a factor of 2). Real °/h data (and the simulator's
+    output at 1, 10 and 200 Hz, at rest or on a rate table) never trip these rules;
+  - ``time_s``: without a sample rate in the metadata, steps that imply less than
+    :data:`SLOW_SAMPLE_RATE_HZ` suggest milliseconds (``--time-unit ms``);
+
+* every sample is plausible: ``freq_hz`` within :data:`FREQ_SAMPLE_RANGE_HZ` (or,
+  given a model, within its calibrated span widened by 100 °C) and within
+  :data:`FREQ_JUMP_FRACTION` of the median of the first rows; ``rate_dph`` and
+  ``bias_dph`` within ±:data:`RATE_MAX_DPH`; temperatures within
+  :data:`TEMPERATURE_RANGE_C`;
+* the sample rate holds through the whole file: the mean step of every block of
+  :data:`RATE_CHECK_ROWS` rows (gaps left out) agrees with the metadata.
+
+The single checks and heuristics are in :mod:`hrgtc.recording.checks`.
 
 Rows are numbered from 0 (the first data row), over the whole file also when it
 is validated chunk by chunk.
@@ -39,7 +53,6 @@ is validated chunk by chunk.
 from __future__ import annotations
 
 import itertools
-import math
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from typing import Any, Literal
@@ -47,59 +60,54 @@ from typing import Any, Literal
 import numpy as np
 
 from hrgtc.errors import RecordingError
+from hrgtc.recording.checks import (
+    DEG_PER_RAD_X3600,
+    FREQ_MAX_HZ,
+    KHZ_BELOW_HZ,
+    RATE_BLOCK_NOISE_DPH,
+    RATE_LEVEL_DPH,
+    RATE_NOISE_DPH,
+    RATE_TABLE_DPH,
+    SAMPLE_RATE_TOLERANCE,
+    SLOW_SAMPLE_RATE_HZ,
+    Problem,
+    _check_freq_unit,
+    _check_rate_unit,
+    _check_sample_rate,
+    _check_time_unit,
+    measured_sample_rate,
+)
 from hrgtc.recording.schema import REQUIRED_COLUMNS, Metadata, Recording
+
+__all__ = [
+    "DEG_PER_RAD_X3600", "FREQ_MAX_HZ", "GAP_PERIODS", "GAP_POLICIES", "HEURISTIC_ROWS",
+    "KHZ_BELOW_HZ", "RATE_BLOCK_NOISE_DPH", "RATE_LEVEL_DPH", "RATE_NOISE_DPH",
+    "RATE_TABLE_DPH", "SAMPLE_RATE_TOLERANCE", "SLOW_SAMPLE_RATE_HZ", "Gap", "GapPolicy",
+    "Problem", "RecordingValidator", "ValidationReport", "check_gap_policy",
+    "measured_sample_rate", "problems_message", "split_at_gaps", "validate",
+]
 
 GapPolicy = Literal["error", "split", "ignore"]
 GAP_POLICIES: tuple[str, ...] = ("error", "split", "ignore")
 
 GAP_PERIODS = 2.0  # a time step longer than this many sample periods is a gap
-SAMPLE_RATE_TOLERANCE = 0.01  # relative disagreement of measured and nominal rate
 HEURISTIC_ROWS = 100_000  # rows used for the sample-rate and unit heuristics
-KHZ_BELOW_HZ = 100.0
-FREQ_MAX_HZ = 1e6
-RATE_LEVEL_DPH = 1.0
-RATE_NOISE_DPH = 1e-3
-RATE_TABLE_DPH = 3600.0
-DEG_PER_RAD_X3600 = 180.0 / math.pi * 3600.0  # °/h per rad/s
 MAX_LISTED_GAPS = 1000
-
-
-@dataclass(frozen=True)
-class Problem:
-    """One way in which a recording breaks the contract.
-
-    Parameters
-    ----------
-    kind
-        One of ``"empty"``, ``"missing_column"``, ``"not_finite"``, ``"time_order"``,
-        ``"gap"``, ``"sample_rate"``, ``"freq_unit"``, ``"rate_unit"``.
-    message
-        Full sentence naming column, row, value and the fix.
-    column
-        Column concerned, if any.
-    row
-        First bad row (0 = first data row), if any.
-    value
-        The bad value as text, if any.
-    count
-        Number of rows (or gaps) with this problem found.
-    """
-
-    kind: str
-    message: str
-    column: str | None = None
-    row: int | None = None
-    value: str | None = None
-    count: int = 1
-
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types."""
-        return asdict(self)
-
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> Problem:
-        """Inverse of :meth:`to_dict`."""
-        return cls(**dict(data))
+#: Physical bounds of every sample (outside: an error naming the first row).
+FREQ_SAMPLE_RANGE_HZ = (100.0, 1e5)  # n = 2 mode of any HRG: a few 100 Hz .. tens of kHz
+FREQ_JUMP_FRACTION = 0.05  # 84 ppm/°C over 300 °C is 2.5 %: more than 5 % off is a glitch
+RATE_MAX_DPH = 3.6e6  # 1000 °/s: beyond any rate table and the rebalance loop of an HRG
+TEMPERATURE_RANGE_C = (-200.0, 500.0)  # chambers, housings, resonators
+#: Rows per block of the sample-rate check that runs through the whole file.
+RATE_CHECK_ROWS = 1000
+_BOUNDS: dict[str, tuple[float, float, str]] = {
+    "freq_hz": (*FREQ_SAMPLE_RANGE_HZ, "Hz"),
+    "rate_dph": (-RATE_MAX_DPH, RATE_MAX_DPH, "°/h"),
+    "bias_dph": (-RATE_MAX_DPH, RATE_MAX_DPH, "°/h"),
+    "chamber_c": (*TEMPERATURE_RANGE_C, "°C"),
+    "housing_c": (*TEMPERATURE_RANGE_C, "°C"),
+    "resonator_c": (*TEMPERATURE_RANGE_C, "°C"),
+}
 
 
 @dataclass(frozen=True)
@@ -237,8 +245,21 @@ class RecordingValidator:
         listed (split the recording with :func:`split_at_gaps`).
     """
 
-    def __init__(self, gaps: GapPolicy | str = "error") -> None:
+    def __init__(self, gaps: GapPolicy | str = "error",
+                 freq_band_hz: tuple[float, float] | None = None,
+                 freq_span_hz: tuple[float, float] | None = None) -> None:
         self.gaps = check_gap_policy(gaps)
+        self.freq_band_hz = freq_band_hz
+        self.freq_span_hz = freq_span_hz
+        self._bounds = dict(_BOUNDS)
+        if freq_band_hz is not None:
+            self._bounds["freq_hz"] = (float(freq_band_hz[0]), float(freq_band_hz[1]), "Hz")
+        self._out_of_bounds: dict[str, list[Any]] = {}  # column -> [row, value, count]
+        self._freq_reference: float | None = None
+        self._jump: list[Any] | None = None  # [row, value, count]
+        self._steps = np.empty(0)
+        self._steps_start = 0
+        self._rate_change: tuple[int, float] | None = None
         self.rows = 0
         self.source: str | None = None
         self.metadata: Metadata | None = None
@@ -272,11 +293,62 @@ class RecordingValidator:
                     self._not_finite[name] = [offset + first, values[first], int(bad.sum())]
                 else:
                     state[2] += int(bad.sum())
+            if name in self._bounds:
+                self._check_bounds(name, values, offset)
+        if "freq_hz" in chunk and self._freq_reference is not None:
+            self._check_jumps(chunk.freq_hz, offset)
         if "time_s" in chunk and n:
             self._check_time(chunk.time_s, offset)
         if self._heuristics is None:
             self._collect_sample(chunk)
         self.rows += n
+
+    def _check_bounds(self, name: str, values: np.ndarray, offset: int) -> None:
+        low, high, _ = self._bounds[name]
+        with np.errstate(invalid="ignore"):
+            bad = ((values < low) | (values > high)) & np.isfinite(values)
+        if bad.any():
+            state = self._out_of_bounds.get(name)
+            if state is None:
+                first = int(np.argmax(bad))
+                self._out_of_bounds[name] = [offset + first, float(values[first]),
+                                             int(bad.sum())]
+            else:
+                state[2] += int(bad.sum())
+
+    def _check_jumps(self, freq: np.ndarray, offset: int) -> None:
+        reference = self._freq_reference
+        with np.errstate(invalid="ignore"):
+            bad = (np.abs(freq - reference) > FREQ_JUMP_FRACTION * reference) & np.isfinite(freq)
+        if bad.any():
+            if self._jump is None:
+                first = int(np.argmax(bad))
+                self._jump = [offset + first, float(freq[first]), int(bad.sum())]
+            else:
+                self._jump[2] += int(bad.sum())
+
+    def _check_rate_throughout(self, step: np.ndarray, offset: int) -> None:
+        """Mean time step of every block of :data:`RATE_CHECK_ROWS` rows (gaps left out)."""
+        if self._rate_change is not None:
+            return
+        if self._steps.size:
+            step = np.concatenate([self._steps, step])
+            offset = self._steps_start
+        blocks = step.size // RATE_CHECK_ROWS
+        period = 1.0 / self.metadata.sample_rate_hz
+        for k in range(blocks):
+            part = step[k * RATE_CHECK_ROWS:(k + 1) * RATE_CHECK_ROWS]
+            with np.errstate(invalid="ignore"):
+                usable = part[np.isfinite(part) & (part > 0) & (part <= GAP_PERIODS * period)]
+            if usable.size < RATE_CHECK_ROWS // 2:
+                continue  # mostly gaps or disorder: reported by those checks
+            measured = 1.0 / float(np.mean(usable))
+            if abs(measured * period - 1.0) > SAMPLE_RATE_TOLERANCE:
+                self._rate_change = (offset + k * RATE_CHECK_ROWS, measured)
+                self._steps = np.empty(0)
+                return
+        self._steps = step[blocks * RATE_CHECK_ROWS:].copy()
+        self._steps_start = offset + blocks * RATE_CHECK_ROWS
 
     def _check_time(self, time: np.ndarray, offset: int) -> None:
         previous = np.empty_like(time)
@@ -295,6 +367,7 @@ class RecordingValidator:
         with np.errstate(invalid="ignore"):
             long = np.flatnonzero((step > GAP_PERIODS * period) & np.isfinite(step))
         self._n_gaps += long.size
+        self._check_rate_throughout(step, offset)
         room = MAX_LISTED_GAPS - len(self._gaps)
         self._gaps += [
             Gap(float(previous[i]), float(step[i]), offset + int(i)) for i in long[:room]
@@ -344,6 +417,30 @@ class RecordingValidator:
                     count=count,
                 )
             )
+        unit_problem = any(p.kind == "freq_unit" for p in self._heuristics or [])
+        for name, (row, value, count) in self._out_of_bounds.items():
+            if name == "freq_hz" and (self._heuristics is None or unit_problem):
+                continue  # the unit heuristic (e.g. "looks like kHz") says it better
+            problems.append(self._bounds_problem(name, row, value, count))
+        if self._jump is not None:
+            row, value, count = self._jump
+            problems.append(Problem(
+                "implausible",
+                f"column 'freq_hz', row {row}: {value:.6g} Hz is more than "
+                f"{FREQ_JUMP_FRACTION:.0%} away from the run's median "
+                f"{self._freq_reference:.6g} Hz (a resonator moves ≈ 0.01 %/°C; first of "
+                f"{count} such rows): a glitch or two files joined; remove those rows",
+                column="freq_hz", row=row, value=f"{value:.6g}", count=count))
+        if self._rate_change is not None:
+            row, measured = self._rate_change
+            nominal = self.metadata.sample_rate_hz
+            problems.append(Problem(
+                "sample_rate",
+                f"column 'time_s', rows {row} to {row + RATE_CHECK_ROWS - 1}: the time step "
+                f"means {measured:.6g} Hz but the metadata (and the start of the file) say "
+                f"{nominal:g} Hz; the sample rate changes within the file: split it at row "
+                f"{row} and process the parts separately (or resample)",
+                column="time_s", row=row, value=f"{measured:.6g}"))
         if self._time_order is not None:
             row, now, before = self._time_order
             what = "a duplicate time" if now == before else "a step back in time"
@@ -378,6 +475,30 @@ class RecordingValidator:
         problems += self._heuristics or []
         return problems
 
+    def _bounds_problem(self, name: str, row: int, value: float, count: int) -> Problem:
+        low, high, unit = self._bounds[name]
+        if name == "freq_hz" and self.freq_band_hz is not None:
+            span = self.freq_span_hz or self.freq_band_hz
+            why = (f"far outside the model's calibrated span {span[0]:.6g} to {span[1]:.6g} Hz "
+                   f"(more than the frequency of 100 °C beyond it: {low:.6g} to {high:.6g} Hz)")
+            fix = ("a glitch, another unit's recording, or the wrong column? remove the row or "
+                   "check --col freq_hz=... and --freq-unit")
+        elif name == "freq_hz":
+            why = (f"outside {low:g} to {high:g} Hz, where the resonator frequency of any HRG "
+                   "lies")
+            fix = "a glitch or the wrong column: remove the row or check --col/--freq-unit"
+        elif name in ("rate_dph", "bias_dph"):
+            why = f"beyond ±{high:g} °/h (1000 °/s), more than any HRG measures"
+            fix = "a glitch or the wrong column: remove the row or check --col/--rate-unit"
+        else:
+            why = f"outside {low:g} to {high:g} °C"
+            fix = "a glitch or not a temperature in °C: remove the row or check the mapping"
+        return Problem(
+            "implausible",
+            f"column '{name}', row {row}: {value:.6g} {unit} is {why} (first of {count} such "
+            f"rows); {fix}",
+            column=name, row=row, value=f"{value:.6g}", count=count)
+
     def raise_for_problems(self) -> None:
         """Raise :class:`~hrgtc.errors.RecordingError` if a problem was found so far."""
         problems = self.problems
@@ -410,100 +531,31 @@ class RecordingValidator:
         if "time_s" in sample and self.metadata is not None:
             self.measured_sample_rate_hz = measured_sample_rate(sample["time_s"])
             problem = _check_sample_rate(self.metadata.sample_rate_hz, self.measured_sample_rate_hz)
+            if problem is None and self.metadata.extra.get("sample_rate_inferred"):
+                problem = _check_time_unit(self.measured_sample_rate_hz, sample["time_s"])
             if problem:
                 problems.append(problem)
         if "freq_hz" in sample:
             problem = _check_freq_unit(sample["freq_hz"])
             if problem:
                 problems.append(problem)
+            else:
+                finite = sample["freq_hz"][np.isfinite(sample["freq_hz"])]
+                if finite.size:
+                    self._freq_reference = float(np.median(finite))
+                    self._check_jumps(sample["freq_hz"], 0)
         if "rate_dph" in sample and self.metadata is not None:
-            problem = _check_rate_unit(sample["rate_dph"], self.metadata.input_rate_dph)
+            problem = _check_rate_unit(sample["rate_dph"], self.metadata.input_rate_dph,
+                                       self.metadata.sample_rate_hz)
             if problem:
                 problems.append(problem)
         self._heuristics = problems
 
 
-def measured_sample_rate(time_s: np.ndarray) -> float | None:
-    """Reciprocal of the median positive finite time step, None if there is none.
-
-    Parameters
-    ----------
-    time_s
-        Sample times. [s]
-
-    Returns
-    -------
-    float or None
-        Sample rate. [Hz]
-    """
-    step = np.diff(np.asarray(time_s, dtype=np.float64))
-    step = step[np.isfinite(step) & (step > 0)]
-    if step.size == 0:
-        return None
-    return float(1.0 / np.median(step))
-
-
-def _check_sample_rate(nominal_hz: float, measured_hz: float | None) -> Problem | None:
-    if measured_hz is None or abs(measured_hz / nominal_hz - 1.0) <= SAMPLE_RATE_TOLERANCE:
-        return None
-    fix = f"fix the metadata (--rate-hz {measured_hz:.6g})"
-    if abs(measured_hz * 1000.0 / nominal_hz - 1.0) <= 0.05:
-        fix = "the time column looks like milliseconds: pass --time-unit ms"
-    return Problem(
-        "sample_rate",
-        f"column 'time_s': the median time step {1.0 / measured_hz:.6g} s means "
-        f"{measured_hz:.6g} Hz but the metadata says sample_rate_hz = {nominal_hz:g}; {fix}",
-        column="time_s",
-        value=f"{measured_hz:.6g}",
-    )
-
-
-def _check_freq_unit(freq: np.ndarray) -> Problem | None:
-    freq = freq[np.isfinite(freq)]
-    if freq.size == 0:
-        return None
-    median = float(np.median(freq))
-    if 0 < median < KHZ_BELOW_HZ and KHZ_BELOW_HZ <= median * 1000.0 <= FREQ_MAX_HZ:
-        message = f"freq_hz looks like kHz (median {median:.6g}); pass --freq-unit kHz"
-    elif median <= 0 or median < KHZ_BELOW_HZ or median > FREQ_MAX_HZ:
-        message = (
-            f"freq_hz is implausible (median {median:.6g} Hz; the resonator frequency of an "
-            "HRG is a few hundred Hz to a few tens of kHz); check the column mapping "
-            "(--col freq_hz=<your column>) and the unit (--freq-unit Hz|kHz)"
-        )
-    else:
-        return None
-    return Problem("freq_unit", message, column="freq_hz", value=f"{median:.6g}")
-
-
-def _check_rate_unit(rate: np.ndarray, input_rate_dph: float) -> Problem | None:
-    rate = rate[np.isfinite(rate)]
-    if rate.size < 2:
-        return None
-    level = float(np.median(np.abs(rate)))
-    noise = float(np.std(np.diff(rate)) / math.sqrt(2.0))
-    quiet_and_small = level < RATE_LEVEL_DPH and noise < RATE_NOISE_DPH
-    scaled_input = False
-    if abs(input_rate_dph) >= RATE_TABLE_DPH:
-        ratio = float(np.median(rate)) / input_rate_dph
-        scaled_input = any(0.5 <= ratio * factor <= 2.0 for factor in (3600.0, DEG_PER_RAD_X3600))
-    if not (quiet_and_small or scaled_input):
-        return None
-    options = ["--rate-unit dps (°/s)", "--rate-unit radps (rad/s)"]
-    if level * 3600.0 < 0.5:
-        options.reverse()  # below 0.5 °/h even if it were °/s: rad/s is more likely
-    return Problem(
-        "rate_unit",
-        f"rate_dph looks like °/s or rad/s, not °/h (median |rate| {level:.3g}, per-sample "
-        f"noise {noise:.3g}; a gyro recorded in °/h reads ≳ {RATE_LEVEL_DPH:g} °/h with "
-        f"≳ {RATE_NOISE_DPH:g} °/h noise per sample); pass {' or '.join(options)}",
-        column="rate_dph",
-        value=f"{level:.3g}",
-    )
-
-
 def validate(
-    recording: Recording, gaps: GapPolicy | str = "error", *, raise_errors: bool = True
+    recording: Recording, gaps: GapPolicy | str = "error", *, raise_errors: bool = True,
+    freq_band_hz: tuple[float, float] | None = None,
+    freq_span_hz: tuple[float, float] | None = None,
 ) -> ValidationReport:
     """Check a recording against the recording contract (see the module docstring).
 
@@ -518,6 +570,9 @@ def validate(
     raise_errors
         Raise :class:`~hrgtc.errors.RecordingError` on a problem (default) rather
         than return a report with ``ok=False``.
+    freq_band_hz, freq_span_hz
+        Plausible frequencies given a model (every sample must lie in the band;
+        without a model :data:`FREQ_SAMPLE_RANGE_HZ`) and its calibrated span.
 
     Returns
     -------
@@ -528,7 +583,7 @@ def validate(
     RecordingError
         Message names the file, column, first bad row, the bad value and the fix.
     """
-    validator = RecordingValidator(gaps)
+    validator = RecordingValidator(gaps, freq_band_hz, freq_span_hz)
     validator.update(recording)
     report = validator.finish()
     if raise_errors:

@@ -1,0 +1,375 @@
+"""The JSON Schema of the model file, and the checks a schema cannot express.
+
+A model file is trusted by nothing: :func:`check_document` validates it with
+``jsonschema`` (Draft 2020-12) against :data:`MODEL_SCHEMA` and then checks what
+a schema cannot say: every term is known and parsable, the selected terms are
+among the candidates with one coefficient each, every range is ordered, the
+user-unit coefficients agree with the scaled ones they are derived from.
+
+Numbers: the *parameters* (coefficients, ranges, scales, settings) must be finite
+numbers; the *statistics* (standard errors, p-values, R², the stepwise record)
+may be missing, written ``null`` (schema version 2) or, in files of version 1,
+the non-standard ``NaN`` that Python's ``json`` used to write. Version 1 files
+are read through :func:`parse_model_json`, which turns ``NaN`` and ``Infinity``
+into the strings ``"NaN"`` / ``"Infinity"`` so that the schema names them where
+they are not allowed.
+
+Integrity: a file of version 2 carries ``parameters_sha256``, the SHA-256 of its
+canonical JSON without provenance (:func:`parameters_sha256`); a file whose
+content no longer matches it was changed after it was written (a flipped digit
+in a coefficient or a range is otherwise a valid model with wrong numbers) and is
+refused. A deliberate hand edit removes that line. The same hash names the model
+in the mark of a compensated output.
+
+One source of truth for coefficients: prediction uses ``scaled_coefficients``
+(coefficients of the centred and scaled variables, what the fit produced); the
+readable ``coefficients`` in user units are derived from them. On loading, the
+file's ``coefficients`` must agree with the derived ones to rounding
+(:data:`COEFFICIENT_RTOL`), else the file was edited by hand and is refused;
+the derived values are the ones kept.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Mapping
+from fractions import Fraction
+from typing import Any
+
+from hrgtc.drift.features import parse_terms
+from hrgtc.errors import InputError, ModelFileError
+
+SCHEMA_NAME = "hrgtc.model"
+#: 2: strict JSON (statistics that are not finite are written ``null``).
+SCHEMA_VERSION = 2
+#: Relative agreement of ``coefficients`` with those derived from ``scaled_coefficients``.
+COEFFICIENT_RTOL = 1e-9
+
+_FINITE = {"type": "number"}
+_STAT = {"anyOf": [{"type": "number"}, {"type": "null"},
+                   {"enum": ["NaN", "Infinity", "-Infinity"]}]}
+_POSITIVE = {"type": "number", "exclusiveMinimum": 0}
+_TERM = {"type": "string", "pattern": r"^[a-z]+(\^[0-9]+)?(\*[a-z]+(\^[0-9]+)?)*$"}
+_RANGE = {"type": "array", "items": _FINITE, "minItems": 2, "maxItems": 2}
+
+_THERMOMETER = {
+    "type": "object",
+    "required": ["order", "n_points", "coefficients", "standard_errors", "rsquared",
+                 "temperature_range_c", "centre_c", "scale_c", "scaled_coefficients"],
+    "properties": {
+        "kind": {"const": "hrgtc.Thermometer"},
+        "order": {"type": "integer", "minimum": 1, "maximum": 12},
+        "n_points": {"type": "integer", "minimum": 2},
+        "coefficients": {"type": "array", "items": _FINITE, "minItems": 2},
+        "standard_errors": {"type": "array", "items": _STAT},
+        "residual_std_hz": _STAT,
+        "rsquared": _STAT,
+        "temperature_range_c": _RANGE,
+        "centre_c": _FINITE,
+        "scale_c": _POSITIVE,
+        "scaled_coefficients": {"type": "array", "items": _FINITE, "minItems": 2},
+        "scaled_covariance": {"anyOf": [{"type": "null"},
+                                        {"type": "array", "items": {"type": "array",
+                                                                    "items": _STAT}}]},
+    },
+}
+
+_DRIFT = {
+    "type": "object",
+    "required": ["settings", "candidates", "selected", "intercept_dph", "coefficients",
+                 "standard_errors", "pvalues", "scaled_coefficients", "stepwise", "ranges",
+                 "window_s", "n_windows", "n_samples", "residual_std_dph", "rsquared"],
+    "properties": {
+        "kind": {"const": "hrgtc.DriftModel"},
+        "settings": {
+            "type": "object",
+            "required": ["reference_freq_hz", "sample_rate_hz", "reference_c", "rate_tau_s",
+                         "warmup_s"],
+            "properties": {
+                "reference_freq_hz": _POSITIVE,
+                "sample_rate_hz": _POSITIVE,
+                "reference_c": _FINITE,
+                "rate_tau_s": _POSITIVE,
+                "warmup_s": {"type": "number", "minimum": 0},
+                "scales": {"type": "object", "additionalProperties": _POSITIVE},
+            },
+        },
+        "candidates": {"type": "array", "items": _TERM, "minItems": 1},
+        "selected": {"type": "array", "items": _TERM},
+        "intercept_dph": _FINITE,
+        "coefficients": {"type": "object", "additionalProperties": _FINITE},
+        "standard_errors": {"type": "object", "additionalProperties": _STAT},
+        "pvalues": {"type": "object", "additionalProperties": _STAT},
+        "scaled_coefficients": {"type": "array", "items": _FINITE},
+        "stepwise": {"type": "object"},
+        "ranges": {"type": "object", "additionalProperties": _RANGE},
+        "window_s": _POSITIVE,
+        "n_windows": {"type": "integer", "minimum": 0},
+        "n_samples": {"type": "integer", "minimum": 0},
+        "residual_std_dph": _STAT,
+        "rsquared": _STAT,
+        "variance_inflation": _STAT,
+        "bandwidth_windows": {"type": "integer", "minimum": 0},
+    },
+}
+
+#: JSON Schema (Draft 2020-12) of the model file, versions 1 and 2.
+MODEL_SCHEMA: dict[str, Any] = {
+    "$schema": "https://json-schema.org/draft/2020-12/schema",
+    "$id": "https://hrgtc.invalid/schema/model.json",
+    "title": "hrgtc model file",
+    "type": "object",
+    "required": ["schema", "schema_version", "thermometer", "drift"],
+    "properties": {
+        "schema": {"const": SCHEMA_NAME},
+        "schema_version": {"type": "integer", "minimum": 1, "maximum": SCHEMA_VERSION},
+        "unit": {"type": "string"},
+        "thermometer": _THERMOMETER,
+        "drift": _DRIFT,
+        "housing": {"anyOf": [{"type": "null"}, _DRIFT]},
+        "plateaus": {"type": "array", "items": {"type": "object"}},
+        "provenance": {"type": "object"},
+        "parameters_sha256": {"type": "string", "pattern": "^[0-9a-f]{64}$"},
+    },
+}
+#: Keys left out of :func:`parameters_sha256`.
+UNHASHED = ("provenance", "parameters_sha256")
+
+
+def parameters_sha256(document: Mapping[str, Any]) -> str:
+    """SHA-256 of a model document's canonical JSON (sorted keys), provenance left out."""
+    import hashlib
+
+    content = {k: v for k, v in strict(dict(document)).items() if k not in UNHASHED}
+    text = json.dumps(content, sort_keys=True, separators=(",", ":"), allow_nan=False)
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()
+
+
+def parse_model_json(text: str) -> tuple[Any, bool]:
+    """Parse a model file's text; ``NaN``/``Infinity`` become strings the schema can name.
+
+    Returns
+    -------
+    (document, non_standard)
+        The parsed document, and whether the text held non-standard constants.
+    """
+    seen: list[str] = []
+
+    def constant(name: str) -> str:
+        seen.append(name)
+        return name
+
+    return json.loads(text, parse_constant=constant), bool(seen)
+
+
+def _path(parts: Any) -> str:
+    text = ""
+    for part in parts:
+        text += f"[{part}]" if isinstance(part, int) else (f".{part}" if text else str(part))
+    return text or "(top level)"
+
+
+def _fail(source: str, where: str, message: str) -> ModelFileError:
+    return ModelFileError(f"{source}: model file is invalid at {where}: {message}; the file is "
+                          "corrupt or was edited: recreate it with 'hrgtc calibrate'")
+
+
+def check_schema(data: Any, source: str) -> None:
+    """Validate ``data`` against :data:`MODEL_SCHEMA`; the first error names its place."""
+    import jsonschema
+
+    validator = jsonschema.Draft202012Validator(MODEL_SCHEMA)
+    error = jsonschema.exceptions.best_match(validator.iter_errors(data))
+    if error is not None:
+        message = error.message
+        if len(message) > 200:
+            message = message[:200] + "..."
+        raise _fail(source, _path(error.absolute_path), message)
+
+
+def _number(value: Any) -> float:
+    """A statistic as a float: None and the non-standard constants become NaN / ±inf."""
+    if value is None or value == "NaN":
+        return math.nan
+    if value == "Infinity":
+        return math.inf
+    if value == "-Infinity":
+        return -math.inf
+    return float(value)
+
+
+def restore_statistics(data: dict[str, Any]) -> dict[str, Any]:
+    """A copy of a checked document with every statistic a float (NaN where missing)."""
+    data = json.loads(json.dumps(data))
+    therm = data["thermometer"]
+    therm["standard_errors"] = [_number(v) for v in therm["standard_errors"]]
+    therm["rsquared"] = _number(therm["rsquared"])
+    if "residual_std_hz" in therm:
+        therm["residual_std_hz"] = _number(therm["residual_std_hz"])
+    if therm.get("scaled_covariance") is not None:
+        therm["scaled_covariance"] = [[_number(v) for v in row]
+                                      for row in therm["scaled_covariance"]]
+    for key in ("drift", "housing"):
+        drift = data.get(key)
+        if drift is None:
+            continue
+        for name in ("standard_errors", "pvalues"):
+            drift[name] = {k: _number(v) for k, v in drift[name].items()}
+        for name in ("residual_std_dph", "rsquared", "variance_inflation"):
+            if name in drift:
+                drift[name] = _number(drift[name])
+        drift["stepwise"] = _numbers_in(drift["stepwise"])
+    return data
+
+
+def _numbers_in(value: Any) -> Any:
+    if isinstance(value, dict):
+        return {k: _numbers_in(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_numbers_in(v) for v in value]
+    if value in ("NaN", "Infinity", "-Infinity"):
+        return _number(value)
+    return value
+
+
+def strict(value: Any) -> Any:
+    """``value`` with every float that is not finite replaced by None (strict JSON)."""
+    if isinstance(value, dict):
+        return {k: strict(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [strict(v) for v in value]
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+def _agree(stored: float, derived: float, magnitude: float) -> bool:
+    return abs(stored - derived) <= COEFFICIENT_RTOL * max(abs(magnitude), abs(derived)) + 1e-300
+
+
+def _check_thermometer(therm: Mapping[str, Any], source: str) -> None:
+    from hrgtc.thermometry.thermometer import _scaled_to_raw_matrix
+
+    order = therm["order"]
+    for name in ("coefficients", "scaled_coefficients", "standard_errors"):
+        if len(therm[name]) != order + 1:
+            raise _fail(source, f"thermometer.{name}",
+                        f"{len(therm[name])} values for a polynomial of order {order} "
+                        f"(expected {order + 1})")
+    low, high = therm["temperature_range_c"]
+    if not low < high:
+        raise _fail(source, "thermometer.temperature_range_c",
+                    f"[{low!r}, {high!r}] is not an ordered range (low < high)")
+    matrix = _scaled_to_raw_matrix(order, therm["centre_c"], therm["scale_c"])
+    scaled = [Fraction(v) for v in therm["scaled_coefficients"]]
+    for i, row in enumerate(matrix):
+        derived = float(sum(m * a for m, a in zip(row, scaled, strict=True)))
+        magnitude = float(sum(abs(m * a) for m, a in zip(row, scaled, strict=True)))
+        if not _agree(therm["coefficients"][i], derived, magnitude):
+            raise _fail(source, f"thermometer.coefficients[{i}]",
+                        f"{therm['coefficients'][i]!r} disagrees with {derived!r} derived from "
+                        "scaled_coefficients (the values used)")
+
+
+def derived_coefficients(drift: Mapping[str, Any]) -> dict[str, float]:
+    """User-unit coefficients from ``scaled_coefficients`` and the feature scales."""
+    scales = drift["settings"].get("scales", {})
+    terms = parse_terms(drift["selected"]) if drift["selected"] else ()
+    return {t.name: float(c) / t.scale_factor(scales)
+            for t, c in zip(terms, drift["scaled_coefficients"], strict=True)}
+
+
+def _check_reference(drift: Mapping[str, Any], therm: Mapping[str, Any], where: str,
+                     source: str) -> None:
+    """f_ref must be the thermometer's frequency at the reference temperature."""
+    import numpy as np
+
+    settings = drift["settings"]
+    u = (settings["reference_c"] - therm["centre_c"]) / therm["scale_c"]
+    expected = float(np.polynomial.polynomial.polyval(u, therm["scaled_coefficients"]))
+    if not _agree(settings["reference_freq_hz"], expected, expected * 1e-3):
+        raise _fail(source, f"{where}.settings.reference_freq_hz",
+                    f"{settings['reference_freq_hz']!r} Hz is not the thermometer's frequency "
+                    f"{expected!r} Hz at the reference {settings['reference_c']!r} °C")
+
+
+def _check_drift(drift: Mapping[str, Any], where: str, source: str) -> dict[str, float]:
+    for name in ("candidates", "selected"):
+        try:
+            terms = parse_terms(drift[name]) if drift[name] else ()
+        except InputError as exc:
+            raise _fail(source, f"{where}.{name}", str(exc)) from None
+        variables = {v for t in terms for v in t.variables}
+        if name == "candidates":
+            candidates = {t.name for t in terms}
+        missing_scale = sorted(v for v in variables
+                               if v not in drift["settings"].get("scales", {}))
+        if name == "selected" and missing_scale:
+            raise _fail(source, f"{where}.settings.scales",
+                        f"no scale for variable(s) {missing_scale}")
+    selected = [t.name for t in (parse_terms(drift["selected"]) if drift["selected"] else ())]
+    unknown = [t for t in selected if t not in candidates]
+    if unknown:
+        raise _fail(source, f"{where}.selected", f"term(s) {unknown} are not among the candidates")
+    if len(drift["scaled_coefficients"]) != len(selected):
+        raise _fail(source, f"{where}.scaled_coefficients",
+                    f"{len(drift['scaled_coefficients'])} values for {len(selected)} selected "
+                    "term(s)")
+    if set(drift["coefficients"]) != set(selected):
+        raise _fail(source, f"{where}.coefficients",
+                    f"terms {sorted(drift['coefficients'])} differ from the selected "
+                    f"{sorted(selected)}")
+    for variable in {v for t in parse_terms(selected) for v in t.variables} if selected else ():
+        if variable not in drift["ranges"]:
+            raise _fail(source, f"{where}.ranges", f"no training range for variable {variable!r}")
+    for variable, (low, high) in drift["ranges"].items():
+        if not low <= high:
+            raise _fail(source, f"{where}.ranges.{variable}",
+                        f"[{low!r}, {high!r}] is reversed (low > high)")
+    derived = derived_coefficients(drift)
+    for name, value in derived.items():
+        if not _agree(drift["coefficients"][name], value, value):
+            raise _fail(source, f"{where}.coefficients.{name}",
+                        f"{drift['coefficients'][name]!r} disagrees with {value!r} derived from "
+                        "scaled_coefficients (the values used)")
+    return derived
+
+
+def check_document(data: Any, source: str, non_standard: bool = False) -> dict[str, Any]:
+    """Validate a parsed model file; return it with statistics as floats, coefficients derived.
+
+    Parameters
+    ----------
+    data
+        The parsed document (:func:`parse_model_json`).
+    source
+        The file, named in every message.
+    non_standard
+        The text held ``NaN`` or ``Infinity`` (allowed for statistics in version 1 only).
+
+    Raises
+    ------
+    ModelFileError
+        Names the place in the file (e.g. ``drift.ranges.f``), what is wrong and the fix.
+    """
+    version = data.get("schema_version") if isinstance(data, Mapping) else None
+    if non_standard and isinstance(version, int) and version >= 2:
+        raise ModelFileError(f"{source}: model file holds NaN or Infinity, which is not JSON "
+                             f"(schema version {version} is strict JSON); it is corrupt or was "
+                             "edited: recreate it with 'hrgtc calibrate'")
+    check_schema(data, source)
+    stored = data.get("parameters_sha256")
+    if stored is not None and stored != parameters_sha256(data):
+        raise ModelFileError(
+            f"{source}: model file was changed after it was written (its content no longer "
+            "matches its parameters_sha256): damaged or edited; recreate it with 'hrgtc "
+            "calibrate' (after a deliberate edit, delete the parameters_sha256 line)")
+    _check_thermometer(data["thermometer"], source)
+    restored = restore_statistics(data)
+    restored["drift"]["coefficients"] = _check_drift(data["drift"], "drift", source)
+    _check_reference(data["drift"], data["thermometer"], "drift", source)
+    if data.get("housing") is not None:
+        restored["housing"]["coefficients"] = _check_drift(data["housing"], "housing", source)
+    restored.pop("parameters_sha256", None)
+    return restored

@@ -1,0 +1,178 @@
+"""The single checks of a recording: the :class:`Problem` they report, and the unit heuristics.
+
+:mod:`hrgtc.recording.validation` runs them (see its docstring for the rules);
+they live here so that each stays a small function of arrays: the measured
+sample rate, the time unit implied by it, the frequency unit from the median,
+and the rate unit from the median magnitude and the noise of 1 s block means.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass
+from typing import Any
+
+import numpy as np
+
+SAMPLE_RATE_TOLERANCE = 0.01  # relative disagreement of measured and nominal rate
+KHZ_BELOW_HZ = 100.0
+FREQ_MAX_HZ = 1e6
+RATE_LEVEL_DPH = 1.0
+RATE_NOISE_DPH = 1e-3
+RATE_TABLE_DPH = 3600.0
+DEG_PER_RAD_X3600 = 180.0 / math.pi * 3600.0  # °/h per rad/s
+#: Scale of 1 s block means below which a rate column is not in °/h (see validation's docstring).
+RATE_BLOCK_NOISE_DPH = 1e-2
+#: Below this inferred sample rate the time column is suspected to be in milliseconds.
+SLOW_SAMPLE_RATE_HZ = 0.5
+
+
+@dataclass(frozen=True)
+class Problem:
+    """One way in which a recording breaks the contract.
+
+    Parameters
+    ----------
+    kind
+        One of ``"empty"``, ``"missing_column"``, ``"not_finite"``, ``"time_order"``,
+        ``"gap"``, ``"sample_rate"``, ``"freq_unit"``, ``"rate_unit"``, ``"time_unit"``,
+        ``"implausible"``.
+    message
+        Full sentence naming column, row, value and the fix.
+    column
+        Column concerned, if any.
+    row
+        First bad row (0 = first data row), if any.
+    value
+        The bad value as text, if any.
+    count
+        Number of rows (or gaps) with this problem found.
+    """
+
+    kind: str
+    message: str
+    column: str | None = None
+    row: int | None = None
+    value: str | None = None
+    count: int = 1
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types."""
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> Problem:
+        """Inverse of :meth:`to_dict`."""
+        return cls(**dict(data))
+
+
+
+def measured_sample_rate(time_s: np.ndarray) -> float | None:
+    """Reciprocal of the median positive finite time step, None if there is none.
+
+    Parameters
+    ----------
+    time_s
+        Sample times. [s]
+
+    Returns
+    -------
+    float or None
+        Sample rate. [Hz]
+    """
+    step = np.diff(np.asarray(time_s, dtype=np.float64))
+    step = step[np.isfinite(step) & (step > 0)]
+    if step.size == 0:
+        return None
+    return float(1.0 / np.median(step))
+
+
+def _check_sample_rate(nominal_hz: float, measured_hz: float | None) -> Problem | None:
+    if measured_hz is None or abs(measured_hz / nominal_hz - 1.0) <= SAMPLE_RATE_TOLERANCE:
+        return None
+    fix = f"fix the metadata (--rate-hz {measured_hz:.6g})"
+    if abs(measured_hz * 1000.0 / nominal_hz - 1.0) <= 0.05:
+        fix = "the time column looks like milliseconds: pass --time-unit ms"
+    return Problem(
+        "sample_rate",
+        f"column 'time_s': the median time step {1.0 / measured_hz:.6g} s means "
+        f"{measured_hz:.6g} Hz but the metadata says sample_rate_hz = {nominal_hz:g}; {fix}",
+        column="time_s",
+        value=f"{measured_hz:.6g}",
+    )
+
+
+def _check_time_unit(measured_hz: float | None, time_s: np.ndarray) -> Problem | None:
+    """A sample rate inferred below :data:`SLOW_SAMPLE_RATE_HZ`: time in ms, most likely."""
+    if measured_hz is None or measured_hz >= SLOW_SAMPLE_RATE_HZ:
+        return None
+    hours = (float(time_s[-1]) - float(time_s[0])) / 3600.0
+    return Problem(
+        "time_unit",
+        f"column 'time_s': the time steps ({1.0 / measured_hz:.6g}) taken as seconds mean "
+        f"{measured_hz:.6g} Hz ({hours:.4g} h in the first {time_s.size} rows), slower than "
+        f"any gyro logger; if the time column is in milliseconds pass --time-unit ms "
+        f"(that is {measured_hz * 1000.0:.6g} Hz); if the rate really is {measured_hz:.6g} Hz "
+        f"confirm it with --rate-hz {measured_hz:.6g}",
+        column="time_s", value=f"{measured_hz:.6g}")
+
+
+def _block_noise(rate: np.ndarray, sample_rate_hz: float) -> float:
+    """Robust scale of 1 s block means (MAD of their differences / √2): any sample rate."""
+    rows = max(1, round(sample_rate_hz))
+    blocks = rate.size // rows
+    if blocks < 3:
+        return math.nan
+    means = rate[: blocks * rows].reshape(blocks, rows).mean(axis=1)
+    step = np.diff(means)
+    return float(1.4826 * np.median(np.abs(step - np.median(step))) / math.sqrt(2.0))
+
+
+def _check_freq_unit(freq: np.ndarray) -> Problem | None:
+    freq = freq[np.isfinite(freq)]
+    if freq.size == 0:
+        return None
+    median = float(np.median(freq))
+    if 0 < median < KHZ_BELOW_HZ and KHZ_BELOW_HZ <= median * 1000.0 <= FREQ_MAX_HZ:
+        message = f"freq_hz looks like kHz (median {median:.6g}); pass --freq-unit kHz"
+    elif median <= 0 or median < KHZ_BELOW_HZ or median > FREQ_MAX_HZ:
+        message = (
+            f"freq_hz is implausible (median {median:.6g} Hz; the resonator frequency of an "
+            "HRG is a few hundred Hz to a few tens of kHz); check the column mapping "
+            "(--col freq_hz=<your column>) and the unit (--freq-unit Hz|kHz)"
+        )
+    else:
+        return None
+    return Problem("freq_unit", message, column="freq_hz", value=f"{median:.6g}")
+
+
+def _check_rate_unit(rate: np.ndarray, input_rate_dph: float,
+                     sample_rate_hz: float = 1.0) -> Problem | None:
+    rate = rate[np.isfinite(rate)]
+    if rate.size < 2:
+        return None
+    with np.errstate(over="ignore", invalid="ignore"):  # 1e300 is reported by the bounds
+        level = float(np.median(np.abs(rate)))
+        noise = float(np.std(np.diff(rate)) / math.sqrt(2.0))
+        block_noise = _block_noise(rate, sample_rate_hz)
+    quiet_and_small = level < RATE_LEVEL_DPH and (
+        noise < RATE_NOISE_DPH or 0.0 < block_noise < RATE_BLOCK_NOISE_DPH)
+    scaled_input = False
+    if abs(input_rate_dph) >= RATE_TABLE_DPH:
+        ratio = float(np.median(rate)) / input_rate_dph
+        scaled_input = any(0.5 <= ratio * factor <= 2.0 for factor in (3600.0, DEG_PER_RAD_X3600))
+    if not (quiet_and_small or scaled_input):
+        return None
+    options = ["--rate-unit dps (°/s)", "--rate-unit radps (rad/s)"]
+    if level * 3600.0 < 0.5:
+        options.reverse()  # below 0.5 °/h even if it were °/s: rad/s is more likely
+    return Problem(
+        "rate_unit",
+        f"rate_dph looks like °/s or rad/s, not °/h (median |rate| {level:.3g}, noise of "
+        f"1 s means {block_noise:.3g}; a gyro recorded in °/h reads ≳ {RATE_LEVEL_DPH:g} °/h "
+        f"with ≳ {RATE_BLOCK_NOISE_DPH:g} °/h noise in 1 s means); pass "
+        f"{' or '.join(options)}",
+        column="rate_dph",
+        value=f"{level:.3g}",
+    )

@@ -1,0 +1,70 @@
+"""The mark of a compensated recording, so that no run is compensated twice.
+
+``hrgtc compensate`` writes its output with ``extra["compensated_by"]`` in the
+metadata (Parquet schema metadata, CSV header, HDF5 attributes)::
+
+    {"model_sha256": "...", "model_unit": "SN 12", "hrgtc_version": "0.1.0",
+     "drift": "frequency"}
+
+and with the columns ``rate_comp_dph`` and ``bias_model_dph`` beside the raw
+``rate_dph``. :func:`compensation_mark` finds either: the metadata survive a
+renaming of the columns (``--col rate_dph=rate_comp_dph``), the column names
+survive a tool that drops the metadata (e.g. a spreadsheet's CSV export). A file
+stripped of both cannot be told from a raw run.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from hrgtc.errors import RecordingError
+
+#: Metadata key of the mark.
+COMPENSATED_KEY = "compensated_by"
+#: Columns only a compensated output has.
+COMPENSATED_COLUMNS = ("rate_comp_dph", "bias_model_dph")
+
+
+def mark(model_sha256: str, model_unit: str, drift: str = "frequency") -> dict[str, Any]:
+    """The ``compensated_by`` record of an output compensated by one model."""
+    from hrgtc._meta import __version__
+
+    return {"model_sha256": model_sha256, "model_unit": model_unit,
+            "hrgtc_version": __version__, "drift": drift}
+
+
+def compensation_mark(metadata: Mapping[str, Any],
+                      names: list[str] | tuple[str, ...]) -> dict[str, Any] | None:
+    """The mark found in a file's raw metadata or column names, None if there is none."""
+    extra = metadata.get("extra") if isinstance(metadata.get("extra"), Mapping) else {}
+    found = extra.get(COMPENSATED_KEY, metadata.get(COMPENSATED_KEY))
+    if found is not None:
+        return dict(found) if isinstance(found, Mapping) else {"model_sha256": str(found)}
+    columns = [c for c in COMPENSATED_COLUMNS if c in names]
+    if columns:
+        return {"columns": columns}
+    return None
+
+
+def describe_mark(found: Mapping[str, Any]) -> str:
+    """The model named by a mark, e.g. ``model 3f2a9c01b7e4 (unit SN 12, hrgtc 0.1.0)``."""
+    if "columns" in found and "model_sha256" not in found:
+        return f"an unknown model (it has the columns {', '.join(found['columns'])})"
+    sha = str(found.get("model_sha256", "?"))[:12]
+    unit = found.get("model_unit", "?")
+    version = found.get("hrgtc_version", "?")
+    return f"model {sha} (unit {unit}, hrgtc {version})"
+
+
+def refuse_compensated(path: str | Path) -> None:
+    """Raise RecordingError if the file at ``path`` is the output of a compensation."""
+    from hrgtc.recording.io import open_source
+
+    with open_source(path) as source:
+        found = compensation_mark(source.metadata, list(source.names))
+    if found is not None:
+        raise RecordingError(
+            f"{path} is already compensated, by {describe_mark(found)}; compensating or "
+            "evaluating it again would subtract the drift twice: use the original recording")

@@ -1,0 +1,174 @@
+"""Tests of hrgtc.model_schema: model files are validated, never trusted (issue 11)."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from hrgtc import drift
+from hrgtc.errors import ModelFileError
+from hrgtc.model import SCHEMA_VERSION, UnitModel, load_model, save_model
+from hrgtc.model_schema import MODEL_SCHEMA, derived_coefficients
+
+from synthetic import THERMOMETER, ramp_run
+
+
+@pytest.fixture(scope="module")
+def unit_model():
+    return UnitModel(thermometer=THERMOMETER,
+                     drift=drift.fit([ramp_run(seed=11, hours=3.0)], THERMOMETER), unit="SN-1")
+
+
+@pytest.fixture()
+def document(unit_model):
+    return json.loads(json.dumps(unit_model.to_dict()))
+
+
+def _write(tmp_path, data, name="unit.json", text=None):
+    path = tmp_path / name
+    path.write_text(text if text is not None else json.dumps(data, allow_nan=True))
+    return path
+
+
+def test_the_schema_is_a_valid_json_schema():
+    import jsonschema
+
+    jsonschema.Draft202012Validator.check_schema(MODEL_SCHEMA)
+
+
+def test_written_file_is_strict_json_and_loads_back(tmp_path, unit_model):
+    model = UnitModel(unit_model.thermometer, unit_model.drift, unit="SN-1",
+                      provenance={"note": math.nan})  # a statistic-like NaN anywhere
+    path = save_model(model, tmp_path / "unit.json")
+    text = path.read_text()
+
+    def refuse(name):
+        raise AssertionError(f"non-standard constant {name} in the model file")
+
+    data = json.loads(text, parse_constant=refuse)
+    assert data["schema_version"] == SCHEMA_VERSION == 2
+    assert data["provenance"]["note"] is None
+    again = load_model(path)
+    assert again.sha256 == unit_model.sha256
+
+
+@pytest.mark.parametrize("where, value, match", [
+    (("drift", "scaled_coefficients", 0), math.nan, r"drift.scaled_coefficients\[0\]: 'NaN'"),
+    (("drift", "scaled_coefficients", 0), math.inf, r"drift.scaled_coefficients\[0\]: "
+                                                      r"'Infinity'"),
+    (("drift", "intercept_dph"), math.nan, r"drift.intercept_dph: 'NaN' is not of type"),
+    (("thermometer", "scaled_coefficients", 1), math.nan,
+     r"thermometer.scaled_coefficients\[1\]: 'NaN'"),
+    (("thermometer", "coefficients", 0), math.nan, r"thermometer.coefficients\[0\]: 'NaN'"),
+    (("drift", "settings", "scales", "f"), -1.0, r"drift.settings.scales.f: -1.0 is less"),
+])
+def test_non_finite_parameters_are_refused(tmp_path, document, where, value, match):
+    # old files (version 1) were written with allow_nan: a bare NaN must be named, not used
+    document["schema_version"] = 1
+    target = document
+    for key in where[:-1]:
+        target = target[key]
+    target[where[-1]] = value
+    with pytest.raises(ModelFileError, match=match):
+        load_model(_write(tmp_path, document))
+
+
+def test_readable_coefficients_must_agree_with_the_scaled_ones(tmp_path, document):
+    document["schema_version"] = 1  # a bare NaN: what older hrgtc wrote
+    name = document["drift"]["selected"][0]
+    document["drift"]["coefficients"][name] = math.nan
+    with pytest.raises(ModelFileError, match=rf"drift.coefficients.{name}: 'NaN'"):
+        load_model(_write(tmp_path, document))
+    document["drift"]["coefficients"][name] = 1.5 * derived_coefficients(document["drift"])[name]
+    with pytest.raises(ModelFileError, match=r"disagrees with .* derived from scaled_coeff"):
+        load_model(_write(tmp_path, document))
+    document["thermometer"]["coefficients"][3] *= 1.001
+    document["drift"]["coefficients"] = derived_coefficients(document["drift"])
+    with pytest.raises(ModelFileError, match=r"thermometer.coefficients\[3\].* disagrees"):
+        load_model(_write(tmp_path, document))
+
+
+def test_reversed_range_short_and_unknown_terms(tmp_path, document):
+    good = json.dumps(document)
+    bad = json.loads(good)
+    bad["drift"]["ranges"]["f"] = bad["drift"]["ranges"]["f"][::-1]
+    with pytest.raises(ModelFileError, match=r"drift.ranges.f: .* is reversed"):
+        load_model(_write(tmp_path, bad))
+    bad = json.loads(good)
+    bad["drift"]["scaled_coefficients"] = bad["drift"]["scaled_coefficients"][:-1]
+    with pytest.raises(ModelFileError, match=r"drift.scaled_coefficients: \d+ values for \d+"):
+        load_model(_write(tmp_path, bad))
+    bad = json.loads(good)
+    bad["drift"]["selected"][0] = "g^2"
+    with pytest.raises(ModelFileError, match=r"drift.selected: .*g"):
+        load_model(_write(tmp_path, bad))
+    bad = json.loads(good)
+    bad["thermometer"]["temperature_range_c"] = [40.0, -20.0]
+    with pytest.raises(ModelFileError, match=r"thermometer.temperature_range_c: .* ordered"):
+        load_model(_write(tmp_path, bad))
+    bad = json.loads(good)
+    bad["thermometer"]["order"] = 5
+    with pytest.raises(ModelFileError, match=r"thermometer.coefficients: 4 values .* order 5"):
+        load_model(_write(tmp_path, bad))
+
+
+def test_old_version_with_nan_statistics_still_loads(tmp_path, document, unit_model):
+    document["schema_version"] = 1
+    name = document["drift"]["selected"][0]
+    document["drift"]["pvalues"][name] = math.nan
+    document["drift"]["rsquared"] = math.nan
+    path = _write(tmp_path, document)
+    assert "NaN" in path.read_text()
+    model = load_model(path)
+    assert math.isnan(model.drift.pvalues[name])
+    values = {"f": np.linspace(-10, 5, 7), "df": np.linspace(-1e-3, 1e-3, 7)}
+    np.testing.assert_array_equal(model.drift.predict(values), unit_model.drift.predict(values))
+
+
+def test_new_version_must_be_strict_json(tmp_path, document):
+    document["drift"]["pvalues"][document["drift"]["selected"][0]] = math.nan
+    with pytest.raises(ModelFileError, match=r"holds NaN or Infinity, which is not JSON"):
+        load_model(_write(tmp_path, document))
+
+
+def test_foreign_and_future_files_say_what_they_are(tmp_path, document):
+    with pytest.raises(ModelFileError, match=r"not an hrgtc model file \(schema 'x.y'"):
+        load_model(_write(tmp_path, {"schema": "x.y", "a": 1}))
+    with pytest.raises(ModelFileError, match=r"not an hrgtc model file \(schema 'list'"):
+        load_model(_write(tmp_path, [1, 2]))
+    with pytest.raises(ModelFileError, match=r"version 9 is newer"):
+        load_model(_write(tmp_path, {**document, "schema_version": 9}))
+
+
+def test_a_model_that_cannot_be_valid_is_never_saved(tmp_path, unit_model):
+    broken = UnitModel(unit_model.thermometer, unit_model.drift.__class__(**{
+        **{f: getattr(unit_model.drift, f) for f in unit_model.drift.__dataclass_fields__
+           if f != "_terms"},
+        "intercept_dph": math.nan}))
+    with pytest.raises(ModelFileError, match=r"drift.intercept_dph: None is not of type"):
+        save_model(broken, tmp_path / "unit.json")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_file_changed_after_writing_is_refused_unless_the_checksum_line_goes(tmp_path,
+                                                                              unit_model):
+    path = save_model(unit_model, tmp_path / "unit.json")
+    data = json.loads(path.read_text())
+    assert data["parameters_sha256"] == unit_model.sha256
+    low, high = data["drift"]["ranges"]["f"]
+    data["drift"]["ranges"]["f"] = [low, high + 0.5]  # still a valid model: wrong numbers
+    edited = _write(tmp_path, data, "edited.json")
+    with pytest.raises(ModelFileError, match=r"edited.json: model file was changed after it was "
+                                             r"written"):
+        load_model(edited)
+    del data["parameters_sha256"]  # a deliberate edit
+    assert load_model(_write(tmp_path, data, "deliberate.json")).drift.ranges["f"][1] == high + 0.5
+
+
+def test_reference_frequency_must_match_the_thermometer(tmp_path, document):
+    document["drift"]["settings"]["reference_freq_hz"] *= 1.5
+    with pytest.raises(ModelFileError, match=r"reference_freq_hz: .* is not the thermometer's"):
+        load_model(_write(tmp_path, document))
