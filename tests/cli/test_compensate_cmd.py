@@ -13,10 +13,13 @@ import json
 import math
 import os
 import re
+import shutil
 import signal
 import subprocess
 import sys
+import tempfile
 import textwrap
+from pathlib import Path
 
 import numpy as np
 import pyarrow as pa
@@ -252,18 +255,33 @@ def test_compensated_output_is_marked_and_refused(files, tmp_path, model):
 
 # -- tracebacks instead of errors ------------------------------------------------------------
 def test_unwritable_directory_fails_before_the_work(files, tmp_path):
-    if os.geteuid() == 0:
-        pytest.skip("root writes everywhere")
+    """A real read-only directory; as root (CI), the command runs as 'nobody' (setpriv)."""
     _, model_path, run = files
-    locked = tmp_path / "locked"
-    locked.mkdir()
-    locked.chmod(0o500)
+    shared = Path(tempfile.mkdtemp(prefix="hrgtc-unwritable-"))
     try:
-        code, _, stderr = compensate(write(run, tmp_path / "r.parquet"), model_path,
-                                     locked / "out.parquet")
+        shared.chmod(0o755)
+        source = write(run, shared / "r.parquet")
+        model = shared / "unit.json"
+        model.write_bytes(Path(model_path).read_bytes())
+        for path in (source, model):
+            path.chmod(0o644)
+        locked = shared / "locked"
+        locked.mkdir()
+        locked.chmod(0o555)
+        if os.geteuid() == 0:
+            command = ["setpriv", "--reuid=65534", "--regid=65534", "--clear-groups",
+                       sys.executable, "-m", "hrgtc.cli", "compensate", str(source),
+                       "--model", str(model), "-o", str(locked / "out.parquet")]
+            done = subprocess.run(command, capture_output=True, text=True, timeout=300,
+                                  env={**os.environ, "HOME": str(shared),
+                                       "NUMBA_CACHE_DIR": str(shared / "numba")})
+            code, stderr = done.returncode, done.stderr
+        else:
+            code, _, stderr = compensate(source, model, locked / "out.parquet")
+        assert code == 2 and "is not writable" in _squash(stderr), stderr
+        assert not list(locked.iterdir())
     finally:
-        locked.chmod(0o700)
-    assert code == 2 and "is not writable" in stderr
+        shutil.rmtree(shared, ignore_errors=True)
 
 
 def test_permission_and_full_disk_are_one_line_errors(files, tmp_path, monkeypatch):

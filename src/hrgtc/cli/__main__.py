@@ -1,0 +1,5 @@
+"""``python -m hrgtc.cli``: the ``hrgtc`` command."""
+
+from hrgtc.cli import main
+
+main()
