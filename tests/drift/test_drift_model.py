@@ -132,3 +132,28 @@ def test_hierarchical_fit_keeps_every_parent(cooldown, model):
         assert set(parents[name]) <= set(marginal.selected), (name, marginal.selected)
     orphans = [n for n in model.selected if not set(parents[n]) <= set(model.selected)]
     assert orphans or marginal.selected == model.selected  # the option changed the fit, or needn't
+
+
+def test_prediction_std_equals_monte_carlo_over_the_coefficients(model, cooldown):
+    import dataclasses
+
+    from hrgtc.drift.features import compute_variables
+
+    cov = np.asarray(model.stepwise.result.cov_params)
+    # the covariance of the final fit (inflated by Newey-West) gives the standard errors
+    assert np.sqrt(cov[0, 0]) == pytest.approx(model.standard_errors["const"], rel=1e-9)
+    assert model.variance_inflation > 1.0
+    values = compute_variables(cooldown, model.settings, model.variables)
+    values = {v: x[::500] for v, x in values.items()}
+    low, high = model.ranges["f"]
+    values["f"] = np.concatenate([values["f"], [high + 0.5 * (high - low)]])  # beyond: tangent
+    values["df"] = np.concatenate([values["df"], [0.0]])
+    std = model.prediction_std(values)
+    mean = np.array([model.intercept_dph, *model.scaled_coefficients])
+    draws = np.random.default_rng(3).multivariate_normal(mean, cov, size=4000)
+    predictions = np.array([
+        dataclasses.replace(model, intercept_dph=float(d[0]),
+                            scaled_coefficients=tuple(map(float, d[1:]))).predict(values)
+        for d in draws])
+    np.testing.assert_allclose(std, predictions.std(axis=0), rtol=0.06)
+    assert std.min() > 0.0 and std[-1] > np.median(std)  # grows beyond the training range

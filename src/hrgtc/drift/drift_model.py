@@ -162,6 +162,29 @@ class DriftModel:
                              f"got {extrapolation!r}")
         return linear_combination(*args, values, self.settings.scales, self.intercept_dph)
 
+    def prediction_std(self, values: Mapping[str, np.ndarray]) -> np.ndarray:
+        """1σ uncertainty of :meth:`predict` from the coefficients' covariance. [°/h]
+
+        The model is linear in its coefficients, also where it is continued along its
+        tangent, so ``B(x) = J(x)·β`` with ``J`` the intercept's 1 and each term's
+        value (tangent-extended, on the scaled variables) and the variance of the
+        prediction is ``J Σ Jᵀ``, Σ the covariance of the scaled coefficients of the
+        final fit (``stepwise.result.cov_params``, which already carries the
+        Newey-West ``variance_inflation`` of the window residuals). It is the
+        uncertainty of the fitted line, not of the gyro's noise around it.
+        """
+        cov = np.asarray(self.stepwise.result.cov_params, dtype=np.float64)
+        n = next(iter(values.values())).shape[0]
+        columns = [np.ones(n)]
+        for k in range(len(self._terms)):
+            unit = np.zeros(len(self._terms))
+            unit[k] = 1.0
+            columns.append(tangent_extension(self._terms, unit, values, self.settings.scales,
+                                             self.ranges, 0.0))
+        jacobian = np.column_stack(columns)
+        variance = np.einsum("ij,jk,ik->i", jacobian, cov, jacobian)
+        return np.sqrt(np.maximum(variance, 0.0))
+
     def predict_recording(self, recording: Recording) -> np.ndarray:
         """Bias of a whole recording, filter started at its first sample. [°/h]"""
         self.settings.check_sample_rate(recording)
