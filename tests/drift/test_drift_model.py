@@ -11,7 +11,7 @@ from hrgtc import drift
 from hrgtc.errors import CalibrationError, InputError
 from hrgtc.recording import Metadata, Recording
 
-from synthetic import THERMOMETER, block_std, ramp_run
+from synthetic import THERMOMETER, block_std, ramp_run, with_heating_extra
 
 
 @pytest.fixture(scope="module")
@@ -157,3 +157,29 @@ def test_prediction_std_equals_monte_carlo_over_the_coefficients(model, cooldown
         for d in draws])
     np.testing.assert_allclose(std, predictions.std(axis=0), rtol=0.06)
     assert std.min() > 0.0 and std[-1] > np.median(std)  # grows beyond the training range
+
+
+def test_heating_switch_dpos_carries_a_heating_only_rate_term(cooldown):
+    from hrgtc.drift.features import EQ21_TERMS, SWITCH_FRACTION, heating_part
+
+    warm = with_heating_extra(ramp_run(seed=5, start_c=-20.0, end_c=20.0))
+    runs = [cooldown, warm]
+    with_switch = drift.fit(runs, THERMOMETER, terms=(*EQ21_TERMS, "dpos"))
+    plain = drift.fit(runs, THERMOMETER)
+    assert "dpos" in with_switch.selected
+    assert with_switch.coefficients["dpos"] == pytest.approx(2000.0, rel=0.25)
+    delta = with_switch.settings.switch_hz_per_s
+    assert delta > 0.0
+    rates = drift.fit([cooldown], THERMOMETER).ranges["df"]
+    assert delta < SWITCH_FRACTION * 2.0 * max(abs(rates[0]), abs(rates[1])) + 1e-12
+    back = drift.DriftModel.from_dict(json.loads(json.dumps(with_switch.to_dict())))
+    assert back.settings.switch_hz_per_s == delta
+    held_out = with_heating_extra(ramp_run(seed=6, start_c=-15.0, end_c=15.0))
+    truth, rows = held_out["bias_dph"], int(10 * held_out.sample_rate_hz)
+    skip = int(with_switch.settings.warmup_s * held_out.sample_rate_hz)
+    errors = [block_std((truth - m.predict_recording(held_out))[skip:], rows)
+              for m in (with_switch, plain)]
+    assert errors[0] < 0.7 * errors[1]
+    assert heating_part(np.array([-5.0 * delta]), delta)[0] == pytest.approx(0.0, abs=1e-3 * delta)
+    with pytest.raises(InputError, match="switch_hz_per_s"):
+        drift.features.FeatureStream(plain.settings, ("f", "dpos")).process(cooldown)

@@ -33,6 +33,7 @@ import numpy as np
 from hrgtc.drift.cross_validation import CrossValidation, cross_validate, select_terms
 from hrgtc.drift.features import (
     EQ21,
+    SWITCH_FRACTION,
     VARIABLES,
     FeatureSettings,
     FeatureStream,
@@ -403,6 +404,11 @@ def fit(
         rate_tau_s=rate_tau_s,
         warmup_s=5.0 * rate_tau_s if warmup_s is None else warmup_s,
     )
+    if "dpos" in variables_for(candidates):  # δ of the heating/cooling switch: a first pass
+        rates = window_means(runs, settings, parse_terms(["df"]), window_s).variables["df"]
+        spread = float(np.std(rates))
+        settings = FeatureSettings(**{**settings.to_dict(), "switch_hz_per_s": (
+            SWITCH_FRACTION * spread if spread > 0.0 else 1.0)})
     windows = window_means(runs, settings, candidates, window_s, progress)
     variables = variables_for(candidates)
     for run in range(min(excitation_runs, len(windows.sources))):
