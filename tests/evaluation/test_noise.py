@@ -57,3 +57,15 @@ def test_a_pure_ramp_has_no_arw():
     back = NoiseTerms.from_dict(json.loads(json.dumps(terms.to_dict())))
     assert back == terms
     assert "n/a (no −½ slope" in terms.summary()
+
+
+def test_too_few_points_on_a_slope_say_how_many():
+    from hrgtc.evaluation import AllanResult
+
+    taus = 2.0 ** np.arange(8)
+    dev = np.array([1.0, 0.72, 0.52, 0.4, 0.35, 0.33, 0.34, 0.48])  # rises as +½ only at the end
+    allan = AllanResult(taus_s=taus, deviation=dev, counts=np.full(8, 10**6), overlapping=True,
+                        sample_rate_hz=1.0, n_samples=10**6)
+    terms = noise_terms(allan)
+    assert terms.rrw_dph_per_rt_h is None
+    assert terms.rrw_reason.startswith("no +½ slope: 1 point(s) right of the minimum")

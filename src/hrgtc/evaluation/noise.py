@@ -210,8 +210,9 @@ def noise_terms(
         arw_reason = (f"no −½ slope: the curve does not fall from its first τ ({taus[0]:g} s; "
                       f"it goes as {_law(slope[0])})")
     else:
-        arw_reason = (f"no −½ slope: left of the minimum the curve falls as "
-                      f"{_law(float(np.median(slope[: i_min + 1])))}")
+        arw_reason = (f"no −½ slope: {int(pick.sum())} point(s) left of the minimum within "
+                      f"±{tol:g} of −½ (needs {min_points}); the curve goes as "
+                      f"{_law(float(np.median(slope[: i_min + 1])))} there")
 
     floor = i_min < last
     bias = bias_reason = None
@@ -238,8 +239,9 @@ def noise_terms(
         rrw_reason = (f"no +½ slope: the curve does not rise within the usable τ "
                       f"(up to {taus[last]:g} s)")
     elif pick.sum() < min_points:
-        rrw_reason = (f"no +½ slope: right of the minimum the curve goes as "
-                      f"{_law(float(np.median(slope[i_min + 1:])))}")
+        rrw_reason = (f"no +½ slope: {int(pick.sum())} point(s) right of the minimum within "
+                      f"±{tol:g} of +½ (needs {min_points}); the curve goes as "
+                      f"{_law(float(np.median(slope[i_min + 1:])))} there")
     else:
         # ln σ = ln(K_s/√3) + ½ ln τ, K in °/h/√s; σ at τ = 3 h equals K_s·60.
         log_k = np.average(log_dev[pick] - 0.5 * log_tau[pick], weights=weights[pick])
