@@ -320,11 +320,9 @@ def _run(page: _Page, k: int, run: Evaluation, model: UnitModel) -> None:
     housing = "housing" in run.bias_stability_dph
     rows = []
     for tau in run.bias_stability_dph["raw"]:
-        rows.append((f"{tau:g}", run.stability_text("raw", tau).replace("-", "–"),
-                     run.stability_text("compensated", tau).replace("-", "–"),
-                     _number(_ratio(run, tau), 3),
-                     *([run.stability_text("housing", tau).replace("-", "–")] if housing
-                       else []),
+        rows.append((f"{tau:g}", _stability(run, "raw", tau),
+                     _stability(run, "compensated", tau), _number(_ratio(run, tau), 3),
+                     *([_stability(run, "housing", tau)] if housing else []),
                      *((_number(paper.BIAS_STABILITY_RAW_DPH, 5),
                         _number(paper.BIAS_STABILITY_COMPENSATED_DPH, 4)) if tau == 10.0
                        else ("–", "–"))))
@@ -359,12 +357,18 @@ def _run(page: _Page, k: int, run: Evaluation, model: UnitModel) -> None:
                     "SP 1065 gives one; squares mark a flat bias-instability minimum.",
                     f"Allan deviation of {run.name}")
         names = {"raw": "raw", "compensated": "compensated", "housing": "housing baseline"}
-        rows = [(names[key], escape(n.text("arw")), escape(n.text("bias_instability")),
-                 escape(n.text("rrw"))) for key, n in run.noise.items()]
+        rows = [(names[key], n.text("arw"), n.text("bias_instability"), n.text("rrw"))
+                for key, n in run.noise.items()]  # _table escapes the cells
         page.add(_table(("output", "ARW [°/√h]", "bias instability [°/h]",
                              "RRW [°/h/√h]"), rows,
                             f"Allan noise terms of {run.name} (IEEE Std 952-1997, Annex C)"))
     page.add("</section>")
+
+
+def _stability(run: Evaluation, series: str, tau_s: float) -> str:
+    """A bias stability with its interval, "–" where there is none."""
+    text = run.stability_text(series, tau_s)
+    return "–" if text == "-" else text
 
 
 def _excluded(d: Any) -> str:
