@@ -354,7 +354,8 @@ def allan_deviation(
         If given (e.g. :data:`ONE_SIGMA`), the result carries the chi-squared
         confidence interval of each τ (:func:`confidence_interval`) with the
         simple edf of SP 1065 Table 5 (:func:`equivalent_degrees_of_freedom`);
-        overlapping ``kind="allan"`` only.
+        ``kind="allan"`` only. For the normal (non-overlapping) deviation the edf is
+        that of the record of ``n // m`` τ-means at m = 1, where both estimators agree.
     noise_alpha
         Power-law exponent α of the dominant noise for the edf, one of
         :data:`NOISE_ALPHAS`; 0 (white FM) is white rate noise, i.e. angle random walk.
@@ -386,10 +387,10 @@ def allan_deviation(
         raise InputError(
             f"kind={kind!r} is computed in its overlapping form only; pass overlapping=True"
         )
-    if confidence is not None and (kind != "allan" or not overlapping):
+    if confidence is not None and kind != "allan":
         raise InputError(
-            f"confidence intervals are implemented for the overlapping Allan deviation only, "
-            f"got kind={kind!r}, overlapping={overlapping}; pass confidence=None"
+            f"confidence intervals are implemented for the Allan deviation only, "
+            f"got kind={kind!r}; pass confidence=None"
         )
     values = _as_rate(rate, "rate", minimum=3)
     n = values.size
@@ -405,7 +406,11 @@ def allan_deviation(
         )
     lower = upper = None
     if confidence is not None:
-        edf = np.array([equivalent_degrees_of_freedom(n + 1, m, noise_alpha) for m in kept])
+        # non-overlapping: the τ-means form a record of n // m samples read at m = 1, where
+        # the overlapping and the normal estimator coincide
+        edf = np.array([equivalent_degrees_of_freedom(n + 1, m, noise_alpha) if overlapping
+                        else equivalent_degrees_of_freedom(n // m + 1, 1, noise_alpha)
+                        for m in kept])
         lower, upper = confidence_interval(deviation, edf, confidence)
     return AllanResult(
         taus_s=kept.astype(np.float64) / fs,

@@ -247,7 +247,7 @@ class Evaluation:
     def allan_csv(self) -> str:
         """The deviation curves as CSV text: series, tau_s, deviation, lower, upper, n.
 
-        ``lower`` / ``upper`` are empty where the curve has no interval (all but oadev).
+        ``lower`` / ``upper`` are empty where the curve has no interval (mdev, hdev, tdev).
         """
         lines = ["series,tau_s,deviation,lower,upper,n"]
         for key, curve in self.allan.items():
@@ -304,9 +304,8 @@ def _curve(allan: AllanResult) -> dict[str, Any]:
 def _deviation(values: np.ndarray, fs: float, deviation: str, confidence: float) -> AllanResult:
     """The run's deviation curve, with a confidence interval where SP 1065 gives one."""
     kind, overlapping = DEVIATIONS[deviation]
-    with_interval = kind == "allan" and overlapping
     return allan_deviation(values, fs, taus="octave", kind=kind, overlapping=overlapping,
-                           confidence=confidence if with_interval else None)
+                           confidence=confidence if kind == "allan" else None)
 
 
 def run_pass(
@@ -354,7 +353,8 @@ def run_pass(
         The deviation curve: ``"oadev"`` (overlapping Allan, default), ``"adev"``
         (non-overlapping), ``"mdev"``, ``"hdev"``, ``"tdev"`` (:data:`DEVIATIONS`).
         Noise terms are read off the Allan deviations only; the chi-squared interval
-        (simple edf, white rate noise, SP 1065 Table 5) is given for ``"oadev"`` only.
+        (simple edf, white rate noise, SP 1065 Table 5) is given for ``"oadev"`` and
+        ``"adev"``.
     confidence
         Two-sided level of the intervals (bias stability and Allan deviation).
 
