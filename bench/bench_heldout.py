@@ -155,8 +155,16 @@ def run(quick: bool = False) -> list[dict]:
 if __name__ == "__main__":
     import json
 
+    from hrgtc.drift.features import EQ21_TERMS
+
     verbose = "-v" in sys.argv
-    rows, lines = heldout(seeds=(1, 2) if "--quick" in sys.argv else (1, 2, 3, 4, 5))
+    options, label = {}, "default"
+    extra = [a.removeprefix("--extra-terms=") for a in sys.argv if a.startswith("--extra-terms=")]
+    if extra:  # e.g. --extra-terms=dpos,f*dpos: candidates beyond Eq. 21
+        options["terms"] = (*EQ21_TERMS, *extra[0].split(","))
+        label = "extra_" + extra[0].replace(",", "_").replace("*", "").replace("^", "")
+    rows, lines = heldout(options, seeds=(1, 2) if "--quick" in sys.argv else (1, 2, 3, 4, 5),
+                          label=label)
     for row in rows if verbose else ():
         print(json.dumps({k: (round(v, 3) if isinstance(v, float) else v)
                           for k, v in row.items()}), file=sys.stderr)

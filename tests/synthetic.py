@@ -50,3 +50,11 @@ def block_std(x, rows):
     """1-sigma of non-overlapping block means (bias stability by hand)."""
     n = x.size // rows
     return float(np.std(x[: n * rows].reshape(n, rows).mean(axis=1), ddof=1))
+
+
+def with_heating_extra(run, per_hz_per_s=2000.0, tau_s=2600.0):
+    """A :func:`ramp_run` whose bias has an extra per_hz_per_s·df while heating (hysteresis)."""
+    df = (THERMOMETER.slope_hz_per_c(run["resonator_c"])
+          * (run["chamber_c"] - run["resonator_c"]) / tau_s)
+    extra = per_hz_per_s * np.maximum(df, 0.0)
+    return run.with_columns(rate_dph=run.rate_dph + extra, bias_dph=run["bias_dph"] + extra)

@@ -21,7 +21,7 @@ from hrgtc.errors import InputError, RecordingError
 from hrgtc.model import UnitModel
 from hrgtc.recording import concatenate
 
-from synthetic import THERMOMETER, ramp_run
+from synthetic import THERMOMETER, ramp_run, with_heating_extra
 
 
 @pytest.fixture(scope="module")
@@ -278,3 +278,21 @@ def test_thermometer_beyond_the_kernel_series_falls_back_to_numpy(unit_model, ru
     reference = compensate(run, unit_model, engine="numpy")
     for name in OUTPUT_COLUMNS:
         np.testing.assert_array_equal(out[name], reference[name])
+
+
+def test_a_model_with_the_heating_switch_runs_on_numpy_in_both_engines(run):
+    from hrgtc.drift.features import EQ21_TERMS
+
+    runs = [ramp_run(seed=31, hours=3.0),
+            with_heating_extra(ramp_run(seed=32, start_c=-20.0, end_c=20.0, hours=3.0))]
+    fitted = drift.fit(runs, THERMOMETER, terms=(*EQ21_TERMS, "dpos", "f*dpos"))
+    assert "dpos" in fitted.variables
+    model = UnitModel(THERMOMETER, fitted)
+    fused, numpy_engine = Compensator(model), Compensator(model, engine="numpy")
+    a, b = fused.process(run), numpy_engine.process(run)
+    assert fused._plan is None  # fell back: the kernel does not compute dpos
+    for name in OUTPUT_COLUMNS:
+        np.testing.assert_array_equal(a[name], b[name])
+    settle = round(fitted.settings.warmup_s * run.sample_rate_hz)
+    np.testing.assert_allclose(a["bias_model_dph"][settle:],
+                               fitted.predict_recording(run)[settle:], rtol=1e-9, atol=1e-9)

@@ -32,7 +32,7 @@ from hrgtc.compensate.export_c import export_c
 from hrgtc.errors import CalibrationError, InputError, OutputExistsError
 from hrgtc.model import UnitModel, save_model
 
-from synthetic import THERMOMETER, block_std, ramp_run
+from synthetic import THERMOMETER, block_std, ramp_run, with_heating_extra
 
 COMPILER = shutil.which("cc") or shutil.which("gcc") or shutil.which("clang")
 needs_compiler = pytest.mark.skipif(COMPILER is None, reason="no C compiler on this system")
@@ -310,3 +310,16 @@ def test_cli_writes_the_files_and_records_the_model_hash(frequency_model, tmp_pa
 
     missing = runner.invoke(app, ["export-c", str(tmp_path / "nope.json"), "-o", str(outdir)])
     assert missing.exit_code == 2 and "no such model file" in missing.output
+
+
+def test_refuses_a_model_with_the_heating_switch(tmp_path):
+    from hrgtc.drift.features import EQ21_TERMS
+
+    runs = [ramp_run(seed=41, hours=3.0),
+            with_heating_extra(ramp_run(seed=42, start_c=-20.0, end_c=20.0,
+                                        hours=3.0))]
+    fitted = drift.fit(runs, THERMOMETER, terms=(*EQ21_TERMS, "dpos"))
+    assert "dpos" in fitted.selected
+    with pytest.raises(InputError, match="heating/cooling switch dpos"):
+        export_c(UnitModel(THERMOMETER, fitted), tmp_path / "c")
+    assert not (tmp_path / "c").exists() or not any((tmp_path / "c").iterdir())

@@ -11,7 +11,7 @@ from hrgtc import drift
 from hrgtc.errors import CalibrationError, InputError
 from hrgtc.recording import Metadata, Recording
 
-from synthetic import THERMOMETER, block_std, ramp_run
+from synthetic import THERMOMETER, block_std, ramp_run, with_heating_extra
 
 
 @pytest.fixture(scope="module")
@@ -132,3 +132,54 @@ def test_hierarchical_fit_keeps_every_parent(cooldown, model):
         assert set(parents[name]) <= set(marginal.selected), (name, marginal.selected)
     orphans = [n for n in model.selected if not set(parents[n]) <= set(model.selected)]
     assert orphans or marginal.selected == model.selected  # the option changed the fit, or needn't
+
+
+def test_prediction_std_equals_monte_carlo_over_the_coefficients(model, cooldown):
+    import dataclasses
+
+    from hrgtc.drift.features import compute_variables
+
+    cov = np.asarray(model.stepwise.result.cov_params)
+    # the covariance of the final fit (inflated by Newey-West) gives the standard errors
+    assert np.sqrt(cov[0, 0]) == pytest.approx(model.standard_errors["const"], rel=1e-9)
+    assert model.variance_inflation > 1.0
+    values = compute_variables(cooldown, model.settings, model.variables)
+    values = {v: x[::500] for v, x in values.items()}
+    low, high = model.ranges["f"]
+    values["f"] = np.concatenate([values["f"], [high + 0.5 * (high - low)]])  # beyond: tangent
+    values["df"] = np.concatenate([values["df"], [0.0]])
+    std = model.prediction_std(values)
+    mean = np.array([model.intercept_dph, *model.scaled_coefficients])
+    draws = np.random.default_rng(3).multivariate_normal(mean, cov, size=4000)
+    predictions = np.array([
+        dataclasses.replace(model, intercept_dph=float(d[0]),
+                            scaled_coefficients=tuple(map(float, d[1:]))).predict(values)
+        for d in draws])
+    np.testing.assert_allclose(std, predictions.std(axis=0), rtol=0.06)
+    assert std.min() > 0.0 and std[-1] > np.median(std)  # grows beyond the training range
+
+
+def test_heating_switch_dpos_carries_a_heating_only_rate_term(cooldown):
+    from hrgtc.drift.features import EQ21_TERMS, SWITCH_FRACTION, heating_part
+
+    warm = with_heating_extra(ramp_run(seed=5, start_c=-20.0, end_c=20.0))
+    runs = [cooldown, warm]
+    with_switch = drift.fit(runs, THERMOMETER, terms=(*EQ21_TERMS, "dpos"))
+    plain = drift.fit(runs, THERMOMETER)
+    assert "dpos" in with_switch.selected
+    assert with_switch.coefficients["dpos"] == pytest.approx(2000.0, rel=0.25)
+    delta = with_switch.settings.switch_hz_per_s
+    assert delta > 0.0
+    rates = drift.fit([cooldown], THERMOMETER).ranges["df"]
+    assert delta < SWITCH_FRACTION * 2.0 * max(abs(rates[0]), abs(rates[1])) + 1e-12
+    back = drift.DriftModel.from_dict(json.loads(json.dumps(with_switch.to_dict())))
+    assert back.settings.switch_hz_per_s == delta
+    held_out = with_heating_extra(ramp_run(seed=6, start_c=-15.0, end_c=15.0))
+    truth, rows = held_out["bias_dph"], int(10 * held_out.sample_rate_hz)
+    skip = int(with_switch.settings.warmup_s * held_out.sample_rate_hz)
+    errors = [block_std((truth - m.predict_recording(held_out))[skip:], rows)
+              for m in (with_switch, plain)]
+    assert errors[0] < 0.7 * errors[1]
+    assert heating_part(np.array([-5.0 * delta]), delta)[0] == pytest.approx(0.0, abs=1e-3 * delta)
+    with pytest.raises(InputError, match="switch_hz_per_s"):
+        drift.features.FeatureStream(plain.settings, ("f", "dpos")).process(cooldown)

@@ -285,3 +285,18 @@ def test_residual_against_truth():
         residual_against_truth(bias_model_dph=truth, true_bias_dph=truth[:-1], sample_rate_hz=fs)
     with pytest.raises(TypeError):
         residual_against_truth(truth, truth, fs)  # type: ignore[misc]
+
+
+def test_bias_stability_interval_covers_the_true_sigma_68_percent_of_the_time():
+    from hrgtc.evaluation.metrics import bias_stability_interval
+
+    rng = np.random.default_rng(11)
+    sigma, blocks, m, trials = 2.0, 12, 50, 3000
+    hits = 0
+    for _ in range(trials):
+        rate = rng.normal(0.0, sigma, blocks * m)
+        value = bias_stability(rate, 1.0, float(m))
+        low, high = bias_stability_interval(value, blocks)
+        hits += low <= sigma / math.sqrt(m) <= high
+    assert hits / trials == pytest.approx(0.683, abs=0.03)  # binomial sd 0.0085
+    assert all(math.isnan(v) for v in bias_stability_interval(1.0, 1))

@@ -117,3 +117,47 @@ def test_evaluation_ranges_cover_temperature_and_df_dt(setup):
     assert data["rate_fraction"] > 0.0 and data["rate_excess_ratio"] > 1.0
     assert data["seen_rate_c_per_h"][1] > 0.0 >= data["trained_rate_c_per_h"][0]
     assert any("df/dt" in line for line in result.summary().splitlines())
+
+
+def test_intervals_deviation_kinds_and_allan_csv(setup, tmp_path):
+    files, model, model_path = setup
+    result = evaluate(files.warmup, model, max_points=500)
+    for series in ("raw", "compensated"):
+        value = result.stability(series, 10.0)
+        low, high = result.stability_interval(series, 10.0)
+        assert low < value < high
+        curve = result.allan[series]
+        assert np.all(curve.lower < curve.deviation) and np.all(curve.deviation < curve.upper)
+    std = result.prediction_std_dph
+    assert 0.0 < std["median"] <= std["max"]
+    assert std["median"] < result.compensated_10s * 10.0
+    assert result.blocks["model_std_dph"].size == result.blocks["model_dph"].size
+
+    csv_path = tmp_path / "allan.csv"
+    out = CliRunner().invoke(app, ["evaluate", str(files.warmup), "--model", str(model_path),
+                                   "--json", "--deviation", "mdev", "--allan-csv",
+                                   str(csv_path)])
+    assert out.exit_code == 0, out.output
+    data = json.loads(out.stdout)
+    assert data["deviation"] == "mdev" and data["allan"] == {}
+    assert data["allan_curve"]["raw"]["lower"][0] is None  # no interval for mdev
+    low, high = data["bias_stability_interval_dph"]["raw"]["10"]
+    assert low < data["bias_stability_dph"]["raw"]["10"] < high
+    assert data["prediction_std_dph"]["max"] >= data["prediction_std_dph"]["median"] > 0.0
+    rows = csv_path.read_text().splitlines()
+    assert rows[0] == "series,tau_s,deviation,lower,upper,n"
+    raw_rows = [r.split(",") for r in rows[1:] if r.startswith("raw,")]
+    assert [float(r[2]) for r in raw_rows] == pytest.approx(
+        list(np.asarray(data["allan_curve"]["raw"]["deviation"], dtype=float)))
+    again = CliRunner().invoke(app, ["evaluate", str(files.warmup), "--model", str(model_path),
+                                     "--allan-csv", str(csv_path)])
+    assert again.exit_code != 0 and "--force" in again.output
+    oadev = CliRunner().invoke(app, ["evaluate", str(files.warmup), "--model", str(model_path),
+                                     "--allan-csv", str(csv_path), "--force"])
+    assert oadev.exit_code == 0, oadev.output
+    assert "(" in oadev.stdout and "–" in oadev.stdout  # "0.957 (0.93–0.99)"
+    first = csv_path.read_text().splitlines()[1].split(",")
+    assert float(first[3]) < float(first[2]) < float(first[4])
+    bad = CliRunner().invoke(app, ["evaluate", str(files.warmup), "--model", str(model_path),
+                                   "--deviation", "xdev"])
+    assert bad.exit_code == 2

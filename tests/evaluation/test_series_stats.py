@@ -7,8 +7,9 @@ import tracemalloc
 import numpy as np
 import pytest
 
-from hrgtc.evaluation.allan import allan_deviation, noise_terms
+from hrgtc.evaluation.allan import allan_deviation
 from hrgtc.evaluation.metrics import bias_stability_table
+from hrgtc.evaluation.noise import noise_terms
 from hrgtc.evaluation.series_stats import SeriesStatistics
 
 

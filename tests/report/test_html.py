@@ -272,3 +272,25 @@ def test_every_figure_loads_in_headless_chromium(report, tmp_path):
     found = re.search(r'id="hrgtc-check">images=(\d+) loaded=(\d+)<', dom)
     assert found, dom[-2000:]
     assert int(found.group(1)) == int(found.group(2)) == len(page.images) == 8
+
+
+def test_intervals_and_noise_reasons_in_the_tables(unit, report):
+    """Each bias stability carries its 1σ interval; a missing noise term shows its reason."""
+    from hrgtc.evaluation import evaluate
+
+    files, model, _ = unit
+    _, _, page, _ = report
+    result = evaluate(files.cooldown, model)
+    row10 = next(row for row in page.table(f"Bias stability of {files.cooldown.name}")
+                 if row[0] == "10")
+    low, high = result.stability_interval("raw", 10.0)
+    bounds = row10[1].split("(")[1].rstrip(")").split("–")
+    assert float(bounds[0]) == pytest.approx(low, rel=1e-2)
+    assert float(bounds[1]) == pytest.approx(high, rel=1e-2)
+    noise = page.table(f"Allan noise terms of {files.cooldown.name}")
+    cells = [cell for row in noise for cell in row[1:]]
+    expected = [result.noise[k].text(t) for k in result.noise
+                for t in ("arw", "bias_instability", "rrw")]
+    assert cells == expected
+    assert any(cell.startswith("no ") for cell in cells) or all(
+        n.rrw_reason is None for n in result.noise.values())

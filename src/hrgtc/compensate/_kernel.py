@@ -46,8 +46,9 @@ from hrgtc.drift import DriftModel
 from hrgtc.drift.features import VARIABLES, rate_filter_coefficients, settle_rows
 from hrgtc.thermometry import Thermometer
 
-#: Variable order of the exponent matrices: the grammar's order (f, df, h, dh).
-ORDER = tuple(VARIABLES)
+#: Variable order of the exponent matrices: the grammar's order (f, df, h, dh). The
+#: heating/cooling switch ``dpos`` is not computed here (:func:`supports_variables`).
+ORDER = tuple(v for v in VARIABLES if v != "dpos")
 #: Slots of ``counts``: samples outside the f/h ranges, outside the df/dh ranges,
 #: samples whose Newton iteration did not converge (left NaN), and samples of the
 #: filter's settling time at the start of the run.
@@ -178,6 +179,11 @@ def plan(drift: DriftModel, thermometer: Thermometer, variables: tuple[str, ...]
         chebyshev=_padded(np.asarray(inverse.start_coefficients, dtype=np.float64),
                           CHEBYSHEV_SIZE),
     )
+
+
+def supports_variables(variables: tuple[str, ...]) -> bool:
+    """Whether the kernel computes every variable (not ``dpos``: the numpy engine does)."""
+    return all(v in ORDER for v in variables)
 
 
 def supports(thermometer: Thermometer) -> bool:

@@ -78,6 +78,11 @@ def plan_for(model: UnitModel) -> CPlan:
         )
     settings = drift.settings
     used = set(drift.variables)
+    if "dpos" in used:
+        raise InputError(
+            f"the drift model uses the heating/cooling switch dpos ({', '.join(drift.selected)}), "
+            "which the C export does not compute; calibrate without dpos terms for on-board use"
+        )
     housing = bool(used & {"h", "dh"})
     # The compensator computes f and df (and h, dh when the terms use them); in_range checks
     # the levels (f, h), rate_in_range the rates of change (df, dh), each where computed.

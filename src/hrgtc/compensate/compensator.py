@@ -73,7 +73,8 @@ class Compensator:
         ``"housing"`` (the classical thermistor baseline kept in the model file).
     engine
         ``"fused"`` (one compiled pass per chunk, default) or ``"numpy"`` (the
-        array-by-array reference); both give the same numbers to rounding.
+        array-by-array reference); both give the same numbers to rounding. A model
+        with the heating/cooling switch ``dpos`` runs on the numpy engine either way.
     gaps
         ``"split"``: the df/dt filter restarts at rest after every gap (a time step
         longer than :data:`~hrgtc.recording.validation.GAP_PERIODS` sample periods),
@@ -189,8 +190,8 @@ class Compensator:
             violation = thermometer._monotonic_violation()
             if violation is not None:
                 raise CalibrationError(violation)
-            if not kernel.supports(thermometer):
-                return False
+            if not kernel.supports(thermometer) or not kernel.supports_variables(self._variables):
+                return False  # the numpy engine computes the same numbers
             self._plan = kernel.plan(self.drift, thermometer, self._variables)
         counts = np.zeros(4, dtype=np.int64)
         freq = chunk.freq_hz

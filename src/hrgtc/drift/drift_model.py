@@ -33,6 +33,7 @@ import numpy as np
 from hrgtc.drift.cross_validation import CrossValidation, cross_validate, select_terms
 from hrgtc.drift.features import (
     EQ21,
+    SWITCH_FRACTION,
     VARIABLES,
     FeatureSettings,
     FeatureStream,
@@ -161,6 +162,29 @@ class DriftModel:
             raise InputError(f"extrapolation must be 'tangent', 'polynomial' or 'clamp', "
                              f"got {extrapolation!r}")
         return linear_combination(*args, values, self.settings.scales, self.intercept_dph)
+
+    def prediction_std(self, values: Mapping[str, np.ndarray]) -> np.ndarray:
+        """1σ uncertainty of :meth:`predict` from the coefficients' covariance. [°/h]
+
+        The model is linear in its coefficients, also where it is continued along its
+        tangent, so ``B(x) = J(x)·β`` with ``J`` the intercept's 1 and each term's
+        value (tangent-extended, on the scaled variables) and the variance of the
+        prediction is ``J Σ Jᵀ``, Σ the covariance of the scaled coefficients of the
+        final fit (``stepwise.result.cov_params``, which already carries the
+        Newey-West ``variance_inflation`` of the window residuals). It is the
+        uncertainty of the fitted line, not of the gyro's noise around it.
+        """
+        cov = np.asarray(self.stepwise.result.cov_params, dtype=np.float64)
+        n = next(iter(values.values())).shape[0]
+        columns = [np.ones(n)]
+        for k in range(len(self._terms)):
+            unit = np.zeros(len(self._terms))
+            unit[k] = 1.0
+            columns.append(tangent_extension(self._terms, unit, values, self.settings.scales,
+                                             self.ranges, 0.0))
+        jacobian = np.column_stack(columns)
+        variance = np.einsum("ij,jk,ik->i", jacobian, cov, jacobian)
+        return np.sqrt(np.maximum(variance, 0.0))
 
     def predict_recording(self, recording: Recording) -> np.ndarray:
         """Bias of a whole recording, filter started at its first sample. [°/h]"""
@@ -380,6 +404,11 @@ def fit(
         rate_tau_s=rate_tau_s,
         warmup_s=5.0 * rate_tau_s if warmup_s is None else warmup_s,
     )
+    if "dpos" in variables_for(candidates):  # δ of the heating/cooling switch: a first pass
+        rates = window_means(runs, settings, parse_terms(["df"]), window_s).variables["df"]
+        spread = float(np.std(rates))
+        settings = FeatureSettings(**{**settings.to_dict(), "switch_hz_per_s": (
+            SWITCH_FRACTION * spread if spread > 0.0 else 1.0)})
     windows = window_means(runs, settings, candidates, window_s, progress)
     variables = variables_for(candidates)
     for run in range(min(excitation_runs, len(windows.sources))):

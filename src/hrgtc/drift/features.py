@@ -23,7 +23,15 @@ name       meaning                                                unit
 ``df``     causal rate of ``f``                                   Hz/s
 ``h``      housing temperature change housing_c - reference_c     °C
 ``dh``     causal rate of ``h``                                   °C/s
+``dpos``   heating part of ``df``: df·(1 + tanh(df/δ))/2          Hz/s
 =========  ====================================================  ========
+
+``dpos`` is a smooth switch between heating (df > 0: dpos ≈ df) and cooling
+(dpos ≈ 0), so ``df`` + ``dpos`` give heating and cooling their own rate
+coefficients (HRG drift differs between the two: Li et al., Sci. Rep. 13:6019,
+2023); δ (``FeatureSettings.switch_hz_per_s``) is set in training from the
+spread of the training df/dt. It is computed by the numpy compensator only:
+the fused kernel falls back to numpy and ``export_c`` refuses such a model.
 
 A term is a product of powers: ``f``, ``f^2``, ``f*df``, ``f^2*df``, ``h^3``.
 
@@ -49,8 +57,13 @@ VARIABLES: dict[str, tuple[str, str]] = {
     "df": ("Hz/s", "causal rate of the frequency change"),
     "h": ("°C", "housing temperature change housing_c - reference_c"),
     "dh": ("°C/s", "causal rate of the housing temperature change"),
+    "dpos": ("Hz/s", "heating part of df/dt, df·(1 + tanh(df/δ))/2"),
 }
 _SOURCE_COLUMN = {"f": "freq_hz", "h": "housing_c"}
+#: The level each rate-like variable is the rate of.
+_RATE_OF = {"df": "f", "dh": "h", "dpos": "f"}
+#: δ of ``dpos`` as a share of the std of the training windows' df/dt.
+SWITCH_FRACTION = 0.1
 _TERM_FACTOR = re.compile(r"^\s*([a-z]+)\s*(?:\^\s*(\d+))?\s*$")
 
 
@@ -210,7 +223,7 @@ def required_columns(terms: Sequence[Term]) -> tuple[str, ...]:
     needed = []
     for term in terms:
         for v in term.variables:
-            column = _SOURCE_COLUMN[v.removeprefix("d")]
+            column = _SOURCE_COLUMN[_RATE_OF.get(v, v)]
             if column not in needed:
                 needed.append(column)
     return tuple(needed)
@@ -295,6 +308,8 @@ class FeatureSettings:
         Start of each run discarded in training while the filter settles. [s]
     scales
         Variable -> scale used internally so every variable is of order one.
+    switch_hz_per_s
+        δ of the heating/cooling switch ``dpos`` (0: not used). [Hz/s]
     """
 
     reference_freq_hz: float
@@ -303,6 +318,7 @@ class FeatureSettings:
     rate_tau_s: float = 10.0
     warmup_s: float = 600.0
     scales: dict[str, float] = field(default_factory=dict)
+    switch_hz_per_s: float = 0.0
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -312,6 +328,7 @@ class FeatureSettings:
             "rate_tau_s": self.rate_tau_s,
             "warmup_s": self.warmup_s,
             "scales": dict(self.scales),
+            "switch_hz_per_s": self.switch_hz_per_s,
         }
 
     @classmethod
@@ -324,6 +341,7 @@ class FeatureSettings:
                 rate_tau_s=float(data["rate_tau_s"]),
                 warmup_s=float(data["warmup_s"]),
                 scales={str(k): float(v) for k, v in dict(data.get("scales", {})).items()},
+                switch_hz_per_s=float(data.get("switch_hz_per_s", 0.0)),
             )
         except (KeyError, TypeError, ValueError) as exc:
             raise InputError(f"not a valid feature-settings record: {exc!r}") from exc
@@ -338,6 +356,17 @@ class FeatureSettings:
                 "Hz; the df/dt filter is defined per sample, so resample the recording or "
                 "calibrate at this rate"
             )
+
+
+def heating_part(rate: np.ndarray, switch: float) -> np.ndarray:
+    """``dpos``: the smooth positive part rate·(1 + tanh(rate/δ))/2 of a rate. [unit of rate]
+
+    Examples
+    --------
+    >>> [round(float(x), 4) for x in heating_part(np.array([-1.0, 0.0, 1.0]), 0.1)]
+    [-0.0, 0.0, 1.0]
+    """
+    return rate * (1.0 + np.tanh(rate / switch)) / 2.0
 
 
 def settle_rows(settings: FeatureSettings) -> int:
@@ -375,20 +404,26 @@ class FeatureStream:
         """Variables of the next chunk of the run, keyed by variable name."""
         s = self.settings
         base: dict[str, np.ndarray] = {}
-        if any(v in ("f", "df") for v in self.variables):
+        if "dpos" in self.variables and not s.switch_hz_per_s > 0.0:
+            raise InputError("the variable dpos needs switch_hz_per_s > 0 in the feature "
+                             "settings (drift.fit sets it from the training df/dt)")
+        if any(v in ("f", "df", "dpos") for v in self.variables):
             base["f"] = chunk["freq_hz"] - s.reference_freq_hz
         if any(v in ("h", "dh") for v in self.variables):
             base["h"] = chunk["housing_c"] - s.reference_c
         out: dict[str, np.ndarray] = {}
+        rates: dict[str, np.ndarray] = {}
         for v in self.variables:
             if v in base:
                 out[v] = base[v]
-            else:
-                source = v.removeprefix("d")
-                rate, _, self._states[source] = causal_rate(
+                continue
+            source = _RATE_OF[v]
+            if source not in rates:
+                rates[source], _, self._states[source] = causal_rate(
                     base[source], s.rate_tau_s, s.sample_rate_hz, self._states.get(source)
                 )
-                out[v] = rate
+            rate = rates[source]
+            out[v] = heating_part(rate, s.switch_hz_per_s) if v == "dpos" else rate
         self.samples_seen += len(chunk)
         return out
 

@@ -9,7 +9,7 @@ merit themselves.
 [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
 """
 
-from hrgtc.evaluation.allan import AllanResult, NoiseTerms, allan_deviation, noise_terms
+from hrgtc.evaluation.allan import AllanResult, allan_deviation
 from hrgtc.evaluation.metrics import (
     DEFAULT_TAUS_S,
     ResidualResult,
@@ -17,6 +17,7 @@ from hrgtc.evaluation.metrics import (
     bias_stability_table,
     residual_against_truth,
 )
+from hrgtc.evaluation.noise import NoiseTerms, noise_terms
 from hrgtc.evaluation.run_pass import BlockMeans, Evaluation, block_rows, evaluate, run_pass
 
 __all__ = [

@@ -8,9 +8,8 @@
   chi-squared confidence interval of SP 1065 Section 5.3 [3].
 - :func:`equivalent_degrees_of_freedom`, :func:`confidence_interval`: the
   simple edf of SP 1065 Table 5 and the chi-squared interval of Eq. (45).
-- :func:`noise_terms`: angle random walk, bias instability and rate random walk
-  read off the Allan deviation with the conventions of IEEE Std 952-1997,
-  Annex C [2].
+- The noise terms read off the deviation (ARW, bias instability, RRW) are in
+  :mod:`hrgtc.evaluation.noise`.
 
 References
 ----------
@@ -41,8 +40,8 @@ from hrgtc.evaluation._allan_edf import (
 from hrgtc.progress import Progress
 
 __all__ = [
-    "KINDS", "NOISE_ALPHAS", "ONE_SIGMA", "AllanResult", "NoiseTerms", "allan_deviation",
-    "confidence_interval", "equivalent_degrees_of_freedom", "noise_terms",
+    "KINDS", "NOISE_ALPHAS", "ONE_SIGMA", "AllanResult", "allan_deviation",
+    "confidence_interval", "equivalent_degrees_of_freedom",
 ]
 
 #: σ_min = 0.664·B at the flat minimum of a flicker (bias instability) floor;
@@ -356,7 +355,8 @@ def allan_deviation(
         If given (e.g. :data:`ONE_SIGMA`), the result carries the chi-squared
         confidence interval of each τ (:func:`confidence_interval`) with the
         simple edf of SP 1065 Table 5 (:func:`equivalent_degrees_of_freedom`);
-        overlapping ``kind="allan"`` only.
+        ``kind="allan"`` only. For the normal (non-overlapping) deviation the edf is
+        that of the record of ``n // m`` τ-means at m = 1, where both estimators agree.
     noise_alpha
         Power-law exponent α of the dominant noise for the edf, one of
         :data:`NOISE_ALPHAS`; 0 (white FM) is white rate noise, i.e. angle random walk.
@@ -388,10 +388,10 @@ def allan_deviation(
         raise InputError(
             f"kind={kind!r} is computed in its overlapping form only; pass overlapping=True"
         )
-    if confidence is not None and (kind != "allan" or not overlapping):
+    if confidence is not None and kind != "allan":
         raise InputError(
-            f"confidence intervals are implemented for the overlapping Allan deviation only, "
-            f"got kind={kind!r}, overlapping={overlapping}; pass confidence=None"
+            f"confidence intervals are implemented for the Allan deviation only, "
+            f"got kind={kind!r}; pass confidence=None"
         )
     values = _as_rate(rate, "rate", minimum=3)
     n = values.size
@@ -407,7 +407,11 @@ def allan_deviation(
         )
     lower = upper = None
     if confidence is not None:
-        edf = np.array([equivalent_degrees_of_freedom(n + 1, m, noise_alpha) for m in kept])
+        # non-overlapping: the τ-means form a record of n // m samples read at m = 1, where
+        # the overlapping and the normal estimator coincide
+        edf = np.array([equivalent_degrees_of_freedom(n + 1, m, noise_alpha) if overlapping
+                        else equivalent_degrees_of_freedom(n // m + 1, 1, noise_alpha)
+                        for m in kept])
         lower, upper = confidence_interval(deviation, edf, confidence)
     return AllanResult(
         taus_s=kept.astype(np.float64) / fs,
@@ -420,161 +424,4 @@ def allan_deviation(
         lower=lower,
         upper=upper,
         confidence=None if confidence is None else float(confidence),
-    )
-
-
-# --------------------------------------------------------------------------- noise terms
-@dataclass(frozen=True)
-class NoiseTerms:
-    """Allan noise terms of a gyro, IEEE Std 952-1997 Annex C conventions [2].
-
-    Attributes
-    ----------
-    arw_deg_per_rt_h
-        Angle random walk N: the −½-slope line σ(τ) = N/√τ read at τ = 1 h.
-        None if no −½ region was found. [°/√h]
-    bias_instability_dph
-        Bias instability B = σ_min / 0.664 at the minimum of the deviation. [°/h]
-    rrw_dph_per_rt_h
-        Rate random walk K: the +½-slope line σ(τ) = K·√(τ/3) read at τ = 3 h.
-        None if the record is too short to show a +½ region. [°/h/√h]
-    arw_taus_s, rrw_taus_s
-        First and last τ of the points each line was fitted to, or None. [s]
-    bias_instability_tau_s
-        τ of the minimum. [s]
-    floor_reached
-        False if the minimum is the longest usable τ, i.e. the deviation was
-        still falling and B is only an upper bound.
-    """
-
-    arw_deg_per_rt_h: float | None
-    bias_instability_dph: float
-    rrw_dph_per_rt_h: float | None
-    arw_taus_s: tuple[float, float] | None
-    bias_instability_tau_s: float
-    rrw_taus_s: tuple[float, float] | None
-    floor_reached: bool
-
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (τ ranges as lists)."""
-        return {k: list(v) if isinstance(v, tuple) else v for k, v in asdict(self).items()}
-
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> NoiseTerms:
-        """Inverse of :meth:`to_dict`."""
-        names = {f.name for f in fields(cls)}
-        return cls(
-            **{k: tuple(v) if isinstance(v, list) else v for k, v in data.items() if k in names}
-        )
-
-    def summary(self) -> str:
-        """Three lines, one per noise term, with the τ range each was read from."""
-
-        def fmt(value: float | None, taus: tuple[float, float] | None, unit: str) -> str:
-            if value is None:
-                return "n/a (no such slope region in the data)"
-            return f"{value:.4g} {unit}  (fit over tau {taus[0]:g}-{taus[1]:g} s)"
-
-        bound = "" if self.floor_reached else "  (upper bound: no minimum reached)"
-        return "\n".join(
-            [
-                f"angle random walk  {fmt(self.arw_deg_per_rt_h, self.arw_taus_s, 'deg/rt-h')}",
-                f"bias instability   {self.bias_instability_dph:.4g} deg/h  "
-                f"(minimum at tau {self.bias_instability_tau_s:g} s){bound}",
-                f"rate random walk   {fmt(self.rrw_dph_per_rt_h, self.rrw_taus_s, 'deg/h/rt-h')}",
-            ]
-        )
-
-
-def noise_terms(
-    allan: AllanResult,
-    *,
-    slope_tolerance: float = 0.15,
-    min_blocks: int = 8,
-    min_points: int = 2,
-) -> NoiseTerms:
-    """Angle random walk, bias instability and rate random walk, IEEE 952 Annex C [2].
-
-    The Allan deviation of a rate in °/h against τ in s is read with the
-    conventions of Annex C of [2]:
-
-    - ARW: σ(τ) = N/√τ. A line of slope −½ is fitted (in log-log, weighted by
-      the number of τ-blocks) to the points left of the minimum whose local
-      slope is within ``slope_tolerance`` of −½, and read at τ = 1 h:
-      ``ARW [°/√h] = σ(3600 s) = N[°/h·√s] / 60``.
-    - Bias instability: ``B = σ_min / 0.664`` (0.664 ≈ √(2 ln 2 / π), flicker floor).
-    - RRW: σ(τ) = K·√(τ/3). A line of slope +½ is fitted to the points right of
-      the minimum with local slope within the tolerance of +½ and read at
-      τ = 3 h: ``K [°/h/√h] = σ(10800 s)``.
-
-    Only τ with at least ``min_blocks`` whole τ-blocks in the record are used
-    (longer τ are too uncertain). A term is None when fewer than ``min_points``
-    points qualify, e.g. RRW on a record too short to show the +½ region.
-
-    Parameters
-    ----------
-    allan
-        Allan deviation of a rate in °/h, from :func:`allan_deviation`.
-    slope_tolerance
-        Accepted distance of the local log-log slope from ∓½.
-    min_blocks
-        Minimum number of non-overlapping τ-blocks for a τ to be used.
-    min_points
-        Minimum number of points for the ARW and RRW lines.
-
-    Returns
-    -------
-    NoiseTerms
-        The three terms and the τ ranges they were read from.
-
-    Raises
-    ------
-    InputError
-        If fewer than 3 usable τ remain or the deviation is not positive.
-    """
-    usable = allan.blocks >= min_blocks
-    taus = allan.taus_s[usable]
-    dev = allan.deviation[usable]
-    if taus.size < 3:
-        raise InputError(
-            f"noise terms need at least 3 averaging times with >= {min_blocks} blocks each, "
-            f"got {taus.size} (record of {allan.n_samples} samples); use a longer record "
-            "or more taus"
-        )
-    if not np.all(dev > 0.0):
-        raise InputError(
-            "the Allan deviation has zero values (constant rate?); noise terms need a noisy record"
-        )
-    log_tau, log_dev = np.log(taus), np.log(dev)
-    slope = np.gradient(log_dev, log_tau)
-    weights = allan.blocks[usable].astype(np.float64)
-    i_min = int(np.argmin(dev))
-    index = np.arange(taus.size)
-
-    arw = None
-    arw_taus = None
-    pick = (index <= i_min) & (np.abs(slope + 0.5) <= slope_tolerance)
-    if pick.sum() >= min_points:
-        log_n = np.average(log_dev[pick] + 0.5 * log_tau[pick], weights=weights[pick])
-        # weighted least squares of ln σ = ln N − ½ ln τ; ARW = σ(1 h) = N/60
-        arw = math.exp(log_n) / math.sqrt(SECONDS_PER_HOUR)
-        arw_taus = (float(taus[pick][0]), float(taus[pick][-1]))
-
-    rrw = None
-    rrw_taus = None
-    pick = (index > i_min) & (np.abs(slope - 0.5) <= slope_tolerance)
-    if pick.sum() >= min_points:
-        # ln σ = ln(K_s/√3) + ½ ln τ, K in °/h/√s; σ at τ = 3 h equals K_s·60.
-        log_k = np.average(log_dev[pick] - 0.5 * log_tau[pick], weights=weights[pick])
-        rrw = math.exp(log_k) * math.sqrt(3.0 * SECONDS_PER_HOUR)
-        rrw_taus = (float(taus[pick][0]), float(taus[pick][-1]))
-
-    return NoiseTerms(
-        arw_deg_per_rt_h=arw,
-        bias_instability_dph=float(dev[i_min]) / FLICKER_FLOOR_FACTOR,
-        rrw_dph_per_rt_h=rrw,
-        arw_taus_s=arw_taus,
-        bias_instability_tau_s=float(taus[i_min]),
-        rrw_taus_s=rrw_taus,
-        floor_reached=i_min < taus.size - 1,
     )

@@ -5,7 +5,8 @@ The paper [1] judges a compensation by the bias stability of the gyro output
 and the three noise terms that gyro data sheets quote.
 
 - :func:`bias_stability`: 1σ of non-overlapping τ-second means, in °/h.
-- :func:`allan_deviation`, :func:`noise_terms`: from :mod:`hrgtc.evaluation.allan`.
+- :func:`allan_deviation` from :mod:`hrgtc.evaluation.allan`, :func:`noise_terms` from
+  :mod:`hrgtc.evaluation.noise`.
 - :func:`residual_against_truth`: how well a bias model tracks the simulator's
   true bias.
 
@@ -24,21 +25,23 @@ import numpy as np
 from hrgtc.errors import InputError
 from hrgtc.evaluation.allan import (
     FLICKER_FLOOR_FACTOR,
+    ONE_SIGMA,
     SECONDS_PER_HOUR,
     TAU_SPACINGS,
     AllanResult,
-    NoiseTerms,
     _as_rate,
     _block_length,
     _check_sample_rate,
     allan_deviation,
-    noise_terms,
+    confidence_interval,
 )
+from hrgtc.evaluation.noise import NoiseTerms, noise_terms
 
 __all__ = [
     "DEFAULT_TAUS_S", "FLICKER_FLOOR_FACTOR", "SECONDS_PER_HOUR", "TAU_SPACINGS",
     "AllanResult", "NoiseTerms", "ResidualResult", "allan_deviation", "bias_stability",
-    "bias_stability_table", "noise_terms", "residual_against_truth", "table_from_json",
+    "bias_stability_interval", "bias_stability_intervals", "bias_stability_table",
+    "noise_terms", "residual_against_truth", "table_from_json",
     "table_to_json",
 ]
 
@@ -114,6 +117,54 @@ def bias_stability_table(
     fs = _check_sample_rate(sample_rate_hz)
     rate = _as_rate(rate_dph, "rate_dph")
     return {float(tau): _bias_stability(rate, _block_length(tau, fs)) for tau in taus_s}
+
+
+def bias_stability_interval(
+    value_dph: float, blocks: int, confidence: float = ONE_SIGMA
+) -> tuple[float, float]:
+    """Chi-squared confidence interval of a bias stability (1σ of ``blocks`` block means).
+
+    The block means of a record whose bias varies as white noise at τ are
+    independent, so ``(blocks − 1)·s²/σ²`` follows χ² with ``blocks − 1`` degrees
+    of freedom (SP 1065 Eq. 45 with edf = blocks − 1): ``σ`` lies between
+    ``s·√((k−1)/χ²(1 − p/2))`` and ``s·√((k−1)/χ²(p/2))``, p = 1 − confidence. Drift
+    makes the block means correlated and the interval too narrow; it is a statement
+    about noise, not about a ramp.
+
+    Parameters
+    ----------
+    value_dph
+        Bias stability from :func:`bias_stability`. [°/h]
+    blocks
+        Number of block means it was computed from (``floor(N / m)``).
+    confidence
+        Two-sided level in (0, 1), :data:`ONE_SIGMA` (0.683) by default.
+
+    Returns
+    -------
+    lower, upper : float
+        NaN for fewer than two blocks or a NaN value. [°/h]
+
+    Examples
+    --------
+    >>> low, high = bias_stability_interval(1.0, blocks=101)
+    >>> round(low, 3), round(high, 3)
+    (0.936, 1.079)
+    """
+    if blocks < 2 or not math.isfinite(value_dph):
+        return math.nan, math.nan
+    lower, upper = confidence_interval(value_dph, blocks - 1, confidence)
+    return float(lower), float(upper)
+
+
+def bias_stability_intervals(
+    table: Mapping[float, float], n_samples: int, sample_rate_hz: float,
+    confidence: float = ONE_SIGMA,
+) -> dict[float, tuple[float, float]]:
+    """:func:`bias_stability_interval` of each τ of a table of a record of ``n_samples``."""
+    fs = _check_sample_rate(sample_rate_hz)
+    return {tau: bias_stability_interval(value, n_samples // _block_length(tau, fs), confidence)
+            for tau, value in table.items()}
 
 
 def table_to_json(table: Mapping[float, float]) -> dict[str, float | None]:

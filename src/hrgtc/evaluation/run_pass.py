@@ -20,7 +20,7 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Callable, Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -29,10 +29,21 @@ import numpy as np
 from hrgtc.compensate import Compensator
 from hrgtc.compensate.compensator import with_model_band
 from hrgtc.compensate.ranges import RangeReport
-from hrgtc.drift.features import settle_rows
+from hrgtc.drift.features import FeatureStream, settle_rows
 from hrgtc.errors import HrgtcError, InputError, RecordingError
-from hrgtc.evaluation.allan import AllanResult, NoiseTerms, noise_terms
-from hrgtc.evaluation.metrics import DEFAULT_TAUS_S, table_to_json
+from hrgtc.evaluation.allan import (
+    ONE_SIGMA,
+    AllanResult,
+    allan_deviation,
+    confidence_interval,
+    equivalent_degrees_of_freedom,
+)
+from hrgtc.evaluation.metrics import (
+    DEFAULT_TAUS_S,
+    bias_stability_intervals,
+    table_to_json,
+)
+from hrgtc.evaluation.noise import NoiseTerms, noise_terms
 from hrgtc.evaluation.series_stats import SeriesStatistics
 from hrgtc.model import UnitModel
 from hrgtc.progress import Progress
@@ -44,6 +55,11 @@ from hrgtc.recording.marks import compensation_mark, describe_mark, refuse_compe
 SERIES = ("raw", "compensated", "housing")
 #: Shortest plotting block. [s]
 BLOCK_S = 10.0
+#: ``--deviation`` names -> (kind of :func:`allan_deviation`, overlapping), after allantools.
+DEVIATIONS = {"adev": ("allan", False), "oadev": ("allan", True), "mdev": ("modified", True),
+              "hdev": ("hadamard", True), "tdev": ("time", True)}
+#: Prefix of the model's variables among the plotting blocks (``var_f``, ``var_df``, ...).
+VARIABLE_PREFIX = "var_"
 
 
 class BlockMeans:
@@ -97,7 +113,8 @@ class Evaluation:
         fewer than two blocks fit (``"housing"`` only with a housing baseline and
         ``housing_c``). [s] -> [°/h]
     allan, noise
-        Allan deviation (overlapping, octave τ) and its noise terms, same keys (empty
+        Allan deviation (``deviation``, octave τ, with its ``confidence`` interval where
+        SP 1065 gives one) and its noise terms (Allan deviations only), same keys (empty
         when not computed or when the series is too short; see ``notes``).
     out_of_range_fraction
         Share of samples outside the calibrated temperature ranges.
@@ -109,13 +126,22 @@ class Evaluation:
         Plotting blocks (length [s] and block means of ``time_s``, ``raw_dph``,
         ``model_dph``, ``comp_dph``, ``temperature_c``, ``in_range`` and where recorded
         ``comp_housing_dph``, ``true_dph``, ``resonator_c``, ``housing_c``,
-        ``chamber_c``), or None when the pass kept none.
+        ``chamber_c``, ``model_std_dph`` the 1σ of the model line from its coefficients'
+        covariance, and the model's variables as ``var_f``, ``var_df``, ...), or None
+        when the pass kept none.
     notes
         Why a figure is missing (e.g. a run too short for the Allan deviation).
     ranges
         Shares of samples beyond the trained temperature and df/dt, and how far. The
         figures leave out the first ``warmup_s`` of the run (the df/dt filter settling),
         as training does.
+    bias_stability_interval_dph
+        ``{series: {tau_s: (lower, upper)}}``: chi-squared interval of each bias
+        stability with (blocks − 1) degrees of freedom at ``confidence``. [°/h]
+    confidence
+        Two-sided level of the intervals (0.683: 1σ).
+    deviation
+        Which deviation ``allan`` holds (a key of :data:`DEVIATIONS`).
     """
 
     file: str
@@ -134,6 +160,10 @@ class Evaluation:
     blocks: dict[str, np.ndarray] | None = None
     notes: tuple[str, ...] = field(default=())
     ranges: RangeReport | None = None
+    bias_stability_interval_dph: dict[str, dict[float, tuple[float, float]]] = field(
+        default_factory=dict)
+    confidence: float = ONE_SIGMA
+    deviation: str = "oadev"
 
     @property
     def name(self) -> str:
@@ -149,6 +179,32 @@ class Evaluation:
         """Bias stability of one series at one τ, None where it is not available. [°/h]"""
         value = self.bias_stability_dph.get(series, {}).get(float(tau_s), math.nan)
         return None if math.isnan(value) else value
+
+    def stability_interval(self, series: str, tau_s: float) -> tuple[float, float] | None:
+        """Confidence interval of one bias stability, None where not available. [°/h]"""
+        bounds = self.bias_stability_interval_dph.get(series, {}).get(float(tau_s))
+        return None if bounds is None or math.isnan(bounds[0]) else bounds
+
+    def stability_text(self, series: str, tau_s: float, digits: int = 4) -> str:
+        """A bias stability with its interval, e.g. ``0.957 (0.93–0.99)``; ``-`` if none."""
+        value = self.stability(series, tau_s)
+        if value is None:
+            return "-"
+        bounds = self.stability_interval(series, tau_s)
+        if bounds is None:
+            return f"{value:.{digits}g}"
+        return f"{value:.{digits}g} ({bounds[0]:.{digits - 1}g}–{bounds[1]:.{digits - 1}g})"
+
+    @property
+    def prediction_std_dph(self) -> dict[str, float] | None:
+        """Median and maximum over the run of the model line's 1σ (blocks kept only). [°/h]"""
+        if self.blocks is None or "model_std_dph" not in self.blocks:
+            return None
+        std = self.blocks["model_std_dph"]
+        std = std[np.isfinite(std)]
+        if std.size == 0:
+            return None
+        return {"median": float(np.median(std)), "max": float(np.max(std))}
 
     @property
     def raw_10s(self) -> float:
@@ -181,12 +237,34 @@ class Evaluation:
                                        "compensated": _finite(self.compensated_10s)},
             "improvement_10s": _finite(self.improvement_10s),
             "allan": noise,
+            "deviation": self.deviation,
+            "allan_curve": {k: _curve(a) for k, a in self.allan.items()},
+            "confidence": self.confidence,
+            "bias_stability_interval_dph": {
+                k: {f"{t:g}": (None if math.isnan(b[0]) else [float(b[0]), float(b[1])])
+                    for t, b in row.items()}
+                for k, row in self.bias_stability_interval_dph.items()},
+            "prediction_std_dph": self.prediction_std_dph,
             "out_of_range_fraction": self.out_of_range_fraction,
             "rate_out_of_range_fraction": self.rate_out_of_range_fraction,
             "residual_rms_dph": self.residual_rms_dph,
             "ranges": None if self.ranges is None else self.ranges.to_dict(),
             "notes": list(self.notes),
         }
+
+    def allan_csv(self) -> str:
+        """The deviation curves as CSV text: series, tau_s, deviation, lower, upper, n.
+
+        ``lower`` / ``upper`` are empty where the curve has no interval (mdev, hdev, tdev).
+        """
+        lines = ["series,tau_s,deviation,lower,upper,n"]
+        for key, curve in self.allan.items():
+            for k, tau in enumerate(curve.taus_s):
+                bounds = ("", "") if curve.lower is None or curve.upper is None else (
+                    repr(float(curve.lower[k])), repr(float(curve.upper[k])))
+                lines.append(f"{key},{float(tau)!r},{float(curve.deviation[k])!r},"
+                             f"{bounds[0]},{bounds[1]},{int(curve.counts[k])}")
+        return "\n".join(lines) + "\n"
 
     def range_warnings(self) -> list[str]:
         """Lines on samples beyond the trained temperature and df/dt (empty if none)."""
@@ -202,6 +280,9 @@ class Evaluation:
                  "bias stability [°/h]  " + "".join(f"{f'{t:g} s':>9}" for t in taus)]
         for name, row in self.bias_stability_dph.items():
             lines.append(f"  {name:<19}" + "".join(f" {fmt(row[t])}" for t in taus))
+        if self.bias_stability_interval_dph:
+            lines.append(f"  ({self.confidence:.3g} intervals at 10 s: " + ", ".join(
+                f"{k} {self.stability_text(k, 10.0)}" for k in self.bias_stability_dph) + ")")
         lines.append(f"improvement at 10 s: {self.improvement_10s:.2f}×; out of calibrated range: "
                      f"{self.out_of_range_fraction:.1%} (df/dt beyond training: "
                      f"{self.rate_out_of_range_fraction:.1%})")
@@ -262,6 +343,33 @@ class _SettlingCut:
         self.flushed = True
 
 
+def _curve(allan: AllanResult) -> dict[str, Any]:
+    """One deviation curve as JSON lists (lower/upper None where no interval)."""
+    def listed(values: np.ndarray | None) -> list[float | None]:
+        if values is None:
+            return [None] * allan.taus_s.size
+        return [_finite(float(v)) for v in values]
+
+    return {"tau_s": allan.taus_s.tolist(), "deviation": listed(allan.deviation),
+            "lower": listed(allan.lower), "upper": listed(allan.upper),
+            "n": allan.counts.tolist(), "kind": allan.kind, "overlapping": allan.overlapping}
+
+
+def _with_interval(result: AllanResult, n_samples: int, confidence: float) -> AllanResult:
+    """The overlapping Allan deviation with its chi-squared interval (SP 1065 simple edf)."""
+    m = np.rint(result.taus_s * result.sample_rate_hz).astype(np.int64)
+    edf = np.array([equivalent_degrees_of_freedom(n_samples + 1, int(k)) for k in m])
+    lower, upper = confidence_interval(result.deviation, edf, confidence)
+    return replace(result, lower=lower, upper=upper, confidence=float(confidence))
+
+
+def _deviation(values: np.ndarray, fs: float, deviation: str, confidence: float) -> AllanResult:
+    """The run's deviation curve, with a confidence interval where SP 1065 gives one."""
+    kind, overlapping = DEVIATIONS[deviation]
+    return allan_deviation(values, fs, taus="octave", kind=kind, overlapping=overlapping,
+                           confidence=confidence if kind == "allan" else None)
+
+
 def run_pass(
     model: UnitModel,
     chunks: Iterable[Recording],
@@ -275,6 +383,8 @@ def run_pass(
     progress: Progress | None = None,
     total_rows: int = 0,
     gaps: str = "ignore",
+    deviation: str = "oadev",
+    confidence: float = ONE_SIGMA,
 ) -> Evaluation:
     """Compensate one run given as consecutive chunks, once, and measure it.
 
@@ -309,16 +419,30 @@ def run_pass(
         ``"split"``: the df/dt filter restarts after each gap (see
         :class:`~hrgtc.compensate.Compensator`); the statistics run over the joined
         segments.
+    deviation
+        The deviation curve: ``"oadev"`` (overlapping Allan, default), ``"adev"``
+        (non-overlapping), ``"mdev"``, ``"hdev"``, ``"tdev"`` (:data:`DEVIATIONS`).
+        Noise terms are read off the Allan deviations only; the chi-squared interval
+        (simple edf, white rate noise, SP 1065 Table 5) is given for ``"oadev"`` and
+        ``"adev"``.
+    confidence
+        Two-sided level of the intervals (bias stability and Allan deviation).
 
     Raises
     ------
     InputError
         The run holds no samples, or is shorter than two 10 s blocks.
     """
+    if deviation not in DEVIATIONS:
+        raise InputError(f"deviation={deviation!r} is not known; use one of {tuple(DEVIATIONS)}")
     frequency = Compensator(model, gaps=gaps)
+    features = None
+    if block_rows:
+        features = FeatureStream(model.drift.settings, model.drift.variables)
     housing: Compensator | None = None
     means = BlockMeans(block_rows) if block_rows else None
     full: dict[str, SeriesStatistics] = {}
+    whole: dict[str, list[np.ndarray]] = {}  # only for deviations the streaming cannot give
     squared_error = 0.0
     truth = False
     metadata = None
@@ -348,44 +472,65 @@ def run_pass(
             pushed["housing"] = comp_h
             columns["comp_housing_dph"] = comp_h
         cut.push(pushed)
+        if allan and deviation != "oadev":
+            for key, values in pushed.items():
+                whole.setdefault(key, []).append(values)
         if truth:
             columns["true_dph"] = chunk["bias_dph"]
             squared_error += float(np.sum((out["bias_model_dph"] - chunk["bias_dph"]) ** 2))
         if means is not None:
             columns.update({k: chunk[k] for k in ("resonator_c", "housing_c", "chamber_c")
                             if k in chunk})
+            assert features is not None
+            columns.update({VARIABLE_PREFIX + k: v for k, v in features.process(chunk).items()})
             means.push(columns)
         if progress is not None:
             progress(frequency.samples, total_rows)
     if metadata is None:
         raise InputError(f"{name}: the run holds no samples")
     fs = metadata.sample_rate_hz
-    cut.finish()
+    n_used = frequency.samples - cut.finish()
     n = frequency.samples
     if n < 2 * round(10.0 * fs):
         raise InputError(f"{name}: {n / fs:.1f} s is too short for a 10 s bias stability "
                          "(it needs at least 20 s)")
     stability: dict[str, dict[float, float]] = {}
+    intervals: dict[str, dict[float, tuple[float, float]]] = {}
     deviations: dict[str, AllanResult] = {}
     terms: dict[str, NoiseTerms] = {}
     notes: list[str] = []
     for key, series in full.items():
         stability[key] = series.bias_stability()
+        intervals[key] = bias_stability_intervals(stability[key], n_used, fs, confidence)
         if not allan:
             continue
         try:
-            deviations[key] = series.allan_deviation()
-            terms[key] = noise_terms(deviations[key])
+            if deviation == "oadev":
+                deviations[key] = _with_interval(series.allan_deviation(), n_used, confidence)
+            else:  # the other deviations need the whole series (held in memory for them)
+                deviations[key] = _deviation(np.concatenate(whole[key])[cut.cut:], fs,
+                                             deviation, confidence)
+            if deviations[key].kind == "allan":
+                terms[key] = noise_terms(deviations[key])
         except HrgtcError as exc:
             notes.append(f"{key}: no Allan noise terms ({exc})")
+    if allan and deviation not in ("adev", "oadev"):
+        notes.append(f"noise terms are read off the Allan deviation; --deviation {deviation} "
+                     "gives the curve only")
+    kept = None if means is None else means.means()
+    if kept is not None and model.drift.terms:
+        values_at = {k.removeprefix(VARIABLE_PREFIX): v for k, v in kept.items()
+                     if k.startswith(VARIABLE_PREFIX)}
+        kept["model_std_dph"] = model.drift.prediction_std(values_at)
     return Evaluation(
         name, n, float(fs), stability, deviations, terms, frequency.out_of_range_fraction,
         frequency.rate_out_of_range_fraction,
         math.sqrt(squared_error / n) if truth else None,
         source=source, unit=metadata.unit, input_rate_dph=metadata.input_rate_dph,
         block_s=None if means is None else means.rows / fs,
-        blocks=None if means is None else means.means(), notes=tuple(notes),
-        ranges=frequency.ranges(),
+        blocks=kept, notes=tuple(notes), ranges=frequency.ranges(),
+        bias_stability_interval_dph=intervals, confidence=float(confidence),
+        deviation=deviation,
     )
 
 
@@ -399,6 +544,8 @@ def evaluate(
     max_points: int | None = None,
     on_output: Callable[[Recording], None] | None = None,
     progress: Progress | None = None,
+    deviation: str = "oadev",
+    confidence: float = ONE_SIGMA,
 ) -> Evaluation:
     """Raw vs compensated bias stability, Allan noise terms and range shares of one run.
 
@@ -416,7 +563,7 @@ def evaluate(
         How to read a file (column mapping, units, metadata, chunk size).
     max_points
         Keep at most this many plotting blocks (of at least 10 s); None keeps none.
-    on_output, progress
+    on_output, progress, deviation, confidence
         As for :func:`run_pass`.
     """
     gaps = (read_options or ReadOptions()).gaps
@@ -441,4 +588,5 @@ def evaluate(
         blocks = block_rows(rows, fs, max_points)
     return run_pass(model, chunks, name, source=source, taus_s=taus_s, allan=allan,
                     block_rows=blocks, on_output=on_output, progress=progress,
-                    total_rows=rows, gaps=gaps)
+                    total_rows=rows, gaps=gaps, deviation=deviation,
+                    confidence=confidence)

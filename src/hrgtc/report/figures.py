@@ -310,6 +310,10 @@ def run_figure(run: Evaluation) -> Figure:
     raw_ax.plot(hours, b["raw_dph"], color=RAW,
                 label=f"output − input rate ({_at10(run, 'raw')})")
     raw_ax.plot(hours, b["model_dph"], color=MODEL, label="drift model (Eq. 22 form)")
+    if "model_std_dph" in b:  # 1σ of the fitted line from the coefficients' covariance
+        raw_ax.fill_between(hours, b["model_dph"] - b["model_std_dph"],
+                            b["model_dph"] + b["model_std_dph"], color=MODEL, alpha=0.25, lw=0,
+                            label="model ±1σ (coefficient covariance, Newey-West)")
     if "true_dph" in b:
         raw_ax.plot(hours, b["true_dph"], color=TRUTH, lw=0.8, ls="--",
                     label="true bias (simulator)")
@@ -351,7 +355,11 @@ def _at10(run: Evaluation, series: str) -> str:
 
 @_styled
 def allan_figure(run: Evaluation) -> Figure:
-    """Allan deviation of the raw and compensated output (log-log), minima marked."""
+    """Allan deviation of the raw and compensated output (log-log), minima marked.
+
+    Where the curve carries a confidence interval (overlapping Allan deviation,
+    chi-squared with the simple edf of SP 1065) it is drawn as error bars.
+    """
     figure = _figure(2 * _PANEL_WIDTH_IN, 3.6)
     ax = figure.subplots()
     colours = {"raw": RAW, "compensated": COMPENSATED, "housing": HOUSING}
@@ -360,13 +368,23 @@ def allan_figure(run: Evaluation) -> Figure:
     for key, allan in run.allan.items():
         ax.loglog(allan.taus_s, allan.deviation, "-o", ms=2.5, color=colours[key],
                   label=labels[key])
+        if allan.lower is not None and allan.upper is not None:
+            ax.errorbar(allan.taus_s, allan.deviation,
+                        yerr=(allan.deviation - allan.lower, allan.upper - allan.deviation),
+                        fmt="none", ecolor=colours[key], elinewidth=0.8, capsize=1.5)
+            ax.fill_between(allan.taus_s, allan.lower, allan.upper, color=colours[key],
+                            alpha=0.12, lw=0)
         terms = run.noise.get(key)
-        if terms is not None:
+        if terms is not None and terms.bias_instability_dph is not None:
             tau = terms.bias_instability_tau_s
             minimum = terms.bias_instability_dph * FLICKER_FLOOR_FACTOR
             ax.plot([tau], [minimum], "s", mfc="none", ms=7, color=colours[key])
     ax.set_xlabel("averaging time τ [s]")
-    ax.set_ylabel("Allan deviation [°/h]")
+    names = {"adev": "Allan deviation (non-overlapping)", "oadev": "Allan deviation",
+             "mdev": "modified Allan deviation", "hdev": "Hadamard deviation",
+             "tdev": "time deviation"}
+    unit = "[°/h·s]" if run.deviation == "tdev" else "[°/h]"
+    ax.set_ylabel(f"{names.get(run.deviation, run.deviation)} {unit}")
     plain = FuncFormatter(lambda value, _: f"{value:g}")
     ax.xaxis.set_major_formatter(plain)
     ax.yaxis.set_major_formatter(plain)

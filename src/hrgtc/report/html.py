@@ -320,9 +320,9 @@ def _run(page: _Page, k: int, run: Evaluation, model: UnitModel) -> None:
     housing = "housing" in run.bias_stability_dph
     rows = []
     for tau in run.bias_stability_dph["raw"]:
-        rows.append((f"{tau:g}", _number(run.stability("raw", tau)),
-                     _number(run.stability("compensated", tau)), _number(_ratio(run, tau), 3),
-                     *([_number(run.stability("housing", tau))] if housing else []),
+        rows.append((f"{tau:g}", _stability(run, "raw", tau),
+                     _stability(run, "compensated", tau), _number(_ratio(run, tau), 3),
+                     *([_stability(run, "housing", tau)] if housing else []),
                      *((_number(paper.BIAS_STABILITY_RAW_DPH, 5),
                         _number(paper.BIAS_STABILITY_COMPENSATED_DPH, 4)) if tau == 10.0
                        else ("–", "–"))))
@@ -330,11 +330,17 @@ def _run(page: _Page, k: int, run: Evaluation, model: UnitModel) -> None:
                *(["housing baseline [°/h]"] if housing else []),
                "paper raw [°/h]", "paper compensated [°/h]"]
     page.add(_table(headers, rows, f"Bias stability of {run.name}: 1σ of τ-second means "
-                        "of output − input rate (paper [1], Section 4.2: 3.0143 → 0.5848 °/h "
+                        "of output − input rate with its "
+                        f"{run.confidence:.3g} chi-squared interval, (blocks − 1) degrees "
+                        "of freedom (paper [1], Section 4.2: 3.0143 → 0.5848 °/h "
                         "on its cool-down)"))
     facts = [("samples outside the calibrated range (f, T)", f"{run.out_of_range_fraction:.2%}"),
              ("samples with df/dt outside its training range",
               f"{run.rate_out_of_range_fraction:.2%}")]
+    if run.prediction_std_dph is not None:
+        facts.append(("1σ of the drift model line (coefficient covariance), median / max "
+                      "[°/h]", f"{_number(run.prediction_std_dph['median'])} / "
+                      f"{_number(run.prediction_std_dph['max'])}"))
     if run.residual_rms_dph is not None:
         facts.append(("RMS of model − true bias (simulator) [°/h]",
                       _number(run.residual_rms_dph)))
@@ -346,17 +352,23 @@ def _run(page: _Page, k: int, run: Evaluation, model: UnitModel) -> None:
                  f"{escape(line.removeprefix('warning: '))}</p>")
     if run.allan:
         page.figure(figures.allan_figure(run),
-                    "Overlapping Allan deviation of the output before and after compensation "
-                    "(octave τ); squares mark the bias-instability minimum.",
+                    f"Deviation ({run.deviation}) of the output before and after compensation "
+                    f"(octave τ) with its {run.confidence:.3g} chi-squared interval where "
+                    "SP 1065 gives one; squares mark a flat bias-instability minimum.",
                     f"Allan deviation of {run.name}")
         names = {"raw": "raw", "compensated": "compensated", "housing": "housing baseline"}
-        rows = [(names[key], _number(n.arw_deg_per_rt_h), _number(n.bias_instability_dph)
-                 + ("" if n.floor_reached else " (bound)"), _number(n.rrw_dph_per_rt_h))
-                for key, n in run.noise.items()]
+        rows = [(names[key], n.text("arw"), n.text("bias_instability"), n.text("rrw"))
+                for key, n in run.noise.items()]  # _table escapes the cells
         page.add(_table(("output", "ARW [°/√h]", "bias instability [°/h]",
                              "RRW [°/h/√h]"), rows,
                             f"Allan noise terms of {run.name} (IEEE Std 952-1997, Annex C)"))
     page.add("</section>")
+
+
+def _stability(run: Evaluation, series: str, tau_s: float) -> str:
+    """A bias stability with its interval, "–" where there is none."""
+    text = run.stability_text(series, tau_s)
+    return "–" if text == "-" else text
 
 
 def _excluded(d: Any) -> str:

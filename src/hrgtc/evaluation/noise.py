@@ -1,0 +1,263 @@
+"""The Allan noise terms of a gyro, read off its Allan deviation only where they show.
+
+Angle random walk, bias instability and rate random walk are each the height of
+one power law of the Allan deviation, IEEE Std 952-1997 Annex C [2]: σ ∝ τ^-½,
+a flat minimum, σ ∝ τ^+½. :func:`noise_terms` reads a term only where the local
+log-log slope of the curve is that law (within a tolerance); elsewhere the term
+is None with the reason, e.g. a curve that rises as τ¹ after its minimum is a
+thermal ramp, and reading a "rate random walk" off it would quote the ramp as
+noise.
+
+References
+----------
+[2] IEEE Std 952-1997, "IEEE Standard Specification Format Guide and Test
+    Procedure for Single-Axis Interferometric Fiber Optic Gyros", Annex C
+    (Allan variance method of fiber optic gyro data reduction).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass, fields
+from typing import Any
+
+import numpy as np
+
+from hrgtc.errors import InputError
+from hrgtc.evaluation.allan import FLICKER_FLOOR_FACTOR, SECONDS_PER_HOUR, AllanResult
+
+__all__ = ["RAMP_SLOPE", "NoiseTerms", "noise_terms"]
+
+#: A rise after the minimum steeper than this (log-log slope, half-way between the
+#: +½ of rate random walk and the +1 of a rate ramp) is read as a ramp.
+RAMP_SLOPE = 0.75
+
+
+@dataclass(frozen=True)
+class NoiseTerms:
+    """Allan noise terms of a gyro, IEEE Std 952-1997 Annex C conventions [2].
+
+    Attributes
+    ----------
+    arw_deg_per_rt_h
+        Angle random walk N: the −½-slope line σ(τ) = N/√τ read at τ = 1 h, or None
+        where the curve has no −½ region (``arw_reason`` says why). [°/√h]
+    bias_instability_dph
+        Bias instability B = σ_min / 0.664 at a flat minimum of the deviation, or None
+        where the minimum is not flat (e.g. still falling at the longest usable τ). [°/h]
+    rrw_dph_per_rt_h
+        Rate random walk K: the +½-slope line σ(τ) = K·√(τ/3) read at τ = 3 h, or None
+        where the curve does not rise as τ^+½ (``rrw_reason``). [°/h/√h]
+    arw_taus_s, rrw_taus_s
+        First and last τ of the points each line was fitted to, or None. [s]
+    bias_instability_tau_s
+        τ of the minimum of the usable curve. [s]
+    floor_reached
+        False if the minimum is the longest usable τ, i.e. the deviation was
+        still falling there.
+    minimum_dph
+        The smallest usable deviation σ_min (an upper bound of 0.664·B). [°/h]
+    arw_reason, bias_instability_reason, rrw_reason
+        Why a term is None (None when it was read).
+    """
+
+    arw_deg_per_rt_h: float | None
+    bias_instability_dph: float | None
+    rrw_dph_per_rt_h: float | None
+    arw_taus_s: tuple[float, float] | None
+    bias_instability_tau_s: float
+    rrw_taus_s: tuple[float, float] | None
+    floor_reached: bool
+    minimum_dph: float = math.nan
+    arw_reason: str | None = None
+    bias_instability_reason: str | None = None
+    rrw_reason: str | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types (τ ranges as lists)."""
+        return {k: list(v) if isinstance(v, tuple) else v for k, v in asdict(self).items()}
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> NoiseTerms:
+        """Inverse of :meth:`to_dict`."""
+        names = {f.name for f in fields(cls)}
+        return cls(
+            **{k: tuple(v) if isinstance(v, list) else v for k, v in data.items() if k in names}
+        )
+
+    def text(self, term: str, digits: int = 4) -> str:
+        """One term as text: the number, or the reason it is missing.
+
+        ``term`` is ``"arw"``, ``"bias_instability"`` or ``"rrw"``.
+        """
+        value = {"arw": self.arw_deg_per_rt_h, "bias_instability": self.bias_instability_dph,
+                 "rrw": self.rrw_dph_per_rt_h}[term]
+        if value is None:
+            return getattr(self, f"{term}_reason") or "n/a"
+        return f"{value:.{digits}g}"
+
+    def summary(self) -> str:
+        """Three lines, one per noise term, with the τ range each was read from."""
+
+        def fmt(value: float | None, taus: tuple[float, float] | None, unit: str,
+                reason: str | None) -> str:
+            if value is None or taus is None:
+                return f"n/a ({reason})"
+            return f"{value:.4g} {unit}  (fit over tau {taus[0]:g}-{taus[1]:g} s)"
+
+        if self.bias_instability_dph is None:
+            bias = f"n/a ({self.bias_instability_reason})"
+        else:
+            bias = (f"{self.bias_instability_dph:.4g} deg/h  "
+                    f"(minimum at tau {self.bias_instability_tau_s:g} s)")
+        return "\n".join(
+            [
+                "angle random walk  " + fmt(self.arw_deg_per_rt_h, self.arw_taus_s, "deg/rt-h",
+                                            self.arw_reason),
+                f"bias instability   {bias}",
+                "rate random walk   " + fmt(self.rrw_dph_per_rt_h, self.rrw_taus_s,
+                                            "deg/h/rt-h", self.rrw_reason),
+            ]
+        )
+
+
+def _law(slope: float) -> str:
+    """A local log-log slope as a power of τ, e.g. ``τ^1.0``."""
+    return f"τ^{slope:+.2g}".replace("+", "")
+
+
+def noise_terms(
+    allan: AllanResult,
+    *,
+    slope_tolerance: float = 0.15,
+    min_blocks: int = 8,
+    min_points: int = 2,
+) -> NoiseTerms:
+    """Angle random walk, bias instability and rate random walk, IEEE 952 Annex C [2].
+
+    The Allan deviation of a rate in °/h against τ in s is read with the
+    conventions of Annex C of [2], each term only where its law shows:
+
+    - ARW: σ(τ) = N/√τ. A line of slope −½ is fitted (in log-log, weighted by
+      the number of τ-blocks) to the points left of the minimum whose local
+      slope is within ``slope_tolerance`` of −½, and read at τ = 1 h:
+      ``ARW [°/√h] = σ(3600 s) = N[°/h·√s] / 60``.
+    - Bias instability: ``B = σ_min / 0.664`` (0.664 ≈ √(2 ln 2 / π), flicker floor),
+      only where the minimum is inside the usable τ and the local slope there is
+      within the tolerance of 0.
+    - RRW: σ(τ) = K·√(τ/3). A line of slope +½ is fitted to the points right of
+      the minimum with local slope within the tolerance of +½ and read at
+      τ = 3 h: ``K [°/h/√h] = σ(10800 s)``; not when the rising part after the
+      minimum (points of local slope ≥ ½ − tolerance) has a fitted slope above
+      :data:`RAMP_SLOPE` (a ramp, σ ∝ τ, dominates the long τ there).
+
+    Only τ with at least ``min_blocks`` whole τ-blocks in the record are used
+    (longer τ are too uncertain). A term is None with a reason when fewer than
+    ``min_points`` points qualify, e.g. RRW on a record too short to show the
+    +½ region.
+
+    Parameters
+    ----------
+    allan
+        Allan deviation of a rate in °/h, from :func:`~hrgtc.evaluation.allan.allan_deviation`.
+    slope_tolerance
+        Accepted distance of the local log-log slope from −½, 0 and +½.
+    min_blocks
+        Minimum number of non-overlapping τ-blocks for a τ to be used.
+    min_points
+        Minimum number of points for the ARW and RRW lines.
+
+    Returns
+    -------
+    NoiseTerms
+        The three terms (or why not) and the τ ranges they were read from.
+
+    Raises
+    ------
+    InputError
+        If fewer than 3 usable τ remain or the deviation is not positive.
+    """
+    usable = allan.blocks >= min_blocks
+    taus = allan.taus_s[usable]
+    dev = allan.deviation[usable]
+    if taus.size < 3:
+        raise InputError(
+            f"noise terms need at least 3 averaging times with >= {min_blocks} blocks each, "
+            f"got {taus.size} (record of {allan.n_samples} samples); use a longer record "
+            "or more taus"
+        )
+    if not np.all(dev > 0.0):
+        raise InputError(
+            "the Allan deviation has zero values (constant rate?); noise terms need a noisy record"
+        )
+    log_tau, log_dev = np.log(taus), np.log(dev)
+    slope = np.gradient(log_dev, log_tau)
+    weights = allan.blocks[usable].astype(np.float64)
+    i_min = int(np.argmin(dev))
+    index = np.arange(taus.size)
+    tol = slope_tolerance
+    last = taus.size - 1
+
+    arw = arw_taus = arw_reason = None
+    pick = (index <= i_min) & (np.abs(slope + 0.5) <= tol)
+    if pick.sum() >= min_points:
+        log_n = np.average(log_dev[pick] + 0.5 * log_tau[pick], weights=weights[pick])
+        # weighted least squares of ln σ = ln N − ½ ln τ; ARW = σ(1 h) = N/60
+        arw = math.exp(log_n) / math.sqrt(SECONDS_PER_HOUR)
+        arw_taus = (float(taus[pick][0]), float(taus[pick][-1]))
+    elif i_min == 0:
+        arw_reason = (f"no −½ slope: the curve does not fall from its first τ ({taus[0]:g} s; "
+                      f"it goes as {_law(slope[0])})")
+    else:
+        arw_reason = (f"no −½ slope: {int(pick.sum())} point(s) left of the minimum within "
+                      f"±{tol:g} of −½ (needs {min_points}); the curve goes as "
+                      f"{_law(float(np.median(slope[: i_min + 1])))} there")
+
+    floor = i_min < last
+    bias = bias_reason = None
+    if not floor:
+        bound = dev[last] / FLICKER_FLOOR_FACTOR
+        bias_reason = (f"no flat minimum: the curve still falls as {_law(slope[last])} at the "
+                       f"longest usable τ ({taus[last]:g} s); B < {bound:.4g} °/h")
+    elif i_min == 0:
+        bias_reason = f"no flat minimum: the curve rises from its first τ ({taus[0]:g} s)"
+    elif abs(slope[i_min]) > tol:
+        bias_reason = f"no flat minimum: the curve goes as {_law(slope[i_min])} at its minimum"
+    else:
+        bias = float(dev[i_min]) / FLICKER_FLOOR_FACTOR
+
+    rrw = rrw_taus = rrw_reason = None
+    pick = (index > i_min) & (np.abs(slope - 0.5) <= tol)
+    rising = (index > i_min) & (slope >= 0.5 - tol)
+    rise = (float(np.polyfit(log_tau[rising], log_dev[rising], 1)[0]) if rising.sum() >= 2
+            else math.nan)
+    if floor and rise > RAMP_SLOPE:
+        rrw_reason = (f"no +½ slope: the curve rises as {_law(rise)} after its minimum (up to "
+                      f"τ = {taus[last]:g} s) — a thermal ramp, not rate random walk")
+    elif not floor:
+        rrw_reason = (f"no +½ slope: the curve does not rise within the usable τ "
+                      f"(up to {taus[last]:g} s)")
+    elif pick.sum() < min_points:
+        rrw_reason = (f"no +½ slope: {int(pick.sum())} point(s) right of the minimum within "
+                      f"±{tol:g} of +½ (needs {min_points}); the curve goes as "
+                      f"{_law(float(np.median(slope[i_min + 1:])))} there")
+    else:
+        # ln σ = ln(K_s/√3) + ½ ln τ, K in °/h/√s; σ at τ = 3 h equals K_s·60.
+        log_k = np.average(log_dev[pick] - 0.5 * log_tau[pick], weights=weights[pick])
+        rrw = math.exp(log_k) * math.sqrt(3.0 * SECONDS_PER_HOUR)
+        rrw_taus = (float(taus[pick][0]), float(taus[pick][-1]))
+
+    return NoiseTerms(
+        arw_deg_per_rt_h=arw,
+        bias_instability_dph=bias,
+        rrw_dph_per_rt_h=rrw,
+        arw_taus_s=arw_taus,
+        bias_instability_tau_s=float(taus[i_min]),
+        rrw_taus_s=rrw_taus,
+        floor_reached=floor,
+        minimum_dph=float(dev[i_min]),
+        arw_reason=arw_reason,
+        bias_instability_reason=bias_reason,
+        rrw_reason=rrw_reason,
+    )
