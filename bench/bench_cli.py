@@ -16,7 +16,7 @@ import sys
 import time
 from pathlib import Path
 
-COMMANDS = ("paper", "simulate", "info", "calibrate", "compensate", "evaluate", "report",
+COMMANDS = ("paper", "simulate", "info", "calibrate", "compensate", "evaluate", "report", "fleet",
             "export-c", "demo")
 
 

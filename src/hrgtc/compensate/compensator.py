@@ -35,8 +35,8 @@ from hrgtc.files import check_writable
 from hrgtc.model import UnitModel
 from hrgtc.progress import Progress
 from hrgtc.recording import Recording
+from hrgtc.recording.gaps import GAP_PERIODS, check_gap_policy
 from hrgtc.recording.marks import COMPENSATED_KEY, mark, refuse_compensated
-from hrgtc.recording.validation import GAP_PERIODS, check_gap_policy
 
 #: Rows worked on at once: small enough for the temporaries to stay in cache.
 BLOCK_ROWS = 1 << 17

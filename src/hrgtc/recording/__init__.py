@@ -8,11 +8,12 @@ write recordings atomically.
 
 Modules: ``schema`` (the type and its columns), ``formats`` and ``csv`` (file
 formats), ``mapping`` (user columns and units), ``validation`` (the contract's
-checks) and ``checks`` (the single checks and unit heuristics), ``io`` (reading
+checks), ``gaps`` (gap policies) and ``checks`` (the single checks and unit heuristics), ``io`` (reading
 and writing), ``info`` (what is in a file), ``marks`` (the mark of a compensated
 output).
 """
 
+from hrgtc.recording.gaps import Gap, split_at_gaps
 from hrgtc.recording.info import RecordingInfo, describe
 from hrgtc.recording.io import (
     ReadOptions,
@@ -33,11 +34,9 @@ from hrgtc.recording.schema import (
     concatenate,
 )
 from hrgtc.recording.validation import (
-    Gap,
     Problem,
     RecordingValidator,
     ValidationReport,
-    split_at_gaps,
     validate,
 )
 

@@ -52,10 +52,9 @@ is validated chunk by chunk.
 
 from __future__ import annotations
 
-import itertools
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 
@@ -77,6 +76,15 @@ from hrgtc.recording.checks import (
     _check_time_unit,
     measured_sample_rate,
 )
+from hrgtc.recording.gaps import (
+    GAP_PERIODS,
+    GAP_POLICIES,
+    MAX_LISTED_GAPS,
+    Gap,
+    GapPolicy,
+    check_gap_policy,
+    split_at_gaps,
+)
 from hrgtc.recording.schema import REQUIRED_COLUMNS, Metadata, Recording
 
 __all__ = [
@@ -87,12 +95,8 @@ __all__ = [
     "measured_sample_rate", "problems_message", "split_at_gaps", "validate",
 ]
 
-GapPolicy = Literal["error", "split", "ignore"]
-GAP_POLICIES: tuple[str, ...] = ("error", "split", "ignore")
 
-GAP_PERIODS = 2.0  # a time step longer than this many sample periods is a gap
 HEURISTIC_ROWS = 100_000  # rows used for the sample-rate and unit heuristics
-MAX_LISTED_GAPS = 1000
 #: Physical bounds of every sample (outside: an error naming the first row).
 FREQ_SAMPLE_RANGE_HZ = (100.0, 1e5)  # n = 2 mode of any HRG: a few 100 Hz .. tens of kHz
 FREQ_JUMP_FRACTION = 0.05  # 84 ppm/°C over 300 °C is 2.5 %: more than 5 % off is a glitch
@@ -108,34 +112,6 @@ _BOUNDS: dict[str, tuple[float, float, str]] = {
     "housing_c": (*TEMPERATURE_RANGE_C, "°C"),
     "resonator_c": (*TEMPERATURE_RANGE_C, "°C"),
 }
-
-
-@dataclass(frozen=True)
-class Gap:
-    """A time step longer than :data:`GAP_PERIODS` sample periods.
-
-    Parameters
-    ----------
-    start_time_s
-        Time of the last sample before the gap. [s]
-    duration_s
-        Time between the samples on either side of the gap. [s]
-    row
-        First row after the gap (0 = first data row).
-    """
-
-    start_time_s: float
-    duration_s: float
-    row: int
-
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types."""
-        return asdict(self)
-
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> Gap:
-        """Inverse of :meth:`to_dict`."""
-        return cls(**dict(data))
 
 
 @dataclass(frozen=True)
@@ -222,13 +198,6 @@ def problems_message(source: str | None, problems: tuple[Problem, ...] | list[Pr
         return f"{where}: {problems[0].message}"
     items = "\n".join(f"  - {p.message}" for p in problems)
     return f"{where}: {len(problems)} problems:\n{items}"
-
-
-def check_gap_policy(gaps: str) -> str:
-    """Return ``gaps`` if it is a known gap policy, else raise InputError."""
-    if gaps not in GAP_POLICIES:
-        raise RecordingError(f"gaps must be one of {list(GAP_POLICIES)}, got {gaps!r}")
-    return gaps
 
 
 class RecordingValidator:
@@ -589,25 +558,3 @@ def validate(
     if raise_errors:
         report.raise_for_problems()
     return report
-
-
-def split_at_gaps(recording: Recording, max_gap_periods: float = GAP_PERIODS) -> list[Recording]:
-    """Cut a recording into gap-free segments.
-
-    Parameters
-    ----------
-    recording
-        Recording with strictly increasing ``time_s``.
-    max_gap_periods
-        A time step longer than this many sample periods (of the metadata's
-        sample rate) starts a new segment.
-
-    Returns
-    -------
-    list of Recording
-        Views of consecutive rows, same metadata; times are not shifted.
-    """
-    period = 1.0 / recording.metadata.sample_rate_hz
-    starts = np.flatnonzero(np.diff(recording.time_s) > max_gap_periods * period) + 1
-    bounds = [0, *starts.tolist(), len(recording)]
-    return [recording.slice(a, b) for a, b in itertools.pairwise(bounds)]
