@@ -8,9 +8,9 @@ write recordings atomically.
 
 Modules: ``schema`` (the type and its columns), ``formats`` and ``csv`` (file
 formats), ``mapping`` (user columns and units), ``validation`` (the contract's
-checks), ``gaps`` (gap policies) and ``checks`` (the single checks and unit heuristics), ``io`` (reading
-and writing), ``info`` (what is in a file), ``marks`` (the mark of a compensated
-output).
+checks), ``checks`` (the single checks and unit heuristics), ``gaps`` (gap
+policies), ``io`` (reading and writing), ``info`` (what is in a file), ``marks``
+(the mark of a compensated output).
 """
 
 from hrgtc.recording.gaps import Gap, split_at_gaps
