@@ -31,6 +31,24 @@ RATE_BLOCK_NOISE_DPH = 1e-2
 #: Below this inferred sample rate the time column is suspected to be in milliseconds.
 SLOW_SAMPLE_RATE_HZ = 0.5
 
+#: Physical bounds of every sample (outside: an error naming the first row).
+FREQ_SAMPLE_RANGE_HZ = (100.0, 1e5)  # n = 2 mode of any HRG: a few 100 Hz .. tens of kHz
+FREQ_JUMP_FRACTION = 0.05  # 84 ppm/°C over 300 °C is 2.5 %: more than 5 % off is a glitch
+RATE_MAX_DPH = 3.6e6  # 1000 °/s: beyond any rate table and the rebalance loop of an HRG
+TEMPERATURE_RANGE_C = (-200.0, 500.0)  # chambers, housings, resonators
+#: Rows per block of the sample-rate check that runs through the whole file.
+RATE_CHECK_ROWS = 1000
+_BOUNDS: dict[str, tuple[float, float, str]] = {
+    "freq_hz": (*FREQ_SAMPLE_RANGE_HZ, "Hz"),
+    "rate_dph": (-RATE_MAX_DPH, RATE_MAX_DPH, "°/h"),
+    "bias_dph": (-RATE_MAX_DPH, RATE_MAX_DPH, "°/h"),
+    "input_rate_dph": (-RATE_MAX_DPH, RATE_MAX_DPH, "°/h"),
+    "temperature_c": (*TEMPERATURE_RANGE_C, "°C"),
+    "chamber_c": (*TEMPERATURE_RANGE_C, "°C"),
+    "housing_c": (*TEMPERATURE_RANGE_C, "°C"),
+    "resonator_c": (*TEMPERATURE_RANGE_C, "°C"),
+}
+
 
 @dataclass(frozen=True)
 class Problem:

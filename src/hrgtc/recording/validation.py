@@ -59,15 +59,21 @@ import numpy as np
 from hrgtc.errors import RecordingError
 from hrgtc.recording.axes import axis_input_rate_dph, axis_names, base_name
 from hrgtc.recording.checks import (
+    _BOUNDS,
     DEG_PER_RAD_X3600,
+    FREQ_JUMP_FRACTION,
     FREQ_MAX_HZ,
+    FREQ_SAMPLE_RANGE_HZ,
     KHZ_BELOW_HZ,
     RATE_BLOCK_NOISE_DPH,
+    RATE_CHECK_ROWS,
     RATE_LEVEL_DPH,
+    RATE_MAX_DPH,
     RATE_NOISE_DPH,
     RATE_TABLE_DPH,
     SAMPLE_RATE_TOLERANCE,
     SLOW_SAMPLE_RATE_HZ,
+    TEMPERATURE_RANGE_C,
     Problem,
     ValidationReport,
     _check_freq_unit,
@@ -90,32 +96,16 @@ from hrgtc.recording.gaps import (
 from hrgtc.recording.schema import Metadata, Recording
 
 __all__ = [
-    "DEG_PER_RAD_X3600", "FREQ_MAX_HZ", "GAP_PERIODS", "GAP_POLICIES", "HEURISTIC_ROWS",
-    "KHZ_BELOW_HZ", "RATE_BLOCK_NOISE_DPH", "RATE_LEVEL_DPH", "RATE_NOISE_DPH",
-    "RATE_TABLE_DPH", "SAMPLE_RATE_TOLERANCE", "SLOW_SAMPLE_RATE_HZ", "Gap", "GapPolicy",
+    "DEG_PER_RAD_X3600", "FREQ_JUMP_FRACTION", "FREQ_MAX_HZ", "FREQ_SAMPLE_RANGE_HZ",
+    "GAP_PERIODS", "GAP_POLICIES", "HEURISTIC_ROWS", "KHZ_BELOW_HZ", "RATE_BLOCK_NOISE_DPH",
+    "RATE_CHECK_ROWS", "RATE_LEVEL_DPH", "RATE_MAX_DPH", "RATE_NOISE_DPH", "RATE_TABLE_DPH",
+    "SAMPLE_RATE_TOLERANCE", "SLOW_SAMPLE_RATE_HZ", "TEMPERATURE_RANGE_C", "Gap", "GapPolicy",
     "Problem", "RecordingValidator", "ValidationReport", "check_gap_policy",
     "measured_sample_rate", "problems_message", "split_at_gaps", "validate",
 ]
 
 
 HEURISTIC_ROWS = 100_000  # rows used for the sample-rate and unit heuristics
-#: Physical bounds of every sample (outside: an error naming the first row).
-FREQ_SAMPLE_RANGE_HZ = (100.0, 1e5)  # n = 2 mode of any HRG: a few 100 Hz .. tens of kHz
-FREQ_JUMP_FRACTION = 0.05  # 84 ppm/°C over 300 °C is 2.5 %: more than 5 % off is a glitch
-RATE_MAX_DPH = 3.6e6  # 1000 °/s: beyond any rate table and the rebalance loop of an HRG
-TEMPERATURE_RANGE_C = (-200.0, 500.0)  # chambers, housings, resonators
-#: Rows per block of the sample-rate check that runs through the whole file.
-RATE_CHECK_ROWS = 1000
-_BOUNDS: dict[str, tuple[float, float, str]] = {
-    "freq_hz": (*FREQ_SAMPLE_RANGE_HZ, "Hz"),
-    "rate_dph": (-RATE_MAX_DPH, RATE_MAX_DPH, "°/h"),
-    "bias_dph": (-RATE_MAX_DPH, RATE_MAX_DPH, "°/h"),
-    "input_rate_dph": (-RATE_MAX_DPH, RATE_MAX_DPH, "°/h"),
-    "temperature_c": (*TEMPERATURE_RANGE_C, "°C"),
-    "chamber_c": (*TEMPERATURE_RANGE_C, "°C"),
-    "housing_c": (*TEMPERATURE_RANGE_C, "°C"),
-    "resonator_c": (*TEMPERATURE_RANGE_C, "°C"),
-}
 
 
 class RecordingValidator:
