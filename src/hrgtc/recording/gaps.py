@@ -20,6 +20,9 @@ from hrgtc.recording.schema import Recording
 GapPolicy = Literal["error", "split", "ignore"]
 GAP_POLICIES: tuple[str, ...] = ("error", "split", "ignore")
 GAP_PERIODS = 2.0  # a time step longer than this many sample periods is a gap
+#: Relative slack of the gap threshold: one missing sample (a step of exactly 2 periods,
+#: e.g. a dropped spike) is not a gap whatever the rounding of the times.
+GAP_TOLERANCE = 1e-6
 MAX_LISTED_GAPS = 1000
 
 
@@ -75,6 +78,7 @@ def split_at_gaps(recording: Recording, max_gap_periods: float = GAP_PERIODS) ->
         Views of consecutive rows, same metadata; times are not shifted.
     """
     period = 1.0 / recording.metadata.sample_rate_hz
-    starts = np.flatnonzero(np.diff(recording.time_s) > max_gap_periods * period) + 1
+    limit = max_gap_periods * period * (1.0 + GAP_TOLERANCE)
+    starts = np.flatnonzero(np.diff(recording.time_s) > limit) + 1
     bounds = [0, *starts.tolist(), len(recording)]
     return [recording.slice(a, b) for a, b in itertools.pairwise(bounds)]

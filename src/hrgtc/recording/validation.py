@@ -87,6 +87,7 @@ from hrgtc.recording.checks import (
 from hrgtc.recording.gaps import (
     GAP_PERIODS,
     GAP_POLICIES,
+    GAP_TOLERANCE,
     MAX_LISTED_GAPS,
     Gap,
     GapPolicy,
@@ -256,7 +257,8 @@ class RecordingValidator:
                 self._time_order = (offset + i, float(time[i]), float(previous[i]))
         period = 1.0 / self.metadata.sample_rate_hz
         with np.errstate(invalid="ignore"):
-            long = np.flatnonzero((step > GAP_PERIODS * period) & np.isfinite(step))
+            limit = GAP_PERIODS * period * (1.0 + GAP_TOLERANCE)
+            long = np.flatnonzero((step > limit) & np.isfinite(step))
         self._n_gaps += long.size
         self._check_rate_throughout(step, offset)
         room = MAX_LISTED_GAPS - len(self._gaps)
