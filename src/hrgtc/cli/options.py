@@ -1,8 +1,9 @@
 """Options shared by the ``hrgtc`` commands, defined once.
 
 Use the ``Annotated`` aliases as parameter types. Commands that read
-recordings get the eight reading options (column mapping, units, sample rate,
-unit name, input rate, gap policy) from :func:`reading_options` and receive them as one
+recordings get the twelve reading options (column mapping, units, sample rate,
+unit name, input rate, gap policy, and for messy IMU files temperature scale and
+offset, spikes and the thermometer) from :func:`reading_options` and receive them as one
 :class:`hrgtc.recording.ReadOptions`, the type the library takes::
 
     @app.command()
@@ -67,6 +68,20 @@ class GapPolicy(StrEnum):
     ignore = "ignore"
 
 
+class SpikePolicy(StrEnum):
+    """What to do with spikes (non-finite or physically impossible samples)."""
+
+    error = "error"
+    drop = "drop"
+
+
+class Thermometer(StrEnum):
+    """What the thermometer of the gyro is."""
+
+    resonator = "resonator"
+    sensor = "sensor"
+
+
 class OutputFormat(StrEnum):
     """Output file format (suffixes .parquet, .csv, .h5)."""
 
@@ -91,7 +106,8 @@ ColumnsOption = Annotated[
         metavar="NAME=THEIRS",
         help="Map a recording column to your file's column, e.g. --col freq_hz=f_res "
         "(repeat, or separate with commas). Names: time_s, freq_hz, rate_dph, chamber_c, "
-        "housing_c, resonator_c, bias_dph.",
+        "housing_c, resonator_c, bias_dph, input_rate_dph, temperature_c, scale_ppm; per axis "
+        "<name>_<axis>, e.g. --col rate_dph_x=gyro_x.",
         callback=_columns_callback,
         rich_help_panel=_INPUT,
     ),
@@ -100,9 +116,9 @@ TimeUnitOption = Annotated[
     str | None,
     typer.Option(
         "--time-unit",
-        metavar="s|ms|timestamp",
-        help="Unit of the time column: seconds, milliseconds or ISO 8601 timestamps "
-        "(converted to seconds since the first sample); default s.",
+        metavar="s|ms|us|timestamp",
+        help="Unit of the time column: seconds, milliseconds, microseconds or ISO 8601 "
+        "timestamps (converted to seconds since the first sample); default s.",
         callback=_unit_callback("time"),
         rich_help_panel=_INPUT,
     ),
@@ -122,7 +138,8 @@ RateUnitOption = Annotated[
     typer.Option(
         "--rate-unit",
         metavar="dph|dps|radps",
-        help="Unit of the gyro rate column: °/h (dph), °/s (dps) or rad/s (radps); default dph.",
+        help="Unit of the gyro rate columns (every rate_dph* and input_rate_dph* column): °/h "
+        "(dph), °/s (dps) or rad/s (radps); default dph.",
         callback=_unit_callback("rate"),
         rich_help_panel=_INPUT,
     ),
@@ -173,6 +190,45 @@ _ReadingGapsOption = Annotated[
         rich_help_panel=_INPUT,
     ),
 ]
+TempScaleOption = Annotated[
+    float | None,
+    typer.Option(
+        "--temp-scale",
+        metavar="K",
+        help="Temperature logged as a raw sensor count: temperature_c = raw * K + C for every "
+        "temperature_c* column (with --temp-offset C); default 1.",
+        rich_help_panel=_INPUT,
+    ),
+]
+TempOffsetOption = Annotated[
+    float | None,
+    typer.Option(
+        "--temp-offset",
+        metavar="C",
+        help="Offset [°C] of --temp-scale: temperature_c = raw * K + C; default 0.",
+        rich_help_panel=_INPUT,
+    ),
+]
+SpikesOption = Annotated[
+    SpikePolicy | None,
+    typer.Option(
+        "--spikes",
+        help="Samples no gyro can produce (NaN, beyond 1000 °/s, impossible temperatures or "
+        "frequencies): fail naming the row (error, default) or drop those rows (drop: "
+        "their number is reported).",
+        rich_help_panel=_INPUT,
+    ),
+]
+ThermometerOption = Annotated[
+    Thermometer | None,
+    typer.Option(
+        "--thermometer",
+        help="The gyro's thermometer: its resonator frequency (resonator, default; freq_hz "
+        "columns) or, for gyros without a frequency output, its temperature sensor (sensor: "
+        "the temperature_c or temperature_c_<axis> column takes the place of freq_hz).",
+        rich_help_panel=_INPUT,
+    ),
+]
 ForceOption = Annotated[bool, typer.Option("--force", help="Overwrite existing output files.")]
 #: Exit status of --strict when samples went beyond the trained ranges.
 STRICT_EXIT = 3
@@ -194,6 +250,10 @@ def recording_input(
     unit_name: str | None = None,
     input_rate_dph: float | None = None,
     gaps: GapPolicy | str | None = None,
+    temp_scale: float | None = None,
+    temp_offset: float | None = None,
+    spikes: SpikePolicy | str | None = None,
+    thermometer: Thermometer | str | None = None,
 ) -> ReadOptions:
     """Gather the values of the shared reading options into a :class:`ReadOptions`."""
     from hrgtc.recording import ReadOptions
@@ -207,6 +267,10 @@ def recording_input(
         units={k: v for k, v in units.items() if v is not None} or None,
         metadata={k: v for k, v in overrides.items() if v is not None} or None,
         gaps=str(getattr(gaps, "value", gaps) or "error"),
+        temp_scale=1.0 if temp_scale is None else float(temp_scale),
+        temp_offset_c=0.0 if temp_offset is None else float(temp_offset),
+        spikes=str(getattr(spikes, "value", spikes) or "error"),
+        thermometer=str(getattr(thermometer, "value", thermometer) or "resonator"),
     )
 
 
@@ -220,6 +284,10 @@ _READING_OPTIONS: tuple[tuple[str, Any], ...] = (
     ("unit_name", UnitNameOption),
     ("input_rate_dph", InputRateOption),
     ("gaps", _ReadingGapsOption),
+    ("temp_scale", TempScaleOption),
+    ("temp_offset", TempOffsetOption),
+    ("spikes", SpikesOption),
+    ("thermometer", ThermometerOption),
 )
 
 
@@ -227,9 +295,10 @@ def reading_options(command: Callable[..., Any]) -> Callable[..., Any]:
     """Give a command the shared reading options, defined once here.
 
     The decorated function takes ``inputs: ReadOptions`` (as its last
-    parameter) instead of the eight options; the command line still shows
+    parameter) instead of the twelve options; the command line still shows
     ``--col``, ``--time-unit``, ``--freq-unit``, ``--rate-unit``, ``--sample-rate-hz``,
-    ``--unit-name``, ``--input-rate-dph`` and ``--gaps``.
+    ``--unit-name``, ``--input-rate-dph``, ``--gaps``, ``--temp-scale``,
+    ``--temp-offset``, ``--spikes`` and ``--thermometer``.
     """
     signature = inspect.signature(command)
     namespace = command.__globals__

@@ -17,6 +17,7 @@ import numpy as np
 
 from hrgtc.errors import RecordingError
 from hrgtc.progress import Progress
+from hrgtc.recording.axes import axis_names, base_name
 from hrgtc.recording.formats import format_of
 from hrgtc.recording.io import iter_chunks
 from hrgtc.recording.schema import COLUMNS, Metadata
@@ -28,7 +29,8 @@ from hrgtc.recording.validation import (
     check_gap_policy,
 )
 
-TEMPERATURE_COLUMNS = ("chamber_c", "housing_c", "resonator_c")
+TEMPERATURE_COLUMNS = ("chamber_c", "housing_c", "resonator_c", "temperature_c")
+SPAN_COLUMNS = (*TEMPERATURE_COLUMNS, "freq_hz")
 
 
 @dataclass(frozen=True)
@@ -89,6 +91,8 @@ class RecordingInfo:
     validation
         The validation report (``ok=False`` with an ``"unreadable"`` problem when
         the file could not be read to the end).
+    axes
+        The axes of a multi-axis recording (``()`` for a single-axis one).
     """
 
     path: str
@@ -103,6 +107,7 @@ class RecordingInfo:
     columns: tuple[ColumnSummary, ...]
     metadata: dict[str, Any] | None
     validation: ValidationReport
+    axes: tuple[str, ...] = ()
 
     @property
     def ok(self) -> bool:
@@ -123,6 +128,9 @@ class RecordingInfo:
                 f"input rate {_num(meta.get('input_rate_dph'))} °/h"
             )
         lines.append(f"  rows: {self.rows}")
+        if self.axes:
+            lines.append(f"  axes: {', '.join(self.axes)} ({len(self.axes)}-axis recording; "
+                         "per-axis columns <name>_<axis>)")
         lines.append(f"  duration: {_num(self.duration_s)} s ({_hours(self.duration_s)})")
         inferred = " (inferred from the time steps)" if self.sample_rate_inferred else ""
         lines.append(
@@ -132,22 +140,17 @@ class RecordingInfo:
         lines.append("  columns:")
         for col in self.columns:
             unit = f"[{col.unit}]" if col.unit else "[?]"
-            lines.append(f"    {col.name:<12} {unit:<8} {_num(col.minimum)} .. {_num(col.maximum)}")
-        for name in (*TEMPERATURE_COLUMNS, "freq_hz"):
-            col = self.column(name)
-            if col is not None and col.minimum is not None:
-                unit = "°C" if name != "freq_hz" else "Hz"
-                lines.append(f"  {name} span: {col.maximum - col.minimum:.6g} {unit}")
+            lines.append(f"    {col.name:<16} {unit:<8} {_num(col.minimum)} .. {_num(col.maximum)}")
+        for col in self._span_columns():
+            if col.minimum is not None:
+                unit = "Hz" if col.unit == "Hz" else "°C"
+                lines.append(f"  {col.name} span: {col.maximum - col.minimum:.6g} {unit}")
         lines.append(self.validation.summary().replace("\n", "\n  ").join(["  ", ""]))
         return "\n".join(lines)
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types."""
-        spans = {
-            name: [col.minimum, col.maximum]
-            for name in (*TEMPERATURE_COLUMNS, "freq_hz")
-            if (col := self.column(name)) is not None
-        }
+        spans = {col.name: [col.minimum, col.maximum] for col in self._span_columns()}
         return {
             "path": self.path,
             "format": self.format,
@@ -162,7 +165,13 @@ class RecordingInfo:
             "spans": spans,
             "metadata": self.metadata,
             "validation": self.validation.to_dict(),
+            "axes": list(self.axes),
         }
+
+    def _span_columns(self) -> list[ColumnSummary]:
+        """Temperature and frequency columns (per axis too), in the order of SPAN_COLUMNS."""
+        return sorted((c for c in self.columns if base_name(c.name) in SPAN_COLUMNS),
+                      key=lambda c: SPAN_COLUMNS.index(base_name(c.name)))
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> RecordingInfo:
@@ -180,6 +189,7 @@ class RecordingInfo:
             columns=tuple(ColumnSummary.from_dict(c) for c in data["columns"]),
             metadata=data.get("metadata"),
             validation=ValidationReport.from_dict(data["validation"]),
+            axes=tuple(data.get("axes") or ()),
         )
 
 
@@ -199,6 +209,11 @@ def describe(
     gaps: GapPolicy | str = "error",
     rows: int = 1_000_000,
     progress: Progress | None = None,
+    *,
+    temp_scale: float = 1.0,
+    temp_offset_c: float = 0.0,
+    spikes: str = "error",
+    thermometer: str = "resonator",
 ) -> RecordingInfo:
     """Summarise and validate a recording file in one streaming pass.
 
@@ -206,6 +221,8 @@ def describe(
     ----------
     path, columns, units, metadata, gaps
         As for :func:`hrgtc.recording.read`.
+    temp_scale, temp_offset_c, spikes, thermometer
+        As for :func:`hrgtc.recording.read` (messy IMU files).
     rows
         Rows per chunk read.
     progress
@@ -218,7 +235,7 @@ def describe(
         problem is in ``validation`` with ``ok=False``.
     """
     check_gap_policy(gaps)
-    validator = RecordingValidator(gaps)
+    validator = RecordingValidator(gaps, thermometer=thermometer)
     ranges: dict[str, list[float]] = {}
     first_time: float | None = None
     last_time: float | None = None
@@ -229,7 +246,9 @@ def describe(
     try:
         fmt = format_of(path)
         for chunk in iter_chunks(
-            path, rows, columns, units, validate=False, metadata=metadata, progress=progress
+            path, rows, columns, units, validate=False, metadata=metadata, progress=progress,
+            temp_scale=temp_scale, temp_offset_c=temp_offset_c, spikes=spikes,
+            thermometer=thermometer,
         ):
             meta = chunk.metadata
             names = names or list(chunk.names)
@@ -275,9 +294,17 @@ def describe(
         sample_rate_inferred=bool(meta is not None and meta.extra.get("sample_rate_inferred")),
         measured_sample_rate_hz=report.measured_sample_rate_hz,
         columns=tuple(
-            ColumnSummary(n, COLUMNS[n][0] if n in COLUMNS else "", *ranges.get(n, (None, None)))
-            for n in names
+            ColumnSummary(n, _unit(n, thermometer), *ranges.get(n, (None, None))) for n in names
         ),
         metadata=None if meta is None else meta.to_dict(),
         validation=report,
+        axes=axis_names(names),
     )
+
+
+def _unit(name: str, thermometer: str) -> str:
+    """Contract unit of a column (per-axis ones too); ``freq_hz`` of a sensor thermometer: °C."""
+    base = base_name(name)
+    if base == "freq_hz" and thermometer == "sensor":
+        return "degC"
+    return COLUMNS[base][0] if base in COLUMNS else ""
