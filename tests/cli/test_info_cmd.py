@@ -13,6 +13,7 @@ import pytest
 from typer.testing import CliRunner
 
 from hrgtc.cli import app
+from hrgtc.errors import SpikeWarning
 from hrgtc.recording import Metadata, Recording, write
 
 runner = CliRunner()
@@ -147,3 +148,46 @@ def test_json_stays_valid_with_infinite_times(tmp_path):
     assert code == 2
     kinds = {p["kind"] for p in data["validation"]["problems"]}
     assert {"not_finite", "time_order"} <= kinds
+
+
+def px4_style_csv(tmp_path, n: int = 600) -> tuple:
+    """A three-axis MEMS log: time in µs, rates in rad/s, a raw temperature count, a spike."""
+    rng = np.random.default_rng(4)
+    t_us = np.arange(n) * 5000  # 200 Hz
+    gyro = {a: (2e-5 * (i + 1) + 1e-6 * rng.standard_normal(n)).tolist()
+            for i, a in enumerate("xyz")}
+    count = np.round(np.linspace(800.0, 960.0, n))  # °C = count / 16
+    gyro["y"][321] = 1e4  # rad/s: a spike
+    path = tmp_path / "px4.csv"
+    with open(path, "w") as out:
+        out.write("timestamp,gyro_x,gyro_y,gyro_z,temp_raw\n")
+        for i in range(n):
+            out.write(f"{t_us[i]},{gyro['x'][i]!r},{gyro['y'][i]!r},{gyro['z'][i]!r},"
+                      f"{count[i]:.0f}\n")
+    return path, count
+
+
+PX4_ARGS = ["--col", "time_s=timestamp,rate_dph_x=gyro_x,rate_dph_y=gyro_y,rate_dph_z=gyro_z",
+            "--col", "temperature_c=temp_raw", "--time-unit", "us", "--rate-unit", "radps",
+            "--thermometer", "sensor", "--temp-scale", "0.0625", "--temp-offset", "0"]
+
+
+def test_info_of_a_messy_multi_axis_imu_file(tmp_path):
+    path, _ = px4_style_csv(tmp_path)
+    code, data, _ = info_json(str(path), *PX4_ARGS)
+    assert code == 2 and not data["validation"]["ok"]
+    problem = data["validation"]["problems"][0]
+    assert (problem["column"], problem["row"]) == ("rate_dph_y", 321)
+    with pytest.warns(SpikeWarning, match=r"dropped 1 row\(s\).*'rate_dph_y', row 321"):
+        code, data, err = info_json(str(path), *PX4_ARGS, "--spikes", "drop")
+    assert code == 0, err
+    assert data["axes"] == ["x", "y", "z"]
+    assert data["rows"] == 599
+    assert data["sample_rate_hz"] == pytest.approx(200.0)
+    assert data["spans"]["temperature_c"] == [50.0, 60.0]  # 800/16 .. 960/16
+    assert data["spans"]["freq_hz_x"] == [50.0, 60.0]
+    units = {c["name"]: c["unit"] for c in data["columns"]}
+    assert units["rate_dph_z"] == "deg/h" and units["freq_hz_y"] == "degC"
+    with pytest.warns(SpikeWarning):
+        result = runner.invoke(app, ["info", str(path), *PX4_ARGS, "--spikes", "drop"])
+    assert "axes: x, y, z" in result.stdout
