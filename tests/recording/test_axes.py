@@ -165,3 +165,34 @@ def test_rate_table_steps_are_checked_on_rate_minus_input():
     in_dps = {**columns, "rate_dph": rate / 3600.0, "input_rate_dph": inputs / 3600.0}
     with pytest.raises(RecordingError, match="rate_dph looks like °/s"):
         validate(Recording(in_dps, Metadata(RATE_HZ)))
+
+
+def test_users_per_axis_names_and_units_mapped(tmp_path):
+    """A foreign Parquet file: its own names, frequencies in kHz, rates in °/s."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    rec = multi_axis()
+    theirs = {"t": rec["time_s"], "tc": rec["chamber_c"]}
+    cols = ["time_s=t", "chamber_c=tc"]
+    for axis in AXES:
+        theirs[f"f{axis}"] = rec[f"freq_hz_{axis}"] / 1000.0
+        theirs[f"w{axis}"] = rec[f"rate_dph_{axis}"] / 3600.0
+        cols += [f"freq_hz_{axis}=f{axis}", f"rate_dph_{axis}=w{axis}"]
+    path = tmp_path / "theirs.parquet"
+    pq.write_table(pa.table(theirs), path)
+    back = read(path, columns=cols, units={"freq": "kHz", "rate": "dps"},
+                metadata={"sample_rate_hz": RATE_HZ})
+    assert axis_names(back.names) == AXES
+    for axis in AXES:
+        np.testing.assert_allclose(back[f"freq_hz_{axis}"], rec[f"freq_hz_{axis}"], rtol=1e-15)
+        np.testing.assert_allclose(back[f"rate_dph_{axis}"], rec[f"rate_dph_{axis}"], rtol=1e-15)
+
+
+def test_per_axis_units_in_the_parquet_schema(tmp_path):
+    import pyarrow.parquet as pq
+
+    path = write(multi_axis(), tmp_path / "imu.parquet")
+    schema = pq.read_schema(path)
+    assert schema.field("rate_dph_y").metadata[b"unit"] == b"deg/h"
+    assert schema.field("temperature_c_z").metadata[b"unit"] == b"degC"

@@ -14,7 +14,7 @@ policies), ``io`` (reading and writing), ``info`` (what is in a file), ``marks``
 (the mark of a compensated output).
 """
 
-from hrgtc.recording.axes import AXIS_COLUMNS, axis_names, axis_view
+from hrgtc.recording.axes import AXIS_COLUMNS, axis_input_rate_dph, axis_names, axis_view
 from hrgtc.recording.gaps import Gap, split_at_gaps
 from hrgtc.recording.info import RecordingInfo, describe
 from hrgtc.recording.io import (
@@ -56,6 +56,7 @@ __all__ = [
     "RecordingValidator",
     "RecordingWriter",
     "ValidationReport",
+    "axis_input_rate_dph",
     "axis_names",
     "axis_view",
     "concatenate",

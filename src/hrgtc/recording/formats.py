@@ -31,6 +31,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from hrgtc.errors import RecordingError
+from hrgtc.recording.axes import base_name
 from hrgtc.recording.schema import COLUMNS, Metadata
 
 SUFFIXES: dict[str, str] = {
@@ -302,8 +303,15 @@ def _attr_value(value: Any) -> Any:
 
 
 # -- sinks ---------------------------------------------------------------------
+def column_unit(name: str) -> str | None:
+    """Unit of a contract column, per-axis ones (``rate_dph_x``) included; None for others."""
+    base = base_name(name)
+    return COLUMNS[base][0] if base in COLUMNS else None
+
+
 def _field_metadata(name: str) -> dict[bytes, bytes] | None:
-    return {b"unit": COLUMNS[name][0].encode()} if name in COLUMNS else None
+    unit = column_unit(name)
+    return {b"unit": unit.encode()} if unit else None
 
 
 class Sink:
@@ -372,8 +380,8 @@ class Hdf5Sink(Sink):
             ds = group.create_dataset(
                 name, shape=(0,), maxshape=(None,), dtype="f8", chunks=(HDF5_CHUNK_ROWS,)
             )
-            if name in COLUMNS:
-                ds.attrs["unit"] = COLUMNS[name][0]
+            if column_unit(name):
+                ds.attrs["unit"] = column_unit(name)
             self._datasets[name] = ds
         self._rows = 0
 

@@ -2,7 +2,9 @@
 
 One place checks every recording that enters hrgtc, whole or chunk by chunk:
 
-* the required columns ``time_s``, ``freq_hz`` and ``rate_dph`` are present;
+* the required columns ``time_s``, ``freq_hz`` and ``rate_dph`` are present
+  (a multi-axis recording: ``freq_hz_<axis>`` and ``rate_dph_<axis>`` of every
+  axis, see :mod:`hrgtc.recording.axes`; every check below runs per axis);
 * no value is NaN or infinite;
 * ``time_s`` is strictly increasing (no duplicates, no steps back);
 * no time step is longer than :data:`GAP_PERIODS` sample periods (a gap); gaps
@@ -39,6 +41,11 @@ One place checks every recording that enters hrgtc, whole or chunk by chunk:
   :data:`TEMPERATURE_RANGE_C`;
 * the sample rate holds through the whole file: the mean step of every block of
   :data:`RATE_CHECK_ROWS` rows (gaps left out) agrees with the metadata.
+
+With the sensor thermometer (``thermometer="sensor"``, a gyro without a frequency
+output) ``freq_hz`` holds a temperature: it is checked against
+:data:`TEMPERATURE_RANGE_C`, without the kHz heuristic or the 5 % jump rule. With
+an ``input_rate_dph`` column the rate-unit heuristic runs on rate - input rate.
 
 The single checks and heuristics are in :mod:`hrgtc.recording.checks`.
 
