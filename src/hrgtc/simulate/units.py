@@ -46,7 +46,6 @@ the Earth-rate components of a unit mounted level at 40° N with ``x`` north,
 from __future__ import annotations
 
 import math
-import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from functools import cache
@@ -62,6 +61,7 @@ from hrgtc.simulate.laws import (
     table1_frequency_law,
 )
 from hrgtc.simulate.noise import GyroNoise
+from hrgtc.simulate.profiles import AXIS_NAME
 from hrgtc.simulate.shell import FUSED_QUARTZ, Shell
 from hrgtc.simulate.thermal import ThermalNetwork
 
@@ -79,8 +79,6 @@ __all__ = [
 DEFAULT_UNIT = "paper-unit"
 #: Earth's rotation rate, 360° per sidereal day (23.9345 h). [°/h]
 EARTH_RATE_DPH = 360.0 / 23.9344696
-#: An axis name: a letter, then letters or digits (no underscore; the column suffix).
-AXIS_NAME = re.compile(r"[A-Za-z][A-Za-z0-9]*")
 
 
 @dataclass(frozen=True)
