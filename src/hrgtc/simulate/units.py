@@ -33,7 +33,7 @@ bias + noise``, as before the law existed).
 ~4.4 kHz, and shells of ~5.7 kHz and ~8.5 kHz from the shell model of Eq. 15),
 each with its own bias law, scale-factor law (several hundred ppm over
 -20...60 °C) and resonator lag behind the one housing they share (2000, 2700
-and 3400 s: during a ramp the three resonators differ by up to a degree), and
+and 3400 s: during a 1 °C/min ramp the resonators differ by several degrees), and
 the Earth-rate components of a unit mounted level at 40° N with ``x`` north,
 ``y`` east and ``z`` up. Each axis is a :class:`Unit` itself
 (``get("imu-3").axes["x"]`` simulates that axis alone).
