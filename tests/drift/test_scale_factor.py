@@ -203,3 +203,42 @@ def test_one_temperature_gives_a_constant(train):
     assert math.isnan(fitted.pvalues["const"])
     assert ScaleFactorModel.from_dict(json.loads(json.dumps(fitted.to_dict()))).to_dict() \
         == fitted.to_dict()
+
+
+def test_k_of_f_equals_statsmodels_wls_on_the_groups(model):
+    """The stepwise fit of the selected terms is the weighted least squares on x_f."""
+    x_f = (np.array([g.freq_hz for g in model.groups]) - model.reference_hz) / model.scale_hz
+    k = np.array([g.k_ppm for g in model.groups])
+    se = np.array([g.k_se_ppm for g in model.groups])
+    powers = [t.power_of("f") for t in model.terms]
+    assert model.history and model.history[0].action == "added"
+    wls = sm.WLS(k, np.column_stack([x_f ** p for p in (0, *powers)]), weights=se ** -2).fit()
+    np.testing.assert_allclose((model.intercept_ppm, *model.scaled_coefficients), wls.params,
+                               rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(np.sqrt(np.diag(np.asarray(model.covariance))), wls.bse,
+                               rtol=1e-6)
+    assert model.standard_errors_ppm["const"] == pytest.approx(wls.bse[0], rel=1e-6)
+
+
+def test_grouping_tolerance(train):
+    segments = find_rate_segments(train)
+    assert len(group_segments(segments, 0.5)) == len(TRAIN_C)
+    # a tolerance wider than the 5 Hz between plateaus joins them all
+    assert len(group_segments(segments, 7.0)) == 1
+    with pytest.raises(InputError, match="tolerance_hz"):
+        group_segments(segments, 0.0)
+    # one group over five temperatures is still a (poor) constant model
+    joined = fit_scale_factor(segments, SETTINGS, tolerance_hz=7.0)
+    assert len(joined.groups) == 1 and joined.selected == ()
+
+
+def test_frequency_scale_defaults_to_the_largest_offset(train):
+    segments = find_rate_segments(train)
+    bare = FeatureSettings(reference_freq_hz=SETTINGS.reference_freq_hz, sample_rate_hz=10.0)
+    fitted = fit_scale_factor(segments, bare)
+    largest = max(abs(s.freq_hz - bare.reference_freq_hz) for s in segments)
+    assert fitted.scale_hz == largest
+    # the same polynomial whatever the scaling of x_f
+    freq = THERMOMETER.frequency(np.array(HELD_OUT_C))
+    reference = fit_scale_factor(segments, SETTINGS)
+    np.testing.assert_allclose(fitted.ppm(freq), reference.ppm(freq), rtol=1e-9)
