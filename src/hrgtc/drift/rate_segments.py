@@ -183,10 +183,10 @@ def find_rate_segments(recording: Recording, table: Sequence[RateStep] | None = 
     From the ``input_rate_dph`` column (each stretch of one constant value, from
     the first row of the stretch, i.e. after each change) or, when given, from a
     segment table (rows with ``start_s + settle_s <= time_s < end_s``). The first
-    ``settle_s`` of each hold are left out (the table's acceleration and the
-    rebalance loop settling); stretches shorter than ``min_duration_s`` after that
-    are dropped from the column (they are the accelerations between holds) and
-    are an error from a table.
+    ``settle_s`` of each hold (the run's first hold included) are left out (the
+    table's acceleration and the rebalance loop settling); stretches shorter than
+    ``min_duration_s`` after that are dropped from the column (they are the
+    accelerations between holds) and are an error from a table.
 
     Parameters
     ----------

@@ -297,7 +297,14 @@ class ScaleFactorModel:
 def group_segments(segments: Sequence[RateSegment],
                    tolerance_hz: float) -> tuple[tuple[RateSegment, ...], ...]:
     """Segments grouped by temperature: sorted by mean frequency, a new group at each gap
-    wider than ``tolerance_hz`` [Hz] (single-linkage clustering). Groups in frequency order."""
+    wider than ``tolerance_hz`` [Hz] (single-linkage clustering). Groups in frequency order.
+
+    Examples
+    --------
+    >>> hold = lambda f: RateSegment(0.0, 1.0, 36000.0, 36000.0, f, 10)
+    >>> [len(g) for g in group_segments([hold(4420.0), hold(4432.1), hold(4420.05)], 0.1)]
+    [2, 1]
+    """
     if not (math.isfinite(tolerance_hz) and tolerance_hz > 0):
         raise InputError(f"tolerance_hz must be a positive number of Hz, got {tolerance_hz!r}")
     ordered = sorted(segments, key=lambda s: (s.freq_hz, s.start_s))
@@ -379,8 +386,10 @@ def fit_scale_factor(segments: Iterable[RateSegment], settings: FeatureSettings,
     f = np.array([s.freq_hz for s in segments]) - reference
     scale = float(settings.scales.get("f", 0.0)) or float(np.max(np.abs(f))) or 1.0
     tolerance = TOLERANCE_SHARE * scale if tolerance_hz is None else tolerance_hz
-    groups = tuple(_fit_group(g, n) for n, g in
-                   enumerate(group_segments(segments, tolerance), start=1))
+    fits = []
+    for number, members in enumerate(group_segments(segments, tolerance), start=1):
+        fits.append(_fit_group(members, number))
+    groups = tuple(fits)
     k = np.array([g.k_ppm for g in groups])
     se = np.array([g.k_se_ppm for g in groups])
     use_weights = bool(weighted and np.all(np.isfinite(se)) and np.all(se > 0))
