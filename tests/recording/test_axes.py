@@ -66,7 +66,8 @@ def test_split_axis_prefers_the_longest_contract_name():
     assert split_axis("input_rate_dph_x") == ("input_rate_dph", "x")
     assert split_axis("rate_dph_x") == ("rate_dph", "x")
     assert split_axis("chamber_c") == ("chamber_c", None)
-    assert base_name("temperature_c_b") == "temperature_c"
+    assert base_name("temperature_c_b", ("a", "b")) == "temperature_c"
+    assert base_name("temperature_c_b", ("x",)) == "temperature_c_b"
 
 
 def test_axis_view_renames_keeps_shared_and_cross_axis_without_copies():
@@ -196,3 +197,14 @@ def test_per_axis_units_in_the_parquet_schema(tmp_path):
     schema = pq.read_schema(path)
     assert schema.field("rate_dph_y").metadata[b"unit"] == b"deg/h"
     assert schema.field("temperature_c_z").metadata[b"unit"] == b"degC"
+
+
+def test_a_suffixed_name_without_its_rate_column_is_no_axis(tmp_path):
+    """``resonator_c_est`` of a compensated single-axis output is not axis 'est'."""
+    n = 50
+    rec = Recording({"time_s": np.arange(n) / RATE_HZ, "freq_hz": np.full(n, 4425.0),
+                     "rate_dph": np.ones(n), "rate_comp_dph": np.ones(n),
+                     "resonator_c_est": np.full(n, 900.0)}, Metadata(RATE_HZ))
+    back = read(write(rec, tmp_path / "out.parquet"))
+    assert back.names == rec.names and axis_names(back.names) == ()
+    assert base_name("resonator_c_est", axis_names(back.names)) == "resonator_c_est"

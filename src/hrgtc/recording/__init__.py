@@ -10,7 +10,8 @@ Modules: ``schema`` (the type and its columns), ``formats`` and ``csv`` (file
 formats), ``axes`` (multi-axis recordings: :func:`axis_names`,
 :func:`axis_view`), ``mapping`` (user columns and units), ``validation`` (the contract's
 checks), ``checks`` (the single checks and unit heuristics), ``gaps`` (gap
-policies), ``io`` (reading and writing), ``info`` (what is in a file), ``marks``
+policies), ``spikes`` (implausible samples: an error, or dropped), ``io``
+(reading), ``writing`` (atomic writing), ``info`` (what is in a file), ``marks``
 (the mark of a compensated output).
 """
 

@@ -24,6 +24,8 @@ Examples
 ()
 >>> split_axis("input_rate_dph_z")
 ('input_rate_dph', 'z')
+>>> base_name("resonator_c_est", axes=())
+'resonator_c_est'
 """
 
 from __future__ import annotations
@@ -71,9 +73,15 @@ def split_axis(name: str) -> tuple[str, str | None]:
     return name, None
 
 
-def base_name(name: str) -> str:
-    """The single-axis contract name of a column: ``"rate_dph_x"`` -> ``"rate_dph"``."""
-    return split_axis(name)[0]
+def base_name(name: str, axes: Iterable[str]) -> str:
+    """The single-axis contract name of a column of a recording with ``axes``.
+
+    ``"rate_dph_x"`` -> ``"rate_dph"`` when ``"x"`` is one of ``axes`` (see
+    :func:`axis_names`); any other name unchanged, so that a column such as
+    ``resonator_c_est`` of a single-axis recording is not taken for an axis's.
+    """
+    base, axis = split_axis(name)
+    return base if axis is not None and axis in axes else name
 
 
 def axis_names(names: Iterable[str]) -> tuple[str, ...]:

@@ -31,7 +31,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from hrgtc.errors import RecordingError
-from hrgtc.recording.axes import base_name
+from hrgtc.recording.axes import axis_names, base_name
 from hrgtc.recording.schema import COLUMNS, Metadata
 
 SUFFIXES: dict[str, str] = {
@@ -303,14 +303,14 @@ def _attr_value(value: Any) -> Any:
 
 
 # -- sinks ---------------------------------------------------------------------
-def column_unit(name: str) -> str | None:
-    """Unit of a contract column, per-axis ones (``rate_dph_x``) included; None for others."""
-    base = base_name(name)
+def column_unit(name: str, axes: Sequence[str] = ()) -> str | None:
+    """Unit of a contract column, per-axis ones (``rate_dph_x`` of ``axes``) included; else None."""
+    base = base_name(name, axes)
     return COLUMNS[base][0] if base in COLUMNS else None
 
 
-def _field_metadata(name: str) -> dict[bytes, bytes] | None:
-    unit = column_unit(name)
+def _field_metadata(name: str, axes: Sequence[str]) -> dict[bytes, bytes] | None:
+    unit = column_unit(name, axes)
     return {b"unit": unit.encode()} if unit else None
 
 
@@ -331,7 +331,8 @@ class Sink:
 class ParquetSink(Sink):
     def __init__(self, path: Path, metadata: Metadata, names: Sequence[str]) -> None:
         super().__init__(path, metadata, names)
-        fields = [pa.field(n, pa.float64(), metadata=_field_metadata(n)) for n in names]
+        axes = axis_names(names)
+        fields = [pa.field(n, pa.float64(), metadata=_field_metadata(n, axes)) for n in names]
         self._schema = pa.schema(fields, metadata={METADATA_KEY: metadata_json(metadata)})
         # Float gyro data does not compress (snappy saved 0 % on simulated runs and cost a
         # third of the write speed), so pages are written plain.
@@ -376,12 +377,13 @@ class Hdf5Sink(Sink):
         for key, value in metadata.to_dict().items():
             group.attrs[key] = json.dumps(value) if key == "extra" else value
         self._datasets = {}
+        axes = axis_names(names)
         for name in names:
             ds = group.create_dataset(
                 name, shape=(0,), maxshape=(None,), dtype="f8", chunks=(HDF5_CHUNK_ROWS,)
             )
-            if column_unit(name):
-                ds.attrs["unit"] = column_unit(name)
+            if column_unit(name, axes):
+                ds.attrs["unit"] = column_unit(name, axes)
             self._datasets[name] = ds
         self._rows = 0
 

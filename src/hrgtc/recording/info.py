@@ -170,8 +170,8 @@ class RecordingInfo:
 
     def _span_columns(self) -> list[ColumnSummary]:
         """Temperature and frequency columns (per axis too), in the order of SPAN_COLUMNS."""
-        return sorted((c for c in self.columns if base_name(c.name) in SPAN_COLUMNS),
-                      key=lambda c: SPAN_COLUMNS.index(base_name(c.name)))
+        return sorted((c for c in self.columns if base_name(c.name, self.axes) in SPAN_COLUMNS),
+                      key=lambda c: SPAN_COLUMNS.index(base_name(c.name, self.axes)))
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> RecordingInfo:
@@ -294,7 +294,8 @@ def describe(
         sample_rate_inferred=bool(meta is not None and meta.extra.get("sample_rate_inferred")),
         measured_sample_rate_hz=report.measured_sample_rate_hz,
         columns=tuple(
-            ColumnSummary(n, _unit(n, thermometer), *ranges.get(n, (None, None))) for n in names
+            ColumnSummary(n, _unit(n, axis_names(names), thermometer), *ranges.get(n, (None, None)))
+            for n in names
         ),
         metadata=None if meta is None else meta.to_dict(),
         validation=report,
@@ -302,9 +303,9 @@ def describe(
     )
 
 
-def _unit(name: str, thermometer: str) -> str:
+def _unit(name: str, axes: tuple[str, ...], thermometer: str) -> str:
     """Contract unit of a column (per-axis ones too); ``freq_hz`` of a sensor thermometer: °C."""
-    base = base_name(name)
+    base = base_name(name, axes)
     if base == "freq_hz" and thermometer == "sensor":
         return "degC"
     return COLUMNS[base][0] if base in COLUMNS else ""

@@ -136,13 +136,14 @@ def parse_columns(pairs: Mapping[str, str] | Iterable[str] | None) -> dict[str, 
     return mapping
 
 
-def is_contract_name(name: str) -> bool:
-    """True for a column of the recording contract, per-axis ones (``rate_dph_x``) included."""
-    return name in COLUMNS or split_axis(name)[1] is not None
+def is_contract_name(name: str, axes: Iterable[str] | None = None) -> bool:
+    """True for a column of the recording contract, per-axis ones (``rate_dph_x``) included.
 
-
-def _contract_order(name: str) -> int:
-    return list(COLUMNS).index(base_name(name))
+    With ``axes`` a per-axis name counts only for one of them (see
+    :func:`hrgtc.recording.axes.axis_names`).
+    """
+    axis = split_axis(name)[1]
+    return name in COLUMNS or (axis is not None and (axes is None or axis in axes))
 
 
 # -- from the file's columns to the contract's ----------------------------------
@@ -161,6 +162,7 @@ class ColumnPlan:
     temp_scale: float = 1.0
     temp_offset_c: float = 0.0
     thermometer: str = "resonator"
+    axes: tuple[str, ...] = ()
 
 
 def plan_columns(source: Source, columns: Any, units: Mapping[str, str] | None,
@@ -191,13 +193,15 @@ def plan_columns(source: Source, columns: Any, units: Mapping[str, str] | None,
             )
     kinds = source.kinds()
     pairs = [(theirs, name) for name, theirs in mapping.items()]
-    pairs += [(n, n) for n in source.names if is_contract_name(n) and n not in mapping]
-    pairs.sort(key=lambda pair: _contract_order(pair[1]))
+    axes = axis_names([*mapping, *(n for n in source.names if n not in mapping.values())])
+    pairs += [(n, n) for n in source.names if is_contract_name(n, axes) and n not in mapping]
+    order = list(COLUMNS)
+    pairs.sort(key=lambda pair: order.index(base_name(pair[1], axes)))
     used = {theirs for theirs, _ in pairs}
     pairs += [
         (n, n)
         for n in source.names
-        if not is_contract_name(n) and n not in used and kinds.get(n) == "numeric"
+        if not is_contract_name(n, axes) and n not in used and kinds.get(n) == "numeric"
     ]
     if thermometer == "sensor":
         _check_sensor_columns(source, [name for _, name in pairs])
@@ -213,7 +217,7 @@ def plan_columns(source: Source, columns: Any, units: Mapping[str, str] | None,
                 "map another column to it"
             )
     names = list(dict.fromkeys(theirs for theirs, _ in pairs))
-    return ColumnPlan(source, pairs, as_text, canon, stamped, read_names=names,
+    return ColumnPlan(source, pairs, as_text, canon, stamped, read_names=names, axes=axes,
                       temp_scale=float(temp_scale), temp_offset_c=float(temp_offset_c),
                       thermometer=thermometer)
 
@@ -331,7 +335,7 @@ def convert_columns(
             out[name] = _time_seconds(plan, column, theirs, row_offset)
         else:
             values = _to_float(plan, column, theirs, row_offset)
-            base = base_name(name)
+            base = base_name(name, plan.axes)
             kind = UNIT_KINDS.get(base)
             out[name] = to_contract_unit(values, plan.units.get(kind, "")) if kind else values
             if base == "temperature_c" and (plan.temp_scale != 1.0 or plan.temp_offset_c != 0.0):

@@ -26,7 +26,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from hrgtc.errors import InputError, SpikeWarning
-from hrgtc.recording.axes import base_name
+from hrgtc.recording.axes import axis_names, base_name
 from hrgtc.recording.checks import _BOUNDS, FREQ_JUMP_FRACTION, TEMPERATURE_RANGE_C
 
 SPIKE_POLICIES: tuple[str, ...] = ("error", "drop")
@@ -67,9 +67,10 @@ class SpikeFilter:
         self.dropped = 0
         self.first: tuple[str, int, float] | None = None
         self._reference: dict[str, float] = {}
+        self._axes: tuple[str, ...] = ()
 
     def _bounds(self, name: str) -> tuple[float, float] | None:
-        base = base_name(name)
+        base = base_name(name, self._axes)
         if base == "freq_hz" and self.sensor:
             return TEMPERATURE_RANGE_C
         bounds = _BOUNDS.get(base)
@@ -81,7 +82,7 @@ class SpikeFilter:
         with np.errstate(invalid="ignore"):
             if bounds is not None:
                 bad |= (values < bounds[0]) | (values > bounds[1])
-            if base_name(name) == "freq_hz" and not self.sensor:
+            if base_name(name, self._axes) == "freq_hz" and not self.sensor:
                 if name not in self._reference and (~bad).any():
                     self._reference[name] = float(np.median(values[~bad]))
                 reference = self._reference.get(name)
@@ -101,6 +102,7 @@ class SpikeFilter:
         """
         keep: np.ndarray | None = None
         first: tuple[str, int, float] | None = None
+        self._axes = axis_names(columns)
         for name, values in columns.items():
             bad = self._bad(name, values)
             if bad.any():

@@ -191,7 +191,7 @@ class RecordingValidator:
                     self._not_finite[name] = [offset + first, values[first], int(bad.sum())]
                 else:
                     state[2] += int(bad.sum())
-            if base_name(name) in self._bounds:
+            if base_name(name, self.axes) in self._bounds:
                 self._check_bounds(name, values, offset)
             if name in self._freq_reference:
                 self._check_jumps(name, values, offset)
@@ -202,7 +202,7 @@ class RecordingValidator:
         self.rows += n
 
     def _check_bounds(self, name: str, values: np.ndarray, offset: int) -> None:
-        low, high, _ = self._bounds[base_name(name)]
+        low, high, _ = self._bounds[base_name(name, self.axes)]
         with np.errstate(invalid="ignore"):
             bad = ((values < low) | (values > high)) & np.isfinite(values)
         if bad.any():
@@ -318,7 +318,8 @@ class RecordingValidator:
             )
         unit_problem = any(p.kind == "freq_unit" for p in self._heuristics or [])
         for name, (row, value, count) in self._out_of_bounds.items():
-            if base_name(name) == "freq_hz" and (self._heuristics is None or unit_problem):
+            is_freq = base_name(name, self.axes) == "freq_hz"
+            if is_freq and (self._heuristics is None or unit_problem):
                 continue  # the unit heuristic (e.g. "looks like kHz") says it better
             problems.append(self._bounds_problem(name, row, value, count))
         for name, (row, value, count) in self._jump.items():
@@ -375,7 +376,7 @@ class RecordingValidator:
         return problems
 
     def _bounds_problem(self, name: str, row: int, value: float, count: int) -> Problem:
-        base = base_name(name)
+        base = base_name(name, self.axes)
         low, high, unit = self._bounds[base]
         if base == "freq_hz" and self.thermometer == "sensor":
             why = f"outside {low:g} to {high:g} °C (the sensor thermometer's temperature)"
