@@ -146,3 +146,11 @@ def test_bursts_in_a_multi_axis_file(tmp_path):
                               units={"rate": "radps"}, thermometer="sensor",
                               metadata={"sample_rate_hz": RATE_HZ}).chunks(path))
     assert sum(len(c) for c in chunks) == N
+
+
+def test_a_mapped_axis_column_without_its_rate_is_kept_as_it_is(tmp_path):
+    path, raw = imu_csv(tmp_path, extra={"f": np.full(N, 4425.0)})
+    rec = read(path, columns=["time_s=t", "freq_hz=f", "rate_dph=gx", "temperature_c_q=temp"],
+               units={"rate": "dps"}, validate=False)
+    assert axis_names(rec.names) == ()
+    np.testing.assert_array_equal(rec["temperature_c_q"], raw["temp"])

@@ -195,8 +195,8 @@ def plan_columns(source: Source, columns: Any, units: Mapping[str, str] | None,
     pairs = [(theirs, name) for name, theirs in mapping.items()]
     axes = axis_names([*mapping, *(n for n in source.names if n not in mapping.values())])
     pairs += [(n, n) for n in source.names if is_contract_name(n, axes) and n not in mapping]
-    order = list(COLUMNS)
-    pairs.sort(key=lambda pair: order.index(base_name(pair[1], axes)))
+    order = {name: i for i, name in enumerate(COLUMNS)}
+    pairs.sort(key=lambda pair: order.get(base_name(pair[1], axes), len(order)))
     used = {theirs for theirs, _ in pairs}
     pairs += [
         (n, n)
