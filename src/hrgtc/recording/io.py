@@ -270,7 +270,8 @@ def iter_chunks(
         :data:`~hrgtc.recording.validation.HEURISTIC_ROWS` rows) have passed, so a
         bad file raises :class:`~hrgtc.errors.RecordingError` before bad data
         reach the caller. With ``gaps="split"`` gaps pass; split downstream. With
-        ``spikes="drop"`` a chunk may be short of the rows dropped from it.
+        ``spikes="drop"`` the rows of spikes are left out before the chunks are cut
+        (the rows of later problems then count the rows kept).
     """
     check_gap_policy(gaps)
     check_spike_policy(spikes)
