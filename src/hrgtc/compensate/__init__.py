@@ -4,7 +4,9 @@ Takes a :class:`~hrgtc.model.UnitModel` and a recording and gives the
 compensated output: batch or streaming (``compensator``: :class:`Compensator`
 keeps the df/dt filter state across chunks; :func:`compensate_file` works file
 to file in bounded memory), or dependency-free C99 for on-board use
-(``export_c``, its text in ``c_text``).
+(``export_c``, its text in ``c_text``). A whole instrument
+(:class:`~hrgtc.model.InstrumentModel`, every axis, bias and scale factor) is
+compensated by ``instrument``'s :class:`InstrumentCompensator`.
 """
 
 from hrgtc.compensate.compensator import (
@@ -15,7 +17,9 @@ from hrgtc.compensate.compensator import (
     compensate_file,
 )
 from hrgtc.compensate.export_c import export_c
+from hrgtc.compensate.instrument import InstrumentCompensator, instrument_output_columns
 
 __all__ = [
     "OUTPUT_COLUMNS",
-    "CompensationSummary", "Compensator", "compensate", "compensate_file", "export_c"]
+    "CompensationSummary", "Compensator", "InstrumentCompensator", "compensate",
+    "compensate_file", "export_c", "instrument_output_columns"]
