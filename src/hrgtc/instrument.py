@@ -276,7 +276,7 @@ def summary_rows(calibration: InstrumentCalibration) -> list[Mapping[str, Any]]:
             "raw_10s_dph": float(np.median(raw)) if raw else None,
             "compensated_10s_dph": float(np.median(comp)) if comp else None,
             "scale_terms": None if unit_model.scale_factor is None
-            else list(unit_model.scale_factor.terms),
+            else list(unit_model.scale_factor.selected),
             "scale_raw_max_ppm": max((c.raw_max_ppm for c in checks), default=None),
             "scale_residual_max_ppm": max((c.compensated_max_ppm for c in checks),
                                           default=None),
