@@ -214,12 +214,15 @@ def render_instrument(calibration: InstrumentCalibration) -> None:
         if model.scale_factor is not None:
             console.print(model.scale_factor.summary())
     if calibration.scale_checks:
-        table = Table(title="Held-out rate tables: scale-factor error (ppm), largest |error|")
-        for column in ("file", "axis", "segments", "raw", "compensated"):
+        table = Table(title="Held-out rate tables: scale-factor error (ppm) at each "
+                      "temperature, raw → compensated")
+        for column in ("file", "axis", "temperatures", "raw → compensated", "largest |error|"):
             table.add_column(column, justify="right")
         for check in calibration.scale_checks:
-            table.add_row(check.file, check.axis or "-", str(len(check.raw_ppm)),
-                          f"{check.raw_max_ppm:.1f}", f"{check.compensated_max_ppm:.1f}")
+            pairs = ", ".join(f"{r:+.1f} → {c:+.1f}"
+                              for r, c in zip(check.raw_ppm, check.compensated_ppm, strict=True))
+            table.add_row(Path(check.file).name, check.axis or "-", str(len(check.raw_ppm)),
+                          pairs, f"{check.raw_max_ppm:.1f} → {check.compensated_max_ppm:.1f}")
         console.print(table)
     if not calibration.model.is_single_axis:
         from hrgtc.instrument import summary_rows
