@@ -44,6 +44,8 @@ class CPlan:
         Newton tolerance of the inverse. [°C]
     extension
         Temperatures over which the inverse is defined. [°C]
+    precision
+        ``"double"`` (C double throughout) or ``"single"`` (float32, centred frequency).
     """
 
     housing: bool
@@ -59,16 +61,26 @@ class CPlan:
     f_range: tuple[float, float]
     tolerance: float
     extension: tuple[float, float]
+    precision: str = "double"
 
 
-def plan_for(model: UnitModel) -> CPlan:
+#: The precisions the export writes.
+PRECISIONS = ("double", "single")
+
+
+def plan_for(model: UnitModel, precision: str = "double") -> CPlan:
     """The numbers the C code needs beyond the model's own, computed as hrgtc computes them.
 
     Raises
     ------
+    InputError
+        An unknown precision, or a model the C export cannot compute (``dpos`` terms).
     CalibrationError
         A thermometer that is not monotonic over its calibrated range.
     """
+    if precision not in PRECISIONS:
+        raise InputError(f"precision {precision!r} is not one of {', '.join(PRECISIONS)}; "
+                         "use 'double' (the default) or 'single' (float32 for FPU-only MCUs)")
     thermometer, drift = model.thermometer, model.drift
     if not thermometer.is_monotonic:
         t_low, t_high = thermometer.temperature_range_c
@@ -118,4 +130,5 @@ def plan_for(model: UnitModel) -> CPlan:
         f_range=(f_low, f_high),
         tolerance=4 * np.finfo(np.float64).eps * max(abs(lo), abs(hi), span),
         extension=(lo, hi),
+        precision=precision,
     )

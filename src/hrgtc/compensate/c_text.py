@@ -14,8 +14,11 @@ from __future__ import annotations
 import math
 import re
 import textwrap
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from hrgtc.compensate.c_plan import TABLE_POINTS, CPlan
 from hrgtc.drift.features import Term, settle_rows
@@ -27,18 +30,58 @@ NEWTON_MAX_ITER = 60
 _WIDTH = 92
 
 
+@dataclass(frozen=True)
+class CType:
+    """The C floating type the export is written in: its name, literal suffix and math calls.
+
+    Every constant, variable and ``math.h`` call of the generated code goes through one
+    of these, so the same text generators write the double build and the float32 build.
+    """
+
+    name: str
+    suffix: str
+
+    def literal(self, value: float, name: str) -> str:
+        """A finite constant as a C literal of this type that reads back to the same value.
+
+        ``%.17g`` for double; for float the shortest decimal that reads back to the
+        same float32 (``numpy.float32``'s repr), with an ``f`` suffix.
+        """
+        value = float(value)
+        if not math.isfinite(value):
+            raise InputError(
+                f"model constant {name} is {value}; a model with non-finite numbers cannot be "
+                "exported: recalibrate the unit"
+            )
+        if self.suffix:
+            single = np.float32(value)
+            if not np.isfinite(single):
+                raise InputError(f"model constant {name} = {value:g} overflows float32; export "
+                                 "with --precision double")
+            text = str(single)
+        else:
+            text = f"{value:.17g}"
+        if not any(c in text for c in ".eEn"):
+            text += ".0"
+        return text + self.suffix
+
+    def call(self, function: str) -> str:
+        """The ``math.h`` function of this type: ``pow`` -> ``powf`` for float."""
+        return function + self.suffix
+
+
+DOUBLE = CType("double", "")
+SINGLE = CType("float", "f")
+
+
+def ctype(plan: CPlan) -> CType:
+    """The C type of a plan's precision (``double`` or ``single``)."""
+    return SINGLE if plan.precision == "single" else DOUBLE
+
+
 def _literal(value: float, name: str) -> str:
     """``%.17g`` text of a finite double as a C double literal (reads back exactly)."""
-    value = float(value)
-    if not math.isfinite(value):
-        raise InputError(
-            f"model constant {name} is {value}; a model with non-finite numbers cannot be "
-            "exported: recalibrate the unit"
-        )
-    text = f"{value:.17g}"
-    if not any(c in text for c in ".eEn"):
-        text += ".0"
-    return text
+    return DOUBLE.literal(value, name)
 
 
 def _comment(text: Any) -> str:
@@ -48,23 +91,24 @@ def _comment(text: Any) -> str:
     return ascii_text.replace("*/", "* /").replace("/*", "/ *")
 
 
-def _array(values: Any, name: str) -> str:
-    items = [_literal(v, f"{name}[{k}]") for k, v in enumerate(values)]
+def _array(values: Any, name: str, t: CType = DOUBLE) -> str:
+    items = [t.literal(v, f"{name}[{k}]") for k, v in enumerate(values)]
     lines = ["    " + ", ".join(items[k : k + 3]) + "," for k in range(0, len(items), 3)]
     return "{\n" + "\n".join(lines) + "\n}"
 
 
-def _factor(variable: str, power: int) -> str:
+def _factor(variable: str, power: int, t: CType = DOUBLE) -> str:
     x = f"x_{variable}"
     if power == 1:
         return x
     if power == 2:
         return f"({x} * {x})"  # numpy squares by multiplication
-    return f"pow({x}, {power}.0)"  # numpy calls the C library's pow for other powers
+    # numpy calls the C library's pow for other powers
+    return f"{t.call('pow')}({x}, {t.literal(power, 'power')})"
 
 
-def _term_expression(term: Term) -> str:
-    return " * ".join(_factor(v, p) for v, p in term.powers)
+def _term_expression(term: Term, t: CType = DOUBLE) -> str:
+    return " * ".join(_factor(v, p, t) for v, p in term.powers)
 
 
 
@@ -273,6 +317,8 @@ int {p}_frequency_in_range(double freq_hz);
 def _bias_function(model: UnitModel, plan: CPlan, prefix: str) -> str:
     drift = model.drift
     housing = plan.housing
+    t = ctype(plan)
+    real, lit, zero = t.name, t.literal, t.literal(0.0, "zero")
     params = ["f_hz", "df_hz_per_s"] + (["h_c", "dh_c_per_s"] if housing else [])
     names = dict(zip(("f", "df", "h", "dh"), params, strict=False))
     used = [v for v in ("f", "df", "h", "dh") if v in drift.variables and drift.selected]
@@ -284,51 +330,51 @@ def _bias_function(model: UnitModel, plan: CPlan, prefix: str) -> str:
         # held at the edge of the training range; the tangent there continues the model
         # beyond it, as DriftModel.predict(extrapolation="tangent")
         u = v.upper()
-        body.append(f"    const double c_{v} = {names[v]} < CLAMP_{u}_LOW ? CLAMP_{u}_LOW : "
+        body.append(f"    const {real} c_{v} = {names[v]} < CLAMP_{u}_LOW ? CLAMP_{u}_LOW : "
                     f"({names[v]} > CLAMP_{u}_HIGH ? CLAMP_{u}_HIGH : {names[v]});")
-        body.append(f"    const double x_{v} = c_{v} / SCALE_{u};")
-    body.append("    double sum = 0.0;")
-    body.append("    double term;")
+        body.append(f"    const {real} x_{v} = c_{v} / SCALE_{u};")
+    body.append(f"    {real} sum = {zero};")
+    body.append(f"    {real} term;")
     for k, term in enumerate(drift.terms):
-        body.append(f"    term = {_term_expression(term)};  /* {term.name} */")
+        body.append(f"    term = {_term_expression(term, t)};  /* {term.name} */")
         body.append(f"    term = COEFFICIENTS[{k}] * term;")
         body.append("    sum = sum + term;")
     for v in used:
         u = v.upper()
         body.append(f"    if ({names[v]} < CLAMP_{u}_LOW || {names[v]} > CLAMP_{u}_HIGH) {{"
                     f"  /* beyond the training range of {v} */")
-        body.append("        double gradient = 0.0;")
+        body.append(f"        {real} gradient = {zero};")
         for k, term in enumerate(drift.terms):
             multiplier, rest = term.derivative(v)
             if not multiplier:
                 continue
-            factor = f"COEFFICIENTS[{k}] * {multiplier}.0 / SCALE_{u}"
-            expression = factor if rest is None else f"{factor} * {_term_expression(rest)}"
+            factor = f"COEFFICIENTS[{k}] * {lit(multiplier, 'multiplier')} / SCALE_{u}"
+            expression = factor if rest is None else f"{factor} * {_term_expression(rest, t)}"
             body.append(f"        gradient = gradient + {expression};  /* d({term.name})/d{v} */")
         body.append(f"        sum = sum + gradient * ({names[v]} - c_{v});")
         body.append("    }")
     body.append("    return INTERCEPT_DPH + sum;")
     if not drift.terms:
         body = [line for line in body if "term" not in line]
-    signature = ", ".join(f"double {name}" for name in params)
-    constants = [f"static const double INTERCEPT_DPH = "
-                 f"{_literal(drift.intercept_dph, 'intercept_dph')};"]
+    signature = ", ".join(f"{real} {name}" for name in params)
+    constants = [f"static const {real} INTERCEPT_DPH = "
+                 f"{lit(drift.intercept_dph, 'intercept_dph')};"]
     for v in used:
-        constants.append(f"static const double SCALE_{v.upper()} = "
-                         f"{_literal(drift.settings.scales[v], f'scales[{v}]')};")
+        constants.append(f"static const {real} SCALE_{v.upper()} = "
+                         f"{lit(drift.settings.scales[v], f'scales[{v}]')};")
         low, high = drift.ranges[v]
-        constants.append(f"static const double CLAMP_{v.upper()}_LOW = "
-                         f"{_literal(low, f'ranges[{v}][0]')};")
-        constants.append(f"static const double CLAMP_{v.upper()}_HIGH = "
-                         f"{_literal(high, f'ranges[{v}][1]')};")
+        constants.append(f"static const {real} CLAMP_{v.upper()}_LOW = "
+                         f"{lit(low, f'ranges[{v}][0]')};")
+        constants.append(f"static const {real} CLAMP_{v.upper()}_HIGH = "
+                         f"{lit(high, f'ranges[{v}][1]')};")
     if drift.terms:
         listed = ", ".join(drift.selected)
         constants.append(f"/* Coefficients on scaled variables, in this order: {listed} */")
-        constants.append(f"static const double COEFFICIENTS[{len(drift.terms)}] = "
-                         f"{_array(drift.scaled_coefficients, 'scaled_coefficients')};")
+        constants.append(f"static const {real} COEFFICIENTS[{len(drift.terms)}] = "
+                         f"{_array(drift.scaled_coefficients, 'scaled_coefficients', t)};")
     return "\n".join(constants) + f"""
 
-double {prefix}_bias_dph({signature})
+{real} {prefix}_bias_dph({signature})
 {{
 """ + "\n".join(body) + "\n}\n"
 
