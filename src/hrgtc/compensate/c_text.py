@@ -11,72 +11,19 @@ separate statements, so a compiler that contracts ``a*b + c`` within an expressi
 
 from __future__ import annotations
 
-import math
 import re
 import textwrap
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from hrgtc.compensate.c_plan import TABLE_POINTS, CPlan
+from hrgtc.compensate.c_types import DOUBLE, CType, ctype
 from hrgtc.drift.features import Term, settle_rows
-from hrgtc.errors import InputError
 from hrgtc.model import UnitModel
 
 #: Iteration cap of the thermometer inverse (as :meth:`Thermometer.temperature`).
 NEWTON_MAX_ITER = 60
 _WIDTH = 92
-
-
-@dataclass(frozen=True)
-class CType:
-    """The C floating type the export is written in: its name, literal suffix and math calls.
-
-    Every constant, variable and ``math.h`` call of the generated code goes through one
-    of these, so the same text generators write the double build and the float32 build.
-    """
-
-    name: str
-    suffix: str
-
-    def literal(self, value: float, name: str) -> str:
-        """A finite constant as a C literal of this type that reads back to the same value.
-
-        ``%.17g`` for double; for float the shortest decimal that reads back to the
-        same float32 (``numpy.float32``'s repr), with an ``f`` suffix.
-        """
-        value = float(value)
-        if not math.isfinite(value):
-            raise InputError(
-                f"model constant {name} is {value}; a model with non-finite numbers cannot be "
-                "exported: recalibrate the unit"
-            )
-        if self.suffix:
-            single = np.float32(value)
-            if not np.isfinite(single):
-                raise InputError(f"model constant {name} = {value:g} overflows float32; export "
-                                 "with --precision double")
-            text = str(single)
-        else:
-            text = f"{value:.17g}"
-        if not any(c in text for c in ".eEn"):
-            text += ".0"
-        return text + self.suffix
-
-    def call(self, function: str) -> str:
-        """The ``math.h`` function of this type: ``pow`` -> ``powf`` for float."""
-        return function + self.suffix
-
-
-DOUBLE = CType("double", "")
-SINGLE = CType("float", "f")
-
-
-def ctype(plan: CPlan) -> CType:
-    """The C type of a plan's precision (``double`` or ``single``)."""
-    return SINGLE if plan.precision == "single" else DOUBLE
 
 
 def _literal(value: float, name: str) -> str:
@@ -114,8 +61,11 @@ def _term_expression(term: Term, t: CType = DOUBLE) -> str:
 
 
 def readme(model: UnitModel, plan: CPlan, prefix: str, origin: str,
-            sha256: str) -> str:
-    """The README comment block at the top of the header: what, provenance, Eq. (22), units, use."""
+            sha256: str, sections: list[str] | None = None) -> str:
+    """The README comment block at the top of the header: what, provenance, Eq. (22), units, use.
+
+    ``sections`` replace the UNITS and USAGE sections (the float32 build writes its own).
+    """
     from hrgtc._meta import PAPER_REFERENCE, __version__
 
     drift, thermometer, settings = model.drift, model.thermometer, model.drift.settings
@@ -219,6 +169,8 @@ def readme(model: UnitModel, plan: CPlan, prefix: str, origin: str,
         "REFERENCE",
         f"  [1] {PAPER_REFERENCE}",
     ]
+    if sections is not None:
+        lines[lines.index("UNITS"):lines.index("REFERENCE")] = sections
     wrapped = []
     for line in lines:
         head = re.match(r"^\s*(?:\S+:\s+|\S+ = |\[\d+\] )?", line)
