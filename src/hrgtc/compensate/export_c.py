@@ -34,7 +34,9 @@ import os
 import re
 from pathlib import Path
 
-from hrgtc.compensate.c_plan import plan_for
+from hrgtc.compensate import c_single
+from hrgtc.compensate.c_float32 import float_accuracy, float_constants
+from hrgtc.compensate.c_plan import PRECISIONS, plan_for
 from hrgtc.compensate.c_text import header, source
 from hrgtc.errors import InputError
 from hrgtc.files import file_sha256, refuse_existing, write_text_atomic
@@ -49,6 +51,7 @@ def export_c(
     outdir: str | os.PathLike[str],
     prefix: str = "hrgtc",
     force: bool = False,
+    precision: str = "double",
 ) -> list[Path]:
     """Write the unit's compensation as C99 files ``<prefix>_model.h`` and ``<prefix>_model.c``.
 
@@ -70,6 +73,12 @@ def export_c(
         C identifier prefix of every exported name (``<prefix>_step``, ...).
     force
         Overwrite existing files.
+    precision
+        ``"double"`` (default): C double throughout. ``"single"``: float32 for FPU-only
+        microcontrollers, with the frequency entering centred (``f_hz = freq_hz -
+        <PREFIX>_CENTRE_HZ``) and the worst error against the double model over the
+        calibrated range, measured at export (:mod:`hrgtc.compensate.c_float32`), stated
+        in the header and as ``<PREFIX>_MAX_ERROR_C`` / ``<PREFIX>_MAX_ERROR_DPH``.
 
     Returns
     -------
@@ -79,7 +88,8 @@ def export_c(
     Raises
     ------
     InputError
-        A prefix that is not a C identifier, or non-finite model constants.
+        A prefix that is not a C identifier, an unknown precision, or non-finite model
+        constants.
     CalibrationError
         A thermometer that is not monotonic over its calibrated range.
     OutputExistsError
@@ -92,6 +102,9 @@ def export_c(
             f"prefix {prefix!r} is not usable as a C identifier prefix; use a letter followed by "
             "up to 31 letters, digits or underscores, e.g. 'hrgtc' or 'gyro_x'"
         )
+    if precision not in PRECISIONS:
+        raise InputError(f"precision {precision!r} is not one of {', '.join(PRECISIONS)}; "
+                         "use 'double' (the default) or 'single' (float32 for FPU-only MCUs)")
     if isinstance(model, UnitModel):
         document = json.dumps(model.to_dict(), indent=2, allow_nan=True) + "\n"
         sha256 = hashlib.sha256(document.encode("utf-8")).hexdigest()
@@ -107,9 +120,15 @@ def export_c(
     header_path = folder / f"{prefix}_model.h"
     source_path = folder / f"{prefix}_model.c"
     refuse_existing((header_path, source_path), force)
-    plan = plan_for(model)
-    header_text = header(model, plan, prefix, origin, sha256)
-    code = source(model, plan, prefix)
+    plan = plan_for(model, precision)
+    if precision == "single":
+        constants = float_constants(model, plan)
+        accuracy = float_accuracy(model, plan, constants)
+        header_text = c_single.header(model, plan, prefix, origin, sha256, constants, accuracy)
+        code = c_single.source(model, plan, prefix, constants)
+    else:
+        header_text = header(model, plan, prefix, origin, sha256)
+        code = source(model, plan, prefix)
     return [
         write_text_atomic(header_path, header_text, force=force),
         write_text_atomic(source_path, code, force=force),
