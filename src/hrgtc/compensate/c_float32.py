@@ -38,6 +38,9 @@ NEWTON_MAX_ITER = 60
 #: Points of the error grids: the frequency line, and the grid of the drift variables.
 TEMPERATURE_POINTS = 20001
 BIAS_POINTS = 250_000
+#: The stated bounds are this many times the worst error measured on the grids: inputs
+#: between grid points (and a run's noisy df/dt) round a little differently.
+MARGIN = 2.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -268,9 +271,22 @@ class FloatAccuracy:
     grid_points: int
 
     @property
-    def worst_bias_dph(self) -> float:
-        """The larger of the grid and ramp figures. [°/h]"""
-        return max(self.bias_dph, self.ramp_bias_dph)
+    def bound_c(self) -> float:
+        """The stated bound of the temperature error: :data:`MARGIN` x the worst measured. [°C]"""
+        return _round_up(MARGIN * self.temperature_c)
+
+    @property
+    def bound_dph(self) -> float:
+        """Stated bound of the bias error: :data:`MARGIN` x the worst of grid and ramps. [°/h]"""
+        return _round_up(MARGIN * max(self.bias_dph, self.ramp_bias_dph))
+
+
+def _round_up(value: float) -> float:
+    """``value`` rounded up to two significant digits (a number a header can state)."""
+    if not value > 0:
+        return 0.0
+    digits = 1 - int(np.floor(np.log10(value)))
+    return float(np.ceil(value * 10.0**digits) / 10.0**digits)
 
 
 def float_accuracy(model: UnitModel, plan: CPlan, c: FloatConstants) -> FloatAccuracy:
@@ -301,33 +317,44 @@ def float_accuracy(model: UnitModel, plan: CPlan, c: FloatConstants) -> FloatAcc
     b32 = mirror_bias(model, c, {v: x.astype(F32) for v, x in values.items()})
     bias_error = float(np.max(np.abs(b32.astype(np.float64) - b64)))
     return FloatAccuracy(temperature_c=temperature_error, bias_dph=bias_error,
-                         ramp_bias_dph=_ramp_error(model, c), grid_points=n)
+                         ramp_bias_dph=_ramp_error(model, plan, c), grid_points=n)
 
 
-def _ramp_error(model: UnitModel, c: FloatConstants) -> float:
-    """Worst |B32 - B64| on steady ramps of f through the float and the double filter."""
+def _ramp_error(model: UnitModel, plan: CPlan, c: FloatConstants) -> float:
+    """Worst |B32 - B64| on steady ramps through the float and the double filters.
+
+    Nine ramps with rates spread over the trained df/dt range (and dh/dt, when the model
+    uses the housing thermistor, whose input enters as ``housing_c`` in float as firmware
+    passes it), from rest, for 12 filter time constants.
+    """
     drift = model.drift
-    if "df" not in drift.variables or "df" not in drift.ranges:
+    rated = [v for v in ("df", "dh") if v in drift.variables and v in drift.ranges]
+    if not rated:
         return 0.0
     from hrgtc.drift.features import causal_rate
 
     settings = drift.settings
     fs, tau = settings.sample_rate_hz, settings.rate_tau_s
     samples = int(min(12 * tau * fs, 100_000))
-    rates = np.linspace(*drift.ranges["df"], 9)
-    f_mid = 0.5 * (drift.ranges["f"][0] + drift.ranges["f"][1]) if "f" in drift.ranges else 0.0
-    time_s = np.arange(samples) / fs
-    f = f_mid + rates[:, None] * (time_s - time_s[-1] / 2)[None, :]
-    f32 = f.astype(F32)
-    df32 = mirror_rate(c, f32)
+    centred_time_s = (np.arange(samples) - samples / 2) / fs
+    values64: dict[str, np.ndarray] = {}
+    values32: dict[str, np.ndarray] = {}
+    for level, rate in (("f", "df"), ("h", "dh")):
+        if level not in plan.computed and rate not in plan.computed:
+            continue
+        middle = 0.5 * sum(drift.ranges[level]) if level in drift.ranges else 0.0
+        rates = np.linspace(*drift.ranges[rate], 9) if rate in drift.ranges else np.zeros(9)
+        x = middle + rates[:, None] * centred_time_s[None, :]
+        if level == "h":  # firmware passes housing_c; the code subtracts REFERENCE_C
+            x32 = (x + settings.reference_c).astype(F32) - c.reference_c
+        else:
+            x32 = x.astype(F32)
+        values64[level], values32[level] = x, x32
+        values64[rate] = np.vstack([causal_rate(row, tau, fs)[0] for row in x])
+        values32[rate] = mirror_rate(c, x32)
     worst = 0.0
-    for row in range(rates.size):
-        df64 = causal_rate(f[row], tau, fs)[0]
-        values = {"f": f[row], "df": df64}
-        for v in ("h", "dh"):
-            values[v] = np.zeros(samples)
-        b64 = drift.predict({v: values[v] for v in drift.variables})
-        b32 = mirror_bias(model, c, {"f": f32[row], "df": df32[row],
-                                     "h": np.zeros(samples, F32), "dh": np.zeros(samples, F32)})
+    for row in range(9):
+        b64 = drift.predict({v: values64[v][row] for v in drift.variables})
+        b32 = mirror_bias(model, c, {v: x[row] for v, x in values32.items()})
         worst = max(worst, float(np.max(np.abs(b32.astype(np.float64) - b64))))
     return worst

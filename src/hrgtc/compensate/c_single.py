@@ -14,7 +14,7 @@ statements). The drift terms are printed by the shared
 
 from __future__ import annotations
 
-from hrgtc.compensate.c_float32 import NEWTON_MAX_ITER, FloatAccuracy, FloatConstants
+from hrgtc.compensate.c_float32 import MARGIN, NEWTON_MAX_ITER, FloatAccuracy, FloatConstants
 from hrgtc.compensate.c_plan import TABLE_POINTS, CPlan
 from hrgtc.compensate.c_text import _array, _bias_function, _comment, readme
 from hrgtc.compensate.c_types import DOUBLE, SINGLE
@@ -50,7 +50,9 @@ def _sections(model: UnitModel, plan: CPlan, prefix: str, accuracy: FloatAccurac
         "ramps over the trained df/dt range.",
         "  rate_comp_dph:   the bias error plus the float rounding of rate_dph itself "
         "(6e-8 of |rate|: 0.06 deg/h at 300 deg/s).",
-        f"  {up}_MAX_ERROR_C and {up}_MAX_ERROR_DPH hold these bounds.",
+        f"  Stated bounds ({MARGIN:g} x the worst measured, for inputs between the grid "
+        f"points): {up}_MAX_ERROR_C = {accuracy.bound_c:.2g} degC, {up}_MAX_ERROR_DPH = "
+        f"{accuracy.bound_dph:.2g} deg/h.",
         "",
         "UNITS",
         f"  inputs:  f_hz = freq_hz - {up}_CENTRE_HZ [Hz]; rate_dph [deg/h] gyro output "
@@ -112,10 +114,10 @@ extern "C" {{
 #define {up}_CENTRE_HZ {DOUBLE.literal(constants.centre_hz, "centre_hz")}
 /* The centred frequency {p}_step() takes, from a double freq_hz. [Hz] */
 #define {up}_CENTRED_HZ(freq_hz) ((float)((freq_hz) - {up}_CENTRE_HZ))
-/* Worst float32 error against the double model over the calibrated range, measured at
-   export: resonator temperature [degC] and bias model [deg/h]. */
-#define {up}_MAX_ERROR_C {lit(accuracy.temperature_c, "max_error_c")}
-#define {up}_MAX_ERROR_DPH {lit(accuracy.worst_bias_dph, "max_error_dph")}
+/* Bound of the float32 error against the double model over the calibrated range, from the
+   worst measured at export: resonator temperature [degC] and bias model [deg/h]. */
+#define {up}_MAX_ERROR_C {lit(accuracy.bound_c, "max_error_c")}
+#define {up}_MAX_ERROR_DPH {lit(accuracy.bound_dph, "max_error_dph")}
 /* Sample rate the df/dt filter was designed for: call {p}_step() at exactly this rate. [Hz] */
 #define {up}_SAMPLE_RATE_HZ {lit(settings.sample_rate_hz, "sample_rate_hz")}
 /* Samples at the start of a run flagged (in_range 0) while the df/dt filter settles,
