@@ -29,12 +29,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from hrgtc.compensate.c_plan import CPlan
+from hrgtc.compensate.c_text import NEWTON_MAX_ITER
 from hrgtc.drift.features import Term
 from hrgtc.model import UnitModel
 
 F32 = np.float32
-#: Iteration cap of the float thermometer inverse (as the double code's).
-NEWTON_MAX_ITER = 60
 #: Points of the error grids: the frequency line, and the grid of the drift variables.
 TEMPERATURE_POINTS = 20001
 BIAS_POINTS = 250_000

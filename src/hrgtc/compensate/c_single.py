@@ -14,9 +14,9 @@ statements). The drift terms are printed by the shared
 
 from __future__ import annotations
 
-from hrgtc.compensate.c_float32 import MARGIN, NEWTON_MAX_ITER, FloatAccuracy, FloatConstants
+from hrgtc.compensate.c_float32 import MARGIN, FloatAccuracy, FloatConstants
 from hrgtc.compensate.c_plan import TABLE_POINTS, CPlan
-from hrgtc.compensate.c_text import _array, _bias_function, _comment, readme
+from hrgtc.compensate.c_text import NEWTON_MAX_ITER, _array, _bias_function, _comment, readme
 from hrgtc.compensate.c_types import DOUBLE, SINGLE
 from hrgtc.drift.features import settle_rows
 from hrgtc.model import UnitModel

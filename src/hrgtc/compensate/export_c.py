@@ -38,10 +38,13 @@ from hrgtc.compensate import c_single
 from hrgtc.compensate.c_float32 import float_accuracy, float_constants
 from hrgtc.compensate.c_plan import PRECISIONS, plan_for
 from hrgtc.compensate.c_text import header, source
+from hrgtc.compensate.parameter_file import parameter_text
 from hrgtc.errors import InputError
 from hrgtc.files import file_sha256, refuse_existing, write_text_atomic
 from hrgtc.model import UnitModel, load_model
 
+#: What the export writes: C99 files, or the plain parameter file.
+FORMATS = ("c", "params")
 _PREFIX = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,31}$")
 
 
@@ -52,6 +55,7 @@ def export_c(
     prefix: str = "hrgtc",
     force: bool = False,
     precision: str = "double",
+    output_format: str = "c",
 ) -> list[Path]:
     """Write the unit's compensation as C99 files ``<prefix>_model.h`` and ``<prefix>_model.c``.
 
@@ -79,11 +83,15 @@ def export_c(
         <PREFIX>_CENTRE_HZ``) and the worst error against the double model over the
         calibrated range, measured at export (:mod:`hrgtc.compensate.c_float32`), stated
         in the header and as ``<PREFIX>_MAX_ERROR_C`` / ``<PREFIX>_MAX_ERROR_DPH``.
+    output_format
+        ``"c"`` (default): the header and source. ``"params"``: one plain parameter file
+        ``<prefix>_params.txt`` of ``key = value`` lines, every number documented
+        (:mod:`hrgtc.compensate.parameter_file`); ``precision`` does not apply.
 
     Returns
     -------
     list of pathlib.Path
-        The header and the source written.
+        The header and the source written (the parameter file for ``output_format="params"``).
 
     Raises
     ------
@@ -102,6 +110,9 @@ def export_c(
             f"prefix {prefix!r} is not usable as a C identifier prefix; use a letter followed by "
             "up to 31 letters, digits or underscores, e.g. 'hrgtc' or 'gyro_x'"
         )
+    if output_format not in FORMATS:
+        raise InputError(f"format {output_format!r} is not one of {', '.join(FORMATS)}; use 'c' "
+                         "(header and source) or 'params' (a key = value parameter file)")
     if precision not in PRECISIONS:
         raise InputError(f"precision {precision!r} is not one of {', '.join(PRECISIONS)}; "
                          "use 'double' (the default) or 'single' (float32 for FPU-only MCUs)")
@@ -117,6 +128,11 @@ def export_c(
     folder = Path(outdir)
     if folder.exists() and not folder.is_dir():
         raise InputError(f"output folder {folder} is a file; give a folder for the C files")
+    if output_format == "params":
+        target = folder / f"{prefix}_params.txt"
+        refuse_existing((target,), force)
+        text = parameter_text(model, plan_for(model), origin, sha256)
+        return [write_text_atomic(target, text, force=force)]
     header_path = folder / f"{prefix}_model.h"
     source_path = folder / f"{prefix}_model.c"
     refuse_existing((header_path, source_path), force)
