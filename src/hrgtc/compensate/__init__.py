@@ -4,7 +4,8 @@ Takes a :class:`~hrgtc.model.UnitModel` and a recording and gives the
 compensated output: batch or streaming (``compensator``: :class:`Compensator`
 keeps the df/dt filter state across chunks; :func:`compensate_file` works file
 to file in bounded memory), or dependency-free C99 for on-board use
-(``export_c``, its text in ``c_text``).
+(``export_c``, its text in ``c_text``, the float32 build in ``c_single`` and
+``c_float32``) or a documented parameter file (``parameter_file``).
 """
 
 from hrgtc.compensate.compensator import (

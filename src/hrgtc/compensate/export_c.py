@@ -23,6 +23,12 @@ thermometer polynomial and the terms round exactly as NumPy does; what remains
 rounding level: about 1e-14 °/h and 3e-12 °C. The C text is printed by
 :mod:`hrgtc.compensate.c_text`.
 
+``precision="single"`` writes the float32 build for FPU-only microcontrollers
+(:mod:`hrgtc.compensate.c_single`; centred frequency input), whose worst error against
+the double model is measured at export by its numpy float32 mirror
+(:mod:`hrgtc.compensate.c_float32`) and stated in the header. ``output_format="params"``
+writes the plain parameter file of :mod:`hrgtc.compensate.parameter_file` instead.
+
 [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
 """
 
