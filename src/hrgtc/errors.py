@@ -43,5 +43,9 @@ class ExtrapolationWarning(HrgtcWarning):
     """Input is valid but outside the range a model was calibrated on."""
 
 
+class SpikeWarning(HrgtcWarning):
+    """Rows of implausible samples were dropped from a recording (``spikes="drop"``)."""
+
+
 class PrecisionWarning(HrgtcWarning):
     """A computation ran at lower precision than asked (no extended-precision type here)."""

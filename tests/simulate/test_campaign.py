@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import itertools
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -385,3 +386,154 @@ def test_output_path_errors(tmp_path):
         simulate.output_paths(runs, tmp_path / "x.parquet")
     with pytest.raises(InputError, match=r"suffix '\.csv' but the format is 'h5'"):
         simulate.output_paths(runs[:1], tmp_path / "x.csv", "h5")
+
+
+# ----------------------------------------------------------------------------- rate table
+def test_rate_table_truth_columns_follow_the_laws():
+    # One imu-3 axis alone: a single-axis unit with a scale-factor law.
+    gyro = units.get("imu-3").axes["x"]
+    fs = 10.0
+    table = standard_profiles.rate_table([-10.0, 40.0], [0.0, 100.0, -300.0], hold_s=60.0,
+                                         soak_h=0.25)
+    rec = simulate.simulate_run(table, gyro, sample_rate_hz=fs, seed=4, input_rate_dph=7.0,
+                                chunk_rows=4001)
+    assert rec.names == (*simulate.COLUMNS, "scale_ppm", "input_rate_dph")
+    assert np.array_equal(rec["scale_ppm"], gyro.scale_factor_law.ppm(rec["resonator_c"]))
+    expected_input = table.table_rate_dps(rec.time_s) * 3600.0 + 7.0
+    assert np.array_equal(rec["input_rate_dph"], expected_input)
+    assert set(np.unique(rec["input_rate_dph"])) == {7.0, 7.0 + 360000.0, 7.0 - 1080000.0}
+    residual = rec.rate_dph - rec["input_rate_dph"] * (1 + rec["scale_ppm"] * 1e-6) - rec[
+        "bias_dph"]
+    # The residual is the gyro noise: its white part has the ARW's per-sample rms
+    # N 60 sqrt(fs) (differences remove the slow parts), and it is the very noise of the
+    # same seed with the table at rest (the input does not change the noise streams).
+    white = np.std(np.diff(residual)) / np.sqrt(2.0)
+    assert white == pytest.approx(gyro.gyro_noise.arw_deg_per_sqrt_h * 60 * np.sqrt(fs),
+                                  rel=0.03)
+    at_rest = simulate.simulate_run(
+        profiles.Profile(tuple(replace(s, table_rate_dps=None) for s in table.segments),
+                         start_c=table.start_c),
+        gyro, sample_rate_hz=fs, seed=4, input_rate_dph=7.0,
+    )
+    assert np.array_equal(at_rest.freq_hz, rec.freq_hz)
+    rest_residual = at_rest.rate_dph - 7.0 * (1 + at_rest["scale_ppm"] * 1e-6) - at_rest[
+        "bias_dph"]
+    np.testing.assert_allclose(residual, rest_residual, rtol=0, atol=1e-6)
+    # At -300 °/s a few hundred ppm are hundreds of °/h of error, far above the noise.
+    for hot in (rec["input_rate_dph"] < -1e6) & (rec.time_s < 1100), (
+            rec["input_rate_dph"] < -1e6) & (rec.time_s > 1100):
+        error = rec.rate_dph[hot] - rec["input_rate_dph"][hot] - rec["bias_dph"][hot]
+        ppm = gyro.scale_factor_law.ppm(rec["resonator_c"][hot])
+        assert abs(error.mean()) > 50.0
+        assert error.mean() == pytest.approx(-1080007.0 * ppm.mean() * 1e-6, rel=0.01)
+
+
+def test_rate_table_steps_at_the_segment_ends():
+    fs = 5.0
+    table = standard_profiles.rate_table([20.0], [10.0, -10.0], hold_s=30.0, soak_h=0.05)
+    rec = simulate.simulate_run(table, sample_rate_hz=fs, seed=0)
+    assert rec.metadata.input_rate_dph == 10.0 and "scale_ppm" not in rec.names
+    steps = np.flatnonzero(np.diff(rec["input_rate_dph"])) + 1
+    # Soak 180 s, then 30 s at +10 °/s, then -10 °/s to the end (210 s).
+    assert rec.time_s[steps].tolist() == pytest.approx([180.0, 210.0], abs=1.0 / fs)
+    assert len(rec) == round(240.0 * fs)
+
+
+# ----------------------------------------------------------------------------- three axes
+def test_imu3_axes_resonators_differ_during_a_ramp():
+    imu = units.get("imu-3")
+    rec = simulate.simulate_run(simulate.cooldown(20.0, -20.0, 3.0), "imu-3", sample_rate_hz=0.2,
+                                seed=1)
+    x, y, z = (rec[f"resonator_c_{a}"] for a in "xyz")
+    ramp = (rec.time_s > 600.0) & (rec.time_s < 2400.0)
+    # Cooling, the resonator with the shortest lag is the coldest: tau 2000 < 2700 < 3400 s.
+    assert np.all(x[ramp] < y[ramp]) and np.all(y[ramp] < z[ramp])
+    assert np.max(z - x) > 3.0
+    # Each axis is its own unit behind the shared housing: the same as simulating it alone
+    # (resonator and bias are deterministic).
+    alone = simulate.simulate_run(simulate.cooldown(20.0, -20.0, 3.0), imu.axes["z"],
+                                  sample_rate_hz=0.2, seed=1)
+    np.testing.assert_allclose(z, alone["resonator_c"], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(rec["bias_dph_z"], alone["bias_dph"], rtol=0, atol=1e-12)
+    for axis, gyro in imu.axes.items():
+        np.testing.assert_allclose(
+            rec[f"freq_hz_{axis}"] - gyro.frequency_law.frequency_hz(rec[f"resonator_c_{axis}"]),
+            0.0, atol=6 * gyro.frequency_noise_hz,
+        )
+    assert rec.metadata.extra["axis_input_rate_dph"] == imu.input_rate_dph
+    assert rec.metadata.input_rate_dph == 0.0
+
+
+def test_imu3_rate_table_rotates_one_axis_at_a_time():
+    imu = units.get("imu-3")
+    table = standard_profiles.rate_table([0.0], [50.0, -50.0], hold_s=20.0, soak_h=0.02,
+                                         axes=imu.axis_names)
+    rec = simulate.simulate_run(table, imu, sample_rate_hz=2.0, seed=3)
+    assert rec.names == simulate.run_columns(table, imu)
+    turning = {}
+    for axis in imu.axis_names:
+        table_dph = rec[f"input_rate_dph_{axis}"] - imu.input_rate_dph[axis]
+        turning[axis] = np.abs(table_dph) > 0
+        assert set(np.unique(table_dph)) == {0.0, 180000.0, -180000.0}
+        assert turning[axis].sum() == 2 * 20 * 2  # two 20 s holds at 2 Hz
+    # The holds are disjoint and in order x, y, z.
+    assert not np.any(turning["x"] & turning["y"]) and not np.any(turning["y"] & turning["z"])
+    starts = [np.flatnonzero(turning[a])[0] for a in "xyz"]
+    assert starts == sorted(starts) and starts[0] == round(0.02 * 3600 * 2)
+
+
+def test_imu3_same_seed_same_arrays_and_independent_axes():
+    p = simulate.constant(20.0, 0.5)
+    a = simulate.simulate_run(p, "imu-3", sample_rate_hz=10.0, seed=5)
+    b = simulate.simulate_run(p, "imu-3", sample_rate_hz=10.0, seed=5, chunk_rows=1234)
+    c = simulate.simulate_run(p, "imu-3", sample_rate_hz=10.0, seed=6)
+    for name in a.names:
+        assert np.array_equal(a[name], b[name]), name
+    assert not np.array_equal(a["rate_dph_x"], c["rate_dph_x"])
+    imu = units.get("imu-3")
+    noise = {}
+    for axis in imu.axis_names:
+        k = 1 + a[f"scale_ppm_{axis}"] * 1e-6
+        noise[axis] = a[f"rate_dph_{axis}"] - imu.input_rate_dph[axis] * k - a[f"bias_dph_{axis}"]
+        white = np.std(np.diff(noise[axis])) / np.sqrt(2.0)
+        arw = imu.axes[axis].gyro_noise.arw_deg_per_sqrt_h
+        assert white == pytest.approx(arw * 60 * np.sqrt(10.0), rel=0.03)
+    # 18,000 samples: independent streams correlate by ~1/sqrt(n) = 0.007.
+    for u, v in itertools.combinations("xyz", 2):
+        assert abs(np.corrcoef(np.diff(noise[u]), np.diff(noise[v]))[0, 1]) < 0.04
+        assert abs(np.corrcoef(np.diff(a[f"freq_hz_{u}"]), np.diff(a[f"freq_hz_{v}"]))[0, 1]) < 0.04
+
+
+@pytest.mark.parametrize("kind", standard_profiles.KINDS)
+def test_imu3_runs_every_standard_profile(kind, tmp_path):
+    options = {"hours": 0.7} if kind in ("cooldown", "warmup", "constant") else {}
+    if kind == "soak":
+        options = {"setpoints_c": [0.0], "hours": 0.05}
+    if kind == "ramp":
+        options = {"start_c": 20.0, "end_c": 22.0}
+    if kind == "ratetable":
+        options = {"setpoints_c": [25.0], "hours": 0.05, "rates_dps": [1.0], "rate_hold_s": 10}
+    (p,) = standard_profiles.build(kind, axes=("x", "y", "z"), **options)
+    written = simulate.simulate_to_file(p, tmp_path / "run.csv", "imu-3", sample_rate_hz=0.5)
+    header = next(line for line in (tmp_path / "run.csv").read_text().splitlines()
+                  if not line.startswith("#"))
+    assert tuple(header.split(",")) == simulate.run_columns(p, "imu-3")
+    assert written.rows == simulate.campaign.row_count(p, 0.5)
+    assert ("input_rate_dph_y" in header) == (kind == "ratetable")
+    assert "rate_dph_z" in header and "scale_ppm_x" in header and "freq_hz," not in header
+
+
+def test_rate_table_axes_must_match_the_unit():
+    single = standard_profiles.rate_table([20.0], [1.0], hold_s=10, soak_h=0.01)
+    three = standard_profiles.rate_table([20.0], [1.0], hold_s=10, soak_h=0.01, axes=("x", "w"))
+    with pytest.raises(InputError, match="without naming an axis, but unit 'imu-3' has axes"):
+        simulate.simulate_run(single, "imu-3", sample_rate_hz=1.0)
+    with pytest.raises(InputError, match=r"turns axis\(es\) \['w'\], not axes of unit 'imu-3'"):
+        simulate.simulate_run(three, "imu-3", sample_rate_hz=1.0)
+    with pytest.raises(InputError, match="has a single axis; drop the segments' axis"):
+        simulate.simulate_run(three, "paper-unit", sample_rate_hz=1.0)
+    with pytest.raises(InputError, match="must give a rate for each axis of unit 'imu-3'"):
+        simulate.simulate_run(single, "imu-3", input_rate_dph={"x": 1.0})
+    rec = simulate.simulate_run(simulate.constant(20.0, 0.01), "imu-3", sample_rate_hz=1.0,
+                                input_rate_dph=3.0)
+    assert rec.metadata.extra["axis_input_rate_dph"] == {"x": 3.0, "y": 3.0, "z": 3.0}

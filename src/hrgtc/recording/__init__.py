@@ -7,12 +7,14 @@ description of it (:func:`describe`). :class:`RecordingWriter` and :func:`write`
 write recordings atomically.
 
 Modules: ``schema`` (the type and its columns), ``formats`` and ``csv`` (file
-formats), ``mapping`` (user columns and units), ``validation`` (the contract's
+formats), ``axes`` (multi-axis recordings: :func:`axis_names`,
+:func:`axis_view`), ``mapping`` (user columns and units), ``validation`` (the contract's
 checks), ``checks`` (the single checks and unit heuristics), ``gaps`` (gap
 policies), ``io`` (reading and writing), ``info`` (what is in a file), ``marks``
 (the mark of a compensated output).
 """
 
+from hrgtc.recording.axes import AXIS_COLUMNS, axis_names, axis_view
 from hrgtc.recording.gaps import Gap, split_at_gaps
 from hrgtc.recording.info import RecordingInfo, describe
 from hrgtc.recording.io import (
@@ -41,6 +43,7 @@ from hrgtc.recording.validation import (
 )
 
 __all__ = [
+    "AXIS_COLUMNS",
     "COLUMNS",
     "REQUIRED_COLUMNS",
     "SCHEMA_VERSION",
@@ -53,6 +56,8 @@ __all__ = [
     "RecordingValidator",
     "RecordingWriter",
     "ValidationReport",
+    "axis_names",
+    "axis_view",
     "concatenate",
     "count_rows",
     "describe",

@@ -1,4 +1,5 @@
-"""The single checks of a recording: the :class:`Problem` they report, and the unit heuristics.
+"""The single checks of a recording: the :class:`Problem` they report, the :class:`ValidationReport`
+of them all, and the unit heuristics.
 
 :mod:`hrgtc.recording.validation` runs them (see its docstring for the rules);
 they live here so that each stays a small function of arrays: the measured
@@ -15,6 +16,9 @@ from typing import Any
 
 import numpy as np
 
+from hrgtc.errors import InputError, RecordingError
+from hrgtc.recording.gaps import Gap
+
 SAMPLE_RATE_TOLERANCE = 0.01  # relative disagreement of measured and nominal rate
 KHZ_BELOW_HZ = 100.0
 FREQ_MAX_HZ = 1e6
@@ -26,6 +30,24 @@ DEG_PER_RAD_X3600 = 180.0 / math.pi * 3600.0  # °/h per rad/s
 RATE_BLOCK_NOISE_DPH = 1e-2
 #: Below this inferred sample rate the time column is suspected to be in milliseconds.
 SLOW_SAMPLE_RATE_HZ = 0.5
+
+#: Physical bounds of every sample (outside: an error naming the first row).
+FREQ_SAMPLE_RANGE_HZ = (100.0, 1e5)  # n = 2 mode of any HRG: a few 100 Hz .. tens of kHz
+FREQ_JUMP_FRACTION = 0.05  # 84 ppm/°C over 300 °C is 2.5 %: more than 5 % off is a glitch
+RATE_MAX_DPH = 3.6e6  # 1000 °/s: beyond any rate table and the rebalance loop of an HRG
+TEMPERATURE_RANGE_C = (-200.0, 500.0)  # chambers, housings, resonators
+#: Rows per block of the sample-rate check that runs through the whole file.
+RATE_CHECK_ROWS = 1000
+_BOUNDS: dict[str, tuple[float, float, str]] = {
+    "freq_hz": (*FREQ_SAMPLE_RANGE_HZ, "Hz"),
+    "rate_dph": (-RATE_MAX_DPH, RATE_MAX_DPH, "°/h"),
+    "bias_dph": (-RATE_MAX_DPH, RATE_MAX_DPH, "°/h"),
+    "input_rate_dph": (-RATE_MAX_DPH, RATE_MAX_DPH, "°/h"),
+    "temperature_c": (*TEMPERATURE_RANGE_C, "°C"),
+    "chamber_c": (*TEMPERATURE_RANGE_C, "°C"),
+    "housing_c": (*TEMPERATURE_RANGE_C, "°C"),
+    "resonator_c": (*TEMPERATURE_RANGE_C, "°C"),
+}
 
 
 @dataclass(frozen=True)
@@ -66,6 +88,91 @@ class Problem:
         """Inverse of :meth:`to_dict`."""
         return cls(**dict(data))
 
+
+@dataclass(frozen=True)
+class ValidationReport:
+    """Outcome of validating a recording.
+
+    Parameters
+    ----------
+    ok
+        True when there is no problem.
+    problems
+        The problems found, in the order of the checks.
+    gaps
+        Gaps found (at most ``MAX_LISTED_GAPS`` listed), whatever the policy.
+    n_gaps
+        Number of gaps found.
+    rows
+        Rows checked.
+    source
+        File the recording came from.
+    measured_sample_rate_hz
+        Reciprocal of the median time step of the first ``HEURISTIC_ROWS``
+        rows, None with fewer than 2 rows. [Hz]
+    gap_policy
+        ``"error"``, ``"split"`` or ``"ignore"``.
+    """
+
+    ok: bool
+    problems: tuple[Problem, ...]
+    gaps: tuple[Gap, ...]
+    n_gaps: int
+    rows: int
+    source: str | None
+    measured_sample_rate_hz: float | None
+    gap_policy: str = "error"
+
+    @property
+    def message(self) -> str:
+        """All problems as one message that names the file ("" when ok)."""
+        return problems_message(self.source, self.problems)
+
+    def raise_for_problems(self) -> None:
+        """Raise :class:`~hrgtc.errors.RecordingError` with :attr:`message` unless ok."""
+        if self.problems:
+            raise RecordingError(self.message)
+
+    def summary(self) -> str:
+        """Human-readable text (does not print)."""
+        where = self.source or "recording"
+        lines = [f"validation of {where}: {'ok' if self.ok else 'FAILED'} ({self.rows} rows)"]
+        if self.measured_sample_rate_hz is not None:
+            lines.append(f"  measured sample rate: {self.measured_sample_rate_hz:.6g} Hz")
+        lines += [f"  problem: {p.message}" for p in self.problems]
+        if self.n_gaps:
+            lines.append(f"  gaps: {self.n_gaps} (policy {self.gap_policy})")
+            lines += [
+                f"    row {g.row}: {g.duration_s:.6g} s without samples after t = "
+                f"{g.start_time_s:.6g} s"
+                for g in self.gaps[:10]
+            ]
+            if self.n_gaps > 10:
+                lines.append(f"    ... {self.n_gaps - 10} more")
+        return "\n".join(lines)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types."""
+        data = asdict(self)
+        return {**data, "problems": list(data["problems"]), "gaps": list(data["gaps"])}
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> ValidationReport:
+        """Inverse of :meth:`to_dict`."""
+        problems = tuple(Problem.from_dict(p) for p in data["problems"])
+        gaps = tuple(Gap.from_dict(g) for g in data["gaps"])
+        return cls(**{**data, "problems": problems, "gaps": gaps})
+
+
+def problems_message(source: str | None, problems: tuple[Problem, ...] | list[Problem]) -> str:
+    """One message for ``problems`` that starts with the file name."""
+    where = source or "recording"
+    if not problems:
+        return ""
+    if len(problems) == 1:
+        return f"{where}: {problems[0].message}"
+    items = "\n".join(f"  - {p.message}" for p in problems)
+    return f"{where}: {len(problems)} problems:\n{items}"
 
 
 def measured_sample_rate(time_s: np.ndarray) -> float | None:
@@ -129,26 +236,27 @@ def _block_noise(rate: np.ndarray, sample_rate_hz: float) -> float:
     return float(1.4826 * np.median(np.abs(step - np.median(step))) / math.sqrt(2.0))
 
 
-def _check_freq_unit(freq: np.ndarray) -> Problem | None:
+def _check_freq_unit(freq: np.ndarray, name: str = "freq_hz") -> Problem | None:
     freq = freq[np.isfinite(freq)]
     if freq.size == 0:
         return None
     median = float(np.median(freq))
     if 0 < median < KHZ_BELOW_HZ and KHZ_BELOW_HZ <= median * 1000.0 <= FREQ_MAX_HZ:
-        message = f"freq_hz looks like kHz (median {median:.6g}); pass --freq-unit kHz"
+        message = f"{name} looks like kHz (median {median:.6g}); pass --freq-unit kHz"
     elif median <= 0 or median < KHZ_BELOW_HZ or median > FREQ_MAX_HZ:
         message = (
-            f"freq_hz is implausible (median {median:.6g} Hz; the resonator frequency of an "
-            "HRG is a few hundred Hz to a few tens of kHz); check the column mapping "
-            "(--col freq_hz=<your column>) and the unit (--freq-unit Hz|kHz)"
+            f"{name} is implausible (median {median:.6g} Hz; the resonator frequency of an "
+            f"HRG is a few hundred Hz to a few tens of kHz); check the column mapping "
+            f"(--col {name}=<your column>) and the unit (--freq-unit Hz|kHz); a gyro without "
+            "a frequency output: --thermometer sensor"
         )
     else:
         return None
-    return Problem("freq_unit", message, column="freq_hz", value=f"{median:.6g}")
+    return Problem("freq_unit", message, column=name, value=f"{median:.6g}")
 
 
 def _check_rate_unit(rate: np.ndarray, input_rate_dph: float,
-                     sample_rate_hz: float = 1.0) -> Problem | None:
+                     sample_rate_hz: float = 1.0, name: str = "rate_dph") -> Problem | None:
     rate = rate[np.isfinite(rate)]
     if rate.size < 2:
         return None
@@ -169,10 +277,25 @@ def _check_rate_unit(rate: np.ndarray, input_rate_dph: float,
         options.reverse()  # below 0.5 °/h even if it were °/s: rad/s is more likely
     return Problem(
         "rate_unit",
-        f"rate_dph looks like °/s or rad/s, not °/h (median |rate| {level:.3g}, noise of "
+        f"{name} looks like °/s or rad/s, not °/h (median |rate| {level:.3g}, noise of "
         f"1 s means {block_noise:.3g}; a gyro recorded in °/h reads ≳ {RATE_LEVEL_DPH:g} °/h "
         f"with ≳ {RATE_BLOCK_NOISE_DPH:g} °/h noise in 1 s means); pass "
         f"{' or '.join(options)}",
-        column="rate_dph",
+        column=name,
         value=f"{level:.3g}",
     )
+
+
+#: What ``freq_hz`` holds: the resonator frequency [Hz] (default) or, for a gyro without a
+#: frequency output, a temperature sensor's reading [°C] (``--thermometer sensor``).
+THERMOMETERS: tuple[str, ...] = ("resonator", "sensor")
+
+
+def check_thermometer(thermometer: str) -> str:
+    """Return ``thermometer`` if it is one of :data:`THERMOMETERS`, else raise InputError."""
+    if thermometer not in THERMOMETERS:
+        raise InputError(
+            f"thermometer must be one of {list(THERMOMETERS)}, got {thermometer!r}; "
+            "'sensor' for a gyro without a frequency output (its temperature_c column)"
+        )
+    return thermometer

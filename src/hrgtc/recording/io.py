@@ -10,38 +10,36 @@ Users' files are mapped onto the recording contract of DESIGN.md on reading:
 
 * ``columns`` and ``units``: see :mod:`hrgtc.recording.mapping`; the date of the
   first sample of a file with timestamps is kept as ``extra["time_origin"]``;
+* ``temp_scale``/``temp_offset_c`` (a temperature logged as a raw count) and
+  ``thermometer="sensor"`` (a gyro without a frequency output): see
+  :mod:`hrgtc.recording.mapping`; the sensor thermometer sets
+  ``extra["thermometer"] = "sensor"``;
+* ``spikes``: ``"error"`` or ``"drop"`` (see :mod:`hrgtc.recording.spikes`); rows
+  dropped are counted in ``extra["spikes_dropped"]`` (by :func:`read`) and a
+  :class:`~hrgtc.errors.SpikeWarning`;
 * missing metadata: ``metadata=`` overrides or completes the file's metadata;
   without a sample rate anywhere it is inferred from the median time step of the
   first rows, and ``extra["sample_rate_inferred"]`` is set to True.
+
+Multi-axis files (``rate_dph_x``, ...) are read like single-axis ones and
+validated axis by axis; :func:`hrgtc.recording.axis_view` gives one axis.
 """
 
 from __future__ import annotations
 
-import os
-import weakref
 from collections.abc import Iterable, Iterator, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from hrgtc.errors import InputError, RecordingError
-from hrgtc.files import (
-    forget_temporary,
-    fsync_file,
-    publish,
-    refuse_existing,
-    temporary_beside,
-)
 from hrgtc.progress import Progress
-from hrgtc.recording.csv import CsvSink, CsvSource
+from hrgtc.recording.csv import CsvSource
 from hrgtc.recording.formats import (
-    Hdf5Sink,
     Hdf5Source,
-    ParquetSink,
     ParquetSource,
-    Sink,
     Source,
     format_of,
 )
@@ -52,6 +50,7 @@ from hrgtc.recording.mapping import (
     table_columns,
 )
 from hrgtc.recording.schema import SCHEMA_VERSION, Metadata, Recording, concatenate
+from hrgtc.recording.spikes import SpikeFilter, check_spike_policy
 from hrgtc.recording.validation import (
     HEURISTIC_ROWS,
     GapPolicy,
@@ -60,9 +59,9 @@ from hrgtc.recording.validation import (
     measured_sample_rate,
 )
 from hrgtc.recording.validation import validate as validate_recording
+from hrgtc.recording.writing import RecordingWriter, write
 
 SOURCES: dict[str, type[Source]] = {"parquet": ParquetSource, "csv": CsvSource, "hdf5": Hdf5Source}
-SINKS: dict[str, type[Sink]] = {"parquet": ParquetSink, "csv": CsvSink, "hdf5": Hdf5Sink}
 
 __all__ = ["ReadOptions", "RecordingWriter", "count_rows", "iter_chunks", "open_source", "read",
            "write"]
@@ -123,6 +122,8 @@ def _metadata(
             )
         data["sample_rate_hz"] = rate
         extra["sample_rate_inferred"] = True
+    if plan.thermometer == "sensor":
+        extra["thermometer"] = "sensor"
     if plan.time_origin_ns is not None and "time_origin" not in extra:
         extra["time_origin"] = str(np.datetime64(plan.time_origin_ns, "ns"))
     data["extra"] = extra
@@ -142,6 +143,11 @@ def read(
     metadata: Mapping[str, Any] | Metadata | None = None,
     freq_band_hz: tuple[float, float] | None = None,
     freq_span_hz: tuple[float, float] | None = None,
+    *,
+    temp_scale: float = 1.0,
+    temp_offset_c: float = 0.0,
+    spikes: str = "error",
+    thermometer: str = "resonator",
 ) -> Recording:
     """Read a whole recording from Parquet, CSV or HDF5 (by suffix).
 
@@ -164,6 +170,13 @@ def read(
     freq_band_hz, freq_span_hz
         With a model: frequencies outside ``freq_band_hz`` are errors (instead of the
         physical range), ``freq_span_hz`` (the calibrated span) is named in the message.
+    temp_scale, temp_offset_c
+        ``temperature_c* = raw * temp_scale + temp_offset_c`` (a raw sensor count). [°C]
+    spikes
+        ``"error"`` (the validation names file, column, row and value) or ``"drop"``
+        (rows with a non-finite or implausible value are removed, and counted).
+    thermometer
+        ``"resonator"`` or ``"sensor"``: ``freq_hz`` is the ``temperature_c`` column.
 
     Returns
     -------
@@ -177,14 +190,22 @@ def read(
         the message names the file, column and row and says how to fix it.
     """
     check_gap_policy(gaps)
+    check_spike_policy(spikes)
+    spike_filter = SpikeFilter(thermometer, str(path)) if spikes == "drop" else None
     with open_source(path) as source:
-        plan = plan_columns(source, columns, units)
+        plan = plan_columns(source, columns, units, temp_scale, temp_offset_c, thermometer)
         columns = table_columns(source.read(plan.read_names, plan.as_text))
         arrays = convert_columns(plan, columns, 0)
+        if spike_filter is not None:
+            arrays = spike_filter.drop(arrays, 0)
         meta = _metadata(plan, metadata, arrays.get("time_s"))
+    if spike_filter is not None and spike_filter.dropped:
+        meta = replace(meta, extra={**meta.extra, "spikes_dropped": spike_filter.dropped})
+        spike_filter.warn()
     recording = Recording(arrays, meta, source=str(path))
     if validate:
-        validate_recording(recording, gaps, freq_band_hz=freq_band_hz, freq_span_hz=freq_span_hz)
+        validate_recording(recording, gaps, freq_band_hz=freq_band_hz, freq_span_hz=freq_span_hz,
+                           thermometer=thermometer)
     return recording
 
 
@@ -225,6 +246,11 @@ def iter_chunks(
     progress: Progress | None = None,
     freq_band_hz: tuple[float, float] | None = None,
     freq_span_hz: tuple[float, float] | None = None,
+    *,
+    temp_scale: float = 1.0,
+    temp_offset_c: float = 0.0,
+    spikes: str = "error",
+    thermometer: str = "resonator",
 ) -> Iterator[Recording]:
     """Stream a recording in chunks of ``rows`` rows without loading the file.
 
@@ -243,21 +269,27 @@ def iter_chunks(
         yielded only after its rows (and the unit heuristics of the first
         :data:`~hrgtc.recording.validation.HEURISTIC_ROWS` rows) have passed, so a
         bad file raises :class:`~hrgtc.errors.RecordingError` before bad data
-        reach the caller. With ``gaps="split"`` gaps pass; split downstream.
+        reach the caller. With ``gaps="split"`` gaps pass; split downstream. With
+        ``spikes="drop"`` a chunk may be short of the rows dropped from it.
     """
     check_gap_policy(gaps)
+    check_spike_policy(spikes)
+    spike_filter = SpikeFilter(thermometer, str(path)) if spikes == "drop" else None
     if int(rows) < 1:
         raise InputError(f"rows must be a positive number of rows per chunk, got {rows!r}")
     rows = int(rows)
-    validator = (RecordingValidator(gaps, freq_band_hz, freq_span_hz) if validate else None)
+    validator = (RecordingValidator(gaps, freq_band_hz, freq_span_hz, thermometer)
+                 if validate else None)
     with open_source(path) as source:
-        plan = plan_columns(source, columns, units)
+        plan = plan_columns(source, columns, units, temp_scale, temp_offset_c, thermometer)
         offset = 0
 
         def converted() -> Iterator[dict[str, np.ndarray]]:
             nonlocal offset
             for table in source.iter_tables(plan.read_names, plan.as_text, rows):
                 part = convert_columns(plan, table_columns(table), offset)
+                if spike_filter is not None:
+                    part = spike_filter.drop(part, offset)
                 offset += table.num_rows
                 yield part
 
@@ -294,6 +326,8 @@ def iter_chunks(
                 progress(*source.position())
         if validator is not None:
             validator.finish().raise_for_problems()
+        if spike_filter is not None:
+            spike_filter.warn()
         if progress is not None:
             total = source.position()[1]
             progress(total, total)
@@ -305,9 +339,9 @@ class ReadOptions:
     """How to read a user's files: the reading options of every command, as one value.
 
     The command line's ``--col``, ``--time-unit``, ``--freq-unit``, ``--rate-unit``,
-    ``--rate-hz``, ``--unit-name``, ``--input-rate-dph`` and ``--gaps`` become one
-    ``ReadOptions``, which the library's functions that read runs take as
-    ``read_options=``.
+    ``--rate-hz``, ``--unit-name``, ``--input-rate-dph``, ``--gaps``, ``--temp-scale``,
+    ``--temp-offset``, ``--spikes`` and ``--thermometer`` become one ``ReadOptions``,
+    which the library's functions that read runs take as ``read_options=``.
 
     Parameters
     ----------
@@ -324,6 +358,14 @@ class ReadOptions:
     freq_band_hz, freq_span_hz
         Plausible frequencies and the calibrated span of the model the run is
         compensated with (set by compensation and evaluation, see :func:`read`).
+    temp_scale, temp_offset_c
+        ``temperature_c* = raw * temp_scale + temp_offset_c`` (a raw sensor count). [°C]
+    spikes
+        ``"error"`` (default) or ``"drop"`` (see :func:`read`).
+    thermometer
+        ``"resonator"`` (default: ``freq_hz`` is the resonator frequency) or
+        ``"sensor"`` (a gyro without a frequency output: ``freq_hz`` is filled from
+        ``temperature_c``, per axis from ``temperature_c_<axis>``). [°C]
     """
 
     columns: Mapping[str, str] | None = None
@@ -333,13 +375,25 @@ class ReadOptions:
     chunk_rows: int = 250_000
     freq_band_hz: tuple[float, float] | None = None
     freq_span_hz: tuple[float, float] | None = None
+    temp_scale: float = 1.0
+    temp_offset_c: float = 0.0
+    spikes: str = "error"
+    thermometer: str = "resonator"
 
     def keywords(self) -> dict[str, Any]:
-        """The options as keyword arguments of :func:`read` and :func:`iter_chunks`."""
+        """The options as keyword arguments of :func:`read` and :func:`iter_chunks`.
+
+        The options of messy files (``temp_scale``, ``temp_offset_c``, ``spikes``,
+        ``thermometer``) only when they differ from their defaults.
+        """
         words = {"columns": self.columns, "units": self.units, "metadata": self.metadata,
                  "gaps": self.gaps}
         if self.freq_band_hz is not None:
             words.update(freq_band_hz=self.freq_band_hz, freq_span_hz=self.freq_span_hz)
+        defaults = {"temp_scale": 1.0, "temp_offset_c": 0.0, "spikes": "error",
+                    "thermometer": "resonator"}
+        words.update({key: getattr(self, key) for key, default in defaults.items()
+                      if getattr(self, key) != default})
         return words
 
     def read(self, path: str | Path, keep: Sequence[str] | None = None) -> Recording:
@@ -363,171 +417,3 @@ class ReadOptions:
     def chunks(self, path: str | Path, rows: int | None = None) -> Iterator[Recording]:
         """Stream the file in chunks (:func:`iter_chunks`)."""
         return iter_chunks(path, rows=rows or self.chunk_rows, **self.keywords())
-
-
-# -- writing -------------------------------------------------------------------
-def _remove(path: str) -> None:
-    try:
-        os.unlink(path)
-    except FileNotFoundError:
-        pass
-    forget_temporary(path)
-
-
-class RecordingWriter:
-    """Write a recording chunk by chunk, atomically.
-
-    Rows go to a temporary file next to ``path``; :meth:`close` (or leaving the
-    ``with`` block normally) syncs it to disk and renames it to ``path``; an
-    exception in the block (or :meth:`abort`) removes it, leaving nothing behind.
-
-    Parameters
-    ----------
-    path
-        Output file; the format follows the suffix.
-    metadata
-        Metadata of the recording.
-    columns
-        Column names, in order; every chunk must have exactly these.
-    force
-        Overwrite ``path`` if it exists.
-
-    Raises
-    ------
-    OutputExistsError
-        ``path`` exists and ``force`` is False (checked at once and again on rename).
-
-    Examples
-    --------
-    >>> with RecordingWriter(path, metadata, ["time_s", "freq_hz", "rate_dph"]) as out:
-    ...     for chunk in chunks:
-    ...         out.write(chunk)                                     # doctest: +SKIP
-    """
-
-    def __init__(
-        self,
-        path: str | Path,
-        metadata: Metadata,
-        columns: Sequence[str],
-        force: bool = False,
-    ) -> None:
-        self.path = Path(path)
-        self.metadata = metadata
-        self.columns = list(columns)
-        self.force = bool(force)
-        self.rows = 0
-        fmt = format_of(self.path)
-        if len(set(self.columns)) != len(self.columns) or not self.columns:
-            raise InputError(f"{self.path}: column names must be unique and non-empty")
-        self._check_target()
-        directory = self.path.parent
-        if not directory.is_dir():
-            raise InputError(f"{self.path}: directory {directory} does not exist; create it first")
-        tmp = temporary_beside(self.path)
-        self._tmp = tmp
-        self._cleanup = weakref.finalize(self, _remove, tmp)
-        try:
-            self._sink: Sink | None = SINKS[fmt](Path(tmp), metadata, self.columns)
-        except BaseException:
-            self._cleanup()
-            raise
-
-    def _check_target(self) -> None:
-        if self.path.is_dir():
-            raise InputError(f"{self.path} is a directory; give a file name")
-        refuse_existing(self.path, self.force)
-
-    def write(self, chunk: Recording | Mapping[str, Any]) -> None:
-        """Append rows (a :class:`Recording` or a mapping of name -> 1-D array)."""
-        if self._sink is None:
-            raise InputError(f"{self.path}: the writer is closed")
-        names = chunk.names if isinstance(chunk, Recording) else tuple(chunk)
-        if set(names) != set(self.columns):
-            raise RecordingError(
-                f"{self.path}: chunk columns {sorted(names)} differ from the writer's "
-                f"{sorted(self.columns)}"
-            )
-        arrays = {n: np.ascontiguousarray(chunk[n], dtype=np.float64) for n in self.columns}
-        lengths = {a.shape for a in arrays.values()}
-        if len(lengths) != 1 or len(next(iter(lengths))) != 1:
-            raise RecordingError(f"{self.path}: chunk columns must be 1-D of one length")
-        self._sink.write(arrays)
-        self.rows += len(arrays[self.columns[0]])
-
-    def start_writeback(self) -> None:
-        """Start writing the rows written so far to disk, without waiting (Linux).
-
-        :meth:`close` still waits for every byte (fsync) before the rename; calling
-        this after each chunk spreads the disk writes over the run, so that wait is
-        short. A no-op where ``os.posix_fadvise`` is missing.
-        """
-        if self._sink is None or not hasattr(os, "posix_fadvise"):
-            return
-        fd = os.open(self._tmp, os.O_RDONLY)
-        try:
-            # DONTNEED starts write-back of the dirty pages (and drops clean ones).
-            os.posix_fadvise(fd, 0, 0, os.POSIX_FADV_DONTNEED)
-        except OSError:
-            pass
-        finally:
-            os.close(fd)
-
-    def close(self) -> Path:
-        """Finish the file: sync it and rename it to :attr:`path`."""
-        if self._sink is None:
-            return self.path
-        sink, self._sink = self._sink, None
-        try:
-            sink.close()
-            fsync_file(self._tmp)
-            publish(self._tmp, self.path, self.force)
-        except BaseException:
-            self._cleanup()
-            raise
-        self._cleanup.detach()
-        return self.path
-
-    def abort(self) -> None:
-        """Discard everything written; the temporary file is removed."""
-        sink, self._sink = self._sink, None
-        try:
-            if sink is not None:
-                sink.abort()
-        finally:
-            self._cleanup()
-
-    def __enter__(self) -> RecordingWriter:
-        return self
-
-    def __exit__(self, exc_type: object, exc: object, tb: object) -> None:
-        if exc_type is None:
-            self.close()
-        else:
-            self.abort()
-
-
-def write(recording: Recording, path: str | Path, force: bool = False) -> Path:
-    """Write a recording atomically; the format follows the suffix of ``path``.
-
-    Parameters
-    ----------
-    recording
-        The recording (all its columns and its metadata are written).
-    path
-        ``.parquet``/``.pq``, ``.csv`` or ``.h5``/``.hdf5``.
-    force
-        Overwrite an existing file.
-
-    Returns
-    -------
-    Path
-        ``path``.
-
-    Raises
-    ------
-    OutputExistsError
-        ``path`` exists and ``force`` is False.
-    """
-    with RecordingWriter(path, recording.metadata, recording.names, force=force) as writer:
-        writer.write(recording)
-    return writer.path

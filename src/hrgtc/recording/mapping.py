@@ -1,13 +1,21 @@
 """Users' column names and units onto the recording contract of DESIGN.md.
 
 * ``columns`` maps contract names to the file's names, e.g.
-  ``{"time_s": "t", "freq_hz": "f_res", "rate_dph": "omega"}``; other columns
-  keep their names (numeric ones are kept, text columns dropped);
-* ``units`` gives the units of ``time`` (``s``, ``ms`` or ``timestamp``),
+  ``{"time_s": "t", "freq_hz": "f_res", "rate_dph": "omega"}``, per-axis names
+  included (``{"rate_dph_x": "gyro_x"}``, see :mod:`hrgtc.recording.axes`); other
+  columns keep their names (numeric ones are kept, text columns dropped);
+* ``units`` gives the units of ``time`` (``s``, ``ms``, ``us`` or ``timestamp``),
   ``freq`` (``Hz`` or ``kHz``) and ``rate`` (``dph`` = °/h, ``dps`` = °/s or
-  ``radps`` = rad/s), converted to s, Hz and °/h. Timestamps (ISO 8601 text or
-  date-time columns, which are recognised without being asked) become seconds
-  since the first sample of the file.
+  ``radps`` = rad/s), converted to s, Hz and °/h: ``freq`` converts every
+  ``freq_hz*`` column, ``rate`` every ``rate_dph*`` and ``input_rate_dph*``
+  column. Timestamps (ISO 8601 text or date-time columns, which are recognised
+  without being asked) become seconds since the first sample of the file;
+* ``temp_scale`` and ``temp_offset_c`` turn a temperature logged as a raw sensor
+  count into °C: ``temperature_c = raw * temp_scale + temp_offset_c`` for every
+  ``temperature_c*`` column;
+* ``thermometer="sensor"`` (a gyro without a frequency output): ``freq_hz`` (and
+  ``freq_hz_<axis>``) is the temperature sensor's column ``temperature_c_<axis>``
+  (or the shared ``temperature_c``), so no frequency column is needed.
 """
 
 from __future__ import annotations
@@ -23,6 +31,8 @@ import pyarrow as pa
 import pyarrow.compute as pc
 
 from hrgtc.errors import InputError, RecordingError
+from hrgtc.recording.axes import AXIS_COLUMNS, axis_names, base_name, split_axis
+from hrgtc.recording.checks import check_thermometer
 from hrgtc.recording.csv import bad_number_hint
 from hrgtc.recording.formats import Source, first_failing
 from hrgtc.recording.schema import COLUMNS
@@ -32,6 +42,7 @@ UNIT_SPELLINGS: dict[str, dict[str, tuple[str, ...]]] = {
     "time": {
         "s": ("s", "sec", "second", "seconds"),
         "ms": ("ms", "msec", "millisecond", "milliseconds"),
+        "us": ("us", "µs", "μs", "usec", "microsecond", "microseconds"),
         "timestamp": ("timestamp", "datetime", "iso", "iso8601"),
     },
     "freq": {"Hz": ("hz",), "kHz": ("khz",)},
@@ -43,16 +54,20 @@ UNIT_SPELLINGS: dict[str, dict[str, tuple[str, ...]]] = {
 }
 #: Contract column converted by each kind of unit.
 UNIT_COLUMNS = {"time": "time_s", "freq": "freq_hz", "rate": "rate_dph"}
+#: Kind of unit of each contract column (per-axis columns by their contract name).
+UNIT_KINDS = {"time_s": "time", "freq_hz": "freq", "rate_dph": "rate", "input_rate_dph": "rate"}
 
 
 def to_contract_unit(values: np.ndarray, unit: str) -> np.ndarray:
     """Convert values in a canonical unit to the contract's s, Hz or °/h.
 
-    ``ms`` / 1000, ``kHz`` × 1000, ``dps`` × 3600, ``radps`` × (180/π) × 3600;
+    ``ms`` / 1000, ``us`` / 10^6, ``kHz`` × 1000, ``dps`` × 3600, ``radps`` × (180/π) × 3600;
     ``s``, ``Hz`` and ``dph`` unchanged (same array).
     """
     if unit == "ms":
         return values / 1000.0
+    if unit == "us":
+        return values / 1e6
     if unit == "kHz":
         return values * 1000.0
     if unit == "dps":
@@ -90,7 +105,8 @@ def parse_units(units: Mapping[str, str] | None) -> dict[str, str]:
 def parse_columns(pairs: Mapping[str, str] | Iterable[str] | None) -> dict[str, str]:
     """A column mapping from a mapping or from ``"time_s=t"`` strings (commas allowed).
 
-    Keys must be contract column names (see :data:`hrgtc.recording.COLUMNS`).
+    Keys must be contract column names (see :data:`hrgtc.recording.COLUMNS`) or
+    per-axis ones (``freq_hz_x``, see :mod:`hrgtc.recording.axes`).
     """
     if pairs is None:
         return {}
@@ -108,15 +124,25 @@ def parse_columns(pairs: Mapping[str, str] | Iterable[str] | None) -> dict[str, 
                 items.append((name.strip(), theirs.strip()))
     mapping: dict[str, str] = {}
     for name, theirs in items:
-        if name not in COLUMNS:
+        if not is_contract_name(name):
             hint = difflib.get_close_matches(name, COLUMNS, n=1)
             did = f" (did you mean {hint[0]!r}?)" if hint else ""
             raise InputError(
                 f"column mapping {name}={theirs}: {name!r} is not a recording column{did}; "
-                f"use one of {list(COLUMNS)}"
+                f"use one of {list(COLUMNS)} or a per-axis name <name>_<axis> for a name in "
+                f"{list(AXIS_COLUMNS)} (e.g. freq_hz_x)"
             )
         mapping[name] = theirs
     return mapping
+
+
+def is_contract_name(name: str) -> bool:
+    """True for a column of the recording contract, per-axis ones (``rate_dph_x``) included."""
+    return name in COLUMNS or split_axis(name)[1] is not None
+
+
+def _contract_order(name: str) -> int:
+    return list(COLUMNS).index(base_name(name))
 
 
 # -- from the file's columns to the contract's ----------------------------------
@@ -132,16 +158,29 @@ class ColumnPlan:
     time_origin_ns: int | None = None
     time_origin_s: float | None = None
     read_names: list[str] = field(default_factory=list)
+    temp_scale: float = 1.0
+    temp_offset_c: float = 0.0
+    thermometer: str = "resonator"
 
 
-def plan_columns(source: Source, columns: Any, units: Mapping[str, str] | None) -> ColumnPlan:
+def plan_columns(source: Source, columns: Any, units: Mapping[str, str] | None,
+                 temp_scale: float = 1.0, temp_offset_c: float = 0.0,
+                 thermometer: str = "resonator") -> ColumnPlan:
     """Decide which of the file's columns become which recording columns, in which unit.
 
-    Contract columns come first in the order of :data:`hrgtc.recording.COLUMNS`,
-    then the file's other numeric columns under their own names.
+    Contract columns come first in the order of :data:`hrgtc.recording.COLUMNS`
+    (per-axis ones by their contract name, in file order), then the file's other
+    numeric columns under their own names.
     """
     mapping = parse_columns(columns)
     canon = parse_units(units)
+    check_thermometer(thermometer)
+    for name, value in (("temp_scale", temp_scale), ("temp_offset_c", temp_offset_c)):
+        usable = isinstance(value, int | float) and math.isfinite(value)
+        if not usable or (name == "temp_scale" and value == 0):
+            raise InputError(f"{name} must be a finite number (a scale other than 0), got "
+                             f"{value!r}; --temp-scale K --temp-offset C give "
+                             "temperature_c = raw * K + C")
     for name, theirs in mapping.items():
         if theirs not in source.names:
             hint = difflib.get_close_matches(theirs, source.names, n=1)
@@ -152,14 +191,16 @@ def plan_columns(source: Source, columns: Any, units: Mapping[str, str] | None) 
             )
     kinds = source.kinds()
     pairs = [(theirs, name) for name, theirs in mapping.items()]
-    pairs += [(n, n) for n in source.names if n in COLUMNS and n not in mapping]
-    pairs.sort(key=lambda pair: list(COLUMNS).index(pair[1]))
+    pairs += [(n, n) for n in source.names if is_contract_name(n) and n not in mapping]
+    pairs.sort(key=lambda pair: _contract_order(pair[1]))
     used = {theirs for theirs, _ in pairs}
     pairs += [
         (n, n)
         for n in source.names
-        if n not in COLUMNS and n not in used and kinds.get(n) == "numeric"
+        if not is_contract_name(n) and n not in used and kinds.get(n) == "numeric"
     ]
+    if thermometer == "sensor":
+        _check_sensor_columns(source, [name for _, name in pairs])
     time_file = next((theirs for theirs, name in pairs if name == "time_s"), None)
     time_kind = kinds.get(time_file or "", "numeric")
     stamped = canon.get("time") == "timestamp" or time_kind == "timestamp"
@@ -172,7 +213,36 @@ def plan_columns(source: Source, columns: Any, units: Mapping[str, str] | None) 
                 "map another column to it"
             )
     names = list(dict.fromkeys(theirs for theirs, _ in pairs))
-    return ColumnPlan(source, pairs, as_text, canon, stamped, read_names=names)
+    return ColumnPlan(source, pairs, as_text, canon, stamped, read_names=names,
+                      temp_scale=float(temp_scale), temp_offset_c=float(temp_offset_c),
+                      thermometer=thermometer)
+
+
+def _check_sensor_columns(source: Source, names: list[str]) -> None:
+    """The temperature column of every axis, for the sensor thermometer."""
+    for axis in axis_names(names) or (None,):
+        own = f"temperature_c_{axis}" if axis else "temperature_c"
+        if own not in names and "temperature_c" not in names:
+            raise RecordingError(
+                f"{source.path}: --thermometer sensor needs the gyro's temperature column "
+                f"{own!r} (or a shared 'temperature_c'), not found among {source.names}; map "
+                f"yours with --col {own}=<your column> (a raw count: add --temp-scale and "
+                "--temp-offset)"
+            )
+
+
+def sensor_frequency(columns: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """``freq_hz`` (``freq_hz_<axis>``) filled with the temperature sensor's column (no copy).
+
+    For a gyro without a frequency output (``thermometer="sensor"``): the
+    temperature ``temperature_c_<axis>`` of each axis, or the shared
+    ``temperature_c``, takes the place of the resonator frequency. [°C]
+    """
+    for axis in axis_names(columns) or (None,):
+        suffix = f"_{axis}" if axis else ""
+        columns[f"freq_hz{suffix}"] = columns.get(f"temperature_c{suffix}",
+                                                   columns.get("temperature_c"))
+    return columns
 
 
 def _is_text(column: pa.ChunkedArray) -> bool:
@@ -261,7 +331,10 @@ def convert_columns(
             out[name] = _time_seconds(plan, column, theirs, row_offset)
         else:
             values = _to_float(plan, column, theirs, row_offset)
-            kind = next((k for k, col in UNIT_COLUMNS.items() if col == name), None)
+            base = base_name(name)
+            kind = UNIT_KINDS.get(base)
             out[name] = to_contract_unit(values, plan.units.get(kind, "")) if kind else values
+            if base == "temperature_c" and (plan.temp_scale != 1.0 or plan.temp_offset_c != 0.0):
+                out[name] = out[name] * plan.temp_scale + plan.temp_offset_c
         del column
-    return out
+    return sensor_frequency(out) if plan.thermometer == "sensor" else out

@@ -1,10 +1,12 @@
 """The recording type: one run of one gyro, its columns and metadata.
 
 The recording contract is that of DESIGN.md: a table with one row per sample
-(``time_s``, ``freq_hz``, ``rate_dph`` required; ``chamber_c``, ``housing_c``
-optional; ``resonator_c`` and ``bias_dph`` ground truth written only by the
-simulator) and metadata (``unit``, ``sample_rate_hz``, ``input_rate_dph``,
-``profile``, ``schema``).
+(``time_s``, ``freq_hz``, ``rate_dph`` required; ``chamber_c``, ``housing_c``,
+``input_rate_dph`` (known input rate per sample) and ``temperature_c`` (a sensor on
+the gyro) optional; ``resonator_c``, ``bias_dph`` and ``scale_ppm`` ground truth
+written only by the simulator) and metadata (``unit``, ``sample_rate_hz``,
+``input_rate_dph``, ``profile``, ``schema``). A multi-axis recording has these
+columns per axis (``rate_dph_x``, ...; see :mod:`hrgtc.recording.axes`).
 """
 
 from __future__ import annotations
@@ -29,6 +31,9 @@ COLUMNS: dict[str, tuple[str, bool, str]] = {
     "housing_c": ("degC", False, "housing thermistor temperature"),
     "resonator_c": ("degC", False, "true resonator temperature (simulator ground truth)"),
     "bias_dph": ("deg/h", False, "true gyro bias (simulator ground truth)"),
+    "input_rate_dph": ("deg/h", False, "known input rate per sample (rate-table runs)"),
+    "temperature_c": ("degC", False, "temperature sensor on the gyro (no frequency output)"),
+    "scale_ppm": ("ppm", False, "true scale-factor error (simulator ground truth)"),
 }
 REQUIRED_COLUMNS = tuple(name for name, (_, required, _) in COLUMNS.items() if required)
 
@@ -198,7 +203,13 @@ class Recording:
 
     @property
     def measured_bias_dph(self) -> np.ndarray:
-        """Gyro output minus the known input rate of the metadata. [°/h]"""
+        """Gyro output minus the known input rate. [°/h]
+
+        The ``input_rate_dph`` column (one input rate per sample, rate-table runs)
+        when the recording has one, else the metadata's constant ``input_rate_dph``.
+        """
+        if "input_rate_dph" in self._columns:
+            return self["rate_dph"] - self._columns["input_rate_dph"]
         return self["rate_dph"] - self.metadata.input_rate_dph
 
     @property

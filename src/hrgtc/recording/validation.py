@@ -52,29 +52,37 @@ is validated chunk by chunk.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
 
 from hrgtc.errors import RecordingError
+from hrgtc.recording.axes import axis_input_rate_dph, axis_names, base_name
 from hrgtc.recording.checks import (
+    _BOUNDS,
     DEG_PER_RAD_X3600,
+    FREQ_JUMP_FRACTION,
     FREQ_MAX_HZ,
+    FREQ_SAMPLE_RANGE_HZ,
     KHZ_BELOW_HZ,
     RATE_BLOCK_NOISE_DPH,
+    RATE_CHECK_ROWS,
     RATE_LEVEL_DPH,
+    RATE_MAX_DPH,
     RATE_NOISE_DPH,
     RATE_TABLE_DPH,
     SAMPLE_RATE_TOLERANCE,
     SLOW_SAMPLE_RATE_HZ,
+    TEMPERATURE_RANGE_C,
     Problem,
+    ValidationReport,
     _check_freq_unit,
     _check_rate_unit,
     _check_sample_rate,
     _check_time_unit,
+    check_thermometer,
     measured_sample_rate,
+    problems_message,
 )
 from hrgtc.recording.gaps import (
     GAP_PERIODS,
@@ -85,119 +93,19 @@ from hrgtc.recording.gaps import (
     check_gap_policy,
     split_at_gaps,
 )
-from hrgtc.recording.schema import REQUIRED_COLUMNS, Metadata, Recording
+from hrgtc.recording.schema import Metadata, Recording
 
 __all__ = [
-    "DEG_PER_RAD_X3600", "FREQ_MAX_HZ", "GAP_PERIODS", "GAP_POLICIES", "HEURISTIC_ROWS",
-    "KHZ_BELOW_HZ", "RATE_BLOCK_NOISE_DPH", "RATE_LEVEL_DPH", "RATE_NOISE_DPH",
-    "RATE_TABLE_DPH", "SAMPLE_RATE_TOLERANCE", "SLOW_SAMPLE_RATE_HZ", "Gap", "GapPolicy",
+    "DEG_PER_RAD_X3600", "FREQ_JUMP_FRACTION", "FREQ_MAX_HZ", "FREQ_SAMPLE_RANGE_HZ",
+    "GAP_PERIODS", "GAP_POLICIES", "HEURISTIC_ROWS", "KHZ_BELOW_HZ", "RATE_BLOCK_NOISE_DPH",
+    "RATE_CHECK_ROWS", "RATE_LEVEL_DPH", "RATE_MAX_DPH", "RATE_NOISE_DPH", "RATE_TABLE_DPH",
+    "SAMPLE_RATE_TOLERANCE", "SLOW_SAMPLE_RATE_HZ", "TEMPERATURE_RANGE_C", "Gap", "GapPolicy",
     "Problem", "RecordingValidator", "ValidationReport", "check_gap_policy",
     "measured_sample_rate", "problems_message", "split_at_gaps", "validate",
 ]
 
 
 HEURISTIC_ROWS = 100_000  # rows used for the sample-rate and unit heuristics
-#: Physical bounds of every sample (outside: an error naming the first row).
-FREQ_SAMPLE_RANGE_HZ = (100.0, 1e5)  # n = 2 mode of any HRG: a few 100 Hz .. tens of kHz
-FREQ_JUMP_FRACTION = 0.05  # 84 ppm/°C over 300 °C is 2.5 %: more than 5 % off is a glitch
-RATE_MAX_DPH = 3.6e6  # 1000 °/s: beyond any rate table and the rebalance loop of an HRG
-TEMPERATURE_RANGE_C = (-200.0, 500.0)  # chambers, housings, resonators
-#: Rows per block of the sample-rate check that runs through the whole file.
-RATE_CHECK_ROWS = 1000
-_BOUNDS: dict[str, tuple[float, float, str]] = {
-    "freq_hz": (*FREQ_SAMPLE_RANGE_HZ, "Hz"),
-    "rate_dph": (-RATE_MAX_DPH, RATE_MAX_DPH, "°/h"),
-    "bias_dph": (-RATE_MAX_DPH, RATE_MAX_DPH, "°/h"),
-    "chamber_c": (*TEMPERATURE_RANGE_C, "°C"),
-    "housing_c": (*TEMPERATURE_RANGE_C, "°C"),
-    "resonator_c": (*TEMPERATURE_RANGE_C, "°C"),
-}
-
-
-@dataclass(frozen=True)
-class ValidationReport:
-    """Outcome of validating a recording.
-
-    Parameters
-    ----------
-    ok
-        True when there is no problem.
-    problems
-        The problems found, in the order of the checks.
-    gaps
-        Gaps found (at most :data:`MAX_LISTED_GAPS` listed), whatever the policy.
-    n_gaps
-        Number of gaps found.
-    rows
-        Rows checked.
-    source
-        File the recording came from.
-    measured_sample_rate_hz
-        Reciprocal of the median time step of the first :data:`HEURISTIC_ROWS`
-        rows, None with fewer than 2 rows. [Hz]
-    gap_policy
-        ``"error"``, ``"split"`` or ``"ignore"``.
-    """
-
-    ok: bool
-    problems: tuple[Problem, ...]
-    gaps: tuple[Gap, ...]
-    n_gaps: int
-    rows: int
-    source: str | None
-    measured_sample_rate_hz: float | None
-    gap_policy: str = "error"
-
-    @property
-    def message(self) -> str:
-        """All problems as one message that names the file ("" when ok)."""
-        return problems_message(self.source, self.problems)
-
-    def raise_for_problems(self) -> None:
-        """Raise :class:`~hrgtc.errors.RecordingError` with :attr:`message` unless ok."""
-        if self.problems:
-            raise RecordingError(self.message)
-
-    def summary(self) -> str:
-        """Human-readable text (does not print)."""
-        where = self.source or "recording"
-        lines = [f"validation of {where}: {'ok' if self.ok else 'FAILED'} ({self.rows} rows)"]
-        if self.measured_sample_rate_hz is not None:
-            lines.append(f"  measured sample rate: {self.measured_sample_rate_hz:.6g} Hz")
-        lines += [f"  problem: {p.message}" for p in self.problems]
-        if self.n_gaps:
-            lines.append(f"  gaps: {self.n_gaps} (policy {self.gap_policy})")
-            lines += [
-                f"    row {g.row}: {g.duration_s:.6g} s without samples after t = "
-                f"{g.start_time_s:.6g} s"
-                for g in self.gaps[:10]
-            ]
-            if self.n_gaps > 10:
-                lines.append(f"    ... {self.n_gaps - 10} more")
-        return "\n".join(lines)
-
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types."""
-        data = asdict(self)
-        return {**data, "problems": list(data["problems"]), "gaps": list(data["gaps"])}
-
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> ValidationReport:
-        """Inverse of :meth:`to_dict`."""
-        problems = tuple(Problem.from_dict(p) for p in data["problems"])
-        gaps = tuple(Gap.from_dict(g) for g in data["gaps"])
-        return cls(**{**data, "problems": problems, "gaps": gaps})
-
-
-def problems_message(source: str | None, problems: tuple[Problem, ...] | list[Problem]) -> str:
-    """One message for ``problems`` that starts with the file name."""
-    where = source or "recording"
-    if not problems:
-        return ""
-    if len(problems) == 1:
-        return f"{where}: {problems[0].message}"
-    items = "\n".join(f"  - {p.message}" for p in problems)
-    return f"{where}: {len(problems)} problems:\n{items}"
 
 
 class RecordingValidator:
@@ -216,16 +124,23 @@ class RecordingValidator:
 
     def __init__(self, gaps: GapPolicy | str = "error",
                  freq_band_hz: tuple[float, float] | None = None,
-                 freq_span_hz: tuple[float, float] | None = None) -> None:
+                 freq_span_hz: tuple[float, float] | None = None,
+                 thermometer: str = "resonator") -> None:
         self.gaps = check_gap_policy(gaps)
         self.freq_band_hz = freq_band_hz
         self.freq_span_hz = freq_span_hz
+        self.thermometer = check_thermometer(thermometer)
         self._bounds = dict(_BOUNDS)
         if freq_band_hz is not None:
-            self._bounds["freq_hz"] = (float(freq_band_hz[0]), float(freq_band_hz[1]), "Hz")
+            unit = "°C" if self.thermometer == "sensor" else "Hz"
+            self._bounds["freq_hz"] = (float(freq_band_hz[0]), float(freq_band_hz[1]), unit)
+        elif self.thermometer == "sensor":  # freq_hz holds the sensor's temperature
+            self._bounds["freq_hz"] = (*TEMPERATURE_RANGE_C, "°C")
         self._out_of_bounds: dict[str, list[Any]] = {}  # column -> [row, value, count]
-        self._freq_reference: float | None = None
-        self._jump: list[Any] | None = None  # [row, value, count]
+        self._freq_reference: dict[str, float] = {}  # frequency column -> median of first rows
+        self._jump: dict[str, list[Any]] = {}  # frequency column -> [row, value, count]
+        self.axes: tuple[str, ...] = ()
+        self._suffixes: tuple[str, ...] = ("",)
         self._steps = np.empty(0)
         self._steps_start = 0
         self._rate_change: tuple[int, float] | None = None
@@ -239,7 +154,7 @@ class RecordingValidator:
         self._time_order_count = 0
         self._gaps: list[Gap] = []
         self._n_gaps = 0
-        self._sample: dict[str, list[np.ndarray]] = {name: [] for name in REQUIRED_COLUMNS}
+        self._sample: dict[str, list[np.ndarray]] = {}
         self._sample_rows = 0
         self._heuristics: list[Problem] | None = None
         self.measured_sample_rate_hz: float | None = None
@@ -250,7 +165,13 @@ class RecordingValidator:
         if self.metadata is None:
             self.metadata = chunk.metadata
             self.source = chunk.source
-            self._missing = tuple(c for c in REQUIRED_COLUMNS if c not in chunk)
+            self.axes = axis_names(chunk.names)
+            self._suffixes = tuple(f"_{axis}" for axis in self.axes) or ("",)
+            required = ("time_s", *(f"{name}{suffix}" for suffix in self._suffixes
+                                    for name in ("freq_hz", "rate_dph")))
+            self._missing = tuple(c for c in required if c not in chunk)
+            sampled = (*required, *(f"input_rate_dph{suffix}" for suffix in self._suffixes))
+            self._sample = {name: [] for name in sampled if name in chunk}
         offset, n = self.rows, len(chunk)
         for name in chunk.names:
             values = chunk[name]
@@ -262,10 +183,10 @@ class RecordingValidator:
                     self._not_finite[name] = [offset + first, values[first], int(bad.sum())]
                 else:
                     state[2] += int(bad.sum())
-            if name in self._bounds:
+            if base_name(name) in self._bounds:
                 self._check_bounds(name, values, offset)
-        if "freq_hz" in chunk and self._freq_reference is not None:
-            self._check_jumps(chunk.freq_hz, offset)
+            if name in self._freq_reference:
+                self._check_jumps(name, values, offset)
         if "time_s" in chunk and n:
             self._check_time(chunk.time_s, offset)
         if self._heuristics is None:
@@ -273,7 +194,7 @@ class RecordingValidator:
         self.rows += n
 
     def _check_bounds(self, name: str, values: np.ndarray, offset: int) -> None:
-        low, high, _ = self._bounds[name]
+        low, high, _ = self._bounds[base_name(name)]
         with np.errstate(invalid="ignore"):
             bad = ((values < low) | (values > high)) & np.isfinite(values)
         if bad.any():
@@ -285,16 +206,17 @@ class RecordingValidator:
             else:
                 state[2] += int(bad.sum())
 
-    def _check_jumps(self, freq: np.ndarray, offset: int) -> None:
-        reference = self._freq_reference
+    def _check_jumps(self, name: str, freq: np.ndarray, offset: int) -> None:
+        reference = self._freq_reference[name]
         with np.errstate(invalid="ignore"):
             bad = (np.abs(freq - reference) > FREQ_JUMP_FRACTION * reference) & np.isfinite(freq)
         if bad.any():
-            if self._jump is None:
+            state = self._jump.get(name)
+            if state is None:
                 first = int(np.argmax(bad))
-                self._jump = [offset + first, float(freq[first]), int(bad.sum())]
+                self._jump[name] = [offset + first, float(freq[first]), int(bad.sum())]
             else:
-                self._jump[2] += int(bad.sum())
+                state[2] += int(bad.sum())
 
     def _check_rate_throughout(self, step: np.ndarray, offset: int) -> None:
         """Mean time step of every block of :data:`RATE_CHECK_ROWS` rows (gaps left out)."""
@@ -344,9 +266,8 @@ class RecordingValidator:
 
     def _collect_sample(self, chunk: Recording) -> None:
         take = min(len(chunk), HEURISTIC_ROWS - self._sample_rows)
-        for name in REQUIRED_COLUMNS:
-            if name in chunk:
-                self._sample[name].append(np.array(chunk[name][:take]))
+        for name, parts in self._sample.items():
+            parts.append(np.array(chunk[name][:take]))
         self._sample_rows += take
         if self._sample_rows >= HEURISTIC_ROWS:
             self._run_heuristics()
@@ -388,18 +309,18 @@ class RecordingValidator:
             )
         unit_problem = any(p.kind == "freq_unit" for p in self._heuristics or [])
         for name, (row, value, count) in self._out_of_bounds.items():
-            if name == "freq_hz" and (self._heuristics is None or unit_problem):
+            if base_name(name) == "freq_hz" and (self._heuristics is None or unit_problem):
                 continue  # the unit heuristic (e.g. "looks like kHz") says it better
             problems.append(self._bounds_problem(name, row, value, count))
-        if self._jump is not None:
-            row, value, count = self._jump
+        for name, (row, value, count) in self._jump.items():
             problems.append(Problem(
                 "implausible",
-                f"column 'freq_hz', row {row}: {value:.6g} Hz is more than "
+                f"column '{name}', row {row}: {value:.6g} Hz is more than "
                 f"{FREQ_JUMP_FRACTION:.0%} away from the run's median "
-                f"{self._freq_reference:.6g} Hz (a resonator moves ≈ 0.01 %/°C; first of "
-                f"{count} such rows): a glitch or two files joined; remove those rows",
-                column="freq_hz", row=row, value=f"{value:.6g}", count=count))
+                f"{self._freq_reference[name]:.6g} Hz (a resonator moves ≈ 0.01 %/°C; first of "
+                f"{count} such rows): a glitch or two files joined; remove those rows "
+                "(--spikes drop)",
+                column=name, row=row, value=f"{value:.6g}", count=count))
         if self._rate_change is not None:
             row, measured = self._rate_change
             nominal = self.metadata.sample_rate_hz
@@ -445,23 +366,31 @@ class RecordingValidator:
         return problems
 
     def _bounds_problem(self, name: str, row: int, value: float, count: int) -> Problem:
-        low, high, unit = self._bounds[name]
-        if name == "freq_hz" and self.freq_band_hz is not None:
+        base = base_name(name)
+        low, high, unit = self._bounds[base]
+        if base == "freq_hz" and self.thermometer == "sensor":
+            why = f"outside {low:g} to {high:g} °C (the sensor thermometer's temperature)"
+            fix = ("a glitch or not a temperature in °C: remove the row (--spikes drop) or "
+                   "check --col temperature_c=... and --temp-scale/--temp-offset")
+        elif base == "freq_hz" and self.freq_band_hz is not None:
             span = self.freq_span_hz or self.freq_band_hz
             why = (f"far outside the model's calibrated span {span[0]:.6g} to {span[1]:.6g} Hz "
                    f"(more than the frequency of 100 °C beyond it: {low:.6g} to {high:.6g} Hz)")
             fix = ("a glitch, another unit's recording, or the wrong column? remove the row or "
                    "check --col freq_hz=... and --freq-unit")
-        elif name == "freq_hz":
+        elif base == "freq_hz":
             why = (f"outside {low:g} to {high:g} Hz, where the resonator frequency of any HRG "
                    "lies")
             fix = "a glitch or the wrong column: remove the row or check --col/--freq-unit"
-        elif name in ("rate_dph", "bias_dph"):
+        elif base in ("rate_dph", "bias_dph", "input_rate_dph"):
             why = f"beyond ±{high:g} °/h (1000 °/s), more than any HRG measures"
-            fix = "a glitch or the wrong column: remove the row or check --col/--rate-unit"
+            fix = ("a glitch or the wrong column: remove the row (--spikes drop) or check "
+                   "--col/--rate-unit")
         else:
             why = f"outside {low:g} to {high:g} °C"
-            fix = "a glitch or not a temperature in °C: remove the row or check the mapping"
+            fix = "a glitch or not a temperature in °C: remove the row (--spikes drop) or check "
+            fix += ("--temp-scale/--temp-offset (a raw sensor count?)"
+                    if base == "temperature_c" else "the mapping")
         return Problem(
             "implausible",
             f"column '{name}', row {row}: {value:.6g} {unit} is {why} (first of {count} such "
@@ -504,27 +433,47 @@ class RecordingValidator:
                 problem = _check_time_unit(self.measured_sample_rate_hz, sample["time_s"])
             if problem:
                 problems.append(problem)
-        if "freq_hz" in sample:
-            problem = _check_freq_unit(sample["freq_hz"])
-            if problem:
-                problems.append(problem)
-            else:
-                finite = sample["freq_hz"][np.isfinite(sample["freq_hz"])]
-                if finite.size:
-                    self._freq_reference = float(np.median(finite))
-                    self._check_jumps(sample["freq_hz"], 0)
-        if "rate_dph" in sample and self.metadata is not None:
-            problem = _check_rate_unit(sample["rate_dph"], self.metadata.input_rate_dph,
-                                       self.metadata.sample_rate_hz)
-            if problem:
-                problems.append(problem)
+        for axis, suffix in zip(self.axes or (None,), self._suffixes, strict=True):
+            problems += self._axis_heuristics(sample, axis, suffix)
         self._heuristics = problems
+
+
+    def _axis_heuristics(self, sample: dict[str, np.ndarray], axis: str | None,
+                         suffix: str) -> list[Problem]:
+        """Unit heuristics of one axis's frequency and rate (on rate - input rate)."""
+        problems: list[Problem] = []
+        freq_name, rate_name = f"freq_hz{suffix}", f"rate_dph{suffix}"
+        if freq_name in sample and self.thermometer != "sensor":
+            freq = sample[freq_name]
+            problem = _check_freq_unit(freq, freq_name)
+            finite = freq[np.isfinite(freq)]
+            if problem:
+                problems.append(problem)
+            elif finite.size:
+                self._freq_reference[freq_name] = float(np.median(finite))
+                self._check_jumps(freq_name, freq, 0)
+        if rate_name in sample and self.metadata is not None:
+            rate, sample_rate = sample[rate_name], self.metadata.sample_rate_hz
+            inputs = sample.get(f"input_rate_dph{suffix}")
+            if inputs is None:
+                problem = _check_rate_unit(rate, axis_input_rate_dph(self.metadata, axis),
+                                           sample_rate, rate_name)
+            else:  # rate-table steps are not the gyro's signal: check rate - input rate
+                problem = _check_rate_unit(rate - inputs, 0.0, sample_rate, rate_name)
+                finite = inputs[np.isfinite(inputs)]
+                level = float(np.median(finite)) if finite.size else 0.0
+                if problem is None and abs(level) >= RATE_TABLE_DPH:
+                    problem = _check_rate_unit(rate, level, sample_rate, rate_name)
+            if problem:
+                problems.append(problem)
+        return problems
 
 
 def validate(
     recording: Recording, gaps: GapPolicy | str = "error", *, raise_errors: bool = True,
     freq_band_hz: tuple[float, float] | None = None,
     freq_span_hz: tuple[float, float] | None = None,
+    thermometer: str = "resonator",
 ) -> ValidationReport:
     """Check a recording against the recording contract (see the module docstring).
 
@@ -542,6 +491,9 @@ def validate(
     freq_band_hz, freq_span_hz
         Plausible frequencies given a model (every sample must lie in the band;
         without a model :data:`FREQ_SAMPLE_RANGE_HZ`) and its calibrated span.
+    thermometer
+        ``"resonator"`` (default) or ``"sensor"``: ``freq_hz`` holds a temperature
+        sensor's reading [°C], checked as a temperature.
 
     Returns
     -------
@@ -552,7 +504,7 @@ def validate(
     RecordingError
         Message names the file, column, first bad row, the bad value and the fix.
     """
-    validator = RecordingValidator(gaps, freq_band_hz, freq_span_hz)
+    validator = RecordingValidator(gaps, freq_band_hz, freq_span_hz, thermometer)
     validator.update(recording)
     report = validator.finish()
     if raise_errors:

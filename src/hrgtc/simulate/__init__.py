@@ -2,15 +2,21 @@
 
 Simulated recordings follow the recording contract (``time_s``, ``freq_hz``,
 ``rate_dph``, ``chamber_c``, ``housing_c``) and add the ground truth
-``resonator_c`` and ``bias_dph``. The parts, one module each:
+``resonator_c`` and ``bias_dph``; a unit with a scale-factor law adds the truth
+``scale_ppm``, and a rate-table run the known input ``input_rate_dph``. A
+multi-axis unit (``imu-3``) writes these per axis (``rate_dph_x``, ...) beside
+the shared ``time_s``, ``chamber_c`` and ``housing_c``
+(:func:`~hrgtc.simulate.campaign.run_columns`). The parts, one module each:
 
 - :mod:`~hrgtc.simulate.profiles`: the chamber program type and its JSON/YAML files;
-- :mod:`~hrgtc.simulate.standard_profiles`: soaks, ramps, cool-down, warm-up, constant;
+- :mod:`~hrgtc.simulate.standard_profiles`: soaks, ramps, cool-down, warm-up, constant,
+  rate table;
 - :mod:`~hrgtc.simulate.thermal`: chamber -> housing -> resonator network;
 - :mod:`~hrgtc.simulate.laws`: frequency law (Table 1 / Eq. 18 of [1], or the
-  shell model) and bias law in physical variables;
+  shell model), bias law and scale-factor law in physical variables;
 - :mod:`~hrgtc.simulate.noise`: ARW, bias instability, rate random walk;
-- :mod:`~hrgtc.simulate.units`: named simulated gyros (``paper-unit``, ``unit-b``);
+- :mod:`~hrgtc.simulate.units`: named simulated gyros (``paper-unit``, ``unit-b``) and
+  the three-axis ``imu-3``;
 - :mod:`~hrgtc.simulate.campaign`: runs in chunks, with ground truth;
 - :mod:`~hrgtc.simulate.output`: runs written to files, atomically.
 
@@ -32,13 +38,16 @@ from hrgtc.simulate import profiles, standard_profiles, units
 from hrgtc.simulate.campaign import (
     COLUMNS,
     DEFAULT_INPUT_RATE_DPH,
+    input_rates_dph,
     iter_run_chunks,
+    run_columns,
     run_metadata,
     simulate_run,
 )
 from hrgtc.simulate.laws import (
     BiasLaw,
     PolynomialFrequencyLaw,
+    ScaleFactorLaw,
     ShellFrequencyLaw,
     table1_frequency_law,
 )
@@ -49,21 +58,24 @@ from hrgtc.simulate.standard_profiles import (
     constant,
     cooldown,
     ramp,
+    rate_table,
     soak,
     soak_campaign,
     soak_series,
     warmup,
 )
 from hrgtc.simulate.thermal import ThermalNetwork
-from hrgtc.simulate.units import Unit
+from hrgtc.simulate.units import MultiAxisUnit, Unit, unit_from_dict
 
 __all__ = [
     "COLUMNS",
     "DEFAULT_INPUT_RATE_DPH",
     "BiasLaw",
     "GyroNoise",
+    "MultiAxisUnit",
     "PolynomialFrequencyLaw",
     "Profile",
+    "ScaleFactorLaw",
     "Segment",
     "ShellFrequencyLaw",
     "ThermalNetwork",
@@ -71,10 +83,13 @@ __all__ = [
     "WrittenFile",
     "constant",
     "cooldown",
+    "input_rates_dph",
     "iter_run_chunks",
     "output_paths",
     "profiles",
     "ramp",
+    "rate_table",
+    "run_columns",
     "run_metadata",
     "simulate_files",
     "simulate_run",
@@ -84,6 +99,7 @@ __all__ = [
     "soak_series",
     "standard_profiles",
     "table1_frequency_law",
+    "unit_from_dict",
     "units",
     "warmup",
 ]

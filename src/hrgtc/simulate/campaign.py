@@ -28,7 +28,7 @@ files: :mod:`hrgtc.simulate.output`.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
@@ -40,7 +40,7 @@ from hrgtc.recording import Metadata, Recording, concatenate
 from hrgtc.simulate import units as _units
 from hrgtc.simulate.noise import WhiteNoiseStream
 from hrgtc.simulate.profiles import Profile
-from hrgtc.simulate.units import Unit
+from hrgtc.simulate.units import MultiAxisUnit, Unit
 
 __all__ = [
     "COLUMNS",
@@ -49,8 +49,10 @@ __all__ = [
     "Seed",
     "check_rate",
     "check_seed",
+    "input_rates_dph",
     "iter_run_chunks",
     "row_count",
+    "run_columns",
     "run_metadata",
     "simulate_run",
 ]
@@ -65,8 +67,12 @@ DEFAULT_INPUT_RATE_DPH = 10.0
 Seed = int | np.random.SeedSequence | np.random.Generator
 
 
-def _resolve_unit(unit: str | Unit) -> Unit:
-    return unit if isinstance(unit, Unit) else _units.get(unit)
+AnyUnit = Unit | MultiAxisUnit
+_SECONDS_PER_HOUR = 3600.0
+
+
+def _resolve_unit(unit: str | AnyUnit) -> AnyUnit:
+    return unit if isinstance(unit, Unit | MultiAxisUnit) else _units.get(unit)
 
 
 def check_rate(sample_rate_hz: float) -> float:
@@ -113,27 +119,121 @@ def row_count(profile: Profile, sample_rate_hz: float) -> int:
     return max(1, round(profile.duration_s * check_rate(sample_rate_hz)))
 
 
+def input_rates_dph(
+    unit: str | AnyUnit, input_rate_dph: float | Mapping[str, float] | None = None
+) -> dict[str | None, float]:
+    """Constant input rate of each axis (key None for a single-axis unit). [°/h]
+
+    ``None`` gives :data:`DEFAULT_INPUT_RATE_DPH` for a single-axis unit and the
+    unit's own rates (its Earth-rate components) for a multi-axis one; a number
+    gives that rate on every axis; a mapping gives each axis its rate.
+    """
+    unit = _resolve_unit(unit)
+    axes: tuple[str | None, ...] = (
+        unit.axis_names if isinstance(unit, MultiAxisUnit) else (None,)
+    )
+    if input_rate_dph is None:
+        if isinstance(unit, MultiAxisUnit):
+            return dict(unit.input_rate_dph)
+        input_rate_dph = DEFAULT_INPUT_RATE_DPH
+    if isinstance(input_rate_dph, Mapping):
+        if not isinstance(unit, MultiAxisUnit) or set(input_rate_dph) != set(axes):
+            raise InputError(
+                f"input_rate_dph {dict(input_rate_dph)} must give a rate for each axis of unit "
+                f"{unit.name!r}: {', '.join(str(a) for a in axes)}"
+            )
+        rates = {a: input_rate_dph[a] for a in axes if a is not None}
+    else:
+        rates = dict.fromkeys(axes, input_rate_dph)
+    for axis, value in rates.items():
+        try:
+            number = float(value)
+        except (TypeError, ValueError):
+            number = math.nan
+        if not math.isfinite(number):
+            where = "" if axis is None else f"[{axis!r}]"
+            raise InputError(f"input_rate_dph{where} must be finite [°/h], got {value!r}")
+        rates[axis] = number
+    return rates
+
+
+def _check_table_axes(profile: Profile, unit: AnyUnit) -> None:
+    """The rate table's axes must be the unit's (none for a single-axis unit)."""
+    table = profile.table_axes
+    if isinstance(unit, MultiAxisUnit):
+        if None in table:
+            raise InputError(
+                f"profile {profile.name!r} turns the rate table without naming an axis, but "
+                f"unit {unit.name!r} has axes {', '.join(unit.axis_names)}; give each rate "
+                "segment an axis (rate_table(..., axes=...))"
+            )
+        unknown = [a for a in table if a not in unit.axes]
+        if unknown:
+            raise InputError(
+                f"profile {profile.name!r} turns axis(es) {unknown}, not axes of unit "
+                f"{unit.name!r} ({', '.join(unit.axis_names)})"
+            )
+    elif any(a is not None for a in table):
+        raise InputError(
+            f"profile {profile.name!r} turns axis(es) {[a for a in table if a]} but unit "
+            f"{unit.name!r} has a single axis; drop the segments' axis"
+        )
+
+
+def run_columns(profile: Profile, unit: str | AnyUnit = _units.DEFAULT_UNIT) -> tuple[str, ...]:
+    """Columns of a run, in order.
+
+    A single-axis unit: :data:`COLUMNS`, then ``scale_ppm`` if the unit has a
+    scale-factor law and ``input_rate_dph`` if the profile turns a rate table.
+    A multi-axis unit: ``time_s``, ``chamber_c``, ``housing_c``, then for each
+    axis the :data:`AXIS_COLUMNS` it has, suffixed ``_<axis>``.
+    """
+    unit = _resolve_unit(unit)
+    table = profile.has_rate_table
+
+    def axis_columns(gyro: Unit, suffix: str) -> list[str]:
+        names = [f"{n}{suffix}" for n in ("freq_hz", "rate_dph", "resonator_c", "bias_dph")]
+        if gyro.scale_factor_law is not None:
+            names.append(f"scale_ppm{suffix}")
+        if table:
+            names.append(f"input_rate_dph{suffix}")
+        return names
+
+    if isinstance(unit, MultiAxisUnit):
+        out = ["time_s", "chamber_c", "housing_c"]
+        for axis, gyro in unit.axes.items():
+            out += axis_columns(gyro, f"_{axis}")
+        return tuple(out)
+    return COLUMNS + tuple(axis_columns(unit, "")[4:])
+
+
 def run_metadata(
     profile: Profile,
-    unit: str | Unit = _units.DEFAULT_UNIT,
+    unit: str | AnyUnit = _units.DEFAULT_UNIT,
     sample_rate_hz: float = 200.0,
     seed: Seed = 0,
-    input_rate_dph: float = DEFAULT_INPUT_RATE_DPH,
+    input_rate_dph: float | Mapping[str, float] | None = None,
 ) -> Metadata:
-    """Metadata of a simulated run (unit name, rate, input rate, profile text, truth)."""
+    """Metadata of a simulated run (unit name, rate, input rate, profile text, truth).
+
+    A multi-axis unit's constant input rates go to ``extra["axis_input_rate_dph"]``
+    (``input_rate_dph`` is then 0).
+    """
     unit = _resolve_unit(unit)
     seed = check_seed(seed)
-    if not math.isfinite(float(input_rate_dph)):
-        raise InputError(f"input_rate_dph must be finite [°/h], got {input_rate_dph!r}")
+    rates = input_rates_dph(unit, input_rate_dph)
+    _check_table_axes(profile, unit)
     extra: dict[str, Any] = {"simulated": True, **_seed_record(seed)}
     if profile.setpoint_c is not None:
         extra["setpoint_c"] = profile.setpoint_c
     extra["chamber_program"] = profile.to_dict()
     extra["unit_parameters"] = unit.to_dict()
+    if isinstance(unit, MultiAxisUnit):
+        extra["axis_input_rate_dph"] = dict(rates)
     return Metadata(
         sample_rate_hz=check_rate(sample_rate_hz),
         unit=unit.name,
-        input_rate_dph=float(input_rate_dph),
+        input_rate_dph=rates.get(None, 0.0),
         profile=profile.description,
         extra=extra,
     )
@@ -141,10 +241,10 @@ def run_metadata(
 
 def iter_run_chunks(
     profile: Profile,
-    unit: str | Unit = _units.DEFAULT_UNIT,
+    unit: str | AnyUnit = _units.DEFAULT_UNIT,
     sample_rate_hz: float = 200.0,
     seed: Seed = 0,
-    input_rate_dph: float = DEFAULT_INPUT_RATE_DPH,
+    input_rate_dph: float | Mapping[str, float] | None = None,
     chunk_rows: int = DEFAULT_CHUNK_ROWS,
     progress: Progress | None = None,
 ) -> Iterator[Recording]:
@@ -153,16 +253,19 @@ def iter_run_chunks(
     Parameters
     ----------
     profile
-        The chamber program.
+        The chamber program (and rate table, if it turns one).
     unit
-        A unit name (:func:`hrgtc.simulate.units.names`) or a :class:`Unit`.
+        A unit name (:func:`hrgtc.simulate.units.names`), a :class:`Unit` or a
+        :class:`MultiAxisUnit`.
     sample_rate_hz
         Sample rate. [Hz]
     seed
         Non-negative integer, :class:`numpy.random.SeedSequence` or
         :class:`numpy.random.Generator`; the same seed gives the same arrays.
     input_rate_dph
-        Known rate on the sensitive axis, added to the output. [°/h]
+        Known constant rate on the sensitive axis (e.g. the Earth-rate
+        component), added to the table's rate; per axis for a multi-axis unit
+        (see :func:`input_rates_dph`; None: the unit's own). [°/h]
     chunk_rows
         Rows per chunk.
     progress
@@ -171,25 +274,42 @@ def iter_run_chunks(
     Yields
     ------
     Recording
-        Consecutive chunks with the columns of :data:`COLUMNS` and the run's metadata.
+        Consecutive chunks with the columns of :func:`run_columns` and the run's metadata.
     """
     unit = _resolve_unit(unit)
     fs = check_rate(sample_rate_hz)
     if int(chunk_rows) < 1:
         raise InputError(f"chunk_rows must be >= 1, got {chunk_rows!r}")
     metadata = run_metadata(profile, unit, fs, seed, input_rate_dph)
+    rates = input_rates_dph(unit, input_rate_dph)
     total = row_count(profile, fs)
-    white, slow, freq_rng, housing_rng = _generators(seed, 4)
-    gyro = unit.gyro_noise.stream(fs, white, slow)
-    freq_noise = WhiteNoiseStream(unit.frequency_noise_hz, freq_rng)
+    multi = isinstance(unit, MultiAxisUnit)
+    gyros: dict[str | None, Unit] = (
+        dict(unit.axes) if isinstance(unit, MultiAxisUnit) else {None: unit}
+    )
+    if multi:  # the housing thermistor, then (white, slow, frequency) per axis
+        housing_rng, *rngs = _generators(seed, 1 + 3 * len(gyros))
+    else:  # the order of the first single-axis runs
+        white, slow, freq_rng, housing_rng = _generators(seed, 4)
+        rngs = [white, slow, freq_rng]
+    streams = {
+        axis: (
+            gyro.gyro_noise.stream(fs, rngs[3 * k], rngs[3 * k + 1]),
+            WhiteNoiseStream(gyro.frequency_noise_hz, rngs[3 * k + 2]),
+        )
+        for k, (axis, gyro) in enumerate(gyros.items())
+    }
     housing_noise = WhiteNoiseStream(unit.housing_noise_c, housing_rng)
-    network = unit.thermal
-    state = network.initial_state(profile.start_c)
+    states = {axis: gyro.thermal.initial_state(profile.start_c) for axis, gyro in gyros.items()}
     times, temps = profile.breakpoints()
+    table = profile.has_rate_table
+    names = run_columns(profile, unit)
     dt = 1.0 / fs
 
-    def draw_noise(count: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        return gyro.next(count), freq_noise.next(count), housing_noise.next(count)
+    def draw_noise(count: int) -> tuple[dict[str | None, tuple[np.ndarray, np.ndarray]],
+                                         np.ndarray]:
+        drawn = {axis: (g.next(count), f.next(count)) for axis, (g, f) in streams.items()}
+        return drawn, housing_noise.next(count)
 
     # The random draws of a chunk run in a worker thread while this thread does the
     # deterministic physics (numpy releases the GIL); each stream stays in time order.
@@ -199,23 +319,40 @@ def iter_run_chunks(
             noise = pool.submit(draw_noise, stop - start)
             time_s = np.arange(start, stop, dtype=np.float64) / fs
             chamber = np.interp(time_s, times, temps)
-            housing, resonator, state = network.response(chamber, dt, state)
-            bias = unit.bias_law.bias_dph(resonator, housing)
-            freq = unit.frequency_law.frequency_hz(resonator)
-            rate, freq_error, housing_logged = noise.result()
-            freq += freq_error
-            rate += bias
-            rate += float(input_rate_dph)
-            housing_logged += housing
-            columns = {
-                "time_s": time_s,
-                "freq_hz": freq,
-                "rate_dph": rate,
-                "chamber_c": chamber,
-                "housing_c": housing_logged,
-                "resonator_c": resonator,
-                "bias_dph": bias,
-            }
+            physics = {}
+            for axis, gyro in gyros.items():
+                housing, resonator, states[axis] = gyro.thermal.response(chamber, dt, states[axis])
+                bias = gyro.bias_law.bias_dph(resonator, housing)
+                freq = gyro.frequency_law.frequency_hz(resonator)
+                physics[axis] = (housing, resonator, bias, freq)
+            drawn, housing_logged = noise.result()
+            housing_logged += physics[next(iter(gyros))][0]  # the axes share the housing
+            axis_columns: dict[str, np.ndarray] = {}
+            for axis, gyro in gyros.items():
+                _, resonator, bias, freq = physics[axis]
+                rate, freq_error = drawn[axis]
+                freq += freq_error
+                rate += bias
+                suffix = "" if axis is None else f"_{axis}"
+                axis_columns[f"freq_hz{suffix}"] = freq
+                axis_columns[f"rate_dph{suffix}"] = rate
+                axis_columns[f"resonator_c{suffix}"] = resonator
+                axis_columns[f"bias_dph{suffix}"] = bias
+                applied: float | np.ndarray = rates[axis]
+                if table:
+                    applied = profile.table_rate_dps(time_s, axis) * _SECONDS_PER_HOUR
+                    applied += rates[axis]
+                if gyro.scale_factor_law is not None:
+                    # rate = input (1 + k 1e-6) + bias + noise
+                    scale = gyro.scale_factor_law.ppm(resonator)
+                    axis_columns[f"scale_ppm{suffix}"] = scale
+                    rate += applied * (1.0 + scale * 1e-6)
+                else:
+                    rate += applied
+                if table:
+                    axis_columns[f"input_rate_dph{suffix}"] = np.asarray(applied)
+            axis_columns.update(time_s=time_s, chamber_c=chamber, housing_c=housing_logged)
+            columns = {name: axis_columns[name] for name in names}
             yield Recording(columns, metadata)
             if progress is not None:
                 progress(float(stop), float(total))
@@ -223,10 +360,10 @@ def iter_run_chunks(
 
 def simulate_run(
     profile: Profile,
-    unit: str | Unit = _units.DEFAULT_UNIT,
+    unit: str | AnyUnit = _units.DEFAULT_UNIT,
     sample_rate_hz: float = 200.0,
     seed: Seed = 0,
-    input_rate_dph: float = DEFAULT_INPUT_RATE_DPH,
+    input_rate_dph: float | Mapping[str, float] | None = None,
     chunk_rows: int = DEFAULT_CHUNK_ROWS,
     progress: Progress | None = None,
 ) -> Recording:

@@ -5,6 +5,10 @@ either a polynomial (by default the cubic of Eq. (17)-(18) of [1] fitted to
 Table 1 at full precision, :func:`table1_frequency_law`) or the shell model of
 Eq. (15) of [1] with material temperature coefficients (:class:`ShellFrequencyLaw`).
 
+Scale factor: the error of the scale factor in ppm as a polynomial in the
+resonator temperature (:class:`ScaleFactorLaw`); the output is
+``rate = input (1 + k 1e-6) + bias + noise``.
+
 Bias: the simulator's own law in resonator temperature ``T_r`` and the
 housing - resonator gradient ``G = T_h - T_r`` (:class:`BiasLaw`), not Eq. (21)
 of [1]: since ``f`` is a smooth monotonic function of ``T_r`` (Eq. 18) and
@@ -20,6 +24,7 @@ but not exactly.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, Protocol
 
@@ -33,7 +38,9 @@ __all__ = [
     "BiasLaw",
     "FrequencyLaw",
     "PolynomialFrequencyLaw",
+    "ScaleFactorLaw",
     "ShellFrequencyLaw",
+    "frequency_law_from_dict",
     "table1_frequency_law",
 ]
 
@@ -89,6 +96,11 @@ class PolynomialFrequencyLaw:
             "source": self.source,
         }
 
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> PolynomialFrequencyLaw:
+        """Inverse of :meth:`to_dict`."""
+        return cls(tuple(data["coefficients"]), source=str(data.get("source", "")))
+
 
 def table1_frequency_law() -> PolynomialFrequencyLaw:
     """Eq. (18) of [1] at full precision: the least-squares cubic through Table 1.
@@ -126,6 +138,89 @@ class ShellFrequencyLaw:
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types."""
         return {"kind": "shell", "shell": self.shell.to_dict()}
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> ShellFrequencyLaw:
+        """Inverse of :meth:`to_dict`."""
+        return cls(Shell.from_dict(data["shell"]))
+
+
+def frequency_law_from_dict(data: Mapping[str, Any]) -> FrequencyLaw:
+    """A frequency law from its :meth:`to_dict` form (``kind`` polynomial or shell)."""
+    kinds: dict[str, Any] = {
+        "polynomial": PolynomialFrequencyLaw,
+        "shell": ShellFrequencyLaw,
+    }
+    kind = data.get("kind")
+    if kind not in kinds:
+        raise InputError(f"frequency law kind {kind!r} is unknown; use one of {sorted(kinds)}")
+    return kinds[kind].from_dict(data)
+
+
+@dataclass(frozen=True)
+class ScaleFactorLaw:
+    """Scale-factor error against resonator temperature, a polynomial in ``T_r - T0``.
+
+    .. math::
+
+        k(T_r) = \\sum_{j=0}^{n} k_j (T_r - T_0)^j \\quad [\\mathrm{ppm}],
+        \\qquad \\Omega_{out} = \\Omega_{in} (1 + 10^{-6} k) + B + \\text{noise}
+
+    The simulator's own law (IEEE Std 1431 thermal tests characterise the scale
+    factor against temperature; [1] models the bias only).
+
+    Parameters
+    ----------
+    coefficients_ppm
+        ``(k0, k1, k2, ...)``: coefficients of (T_r - T0)^j. [ppm/°C^j]
+    reference_c
+        Reference temperature T0. [°C]
+
+    Examples
+    --------
+    >>> law = ScaleFactorLaw((120.0, 4.0, 0.05), reference_c=20.0)
+    >>> law.ppm(np.array([20.0, 30.0])).tolist()
+    [120.0, 165.0]
+    """
+
+    coefficients_ppm: tuple[float, ...]
+    reference_c: float = 20.0
+
+    def __post_init__(self) -> None:
+        coefficients = tuple(float(c) for c in self.coefficients_ppm)
+        if not coefficients or not all(math.isfinite(c) for c in coefficients):
+            raise InputError(
+                f"coefficients_ppm must be finite numbers, got {self.coefficients_ppm!r}"
+            )
+        reference = float(self.reference_c)
+        if not math.isfinite(reference):
+            raise InputError(f"reference_c must be finite [°C], got {self.reference_c!r}")
+        object.__setattr__(self, "coefficients_ppm", coefficients)
+        object.__setattr__(self, "reference_c", reference)
+
+    def ppm(self, resonator_c: np.ndarray) -> np.ndarray:
+        """Scale-factor error at a resonator temperature (Horner). [ppm]
+
+        Parameters
+        ----------
+        resonator_c
+            Resonator temperature. [°C]
+        """
+        dt = np.asarray(resonator_c, dtype=np.float64) - self.reference_c
+        out = np.full(dt.shape, self.coefficients_ppm[-1])
+        for c in self.coefficients_ppm[-2::-1]:
+            out *= dt
+            out += c
+        return out
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types."""
+        return {"coefficients_ppm": list(self.coefficients_ppm), "reference_c": self.reference_c}
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> ScaleFactorLaw:
+        """Inverse of :meth:`to_dict`."""
+        return cls(tuple(data["coefficients_ppm"]), float(data.get("reference_c", 20.0)))
 
 
 @dataclass(frozen=True)
@@ -233,3 +328,8 @@ class BiasLaw:
             "hysteresis_dph": self.hysteresis_dph,
             "hysteresis_width_c": self.hysteresis_width_c,
         }
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> BiasLaw:
+        """Inverse of :meth:`to_dict`."""
+        return cls(**{**data, "temperature_dph": tuple(data["temperature_dph"])})

@@ -31,6 +31,7 @@ run is the same whatever the chunk size.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from typing import Any
 
@@ -156,6 +157,11 @@ class GyroNoise:
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types."""
         return asdict(self)
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> GyroNoise:
+        """Inverse of :meth:`to_dict`."""
+        return cls(**data)
 
 
 class WhiteNoiseStream:

@@ -9,7 +9,7 @@ overwritten without ``force``; a campaign checks all its targets first.
 from __future__ import annotations
 
 import threading
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -24,18 +24,17 @@ from hrgtc.recording import RecordingWriter
 from hrgtc.recording.formats import FORMAT_SUFFIXES, SUFFIXES
 from hrgtc.simulate import units as _units
 from hrgtc.simulate.campaign import (
-    COLUMNS,
     DEFAULT_CHUNK_ROWS,
-    DEFAULT_INPUT_RATE_DPH,
     Seed,
     check_rate,
     check_seed,
     iter_run_chunks,
     row_count,
+    run_columns,
     run_metadata,
 )
 from hrgtc.simulate.profiles import Profile
-from hrgtc.simulate.units import Unit
+from hrgtc.simulate.units import MultiAxisUnit, Unit
 
 __all__ = ["WrittenFile", "output_paths", "simulate_files", "simulate_to_file"]
 
@@ -75,10 +74,10 @@ class WrittenFile:
 def simulate_to_file(
     profile: Profile,
     path: str | Path,
-    unit: str | Unit = _units.DEFAULT_UNIT,
+    unit: str | Unit | MultiAxisUnit = _units.DEFAULT_UNIT,
     sample_rate_hz: float = 200.0,
     seed: Seed = 0,
-    input_rate_dph: float = DEFAULT_INPUT_RATE_DPH,
+    input_rate_dph: float | Mapping[str, float] | None = None,
     chunk_rows: int = DEFAULT_CHUNK_ROWS,
     force: bool = False,
     progress: Progress | None = None,
@@ -115,7 +114,7 @@ def simulate_to_file(
     # Encode and write chunk k in a worker thread while chunk k+1 is generated
     # (numpy, scipy and pyarrow release the GIL in their loops).
     with (
-        RecordingWriter(path, metadata, COLUMNS, force=force) as writer,
+        RecordingWriter(path, metadata, run_columns(profile, unit), force=force) as writer,
         ThreadPoolExecutor(max_workers=1, thread_name_prefix="hrgtc-writer") as pool,
     ):
         pending: Future[None] | None = None
@@ -175,10 +174,10 @@ def simulate_files(
     profiles: Sequence[Profile],
     output: str | Path,
     file_format: str | None = None,
-    unit: str | Unit = _units.DEFAULT_UNIT,
+    unit: str | Unit | MultiAxisUnit = _units.DEFAULT_UNIT,
     sample_rate_hz: float = 200.0,
     seed: int = 0,
-    input_rate_dph: float = DEFAULT_INPUT_RATE_DPH,
+    input_rate_dph: float | Mapping[str, float] | None = None,
     chunk_rows: int = DEFAULT_CHUNK_ROWS,
     force: bool = False,
     progress: Progress | None = None,
@@ -223,7 +222,7 @@ def simulate_files(
     """
     if not profiles:
         raise InputError("no runs to simulate; give at least one profile")
-    unit = unit if isinstance(unit, Unit) else _units.get(unit)
+    unit = unit if isinstance(unit, Unit | MultiAxisUnit) else _units.get(unit)
     fs = check_rate(sample_rate_hz)
     seed = check_seed(seed)
     if not isinstance(seed, int):

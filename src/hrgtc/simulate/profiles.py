@@ -31,6 +31,16 @@ Profile files (JSON or YAML) hold either a list of segments or a mapping::
 
 Each segment has ``setpoint_c`` and exactly one of ``hold_h`` and ``ramp_c_per_min``.
 
+A segment may also turn a rate table under the unit (IEEE Std 1431 scale-factor
+tests): ``table_rate_dps`` is the table's rate held through the segment [°/s]
+(none: the table at rest), and ``axis`` the axis of a multi-axis unit it turns
+(the other axes see no table rate; none for a single-axis unit)::
+
+      - {setpoint_c: 30, hold_h: 3}                                  # soak at 30 °C
+      - {setpoint_c: 30, hold_h: 0.025, table_rate_dps: 100, axis: x}  # 90 s at 100 °/s
+
+:func:`hrgtc.simulate.standard_profiles.rate_table` builds such a program.
+
 [1] X. Wang, W. Wu, Z. Fang, B. Luo, Y. Li, Q. Jiang, "Temperature Drift
     Compensation for Hemispherical Resonator Gyro Based on Natural Frequency",
     Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
@@ -52,6 +62,7 @@ import yaml
 from hrgtc.errors import InputError
 
 __all__ = [
+    "AXIS_NAME",
     "CHAMBER_MAX_C_PER_MIN",
     "DEFAULT_RAMP_C_PER_MIN",
     "ROOM_TEMPERATURE_C",
@@ -67,6 +78,10 @@ ROOM_TEMPERATURE_C = 20.0
 CHAMBER_MAX_C_PER_MIN = 2.0
 #: Default ramp rate of the cool-down and warm-up runs (Fig. 6 of [1]). [°C/min]
 DEFAULT_RAMP_C_PER_MIN = 1.0
+#: An axis name: a letter, then letters or digits (the suffix of per-axis columns).
+AXIS_NAME = re.compile(r"[A-Za-z][A-Za-z0-9]*")
+#: Keys of a segment in a profile file.
+SEGMENT_KEYS = ("setpoint_c", "hold_h", "ramp_c_per_min", "table_rate_dps", "axis")
 
 
 def finite_number(name: str, value: Any, unit: str, where: str = "") -> float:
@@ -96,14 +111,34 @@ class Segment:
         included; None for a ramp. [h]
     ramp_c_per_min
         Ramp rate of a ramp segment; None for a hold. [°C/min]
+    table_rate_dps
+        Rate of a rate table under the unit through the segment; None: at rest. [°/s]
+    axis
+        Axis of a multi-axis unit the table turns (the others see none); None
+        for a single-axis unit.
     """
 
     setpoint_c: float
     hold_h: float | None = None
     ramp_c_per_min: float | None = None
+    table_rate_dps: float | None = None
+    axis: str | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "setpoint_c", finite_number("setpoint_c", self.setpoint_c, "°C"))
+        if self.table_rate_dps is not None:
+            rate = finite_number("table_rate_dps", self.table_rate_dps, "°/s")
+            object.__setattr__(self, "table_rate_dps", rate)
+        if self.axis is not None:
+            if not (isinstance(self.axis, str) and AXIS_NAME.fullmatch(self.axis)):
+                raise InputError(
+                    f"axis must be a letter then letters or digits (e.g. x), got {self.axis!r}"
+                )
+            if self.table_rate_dps is None:
+                raise InputError(
+                    f"axis {self.axis!r} is given without table_rate_dps; give the table's "
+                    "rate [°/s] or drop the axis"
+                )
         if (self.hold_h is None) == (self.ramp_c_per_min is None):
             raise InputError(
                 "a segment needs exactly one of hold_h and ramp_c_per_min, got "
@@ -123,14 +158,18 @@ class Segment:
                 )
             object.__setattr__(self, "ramp_c_per_min", rate)
 
-    def to_dict(self) -> dict[str, float]:
+    def to_dict(self) -> dict[str, Any]:
         """Plain JSON types, the schema of profile files."""
-        out: dict[str, float] = {"setpoint_c": self.setpoint_c}
+        out: dict[str, Any] = {"setpoint_c": self.setpoint_c}
         if self.hold_h is not None:
             out["hold_h"] = self.hold_h
         else:
             assert self.ramp_c_per_min is not None
             out["ramp_c_per_min"] = self.ramp_c_per_min
+        if self.table_rate_dps is not None:
+            out["table_rate_dps"] = self.table_rate_dps
+        if self.axis is not None:
+            out["axis"] = self.axis
         return out
 
 
@@ -205,8 +244,48 @@ class Profile:
         chamber_c : numpy.ndarray
             Chamber temperature at the corners. [°C]
         """
+        times, temps, _ = self._corners()
+        return times, temps
+
+    def segment_ends_s(self) -> np.ndarray:
+        """Time at which each segment ends (the next one starts). [s]"""
+        return self._corners()[2]
+
+    @property
+    def has_rate_table(self) -> bool:
+        """True if a segment turns a rate table (the run has an ``input_rate_dph`` column)."""
+        return any(s.table_rate_dps is not None for s in self.segments)
+
+    @property
+    def table_axes(self) -> tuple[str | None, ...]:
+        """The axes the table turns, in order of first use (None: a single-axis segment)."""
+        axes = [s.axis for s in self.segments if s.table_rate_dps is not None]
+        return tuple(dict.fromkeys(axes))
+
+    def table_rate_dps(self, time_s: Any, axis: str | None = None) -> np.ndarray:
+        """Rate of the table on ``axis`` at the given times (0 at rest or on another axis). [°/s]
+
+        A sample at a segment's end time belongs to the next segment; after the
+        end of the program the last segment's rate holds.
+
+        Parameters
+        ----------
+        time_s
+            Times. [s]
+        axis
+            The axis (None for a single-axis unit: the segments that name no axis).
+        """
+        rates = np.array([
+            s.table_rate_dps if s.table_rate_dps is not None and s.axis == axis else 0.0
+            for s in self.segments
+        ])
+        index = np.searchsorted(self.segment_ends_s(), np.asarray(time_s, np.float64), "right")
+        return rates[np.minimum(index, rates.size - 1)]
+
+    def _corners(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         max_rate = self.chamber_max_c_per_min / 60.0
         times, temps = [0.0], [self.start_c]
+        ends: list[float] = []
         t, temp = 0.0, self.start_c
         for segment in self.segments:
             delta = segment.setpoint_c - temp
@@ -218,6 +297,7 @@ class Profile:
                     t += duration
                     times.append(t)
                     temps.append(temp)
+                    ends.append(t)
                     continue
                 if slew > 0.0:
                     times.append(t + slew)
@@ -230,7 +310,8 @@ class Profile:
                 temp = segment.setpoint_c
             times.append(t)
             temps.append(temp)
-        return np.array(times), np.array(temps)
+            ends.append(t)
+        return np.array(times), np.array(temps), np.array(ends)
 
     @property
     def duration_s(self) -> float:
@@ -305,17 +386,23 @@ def from_mapping(data: Any, source: str = "profile", name: str = "profile") -> P
         where = f"{source}: segment {index}: "
         if not isinstance(item, Mapping):
             raise InputError(f"{where}expected a mapping, got {item!r}")
-        unknown = sorted(set(map(str, item)) - {"setpoint_c", "hold_h", "ramp_c_per_min"})
+        unknown = sorted(set(map(str, item)) - set(SEGMENT_KEYS))
         if unknown:
             raise InputError(
                 f"{where}unknown key(s) {unknown}; use setpoint_c and one of hold_h, "
-                "ramp_c_per_min"
+                "ramp_c_per_min (optionally table_rate_dps and axis)"
             )
         if "setpoint_c" not in item:
             raise InputError(f"{where}missing setpoint_c [°C]")
         try:
             segments.append(
-                Segment(item["setpoint_c"], item.get("hold_h"), item.get("ramp_c_per_min"))
+                Segment(
+                    item["setpoint_c"],
+                    item.get("hold_h"),
+                    item.get("ramp_c_per_min"),
+                    item.get("table_rate_dps"),
+                    item.get("axis"),
+                )
             )
         except InputError as exc:
             raise InputError(f"{where}{exc}") from None

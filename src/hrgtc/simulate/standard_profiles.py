@@ -9,6 +9,9 @@
   :func:`warmup`): ramp, then hold until the end of the run;
 * a ramp between two temperatures (:func:`ramp`) and a constant temperature
   (:func:`constant`);
+* a rate-table run (:func:`rate_table`): temperature plateaus, each a soak with
+  the table at rest and then known rates held in turn (on each axis in turn for
+  a multi-axis unit), as in the scale-factor tests of IEEE Std 1431;
 * :func:`build` turns the ``hrgtc simulate`` options (or a profile file, see
   :mod:`hrgtc.simulate.profiles`) into the list of runs.
 
@@ -35,11 +38,14 @@ from hrgtc.simulate.profiles import (
 )
 
 __all__ = [
+    "DEFAULT_PLATEAUS_C",
+    "DEFAULT_TABLE_RATES_DPS",
     "KINDS",
     "build",
     "constant",
     "cooldown",
     "ramp",
+    "rate_table",
     "soak",
     "soak_campaign",
     "soak_series",
@@ -289,8 +295,88 @@ def constant(temperature_c: float, hours: float) -> Profile:
     )
 
 
+#: Plateau temperatures of :func:`rate_table` by default. [°C]
+DEFAULT_PLATEAUS_C = (-10.0, 10.0, 30.0, 50.0)
+#: Table rates of :func:`rate_table` by default: 0, ±10, ±50, ±100, ±300 °/s. [°/s]
+DEFAULT_TABLE_RATES_DPS = (0.0, 10.0, -10.0, 50.0, -50.0, 100.0, -100.0, 300.0, -300.0)
+
+
+def rate_table(
+    plateaus_c: Sequence[float] = DEFAULT_PLATEAUS_C,
+    rates_dps: Sequence[float] = DEFAULT_TABLE_RATES_DPS,
+    hold_s: float = 60.0,
+    soak_h: float = 3.0,
+    axes: Sequence[str] | None = None,
+    start_c: float = ROOM_TEMPERATURE_C,
+    chamber_max_c_per_min: float = CHAMBER_MAX_C_PER_MIN,
+) -> Profile:
+    """A rate-table run: at each plateau a soak, then each rate held ``hold_s`` in turn.
+
+    At every plateau the chamber slews to the temperature and holds it for
+    ``soak_h`` hours with the table at rest, then the table turns at each of
+    ``rates_dps`` for ``hold_s`` seconds (the chamber still holding), axis after
+    axis for a multi-axis unit (the other axes see no table rate). The unit
+    starts in equilibrium at ``start_c``. The run lasts
+    ``len(plateaus) * (soak_h * 3600 + len(axes) * len(rates) * hold_s)`` seconds.
+
+    Parameters
+    ----------
+    plateaus_c
+        Chamber temperatures, in order. [°C]
+    rates_dps
+        Table rates held at every plateau, in order. [°/s]
+    hold_s
+        Time each rate is held. [s]
+    soak_h
+        Soak at each plateau before the rates, the chamber's slew included. [h]
+    axes
+        Axes of a multi-axis unit, turned one at a time; None for a single-axis unit.
+    start_c
+        Temperature of the unit and the chamber at the start. [°C]
+    chamber_max_c_per_min
+        Rate at which the chamber slews between plateaus. [°C/min]
+
+    Examples
+    --------
+    >>> p = rate_table([20.0], [0.0, 100.0], hold_s=90.0, soak_h=1.0)
+    >>> p.segment_ends_s().tolist(), p.table_rate_dps([3599.0, 3650.0, 3700.0]).tolist()
+    ([3600.0, 3690.0, 3780.0], [0.0, 0.0, 100.0])
+    """
+    points = _check_setpoints(plateaus_c)
+    rates = [finite_number(f"rates_dps[{i}]", r, "°/s") for i, r in enumerate(rates_dps)]
+    if not rates:
+        raise InputError("rates_dps is empty; give at least one table rate, e.g. 0,10,-10")
+    hold = finite_number("hold_s", hold_s, "s")
+    if hold <= 0.0:
+        raise InputError(f"hold_s must be > 0 [s], got {hold!r}")
+    soak_hours = _check_hours(soak_h)
+    start = finite_number("start_c", start_c, "°C")
+    turned: tuple[str | None, ...] = (None,) if axes is None else tuple(axes)
+    if not turned:
+        raise InputError("axes is empty; give the unit's axes, or None for a single-axis unit")
+    segments = []
+    for plateau in points:
+        segments.append(Segment(plateau, hold_h=soak_hours))
+        segments += [
+            Segment(plateau, hold_h=hold / 3600.0, table_rate_dps=rate, axis=axis)
+            for axis in turned
+            for rate in rates
+        ]
+    label = ", ".join(format_temperature(p) for p in points)
+    on_axes = "" if axes is None else f" on axes {', '.join(axes)} in turn"
+    return Profile(
+        tuple(segments),
+        start_c=start,
+        chamber_max_c_per_min=chamber_max_c_per_min,
+        name=f"ratetable_{format_temperature(points[0])}C_to_{format_temperature(points[-1])}C",
+        description=f"rate table at {label} C ({soak_hours:g} h soak each), rates "
+        f"{', '.join(f'{r:g}' for r in rates)} °/s {hold:g} s each{on_axes}, from "
+        f"{format_temperature(start)} C",
+    )
+
+
 #: Profile kinds known to :func:`build` (besides a path to a profile file).
-KINDS = ("soak", "cooldown", "warmup", "constant", "ramp")
+KINDS = ("soak", "cooldown", "warmup", "constant", "ramp", "ratetable")
 
 
 def build(
@@ -303,19 +389,24 @@ def build(
     temperature_c: float | None = None,
     ramp_c_per_min: float | None = None,
     single_file: bool = False,
+    rates_dps: Sequence[float] | None = None,
+    rate_hold_s: float | None = None,
+    axes: Sequence[str] | None = None,
 ) -> list[Profile]:
     """The runs of one command line: a kind of profile (or a profile file) and its options.
 
     Parameters
     ----------
     kind
-        ``"soak"``, ``"cooldown"``, ``"warmup"``, ``"constant"``, ``"ramp"``, or
-        the path of a JSON/YAML profile file.
+        ``"soak"``, ``"cooldown"``, ``"warmup"``, ``"constant"``, ``"ramp"``,
+        ``"ratetable"``, or the path of a JSON/YAML profile file.
     setpoints_c
-        Soak set-points (soak only; default -20, -10, ..., 40 as in Table 1 of [1]). [°C]
+        Soak set-points (default -20, -10, ..., 40 as in Table 1 of [1]), or the
+        plateaus of a rate table (default -10, 10, 30, 50). [°C]
     hours
-        Hours per soak, or duration of a cool-down/warm-up/constant run
-        (default 5); hold after a ramp (default 0). [h]
+        Hours per soak (also at each rate-table plateau, default 3), or duration
+        of a cool-down/warm-up/constant run (default 5); hold after a ramp
+        (default 0). [h]
     start_c, end_c
         Start and end temperatures of a cool-down (default 20, -20), warm-up
         (-20, 20) or ramp (required). [°C]
@@ -325,6 +416,13 @@ def build(
         Ramp rate of a cool-down, warm-up or ramp (default 1). [°C/min]
     single_file
         Soaks: one run visiting all set-points instead of one run per set-point.
+    rates_dps
+        Rate table: the rates (default 0, ±10, ±50, ±100, ±300). [°/s]
+    rate_hold_s
+        Rate table: time each rate is held (default 60). [s]
+    axes
+        Rate table: the axes of a multi-axis unit, turned one at a time (ignored
+        by the other kinds); None for a single-axis unit.
 
     Returns
     -------
@@ -337,6 +435,8 @@ def build(
         "end_c": end_c,
         "temperature_c": temperature_c,
         "ramp_c_per_min": ramp_c_per_min,
+        "rates_dps": rates_dps,
+        "rate_hold_s": rate_hold_s,
     }
     allowed = {
         "soak": {"setpoints_c"},
@@ -344,6 +444,7 @@ def build(
         "warmup": {"start_c", "end_c", "ramp_c_per_min"},
         "constant": {"temperature_c"},
         "ramp": {"start_c", "end_c", "ramp_c_per_min"},
+        "ratetable": {"setpoints_c", "start_c", "rates_dps", "rate_hold_s"},
     }
     if kind not in KINDS:
         path = Path(kind)
@@ -383,6 +484,17 @@ def build(
             raise InputError("a ramp needs start_c and end_c (--start, --end)")
         rate = DEFAULT_RAMP_C_PER_MIN if ramp_c_per_min is None else ramp_c_per_min
         return [ramp(start_c, end_c, rate, 0.0 if hours is None else hours)]
+    if kind == "ratetable":
+        return [
+            rate_table(
+                DEFAULT_PLATEAUS_C if setpoints_c is None else list(setpoints_c),
+                DEFAULT_TABLE_RATES_DPS if rates_dps is None else list(rates_dps),
+                60.0 if rate_hold_s is None else rate_hold_s,
+                3.0 if hours is None else hours,
+                axes=axes,
+                start_c=ROOM_TEMPERATURE_C if start_c is None else start_c,
+            )
+        ]
     if hours is not None:
         raise InputError(f"option hours does not apply to the profile file {kind}")
     return [load(kind)]

@@ -27,6 +27,7 @@ carrying the filter state from chunk to chunk. No Python loop per sample.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from typing import Any
 
@@ -189,6 +190,11 @@ class ThermalNetwork:
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types."""
         return asdict(self)
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> ThermalNetwork:
+        """Inverse of :meth:`to_dict`."""
+        return cls(**data)
 
 
 def step_response(network: ThermalNetwork, step_c: float, time_s: Any) -> np.ndarray:

@@ -25,6 +25,19 @@ unit cools and with the opposite gradient sign, a temperature-dependent
 gradient sensitivity, a small cooling/heating hysteresis (0.2 °/h, which the
 polynomial model of Eq. 21 cannot represent), and lower noise.
 
+Neither has a scale-factor law (``scale_factor_law`` None: ``rate = input +
+bias + noise``, as before the law existed).
+
+``imu-3`` is a three-axis unit (:class:`MultiAxisUnit`, axes ``x``, ``y``,
+``z``): three resonators of different shells (the Eq. 18 law of [1] at
+~4.4 kHz, and shells of ~5.7 kHz and ~8.5 kHz from the shell model of Eq. 15),
+each with its own bias law, scale-factor law (several hundred ppm over
+-20...60 °C) and resonator lag behind the one housing they share (2000, 2700
+and 3400 s: during a 1 °C/min ramp the resonators differ by several degrees), and
+the Earth-rate components of a unit mounted level at 40° N with ``x`` north,
+``y`` east and ``z`` up. Each axis is a :class:`Unit` itself
+(``get("imu-3").axes["x"]`` simulates that axis alone).
+
 [1] X. Wang, W. Wu, Z. Fang, B. Luo, Y. Li, Q. Jiang, "Temperature Drift
     Compensation for Hemispherical Resonator Gyro Based on Natural Frequency",
     Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
@@ -33,20 +46,39 @@ polynomial model of Eq. 21 cannot represent), and lower noise.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
 from functools import cache
 from typing import Any
 
 from hrgtc.errors import InputError
-from hrgtc.simulate.laws import BiasLaw, FrequencyLaw, ShellFrequencyLaw, table1_frequency_law
+from hrgtc.simulate.laws import (
+    BiasLaw,
+    FrequencyLaw,
+    ScaleFactorLaw,
+    ShellFrequencyLaw,
+    frequency_law_from_dict,
+    table1_frequency_law,
+)
 from hrgtc.simulate.noise import GyroNoise
+from hrgtc.simulate.profiles import AXIS_NAME
 from hrgtc.simulate.shell import FUSED_QUARTZ, Shell
 from hrgtc.simulate.thermal import ThermalNetwork
 
-__all__ = ["DEFAULT_UNIT", "Unit", "get", "names"]
+__all__ = [
+    "AXIS_NAME",
+    "DEFAULT_UNIT",
+    "EARTH_RATE_DPH",
+    "MultiAxisUnit",
+    "Unit",
+    "get",
+    "names",
+    "unit_from_dict",
+]
 
 DEFAULT_UNIT = "paper-unit"
+#: Earth's rotation rate, 360° per sidereal day (23.9345 h). [°/h]
+EARTH_RATE_DPH = 360.0 / 23.9344696
 
 
 @dataclass(frozen=True)
@@ -71,6 +103,9 @@ class Unit:
         White measurement noise of the frequency, rms per sample. [Hz]
     housing_noise_c
         White noise of the housing thermistor, rms per sample. [°C]
+    scale_factor_law
+        Scale-factor error against resonator temperature; None for none
+        (``rate = input + bias + noise``).
     """
 
     name: str
@@ -81,17 +116,18 @@ class Unit:
     gyro_noise: GyroNoise
     frequency_noise_hz: float
     housing_noise_c: float
+    scale_factor_law: ScaleFactorLaw | None = None
 
     def __post_init__(self) -> None:
-        for field in ("frequency_noise_hz", "housing_noise_c"):
-            value = float(getattr(self, field))
+        for attribute in ("frequency_noise_hz", "housing_noise_c"):
+            value = float(getattr(self, attribute))
             if not (math.isfinite(value) and value >= 0.0):
-                raise InputError(f"{field} must be finite and >= 0, got {value!r}")
-            object.__setattr__(self, field, value)
+                raise InputError(f"{attribute} must be finite and >= 0, got {value!r}")
+            object.__setattr__(self, attribute, value)
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types (the simulator's ground truth for a recording)."""
-        return {
+        out = {
             "name": self.name,
             "description": self.description,
             "thermal": self.thermal.to_dict(),
@@ -101,6 +137,25 @@ class Unit:
             "frequency_noise_hz": self.frequency_noise_hz,
             "housing_noise_c": self.housing_noise_c,
         }
+        if self.scale_factor_law is not None:  # absent: the dict of a unit without one
+            out["scale_factor_law"] = self.scale_factor_law.to_dict()
+        return out
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> Unit:
+        """Inverse of :meth:`to_dict`."""
+        law = data.get("scale_factor_law")
+        return cls(
+            name=str(data["name"]),
+            description=str(data["description"]),
+            thermal=ThermalNetwork.from_dict(data["thermal"]),
+            frequency_law=frequency_law_from_dict(data["frequency_law"]),
+            bias_law=BiasLaw.from_dict(data["bias_law"]),
+            gyro_noise=GyroNoise.from_dict(data["gyro_noise"]),
+            frequency_noise_hz=float(data["frequency_noise_hz"]),
+            housing_noise_c=float(data["housing_noise_c"]),
+            scale_factor_law=None if law is None else ScaleFactorLaw.from_dict(law),
+        )
 
     def summary(self) -> str:
         """The unit's parameters as text."""
@@ -120,7 +175,116 @@ class Unit:
             f"  noise: ARW {noise.arw_deg_per_sqrt_h:g} °/√h, bias instability "
             f"{noise.bias_instability_dph:g} °/h, RRW {noise.rrw_dph_per_sqrt_h:g} °/h/√h",
         ]
+        if self.scale_factor_law is not None:
+            sf = self.scale_factor_law
+            lines.append(
+                f"  scale factor: k0..kn {sf.coefficients_ppm} ppm/°C^j about "
+                f"T0 {sf.reference_c:g} °C"
+            )
         return "\n".join(lines)
+
+
+@dataclass(frozen=True)
+class MultiAxisUnit:
+    """A unit of several gyros (axes) sharing one housing in the chamber.
+
+    Parameters
+    ----------
+    name
+        Name (the recording's ``unit`` metadata).
+    description
+        One line about the unit.
+    axes
+        Axis name -> the gyro on that axis, in column order. Each axis has its own
+        resonator (frequency, bias and scale-factor laws, noise and resonator lag);
+        all share the housing, so their thermal networks must have the same
+        ``tau_housing_s``.
+    input_rate_dph
+        Axis name -> constant rate on that axis, e.g. its Earth-rate component. [°/h]
+    housing_noise_c
+        White noise of the one housing thermistor, rms per sample. [°C]
+    """
+
+    name: str
+    description: str
+    axes: dict[str, Unit]
+    input_rate_dph: dict[str, float] = field(default_factory=dict)
+    housing_noise_c: float = 0.01
+
+    def __post_init__(self) -> None:
+        axes = dict(self.axes)
+        if not axes:
+            raise InputError(f"unit {self.name!r}: a multi-axis unit needs at least one axis")
+        for axis, gyro in axes.items():
+            if not (isinstance(axis, str) and AXIS_NAME.fullmatch(axis)):
+                raise InputError(
+                    f"unit {self.name!r}: axis name {axis!r} must be a letter then letters or "
+                    "digits (no underscore), e.g. x, y, z"
+                )
+            if not isinstance(gyro, Unit):
+                raise InputError(f"unit {self.name!r}: axis {axis} must be a Unit")
+        housing = {gyro.thermal.tau_housing_s for gyro in axes.values()}
+        if len(housing) != 1:
+            raise InputError(
+                f"unit {self.name!r}: the axes share one housing but have tau_housing_s "
+                f"{sorted(housing)} s; give them the same"
+            )
+        rates = {str(k): float(v) for k, v in dict(self.input_rate_dph).items()}
+        if set(rates) - set(axes) or not all(math.isfinite(v) for v in rates.values()):
+            raise InputError(
+                f"unit {self.name!r}: input_rate_dph {rates} must be finite rates of axes "
+                f"{list(axes)}"
+            )
+        noise = float(self.housing_noise_c)
+        if not (math.isfinite(noise) and noise >= 0.0):
+            raise InputError(f"housing_noise_c must be finite and >= 0, got {noise!r}")
+        object.__setattr__(self, "axes", axes)
+        object.__setattr__(self, "input_rate_dph", {a: rates.get(a, 0.0) for a in axes})
+        object.__setattr__(self, "housing_noise_c", noise)
+
+    @property
+    def axis_names(self) -> tuple[str, ...]:
+        """The axes, in column order."""
+        return tuple(self.axes)
+
+    @property
+    def thermal(self) -> ThermalNetwork:
+        """The first axis's network (its housing is every axis's housing)."""
+        return next(iter(self.axes.values())).thermal
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types (the simulator's ground truth for a recording)."""
+        return {
+            "name": self.name,
+            "description": self.description,
+            "axes": {axis: gyro.to_dict() for axis, gyro in self.axes.items()},
+            "input_rate_dph": dict(self.input_rate_dph),
+            "housing_noise_c": self.housing_noise_c,
+        }
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> MultiAxisUnit:
+        """Inverse of :meth:`to_dict`."""
+        return cls(
+            name=str(data["name"]),
+            description=str(data["description"]),
+            axes={str(a): Unit.from_dict(g) for a, g in data["axes"].items()},
+            input_rate_dph=dict(data.get("input_rate_dph") or {}),
+            housing_noise_c=float(data.get("housing_noise_c", 0.01)),
+        )
+
+    def summary(self) -> str:
+        """The unit's parameters as text, axis by axis."""
+        lines = [f"unit {self.name}: {self.description}"]
+        for axis, gyro in self.axes.items():
+            lines.append(f"axis {axis} (input {self.input_rate_dph[axis]:g} °/h):")
+            lines += ["  " + line for line in gyro.summary().splitlines()]
+        return "\n".join(lines)
+
+
+def unit_from_dict(data: Mapping[str, Any]) -> Unit | MultiAxisUnit:
+    """A :class:`Unit` or :class:`MultiAxisUnit` from its ``to_dict`` form."""
+    return MultiAxisUnit.from_dict(data) if "axes" in data else Unit.from_dict(data)
 
 
 def _paper_unit() -> Unit:
@@ -173,9 +337,61 @@ def _unit_b() -> Unit:
     )
 
 
-_FACTORIES: dict[str, Callable[[], Unit]] = {
+def _imu3() -> MultiAxisUnit:
+    housing_s = 600.0
+    latitude = math.radians(40.0)
+    x = Unit(
+        name="imu-3:x",
+        description="Eq. (18) frequency law of [1] (~4.4 kHz), fastest resonator",
+        thermal=ThermalNetwork(tau_housing_s=housing_s, tau_resonator_s=2000.0),
+        frequency_law=table1_frequency_law(),
+        bias_law=BiasLaw(-1.2, 20.0, (0.12, -2.0e-3, 0.0), gradient_dph_per_c=0.10),
+        gyro_noise=GyroNoise(0.02, 0.2, 0.08),
+        frequency_noise_hz=2.0e-3,
+        housing_noise_c=0.01,
+        scale_factor_law=ScaleFactorLaw((150.0, 6.0, 0.02), reference_c=20.0),
+    )
+    y = Unit(
+        name="imu-3:y",
+        description="shell r 13 mm, h 0.75 mm (~5.7 kHz, shell model)",
+        thermal=ThermalNetwork(tau_housing_s=housing_s, tau_resonator_s=2700.0),
+        frequency_law=ShellFrequencyLaw(Shell(13.0e-3, 0.75e-3, FUSED_QUARTZ)),
+        bias_law=BiasLaw(2.5, 25.0, (-0.09, 1.5e-3, 1.0e-5), gradient_dph_per_c=-0.18,
+                         gradient_temperature_dph_per_c2=2.0e-3),
+        gyro_noise=GyroNoise(0.015, 0.15, 0.06),
+        frequency_noise_hz=1.5e-3,
+        housing_noise_c=0.01,
+        scale_factor_law=ScaleFactorLaw((-80.0, -4.5, 0.035, 2.0e-4), reference_c=25.0),
+    )
+    z = Unit(
+        name="imu-3:z",
+        description="shell r 11 mm, h 0.8 mm (~8.5 kHz, shell model), slowest resonator",
+        thermal=ThermalNetwork(tau_housing_s=housing_s, tau_resonator_s=3400.0),
+        frequency_law=ShellFrequencyLaw(Shell(11.0e-3, 0.8e-3, FUSED_QUARTZ)),
+        bias_law=BiasLaw(0.6, 20.0, (0.2, 1.0e-3, -1.5e-5), gradient_dph_per_c=0.22),
+        gyro_noise=GyroNoise(0.025, 0.25, 0.1),
+        frequency_noise_hz=3.0e-3,
+        housing_noise_c=0.01,
+        scale_factor_law=ScaleFactorLaw((40.0, 7.5, -0.03), reference_c=20.0),
+    )
+    return MultiAxisUnit(
+        name="imu-3",
+        description="three resonators (x ~4.4 kHz, y ~5.7 kHz, z ~8.5 kHz) in one housing, "
+        "each with its own bias, scale factor and lag; level at 40° N, x north, z up",
+        axes={"x": x, "y": y, "z": z},
+        input_rate_dph={
+            "x": EARTH_RATE_DPH * math.cos(latitude),
+            "y": 0.0,
+            "z": EARTH_RATE_DPH * math.sin(latitude),
+        },
+        housing_noise_c=0.01,
+    )
+
+
+_FACTORIES: dict[str, Callable[[], Unit | MultiAxisUnit]] = {
     "paper-unit": _paper_unit,
     "unit-b": _unit_b,
+    "imu-3": _imu3,
 }
 
 
@@ -185,8 +401,8 @@ def names() -> list[str]:
 
 
 @cache
-def get(name: str = DEFAULT_UNIT) -> Unit:
-    """The named unit.
+def get(name: str = DEFAULT_UNIT) -> Unit | MultiAxisUnit:
+    """The named unit (a :class:`MultiAxisUnit` for ``imu-3``).
 
     Raises
     ------

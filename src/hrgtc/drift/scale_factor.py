@@ -1,0 +1,490 @@
+"""Scale factor against temperature: k(f) from rate-table segments.
+
+The gyro's output at input rate Ω is rate = b + (1 + k)·Ω, with b the bias and
+k the scale-factor error; both change with temperature. Wang et al. [1] model
+the bias from the resonator frequency f (Eq. 21-22); here k is modelled the same
+way, as a polynomial in the same scaled variable
+x_f = (freq_hz - f_ref) / scale_f of the drift model (its ``FeatureSettings``),
+so one evaluation of x_f serves both, and its terms are selected by the same
+stepwise regression (Section 4.1 of [1]).
+
+Fitting takes :class:`~hrgtc.drift.rate_segments.RateSegment` holds (rate-table
+segments, :func:`~hrgtc.drift.rate_segments.find_rate_segments`) and
+
+1. groups them by temperature: segments whose mean frequencies lie within
+   ``tolerance_hz`` of each other, in frequency order, form one group;
+2. fits each group by least squares, rate - Ω = b + k·Ω over its segments (b a
+   nuisance), giving k in ppm with its standard error;
+3. selects and fits k_ppm(x_f) by stepwise regression on the groups, weighted by
+   1/se² when every group has a finite, positive standard error.
+
+Compensation applies bias and scale factor together:
+rate_comp = (rate - bias(f, df)) / (1 + ppm(f)·1e-6).
+
+[1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+import numpy as np
+
+from hrgtc.drift.features import (
+    FeatureSettings,
+    Term,
+    linear_combination,
+    parse_terms,
+    tangent_extension,
+)
+from hrgtc.drift.rate_segments import RateSegment
+from hrgtc.drift.stepwise import Step, stepwise
+from hrgtc.errors import HrgtcWarning, InputError
+
+__all__ = [
+    "SCALE_FACTOR_JSON_SCHEMA",
+    "ScaleFactorModel",
+    "ScaleGroup",
+    "fit_scale_factor",
+    "group_segments",
+]
+
+#: Default candidate terms of k(f).
+SCALE_TERMS = ("f", "f^2", "f^3")
+#: Default grouping tolerance as a share of the drift model's frequency scale.
+TOLERANCE_SHARE = 0.02
+
+
+def _nullable(value: float) -> float | None:
+    return value if math.isfinite(value) else None
+
+
+def _float(value: Any) -> float:
+    return math.nan if value is None else float(value)
+
+
+@dataclass(frozen=True)
+class ScaleGroup:
+    """Segments at one temperature and their scale-factor error.
+
+    Attributes
+    ----------
+    freq_hz
+        Mean of the segments' mean frequencies. [Hz]
+    k_ppm, k_se_ppm
+        Scale-factor error of the group's fit rate - Ω = b + k·Ω, and its standard
+        error (NaN with two segments). [ppm]
+    bias_dph
+        The group's b. [°/h]
+    n
+        Number of segments.
+    rows
+        Number of samples in the segments.
+    """
+
+    freq_hz: float
+    k_ppm: float
+    k_se_ppm: float
+    bias_dph: float
+    n: int
+    rows: int
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain-JSON form (a NaN standard error becomes null)."""
+        out = asdict(self)
+        out["k_se_ppm"] = _nullable(self.k_se_ppm)
+        return out
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> ScaleGroup:
+        return cls(freq_hz=float(data["freq_hz"]), k_ppm=float(data["k_ppm"]),
+                   k_se_ppm=_float(data["k_se_ppm"]), bias_dph=float(data["bias_dph"]),
+                   n=int(data["n"]), rows=int(data["rows"]))
+
+
+@dataclass(frozen=True, eq=False)
+class ScaleFactorModel:
+    """A fitted scale-factor error k_ppm = c0 + sum c_i term_i(f).
+
+    Attributes
+    ----------
+    reference_hz, scale_hz
+        f_ref and scale_f of x_f = (freq_hz - f_ref)/scale_f (the drift model's). [Hz]
+    candidates, selected
+        Candidate terms and those kept by the stepwise selection (in candidate order).
+    intercept_ppm
+        c0: k at f_ref. [ppm]
+    coefficients_ppm
+        Term name -> coefficient in user units. [ppm per Hz^p]
+    standard_errors_ppm, pvalues
+        Term name -> standard error (user units) and p-value; intercept under ``"const"``.
+    scaled_coefficients
+        Coefficients on x_f, in ``selected`` order (what :meth:`ppm` uses). [ppm]
+    covariance
+        Covariance of (intercept, scaled coefficients). [ppm²]
+    freq_range_hz
+        Range of the segments' mean frequencies. [Hz]
+    input_rate_range_dph
+        Range of |input rate| of the segments. [°/h]
+    residual_ppm
+        Root mean square of k_ppm(group) - ppm(group frequency) over the groups. [ppm]
+    groups
+        The temperature groups, in frequency order.
+    history
+        Steps of the stepwise selection.
+    weighted
+        Whether the groups were weighted by 1/se².
+    penter, premove
+        Stepwise thresholds used.
+    """
+
+    reference_hz: float
+    scale_hz: float
+    candidates: tuple[str, ...]
+    selected: tuple[str, ...]
+    intercept_ppm: float
+    coefficients_ppm: dict[str, float]
+    standard_errors_ppm: dict[str, float]
+    pvalues: dict[str, float]
+    scaled_coefficients: tuple[float, ...]
+    covariance: tuple[tuple[float, ...], ...]
+    freq_range_hz: tuple[float, float]
+    input_rate_range_dph: tuple[float, float]
+    residual_ppm: float
+    groups: tuple[ScaleGroup, ...]
+    history: tuple[Step, ...] = ()
+    weighted: bool = False
+    penter: float = 0.05
+    premove: float = 0.10
+    _terms: tuple[Term, ...] = field(default=(), repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "_terms", parse_terms(self.selected) if self.selected else ())
+
+    @property
+    def terms(self) -> tuple[Term, ...]:
+        """The selected terms, parsed."""
+        return self._terms
+
+    def _args(self, freq_hz: Any) -> tuple[dict[str, np.ndarray], dict[str, float],
+                                           dict[str, tuple[float, float]]]:
+        f = np.atleast_1d(np.asarray(freq_hz, dtype=np.float64)) - self.reference_hz
+        ranges = {"f": (self.freq_range_hz[0] - self.reference_hz,
+                        self.freq_range_hz[1] - self.reference_hz)}
+        return {"f": f}, {"f": self.scale_hz}, ranges
+
+    def ppm(self, freq_hz: Any, extrapolation: str = "tangent") -> np.ndarray:
+        """Scale-factor error at resonator frequencies ``freq_hz`` [Hz]. [ppm]
+
+        Beyond the calibrated frequency range the polynomial is continued along
+        its tangent (``"tangent"``, default, as the drift model does), evaluated
+        anyway (``"polynomial"``) or held at the edge (``"clamp"``).
+        """
+        values, scales, ranges = self._args(freq_hz)
+        if not self._terms:
+            return np.full(values["f"].shape, self.intercept_ppm)
+        args = (self._terms, self.scaled_coefficients)
+        if extrapolation == "tangent":
+            return tangent_extension(*args, values, scales, ranges, self.intercept_ppm)
+        if extrapolation == "clamp":
+            values = {"f": np.clip(values["f"], *ranges["f"])}
+        elif extrapolation != "polynomial":
+            raise InputError(f"extrapolation must be 'tangent', 'polynomial' or 'clamp', "
+                             f"got {extrapolation!r}")
+        return linear_combination(*args, values, scales, self.intercept_ppm)
+
+    def ppm_std(self, freq_hz: Any) -> np.ndarray:
+        """1σ uncertainty of :meth:`ppm` from the coefficients' covariance. [ppm]"""
+        values, scales, ranges = self._args(freq_hz)
+        n = values["f"].size
+        columns = [np.ones(n)]
+        for k in range(len(self._terms)):
+            unit = np.zeros(len(self._terms))
+            unit[k] = 1.0
+            columns.append(tangent_extension(self._terms, unit, values, scales, ranges, 0.0))
+        jacobian = np.column_stack(columns)
+        cov = np.asarray(self.covariance, dtype=np.float64)
+        return np.sqrt(np.maximum(np.einsum("ij,jk,ik->i", jacobian, cov, jacobian), 0.0))
+
+    def equation(self) -> str:
+        """The model with numbers, e.g. ``k = 120 - 3.1·f + ...   [ppm; f in Hz]``."""
+        parts = [f"k = {self.intercept_ppm:.6g}"]
+        for name in self.selected:
+            value = self.coefficients_ppm[name]
+            parts.append(f" {'-' if value < 0 else '+'} {abs(value):.6g}·{name}")
+        return "".join(parts) + f"   [ppm; f = freq_hz - {self.reference_hz:.10g} Hz]"
+
+    def summary(self) -> str:
+        """Groups, coefficient table and fit quality as text."""
+        lines = [f"Scale-factor model: {len(self.selected)} of {len(self.candidates)} candidate "
+                 f"terms, {len(self.groups)} temperature groups"
+                 f"{' (weighted 1/se²)' if self.weighted else ''}",
+                 f"{'freq_hz':>16}{'k ppm':>12}{'se ppm':>10}{'bias °/h':>12}{'segments':>10}"]
+        for g in self.groups:
+            lines.append(f"{g.freq_hz:>16.10g}{g.k_ppm:>12.5g}{g.k_se_ppm:>10.3g}"
+                         f"{g.bias_dph:>12.5g}{g.n:>10d}")
+        lines.append(f"{'term':<10}{'coefficient':>16}{'std error':>14}{'p-value':>11}")
+        for name, value in (("const", self.intercept_ppm),
+                            *((n, self.coefficients_ppm[n]) for n in self.selected)):
+            lines.append(f"{name:<10}{value:>16.6g}{self.standard_errors_ppm[name]:>14.4g}"
+                         f"{self.pvalues[name]:>11.3g}")
+        lines.append(f"residual {self.residual_ppm:.4g} ppm rms over the groups; frequency "
+                     f"{self.freq_range_hz[0]:.10g} to {self.freq_range_hz[1]:.10g} Hz, |input| "
+                     f"up to {self.input_rate_range_dph[1] / 3600.0:.6g} °/s")
+        lines.append(self.equation())
+        return "\n".join(lines)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types (statistics that are not finite become null)."""
+        return {
+            "kind": "hrgtc.ScaleFactorModel",
+            "reference_hz": self.reference_hz,
+            "scale_hz": self.scale_hz,
+            "candidates": list(self.candidates),
+            "selected": list(self.selected),
+            "intercept_ppm": self.intercept_ppm,
+            "coefficients_ppm": dict(self.coefficients_ppm),
+            "standard_errors_ppm": {k: _nullable(v) for k, v in self.standard_errors_ppm.items()},
+            "pvalues": {k: _nullable(v) for k, v in self.pvalues.items()},
+            "scaled_coefficients": list(self.scaled_coefficients),
+            "covariance": [[_nullable(v) for v in row] for row in self.covariance],
+            "freq_range_hz": list(self.freq_range_hz),
+            "input_rate_range_dph": list(self.input_rate_range_dph),
+            "residual_ppm": _nullable(self.residual_ppm),
+            "groups": [g.to_dict() for g in self.groups],
+            "history": [{**s.to_dict(), "pvalue": _nullable(s.pvalue),
+                         "fstat": _nullable(s.fstat)} for s in self.history],
+            "weighted": self.weighted,
+            "penter": self.penter,
+            "premove": self.premove,
+        }
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> ScaleFactorModel:
+        """Inverse of :meth:`to_dict`."""
+        try:
+            return cls(
+                reference_hz=float(data["reference_hz"]),
+                scale_hz=float(data["scale_hz"]),
+                candidates=tuple(str(t) for t in data["candidates"]),
+                selected=tuple(str(t) for t in data["selected"]),
+                intercept_ppm=float(data["intercept_ppm"]),
+                coefficients_ppm={k: float(v) for k, v in data["coefficients_ppm"].items()},
+                standard_errors_ppm={k: _float(v) for k, v in data["standard_errors_ppm"].items()},
+                pvalues={k: _float(v) for k, v in data["pvalues"].items()},
+                scaled_coefficients=tuple(float(v) for v in data["scaled_coefficients"]),
+                covariance=tuple(tuple(_float(v) for v in row) for row in data["covariance"]),
+                freq_range_hz=(float(data["freq_range_hz"][0]), float(data["freq_range_hz"][1])),
+                input_rate_range_dph=(float(data["input_rate_range_dph"][0]),
+                                      float(data["input_rate_range_dph"][1])),
+                residual_ppm=_float(data["residual_ppm"]),
+                groups=tuple(ScaleGroup.from_dict(g) for g in data["groups"]),
+                history=tuple(Step(action=str(s["action"]), term=str(s["term"]),
+                                   fstat=_float(s["fstat"]), pvalue=_float(s["pvalue"]))
+                              for s in data.get("history", ())),
+                weighted=bool(data.get("weighted", False)),
+                penter=float(data.get("penter", 0.05)),
+                premove=float(data.get("premove", 0.10)),
+            )
+        except (KeyError, TypeError, ValueError, IndexError) as exc:
+            raise InputError(f"not a valid scale-factor record: {exc!r}") from exc
+
+
+def group_segments(segments: Sequence[RateSegment],
+                   tolerance_hz: float) -> tuple[tuple[RateSegment, ...], ...]:
+    """Segments grouped by temperature: sorted by mean frequency, a new group at each gap
+    wider than ``tolerance_hz`` [Hz] (single-linkage clustering). Groups in frequency order.
+
+    Examples
+    --------
+    >>> hold = lambda f: RateSegment(0.0, 1.0, 36000.0, 36000.0, f, 10)
+    >>> [len(g) for g in group_segments([hold(4420.0), hold(4432.1), hold(4420.05)], 0.1)]
+    [2, 1]
+    """
+    if not (math.isfinite(tolerance_hz) and tolerance_hz > 0):
+        raise InputError(f"tolerance_hz must be a positive number of Hz, got {tolerance_hz!r}")
+    ordered = sorted(segments, key=lambda s: (s.freq_hz, s.start_s))
+    groups: list[list[RateSegment]] = []
+    for seg in ordered:
+        if groups and seg.freq_hz - groups[-1][-1].freq_hz <= tolerance_hz:
+            groups[-1].append(seg)
+        else:
+            groups.append([seg])
+    return tuple(tuple(g) for g in groups)
+
+
+def _fit_group(group: Sequence[RateSegment], number: int) -> ScaleGroup:
+    """Least squares rate - Ω = b + k·Ω over one group's segments."""
+    freq = float(np.mean([s.freq_hz for s in group]))
+    x = np.array([s.input_rate_dph for s in group])
+    y = np.array([s.rate_dph for s in group]) - x
+    name = (f"temperature group {number} (mean frequency {freq:.10g} Hz, segments from "
+            f"{min(s.start_s for s in group):g} s)")
+    distinct = np.unique(x)
+    if distinct.size < 2:
+        raise InputError(f"{name} has {len(group)} segment(s) at one input rate "
+                         f"({distinct[0] / 3600.0:g} °/s); the scale factor needs at least two "
+                         "distinct input rates per temperature, ideally of both signs")
+    if not (np.any(x > 0) and np.any(x < 0)):
+        warnings.warn(f"{name} has input rates of one sign only; the scale factor then "
+                      "absorbs any asymmetry: turn the table both ways", HrgtcWarning,
+                      stacklevel=3)
+    xm, ym = float(np.mean(x)), float(np.mean(y))
+    dx = x - xm
+    sxx = float(dx @ dx)
+    slope = float(dx @ (y - ym)) / sxx
+    intercept = ym - slope * xm
+    resid = y - intercept - slope * x
+    dof = x.size - 2
+    se = math.sqrt(float(resid @ resid) / dof / sxx) if dof > 0 else math.nan
+    return ScaleGroup(freq_hz=freq, k_ppm=slope * 1e6, k_se_ppm=se * 1e6, bias_dph=intercept,
+                      n=len(group), rows=int(sum(s.rows for s in group)))
+
+
+def fit_scale_factor(segments: Iterable[RateSegment], settings: FeatureSettings,
+                     terms: Iterable[str] = SCALE_TERMS, penter: float = 0.05,
+                     premove: float | None = None, *, tolerance_hz: float | None = None,
+                     weighted: bool = True) -> ScaleFactorModel:
+    """Fit the scale-factor error k_ppm(f) from rate-table segments at several temperatures.
+
+    Parameters
+    ----------
+    segments
+        Holds at known input rates (:func:`~hrgtc.drift.rate_segments.find_rate_segments`),
+        from one or more runs.
+    settings
+        The drift model's feature settings: f_ref (``reference_freq_hz``) and the
+        frequency scale (``scales["f"]``; default the largest |f| of the segments).
+    terms
+        Candidate terms in ``f`` (Eq. 21 grammar).
+    penter, premove
+        Stepwise thresholds (MATLAB ``stepwisefit`` semantics, Section 4.1 of [1]).
+    tolerance_hz
+        Largest frequency gap within one temperature group; default 2 % of the
+        frequency scale. [Hz]
+    weighted
+        Weight the groups by 1/se² of their k (when every se is finite and positive).
+
+    Returns
+    -------
+    ScaleFactorModel
+    """
+    segments = tuple(segments)
+    if not segments:
+        raise InputError("no rate-table segments given; find them with find_rate_segments")
+    candidates = parse_terms(list(terms))
+    foreign = [t.name for t in candidates if t.variables != ("f",)]
+    if foreign:
+        raise InputError(f"scale-factor terms may use only f, got {foreign}; "
+                         f"use terms like {list(SCALE_TERMS)}")
+    names = tuple(t.name for t in candidates)
+    reference = float(settings.reference_freq_hz)
+    f = np.array([s.freq_hz for s in segments]) - reference
+    scale = float(settings.scales.get("f", 0.0)) or float(np.max(np.abs(f))) or 1.0
+    tolerance = TOLERANCE_SHARE * scale if tolerance_hz is None else tolerance_hz
+    fits = []
+    for number, members in enumerate(group_segments(segments, tolerance), start=1):
+        fits.append(_fit_group(members, number))
+    groups = tuple(fits)
+    k = np.array([g.k_ppm for g in groups])
+    se = np.array([g.k_se_ppm for g in groups])
+    use_weights = bool(weighted and np.all(np.isfinite(se)) and np.all(se > 0))
+    w = 1.0 / se ** 2 if use_weights else np.ones(k.size)
+    x_f = (np.array([g.freq_hz for g in groups]) - reference) / scale
+    factors = {t.name: t.scale_factor({"f": scale}) for t in candidates}
+    history: tuple[Step, ...] = ()
+    premove = max(penter, 0.10) if premove is None else premove
+    if len(groups) >= 3:
+        design = np.column_stack([t.evaluate({"f": x_f}, {}) for t in candidates])
+        found = stepwise(design, k, names=names, penter=penter, premove=premove,
+                         weights=w if use_weights else None)
+        result = found.result
+        selected, history = found.selected, found.history
+        params, bse, pvalues = (np.asarray(result.params), np.asarray(result.bse),
+                                np.asarray(result.pvalues))
+        covariance = np.asarray(result.cov_params)
+    else:  # one or two temperatures: a constant k, the weighted mean of the groups
+        selected = ()
+        mean = float(np.sum(w * k) / np.sum(w))
+        if use_weights:
+            var = 1.0 / float(np.sum(w))
+        elif k.size > 1:
+            var = float(np.sum((k - mean) ** 2)) / (k.size - 1) / k.size
+        else:
+            var = float(se[0]) ** 2
+        params, bse, pvalues = np.array([mean]), np.array([math.sqrt(var)]), np.array([math.nan])
+        covariance = np.array([[var]])
+    chosen = [t for t in candidates if t.name in selected]
+    fitted = params[0] + sum((c * t.evaluate({"f": x_f}, {}) for c, t in
+                              zip(params[1:], chosen, strict=True)), np.zeros(k.size))
+    rates = np.abs([s.input_rate_dph for s in segments])
+    freqs = [s.freq_hz for s in segments]
+    return ScaleFactorModel(
+        reference_hz=reference, scale_hz=scale, candidates=names, selected=tuple(selected),
+        intercept_ppm=float(params[0]),
+        coefficients_ppm={n: float(params[j + 1] / factors[n]) for j, n in enumerate(selected)},
+        standard_errors_ppm={"const": float(bse[0]), **{
+            n: float(bse[j + 1] / factors[n]) for j, n in enumerate(selected)}},
+        pvalues={"const": float(pvalues[0]), **{
+            n: float(pvalues[j + 1]) for j, n in enumerate(selected)}},
+        scaled_coefficients=tuple(float(p) for p in params[1:]),
+        covariance=tuple(tuple(float(v) for v in row) for row in covariance),
+        freq_range_hz=(float(min(freqs)), float(max(freqs))),
+        input_rate_range_dph=(float(rates.min()), float(rates.max())),
+        residual_ppm=float(np.sqrt(np.mean((k - fitted) ** 2))),
+        groups=groups, history=tuple(history), weighted=use_weights,
+        penter=float(penter), premove=float(premove))
+
+
+_NUMBER = {"type": "number"}
+_STAT = {"type": ["number", "null"]}
+_PAIR = {"type": "array", "items": _NUMBER, "minItems": 2, "maxItems": 2}
+_TERM = {"type": "string", "pattern": r"^f(\^[0-9]+)?$"}
+
+#: JSON Schema (Draft 2020-12) of :meth:`ScaleFactorModel.to_dict`.
+SCALE_FACTOR_JSON_SCHEMA: dict[str, Any] = {
+    "$schema": "https://json-schema.org/draft/2020-12/schema",
+    "$id": "https://hrgtc.invalid/schema/scale-factor.json",
+    "title": "hrgtc scale-factor model",
+    "type": "object",
+    "required": ["reference_hz", "scale_hz", "candidates", "selected", "intercept_ppm",
+                 "coefficients_ppm", "standard_errors_ppm", "pvalues", "scaled_coefficients",
+                 "covariance", "freq_range_hz", "input_rate_range_dph", "residual_ppm",
+                 "groups"],
+    "properties": {
+        "kind": {"const": "hrgtc.ScaleFactorModel"},
+        "reference_hz": _NUMBER,
+        "scale_hz": {"type": "number", "exclusiveMinimum": 0},
+        "candidates": {"type": "array", "items": _TERM, "minItems": 1},
+        "selected": {"type": "array", "items": _TERM},
+        "intercept_ppm": _NUMBER,
+        "coefficients_ppm": {"type": "object", "additionalProperties": _NUMBER},
+        "standard_errors_ppm": {"type": "object", "additionalProperties": _STAT},
+        "pvalues": {"type": "object", "additionalProperties": _STAT},
+        "scaled_coefficients": {"type": "array", "items": _NUMBER},
+        "covariance": {"type": "array", "items": {"type": "array", "items": _STAT}},
+        "freq_range_hz": _PAIR,
+        "input_rate_range_dph": _PAIR,
+        "residual_ppm": _STAT,
+        "groups": {"type": "array", "minItems": 1, "items": {
+            "type": "object",
+            "required": ["freq_hz", "k_ppm", "k_se_ppm", "bias_dph", "n", "rows"],
+            "properties": {"freq_hz": _NUMBER, "k_ppm": _NUMBER, "k_se_ppm": _STAT,
+                           "bias_dph": _NUMBER, "n": {"type": "integer", "minimum": 2},
+                           "rows": {"type": "integer", "minimum": 1}},
+            "additionalProperties": False}},
+        "history": {"type": "array", "items": {
+            "type": "object", "required": ["action", "term", "fstat", "pvalue"],
+            "properties": {"action": {"enum": ["added", "removed"]}, "term": _TERM,
+                           "fstat": _STAT, "pvalue": _STAT},
+            "additionalProperties": False}},
+        "weighted": {"type": "boolean"},
+        "penter": {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1},
+        "premove": {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1},
+    },
+    "additionalProperties": False,
+}
