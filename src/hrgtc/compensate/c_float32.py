@@ -177,6 +177,32 @@ def mirror_bias(model: UnitModel, c: FloatConstants,
     return (c.intercept + total).astype(F32)
 
 
+def mirror_scale(model: UnitModel, f_hz: np.ndarray) -> np.ndarray:
+    """``<prefix>_scale_ppm()`` of the float build, from the centred frequency. [ppm]"""
+    sf = getattr(model, "scale_factor", None)
+    f = np.asarray(f_hz, dtype=F32)
+    offset = sf.reference_hz - model.drift.settings.reference_freq_hz
+    if offset:
+        f = f - F32(offset)
+    low = F32(sf.freq_range_hz[0] - sf.reference_hz)
+    high = F32(sf.freq_range_hz[1] - sf.reference_hz)
+    scale = F32(sf.scale_hz)
+    coefficients = np.asarray(sf.scaled_coefficients, dtype=np.float64).astype(F32)
+    held = np.where(f < low, low, np.where(f > high, high, f)).astype(F32)
+    x = {"f": held / scale}
+    k = np.full(f.shape, F32(sf.intercept_ppm), dtype=F32)
+    for j, term in enumerate(sf.terms):
+        k = k + coefficients[j] * _term(term, x)
+    if sf.terms:
+        gradient = np.zeros(f.shape, dtype=F32)
+        for j, term in enumerate(sf.terms):
+            multiplier, rest = term.derivative("f")
+            factor = coefficients[j] * F32(multiplier) / scale
+            gradient = gradient + (factor if rest is None else factor * _term(rest, x))
+        k = np.where((f < low) | (f > high), k + gradient * (f - held), k)
+    return k.astype(F32)
+
+
 def _horner(coefficients: np.ndarray, z: np.ndarray) -> np.ndarray:
     r = np.full(z.shape, coefficients[-1], dtype=F32)
     for k in range(coefficients.size - 2, -1, -1):
@@ -262,12 +288,15 @@ class FloatAccuracy:
         trained df/dt range (0 when the model has no df term). [°/h]
     grid_points
         Points of the bias grid.
+    scale_ppm
+        The scale-factor error k over the calibrated frequency range (0 without one). [ppm]
     """
 
     temperature_c: float
     bias_dph: float
     ramp_bias_dph: float
     grid_points: int
+    scale_ppm: float = 0.0
 
     @property
     def bound_c(self) -> float:
@@ -315,8 +344,15 @@ def float_accuracy(model: UnitModel, plan: CPlan, c: FloatConstants) -> FloatAcc
     b64 = drift.predict({v: values[v] for v in drift.variables} or values)
     b32 = mirror_bias(model, c, {v: x.astype(F32) for v, x in values.items()})
     bias_error = float(np.max(np.abs(b32.astype(np.float64) - b64)))
+    scale_error = 0.0
+    scale_factor = getattr(model, "scale_factor", None)
+    if scale_factor is not None:
+        k64 = scale_factor.ppm(freq)
+        k32 = mirror_scale(model, (freq - c.centre_hz).astype(F32))
+        scale_error = float(np.max(np.abs(k32.astype(np.float64) - k64)))
     return FloatAccuracy(temperature_c=temperature_error, bias_dph=bias_error,
-                         ramp_bias_dph=_ramp_error(model, plan, c), grid_points=n)
+                         ramp_bias_dph=_ramp_error(model, plan, c), grid_points=n,
+                         scale_ppm=scale_error)
 
 
 def _ramp_error(model: UnitModel, plan: CPlan, c: FloatConstants) -> float:
