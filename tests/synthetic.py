@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 from scipy import signal
 
+from hrgtc.drift.scale_factor import ScaleFactorModel
+from hrgtc.model import UnitModel
 from hrgtc.recording import Metadata, Recording
 from hrgtc.thermometry import fit
 
@@ -58,3 +62,31 @@ def with_heating_extra(run, per_hz_per_s=2000.0, tau_s=2600.0):
           * (run["chamber_c"] - run["resonator_c"]) / tau_s)
     extra = per_hz_per_s * np.maximum(df, 0.0)
     return run.with_columns(rate_dph=run.rate_dph + extra, bias_dph=run["bias_dph"] + extra)
+
+
+# -- a scale factor with known coefficients (for the firmware exports) -------------------
+def scale_factor(reference_hz: float) -> ScaleFactorModel:
+    """k = 150 - 12 x + 3 x^2 ppm, x = (freq - f_ref) / 8 Hz, fitted over -10..+30 degC."""
+    low, high = THERMOMETER.frequency(np.array([-10.0, 30.0]))
+    return ScaleFactorModel(
+        reference_hz=reference_hz, scale_hz=8.0, candidates=("f", "f^2", "f^3"),
+        selected=("f", "f^2"), intercept_ppm=150.0,
+        coefficients_ppm={"f": -12.0 / 8.0, "f^2": 3.0 / 64.0},
+        standard_errors_ppm={"const": 1.0, "f": 0.1, "f^2": 0.01},
+        pvalues={"const": 0.0, "f": 0.0, "f^2": 0.0}, scaled_coefficients=(-12.0, 3.0),
+        covariance=((1.0, 0.0, 0.0), (0.0, 0.01, 0.0), (0.0, 0.0, 0.0001)),
+        freq_range_hz=(float(low), float(high)), input_rate_range_dph=(3.6e4, 1.08e6),
+        residual_ppm=2.0, groups=())
+
+
+def with_scale_factor(model: UnitModel, sf: ScaleFactorModel) -> UnitModel:
+    """The model with a scale factor (UnitModel.scale_factor; a stand-in before it exists)."""
+    if "scale_factor" in {f.name for f in dataclasses.fields(UnitModel)}:
+        return dataclasses.replace(model, scale_factor=sf)
+
+    @dataclasses.dataclass(frozen=True)
+    class Scaled(UnitModel):
+        scale_factor: ScaleFactorModel | None = None
+
+    return Scaled(**{f.name: getattr(model, f.name) for f in dataclasses.fields(UnitModel)},
+                  scale_factor=sf)

@@ -8,7 +8,6 @@ compensation law ``rate_comp = (rate - B) / (1 + 1e-6 k)`` of the contract.
 
 from __future__ import annotations
 
-import dataclasses
 import shutil
 import subprocess
 from pathlib import Path
@@ -21,10 +20,9 @@ from hrgtc.compensate import Compensator
 from hrgtc.compensate.c_float32 import float_accuracy, float_constants, mirror_scale
 from hrgtc.compensate.c_plan import plan_for
 from hrgtc.compensate.export_c import export_c
-from hrgtc.drift.scale_factor import ScaleFactorModel
 from hrgtc.model import UnitModel
 
-from synthetic import THERMOMETER, ramp_run
+from synthetic import THERMOMETER, ramp_run, scale_factor, with_scale_factor
 
 COMPILER = shutil.which("gcc") or shutil.which("cc")
 needs_compiler = pytest.mark.skipif(COMPILER is None, reason="no C compiler on this system")
@@ -56,33 +54,6 @@ int main(int argc, char **argv)
     return UPFX_USES_SCALE_FACTOR == 1 ? 0 : 5;
 }
 """
-
-
-def scale_factor(reference_hz: float) -> ScaleFactorModel:
-    """k = 150 - 12 x + 3 x^2 ppm, x = (freq - f_ref) / 8 Hz, fitted over -10..+30 degC."""
-    low, high = THERMOMETER.frequency(np.array([-10.0, 30.0]))
-    return ScaleFactorModel(
-        reference_hz=reference_hz, scale_hz=8.0, candidates=("f", "f^2", "f^3"),
-        selected=("f", "f^2"), intercept_ppm=150.0,
-        coefficients_ppm={"f": -12.0 / 8.0, "f^2": 3.0 / 64.0},
-        standard_errors_ppm={"const": 1.0, "f": 0.1, "f^2": 0.01},
-        pvalues={"const": 0.0, "f": 0.0, "f^2": 0.0}, scaled_coefficients=(-12.0, 3.0),
-        covariance=((1.0, 0.0, 0.0), (0.0, 0.01, 0.0), (0.0, 0.0, 0.0001)),
-        freq_range_hz=(float(low), float(high)), input_rate_range_dph=(3.6e4, 1.08e6),
-        residual_ppm=2.0, groups=())
-
-
-def with_scale_factor(model: UnitModel, sf: ScaleFactorModel) -> UnitModel:
-    """The model with a scale factor (UnitModel.scale_factor; a stand-in before it exists)."""
-    if "scale_factor" in {f.name for f in dataclasses.fields(UnitModel)}:
-        return dataclasses.replace(model, scale_factor=sf)
-
-    @dataclasses.dataclass(frozen=True)
-    class Scaled(UnitModel):
-        scale_factor: ScaleFactorModel | None = None
-
-    return Scaled(**{f.name: getattr(model, f.name) for f in dataclasses.fields(UnitModel)},
-                  scale_factor=sf)
 
 
 @pytest.fixture(scope="module")

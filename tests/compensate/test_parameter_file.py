@@ -22,7 +22,7 @@ from hrgtc.compensate.export_c import export_c
 from hrgtc.errors import InputError, OutputExistsError
 from hrgtc.model import UnitModel
 
-from synthetic import THERMOMETER, ramp_run
+from synthetic import THERMOMETER, ramp_run, scale_factor, with_scale_factor
 
 
 def parse(text: str) -> dict[str, float | str]:
@@ -174,3 +174,45 @@ def test_parameter_thermometer_gives_table2(tmp_path):
         export_c(model, tmp_path, output_format="params")
     with pytest.raises(InputError, match="format 'json' is not one of c, params"):
         export_c(model, tmp_path, output_format="json")
+
+
+def scale_from(p, freq_hz):
+    """The header's step 5 with the scale factor: k(g), tangent beyond the range."""
+    g = freq_hz - p["sf_reference_hz"]
+    low = p["sf_range_low_hz"] - p["sf_reference_hz"]
+    high = p["sf_range_high_hz"] - p["sf_reference_hz"]
+    held = np.clip(g, low, high)
+    x = held / p["sf_scale_hz"]
+    k = np.full(g.shape, p["sf_intercept_ppm"])
+    gradient = np.zeros_like(g)
+    for j in range(1, int(p["sf_n_terms"]) + 1):
+        ((name, power),) = factors(p[f"sf_term_{j}"])
+        assert name == "f"
+        k = k + p[f"sf_coefficient_{j}"] * x**power
+        gradient = gradient + p[f"sf_coefficient_{j}"] * power * x ** (power - 1) / p[
+            "sf_scale_hz"]
+    return k + gradient * (g - held)
+
+
+def test_parameters_with_a_scale_factor(tmp_path):
+    fitted = drift.fit([ramp_run(seed=1)], THERMOMETER)
+    sf = scale_factor(fitted.settings.reference_freq_hz + 0.5)
+    model = with_scale_factor(UnitModel(thermometer=THERMOMETER, drift=fitted), sf)
+    (path,) = export_c(model, tmp_path, output_format="params")
+    p = parse(path.read_text())
+    assert p["uses_scale_factor"] == 1.0
+    recording = ramp_run(seed=7, start_c=25.0, end_c=-25.0, hours=3.0, input_rate_dph=3.6e5)
+    k = scale_from(p, recording.freq_hz)
+    np.testing.assert_allclose(k, sf.ppm(recording.freq_hz), rtol=1e-12, atol=1e-12 * 150)
+    values = {"f": recording.freq_hz - p["reference_freq_hz"]}
+    values["df"] = rate_of(values["f"], p)
+    bias = bias_from(p, values)
+    expected_bias = Compensator(model).process(recording)["bias_model_dph"]
+    np.testing.assert_allclose(bias, expected_bias, rtol=1e-12, atol=1e-12 * 100)
+    # the contract's law, from the library's own pieces
+    np.testing.assert_allclose((recording.rate_dph - bias) / (1 + 1e-6 * k),
+                               (recording.rate_dph - expected_bias) / (1 + 1e-6 * sf.ppm(
+                                   recording.freq_hz)), rtol=1e-12)
+    plain = parse(export_c(UnitModel(thermometer=THERMOMETER, drift=fitted), tmp_path / "plain",
+                           output_format="params")[0].read_text())
+    assert plain["uses_scale_factor"] == 0.0 and "sf_intercept_ppm" not in plain

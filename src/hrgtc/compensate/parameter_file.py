@@ -17,6 +17,8 @@ ranges, and the thermometer of Eq. (18) (its inverse gives Table 2).
 
 from __future__ import annotations
 
+from typing import Any
+
 from hrgtc.compensate.c_plan import CPlan
 from hrgtc.compensate.c_text import NEWTON_MAX_ITER
 from hrgtc.compensate.c_types import DOUBLE
@@ -53,6 +55,12 @@ def formula(key: str = "") -> list[str]:
         "     (algebraically, inside the ranges B = <{k}intercept_dph> + sum_k",
         "      <{k}coefficient_raw_k> * term_k(f, df, h, dh), Eq. (22) of [1])",
         "  5. rate_comp_dph = rate_dph - B                                          [deg/h]",
+        "     or, when <{k}uses_scale_factor> = 1, with the scale-factor error k [ppm]:",
+        "       g = freq_hz - <{k}sf_reference_hz>; c_g = g held in [<{k}sf_range_low_hz>,",
+        "       <{k}sf_range_high_hz>] - <{k}sf_reference_hz>; x = c_g / <{k}sf_scale_hz>;",
+        "       k = <{k}sf_intercept_ppm> + sum_k <{k}sf_coefficient_k> * x^(power of",
+        "       <{k}sf_term_k>), continued along its tangent beyond the range as B is;",
+        "       rate_comp_dph = (rate_dph - B) / (1 + 1e-6 * k)",
         "  6. resonator temperature: the T in [<{k}inverse_low_c>, <{k}inverse_high_c>] with",
         "       F(T) = freq_hz, F(T) = sum_j <{k}thermometer_coefficient_j> * z^j,",
         "       z = (T - <{k}thermometer_centre_c>) / <{k}thermometer_scale_c>        [Hz]",
@@ -129,6 +137,7 @@ def parameter_lines(model: UnitModel, plan: CPlan, key: str = "") -> list[str]:
         put(f"coefficient_raw_{k}", drift.coefficients[term.name],
             f"Coefficient of term {k} ({term.name}) on the raw variables, Eq. (22) form. "
             f"[deg/h per {term.unit}]".replace("·", " "))
+    _scale_factor_lines(model, put)
     put("thermometer_order", th.order, "Order of the thermometer polynomial F(T) (Eq. 18).")
     put("thermometer_centre_c", th.centre_c,
         "z = (T - thermometer_centre_c) / thermometer_scale_c. [degC]")
@@ -157,6 +166,31 @@ def parameter_lines(model: UnitModel, plan: CPlan, key: str = "") -> list[str]:
         "Stop Newton's iteration when a step changes T by at most this. [degC]")
     put("inverse_max_iterations", NEWTON_MAX_ITER, "Iteration cap of the inverse. [1]")
     return lines
+
+
+def _scale_factor_lines(model: UnitModel, put: Any) -> None:
+    """The scale factor's keys (``uses_scale_factor`` 0 and nothing else without one)."""
+    sf = getattr(model, "scale_factor", None)
+    put("uses_scale_factor", int(sf is not None),
+        "1 when rate_comp also corrects the scale factor: (rate - B) / (1 + 1e-6 k).")
+    if sf is None:
+        return
+    put("sf_reference_hz", sf.reference_hz,
+        "Reference of the scale factor's variable g = freq_hz - sf_reference_hz. [Hz]")
+    put("sf_scale_hz", sf.scale_hz, "Scale of g: x = g / sf_scale_hz. [Hz]")
+    put("sf_range_low_hz", sf.freq_range_hz[0],
+        "Frequency range of the rate-table runs, low end; k continues along its tangent "
+        "beyond. [Hz]")
+    put("sf_range_high_hz", sf.freq_range_hz[1], "High end of that range. [Hz]")
+    put("sf_intercept_ppm", sf.intercept_ppm, "k at freq_hz = sf_reference_hz. [ppm]")
+    put("sf_n_terms", len(sf.terms), "Number of terms of k(f).")
+    for j, (term, scaled) in enumerate(zip(sf.terms, sf.scaled_coefficients, strict=True),
+                                       start=1):
+        put(f"sf_term_{j}", term.name, f"Scale-factor term {j}: a power of f (= g).")
+        put(f"sf_coefficient_{j}", scaled,
+            f"Coefficient of scale-factor term {j} ({term.name}) on x. [ppm]")
+        put(f"sf_coefficient_raw_{j}", sf.coefficients_ppm[term.name],
+            f"Coefficient of term {j} ({term.name}) on g itself. [ppm per {term.unit}]")
 
 
 def parameter_text(model: UnitModel, plan: CPlan, origin: str, sha256: str) -> str:
