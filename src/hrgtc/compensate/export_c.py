@@ -39,12 +39,13 @@ import json
 import os
 import re
 from pathlib import Path
+from typing import Any
 
 from hrgtc.compensate import c_single
 from hrgtc.compensate.c_float32 import float_accuracy, float_constants
 from hrgtc.compensate.c_plan import PRECISIONS, plan_for
-from hrgtc.compensate.c_text import header, source
-from hrgtc.compensate.parameter_file import parameter_text
+from hrgtc.compensate.c_text import _comment, header, source
+from hrgtc.compensate.parameter_file import instrument_parameter_text, parameter_text
 from hrgtc.errors import InputError
 from hrgtc.files import file_sha256, refuse_existing, write_text_atomic
 from hrgtc.model import UnitModel, load_model
@@ -56,7 +57,7 @@ _PREFIX = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,31}$")
 
 # -- public API ---------------------------------------------------------------------------
 def export_c(
-    model: UnitModel | str | os.PathLike[str],
+    model: Any,
     outdir: str | os.PathLike[str],
     prefix: str = "hrgtc",
     force: bool = False,
@@ -74,7 +75,8 @@ def export_c(
     Parameters
     ----------
     model
-        The unit's model, or the path of its model file (then the header
+        The unit's model (a :class:`UnitModel`, or an instrument's ``InstrumentModel``
+        with one model per axis), or the path of its model file (then the header
         records the file's SHA-256; for an in-memory model, the SHA-256 of the
         JSON document :func:`hrgtc.model.save_model` would write).
     outdir
@@ -98,6 +100,10 @@ def export_c(
     -------
     list of pathlib.Path
         The header and the source written (the parameter file for ``output_format="params"``).
+        For an instrument with named axes: ``<prefix>_model.h``, which includes every
+        axis's ``<prefix>_<axis>_model.h``, then each axis's header and source (every
+        name of axis a prefixed ``<prefix>_<a>``); its parameter file prefixes every key
+        with ``<axis>_``.
 
     Raises
     ------
@@ -122,36 +128,113 @@ def export_c(
     if precision not in PRECISIONS:
         raise InputError(f"precision {precision!r} is not one of {', '.join(PRECISIONS)}; "
                          "use 'double' (the default) or 'single' (float32 for FPU-only MCUs)")
-    if isinstance(model, UnitModel):
-        document = json.dumps(model.to_dict(), indent=2, allow_nan=True) + "\n"
-        sha256 = hashlib.sha256(document.encode("utf-8")).hexdigest()
-        origin = "in memory (SHA-256 of its JSON document as hrgtc writes it)"
-    else:
-        path = Path(model)
-        model = load_model(path)
-        sha256 = file_sha256(path)
-        origin = path.name
+    axes, origin, sha256 = _axes_of(model)
     folder = Path(outdir)
     if folder.exists() and not folder.is_dir():
         raise InputError(f"output folder {folder} is a file; give a folder for the C files")
+    single_axis = list(axes) == [""]
+    for name in axes:
+        if name and not _PREFIX.match(f"{prefix}_{name}"):
+            raise InputError(f"prefix {prefix!r} with axis {name!r} gives {prefix}_{name}, "
+                             "longer than 32 characters; use a shorter --prefix")
     if output_format == "params":
         target = folder / f"{prefix}_params.txt"
         refuse_existing((target,), force)
-        text = parameter_text(model, plan_for(model), origin, sha256)
+        plans = {name: plan_for(unit) for name, unit in axes.items()}
+        text = (parameter_text(axes[""], plans[""], origin, sha256) if single_axis else
+                instrument_parameter_text(axes, plans, origin, sha256))
         return [write_text_atomic(target, text, force=force)]
-    header_path = folder / f"{prefix}_model.h"
-    source_path = folder / f"{prefix}_model.c"
-    refuse_existing((header_path, source_path), force)
+    files: dict[Path, str] = {}
+    if single_axis:
+        files[folder / f"{prefix}_model.h"] = ""
+        files[folder / f"{prefix}_model.c"] = ""
+    else:
+        files[folder / f"{prefix}_model.h"] = ""
+        for name in axes:
+            files[folder / f"{prefix}_{name}_model.h"] = ""
+            files[folder / f"{prefix}_{name}_model.c"] = ""
+    refuse_existing(tuple(files), force)
+    if single_axis:
+        texts = _c_texts(axes[""], prefix, origin, sha256, precision)
+    else:
+        texts = (umbrella_header(axes, prefix, origin, sha256, precision),)
+        for name, unit in axes.items():
+            texts += _c_texts(unit, f"{prefix}_{name}", f"{origin}, axis {name}", sha256,
+                              precision)
+    return [write_text_atomic(path, text, force=force)
+            for path, text in zip(files, texts, strict=True)]
+
+
+def _axes_of(model: Any) -> tuple[dict[str, UnitModel], str, str]:
+    """Axis name -> model ('' for a single gyro), the model's origin and SHA-256."""
+    if isinstance(model, (str, os.PathLike)):
+        path = Path(model)
+        loaded: Any = _load(path)
+        origin, sha256 = path.name, file_sha256(path)
+    else:
+        loaded = model
+        document = json.dumps(model.to_dict(), indent=2, allow_nan=True) + "\n"
+        sha256 = hashlib.sha256(document.encode("utf-8")).hexdigest()
+        origin = "in memory (SHA-256 of its JSON document as hrgtc writes it)"
+    if isinstance(loaded, UnitModel):
+        return {"": loaded}, origin, sha256
+    axes = dict(loaded.axes)  # an InstrumentModel: one UnitModel per axis
+    return axes, origin, sha256
+
+
+def _load(path: Path) -> Any:
+    """A model file as an instrument (every axis) where hrgtc.model reads those."""
+    from hrgtc import model as model_module
+
+    load = getattr(model_module, "load_instrument", None)
+    return load_model(path) if load is None else load(path)
+
+
+def _c_texts(model: UnitModel, prefix: str, origin: str, sha256: str,
+             precision: str) -> tuple[str, str]:
+    """Header and source of one gyro (one axis)."""
     plan = plan_for(model, precision)
     if precision == "single":
         constants = float_constants(model, plan)
         accuracy = float_accuracy(model, plan, constants)
-        header_text = c_single.header(model, plan, prefix, origin, sha256, constants, accuracy)
-        code = c_single.source(model, plan, prefix, constants)
-    else:
-        header_text = header(model, plan, prefix, origin, sha256)
-        code = source(model, plan, prefix)
-    return [
-        write_text_atomic(header_path, header_text, force=force),
-        write_text_atomic(source_path, code, force=force),
-    ]
+        return (c_single.header(model, plan, prefix, origin, sha256, constants, accuracy),
+                c_single.source(model, plan, prefix, constants))
+    return header(model, plan, prefix, origin, sha256), source(model, plan, prefix)
+
+
+def umbrella_header(axes: dict[str, UnitModel], prefix: str, origin: str, sha256: str,
+                    precision: str) -> str:
+    """``<prefix>_model.h`` of an instrument: includes every axis's header."""
+    up = prefix.upper()
+    names = list(axes)
+    first = f"{prefix}_{names[0]}"
+    includes = "".join(f'#include "{prefix}_{name}_model.h"\n' for name in names)
+    argument = f"{first.upper()}_CENTRED_HZ(freq_hz)" if precision == "single" else "freq_hz"
+    return f"""/*
+ * {prefix}_model.h -- HRG compensation of every axis of instrument {_comment(origin)}
+ *
+ * Generated by hrgtc (hrgtc export-c); do not edit, regenerate from the model file.
+ * One axis, one prefix: axis <a> is compensated by {prefix}_<a>_step() with its own state,
+ * constants and files {prefix}_<a>_model.h / .c (each documented there: its model, units,
+ * {'float32 accuracy, ' if precision == 'single' else ''}use); this header includes them all.
+ * Axes: {", ".join(names)}.
+ *
+ * USAGE
+ *   #include "{prefix}_model.h"
+ *   static {first}_state gyro_{names[0]};
+ *   {first}_init(&gyro_{names[0]});
+ *   rate = {first}_step(&gyro_{names[0]}, {argument}, rate_dph, ..., &out);  // each sample
+ *   (and likewise for the other axes, each with its own frequency and rate)
+ *   Build: cc -std=c99 -O2 -c {" ".join(f"{prefix}_{n}_model.c" for n in names)}, link -lm.
+ *
+ * model SHA-256: {sha256}
+ */
+#ifndef {up}_MODEL_H
+#define {up}_MODEL_H
+
+/* Number of axes. */
+#define {up}_N_AXES {len(names)}
+
+{includes}
+#endif /* {up}_MODEL_H */
+"""
