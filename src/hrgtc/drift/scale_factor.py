@@ -399,6 +399,16 @@ def fit_scale_factor(segments: Iterable[RateSegment], settings: FeatureSettings,
     history: tuple[Step, ...] = ()
     premove = max(penter, 0.10) if premove is None else premove
     if len(groups) >= 3:
+        # n groups fit the constant and at most n - 2 terms with a residual left over: the
+        # lowest powers first (a cubic needs five temperatures).
+        usable = sorted(candidates, key=lambda t: sum(p for _, p in t.powers))[:len(groups) - 2]
+        if len(usable) < len(candidates):
+            dropped = [t.name for t in candidates if t not in usable]
+            warnings.warn(f"{len(groups)} rate-table temperatures cannot select among "
+                          f"{len(candidates)} scale-factor terms: {', '.join(dropped)} left out "
+                          "(add temperatures)", HrgtcWarning, stacklevel=2)
+            candidates = [t for t in candidates if t in usable]
+            names = tuple(t.name for t in candidates)
         design = np.column_stack([t.evaluate({"f": x_f}, {}) for t in candidates])
         found = stepwise(design, k, names=names, penter=penter, premove=premove,
                          weights=w if use_weights else None)
