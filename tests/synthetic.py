@@ -7,7 +7,7 @@ import dataclasses
 import numpy as np
 from scipy import signal
 
-from hrgtc.drift.scale_factor import ScaleFactorModel
+from hrgtc.drift.scale_factor import ScaleFactorModel, ScaleGroup
 from hrgtc.model import UnitModel
 from hrgtc.recording import Metadata, Recording
 from hrgtc.thermometry import fit
@@ -76,17 +76,12 @@ def scale_factor(reference_hz: float) -> ScaleFactorModel:
         pvalues={"const": 0.0, "f": 0.0, "f^2": 0.0}, scaled_coefficients=(-12.0, 3.0),
         covariance=((1.0, 0.0, 0.0), (0.0, 0.01, 0.0), (0.0, 0.0, 0.0001)),
         freq_range_hz=(float(low), float(high)), input_rate_range_dph=(3.6e4, 1.08e6),
-        residual_ppm=2.0, groups=())
+        residual_ppm=2.0,
+        groups=tuple(ScaleGroup(freq_hz=float(f), k_ppm=150.0, k_se_ppm=1.0, bias_dph=0.0, n=4,
+                                rows=4000)
+                     for f in THERMOMETER.frequency(np.array([-10.0, 10.0, 30.0]))))
 
 
 def with_scale_factor(model: UnitModel, sf: ScaleFactorModel) -> UnitModel:
-    """The model with a scale factor (UnitModel.scale_factor; a stand-in before it exists)."""
-    if "scale_factor" in {f.name for f in dataclasses.fields(UnitModel)}:
-        return dataclasses.replace(model, scale_factor=sf)
-
-    @dataclasses.dataclass(frozen=True)
-    class Scaled(UnitModel):
-        scale_factor: ScaleFactorModel | None = None
-
-    return Scaled(**{f.name: getattr(model, f.name) for f in dataclasses.fields(UnitModel)},
-                  scale_factor=sf)
+    """The model with a scale factor."""
+    return dataclasses.replace(model, scale_factor=sf)

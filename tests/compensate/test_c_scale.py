@@ -90,10 +90,12 @@ def test_double_build_divides_by_the_scale_factor(model, tmp_path):
     beyond = (recording.freq_hz < low) | (recording.freq_hz > high)
     assert 0.05 < beyond.mean() < 0.95  # the tangent continuation is exercised
     np.testing.assert_allclose(out[:, 2], k, rtol=0, atol=1e-9)
-    bias = Compensator(model).process(recording)["bias_model_dph"]
+    compensated = Compensator(model).process(recording)
+    bias = compensated["bias_model_dph"]
     np.testing.assert_allclose(out[:, 1], bias, rtol=0, atol=1e-9)
     expected = (recording.rate_dph - bias) / (1.0 + 1e-6 * k)
     np.testing.assert_allclose(out[:, 0], expected, rtol=1e-14, atol=1e-9)
+    np.testing.assert_allclose(out[:, 0], compensated["rate_comp_dph"], rtol=1e-14, atol=1e-9)
     # the correction is real: at 100 deg/s input, 150 ppm is 54 deg/h
     assert np.max(np.abs(out[:, 0] - (recording.rate_dph - bias))) > 30.0
     header = (tmp_path / "sfx_model.h").read_text()

@@ -8,20 +8,18 @@ contract's law ``(rate - B) / (1 + 1e-6 k)`` where the axis has a scale factor).
 
 from __future__ import annotations
 
-import dataclasses
+import hashlib
 import shutil
 import subprocess
-from typing import Any
 
 import numpy as np
 import pytest
 
-import hrgtc.model
 from hrgtc import drift
 from hrgtc.compensate import Compensator
 from hrgtc.compensate.export_c import export_c
 from hrgtc.errors import InputError
-from hrgtc.model import UnitModel
+from hrgtc.model import InstrumentModel, UnitModel, save_instrument
 
 from synthetic import THERMOMETER, ramp_run, scale_factor, with_scale_factor
 
@@ -57,23 +55,6 @@ int main(int argc, char **argv)
 """
 
 
-@dataclasses.dataclass(frozen=True)
-class StandIn:
-    """An instrument as the contract describes InstrumentModel (used until it exists)."""
-
-    axes: dict[str, Any]
-    unit: str = "imu"
-    provenance: dict[str, Any] = dataclasses.field(default_factory=dict)
-
-    def to_dict(self) -> dict[str, Any]:
-        return {"axes": {name: m.to_dict() for name, m in self.axes.items()}}
-
-
-def instrument(axes: dict[str, UnitModel]) -> Any:
-    real = getattr(hrgtc.model, "InstrumentModel", None)
-    return StandIn(axes) if real is None else real(axes, "imu", {})
-
-
 @pytest.fixture(scope="module")
 def imu():
     models = {}
@@ -83,7 +64,7 @@ def imu():
         models[name] = UnitModel(thermometer=THERMOMETER, drift=fitted, unit="imu")
     models["y"] = with_scale_factor(models["y"],
                                     scale_factor(models["y"].drift.settings.reference_freq_hz))
-    return instrument(models)
+    return InstrumentModel(models, "imu", {})
 
 
 def runs():
@@ -93,10 +74,14 @@ def runs():
 
 
 def expected_rate(model, recording):
-    bias = Compensator(model).process(recording)["bias_model_dph"]
-    sf = getattr(model, "scale_factor", None)
+    """The axis's Compensator, which is the contract's (rate - B) / (1 + 1e-6 k)."""
+    out = Compensator(model).process(recording)
+    sf = model.scale_factor
     k = 0.0 if sf is None else sf.ppm(recording.freq_hz)
-    return (recording.rate_dph - bias) / (1.0 + 1e-6 * k)
+    np.testing.assert_allclose(out["rate_comp_dph"],
+                               (recording.rate_dph - out["bias_model_dph"]) / (1.0 + 1e-6 * k),
+                               rtol=1e-15)
+    return out["rate_comp_dph"]
 
 
 @needs_compiler
@@ -157,3 +142,14 @@ def test_long_axis_prefix_is_refused(imu, tmp_path):
     with pytest.raises(InputError, match="longer than 32 characters"):
         export_c(imu, tmp_path, prefix="p" * 31)
     assert not any(tmp_path.iterdir())
+
+
+def test_from_the_instrument_file(imu, tmp_path):
+    path = save_instrument(imu, tmp_path / "imu.json")
+    files = export_c(path, tmp_path / "c", prefix="imu")
+    digest = hashlib.sha256(path.read_bytes()).hexdigest()
+    for name in AXES:
+        header = (tmp_path / "c" / f"imu_{name}_model.h").read_text()
+        assert f'#define IMU_{name.upper()}_MODEL_SHA256 "{digest}"' in header
+        assert f"imu.json, axis {name}" in header
+    assert files[0].name == "imu_model.h" and len(files) == 7

@@ -179,7 +179,8 @@ def mirror_bias(model: UnitModel, c: FloatConstants,
 
 def mirror_scale(model: UnitModel, f_hz: np.ndarray) -> np.ndarray:
     """``<prefix>_scale_ppm()`` of the float build, from the centred frequency. [ppm]"""
-    sf = getattr(model, "scale_factor", None)
+    sf = model.scale_factor
+    assert sf is not None
     f = np.asarray(f_hz, dtype=F32)
     offset = sf.reference_hz - model.drift.settings.reference_freq_hz
     if offset:
@@ -345,7 +346,7 @@ def float_accuracy(model: UnitModel, plan: CPlan, c: FloatConstants) -> FloatAcc
     b32 = mirror_bias(model, c, {v: x.astype(F32) for v, x in values.items()})
     bias_error = float(np.max(np.abs(b32.astype(np.float64) - b64)))
     scale_error = 0.0
-    scale_factor = getattr(model, "scale_factor", None)
+    scale_factor = model.scale_factor
     if scale_factor is not None:
         k64 = scale_factor.ppm(freq)
         k32 = mirror_scale(model, (freq - c.centre_hz).astype(F32))

@@ -11,23 +11,23 @@ so those files stay as they were.
 
 from __future__ import annotations
 
-from typing import Any
-
 from hrgtc.compensate.c_plan import CPlan
 from hrgtc.compensate.c_text import _array, _term_expression
 from hrgtc.compensate.c_types import CType, ctype
+from hrgtc.drift.scale_factor import ScaleFactorModel
 from hrgtc.model import UnitModel
 
 PIECES = ("define", "field", "prototype", "function", "declare", "apply", "out", "readme")
 
 
-def scale_factor_of(model: UnitModel) -> Any:
-    """The model's scale factor, or None (also for models from before scale factors)."""
-    return getattr(model, "scale_factor", None)
+def scale_factor_of(model: UnitModel) -> ScaleFactorModel | None:
+    """The model's scale factor, or None."""
+    return model.scale_factor
 
 
 def _function(model: UnitModel, prefix: str, t: CType) -> str:
     sf = scale_factor_of(model)
+    assert sf is not None
     real, lit = t.name, t.literal
     low = sf.freq_range_hz[0] - sf.reference_hz  # as ScaleFactorModel.ppm, in double
     high = sf.freq_range_hz[1] - sf.reference_hz
@@ -90,7 +90,7 @@ def scale_pieces(model: UnitModel, plan: CPlan, prefix: str) -> dict[str, str]:
     real, lit = t.name, t.literal
     up = prefix.upper()
     argument = "f_value" if t.suffix else "freq_hz"
-    sf = scale_factor_of(model)
+    sf = model.scale_factor
     return {
         "define": f"/* 1: {prefix}_step() also corrects the scale factor, "
                   "rate_comp = (rate - B) / (1 + 1e-6 k). */\n"

@@ -39,7 +39,6 @@ import json
 import os
 import re
 from pathlib import Path
-from typing import Any
 
 from hrgtc.compensate import c_single
 from hrgtc.compensate.c_float32 import float_accuracy, float_constants
@@ -48,7 +47,7 @@ from hrgtc.compensate.c_text import _comment, header, source
 from hrgtc.compensate.parameter_file import instrument_parameter_text, parameter_text
 from hrgtc.errors import InputError
 from hrgtc.files import file_sha256, refuse_existing, write_text_atomic
-from hrgtc.model import UnitModel, load_model
+from hrgtc.model import InstrumentModel, UnitModel, load_instrument
 
 #: What the export writes: C99 files, or the plain parameter file.
 FORMATS = ("c", "params")
@@ -57,7 +56,7 @@ _PREFIX = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,31}$")
 
 # -- public API ---------------------------------------------------------------------------
 def export_c(
-    model: Any,
+    model: UnitModel | InstrumentModel | str | os.PathLike[str],
     outdir: str | os.PathLike[str],
     prefix: str = "hrgtc",
     force: bool = False,
@@ -75,8 +74,8 @@ def export_c(
     Parameters
     ----------
     model
-        The unit's model (a :class:`UnitModel`, or an instrument's ``InstrumentModel``
-        with one model per axis), or the path of its model file (then the header
+        The unit's model (a :class:`UnitModel`, or an :class:`InstrumentModel` with one
+        model per axis), or the path of its model file (then the header
         records the file's SHA-256; for an in-memory model, the SHA-256 of the
         JSON document :func:`hrgtc.model.save_model` would write).
     outdir
@@ -165,29 +164,21 @@ def export_c(
             for path, text in zip(files, texts, strict=True)]
 
 
-def _axes_of(model: Any) -> tuple[dict[str, UnitModel], str, str]:
+def _axes_of(model: UnitModel | InstrumentModel | str | os.PathLike[str],
+             ) -> tuple[dict[str, UnitModel], str, str]:
     """Axis name -> model ('' for a single gyro), the model's origin and SHA-256."""
-    if isinstance(model, (str, os.PathLike)):
-        path = Path(model)
-        loaded: Any = _load(path)
-        origin, sha256 = path.name, file_sha256(path)
-    else:
-        loaded = model
+    if isinstance(model, (UnitModel, InstrumentModel)):
         document = json.dumps(model.to_dict(), indent=2, allow_nan=True) + "\n"
         sha256 = hashlib.sha256(document.encode("utf-8")).hexdigest()
         origin = "in memory (SHA-256 of its JSON document as hrgtc writes it)"
+        loaded = model
+    else:
+        path = Path(model)
+        loaded = load_instrument(path)
+        origin, sha256 = path.name, file_sha256(path)
     if isinstance(loaded, UnitModel):
         return {"": loaded}, origin, sha256
-    axes = dict(loaded.axes)  # an InstrumentModel: one UnitModel per axis
-    return axes, origin, sha256
-
-
-def _load(path: Path) -> Any:
-    """A model file as an instrument (every axis) where hrgtc.model reads those."""
-    from hrgtc import model as model_module
-
-    load = getattr(model_module, "load_instrument", None)
-    return load_model(path) if load is None else load(path)
+    return dict(loaded.axes), origin, sha256
 
 
 def _c_texts(model: UnitModel, prefix: str, origin: str, sha256: str,

@@ -170,7 +170,7 @@ def parameter_lines(model: UnitModel, plan: CPlan, key: str = "") -> list[str]:
 
 def _scale_factor_lines(model: UnitModel, put: Any) -> None:
     """The scale factor's keys (``uses_scale_factor`` 0 and nothing else without one)."""
-    sf = getattr(model, "scale_factor", None)
+    sf = model.scale_factor
     put("uses_scale_factor", int(sf is not None),
         "1 when rate_comp also corrects the scale factor: (rate - B) / (1 + 1e-6 k).")
     if sf is None:
