@@ -16,7 +16,7 @@ from typer.testing import CliRunner
 from hrgtc import drift
 from hrgtc.cli import app
 from hrgtc.compensate.export_c import export_c
-from hrgtc.model import UnitModel, save_model
+from hrgtc.model import InstrumentModel, UnitModel, save_instrument, save_model
 
 from synthetic import THERMOMETER, ramp_run
 
@@ -74,3 +74,20 @@ def test_bad_options_exit_2_and_say_why(options, message, model_file, tmp_path):
     assert result.exit_code == 2
     assert message in " ".join(result.output.split())
     assert not any(tmp_path.iterdir())
+
+
+def test_an_instrument_file_exports_every_axis(tmp_path):
+    fitted = drift.fit([ramp_run(seed=1)], THERMOMETER)
+    axes = {name: UnitModel(thermometer=THERMOMETER, drift=fitted, unit="imu") for name in "ab"}
+    path = save_instrument(InstrumentModel(axes, "imu", {}), tmp_path / "imu.json")
+    result = runner.invoke(app, ["export-c", str(path), "-o", str(tmp_path / "c"), "--json",
+                                 "--precision", "single"])
+    assert result.exit_code == 0, result.output
+    names = [Path(p).name for p in json.loads(result.stdout)["files"]]
+    assert names == ["hrgtc_model.h", "hrgtc_a_model.h", "hrgtc_a_model.c", "hrgtc_b_model.h",
+                     "hrgtc_b_model.c"]
+    params = runner.invoke(app, ["export-c", str(path), "-o", str(tmp_path / "p"),
+                                 "--format", "params"])
+    assert params.exit_code == 0, params.output
+    text = (tmp_path / "p" / "hrgtc_params.txt").read_text()
+    assert "\nn_axes = 2\n" in text and "\na_intercept_dph = " in text and "\nb_n_terms = " in text

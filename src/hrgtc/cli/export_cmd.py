@@ -28,7 +28,9 @@ class ExportFormat(StrEnum):
 
 @app.command("export-c")
 def export_c_command(
-    model: Path = typer.Argument(..., help="Model file written by 'hrgtc calibrate'."),
+    model: Path = typer.Argument(
+        ..., help="Model file written by 'hrgtc calibrate' (one gyro, or every axis of an "
+                  "instrument: then <prefix>_<axis>_model.h/.c per axis)."),
     output: Path = typer.Option(..., "-o", "--output", help="Folder for the files."),
     prefix: str = typer.Option(
         "hrgtc", "--prefix", help="C name prefix: <prefix>_model.h, <prefix>_step(), ..."
@@ -47,8 +49,9 @@ def export_c_command(
     json_output: JsonOption = False,
 ) -> None:
     """Write <prefix>_model.h and <prefix>_model.c: the causal df/dt filter, the drift model
-    of Eq. (22), the thermometer inverse and a streaming step() API (C99, math.h only);
-    or, with --format params, the same numbers as a documented parameter file.
+    of Eq. (22), the thermometer inverse, the scale factor when calibrated and a streaming
+    step() API (C99, math.h only); or, with --format params, the same numbers as a
+    documented parameter file. An instrument's file gives every axis, each its own prefix.
 
     Example: hrgtc export-c unit.json -o firmware/ --precision single
     """
