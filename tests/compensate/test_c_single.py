@@ -240,8 +240,9 @@ def test_float_build_streams_like_the_double_compensator(kind, models, tmp_path)
 
 
 def test_float_filter_is_the_double_filter():
-    # a ramp then a hold, sampled at 200 Hz with tau = 10 s (alpha = 5e-4): float32 keeps
-    # the rate to 1e-4 of its size where levels-form float32 would lose ~1e-2
+    # a ramp then a hold, sampled at 200 Hz with tau = 10 s (alpha = 5e-4): the float32
+    # filter (differences, compensated sums) keeps the rate to 5e-6 of its size; the two
+    # low-passed levels in float32 would lose ~1e-3 (2^-24 of f over alpha, each sample)
     fs, tau = 200.0, 10.0
     t = np.arange(0.0, 600.0, 1.0 / fs)
     f = -3.0 + np.minimum(t, 300.0) * -4e-3
@@ -257,8 +258,8 @@ def test_float_filter_is_the_double_filter():
     df32 = mirror_rate(constants, f.astype(F32))
     df64 = causal_rate(f, tau, fs)[0]
     ramp = (t > 150.0) & (t < 300.0)
-    np.testing.assert_allclose(df32[ramp], -4e-3, rtol=1e-4)
-    np.testing.assert_allclose(df32, df64, rtol=0, atol=4e-7)
+    np.testing.assert_allclose(df32[ramp], -4e-3, rtol=1e-5)
+    np.testing.assert_allclose(df32, df64, rtol=0, atol=2e-8)
 
 
 def test_float_thermometer_gives_table2(models):

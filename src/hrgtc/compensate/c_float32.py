@@ -9,7 +9,9 @@ model's variable (a few Hz, resolved to ~1e-7 Hz) and the thermometer is written
 about the same centre (its constant term ``a0 - f_ref`` is taken in double at
 export time). The df/dt filter keeps its state as differences (the first stage's
 lag ``f - y1`` and ``y1 - y2``), which are small and carry the rate, instead of the
-two low-passed levels, whose difference would cancel float32's digits; it is
+two low-passed levels, whose difference would cancel float32's digits; each is
+updated by a small increment, with compensated (Kahan) summation so that rounding
+does not accumulate over the filter's 1/alpha samples of memory. It is
 algebraically the filter of :func:`hrgtc.drift.features.causal_rate`.
 
 :func:`float_constants` rounds every constant once, so the C text
@@ -248,8 +250,8 @@ def mirror_temperature(c: FloatConstants, f_hz: np.ndarray, increasing: bool) ->
 def mirror_rate(c: FloatConstants, x: np.ndarray) -> np.ndarray:
     """The float build's causal rate of one signal (df/dt of f, or dh/dt), from rest. [/s]
 
-    Its ``rate_update()``: the sample's change added to the first stage's lag,
-    ``lag = s - alpha s``, ``u = difference + alpha s``, ``difference = u - alpha u``.
+    Its ``rate_update()``: the lag ``x - y1`` and the difference ``y1 - y2`` of the two
+    stages, each updated by its small increment with compensated (Kahan) summation.
     Runs along the last axis (rows of signals at once).
     """
     x = np.asarray(x, dtype=F32)
@@ -258,17 +260,24 @@ def mirror_rate(c: FloatConstants, x: np.ndarray) -> np.ndarray:
         return out
     previous = x[..., 0].copy()
     lag = np.zeros_like(previous)
+    lag_carry = np.zeros_like(previous)
     difference = np.zeros_like(previous)
+    difference_carry = np.zeros_like(previous)
     alpha, gain = c.alpha, c.gain
     for i in range(x.shape[-1]):
-        s = x[..., i] - previous
+        delta = x[..., i] - previous
         previous = x[..., i]
-        s = s + lag
+        s = lag + delta
         a = alpha * s
-        lag = s - a
-        a = difference + a
-        s = alpha * a
-        difference = a - s
+        increment = (delta - a) - lag_carry
+        total = lag + increment
+        lag_carry = (total - lag) - increment
+        lag = total
+        s = difference + a
+        increment = (a - alpha * s) - difference_carry
+        total = difference + increment
+        difference_carry = (total - difference) - increment
+        difference = total
         out[..., i] = difference * gain
     return out
 

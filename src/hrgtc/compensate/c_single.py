@@ -38,8 +38,8 @@ def _sections(model: UnitModel, plan: CPlan, prefix: str, accuracy: FloatAccurac
         f"the macro {up}_CENTRED_HZ(freq_hz) does it) or in the units of your frequency "
         "counter; a float freq_hz would already have lost 0.5 mHz (2 mdegC) to rounding. "
         "The thermometer polynomial is written about the same centre and the df/dt filter "
-        "keeps its state as the differences f - y1 and y1 - y2 (algebraically the same "
-        "filter; float32 keeps their digits).",
+        "keeps its state as the differences f - y1 and y1 - y2, updated with compensated "
+        "(Kahan) sums (algebraically the same filter; float32 keeps their digits).",
         "",
         "ACCURACY (float32 against hrgtc's double model, measured at export by evaluating "
         "this code's float32 operations in numpy)",
@@ -94,7 +94,9 @@ def header(model: UnitModel, plan: CPlan, prefix: str, origin: str, sha256: str,
     housing = plan.housing
     state_h = ("    float h_previous;           /* previous h [degC] */\n"
                "    float h_lag;                /* h - y1 of the first low-pass stage [degC] */\n"
+               "    float h_lag_carry;          /* what its float sums rounded off [degC] */\n"
                "    float h_difference;         /* y1 - y2 of the two stages [degC] */\n"
+               "    float h_difference_carry;   /* what its float sums rounded off [degC] */\n"
                if housing else "")
     out_h = ("    float h_c;                  /* housing temperature change h [degC] */\n"
              "    float dh_c_per_s;           /* its causal rate dh/dt [degC/s] */\n"
@@ -138,7 +140,9 @@ extern "C" {{
 typedef struct {p}_state {{
     float f_previous;           /* previous f [Hz] */
     float f_lag;                /* f - y1 of the first low-pass stage [Hz] */
+    float f_lag_carry;          /* what its float sums rounded off [Hz] */
     float f_difference;         /* y1 - y2 of the two stages [Hz] */
+    float f_difference_carry;   /* what its float sums rounded off [Hz] */
 {state_h}    int started;                /* 0 until the first sample after init/reset */
     unsigned long samples;      /* samples since init/reset */
     unsigned long out_of_range; /* of which outside the calibrated temperature */
@@ -210,15 +214,18 @@ def source(model: UnitModel, plan: CPlan, prefix: str, constants: FloatConstants
     h = {
         "constants": f"static const float REFERENCE_C = {lit(c.reference_c, 'reference_c')};\n",
         "start": "        state->h_previous = h_value;\n        state->h_lag = 0.0f;\n"
-                 "        state->h_difference = 0.0f;\n",
+                 "        state->h_lag_carry = 0.0f;\n        state->h_difference = 0.0f;\n"
+                 "        state->h_difference_carry = 0.0f;\n",
         "values": "    const float h_value = housing_c - REFERENCE_C;\n    float dh_value;\n",
         "rate": "    dh_value = rate_update(&state->h_previous, &state->h_lag, "
-                "&state->h_difference, h_value);\n",
+                "&state->h_lag_carry,\n                           &state->h_difference, "
+                "&state->h_difference_carry, h_value);\n",
         "out": "        out->h_c = h_value;\n        out->dh_c_per_s = dh_value;\n",
         "arg": ", float housing_c",
         "bias": ", h_value, dh_value",
         "reset": "    state->h_previous = 0.0f;\n    state->h_lag = 0.0f;\n"
-                 "    state->h_difference = 0.0f;\n",
+                 "    state->h_lag_carry = 0.0f;\n    state->h_difference = 0.0f;\n"
+                 "    state->h_difference_carry = 0.0f;\n",
     }
     if not plan.housing:
         h = dict.fromkeys(h, "")
@@ -238,18 +245,29 @@ def source(model: UnitModel, plan: CPlan, prefix: str, constants: FloatConstants
 static const float RATE_GAIN = {lit(c.gain, 'gain')};  /* alpha * fs / (1 - alpha) */
 
 /* One sample of two exact first-order lags y1, y2 of x, held as lag = x - y1 and
-   difference = y1 - y2; returns the rate (y1 - y2) * gain. */
-static float rate_update(float *previous, float *lag, float *difference, float x)
+   difference = y1 - y2; returns the rate (y1 - y2) * gain. Each is updated by a small
+   increment (a fraction alpha of itself); compensated (Kahan) summation keeps what the
+   float sum rounds off in a carry, so the state does not drift by rounding. */
+static float rate_update(float *previous, float *lag, float *lag_carry, float *difference,
+                         float *difference_carry, float x)
 {{
-    float s = x - *previous;
-    float a;
+    const float delta = x - *previous;
+    float s, a, product, increment, sum;
     *previous = x;
-    s = s + *lag;               /* x - y1 before this sample's update */
+    s = *lag + delta;           /* x - y1 before this sample's update */
     a = RATE_ALPHA * s;         /* the change of y1 */
-    *lag = s - a;
-    a = *difference + a;        /* y1 - y2 before y2's update */
-    s = RATE_ALPHA * a;         /* the change of y2 */
-    *difference = a - s;
+    increment = delta - a;      /* the change of x - y1 */
+    increment = increment - *lag_carry;
+    sum = *lag + increment;
+    *lag_carry = (sum - *lag) - increment;
+    *lag = sum;
+    s = *difference + a;        /* y1 - y2 before y2's update */
+    product = RATE_ALPHA * s;   /* the change of y2 */
+    increment = a - product;    /* the change of y1 - y2 */
+    increment = increment - *difference_carry;
+    sum = *difference + increment;
+    *difference_carry = (sum - *difference) - increment;
+    *difference = sum;
     return *difference * RATE_GAIN;
 }}
 
@@ -345,7 +363,9 @@ void {p}_reset({p}_state *state)
 {{
     state->f_previous = 0.0f;
     state->f_lag = 0.0f;
+    state->f_lag_carry = 0.0f;
     state->f_difference = 0.0f;
+    state->f_difference_carry = 0.0f;
 {h['reset']}    state->started = 0;
     state->samples = 0UL;
     state->out_of_range = 0UL;
@@ -365,10 +385,13 @@ float {p}_step({p}_state *state, float f_hz, float rate_dph{h['arg']}, {p}_outpu
     if (!state->started) {{  /* the filter starts at rest on the first sample */
         state->f_previous = f_value;
         state->f_lag = 0.0f;
+        state->f_lag_carry = 0.0f;
         state->f_difference = 0.0f;
+        state->f_difference_carry = 0.0f;
 {h['start']}        state->started = 1;
     }}
-    df_value = rate_update(&state->f_previous, &state->f_lag, &state->f_difference, f_value);
+    df_value = rate_update(&state->f_previous, &state->f_lag, &state->f_lag_carry,
+                           &state->f_difference, &state->f_difference_carry, f_value);
 {h['rate']}    bias = {p}_bias_dph(f_value, df_value{h['bias']});
     compensated = rate_dph - bias;
 {k['apply']}    temperature = {p}_temperature_c(f_value);
