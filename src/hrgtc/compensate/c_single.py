@@ -77,7 +77,8 @@ def _sections(model: UnitModel, plan: CPlan, prefix: str, accuracy: FloatAccurac
         "      if (!out.in_range) { flag_sample(); }  // outside the calibration",
         "  }",
         f"  Build: cc -std=c99 -O2 -c {p}_model.c (arm-none-eabi-gcc -mfpu=fpv4-sp-d16 "
-        "-mfloat-abi=hard for a Cortex-M4F), link with -lm. Do not use -ffast-math; with "
+        "-mfloat-abi=hard for a Cortex-M4F), link with -lm. Do not use -ffast-math (it "
+        "would undo the filter's compensated sums); with "
         "-ffp-contract=off (GCC's default under -std=c99) the code rounds exactly as the "
         "mirror that measured the figures above (fused multiply-add changes only last bits).",
         f"  The step signature: float {p}_step({p}_state *, float f_hz, float rate_dph, "
