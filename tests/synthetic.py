@@ -56,14 +56,6 @@ def block_std(x, rows):
     return float(np.std(x[: n * rows].reshape(n, rows).mean(axis=1), ddof=1))
 
 
-def with_heating_extra(run, per_hz_per_s=2000.0, tau_s=2600.0):
-    """A :func:`ramp_run` whose bias has an extra per_hz_per_s·df while heating (hysteresis)."""
-    df = (THERMOMETER.slope_hz_per_c(run["resonator_c"])
-          * (run["chamber_c"] - run["resonator_c"]) / tau_s)
-    extra = per_hz_per_s * np.maximum(df, 0.0)
-    return run.with_columns(rate_dph=run.rate_dph + extra, bias_dph=run["bias_dph"] + extra)
-
-
 # -- a scale factor with known coefficients (for the firmware exports) -------------------
 def scale_factor(reference_hz: float) -> ScaleFactorModel:
     """k = 150 - 12 x + 3 x^2 ppm, x = (freq - f_ref) / 8 Hz, fitted over -10..+30 degC."""
@@ -85,3 +77,12 @@ def scale_factor(reference_hz: float) -> ScaleFactorModel:
 def with_scale_factor(model: UnitModel, sf: ScaleFactorModel) -> UnitModel:
     """The model with a scale factor."""
     return dataclasses.replace(model, scale_factor=sf)
+
+
+def with_heating_extra(run, per_hz_per_s=2000.0, tau_s=2600.0):
+    """A :func:`ramp_run` whose bias has an extra per_hz_per_s·df while heating (hysteresis)."""
+    df = (THERMOMETER.slope_hz_per_c(run["resonator_c"])
+          * (run["chamber_c"] - run["resonator_c"]) / tau_s)
+    extra = per_hz_per_s * np.maximum(df, 0.0)
+    return run.with_columns(rate_dph=run.rate_dph + extra, bias_dph=run["bias_dph"] + extra)
+

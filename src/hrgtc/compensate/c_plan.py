@@ -66,6 +66,8 @@ class CPlan:
 
 #: The precisions the export writes.
 PRECISIONS = ("double", "single")
+#: The variables the float32 build computes (its filter and mirror know these).
+SINGLE_VARIABLES = ("f", "df", "h", "dh")
 
 
 def plan_for(model: UnitModel, precision: str = "double") -> CPlan:
@@ -94,6 +96,12 @@ def plan_for(model: UnitModel, precision: str = "double") -> CPlan:
         raise InputError(
             f"the drift model uses the heating/cooling switch dpos ({', '.join(drift.selected)}), "
             "which the C export does not compute; calibrate without dpos terms for on-board use"
+        )
+    beyond = sorted(used - set(SINGLE_VARIABLES))
+    if precision == "single" and beyond:
+        raise InputError(
+            f"the float32 export computes the variables {', '.join(SINGLE_VARIABLES)}; the "
+            f"drift model also uses {', '.join(beyond)}: export it with --precision double"
         )
     housing = bool(used & {"h", "dh"})
     # The compensator computes f and df (and h, dh when the terms use them); in_range checks

@@ -134,9 +134,9 @@ extern "C" {{
 #define {up}_SETTLE_ROWS {settle_rows(settings)}UL
 /* 1 when {p}_step() takes the housing temperature (the model uses h or dh terms). */
 #define {up}_USES_HOUSING {1 if housing else 0}
-{k['define']}/* SHA-256 of the model this code was generated from. */
+/* SHA-256 of the model this code was generated from. */
 #define {up}_MODEL_SHA256 "{sha256}"
-
+{k['define']}
 /* Filter state of one gyro; initialise with {p}_init(). */
 typedef struct {p}_state {{
     float f_previous;           /* previous f [Hz] */
@@ -381,9 +381,9 @@ void {p}_init({p}_state *state)
 float {p}_step({p}_state *state, float f_hz, float rate_dph{h['arg']}, {p}_output *out)
 {{
     const float f_value = f_hz;
-{h['values']}{k['declare']}    float df_value, bias, compensated, temperature;
+{h['values']}    float df_value, bias, compensated, temperature;
     int in_range, rate_in_range, level_in_range;
-    if (!state->started) {{  /* the filter starts at rest on the first sample */
+{k['declare']}    if (!state->started) {{  /* the filter starts at rest on the first sample */
         state->f_previous = f_value;
         state->f_lag = 0.0f;
         state->f_lag_carry = 0.0f;
@@ -395,7 +395,7 @@ float {p}_step({p}_state *state, float f_hz, float rate_dph{h['arg']}, {p}_outpu
                            &state->f_difference, &state->f_difference_carry, f_value);
 {h['rate']}    bias = {p}_bias_dph(f_value, df_value{h['bias']});
     compensated = rate_dph - bias;
-{k['apply']}    temperature = {p}_temperature_c(f_value);
+    temperature = {p}_temperature_c(f_value);
     level_in_range = {p}_frequency_in_range(f_value){checks(("f", "h"))};
     rate_in_range = 1{checks(("df", "dh"))};
     /* in_range: calibrated temperature, trained df/dt, and the filter settled */
@@ -403,7 +403,7 @@ float {p}_step({p}_state *state, float f_hz, float rate_dph{h['arg']}, {p}_outpu
     state->samples += 1UL;
     state->out_of_range += level_in_range ? 0UL : 1UL;
     state->rate_out_of_range += rate_in_range ? 0UL : 1UL;
-    if (out) {{
+{k['apply']}    if (out) {{
         out->rate_comp_dph = compensated;
         out->bias_model_dph = bias;
         out->resonator_c_est = temperature;

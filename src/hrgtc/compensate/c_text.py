@@ -219,9 +219,9 @@ extern "C" {{
 #define {up}_SETTLE_ROWS {settle}UL
 /* 1 when {p}_step() takes the housing temperature (the model uses h or dh terms). */
 #define {up}_USES_HOUSING {1 if housing else 0}
-{k['define']}/* SHA-256 of the model this code was generated from. */
+/* SHA-256 of the model this code was generated from. */
 #define {up}_MODEL_SHA256 "{sha256}"
-
+{k['define']}
 /* Filter state of one gyro; initialise with {p}_init(). */
 typedef struct {p}_state {{
     double f_y1;                /* first low-pass stage of f [Hz] */
@@ -277,12 +277,12 @@ int {p}_frequency_in_range(double freq_hz);
 def _bias_function(model: UnitModel, plan: CPlan, prefix: str) -> str:
     drift = model.drift
     housing = plan.housing
-    t = ctype(plan)
-    real, lit, zero = t.name, t.literal, t.literal(0.0, "zero")
     params = ["f_hz", "df_hz_per_s"] + (["h_c", "dh_c_per_s"] if housing else [])
     names = dict(zip(("f", "df", "h", "dh"), params, strict=False))
     used = [v for v in ("f", "df", "h", "dh") if v in drift.variables and drift.selected]
     body = []
+    t = ctype(plan)  # the C type: every declaration, literal and math call below
+    real, lit, zero = t.name, t.literal, t.literal(0.0, "zero")
     for v in names:
         if v not in used:
             body.append(f"    (void){names[v]};")
@@ -516,9 +516,9 @@ double {p}_step({p}_state *state, double freq_hz, double rate_dph{h['arg']}, \
 {p}_output *out)
 {{
     const double f_value = freq_hz - REFERENCE_FREQ_HZ;
-{h['values']}{k['declare']}    double df_value, bias, compensated, temperature;
+{h['values']}    double df_value, bias, compensated, temperature;
     int in_range, rate_in_range, level_in_range;
-    if (!state->started) {{  /* the filter starts at rest on the first sample */
+{k['declare']}    if (!state->started) {{  /* the filter starts at rest on the first sample */
         state->f_y1 = f_value;
         state->f_y2 = f_value;
 {h['start']}        state->started = 1;
@@ -526,7 +526,7 @@ double {p}_step({p}_state *state, double freq_hz, double rate_dph{h['arg']}, \
     df_value = rate_update(&state->f_y1, &state->f_y2, f_value);
 {h['rate']}    bias = {p}_bias_dph(f_value, df_value{h['bias']});
     compensated = rate_dph - bias;
-{k['apply']}    temperature = {p}_temperature_c(freq_hz);
+    temperature = {p}_temperature_c(freq_hz);
     level_in_range = {p}_frequency_in_range(freq_hz){checks(("f", "h"))};
     rate_in_range = 1{checks(("df", "dh"))};
     /* in_range: calibrated temperature, trained df/dt, and the filter settled */
@@ -534,7 +534,7 @@ double {p}_step({p}_state *state, double freq_hz, double rate_dph{h['arg']}, \
     state->samples += 1UL;
     state->out_of_range += level_in_range ? 0UL : 1UL;
     state->rate_out_of_range += rate_in_range ? 0UL : 1UL;
-    if (out) {{
+{k['apply']}    if (out) {{
         out->rate_comp_dph = compensated;
         out->bias_model_dph = bias;
         out->resonator_c_est = temperature;
