@@ -85,4 +85,3 @@ def with_heating_extra(run, per_hz_per_s=2000.0, tau_s=2600.0):
           * (run["chamber_c"] - run["resonator_c"]) / tau_s)
     extra = per_hz_per_s * np.maximum(df, 0.0)
     return run.with_columns(rate_dph=run.rate_dph + extra, bias_dph=run["bias_dph"] + extra)
-
