@@ -306,7 +306,7 @@ def _calibrate_sensor(soaks: Sequence[PathLike], drifts: Sequence[PathLike],
                 high = max(high, float(np.max(chunk.freq_hz)))
     thermometer = identity((low, high))
     heads = {str(path): options.head(path) for path in training}
-    model, housing = _fit_drift(training, heads, thermometer, options, progress, len(training),
+    model, housing = _fit_drift(training, heads, thermometer, options, progress, len(drifts),
                                 **fit)
     settings = {key: (list(v) if isinstance(v, tuple | list) else v)
                 for key, v in fit.items()}

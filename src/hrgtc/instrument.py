@@ -25,10 +25,12 @@ from hrgtc.compensate import InstrumentCompensator
 from hrgtc.drift import (
     ScaleFactorModel,
     find_rate_segments,
+    fit_group,
     fit_scale_factor,
+    group_segments,
     read_segment_table,
-    segment_scale_errors,
 )
+from hrgtc.drift.scale_factor import TOLERANCE_SHARE
 from hrgtc.errors import InputError
 from hrgtc.evaluation import Evaluation, evaluate
 from hrgtc.model import InstrumentModel, UnitModel, provenance
@@ -43,34 +45,36 @@ PathLike = str | os.PathLike[str]
 
 @dataclass(frozen=True)
 class ScaleFactorCheck:
-    """Scale-factor error of a rate-table run before and after compensation, one axis.
+    """Scale-factor error of a held-out rate-table run, one axis, before and after.
 
-    ``raw_ppm``: (rate − bias model) / input − 1 per segment (the bias removed, the
-    scale factor not); ``compensated_ppm``: the same of the fully compensated rate.
+    At each temperature (the run's holds grouped as in the fit), the least-squares slope
+    of rate − Ω against Ω over the holds (IEEE Std 1431: the bias, common to all holds
+    of a group, drops out): ``raw_ppm`` of the gyro's output, ``compensated_ppm`` of the
+    compensated output (bias and scale factor removed).
     """
 
     file: str
     axis: str
-    input_rate_dph: tuple[float, ...]
     freq_hz: tuple[float, ...]
+    holds: tuple[int, ...]
     raw_ppm: tuple[float, ...]
     compensated_ppm: tuple[float, ...]
 
     @property
     def raw_max_ppm(self) -> float:
-        """Largest |raw| error over the segments. [ppm]"""
+        """Largest |raw| error over the temperatures. [ppm]"""
         return float(np.max(np.abs(self.raw_ppm))) if self.raw_ppm else float("nan")
 
     @property
     def compensated_max_ppm(self) -> float:
-        """Largest |compensated| error over the segments. [ppm]"""
+        """Largest |compensated| error over the temperatures. [ppm]"""
         return (float(np.max(np.abs(self.compensated_ppm))) if self.compensated_ppm
                 else float("nan"))
 
     def to_dict(self) -> dict[str, Any]:
-        return {"file": self.file, "axis": self.axis,
-                "input_rate_dph": list(self.input_rate_dph), "freq_hz": list(self.freq_hz),
-                "raw_ppm": list(self.raw_ppm), "compensated_ppm": list(self.compensated_ppm),
+        return {"file": self.file, "axis": self.axis, "freq_hz": list(self.freq_hz),
+                "holds": list(self.holds), "raw_ppm": list(self.raw_ppm),
+                "compensated_ppm": list(self.compensated_ppm),
                 "raw_max_ppm": self.raw_max_ppm, "compensated_max_ppm": self.compensated_max_ppm}
 
 
@@ -228,22 +232,28 @@ def check_scale_factor(path: PathLike, model: InstrumentModel, options: ReadOpti
                        table: Any = None) -> tuple[ScaleFactorCheck, ...]:
     """Scale-factor error of a held-out rate-table run, each axis, before and after."""
     checks = []
-    compensator = InstrumentCompensator(model)
-    whole = options.read(path)
-    compensated = compensator.process(whole)
+    compensated = InstrumentCompensator(model).process(options.read(path))
     for axis, unit_model in model.axes.items():
-        if unit_model.scale_factor is None:
+        sf = unit_model.scale_factor
+        if sf is None:
             continue
         view = compensated if not axis else _view(compensated, axis)
         segments = steady_segments(view, find_rate_segments(view, table), unit_model)
-        moving = [s for s in segments if s.input_rate_dph != 0.0]  # as segment_scale_errors
-        raw = segment_scale_errors(view, view["bias_model_dph"], segments=segments).error_ppm
-        after = segment_scale_errors(view.with_columns(rate_dph=view["rate_comp_dph"]),
-                                     None, segments=segments).error_ppm
-        checks.append(ScaleFactorCheck(
-            str(path), axis, tuple(s.input_rate_dph for s in moving),
-            tuple(s.freq_hz for s in moving), tuple(float(v) for v in raw),
-            tuple(float(v) for v in after)))
+        scale = float(unit_model.drift.settings.scales.get("f", 0.0)) or 1.0
+        groups = group_segments(segments, TOLERANCE_SHARE * scale)
+        freq, holds, raw, after = [], [], [], []
+        comp = view["rate_comp_dph"]
+        for number, group in enumerate(groups, start=1):
+            if len({s.input_rate_dph for s in group}) < 2:
+                continue  # one rate at this temperature: no slope to check
+            freq.append(float(np.mean([s.freq_hz for s in group])))
+            holds.append(len(group))
+            raw.append(fit_group(group, number).k_ppm)
+            done = [dataclasses.replace(s, rate_dph=float(np.mean(
+                comp[s.first_row:s.first_row + s.rows]))) for s in group]
+            after.append(fit_group(done, number).k_ppm)
+        checks.append(ScaleFactorCheck(str(path), axis, tuple(freq), tuple(holds),
+                                       tuple(raw), tuple(after)))
     return tuple(checks)
 
 
@@ -276,7 +286,7 @@ def summary_rows(calibration: InstrumentCalibration) -> list[Mapping[str, Any]]:
             "raw_10s_dph": float(np.median(raw)) if raw else None,
             "compensated_10s_dph": float(np.median(comp)) if comp else None,
             "scale_terms": None if unit_model.scale_factor is None
-            else list(unit_model.scale_factor.terms),
+            else list(unit_model.scale_factor.selected),
             "scale_raw_max_ppm": max((c.raw_max_ppm for c in checks), default=None),
             "scale_residual_max_ppm": max((c.compensated_max_ppm for c in checks),
                                           default=None),

@@ -19,9 +19,13 @@ from hrgtc.compensate.compensator import (
     compensate_file,
 )
 from hrgtc.compensate.export_c import export_c
-from hrgtc.compensate.instrument import InstrumentCompensator, instrument_output_columns
+from hrgtc.compensate.instrument import (
+    InstrumentCompensator,
+    compensate_instrument_file,
+    instrument_output_columns,
+)
 
 __all__ = [
     "OUTPUT_COLUMNS",
     "CompensationSummary", "Compensator", "InstrumentCompensator", "compensate",
-    "compensate_file", "export_c", "instrument_output_columns"]
+    "compensate_file", "compensate_instrument_file", "export_c", "instrument_output_columns"]

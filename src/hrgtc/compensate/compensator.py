@@ -304,8 +304,15 @@ def compensate_file(
     chunk_rows: int = FILE_CHUNK_ROWS,
     drift: str = "frequency",
     progress: Progress | None = None,
+    compensator: Any = None,
 ) -> CompensationSummary:
     """Compensate a recording file into a new file, chunk by chunk (bounded memory).
+
+    ``compensator``: another streaming compensator with the interface of
+    :class:`Compensator` and a ``columns`` attribute (e.g. the
+    :class:`~hrgtc.compensate.instrument.InstrumentCompensator` of every axis, see
+    :func:`~hrgtc.compensate.instrument.compensate_instrument_file`); ``model`` then
+    only marks the output.
 
     The output is written atomically in the format of its suffix; it is never
     overwritten without ``force``. ``read_options`` says how to read ``source``
@@ -317,14 +324,19 @@ def compensate_file(
     one and starts its write-back to disk, so that the fsync before the atomic
     rename finds little left to wait for. At most three chunks are held at a time.
     """
-    options = with_model_band(read_options or rec_io.ReadOptions(), model)
-    compensator = Compensator(model, drift, gaps=options.gaps)
+    if compensator is None:
+        options = with_model_band(read_options or rec_io.ReadOptions(), model)
+        compensator = Compensator(model, drift, gaps=options.gaps)
+        added = output_columns(model)
+    else:
+        options = read_options or rec_io.ReadOptions()
+        added = compensator.columns
     refuse_compensated(source)
-    check_writable(output, estimated_output_bytes(source, output, len(OUTPUT_COLUMNS)))
+    check_writable(output, estimated_output_bytes(source, output, len(added)))
     chunks = options.chunks(source, rows=chunk_rows)
     try:
         first = next(chunks)
-        names = (*first.names, *OUTPUT_COLUMNS)
+        names = (*first.names, *added)
         total = rec_io.count_rows(source)
         metadata = compensated_metadata(first.metadata, model, drift)
         with rec_io.RecordingWriter(output, metadata, names, force=force) as writer, \

@@ -10,17 +10,26 @@ A single-axis model is the one-axis case: the plain single-axis columns, unchang
 
 from __future__ import annotations
 
+import os
 from typing import Any
 
 import numpy as np
 
-from hrgtc.compensate.compensator import Compensator, output_columns
+from hrgtc import recording as rec_io
+from hrgtc.compensate.compensator import (
+    CompensationSummary,
+    Compensator,
+    compensate_file,
+    output_columns,
+    plausible_frequency_band,
+)
 from hrgtc.compensate.ranges import RangeReport
 from hrgtc.errors import RecordingError
 from hrgtc.model import InstrumentModel, UnitModel, axis_suffix
 from hrgtc.recording import Recording, axis_names, axis_view
 
-__all__ = ["InstrumentCompensator", "instrument_output_columns"]
+__all__ = ["InstrumentCompensator", "compensate_instrument_file",
+           "instrument_output_columns"]
 
 
 def instrument_output_columns(model: InstrumentModel) -> tuple[str, ...]:
@@ -126,3 +135,30 @@ class InstrumentCompensator:
     def summary(self) -> dict[str, Any]:
         """Per-axis shares beyond the trained ranges (plain JSON)."""
         return {axis or "-": c.ranges().to_dict() for axis, c in self.axes.items()}
+
+
+def compensate_instrument_file(
+    source: str | os.PathLike[str],
+    output: str | os.PathLike[str],
+    model: InstrumentModel,
+    *,
+    drift: str = "frequency",
+    read_options: rec_io.ReadOptions | None = None,
+    **options: Any,
+) -> CompensationSummary:
+    """Compensate every axis of a recording file into a new file (bounded memory).
+
+    As :func:`~hrgtc.compensate.compensator.compensate_file` (``options`` are its
+    keyword arguments); each axis's frequency is checked against that axis's
+    plausible band. A single-axis model is compensated exactly as by
+    ``compensate_file``.
+    """
+    if model.is_single_axis:
+        return compensate_file(source, output, model.axes[""], drift=drift,
+                               read_options=read_options, **options)
+    reading = read_options or rec_io.ReadOptions()
+    compensator = InstrumentCompensator(
+        model, drift, gaps=reading.gaps,
+        bands_hz={axis: plausible_frequency_band(unit) for axis, unit in model.axes.items()})
+    return compensate_file(source, output, model, drift=drift,  # type: ignore[arg-type]
+                           read_options=reading, compensator=compensator, **options)

@@ -317,7 +317,7 @@ def group_segments(segments: Sequence[RateSegment],
     return tuple(tuple(g) for g in groups)
 
 
-def _fit_group(group: Sequence[RateSegment], number: int) -> ScaleGroup:
+def fit_group(group: Sequence[RateSegment], number: int) -> ScaleGroup:
     """Least squares rate - Ω = b + k·Ω over one group's segments."""
     freq = float(np.mean([s.freq_hz for s in group]))
     x = np.array([s.input_rate_dph for s in group])
@@ -388,7 +388,7 @@ def fit_scale_factor(segments: Iterable[RateSegment], settings: FeatureSettings,
     tolerance = TOLERANCE_SHARE * scale if tolerance_hz is None else tolerance_hz
     fits = []
     for number, members in enumerate(group_segments(segments, tolerance), start=1):
-        fits.append(_fit_group(members, number))
+        fits.append(fit_group(members, number))
     groups = tuple(fits)
     k = np.array([g.k_ppm for g in groups])
     se = np.array([g.k_se_ppm for g in groups])
