@@ -29,3 +29,37 @@ def make_campaign(folder: Path, unit: str, sample_rate_hz: float = RATE_HZ, hour
     warm = simulate_files([profiles.warmup(-20.0, 20.0, 5.0)], folder / "warm", "parquet",
                           unit=unit, sample_rate_hz=sample_rate_hz, seed=seed + 2)
     return Campaign([Path(w.path) for w in soaks], Path(cool[0].path), Path(warm[0].path))
+
+
+@dataclass(frozen=True)
+class InstrumentCampaign:
+    soaks: list[Path]
+    cooldown: Path
+    warmup: Path
+    rate_table: Path
+    rate_table_heldout: Path
+
+
+#: Rate-table plateaus of training and of the held-out run (temperatures between them).
+TABLE_PLATEAUS_C = (-15.0, 0.0, 15.0, 30.0)
+HELDOUT_PLATEAUS_C = (-5.0, 22.0)
+
+
+def make_instrument_campaign(folder: Path, unit: str = "imu-3", sample_rate_hz: float = 1.0,
+                             seed: int = 11) -> InstrumentCampaign:
+    """A three-axis unit: soaks, cool-down, warm-up (held out), rate tables at four
+    temperatures (training) and at two others (held out)."""
+    def one(profiles_: list, name: str, k: int) -> list[Path]:
+        written = simulate_files(profiles_, folder / name, "parquet", unit=unit,
+                                 sample_rate_hz=sample_rate_hz, seed=seed + k)
+        return [Path(w.path) for w in written]
+
+    axes = ("x", "y", "z")
+    soaks = one([profiles.soak(sp, 5.0) for sp in SETPOINTS_C], "soaks", 0)
+    cool = one([profiles.cooldown(20.0, -20.0, 5.0)], "cool", 1)
+    warm = one([profiles.warmup(-20.0, 20.0, 5.0)], "warm", 2)
+    table = one([profiles.rate_table(TABLE_PLATEAUS_C, hold_s=60.0, soak_h=2.0, axes=axes)],
+                "table", 3)
+    heldout = one([profiles.rate_table(HELDOUT_PLATEAUS_C, hold_s=60.0, soak_h=2.0,
+                                       axes=axes)], "table_heldout", 4)
+    return InstrumentCampaign(soaks, cool[0], warm[0], table[0], heldout[0])

@@ -13,7 +13,7 @@ import pytest
 from filelock import FileLock
 from hypothesis import settings
 
-from campaign import Campaign, make_campaign
+from campaign import Campaign, InstrumentCampaign, make_campaign, make_instrument_campaign
 
 # The same examples on every run (CI must not flake); no example database between runs.
 settings.register_profile("hrgtc", derandomize=True, database=None, deadline=None)
@@ -51,3 +51,18 @@ def campaign_factory(tmp_path_factory):
 def paper_campaign(campaign_factory) -> Campaign:
     """The paper-unit at 2 Hz (evaluation and report do not depend on the rate)."""
     return campaign_factory("paper-unit", sample_rate_hz=2.0)
+
+
+@pytest.fixture(scope="session")
+def imu_campaign(tmp_path_factory) -> InstrumentCampaign:
+    """The three-axis ``imu-3`` at 1 Hz with rate tables, simulated once per session."""
+    folder = tmp_path_factory.getbasetemp().parent / "campaign-imu-3-1hz"
+    done = folder / "campaign.json"
+    with FileLock(str(folder) + ".lock"):
+        if not done.exists():
+            files = make_instrument_campaign(folder)
+            done.write_text(json.dumps({k: [str(p) for p in v] if isinstance(v, list)
+                                        else str(v) for k, v in vars(files).items()}))
+    data = json.loads(done.read_text())
+    return InstrumentCampaign(**{k: [Path(p) for p in v] if isinstance(v, list) else Path(v)
+                                 for k, v in data.items()})

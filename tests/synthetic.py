@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 from scipy import signal
 
+from hrgtc.drift.scale_factor import ScaleFactorModel, ScaleGroup
+from hrgtc.model import UnitModel
 from hrgtc.recording import Metadata, Recording
 from hrgtc.thermometry import fit
 
@@ -50,6 +54,29 @@ def block_std(x, rows):
     """1-sigma of non-overlapping block means (bias stability by hand)."""
     n = x.size // rows
     return float(np.std(x[: n * rows].reshape(n, rows).mean(axis=1), ddof=1))
+
+
+# -- a scale factor with known coefficients (for the firmware exports) -------------------
+def scale_factor(reference_hz: float) -> ScaleFactorModel:
+    """k = 150 - 12 x + 3 x^2 ppm, x = (freq - f_ref) / 8 Hz, fitted over -10..+30 degC."""
+    low, high = THERMOMETER.frequency(np.array([-10.0, 30.0]))
+    return ScaleFactorModel(
+        reference_hz=reference_hz, scale_hz=8.0, candidates=("f", "f^2", "f^3"),
+        selected=("f", "f^2"), intercept_ppm=150.0,
+        coefficients_ppm={"f": -12.0 / 8.0, "f^2": 3.0 / 64.0},
+        standard_errors_ppm={"const": 1.0, "f": 0.1, "f^2": 0.01},
+        pvalues={"const": 0.0, "f": 0.0, "f^2": 0.0}, scaled_coefficients=(-12.0, 3.0),
+        covariance=((1.0, 0.0, 0.0), (0.0, 0.01, 0.0), (0.0, 0.0, 0.0001)),
+        freq_range_hz=(float(low), float(high)), input_rate_range_dph=(3.6e4, 1.08e6),
+        residual_ppm=2.0,
+        groups=tuple(ScaleGroup(freq_hz=float(f), k_ppm=150.0, k_se_ppm=1.0, bias_dph=0.0, n=4,
+                                rows=4000)
+                     for f in THERMOMETER.frequency(np.array([-10.0, 10.0, 30.0]))))
+
+
+def with_scale_factor(model: UnitModel, sf: ScaleFactorModel) -> UnitModel:
+    """The model with a scale factor."""
+    return dataclasses.replace(model, scale_factor=sf)
 
 
 def with_heating_extra(run, per_hz_per_s=2000.0, tau_s=2600.0):

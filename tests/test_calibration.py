@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import numpy as np
@@ -189,3 +190,68 @@ def test_library_refuses_empty_inputs():
         calibrate([], ["x.parquet"])
     with pytest.raises(InputError, match="no drift recordings"):
         calibrate(["x.parquet"], [])
+
+
+# -- a gyro without a frequency output (--thermometer sensor) ----------------------------------
+#: A MEMS-style temperature register: 326.8 counts per °C, 0 counts at 25 °C.
+COUNTS_PER_C = 326.8
+
+
+def _imu_log(path, run) -> None:
+    """``run`` as a messy IMU log: time in ms, rate in rad/s, temperature as raw counts (the
+    true resonator temperature quantised by the register), no frequency column."""
+    import csv
+
+    counts = np.round((run["resonator_c"] - 25.0) * COUNTS_PER_C)
+    rate_radps = run.rate_dph / 3600.0 * np.pi / 180.0
+    with open(path, "w", newline="") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(["t_ms", "gz", "temp_raw"])
+        for t, g, c in zip(run.time_s * 1000.0, rate_radps, counts, strict=True):
+            writer.writerow([f"{t:.1f}", repr(float(g)), f"{c:.0f}"])
+
+
+def test_sensor_thermometer_on_a_messy_imu_log(campaign_factory, tmp_path):
+    from hrgtc.instrument import calibrate_instrument
+    from hrgtc.recording import ReadOptions
+
+    files = campaign_factory("paper-unit")
+    soaks = [files.soaks[SETPOINTS_C.index(t)] for t in (-20.0, 0.0, 20.0, 40.0)]
+    for name, source in (("cool", files.cooldown), ("warm", files.warmup),
+                         *((f"soak{k}", path) for k, path in enumerate(soaks))):
+        _imu_log(tmp_path / f"{name}.csv", recording.read(source))
+    options = ReadOptions(columns={"time_s": "t_ms", "rate_dph": "gz",
+                                   "temperature_c": "temp_raw"},
+                          units={"time": "ms", "rate": "radps"},
+                          metadata={"sample_rate_hz": 5.0, "input_rate_dph": 10.0},
+                          temp_scale=1.0 / COUNTS_PER_C, temp_offset_c=25.0)
+    # The soaks' warming and cooling transients train the drift model too (both signs of
+    # dT/dt), as for a resonator thermometer.
+    result = calibrate_instrument([tmp_path / f"soak{k}.csv" for k in range(len(soaks))],
+                                  [tmp_path / "cool.csv"], [tmp_path / "warm.csv"],
+                                  thermometer="sensor", read_options=options)
+    model = result.model.axes[""]
+    assert model.thermometer.source == "sensor"
+    low, high = model.thermometer.temperature_range_c
+    assert -20.5 < low < -19.5 and 39.5 < high < 40.5  # the training runs' temperatures
+    # the reading: counts * scale + offset is the resonator temperature to within a count
+    rec = dataclasses.replace(options, thermometer="sensor").read(tmp_path / "warm.csv")
+    truth = recording.read(files.warmup)
+    np.testing.assert_allclose(rec.freq_hz, truth["resonator_c"], atol=0.5 / COUNTS_PER_C)
+    np.testing.assert_allclose(rec.rate_dph, truth.rate_dph, rtol=1e-12)
+    (held_out,) = result.validation[""]
+    assert held_out.raw_10s / held_out.compensated_10s > 2.5  # no frequency needed
+
+
+def test_sensor_thermometer_cli_needs_no_soaks(campaign_factory, tmp_path):
+    files = campaign_factory("paper-unit")
+    _imu_log(tmp_path / "cool.csv", recording.read(files.cooldown))
+    output = tmp_path / "imu.json"
+    result = CliRunner().invoke(app, [
+        "calibrate", "--thermometer", "sensor", "--drift", str(tmp_path / "cool.csv"),
+        "--col", "time_s=t_ms,rate_dph=gz,temperature_c=temp_raw", "--time-unit", "ms",
+        "--rate-unit", "rad/s", "--temp-scale", str(1.0 / COUNTS_PER_C), "--temp-offset", "25",
+        "--rate-hz", "5", "--input-rate-dph", "10", "-o", str(output)])
+    assert result.exit_code == 0, result.output
+    assert "temperature sensor" in result.output
+    assert load_model(output).thermometer.source == "sensor"

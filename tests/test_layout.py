@@ -33,6 +33,7 @@ STAGES: list[set[str]] = [
     {"hrgtc.evaluation"},
     {"hrgtc.report"},
     {"hrgtc.calibration"},
+    {"hrgtc.instrument"},
     {"hrgtc.fleet"},
     {"hrgtc.demo"},
     {"hrgtc.cli", "hrgtc"},

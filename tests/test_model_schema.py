@@ -49,7 +49,7 @@ def test_written_file_is_strict_json_and_loads_back(tmp_path, unit_model):
         raise AssertionError(f"non-standard constant {name} in the model file")
 
     data = json.loads(text, parse_constant=refuse)
-    assert data["schema_version"] == SCHEMA_VERSION == 2
+    assert data["schema_version"] == 2 and SCHEMA_VERSION == 3  # 3 only with axes or scale
     assert data["provenance"]["note"] is None
     again = load_model(path)
     assert again.sha256 == unit_model.sha256

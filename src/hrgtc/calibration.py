@@ -14,6 +14,7 @@ memory stays bounded whatever their length; each soak file is read whole
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import warnings
@@ -32,6 +33,7 @@ from hrgtc.model import UnitModel, provenance
 from hrgtc.progress import StageProgress, for_stage
 from hrgtc.recording import ReadOptions
 from hrgtc.thermometry import fit as fit_thermometer
+from hrgtc.thermometry import identity
 from hrgtc.thermometry.plateaus import Plateau, find_plateaus, plateau_table
 from hrgtc.thermometry.prior import PriorFit, ThermometerPrior, fit_with_prior, load_prior
 
@@ -119,6 +121,7 @@ def calibrate(
     read_options: ReadOptions | None = None,
     progress: StageProgress | None = None,
     prior: ThermometerPrior | PathLike | None = None,
+    thermometer: str = "resonator",
 ) -> CalibrationResult:
     """Calibrate a unit: thermometer from soaks, drift model from ramps, held-out validation.
 
@@ -166,12 +169,26 @@ def calibrate(
         the prior and the soaks (two or three suffice), valid over the prior's
         range, and ``order`` is the prior's. A prior of units of another kind is
         refused.
+    thermometer
+        ``"resonator"`` ([1]: the thermometer from the soaks' plateaus) or
+        ``"sensor"``: a gyro without a frequency output, whose temperature sensor
+        (``temperature_c``, read in the place of ``freq_hz``) is the thermometer
+        (:func:`hrgtc.thermometry.identity`); soaks are then optional training runs.
     """
     options = read_options or ReadOptions()
-    if not soaks:
-        raise InputError("no soak recordings given; pass --soak FILE for each soak")
     if not drifts:
         raise InputError("no drift recordings given; pass --drift FILE (a cool-down or warm-up)")
+    if thermometer == "sensor":
+        return _calibrate_sensor(soaks, drifts, validate, options, progress, order=order,
+                                 terms=terms, window_s=window_s, penter=penter,
+                                 premove=premove, reference_c=reference_c,
+                                 rate_tau_s=rate_tau_s, housing_terms=housing_terms,
+                                 select=select)
+    if thermometer != "resonator":
+        raise InputError(f"thermometer must be 'resonator' or 'sensor', got {thermometer!r}")
+    if not soaks:
+        raise InputError("no soak recordings given; pass --soak FILE for each soak "
+                         "(a gyro without a frequency output: --thermometer sensor)")
 
     plateaus: list[Plateau] = []
     soak_rates: list[float] = []
@@ -213,22 +230,10 @@ def calibrate(
             HrgtcWarning, stacklevel=2,
         )
     training = [*drifts, *(extra if drift_from_soaks else ())]
-    runs = [partial(options.chunks, path) for path in training]
-    model = drift_model.fit(
-        runs, thermometer, terms=terms, window_s=window_s, penter=penter, premove=premove,
-        reference_c=reference_c, rate_tau_s=rate_tau_s, excitation_runs=len(drifts),
-        select=select, progress=for_stage(progress, "drift"),
-    )
-    housing = None
-    if housing_terms is not None and all("housing_c" in heads[str(p)] for p in training):
-        try:
-            housing = drift_model.fit(
-                runs, thermometer, terms=housing_terms, window_s=window_s, penter=penter,
-                premove=premove, reference_c=reference_c, rate_tau_s=rate_tau_s,
-                progress=for_stage(progress, "housing baseline"),
-            )
-        except CalibrationError as exc:  # the baseline is optional: say why it is missing
-            warnings.warn(f"no housing-thermistor baseline: {exc}", HrgtcWarning, stacklevel=2)
+    model, housing = _fit_drift(training, heads, thermometer, options, progress, len(drifts),
+                                terms=terms, window_s=window_s, penter=penter, premove=premove,
+                                reference_c=reference_c, rate_tau_s=rate_tau_s,
+                                housing_terms=housing_terms, select=select)
     unit = heads[str(drifts[0])].metadata.unit
     settings = {
         "order": order, "terms": list(terms), "window_s": window_s, "penter": penter,
@@ -259,3 +264,62 @@ def calibrate(
         for path in validate
     )
     return CalibrationResult(unit_model, tuple(plateaus), table, validation, prior_fit)
+
+
+def _fit_drift(training: Sequence[PathLike], heads: Mapping[str, Any], thermometer: Any,
+               options: ReadOptions, progress: StageProgress | None, excitation_runs: int,
+               *, housing_terms: Iterable[str] | None, **fit: Any) -> tuple[Any, Any]:
+    """The drift model on ``training`` and the housing baseline when every run has
+    ``housing_c`` (None otherwise, or when its fit fails: the baseline is optional)."""
+    runs = [partial(options.chunks, path) for path in training]
+    model = drift_model.fit(runs, thermometer, excitation_runs=excitation_runs,
+                            progress=for_stage(progress, "drift"), **fit)
+    housing = None
+    if housing_terms is not None and all("housing_c" in heads[str(p)] for p in training):
+        baseline = {k: v for k, v in fit.items() if k != "select"}  # as before: defaults
+        baseline["terms"] = housing_terms
+        try:
+            housing = drift_model.fit(runs, thermometer,
+                                      progress=for_stage(progress, "housing baseline"),
+                                      **baseline)
+        except CalibrationError as exc:  # the baseline is optional: say why it is missing
+            warnings.warn(f"no housing-thermistor baseline: {exc}", HrgtcWarning, stacklevel=2)
+    return model, housing
+
+
+def _calibrate_sensor(soaks: Sequence[PathLike], drifts: Sequence[PathLike],
+                      validate: Sequence[PathLike], options: ReadOptions,
+                      progress: StageProgress | None, *, order: int, **fit: Any
+                      ) -> CalibrationResult:
+    """A gyro without a frequency output: its temperature sensor is the thermometer.
+
+    Every run (soaks included) trains the drift model in (T, dT/dt); the identity
+    thermometer's range is that of the training runs' temperatures.
+    """
+    options = dataclasses.replace(options, thermometer="sensor")
+    training = [*drifts, *soaks]
+    low, high = math.inf, -math.inf
+    for path in training:
+        for chunk in options.chunks(path):
+            if len(chunk):
+                low = min(low, float(np.min(chunk.freq_hz)))
+                high = max(high, float(np.max(chunk.freq_hz)))
+    thermometer = identity((low, high))
+    heads = {str(path): options.head(path) for path in training}
+    model, housing = _fit_drift(training, heads, thermometer, options, progress, len(drifts),
+                                **fit)
+    settings = {key: (list(v) if isinstance(v, tuple | list) else v)
+                for key, v in fit.items()}
+    unit_model = UnitModel(
+        thermometer=thermometer, drift=model, housing=housing,
+        unit=heads[str(drifts[0])].metadata.unit,
+        provenance=provenance(
+            {"soak": [str(p) for p in soaks], "drift": [str(p) for p in drifts],
+             "validate": [str(p) for p in validate]},
+            {**settings, "thermometer": "sensor", "columns": dict(options.columns or {}),
+             "units": dict(options.units or {})},
+        ),
+    )
+    validation = tuple(evaluate(path, unit_model, allan=False, read_options=options)
+                       for path in validate)
+    return CalibrationResult(unit_model, (), (), validation, None)

@@ -25,11 +25,13 @@ from pathlib import Path
 from typing import Any
 
 from hrgtc.drift import DriftModel
+from hrgtc.drift.scale_factor import ScaleFactorModel
 from hrgtc.errors import HrgtcError, ModelFileError
 from hrgtc.files import file_sha256, write_text_atomic
 from hrgtc.model_schema import (
     SCHEMA_NAME,
     SCHEMA_VERSION,
+    axis_parts,
     check_document,
     parameters_sha256,
     parse_model_json,
@@ -37,8 +39,12 @@ from hrgtc.model_schema import (
 )
 from hrgtc.thermometry import Thermometer
 
-__all__ = ["SCHEMA_NAME", "SCHEMA_VERSION", "UnitModel", "load_model", "model_sha256",
-           "provenance", "save_model"]
+__all__ = ["SCHEMA_NAME", "SCHEMA_VERSION", "InstrumentModel", "UnitModel", "axis_suffix",
+           "load_instrument", "load_model", "model_sha256", "provenance", "save_instrument",
+           "save_model"]
+
+#: Schema version of files with one axis and no scale factor (unchanged since version 2).
+_PLAIN_VERSION = 2
 
 
 @dataclass(frozen=True)
@@ -60,6 +66,9 @@ class UnitModel:
         The unit's Table 1: one record per soak plateau (plain JSON).
     provenance
         Inputs with SHA-256, settings, package version, creation time.
+    scale_factor
+        Scale-factor error against frequency from rate-table runs (None: not
+        calibrated; compensation then removes the bias only).
     """
 
     thermometer: Thermometer
@@ -68,19 +77,46 @@ class UnitModel:
     unit: str = "unknown"
     plateaus: tuple[dict[str, Any], ...] = ()
     provenance: dict[str, Any] = field(default_factory=dict)
+    scale_factor: ScaleFactorModel | None = None
 
-    def to_dict(self) -> dict[str, Any]:
-        """The model file's JSON document."""
-        return {
-            "schema": SCHEMA_NAME,
-            "schema_version": SCHEMA_VERSION,
-            "unit": self.unit,
+    def parts(self) -> dict[str, Any]:
+        """The axis's parts of the model file (thermometer, drift, housing, ...)."""
+        parts: dict[str, Any] = {
             "thermometer": self.thermometer.to_dict(),
             "drift": self.drift.to_dict(),
             "housing": None if self.housing is None else self.housing.to_dict(),
             "plateaus": list(self.plateaus),
+        }
+        if self.scale_factor is not None:
+            parts["scale_factor"] = self.scale_factor.to_dict()
+        return parts
+
+    def to_dict(self) -> dict[str, Any]:
+        """The model file's JSON document."""
+        parts = self.parts()
+        return {
+            "schema": SCHEMA_NAME,
+            "schema_version": SCHEMA_VERSION if "scale_factor" in parts else _PLAIN_VERSION,
+            "unit": self.unit,
+            **parts,
             "provenance": dict(self.provenance),
         }
+
+    @classmethod
+    def from_parts(cls, data: Mapping[str, Any], unit: str,
+                   provenance: Mapping[str, Any]) -> UnitModel:
+        """One axis from its checked parts (see :func:`model_schema.check_document`)."""
+        housing = data.get("housing")
+        scale_factor = data.get("scale_factor")
+        return cls(
+            thermometer=Thermometer.from_dict(data["thermometer"]),
+            drift=DriftModel.from_dict(data["drift"]),
+            housing=None if housing is None else DriftModel.from_dict(housing),
+            unit=unit,
+            plateaus=tuple(data.get("plateaus", ())),
+            provenance=dict(provenance),
+            scale_factor=None if scale_factor is None else ScaleFactorModel.from_dict(scale_factor),
+        )
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any], source: str = "model",
@@ -103,17 +139,16 @@ class UnitModel:
                 f"{source}: model schema version {version} is newer than this hrgtc "
                 f"understands ({SCHEMA_VERSION}); upgrade hrgtc"
             )
+        if "axes" in data:
+            names = ", ".join(data["axes"]) if isinstance(data["axes"], Mapping) else "?"
+            raise ModelFileError(
+                f"{source}: a multi-axis model file (axes {names}); load it with "
+                "hrgtc.model.load_instrument, or pick one axis with InstrumentModel.axes[name]"
+            )
         data = check_document(strict(dict(data)), source, non_standard)
         try:
-            housing = data.get("housing")
-            return cls(
-                thermometer=Thermometer.from_dict(data["thermometer"]),
-                drift=DriftModel.from_dict(data["drift"]),
-                housing=None if housing is None else DriftModel.from_dict(housing),
-                unit=str(data.get("unit", "unknown")),
-                plateaus=tuple(data.get("plateaus", ())),
-                provenance=dict(data.get("provenance", {})),
-            )
+            return cls.from_parts(data, str(data.get("unit", "unknown")),
+                                  data.get("provenance", {}))
         except KeyError as exc:
             raise ModelFileError(f"{source}: model file is missing {exc}; it is corrupt") from exc
         except HrgtcError as exc:
@@ -123,6 +158,102 @@ class UnitModel:
     def sha256(self) -> str:
         """SHA-256 of the model's canonical JSON (independent of file layout and provenance)."""
         return model_sha256(self)
+
+
+def axis_suffix(axis: str) -> str:
+    """Column suffix of an axis: ``"_x"`` for axis ``"x"``, ``""`` for a single-axis model."""
+    return f"_{axis}" if axis else ""
+
+
+@dataclass(frozen=True)
+class InstrumentModel:
+    """A calibrated instrument: one :class:`UnitModel` per axis, in one model file.
+
+    A single-axis model is the one-axis case: ``axes == {"": model}``, and its file is
+    exactly a single-axis model file. A multi-axis file (schema version 3) holds each
+    axis's thermometer, drift model, housing baseline, plateaus and scale factor under
+    ``axes``.
+
+    Attributes
+    ----------
+    axes
+        Axis name -> that axis's model (names as the recording's column suffixes).
+    unit
+        Serial or name of the instrument.
+    provenance
+        Inputs with SHA-256, settings, package version, creation time.
+    """
+
+    axes: dict[str, UnitModel]
+    unit: str = "unknown"
+    provenance: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if not self.axes:
+            raise ModelFileError("an instrument model needs at least one axis")
+        if "" in self.axes and len(self.axes) > 1:
+            raise ModelFileError("the unnamed axis is the single-axis case; name every axis")
+
+    @classmethod
+    def single(cls, model: UnitModel) -> InstrumentModel:
+        """The one-axis instrument of a single-axis model."""
+        return cls({"": model}, model.unit, dict(model.provenance))
+
+    @property
+    def is_single_axis(self) -> bool:
+        """True for the one-axis case (plain single-axis columns and file)."""
+        return list(self.axes) == [""]
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """Axis names in file order (``("",)`` for a single-axis model)."""
+        return tuple(self.axes)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The model file's JSON document."""
+        if self.is_single_axis:
+            document = self.axes[""].to_dict()
+            document.update(unit=self.unit, provenance=dict(self.provenance))
+            return document
+        return {
+            "schema": SCHEMA_NAME,
+            "schema_version": SCHEMA_VERSION,
+            "unit": self.unit,
+            "axes": {name: model.parts() for name, model in self.axes.items()},
+            "provenance": dict(self.provenance),
+        }
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any], source: str = "model",
+                  non_standard: bool = False) -> InstrumentModel:
+        """Inverse of :meth:`to_dict`, with the checks of :meth:`UnitModel.from_dict`."""
+        if not (isinstance(data, Mapping) and "axes" in data):
+            return cls.single(UnitModel.from_dict(data, source, non_standard))
+        if data.get("schema") != SCHEMA_NAME:
+            raise ModelFileError(f"{source}: not an hrgtc model file (schema "
+                                 f"{data.get('schema')!r}, expected {SCHEMA_NAME!r})")
+        version = data.get("schema_version")
+        if isinstance(version, int) and version > SCHEMA_VERSION:
+            raise ModelFileError(
+                f"{source}: model schema version {version} is newer than this hrgtc "
+                f"understands ({SCHEMA_VERSION}); upgrade hrgtc"
+            )
+        checked = check_document(strict(dict(data)), source, non_standard)
+        unit = str(checked.get("unit", "unknown"))
+        provenance = dict(checked.get("provenance", {}))
+        try:
+            axes = {name: UnitModel.from_parts(part, unit, provenance)
+                    for name, part in axis_parts(checked).items()}
+        except KeyError as exc:
+            raise ModelFileError(f"{source}: model file is missing {exc}; it is corrupt") from exc
+        except HrgtcError as exc:
+            raise ModelFileError(f"{source}: model file is corrupt: {exc}") from exc
+        return cls(axes, unit, provenance)
+
+    @property
+    def sha256(self) -> str:
+        """SHA-256 of the parameters as canonical JSON (see :func:`model_sha256`)."""
+        return parameters_sha256(self.to_dict())
 
 
 def model_sha256(model: UnitModel) -> str:
@@ -150,6 +281,12 @@ def provenance(inputs: Mapping[str, list[str]], settings: Mapping[str, Any]) -> 
     }
 
 
+def save_instrument(model: InstrumentModel, path: str | os.PathLike[str],
+                    force: bool = False) -> Path:
+    """Write an instrument's model file (one file, every axis); as :func:`save_model`."""
+    return _save_document(model.to_dict(), path, force)
+
+
 def save_model(model: UnitModel, path: str | os.PathLike[str], force: bool = False) -> Path:
     """Write the model file atomically as strict JSON (refuses to overwrite without ``force``).
 
@@ -159,7 +296,11 @@ def save_model(model: UnitModel, path: str | os.PathLike[str], force: bool = Fal
         The model does not pass the checks of loading (e.g. a coefficient that is
         not finite): such a file is never written.
     """
-    document = strict(model.to_dict())
+    return _save_document(model.to_dict(), path, force)
+
+
+def _save_document(document: dict[str, Any], path: str | os.PathLike[str], force: bool) -> Path:
+    document = strict(document)
     document["parameters_sha256"] = parameters_sha256(document)
     check_document(document, str(path))
     text = json.dumps(document, indent=2, allow_nan=False)
@@ -167,13 +308,31 @@ def save_model(model: UnitModel, path: str | os.PathLike[str], force: bool = Fal
 
 
 def load_model(path: str | os.PathLike[str]) -> UnitModel:
-    """Read a model file written by :func:`save_model` (or ``hrgtc calibrate``).
+    """Read a single-axis model file written by :func:`save_model` (or ``hrgtc calibrate``).
 
     Raises
     ------
     ModelFileError
-        Unreadable, not JSON, foreign, corrupt, or of a newer schema.
+        Unreadable, not JSON, foreign, corrupt, of a newer schema, or multi-axis
+        (read those with :func:`load_instrument`).
     """
+    data, non_standard = _read_document(path)
+    return UnitModel.from_dict(data, source=str(path), non_standard=non_standard)
+
+
+def load_instrument(path: str | os.PathLike[str]) -> InstrumentModel:
+    """Read any model file, single- or multi-axis, as an :class:`InstrumentModel`.
+
+    Raises
+    ------
+    ModelFileError
+        As :func:`load_model`.
+    """
+    data, non_standard = _read_document(path)
+    return InstrumentModel.from_dict(data, source=str(path), non_standard=non_standard)
+
+
+def _read_document(path: str | os.PathLike[str]) -> tuple[Any, bool]:
     source = str(path)
     try:
         text = Path(path).read_text(encoding="utf-8")
@@ -190,4 +349,4 @@ def load_model(path: str | os.PathLike[str]) -> UnitModel:
         ) from exc
     except RecursionError:
         raise ModelFileError(f"{source}: not a model file (nested too deeply)") from None
-    return UnitModel.from_dict(data, source=source, non_standard=non_standard)
+    return data, non_standard

@@ -42,7 +42,10 @@ from hrgtc.errors import InputError, ModelFileError
 
 SCHEMA_NAME = "hrgtc.model"
 #: 2: strict JSON (statistics that are not finite are written ``null``).
-SCHEMA_VERSION = 2
+#: 3: several axes (``axes``) and scale factor (``scale_factor``); written only when used.
+SCHEMA_VERSION = 3
+#: Axis names of a multi-axis model (as the recording's per-axis column suffixes).
+AXIS_PATTERN = r"^[A-Za-z][A-Za-z0-9]*$"
 #: Relative agreement of ``coefficients`` with those derived from ``scaled_coefficients``.
 COEFFICIENT_RTOL = 1e-9
 
@@ -59,6 +62,7 @@ _THERMOMETER = {
                  "temperature_range_c", "centre_c", "scale_c", "scaled_coefficients"],
     "properties": {
         "kind": {"const": "hrgtc.Thermometer"},
+        "source": {"enum": ["resonator", "sensor"]},
         "order": {"type": "integer", "minimum": 1, "maximum": 12},
         "n_points": {"type": "integer", "minimum": 2},
         "coefficients": {"type": "array", "items": _FINITE, "minItems": 2},
@@ -87,7 +91,8 @@ _DRIFT = {
             "required": ["reference_freq_hz", "sample_rate_hz", "reference_c", "rate_tau_s",
                          "warmup_s"],
             "properties": {
-                "reference_freq_hz": _POSITIVE,
+                # A sensor thermometer reads °C in the place of f: any finite reference.
+                "reference_freq_hz": _FINITE,
                 "sample_rate_hz": _POSITIVE,
                 "reference_c": _FINITE,
                 "rate_tau_s": _POSITIVE,
@@ -114,21 +119,50 @@ _DRIFT = {
     },
 }
 
-#: JSON Schema (Draft 2020-12) of the model file, versions 1 and 2.
+def _scale_factor_schema() -> dict[str, Any]:
+    from hrgtc.drift.scale_factor import SCALE_FACTOR_JSON_SCHEMA
+
+    return SCALE_FACTOR_JSON_SCHEMA
+
+
+#: What one axis holds: the parts of a single-axis model file.
+_AXIS_PARTS = {
+    "thermometer": _THERMOMETER,
+    "drift": _DRIFT,
+    "housing": {"anyOf": [{"type": "null"}, _DRIFT]},
+    "scale_factor": {"anyOf": [{"type": "null"}, _scale_factor_schema()]},
+    "plateaus": {"type": "array", "items": {"type": "object"}},
+}
+
+#: JSON Schema (Draft 2020-12) of the model file, versions 1 to 3. A single-axis file
+#: holds one axis's parts at the top level; a multi-axis file (version 3) holds them
+#: under ``axes``, one object per axis name.
 MODEL_SCHEMA: dict[str, Any] = {
     "$schema": "https://json-schema.org/draft/2020-12/schema",
     "$id": "https://hrgtc.invalid/schema/model.json",
     "title": "hrgtc model file",
     "type": "object",
-    "required": ["schema", "schema_version", "thermometer", "drift"],
+    "required": ["schema", "schema_version"],
+    "oneOf": [
+        {"required": ["thermometer", "drift"], "not": {"required": ["axes"]}},
+        {"required": ["axes"], "not": {"anyOf": [{"required": ["thermometer"]},
+                                                  {"required": ["drift"]}]}},
+    ],
     "properties": {
         "schema": {"const": SCHEMA_NAME},
         "schema_version": {"type": "integer", "minimum": 1, "maximum": SCHEMA_VERSION},
         "unit": {"type": "string"},
-        "thermometer": _THERMOMETER,
-        "drift": _DRIFT,
-        "housing": {"anyOf": [{"type": "null"}, _DRIFT]},
-        "plateaus": {"type": "array", "items": {"type": "object"}},
+        **_AXIS_PARTS,
+        "axes": {
+            "type": "object",
+            "minProperties": 1,
+            "propertyNames": {"pattern": AXIS_PATTERN},
+            "additionalProperties": {
+                "type": "object",
+                "required": ["thermometer", "drift"],
+                "properties": _AXIS_PARTS,
+            },
+        },
         "provenance": {"type": "object"},
         "parameters_sha256": {"type": "string", "pattern": "^[0-9a-f]{64}$"},
     },
@@ -202,6 +236,19 @@ def _number(value: Any) -> float:
 def restore_statistics(data: dict[str, Any]) -> dict[str, Any]:
     """A copy of a checked document with every statistic a float (NaN where missing)."""
     data = json.loads(json.dumps(data))
+    for part in axis_parts(data).values():
+        _restore_axis(part)
+    return data
+
+
+def axis_parts(data: Mapping[str, Any]) -> dict[str, Any]:
+    """Axis name -> the object holding that axis's parts (``""`` -> the document itself
+    for a single-axis file)."""
+    axes = data.get("axes")
+    return {"": data} if axes is None else dict(axes)
+
+
+def _restore_axis(data: dict[str, Any]) -> None:
     therm = data["thermometer"]
     therm["standard_errors"] = [_number(v) for v in therm["standard_errors"]]
     therm["rsquared"] = _number(therm["rsquared"])
@@ -220,7 +267,6 @@ def restore_statistics(data: dict[str, Any]) -> dict[str, Any]:
             if name in drift:
                 drift[name] = _number(drift[name])
         drift["stepwise"] = _numbers_in(drift["stepwise"])
-    return data
 
 
 def _numbers_in(value: Any) -> Any:
@@ -248,18 +294,18 @@ def _agree(stored: float, derived: float, magnitude: float) -> bool:
     return abs(stored - derived) <= COEFFICIENT_RTOL * max(abs(magnitude), abs(derived)) + 1e-300
 
 
-def _check_thermometer(therm: Mapping[str, Any], source: str) -> None:
+def _check_thermometer(therm: Mapping[str, Any], source: str, at: str = "") -> None:
     from hrgtc.thermometry.thermometer import _scaled_to_raw_matrix
 
     order = therm["order"]
     for name in ("coefficients", "scaled_coefficients", "standard_errors"):
         if len(therm[name]) != order + 1:
-            raise _fail(source, f"thermometer.{name}",
+            raise _fail(source, f"{at}thermometer.{name}",
                         f"{len(therm[name])} values for a polynomial of order {order} "
                         f"(expected {order + 1})")
     low, high = therm["temperature_range_c"]
     if not low < high:
-        raise _fail(source, "thermometer.temperature_range_c",
+        raise _fail(source, f"{at}thermometer.temperature_range_c",
                     f"[{low!r}, {high!r}] is not an ordered range (low < high)")
     matrix = _scaled_to_raw_matrix(order, therm["centre_c"], therm["scale_c"])
     scaled = [Fraction(v) for v in therm["scaled_coefficients"]]
@@ -267,7 +313,7 @@ def _check_thermometer(therm: Mapping[str, Any], source: str) -> None:
         derived = float(sum(m * a for m, a in zip(row, scaled, strict=True)))
         magnitude = float(sum(abs(m * a) for m, a in zip(row, scaled, strict=True)))
         if not _agree(therm["coefficients"][i], derived, magnitude):
-            raise _fail(source, f"thermometer.coefficients[{i}]",
+            raise _fail(source, f"{at}thermometer.coefficients[{i}]",
                         f"{therm['coefficients'][i]!r} disagrees with {derived!r} derived from "
                         "scaled_coefficients (the values used)")
 
@@ -365,11 +411,15 @@ def check_document(data: Any, source: str, non_standard: bool = False) -> dict[s
             f"{source}: model file was changed after it was written (its content no longer "
             "matches its parameters_sha256): damaged or edited; recreate it with 'hrgtc "
             "calibrate' (after a deliberate edit, delete the parameters_sha256 line)")
-    _check_thermometer(data["thermometer"], source)
     restored = restore_statistics(data)
-    restored["drift"]["coefficients"] = _check_drift(data["drift"], "drift", source)
-    _check_reference(data["drift"], data["thermometer"], "drift", source)
-    if data.get("housing") is not None:
-        restored["housing"]["coefficients"] = _check_drift(data["housing"], "housing", source)
+    kept = axis_parts(restored)
+    for axis, part in axis_parts(data).items():
+        at = f"axes.{axis}." if axis else ""
+        _check_thermometer(part["thermometer"], source, at)
+        kept[axis]["drift"]["coefficients"] = _check_drift(part["drift"], f"{at}drift", source)
+        _check_reference(part["drift"], part["thermometer"], f"{at}drift", source)
+        if part.get("housing") is not None:
+            kept[axis]["housing"]["coefficients"] = _check_drift(part["housing"],
+                                                                  f"{at}housing", source)
     restored.pop("parameters_sha256", None)
     return restored

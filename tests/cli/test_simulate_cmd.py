@@ -16,6 +16,7 @@ from typer.testing import CliRunner
 from hrgtc import simulate
 from hrgtc.cli import app
 from hrgtc.recording import read
+from hrgtc.simulate import standard_profiles
 
 runner = CliRunner()
 
@@ -132,3 +133,37 @@ def test_errors_exit_2_with_a_message(tmp_path, args, message):
 def test_bad_setpoints_list(tmp_path):
     code, _, err = run("--setpoints=-20,warm", "-o", str(tmp_path))
     assert code == 2 and "comma-separated list of temperatures" in err
+
+
+def test_ratetable_single_axis_reads_back_with_its_input_rate(tmp_path):
+    code, data, _ = run(
+        "--profile", "ratetable", "--setpoints=10,30", "--hours", "0.05", "--rates", "0,-50",
+        "--rate-hold-s", "20", "--rate-hz", "2", "-o", str(tmp_path),
+    )
+    assert code == 0
+    assert data[0]["path"] == str(tmp_path / "ratetable_10C_to_30C.parquet")
+    assert data[0]["rows"] == 2 * (180 + 2 * 20) * 2  # two plateaus of 180 s + 2 x 20 s, 2 Hz
+    rec = read(data[0]["path"])
+    assert rec.metadata.input_rate_dph == 10.0
+    assert set(np.unique(rec["input_rate_dph"])) == {10.0, 10.0 - 50 * 3600}
+    assert rec.metadata.extra["chamber_program"]["segments"][2]["table_rate_dps"] == -50.0
+
+
+def test_ratetable_on_imu3_writes_per_axis_columns(tmp_path):
+    code, data, _ = run(
+        "--profile", "ratetable", "--unit", "imu-3", "--setpoints=20", "--hours", "0.02",
+        "--rates", "100", "--rate-hold-s", "10", "--rate-hz", "1", "--format", "csv",
+        "-o", str(tmp_path),
+    )
+    assert code == 0 and data[0]["rows"] == 72 + 3 * 10
+    lines = [
+        line for line in (tmp_path / "ratetable_20C.csv").read_text().splitlines()
+        if not line.startswith("#")
+    ]
+    header = lines[0].split(",")
+    assert header == list(simulate.run_columns(standard_profiles.rate_table(
+        [20.0], [100.0], 10.0, 0.02, axes=("x", "y", "z")), "imu-3"))
+    values = np.array([[float(v) for v in line.split(",")] for line in lines[1:]])
+    turning = {a: values[:, header.index(f"input_rate_dph_{a}")] > 1000.0 for a in "xyz"}
+    assert [int(np.flatnonzero(turning[a])[0]) for a in "xyz"] == [72, 82, 92]
+    assert all(turning[a].sum() == 10 for a in "xyz")

@@ -537,3 +537,22 @@ def test_rate_table_axes_must_match_the_unit():
     rec = simulate.simulate_run(simulate.constant(20.0, 0.01), "imu-3", sample_rate_hz=1.0,
                                 input_rate_dph=3.0)
     assert rec.metadata.extra["axis_input_rate_dph"] == {"x": 3.0, "y": 3.0, "z": 3.0}
+
+
+def test_imu3_file_reads_back_axis_by_axis(tmp_path):
+    from hrgtc.recording import axis_names, axis_view
+
+    imu = units.get("imu-3")
+    table = standard_profiles.rate_table([15.0], [20.0], hold_s=10.0, soak_h=0.01,
+                                         axes=imu.axis_names)
+    written = simulate.simulate_to_file(table, tmp_path / "t.parquet", imu, sample_rate_hz=2.0,
+                                        seed=9)
+    rec = read(written.path)
+    library = simulate.simulate_run(table, imu, sample_rate_hz=2.0, seed=9)
+    assert axis_names(rec.names) == ("x", "y", "z")
+    for axis in imu.axis_names:
+        view = axis_view(rec, axis)
+        assert view.metadata.input_rate_dph == imu.input_rate_dph[axis]
+        assert np.array_equal(view["input_rate_dph"], library[f"input_rate_dph_{axis}"])
+        assert np.array_equal(view.rate_dph, library[f"rate_dph_{axis}"])
+        assert np.array_equal(view["scale_ppm"], library[f"scale_ppm_{axis}"])

@@ -20,6 +20,7 @@ from hrgtc.cli.options import (
 
 if TYPE_CHECKING:
     from hrgtc.calibration import CalibrationResult
+    from hrgtc.instrument import InstrumentCalibration
     from hrgtc.recording import ReadOptions
 
 #: The nine candidate terms of Eq. (21) of [1], as the default of --terms (written out so
@@ -30,6 +31,12 @@ EQ21_DEFAULT = "f,f^2,f^3,df,df^2,df^3,f*df,f^2*df,f*df^2"
 def render(result: CalibrationResult) -> None:
     """Print the unit's Table 1, Eq. 18 form, Table 2 form, steps and Eq. 22 form."""
     th = result.model.thermometer
+    if th.source == "sensor":
+        low, high = th.temperature_range_c
+        console.print(f"Thermometer: the gyro's temperature sensor (no frequency output), "
+                      f"trained {low:.2f} to {high:.2f} °C; drift terms in T and dT/dt")
+        _render_drift(result)
+        return
     table = Table(title="The unit's Table 1 (plateaus) and Table 2 (temperature from frequency)")
     for column in ("chamber (°C)", "settled freq (Hz)", "method", "unsettled (°C)",
                    "T from freq (°C)", "error (°C)"):
@@ -48,6 +55,11 @@ def render(result: CalibrationResult) -> None:
         )
     else:
         console.print(th.summary().splitlines()[-1])
+    _render_drift(result)
+
+
+def _render_drift(result: CalibrationResult) -> None:
+    th = result.model.thermometer
     if result.prior_fit is not None:
         fit = result.prior_fit
         low, high = th.temperature_range_c
@@ -104,22 +116,45 @@ def calibrate_command(
         "stepwise", "--select",
         help="Term selection: 'stepwise' (F-tests) or 'cv' (leave-one-run-out "
         "cross-validated bias stability; needs two training runs or more)."),
+    rate_table: list[Path] = typer.Option(
+        None, "--rate-table", help="Rate-table run (known input rates at several temperatures: "
+        "an input_rate_dph column or --segments): fits the scale factor against frequency."),
+    validate_rate_table: list[Path] = typer.Option(
+        None, "--validate-rate-table",
+        help="Held-out rate-table run: scale-factor error [ppm] before and after."),
+    segments: Path = typer.Option(
+        None, "--segments", help="CSV start_s,end_s,input_rate_dph of the rate-table holds, for "
+        "files without an input_rate_dph column."),
+    scale_terms: str = typer.Option(
+        "f,f^2,f^3", "--scale-terms", help="Candidate terms of the scale-factor model."),
     force: ForceOption = False,
     strict: StrictOption = False,
     json_output: JsonOption = False,
     inputs: ReadOptions | None = None,
 ) -> None:
-    """Calibrate a gyro: soak plateaus -> thermometer (Eq. 18), ramps -> drift model (Eq. 22).
+    """Calibrate a gyro or a whole instrument: soak plateaus -> thermometer (Eq. 18), ramps ->
+    drift model (Eq. 22), rate tables -> scale factor; every axis of a multi-axis file.
 
     Example: hrgtc calibrate --soak soaks/*.parquet --drift cooldown.parquet
     --validate warmup.parquet -o unit.json
 
     With a population prior, 2 or 3 soaks: hrgtc calibrate --prior prior.json
     --soak soak_-20C.parquet --soak soak_40C.parquet --drift cooldown.parquet -o unit.json
+
+    A three-axis unit with scale factor: hrgtc calibrate --soak soaks/*.parquet
+    --drift cooldown.parquet --rate-table ratetable.parquet --validate warmup.parquet
+    --validate-rate-table ratetable_heldout.parquet -o imu.json
+
+    A gyro without a frequency output (its temperature sensor as the thermometer):
+    hrgtc calibrate --thermometer sensor --drift cooldown.csv --drift warmup.csv -o imu.json
     """
-    from hrgtc.calibration import HOUSING_TERMS, calibrate
+    from hrgtc.calibration import HOUSING_TERMS
     from hrgtc.files import check_writable, refuse_existing
-    from hrgtc.model import save_model
+    from hrgtc.instrument import calibrate_instrument
+    from hrgtc.model import save_instrument
+    from hrgtc.recording import ReadOptions
+
+    inputs = inputs or ReadOptions()
 
     soaks = [*(soak or []), *(extra_soaks or [])]
     with library_errors():
@@ -132,25 +167,78 @@ def calibrate_command(
                 stages[stage] = True
                 error_console.print(f"[dim]… {stage}[/]")
 
-        result = calibrate(
+        calibration = calibrate_instrument(
             soaks, drift, validate or (), order=order,
             terms=[t.strip() for t in terms.split(",") if t.strip()],
             window_s=window_s, penter=penter, premove=premove, reference_c=reference_c,
             rate_tau_s=rate_tau_s, housing_terms=HOUSING_TERMS,
             drift_from_soaks=drift_from_soaks, select=select,
             read_options=inputs, progress=progress, prior=prior,
+            thermometer=inputs.thermometer, rate_tables=rate_table or (),
+            validate_rate_tables=validate_rate_table or (), segment_table=segments,
+            scale_terms=[t.strip() for t in scale_terms.split(",") if t.strip()],
         )
-        save_model(result.model, output, force=force)
+        save_instrument(calibration.model, output, force=force)
+    single = calibration.model.is_single_axis
     if json_output:
-        print_json({**result.to_dict(), "model_file": str(output)})
+        document = (calibration.axes[""].to_dict() if single and not calibration.scale_checks
+                    and calibration.model.axes[""].scale_factor is None
+                    else calibration.to_dict())
+        if single:
+            document["validation"] = [v.to_dict() for v in calibration.validation[""]]
+        print_json({**document, "model_file": str(output)})
     else:
-        render(result)
+        render_instrument(calibration)
         console.print(f"Model written to {output}")
     beyond = False
-    for v in result.validation:  # held-out runs beyond the trained ranges (--strict: exit 3)
-        if v.range_warnings():
-            beyond = True
-            (error_console if json_output else console).print(f"{v.file}:")
-            warn_ranges([v.ranges], json_output, strict=False)
+    for axis, runs in calibration.validation.items():  # beyond the trained ranges: --strict
+        for v in runs:
+            if v.range_warnings():
+                beyond = True
+                where = f"{v.file}" + (f", axis {axis}" if axis else "")
+                (error_console if json_output else console).print(f"{where}:")
+                warn_ranges([v.ranges], json_output, strict=False)
     if strict and beyond:
         raise typer.Exit(STRICT_EXIT)
+
+
+def render_instrument(calibration: InstrumentCalibration) -> None:
+    """Each axis as :func:`render`, its scale factor, then the instrument's summary."""
+    from dataclasses import replace
+
+    for axis, result in calibration.axes.items():
+        if axis:
+            console.rule(f"axis {axis}")
+        model = calibration.model.axes[axis]
+        render(replace(result, model=model, validation=calibration.validation.get(axis, ())))
+        if model.scale_factor is not None:
+            console.print(model.scale_factor.summary())
+    if calibration.scale_checks:
+        table = Table(title="Held-out rate tables: scale-factor error (ppm) at each "
+                      "temperature, raw → compensated")
+        for column in ("file", "axis", "temperatures", "raw → compensated", "largest |error|"):
+            table.add_column(column, justify="right")
+        for check in calibration.scale_checks:
+            pairs = ", ".join(f"{r:+.1f} → {c:+.1f}"
+                              for r, c in zip(check.raw_ppm, check.compensated_ppm, strict=True))
+            table.add_row(Path(check.file).name, check.axis or "-", str(len(check.raw_ppm)),
+                          pairs, f"{check.raw_max_ppm:.1f} → {check.compensated_max_ppm:.1f}")
+        console.print(table)
+    if not calibration.model.is_single_axis:
+        from hrgtc.instrument import summary_rows
+
+        table = Table(title=f"{calibration.model.unit}: per-axis summary (held-out median, °/h)")
+        for column in ("axis", "drift terms", "raw 10 s", "compensated 10 s",
+                       "scale terms", "scale raw max ppm", "scale residual max ppm"):
+            table.add_column(column, justify="right")
+
+        def number(value: float | None, digits: int) -> str:
+            return "–" if value is None else f"{value:.{digits}f}"
+
+        for row in summary_rows(calibration):
+            table.add_row(row["axis"], ",".join(row["terms"]),
+                          number(row["raw_10s_dph"], 4), number(row["compensated_10s_dph"], 4),
+                          "–" if row["scale_terms"] is None else ",".join(row["scale_terms"]),
+                          number(row["scale_raw_max_ppm"], 1),
+                          number(row["scale_residual_max_ppm"], 1))
+        console.print(table)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -46,24 +47,28 @@ def compensate_command(
     inputs: ReadOptions | None = None,
 ) -> None:
     """Compensate a run file to file: adds rate_comp_dph, bias_model_dph, resonator_c_est
-    and in_range, chunk by chunk (memory bounded whatever the file size).
+    and in_range (and scale_model_ppm with a scale factor), chunk by chunk (memory bounded
+    whatever the file size). A multi-axis model compensates every axis: rate_comp_dph_x, ...
 
     Example: hrgtc compensate warmup.parquet --model unit.json -o warmup_comp.parquet
     """
-    from hrgtc.compensate import compensate_file
-    from hrgtc.model import load_model
+    from hrgtc.compensate import compensate_instrument_file
+    from hrgtc.model import load_instrument
 
     with library_errors(), progress_bar("compensating", enabled=not json_output) as progress:
-        model = load_model(model_path)
-        summary = compensate_file(run, output, model, force=force, chunk_rows=chunk_rows,
-                                  progress=progress, read_options=inputs)
+        model = load_instrument(model_path)
+        summary = compensate_instrument_file(run, output, model, force=force,
+                                             chunk_rows=chunk_rows, progress=progress,
+                                             read_options=inputs)
     if json_output:
         print_json(summary.to_dict())
     else:
+        axes = "" if model.is_single_axis else f" (axes {', '.join(model.names)}; the worst)"
         console.print(
             f"wrote {summary.output}: {summary.rows} rows; "
             f"{summary.out_of_range_fraction:.2%} outside the calibrated temperature range, "
             f"{summary.rate_out_of_range_fraction:.2%} with df/dt beyond its training range"
+            f"{axes}"
         )
     warn_ranges([summary.ranges], json_output, strict)
 
@@ -131,7 +136,8 @@ def evaluate_command(
     inputs: ReadOptions | None = None,
 ) -> None:
     """Bias stability at 1, 10, 100 s (with 1σ intervals) and Allan noise terms, raw vs
-    compensated (and vs the housing-thermistor baseline when the run has housing_c).
+    compensated (and vs the housing-thermistor baseline when the run has housing_c);
+    with a multi-axis model, each axis and the instrument's summary.
 
     Example: hrgtc evaluate warmup.parquet --model unit.json --deviation oadev
     --allan-csv warmup_allan.csv --json
@@ -139,7 +145,10 @@ def evaluate_command(
     from hrgtc.evaluation import evaluate
     from hrgtc.evaluation.run_pass import DEVIATIONS
     from hrgtc.files import refuse_existing, write_text_atomic
-    from hrgtc.model import load_model
+    from hrgtc.model import load_instrument
+    from hrgtc.recording import ReadOptions
+
+    inputs = inputs or ReadOptions()
 
     if deviation not in DEVIATIONS:
         error_console.print(f"error: --deviation {deviation!r} is not known; use one of "
@@ -148,13 +157,65 @@ def evaluate_command(
     with library_errors():
         if allan_csv is not None:
             refuse_existing(allan_csv, force)
-    with library_errors(), progress_bar("evaluating", enabled=not json_output) as progress:
-        result = evaluate(run, load_model(model_path), progress=progress, read_options=inputs,
-                          deviation=deviation, max_points=PREDICTION_BLOCKS)
+    results: dict[str, Evaluation] = {}
+    with library_errors():
+        model = load_instrument(model_path)
+    for axis, unit_model in model.axes.items():
+        label = "evaluating" + (f" axis {axis}" if axis else "")
+        with library_errors(), progress_bar(label, enabled=not json_output) as progress:
+            results[axis] = evaluate(
+                run, unit_model, progress=progress, deviation=deviation,
+                read_options=dataclasses.replace(inputs, axis=axis or None),
+                max_points=PREDICTION_BLOCKS)
+    with library_errors():
         if allan_csv is not None:
-            write_text_atomic(allan_csv, result.allan_csv(), force=force)
-    if json_output:
-        print_json(result.to_dict())
+            write_text_atomic(allan_csv, allan_text(results), force=force)
+    if model.is_single_axis:
+        if json_output:
+            print_json(results[""].to_dict())
+        else:
+            render_evaluation(results[""])
+    elif json_output:
+        print_json({"unit": model.unit, "axes": {a: r.to_dict() for a, r in results.items()},
+                    "summary": axis_summary(results)})
     else:
-        render_evaluation(result)
-    warn_ranges([result.ranges], json_output, strict)
+        for axis, result in results.items():
+            console.rule(f"axis {axis}")
+            render_evaluation(result)
+        render_axis_summary(model.unit, results)
+    warn_ranges([r.ranges for r in results.values()], json_output, strict)
+
+
+def allan_text(results: dict[str, Evaluation]) -> str:
+    """The Allan CSV of every axis (an ``axis`` column first when there are several)."""
+    if list(results) == [""]:
+        return results[""].allan_csv()
+    lines: list[str] = []
+    for axis, result in results.items():
+        header, *rows = result.allan_csv().splitlines()
+        if not lines:
+            lines.append("axis," + header)
+        lines.extend(f"{axis},{row}" for row in rows)
+    return "\n".join(lines) + "\n"
+
+
+def axis_summary(results: dict[str, Evaluation]) -> list[dict[str, float | str]]:
+    """One row per axis: 10 s bias stability raw and compensated, improvement, ranges."""
+    return [{"axis": axis, "raw_10s_dph": r.raw_10s, "compensated_10s_dph": r.compensated_10s,
+             "improvement_10s": r.improvement_10s,
+             "out_of_range_fraction": r.out_of_range_fraction,
+             "rate_out_of_range_fraction": r.rate_out_of_range_fraction}
+            for axis, r in results.items()]
+
+
+def render_axis_summary(unit: str, results: dict[str, Evaluation]) -> None:
+    """The instrument's summary table: one row per axis."""
+    table = Table(title=f"{unit}: 10 s bias stability per axis (°/h)")
+    for column in ("axis", "raw", "compensated", "improvement", "beyond T", "beyond df/dt"):
+        table.add_column(column, justify="right")
+    for row in axis_summary(results):
+        table.add_row(str(row["axis"]), f"{row['raw_10s_dph']:.4f}",
+                      f"{row['compensated_10s_dph']:.4f}", f"{row['improvement_10s']:.2f}×",
+                      f"{row['out_of_range_fraction']:.1%}",
+                      f"{row['rate_out_of_range_fraction']:.1%}")
+    console.print(table)

@@ -19,7 +19,8 @@ if TYPE_CHECKING:
 def report_command(
     runs: list[Path] = typer.Argument(
         ..., metavar="RUN...", help="Runs to compensate and show (Fig. 6), one section each."),
-    model: Path = typer.Option(..., "--model", help="Model file written by 'hrgtc calibrate'."),
+    model: Path = typer.Option(
+        ..., "--model", "-m", help="Model file written by 'hrgtc calibrate'."),
     output: Path = typer.Option(..., "-o", "--output", help="HTML file to write."),
     soak: list[Path] = typer.Option(
         None, "--soak", help="Soak recording for Figs. 3 and 5 (repeat); default: the soaks "

@@ -44,6 +44,8 @@ class CPlan:
         Newton tolerance of the inverse. [°C]
     extension
         Temperatures over which the inverse is defined. [°C]
+    precision
+        ``"double"`` (C double throughout) or ``"single"`` (float32, centred frequency).
     """
 
     housing: bool
@@ -59,16 +61,28 @@ class CPlan:
     f_range: tuple[float, float]
     tolerance: float
     extension: tuple[float, float]
+    precision: str = "double"
 
 
-def plan_for(model: UnitModel) -> CPlan:
+#: The precisions the export writes.
+PRECISIONS = ("double", "single")
+#: The variables the float32 build computes (its filter and mirror know these).
+SINGLE_VARIABLES = ("f", "df", "h", "dh")
+
+
+def plan_for(model: UnitModel, precision: str = "double") -> CPlan:
     """The numbers the C code needs beyond the model's own, computed as hrgtc computes them.
 
     Raises
     ------
+    InputError
+        An unknown precision, or a model the C export cannot compute (``dpos`` terms).
     CalibrationError
         A thermometer that is not monotonic over its calibrated range.
     """
+    if precision not in PRECISIONS:
+        raise InputError(f"precision {precision!r} is not one of {', '.join(PRECISIONS)}; "
+                         "use 'double' (the default) or 'single' (float32 for FPU-only MCUs)")
     thermometer, drift = model.thermometer, model.drift
     if not thermometer.is_monotonic:
         t_low, t_high = thermometer.temperature_range_c
@@ -82,6 +96,12 @@ def plan_for(model: UnitModel) -> CPlan:
         raise InputError(
             f"the drift model uses the heating/cooling switch dpos ({', '.join(drift.selected)}), "
             "which the C export does not compute; calibrate without dpos terms for on-board use"
+        )
+    beyond = sorted(used - set(SINGLE_VARIABLES))
+    if precision == "single" and beyond:
+        raise InputError(
+            f"the float32 export computes the variables {', '.join(SINGLE_VARIABLES)}; the "
+            f"drift model also uses {', '.join(beyond)}: export it with --precision double"
         )
     housing = bool(used & {"h", "dh"})
     # The compensator computes f and df (and h, dh when the terms use them); in_range checks
@@ -118,4 +138,5 @@ def plan_for(model: UnitModel) -> CPlan:
         f_range=(f_low, f_high),
         tolerance=4 * np.finfo(np.float64).eps * max(abs(lo), abs(hi), span),
         extension=(lo, hi),
+        precision=precision,
     )

@@ -11,15 +11,14 @@ separate statements, so a compiler that contracts ``a*b + c`` within an expressi
 
 from __future__ import annotations
 
-import math
 import re
 import textwrap
 from pathlib import Path
 from typing import Any
 
 from hrgtc.compensate.c_plan import TABLE_POINTS, CPlan
+from hrgtc.compensate.c_types import DOUBLE, CType, ctype
 from hrgtc.drift.features import Term, settle_rows
-from hrgtc.errors import InputError
 from hrgtc.model import UnitModel
 
 #: Iteration cap of the thermometer inverse (as :meth:`Thermometer.temperature`).
@@ -29,16 +28,7 @@ _WIDTH = 92
 
 def _literal(value: float, name: str) -> str:
     """``%.17g`` text of a finite double as a C double literal (reads back exactly)."""
-    value = float(value)
-    if not math.isfinite(value):
-        raise InputError(
-            f"model constant {name} is {value}; a model with non-finite numbers cannot be "
-            "exported: recalibrate the unit"
-        )
-    text = f"{value:.17g}"
-    if not any(c in text for c in ".eEn"):
-        text += ".0"
-    return text
+    return DOUBLE.literal(value, name)
 
 
 def _comment(text: Any) -> str:
@@ -48,31 +38,36 @@ def _comment(text: Any) -> str:
     return ascii_text.replace("*/", "* /").replace("/*", "/ *")
 
 
-def _array(values: Any, name: str) -> str:
-    items = [_literal(v, f"{name}[{k}]") for k, v in enumerate(values)]
+def _array(values: Any, name: str, t: CType = DOUBLE) -> str:
+    items = [t.literal(v, f"{name}[{k}]") for k, v in enumerate(values)]
     lines = ["    " + ", ".join(items[k : k + 3]) + "," for k in range(0, len(items), 3)]
     return "{\n" + "\n".join(lines) + "\n}"
 
 
-def _factor(variable: str, power: int) -> str:
+def _factor(variable: str, power: int, t: CType = DOUBLE) -> str:
     x = f"x_{variable}"
     if power == 1:
         return x
     if power == 2:
         return f"({x} * {x})"  # numpy squares by multiplication
-    return f"pow({x}, {power}.0)"  # numpy calls the C library's pow for other powers
+    # numpy calls the C library's pow for other powers
+    return f"{t.call('pow')}({x}, {t.literal(power, 'power')})"
 
 
-def _term_expression(term: Term) -> str:
-    return " * ".join(_factor(v, p) for v, p in term.powers)
+def _term_expression(term: Term, t: CType = DOUBLE) -> str:
+    return " * ".join(_factor(v, p, t) for v, p in term.powers)
 
 
 
 
 def readme(model: UnitModel, plan: CPlan, prefix: str, origin: str,
-            sha256: str) -> str:
-    """The README comment block at the top of the header: what, provenance, Eq. (22), units, use."""
+            sha256: str, sections: list[str] | None = None) -> str:
+    """The README comment block at the top of the header: what, provenance, Eq. (22), units, use.
+
+    ``sections`` replace the UNITS and USAGE sections (the float32 build writes its own).
+    """
     from hrgtc._meta import PAPER_REFERENCE, __version__
+    from hrgtc.compensate.c_scale import scale_pieces
 
     drift, thermometer, settings = model.drift, model.thermometer, model.drift.settings
     p, up = prefix, prefix.upper()
@@ -175,6 +170,11 @@ def readme(model: UnitModel, plan: CPlan, prefix: str, origin: str,
         "REFERENCE",
         f"  [1] {PAPER_REFERENCE}",
     ]
+    scale = scale_pieces(model, plan, prefix)["readme"]
+    if scale:
+        lines[lines.index("  rate_comp_dph = rate_dph - B")] = scale
+    if sections is not None:
+        lines[lines.index("UNITS"):lines.index("REFERENCE")] = sections
     wrapped = []
     for line in lines:
         head = re.match(r"^\s*(?:\S+:\s+|\S+ = |\[\d+\] )?", line)
@@ -187,6 +187,8 @@ def readme(model: UnitModel, plan: CPlan, prefix: str, origin: str,
 def header(model: UnitModel, plan: CPlan, prefix: str, origin: str,
             sha256: str) -> str:
     """Text of ``<prefix>_model.h``: README block, state and output structs, prototypes."""
+    from hrgtc.compensate.c_scale import scale_pieces
+
     p, up = prefix, prefix.upper()
     housing = plan.housing
     state_h = "    double h_y1;                /* first low-pass stage of h [degC] */\n" \
@@ -199,6 +201,8 @@ def header(model: UnitModel, plan: CPlan, prefix: str, origin: str,
     bias_h = ", double h_c, double dh_c_per_s" if housing else ""
     levels = " and ".join(v for v in plan.computed if v in ("f", "h"))
     settle = settle_rows(model.drift.settings)
+    k = scale_pieces(model, plan, prefix)
+    out_h += k["field"]
     rates = " and ".join(v for v in plan.computed if v in ("df", "dh"))
     return f"""{readme(model, plan, prefix, origin, sha256)}
 #ifndef {up}_MODEL_H
@@ -217,7 +221,7 @@ extern "C" {{
 #define {up}_USES_HOUSING {1 if housing else 0}
 /* SHA-256 of the model this code was generated from. */
 #define {up}_MODEL_SHA256 "{sha256}"
-
+{k['define']}
 /* Filter state of one gyro; initialise with {p}_init(). */
 typedef struct {p}_state {{
     double f_y1;                /* first low-pass stage of f [Hz] */
@@ -253,7 +257,7 @@ double {p}_step({p}_state *state, double freq_hz, double rate_dph{arg_h}, {p}_ou
 /* Bias model B of Eq. (22) from the variables. [deg/h] */
 double {p}_bias_dph(double f_hz, double df_hz_per_s{bias_h});
 
-/* Thermometer f(T), Eq. (18) form. [Hz] from [degC] */
+{k['prototype']}/* Thermometer f(T), Eq. (18) form. [Hz] from [degC] */
 double {p}_frequency_hz(double temperature_c);
 
 /* Its inverse: resonator temperature from frequency; NaN beyond the monotonic extension. */
@@ -277,6 +281,8 @@ def _bias_function(model: UnitModel, plan: CPlan, prefix: str) -> str:
     names = dict(zip(("f", "df", "h", "dh"), params, strict=False))
     used = [v for v in ("f", "df", "h", "dh") if v in drift.variables and drift.selected]
     body = []
+    t = ctype(plan)  # the C type: every declaration, literal and math call below
+    real, lit, zero = t.name, t.literal, t.literal(0.0, "zero")
     for v in names:
         if v not in used:
             body.append(f"    (void){names[v]};")
@@ -284,57 +290,59 @@ def _bias_function(model: UnitModel, plan: CPlan, prefix: str) -> str:
         # held at the edge of the training range; the tangent there continues the model
         # beyond it, as DriftModel.predict(extrapolation="tangent")
         u = v.upper()
-        body.append(f"    const double c_{v} = {names[v]} < CLAMP_{u}_LOW ? CLAMP_{u}_LOW : "
+        body.append(f"    const {real} c_{v} = {names[v]} < CLAMP_{u}_LOW ? CLAMP_{u}_LOW : "
                     f"({names[v]} > CLAMP_{u}_HIGH ? CLAMP_{u}_HIGH : {names[v]});")
-        body.append(f"    const double x_{v} = c_{v} / SCALE_{u};")
-    body.append("    double sum = 0.0;")
-    body.append("    double term;")
+        body.append(f"    const {real} x_{v} = c_{v} / SCALE_{u};")
+    body.append(f"    {real} sum = {zero};")
+    body.append(f"    {real} term;")
     for k, term in enumerate(drift.terms):
-        body.append(f"    term = {_term_expression(term)};  /* {term.name} */")
+        body.append(f"    term = {_term_expression(term, t)};  /* {term.name} */")
         body.append(f"    term = COEFFICIENTS[{k}] * term;")
         body.append("    sum = sum + term;")
     for v in used:
         u = v.upper()
         body.append(f"    if ({names[v]} < CLAMP_{u}_LOW || {names[v]} > CLAMP_{u}_HIGH) {{"
                     f"  /* beyond the training range of {v} */")
-        body.append("        double gradient = 0.0;")
+        body.append(f"        {real} gradient = {zero};")
         for k, term in enumerate(drift.terms):
             multiplier, rest = term.derivative(v)
             if not multiplier:
                 continue
-            factor = f"COEFFICIENTS[{k}] * {multiplier}.0 / SCALE_{u}"
-            expression = factor if rest is None else f"{factor} * {_term_expression(rest)}"
+            factor = f"COEFFICIENTS[{k}] * {lit(multiplier, 'multiplier')} / SCALE_{u}"
+            expression = factor if rest is None else f"{factor} * {_term_expression(rest, t)}"
             body.append(f"        gradient = gradient + {expression};  /* d({term.name})/d{v} */")
         body.append(f"        sum = sum + gradient * ({names[v]} - c_{v});")
         body.append("    }")
     body.append("    return INTERCEPT_DPH + sum;")
     if not drift.terms:
         body = [line for line in body if "term" not in line]
-    signature = ", ".join(f"double {name}" for name in params)
-    constants = [f"static const double INTERCEPT_DPH = "
-                 f"{_literal(drift.intercept_dph, 'intercept_dph')};"]
+    signature = ", ".join(f"{real} {name}" for name in params)
+    constants = [f"static const {real} INTERCEPT_DPH = "
+                 f"{lit(drift.intercept_dph, 'intercept_dph')};"]
     for v in used:
-        constants.append(f"static const double SCALE_{v.upper()} = "
-                         f"{_literal(drift.settings.scales[v], f'scales[{v}]')};")
+        constants.append(f"static const {real} SCALE_{v.upper()} = "
+                         f"{lit(drift.settings.scales[v], f'scales[{v}]')};")
         low, high = drift.ranges[v]
-        constants.append(f"static const double CLAMP_{v.upper()}_LOW = "
-                         f"{_literal(low, f'ranges[{v}][0]')};")
-        constants.append(f"static const double CLAMP_{v.upper()}_HIGH = "
-                         f"{_literal(high, f'ranges[{v}][1]')};")
+        constants.append(f"static const {real} CLAMP_{v.upper()}_LOW = "
+                         f"{lit(low, f'ranges[{v}][0]')};")
+        constants.append(f"static const {real} CLAMP_{v.upper()}_HIGH = "
+                         f"{lit(high, f'ranges[{v}][1]')};")
     if drift.terms:
         listed = ", ".join(drift.selected)
         constants.append(f"/* Coefficients on scaled variables, in this order: {listed} */")
-        constants.append(f"static const double COEFFICIENTS[{len(drift.terms)}] = "
-                         f"{_array(drift.scaled_coefficients, 'scaled_coefficients')};")
+        constants.append(f"static const {real} COEFFICIENTS[{len(drift.terms)}] = "
+                         f"{_array(drift.scaled_coefficients, 'scaled_coefficients', t)};")
     return "\n".join(constants) + f"""
 
-double {prefix}_bias_dph({signature})
+{real} {prefix}_bias_dph({signature})
 {{
 """ + "\n".join(body) + "\n}\n"
 
 
 def source(model: UnitModel, plan: CPlan, prefix: str) -> str:
     """Text of ``<prefix>_model.c``: filter, drift model, thermometer inverse, step()."""
+    from hrgtc.compensate.c_scale import scale_pieces
+
     p, up = prefix, prefix.upper()
     drift, th = model.drift, model.thermometer
     settings = drift.settings
@@ -370,6 +378,7 @@ def source(model: UnitModel, plan: CPlan, prefix: str) -> str:
     if not plan.housing:
         h = dict.fromkeys(h, "")
     n_th = len(plan.th_coefficients)
+    k = scale_pieces(model, plan, prefix)
     return f"""/* {p}_model.c -- generated by hrgtc export-c for unit {_comment(model.unit)};
  * see {p}_model.h for what it computes, its provenance and its use. Do not edit.
  * Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
@@ -400,7 +409,7 @@ static double rate_update(double *y1, double *y2, double x)
 }}
 
 /* ---- the drift model, Eq. (22) of [1] (hrgtc.drift.DriftModel.predict) ---- */
-{_bias_function(model, plan, p)}
+{_bias_function(model, plan, p)}{k['function']}
 /* ---- the thermometer, Eq. (18) of [1] (hrgtc.thermometry.Thermometer) ---- */
 static const double TH_CENTRE_C = {_literal(th.centre_c, 'centre_c')};
 static const double TH_SCALE_C = {_literal(th.scale_c, 'scale_c')};
@@ -509,7 +518,7 @@ double {p}_step({p}_state *state, double freq_hz, double rate_dph{h['arg']}, \
     const double f_value = freq_hz - REFERENCE_FREQ_HZ;
 {h['values']}    double df_value, bias, compensated, temperature;
     int in_range, rate_in_range, level_in_range;
-    if (!state->started) {{  /* the filter starts at rest on the first sample */
+{k['declare']}    if (!state->started) {{  /* the filter starts at rest on the first sample */
         state->f_y1 = f_value;
         state->f_y2 = f_value;
 {h['start']}        state->started = 1;
@@ -525,13 +534,13 @@ double {p}_step({p}_state *state, double freq_hz, double rate_dph{h['arg']}, \
     state->samples += 1UL;
     state->out_of_range += level_in_range ? 0UL : 1UL;
     state->rate_out_of_range += rate_in_range ? 0UL : 1UL;
-    if (out) {{
+{k['apply']}    if (out) {{
         out->rate_comp_dph = compensated;
         out->bias_model_dph = bias;
         out->resonator_c_est = temperature;
         out->f_hz = f_value;
         out->df_hz_per_s = df_value;
-{h['out']}        out->in_range = in_range;
+{h['out']}{k['out']}        out->in_range = in_range;
         out->rate_in_range = rate_in_range;
     }}
     return compensated;

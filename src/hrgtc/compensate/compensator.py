@@ -45,8 +45,16 @@ BLOCK_ROWS = 1 << 17
 FILE_CHUNK_ROWS = 1 << 20
 #: Columns added by compensation.
 OUTPUT_COLUMNS = ("rate_comp_dph", "bias_model_dph", "resonator_c_est", "in_range")
+#: Column added when the model has a scale factor: its error at each sample's frequency.
+SCALE_COLUMN = "scale_model_ppm"
 #: Ways of computing them (see the module docstring).
 ENGINES = ("fused", "numpy")
+
+
+def output_columns(model: UnitModel) -> tuple[str, ...]:
+    """Columns compensation with ``model`` adds (:data:`OUTPUT_COLUMNS`, and
+    :data:`SCALE_COLUMN` when the model has a scale factor)."""
+    return OUTPUT_COLUMNS if model.scale_factor is None else (*OUTPUT_COLUMNS, SCALE_COLUMN)
 
 
 def _in_training_range(
@@ -104,6 +112,8 @@ class Compensator:
         else:
             raise InputError(f"drift must be 'frequency' or 'housing', got {drift!r}")
         self.model = model
+        #: Applied with the frequency drift model only (the housing baseline is bias only).
+        self.scale_factor = model.scale_factor if drift == "frequency" else None
         self.engine = engine
         self._plan: Any = None
         self._variables = tuple(dict.fromkeys(("f", "df", *self.drift.variables)))
@@ -169,16 +179,21 @@ class Compensator:
                         self.segments += 1
                     pieces.append(self._process(chunk.slice(start, stop)))
                 return chunk.with_columns(**{
-                    name: np.concatenate([p[name] for p in pieces]) for name in OUTPUT_COLUMNS})
+                    name: np.concatenate([p[name] for p in pieces])
+                    for name in output_columns(self.model) if name in pieces[0]})
         return self._process(chunk)
 
     def _process(self, chunk: Recording) -> Recording:
         n = len(chunk)
         out = {name: np.empty(n) for name in OUTPUT_COLUMNS}
-        if self.engine == "fused" and self._fused(chunk, out):
-            return chunk.with_columns(**out)
-        for start in range(0, n, BLOCK_ROWS):
-            self._block(chunk.slice(start, start + BLOCK_ROWS), out, start)
+        if not (self.engine == "fused" and self._fused(chunk, out)):
+            for start in range(0, n, BLOCK_ROWS):
+                self._block(chunk.slice(start, start + BLOCK_ROWS), out, start)
+        if self.scale_factor is not None:
+            # rate = input * (1 + k) + bias, so input = (rate - bias) / (1 + k).
+            ppm = self.scale_factor.ppm(chunk.freq_hz)
+            out[SCALE_COLUMN] = ppm
+            out["rate_comp_dph"] /= 1.0 + 1e-6 * ppm
         return chunk.with_columns(**out)
 
     def _fused(self, chunk: Recording, out: dict[str, np.ndarray]) -> bool:
@@ -289,8 +304,15 @@ def compensate_file(
     chunk_rows: int = FILE_CHUNK_ROWS,
     drift: str = "frequency",
     progress: Progress | None = None,
+    compensator: Any = None,
 ) -> CompensationSummary:
     """Compensate a recording file into a new file, chunk by chunk (bounded memory).
+
+    ``compensator``: another streaming compensator with the interface of
+    :class:`Compensator` and a ``columns`` attribute (e.g. the
+    :class:`~hrgtc.compensate.instrument.InstrumentCompensator` of every axis, see
+    :func:`~hrgtc.compensate.instrument.compensate_instrument_file`); ``model`` then
+    only marks the output.
 
     The output is written atomically in the format of its suffix; it is never
     overwritten without ``force``. ``read_options`` says how to read ``source``
@@ -302,14 +324,19 @@ def compensate_file(
     one and starts its write-back to disk, so that the fsync before the atomic
     rename finds little left to wait for. At most three chunks are held at a time.
     """
-    options = with_model_band(read_options or rec_io.ReadOptions(), model)
-    compensator = Compensator(model, drift, gaps=options.gaps)
+    if compensator is None:
+        options = with_model_band(read_options or rec_io.ReadOptions(), model)
+        compensator = Compensator(model, drift, gaps=options.gaps)
+        added = output_columns(model)
+    else:
+        options = read_options or rec_io.ReadOptions()
+        added = compensator.columns
     refuse_compensated(source)
-    check_writable(output, estimated_output_bytes(source, output, len(OUTPUT_COLUMNS)))
+    check_writable(output, estimated_output_bytes(source, output, len(added)))
     chunks = options.chunks(source, rows=chunk_rows)
     try:
         first = next(chunks)
-        names = (*first.names, *OUTPUT_COLUMNS)
+        names = (*first.names, *added)
         total = rec_io.count_rows(source)
         metadata = compensated_metadata(first.metadata, model, drift)
         with rec_io.RecordingWriter(output, metadata, names, force=force) as writer, \

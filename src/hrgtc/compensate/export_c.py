@@ -23,6 +23,12 @@ thermometer polynomial and the terms round exactly as NumPy does; what remains
 rounding level: about 1e-14 °/h and 3e-12 °C. The C text is printed by
 :mod:`hrgtc.compensate.c_text`.
 
+``precision="single"`` writes the float32 build for FPU-only microcontrollers
+(:mod:`hrgtc.compensate.c_single`; centred frequency input), whose worst error against
+the double model is measured at export by its numpy float32 mirror
+(:mod:`hrgtc.compensate.c_float32`) and stated in the header. ``output_format="params"``
+writes the plain parameter file of :mod:`hrgtc.compensate.parameter_file` instead.
+
 [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
 """
 
@@ -34,21 +40,28 @@ import os
 import re
 from pathlib import Path
 
-from hrgtc.compensate.c_plan import plan_for
-from hrgtc.compensate.c_text import header, source
+from hrgtc.compensate import c_single
+from hrgtc.compensate.c_float32 import float_accuracy, float_constants
+from hrgtc.compensate.c_plan import PRECISIONS, plan_for
+from hrgtc.compensate.c_text import _comment, header, source
+from hrgtc.compensate.parameter_file import instrument_parameter_text, parameter_text
 from hrgtc.errors import InputError
 from hrgtc.files import file_sha256, refuse_existing, write_text_atomic
-from hrgtc.model import UnitModel, load_model
+from hrgtc.model import InstrumentModel, UnitModel, load_instrument
 
+#: What the export writes: C99 files, or the plain parameter file.
+FORMATS = ("c", "params")
 _PREFIX = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,31}$")
 
 
 # -- public API ---------------------------------------------------------------------------
 def export_c(
-    model: UnitModel | str | os.PathLike[str],
+    model: UnitModel | InstrumentModel | str | os.PathLike[str],
     outdir: str | os.PathLike[str],
     prefix: str = "hrgtc",
     force: bool = False,
+    precision: str = "double",
+    output_format: str = "c",
 ) -> list[Path]:
     """Write the unit's compensation as C99 files ``<prefix>_model.h`` and ``<prefix>_model.c``.
 
@@ -61,7 +74,8 @@ def export_c(
     Parameters
     ----------
     model
-        The unit's model, or the path of its model file (then the header
+        The unit's model (a :class:`UnitModel`, or an :class:`InstrumentModel` with one
+        model per axis), or the path of its model file (then the header
         records the file's SHA-256; for an in-memory model, the SHA-256 of the
         JSON document :func:`hrgtc.model.save_model` would write).
     outdir
@@ -70,16 +84,31 @@ def export_c(
         C identifier prefix of every exported name (``<prefix>_step``, ...).
     force
         Overwrite existing files.
+    precision
+        ``"double"`` (default): C double throughout. ``"single"``: float32 for FPU-only
+        microcontrollers, with the frequency entering centred (``f_hz = freq_hz -
+        <PREFIX>_CENTRE_HZ``) and the worst error against the double model over the
+        calibrated range, measured at export (:mod:`hrgtc.compensate.c_float32`), stated
+        in the header and as ``<PREFIX>_MAX_ERROR_C`` / ``<PREFIX>_MAX_ERROR_DPH``.
+    output_format
+        ``"c"`` (default): the header and source. ``"params"``: one plain parameter file
+        ``<prefix>_params.txt`` of ``key = value`` lines, every number documented
+        (:mod:`hrgtc.compensate.parameter_file`); ``precision`` does not apply.
 
     Returns
     -------
     list of pathlib.Path
-        The header and the source written.
+        The header and the source written (the parameter file for ``output_format="params"``).
+        For an instrument with named axes: ``<prefix>_model.h``, which includes every
+        axis's ``<prefix>_<axis>_model.h``, then each axis's header and source (every
+        name of axis a prefixed ``<prefix>_<a>``); its parameter file prefixes every key
+        with ``<axis>_``.
 
     Raises
     ------
     InputError
-        A prefix that is not a C identifier, or non-finite model constants.
+        A prefix that is not a C identifier, an unknown precision, or non-finite model
+        constants.
     CalibrationError
         A thermometer that is not monotonic over its calibrated range.
     OutputExistsError
@@ -92,25 +121,111 @@ def export_c(
             f"prefix {prefix!r} is not usable as a C identifier prefix; use a letter followed by "
             "up to 31 letters, digits or underscores, e.g. 'hrgtc' or 'gyro_x'"
         )
-    if isinstance(model, UnitModel):
-        document = json.dumps(model.to_dict(), indent=2, allow_nan=True) + "\n"
-        sha256 = hashlib.sha256(document.encode("utf-8")).hexdigest()
-        origin = "in memory (SHA-256 of its JSON document as hrgtc writes it)"
-    else:
-        path = Path(model)
-        model = load_model(path)
-        sha256 = file_sha256(path)
-        origin = path.name
+    if output_format not in FORMATS:
+        raise InputError(f"format {output_format!r} is not one of {', '.join(FORMATS)}; use 'c' "
+                         "(header and source) or 'params' (a key = value parameter file)")
+    if precision not in PRECISIONS:
+        raise InputError(f"precision {precision!r} is not one of {', '.join(PRECISIONS)}; "
+                         "use 'double' (the default) or 'single' (float32 for FPU-only MCUs)")
+    axes, origin, sha256 = _axes_of(model)
     folder = Path(outdir)
     if folder.exists() and not folder.is_dir():
         raise InputError(f"output folder {folder} is a file; give a folder for the C files")
-    header_path = folder / f"{prefix}_model.h"
-    source_path = folder / f"{prefix}_model.c"
-    refuse_existing((header_path, source_path), force)
-    plan = plan_for(model)
-    header_text = header(model, plan, prefix, origin, sha256)
-    code = source(model, plan, prefix)
-    return [
-        write_text_atomic(header_path, header_text, force=force),
-        write_text_atomic(source_path, code, force=force),
-    ]
+    single_axis = list(axes) == [""]
+    for name in axes:
+        if name and not _PREFIX.match(f"{prefix}_{name}"):
+            raise InputError(f"prefix {prefix!r} with axis {name!r} gives {prefix}_{name}, "
+                             "longer than 32 characters; use a shorter --prefix")
+    if output_format == "params":
+        target = folder / f"{prefix}_params.txt"
+        refuse_existing((target,), force)
+        plans = {name: plan_for(unit) for name, unit in axes.items()}
+        text = (parameter_text(axes[""], plans[""], origin, sha256) if single_axis else
+                instrument_parameter_text(axes, plans, origin, sha256))
+        return [write_text_atomic(target, text, force=force)]
+    files: dict[Path, str] = {}
+    if single_axis:
+        files[folder / f"{prefix}_model.h"] = ""
+        files[folder / f"{prefix}_model.c"] = ""
+    else:
+        files[folder / f"{prefix}_model.h"] = ""
+        for name in axes:
+            files[folder / f"{prefix}_{name}_model.h"] = ""
+            files[folder / f"{prefix}_{name}_model.c"] = ""
+    refuse_existing(tuple(files), force)
+    if single_axis:
+        texts = _c_texts(axes[""], prefix, origin, sha256, precision)
+    else:
+        texts = (umbrella_header(axes, prefix, origin, sha256, precision),)
+        for name, unit in axes.items():
+            texts += _c_texts(unit, f"{prefix}_{name}", f"{origin}, axis {name}", sha256,
+                              precision)
+    return [write_text_atomic(path, text, force=force)
+            for path, text in zip(files, texts, strict=True)]
+
+
+def _axes_of(model: UnitModel | InstrumentModel | str | os.PathLike[str],
+             ) -> tuple[dict[str, UnitModel], str, str]:
+    """Axis name -> model ('' for a single gyro), the model's origin and SHA-256."""
+    if isinstance(model, (UnitModel, InstrumentModel)):
+        document = json.dumps(model.to_dict(), indent=2, allow_nan=True) + "\n"
+        sha256 = hashlib.sha256(document.encode("utf-8")).hexdigest()
+        origin = "in memory (SHA-256 of its JSON document as hrgtc writes it)"
+        loaded = model
+    else:
+        path = Path(model)
+        loaded = load_instrument(path)
+        origin, sha256 = path.name, file_sha256(path)
+    if isinstance(loaded, UnitModel):
+        return {"": loaded}, origin, sha256
+    return dict(loaded.axes), origin, sha256
+
+
+def _c_texts(model: UnitModel, prefix: str, origin: str, sha256: str,
+             precision: str) -> tuple[str, str]:
+    """Header and source of one gyro (one axis)."""
+    plan = plan_for(model, precision)
+    if precision == "single":
+        constants = float_constants(model, plan)
+        accuracy = float_accuracy(model, plan, constants)
+        return (c_single.header(model, plan, prefix, origin, sha256, constants, accuracy),
+                c_single.source(model, plan, prefix, constants))
+    return header(model, plan, prefix, origin, sha256), source(model, plan, prefix)
+
+
+def umbrella_header(axes: dict[str, UnitModel], prefix: str, origin: str, sha256: str,
+                    precision: str) -> str:
+    """``<prefix>_model.h`` of an instrument: includes every axis's header."""
+    up = prefix.upper()
+    names = list(axes)
+    first = f"{prefix}_{names[0]}"
+    includes = "".join(f'#include "{prefix}_{name}_model.h"\n' for name in names)
+    argument = f"{first.upper()}_CENTRED_HZ(freq_hz)" if precision == "single" else "freq_hz"
+    return f"""/*
+ * {prefix}_model.h -- HRG compensation of every axis of instrument {_comment(origin)}
+ *
+ * Generated by hrgtc (hrgtc export-c); do not edit, regenerate from the model file.
+ * One axis, one prefix: axis <a> is compensated by {prefix}_<a>_step() with its own state,
+ * constants and files {prefix}_<a>_model.h / .c (each documented there: its model, units,
+ * {'float32 accuracy, ' if precision == 'single' else ''}use); this header includes them all.
+ * Axes: {", ".join(names)}.
+ *
+ * USAGE
+ *   #include "{prefix}_model.h"
+ *   static {first}_state gyro_{names[0]};
+ *   {first}_init(&gyro_{names[0]});
+ *   rate = {first}_step(&gyro_{names[0]}, {argument}, rate_dph, ..., &out);  // each sample
+ *   (and likewise for the other axes, each with its own frequency and rate)
+ *   Build: cc -std=c99 -O2 -c {" ".join(f"{prefix}_{n}_model.c" for n in names)}, link -lm.
+ *
+ * model SHA-256: {sha256}
+ */
+#ifndef {up}_MODEL_H
+#define {up}_MODEL_H
+
+/* Number of axes. */
+#define {up}_N_AXES {len(names)}
+
+{includes}
+#endif /* {up}_MODEL_H */
+"""

@@ -36,6 +36,7 @@ from hrgtc.drift.scale_factor import (
     SCALE_FACTOR_JSON_SCHEMA,
     ScaleFactorModel,
     ScaleGroup,
+    fit_group,
     fit_scale_factor,
     group_segments,
 )
@@ -63,6 +64,7 @@ __all__ = [
     "causal_rate",
     "find_rate_segments",
     "fit",
+    "fit_group",
     "fit_scale_factor",
     "group_segments",
     "ols",

@@ -317,7 +317,7 @@ def group_segments(segments: Sequence[RateSegment],
     return tuple(tuple(g) for g in groups)
 
 
-def _fit_group(group: Sequence[RateSegment], number: int) -> ScaleGroup:
+def fit_group(group: Sequence[RateSegment], number: int) -> ScaleGroup:
     """Least squares rate - Ω = b + k·Ω over one group's segments."""
     freq = float(np.mean([s.freq_hz for s in group]))
     x = np.array([s.input_rate_dph for s in group])
@@ -388,7 +388,7 @@ def fit_scale_factor(segments: Iterable[RateSegment], settings: FeatureSettings,
     tolerance = TOLERANCE_SHARE * scale if tolerance_hz is None else tolerance_hz
     fits = []
     for number, members in enumerate(group_segments(segments, tolerance), start=1):
-        fits.append(_fit_group(members, number))
+        fits.append(fit_group(members, number))
     groups = tuple(fits)
     k = np.array([g.k_ppm for g in groups])
     se = np.array([g.k_se_ppm for g in groups])
@@ -399,6 +399,16 @@ def fit_scale_factor(segments: Iterable[RateSegment], settings: FeatureSettings,
     history: tuple[Step, ...] = ()
     premove = max(penter, 0.10) if premove is None else premove
     if len(groups) >= 3:
+        # n groups fit the constant and at most n - 2 terms with a residual left over: the
+        # lowest powers first (a cubic needs five temperatures).
+        usable = sorted(candidates, key=lambda t: sum(p for _, p in t.powers))[:len(groups) - 2]
+        if len(usable) < len(candidates):
+            dropped = [t.name for t in candidates if t not in usable]
+            warnings.warn(f"{len(groups)} rate-table temperatures cannot select among "
+                          f"{len(candidates)} scale-factor terms: {', '.join(dropped)} left out "
+                          "(add temperatures)", HrgtcWarning, stacklevel=2)
+            candidates = [t for t in candidates if t in usable]
+            names = tuple(t.name for t in candidates)
         design = np.column_stack([t.evaluate({"f": x_f}, {}) for t in candidates])
         found = stepwise(design, k, names=names, penter=penter, premove=premove,
                          weights=w if use_weights else None)

@@ -584,7 +584,7 @@ def evaluate(
     blocks = None
     if max_points is not None:
         if fs is None:
-            fs = options.head(run, rows=2).sample_rate_hz
+            fs = options.head(run).sample_rate_hz  # (tiny chunks would each be validated)
         blocks = block_rows(rows, fs, max_points)
     return run_pass(model, chunks, name, source=source, taus_s=taus_s, allan=allan,
                     block_rows=blocks, on_output=on_output, progress=progress,

@@ -50,6 +50,9 @@ AXIS_INPUT_RATE_KEY = "axis_input_rate_dph"
 AXIS_PATTERN = re.compile(r"[A-Za-z][A-Za-z0-9]*")
 # longest names first, so that "input_rate_dph_x" is not read as "rate_dph" of axis "x"
 _BY_LENGTH = sorted(AXIS_COLUMNS, key=len, reverse=True)
+#: Names that look per-axis but are not: compensation's estimate of the resonator
+#: temperature (``resonator_c_est`` is not ``resonator_c`` of an axis ``est``).
+NOT_PER_AXIS = frozenset({"resonator_c_est"})
 
 __all__ = [
     "AXIS_COLUMNS", "AXIS_INPUT_RATE_KEY", "CROSS_AXIS_COLUMNS", "axis_input_rate_dph",
@@ -65,6 +68,8 @@ def split_axis(name: str) -> tuple[str, str | None]:
     name
         A column name such as ``"freq_hz_x"`` or ``"chamber_c"``.
     """
+    if name in NOT_PER_AXIS:
+        return name, None
     for base in _BY_LENGTH:
         if name.startswith(base + "_"):
             axis = name[len(base) + 1:]

@@ -36,6 +36,7 @@ import numpy as np
 
 from hrgtc.errors import InputError, RecordingError
 from hrgtc.progress import Progress
+from hrgtc.recording.axes import axis_view
 from hrgtc.recording.csv import CsvSource
 from hrgtc.recording.formats import (
     Hdf5Source,
@@ -367,6 +368,10 @@ class ReadOptions:
         ``"resonator"`` (default: ``freq_hz`` is the resonator frequency) or
         ``"sensor"`` (a gyro without a frequency output: ``freq_hz`` is filled from
         ``temperature_c``, per axis from ``temperature_c_<axis>``). [°C]
+    axis
+        Read one axis of a multi-axis file: every axis is validated, the single-axis
+        view of this one returned (:func:`~hrgtc.recording.axis_view`), and the
+        plausible band checked on its frequency only. None: the file as it is.
     """
 
     columns: Mapping[str, str] | None = None
@@ -380,6 +385,7 @@ class ReadOptions:
     temp_offset_c: float = 0.0
     spikes: str = "error"
     thermometer: str = "resonator"
+    axis: str | None = None
 
     def keywords(self) -> dict[str, Any]:
         """The options as keyword arguments of :func:`read` and :func:`iter_chunks`.
@@ -399,8 +405,10 @@ class ReadOptions:
 
     def read(self, path: str | Path, keep: Sequence[str] | None = None) -> Recording:
         """The whole file; with ``keep``, streamed keeping only those columns (less memory)."""
-        if keep is None:
+        if keep is None and self.axis is None:
             return read(path, **self.keywords())
+        if keep is None:
+            return concatenate(list(self.chunks(path)))
         parts = [Recording({k: c[k] for k in keep if k in c}, c.metadata, c.source)
                  for c in self.chunks(path)]
         return concatenate(parts)
@@ -416,5 +424,32 @@ class ReadOptions:
             chunks.close()
 
     def chunks(self, path: str | Path, rows: int | None = None) -> Iterator[Recording]:
-        """Stream the file in chunks (:func:`iter_chunks`)."""
-        return iter_chunks(path, rows=rows or self.chunk_rows, **self.keywords())
+        """Stream the file in chunks (:func:`iter_chunks`); with ``axis``, that axis's view."""
+        if self.axis is None:
+            return iter_chunks(path, rows=rows or self.chunk_rows, **self.keywords())
+        words = self.keywords()
+        words.pop("freq_band_hz", None)
+        words.pop("freq_span_hz", None)
+        return self._axis_chunks(iter_chunks(path, rows=rows or self.chunk_rows, **words),
+                                 str(path))
+
+    def _axis_chunks(self, chunks: Iterator[Recording], path: str) -> Iterator[Recording]:
+        axis = str(self.axis)
+        row = 0
+        try:
+            for chunk in chunks:
+                view = axis_view(chunk, axis)
+                band = self.freq_band_hz
+                if band is not None and len(view):
+                    freq = view.freq_hz
+                    bad = np.flatnonzero(~((freq >= band[0]) & (freq <= band[1])))
+                    if bad.size:
+                        raise RecordingError(
+                            f"{path}: column freq_hz_{axis}, row {row + int(bad[0])}: "
+                            f"{freq[bad[0]]!r} is outside the band {band[0]:.6g}-{band[1]:.6g} "
+                            f"this axis of the model can reach ({bad.size} such rows in the "
+                            "chunk); is it another unit's file, or the wrong column?")
+                row += len(chunk)
+                yield view
+        finally:
+            chunks.close()

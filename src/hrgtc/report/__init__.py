@@ -8,6 +8,6 @@ deviations, the stepwise table and the final model; ``figures`` draws them.
 [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
 """
 
-from hrgtc.report.html import build_report
+from hrgtc.report.build import build_report
 
 __all__ = ["build_report"]

@@ -1,6 +1,6 @@
-"""The HTML report: one self-contained file with the evidence of a calibration, like [1].
+"""The HTML report's sections: the evidence of a calibration, like [1].
 
-:func:`build_report` reads the unit's soaks and any number of runs chunk by
+:func:`hrgtc.report.build.build_report` reads the unit's soaks and any number of runs chunk by
 chunk (:func:`~hrgtc.report.figures.trace_soak`, and the one run pass of
 :func:`hrgtc.evaluation.evaluate`), decimates them to block means for plotting,
 compensates each run with the unit's model (and with the housing-thermistor
@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from datetime import UTC, datetime
 from html import escape
 from pathlib import Path
@@ -31,16 +31,13 @@ import numpy as np
 import hrgtc.report.figures as figures
 from hrgtc import paper
 from hrgtc.drift.features import parse_terms
-from hrgtc.errors import InputError
-from hrgtc.evaluation import Evaluation, evaluate
-from hrgtc.files import file_sha256, refuse_existing, write_text_atomic
-from hrgtc.model import UnitModel, load_model
-from hrgtc.progress import Progress
-from hrgtc.recording import ReadOptions, count_rows
-from hrgtc.report.figures import SoakTrace, trace_soak
+from hrgtc.evaluation import Evaluation
+from hrgtc.files import file_sha256
+from hrgtc.model import UnitModel
+from hrgtc.report.figures import SoakTrace
 from hrgtc.thermometry.plateaus import Plateau
 
-__all__ = ["build_report"]
+__all__: list[str] = []  # the sections; build.build_report puts them together
 
 PathLike = str | os.PathLike[str]
 
@@ -413,130 +410,21 @@ def _drift_model(page: _Page, model: UnitModel) -> None:
     page.add("</section>")
 
 
-# -- the report --------------------------------------------------------------------------------
-def _soak_files(model: UnitModel) -> tuple[list[str], list[str]]:
-    """(existing, missing) soak files named in the model's provenance."""
-    paths = [str(i["path"]) for i in model.provenance.get("inputs", [])
-             if i.get("role") == "soak" and i.get("path")]
-    return [p for p in paths if Path(p).is_file()], [p for p in paths if not Path(p).is_file()]
-
-
-def build_report(
-    model: UnitModel | PathLike,
-    runs: Sequence[PathLike | Evaluation],
-    output: PathLike,
-    *,
-    soaks: Sequence[PathLike] | None = None,
-    title: str | None = None,
-    force: bool = False,
-    max_points: int = 20_000,
-    read_options: ReadOptions | None = None,
-    progress: Progress | None = None,
-) -> Path:
-    """Write the unit's report: one self-contained HTML file with Figs. 3-6 and Tables 1-2 of [1].
-
-    Parameters
-    ----------
-    model
-        The unit's model, or the path of its model file.
-    runs
-        Recordings to compensate and evaluate (Fig. 6 of [1]), one section each, or
-        evaluations already made with plotting blocks (:func:`hrgtc.evaluation.evaluate`
-        with ``max_points``), which are not computed again.
-    output
-        The HTML file; written atomically, never overwritten without ``force``.
-    soaks
-        Soak recordings for Figs. 3 and 5(b); default: the model's soak inputs that
-        still exist on disk (read with the column mapping stored in the model).
-    title
-        Page title (default names the unit).
-    max_points
-        Most points per plotted curve; plots use block means of at least 10 s.
-    read_options
-        How to read the runs and the given soaks (column mapping, units, metadata).
-    progress
-        Optional ``callback(rows_done, rows_total)``.
-
-    Returns
-    -------
-    pathlib.Path
-        The written file.
-
-    Raises
-    ------
-    OutputExistsError
-        ``output`` exists and ``force`` is False (checked before any work).
-    InputError
-        An evaluation given in ``runs`` kept no plotting blocks.
-    """
-    target = Path(output)
-    refuse_existing(target, force)
-    model_path = None
-    if not isinstance(model, UnitModel):
-        model_path, model = str(model), load_model(model)
-    options = read_options or ReadOptions()
-    missing: list[str] = []
-    if soaks is None:
-        soak_paths, missing = _soak_files(model)
-        settings = model.provenance.get("settings", {})
-        soak_options = ReadOptions(columns=settings.get("columns") or None,
-                                   units=settings.get("units") or None)
-    else:
-        soak_paths, soak_options = [str(p) for p in soaks], options
-    for run in runs:
-        if isinstance(run, Evaluation) and run.blocks is None:
-            raise InputError(f"{run.file}: the evaluation kept no plotting blocks; "
-                             "evaluate it with max_points, or pass the file")
-    files = [run for run in runs if not isinstance(run, Evaluation)]
-    total = sum(count_rows(p) for p in [*soak_paths, *files])
-    done = 0
-
-    def advance(rows: int) -> None:
-        nonlocal done
-        done += rows
-        if progress is not None:
-            progress(done, total)
-
-    plateaus = [Plateau.from_dict(p) for p in model.plateaus]
-    table = _table_rows(model, plateaus)
-    traces = [trace_soak(p, model.thermometer, max_points=max_points, read_options=soak_options,
-                         on_chunk=advance) for p in soak_paths]
-    evaluations = [run if isinstance(run, Evaluation) else
-                   _evaluate_run(run, model, options, max_points, advance) for run in runs]
-    title = title or f"Temperature compensation report — unit {model.unit}"
-    page = _Page()
-    _header(page, model, title, model_path)
-    _summary(page, evaluations)
-    _settling(page, plateaus, traces, missing)
-    _thermometer(page, model, plateaus, table)
-    _temperature(page, table, traces)
-    page.add('<section id="runs"><h2>4. Runs: raw and compensated output</h2>')
-    if not runs:
-        page.note("No runs given.")
-    for k, run in enumerate(evaluations, start=1):
-        _run(page, k, run, model)
-    page.add("</section>")
-    _drift_model(page, model)
-    body = "\n".join(page.parts)
-    html = (f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
-            f'<meta name="viewport" content="width=device-width, initial-scale=1">'
-            f"<title>{escape(title)}</title>"
-            f"<style>{_CSS}</style></head><body>\n{body}\n<footer class=\"muted\"><p>[1] "
-            f"{REFERENCE}. doi:{DOI}. Generated by hrgtc.</p></footer></body></html>\n")
-    written = write_text_atomic(target, html, force=force)
-    if progress is not None:
-        progress(total, total)
-    return written
-
-
-def _evaluate_run(path: PathLike, model: UnitModel, options: ReadOptions, max_points: int,
-                  advance: Callable[[int], None]) -> Evaluation:
-    """The one run pass of :func:`hrgtc.evaluation.evaluate`, with plotting blocks."""
-    seen = 0
-
-    def progress(done: float, _total: float) -> None:
-        nonlocal seen
-        advance(int(done) - seen)
-        seen = int(done)
-
-    return evaluate(path, model, read_options=options, max_points=max_points, progress=progress)
+def _scale_factor(page: _Page, model: UnitModel) -> None:
+    """The scale-factor model: per-temperature k from the rate-table holds and k(f)."""
+    sf = model.scale_factor
+    if sf is None:
+        return
+    page.add('<section id="scale"><h2>6. Scale factor against frequency</h2>',
+             f"<p>Rate-table holds grouped by temperature; in each group rate = b + (1 + k)·Ω "
+             f"by least squares, then k(f) by stepwise regression over candidates "
+             f"<code>{escape(', '.join(sf.candidates))}</code>. Compensation applies "
+             f"rate_comp = (rate − bias(f, ḟ)) / (1 + k(f)·10⁻⁶).</p>")
+    rows = [(_number(g.freq_hz, 10), _number(g.k_ppm, 5), _number(g.k_se_ppm, 3),
+             _number(float(sf.ppm(np.array([g.freq_hz]))[0]), 5), str(g.n))
+            for g in sf.groups]
+    page.add(_table(("mean frequency [Hz]", "k [ppm]", "std error [ppm]", "model k [ppm]",
+                     "holds"), rows, "Temperature groups of the rate-table holds"),
+             f'<p class="eq">{escape(sf.equation())}</p>',
+             f'<p class="muted">Residual {_number(sf.residual_ppm)} ppm RMS over the groups; '
+             f"|input| up to {sf.input_rate_range_dph[1] / 3600:.4g} °/s.</p></section>")

@@ -11,8 +11,17 @@ through
    (``freq_hz``);
 4. the bias law in resonator temperature and gradient (``bias_dph``, ground truth:
    the thermal bias B0 included, without the random noise terms);
-5. the gyro noise: ``rate_dph = input_rate_dph + bias_dph + ARW + flicker + RRW``;
+5. the gyro noise: ``rate_dph = input_rate_dph + bias_dph + ARW + flicker + RRW``,
+   or ``input_rate_dph (1 + scale_ppm 1e-6) + ...`` for a unit with a
+   scale-factor law (``scale_ppm``, ground truth); the input is the constant
+   input rate plus, on a rate-table run, the table's rate (the
+   ``input_rate_dph`` column);
 6. the housing thermistor: ``housing_c`` = true housing temperature + white noise.
+
+A :class:`~hrgtc.simulate.units.MultiAxisUnit` runs steps 2-5 once per axis
+behind the one housing and writes the per-axis columns ``<name>_<axis>``
+(:func:`run_columns`); the housing thermistor and each axis's gyro and
+frequency noise draw from their own generators.
 
 ``resonator_c`` is the true resonator temperature. Memory does not grow with
 duration (chunks of ``chunk_rows`` rows), and a run depends only on its seed:

@@ -368,7 +368,8 @@ def rate_table(
         tuple(segments),
         start_c=start,
         chamber_max_c_per_min=chamber_max_c_per_min,
-        name=f"ratetable_{format_temperature(points[0])}C_to_{format_temperature(points[-1])}C",
+        name=f"ratetable_{format_temperature(points[0])}C"
+        + (f"_to_{format_temperature(points[-1])}C" if len(points) > 1 else ""),
         description=f"rate table at {label} C ({soak_hours:g} h soak each), rates "
         f"{', '.join(f'{r:g}' for r in rates)} °/s {hold:g} s each{on_axes}, from "
         f"{format_temperature(start)} C",

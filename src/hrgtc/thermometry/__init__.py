@@ -16,7 +16,7 @@ from hrgtc.thermometry.plateaus import (
     plateaus_from_recordings,
 )
 from hrgtc.thermometry.settling import TransientFit, fit_transient
-from hrgtc.thermometry.thermometer import Thermometer, fit
+from hrgtc.thermometry.thermometer import Thermometer, fit, identity
 
 __all__ = [
     "DEFAULT_HZ_PER_C",
@@ -26,6 +26,7 @@ __all__ = [
     "find_plateaus",
     "fit",
     "fit_transient",
+    "identity",
     "plateau_table",
     "plateaus_from_recordings",
 ]

@@ -113,6 +113,10 @@ class Thermometer:
         Coefficients of the polynomial in z, ascending; what is evaluated. [Hz]
     scaled_covariance
         Covariance of ``scaled_coefficients`` (None without residual dof). [Hz²]
+    source
+        ``"resonator"``: f is the resonator's natural frequency (Eq. 18 of [1]);
+        ``"sensor"``: a gyro without a frequency output, whose temperature sensor
+        is read in place of f (:func:`identity`: f = T, in °C).
     """
 
     coefficients: tuple[float, ...]
@@ -126,6 +130,7 @@ class Thermometer:
     scale_c: float
     scaled_coefficients: tuple[float, ...]
     scaled_covariance: tuple[tuple[float, ...], ...] | None = None
+    source: str = "resonator"
 
     # -- derived -------------------------------------------------------------------
     @property
@@ -398,7 +403,7 @@ class Thermometer:
         def clean(values: tuple[float, ...]) -> list[float | None]:
             return [None if not np.isfinite(v) else float(v) for v in values]
 
-        return {
+        document = {
             "kind": "hrgtc.Thermometer",
             "order": self.order,
             "n_points": self.n_points,
@@ -417,6 +422,9 @@ class Thermometer:
                 else [list(row) for row in self.scaled_covariance]
             ),
         }
+        if self.source != "resonator":  # written only when not the default: old files hash alike
+            document["source"] = self.source
+        return document
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> Thermometer:
@@ -446,6 +454,7 @@ class Thermometer:
                     if covariance is None
                     else tuple(tuple(float(v) for v in row) for row in covariance)
                 ),
+                source=str(data.get("source", "resonator")),
             )
         except (KeyError, TypeError, ValueError, IndexError) as exc:
             raise InputError(f"not a valid thermometer record: {exc!r}") from exc
@@ -566,6 +575,48 @@ def fit(temperatures_c: Any, frequencies_hz: Any, order: int = 3) -> Thermometer
         scale_c=scale,
         scaled_coefficients=tuple(float(v) for v in a),
         scaled_covariance=covariance,
+    )
+
+
+def identity(temperature_range_c: tuple[float, float]) -> Thermometer:
+    """The thermometer of a gyro without a frequency output: f = T exactly.
+
+    Its temperature sensor is read in the place of the frequency (``--thermometer
+    sensor``), so the drift model's terms in f and df/dt are in °C and °C/s, and the
+    rest of the pipeline (stepwise selection, range flags, C export) is unchanged.
+
+    Parameters
+    ----------
+    temperature_range_c
+        (min, max) of the training runs' sensor temperatures: the range flags of
+        compensation compare against it. [°C]
+
+    Examples
+    --------
+    >>> th = identity((-10.0, 50.0))
+    >>> th.coefficients, float(th.temperature(23.5)), th.source
+    ((0.0, 1.0), 23.5, 'sensor')
+    """
+    low, high = (float(v) for v in temperature_range_c)
+    if not (math.isfinite(low) and math.isfinite(high) and low < high):
+        raise InputError(
+            f"sensor temperature range ({low!r}, {high!r}) °C is not an ordered finite range; "
+            "the training runs must span more than one temperature"
+        )
+    centre, scale = 0.5 * (low + high), 0.5 * (high - low)
+    return Thermometer(
+        coefficients=(0.0, 1.0),
+        standard_errors=(0.0, 0.0),
+        residual_std_hz=0.0,
+        rsquared=1.0,
+        temperature_range_c=(low, high),
+        order=1,
+        n_points=2,
+        centre_c=centre,
+        scale_c=scale,
+        scaled_coefficients=(centre, scale),
+        scaled_covariance=None,
+        source="sensor",
     )
 
 

@@ -1,0 +1,417 @@
+"""C text of the float32 firmware export (``hrgtc export-c --precision single``).
+
+For FPU-only microcontrollers (Cortex-M4F and the like: single precision in hardware,
+double in software). The same computation as the double build of
+:mod:`hrgtc.compensate.c_text`, in ``float`` throughout (``f`` literals, ``powf``,
+``fabsf``), with the frequency entering centred, the thermometer written about the
+same centre and the df/dt filter kept as differences (see
+:mod:`hrgtc.compensate.c_float32`, whose numpy mirror evaluates exactly these
+statements). The drift terms are printed by the shared
+:func:`hrgtc.compensate.c_text._bias_function` with the float :class:`CType`.
+
+[1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
+"""
+
+from __future__ import annotations
+
+from hrgtc.compensate.c_float32 import MARGIN, FloatAccuracy, FloatConstants
+from hrgtc.compensate.c_plan import TABLE_POINTS, CPlan
+from hrgtc.compensate.c_scale import scale_factor_of, scale_pieces
+from hrgtc.compensate.c_text import NEWTON_MAX_ITER, _array, _bias_function, _comment, readme
+from hrgtc.compensate.c_types import DOUBLE, SINGLE
+from hrgtc.drift.features import settle_rows
+from hrgtc.model import UnitModel
+
+
+def _sections(model: UnitModel, plan: CPlan, prefix: str, accuracy: FloatAccuracy) -> list[str]:
+    """UNITS, USAGE and ACCURACY of the float build's README block."""
+    p, up = prefix, prefix.upper()
+    fs = model.drift.settings.sample_rate_hz
+    housing_use = "housing_c, " if plan.housing else ""
+    housing_arg = "float housing_c, " if plan.housing else ""
+    return [
+        "FLOAT32 BUILD (for FPU-only microcontrollers, e.g. Cortex-M4F)",
+        "  Everything is float: constants, state, arithmetic (powf, fabsf). The frequency "
+        f"enters CENTRED: pass f_hz = freq_hz - {up}_CENTRE_HZ (the model's f_ref, "
+        f"{model.drift.settings.reference_freq_hz:.12g} Hz) as a float. Take that difference "
+        "where the frequency is still exact: in double (one software subtraction per sample, "
+        f"the macro {up}_CENTRED_HZ(freq_hz) does it) or in the units of your frequency "
+        "counter; a float freq_hz would already have lost 0.5 mHz (2 mdegC) to rounding. "
+        "The thermometer polynomial is written about the same centre and the df/dt filter "
+        "keeps its state as the differences f - y1 and y1 - y2, updated with compensated "
+        "(Kahan) sums (algebraically the same filter; float32 keeps their digits).",
+        "",
+        "ACCURACY (float32 against hrgtc's double model, measured at export by evaluating "
+        "this code's float32 operations in numpy)",
+        f"  resonator_c_est: worst {accuracy.temperature_c:.2g} degC over the calibrated "
+        "frequency range.",
+        f"  bias_model_dph:  worst {accuracy.bias_dph:.2g} deg/h over a grid of "
+        f"{accuracy.grid_points} points of the trained ranges of its variables; "
+        f"{accuracy.ramp_bias_dph:.2g} deg/h end to end through the df/dt filter on steady "
+        "ramps over the trained df/dt range.",
+        "  rate_comp_dph:   the bias error plus the float rounding of rate_dph itself "
+        "(6e-8 of |rate|: 0.06 deg/h at 300 deg/s)"
+        + (f"; scale_model_ppm: worst {accuracy.scale_ppm:.2g} ppm over the calibrated "
+           "frequency range, and the float rounding of 1 + 1e-6 k (0.06 ppm)."
+           if scale_factor_of(model) is not None else "."),
+        f"  Stated bounds ({MARGIN:g} x the worst measured, for inputs between the grid "
+        f"points): {up}_MAX_ERROR_C = {accuracy.bound_c:.2g} degC, {up}_MAX_ERROR_DPH = "
+        f"{accuracy.bound_dph:.2g} deg/h.",
+        "",
+        "UNITS",
+        f"  inputs:  f_hz = freq_hz - {up}_CENTRE_HZ [Hz]; rate_dph [deg/h] gyro output "
+        "(input rate included)"
+        + ("; housing_c [degC] housing thermistor" if plan.housing else "")
+        + f". One call per sample at exactly {up}_SAMPLE_RATE_HZ ({fs:g} Hz).",
+        "  outputs: rate_comp_dph, bias_model_dph [deg/h]; resonator_c_est [degC];",
+        "           f_hz [Hz]; df_hz_per_s [Hz/s]; in_range, rate_in_range 1/0.",
+        "",
+        "USAGE",
+        f'  #include "{p}_model.h"',
+        f"  static {p}_state gyro;",
+        f"  {p}_init(&gyro);                      // once; {p}_reset(&gyro) at a new run",
+        "  for (;;) {                              // each sample",
+        f"      {p}_output out;",
+        f"      float rate = {p}_step(&gyro, {up}_CENTRED_HZ(freq_hz), rate_dph, "
+        f"{housing_use}&out);",
+        "      if (!out.in_range) { flag_sample(); }  // outside the calibration",
+        "  }",
+        f"  Build: cc -std=c99 -O2 -c {p}_model.c (arm-none-eabi-gcc -mfpu=fpv4-sp-d16 "
+        "-mfloat-abi=hard for a Cortex-M4F), link with -lm. Do not use -ffast-math (it "
+        "would undo the filter's compensated sums); with "
+        "-ffp-contract=off (GCC's default under -std=c99) the code rounds exactly as the "
+        "mirror that measured the figures above (fused multiply-add changes only last bits).",
+        f"  The step signature: float {p}_step({p}_state *, float f_hz, float rate_dph, "
+        f"{housing_arg}{p}_output *out);",
+        "",
+    ]
+
+
+def header(model: UnitModel, plan: CPlan, prefix: str, origin: str, sha256: str,
+           constants: FloatConstants, accuracy: FloatAccuracy) -> str:
+    """Text of the float build's ``<prefix>_model.h``."""
+    p, up = prefix, prefix.upper()
+    lit = SINGLE.literal
+    housing = plan.housing
+    state_h = ("    float h_previous;           /* previous h [degC] */\n"
+               "    float h_lag;                /* h - y1 of the first low-pass stage [degC] */\n"
+               "    float h_lag_carry;          /* what its float sums rounded off [degC] */\n"
+               "    float h_difference;         /* y1 - y2 of the two stages [degC] */\n"
+               "    float h_difference_carry;   /* what its float sums rounded off [degC] */\n"
+               if housing else "")
+    out_h = ("    float h_c;                  /* housing temperature change h [degC] */\n"
+             "    float dh_c_per_s;           /* its causal rate dh/dt [degC/s] */\n"
+             if housing else "")
+    arg_h = ", float housing_c" if housing else ""
+    bias_h = ", float h_c, float dh_c_per_s" if housing else ""
+    settings = model.drift.settings
+    k = scale_pieces(model, plan, prefix)
+    out_h += k["field"]
+    housing_in = ", housing_c [degC]" if housing else ""
+    sections = _sections(model, plan, prefix, accuracy)
+    return f"""{readme(model, plan, prefix, origin, sha256, sections)}
+#ifndef {up}_MODEL_H
+#define {up}_MODEL_H
+
+#ifdef __cplusplus
+extern "C" {{
+#endif
+
+/* This is the float32 build (hrgtc export-c --precision single). */
+#define {up}_SINGLE_PRECISION 1
+/* Centre of the frequency input: f_ref, the thermometer at {settings.reference_c:g} degC. [Hz] */
+#define {up}_CENTRE_HZ {DOUBLE.literal(constants.centre_hz, "centre_hz")}
+/* The centred frequency {p}_step() takes, from a double freq_hz. [Hz] */
+#define {up}_CENTRED_HZ(freq_hz) ((float)((freq_hz) - {up}_CENTRE_HZ))
+/* Bound of the float32 error against the double model over the calibrated range, from the
+   worst measured at export: resonator temperature [degC] and bias model [deg/h]. */
+#define {up}_MAX_ERROR_C {lit(accuracy.bound_c, "max_error_c")}
+#define {up}_MAX_ERROR_DPH {lit(accuracy.bound_dph, "max_error_dph")}
+/* Sample rate the df/dt filter was designed for: call {p}_step() at exactly this rate. [Hz] */
+#define {up}_SAMPLE_RATE_HZ {lit(settings.sample_rate_hz, "sample_rate_hz")}
+/* Samples at the start of a run flagged (in_range 0) while the df/dt filter settles,
+   as training leaves them out. */
+#define {up}_SETTLE_ROWS {settle_rows(settings)}UL
+/* 1 when {p}_step() takes the housing temperature (the model uses h or dh terms). */
+#define {up}_USES_HOUSING {1 if housing else 0}
+/* SHA-256 of the model this code was generated from. */
+#define {up}_MODEL_SHA256 "{sha256}"
+{k['define']}
+/* Filter state of one gyro; initialise with {p}_init(). */
+typedef struct {p}_state {{
+    float f_previous;           /* previous f [Hz] */
+    float f_lag;                /* f - y1 of the first low-pass stage [Hz] */
+    float f_lag_carry;          /* what its float sums rounded off [Hz] */
+    float f_difference;         /* y1 - y2 of the two stages [Hz] */
+    float f_difference_carry;   /* what its float sums rounded off [Hz] */
+{state_h}    int started;                /* 0 until the first sample after init/reset */
+    unsigned long samples;      /* samples since init/reset */
+    unsigned long out_of_range; /* of which outside the calibrated temperature */
+    unsigned long rate_out_of_range; /* of which with rate_in_range == 0 */
+}} {p}_state;
+
+/* Everything one step computes. */
+typedef struct {p}_output {{
+    float rate_comp_dph;        /* compensated rate, rate_dph - bias_model_dph [deg/h] */
+    float bias_model_dph;       /* modelled bias B, Eq. (22) [deg/h] */
+    float resonator_c_est;      /* resonator temperature from frequency [degC] (NaN: beyond) */
+    float f_hz;                 /* frequency change f = freq_hz - f_ref [Hz] */
+    float df_hz_per_s;          /* its causal rate df/dt [Hz/s] */
+{out_h}    int in_range;               /* 1: frequency calibrated, levels and rates in training
+                                   range, filter settled */
+    int rate_in_range;          /* 1: rates in training range (else extrapolated in time) */
+}} {p}_output;
+
+/* Set the state to the start of a run (before first use). */
+void {p}_init({p}_state *state);
+
+/* Start a new run: the df/dt filter restarts at rest on the next sample. */
+void {p}_reset({p}_state *state);
+
+/* Compensate one sample; returns rate_comp_dph and fills *out unless out is NULL.
+   f_hz = freq_hz - {up}_CENTRE_HZ [Hz], rate_dph [deg/h]{housing_in}. */
+float {p}_step({p}_state *state, float f_hz, float rate_dph{arg_h}, {p}_output *out);
+
+/* Bias model B of Eq. (22) from the variables. [deg/h] */
+float {p}_bias_dph(float f_hz, float df_hz_per_s{bias_h});
+
+{k['prototype']}/* Thermometer, Eq. (18) form, centred: f(T) - {up}_CENTRE_HZ. [Hz] from [degC] */
+float {p}_centred_frequency_hz(float temperature_c);
+
+/* Its inverse: resonator temperature from f_hz = freq_hz - {up}_CENTRE_HZ; NaN beyond the
+   monotonic extension. */
+float {p}_temperature_c(float f_hz);
+
+/* 1 when f_hz = freq_hz - {up}_CENTRE_HZ lies in the calibrated frequency range, else 0. */
+int {p}_frequency_in_range(float f_hz);
+
+#ifdef __cplusplus
+}}
+#endif
+
+#endif /* {up}_MODEL_H */
+"""
+
+
+def source(model: UnitModel, plan: CPlan, prefix: str, constants: FloatConstants) -> str:
+    """Text of the float build's ``<prefix>_model.c``."""
+    p, up = prefix, prefix.upper()
+    c = constants
+    lit = SINGLE.literal
+    drift = model.drift
+    ranges = [(v, lit(drift.ranges[v][0], f"ranges[{v}][0]"),
+               lit(drift.ranges[v][1], f"ranges[{v}][1]"))
+              for v in plan.computed if v in drift.ranges]
+
+    def checks(kind: tuple[str, ...]) -> str:
+        return "".join(f"\n        && {v}_value >= RANGE_{v.upper()}_LOW "
+                       f"&& {v}_value <= RANGE_{v.upper()}_HIGH"
+                       for v, _, _ in ranges if v in kind)
+
+    range_constants = "".join(f"static const float RANGE_{v.upper()}_LOW = {low};\n"
+                              f"static const float RANGE_{v.upper()}_HIGH = {high};\n"
+                              for v, low, high in ranges)
+    above = "residual > 0.0f" if plan.increasing else "!(residual > 0.0f)"
+    h = {
+        "constants": f"static const float REFERENCE_C = {lit(c.reference_c, 'reference_c')};\n",
+        "start": "        state->h_previous = h_value;\n        state->h_lag = 0.0f;\n"
+                 "        state->h_lag_carry = 0.0f;\n        state->h_difference = 0.0f;\n"
+                 "        state->h_difference_carry = 0.0f;\n",
+        "values": "    const float h_value = housing_c - REFERENCE_C;\n    float dh_value;\n",
+        "rate": "    dh_value = rate_update(&state->h_previous, &state->h_lag, "
+                "&state->h_lag_carry,\n                           &state->h_difference, "
+                "&state->h_difference_carry, h_value);\n",
+        "out": "        out->h_c = h_value;\n        out->dh_c_per_s = dh_value;\n",
+        "arg": ", float housing_c",
+        "bias": ", h_value, dh_value",
+        "reset": "    state->h_previous = 0.0f;\n    state->h_lag = 0.0f;\n"
+                 "    state->h_lag_carry = 0.0f;\n    state->h_difference = 0.0f;\n"
+                 "    state->h_difference_carry = 0.0f;\n",
+    }
+    if not plan.housing:
+        h = dict.fromkeys(h, "")
+    n_th = c.th_coefficients.size
+    k = scale_pieces(model, plan, prefix)
+    return f"""/* {p}_model.c -- generated by hrgtc export-c --precision single for unit \
+{_comment(model.unit)};
+ * see {p}_model.h for what it computes, its accuracy, its provenance and its use. Do not edit.
+ * Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
+ */
+#include "{p}_model.h"
+
+#include <math.h>
+
+/* ---- the causal df/dt filter (hrgtc.drift.features.causal_rate), kept as differences ---- */
+{h['constants']}static const float RATE_ALPHA = {lit(c.alpha, 'alpha')};
+static const float RATE_GAIN = {lit(c.gain, 'gain')};  /* alpha * fs / (1 - alpha) */
+
+/* One sample of two exact first-order lags y1, y2 of x, held as lag = x - y1 and
+   difference = y1 - y2; returns the rate (y1 - y2) * gain. Each is updated by a small
+   increment (a fraction alpha of itself); compensated (Kahan) summation keeps what the
+   float sum rounds off in a carry, so the state does not drift by rounding. */
+static float rate_update(float *previous, float *lag, float *lag_carry, float *difference,
+                         float *difference_carry, float x)
+{{
+    const float delta = x - *previous;
+    float s, a, product, increment, sum;
+    *previous = x;
+    s = *lag + delta;           /* x - y1 before this sample's update */
+    a = RATE_ALPHA * s;         /* the change of y1 */
+    increment = delta - a;      /* the change of x - y1 */
+    increment = increment - *lag_carry;
+    sum = *lag + increment;
+    *lag_carry = (sum - *lag) - increment;
+    *lag = sum;
+    s = *difference + a;        /* y1 - y2 before y2's update */
+    product = RATE_ALPHA * s;   /* the change of y2 */
+    increment = a - product;    /* the change of y1 - y2 */
+    increment = increment - *difference_carry;
+    sum = *difference + increment;
+    *difference_carry = (sum - *difference) - increment;
+    *difference = sum;
+    return *difference * RATE_GAIN;
+}}
+
+/* ---- the drift model, Eq. (22) of [1] (hrgtc.drift.DriftModel.predict) ---- */
+{_bias_function(model, plan, p)}{k['function']}
+/* ---- the thermometer, Eq. (18) of [1], centred on {up}_CENTRE_HZ ---- */
+static const float TH_CENTRE_C = {lit(c.th_centre_c, 'centre_c')};
+static const float TH_SCALE_C = {lit(c.th_scale_c, 'scale_c')};
+/* f(T) - CENTRE_HZ = sum_k TH_COEFFICIENTS[k] z^k, z = (T - TH_CENTRE_C) / TH_SCALE_C [Hz] */
+static const float TH_COEFFICIENTS[{n_th}] = {_array(c.th_coefficients, 'coefficients', SINGLE)};
+/* d f / d z, ascending */
+static const float TH_DERIVATIVE[{n_th - 1}] = {_array(c.th_derivative, 'derivative', SINGLE)};
+/* calibrated range of f_hz [Hz] */
+static const float TH_F_LOW_HZ = {lit(c.f_low, 'f_low')};
+static const float TH_F_HIGH_HZ = {lit(c.f_high, 'f_high')};
+/* table of f(T) - CENTRE_HZ over the monotonic extension, ascending: starts Newton */
+#define TH_TABLE_POINTS {TABLE_POINTS}
+static const float TH_TABLE_F[TH_TABLE_POINTS] = {_array(c.table_f, 'table_f', SINGLE)};
+static const float TH_TABLE_T[TH_TABLE_POINTS] = {_array(c.table_t, 'table_t', SINGLE)};
+static const float TH_TOLERANCE_C = {lit(c.tolerance, 'tolerance')};
+#define TH_MAX_ITER {NEWTON_MAX_ITER}
+
+static float horner(const float *c, int n, float z)
+{{
+    float r = c[n - 1];
+    int k;
+    for (k = n - 2; k >= 0; --k) {{
+        const float product = r * z;
+        r = product + c[k];
+    }}
+    return r;
+}}
+
+float {p}_centred_frequency_hz(float temperature_c)
+{{
+    const float z = (temperature_c - TH_CENTRE_C) / TH_SCALE_C;
+    return horner(TH_COEFFICIENTS, {n_th}, z);
+}}
+
+static float slope_hz_per_c(float temperature_c)
+{{
+    const float z = (temperature_c - TH_CENTRE_C) / TH_SCALE_C;
+    return horner(TH_DERIVATIVE, {n_th - 1}, z) / TH_SCALE_C;
+}}
+
+int {p}_frequency_in_range(float f_hz)
+{{
+    return f_hz >= TH_F_LOW_HZ && f_hz <= TH_F_HIGH_HZ;
+}}
+
+float {p}_temperature_c(float f_hz)
+{{
+    int low = 0;
+    int high = TH_TABLE_POINTS - 1;
+    int k;
+    float t, lower, upper, t0, t1, f0, f1;
+    if (!(f_hz >= TH_TABLE_F[0] && f_hz <= TH_TABLE_F[TH_TABLE_POINTS - 1])) {{
+        return NAN;  /* beyond the monotonic extension, or not a number */
+    }}
+    /* first table entry not below f_hz (numpy.searchsorted), at least the second */
+    while (low < high) {{
+        const int middle = low + (high - low) / 2;
+        if (TH_TABLE_F[middle] < f_hz) {{ low = middle + 1; }} else {{ high = middle; }}
+    }}
+    low = low < 1 ? 1 : low;
+    f0 = TH_TABLE_F[low - 1];
+    f1 = TH_TABLE_F[low];
+    t0 = TH_TABLE_T[low - 1];
+    t1 = TH_TABLE_T[low];
+    lower = t0 < t1 ? t0 : t1;
+    upper = t0 < t1 ? t1 : t0;
+    t = t0 + (f_hz - f0) * (t1 - t0) / (f1 - f0);
+    t = t < lower ? lower : (t > upper ? upper : t);
+    /* safeguarded Newton: keep the bracket, bisect when a step leaves it */
+    for (k = 0; k < TH_MAX_ITER; ++k) {{
+        const float residual = {p}_centred_frequency_hz(t) - f_hz;
+        const float step = residual / slope_hz_per_c(t);
+        float candidate = t - step;
+        float change;
+        if ({above}) {{ upper = t < upper ? t : upper; }} else {{ lower = t > lower ? t : lower; }}
+        if (!(candidate >= lower && candidate <= upper)) {{ candidate = 0.5f * (lower + upper); }}
+        change = fabsf(candidate - t);
+        t = candidate;
+        if (!(change > TH_TOLERANCE_C)) {{ break; }}
+    }}
+    return t;
+}}
+
+/* ---- streaming compensation (hrgtc.compensate.Compensator) ---- */
+/* training ranges of the drift model's variables (window means) */
+{range_constants}
+void {p}_reset({p}_state *state)
+{{
+    state->f_previous = 0.0f;
+    state->f_lag = 0.0f;
+    state->f_lag_carry = 0.0f;
+    state->f_difference = 0.0f;
+    state->f_difference_carry = 0.0f;
+{h['reset']}    state->started = 0;
+    state->samples = 0UL;
+    state->out_of_range = 0UL;
+    state->rate_out_of_range = 0UL;
+}}
+
+void {p}_init({p}_state *state)
+{{
+    {p}_reset(state);
+}}
+
+float {p}_step({p}_state *state, float f_hz, float rate_dph{h['arg']}, {p}_output *out)
+{{
+    const float f_value = f_hz;
+{h['values']}    float df_value, bias, compensated, temperature;
+    int in_range, rate_in_range, level_in_range;
+{k['declare']}    if (!state->started) {{  /* the filter starts at rest on the first sample */
+        state->f_previous = f_value;
+        state->f_lag = 0.0f;
+        state->f_lag_carry = 0.0f;
+        state->f_difference = 0.0f;
+        state->f_difference_carry = 0.0f;
+{h['start']}        state->started = 1;
+    }}
+    df_value = rate_update(&state->f_previous, &state->f_lag, &state->f_lag_carry,
+                           &state->f_difference, &state->f_difference_carry, f_value);
+{h['rate']}    bias = {p}_bias_dph(f_value, df_value{h['bias']});
+    compensated = rate_dph - bias;
+    temperature = {p}_temperature_c(f_value);
+    level_in_range = {p}_frequency_in_range(f_value){checks(("f", "h"))};
+    rate_in_range = 1{checks(("df", "dh"))};
+    /* in_range: calibrated temperature, trained df/dt, and the filter settled */
+    in_range = level_in_range && rate_in_range && state->samples >= {up}_SETTLE_ROWS;
+    state->samples += 1UL;
+    state->out_of_range += level_in_range ? 0UL : 1UL;
+    state->rate_out_of_range += rate_in_range ? 0UL : 1UL;
+{k['apply']}    if (out) {{
+        out->rate_comp_dph = compensated;
+        out->bias_model_dph = bias;
+        out->resonator_c_est = temperature;
+        out->f_hz = f_value;
+        out->df_hz_per_s = df_value;
+{h['out']}{k['out']}        out->in_range = in_range;
+        out->rate_in_range = rate_in_range;
+    }}
+    return compensated;
+}}
+"""

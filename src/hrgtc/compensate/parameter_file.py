@@ -1,0 +1,243 @@
+"""The plain parameter file (``hrgtc export-c --format params``): every number, documented.
+
+For firmware that evaluates its own polynomials (in its own language, fixed point,
+an FPGA): ``key = value`` lines, one number each (a term's spelling is the only
+text value), a ``#`` comment above each key saying what it is and its unit, and a
+header comment giving the formula to evaluate, step by step, in the order
+:class:`hrgtc.compensate.Compensator` computes it. Numbers are printed with
+``%.17g`` so they read back to the same double.
+
+The computation written out in the header is the one of :mod:`hrgtc.compensate.export_c`:
+the causal df/dt filter of :func:`hrgtc.drift.features.causal_rate`, the drift model of
+Eq. (22) of [1] on scaled variables, continued along its tangent beyond the training
+ranges, and the thermometer of Eq. (18) (its inverse gives Table 2).
+
+[1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from hrgtc.compensate.c_plan import CPlan
+from hrgtc.compensate.c_text import NEWTON_MAX_ITER
+from hrgtc.compensate.c_types import DOUBLE
+from hrgtc.drift.features import VARIABLES, settle_rows
+from hrgtc.model import UnitModel
+
+#: Version of the file's layout (a key of the file).
+FORMAT_VERSION = 1
+_UNITS = {"f": "Hz", "df": "Hz/s", "h": "degC", "dh": "degC/s"}
+
+
+def _number(value: float, name: str) -> str:
+    return DOUBLE.literal(value, name)
+
+
+def formula(key: str = "") -> list[str]:
+    """The header's formula, with ``key`` the key prefix (``x_`` for axis x, '' for one)."""
+    lines = [
+        "FORMULA (per sample, at exactly {k}sample_rate_hz; keys below are written <key>)",
+        "  1. f = freq_hz - <{k}reference_freq_hz>                                  [Hz]",
+        "  2. df/dt, a causal filter started at rest (y1 = y2 = f on the first sample):",
+        "       y1 = <{k}filter_alpha>*f  + <{k}filter_beta>*y1",
+        "       y2 = <{k}filter_alpha>*y1 + <{k}filter_beta>*y2",
+        "       df = (y1 - y2) * <{k}filter_gain>                                   [Hz/s]",
+        "     (when <{k}uses_housing> = 1: h = housing_c - <{k}reference_c> [degC] and dh its",
+        "      rate by the same filter on its own y1, y2 [degC/s])",
+        "  3. for each variable v in f, df, h, dh that the terms use:",
+        "       c_v = v held in [<{k}range_v_low>, <{k}range_v_high>];  x_v = c_v / <{k}scale_v>",
+        "  4. B = <{k}intercept_dph> + sum over k = 1..<{k}n_terms> of",
+        "         <{k}coefficient_k> * product over the factors v^p of <{k}term_k> of x_v^p",
+        "     beyond a range (v != c_v) B continues along its tangent at the edge:",
+        "       B += dB/dv * (v - c_v), dB/dv = sum_k <{k}coefficient_k> * p_v(k) *",
+        "            (term_k with v's power lowered by one, on x) / <{k}scale_v>    [deg/h]",
+        "     (algebraically, inside the ranges B = <{k}intercept_dph> + sum_k",
+        "      <{k}coefficient_raw_k> * term_k(f, df, h, dh), Eq. (22) of [1])",
+        "  5. rate_comp_dph = rate_dph - B                                          [deg/h]",
+        "     or, when <{k}uses_scale_factor> = 1, with the scale-factor error k [ppm]:",
+        "       g = freq_hz - <{k}sf_reference_hz>; c_g = g held in [<{k}sf_range_low_hz>,",
+        "       <{k}sf_range_high_hz>] - <{k}sf_reference_hz>; x = c_g / <{k}sf_scale_hz>;",
+        "       k = <{k}sf_intercept_ppm> + sum_k <{k}sf_coefficient_k> * x^(power of",
+        "       <{k}sf_term_k>), continued along its tangent beyond the range as B is;",
+        "       rate_comp_dph = (rate_dph - B) / (1 + 1e-6 * k)",
+        "  6. resonator temperature: the T in [<{k}inverse_low_c>, <{k}inverse_high_c>] with",
+        "       F(T) = freq_hz, F(T) = sum_j <{k}thermometer_coefficient_j> * z^j,",
+        "       z = (T - <{k}thermometer_centre_c>) / <{k}thermometer_scale_c>        [Hz]",
+        "     (Newton's iteration to <{k}inverse_tolerance_c>; no solution: NaN). Same F:",
+        "       sum_j <{k}thermometer_raw_coefficient_j> * T^j, Eq. (18) of [1].",
+        "  7. in_range = freq_hz in [<{k}calibrated_freq_low_hz>, <{k}calibrated_freq_high_hz>]",
+        "     and f, h, df, dh in their ranges and at least <{k}settle_rows> samples seen.",
+    ]
+    return [line.replace("{k}", key) for line in lines]
+
+
+def parameter_lines(model: UnitModel, plan: CPlan, key: str = "") -> list[str]:
+    """``key = value`` lines of one unit's compensation, each documented by a comment above.
+
+    Parameters
+    ----------
+    model, plan
+        The unit's model and its export plan.
+    key
+        Prefix of every key (``x_`` for axis x of an instrument; '' for a single gyro).
+    """
+    drift, th = model.drift, model.thermometer
+    settings = drift.settings
+    lines: list[str] = []
+
+    def put(name: str, value: float | int | str, comment: str) -> None:
+        if isinstance(value, str):
+            text = value
+        elif isinstance(value, int):
+            text = str(value)
+        else:
+            text = _number(value, key + name)
+        lines.extend([f"# {comment}", f"{key}{name} = {text}", ""])
+
+    put("sample_rate_hz", settings.sample_rate_hz,
+        "Sample rate the df/dt filter is designed for: evaluate once per sample at it. [Hz]")
+    put("reference_freq_hz", settings.reference_freq_hz,
+        f"f_ref: the thermometer's frequency at {settings.reference_c:g} degC; "
+        "f = freq_hz - f_ref. [Hz]")
+    put("reference_c", settings.reference_c,
+        "Reference temperature; origin of h = housing_c - reference_c. [degC]")
+    put("uses_housing", int(plan.housing),
+        "1 when the terms use the housing thermistor (h, dh): then housing_c is an input.")
+    put("rate_tau_s", settings.rate_tau_s,
+        "Time constant of each of the two low-pass stages of the df/dt filter. [s]")
+    put("filter_alpha", plan.alpha,
+        "Filter stage coefficient alpha = 1 - exp(-1/(rate_tau_s*sample_rate_hz)). [1]")
+    put("filter_beta", plan.beta, "Filter stage coefficient beta = 1 - alpha. [1]")
+    put("filter_gain", plan.gain,
+        "Ramp gain alpha*sample_rate_hz/beta: (y1 - y2)*gain is the rate. [1/s]")
+    put("settle_rows", settle_rows(settings),
+        "Samples at the start of a run flagged (in_range 0) while the filter settles. [1]")
+    for v in plan.computed:
+        if v in settings.scales and v in drift.variables:
+            put(f"scale_{v}", settings.scales[v],
+                f"Scale of {v} ({VARIABLES[v][1]}): x_{v} = {v} / scale_{v}. [{_UNITS[v]}]")
+    for v in plan.computed:
+        if v in drift.ranges:
+            low, high = drift.ranges[v]
+            put(f"range_{v}_low", low, f"Training range of {v}, low end (window means); "
+                "the model is continued along its tangent below it. "
+                f"[{_UNITS[v]}]")
+            put(f"range_{v}_high", high, f"Training range of {v}, high end. [{_UNITS[v]}]")
+    put("intercept_dph", drift.intercept_dph, "B0: the bias at f = df = 0 (h = dh = 0). [deg/h]")
+    put("n_terms", len(drift.terms), "Number of selected terms of the drift model (Eq. 22).")
+    for k, (term, scaled) in enumerate(zip(drift.terms, drift.scaled_coefficients,
+                                           strict=True), start=1):
+        factors = " * ".join(f"x_{v}" if p == 1 else f"x_{v}^{p}" for v, p in term.powers)
+        put(f"term_{k}", term.name,
+            f"Term {k}: its factors v^p (variables f, df, h, dh); on the scaled variables "
+            f"it is {factors}.")
+        put(f"coefficient_{k}", scaled,
+            f"Coefficient of term {k} ({term.name}) on the scaled variables. [deg/h]")
+        put(f"coefficient_raw_{k}", drift.coefficients[term.name],
+            f"Coefficient of term {k} ({term.name}) on the raw variables, Eq. (22) form. "
+            f"[deg/h per {term.unit}]".replace("·", " "))
+    _scale_factor_lines(model, put)
+    put("thermometer_order", th.order, "Order of the thermometer polynomial F(T) (Eq. 18).")
+    put("thermometer_centre_c", th.centre_c,
+        "z = (T - thermometer_centre_c) / thermometer_scale_c. [degC]")
+    put("thermometer_scale_c", th.scale_c, "Scale of z. [degC]")
+    for j, value in enumerate(th.scaled_coefficients):
+        put(f"thermometer_coefficient_{j}", value,
+            f"F(T) = sum_j thermometer_coefficient_j z^j: coefficient of z^{j}. [Hz]")
+    for j, value in enumerate(th.coefficients):
+        put(f"thermometer_raw_coefficient_{j}", value,
+            f"The same F(T) in T (Eq. 18): coefficient of T^{j}. [Hz/degC^{j}]")
+    t_low, t_high = th.temperature_range_c
+    put("calibrated_temperature_low_c", t_low, "Calibrated temperature range, low end. [degC]")
+    put("calibrated_temperature_high_c", t_high, "Calibrated temperature range, high end. [degC]")
+    put("calibrated_freq_low_hz", plan.f_range[0],
+        "Calibrated frequency range (F over the calibrated temperatures), low end. [Hz]")
+    put("calibrated_freq_high_hz", plan.f_range[1],
+        "Calibrated frequency range, high end. [Hz]")
+    put("inverse_low_c", plan.extension[0],
+        "The inverse T(freq_hz) is defined on [inverse_low_c, inverse_high_c] (F monotonic "
+        "there); beyond: NaN. [degC]")
+    put("inverse_high_c", plan.extension[1], "High end of the inverse's interval. [degC]")
+    put("inverse_freq_low_hz", float(plan.grid_f[0]),
+        "Frequencies the inverse accepts: F over that interval, low end. [Hz]")
+    put("inverse_freq_high_hz", float(plan.grid_f[-1]), "High end. [Hz]")
+    put("inverse_tolerance_c", plan.tolerance,
+        "Stop Newton's iteration when a step changes T by at most this. [degC]")
+    put("inverse_max_iterations", NEWTON_MAX_ITER, "Iteration cap of the inverse. [1]")
+    return lines
+
+
+def _scale_factor_lines(model: UnitModel, put: Any) -> None:
+    """The scale factor's keys (``uses_scale_factor`` 0 and nothing else without one)."""
+    sf = model.scale_factor
+    put("uses_scale_factor", int(sf is not None),
+        "1 when rate_comp also corrects the scale factor: (rate - B) / (1 + 1e-6 k).")
+    if sf is None:
+        return
+    put("sf_reference_hz", sf.reference_hz,
+        "Reference of the scale factor's variable g = freq_hz - sf_reference_hz. [Hz]")
+    put("sf_scale_hz", sf.scale_hz, "Scale of g: x = g / sf_scale_hz. [Hz]")
+    put("sf_range_low_hz", sf.freq_range_hz[0],
+        "Frequency range of the rate-table runs, low end; k continues along its tangent "
+        "beyond. [Hz]")
+    put("sf_range_high_hz", sf.freq_range_hz[1], "High end of that range. [Hz]")
+    put("sf_intercept_ppm", sf.intercept_ppm, "k at freq_hz = sf_reference_hz. [ppm]")
+    put("sf_n_terms", len(sf.terms), "Number of terms of k(f).")
+    for j, (term, scaled) in enumerate(zip(sf.terms, sf.scaled_coefficients, strict=True),
+                                       start=1):
+        put(f"sf_term_{j}", term.name, f"Scale-factor term {j}: a power of f (= g).")
+        put(f"sf_coefficient_{j}", scaled,
+            f"Coefficient of scale-factor term {j} ({term.name}) on x. [ppm]")
+        put(f"sf_coefficient_raw_{j}", sf.coefficients_ppm[term.name],
+            f"Coefficient of term {j} ({term.name}) on g itself. [ppm per {term.unit}]")
+
+
+def _head(model: UnitModel, origin: str, sha256: str, key: str = "") -> list[str]:
+    from hrgtc._meta import PAPER_REFERENCE, __version__
+
+    prov = model.provenance
+    return [
+        f"hrgtc parameter file -- HRG temperature-drift compensation of unit {model.unit!r}",
+        "Generated by hrgtc export-c --format params; do not edit, regenerate from the model.",
+        "Lines are 'key = value'; lines starting with # are comments. Numbers are %.17g",
+        "(they read back to the same double).",
+        "",
+        f"unit:            {model.unit}",
+        f"model:           {origin}",
+        f"model SHA-256:   {sha256}",
+        f"calibrated with: hrgtc {prov.get('hrgtc_version', 'unknown')}, "
+        f"{prov.get('created_utc', 'time unknown')}",
+        f"exported by:     hrgtc {__version__}",
+        "",
+        *formula(key),
+        "",
+        f"[1] {PAPER_REFERENCE}",
+    ]
+
+
+def parameter_text(model: UnitModel, plan: CPlan, origin: str, sha256: str) -> str:
+    """The whole parameter file of one unit."""
+    lines = [("# " + line).rstrip() for line in _head(model, origin, sha256)]
+    lines += ["", "# Layout version of this file.", f"format_version = {FORMAT_VERSION}", ""]
+    lines += parameter_lines(model, plan)
+    return "\n".join(lines).rstrip() + "\n"
+
+
+def instrument_parameter_text(axes: dict[str, UnitModel], plans: dict[str, CPlan],
+                              origin: str, sha256: str) -> str:
+    """The parameter file of an instrument: every axis's keys, prefixed ``<axis>_``."""
+    names = list(axes)
+    head = _head(axes[names[0]], origin, sha256, "<axis>_")
+    head[0] = (f"hrgtc parameter file -- HRG temperature-drift compensation of the axes "
+               f"{', '.join(names)} of unit {axes[names[0]].unit!r}")
+    head.insert(4, "Every axis has its own keys, written <axis>_<key>: x_sample_rate_hz, ...")
+    lines = [("# " + line).rstrip() for line in head]
+    lines += ["", "# Layout version of this file.", f"format_version = {FORMAT_VERSION}", "",
+              "# Number of axes.", f"n_axes = {len(names)}", "",
+              "# The axes' names, in file order (the <axis> of every other key).",
+              f"axes = {' '.join(names)}", ""]
+    for name in names:
+        lines += [f"# ---- axis {name} " + "-" * 60, ""]
+        lines += parameter_lines(axes[name], plans[name], key=f"{name}_")
+    return "\n".join(lines).rstrip() + "\n"

@@ -1,0 +1,238 @@
+"""Build the HTML report of a unit or of a whole instrument (one section per axis).
+
+:func:`build_report` reads the soaks and runs chunk by chunk, evaluates each run
+(:func:`hrgtc.evaluation.evaluate` with plotting blocks) and writes one
+self-contained page with the sections of :mod:`hrgtc.report.html`. A multi-axis
+model gives the instrument's summary (one row per axis and run) and then every
+axis's sections, each reading its single-axis view of the files.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+from collections.abc import Callable, Sequence
+from html import escape
+from pathlib import Path
+
+from hrgtc.errors import InputError
+from hrgtc.evaluation import Evaluation, evaluate
+from hrgtc.files import refuse_existing, write_text_atomic
+from hrgtc.model import InstrumentModel, UnitModel, load_instrument
+from hrgtc.progress import Progress
+from hrgtc.recording import ReadOptions, count_rows
+from hrgtc.report.figures import trace_soak
+from hrgtc.report.html import (
+    _CSS,
+    DOI,
+    REFERENCE,
+    _drift_model,
+    _header,
+    _number,
+    _Page,
+    _run,
+    _scale_factor,
+    _settling,
+    _summary,
+    _table,
+    _table_rows,
+    _temperature,
+    _thermometer,
+)
+from hrgtc.thermometry.plateaus import Plateau
+
+__all__ = ["build_report"]
+
+PathLike = str | os.PathLike[str]
+
+
+def _soak_files(model: UnitModel) -> tuple[list[str], list[str]]:
+    """(existing, missing) soak files named in the model's provenance."""
+    paths = [str(i["path"]) for i in model.provenance.get("inputs", [])
+             if i.get("role") == "soak" and i.get("path")]
+    return [p for p in paths if Path(p).is_file()], [p for p in paths if not Path(p).is_file()]
+
+
+def build_report(
+    model: UnitModel | InstrumentModel | PathLike,
+    runs: Sequence[PathLike | Evaluation],
+    output: PathLike,
+    *,
+    soaks: Sequence[PathLike] | None = None,
+    title: str | None = None,
+    force: bool = False,
+    max_points: int = 20_000,
+    read_options: ReadOptions | None = None,
+    progress: Progress | None = None,
+) -> Path:
+    """Write the report: one self-contained HTML file with Figs. 3-6 and Tables 1-2 of [1].
+
+    Parameters
+    ----------
+    model
+        The unit's or instrument's model, or the path of its model file.
+    runs
+        Recordings to compensate and evaluate (Fig. 6 of [1]), one section each, or
+        evaluations already made with plotting blocks (:func:`hrgtc.evaluation.evaluate`
+        with ``max_points``; single-axis models only), which are not computed again.
+    output
+        The HTML file; written atomically, never overwritten without ``force``.
+    soaks
+        Soak recordings for Figs. 3 and 5(b); default: the model's soak inputs that
+        still exist on disk (read with the column mapping stored in the model).
+    title
+        Page title (default names the unit).
+    max_points
+        Most points per plotted curve; plots use block means of at least 10 s.
+    read_options
+        How to read the runs and the given soaks (column mapping, units, metadata).
+    progress
+        Optional ``callback(rows_done, rows_total)``.
+
+    Returns
+    -------
+    pathlib.Path
+        The written file.
+
+    Raises
+    ------
+    OutputExistsError
+        ``output`` exists and ``force`` is False (checked before any work).
+    InputError
+        An evaluation given in ``runs`` kept no plotting blocks, or was given for a
+        multi-axis model.
+    """
+    target = Path(output)
+    refuse_existing(target, force)
+    model_path = None
+    if isinstance(model, UnitModel):
+        instrument = InstrumentModel.single(model)
+    elif isinstance(model, InstrumentModel):
+        instrument = model
+    else:
+        model_path, instrument = str(model), load_instrument(model)
+    options = read_options or ReadOptions()
+    first = next(iter(instrument.axes.values()))
+    soak_paths, missing = _soak_files(first) if soaks is None else ([str(p) for p in soaks], [])
+    if soaks is None:
+        settings = first.provenance.get("settings", {})
+        soak_options = ReadOptions(columns=settings.get("columns") or None,
+                                   units=settings.get("units") or None)
+    else:
+        soak_options = options
+    for run in runs:
+        if isinstance(run, Evaluation) and (run.blocks is None or not instrument.is_single_axis):
+            raise InputError(f"{run.file}: the evaluation kept no plotting blocks (or the model "
+                             "has several axes); evaluate it with max_points, or pass the file")
+    files = [run for run in runs if not isinstance(run, Evaluation)]
+    total = len(instrument.axes) * sum(count_rows(p) for p in [*soak_paths, *files])
+    done = 0
+
+    def advance(rows: int) -> None:
+        nonlocal done
+        done += rows
+        if progress is not None:
+            progress(done, total)
+
+    page = _Page()
+    _header(page, dataclasses.replace(first, unit=instrument.unit), title
+            or f"Temperature compensation report — unit {instrument.unit}", model_path)
+    sections: dict[str, list[str]] = {}
+    evaluations: dict[str, list[Evaluation]] = {}
+    for axis, unit_model in instrument.axes.items():
+        axis_page = _Page()
+        axis_page.count = page.count
+        read = dataclasses.replace(options, axis=axis or None)
+        soak_read = dataclasses.replace(soak_options, axis=axis or None)
+        evaluations[axis] = [run if isinstance(run, Evaluation) else
+                             _evaluate_run(run, unit_model, read, max_points, advance)
+                             for run in runs]
+        _unit_sections(axis_page, unit_model, evaluations[axis], soak_paths, soak_read,
+                       missing, max_points, advance)
+        page.count = axis_page.count
+        sections[axis] = axis_page.parts
+    if instrument.is_single_axis:
+        _summary(page, evaluations[""])
+        page.add(*sections[""])
+    else:
+        _instrument_summary(page, instrument, evaluations)
+        for axis, parts in sections.items():
+            html = "\n".join(parts).replace(' id="', f' id="{axis}-').replace(
+                'href="#', f'href="#{axis}-')
+            page.add(f'<section id="axis-{escape(axis)}"><h2 class="axis">Axis '
+                     f"{escape(axis)}</h2>", html, "</section>")
+    body = "\n".join(page.parts)
+    title_text = title or f"Temperature compensation report — unit {instrument.unit}"
+    html = (f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
+            f'<meta name="viewport" content="width=device-width, initial-scale=1">'
+            f"<title>{escape(title_text)}</title>"
+            f"<style>{_CSS}</style></head><body>\n{body}\n<footer class=\"muted\"><p>[1] "
+            f"{REFERENCE}. doi:{DOI}. Generated by hrgtc.</p></footer></body></html>\n")
+    written = write_text_atomic(target, html, force=force)
+    if progress is not None:
+        progress(total, total)
+    return written
+
+
+def _unit_sections(page: _Page, model: UnitModel, evaluations: Sequence[Evaluation],
+                   soak_paths: Sequence[str], soak_options: ReadOptions, missing: list[str],
+                   max_points: int, advance: Callable[[int], None]) -> None:
+    """One axis's sections: Figs. 3-5 and Tables 1-2, its runs, drift and scale factor."""
+    plateaus = [Plateau.from_dict(p) for p in model.plateaus]
+    table = _table_rows(model, plateaus)
+    sensor = model.thermometer.source == "sensor"
+    traces = [] if sensor else [
+        trace_soak(p, model.thermometer, max_points=max_points, read_options=soak_options,
+                   on_chunk=advance) for p in soak_paths]
+    if sensor:
+        low, high = model.thermometer.temperature_range_c
+        page.note(f"No frequency output: the gyro's temperature sensor is the thermometer "
+                  f"(trained {low:.2f} to {high:.2f} °C); Figs. 3-5 do not apply.")
+    else:
+        _settling(page, plateaus, traces, missing)
+        _thermometer(page, model, plateaus, table)
+        _temperature(page, table, traces)
+    page.add('<section id="runs"><h2>4. Runs: raw and compensated output</h2>')
+    if not evaluations:
+        page.note("No runs given.")
+    for k, run in enumerate(evaluations, start=1):
+        _run(page, k, run, model)
+    page.add("</section>")
+    _drift_model(page, model)
+    _scale_factor(page, model)
+
+
+def _instrument_summary(page: _Page, model: InstrumentModel,
+                        evaluations: dict[str, list[Evaluation]]) -> None:
+    """The instrument at a glance: each axis's 10 s bias stability per run, scale factor."""
+    rows = []
+    for axis, runs in evaluations.items():
+        sf = model.axes[axis].scale_factor
+        scale = "–" if sf is None else f"{_number(sf.residual_ppm, 3)} ppm RMS"
+        for run in runs:
+            raw, comp = run.stability("raw", 10.0), run.stability("compensated", 10.0)
+            rows.append((axis, run.name, _number(raw), _number(comp),
+                         _number(raw / comp if raw is not None and comp else None, 3),
+                         f"{run.out_of_range_fraction:.1%}", scale))
+        if not runs:
+            rows.append((axis, "–", "–", "–", "–", "–", scale))
+    page.add(f'<section id="instrument"><h2>Instrument {escape(model.unit)}: '
+             f"{len(model.axes)} axes</h2>",
+             _table(("axis", "run", "raw [°/h]", "compensated [°/h]", "improvement [×]",
+                     "outside calibrated range", "scale-factor fit residual"), rows,
+                    "At a glance: 10 s bias stability per axis and run"),
+             "<nav><ol>" + "".join(f'<li><a href="#axis-{escape(a)}">Axis {escape(a)}</a></li>'
+                                   for a in model.axes) + "</ol></nav></section>")
+
+
+def _evaluate_run(path: PathLike, model: UnitModel, options: ReadOptions, max_points: int,
+                  advance: Callable[[int], None]) -> Evaluation:
+    """The one run pass of :func:`hrgtc.evaluation.evaluate`, with plotting blocks."""
+    seen = 0
+
+    def progress(done: float, _total: float) -> None:
+        nonlocal seen
+        advance(int(done) - seen)
+        seen = int(done)
+
+    return evaluate(path, model, read_options=options, max_points=max_points, progress=progress)

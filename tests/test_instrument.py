@@ -1,0 +1,152 @@
+"""A three-axis unit calibrated, compensated and checked end to end (issue 14).
+
+The simulated ``imu-3`` has three resonators (x ~4.4 kHz, y ~5.7 kHz, z ~8.5 kHz) with
+their own bias laws, lags and scale-factor laws (truth in the files). Held-out: a
+warm-up and a rate table at two temperatures between the training ones.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from hrgtc.compensate import Compensator, InstrumentCompensator, compensate_instrument_file
+from hrgtc.drift import find_rate_segments
+from hrgtc.errors import ModelFileError, RecordingError
+from hrgtc.instrument import calibrate_instrument, steady_segments, summary_rows
+from hrgtc.model import InstrumentModel, load_instrument, load_model, save_instrument
+from hrgtc.model_schema import strict
+from hrgtc.recording import ReadOptions, axis_view, read
+
+AXES = ("x", "y", "z")
+
+
+@pytest.fixture(scope="module")
+def calibration(imu_campaign):
+    files = imu_campaign
+    return calibrate_instrument(files.soaks, [files.cooldown], [files.warmup],
+                                rate_tables=[files.rate_table],
+                                validate_rate_tables=[files.rate_table_heldout])
+
+
+def test_every_axis_has_its_own_thermometer_drift_and_scale_factor(calibration):
+    model = calibration.model
+    assert model.names == AXES and not model.is_single_axis
+    centres = [model.axes[a].drift.settings.reference_freq_hz for a in AXES]
+    assert centres[0] < 4500 < centres[1] < 6000 < centres[2]  # three different resonators
+    for axis in AXES:
+        assert model.axes[axis].scale_factor is not None
+        assert len(calibration.axes[axis].plateaus) == 7
+
+
+def test_held_out_warmup_improves_on_every_axis(calibration):
+    rows = {row["axis"]: row for row in summary_rows(calibration)}
+    for axis in AXES:
+        raw, comp = rows[axis]["raw_10s_dph"], rows[axis]["compensated_10s_dph"]
+        assert raw / comp > 1.3, (axis, raw, comp)
+    # x and y are compensated to within ~1.5x of their noise floor (0.2 and 0.15 °/h BI)
+    assert rows["x"]["raw_10s_dph"] / rows["x"]["compensated_10s_dph"] > 3.0
+    assert rows["y"]["raw_10s_dph"] / rows["y"]["compensated_10s_dph"] > 3.0
+
+
+def test_scale_factor_residual_on_held_out_temperatures(calibration):
+    """At -5 and 22 °C (not trained on): raw tens to hundreds of ppm, compensated <= 20."""
+    checks = {c.axis: c for c in calibration.scale_checks}
+    assert set(checks) == set(AXES)
+    for axis, check in checks.items():
+        assert len(check.freq_hz) == 2, axis
+        assert check.raw_max_ppm > 60.0, axis
+        assert check.compensated_max_ppm <= 20.0, (axis, check.compensated_ppm)
+        assert check.compensated_max_ppm < check.raw_max_ppm / 5, axis
+
+
+def test_scale_factor_model_against_the_simulators_truth(calibration, imu_campaign):
+    """k(f) at the held-out holds' frequencies against the true scale_ppm of those holds."""
+    run = read(imu_campaign.rate_table_heldout)
+    for axis in AXES:
+        view = axis_view(run, axis)
+        unit = calibration.model.axes[axis]
+        segments = steady_segments(view, find_rate_segments(view), unit)
+        assert len(segments) >= 12
+        for s in segments:
+            truth = float(np.mean(view["scale_ppm"][s.first_row:s.first_row + s.rows]))
+            model = float(unit.scale_factor.ppm(np.array([s.freq_hz]))[0])
+            assert abs(model - truth) < 6.0, (axis, s.freq_hz, model, truth)
+
+
+def test_instrument_compensator_equals_each_axis_alone(calibration, imu_campaign):
+    run = read(imu_campaign.warmup)
+    together = InstrumentCompensator(calibration.model).process(run)
+    for axis in AXES:
+        unit = calibration.model.axes[axis]
+        alone = Compensator(unit).process(axis_view(run, axis))
+        for name in ("rate_comp_dph", "bias_model_dph", "resonator_c_est", "in_range",
+                     "scale_model_ppm"):
+            np.testing.assert_array_equal(together[f"{name}_{axis}"], alone[name])
+        # rate = input (1 + k) + bias: the output undoes both
+        k = together[f"scale_model_ppm_{axis}"] * 1e-6
+        np.testing.assert_allclose(
+            together[f"rate_comp_dph_{axis}"] * (1 + k) + together[f"bias_model_dph_{axis}"],
+            run[f"rate_dph_{axis}"], rtol=0, atol=1e-9)
+
+
+def test_file_to_file_in_chunks_equals_batch(calibration, imu_campaign, tmp_path):
+    output = tmp_path / "warm_comp.parquet"
+    summary = compensate_instrument_file(imu_campaign.warmup, output, calibration.model,
+                                         chunk_rows=7_001)
+    written = read(output)
+    batch = InstrumentCompensator(calibration.model).process(read(imu_campaign.warmup))
+    assert summary.rows == len(batch)
+    for name in batch.names:
+        np.testing.assert_array_equal(written[name], batch[name])
+
+
+def test_a_single_axis_file_is_refused_by_a_three_axis_model(calibration, campaign_factory):
+    single = campaign_factory("paper-unit", sample_rate_hz=2.0)
+    with pytest.raises(RecordingError, match="no columns of axis x, y, z"):
+        InstrumentCompensator(calibration.model).process(read(single.warmup))
+
+
+def test_model_file_round_trip_and_checks(calibration, tmp_path):
+    path = save_instrument(calibration.model, tmp_path / "imu.json")
+    loaded = load_instrument(path)
+    assert loaded.sha256 == calibration.model.sha256
+    assert strict(loaded.to_dict()) == strict(calibration.model.to_dict())  # NaN -> None
+    for axis in AXES:
+        f = np.linspace(*loaded.axes[axis].scale_factor.freq_range_hz, 7)
+        np.testing.assert_array_equal(loaded.axes[axis].scale_factor.ppm(f),
+                                      calibration.model.axes[axis].scale_factor.ppm(f))
+    with pytest.raises(ModelFileError, match=r"multi-axis model file \(axes x, y, z\); load it"):
+        load_model(path)
+    document = json.loads(path.read_text())
+    document.pop("parameters_sha256")
+    term = document["axes"]["y"]["drift"]["selected"][0]
+    document["axes"]["y"]["drift"]["coefficients"][term] *= 1.01
+    path.write_text(json.dumps(document))
+    with pytest.raises(ModelFileError, match=r"axes\.y\.drift\.coefficients"):
+        load_instrument(path)
+
+
+def test_single_axis_model_is_the_one_axis_case(calibration):
+    unit = calibration.model.axes["x"]
+    plain = InstrumentModel.single(unit)
+    assert plain.is_single_axis and plain.names == ("",)
+    document = plain.to_dict()
+    assert "axes" not in document and document["schema_version"] == 3  # it has a scale factor
+    bare = InstrumentModel.single(unit.__class__(unit.thermometer, unit.drift, unit.housing,
+                                                 unit.unit))
+    assert bare.to_dict()["schema_version"] == 2  # unchanged files stay version 2
+
+
+def test_axis_read_options_check_that_axis_only(calibration, imu_campaign):
+    """The plausible band of axis y's model is checked on freq_hz_y, not on x's column."""
+    from hrgtc.compensate.compensator import plausible_frequency_band
+
+    band = plausible_frequency_band(calibration.model.axes["y"])
+    options = ReadOptions(axis="y", freq_band_hz=band, freq_span_hz=band)
+    assert len(options.read(imu_campaign.warmup)) > 0
+    wrong = ReadOptions(axis="x", freq_band_hz=band, freq_span_hz=band)
+    with pytest.raises(RecordingError, match="column freq_hz_x, row 0"):
+        wrong.read(imu_campaign.warmup)
