@@ -21,6 +21,7 @@ from hrgtc.cli.options import STRICT_EXIT, ForceOption, JsonOption, StrictOption
 
 if TYPE_CHECKING:
     from hrgtc.compensate.ranges import RangeReport
+    from hrgtc.model import InstrumentModel
     from hrgtc.evaluation import Evaluation
     from hrgtc.recording import ReadOptions
 
@@ -183,7 +184,40 @@ def evaluate_command(
             console.rule(f"axis {axis}")
             render_evaluation(result)
         render_axis_summary(model.unit, results)
+    checks = scale_checks(run, model, inputs)
+    if checks and json_output:
+        error_console.print("scale factor: " + "; ".join(
+            f"axis {c.axis or '-'} {c.raw_max_ppm:.1f} → {c.compensated_max_ppm:.1f} ppm"
+            for c in checks))
+    elif checks:
+        render_scale_checks(checks)
     warn_ranges([r.ranges for r in results.values()], json_output, strict)
+
+
+def scale_checks(run: Path, model: InstrumentModel, inputs: ReadOptions) -> tuple:
+    """The scale-factor check of a rate-table run (it has input_rate_dph columns) when the
+    model has a scale factor; () otherwise."""
+    from hrgtc.instrument import check_scale_factor
+
+    if all(m.scale_factor is None for m in model.axes.values()):
+        return ()
+    names = inputs.head(run).names
+    if not any(n == "input_rate_dph" or n.startswith("input_rate_dph_") for n in names):
+        return ()
+    return check_scale_factor(run, model, inputs)
+
+
+def render_scale_checks(checks: tuple) -> None:
+    """Scale-factor error at each temperature of a rate-table run, raw → compensated."""
+    table = Table(title="Scale-factor error (ppm) at each temperature of the rate table "
+                  "(slope of rate − Ω against Ω, IEEE Std 1431), raw → compensated")
+    for column in ("axis", "frequency (Hz)", "holds", "raw", "compensated"):
+        table.add_column(column, justify="right")
+    for check in checks:
+        for f, n, raw, comp in zip(check.freq_hz, check.holds, check.raw_ppm,
+                                   check.compensated_ppm, strict=True):
+            table.add_row(check.axis or "-", f"{f:.4f}", str(n), f"{raw:+.2f}", f"{comp:+.2f}")
+    console.print(table)
 
 
 def allan_text(results: dict[str, Evaluation]) -> str:
