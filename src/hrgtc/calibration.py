@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from hrgtc import drift as drift_model
-from hrgtc.drift.features import EQ21
+from hrgtc.drift.features import AUX_NAME, EQ21, parse_terms
 from hrgtc.errors import CalibrationError, ExtrapolationWarning, HrgtcWarning, InputError
 from hrgtc.evaluation import Evaluation, evaluate
 from hrgtc.model import UnitModel, provenance
@@ -112,6 +112,8 @@ def calibrate(
     premove: float | None = None,
     reference_c: float = 20.0,
     rate_tau_s: float = 10.0,
+    rate_tau2_s: float | None = None,
+    aux: Mapping[str, str] | None = None,
     housing_terms: Iterable[str] | None = HOUSING_TERMS,
     plateau_options: Mapping[str, Any] | None = None,
     drift_from_soaks: bool = True,
@@ -142,6 +144,14 @@ def calibrate(
         Reference temperature of the frequency change f. [°C]
     rate_tau_s
         Time constant of the causal df/dt filter stages. [s]
+    rate_tau2_s
+        Time constant of the second df/dt filter (variable ``d2``); default
+        :data:`hrgtc.drift.drift_model.TAU2_FACTOR` × ``rate_tau_s``. [s]
+    aux
+        Extra logged channels, name -> column (``--aux NAME=COLUMN``): each becomes the
+        variable ``a_NAME`` (the column minus its training mean) and the term
+        ``a_NAME`` is added to the candidates unless ``terms`` already use it;
+        compensation reads the same column.
     housing_terms
         Terms of the classical housing-thermistor baseline, fitted when every
         drift run has ``housing_c``; None to skip.
@@ -214,10 +224,12 @@ def calibrate(
         )
     training = [*drifts, *(extra if drift_from_soaks else ())]
     runs = [partial(options.chunks, path) for path in training]
+    terms = candidate_terms(terms, aux, [heads[str(p)] for p in training])
     model = drift_model.fit(
         runs, thermometer, terms=terms, window_s=window_s, penter=penter, premove=premove,
-        reference_c=reference_c, rate_tau_s=rate_tau_s, excitation_runs=len(drifts),
-        select=select, progress=for_stage(progress, "drift"),
+        reference_c=reference_c, rate_tau_s=rate_tau_s, rate_tau2_s=rate_tau2_s,
+        aux_columns=aux, excitation_runs=len(drifts), select=select,
+        progress=for_stage(progress, "drift"),
     )
     housing = None
     if housing_terms is not None and all("housing_c" in heads[str(p)] for p in training):
@@ -233,6 +245,7 @@ def calibrate(
     settings = {
         "order": order, "terms": list(terms), "window_s": window_s, "penter": penter,
         "premove": premove, "reference_c": reference_c, "rate_tau_s": rate_tau_s,
+        "rate_tau2_s": rate_tau2_s, "aux": dict(aux or {}),
         "housing_terms": None if housing_terms is None else list(housing_terms),
         "plateau_options": dict(plateau_options or {}), "drift_from_soaks": drift_from_soaks,
         "select": select,
@@ -259,3 +272,30 @@ def calibrate(
         for path in validate
     )
     return CalibrationResult(unit_model, tuple(plateaus), table, validation, prior_fit)
+
+
+def candidate_terms(terms: Iterable[str], aux: Mapping[str, str] | None,
+                    heads: Sequence[Any]) -> tuple[str, ...]:
+    """The drift fit's candidates: ``terms``, plus ``a_NAME`` for each mapped channel.
+
+    Every training run must log each mapped column (the error names the file and the
+    column); gradient terms (``g``) need ``housing_c`` in every run.
+    """
+    out = [str(t) for t in terms]
+    used = {v for t in parse_terms(out) for v in t.variables}
+    for name, column in dict(aux or {}).items():
+        if not AUX_NAME.match(str(name)):
+            raise InputError(f"--aux name {name!r} is not usable; use a letter followed by "
+                             "letters or digits, e.g. --aux drive=drive_amplitude_v")
+        for head in heads:
+            if column not in head:
+                raise InputError(f"{head.source}: no column {column!r} for --aux "
+                                 f"{name}={column}; columns: {', '.join(head.names)}")
+        if f"a_{name}" not in used:
+            out.append(f"a_{name}")
+    if "g" in used:
+        for head in heads:
+            if "housing_c" not in head:
+                raise InputError(f"{head.source}: no column 'housing_c', which the gradient "
+                                 "terms (g) need; drop them or log the housing thermistor")
+    return tuple(out)

@@ -109,6 +109,8 @@ def render_evaluation(result: Evaluation) -> None:
                       f"{std['median']:.4g} °/h, max {std['max']:.4g} °/h")
     if result.residual_rms_dph is not None:
         console.print(f"RMS of true bias minus model: {result.residual_rms_dph:.4f} °/h")
+    if result.directions is not None:
+        console.print(result.directions.summary(), markup=False)
     for note in result.notes:
         console.print(note)
 
