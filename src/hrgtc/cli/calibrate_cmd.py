@@ -88,7 +88,9 @@ def calibrate_command(
     output: Path = typer.Option(..., "-o", "--output", help="Model file to write (JSON)."),
     order: int = typer.Option(3, help="Order of the thermometer polynomial f(T)."),
     terms: str = typer.Option(
-        EQ21_DEFAULT, help="Candidate drift terms, comma separated (Eq. 21 default)."),
+        None, help="Candidate drift terms, comma separated [default: f,f^2,f^3,g,f*g,f^2*g "
+        "(g the housing - resonator gradient) when the runs log housing_c, else Eq. 21's "
+        f"{EQ21_DEFAULT}]. Variables: f, df, h, dh, dpos, d2, g, a_NAME (--aux)."),
     window_s: float = typer.Option(10.0, "--window-s", help="Averaging window of the fit [s]."),
     penter: float = typer.Option(0.05, help="Stepwise p-value to enter."),
     premove: float = typer.Option(
@@ -144,7 +146,7 @@ def calibrate_command(
 
         result = calibrate(
             soaks, drift, validate or (), order=order,
-            terms=[t.strip() for t in terms.split(",") if t.strip()],
+            terms=None if terms is None else [t.strip() for t in terms.split(",") if t.strip()],
             window_s=window_s, penter=penter, premove=premove, reference_c=reference_c,
             rate_tau_s=rate_tau_s, rate_tau2_s=rate_tau2_s, aux=_aux_mapping(aux or []),
             housing_terms=HOUSING_TERMS,
