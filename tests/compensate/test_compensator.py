@@ -316,5 +316,5 @@ def test_models_with_d2_g_and_aux_run_on_numpy_in_both_engines():
     assert np.sqrt(np.mean(err ** 2)) < 0.5
     without = recording_io.Recording({k: run[k] for k in run.names if k != "drive_v"},
                                       run.metadata, "held-out.parquet")
-    with pytest.raises(InputError, match="held-out.parquet: no column 'drive_v'"):
+    with pytest.raises(InputError, match=r"held-out\.parquet: no column 'drive_v'"):
         Compensator(model).process(without)
