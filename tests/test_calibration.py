@@ -189,3 +189,27 @@ def test_library_refuses_empty_inputs():
         calibrate([], ["x.parquet"])
     with pytest.raises(InputError, match="no drift recordings"):
         calibrate(["x.parquet"], [])
+
+
+def test_aux_channels_and_gradient_terms_need_their_columns():
+    # --aux NAME=COLUMN adds a_NAME to the candidates; a training run without the column, or
+    # gradient terms without housing_c, stop with the file and the column named
+    from hrgtc.calibration import GRADIENT_TERMS, candidate_terms
+    from hrgtc.cli.calibrate_cmd import _aux_mapping
+    from hrgtc.errors import InputError
+    from synthetic import lagged_run, ramp_run
+
+    run = lagged_run(seed=1, hours=0.2)
+    assert candidate_terms(("f", "df"), {"drive": "drive_v"}, [run]) == ("f", "df", "a_drive")
+    assert candidate_terms(("f", "a_drive"), {"drive": "drive_v"}, [run]) == ("f", "a_drive")
+    assert candidate_terms(GRADIENT_TERMS, None, [run]) == GRADIENT_TERMS
+    bare = ramp_run(seed=2, hours=0.2)
+    with pytest.raises(InputError, match=r"synthetic-2: no column 'drive_v' for --aux drive"):
+        candidate_terms(("f",), {"drive": "drive_v"}, [run, bare])
+    with pytest.raises(InputError, match=r"synthetic-2: no column 'housing_c'.*\(g\)"):
+        candidate_terms(GRADIENT_TERMS, None, [bare])
+    with pytest.raises(InputError, match="not usable"):
+        candidate_terms(("f",), {"drive_1": "drive_v"}, [run])
+    assert _aux_mapping(["drive=drive_v", " quad = q_v "]) == {"drive": "drive_v", "quad": "q_v"}
+    with pytest.raises(InputError, match="write NAME=COLUMN"):
+        _aux_mapping(["drive"])

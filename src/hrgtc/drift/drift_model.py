@@ -440,7 +440,9 @@ def fit(
             spread = float(np.std(means["df"]))
             update["switch_hz_per_s"] = SWITCH_FRACTION * spread if spread > 0.0 else 1.0
         settings = FeatureSettings(**{**settings.to_dict(), **update})
-    windows = window_means(runs, settings, candidates, window_s, progress, thermometer)
+    # df/dt's training range is kept for the range warnings even when no candidate uses it
+    tracked = ("df",) if "f" in variables else ()
+    windows = window_means(runs, settings, candidates, window_s, progress, thermometer, tracked)
     for run in range(min(excitation_runs, len(windows.sources))):
         _check_excitation(windows, thermometer, variables, run)
     _check_excitation(windows, thermometer, variables)
@@ -491,7 +493,7 @@ def fit(
     pv = {"const": float(pvalues[0])}
     pv.update({n: float(pvalues[k + 1]) for k, n in enumerate(selected)})
     ranges = {v: (float(windows.variables[v].min()), float(windows.variables[v].max()))
-              for v in variables}
+              for v in windows.variables}
     return DriftModel(
         settings=settings,
         candidates=names,

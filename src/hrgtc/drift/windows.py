@@ -91,6 +91,7 @@ def window_means(
     window_s: float = 10.0,
     progress: Progress | None = None,
     thermometer: Any = None,
+    extra_variables: Sequence[str] = (),
 ) -> TrainingWindows:
     """Window means of candidate terms and measured bias over training runs.
 
@@ -109,8 +110,12 @@ def window_means(
         Optional ``callback(samples_done, samples_total_or_0)``.
     thermometer
         The unit's thermometer, for the gradient ``g`` (see :class:`FeatureStream`).
+    extra_variables
+        Variables whose window means are kept although no term uses them (their
+        training ranges: ``df`` for the range warnings of a model without df terms).
     """
     variables = variables_for(terms)
+    variables += tuple(v for v in extra_variables if v not in variables)
     window_rows = round(window_s * settings.sample_rate_hz)
     if window_rows < 1:
         raise InputError(f"window_s={window_s} s holds no sample at {settings.sample_rate_hz} Hz")
