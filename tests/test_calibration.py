@@ -197,6 +197,7 @@ def test_aux_channels_and_gradient_terms_need_their_columns():
     from hrgtc.calibration import GRADIENT_TERMS, candidate_terms
     from hrgtc.cli.calibrate_cmd import _aux_mapping
     from hrgtc.errors import InputError
+
     from synthetic import lagged_run, ramp_run
 
     run = lagged_run(seed=1, hours=0.2)
