@@ -18,7 +18,15 @@ from pathlib import Path
 from typing import Any
 
 from hrgtc.compensate.c_plan import TABLE_POINTS, CPlan
-from hrgtc.drift.features import Term, is_aux, settle_rows
+from hrgtc.compensate.c_variables import (
+    RATES,
+    bias_params,
+    cname,
+    extra_variables,
+    levels,
+    step_inputs,
+)
+from hrgtc.drift.features import Term, settle_rows
 from hrgtc.errors import InputError
 from hrgtc.model import UnitModel
 
@@ -67,34 +75,6 @@ def _term_expression(term: Term) -> str:
     return " * ".join(_factor(v, p) for v, p in term.powers)
 
 
-def _cname(variable: str) -> str:
-    """Upper-case stem of a variable's constants (``F``, ``D2``; ``A_drive`` keeps its case)."""
-    return f"A_{variable[2:]}" if is_aux(variable) else variable.upper()
-
-
-def _bias_params(plan: CPlan) -> list[tuple[str, str]]:
-    """(variable, parameter of ``bias_dph()``) in the order of its signature."""
-    out = [("f", "f_hz"), ("df", "df_hz_per_s")]
-    if plan.housing:
-        out += [("h", "h_c"), ("dh", "dh_c_per_s")]
-    if plan.rate2:
-        out.append(("d2", "d2_hz_per_s"))
-    if plan.gradient:
-        out.append(("g", "g_c"))
-    return out + [(f"a_{name}", f"a_{name}") for name in plan.aux]
-
-
-def _step_inputs(plan: CPlan) -> list[str]:
-    """``step()``'s inputs after freq_hz and rate_dph: housing_c, then each extra channel."""
-    return (["housing_c"] if plan.housing_input else []) + [f"aux_{n}" for n in plan.aux]
-
-
-def _levels(plan: CPlan) -> tuple[str, ...]:
-    """Variables checked as levels (``in_range``); the rates are :data:`_RATES`."""
-    return ("f", "h", "g", *(f"a_{n}" for n in plan.aux))
-
-
-_RATES = ("df", "dh", "d2")
 
 
 
@@ -142,8 +122,8 @@ def readme(model: UnitModel, plan: CPlan, prefix: str, origin: str,
         return ", ".join(f"{v} in [{drift.ranges[v][0]:.6g}, {drift.ranges[v][1]:.6g}]"
                          for v in plan.computed if v in drift.ranges and v in kind) or "none"
 
-    housing_arg = "".join(f"double {name}, " for name in _step_inputs(plan))
-    housing_use = "".join(f"{name}, " for name in _step_inputs(plan))
+    housing_arg = "".join(f"double {name}, " for name in step_inputs(plan))
+    housing_use = "".join(f"{name}, " for name in step_inputs(plan))
     lines += [
         "",
         "THE MODEL (Eq. (22) form of [1]; coefficients rounded here for reading)",
@@ -180,11 +160,11 @@ def readme(model: UnitModel, plan: CPlan, prefix: str, origin: str,
         f"{plan.extension[1]:g} degC.",
         f"  in_range = 1 when freq_hz is in the calibrated range [{f_low:.10g}, {f_high:.10g}] "
         f"Hz ({thermometer.temperature_range_c[0]:g} to {thermometer.temperature_range_c[1]:g} "
-        f"degC), the training ranges of the levels hold: {ranges(_levels(plan))}, rate_in_range "
+        f"degC), the training ranges of the levels hold: {ranges(levels(plan))}, rate_in_range "
         f"is 1 and the filter has settled (the first {settle_rows(settings)} samples of a run, "
         "which training leaves out too, are 0); else 0.",
         f"  rate_in_range = 1 when the rates are in their training ranges: "
-        f"{ranges(_RATES)}; else 0 (a model trained on a cool-down has seen only "
+        f"{ranges(RATES)}; else 0 (a model trained on a cool-down has seen only "
         "negative df/dt).",
         "",
         "UNITS",
@@ -240,8 +220,8 @@ def header(model: UnitModel, plan: CPlan, prefix: str, origin: str,
     out_h = "    double h_c;                 /* housing temperature change h [degC] */\n" \
             "    double dh_c_per_s;          /* its causal rate dh/dt [degC/s] */\n" \
         if housing else ""
-    arg_h = "".join(f", double {name}" for name in _step_inputs(plan))
-    bias_h = "".join(f", double {name}" for _, name in _bias_params(plan)[2:])
+    arg_h = "".join(f", double {name}" for name in step_inputs(plan))
+    bias_h = "".join(f", double {name}" for _, name in bias_params(plan)[2:])
     levels = " and ".join(v for v in plan.computed if v in ("f", "h"))
     settle = settle_rows(model.drift.settings)
     rates = " and ".join(v for v in plan.computed if v in ("df", "dh"))
@@ -320,7 +300,7 @@ int {p}_frequency_in_range(double freq_hz);
 
 def _bias_function(model: UnitModel, plan: CPlan, prefix: str) -> str:
     drift = model.drift
-    names = dict(_bias_params(plan))
+    names = dict(bias_params(plan))
     params = list(names.values())
     used = [v for v in names if v in drift.variables and drift.selected]
     body = []
@@ -330,7 +310,7 @@ def _bias_function(model: UnitModel, plan: CPlan, prefix: str) -> str:
     for v in used:
         # held at the edge of the training range; the tangent there continues the model
         # beyond it, as DriftModel.predict(extrapolation="tangent")
-        u = _cname(v)
+        u = cname(v)
         body.append(f"    const double c_{v} = {names[v]} < CLAMP_{u}_LOW ? CLAMP_{u}_LOW : "
                     f"({names[v]} > CLAMP_{u}_HIGH ? CLAMP_{u}_HIGH : {names[v]});")
         body.append(f"    const double x_{v} = c_{v} / SCALE_{u};")
@@ -341,7 +321,7 @@ def _bias_function(model: UnitModel, plan: CPlan, prefix: str) -> str:
         body.append(f"    term = COEFFICIENTS[{k}] * term;")
         body.append("    sum = sum + term;")
     for v in used:
-        u = _cname(v)
+        u = cname(v)
         body.append(f"    if ({names[v]} < CLAMP_{u}_LOW || {names[v]} > CLAMP_{u}_HIGH) {{"
                     f"  /* beyond the training range of {v} */")
         body.append("        double gradient = 0.0;")
@@ -361,12 +341,12 @@ def _bias_function(model: UnitModel, plan: CPlan, prefix: str) -> str:
     constants = [f"static const double INTERCEPT_DPH = "
                  f"{_literal(drift.intercept_dph, 'intercept_dph')};"]
     for v in used:
-        constants.append(f"static const double SCALE_{_cname(v)} = "
+        constants.append(f"static const double SCALE_{cname(v)} = "
                          f"{_literal(drift.settings.scales[v], f'scales[{v}]')};")
         low, high = drift.ranges[v]
-        constants.append(f"static const double CLAMP_{_cname(v)}_LOW = "
+        constants.append(f"static const double CLAMP_{cname(v)}_LOW = "
                          f"{_literal(low, f'ranges[{v}][0]')};")
-        constants.append(f"static const double CLAMP_{_cname(v)}_HIGH = "
+        constants.append(f"static const double CLAMP_{cname(v)}_HIGH = "
                          f"{_literal(high, f'ranges[{v}][1]')};")
     if drift.terms:
         listed = ", ".join(drift.selected)
@@ -393,12 +373,12 @@ def source(model: UnitModel, plan: CPlan, prefix: str) -> str:
     def checks(kind: tuple[str, ...]) -> str:
         return "".join(
             f"\n        && {v}_value >= RANGE_{u}_LOW && {v}_value <= RANGE_{u}_HIGH"
-            for v, u in ((v, _cname(v)) for v, _, _ in ranges) if v in kind
+            for v, u in ((v, cname(v)) for v, _, _ in ranges) if v in kind
         )
 
     range_constants = "".join(
-        f"static const double RANGE_{_cname(v)}_LOW = {low};\n"
-        f"static const double RANGE_{_cname(v)}_HIGH = {high};\n"
+        f"static const double RANGE_{cname(v)}_LOW = {low};\n"
+        f"static const double RANGE_{cname(v)}_HIGH = {high};\n"
         for v, low, high in ranges
     )
     above = "residual > 0.0" if plan.increasing else "!(residual > 0.0)"
@@ -416,8 +396,8 @@ def source(model: UnitModel, plan: CPlan, prefix: str) -> str:
     }
     if not plan.housing:
         h = dict.fromkeys(h, "")
-    h["arg"] = "".join(f", double {name}" for name in _step_inputs(plan))
-    extra = _extra_variables(plan, settings)
+    h["arg"] = "".join(f", double {name}" for name in step_inputs(plan))
+    extra = extra_variables(plan, settings, _literal, _comment)
     n_th = len(plan.th_coefficients)
     return f"""/* {p}_model.c -- generated by hrgtc export-c for unit {_comment(model.unit)};
  * see {p}_model.h for what it computes, its provenance and its use. Do not edit.
@@ -568,8 +548,8 @@ double {p}_step({p}_state *state, double freq_hz, double rate_dph{h['arg']}, \
 {h['rate']}    temperature = {p}_temperature_c(freq_hz);
 {extra['rate']}    bias = {p}_bias_dph(f_value, df_value{h['bias']}{extra['bias']});
     compensated = rate_dph - bias;
-    level_in_range = {p}_frequency_in_range(freq_hz){checks(_levels(plan))};
-    rate_in_range = 1{checks(_RATES)};
+    level_in_range = {p}_frequency_in_range(freq_hz){checks(levels(plan))};
+    rate_in_range = 1{checks(RATES)};
     /* in_range: calibrated temperature, trained df/dt, and the filter settled */
     in_range = level_in_range && rate_in_range && state->samples >= {up}_SETTLE_ROWS;
     state->samples += 1UL;
@@ -587,46 +567,3 @@ double {p}_step({p}_state *state, double freq_hz, double rate_dph{h['arg']}, \
     return compensated;
 }}
 """
-
-
-
-def _extra_variables(plan: CPlan, settings: Any) -> dict[str, str]:
-    """C pieces of the second rate filter (d2), the gradient (g) and the extra channels."""
-    out = dict.fromkeys(("constants", "functions", "reset", "start", "values", "rate", "bias"),
-                        "")
-    if plan.rate2:
-        out["constants"] += (
-            f"static const double RATE2_ALPHA = {_literal(plan.alpha2, 'alpha2')};\n"
-            f"static const double RATE2_BETA = {_literal(plan.beta2, 'beta2')};\n"
-            f"static const double RATE2_GAIN = {_literal(plan.gain2, 'gain2')};\n")
-        out["functions"] = """
-/* The second df/dt filter (variable d2, time constant rate_tau2_s): rate_update's steps. */
-static double rate2_update(double *y1, double *y2, double x)
-{
-    double a = RATE2_ALPHA * x;
-    double b = RATE2_BETA * *y1;
-    *y1 = a + b;
-    a = RATE2_ALPHA * *y1;
-    b = RATE2_BETA * *y2;
-    *y2 = a + b;
-    a = *y1 - *y2;
-    return a * RATE2_GAIN;
-}
-"""
-        out["reset"] += "    state->f2_y1 = 0.0;\n    state->f2_y2 = 0.0;\n"
-        out["start"] += "        state->f2_y1 = f_value;\n        state->f2_y2 = f_value;\n"
-        out["values"] += "    double d2_value;\n"
-        out["rate"] += "    d2_value = rate2_update(&state->f2_y1, &state->f2_y2, f_value);\n"
-        out["bias"] += ", d2_value"
-    if plan.gradient:
-        out["values"] += "    double g_value;\n"
-        out["rate"] += "    g_value = housing_c - temperature;  /* NaN beyond the inverse */\n"
-        out["bias"] += ", g_value"
-    for name in plan.aux:
-        centre = _literal(settings.aux_centres.get(name, 0.0), f"aux_centres[{name}]")
-        out["constants"] += (f"/* training mean of aux_{name}, the logged column "
-                             f"{_comment(settings.aux_columns.get(name, '?'))} */\n"
-                             f"static const double AUX_CENTRE_{name} = {centre};\n")
-        out["values"] += f"    const double a_{name}_value = aux_{name} - AUX_CENTRE_{name};\n"
-        out["bias"] += f", a_{name}_value"
-    return out
