@@ -111,6 +111,9 @@ def test_calibrate_command_json(tmp_path, campaign):
     )
     assert data["drift"]["selected_terms"] and data["drift"]["history"][0]["action"] == "added"
     (validation,) = data["validation"]
+    heating = validation["heating_cooling"]["heating"]  # a warm-up: heating blocks only
+    assert heating["blocks"] > 0 and heating["compensated_dph"] < heating["raw_dph"]
+    assert validation["heating_cooling"]["cooling"]["blocks"] == 0
     assert validation["bias_stability_10s_dph"]["raw"] > validation["bias_stability_10s_dph"][
         "compensated"
     ]
@@ -124,9 +127,12 @@ def test_calibrate_command_json(tmp_path, campaign):
 def test_glob_after_soak_and_tables(tmp_path, campaign):
     _, files = campaign
     out = tmp_path / "unit.json"
-    result = _cli(["--soak", *files.soaks, "--drift", files.cooldown, "-o", out])
+    result = _cli(["--soak", *files.soaks, "--drift", files.cooldown, "--validate",
+                   files.warmup, "-o", out])
     assert result.exit_code == 0, result.output
     assert "Eq. (18) form" in result.stdout and "B = " in result.stdout
+    text = " ".join(result.stdout.split())  # --validate: heating and cooling apart, plainly
+    assert "heating and cooling apart" in text and "heating: " in text
 
 
 # -- bad inputs: a clear error and nothing written --------------------------------------------

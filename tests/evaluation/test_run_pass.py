@@ -105,6 +105,8 @@ def test_range_warnings_in_plain_output_and_strict_exit(setup, tmp_path, command
     assert plain.exit_code == 0, plain.output
     text = " ".join(plain.stdout.split())
     assert "beyond the trained df/dt" in text and "× the largest trained" in text
+    if command == "evaluate":  # heating and cooling apart, in the plain output too
+        assert "heating and cooling apart" in text and "compensated" in text
     strict = CliRunner().invoke(app, [*args, "--strict", "--force"] if command == "compensate"
                                 else [*args, "--strict"])
     assert strict.exit_code == 3, strict.output
