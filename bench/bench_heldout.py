@@ -163,6 +163,20 @@ if __name__ == "__main__":
     if extra:  # e.g. --extra-terms=dpos,f*dpos: candidates beyond Eq. 21
         options["terms"] = (*EQ21_TERMS, *extra[0].split(","))
         label = "extra_" + extra[0].replace(",", "_").replace("*", "").replace("^", "")
+    for arg in sys.argv:  # --rate-tau2-s=60, --select=cv, --aux=chamber=chamber_c, --terms=
+        if arg.startswith("--terms="):  # the whole candidate set, e.g. --terms=f,f^2,f^3,g,f*g
+            options["terms"] = tuple(arg.split("=", 1)[1].split(","))
+            label = "terms_" + "_".join(options["terms"]).replace("*", "").replace("^", "")
+        elif arg.startswith("--rate-tau2-s="):
+            options["rate_tau2_s"] = float(arg.split("=", 1)[1])
+            label += "_tau2_" + arg.split("=", 1)[1]
+        elif arg.startswith("--select="):
+            options["select"] = arg.split("=", 1)[1]
+            label += "_" + options["select"]
+        elif arg.startswith("--aux="):
+            name, column = arg.split("=", 2)[1:]
+            options.setdefault("aux", {})[name] = column
+            label += "_aux_" + name
     rows, lines = heldout(options, seeds=(1, 2) if "--quick" in sys.argv else (1, 2, 3, 4, 5),
                           label=label)
     for row in rows if verbose else ():

@@ -85,3 +85,32 @@ def with_heating_extra(run, per_hz_per_s=2000.0, tau_s=2600.0):
           * (run["chamber_c"] - run["resonator_c"]) / tau_s)
     extra = per_hz_per_s * np.maximum(df, 0.0)
     return run.with_columns(rate_dph=run.rate_dph + extra, bias_dph=run["bias_dph"] + extra)
+
+
+#: Terms of :func:`lagged_model`: the second rate filter, the gradient and an extra channel.
+LAGGED_TERMS = ("f", "f^2", "df", "d2", "g", "f*g", "a_drive", "f*a_drive")
+
+
+def lagged_run(seed, start_c=20.0, end_c=-20.0, hours=3.0, drive_amplitude_v=0.05):
+    """A :func:`ramp_run` with a housing thermistor (lag 900 s of the chamber) and a logged
+    drive amplitude ``drive_v``; the bias also depends on the housing - resonator gradient
+    and the drive."""
+    run = ramp_run(seed, start_c=start_c, end_c=end_c, hours=hours)
+    chamber, resonator, t = run["chamber_c"], run["resonator_c"], run.time_s
+    a = -np.expm1(-1.0 / (900.0 * run.sample_rate_hz))
+    housing = signal.lfilter([a], [1.0, a - 1.0], chamber, zi=[(1.0 - a) * chamber[0]])[0]
+    drive = 2.5 + drive_amplitude_v * np.sin(2.0 * np.pi * t / 1700.0 + seed)
+    extra = 0.4 * (housing - resonator) + 20.0 * (drive - 2.5)
+    return run.with_columns(housing_c=housing, drive_v=drive, rate_dph=run.rate_dph + extra,
+                            bias_dph=run["bias_dph"] + extra)
+
+
+def lagged_model():
+    """A unit model whose drift terms use d2, g and a_drive (all of :data:`LAGGED_TERMS`)."""
+    from hrgtc import drift
+    from hrgtc.model import UnitModel
+
+    fitted = drift.fit([lagged_run(seed=5), lagged_run(seed=6, start_c=-20.0, end_c=20.0)],
+                       THERMOMETER, terms=LAGGED_TERMS, initial=LAGGED_TERMS, premove=0.999999,
+                       rate_tau2_s=120.0, aux_columns={"drive": "drive_v"})
+    return UnitModel(thermometer=THERMOMETER, drift=fitted, unit="synthetic-lagged")

@@ -112,6 +112,9 @@ def test_calibrate_command_json(tmp_path, campaign):
     )
     assert data["drift"]["selected_terms"] and data["drift"]["history"][0]["action"] == "added"
     (validation,) = data["validation"]
+    heating = validation["heating_cooling"]["heating"]  # a warm-up: heating blocks only
+    assert heating["blocks"] > 0 and heating["compensated_dph"] < heating["raw_dph"]
+    assert validation["heating_cooling"]["cooling"]["blocks"] == 0
     assert validation["bias_stability_10s_dph"]["raw"] > validation["bias_stability_10s_dph"][
         "compensated"
     ]
@@ -125,9 +128,12 @@ def test_calibrate_command_json(tmp_path, campaign):
 def test_glob_after_soak_and_tables(tmp_path, campaign):
     _, files = campaign
     out = tmp_path / "unit.json"
-    result = _cli(["--soak", *files.soaks, "--drift", files.cooldown, "-o", out])
+    result = _cli(["--soak", *files.soaks, "--drift", files.cooldown, "--validate",
+                   files.warmup, "-o", out])
     assert result.exit_code == 0, result.output
     assert "Eq. (18) form" in result.stdout and "B = " in result.stdout
+    text = " ".join(result.stdout.split())  # --validate: heating and cooling apart, plainly
+    assert "heating and cooling apart" in text and "heating: " in text
 
 
 # -- bad inputs: a clear error and nothing written --------------------------------------------
@@ -255,3 +261,28 @@ def test_sensor_thermometer_cli_needs_no_soaks(campaign_factory, tmp_path):
     assert result.exit_code == 0, result.output
     assert "temperature sensor" in result.output
     assert load_model(output).thermometer.source == "sensor"
+
+
+def test_aux_channels_and_gradient_terms_need_their_columns():
+    # --aux NAME=COLUMN adds a_NAME to the candidates; a training run without the column, or
+    # gradient terms without housing_c, stop with the file and the column named
+    from hrgtc.calibration import GRADIENT_TERMS, candidate_terms
+    from hrgtc.cli.calibrate_cmd import _aux_mapping
+    from hrgtc.errors import InputError
+
+    from synthetic import lagged_run, ramp_run
+
+    run = lagged_run(seed=1, hours=0.2)
+    assert candidate_terms(("f", "df"), {"drive": "drive_v"}, [run]) == ("f", "df", "a_drive")
+    assert candidate_terms(("f", "a_drive"), {"drive": "drive_v"}, [run]) == ("f", "a_drive")
+    assert candidate_terms(GRADIENT_TERMS, None, [run]) == GRADIENT_TERMS
+    bare = ramp_run(seed=2, hours=0.2)
+    with pytest.raises(InputError, match=r"synthetic-2: no column 'drive_v' for --aux drive"):
+        candidate_terms(("f",), {"drive": "drive_v"}, [run, bare])
+    with pytest.raises(InputError, match=r"synthetic-2: no column 'housing_c'.*\(g\)"):
+        candidate_terms(GRADIENT_TERMS, None, [bare])
+    with pytest.raises(InputError, match="not usable"):
+        candidate_terms(("f",), {"drive_1": "drive_v"}, [run])
+    assert _aux_mapping(["drive=drive_v", " quad = q_v "]) == {"drive": "drive_v", "quad": "q_v"}
+    with pytest.raises(InputError, match="write NAME=COLUMN"):
+        _aux_mapping(["drive"])

@@ -88,3 +88,24 @@ def test_written_file_has_ordinary_permissions(tmp_path, unit_model):
     finally:
         os.umask(old)
     assert path.stat().st_mode & 0o777 == 0o644
+
+
+def test_round_trip_of_a_model_with_d2_g_and_an_extra_channel(tmp_path):
+    # issue 12: the second rate filter, the gradient and --aux channels pass the schema and
+    # the integrity checks and come back exactly
+    from synthetic import LAGGED_TERMS, lagged_model, lagged_run
+
+    model = lagged_model()
+    assert set(model.drift.selected) == set(LAGGED_TERMS)
+    again = load_model(save_model(model, tmp_path / "unit.json"))
+    assert again.drift.settings == model.drift.settings
+    assert again.drift.settings.aux_columns == {"drive": "drive_v"}
+    assert again.drift.settings.rate_tau2_s == 120.0
+    run = lagged_run(seed=9, start_c=25.0, end_c=-25.0, hours=1.0)
+    np.testing.assert_array_equal(again.drift.predict_recording(run, THERMOMETER),
+                                  model.drift.predict_recording(run, THERMOMETER))
+    text = json.loads((tmp_path / "unit.json").read_text())
+    text["drift"]["settings"]["aux_columns"] = {"drive": 3}
+    (tmp_path / "bad.json").write_text(json.dumps(text))
+    with pytest.raises(ModelFileError, match="aux_columns"):
+        load_model(tmp_path / "bad.json")

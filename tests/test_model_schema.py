@@ -102,8 +102,8 @@ def test_reversed_range_short_and_unknown_terms(tmp_path, document):
     with pytest.raises(ModelFileError, match=r"drift.scaled_coefficients: \d+ values for \d+"):
         load_model(_write(tmp_path, bad))
     bad = json.loads(good)
-    bad["drift"]["selected"][0] = "g^2"
-    with pytest.raises(ModelFileError, match=r"drift.selected: .*g"):
+    bad["drift"]["selected"][0] = "q^2"
+    with pytest.raises(ModelFileError, match=r"drift.selected: .*q"):
         load_model(_write(tmp_path, bad))
     bad = json.loads(good)
     bad["thermometer"]["temperature_range_c"] = [40.0, -20.0]

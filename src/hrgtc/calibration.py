@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 
 from hrgtc import drift as drift_model
-from hrgtc.drift.features import EQ21
+from hrgtc.drift.features import AUX_NAME, EQ21, parse_terms
 from hrgtc.errors import CalibrationError, ExtrapolationWarning, HrgtcWarning, InputError
 from hrgtc.evaluation import Evaluation, evaluate
 from hrgtc.model import UnitModel, provenance
@@ -43,6 +43,12 @@ PathLike = str | os.PathLike[str]
 SOAK_COLUMNS = ("time_s", "freq_hz", "chamber_c")
 #: Classical baseline: cubic in housing temperature.
 HOUSING_TERMS = ("h", "h^2", "h^3")
+#: Default candidates when every training run logs ``housing_c``: the cubic in f of Eq. (21)
+#: of [1] with the housing - resonator gradient g = housing_c - T(f) in place of df/dt (the
+#: gradient is what makes the bias depend on the rate of change; measured, it carries over
+#: to held-out warm-ups and cycles where the df/dt terms fitted on a cool-down do not:
+#: bench/heldout_gradient.jsonl).
+GRADIENT_TERMS = ("f", "f^2", "f^3", "g", "f*g", "f^2*g")
 
 
 @dataclass(frozen=True)
@@ -108,12 +114,14 @@ def calibrate(
     validate: Sequence[PathLike] = (),
     *,
     order: int = 3,
-    terms: Iterable[str] = tuple(t.name for t in EQ21),
+    terms: Iterable[str] | None = None,
     window_s: float = 10.0,
     penter: float = 0.05,
     premove: float | None = None,
     reference_c: float = 20.0,
     rate_tau_s: float = 10.0,
+    rate_tau2_s: float | None = None,
+    aux: Mapping[str, str] | None = None,
     housing_terms: Iterable[str] | None = HOUSING_TERMS,
     plateau_options: Mapping[str, Any] | None = None,
     drift_from_soaks: bool = True,
@@ -138,13 +146,22 @@ def calibrate(
     order
         Order of the thermometer polynomial (3 in [1]).
     terms
-        Candidate terms of the drift model (Eq. 21 by default).
+        Candidate terms of the drift model; default :data:`GRADIENT_TERMS` when every
+        training run logs ``housing_c``, else the nine of Eq. (21).
     window_s, penter, premove
         Drift fit on ``window_s`` means with these stepwise thresholds.
     reference_c
         Reference temperature of the frequency change f. [°C]
     rate_tau_s
         Time constant of the causal df/dt filter stages. [s]
+    rate_tau2_s
+        Time constant of the second df/dt filter (variable ``d2``); default
+        :data:`hrgtc.drift.drift_model.TAU2_FACTOR` × ``rate_tau_s``. [s]
+    aux
+        Extra logged channels, name -> column (``--aux NAME=COLUMN``): each becomes the
+        variable ``a_NAME`` (the column minus its training mean) and the term
+        ``a_NAME`` is added to the candidates unless ``terms`` already use it;
+        compensation reads the same column.
     housing_terms
         Terms of the classical housing-thermistor baseline, fitted when every
         drift run has ``housing_c``; None to skip.
@@ -182,8 +199,8 @@ def calibrate(
         return _calibrate_sensor(soaks, drifts, validate, options, progress, order=order,
                                  terms=terms, window_s=window_s, penter=penter,
                                  premove=premove, reference_c=reference_c,
-                                 rate_tau_s=rate_tau_s, housing_terms=housing_terms,
-                                 select=select)
+                                 rate_tau_s=rate_tau_s, rate_tau2_s=rate_tau2_s,
+                                 aux_columns=aux, housing_terms=housing_terms, select=select)
     if thermometer != "resonator":
         raise InputError(f"thermometer must be 'resonator' or 'sensor', got {thermometer!r}")
     if not soaks:
@@ -230,14 +247,18 @@ def calibrate(
             HrgtcWarning, stacklevel=2,
         )
     training = [*drifts, *(extra if drift_from_soaks else ())]
+    training_heads = [heads[str(p)] for p in training]
+    terms = resolve_terms(terms, aux, training_heads)
     model, housing = _fit_drift(training, heads, thermometer, options, progress, len(drifts),
                                 terms=terms, window_s=window_s, penter=penter, premove=premove,
                                 reference_c=reference_c, rate_tau_s=rate_tau_s,
+                                rate_tau2_s=rate_tau2_s, aux_columns=aux,
                                 housing_terms=housing_terms, select=select)
     unit = heads[str(drifts[0])].metadata.unit
     settings = {
         "order": order, "terms": list(terms), "window_s": window_s, "penter": penter,
         "premove": premove, "reference_c": reference_c, "rate_tau_s": rate_tau_s,
+        "rate_tau2_s": rate_tau2_s, "aux": dict(aux or {}),
         "housing_terms": None if housing_terms is None else list(housing_terms),
         "plateau_options": dict(plateau_options or {}), "drift_from_soaks": drift_from_soaks,
         "select": select,
@@ -276,7 +297,9 @@ def _fit_drift(training: Sequence[PathLike], heads: Mapping[str, Any], thermomet
                             progress=for_stage(progress, "drift"), **fit)
     housing = None
     if housing_terms is not None and all("housing_c" in heads[str(p)] for p in training):
-        baseline = {k: v for k, v in fit.items() if k != "select"}  # as before: defaults
+        # the baseline's own terms in h and dh/dt, with the defaults otherwise
+        baseline = {k: v for k, v in fit.items()
+                    if k not in ("select", "rate_tau2_s", "aux_columns")}
         baseline["terms"] = housing_terms
         try:
             housing = drift_model.fit(runs, thermometer,
@@ -306,10 +329,12 @@ def _calibrate_sensor(soaks: Sequence[PathLike], drifts: Sequence[PathLike],
                 high = max(high, float(np.max(chunk.freq_hz)))
     thermometer = identity((low, high))
     heads = {str(path): options.head(path) for path in training}
+    fit["terms"] = resolve_terms(fit["terms"], fit.get("aux_columns"),
+                                 [heads[str(p)] for p in training])
     model, housing = _fit_drift(training, heads, thermometer, options, progress, len(drifts),
                                 **fit)
-    settings = {key: (list(v) if isinstance(v, tuple | list) else v)
-                for key, v in fit.items()}
+    settings = {key: (list(v) if isinstance(v, tuple | list) else
+                      dict(v) if isinstance(v, Mapping) else v) for key, v in fit.items()}
     unit_model = UnitModel(
         thermometer=thermometer, drift=model, housing=housing,
         unit=heads[str(drifts[0])].metadata.unit,
@@ -323,3 +348,38 @@ def _calibrate_sensor(soaks: Sequence[PathLike], drifts: Sequence[PathLike],
     validation = tuple(evaluate(path, unit_model, allan=False, read_options=options)
                        for path in validate)
     return CalibrationResult(unit_model, (), (), validation, None)
+def candidate_terms(terms: Iterable[str], aux: Mapping[str, str] | None,
+                    heads: Sequence[Any]) -> tuple[str, ...]:
+    """The drift fit's candidates: ``terms``, plus ``a_NAME`` for each mapped channel.
+
+    Every training run must log each mapped column (the error names the file and the
+    column); gradient terms (``g``) need ``housing_c`` in every run.
+    """
+    out = [str(t) for t in terms]
+    used = {v for t in parse_terms(out) for v in t.variables}
+    for name, column in dict(aux or {}).items():
+        if not AUX_NAME.match(str(name)):
+            raise InputError(f"--aux name {name!r} is not usable; use a letter followed by "
+                             "letters or digits, e.g. --aux drive=drive_amplitude_v")
+        for head in heads:
+            if column not in head:
+                raise InputError(f"{head.source}: no column {column!r} for --aux "
+                                 f"{name}={column}; columns: {', '.join(head.names)}")
+        if f"a_{name}" not in used:
+            out.append(f"a_{name}")
+    if "g" in used:
+        for head in heads:
+            if "housing_c" not in head:
+                raise InputError(f"{head.source}: no column 'housing_c', which the gradient "
+                                 "terms (g) need; drop them or log the housing thermistor")
+    return tuple(out)
+
+
+def resolve_terms(terms: Iterable[str] | None, aux: Mapping[str, str] | None,
+                  heads: Sequence[Any]) -> tuple[str, ...]:
+    """The candidates of a drift fit: ``terms``, or by default the gradient set when every
+    training run logs ``housing_c`` (Eq. 21's nine otherwise), and the ``--aux`` channels."""
+    if terms is None:
+        housed = all("housing_c" in head for head in heads)
+        terms = GRADIENT_TERMS if housed else tuple(t.name for t in EQ21)
+    return candidate_terms(terms, aux, heads)

@@ -53,7 +53,9 @@ _FINITE = {"type": "number"}
 _STAT = {"anyOf": [{"type": "number"}, {"type": "null"},
                    {"enum": ["NaN", "Infinity", "-Infinity"]}]}
 _POSITIVE = {"type": "number", "exclusiveMinimum": 0}
-_TERM = {"type": "string", "pattern": r"^[a-z]+(\^[0-9]+)?(\*[a-z]+(\^[0-9]+)?)*$"}
+_VARIABLE = r"(?:[a-z][a-z0-9]*|a_[A-Za-z][A-Za-z0-9]*)"
+_TERM = {"type": "string",
+         "pattern": rf"^{_VARIABLE}(\^[0-9]+)?(\*{_VARIABLE}(\^[0-9]+)?)*$"}
 _RANGE = {"type": "array", "items": _FINITE, "minItems": 2, "maxItems": 2}
 
 _THERMOMETER = {
@@ -98,6 +100,10 @@ _DRIFT = {
                 "rate_tau_s": _POSITIVE,
                 "warmup_s": {"type": "number", "minimum": 0},
                 "scales": {"type": "object", "additionalProperties": _POSITIVE},
+                "switch_hz_per_s": {"type": "number", "minimum": 0},
+                "rate_tau2_s": {"type": "number", "minimum": 0},
+                "aux_columns": {"type": "object", "additionalProperties": {"type": "string"}},
+                "aux_centres": {"type": "object", "additionalProperties": _FINITE},
             },
         },
         "candidates": {"type": "array", "items": _TERM, "minItems": 1},

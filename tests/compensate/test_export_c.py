@@ -41,7 +41,7 @@ FLAGS = ["-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", "-pedantic"]
 STRICT = ["-Wshadow", "-Wconversion", "-Wdouble-promotion", "-Wstrict-prototypes",
           "-Wmissing-prototypes", "-Wcast-qual", "-Wfloat-equal"]
 
-# Reads rows of (freq_hz, rate_dph[, housing_c]) doubles, writes rows of 8 doubles:
+# Reads rows of (freq_hz, rate_dph[, housing_c][, aux]) doubles, writes rows of 8 doubles:
 # rate_comp, bias, resonator_c_est, in_range, f, df, return value of step(), rate_in_range.
 # Prints the state's counters; replays the first samples after reset and fails (3) if they differ.
 DRIVER = r"""
@@ -50,11 +50,17 @@ DRIVER = r"""
 
 #define REPLAY 64
 
+#ifndef UPFX_AUX_INPUTS
+#define UPFX_AUX_INPUTS 0
+#endif
+
 static int same(double a, double b) { return a == b || (a != a && b != b); }
 
 static double step(PFX_state *s, const double *row, PFX_output *out)
 {
-#if UPFX_USES_HOUSING
+#if UPFX_AUX_INPUTS
+    return PFX_step(s, row[0], row[1], row[2], row[3], out);
+#elif UPFX_USES_HOUSING
     return PFX_step(s, row[0], row[1], row[2], out);
 #else
     return PFX_step(s, row[0], row[1], out);
@@ -63,8 +69,8 @@ static double step(PFX_state *s, const double *row, PFX_output *out)
 
 int main(int argc, char **argv)
 {
-    const size_t columns = UPFX_USES_HOUSING ? 3 : 2;
-    double row[3], record[8];
+    const size_t columns = (UPFX_USES_HOUSING ? 3 : 2) + UPFX_AUX_INPUTS;
+    double row[4], record[8];
     PFX_state state;
     PFX_output out, first[REPLAY];
     size_t n = 0, k;
@@ -323,3 +329,34 @@ def test_refuses_a_model_with_the_heating_switch(tmp_path):
     with pytest.raises(InputError, match="heating/cooling switch dpos"):
         export_c(UnitModel(THERMOMETER, fitted), tmp_path / "c")
     assert not (tmp_path / "c").exists() or not any((tmp_path / "c").iterdir())
+
+
+@needs_compiler
+def test_c_computes_d2_g_and_the_extra_channel_as_python_does(tmp_path):
+    # issue 12: the second df/dt filter (its own state), the gradient housing_c - T(f) from the
+    # C thermometer inverse, and --aux channels as step() inputs, centred as in training;
+    # a held-out run leaving every training range, so the tangent branches run too
+    from synthetic import lagged_model, lagged_run
+
+    model = lagged_model()
+    recording = lagged_run(seed=13, start_c=25.0, end_c=-25.0, hours=2.0,
+                           drive_amplitude_v=0.2)
+    exe = build(model, tmp_path, "lag")
+    header = (tmp_path / "lag_model.h").read_text()
+    assert "#define LAG_AUX_INPUTS 1" in header and "double aux_drive" in header
+    assert "f2_y1" in header  # the second filter's state
+    inputs = [recording.freq_hz, recording.rate_dph, recording["housing_c"],
+              recording["drive_v"]]
+    compensator = Compensator(model)
+    expected = compensator.process(recording)
+    out, counters = run_driver(exe, inputs, tmp_path, "run")
+    assert counters == [compensator.samples, compensator.out_of_range,
+                        compensator.rate_out_of_range]
+    assert 0 < compensator.out_of_range < len(recording)
+    np.testing.assert_array_equal(out[:, 3] * out[:, 7], expected["in_range"])
+    np.testing.assert_allclose(out[:, 1], expected["bias_model_dph"], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(out[:, 0], expected["rate_comp_dph"], rtol=0, atol=1e-9)
+    # the C bias is the model's: B(x) with d2 and g from their own definitions
+    skip = 6000
+    err = out[skip:, 1] - recording["bias_dph"][skip:]
+    assert np.sqrt(np.mean(err ** 2)) < 0.5

@@ -112,3 +112,79 @@ def test_sample_rate_mismatch_is_refused():
     s = FeatureSettings(reference_freq_hz=1.0, sample_rate_hz=200.0)
     with pytest.raises(InputError, match=r"run.parquet: sample rate 10 Hz differs.*200 Hz"):
         s.check_sample_rate(rec)
+
+
+# -- the second rate filter, the gradient and the user's channels (issue 12, item 2) ------
+def _lagged_run(n=6000, fs=5.0, seed=3):
+    from synthetic import THERMOMETER
+
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) / fs
+    resonator = 20.0 - 10.0 * (1.0 - np.exp(-t / 900.0))
+    return Recording(
+        {"time_s": t, "freq_hz": THERMOMETER.frequency(resonator),
+         "rate_dph": rng.normal(size=n), "housing_c": resonator - 0.5 + 0.01 * rng.normal(size=n),
+         "drive_v": 2.5 + 0.1 * np.sin(t / 50.0)},
+        Metadata(sample_rate_hz=fs), source="lagged.csv")
+
+
+def test_grammar_knows_d2_g_and_aux_channels():
+    assert parse_term("a_drive*f").name == "f*a_drive"
+    assert parse_term("a_quad^2*d2*g").name == "d2*g*a_quad^2"
+    assert parse_term("g").unit == "°C"
+    assert required_columns(parse_terms(["f*g", "a_drive"])) == ("freq_hz", "housing_c")
+    with pytest.raises(InputError, match="cannot read term 'a_'"):
+        parse_term("a_")
+    with pytest.raises(InputError, match="unknown variable 'd3'"):
+        parse_term("d3")
+
+
+def test_d2_is_the_rate_filter_with_its_own_time_constant():
+    # independent: both low-pass stages by scipy.signal.lfilter with alpha = 1 - exp(-1/(tau fs)),
+    # started at the first sample, and the ramp gain alpha fs / (1 - alpha)
+    run = _lagged_run()
+    fs, tau2 = 5.0, 120.0
+    s = FeatureSettings(reference_freq_hz=4432.0, sample_rate_hz=fs, rate_tau_s=3.0,
+                        rate_tau2_s=tau2)
+    values = compute_variables(run, s, ("f", "df", "d2"))
+    f = run.freq_hz - 4432.0
+    alpha = 1.0 - np.exp(-1.0 / (tau2 * fs))
+    y1 = signal.lfilter([alpha], [1.0, alpha - 1.0], f, zi=[(1.0 - alpha) * f[0]])[0]
+    y2 = signal.lfilter([alpha], [1.0, alpha - 1.0], y1, zi=[(1.0 - alpha) * f[0]])[0]
+    expected = (y1 - y2) * alpha * fs / (1.0 - alpha)
+    np.testing.assert_allclose(values["d2"], expected, rtol=1e-9, atol=1e-15)
+    assert not np.allclose(values["d2"], values["df"])  # a slower filter, not df again
+    # the slow filter lags more: on the exponential approach its rate is behind df's
+    late = slice(2000, None)
+    assert np.all(np.abs(values["d2"][late]) > np.abs(values["df"][late]))
+    with pytest.raises(InputError, match="rate_tau2_s > 0"):
+        compute_variables(run, FeatureSettings(4432.0, fs), ("d2",))
+
+
+def test_g_is_housing_minus_resonator_temperature_from_the_thermometer():
+    from synthetic import THERMOMETER
+
+    run = _lagged_run()
+    s = FeatureSettings(reference_freq_hz=4432.0, sample_rate_hz=5.0)
+    g = compute_variables(run, s, ("g",), THERMOMETER)["g"]
+    np.testing.assert_allclose(g, run["housing_c"] - THERMOMETER.temperature(run.freq_hz),
+                               rtol=0, atol=1e-12)
+    assert abs(float(np.median(g)) + 0.5) < 0.01  # the housing logged 0.5 °C below
+    with pytest.raises(InputError, match="needs the unit's thermometer"):
+        compute_variables(run, s, ("g",))
+
+
+def test_aux_channel_is_centred_and_a_missing_column_is_named():
+    run = _lagged_run()
+    s = FeatureSettings(reference_freq_hz=4432.0, sample_rate_hz=5.0,
+                        aux_columns={"drive": "drive_v"}, aux_centres={"drive": 2.5})
+    a = compute_variables(run, s, ("a_drive",))["a_drive"]
+    np.testing.assert_allclose(a, run["drive_v"] - 2.5, rtol=0, atol=1e-15)
+    again = FeatureSettings.from_dict(s.to_dict())
+    assert again.aux_columns == {"drive": "drive_v"} and again.aux_centres == {"drive": 2.5}
+    with pytest.raises(InputError, match=r"lagged.csv: no column 'drive_v'.*--aux drive=drive_v"):
+        compute_variables(run.drop("drive_v") if hasattr(run, "drop") else Recording(
+            {k: run[k] for k in run.names if k != "drive_v"}, run.metadata, run.source),
+            s, ("a_drive",))
+    with pytest.raises(InputError, match="have no column"):
+        compute_variables(run, FeatureSettings(4432.0, 5.0), ("a_quad",))

@@ -34,7 +34,7 @@ def test_evaluation_against_metrics_by_hand(setup):
     assert settle > 0 and result.ranges.settling_fraction == pytest.approx(settle / len(run))
     assert result.raw_10s == pytest.approx(
         bias_stability(raw[settle:], run.sample_rate_hz, 10.0), rel=1e-12)
-    predicted = model.drift.predict_recording(run)
+    predicted = model.drift.predict_recording(run, model.thermometer)
     assert result.compensated_10s == pytest.approx(
         bias_stability((raw - predicted)[settle:], run.sample_rate_hz, 10.0), rel=1e-12)
     truth = np.sqrt(np.mean((run["bias_dph"] - predicted) ** 2))
@@ -67,7 +67,8 @@ def test_compensate_command_file_to_file(setup, tmp_path):
     assert json.loads(result.stdout)["rows"] == len(recording.read(files.warmup))
     written = recording.read(out)
     run = recording.read(files.warmup)
-    np.testing.assert_array_equal(written["bias_model_dph"], model.drift.predict_recording(run))
+    np.testing.assert_array_equal(written["bias_model_dph"], model.drift.predict_recording(
+        run, model.thermometer))
     np.testing.assert_array_equal(written["rate_comp_dph"],
                                   run.rate_dph - written["bias_model_dph"])
     assert set(np.unique(written["in_range"])) <= {0.0, 1.0}
@@ -104,6 +105,8 @@ def test_range_warnings_in_plain_output_and_strict_exit(setup, tmp_path, command
     assert plain.exit_code == 0, plain.output
     text = " ".join(plain.stdout.split())
     assert "beyond the trained df/dt" in text and "× the largest trained" in text
+    if command == "evaluate":  # heating and cooling apart, in the plain output too
+        assert "heating and cooling apart" in text and "compensated" in text
     strict = CliRunner().invoke(app, [*args, "--strict", "--force"] if command == "compensate"
                                 else [*args, "--strict"])
     assert strict.exit_code == 3, strict.output

@@ -79,6 +79,9 @@ def _render_drift(result: CalibrationResult) -> None:
                         f"{v.raw_10s / v.compensated_10s:.2f}×", f"{v.out_of_range_fraction:.1%}",
                         f"{v.rate_out_of_range_fraction:.1%}")
         console.print(val)
+        for v in result.validation:
+            if v.directions is not None:
+                console.print(f"{v.file}: " + v.directions.summary(), markup=False)
 
 
 @app.command("calibrate")
@@ -97,7 +100,9 @@ def calibrate_command(
     output: Path = typer.Option(..., "-o", "--output", help="Model file to write (JSON)."),
     order: int = typer.Option(3, help="Order of the thermometer polynomial f(T)."),
     terms: str = typer.Option(
-        EQ21_DEFAULT, help="Candidate drift terms, comma separated (Eq. 21 default)."),
+        None, help="Candidate drift terms, comma separated [default: f,f^2,f^3,g,f*g,f^2*g "
+        "(g the housing - resonator gradient) when the runs log housing_c, else Eq. 21's "
+        f"{EQ21_DEFAULT}]. Variables: f, df, h, dh, dpos, d2, g, a_NAME (--aux)."),
     window_s: float = typer.Option(10.0, "--window-s", help="Averaging window of the fit [s]."),
     penter: float = typer.Option(0.05, help="Stepwise p-value to enter."),
     premove: float = typer.Option(
@@ -109,6 +114,13 @@ def calibrate_command(
         help="Also fit the drift model on the soaks' warming and cooling transients."),
     rate_tau_s: float = typer.Option(
         10.0, "--rate-tau-s", help="Time constant of each stage of the causal df/dt filter [s]."),
+    rate_tau2_s: float = typer.Option(
+        None, "--rate-tau2-s", help="Time constant of the second df/dt filter, variable d2 "
+        "(terms like d2, f*d2) [s; default 6 × --rate-tau-s]."),
+    aux: list[str] = typer.Option(
+        None, "--aux", metavar="NAME=COLUMN", help="An extra logged channel (drive amplitude, "
+        "quadrature control voltage) as variable a_NAME, centred on its training mean; the "
+        "term a_NAME joins the candidates. compensate/evaluate read the same column."),
     prior: Path = typer.Option(
         None, "--prior", help="Population prior (hrgtc fleet prior): a Bayesian thermometer "
         "fit, so that 2 or 3 soaks suffice."),
@@ -169,9 +181,10 @@ def calibrate_command(
 
         calibration = calibrate_instrument(
             soaks, drift, validate or (), order=order,
-            terms=[t.strip() for t in terms.split(",") if t.strip()],
+            terms=None if terms is None else [t.strip() for t in terms.split(",") if t.strip()],
             window_s=window_s, penter=penter, premove=premove, reference_c=reference_c,
-            rate_tau_s=rate_tau_s, housing_terms=HOUSING_TERMS,
+            rate_tau_s=rate_tau_s, rate_tau2_s=rate_tau2_s, aux=_aux_mapping(aux or []),
+            housing_terms=HOUSING_TERMS,
             drift_from_soaks=drift_from_soaks, select=select,
             read_options=inputs, progress=progress, prior=prior,
             thermometer=inputs.thermometer, rate_tables=rate_table or (),
@@ -242,3 +255,18 @@ def render_instrument(calibration: InstrumentCalibration) -> None:
                           number(row["scale_raw_max_ppm"], 1),
                           number(row["scale_residual_max_ppm"], 1))
         console.print(table)
+
+
+def _aux_mapping(items: list[str]) -> dict[str, str]:
+    """``--aux NAME=COLUMN`` options as {NAME: COLUMN}."""
+    from hrgtc.errors import InputError
+
+    out: dict[str, str] = {}
+    for item in items:
+        name, sep, column = item.partition("=")
+        if not sep or not name.strip() or not column.strip():
+            raise InputError(f"--aux {item!r}: write NAME=COLUMN, e.g. --aux drive=drive_amp_v")
+        if name.strip() in out:
+            raise InputError(f"--aux {name.strip()!r} given twice")
+        out[name.strip()] = column.strip()
+    return out

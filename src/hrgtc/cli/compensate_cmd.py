@@ -21,8 +21,8 @@ from hrgtc.cli.options import STRICT_EXIT, ForceOption, JsonOption, StrictOption
 
 if TYPE_CHECKING:
     from hrgtc.compensate.ranges import RangeReport
-    from hrgtc.model import InstrumentModel
     from hrgtc.evaluation import Evaluation
+    from hrgtc.model import InstrumentModel
     from hrgtc.recording import ReadOptions
 
 
@@ -115,6 +115,8 @@ def render_evaluation(result: Evaluation) -> None:
                       f"{std['median']:.4g} °/h, max {std['max']:.4g} °/h")
     if result.residual_rms_dph is not None:
         console.print(f"RMS of true bias minus model: {result.residual_rms_dph:.4f} °/h")
+    if result.directions is not None:
+        console.print(result.directions.summary(), markup=False)
     for note in result.notes:
         console.print(note)
 

@@ -43,12 +43,14 @@ import numpy as np
 from numba import njit
 
 from hrgtc.drift import DriftModel
-from hrgtc.drift.features import VARIABLES, rate_filter_coefficients, settle_rows
+from hrgtc.drift.features import rate_filter_coefficients, settle_rows
 from hrgtc.thermometry import Thermometer
 
-#: Variable order of the exponent matrices: the grammar's order (f, df, h, dh). The
-#: heating/cooling switch ``dpos`` is not computed here (:func:`supports_variables`).
-ORDER = tuple(v for v in VARIABLES if v != "dpos")
+#: Variable order of the exponent matrices (f, df, h, dh). The heating/cooling switch
+#: ``dpos``, the second rate filter ``d2``, the gradient ``g`` and the user's channels
+#: ``a_NAME`` are not computed here (:func:`supports_variables`): a model using them runs on
+#: the numpy engine, which gives the same numbers.
+ORDER = ("f", "df", "h", "dh")
 #: Slots of ``counts``: samples outside the f/h ranges, outside the df/dh ranges,
 #: samples whose Newton iteration did not converge (left NaN), and samples of the
 #: filter's settling time at the start of the run.
@@ -182,7 +184,7 @@ def plan(drift: DriftModel, thermometer: Thermometer, variables: tuple[str, ...]
 
 
 def supports_variables(variables: tuple[str, ...]) -> bool:
-    """Whether the kernel computes every variable (not ``dpos``: the numpy engine does)."""
+    """Whether the kernel computes every variable (not dpos, d2, g, a_NAME: numpy does)."""
     return all(v in ORDER for v in variables)
 
 

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hrgtc.drift.features import rate_filter_coefficients
+from hrgtc.drift.features import is_aux, rate_filter_coefficients, variable_key
 from hrgtc.errors import CalibrationError, InputError
 from hrgtc.model import UnitModel
 
@@ -46,6 +46,13 @@ class CPlan:
         Temperatures over which the inverse is defined. [°C]
     precision
         ``"double"`` (C double throughout) or ``"single"`` (float32, centred frequency).
+    gradient
+        The terms use the housing - resonator gradient g = housing_c - T(freq_hz).
+    rate2, alpha2, beta2, gain2
+        The terms use the second df/dt filter ``d2``; its stage coefficients and gain.
+    aux
+        Names of the user's extra channels the terms use (``a_NAME``), in grammar order:
+        each is one more input of ``step()``.
     """
 
     housing: bool
@@ -62,6 +69,17 @@ class CPlan:
     tolerance: float
     extension: tuple[float, float]
     precision: str = "double"
+    gradient: bool = False
+    rate2: bool = False
+    alpha2: float = 0.0
+    beta2: float = 0.0
+    gain2: float = 0.0
+    aux: tuple[str, ...] = ()
+
+    @property
+    def housing_input(self) -> bool:
+        """``step()`` takes ``housing_c`` (for h, dh or g)."""
+        return self.housing or self.gradient
 
 
 #: The precisions the export writes.
@@ -107,8 +125,15 @@ def plan_for(model: UnitModel, precision: str = "double") -> CPlan:
     # The compensator computes f and df (and h, dh when the terms use them); in_range checks
     # the levels (f, h), rate_in_range the rates of change (df, dh), each where computed.
     computed = ["f", "df"] + [v for v in ("h", "dh") if v in used]
+    # second rate filter, gradient and extra channels: levels (g, a_NAME) join in_range,
+    # the rate d2 rate_in_range, as in the compensator
+    computed += [v for v in variables_for_c(used) if v not in computed]
     alpha, beta = rate_filter_coefficients(settings.rate_tau_s, settings.sample_rate_hz)
     gain = alpha * settings.sample_rate_hz / beta  # the factor causal_rate applies
+    alpha2 = beta2 = gain2 = 0.0
+    if "d2" in used:
+        alpha2, beta2 = rate_filter_coefficients(settings.rate_tau2_s, settings.sample_rate_hz)
+        gain2 = alpha2 * settings.sample_rate_hz / beta2
     for v in used:
         if v not in settings.scales:
             raise InputError(f"the drift model has no scale for variable {v!r}; it is corrupt")
@@ -139,4 +164,15 @@ def plan_for(model: UnitModel, precision: str = "double") -> CPlan:
         tolerance=4 * np.finfo(np.float64).eps * max(abs(lo), abs(hi), span),
         extension=(lo, hi),
         precision=precision,
+        gradient="g" in used,
+        rate2="d2" in used,
+        alpha2=alpha2,
+        beta2=beta2,
+        gain2=gain2,
+        aux=tuple(v[2:] for v in variables_for_c(used) if is_aux(v)),
     )
+
+
+def variables_for_c(used: set[str]) -> list[str]:
+    """The variables beyond f, df, h, dh the C code computes, in grammar order."""
+    return [v for v in sorted(used, key=variable_key) if v == "d2" or v == "g" or is_aux(v)]

@@ -18,6 +18,14 @@ from typing import Any
 
 from hrgtc.compensate.c_plan import TABLE_POINTS, CPlan
 from hrgtc.compensate.c_types import DOUBLE, CType, ctype
+from hrgtc.compensate.c_variables import (
+    RATES,
+    bias_params,
+    cname,
+    extra_variables,
+    levels,
+    step_inputs,
+)
 from hrgtc.drift.features import Term, settle_rows
 from hrgtc.model import UnitModel
 
@@ -56,6 +64,8 @@ def _factor(variable: str, power: int, t: CType = DOUBLE) -> str:
 
 def _term_expression(term: Term, t: CType = DOUBLE) -> str:
     return " * ".join(_factor(v, p, t) for v, p in term.powers)
+
+
 
 
 
@@ -107,8 +117,8 @@ def readme(model: UnitModel, plan: CPlan, prefix: str, origin: str,
         return ", ".join(f"{v} in [{drift.ranges[v][0]:.6g}, {drift.ranges[v][1]:.6g}]"
                          for v in plan.computed if v in drift.ranges and v in kind) or "none"
 
-    housing_arg = "double housing_c, " if plan.housing else ""
-    housing_use = "housing_c, " if plan.housing else ""
+    housing_arg = "".join(f"double {name}, " for name in step_inputs(plan))
+    housing_use = "".join(f"{name}, " for name in step_inputs(plan))
     lines += [
         "",
         "THE MODEL (Eq. (22) form of [1]; coefficients rounded here for reading)",
@@ -123,6 +133,16 @@ def readme(model: UnitModel, plan: CPlan, prefix: str, origin: str,
     if plan.housing:
         lines.append(f"  h  = housing_c - {settings.reference_c:g} degC, dh = its rate by the "
                      "same filter   [degC, degC/s]")
+    if plan.rate2:
+        lines.append(f"  d2 = df/dt by the same filter with tau2 = {settings.rate_tau2_s:g} s "
+                     "(its own state)   [Hz/s]")
+    if plan.gradient:
+        lines.append("  g  = housing_c - resonator_c_est, the housing - resonator gradient   "
+                     "[degC]")
+    for name in plan.aux:
+        lines.append(f"  a_{name} = aux_{name} - {settings.aux_centres.get(name, 0.0):.12g}: "
+                     f"the logged column {settings.aux_columns.get(name, '?')!r} minus its "
+                     "training mean   [its unit]")
     lines += [
         "  The code evaluates B on the scaled variables v/scale_v with the exact (%.17g)",
         "  coefficients of the model file; algebraically the same polynomial. Beyond a",
@@ -135,17 +155,19 @@ def readme(model: UnitModel, plan: CPlan, prefix: str, origin: str,
         f"{plan.extension[1]:g} degC.",
         f"  in_range = 1 when freq_hz is in the calibrated range [{f_low:.10g}, {f_high:.10g}] "
         f"Hz ({thermometer.temperature_range_c[0]:g} to {thermometer.temperature_range_c[1]:g} "
-        f"degC), the training ranges of the levels hold: {ranges(('f', 'h'))}, rate_in_range "
+        f"degC), the training ranges of the levels hold: {ranges(levels(plan))}, rate_in_range "
         f"is 1 and the filter has settled (the first {settle_rows(settings)} samples of a run, "
         "which training leaves out too, are 0); else 0.",
         f"  rate_in_range = 1 when the rates are in their training ranges: "
-        f"{ranges(('df', 'dh'))}; else 0 (a model trained on a cool-down has seen only "
+        f"{ranges(RATES)}; else 0 (a model trained on a cool-down has seen only "
         "negative df/dt).",
         "",
         "UNITS",
         "  inputs:  freq_hz [Hz] resonator natural frequency; rate_dph [deg/h] gyro output "
         "(input rate included)"
-        + ("; housing_c [degC] housing thermistor" if plan.housing else "")
+        + ("; housing_c [degC] housing thermistor" if plan.housing_input else "")
+        + "".join(f"; aux_{n} the logged {settings.aux_columns.get(n, '?')!r}"
+                  for n in plan.aux)
         + f". One call per sample at exactly {up}_SAMPLE_RATE_HZ "
         f"({settings.sample_rate_hz:g} Hz): the filter is defined per sample.",
         "  outputs: rate_comp_dph, bias_model_dph [deg/h]; resonator_c_est [degC];",
@@ -194,11 +216,14 @@ def header(model: UnitModel, plan: CPlan, prefix: str, origin: str,
     state_h = "    double h_y1;                /* first low-pass stage of h [degC] */\n" \
               "    double h_y2;                /* second low-pass stage of h [degC] */\n" \
         if housing else ""
+    if plan.rate2:  # the second df/dt filter (d2) has its own state
+        state_h += "    double f2_y1;               /* first stage of f, second filter [Hz] */\n" \
+                   "    double f2_y2;               /* second stage of f, second filter [Hz] */\n"
     out_h = "    double h_c;                 /* housing temperature change h [degC] */\n" \
             "    double dh_c_per_s;          /* its causal rate dh/dt [degC/s] */\n" \
         if housing else ""
-    arg_h = ", double housing_c" if housing else ""
-    bias_h = ", double h_c, double dh_c_per_s" if housing else ""
+    arg_h = "".join(f", double {name}" for name in step_inputs(plan))
+    bias_h = "".join(f", double {name}" for _, name in bias_params(plan)[2:])
     levels = " and ".join(v for v in plan.computed if v in ("f", "h"))
     settle = settle_rows(model.drift.settings)
     k = scale_pieces(model, plan, prefix)
@@ -217,8 +242,10 @@ extern "C" {{
 /* Samples at the start of a run flagged (in_range 0) while the df/dt filter settles,
    as training leaves them out. */
 #define {up}_SETTLE_ROWS {settle}UL
-/* 1 when {p}_step() takes the housing temperature (the model uses h or dh terms). */
-#define {up}_USES_HOUSING {1 if housing else 0}
+/* 1 when {p}_step() takes the housing temperature (the model uses h, dh or g terms). */
+#define {up}_USES_HOUSING {1 if plan.housing_input else 0}
+/* Extra logged channels {p}_step() takes after housing_c (aux_NAME, --aux NAME=COLUMN). */
+#define {up}_AUX_INPUTS {len(plan.aux)}
 /* SHA-256 of the model this code was generated from. */
 #define {up}_MODEL_SHA256 "{sha256}"
 {k['define']}
@@ -251,7 +278,8 @@ void {p}_init({p}_state *state);
 void {p}_reset({p}_state *state);
 
 /* Compensate one sample; returns rate_comp_dph and fills *out unless out is NULL.
-   freq_hz [Hz], rate_dph [deg/h]{", housing_c [degC]" if housing else ""}. */
+   freq_hz [Hz], rate_dph [deg/h]{", housing_c [degC]" if plan.housing_input else ""}\
+{"".join(", aux_" + n for n in plan.aux)}. */
 double {p}_step({p}_state *state, double freq_hz, double rate_dph{arg_h}, {p}_output *out);
 
 /* Bias model B of Eq. (22) from the variables. [deg/h] */
@@ -276,10 +304,9 @@ int {p}_frequency_in_range(double freq_hz);
 
 def _bias_function(model: UnitModel, plan: CPlan, prefix: str) -> str:
     drift = model.drift
-    housing = plan.housing
-    params = ["f_hz", "df_hz_per_s"] + (["h_c", "dh_c_per_s"] if housing else [])
-    names = dict(zip(("f", "df", "h", "dh"), params, strict=False))
-    used = [v for v in ("f", "df", "h", "dh") if v in drift.variables and drift.selected]
+    names = dict(bias_params(plan))
+    params = list(names.values())
+    used = [v for v in names if v in drift.variables and drift.selected]
     body = []
     t = ctype(plan)  # the C type: every declaration, literal and math call below
     real, lit, zero = t.name, t.literal, t.literal(0.0, "zero")
@@ -289,7 +316,7 @@ def _bias_function(model: UnitModel, plan: CPlan, prefix: str) -> str:
     for v in used:
         # held at the edge of the training range; the tangent there continues the model
         # beyond it, as DriftModel.predict(extrapolation="tangent")
-        u = v.upper()
+        u = cname(v)
         body.append(f"    const {real} c_{v} = {names[v]} < CLAMP_{u}_LOW ? CLAMP_{u}_LOW : "
                     f"({names[v]} > CLAMP_{u}_HIGH ? CLAMP_{u}_HIGH : {names[v]});")
         body.append(f"    const {real} x_{v} = c_{v} / SCALE_{u};")
@@ -300,7 +327,7 @@ def _bias_function(model: UnitModel, plan: CPlan, prefix: str) -> str:
         body.append(f"    term = COEFFICIENTS[{k}] * term;")
         body.append("    sum = sum + term;")
     for v in used:
-        u = v.upper()
+        u = cname(v)
         body.append(f"    if ({names[v]} < CLAMP_{u}_LOW || {names[v]} > CLAMP_{u}_HIGH) {{"
                     f"  /* beyond the training range of {v} */")
         body.append(f"        {real} gradient = {zero};")
@@ -320,12 +347,13 @@ def _bias_function(model: UnitModel, plan: CPlan, prefix: str) -> str:
     constants = [f"static const {real} INTERCEPT_DPH = "
                  f"{lit(drift.intercept_dph, 'intercept_dph')};"]
     for v in used:
-        constants.append(f"static const {real} SCALE_{v.upper()} = "
+        u = cname(v)
+        constants.append(f"static const {real} SCALE_{u} = "
                          f"{lit(drift.settings.scales[v], f'scales[{v}]')};")
         low, high = drift.ranges[v]
-        constants.append(f"static const {real} CLAMP_{v.upper()}_LOW = "
+        constants.append(f"static const {real} CLAMP_{u}_LOW = "
                          f"{lit(low, f'ranges[{v}][0]')};")
-        constants.append(f"static const {real} CLAMP_{v.upper()}_HIGH = "
+        constants.append(f"static const {real} CLAMP_{u}_HIGH = "
                          f"{lit(high, f'ranges[{v}][1]')};")
     if drift.terms:
         listed = ", ".join(drift.selected)
@@ -354,12 +382,12 @@ def source(model: UnitModel, plan: CPlan, prefix: str) -> str:
     def checks(kind: tuple[str, ...]) -> str:
         return "".join(
             f"\n        && {v}_value >= RANGE_{u}_LOW && {v}_value <= RANGE_{u}_HIGH"
-            for v, u in ((v, v.upper()) for v, _, _ in ranges) if v in kind
+            for v, u in ((v, cname(v)) for v, _, _ in ranges) if v in kind
         )
 
     range_constants = "".join(
-        f"static const double RANGE_{v.upper()}_LOW = {low};\n"
-        f"static const double RANGE_{v.upper()}_HIGH = {high};\n"
+        f"static const double RANGE_{cname(v)}_LOW = {low};\n"
+        f"static const double RANGE_{cname(v)}_HIGH = {high};\n"
         for v, low, high in ranges
     )
     above = "residual > 0.0" if plan.increasing else "!(residual > 0.0)"
@@ -377,6 +405,8 @@ def source(model: UnitModel, plan: CPlan, prefix: str) -> str:
     }
     if not plan.housing:
         h = dict.fromkeys(h, "")
+    h["arg"] = "".join(f", double {name}" for name in step_inputs(plan))
+    extra = extra_variables(plan, settings, _literal, _comment)
     n_th = len(plan.th_coefficients)
     k = scale_pieces(model, plan, prefix)
     return f"""/* {p}_model.c -- generated by hrgtc export-c for unit {_comment(model.unit)};
@@ -390,7 +420,8 @@ def source(model: UnitModel, plan: CPlan, prefix: str) -> str:
 /* ---- frequency change and the causal df/dt filter (hrgtc.drift.features.causal_rate) ---- */
 static const double REFERENCE_FREQ_HZ = \
 {_literal(settings.reference_freq_hz, 'reference_freq_hz')};
-{h['constants']}static const double RATE_ALPHA = {_literal(plan.alpha, 'alpha')};
+{h['constants']}{extra['constants']}\
+static const double RATE_ALPHA = {_literal(plan.alpha, 'alpha')};
 static const double RATE_BETA = {_literal(plan.beta, 'beta')};
 static const double RATE_GAIN = {_literal(plan.gain, 'gain')};  /* alpha * fs / beta */
 
@@ -407,7 +438,7 @@ static double rate_update(double *y1, double *y2, double x)
     a = *y1 - *y2;
     return a * RATE_GAIN;
 }}
-
+{extra['functions']}
 /* ---- the drift model, Eq. (22) of [1] (hrgtc.drift.DriftModel.predict) ---- */
 {_bias_function(model, plan, p)}{k['function']}
 /* ---- the thermometer, Eq. (18) of [1] (hrgtc.thermometry.Thermometer) ---- */
@@ -501,7 +532,7 @@ void {p}_reset({p}_state *state)
 {{
     state->f_y1 = 0.0;
     state->f_y2 = 0.0;
-{h['reset']}    state->started = 0;
+{h['reset']}{extra['reset']}    state->started = 0;
     state->samples = 0UL;
     state->out_of_range = 0UL;
     state->rate_out_of_range = 0UL;
@@ -516,19 +547,19 @@ double {p}_step({p}_state *state, double freq_hz, double rate_dph{h['arg']}, \
 {p}_output *out)
 {{
     const double f_value = freq_hz - REFERENCE_FREQ_HZ;
-{h['values']}    double df_value, bias, compensated, temperature;
+{h['values']}{extra['values']}    double df_value, bias, compensated, temperature;
     int in_range, rate_in_range, level_in_range;
 {k['declare']}    if (!state->started) {{  /* the filter starts at rest on the first sample */
         state->f_y1 = f_value;
         state->f_y2 = f_value;
-{h['start']}        state->started = 1;
+{h['start']}{extra['start']}        state->started = 1;
     }}
     df_value = rate_update(&state->f_y1, &state->f_y2, f_value);
-{h['rate']}    bias = {p}_bias_dph(f_value, df_value{h['bias']});
+{h['rate']}    temperature = {p}_temperature_c(freq_hz);
+{extra['rate']}    bias = {p}_bias_dph(f_value, df_value{h['bias']}{extra['bias']});
     compensated = rate_dph - bias;
-    temperature = {p}_temperature_c(freq_hz);
-    level_in_range = {p}_frequency_in_range(freq_hz){checks(("f", "h"))};
-    rate_in_range = 1{checks(("df", "dh"))};
+    level_in_range = {p}_frequency_in_range(freq_hz){checks(levels(plan))};
+    rate_in_range = 1{checks(RATES)};
     /* in_range: calibrated temperature, trained df/dt, and the filter settled */
     in_range = level_in_range && rate_in_range && state->samples >= {up}_SETTLE_ROWS;
     state->samples += 1UL;
@@ -546,4 +577,3 @@ double {p}_step({p}_state *state, double freq_hz, double rate_dph{h['arg']}, \
     return compensated;
 }}
 """
-

@@ -29,7 +29,13 @@ import numpy as np
 from hrgtc import recording as rec_io
 from hrgtc.compensate.ranges import RangeReport, range_report
 from hrgtc.drift import DriftModel
-from hrgtc.drift.features import FeatureStream, settle_rows
+from hrgtc.drift.features import (
+    LEVEL_VARIABLES,
+    RATE_VARIABLES,
+    FeatureStream,
+    is_aux,
+    settle_rows,
+)
 from hrgtc.errors import CalibrationError, InputError
 from hrgtc.files import check_writable
 from hrgtc.model import UnitModel
@@ -82,7 +88,9 @@ class Compensator:
     engine
         ``"fused"`` (one compiled pass per chunk, default) or ``"numpy"`` (the
         array-by-array reference); both give the same numbers to rounding. A model
-        with the heating/cooling switch ``dpos`` runs on the numpy engine either way.
+        with the heating/cooling switch ``dpos``, the second rate filter ``d2``, the
+        gradient ``g`` or an extra channel ``a_NAME`` runs on the numpy engine either way
+        (the fused kernel computes f, df, h, dh only).
     gaps
         ``"split"``: the df/dt filter restarts at rest after every gap (a time step
         longer than :data:`~hrgtc.recording.validation.GAP_PERIODS` sample periods),
@@ -117,6 +125,7 @@ class Compensator:
         self.engine = engine
         self._plan: Any = None
         self._variables = tuple(dict.fromkeys(("f", "df", *self.drift.variables)))
+        self._levels = tuple(v for v in self._variables if v in LEVEL_VARIABLES or is_aux(v))
         self.reset()
 
     def reset(self) -> None:
@@ -137,7 +146,7 @@ class Compensator:
         The filter settles again: the first ``warmup_s`` after a restart are flagged
         ``in_range`` 0, as at the start of a run.
         """
-        self._stream = FeatureStream(self.drift.settings, self._variables)
+        self._stream = FeatureStream(self.drift.settings, self._variables, self.model.thermometer)
         self._state = np.zeros(7)  # the fused engine's filter state (compensate._kernel)
         self._segment_samples = 0  # samples since the filter (re)started
 
@@ -157,8 +166,8 @@ class Compensator:
         """The next chunk of the run with the :data:`OUTPUT_COLUMNS` added.
 
         ``in_range`` is 1.0 where the frequency is inside the thermometer's calibrated
-        range and the drift model's training range of f (and of h), df/dt (and dh/dt)
-        is inside its training range (a model trained on a cool-down has seen only
+        range and the drift model's training range of f (and of h, g, a_NAME), df/dt (and
+        dh/dt, d2) is inside its training range (a model trained on a cool-down has seen only
         negative df/dt), and the df/dt filter has settled (the first ``warmup_s`` of the
         run, which training leaves out too); else 0.0. The three are counted separately
         (:attr:`out_of_range_fraction`, :attr:`rate_out_of_range_fraction`,
@@ -230,9 +239,9 @@ class Compensator:
         bias = self.drift.predict(values)
         thermometer = self.model.thermometer
         in_range = thermometer.in_range(chunk.freq_hz) & _in_training_range(
-            self.drift, values, ("f", "h")
+            self.drift, values, self._levels
         )
-        rate_in_range = _in_training_range(self.drift, values, ("df", "dh"))
+        rate_in_range = _in_training_range(self.drift, values, RATE_VARIABLES)
         settled = self._segment_samples + np.arange(len(chunk)) >= self._settle_rows
         self._segment_samples += len(chunk)
         np.subtract(chunk.rate_dph, bias, out=out["rate_comp_dph"][start:stop])

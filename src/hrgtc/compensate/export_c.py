@@ -17,6 +17,12 @@ terms use them, ``step()`` takes ``housing_c`` as well and the header defines
 ``<PREFIX>_USES_HOUSING`` as 1. Only the frequency drift model (the paper's) is
 exported, not the classical housing baseline.
 
+The variables of issue 12 are supported too: ``d2`` (a second df/dt filter with its own
+state ``f2_y1``/``f2_y2`` and time constant), ``g`` (``housing_c`` minus the C thermometer
+inverse's temperature; ``step()`` then takes ``housing_c``) and ``a_NAME`` (one more
+``step()`` input ``aux_NAME`` per channel, centred on its training mean;
+``<PREFIX>_AUX_INPUTS`` counts them). The heating/cooling switch ``dpos`` is refused.
+
 With ``-ffp-contract=off`` (GCC's default under ``-std=c99``) the filter, the
 thermometer polynomial and the terms round exactly as NumPy does; what remains
 (the order of the final sum, the Newton iteration's last step) is at the

@@ -32,16 +32,18 @@ import numpy as np
 
 from hrgtc.drift.cross_validation import CrossValidation, cross_validate, select_terms
 from hrgtc.drift.features import (
+    AUX_PREFIX,
     EQ21,
     SWITCH_FRACTION,
-    VARIABLES,
     FeatureSettings,
     FeatureStream,
     Term,
     hierarchy,
+    is_aux,
     linear_combination,
     parse_terms,
     tangent_extension,
+    variable_unit,
     variables_for,
 )
 from hrgtc.drift.regression import EXTENDED_PRECISION, newey_west_inflation
@@ -56,6 +58,8 @@ from hrgtc.thermometry import Thermometer
 MIN_RATE_SPAN_C_PER_H = 0.5
 #: Smallest training spread of the resonator temperature for a drift model. [°C]
 MIN_TEMPERATURE_SPAN_C = 1.0
+#: Default time constant of the second df/dt filter (``d2``) as a multiple of the first's.
+TAU2_FACTOR = 6.0
 
 
 @dataclass(frozen=True)
@@ -186,10 +190,13 @@ class DriftModel:
         variance = np.einsum("ij,jk,ik->i", jacobian, cov, jacobian)
         return np.sqrt(np.maximum(variance, 0.0))
 
-    def predict_recording(self, recording: Recording) -> np.ndarray:
-        """Bias of a whole recording, filter started at its first sample. [°/h]"""
+    def predict_recording(self, recording: Recording, thermometer: Any = None) -> np.ndarray:
+        """Bias of a whole recording, filter started at its first sample. [°/h]
+
+        ``thermometer`` (the unit's) is needed when the terms use the gradient ``g``.
+        """
         self.settings.check_sample_rate(recording)
-        stream = FeatureStream(self.settings, self.variables)
+        stream = FeatureStream(self.settings, self.variables, thermometer)
         return self.predict(stream.process(recording))
 
     def equation(self) -> str:
@@ -199,7 +206,7 @@ class DriftModel:
             value = self.coefficients[name]
             sign = "-" if value < 0 else "+"
             parts.append(f" {sign} {abs(value):.6g}·{name}")
-        units = ", ".join(f"{v} in {VARIABLES[v][0]}" for v in self.variables)
+        units = ", ".join(f"{v} in {variable_unit(v)}" for v in self.variables)
         return "".join(parts) + f"   [°/h; {units}]"
 
     def summary(self) -> str:
@@ -331,6 +338,8 @@ def fit(
     initial: Iterable[str] | None = None,
     reference_c: float = 20.0,
     rate_tau_s: float = 10.0,
+    rate_tau2_s: float | None = None,
+    aux_columns: Mapping[str, str] | None = None,
     warmup_s: float | None = None,
     autocorrelation: str = "newey-west",
     hierarchical: bool = False,
@@ -359,8 +368,15 @@ def fit(
         Reference temperature of f. [°C]
     rate_tau_s
         Time constant of each stage of the causal df/dt filter. [s]
+    rate_tau2_s
+        Time constant of the second df/dt filter, variable ``d2``; default
+        :data:`TAU2_FACTOR` × ``rate_tau_s`` when a candidate uses ``d2``. [s]
+    aux_columns
+        Extra channel name -> recording column, for candidates in ``a_NAME``; each is
+        centred on its training mean (stored in the settings).
     warmup_s
-        Start of each run left out while the filter settles; default 5 tau. [s]
+        Start of each run left out while the filters settle; default 5 × the
+        longest time constant. [s]
     excitation_runs
         How many leading runs must each show a temperature change and df/dt
         variation on their own (the user's drift runs, when soaks follow them);
@@ -397,20 +413,36 @@ def fit(
         raise InputError("the first drift run holds no samples") from None
     finally:
         head.close()
+    variables = variables_for(candidates)
+    tau2 = 0.0
+    if "d2" in variables:
+        tau2 = TAU2_FACTOR * rate_tau_s if rate_tau2_s is None else float(rate_tau2_s)
+    aux = {str(k): str(v) for k, v in dict(aux_columns or {}).items()}
+    unmapped = [v for v in variables if is_aux(v) and v[len(AUX_PREFIX):] not in aux]
+    if unmapped:
+        raise InputError(f"candidate variable(s) {unmapped} have no column; map each with "
+                         "--aux NAME=COLUMN")
     settings = FeatureSettings(
         reference_freq_hz=float(thermometer.frequency(reference_c)),
         sample_rate_hz=first.metadata.sample_rate_hz,
         reference_c=reference_c,
         rate_tau_s=rate_tau_s,
-        warmup_s=5.0 * rate_tau_s if warmup_s is None else warmup_s,
+        warmup_s=5.0 * max(rate_tau_s, tau2) if warmup_s is None else warmup_s,
+        rate_tau2_s=tau2,
+        aux_columns=aux,
     )
-    if "dpos" in variables_for(candidates):  # δ of the heating/cooling switch: a first pass
-        rates = window_means(runs, settings, parse_terms(["df"]), window_s).variables["df"]
-        spread = float(np.std(rates))
-        settings = FeatureSettings(**{**settings.to_dict(), "switch_hz_per_s": (
-            SWITCH_FRACTION * spread if spread > 0.0 else 1.0)})
-    windows = window_means(runs, settings, candidates, window_s, progress)
-    variables = variables_for(candidates)
+    first_pass = [v for v in variables if is_aux(v)] + (["df"] if "dpos" in variables else [])
+    if first_pass:  # δ of the heating/cooling switch and the channels' centres: a first pass
+        means = window_means(runs, settings, parse_terms(first_pass), window_s).variables
+        update: dict[str, Any] = {"aux_centres": {
+            v[len(AUX_PREFIX):]: float(np.mean(means[v])) for v in first_pass if is_aux(v)}}
+        if "dpos" in variables:
+            spread = float(np.std(means["df"]))
+            update["switch_hz_per_s"] = SWITCH_FRACTION * spread if spread > 0.0 else 1.0
+        settings = FeatureSettings(**{**settings.to_dict(), **update})
+    # df/dt's training range is kept for the range warnings even when no candidate uses it
+    tracked = ("df",) if "f" in variables else ()
+    windows = window_means(runs, settings, candidates, window_s, progress, thermometer, tracked)
     for run in range(min(excitation_runs, len(windows.sources))):
         _check_excitation(windows, thermometer, variables, run)
     _check_excitation(windows, thermometer, variables)
@@ -461,7 +493,7 @@ def fit(
     pv = {"const": float(pvalues[0])}
     pv.update({n: float(pvalues[k + 1]) for k, n in enumerate(selected)})
     ranges = {v: (float(windows.variables[v].min()), float(windows.variables[v].max()))
-              for v in variables}
+              for v in windows.variables}
     return DriftModel(
         settings=settings,
         candidates=names,

@@ -6,7 +6,7 @@ thermometer's frequency at a reference temperature (20 °C by default), and
 df/dt comes from a causal filter whose settings are stored in the model file,
 so deployment computes the same numbers sample by sample as training did.
 
-The rate filter is the derivative of a twice low-passed signal,
+The rate filter (:mod:`hrgtc.drift.rate_filter`) is the derivative of a twice low-passed signal,
 D(s) = s / (tau s + 1)^2: y1 follows f through the exact one-step update of a
 first-order lag with time constant tau, y2 follows y1 likewise, and the rate
 is (y1 - y2) divided by the stages' ramp lag (tau in the continuous limit).
@@ -24,7 +24,18 @@ name       meaning                                                unit
 ``h``      housing temperature change housing_c - reference_c     °C
 ``dh``     causal rate of ``h``                                   °C/s
 ``dpos``   heating part of ``df``: df·(1 + tanh(df/δ))/2          Hz/s
+``d2``     causal rate of ``f`` through a second, slower filter   Hz/s
+``g``      housing - resonator gradient housing_c - T(f)          °C
+``a_NAME`` a logged channel the user maps (``--aux NAME=COLUMN``) its unit
 =========  ====================================================  ========
+
+``d2`` is the rate filter of ``df`` with its own time constant
+(``FeatureSettings.rate_tau2_s``), so a fit can mix a fast and a slow rate (a
+thermal lag between the resonator and the part of the gyro whose temperature
+drives the bias). ``g`` needs the unit's thermometer (T(f), Eq. 18 of [1]
+inverted) and a housing thermistor; :class:`FeatureStream` takes the thermometer.
+``a_NAME`` is the mapped column minus its training mean (``aux_centres``), the
+column's name stored in ``aux_columns``; compensation reads the same column.
 
 ``dpos`` is a smooth switch between heating (df > 0: dpos ≈ df) and cooling
 (dpos ≈ 0), so ``df`` + ``dpos`` give heating and cooling their own rate
@@ -48,6 +59,11 @@ from typing import Any
 
 import numpy as np
 
+from hrgtc.drift.rate_filter import (  # noqa: F401  (re-exported: imported from here)
+    RateFilterState,
+    causal_rate,
+    rate_filter_coefficients,
+)
 from hrgtc.errors import InputError
 from hrgtc.recording.schema import Recording
 
@@ -58,13 +74,45 @@ VARIABLES: dict[str, tuple[str, str]] = {
     "h": ("°C", "housing temperature change housing_c - reference_c"),
     "dh": ("°C/s", "causal rate of the housing temperature change"),
     "dpos": ("Hz/s", "heating part of df/dt, df·(1 + tanh(df/δ))/2"),
+    "d2": ("Hz/s", "causal rate of the frequency change through the second filter"),
+    "g": ("°C", "housing - resonator gradient housing_c - T(freq_hz)"),
 }
 _SOURCE_COLUMN = {"f": "freq_hz", "h": "housing_c"}
 #: The level each rate-like variable is the rate of.
-_RATE_OF = {"df": "f", "dh": "h", "dpos": "f"}
+_RATE_OF = {"df": "f", "dh": "h", "dpos": "f", "d2": "f"}
+#: Variables that are levels (checked against the calibrated/training range as ``in_range``)
+#: and rates of change (``rate_in_range``); ``a_NAME`` channels are levels too.
+LEVEL_VARIABLES = ("f", "h", "g")
+RATE_VARIABLES = ("df", "dh", "d2")
+#: Prefix of the user's extra channels in the grammar: ``a_drive`` reads the mapped column.
+AUX_PREFIX = "a_"
+#: An extra channel's name (the part after ``a_``): a letter, then letters and digits.
+AUX_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9]*$")
 #: δ of ``dpos`` as a share of the std of the training windows' df/dt.
 SWITCH_FRACTION = 0.1
-_TERM_FACTOR = re.compile(r"^\s*([a-z]+)\s*(?:\^\s*(\d+))?\s*$")
+_TERM_FACTOR = re.compile(
+    r"^\s*([a-z][a-z0-9]*|a_[A-Za-z][A-Za-z0-9]*)\s*(?:\^\s*(\d+))?\s*$")
+
+
+def is_aux(variable: str) -> bool:
+    """Whether ``variable`` is a user's extra channel ``a_NAME``."""
+    return variable.startswith(AUX_PREFIX) and bool(AUX_NAME.match(variable[len(AUX_PREFIX):]))
+
+
+def is_variable(variable: str) -> bool:
+    """Whether ``variable`` belongs to the grammar (a fixed variable or an ``a_NAME``)."""
+    return variable in VARIABLES or is_aux(variable)
+
+
+def variable_key(variable: str) -> tuple[int, str]:
+    """Canonical order of variables: the fixed ones in :data:`VARIABLES` order, then a_NAME."""
+    order = list(VARIABLES)
+    return (order.index(variable), "") if variable in VARIABLES else (len(order), variable)
+
+
+def variable_unit(variable: str) -> str:
+    """Unit of a variable (an extra channel's is its column's, unknown here)."""
+    return VARIABLES[variable][0] if variable in VARIABLES else "aux"
 
 
 # -- terms ---------------------------------------------------------------------------
@@ -94,7 +142,7 @@ class Term:
         """Unit of the term's value, e.g. ``Hz^2·Hz/s``."""
         parts = []
         for v, p in self.powers:
-            unit = VARIABLES[v][0]
+            unit = variable_unit(v)
             parts.append(unit if p == 1 else f"({unit})^{p}")
         return "·".join(parts)
 
@@ -182,15 +230,15 @@ def parse_term(text: str) -> Term:
                 "like 'f^2*df'"
             )
         name, power = match.group(1), int(match.group(2) or 1)
-        if name not in VARIABLES:
+        if not is_variable(name):
             raise InputError(
-                f"unknown variable {name!r} in term {text!r}; known: {', '.join(VARIABLES)}"
+                f"unknown variable {name!r} in term {text!r}; known: {', '.join(VARIABLES)} "
+                "and a_NAME for a channel mapped with --aux NAME=COLUMN"
             )
         if power < 1:
             raise InputError(f"power must be at least 1 in term {text!r}")
         powers[name] = powers.get(name, 0) + power
-    order = list(VARIABLES)
-    return Term(tuple(sorted(powers.items(), key=lambda item: order.index(item[0]))))
+    return Term(tuple(sorted(powers.items(), key=lambda item: variable_key(item[0]))))
 
 
 def parse_terms(texts: Iterable[str]) -> tuple[Term, ...]:
@@ -219,74 +267,16 @@ def hierarchy(terms: Sequence[Term]) -> dict[str, list[str]]:
 
 
 def required_columns(terms: Sequence[Term]) -> tuple[str, ...]:
-    """Recording columns the terms need (``freq_hz`` and/or ``housing_c``)."""
+    """Recording columns the terms need (``freq_hz`` and/or ``housing_c``; not a_NAME's)."""
     needed = []
     for term in terms:
         for v in term.variables:
-            column = _SOURCE_COLUMN[_RATE_OF.get(v, v)]
-            if column not in needed:
-                needed.append(column)
+            if is_aux(v):
+                continue
+            level = _RATE_OF.get(v, v)
+            columns = ("freq_hz", "housing_c") if v == "g" else (_SOURCE_COLUMN[level],)
+            needed.extend(c for c in columns if c not in needed)
     return tuple(needed)
-
-
-# -- the causal rate filter -------------------------------------------------------------
-def rate_filter_coefficients(tau_s: float, sample_rate_hz: float) -> tuple[float, float]:
-    """(alpha, beta) of one exact first-order low-pass step y += alpha (x - y)."""
-    if not (tau_s > 0 and np.isfinite(tau_s)):
-        raise InputError(f"rate filter time constant must be positive, got {tau_s} s")
-    if not (sample_rate_hz > 0 and np.isfinite(sample_rate_hz)):
-        raise InputError(f"sample rate must be positive, got {sample_rate_hz} Hz")
-    alpha = -math.expm1(-1.0 / (tau_s * sample_rate_hz))
-    return alpha, 1.0 - alpha
-
-
-@dataclass
-class RateFilterState:
-    """State of :func:`causal_rate` for one signal: the two low-pass outputs."""
-
-    y1: float | None = None
-    y2: float | None = None
-
-
-def causal_rate(
-    x: np.ndarray, tau_s: float, sample_rate_hz: float, state: RateFilterState | None = None
-) -> tuple[np.ndarray, np.ndarray, RateFilterState]:
-    """Causal rate of ``x`` by a twice low-passed exact derivative, D(s) = s/(tau s + 1)^2.
-
-    Parameters
-    ----------
-    x
-        Signal sampled at ``sample_rate_hz``. [unit]
-    tau_s
-        Time constant of each low-pass stage. [s]
-    sample_rate_hz
-        Sample rate. [Hz]
-    state
-        Filter state from the previous chunk; ``None`` starts at rest on the
-        first sample (rate 0).
-
-    Returns
-    -------
-    rate, smoothed, state
-        The rate [unit/s], the once-smoothed signal y1 [unit] and the new state.
-    """
-    from scipy import signal  # imported on use: it costs the CLI's start half a second
-
-    x = np.asarray(x, dtype=np.float64)
-    state = RateFilterState() if state is None else RateFilterState(state.y1, state.y2)
-    if x.size == 0:
-        return np.empty(0), np.empty(0), state
-    alpha, beta = rate_filter_coefficients(tau_s, sample_rate_hz)
-    if state.y1 is None or state.y2 is None:
-        state.y1 = state.y2 = float(x[0])
-    b, a = [alpha], [1.0, -beta]
-    y1, _ = signal.lfilter(b, a, x, zi=[beta * state.y1])
-    y2, _ = signal.lfilter(b, a, y1, zi=[beta * state.y2])
-    # For a ramp of slope s the discrete stages lag by s·dt·beta/alpha (= s·tau in the
-    # continuous limit), so this gain makes the steady ramp response exactly s.
-    rate = (y1 - y2) * (alpha * sample_rate_hz / beta)
-    state.y1, state.y2 = float(y1[-1]), float(y2[-1])
-    return rate, y1, state
 
 
 # -- feature settings and computation ---------------------------------------------------
@@ -310,6 +300,11 @@ class FeatureSettings:
         Variable -> scale used internally so every variable is of order one.
     switch_hz_per_s
         δ of the heating/cooling switch ``dpos`` (0: not used). [Hz/s]
+    rate_tau2_s
+        Time constant of each stage of the second rate filter, ``d2`` (0: not used). [s]
+    aux_columns, aux_centres
+        Extra channel name -> the recording column it reads, and its training mean,
+        subtracted (``a_NAME = column - centre``). [column unit]
     """
 
     reference_freq_hz: float
@@ -319,6 +314,9 @@ class FeatureSettings:
     warmup_s: float = 600.0
     scales: dict[str, float] = field(default_factory=dict)
     switch_hz_per_s: float = 0.0
+    rate_tau2_s: float = 0.0
+    aux_columns: dict[str, str] = field(default_factory=dict)
+    aux_centres: dict[str, float] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -329,6 +327,9 @@ class FeatureSettings:
             "warmup_s": self.warmup_s,
             "scales": dict(self.scales),
             "switch_hz_per_s": self.switch_hz_per_s,
+            "rate_tau2_s": self.rate_tau2_s,
+            "aux_columns": dict(self.aux_columns),
+            "aux_centres": dict(self.aux_centres),
         }
 
     @classmethod
@@ -342,6 +343,10 @@ class FeatureSettings:
                 warmup_s=float(data["warmup_s"]),
                 scales={str(k): float(v) for k, v in dict(data.get("scales", {})).items()},
                 switch_hz_per_s=float(data.get("switch_hz_per_s", 0.0)),
+                rate_tau2_s=float(data.get("rate_tau2_s", 0.0)),
+                aux_columns={str(k): str(v) for k, v in dict(data.get("aux_columns", {})).items()},
+                aux_centres={str(k): float(v)
+                             for k, v in dict(data.get("aux_centres", {})).items()},
             )
         except (KeyError, TypeError, ValueError) as exc:
             raise InputError(f"not a valid feature-settings record: {exc!r}") from exc
@@ -381,33 +386,65 @@ def settle_rows(settings: FeatureSettings) -> int:
 
 
 class FeatureStream:
-    """Sample-by-sample computation of f, df, h, dh over consecutive chunks of one run.
+    """Sample-by-sample computation of the grammar's variables over consecutive chunks of one run.
 
     The batch computation is "reset, then one chunk", so any chunking gives
     the same numbers (to rounding of the filter's state hand-over).
+
+    Parameters
+    ----------
+    settings
+        How the variables are computed.
+    variables
+        Variables to compute.
+    thermometer
+        The unit's thermometer (anything with ``temperature(freq_hz, warn=False)``);
+        needed for the gradient ``g`` only.
     """
 
-    def __init__(self, settings: FeatureSettings, variables: Iterable[str] = ("f", "df")):
+    def __init__(self, settings: FeatureSettings, variables: Iterable[str] = ("f", "df"),
+                 thermometer: Any = None):
         self.settings = settings
         self.variables = tuple(variables)
-        unknown = [v for v in self.variables if v not in VARIABLES]
+        self.thermometer = thermometer
+        unknown = [v for v in self.variables if not is_variable(v)]
         if unknown:
-            raise InputError(f"unknown variable(s) {unknown}; known: {', '.join(VARIABLES)}")
+            raise InputError(f"unknown variable(s) {unknown}; known: {', '.join(VARIABLES)} "
+                             "and a_NAME")
+        self._check()
         self.reset()
+
+    def _check(self) -> None:
+        s, used = self.settings, self.variables
+        if "dpos" in used and not s.switch_hz_per_s > 0.0:
+            raise InputError("the variable dpos needs switch_hz_per_s > 0 in the feature "
+                             "settings (drift.fit sets it from the training df/dt)")
+        if "d2" in used and not s.rate_tau2_s > 0.0:
+            raise InputError("the variable d2 needs rate_tau2_s > 0 in the feature settings "
+                             "(the second df/dt filter's time constant, --rate-tau2-s)")
+        if "g" in used and self.thermometer is None:
+            raise InputError("the variable g (housing - resonator gradient) needs the unit's "
+                             "thermometer for T(f)")
+        unmapped = [v for v in used if is_aux(v) and v[len(AUX_PREFIX):] not in s.aux_columns]
+        if unmapped:
+            raise InputError(f"variable(s) {unmapped} have no column: map each with "
+                             "--aux NAME=COLUMN")
 
     def reset(self) -> None:
         """Forget the filter state (start of a new run)."""
         self._states: dict[str, RateFilterState] = {}
         self.samples_seen = 0
 
+    def _rate(self, key: str, level: np.ndarray, tau_s: float) -> np.ndarray:
+        rate, _, self._states[key] = causal_rate(level, tau_s, self.settings.sample_rate_hz,
+                                                 self._states.get(key))
+        return rate
+
     def process(self, chunk: Recording) -> dict[str, np.ndarray]:
         """Variables of the next chunk of the run, keyed by variable name."""
         s = self.settings
         base: dict[str, np.ndarray] = {}
-        if "dpos" in self.variables and not s.switch_hz_per_s > 0.0:
-            raise InputError("the variable dpos needs switch_hz_per_s > 0 in the feature "
-                             "settings (drift.fit sets it from the training df/dt)")
-        if any(v in ("f", "df", "dpos") for v in self.variables):
+        if any(v in ("f", "df", "dpos", "d2") for v in self.variables):
             base["f"] = chunk["freq_hz"] - s.reference_freq_hz
         if any(v in ("h", "dh") for v in self.variables):
             base["h"] = chunk["housing_c"] - s.reference_c
@@ -416,23 +453,46 @@ class FeatureStream:
         for v in self.variables:
             if v in base:
                 out[v] = base[v]
-                continue
-            source = _RATE_OF[v]
-            if source not in rates:
-                rates[source], _, self._states[source] = causal_rate(
-                    base[source], s.rate_tau_s, s.sample_rate_hz, self._states.get(source)
-                )
-            rate = rates[source]
-            out[v] = heating_part(rate, s.switch_hz_per_s) if v == "dpos" else rate
+            elif v == "g":
+                resonator = self.thermometer.temperature(chunk["freq_hz"], warn=False)
+                out[v] = chunk["housing_c"] - resonator
+            elif is_aux(v):
+                out[v] = self._aux(chunk, v)
+            elif v == "d2":
+                out[v] = self._rate("f2", base["f"], s.rate_tau2_s)
+            else:
+                source = _RATE_OF[v]
+                if source not in rates:
+                    rates[source] = self._rate(source, base[source], s.rate_tau_s)
+                rate = rates[source]
+                out[v] = heating_part(rate, s.switch_hz_per_s) if v == "dpos" else rate
         self.samples_seen += len(chunk)
         return out
 
+    def _aux(self, chunk: Recording, variable: str) -> np.ndarray:
+        name = variable[len(AUX_PREFIX):]
+        column = self.settings.aux_columns[name]
+        if column not in chunk:
+            where = f"{chunk.source}: " if chunk.source else ""
+            raise InputError(
+                f"{where}no column {column!r}, which the extra channel {name!r} (variable "
+                f"{variable}) reads; the model was calibrated with --aux {name}={column}: log "
+                f"that channel, or rename the file's column to {column!r} (--col)"
+            )
+        return np.asarray(chunk[column], dtype=np.float64) - aux_centre(self.settings, name)
+
+
+def aux_centre(settings: FeatureSettings, name: str) -> float:
+    """Training mean of the extra channel ``name`` (0 before it is known). [column unit]"""
+    return float(settings.aux_centres.get(name, 0.0))
+
 
 def compute_variables(
-    recording: Recording, settings: FeatureSettings, variables: Iterable[str] = ("f", "df")
+    recording: Recording, settings: FeatureSettings, variables: Iterable[str] = ("f", "df"),
+    thermometer: Any = None,
 ) -> dict[str, np.ndarray]:
     """Batch form of :class:`FeatureStream`: the variables of a whole run."""
-    return FeatureStream(settings, variables).process(recording)
+    return FeatureStream(settings, variables, thermometer).process(recording)
 
 
 def linear_combination(
@@ -487,9 +547,8 @@ def tangent_extension(
 
 
 def variables_for(terms: Sequence[Term]) -> tuple[str, ...]:
-    """Variables the terms use, in grammar order."""
-    used = {v for t in terms for v in t.variables}
-    return tuple(v for v in VARIABLES if v in used)
+    """Variables the terms use, in grammar order (a_NAME last, by name)."""
+    return tuple(sorted({v for t in terms for v in t.variables}, key=variable_key))
 
 
 def design_matrix(

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -89,6 +90,8 @@ def window_means(
     terms: Sequence[Term],
     window_s: float = 10.0,
     progress: Progress | None = None,
+    thermometer: Any = None,
+    extra_variables: Sequence[str] = (),
 ) -> TrainingWindows:
     """Window means of candidate terms and measured bias over training runs.
 
@@ -105,8 +108,14 @@ def window_means(
         Window length. [s]
     progress
         Optional ``callback(samples_done, samples_total_or_0)``.
+    thermometer
+        The unit's thermometer, for the gradient ``g`` (see :class:`FeatureStream`).
+    extra_variables
+        Variables whose window means are kept although no term uses them (their
+        training ranges: ``df`` for the range warnings of a model without df terms).
     """
     variables = variables_for(terms)
+    variables += tuple(v for v in extra_variables if v not in variables)
     window_rows = round(window_s * settings.sample_rate_hz)
     if window_rows < 1:
         raise InputError(f"window_s={window_s} s holds no sample at {settings.sample_rate_hz} Hz")
@@ -116,7 +125,7 @@ def window_means(
     total = 0
     sources: list[str] = []
     for index, source in enumerate(runs):
-        stream = FeatureStream(settings, variables)
+        stream = FeatureStream(settings, variables, thermometer)
         averager = _WindowMeans(window_rows, skip)
         input_rate = None
         for chunk in _iter_run(source):

@@ -38,6 +38,7 @@ from hrgtc.evaluation.allan import (
     confidence_interval,
     equivalent_degrees_of_freedom,
 )
+from hrgtc.evaluation.heating_cooling import DirectionSplit, DirectionStats
 from hrgtc.evaluation.metrics import (
     DEFAULT_TAUS_S,
     bias_stability_intervals,
@@ -142,6 +143,8 @@ class Evaluation:
         Two-sided level of the intervals (0.683: 1σ).
     deviation
         Which deviation ``allan`` holds (a key of :data:`DEVIATIONS`).
+    directions
+        Heating and cooling apart (:mod:`hrgtc.evaluation.heating_cooling`).
     """
 
     file: str
@@ -164,6 +167,7 @@ class Evaluation:
         default_factory=dict)
     confidence: float = ONE_SIGMA
     deviation: str = "oadev"
+    directions: DirectionStats | None = None
 
     @property
     def name(self) -> str:
@@ -250,6 +254,7 @@ class Evaluation:
             "residual_rms_dph": self.residual_rms_dph,
             "ranges": None if self.ranges is None else self.ranges.to_dict(),
             "notes": list(self.notes),
+            "heating_cooling": None if self.directions is None else self.directions.to_dict(),
         }
 
     def allan_csv(self) -> str:
@@ -288,6 +293,7 @@ class Evaluation:
                      f"{self.rate_out_of_range_fraction:.1%})")
         if self.residual_rms_dph is not None:
             lines.append(f"RMS of true bias minus model: {self.residual_rms_dph:.4f} °/h")
+        lines.extend([] if self.directions is None else [self.directions.summary()])
         lines.extend(self.range_warnings())
         lines.extend(self.notes)
         return "\n".join(lines)
@@ -438,7 +444,7 @@ def run_pass(
     frequency = Compensator(model, gaps=gaps)
     features = None
     if block_rows:
-        features = FeatureStream(model.drift.settings, model.drift.variables)
+        features = FeatureStream(model.drift.settings, model.drift.variables, model.thermometer)
     housing: Compensator | None = None
     means = BlockMeans(block_rows) if block_rows else None
     full: dict[str, SeriesStatistics] = {}
@@ -458,6 +464,7 @@ def run_pass(
                     for key in keys}
             cut = _SettlingCut(full, settle_rows(model.drift.settings),
                                2 * round(10.0 * metadata.sample_rate_hz))
+            split = DirectionSplit(model, metadata.sample_rate_hz)
         out = frequency.process(chunk)
         if on_output is not None:
             on_output(out)
@@ -475,6 +482,7 @@ def run_pass(
         if allan and deviation != "oadev":
             for key, values in pushed.items():
                 whole.setdefault(key, []).append(values)
+        split.push(chunk, raw, comp, out["bias_model_dph"] - chunk["bias_dph"] if truth else None)
         if truth:
             columns["true_dph"] = chunk["bias_dph"]
             squared_error += float(np.sum((out["bias_model_dph"] - chunk["bias_dph"]) ** 2))
@@ -530,7 +538,7 @@ def run_pass(
         block_s=None if means is None else means.rows / fs,
         blocks=kept, notes=tuple(notes), ranges=frequency.ranges(),
         bias_stability_interval_dph=intervals, confidence=float(confidence),
-        deviation=deviation,
+        deviation=deviation, directions=split.result(),
     )
 
 

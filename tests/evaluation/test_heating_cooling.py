@@ -1,0 +1,91 @@
+"""Tests of hrgtc.evaluation.heating_cooling: a run's figures split into heating and cooling."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy import signal
+
+from hrgtc import drift
+from hrgtc.drift.features import causal_rate
+from hrgtc.evaluation import evaluate
+from hrgtc.evaluation.heating_cooling import DirectionSplit
+from hrgtc.model import UnitModel
+from hrgtc.recording import Metadata, Recording
+
+from synthetic import THERMOMETER, law, ramp_run
+
+FS = 5.0
+
+
+def cycle_run(seed, heating_extra_dph_per_c_per_h=0.0):
+    """Chamber 20 -> -20 -> 20 °C with holds; resonator a 2600 s lag; bias = law + an extra
+    term while heating (the resonator warming) only."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(0.0, 8 * 3600.0, 1.0 / FS)
+    chamber = np.interp(t, [0, 7200, 14400, 21600, 28800], [20.0, -20.0, -20.0, 20.0, 20.0])
+    a = -np.expm1(-1.0 / (2600.0 * FS))
+    resonator = signal.lfilter([a], [1.0, a - 1.0], chamber, zi=[(1.0 - a) * 20.0])[0]
+    rate_c_per_s = (chamber - resonator) / 2600.0
+    f = THERMOMETER.frequency(resonator) - THERMOMETER.frequency(20.0)
+    bias = law(f, THERMOMETER.slope_hz_per_c(resonator) * rate_c_per_s)
+    bias += heating_extra_dph_per_c_per_h * np.maximum(rate_c_per_s, 0.0) * 3600.0
+    return Recording(
+        {"time_s": t, "freq_hz": THERMOMETER.frequency(resonator) + rng.normal(0, 0.002, t.size),
+         "rate_dph": bias + rng.normal(0.0, 1.0, t.size), "resonator_c": resonator,
+         "bias_dph": bias},
+        Metadata(sample_rate_hz=FS, input_rate_dph=0.0), source=f"cycle-{seed}")
+
+
+@pytest.fixture(scope="module")
+def model():
+    runs = [ramp_run(seed=31, hours=4.0, sample_rate_hz=FS),
+            ramp_run(seed=32, start_c=-20.0, end_c=20.0, hours=4.0, sample_rate_hz=FS)]
+    return UnitModel(THERMOMETER, drift.fit(runs, THERMOMETER), unit="synthetic")
+
+
+def test_split_by_hand_and_by_the_resonator_temperature(model):
+    run = cycle_run(seed=3, heating_extra_dph_per_c_per_h=0.8)
+    result = evaluate(run, model, allan=False)
+    split = result.directions
+    assert split is not None
+    # by hand: 10 s block means after the settling, df/dt from the filter, 5 % dead band
+    settle, rows = round(model.drift.settings.warmup_s * FS), round(10.0 * FS)
+    df = causal_rate(run.freq_hz - model.drift.settings.reference_freq_hz,
+                     model.drift.settings.rate_tau_s, FS)[0][settle:]
+    comp = (run.rate_dph - model.drift.predict_recording(run))[settle:]
+    n = comp.size // rows
+    df_blocks = df[: n * rows].reshape(n, rows).mean(axis=1)
+    comp_blocks = comp[: n * rows].reshape(n, rows).mean(axis=1)
+    band = 0.05 * np.max(np.abs(df_blocks))
+    heating, cooling = df_blocks > band, df_blocks < -band  # df/dT > 0 for Table 1's unit
+    assert split.blocks == {"heating": int(heating.sum()), "cooling": int(cooling.sum())}
+    assert split.compensated_dph["heating"] == pytest.approx(
+        np.std(comp_blocks[heating], ddof=1), rel=1e-9)
+    assert split.compensated_dph["cooling"] == pytest.approx(
+        np.std(comp_blocks[cooling], ddof=1), rel=1e-9)
+    # physical truth: blocks called heating are those where the resonator warms
+    warming = np.diff(run["resonator_c"][settle:][: n * rows: rows], append=np.nan) > 0
+    assert np.mean(warming[heating][:-1]) == 1.0 and np.mean(warming[cooling]) == 0.0
+    # the extra bias while heating, which the model does not have, shows on heating only
+    assert split.residual_rms_dph["heating"] > 3 * split.residual_rms_dph["cooling"]
+    assert split.compensated_dph["heating"] > 1.5 * split.compensated_dph["cooling"]
+    d = result.to_dict()["heating_cooling"]
+    assert d["heating"]["blocks"] == split.blocks["heating"]
+    assert d["cooling"]["compensated_dph"] == pytest.approx(split.compensated_dph["cooling"])
+    assert "heating:" in result.summary() and "cooling:" in result.summary()
+
+
+def test_chunking_does_not_change_the_split(model):
+    run = cycle_run(seed=4)
+    whole, parts = DirectionSplit(model, FS), DirectionSplit(model, FS)
+    comp = run.rate_dph - model.drift.predict_recording(run)
+    whole.push(run, run.rate_dph, comp)
+    for start in range(0, len(run), 7777):
+        stop = min(start + 7777, len(run))
+        parts.push(run.slice(start, stop), run.rate_dph[start:stop], comp[start:stop])
+    a, b = whole.result(), parts.result()
+    assert a.blocks == b.blocks and a.residual_rms_dph is None
+    for d in ("heating", "cooling"):
+        assert a.compensated_dph[d] == pytest.approx(b.compensated_dph[d], rel=1e-12)
+        assert a.raw_dph[d] > a.compensated_dph[d]  # the model removes the thermal drift
