@@ -150,3 +150,41 @@ def test_axis_read_options_check_that_axis_only(calibration, imu_campaign):
     wrong = ReadOptions(axis="x", freq_band_hz=band, freq_span_hz=band)
     with pytest.raises(RecordingError, match="column freq_hz_x, row 0"):
         wrong.read(imu_campaign.warmup)
+
+
+def test_cross_axis_candidates_are_judged_on_held_out_runs(imu_campaign):
+    """Each axis is refitted with the other resonators' frequencies as candidates; the
+    trial is kept only if the held-out warm-up improves by more than 2 %."""
+    files = imu_campaign
+    result = calibrate_instrument(files.soaks, [files.cooldown], [files.warmup],
+                                  cross_axis=True)
+    assert set(result.cross_axis) == set(AXES)
+    for axis, trial in result.cross_axis.items():
+        assert trial["channels"] == {f"f{b}": f"freq_hz_{b}" for b in AXES if b != axis}
+        gain = trial["held_out_10s_dph_with"] < 0.98 * trial["held_out_10s_dph_without"]
+        assert trial["kept"] == gain
+        (held_out,) = result.validation[axis]
+        chosen = trial["held_out_10s_dph_with" if gain else "held_out_10s_dph_without"]
+        assert held_out.compensated_10s == pytest.approx(chosen, rel=1e-12)
+        uses = any("a_f" in t for t in result.model.axes[axis].drift.selected)
+        assert uses == (gain and bool(trial["selected"]))
+
+
+def test_an_axis_model_reads_another_axis_frequency(imu_campaign):
+    """A model of axis x with y's frequency as a term compensates from the instrument's
+    file: the view of axis x keeps freq_hz_y, the numpy and fused engines agree."""
+    from hrgtc.calibration import calibrate
+
+    files = imu_campaign
+    options = ReadOptions(axis="x")
+    result = calibrate(files.soaks, [files.cooldown], read_options=options,
+                       terms=["f", "f^2", "g", "a_fy", "f*a_fy"], aux={"fy": "freq_hz_y"},
+                       penter=0.5, premove=0.6)
+    assert any("a_fy" in t for t in result.model.drift.selected)
+    run = read(files.warmup)
+    view = axis_view(run, "x")
+    fused = Compensator(result.model).process(view)
+    reference = Compensator(result.model, engine="numpy").process(view)
+    np.testing.assert_allclose(fused["rate_comp_dph"], reference["rate_comp_dph"], atol=1e-9)
+    centre = result.model.drift.settings.aux_centres["fy"]
+    assert abs(centre - np.mean(axis_view(read(files.cooldown), "y").freq_hz)) < 10.0

@@ -139,6 +139,10 @@ def calibrate_command(
         "files without an input_rate_dph column."),
     scale_terms: str = typer.Option(
         "f,f^2,f^3", "--scale-terms", help="Candidate terms of the scale-factor model."),
+    cross_axis: bool = typer.Option(
+        False, "--cross-axis", help="Several axes: also try the other resonators' frequencies "
+        "as candidate terms of each axis (gradients across the unit); kept per axis only where "
+        "the --validate runs improve by more than 2 %."),
     force: ForceOption = False,
     strict: StrictOption = False,
     json_output: JsonOption = False,
@@ -190,6 +194,7 @@ def calibrate_command(
             thermometer=inputs.thermometer, rate_tables=rate_table or (),
             validate_rate_tables=validate_rate_table or (), segment_table=segments,
             scale_terms=[t.strip() for t in scale_terms.split(",") if t.strip()],
+            cross_axis=cross_axis,
         )
         save_instrument(calibration.model, output, force=force)
     single = calibration.model.is_single_axis
@@ -237,6 +242,17 @@ def render_instrument(calibration: InstrumentCalibration) -> None:
             table.add_row(Path(check.file).name, check.axis or "-", str(len(check.raw_ppm)),
                           pairs, f"{check.raw_max_ppm:.1f} → {check.compensated_max_ppm:.1f}")
         console.print(table)
+    for axis, trial in calibration.cross_axis.items():
+        if "why" in trial:
+            console.print(f"axis {axis}: cross-axis terms not tried: {trial['why']}")
+            continue
+        verdict = "kept" if trial["kept"] else "not kept"
+        console.print(
+            f"axis {axis}: with the other resonators' frequencies "
+            f"({', '.join(trial['channels'].values())}) held-out 10 s bias stability "
+            f"{trial['held_out_10s_dph_with']:.4f} °/h against "
+            f"{trial['held_out_10s_dph_without']:.4f} without: {verdict}"
+            + (f" (terms {', '.join(trial['selected'])})" if trial["selected"] else ""))
     if not calibration.model.is_single_axis:
         from hrgtc.instrument import summary_rows
 
