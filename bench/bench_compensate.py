@@ -15,7 +15,9 @@
   memory does not grow with the file;
 * compile time of the kernel on first call, with an empty and a warm cache.
 
-The model is calibrated on a small simulated campaign (not timed); the run to
+The model is calibrated on a small simulated campaign (not timed); its runs log a housing
+thermistor, so the drift model's candidates are the gradient terms (``g = housing_c - T(f)``,
+:data:`hrgtc.calibration.GRADIENT_TERMS`), which the fused kernel computes. The run to
 compensate is a simulated warm-up, 14 h at 200 Hz (10 M samples).
 """
 
@@ -70,7 +72,7 @@ def plain_script(model_path: str, source: str, output: str, rows: int = 1 << 20)
     done = 0
     for batch in pq.ParquetFile(source).iter_batches(batch_size=rows):
         out = {name: np.empty(batch.num_rows) for name in OUTPUT_COLUMNS}
-        housing = batch.column("housing_c").to_numpy() if plan.uses_housing else None
+        housing = batch.column("housing_c").to_numpy() if plan.needs_housing else None
         kernel.run(plan, state, batch.column("freq_hz").to_numpy(),
                    batch.column("rate_dph").to_numpy(), housing, out, counts, extremes)
         table = pa.Table.from_batches([batch])
@@ -97,7 +99,8 @@ def _warm(model_path: str) -> None:
     model = load_model(model_path)
     f = np.full(16, model.thermometer.frequency(20.0))
     compensate(Recording({"time_s": np.arange(16.0) / model.drift.settings.sample_rate_hz,
-                          "freq_hz": f, "rate_dph": np.zeros(16)},
+                          "freq_hz": f, "rate_dph": np.zeros(16),
+                          "housing_c": np.full(16, 20.0)},
                          Metadata(sample_rate_hz=model.drift.settings.sample_rate_hz)), model)
 
 
@@ -144,7 +147,8 @@ def _first_call(model_path: str, cache_dir: str) -> float:
     rate = model.drift.settings.sample_rate_hz
     recording = Recording({"time_s": np.arange(16.0) / rate,
                            "freq_hz": np.full(16, model.thermometer.frequency(20.0)),
-                           "rate_dph": np.zeros(16)}, Metadata(sample_rate_hz=rate))
+                           "rate_dph": np.zeros(16), "housing_c": np.full(16, 20.0)},
+                          Metadata(sample_rate_hz=rate))
     start = time.perf_counter()
     compensate(recording, model)
     return time.perf_counter() - start

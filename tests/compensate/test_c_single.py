@@ -26,6 +26,7 @@ from hrgtc.compensate.c_float32 import (
     float_accuracy,
     float_constants,
     mirror_bias,
+    mirror_gradient,
     mirror_rate,
     mirror_temperature,
 )
@@ -35,7 +36,7 @@ from hrgtc.drift.features import causal_rate
 from hrgtc.errors import InputError
 from hrgtc.model import UnitModel
 
-from synthetic import THERMOMETER, ramp_run
+from synthetic import THERMOMETER, lagged_run, ramp_run
 
 COMPILER = shutil.which("gcc") or shutil.which("cc")
 needs_compiler = pytest.mark.skipif(COMPILER is None, reason="no C compiler on this system")
@@ -46,16 +47,21 @@ F32 = np.float32
 
 # mode "run": rows of (f_hz centred, rate_dph[, housing_c]) floats -> 8 floats a row
 #   (rate_comp, bias, resonator_c_est, in_range, f, df, return value, rate_in_range);
-# mode "grid": rows of (f, df[, h, dh]) floats -> (bias_dph(f, df, ...), temperature_c(f)).
+# mode "grid": rows of (f, df[, h, dh]) floats, or (f, df, g) when compiled with
+#   -DGRADIENT=1 -> (bias_dph(f, df, ...), temperature_c(f)).
 DRIVER = r"""
 #include <stdio.h>
 #include <string.h>
 #include "PFX_model.h"
 
+#ifndef GRADIENT
+#define GRADIENT 0
+#endif
+
 int main(int argc, char **argv)
 {
     const size_t run_columns = UPFX_USES_HOUSING ? 3 : 2;
-    const size_t grid_columns = UPFX_USES_HOUSING ? 4 : 2;
+    const size_t grid_columns = GRADIENT ? 3 : (UPFX_USES_HOUSING ? 4 : 2);
     float row[4], record[8];
     PFX_state state;
     PFX_output out;
@@ -66,7 +72,9 @@ int main(int argc, char **argv)
     PFX_init(&state);
     if (strcmp(argv[1], "grid") == 0) {
         while (fread(row, sizeof(float), grid_columns, in) == grid_columns) {
-#if UPFX_USES_HOUSING
+#if GRADIENT
+            record[0] = PFX_bias_dph(row[0], row[1], row[2]);
+#elif UPFX_USES_HOUSING
             record[0] = PFX_bias_dph(row[0], row[1], row[2], row[3]);
 #else
             record[0] = PFX_bias_dph(row[0], row[1]);
@@ -115,19 +123,27 @@ def models():
                           drift=drift.fit([ramp_run(seed=1)], THERMOMETER))
     fitted = drift.fit([housing_run(seed=3)], THERMOMETER,
                        terms=("f", "f^2", "df", "h", "dh", "f*dh", "f^3"))
+    # the default candidates with a housing thermistor (hrgtc.calibration.GRADIENT_TERMS),
+    # and df: g = housing_c - T(f), the temperature from the float inverse
+    terms = ("f", "f^2", "f^3", "g", "f*g", "f^2*g", "df")
+    gradient = drift.fit([lagged_run(seed=5), lagged_run(seed=6, start_c=-20.0, end_c=20.0)],
+                         THERMOMETER, terms=terms, initial=terms, premove=0.999999)
     return {"frequency": frequency,
-            "housing": UnitModel(thermometer=THERMOMETER, drift=fitted, unit="synthetic-h")}
+            "housing": UnitModel(thermometer=THERMOMETER, drift=fitted, unit="synthetic-h"),
+            "gradient": UnitModel(thermometer=THERMOMETER, drift=gradient, unit="synthetic-g")}
 
 
 def build(model, folder: Path, prefix: str) -> Path:
     export_c(model, folder, prefix=prefix, precision="single")
     (folder / "driver.c").write_text(DRIVER.replace("UPFX", prefix.upper()).replace("PFX", prefix))
+    gradient = ["-DGRADIENT=1"] if "g" in model.drift.variables else []
     obj = folder / "model.o"
     subprocess.run([COMPILER, *FLAGS, *STRICT, "-ffp-contract=off", "-c",
                     str(folder / f"{prefix}_model.c"), "-o", str(obj)],
                    check=True, capture_output=True, text=True)
     exe = folder / "driver"
-    subprocess.run([COMPILER, *FLAGS, "-I", str(folder), str(folder / "driver.c"), str(obj),
+    subprocess.run([COMPILER, *FLAGS, *gradient, "-I", str(folder), str(folder / "driver.c"),
+                    str(obj),
                     "-o", str(exe), "-lm"], check=True, capture_output=True, text=True)
     return exe
 
@@ -156,7 +172,7 @@ def ulps(a, b, scale):
 
 
 @needs_compiler
-@pytest.mark.parametrize("kind", ["frequency", "housing"])
+@pytest.mark.parametrize("kind", ["frequency", "housing", "gradient"])
 def test_float_build_on_the_grid_matches_its_mirror_and_the_double_model(kind, models, tmp_path):
     model = models[kind]
     exe = build(model, tmp_path, "gyro")
@@ -165,7 +181,8 @@ def test_float_build_on_the_grid_matches_its_mirror_and_the_double_model(kind, m
     constants = float_constants(model, plan)
     rng = np.random.default_rng(5)
     n = 40_000
-    names = ["f", "df", "h", "dh"] if plan.housing else ["f", "df"]
+    names = (["f", "df", "g"] if plan.gradient else
+             ["f", "df", "h", "dh"] if plan.housing else ["f", "df"])
     values = {v: rng.uniform(*model.drift.ranges[v], n) for v in names}
     # the calibrated range of f beyond the trained one (the tangent continues the model)
     f_low, f_high = THERMOMETER.frequency_range_hz
@@ -192,17 +209,17 @@ def test_float_build_on_the_grid_matches_its_mirror_and_the_double_model(kind, m
 
 
 @needs_compiler
-@pytest.mark.parametrize("kind", ["frequency", "housing"])
+@pytest.mark.parametrize("kind", ["frequency", "housing", "gradient"])
 def test_float_build_streams_like_the_double_compensator(kind, models, tmp_path):
     model = models[kind]
     exe = build(model, tmp_path, "hrg")
     bound_c, bound_dph = stated_bounds(tmp_path / "hrg_model.h", "hrg")
-    make = housing_run if kind == "housing" else ramp_run
+    make = {"housing": housing_run, "gradient": lagged_run}.get(kind, ramp_run)
     recording = make(seed=8, start_c=25.0, end_c=-25.0, hours=3.0)  # leaves the ranges
     centre = model.drift.settings.reference_freq_hz
     f32 = (recording.freq_hz - centre).astype(F32)
     columns = [f32, recording.rate_dph.astype(F32)]
-    if kind == "housing":
+    if kind != "frequency":
         columns.append(recording["housing_c"].astype(F32))
     out, counters = run_driver(exe, "run", columns, tmp_path, 8)
     compensator = Compensator(model)
@@ -217,6 +234,10 @@ def test_float_build_streams_like_the_double_compensator(kind, models, tmp_path)
     if kind == "housing":
         h32 = columns[2] - constants.reference_c
         inputs.update(h=h32, dh=mirror_rate(constants, h32))
+    if kind == "gradient":
+        inputs["g"] = mirror_gradient(constants, columns[2], f32, plan.increasing)
+        np.testing.assert_array_equal(out[:, 2], mirror_temperature(constants, f32,
+                                                                    plan.increasing))
     scale = np.abs(model.drift.intercept_dph) + np.sum(np.abs(model.drift.scaled_coefficients))
     assert np.max(ulps(out[:, 1], mirror_bias(model, constants, inputs), scale)) <= 4
     np.testing.assert_array_equal(out[:, 6], out[:, 0])  # return value == out->rate_comp_dph

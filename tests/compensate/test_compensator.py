@@ -117,12 +117,13 @@ def housing_run(seed, **kwargs):
     return run.with_columns(housing_c=housing)
 
 
-def assert_engines_agree(model, recording, drift_kind="frequency"):
+def assert_engines_agree(model, recording, drift_kind="frequency", temperature_atol=1e-12):
     fused, numpy_ = Compensator(model, drift_kind), Compensator(model, drift_kind, "numpy")
     a, b = fused.process(recording), numpy_.process(recording)
     for name in ("rate_comp_dph", "bias_model_dph"):
         np.testing.assert_allclose(a[name], b[name], rtol=0, atol=1e-9)
-    np.testing.assert_allclose(a["resonator_c_est"], b["resonator_c_est"], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(a["resonator_c_est"], b["resonator_c_est"], rtol=0,
+                               atol=temperature_atol)
     np.testing.assert_array_equal(a["in_range"], b["in_range"])
     assert (fused.samples, fused.out_of_range, fused.rate_out_of_range) == (
         numpy_.samples, numpy_.out_of_range, numpy_.rate_out_of_range)
@@ -137,7 +138,7 @@ def test_fused_engine_equals_numpy_reference(unit_model, start_c, end_c):
 
 
 GRAMMAR = ("f", "f^2", "f^3", "df", "f*df", "f^2*df", "h", "h^2", "h^3", "dh", "f*dh",
-           "f^4*dh", "h*df", "df^2", "f*h*dh")
+           "f^4*dh", "h*df", "df^2", "f*h*dh", "g", "f*g", "f^2*g", "g^2", "dh*g")
 
 
 @settings(max_examples=20, deadline=None)
@@ -149,9 +150,10 @@ def test_fused_engine_is_generic_over_the_term_grammar(unit_model, hot_housing_r
     # any terms of the grammar, ranges cut inside the data: the tangent extension is exercised
     from hrgtc.drift.features import compute_variables
 
-    values = compute_variables(hot_housing_run, unit_model.drift.settings, ("f", "df", "h", "dh"))
+    values = compute_variables(hot_housing_run, unit_model.drift.settings,
+                               ("f", "df", "h", "dh", "g"), THERMOMETER)
     ranges = {v: tuple(float(q) for q in np.quantile(x, quantiles)) for v, x in values.items()}
-    scales = {"f": 10.0, "df": 1e-3, "h": 20.0, "dh": 1e-2}
+    scales = {"f": 10.0, "df": 1e-3, "h": 20.0, "dh": 1e-2, "g": 2.0}
     settings_ = dataclasses.replace(unit_model.drift.settings, scales=scales)
     fitted = dataclasses.replace(
         unit_model.drift, selected=tuple(selected), settings=settings_, ranges=ranges,
@@ -199,6 +201,97 @@ def test_fused_slow_path_of_the_thermometer(unit_model, run):
     np.testing.assert_allclose(out["resonator_c_est"],
                                THERMOMETER.temperature(run.freq_hz[:2000], warn=False),
                                rtol=0, atol=1e-11)
+
+
+# -- the gradient g = housing_c - T(freq_hz) in the fused kernel ---------------------------
+#: The default candidates with a housing thermistor (hrgtc.calibration.GRADIENT_TERMS).
+GRADIENT_TERMS = ("f", "f^2", "f^3", "g", "f*g", "f^2*g")
+
+
+@pytest.fixture(scope="module")
+def gradient_model():
+    from synthetic import lagged_run
+
+    fitted = drift.fit([lagged_run(seed=5), lagged_run(seed=6, start_c=-20.0, end_c=20.0)],
+                       THERMOMETER, terms=GRADIENT_TERMS, initial=GRADIENT_TERMS,
+                       premove=0.999999)
+    assert fitted.selected == GRADIENT_TERMS and "g" in fitted.ranges
+    return UnitModel(THERMOMETER, fitted)
+
+
+@pytest.fixture(scope="module")
+def steep_gradient_run():
+    # hotter, colder and three times faster than training, down then up: f and g leave
+    # their ranges on both sides (one run for the compensator: the halves are joined)
+    from synthetic import lagged_run
+
+    down = lagged_run(seed=13, start_c=40.0, end_c=-35.0, hours=1.0)
+    up = lagged_run(seed=14, start_c=-35.0, end_c=40.0, hours=1.0)
+    return concatenate([down, up.with_columns(time_s=up.time_s + down.time_s[-1] + 0.1)])
+
+
+def test_fused_engine_computes_the_gradient_as_numpy(gradient_model, steep_gradient_run):
+    from hrgtc.compensate import _kernel as kernel
+    from hrgtc.drift.features import compute_variables
+
+    assert kernel.supports_variables(("f", "df", "g"))
+    g = compute_variables(steep_gradient_run, gradient_model.drift.settings, ("g",),
+                          THERMOMETER)["g"]
+    low, high = gradient_model.drift.ranges["g"]
+    assert np.count_nonzero(g < low) > 100 and np.count_nonzero(g > high) > 100
+    # beyond 40 °C some blocks need a second Newton step: numpy's block-wide iteration then
+    # polishes every sample of the block once more, the kernel only those samples; both are
+    # within the inverse's tolerance (5e-11 °C), as with a model without g
+    fused = assert_engines_agree(gradient_model, steep_gradient_run, temperature_atol=5e-11)
+    assert fused._plan is not None and fused._plan.uses_gradient  # no fallback
+    out = compensate(steep_gradient_run, gradient_model)
+    assert np.all(out["in_range"][(g < low) | (g > high)] == 0.0)
+    # the bias law has 0.4 (housing - resonator): the model follows it beyond the range too
+    assert np.all(np.isfinite(out["bias_model_dph"]))
+
+
+@settings(max_examples=15, deadline=None)
+@given(cuts=st.lists(st.integers(1, 71_999), min_size=1, max_size=8, unique=True))
+def test_fused_gradient_chunked_equals_batch(gradient_model, steep_gradient_run, cuts):
+    batch = compensate(steep_gradient_run, gradient_model)
+    compensator = Compensator(gradient_model)
+    bounds = [0, *sorted(cuts), len(steep_gradient_run)]
+    streamed = concatenate([compensator.process(steep_gradient_run.slice(a, b))
+                            for a, b in itertools.pairwise(bounds)])
+    for name in OUTPUT_COLUMNS:
+        np.testing.assert_array_equal(streamed[name], batch[name])
+
+
+def test_fused_gradient_on_two_threads_gives_the_bits_of_one_call(gradient_model,
+                                                                  steep_gradient_run,
+                                                                  monkeypatch):
+    from hrgtc.compensate import _kernel as kernel
+
+    whole = compensate(steep_gradient_run, gradient_model)
+    monkeypatch.setattr(kernel, "PARALLEL_ROWS", 1 << 12)
+    split = compensate(steep_gradient_run, gradient_model)
+    for name in OUTPUT_COLUMNS:
+        np.testing.assert_array_equal(split[name], whole[name])
+
+
+def test_fused_gradient_through_the_slow_path_of_the_thermometer(gradient_model,
+                                                                 steep_gradient_run):
+    # every sample's temperature from the kernel's bracketed Newton, before the bias needs it
+    from hrgtc.compensate import _kernel as kernel
+
+    compensator = Compensator(gradient_model)
+    plan = kernel.plan(gradient_model.drift, THERMOMETER, compensator._variables)
+    strict = plan.thermometer.copy()
+    strict[10:12] = 0.0  # one_step_limit, tolerance
+    compensator._plan = dataclasses.replace(plan, thermometer=strict)
+    part = steep_gradient_run.slice(0, 3000)
+    out = compensator.process(part)
+    reference = compensate(part, gradient_model, engine="numpy")
+    np.testing.assert_allclose(out["resonator_c_est"], reference["resonator_c_est"],
+                               rtol=0, atol=1e-11)
+    np.testing.assert_allclose(out["bias_model_dph"], reference["bias_model_dph"],
+                               rtol=0, atol=1e-9)
+    np.testing.assert_array_equal(out["in_range"], reference["in_range"])
 
 
 def test_unknown_engine_is_a_clear_error(unit_model):
@@ -298,8 +391,8 @@ def test_a_model_with_the_heating_switch_runs_on_numpy_in_both_engines(run):
                                fitted.predict_recording(run)[settle:], rtol=1e-9, atol=1e-9)
 
 
-def test_models_with_d2_g_and_aux_run_on_numpy_in_both_engines():
-    # the fused kernel computes f, df, h, dh only: a model using d2, g or a_NAME falls back
+def test_models_with_d2_and_aux_run_on_numpy_in_both_engines():
+    # the fused kernel computes f, df, h, dh, g only: a model using d2 or a_NAME falls back
     # to the numpy engine, which must then give the same numbers as asking for numpy
     from synthetic import lagged_model, lagged_run
 

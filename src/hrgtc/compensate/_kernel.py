@@ -12,12 +12,15 @@ and order as the numpy reference path (so results agree to rounding):
   the training ranges the gradient at the clipped point times the excess;
 * the thermometer inverse of :meth:`hrgtc.thermometry.Thermometer.temperature`:
   the Chebyshev start, clipped to the bracket, then Newton steps until one is
-  below the one-step limit; a sample that does not converge is marked NaN and
-  counted, and the caller hands it to the bracketed slow path;
+  below the one-step limit; a sample that does not converge is counted and solved
+  by the safeguarded Newton iteration in its cell of the dense table (the slow path
+  of ``Thermometer._bracketed_newton``). It runs before the drift model, which needs
+  it for the gradient ``g = housing_c - T(freq_hz)`` of
+  :class:`hrgtc.drift.features.FeatureStream` (NaN beyond the bracket, as there);
 * the range flags and out-of-range counts of the compensator.
 
 The term grammar is not hard-coded: terms come in as an exponent matrix over
-the variables ``(f, df, h, dh)`` and their derivatives as precomputed
+the variables ``(f, df, h, dh, g)`` and their derivatives as precomputed
 (factor, exponents) tables, built by :func:`plan` from a fitted model.
 
 Speed: the block is worked through in tiles of :data:`TILE` samples whose
@@ -45,15 +48,18 @@ from numba import njit
 from hrgtc.drift import DriftModel
 from hrgtc.drift.features import rate_filter_coefficients, settle_rows
 from hrgtc.thermometry import Thermometer
+from hrgtc.thermometry.thermometer import _NEWTON_MAX_ITER as NEWTON_MAX_ITER
 
-#: Variable order of the exponent matrices (f, df, h, dh). The heating/cooling switch
-#: ``dpos``, the second rate filter ``d2``, the gradient ``g`` and the user's channels
-#: ``a_NAME`` are not computed here (:func:`supports_variables`): a model using them runs on
-#: the numpy engine, which gives the same numbers.
-ORDER = ("f", "df", "h", "dh")
-#: Slots of ``counts``: samples outside the f/h ranges, outside the df/dh ranges,
-#: samples whose Newton iteration did not converge (left NaN), and samples of the
-#: filter's settling time at the start of the run.
+#: Variable order of the exponent matrices (f, df, h, dh, g). The heating/cooling switch
+#: ``dpos``, the second rate filter ``d2`` and the user's channels ``a_NAME`` are not
+#: computed here (:func:`supports_variables`): a model using them runs on the numpy engine,
+#: which gives the same numbers.
+ORDER = ("f", "df", "h", "dh", "g")
+#: Indices of the rates in :data:`ORDER` (flagged in the rate count; the others are levels).
+RATES = (1, 3)
+#: Slots of ``counts``: samples outside the f/h/g ranges, outside the df/dh ranges,
+#: samples whose Newton iteration did not converge (solved by the bracketed slow path),
+#: and samples of the filter's settling time at the start of the run.
 OUT_OF_RANGE, RATE_OUT_OF_RANGE, NOT_CONVERGED, SETTLING = 0, 1, 2, 3
 #: Slots of ``extremes``: the smallest and largest f and df/dt seen. [Hz, Hz/s]
 F_MIN, F_MAX, DF_MIN, DF_MAX = 0, 1, 2, 3
@@ -76,8 +82,10 @@ class KernelPlan:
         ``settle_rows`` samples at the start of a run are flagged, as training skips them).
     uses_housing
         Whether h/dh are computed (the recording then needs ``housing_c``).
+    uses_gradient
+        Whether g is computed (the recording then needs ``housing_c``).
     exponents
-        (n_terms, 4) powers of (f, df, h, dh) in each term. ``int64``
+        (n_terms, 5) powers of (f, df, h, dh, g) in each term. ``int64``
     coefficients
         Scaled coefficients, term order; ``intercept`` is B0. [°/h]
     scales
@@ -86,7 +94,7 @@ class KernelPlan:
         Per variable: continue along the tangent beyond [low, high] (a used
         variable with a training range).
     flagged
-        Per variable: counted in ``in_range`` (f, h) or the rate count (df, dh).
+        Per variable: counted in ``in_range`` (f, h, g) or the rate count (df, dh).
     d_factor, d_exponents, d_constant
         Derivative of term k by variable v: ``d_factor[v, k] * rest``, rest the
         term of exponents ``d_exponents[v, k]`` or 1 when ``d_constant[v, k]``;
@@ -96,10 +104,13 @@ class KernelPlan:
         f_cal_low, f_cal_high, one_step_limit, tolerance]`` of the inverse.
     poly, slope, chebyshev
         Scaled f(z) coefficients, their derivative, the Chebyshev start series.
+    grid_t, grid_f
+        The inverse's dense table (f increasing) for the bracketed slow path. [°C, Hz]
     """
 
     filter: np.ndarray
     uses_housing: bool
+    uses_gradient: bool
     exponents: np.ndarray
     coefficients: np.ndarray
     intercept: float
@@ -115,6 +126,13 @@ class KernelPlan:
     poly: np.ndarray
     slope: np.ndarray
     chebyshev: np.ndarray
+    grid_t: np.ndarray
+    grid_f: np.ndarray
+
+    @property
+    def needs_housing(self) -> bool:
+        """Whether the kernel reads ``housing_c`` (for h, dh or g)."""
+        return self.uses_housing or self.uses_gradient
 
 
 def plan(drift: DriftModel, thermometer: Thermometer, variables: tuple[str, ...]) -> KernelPlan:
@@ -133,12 +151,12 @@ def plan(drift: DriftModel, thermometer: Thermometer, variables: tuple[str, ...]
     alpha, beta = rate_filter_coefficients(s.rate_tau_s, s.sample_rate_hz)
     terms = drift._terms
     used = {v for t in terms for v in t.variables}
-    n = len(terms)
-    exponents = np.zeros((n, 4), dtype=np.int64)
-    d_factor = np.zeros((4, n))
-    d_exponents = np.zeros((4, n, 4), dtype=np.int64)
-    d_constant = np.zeros((4, n), dtype=np.bool_)
-    scales = np.ones(4)
+    n, nv = len(terms), len(ORDER)
+    exponents = np.zeros((n, nv), dtype=np.int64)
+    d_factor = np.zeros((nv, n))
+    d_exponents = np.zeros((nv, n, nv), dtype=np.int64)
+    d_constant = np.zeros((nv, n), dtype=np.bool_)
+    scales = np.ones(nv)
     for j, v in enumerate(ORDER):
         if v in used:
             scales[j] = s.scales[v]
@@ -162,6 +180,7 @@ def plan(drift: DriftModel, thermometer: Thermometer, variables: tuple[str, ...]
         filter=np.array([alpha, beta, alpha * s.sample_rate_hz / beta, s.reference_freq_hz,
                          s.reference_c, float(settle_rows(s))]),
         uses_housing=any(v in ("h", "dh") for v in variables),
+        uses_gradient="g" in variables,
         exponents=exponents,
         coefficients=np.asarray(drift.scaled_coefficients, dtype=np.float64).reshape(n),
         intercept=float(drift.intercept_dph),
@@ -180,11 +199,13 @@ def plan(drift: DriftModel, thermometer: Thermometer, variables: tuple[str, ...]
         slope=_padded(a[1:] * np.arange(1, a.size), POLY_SIZE - 1),  # as slope_hz_per_c
         chebyshev=_padded(np.asarray(inverse.start_coefficients, dtype=np.float64),
                           CHEBYSHEV_SIZE),
+        grid_t=np.asarray(inverse.grid_t, dtype=np.float64),
+        grid_f=np.asarray(inverse.grid_f, dtype=np.float64),
     )
 
 
 def supports_variables(variables: tuple[str, ...]) -> bool:
-    """Whether the kernel computes every variable (not dpos, d2, g, a_NAME: numpy does)."""
+    """Whether the kernel computes every variable (not dpos, d2, a_NAME: numpy does)."""
     return all(v in ORDER for v in variables)
 
 
@@ -225,7 +246,7 @@ def _term(exponents, k, x, m, out, factor):  # pragma: no cover - compiled
     multiplied in variable order, so the rounding is that of the numpy path.
     """
     first = True
-    for v in range(4):
+    for v in range(exponents.shape[1]):
         p = exponents[k, v]
         if p == 0:
             continue
@@ -290,10 +311,55 @@ def _newton_scalar(t, clipped, poly, slope, centre, scale_c, tolerance):  # prag
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def compensate_block(freq_hz, rate_dph, housing_c, filt, uses_housing, state,
+def _bracketed_scalar(fi, grid_t, grid_f, poly, slope, centre, scale_c,
+                      tolerance):  # pragma: no cover - compiled
+    """Safeguarded Newton of one sample in its cell of the dense table (the slow path).
+
+    ``Thermometer._bracketed_newton`` for one sample: linear interpolation in the cell,
+    then Newton steps kept inside the shrinking bracket until one moves less than
+    ``tolerance``.
+    """
+    size = grid_f.size
+    index = np.searchsorted(grid_f, fi)
+    index = 1 if index < 1 else index
+    index = size - 1 if index > size - 1 else index
+    f0, f1 = grid_f[index - 1], grid_f[index]
+    t0, t1 = grid_t[index - 1], grid_t[index]
+    t = t0 + (fi - f0) * (t1 - t0) / (f1 - f0)
+    lower = min(t0, t1)
+    upper = max(t0, t1)
+    t = 0.5 * (t0 + t1) if np.isnan(t) else t
+    t = lower if t < lower else t
+    t = upper if t > upper else t
+    increasing = grid_t[size - 1] > grid_t[0]
+    for _ in range(NEWTON_MAX_ITER):
+        z = (t - centre) / scale_c
+        value = poly[poly.size - 1]
+        for j in range(poly.size - 2, -1, -1):
+            value = value * z + poly[j]
+        derivative = slope[slope.size - 1]
+        for j in range(slope.size - 2, -1, -1):
+            derivative = derivative * z + slope[j]
+        residual = value - fi
+        candidate = t - residual / (derivative / scale_c)
+        if (residual > 0) == increasing:
+            upper = min(upper, t)
+        else:
+            lower = max(lower, t)
+        if not ((candidate >= lower) & (candidate <= upper)):
+            candidate = 0.5 * (lower + upper)
+        change = abs(candidate - t)
+        t = candidate
+        if not change > tolerance:
+            break
+    return t
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def compensate_block(freq_hz, rate_dph, housing_c, filt, uses_housing, uses_gradient, state,
                      exponents, coefficients, intercept, scales, tangent, low, high, flagged,
                      d_factor, d_exponents, d_constant, therm, poly, slope, chebyshev,
-                     out_rate, out_bias, out_temp, out_in_range, counts,
+                     grid_t, grid_f, out_rate, out_bias, out_temp, out_in_range, counts,
                      extremes):  # pragma: no cover
     """Compensate one block in place; see the module docstring for what is computed.
 
@@ -305,9 +371,10 @@ def compensate_block(freq_hz, rate_dph, housing_c, filt, uses_housing, state,
     t_low, t_high, f_low, f_high = therm[4], therm[5], therm[6], therm[7]
     f_cal_low, f_cal_high, one_step_limit, tolerance = therm[8], therm[9], therm[10], therm[11]
     n_terms = coefficients.size
-    value = np.zeros((4, TILE))
-    scaled = np.zeros((4, TILE))
-    delta = np.zeros((4, TILE))
+    nv = scales.size
+    value = np.zeros((nv, TILE))
+    scaled = np.zeros((nv, TILE))
+    delta = np.zeros((nv, TILE))
     term = np.empty(TILE)
     factor = np.empty(TILE)
     bias = np.empty(TILE)
@@ -319,7 +386,41 @@ def compensate_block(freq_hz, rate_dph, housing_c, filt, uses_housing, state,
     for start in range(0, n, TILE):
         m = min(TILE, n - start)
         freq = freq_hz[start:start + m]
-        # variables f, df (h, dh): features.FeatureStream; the filter is the only serial loop
+        temp = out_temp[start:start + m]
+        # thermometer inverse: Thermometer.temperature (Chebyshev start, one Newton step);
+        # the series have a fixed length (zero-padded), so this loop unrolls and vectorises
+        n_more = 0
+        n_lost = 0
+        for i in range(m):
+            fi = freq[i]
+            t, step = _start_and_step(fi, f_low, f_high, map_offset, map_scale, chebyshev,
+                                      t_low, t_high, centre, scale_c, poly, slope)
+            inside = (fi >= f_low) & (fi <= f_high)
+            more = abs(step) > one_step_limit
+            converged = (abs(step) <= one_step_limit) & (t >= t_low) & (t <= t_high)
+            temp[i] = t if inside & converged else np.nan
+            n_more += inside & more
+            n_lost += inside & (not converged) & (not more)
+        if n_more or n_lost:  # rare: a poor start, Newton goes on for those samples (one by one)
+            n_lost = 0
+            for i in range(m):
+                fi = freq[i]
+                if not ((fi >= f_low) & (fi <= f_high)):
+                    continue
+                t, step = _start_and_step(fi, f_low, f_high, map_offset, map_scale,
+                                          chebyshev, t_low, t_high, centre, scale_c, poly, slope)
+                limit = one_step_limit
+                if abs(step) > one_step_limit:
+                    clipped = min(max(fi, f_low), f_high)
+                    t, step, limit = _newton_scalar(t, clipped, poly, slope, centre, scale_c,
+                                                    tolerance)
+                if not ((abs(step) <= limit) & (t >= t_low) & (t <= t_high)):
+                    t = _bracketed_scalar(fi, grid_t, grid_f, poly, slope, centre, scale_c,
+                                          tolerance)
+                    n_lost += 1
+                temp[i] = t
+        counts[2] += n_lost
+        # variables f, df (h, dh, g): features.FeatureStream; the filter is the only serial loop
         f, df = value[0], value[1]
         for i in range(m):
             f[i] = freq[i] - ref_f
@@ -330,8 +431,8 @@ def compensate_block(freq_hz, rate_dph, housing_c, filt, uses_housing, state,
             y1f = beta * y1f + alpha * f[i]
             y2f = beta * y2f + alpha * y1f
             df[i] = (y1f - y2f) * gain
+        housing = housing_c[start:start + m]
         if uses_housing:
-            housing = housing_c[start:start + m]
             h, dh = value[2], value[3]
             for i in range(m):
                 h[i] = housing[i] - ref_h
@@ -342,9 +443,13 @@ def compensate_block(freq_hz, rate_dph, housing_c, filt, uses_housing, state,
                 y1h = beta * y1h + alpha * h[i]
                 y2h = beta * y2h + alpha * y1h
                 dh[i] = (y1h - y2h) * gain
+        if uses_gradient:
+            g = value[4]
+            for i in range(m):
+                g[i] = housing[i] - temp[i]
         # drift model: features.tangent_extension (linear_combination at the held point)
         outside = False
-        for v in range(4):
+        for v in range(nv):
             x, sv, dv = value[v], scaled[v], delta[v]
             lo, hi, scale = low[v], high[v], scales[v]
             if tangent[v]:
@@ -368,7 +473,7 @@ def compensate_block(freq_hz, rate_dph, housing_c, filt, uses_housing, state,
             for i in range(m):
                 bias[i] += c * term[i]
         if outside:
-            for v in range(4):
+            for v in range(nv):
                 if not tangent[v]:
                     continue
                 for i in range(m):
@@ -391,42 +496,14 @@ def compensate_block(freq_hz, rate_dph, housing_c, filt, uses_housing, state,
         for i in range(m):
             out_bias[start + i] = bias[i]
             out_rate[start + i] = rate[i] - bias[i]
-        # thermometer inverse: Thermometer.temperature (Chebyshev start, one Newton step);
-        # the series have a fixed length (zero-padded), so this loop unrolls and vectorises
-        n_more = 0
-        n_lost = 0
-        for i in range(m):
-            fi = freq[i]
-            t, step = _start_and_step(fi, f_low, f_high, map_offset, map_scale, chebyshev,
-                                      t_low, t_high, centre, scale_c, poly, slope)
-            inside = (fi >= f_low) & (fi <= f_high)
-            more = abs(step) > one_step_limit
-            converged = (abs(step) <= one_step_limit) & (t >= t_low) & (t <= t_high)
-            out_temp[start + i] = t if inside & converged else np.nan
-            n_more += more
-            n_lost += inside & (not converged) & (not more)
-        if n_more:  # rare: a poor start, Newton goes on for those samples (one by one)
-            for i in range(m):
-                fi = freq[i]
-                t, step = _start_and_step(fi, f_low, f_high, map_offset, map_scale,
-                                          chebyshev, t_low, t_high, centre, scale_c, poly, slope)
-                if abs(step) > one_step_limit:
-                    clipped = min(max(fi, f_low), f_high)
-                    t, step, limit = _newton_scalar(t, clipped, poly, slope, centre, scale_c,
-                                                    tolerance)
-                    inside = (fi >= f_low) & (fi <= f_high)
-                    converged = (abs(step) <= limit) & (t >= t_low) & (t <= t_high)
-                    out_temp[start + i] = t if inside & converged else np.nan
-                    n_lost += inside & (not converged)
-        counts[2] += n_lost
         # flags: Compensator._block (1.0 inside, 0.0 outside; NaN is outside)
         for i in range(m):
             fi = freq[i]
             ok[i] = 1.0 if (fi >= f_cal_low) & (fi <= f_cal_high) else 0.0
             rate_ok[i] = 1.0
-        for v in range(4):
+        for v in range(nv):
             if flagged[v]:
-                flag = ok if v == 0 or v == 2 else rate_ok
+                flag = rate_ok if v == RATES[0] or v == RATES[1] else ok
                 x, lo, hi = value[v], low[v], high[v]
                 for i in range(m):
                     flag[i] = flag[i] if (x[i] >= lo) & (x[i] <= hi) else 0.0
@@ -527,9 +604,10 @@ def _call(p: KernelPlan, state: np.ndarray, freq_hz: np.ndarray, rate_dph: np.nd
           extremes: np.ndarray, start: int, stop: int) -> None:
     part = slice(start, stop)
     compensate_block(
-        freq_hz[part], rate_dph[part], housing_c[part], p.filter, p.uses_housing, state,
-        p.exponents, p.coefficients, p.intercept, p.scales, p.tangent, p.low, p.high,
-        p.flagged, p.d_factor, p.d_exponents, p.d_constant, p.thermometer, p.poly, p.slope,
-        p.chebyshev, out["rate_comp_dph"][part], out["bias_model_dph"][part],
-        out["resonator_c_est"][part], out["in_range"][part], counts, extremes,
+        freq_hz[part], rate_dph[part], housing_c[part], p.filter, p.uses_housing,
+        p.uses_gradient, state, p.exponents, p.coefficients, p.intercept, p.scales, p.tangent,
+        p.low, p.high, p.flagged, p.d_factor, p.d_exponents, p.d_constant, p.thermometer,
+        p.poly, p.slope, p.chebyshev, p.grid_t, p.grid_f, out["rate_comp_dph"][part],
+        out["bias_model_dph"][part], out["resonator_c_est"][part], out["in_range"][part],
+        counts, extremes,
     )

@@ -18,7 +18,8 @@ algebraically the filter of :func:`hrgtc.drift.features.causal_rate`.
 (:mod:`hrgtc.compensate.c_single`) prints exactly these float32 values and the
 mirror below computes with them; :func:`mirror_bias`, :func:`mirror_temperature`
 and :func:`mirror_rate` evaluate the generated code's operations one by one in
-``numpy.float32`` (the order of the C statements), and :func:`float_accuracy`
+``numpy.float32`` (the order of the C statements), :func:`mirror_gradient` the
+gradient ``g = housing_c - T(f)`` from the float inverse, and :func:`float_accuracy`
 compares them with the double model over dense grids of the trained ranges.
 
 [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
@@ -148,10 +149,11 @@ def mirror_bias(model: UnitModel, c: FloatConstants,
                 values: dict[str, np.ndarray]) -> np.ndarray:
     """``<prefix>_bias_dph()`` of the float build. [°/h]
 
-    ``values`` maps the variables (f [Hz], df [Hz/s], h [°C], dh [°C/s]) to float32 arrays.
+    ``values`` maps the variables (f [Hz], df [Hz/s], h [°C], dh [°C/s], g [°C]) to float32
+    arrays.
     """
     drift = model.drift
-    used = [v for v in ("f", "df", "h", "dh") if v in drift.variables and drift.selected]
+    used = [v for v in ("f", "df", "h", "dh", "g") if v in drift.variables and drift.selected]
     n = np.asarray(next(iter(values.values()))).shape
     raw = {v: np.asarray(values[v], dtype=F32) for v in used}
     held, x = {}, {}
@@ -247,6 +249,16 @@ def mirror_temperature(c: FloatConstants, f_hz: np.ndarray, increasing: bool) ->
     return out
 
 
+def mirror_gradient(c: FloatConstants, housing_c: np.ndarray, f_hz: np.ndarray,
+                    increasing: bool) -> np.ndarray:
+    """The float build's ``g = housing_c - T(f)``, T from :func:`mirror_temperature`. [°C]
+
+    ``housing_c`` as firmware passes it (float32), ``f_hz`` centred; NaN beyond the inverse.
+    """
+    temperature = mirror_temperature(c, f_hz, increasing)
+    return (np.asarray(housing_c, dtype=F32) - temperature).astype(F32)
+
+
 def mirror_rate(c: FloatConstants, x: np.ndarray) -> np.ndarray:
     """The float build's causal rate of one signal (df/dt of f, or dh/dt), from rest. [/s]
 
@@ -292,7 +304,9 @@ class FloatAccuracy:
     temperature_c
         Over the calibrated frequency range (``TEMPERATURE_POINTS`` frequencies). [°C]
     bias_dph
-        B(f, df, ...) over a grid of the trained ranges of its variables. [°/h]
+        B(f, df, ...) over a grid of the trained ranges of its variables; g enters as
+        firmware computes it, ``housing_c`` (float32) minus the float inverse, so the
+        temperature's float error is part of the figure. [°/h]
     ramp_bias_dph
         B end to end through the df/dt filter on steady ramps at rates spread over the
         trained df/dt range (0 when the model has no df term). [°/h]
@@ -351,9 +365,12 @@ def float_accuracy(model: UnitModel, plan: CPlan, c: FloatConstants) -> FloatAcc
     n = values["f"].size
     for v in plan.computed:
         values.setdefault(v, np.zeros(n))
+    inputs = {v: x.astype(F32) for v, x in values.items()}
+    if plan.gradient:
+        values, inputs = _gradient_inputs(model, plan, c, values, inputs)
     b64 = drift.predict({v: values[v] for v in drift.variables} or values)
-    b32 = mirror_bias(model, c, {v: x.astype(F32) for v, x in values.items()})
-    bias_error = float(np.max(np.abs(b32.astype(np.float64) - b64)))
+    b32 = mirror_bias(model, c, inputs)
+    bias_error = float(np.nanmax(np.abs(b32.astype(np.float64) - b64)))
     scale_error = 0.0
     scale_factor = model.scale_factor
     if scale_factor is not None:
@@ -363,6 +380,24 @@ def float_accuracy(model: UnitModel, plan: CPlan, c: FloatConstants) -> FloatAcc
     return FloatAccuracy(temperature_c=temperature_error, bias_dph=bias_error,
                          ramp_bias_dph=_ramp_error(model, plan, c), grid_points=n,
                          scale_ppm=scale_error)
+
+
+def _gradient_inputs(model: UnitModel, plan: CPlan, c: FloatConstants,
+                     values: dict[str, np.ndarray], inputs: dict[str, np.ndarray]
+                     ) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
+    """g of the double model and of the float build at the same f and housing_c.
+
+    ``housing_c = g + T(f)`` in double; the double side keeps g exact, the float side
+    gets ``float32(housing_c) - T32(f32)`` as the generated step() computes it. Where f
+    is beyond the inverse both are NaN (left out of the worst error).
+    """
+    centre = c.centre_hz
+    temperature = model.thermometer.temperature(values["f"] + centre, warn=False)
+    housing = values["g"] + temperature
+    values = {**values, "g": housing - temperature}
+    inputs = {**inputs, "g": mirror_gradient(c, housing.astype(F32), inputs["f"],
+                                             plan.increasing)}
+    return values, inputs
 
 
 def _ramp_error(model: UnitModel, plan: CPlan, c: FloatConstants) -> float:
@@ -397,9 +432,13 @@ def _ramp_error(model: UnitModel, plan: CPlan, c: FloatConstants) -> float:
         values64[level], values32[level] = x, x32
         values64[rate] = np.vstack([causal_rate(row, tau, fs)[0] for row in x])
         values32[rate] = mirror_rate(c, x32)
+    if plan.gradient:  # g held at the middle of its range, through both inverses
+        middle = 0.5 * sum(drift.ranges["g"]) if "g" in drift.ranges else 0.0
+        values64["g"] = np.full(values64["f"].shape, middle)
+        values64, values32 = _gradient_inputs(model, plan, c, values64, values32)
     worst = 0.0
     for row in range(9):
         b64 = drift.predict({v: values64[v][row] for v in drift.variables})
         b32 = mirror_bias(model, c, {v: x[row] for v, x in values32.items()})
-        worst = max(worst, float(np.max(np.abs(b32.astype(np.float64) - b64))))
+        worst = max(worst, float(np.nanmax(np.abs(b32.astype(np.float64) - b64))))
     return worst

@@ -85,7 +85,7 @@ class CPlan:
 #: The precisions the export writes.
 PRECISIONS = ("double", "single")
 #: The variables the float32 build computes (its filter and mirror know these).
-SINGLE_VARIABLES = ("f", "df", "h", "dh")
+SINGLE_VARIABLES = ("f", "df", "h", "dh", "g")
 
 
 def plan_for(model: UnitModel, precision: str = "double") -> CPlan:

@@ -88,9 +88,9 @@ class Compensator:
     engine
         ``"fused"`` (one compiled pass per chunk, default) or ``"numpy"`` (the
         array-by-array reference); both give the same numbers to rounding. A model
-        with the heating/cooling switch ``dpos``, the second rate filter ``d2``, the
-        gradient ``g`` or an extra channel ``a_NAME`` runs on the numpy engine either way
-        (the fused kernel computes f, df, h, dh only).
+        with the heating/cooling switch ``dpos``, the second rate filter ``d2`` or an
+        extra channel ``a_NAME`` runs on the numpy engine either way (the fused kernel
+        computes f, df, h, dh and the gradient g only).
     gaps
         ``"split"``: the df/dt filter restarts at rest after every gap (a time step
         longer than :data:`~hrgtc.recording.validation.GAP_PERIODS` sample periods),
@@ -219,13 +219,9 @@ class Compensator:
             self._plan = kernel.plan(self.drift, thermometer, self._variables)
         counts = np.zeros(4, dtype=np.int64)
         freq = chunk.freq_hz
-        housing = chunk["housing_c"] if self._plan.uses_housing else None
+        housing = chunk["housing_c"] if self._plan.needs_housing else None
         kernel.run(self._plan, self._state, freq, chunk.rate_dph, housing, out, counts,
                    self._extremes)
-        if counts[kernel.NOT_CONVERGED]:  # rare: the bracketed slow path, as temperature() does
-            low, high = thermometer._inverse.f_bracket
-            lost = np.isnan(out["resonator_c_est"]) & (freq >= low) & (freq <= high)
-            out["resonator_c_est"][lost] = thermometer.temperature(freq[lost], warn=False)
         self.samples += len(chunk)
         self._segment_samples += len(chunk)
         self.out_of_range += int(counts[kernel.OUT_OF_RANGE])
