@@ -200,6 +200,19 @@ def problems_message(source: str | None, problems: tuple[Problem, ...] | list[Pr
     return f"{where}: {len(problems)} problems:\n{items}"
 
 
+def _extremes(values: np.ndarray) -> tuple[float, float] | None:
+    """Smallest and largest value when all are finite, else None (two reductions, no copy).
+
+    The fast path of the checks: a NaN makes both NaN, an infinity shows as one.
+    """
+    if not values.size:
+        return None
+    low, high = float(np.min(values)), float(np.max(values))
+    if not (np.isfinite(low) and np.isfinite(high)):
+        return None
+    return low, high
+
+
 class RecordingValidator:
     """Validate a recording chunk by chunk, carrying state across chunks.
 
@@ -252,8 +265,15 @@ class RecordingValidator:
             self.source = chunk.source
             self._missing = tuple(c for c in REQUIRED_COLUMNS if c not in chunk)
         offset, n = self.rows, len(chunk)
+        freq_extremes = None
         for name in chunk.names:
             values = chunk[name]
+            low, high, _ = self._bounds.get(name, (-np.inf, np.inf, ""))
+            extremes = _extremes(values)
+            if name == "freq_hz":
+                freq_extremes = extremes
+            if extremes is not None and low <= extremes[0] and extremes[1] <= high:
+                continue  # every value finite and within bounds: nothing to report
             bad = ~np.isfinite(values)
             if bad.any():
                 state = self._not_finite.get(name)
@@ -265,7 +285,7 @@ class RecordingValidator:
             if name in self._bounds:
                 self._check_bounds(name, values, offset)
         if "freq_hz" in chunk and self._freq_reference is not None:
-            self._check_jumps(chunk.freq_hz, offset)
+            self._check_jumps(chunk.freq_hz, offset, freq_extremes)
         if "time_s" in chunk and n:
             self._check_time(chunk.time_s, offset)
         if self._heuristics is None:
@@ -285,8 +305,14 @@ class RecordingValidator:
             else:
                 state[2] += int(bad.sum())
 
-    def _check_jumps(self, freq: np.ndarray, offset: int) -> None:
+    def _check_jumps(self, freq: np.ndarray, offset: int,
+                     extremes: tuple[float, float] | None = None) -> None:
+        """Frequencies too far from the run's median; ``extremes``: min and max of ``freq``."""
         reference = self._freq_reference
+        band = FREQ_JUMP_FRACTION * reference * (1.0 - 1e-9)  # margin for rounding
+        if extremes is not None and reference - band < extremes[0] and extremes[1] < (
+                reference + band):
+            return  # no sample near the limit, let alone beyond it
         with np.errstate(invalid="ignore"):
             bad = (np.abs(freq - reference) > FREQ_JUMP_FRACTION * reference) & np.isfinite(freq)
         if bad.any():
@@ -296,30 +322,55 @@ class RecordingValidator:
             else:
                 self._jump[2] += int(bad.sum())
 
-    def _check_rate_throughout(self, step: np.ndarray, offset: int) -> None:
-        """Mean time step of every block of :data:`RATE_CHECK_ROWS` rows (gaps left out)."""
+    def _check_rate_throughout(self, step: np.ndarray, offset: int,
+                               all_usable: bool = False) -> None:
+        """Mean time step of every block of :data:`RATE_CHECK_ROWS` rows (gaps left out).
+
+        ``all_usable``: every step is known finite, positive and no gap (the mask is skipped).
+        """
         if self._rate_change is not None:
             return
         if self._steps.size:
             step = np.concatenate([self._steps, step])
             offset = self._steps_start
+            all_usable = False
         blocks = step.size // RATE_CHECK_ROWS
         period = 1.0 / self.metadata.sample_rate_hz
-        for k in range(blocks):
-            part = step[k * RATE_CHECK_ROWS:(k + 1) * RATE_CHECK_ROWS]
-            with np.errstate(invalid="ignore"):
-                usable = part[np.isfinite(part) & (part > 0) & (part <= GAP_PERIODS * period)]
-            if usable.size < RATE_CHECK_ROWS // 2:
-                continue  # mostly gaps or disorder: reported by those checks
-            measured = 1.0 / float(np.mean(usable))
-            if abs(measured * period - 1.0) > SAMPLE_RATE_TOLERANCE:
-                self._rate_change = (offset + k * RATE_CHECK_ROWS, measured)
+        if blocks:  # every block at once: the mean step of its usable steps
+            part = step[:blocks * RATE_CHECK_ROWS].reshape(blocks, RATE_CHECK_ROWS)
+            if all_usable:
+                counts = np.full(blocks, RATE_CHECK_ROWS)
+                sums = part.sum(axis=1)
+            else:
+                with np.errstate(invalid="ignore"):
+                    usable = np.isfinite(part) & (part > 0) & (part <= GAP_PERIODS * period)
+                counts = usable.sum(axis=1)
+                sums = np.where(usable, part, 0.0).sum(axis=1)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                measured = 1.0 / (sums / counts)
+                # mostly gaps or disorder: left to those checks
+                changed = (counts >= RATE_CHECK_ROWS // 2) & (
+                    np.abs(measured * period - 1.0) > SAMPLE_RATE_TOLERANCE)
+            if changed.any():
+                k = int(np.argmax(changed))
+                self._rate_change = (offset + k * RATE_CHECK_ROWS, float(measured[k]))
                 self._steps = np.empty(0)
                 return
         self._steps = step[blocks * RATE_CHECK_ROWS:].copy()
         self._steps_start = offset + blocks * RATE_CHECK_ROWS
 
     def _check_time(self, time: np.ndarray, offset: int) -> None:
+        period = 1.0 / self.metadata.sample_rate_hz
+        if self._last_time is not None:  # fast path: steps all positive and no gap
+            step = np.empty_like(time)
+            step[0] = time[0] - self._last_time
+            np.subtract(time[1:], time[:-1], out=step[1:])
+            extremes = _extremes(step)
+            if extremes is not None and extremes[0] > 0.0 and (
+                    extremes[1] <= GAP_PERIODS * period):
+                self._last_time = float(time[-1])
+                self._check_rate_throughout(step, offset, all_usable=True)
+                return
         previous = np.empty_like(time)
         previous[0] = np.nan if self._last_time is None else self._last_time
         previous[1:] = time[:-1]
@@ -332,7 +383,6 @@ class RecordingValidator:
             if self._time_order is None:
                 i = int(np.argmax(backwards))
                 self._time_order = (offset + i, float(time[i]), float(previous[i]))
-        period = 1.0 / self.metadata.sample_rate_hz
         with np.errstate(invalid="ignore"):
             long = np.flatnonzero((step > GAP_PERIODS * period) & np.isfinite(step))
         self._n_gaps += long.size
