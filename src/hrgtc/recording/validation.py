@@ -74,6 +74,7 @@ from hrgtc.recording.checks import (
     _check_rate_unit,
     _check_sample_rate,
     _check_time_unit,
+    finite_extremes,
     measured_sample_rate,
 )
 from hrgtc.recording.gaps import (
@@ -200,19 +201,6 @@ def problems_message(source: str | None, problems: tuple[Problem, ...] | list[Pr
     return f"{where}: {len(problems)} problems:\n{items}"
 
 
-def _extremes(values: np.ndarray) -> tuple[float, float] | None:
-    """Smallest and largest value when all are finite, else None (two reductions, no copy).
-
-    The fast path of the checks: a NaN makes both NaN, an infinity shows as one.
-    """
-    if not values.size:
-        return None
-    low, high = float(np.min(values)), float(np.max(values))
-    if not (np.isfinite(low) and np.isfinite(high)):
-        return None
-    return low, high
-
-
 class RecordingValidator:
     """Validate a recording chunk by chunk, carrying state across chunks.
 
@@ -269,7 +257,7 @@ class RecordingValidator:
         for name in chunk.names:
             values = chunk[name]
             low, high, _ = self._bounds.get(name, (-np.inf, np.inf, ""))
-            extremes = _extremes(values)
+            extremes = finite_extremes(values)
             if name == "freq_hz":
                 freq_extremes = extremes
             if extremes is not None and low <= extremes[0] and extremes[1] <= high:
@@ -324,10 +312,8 @@ class RecordingValidator:
 
     def _check_rate_throughout(self, step: np.ndarray, offset: int,
                                all_usable: bool = False) -> None:
-        """Mean time step of every block of :data:`RATE_CHECK_ROWS` rows (gaps left out).
-
-        ``all_usable``: every step is known finite, positive and no gap (the mask is skipped).
-        """
+        """Mean time step of each block of :data:`RATE_CHECK_ROWS` rows (gaps left out; none
+        if ``all_usable``: every step known finite, positive and no gap)."""
         if self._rate_change is not None:
             return
         if self._steps.size:
@@ -365,7 +351,7 @@ class RecordingValidator:
             step = np.empty_like(time)
             step[0] = time[0] - self._last_time
             np.subtract(time[1:], time[:-1], out=step[1:])
-            extremes = _extremes(step)
+            extremes = finite_extremes(step)
             if extremes is not None and extremes[0] > 0.0 and (
                     extremes[1] <= GAP_PERIODS * period):
                 self._last_time = float(time[-1])
