@@ -26,7 +26,7 @@ from bench_stepwise import NAMES, PENTER, PREMOVE, chunks
 from gram_accumulator import OldGramAccumulator
 from hrgtc.drift.stepwise import GramAccumulator, stepwise_from_accumulator
 
-FULL_ROWS = 25_000_000
+FULL_ROWS = 10_000_000  # 10 chunks of 1 M per repetition (25 M took 40 s of make bench)
 QUICK_ROWS = 2_000_000
 REPEATS = 3
 

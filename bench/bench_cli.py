@@ -34,7 +34,7 @@ def _median_seconds(argv: list[str], repeat: int) -> float:
 
 
 def run(quick: bool = False) -> list[dict]:
-    repeat = 3 if quick else 7
+    repeat = 3  # median of 3 fresh processes per figure (7 took minutes of make bench)
     floor = _median_seconds([sys.executable, "-c", "pass"], repeat)
     eager = _median_seconds([sys.executable, "-c",
                              "import hrgtc.calibration, hrgtc.report, hrgtc.simulate"], repeat)

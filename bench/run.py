@@ -11,7 +11,9 @@ dict has at least name, n, seconds, rate and peak_rss_mb. Each module runs in a
 fresh Python subprocess, so ``peak_rss_mb`` (the process's own maximum resident
 set size) belongs to that benchmark alone; a result that does not set it gets
 the peak of its module's process. Lines are streamed as they come; a module
-that fails is reported on stderr and makes the exit status 1.
+that fails is reported on stderr and makes the exit status 1. A last line,
+``bench_wall``, gives the wall time of each module and of the whole run (issue 13:
+``make bench`` under 10 minutes on the project's 2-core machine).
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ import json
 import resource
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 BENCH_DIR = Path(__file__).resolve().parent
@@ -65,7 +68,10 @@ def main(argv: list[str] | None = None) -> int:
     if unknown:
         parser.error(f"unknown benchmark(s) {unknown}; available: {sorted(known)}")
     status = 0
+    walls: dict[str, float] = {}
+    start = time.perf_counter()
     for name in args.names or list(known):
+        began = time.perf_counter()
         command = [sys.executable, str(Path(__file__).resolve()), "--child", name]
         with subprocess.Popen(command + (["--quick"] if args.quick else []),
                               stdout=subprocess.PIPE, text=True) as proc:
@@ -76,6 +82,11 @@ def main(argv: list[str] | None = None) -> int:
             print(f"benchmark {name!r} failed with exit status {proc.returncode}",
                   file=sys.stderr)
             status = 1
+        walls[name] = round(time.perf_counter() - began, 1)
+    total = time.perf_counter() - start
+    print(json.dumps({"name": "bench_wall", "n": len(walls), "seconds": round(total, 1),
+                      "rate": round(len(walls) / total, 4), "module_seconds": walls,
+                      "target_seconds": 600, "quick": args.quick}), flush=True)
     return status
 
 

@@ -199,8 +199,6 @@ def test_errors():
         allan_deviation(rate, 1.0, kind="total")
     with pytest.raises(InputError, match="overlapping form only"):
         allan_deviation(rate, 1.0, kind="modified", overlapping=False)
-    with pytest.raises(InputError, match="Allan deviation only"):
-        allan_deviation(rate, 1.0, kind="hadamard", confidence=0.9)
     with pytest.raises(InputError, match=r"confidence must be in \(0, 1\)"):
         allan_deviation(rate, 1.0, confidence=1.5)
     with pytest.raises(InputError, match="noise_alpha=3"):

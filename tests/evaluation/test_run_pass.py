@@ -143,7 +143,11 @@ def test_intervals_deviation_kinds_and_allan_csv(setup, tmp_path):
     assert out.exit_code == 0, out.output
     data = json.loads(out.stdout)
     assert data["deviation"] == "mdev" and data["allan"] == {}
-    assert data["allan_curve"]["raw"]["lower"][0] is None  # no interval for mdev
+    curve = data["allan_curve"]["raw"]  # mdev with Greenhall's edf (SP 1065 Section 5.3.3)
+    assert all(low < dev < high for low, dev, high in
+               zip(curve["lower"], curve["deviation"], curve["upper"], strict=True)
+               if low is not None)
+    assert curve["lower"][0] is not None
     low, high = data["bias_stability_interval_dph"]["raw"]["10"]
     assert low < data["bias_stability_dph"]["raw"]["10"] < high
     assert data["prediction_std_dph"]["max"] >= data["prediction_std_dph"]["median"] > 0.0

@@ -326,8 +326,10 @@ def compensate_file(
     Three stages overlap, each one chunk ahead of the next (pyarrow, h5py and the
     fused kernel release the GIL): a thread reads and validates the next chunk,
     this thread compensates the current one, and a writer thread writes the previous
-    one and starts its write-back to disk, so that the fsync before the atomic
-    rename finds little left to wait for. At most three chunks are held at a time.
+    one, starts its write to disk and waits for the one before
+    (:meth:`~hrgtc.recording.RecordingWriter.start_writeback`), so that the fsync
+    before the atomic rename finds one chunk left to wait for. At most three chunks
+    are held at a time.
     """
     if compensator is None:
         options = with_model_band(read_options or rec_io.ReadOptions(), model)

@@ -6,8 +6,10 @@
   ``kind=`` also the modified Allan, overlapping Hadamard and time deviations
   (``allantools.mdev`` / ``ohdev`` / ``tdev``), and with ``confidence=`` the
   chi-squared confidence interval of SP 1065 Section 5.3 [3].
-- :func:`equivalent_degrees_of_freedom`, :func:`confidence_interval`: the
-  simple edf of SP 1065 Table 5 and the chi-squared interval of Eq. (45).
+- :func:`equivalent_degrees_of_freedom`, :func:`greenhall_edf`,
+  :func:`deviation_edf`, :func:`confidence_interval`: the simple edf of SP 1065
+  Table 5 (Allan), Greenhall's edf of Section 5.3.3 (modified, time, Hadamard)
+  and the chi-squared interval of Eq. (45).
 - The noise terms read off the deviation (ARW, bias instability, RRW) are in
   :mod:`hrgtc.evaluation.noise`.
 
@@ -35,13 +37,15 @@ from hrgtc.evaluation._allan_edf import (
     NOISE_ALPHAS,
     ONE_SIGMA,
     confidence_interval,
+    deviation_edf,
     equivalent_degrees_of_freedom,
+    greenhall_edf,
 )
 from hrgtc.progress import Progress
 
 __all__ = [
     "KINDS", "NOISE_ALPHAS", "ONE_SIGMA", "AllanResult", "allan_deviation",
-    "confidence_interval", "equivalent_degrees_of_freedom",
+    "confidence_interval", "deviation_edf", "equivalent_degrees_of_freedom", "greenhall_edf",
 ]
 
 #: σ_min = 0.664·B at the flat minimum of a flicker (bias instability) floor;
@@ -353,9 +357,11 @@ def allan_deviation(
         One of :data:`KINDS`.
     confidence
         If given (e.g. :data:`ONE_SIGMA`), the result carries the chi-squared
-        confidence interval of each τ (:func:`confidence_interval`) with the
-        simple edf of SP 1065 Table 5 (:func:`equivalent_degrees_of_freedom`);
-        ``kind="allan"`` only. For the normal (non-overlapping) deviation the edf is
+        confidence interval of each τ (:func:`confidence_interval`). The edf is
+        the simple one of SP 1065 Table 5 for the Allan deviation
+        (:func:`equivalent_degrees_of_freedom`) and Greenhall's (SP 1065 Section
+        5.3.3, :func:`greenhall_edf`) for the modified, time and Hadamard ones
+        (:func:`deviation_edf`). For the normal (non-overlapping) deviation the edf is
         that of the record of ``n // m`` τ-means at m = 1, where both estimators agree.
     noise_alpha
         Power-law exponent α of the dominant noise for the edf, one of
@@ -388,11 +394,6 @@ def allan_deviation(
         raise InputError(
             f"kind={kind!r} is computed in its overlapping form only; pass overlapping=True"
         )
-    if confidence is not None and kind != "allan":
-        raise InputError(
-            f"confidence intervals are implemented for the Allan deviation only, "
-            f"got kind={kind!r}; pass confidence=None"
-        )
     values = _as_rate(rate, "rate", minimum=3)
     n = values.size
     factors = _averaging_factors(taus, n + 1, fs)
@@ -409,7 +410,7 @@ def allan_deviation(
     if confidence is not None:
         # non-overlapping: the τ-means form a record of n // m samples read at m = 1, where
         # the overlapping and the normal estimator coincide
-        edf = np.array([equivalent_degrees_of_freedom(n + 1, m, noise_alpha) if overlapping
+        edf = np.array([deviation_edf(kind, n + 1, int(m), noise_alpha) if overlapping
                         else equivalent_degrees_of_freedom(n // m + 1, 1, noise_alpha)
                         for m in kept])
         lower, upper = confidence_interval(deviation, edf, confidence)

@@ -370,10 +370,10 @@ def _with_interval(result: AllanResult, n_samples: int, confidence: float) -> Al
 
 
 def _deviation(values: np.ndarray, fs: float, deviation: str, confidence: float) -> AllanResult:
-    """The run's deviation curve, with a confidence interval where SP 1065 gives one."""
+    """The run's deviation curve with its confidence interval (SP 1065 Section 5.3)."""
     kind, overlapping = DEVIATIONS[deviation]
     return allan_deviation(values, fs, taus="octave", kind=kind, overlapping=overlapping,
-                           confidence=confidence if kind == "allan" else None)
+                           confidence=confidence)
 
 
 def run_pass(

@@ -175,6 +175,19 @@ def problems_message(source: str | None, problems: tuple[Problem, ...] | list[Pr
     return f"{where}: {len(problems)} problems:\n{items}"
 
 
+def finite_extremes(values: np.ndarray) -> tuple[float, float] | None:
+    """Smallest and largest value when all are finite, else None (two reductions, no copy).
+
+    The fast path of validation: a NaN makes both NaN, an infinity shows as one.
+    """
+    if not values.size:
+        return None
+    low, high = float(np.min(values)), float(np.max(values))
+    if not (math.isfinite(low) and math.isfinite(high)):
+        return None
+    return low, high
+
+
 def measured_sample_rate(time_s: np.ndarray) -> float | None:
     """Reciprocal of the median positive finite time step, None if there is none.
 

@@ -328,6 +328,12 @@ class Sink:
         raise NotImplementedError
 
 
+def _arrow_float64(values: np.ndarray) -> pa.Array:
+    """A float64 numpy array as an Arrow array over the same memory (no pandas import)."""
+    values = np.ascontiguousarray(values, dtype=np.float64)
+    return pa.Array.from_buffers(pa.float64(), len(values), [None, pa.py_buffer(values)])
+
+
 class ParquetSink(Sink):
     def __init__(self, path: Path, metadata: Metadata, names: Sequence[str]) -> None:
         super().__init__(path, metadata, names)
@@ -343,7 +349,7 @@ class ParquetSink(Sink):
         self._pending_rows = 0
 
     def write(self, columns: Mapping[str, np.ndarray]) -> None:
-        arrays = [pa.array(columns[n]) for n in self.names]
+        arrays = [_arrow_float64(columns[n]) for n in self.names]
         table = pa.Table.from_arrays(arrays, schema=self._schema)
         self._pending.append(table)
         self._pending_rows += table.num_rows

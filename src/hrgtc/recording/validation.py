@@ -88,6 +88,7 @@ from hrgtc.recording.checks import (
     _check_sample_rate,
     _check_time_unit,
     check_thermometer,
+    finite_extremes,
     measured_sample_rate,
     problems_message,
 )
@@ -183,6 +184,12 @@ class RecordingValidator:
         offset, n = self.rows, len(chunk)
         for name in chunk.names:
             values = chunk[name]
+            low, high, _ = self._bounds.get(base_name(name, self.axes), (-np.inf, np.inf, ""))
+            extremes = finite_extremes(values)
+            if name in self._freq_reference:
+                self._check_jumps(name, values, offset, extremes)
+            if extremes is not None and low <= extremes[0] and extremes[1] <= high:
+                continue  # every value finite and within bounds: nothing to report
             bad = ~np.isfinite(values)
             if bad.any():
                 state = self._not_finite.get(name)
@@ -193,8 +200,6 @@ class RecordingValidator:
                     state[2] += int(bad.sum())
             if base_name(name, self.axes) in self._bounds:
                 self._check_bounds(name, values, offset)
-            if name in self._freq_reference:
-                self._check_jumps(name, values, offset)
         if "time_s" in chunk and n:
             self._check_time(chunk.time_s, offset)
         if self._heuristics is None:
@@ -214,8 +219,14 @@ class RecordingValidator:
             else:
                 state[2] += int(bad.sum())
 
-    def _check_jumps(self, name: str, freq: np.ndarray, offset: int) -> None:
+    def _check_jumps(self, name: str, freq: np.ndarray, offset: int,
+                     extremes: tuple[float, float] | None = None) -> None:
+        """Frequencies too far from the run's median; ``extremes``: min and max of ``freq``."""
         reference = self._freq_reference[name]
+        band = FREQ_JUMP_FRACTION * reference * (1.0 - 1e-9)  # margin for rounding
+        if extremes is not None and reference - band < extremes[0] and extremes[1] < (
+                reference + band):
+            return  # no sample near the limit, let alone beyond it
         with np.errstate(invalid="ignore"):
             bad = (np.abs(freq - reference) > FREQ_JUMP_FRACTION * reference) & np.isfinite(freq)
         if bad.any():
@@ -226,30 +237,53 @@ class RecordingValidator:
             else:
                 state[2] += int(bad.sum())
 
-    def _check_rate_throughout(self, step: np.ndarray, offset: int) -> None:
-        """Mean time step of every block of :data:`RATE_CHECK_ROWS` rows (gaps left out)."""
+    def _check_rate_throughout(self, step: np.ndarray, offset: int,
+                               all_usable: bool = False) -> None:
+        """Mean time step of each block of :data:`RATE_CHECK_ROWS` rows (gaps left out; none
+        if ``all_usable``: every step known finite, positive and no gap)."""
         if self._rate_change is not None:
             return
         if self._steps.size:
             step = np.concatenate([self._steps, step])
             offset = self._steps_start
+            all_usable = False
         blocks = step.size // RATE_CHECK_ROWS
         period = 1.0 / self.metadata.sample_rate_hz
-        for k in range(blocks):
-            part = step[k * RATE_CHECK_ROWS:(k + 1) * RATE_CHECK_ROWS]
-            with np.errstate(invalid="ignore"):
-                usable = part[np.isfinite(part) & (part > 0) & (part <= GAP_PERIODS * period)]
-            if usable.size < RATE_CHECK_ROWS // 2:
-                continue  # mostly gaps or disorder: reported by those checks
-            measured = 1.0 / float(np.mean(usable))
-            if abs(measured * period - 1.0) > SAMPLE_RATE_TOLERANCE:
-                self._rate_change = (offset + k * RATE_CHECK_ROWS, measured)
+        if blocks:  # every block at once: the mean step of its usable steps
+            part = step[:blocks * RATE_CHECK_ROWS].reshape(blocks, RATE_CHECK_ROWS)
+            if all_usable:
+                counts = np.full(blocks, RATE_CHECK_ROWS)
+                sums = part.sum(axis=1)
+            else:
+                with np.errstate(invalid="ignore"):
+                    usable = np.isfinite(part) & (part > 0) & (part <= GAP_PERIODS * period)
+                counts = usable.sum(axis=1)
+                sums = np.where(usable, part, 0.0).sum(axis=1)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                measured = 1.0 / (sums / counts)
+                # mostly gaps or disorder: left to those checks
+                changed = (counts >= RATE_CHECK_ROWS // 2) & (
+                    np.abs(measured * period - 1.0) > SAMPLE_RATE_TOLERANCE)
+            if changed.any():
+                k = int(np.argmax(changed))
+                self._rate_change = (offset + k * RATE_CHECK_ROWS, float(measured[k]))
                 self._steps = np.empty(0)
                 return
         self._steps = step[blocks * RATE_CHECK_ROWS:].copy()
         self._steps_start = offset + blocks * RATE_CHECK_ROWS
 
     def _check_time(self, time: np.ndarray, offset: int) -> None:
+        period = 1.0 / self.metadata.sample_rate_hz
+        if self._last_time is not None:  # fast path: steps all positive and no gap
+            step = np.empty_like(time)
+            step[0] = time[0] - self._last_time
+            np.subtract(time[1:], time[:-1], out=step[1:])
+            extremes = finite_extremes(step)
+            if extremes is not None and extremes[0] > 0.0 and (
+                    extremes[1] <= GAP_PERIODS * period):
+                self._last_time = float(time[-1])
+                self._check_rate_throughout(step, offset, all_usable=True)
+                return
         previous = np.empty_like(time)
         previous[0] = np.nan if self._last_time is None else self._last_time
         previous[1:] = time[:-1]
@@ -262,7 +296,6 @@ class RecordingValidator:
             if self._time_order is None:
                 i = int(np.argmax(backwards))
                 self._time_order = (offset + i, float(time[i]), float(previous[i]))
-        period = 1.0 / self.metadata.sample_rate_hz
         with np.errstate(invalid="ignore"):
             limit = GAP_PERIODS * period * (1.0 + GAP_TOLERANCE)
             long = np.flatnonzero((step > limit) & np.isfinite(step))

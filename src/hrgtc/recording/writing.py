@@ -18,6 +18,7 @@ import numpy as np
 
 from hrgtc.errors import InputError, RecordingError
 from hrgtc.files import (
+    WriteBehind,
     forget_temporary,
     fsync_file,
     publish,
@@ -92,6 +93,7 @@ class RecordingWriter:
             raise InputError(f"{self.path}: directory {directory} does not exist; create it first")
         tmp = temporary_beside(self.path)
         self._tmp = tmp
+        self._behind: WriteBehind | None = None
         self._cleanup = weakref.finalize(self, _remove, tmp)
         try:
             self._sink: Sink | None = SINKS[fmt](Path(tmp), metadata, self.columns)
@@ -122,28 +124,24 @@ class RecordingWriter:
         self.rows += len(arrays[self.columns[0]])
 
     def start_writeback(self) -> None:
-        """Start writing the rows written so far to disk, without waiting (Linux).
+        """Send the rows written so far to disk beside the work (:class:`~hrgtc.files.WriteBehind`).
 
         :meth:`close` still waits for every byte (fsync) before the rename; calling
-        this after each chunk spreads the disk writes over the run, so that wait is
-        short. A no-op where ``os.posix_fadvise`` is missing.
+        this after each chunk, in a writer thread, spreads the disk writes over the
+        run (the previous chunk's bytes are waited for here), so that wait is short.
         """
-        if self._sink is None or not hasattr(os, "posix_fadvise"):
+        if self._sink is None:
             return
-        fd = os.open(self._tmp, os.O_RDONLY)
-        try:
-            # DONTNEED starts write-back of the dirty pages (and drops clean ones).
-            os.posix_fadvise(fd, 0, 0, os.POSIX_FADV_DONTNEED)
-        except OSError:
-            pass
-        finally:
-            os.close(fd)
+        if self._behind is None:
+            self._behind = WriteBehind(self._tmp)
+        self._behind.advance()
 
     def close(self) -> Path:
         """Finish the file: sync it and rename it to :attr:`path`."""
         if self._sink is None:
             return self.path
         sink, self._sink = self._sink, None
+        self._stop_behind()
         try:
             sink.close()
             fsync_file(self._tmp)
@@ -154,9 +152,15 @@ class RecordingWriter:
         self._cleanup.detach()
         return self.path
 
+    def _stop_behind(self) -> None:
+        behind, self._behind = self._behind, None
+        if behind is not None:
+            behind.close()
+
     def abort(self) -> None:
         """Discard everything written; the temporary file is removed."""
         sink, self._sink = self._sink, None
+        self._stop_behind()
         try:
             if sink is not None:
                 sink.abort()
