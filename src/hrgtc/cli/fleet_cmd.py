@@ -113,8 +113,9 @@ def calibrate_command(
     output: Annotated[Path, typer.Option("-o", "--output", help="Models folder.")] = Path(
         "models"),
     order: Annotated[int, typer.Option(help="Order of the thermometer polynomial f(T).")] = 3,
-    terms: Annotated[str, typer.Option(help="Candidate drift terms (Eq. 21 default).")
-                     ] = EQ21_DEFAULT,
+    terms: Annotated[str | None, typer.Option(
+        help="Candidate drift terms [default: as calibrate: f,f^2,f^3,g,f*g,f^2*g when the "
+        f"runs log housing_c, else Eq. 21's {EQ21_DEFAULT}].")] = None,
     prior: Annotated[Path | None, typer.Option(
         "--prior", help="Population prior (hrgtc fleet prior): fit each thermometer with it.")
     ] = None,
@@ -135,7 +136,9 @@ def calibrate_command(
     """
     from hrgtc.fleet import calibrate_fleet, load_fleet
 
-    settings = {"order": order, "terms": [t.strip() for t in terms.split(",") if t.strip()]}
+    settings: dict[str, object] = {"order": order}
+    if terms is not None:
+        settings["terms"] = [t.strip() for t in terms.split(",") if t.strip()]
     with library_errors():
         fleet = load_fleet(root, unit)
         with progress_bar("units", enabled=not json_output) as progress:
