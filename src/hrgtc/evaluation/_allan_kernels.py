@@ -180,18 +180,21 @@ def compensated_sum(values):
 
 
 @njit(inline="always", **_JIT)
-def _oadev_lane(y, mean, m, i, d, acc):
-    d += ((y[i + 2 * m] - mean) + (y[i] - mean)) - 2.0 * (y[i + m] - mean)
-    return d, acc + d * d
+def _increments(y, mean, m, start, e):
+    """e[k] = d_{start+k+1} − d_{start+k}, the step of the second difference (vectorises)."""
+    for k in range(e.size):
+        i = start + k
+        e[k] = ((y[i + 2 * m] - mean) + (y[i] - mean)) - 2.0 * (y[i + m] - mean)
 
 
 @njit(parallel=True, **_JIT)
 def oadev_sum(y, mean, marks, m):
     """Σ_i d_i² over the N+1−2m overlapping second differences of the phase.
 
-    Each block is walked as four interleaved lanes (quarters of the block, each
-    started exactly) so that four independent dependency chains fill the
-    floating-point pipeline.
+    Each block's steps d_{i+1} − d_i are computed first in one contiguous pass (SIMD),
+    then walked as four interleaved lanes (quarters of the block, each started
+    exactly) so that four independent dependency chains fill the floating-point
+    pipeline; the arithmetic is that of one step at a time, so the sum is too.
     """
     terms = y.size + 1 - 2 * m
     blocks = (terms + BLOCK - 1) // BLOCK
@@ -200,34 +203,38 @@ def oadev_sum(y, mean, marks, m):
         start = b * BLOCK
         stop = min(start + BLOCK, terms)
         quarter = (stop - start) // LANES
+        e = np.empty(stop - start - 1)
+        _increments(y, mean, m, start, e)
         acc = 0.0
         if quarter > 1:
-            s0 = start
-            s1 = s0 + quarter
-            s2 = s1 + quarter
-            s3 = s2 + quarter
-            d0 = _second_difference(y, mean, marks, s0, m)
-            d1 = _second_difference(y, mean, marks, s1, m)
-            d2 = _second_difference(y, mean, marks, s2, m)
-            d3 = _second_difference(y, mean, marks, s3, m)
+            d0 = _second_difference(y, mean, marks, start, m)
+            d1 = _second_difference(y, mean, marks, start + quarter, m)
+            d2 = _second_difference(y, mean, marks, start + 2 * quarter, m)
+            d3 = _second_difference(y, mean, marks, start + 3 * quarter, m)
             a0 = d0 * d0
             a1 = d1 * d1
             a2 = d2 * d2
             a3 = d3 * d3
             for k in range(quarter - 1):
-                d0, a0 = _oadev_lane(y, mean, m, s0 + k, d0, a0)
-                d1, a1 = _oadev_lane(y, mean, m, s1 + k, d1, a1)
-                d2, a2 = _oadev_lane(y, mean, m, s2 + k, d2, a2)
-                d3, a3 = _oadev_lane(y, mean, m, s3 + k, d3, a3)
+                d0 += e[k]
+                a0 += d0 * d0
+                d1 += e[quarter + k]
+                a1 += d1 * d1
+                d2 += e[2 * quarter + k]
+                a2 += d2 * d2
+                d3 += e[3 * quarter + k]
+                a3 += d3 * d3
             # the last lane also takes the remainder of the block
-            for i in range(s3 + quarter - 1, stop - 1):
-                d3, a3 = _oadev_lane(y, mean, m, i, d3, a3)
+            for k in range(4 * quarter - 1, stop - start - 1):
+                d3 += e[k]
+                a3 += d3 * d3
             acc = (a0 + a1) + (a2 + a3)
         else:
             d = _second_difference(y, mean, marks, start, m)
             acc = d * d
-            for i in range(start, stop - 1):
-                d, acc = _oadev_lane(y, mean, m, i, d, acc)
+            for k in range(stop - start - 1):
+                d += e[k]
+                acc += d * d
         partial[b] = acc
     return compensated_sum(partial)
 
