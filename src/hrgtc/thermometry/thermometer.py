@@ -249,7 +249,10 @@ class Thermometer:
                 warnings.warn(
                     f"{n_out} of {flat.size} frequencies ({n_out / flat.size:.2%}) are outside "
                     f"the calibrated range {f_low_cal:.4f}-{f_high_cal:.4f} Hz "
-                    f"({t_low:g} to {t_high:g} °C); their temperatures are extrapolated",
+                    f"({t_low:g} to {t_high:g} °C); their temperatures are extrapolated"
+                    if self.source == "resonator" else
+                    f"{n_out} of {flat.size} sensor temperatures ({n_out / flat.size:.2%}) are "
+                    f"outside the trained range {t_low:g} to {t_high:g} °C",
                     ExtrapolationWarning,
                     stacklevel=2,
                 )
