@@ -15,8 +15,9 @@ from hrgtc.thermometry.plateaus import (
     plateau_table,
     plateaus_from_recordings,
 )
+from hrgtc.thermometry.sensor import identity
 from hrgtc.thermometry.settling import TransientFit, fit_transient
-from hrgtc.thermometry.thermometer import Thermometer, fit, identity
+from hrgtc.thermometry.thermometer import Thermometer, fit
 
 __all__ = [
     "DEFAULT_HZ_PER_C",
