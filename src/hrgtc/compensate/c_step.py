@@ -1,0 +1,48 @@
+"""C text of the end of ``step()``, shared by the double and the float32 exports.
+
+The compensated rate, the range flags and their counts, the scale factor (when the
+model has one) and the output record: the same statements in either precision.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+__all__ = ["step_tail"]
+
+
+def step_tail(*, up: str, level_test: str, rate_test: str, h: Mapping[str, str],
+              k: Mapping[str, str]) -> str:
+    """The statements of ``step()`` from the compensated rate to ``return``.
+
+    Parameters
+    ----------
+    up
+        Upper-case prefix of the exported names.
+    level_test, rate_test
+        C expressions: the sample is inside the calibrated temperature and trained
+        levels, and inside the trained rates.
+    h, k
+        Pieces of the housing variables (``h['out']``) and of the scale factor
+        (``k['apply']``, ``k['out']``).
+    """
+    return f"""    compensated = rate_dph - bias;
+    level_in_range = {level_test};
+    rate_in_range = {rate_test};
+    /* in_range: calibrated temperature, trained df/dt, and the filter settled */
+    in_range = level_in_range && rate_in_range && state->samples >= {up}_SETTLE_ROWS;
+    state->samples += 1UL;
+    state->out_of_range += level_in_range ? 0UL : 1UL;
+    state->rate_out_of_range += rate_in_range ? 0UL : 1UL;
+{k['apply']}    if (out) {{
+        out->rate_comp_dph = compensated;
+        out->bias_model_dph = bias;
+        out->resonator_c_est = temperature;
+        out->f_hz = f_value;
+        out->df_hz_per_s = df_value;
+{h['out']}{k['out']}        out->in_range = in_range;
+        out->rate_in_range = rate_in_range;
+    }}
+    return compensated;
+}}
+"""
