@@ -22,7 +22,7 @@ SOURCE = Path(__file__).resolve().parents[1] / "src" / "hrgtc"
 #: The stages, lowest first; a module may import its own stage and the ones above it in
 #: this list. Stages on one line do not import each other.
 STAGES: list[set[str]] = [
-    {"hrgtc._meta", "hrgtc.errors"},
+    {"hrgtc._meta", "hrgtc.errors", "hrgtc._process"},
     {"hrgtc.files", "hrgtc.progress"},
     {"hrgtc.recording"},
     {"hrgtc.thermometry"},

@@ -27,6 +27,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+from hrgtc._process import peak_rss_mb
 from hrgtc.fleet.tasks import UnitOutcome, error_record
 from hrgtc.progress import Progress
 
@@ -88,20 +89,6 @@ def scheduler_address(scheduler: str | None = None) -> str | None:
         return dask.config.get("scheduler-address", None) or None
     except ImportError:  # pragma: no cover - dask is a dependency
         return None
-
-
-def _peak_rss_mb() -> float:
-    """This process's peak resident set size (VmHWM). [MB]"""
-    try:
-        with open("/proc/self/status", encoding="ascii") as status:
-            for line in status:
-                if line.startswith("VmHWM:"):
-                    return round(int(line.split()[1]) / 1024.0, 1)
-    except OSError:
-        pass
-    import resource
-
-    return round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, 1)
 
 
 def _sequential(tasks: Sequence[Task], progress: Progress | None) -> list[UnitOutcome]:
@@ -192,7 +179,7 @@ def run_tasks(tasks: Sequence[Task], *, scheduler: str | None = None, workers: i
             Client(cluster) as client,
         ):
             outcomes = _on_cluster(client, tasks, progress, label)
-            peaks = {str(k): float(v) for k, v in client.run(_peak_rss_mb).items()}
+            peaks = {str(k): float(v) for k, v in client.run(peak_rss_mb).items()}
         where = f"local cluster of {n} worker{'s' if n > 1 else ''}"
     return FleetRun(tuple(sorted(outcomes, key=lambda o: o.unit)),
                     time.perf_counter() - start, where, peaks)
