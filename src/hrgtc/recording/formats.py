@@ -338,7 +338,11 @@ class ParquetSink(Sink):
     def __init__(self, path: Path, metadata: Metadata, names: Sequence[str]) -> None:
         super().__init__(path, metadata, names)
         axes = axis_names(names)
-        fields = [pa.field(n, pa.float64(), metadata=_field_metadata(n, axes)) for n in names]
+        # Columns are declared non-nullable (a sample is a float, NaN included, never
+        # missing): the writer then encodes no definition levels, which cost a third of
+        # the write (151 -> 102 ms per million rows of 11 columns), and readers skip them.
+        fields = [pa.field(n, pa.float64(), nullable=False, metadata=_field_metadata(n, axes))
+                  for n in names]
         self._schema = pa.schema(fields, metadata={METADATA_KEY: metadata_json(metadata)})
         # Float gyro data does not compress as it is (snappy saved 0 % on simulated runs
         # and cost a third of the write speed), but with its bytes split into streams
