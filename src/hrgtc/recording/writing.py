@@ -124,11 +124,11 @@ class RecordingWriter:
         self.rows += len(arrays[self.columns[0]])
 
     def start_writeback(self) -> None:
-        """Send the rows written so far to disk beside the work (:class:`~hrgtc.files.WriteBehind`).
+        """Make the rows written so far durable beside the work (:class:`~hrgtc.files.WriteBehind`).
 
-        :meth:`close` still waits for every byte (fsync) before the rename; calling
-        this after each chunk, in a writer thread, spreads the disk writes over the
-        run (the previous chunk's bytes are waited for here), so that wait is short.
+        The first call starts a thread that syncs the file as it grows (each later
+        call wakes it at once); :meth:`close` still waits for every byte (fsync)
+        before the rename, but finds little left to wait for.
         """
         if self._sink is None:
             return
@@ -141,26 +141,27 @@ class RecordingWriter:
         if self._sink is None:
             return self.path
         sink, self._sink = self._sink, None
-        self._stop_behind()
         try:
             sink.close()
+            self._stop_behind()  # after the last bytes, which it may still sync
             fsync_file(self._tmp)
             publish(self._tmp, self.path, self.force)
         except BaseException:
+            self._stop_behind(discard=True)
             self._cleanup()
             raise
         self._cleanup.detach()
         return self.path
 
-    def _stop_behind(self) -> None:
+    def _stop_behind(self, discard: bool = False) -> None:
         behind, self._behind = self._behind, None
         if behind is not None:
-            behind.close()
+            behind.close(discard=discard)
 
     def abort(self) -> None:
         """Discard everything written; the temporary file is removed."""
         sink, self._sink = self._sink, None
-        self._stop_behind()
+        self._stop_behind(discard=True)
         try:
             if sink is not None:
                 sink.abort()
