@@ -62,3 +62,33 @@ def test_a_sample_rate_change_late_in_the_run_is_found(tmp_path, rows):
         list(iter_chunks(path, rows=rows))
     assert sum(len(c) for c in iter_chunks(write(Recording(clean(), Metadata(
         sample_rate_hz=RATE_HZ)), tmp_path / "clean.parquet"), rows=rows)) == N
+
+
+@settings(max_examples=40, deadline=None)
+@given(start=st.integers(1, N - 1200), factor=st.floats(0.95, 1.05),
+       rows=st.integers(300, N), seed=st.integers(0, 10))
+def test_the_sample_rate_check_by_block_end_times_equals_summing_every_step(start, factor,
+                                                                           rows, seed):
+    """A clean chunk's block means come from the times at the block ends (no pass over the
+    steps); chunk by chunk they find the same block, and the same mean, as one chunk whose
+    steps are summed (the first chunk always is: its first step is unknown)."""
+    from hrgtc.recording.validation import RecordingValidator
+
+    rng = np.random.default_rng(seed)
+    step = (1.0 + 1e-4 * rng.standard_normal(N)) / RATE_HZ
+    step[start:] /= factor
+    columns = {**clean(seed), "time_s": 100.0 + np.cumsum(step)}
+    whole = Recording(columns, Metadata(sample_rate_hz=RATE_HZ))
+    found = []
+    for size in (N, rows):
+        validator = RecordingValidator()
+        for first in range(0, N, size):
+            validator.update(whole.slice(first, min(first + size, N)))
+        found.append(validator._rate_change)
+    if found[0] is None:
+        assert found[1] is None
+    else:
+        assert found[1][0] == found[0][0]
+        assert found[1][1] == pytest.approx(found[0][1], rel=1e-10)
+    if abs(factor - 1.0) > 0.02 and start < N - 2 * 1000:
+        assert found[0] is not None  # the change is there to find

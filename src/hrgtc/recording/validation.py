@@ -152,6 +152,7 @@ class RecordingValidator:
         self._suffixes: tuple[str, ...] = ("",)
         self._steps = np.empty(0)
         self._steps_start = 0
+        self._steps_usable = True  # every carried step finite, positive and no gap
         self._rate_change: tuple[int, float] | None = None
         self.rows = 0
         self.source: str | None = None
@@ -238,39 +239,56 @@ class RecordingValidator:
                 state[2] += int(bad.sum())
 
     def _check_rate_throughout(self, step: np.ndarray, offset: int,
-                               all_usable: bool = False) -> None:
-        """Mean time step of each block of :data:`RATE_CHECK_ROWS` rows (gaps left out; none
-        if ``all_usable``: every step known finite, positive and no gap)."""
+                               time: np.ndarray | None = None) -> None:
+        """Mean time step of each block of :data:`RATE_CHECK_ROWS` rows (gaps left out).
+
+        ``time``: the chunk's times, given when every step is known finite, positive
+        and no gap (``step[i] = time[i] - time[i - 1]``); then a block's sum of steps
+        is the difference of the times at its ends, and the steps are not summed.
+        """
         if self._rate_change is not None:
             return
-        if self._steps.size:
-            step = np.concatenate([self._steps, step])
-            offset = self._steps_start
-            all_usable = False
-        blocks = step.size // RATE_CHECK_ROWS
+        rows = RATE_CHECK_ROWS
         period = 1.0 / self.metadata.sample_rate_hz
-        if blocks:  # every block at once: the mean step of its usable steps
-            part = step[:blocks * RATE_CHECK_ROWS].reshape(blocks, RATE_CHECK_ROWS)
-            if all_usable:
-                counts = np.full(blocks, RATE_CHECK_ROWS)
-                sums = part.sum(axis=1)
-            else:
-                with np.errstate(invalid="ignore"):
-                    usable = np.isfinite(part) & (part > 0) & (part <= GAP_PERIODS * period)
-                counts = usable.sum(axis=1)
-                sums = np.where(usable, part, 0.0).sum(axis=1)
+        carried = self._steps
+        base = self._steps_start if carried.size else offset
+        blocks = (carried.size + step.size) // rows
+        if time is not None and self._steps_usable:
+            ends = np.arange(1, blocks + 1) * rows - carried.size  # block ends within step
+            starts = np.maximum(ends - rows, 0)
+            # a block's steps add up to its last time minus the time before its first
+            # step (time[0] - step[0]: the previous chunk's last), plus the carried steps
+            before = np.where(starts > 0, time[np.maximum(starts - 1, 0)], time[0] - step[0])
+            sums = time[ends - 1] - before
+            if blocks:
+                sums[0] += carried.sum()
+            counts = np.full(blocks, rows)
+            rest = step[ends[-1]:] if blocks else np.concatenate([carried, step])
+        else:
+            if carried.size:
+                step = np.concatenate([carried, step])
+            part = step[:blocks * rows].reshape(blocks, rows)
+            with np.errstate(invalid="ignore"):
+                usable = np.isfinite(part) & (part > 0) & (part <= GAP_PERIODS * period)
+            counts = usable.sum(axis=1)
+            sums = np.where(usable, part, 0.0).sum(axis=1)
+            rest = step[blocks * rows:]
+        if blocks:
             with np.errstate(divide="ignore", invalid="ignore"):
                 measured = 1.0 / (sums / counts)
                 # mostly gaps or disorder: left to those checks
-                changed = (counts >= RATE_CHECK_ROWS // 2) & (
+                changed = (counts >= rows // 2) & (
                     np.abs(measured * period - 1.0) > SAMPLE_RATE_TOLERANCE)
             if changed.any():
                 k = int(np.argmax(changed))
-                self._rate_change = (offset + k * RATE_CHECK_ROWS, float(measured[k]))
+                self._rate_change = (base + k * rows, float(measured[k]))
                 self._steps = np.empty(0)
                 return
-        self._steps = step[blocks * RATE_CHECK_ROWS:].copy()
-        self._steps_start = offset + blocks * RATE_CHECK_ROWS
+        self._steps = rest.copy()
+        self._steps_start = base + blocks * rows
+        with np.errstate(invalid="ignore"):
+            self._steps_usable = bool(np.all(np.isfinite(rest) & (rest > 0)
+                                             & (rest <= GAP_PERIODS * period)))
 
     def _check_time(self, time: np.ndarray, offset: int) -> None:
         period = 1.0 / self.metadata.sample_rate_hz
@@ -282,7 +300,7 @@ class RecordingValidator:
             if extremes is not None and extremes[0] > 0.0 and (
                     extremes[1] <= GAP_PERIODS * period):
                 self._last_time = float(time[-1])
-                self._check_rate_throughout(step, offset, all_usable=True)
+                self._check_rate_throughout(step, offset, time=time)
                 return
         previous = np.empty_like(time)
         previous[0] = np.nan if self._last_time is None else self._last_time
