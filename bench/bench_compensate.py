@@ -58,7 +58,7 @@ def plain_script(model_path: str, source: str, output: str, rows: int = 1 << 20)
     Written as a user would with pyarrow and numpy, with pyarrow's fastest writer
     options for float columns (uncompressed, no dictionary: less work per row than
     hrgtc's byte-stream split, LZ4 and page checksums, for a file 1.6x larger; pyarrow's
-    defaults, snappy and dictionary, cost 2.5x more), so it is the strictest baseline.
+    defaults, snappy and dictionary, cost 2.7x more), so it is the strictest baseline.
     """
     import numpy as np
     import pyarrow as pa
