@@ -232,3 +232,18 @@ def test_non_overlapping_interval_covers_68_percent_of_white_noise_records():
                                  overlapping=False, confidence=ONE_SIGMA)
         hits += result.lower[0] <= truth <= result.upper[0]
     assert hits / trials == pytest.approx(ONE_SIGMA, abs=0.035)  # binomial sd 0.010
+
+
+@pytest.mark.parametrize("kind", ["allan", "modified", "hadamard"])
+def test_many_taus_shared_among_threads_equal_one_tau_at_a_time_bit_for_bit(kind, monkeypatch):
+    """From MANY_TAUS τ on, the τ (not the blocks of one τ) go to the threads: same bits."""
+    from hrgtc.evaluation import _allan_kernels
+
+    rate = noise("flicker_fm", 9_001, seed=11)  # 3 blocks at small m, 1 at large
+    taus = np.arange(1, 2_000, 7) / 4.0
+    many = allan_deviation(rate, 4.0, taus=taus, kind=kind)
+    monkeypatch.setattr(_allan_kernels, "MANY_TAUS", 10**9)
+    one = allan_deviation(rate, 4.0, taus=taus, kind=kind)
+    assert many.taus_s.size >= _allan_kernels.TAU_BATCH + 1  # two batches, the last partial
+    assert many.deviation.tobytes() == one.deviation.tobytes()
+    np.testing.assert_array_equal(many.counts, one.counts)
