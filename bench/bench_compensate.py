@@ -36,7 +36,7 @@ from pathlib import Path
 from _child import measure
 
 SETPOINTS_C = (-20.0, -10.0, 0.0, 10.0, 20.0, 30.0, 40.0)
-FILE_PAIRS = 5
+FILE_PAIRS = 7
 MEMORY_REPEATS = 3
 
 
