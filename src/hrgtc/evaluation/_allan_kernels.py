@@ -205,7 +205,13 @@ def _increments(y, mean, m, start, e):
 
 @njit(inline="always", **_JIT)
 def _oadev_block(y, mean, marks, m, start, stop):
-    """One block's Σ d_i² (see :func:`oadev_sum`)."""
+    """One block of Σ_i d_i², the N+1−2m overlapping second differences of the phase.
+
+    Each block's steps d_{i+1} − d_i are computed first in one contiguous pass (SIMD),
+    then walked as four interleaved lanes (quarters of the block, each started
+    exactly) so that four independent dependency chains fill the floating-point
+    pipeline; the arithmetic is that of one step at a time, so the sum is too.
+    """
     quarter = (stop - start) // LANES
     e = np.empty(stop - start - 1)
     _increments(y, mean, m, start, e)
@@ -242,99 +248,35 @@ def _oadev_block(y, mean, marks, m, start, stop):
     return acc
 
 
-@njit(parallel=True, **_JIT)
-def oadev_sum(y, mean, marks, m):
-    """Σ_i d_i² over the N+1−2m overlapping second differences of the phase.
-
-    Each block's steps d_{i+1} − d_i are computed first in one contiguous pass (SIMD),
-    then walked as four interleaved lanes (quarters of the block, each started
-    exactly) so that four independent dependency chains fill the floating-point
-    pipeline; the arithmetic is that of one step at a time, so the sum is too.
-    """
-    terms = y.size + 1 - 2 * m
-    blocks = (terms + BLOCK - 1) // BLOCK
-    partial = np.empty(blocks)
-    for b in prange(blocks):
-        start = b * BLOCK
-        partial[b] = _oadev_block(y, mean, marks, m, start, min(start + BLOCK, terms))
-    return compensated_sum(partial)
-
-
-@njit(parallel=True, **_JIT)
-def oadev_sums(y, mean, marks, factors):
-    """:func:`oadev_sum` of every factor, the factors shared out among the threads.
-
-    For many τ (``taus="all"``), where one call per τ would cost more in thread
-    start-ups than in arithmetic. Each τ is summed by one thread through the same
-    blocks in the same order, so the sums equal :func:`oadev_sum`'s bit for bit.
-    """
-    out = np.empty(factors.size)
-    for t in prange(THREADS):
-        for j in range(t, factors.size, THREADS):
-            m = factors[j]
-            terms = y.size + 1 - 2 * m
-            blocks = (terms + BLOCK - 1) // BLOCK
-            partial = np.empty(blocks)
-            for b in range(blocks):
-                start = b * BLOCK
-                partial[b] = _oadev_block(y, mean, marks, m, start, min(start + BLOCK, terms))
-            out[j] = compensated_sum(partial)
-    return out
+@njit(inline="always", **_JIT)
+def _lagged(y, start, m, n):
+    """y[start + k·m :][:n] for k = 0..3: slices indexed from 0, so that no
+    wrap-around check is left in the loops over them (see :func:`_increments`)."""
+    return (y[start:start + n], y[start + m:start + m + n],
+            y[start + 2 * m:start + 2 * m + n], y[start + 3 * m:start + 3 * m + n])
 
 
 @njit(inline="always", **_JIT)
 def _ohdev_block(y, mean, marks, m, start, stop):
-    """One block's Σ h_i² (see :func:`ohdev_sum`)."""
+    """One block of Σ_i h_i², the N+1−3m overlapping third differences of the phase."""
     h = _third_difference(y, mean, marks, start, m, 1)
     acc = h * h
     n = stop - 1 - start
-    y0 = y[start:start + n]  # slices from 0: no wrap-around check (see _increments)
-    y1 = y[start + m:start + m + n]
-    y2 = y[start + 2 * m:start + 2 * m + n]
-    y3 = y[start + 3 * m:start + 3 * m + n]
+    y0, y1, y2, y3 = _lagged(y, start, m, n)
     for k in range(n):
         h += ((y3[k] - mean) - (y0[k] - mean)) - 3.0 * ((y2[k] - mean) - (y1[k] - mean))
         acc += h * h
     return acc
 
 
-@njit(parallel=True, **_JIT)
-def ohdev_sum(y, mean, marks, m):
-    """Σ_i h_i² over the N+1−3m overlapping third differences of the phase."""
-    terms = y.size + 1 - 3 * m
-    blocks = (terms + BLOCK - 1) // BLOCK
-    partial = np.empty(blocks)
-    for b in prange(blocks):
-        start = b * BLOCK
-        partial[b] = _ohdev_block(y, mean, marks, m, start, min(start + BLOCK, terms))
-    return compensated_sum(partial)
-
-
-@njit(parallel=True, **_JIT)
-def ohdev_sums(y, mean, marks, factors):
-    """:func:`ohdev_sum` of every factor, the factors shared out among the threads.
-
-    For many τ (``taus="all"``), where one call per τ would cost more in thread
-    start-ups than in arithmetic. Each τ is summed by one thread through the same
-    blocks in the same order, so the sums equal :func:`ohdev_sum`'s bit for bit.
-    """
-    out = np.empty(factors.size)
-    for t in prange(THREADS):
-        for j in range(t, factors.size, THREADS):
-            m = factors[j]
-            terms = y.size + 1 - 3 * m
-            blocks = (terms + BLOCK - 1) // BLOCK
-            partial = np.empty(blocks)
-            for b in range(blocks):
-                start = b * BLOCK
-                partial[b] = _ohdev_block(y, mean, marks, m, start, min(start + BLOCK, terms))
-            out[j] = compensated_sum(partial)
-    return out
-
-
 @njit(inline="always", **_JIT)
 def _mdev_block(y, mean, marks, m, start, stop):
-    """One block's Σ v_j² (see :func:`mdev_sum`)."""
+    """One block of Σ_j v_j², the N+2−3m sums v_j of m consecutive second differences.
+
+    The two second differences d_j and d_{j+m} that drive v are carried with
+    their rounding errors (TwoSum), so that v, their running sum, stays exact
+    to ~ε over the block.
+    """
     v = _third_difference(y, mean, marks, start, m, 2)
     acc = v * v
     if stop - start > 1:
@@ -344,10 +286,7 @@ def _mdev_block(y, mean, marks, m, start, stop):
         d1l = 0.0
         vl = 0.0
         n = stop - 1 - start
-        s0 = y[start:start + n]  # slices from 0: no wrap-around check (see _increments)
-        s1 = y[start + m:start + m + n]
-        s2 = y[start + 2 * m:start + 2 * m + n]
-        s3 = y[start + 3 * m:start + 3 * m + n]
+        s0, s1, s2, s3 = _lagged(y, start, m, n)
         for k in range(n):
             step, e = _two_sum(d1h, -d0h)
             v, e2 = _two_sum(v, step)
@@ -367,48 +306,70 @@ def _mdev_block(y, mean, marks, m, start, stop):
     return acc
 
 
-@njit(parallel=True, **_JIT)
-def mdev_sum(y, mean, marks, m):
-    """Σ_j v_j² over the N+2−3m sums v_j of m consecutive second differences.
+#: Statistics by number: overlapping Allan, Hadamard, modified Allan.
+ALLAN, HADAMARD, MODIFIED = 0, 1, 2
 
-    The two second differences d_j and d_{j+m} that drive v are carried with
-    their rounding errors (TwoSum), so that v, their running sum, stays exact
-    to ~ε over the block.
+
+@njit(inline="always", **_JIT)
+def _terms(n, kind, m):
+    """Number of terms of statistic ``kind`` at factor m on n samples (SP 1065 [1])."""
+    if kind == ALLAN:
+        return n + 1 - 2 * m
+    if kind == HADAMARD:
+        return n + 1 - 3 * m
+    return n + 2 - 3 * m
+
+
+@njit(inline="always", **_JIT)
+def _block(y, mean, marks, m, start, stop, kind):
+    """The squares of one block of terms of statistic ``kind``, summed."""
+    if kind == ALLAN:
+        return _oadev_block(y, mean, marks, m, start, stop)
+    if kind == HADAMARD:
+        return _ohdev_block(y, mean, marks, m, start, stop)
+    return _mdev_block(y, mean, marks, m, start, stop)
+
+
+@njit(parallel=True, **_JIT)
+def sum_of_squares(y, mean, marks, m, kind):
+    """Σ of the squared terms of statistic ``kind`` at factor m, its blocks in parallel.
+
+    The block sums go into one slot each and are added in order
+    (:func:`compensated_sum`), so the result does not depend on the threads.
     """
-    terms = y.size + 2 - 3 * m
+    terms = _terms(y.size, kind, m)
     blocks = (terms + BLOCK - 1) // BLOCK
     partial = np.empty(blocks)
     for b in prange(blocks):
         start = b * BLOCK
-        partial[b] = _mdev_block(y, mean, marks, m, start, min(start + BLOCK, terms))
+        partial[b] = _block(y, mean, marks, m, start, min(start + BLOCK, terms), kind)
     return compensated_sum(partial)
 
 
 @njit(parallel=True, **_JIT)
-def mdev_sums(y, mean, marks, factors):
-    """:func:`mdev_sum` of every factor, the factors shared out among the threads.
+def sums_of_squares_many(y, mean, marks, factors, kind):
+    """:func:`sum_of_squares` of every factor, the factors shared out among the threads.
 
     For many τ (``taus="all"``), where one call per τ would cost more in thread
     start-ups than in arithmetic. Each τ is summed by one thread through the same
-    blocks in the same order, so the sums equal :func:`mdev_sum`'s bit for bit.
+    blocks in the same order, so the sums equal :func:`sum_of_squares`' bit for bit.
     """
     out = np.empty(factors.size)
     for t in prange(THREADS):
         for j in range(t, factors.size, THREADS):
             m = factors[j]
-            terms = y.size + 2 - 3 * m
+            terms = _terms(y.size, kind, m)
             blocks = (terms + BLOCK - 1) // BLOCK
             partial = np.empty(blocks)
             for b in range(blocks):
                 start = b * BLOCK
-                partial[b] = _mdev_block(y, mean, marks, m, start, min(start + BLOCK, terms))
+                partial[b] = _block(y, mean, marks, m, start, min(start + BLOCK, terms), kind)
             out[j] = compensated_sum(partial)
     return out
 
 
-#: Kernels (one τ, blocks in parallel; many τ, τ in parallel) and checkpoint levels.
-KERNELS = {"allan": (oadev_sum, oadev_sums, 1), "hadamard": (ohdev_sum, ohdev_sums, 1),
-           "modified": (mdev_sum, mdev_sums, 2)}
+#: Number and checkpoint levels of each statistic.
+KINDS = {"allan": (ALLAN, 1), "hadamard": (HADAMARD, 1), "modified": (MODIFIED, 2)}
 #: From this many τ on, the τ (not the blocks of each) are shared among the threads.
 MANY_TAUS = 64
 #: τ per call of a many-τ kernel (progress is reported after each call).
@@ -425,7 +386,7 @@ def sums_of_squares(y, kind, factors, progress=None):
     """
     import numba
 
-    one, many, levels = KERNELS[kind]
+    number, levels = KINDS[kind]
     mean = float(np.mean(y))  # pairwise, as allantools' frequency2phase (np.nanmean)
     marks = checkpoints(y, mean, levels)
     previous = numba.get_num_threads()
@@ -437,12 +398,13 @@ def sums_of_squares(y, kind, factors, progress=None):
             factors = np.ascontiguousarray(factors, dtype=np.int64)
             for start in range(0, total, TAU_BATCH):
                 stop = min(start + TAU_BATCH, total)
-                out[start:stop] = many(y, mean, marks, factors[start:stop])
+                out[start:stop] = sums_of_squares_many(y, mean, marks, factors[start:stop],
+                                                       number)
                 if progress is not None:
                     progress(float(stop), float(total))
         else:
             for done, m in enumerate(factors, start=1):
-                out[done - 1] = one(y, mean, marks, int(m))
+                out[done - 1] = sum_of_squares(y, mean, marks, int(m), number)
                 if progress is not None:
                     progress(float(done), float(total))
     finally:
