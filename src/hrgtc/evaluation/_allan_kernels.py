@@ -203,15 +203,9 @@ def _increments(y, mean, m, start, e):
         e[k] = ((y2[k] - mean) + (y0[k] - mean)) - 2.0 * (y1[k] - mean)
 
 
-@njit(inline="always", **_JIT)
+@njit(**_JIT)
 def _oadev_block(y, mean, marks, m, start, stop):
-    """One block of Σ_i d_i², the N+1−2m overlapping second differences of the phase.
-
-    Each block's steps d_{i+1} − d_i are computed first in one contiguous pass (SIMD),
-    then walked as four interleaved lanes (quarters of the block, each started
-    exactly) so that four independent dependency chains fill the floating-point
-    pipeline; the arithmetic is that of one step at a time, so the sum is too.
-    """
+    """One block's Σ d_i² (see :func:`oadev_sum`)."""
     quarter = (stop - start) // LANES
     e = np.empty(stop - start - 1)
     _increments(y, mean, m, start, e)
@@ -248,6 +242,46 @@ def _oadev_block(y, mean, marks, m, start, stop):
     return acc
 
 
+@njit(parallel=True, **_JIT)
+def oadev_sum(y, mean, marks, m):
+    """Σ_i d_i² over the N+1−2m overlapping second differences of the phase.
+
+    Each block's steps d_{i+1} − d_i are computed first in one contiguous pass (SIMD),
+    then walked as four interleaved lanes (quarters of the block, each started
+    exactly) so that four independent dependency chains fill the floating-point
+    pipeline; the arithmetic is that of one step at a time, so the sum is too.
+    """
+    terms = y.size + 1 - 2 * m
+    blocks = (terms + BLOCK - 1) // BLOCK
+    partial = np.empty(blocks)
+    for b in prange(blocks):
+        start = b * BLOCK
+        partial[b] = _oadev_block(y, mean, marks, m, start, min(start + BLOCK, terms))
+    return compensated_sum(partial)
+
+
+@njit(parallel=True, **_JIT)
+def oadev_sums(y, mean, marks, factors):
+    """:func:`oadev_sum` of every factor, the factors shared out among the threads.
+
+    For many τ (``taus="all"``), where one call per τ would cost more in thread
+    start-ups than in arithmetic. Each τ is summed by one thread through the same
+    blocks in the same order, so the sums equal :func:`oadev_sum`'s bit for bit.
+    """
+    out = np.empty(factors.size)
+    for t in prange(THREADS):
+        for j in range(t, factors.size, THREADS):
+            m = factors[j]
+            terms = y.size + 1 - 2 * m
+            blocks = (terms + BLOCK - 1) // BLOCK
+            partial = np.empty(blocks)
+            for b in range(blocks):
+                start = b * BLOCK
+                partial[b] = _oadev_block(y, mean, marks, m, start, min(start + BLOCK, terms))
+            out[j] = compensated_sum(partial)
+    return out
+
+
 @njit(inline="always", **_JIT)
 def _lagged(y, start, m, n):
     """y[start + k·m :][:n] for k = 0..3: slices indexed from 0, so that no
@@ -256,9 +290,9 @@ def _lagged(y, start, m, n):
             y[start + 2 * m:start + 2 * m + n], y[start + 3 * m:start + 3 * m + n])
 
 
-@njit(inline="always", **_JIT)
+@njit(**_JIT)
 def _ohdev_block(y, mean, marks, m, start, stop):
-    """One block of Σ_i h_i², the N+1−3m overlapping third differences of the phase."""
+    """One block's Σ h_i² (see :func:`ohdev_sum`)."""
     h = _third_difference(y, mean, marks, start, m, 1)
     acc = h * h
     n = stop - 1 - start
@@ -269,14 +303,43 @@ def _ohdev_block(y, mean, marks, m, start, stop):
     return acc
 
 
-@njit(inline="always", **_JIT)
-def _mdev_block(y, mean, marks, m, start, stop):
-    """One block of Σ_j v_j², the N+2−3m sums v_j of m consecutive second differences.
+@njit(parallel=True, **_JIT)
+def ohdev_sum(y, mean, marks, m):
+    """Σ_i h_i² over the N+1−3m overlapping third differences of the phase."""
+    terms = y.size + 1 - 3 * m
+    blocks = (terms + BLOCK - 1) // BLOCK
+    partial = np.empty(blocks)
+    for b in prange(blocks):
+        start = b * BLOCK
+        partial[b] = _ohdev_block(y, mean, marks, m, start, min(start + BLOCK, terms))
+    return compensated_sum(partial)
 
-    The two second differences d_j and d_{j+m} that drive v are carried with
-    their rounding errors (TwoSum), so that v, their running sum, stays exact
-    to ~ε over the block.
+
+@njit(parallel=True, **_JIT)
+def ohdev_sums(y, mean, marks, factors):
+    """:func:`ohdev_sum` of every factor, the factors shared out among the threads.
+
+    For many τ (``taus="all"``), where one call per τ would cost more in thread
+    start-ups than in arithmetic. Each τ is summed by one thread through the same
+    blocks in the same order, so the sums equal :func:`ohdev_sum`'s bit for bit.
     """
+    out = np.empty(factors.size)
+    for t in prange(THREADS):
+        for j in range(t, factors.size, THREADS):
+            m = factors[j]
+            terms = y.size + 1 - 3 * m
+            blocks = (terms + BLOCK - 1) // BLOCK
+            partial = np.empty(blocks)
+            for b in range(blocks):
+                start = b * BLOCK
+                partial[b] = _ohdev_block(y, mean, marks, m, start, min(start + BLOCK, terms))
+            out[j] = compensated_sum(partial)
+    return out
+
+
+@njit(**_JIT)
+def _mdev_block(y, mean, marks, m, start, stop):
+    """One block's Σ v_j² (see :func:`mdev_sum`)."""
     v = _third_difference(y, mean, marks, start, m, 2)
     acc = v * v
     if stop - start > 1:
@@ -306,70 +369,51 @@ def _mdev_block(y, mean, marks, m, start, stop):
     return acc
 
 
-#: Statistics by number: overlapping Allan, Hadamard, modified Allan.
-ALLAN, HADAMARD, MODIFIED = 0, 1, 2
-
-
-@njit(inline="always", **_JIT)
-def _terms(n, kind, m):
-    """Number of terms of statistic ``kind`` at factor m on n samples (SP 1065 [1])."""
-    if kind == ALLAN:
-        return n + 1 - 2 * m
-    if kind == HADAMARD:
-        return n + 1 - 3 * m
-    return n + 2 - 3 * m
-
-
-@njit(inline="always", **_JIT)
-def _block(y, mean, marks, m, start, stop, kind):
-    """The squares of one block of terms of statistic ``kind``, summed."""
-    if kind == ALLAN:
-        return _oadev_block(y, mean, marks, m, start, stop)
-    if kind == HADAMARD:
-        return _ohdev_block(y, mean, marks, m, start, stop)
-    return _mdev_block(y, mean, marks, m, start, stop)
-
-
 @njit(parallel=True, **_JIT)
-def sum_of_squares(y, mean, marks, m, kind):
-    """Σ of the squared terms of statistic ``kind`` at factor m, its blocks in parallel.
+def mdev_sum(y, mean, marks, m):
+    """Σ_j v_j² over the N+2−3m sums v_j of m consecutive second differences.
 
-    The block sums go into one slot each and are added in order
-    (:func:`compensated_sum`), so the result does not depend on the threads.
+    The two second differences d_j and d_{j+m} that drive v are carried with
+    their rounding errors (TwoSum), so that v, their running sum, stays exact
+    to ~ε over the block.
     """
-    terms = _terms(y.size, kind, m)
+    terms = y.size + 2 - 3 * m
     blocks = (terms + BLOCK - 1) // BLOCK
     partial = np.empty(blocks)
     for b in prange(blocks):
         start = b * BLOCK
-        partial[b] = _block(y, mean, marks, m, start, min(start + BLOCK, terms), kind)
+        partial[b] = _mdev_block(y, mean, marks, m, start, min(start + BLOCK, terms))
     return compensated_sum(partial)
 
 
 @njit(parallel=True, **_JIT)
-def sums_of_squares_many(y, mean, marks, factors, kind):
-    """:func:`sum_of_squares` of every factor, the factors shared out among the threads.
+def mdev_sums(y, mean, marks, factors):
+    """:func:`mdev_sum` of every factor, the factors shared out among the threads.
 
     For many τ (``taus="all"``), where one call per τ would cost more in thread
     start-ups than in arithmetic. Each τ is summed by one thread through the same
-    blocks in the same order, so the sums equal :func:`sum_of_squares`' bit for bit.
+    blocks in the same order, so the sums equal :func:`mdev_sum`'s bit for bit.
     """
     out = np.empty(factors.size)
     for t in prange(THREADS):
         for j in range(t, factors.size, THREADS):
             m = factors[j]
-            terms = _terms(y.size, kind, m)
+            terms = y.size + 2 - 3 * m
             blocks = (terms + BLOCK - 1) // BLOCK
             partial = np.empty(blocks)
             for b in range(blocks):
                 start = b * BLOCK
-                partial[b] = _block(y, mean, marks, m, start, min(start + BLOCK, terms), kind)
+                partial[b] = _mdev_block(y, mean, marks, m, start, min(start + BLOCK, terms))
             out[j] = compensated_sum(partial)
     return out
 
 
-#: Number and checkpoint levels of each statistic.
-KINDS = {"allan": (ALLAN, 1), "hadamard": (HADAMARD, 1), "modified": (MODIFIED, 2)}
+#: Kernels (one τ, blocks in parallel; many τ, τ in parallel) and checkpoint levels. One
+#: pair per statistic, each compiled on its first use only: one kernel for all three
+#: (chosen by number) compiled them all, 30-60 s, and a block function passed as an
+#: argument defeats numba's cache (it recompiled in every process).
+KERNELS = {"allan": (oadev_sum, oadev_sums, 1), "hadamard": (ohdev_sum, ohdev_sums, 1),
+           "modified": (mdev_sum, mdev_sums, 2)}
 #: From this many τ on, the τ (not the blocks of each) are shared among the threads.
 MANY_TAUS = 64
 #: τ per call of a many-τ kernel (progress is reported after each call).
@@ -386,7 +430,7 @@ def sums_of_squares(y, kind, factors, progress=None):
     """
     import numba
 
-    number, levels = KINDS[kind]
+    one, many, levels = KERNELS[kind]
     mean = float(np.mean(y))  # pairwise, as allantools' frequency2phase (np.nanmean)
     marks = checkpoints(y, mean, levels)
     previous = numba.get_num_threads()
@@ -398,13 +442,12 @@ def sums_of_squares(y, kind, factors, progress=None):
             factors = np.ascontiguousarray(factors, dtype=np.int64)
             for start in range(0, total, TAU_BATCH):
                 stop = min(start + TAU_BATCH, total)
-                out[start:stop] = sums_of_squares_many(y, mean, marks, factors[start:stop],
-                                                       number)
+                out[start:stop] = many(y, mean, marks, factors[start:stop])
                 if progress is not None:
                     progress(float(stop), float(total))
         else:
             for done, m in enumerate(factors, start=1):
-                out[done - 1] = sum_of_squares(y, mean, marks, int(m), number)
+                out[done - 1] = one(y, mean, marks, int(m))
                 if progress is not None:
                     progress(float(done), float(total))
     finally:

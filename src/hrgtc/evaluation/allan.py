@@ -334,11 +334,12 @@ def allan_deviation(
     The overlapping statistics run in fused numba kernels (``_allan_kernels``)
     that never store the phase: extra memory is ~1/32 of the input, the values
     are exact to ~1e-14 relative also at 10^8 samples (compensated
-    arithmetic; ``allantools`` itself drifts to ~1e-12 there), about 9× faster
+    arithmetic; ``allantools`` itself drifts to ~1e-12 there), 7-9× faster
     than ``allantools.oadev`` at 10^8 samples on two threads (5× and more with
     ``taus="all"`` on records of 10^4 to 4·10^4 samples), identical bit
-    for bit from run to run. The first call in a fresh environment compiles
-    the kernels (~25 s, cached in ``__pycache__`` afterwards).
+    for bit from run to run. The first call of a statistic in a fresh
+    environment compiles its kernels (~10 s, and ~6 s more for the many-τ
+    kernel; cached in ``__pycache__`` afterwards).
 
     Parameters
     ----------
