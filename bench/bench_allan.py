@@ -9,7 +9,7 @@ no second copy; both are measured in the same run. Reported per size: seconds
 and samples per second of each, ``speed_ratio`` (allantools / ours), peak RSS
 and extra memory (peak RSS minus the input's size) of each, the kernels'
 first-call time in the child (loading the cached compilation; a fresh
-environment compiles for ~25 s) and the largest relative difference of the
+environment compiles for ~10 s) and the largest relative difference of the
 deviations (the τ lists and term counts must be identical).
 
 Run alone with ``python bench/bench_allan.py [--quick]`` or through ``bench/run.py``.
