@@ -261,6 +261,7 @@ def test_constants_are_printed_to_round_trip(frequency_model, tmp_path):
     assert "doi:10.3390/s120506434" in text and "synthetic-1" in text
     assert "#include <stdio.h>" not in code and "malloc" not in code
     assert all(ord(c) < 128 for c in text + code)
+    assert "TEMPERATURE SENSOR" not in text  # a resonator thermometer: the Hz are Hz
 
 
 def test_refuses_to_overwrite_without_force(frequency_model, tmp_path):

@@ -72,6 +72,25 @@ def _term_expression(term: Term, t: CType = DOUBLE) -> str:
 
 
 
+def sensor_note(model: UnitModel) -> list[str]:
+    """Lines that say, for a model whose thermometer is the gyro's temperature sensor
+    (``calibrate --thermometer sensor``), that every "Hz" of the export means °C.
+
+    The export's text names f and df/dt in Hz and Hz/s throughout; with a sensor
+    thermometer the input called freq_hz is a temperature. Empty for a resonator.
+    """
+    if model.thermometer.source != "sensor":
+        return []
+    return [
+        "THERMOMETER: THE GYRO'S TEMPERATURE SENSOR (calibrate --thermometer sensor)",
+        "  This unit has no frequency output. The input named freq_hz is the temperature",
+        "  sensor's reading [degC], not a frequency: wherever this file says Hz or Hz/s",
+        "  for freq_hz, f, df/dt, f_ref or their ranges, read degC and degC/s. The",
+        "  thermometer is the identity, so resonator_c_est is that reading.",
+        "",
+    ]
+
+
 def readme(model: UnitModel, plan: CPlan, prefix: str, origin: str,
             sha256: str, sections: list[str] | None = None) -> str:
     """The README comment block at the top of the header: what, provenance, Eq. (22), units, use.
@@ -121,8 +140,8 @@ def readme(model: UnitModel, plan: CPlan, prefix: str, origin: str,
 
     housing_arg = "".join(f"double {name}, " for name in step_inputs(plan))
     housing_use = "".join(f"{name}, " for name in step_inputs(plan))
+    lines += ["", *sensor_note(model)]
     lines += [
-        "",
         "THE MODEL (Eq. (22) form of [1]; coefficients rounded here for reading)",
         f"  B = {drift.intercept_dph:.10g}{terms}   [deg/h]",
         f"  f  = freq_hz - f_ref, f_ref = {settings.reference_freq_hz:.12g} Hz "

@@ -20,7 +20,7 @@ from __future__ import annotations
 from typing import Any
 
 from hrgtc.compensate.c_plan import CPlan
-from hrgtc.compensate.c_text import NEWTON_MAX_ITER
+from hrgtc.compensate.c_text import NEWTON_MAX_ITER, sensor_note
 from hrgtc.compensate.c_types import DOUBLE
 from hrgtc.drift.features import VARIABLES, settle_rows
 from hrgtc.model import UnitModel
@@ -210,6 +210,7 @@ def _head(model: UnitModel, origin: str, sha256: str, key: str = "") -> list[str
         f"{prov.get('created_utc', 'time unknown')}",
         f"exported by:     hrgtc {__version__}",
         "",
+        *sensor_note(model),
         *formula(key),
         "",
         f"[1] {PAPER_REFERENCE}",
