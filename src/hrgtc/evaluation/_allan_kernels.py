@@ -196,9 +196,7 @@ def _increments(y, mean, m, start, e):
     at 1.8 instead of 0.37 ns a term).
     """
     n = e.size
-    y0 = y[start:start + n]
-    y1 = y[start + m:start + m + n]
-    y2 = y[start + 2 * m:start + 2 * m + n]
+    y0, y1, y2, _ = _lagged(y, start, m, n)
     for k in range(n):
         e[k] = ((y2[k] - mean) + (y0[k] - mean)) - 2.0 * (y1[k] - mean)
 
