@@ -37,6 +37,7 @@ from hrgtc.drift.features import (
     SWITCH_FRACTION,
     FeatureSettings,
     FeatureStream,
+    ParsedTerms,
     Term,
     hierarchy,
     is_aux,
@@ -63,7 +64,7 @@ TAU2_FACTOR = 6.0
 
 
 @dataclass(frozen=True)
-class DriftModel:
+class DriftModel(ParsedTerms):
     """A fitted bias model B = B0 + sum k_i term_i (Eq. 22 of [1]).
 
     Attributes
@@ -121,14 +122,6 @@ class DriftModel:
     selection: str = "stepwise"
     cross_validation: CrossValidation | None = None
     _terms: tuple[Term, ...] = field(default=(), repr=False, compare=False)
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "_terms", parse_terms(self.selected) if self.selected else ())
-
-    @property
-    def terms(self) -> tuple[Term, ...]:
-        """The selected terms, parsed (in ``selected`` order)."""
-        return self._terms
 
     @property
     def history(self) -> tuple[Any, ...]:

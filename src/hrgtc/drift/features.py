@@ -253,6 +253,23 @@ def parse_terms(texts: Iterable[str]) -> tuple[Term, ...]:
     return terms
 
 
+class ParsedTerms:
+    """Mixin of the frozen dataclasses that hold ``selected`` term texts and a ``_terms``
+    field (the drift and scale-factor models): the texts are parsed once, at
+    construction, into :attr:`terms`."""
+
+    selected: tuple[str, ...]
+    _terms: tuple[Term, ...]
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "_terms", parse_terms(self.selected) if self.selected else ())
+
+    @property
+    def terms(self) -> tuple[Term, ...]:
+        """The selected terms, parsed (in ``selected`` order)."""
+        return self._terms
+
+
 #: Eq. (21) of [1]: the nine candidate terms of the drift model, f = frequency
 #: change, df = its rate of change df/dt.
 EQ21_TERMS = ("f", "f^2", "f^3", "df", "df^2", "df^3", "f*df", "f^2*df", "f*df^2")

@@ -36,6 +36,7 @@ import numpy as np
 
 from hrgtc.drift.features import (
     FeatureSettings,
+    ParsedTerms,
     Term,
     linear_combination,
     parse_terms,
@@ -107,7 +108,7 @@ class ScaleGroup:
 
 
 @dataclass(frozen=True, eq=False)
-class ScaleFactorModel:
+class ScaleFactorModel(ParsedTerms):
     """A fitted scale-factor error k_ppm = c0 + sum c_i term_i(f).
 
     Attributes
@@ -161,14 +162,6 @@ class ScaleFactorModel:
     penter: float = 0.05
     premove: float = 0.10
     _terms: tuple[Term, ...] = field(default=(), repr=False, compare=False)
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "_terms", parse_terms(self.selected) if self.selected else ())
-
-    @property
-    def terms(self) -> tuple[Term, ...]:
-        """The selected terms, parsed."""
-        return self._terms
 
     def _args(self, freq_hz: Any) -> tuple[dict[str, np.ndarray], dict[str, float],
                                            dict[str, tuple[float, float]]]:
