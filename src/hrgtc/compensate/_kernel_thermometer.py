@@ -48,19 +48,25 @@ def _start_and_step(f, f_low, f_high, map_offset, map_scale, chebyshev, t_low, t
     return t - step, step
 
 
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _value_and_slope(poly, slope, z):  # pragma: no cover - compiled
+    """The thermometer polynomial and its derivative series at scaled z (Horner)."""
+    value = poly[poly.size - 1]
+    for j in range(poly.size - 2, -1, -1):
+        value = value * z + poly[j]
+    derivative = slope[slope.size - 1]
+    for j in range(slope.size - 2, -1, -1):
+        derivative = derivative * z + slope[j]
+    return value, derivative
+
+
 @njit(cache=True, nogil=True, error_model="numpy")
 def _newton_scalar(t, clipped, poly, slope, centre, scale_c, tolerance):  # pragma: no cover
     """Up to three more Newton steps of one sample whose first step was above the limit."""
     step = np.inf
     limit = tolerance
     for _ in range(3):
-        z = (t - centre) / scale_c
-        value = poly[poly.size - 1]
-        for j in range(poly.size - 2, -1, -1):
-            value = value * z + poly[j]
-        derivative = slope[slope.size - 1]
-        for j in range(slope.size - 2, -1, -1):
-            derivative = derivative * z + slope[j]
+        value, derivative = _value_and_slope(poly, slope, (t - centre) / scale_c)
         step = (value - clipped) / (derivative / scale_c)
         t -= step
         if not abs(step) > limit:
@@ -91,13 +97,7 @@ def _bracketed_scalar(fi, grid_t, grid_f, poly, slope, centre, scale_c,
     t = upper if t > upper else t
     increasing = grid_t[size - 1] > grid_t[0]
     for _ in range(NEWTON_MAX_ITER):
-        z = (t - centre) / scale_c
-        value = poly[poly.size - 1]
-        for j in range(poly.size - 2, -1, -1):
-            value = value * z + poly[j]
-        derivative = slope[slope.size - 1]
-        for j in range(slope.size - 2, -1, -1):
-            derivative = derivative * z + slope[j]
+        value, derivative = _value_and_slope(poly, slope, (t - centre) / scale_c)
         residual = value - fi
         candidate = t - residual / (derivative / scale_c)
         if (residual > 0) == increasing:
