@@ -49,3 +49,7 @@ class SpikeWarning(HrgtcWarning):
 
 class PrecisionWarning(HrgtcWarning):
     """A computation ran at lower precision than asked (no extended-precision type here)."""
+
+
+class UnitWarning(HrgtcWarning):
+    """Values were reinterpreted on reading (e.g. a signed count stored unsigned, unwrapped)."""

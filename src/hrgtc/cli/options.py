@@ -1,7 +1,7 @@
 """Options shared by the ``hrgtc`` commands, defined once.
 
 Use the ``Annotated`` aliases as parameter types. Commands that read
-recordings get the twelve reading options (column mapping, units, sample rate,
+recordings get the shared reading options (column mapping, units, sample rate,
 unit name, input rate, gap policy, and for messy IMU files temperature scale and
 offset, spikes and the thermometer) from :func:`reading_options` and receive them as one
 :class:`hrgtc.recording.ReadOptions`, the type the library takes::
@@ -112,13 +112,36 @@ ColumnsOption = Annotated[
         rich_help_panel=_INPUT,
     ),
 ]
+#: The conversions of each unit option, written out from
+#: :func:`hrgtc.recording.units.unit_help` (``--help`` must not import numpy; a test
+#: checks that they agree).
+UNIT_HELP = {
+    "time": (
+        'to s: s (s, ×1); ms (ms, /1000); us (µs, /10^6); ns (ns, /10^9); timestamp '
+        '(ISO 8601, seconds since the first sample)'
+    ),
+    "freq": (
+        'to Hz: Hz (Hz, ×1); kHz (kHz, ×1000)'
+    ),
+    "rate": (
+        'to °/h: dph (°/h, ×1); dps (°/s, ×3600); mdps (m°/s, ×3.6); radps (rad/s, '
+        '×648000/π); mradps (mrad/s, ×648/π); drad (Δθ rad/sample, ×648000/π ÷ Δt); '
+        'ddeg (Δθ °/sample, ×3600 ÷ Δt); lsb (LSB, ×3600/K, K = --rate-scale LSB per '
+        '°/s)'
+    ),
+    "temp": (
+        'to °C: C (°C, ×1); F (°F, (F − 32)×5/9); K (K, − 273.15); count (raw count, × '
+        '--temp-scale + --temp-offset, or a --temp-ref log)'
+    ),
+}
+
+
 TimeUnitOption = Annotated[
     str | None,
     typer.Option(
         "--time-unit",
-        metavar="s|ms|us|timestamp",
-        help="Unit of the time column: seconds, milliseconds, microseconds or ISO 8601 "
-        "timestamps (converted to seconds since the first sample); default s.",
+        metavar="s|ms|us|ns|timestamp",
+        help="Unit of the time column, " + UNIT_HELP["time"] + "; default s.",
         callback=_unit_callback("time"),
         rich_help_panel=_INPUT,
     ),
@@ -128,7 +151,7 @@ FreqUnitOption = Annotated[
     typer.Option(
         "--freq-unit",
         metavar="Hz|kHz",
-        help="Unit of the frequency column; default Hz.",
+        help="Unit of the frequency column, " + UNIT_HELP["freq"] + "; default Hz.",
         callback=_unit_callback("freq"),
         rich_help_panel=_INPUT,
     ),
@@ -137,10 +160,43 @@ RateUnitOption = Annotated[
     str | None,
     typer.Option(
         "--rate-unit",
-        metavar="dph|dps|radps",
-        help="Unit of the gyro rate columns (every rate_dph* and input_rate_dph* column): °/h "
-        "(dph), °/s (dps) or rad/s (radps); default dph.",
+        metavar="UNIT",
+        help="Unit of the gyro rate columns (every rate_dph* and input_rate_dph* column), "
+        + UNIT_HELP["rate"] + "; Δt is each sample's time step (the median period after a "
+        "gap); default dph.",
         callback=_unit_callback("rate"),
+        rich_help_panel=_INPUT,
+    ),
+]
+RateScaleOption = Annotated[
+    float | None,
+    typer.Option(
+        "--rate-scale",
+        metavar="K",
+        help="With --rate-unit lsb: the datasheet's sensitivity K in LSB per °/s "
+        "(rate [°/h] = count × 3600 / K).",
+        rich_help_panel=_INPUT,
+    ),
+]
+TempUnitOption = Annotated[
+    str | None,
+    typer.Option(
+        "--temp-unit",
+        metavar="C|F|K|count",
+        help="Unit of the temperature columns, " + UNIT_HELP["temp"] + "; °F and K convert "
+        "every temperature column, a count only temperature_c*; default C.",
+        callback=_unit_callback("temp"),
+        rich_help_panel=_INPUT,
+    ),
+]
+TempUnwrapOption = Annotated[
+    str | None,
+    typer.Option(
+        "--temp-unwrap",
+        metavar="auto|off",
+        help="A raw temperature count that sits just under 2^16 or 2^32 is a signed count "
+        "stored unsigned and is unwrapped (65236 -> -300), with a warning (auto, default); "
+        "off reads it as it is.",
         rich_help_panel=_INPUT,
     ),
 ]
@@ -254,12 +310,17 @@ def recording_input(
     temp_offset: float | None = None,
     spikes: SpikePolicy | str | None = None,
     thermometer: Thermometer | str | None = None,
+    rate_scale: float | None = None,
+    temp_unit: str | None = None,
+    temp_unwrap: str | None = None,
 ) -> ReadOptions:
     """Gather the values of the shared reading options into a :class:`ReadOptions`."""
     from hrgtc.recording import ReadOptions
     from hrgtc.recording.mapping import parse_columns
 
-    units = {"time": time_unit, "freq": freq_unit, "rate": rate_unit}
+    units = {"time": time_unit, "freq": freq_unit, "rate": rate_unit, "temp": temp_unit}
+    if temp_unwrap not in (None, "auto", "off"):
+        raise typer.BadParameter(f"--temp-unwrap must be auto or off, got {temp_unwrap!r}")
     overrides = {"sample_rate_hz": sample_rate_hz, "unit": unit_name,
                  "input_rate_dph": input_rate_dph}
     return ReadOptions(
@@ -271,6 +332,8 @@ def recording_input(
         temp_offset_c=0.0 if temp_offset is None else float(temp_offset),
         spikes=str(getattr(spikes, "value", spikes) or "error"),
         thermometer=str(getattr(thermometer, "value", thermometer) or "resonator"),
+        rate_scale=None if rate_scale is None else float(rate_scale),
+        temp_unwrap=temp_unwrap or "auto",
     )
 
 
@@ -280,12 +343,15 @@ _READING_OPTIONS: tuple[tuple[str, Any], ...] = (
     ("time_unit", TimeUnitOption),
     ("freq_unit", FreqUnitOption),
     ("rate_unit", RateUnitOption),
+    ("rate_scale", RateScaleOption),
     ("sample_rate_hz", SampleRateOption),
     ("unit_name", UnitNameOption),
     ("input_rate_dph", InputRateOption),
     ("gaps", _ReadingGapsOption),
     ("temp_scale", TempScaleOption),
     ("temp_offset", TempOffsetOption),
+    ("temp_unit", TempUnitOption),
+    ("temp_unwrap", TempUnwrapOption),
     ("spikes", SpikesOption),
     ("thermometer", ThermometerOption),
 )
@@ -295,7 +361,7 @@ def reading_options(command: Callable[..., Any]) -> Callable[..., Any]:
     """Give a command the shared reading options, defined once here.
 
     The decorated function takes ``inputs: ReadOptions`` (as its last
-    parameter) instead of the twelve options; the command line still shows
+    parameter) instead of the separate options; the command line still shows
     ``--col``, ``--time-unit``, ``--freq-unit``, ``--rate-unit``, ``--sample-rate-hz``,
     ``--unit-name``, ``--input-rate-dph``, ``--gaps``, ``--temp-scale``,
     ``--temp-offset``, ``--spikes`` and ``--thermometer``.

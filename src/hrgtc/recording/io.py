@@ -125,6 +125,8 @@ def _metadata(
         extra["sample_rate_inferred"] = True
     if plan.thermometer == "sensor":
         extra["thermometer"] = "sensor"
+    if plan.wrap_bits is not None:
+        extra["temperature_count_bits"] = plan.wrap_bits
     if plan.time_origin_ns is not None and "time_origin" not in extra:
         extra["time_origin"] = str(np.datetime64(plan.time_origin_ns, "ns"))
     data["extra"] = extra
@@ -149,6 +151,8 @@ def read(
     temp_offset_c: float = 0.0,
     spikes: str = "error",
     thermometer: str = "resonator",
+    rate_scale: float | None = None,
+    temp_unwrap: str = "auto",
 ) -> Recording:
     """Read a whole recording from Parquet, CSV or HDF5 (by suffix).
 
@@ -178,6 +182,14 @@ def read(
         (rows with a non-finite or implausible value are removed, and counted).
     thermometer
         ``"resonator"`` or ``"sensor"``: ``freq_hz`` is the ``temperature_c`` column.
+    rate_scale
+        LSB per °/s of a rate logged as a raw count (``units={"rate": "lsb"}``).
+    temp_unwrap
+        ``"auto"``: a raw temperature count (a count unit, ``temp_scale`` or
+        ``temp_offset_c``) that sits just under 2^16 or 2^32 is a signed count stored
+        unsigned and is unwrapped (65236 -> -300), with a
+        :class:`~hrgtc.errors.UnitWarning` and ``extra["temperature_count_bits"]``;
+        ``"off"``: read as it is.
 
     Returns
     -------
@@ -194,7 +206,8 @@ def read(
     check_spike_policy(spikes)
     spike_filter = SpikeFilter(thermometer, str(path)) if spikes == "drop" else None
     with open_source(path) as source:
-        plan = plan_columns(source, columns, units, temp_scale, temp_offset_c, thermometer)
+        plan = plan_columns(source, columns, units, temp_scale, temp_offset_c, thermometer,
+                            rate_scale, temp_unwrap)
         columns = table_columns(source.read(plan.read_names, plan.as_text))
         arrays = convert_columns(plan, columns, 0)
         if spike_filter is not None:
@@ -252,6 +265,8 @@ def iter_chunks(
     temp_offset_c: float = 0.0,
     spikes: str = "error",
     thermometer: str = "resonator",
+    rate_scale: float | None = None,
+    temp_unwrap: str = "auto",
 ) -> Iterator[Recording]:
     """Stream a recording in chunks of ``rows`` rows without loading the file.
 
@@ -283,7 +298,8 @@ def iter_chunks(
     validator = (RecordingValidator(gaps, freq_band_hz, freq_span_hz, thermometer)
                  if validate else None)
     with open_source(path) as source:
-        plan = plan_columns(source, columns, units, temp_scale, temp_offset_c, thermometer)
+        plan = plan_columns(source, columns, units, temp_scale, temp_offset_c, thermometer,
+                            rate_scale, temp_unwrap)
         offset = 0
 
         def converted() -> Iterator[dict[str, np.ndarray]]:
@@ -350,7 +366,8 @@ class ReadOptions:
     columns
         Recording column -> the file's column (see :func:`read`).
     units
-        ``{"time"|"freq"|"rate": unit}`` of the file's columns.
+        ``{"time"|"freq"|"rate"|"temp": unit}`` of the file's columns (see
+        :mod:`hrgtc.recording.units`).
     metadata
         Metadata overrides (``sample_rate_hz``, ``unit``, ``input_rate_dph``).
     gaps
@@ -372,6 +389,10 @@ class ReadOptions:
         Read one axis of a multi-axis file: every axis is validated, the single-axis
         view of this one returned (:func:`~hrgtc.recording.axis_view`), and the
         plausible band checked on its frequency only. None: the file as it is.
+    rate_scale
+        LSB per °/s of a rate logged as a raw count (``--rate-unit lsb --rate-scale K``).
+    temp_unwrap
+        ``"auto"`` or ``"off"``: a signed temperature count stored unsigned (see :func:`read`).
     """
 
     columns: Mapping[str, str] | None = None
@@ -386,6 +407,8 @@ class ReadOptions:
     spikes: str = "error"
     thermometer: str = "resonator"
     axis: str | None = None
+    rate_scale: float | None = None
+    temp_unwrap: str = "auto"
 
     def keywords(self) -> dict[str, Any]:
         """The options as keyword arguments of :func:`read` and :func:`iter_chunks`.
@@ -398,7 +421,7 @@ class ReadOptions:
         if self.freq_band_hz is not None:
             words.update(freq_band_hz=self.freq_band_hz, freq_span_hz=self.freq_span_hz)
         defaults = {"temp_scale": 1.0, "temp_offset_c": 0.0, "spikes": "error",
-                    "thermometer": "resonator"}
+                    "thermometer": "resonator", "rate_scale": None, "temp_unwrap": "auto"}
         words.update({key: getattr(self, key) for key, default in defaults.items()
                       if getattr(self, key) != default})
         return words

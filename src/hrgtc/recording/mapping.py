@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import difflib
 import math
+import warnings
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -30,75 +31,54 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.compute as pc
 
-from hrgtc.errors import InputError, RecordingError
+from hrgtc.errors import InputError, RecordingError, UnitWarning
 from hrgtc.recording.axes import AXIS_COLUMNS, axis_names, base_name, split_axis
 from hrgtc.recording.checks import check_thermometer
 from hrgtc.recording.csv import bad_number_hint
 from hrgtc.recording.formats import Source, first_failing
 from hrgtc.recording.schema import COLUMNS
+from hrgtc.recording.units import UNITS, find_unit, median_period, per_sample_steps, unit_of
 
-#: kind -> canonical unit -> accepted spellings (compared case-insensitively).
-UNIT_SPELLINGS: dict[str, dict[str, tuple[str, ...]]] = {
-    "time": {
-        "s": ("s", "sec", "second", "seconds"),
-        "ms": ("ms", "msec", "millisecond", "milliseconds"),
-        "us": ("us", "µs", "μs", "usec", "microsecond", "microseconds"),
-        "timestamp": ("timestamp", "datetime", "iso", "iso8601"),
-    },
-    "freq": {"Hz": ("hz",), "kHz": ("khz",)},
-    "rate": {
-        "dph": ("dph", "°/h", "deg/h", "deg/hr", "°/hr"),
-        "dps": ("dps", "°/s", "deg/s", "deg/sec"),
-        "radps": ("radps", "rad/s", "rad/sec"),
-    },
-}
+#: kind -> canonical unit -> accepted spellings (compared case-insensitively); from
+#: the one table of units, :data:`hrgtc.recording.units.UNITS`.
+UNIT_SPELLINGS: dict[str, dict[str, tuple[str, ...]]] = {}
+for _unit in UNITS:
+    UNIT_SPELLINGS.setdefault(_unit.kind, {})[_unit.name] = _unit.spellings
 #: Contract column converted by each kind of unit.
-UNIT_COLUMNS = {"time": "time_s", "freq": "freq_hz", "rate": "rate_dph"}
+UNIT_COLUMNS = {"time": "time_s", "freq": "freq_hz", "rate": "rate_dph", "temp": "temperature_c"}
 #: Kind of unit of each contract column (per-axis columns by their contract name).
-UNIT_KINDS = {"time_s": "time", "freq_hz": "freq", "rate_dph": "rate", "input_rate_dph": "rate"}
+UNIT_KINDS = {"time_s": "time", "freq_hz": "freq", "rate_dph": "rate", "input_rate_dph": "rate",
+              "temperature_c": "temp", "chamber_c": "temp", "housing_c": "temp",
+              "resonator_c": "temp"}
+_PLAIN_UNITS = {u.name: u for u in UNITS if not (u.per_sample or u.scaled)}
 
 
 def to_contract_unit(values: np.ndarray, unit: str) -> np.ndarray:
-    """Convert values in a canonical unit to the contract's s, Hz or °/h.
+    """Convert values in a canonical unit to the contract's s, Hz, °/h or °C.
 
-    ``ms`` / 1000, ``us`` / 10^6, ``kHz`` × 1000, ``dps`` × 3600, ``radps`` × (180/π) × 3600;
-    ``s``, ``Hz`` and ``dph`` unchanged (same array).
+    The factors of :data:`hrgtc.recording.units.UNITS` (``ms`` / 1000, ``kHz`` × 1000,
+    ``radps`` × 648000/π, ``F`` (F − 32) × 5/9, ...); the contract's own units, an
+    unknown name and the units that need time steps or a scale unchanged (same array).
     """
-    if unit == "ms":
-        return values / 1000.0
-    if unit == "us":
-        return values / 1e6
-    if unit == "kHz":
-        return values * 1000.0
-    if unit == "dps":
-        return values * 3600.0
-    if unit == "radps":
-        return values * (180.0 / math.pi) * 3600.0
-    return values
+    found = _PLAIN_UNITS.get(unit)
+    return values if found is None else found.apply(values)
 
 
 def parse_unit(kind: str, text: str) -> str:
-    """Canonical unit name (``"s"``, ``"kHz"``, ``"dps"``, ...) of a spelling.
+    """Canonical unit name (``"s"``, ``"kHz"``, ``"mradps"``, ``"F"``, ...) of a spelling.
 
     Parameters
     ----------
     kind
-        ``"time"``, ``"freq"`` or ``"rate"``.
+        ``"time"``, ``"freq"``, ``"rate"`` or ``"temp"``.
     text
-        A spelling such as ``"kHz"``, ``"°/s"``, ``"rad/s"`` or ``"ms"``.
+        A spelling such as ``"kHz"``, ``"°/s"``, ``"mrad/s"``, ``"ms"`` or ``"°F"``.
     """
-    if kind not in UNIT_SPELLINGS:
-        raise InputError(f"unknown unit kind {kind!r}; use one of {list(UNIT_SPELLINGS)}")
-    wanted = str(text).strip().lower().replace(" ", "")
-    for canonical, spellings in UNIT_SPELLINGS[kind].items():
-        if wanted == canonical.lower() or wanted in spellings:
-            return canonical
-    known = ", ".join(UNIT_SPELLINGS[kind])
-    raise InputError(f"unknown {kind} unit {text!r}; use one of {known}")
+    return find_unit(kind, text).name
 
 
 def parse_units(units: Mapping[str, str] | None) -> dict[str, str]:
-    """``{"time"|"freq"|"rate": spelling}`` -> canonical units (missing kinds left out)."""
+    """``{"time"|"freq"|"rate"|"temp": spelling}`` -> canonical units (missing kinds left out)."""
     return {kind: parse_unit(kind, text) for kind, text in (units or {}).items()}
 
 
@@ -163,20 +143,54 @@ class ColumnPlan:
     temp_offset_c: float = 0.0
     thermometer: str = "resonator"
     axes: tuple[str, ...] = ()
+    rate_scale: float | None = None
+    temp_unwrap: str = "auto"
+    previous_time_s: float | None = None
+    period_s: float | None = None
+    wrap_bits: int | None = None
+    wrap_decided: bool = False
+
+    @property
+    def temperature_is_count(self) -> bool:
+        """True when ``temperature_c*`` holds a raw count (a count unit, a scale or an offset)."""
+        return (self.units.get("temp") == "count" or self.temp_scale != 1.0
+                or self.temp_offset_c != 0.0)
 
 
 def plan_columns(source: Source, columns: Any, units: Mapping[str, str] | None,
                  temp_scale: float = 1.0, temp_offset_c: float = 0.0,
-                 thermometer: str = "resonator") -> ColumnPlan:
+                 thermometer: str = "resonator", rate_scale: float | None = None,
+                 temp_unwrap: str = "auto") -> ColumnPlan:
     """Decide which of the file's columns become which recording columns, in which unit.
 
     Contract columns come first in the order of :data:`hrgtc.recording.COLUMNS`
     (per-axis ones by their contract name, in file order), then the file's other
-    numeric columns under their own names.
+    numeric columns under their own names. ``rate_scale`` is the LSB per °/s of a
+    rate logged as a raw count (``units={"rate": "lsb"}``); ``temp_unwrap``
+    (``"auto"`` or ``"off"``) whether a raw temperature count that sits just
+    under 2^16 or 2^32 is read as a signed count stored unsigned.
     """
     mapping = parse_columns(columns)
     canon = parse_units(units)
     check_thermometer(thermometer)
+    rate_unit = unit_of("rate", canon.get("rate", "dph"))
+    if rate_unit.scaled:
+        usable = isinstance(rate_scale, int | float) and math.isfinite(rate_scale)
+        if not usable or rate_scale == 0:
+            raise InputError(f"a rate logged as a raw count (--rate-unit lsb) needs its scale in "
+                             f"LSB per °/s, a finite number other than 0, got {rate_scale!r}; "
+                             "pass --rate-scale K from the datasheet (e.g. 131 for ±250 °/s "
+                             "on 16 bits)")
+    elif rate_scale is not None:
+        raise InputError(f"--rate-scale {rate_scale!r} is the LSB per °/s of a raw count; give "
+                         "it with --rate-unit lsb (the rate unit is "
+                         f"{rate_unit.symbol})")
+    if temp_unwrap not in ("auto", "off"):
+        raise InputError(f"temp_unwrap must be 'auto' or 'off', got {temp_unwrap!r}")
+    if canon.get("temp") not in (None, "C", "count") and (temp_scale != 1.0
+                                                            or temp_offset_c != 0.0):
+        raise InputError(f"--temp-scale/--temp-offset map a raw count to °C; with --temp-unit "
+                         f"{canon['temp']} the temperature is not a count: drop one of them")
     for name, value in (("temp_scale", temp_scale), ("temp_offset_c", temp_offset_c)):
         usable = isinstance(value, int | float) and math.isfinite(value)
         if not usable or (name == "temp_scale" and value == 0):
@@ -219,7 +233,9 @@ def plan_columns(source: Source, columns: Any, units: Mapping[str, str] | None,
     names = list(dict.fromkeys(theirs for theirs, _ in pairs))
     return ColumnPlan(source, pairs, as_text, canon, stamped, read_names=names, axes=axes,
                       temp_scale=float(temp_scale), temp_offset_c=float(temp_offset_c),
-                      thermometer=thermometer)
+                      thermometer=thermometer,
+                      rate_scale=None if rate_scale is None else float(rate_scale),
+                      temp_unwrap=temp_unwrap)
 
 
 def _check_sensor_columns(source: Source, names: list[str]) -> None:
@@ -247,6 +263,82 @@ def sensor_frequency(columns: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         columns[f"freq_hz{suffix}"] = columns.get(f"temperature_c{suffix}",
                                                    columns.get("temperature_c"))
     return columns
+
+
+def _rate_values(plan: ColumnPlan, values: np.ndarray, time_s: np.ndarray | None,
+                 theirs: str) -> np.ndarray:
+    """A rate column in °/h: a factor, a raw count's scale, or an increment per sample ÷ Δt."""
+    unit = unit_of("rate", plan.units.get("rate", "dph"))
+    if unit.scaled:
+        return values * (3600.0 / float(plan.rate_scale or 1.0))
+    if not unit.per_sample:
+        return unit.apply(values)
+    if time_s is None:
+        raise RecordingError(f"{plan.source.path}: column {theirs!r} is an angle increment per "
+                             f"sample ({unit.symbol}), which needs the time column to divide "
+                             "by each sample's Δt; map it with --col time_s=<your column>")
+    if plan.period_s is None:
+        plan.period_s = median_period(time_s)
+        if plan.period_s is None:
+            raise RecordingError(f"{plan.source.path}: column {theirs!r} is an angle increment "
+                                 f"per sample ({unit.symbol}) but time_s has no increasing step "
+                                 "to give a sample's Δt")
+    steps = per_sample_steps(time_s, plan.previous_time_s, plan.period_s)
+    return unit.apply(values) / steps
+
+
+#: A signed count stored unsigned: widths tried and how close under 2^bits it must sit.
+_WRAP_WIDTHS = ((16, 2.0**12), (32, 2.0**24))
+
+
+def _temperature_values(plan: ColumnPlan, values: np.ndarray, base: str,
+                        theirs: str) -> np.ndarray:
+    """A temperature column in °C: °F or K converted; a raw count unwrapped, scaled, offset."""
+    temp = plan.units.get("temp", "C")
+    if temp in ("F", "K"):
+        return unit_of("temp", temp).apply(values)
+    if base != "temperature_c" or not plan.temperature_is_count:
+        return values
+    if plan.temp_unwrap == "auto" and not plan.wrap_decided:
+        plan.wrap_bits = wrapped_count_bits(values)
+        plan.wrap_decided = True
+        if plan.wrap_bits is not None:
+            bits = plan.wrap_bits
+            first = values[np.isfinite(values)][:1]
+            warnings.warn(
+                f"{plan.source.path}: column {theirs!r} sits just under 2^{bits} "
+                f"({first[0]:.0f} at first): read as a signed {bits}-bit count stored unsigned, "
+                f"values from 2^{bits - 1} on taken minus 2^{bits} ({first[0]:.0f} -> "
+                f"{unwrap_count(first, bits)[0]:.0f}); pass --temp-unwrap off if your sensor "
+                "really counts that high", UnitWarning, stacklevel=4)
+    if plan.wrap_bits is not None:
+        values = unwrap_count(values, plan.wrap_bits)
+    if plan.temp_scale != 1.0 or plan.temp_offset_c != 0.0:
+        return values * plan.temp_scale + plan.temp_offset_c
+    return values
+
+
+def wrapped_count_bits(values: np.ndarray) -> int | None:
+    """16 or 32 when a raw count looks like a signed count stored unsigned, else None.
+
+    That is: whole numbers in [0, 2^bits) with the median within 2^12 (2^24 for 32
+    bits) under 2^bits, i.e. small negative numbers read as unsigned ones.
+    """
+    finite = values[np.isfinite(values)]
+    if finite.size == 0 or np.any(finite != np.round(finite)) or finite.min() < 0:
+        return None
+    middle = float(np.median(finite))
+    for bits, near in _WRAP_WIDTHS:
+        top = 2.0**bits
+        if finite.max() < top and top - near <= middle < top:
+            return bits
+    return None
+
+
+def unwrap_count(values: np.ndarray, bits: int) -> np.ndarray:
+    """A signed ``bits``-bit count stored unsigned, signed again (65236 -> -300 for 16 bits)."""
+    half, full = 2.0 ** (bits - 1), 2.0**bits
+    return np.where(values >= half, values - full, values)
 
 
 def _is_text(column: pa.ChunkedArray) -> bool:
@@ -355,8 +447,15 @@ def convert_columns(
             values = _to_float(plan, column, theirs, row_offset)
             base = base_name(name, plan.axes)
             kind = UNIT_KINDS.get(base)
-            out[name] = to_contract_unit(values, plan.units.get(kind, "")) if kind else values
-            if base == "temperature_c" and (plan.temp_scale != 1.0 or plan.temp_offset_c != 0.0):
-                out[name] = out[name] * plan.temp_scale + plan.temp_offset_c
+            if kind == "rate":
+                out[name] = _rate_values(plan, values, out.get("time_s"), theirs)
+            elif kind == "temp":
+                out[name] = _temperature_values(plan, values, base, theirs)
+            elif kind:
+                out[name] = to_contract_unit(values, plan.units.get(kind, ""))
+            else:
+                out[name] = values
         del column
+    if "time_s" in out and len(out["time_s"]):
+        plan.previous_time_s = float(out["time_s"][-1])
     return sensor_frequency(out) if plan.thermometer == "sensor" else out
