@@ -170,7 +170,7 @@ def calibrate_command(
     from hrgtc.model import save_instrument
     from hrgtc.recording import ReadOptions
 
-    inputs = inputs or ReadOptions()
+    inputs = (inputs or ReadOptions()).with_spike_default("drop")
 
     soaks = [*(soak or []), *(extra_soaks or [])]
     with library_errors():

@@ -55,7 +55,13 @@ def compensate_command(
     """
     from hrgtc.compensate import compensate_instrument_file
     from hrgtc.model import load_instrument
+    from hrgtc.recording import ReadOptions
 
+    inputs = (inputs or ReadOptions()).with_spike_default("flag")
+    if inputs.spike_filter == "drop":
+        error_console.print("error: compensate flags spikes, it never drops a row: use "
+                            "--spike-filter flag (a 'spike' column marks them) or off")
+        raise typer.Exit(2)
     with library_errors(), progress_bar("compensating", enabled=not json_output) as progress:
         model = load_instrument(model_path)
         summary = compensate_instrument_file(run, output, model, force=force,
@@ -151,7 +157,7 @@ def evaluate_command(
     from hrgtc.model import load_instrument
     from hrgtc.recording import ReadOptions
 
-    inputs = inputs or ReadOptions()
+    inputs = (inputs or ReadOptions()).with_spike_default("drop")
 
     if deviation not in DEVIATIONS:
         error_console.print(f"error: --deviation {deviation!r} is not known; use one of "

@@ -75,6 +75,14 @@ class SpikePolicy(StrEnum):
     drop = "drop"
 
 
+class SpikeFilterMode(StrEnum):
+    """What to do with single-sample spikes of plausible value."""
+
+    drop = "drop"
+    flag = "flag"
+    off = "off"
+
+
 class Thermometer(StrEnum):
     """What the thermometer of the gyro is."""
 
@@ -275,6 +283,35 @@ SpikesOption = Annotated[
         rich_help_panel=_INPUT,
     ),
 ]
+SpikeFilterOption = Annotated[
+    SpikeFilterMode | None,
+    typer.Option(
+        "--spike-filter",
+        help="Single-sample spikes of plausible value in the rate and thermometer columns "
+        "(beyond max(k·σ_MAD, m·LSB) from both neighbours, σ_MAD over --spike-window-s "
+        "windows that never span a gap): remove their rows (drop; default of calibrate and "
+        "evaluate), mark them in a 'spike' column (flag; compensate's default, which never "
+        "drops) or leave them (off). Their number is reported.",
+        rich_help_panel=_INPUT,
+    ),
+]
+SpikeKOption = Annotated[
+    float | None,
+    typer.Option("--spike-k", metavar="K", help="Spike threshold in robust σ (MAD); default 8.",
+                 rich_help_panel=_INPUT),
+]
+SpikeLsbOption = Annotated[
+    float | None,
+    typer.Option("--spike-lsb", metavar="M",
+                 help="Spike threshold floor in steps of the channel's resolution (LSB), so a "
+                 "quantised stream keeps its pulses; default 4.", rich_help_panel=_INPUT),
+]
+SpikeWindowOption = Annotated[
+    float | None,
+    typer.Option("--spike-window-s", metavar="S",
+                 help="Window of the spike filter's σ_MAD [s]; default 10.",
+                 rich_help_panel=_INPUT),
+]
 ThermometerOption = Annotated[
     Thermometer | None,
     typer.Option(
@@ -313,6 +350,10 @@ def recording_input(
     rate_scale: float | None = None,
     temp_unit: str | None = None,
     temp_unwrap: str | None = None,
+    spike_filter: SpikeFilterMode | str | None = None,
+    spike_k: float | None = None,
+    spike_lsb: float | None = None,
+    spike_window_s: float | None = None,
 ) -> ReadOptions:
     """Gather the values of the shared reading options into a :class:`ReadOptions`."""
     from hrgtc.recording import ReadOptions
@@ -334,6 +375,11 @@ def recording_input(
         thermometer=str(getattr(thermometer, "value", thermometer) or "resonator"),
         rate_scale=None if rate_scale is None else float(rate_scale),
         temp_unwrap=temp_unwrap or "auto",
+        spike_filter=None if spike_filter is None else str(getattr(spike_filter, "value",
+                                                                   spike_filter)),
+        **{name: float(value) for name, value in (("spike_k", spike_k), ("spike_lsb", spike_lsb),
+                                                 ("spike_window_s", spike_window_s))
+           if value is not None},
     )
 
 
@@ -353,6 +399,10 @@ _READING_OPTIONS: tuple[tuple[str, Any], ...] = (
     ("temp_unit", TempUnitOption),
     ("temp_unwrap", TempUnwrapOption),
     ("spikes", SpikesOption),
+    ("spike_filter", SpikeFilterOption),
+    ("spike_k", SpikeKOption),
+    ("spike_lsb", SpikeLsbOption),
+    ("spike_window_s", SpikeWindowOption),
     ("thermometer", ThermometerOption),
 )
 

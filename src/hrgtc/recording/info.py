@@ -20,7 +20,9 @@ from hrgtc.progress import Progress
 from hrgtc.recording.axes import axis_names, base_name
 from hrgtc.recording.formats import format_of
 from hrgtc.recording.io import iter_chunks
+from hrgtc.recording.resolution import resolution
 from hrgtc.recording.schema import COLUMNS, Metadata
+from hrgtc.recording.spikes import SPIKE_COLUMN, SPIKE_K, SPIKE_LSB, SPIKE_WINDOW_S
 from hrgtc.recording.validation import (
     GapPolicy,
     Problem,
@@ -45,21 +47,28 @@ class ColumnSummary:
         Unit of the recording contract (``""`` for a column outside it).
     minimum, maximum
         Smallest and largest finite value, None if there is none. [unit]
+    resolution
+        Smallest step between distinct values of the first chunk read (the
+        logger's resolution, see :func:`hrgtc.recording.resolution.resolution`),
+        None if unknown. [unit]
     """
 
     name: str
     unit: str
     minimum: float | None
     maximum: float | None
+    resolution: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types."""
-        return {"name": self.name, "unit": self.unit, "min": self.minimum, "max": self.maximum}
+        return {"name": self.name, "unit": self.unit, "min": self.minimum, "max": self.maximum,
+                "resolution": self.resolution}
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> ColumnSummary:
         """Inverse of :meth:`to_dict`."""
-        return cls(str(data["name"]), str(data["unit"]), data.get("min"), data.get("max"))
+        return cls(str(data["name"]), str(data["unit"]), data.get("min"), data.get("max"),
+                   data.get("resolution"))
 
 
 @dataclass(frozen=True)
@@ -93,6 +102,9 @@ class RecordingInfo:
         the file could not be read to the end).
     axes
         The axes of a multi-axis recording (``()`` for a single-axis one).
+    spike_rows
+        Rows with a single-sample spike (:func:`hrgtc.recording.spikes.find_spikes`),
+        None when the spike filter was off.
     """
 
     path: str
@@ -108,6 +120,7 @@ class RecordingInfo:
     metadata: dict[str, Any] | None
     validation: ValidationReport
     axes: tuple[str, ...] = ()
+    spike_rows: int | None = None
 
     @property
     def ok(self) -> bool:
@@ -140,7 +153,12 @@ class RecordingInfo:
         lines.append("  columns:")
         for col in self.columns:
             unit = f"[{col.unit}]" if col.unit else "[?]"
-            lines.append(f"    {col.name:<16} {unit:<8} {_num(col.minimum)} .. {_num(col.maximum)}")
+            step = "" if col.resolution is None else f"  (steps of {col.resolution:.3g})"
+            lines.append(f"    {col.name:<16} {unit:<8} {_num(col.minimum)} .. "
+                         f"{_num(col.maximum)}{step}")
+        if self.spike_rows is not None:
+            lines.append(f"  single-sample spikes: {self.spike_rows} row(s) (calibrate and "
+                         "evaluate remove them, compensate flags them; --spike-filter)")
         for col in self._span_columns():
             if col.minimum is not None:
                 unit = "Hz" if col.unit == "Hz" else "°C"
@@ -166,6 +184,7 @@ class RecordingInfo:
             "metadata": self.metadata,
             "validation": self.validation.to_dict(),
             "axes": list(self.axes),
+            "spike_rows": self.spike_rows,
         }
 
     def _span_columns(self) -> list[ColumnSummary]:
@@ -190,6 +209,7 @@ class RecordingInfo:
             metadata=data.get("metadata"),
             validation=ValidationReport.from_dict(data["validation"]),
             axes=tuple(data.get("axes") or ()),
+            spike_rows=data.get("spike_rows"),
         )
 
 
@@ -214,6 +234,12 @@ def describe(
     temp_offset_c: float = 0.0,
     spikes: str = "error",
     thermometer: str = "resonator",
+    rate_scale: float | None = None,
+    temp_unwrap: str = "auto",
+    spike_filter: str | None = "flag",
+    spike_k: float = SPIKE_K,
+    spike_lsb: float = SPIKE_LSB,
+    spike_window_s: float = SPIKE_WINDOW_S,
 ) -> RecordingInfo:
     """Summarise and validate a recording file in one streaming pass.
 
@@ -221,8 +247,13 @@ def describe(
     ----------
     path, columns, units, metadata, gaps
         As for :func:`hrgtc.recording.read`.
-    temp_scale, temp_offset_c, spikes, thermometer
+    temp_scale, temp_offset_c, spikes, thermometer, rate_scale, temp_unwrap
         As for :func:`hrgtc.recording.read` (messy IMU files).
+    spike_filter, spike_k, spike_lsb, spike_window_s
+        The robust spike filter (see :func:`hrgtc.recording.read`); by default the
+        spikes are flagged and counted (``metadata["extra"]["spikes_flagged"]``), no
+        row is dropped. For the sensor thermometer the ``freq_hz*`` columns, copies
+        of the temperature, are not listed.
     rows
         Rows per chunk read.
     progress
@@ -237,6 +268,8 @@ def describe(
     check_gap_policy(gaps)
     validator = RecordingValidator(gaps, thermometer=thermometer)
     ranges: dict[str, list[float]] = {}
+    steps: dict[str, float] = {}
+    spike_rows: int | None = None if (spike_filter or "off") == "off" else 0
     first_time: float | None = None
     last_time: float | None = None
     meta: Metadata | None = None
@@ -248,18 +281,27 @@ def describe(
         for chunk in iter_chunks(
             path, rows, columns, units, validate=False, metadata=metadata, progress=progress,
             temp_scale=temp_scale, temp_offset_c=temp_offset_c, spikes=spikes,
-            thermometer=thermometer,
+            thermometer=thermometer, rate_scale=rate_scale, temp_unwrap=temp_unwrap,
+            spike_filter=spike_filter or "off", spike_k=spike_k, spike_lsb=spike_lsb,
+            spike_window_s=spike_window_s,
         ):
             meta = chunk.metadata
-            names = names or list(chunk.names)
+            names = names or [n for n in chunk.names if n != SPIKE_COLUMN
+                              and not _sensor_copy(n, chunk.names, thermometer)]
+            if SPIKE_COLUMN in chunk:
+                spike_rows = (spike_rows or 0) + int(np.count_nonzero(chunk[SPIKE_COLUMN]))
             validator.update(chunk)
-            for name in chunk.names:
+            for name in names:
                 values = chunk[name]
                 finite = values[np.isfinite(values)]
                 if finite.size:
                     low, high = float(finite.min()), float(finite.max())
                     old = ranges.setdefault(name, [low, high])
                     old[0], old[1] = min(old[0], low), max(old[1], high)
+                    if first_time is None:  # the first chunk's
+                        step = resolution(finite)
+                        if step is not None:
+                            steps[name] = step
             if "time_s" in chunk:
                 finite = chunk.time_s[np.isfinite(chunk.time_s)]
                 if finite.size:
@@ -294,13 +336,23 @@ def describe(
         sample_rate_inferred=bool(meta is not None and meta.extra.get("sample_rate_inferred")),
         measured_sample_rate_hz=report.measured_sample_rate_hz,
         columns=tuple(
-            ColumnSummary(n, _unit(n, axis_names(names), thermometer), *ranges.get(n, (None, None)))
+            ColumnSummary(n, _unit(n, axis_names(names), thermometer),
+                          *ranges.get(n, (None, None)), steps.get(n))
             for n in names
         ),
         metadata=None if meta is None else meta.to_dict(),
         validation=report,
         axes=axis_names(names),
+        spike_rows=spike_rows,
     )
+
+
+def _sensor_copy(name: str, names: Iterable[str], thermometer: str) -> bool:
+    """True for ``freq_hz*`` of the sensor thermometer (a copy of its temperature column)."""
+    if thermometer != "sensor" or not name.startswith("freq_hz"):
+        return False
+    own = "temperature_c" + name[len("freq_hz"):]
+    return own in names or "temperature_c" in names
 
 
 def _unit(name: str, axes: tuple[str, ...], thermometer: str) -> str:

@@ -51,7 +51,14 @@ from hrgtc.recording.mapping import (
     table_columns,
 )
 from hrgtc.recording.schema import SCHEMA_VERSION, Metadata, Recording, concatenate
-from hrgtc.recording.spikes import SpikeFilter, check_spike_policy
+from hrgtc.recording.spikes import (
+    SPIKE_K,
+    SPIKE_LSB,
+    SPIKE_WINDOW_S,
+    RobustSpikeFilter,
+    SpikeFilter,
+    check_spike_policy,
+)
 from hrgtc.recording.validation import (
     HEURISTIC_ROWS,
     GapPolicy,
@@ -61,6 +68,9 @@ from hrgtc.recording.validation import (
 )
 from hrgtc.recording.validation import validate as validate_recording
 from hrgtc.recording.writing import RecordingWriter, write
+
+#: Metadata key counting the rows of robust spikes, by ``spike_filter``.
+_SPIKE_KEYS = {"drop": "spikes_removed", "flag": "spikes_flagged"}
 
 SOURCES: dict[str, type[Source]] = {"parquet": ParquetSource, "csv": CsvSource, "hdf5": Hdf5Source}
 
@@ -153,6 +163,10 @@ def read(
     thermometer: str = "resonator",
     rate_scale: float | None = None,
     temp_unwrap: str = "auto",
+    spike_filter: str = "off",
+    spike_k: float = SPIKE_K,
+    spike_lsb: float = SPIKE_LSB,
+    spike_window_s: float = SPIKE_WINDOW_S,
 ) -> Recording:
     """Read a whole recording from Parquet, CSV or HDF5 (by suffix).
 
@@ -190,6 +204,14 @@ def read(
         unsigned and is unwrapped (65236 -> -300), with a
         :class:`~hrgtc.errors.UnitWarning` and ``extra["temperature_count_bits"]``;
         ``"off"``: read as it is.
+    spike_filter
+        Single-sample spikes of plausible value in the rate and thermometer columns
+        (:func:`hrgtc.recording.spikes.find_spikes`): ``"off"``, ``"drop"`` (rows
+        removed, counted in ``extra["spikes_removed"]``) or ``"flag"`` (rows kept,
+        a ``spike`` column 1.0 at them, counted in ``extra["spikes_flagged"]``);
+        one :class:`~hrgtc.errors.SpikeWarning` says how many and where.
+    spike_k, spike_lsb, spike_window_s
+        Threshold max(k·σ_MAD, m·LSB) and window [s] of the spike filter.
 
     Returns
     -------
@@ -204,18 +226,24 @@ def read(
     """
     check_gap_policy(gaps)
     check_spike_policy(spikes)
-    spike_filter = SpikeFilter(thermometer, str(path)) if spikes == "drop" else None
+    spike_filter_ = SpikeFilter(thermometer, str(path)) if spikes == "drop" else None
+    robust = RobustSpikeFilter(spike_filter, thermometer, str(path), k=spike_k,
+                               lsb_multiple=spike_lsb, window_s=spike_window_s)
     with open_source(path) as source:
         plan = plan_columns(source, columns, units, temp_scale, temp_offset_c, thermometer,
                             rate_scale, temp_unwrap)
         columns = table_columns(source.read(plan.read_names, plan.as_text))
         arrays = convert_columns(plan, columns, 0)
-        if spike_filter is not None:
-            arrays = spike_filter.drop(arrays, 0)
+        if spike_filter_ is not None:
+            arrays = spike_filter_.drop(arrays, 0)
+        arrays = robust.apply(arrays, 0)
         meta = _metadata(plan, metadata, arrays.get("time_s"))
-    if spike_filter is not None and spike_filter.dropped:
-        meta = replace(meta, extra={**meta.extra, "spikes_dropped": spike_filter.dropped})
-        spike_filter.warn()
+    if spike_filter_ is not None and spike_filter_.dropped:
+        meta = replace(meta, extra={**meta.extra, "spikes_dropped": spike_filter_.dropped})
+        spike_filter_.warn()
+    if spike_filter != "off":
+        meta = replace(meta, extra={**meta.extra, _SPIKE_KEYS[spike_filter]: robust.rows})
+        robust.warn()
     recording = Recording(arrays, meta, source=str(path))
     if validate:
         validate_recording(recording, gaps, freq_band_hz=freq_band_hz, freq_span_hz=freq_span_hz,
@@ -267,6 +295,10 @@ def iter_chunks(
     thermometer: str = "resonator",
     rate_scale: float | None = None,
     temp_unwrap: str = "auto",
+    spike_filter: str = "off",
+    spike_k: float = SPIKE_K,
+    spike_lsb: float = SPIKE_LSB,
+    spike_window_s: float = SPIKE_WINDOW_S,
 ) -> Iterator[Recording]:
     """Stream a recording in chunks of ``rows`` rows without loading the file.
 
@@ -291,7 +323,9 @@ def iter_chunks(
     """
     check_gap_policy(gaps)
     check_spike_policy(spikes)
-    spike_filter = SpikeFilter(thermometer, str(path)) if spikes == "drop" else None
+    spike_filter_ = SpikeFilter(thermometer, str(path)) if spikes == "drop" else None
+    robust = RobustSpikeFilter(spike_filter, thermometer, str(path), k=spike_k,
+                               lsb_multiple=spike_lsb, window_s=spike_window_s)
     if int(rows) < 1:
         raise InputError(f"rows must be a positive number of rows per chunk, got {rows!r}")
     rows = int(rows)
@@ -306,8 +340,9 @@ def iter_chunks(
             nonlocal offset
             for table in source.iter_tables(plan.read_names, plan.as_text, rows):
                 part = convert_columns(plan, table_columns(table), offset)
-                if spike_filter is not None:
-                    part = spike_filter.drop(part, offset)
+                if spike_filter_ is not None:
+                    part = spike_filter_.drop(part, offset)
+                part = robust.apply(part, offset)
                 offset += table.num_rows
                 yield part
 
@@ -344,8 +379,9 @@ def iter_chunks(
                 progress(*source.position())
         if validator is not None:
             validator.finish().raise_for_problems()
-        if spike_filter is not None:
-            spike_filter.warn()
+        if spike_filter_ is not None:
+            spike_filter_.warn()
+        robust.warn()
         if progress is not None:
             total = source.position()[1]
             progress(total, total)
@@ -393,6 +429,10 @@ class ReadOptions:
         LSB per °/s of a rate logged as a raw count (``--rate-unit lsb --rate-scale K``).
     temp_unwrap
         ``"auto"`` or ``"off"``: a signed temperature count stored unsigned (see :func:`read`).
+    spike_filter, spike_k, spike_lsb, spike_window_s
+        The robust spike filter (see :func:`read`); ``spike_filter`` None: the
+        command's default (``calibrate``/``evaluate`` drop, ``compensate`` flags),
+        ``"off"`` in the library.
     """
 
     columns: Mapping[str, str] | None = None
@@ -409,6 +449,10 @@ class ReadOptions:
     axis: str | None = None
     rate_scale: float | None = None
     temp_unwrap: str = "auto"
+    spike_filter: str | None = None
+    spike_k: float = SPIKE_K
+    spike_lsb: float = SPIKE_LSB
+    spike_window_s: float = SPIKE_WINDOW_S
 
     def keywords(self) -> dict[str, Any]:
         """The options as keyword arguments of :func:`read` and :func:`iter_chunks`.
@@ -421,10 +465,16 @@ class ReadOptions:
         if self.freq_band_hz is not None:
             words.update(freq_band_hz=self.freq_band_hz, freq_span_hz=self.freq_span_hz)
         defaults = {"temp_scale": 1.0, "temp_offset_c": 0.0, "spikes": "error",
-                    "thermometer": "resonator", "rate_scale": None, "temp_unwrap": "auto"}
+                    "thermometer": "resonator", "rate_scale": None, "temp_unwrap": "auto",
+                    "spike_filter": None, "spike_k": SPIKE_K, "spike_lsb": SPIKE_LSB,
+                    "spike_window_s": SPIKE_WINDOW_S}
         words.update({key: getattr(self, key) for key, default in defaults.items()
                       if getattr(self, key) != default})
         return words
+
+    def with_spike_default(self, mode: str) -> ReadOptions:
+        """These options with ``spike_filter`` set to ``mode`` unless the user chose one."""
+        return self if self.spike_filter is not None else replace(self, spike_filter=mode)
 
     def read(self, path: str | Path, keep: Sequence[str] | None = None) -> Recording:
         """The whole file; with ``keep``, streamed keeping only those columns (less memory)."""

@@ -184,6 +184,8 @@ class RecordingValidator:
             self._sample = {name: [] for name in sampled if name in chunk}
         offset, n = self.rows, len(chunk)
         for name in chunk.names:
+            if self._sensor_copy(name, chunk):
+                continue  # the temperature column it copies is checked (and named) itself
             values = chunk[name]
             low, high, _ = self._bounds.get(base_name(name, self.axes), (-np.inf, np.inf, ""))
             extremes = finite_extremes(values)
@@ -206,6 +208,14 @@ class RecordingValidator:
         if self._heuristics is None:
             self._collect_sample(chunk)
         self.rows += n
+
+    def _sensor_copy(self, name: str, chunk: Recording) -> bool:
+        """True for ``freq_hz*`` of the sensor thermometer: a copy of a temperature column."""
+        if self.thermometer != "sensor":
+            return False
+        base, axis = base_name(name, self.axes), name[len("freq_hz_"):]
+        return base == "freq_hz" and (f"temperature_c_{axis}" in chunk
+                                      or "temperature_c" in chunk)
 
     def _check_bounds(self, name: str, values: np.ndarray, offset: int) -> None:
         low, high, _ = self._bounds[base_name(name, self.axes)]
