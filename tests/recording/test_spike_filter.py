@@ -1,0 +1,101 @@
+"""Tests of the robust, time-windowed spike filter (hrgtc.recording.spikes.find_spikes).
+
+Truth: the positions and sizes of the spikes the tests inject into simulated streams
+(Gaussian, quantised, pulse-type, with gaps and a drifting level), and the three
+single-sample spikes of the real PAN cold-test recording near −0.102 rad/s (rows
+2340, 2570 and 3223 of the x gyro, read off the file: its other samples sit within
+a few 10^-3 rad/s of their burst's level).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from hrgtc.errors import InputError, SpikeWarning
+from hrgtc.recording import ReadOptions, read
+from hrgtc.recording.spikes import SPIKE_COLUMN, RobustSpikeFilter, find_spikes
+
+PAN = Path(__file__).parents[1] / "data" / "pan-cold-test" / "pan_tvc_cold_2020-03-07.csv"
+PAN_COLUMNS = {"time_s": "time (ms)", "rate_dph_x": "gyrox rad/s", "rate_dph_y": "gyroy rad/s",
+               "rate_dph_z": "gyroz rad/s", "temperature_c": "temp"}
+
+
+def bursts(rng, n_bursts=20, per_burst=250, rate_hz=50.0, period_s=300.0):
+    """Time of a burst logger: ``per_burst`` samples at ``rate_hz`` every ``period_s``."""
+    one = np.arange(per_burst) / rate_hz
+    return np.concatenate([k * period_s + one for k in range(n_bursts)])
+
+
+def test_injected_spikes_of_known_size_and_position_are_found():
+    rng = np.random.default_rng(1)
+    time_s = bursts(rng)
+    values = 0.002 * time_s + rng.standard_normal(time_s.size)  # drifting level, σ = 1
+    where = np.array([0, 17, 251, 1999, 2600, 4999])  # a burst's first, inner, last samples
+    sizes = np.array([15.0, -12.0, 40.0, -9.5, 300.0, 20.0])
+    values[where] += sizes
+    found = find_spikes(time_s, values)
+    np.testing.assert_array_equal(np.flatnonzero(found), where)
+
+
+def test_gaussian_stream_without_spikes_gives_none():
+    rng = np.random.default_rng(2)
+    time_s = np.arange(1_000_000) / 200.0
+    assert not find_spikes(time_s, 5.0 + 0.3 * rng.standard_normal(time_s.size)).any()
+
+
+def test_quantised_pulse_stream_keeps_every_pulse_and_its_mean():
+    rng = np.random.default_rng(3)
+    time_s = np.arange(200_000) / 100.0
+    lsb = 0.0625
+    pulses = lsb * rng.poisson(0.05, time_s.size)  # mostly 0, single pulses: MAD = 0
+    assert np.median(np.abs(pulses - np.median(pulses))) == 0.0
+    assert not find_spikes(time_s, pulses).any()
+    counts = lsb * np.round(3.0 + 1.2 * rng.standard_normal(time_s.size))  # ±1 LSB noise
+    assert not find_spikes(time_s, counts).any()
+    counts[1234] += 40 * lsb  # a real spike on the quantised stream is still found
+    assert np.flatnonzero(find_spikes(time_s, counts)).tolist() == [1234]
+
+
+def test_a_step_is_not_a_spike_and_windows_never_span_a_gap():
+    rng = np.random.default_rng(4)
+    time_s = np.r_[np.arange(2000) / 100.0, 100.0 + np.arange(2000) / 100.0]
+    noise = np.r_[20.0 * rng.standard_normal(2000), 0.1 * rng.standard_normal(2000)]
+    values = noise.copy()
+    values[2500:] += 50.0  # a step inside the quiet segment: not a spike
+    values[3100] += 5.0  # 50 σ of the quiet segment, 0.25 σ of the noisy one
+    found = find_spikes(time_s, values, window_s=1000.0)  # one window per segment
+    assert np.flatnonzero(found).tolist() == [3100]
+
+
+def test_real_recording_three_spikes_found_and_removed():
+    with pytest.warns(SpikeWarning, match=r"3 row\(s\) .* removed .*rate_dph_x 3.* row 2340"):
+        rec = read(PAN, columns=PAN_COLUMNS, units={"time": "ms", "rate": "rad/s"},
+                   thermometer="sensor", temp_scale=0.001, temp_offset_c=-40.0,
+                   temp_unwrap="off", gaps="split",
+                   validate=False, spike_filter="drop")
+    assert len(rec) == 6250 - 3 and rec.metadata.extra["spikes_removed"] == 3
+    raw = np.genfromtxt(PAN, delimiter=",", skip_header=1)
+    kept = np.delete(raw, [2340, 2570, 3223], axis=0)
+    np.testing.assert_array_equal(rec.time_s, kept[:, 0] / 1000.0)
+    assert raw[[2340, 2570, 3223], 4].tolist() == [-0.102, -0.102, -0.102]
+
+
+def test_flag_keeps_every_row_and_marks_the_spikes_streamed_in_chunks():
+    options = ReadOptions(columns=PAN_COLUMNS, units={"time": "ms", "rate": "rad/s"},
+                          thermometer="sensor", temp_scale=0.001, temp_offset_c=-40.0,
+                          temp_unwrap="off",
+                          gaps="split", spike_filter="flag", chunk_rows=1000)
+    with pytest.warns(SpikeWarning, match="flagged in column 'spike'"):
+        chunks = list(options.chunks(PAN))
+    flags = np.concatenate([c[SPIKE_COLUMN] for c in chunks])
+    assert flags.size == 6250 and np.flatnonzero(flags).tolist() == [2340, 2570, 3223]
+
+
+def test_bad_settings_are_named():
+    with pytest.raises(InputError, match="spike_filter must be one of"):
+        RobustSpikeFilter("remove")
+    with pytest.raises(InputError, match="window_s must be a positive number"):
+        RobustSpikeFilter("drop", window_s=0.0)
