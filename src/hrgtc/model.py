@@ -19,7 +19,7 @@ from __future__ import annotations
 import json
 import os
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
@@ -182,11 +182,16 @@ class InstrumentModel:
         Serial or name of the instrument.
     provenance
         Inputs with SHA-256, settings, package version, creation time.
+    temperature_map
+        The count -> °C map of a raw temperature sensor fitted to a reference log
+        (``calibrate --temp-ref``, :class:`hrgtc.thermometry.reference.TemperatureMap`
+        as a dict), applied to the raw count at compensation; None without one.
     """
 
     axes: dict[str, UnitModel]
     unit: str = "unknown"
     provenance: dict[str, Any] = field(default_factory=dict)
+    temperature_map: dict[str, Any] | None = None
 
     def __post_init__(self) -> None:
         if not self.axes:
@@ -214,21 +219,27 @@ class InstrumentModel:
         if self.is_single_axis:
             document = self.axes[""].to_dict()
             document.update(unit=self.unit, provenance=dict(self.provenance))
-            return document
-        return {
-            "schema": SCHEMA_NAME,
-            "schema_version": SCHEMA_VERSION,
-            "unit": self.unit,
-            "axes": {name: model.parts() for name, model in self.axes.items()},
-            "provenance": dict(self.provenance),
-        }
+        else:
+            document = {
+                "schema": SCHEMA_NAME,
+                "schema_version": SCHEMA_VERSION,
+                "unit": self.unit,
+                "axes": {name: model.parts() for name, model in self.axes.items()},
+                "provenance": dict(self.provenance),
+            }
+        if self.temperature_map is not None:
+            document["temperature_map"] = dict(self.temperature_map)
+        return document
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any], source: str = "model",
                   non_standard: bool = False) -> InstrumentModel:
         """Inverse of :meth:`to_dict`, with the checks of :meth:`UnitModel.from_dict`."""
+        temperature_map = _temperature_map(data, source)
         if not (isinstance(data, Mapping) and "axes" in data):
-            return cls.single(UnitModel.from_dict(data, source, non_standard))
+            single = cls.single(UnitModel.from_dict(data, source, non_standard))
+            return single if temperature_map is None else replace(
+                single, temperature_map=temperature_map)
         if data.get("schema") != SCHEMA_NAME:
             raise ModelFileError(f"{source}: not an hrgtc model file (schema "
                                  f"{data.get('schema')!r}, expected {SCHEMA_NAME!r})")
@@ -248,12 +259,28 @@ class InstrumentModel:
             raise ModelFileError(f"{source}: model file is missing {exc}; it is corrupt") from exc
         except HrgtcError as exc:
             raise ModelFileError(f"{source}: model file is corrupt: {exc}") from exc
-        return cls(axes, unit, provenance)
+        return cls(axes, unit, provenance, temperature_map)
 
     @property
     def sha256(self) -> str:
         """SHA-256 of the parameters as canonical JSON (see :func:`model_sha256`)."""
         return parameters_sha256(self.to_dict())
+
+
+def _temperature_map(data: Any, source: str) -> dict[str, Any] | None:
+    """The document's ``temperature_map``, checked (None without one)."""
+    if not isinstance(data, Mapping) or data.get("temperature_map") is None:
+        return None
+    from hrgtc.thermometry.reference import TemperatureMap
+
+    raw = data["temperature_map"]
+    if not isinstance(raw, Mapping):
+        raise ModelFileError(f"{source}: temperature_map is {raw!r}, not an object")
+    try:
+        TemperatureMap.from_dict(raw)
+    except HrgtcError as exc:
+        raise ModelFileError(f"{source}: {exc}") from None
+    return dict(raw)
 
 
 def model_sha256(model: UnitModel) -> str:

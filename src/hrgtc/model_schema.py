@@ -171,6 +171,18 @@ MODEL_SCHEMA: dict[str, Any] = {
         },
         "provenance": {"type": "object"},
         "parameters_sha256": {"type": "string", "pattern": "^[0-9a-f]{64}$"},
+        # optional: a raw temperature count's map to °C (calibrate --temp-ref)
+        "temperature_map": {
+            "type": ["object", "null"],
+            "required": ["scale_c_per_count", "offset_c"],
+            "properties": {
+                "scale_c_per_count": {"type": "number"},
+                "offset_c": {"type": "number"},
+                "count_bits": {"enum": [16, 32, None]},
+                "lag_s": {"type": "number"},
+                "points": {"type": "integer", "minimum": 0},
+            },
+        },
     },
 }
 #: Keys left out of :func:`parameters_sha256`.

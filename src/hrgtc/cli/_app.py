@@ -7,7 +7,9 @@ Commands live in their own modules of this package and register themselves on
 from __future__ import annotations
 
 import json
+import re
 import sys
+import warnings
 from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
@@ -122,6 +124,53 @@ def progress_bar(
         yield callback
 
 
+_AXIS_TOKENS = (
+    (re.compile(r"_(?:x|y|z)\b"), "_*"),
+    (re.compile(r"\baxis \w+"), "axis *"),
+    (re.compile(r"[-+]?\d[\d.]*(?:e[-+]?\d+)?", re.IGNORECASE), "#"),
+)
+
+
+def warning_cause(text: str) -> str:
+    """A warning's text without its axis names and numbers: one cause, one key."""
+    for pattern, replacement in _AXIS_TOKENS:
+        text = pattern.sub(replacement, text)
+    return text
+
+
+def _format_warning(message: Warning | str, category: type[Warning], filename: str,
+                    lineno: int, line: str | None = None) -> str:
+    return f"warning: {message}\n"
+
+
+def print_warnings_once(context: typer.Context) -> None:
+    """Show each warning once per cause for this command, then count the repeats.
+
+    The same warning of every axis (or of every pass over a file) differs only in
+    the axis name and its numbers: the first is shown, as ``warning: ...`` without
+    Python's source line, and the number of the others at the end.
+    """
+    previous_show, previous_format = warnings.showwarning, warnings.formatwarning
+    seen: dict[tuple[str, str], int] = {}
+
+    def show(message: Warning | str, category: type[Warning], filename: str, lineno: int,
+             file: Any = None, line: str | None = None) -> None:
+        key = (category.__name__, warning_cause(str(message)))
+        seen[key] = seen.get(key, 0) + 1
+        if seen[key] == 1:
+            previous_show(message, category, filename, lineno, file, line)
+
+    def close() -> None:
+        warnings.showwarning, warnings.formatwarning = previous_show, previous_format
+        repeats = sum(count - 1 for count in seen.values())
+        if repeats:
+            error_console.print(f"({repeats} more warning(s) like those above, for other axes "
+                                "or passes over the same file, not repeated)", markup=False)
+
+    warnings.showwarning, warnings.formatwarning = show, _format_warning
+    context.call_on_close(close)
+
+
 @app.callback(invoke_without_command=True)
 def _root(
     context: typer.Context,
@@ -136,3 +185,4 @@ def _root(
     if context.invoked_subcommand is None:
         console.print(context.get_help())
         raise typer.Exit(2)
+    print_warnings_once(context)

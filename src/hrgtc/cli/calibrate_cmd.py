@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -143,6 +144,28 @@ def calibrate_command(
         False, "--cross-axis", help="Several axes: also try the other resonators' frequencies "
         "as candidate terms of each axis (gradients across the unit); kept per axis only where "
         "the --validate runs improve by more than 2 %."),
+    temp_ref: Path = typer.Option(
+        None, "--temp-ref", help="Reference log of the temperature (sparse, e.g. a hand log "
+        "every 5 min) written beside the first --drift run: fits its raw temperature count's "
+        "map to °C (residual printed, the reference's lag fitted), stores it in the model and "
+        "compensation applies it. Columns time_s (seconds, clock times HH:MM[:SS] or dates) "
+        "and temperature_c by default (--temp-ref-col)."),
+    temp_ref_col: list[str] = typer.Option(
+        None, "--temp-ref-col", metavar="NAME=THEIRS", help="The reference log's columns, e.g. "
+        "--temp-ref-col time_s=Time --temp-ref-col 'temperature_c=C1 (C)'."),
+    temp_ref_start: str = typer.Option(
+        None, "--temp-ref-start", metavar="CLOCK", help="Clock time of the recording's t = 0 "
+        "(15:40, or 2020-03-07T15:40:00+01:00) when the log has clock times; default: the "
+        "recording's first time stamp."),
+    temp_ref_unit: str = typer.Option(
+        None, "--temp-ref-unit", metavar="C|F", help="Unit of the reference temperature "
+        "[default: F when its header says (F), °F or degF, else C]."),
+    temp_ref_tz: str = typer.Option(
+        None, "--temp-ref-tz", metavar="ZONE", help="Time zone of naive clock times (+01:00, "
+        "Europe/Berlin) when the other side carries a UTC offset."),
+    temp_ref_lag_s: float = typer.Option(
+        None, "--temp-ref-lag-s", help="The reference's lag behind the sensor [s; default: "
+        "fitted within ±1800 s]."),
     force: ForceOption = False,
     strict: StrictOption = False,
     json_output: JsonOption = False,
@@ -177,6 +200,24 @@ def calibrate_command(
         refuse_existing(output, force)
         check_writable(output, 1e6)  # before the fit, not after it
         stages: dict[str, object] = {}
+        temperature_map = None
+        if temp_ref is not None:
+            from hrgtc.recording.mapping import parse_columns
+            from hrgtc.thermometry.reference import map_from_reference, options_with_map
+
+            ref_columns = dict(item.split("=", 1) for text in temp_ref_col or []
+                               for item in text.split(",") if "=" in item)
+            if any(not item.count("=") for text in temp_ref_col or [] for item in text.split(",")):
+                parse_columns(temp_ref_col)  # names the malformed item
+            temperature_map = map_from_reference(
+                drift[0], temp_ref, inputs, columns=ref_columns, unit=temp_ref_unit,
+                start=temp_ref_start, tz=temp_ref_tz, lag_s=temp_ref_lag_s)
+            inputs = options_with_map(dataclasses.replace(inputs, temp_scale=1.0,
+                                                          temp_offset_c=0.0), temperature_map)
+            if not json_output:
+                console.print("Temperature map: " + temperature_map.summary())
+                if temperature_map.extra.get("note"):
+                    console.print(f"[yellow]note:[/] {temperature_map.extra['note']}")
 
         def progress(stage: str, done: float, total: float) -> None:
             if not json_output and stage not in stages:
@@ -196,7 +237,10 @@ def calibrate_command(
             scale_terms=[t.strip() for t in scale_terms.split(",") if t.strip()],
             cross_axis=cross_axis,
         )
-        save_instrument(calibration.model, output, force=force)
+        model = calibration.model
+        if temperature_map is not None:
+            model = dataclasses.replace(model, temperature_map=temperature_map.to_dict())
+        save_instrument(model, output, force=force)
     single = calibration.model.is_single_axis
     if json_output:
         document = (calibration.axes[""].to_dict() if single and not calibration.scale_checks
@@ -204,6 +248,8 @@ def calibrate_command(
                     else calibration.to_dict())
         if single:
             document["validation"] = [v.to_dict() for v in calibration.validation[""]]
+        if temperature_map is not None:
+            document["temperature_map"] = temperature_map.to_dict()
         print_json({**document, "model_file": str(output)})
     else:
         render_instrument(calibration)

@@ -56,6 +56,7 @@ def compensate_command(
     from hrgtc.compensate import compensate_instrument_file
     from hrgtc.model import load_instrument
     from hrgtc.recording import ReadOptions
+    from hrgtc.thermometry.reference import options_with_map
 
     inputs = (inputs or ReadOptions()).with_spike_default("flag")
     if inputs.spike_filter == "drop":
@@ -64,6 +65,7 @@ def compensate_command(
         raise typer.Exit(2)
     with library_errors(), progress_bar("compensating", enabled=not json_output) as progress:
         model = load_instrument(model_path)
+        inputs = options_with_map(inputs, model.temperature_map)
         summary = compensate_instrument_file(run, output, model, force=force,
                                              chunk_rows=chunk_rows, progress=progress,
                                              read_options=inputs)
@@ -156,6 +158,7 @@ def evaluate_command(
     from hrgtc.files import refuse_existing, write_text_atomic
     from hrgtc.model import load_instrument
     from hrgtc.recording import ReadOptions
+    from hrgtc.thermometry.reference import options_with_map
 
     inputs = (inputs or ReadOptions()).with_spike_default("drop")
 
@@ -169,6 +172,7 @@ def evaluate_command(
     results: dict[str, Evaluation] = {}
     with library_errors():
         model = load_instrument(model_path)
+        inputs = options_with_map(inputs, model.temperature_map)
     for axis, unit_model in model.axes.items():
         label = "evaluating" + (f" axis {axis}" if axis else "")
         with library_errors(), progress_bar(label, enabled=not json_output) as progress:

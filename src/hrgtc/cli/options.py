@@ -201,10 +201,10 @@ TempUnwrapOption = Annotated[
     str | None,
     typer.Option(
         "--temp-unwrap",
-        metavar="auto|off",
+        metavar="auto|off|16|32",
         help="A raw temperature count that sits just under 2^16 or 2^32 is a signed count "
         "stored unsigned and is unwrapped (65236 -> -300), with a warning (auto, default); "
-        "off reads it as it is.",
+        "off reads it as it is; 16 or 32 always unwraps that width.",
         rich_help_panel=_INPUT,
     ),
 ]
@@ -360,8 +360,9 @@ def recording_input(
     from hrgtc.recording.mapping import parse_columns
 
     units = {"time": time_unit, "freq": freq_unit, "rate": rate_unit, "temp": temp_unit}
-    if temp_unwrap not in (None, "auto", "off"):
-        raise typer.BadParameter(f"--temp-unwrap must be auto or off, got {temp_unwrap!r}")
+    if temp_unwrap not in (None, "auto", "off", "16", "32"):
+        raise typer.BadParameter(f"--temp-unwrap must be auto, off, 16 or 32, got "
+                                 f"{temp_unwrap!r}")
     overrides = {"sample_rate_hz": sample_rate_hz, "unit": unit_name,
                  "input_rate_dph": input_rate_dph}
     return ReadOptions(

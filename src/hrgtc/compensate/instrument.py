@@ -151,8 +151,13 @@ def compensate_instrument_file(
     As :func:`~hrgtc.compensate.compensator.compensate_file` (``options`` are its
     keyword arguments); each axis's frequency is checked against that axis's
     plausible band. A single-axis model is compensated exactly as by
-    ``compensate_file``.
+    ``compensate_file``. The model's temperature map (a raw count's map to °C from
+    ``calibrate --temp-ref``) is applied unless ``read_options`` give their own
+    scale and offset.
     """
+    from hrgtc.thermometry.reference import options_with_map
+
+    read_options = options_with_map(read_options, model.temperature_map)
     if model.is_single_axis:
         return compensate_file(source, output, model.axes[""], drift=drift,
                                read_options=read_options, **options)

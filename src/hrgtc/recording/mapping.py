@@ -168,7 +168,8 @@ def plan_columns(source: Source, columns: Any, units: Mapping[str, str] | None,
     numeric columns under their own names. ``rate_scale`` is the LSB per °/s of a
     rate logged as a raw count (``units={"rate": "lsb"}``); ``temp_unwrap``
     (``"auto"`` or ``"off"``) whether a raw temperature count that sits just
-    under 2^16 or 2^32 is read as a signed count stored unsigned.
+    under 2^16 or 2^32 is read as a signed count stored unsigned (``"16"``, ``"32"``:
+    always, as a model's temperature map says).
     """
     mapping = parse_columns(columns)
     canon = parse_units(units)
@@ -185,8 +186,8 @@ def plan_columns(source: Source, columns: Any, units: Mapping[str, str] | None,
         raise InputError(f"--rate-scale {rate_scale!r} is the LSB per °/s of a raw count; give "
                          "it with --rate-unit lsb (the rate unit is "
                          f"{rate_unit.symbol})")
-    if temp_unwrap not in ("auto", "off"):
-        raise InputError(f"temp_unwrap must be 'auto' or 'off', got {temp_unwrap!r}")
+    if temp_unwrap not in ("auto", "off", "16", "32"):
+        raise InputError(f"temp_unwrap must be 'auto', 'off', '16' or '32', got {temp_unwrap!r}")
     if canon.get("temp") not in (None, "C", "count") and (temp_scale != 1.0
                                                             or temp_offset_c != 0.0):
         raise InputError(f"--temp-scale/--temp-offset map a raw count to °C; with --temp-unit "
@@ -235,7 +236,9 @@ def plan_columns(source: Source, columns: Any, units: Mapping[str, str] | None,
                       temp_scale=float(temp_scale), temp_offset_c=float(temp_offset_c),
                       thermometer=thermometer,
                       rate_scale=None if rate_scale is None else float(rate_scale),
-                      temp_unwrap=temp_unwrap)
+                      temp_unwrap=temp_unwrap,
+                      wrap_bits=int(temp_unwrap) if temp_unwrap in ("16", "32") else None,
+                      wrap_decided=temp_unwrap != "auto")
 
 
 def _check_sensor_columns(source: Source, names: list[str]) -> None:

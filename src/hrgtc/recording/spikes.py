@@ -228,7 +228,10 @@ def find_spikes(time_s: np.ndarray, values: np.ndarray, *, k: float = SPIKE_K,
         second[0], second[-1] = second[1], second[-2]
         segment_sigma = _sigma(second[np.isfinite(second)]) if np.isfinite(second).any() else 0.0
         limit = np.empty_like(xs)
-        block = np.floor((t[start:stop] - t[start]) / window_s)
+        ts = t[start:stop]
+        with np.errstate(invalid="ignore"):
+            origin = float(np.nanmin(ts)) if np.isfinite(ts).any() else 0.0
+            block = np.floor((ts - origin) / window_s)
         edges = np.flatnonzero(np.diff(block)) + 1
         bounds = [0, *edges.tolist(), len(xs)]
         for a, b in itertools.pairwise(bounds):
