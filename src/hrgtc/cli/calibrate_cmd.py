@@ -67,7 +67,7 @@ def _render_drift(result: CalibrationResult) -> None:
         console.print(f"Thermometer from the prior of {fit.prior.n_units} units: temperature "
                       f"uncertainty ≤ {fit.max_temperature_std_c:.4f} °C (1σ) over {low:g} to "
                       f"{high:g} °C")
-    console.print(result.model.drift.summary())
+    console.print(result.model.drift.summary(sensor=th.source == "sensor"))
     if result.model.housing is not None:
         console.print("Housing-thermistor baseline: " + result.model.housing.equation())
     if result.validation:
@@ -82,7 +82,8 @@ def _render_drift(result: CalibrationResult) -> None:
         console.print(val)
         for v in result.validation:
             if v.directions is not None:
-                console.print(f"{v.file}: " + v.directions.summary(), markup=False)
+                console.print(f"{v.file}: " + v.directions.summary(sensor=th.source == "sensor"),
+                              markup=False)
 
 
 @app.command("calibrate")

@@ -50,6 +50,8 @@ def compensate_command(
     """Compensate a run file to file: adds rate_comp_dph, bias_model_dph, resonator_c_est
     and in_range (and scale_model_ppm with a scale factor), chunk by chunk (memory bounded
     whatever the file size). A multi-axis model compensates every axis: rate_comp_dph_x, ...
+    With --thermometer sensor the output keeps temperature_c and carries no freq_hz* or
+    resonator_c_est* copies of it; spikes are flagged in a 'spike' column, never dropped.
 
     Example: hrgtc compensate warmup.parquet --model unit.json -o warmup_comp.parquet
     """
@@ -86,8 +88,12 @@ def compensate_command(
 PREDICTION_BLOCKS = 2000
 
 
-def render_evaluation(result: Evaluation) -> None:
-    """Bias stability table raw / compensated / housing, beside the paper's figures."""
+def render_evaluation(result: Evaluation, sensor: bool = False) -> None:
+    """Bias stability table raw / compensated / housing, beside the paper's figures.
+
+    ``sensor``: the thermometer is a temperature sensor (a MEMS gyro, not an HRG):
+    the compensated row says so and the paper's HRG figures are left out.
+    """
     from hrgtc import paper
 
     table = Table(title=f"Bias stability of {result.file} (1σ of τ-s means, °/h; "
@@ -96,13 +102,15 @@ def render_evaluation(result: Evaluation) -> None:
     taus = list(result.bias_stability_dph["raw"])
     for tau in taus:
         table.add_column(f"τ = {tau:g} s", justify="right")
-    labels = {"raw": "raw", "compensated": "compensated (frequency, Eq. 22)",
+    labels = {"raw": "raw", "compensated": ("compensated (temperature sensor)" if sensor
+                                            else "compensated (frequency, Eq. 22)"),
               "housing": "compensated (housing thermistor)"}
     for name in result.bias_stability_dph:
         table.add_row(labels.get(name, name), *(result.stability_text(name, t) for t in taus))
-    table.add_row("paper, Section 4.2 (10 s)", *(
-        f"{paper.BIAS_STABILITY_RAW_DPH} → {paper.BIAS_STABILITY_COMPENSATED_DPH}"
-        if t == 10.0 else "" for t in taus))
+    if not sensor:  # the paper's figures are an HRG's
+        table.add_row("paper, Section 4.2 (10 s)", *(
+            f"{paper.BIAS_STABILITY_RAW_DPH} → {paper.BIAS_STABILITY_COMPENSATED_DPH}"
+            if t == 10.0 else "" for t in taus))
     console.print(table)
     if result.noise:
         allan = Table(title="Allan noise terms (IEEE Std 952)")
@@ -124,7 +132,7 @@ def render_evaluation(result: Evaluation) -> None:
     if result.residual_rms_dph is not None:
         console.print(f"RMS of true bias minus model: {result.residual_rms_dph:.4f} °/h")
     if result.directions is not None:
-        console.print(result.directions.summary(), markup=False)
+        console.print(result.directions.summary(sensor=sensor), markup=False)
     for note in result.notes:
         console.print(note)
 
@@ -183,18 +191,19 @@ def evaluate_command(
     with library_errors():
         if allan_csv is not None:
             write_text_atomic(allan_csv, allan_text(results), force=force)
+    sensor = {axis: m.thermometer.source == "sensor" for axis, m in model.axes.items()}
     if model.is_single_axis:
         if json_output:
             print_json(results[""].to_dict())
         else:
-            render_evaluation(results[""])
+            render_evaluation(results[""], sensor[""])
     elif json_output:
         print_json({"unit": model.unit, "axes": {a: r.to_dict() for a, r in results.items()},
                     "summary": axis_summary(results)})
     else:
         for axis, result in results.items():
             console.rule(f"axis {axis}")
-            render_evaluation(result)
+            render_evaluation(result, sensor[axis])
         render_axis_summary(model.unit, results)
     checks = scale_checks(run, model, inputs)
     if checks and json_output:

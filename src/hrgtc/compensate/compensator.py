@@ -19,6 +19,7 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import os
+import warnings
 from collections.abc import Mapping
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
@@ -36,7 +37,7 @@ from hrgtc.drift.features import (
     is_aux,
     settle_rows,
 )
-from hrgtc.errors import CalibrationError, InputError
+from hrgtc.errors import CalibrationError, ExtrapolationWarning, InputError
 from hrgtc.files import check_writable
 from hrgtc.model import UnitModel
 from hrgtc.progress import Progress
@@ -137,6 +138,7 @@ class Compensator:
         self.out_of_range = 0
         self.rate_out_of_range = 0
         self.settling = 0
+        self.temperature_nan = 0
         self.segments = 1
         self._last_time: float | None = None
 
@@ -198,12 +200,32 @@ class Compensator:
         if not (self.engine == "fused" and self._fused(chunk, out)):
             for start in range(0, n, BLOCK_ROWS):
                 self._block(chunk.slice(start, start + BLOCK_ROWS), out, start)
+        self._count_temperature_nan(out["resonator_c_est"], chunk)
         if self.scale_factor is not None:
             # rate = input * (1 + k) + bias, so input = (rate - bias) / (1 + k).
             ppm = self.scale_factor.ppm(chunk.freq_hz)
             out[SCALE_COLUMN] = ppm
             out["rate_comp_dph"] /= 1.0 + 1e-6 * ppm
         return chunk.with_columns(**out)
+
+    def _count_temperature_nan(self, estimate: np.ndarray, chunk: Recording) -> None:
+        """Count NaN temperature estimates; warn at the first (once per compensator)."""
+        bad = np.isnan(estimate)
+        if not bad.any():
+            return
+        if not self.temperature_nan:
+            i = int(np.argmax(bad))
+            low, high = self.model.thermometer.temperature_range_c
+            what = ("temperature" if self.model.thermometer.source == "sensor"
+                    else "resonator temperature estimate resonator_c_est")
+            row = self.samples - len(chunk) + i
+            warnings.warn(
+                f"{chunk.source or 'the run'}: the {what} is NaN from sample {row} "
+                f"on (thermometer calibrated {low:.4g} to {high:.4g} °C; the inverse of f(T) "
+                "is not extrapolated beyond it): those samples are flagged in_range = 0 and "
+                "their compensation is an extrapolation of the drift model",
+                ExtrapolationWarning, stacklevel=4)
+        self.temperature_nan += int(np.count_nonzero(bad))
 
     def _fused(self, chunk: Recording, out: dict[str, np.ndarray]) -> bool:
         """Compensate ``chunk`` into ``out`` with the kernel; False if it cannot (order > 5)."""
@@ -343,7 +365,8 @@ def compensate_file(
     chunks = options.chunks(source, rows=chunk_rows)
     try:
         first = next(chunks)
-        names = (*first.names, *added)
+        copies = sensor_copies((*first.names, *added), first.metadata)
+        names = tuple(n for n in (*first.names, *added) if n not in copies)
         total = rec_io.count_rows(source)
         metadata = compensated_metadata(first.metadata, model, drift)
         with rec_io.RecordingWriter(output, metadata, names, force=force) as writer, \
@@ -354,6 +377,9 @@ def compensate_file(
             chunk: Recording | None = first
             while chunk is not None:
                 result = compensator.process(chunk)
+                if copies:
+                    result = Recording({n: result[n] for n in names}, result.metadata,
+                                       result.source)
                 if pending is not None:
                     pending.result()
                 pending = writing.submit(_write, writer, result)
@@ -427,6 +453,18 @@ def estimated_output_bytes(source: str | os.PathLike[str], output: str | os.Path
         return 0.0
     per_value = 20.0 if str(output).lower().endswith(".csv") else 8.0
     return rows * columns * per_value
+
+
+def sensor_copies(names: tuple[str, ...], metadata: rec_io.Metadata) -> set[str]:
+    """Columns a sensor thermometer's output would only copy its temperature into.
+
+    With ``--thermometer sensor`` the ``freq_hz*`` columns hold the temperature
+    sensor's reading and ``resonator_c_est*`` the same again (the thermometer is the
+    identity): neither is written; ``temperature_c*`` is.
+    """
+    if metadata.extra.get("thermometer") != "sensor":
+        return set()
+    return {n for n in names if n.startswith(("freq_hz", "resonator_c_est"))}
 
 
 def _write(writer: rec_io.RecordingWriter, chunk: Recording) -> None:

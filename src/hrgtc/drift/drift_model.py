@@ -192,18 +192,26 @@ class DriftModel(ParsedTerms):
         stream = FeatureStream(self.settings, self.variables, thermometer)
         return self.predict(stream.process(recording))
 
-    def equation(self) -> str:
-        """The model in Eq. (22) form with numbers, e.g. ``B = 1.2 + 0.3·f - ...``."""
+    def equation(self, sensor: bool = False) -> str:
+        """The model in Eq. (22) form with numbers, e.g. ``B = 1.2 + 0.3·f - ...``.
+
+        ``sensor``: the thermometer is a temperature sensor (no frequency output),
+        so f is its temperature T in °C and df its rate dT/dt in °C/s, not Hz.
+        """
         parts = [f"B = {self.intercept_dph:.6g}"]
         for name in self.selected:
             value = self.coefficients[name]
             sign = "-" if value < 0 else "+"
             parts.append(f" {sign} {abs(value):.6g}·{name}")
-        units = ", ".join(f"{v} in {variable_unit(v)}" for v in self.variables)
+        units = ", ".join(_variable_text(v, sensor) for v in self.variables)
         return "".join(parts) + f"   [°/h; {units}]"
 
-    def summary(self) -> str:
-        """Stepwise history, coefficient table and fit statistics as text."""
+    def summary(self, sensor: bool = False) -> str:
+        """Stepwise history, coefficient table and fit statistics as text.
+
+        ``sensor``: the equation's units are those of a temperature sensor (see
+        :meth:`equation`).
+        """
         lines = [
             f"Drift model: {len(self.selected)} of {len(self.candidates)} candidate terms, "
             f"{self.n_windows} windows of {self.window_s:g} s ({self.n_samples} samples)",
@@ -234,7 +242,7 @@ class DriftModel(ParsedTerms):
             )
         if self.cross_validation is not None:
             lines.append(self.cross_validation.summary())
-        lines.append(self.equation())
+        lines.append(self.equation(sensor))
         return "\n".join(lines)
 
     def to_dict(self) -> dict[str, Any]:
@@ -509,3 +517,15 @@ def fit(
         cross_validation=cross_validate(*cv_args, selected, windows.sources, rate, slope_sign)
         if n_runs >= 2 else None,
     )
+
+
+#: What f and its rates are when a temperature sensor takes the frequency's place.
+_SENSOR_VARIABLES = {"f": "f = T in °C", "df": "df = dT/dt in °C/s"}
+
+
+def _variable_text(variable: str, sensor: bool) -> str:
+    """``f in Hz`` for a resonator; ``f = T in °C`` (Hz read as °C) for a temperature sensor."""
+    if sensor and variable in _SENSOR_VARIABLES:
+        return _SENSOR_VARIABLES[variable]
+    unit = variable_unit(variable)
+    return f"{variable} in {unit.replace('Hz', '°C') if sensor else unit}"

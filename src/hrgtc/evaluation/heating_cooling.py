@@ -79,8 +79,8 @@ class DirectionStats:
                     else clean(self.residual_rms_dph[d])}
                 for d in DIRECTIONS} | {"block_s": self.block_s}
 
-    def summary(self) -> str:
-        """One line per direction."""
+    def summary(self, sensor: bool = False) -> str:
+        """One line per direction (``sensor``: the thermometer is a temperature sensor)."""
         lines = []
         for d in DIRECTIONS:
             if not self.blocks[d]:
@@ -92,8 +92,8 @@ class DirectionStats:
             if self.residual_rms_dph is not None:
                 line += f", RMS model - true bias {self.residual_rms_dph[d]:.4g} °/h"
             lines.append(line)
-        return "heating and cooling apart (sign of the resonator temperature rate):\n" + \
-            "\n".join(lines)
+        what = "temperature" if sensor else "resonator temperature"
+        return f"heating and cooling apart (sign of the {what} rate):\n" + "\n".join(lines)
 
 
 class DirectionSplit:

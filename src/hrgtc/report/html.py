@@ -397,7 +397,7 @@ def _drift_model(page: _Page, model: UnitModel) -> None:
                      "yes" if name in paper.EQ22_TERMS else "no"))
     page.add(_table(("term", "coefficient unit", "coefficient", "std error", "p-value",
                          "kept in Eq. 22 of [1]"), rows, "The final model"),
-             f'<p class="eq">{escape(d.equation())}</p>',
+             f'<p class="eq">{escape(d.equation(model.thermometer.source == "sensor"))}</p>',
              f'<p class="muted">Eq. (22) form. Residual std {_number(d.residual_std_dph)} °/h on '
              f"{d.window_s:g} s means, R² {d.rsquared:.6f}.</p>")
     if d.variance_inflation > 1.0:
