@@ -1,0 +1,84 @@
+"""The real PAN cold test end to end: raw count + hand log -> model -> compensated file.
+
+Truth: the file itself (three single-sample spikes of the x gyro at rows 2340, 2570
+and 3223; the raw count 65236 of row 0 is −300 as a signed 16-bit number), the
+hand log's reference temperatures (the map's residual stays within the spread of
+a hand-read probe, < 0.5 °C), and the words the output must not use on a MEMS gyro.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from hrgtc.cli import app
+from hrgtc.cli._app import warning_cause
+
+DATA = Path(__file__).parents[1] / "data" / "pan-cold-test"
+RUN = DATA / "pan_tvc_cold_2020-03-07.csv"
+LOG = DATA / "pan_etu_cold_handlog_2020-03-07.csv"
+READ = ["--thermometer", "sensor", "--time-unit", "ms", "--rate-unit", "rad/s", "--gaps", "split",
+        "--col", "time_s=time (ms),rate_dph_x=gyrox rad/s,rate_dph_y=gyroy rad/s,"
+        "rate_dph_z=gyroz rad/s,temperature_c=temp"]
+REF = ["--temp-ref", str(LOG), "--temp-ref-col", "time_s=Time", "--temp-ref-col",
+       "temperature_c=C1 (C)", "--temp-ref-start", "15:45"]
+runner = CliRunner()
+
+
+def hrgtc(*args, cwd):
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).parents[2] / "src")}
+    return subprocess.run([sys.executable, "-m", "hrgtc.cli", *args], cwd=cwd, env=env,
+                          capture_output=True, text=True)
+
+
+@pytest.mark.slow
+def test_cold_test_with_its_hand_log_end_to_end(tmp_path, monkeypatch):
+    monkeypatch.setenv("COLUMNS", "200")  # rich tables unwrapped
+    done = hrgtc("calibrate", "--drift", str(RUN), *READ, *REF, "--rate-tau-s", "1",
+                 "--window-s", "5", "-o", "pan.json", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert "temperature_c = 0.00582219 × count + 24.1839 °C" in " ".join(done.stdout.split())
+    assert "f = T in °C" in done.stdout and "f in Hz" not in done.stdout
+    # the spikes' warning once, though the file is read twice
+    assert done.stderr.count("single-sample spikes removed") == 1, done.stderr
+    model = json.loads((tmp_path / "pan.json").read_text())
+    fitted = model["temperature_map"]
+    assert fitted["count_bits"] == 16 and fitted["points"] == 25
+    assert fitted["residual_rms_c"] < 0.5
+
+    result = runner.invoke(app, ["compensate", str(RUN), "--model", str(tmp_path / "pan.json"),
+                                 *READ, "-o", str(tmp_path / "out.csv")])
+    assert result.exit_code == 0, result.output
+    rows = (tmp_path / "out.csv").read_text().splitlines()
+    header = next(line for line in rows if not line.startswith("#")).split(",")
+    assert not any(n.startswith(("freq_hz", "resonator_c_est")) for n in header)
+    table = np.genfromtxt(tmp_path / "out.csv", delimiter=",", comments="#", skip_header=1,
+                          names=None)
+    table = table[~np.isnan(table[:, 0])]
+    assert table.shape[0] == 6250  # compensate flags, never drops
+    spikes = np.flatnonzero(table[:, header.index("spike")])
+    assert spikes.tolist() == [2340, 2570, 3223]
+    temperature = table[:, header.index("temperature_c")]
+    assert temperature[0] == pytest.approx(-300 * fitted["scale_c_per_count"]
+                                           + fitted["offset_c"], rel=1e-12)
+
+    result = runner.invoke(app, ["evaluate", str(RUN), "--model", str(tmp_path / "pan.json"),
+                                 *READ], terminal_width=200)
+    assert result.exit_code == 0, result.output
+    assert "compensated (temperature sensor)" in result.output
+    assert "3.0143" not in result.output and "Eq. 22" not in result.output
+    assert "resonator temperature rate" not in result.output
+
+
+def test_one_cause_per_warning_whatever_the_axis():
+    texts = [f"11.{k}% of samples of axis {a} beyond the trained temperature on rate_dph_{a}"
+             for k, a in enumerate("xyz")]
+    assert len({warning_cause(t) for t in texts}) == 1
+    assert warning_cause("spikes in rate_dph_x") != warning_cause("NaN in rate_dph_x")
