@@ -99,3 +99,21 @@ def test_bad_settings_are_named():
         RobustSpikeFilter("remove")
     with pytest.raises(InputError, match="window_s must be a positive number"):
         RobustSpikeFilter("drop", window_s=0.0)
+
+
+def test_impossible_values_stay_the_validation_s_business(tmp_path):
+    from hrgtc.errors import RecordingError
+    from hrgtc.recording import Metadata, Recording, write
+
+    rng = np.random.default_rng(6)
+    n = 400
+    columns = {"time_s": np.arange(n) / 100.0, "freq_hz": 4425.0 + 0.01 * rng.standard_normal(n),
+               "rate_dph": rng.standard_normal(n)}
+    columns["rate_dph"][123] = 1e30  # beyond 1000 °/s: an error that names the row
+    columns["rate_dph"][300] = 60.0  # plausible, 60 σ: a spike
+    path = write(Recording(columns, Metadata(sample_rate_hz=100.0)), tmp_path / "run.parquet")
+    with pytest.raises(RecordingError, match=r"column 'rate_dph', row 123"):
+        read(path, spike_filter="drop")
+    with pytest.warns(SpikeWarning, match=r"1 row\(s\) .* removed"):
+        rec = read(path, spike_filter="drop", spikes="drop")
+    assert len(rec) == n - 2

@@ -232,6 +232,7 @@ def read(
     with open_source(path) as source:
         plan = plan_columns(source, columns, units, temp_scale, temp_offset_c, thermometer,
                             rate_scale, temp_unwrap)
+        robust.counts = plan.temperature_is_count and (temp_scale, temp_offset_c) == (1.0, 0.0)
         columns = table_columns(source.read(plan.read_names, plan.as_text))
         arrays = convert_columns(plan, columns, 0)
         if spike_filter_ is not None:
@@ -334,6 +335,7 @@ def iter_chunks(
     with open_source(path) as source:
         plan = plan_columns(source, columns, units, temp_scale, temp_offset_c, thermometer,
                             rate_scale, temp_unwrap)
+        robust.counts = plan.temperature_is_count and (temp_scale, temp_offset_c) == (1.0, 0.0)
         offset = 0
 
         def converted() -> Iterator[dict[str, np.ndarray]]:

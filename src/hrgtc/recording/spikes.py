@@ -302,6 +302,7 @@ class RobustSpikeFilter:
         self.source = source
         self.k, self.lsb_multiple, self.window_s = float(k), float(lsb_multiple), float(window_s)
         self.found: dict[str, int] = {}
+        self.counts = False  # True: temperature_c holds a raw count (no °C bounds)
         self.rows = 0
         self.first: tuple[str, int, float] | None = None
         self._lsb: dict[str, float | None] = {}
@@ -320,6 +321,10 @@ class RobustSpikeFilter:
                 self._lsb[name] = resolution(values)
             mask = find_spikes(time_s, values, k=self.k, lsb_multiple=self.lsb_multiple,
                                window_s=self.window_s, lsb=self._lsb[name])
+            bounds = self._bounds(name, axes)
+            if bounds is not None and mask.any():  # impossible values: --spikes says
+                with np.errstate(invalid="ignore"):
+                    mask &= (values >= bounds[0]) & (values <= bounds[1])
             if mask.any():
                 count = int(np.count_nonzero(mask))
                 self.found[name] = self.found.get(name, 0) + count
@@ -336,6 +341,16 @@ class RobustSpikeFilter:
             return out
         keep = ~marked
         return {name: values[keep] for name, values in out.items()}
+
+    def _bounds(self, name: str, axes: tuple[str, ...]) -> tuple[float, float] | None:
+        """Physical bounds of a column: values beyond are for ``spikes``, not this filter."""
+        base = base_name(name, axes)
+        if base == "temperature_c" and not self.counts:
+            return TEMPERATURE_RANGE_C
+        if base == "temperature_c" or (base == "freq_hz" and self.sensor):
+            return None
+        bounds = _BOUNDS.get(base)
+        return None if bounds is None else (bounds[0], bounds[1])
 
     def summary(self) -> str:
         """One line: how many spikes, where, what was done (empty without any)."""
