@@ -4,15 +4,20 @@
   ``{"time_s": "t", "freq_hz": "f_res", "rate_dph": "omega"}``, per-axis names
   included (``{"rate_dph_x": "gyro_x"}``, see :mod:`hrgtc.recording.axes`); other
   columns keep their names (numeric ones are kept, text columns dropped);
-* ``units`` gives the units of ``time`` (``s``, ``ms``, ``us`` or ``timestamp``),
-  ``freq`` (``Hz`` or ``kHz``) and ``rate`` (``dph`` = °/h, ``dps`` = °/s or
-  ``radps`` = rad/s), converted to s, Hz and °/h: ``freq`` converts every
-  ``freq_hz*`` column, ``rate`` every ``rate_dph*`` and ``input_rate_dph*``
-  column. Timestamps (ISO 8601 text or date-time columns, which are recognised
-  without being asked) become seconds since the first sample of the file;
+* ``units`` gives the units of ``time`` (``s``, ``ms``, ``us``, ``ns`` or
+  ``timestamp``), ``freq`` (``Hz`` or ``kHz``), ``rate`` (``dph`` = °/h, ``dps`` =
+  °/s, ``mdps`` = m°/s, ``radps`` = rad/s, ``mradps`` = mrad/s, ``drad``/``ddeg`` =
+  an angle increment per sample, ``lsb`` = a raw count with ``rate_scale`` LSB per
+  °/s) and ``temp`` (``C``, ``F``, ``K`` or ``count``), converted to s, Hz, °/h and °C
+  by the one table of :mod:`hrgtc.recording.units`: ``freq`` converts every
+  ``freq_hz*`` column, ``rate`` every ``rate_dph*`` and ``input_rate_dph*`` column,
+  ``temp`` °F and K every temperature column. Timestamps (ISO 8601 text or
+  date-time columns, which are recognised without being asked) become seconds since
+  the first sample of the file;
 * ``temp_scale`` and ``temp_offset_c`` turn a temperature logged as a raw sensor
   count into °C: ``temperature_c = raw * temp_scale + temp_offset_c`` for every
-  ``temperature_c*`` column;
+  ``temperature_c*`` column; a raw count that sits just under 2^16 or 2^32 is a
+  signed count stored unsigned and is unwrapped first (``temp_unwrap``);
 * ``thermometer="sensor"`` (a gyro without a frequency output): ``freq_hz`` (and
   ``freq_hz_<axis>``) is the temperature sensor's column ``temperature_c_<axis>``
   (or the shared ``temperature_c``), so no frequency column is needed.

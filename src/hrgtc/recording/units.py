@@ -16,7 +16,7 @@ Two kinds of unit need more than a factor:
   period: the increment covers one output period, not the logger's pause);
 * a **raw count** (``lsb`` for rates, with ``--rate-scale`` LSB per °/s as
   datasheets give it; ``count`` for temperatures, with ``--temp-scale`` and
-  ``--temp-offset`` or a reference log, see :mod:`hrgtc.recording.tempref`).
+  ``--temp-offset`` or a reference log, see :mod:`hrgtc.thermometry.reference`).
 
 Temperatures in °F or K convert every temperature column (``temperature_c*``,
 ``chamber_c``, ``housing_c``, ``resonator_c``); a raw count is the gyro's own

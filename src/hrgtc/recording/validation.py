@@ -454,14 +454,16 @@ class RecordingValidator:
                    "lies")
             fix = "a glitch or the wrong column: remove the row or check --col/--freq-unit"
         elif base in ("rate_dph", "bias_dph", "input_rate_dph"):
-            why = f"beyond ±{high:g} °/h (1000 °/s), more than any HRG measures"
+            why = f"beyond ±{high:g} °/h (1000 °/s), more than any " + (
+                "gyro in a test" if self.thermometer == "sensor" else "HRG") + " measures"
             fix = ("a glitch or the wrong column: remove the row (--spikes drop) or check "
                    "--col/--rate-unit")
         else:
             why = f"outside {low:g} to {high:g} °C"
             fix = "a glitch or not a temperature in °C: remove the row (--spikes drop) or check "
-            fix += ("--temp-scale/--temp-offset (a raw sensor count?)"
-                    if base == "temperature_c" else "the mapping")
+            fix += ("--temp-scale/--temp-offset (a raw sensor count? calibrate --temp-ref LOG "
+                    "fits its map to a reference log)" if base == "temperature_c"
+                    else "the mapping")
         return Problem(
             "implausible",
             f"column '{name}', row {row}: {value:.6g} {unit} is {why} (first of {count} such "

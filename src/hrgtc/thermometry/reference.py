@@ -25,7 +25,9 @@ the fitted lag Δ minutes shorter (the fit absorbs it, while the map stays right
 long as the temperature changes smoothly); with the lag fixed at 0 the map instead
 takes the error as a bias of about (the temperature slope) × Δ. The fitted lag is
 in the report: a lag far from what the probe's mounting explains means a wrong
-start.
+start. A delay of an exponential settling is the same curve with a larger
+amplitude, so on a run that only settles exponentially the lag and the scale trade
+off (a ramp and a hold, or a known lag, pin both down).
 """
 
 from __future__ import annotations
