@@ -42,6 +42,10 @@ def report_command(
     from hrgtc.report import build_report
 
     with library_errors(), progress_bar("report", enabled=not json_output) as progress:
+        from hrgtc.model import load_instrument
+        from hrgtc.thermometry.reference import options_with_map
+
+        inputs = options_with_map(inputs, load_instrument(model).temperature_map)
         refuse_existing(output, force)
         check_writable(output, 20e6)  # before the passes over the runs
         path = build_report(model, runs, output, soaks=soak or None, title=title, force=force,
