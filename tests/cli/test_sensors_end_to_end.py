@@ -82,3 +82,17 @@ def test_one_cause_per_warning_whatever_the_axis():
              for k, a in enumerate("xyz")]
     assert len({warning_cause(t) for t in texts}) == 1
     assert warning_cause("spikes in rate_dph_x") != warning_cause("NaN in rate_dph_x")
+
+
+def test_info_shows_each_channel_s_resolution_and_the_count_as_a_count():
+    result = runner.invoke(app, ["info", str(RUN), *READ, "--temp-unit", "count", "--json"])
+    data = json.loads(result.stdout)
+    columns = {c["name"]: c for c in data["columns"]}
+    # three significant figures in rad/s: steps of 1e-4 rad/s = 20.6 °/h
+    assert columns["rate_dph_x"]["resolution"] == pytest.approx(1e-4 * 180 / np.pi * 3600,
+                                                                rel=1e-9)
+    assert columns["temperature_c"]["resolution"] == 1.0
+    assert columns["temperature_c"]["unit"] == "count"
+    assert columns["temperature_c"]["min"] == 63123 - 65536  # unwrapped
+    assert data["spike_rows"] == 3
+    assert not any(name.startswith("freq_hz") for name in columns)

@@ -161,7 +161,7 @@ class RecordingInfo:
                          "evaluate remove them, compensate flags them; --spike-filter)")
         for col in self._span_columns():
             if col.minimum is not None:
-                unit = "Hz" if col.unit == "Hz" else "°C"
+                unit = {"Hz": "Hz", "count": "counts"}.get(col.unit, "°C")
                 lines.append(f"  {col.name} span: {col.maximum - col.minimum:.6g} {unit}")
         lines.append(self.validation.summary().replace("\n", "\n  ").join(["  ", ""]))
         return "\n".join(lines)
@@ -322,6 +322,8 @@ def describe(
             measured_sample_rate_hz=report.measured_sample_rate_hz,
             gap_policy=report.gap_policy,
         )
+    raw_count = (dict(units or {}).get("temp") in ("count", "counts", "lsb", "raw")
+                 and (temp_scale, temp_offset_c) == (1.0, 0.0))
     duration = None
     if first_time is not None and meta is not None:
         duration = last_time - first_time + 1.0 / meta.sample_rate_hz
@@ -336,7 +338,7 @@ def describe(
         sample_rate_inferred=bool(meta is not None and meta.extra.get("sample_rate_inferred")),
         measured_sample_rate_hz=report.measured_sample_rate_hz,
         columns=tuple(
-            ColumnSummary(n, _unit(n, axis_names(names), thermometer),
+            ColumnSummary(n, _unit(n, axis_names(names), thermometer, raw_count),
                           *ranges.get(n, (None, None)), steps.get(n))
             for n in names
         ),
@@ -355,9 +357,14 @@ def _sensor_copy(name: str, names: Iterable[str], thermometer: str) -> bool:
     return own in names or "temperature_c" in names
 
 
-def _unit(name: str, axes: tuple[str, ...], thermometer: str) -> str:
-    """Contract unit of a column (per-axis ones too); ``freq_hz`` of a sensor thermometer: °C."""
+def _unit(name: str, axes: tuple[str, ...], thermometer: str, raw_count: bool = False) -> str:
+    """Contract unit of a column (per-axis ones too); ``freq_hz`` of a sensor thermometer: °C.
+
+    ``raw_count``: ``temperature_c*`` holds a raw count not yet mapped to °C (``count``).
+    """
     base = base_name(name, axes)
+    if raw_count and base == "temperature_c":
+        return "count"
     if base == "freq_hz" and thermometer == "sensor":
         return "degC"
     return COLUMNS[base][0] if base in COLUMNS else ""
