@@ -96,3 +96,10 @@ def test_info_shows_each_channel_s_resolution_and_the_count_as_a_count():
     assert columns["temperature_c"]["min"] == 63123 - 65536  # unwrapped
     assert data["spike_rows"] == 3
     assert not any(name.startswith("freq_hz") for name in columns)
+
+
+def test_reference_options_without_a_reference_log_are_refused(tmp_path):
+    result = runner.invoke(app, ["calibrate", "--drift", str(RUN), *READ, "--temp-ref-start",
+                                 "15:45", "-o", str(tmp_path / "m.json")])
+    assert result.exit_code == 2
+    assert "--temp-ref-start describes a reference log" in result.output

@@ -160,3 +160,13 @@ def test_real_cold_test_map_from_its_hand_log():
         earlier = map_from_reference(PAN, HANDLOG, PAN_OPTIONS, columns=cols, start="15:30")
     assert earlier.scale_c_per_count == pytest.approx(fitted.scale_c_per_count, rel=1e-12)
     assert earlier.lag_s == fitted.lag_s + 900.0
+
+
+def test_reference_columns_option():
+    from hrgtc.errors import InputError
+    from hrgtc.thermometry.reference import parse_reference_columns
+
+    assert parse_reference_columns(["time_s=Time", "temperature_c=C1 (C)"]) == {
+        "time_s": "Time", "temperature_c": "C1 (C)"}
+    with pytest.raises(InputError, match="--temp-ref-col 'probe=C1': write NAME=THEIRS"):
+        parse_reference_columns(["probe=C1"])

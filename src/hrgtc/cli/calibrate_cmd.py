@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 import typer
 from rich.table import Table
 
-from hrgtc.cli._app import app, console, error_console, library_errors, print_json
+from hrgtc.cli._app import app, console, error_console, fail, library_errors, print_json
 from hrgtc.cli.compensate_cmd import warn_ranges
 from hrgtc.cli.options import (
     STRICT_EXIT,
@@ -202,16 +202,22 @@ def calibrate_command(
         check_writable(output, 1e6)  # before the fit, not after it
         stages: dict[str, object] = {}
         temperature_map = None
+        ref_options = {"--temp-ref-col": temp_ref_col, "--temp-ref-start": temp_ref_start,
+                       "--temp-ref-unit": temp_ref_unit, "--temp-ref-tz": temp_ref_tz,
+                       "--temp-ref-lag-s": temp_ref_lag_s}
+        stray = [name for name, value in ref_options.items() if value not in (None, [])]
+        if temp_ref is None and stray:
+            raise fail(f"{stray[0]} describes a reference log: give the log with --temp-ref")
         if temp_ref is not None:
-            from hrgtc.recording.mapping import parse_columns
-            from hrgtc.thermometry.reference import map_from_reference, options_with_map
+            from hrgtc.thermometry.reference import (
+                map_from_reference,
+                options_with_map,
+                parse_reference_columns,
+            )
 
-            ref_columns = dict(item.split("=", 1) for text in temp_ref_col or []
-                               for item in text.split(",") if "=" in item)
-            if any(not item.count("=") for text in temp_ref_col or [] for item in text.split(",")):
-                parse_columns(temp_ref_col)  # names the malformed item
             temperature_map = map_from_reference(
-                drift[0], temp_ref, inputs, columns=ref_columns, unit=temp_ref_unit,
+                drift[0], temp_ref, inputs, columns=parse_reference_columns(temp_ref_col),
+                unit=temp_ref_unit,
                 start=temp_ref_start, tz=temp_ref_tz, lag_s=temp_ref_lag_s)
             inputs = options_with_map(dataclasses.replace(inputs, temp_scale=1.0,
                                                           temp_offset_c=0.0), temperature_map)

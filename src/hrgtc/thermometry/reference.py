@@ -173,6 +173,19 @@ def _nan(value: Any) -> float:
 
 
 # -- reading the log ---------------------------------------------------------------
+def parse_reference_columns(items: list[str] | None) -> dict[str, str]:
+    """``--temp-ref-col NAME=THEIRS`` options (repeated, or comma separated) as a dict."""
+    mapping: dict[str, str] = {}
+    for text in items or []:
+        for part in str(text).split(","):
+            name, sep, theirs = part.partition("=")
+            if not sep or name.strip() not in REFERENCE_COLUMNS or not theirs.strip():
+                raise InputError(f"--temp-ref-col {part!r}: write NAME=THEIRS with NAME one of "
+                                 f"{list(REFERENCE_COLUMNS)}, e.g. --temp-ref-col time_s=Time")
+            mapping[name.strip()] = theirs.strip()
+    return mapping
+
+
 def parse_clock(text: str, tz: dt.tzinfo | None = None) -> dt.datetime | dt.time:
     """A clock time ``HH:MM[:SS]`` (a :class:`datetime.time`) or an ISO date-time.
 
