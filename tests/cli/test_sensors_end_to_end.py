@@ -75,6 +75,9 @@ def test_cold_test_with_its_hand_log_end_to_end(tmp_path, monkeypatch):
     assert "compensated (temperature sensor)" in result.output
     assert "3.0143" not in result.output and "Eq. 22" not in result.output
     assert "resonator temperature rate" not in result.output
+    # the same range warning of the three axes: once, naming them
+    assert result.output.count("beyond the trained temperature") == 1
+    assert "(axes x, y, z)" in result.output
 
 
 def test_one_cause_per_warning_whatever_the_axis():

@@ -26,12 +26,31 @@ if TYPE_CHECKING:
     from hrgtc.recording import ReadOptions
 
 
-def warn_ranges(reports: list[RangeReport | None], json_output: bool, strict: bool) -> None:
-    """Print the range warnings (on stderr beside --json); with ``strict`` exit 3 if any."""
-    lines = [line for report in reports if report is not None for line in report.warnings()]
-    for line in lines:
+def warn_ranges(reports: list[RangeReport | None], json_output: bool, strict: bool,
+                labels: list[str] | None = None) -> None:
+    """Print the range warnings (on stderr beside --json); with ``strict`` exit 3 if any.
+
+    ``labels`` name the reports (the axes): a warning with the same cause on several
+    axes is printed once, naming them (its first axis's numbers).
+    """
+    from hrgtc.cli._app import warning_cause
+
+    groups: dict[str, list[tuple[str, str]]] = {}
+    for k, report in enumerate(reports):
+        if report is None:
+            continue
+        label = labels[k] if labels and k < len(labels) else ""
+        for line in report.warnings():
+            groups.setdefault(warning_cause(line), []).append((line, label))
+    for members in groups.values():
+        line, label = members[0]
+        named = [m[1] for m in members if m[1]]
+        if len(members) > 1 and named:
+            same = all(m[0] == line for m in members)
+            line += (f" (axes {', '.join(named)})" if same else
+                     f" (axis {label}; the same cause on {', '.join(named[1:])})")
         (error_console if json_output else console).print(f"[yellow]{line}[/]")
-    if strict and lines:
+    if strict and groups:
         raise typer.Exit(STRICT_EXIT)
 
 
@@ -212,7 +231,7 @@ def evaluate_command(
             for c in checks))
     elif checks:
         render_scale_checks(checks)
-    warn_ranges([r.ranges for r in results.values()], json_output, strict)
+    warn_ranges([r.ranges for r in results.values()], json_output, strict, list(results))
 
 
 def scale_checks(run: Path, model: InstrumentModel, inputs: ReadOptions) -> tuple:
