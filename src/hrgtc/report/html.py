@@ -316,21 +316,22 @@ def _run(page: _Page, k: int, run: Evaluation, model: UnitModel) -> None:
                 f"calibrated range.", f"raw and compensated output of {run.name}")
     housing = "housing" in run.bias_stability_dph
     rows = []
+    hrg = model.thermometer.source != "sensor"  # the paper's figures are an HRG's
     for tau in run.bias_stability_dph["raw"]:
+        paper_cells = ((_number(paper.BIAS_STABILITY_RAW_DPH, 5),
+                        _number(paper.BIAS_STABILITY_COMPENSATED_DPH, 4)) if tau == 10.0
+                       else ("–", "–")) if hrg else ()
         rows.append((f"{tau:g}", _stability(run, "raw", tau),
                      _stability(run, "compensated", tau), _number(_ratio(run, tau), 3),
-                     *([_stability(run, "housing", tau)] if housing else []),
-                     *((_number(paper.BIAS_STABILITY_RAW_DPH, 5),
-                        _number(paper.BIAS_STABILITY_COMPENSATED_DPH, 4)) if tau == 10.0
-                       else ("–", "–"))))
+                     *([_stability(run, "housing", tau)] if housing else []), *paper_cells))
     headers = ["τ [s]", "raw [°/h]", "compensated [°/h]", "improvement [×]",
                *(["housing baseline [°/h]"] if housing else []),
-               "paper raw [°/h]", "paper compensated [°/h]"]
+               *(["paper raw [°/h]", "paper compensated [°/h]"] if hrg else [])]
     page.add(_table(headers, rows, f"Bias stability of {run.name}: 1σ of τ-second means "
                         "of output − input rate with its "
                         f"{run.confidence:.3g} chi-squared interval, (blocks − 1) degrees "
-                        "of freedom (paper [1], Section 4.2: 3.0143 → 0.5848 °/h "
-                        "on its cool-down)"))
+                        "of freedom" + (" (paper [1], Section 4.2: 3.0143 → 0.5848 °/h "
+                                        "on its cool-down)" if hrg else "")))
     facts = [("samples outside the calibrated range (f, T)", f"{run.out_of_range_fraction:.2%}"),
              ("samples with df/dt outside its training range",
               f"{run.rate_out_of_range_fraction:.2%}")]
