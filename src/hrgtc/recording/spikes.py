@@ -28,7 +28,8 @@ state, left to the motion detector). The threshold is
 
     max(k · σ_MAD, m · LSB)
 
-with σ_MAD = 1.4826 · MAD / sqrt(1.5) of the second differences
+with σ_MAD = 1.4826 · MAD / sqrt(1.5) of the second differences (their MAD about
+0: they carry no level and no linear trend)
 ``x[i] − (x[i−1] + x[i+1]) / 2`` over a window of ``window_s`` seconds (never across
 a gap, a step of more than 2 median periods; a window with fewer than
 :data:`MIN_WINDOW_SAMPLES` samples uses its segment's), and LSB the channel's
@@ -61,6 +62,8 @@ SPIKE_LSB = 4.0
 SPIKE_WINDOW_S = 10.0
 #: Fewest samples a window needs for its own σ_MAD (else its segment's).
 MIN_WINDOW_SAMPLES = 16
+#: Rows the resolution (LSB) of a channel is taken from (its first ones).
+RESOLUTION_ROWS = 100_000
 #: Name of the column that marks spikes with ``spike_filter="flag"``.
 SPIKE_COLUMN = "spike"
 _MAD_TO_SIGMA = 1.482602218505602  # 1 / Φ^-1(3/4): MAD of a Gaussian -> its σ
@@ -181,10 +184,41 @@ def _segments(time_s: np.ndarray) -> list[tuple[int, int]]:
     return [(a, b) for a, b in itertools.pairwise(bounds) if b > a]
 
 
-def _sigma(residual: np.ndarray) -> float:
-    """σ of the samples from the MAD of their second differences (0 for a constant)."""
-    middle = float(np.median(residual))
-    return _MAD_TO_SIGMA * float(np.median(np.abs(residual - middle))) / _SECOND_DIFF
+def _sigma(second: np.ndarray) -> float:
+    """σ of the samples from the MAD of their second differences (0 for a constant).
+
+    The MAD about 0: second differences carry no level and no linear trend.
+    """
+    return _MAD_TO_SIGMA * float(np.median(np.abs(second))) / _SECOND_DIFF
+
+
+def _window_sigmas(second: np.ndarray, bounds: np.ndarray) -> np.ndarray:
+    """σ_MAD of each window ``bounds[i]:bounds[i+1]`` of the second differences.
+
+    Windows of equal length are done together (one median per row of a 2-D view);
+    a window with fewer than :data:`MIN_WINDOW_SAMPLES` finite values takes its
+    segment's σ.
+    """
+    sizes = np.diff(bounds)
+    sigmas = np.full(sizes.size, np.nan)
+    finite = np.isfinite(second)
+    if finite.all():
+        for size in np.unique(sizes):
+            which = np.flatnonzero(sizes == size)
+            if size < MIN_WINDOW_SAMPLES:
+                continue
+            rows = np.abs(second[bounds[which][:, None] + np.arange(size)])
+            sigmas[which] = _MAD_TO_SIGMA * np.median(rows, axis=1) / _SECOND_DIFF
+    else:
+        for i, (a, b) in enumerate(itertools.pairwise(bounds.tolist())):
+            part = second[a:b][finite[a:b]]
+            if part.size >= MIN_WINDOW_SAMPLES:
+                sigmas[i] = _sigma(part)
+    short = np.isnan(sigmas)
+    if short.any():
+        whole = second[finite]
+        sigmas[short] = _sigma(whole) if whole.size else 0.0
+    return sigmas
 
 
 def find_spikes(time_s: np.ndarray, values: np.ndarray, *, k: float = SPIKE_K,
@@ -205,7 +239,8 @@ def find_spikes(time_s: np.ndarray, values: np.ndarray, *, k: float = SPIKE_K,
     window_s
         Length of the windows σ_MAD is estimated on (cut at gaps). [s]
     lsb
-        The channel's resolution; None: :func:`hrgtc.recording.resolution.resolution`.
+        The channel's resolution; None: :func:`hrgtc.recording.resolution.resolution`
+        of its first :data:`RESOLUTION_ROWS` values.
 
     Returns
     -------
@@ -216,7 +251,7 @@ def find_spikes(time_s: np.ndarray, values: np.ndarray, *, k: float = SPIKE_K,
     x = np.asarray(values, dtype=np.float64)
     t = np.asarray(time_s, dtype=np.float64)
     if lsb is None:
-        lsb = resolution(x)
+        lsb = resolution(x[:RESOLUTION_ROWS])
     floor = lsb_multiple * float(lsb or 0.0)
     spikes = np.zeros(x.size, dtype=bool)
     for start, stop in _segments(t):
@@ -226,18 +261,14 @@ def find_spikes(time_s: np.ndarray, values: np.ndarray, *, k: float = SPIKE_K,
         second = np.empty_like(xs)
         second[1:-1] = xs[1:-1] - 0.5 * (xs[:-2] + xs[2:])
         second[0], second[-1] = second[1], second[-2]
-        segment_sigma = _sigma(second[np.isfinite(second)]) if np.isfinite(second).any() else 0.0
-        limit = np.empty_like(xs)
         ts = t[start:stop]
         with np.errstate(invalid="ignore"):
             origin = float(np.nanmin(ts)) if np.isfinite(ts).any() else 0.0
             block = np.floor((ts - origin) / window_s)
         edges = np.flatnonzero(np.diff(block)) + 1
-        bounds = [0, *edges.tolist(), len(xs)]
-        for a, b in itertools.pairwise(bounds):
-            part = second[a:b][np.isfinite(second[a:b])]
-            sigma = _sigma(part) if part.size >= MIN_WINDOW_SAMPLES else segment_sigma
-            limit[a:b] = max(k * sigma, floor)
+        bounds = np.array([0, *edges.tolist(), len(xs)])
+        sigmas = _window_sigmas(second, bounds)
+        limit = np.repeat(np.maximum(k * sigmas, floor), np.diff(bounds))
         with np.errstate(invalid="ignore"):
             left = np.abs(np.diff(xs, prepend=np.nan))
             right = np.abs(np.diff(xs, append=np.nan))
@@ -317,8 +348,8 @@ class RobustSpikeFilter:
         marked = np.zeros(len(time_s), dtype=bool)
         for name in _filtered_columns(columns, axes, self.sensor):
             values = columns[name]
-            if name not in self._lsb:  # the resolution of the first piece holds for the file
-                self._lsb[name] = resolution(values)
+            if name not in self._lsb:  # the resolution of the first rows holds for the file
+                self._lsb[name] = resolution(values[:RESOLUTION_ROWS])
             mask = find_spikes(time_s, values, k=self.k, lsb_multiple=self.lsb_multiple,
                                window_s=self.window_s, lsb=self._lsb[name])
             bounds = self._bounds(name, axes)
