@@ -14,7 +14,7 @@ from hrgtc.cli.options import ForceOption, JsonOption, OutputFormat
 # Written out so that --help needs no import of the simulator (it starts at once); a test
 # holds them equal to hrgtc.simulate's KINDS, unit names, DEFAULT_UNIT and input rate.
 PROFILE_KINDS = ("soak", "cooldown", "warmup", "constant", "ramp", "ratetable")
-UNIT_NAMES = ("paper-unit", "unit-b", "imu-3")
+UNIT_NAMES = ("paper-unit", "unit-b", "imu-3", "mems-3")
 DEFAULT_UNIT = "paper-unit"
 DEFAULT_INPUT_RATE_DPH = 10.0
 

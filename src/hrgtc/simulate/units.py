@@ -388,10 +388,17 @@ def _imu3() -> MultiAxisUnit:
     )
 
 
+def _mems3() -> MultiAxisUnit:
+    from hrgtc.simulate.mems import mems3  # mems.py builds on this module's types
+
+    return mems3()
+
+
 _FACTORIES: dict[str, Callable[[], Unit | MultiAxisUnit]] = {
     "paper-unit": _paper_unit,
     "unit-b": _unit_b,
     "imu-3": _imu3,
+    "mems-3": _mems3,
 }
 
 
@@ -402,7 +409,7 @@ def names() -> list[str]:
 
 @cache
 def get(name: str = DEFAULT_UNIT) -> Unit | MultiAxisUnit:
-    """The named unit (a :class:`MultiAxisUnit` for ``imu-3``).
+    """The named unit (a :class:`MultiAxisUnit` for ``imu-3`` and ``mems-3``).
 
     Raises
     ------
