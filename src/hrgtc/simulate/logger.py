@@ -1,0 +1,525 @@
+"""What a real logger writes, with ground truth: bursts, clocks, restarts, counts, spikes.
+
+The simulator's runs (:mod:`hrgtc.simulate.campaign`) are continuous, in seconds, in
+°/h, with a resonator frequency. A test bench's logger writes something else, and
+:func:`log_run` turns a simulated run into it, keeping the truth of every row:
+
+* **duty cycle**: ``burst`` keeps ``burst_s`` of every ``period_s`` (50 Hz bursts of 5 s
+  every 300 s in the PAN cold test); ``continuous`` keeps every sample;
+* **clock**: time in s, ms or µs since power-on (from ``clock_start_s``), with Gaussian
+  jitter, optionally a ``counter_bits`` counter that wraps (a 32-bit µs counter every
+  71.6 min);
+* **restarts**: at each ``restarts_s`` the logger is off for ``restart_off_s``, then its
+  clock, burst schedule and the gyro's warm-up start again; each run may have its own
+  turn-on offset (``run_offset_dph``, a nuisance constant) and warm-up transient;
+* **rates** in °/h, °/s, rad/s or mrad/s, rounded to ``rate_digits`` significant digits
+  as some loggers print them;
+* **temperature** (:class:`~hrgtc.simulate.reflog.TemperatureChannel`): °C or a raw count,
+  possibly slower than the rates (empty cells between), and a hand-written reference
+  log (:class:`~hrgtc.simulate.reflog.ReferenceLog`);
+* **spikes**: single-sample spikes of known size and row;
+* **handling** (:class:`~hrgtc.simulate.handling.Handling`): still periods in several
+  orientations with rotation bursts between them, and accelerometer columns.
+
+The simulation runs at the logger's sample rate over the whole run and then keeps
+the logged rows (2 h at 50 Hz of a three-axis unit take about a second), so the noise
+of the kept samples is the noise of a continuous recording cut into bursts.
+Writing the files: :mod:`hrgtc.simulate.logged_files`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+import numpy as np
+
+from hrgtc.errors import InputError
+from hrgtc.simulate import units as _units
+from hrgtc.simulate.campaign import simulate_run
+from hrgtc.simulate.handling import Handling, handling_truth
+from hrgtc.simulate.profiles import Profile
+from hrgtc.simulate.reflog import ReferenceLog, TemperatureChannel, reference_log_text
+from hrgtc.simulate.units import MultiAxisUnit, Unit
+
+__all__ = ["RATE_FACTORS", "TIME_FACTORS", "LoggedRun", "Logger", "log_run", "unwrap_counter"]
+
+#: °/h -> the rate unit written: value_written = rate_dph * factor.
+RATE_FACTORS = {
+    "dph": 1.0,
+    "dps": 1.0 / 3600.0,
+    "radps": math.pi / 180.0 / 3600.0,
+    "mradps": 1000.0 * math.pi / 180.0 / 3600.0,
+}
+#: s -> the time unit written.
+TIME_FACTORS = {"s": 1.0, "ms": 1e3, "us": 1e6}
+_RATE_LABELS = {"dph": "deg/h", "dps": "deg/s", "radps": "rad/s", "mradps": "mrad/s"}
+
+
+@dataclass(frozen=True)
+class Logger:
+    """A data logger: what it keeps of a run and how it writes it.
+
+    Parameters
+    ----------
+    kind
+        ``continuous`` or ``burst``.
+    sample_rate_hz
+        Sample rate of the logger (the run is simulated at this rate). [Hz]
+    burst_s, period_s
+        A burst logger keeps ``burst_s`` of every ``period_s``, from each power-on. [s]
+    time_unit
+        ``s``, ``ms`` or ``us``; ms and µs are written as integers.
+    counter_bits
+        The time is an unsigned counter of this many bits that wraps; None: no wrap.
+    clock_start_s
+        Clock reading at the first sample after power-on. [s]
+    jitter_s
+        Rms jitter of each time stamp. [s]
+    restarts_s
+        Times of power cycles, from the start of the run. [s]
+    restart_off_s
+        How long the logger stays off at a restart. [s]
+    run_offset_dph
+        Rms of a constant turn-on offset drawn for each run (the first run included). [°/h]
+    warmup_dph, warmup_tau_s
+        A warm-up transient ``warmup_dph * exp(-t/warmup_tau_s)`` after each power-on. [°/h], [s]
+    rate_unit
+        ``dph``, ``dps``, ``radps`` or ``mradps``.
+    rate_digits
+        Significant digits of the rates in the file; None: full precision.
+    frequency
+        Write the resonator frequency (an HRG); False for a gyro without one (MEMS).
+    temperature
+        The logged temperature channel, or None.
+    reference_log
+        A hand-written reference log beside the file, or None (needs ``temperature``).
+    spikes
+        Number of single-sample spikes.
+    spike_dph
+        Size of each spike (sign included); 0: 500 times the rate noise, negative. [°/h]
+    handling
+        Orientations and handling between them, or None (at rest in one orientation).
+    accelerometer
+        Write accelerometer columns (``accel_unit``).
+    accel_unit
+        ``g`` or ``mps2``.
+    columns
+        Role -> the logger's column name; roles ``time``, ``rate_<axis>``, ``freq_<axis>``,
+        ``temperature``, ``accel_x|y|z`` (``rate``/``freq`` for a single-axis unit).
+        Roles not given get generic names (:meth:`column_names`).
+    """
+
+    kind: str = "continuous"
+    sample_rate_hz: float = 50.0
+    burst_s: float = 5.0
+    period_s: float = 300.0
+    time_unit: str = "s"
+    counter_bits: int | None = None
+    clock_start_s: float = 0.0
+    jitter_s: float = 0.0
+    restarts_s: tuple[float, ...] = ()
+    restart_off_s: float = 10.0
+    run_offset_dph: float = 0.0
+    warmup_dph: float = 0.0
+    warmup_tau_s: float = 120.0
+    rate_unit: str = "dph"
+    rate_digits: int | None = None
+    frequency: bool = True
+    temperature: TemperatureChannel | None = None
+    reference_log: ReferenceLog | None = None
+    spikes: int = 0
+    spike_dph: float = 0.0
+    handling: Handling | None = None
+    accelerometer: bool = False
+    accel_unit: str = "g"
+    columns: Mapping[str, str] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        choices = {"kind": ("continuous", "burst"), "time_unit": tuple(TIME_FACTORS),
+                   "rate_unit": tuple(RATE_FACTORS), "accel_unit": ("g", "mps2")}
+        for name, allowed in choices.items():
+            if getattr(self, name) not in allowed:
+                raise InputError(f"logger {name} {getattr(self, name)!r}: choose one of "
+                                 f"{', '.join(allowed)}")
+        positive = ["sample_rate_hz"] + (["burst_s", "period_s"] if self.kind == "burst" else [])
+        for name in positive:
+            value = float(getattr(self, name))
+            if not (math.isfinite(value) and value > 0.0):
+                raise InputError(f"logger {name} must be finite and > 0, got {value!r}")
+        if self.kind == "burst" and self.burst_s >= self.period_s:
+            raise InputError(f"burst_s {self.burst_s:g} must be shorter than period_s "
+                             f"{self.period_s:g} [s]; use kind='continuous' for no gaps")
+        if self.counter_bits is not None:
+            if self.time_unit == "s":
+                raise InputError("a wrapping counter needs time_unit ms or us, not s")
+            if not 8 <= int(self.counter_bits) <= 63:
+                raise InputError(f"counter_bits must be 8..63, got {self.counter_bits!r}")
+        if not (0.0 <= self.jitter_s < 0.25 / self.sample_rate_hz):
+            raise InputError(f"jitter_s {self.jitter_s!r} must be >= 0 and below a quarter "
+                             f"of the sample period {1.0 / self.sample_rate_hz:g} s")
+        restarts = tuple(float(t) for t in self.restarts_s)
+        if list(restarts) != sorted(restarts) or any(t <= 0 for t in restarts):
+            raise InputError(f"restarts_s {restarts} must be increasing times > 0 [s]")
+        object.__setattr__(self, "restarts_s", restarts)
+        if self.reference_log is not None and self.temperature is None:
+            raise InputError("a reference log needs a logged temperature channel")
+        if self.rate_digits is not None and not 1 <= int(self.rate_digits) <= 17:
+            raise InputError(f"rate_digits must be 1..17, got {self.rate_digits!r}")
+        object.__setattr__(self, "columns", dict(self.columns))
+
+    def column_names(self, axes: tuple[str | None, ...]) -> dict[str, str]:
+        """Role -> column name in the file, in column order."""
+        time_name = {"s": "time_s", "ms": "time_ms", "us": "time_us"}[self.time_unit]
+        names = {"time": time_name}
+        label = _RATE_LABELS[self.rate_unit]
+        for axis in axes:
+            key = "" if axis is None else f"_{axis}"
+            if self.frequency:
+                names[f"freq{key}"] = f"f{key} [Hz]"
+            names[f"rate{key}"] = f"gyro{key} [{label}]"
+        if self.temperature is not None:
+            names["temperature"] = "temp_raw" if self.temperature.lsb_c is not None else "temp [C]"
+        if self.accelerometer:
+            unit = "g" if self.accel_unit == "g" else "m/s^2"
+            names.update({f"accel_{a}": f"acc_{a} [{unit}]" for a in "xyz"})
+        unknown = sorted(set(self.columns) - set(names))
+        if unknown:
+            raise InputError(f"logger columns {unknown} are not roles of this file; roles: "
+                             f"{', '.join(names)}")
+        names.update(self.columns)
+        if len(set(names.values())) != len(names):
+            raise InputError(f"logger column names must be distinct, got {list(names.values())}")
+        return names
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types."""
+        out = asdict(self)
+        out["restarts_s"] = list(self.restarts_s)
+        out["temperature"] = None if self.temperature is None else self.temperature.to_dict()
+        out["reference_log"] = (None if self.reference_log is None
+                                else self.reference_log.to_dict())
+        out["handling"] = None if self.handling is None else self.handling.to_dict()
+        out["columns"] = dict(self.columns)
+        return out
+
+
+@dataclass
+class LoggedRun:
+    """A run as a logger wrote it, and its truth.
+
+    Attributes
+    ----------
+    columns
+        Column name -> values as written (NaN: an empty cell), in file order.
+    kinds
+        Column name -> ``int`` or ``float`` and its digits, for writing.
+    truth
+        Per logged row: true time, run, segment, flags and the simulator's truth columns.
+    info
+        The sidecar (plain JSON types): logger, unit, maps, spikes, segments, ranges,
+        and the ``hrgtc`` options that read the file.
+    reference_log
+        Text of the hand-written reference log, or None.
+    """
+
+    columns: dict[str, np.ndarray]
+    kinds: dict[str, str]
+    truth: dict[str, np.ndarray]
+    info: dict[str, Any]
+    reference_log: str | None = None
+
+    def __len__(self) -> int:
+        return len(next(iter(self.columns.values())))
+
+
+def unwrap_counter(values: np.ndarray, bits: int) -> np.ndarray:
+    """Unwrap an unsigned ``bits``-bit counter that only moves forward (between wraps).
+
+    Examples
+    --------
+    >>> unwrap_counter(np.array([250.0, 254.0, 2.0, 6.0]), 8).tolist()
+    [250.0, 254.0, 258.0, 262.0]
+    """
+    v = np.asarray(values, dtype=np.float64)
+    wraps = np.concatenate(([0.0], np.cumsum(np.diff(v) < 0)))
+    return v + wraps * 2.0 ** int(bits)
+
+
+def _round_significant(value: np.ndarray, digits: int) -> np.ndarray:
+    """``value`` rounded to ``digits`` significant digits (as printf's %.{d-1}E)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        exponent = np.floor(np.log10(np.abs(value)))
+    exponent = np.where(np.isfinite(exponent), exponent, 0.0)
+    scale = 10.0 ** (digits - 1 - exponent)
+    return np.round(value * scale) / scale
+
+
+def _segments(keep: np.ndarray, run: np.ndarray, burst: np.ndarray) -> np.ndarray:
+    """Segment index of each kept row: a new one at each burst or run start."""
+    r, b = run[keep], burst[keep]
+    new = np.ones(r.size, dtype=bool)
+    new[1:] = (r[1:] != r[:-1]) | (b[1:] != b[:-1])
+    return np.cumsum(new) - 1
+
+
+def log_run(
+    profile: Profile,
+    unit: str | Unit | MultiAxisUnit,
+    logger: Logger,
+    seed: int = 0,
+    input_rate_dph: float | Mapping[str, float] | None = None,
+) -> LoggedRun:
+    """Simulate a run and write it as ``logger`` would, with the truth of every row.
+
+    Parameters
+    ----------
+    profile
+        The chamber program.
+    unit
+        A unit name or unit (``mems-3`` for a MEMS gyro: write it with ``frequency`` False).
+    logger
+        The logger.
+    seed
+        Non-negative integer; the same seed gives the same files.
+    input_rate_dph
+        Known constant input rate, as for :func:`hrgtc.simulate.simulate_run`. [°/h]
+
+    Returns
+    -------
+    LoggedRun
+        Columns as written, the truth per row and the sidecar.
+    """
+    gyro = unit if isinstance(unit, Unit | MultiAxisUnit) else _units.get(unit)
+    axes: tuple[str | None, ...] = (gyro.axis_names if isinstance(gyro, MultiAxisUnit)
+                                    else (None,))
+    names = logger.column_names(axes)
+    sim_seed, logger_seed = np.random.SeedSequence(int(seed)).spawn(2)
+    rng = np.random.default_rng(logger_seed)
+    fs = logger.sample_rate_hz
+    rec = simulate_run(profile, gyro, fs, sim_seed, input_rate_dph)
+    t = rec["time_s"]
+    n = t.size
+    duration = float(t[-1])
+
+    # Power cycles: off from each restart for restart_off_s, then a new run.
+    power_on = np.array([0.0, *[r + logger.restart_off_s for r in logger.restarts_s]])
+    if logger.restarts_s and power_on[-1] >= duration:
+        raise InputError(f"a restart at {logger.restarts_s[-1]:g} s leaves no run before the "
+                         f"end of the {duration:g} s run")
+    run = np.searchsorted(power_on, t, side="right") - 1
+    since_on = t - power_on[run]
+    on = np.ones(n, dtype=bool)
+    for r in logger.restarts_s:
+        on &= ~((t >= r) & (t < r + logger.restart_off_s))
+    if logger.kind == "burst":
+        burst = np.floor(since_on / logger.period_s + 1e-9).astype(np.int64)
+        keep = on & (since_on - burst * logger.period_s < logger.burst_s - 0.5 / fs)
+    else:
+        burst = np.zeros(n, dtype=np.int64)
+        keep = on
+    rows = np.flatnonzero(keep)
+    if rows.size < 2:
+        raise InputError("the logger keeps fewer than 2 samples of this run; log longer runs")
+
+    body = {a: (a if a is not None else "z") for a in axes}
+    handled = (handling_truth(t, list(body.values()), logger.handling, rng)
+               if logger.handling is not None else None)
+    run_offsets = rng.normal(0.0, logger.run_offset_dph, size=power_on.size)
+    warmup = logger.warmup_dph * np.exp(-since_on / logger.warmup_tau_s)
+
+    truth: dict[str, np.ndarray] = {
+        "time_s": t[rows],
+        "run": run[rows],
+        "segment": _segments(keep, run, burst),
+        "motion": (handled.motion[rows] if handled else np.zeros(rows.size, dtype=bool)),
+        "orientation": (handled.orientation[rows] if handled
+                        else np.zeros(rows.size, dtype=np.int64)),
+        "chamber_c": rec["chamber_c"][rows],
+        "housing_c": rec["housing_c"][rows],
+    }
+    restart = np.zeros(rows.size, dtype=bool)
+    restart[0] = True
+    restart[1:] = truth["run"][1:] != truth["run"][:-1]
+    truth["restart"] = restart
+
+    columns: dict[str, np.ndarray] = {}
+    kinds: dict[str, str] = {}
+    # The clock: time since power-on from clock_start_s, jitter, unit, counter wrap.
+    clock_s = logger.clock_start_s + since_on[rows]
+    if logger.jitter_s > 0.0:
+        clock_s = clock_s + rng.normal(0.0, logger.jitter_s, size=rows.size)
+    factor = TIME_FACTORS[logger.time_unit]
+    if logger.time_unit == "s":
+        written_time = np.round(clock_s, 6)
+        kinds[names["time"]] = "float:.6f"
+    else:
+        written_time = np.round(clock_s * factor)
+        kinds[names["time"]] = "int"
+    truth["clock_s"] = written_time / factor
+    if logger.counter_bits is not None:
+        written_time = np.mod(written_time, 2.0 ** int(logger.counter_bits))
+    columns[names["time"]] = written_time
+
+    motion_rate_max = 0.0
+    spike_rows = np.array([], dtype=np.int64)
+    spike_axes: list[str | None] = []
+    if logger.spikes:
+        candidates = np.flatnonzero(~truth["motion"])
+        spike_rows = np.sort(rng.choice(candidates, size=int(logger.spikes), replace=False))
+        spike_axes = [axes[int(i)] for i in rng.integers(0, len(axes), size=spike_rows.size)]
+    truth["spike"] = np.isin(np.arange(rows.size), spike_rows)
+    spikes_info = []
+    dfdt_info: dict[str, Any] = {}
+    still = ~truth["motion"]
+    for axis in axes:
+        key = "" if axis is None else f"_{axis}"
+        gyro_axis = gyro.axes[axis] if isinstance(gyro, MultiAxisUnit) else gyro
+        offset = run_offsets[run[rows]] + warmup[rows]
+        motion_dph = np.zeros(rows.size)
+        if handled is not None:
+            offset = offset + handled.offset_dph[body[axis]][rows]
+            motion_dph = handled.motion_dph[body[axis]][rows]
+            motion_rate_max = max(motion_rate_max, float(np.max(np.abs(motion_dph))) / 3600.0)
+        rate = rec[f"rate_dph{key}"][rows] + offset + motion_dph
+        truth[f"rate_dph{key}"] = rate.copy()
+        truth[f"bias_dph{key}"] = rec[f"bias_dph{key}"][rows]
+        truth[f"offset_dph{key}"] = offset
+        truth[f"motion_dph{key}"] = motion_dph
+        truth[f"resonator_c{key}"] = rec[f"resonator_c{key}"][rows]
+        if f"scale_ppm{key}" in rec.names:
+            truth[f"scale_ppm{key}"] = rec[f"scale_ppm{key}"][rows]
+        # The true rate of change of the thermometer, from the noiseless continuous run.
+        resonator = rec[f"resonator_c{key}"]
+        dtdt = np.gradient(resonator, t)
+        truth[f"dtdt_c_per_s{key}"] = dtdt[rows]
+        dfdt = np.gradient(gyro_axis.frequency_law.frequency_hz(resonator), t)
+        truth[f"dfdt_hz_per_s{key}"] = dfdt[rows]
+        sigma = float(np.std(np.diff(rec[f"rate_dph{key}"][: min(n, 20000)]))) / math.sqrt(2.0)
+        size = logger.spike_dph or -500.0 * sigma
+        for r, a in zip(spike_rows, spike_axes, strict=True):
+            if a == axis:
+                rate[r] += size
+                spikes_info.append({"row": int(r), "axis": axis, "column": names[f"rate{key}"],
+                                    "size_dph": size, "size_written": size *
+                                    RATE_FACTORS[logger.rate_unit]})
+        written = rate * RATE_FACTORS[logger.rate_unit]
+        if logger.rate_digits is not None:
+            written = _round_significant(written, int(logger.rate_digits))
+            kinds[names[f"rate{key}"]] = f"float:.{int(logger.rate_digits) - 1}E"
+        else:
+            kinds[names[f"rate{key}"]] = "float:.17g"
+        if logger.frequency:
+            columns[names[f"freq{key}"]] = rec[f"freq_hz{key}"][rows]
+            kinds[names[f"freq{key}"]] = "float:.6f"
+            truth[f"freq_hz{key}"] = rec[f"freq_hz{key}"][rows]
+        columns[names[f"rate{key}"]] = written
+        label = "x" if axis is None else axis
+        for what, values in (("dtdt_c_per_s", dtdt[rows]), ("dfdt_hz_per_s", dfdt[rows])):
+            kept = values[still]
+            dfdt_info.setdefault(what, {})[label] = {
+                "min": float(kept.min()), "max": float(kept.max()),
+                "p01": float(np.percentile(kept, 1)), "p99": float(np.percentile(kept, 99)),
+            }
+
+    temperature_info = None
+    reference_text = None
+    first = axes[0]
+    sensor_true = rec["resonator_c" + ("" if first is None else f"_{first}")]
+    if logger.temperature is not None:
+        channel = logger.temperature
+        source = sensor_true if channel.source == "die" else rec["housing_c"]
+        written = channel.written(source[rows], rng)
+        if channel.rate_hz is not None:
+            tick = np.floor(t[rows] * channel.rate_hz + 1e-9)
+            fresh = np.ones(rows.size, dtype=bool)
+            fresh[1:] = tick[1:] != tick[:-1]
+            written = np.where(fresh, written, np.nan)
+            truth["temperature_fresh"] = fresh
+        columns[names["temperature"]] = written
+        kinds[names["temperature"]] = ("int" if channel.lsb_c is not None
+                                       else f"float:.{int(channel.decimals)}f")
+        truth["sensor_c"] = source[rows]
+        temperature_info = {"column": names["temperature"], "source": channel.source,
+                            "map": channel.map(), "rate_hz": channel.rate_hz,
+                            "range_c": [float(source[rows].min()), float(source[rows].max())]}
+        if logger.reference_log is not None:
+            reference_text, readings = reference_log_text(
+                logger.reference_log, t, source, rec["housing_c"], rec["chamber_c"], rng)
+            temperature_info["reference_log"] = {
+                "probe_column": logger.reference_log.probe_column,
+                "start": logger.reference_log.start, "lag_s": logger.reference_log.lag_s,
+                "readings": readings,
+            }
+    if logger.accelerometer:
+        accel = (handled.accel_g[rows] if handled is not None
+                 else np.tile([0.0, 0.0, 1.0], (rows.size, 1))
+                 + rng.normal(0.0, 0.002, size=(rows.size, 3)))
+        scale = 1.0 if logger.accel_unit == "g" else 9.80665
+        for i, a in enumerate("xyz"):
+            columns[names[f"accel_{a}"]] = np.round(accel[:, i] * scale, 4)
+            kinds[names[f"accel_{a}"]] = "float:.4f"
+    columns = {name: columns[name] for name in names.values() if name in columns}
+
+    segment_first = np.flatnonzero(np.diff(truth["segment"], prepend=-1))
+    segment_last = np.concatenate((segment_first[1:] - 1, [rows.size - 1]))
+    info: dict[str, Any] = {
+        "simulated": True,
+        "seed": int(seed),
+        "unit": gyro.name,
+        "profile": profile.description,
+        "chamber_program": profile.to_dict(),
+        "logger": logger.to_dict(),
+        "rows": int(rows.size),
+        "simulated_rows": int(n),
+        "duration_s": duration,
+        "columns": {role: name for role, name in names.items()},
+        "rate_unit": logger.rate_unit,
+        "time_unit": logger.time_unit,
+        "segments": [
+            {"first_row": int(a), "last_row": int(b), "run": int(truth["run"][a]),
+             "start_s": float(truth["time_s"][a]), "end_s": float(truth["time_s"][b])}
+            for a, b in zip(segment_first, segment_last, strict=True)
+        ],
+        "restarts": [{"row": int(r), "time_s": float(truth["time_s"][r]),
+                      "run_offset_dph": float(run_offsets[truth["run"][r]])}
+                     for r in np.flatnonzero(restart)],
+        "spikes": spikes_info,
+        "temperature": temperature_info,
+        "dfdt_still": dfdt_info,
+        "motion_rows": int(truth["motion"].sum()),
+        "motion_peak_dps": motion_rate_max,
+        "orientations": handled.table if handled is not None else [],
+        "handling_windows": handled.windows if handled is not None else [],
+    }
+    info["hrgtc_options"] = reading_options(info, axes, logger)
+    return LoggedRun(columns, kinds, truth, info, reference_text)
+
+
+def reading_options(info: Mapping[str, Any], axes: tuple[str | None, ...],
+                    logger: Logger) -> list[str]:
+    """The ``hrgtc`` reading options for a logged file (its column names and units)."""
+    roles = info["columns"]
+    cols = [f"time_s={roles['time']}"]
+    for axis in axes:
+        key = "" if axis is None else f"_{axis}"
+        cols.append(f"rate_dph{key}={roles[f'rate{key}']}")
+        if logger.frequency:
+            cols.append(f"freq_hz{key}={roles[f'freq{key}']}")
+    if logger.temperature is not None:
+        cols.append(f"temperature_c={roles['temperature']}")
+    options = []
+    for c in cols:
+        options += ["--col", c]
+    options += ["--time-unit", logger.time_unit, "--rate-unit", logger.rate_unit]
+    channel = logger.temperature
+    if channel is not None and channel.lsb_c is not None and channel.bits is None:
+        options += ["--temp-scale", f"{channel.lsb_c:.17g}",
+                    "--temp-offset", f"{channel.offset_c:.17g}"]
+    if not logger.frequency:
+        options += ["--thermometer", "sensor"]
+    if logger.kind == "burst" or logger.restarts_s:
+        options += ["--gaps", "split"]
+    return options
