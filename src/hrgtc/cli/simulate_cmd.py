@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 from rich.table import Table
@@ -18,8 +18,12 @@ UNIT_NAMES = ("paper-unit", "unit-b", "imu-3", "mems-3")
 DEFAULT_UNIT = "paper-unit"
 DEFAULT_INPUT_RATE_DPH = 10.0
 
+LOGGER_KINDS = ("continuous", "burst", "pan-cold", "fridge-3day")
+LOGGER_RATE_UNITS = ("dph", "dps", "radps", "mradps")
+
 _PROFILE = "Profile"
 _RUN = "Run"
+_LOGGER = "Logger (files as a real logger writes them, with ground truth)"
 
 
 def _numbers(value: str | None, example: str = "-20,-10,0,10",
@@ -37,17 +41,18 @@ def _numbers(value: str | None, example: str = "-20,-10,0,10",
 @app.command("simulate")
 def simulate_command(
     profile: Annotated[
-        str,
+        str | None,
         typer.Option(
             "--profile",
             metavar="|".join(PROFILE_KINDS) + "|FILE.yaml",
             help="Chamber program: soak (one run per set-point), cooldown, warmup, constant, "
             "ramp, ratetable (plateaus from --setpoints, each soaked --hours then the "
             "--rates held --rate-hold-s each, axis after axis), or a JSON/YAML profile file "
-            "(list of {setpoint_c, hold_h | ramp_c_per_min[, table_rate_dps, axis]} segments).",
+            "(list of {setpoint_c, hold_h | ramp_c_per_min[, table_rate_dps, axis]} segments). "
+            "Default soak, or the --logger preset's program.",
             rich_help_panel=_PROFILE,
         ),
-    ] = "soak",
+    ] = None,
     setpoints: Annotated[
         str | None,
         typer.Option(
@@ -119,15 +124,18 @@ def simulate_command(
         ),
     ] = False,
     unit: Annotated[
-        str,
+        str | None,
         typer.Option(
-            help=f"Simulated gyro: {', '.join(UNIT_NAMES)}.", rich_help_panel=_RUN
+            help=f"Simulated gyro: {', '.join(UNIT_NAMES)} (default {DEFAULT_UNIT}, or the "
+            "--logger preset's mems-3).", rich_help_panel=_RUN
         ),
-    ] = DEFAULT_UNIT,
+    ] = None,
     sample_rate_hz: Annotated[
-        float, typer.Option("--sample-rate-hz", "--rate-hz", help="Sample rate [Hz].",
-                            rich_help_panel=_RUN)
-    ] = 200.0,
+        float | None,
+        typer.Option("--sample-rate-hz", "--rate-hz",
+                     help="Sample rate [Hz] (default 200, or the --logger preset's).",
+                     rich_help_panel=_RUN)
+    ] = None,
     seed: Annotated[
         int, typer.Option(min=0, help="Random seed; the same seed gives the same files.",
                           rich_help_panel=_RUN)
@@ -141,6 +149,119 @@ def simulate_command(
             "multi-axis unit (a value given applies to every axis).",
             rich_help_panel=_RUN,
         ),
+    ] = None,
+    logger: Annotated[
+        str | None,
+        typer.Option(
+            "--logger",
+            metavar="|".join(LOGGER_KINDS),
+            help="Write the run as a real logger does, with ground truth beside it "
+            "(FILE.truth.json, FILE.truth.csv): continuous, burst (--burst-s of every "
+            "--period-s), or a preset: pan-cold (the PAN cold test: MEMS, 50 Hz bursts, ms, "
+            "rad/s, raw count, hand log), fridge-3day (MEMS at 1 Hz for 3 days in a fridge, "
+            "three orientations with handling, mrad/s). Options below override a preset.",
+            rich_help_panel=_LOGGER,
+        ),
+    ] = None,
+    burst_s: Annotated[
+        float | None, typer.Option("--burst-s", help="Burst length [s] (5).",
+                                   rich_help_panel=_LOGGER)
+    ] = None,
+    period_s: Annotated[
+        float | None, typer.Option("--period-s", help="Burst period [s] (300).",
+                                   rich_help_panel=_LOGGER)
+    ] = None,
+    time_unit: Annotated[
+        str | None, typer.Option("--time-unit", metavar="s|ms|us",
+                                 help="Unit of the written time (s).", rich_help_panel=_LOGGER)
+    ] = None,
+    counter_bits: Annotated[
+        int | None, typer.Option("--counter-bits",
+                                 help="Time as an unsigned counter of this many bits that "
+                                 "wraps (32: µs wrap every 71.6 min).", rich_help_panel=_LOGGER)
+    ] = None,
+    clock_start_s: Annotated[
+        float | None, typer.Option("--clock-start-s",
+                                   help="Clock reading at the first sample [s] (0); near "
+                                   "2^32 µs to see a wrap early.", rich_help_panel=_LOGGER)
+    ] = None,
+    jitter_ms: Annotated[
+        float | None, typer.Option("--jitter-ms", help="Rms time-stamp jitter [ms] (0).",
+                                   rich_help_panel=_LOGGER)
+    ] = None,
+    restarts: Annotated[
+        str | None, typer.Option("--restarts", metavar="T1,T2,...",
+                                 help="Power cycles at these times [s]: the clock, the bursts "
+                                 "and the warm-up start again.", rich_help_panel=_LOGGER)
+    ] = None,
+    run_offset_dph: Annotated[
+        float | None, typer.Option("--run-offset-dph",
+                                   help="Rms of a turn-on offset drawn per run [°/h] (0).",
+                                   rich_help_panel=_LOGGER)
+    ] = None,
+    rate_unit: Annotated[
+        str | None, typer.Option("--rate-unit", metavar="|".join(LOGGER_RATE_UNITS),
+                                 help="Unit of the written rates (dph).", rich_help_panel=_LOGGER)
+    ] = None,
+    rate_digits: Annotated[
+        int | None, typer.Option("--rate-digits",
+                                 help="Significant digits of the written rates (all).",
+                                 rich_help_panel=_LOGGER)
+    ] = None,
+    temp_lsb: Annotated[
+        float | None, typer.Option("--temp-lsb",
+                                   help="Log the sensor temperature as a raw count of this "
+                                   "size [°C] (T = count * LSB + --temp-offset); with no "
+                                   "--temp-lsb and a MEMS unit, in °C.", rich_help_panel=_LOGGER)
+    ] = None,
+    temp_offset: Annotated[
+        float | None, typer.Option("--temp-offset", help="°C of count 0 (0).",
+                                   rich_help_panel=_LOGGER)
+    ] = None,
+    temp_bits: Annotated[
+        int | None, typer.Option("--temp-bits",
+                                 help="The signed count stored unsigned in this many bits "
+                                 "(16: -300 is written 65236).", rich_help_panel=_LOGGER)
+    ] = None,
+    temp_rate_hz: Annotated[
+        float | None, typer.Option("--temp-rate-hz",
+                                   help="A slower temperature channel: a new value at this "
+                                   "rate, empty cells between [Hz].", rich_help_panel=_LOGGER)
+    ] = None,
+    reference_log: Annotated[
+        bool | None, typer.Option("--reference-log/--no-reference-log",
+                                  help="Write a hand-written reference log FILE_reflog.csv "
+                                  "(HH:MM clock times, °F and °C columns, blank cells, BOM).",
+                                  rich_help_panel=_LOGGER)
+    ] = None,
+    reference_lag_s: Annotated[
+        float | None, typer.Option("--reference-lag-s",
+                                   help="Lag of the reference probe behind the sensor [s].",
+                                   rich_help_panel=_LOGGER)
+    ] = None,
+    spikes: Annotated[
+        int | None, typer.Option("--spikes", help="Single-sample spikes to inject (0).",
+                                 rich_help_panel=_LOGGER)
+    ] = None,
+    spike_dph: Annotated[
+        float | None, typer.Option("--spike-dph",
+                                   help="Size of each spike [°/h] (default: -500 σ).",
+                                   rich_help_panel=_LOGGER)
+    ] = None,
+    orientations: Annotated[
+        int | None, typer.Option("--orientations",
+                                 help="Orientations visited, with handling between them (1).",
+                                 rich_help_panel=_LOGGER)
+    ] = None,
+    handling_max_dps: Annotated[
+        float | None, typer.Option("--handling-max-dps",
+                                   help="Peak rotation rate of the handling [°/s] (300).",
+                                   rich_help_panel=_LOGGER)
+    ] = None,
+    accelerometer: Annotated[
+        bool | None, typer.Option("--accelerometer/--no-accelerometer",
+                                  help="Write accelerometer columns (in g).",
+                                  rich_help_panel=_LOGGER)
     ] = None,
     output: Annotated[
         Path,
@@ -177,20 +298,64 @@ def simulate_command(
     from hrgtc.simulate import MultiAxisUnit, simulate_files, standard_profiles, units
 
     with library_errors():
+        chosen = None
+        if logger is not None and logger not in ("continuous", "burst"):
+            from hrgtc.simulate.logger_presets import preset
+
+            chosen = preset(logger)
+        unit = unit or (chosen.unit if chosen is not None else DEFAULT_UNIT)
         gyro = units.get(unit)
-        runs = standard_profiles.build(
-            profile,
-            setpoints_c=_numbers(setpoints),
-            hours=hours,
-            start_c=start,
-            end_c=end,
-            temperature_c=temperature,
-            ramp_c_per_min=ramp_rate,
-            single_file=single_file,
-            rates_dps=_numbers(rates, "0,10,-10,100,-100", "rates"),
-            rate_hold_s=rate_hold_s,
-            axes=gyro.axis_names if isinstance(gyro, MultiAxisUnit) else None,
-        )
+        if chosen is not None and profile is None:
+            runs = [chosen.profile]
+        else:
+            runs = standard_profiles.build(
+                profile or "soak",
+                setpoints_c=_numbers(setpoints),
+                hours=hours,
+                start_c=start,
+                end_c=end,
+                temperature_c=temperature,
+                ramp_c_per_min=ramp_rate,
+                single_file=single_file,
+                rates_dps=_numbers(rates, "0,10,-10,100,-100", "rates"),
+                rate_hold_s=rate_hold_s,
+                axes=gyro.axis_names if isinstance(gyro, MultiAxisUnit) else None,
+            )
+        if logger is not None:
+            from hrgtc.simulate.logged_files import simulate_logged_files
+
+            spec = _logger_spec(
+                chosen.logger if chosen is not None else None, logger, unit,
+                sample_rate_hz=sample_rate_hz, burst_s=burst_s, period_s=period_s,
+                time_unit=time_unit, counter_bits=counter_bits, clock_start_s=clock_start_s,
+                jitter_s=None if jitter_ms is None else jitter_ms * 1e-3,
+                restarts_s=None if restarts is None else tuple(
+                    _numbers(restarts, "3600,7200", "times") or ()),
+                run_offset_dph=run_offset_dph, rate_unit=rate_unit, rate_digits=rate_digits,
+                spikes=spikes, spike_dph=spike_dph, accelerometer=accelerometer,
+                temp_lsb=temp_lsb, temp_offset=temp_offset, temp_bits=temp_bits,
+                temp_rate_hz=temp_rate_hz, reference_log=reference_log,
+                reference_lag_s=reference_lag_s, orientations=orientations,
+                handling_max_dps=handling_max_dps,
+            )
+            logged = simulate_logged_files(
+                runs, output, spec, unit=gyro, seed=seed,
+                file_format=None if file_format is None else file_format.value,
+                input_rate_dph=input_rate_dph, force=force,
+            )
+            if json_output:
+                print_json([w.to_dict() for w in logged])
+                return
+            table = Table(title=f"simulated {unit} through a {logger} logger, "
+                          f"{spec.sample_rate_hz:g} Hz, seed {seed}")
+            for column in ("file", "rows", "truth"):
+                table.add_column(column, justify="right" if column == "rows" else "left")
+            for w in logged:
+                truth = w.truth_json + (f", {w.reference_log}" if w.reference_log else "")
+                table.add_row(w.path, f"{w.rows:,}", truth)
+            console.print(table)
+            return
+        sample_rate_hz = 200.0 if sample_rate_hz is None else sample_rate_hz
         with progress_bar("simulating") as progress:
             written = simulate_files(
                 runs,
@@ -212,3 +377,38 @@ def simulate_command(
     for w in written:
         table.add_row(w.path, f"{w.rows:,}", w.profile)
     console.print(table)
+
+
+def _logger_spec(base: Any, kind: str, unit: str, **given: Any) -> Any:
+    """The Logger of ``--logger``: a preset's, or a plain one, with the options given."""
+    from dataclasses import replace
+
+    from hrgtc.simulate.handling import Handling
+    from hrgtc.simulate.logger import Logger
+    from hrgtc.simulate.mems import G_SENSITIVITY_DPH_PER_G, MEMS_UNIT
+    from hrgtc.simulate.reflog import ReferenceLog, TemperatureChannel
+
+    mems = unit == MEMS_UNIT
+    if base is None:
+        base = Logger(kind=kind, sample_rate_hz=200.0, frequency=not mems,
+                      temperature=TemperatureChannel(decimals=2) if mems else None)
+    temperature = {"lsb_c": given.pop("temp_lsb"), "offset_c": given.pop("temp_offset"),
+                   "bits": given.pop("temp_bits"), "rate_hz": given.pop("temp_rate_hz")}
+    temperature = {k: v for k, v in temperature.items() if v is not None}
+    if temperature:
+        base = replace(base, temperature=replace(base.temperature or TemperatureChannel(),
+                                                 **temperature))
+    reference, lag = given.pop("reference_log"), given.pop("reference_lag_s")
+    if reference is False:
+        base = replace(base, reference_log=None)
+    elif reference or lag is not None:
+        log = base.reference_log or ReferenceLog()
+        base = replace(base, reference_log=log if lag is None else replace(log, lag_s=lag))
+    handling = {"orientations": given.pop("orientations"),
+                "max_rate_dps": given.pop("handling_max_dps")}
+    handling = {k: v for k, v in handling.items() if v is not None}
+    if handling:
+        start = base.handling or Handling(
+            orientations=1, g_sensitivity_dph_per_g=G_SENSITIVITY_DPH_PER_G if mems else {})
+        base = replace(base, handling=replace(start, **handling))
+    return replace(base, **{k: v for k, v in given.items() if v is not None})

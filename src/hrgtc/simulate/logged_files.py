@@ -35,9 +35,18 @@ from hrgtc.files import (
     write_text_atomic,
 )
 from hrgtc.recording import Metadata, Recording, RecordingWriter
-from hrgtc.simulate.logger import LoggedRun
+from hrgtc.simulate.logger import LoggedRun, Logger, log_run
+from hrgtc.simulate.output import output_paths
+from hrgtc.simulate.profiles import Profile
+from hrgtc.simulate.units import MultiAxisUnit, Unit
 
-__all__ = ["LoggedFiles", "csv_text", "sidecar_paths", "write_logged"]
+__all__ = [
+    "LoggedFiles",
+    "csv_text",
+    "sidecar_paths",
+    "simulate_logged_files",
+    "write_logged",
+]
 
 
 @dataclass(frozen=True)
@@ -168,3 +177,46 @@ def write_logged(run: LoggedRun, path: str | Path, file_format: str | None = Non
         reference = str(write_text_atomic(side["reference_log"], run.reference_log, force=force))
     return LoggedFiles(str(path), str(side["truth_json"]), str(side["truth_csv"]), reference,
                        len(run))
+
+
+def simulate_logged_files(
+    profiles: list[Profile],
+    output: str | Path,
+    logger: Logger,
+    unit: str | Unit | MultiAxisUnit = "paper-unit",
+    seed: int = 0,
+    file_format: str | None = None,
+    input_rate_dph: float | None = None,
+    force: bool = False,
+) -> list[LoggedFiles]:
+    """Simulate each profile as ``logger`` writes it, one recording (and its truth) per run.
+
+    ``output`` is a file for a single run, else a directory of ``<profile name>.csv``
+    (or the suffix of ``file_format``). A single run uses ``seed`` itself; run ``k`` of
+    several the seed ``SeedSequence(seed, spawn_key=(k,))`` draws.
+
+    Raises
+    ------
+    OutputExistsError
+        When a target exists and ``force`` is False (nothing is written).
+    """
+    if not profiles:
+        raise InputError("no runs to simulate; give at least one profile")
+    paths = output_paths(profiles, output, file_format or (
+        None if Path(output).suffix.lower() in (".csv", ".parquet", ".pq", ".h5", ".hdf5")
+        else "csv"))
+    targets = []
+    for path in paths:
+        side = sidecar_paths(path)
+        targets += [path, side["truth_json"], side["truth_csv"]]
+        if logger.reference_log is not None:
+            targets.append(side["reference_log"])
+    refuse_existing(targets, force, "nothing was written")
+    seeds = [int(seed)] if len(profiles) == 1 else [
+        int(np.random.SeedSequence(int(seed), spawn_key=(k,)).generate_state(1)[0])
+        for k in range(len(profiles))
+    ]
+    return [
+        write_logged(log_run(profile, unit, logger, s, input_rate_dph), path, force=force)
+        for profile, path, s in zip(profiles, paths, seeds, strict=True)
+    ]
