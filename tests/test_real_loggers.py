@@ -1,0 +1,262 @@
+"""Acceptance tests of issue 20 item 15: hrgtc on real-logger files, against the simulator's truth.
+
+Each test simulates, with :mod:`hrgtc.simulate.logger`, the files a real logger writes (its
+column names, ms time, rad/s, bursts, handling) with their truth, and runs the CLI on them
+with the reading options the sidecar lists (``hrgtc_options``), as a user would:
+
+* a burst recording gives the model and figures of the continuous recording it was cut
+  from (same seed, so the same samples), within the statistical tolerance stated in
+  each test;
+* the df/dt range stored in the model is the true one within 20 %;
+* a model applied to its own training file flags at most 5 % of the samples out of range;
+* a recording with handling between still periods gives the model of its still samples,
+  and the offsets of its orientations do not bias the temperature coefficients.
+
+The ones that need work still under way elsewhere (one notion of time, causal df/dt with
+each step's true Δt, the motion detector, per-orientation offsets) are marked
+``xfail(strict=True)`` with what they need, to be flipped when it lands.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pyarrow.parquet as pq
+import pytest
+from typer.testing import CliRunner
+
+from hrgtc.cli import app
+from hrgtc.simulate import cooldown
+from hrgtc.simulate.handling import Handling
+from hrgtc.simulate.logged_files import csv_text, write_logged
+from hrgtc.simulate.logger import Logger, log_run
+from hrgtc.simulate.mems import G_SENSITIVITY_DPH_PER_G
+from hrgtc.simulate.reflog import TemperatureChannel
+
+runner = CliRunner()
+AXES = "xyz"
+SEED = 11
+#: The chamber program of the burst tests: a 2 h cool-down 22 -> 5 °C at 0.15 °C/min.
+PROFILE = cooldown(22.0, 5.0, hours=2.0, ramp_c_per_min=0.15)
+NEEDS_TIME = ("needs one notion of time: df/dt carried across gaps with each step's true Δt "
+              "and windows that never span a gap (dfdt + time)")
+NEEDS_MOTION = "needs the motion detector (--motion exclude by default) and per-orientation offsets"
+
+
+def _logger(kind: str, **kw) -> Logger:
+    return Logger(kind=kind, sample_rate_hz=10.0, burst_s=5.0, period_s=60.0, time_unit="ms",
+                  rate_unit="radps", frequency=False,
+                  temperature=TemperatureChannel(decimals=3, noise_c=0.005), **kw)
+
+
+def _write(directory: Path, name: str, run) -> tuple[Path, list[str], dict]:
+    files = write_logged(run, directory / f"{name}.csv")
+    return Path(files.path), run.info["hrgtc_options"], run.info
+
+
+def _cli(*args: str) -> dict:
+    result = runner.invoke(app, [*args, "--json"])
+    assert result.exit_code == 0, result.stderr + result.stdout
+    text = result.stdout
+    return json.loads(text[text.index("{"):]) if "{" in text else {}
+
+
+def _calibrate(path: Path, options: list[str], out: Path) -> dict:
+    _cli("calibrate", "--drift", str(path), *options, "-o", str(out))
+    return json.loads(out.read_text())
+
+
+def _bias_model(path: Path, options: list[str], model: Path, out: Path) -> tuple[dict, dict]:
+    """The model's bias along a file (per axis) and compensate's JSON."""
+    report = _cli("compensate", str(path), "-m", str(model), *options, "-o", str(out))
+    table = pq.read_table(out)
+    return {a: table[f"bias_model_dph_{a}"].to_numpy() for a in AXES}, report
+
+
+@pytest.fixture(scope="module")
+def burst_pair(tmp_path_factory):
+    """A continuous 10 Hz cool-down of mems-3 and the 5 s-every-60 s bursts cut from it."""
+    directory = tmp_path_factory.mktemp("loggers")
+    out = {}
+    for kind in ("continuous", "burst"):
+        run = log_run(PROFILE, "mems-3", _logger(kind), seed=SEED)
+        path, options, info = _write(directory, kind, run)
+        model = _calibrate(path, options, directory / f"{kind}.json")
+        out[kind] = {"path": path, "options": options, "info": info, "run": run,
+                     "model": model, "model_path": directory / f"{kind}.json"}
+    out["dir"] = directory
+    return out
+
+
+def test_burst_file_is_the_continuous_file_cut(burst_pair):
+    """The premise of the comparisons below: same seed, the same samples."""
+    cont, burst = burst_pair["continuous"]["run"], burst_pair["burst"]["run"]
+    index = np.searchsorted(cont.truth["time_s"], burst.truth["time_s"])
+    assert np.array_equal(cont.truth["rate_dph_x"][index], burst.truth["rate_dph_x"])
+    assert len(burst) == len(cont) // 12
+
+
+def _drift_error(bias: dict, run, skip_s: float = 600.0) -> dict:
+    """Per axis: the model's bias minus the true drift, mean removed (the constant is the
+    input rate and offset, not the drift), after ``skip_s`` of warm-up."""
+    keep = run.truth["time_s"] > skip_s
+    out = {}
+    for a in AXES:
+        true = run.truth[f"bias_dph_{a}"] + run.truth[f"offset_dph_{a}"]
+        error = (bias[a] - true)[keep]
+        out[a] = error - np.mean(error)
+    return out
+
+
+@pytest.mark.xfail(strict=True, reason=NEEDS_TIME)
+def test_burst_recording_gives_the_model_of_the_continuous_recording(burst_pair):
+    """Both models predict the continuous run's true drift equally well.
+
+    Tolerance: the burst model is fitted on 1/12 of the samples, so its prediction error
+    may exceed the continuous model's by 3 standard errors of a prediction,
+    ``3 * residual_std * sqrt((p + 1) / n_windows)`` of the burst model, plus 20 %.
+    """
+    cont = burst_pair["continuous"]
+    d = burst_pair["dir"]
+    errors = {}
+    for kind in ("continuous", "burst"):
+        bias, _ = _bias_model(cont["path"], cont["options"], burst_pair[kind]["model_path"],
+                              d / f"{kind}_on_cont.parquet")
+        errors[kind] = _drift_error(bias, cont["run"])
+    for a in AXES:
+        drift = burst_pair["burst"]["model"]["axes"][a]["drift"]
+        sigma = drift["residual_std_dph"] * math.sqrt(
+            (len(drift["selected"]) + 1) / drift["n_windows"])
+        rms_cont = float(np.sqrt(np.mean(errors["continuous"][a] ** 2)))
+        rms_burst = float(np.sqrt(np.mean(errors["burst"][a] ** 2)))
+        assert rms_burst <= 1.2 * rms_cont + 3.0 * sigma, (a, rms_burst, rms_cont, sigma)
+        # the temperature coefficient: both near the truth's c1 (the unit's bias law)
+        assert "f" in drift["selected"]
+
+
+@pytest.mark.xfail(strict=True, reason=NEEDS_TIME)
+def test_burst_recording_gives_the_figures_of_the_continuous_recording(burst_pair):
+    """Compensated with the burst model, the continuous run's 10 s means scatter as with its
+    own model (within 25 %: the 10 s figure of a 2 h run has ~720 windows, a 1σ
+    interval of a few % on its own, plus the burst model's larger coefficient errors)."""
+    cont = burst_pair["continuous"]
+    d = burst_pair["dir"]
+    spread = {}
+    for kind in ("continuous", "burst"):
+        out = d / f"{kind}_fig.parquet"
+        _bias_model(cont["path"], cont["options"], burst_pair[kind]["model_path"], out)
+        table = pq.read_table(out)
+        t = table["time_s"].to_numpy()
+        window = np.floor(t / 10.0)
+        spread[kind] = {}
+        for a in AXES:
+            rate = table[f"rate_comp_dph_{a}"].to_numpy()
+            keep = t > 600.0
+            _, inverse = np.unique(window[keep], return_inverse=True)
+            means = np.bincount(inverse, rate[keep]) / np.bincount(inverse)
+            spread[kind][a] = float(np.std(means))
+    for a in AXES:
+        assert spread["burst"][a] <= 1.25 * spread["continuous"][a], (a, spread)
+
+
+@pytest.mark.parametrize("kind", [
+    "continuous",
+    pytest.param("burst", marks=pytest.mark.xfail(strict=True, reason=NEEDS_TIME)),
+])
+def test_dfdt_range_in_the_model_is_the_true_one(burst_pair, kind):
+    """The model's df/dt range (°C/s for a temperature sensor) spans the true dT/dt of the
+    sensor on the still samples within 20 %."""
+    case = burst_pair[kind]
+    for a in AXES:
+        low, high = case["model"]["axes"][a]["drift"]["ranges"]["df"]
+        true = case["info"]["dfdt_still"]["dtdt_c_per_s"][a]
+        span = true["max"] - true["min"]
+        assert abs((high - low) - span) <= 0.2 * span, (a, low, high, true)
+        assert abs(low - true["min"]) <= 0.2 * span, (a, low, true)
+
+
+@pytest.mark.parametrize("kind", [
+    "continuous",
+    pytest.param("burst", marks=pytest.mark.xfail(strict=True, reason=NEEDS_TIME)),
+])
+def test_model_flags_at_most_5_percent_of_its_own_training_file(burst_pair, kind):
+    case = burst_pair[kind]
+    _, report = _bias_model(case["path"], case["options"], case["model_path"],
+                            burst_pair["dir"] / f"{kind}_own.parquet")
+    assert report["out_of_range_fraction"] <= 0.05, report["ranges"]
+    assert report["rate_out_of_range_fraction"] <= 0.05, report["ranges"]
+
+
+@pytest.fixture(scope="module")
+def handled(tmp_path_factory):
+    """mems-3 cooling 22 -> 5 °C at 2 Hz in three orientations, handled between them
+    (bursts up to 500 °/s), and the same file with the handled rows removed."""
+    directory = tmp_path_factory.mktemp("handled")
+    logger = Logger(kind="continuous", sample_rate_hz=2.0, time_unit="ms", rate_unit="radps",
+                    frequency=False, temperature=TemperatureChannel(decimals=3, noise_c=0.005),
+                    handling=Handling(orientations=3, handling_s=60.0, max_rate_dps=500.0,
+                                      g_sensitivity_dph_per_g=G_SENSITIVITY_DPH_PER_G),
+                    accelerometer=True)
+    run = log_run(cooldown(22.0, 5.0, hours=3.0, ramp_c_per_min=0.15), "mems-3", logger, SEED)
+    path, options, info = _write(directory, "handled", run)
+    still = ~run.truth["motion"]
+    still_path = directory / "still.csv"
+    still_path.write_text(csv_text({k: v[still] for k, v in run.columns.items()}, run.kinds))
+    still_options = [*options, "--gaps", "split"]  # the handled minutes are gaps there
+    models = {"handled": _calibrate(path, options, directory / "handled.json"),
+              "still": _calibrate(still_path, still_options, directory / "still.json")}
+    return {"dir": directory, "run": run, "path": path, "still_path": still_path,
+            "options": options, "still_options": still_options, "info": info,
+            "models": models}
+
+
+def test_handling_file_has_motion_the_truth_lists(handled):
+    run = handled["run"]
+    assert run.truth["motion"].sum() == 2 * 60 * 2  # two windows of 60 s at 2 Hz
+    assert handled["info"]["motion_peak_dps"] > 400.0
+    assert set(np.unique(run.truth["orientation"])) == {-1, 0, 1, 2}
+
+
+@pytest.mark.xfail(strict=True, reason=NEEDS_MOTION)
+def test_recording_with_handling_gives_the_model_of_its_still_samples(handled):
+    """Trained on the whole file, the model predicts what the model of its still samples
+    predicts (within 3 standard errors of a prediction of the still model), and its
+    trained ranges are those of the still samples."""
+    d = handled["dir"]
+    bias = {}
+    for name in ("handled", "still"):
+        bias[name], _ = _bias_model(handled["still_path"], handled["still_options"],
+                                    d / f"{name}.json", d / f"{name}_on_still.parquet")
+    for a in AXES:
+        still = handled["models"]["still"]["axes"][a]["drift"]
+        whole = handled["models"]["handled"]["axes"][a]["drift"]
+        sigma = still["residual_std_dph"] * math.sqrt(
+            (len(still["selected"]) + 1) / still["n_windows"])
+        diff = bias["handled"][a] - bias["still"][a]
+        assert float(np.sqrt(np.mean(diff**2))) <= 3.0 * sigma, a
+        for variable in ("f", "df"):
+            assert np.allclose(whole["ranges"][variable], still["ranges"][variable],
+                               rtol=0.05, atol=1e-6), (a, variable)
+
+
+@pytest.mark.xfail(strict=True, reason=NEEDS_MOTION)
+def test_orientation_offsets_do_not_bias_the_temperature_coefficient(handled):
+    """With an offset per orientation as a nuisance parameter, the model's drift along the
+    run is the true thermal drift (the unit's bias law, without the g-sensitivity
+    offsets) within 3 % of the drift's own range."""
+    run = handled["run"]
+    bias, _ = _bias_model(handled["path"], handled["options"], handled["dir"] / "handled.json",
+                          handled["dir"] / "handled_on_itself.parquet")
+    keep = (run.truth["time_s"] > 600.0) & ~run.truth["motion"]
+    for a in AXES:
+        thermal = run.truth[f"bias_dph_{a}"][keep]
+        orientation = run.truth["orientation"][keep]
+        model = bias[a][keep].copy()
+        for k in np.unique(orientation):  # the offsets are the nuisance: one constant each
+            rows = orientation == k
+            model[rows] -= np.mean(model[rows] - thermal[rows])
+        error = model - thermal
+        assert float(np.sqrt(np.mean(error**2))) <= 0.03 * float(np.ptp(thermal)), a
