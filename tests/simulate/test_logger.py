@@ -317,3 +317,32 @@ def test_logger_refuses_bad_settings():
         log_run(constant(20.0, 0.01), "paper-unit", Logger(columns={"rate_q": "q"}), 0)
     with pytest.raises(InputError, match="needs a logged temperature"):
         Logger(reference_log=ReferenceLog())
+
+
+def test_cli_logger_burst_and_preset_overrides(tmp_path):
+    from typer.testing import CliRunner
+
+    from hrgtc.cli import app
+
+    runner = CliRunner()
+    args = ["simulate", "--logger", "burst", "--profile", "constant", "--hours", "0.1",
+            "--rate-hz", "10", "--burst-s", "2", "--period-s", "30", "--time-unit", "ms",
+            "--counter-bits", "32", "-o", str(tmp_path / "b.csv"), "--json"]
+    result = runner.invoke(app, args)
+    assert result.exit_code == 0, result.stderr
+    written = json.loads(result.stdout)[0]
+    assert written["rows"] == 12 * 20  # 360 s / 30 s bursts of 2 s at 10 Hz
+    info = json.loads(open(written["truth_json"]).read())
+    assert info["logger"]["kind"] == "burst" and info["logger"]["counter_bits"] == 32
+    assert "--gaps" in info["hrgtc_options"]
+    again = runner.invoke(app, args)
+    assert again.exit_code != 0 and "exist" in again.stderr
+    result = runner.invoke(app, ["simulate", "--logger", "pan-cold", "--spikes", "0",
+                                 "--no-reference-log", "--hours", "0.5", "--profile",
+                                 "constant", "-o", str(tmp_path / "p.csv"), "--json"])
+    assert result.exit_code == 0, result.stderr
+    info = json.loads(open(json.loads(result.stdout)[0]["truth_json"]).read())
+    assert info["spikes"] == [] and info["unit"] == "mems-3"
+    assert info["logger"]["rate_unit"] == "radps" and info["temperature"]["map"]["lsb_c"]
+    assert not (tmp_path / "p_reflog.csv").exists()
+    assert info["rows"] == 6 * 250  # 1800 s: bursts at 0, 305, ..., 1525 s

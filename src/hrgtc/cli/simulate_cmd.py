@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+import shlex
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -245,7 +247,7 @@ def simulate_command(
     ] = None,
     spike_dph: Annotated[
         float | None, typer.Option("--spike-dph",
-                                   help="Size of each spike [°/h] (default: -500 σ).",
+                                   help="Size of each spike [°/h] (default: -50 σ).",
                                    rich_help_panel=_LOGGER)
     ] = None,
     orientations: Annotated[
@@ -354,6 +356,10 @@ def simulate_command(
                 truth = w.truth_json + (f", {w.reference_log}" if w.reference_log else "")
                 table.add_row(w.path, f"{w.rows:,}", truth)
             console.print(table)
+            first = json.loads(Path(logged[0].truth_json).read_text())["hrgtc_options"]
+            console.print("read it with: hrgtc info " + shlex.quote(logged[0].path) + " "
+                          + " ".join(shlex.quote(o) for o in first), markup=False,
+                          highlight=False, soft_wrap=True)
             return
         sample_rate_hz = 200.0 if sample_rate_hz is None else sample_rate_hz
         with progress_bar("simulating") as progress:

@@ -99,7 +99,7 @@ class Logger:
     spikes
         Number of single-sample spikes.
     spike_dph
-        Size of each spike (sign included); 0: 500 times the rate noise, negative. [°/h]
+        Size of each spike (sign included); 0: 50 times the rate noise, negative. [°/h]
     handling
         Orientations and handling between them, or None (at rest in one orientation).
     accelerometer
@@ -398,7 +398,7 @@ def log_run(
         dfdt = np.gradient(gyro_axis.frequency_law.frequency_hz(resonator), t)
         truth[f"dfdt_hz_per_s{key}"] = dfdt[rows]
         sigma = float(np.std(np.diff(rec[f"rate_dph{key}"][: min(n, 20000)]))) / math.sqrt(2.0)
-        size = logger.spike_dph or -500.0 * sigma
+        size = logger.spike_dph or -50.0 * sigma
         for r, a in zip(spike_rows, spike_axes, strict=True):
             if a == axis:
                 rate[r] += size
