@@ -103,6 +103,15 @@ def test_restarts_reset_the_clock_and_the_bursts():
     assert run.info["restarts"][1]["run_offset_dph"] == pytest.approx(offsets[first[1]])
 
 
+def test_warmup_transient_starts_again_at_each_power_on():
+    logger = Logger(sample_rate_hz=5.0, restarts_s=(600.0,), warmup_dph=30.0, warmup_tau_s=60.0)
+    run = log_run(constant(20.0, 0.4), "paper-unit", logger, seed=2)
+    t, since = run.truth["time_s"], run.truth["clock_s"]
+    assert np.allclose(run.truth["offset_dph"], 30.0 * np.exp(-since / 60.0))
+    assert run.truth["offset_dph"][np.flatnonzero(run.truth["restart"])].tolist() == [30.0, 30.0]
+    assert t[np.flatnonzero(run.truth["restart"])[1]] == pytest.approx(610.0)
+
+
 def test_count_map_round_trip_and_unsigned_storage():
     channel = TemperatureChannel(lsb_c=0.00625, offset_c=23.375, bits=16)
     logger = Logger(sample_rate_hz=5.0, temperature=channel, frequency=False)

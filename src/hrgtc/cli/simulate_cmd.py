@@ -201,6 +201,16 @@ def simulate_command(
                                    help="Rms of a turn-on offset drawn per run [°/h] (0).",
                                    rich_help_panel=_LOGGER)
     ] = None,
+    warmup_dph: Annotated[
+        float | None, typer.Option("--warmup-dph",
+                                   help="A warm-up transient after each power-on: this offset "
+                                   "[°/h] decaying with --warmup-tau-s (0).",
+                                   rich_help_panel=_LOGGER)
+    ] = None,
+    warmup_tau_s: Annotated[
+        float | None, typer.Option("--warmup-tau-s", help="Time constant of the warm-up [s] "
+                                   "(120).", rich_help_panel=_LOGGER)
+    ] = None,
     rate_unit: Annotated[
         str | None, typer.Option("--rate-unit", metavar="|".join(LOGGER_RATE_UNITS),
                                  help="Unit of the written rates (dph).", rich_help_panel=_LOGGER)
@@ -333,7 +343,8 @@ def simulate_command(
                 jitter_s=None if jitter_ms is None else jitter_ms * 1e-3,
                 restarts_s=None if restarts is None else tuple(
                     _numbers(restarts, "3600,7200", "times") or ()),
-                run_offset_dph=run_offset_dph, rate_unit=rate_unit, rate_digits=rate_digits,
+                run_offset_dph=run_offset_dph, warmup_dph=warmup_dph,
+                warmup_tau_s=warmup_tau_s, rate_unit=rate_unit, rate_digits=rate_digits,
                 spikes=spikes, spike_dph=spike_dph, accelerometer=accelerometer,
                 temp_lsb=temp_lsb, temp_offset=temp_offset, temp_bits=temp_bits,
                 temp_rate_hz=temp_rate_hz, reference_log=reference_log,
