@@ -355,3 +355,30 @@ def test_cli_logger_burst_and_preset_overrides(tmp_path):
     assert info["logger"]["rate_unit"] == "radps" and info["temperature"]["map"]["lsb_c"]
     assert not (tmp_path / "p_reflog.csv").exists()
     assert info["rows"] == 6 * 250  # 1800 s: bursts at 0, 305, ..., 1525 s
+
+
+def test_true_dfdt_from_the_slow_track_matches_the_samples():
+    """The truth's dT/dt and df/dt (from a ~1 Hz track of the whole run) agree with the
+    derivative of the kept samples' noiseless resonator temperature and frequency law."""
+    from hrgtc.simulate import units
+
+    run = log_run(cooldown(20.0, 0.0, hours=1.0, ramp_c_per_min=0.5), "paper-unit",
+                  Logger(sample_rate_hz=10.0), seed=0)
+    t, resonator = run.truth["time_s"], run.truth["resonator_c"]
+    direct = np.gradient(resonator, t)
+    assert np.allclose(run.truth["dtdt_c_per_s"][10:-10], direct[10:-10],
+                       atol=1e-3 * np.max(np.abs(direct)))
+    law = units.get("paper-unit").frequency_law
+    dfdt = np.gradient(law.frequency_hz(resonator), t)
+    assert np.allclose(run.truth["dfdt_hz_per_s"][10:-10], dfdt[10:-10],
+                       atol=1e-3 * np.max(np.abs(dfdt)))
+    still = run.info["dfdt_still"]["dfdt_hz_per_s"]["x"]
+    assert still["min"] == pytest.approx(run.truth["dfdt_hz_per_s"].min())
+
+
+def test_memory_follows_the_kept_rows():
+    """10 h at 200 Hz in 5 s bursts every 300 s: 120,000 rows kept of 7.2 M simulated."""
+    logger = Logger(kind="burst", sample_rate_hz=200.0, burst_s=5.0, period_s=300.0)
+    run = log_run(constant(20.0, 10.0), "paper-unit", logger, seed=0)
+    assert len(run) == 120 * 1000
+    assert run.info["simulated_rows"] == 7_200_000

@@ -190,7 +190,11 @@ def _orientation_offsets(handling: Handling, axes: Sequence[str]) -> list[dict[s
 
 
 def handling_truth(
-    time_s: np.ndarray, axes: Sequence[str], handling: Handling, rng: np.random.Generator
+    time_s: np.ndarray,
+    axes: Sequence[str],
+    handling: Handling,
+    rng: np.random.Generator,
+    duration_s: float | None = None,
 ) -> HandlingTruth:
     """Play a handling schedule on a run's time axis.
 
@@ -204,6 +208,9 @@ def handling_truth(
         The schedule.
     rng
         Draws the rate pulses and the accelerometer noise.
+    duration_s
+        Length of the run (the default windows spread over it); None: the span of
+        ``time_s``. [s]
 
     Returns
     -------
@@ -215,7 +222,7 @@ def handling_truth(
         raise InputError(f"handling needs body axes x, y, z; got axis names {unknown}")
     t = np.asarray(time_s, dtype=np.float64)
     n = t.size
-    duration = float(t[-1] - t[0]) if n else 0.0
+    duration = (float(t[-1] - t[0]) if n else 0.0) if duration_s is None else float(duration_s)
     starts = handling.starts_s(duration)
     offsets = _orientation_offsets(handling, axes)
     up = np.array([0.0, 0.0, 1.0])

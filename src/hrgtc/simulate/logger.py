@@ -21,9 +21,10 @@ The simulator's runs (:mod:`hrgtc.simulate.campaign`) are continuous, in seconds
 * **handling** (:class:`~hrgtc.simulate.handling.Handling`): still periods in several
   orientations with rotation bursts between them, and accelerometer columns.
 
-The simulation runs at the logger's sample rate over the whole run and then keeps
-the logged rows (2 h at 50 Hz of a three-axis unit take about a second), so the noise
-of the kept samples is the noise of a continuous recording cut into bursts.
+The simulation runs at the logger's sample rate over the whole run, chunk by chunk, and
+keeps the logged rows (:mod:`hrgtc.simulate.duty`; 2 h at 50 Hz of a three-axis unit
+take about a second), so the kept samples are those of the continuous recording with
+the same seed, cut into bursts, and memory grows with the rows kept.
 Writing the files: :mod:`hrgtc.simulate.logged_files`.
 """
 
@@ -38,7 +39,7 @@ import numpy as np
 
 from hrgtc.errors import InputError
 from hrgtc.simulate import units as _units
-from hrgtc.simulate.campaign import simulate_run
+from hrgtc.simulate.duty import DutyCycle, simulate_kept
 from hrgtc.simulate.handling import Handling, handling_truth
 from hrgtc.simulate.profiles import Profile
 from hrgtc.simulate.reflog import ReferenceLog, TemperatureChannel, reference_log_text
@@ -257,12 +258,19 @@ def _round_significant(value: np.ndarray, digits: int) -> np.ndarray:
     return np.round(value * scale) / scale
 
 
-def _segments(keep: np.ndarray, run: np.ndarray, burst: np.ndarray) -> np.ndarray:
-    """Segment index of each kept row: a new one at each burst or run start."""
-    r, b = run[keep], burst[keep]
+def _segments(r: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Segment index of each kept row (run ``r``, burst ``b``): a new one at each burst or run."""
     new = np.ones(r.size, dtype=bool)
     new[1:] = (r[1:] != r[:-1]) | (b[1:] != b[:-1])
     return np.cumsum(new) - 1
+
+
+def _derivative(track: Mapping[str, np.ndarray], name: str, time_s: np.ndarray) -> np.ndarray:
+    """d(track[name])/dt at ``time_s`` (the slow track's central differences, interpolated)."""
+    t = track["time_s"]
+    if t.size < 2:
+        return np.zeros(np.shape(time_s))
+    return np.interp(time_s, t, np.gradient(track[name], t))
 
 
 def log_run(
@@ -299,33 +307,21 @@ def log_run(
     sim_seed, logger_seed = np.random.SeedSequence(int(seed)).spawn(2)
     rng = np.random.default_rng(logger_seed)
     fs = logger.sample_rate_hz
-    rec = simulate_run(profile, gyro, fs, sim_seed, input_rate_dph)
+    burst_logger = logger.kind == "burst"
+    duty = DutyCycle(fs, logger.burst_s if burst_logger else None,
+                     logger.period_s if burst_logger else None,
+                     logger.restarts_s, logger.restart_off_s)
+    kept = simulate_kept(profile, gyro, duty, sim_seed, input_rate_dph)
+    rec, track = kept.columns, kept.track
     t = rec["time_s"]
-    n = t.size
-    duration = float(t[-1])
-
-    # Power cycles: off from each restart for restart_off_s, then a new run.
-    power_on = np.array([0.0, *[r + logger.restart_off_s for r in logger.restarts_s]])
-    if logger.restarts_s and power_on[-1] >= duration:
-        raise InputError(f"a restart at {logger.restarts_s[-1]:g} s leaves no run before the "
-                         f"end of the {duration:g} s run")
-    run = np.searchsorted(power_on, t, side="right") - 1
-    since_on = t - power_on[run]
-    on = np.ones(n, dtype=bool)
-    for r in logger.restarts_s:
-        on &= ~((t >= r) & (t < r + logger.restart_off_s))
-    if logger.kind == "burst":
-        burst = np.floor(since_on / logger.period_s + 1e-9).astype(np.int64)
-        keep = on & (since_on - burst * logger.period_s < logger.burst_s - 0.5 / fs)
-    else:
-        burst = np.zeros(n, dtype=np.int64)
-        keep = on
-    rows = np.flatnonzero(keep)
-    if rows.size < 2:
-        raise InputError("the logger keeps fewer than 2 samples of this run; log longer runs")
+    rows = np.arange(t.size)  # every kept row
+    run, since_on, burst = kept.run, kept.since_on_s, kept.burst
+    power_on = duty.power_on_s
+    duration = kept.duration_s
+    n = kept.simulated_rows
 
     body = {a: (a if a is not None else "z") for a in axes}
-    handled = (handling_truth(t, list(body.values()), logger.handling, rng)
+    handled = (handling_truth(t, list(body.values()), logger.handling, rng, duration)
                if logger.handling is not None else None)
     run_offsets = rng.normal(0.0, logger.run_offset_dph, size=power_on.size)
     warmup = logger.warmup_dph * np.exp(-since_on / logger.warmup_tau_s)
@@ -333,7 +329,7 @@ def log_run(
     truth: dict[str, np.ndarray] = {
         "time_s": t[rows],
         "run": run[rows],
-        "segment": _segments(keep, run, burst),
+        "segment": _segments(run, burst),
         "motion": (handled.motion[rows] if handled else np.zeros(rows.size, dtype=bool)),
         "orientation": (handled.orientation[rows] if handled
                         else np.zeros(rows.size, dtype=np.int64)),
@@ -376,7 +372,6 @@ def log_run(
     still = ~truth["motion"]
     for axis in axes:
         key = "" if axis is None else f"_{axis}"
-        gyro_axis = gyro.axes[axis] if isinstance(gyro, MultiAxisUnit) else gyro
         offset = run_offsets[run[rows]] + warmup[rows]
         motion_dph = np.zeros(rows.size)
         if handled is not None:
@@ -389,15 +384,16 @@ def log_run(
         truth[f"offset_dph{key}"] = offset
         truth[f"motion_dph{key}"] = motion_dph
         truth[f"resonator_c{key}"] = rec[f"resonator_c{key}"][rows]
-        if f"scale_ppm{key}" in rec.names:
+        if f"scale_ppm{key}" in rec:
             truth[f"scale_ppm{key}"] = rec[f"scale_ppm{key}"][rows]
-        # The true rate of change of the thermometer, from the noiseless continuous run.
-        resonator = rec[f"resonator_c{key}"]
-        dtdt = np.gradient(resonator, t)
-        truth[f"dtdt_c_per_s{key}"] = dtdt[rows]
-        dfdt = np.gradient(gyro_axis.frequency_law.frequency_hz(resonator), t)
-        truth[f"dfdt_hz_per_s{key}"] = dfdt[rows]
-        sigma = float(np.std(np.diff(rec[f"rate_dph{key}"][: min(n, 20000)]))) / math.sqrt(2.0)
+        # The true rate of change of the thermometer, from the continuous run's slow track.
+        dtdt = _derivative(track, f"resonator_c{key}", t)
+        truth[f"dtdt_c_per_s{key}"] = dtdt
+        dfdt = _derivative(track, f"freq_true_hz{key}", t)
+        truth[f"dfdt_hz_per_s{key}"] = dfdt
+        head = rec[f"rate_dph{key}"][:20000]
+        same = np.diff(truth["segment"][:20000]) == 0
+        sigma = float(np.std(np.diff(head)[same])) / math.sqrt(2.0) if same.any() else 0.0
         size = logger.spike_dph or -50.0 * sigma
         for r, a in zip(spike_rows, spike_axes, strict=True):
             if a == axis:
@@ -427,10 +423,10 @@ def log_run(
     temperature_info = None
     reference_text = None
     first = axes[0]
-    sensor_true = rec["resonator_c" + ("" if first is None else f"_{first}")]
+    die = "resonator_c" + ("" if first is None else f"_{first}")
     if logger.temperature is not None:
         channel = logger.temperature
-        source = sensor_true if channel.source == "die" else rec["housing_c"]
+        source = rec[die] if channel.source == "die" else rec["housing_c"]
         written = channel.written(source[rows], rng)
         if channel.rate_hz is not None:
             tick = np.floor(t[rows] * channel.rate_hz + 1e-9)
@@ -447,7 +443,9 @@ def log_run(
                             "range_c": [float(source[rows].min()), float(source[rows].max())]}
         if logger.reference_log is not None:
             reference_text, readings = reference_log_text(
-                logger.reference_log, t, source, rec["housing_c"], rec["chamber_c"], rng)
+                logger.reference_log, track["time_s"],
+                track[die] if channel.source == "die" else track["housing_c"],
+                track["housing_c"], track["chamber_c"], rng)
             temperature_info["reference_log"] = {
                 "probe_column": logger.reference_log.probe_column,
                 "start": logger.reference_log.start, "lag_s": logger.reference_log.lag_s,
