@@ -18,7 +18,14 @@ the shared ``time_s``, ``chamber_c`` and ``housing_c``
 - :mod:`~hrgtc.simulate.units`: named simulated gyros (``paper-unit``, ``unit-b``) and
   the three-axis ``imu-3``;
 - :mod:`~hrgtc.simulate.campaign`: runs in chunks, with ground truth;
-- :mod:`~hrgtc.simulate.output`: runs written to files, atomically.
+- :mod:`~hrgtc.simulate.output`: runs written to files, atomically;
+- :mod:`~hrgtc.simulate.mems`: a three-axis MEMS gyro (``mems-3``) for the real-logger cases;
+- :mod:`~hrgtc.simulate.logger`: what a real logger writes (bursts, ms/µs clocks that
+  wrap, restarts, raw counts, spikes, handling), with the truth of every row, built on
+  :mod:`~hrgtc.simulate.duty` (kept rows), :mod:`~hrgtc.simulate.handling`
+  (orientations, handling) and :mod:`~hrgtc.simulate.reflog` (counts, hand log);
+  written by :mod:`~hrgtc.simulate.logged_files`; named cases in
+  :mod:`~hrgtc.simulate.logger_presets` (``pan-cold``, ``fridge-3day``).
 
 Examples
 --------
@@ -44,6 +51,7 @@ from hrgtc.simulate.campaign import (
     run_metadata,
     simulate_run,
 )
+from hrgtc.simulate.handling import Handling
 from hrgtc.simulate.laws import (
     BiasLaw,
     PolynomialFrequencyLaw,
@@ -51,9 +59,12 @@ from hrgtc.simulate.laws import (
     ShellFrequencyLaw,
     table1_frequency_law,
 )
+from hrgtc.simulate.logged_files import LoggedFiles, simulate_logged_files, write_logged
+from hrgtc.simulate.logger import LoggedRun, Logger, log_run
 from hrgtc.simulate.noise import GyroNoise
 from hrgtc.simulate.output import WrittenFile, output_paths, simulate_files, simulate_to_file
 from hrgtc.simulate.profiles import Profile, Segment
+from hrgtc.simulate.reflog import ReferenceLog, TemperatureChannel
 from hrgtc.simulate.standard_profiles import (
     constant,
     cooldown,
@@ -72,12 +83,18 @@ __all__ = [
     "DEFAULT_INPUT_RATE_DPH",
     "BiasLaw",
     "GyroNoise",
+    "Handling",
+    "LoggedFiles",
+    "LoggedRun",
+    "Logger",
     "MultiAxisUnit",
     "PolynomialFrequencyLaw",
     "Profile",
+    "ReferenceLog",
     "ScaleFactorLaw",
     "Segment",
     "ShellFrequencyLaw",
+    "TemperatureChannel",
     "ThermalNetwork",
     "Unit",
     "WrittenFile",
@@ -85,6 +102,7 @@ __all__ = [
     "cooldown",
     "input_rates_dph",
     "iter_run_chunks",
+    "log_run",
     "output_paths",
     "profiles",
     "ramp",
@@ -92,6 +110,7 @@ __all__ = [
     "run_columns",
     "run_metadata",
     "simulate_files",
+    "simulate_logged_files",
     "simulate_run",
     "simulate_to_file",
     "soak",
@@ -102,4 +121,5 @@ __all__ = [
     "unit_from_dict",
     "units",
     "warmup",
+    "write_logged",
 ]
