@@ -275,6 +275,18 @@ def test_written_files_round_trip(tmp_path):
     assert sidecar_paths(tmp_path / "a.csv")["reference_log"].name == "a_reflog.csv"
 
 
+def test_hdf5_writes_slashes_in_names_as_per(tmp_path):
+    import h5py
+
+    run = log_run(constant(20.0, 0.02), "paper-unit", Logger(sample_rate_hz=5.0), seed=0)
+    files = write_logged(run, tmp_path / "run.h5")
+    with h5py.File(files.path) as f:
+        assert np.array_equal(f["gyro [deg_per_h]"][()], run.columns["gyro [deg/h]"])
+    info = json.loads(open(files.truth_json).read())
+    assert info["columns"]["rate"] == "gyro [deg_per_h]"
+    assert "rate_dph=gyro [deg_per_h]" in info["hrgtc_options"]
+
+
 def test_pan_cold_preset_looks_like_the_real_file():
     start = time.perf_counter()
     p = preset("pan-cold")

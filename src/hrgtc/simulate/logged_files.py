@@ -5,7 +5,8 @@ For ``run.csv`` (or ``.parquet``, ``.h5``) the files are:
 * ``run.csv``: what the logger wrote, in its column names (the reading options of
   hrgtc have to be used: ``--col``, ``--time-unit``, ``--rate-unit``, ...); a CSV is
   written as loggers print (integer ms, rates to a few significant digits, empty cells);
-  Parquet and HDF5 hold the same columns as float64, NaN for an empty cell;
+  Parquet and HDF5 hold the same columns as float64, NaN for an empty cell (in HDF5 a
+  ``/`` in a column name is written ``_per_``: ``/`` would make it a group);
 * ``run.truth.json``: the sidecar (logger, unit, count map, spikes, segments, restarts,
   orientations, handling windows, true df/dt ranges, the hrgtc options that read the file);
 * ``run.truth.csv``: the truth of every row (true time, run, segment, flags as
@@ -127,6 +128,23 @@ def _write_table_csv(path: Path, columns: dict[str, np.ndarray], force: bool) ->
     return path
 
 
+def _hdf5_names(run: LoggedRun) -> LoggedRun:
+    """The run with ``/`` in column names written ``_per_`` (HDF5 reads ``/`` as a group)."""
+    rename = {name: name.replace("/", "_per_") for name in run.columns if "/" in name}
+    if not rename:
+        return run
+    info = json.loads(json.dumps(run.info))
+    info["columns"] = {role: rename.get(name, name) for role, name in info["columns"].items()}
+    options = []
+    for option in info["hrgtc_options"]:
+        ours, _, theirs = option.partition("=")
+        options.append(f"{ours}={rename[theirs]}" if theirs in rename else option)
+    info["hrgtc_options"] = options
+    return LoggedRun({rename.get(k, k): v for k, v in run.columns.items()},
+                     {rename.get(k, k): v for k, v in run.kinds.items()},
+                     run.truth, info, run.reference_log)
+
+
 def write_logged(run: LoggedRun, path: str | Path, file_format: str | None = None,
                  force: bool = False) -> LoggedFiles:
     """Write a logged run, its truth and its reference log (see the module's docstring).
@@ -155,6 +173,8 @@ def write_logged(run: LoggedRun, path: str | Path, file_format: str | None = Non
     if fmt not in ("csv", "parquet", "h5") or (suffix in by_suffix and by_suffix[suffix] != fmt):
         raise InputError(f"output {path}: give a .csv, .parquet or .h5 file (format "
                          f"{file_format!r} and suffix {suffix!r} must agree)")
+    if fmt == "h5":
+        run = _hdf5_names(run)
     side = sidecar_paths(path)
     targets = [path, side["truth_json"], side["truth_csv"]]
     if run.reference_log is not None:
