@@ -281,7 +281,7 @@ def test_hdf5_writes_slashes_in_names_as_per(tmp_path):
     run = log_run(constant(20.0, 0.02), "paper-unit", Logger(sample_rate_hz=5.0), seed=0)
     files = write_logged(run, tmp_path / "run.h5")
     with h5py.File(files.path) as f:
-        assert np.array_equal(f["gyro [deg_per_h]"][()], run.columns["gyro [deg/h]"])
+        assert np.array_equal(f["recording/gyro [deg_per_h]"][()], run.columns["gyro [deg/h]"])
     info = json.loads(open(files.truth_json).read())
     assert info["columns"]["rate"] == "gyro [deg_per_h]"
     assert "rate_dph=gyro [deg_per_h]" in info["hrgtc_options"]
