@@ -306,6 +306,18 @@ def test_pan_cold_preset_looks_like_the_real_file():
     rates = np.column_stack([run.columns[f"gyro{a} rad/s"] for a in "xyz"])
     assert np.allclose(np.median(rates, axis=0), np.median(real[:, 4:7], axis=0), atol=0.01)
     assert len(run.info["spikes"]) == 3
+
+    def bursts(time_ms, rates):
+        segment = np.cumsum(np.r_[0, np.diff(time_ms) > 1000])
+        parts = [rates[segment == k] for k in range(segment.max() + 1)]
+        return (np.median([p.std(axis=0) for p in parts], axis=0),
+                np.array([p.mean(axis=0) for p in parts]))
+
+    noise_sim, means_sim = bursts(t, rates)
+    noise_real, means_real = bursts(real[:, 0], real[:, 4:7])
+    assert np.allclose(noise_sim, noise_real, rtol=0.15)  # 0.00053 rad/s within a burst
+    drift_sim, drift_real = means_sim[-1] - means_sim[0], means_real[-1] - means_real[0]
+    assert np.allclose(drift_sim[:2], drift_real[:2], rtol=0.4)  # x -0.0086, y +0.0040 rad/s
     sensor = run.truth["sensor_c"]
     assert sensor[0] == 21.5 and 6.0 < sensor[-1] < 11.0  # the real unit: 21.5 -> 8.8 °C
     dtdt = run.info["dfdt_still"]["dtdt_c_per_s"]["x"]

@@ -9,11 +9,12 @@ network). Its parameters, chosen from the PAN cold test in ``tests/data/pan-cold
 
 * offsets of several °/s at rest (x -3.9, y +3.4, z +1.65 °/s, as the PAN unit's
   -0.069, +0.059, +0.029 rad/s);
-* temperature coefficients of about 100 °/h/°C (the PAN x axis moved by -0.008 rad/s
-  over a 12.7 °C cool-down, -130 °/h/°C), a small curvature, and a sensitivity to the
-  housing - die gradient (a df/dt-like term);
-* noise: ARW 0.6 °/√h (0.01 °/s/√Hz, a consumer MEMS part), bias instability 10 °/h,
-  rate random walk 3 °/h/√h;
+* temperature coefficients as the PAN unit's: while it cooled by 12.7 °C its burst means
+  moved by -0.0086 (x), +0.0040 (y) and -0.0004 rad/s (z), i.e. +140, -65 and +7 °/h/°C;
+  a small curvature, and a sensitivity to the housing - die gradient (a df/dt-like term);
+* noise: ARW 0.26 °/√h (0.0043 °/s/√Hz), so that a 50 Hz sample scatters by 0.00053 rad/s
+  rms as the PAN unit's do within a burst; bias instability 10 °/h, rate random walk
+  3 °/h/√h;
 * g-sensitivity (:data:`G_SENSITIVITY_DPH_PER_G`): each axis's offset moves by a few
   hundred °/h per g of gravity along the body axes, so turning the unit over changes
   its offsets (the orientation offsets of :mod:`hrgtc.simulate.handling`).
@@ -55,9 +56,9 @@ def mems3() -> MultiAxisUnit:
     # One die: the same thermal network on every axis (resonator_c is the die temperature).
     thermal = ThermalNetwork(tau_housing_s=1500.0, tau_resonator_s=300.0)
     laws = {
-        "x": BiasLaw(-3.9 * _SECONDS_PER_HOUR, 20.0, (-130.0, 1.5, 0.0), gradient_dph_per_c=25.0),
-        "y": BiasLaw(3.4 * _SECONDS_PER_HOUR, 20.0, (60.0, -0.8, 0.0), gradient_dph_per_c=-15.0),
-        "z": BiasLaw(1.65 * _SECONDS_PER_HOUR, 20.0, (-25.0, 0.6, 0.0), gradient_dph_per_c=10.0),
+        "x": BiasLaw(-3.9 * _SECONDS_PER_HOUR, 20.0, (140.0, 1.5, 0.0), gradient_dph_per_c=25.0),
+        "y": BiasLaw(3.4 * _SECONDS_PER_HOUR, 20.0, (-65.0, -0.8, 0.0), gradient_dph_per_c=-15.0),
+        "z": BiasLaw(1.65 * _SECONDS_PER_HOUR, 20.0, (7.0, 0.6, 0.0), gradient_dph_per_c=10.0),
     }
     axes = {
         axis: Unit(
@@ -66,7 +67,7 @@ def mems3() -> MultiAxisUnit:
             thermal=thermal,
             frequency_law=table1_frequency_law(),
             bias_law=law,
-            gyro_noise=GyroNoise(0.6, 10.0, 3.0),
+            gyro_noise=GyroNoise(0.26, 10.0, 3.0),
             frequency_noise_hz=0.0,
             housing_noise_c=0.05,
         )
@@ -75,7 +76,7 @@ def mems3() -> MultiAxisUnit:
     latitude = math.radians(LATITUDE_DEG)
     return MultiAxisUnit(
         name=MEMS_UNIT,
-        description="three-axis MEMS gyro: offsets of several °/s, ~100 °/h/°C, "
+        description="three-axis MEMS gyro: offsets of several °/s, up to 140 °/h/°C, "
         "g-sensitivity, a die temperature sensor and no frequency output",
         axes=axes,
         input_rate_dph={
