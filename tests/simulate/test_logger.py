@@ -83,6 +83,31 @@ def test_jitter_and_milliseconds():
         Logger(sample_rate_hz=50.0, jitter_s=0.01)
 
 
+def test_wall_clock_timestamps_step_at_daylight_saving(tmp_path):
+    from hrgtc.simulate.clock import wall_clock
+
+    # Autumn: 03:00 CEST -> 02:00 CET, the naive clock steps back an hour.
+    back = wall_clock("2021-10-31T02:59:59", np.array([0.0, 1.0, 2.0]), "Europe/Berlin")
+    assert back.tolist() == ["2021-10-31T02:59:59.000", "2021-10-31T02:00:00.000",
+                             "2021-10-31T02:00:01.000"]
+    plain = wall_clock("2021-10-31T02:59:59", np.array([0.0, 1.0]))
+    assert plain.tolist() == ["2021-10-31T02:59:59.000", "2021-10-31T03:00:00.000"]
+    with pytest.raises(InputError, match="time zone"):
+        wall_clock("2021-10-31T02:59:59", np.array([0.0]), "Mars/Olympus")
+    logger = Logger(sample_rate_hz=1.0, time_unit="timestamp", start="2021-03-28T01:59:00",
+                    timezone="Europe/Berlin", restarts_s=(30.0,), restart_off_s=5.0)
+    run = log_run(constant(20.0, 0.05), "paper-unit", logger, seed=0)
+    stamps = run.columns["timestamp"]
+    i = int(np.flatnonzero(run.truth["time_s"] == 60.0)[0])
+    assert stamps[i - 1] == "2021-03-28T01:59:59.000" and stamps[i] == "2021-03-28T03:00:00.000"
+    assert np.array_equal(run.truth["clock_s"], run.truth["time_s"])  # no reset at restart
+    assert "--time-unit" in run.info["hrgtc_options"] and "timestamp" in run.info["hrgtc_options"]
+    text = csv_text(run.columns, run.kinds).splitlines()
+    assert text[1].startswith("2021-03-28T01:59:00.000,")
+    with pytest.raises(InputError, match="CSV only"):
+        write_logged(run, tmp_path / "t.parquet")
+
+
 def test_restarts_reset_the_clock_and_the_bursts():
     logger = _burst(time_unit="ms", restarts_s=(400.0,), restart_off_s=10.0,
                     clock_start_s=0.2, run_offset_dph=5.0)

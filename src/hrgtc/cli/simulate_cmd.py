@@ -174,8 +174,21 @@ def simulate_command(
                                    rich_help_panel=_LOGGER)
     ] = None,
     time_unit: Annotated[
-        str | None, typer.Option("--time-unit", metavar="s|ms|us",
-                                 help="Unit of the written time (s).", rich_help_panel=_LOGGER)
+        str | None, typer.Option("--time-unit", metavar="s|ms|us|timestamp",
+                                 help="Unit of the written time since power-on (s), or "
+                                 "timestamp: ISO 8601 wall-clock times from --wall-start.",
+                                 rich_help_panel=_LOGGER)
+    ] = None,
+    wall_start: Annotated[
+        str | None, typer.Option("--wall-start", metavar="ISO",
+                                 help="Wall-clock time of the run's start (local, e.g. "
+                                 "2021-03-28T00:30:00).", rich_help_panel=_LOGGER)
+    ] = None,
+    tz: Annotated[
+        str | None, typer.Option("--tz", metavar="ZONE",
+                                 help="Time zone of the wall clock (e.g. Europe/Berlin): a "
+                                 "daylight-saving change in the run is a ±1 h step.",
+                                 rich_help_panel=_LOGGER)
     ] = None,
     counter_bits: Annotated[
         int | None, typer.Option("--counter-bits",
@@ -339,7 +352,8 @@ def simulate_command(
             spec = _logger_spec(
                 chosen.logger if chosen is not None else None, logger, unit,
                 sample_rate_hz=sample_rate_hz, burst_s=burst_s, period_s=period_s,
-                time_unit=time_unit, counter_bits=counter_bits, clock_start_s=clock_start_s,
+                time_unit=time_unit, start=wall_start, timezone=tz, counter_bits=counter_bits,
+                clock_start_s=clock_start_s,
                 jitter_s=None if jitter_ms is None else jitter_ms * 1e-3,
                 restarts_s=None if restarts is None else tuple(
                     _numbers(restarts, "3600,7200", "times") or ()),

@@ -87,6 +87,8 @@ def sidecar_paths(path: str | Path) -> dict[str, Path]:
 
 
 def _format_column(values: np.ndarray, kind: str) -> list[str]:
+    if kind == "str":
+        return [str(x) for x in np.asarray(values).tolist()]
     v = np.asarray(values, dtype=np.float64)
     empty = ~np.isfinite(v)
     if kind == "int":
@@ -173,6 +175,9 @@ def write_logged(run: LoggedRun, path: str | Path, file_format: str | None = Non
     if fmt not in ("csv", "parquet", "h5") or (suffix in by_suffix and by_suffix[suffix] != fmt):
         raise InputError(f"output {path}: give a .csv, .parquet or .h5 file (format "
                          f"{file_format!r} and suffix {suffix!r} must agree)")
+    if fmt != "csv" and "str" in run.kinds.values():
+        raise InputError(f"output {path}: wall-clock timestamps are written to CSV only; "
+                         "give a .csv file or another time unit")
     if fmt == "h5":
         run = _hdf5_names(run)
     side = sidecar_paths(path)

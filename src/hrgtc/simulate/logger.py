@@ -8,7 +8,8 @@ The simulator's runs (:mod:`hrgtc.simulate.campaign`) are continuous, in seconds
   every 300 s in the PAN cold test); ``continuous`` keeps every sample;
 * **clock**: time in s, ms or µs since power-on (from ``clock_start_s``), with Gaussian
   jitter, optionally a ``counter_bits`` counter that wraps (a 32-bit µs counter every
-  71.6 min);
+  71.6 min); or wall-clock ISO 8601 timestamps, in a time zone whose daylight-saving
+  change is a ±1 h step;
 * **restarts**: at each ``restarts_s`` the logger is off for ``restart_off_s``, then its
   clock, burst schedule and the gyro's warm-up start again; each run may have its own
   turn-on offset (``run_offset_dph``, a nuisance constant) and warm-up transient;
@@ -39,13 +40,22 @@ import numpy as np
 
 from hrgtc.errors import InputError
 from hrgtc.simulate import units as _units
+from hrgtc.simulate.clock import unwrap_counter, wall_clock
 from hrgtc.simulate.duty import DutyCycle, simulate_kept
 from hrgtc.simulate.handling import Handling, handling_truth
 from hrgtc.simulate.profiles import Profile
 from hrgtc.simulate.reflog import ReferenceLog, TemperatureChannel, reference_log_text
 from hrgtc.simulate.units import MultiAxisUnit, Unit
 
-__all__ = ["RATE_FACTORS", "TIME_FACTORS", "LoggedRun", "Logger", "log_run", "unwrap_counter"]
+__all__ = [
+    "RATE_FACTORS",
+    "TIME_FACTORS",
+    "LoggedRun",
+    "Logger",
+    "log_run",
+    "unwrap_counter",
+    "wall_clock",
+]
 
 #: °/h -> the rate unit written: value_written = rate_dph * factor.
 RATE_FACTORS = {
@@ -72,13 +82,19 @@ class Logger:
     burst_s, period_s
         A burst logger keeps ``burst_s`` of every ``period_s``, from each power-on. [s]
     time_unit
-        ``s``, ``ms`` or ``us``; ms and µs are written as integers.
+        ``s``, ``ms`` or ``us`` since power-on (ms and µs as integers), or ``timestamp``:
+        ISO 8601 wall-clock times from ``start`` (they do not reset at a restart).
     counter_bits
         The time is an unsigned counter of this many bits that wraps; None: no wrap.
     clock_start_s
         Clock reading at the first sample after power-on. [s]
     jitter_s
         Rms jitter of each time stamp. [s]
+    start
+        Wall-clock time (naive, local) of the run's t = 0, for ``timestamp``.
+    timezone
+        IANA zone of the wall clock (e.g. ``Europe/Berlin``): a daylight-saving change
+        inside the run is a ±1 h step in the timestamps; None: no zone, no step.
     restarts_s
         Times of power cycles, from the start of the run. [s]
     restart_off_s
@@ -121,6 +137,8 @@ class Logger:
     counter_bits: int | None = None
     clock_start_s: float = 0.0
     jitter_s: float = 0.0
+    start: str = "2020-03-07T15:44:40"
+    timezone: str | None = None
     restarts_s: tuple[float, ...] = ()
     restart_off_s: float = 10.0
     run_offset_dph: float = 0.0
@@ -139,7 +157,8 @@ class Logger:
     columns: Mapping[str, str] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        choices = {"kind": ("continuous", "burst"), "time_unit": tuple(TIME_FACTORS),
+        choices = {"kind": ("continuous", "burst"),
+                   "time_unit": (*TIME_FACTORS, "timestamp"),
                    "rate_unit": tuple(RATE_FACTORS), "accel_unit": ("g", "mps2")}
         for name, allowed in choices.items():
             if getattr(self, name) not in allowed:
@@ -154,8 +173,9 @@ class Logger:
             raise InputError(f"burst_s {self.burst_s:g} must be shorter than period_s "
                              f"{self.period_s:g} [s]; use kind='continuous' for no gaps")
         if self.counter_bits is not None:
-            if self.time_unit == "s":
-                raise InputError("a wrapping counter needs time_unit ms or us, not s")
+            if self.time_unit not in ("ms", "us"):
+                raise InputError(f"a wrapping counter needs time_unit ms or us, not "
+                                 f"{self.time_unit}")
             if not 8 <= int(self.counter_bits) <= 63:
                 raise InputError(f"counter_bits must be 8..63, got {self.counter_bits!r}")
         if not (0.0 <= self.jitter_s < 0.25 / self.sample_rate_hz):
@@ -173,7 +193,8 @@ class Logger:
 
     def column_names(self, axes: tuple[str | None, ...]) -> dict[str, str]:
         """Role -> column name in the file, in column order."""
-        time_name = {"s": "time_s", "ms": "time_ms", "us": "time_us"}[self.time_unit]
+        time_name = {"s": "time_s", "ms": "time_ms", "us": "time_us",
+                     "timestamp": "timestamp"}[self.time_unit]
         names = {"time": time_name}
         label = _RATE_LABELS[self.rate_unit]
         for axis in axes:
@@ -234,19 +255,6 @@ class LoggedRun:
 
     def __len__(self) -> int:
         return len(next(iter(self.columns.values())))
-
-
-def unwrap_counter(values: np.ndarray, bits: int) -> np.ndarray:
-    """Unwrap an unsigned ``bits``-bit counter that only moves forward (between wraps).
-
-    Examples
-    --------
-    >>> unwrap_counter(np.array([250.0, 254.0, 2.0, 6.0]), 8).tolist()
-    [250.0, 254.0, 258.0, 262.0]
-    """
-    v = np.asarray(values, dtype=np.float64)
-    wraps = np.concatenate(([0.0], np.cumsum(np.diff(v) < 0)))
-    return v + wraps * 2.0 ** int(bits)
 
 
 def _round_significant(value: np.ndarray, digits: int) -> np.ndarray:
@@ -343,20 +351,27 @@ def log_run(
 
     columns: dict[str, np.ndarray] = {}
     kinds: dict[str, str] = {}
-    # The clock: time since power-on from clock_start_s, jitter, unit, counter wrap.
-    clock_s = logger.clock_start_s + since_on[rows]
-    if logger.jitter_s > 0.0:
-        clock_s = clock_s + rng.normal(0.0, logger.jitter_s, size=rows.size)
-    factor = TIME_FACTORS[logger.time_unit]
-    if logger.time_unit == "s":
-        written_time = np.round(clock_s, 6)
-        kinds[names["time"]] = "float:.6f"
+    # The clock: time since power-on from clock_start_s, jitter, unit, counter wrap;
+    # or the wall clock, which runs on through restarts.
+    jitter = (rng.normal(0.0, logger.jitter_s, size=rows.size) if logger.jitter_s > 0.0
+              else np.zeros(rows.size))
+    if logger.time_unit == "timestamp":
+        clock_s = np.round(t + jitter, 3)
+        written_time = wall_clock(logger.start, clock_s, logger.timezone)
+        kinds[names["time"]] = "str"
+        truth["clock_s"] = clock_s
     else:
-        written_time = np.round(clock_s * factor)
-        kinds[names["time"]] = "int"
-    truth["clock_s"] = written_time / factor
-    if logger.counter_bits is not None:
-        written_time = np.mod(written_time, 2.0 ** int(logger.counter_bits))
+        clock_s = logger.clock_start_s + since_on[rows] + jitter
+        factor = TIME_FACTORS[logger.time_unit]
+        if logger.time_unit == "s":
+            written_time = np.round(clock_s, 6)
+            kinds[names["time"]] = "float:.6f"
+        else:
+            written_time = np.round(clock_s * factor)
+            kinds[names["time"]] = "int"
+        truth["clock_s"] = written_time / factor
+        if logger.counter_bits is not None:
+            written_time = np.mod(written_time, 2.0 ** int(logger.counter_bits))
     columns[names["time"]] = written_time
 
     motion_rate_max = 0.0
