@@ -180,6 +180,24 @@ def test_spikes_are_where_the_truth_says():
     assert np.array_equal(np.flatnonzero(run.truth["spike"]), sorted({r for r, _ in listed}))
 
 
+def test_duplicated_rows_follow_their_originals():
+    logger = _burst(spikes=2, duplicates=5, time_unit="ms")
+    run = log_run(constant(20.0, 0.25), "paper-unit", logger, seed=8)
+    assert len(run) == 1505 and run.info["rows"] == 1505
+    dup = np.flatnonzero(run.truth["duplicate"])
+    assert dup.tolist() == run.info["duplicates"] and dup.size == 5
+    for name, values in run.columns.items():
+        assert np.array_equal(values[dup], values[dup - 1]), name
+    assert np.array_equal(run.truth["time_s"][dup], run.truth["time_s"][dup - 1])
+    keep = ~run.truth["duplicate"]
+    assert np.all(np.diff(run.truth["time_s"][keep]) > 0)
+    for spike in run.info["spikes"]:
+        assert run.truth["spike"][spike["row"]]
+    for segment in run.info["segments"]:
+        rows = np.flatnonzero(run.truth["segment"] == run.truth["segment"][segment["first_row"]])
+        assert rows[0] == segment["first_row"] and rows[-1] == segment["last_row"]
+
+
 def test_rates_rounded_to_significant_digits():
     logger = Logger(sample_rate_hz=5.0, rate_unit="radps", rate_digits=3, frequency=False)
     run = log_run(constant(20.0, 0.02), "mems-3", logger, seed=0)

@@ -264,6 +264,10 @@ def simulate_command(
                                    help="Lag of the reference probe behind the sensor [s].",
                                    rich_help_panel=_LOGGER)
     ] = None,
+    duplicates: Annotated[
+        int | None, typer.Option("--duplicates", help="Rows written twice (a logger "
+                                 "re-sending a line) (0).", rich_help_panel=_LOGGER)
+    ] = None,
     spikes: Annotated[
         int | None, typer.Option("--spikes", help="Single-sample spikes to inject (0).",
                                  rich_help_panel=_LOGGER)
@@ -359,7 +363,8 @@ def simulate_command(
                     _numbers(restarts, "3600,7200", "times") or ()),
                 run_offset_dph=run_offset_dph, warmup_dph=warmup_dph,
                 warmup_tau_s=warmup_tau_s, rate_unit=rate_unit, rate_digits=rate_digits,
-                spikes=spikes, spike_dph=spike_dph, accelerometer=accelerometer,
+                duplicates=duplicates, spikes=spikes, spike_dph=spike_dph,
+                accelerometer=accelerometer,
                 temp_lsb=temp_lsb, temp_offset=temp_offset, temp_bits=temp_bits,
                 temp_rate_hz=temp_rate_hz, reference_log=reference_log,
                 reference_lag_s=reference_lag_s, orientations=orientations,

@@ -23,7 +23,7 @@ from hrgtc.simulate.campaign import Seed, iter_run_chunks, row_count
 from hrgtc.simulate.profiles import Profile
 from hrgtc.simulate.units import MultiAxisUnit, Unit
 
-__all__ = ["TRACK_HZ", "DutyCycle", "KeptRun", "simulate_kept"]
+__all__ = ["TRACK_HZ", "DutyCycle", "KeptRun", "duplicate_rows", "simulate_kept"]
 
 #: Rate of the slow track of the continuous run. [Hz]
 TRACK_HZ = 1.0
@@ -161,3 +161,37 @@ def simulate_kept(
         simulated_rows=done,
         duration_s=duration,
     )
+
+
+def duplicate_rows(
+    columns: dict[str, np.ndarray],
+    truth: dict[str, np.ndarray],
+    info: dict,
+    rows: np.ndarray,
+) -> None:
+    """Write each of ``rows`` twice, as a logger that re-sends a line does (in place).
+
+    The copies follow their originals; ``truth["duplicate"]`` marks them, and the row
+    numbers in ``info`` (spikes, segments, restarts) move to the rows' new places.
+    """
+    n = len(truth["time_s"])
+    rows = np.unique(np.asarray(rows, dtype=np.int64))
+    take = np.sort(np.concatenate([np.arange(n), rows]))
+    shifted = np.arange(n) + np.searchsorted(rows, np.arange(n), side="left")
+    for table in (columns, truth):
+        for name in list(table):
+            table[name] = table[name][take]
+    duplicate = np.zeros(take.size, dtype=bool)
+    duplicate[1:] = take[1:] == take[:-1]
+    truth["duplicate"] = duplicate
+    truth["restart"] = truth["restart"] & ~duplicate
+    for spike in info.get("spikes", []):
+        spike["row"] = int(shifted[spike["row"]])
+    for segment in info.get("segments", []):
+        last = segment["last_row"]
+        segment["first_row"] = int(shifted[segment["first_row"]])
+        segment["last_row"] = int(shifted[last] + (1 if last in set(rows.tolist()) else 0))
+    for restart in info.get("restarts", []):
+        restart["row"] = int(shifted[restart["row"]])
+    info["rows"] = int(take.size)
+    info["duplicates"] = [int(shifted[r]) + 1 for r in rows.tolist()]

@@ -41,7 +41,7 @@ import numpy as np
 from hrgtc.errors import InputError
 from hrgtc.simulate import units as _units
 from hrgtc.simulate.clock import unwrap_counter, wall_clock
-from hrgtc.simulate.duty import DutyCycle, simulate_kept
+from hrgtc.simulate.duty import DutyCycle, duplicate_rows, simulate_kept
 from hrgtc.simulate.handling import Handling, handling_truth
 from hrgtc.simulate.profiles import Profile
 from hrgtc.simulate.reflog import ReferenceLog, TemperatureChannel, reference_log_text
@@ -113,6 +113,8 @@ class Logger:
         The logged temperature channel, or None.
     reference_log
         A hand-written reference log beside the file, or None (needs ``temperature``).
+    duplicates
+        Number of rows written twice (a logger re-sending a line).
     spikes
         Number of single-sample spikes.
     spike_dph
@@ -149,6 +151,7 @@ class Logger:
     frequency: bool = True
     temperature: TemperatureChannel | None = None
     reference_log: ReferenceLog | None = None
+    duplicates: int = 0
     spikes: int = 0
     spike_dph: float = 0.0
     handling: Handling | None = None
@@ -507,6 +510,11 @@ def log_run(
         "orientations": handled.table if handled is not None else [],
         "handling_windows": handled.windows if handled is not None else [],
     }
+    info["duplicates"] = []
+    truth["duplicate"] = np.zeros(rows.size, dtype=bool)
+    if logger.duplicates:
+        duplicate_rows(columns, truth, info,
+                       rng.choice(rows.size, size=int(logger.duplicates), replace=False))
     info["hrgtc_options"] = reading_options(info, axes, logger)
     return LoggedRun(columns, kinds, truth, info, reference_text)
 
