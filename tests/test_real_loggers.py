@@ -11,8 +11,8 @@ with the reading options the sidecar lists (``hrgtc_options``), as a user would:
 * a model applied to its own training file flags at most 5 % of the samples out of range;
 * a recording with handling between still periods gives the model of its still samples,
   and the offsets of its orientations do not bias the temperature coefficients;
-* and, for items 3 and 5: a µs counter that wraps, and a temperature logged at 1 Hz in a
-  10 Hz file, give the model of the clean file.
+* and, for items 3 and 5: a µs counter that wraps, rows written twice, and a temperature
+  logged at 1 Hz in a 10 Hz file give the model of the clean file.
 
 The ones that need work still under way elsewhere (one notion of time, causal df/dt with
 each step's true Δt, the motion detector, per-orientation offsets) are marked
@@ -266,6 +266,7 @@ def test_orientation_offsets_do_not_bias_the_temperature_coefficient(handled):
 
 
 NEEDS_CLOCK = "needs the time-step classifier: a 32-bit counter wrap unwrapped (time)"
+NEEDS_DUPLICATES = "needs the time-step classifier: duplicated rows dropped and counted (time)"
 NEEDS_RATES = "needs channels at different rates: a slower temperature held or interpolated (time)"
 
 
@@ -275,23 +276,31 @@ def _drift_terms(model: dict) -> dict:
                 model["axes"][a]["drift"]["coefficients"]) for a in AXES}
 
 
-@pytest.mark.xfail(strict=True, reason=NEEDS_CLOCK)
-def test_microsecond_counter_wrap_gives_the_model_of_the_clean_file(tmp_path):
-    """The same samples with a µs clock that wraps 20 min in give the clean file's model."""
+@pytest.mark.parametrize("variant", [
+    pytest.param("wrapped", marks=pytest.mark.xfail(strict=True, reason=NEEDS_CLOCK)),
+    pytest.param("duplicates", marks=pytest.mark.xfail(strict=True, reason=NEEDS_DUPLICATES)),
+])
+def test_time_defects_give_the_model_of_the_clean_file(tmp_path, variant):
+    """The same samples with a µs clock that wraps 20 min in, or with 30 rows written twice,
+    give the clean file's model."""
     profile = cooldown(22.0, 12.0, hours=1.0, ramp_c_per_min=0.25)
+    base = replace(_logger("continuous"), time_unit="us")
+    loggers = {
+        "clean": base,
+        "wrapped": replace(base, counter_bits=32, clock_start_s=2.0**32 / 1e6 - 1200.0),
+        "duplicates": replace(base, duplicates=30),
+    }
     models = {}
-    for name, start in (("clean", 0.0), ("wrapped", 2.0**32 / 1e6 - 1200.0)):
-        logger = replace(_logger("continuous"), time_unit="us", clock_start_s=start,
-                         counter_bits=32 if name == "wrapped" else None)
-        run = log_run(profile, "mems-3", logger, seed=SEED)
+    for name in ("clean", variant):
+        run = log_run(profile, "mems-3", loggers[name], seed=SEED)
         path, options, _ = _write(tmp_path, name, run)
         models[name] = _calibrate(path, options, tmp_path / f"{name}.json")
-    clean, wrapped = _drift_terms(models["clean"]), _drift_terms(models["wrapped"])
+    clean, other = _drift_terms(models["clean"]), _drift_terms(models[variant])
     for a in AXES:
-        assert wrapped[a][0] == clean[a][0]
-        assert wrapped[a][1] == pytest.approx(clean[a][1], rel=1e-6)
+        assert other[a][0] == clean[a][0]
+        assert other[a][1] == pytest.approx(clean[a][1], rel=1e-6)
         for term, value in clean[a][2].items():
-            assert wrapped[a][2][term] == pytest.approx(value, rel=1e-6)
+            assert other[a][2][term] == pytest.approx(value, rel=1e-6)
 
 
 @pytest.mark.xfail(strict=True, reason=NEEDS_RATES)
