@@ -304,7 +304,8 @@ def simulate_command(
     file_format: Annotated[
         OutputFormat | None,
         typer.Option(
-            "--format", help="Output file format (default: from the -o suffix, else parquet)."
+            "--format", help="Output file format (default: from the -o suffix, else parquet; "
+            "csv with --logger)."
         ),
     ] = None,
     force: ForceOption = False,
@@ -432,8 +433,9 @@ def _logger_spec(base: Any, kind: str, unit: str, **given: Any) -> Any:
                    "bits": given.pop("temp_bits"), "rate_hz": given.pop("temp_rate_hz")}
     temperature = {k: v for k, v in temperature.items() if v is not None}
     if temperature:
-        base = replace(base, temperature=replace(base.temperature or TemperatureChannel(),
-                                                 **temperature))
+        # An HRG's temperature sensor sits on the housing; a MEMS die has its own.
+        channel = base.temperature or TemperatureChannel(source="die" if mems else "housing")
+        base = replace(base, temperature=replace(channel, **temperature))
     reference, lag = given.pop("reference_log"), given.pop("reference_lag_s")
     if reference is False:
         base = replace(base, reference_log=None)

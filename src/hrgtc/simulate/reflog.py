@@ -183,7 +183,7 @@ class ReferenceLog:
     decimals: int = 1
     blank_fraction: float = 0.05
     trailing_rows: int = 5
-    empty_columns: int = 13
+    empty_columns: int = 14
     bom: bool = True
     crlf: bool = True
 
