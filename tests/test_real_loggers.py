@@ -81,17 +81,25 @@ def _bias_model(path: Path, options: list[str], model: Path, out: Path) -> tuple
 
 @pytest.fixture(scope="module")
 def burst_pair(tmp_path_factory):
-    """A continuous 10 Hz cool-down of mems-3 and the 5 s-every-60 s bursts cut from it."""
+    """A continuous 10 Hz cool-down of mems-3 and the 5 s-every-60 s bursts cut from it.
+
+    Each model is fitted once, by the first test that needs it (:func:`_model`)."""
     directory = tmp_path_factory.mktemp("loggers")
     out = {}
     for kind in ("continuous", "burst"):
         run = log_run(PROFILE, "mems-3", _logger(kind), seed=SEED)
         path, options, info = _write(directory, kind, run)
-        model = _calibrate(path, options, directory / f"{kind}.json")
         out[kind] = {"path": path, "options": options, "info": info, "run": run,
-                     "model": model, "model_path": directory / f"{kind}.json"}
+                     "model_path": directory / f"{kind}.json"}
     out["dir"] = directory
     return out
+
+
+def _model(pair: dict, kind: str) -> dict:
+    case = pair[kind]
+    if "model" not in case:
+        case["model"] = _calibrate(case["path"], case["options"], case["model_path"])
+    return case["model"]
 
 
 def test_burst_file_is_the_continuous_file_cut(burst_pair):
@@ -126,11 +134,12 @@ def test_burst_recording_gives_the_model_of_the_continuous_recording(burst_pair)
     d = burst_pair["dir"]
     errors = {}
     for kind in ("continuous", "burst"):
+        _model(burst_pair, kind)
         bias, _ = _bias_model(cont["path"], cont["options"], burst_pair[kind]["model_path"],
                               d / f"{kind}_on_cont.parquet")
         errors[kind] = _drift_error(bias, cont["run"])
     for a in AXES:
-        drift = burst_pair["burst"]["model"]["axes"][a]["drift"]
+        drift = _model(burst_pair, "burst")["axes"][a]["drift"]
         sigma = drift["residual_std_dph"] * math.sqrt(
             (len(drift["selected"]) + 1) / drift["n_windows"])
         rms_cont = float(np.sqrt(np.mean(errors["continuous"][a] ** 2)))
@@ -149,6 +158,7 @@ def test_burst_recording_gives_the_figures_of_the_continuous_recording(burst_pai
     d = burst_pair["dir"]
     spread = {}
     for kind in ("continuous", "burst"):
+        _model(burst_pair, kind)
         out = d / f"{kind}_fig.parquet"
         _bias_model(cont["path"], cont["options"], burst_pair[kind]["model_path"], out)
         table = pq.read_table(out)
@@ -174,7 +184,7 @@ def test_dfdt_range_in_the_model_is_the_true_one(burst_pair, kind):
     sensor on the still samples within 20 %."""
     case = burst_pair[kind]
     for a in AXES:
-        low, high = case["model"]["axes"][a]["drift"]["ranges"]["df"]
+        low, high = _model(burst_pair, kind)["axes"][a]["drift"]["ranges"]["df"]
         true = case["info"]["dfdt_still"]["dtdt_c_per_s"][a]
         span = true["max"] - true["min"]
         assert abs((high - low) - span) <= 0.2 * span, (a, low, high, true)
@@ -187,6 +197,7 @@ def test_dfdt_range_in_the_model_is_the_true_one(burst_pair, kind):
 ])
 def test_model_flags_at_most_5_percent_of_its_own_training_file(burst_pair, kind):
     case = burst_pair[kind]
+    _model(burst_pair, kind)
     _, report = _bias_model(case["path"], case["options"], case["model_path"],
                             burst_pair["dir"] / f"{kind}_own.parquet")
     assert report["out_of_range_fraction"] <= 0.05, report["ranges"]
@@ -196,7 +207,8 @@ def test_model_flags_at_most_5_percent_of_its_own_training_file(burst_pair, kind
 @pytest.fixture(scope="module")
 def handled(tmp_path_factory):
     """mems-3 cooling 22 -> 5 °C at 2 Hz in three orientations, handled between them
-    (bursts up to 500 °/s), and the same file with the handled rows removed."""
+    (bursts up to 500 °/s, accelerometer columns), and the same file with the handled rows
+    removed. The models are fitted by the tests (:func:`_handled_model`)."""
     directory = tmp_path_factory.mktemp("handled")
     logger = Logger(kind="continuous", sample_rate_hz=2.0, time_unit="ms", rate_unit="radps",
                     frequency=False, temperature=TemperatureChannel(decimals=3, noise_c=0.005),
@@ -208,12 +220,18 @@ def handled(tmp_path_factory):
     still = ~run.truth["motion"]
     still_path = directory / "still.csv"
     still_path.write_text(csv_text({k: v[still] for k, v in run.columns.items()}, run.kinds))
-    still_options = [*options, "--gaps", "split"]  # the handled minutes are gaps there
-    models = {"handled": _calibrate(path, options, directory / "handled.json"),
-              "still": _calibrate(still_path, still_options, directory / "still.json")}
+    still_options = [*options, "--gaps", "bridge"]  # the handled minutes are gaps there
     return {"dir": directory, "run": run, "path": path, "still_path": still_path,
-            "options": options, "still_options": still_options, "info": info,
-            "models": models}
+            "options": options, "still_options": still_options, "info": info, "models": {}}
+
+
+def _handled_model(handled: dict, name: str) -> dict:
+    """The model of the whole handled file (``handled``) or of its still rows (``still``)."""
+    if name not in handled["models"]:
+        path, options = ((handled["path"], handled["options"]) if name == "handled"
+                         else (handled["still_path"], handled["still_options"]))
+        handled["models"][name] = _calibrate(path, options, handled["dir"] / f"{name}.json")
+    return handled["models"][name]
 
 
 def test_handling_file_has_motion_the_truth_lists(handled):
@@ -231,11 +249,12 @@ def test_recording_with_handling_gives_the_model_of_its_still_samples(handled):
     d = handled["dir"]
     bias = {}
     for name in ("handled", "still"):
+        _handled_model(handled, name)
         bias[name], _ = _bias_model(handled["still_path"], handled["still_options"],
                                     d / f"{name}.json", d / f"{name}_on_still.parquet")
     for a in AXES:
-        still = handled["models"]["still"]["axes"][a]["drift"]
-        whole = handled["models"]["handled"]["axes"][a]["drift"]
+        still = _handled_model(handled, "still")["axes"][a]["drift"]
+        whole = _handled_model(handled, "handled")["axes"][a]["drift"]
         sigma = still["residual_std_dph"] * math.sqrt(
             (len(still["selected"]) + 1) / still["n_windows"])
         diff = bias["handled"][a] - bias["still"][a]
@@ -251,6 +270,7 @@ def test_orientation_offsets_do_not_bias_the_temperature_coefficient(handled):
     run is the true thermal drift (the unit's bias law, without the g-sensitivity
     offsets) within 3 % of the drift's own range."""
     run = handled["run"]
+    _handled_model(handled, "handled")
     bias, _ = _bias_model(handled["path"], handled["options"], handled["dir"] / "handled.json",
                           handled["dir"] / "handled_on_itself.parquet")
     keep = (run.truth["time_s"] > 600.0) & ~run.truth["motion"]

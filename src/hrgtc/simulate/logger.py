@@ -531,6 +531,8 @@ def reading_options(info: Mapping[str, Any], axes: tuple[str | None, ...],
             cols.append(f"freq_hz{key}={roles[f'freq{key}']}")
     if logger.temperature is not None:
         cols.append(f"temperature_c={roles['temperature']}")
+    if logger.accelerometer:
+        cols += [f"accel_{a}={roles[f'accel_{a}']}" for a in "xyz"]
     options = []
     for c in cols:
         options += ["--col", c]
@@ -542,5 +544,6 @@ def reading_options(info: Mapping[str, Any], axes: tuple[str | None, ...],
     if not logger.frequency:
         options += ["--thermometer", "sensor"]
     if logger.kind == "burst" or logger.restarts_s:
-        options += ["--gaps", "split"]
+        # Filters carried across each gap with its duration (the temperature kept changing).
+        options += ["--gaps", "bridge"]
     return options
