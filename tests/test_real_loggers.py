@@ -32,10 +32,10 @@ import pytest
 from typer.testing import CliRunner
 
 from hrgtc.cli import app
-from hrgtc.simulate import cooldown
+from hrgtc.simulate import cooldown, units
 from hrgtc.simulate.handling import Handling
 from hrgtc.simulate.logged_files import csv_text, write_logged
-from hrgtc.simulate.logger import Logger, log_run
+from hrgtc.simulate.logger import RATE_FACTORS, Logger, log_run
 from hrgtc.simulate.mems import G_SENSITIVITY_DPH_PER_G
 from hrgtc.simulate.reflog import TemperatureChannel
 
@@ -207,8 +207,10 @@ def test_model_flags_at_most_5_percent_of_its_own_training_file(burst_pair, kind
 @pytest.fixture(scope="module")
 def handled(tmp_path_factory):
     """mems-3 cooling 22 -> 5 °C at 2 Hz in three orientations, handled between them
-    (bursts up to 500 °/s, accelerometer columns), and the same file with the handled rows
-    removed. The models are fitted by the tests (:func:`_handled_model`)."""
+    (bursts up to 500 °/s, accelerometer columns), and its still samples: the same file
+    as if nobody had touched the unit during the handling minutes (the rates without the
+    handling's rotation, the accelerometer at rest; the orientation changes at the end of
+    each window, as in the truth). The models are fitted by the tests (:func:`_handled_model`)."""
     directory = tmp_path_factory.mktemp("handled")
     logger = Logger(kind="continuous", sample_rate_hz=2.0, time_unit="ms", rate_unit="radps",
                     frequency=False, temperature=TemperatureChannel(decimals=3, noise_c=0.005),
@@ -217,10 +219,22 @@ def handled(tmp_path_factory):
                     accelerometer=True)
     run = log_run(cooldown(22.0, 5.0, hours=3.0, ramp_c_per_min=0.15), "mems-3", logger, SEED)
     path, options, info = _write(directory, "handled", run)
-    still = ~run.truth["motion"]
+    moving = run.truth["motion"]
+    columns = {name: values.copy() for name, values in run.columns.items()}
+    factor = RATE_FACTORS["radps"]
+    for a in AXES:
+        rate = (run.truth[f"rate_dph_{a}"] - run.truth[f"motion_dph_{a}"]) * factor
+        columns[info["columns"][f"rate_{a}"]][moving] = rate[moving]
+    time_s = run.truth["time_s"]
+    for window in info["handling_windows"]:
+        rows = moving & (time_s >= window["start_s"]) & (time_s < window["end_s"])
+        gravity = info["orientations"][window["from"]]["gravity_body_g"]
+        for i, a in enumerate(AXES):
+            columns[info["columns"][f"accel_{a}"]][rows] = gravity[i]
     still_path = directory / "still.csv"
-    still_path.write_text(csv_text({k: v[still] for k, v in run.columns.items()}, run.kinds))
-    still_options = [*options, "--gaps", "bridge"]  # the handled minutes are gaps there
+    still_path.write_text(csv_text(columns, {**run.kinds, **{
+        info["columns"][f"rate_{a}"]: "float:.17g" for a in AXES}}))
+    still_options = options
     return {"dir": directory, "run": run, "path": path, "still_path": still_path,
             "options": options, "still_options": still_options, "info": info, "models": {}}
 
@@ -243,9 +257,11 @@ def test_handling_file_has_motion_the_truth_lists(handled):
 
 @pytest.mark.xfail(strict=True, reason=NEEDS_MOTION)
 def test_recording_with_handling_gives_the_model_of_its_still_samples(handled):
-    """Trained on the whole file, the model predicts what the model of its still samples
-    predicts (within 3 standard errors of a prediction of the still model), and its
-    trained ranges are those of the still samples."""
+    """Trained on the handled file, the model predicts what the model of its still samples
+    predicts, within 3 standard errors of a prediction of the still model plus 1 % of the
+    drift it predicts (the two may select different terms); its trained ranges are those
+    of the still samples (temperature within 5 %, df/dt within 20 %). Without a motion
+    detector the handled model is off by hundreds of °/h."""
     d = handled["dir"]
     bias = {}
     for name in ("handled", "still"):
@@ -258,17 +274,20 @@ def test_recording_with_handling_gives_the_model_of_its_still_samples(handled):
         sigma = still["residual_std_dph"] * math.sqrt(
             (len(still["selected"]) + 1) / still["n_windows"])
         diff = bias["handled"][a] - bias["still"][a]
-        assert float(np.sqrt(np.mean(diff**2))) <= 3.0 * sigma, a
-        for variable in ("f", "df"):
-            assert np.allclose(whole["ranges"][variable], still["ranges"][variable],
-                               rtol=0.05, atol=1e-6), (a, variable)
+        tolerance = 3.0 * sigma + 0.01 * float(np.ptp(bias["still"][a]))
+        assert float(np.sqrt(np.mean(diff**2))) <= tolerance, a
+        assert np.allclose(whole["ranges"]["f"], still["ranges"]["f"], rtol=0.05, atol=0.05), a
+        span = np.ptp(still["ranges"]["df"])
+        assert np.allclose(whole["ranges"]["df"], still["ranges"]["df"], atol=0.2 * span), a
 
 
 @pytest.mark.xfail(strict=True, reason=NEEDS_MOTION)
 def test_orientation_offsets_do_not_bias_the_temperature_coefficient(handled):
     """With an offset per orientation as a nuisance parameter, the model's drift along the
     run is the true thermal drift (the unit's bias law, without the g-sensitivity
-    offsets) within 3 % of the drift's own range."""
+    offsets) within 3 % of the drift's own range plus the gyro's own slow noise over the
+    run (bias instability + rate random walk x sqrt(hours): 10 + 3 sqrt(3) °/h for mems-3
+    over 3 h), which no model of temperature can follow."""
     run = handled["run"]
     _handled_model(handled, "handled")
     bias, _ = _bias_model(handled["path"], handled["options"], handled["dir"] / "handled.json",
@@ -282,7 +301,10 @@ def test_orientation_offsets_do_not_bias_the_temperature_coefficient(handled):
             rows = orientation == k
             model[rows] -= np.mean(model[rows] - thermal[rows])
         error = model - thermal
-        assert float(np.sqrt(np.mean(error**2))) <= 0.03 * float(np.ptp(thermal)), a
+        noise = units.get("mems-3").axes[a].gyro_noise
+        slow_noise = noise.bias_instability_dph + noise.rrw_dph_per_sqrt_h * math.sqrt(
+            run.info["duration_s"] / 3600.0)
+        assert float(np.sqrt(np.mean(error**2))) <= 0.03 * float(np.ptp(thermal)) + slow_noise, a
 
 
 NEEDS_CLOCK = "needs the time-step classifier: a 32-bit counter wrap unwrapped (time)"
