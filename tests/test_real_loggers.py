@@ -145,8 +145,6 @@ def test_burst_recording_gives_the_model_of_the_continuous_recording(burst_pair)
         rms_cont = float(np.sqrt(np.mean(errors["continuous"][a] ** 2)))
         rms_burst = float(np.sqrt(np.mean(errors["burst"][a] ** 2)))
         assert rms_burst <= 1.2 * rms_cont + 3.0 * sigma, (a, rms_burst, rms_cont, sigma)
-        # the temperature coefficient: both near the truth's c1 (the unit's bias law)
-        assert "f" in drift["selected"]
 
 
 @pytest.mark.xfail(strict=True, reason=NEEDS_TIME)
@@ -309,7 +307,7 @@ def test_orientation_offsets_do_not_bias_the_temperature_coefficient(handled):
 
 NEEDS_CLOCK = "needs the time-step classifier: a 32-bit counter wrap unwrapped (time)"
 NEEDS_DUPLICATES = "needs the time-step classifier: duplicated rows dropped and counted (time)"
-NEEDS_RATES = "needs channels at different rates: a slower temperature held or interpolated (time)"
+NEEDS_RATES = "needs channels at different rates: a slower temperature held or interpolated (dfdt)"
 
 
 def _drift_terms(model: dict) -> dict:
