@@ -34,6 +34,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass, field
+from datetime import datetime, timedelta
 from typing import Any
 
 import numpy as np
@@ -467,6 +468,12 @@ def log_run(
             temperature_info["reference_log"] = {
                 "probe_column": logger.reference_log.probe_column,
                 "start": logger.reference_log.start, "lag_s": logger.reference_log.lag_s,
+                # The wall-clock time at which the logger's clock read 0 (hrgtc's t = 0 of a
+                # file in s/ms/µs since power-on; the first run's, without a counter wrap).
+                "recording_clock_zero": (
+                    datetime.fromisoformat(logger.reference_log.start)
+                    - timedelta(seconds=logger.clock_start_s)).isoformat(timespec="milliseconds")
+                if logger.time_unit != "timestamp" else logger.start,
                 "readings": readings,
             }
     if logger.accelerometer:
