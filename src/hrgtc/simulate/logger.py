@@ -465,15 +465,20 @@ def log_run(
                 logger.reference_log, track["time_s"],
                 track[die] if channel.source == "die" else track["housing_c"],
                 track["housing_c"], track["chamber_c"], rng)
+            log = logger.reference_log
+            # The wall-clock time at which the logger's clock read 0: hrgtc's t = 0 of a file
+            # in s/ms/µs since power-on (the first run's, without a counter wrap).
+            zero = (datetime.fromisoformat(log.start) - timedelta(seconds=logger.clock_start_s)
+                    if logger.time_unit != "timestamp" else datetime.fromisoformat(logger.start))
+            zero_text = zero.isoformat(timespec="milliseconds")
             temperature_info["reference_log"] = {
-                "probe_column": logger.reference_log.probe_column,
-                "start": logger.reference_log.start, "lag_s": logger.reference_log.lag_s,
-                # The wall-clock time at which the logger's clock read 0 (hrgtc's t = 0 of a
-                # file in s/ms/µs since power-on; the first run's, without a counter wrap).
-                "recording_clock_zero": (
-                    datetime.fromisoformat(logger.reference_log.start)
-                    - timedelta(seconds=logger.clock_start_s)).isoformat(timespec="milliseconds")
-                if logger.time_unit != "timestamp" else logger.start,
+                "probe_column": log.probe_column, "start": log.start, "lag_s": log.lag_s,
+                "recording_clock_zero": zero_text,
+                "hrgtc_options": [
+                    "--temp-ref-col", "time_s=Time", "--temp-ref-col",
+                    f"temperature_c={log.probe_column}", "--temp-ref-start",
+                    zero_text if log.dates else zero_text[11:].removesuffix(".000"),
+                ],
                 "readings": readings,
             }
     if logger.accelerometer:

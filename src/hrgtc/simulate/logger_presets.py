@@ -55,7 +55,9 @@ def _pan_cold() -> LoggerPreset:
         frequency=False,
         # 1/160 °C per count, count -300 at 21.5 °C, stored as an unsigned 16-bit value.
         temperature=TemperatureChannel(lsb_c=0.00625, offset_c=23.375, bits=16, noise_c=0.01),
-        reference_log=ReferenceLog(every_s=300.0, start="2020-03-07T15:44:40", lag_s=300.0,
+        # Started so that the logger's clock read 0 at 15:44:25 (its first sample, at
+        # 15352 ms, comes 15.352 s later).
+        reference_log=ReferenceLog(every_s=300.0, start="2020-03-07T15:44:40.352", lag_s=300.0,
                                    trailing_rows=13, empty_columns=14),
         spikes=3, spike_dph=-6200.0, columns=names,
     )
