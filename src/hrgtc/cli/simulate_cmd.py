@@ -324,6 +324,13 @@ def simulate_command(
 
     A rate table on the three-axis unit: hrgtc simulate --profile ratetable --unit imu-3
     --setpoints=-10,10,30,50 --rates 0,10,-10,100,-100 --rate-hold-s 60 -o runs/
+
+    As a burst logger writes it, truth beside (cold.truth.json, cold.truth.csv):
+    hrgtc simulate --logger burst --unit mems-3 --profile cooldown --start 22 --end 5
+    --hours 2 --rate-hz 50 --burst-s 5 --period-s 300 --time-unit ms --rate-unit radps -o cold.csv
+
+    The PAN cold test of tests/data/pan-cold-test, with its hand log:
+    hrgtc simulate --logger pan-cold -o pan.csv
     """
     from hrgtc.simulate import MultiAxisUnit, simulate_files, standard_profiles, units
 
