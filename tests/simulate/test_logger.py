@@ -393,6 +393,12 @@ def test_logger_refuses_bad_settings():
         log_run(constant(20.0, 0.01), "paper-unit", Logger(columns={"rate_q": "q"}), 0)
     with pytest.raises(InputError, match="needs a logged temperature"):
         Logger(reference_log=ReferenceLog())
+    with pytest.raises(InputError, match="one per ten rows"):
+        log_run(constant(20.0, 0.01), "paper-unit", Logger(sample_rate_hz=1.0, spikes=10), 0)
+    with pytest.raises(InputError, match="one per ten rows"):
+        log_run(constant(20.0, 0.01), "paper-unit", Logger(sample_rate_hz=1.0, duplicates=9), 0)
+    with pytest.raises(InputError, match="leaves no run"):
+        log_run(constant(20.0, 0.01), "paper-unit", Logger(restarts_s=(30.0,)), 0)
 
 
 def test_cli_logger_burst_and_preset_overrides(tmp_path):

@@ -383,6 +383,9 @@ def log_run(
     spike_axes: list[str | None] = []
     if logger.spikes:
         candidates = np.flatnonzero(~truth["motion"])
+        if int(logger.spikes) > candidates.size // 10:
+            raise InputError(f"{logger.spikes} spikes in {candidates.size} still rows: give at "
+                             "most one per ten rows (single-sample spikes)")
         spike_rows = np.sort(rng.choice(candidates, size=int(logger.spikes), replace=False))
         spike_axes = [axes[int(i)] for i in rng.integers(0, len(axes), size=spike_rows.size)]
     truth["spike"] = np.isin(np.arange(rows.size), spike_rows)
@@ -525,6 +528,9 @@ def log_run(
     info["duplicates"] = []
     truth["duplicate"] = np.zeros(rows.size, dtype=bool)
     if logger.duplicates:
+        if int(logger.duplicates) > rows.size // 10:
+            raise InputError(f"{logger.duplicates} duplicated rows of {rows.size}: give at most "
+                             "one per ten rows")
         duplicate_rows(columns, truth, info,
                        rng.choice(rows.size, size=int(logger.duplicates), replace=False))
     info["hrgtc_options"] = reading_options(info, axes, logger)
