@@ -130,6 +130,9 @@ class Logger:
         Role -> the logger's column name; roles ``time``, ``rate_<axis>``, ``freq_<axis>``,
         ``temperature``, ``accel_x|y|z`` (``rate``/``freq`` for a single-axis unit).
         Roles not given get generic names (:meth:`column_names`).
+    extra_columns
+        Channels the logger also writes that hrgtc does not use (a magnetometer): name ->
+        (mean, rms) of a white noise, written right after the time (as the PAN file does).
     """
 
     kind: str = "continuous"
@@ -159,6 +162,7 @@ class Logger:
     accelerometer: bool = False
     accel_unit: str = "g"
     columns: Mapping[str, str] = field(default_factory=dict)
+    extra_columns: Mapping[str, tuple[float, float]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         choices = {"kind": ("continuous", "burst"),
@@ -194,12 +198,15 @@ class Logger:
         if self.rate_digits is not None and not 1 <= int(self.rate_digits) <= 17:
             raise InputError(f"rate_digits must be 1..17, got {self.rate_digits!r}")
         object.__setattr__(self, "columns", dict(self.columns))
+        object.__setattr__(self, "extra_columns", {
+            str(k): (float(v[0]), float(v[1])) for k, v in dict(self.extra_columns).items()})
 
     def column_names(self, axes: tuple[str | None, ...]) -> dict[str, str]:
         """Role -> column name in the file, in column order."""
         time_name = {"s": "time_s", "ms": "time_ms", "us": "time_us",
                      "timestamp": "timestamp"}[self.time_unit]
         names = {"time": time_name}
+        names.update({f"extra:{name}": name for name in self.extra_columns})
         label = _RATE_LABELS[self.rate_unit]
         for axis in axes:
             key = "" if axis is None else f"_{axis}"
@@ -229,6 +236,7 @@ class Logger:
                                 else self.reference_log.to_dict())
         out["handling"] = None if self.handling is None else self.handling.to_dict()
         out["columns"] = dict(self.columns)
+        out["extra_columns"] = {k: list(v) for k, v in self.extra_columns.items()}
         return out
 
 
@@ -492,6 +500,11 @@ def log_run(
         for i, a in enumerate("xyz"):
             columns[names[f"accel_{a}"]] = np.round(accel[:, i] * scale, 4)
             kinds[names[f"accel_{a}"]] = "float:.4f"
+    digits = logger.rate_digits
+    for name, (mean, rms) in logger.extra_columns.items():
+        values = mean + rng.normal(0.0, rms, size=rows.size)
+        columns[name] = values if digits is None else _round_significant(values, int(digits))
+        kinds[name] = "float:.17g" if digits is None else f"float:.{int(digits) - 1}E"
     columns = {name: columns[name] for name in names.values() if name in columns}
 
     segment_first = np.flatnonzero(np.diff(truth["segment"], prepend=-1))

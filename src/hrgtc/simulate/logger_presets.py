@@ -3,7 +3,8 @@
 * ``pan-cold``: like ``tests/data/pan-cold-test/pan_tvc_cold_2020-03-07.csv``: a
   three-axis MEMS gyro (``mems-3``) at rest in a chamber cooling it by about 13 °C in 2 h,
   logged at 50 Hz in 5 s bursts every 305 s (a burst then 300 s asleep), time in ms
-  from 15352 ms with ~0.5 ms jitter, rates in rad/s to three significant digits, the
+  from 15352 ms with ~0.5 ms jitter, its magnetometer columns (not read), rates in rad/s to
+  three significant digits, the
   temperature a signed 16-bit count stored unsigned (65236 = -300), three
   single-sample spikes, and a hand log every 5 min with clock times ``HH:MM``, °F and °C
   columns, blank cells, trailing empty columns and a byte-order mark (its probe lags
@@ -60,6 +61,9 @@ def _pan_cold() -> LoggerPreset:
         reference_log=ReferenceLog(every_s=300.0, start="2020-03-07T15:44:40.352", lag_s=300.0,
                                    trailing_rows=13, empty_columns=14),
         spikes=3, spike_dph=-6200.0, columns=names,
+        # The magnetometer the real file logs too (hrgtc does not read it). [T]
+        extra_columns={"mag1x [T]": (-1.7e-5, 3e-7), "mag1y [T]": (2.8e-5, 3e-7),
+                       "mag1z [T]": (2.8e-5, 3e-7)},
     )
     return LoggerPreset("pan-cold", profile, MEMS_UNIT, logger)
 
