@@ -252,6 +252,31 @@ def test_mems_orientation_offsets_follow_g_sensitivity():
         assert np.allclose(run.truth["offset_dph_x"][rows], row["offset_dph"]["x"])
 
 
+def test_hand_warming_moves_temperature_bias_and_rate_together():
+    from hrgtc.simulate import units
+    from hrgtc.simulate.handling import hand_warming
+
+    handling = Handling(orientations=2, handling_s=60.0, change_times_s=(1800.0,),
+                        g_sensitivity_dph_per_g=G_SENSITIVITY_DPH_PER_G)
+    base = Logger(sample_rate_hz=1.0, frequency=False, handling=handling,
+                  temperature=TemperatureChannel(decimals=3))
+    warm = replace(base, handling=replace(handling, hand_warming_c=3.8))
+    profile = cooldown(24.0, 20.0, hours=1.0, ramp_c_per_min=0.1)
+    cold_run, warm_run = (log_run(profile, "mems-3", b, seed=3) for b in (base, warm))
+    t = warm_run.truth["time_s"]
+    warming = hand_warming(t, warm.handling, 3599.0)
+    assert warming.max() == pytest.approx(3.8)
+    assert np.allclose(warm_run.truth["sensor_c"] - cold_run.truth["sensor_c"], warming)
+    law = units.get("mems-3").axes["x"].bias_law
+    r, h = cold_run.truth["resonator_c_x"], cold_run.truth["housing_c"]
+    change = law.bias_dph(r + warming, h) - law.bias_dph(r, h)
+    assert np.allclose(warm_run.truth["bias_dph_x"] - cold_run.truth["bias_dph_x"], change)
+    assert np.allclose(warm_run.truth["rate_dph_x"] - cold_run.truth["rate_dph_x"], change)
+    # the true dT/dt sees the warming: +3.8 °C in 60 s while the chamber cools
+    moving = warm_run.truth["motion"]
+    assert np.median(warm_run.truth["dtdt_c_per_s_x"][moving]) == pytest.approx(3.8 / 60, rel=0.1)
+
+
 def test_reference_log_has_the_real_hand_log_quirks():
     log = ReferenceLog(every_s=300.0, start="2020-03-07T15:44:40", lag_s=300.0, trailing_rows=3,
                        blank_fraction=0.2, empty_columns=14)

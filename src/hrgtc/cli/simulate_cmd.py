@@ -287,6 +287,12 @@ def simulate_command(
                                    help="Peak rotation rate of the handling [°/s] (300).",
                                    rich_help_panel=_LOGGER)
     ] = None,
+    hand_warming_c: Annotated[
+        float | None, typer.Option("--hand-warming-c",
+                                   help="The hands warm the sensor by this much during each "
+                                   "handling [°C] (0), cooling back over 10 min.",
+                                   rich_help_panel=_LOGGER)
+    ] = None,
     accelerometer: Annotated[
         bool | None, typer.Option("--accelerometer/--no-accelerometer",
                                   help="Write accelerometer columns (in g).",
@@ -376,7 +382,7 @@ def simulate_command(
                 temp_lsb=temp_lsb, temp_offset=temp_offset, temp_bits=temp_bits,
                 temp_rate_hz=temp_rate_hz, reference_log=reference_log,
                 reference_lag_s=reference_lag_s, orientations=orientations,
-                handling_max_dps=handling_max_dps,
+                handling_max_dps=handling_max_dps, hand_warming_c=hand_warming_c,
             )
             logged = simulate_logged_files(
                 runs, output, spec, unit=gyro, seed=seed,
@@ -450,7 +456,8 @@ def _logger_spec(base: Any, kind: str, unit: str, **given: Any) -> Any:
         log = base.reference_log or ReferenceLog()
         base = replace(base, reference_log=log if lag is None else replace(log, lag_s=lag))
     handling = {"orientations": given.pop("orientations"),
-                "max_rate_dps": given.pop("handling_max_dps")}
+                "max_rate_dps": given.pop("handling_max_dps"),
+                "hand_warming_c": given.pop("hand_warming_c")}
     handling = {k: v for k, v in handling.items() if v is not None}
     if handling:
         start = base.handling or Handling(

@@ -32,7 +32,7 @@ import numpy as np
 from hrgtc.errors import InputError
 from hrgtc.simulate.units import EARTH_RATE_DPH
 
-__all__ = ["Handling", "HandlingTruth", "handling_truth", "orientation_matrix"]
+__all__ = ["Handling", "HandlingTruth", "hand_warming", "handling_truth", "orientation_matrix"]
 
 _BODY = {"x": 0, "y": 1, "z": 2}
 _SECONDS_PER_HOUR = 3600.0
@@ -83,6 +83,11 @@ class Handling:
         (an HRG: only the Earth-rate projection changes). [°/h/g]
     accel_noise_g
         White noise of the accelerometer, rms per sample. [g]
+    hand_warming_c
+        A hand's warmth: the sensor warms by this much over each handling window, then
+        cools back with ``hand_warming_tau_s`` (:func:`hand_warming`). [°C]
+    hand_warming_tau_s
+        Time constant of that cooling. [s]
     """
 
     orientations: int = 3
@@ -94,6 +99,8 @@ class Handling:
         default_factory=dict
     )
     accel_noise_g: float = 0.002
+    hand_warming_c: float = 0.0
+    hand_warming_tau_s: float = 600.0
 
     def __post_init__(self) -> None:
         if int(self.orientations) < 1:
@@ -137,6 +144,30 @@ class Handling:
         out["g_sensitivity_dph_per_g"] = {a: list(g) for a, g in
                                           self.g_sensitivity_dph_per_g.items()}
         return out
+
+
+def hand_warming(time_s: np.ndarray, handling: Handling, duration_s: float) -> np.ndarray:
+    """Warming of the sensor by the hands that turn it. [°C]
+
+    A ramp from 0 to ``hand_warming_c`` across each handling window, then an exponential
+    return with ``hand_warming_tau_s``; the windows' warmings add up.
+
+    Examples
+    --------
+    >>> h = Handling(orientations=2, handling_s=60.0, hand_warming_c=3.0, change_times_s=(100,))
+    >>> hand_warming(np.array([0.0, 130.0, 160.0, 760.0]), h, 1000.0).round(3).tolist()
+    [0.0, 1.5, 3.0, 1.104]
+    """
+    t = np.asarray(time_s, dtype=np.float64)
+    out = np.zeros(t.shape)
+    if handling.hand_warming_c == 0.0:
+        return out
+    for start in handling.starts_s(duration_s):
+        end = start + handling.handling_s
+        ramp = np.clip((t - start) / handling.handling_s, 0.0, 1.0)
+        decay = np.exp(-np.clip(t - end, 0.0, None) / handling.hand_warming_tau_s)
+        out += handling.hand_warming_c * ramp * decay
+    return out
 
 
 @dataclass(frozen=True)

@@ -43,7 +43,7 @@ from hrgtc.errors import InputError
 from hrgtc.simulate import units as _units
 from hrgtc.simulate.clock import unwrap_counter, wall_clock
 from hrgtc.simulate.duty import DutyCycle, duplicate_rows, simulate_kept
-from hrgtc.simulate.handling import Handling, handling_truth
+from hrgtc.simulate.handling import Handling, hand_warming, handling_truth
 from hrgtc.simulate.profiles import Profile
 from hrgtc.simulate.reflog import ReferenceLog, TemperatureChannel, reference_log_text
 from hrgtc.simulate.units import MultiAxisUnit, Unit
@@ -285,6 +285,32 @@ def _segments(r: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.cumsum(new) - 1
 
 
+def _warm_by_hand(gyro: Unit | MultiAxisUnit, axes: tuple[str | None, ...], handling: Handling,
+                  rec: dict[str, np.ndarray], track: dict[str, np.ndarray],
+                  duration: float) -> None:
+    """The sensor warmed by the handling hands (in place): resonator temperature, its thermal
+    bias through the unit's bias law, the rate, and the slow track (scale factor unchanged)."""
+    warming = hand_warming(rec["time_s"], handling, duration)
+    warming_track = hand_warming(track["time_s"], handling, duration)
+    for axis in axes:
+        key = "" if axis is None else f"_{axis}"
+        law = (gyro.axes[axis] if isinstance(gyro, MultiAxisUnit) else gyro).bias_law
+        resonator = rec[f"resonator_c{key}"]
+        change = (law.bias_dph(resonator + warming, rec["housing_c"])
+                  - law.bias_dph(resonator, rec["housing_c"]))
+        rec[f"resonator_c{key}"] = resonator + warming
+        rec[f"bias_dph{key}"] = rec[f"bias_dph{key}"] + change
+        rec[f"rate_dph{key}"] = rec[f"rate_dph{key}"] + change
+        axis_unit = gyro.axes[axis] if isinstance(gyro, MultiAxisUnit) else gyro
+        if f"freq_hz{key}" in rec:  # a resonator's frequency follows its temperature
+            law_f = axis_unit.frequency_law.frequency_hz
+            rec[f"freq_hz{key}"] = rec[f"freq_hz{key}"] + (
+                np.asarray(law_f(resonator + warming)) - np.asarray(law_f(resonator)))
+        track[f"resonator_c{key}"] = track[f"resonator_c{key}"] + warming_track
+        track[f"freq_true_hz{key}"] = np.asarray(
+            axis_unit.frequency_law.frequency_hz(track[f"resonator_c{key}"]), dtype=np.float64)
+
+
 def _derivative(track: Mapping[str, np.ndarray], name: str, time_s: np.ndarray) -> np.ndarray:
     """d(track[name])/dt at ``time_s`` (the slow track's central differences, interpolated)."""
     t = track["time_s"]
@@ -339,6 +365,8 @@ def log_run(
     power_on = duty.power_on_s
     duration = kept.duration_s
     n = kept.simulated_rows
+    if logger.handling is not None and logger.handling.hand_warming_c:
+        _warm_by_hand(gyro, axes, logger.handling, rec, track, duration)
 
     body = {a: (a if a is not None else "z") for a in axes}
     handled = (handling_truth(t, list(body.values()), logger.handling, rng, duration)
