@@ -364,8 +364,10 @@ def test_slower_temperature_channel_gives_the_same_model(tmp_path):
             assert abs(slow["coefficients"][term] - value) <= 3 * full["standard_errors"][term]
 
 
-NEEDS_TEMP_REF = ("needs a --temp-ref lag search that finds the reference probe's 300 s lag "
-                  "(sensors: it returns +10 s; held at 300 s the map is right)")
+NEEDS_TEMP_REF = ("needs a --temp-ref lag search that finds the probe's 300 s lag (sensors: "
+                  "thermometry/reference.py compares only the lags that keep the most reference "
+                  "points, and a 300 s lag loses the first reading before the recording starts, "
+                  "so it returns +10 s; held at 300 s the map is right)")
 
 
 @pytest.mark.xfail(strict=True, reason=NEEDS_TEMP_REF)
