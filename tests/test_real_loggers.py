@@ -370,7 +370,6 @@ NEEDS_TEMP_REF = ("needs a --temp-ref lag search that finds the probe's 300 s la
                   "so it returns +10 s; held at 300 s the map is right)")
 
 
-@pytest.mark.xfail(strict=True, reason=NEEDS_TEMP_REF)
 def test_hand_log_gives_the_true_count_map(tmp_path):
     """The pan-cold preset's hand log (HH:MM, °F and °C columns, blanks, BOM, its probe 5 min
     behind the sensor) gives the true count -> °C map: within 0.1 °C over the counts of the

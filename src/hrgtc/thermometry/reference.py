@@ -419,17 +419,25 @@ def fit_count_map(time_s: np.ndarray, count: np.ndarray, reference: ReferenceLog
         used = np.isfinite(at)
         if np.count_nonzero(used) >= 3 and np.ptp(at[used]) > 0:
             trials.append((float(lag), used, at))
-    best: tuple[float, float, float, float, np.ndarray, np.ndarray] | None = None
+    # Lags that keep different numbers of reference points (a lag loses readings at the
+    # recording's ends) are compared by the residual variance per degree of freedom,
+    # sum(r²)/(n − 2), which fewer points do not lower by themselves; a lag must keep at
+    # least half of the most points any lag keeps.
     most = max((int(np.count_nonzero(used)) for _, used, _ in trials), default=0)
+    best: tuple[float, float, float, float, np.ndarray, np.ndarray] | None = None
+    best_variance = np.inf
     for lag, used, at in trials:
-        if np.count_nonzero(used) < most:
-            continue  # fewer points always fit better: compare lags on the same number
+        n = int(np.count_nonzero(used))
+        if n < max(3, (most + 1) // 2):
+            continue
         scale, offset, residual = _line(at[used], reference.temperature_c[used])
-        rms = float(np.sqrt(np.mean(residual**2)))
+        variance = float(np.sum(residual**2)) / max(n - 2, 1)
         # the same residual: the lag nearest 0 (grid order is not a preference)
-        if best is None or rms < best[0] - 1e-12 or (abs(rms - best[0]) <= 1e-12
-                                                      and abs(lag) < abs(best[1])):
-            best = (rms, lag, scale, offset, residual, at[used])
+        if best is None or variance < best_variance * (1 - 1e-12) or (
+                abs(variance - best_variance) <= 1e-12 * best_variance
+                and abs(lag) < abs(best[1])):
+            rms = float(np.sqrt(np.mean(residual**2)))
+            best, best_variance = (rms, lag, scale, offset, residual, at[used]), variance
     if best is None:
         inside = np.count_nonzero((reference.time_s >= t[0]) & (reference.time_s <= t[-1]))
         raise CalibrationError(
