@@ -69,6 +69,10 @@ def test_cold_test_with_its_hand_log_end_to_end(tmp_path, monkeypatch):
     assert temperature[0] == pytest.approx(-300 * fitted["scale_c_per_count"]
                                            + fitted["offset_c"], rel=1e-12)
 
+    from hrgtc.cli import _app
+
+    # the console is made once per process, at the width of whoever imported it first
+    monkeypatch.setattr(_app.console, "width", 200)
     result = runner.invoke(app, ["evaluate", str(RUN), "--model", str(tmp_path / "pan.json"),
                                  *READ], terminal_width=200)
     assert result.exit_code == 0, result.output
