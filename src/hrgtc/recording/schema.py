@@ -4,7 +4,8 @@ The recording contract is that of DESIGN.md: a table with one row per sample
 (``time_s``, ``freq_hz``, ``rate_dph`` required; ``chamber_c``, ``housing_c``,
 ``input_rate_dph`` (known input rate per sample), ``temperature_c`` (a sensor on
 the gyro), ``accel_x/y/z`` (accelerometer axes: motion and orientation, see
-:mod:`hrgtc.recording.motion`) and ``orientation`` (the user's label) optional; ``resonator_c``, ``bias_dph`` and ``scale_ppm`` ground truth
+:mod:`hrgtc.recording.motion`) and ``orientation`` (the user's label) optional;
+``resonator_c``, ``bias_dph`` and ``scale_ppm`` ground truth
 written only by the simulator) and metadata (``unit``, ``sample_rate_hz``,
 ``input_rate_dph``, ``profile``, ``schema``). A multi-axis recording has these
 columns per axis (``rate_dph_x``, ...; see :mod:`hrgtc.recording.axes`).
