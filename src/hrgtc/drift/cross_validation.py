@@ -106,6 +106,8 @@ def _held_out_residuals(x: np.ndarray, y: np.ndarray, run: np.ndarray,
     out = np.full(y.size, np.nan)
     design = np.column_stack([np.ones(y.size), x[:, list(columns)]])
     for r in np.unique(run):
+        if r < 0:  # never left out (the middle of a single run: always training)
+            continue
         test = run == r
         train = ~test
         if np.count_nonzero(train) <= design.shape[1] + 1:
@@ -202,16 +204,20 @@ PRUNE_TOLERANCE = 0.01
 def folds_of(run: np.ndarray, time_s: np.ndarray, blocks: int = TIME_BLOCKS
              ) -> tuple[np.ndarray, str]:
     """Cross-validation folds of training windows: the runs when there are two or more,
-    else ``blocks`` contiguous time blocks of the one run (equal numbers of windows).
+    else the first and the last of ``blocks`` contiguous time blocks of the one run (equal
+    numbers of windows; fold -1, the middle, is never left out).
 
-    Returns the fold of each window and a description (``"runs"`` or ``"time blocks"``).
+    Returns the fold of each window and a description (``"runs"`` or ``"end time blocks"``).
     """
     if np.unique(run).size >= 2:
         return np.asarray(run), "runs"
     order = np.argsort(time_s, kind="stable")
     folds = np.empty(run.size, dtype=np.int64)
     folds[order] = np.minimum(np.arange(run.size) * blocks // max(run.size, 1), blocks - 1)
-    return folds, "time blocks"
+    # only the first and the last block are left out, each predicted from all the rest:
+    # the model has to extrapolate in time (and, on a ramp, in temperature), as on a later run
+    folds = np.where(folds == 0, 0, np.where(folds == blocks - 1, 1, -1))
+    return folds, "end time blocks"
 
 
 def held_out_rms(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarray,

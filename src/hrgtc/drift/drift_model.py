@@ -513,6 +513,8 @@ def fit(
         reference_c = float(thermometer.temperature(np.array([centre]), warn=False)[0])
         if not math.isfinite(reference_c):
             reference_c = float(np.mean(thermometer.temperature_range_c))
+        # the origin of h: on a 1/1024 °C grid, exact in the float32 firmware build
+        reference_c = round(reference_c * 1024.0) / 1024.0
     else:
         reference_freq = float(thermometer.frequency(reference_c))
     settings = FeatureSettings(
