@@ -509,12 +509,12 @@ def fit(
         if centre is None:
             raise CalibrationError("the drift runs hold no sample at rest after the "
                                    f"{warmup:g} s warm-up; see --motion")
-        reference_freq = centre
         reference_c = float(thermometer.temperature(np.array([centre]), warn=False)[0])
         if not math.isfinite(reference_c):
             reference_c = float(np.mean(thermometer.temperature_range_c))
-        # the origin of h: on a 1/1024 °C grid, exact in the float32 firmware build
-        reference_c = round(reference_c * 1024.0) / 1024.0
+        # f_ref = f(reference_c), as the model file's integrity check requires (= the centre
+        # to the thermometer's round trip)
+        reference_freq = float(thermometer.frequency(reference_c))
     else:
         reference_freq = float(thermometer.frequency(reference_c))
     settings = FeatureSettings(
