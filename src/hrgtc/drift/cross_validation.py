@@ -271,3 +271,20 @@ def prune_terms(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarray,
         current = trial[name]
         best = min(best, current)
     return tuple(chosen), before, current
+
+
+def guard_selection(x_scaled: np.ndarray, bias_dph: np.ndarray, run: np.ndarray,
+                    time_s: np.ndarray, names: Sequence[str], selected: Sequence[str],
+                    parents: Mapping[str, Sequence[str]] | None = None,
+                    keep: Sequence[str] = ()) -> tuple[tuple[str, ...] | None, dict[str, Any]]:
+    """The guarded selection: :func:`prune_terms` on the folds of :func:`folds_of`.
+
+    Returns the terms to refit (None when nothing was dropped) and the record of the check
+    (``folds``, ``dropped``, ``before_dph``, ``after_dph``) stored in the model.
+    """
+    folds, kind = folds_of(run, time_s)
+    kept, before, after = prune_terms(x_scaled, bias_dph, folds, names, selected,
+                                      parents=parents, keep=keep)
+    record = {"folds": kind, "dropped": [t for t in selected if t not in kept],
+              "before_dph": before, "after_dph": after}
+    return (kept if len(kept) < len(selected) else None), record

@@ -34,8 +34,7 @@ import numpy as np
 from hrgtc.drift.cross_validation import (
     CrossValidation,
     cross_validate,
-    folds_of,
-    prune_terms,
+    guard_selection,
     select_terms,
 )
 from hrgtc.drift.features import (
@@ -54,15 +53,9 @@ from hrgtc.drift.features import (
     variable_unit,
     variables_for,
 )
-from hrgtc.drift.offsets import (
-    OffsetGroups,
-    offset_groups,
-    orientation_offset,
-    project_off,
-    recover_offsets,
-)
+from hrgtc.drift.offsets import fit_offsets, offset_groups, orientation_offset, project_off
 from hrgtc.drift.regression import EXTENDED_PRECISION, newey_west_inflation
-from hrgtc.drift.rest import check_policy, run_rest, training_centre
+from hrgtc.drift.rest import check_policy, reference_point, run_rest
 from hrgtc.drift.stepwise import StepwiseResult, stepwise
 from hrgtc.drift.windows import RunSource, TrainingWindows, _iter_run, window_means
 from hrgtc.errors import CalibrationError, InputError
@@ -504,19 +497,7 @@ def fit(
     check_policy(motion)
     rests = [run_rest(_iter_run(run), motion, motion_settings, warmup) for run in runs]
     keep = None if motion == "keep" else [r.keep for r in rests]
-    if reference_c is None:  # centred on the still training data, not on a fixed 20 °C
-        centre = training_centre(rests)
-        if centre is None:
-            raise CalibrationError("the drift runs hold no sample at rest after the "
-                                   f"{warmup:g} s warm-up; see --motion")
-        reference_c = float(thermometer.temperature(np.array([centre]), warn=False)[0])
-        if not math.isfinite(reference_c):
-            reference_c = float(np.mean(thermometer.temperature_range_c))
-        # f_ref = f(reference_c), as the model file's integrity check requires (= the centre
-        # to the thermometer's round trip)
-        reference_freq = float(thermometer.frequency(reference_c))
-    else:
-        reference_freq = float(thermometer.frequency(reference_c))
+    reference_freq, reference_c = reference_point(rests, thermometer, reference_c, warmup)
     settings = FeatureSettings(
         reference_freq_hz=float(reference_freq),
         sample_rate_hz=first.metadata.sample_rate_hz,
@@ -584,14 +565,9 @@ def fit(
         chosen = select_terms(*cv_args, windows.sources, rate, slope_sign, parents=parents,
                               initial=result.selected)
     elif select == "guarded" and result.selected:
-        folds, kind = folds_of(windows.run, windows.time_s)
-        kept, before, after = prune_terms(x_scaled, bias, folds, names, result.selected,
-                                          parents=hierarchy(candidates),
-                                          keep=[parse_terms([t])[0].name for t in initial or ()])
-        pruning = {"folds": kind, "dropped": [t for t in result.selected if t not in kept],
-                   "before_dph": before, "after_dph": after}
-        if len(kept) < len(result.selected):
-            chosen = kept
+        chosen, pruning = guard_selection(
+            x_scaled, bias, windows.run, windows.time_s, names, result.selected,
+            parents=hierarchy(candidates), keep=[parse_terms([t])[0].name for t in initial or ()])
     if chosen is not None:
         history = result.history
         result = stepwise(x_scaled, bias, names=names, penter=penter,
@@ -612,8 +588,8 @@ def fit(
     pv.update({n: float(pvalues[k + 1]) for k, n in enumerate(selected)})
     ranges = {v: (float(windows.variables[v].min()), float(windows.variables[v].max()))
               for v in windows.variables}
-    intercept, group_offsets = _offsets(groups, windows.bias_dph, x_full, names, selected,
-                                        params, float(params[0]))
+    intercept, group_offsets = fit_offsets(groups, windows.bias_dph, x_full, names, selected,
+                                           params, float(params[0]))
     return DriftModel(
         settings=settings,
         candidates=names,
@@ -653,13 +629,3 @@ def _variable_text(variable: str, sensor: bool) -> str:
         return _SENSOR_VARIABLES[variable]
     unit = variable_unit(variable)
     return f"{variable} in {unit.replace('Hz', '°C') if sensor else unit}"
-
-
-def _offsets(groups: OffsetGroups, bias: np.ndarray, x_full: np.ndarray, names: Sequence[str],
-             selected: Sequence[str], params: np.ndarray, intercept: float
-             ) -> tuple[float, dict[str, float]]:
-    """The intercept and the nuisance offsets (none: the fit's own intercept)."""
-    if groups.mode == "none":
-        return intercept, {}
-    columns = [list(names).index(t) for t in selected]
-    return recover_offsets(groups, bias, x_full[:, columns], np.asarray(params[1:]))

@@ -176,3 +176,14 @@ def orientation_offset(offsets: Mapping[str, float], orientations: Sequence[Sequ
         return None
     value = offsets.get(f"orientation {label}")
     return None if value is None or not math.isfinite(value) else float(value)
+
+
+def fit_offsets(groups: OffsetGroups, bias: np.ndarray, x_full: np.ndarray,
+                names: Sequence[str], selected: Sequence[str], params: np.ndarray,
+                intercept: float) -> tuple[float, dict[str, float]]:
+    """The intercept and the nuisance offsets of a fit whose selected terms have the scaled
+    coefficients ``params[1:]`` (mode ``"none"``: the fit's own ``intercept``, no offsets)."""
+    if groups.mode == "none":
+        return intercept, {}
+    columns = [list(names).index(t) for t in selected]
+    return recover_offsets(groups, bias, x_full[:, columns], np.asarray(params[1:]))

@@ -11,6 +11,7 @@ temperature offset (``--temp-offset``) or reference temperature.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -130,3 +131,23 @@ def training_centre(rests: Sequence[RunRest]) -> float | None:
     if count == 0:
         return None
     return sum(r.freq_sum for r in rests) / count
+
+
+def reference_point(rests: Sequence[RunRest], thermometer: Any, reference_c: float | None,
+                    warmup_s: float = 0.0) -> tuple[float, float]:
+    """``(f_ref [Hz], reference temperature [°C])`` of a drift fit.
+
+    With ``reference_c`` None, the centre of the still training samples (not a fixed
+    20 °C): the model then does not depend on an arbitrary temperature offset or scale.
+    f_ref is ``thermometer.frequency(reference_c)`` either way (the model file's
+    integrity check), the centre to the thermometer's round trip.
+    """
+    if reference_c is None:
+        centre = training_centre(rests)
+        if centre is None:
+            raise CalibrationError("the drift runs hold no sample at rest after the "
+                                   f"{warmup_s:g} s warm-up; see --motion")
+        reference_c = float(thermometer.temperature(np.array([centre]), warn=False)[0])
+        if not math.isfinite(reference_c):
+            reference_c = float(np.mean(thermometer.temperature_range_c))
+    return float(thermometer.frequency(reference_c)), float(reference_c)
