@@ -165,3 +165,26 @@ def test_guarded_selection_does_not_extrapolate_high_order_terms():
             assert guarded.pruning["folds"] == "end time blocks"
             assert error(guarded) < 0.6 * error(plain)
     assert sum(g > 1.2 for g in gains) >= 4
+
+
+def test_compensation_applies_known_orientations_and_reports_an_unknown_one():
+    from hrgtc.compensate import Compensator
+    from hrgtc.errors import HrgtcWarning
+    from hrgtc.model import UnitModel
+
+    orientations = ([300.0, -200.0, 100.0], [[0, 0, 1], [1, 0, 0], [0, -1, 0]])
+    run, _ = mems_run(2, orientations=orientations)
+    model = UnitModel(thermometer=THERMOMETER, unit="mems",
+                      drift=quiet_fit([run], THERMOMETER, terms=("f", "f^2", "df")))
+    later, _ = mems_run(7, orientations=orientations)
+    out = Compensator(model).process(later)
+    residual = out["bias_model_dph"] - later["bias_dph"]
+    parts = np.array_split(residual[600:], 3)  # after the df/dt filter settles
+    for part, offset in zip(parts, orientations[0], strict=True):
+        assert np.median(part) == pytest.approx(offset, abs=3.0)  # each orientation's own
+    # a fourth orientation never seen: the training mean, counted and warned about
+    turned, _ = mems_run(8, orientations=([0.0], [[0, 1, 0]]))
+    compensator = Compensator(model)
+    with pytest.warns(HrgtcWarning, match="never seen in training"):
+        compensator.process(turned)
+    assert compensator.unknown_orientation == len(turned)

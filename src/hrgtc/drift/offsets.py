@@ -187,3 +187,23 @@ def fit_offsets(groups: OffsetGroups, bias: np.ndarray, x_full: np.ndarray,
         return intercept, {}
     columns = [list(names).index(t) for t in selected]
     return recover_offsets(groups, bias, x_full[:, columns], np.asarray(params[1:]))
+
+
+def sample_offsets(offsets: Mapping[str, float], orientations: Sequence[Sequence[float]],
+                   accel: np.ndarray, tolerance_deg: float = ORIENTATION_TOLERANCE_DEG
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """Per sample: the trained offset of its orientation (from the intercept) and whether
+    the orientation is unknown (offset 0 there: the intercept, the training mean).
+
+    ``accel`` has shape (samples, 3). A direction within ``tolerance_deg`` of no trained
+    orientation (or a zero vector) is unknown: its offset is not guessed. [°/h]
+    """
+    accel = np.asarray(accel, dtype=np.float64)
+    centres = np.asarray(orientations, dtype=np.float64)
+    norm = np.linalg.norm(accel, axis=1)
+    unit = accel / np.where(norm > 0, norm, 1.0)[:, None]
+    dots = unit @ centres.T
+    best = np.argmax(dots, axis=1)
+    known = (np.max(dots, axis=1) >= math.cos(math.radians(tolerance_deg))) & (norm > 0)
+    table = np.array([offsets.get(f"orientation {k}", 0.0) for k in range(len(centres))])
+    return np.where(known, table[best], 0.0), ~known

@@ -563,6 +563,9 @@ def run_pass(
                 terms[key] = noise_terms(deviations[key])
         except HrgtcError as exc:
             notes.append(f"{key}: no Allan noise terms ({exc})")
+    if frequency.unknown_orientation:
+        notes.append(f"{frequency.unknown_orientation} samples in an orientation the model was "
+                     "not trained in: their offset is unknown (the training mean is used)")
     if allan and deviation not in ("adev", "oadev"):
         notes.append(f"noise terms are read off the Allan deviation; --deviation {deviation} "
                      "gives the curve only")
