@@ -113,8 +113,8 @@ def calibrate_command(
     premove: float = typer.Option(
         None, help="Stepwise p-value to remove [default max(penter, 0.10)]."),
     reference_c: float = typer.Option(
-        None, "--reference-c", help="Reference temperature of f [°C; default: the mean of the "
-        "still training data, so the model does not depend on a temperature offset]."),
+        None, "--reference-c", help="Reference temperature of f [°C]. [default: the centre of "
+        "the still training data, so a temperature offset does not change the model]"),
     drift_from_soaks: bool = typer.Option(
         True, "--drift-from-soaks/--no-drift-from-soaks",
         help="Also fit the drift model on the soaks' warming and cooling transients."),
