@@ -188,3 +188,28 @@ def test_compensation_applies_known_orientations_and_reports_an_unknown_one():
     with pytest.warns(HrgtcWarning, match="never seen in training"):
         compensator.process(turned)
     assert compensator.unknown_orientation == len(turned)
+
+
+def test_windows_never_span_left_out_samples_across_chunks():
+    from hrgtc.drift.features import FeatureSettings, parse_terms
+    from hrgtc.drift.windows import window_means
+
+    run, _ = mems_run(9, hours=1.0)
+    n = len(run)
+    keep = np.ones(n, dtype=bool)
+    keep[1005:1012] = False  # inside the 11th window of 100 samples
+    keep[2995:3005] = False  # across the 30th/31st boundary
+    settings = FeatureSettings(reference_freq_hz=15.0, sample_rate_hz=1.0, warmup_s=0.0)
+    chunks = [run.slice(a, a + 777) for a in range(0, n, 777)]
+    windows = window_means([lambda: iter(chunks)], settings, parse_terms(["f"]), 100.0,
+                           keep=[keep])
+    t = run.time_s
+    starts = windows.time_s - 49.5  # each window's first sample time (1 Hz, 100 samples)
+    for start in starts:
+        rows = (t >= start) & (t < start + 100.0)
+        assert rows.sum() == 100 and keep[rows].all()
+    # 36 whole windows less the two that held a left-out stretch, plus the partial ones dropped
+    assert windows.time_s.size == 34
+    assert windows.n_not_at_rest == 17
+    expected = [run.rate_dph[(t >= s) & (t < s + 100.0)].mean() for s in starts]
+    np.testing.assert_allclose(windows.bias_dph, expected, rtol=1e-12)
