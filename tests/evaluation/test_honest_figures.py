@@ -6,7 +6,6 @@ import warnings
 
 import numpy as np
 import pytest
-from synthetic import THERMOMETER, ramp_run
 
 from hrgtc import drift
 from hrgtc.compensate import Compensator
@@ -14,6 +13,8 @@ from hrgtc.drift.features import settle_rows
 from hrgtc.evaluation import evaluate
 from hrgtc.model import UnitModel
 from hrgtc.recording import ReadOptions, Recording
+
+from synthetic import THERMOMETER, ramp_run
 
 
 @pytest.fixture(scope="module")
