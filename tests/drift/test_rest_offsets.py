@@ -213,3 +213,31 @@ def test_windows_never_span_left_out_samples_across_chunks():
     assert windows.n_not_at_rest == 17
     expected = [run.rate_dph[(t >= s) & (t < s + 100.0)].mean() for s in starts]
     np.testing.assert_allclose(windows.bias_dph, expected, rtol=1e-12)
+
+
+def test_user_orientation_labels_give_an_offset_each_like_an_hrg_turned_on_its_table():
+    # an HRG turned between two positions: the Earth-rate component on its axis changes by
+    # 12 °/h, logged only as the operator's label
+    a, _ = mems_run(13, noise_dph=1.0, slope=0.4)
+    label = np.where(a.time_s < a.time_s[-1] / 2, 1.0, 2.0)
+    rate = a.rate_dph + np.where(label == 2.0, 12.0, 0.0)
+    run = Recording({**a.columns, "rate_dph": rate, "orientation": label}, a.metadata, a.source)
+    model = quiet_fit([run], THERMOMETER, terms=("f",))
+    assert model.offset_mode == "orientation" and model.orientations == ()
+    assert model.coefficients["f"] == pytest.approx(0.4, abs=3 * model.standard_errors["f"])
+    assert model.offsets_dph["orientation 2"] - model.offsets_dph["orientation 1"] == \
+        pytest.approx(12.0, abs=0.2)
+    # compensation reads the label; a label never trained is unknown, counted, not guessed
+    from hrgtc.compensate import Compensator
+    from hrgtc.model import UnitModel
+
+    unit = UnitModel(thermometer=THERMOMETER, drift=model, unit="hrg")
+    out = Compensator(unit).process(run)
+    step = out["rate_comp_dph"][label == 2.0].mean() - out["rate_comp_dph"][label == 1.0].mean()
+    assert abs(step) < 0.2  # the 12 °/h step is taken out
+    relabelled = Recording({**run.columns, "orientation": np.full(len(run), 3.0)},
+                           run.metadata, run.source)
+    compensator = Compensator(unit)
+    with pytest.warns(UserWarning, match="never seen in training"):
+        compensator.process(relabelled)
+    assert compensator.unknown_orientation == len(run)

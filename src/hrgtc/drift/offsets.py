@@ -207,3 +207,18 @@ def sample_offsets(offsets: Mapping[str, float], orientations: Sequence[Sequence
     known = (np.max(dots, axis=1) >= math.cos(math.radians(tolerance_deg))) & (norm > 0)
     table = np.array([offsets.get(f"orientation {k}", 0.0) for k in range(len(centres))])
     return np.where(known, table[best], 0.0), ~known
+
+
+def label_offsets(offsets: Mapping[str, float], label: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Per sample: the trained offset of the user's orientation label (from the intercept)
+    and whether the label was never seen in training (offset 0 there, not guessed). [°/h]"""
+    rounded = np.round(np.asarray(label, dtype=np.float64))
+    offset = np.zeros(rounded.size)
+    unknown = np.ones(rounded.size, dtype=bool)
+    for value in np.unique(rounded[np.isfinite(rounded)]):
+        key = f"orientation {int(value)}"
+        if key in offsets:
+            at = rounded == value
+            offset[at] = offsets[key]
+            unknown[at] = False
+    return offset, unknown
