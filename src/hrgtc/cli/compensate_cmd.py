@@ -131,6 +131,9 @@ def render_evaluation(result: Evaluation, sensor: bool = False) -> None:
             f"{paper.BIAS_STABILITY_RAW_DPH} → {paper.BIAS_STABILITY_COMPENSATED_DPH}"
             if t == 10.0 else "" for t in taus))
     console.print(table)
+    console.print("offset and spread the bias stability does not show: " + "; ".join(
+        f"{name} {result.offset_text(name)}" for name in result.bias_stability_dph),
+        markup=False)
     if result.noise:
         allan = Table(title="Allan noise terms (IEEE Std 952)")
         for column in ("output", "ARW (°/√h)", "bias instability (°/h)", "RRW (°/h/√h)"):
@@ -140,7 +143,8 @@ def render_evaluation(result: Evaluation, sensor: bool = False) -> None:
                           terms.text("bias_instability"), terms.text("rrw"))
         console.print(allan)
     console.print(
-        f"improvement at 10 s: {result.improvement_10s:.2f}×; outside the calibrated range: "
+        f"improvement at 10 s: {result.improvement_10s:.2f}×; compensated "
+        f"{result.offset_text()}; outside the calibrated range: "
         f"{result.out_of_range_fraction:.2%}; df/dt beyond training: "
         f"{result.rate_out_of_range_fraction:.2%}"
     )
@@ -150,6 +154,9 @@ def render_evaluation(result: Evaluation, sensor: bool = False) -> None:
                       f"{std['median']:.4g} °/h, max {std['max']:.4g} °/h")
     if result.residual_rms_dph is not None:
         console.print(f"RMS of true bias minus model: {result.residual_rms_dph:.4f} °/h")
+    if result.n_not_at_rest:
+        console.print(f"{result.n_not_at_rest} samples not at rest left out of the figures "
+                      f"({result.n_not_at_rest / result.n_samples:.1%}; --motion keep uses them)")
     if result.directions is not None:
         console.print(result.directions.summary(sensor=sensor), markup=False)
     for note in result.notes:
@@ -277,6 +284,8 @@ def axis_summary(results: dict[str, Evaluation]) -> list[dict[str, float | str]]
     """One row per axis: 10 s bias stability raw and compensated, improvement, ranges."""
     return [{"axis": axis, "raw_10s_dph": r.raw_10s, "compensated_10s_dph": r.compensated_10s,
              "improvement_10s": r.improvement_10s,
+             "compensated_mean_dph": r.mean_dph.get("compensated", float("nan")),
+             "compensated_rms_dph": r.rms_dph.get("compensated", float("nan")),
              "out_of_range_fraction": r.out_of_range_fraction,
              "rate_out_of_range_fraction": r.rate_out_of_range_fraction}
             for axis, r in results.items()]
@@ -285,11 +294,13 @@ def axis_summary(results: dict[str, Evaluation]) -> list[dict[str, float | str]]
 def render_axis_summary(unit: str, results: dict[str, Evaluation]) -> None:
     """The instrument's summary table: one row per axis."""
     table = Table(title=f"{unit}: 10 s bias stability per axis (°/h)")
-    for column in ("axis", "raw", "compensated", "improvement", "beyond T", "beyond df/dt"):
+    for column in ("axis", "raw", "compensated", "improvement", "comp. mean", "comp. RMS",
+                   "beyond T", "beyond df/dt"):
         table.add_column(column, justify="right")
     for row in axis_summary(results):
         table.add_row(str(row["axis"]), f"{row['raw_10s_dph']:.4f}",
                       f"{row['compensated_10s_dph']:.4f}", f"{row['improvement_10s']:.2f}×",
+                      f"{row['compensated_mean_dph']:+.4g}", f"{row['compensated_rms_dph']:.4g}",
                       f"{row['out_of_range_fraction']:.1%}",
                       f"{row['rate_out_of_range_fraction']:.1%}")
     console.print(table)

@@ -68,6 +68,14 @@ class GapPolicy(StrEnum):
     ignore = "ignore"
 
 
+class MotionPolicy(StrEnum):
+    """What calibration and evaluation do with samples not at rest."""
+
+    exclude = "exclude"
+    keep = "keep"
+    error = "error"
+
+
 class SpikePolicy(StrEnum):
     """What to do with spikes (non-finite or physically impossible samples)."""
 
@@ -322,6 +330,17 @@ ThermometerOption = Annotated[
         rich_help_panel=_INPUT,
     ),
 ]
+MotionOption = Annotated[
+    MotionPolicy | None,
+    typer.Option(
+        "--motion",
+        help="Samples not at rest (handling, turning, shaking, clipping; found against the "
+        "local still level, the at-rest noise and any accel_x/y/z columns, with a guard time): "
+        "left out of calibration and evaluation and counted (exclude, default), used (keep), "
+        "or an error naming the first one (error).",
+        rich_help_panel=_INPUT,
+    ),
+]
 ForceOption = Annotated[bool, typer.Option("--force", help="Overwrite existing output files.")]
 #: Exit status of --strict when samples went beyond the trained ranges.
 STRICT_EXIT = 3
@@ -354,6 +373,7 @@ def recording_input(
     spike_k: float | None = None,
     spike_lsb: float | None = None,
     spike_window_s: float | None = None,
+    motion: MotionPolicy | str | None = None,
 ) -> ReadOptions:
     """Gather the values of the shared reading options into a :class:`ReadOptions`."""
     from hrgtc.recording import ReadOptions
@@ -381,6 +401,7 @@ def recording_input(
         **{name: float(value) for name, value in (("spike_k", spike_k), ("spike_lsb", spike_lsb),
                                                  ("spike_window_s", spike_window_s))
            if value is not None},
+        motion=str(getattr(motion, "value", motion) or "exclude"),
     )
 
 
@@ -405,6 +426,7 @@ _READING_OPTIONS: tuple[tuple[str, Any], ...] = (
     ("spike_lsb", SpikeLsbOption),
     ("spike_window_s", SpikeWindowOption),
     ("thermometer", ThermometerOption),
+    ("motion", MotionOption),
 )
 
 
@@ -415,7 +437,7 @@ def reading_options(command: Callable[..., Any]) -> Callable[..., Any]:
     parameter) instead of the separate options; the command line still shows
     ``--col``, ``--time-unit``, ``--freq-unit``, ``--rate-unit``, ``--sample-rate-hz``,
     ``--unit-name``, ``--input-rate-dph``, ``--gaps``, ``--temp-scale``,
-    ``--temp-offset``, ``--spikes`` and ``--thermometer``.
+    ``--temp-offset``, ``--spikes``, ``--thermometer`` and ``--motion``.
     """
     signature = inspect.signature(command)
     namespace = command.__globals__

@@ -37,7 +37,8 @@ from hrgtc.drift.features import (
     is_aux,
     settle_rows,
 )
-from hrgtc.errors import CalibrationError, ExtrapolationWarning, InputError
+from hrgtc.drift.offsets import label_offsets, sample_offsets
+from hrgtc.errors import CalibrationError, ExtrapolationWarning, HrgtcWarning, InputError
 from hrgtc.files import check_writable
 from hrgtc.model import UnitModel
 from hrgtc.progress import Progress
@@ -139,6 +140,7 @@ class Compensator:
         self.rate_out_of_range = 0
         self.settling = 0
         self.temperature_nan = 0
+        self.unknown_orientation = 0
         self.segments = 1
         self._last_time: float | None = None
 
@@ -201,6 +203,8 @@ class Compensator:
             for start in range(0, n, BLOCK_ROWS):
                 self._block(chunk.slice(start, start + BLOCK_ROWS), out, start)
         self._count_temperature_nan(out["resonator_c_est"], chunk)
+        if "orientation" in self.drift.offset_mode:
+            self._orientation_offsets(chunk, out)
         if self.scale_factor is not None:
             # rate = input * (1 + k) + bias, so input = (rate - bias) / (1 + k).
             ppm = self.scale_factor.ppm(chunk.freq_hz)
@@ -226,6 +230,35 @@ class Compensator:
                 "their compensation is an extrapolation of the drift model",
                 ExtrapolationWarning, stacklevel=4)
         self.temperature_nan += int(np.count_nonzero(bad))
+
+    def _orientation_offsets(self, chunk: Recording, out: dict[str, np.ndarray]) -> None:
+        """Add each sample's trained orientation offset (:mod:`hrgtc.drift.offsets`) to the
+        bias; an orientation never seen in training keeps the mean offset and is counted in
+        :attr:`unknown_orientation` (and warned about once), not guessed."""
+        axes = ("accel_x", "accel_y", "accel_z")
+        labelled = not self.drift.orientations  # the user's orientation column
+        readable = "orientation" in chunk if labelled else all(a in chunk for a in axes)
+        if readable:
+            if labelled:
+                offset, unknown = label_offsets(self.drift.offsets_dph, chunk["orientation"])
+            else:
+                offset, unknown = sample_offsets(self.drift.offsets_dph, self.drift.orientations,
+                                                 np.column_stack([chunk[a] for a in axes]))
+            out["bias_model_dph"] += offset
+            out["rate_comp_dph"] -= offset
+        else:
+            unknown = np.ones(len(chunk), dtype=bool)
+        count = int(np.count_nonzero(unknown))
+        if count and not self.unknown_orientation:
+            spread = max(self.drift.offsets_dph.values()) - min(self.drift.offsets_dph.values())
+            what = ("is in an orientation never seen in training" if readable else
+                    "has no orientation column to tell its orientation" if labelled else
+                    "has no accel_x/y/z columns to tell its orientation")
+            warnings.warn(
+                f"{chunk.source or 'the run'} {what}: its offset is unknown (the trained "
+                f"orientations' offsets span {spread:.4g} °/h); the training mean is used and "
+                "the compensated mean is uncertain by that much", HrgtcWarning, stacklevel=4)
+        self.unknown_orientation += count
 
     def _fused(self, chunk: Recording, out: dict[str, np.ndarray]) -> bool:
         """Compensate ``chunk`` into ``out`` with the kernel; False if it cannot (order > 5)."""

@@ -106,6 +106,8 @@ def _held_out_residuals(x: np.ndarray, y: np.ndarray, run: np.ndarray,
     out = np.full(y.size, np.nan)
     design = np.column_stack([np.ones(y.size), x[:, list(columns)]])
     for r in np.unique(run):
+        if r < 0:  # never left out (the middle of a single run: always training)
+            continue
         test = run == r
         train = ~test
         if np.count_nonzero(train) <= design.shape[1] + 1:
@@ -191,3 +193,98 @@ def select_terms(x_scaled: np.ndarray, bias_dph: np.ndarray, run: np.ndarray,
         chosen = [n for n in chosen if n != name] if name in chosen else [*chosen, name]
         best = trial[name]
     return tuple(n for n in names if n in chosen)
+
+
+#: Contiguous time blocks of a single training run for blocked cross-validation.
+TIME_BLOCKS = 5
+#: A term is pruned when the held-out score without it is within this share of the best.
+PRUNE_TOLERANCE = 0.01
+
+
+def folds_of(run: np.ndarray, time_s: np.ndarray, blocks: int = TIME_BLOCKS
+             ) -> tuple[np.ndarray, str]:
+    """Cross-validation folds of training windows: the runs when there are two or more,
+    else the first and the last of ``blocks`` contiguous time blocks of the one run (equal
+    numbers of windows; fold -1, the middle, is never left out).
+
+    Returns the fold of each window and a description (``"runs"`` or ``"end time blocks"``).
+    """
+    if np.unique(run).size >= 2:
+        return np.asarray(run), "runs"
+    order = np.argsort(time_s, kind="stable")
+    folds = np.empty(run.size, dtype=np.int64)
+    folds[order] = np.minimum(np.arange(run.size) * blocks // max(run.size, 1), blocks - 1)
+    # only the first and the last block are left out, each predicted from all the rest:
+    # the model has to extrapolate in time (and, on a ramp, in temperature), as on a later run
+    folds = np.where(folds == 0, 0, np.where(folds == blocks - 1, 1, -1))
+    return folds, "end time blocks"
+
+
+def held_out_rms(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarray,
+                 names: Sequence[str], terms: Sequence[str]) -> float:
+    """Root mean square over folds of each left-out fold's residual RMS (offset included:
+    a term that extrapolates badly shows in the level as much as in the slope). [°/h]"""
+    columns = [list(names).index(t) for t in terms]
+    residual = _held_out_residuals(x_scaled, bias_dph, folds, columns)
+    per_fold = [float(np.mean(residual[(folds == f) & np.isfinite(residual)] ** 2))
+                for f in np.unique(folds) if np.any((folds == f) & np.isfinite(residual))]
+    return float(np.sqrt(np.mean(per_fold))) if per_fold else math.nan
+
+
+def prune_terms(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarray,
+                names: Sequence[str], selected: Sequence[str],
+                tolerance: float = PRUNE_TOLERANCE,
+                parents: Mapping[str, Sequence[str]] | None = None,
+                keep: Sequence[str] = ()) -> tuple[tuple[str, ...], float, float]:
+    """Drop selected terms that do not carry over to held-out folds.
+
+    From ``selected`` (the stepwise terms), the term whose removal gives the lowest
+    :func:`held_out_rms` is removed while that score stays within ``tolerance`` of the
+    best score seen: a term that only fits the training folds (a cubic that runs away
+    outside the temperatures it was fitted on) goes; a term the held-out folds need
+    stays. Only removals: the result is never richer than ``selected``. With
+    ``parents`` (term -> its lower-order parents), a term is removed only once no kept
+    term has it as a parent: the highest orders go first (marginality). Terms in
+    ``keep`` (the user's starting model) are never removed.
+
+    Returns
+    -------
+    terms, score_before, score_after
+        The kept terms (candidate order) and the held-out RMS before and after. [°/h]
+    """
+    chosen = [n for n in names if n in set(selected)]
+    before = held_out_rms(x_scaled, bias_dph, folds, names, chosen)
+    if not math.isfinite(before):
+        return tuple(chosen), before, before
+    best = current = before
+    while chosen:
+        leaves = [n for n in chosen if n not in keep
+                  and not any(n in (parents or {}).get(c, ()) for c in chosen if c != n)]
+        trial = {n: held_out_rms(x_scaled, bias_dph, folds, names,
+                                 [c for c in chosen if c != n]) for n in leaves}
+        if not trial:
+            break
+        name = min(trial, key=trial.__getitem__)
+        if not trial[name] <= best * (1.0 + tolerance):
+            break
+        chosen.remove(name)
+        current = trial[name]
+        best = min(best, current)
+    return tuple(chosen), before, current
+
+
+def guard_selection(x_scaled: np.ndarray, bias_dph: np.ndarray, run: np.ndarray,
+                    time_s: np.ndarray, names: Sequence[str], selected: Sequence[str],
+                    parents: Mapping[str, Sequence[str]] | None = None,
+                    keep: Sequence[str] = ()) -> tuple[tuple[str, ...] | None, dict[str, Any]]:
+    """The guarded selection: :func:`prune_terms` on the folds of :func:`folds_of`.
+
+    Returns the terms to refit (None when nothing was dropped) and the record of the check
+    (``folds``, ``dropped``, ``before_dph``, ``after_dph``) stored in the model.
+    """
+    folds, kind = folds_of(run, time_s)
+    kept, before, after = prune_terms(x_scaled, bias_dph, folds, names, selected,
+                                      parents=parents, keep=keep)
+    record = {"folds": kind, "dropped": [t for t in selected if t not in kept],
+              "before_dph": before, "after_dph": after}
+    return (kept if len(kept) < len(selected) else None), record

@@ -23,6 +23,7 @@ reported in the user's units.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -30,7 +31,12 @@ from typing import Any
 
 import numpy as np
 
-from hrgtc.drift.cross_validation import CrossValidation, cross_validate, select_terms
+from hrgtc.drift.cross_validation import (
+    CrossValidation,
+    cross_validate,
+    guard_selection,
+    select_terms,
+)
 from hrgtc.drift.features import (
     AUX_PREFIX,
     EQ21,
@@ -47,12 +53,15 @@ from hrgtc.drift.features import (
     variable_unit,
     variables_for,
 )
+from hrgtc.drift.offsets import fit_offsets, offset_groups, orientation_offset, project_off
 from hrgtc.drift.regression import EXTENDED_PRECISION, newey_west_inflation
+from hrgtc.drift.rest import check_policy, reference_point, run_rest
 from hrgtc.drift.stepwise import StepwiseResult, stepwise
 from hrgtc.drift.windows import RunSource, TrainingWindows, _iter_run, window_means
 from hrgtc.errors import CalibrationError, InputError
 from hrgtc.progress import Progress
 from hrgtc.recording import Recording
+from hrgtc.recording.motion import MotionSettings
 from hrgtc.thermometry import Thermometer
 
 #: Smallest training spread of df/dt, as a resonator temperature rate, for a drift model. [°C/h]
@@ -61,6 +70,8 @@ MIN_RATE_SPAN_C_PER_H = 0.5
 MIN_TEMPERATURE_SPAN_C = 1.0
 #: Default time constant of the second df/dt filter (``d2``) as a multiple of the first's.
 TAU2_FACTOR = 6.0
+#: Ways of choosing the terms (``select``): ``guarded`` is the default.
+SELECTIONS = ("guarded", "stepwise", "cv")
 
 
 @dataclass(frozen=True)
@@ -100,6 +111,16 @@ class DriftModel(ParsedTerms):
         How the terms were chosen: ``"stepwise"`` (F-tests) or ``"cv"``.
     cross_validation
         Leave-one-run-out cross-validation of the selected terms (None with one run).
+    n_not_at_rest
+        Training samples left out because they were not at rest (handling, motion).
+    offset_mode, offsets_dph
+        The nuisance offsets of the fit (:mod:`hrgtc.drift.offsets`): ``"none"``,
+        ``"run"``, ``"orientation"`` or ``"run+orientation"``, and each group's offset
+        from ``intercept_dph`` (the windows' mean offset). [°/h]
+    orientations
+        Unit accelerometer vectors of the trained orientations (empty without them).
+    pruning
+        The guarded selection's held-out check (folds, terms dropped, scores), or None.
     """
 
     settings: FeatureSettings
@@ -121,6 +142,11 @@ class DriftModel(ParsedTerms):
     bandwidth_windows: int = 0
     selection: str = "stepwise"
     cross_validation: CrossValidation | None = None
+    n_not_at_rest: int = 0
+    offset_mode: str = "none"
+    offsets_dph: dict[str, float] = field(default_factory=dict)
+    orientations: tuple[tuple[float, ...], ...] = ()
+    pruning: dict[str, Any] | None = None
     _terms: tuple[Term, ...] = field(default=(), repr=False, compare=False)
 
     @property
@@ -192,6 +218,11 @@ class DriftModel(ParsedTerms):
         stream = FeatureStream(self.settings, self.variables, thermometer)
         return self.predict(stream.process(recording))
 
+    def orientation_offset(self, accel: Any) -> float | None:
+        """Offset from ``intercept_dph`` of the orientation of a mean accelerometer vector;
+        None when it matches no trained orientation (unknown, not guessed). [°/h]"""
+        return orientation_offset(self.offsets_dph, self.orientations, accel)
+
     def equation(self, sensor: bool = False) -> str:
         """The model in Eq. (22) form with numbers, e.g. ``B = 1.2 + 0.3·f - ...``.
 
@@ -242,6 +273,15 @@ class DriftModel(ParsedTerms):
             )
         if self.cross_validation is not None:
             lines.append(self.cross_validation.summary())
+        if self.pruning is not None and self.pruning.get("dropped"):
+            p = self.pruning
+            lines.append(f"guarded selection: dropped {', '.join(p['dropped'])} (held-out RMS "
+                         f"over {p['folds']} {p['before_dph']:.4g} -> {p['after_dph']:.4g} °/h)")
+        if self.n_not_at_rest:
+            lines.append(f"{self.n_not_at_rest} training samples not at rest were left out")
+        if self.offsets_dph:
+            lines.append(f"offsets ({self.offset_mode}, nuisance, from the intercept) [°/h]: "
+                         + ", ".join(f"{k} {v:+.4g}" for k, v in self.offsets_dph.items()))
         lines.append(self.equation(sensor))
         return "\n".join(lines)
 
@@ -269,6 +309,11 @@ class DriftModel(ParsedTerms):
             "selection": self.selection,
             "cross_validation": None if self.cross_validation is None
             else self.cross_validation.to_dict(),
+            "n_not_at_rest": self.n_not_at_rest,
+            "offset_mode": self.offset_mode,
+            "offsets_dph": dict(self.offsets_dph),
+            "orientations": [list(v) for v in self.orientations],
+            "pruning": None if self.pruning is None else dict(self.pruning),
         }
 
     @classmethod
@@ -296,6 +341,13 @@ class DriftModel(ParsedTerms):
                 selection=str(data.get("selection", "stepwise")),
                 cross_validation=None if data.get("cross_validation") is None
                 else CrossValidation.from_dict(data["cross_validation"]),
+                n_not_at_rest=int(data.get("n_not_at_rest", 0)),
+                offset_mode=str(data.get("offset_mode", "none")),
+                offsets_dph={str(k): float(v)
+                             for k, v in dict(data.get("offsets_dph") or {}).items()},
+                orientations=tuple(tuple(float(x) for x in v)
+                                   for v in data.get("orientations") or ()),
+                pruning=None if data.get("pruning") is None else dict(data["pruning"]),
             )
         except (KeyError, TypeError, ValueError, IndexError) as exc:
             raise InputError(f"not a valid drift-model record: {exc!r}") from exc
@@ -337,7 +389,7 @@ def fit(
     premove: float | None = None,
     *,
     initial: Iterable[str] | None = None,
-    reference_c: float = 20.0,
+    reference_c: float | None = None,
     rate_tau_s: float = 10.0,
     rate_tau2_s: float | None = None,
     aux_columns: Mapping[str, str] | None = None,
@@ -345,8 +397,11 @@ def fit(
     autocorrelation: str = "newey-west",
     hierarchical: bool = False,
     excitation_runs: int = 0,
-    select: str = "stepwise",
+    select: str = "guarded",
     progress: Progress | None = None,
+    motion: str = "exclude",
+    motion_settings: MotionSettings | None = None,
+    offsets: str = "auto",
 ) -> DriftModel:
     """Fit the drift model of Eq. (21)-(22) of [1] by stepwise regression on window means.
 
@@ -366,7 +421,10 @@ def fit(
     initial
         Terms in the starting model.
     reference_c
-        Reference temperature of f. [°C]
+        Reference temperature of f. [°C] Default None: f is centred on the training
+        data (the mean frequency of the still samples used), so the model does not
+        depend on an arbitrary temperature offset or reference; its temperature is
+        stored as ``settings.reference_c``.
     rate_tau_s
         Time constant of each stage of the causal df/dt filter. [s]
     rate_tau2_s
@@ -389,10 +447,22 @@ def fit(
         random walk keep 10 s means correlated and plain F-tests then admit terms
         that fit noise and extrapolate badly. ``"none"``: plain ``stepwisefit``.
     select
-        ``"stepwise"`` (default): terms by the stepwise F-tests. ``"cv"``: forward
-        selection by leave-one-run-out cross-validated bias stability
+        ``"guarded"`` (default): the stepwise F-tests, then every selected term that does
+        not carry over to held-out data is dropped (:func:`~hrgtc.drift.cross_validation.
+        prune_terms`; folds are the runs, or five contiguous time blocks of a single
+        run): a cubic fitted on the temperatures of the training part does not survive
+        the held-out block beyond them. ``"stepwise"``: the F-tests alone. ``"cv"``:
+        forward selection by leave-one-run-out cross-validated bias stability
         (:mod:`hrgtc.drift.cross_validation`; needs two runs or more). Either way the
         selected model is cross-validated when there are two runs or more.
+    motion, motion_settings
+        ``"exclude"`` (default): samples not at rest (:mod:`hrgtc.recording.motion`)
+        are left out of the windows and counted, so every trained range comes from the
+        samples used; ``"keep"``: no check; ``"error"``: motion is an error.
+    offsets
+        Nuisance offsets (:mod:`hrgtc.drift.offsets`): ``"auto"`` (default: one per
+        orientation when the runs log accelerometer axes or an ``orientation`` label,
+        else none), ``"none"``, ``"run"``, ``"orientation"``, ``"run+orientation"``.
     progress
         Optional ``callback(samples_done, 0)``.
 
@@ -423,18 +493,24 @@ def fit(
     if unmapped:
         raise InputError(f"candidate variable(s) {unmapped} have no column; map each with "
                          "--aux NAME=COLUMN")
+    warmup = 5.0 * max(rate_tau_s, tau2) if warmup_s is None else warmup_s
+    check_policy(motion)
+    rests = [run_rest(_iter_run(run), motion, motion_settings, warmup) for run in runs]
+    keep = None if motion == "keep" else [r.keep for r in rests]
+    reference_freq, reference_c = reference_point(rests, thermometer, reference_c, warmup)
     settings = FeatureSettings(
-        reference_freq_hz=float(thermometer.frequency(reference_c)),
+        reference_freq_hz=float(reference_freq),
         sample_rate_hz=first.metadata.sample_rate_hz,
-        reference_c=reference_c,
+        reference_c=float(reference_c),
         rate_tau_s=rate_tau_s,
-        warmup_s=5.0 * max(rate_tau_s, tau2) if warmup_s is None else warmup_s,
+        warmup_s=warmup,
         rate_tau2_s=tau2,
         aux_columns=aux,
     )
     first_pass = [v for v in variables if is_aux(v)] + (["df"] if "dpos" in variables else [])
     if first_pass:  # δ of the heating/cooling switch and the channels' centres: a first pass
-        means = window_means(runs, settings, parse_terms(first_pass), window_s).variables
+        means = window_means(runs, settings, parse_terms(first_pass), window_s,
+                             keep=keep).variables
         update: dict[str, Any] = {"aux_centres": {
             v[len(AUX_PREFIX):]: float(np.mean(means[v])) for v in first_pass if is_aux(v)}}
         if "dpos" in variables:
@@ -443,7 +519,8 @@ def fit(
         settings = FeatureSettings(**{**settings.to_dict(), **update})
     # df/dt's training range is kept for the range warnings even when no candidate uses it
     tracked = ("df",) if "f" in variables else ()
-    windows = window_means(runs, settings, candidates, window_s, progress, thermometer, tracked)
+    windows = window_means(runs, settings, candidates, window_s, progress, thermometer, tracked,
+                           keep=keep)
     for run in range(min(excitation_runs, len(windows.sources))):
         _check_excitation(windows, thermometer, variables, run)
     _check_excitation(windows, thermometer, variables)
@@ -453,35 +530,51 @@ def fit(
         scales[v] = magnitude if magnitude > 0 else 1.0
     settings = FeatureSettings(**{**settings.to_dict(), "scales": scales})
     factors = np.array([t.scale_factor(scales) for t in candidates])
-    x_scaled = windows.terms / factors
+    groups = offset_groups(offsets, windows.run, windows.sources, windows.accel,
+                           windows.orientation)
+    x_full = windows.terms / factors
+    bias = windows.bias_dph
+    x_scaled = x_full
+    if groups.mode != "none":  # the offsets are always in: project them off (FWL)
+        x_scaled, bias = project_off(groups, x_full, windows.bias_dph)
     if autocorrelation == "newey-west":
         design = np.column_stack([np.ones(x_scaled.shape[0]), x_scaled])
-        solution = np.linalg.lstsq(design, windows.bias_dph, rcond=None)[0]
-        inflation, bandwidth = newey_west_inflation(windows.bias_dph - design @ solution)
+        solution = np.linalg.lstsq(design, bias, rcond=None)[0]
+        inflation, bandwidth = newey_west_inflation(bias - design @ solution)
     elif autocorrelation == "none":
         inflation, bandwidth = 1.0, 0
     else:
         raise InputError(
             f"autocorrelation must be 'newey-west' or 'none', got {autocorrelation!r}"
         )
-    if select not in ("stepwise", "cv"):
-        raise InputError(f"select must be 'stepwise' or 'cv', got {select!r}")
+    if select not in SELECTIONS:
+        raise InputError(f"select must be one of {', '.join(SELECTIONS)}, got {select!r}")
     n_runs = len(windows.sources)
     if select == "cv" and n_runs < 2:
         raise InputError("select='cv' needs two training runs or more (leave-one-run-out)")
     slope_sign = 1.0 if thermometer.slope_hz_per_c(reference_c) >= 0 else -1.0
     rate = windows.variables.get("df", np.zeros(windows.bias_dph.size))
-    cv_args = (x_scaled, windows.bias_dph, windows.run, names)
+    cv_args = (x_scaled, bias, windows.run, names)
     parents = hierarchy(candidates) if hierarchical else None
-    result = stepwise(x_scaled, windows.bias_dph, names=names, penter=penter, premove=premove,
+    result = stepwise(x_scaled, bias, names=names, penter=penter, premove=premove,
                       initial=initial, variance_inflation=inflation, parents=parents,
                       refine=EXTENDED_PRECISION)  # quietly unrefined without long double
+    chosen = None
+    pruning = None
     if select == "cv":  # from the stepwise terms, one-term changes that cross-validate better
         chosen = select_terms(*cv_args, windows.sources, rate, slope_sign, parents=parents,
                               initial=result.selected)
-        result = stepwise(x_scaled, windows.bias_dph, names=names, penter=penter,
+    elif select == "guarded" and result.selected:
+        chosen, pruning = guard_selection(
+            x_scaled, bias, windows.run, windows.time_s, names, result.selected,
+            parents=hierarchy(candidates), keep=[parse_terms([t])[0].name for t in initial or ()])
+    if chosen is not None:
+        history = result.history
+        result = stepwise(x_scaled, bias, names=names, penter=penter,
                           premove=premove, initial=chosen, variance_inflation=inflation,
                           max_steps=0, refine=EXTENDED_PRECISION)
+        if select == "guarded":  # the F-test steps stay on record; the pruning is in `pruning`
+            result = dataclasses.replace(result, history=history)
     ols = result.result
     selected = result.selected
     selected_factor = {t.name: t.scale_factor(scales) for t in candidates}
@@ -495,11 +588,13 @@ def fit(
     pv.update({n: float(pvalues[k + 1]) for k, n in enumerate(selected)})
     ranges = {v: (float(windows.variables[v].min()), float(windows.variables[v].max()))
               for v in windows.variables}
+    intercept, group_offsets = fit_offsets(groups, windows.bias_dph, x_full, names, selected,
+                                           params, float(params[0]))
     return DriftModel(
         settings=settings,
         candidates=names,
         selected=tuple(selected),
-        intercept_dph=float(params[0]),
+        intercept_dph=intercept,
         coefficients=coefficients,
         standard_errors=errors,
         pvalues=pv,
@@ -516,6 +611,11 @@ def fit(
         selection=select,
         cross_validation=cross_validate(*cv_args, selected, windows.sources, rate, slope_sign)
         if n_runs >= 2 else None,
+        n_not_at_rest=windows.n_not_at_rest,
+        offset_mode=groups.mode,
+        offsets_dph=group_offsets,
+        orientations=groups.orientations,
+        pruning=pruning,
     )
 
 

@@ -30,6 +30,7 @@ from hrgtc.compensate import Compensator
 from hrgtc.compensate.compensator import with_model_band
 from hrgtc.compensate.ranges import RangeReport
 from hrgtc.drift.features import FeatureStream, settle_rows
+from hrgtc.drift.rest import run_rest
 from hrgtc.errors import HrgtcError, InputError, RecordingError
 from hrgtc.evaluation.allan import (
     ONE_SIGMA,
@@ -145,6 +146,12 @@ class Evaluation:
         Which deviation ``allan`` holds (a key of :data:`DEVIATIONS`).
     directions
         Heating and cooling apart (:mod:`hrgtc.evaluation.heating_cooling`).
+    mean_dph, rms_dph
+        ``{series: value}``: mean and root mean square of each series over the samples
+        the bias stabilities use. A bias stability is blind to a constant offset; these
+        are not (a +136 °/h mean residual is not a 36 °/h bias stability). [°/h]
+    n_not_at_rest
+        Samples left out of the figures because they were not at rest.
     """
 
     file: str
@@ -168,6 +175,9 @@ class Evaluation:
     confidence: float = ONE_SIGMA
     deviation: str = "oadev"
     directions: DirectionStats | None = None
+    mean_dph: dict[str, float] = field(default_factory=dict)
+    rms_dph: dict[str, float] = field(default_factory=dict)
+    n_not_at_rest: int = 0
 
     @property
     def name(self) -> str:
@@ -210,6 +220,14 @@ class Evaluation:
             return None
         return {"median": float(np.median(std)), "max": float(np.max(std))}
 
+    def offset_text(self, series: str = "compensated") -> str:
+        """Mean and RMS of a series, e.g. ``mean +0.12, RMS 0.64 °/h``; ``-`` if unknown."""
+        mean = self.mean_dph.get(series, math.nan)
+        rms = self.rms_dph.get(series, math.nan)
+        if math.isnan(mean):
+            return "-"
+        return f"mean {mean:+.4g}, RMS {rms:.4g} °/h"
+
     @property
     def raw_10s(self) -> float:
         """10 s bias stability of the raw output. [°/h]"""
@@ -240,6 +258,9 @@ class Evaluation:
             "bias_stability_10s_dph": {"raw": _finite(self.raw_10s),
                                        "compensated": _finite(self.compensated_10s)},
             "improvement_10s": _finite(self.improvement_10s),
+            "mean_dph": {k: _finite(v) for k, v in self.mean_dph.items()},
+            "rms_dph": {k: _finite(v) for k, v in self.rms_dph.items()},
+            "n_not_at_rest": self.n_not_at_rest,
             "allan": noise,
             "deviation": self.deviation,
             "allan_curve": {k: _curve(a) for k, a in self.allan.items()},
@@ -282,17 +303,24 @@ class Evaluation:
 
         taus = list(self.bias_stability_dph["raw"])
         lines = [f"{self.file}: {self.n_samples} samples at {self.sample_rate_hz:g} Hz",
-                 "bias stability [°/h]  " + "".join(f"{f'{t:g} s':>9}" for t in taus)]
+                 "bias stability [°/h]  " + "".join(f"{f'{t:g} s':>9}" for t in taus)
+                 + f"{'mean':>10}{'RMS':>9}"]
         for name, row in self.bias_stability_dph.items():
-            lines.append(f"  {name:<19}" + "".join(f" {fmt(row[t])}" for t in taus))
+            lines.append(f"  {name:<19}" + "".join(f" {fmt(row[t])}" for t in taus)
+                         + f"  {fmt(self.mean_dph.get(name, math.nan))}"
+                         + f" {fmt(self.rms_dph.get(name, math.nan))}")
         if self.bias_stability_interval_dph:
             lines.append(f"  ({self.confidence:.3g} intervals at 10 s: " + ", ".join(
                 f"{k} {self.stability_text(k, 10.0)}" for k in self.bias_stability_dph) + ")")
-        lines.append(f"improvement at 10 s: {self.improvement_10s:.2f}×; out of calibrated range: "
+        lines.append(f"improvement at 10 s: {self.improvement_10s:.2f}×; compensated "
+                     f"{self.offset_text()}; out of calibrated range: "
                      f"{self.out_of_range_fraction:.1%} (df/dt beyond training: "
                      f"{self.rate_out_of_range_fraction:.1%})")
         if self.residual_rms_dph is not None:
             lines.append(f"RMS of true bias minus model: {self.residual_rms_dph:.4f} °/h")
+        if self.n_not_at_rest:
+            lines.append(f"{self.n_not_at_rest} samples not at rest left out of the figures "
+                         f"({self.n_not_at_rest / self.n_samples:.1%})")
         lines.extend([] if self.directions is None else [self.directions.summary()])
         lines.extend(self.range_warnings())
         lines.extend(self.notes)
@@ -391,6 +419,7 @@ def run_pass(
     gaps: str = "ignore",
     deviation: str = "oadev",
     confidence: float = ONE_SIGMA,
+    keep: np.ndarray | None = None,
 ) -> Evaluation:
     """Compensate one run given as consecutive chunks, once, and measure it.
 
@@ -433,6 +462,10 @@ def run_pass(
         ``"adev"``.
     confidence
         Two-sided level of the intervals (bias stability and Allan deviation).
+    keep
+        True for each sample of the run at rest (:func:`hrgtc.drift.rest.run_rest`): the
+        others are compensated and written but left out of every figure, and counted
+        (``n_not_at_rest``). None: every sample counts.
 
     Raises
     ------
@@ -450,6 +483,7 @@ def run_pass(
     full: dict[str, SeriesStatistics] = {}
     whole: dict[str, list[np.ndarray]] = {}  # only for deviations the streaming cannot give
     squared_error = 0.0
+    left_out = 0
     truth = False
     metadata = None
     for chunk in chunks:
@@ -478,6 +512,10 @@ def run_pass(
             comp_h = housing.process(chunk)["rate_comp_dph"] - metadata.input_rate_dph
             pushed["housing"] = comp_h
             columns["comp_housing_dph"] = comp_h
+        if keep is not None:
+            kept = keep[frequency.samples - len(chunk):frequency.samples]
+            left_out += int(np.count_nonzero(~kept))
+            pushed = {key: values[kept] for key, values in pushed.items()}
         cut.push(pushed)
         if allan and deviation != "oadev":
             for key, values in pushed.items():
@@ -507,8 +545,11 @@ def run_pass(
     deviations: dict[str, AllanResult] = {}
     terms: dict[str, NoiseTerms] = {}
     notes: list[str] = []
+    mean: dict[str, float] = {}
+    rms: dict[str, float] = {}
     for key, series in full.items():
         stability[key] = series.bias_stability()
+        mean[key], rms[key] = series.mean(), series.rms()
         intervals[key] = bias_stability_intervals(stability[key], n_used, fs, confidence)
         if not allan:
             continue
@@ -522,6 +563,9 @@ def run_pass(
                 terms[key] = noise_terms(deviations[key])
         except HrgtcError as exc:
             notes.append(f"{key}: no Allan noise terms ({exc})")
+    if frequency.unknown_orientation:
+        notes.append(f"{frequency.unknown_orientation} samples in an orientation the model was "
+                     "not trained in: their offset is unknown (the training mean is used)")
     if allan and deviation not in ("adev", "oadev"):
         notes.append(f"noise terms are read off the Allan deviation; --deviation {deviation} "
                      "gives the curve only")
@@ -538,7 +582,8 @@ def run_pass(
         block_s=None if means is None else means.rows / fs,
         blocks=kept, notes=tuple(notes), ranges=frequency.ranges(),
         bias_stability_interval_dph=intervals, confidence=float(confidence),
-        deviation=deviation, directions=split.result(),
+        deviation=deviation, directions=split.result(), mean_dph=mean, rms_dph=rms,
+        n_not_at_rest=left_out,
     )
 
 
@@ -575,6 +620,7 @@ def evaluate(
         As for :func:`run_pass`.
     """
     gaps = (read_options or ReadOptions()).gaps
+    motion = (read_options or ReadOptions()).motion
     if isinstance(run, Recording):
         found = compensation_mark(run.metadata.to_dict(), list(run.names))
         if found is not None:
@@ -589,6 +635,10 @@ def evaluate(
         rows = count_rows(run)  # cheap (metadata, or a scan of a CSV's bytes); plans the pass
         name, source, chunks = Path(run).name, str(run), options.chunks(run)
         fs = None
+    keep = None
+    if motion != "keep":  # one pass of the detector's columns first
+        keep = run_rest(options.chunks(run) if not isinstance(run, Recording) else [run],
+                        motion, name=name).keep
     blocks = None
     if max_points is not None:
         if fs is None:
@@ -597,4 +647,4 @@ def evaluate(
     return run_pass(model, chunks, name, source=source, taus_s=taus_s, allan=allan,
                     block_rows=blocks, on_output=on_output, progress=progress,
                     total_rows=rows, gaps=gaps, deviation=deviation,
-                    confidence=confidence)
+                    confidence=confidence, keep=keep)

@@ -154,6 +154,8 @@ class SeriesStatistics:
         self.sample_rate_hz = float(sample_rate_hz)
         self.taus_s = tuple(float(t) for t in taus_s)
         self.n = 0
+        self._sum = 0.0
+        self._sum_squares = 0.0
         self._stability = {t: _BlockMeans(_block_length(t, self.sample_rate_hz), keep=False)
                            for t in self.taus_s}
         self.allan = allan
@@ -173,6 +175,8 @@ class SeriesStatistics:
         """Add the next samples."""
         values = np.asarray(values, dtype=np.float64)
         self.n += values.size
+        self._sum += float(np.sum(values))
+        self._sum_squares += float(np.dot(values, values))
         for means in self._stability.values():
             means.push(values)
         if not self.allan:
@@ -197,6 +201,14 @@ class SeriesStatistics:
             if self._decimated.rows >= 2 * self._largest_exact:
                 break  # beyond the exact sums' reach: keep the resolution, and the memory
             self._decimated.halve()
+
+    def mean(self) -> float:
+        """Mean of the series (NaN when empty): the offset a bias stability does not show."""
+        return self._sum / self.n if self.n else math.nan
+
+    def rms(self) -> float:
+        """Root mean square of the series (NaN when empty): offset and spread together."""
+        return math.sqrt(self._sum_squares / self.n) if self.n else math.nan
 
     def bias_stability(self) -> dict[float, float]:
         """``{tau_s: 1σ of the τ-block means}``, NaN where fewer than two blocks fit. [°/h]"""

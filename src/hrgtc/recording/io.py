@@ -435,6 +435,10 @@ class ReadOptions:
         The robust spike filter (see :func:`read`); ``spike_filter`` None: the
         command's default (``calibrate``/``evaluate`` drop, ``compensate`` flags),
         ``"off"`` in the library.
+    motion
+        Samples not at rest (:mod:`hrgtc.recording.motion`) in calibration and
+        evaluation: ``"exclude"`` (left out and counted, default), ``"keep"`` (used, not
+        checked) or ``"error"``. Reading itself never drops them.
     """
 
     columns: Mapping[str, str] | None = None
@@ -455,6 +459,7 @@ class ReadOptions:
     spike_k: float = SPIKE_K
     spike_lsb: float = SPIKE_LSB
     spike_window_s: float = SPIKE_WINDOW_S
+    motion: str = "exclude"
 
     def keywords(self) -> dict[str, Any]:
         """The options as keyword arguments of :func:`read` and :func:`iter_chunks`.

@@ -2,8 +2,10 @@
 
 The recording contract is that of DESIGN.md: a table with one row per sample
 (``time_s``, ``freq_hz``, ``rate_dph`` required; ``chamber_c``, ``housing_c``,
-``input_rate_dph`` (known input rate per sample) and ``temperature_c`` (a sensor on
-the gyro) optional; ``resonator_c``, ``bias_dph`` and ``scale_ppm`` ground truth
+``input_rate_dph`` (known input rate per sample), ``temperature_c`` (a sensor on
+the gyro), ``accel_x/y/z`` (accelerometer axes: motion and orientation, see
+:mod:`hrgtc.recording.motion`) and ``orientation`` (the user's label) optional;
+``resonator_c``, ``bias_dph`` and ``scale_ppm`` ground truth
 written only by the simulator) and metadata (``unit``, ``sample_rate_hz``,
 ``input_rate_dph``, ``profile``, ``schema``). A multi-axis recording has these
 columns per axis (``rate_dph_x``, ...; see :mod:`hrgtc.recording.axes`).
@@ -34,6 +36,10 @@ COLUMNS: dict[str, tuple[str, bool, str]] = {
     "input_rate_dph": ("deg/h", False, "known input rate per sample (rate-table runs)"),
     "temperature_c": ("degC", False, "temperature sensor on the gyro (no frequency output)"),
     "scale_ppm": ("ppm", False, "true scale-factor error (simulator ground truth)"),
+    "accel_x": ("m/s^2", False, "accelerometer x (motion and orientation; any one unit)"),
+    "accel_y": ("m/s^2", False, "accelerometer y (motion and orientation; any one unit)"),
+    "accel_z": ("m/s^2", False, "accelerometer z (motion and orientation; any one unit)"),
+    "orientation": ("label", False, "the user's number for the unit's orientation"),
 }
 REQUIRED_COLUMNS = tuple(name for name, (_, required, _) in COLUMNS.items() if required)
 

@@ -213,13 +213,16 @@ def _instrument_summary(page: _Page, model: InstrumentModel,
             raw, comp = run.stability("raw", 10.0), run.stability("compensated", 10.0)
             rows.append((axis, run.name, _number(raw), _number(comp),
                          _number(raw / comp if raw is not None and comp else None, 3),
-                         f"{run.out_of_range_fraction:.1%}", scale))
+                         f"{run.out_of_range_fraction:.1%}", scale,
+                         _number(run.mean_dph.get("compensated")),
+                         _number(run.rms_dph.get("compensated"))))
         if not runs:
-            rows.append((axis, "–", "–", "–", "–", "–", scale))
+            rows.append((axis, "–", "–", "–", "–", "–", scale, "–", "–"))
     page.add(f'<section id="instrument"><h2>Instrument {escape(model.unit)}: '
              f"{len(model.axes)} axes</h2>",
              _table(("axis", "run", "raw [°/h]", "compensated [°/h]", "improvement [×]",
-                     "outside calibrated range", "scale-factor fit residual"), rows,
+                     "outside calibrated range", "scale-factor fit residual",
+                     "compensated mean [°/h]", "compensated RMS [°/h]"), rows,
                     "At a glance: 10 s bias stability per axis and run"),
              "<nav><ol>" + "".join(f'<li><a href="#axis-{escape(a)}">Axis {escape(a)}</a></li>'
                                    for a in model.axes) + "</ol></nav></section>")

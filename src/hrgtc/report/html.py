@@ -161,13 +161,16 @@ def _summary(page: _Page, runs: Sequence[Evaluation]) -> None:
              _number(r.stability("compensated", 10.0)),
              _number(_ratio(r, 10.0), 3),
              _number(r.stability("housing", 10.0)),
-             f"{r.out_of_range_fraction:.1%}") for r in runs]
+             f"{r.out_of_range_fraction:.1%}",
+             _number(r.mean_dph.get("compensated")), _number(r.rms_dph.get("compensated")))
+            for r in runs]
     rows.append(("paper [1], Section 4.2 (its cool-down)", _number(paper.BIAS_STABILITY_RAW_DPH,
                  5), _number(paper.BIAS_STABILITY_COMPENSATED_DPH, 4), _number(
                  paper.BIAS_STABILITY_RAW_DPH / paper.BIAS_STABILITY_COMPENSATED_DPH, 3), "–",
-                 "–"))
+                 "–", "–", "–"))
     page.add(_table(("run", "raw [°/h]", "compensated [°/h]", "improvement [×]",
-                     "housing baseline [°/h]", "outside calibrated range"), rows,
+                     "housing baseline [°/h]", "outside calibrated range",
+                     "compensated mean [°/h]", "compensated RMS [°/h]"), rows,
                     "At a glance: 10 s bias stability, raw and compensated"))
 
 
@@ -332,7 +335,10 @@ def _run(page: _Page, k: int, run: Evaluation, model: UnitModel) -> None:
                         f"{run.confidence:.3g} chi-squared interval, (blocks − 1) degrees "
                         "of freedom" + (" (paper [1], Section 4.2: 3.0143 → 0.5848 °/h "
                                         "on its cool-down)" if hrg else "")))
-    facts = [("samples outside the calibrated range (f, T)", f"{run.out_of_range_fraction:.2%}"),
+    facts = [*((f"{name} mean and RMS (the offset a bias stability does not show)",
+                f"{_number(run.mean_dph.get(name))} and {_number(run.rms_dph.get(name))} °/h")
+               for name in run.bias_stability_dph if name in run.mean_dph),
+             ("samples outside the calibrated range (f, T)", f"{run.out_of_range_fraction:.2%}"),
              ("samples with df/dt outside its training range",
               f"{run.rate_out_of_range_fraction:.2%}")]
     if run.prediction_std_dph is not None:

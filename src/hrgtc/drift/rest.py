@@ -1,0 +1,153 @@
+"""The still samples of each training run, and the training data's own centre.
+
+A drift model is trained on samples at rest (:mod:`hrgtc.recording.motion`). Before
+the window means are taken, one pass over each run reads only the columns the
+detector needs (time, rate, known input rate, accelerometer axes), marks the
+samples not at rest, and at the same time measures the centre of the frequency
+(or temperature-sensor) channel over the still samples after the warm-up: the
+drift terms are centred on it, so a model does not depend on an arbitrary
+temperature offset (``--temp-offset``) or reference temperature.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from hrgtc.errors import CalibrationError, InputError
+from hrgtc.recording.motion import (
+    ACCEL_COLUMNS,
+    MOTION_POLICIES,
+    MotionMask,
+    MotionSettings,
+    detect_motion,
+)
+
+
+@dataclass(frozen=True, eq=False)
+class RunRest:
+    """What the pre-pass found in one training run.
+
+    Attributes
+    ----------
+    source
+        The run's name.
+    keep
+        True for each sample the fit may use (all True with ``--motion keep``).
+    mask
+        The detector's result (None when motion is kept unchecked).
+    freq_sum, freq_count
+        Sum and number of the still ``freq_hz`` values after the warm-up (the centre).
+    accel
+        Whether the run logs the three accelerometer axes.
+    """
+
+    source: str
+    keep: np.ndarray
+    mask: MotionMask | None = None
+    freq_sum: float = 0.0
+    freq_count: int = 0
+    accel: bool = False
+    counts: dict[str, int] = field(default_factory=dict)
+
+    @property
+    def n_moving(self) -> int:
+        return int(np.count_nonzero(~self.keep))
+
+
+def check_policy(policy: str) -> str:
+    """``policy`` if it is one of :data:`MOTION_POLICIES`, else an error naming them."""
+    if policy not in MOTION_POLICIES:
+        raise InputError(f"motion policy {policy!r} is not known; use one of "
+                         f"{', '.join(MOTION_POLICIES)} (--motion)")
+    return policy
+
+
+def run_rest(chunks: Any, policy: str = "exclude", settings: MotionSettings | None = None,
+             warmup_s: float = 0.0, name: str = "") -> RunRest:
+    """One pass over a run's chunks: its still samples and its still ``freq_hz`` centre.
+
+    Parameters
+    ----------
+    chunks
+        The run's consecutive :class:`~hrgtc.recording.Recording` chunks.
+    policy
+        ``"exclude"`` (moving samples are left out), ``"keep"`` (no detection: every
+        sample is used) or ``"error"`` (moving samples are an error naming the run).
+    settings
+        The detector's settings.
+    warmup_s
+        Start of the run left out of the centre (the df/dt filter settling). [s]
+    """
+    check_policy(policy)
+    parts: dict[str, list[np.ndarray]] = {}
+    source = name
+    input_rate = 0.0
+    for chunk in chunks:
+        if not source:
+            source = chunk.source or "run"
+        if not parts:
+            input_rate = chunk.metadata.input_rate_dph
+        wanted = ["time_s", "rate_dph", "freq_hz", "input_rate_dph", *ACCEL_COLUMNS]
+        for column in wanted:
+            if column in chunk:
+                parts.setdefault(column, []).append(np.asarray(chunk[column], dtype=np.float64))
+    if not parts:
+        return RunRest(source, np.zeros(0, dtype=bool))
+    columns = {k: np.concatenate(v) for k, v in parts.items()}
+    time_s = columns["time_s"]
+    accel = all(c in columns for c in ACCEL_COLUMNS)
+    mask = None
+    keep = np.ones(time_s.size, dtype=bool)
+    if policy != "keep":
+        mask = detect_motion(
+            time_s, {"rate_dph": columns["rate_dph"]},
+            accel={c: columns[c] for c in ACCEL_COLUMNS if c in columns} or None,
+            input_rate=columns.get("input_rate_dph", input_rate), settings=settings)
+        keep = mask.still
+        if policy == "error" and mask.n_moving:
+            first = int(np.flatnonzero(mask.moving)[0])
+            raise CalibrationError(
+                f"{source}: {mask.n_moving} of {mask.n_samples} samples are not at rest "
+                f"(first at row {first}, t = {time_s[first]:g} s; {mask.summary()}); the drift "
+                "model is a law of the gyro at rest: cut the handling out, or pass --motion "
+                "exclude (leave them out, counted) or --motion keep (train on them)")
+    after = time_s >= time_s[0] + warmup_s
+    used = keep & after
+    freq = columns.get("freq_hz")
+    total = float(np.sum(freq[used])) if freq is not None else 0.0
+    counts = {} if mask is None else mask.counts()
+    return RunRest(source, keep, mask, total, int(np.count_nonzero(used)) if freq is not None
+                   else 0, accel, counts)
+
+
+def training_centre(rests: Sequence[RunRest]) -> float | None:
+    """Mean ``freq_hz`` of the still samples after the warm-up of all runs (None: none)."""
+    count = sum(r.freq_count for r in rests)
+    if count == 0:
+        return None
+    return sum(r.freq_sum for r in rests) / count
+
+
+def reference_point(rests: Sequence[RunRest], thermometer: Any, reference_c: float | None,
+                    warmup_s: float = 0.0) -> tuple[float, float]:
+    """``(f_ref [Hz], reference temperature [°C])`` of a drift fit.
+
+    With ``reference_c`` None, the centre of the still training samples (not a fixed
+    20 °C): the model then does not depend on an arbitrary temperature offset or scale.
+    f_ref is ``thermometer.frequency(reference_c)`` either way (the model file's
+    integrity check), the centre to the thermometer's round trip.
+    """
+    if reference_c is None:
+        centre = training_centre(rests)
+        if centre is None:
+            raise CalibrationError("the drift runs hold no sample at rest after the "
+                                   f"{warmup_s:g} s warm-up; see --motion")
+        reference_c = float(thermometer.temperature(np.array([centre]), warn=False)[0])
+        if not math.isfinite(reference_c):
+            reference_c = float(np.mean(thermometer.temperature_range_c))
+    return float(thermometer.frequency(reference_c)), float(reference_c)

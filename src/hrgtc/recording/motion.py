@@ -1,0 +1,494 @@
+"""At rest is checked, not assumed: find the samples where the gyro was moved.
+
+A drift model is a law of the bias of a gyro at rest. A recording picked up,
+turned or shaken between still periods holds samples whose rate is the motion,
+not the bias; trained on, they pull the temperature and df/dt terms and set the
+trained ranges. :func:`detect_motion` marks every sample that is not at rest:
+
+- **level**: the rate (minus the known input rate) against the *local* still
+  baseline, a robust running level (median of ``baseline_s`` blocks, then a
+  running median of those over :data:`BASELINE_BLOCKS` blocks, interpolated in
+  time), not against zero: a MEMS axis may sit several °/s from zero at rest. A
+  sample is moving when it lies more than ``threshold`` robust σ from the
+  baseline for at least ``min_motion_s`` (and two samples): an isolated
+  single-sample excursion is a spike (the spike filter's business), not motion.
+- **variance**: the robust (MAD-based) spread of the first differences in
+  ``window_s`` blocks against the at-rest noise of the whole recording: shaking
+  without a net rate.
+- **clipped**: runs of ``clip_samples`` equal values at a channel's extreme, away
+  from its baseline (saturation).
+- **accelerometer**: the same level and variance tests on each mapped ``accel_*``
+  column (a tilt or a knock that the gyro barely sees).
+- **guard**: ``guard_s`` after (and ``guard_before_s`` before) every moving
+  sample, while the unit settles.
+
+Every window is in seconds and lives inside one contiguous segment: a gap (a
+time step larger than :data:`GAP_FACTOR` median periods, or a step that does not
+go forward) starts a new segment, and neither the baseline nor a guard reaches
+across it.
+
+The same detector finds the still periods of an in-field update:
+:meth:`MotionMask.still_periods`.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from hrgtc.errors import InputError
+
+#: A gap: a time step larger than this many median periods.
+GAP_FACTOR = 2.0
+#: Consistency constant of the MAD for a Gaussian (σ = 1.4826 · MAD).
+MAD_TO_SIGMA = 1.482602218505602
+#: Baseline blocks in the running median of block medians (centred).
+BASELINE_BLOCKS = 5
+#: Fewest samples of a variance block (the MAD of fewer differences is too noisy a figure).
+VARIANCE_MIN_SAMPLES = 32
+#: What calibration and evaluation do with moving samples (``--motion``).
+MOTION_POLICIES = ("exclude", "keep", "error")
+#: Reasons a sample is marked, in the order they are reported.
+REASONS = ("level", "variance", "clipped", "accelerometer", "guard")
+#: Columns read as accelerometer axes when present.
+ACCEL_COLUMNS = ("accel_x", "accel_y", "accel_z")
+
+
+@dataclass(frozen=True)
+class MotionSettings:
+    """How :func:`detect_motion` decides that a sample is not at rest.
+
+    Attributes
+    ----------
+    baseline_s
+        Block length of the robust running level of each channel. [s]
+    window_s
+        Block length of the variance test (at least :data:`VARIANCE_MIN_SAMPLES`). [s]
+    threshold
+        Level test: distance from the baseline in robust σ of the at-rest noise.
+    variance_ratio
+        Variance test: ratio of a block's robust σ of first differences to the
+        recording's above which the block is moving.
+    min_motion_s
+        Shortest excursion (beyond ``threshold``) that counts as motion; shorter ones,
+        and single samples always, are spikes. [s]
+    guard_s, guard_before_s
+        Samples this long after / before motion are marked too (the unit settling;
+        the motion's onset below the threshold). [s]
+    clip_samples
+        Equal consecutive samples at a channel's extreme that make a clipped plateau.
+    """
+
+    baseline_s: float = 60.0
+    window_s: float = 1.0
+    threshold: float = 6.0
+    variance_ratio: float = 3.0
+    min_motion_s: float = 0.1
+    guard_s: float = 5.0
+    guard_before_s: float = 1.0
+    clip_samples: int = 3
+
+    def __post_init__(self) -> None:
+        for name in ("baseline_s", "window_s", "threshold", "variance_ratio"):
+            value = getattr(self, name)
+            if not (isinstance(value, int | float) and math.isfinite(value) and value > 0):
+                raise InputError(f"motion setting {name} must be a positive number, got "
+                                 f"{value!r}")
+        for name in ("min_motion_s", "guard_s", "guard_before_s"):
+            value = getattr(self, name)
+            if not (isinstance(value, int | float) and math.isfinite(value) and value >= 0):
+                raise InputError(f"motion setting {name} must be a number of seconds >= 0, "
+                                 f"got {value!r}")
+        if int(self.clip_samples) < 2:
+            raise InputError(f"motion setting clip_samples must be at least 2, got "
+                             f"{self.clip_samples!r}")
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types."""
+        return {k: getattr(self, k) for k in self.__dataclass_fields__}
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> MotionSettings:
+        """Inverse of :meth:`to_dict` (missing keys take their defaults)."""
+        known = set(cls.__dataclass_fields__)
+        return cls(**{k: v for k, v in data.items() if k in known})
+
+
+@dataclass(frozen=True, eq=False)
+class MotionMask:
+    """Which samples of a recording are not at rest, and why.
+
+    Attributes
+    ----------
+    moving
+        True where the sample is not at rest (any reason), one per sample.
+    reasons
+        Reason (:data:`REASONS`) -> boolean mask; a sample may have several.
+    segment
+        Index of the contiguous segment of each sample (a gap starts a new one).
+    noise
+        Channel -> robust σ of its at-rest noise (sample to sample). [channel unit]
+    settings
+        The settings used.
+    """
+
+    moving: np.ndarray
+    reasons: dict[str, np.ndarray]
+    segment: np.ndarray
+    noise: dict[str, float] = field(default_factory=dict)
+    settings: MotionSettings = field(default_factory=MotionSettings)
+
+    @property
+    def n_samples(self) -> int:
+        return int(self.moving.size)
+
+    @property
+    def n_moving(self) -> int:
+        """Samples not at rest."""
+        return int(np.count_nonzero(self.moving))
+
+    @property
+    def fraction(self) -> float:
+        """Share of samples not at rest (0 for an empty recording)."""
+        return self.n_moving / self.n_samples if self.n_samples else 0.0
+
+    @property
+    def still(self) -> np.ndarray:
+        """True where the sample is at rest."""
+        return ~self.moving
+
+    def counts(self) -> dict[str, int]:
+        """Samples marked for each reason (a sample may count under several)."""
+        return {r: int(np.count_nonzero(m)) for r, m in self.reasons.items()}
+
+    def still_periods(self, min_s: float = 0.0, time_s: np.ndarray | None = None
+                      ) -> list[tuple[int, int]]:
+        """Index ranges ``[start, stop)`` of contiguous still samples inside one segment.
+
+        With ``time_s``, periods shorter than ``min_s`` seconds are left out. This is
+        what an in-field update of the bias uses.
+        """
+        still = self.still.astype(np.int8)
+        breaks = np.flatnonzero(np.diff(self.segment) != 0) + 1
+        edges = np.diff(np.concatenate([[0], still, [0]]))
+        starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+        out: list[tuple[int, int]] = []
+        for start, stop in zip(starts, stops, strict=True):
+            cuts = breaks[(breaks > start) & (breaks < stop)]
+            bounds = [int(start), *map(int, cuts), int(stop)]
+            for a, b in itertools.pairwise(bounds):
+                if time_s is not None and min_s > 0 and time_s[b - 1] - time_s[a] < min_s:
+                    continue
+                out.append((a, b))
+        return out
+
+    def to_dict(self) -> dict[str, Any]:
+        """The counts as plain JSON types (not the masks)."""
+        return {"n_samples": self.n_samples, "n_moving": self.n_moving,
+                "fraction": self.fraction, "reasons": self.counts(),
+                "noise": dict(self.noise), "settings": self.settings.to_dict()}
+
+    def summary(self) -> str:
+        """One line: how many samples were found moving, and why."""
+        why = ", ".join(f"{r} {n}" for r, n in self.counts().items() if n)
+        return (f"motion: {self.n_moving} of {self.n_samples} samples not at rest "
+                f"({self.fraction:.1%})" + (f" [{why}]" if why else ""))
+
+
+# --------------------------------------------------------------------------- helpers
+def segments_of(time_s: np.ndarray, gap_factor: float = GAP_FACTOR) -> np.ndarray:
+    """Segment index of each sample: a new segment after each gap or backward step.
+
+    Examples
+    --------
+    >>> segments_of(np.array([0.0, 1.0, 2.0, 10.0, 11.0])).tolist()
+    [0, 0, 0, 1, 1]
+    """
+    time_s = np.asarray(time_s, dtype=np.float64)
+    if time_s.size < 2:
+        return np.zeros(time_s.size, dtype=np.int64)
+    step = np.diff(time_s)
+    forward = step[step > 0]
+    period = float(np.median(forward)) if forward.size else 1.0
+    breaks = (step > gap_factor * period) | (step <= 0)
+    return np.concatenate([[0], np.cumsum(breaks)]).astype(np.int64)
+
+
+def _bounds(segment: np.ndarray) -> list[tuple[int, int]]:
+    edges = np.flatnonzero(np.diff(segment) != 0) + 1
+    starts = np.concatenate([[0], edges])
+    stops = np.concatenate([edges, [segment.size]])
+    return [(int(a), int(b)) for a, b in zip(starts, stops, strict=True)]
+
+
+def _period(time_s: np.ndarray, segment: np.ndarray) -> float:
+    step = np.diff(time_s)[np.diff(segment) == 0]
+    step = step[step > 0]
+    return float(np.median(step)) if step.size else 1.0
+
+
+def _rows(seconds: float, period: float, minimum: int = 1) -> int:
+    return max(round(seconds / period), minimum)
+
+
+def _mad(rows: np.ndarray) -> np.ndarray:
+    """Median absolute deviation of each row (no consistency factor)."""
+    centre = np.median(rows, axis=1, keepdims=True)
+    return np.median(np.abs(rows - centre), axis=1)
+
+
+def _resolution(values: np.ndarray) -> float:
+    """Smallest step between distinct values (the quantum of a quantised stream; from the
+    first 200,000 values, which show it as well as all of them)."""
+    distinct = np.unique(values[:200_000][np.isfinite(values[:200_000])])
+    if distinct.size < 2:
+        return 0.0
+    return float(np.min(np.diff(distinct)))
+
+
+def _baseline(time_s: np.ndarray, values: np.ndarray, rows: int) -> np.ndarray:
+    """Robust running level of one segment: block medians, their running median, interpolated."""
+    n = values.size
+    blocks = max(n // rows, 1)
+    edges = np.linspace(0, n, blocks + 1).astype(np.int64)
+    medians = np.array([np.median(values[a:b]) for a, b in itertools.pairwise(edges)]) \
+        if blocks < 64 or n % blocks else np.median(values.reshape(blocks, -1), axis=1)
+    centres = np.array([0.5 * (time_s[a] + time_s[b - 1]) for a, b in
+                        itertools.pairwise(edges)])
+    if blocks >= 3:  # symmetric windows (shrinking at the ends): a linear drift is kept
+        half = BASELINE_BLOCKS // 2
+        reach = [min(half, k, blocks - 1 - k) for k in range(blocks)]
+        medians = np.array([np.median(medians[k - r:k + r + 1]) for k, r in enumerate(reach)])
+    level = np.interp(time_s, centres, medians)
+    if blocks >= 2:  # beyond the outer block centres: continue the end slopes
+        head = time_s < centres[0]
+        tail = time_s > centres[-1]
+        slope0 = (medians[1] - medians[0]) / (centres[1] - centres[0])
+        slope1 = (medians[-1] - medians[-2]) / (centres[-1] - centres[-2])
+        level[head] = medians[0] + slope0 * (time_s[head] - centres[0])
+        level[tail] = medians[-1] + slope1 * (time_s[tail] - centres[-1])
+    return level
+
+
+def _runs(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    edges = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
+    return np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+
+
+def _long_runs(mask: np.ndarray, minimum: int) -> np.ndarray:
+    """``mask`` keeping only runs of at least ``minimum`` consecutive True."""
+    out = np.zeros_like(mask)
+    for a, b in zip(*_runs(mask), strict=True):
+        if b - a >= minimum:
+            out[a:b] = True
+    return out
+
+
+def _dilate(mask: np.ndarray, after: int, before: int) -> np.ndarray:
+    """Extend each True run by ``after`` samples after it and ``before`` before it."""
+    out = mask.copy()
+    n = mask.size
+    for a, b in zip(*_runs(mask), strict=True):
+        out[max(a - before, 0):min(b + after, n)] = True
+    return out
+
+
+@dataclass
+class _Channel:
+    name: str
+    values: np.ndarray
+    sigma: float = 0.0
+    diff_sigma: float = 0.0
+    lsb: float = 0.0
+
+
+def _prepare(name: str, values: np.ndarray, segment: np.ndarray) -> _Channel:
+    """A channel's at-rest noise: robust σ of its first differences inside segments."""
+    same = np.diff(segment) == 0
+    diffs = np.diff(values)[same]
+    lsb = _resolution(values)
+    diff_sigma = MAD_TO_SIGMA * float(np.median(np.abs(diffs - np.median(diffs)))) \
+        if diffs.size else 0.0
+    # white noise: a difference has twice the variance of a sample; the quantum floors it
+    sigma = max(diff_sigma / math.sqrt(2.0), lsb)
+    return _Channel(name, values, sigma, max(diff_sigma, lsb), lsb)
+
+
+# --------------------------------------------------------------------------- detection
+def detect_motion(
+    time_s: Any,
+    rates: Mapping[str, Any] | Any,
+    *,
+    accel: Mapping[str, Any] | None = None,
+    input_rate: Any = None,
+    settings: MotionSettings | None = None,
+) -> MotionMask:
+    """Mark the samples of a recording that are not at rest.
+
+    Parameters
+    ----------
+    time_s
+        Sample times (gaps allowed: each contiguous segment is treated alone). [s]
+    rates
+        The gyro rate, one array, or several axes as name -> array (motion on any
+        axis marks the sample). [any rate unit, e.g. °/h]
+    accel
+        Accelerometer axes, name -> array (optional). [any unit]
+    input_rate
+        The known input rate (a number or one per sample), subtracted from every rate
+        before the level test: a rate table's steps are not motion. [unit of ``rates``]
+    settings
+        Thresholds and windows (:class:`MotionSettings`).
+
+    Returns
+    -------
+    MotionMask
+
+    Examples
+    --------
+    >>> t = np.arange(0.0, 600.0, 0.1)
+    >>> rate = 4.0 + 0.01 * np.random.default_rng(1).standard_normal(t.size)
+    >>> rate[3000:3030] += 50.0  # three seconds of handling
+    >>> mask = detect_motion(t, rate)
+    >>> bool(mask.moving[3000:3030].all()), bool(mask.moving[:2900].any())
+    (True, False)
+    """
+    s = settings or MotionSettings()
+    time_s = np.asarray(time_s, dtype=np.float64)
+    if time_s.ndim != 1:
+        raise InputError("time_s must be one-dimensional")
+    n = time_s.size
+    channels = dict(rates) if isinstance(rates, Mapping) else {"rate": rates}
+    arrays: dict[str, np.ndarray] = {}
+    for name, values in channels.items():
+        arrays[name] = np.asarray(values, dtype=np.float64)
+        if input_rate is not None:
+            arrays[name] = arrays[name] - np.asarray(input_rate, dtype=np.float64)
+    accel_names = []
+    for name, values in dict(accel or {}).items():
+        arrays[name] = np.asarray(values, dtype=np.float64)
+        accel_names.append(name)
+    for name, values in arrays.items():
+        if values.shape != (n,):
+            raise InputError(f"motion channel {name!r} has {values.size} samples, time_s has "
+                             f"{n}; give one value per sample")
+        if not np.all(np.isfinite(values)):
+            row = int(np.flatnonzero(~np.isfinite(values))[0])
+            raise InputError(f"motion channel {name!r} is not finite at row {row}; drop or "
+                             "repair non-finite samples first (--spikes drop)")
+    reasons = {r: np.zeros(n, dtype=bool) for r in REASONS}
+    segment = segments_of(time_s)
+    if n == 0:
+        return MotionMask(np.zeros(0, dtype=bool), reasons, segment, {}, s)
+    period = _period(time_s, segment)
+    prepared = [_prepare(name, values, segment) for name, values in arrays.items()]
+    base_rows = _rows(s.baseline_s, period, 8)
+    var_rows = _rows(s.window_s, period, VARIANCE_MIN_SAMPLES)
+    min_run = max(_rows(s.min_motion_s, period), 2)
+    for a, b in _bounds(segment):
+        t = time_s[a:b]
+        for channel in prepared:
+            level_mask, var_mask, clip_mask = _channel_tests(
+                channel, t, channel.values[a:b], base_rows, var_rows, min_run, s)
+            if channel.name in accel_names:
+                reasons["accelerometer"][a:b] |= level_mask | var_mask | clip_mask
+            else:
+                reasons["level"][a:b] |= level_mask
+                reasons["variance"][a:b] |= var_mask
+                reasons["clipped"][a:b] |= clip_mask
+    found = reasons["level"] | reasons["variance"] | reasons["clipped"] | reasons["accelerometer"]
+    after, before = _rows(s.guard_s, period, 0), _rows(s.guard_before_s, period, 0)
+    moving = np.zeros(n, dtype=bool)
+    for a, b in _bounds(segment):  # a guard never reaches across a gap
+        moving[a:b] = _dilate(found[a:b], after, before)
+    reasons["guard"] = moving & ~found
+    noise = {c.name: c.sigma for c in prepared}
+    return MotionMask(moving, reasons, segment, noise, s)
+
+
+def _channel_tests(channel: _Channel, t: np.ndarray, values: np.ndarray, base_rows: int,
+                   var_rows: int, min_run: int, s: MotionSettings
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Level, variance and clipping tests of one channel over one segment."""
+    m = values.size
+    baseline = _baseline(t, values, base_rows)
+    deviation = values - baseline
+    level = np.zeros(m, dtype=bool)
+    if channel.sigma > 0:
+        level = _long_runs(np.abs(deviation) > s.threshold * channel.sigma, min_run)
+    variance = np.zeros(m, dtype=bool)
+    if channel.diff_sigma > 0 and m >= var_rows:
+        # blocks of var_rows samples (the last takes the remainder); differences inside each
+        blocks = m // var_rows
+        d = np.diff(values)
+        whole = d[: (blocks - 1) * var_rows].reshape(blocks - 1, var_rows) if blocks > 1 \
+            else np.empty((0, var_rows))
+        spreads = list(_mad(whole)) if whole.size else []
+        spreads.append(float(_mad(d[(blocks - 1) * var_rows:][None, :])[0]))
+        loud = MAD_TO_SIGMA * np.asarray(spreads) > s.variance_ratio * channel.diff_sigma
+        for k in np.flatnonzero(loud):
+            variance[k * var_rows: m if k == blocks - 1 else (k + 1) * var_rows] = True
+    clipped = np.zeros(m, dtype=bool)
+    for extreme in (float(np.max(channel.values)), float(np.min(channel.values))):
+        at = values == extreme
+        far = np.abs(extreme - baseline) > s.threshold * max(channel.sigma, channel.lsb)
+        clipped |= _long_runs(at & far, int(s.clip_samples))
+    return level, variance, clipped
+
+
+def recording_motion(recording: Any, settings: MotionSettings | None = None) -> MotionMask:
+    """:func:`detect_motion` on a :class:`~hrgtc.recording.Recording`.
+
+    Reads ``rate_dph`` (minus ``input_rate_dph``, the column where logged, else the
+    metadata's) and, where present, the accelerometer columns :data:`ACCEL_COLUMNS`.
+    """
+    names = set(recording.names)
+    input_rate = (recording["input_rate_dph"] if "input_rate_dph" in names
+                  else recording.metadata.input_rate_dph)
+    accel = {c: recording[c] for c in ACCEL_COLUMNS if c in names}
+    return detect_motion(recording.time_s, {"rate_dph": recording.rate_dph}, accel=accel or None,
+                         input_rate=input_rate, settings=settings)
+
+
+# --------------------------------------------------------------------------- orientation
+def orientation_labels(vectors: Any, tolerance_deg: float = 10.0,
+                       centres: Sequence[Sequence[float]] = ()) -> tuple[np.ndarray, list]:
+    """Cluster mean accelerometer vectors into orientations by the angle between them.
+
+    Each vector joins the first known orientation within ``tolerance_deg`` of its
+    direction, else starts a new one (with ``centres`` given, an unknown direction gets
+    the label -1 instead: an orientation never seen in training is not guessed).
+
+    Returns
+    -------
+    labels, centres
+        Orientation index of each vector, and the unit vector of each orientation.
+
+    Examples
+    --------
+    >>> labels, found = orientation_labels([[0, 0, 1], [0, 0.01, 1], [1, 0, 0]])
+    >>> labels.tolist(), len(found)
+    ([0, 0, 1], 2)
+    """
+    vectors = np.atleast_2d(np.asarray(vectors, dtype=np.float64))
+    cosine = math.cos(math.radians(tolerance_deg))
+    known = [np.asarray(c, dtype=np.float64) / np.linalg.norm(c) for c in centres]
+    fixed = bool(known)
+    labels = np.full(vectors.shape[0], -1, dtype=np.int64)
+    for k, v in enumerate(vectors):
+        norm = float(np.linalg.norm(v))
+        if norm == 0.0:
+            continue
+        u = v / norm
+        dots = [float(u @ c) for c in known]
+        if dots and max(dots) >= cosine:
+            labels[k] = int(np.argmax(dots))
+        elif not fixed:
+            known.append(u)
+            labels[k] = len(known) - 1
+    return labels, [c.tolist() for c in known]
