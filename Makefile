@@ -29,10 +29,12 @@ system:
 
 test: $(STAMP) system
 	$(BIN)/ruff check .
+	PYTHONPATH=src $(BIN)/lint-imports --no-logo
 	$(BIN)/python -m pytest -n 2 -q
 
 lint: $(STAMP)
 	$(BIN)/ruff check .
+	PYTHONPATH=src $(BIN)/lint-imports --no-logo
 
 bench: $(STAMP)
 	$(BIN)/python bench/run.py

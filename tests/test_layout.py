@@ -1,156 +1,98 @@
-"""The package layout stays true: imports flow one way, no module imports in a circle.
+"""The package layout stays true: the import-linter contracts of pyproject.toml hold.
 
-Every module of ``src/hrgtc`` is parsed (ast, nothing is imported), each import
-is resolved to the module it loads, and two rules are checked:
+The rules of the house (``docs/architecture.md``) are written once, as import-linter
+contracts in ``[tool.importlinter]`` of ``pyproject.toml``, and ``make test`` runs
+``lint-imports``. import-linter builds the graph of every import, including the ones
+inside functions and under ``TYPE_CHECKING``, which the ast check this file held before
+(module-level imports only, for the circles) missed. This file
 
-1. **One way**: a module imports only from its own stage or from a lower one,
-   in the order of README's "Architecture" section (:data:`STAGES`).
-2. **No circle**: the graph of module-level imports has no cycle (a package's
-   ``__init__`` counts as a module, so a submodule that imports its own package
-   is a circle).
+- runs the contracts on ``src/hrgtc`` (so ``pytest`` alone checks them too),
+- makes sure every top-level module or package is placed in the layers contract (import-linter
+  itself says nothing about a module that no contract names),
+- shows that the contracts can fail: an upward import, a lazy circle and an import of
+  ``hrgtc.cli`` planted in a copy of the package are each reported.
 """
 
 from __future__ import annotations
 
-import ast
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tomllib
 from pathlib import Path
 
 import pytest
 
-SOURCE = Path(__file__).resolve().parents[1] / "src" / "hrgtc"
-
-#: The stages, lowest first; a module may import its own stage and the ones above it in
-#: this list. Stages on one line do not import each other.
-STAGES: list[set[str]] = [
-    {"hrgtc._meta", "hrgtc.errors", "hrgtc._process"},
-    {"hrgtc.files", "hrgtc.progress"},
-    {"hrgtc.recording"},
-    {"hrgtc.thermometry"},
-    {"hrgtc.drift"},
-    {"hrgtc.model_schema"},
-    {"hrgtc.model", "hrgtc.paper"},
-    {"hrgtc.compensate", "hrgtc.simulate"},
-    {"hrgtc.evaluation"},
-    {"hrgtc.report"},
-    {"hrgtc.calibration"},
-    {"hrgtc.instrument"},
-    {"hrgtc.fleet"},
-    {"hrgtc.demo"},
-    {"hrgtc.cli", "hrgtc"},
-]
+ROOT = Path(__file__).resolve().parents[1]
+SOURCE = ROOT / "src" / "hrgtc"
+LINT_IMPORTS = Path(sys.executable).with_name("lint-imports")
+PYPROJECT = ROOT / "pyproject.toml"
+CONFIG = tomllib.loads(PYPROJECT.read_text(encoding="utf-8"))["tool"]["importlinter"]
 
 
-def module_name(path: Path) -> str:
-    parts = ("hrgtc", *path.relative_to(SOURCE).with_suffix("").parts)
-    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+def lint_imports(source_parent: Path) -> subprocess.CompletedProcess[str]:
+    """Run ``lint-imports`` with pyproject's contracts on the ``hrgtc`` under ``source_parent``."""
+    env = {**os.environ, "PYTHONPATH": str(source_parent)}
+    assert LINT_IMPORTS.exists(), "import-linter is missing: pip install -e '.[test]'"
+    return subprocess.run([str(LINT_IMPORTS), "--no-cache", "--no-logo", str(PYPROJECT)],
+                          capture_output=True, text=True, env=env, cwd=source_parent, timeout=120)
 
 
-MODULES = {module_name(p): p for p in sorted(SOURCE.rglob("*.py"))}
+def layered_modules() -> set[str]:
+    (layers,) = [c["layers"] for c in CONFIG["contracts"] if c["type"] == "layers"]
+    names = set()
+    for layer in layers:
+        names.update(part.strip().strip("()") for part in re.split(r"[|:]", layer))
+    return names
 
 
-def stage_of(module: str) -> str:
-    """The stage a module belongs to: ``hrgtc.<first part>`` (the package itself for __init__)."""
-    parts = module.split(".")
-    return ".".join(parts[:2])
+def test_the_contracts_hold():
+    result = lint_imports(SOURCE.parent)
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert "0 broken" in result.stdout
 
 
-def rank(module: str) -> int:
-    stage = stage_of(module)
-    for level, stages in enumerate(STAGES):
-        if stage in stages:
-            return level
-    raise AssertionError(f"{module}: stage {stage} is not in STAGES; add it where it belongs")
+def test_every_top_level_module_has_a_layer():
+    top = {f"hrgtc.{p.stem}" for p in SOURCE.glob("*.py") if p.name != "__init__.py"}
+    top |= {f"hrgtc.{p.parent.name}" for p in SOURCE.glob("*/__init__.py")}
+    missing = sorted(top - layered_modules())
+    assert not missing, (f"{missing}: not in the layers contract of pyproject.toml "
+                         "([tool.importlinter]); add each to the layer it belongs to")
 
 
-def imports(module: str, top_level_only: bool) -> set[str]:
-    """Modules that ``module`` imports (``from pkg import sub`` resolves to ``pkg.sub``)."""
-    path = MODULES[module]
-    tree = ast.parse(path.read_text(encoding="utf-8"))
-    package = module if path.name == "__init__.py" else module.rpartition(".")[0]
-    nodes = tree.body if top_level_only else list(ast.walk(tree))
-    found: set[str] = set()
-    for node in nodes:
-        if isinstance(node, ast.Import):
-            found.update(a.name for a in node.names if a.name.split(".")[0] == "hrgtc")
-        elif isinstance(node, ast.ImportFrom):
-            base = node.module or ""
-            if node.level:
-                anchor = package.split(".")
-                anchor = anchor[: len(anchor) - node.level + 1]
-                base = ".".join([*anchor, base] if base else anchor)
-            if base.split(".")[0] != "hrgtc":
-                continue
-            for alias in node.names:
-                candidate = f"{base}.{alias.name}"
-                found.add(candidate if candidate in MODULES else base)
-    return found
+def test_the_package_root_imports_only_the_version():
+    """``import hrgtc`` stays cheap: it loads ``hrgtc._meta`` and no stage."""
+    code = "import sys, hrgtc; print(sorted(m for m in sys.modules if m.startswith('hrgtc')))"
+    env = {**os.environ, "PYTHONPATH": str(SOURCE.parent)}
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env,
+                         check=True, timeout=60).stdout
+    assert out.strip() == "['hrgtc', 'hrgtc._meta']"
 
 
-def test_every_module_belongs_to_a_stage():
-    for module in MODULES:
-        rank(module)
-
-
-@pytest.mark.parametrize("module", sorted(MODULES))
-def test_imports_flow_one_way(module):
-    upward = []
-    for target in sorted(imports(module, top_level_only=False)):
-        assert target in MODULES, f"{module} imports {target}, which does not exist"
-        same_stage = stage_of(target) == stage_of(module)
-        if not same_stage and rank(target) >= rank(module):
-            upward.append(target)
-    assert not upward, f"{module} imports from a stage that is not below it: {upward}"
-
-
-def test_no_import_cycles():
-    graph = {m: imports(m, top_level_only=True) for m in MODULES}
-    # an import of pkg.sub first runs pkg/__init__: the edge to the package is implied
-    for module in MODULES:
-        for target in list(graph[module]):
-            parent = target.rpartition(".")[0]
-            while parent and parent != "hrgtc":
-                if parent in MODULES and not module.startswith(parent + ".") and module != parent:
-                    graph[module].add(parent)
-                parent = parent.rpartition(".")[0]
-    state: dict[str, int] = {}
-    stack: list[str] = []
-
-    def visit(node: str) -> None:
-        state[node] = 1
-        stack.append(node)
-        for target in sorted(graph.get(node, ())):
-            if target == node:
-                continue
-            if state.get(target) == 1:
-                cycle = [*stack[stack.index(target):], target]
-                raise AssertionError("import cycle: " + " -> ".join(cycle))
-            if target not in state:
-                visit(target)
-        stack.pop()
-        state[node] = 2
-
-    for module in sorted(graph):
-        if module not in state:
-            visit(module)
-
-
-def test_version_module_imports_nothing_of_hrgtc():
-    assert imports("hrgtc._meta", top_level_only=False) == set()
-    assert imports("hrgtc", top_level_only=True) == {"hrgtc._meta"}
-
-
-def test_the_rules_catch_a_circle_and_an_upward_import(tmp_path, monkeypatch):
-    """The checker itself can fail: a fake upward import and a fake cycle are found."""
-    fake = dict(MODULES)
-    low = tmp_path / "low.py"
-    low.write_text("from hrgtc.report import build_report\n")
-    a = tmp_path / "a.py"
-    a.write_text("import hrgtc.drift.b\n")
-    b = tmp_path / "b.py"
-    b.write_text("from hrgtc.drift import a\n")
-    fake.update({"hrgtc.recording.low": low, "hrgtc.drift.a": a, "hrgtc.drift.b": b})
-    monkeypatch.setitem(globals(), "MODULES", fake)
-    with pytest.raises(AssertionError, match="not below it"):
-        test_imports_flow_one_way("hrgtc.recording.low")
-    with pytest.raises(AssertionError, match="import cycle"):
-        test_no_import_cycles()
+@pytest.mark.parametrize(("module", "text", "broken"), [
+    # a lower stage reaching up, inside a function (the old ast test saw this one too)
+    ("recording/_planted.py", "def f():\n    from hrgtc.report import build_report\n",
+     "Stages import only downwards"),
+    # a circle closed by a lazy import (the old test looked at module-level imports only)
+    ("compensate/_planted.py", "def f():\n    from hrgtc.compensate import c_text\n",
+     "No import circles"),
+    # the library importing the command line
+    ("evaluation/_planted.py", "from hrgtc.cli import options\n",
+     "Nothing imports the command line"),
+])
+def test_the_contracts_catch_a_planted_import(tmp_path, module, text, broken):
+    copy = tmp_path / "hrgtc"
+    shutil.copytree(SOURCE, copy, ignore=shutil.ignore_patterns("__pycache__"))
+    target = copy / module
+    target.write_text(text, encoding="utf-8")
+    if module.startswith("compensate"):
+        # close the circle: c_text (lazily) imports the planted module, which imports c_text
+        c_text = copy / "compensate" / "c_text.py"
+        c_text.write_text(c_text.read_text(encoding="utf-8")
+                          + "\n\ndef _planted():\n    from hrgtc.compensate import _planted\n",
+                          encoding="utf-8")
+    result = lint_imports(tmp_path)
+    assert result.returncode != 0
+    assert re.search(rf"^{re.escape(broken)}.* BROKEN$", result.stdout, re.M), result.stdout

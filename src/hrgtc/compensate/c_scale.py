@@ -11,8 +11,9 @@ so those files stay as they were.
 
 from __future__ import annotations
 
+from hrgtc.compensate.c_expr import array as _array
+from hrgtc.compensate.c_expr import term_expression as _term_expression
 from hrgtc.compensate.c_plan import CPlan
-from hrgtc.compensate.c_text import _array, _term_expression
 from hrgtc.compensate.c_types import CType, ctype
 from hrgtc.drift.scale_factor import ScaleFactorModel
 from hrgtc.model import UnitModel

@@ -16,10 +16,12 @@ import textwrap
 from pathlib import Path
 from typing import Any
 
+from hrgtc.compensate.c_expr import array as _array
+from hrgtc.compensate.c_expr import term_expression as _term_expression
 from hrgtc.compensate.c_plan import TABLE_POINTS, CPlan
 from hrgtc.compensate.c_step import step_tail
 from hrgtc.compensate.c_thermometer import thermometer_functions
-from hrgtc.compensate.c_types import DOUBLE, CType, ctype
+from hrgtc.compensate.c_types import DOUBLE, ctype
 from hrgtc.compensate.c_variables import (
     RATES,
     bias_params,
@@ -28,7 +30,7 @@ from hrgtc.compensate.c_variables import (
     levels,
     step_inputs,
 )
-from hrgtc.drift.features import Term, settle_rows
+from hrgtc.drift.features import settle_rows
 from hrgtc.model import UnitModel
 
 #: Iteration cap of the thermometer inverse (as :meth:`Thermometer.temperature`).
@@ -46,30 +48,6 @@ def _comment(text: Any) -> str:
     ascii_text = str(text).encode("ascii", "backslashreplace").decode("ascii")
     ascii_text = re.sub(r"[\x00-\x1f\x7f]", " ", ascii_text)
     return ascii_text.replace("*/", "* /").replace("/*", "/ *")
-
-
-def _array(values: Any, name: str, t: CType = DOUBLE) -> str:
-    items = [t.literal(v, f"{name}[{k}]") for k, v in enumerate(values)]
-    lines = ["    " + ", ".join(items[k : k + 3]) + "," for k in range(0, len(items), 3)]
-    return "{\n" + "\n".join(lines) + "\n}"
-
-
-def _factor(variable: str, power: int, t: CType = DOUBLE) -> str:
-    x = f"x_{variable}"
-    if power == 1:
-        return x
-    if power == 2:
-        return f"({x} * {x})"  # numpy squares by multiplication
-    # numpy calls the C library's pow for other powers
-    return f"{t.call('pow')}({x}, {t.literal(power, 'power')})"
-
-
-def _term_expression(term: Term, t: CType = DOUBLE) -> str:
-    return " * ".join(_factor(v, p, t) for v, p in term.powers)
-
-
-
-
 
 
 def sensor_note(model: UnitModel) -> list[str]:

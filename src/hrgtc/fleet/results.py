@@ -16,7 +16,7 @@ import math
 import os
 from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 import pyarrow as pa
 import pyarrow.parquet as pq
@@ -27,9 +27,27 @@ from hrgtc.files import publish, refuse_existing, temporary_beside
 if TYPE_CHECKING:
     from hrgtc.calibration import CalibrationResult
     from hrgtc.evaluation import Evaluation
-    from hrgtc.fleet.tasks import UnitOutcome
 
 __all__ = ["SCHEMA", "calibration_row", "evaluation_row", "read_table", "table", "write_table"]
+
+
+class Outcome(Protocol):
+    """What :func:`table` reads of a task's outcome (:class:`hrgtc.fleet.tasks.UnitOutcome`).
+
+    A protocol rather than an import: ``tasks`` imports this module to build its rows,
+    so importing ``tasks`` here, even for typing only, would close an import circle.
+    """
+
+    @property
+    def unit(self) -> str: ...
+    @property
+    def status(self) -> str: ...
+    @property
+    def row(self) -> dict[str, Any]: ...
+    @property
+    def error(self) -> dict[str, Any] | None: ...
+    @property
+    def seconds(self) -> float: ...
 
 _F = pa.float64()
 _LF = pa.list_(pa.float64())
@@ -96,7 +114,7 @@ def calibration_row(result: CalibrationResult, model_file: str) -> dict[str, Any
     }
 
 
-def table(outcomes: Sequence[UnitOutcome]) -> pa.Table:
+def table(outcomes: Sequence[Outcome]) -> pa.Table:
     """The fleet table of some outcomes, a row per unit in name order."""
     rows = []
     for outcome in sorted(outcomes, key=lambda o: o.unit):
@@ -111,7 +129,7 @@ def table(outcomes: Sequence[UnitOutcome]) -> pa.Table:
     return pa.Table.from_pylist(rows, schema=SCHEMA)
 
 
-def write_table(outcomes: Sequence[UnitOutcome], path: str | os.PathLike[str],
+def write_table(outcomes: Sequence[Outcome], path: str | os.PathLike[str],
                 force: bool = False) -> Path:
     """Write the fleet table to Parquet atomically."""
     target = Path(path)

@@ -1,0 +1,38 @@
+"""C expressions shared by the export's text modules: array initialisers and drift terms.
+
+:mod:`hrgtc.compensate.c_text` (header, source) and :mod:`hrgtc.compensate.c_scale`
+(the scale-factor pieces that ``c_text`` inserts) both print these; they live here so
+that ``c_scale`` does not import ``c_text`` back (no import circle).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from hrgtc.compensate.c_types import DOUBLE, CType
+from hrgtc.drift.features import Term
+
+__all__ = ["array", "factor", "term_expression"]
+
+
+def array(values: Any, name: str, t: CType = DOUBLE) -> str:
+    """A C array initialiser ``{...}`` of ``values``, three literals a line."""
+    items = [t.literal(v, f"{name}[{k}]") for k, v in enumerate(values)]
+    lines = ["    " + ", ".join(items[k : k + 3]) + "," for k in range(0, len(items), 3)]
+    return "{\n" + "\n".join(lines) + "\n}"
+
+
+def factor(variable: str, power: int, t: CType = DOUBLE) -> str:
+    """C expression of ``x_variable ** power``, rounded as NumPy rounds it."""
+    x = f"x_{variable}"
+    if power == 1:
+        return x
+    if power == 2:
+        return f"({x} * {x})"  # numpy squares by multiplication
+    # numpy calls the C library's pow for other powers
+    return f"{t.call('pow')}({x}, {t.literal(power, 'power')})"
+
+
+def term_expression(term: Term, t: CType = DOUBLE) -> str:
+    """C expression of a drift term, the product of its factors."""
+    return " * ".join(factor(v, p, t) for v, p in term.powers)
