@@ -280,10 +280,35 @@ class QRAccumulator:
 
 def _shift_and_scale(X: np.ndarray, y: np.ndarray, w: np.ndarray | None
                      ) -> tuple[np.ndarray, np.ndarray]:
-    """Mean and a power of two near the standard deviation of each column of [X, y]."""
-    z = np.column_stack([X, y])
-    shift = np.average(z, axis=0, weights=w)
-    spread = np.sqrt(np.average((z - shift) ** 2, axis=0, weights=w))
+    """Mean and a power of two near the standard deviation of each column of [X, y].
+
+    Block by block (``_BLOCK_ROWS`` rows at a time), so no copy of [X, y] and no
+    temporary as large as X is made: on a chunk of a million rows the copies cost more
+    than the QR itself. The scale only conditions the factor (any power of two is
+    exact), so the standard deviation need not be correctly rounded.
+    """
+    n, p = X.shape
+    shift = np.empty(p + 1)
+    if w is None:
+        shift[:p] = X.mean(axis=0)
+        shift[p] = y.mean()
+    else:
+        total = w.sum()
+        shift[:p] = (w @ X) / total
+        shift[p] = (w @ y) / total
+    squares = np.zeros(p + 1)
+    for start in range(0, n, _BLOCK_ROWS):
+        stop = min(start + _BLOCK_ROWS, n)
+        dx = X[start:stop] - shift[:p]
+        dy = y[start:stop] - shift[p]
+        if w is None:
+            squares[:p] += np.einsum("ij,ij->j", dx, dx)
+            squares[p] += dy @ dy
+        else:
+            wb = w[start:stop]
+            squares[:p] += np.einsum("i,ij,ij->j", wb, dx, dx)
+            squares[p] += (wb * dy) @ dy
+    spread = np.sqrt(squares / (n if w is None else w.sum()))
     ok = np.isfinite(spread) & (spread > 0)
     scale = np.ones_like(spread)
     scale[ok] = np.exp2(np.round(np.log2(spread[ok])))

@@ -179,15 +179,17 @@ def refine(result: OLSResult, X: Any, y: Any, weights: Any = None, *,
         raise InputError(f"X has {X.shape[0]} rows with positive weight but the fit used "
                          f"{result.nobs}; pass the rows and weights of the fit")
     shift, scale = _shift_and_scale(X, y, w)
-    shift_ld, scale_ld = shift.astype(np.longdouble), scale.astype(np.longdouble)
+    inverse = 1.0 / scale  # powers of two: exact in float64 and in extended precision
+    shift_ld, inverse_ld = shift.astype(np.longdouble), inverse.astype(np.longdouble)
     root_w = None if w is None else np.sqrt(w.astype(np.longdouble))
 
     def rows(start: int, stop: int) -> tuple[np.ndarray, np.ndarray]:
         """Centred, scaled (and weighted) design and response of some rows, extended."""
         a = np.empty((stop - start, k + 1), dtype=np.longdouble)
         a[:, 0] = 1.0
-        a[:, 1:] = (X[start:stop] - shift_ld[:k]) / scale_ld[:k]
-        b = (y[start:stop] - shift_ld[k]) / scale_ld[k]
+        np.subtract(X[start:stop], shift_ld[:k], out=a[:, 1:])
+        a[:, 1:] *= inverse_ld[:k]
+        b = (y[start:stop] - shift_ld[k]) * inverse_ld[k]
         if root_w is not None:
             a *= root_w[start:stop, None]
             b = b * root_w[start:stop]
@@ -195,27 +197,40 @@ def refine(result: OLSResult, X: Any, y: Any, weights: Any = None, *,
 
     n = X.shape[0]
     blocks = [(s, min(s + _REFINE_BLOCK_ROWS, n)) for s in range(0, n, _REFINE_BLOCK_ROWS)]
+    # The float64 factorization only preconditions the refinement: its design and
+    # right-hand side are formed in float64 (no extended pass), its solution x0 is then
+    # corrected against residuals computed in extended precision.
     design = np.empty((n, k + 1))
-    response = np.empty(n)
-    for start, stop in blocks:
-        a, b = rows(start, stop)
-        design[start:stop], response[start:stop] = a, b
+    design[:, 0] = 1.0
+    np.subtract(X, shift[:k], out=design[:, 1:])
+    design[:, 1:] *= inverse[:k]
+    response = (y - shift[k]) * inverse[k]
+    if w is not None:
+        root = np.sqrt(w)
+        design *= root[:, None]
+        response *= root
     q, r_factor = np.linalg.qr(design)
     del design
     x = solve_triangular(r_factor, q.T @ response).astype(np.longdouble)
     del response
+    # One extended pass gives r0 = b - A x0 and g = -A' r0 together; the first
+    # augmented residual f = b - r0 - A x0 is then zero by construction, and every
+    # later pass computes f and g of the current (r, x) at once.
     resid = np.empty(n, dtype=np.longdouble)
+    f = np.zeros(n)
+    g = np.zeros(k + 1, dtype=np.longdouble)
     for start, stop in blocks:
         a, b = rows(start, stop)
         resid[start:stop] = b - a @ x
+        g -= a.T @ resid[start:stop]
     previous = np.inf
-    for _ in range(max_steps):
-        f = np.empty(n)
-        g = np.zeros(k + 1, dtype=np.longdouble)
-        for start, stop in blocks:
-            a, b = rows(start, stop)
-            f[start:stop] = b - resid[start:stop] - a @ x
-            g -= a.T @ resid[start:stop]
+    for step in range(max_steps):
+        if step:
+            g = np.zeros(k + 1, dtype=np.longdouble)
+            for start, stop in blocks:
+                a, b = rows(start, stop)
+                f[start:stop] = b - resid[start:stop] - a @ x
+                g -= a.T @ resid[start:stop]
         h = solve_triangular(r_factor, g.astype(np.float64), trans="T")
         d = q.T @ f
         dx = solve_triangular(r_factor, d - h)
@@ -227,6 +242,7 @@ def refine(result: OLSResult, X: Any, y: Any, weights: Any = None, *,
         previous = size
         if size <= np.finfo(np.float64).eps * float(np.max(np.abs(x))):
             break
+    scale_ld = scale.astype(np.longdouble)
     sy = scale_ld[k]
     slopes = sy * x[1:] / scale_ld[:k]
     intercept = shift_ld[k] + sy * x[0] - slopes @ shift_ld[:k]
