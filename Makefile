@@ -1,11 +1,11 @@
 # Every target does its own set-up on a fresh machine: the venv is created and the
-# package installed (with its test extras) when missing or when pyproject.toml changed.
+# package installed (with its test and docs extras) when missing or when pyproject.toml changed.
 PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test lint bench clean system
+.PHONY: demo test lint docs bench clean system
 
 # Debian packages the tests exercise for real: headless Chromium opens the HTML report,
 # gcc compiles the C export. Installed with apt-get when missing (CI runs as root).
@@ -14,7 +14,7 @@ SYSTEM_COMMANDS := chromium gcc
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e '.[test]'
+	$(BIN)/python -m pip install --quiet -e '.[test,docs]'
 	touch $(STAMP)
 
 demo: $(STAMP)
@@ -30,14 +30,19 @@ system:
 test: $(STAMP) system
 	$(BIN)/ruff check .
 	PYTHONPATH=src $(BIN)/lint-imports --no-logo
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict --quiet
 	$(BIN)/python -m pytest -n 2 -q
 
 lint: $(STAMP)
 	$(BIN)/ruff check .
 	PYTHONPATH=src $(BIN)/lint-imports --no-logo
 
+# The documentation site into build/site/ (strict: a broken link or a missing page fails).
+docs: $(STAMP)
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict
+
 bench: $(STAMP)
 	$(BIN)/python bench/run.py
 
 clean:
-	rm -rf $(VENV) build dist src/*.egg-info .pytest_cache .ruff_cache
+	rm -rf $(VENV) build dist site src/*.egg-info .pytest_cache .ruff_cache

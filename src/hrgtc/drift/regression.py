@@ -11,7 +11,7 @@ raise :class:`RankDeficientError` naming the columns.
 
 For rows held in memory, :func:`ols` (and :func:`hrgtc.drift.stepwise.stepwise`) go
 one step further: :func:`refine` polishes the coefficients by iterative
-refinement of the augmented system [I A; A' 0][r; x] = [b; 0] with residuals in
+refinement of the augmented system ``[I A; A' 0] [r; x] = [b; 0]`` with residuals in
 extended precision (Bjorck 1967), which removes the eps * cond^2 * |r| term that
 caps every float64 QR or SVD solver on large-residual problems (NIST's Wampler5:
 LRE 5.6 from the factor, >= 8 refined). The streaming accumulator keeps no rows,
@@ -114,7 +114,7 @@ def refine(result: OLSResult, X: Any, y: Any, weights: Any = None, *,
 
     With A the design [1, X] (rows scaled by sqrt(weights)) and A = QR its
     float64 Householder factorization, each step computes the residuals of the
-    augmented system [I A; A' 0][r; x] = [b; 0],
+    augmented system ``[I A; A' 0] [r; x] = [b; 0]``,
 
         f = b - r - A x,    g = -A' r,
 
