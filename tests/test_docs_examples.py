@@ -131,3 +131,11 @@ def test_the_docs_have_runnable_examples():
         text = page.read_text(encoding="utf-8")
         if "$ hrgtc" in text or "    hrgtc " in text:
             assert console_blocks(text), f"{page.name}: commands shown but none runs"
+
+
+def test_the_readme_stays_short():
+    """The README is what a newcomer reads in five minutes; the rest is on the site."""
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    assert len(readme.encode("utf-8")) <= 15 * 1024
+    assert "make test" in readme and "make demo" in readme
+    assert console_blocks(readme), "the README's quick start runs as a console block"
