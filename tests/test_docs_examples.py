@@ -78,11 +78,17 @@ def _commands(body: list[tuple[int, str]]) -> list[Command]:
 
 
 def _cases() -> list[pytest.param]:
+    """One case per block; a block whose commands repeat an earlier block's runs once."""
     cases = []
+    seen: dict[tuple[str, ...], str] = {}
     for page in PAGES:
         for start, commands in console_blocks(page.read_text(encoding="utf-8")):
             name = f"{page.relative_to(ROOT)}:{start}"
-            cases.append(pytest.param(page, commands, id=name))
+            key = tuple(f"{c.text} -> {c.exit_code}" for c in commands)
+            marks = [pytest.mark.skip(reason=f"the same commands as {seen[key]}")] \
+                if key in seen else []
+            seen.setdefault(key, name)
+            cases.append(pytest.param(page, commands, id=name, marks=marks))
     return cases
 
 
@@ -96,6 +102,7 @@ def _environment() -> dict[str, str]:
     return env
 
 
+@pytest.mark.slow  # about 180 CPU-seconds in all: ~90 s on two idle cores with -n 2
 @pytest.mark.parametrize(("page", "commands"), _cases())
 def test_console_block_runs(page: Path, commands: list[Command], tmp_path: Path):
     assert commands, f"{page}: a console block without a '$ ' command"
