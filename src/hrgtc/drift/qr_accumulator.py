@@ -253,6 +253,24 @@ class QRAccumulator:
             else list(range(len(names)))
         return _solve(self, idx, names, tol, variance_inflation)
 
+    def select(self, columns: Sequence[str | int]) -> QRAccumulator:
+        """The accumulator of the same rows with only ``columns`` of X (names or indices).
+
+        From the factor alone: the rows [1, X, y] = Q R give [1, X_sel, y] = Q R_sel with
+        R_sel the columns [0, sel, y] of R, whose QR gives the subset's factor. Shift,
+        scale and counts are those of the selected columns.
+        """
+        names = self._require_data()
+        assert self.r_ is not None and self.shift_ is not None and self.scale_ is not None
+        idx = sorted(_resolve_terms(columns, names, "columns"))
+        p = len(names)
+        subset = type(self)([names[j] for j in idx])
+        subset.n_, subset.sum_weights_ = self.n_, self.sum_weights_
+        subset.shift_ = self.shift_[[*idx, p]].copy()
+        subset.scale_ = self.scale_[[*idx, p]].copy()
+        subset.r_ = _canonical(_r_factor(self.r_[:, [0, *(j + 1 for j in idx), p + 1]]))
+        return subset
+
     def _require_data(self) -> tuple[str, ...]:
         if self.names_ is None or self.r_ is None:
             raise InputError("the accumulator holds no rows yet; call partial_fit(X, y) first")

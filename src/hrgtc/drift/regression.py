@@ -39,7 +39,6 @@ from hrgtc.drift.qr_accumulator import (
     QRAccumulator,
     _check_names,
     _readonly,
-    _shift_and_scale,
     _validate_chunk,
 )
 from hrgtc.errors import InputError, PrecisionWarning
@@ -109,7 +108,8 @@ def ols_from_accumulator(acc: GramAccumulator, columns: Sequence[str | int] | No
 
 
 def refine(result: OLSResult, X: Any, y: Any, weights: Any = None, *,
-           max_steps: int = _REFINE_MAX_STEPS) -> OLSResult:
+           max_steps: int = _REFINE_MAX_STEPS,
+           factor: QRAccumulator | None = None) -> OLSResult:
     """Coefficients of ``result`` polished by refinement of the augmented system.
 
     With A the design [1, X] (rows scaled by sqrt(weights)) and A = QR its
@@ -146,6 +146,10 @@ def refine(result: OLSResult, X: Any, y: Any, weights: Any = None, *,
     max_steps
         Most refinement steps; it stops earlier once a correction is below
         float64 resolution or no longer shrinks.
+    factor
+        The :class:`QRAccumulator` of exactly these rows, weights and columns (e.g.
+        ``acc.select(columns)`` of the accumulator the fit came from), to save a pass
+        over the rows; default: built here.
 
     Returns
     -------
@@ -178,7 +182,16 @@ def refine(result: OLSResult, X: Any, y: Any, weights: Any = None, *,
     if X.shape[0] != result.nobs:
         raise InputError(f"X has {X.shape[0]} rows with positive weight but the fit used "
                          f"{result.nobs}; pass the rows and weights of the fit")
-    shift, scale = _shift_and_scale(X, y, w)
+    # The rows' triangular factor, shift and scale: the streamed TSQR of the accumulator
+    # (cache-sized blocks, no Q), of the same centred, scaled, weighted [1, X, y] as below.
+    if factor is None:
+        factor = QRAccumulator().partial_fit(X, y, w)
+    elif factor.n_ != X.shape[0] or factor.r_ is None or factor.r_.shape != (k + 2, k + 2):
+        raise InputError(f"factor holds {factor.n_} rows and {len(factor.names_ or ())} "
+                         f"columns but X has {X.shape[0]} rows and {k}; pass the "
+                         "accumulator of these rows and columns")
+    assert factor.shift_ is not None and factor.scale_ is not None and factor.r_ is not None
+    shift, scale = factor.shift_, factor.scale_
     inverse = 1.0 / scale  # powers of two: exact in float64 and in extended precision
     shift_ld, inverse_ld = shift.astype(np.longdouble), inverse.astype(np.longdouble)
     root_w = None if w is None else np.sqrt(w.astype(np.longdouble))
@@ -196,26 +209,43 @@ def refine(result: OLSResult, X: Any, y: Any, weights: Any = None, *,
         return a, b
 
     n = X.shape[0]
+    eps = np.finfo(np.float64).eps
     blocks = [(s, min(s + _REFINE_BLOCK_ROWS, n)) for s in range(0, n, _REFINE_BLOCK_ROWS)]
-    # The float64 factorization only preconditions the refinement: its design and
-    # right-hand side are formed in float64 (no extended pass), its solution x0 is then
-    # corrected against residuals computed in extended precision.
+    # The float64 factorization only preconditions the refinement: its design is formed in
+    # float64 (no extended pass), its solution x0 is then corrected against residuals
+    # computed in extended precision.
     design = np.empty((n, k + 1))
     design[:, 0] = 1.0
     np.subtract(X, shift[:k], out=design[:, 1:])
     design[:, 1:] *= inverse[:k]
-    response = (y - shift[k]) * inverse[k]
     if w is not None:
-        root = np.sqrt(w)
-        design *= root[:, None]
-        response *= root
-    q, r_factor = np.linalg.qr(design)
-    del design
-    x = solve_triangular(r_factor, q.T @ response).astype(np.longdouble)
-    del response
+        design *= np.sqrt(w)[:, None]
+    r_factor = factor.r_[:k + 1, :k + 1]
+    cond = float(np.linalg.cond(r_factor))
+    # Well-conditioned (cond^2 eps small): the corrections solve the corrected seminormal
+    # equations with R alone, Q = A R^-1 applied as A and R (Bjorck 1987, BIT 27, 303-313;
+    # Bjorck 1996, Sec. 2.9), and x0 is the factor's own solution. Otherwise Q is formed
+    # by a Householder QR of the design, as the augmented refinement needs.
+    seminormal = 16.0 * (k + 1) * eps * cond * cond < 1e-3
+    if seminormal:
+        q = None
+        x = solve_triangular(r_factor, factor.r_[:k + 1, k + 1]).astype(np.longdouble)
+        # each step shrinks the error of x by about c (k + 1) eps cond(A)^2
+        contraction = min(1.0, 16.0 * (k + 1) * eps * cond * cond)
+    else:
+        response = (y - shift[k]) * inverse[k]
+        if w is not None:
+            response *= np.sqrt(w)
+        q, r_factor = np.linalg.qr(design)
+        x = solve_triangular(r_factor, q.T @ response).astype(np.longdouble)
+        del response, design
+        # each step shrinks the error of x by about c (k + 1) eps cond(A) (Bjorck 1967)
+        contraction = min(1.0, 16.0 * (k + 1) * eps * cond)
     # One extended pass gives r0 = b - A x0 and g = -A' r0 together; the first
     # augmented residual f = b - r0 - A x0 is then zero by construction, and every
-    # later pass computes f and g of the current (r, x) at once.
+    # later pass computes f and g of the current (r, x) at once. Where the contraction
+    # factor is tiny, the correction just applied leaves an error below float64
+    # resolution and the next pass over the rows is skipped.
     resid = np.empty(n, dtype=np.longdouble)
     f = np.zeros(n)
     g = np.zeros(k + 1, dtype=np.longdouble)
@@ -223,11 +253,6 @@ def refine(result: OLSResult, X: Any, y: Any, weights: Any = None, *,
         a, b = rows(start, stop)
         resid[start:stop] = b - a @ x
         g -= a.T @ resid[start:stop]
-    # Each step shrinks the error of x by about c (k + 1) eps cond(A) (Bjorck 1967): where that
-    # factor is tiny, the correction just applied leaves an error below float64 resolution
-    # and the next pass over the rows is skipped; where it is not, the rule is the plain one.
-    contraction = min(1.0, 16.0 * (k + 1) * np.finfo(np.float64).eps
-                      * float(np.linalg.cond(r_factor)))
     previous = np.inf
     for step in range(max_steps):
         if step:
@@ -237,15 +262,22 @@ def refine(result: OLSResult, X: Any, y: Any, weights: Any = None, *,
                 f[start:stop] = b - resid[start:stop] - a @ x
                 g -= a.T @ resid[start:stop]
         h = solve_triangular(r_factor, g.astype(np.float64), trans="T")
-        d = q.T @ f
+        if q is None:  # Q' f = R^-T A' f
+            d = solve_triangular(r_factor, design.T @ f, trans="T") if step \
+                else np.zeros(k + 1)
+        else:
+            d = q.T @ f
         dx = solve_triangular(r_factor, d - h)
         size = float(np.max(np.abs(dx)))
         if size >= previous:  # no longer contracting: cond(A) * eps too large to gain more
             break
         x += dx
-        resid += f + q @ (h - d)
+        if q is None:  # dr = Q h + (I - Q Q') f = f - A dx
+            resid += f - design @ dx
+        else:
+            resid += f + q @ (h - d)
         previous = size
-        if contraction * size <= np.finfo(np.float64).eps * float(np.max(np.abs(x))):
+        if contraction * size <= eps * float(np.max(np.abs(x))):
             break
     scale_ld = scale.astype(np.longdouble)
     sy = scale_ld[k]

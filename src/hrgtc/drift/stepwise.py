@@ -211,7 +211,7 @@ def stepwise(X: Any, y: Any, names: Sequence[str] | None = None, penter: float =
     if not refine:
         return found
     columns = [found.candidates.index(name) for name in found.selected]
-    polished = _refine(found.result, X[:, columns], y, weights)
+    polished = _refine(found.result, X[:, columns], y, weights, factor=acc.select(columns))
     return dataclasses.replace(found, result=polished)
 
 
