@@ -130,7 +130,12 @@ def refine(result: OLSResult, X: Any, y: Any, weights: Any = None, *,
     Standard errors, residual_std and rsquared stay those of ``result`` (from
     the triangular factor); ``params``, ``tvalues`` and ``pvalues`` change.
     Needs the rows, so it applies to in-memory arrays, not to a streamed
-    :class:`GramAccumulator`. Memory: Q (as large as X) plus a few vectors.
+    :class:`GramAccumulator`. R comes from the rows' TSQR (or ``factor``); where
+    cond(R)^2 eps is small Q is not formed and Q h, Q' f are applied as A R^-1 h and
+    R^-T A' f (the corrected seminormal equations, Bjorck, BIT 27, 303-313, 1987), so
+    the corrections become dx = R^-1 R^-T (A' f - g), dr = f - A dx; otherwise Q comes
+    from a Householder QR of A. Memory: the float64 design (as large as X), Q as well
+    in the second case, plus a few vectors.
 
     Parameters
     ----------
