@@ -41,7 +41,8 @@ Examples
 
 from __future__ import annotations
 
-from hrgtc.simulate import profiles, standard_profiles, units
+# mems registers the unit 'mems-3' with units.get (units does not import it back)
+from hrgtc.simulate import mems, profiles, standard_profiles, units
 from hrgtc.simulate.campaign import (
     COLUMNS,
     DEFAULT_INPUT_RATE_DPH,
@@ -103,6 +104,7 @@ __all__ = [
     "input_rates_dph",
     "iter_run_chunks",
     "log_run",
+    "mems",
     "output_paths",
     "profiles",
     "ramp",

@@ -34,7 +34,7 @@ import math
 from hrgtc.simulate.laws import BiasLaw, table1_frequency_law
 from hrgtc.simulate.noise import GyroNoise
 from hrgtc.simulate.thermal import ThermalNetwork
-from hrgtc.simulate.units import EARTH_RATE_DPH, MultiAxisUnit, Unit
+from hrgtc.simulate.units import EARTH_RATE_DPH, MultiAxisUnit, Unit, register
 
 __all__ = ["G_SENSITIVITY_DPH_PER_G", "LATITUDE_DEG", "MEMS_UNIT", "mems3"]
 
@@ -86,3 +86,6 @@ def mems3() -> MultiAxisUnit:
         },
         housing_noise_c=0.05,
     )
+
+
+register(MEMS_UNIT, mems3)  # units.get('mems-3'); the package imports this module

@@ -388,18 +388,20 @@ def _imu3() -> MultiAxisUnit:
     )
 
 
-def _mems3() -> MultiAxisUnit:
-    from hrgtc.simulate.mems import mems3  # mems.py builds on this module's types
-
-    return mems3()
-
-
 _FACTORIES: dict[str, Callable[[], Unit | MultiAxisUnit]] = {
     "paper-unit": _paper_unit,
     "unit-b": _unit_b,
     "imu-3": _imu3,
-    "mems-3": _mems3,
+    # "mems-3" is registered by hrgtc.simulate.mems (imported by the package), which builds on
+    # this module's types: importing it from here would close an import circle.
 }
+
+
+def register(name: str, factory: Callable[[], Unit | MultiAxisUnit]) -> None:
+    """Add a named unit that another module of the package builds (``mems-3``)."""
+    if _FACTORIES.get(name, factory) is not factory:
+        raise InputError(f"a simulated unit named {name!r} is already registered")
+    _FACTORIES[name] = factory
 
 
 def names() -> list[str]:
