@@ -218,3 +218,39 @@ def test_parameters_with_a_scale_factor(tmp_path):
     plain = parse(export_c(UnitModel(thermometer=THERMOMETER, drift=fitted), tmp_path / "plain",
                            output_format="params")[0].read_text())
     assert plain["uses_scale_factor"] == 0.0 and "sf_intercept_ppm" not in plain
+
+
+def test_params_export_of_every_model_the_demo_writes(paper_campaign, imu_campaign, tmp_path):
+    """Issue 21: ``export-c --format params`` failed with KeyError 'g' on every model whose
+    runs log housing_c. The demo's two models, calibrated as :mod:`hrgtc.demo` does (default
+    terms), on the shared simulated campaigns, exported through the CLI."""
+    import warnings
+
+    from typer.testing import CliRunner
+
+    import hrgtc.cli.export_cmd  # noqa: F401  (registers the command)
+    from hrgtc.calibration import calibrate
+    from hrgtc.cli._app import app
+    from hrgtc.errors import HrgtcWarning
+    from hrgtc.instrument import calibrate_instrument
+    from hrgtc.model import save_instrument, save_model
+
+    files = paper_campaign
+    unit = calibrate(files.soaks, [files.cooldown]).model
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", HrgtcWarning)
+        imu = imu_campaign
+        instrument = calibrate_instrument(imu.soaks, [imu.cooldown], [imu.warmup],
+                                          rate_tables=[imu.rate_table],
+                                          validate_rate_tables=[imu.rate_table_heldout]).model
+    paths = [save_model(unit, tmp_path / "paper-unit.json"),
+             save_instrument(instrument, tmp_path / "imu-3.json")]
+    used = set(unit.drift.variables).union(*(a.drift.variables for a in instrument.axes.values()))
+    assert "g" in used  # the housing gradient the demo's runs give: the variable that crashed
+    for path in paths:
+        done = CliRunner().invoke(app, ["export-c", str(path), "-o", str(tmp_path / path.stem),
+                                        "--format", "params"])
+        assert done.exit_code == 0, done.output
+        p = parse((tmp_path / path.stem / "hrgtc_params.txt").read_text())
+        keys = [k for k in p if k.endswith("range_g_high")]
+        assert keys, "the gradient's range is written"

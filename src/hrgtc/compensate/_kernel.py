@@ -54,6 +54,7 @@ from hrgtc.compensate._kernel_thermometer import (
 )
 from hrgtc.drift import DriftModel
 from hrgtc.drift.features import rate_filter_coefficients, settle_rows
+from hrgtc.drift.variables import unsupported
 from hrgtc.thermometry import Thermometer
 
 #: Variable order of the exponent matrices (f, df, h, dh, g). The heating/cooling switch
@@ -206,8 +207,9 @@ def plan(drift: DriftModel, thermometer: Thermometer, variables: tuple[str, ...]
 
 
 def supports_variables(variables: tuple[str, ...]) -> bool:
-    """Whether the kernel computes every variable (not dpos, d2, a_NAME: numpy does)."""
-    return all(v in ORDER for v in variables)
+    """Whether the kernel computes every variable (not dpos, d2, a_NAME: numpy does), as
+    :mod:`hrgtc.drift.variables` lists for the backend ``numba``."""
+    return not unsupported(variables, "numba")
 
 
 def supports(thermometer: Thermometer) -> bool:

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from hrgtc.drift.features import is_aux, rate_filter_coefficients, variable_key
+from hrgtc.drift.variables import refusal, supported
 from hrgtc.errors import CalibrationError, InputError
 from hrgtc.model import UnitModel
 
@@ -85,7 +86,7 @@ class CPlan:
 #: The precisions the export writes.
 PRECISIONS = ("double", "single")
 #: The variables the float32 build computes (its filter and mirror know these).
-SINGLE_VARIABLES = ("f", "df", "h", "dh", "g")
+SINGLE_VARIABLES = supported("c_float32")
 
 
 def plan_for(model: UnitModel, precision: str = "double") -> CPlan:
@@ -94,7 +95,8 @@ def plan_for(model: UnitModel, precision: str = "double") -> CPlan:
     Raises
     ------
     InputError
-        An unknown precision, or a model the C export cannot compute (``dpos`` terms).
+        An unknown precision, or a model with a variable the export does not compute
+        (:mod:`hrgtc.drift.variables` says which: ``dpos``; ``d2`` and ``a_NAME`` in float32).
     CalibrationError
         A thermometer that is not monotonic over its calibrated range.
     """
@@ -110,17 +112,11 @@ def plan_for(model: UnitModel, precision: str = "double") -> CPlan:
         )
     settings = drift.settings
     used = set(drift.variables)
-    if "dpos" in used:
-        raise InputError(
-            f"the drift model uses the heating/cooling switch dpos ({', '.join(drift.selected)}), "
-            "which the C export does not compute; calibrate without dpos terms for on-board use"
-        )
-    beyond = sorted(used - set(SINGLE_VARIABLES))
-    if precision == "single" and beyond:
-        raise InputError(
-            f"the float32 export computes the variables {', '.join(SINGLE_VARIABLES)}; the "
-            f"drift model also uses {', '.join(beyond)}: export it with --precision double"
-        )
+    refused = refusal(sorted(used, key=variable_key), "c_double", drift.selected)
+    if refused is None and precision == "single":
+        refused = refusal(sorted(used, key=variable_key), "c_float32", drift.selected)
+    if refused is not None:
+        raise InputError(refused)
     housing = bool(used & {"h", "dh"})
     # The compensator computes f and df (and h, dh when the terms use them); in_range checks
     # the levels (f, h), rate_in_range the rates of change (df, dh), each where computed.

@@ -22,12 +22,21 @@ from typing import Any
 from hrgtc.compensate.c_plan import CPlan
 from hrgtc.compensate.c_text import NEWTON_MAX_ITER, sensor_note
 from hrgtc.compensate.c_types import DOUBLE
-from hrgtc.drift.features import VARIABLES, settle_rows
+from hrgtc.drift.features import settle_rows
+from hrgtc.drift.variables import ascii_unit, refusal, variable
+from hrgtc.errors import InputError
 from hrgtc.model import UnitModel
 
 #: Version of the file's layout (a key of the file).
 FORMAT_VERSION = 1
-_UNITS = {"f": "Hz", "df": "Hz/s", "h": "degC", "dh": "degC/s"}
+
+
+def _unit(model: UnitModel, name: str) -> str:
+    """A variable's unit as this file writes it (from :mod:`hrgtc.drift.variables`)."""
+    if name.startswith("a_"):
+        column = model.drift.settings.aux_columns.get(name[2:], "?")
+        return f"unit of the column {column}"
+    return ascii_unit(name, model.thermometer.source)
 
 
 def _number(value: float, name: str) -> str:
@@ -45,7 +54,13 @@ def formula(key: str = "") -> list[str]:
         "       df = (y1 - y2) * <{k}filter_gain>                                   [Hz/s]",
         "     (when <{k}uses_housing> = 1: h = housing_c - <{k}reference_c> [degC] and dh its",
         "      rate by the same filter on its own y1, y2 [degC/s])",
-        "  3. for each variable v in f, df, h, dh that the terms use:",
+        "     (when <{k}uses_rate2> = 1: d2, the rate of f by the same filter with",
+        "      <{k}filter2_alpha>, <{k}filter2_beta>, <{k}filter2_gain>, on its own y1, y2 [Hz/s])",
+        "     (when <{k}uses_gradient> = 1: g = housing_c - T [degC], T the resonator",
+        "      temperature of step 6, NaN where the inverse has no solution)",
+        "     (for each NAME of <{k}aux_names>: a_NAME = aux_NAME - <{k}aux_centre_NAME>,",
+        "      aux_NAME the logged channel <{k}aux_column_NAME> [its unit])",
+        "  3. for each variable v in f, df, h, dh, d2, g, a_NAME that the terms use:",
         "       c_v = v held in [<{k}range_v_low>, <{k}range_v_high>];  x_v = c_v / <{k}scale_v>",
         "  4. B = <{k}intercept_dph> + sum over k = 1..<{k}n_terms> of",
         "         <{k}coefficient_k> * product over the factors v^p of <{k}term_k> of x_v^p",
@@ -67,7 +82,8 @@ def formula(key: str = "") -> list[str]:
         "     (Newton's iteration to <{k}inverse_tolerance_c>; no solution: NaN). Same F:",
         "       sum_j <{k}thermometer_raw_coefficient_j> * T^j, Eq. (18) of [1].",
         "  7. in_range = freq_hz in [<{k}calibrated_freq_low_hz>, <{k}calibrated_freq_high_hz>]",
-        "     and f, h, df, dh in their ranges and at least <{k}settle_rows> samples seen.",
+        "     and every variable computed (f, df, h, dh, d2, g, a_NAME) in its range and at",
+        "     least <{k}settle_rows> samples seen.",
     ]
     return [line.replace("{k}", key) for line in lines]
 
@@ -84,6 +100,9 @@ def parameter_lines(model: UnitModel, plan: CPlan, key: str = "") -> list[str]:
     """
     drift, th = model.drift, model.thermometer
     settings = drift.settings
+    refused = refusal(drift.variables, "params", drift.selected)
+    if refused is not None:
+        raise InputError(refused)
     lines: list[str] = []
 
     def put(name: str, value: float | int | str, comment: str) -> None:
@@ -113,24 +132,28 @@ def parameter_lines(model: UnitModel, plan: CPlan, key: str = "") -> list[str]:
         "Ramp gain alpha*sample_rate_hz/beta: (y1 - y2)*gain is the rate. [1/s]")
     put("settle_rows", settle_rows(settings),
         "Samples at the start of a run flagged (in_range 0) while the filter settles. [1]")
+    _extra_variable_lines(model, plan, put)
     for v in plan.computed:
         if v in settings.scales and v in drift.variables:
             put(f"scale_{v}", settings.scales[v],
-                f"Scale of {v} ({VARIABLES[v][1]}): x_{v} = {v} / scale_{v}. [{_UNITS[v]}]")
+                f"Scale of {v} ({variable(v).description}): x_{v} = {v} / scale_{v}. "
+                f"[{_unit(model, v)}]")
     for v in plan.computed:
         if v in drift.ranges:
             low, high = drift.ranges[v]
             put(f"range_{v}_low", low, f"Training range of {v}, low end (window means); "
                 "the model is continued along its tangent below it. "
-                f"[{_UNITS[v]}]")
-            put(f"range_{v}_high", high, f"Training range of {v}, high end. [{_UNITS[v]}]")
+                f"[{_unit(model, v)}]")
+            put(f"range_{v}_high", high, f"Training range of {v}, high end. "
+                f"[{_unit(model, v)}]")
     put("intercept_dph", drift.intercept_dph, "B0: the bias at f = df = 0 (h = dh = 0). [deg/h]")
     put("n_terms", len(drift.terms), "Number of selected terms of the drift model (Eq. 22).")
     for k, (term, scaled) in enumerate(zip(drift.terms, drift.scaled_coefficients,
                                            strict=True), start=1):
         factors = " * ".join(f"x_{v}" if p == 1 else f"x_{v}^{p}" for v, p in term.powers)
         put(f"term_{k}", term.name,
-            f"Term {k}: its factors v^p (variables f, df, h, dh); on the scaled variables "
+            f"Term {k}: its factors v^p (variables f, df, h, dh, d2, g, a_NAME); on the "
+            "scaled variables "
             f"it is {factors}.")
         put(f"coefficient_{k}", scaled,
             f"Coefficient of term {k} ({term.name}) on the scaled variables. [deg/h]")
@@ -166,6 +189,32 @@ def parameter_lines(model: UnitModel, plan: CPlan, key: str = "") -> list[str]:
         "Stop Newton's iteration when a step changes T by at most this. [degC]")
     put("inverse_max_iterations", NEWTON_MAX_ITER, "Iteration cap of the inverse. [1]")
     return lines
+
+
+def _extra_variable_lines(model: UnitModel, plan: CPlan, put: Any) -> None:
+    """Keys of the second rate filter (d2), the gradient (g) and the extra channels (a_NAME),
+    written only for a model that uses them (older files' keys unchanged)."""
+    settings = model.drift.settings
+    if plan.rate2:
+        put("uses_rate2", 1, "1: the terms use d2, the rate of f by the second filter.")
+        put("rate_tau2_s", settings.rate_tau2_s,
+            "Time constant of each of the two stages of the second df/dt filter. [s]")
+        put("filter2_alpha", plan.alpha2,
+            "Second filter's stage coefficient 1 - exp(-1/(rate_tau2_s*sample_rate_hz)). [1]")
+        put("filter2_beta", plan.beta2, "Second filter's beta = 1 - filter2_alpha. [1]")
+        put("filter2_gain", plan.gain2,
+            "Second filter's ramp gain filter2_alpha*sample_rate_hz/filter2_beta. [1/s]")
+    if plan.gradient:
+        put("uses_gradient", 1, "1: the terms use g = housing_c - T(freq_hz); housing_c is "
+            "an input.")
+    if plan.aux:
+        put("aux_names", " ".join(plan.aux),
+            "Extra logged channels the terms use (a_NAME = aux_NAME - aux_centre_NAME).")
+        for name in plan.aux:
+            column = settings.aux_columns.get(name, "?")
+            put(f"aux_column_{name}", column, f"The logged column aux_{name} is read from.")
+            put(f"aux_centre_{name}", settings.aux_centres.get(name, 0.0),
+                f"Training mean of aux_{name}, subtracted. [unit of the column {column}]")
 
 
 def _scale_factor_lines(model: UnitModel, put: Any) -> None:

@@ -64,28 +64,21 @@ from hrgtc.drift.rate_filter import (  # noqa: F401  (re-exported: imported from
     causal_rate,
     rate_filter_coefficients,
 )
+from hrgtc.drift.variables import AUX_PREFIX, DRIFT_VARIABLES, FIXED
+from hrgtc.drift.variables import variable as _registered
 from hrgtc.errors import InputError
 from hrgtc.recording.schema import Recording
 
-#: Variable name -> (unit, description).
+#: Variable name -> (unit, description), from the one list of :mod:`hrgtc.drift.variables`.
 VARIABLES: dict[str, tuple[str, str]] = {
-    "f": ("Hz", "frequency change freq_hz - f_ref"),
-    "df": ("Hz/s", "causal rate of the frequency change"),
-    "h": ("°C", "housing temperature change housing_c - reference_c"),
-    "dh": ("°C/s", "causal rate of the housing temperature change"),
-    "dpos": ("Hz/s", "heating part of df/dt, df·(1 + tanh(df/δ))/2"),
-    "d2": ("Hz/s", "causal rate of the frequency change through the second filter"),
-    "g": ("°C", "housing - resonator gradient housing_c - T(freq_hz)"),
-}
+    v.name: (v.unit, v.description) for v in DRIFT_VARIABLES if v.name in FIXED}
 _SOURCE_COLUMN = {"f": "freq_hz", "h": "housing_c"}
 #: The level each rate-like variable is the rate of.
 _RATE_OF = {"df": "f", "dh": "h", "dpos": "f", "d2": "f"}
 #: Variables that are levels (checked against the calibrated/training range as ``in_range``)
 #: and rates of change (``rate_in_range``); ``a_NAME`` channels are levels too.
-LEVEL_VARIABLES = ("f", "h", "g")
-RATE_VARIABLES = ("df", "dh", "d2")
-#: Prefix of the user's extra channels in the grammar: ``a_drive`` reads the mapped column.
-AUX_PREFIX = "a_"
+LEVEL_VARIABLES = tuple(v for v in FIXED if _registered(v).kind == "level")
+RATE_VARIABLES = tuple(v for v in FIXED if _registered(v).kind == "rate" and v != "dpos")
 #: An extra channel's name (the part after ``a_``): a letter, then letters and digits.
 AUX_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9]*$")
 #: δ of ``dpos`` as a share of the std of the training windows' df/dt.
