@@ -48,6 +48,12 @@ SCHEMA_VERSION = 3
 AXIS_PATTERN = r"^[A-Za-z][A-Za-z0-9]*$"
 #: Relative agreement of ``coefficients`` with those derived from ``scaled_coefficients``.
 COEFFICIENT_RTOL = 1e-9
+#: Largest bias the intercept or any one term may give over the trained ranges: ten times
+#: the largest rate a recording may hold (1000 °/s, ``recording.checks.RATE_MAX_DPH``).
+#: No gyro has such a bias; a coefficient beyond it is a corrupt or hand-made file. [°/h]
+BIAS_BOUND_DPH = 3.6e7
+#: Largest scale-factor error any one term may give over the rate tables' range. [ppm]
+SCALE_BOUND_PPM = 1e6
 
 _FINITE = {"type": "number"}
 _STAT = {"anyOf": [{"type": "number"}, {"type": "null"},
@@ -391,6 +397,7 @@ def _check_drift(drift: Mapping[str, Any], where: str, source: str) -> dict[str,
         if not low <= high:
             raise _fail(source, f"{where}.ranges.{variable}",
                         f"[{low!r}, {high!r}] is reversed (low > high)")
+    _check_bounds(drift, where, source)
     derived = derived_coefficients(drift)
     for name, value in derived.items():
         if not _agree(drift["coefficients"][name], value, value):
@@ -398,6 +405,49 @@ def _check_drift(drift: Mapping[str, Any], where: str, source: str) -> dict[str,
                         f"{drift['coefficients'][name]!r} disagrees with {value!r} derived from "
                         "scaled_coefficients (the values used)")
     return derived
+
+
+def _check_bounds(drift: Mapping[str, Any], where: str, source: str) -> None:
+    """Refuse an intercept or a term whose bias over the trained ranges no gyro can have.
+
+    A term's largest magnitude over the box of the training ranges is |c| times the
+    product of max(|low|, |high|)/scale to its powers (``scaled_coefficients`` act on
+    the variables divided by their scales).
+    """
+    intercept = drift["intercept_dph"]
+    if abs(intercept) > BIAS_BOUND_DPH:
+        raise _fail(source, f"{where}.intercept_dph",
+                    f"{intercept:.6g} °/h is beyond any gyro's bias (bound {BIAS_BOUND_DPH:.3g} "
+                    "°/h = 10,000 °/s)")
+    scales = drift["settings"].get("scales", {})
+    ranges = drift["ranges"]
+    terms = parse_terms(drift["selected"]) if drift["selected"] else ()
+    for k, (term, c) in enumerate(zip(terms, drift["scaled_coefficients"], strict=True)):
+        size = abs(float(c))
+        for v, p in term.powers:
+            low, high = ranges[v]
+            size *= (max(abs(low), abs(high)) / scales[v]) ** p
+        if not size <= BIAS_BOUND_DPH:  # also inf and NaN from an overflow
+            raise _fail(source, f"{where}.scaled_coefficients[{k}]",
+                        f"term {term.name} gives a bias of {size:.3g} °/h over its trained "
+                        f"range, beyond any gyro's (bound {BIAS_BOUND_DPH:.3g} °/h = 10,000 "
+                        "°/s)")
+
+
+def _check_scale_bounds(sf: Mapping[str, Any], where: str, source: str) -> None:
+    """Refuse a scale-factor model whose error over its range reaches 100 % (1e6 ppm)."""
+    values = [("intercept_ppm", sf["intercept_ppm"])] + [
+        (f"scaled_coefficients[{k}]", c) for k, c in enumerate(sf["scaled_coefficients"])]
+    low, high = sf["freq_range_hz"]
+    reach = max(abs(low - sf["reference_hz"]), abs(high - sf["reference_hz"])) / sf["scale_hz"]
+    terms = parse_terms(sf["selected"]) if sf.get("selected") else ()
+    powers = [0] + [t.power_of("f") for t in terms]
+    for (key, c), p in zip(values, powers, strict=False):
+        size = abs(float(c)) * reach ** p
+        if not size <= SCALE_BOUND_PPM:
+            raise _fail(source, f"{where}.{key}",
+                        f"{size:.3g} ppm of scale-factor error over the rate tables' range is "
+                        f"beyond any gyro's (bound {SCALE_BOUND_PPM:.3g} ppm = 100 %)")
 
 
 def check_document(data: Any, source: str, non_standard: bool = False) -> dict[str, Any]:
@@ -439,5 +489,7 @@ def check_document(data: Any, source: str, non_standard: bool = False) -> dict[s
         if part.get("housing") is not None:
             kept[axis]["housing"]["coefficients"] = _check_drift(part["housing"],
                                                                   f"{at}housing", source)
+        if part.get("scale_factor") is not None:
+            _check_scale_bounds(part["scale_factor"], f"{at}scale_factor", source)
     restored.pop("parameters_sha256", None)
     return restored

@@ -44,8 +44,27 @@ error_console = Console(stderr=True, highlight=False, soft_wrap=True)
 
 
 def print_json(data: Any) -> None:
-    """Write ``data`` as JSON to standard output (machine readable, nothing else)."""
-    sys.stdout.write(json.dumps(data, indent=2, allow_nan=False) + "\n")
+    """Write ``data`` as strict JSON to standard output (machine readable, nothing else).
+
+    A figure that is not finite (an overflow, a statistic of too few samples) is written
+    ``null``, as in the model file: the output stays valid JSON, never a traceback.
+    """
+    sys.stdout.write(json.dumps(_strict(data), indent=2, allow_nan=False) + "\n")
+
+
+def _strict(value: Any) -> Any:
+    """``value`` with numpy scalars as Python numbers and non-finite floats as None."""
+    import math
+
+    if isinstance(value, dict):
+        return {k: _strict(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_strict(v) for v in value]
+    if type(value).__module__ == "numpy" and getattr(value, "ndim", None) == 0:
+        value = value.item()  # numpy scalar -> Python
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
 
 
 def fail(message: str, code: int = 2) -> typer.Exit:
