@@ -94,12 +94,11 @@ def compensate_command(
         print_json(summary.to_dict())
     else:
         axes = "" if model.is_single_axis else f" (axes {', '.join(model.names)}; the worst)"
-        console.print(
-            f"wrote {summary.output}: {summary.rows} rows; "
-            f"{summary.out_of_range_fraction:.2%} outside the calibrated temperature range, "
-            f"{summary.rate_out_of_range_fraction:.2%} with df/dt beyond its training range"
-            f"{axes}"
-        )
+        shares = (f"{summary.out_of_range_fraction:.2%} outside the calibrated temperature "
+                  f"range, {summary.rate_out_of_range_fraction:.2%} with df/dt beyond its "
+                  "training range") if summary.ranges is None else \
+            f"beyond the trained ranges: {summary.ranges.shares_text()}"
+        console.print(f"wrote {summary.output}: {summary.rows} rows; {shares}{axes}")
     warn_ranges([summary.ranges], json_output, strict)
 
 

@@ -68,7 +68,15 @@ RATES = (1, 3)
 #: samples whose Newton iteration did not converge (solved by the bracketed slow path),
 #: and samples of the filter's settling time at the start of the run.
 OUT_OF_RANGE, RATE_OUT_OF_RANGE, NOT_CONVERGED, SETTLING = 0, 1, 2, 3
-#: Slots of ``extremes``: the smallest and largest f and df/dt seen. [Hz, Hz/s]
+#: Then ``counts[VARIABLE_OUT + v]``: samples outside the training range of variable v of
+#: :data:`ORDER` (each apart, so the range report can say which variable left its range),
+#: and ``counts[TEMPERATURE_OUT]``: outside the calibrated frequencies or f's range.
+VARIABLE_OUT = 4
+TEMPERATURE_OUT = VARIABLE_OUT + len(ORDER)
+#: Length of ``counts``.
+N_COUNTS = TEMPERATURE_OUT + 1
+#: Slots of ``extremes``: the smallest and largest f and df/dt seen [Hz, Hz/s]; then,
+#: for every variable v of :data:`ORDER`, ``extremes[2 v]`` and ``extremes[2 v + 1]``.
 F_MIN, F_MAX, DF_MIN, DF_MAX = 0, 1, 2, 3
 
 
@@ -231,8 +239,8 @@ def new_state() -> np.ndarray:
 
 
 def new_extremes() -> np.ndarray:
-    """``extremes`` before the first sample: [+inf, -inf, +inf, -inf]."""
-    return np.array([np.inf, -np.inf, np.inf, -np.inf])
+    """``extremes`` before the first sample: [+inf, -inf] for every variable of :data:`ORDER`."""
+    return np.tile([np.inf, -np.inf], len(ORDER))
 
 
 # -- the kernel -------------------------------------------------------------------------
@@ -416,8 +424,18 @@ def compensate_block(freq_hz, rate_dph, housing_c, filt, uses_housing, uses_grad
             if flagged[v]:
                 flag = rate_ok if v == RATES[0] or v == RATES[1] else ok
                 x, lo, hi = value[v], low[v], high[v]
+                n_out = 0
                 for i in range(m):
-                    flag[i] = flag[i] if (x[i] >= lo) & (x[i] <= hi) else 0.0
+                    inside = (x[i] >= lo) & (x[i] <= hi)
+                    flag[i] = flag[i] if inside else 0.0
+                    n_out += not inside
+                if counts.size > VARIABLE_OUT + v:
+                    counts[VARIABLE_OUT + v] += n_out
+            if v == 0 and counts.size > TEMPERATURE_OUT:  # calibrated span and f's range
+                n_temperature = 0.0
+                for i in range(m):
+                    n_temperature += ok[i]
+                counts[TEMPERATURE_OUT] += m - int(n_temperature)
         n_ok = 0.0
         n_rate_ok = 0.0
         first = state[6] + start  # samples of the run before this tile
@@ -431,7 +449,7 @@ def compensate_block(freq_hz, rate_dph, housing_c, filt, uses_housing, uses_grad
         counts[0] += m - int(n_ok)
         counts[1] += m - int(n_rate_ok)
         counts[3] += n_settling
-        for v in range(2):  # extremes of f and df/dt (the range warnings say how far)
+        for v in range(min(nv, extremes.size // 2)):  # the range warnings say how far
             x = value[v]
             lo, hi = extremes[2 * v], extremes[2 * v + 1]
             for i in range(m):

@@ -141,6 +141,11 @@ class Compensator:
         self.settling = 0
         self.temperature_nan = 0
         self.unknown_orientation = 0
+        #: Samples beyond the trained temperature (calibrated frequencies or f's range).
+        self.temperature_out = 0
+        #: Per variable with a training range: [samples outside it, smallest, largest seen].
+        self.variable_ranges: dict[str, list[float]] = {
+            v: [0, np.inf, -np.inf] for v in self._variables if v in self.drift.ranges}
         self.segments = 1
         self._last_time: float | None = None
 
@@ -272,17 +277,34 @@ class Compensator:
             if not kernel.supports(thermometer) or not kernel.supports_variables(self._variables):
                 return False  # the numpy engine computes the same numbers
             self._plan = kernel.plan(self.drift, thermometer, self._variables)
-        counts = np.zeros(4, dtype=np.int64)
+        counts = np.zeros(kernel.N_COUNTS, dtype=np.int64)
         freq = chunk.freq_hz
         housing = chunk["housing_c"] if self._plan.needs_housing else None
+        extremes = kernel.new_extremes()
         kernel.run(self._plan, self._state, freq, chunk.rate_dph, housing, out, counts,
-                   self._extremes)
+                   extremes)
         self.samples += len(chunk)
         self._segment_samples += len(chunk)
         self.out_of_range += int(counts[kernel.OUT_OF_RANGE])
         self.rate_out_of_range += int(counts[kernel.RATE_OUT_OF_RANGE])
         self.settling += int(counts[kernel.SETTLING])
+        self.temperature_out += int(counts[kernel.TEMPERATURE_OUT])
+        if len(chunk):
+            for v in self.variable_ranges:
+                j = kernel.ORDER.index(v)
+                self._track(v, int(counts[kernel.VARIABLE_OUT + j]), extremes[2 * j],
+                            extremes[2 * j + 1])
+            e = self._extremes
+            e[0], e[1] = min(e[0], extremes[0]), max(e[1], extremes[1])
+            e[2], e[3] = min(e[2], extremes[2]), max(e[3], extremes[3])
         return True
+
+    def _track(self, variable: str, outside: int, low: float, high: float) -> None:
+        """Add a block's samples outside ``variable``'s range and its extremes."""
+        kept = self.variable_ranges[variable]
+        kept[0] += outside
+        kept[1] = min(kept[1], float(low))
+        kept[2] = max(kept[2], float(high))
 
     def _block(self, chunk: Recording, out: dict[str, np.ndarray], start: int) -> None:
         stop = start + len(chunk)
@@ -293,6 +315,16 @@ class Compensator:
             self.drift, values, self._levels
         )
         rate_in_range = _in_training_range(self.drift, values, RATE_VARIABLES)
+        temperature = thermometer.in_range(chunk.freq_hz) & _in_training_range(
+            self.drift, values, ("f",))
+        self.temperature_out += int(np.count_nonzero(~temperature))
+        if len(chunk):
+            for v in self.variable_ranges:
+                x = values[v]
+                low, high = self.drift.ranges[v]
+                outside = int(np.count_nonzero(~((x >= low) & (x <= high))))
+                self._track(v, outside, np.nanmin(x) if np.isfinite(x).any() else np.inf,
+                            np.nanmax(x) if np.isfinite(x).any() else -np.inf)
         settled = self._segment_samples + np.arange(len(chunk)) >= self._settle_rows
         self._segment_samples += len(chunk)
         np.subtract(chunk.rate_dph, bias, out=out["rate_comp_dph"][start:stop])
@@ -321,9 +353,10 @@ class Compensator:
 
     def ranges(self) -> RangeReport:
         """Shares of the samples so far beyond the trained temperature and df/dt, how far."""
-        counts = np.array([self.out_of_range, self.rate_out_of_range, 0, self.settling])
+        df = self.variable_ranges.get("df", [self.rate_out_of_range])[0]
+        counts = np.array([self.temperature_out, df, 0, self.settling])
         return range_report(self.drift, self.model.thermometer, self.samples, counts,
-                            self._extremes)
+                            self._extremes, self.variable_ranges)
 
 
 def compensate(recording: Recording, model: UnitModel, drift: str = "frequency",

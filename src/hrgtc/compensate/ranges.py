@@ -22,8 +22,68 @@ from typing import Any
 import numpy as np
 
 from hrgtc.drift import DriftModel
+from hrgtc.drift.variables import is_aux, unit, variable
 from hrgtc.errors import ExtrapolationWarning
 from hrgtc.thermometry import Thermometer
+
+
+@dataclass(frozen=True)
+class VariableRange:
+    """How far one drift variable (beyond f and df) went beyond its training range.
+
+    Attributes
+    ----------
+    name
+        The variable (``h``, ``dh``, ``d2``, ``g``, ``a_NAME``; see
+        :mod:`hrgtc.drift.variables`).
+    unit
+        Unit of ``trained`` and ``seen`` (rates of change per hour: °C/h or Hz/h...).
+    fraction
+        Share of the samples outside the training range.
+    trained, seen
+        (min, max) of the training window means and of the samples seen. [unit]
+    """
+
+    name: str
+    unit: str
+    fraction: float
+    trained: tuple[float, float]
+    seen: tuple[float, float]
+
+    @property
+    def excess(self) -> float:
+        """Farthest seen value beyond the trained range (0 inside). [unit]"""
+        low, high = self.trained
+        beyond = [0.0, low - self.seen[0], self.seen[1] - high]
+        return max(b for b in beyond if math.isfinite(b)) if self.fraction else 0.0
+
+    def warning(self) -> str:
+        """One line: the share, the variable, its trained and seen range, how far beyond."""
+        described = variable(self.name).description.split(" (")[0]
+        low, high = self.trained
+        return (f"warning: {self.fraction:.1%} of samples beyond the trained range of "
+                f"{self.name} ({described}) {low:.4g} to {high:.4g} {self.unit}, up to "
+                f"{self.excess:.4g} {self.unit} beyond (seen {self.seen[0]:.4g} to "
+                f"{self.seen[1]:.4g} {self.unit})")
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"variable": self.name, "unit": self.unit, "fraction": self.fraction,
+                "trained": _pair(self.trained), "seen": _pair(self.seen),
+                "excess": self.excess}
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> VariableRange:
+        return cls(str(data["variable"]), str(data["unit"]), float(data["fraction"]),
+                   _unpair(data["trained"]), _unpair(data["seen"]))
+
+
+def _pair(values: tuple[float, float]) -> list[float | None]:
+    return [v if math.isfinite(v) else None for v in values]
+
+
+def _unpair(values: Any) -> tuple[float, float]:
+    low, high = values
+    return (math.nan if low is None else float(low), math.nan if high is None else float(high))
 
 
 @dataclass(frozen=True)
@@ -44,6 +104,11 @@ class RangeReport:
         (min, max) trained and seen resonator temperature. [°C]
     trained_rate_c_per_h, seen_rate_c_per_h
         (min, max) trained and seen df/dt as a resonator temperature rate. [°C/h]
+    variables
+        The model's other variables with a training range (h, dh, d2, g, a_NAME), each
+        with its own share and how far it went: a gradient ``g`` beyond its range is
+        said as such, not as a temperature (``temperature_fraction`` counts only the
+        calibrated frequencies and f's range, ``rate_fraction`` only df/dt's).
     """
 
     samples: int
@@ -54,6 +119,7 @@ class RangeReport:
     seen_c: tuple[float, float]
     trained_rate_c_per_h: tuple[float, float]
     seen_rate_c_per_h: tuple[float, float]
+    variables: tuple[VariableRange, ...] = ()
 
     @property
     def temperature_excess_c(self) -> float:
@@ -75,7 +141,19 @@ class RangeReport:
     @property
     def beyond(self) -> bool:
         """Whether any sample after the settling time was beyond a trained range."""
-        return self.temperature_fraction > 0.0 or self.rate_fraction > 0.0
+        return (self.temperature_fraction > 0.0 or self.rate_fraction > 0.0
+                or any(v.fraction > 0.0 for v in self.variables))
+
+    def shares(self) -> dict[str, float]:
+        """Share of samples beyond each trained range: ``temperature``, ``df/dt``, then
+        every other variable by name."""
+        out = {"temperature": self.temperature_fraction, "df/dt": self.rate_fraction}
+        out.update((v.name, v.fraction) for v in self.variables)
+        return out
+
+    def shares_text(self) -> str:
+        """``temperature 0.0%, df/dt 1.2%, g 72.5%``: one share per variable, for summaries."""
+        return ", ".join(f"{name} {share:.1%}" for name, share in self.shares().items())
 
     def warnings(self) -> list[str]:
         """One line per kind of excursion (empty when the run stayed inside)."""
@@ -98,13 +176,12 @@ class RangeReport:
                 f"{self.seen_rate_c_per_h[1]:+.1f} °C/h{how_far}); train on runs this fast "
                 "(calibrate --drift takes several)"
             )
+        lines += [v.warning() for v in self.variables if v.fraction > 0.0]
         return lines
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types."""
-        def pair(values: tuple[float, float]) -> list[float | None]:
-            return [v if math.isfinite(v) else None for v in values]
-
+        pair = _pair
         ratio = self.rate_excess_ratio
         return {
             "samples": self.samples,
@@ -117,6 +194,7 @@ class RangeReport:
             "trained_rate_c_per_h": pair(self.trained_rate_c_per_h),
             "seen_rate_c_per_h": pair(self.seen_rate_c_per_h),
             "rate_excess_ratio": ratio if math.isfinite(ratio) else None,
+            "variables": [v.to_dict() for v in self.variables],
         }
 
     @classmethod
@@ -129,7 +207,8 @@ class RangeReport:
         return cls(int(data["samples"]), float(data["temperature_fraction"]),
                    float(data["rate_fraction"]), float(data["settling_fraction"]),
                    pair("trained_c"), pair("seen_c"), pair("trained_rate_c_per_h"),
-                   pair("seen_rate_c_per_h"))
+                   pair("seen_rate_c_per_h"),
+                   tuple(VariableRange.from_dict(v) for v in data.get("variables", ())))
 
 
 def _temperature(thermometer: Thermometer, freq_hz: np.ndarray) -> np.ndarray:
@@ -146,11 +225,14 @@ def _temperature(thermometer: Thermometer, freq_hz: np.ndarray) -> np.ndarray:
 
 
 def range_report(drift: DriftModel, thermometer: Thermometer, samples: int, counts: np.ndarray,
-                 extremes: np.ndarray) -> RangeReport:
+                 extremes: np.ndarray,
+                 variables: Mapping[str, Any] | None = None) -> RangeReport:
     """A :class:`RangeReport` from the compensator's counts and extremes of f and df/dt.
 
     ``counts`` are (outside temperature, outside df/dt, -, settling) and ``extremes``
-    (f min, f max, df min, df max) [Hz, Hz/s], as kept by the compensator.
+    (f min, f max, df min, df max) [Hz, Hz/s], as kept by the compensator;
+    ``variables`` maps each other variable with a training range to (samples outside
+    it, smallest, largest seen) in its own unit.
     """
     s = drift.settings
     f_ref = s.reference_freq_hz
@@ -171,6 +253,21 @@ def range_report(drift: DriftModel, thermometer: Thermometer, samples: int, coun
         low, high = sorted((values[0] / slope * 3600.0, values[1] / slope * 3600.0))
         return (low, high)
 
+    others = []
+    for name, (outside, low, high) in (variables or {}).items():
+        if name in ("f", "df"):
+            continue
+        trained = drift.ranges[name]
+        seen = (float(low), float(high)) if samples else (math.nan, math.nan)
+        unit = variable_unit(name, thermometer.source, drift.settings.aux_columns)
+        if variable(name).kind == "rate":  # per hour, as the df/dt line
+            if unit.endswith("/s"):
+                unit = unit[:-2] + "/h"
+            trained = (trained[0] * 3600.0, trained[1] * 3600.0)
+            seen = (seen[0] * 3600.0, seen[1] * 3600.0)
+        others.append(VariableRange(name, unit, float(outside) / samples if samples else 0.0,
+                                    (float(trained[0]), float(trained[1])), seen))
+
     df_trained = drift.ranges.get("df", (-math.inf, math.inf))
     share = (lambda k: counts[k] / samples if samples else 0.0)  # noqa: E731
     return RangeReport(
@@ -182,4 +279,12 @@ def range_report(drift: DriftModel, thermometer: Thermometer, samples: int, coun
         seen_c=seen_c,
         trained_rate_c_per_h=per_hour(df_trained),
         seen_rate_c_per_h=per_hour((float(extremes[2]), float(extremes[3]))),
+        variables=tuple(others),
     )
+
+
+def variable_unit(name: str, source: str, aux_columns: Mapping[str, str]) -> str:
+    """A variable's unit for the range report (an extra channel: its column's)."""
+    if is_aux(name):
+        return f"(unit of {aux_columns.get(name[2:], name[2:])})"
+    return unit(name, source)

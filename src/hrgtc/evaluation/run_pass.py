@@ -312,10 +312,10 @@ class Evaluation:
         if self.bias_stability_interval_dph:
             lines.append(f"  ({self.confidence:.3g} intervals at 10 s: " + ", ".join(
                 f"{k} {self.stability_text(k, 10.0)}" for k in self.bias_stability_dph) + ")")
+        shares = self.ranges.shares_text() if self.ranges else (
+            f"{self.out_of_range_fraction:.1%}, df/dt {self.rate_out_of_range_fraction:.1%}")
         lines.append(f"improvement at 10 s: {self.improvement_10s:.2f}×; compensated "
-                     f"{self.offset_text()}; out of calibrated range: "
-                     f"{self.out_of_range_fraction:.1%} (df/dt beyond training: "
-                     f"{self.rate_out_of_range_fraction:.1%})")
+                     f"{self.offset_text()}; beyond the trained ranges: {shares}")
         if self.residual_rms_dph is not None:
             lines.append(f"RMS of true bias minus model: {self.residual_rms_dph:.4f} °/h")
         if self.n_not_at_rest:

@@ -1,0 +1,146 @@
+"""Tests of hrgtc.compensate.ranges: which variable left its trained range, and by how much.
+
+Issue 21: on clean data ``compensate``/``evaluate`` said "72.5 % of samples beyond the
+trained temperature" when the temperature was inside its range and the gradient ``g``
+was beyond its trained maximum; the °C/h figures of the range report were only
+compared by sign and ratio (a factor 3600 would pass); the lower calibration edge of
+``in_range`` was not tested. Truth: the simulator's resonator temperature and rate,
+and the variables recomputed here with :class:`FeatureStream`.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from hrgtc import drift
+from hrgtc.compensate import Compensator
+from hrgtc.compensate.ranges import RangeReport
+from hrgtc.drift.features import FeatureStream
+from hrgtc.model import UnitModel
+
+from synthetic import THERMOMETER, lagged_run, ramp_run
+
+
+@pytest.fixture(scope="module")
+def gradient_model():
+    terms = ("f", "df", "g")
+    runs = [lagged_run(seed=5), lagged_run(seed=6, start_c=-20.0, end_c=20.0)]
+    fitted = drift.fit(runs, THERMOMETER, terms=terms, initial=terms, premove=0.999999)
+    return UnitModel(thermometer=THERMOMETER, drift=fitted, unit="gradient")
+
+
+@pytest.fixture(scope="module")
+def unit_model():
+    return UnitModel(thermometer=THERMOMETER, drift=drift.fit([ramp_run(seed=1)], THERMOMETER))
+
+
+def hot_housing(model):
+    """A run well inside the trained temperatures whose housing reads 4 °C above the gradient
+    the model was trained on: only g leaves its range."""
+    run = lagged_run(seed=9, start_c=10.0, end_c=5.0, hours=1.5)
+    high = model.drift.ranges["g"][1]
+    return run.with_columns(housing_c=run["housing_c"] + high + 4.0)
+
+
+@pytest.mark.parametrize("engine", ["fused", "numpy"])
+def test_the_gradient_beyond_its_range_is_not_called_a_temperature(gradient_model, engine):
+    run = hot_housing(gradient_model)
+    compensator = Compensator(gradient_model, engine=engine)
+    compensator.process(run)
+    report = compensator.ranges()
+    # the truth: g recomputed, and the resonator temperature well inside the calibration
+    g = FeatureStream(gradient_model.drift.settings, ("g",), THERMOMETER).process(run)["g"]
+    low, high = gradient_model.drift.ranges["g"]
+    beyond = int(np.count_nonzero((g < low) | (g > high)))
+    assert beyond > 0.5 * len(run)
+    assert report.temperature_fraction == 0.0 and report.seen_c[1] < 25.0
+    (gradient,) = [v for v in report.variables if v.name == "g"]
+    assert gradient.fraction == beyond / len(run)
+    assert gradient.unit == "°C"
+    assert gradient.excess == pytest.approx(float(np.nanmax(g)) - high, rel=1e-12)
+    lines = report.warnings()
+    assert not any("trained temperature" in line for line in lines)
+    (line,) = [line for line in lines if "of g" in line]
+    assert f"{gradient.fraction:.1%} of samples beyond the trained range of g" in line
+    # the JSON says the same per variable, and reads back
+    data = json.loads(json.dumps(report.to_dict()))
+    assert data["temperature_fraction"] == 0.0
+    assert data["variables"][0]["variable"] == "g"
+    assert data["variables"][0]["fraction"] == gradient.fraction
+    assert RangeReport.from_dict(data) == report
+    assert report.shares_text().endswith(f"g {gradient.fraction:.1%}")
+
+
+def test_the_engines_count_every_variable_alike(gradient_model):
+    run = hot_housing(gradient_model)
+    a, b = Compensator(gradient_model, engine="fused"), Compensator(gradient_model,
+                                                                    engine="numpy")
+    for c in (a, b):
+        c.process(run.slice(0, 20_000))
+        c.process(run.slice(20_000, len(run)))  # two chunks: counts and extremes add up
+    assert a._plan is not None  # the kernel did run
+    assert a.temperature_out == b.temperature_out
+    for name, (outside, low, high) in b.variable_ranges.items():
+        assert a.variable_ranges[name][0] == outside, name
+        assert a.variable_ranges[name][1:] == pytest.approx([low, high], rel=1e-12), name
+
+
+def test_rates_in_degrees_per_hour_are_the_simulated_ones(unit_model):
+    """The °C/h figures against the simulator's resonator rate (a factor 3600 fails)."""
+    trained_low, trained_high = Compensator(unit_model).ranges().trained_rate_c_per_h
+    # the truth: the training run's resonator rate on 10 s window means (the fit's windows)
+    training = ramp_run(seed=1)
+    rows = int(10.0 * training.sample_rate_hz)
+    true = np.gradient(training["resonator_c"], training.time_s) * 3600.0
+    n = true.size // rows
+    windows = true[: n * rows].reshape(n, rows).mean(axis=1)
+    assert windows.min() < -15.0  # °C/h: the chamber cools 40 °C in 2 h through a lag
+    assert trained_low == pytest.approx(windows.min(), rel=0.05)  # window noise of df/dt
+    assert trained_high < 1.0
+    fast = ramp_run(seed=24, start_c=0.0, end_c=10.0, hours=1.0, ramp_hours=0.1)
+    compensator = Compensator(unit_model)
+    compensator.process(fast)
+    seen = compensator.ranges().seen_rate_c_per_h
+    true = np.gradient(fast["resonator_c"], fast.time_s) * 3600.0
+    assert seen[1] == pytest.approx(true.max(), rel=0.15)  # the filter lags and smooths a bit
+    assert seen[1] > 10.0  # °C/h (the same warm-up in °C/s would read 0.004)
+
+
+def test_in_range_holds_at_both_calibration_edges_and_not_beyond():
+    low_t, _ = THERMOMETER.temperature_range_c
+    f_low, f_high = THERMOMETER.frequency_range_hz
+    assert THERMOMETER.frequency(low_t) in (f_low, f_high)
+    edges = np.array([f_low, f_high])
+    outward = np.spacing(edges) * np.array([-4.0, 4.0])
+    assert THERMOMETER.in_range(edges).all()
+    assert not THERMOMETER.in_range(edges + outward).any()  # just beyond each edge
+    assert THERMOMETER.in_range(edges - outward).all()  # just inside
+
+
+@pytest.mark.parametrize("engine", ["fused", "numpy"])
+def test_samples_at_the_lower_calibration_edge_are_flagged_in_range(unit_model, engine):
+    """A constant frequency exactly at the lower calibrated edge: in range (the run is at
+    rest, inside f's training range); one ulp below: out of range."""
+    import dataclasses
+
+    from hrgtc.recording import Metadata, Recording
+
+    f_low, _ = THERMOMETER.frequency_range_hz
+    rows = 4000
+    settings = unit_model.drift.settings
+    # f's training range widened past the calibration, so the calibrated edge decides
+    f_range = (f_low - settings.reference_freq_hz - 1.0, unit_model.drift.ranges["f"][1])
+    wide = dataclasses.replace(unit_model, drift=dataclasses.replace(
+        unit_model.drift, ranges={**unit_model.drift.ranges, "f": f_range,
+                                  "df": (-1.0, 1.0)}))
+    for freq, expected in ((f_low, 1.0), (np.nextafter(f_low, -np.inf), 0.0)):
+        run = Recording({"time_s": np.arange(rows) / settings.sample_rate_hz,
+                         "freq_hz": np.full(rows, freq), "rate_dph": np.zeros(rows)},
+                        Metadata(sample_rate_hz=settings.sample_rate_hz))
+        compensator = Compensator(wide, engine=engine)
+        out = compensator.process(run)
+        assert (out["in_range"][-100:] == expected).all(), (freq, expected)
+        assert compensator.temperature_out == (0 if expected else rows)
