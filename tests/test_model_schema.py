@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -171,4 +172,41 @@ def test_a_file_changed_after_writing_is_refused_unless_the_checksum_line_goes(t
 def test_reference_frequency_must_match_the_thermometer(tmp_path, document):
     document["drift"]["settings"]["reference_freq_hz"] *= 1.5
     with pytest.raises(ModelFileError, match=r"reference_freq_hz: .* is not the thermometer's"):
+        load_model(_write(tmp_path, document))
+
+
+@pytest.mark.parametrize("variable", ["f", "df"])
+def test_every_reversed_training_range_is_refused(tmp_path, document, variable):
+    """Issue 21: a reversed range (a mutant that swapped the check passed every test that
+    reversed only f); clipping to [high, low] would silently hold every sample at one edge."""
+    low, high = document["drift"]["ranges"][variable]
+    assert low < high
+    document["drift"]["ranges"][variable] = [high, low]
+    with pytest.raises(ModelFileError, match=rf"unit.json: model file is invalid at "
+                                             rf"drift.ranges.{variable}: .* is reversed"):
+        load_model(_write(tmp_path, document))
+    document["drift"]["ranges"][variable] = [low, low]  # a single value is a range
+    load_model(_write(tmp_path, document))
+
+
+def test_a_reversed_scale_factor_range_is_refused(tmp_path, unit_model):
+    from synthetic import scale_factor, with_scale_factor
+
+    model = with_scale_factor(unit_model, scale_factor(unit_model.drift.settings.reference_freq_hz))
+    data = json.loads(json.dumps(model.to_dict()))
+    data["scale_factor"]["freq_range_hz"] = data["scale_factor"]["freq_range_hz"][::-1]
+    with pytest.raises(ModelFileError, match=r"scale_factor.freq_range_hz: .* is reversed"):
+        load_model(_write(tmp_path, data))
+
+
+def test_terms_beyond_any_gyro_bias_are_refused_naming_the_term(tmp_path, document):
+    """The bound is on each term's bias over the trained box of its variables."""
+    from hrgtc.model_schema import BIAS_BOUND_DPH
+
+    terms = document["drift"]["selected"]
+    k = len(terms) - 1
+    document["drift"]["scaled_coefficients"][k] = 2.0 * BIAS_BOUND_DPH
+    document["drift"]["coefficients"] = derived_coefficients(document["drift"])
+    with pytest.raises(ModelFileError, match=rf"drift.scaled_coefficients\[{k}\]: term "
+                                             rf"{re.escape(terms[k])} gives a bias of"):
         load_model(_write(tmp_path, document))

@@ -439,6 +439,9 @@ def _check_scale_bounds(sf: Mapping[str, Any], where: str, source: str) -> None:
     values = [("intercept_ppm", sf["intercept_ppm"])] + [
         (f"scaled_coefficients[{k}]", c) for k, c in enumerate(sf["scaled_coefficients"])]
     low, high = sf["freq_range_hz"]
+    if not low <= high:
+        raise _fail(source, f"{where}.freq_range_hz",
+                    f"[{low!r}, {high!r}] is reversed (low > high)")
     reach = max(abs(low - sf["reference_hz"]), abs(high - sf["reference_hz"])) / sf["scale_hz"]
     terms = parse_terms(sf["selected"]) if sf.get("selected") else ()
     powers = [0] + [t.power_of("f") for t in terms]
