@@ -111,3 +111,47 @@ def test_json_output_is_strict_even_with_figures_that_are_not_finite(capsys):
 
     print_json({"a": math.inf, "b": [np.float64(1.5), np.nan], "c": np.int64(3)})
     assert json.loads(capsys.readouterr().out) == {"a": None, "b": [1.5, None], "c": 3}
+
+
+# -- a model of the other kind of thermometer --------------------------------------------------
+@pytest.fixture(scope="module")
+def sensor_model_path(tmp_path_factory):
+    """A genuine sensor-thermometer model: the identity thermometer, drift trained on a run
+    whose freq_hz column holds the resonator temperature (what --thermometer sensor reads)."""
+    import numpy as np
+
+    from hrgtc import drift
+    from hrgtc.model import UnitModel
+    from hrgtc.thermometry.sensor import identity
+
+    from synthetic import ramp_run
+
+    run = ramp_run(seed=11, hours=3.0)
+    rng = np.random.default_rng(0)
+    reading = run.with_columns(freq_hz=run["resonator_c"] + rng.normal(0.0, 0.01, len(run)))
+    thermometer = identity((-20.0, 40.0))
+    model = UnitModel(thermometer=thermometer, drift=drift.fit([reading], thermometer),
+                      unit="MEMS-1")
+    return save_model(model, tmp_path_factory.mktemp("sensor") / "sensor.json")
+
+
+@pytest.mark.parametrize("command", ["compensate", "evaluate", "report"])
+def test_a_sensor_model_on_a_frequency_recording_says_it_is_a_sensor_model(
+        files, sensor_model_path, tmp_path, command):
+    _, _, run_path = files
+    code, stdout, stderr = invoke(*COMMANDS[command](run_path, sensor_model_path, tmp_path))
+    message = squash(stderr)
+    assert code == 2, (stdout, stderr)
+    assert "is a sensor-thermometer model" in message
+    assert "pass --thermometer sensor" in message
+    assert "calibrated span" not in message
+
+
+def test_a_resonator_model_read_as_a_sensor_recording_says_so(files, tmp_path):
+    _, model_path, run_path = files
+    code, _, stderr = invoke("compensate", run_path, "-m", model_path, "-o",
+                             tmp_path / "out.parquet", "--thermometer", "sensor")
+    message = squash(stderr)
+    assert code == 2
+    assert "is a resonator-thermometer model" in message and "drop --thermometer sensor" in \
+        message

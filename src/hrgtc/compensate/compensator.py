@@ -491,8 +491,48 @@ def plausible_frequency_band(model: UnitModel,
     return low - margin, high + margin
 
 
+def check_thermometer_kind(options: rec_io.ReadOptions, model: UnitModel) -> None:
+    """Refuse to read a recording as the other kind of thermometer than the model's.
+
+    A sensor-thermometer model (``calibrate --thermometer sensor``) reads the gyro's
+    temperature sensor [°C] in the place of the frequency; applied to a frequency
+    recording, every sample would be "far outside the calibrated span" with no word of
+    why. The reverse (a resonator model on a sensor reading) likewise.
+
+    Raises
+    ------
+    InputError
+        The kinds differ: says which the model is and which option to pass.
+    """
+    model_kind = model.thermometer.source
+    reading = options.thermometer
+    if model_kind == reading:
+        return
+    low, high = model.thermometer.temperature_range_c
+    if model_kind == "sensor":
+        raise InputError(
+            f"the model of unit {model.unit!r} is a sensor-thermometer model (calibrated with "
+            f"--thermometer sensor on the gyro's temperature sensor, {low:g} to {high:g} °C), "
+            "but the recording is read as a resonator frequency (freq_hz); pass --thermometer "
+            "sensor (and --col temperature_c=... for the sensor's column), or use a model "
+            "calibrated on the resonator frequency")
+    raise InputError(
+        f"the model of unit {model.unit!r} is a resonator-thermometer model (its thermometer "
+        "turns the resonator frequency into temperature), but the recording is read with "
+        "--thermometer sensor (a temperature sensor in the place of freq_hz); drop "
+        "--thermometer sensor for this model, or calibrate one with --thermometer sensor")
+
+
 def with_model_band(options: rec_io.ReadOptions, model: UnitModel) -> rec_io.ReadOptions:
-    """``options`` that check every frequency against the model's plausible band."""
+    """``options`` that check every frequency against the model's plausible band.
+
+    Raises
+    ------
+    InputError
+        The model's thermometer is not the kind the recording is read as
+        (:func:`check_thermometer_kind`).
+    """
+    check_thermometer_kind(options, model)
     return dataclasses.replace(options, freq_band_hz=plausible_frequency_band(model),
                                freq_span_hz=frequency_span(model))
 

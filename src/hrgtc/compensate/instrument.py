@@ -19,6 +19,7 @@ from hrgtc import recording as rec_io
 from hrgtc.compensate.compensator import (
     CompensationSummary,
     Compensator,
+    check_thermometer_kind,
     compensate_file,
     output_columns,
     plausible_frequency_band,
@@ -162,6 +163,8 @@ def compensate_instrument_file(
         return compensate_file(source, output, model.axes[""], drift=drift,
                                read_options=read_options, **options)
     reading = read_options or rec_io.ReadOptions()
+    for unit in model.axes.values():
+        check_thermometer_kind(reading, unit)
     compensator = InstrumentCompensator(
         model, drift, gaps=reading.gaps,
         bands_hz={axis: plausible_frequency_band(unit) for axis, unit in model.axes.items()})
