@@ -155,3 +155,99 @@ def test_a_resonator_model_read_as_a_sensor_recording_says_so(files, tmp_path):
     assert code == 2
     assert "is a resonator-thermometer model" in message and "drop --thermometer sensor" in \
         message
+
+
+# -- axis sets: a model and a recording with different axes ------------------------------------
+@pytest.fixture(scope="module")
+def axis_files(tmp_path_factory):
+    """A three-axis recording (x, y, z: the same run on each axis), a two-axis model (x, y)
+    and a single-axis model."""
+    from hrgtc.model import InstrumentModel, save_instrument
+    from hrgtc.recording import Recording
+
+    folder = tmp_path_factory.mktemp("axes")
+    unit = make_model()
+    run = make_run(rows=3000)
+    columns = {"time_s": run.time_s}
+    for axis in "xyz":
+        columns[f"freq_hz_{axis}"] = run.freq_hz
+        columns[f"rate_dph_{axis}"] = run.rate_dph
+    xyz = write(Recording(columns, run.metadata), folder / "xyz.parquet")
+    xy = save_instrument(InstrumentModel({"x": unit, "y": unit}, "imu"), folder / "xy.json")
+    single = save_model(unit, folder / "single.json")
+    return folder, xyz, xy, single
+
+
+@pytest.mark.parametrize("command", ["compensate", "evaluate", "report"])
+@pytest.mark.parametrize("which", ["xy", "single"])
+def test_an_axis_mismatch_is_an_error_naming_the_axes_and_the_option(axis_files, tmp_path,
+                                                                     command, which):
+    """Issue 21: a model with fewer axes than the recording compensated only its own axes
+    without a word (exit 0); a single-axis model on a 3-axis file said 'column freq_hz not
+    found'."""
+    _, xyz, xy, single = axis_files
+    model = xy if which == "xy" else single
+    code, stdout, stderr = invoke(*COMMANDS[command](xyz, model, tmp_path))
+    message = squash(stderr)
+    assert code == 2, (stdout, stderr)
+    assert "has axes x, y, z" in message
+    if which == "xy":
+        assert "axis z of the recording would be left uncompensated" in message
+        assert "pass --axes x,y" in message
+    else:
+        assert "is single-axis: pass --axes x (one of x, y, z)" in message
+    assert not (tmp_path / "out.parquet").exists()
+
+
+def test_axes_says_which_to_compensate(axis_files, tmp_path):
+    import pyarrow.parquet as pq
+
+    from hrgtc.compensate import Compensator
+    from hrgtc.recording import read
+
+    _, xyz, xy, single = axis_files
+    code, _, stderr = invoke("compensate", xyz, "-m", xy, "-o", tmp_path / "xy.parquet",
+                             "--axes", "x,y")
+    assert code == 0, stderr
+    names = pq.read_schema(tmp_path / "xy.parquet").names
+    assert "rate_comp_dph_x" in names and "rate_comp_dph_y" in names
+    assert not any(n.endswith("_z") and n.startswith(("rate_comp", "in_range")) for n in names)
+    # a single-axis model on one named axis: that axis's outputs, equal to compensating its
+    # own single-axis file
+    code, _, stderr = invoke("compensate", xyz, "-m", single, "-o", tmp_path / "z.parquet",
+                             "--axes", "z")
+    assert code == 0, stderr
+    out = read(tmp_path / "z.parquet")
+    expected = Compensator(make_model()).process(make_run(rows=3000))
+    np_equal = (out["rate_comp_dph_z"] == expected["rate_comp_dph"]).all()
+    assert np_equal and "rate_comp_dph_x" not in out
+    code, _, stderr = invoke("evaluate", xyz, "-m", single, "--axes", "y", "--json")
+    assert code == 0, stderr
+
+
+@pytest.mark.parametrize("axes, match", [
+    ("x,w", "has no axis w"),
+    ("z", "the model .*xy.json has no axis z"),
+    ("x_1", "'x_1' is not an axis name"),
+])
+def test_wrong_axes_are_named(axis_files, axes, match):
+    _, xyz, xy, _ = axis_files
+    code, _, stderr = invoke("evaluate", xyz, "-m", xy, "--axes", axes)
+    assert code == 2
+    assert re.search(match, squash(stderr)), stderr
+
+
+def test_a_model_with_more_axes_than_the_recording(axis_files, tmp_path):
+    from hrgtc.model import InstrumentModel, save_instrument
+
+    _, xyz, _, _ = axis_files
+    unit = make_model()
+    xyzw = save_instrument(InstrumentModel({a: unit for a in "xyzw"}, "imu4"),
+                           tmp_path / "xyzw.json")
+    code, _, stderr = invoke("compensate", xyz, "-m", xyzw, "-o", tmp_path / "o.parquet")
+    message = squash(stderr)
+    assert code == 2
+    assert "the model's axis w is not in the recording; pass --axes x,y,z" in message
+    code, _, stderr = invoke("compensate", xyz, "-m", xyzw, "-o", tmp_path / "o.parquet",
+                             "--axes", "x,y,z")
+    assert code == 0, stderr

@@ -17,7 +17,14 @@ from hrgtc.cli._app import (
     print_json,
     progress_bar,
 )
-from hrgtc.cli.options import STRICT_EXIT, ForceOption, JsonOption, StrictOption, reading_options
+from hrgtc.cli.options import (
+    STRICT_EXIT,
+    AxesOption,
+    ForceOption,
+    JsonOption,
+    StrictOption,
+    reading_options,
+)
 
 if TYPE_CHECKING:
     from hrgtc.compensate.ranges import RangeReport
@@ -64,6 +71,7 @@ def compensate_command(
     force: ForceOption = False,
     strict: StrictOption = False,
     json_output: JsonOption = False,
+    axes: AxesOption = None,
     inputs: ReadOptions | None = None,
 ) -> None:
     """Compensate a run file to file: adds rate_comp_dph, bias_model_dph, resonator_c_est
@@ -75,6 +83,7 @@ def compensate_command(
     Example: hrgtc compensate warmup.parquet --model unit.json -o warmup_comp.parquet
     """
     from hrgtc.compensate import compensate_instrument_file
+    from hrgtc.compensate.instrument import parse_axes
     from hrgtc.model import load_instrument
     from hrgtc.recording import ReadOptions
     from hrgtc.thermometry.reference import options_with_map
@@ -89,7 +98,7 @@ def compensate_command(
         inputs = options_with_map(inputs, model.temperature_map)
         summary = compensate_instrument_file(run, output, model, force=force,
                                              chunk_rows=chunk_rows, progress=progress,
-                                             read_options=inputs)
+                                             read_options=inputs, axes=parse_axes(axes))
     if json_output:
         print_json(summary.to_dict())
     else:
@@ -141,12 +150,12 @@ def render_evaluation(result: Evaluation, sensor: bool = False) -> None:
             allan.add_row(labels.get(name, name), terms.text("arw"),
                           terms.text("bias_instability"), terms.text("rrw"))
         console.print(allan)
-    console.print(
-        f"improvement at 10 s: {result.improvement_10s:.2f}×; compensated "
-        f"{result.offset_text()}; outside the calibrated range: "
-        f"{result.out_of_range_fraction:.2%}; df/dt beyond training: "
-        f"{result.rate_out_of_range_fraction:.2%}"
-    )
+    shares = (f"outside the calibrated range: {result.out_of_range_fraction:.2%}; df/dt "
+              f"beyond training: {result.rate_out_of_range_fraction:.2%}"
+              if result.ranges is None else
+              f"beyond the trained ranges: {result.ranges.shares_text()}")
+    console.print(f"improvement at 10 s: {result.improvement_10s:.2f}×; compensated "
+                  f"{result.offset_text()}; {shares}")
     if result.prediction_std_dph is not None:
         std = result.prediction_std_dph
         console.print(f"1σ of the drift model line (coefficient covariance): median "
@@ -177,6 +186,7 @@ def evaluate_command(
     force: ForceOption = False,
     strict: StrictOption = False,
     json_output: JsonOption = False,
+    axes: AxesOption = None,
     inputs: ReadOptions | None = None,
 ) -> None:
     """Bias stability at 1, 10, 100 s (with 1σ intervals) and Allan noise terms, raw vs
@@ -186,6 +196,8 @@ def evaluate_command(
     Example: hrgtc evaluate warmup.parquet --model unit.json --deviation oadev
     --allan-csv warmup_allan.csv --json
     """
+    from hrgtc.compensate.compensator import check_thermometer_kind
+    from hrgtc.compensate.instrument import match_axes, parse_axes, recording_axes
     from hrgtc.evaluation import evaluate
     from hrgtc.evaluation.run_pass import DEVIATIONS
     from hrgtc.files import refuse_existing, write_text_atomic
@@ -206,6 +218,10 @@ def evaluate_command(
     with library_errors():
         model = load_instrument(model_path)
         inputs = options_with_map(inputs, model.temperature_map)
+        for unit_model in model.axes.values():  # before reading the recording's axes
+            check_thermometer_kind(inputs, unit_model)
+        model = match_axes(model, recording_axes(run, inputs), parse_axes(axes), str(run),
+                           str(model_path))
     for axis, unit_model in model.axes.items():
         label = "evaluating" + (f" axis {axis}" if axis else "")
         with library_errors(), progress_bar(label, enabled=not json_output) as progress:

@@ -351,6 +351,10 @@ JsonOption = Annotated[
     bool, typer.Option("--json", help="Print machine-readable JSON on standard output.")
 ]
 FormatOption = Annotated[OutputFormat, typer.Option("--format", help="Output file format.")]
+AxesOption = Annotated[str | None, typer.Option(
+    "--axes", help="Axes to compensate, comma-separated (x,y): needed when the model and the "
+    "recording have different axes (each other axis is left as it is), or to apply a "
+    "single-axis model to one axis of a multi-axis recording.")]
 
 
 def recording_input(

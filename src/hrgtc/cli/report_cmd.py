@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 import typer
 
 from hrgtc.cli._app import app, console, library_errors, print_json, progress_bar
-from hrgtc.cli.options import ForceOption, JsonOption, reading_options
+from hrgtc.cli.options import AxesOption, ForceOption, JsonOption, reading_options
 
 if TYPE_CHECKING:
     from hrgtc.recording import ReadOptions
@@ -30,6 +30,7 @@ def report_command(
         20_000, "--max-points", help="Most points per plotted curve (block means >= 10 s)."),
     force: ForceOption = False,
     json_output: JsonOption = False,
+    axes: AxesOption = None,
     inputs: ReadOptions | None = None,
 ) -> None:
     """Write the HTML report: settling of the soaks (Fig. 3), T-f fit (Fig. 4, Table 1),
@@ -38,7 +39,11 @@ def report_command(
 
     Example: hrgtc report --model unit.json cooldown.parquet warmup.parquet -o report.html
     """
+    from hrgtc.compensate.compensator import check_thermometer_kind
+    from hrgtc.compensate.instrument import match_axes, parse_axes, recording_axes
     from hrgtc.files import check_writable, refuse_existing
+    from hrgtc.model import load_instrument
+    from hrgtc.recording import ReadOptions
     from hrgtc.report import build_report
 
     with library_errors(), progress_bar("report", enabled=not json_output) as progress:
@@ -48,8 +53,16 @@ def report_command(
         inputs = options_with_map(inputs, load_instrument(model).temperature_map)
         refuse_existing(output, force)
         check_writable(output, 20e6)  # before the passes over the runs
-        path = build_report(model, runs, output, soaks=soak or None, title=title, force=force,
-                            max_points=max_points, progress=progress, read_options=inputs)
+        loaded = load_instrument(model)
+        for unit_model in loaded.axes.values():  # before reading the recordings' axes
+            check_thermometer_kind(inputs or ReadOptions(), unit_model)
+        chosen = parse_axes(axes)
+        matched = [match_axes(loaded, recording_axes(r, inputs), chosen, str(r), str(model))
+                   for r in runs]
+        chosen_model = model if matched[0] is loaded else matched[0]
+        path = build_report(chosen_model, runs, output, soaks=soak or None, title=title,
+                            force=force, max_points=max_points, progress=progress,
+                            read_options=inputs)
     size = path.stat().st_size
     if json_output:
         print_json({"report": str(path), "bytes": size, "runs": [str(r) for r in runs]})

@@ -11,6 +11,7 @@ A single-axis model is the one-axis case: the plain single-axis columns, unchang
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -25,12 +26,13 @@ from hrgtc.compensate.compensator import (
     plausible_frequency_band,
 )
 from hrgtc.compensate.ranges import RangeReport
-from hrgtc.errors import RecordingError
+from hrgtc.errors import InputError, RecordingError
 from hrgtc.model import InstrumentModel, UnitModel, axis_suffix
 from hrgtc.recording import Recording, axis_names, axis_view
+from hrgtc.recording.axes import AXIS_PATTERN
 
 __all__ = ["InstrumentCompensator", "compensate_instrument_file",
-           "instrument_output_columns"]
+           "instrument_output_columns", "match_axes", "parse_axes", "recording_axes"]
 
 
 def instrument_output_columns(model: InstrumentModel) -> tuple[str, ...]:
@@ -54,11 +56,16 @@ class InstrumentCompensator:
         :func:`~hrgtc.compensate.compensator.plausible_frequency_band`): a sample
         outside is an error naming its column and row, as the reader does for a
         single-axis file. None: not checked here.
+    partial
+        The model's axes were chosen among the recording's (``--axes``): other axes of
+        the recording pass through. False: a recording axis the model lacks is an error.
     """
 
     def __init__(self, model: InstrumentModel | UnitModel, drift: str = "frequency",
                  engine: str = "fused", gaps: str = "ignore",
-                 bands_hz: dict[str, tuple[float, float]] | None = None) -> None:
+                 bands_hz: dict[str, tuple[float, float]] | None = None,
+                 partial: bool = False) -> None:
+        self.partial = partial
         if isinstance(model, UnitModel):
             model = InstrumentModel.single(model)
         self.model = model
@@ -83,6 +90,14 @@ class InstrumentCompensator:
                 f"(its axes: {', '.join(found) or 'none, a single-axis file'}); the model "
                 f"{self.model.unit!r} has axes {', '.join(self.axes)}"
             )
+        extra = [axis for axis in found if axis not in self.axes]
+        if extra and not self.partial:
+            where = f" of {chunk.source}" if chunk.source else ""
+            raise RecordingError(
+                f"the recording{where} has axes {', '.join(found)} but the model "
+                f"{self.model.unit!r} has {', '.join(self.axes)}: axis {', '.join(extra)} "
+                f"would be left uncompensated; pass --axes {','.join(self.axes)} to "
+                "compensate only those")
         added: dict[str, np.ndarray] = {}
         for axis, compensator in self.axes.items():
             view = axis_view(chunk, axis)
@@ -138,6 +153,102 @@ class InstrumentCompensator:
         return {axis or "-": c.ranges().to_dict() for axis, c in self.axes.items()}
 
 
+def recording_axes(path: str | os.PathLike[str],
+                   options: rec_io.ReadOptions | None = None) -> tuple[str, ...] | None:
+    """Axis names of a recording file as read with ``options`` (its column mapping); ()
+    for a single-axis file. Reads the file's column names only; None when the file cannot
+    be opened (reading it will say why)."""
+    from hrgtc.errors import HrgtcError
+    from hrgtc.recording.mapping import parse_columns
+
+    try:
+        with rec_io.open_source(path) as source:
+            names = list(source.names)
+        mapping = parse_columns((options or rec_io.ReadOptions()).columns)
+    except (HrgtcError, OSError, ValueError):
+        return None
+    return tuple(axis_names([*mapping, *(n for n in names if n not in mapping.values())]))
+
+
+def parse_axes(text: str | Sequence[str] | None) -> tuple[str, ...] | None:
+    """``"x,y"`` (the ``--axes`` option) -> ``("x", "y")``; None or empty: None."""
+    if text is None:
+        return None
+    items = text.split(",") if isinstance(text, str) else list(text)
+    names = tuple(a.strip() for a in items if a.strip())
+    bad = [a for a in names if not AXIS_PATTERN.fullmatch(a)]
+    if bad:
+        raise InputError(f"--axes {','.join(names)}: {bad[0]!r} is not an axis name (a letter, "
+                         "then letters or digits, as the column suffixes: --axes x,y)")
+    return names or None
+
+
+def match_axes(model: InstrumentModel, recording_axes: Sequence[str] | None,
+               axes: Sequence[str] | None = None, source: str = "",
+               model_source: str = "") -> InstrumentModel:
+    """The model's axes to apply to a recording with ``recording_axes``: all of each, or
+    those ``axes`` names.
+
+    A model and a recording must have the same axes: a recording axis the model lacks
+    would pass through uncompensated, a model axis the recording lacks has nothing to
+    compensate. Either is an error unless ``axes`` (``--axes``) says which to
+    compensate. A single-axis model applies to one axis of a multi-axis recording only
+    when ``axes`` names it (then it is that axis's model, its outputs suffixed).
+
+    Raises
+    ------
+    InputError
+        The axis sets differ and ``axes`` does not say which, or ``axes`` names an axis
+        the model or the recording lacks.
+    """
+    if recording_axes is None:  # the file cannot be opened: reading it will say why
+        return model
+    found = tuple(recording_axes)
+    named = tuple(a for a in model.names if a)
+    where = f"the recording {source}" if source else "the recording"
+    of_model = f"the model {model_source or repr(model.unit)}"
+    has = f"has axes {', '.join(found)}" if found else "is single-axis"
+    if axes:
+        axes = tuple(axes)
+        lacking = [a for a in axes if a not in found]
+        if lacking:
+            raise InputError(f"--axes {','.join(axes)}: {where} has no axis "
+                             f"{', '.join(lacking)} (it {has})")
+        if model.is_single_axis:
+            if len(axes) != 1:
+                raise InputError(f"--axes {','.join(axes)}: {of_model} is single-axis; name "
+                                 "the one recording axis to compensate with it")
+            return InstrumentModel({axes[0]: model.axes[""]}, model.unit,
+                                   dict(model.provenance), model.temperature_map)
+        unknown = [a for a in axes if a not in named]
+        if unknown:
+            raise InputError(f"--axes {','.join(axes)}: {of_model} has no axis "
+                             f"{', '.join(unknown)} (its axes: {', '.join(named)})")
+        return InstrumentModel({a: model.axes[a] for a in axes}, model.unit,
+                               dict(model.provenance), model.temperature_map)
+    if model.is_single_axis and not found:
+        return model
+    if model.is_single_axis:
+        raise InputError(f"{where} {has} and {of_model} is single-axis: pass --axes "
+                         f"{found[0]} (one of {', '.join(found)}) to compensate that axis with "
+                         "it, or use the instrument's multi-axis model")
+    if not found:
+        raise InputError(f"{where} is single-axis (freq_hz, rate_dph) and {of_model} has "
+                         f"axes {', '.join(named)}: compensate each axis's recording with a "
+                         "single-axis model, or name the columns by axis (rate_dph_x, ...)")
+    extra = [a for a in found if a not in named]
+    missing = [a for a in named if a not in found]
+    if extra or missing:
+        common = [a for a in named if a in found]
+        what = (f"axis {', '.join(extra)} of the recording would be left uncompensated"
+                if extra else f"the model's axis {', '.join(missing)} is not in the recording")
+        hint = (f"pass --axes {','.join(common)} to compensate only those" if common else
+                "is it another instrument's model?")
+        raise InputError(f"{where} {has} but {of_model} has axes {', '.join(named)}: {what}; "
+                         f"{hint}")
+    return model
+
+
 def compensate_instrument_file(
     source: str | os.PathLike[str],
     output: str | os.PathLike[str],
@@ -145,6 +256,7 @@ def compensate_instrument_file(
     *,
     drift: str = "frequency",
     read_options: rec_io.ReadOptions | None = None,
+    axes: Sequence[str] | None = None,
     **options: Any,
 ) -> CompensationSummary:
     """Compensate every axis of a recording file into a new file (bounded memory).
@@ -154,19 +266,25 @@ def compensate_instrument_file(
     plausible band. A single-axis model is compensated exactly as by
     ``compensate_file``. The model's temperature map (a raw count's map to °C from
     ``calibrate --temp-ref``) is applied unless ``read_options`` give their own
-    scale and offset.
+    scale and offset. The model's and the recording's axes must agree unless ``axes``
+    names those to compensate (:func:`match_axes`).
     """
     from hrgtc.thermometry.reference import options_with_map
 
     read_options = options_with_map(read_options, model.temperature_map)
+    reading = read_options or rec_io.ReadOptions()
+    for unit in model.axes.values():  # before reading: a model of the other thermometer kind
+        check_thermometer_kind(reading, unit)
+    found = recording_axes(source, reading)
+    partial = bool(axes)
+    if found is not None:
+        model = match_axes(model, found, axes, str(source))
     if model.is_single_axis:
         return compensate_file(source, output, model.axes[""], drift=drift,
                                read_options=read_options, **options)
-    reading = read_options or rec_io.ReadOptions()
-    for unit in model.axes.values():
-        check_thermometer_kind(reading, unit)
     compensator = InstrumentCompensator(
         model, drift, gaps=reading.gaps,
-        bands_hz={axis: plausible_frequency_band(unit) for axis, unit in model.axes.items()})
+        bands_hz={axis: plausible_frequency_band(unit) for axis, unit in model.axes.items()},
+        partial=partial)
     return compensate_file(source, output, model, drift=drift,  # type: ignore[arg-type]
                            read_options=reading, compensator=compensator, **options)
