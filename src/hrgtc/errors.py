@@ -6,9 +6,39 @@ warning from :class:`HrgtcWarning`, so a caller can catch the whole family.
 
 from __future__ import annotations
 
+import re
+from typing import Any
+
+#: ``np.float64(1.5)``, ``np.int64(3)``, ``np.str_('x')``, ``np.True_``: the repr of numpy
+#: scalars (numpy >= 2), which an f-string's ``!r`` puts into a message.
+_NUMPY_REPR = re.compile(r"\bnp\.(?:float|int|uint|complex|bool|str|bytes)\w*\(([^()]*)\)")
+_NUMPY_BOOL = re.compile(r"\bnp\.(True|False)_")
+
+
+def plain(message: str) -> str:
+    """``message`` with every numpy scalar repr (``np.float64(1.5)``) as the number (``1.5``).
+
+    Examples
+    --------
+    >>> plain("row 3: np.float64(4417.5) Hz, np.int64(2) rows, np.True_")
+    'row 3: 4417.5 Hz, 2 rows, True'
+    """
+    return _NUMPY_BOOL.sub(r"\1", _NUMPY_REPR.sub(r"\1", message))
+
+
+def _cleaned(args: tuple[Any, ...]) -> tuple[Any, ...]:
+    return tuple(plain(a) if isinstance(a, str) else a for a in args)
+
 
 class HrgtcError(Exception):
-    """Base class of all errors raised by hrgtc."""
+    """Base class of all errors raised by hrgtc.
+
+    Its message never shows numpy's scalar repr: ``np.float64(4417.5)`` in an f-string's
+    ``!r`` reads ``4417.5`` (:func:`plain`), for every error of the package at once.
+    """
+
+    def __init__(self, *args: Any) -> None:
+        super().__init__(*_cleaned(args))
 
 
 class InputError(HrgtcError, ValueError):
@@ -36,7 +66,10 @@ class OutputExistsError(HrgtcError, FileExistsError):
 
 
 class HrgtcWarning(UserWarning):
-    """Base class of all warnings issued by hrgtc."""
+    """Base class of all warnings issued by hrgtc (messages cleaned as :class:`HrgtcError`'s)."""
+
+    def __init__(self, *args: Any) -> None:
+        super().__init__(*_cleaned(args))
 
 
 class ExtrapolationWarning(HrgtcWarning):

@@ -118,9 +118,9 @@ class InstrumentCompensator:
             row = self._rows + int(bad[0])
             where = f"{view.source}: " if view.source else ""
             raise RecordingError(
-                f"{where}column freq_hz_{axis}, row {row}: {freq[bad[0]]!r} Hz is outside the "
-                f"band {band[0]:.6g}-{band[1]:.6g} Hz this axis can reach ({bad.size} such rows "
-                "in this chunk); is it another unit's file, or the wrong column?"
+                f"{where}column freq_hz_{axis}, row {row}: {float(freq[bad[0]])!r} Hz is outside "
+                f"the band {band[0]:.6g}-{band[1]:.6g} Hz this axis can reach ({bad.size} such "
+                "rows in this chunk); is it another unit's file, or the wrong column?"
             )
 
     # -- what :func:`compensate_file` and the CLI report ----------------------------
