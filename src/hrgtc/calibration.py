@@ -28,6 +28,7 @@ import numpy as np
 from hrgtc import drift as drift_model
 from hrgtc.drift.features import AUX_NAME, EQ21, parse_terms
 from hrgtc.drift.rest import run_rest
+from hrgtc.drift.training import TrainingStatistics
 from hrgtc.errors import CalibrationError, ExtrapolationWarning, HrgtcWarning, InputError
 from hrgtc.evaluation import Evaluation, evaluate
 from hrgtc.model import UnitModel, provenance
@@ -285,6 +286,7 @@ def calibrate(
         drift=model,
         housing=housing,
         unit=unit,
+        training=TrainingStatistics.from_runs(training_heads),
         plateaus=tuple(p.to_dict() for p in plateaus),
         provenance=provenance(
             {"soak": [str(p) for p in soaks], "drift": [str(p) for p in drifts],
@@ -356,6 +358,7 @@ def _calibrate_sensor(soaks: Sequence[PathLike], drifts: Sequence[PathLike],
     unit_model = UnitModel(
         thermometer=thermometer, drift=model, housing=housing,
         unit=heads[str(drifts[0])].metadata.unit,
+        training=TrainingStatistics.from_runs([heads[str(p)] for p in training]),
         provenance=provenance(
             {"soak": [str(p) for p in soaks], "drift": [str(p) for p in drifts],
              "validate": [str(p) for p in validate]},

@@ -26,6 +26,7 @@ from typing import Any
 
 from hrgtc.drift import DriftModel
 from hrgtc.drift.scale_factor import ScaleFactorModel
+from hrgtc.drift.training import TrainingStatistics
 from hrgtc.errors import HrgtcError, ModelFileError
 from hrgtc.files import file_sha256, write_text_atomic
 from hrgtc.model_schema import (
@@ -69,6 +70,9 @@ class UnitModel:
     scale_factor
         Scale-factor error against frequency from rate-table runs (None: not
         calibrated; compensation then removes the bias only).
+    training
+        Statistics of the training data (rate noise and level, sample rate) that a
+        recording is checked against for unit mistakes (None: an older model file).
     """
 
     thermometer: Thermometer
@@ -78,6 +82,7 @@ class UnitModel:
     plateaus: tuple[dict[str, Any], ...] = ()
     provenance: dict[str, Any] = field(default_factory=dict)
     scale_factor: ScaleFactorModel | None = None
+    training: TrainingStatistics | None = None
 
     def parts(self) -> dict[str, Any]:
         """The axis's parts of the model file (thermometer, drift, housing, ...)."""
@@ -89,6 +94,8 @@ class UnitModel:
         }
         if self.scale_factor is not None:
             parts["scale_factor"] = self.scale_factor.to_dict()
+        if self.training is not None:  # written only when known: older files hash alike
+            parts["training"] = self.training.to_dict()
         return parts
 
     def to_dict(self) -> dict[str, Any]:
@@ -108,6 +115,7 @@ class UnitModel:
         """One axis from its checked parts (see :func:`model_schema.check_document`)."""
         housing = data.get("housing")
         scale_factor = data.get("scale_factor")
+        training = data.get("training")
         return cls(
             thermometer=Thermometer.from_dict(data["thermometer"]),
             drift=DriftModel.from_dict(data["drift"]),
@@ -116,6 +124,7 @@ class UnitModel:
             plateaus=tuple(data.get("plateaus", ())),
             provenance=dict(provenance),
             scale_factor=None if scale_factor is None else ScaleFactorModel.from_dict(scale_factor),
+            training=None if training is None else TrainingStatistics.from_dict(training),
         )
 
     @classmethod

@@ -137,6 +137,20 @@ def _scale_factor_schema() -> dict[str, Any]:
     return SCALE_FACTOR_JSON_SCHEMA
 
 
+#: Statistics of the training data (:class:`hrgtc.drift.training.TrainingStatistics`);
+#: optional (files written before it still load; the noise check is then skipped).
+_TRAINING = {
+    "type": "object",
+    "required": ["sample_rate_hz", "rate_noise_dph", "rate_level_dph", "samples", "runs"],
+    "properties": {
+        "sample_rate_hz": _POSITIVE,
+        "rate_noise_dph": {"type": "number", "minimum": 0},
+        "rate_level_dph": _FINITE,
+        "samples": {"type": "integer", "minimum": 0},
+        "runs": {"type": "integer", "minimum": 0},
+    },
+}
+
 #: What one axis holds: the parts of a single-axis model file.
 _AXIS_PARTS = {
     "thermometer": _THERMOMETER,
@@ -144,6 +158,7 @@ _AXIS_PARTS = {
     "housing": {"anyOf": [{"type": "null"}, _DRIFT]},
     "scale_factor": {"anyOf": [{"type": "null"}, _scale_factor_schema()]},
     "plateaus": {"type": "array", "items": {"type": "object"}},
+    "training": {"anyOf": [{"type": "null"}, _TRAINING]},
 }
 
 #: JSON Schema (Draft 2020-12) of the model file, versions 1 to 3. A single-axis file

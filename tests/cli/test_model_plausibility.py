@@ -251,3 +251,58 @@ def test_a_model_with_more_axes_than_the_recording(axis_files, tmp_path):
     code, _, stderr = invoke("compensate", xyz, "-m", xyzw, "-o", tmp_path / "o.parquet",
                              "--axes", "x,y,z")
     assert code == 0, stderr
+
+
+# -- the recording's noise against the training data's (Deliver 2) ------------------------------
+@pytest.fixture(scope="module")
+def checked_model(tmp_path_factory):
+    """make_model() with the statistics of its training run, as calibrate records them."""
+    import dataclasses
+
+    from hrgtc.drift.training import TrainingStatistics
+
+    from synthetic import ramp_run
+
+    model = dataclasses.replace(make_model(), training=TrainingStatistics.from_runs(
+        [ramp_run(seed=11, hours=3.0)]))
+    return save_model(model, tmp_path_factory.mktemp("checked") / "checked.json")
+
+
+@pytest.mark.parametrize("command", ["compensate", "evaluate", "report"])
+def test_rate_unit_dps_on_degrees_per_hour_is_refused(checked_model, tmp_path, command):
+    """The issue's case: --rate-unit dps on °/h data (every value × 3600) passed validation
+    and was compensated (exit 0)."""
+    run_path = write(make_run(rows=3000), tmp_path / "run.csv")
+    args = [*COMMANDS[command](run_path, checked_model, tmp_path), "--rate-unit", "dps"]
+    code, stdout, stderr = invoke(*args)
+    message = squash(stderr)
+    assert code == 2, (stdout, stderr)
+    assert "run.csv: column 'rate_dph': its noise" in message
+    assert "near the unit factor 3600" in message and "--rate-unit dps on a rate in °/h" in \
+        message
+    assert not (tmp_path / "out.parquet").exists()
+
+
+@pytest.mark.parametrize("offset_dph", [360_000.0, 14_400.0])
+def test_a_rate_table_run_and_a_biased_mems_file_are_accepted(checked_model, tmp_path,
+                                                              offset_dph):
+    """100 °/s on a rate table, or a 4 °/s offset, against a model trained at rest: another
+    level, the same noise."""
+    run = make_run(rows=3000)
+    run_path = write(run.with_columns(rate_dph=run.rate_dph + offset_dph),
+                     tmp_path / "level.parquet")
+    code, _, stderr = invoke("compensate", run_path, "-m", checked_model, "-o",
+                                  tmp_path / "out.parquet", "--json")
+    assert code == 0, stderr
+    assert "note:" not in stderr  # the model has statistics: the check ran
+    code, _, stderr = invoke("evaluate", run_path, "-m", checked_model, "--json")
+    assert code == 0, stderr
+
+
+def test_an_older_model_without_statistics_loads_and_says_so_once(files, tmp_path):
+    _, model_path, run_path = files
+    assert "training" not in json.loads(model_path.read_text())
+    code, _, stderr = invoke("compensate", run_path, "-m", model_path, "-o",
+                             tmp_path / "out.parquet", "--json")
+    assert code == 0, stderr
+    assert squash(stderr).count("has no statistics of its training data") == 1

@@ -246,6 +246,9 @@ def test_params_export_of_every_model_the_demo_writes(paper_campaign, imu_campai
     paths = [save_model(unit, tmp_path / "paper-unit.json"),
              save_instrument(instrument, tmp_path / "imu-3.json")]
     used = set(unit.drift.variables).union(*(a.drift.variables for a in instrument.axes.values()))
+    # calibration records its training data's statistics, per axis (issue 21, Deliver 2)
+    for model in (unit, *instrument.axes.values()):
+        assert model.training is not None and model.training.rate_noise_dph > 0.0
     assert "g" in used  # the housing gradient the demo's runs give: the variable that crashed
     for path in paths:
         done = CliRunner().invoke(app, ["export-c", str(path), "-o", str(tmp_path / path.stem),

@@ -33,6 +33,16 @@ if TYPE_CHECKING:
     from hrgtc.recording import ReadOptions
 
 
+def note_unchecked(model: InstrumentModel, model_path: Path) -> None:
+    """Say once, on stderr, that an older model file has no training statistics, so the
+    recording's rate unit is not checked against them."""
+    if any(unit.training is None for unit in model.axes.values()):
+        error_console.print(
+            f"note: {model_path} has no statistics of its training data (written by an older "
+            "hrgtc): the recording's rate noise is not checked against them for a unit "
+            "mistake; recalibrate to have it checked", soft_wrap=True)
+
+
 def warn_ranges(reports: list[RangeReport | None], json_output: bool, strict: bool,
                 labels: list[str] | None = None) -> None:
     """Print the range warnings (on stderr beside --json); with ``strict`` exit 3 if any.

@@ -39,6 +39,7 @@ def report_command(
 
     Example: hrgtc report --model unit.json cooldown.parquet warmup.parquet -o report.html
     """
+    from hrgtc.cli.compensate_cmd import note_unchecked
     from hrgtc.compensate.compensator import check_thermometer_kind
     from hrgtc.compensate.instrument import match_axes, parse_axes, recording_axes
     from hrgtc.files import check_writable, refuse_existing
@@ -54,6 +55,7 @@ def report_command(
         refuse_existing(output, force)
         check_writable(output, 20e6)  # before the passes over the runs
         loaded = load_instrument(model)
+        note_unchecked(loaded, model)
         for unit_model in loaded.axes.values():  # before reading the recordings' axes
             check_thermometer_kind(inputs or ReadOptions(), unit_model)
         chosen = parse_axes(axes)

@@ -433,6 +433,7 @@ def compensate_file(
         first = next(chunks)
         copies = sensor_copies((*first.names, *added), first.metadata)
         names = tuple(n for n in (*first.names, *added) if n not in copies)
+        check_recording_noise(model, first, str(source))
         total = rec_io.count_rows(source)
         metadata = compensated_metadata(first.metadata, model, drift)
         with rec_io.RecordingWriter(output, metadata, names, force=force) as writer, \
@@ -461,6 +462,28 @@ def compensate_file(
     return CompensationSummary(str(source), str(output), compensator.samples,
                                compensator.out_of_range_fraction,
                                compensator.rate_out_of_range_fraction, compensator.ranges())
+
+
+def check_recording_noise(model: Any, chunk: Recording, source: str = "") -> None:
+    """Refuse a recording whose rate noise is a unit factor off the model's training data
+    (:func:`hrgtc.drift.training.check_noise`), every axis of an instrument's.
+
+    ``model`` is a :class:`UnitModel` or an :class:`~hrgtc.model.InstrumentModel`; axes
+    the chunk lacks are left to the compensator's own error.
+    """
+    from hrgtc.drift.training import check_noise
+    from hrgtc.recording import axis_names, axis_view
+
+    axes = getattr(model, "axes", None)
+    units = {"": model} if axes is None else dict(axes)
+    found = axis_names(chunk.names)
+    fs = chunk.metadata.sample_rate_hz
+    for axis, unit in units.items():
+        if axis and axis in found:
+            view = axis_view(chunk, axis)
+            check_noise(unit.training, view.rate_dph, fs, source, f"rate_dph_{axis}")
+        elif not axis and "rate_dph" in chunk:
+            check_noise(unit.training, chunk.rate_dph, fs, source)
 
 
 #: Frequencies farther than this beyond the calibrated span are errors, not extrapolation. [°C]

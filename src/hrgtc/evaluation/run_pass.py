@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from hrgtc.compensate import Compensator
-from hrgtc.compensate.compensator import with_model_band
+from hrgtc.compensate.compensator import check_recording_noise, with_model_band
 from hrgtc.compensate.ranges import RangeReport
 from hrgtc.drift.features import FeatureStream, settle_rows
 from hrgtc.drift.rest import run_rest
@@ -626,12 +626,14 @@ def evaluate(
         if found is not None:
             raise RecordingError(f"{run.source or 'recording'} is already compensated, by "
                                  f"{describe_mark(found)}; evaluate the original recording")
+        check_recording_noise(model, run, run.source or "")
         rows = len(run)
         name, source, chunks = Path(run.source or "recording").name, run.source or "", [run]
         fs = run.sample_rate_hz
     else:
         options = with_model_band(read_options or ReadOptions(), model)
         refuse_compensated(run)
+        check_recording_noise(model, options.head(run), str(run))
         rows = count_rows(run)  # cheap (metadata, or a scan of a CSV's bytes); plans the pass
         name, source, chunks = Path(run).name, str(run), options.chunks(run)
         fs = None

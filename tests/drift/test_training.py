@@ -1,0 +1,90 @@
+"""Tests of hrgtc.drift.training: training statistics and the noise check of recordings.
+
+Issue 21, Deliver 2: a wrong unit that makes values larger (``--rate-unit dps`` on °/h
+data) passed every check. Truth: the simulator's white noise (2 °/h per sample at
+10 Hz: differences of std 2√2, MAD 0.6745·2√2 = 1.908 °/h), and unit factors applied
+here by hand.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from hrgtc.drift.training import (
+    UNIT_FACTORS,
+    TrainingStatistics,
+    check_noise,
+    rate_noise_dph,
+    unit_mistake,
+)
+from hrgtc.errors import InputError
+
+from synthetic import ramp_run
+
+EXPECTED_MAD = 0.6745 * 2.0 * math.sqrt(2.0)  # white noise 2 °/h: MAD of differences
+
+
+@pytest.fixture(scope="module")
+def statistics():
+    return TrainingStatistics.from_runs([ramp_run(seed=11, hours=1.0),
+                                         ramp_run(seed=12, hours=1.0)])
+
+
+def test_the_noise_of_the_training_runs_is_the_simulated_one(statistics):
+    assert statistics.rate_noise_dph == pytest.approx(EXPECTED_MAD, rel=0.03)
+    assert statistics.sample_rate_hz == 10.0 and statistics.runs == 2
+    # the slow drift (a ramp of several °/h in bias) does not enter the differences
+    assert statistics.rate_level_dph == pytest.approx(10.0 + 1.5, abs=30.0)
+    back = TrainingStatistics.from_dict(statistics.to_dict())
+    assert back == statistics
+
+
+@pytest.mark.parametrize("factor", [f for f, _, _ in UNIT_FACTORS])
+@pytest.mark.parametrize("direction", [1, -1])
+def test_unit_factors_either_way_are_refused_naming_the_mistake(statistics, factor,
+                                                                direction):
+    run = ramp_run(seed=3, start_c=5.0, end_c=0.0, hours=0.3)
+    scaled = run.rate_dph * factor ** direction
+    with pytest.raises(InputError) as raised:
+        check_noise(statistics, scaled, 10.0, "run.csv")
+    message = str(raised.value)
+    assert message.startswith("run.csv: column 'rate_dph': its noise")
+    _, larger, smaller = next(u for u in UNIT_FACTORS if u[0] == factor)
+    assert (larger if direction == 1 else smaller) in message
+    assert "np." not in message
+
+
+def test_the_dps_mistake_of_the_issue_names_the_option(statistics):
+    """`--rate-unit dps` on °/h data: every value × 3600 (bias stability 1.169 -> 4208)."""
+    run = ramp_run(seed=3, start_c=5.0, end_c=0.0, hours=0.3)
+    with pytest.raises(InputError, match=r"3600.*--rate-unit dps on a rate in °/h"):
+        check_noise(statistics, run.rate_dph * 3600.0, 10.0)
+
+
+@pytest.mark.parametrize("level_dph", [360_000.0, 14_400.0, -14_400.0])
+def test_another_level_is_accepted(statistics, level_dph):
+    """A 100 °/s rate-table run and a MEMS file with a ±4 °/s offset: same noise."""
+    run = ramp_run(seed=4, start_c=5.0, end_c=0.0, hours=0.3)
+    ratio = check_noise(statistics, run.rate_dph + level_dph, 10.0)
+    assert ratio == pytest.approx(1.0, rel=0.1)
+
+
+def test_noise_is_compared_at_the_training_rate(statistics):
+    """White noise of the same density at 40 Hz has twice the per-sample noise: scaled by
+    √(10/40) it is the training noise."""
+    rng = np.random.default_rng(5)
+    density = 2.0 / math.sqrt(10.0)  # the training noise's σ/√fs
+    rate = rng.normal(0.0, density * math.sqrt(40.0), 200_000)
+    assert rate_noise_dph(rate) == pytest.approx(2.0 * EXPECTED_MAD, rel=0.03)
+    assert statistics.noise_ratio(rate, 40.0) == pytest.approx(1.0, rel=0.05)
+
+
+def test_no_statistics_or_a_quantised_rate_is_not_compared(statistics):
+    assert math.isnan(check_noise(None, np.arange(100.0), 10.0))
+    steps = np.repeat(np.arange(50.0), 20)  # mostly equal neighbours: MAD 0
+    assert math.isnan(check_noise(statistics, steps, 10.0))
+    assert unit_mistake(1.0) is None and unit_mistake(5.0) is None
+    assert unit_mistake(math.nan) is None
