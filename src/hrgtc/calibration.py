@@ -28,7 +28,11 @@ import numpy as np
 from hrgtc import drift as drift_model
 from hrgtc.drift.features import AUX_NAME, EQ21, parse_terms
 from hrgtc.drift.rest import run_rest
-from hrgtc.drift.training import TrainingStatistics
+from hrgtc.drift.training import (
+    TrainingStatistics,
+    check_resonator_gyro,
+    implausible_for_any_gyro,
+)
 from hrgtc.errors import CalibrationError, ExtrapolationWarning, HrgtcWarning, InputError
 from hrgtc.evaluation import Evaluation, evaluate
 from hrgtc.model import UnitModel, provenance
@@ -220,6 +224,11 @@ def calibrate(
         raise InputError("no soak recordings given; pass --soak FILE for each soak "
                          "(a gyro without a frequency output: --thermometer sensor)")
 
+    heads = {str(path): options.head(path) for path in drifts}
+    for path in drifts:  # an HRG: a noise or bias only a MEMS gyro has is a unit mistake
+        head = heads[str(path)]
+        check_resonator_gyro(head.rate_dph, head.metadata.sample_rate_hz,
+                             head.metadata.input_rate_dph or 0.0, str(path))
     plateaus: list[Plateau] = []
     soak_rates: list[float] = []
     for number, path in enumerate(soaks):
@@ -249,7 +258,7 @@ def calibrate(
         for t, f, e in zip(temperatures, frequencies, from_freq, strict=True)
     )
 
-    heads = {str(path): options.head(path) for path in (*drifts, *soaks)}
+    heads.update({str(path): options.head(path) for path in soaks if str(path) not in heads})
     drift_rate = heads[str(drifts[0])].metadata.sample_rate_hz
     extra = [p for p, r in zip(soaks, soak_rates, strict=True) if math.isclose(r, drift_rate)]
     if drift_from_soaks and len(extra) < len(soaks):
@@ -349,6 +358,11 @@ def _calibrate_sensor(soaks: Sequence[PathLike], drifts: Sequence[PathLike],
                 high = max(high, float(np.max(used)))
     thermometer = identity((low, high))
     heads = {str(path): options.head(path) for path in training}
+    for path in drifts:  # any gyro: only a density beyond every gyro's can be told
+        head = heads[str(path)]
+        message = implausible_for_any_gyro(head.rate_dph, head.metadata.sample_rate_hz)
+        if message is not None:
+            warnings.warn(f"{path}: column 'rate_dph': {message}", HrgtcWarning, stacklevel=3)
     fit["terms"] = resolve_terms(fit["terms"], fit.get("aux_columns"),
                                  [heads[str(p)] for p in training])
     model, housing = _fit_drift(training, heads, thermometer, options, progress, len(drifts),

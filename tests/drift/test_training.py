@@ -88,3 +88,47 @@ def test_no_statistics_or_a_quantised_rate_is_not_compared(statistics):
     assert math.isnan(check_noise(statistics, steps, 10.0))
     assert unit_mistake(1.0) is None and unit_mistake(5.0) is None
     assert unit_mistake(math.nan) is None
+
+
+# -- calibrate, where there is no model ------------------------------------------------------
+def test_an_hrg_with_mems_noise_is_refused_naming_the_unit():
+    from hrgtc.drift.training import check_resonator_gyro
+
+    run = ramp_run(seed=3, start_c=5.0, end_c=0.0, hours=0.3)
+    check_resonator_gyro(run.rate_dph, 10.0, 10.0, "run.csv")  # a plausible HRG: no error
+    with pytest.raises(InputError) as raised:
+        check_resonator_gyro(run.rate_dph * 3600.0, 10.0, 10.0, "run.csv")
+    message = str(raised.value)
+    assert message.startswith("run.csv: column 'rate_dph': a noise density of")
+    assert "only a MEMS gyro could have" in message
+    assert "--rate-unit dps on a rate in °/h) (values × 3600)" in message
+    # a bias of 4 °/s at rest: a MEMS bias
+    with pytest.raises(InputError, match=r"a bias of 1\.44\d*e\+04 °/h at rest"):
+        check_resonator_gyro(run.rate_dph + 14_400.0, 10.0, 10.0)
+
+
+def test_a_noise_density_beyond_any_gyro_is_warned_about():
+    from hrgtc.drift.training import implausible_for_any_gyro, noise_density
+
+    run = ramp_run(seed=3, start_c=5.0, end_c=0.0, hours=0.3)
+    # the simulated 2 °/h per sample at 10 Hz: 0.63 °/h/√Hz
+    assert noise_density(run.rate_dph, 10.0) == pytest.approx(2.0 / math.sqrt(10.0), rel=0.05)
+    assert implausible_for_any_gyro(run.rate_dph, 10.0) is None
+    # a MEMS-like 36 °/h/√Hz read ×3600 (°/h data as dps) is beyond every gyro ...
+    rng = np.random.default_rng(1)
+    mems = rng.normal(0.0, 36.0 * math.sqrt(10.0), 20_000)
+    assert implausible_for_any_gyro(mems, 10.0) is None
+    assert "above the noisiest gyro's" in implausible_for_any_gyro(mems * 3600.0, 10.0)
+    # ... but ÷3600 (dps data read as °/h) looks like a good HRG: it cannot be told
+    assert implausible_for_any_gyro(mems / 3600.0, 10.0) is None
+
+
+def test_calibrate_refuses_rate_unit_dps_on_an_hrg(paper_campaign):
+    """The issue's case: calibrate fitted a model on °/h data read with --rate-unit dps."""
+    from hrgtc.calibration import calibrate
+    from hrgtc.recording import ReadOptions
+
+    files = paper_campaign
+    with pytest.raises(InputError, match=r"cooldown.*only a MEMS gyro.*--rate-unit dps"):
+        calibrate(files.soaks[:3], [files.cooldown],
+                  read_options=ReadOptions(units={"rate": "dps"}))

@@ -169,3 +169,86 @@ def check_noise(statistics: TrainingStatistics | None, rate_dph: Any, sample_rat
         f"({statistics.rate_noise_dph:.4g} °/h at {statistics.sample_rate_hz:g} Hz), near the "
         f"unit factor {factor:.6g}: likely {mistake}; check --rate-unit (the level of a "
         "rate-table or biased run may differ, its noise may not)")
+
+
+# -- without a model: the sensor class (calibrate) ------------------------------------------
+#: Angle random walk of 1 °/√h (60 °/h/√Hz): beyond any HRG (navigation and tactical HRGs
+#: have 0.0002-0.05 °/√h), typical of a MEMS gyro. [°/h/√Hz]
+HRG_MAX_NOISE_DENSITY = 60.0
+#: A bias of 1 °/s at rest: beyond any HRG (a few °/h at most), common in MEMS gyros. [°/h]
+HRG_MAX_BIAS_DPH = 3600.0
+#: Noise densities of any gyro, from the best HRG/FOG (ARW 1e-4 °/√h = 0.006 °/h/√Hz) to the
+#: noisiest MEMS (1 °/s/√Hz). [°/h/√Hz]
+ANY_GYRO_NOISE_DENSITY = (1e-3, 3600.0)
+#: MAD of the differences of white noise of σ = 1: 0.6745·√2.
+_MAD_PER_SIGMA = 0.6744897501960817 * math.sqrt(2.0)
+
+
+def noise_density(rate_dph: Any, sample_rate_hz: float) -> float:
+    """White-noise density of a rate from the MAD of its differences. [°/h/√Hz]
+
+    σ per sample = MAD / (0.6745·√2); density = σ / √fs (= ARW × 60 in °/√h).
+    """
+    return rate_noise_dph(rate_dph) / _MAD_PER_SIGMA / math.sqrt(sample_rate_hz)
+
+
+def _likely_unit(density: float, bias_dph: float) -> str:
+    """The unit factor that brings an HRG-implausible rate closest to a typical HRG."""
+    best = None
+    for factor, larger, _ in UNIT_FACTORS:
+        scaled = density / factor
+        if scaled <= HRG_MAX_NOISE_DENSITY and abs(bias_dph) / factor <= HRG_MAX_BIAS_DPH:
+            distance = abs(math.log(max(scaled, 1e-12) / 0.3))  # a typical HRG: 0.3 °/h/√Hz
+            if best is None or distance < best[0]:
+                best = (distance, factor, larger)
+    if best is None:
+        return "a rate in another unit or another gyro's column"
+    return f"{best[2]} (values × {best[1]:.6g})"
+
+
+def check_resonator_gyro(rate_dph: Any, sample_rate_hz: float, input_rate_dph: float = 0.0,
+                         source: str = "", column: str = "rate_dph") -> None:
+    """Refuse the training data of an HRG (resonator thermometer) whose noise or bias only a
+    MEMS gyro could have: a unit mistake that makes values larger (``--rate-unit dps`` on
+    °/h data makes the bias stability 4208 instead of 1.2 °/h).
+
+    Raises
+    ------
+    InputError
+        Names the file, the column, the figures and the likely unit.
+    """
+    rate = np.asarray(rate_dph, dtype=np.float64)
+    density = noise_density(rate, sample_rate_hz)
+    finite = rate[np.isfinite(rate)]
+    bias = float(np.median(finite)) - input_rate_dph if finite.size else math.nan
+    noisy = density > HRG_MAX_NOISE_DENSITY
+    biased = abs(bias) > HRG_MAX_BIAS_DPH
+    if not (noisy or biased):
+        return
+    where = f"{source}: " if source else ""
+    what = " and ".join(
+        [f"a noise density of {density:.4g} °/h/√Hz (angle random walk {density / 60.0:.3g} "
+         f"°/√h; an HRG has at most {HRG_MAX_NOISE_DENSITY / 60.0:g})"] * noisy
+        + [f"a bias of {bias:.4g} °/h at rest (an HRG has at most {HRG_MAX_BIAS_DPH:g})"]
+        * biased)
+    raise InputError(
+        f"{where}column {column!r}: {what}: only a MEMS gyro could have that, and this unit "
+        f"is calibrated with its resonator as thermometer (an HRG). Likely "
+        f"{_likely_unit(density, bias)}: check --rate-unit; for a MEMS gyro use "
+        "--thermometer sensor")
+
+
+def implausible_for_any_gyro(rate_dph: Any, sample_rate_hz: float) -> str | None:
+    """A warning when a rate's noise density is outside what any gyro has (None: inside).
+
+    With a temperature sensor as thermometer (a MEMS gyro, most often) a unit that only
+    makes values larger cannot always be told from a noisier gyro: only densities beyond
+    every gyro are flagged.
+    """
+    density = noise_density(rate_dph, sample_rate_hz)
+    low, high = ANY_GYRO_NOISE_DENSITY
+    if not math.isfinite(density) or low <= density <= high or density == 0.0:
+        return None
+    side = "above the noisiest" if density > high else "below the quietest"
+    return (f"the rate's noise density {density:.4g} °/h/√Hz is {side} gyro's ({low:g} to "
+            f"{high:g} °/h/√Hz): check --rate-unit (°/h, °/s, rad/s)")
