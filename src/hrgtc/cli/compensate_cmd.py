@@ -34,12 +34,12 @@ if TYPE_CHECKING:
 
 
 def note_unchecked(model: InstrumentModel, model_path: Path) -> None:
-    """Say once, on stderr, that an older model file has no training statistics, so the
-    recording's rate unit is not checked against them."""
+    """Say once, on stderr after the work, that an older model file has no training
+    statistics, so the recording's rate unit was not checked against them."""
     if any(unit.training is None for unit in model.axes.values()):
         error_console.print(
             f"note: {model_path} has no statistics of its training data (written by an older "
-            "hrgtc): the recording's rate noise is not checked against them for a unit "
+            "hrgtc): the recording's rate noise was not checked against them for a unit "
             "mistake; recalibrate to have it checked", soft_wrap=True)
 
 
@@ -118,6 +118,7 @@ def compensate_command(
                   "training range") if summary.ranges is None else \
             f"beyond the trained ranges: {summary.ranges.shares_text()}"
         console.print(f"wrote {summary.output}: {summary.rows} rows; {shares}{axes}")
+    note_unchecked(model, model_path)
     warn_ranges([summary.ranges], json_output, strict)
 
 
@@ -263,6 +264,7 @@ def evaluate_command(
             for c in checks))
     elif checks:
         render_scale_checks(checks)
+    note_unchecked(model, model_path)
     warn_ranges([r.ranges for r in results.values()], json_output, strict, list(results))
 
 

@@ -55,7 +55,6 @@ def report_command(
         refuse_existing(output, force)
         check_writable(output, 20e6)  # before the passes over the runs
         loaded = load_instrument(model)
-        note_unchecked(loaded, model)
         for unit_model in loaded.axes.values():  # before reading the recordings' axes
             check_thermometer_kind(inputs or ReadOptions(), unit_model)
         chosen = parse_axes(axes)
@@ -65,6 +64,7 @@ def report_command(
         path = build_report(chosen_model, runs, output, soaks=soak or None, title=title,
                             force=force, max_points=max_points, progress=progress,
                             read_options=inputs)
+    note_unchecked(loaded, model)
     size = path.stat().st_size
     if json_output:
         print_json({"report": str(path), "bytes": size, "runs": [str(r) for r in runs]})

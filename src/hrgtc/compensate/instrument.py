@@ -142,7 +142,7 @@ class InstrumentCompensator:
     def ranges(self) -> RangeReport:
         """The range report of the axis that went farthest (single axis: its report)."""
         reports = [c.ranges() for c in self.axes.values()]
-        return max(reports, key=lambda r: r.temperature_fraction + r.rate_fraction)
+        return max(reports, key=lambda r: sum(r.shares().values()))
 
     def axis_ranges(self) -> dict[str, RangeReport]:
         """Each axis's range report."""
