@@ -179,7 +179,8 @@ def test_numbers_agree_with_hrgtc_evaluate(unit, report):
         for column, key in ((1, "raw"), (2, "compensated"), (4, "housing")):
             assert _number(row[column]) == pytest.approx(
                 result["bias_stability_dph"][key]["10"], rel=1e-3)
-        assert row[5] == f"{result['out_of_range_fraction']:.1%}"
+        # beyond the calibrated temperatures only (issue 21: the gradient g's share is its own)
+        assert row[5] == f"{result['ranges']['temperature_fraction']:.1%}"
     assert glance["paper [1], Section 4.2 (its cool-down)"][1:3] == ["3.0143", "0.5848"]
 
 

@@ -37,6 +37,7 @@ from hrgtc.report.html import (
     _table,
     _table_rows,
     _temperature,
+    _temperature_share,
     _thermometer,
 )
 from hrgtc.thermometry.plateaus import Plateau
@@ -213,7 +214,7 @@ def _instrument_summary(page: _Page, model: InstrumentModel,
             raw, comp = run.stability("raw", 10.0), run.stability("compensated", 10.0)
             rows.append((axis, run.name, _number(raw), _number(comp),
                          _number(raw / comp if raw is not None and comp else None, 3),
-                         f"{run.out_of_range_fraction:.1%}", scale,
+                         f"{_temperature_share(run):.1%}", scale,
                          _number(run.mean_dph.get("compensated")),
                          _number(run.rms_dph.get("compensated"))))
         if not runs:

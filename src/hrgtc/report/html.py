@@ -153,6 +153,11 @@ def _header(page: _Page, model: UnitModel, title: str, model_path: str | None) -
              '(Eq. 21–22)</a></li></ol></nav>')
 
 
+def _temperature_share(run: Evaluation) -> float:
+    """Share of the run beyond the calibrated temperatures (not other variables' ranges)."""
+    return run.out_of_range_fraction if run.ranges is None else run.ranges.temperature_fraction
+
+
 def _summary(page: _Page, runs: Sequence[Evaluation]) -> None:
     """The result at a glance: 10 s bias stability of each run beside the paper's."""
     if not runs:
@@ -161,7 +166,7 @@ def _summary(page: _Page, runs: Sequence[Evaluation]) -> None:
              _number(r.stability("compensated", 10.0)),
              _number(_ratio(r, 10.0), 3),
              _number(r.stability("housing", 10.0)),
-             f"{r.out_of_range_fraction:.1%}",
+             f"{_temperature_share(r):.1%}",
              _number(r.mean_dph.get("compensated")), _number(r.rms_dph.get("compensated")))
             for r in runs]
     rows.append(("paper [1], Section 4.2 (its cool-down)", _number(paper.BIAS_STABILITY_RAW_DPH,
@@ -335,12 +340,18 @@ def _run(page: _Page, k: int, run: Evaluation, model: UnitModel) -> None:
                         f"{run.confidence:.3g} chi-squared interval, (blocks − 1) degrees "
                         "of freedom" + (" (paper [1], Section 4.2: 3.0143 → 0.5848 °/h "
                                         "on its cool-down)" if hrg else "")))
-    facts = [*((f"{name} mean and RMS (the offset a bias stability does not show)",
-                f"{_number(run.mean_dph.get(name))} and {_number(run.rms_dph.get(name))} °/h")
-               for name in run.bias_stability_dph if name in run.mean_dph),
-             ("samples outside the calibrated range (f, T)", f"{run.out_of_range_fraction:.2%}"),
-             ("samples with df/dt outside its training range",
-              f"{run.rate_out_of_range_fraction:.2%}")]
+    facts = [(f"{name} mean and RMS (the offset a bias stability does not show)",
+              f"{_number(run.mean_dph.get(name))} and {_number(run.rms_dph.get(name))} °/h")
+             for name in run.bias_stability_dph if name in run.mean_dph]
+    if run.ranges is None:
+        facts += [("samples outside the calibrated range (f, T)",
+                   f"{run.out_of_range_fraction:.2%}"),
+                  ("samples with df/dt outside its training range",
+                   f"{run.rate_out_of_range_fraction:.2%}")]
+    else:  # one share per variable: a gradient beyond its range is not a temperature
+        facts += [(f"samples beyond the trained {name}" if name in ("temperature", "df/dt")
+                   else f"samples beyond the trained range of {name}", f"{share:.2%}")
+                  for name, share in run.ranges.shares().items()]
     if run.prediction_std_dph is not None:
         facts.append(("1σ of the drift model line (coefficient covariance), median / max "
                       "[°/h]", f"{_number(run.prediction_std_dph['median'])} / "
