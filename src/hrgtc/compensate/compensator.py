@@ -343,7 +343,8 @@ class Compensator:
 
     @property
     def out_of_range_fraction(self) -> float:
-        """Share of the samples so far outside the calibrated temperature ranges."""
+        """Share of the samples so far outside the calibrated temperature range or a level
+        variable's training range (f, h, g, a_NAME); :meth:`ranges` gives each apart."""
         return self.out_of_range / self.samples if self.samples else 0.0
 
     @property
