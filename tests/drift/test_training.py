@@ -132,3 +132,33 @@ def test_calibrate_refuses_rate_unit_dps_on_an_hrg(paper_campaign):
     with pytest.raises(InputError, match=r"cooldown.*only a MEMS gyro.*--rate-unit dps"):
         calibrate(files.soaks[:3], [files.cooldown],
                   read_options=ReadOptions(units={"rate": "dps"}))
+
+
+def test_the_pan_mems_recording_by_its_noise():
+    """Reality check on the real PAN recording (3-axis MEMS, rad/s, 50 Hz bursts): the
+    statistics of its rad/s reading accept the same reading, and refuse it read as °/s
+    (× 1/57.3), naming rad/s (read as °/h, the reader itself finds it too small). Its rate
+    is quantised (few distinct steps), which the MAD of differences survives."""
+    from pathlib import Path
+
+    from hrgtc.recording import ReadOptions
+
+    pan = Path(__file__).parents[1] / "data" / "pan-cold-test" / "pan_tvc_cold_2020-03-07.csv"
+    columns = {"time_s": "time (ms)", "rate_dph_x": "gyrox rad/s", "rate_dph_y": "gyroy rad/s",
+               "rate_dph_z": "gyroz rad/s", "temperature_c": "temp"}
+
+    def read_as(rate_unit):
+        options = ReadOptions(columns=columns, units={"time": "ms", "rate": rate_unit,
+                                                      "temp": "count"},
+                              temp_scale=0.00582219, temp_offset_c=24.1839,  # its map
+                              gaps="split", thermometer="sensor", axis="x")
+        return options.head(pan, rows=6000)
+
+    right = read_as("rad/s")
+    statistics = TrainingStatistics.from_runs([right])
+    assert statistics.rate_noise_dph > 0.0
+    fs = right.metadata.sample_rate_hz
+    assert check_noise(statistics, right.rate_dph, fs) == pytest.approx(1.0)
+    wrong = read_as("dps")
+    with pytest.raises(InputError, match=r"rad/s data read as °/s \(pass --rate-unit rad/s\)"):
+        check_noise(statistics, wrong.rate_dph, fs, "pan.csv", "rate_dph_x")
