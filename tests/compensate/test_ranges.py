@@ -37,10 +37,10 @@ def unit_model():
     return UnitModel(thermometer=THERMOMETER, drift=drift.fit([ramp_run(seed=1)], THERMOMETER))
 
 
-def hot_housing(model):
+def hot_housing(model, hours=1.5):
     """A run well inside the trained temperatures whose housing reads 4 °C above the gradient
     the model was trained on: only g leaves its range."""
-    run = lagged_run(seed=9, start_c=10.0, end_c=5.0, hours=1.5)
+    run = lagged_run(seed=9, start_c=10.0, end_c=5.0, hours=hours)
     high = model.drift.ranges["g"][1]
     return run.with_columns(housing_c=run["housing_c"] + high + 4.0)
 
@@ -74,13 +74,19 @@ def test_the_gradient_beyond_its_range_is_not_called_a_temperature(gradient_mode
     assert report.shares_text().endswith(f"g {gradient.fraction:.1%}")
 
 
-def test_the_engines_count_every_variable_alike(gradient_model):
-    run = hot_housing(gradient_model)
+@pytest.mark.parametrize("hours", [1.5, 8.0])
+def test_the_engines_count_every_variable_alike(gradient_model, hours):
+    """Two chunks (counts and extremes add up); at 8 h the second chunk is long enough for
+    the kernel to work its two halves on two threads (their counts are merged)."""
+    from hrgtc.compensate._kernel import PARALLEL_ROWS
+
+    run = hot_housing(gradient_model, hours)
+    assert (len(run) - 20_000 >= PARALLEL_ROWS) == (hours > 2)
     a, b = Compensator(gradient_model, engine="fused"), Compensator(gradient_model,
                                                                     engine="numpy")
     for c in (a, b):
         c.process(run.slice(0, 20_000))
-        c.process(run.slice(20_000, len(run)))  # two chunks: counts and extremes add up
+        c.process(run.slice(20_000, len(run)))
     assert a._plan is not None  # the kernel did run
     assert a.temperature_out == b.temperature_out
     for name, (outside, low, high) in b.variable_ranges.items():

@@ -60,6 +60,8 @@ def formula(key: str = "") -> list[str]:
         "      temperature of step 6, NaN where the inverse has no solution)",
         "     (for each NAME of <{k}aux_names>: a_NAME = aux_NAME - <{k}aux_centre_NAME>,",
         "      aux_NAME the logged channel <{k}aux_column_NAME> [its unit])",
+        "     (the keys of d2, g and a_NAME are written only when the terms use them: a",
+        "      missing uses_rate2, uses_gradient or aux_names means not used)",
         "  3. for each variable v in f, df, h, dh, d2, g, a_NAME that the terms use:",
         "       c_v = v held in [<{k}range_v_low>, <{k}range_v_high>];  x_v = c_v / <{k}scale_v>",
         "  4. B = <{k}intercept_dph> + sum over k = 1..<{k}n_terms> of",
