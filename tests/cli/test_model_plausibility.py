@@ -223,6 +223,8 @@ def test_axes_says_which_to_compensate(axis_files, tmp_path):
     assert np_equal and "rate_comp_dph_x" not in out
     code, _, stderr = invoke("evaluate", xyz, "-m", single, "--axes", "y", "--json")
     assert code == 0, stderr
+    code, _, stderr = invoke("report", xyz, "-m", xy, "--axes", "x,y", "-o", tmp_path / "r.html")
+    assert code == 0, stderr
 
 
 @pytest.mark.parametrize("axes, match", [
