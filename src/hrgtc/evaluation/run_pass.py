@@ -119,9 +119,8 @@ class Evaluation:
         SP 1065 gives one) and its noise terms (Allan deviations only), same keys (empty
         when not computed or when the series is too short; see ``notes``).
     out_of_range_fraction
-        Share of samples outside the calibrated temperature range or the training range
-        of any level variable (f, h, g, a_NAME): ``in_range`` 0 for that reason.
-        ``ranges`` gives each variable's own share.
+        Share outside the calibrated temperatures or a level variable's training range
+        (f, h, g, a_NAME); ``ranges`` gives each variable's own share.
     rate_out_of_range_fraction
         Share of samples whose df/dt (dh/dt, d2) is outside its training range.
     residual_rms_dph
