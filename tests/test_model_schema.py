@@ -210,3 +210,19 @@ def test_terms_beyond_any_gyro_bias_are_refused_naming_the_term(tmp_path, docume
     with pytest.raises(ModelFileError, match=rf"drift.scaled_coefficients\[{k}\]: term "
                                              rf"{re.escape(terms[k])} gives a bias of"):
         load_model(_write(tmp_path, document))
+
+
+def test_a_thermometer_beyond_any_hrg_frequency_is_refused(tmp_path, document):
+    """An absurd but consistent thermometer coefficient (its raw form derived from it, the
+    hash line removed): F(T) of 1e300 Hz is no resonator."""
+    from hrgtc.thermometry.thermometer import _scaled_to_raw_matrix
+
+    therm = document["thermometer"]
+    therm["scaled_coefficients"][1] = 1e300
+    matrix = _scaled_to_raw_matrix(therm["order"], therm["centre_c"], therm["scale_c"])
+    therm["coefficients"] = [float(sum(float(m) * a for m, a in
+                                       zip(row, therm["scaled_coefficients"], strict=True)))
+                             for row in matrix]
+    with pytest.raises(ModelFileError, match=r"thermometer.scaled_coefficients: F\(T\) over the "
+                                             r"calibrated .* outside any HRG's resonator"):
+        load_model(_write(tmp_path, document))

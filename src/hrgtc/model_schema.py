@@ -346,6 +346,7 @@ def _check_thermometer(therm: Mapping[str, Any], source: str, at: str = "") -> N
     if not low < high:
         raise _fail(source, f"{at}thermometer.temperature_range_c",
                     f"[{low!r}, {high!r}] is not an ordered range (low < high)")
+    _check_thermometer_bounds(therm, source, at)
     matrix = _scaled_to_raw_matrix(order, therm["centre_c"], therm["scale_c"])
     scaled = [Fraction(v) for v in therm["scaled_coefficients"]]
     for i, row in enumerate(matrix):
@@ -355,6 +356,28 @@ def _check_thermometer(therm: Mapping[str, Any], source: str, at: str = "") -> N
             raise _fail(source, f"{at}thermometer.coefficients[{i}]",
                         f"{therm['coefficients'][i]!r} disagrees with {derived!r} derived from "
                         "scaled_coefficients (the values used)")
+
+
+def _check_thermometer_bounds(therm: Mapping[str, Any], source: str, at: str) -> None:
+    """Refuse a thermometer whose F(T) over its calibrated range leaves what any HRG's
+    frequency (a temperature sensor's reading) can be: an absurd coefficient."""
+    import numpy as np
+
+    from hrgtc.recording.checks import FREQ_SAMPLE_RANGE_HZ, TEMPERATURE_RANGE_C
+
+    sensor = therm.get("source") == "sensor"
+    low_t, high_t = therm["temperature_range_c"]
+    u = (np.linspace(low_t, high_t, 33) - therm["centre_c"]) / therm["scale_c"]
+    with np.errstate(all="ignore"):
+        values = np.polynomial.polynomial.polyval(u, therm["scaled_coefficients"])
+    low, high = TEMPERATURE_RANGE_C if sensor else FREQ_SAMPLE_RANGE_HZ
+    worst = float(values[np.argmax(np.abs(values))]) if values.size else 0.0
+    if not (np.all(np.isfinite(values)) and low <= values.min() and values.max() <= high):
+        what = "a temperature sensor's reading" if sensor else "any HRG's resonator frequency"
+        unit = "°C" if sensor else "Hz"
+        raise _fail(source, f"{at}thermometer.scaled_coefficients",
+                    f"F(T) over the calibrated {low_t:g} to {high_t:g} °C reaches {worst:.6g} "
+                    f"{unit}, outside {what} ({low:g} to {high:g} {unit})")
 
 
 def derived_coefficients(drift: Mapping[str, Any]) -> dict[str, float]:
