@@ -1,0 +1,139 @@
+"""Accounting of samples: read, used, and dropped or flagged by reason.
+
+Nothing is dropped silently: every stage that leaves samples out (a warm-up skip,
+the edge of a gap, a partial window, a duplicate, a slice, a spike, motion, a value
+out of range) says so through one :class:`Accounting`, which every command reports
+in its plain output and its ``--json``. More than :data:`DROPPED_WARNING_FRACTION`
+of the samples dropped is a warning in the summary line.
+
+Adding a reason is one line in :data:`REASONS`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+from hrgtc.errors import InputError
+
+#: Reason -> how it reads in a report. One line per reason.
+REASONS: dict[str, str] = {
+    "warmup": "warm-up (df/dt filter settling)",
+    "gap_edges": "gap edges (filter restart after a gap)",
+    "partial_windows": "partial windows at segment ends",
+    "slicing": "outside --start/--end",
+    "duplicates": "duplicated rows",
+    "spikes": "spikes",
+    "motion": "motion (not at rest)",
+    "out_of_range": "out of the calibrated range",
+    "held_out": "held out for validation",
+}
+DROPPED_WARNING_FRACTION = 0.10
+
+
+def _check_reason(reason: str) -> None:
+    if reason not in REASONS:
+        raise InputError(f"unknown accounting reason {reason!r}; known: {sorted(REASONS)}")
+
+
+@dataclass
+class Accounting:
+    """Samples read, used, and dropped or flagged by reason, for one command.
+
+    Attributes
+    ----------
+    read
+        Samples read from the file(s).
+    dropped
+        Reason -> samples left out of the computation.
+    flagged
+        Reason -> samples kept but flagged (``compensate`` flags, never drops).
+
+    Examples
+    --------
+    >>> a = Accounting(read=6250)
+    >>> a.drop("warmup", 250)
+    >>> a.used, f"{a.dropped_fraction:.2f}"
+    (6000, '0.04')
+    """
+
+    read: int = 0
+    dropped: dict[str, int] = field(default_factory=dict)
+    flagged: dict[str, int] = field(default_factory=dict)
+
+    def add_read(self, count: int) -> None:
+        """``count`` more samples read."""
+        self.read += int(count)
+
+    def drop(self, reason: str, count: int) -> None:
+        """``count`` samples left out for ``reason`` (a key of :data:`REASONS`)."""
+        _check_reason(reason)
+        if count:
+            self.dropped[reason] = self.dropped.get(reason, 0) + int(count)
+
+    def flag(self, reason: str, count: int) -> None:
+        """``count`` samples kept but flagged for ``reason``."""
+        _check_reason(reason)
+        if count:
+            self.flagged[reason] = self.flagged.get(reason, 0) + int(count)
+
+    def merge(self, other: Accounting) -> None:
+        """Add another accounting (another file or axis) to this one."""
+        self.read += other.read
+        for reason, count in other.dropped.items():
+            self.drop(reason, count)
+        for reason, count in other.flagged.items():
+            self.flag(reason, count)
+
+    @property
+    def n_dropped(self) -> int:
+        """Samples dropped for any reason."""
+        return sum(self.dropped.values())
+
+    @property
+    def used(self) -> int:
+        """Samples read and not dropped."""
+        return self.read - self.n_dropped
+
+    @property
+    def dropped_fraction(self) -> float:
+        """Share of the samples read that were dropped (0 when nothing was read)."""
+        return self.n_dropped / self.read if self.read else 0.0
+
+    @property
+    def warning(self) -> str | None:
+        """The summary-line warning when more than 10 % were dropped, else None."""
+        if self.dropped_fraction <= DROPPED_WARNING_FRACTION:
+            return None
+        top = max(self.dropped, key=self.dropped.__getitem__)
+        return (f"{self.dropped_fraction:.0%} of the samples dropped (most for "
+                f"{REASONS[top]}: {self.dropped[top]})")
+
+    def summary(self) -> str:
+        """One line: read, used, dropped and flagged by reason."""
+        line = f"samples: {self.read} read, {self.used} used"
+        if self.dropped:
+            line += ", dropped " + ", ".join(f"{count} {REASONS[reason]}"
+                                             for reason, count in self.dropped.items())
+        if self.flagged:
+            line += ", flagged " + ", ".join(f"{count} {REASONS[reason]}"
+                                             for reason, count in self.flagged.items())
+        warning = self.warning
+        return f"{line} -- warning: {warning}" if warning else line
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types."""
+        return {"read": self.read, "used": self.used, "dropped": dict(self.dropped),
+                "flagged": dict(self.flagged), "dropped_fraction": self.dropped_fraction,
+                "warning": self.warning}
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> Accounting:
+        """Inverse of :meth:`to_dict`."""
+        out = cls(read=int(data["read"]))
+        for reason, count in dict(data.get("dropped", {})).items():
+            out.drop(str(reason), int(count))
+        for reason, count in dict(data.get("flagged", {})).items():
+            out.flag(str(reason), int(count))
+        return out

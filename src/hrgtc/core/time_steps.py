@@ -1,0 +1,360 @@
+"""One classifier of odd time steps, and the repair that makes each case the clean file.
+
+A real logger's time column goes backwards or jumps for reasons that need different
+fixes, and "sort the file by time" (which would interleave two runs) fits none of
+them. :func:`classify_time_steps` looks at every non-increasing or odd step and
+says which it is:
+
+``wrap``
+    A 32-bit counter wrapped (a µs counter every 2³² µs = 71.6 min, a ms counter
+    every 49.7 days): the step is about -2³² units. Unwrapped (2³² units added to
+    every later time).
+``reset``
+    The logger's clock restarted near zero (a power cycle): a new run, so a new
+    segment starts there (listed in :attr:`TimeDiagnosis.restarts`); later times are
+    shifted to follow the earlier run after a gap.
+``dst``
+    A step of about ±3600 s in naive clock times: daylight saving time began or
+    ended. Not repairable without the time zone: a problem naming ``--tz``.
+``duplicate``
+    Rows repeated with the same time and the same values (a logger that re-sent a
+    block): dropped and counted.
+``duplicate_time`` / ``backwards``
+    The same time with other values, or a step back that is none of the above: a
+    problem naming the row.
+``time_unit``
+    The time steps are 1000 (or 10⁶) times the sample period: ms or µs read as
+    seconds (``--time-unit ms``), or 1000 times smaller: ``--time-unit ms`` given
+    on seconds.
+``sample_rate``
+    Every step disagrees with the stated sample rate by the same factor: the
+    ``--rate-hz`` given is wrong (the measured rate is named).
+``rate_change``
+    The rate really changes within the file: the row where it changes.
+
+Every command reads this one diagnosis (through the recording validator), so
+``info``, ``calibrate``, ``compensate`` and ``evaluate`` say the same thing.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from hrgtc.core.timeline import GAP_FACTOR, gap_limit_s, median_period_s
+
+#: Modulus of a 32-bit counter in seconds, per time unit of the raw column.
+WRAP_MODULUS_S = {"ms": 2.0**32 * 1e-3, "us": 2.0**32 * 1e-6}
+DST_STEP_S = 3600.0
+#: A step back lands "near zero" (a reset) when it lands below this fraction of the
+#: time it came from.
+RESET_FRACTION = 0.1
+#: Relative tolerance of a sample rate (a rate change, a wrong --rate-hz).
+RATE_TOLERANCE = 0.01
+#: Rows per block of the rate-change scan.
+RATE_BLOCK_ROWS = 1000
+REPAIRED = ("wrap", "reset", "duplicate")
+
+
+@dataclass(frozen=True)
+class TimeEvent:
+    """One kind of odd time step found in a recording.
+
+    Attributes
+    ----------
+    kind
+        ``wrap``, ``reset``, ``dst``, ``duplicate``, ``duplicate_time``,
+        ``backwards``, ``time_unit``, ``sample_rate`` or ``rate_change``.
+    row
+        First row concerned (0 = first data row).
+    count
+        Number of steps (or rows, for duplicates) of this kind.
+    message
+        What it is and what was done or what to do.
+    repaired
+        True when the time axis was repaired (no action needed).
+    """
+
+    kind: str
+    row: int
+    count: int
+    message: str
+    repaired: bool
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types."""
+        return {"kind": self.kind, "row": self.row, "count": self.count,
+                "message": self.message, "repaired": self.repaired}
+
+
+@dataclass(frozen=True)
+class TimeDiagnosis:
+    """The classifier's verdict on a time column.
+
+    Attributes
+    ----------
+    time_s
+        The repaired times (wraps unwrapped, resets shifted), duplicates removed. [s]
+    keep
+        Mask of the input rows kept (False: a dropped duplicate).
+    restarts
+        Rows (of the repaired, kept rows) where a new run starts after a reset.
+    events
+        One :class:`TimeEvent` per kind found, in the order of their first row.
+    period_s
+        Median period of the repaired time. [s]
+    """
+
+    time_s: np.ndarray
+    keep: np.ndarray
+    restarts: tuple[int, ...]
+    events: tuple[TimeEvent, ...] = field(default_factory=tuple)
+    period_s: float = math.nan
+
+    @property
+    def problems(self) -> tuple[TimeEvent, ...]:
+        """Events the repair cannot fix (the user must)."""
+        return tuple(e for e in self.events if not e.repaired)
+
+    @property
+    def duplicates(self) -> int:
+        """Rows dropped as duplicates."""
+        return int((~self.keep).sum())
+
+    def event(self, kind: str) -> TimeEvent | None:
+        """The event of one kind, or None."""
+        return next((e for e in self.events if e.kind == kind), None)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types (without the arrays)."""
+        return {"events": [e.to_dict() for e in self.events],
+                "restarts": list(self.restarts), "duplicates": self.duplicates,
+                "period_s": self.period_s if math.isfinite(self.period_s) else None}
+
+
+def _same_rows(values: np.ndarray | None, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    if values is None:
+        return np.ones(a.size, dtype=bool)
+    return np.all((values[a] == values[b]) | (np.isnan(values[a]) & np.isnan(values[b])),
+                  axis=1)
+
+
+def classify_time_steps(time_s: np.ndarray, *, nominal_period_s: float | None = None,
+                        time_unit: str = "s", naive_clock: bool = False,
+                        values: np.ndarray | None = None,
+                        gap_factor: float = GAP_FACTOR) -> TimeDiagnosis:
+    """Classify every non-increasing or odd time step and repair what can be repaired.
+
+    Parameters
+    ----------
+    time_s
+        Times as read, in seconds after the unit conversion (a raw ms counter / 1000). [s]
+    nominal_period_s
+        Sample period stated by the metadata or ``--rate-hz`` (None: inferred from the
+        steps, then no ``sample_rate`` verdict). [s]
+    time_unit
+        Unit of the raw time column (``s``, ``ms``, ``us``, ``timestamp``): which
+        counter wraps to look for, and the hints.
+    naive_clock
+        The times are clock times without a time zone (``±3600 s`` steps are daylight
+        saving).
+    values
+        The other columns, shape (rows, columns), to tell a duplicated row from a
+        duplicated time with other values (None: a repeated time is a duplicate row).
+    gap_factor
+        A step longer than this many periods is a gap.
+
+    Returns
+    -------
+    TimeDiagnosis
+
+    Examples
+    --------
+    >>> t = (np.arange(10) * 0.5 + 4294.0) % (2**32 * 1e-6)   # a µs counter wraps
+    >>> d = classify_time_steps(t, time_unit="us")
+    >>> [e.kind for e in d.events], bool(np.all(np.diff(d.time_s) > 0))
+    (['wrap'], True)
+    """
+    raw = np.asarray(time_s, dtype=np.float64)
+    n = raw.size
+    events: dict[str, list[Any]] = {}  # kind -> [first row, count, detail]
+
+    def note(kind: str, row: int, count: int = 1, detail: Any = None) -> None:
+        if kind in events:
+            events[kind][1] += count
+        else:
+            events[kind] = [row, count, detail]
+
+    keep = np.ones(n, dtype=bool)
+    restarts: list[int] = []
+    step = np.diff(raw)
+    period = median_period_s(raw)
+    modulus = WRAP_MODULUS_S.get(time_unit)
+    with np.errstate(invalid="ignore"):
+        odd = step <= 0
+        if naive_clock and math.isfinite(period):
+            limit = gap_limit_s(period, gap_factor)
+            forward = np.abs(step - DST_STEP_S) <= limit
+            odd |= forward
+    cumulative = 0.0
+    shifts: list[tuple[int, float]] = []  # (row, offset from that row on)
+    for i in np.flatnonzero(odd):
+        row = int(i) + 1
+        if not keep[row]:
+            continue
+        before, after, s = float(raw[row - 1]), float(raw[row]), float(step[i])
+        limit = gap_limit_s(period, gap_factor) if math.isfinite(period) else 0.0
+        if modulus is not None and 0.0 < s + modulus <= modulus / 2.0:
+            note("wrap", row)
+            cumulative += modulus
+            shifts.append((row, cumulative))
+        elif naive_clock and abs(abs(s) - DST_STEP_S) <= limit:
+            note("dst", row, detail=s)
+        elif s <= 0.0:
+            count = _duplicate_block(raw, keep, values, row)
+            if count:
+                note("duplicate", row, count)
+            elif s == 0.0:
+                note("duplicate_time", row)
+            elif before > 0.0 and -limit <= after <= RESET_FRACTION * before:
+                note("reset", row)
+                restarts.append(row)
+                # follow the earlier run after a gap of 10 gap limits (its length is unknown)
+                cumulative += before - after + 10.0 * limit
+                shifts.append((row, cumulative))
+            else:
+                note("backwards", row, detail=(before, after))
+    offset = np.zeros(n)
+    for row, value in shifts:
+        offset[row:] = value
+    repaired = raw + offset
+    kept_index = np.flatnonzero(keep)
+    repaired = repaired[keep]
+    restart_rows = tuple(int(np.searchsorted(kept_index, r)) for r in restarts)
+    good_period = median_period_s(repaired)
+    out = [_event(kind, row, count, detail, time_unit) for kind, (row, count, detail)
+           in events.items()]
+    out += _rate_events(repaired, kept_index, good_period, nominal_period_s, gap_factor,
+                        time_unit)
+    out.sort(key=lambda e: e.row)
+    return TimeDiagnosis(repaired, keep, restart_rows, tuple(out), good_period)
+
+
+def _duplicate_block(raw: np.ndarray, keep: np.ndarray, values: np.ndarray | None,
+                     row: int) -> int:
+    """Rows from ``row`` on that repeat earlier rows (same time, same values); marks them."""
+    end = row
+    before = raw[row - 1]
+    n = raw.size
+    while end < n and raw[end] <= before:
+        end += 1
+    earlier = np.searchsorted(raw[:row], raw[row:end], side="left")
+    earlier = np.minimum(earlier, row - 1)
+    same = raw[earlier] == raw[row:end]
+    if not same.all():
+        return 0
+    if not _same_rows(values, earlier, np.arange(row, end)).all():
+        return 0
+    keep[row:end] = False
+    return end - row
+
+
+def _event(kind: str, row: int, count: int, detail: Any, unit: str) -> TimeEvent:
+    if kind == "wrap":
+        modulus = WRAP_MODULUS_S[unit]
+        return TimeEvent(kind, row, count,
+                         f"row {row}: the 32-bit {unit} time counter wrapped ({count} time(s), "
+                         f"every {modulus:.6g} s = {modulus / 60:.4g} min); unwrapped", True)
+    if kind == "reset":
+        return TimeEvent(kind, row, count,
+                         f"row {row}: the time restarts near zero ({count} time(s)): the logger "
+                         "was reset; a new run (segment) starts there", True)
+    if kind == "duplicate":
+        return TimeEvent(kind, row, count,
+                         f"row {row}: {count} duplicated row(s) (same time, same values) "
+                         "dropped", True)
+    if kind == "dst":
+        sign = "back" if detail < 0 else "forward"
+        return TimeEvent(kind, row, count,
+                         f"row {row}: the clock time jumps {sign} by 3600 s ({count} time(s)): "
+                         "daylight saving time in clock times without a time zone; convert "
+                         "the time column to UTC (or to seconds) before reading", False)
+    if kind == "duplicate_time":
+        return TimeEvent(kind, row, count,
+                         f"row {row}: the same time as the row before with other values "
+                         f"({count} row(s)); two records per time stamp: drop one or fix the "
+                         "time column", False)
+    before, after = detail
+    return TimeEvent(kind, row, count,
+                     f"row {row}: time steps back from {before:.9g} s to {after:.9g} s "
+                     f"({count} step(s)), neither a counter wrap, a reset to zero nor a "
+                     "duplicated block; two files joined out of order? split the file at "
+                     f"row {row}", False)
+
+
+def _rate_events(time_s: np.ndarray, kept_index: np.ndarray, period: float,
+                 nominal: float | None, gap_factor: float, unit: str) -> list[TimeEvent]:
+    if not math.isfinite(period):
+        return []
+    if nominal is not None and nominal > 0:
+        ratio = period / nominal
+        for factor, fix in ((1e3, "pass --time-unit ms"), (1e6, "pass --time-unit us")):
+            if abs(ratio / factor - 1.0) <= 0.05:
+                return [TimeEvent(
+                    "time_unit", 0, 1,
+                    f"the median time step {period:.6g} is {factor:g} times the sample period "
+                    f"{nominal:.6g} s: the time column is in {fix[-2:]}, not seconds; {fix}",
+                    False)]
+        for factor, was in ((1e-3, "ms"), (1e-6, "us")):
+            if abs(ratio / factor - 1.0) <= 0.05:
+                return [TimeEvent(
+                    "time_unit", 0, 1,
+                    f"the median time step {period:.6g} s is {1 / factor:g} times shorter than "
+                    f"the sample period {nominal:.6g} s: the time column is already in "
+                    f"seconds; drop --time-unit {unit if unit != 's' else was}", False)]
+        if abs(ratio - 1.0) > RATE_TOLERANCE:
+            return [TimeEvent(
+                "sample_rate", 0, 1,
+                f"every time step says {1 / period:.6g} Hz (median step {period:.6g} s) but the "
+                f"sample rate given is {1 / nominal:.6g} Hz; the rate does not change within "
+                f"the file: fix --rate-hz (--rate-hz {1 / period:.6g})", False)]
+    change = _rate_change_row(time_s, period, gap_factor)
+    if change is None:
+        return []
+    row, old, new = change
+    row = int(kept_index[row]) if row < kept_index.size else row
+    return [TimeEvent(
+        "rate_change", row, 1,
+        f"row {row}: the sample rate changes from {old:.6g} Hz to {new:.6g} Hz; split the file "
+        f"at row {row} and process the parts separately (or resample)", False)]
+
+
+def _rate_change_row(time_s: np.ndarray, period: float,
+                     gap_factor: float) -> tuple[int, float, float] | None:
+    """First row where the local period leaves the file's start period for good."""
+    step = np.diff(time_s)
+    if step.size < 2 * RATE_BLOCK_ROWS // 10:
+        return None
+    rows = max(10, min(RATE_BLOCK_ROWS, step.size // 4))
+    blocks = step.size // rows
+    if blocks < 2:
+        return None
+    part = step[: blocks * rows].reshape(blocks, rows)
+    with np.errstate(invalid="ignore"):
+        medians = np.nanmedian(np.where(part > 0, part, np.nan), axis=1)
+    first = medians[0]
+    changed = np.abs(medians / first - 1.0) > RATE_TOLERANCE
+    if not changed.any():
+        return None
+    k = int(np.argmax(changed))
+    new = medians[k]
+    start = (k - 1) * rows
+    window = step[start:(k + 1) * rows]
+    away = np.abs(window / first - 1.0) > RATE_TOLERANCE
+    limit = gap_limit_s(max(first, new), gap_factor)
+    away &= (window <= limit) & (window > 0)
+    at = start + int(np.argmax(away)) + 1 if away.any() else k * rows
+    return at, 1.0 / first, 1.0 / new
