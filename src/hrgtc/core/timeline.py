@@ -25,6 +25,7 @@ Times are in seconds (``time_s``), rows are numbered from 0.
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -449,7 +450,7 @@ def time_blocks(time_s: np.ndarray, n_blocks: int, bounds: np.ndarray | None = N
     else:
         cuts = [round(k * n / n_blocks) for k in range(1, n_blocks)]
     edges = [0, *cuts, n]
-    return [(int(a), int(b)) for a, b in zip(edges[:-1], edges[1:], strict=True)]
+    return [(int(a), int(b)) for a, b in itertools.pairwise(edges)]
 
 
 def holdout_rows(time_s: np.ndarray, holdout_s: float | None = None,
@@ -471,7 +472,8 @@ def holdout_rows(time_s: np.ndarray, holdout_s: float | None = None,
     period = median_period_s(time_s)
     if holdout_fraction is not None:
         if not 0.0 < holdout_fraction < 1.0:
-            raise InputError(f"--holdout-fraction must be between 0 and 1, got {holdout_fraction!r}")
+            raise InputError(
+                f"--holdout-fraction must be between 0 and 1, got {holdout_fraction!r}")
         held = round(holdout_fraction * n)
     else:
         if not holdout_s > 0.0:
