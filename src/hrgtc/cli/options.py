@@ -65,6 +65,7 @@ class GapPolicy(StrEnum):
 
     error = "error"
     split = "split"
+    bridge = "bridge"
     ignore = "ignore"
 
 
@@ -248,7 +249,8 @@ GapsOption = Annotated[
     typer.Option(
         "--gaps",
         help="Gaps longer than 2 sample periods: fail (error), process the segments "
-        "separately (split), or accept them (ignore).",
+        "separately (split: filters restart), or carry the filters across each gap with its "
+        "duration (bridge; ignore is an old name for it). Windows and Allan never cross a gap.",
         rich_help_panel=_INPUT,
     ),
 ]
@@ -257,8 +259,9 @@ _ReadingGapsOption = Annotated[
     typer.Option(
         "--gaps",
         help="Gaps longer than 2 sample periods: fail (error, default), process the segments "
-        "separately (split: the df/dt filter restarts after each gap), or accept them "
-        "(ignore).",
+        "separately (split: the df/dt filter restarts after each gap), or carry the filters "
+        "across each gap with its duration (bridge, e.g. a burst logger; ignore is an old "
+        "name for it). Windows, bias stability and Allan deviation never cross a gap.",
         rich_help_panel=_INPUT,
     ),
 ]

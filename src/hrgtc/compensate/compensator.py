@@ -43,7 +43,8 @@ from hrgtc.files import check_writable
 from hrgtc.model import UnitModel
 from hrgtc.progress import Progress
 from hrgtc.recording import Recording
-from hrgtc.recording.gaps import GAP_PERIODS, check_gap_policy
+from hrgtc.core.timeline import is_gap
+from hrgtc.recording.gaps import check_gap_policy
 from hrgtc.recording.marks import COMPENSATED_KEY, mark, refuse_compensated
 
 #: Rows worked on at once: small enough for the temporaries to stay in cache.
@@ -164,9 +165,9 @@ class Compensator:
         time = chunk.time_s
         if not len(time):
             return []
-        limit = GAP_PERIODS / chunk.metadata.sample_rate_hz
-        rows = (np.flatnonzero(np.diff(time) > limit) + 1).tolist()
-        if self._last_time is not None and time[0] - self._last_time > limit:
+        period = 1.0 / chunk.metadata.sample_rate_hz  # the package's one gap test:
+        rows = (np.flatnonzero(is_gap(np.diff(time), period)) + 1).tolist()
+        if self._last_time is not None and is_gap(time[0] - self._last_time, period):
             rows.insert(0, 0)
         self._last_time = float(time[-1])
         return rows

@@ -63,6 +63,7 @@ from typing import Any
 
 import numpy as np
 
+from hrgtc.core.timeline import gap_limit_s, is_gap
 from hrgtc.errors import RecordingError
 from hrgtc.recording.axes import axis_input_rate_dph, axis_names, base_name
 from hrgtc.recording.checks import (
@@ -95,7 +96,6 @@ from hrgtc.recording.checks import (
 from hrgtc.recording.gaps import (
     GAP_PERIODS,
     GAP_POLICIES,
-    GAP_TOLERANCE,
     MAX_LISTED_GAPS,
     Gap,
     GapPolicy,
@@ -279,7 +279,7 @@ class RecordingValidator:
                 step = np.concatenate([carried, step])
             part = step[:blocks * rows].reshape(blocks, rows)
             with np.errstate(invalid="ignore"):
-                usable = np.isfinite(part) & (part > 0) & (part <= GAP_PERIODS * period)
+                usable = np.isfinite(part) & (part > 0) & (part <= gap_limit_s(period))
             counts = usable.sum(axis=1)
             sums = np.where(usable, part, 0.0).sum(axis=1)
             rest = step[blocks * rows:]
@@ -298,7 +298,7 @@ class RecordingValidator:
         self._steps_start = base + blocks * rows
         with np.errstate(invalid="ignore"):
             self._steps_usable = bool(np.all(np.isfinite(rest) & (rest > 0)
-                                             & (rest <= GAP_PERIODS * period)))
+                                             & (rest <= gap_limit_s(period))))
 
     def _check_time(self, time: np.ndarray, offset: int) -> None:
         period = 1.0 / self.metadata.sample_rate_hz
@@ -308,7 +308,7 @@ class RecordingValidator:
             np.subtract(time[1:], time[:-1], out=step[1:])
             extremes = finite_extremes(step)
             if extremes is not None and extremes[0] > 0.0 and (
-                    extremes[1] <= GAP_PERIODS * period):
+                    extremes[1] <= gap_limit_s(period)):
                 self._last_time = float(time[-1])
                 self._check_rate_throughout(step, offset, time=time)
                 return
@@ -325,8 +325,7 @@ class RecordingValidator:
                 i = int(np.argmax(backwards))
                 self._time_order = (offset + i, float(time[i]), float(previous[i]))
         with np.errstate(invalid="ignore"):
-            limit = GAP_PERIODS * period * (1.0 + GAP_TOLERANCE)
-            long = np.flatnonzero((step > limit) & np.isfinite(step))
+            long = np.flatnonzero(is_gap(step, period) & np.isfinite(step))
         self._n_gaps += long.size
         self._check_rate_throughout(step, offset)
         room = MAX_LISTED_GAPS - len(self._gaps)
@@ -426,7 +425,8 @@ class RecordingValidator:
                     f"column 'time_s', row {first.row}: {self._n_gaps} gap(s) longer than "
                     f"{GAP_PERIODS:g} sample periods ({GAP_PERIODS * period:.6g} s), the first "
                     f"{first.duration_s:.6g} s after t = {first.start_time_s:.6g} s; "
-                    "pass --gaps split to process the segments separately (or --gaps ignore)",
+                    "pass --gaps bridge (filters carry across gaps, e.g. a burst logger) or "
+                    "--gaps split (each segment a separate run)",
                     column="time_s",
                     row=first.row,
                     value=f"{first.duration_s:.6g}",
