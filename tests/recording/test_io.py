@@ -286,7 +286,8 @@ def test_clean_recording_validates():
         ("freq_hz", 3, np.inf, r"column 'freq_hz', row 3: value inf is not finite"),
         ("chamber_c", 399, -np.inf, r"column 'chamber_c', row 399: value -inf .*interpolate"),
         ("time_s", 5, 4 / RATE_HZ, r"'time_s', row 5: 0\.02 s after 0\.02 s is a duplicate time"),
-        ("time_s", 9, 0.0, r"row 9: 0\.0 s after 0\.04 s is a step back in time.*sort the file"),
+        ("time_s", 9, 0.0, r"row 9: 0\.0 s after 0\.04 s is a step back in time.*neither a "
+         r"counter wrap, a reset to zero nor a duplicated block.*split the file"),
     ],
 )
 def test_bad_values_name_file_column_row_and_fix(tmp_path, name, row, value, match):
@@ -553,6 +554,11 @@ def test_disordered_times_are_always_caught(suffix, kind, i, seed):
         if np.all(order[i:] == np.arange(i, 300)):
             order[[i, i + 1]] = order[[i + 1, i]]
     shuffled = Recording({n: BASE[n][order] for n in BASE.names}, BASE.metadata)
+    if kind == "duplicate":  # a repeated row (same time, same values) is dropped and counted
+        recording = read_written(shuffled, suffix)
+        assert len(recording) == 299 and recording.metadata.extra["duplicates_dropped"] == 1
+        assert np.all(np.diff(recording.time_s) > 0)
+        return
     with pytest.raises(RecordingError, match=r"column 'time_s', row \d+: .*(duplicate|back)"):
         read_written(shuffled, suffix)
 

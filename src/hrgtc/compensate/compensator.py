@@ -29,6 +29,7 @@ import numpy as np
 
 from hrgtc import recording as rec_io
 from hrgtc.compensate.ranges import RangeReport, range_report
+from hrgtc.core.timeline import is_gap
 from hrgtc.drift import DriftModel
 from hrgtc.drift.features import (
     LEVEL_VARIABLES,
@@ -43,7 +44,6 @@ from hrgtc.files import check_writable
 from hrgtc.model import UnitModel
 from hrgtc.progress import Progress
 from hrgtc.recording import Recording
-from hrgtc.core.timeline import is_gap
 from hrgtc.recording.gaps import check_gap_policy
 from hrgtc.recording.marks import COMPENSATED_KEY, mark, refuse_compensated
 

@@ -106,6 +106,8 @@ class TimeDiagnosis:
         One :class:`TimeEvent` per kind found, in the order of their first row.
     period_s
         Median period of the repaired time. [s]
+    offset_s
+        Shift added to each input row's time by the repair (unwraps, resets). [s]
     """
 
     time_s: np.ndarray
@@ -113,6 +115,7 @@ class TimeDiagnosis:
     restarts: tuple[int, ...]
     events: tuple[TimeEvent, ...] = field(default_factory=tuple)
     period_s: float = math.nan
+    offset_s: np.ndarray | None = None
 
     @property
     def problems(self) -> tuple[TimeEvent, ...]:
@@ -143,9 +146,10 @@ def _same_rows(values: np.ndarray | None, a: np.ndarray, b: np.ndarray) -> np.nd
 
 
 def classify_time_steps(time_s: np.ndarray, *, nominal_period_s: float | None = None,
-                        time_unit: str = "s", naive_clock: bool = False,
+                        time_unit: str | None = "s", naive_clock: bool = False,
                         values: np.ndarray | None = None,
-                        gap_factor: float = GAP_FACTOR) -> TimeDiagnosis:
+                        gap_factor: float = GAP_FACTOR, period_s: float | None = None,
+                        rate_events: bool = True) -> TimeDiagnosis:
     """Classify every non-increasing or odd time step and repair what can be repaired.
 
     Parameters
@@ -157,7 +161,7 @@ def classify_time_steps(time_s: np.ndarray, *, nominal_period_s: float | None = 
         steps, then no ``sample_rate`` verdict). [s]
     time_unit
         Unit of the raw time column (``s``, ``ms``, ``us``, ``timestamp``): which
-        counter wraps to look for, and the hints.
+        counter wraps to look for, and the hints (None: unknown, both wraps looked for).
     naive_clock
         The times are clock times without a time zone (``±3600 s`` steps are daylight
         saving).
@@ -166,6 +170,11 @@ def classify_time_steps(time_s: np.ndarray, *, nominal_period_s: float | None = 
         duplicated time with other values (None: a repeated time is a duplicate row).
     gap_factor
         A step longer than this many periods is a gap.
+    period_s
+        Sample period to judge steps by (default: the median step). [s]
+    rate_events
+        Also judge the time unit and sample rate (``time_unit``, ``sample_rate``,
+        ``rate_change``); off for the chunk-by-chunk repair.
 
     Returns
     -------
@@ -191,8 +200,9 @@ def classify_time_steps(time_s: np.ndarray, *, nominal_period_s: float | None = 
     keep = np.ones(n, dtype=bool)
     restarts: list[int] = []
     step = np.diff(raw)
-    period = median_period_s(raw)
-    modulus = WRAP_MODULUS_S.get(time_unit)
+    period = median_period_s(raw) if period_s is None else float(period_s)
+    moduli = tuple(WRAP_MODULUS_S.values()) if time_unit is None else tuple(
+        m for u, m in WRAP_MODULUS_S.items() if u == time_unit)
     with np.errstate(invalid="ignore"):
         odd = step <= 0
         if naive_clock and math.isfinite(period):
@@ -206,9 +216,16 @@ def classify_time_steps(time_s: np.ndarray, *, nominal_period_s: float | None = 
         if not keep[row]:
             continue
         before, after, s = float(raw[row - 1]), float(raw[row]), float(step[i])
+        if not (math.isfinite(before) and math.isfinite(after)):
+            continue  # a non-finite time is the validation's to report
         limit = gap_limit_s(period, gap_factor) if math.isfinite(period) else 0.0
-        if modulus is not None and 0.0 < s + modulus <= modulus / 2.0:
-            note("wrap", row)
+        # a wrap or a reset goes on from there: the next step is an ordinary one (a single
+        # glitched time is neither)
+        goes_on = row + 1 >= n or 0.0 < raw[row + 1] - after <= max(limit, 0.0) or (
+            not math.isfinite(limit))
+        modulus = next((m for m in moduli if 0.0 < s + m <= m / 2.0), None)
+        if modulus is not None and goes_on:
+            note("wrap", row, detail=modulus)
             cumulative += modulus
             shifts.append((row, cumulative))
         elif naive_clock and abs(abs(s) - DST_STEP_S) <= limit:
@@ -219,7 +236,7 @@ def classify_time_steps(time_s: np.ndarray, *, nominal_period_s: float | None = 
                 note("duplicate", row, count)
             elif s == 0.0:
                 note("duplicate_time", row)
-            elif before > 0.0 and -limit <= after <= RESET_FRACTION * before:
+            elif goes_on and before > 0.0 and -limit <= after <= RESET_FRACTION * before:
                 note("reset", row)
                 restarts.append(row)
                 # follow the earlier run after a gap of 10 gap limits (its length is unknown)
@@ -235,12 +252,12 @@ def classify_time_steps(time_s: np.ndarray, *, nominal_period_s: float | None = 
     repaired = repaired[keep]
     restart_rows = tuple(int(np.searchsorted(kept_index, r)) for r in restarts)
     good_period = median_period_s(repaired)
-    out = [_event(kind, row, count, detail, time_unit) for kind, (row, count, detail)
-           in events.items()]
-    out += _rate_events(repaired, kept_index, good_period, nominal_period_s, gap_factor,
-                        time_unit)
+    out = [_event(kind, row, count, detail) for kind, (row, count, detail) in events.items()]
+    if rate_events:
+        out += _rate_events(repaired, kept_index, good_period, nominal_period_s, gap_factor,
+                            time_unit or "s")
     out.sort(key=lambda e: e.row)
-    return TimeDiagnosis(repaired, keep, restart_rows, tuple(out), good_period)
+    return TimeDiagnosis(repaired, keep, restart_rows, tuple(out), good_period, offset)
 
 
 def _duplicate_block(raw: np.ndarray, keep: np.ndarray, values: np.ndarray | None,
@@ -262,9 +279,10 @@ def _duplicate_block(raw: np.ndarray, keep: np.ndarray, values: np.ndarray | Non
     return end - row
 
 
-def _event(kind: str, row: int, count: int, detail: Any, unit: str) -> TimeEvent:
+def _event(kind: str, row: int, count: int, detail: Any) -> TimeEvent:
     if kind == "wrap":
-        modulus = WRAP_MODULUS_S[unit]
+        modulus = detail
+        unit = next(u for u, m in WRAP_MODULUS_S.items() if m == modulus)
         return TimeEvent(kind, row, count,
                          f"row {row}: the 32-bit {unit} time counter wrapped ({count} time(s), "
                          f"every {modulus:.6g} s = {modulus / 60:.4g} min); unwrapped", True)
@@ -358,3 +376,99 @@ def _rate_change_row(time_s: np.ndarray, period: float,
     away &= (window <= limit) & (window > 0)
     at = start + int(np.argmax(away)) + 1 if away.any() else k * rows
     return at, 1.0 / first, 1.0 / new
+
+
+class TimeRepairStream:
+    """The repair of :func:`classify_time_steps`, chunk by chunk, for streamed reading.
+
+    Carries the last row of the previous chunk (so a step across a chunk boundary is
+    judged), the accumulated shift (unwrapped counters, resets) and the counts. A
+    duplicated block is recognised when it repeats rows of the same chunk (or the
+    carried row); one reaching further back is reported as a step back.
+
+    Parameters
+    ----------
+    time_unit, naive_clock
+        As for :func:`classify_time_steps`.
+    """
+
+    def __init__(self, time_unit: str | None = "s", naive_clock: bool = False) -> None:
+        self.time_unit = time_unit
+        self.naive_clock = naive_clock
+        self._shift = 0.0
+        self._last: tuple[float, np.ndarray | None] | None = None
+        self._period: float | None = None
+        self._rows = 0  # input rows seen
+        self._kept = 0  # rows kept
+        self._events: dict[str, list[Any]] = {}
+        self.restarts: list[int] = []
+        self.duplicates = 0
+
+    def repair(self, time_s: np.ndarray, columns: list[np.ndarray] | None = None,
+               ) -> tuple[np.ndarray, np.ndarray]:
+        """Repaired times and the mask of rows kept, for the next chunk.
+
+        ``columns``: the chunk's other columns (to tell duplicated rows from a
+        duplicated time); stacked only when a step is not positive.
+        """
+        time_s = np.asarray(time_s, dtype=np.float64)
+        if not time_s.size:
+            return time_s, np.ones(0, dtype=bool)
+        columns = list(columns or [])
+        if self._period is None:
+            period = median_period_s(time_s)
+            self._period = period if math.isfinite(period) else None
+        with np.errstate(invalid="ignore"):
+            step = np.diff(time_s)
+            clean = not self.naive_clock and not bool(np.any(step <= 0)) and (
+                self._last is None or not time_s[0] <= self._last[0])
+        if clean:  # the common case: nothing to classify
+            keep = np.ones(time_s.size, dtype=bool)
+            self._advance(time_s, columns, keep, 0.0)
+            return time_s + self._shift if self._shift else time_s, keep
+        pre = 0 if self._last is None else 1
+        values = np.column_stack(columns) if columns else None
+        if pre:
+            last_time, last_values = self._last
+            time_all = np.concatenate([[last_time], time_s])
+            values_all = (None if values is None or last_values is None
+                          else np.vstack([last_values[None, :], values]))
+        else:
+            time_all, values_all = time_s, values
+        diagnosis = classify_time_steps(time_all, time_unit=self.time_unit,
+                                        naive_clock=self.naive_clock, values=values_all,
+                                        period_s=self._period, rate_events=False)
+        keep = diagnosis.keep[pre:]
+        repaired = time_s + diagnosis.offset_s[pre:] + self._shift
+        base_row = self._rows - pre
+        base_kept = self._kept - pre
+        for event in diagnosis.events:
+            state = self._events.get(event.kind)
+            if state is None:
+                self._events[event.kind] = [event, base_row + event.row, event.count]
+            else:
+                state[2] += event.count
+        self.restarts += [base_kept + r for r in diagnosis.restarts]
+        self.duplicates += int((~keep).sum())
+        self._advance(time_s, columns, keep,
+                      float(diagnosis.offset_s[-1]) if time_s.size else 0.0)
+        return repaired[keep], keep
+
+    def _advance(self, time_s: np.ndarray, columns: list[np.ndarray], keep: np.ndarray,
+                 shift: float) -> None:
+        if time_s.size:
+            self._shift += shift
+            last = np.array([float(c[-1]) for c in columns]) if columns else None
+            self._last = (float(time_s[-1]), last)
+        self._rows += time_s.size
+        self._kept += int(keep.sum())
+
+    @property
+    def events(self) -> tuple[TimeEvent, ...]:
+        """One event per kind found so far (first row over the whole file, total count)."""
+        out = []
+        for first, row, count in self._events.values():
+            message = first.message.replace(f"row {first.row}", f"row {row}", 1)
+            message = message.replace(f"({first.count} ", f"({count} ", 1)
+            out.append(TimeEvent(first.kind, row, count, message, first.repaired))
+        return tuple(sorted(out, key=lambda e: e.row))

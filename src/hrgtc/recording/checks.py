@@ -211,9 +211,15 @@ def measured_sample_rate(time_s: np.ndarray) -> float | None:
 def _check_sample_rate(nominal_hz: float, measured_hz: float | None) -> Problem | None:
     if measured_hz is None or abs(measured_hz / nominal_hz - 1.0) <= SAMPLE_RATE_TOLERANCE:
         return None
-    fix = f"fix the metadata (--rate-hz {measured_hz:.6g})"
+    fix = (f"every step says so, the rate does not change within the file: fix the metadata "
+           f"(--rate-hz {measured_hz:.6g})")
     if abs(measured_hz * 1000.0 / nominal_hz - 1.0) <= 0.05:
         fix = "the time column looks like milliseconds: pass --time-unit ms"
+    elif abs(measured_hz * 1e6 / nominal_hz - 1.0) <= 0.05:
+        fix = "the time column looks like microseconds: pass --time-unit us"
+    elif abs(measured_hz / 1000.0 / nominal_hz - 1.0) <= 0.05:
+        fix = ("the steps are 1000 times shorter than the sample period: the time column is "
+               "already in seconds (drop --time-unit ms)")
     return Problem(
         "sample_rate",
         f"column 'time_s': the median time step {1.0 / measured_hz:.6g} s means "

@@ -17,6 +17,12 @@ Users' files are mapped onto the recording contract of DESIGN.md on reading:
 * ``spikes``: ``"error"`` or ``"drop"`` (see :mod:`hrgtc.recording.spikes`); rows
   dropped are counted in ``extra["spikes_dropped"]`` (by :func:`read`) and a
   :class:`~hrgtc.errors.SpikeWarning`;
+* odd time steps (see :mod:`hrgtc.core.time_steps`): a wrapped 32-bit µs/ms
+  counter is unwrapped, a logger reset to about zero starts a new segment (later
+  times follow after a gap), duplicated rows are dropped; :func:`read` lists what
+  was done in ``extra["time_repairs"]`` (and ``extra["duplicates_dropped"]``); the
+  steps that cannot be repaired (a daylight-saving step in clock times, a step back
+  of unknown cause) are left to the validation, which names their kind and row;
 * missing metadata: ``metadata=`` overrides or completes the file's metadata;
   without a sample rate anywhere it is inferred from the median time step of the
   first rows, and ``extra["sample_rate_inferred"]`` is set to True.
@@ -34,6 +40,7 @@ from typing import Any
 
 import numpy as np
 
+from hrgtc.core.time_steps import TimeRepairStream
 from hrgtc.errors import InputError, RecordingError
 from hrgtc.progress import Progress
 from hrgtc.recording.axes import axis_view
@@ -147,6 +154,35 @@ def _metadata(
 
 
 # -- reading -------------------------------------------------------------------
+def _time_repairer(plan: Any) -> TimeRepairStream:
+    unit = plan.units.get("time", "s")
+    return TimeRepairStream(None if unit == "s" else unit, naive_clock=plan.time_is_timestamp)
+
+
+def _repair_time(part: dict[str, np.ndarray], repairer: TimeRepairStream,
+                 ) -> dict[str, np.ndarray]:
+    """``part`` with its time axis repaired (unwrapped, resets shifted, duplicates out)."""
+    time = part.get("time_s")
+    if time is None or not len(time):
+        return part
+    others = [values for name, values in part.items() if name != "time_s"]
+    repaired, keep = repairer.repair(time, others)
+    if keep.all():
+        return part if repaired is time else {**part, "time_s": repaired}
+    return {name: repaired if name == "time_s" else values[keep]
+            for name, values in part.items()}
+
+
+def _repair_extra(repairer: TimeRepairStream) -> dict[str, Any]:
+    extra: dict[str, Any] = {}
+    repaired = [event.message for event in repairer.events if event.repaired]
+    if repaired:
+        extra["time_repairs"] = repaired
+    if repairer.duplicates:
+        extra["duplicates_dropped"] = repairer.duplicates
+    return extra
+
+
 def read(
     path: str | Path,
     columns: Mapping[str, str] | Iterable[str] | None = None,
@@ -238,7 +274,11 @@ def read(
         if spike_filter_ is not None:
             arrays = spike_filter_.drop(arrays, 0)
         arrays = robust.apply(arrays, 0)
+        repairer = _time_repairer(plan)
+        arrays = _repair_time(arrays, repairer)
         meta = _metadata(plan, metadata, arrays.get("time_s"))
+    if repairer.events or repairer.duplicates:
+        meta = replace(meta, extra={**meta.extra, **_repair_extra(repairer)})
     if spike_filter_ is not None and spike_filter_.dropped:
         meta = replace(meta, extra={**meta.extra, "spikes_dropped": spike_filter_.dropped})
         spike_filter_.warn()
@@ -337,6 +377,7 @@ def iter_chunks(
                             rate_scale, temp_unwrap)
         robust.counts = plan.temperature_is_count and (temp_scale, temp_offset_c) == (1.0, 0.0)
         offset = 0
+        repairer = _time_repairer(plan)
 
         def converted() -> Iterator[dict[str, np.ndarray]]:
             nonlocal offset
@@ -346,7 +387,7 @@ def iter_chunks(
                     part = spike_filter_.drop(part, offset)
                 part = robust.apply(part, offset)
                 offset += table.num_rows
-                yield part
+                yield _repair_time(part, repairer)
 
         pieces = _rechunk(converted(), rows)
         head: list[dict[str, np.ndarray]] = []

@@ -63,6 +63,7 @@ from typing import Any
 
 import numpy as np
 
+from hrgtc.core.time_steps import classify_time_steps
 from hrgtc.core.timeline import gap_limit_s, is_gap
 from hrgtc.errors import RecordingError
 from hrgtc.recording.axes import axis_input_rate_dph, axis_names, base_name
@@ -152,6 +153,7 @@ class RecordingValidator:
         self._suffixes: tuple[str, ...] = ("",)
         self._steps = np.empty(0)
         self._steps_start = 0
+        self._history = np.empty(0)  # steps of the last complete block checked
         self._steps_usable = True  # every carried step finite, positive and no gap
         self._rate_change: tuple[int, float] | None = None
         self.rows = 0
@@ -162,6 +164,7 @@ class RecordingValidator:
         self._not_finite: dict[str, list[Any]] = {}  # column -> [row, value, count]
         self._time_order: tuple[int, float, float] | None = None
         self._time_order_count = 0
+        self._time_order_kind = ""
         self._gaps: list[Gap] = []
         self._n_gaps = 0
         self._sample: dict[str, list[np.ndarray]] = {}
@@ -204,7 +207,7 @@ class RecordingValidator:
             if base_name(name, self.axes) in self._bounds:
                 self._check_bounds(name, values, offset)
         if "time_s" in chunk and n:
-            self._check_time(chunk.time_s, offset)
+            self._check_time(chunk.time_s, offset, chunk)
         if self._heuristics is None:
             self._collect_sample(chunk)
         self.rows += n
@@ -263,6 +266,7 @@ class RecordingValidator:
         carried = self._steps
         base = self._steps_start if carried.size else offset
         blocks = (carried.size + step.size) // rows
+        new_steps = step
         if time is not None and self._steps_usable:
             ends = np.arange(1, blocks + 1) * rows - carried.size  # block ends within step
             starts = np.maximum(ends - rows, 0)
@@ -291,16 +295,25 @@ class RecordingValidator:
                     np.abs(measured * period - 1.0) > SAMPLE_RATE_TOLERANCE)
             if changed.any():
                 k = int(np.argmax(changed))
-                self._rate_change = (base + k * rows, float(measured[k]))
+                # the change may have begun in the block before (checked earlier, still in
+                # tolerance): search from there, with the last block's steps kept
+                history = self._history
+                combined = np.concatenate([history, carried, new_steps])
+                at, rate = _change_row(combined, k + (1 if history.size else 0), rows, period)
+                self._rate_change = (base - history.size + at, rate)
                 self._steps = np.empty(0)
                 return
+        if blocks:  # the steps of the last complete block, for the search above
+            end = blocks * rows - carried.size  # its end within new_steps
+            self._history = (new_steps[end - rows:end].copy() if end >= rows else
+                             np.concatenate([carried, new_steps[:end]])[-rows:])
         self._steps = rest.copy()
         self._steps_start = base + blocks * rows
         with np.errstate(invalid="ignore"):
             self._steps_usable = bool(np.all(np.isfinite(rest) & (rest > 0)
                                              & (rest <= gap_limit_s(period))))
 
-    def _check_time(self, time: np.ndarray, offset: int) -> None:
+    def _check_time(self, time: np.ndarray, offset: int, chunk: Recording | None = None) -> None:
         period = 1.0 / self.metadata.sample_rate_hz
         if self._last_time is not None:  # fast path: steps all positive and no gap
             step = np.empty_like(time)
@@ -324,6 +337,8 @@ class RecordingValidator:
             if self._time_order is None:
                 i = int(np.argmax(backwards))
                 self._time_order = (offset + i, float(time[i]), float(previous[i]))
+                self._time_order_kind = _step_diagnosis(time, previous, i, period,
+                                                        self.metadata, chunk)
         with np.errstate(invalid="ignore"):
             long = np.flatnonzero(is_gap(step, period) & np.isfinite(step))
         self._n_gaps += long.size
@@ -391,15 +406,19 @@ class RecordingValidator:
                 f"{count} such rows): a glitch or two files joined; remove those rows "
                 "(--spikes drop)",
                 column=name, row=row, value=f"{value:.6g}", count=count))
-        if self._rate_change is not None:
+        # a time unit or sample rate wrong for the whole file: its gaps and "rate changes"
+        # are consequences, not news (one diagnosis, see hrgtc.core.time_steps)
+        whole_file = any(p.kind in ("sample_rate", "time_unit") and p.row is None
+                         for p in self._heuristics or [])
+        if self._rate_change is not None and not whole_file:
             row, measured = self._rate_change
             nominal = self.metadata.sample_rate_hz
             problems.append(Problem(
                 "sample_rate",
-                f"column 'time_s', rows {row} to {row + RATE_CHECK_ROWS - 1}: the time step "
-                f"means {measured:.6g} Hz but the metadata (and the start of the file) say "
-                f"{nominal:g} Hz; the sample rate changes within the file: split it at row "
-                f"{row} and process the parts separately (or resample)",
+                f"column 'time_s', row {row}: the time step changes to {measured:.6g} Hz but "
+                f"the metadata (and the start of the file) say {nominal:g} Hz; the sample rate "
+                f"changes within the file: split it at row {row} and process the parts "
+                "separately (or resample)",
                 column="time_s", row=row, value=f"{measured:.6g}"))
         if self._time_order is not None:
             row, now, before = self._time_order
@@ -409,14 +428,14 @@ class RecordingValidator:
                     "time_order",
                     f"column 'time_s', row {row}: {now!r} s after {before!r} s is {what} "
                     f"(time must increase strictly; {self._time_order_count} bad step(s)); "
-                    "sort the file by time and drop duplicate rows",
+                    f"{self._time_order_kind}",
                     column="time_s",
                     row=row,
                     value=repr(now),
                     count=self._time_order_count,
                 )
             )
-        if self._n_gaps and self.gaps == "error":
+        if self._n_gaps and self.gaps == "error" and not whole_file:
             first = self._gaps[0]
             period = 1.0 / self.metadata.sample_rate_hz
             problems.append(
@@ -540,6 +559,71 @@ class RecordingValidator:
             if problem:
                 problems.append(problem)
         return problems
+
+
+def _change_row(step: np.ndarray, block: int, rows: int, period: float) -> tuple[int, float]:
+    """Row where the sample rate changes, and the new rate [Hz], ``block`` being the first
+    block whose mean step is off the nominal ``period``.
+
+    The new period is the median step of that block; the change is at the row before the
+    first step of the new period (searched from the block before on).
+    """
+    limit = gap_limit_s(period)
+    blk = step[block * rows:(block + 1) * rows]
+    blk = blk[(blk > 0) & (blk <= limit)]
+    if not blk.size:
+        return block * rows, 1.0 / period
+    new = float(np.median(blk))
+    start = max(block - 1, 0) * rows
+    window = step[start:(block + 1) * rows]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        match = (np.abs(window / new - 1.0) <= SAMPLE_RATE_TOLERANCE / 2) & (
+            np.abs(window / period - 1.0) > SAMPLE_RATE_TOLERANCE)
+    at = start + int(np.argmax(match)) if match.any() else block * rows
+    return max(at - 1, 0), 1.0 / new
+
+
+#: What to do about each kind of step back the classifier names (the time column as read:
+#: wraps, resets and duplicated rows are repaired on reading, so here they come from a
+#: recording built in memory or read without the repair).
+_STEP_FIX = {
+    "wrap": "a 32-bit time counter wrapped: read the file with its --time-unit (us or ms) "
+            "and hrgtc unwraps it",
+    "reset": "the logger's clock restarted near zero: read the file with hrgtc, which starts "
+             "a new segment there (or split the file at that row)",
+    "duplicate": "the rows repeat earlier ones (same time, same values): reading the file with "
+                 "hrgtc drops them",
+    "duplicate_time": "two records with the same time and other values: drop one or fix the "
+                      "time column",
+    "dst": "a step of 3600 s in clock times without a time zone is daylight saving time: "
+           "convert the time column to UTC (or to seconds) before reading",
+    "backwards": "neither a counter wrap, a reset to zero nor a duplicated block (two files "
+                 "joined out of order? sorting would interleave them): split the file at "
+                 "that row",
+}
+
+
+def _step_diagnosis(time: np.ndarray, previous: np.ndarray, i: int, period: float,
+                    metadata: Metadata | None, chunk: Recording | None = None) -> str:
+    """The classifier's word on the step back at ``time[i]`` (see :mod:`hrgtc.core.time_steps`).
+
+    Looks at up to 1000 rows either side within the chunk (with the other columns, to
+    tell a duplicated row from a duplicated time).
+    """
+    low, high = max(i - 1000, 0), i + 1000
+    window = time[low:high]
+    values = None
+    if chunk is not None:
+        others = [chunk[name][low:high] for name in chunk.names if name != "time_s"]
+        values = np.column_stack(others) if others else None
+    naive = bool(metadata is not None and metadata.extra.get("time_origin"))
+    diagnosis = classify_time_steps(window, time_unit=None, naive_clock=naive, values=values,
+                                    period_s=period, rate_events=False)
+    row = i - low
+    event = next((e for e in diagnosis.events if e.row == row), None)
+    if event is None:
+        return _STEP_FIX["duplicate_time" if time[i] == previous[i] else "backwards"]
+    return _STEP_FIX.get(event.kind, _STEP_FIX["backwards"])
 
 
 def validate(
