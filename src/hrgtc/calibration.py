@@ -316,6 +316,7 @@ def _fit_drift(training: Sequence[PathLike], heads: Mapping[str, Any], thermomet
     """The drift model on ``training`` and the housing baseline when every run has
     ``housing_c`` (None otherwise, or when its fit fails: the baseline is optional)."""
     runs = [partial(options.chunks, path) for path in training]
+    fit.setdefault("gaps", options.gaps)
     model = drift_model.fit(runs, thermometer, excitation_runs=excitation_runs,
                             progress=for_stage(progress, "drift"), motion=options.motion,
                             **fit)

@@ -402,6 +402,8 @@ def fit(
     motion: str = "exclude",
     motion_settings: MotionSettings | None = None,
     offsets: str = "auto",
+    gaps: str = "bridge",
+    restart_each_segment: bool = False,
 ) -> DriftModel:
     """Fit the drift model of Eq. (21)-(22) of [1] by stepwise regression on window means.
 
@@ -465,6 +467,12 @@ def fit(
         else none), ``"none"``, ``"run"``, ``"orientation"``, ``"run+orientation"``.
     progress
         Optional ``callback(samples_done, 0)``.
+    gaps, restart_each_segment
+        How the time axis's gaps are treated (see
+        :func:`hrgtc.drift.windows.window_means`): ``"split"`` restarts the df/dt
+        filter after every gap, ``"bridge"`` (default) carries it across; windows never
+        span a gap; the warm-up counts from the run's start (from every segment's with
+        ``restart_each_segment``).
 
     Returns
     -------
@@ -510,7 +518,8 @@ def fit(
     first_pass = [v for v in variables if is_aux(v)] + (["df"] if "dpos" in variables else [])
     if first_pass:  # δ of the heating/cooling switch and the channels' centres: a first pass
         means = window_means(runs, settings, parse_terms(first_pass), window_s,
-                             keep=keep).variables
+                             keep=keep, gaps=gaps,
+                             restart_each_segment=restart_each_segment).variables
         update: dict[str, Any] = {"aux_centres": {
             v[len(AUX_PREFIX):]: float(np.mean(means[v])) for v in first_pass if is_aux(v)}}
         if "dpos" in variables:
@@ -520,7 +529,7 @@ def fit(
     # df/dt's training range is kept for the range warnings even when no candidate uses it
     tracked = ("df",) if "f" in variables else ()
     windows = window_means(runs, settings, candidates, window_s, progress, thermometer, tracked,
-                           keep=keep)
+                           keep=keep, gaps=gaps, restart_each_segment=restart_each_segment)
     for run in range(min(excitation_runs, len(windows.sources))):
         _check_excitation(windows, thermometer, variables, run)
     _check_excitation(windows, thermometer, variables)

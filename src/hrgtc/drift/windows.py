@@ -4,17 +4,30 @@ The regression of :mod:`hrgtc.drift.drift_model` runs on non-overlapping window
 means (10 s by default) of the candidate terms and the measured bias: raw 200 Hz
 residuals are too autocorrelated for F-tests. Each run's variables come from a
 causal :class:`~hrgtc.drift.features.FeatureStream` that keeps its state across
-chunks; the first ``warmup_s`` of each run is left out while the filter settles.
+chunks.
+
+Time, not samples (see :mod:`hrgtc.core.timeline`):
+
+* the warm-up is ``warmup_s`` seconds on the time axis, applied once from the run's
+  first sample (a duty-cycled logger does not restart the gyro); with
+  ``gaps="split"`` the filter restarts after every gap, so each segment settles for
+  ``warmup_s`` again; ``restart_each_segment=True`` says each segment is a power-on;
+* a window never spans a gap: the partial window at the end of a segment (and of the
+  run) is kept when it holds at least half a window
+  (:data:`~hrgtc.core.timeline.PARTIAL_WINDOW_FRACTION`), else dropped; a window never
+  reaches across samples left out as not at rest either (its partial start is dropped);
+* rows left out are counted by reason in :attr:`TrainingWindows.dropped`.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
+from hrgtc.core.timeline import PARTIAL_WINDOW_FRACTION, is_gap
 from hrgtc.drift.features import FeatureSettings, FeatureStream, Term, design_matrix, variables_for
 from hrgtc.errors import CalibrationError, InputError
 from hrgtc.progress import Progress
@@ -43,7 +56,7 @@ class TrainingWindows:
     variables
         Window means of each variable (f [Hz], df [Hz/s], ...).
     n_samples
-        Samples that went into the windows.
+        Samples read from the runs.
     sources
         Name (file) of each run, in run order.
     n_not_at_rest
@@ -52,6 +65,11 @@ class TrainingWindows:
         Window means of ``accel_x/y/z`` (shape (windows, 3)) when every run logs them.
     orientation
         Window means of the user's ``orientation`` label when every run logs it.
+    dropped
+        Reason -> samples read but in no window (``warmup``, ``partial_windows``; the
+        reasons of :data:`hrgtc.core.accounting.REASONS`).
+    segments
+        Contiguous segments found in the runs (gaps split them).
     """
 
     time_s: np.ndarray
@@ -64,35 +82,44 @@ class TrainingWindows:
     n_not_at_rest: int = 0
     accel: np.ndarray | None = None
     orientation: np.ndarray | None = None
+    dropped: dict[str, int] = field(default_factory=dict)
+    segments: int = 0
 
 
 class _WindowMeans:
-    """Means of non-overlapping windows of ``rows`` samples over consecutive chunks."""
+    """Means of non-overlapping windows of ``rows`` samples over consecutive chunks.
 
-    def __init__(self, rows: int, skip: int) -> None:
+    A window never spans a segment break (a gap): the partial window before it is kept
+    when it holds at least :data:`PARTIAL_WINDOW_FRACTION` of ``rows``, else dropped and
+    counted. At a cut (samples left out as not at rest) the partial window is dropped.
+    """
+
+    def __init__(self, rows: int) -> None:
         self.rows = rows
-        self.skip = skip
+        self.min_rows = max(1, int(np.ceil(PARTIAL_WINDOW_FRACTION * rows)))
         self._carry: np.ndarray | None = None
+        self.partial_dropped_rows = 0
 
-    def push(self, block: np.ndarray, keep: np.ndarray | None = None) -> np.ndarray:
-        """Means of the windows completed by ``block``; rows where ``keep`` is False are
-        left out, and a window never reaches across them (its partial start is dropped)."""
-        if self.skip:
-            dropped = min(self.skip, block.shape[0])
-            block = block[dropped:]
-            keep = None if keep is None else keep[dropped:]
-            self.skip -= dropped
-        if keep is not None and not keep.all():
-            out = []
-            edges = np.diff(np.concatenate([[0], keep.astype(np.int8), [0]]))
-            starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
-            for a, b in zip(starts, stops, strict=True):
-                if a > 0:
-                    self._carry = None  # a break: the partial window before it is dropped
-                out.append(self.push(block[a:b]))
-            if stops.size == 0 or stops[-1] < block.shape[0]:
-                self._carry = None
-            return np.concatenate(out) if out else np.empty((0, block.shape[1]))
+    def push(self, block: np.ndarray, breaks: Sequence[int] = (),
+             cuts: Sequence[int] = ()) -> np.ndarray:
+        """Window means of ``block``; ``breaks``: its rows that start a new segment,
+        ``cuts``: its rows that follow left-out samples."""
+        marks = {int(b): "break" for b in breaks if 0 <= b < block.shape[0]}
+        marks.update({int(c): "cut" for c in cuts if 0 <= c < block.shape[0]
+                      and int(c) not in marks})
+        edges = [0, *sorted(m for m in marks if m > 0), block.shape[0]]
+        out = []
+        for k in range(len(edges) - 1):
+            kind = marks.get(edges[k])
+            if kind == "break":
+                out.append(self.flush())
+            elif kind == "cut":
+                self.drop()
+            out.append(self._push(block[edges[k]:edges[k + 1]]))
+        out = [o for o in out if o.shape[0]]
+        return np.concatenate(out) if out else np.empty((0, block.shape[1]))
+
+    def _push(self, block: np.ndarray) -> np.ndarray:
         if self._carry is not None and self._carry.shape[0]:
             block = np.concatenate([self._carry, block])
         complete = block.shape[0] // self.rows
@@ -101,6 +128,22 @@ class _WindowMeans:
             return np.empty((0, block.shape[1]))
         used = block[: complete * self.rows]
         return used.reshape(complete, self.rows, block.shape[1]).mean(axis=1)
+
+    def drop(self) -> None:
+        """A cut: the partial window is dropped (counted)."""
+        if self._carry is not None:
+            self.partial_dropped_rows += self._carry.shape[0]
+        self._carry = None
+
+    def flush(self) -> np.ndarray:
+        """End of a segment: the partial window, kept when long enough, else counted."""
+        carry, self._carry = self._carry, None
+        if carry is None or carry.shape[0] == 0:
+            return np.empty((0, 0 if carry is None else carry.shape[1]))
+        if carry.shape[0] >= self.min_rows:
+            return carry.mean(axis=0, keepdims=True)
+        self.partial_dropped_rows += carry.shape[0]
+        return np.empty((0, carry.shape[1]))
 
 
 def _iter_run(source: RunSource) -> Iterator[Recording]:
@@ -119,6 +162,9 @@ def window_means(
     thermometer: Any = None,
     extra_variables: Sequence[str] = (),
     keep: Sequence[np.ndarray | None] | None = None,
+    *,
+    gaps: str = "bridge",
+    restart_each_segment: bool = False,
 ) -> TrainingWindows:
     """Window means of candidate terms and measured bias over training runs.
 
@@ -145,26 +191,36 @@ def window_means(
         None to use every sample: the windows are means of kept samples only and never
         reach across a left-out stretch, so every trained range comes from the samples
         actually used.
+    gaps
+        ``"split"``: the df/dt filter restarts after every gap (and settles for
+        ``warmup_s`` again); otherwise (``"bridge"``, ``"ignore"``, ``"error"``) it
+        carries across. Windows never span a gap either way.
+    restart_each_segment
+        Each segment is a power-on: the warm-up is skipped after every gap.
     """
     variables = variables_for(terms)
     variables += tuple(v for v in extra_variables if v not in variables)
     window_rows = round(window_s * settings.sample_rate_hz)
     if window_rows < 1:
         raise InputError(f"window_s={window_s} s holds no sample at {settings.sample_rate_hz} Hz")
-    skip = round(settings.warmup_s * settings.sample_rate_hz)
+    period = 1.0 / settings.sample_rate_hz
+    split = gaps == "split"
     out_terms, out_bias, out_time, out_run = [], [], [], []
     out_vars: dict[str, list[np.ndarray]] = {v: [] for v in variables}
     out_extra: list[np.ndarray] = []
-    total = 0
+    total = warm = segments = partial = 0
     left_out = 0
     sources: list[str] = []
     extra: tuple[str, ...] | None = None
     for index, source in enumerate(runs):
         stream = FeatureStream(settings, variables, thermometer)
-        averager = _WindowMeans(window_rows, skip)
+        averager = _WindowMeans(window_rows)
         input_rate = None
         run_keep = None if keep is None else keep[index]
         row = 0
+        last_time: float | None = None
+        power_on: float | None = None  # time the warm-up counts from
+        last_used = True  # the previous row was used (not left out as not at rest)
         for chunk in _iter_run(source):
             settings.check_sample_rate(chunk)
             if input_rate is None:
@@ -172,7 +228,34 @@ def window_means(
                 sources.append(chunk.source or f"run {index}")
             if extra is None:  # the accelerometer and label columns, where every run has them
                 extra = tuple(c for c in _EXTRA_COLUMNS if c in chunk)
-            values = stream.process(chunk)
+            time = chunk.time_s
+            if not len(time):
+                continue
+            starts = np.flatnonzero(is_gap(np.diff(time), period)) + 1
+            if last_time is None:
+                power_on = float(time[0])
+                segments += 1
+            elif is_gap(time[0] - last_time, period):
+                starts = np.concatenate([[0], starts])
+            segments += starts.size
+            last_time = float(time[-1])
+            if split and starts.size:  # the filter restarts after each gap
+                edges = [0, *starts[starts > 0].tolist(), len(chunk)]
+                parts = []
+                for k in range(len(edges) - 1):
+                    if k > 0 or starts[0] == 0:
+                        stream = FeatureStream(settings, variables, thermometer)
+                    parts.append(stream.process(chunk.slice(edges[k], edges[k + 1])))
+                values = {v: np.concatenate([p[v] for p in parts]) for v in parts[0]}
+            else:
+                values = stream.process(chunk)
+            # seconds since power-on (or since the filter restarted): the warm-up skip
+            origin = np.full(len(time), power_on)
+            if (split or restart_each_segment) and starts.size:
+                lengths = np.diff(np.append(starts, len(time)))
+                origin[starts[0]:] = np.repeat(time[starts], lengths)
+                power_on = float(time[starts[-1]])
+            settled = time - origin >= settings.warmup_s
             rate = chunk["input_rate_dph"] if "input_rate_dph" in chunk else input_rate
             block = np.column_stack(
                 [
@@ -185,9 +268,17 @@ def window_means(
             )
             kept = None if run_keep is None else run_keep[row:row + len(chunk)]
             if kept is not None:
-                left_out += int(np.count_nonzero(~kept))
+                left_out += int(np.count_nonzero(~kept & settled))
             row += len(chunk)
-            means = averager.push(block, kept)
+            rested = np.ones(len(chunk), dtype=bool) if kept is None else kept.astype(bool)
+            use = settled & rested
+            before = np.cumsum(use) - use  # rows used before each row
+            breaks = sorted({int(before[b]) for b in starts})
+            previous = np.concatenate([[last_used], rested[:-1]])
+            cuts = sorted({int(before[i]) for i in np.flatnonzero(rested & ~previous)})
+            last_used = bool(rested[-1])
+            warm += int(np.count_nonzero(~settled))
+            means = averager.push(block[use], breaks, cuts)
             if means.shape[0]:
                 out_time.append(means[:, 0])
                 out_bias.append(means[:, 1])
@@ -200,11 +291,25 @@ def window_means(
             total += len(chunk)
             if progress is not None:
                 progress(total, 0)
+        means = averager.flush()
+        if means.shape[0]:
+            out_time.append(means[:, 0])
+            out_bias.append(means[:, 1])
+            for k, v in enumerate(variables):
+                out_vars[v].append(means[:, 2 + k])
+            first = 2 + len(variables)
+            out_extra.append(means[:, first:first + len(extra or ())])
+            out_terms.append(means[:, first + len(extra or ()):])
+            out_run.append(np.full(means.shape[0], index))
+        partial += averager.partial_dropped_rows
     if not out_time:
+        restart = " after every gap (--gaps split restarts the filter)" if split else ""
         raise CalibrationError(
             f"the drift runs hold no complete {window_s:g} s window after the "
-            f"{settings.warmup_s:g} s filter warm-up; give longer runs"
+            f"{settings.warmup_s:g} s filter warm-up{restart}; give longer runs"
+            + (", or --gaps bridge for a burst logger" if split else "")
         )
+    dropped = {k: v for k, v in (("warmup", warm), ("partial_windows", partial)) if v}
     columns = np.concatenate(out_extra) if out_extra else np.empty((0, 0))
     named = {c: columns[:, k] for k, c in enumerate(extra or ())
              if np.all(np.isfinite(columns[:, k]))}
@@ -222,4 +327,6 @@ def window_means(
         variables={v: np.concatenate(x) for v, x in out_vars.items()},
         n_samples=total,
         sources=tuple(sources),
+        dropped=dropped,
+        segments=segments,
     )
