@@ -15,6 +15,8 @@ from typing import Any
 
 import numpy as np
 
+from hrgtc.core.time_steps import TimeRepairStream
+from hrgtc.core.timeline import Timeline, TimelineBuilder
 from hrgtc.errors import RecordingError
 from hrgtc.progress import Progress
 from hrgtc.recording.axes import axis_names, base_name
@@ -121,6 +123,7 @@ class RecordingInfo:
     validation: ValidationReport
     axes: tuple[str, ...] = ()
     spike_rows: int | None = None
+    timeline: dict[str, Any] | None = None
 
     @property
     def ok(self) -> bool:
@@ -144,7 +147,23 @@ class RecordingInfo:
         if self.axes:
             lines.append(f"  axes: {', '.join(self.axes)} ({len(self.axes)}-axis recording; "
                          "per-axis columns <name>_<axis>)")
-        lines.append(f"  duration: {_num(self.duration_s)} s ({_hours(self.duration_s)})")
+        timeline = self.timeline or {}
+        if timeline.get("segments"):
+            lines.append(f"  duration: span {_num(self.duration_s)} s ({_hours(self.duration_s)}), "
+                         f"recorded {_num(timeline['recorded_s'])} s "
+                         f"({_hours(timeline['recorded_s'])}) in {timeline['segments']} "
+                         "segment(s)")
+            if timeline["segments"] > 1:
+                lines.append(
+                    f"  segments: {_num(timeline['burst_length_s'])} s long (median), one every "
+                    f"{_num(timeline['burst_period_s'])} s (median); "
+                    + ("a burst (duty-cycled) logger" if timeline.get("bursty")
+                       else "a logger with pauses")
+                    + f"; median period {_num(timeline['period_s'])} s")
+        else:
+            lines.append(f"  duration: {_num(self.duration_s)} s ({_hours(self.duration_s)})")
+        for repair in timeline.get("repairs", []):
+            lines.append(f"  time: {repair}")
         inferred = " (inferred from the time steps)" if self.sample_rate_inferred else ""
         lines.append(
             f"  sample rate: {_num(self.sample_rate_hz)} Hz in the metadata{inferred}, "
@@ -185,6 +204,7 @@ class RecordingInfo:
             "validation": self.validation.to_dict(),
             "axes": list(self.axes),
             "spike_rows": self.spike_rows,
+            "timeline": self.timeline,
         }
 
     def _span_columns(self) -> list[ColumnSummary]:
@@ -210,6 +230,7 @@ class RecordingInfo:
             validation=ValidationReport.from_dict(data["validation"]),
             axes=tuple(data.get("axes") or ()),
             spike_rows=data.get("spike_rows"),
+            timeline=data.get("timeline"),
         )
 
 
@@ -276,6 +297,8 @@ def describe(
     unreadable: str | None = None
     fmt: str | None = None
     names: list[str] = []
+    builder: TimelineBuilder | None = None
+    repairer = TimeRepairStream()  # filled by iter_chunks: what the time repair did
     try:
         fmt = format_of(path)
         for chunk in iter_chunks(
@@ -284,6 +307,7 @@ def describe(
             thermometer=thermometer, rate_scale=rate_scale, temp_unwrap=temp_unwrap,
             spike_filter=spike_filter or "off", spike_k=spike_k, spike_lsb=spike_lsb,
             spike_window_s=spike_window_s,
+            time_repair=repairer,
         ):
             meta = chunk.metadata
             names = names or [n for n in chunk.names if n != SPIKE_COLUMN
@@ -291,6 +315,10 @@ def describe(
             if SPIKE_COLUMN in chunk:
                 spike_rows = (spike_rows or 0) + int(np.count_nonzero(chunk[SPIKE_COLUMN]))
             validator.update(chunk)
+            if "time_s" in chunk:
+                if builder is None:
+                    builder = TimelineBuilder(1.0 / meta.sample_rate_hz)
+                builder.update(chunk.time_s)
             for name in names:
                 values = chunk[name]
                 finite = values[np.isfinite(values)]
@@ -327,6 +355,7 @@ def describe(
     duration = None
     if first_time is not None and meta is not None:
         duration = last_time - first_time + 1.0 / meta.sample_rate_hz
+    timeline: Timeline | None = None if builder is None else builder.timeline()
     return RecordingInfo(
         path=str(path),
         format=fmt,
@@ -346,6 +375,9 @@ def describe(
         validation=report,
         axes=axis_names(names),
         spike_rows=spike_rows,
+        timeline=None if timeline is None or not timeline.n_segments else {
+            **timeline.to_dict(), "repairs": [e.message for e in repairer.events if e.repaired],
+            "duplicates_dropped": repairer.duplicates},
     )
 
 

@@ -340,6 +340,7 @@ def iter_chunks(
     spike_k: float = SPIKE_K,
     spike_lsb: float = SPIKE_LSB,
     spike_window_s: float = SPIKE_WINDOW_S,
+    time_repair: TimeRepairStream | None = None,
 ) -> Iterator[Recording]:
     """Stream a recording in chunks of ``rows`` rows without loading the file.
 
@@ -358,7 +359,10 @@ def iter_chunks(
         yielded only after its rows (and the unit heuristics of the first
         :data:`~hrgtc.recording.validation.HEURISTIC_ROWS` rows) have passed, so a
         bad file raises :class:`~hrgtc.errors.RecordingError` before bad data
-        reach the caller. With ``gaps="split"`` gaps pass; split downstream. With
+        reach the caller. With ``gaps="split"`` gaps pass; split downstream. The time
+        axis is repaired as by :func:`read` (``time_repair``: a
+        :class:`~hrgtc.core.time_steps.TimeRepairStream` to use, whose events and counts
+        the caller reads afterwards). With
         ``spikes="drop"`` the rows of spikes are left out before the chunks are cut
         (the rows of later problems then count the rows kept).
     """
@@ -378,6 +382,10 @@ def iter_chunks(
         robust.counts = plan.temperature_is_count and (temp_scale, temp_offset_c) == (1.0, 0.0)
         offset = 0
         repairer = _time_repairer(plan)
+        if time_repair is not None:  # the caller's, to read what was repaired
+            time_repair.time_unit, time_repair.naive_clock = (repairer.time_unit,
+                                                              repairer.naive_clock)
+            repairer = time_repair
 
         def converted() -> Iterator[dict[str, np.ndarray]]:
             nonlocal offset
