@@ -38,7 +38,7 @@ from hrgtc.core.timeline import (
 
 __all__ = [
     "GAP_FACTOR", "GAP_TOLERANCE", "REASONS", "Accounting", "TimeDiagnosis", "TimeEvent",
-    "Timeline", "TimelineBuilder", "classify_time_steps", "gap_limit_s", "is_gap", "median_period_s",
-    "parse_time_bound", "seconds_since_power_on", "segment_bounds", "slice_rows",
-    "time_blocks", "windows",
+    "Timeline", "TimelineBuilder", "classify_time_steps", "gap_limit_s", "is_gap",
+    "median_period_s", "parse_time_bound", "seconds_since_power_on", "segment_bounds",
+    "slice_rows", "time_blocks", "windows",
 ]
