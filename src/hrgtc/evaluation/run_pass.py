@@ -29,7 +29,7 @@ import numpy as np
 from hrgtc.compensate import Compensator
 from hrgtc.compensate.compensator import check_recording_noise, with_model_band
 from hrgtc.compensate.ranges import RangeReport
-from hrgtc.drift.features import FeatureStream, settle_rows
+from hrgtc.drift.features import FeatureStream
 from hrgtc.drift.rest import run_rest
 from hrgtc.errors import HrgtcError, InputError, RecordingError
 from hrgtc.evaluation.allan import (
@@ -47,6 +47,7 @@ from hrgtc.evaluation.metrics import (
 )
 from hrgtc.evaluation.noise import NoiseTerms, noise_terms
 from hrgtc.evaluation.series_stats import SeriesStatistics
+from hrgtc.evaluation.settling_cut import SettlingCut
 from hrgtc.model import UnitModel
 from hrgtc.progress import Progress
 from hrgtc.recording import ReadOptions, Recording, count_rows
@@ -332,52 +333,6 @@ def _finite(value: float | None) -> float | None:
     return None if value is None or not math.isfinite(value) else float(value)
 
 
-class _SettlingCut:
-    """Series statistics fed after the df/dt filter's settling time at the start of a run.
-
-    Training leaves out the first ``settle`` samples of a run (the filter starts at rest),
-    and so does the evaluation. A run shorter than ``settle + minimum`` keeps its last
-    ``minimum`` samples (two 10 s blocks) instead. Until that is decided the first
-    ``settle + minimum`` samples are held back; then they are fed in order.
-    """
-
-    def __init__(self, series: dict[str, SeriesStatistics], settle: int, minimum: int) -> None:
-        self.series = series
-        self.settle = settle
-        self.hold = settle + minimum
-        self.minimum = minimum
-        self.held: dict[str, list[np.ndarray]] = {key: [] for key in series}
-        self.rows = 0
-        self.flushed = False
-
-    def push(self, values: dict[str, np.ndarray]) -> None:
-        """The next rows of every series (one length)."""
-        if self.flushed:
-            for key, array in values.items():
-                self.series[key].push(array)
-            return
-        for key, array in values.items():
-            self.held[key].append(array)
-        self.rows += len(next(iter(values.values())))
-        if self.rows > self.hold:
-            self._flush(self.settle)
-
-    def finish(self) -> int:
-        """Feed what is still held back; the number of samples left out at the start."""
-        if not self.flushed:
-            self._flush(max(self.rows - self.minimum, 0))
-        return self.cut
-
-    def _flush(self, cut: int) -> None:
-        self.cut = cut
-        for key, parts in self.held.items():
-            rest = np.concatenate(parts)[cut:] if parts else np.empty(0)
-            if rest.size:
-                self.series[key].push(rest)
-        self.held = {}
-        self.flushed = True
-
-
 def _curve(allan: AllanResult) -> dict[str, Any]:
     """One deviation curve as JSON lists (lower/upper None where no interval)."""
     def listed(values: np.ndarray | None) -> list[float | None]:
@@ -453,8 +408,10 @@ def run_pass(
         Rows of the run, for the progress callback (0 when not known).
     gaps
         ``"split"``: the df/dt filter restarts after each gap (see
-        :class:`~hrgtc.compensate.Compensator`); the statistics run over the joined
-        segments.
+        :class:`~hrgtc.compensate.Compensator`) and settles again: the figures leave out
+        the first ``warmup_s`` after every gap (an error when nothing is left);
+        otherwise the filter carries across and only the run's first ``warmup_s`` is
+        left out. The statistics run over the joined segments.
     deviation
         The deviation curve: ``"oadev"`` (overlapping Allan, default), ``"adev"``
         (non-overlapping), ``"mdev"``, ``"hdev"``, ``"tdev"`` (:data:`DEVIATIONS`).
@@ -497,8 +454,11 @@ def run_pass(
             full = {key: SeriesStatistics(metadata.sample_rate_hz, taus_s, allan,
                                           expected_samples=total_rows)
                     for key in keys}
-            cut = _SettlingCut(full, settle_rows(model.drift.settings),
-                               2 * round(10.0 * metadata.sample_rate_hz))
+            cut = SettlingCut(full, model.drift.settings.warmup_s,
+                               1.0 / metadata.sample_rate_hz,
+                               2 * round(10.0 * metadata.sample_rate_hz),
+                               restart_at_gaps=gaps == "split",
+                               keep_mask=allan and deviation != "oadev")
             split = DirectionSplit(model, metadata.sample_rate_hz)
         out = frequency.process(chunk)
         if on_output is not None:
@@ -517,7 +477,7 @@ def run_pass(
             kept = keep[frequency.samples - len(chunk):frequency.samples]
             left_out += int(np.count_nonzero(~kept))
             pushed = {key: values[kept] for key, values in pushed.items()}
-        cut.push(pushed)
+        cut.push(pushed, chunk.time_s if keep is None else chunk.time_s[kept])
         if allan and deviation != "oadev":
             for key, values in pushed.items():
                 whole.setdefault(key, []).append(values)
@@ -536,7 +496,7 @@ def run_pass(
     if metadata is None:
         raise InputError(f"{name}: the run holds no samples")
     fs = metadata.sample_rate_hz
-    n_used = frequency.samples - cut.finish()
+    n_used = frequency.samples - cut.finish(name)
     n = frequency.samples
     if n < 2 * round(10.0 * fs):
         raise InputError(f"{name}: {n / fs:.1f} s is too short for a 10 s bias stability "
@@ -558,7 +518,7 @@ def run_pass(
             if deviation == "oadev":
                 deviations[key] = _with_interval(series.allan_deviation(), n_used, confidence)
             else:  # the other deviations need the whole series (held in memory for them)
-                deviations[key] = _deviation(np.concatenate(whole[key])[cut.cut:], fs,
+                deviations[key] = _deviation(np.concatenate(whole[key])[cut.kept()], fs,
                                              deviation, confidence)
             if deviations[key].kind == "allan":
                 terms[key] = noise_terms(deviations[key])

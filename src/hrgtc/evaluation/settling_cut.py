@@ -1,0 +1,110 @@
+"""The evaluation's cut of the df/dt filter's settling time, on the time axis.
+
+Training leaves out the first ``warmup_s`` seconds after power-on (and after every gap
+when the filter restarts there, ``--gaps split``); the evaluation's figures leave out
+the same samples (:class:`SettlingCut`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hrgtc.core.timeline import is_gap
+from hrgtc.errors import InputError
+from hrgtc.evaluation.series_stats import SeriesStatistics
+
+
+class SettlingCut:
+    """Series statistics fed only with samples past the df/dt filter's settling time.
+
+    Settling is time on the axis (:mod:`hrgtc.core.timeline`), as in training: the
+    first ``warmup_s`` seconds after the run's first sample and, when the filter
+    restarts after every gap (``gaps="split"``), after every gap too. A run with fewer
+    than ``minimum`` settled samples keeps its last ``minimum`` samples (two 10 s
+    blocks) instead -- except when the filter restarts at gaps: then no sample is a
+    fair one and :meth:`finish` raises, naming ``--gaps bridge``. Until that is decided
+    the rows are held back; then they are fed in order.
+    """
+
+    def __init__(self, series: dict[str, SeriesStatistics], warmup_s: float, period_s: float,
+                 minimum: int, restart_at_gaps: bool = False, keep_mask: bool = False,
+                 ) -> None:
+        self.series = series
+        self.warmup_s = float(warmup_s)
+        self.period_s = float(period_s)
+        self.minimum = minimum
+        self.restart_at_gaps = restart_at_gaps
+        self.held: dict[str, list[np.ndarray]] = {key: [] for key in series}
+        self.held_masks: list[np.ndarray] = []
+        self.masks: list[np.ndarray] | None = [] if keep_mask else None
+        self.rows = 0
+        self.settled_rows = 0
+        self.cut = 0
+        self.flushed = False
+        self._origin: float | None = None
+        self._last: float | None = None
+
+    def _settled(self, time: np.ndarray) -> np.ndarray:
+        if self._origin is None:
+            self._origin = float(time[0])
+        origin = np.full(time.size, self._origin)
+        if self.restart_at_gaps:
+            starts = np.flatnonzero(is_gap(np.diff(time), self.period_s)) + 1
+            if self._last is not None and is_gap(time[0] - self._last, self.period_s):
+                starts = np.concatenate([[0], starts])
+            if starts.size:
+                lengths = np.diff(np.append(starts, time.size))
+                origin[starts[0]:] = np.repeat(time[starts], lengths)
+                self._origin = float(time[starts[-1]])
+        self._last = float(time[-1])
+        return time - origin >= self.warmup_s
+
+    def push(self, values: dict[str, np.ndarray], time: np.ndarray) -> None:
+        """The next rows of every series (one length) and their times [s]."""
+        if not time.size:
+            return
+        mask = self._settled(time)
+        self.rows += time.size
+        if self.flushed:
+            self._feed(values, mask)
+            return
+        for key, array in values.items():
+            self.held[key].append(array)
+        self.held_masks.append(mask)
+        self.settled_rows += int(mask.sum())
+        if self.settled_rows >= self.minimum:
+            self._flush(np.concatenate(self.held_masks))
+
+    def _feed(self, values: dict[str, np.ndarray], mask: np.ndarray) -> None:
+        self.cut += int(mask.size - np.count_nonzero(mask))
+        if self.masks is not None:
+            self.masks.append(mask)
+        for key, array in values.items():
+            rest = array[mask]
+            if rest.size:
+                self.series[key].push(rest)
+
+    def finish(self, name: str = "run") -> int:
+        """Feed what is still held back; the number of samples left out (settling)."""
+        if not self.flushed:
+            if self.restart_at_gaps and self.settled_rows < self.minimum:
+                raise InputError(
+                    f"{name}: only {self.settled_rows} of {self.rows} samples are past the df/dt "
+                    f"filter's {self.warmup_s:g} s settling time: --gaps split restarts the "
+                    "filter after every gap and the segments are shorter than that; use --gaps "
+                    "bridge (the filter carries across gaps, e.g. a burst logger)")
+            mask = np.zeros(self.rows, dtype=bool)
+            mask[max(self.rows - self.minimum, 0):] = True
+            self._flush(mask)
+        return self.cut
+
+    def kept(self) -> np.ndarray:
+        """Mask of the rows fed (only with ``keep_mask``)."""
+        return np.concatenate(self.masks) if self.masks else np.empty(0, dtype=bool)
+
+    def _flush(self, mask: np.ndarray) -> None:
+        held = {key: np.concatenate(parts) if parts else np.empty(0)
+                for key, parts in self.held.items()}
+        self.held, self.held_masks = {}, []
+        self.flushed = True
+        self._feed(held, mask)
