@@ -254,6 +254,27 @@ GapsOption = Annotated[
         rich_help_panel=_INPUT,
     ),
 ]
+StartOption = Annotated[
+    str | None,
+    typer.Option(
+        "--start",
+        metavar="SECONDS|ISO",
+        help="Read from this time on: seconds since the file's first sample (e.g. 600) or, for "
+        "a file with clock times, an ISO time (e.g. 2020-03-07T16:30). Rows before are "
+        "counted, not used.",
+        rich_help_panel=_INPUT,
+    ),
+]
+EndOption = Annotated[
+    str | None,
+    typer.Option(
+        "--end",
+        metavar="SECONDS|ISO",
+        help="Read up to (not including) this time: seconds since the file's first sample or "
+        "an ISO clock time, as for --start.",
+        rich_help_panel=_INPUT,
+    ),
+]
 _ReadingGapsOption = Annotated[
     GapPolicy | None,
     typer.Option(
@@ -381,6 +402,8 @@ def recording_input(
     spike_lsb: float | None = None,
     spike_window_s: float | None = None,
     motion: MotionPolicy | str | None = None,
+    start: str | None = None,
+    end: str | None = None,
 ) -> ReadOptions:
     """Gather the values of the shared reading options into a :class:`ReadOptions`."""
     from hrgtc.recording import ReadOptions
@@ -409,6 +432,8 @@ def recording_input(
                                                  ("spike_window_s", spike_window_s))
            if value is not None},
         motion=str(getattr(motion, "value", motion) or "exclude"),
+        start=start,
+        end=end,
     )
 
 
@@ -434,6 +459,8 @@ _READING_OPTIONS: tuple[tuple[str, Any], ...] = (
     ("spike_window_s", SpikeWindowOption),
     ("thermometer", ThermometerOption),
     ("motion", MotionOption),
+    ("start", StartOption),
+    ("end", EndOption),
 )
 
 
@@ -444,7 +471,8 @@ def reading_options(command: Callable[..., Any]) -> Callable[..., Any]:
     parameter) instead of the separate options; the command line still shows
     ``--col``, ``--time-unit``, ``--freq-unit``, ``--rate-unit``, ``--sample-rate-hz``,
     ``--unit-name``, ``--input-rate-dph``, ``--gaps``, ``--temp-scale``,
-    ``--temp-offset``, ``--spikes``, ``--thermometer`` and ``--motion``.
+    ``--temp-offset``, ``--spikes``, ``--thermometer``, ``--motion``, ``--start`` and
+    ``--end``.
     """
     signature = inspect.signature(command)
     namespace = command.__globals__

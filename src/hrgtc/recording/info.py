@@ -261,6 +261,8 @@ def describe(
     spike_k: float = SPIKE_K,
     spike_lsb: float = SPIKE_LSB,
     spike_window_s: float = SPIKE_WINDOW_S,
+    start: str | float | None = None,
+    end: str | float | None = None,
 ) -> RecordingInfo:
     """Summarise and validate a recording file in one streaming pass.
 
@@ -275,6 +277,8 @@ def describe(
         spikes are flagged and counted (``metadata["extra"]["spikes_flagged"]``), no
         row is dropped. For the sensor thermometer the ``freq_hz*`` columns, copies
         of the temperature, are not listed.
+    start, end
+        The slice read (``--start/--end``, see :func:`hrgtc.recording.read`).
     rows
         Rows per chunk read.
     progress
@@ -307,7 +311,7 @@ def describe(
             thermometer=thermometer, rate_scale=rate_scale, temp_unwrap=temp_unwrap,
             spike_filter=spike_filter or "off", spike_k=spike_k, spike_lsb=spike_lsb,
             spike_window_s=spike_window_s,
-            time_repair=repairer,
+            time_repair=repairer, start=start, end=end,
         ):
             meta = chunk.metadata
             names = names or [n for n in chunk.names if n != SPIKE_COLUMN

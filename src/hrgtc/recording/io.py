@@ -41,6 +41,7 @@ from typing import Any
 import numpy as np
 
 from hrgtc.core.time_steps import TimeRepairStream
+from hrgtc.core.timeline import parse_time_bound
 from hrgtc.errors import InputError, RecordingError
 from hrgtc.progress import Progress
 from hrgtc.recording.axes import axis_view
@@ -173,6 +174,44 @@ def _repair_time(part: dict[str, np.ndarray], repairer: TimeRepairStream,
             for name, values in part.items()}
 
 
+class _TimeSlice:
+    """``--start/--end``: keep the rows from ``start`` to before ``end``, seconds since the
+    file's first sample or ISO clock times (a file with clock times); counts the rest."""
+
+    def __init__(self, start: str | float | None, end: str | float | None, plan: Any) -> None:
+        self.start, self.end, self.plan = start, end, plan
+        self.first: float | None = None
+        self.low = self.high = None
+        self.dropped = 0
+
+    @property
+    def active(self) -> bool:
+        return self.start is not None or self.end is not None
+
+    def apply(self, part: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+        time = part.get("time_s")
+        if not self.active or time is None or not len(time):
+            return part
+        if self.first is None:
+            self.first = float(time[0])
+            origin = (None if self.plan.time_origin_ns is None
+                      else str(np.datetime64(self.plan.time_origin_ns, "ns")))
+            self.low = parse_time_bound(self.start, origin)
+            self.high = parse_time_bound(self.end, origin)
+            if self.low is not None and self.high is not None and not self.high > self.low:
+                raise InputError(f"--end ({self.end}) must be after --start ({self.start})")
+        since = time - self.first
+        keep = np.ones(len(time), dtype=bool)
+        if self.low is not None:
+            keep &= since >= self.low
+        if self.high is not None:
+            keep &= since < self.high
+        if keep.all():
+            return part
+        self.dropped += int(len(time) - np.count_nonzero(keep))
+        return {name: values[keep] for name, values in part.items()}
+
+
 def _repair_extra(repairer: TimeRepairStream) -> dict[str, Any]:
     extra: dict[str, Any] = {}
     repaired = [event.message for event in repairer.events if event.repaired]
@@ -203,6 +242,8 @@ def read(
     spike_k: float = SPIKE_K,
     spike_lsb: float = SPIKE_LSB,
     spike_window_s: float = SPIKE_WINDOW_S,
+    start: str | float | None = None,
+    end: str | float | None = None,
 ) -> Recording:
     """Read a whole recording from Parquet, CSV or HDF5 (by suffix).
 
@@ -248,6 +289,11 @@ def read(
         one :class:`~hrgtc.errors.SpikeWarning` says how many and where.
     spike_k, spike_lsb, spike_window_s
         Threshold max(k·σ_MAD, m·LSB) and window [s] of the spike filter.
+    start, end
+        Keep only the rows from ``start`` to before ``end`` (``--start/--end``): seconds
+        since the file's first sample, or ISO clock times for a file with clock times
+        (e.g. ``"2020-03-07T16:30"``). Rows left out are counted in
+        ``extra["rows_sliced"]``; row numbers in later messages count the rows kept.
 
     Returns
     -------
@@ -276,6 +322,8 @@ def read(
         arrays = robust.apply(arrays, 0)
         repairer = _time_repairer(plan)
         arrays = _repair_time(arrays, repairer)
+        cut = _TimeSlice(start, end, plan)
+        arrays = cut.apply(arrays)
         meta = _metadata(plan, metadata, arrays.get("time_s"))
     if repairer.events or repairer.duplicates:
         meta = replace(meta, extra={**meta.extra, **_repair_extra(repairer)})
@@ -285,6 +333,8 @@ def read(
     if spike_filter != "off":
         meta = replace(meta, extra={**meta.extra, _SPIKE_KEYS[spike_filter]: robust.rows})
         robust.warn()
+    if cut.dropped:
+        meta = replace(meta, extra={**meta.extra, "rows_sliced": cut.dropped})
     recording = Recording(arrays, meta, source=str(path))
     if validate:
         validate_recording(recording, gaps, freq_band_hz=freq_band_hz, freq_span_hz=freq_span_hz,
@@ -341,6 +391,8 @@ def iter_chunks(
     spike_lsb: float = SPIKE_LSB,
     spike_window_s: float = SPIKE_WINDOW_S,
     time_repair: TimeRepairStream | None = None,
+    start: str | float | None = None,
+    end: str | float | None = None,
 ) -> Iterator[Recording]:
     """Stream a recording in chunks of ``rows`` rows without loading the file.
 
@@ -362,7 +414,7 @@ def iter_chunks(
         reach the caller. With ``gaps="split"`` gaps pass; split downstream. The time
         axis is repaired as by :func:`read` (``time_repair``: a
         :class:`~hrgtc.core.time_steps.TimeRepairStream` to use, whose events and counts
-        the caller reads afterwards). With
+        the caller reads afterwards) and sliced by ``start``/``end``. With
         ``spikes="drop"`` the rows of spikes are left out before the chunks are cut
         (the rows of later problems then count the rows kept).
     """
@@ -386,6 +438,7 @@ def iter_chunks(
             time_repair.time_unit, time_repair.naive_clock = (repairer.time_unit,
                                                               repairer.naive_clock)
             repairer = time_repair
+        cut = _TimeSlice(start, end, plan)
 
         def converted() -> Iterator[dict[str, np.ndarray]]:
             nonlocal offset
@@ -395,7 +448,9 @@ def iter_chunks(
                     part = spike_filter_.drop(part, offset)
                 part = robust.apply(part, offset)
                 offset += table.num_rows
-                yield _repair_time(part, repairer)
+                part = cut.apply(_repair_time(part, repairer))
+                if part.get("time_s") is None or len(part["time_s"]):
+                    yield part
 
         pieces = _rechunk(converted(), rows)
         head: list[dict[str, np.ndarray]] = []
@@ -488,6 +543,9 @@ class ReadOptions:
         Samples not at rest (:mod:`hrgtc.recording.motion`) in calibration and
         evaluation: ``"exclude"`` (left out and counted, default), ``"keep"`` (used, not
         checked) or ``"error"``. Reading itself never drops them.
+    start, end
+        ``--start/--end``: the slice of the file to read, seconds since its first
+        sample or ISO clock times (see :func:`read`). None: from the start / to the end.
     """
 
     columns: Mapping[str, str] | None = None
@@ -509,6 +567,8 @@ class ReadOptions:
     spike_lsb: float = SPIKE_LSB
     spike_window_s: float = SPIKE_WINDOW_S
     motion: str = "exclude"
+    start: str | None = None
+    end: str | None = None
 
     def keywords(self) -> dict[str, Any]:
         """The options as keyword arguments of :func:`read` and :func:`iter_chunks`.
@@ -526,6 +586,8 @@ class ReadOptions:
                     "spike_window_s": SPIKE_WINDOW_S}
         words.update({key: getattr(self, key) for key, default in defaults.items()
                       if getattr(self, key) != default})
+        words.update({key: getattr(self, key) for key in ("start", "end")
+                      if getattr(self, key) is not None})
         return words
 
     def with_spike_default(self, mode: str) -> ReadOptions:
