@@ -48,6 +48,8 @@ from hrgtc.core.timeline import GAP_FACTOR, gap_limit_s, median_period_s
 
 #: Modulus of a 32-bit counter in seconds, per time unit of the raw column.
 WRAP_MODULUS_S = {"ms": 2.0**32 * 1e-3, "us": 2.0**32 * 1e-6}
+#: Longest gap (as a fraction of the counter's range) a wrap may hide in.
+WRAP_GAP = 0.01
 DST_STEP_S = 3600.0
 #: A step back lands "near zero" (a reset) when it lands below this fraction of the
 #: time it came from.
@@ -203,6 +205,8 @@ def classify_time_steps(time_s: np.ndarray, *, nominal_period_s: float | None = 
     period = median_period_s(raw) if period_s is None else float(period_s)
     moduli = tuple(WRAP_MODULUS_S.values()) if time_unit is None else tuple(
         m for u, m in WRAP_MODULUS_S.items() if u == time_unit)
+    if naive_clock:
+        moduli = ()  # clock times do not wrap; their odd steps are daylight saving
     with np.errstate(invalid="ignore"):
         odd = step <= 0
         if naive_clock and math.isfinite(period):
@@ -223,7 +227,9 @@ def classify_time_steps(time_s: np.ndarray, *, nominal_period_s: float | None = 
         # glitched time is neither)
         goes_on = row + 1 >= n or 0.0 < raw[row + 1] - after <= max(limit, 0.0) or (
             not math.isfinite(limit))
-        modulus = next((m for m in moduli if 0.0 < s + m <= m / 2.0), None)
+        # a wrap lands where the counter would have been: a step of one period (or a gap
+        # of up to 1 % of the counter's range) past 2^32 units
+        modulus = next((m for m in moduli if 0.0 < s + m <= max(limit, WRAP_GAP * m)), None)
         if modulus is not None and goes_on:
             note("wrap", row, detail=modulus)
             cumulative += modulus

@@ -156,8 +156,7 @@ def _metadata(
 
 # -- reading -------------------------------------------------------------------
 def _time_repairer(plan: Any) -> TimeRepairStream:
-    unit = plan.units.get("time", "s")
-    return TimeRepairStream(None if unit == "s" else unit, naive_clock=plan.time_is_timestamp)
+    return TimeRepairStream(plan.units.get("time", "s"), naive_clock=plan.time_is_timestamp)
 
 
 def _repair_time(part: dict[str, np.ndarray], repairer: TimeRepairStream,

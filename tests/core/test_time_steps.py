@@ -1,0 +1,139 @@
+"""One classifier of odd time steps: each repaired case reads as the clean file."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from bursts import cut_bursts, duplicated_rows, with_time, wrapped_counter_s
+from hrgtc.core.time_steps import WRAP_MODULUS_S, TimeRepairStream, classify_time_steps
+from hrgtc.drift.features import EQ21, FeatureSettings
+from hrgtc.drift.windows import window_means
+from hrgtc.errors import RecordingError
+from hrgtc.recording import Metadata, Recording, iter_chunks, read, write
+from hrgtc.recording.validation import validate
+
+from synthetic import ramp_run
+
+
+@pytest.fixture(scope="module")
+def clean():
+    """A 2 h, 10 Hz ramp (longer than a µs counter's 71.6 min wrap)."""
+    return ramp_run(3, hours=2.0, sample_rate_hz=10.0, ramp_hours=1.0)
+
+
+def _csv(run: Recording, path, time_column: np.ndarray, fmt: str = "%.17g"):
+    data = np.column_stack([time_column, run.freq_hz, run.rate_dph])
+    np.savetxt(path, data, delimiter=",", header="t,f,w", comments="", fmt=fmt)
+    return path
+
+
+READ = {"columns": {"time_s": "t", "freq_hz": "f", "rate_dph": "w"},
+        "metadata": {"sample_rate_hz": 10.0, "input_rate_dph": 10.0}}
+
+
+def _windows(run: Recording):
+    settings = FeatureSettings(reference_freq_hz=4432.0, sample_rate_hz=10.0, warmup_s=100.0)
+    return window_means([run], settings, list(EQ21[:4]), 10.0)
+
+
+def test_a_wrapped_microsecond_counter_reads_as_the_clean_file(clean, tmp_path):
+    ticks = np.round((clean.time_s - clean.time_s[0] + 4000.0) / 1e-6).astype(np.int64)
+    counter = ticks % 2**32  # wraps after 294.967 s and again after 71.6 min
+    path = _csv(clean, tmp_path / "wrapped.csv", counter, fmt="%d")
+    run = read(path, units={"time": "us"}, **READ)
+    np.testing.assert_allclose(np.diff(run.time_s), np.diff(clean.time_s), atol=2e-6)
+    assert "wrapped (2 time(s)" in run.metadata.extra["time_repairs"][0]
+    # streamed in chunks of any size: the same times, a wrap on a chunk boundary included
+    for rows in (1000, 2950, 49_999):
+        streamed = np.concatenate([c.time_s for c in iter_chunks(path, rows=rows,
+                                                                 units={"time": "us"}, **READ)])
+        np.testing.assert_array_equal(streamed, run.time_s)
+    # the training windows are those of the clean file
+    a, b = _windows(with_time(clean, run.time_s)), _windows(clean)
+    np.testing.assert_allclose(a.terms, b.terms, rtol=1e-12)
+    np.testing.assert_allclose(a.bias_dph, b.bias_dph, rtol=1e-12)
+
+
+def test_a_reset_starts_a_new_segment_like_two_files(clean, tmp_path):
+    time = clean.time_s.copy()
+    time[36_000:] = time[36_000:] - time[36_000] + 0.0  # the logger restarts at 0
+    path = _csv(clean, tmp_path / "reset.csv", time)
+    run = read(path, gaps="split", **READ)
+    assert "restarts near zero" in run.metadata.extra["time_repairs"][0]
+    assert np.all(np.diff(run.time_s) > 0)
+    step = np.diff(run.time_s)
+    assert np.flatnonzero(step > 0.2).tolist() == [35_999]  # one gap, at the reset
+    np.testing.assert_array_equal(run.rate_dph, clean.rate_dph)
+
+
+def test_duplicated_rows_are_dropped_and_counted(clean, tmp_path):
+    doubled = duplicated_rows(clean, 5000, 40)  # a block of 40 rows sent twice
+    path = _csv(doubled, tmp_path / "dup.csv", doubled.time_s)
+    run = read(path, **READ)
+    assert run.metadata.extra["duplicates_dropped"] == 40
+    np.testing.assert_array_equal(run.time_s, clean.time_s)
+    np.testing.assert_array_equal(run.rate_dph, clean.rate_dph)
+
+
+def test_a_daylight_saving_step_in_clock_times_is_named(tmp_path):
+    start = np.datetime64("2026-10-25T02:30:00")
+    stamps = start + (np.arange(200) * 1000).astype("timedelta64[ms]")
+    stamps[100:] -= np.timedelta64(3600, "s")  # clocks go back at 03:00 local time
+    rng = np.random.default_rng(0)
+    lines = [f"{s},{4428.5 + rng.normal(0, 0.002)},{10 + rng.normal(0, 2)}" for s in stamps]
+    path = tmp_path / "dst.csv"
+    path.write_text("t,f,w\n" + "\n".join(lines) + "\n")
+    with pytest.raises(RecordingError, match=r"row 100: .*daylight saving"):
+        read(path, columns=READ["columns"], units={"time": "timestamp"})
+
+
+@pytest.mark.parametrize(("time_factor", "rate_hz", "hint"), [
+    (1000.0, 200.0, "looks like milliseconds: pass --time-unit ms"),
+    (1.0, 100.0, "the rate does not change within the file: fix the metadata (--rate-hz 200)"),
+    (1e-3, 200.0, "already in seconds (drop --time-unit ms)"),
+])
+def test_a_wrong_time_unit_or_rate_gives_one_hint_not_gaps_or_rate_changes(time_factor,
+                                                                          rate_hz, hint):
+    n = 6000
+    rng = np.random.default_rng(1)
+    run = Recording({"time_s": np.arange(n) * 0.005 * time_factor,
+                     "freq_hz": 4425 + rng.normal(0, 0.002, n),
+                     "rate_dph": 10 + rng.normal(0, 1, n)}, Metadata(sample_rate_hz=rate_hz))
+    report = validate(run, raise_errors=False)
+    assert [p.kind for p in report.problems] == ["sample_rate"]
+    assert hint in report.problems[0].message
+    assert "gap" not in report.problems[0].message
+
+
+def test_a_rate_that_really_changes_names_the_row(tmp_path):
+    n = 6000
+    time = np.r_[np.arange(4321) * 0.005, 4320 * 0.005 + np.arange(1, n - 4320) * 0.01]
+    rng = np.random.default_rng(2)
+    run = Recording({"time_s": time, "freq_hz": 4425 + rng.normal(0, 0.002, n),
+                     "rate_dph": 10 + rng.normal(0, 1, n)}, Metadata(sample_rate_hz=200.0))
+    path = write(run, tmp_path / "change.parquet")
+    for rows in (1000, 777, 6000):
+        with pytest.raises(RecordingError, match=r"row 4320: the time step changes to 100 Hz.*"
+                                                 r"split it at row 4320"):
+            list(iter_chunks(path, rows=rows))
+
+
+def test_classifier_cases_directly():
+    t = np.arange(20_000) * 0.5
+    wrapped = wrapped_counter_s(t, "us", start_s=4000.0)
+    d = classify_time_steps(wrapped, time_unit="us")
+    assert [e.kind for e in d.events] == ["wrap"] and d.events[0].repaired
+    np.testing.assert_allclose(np.diff(d.time_s), 0.5, atol=1e-6)
+    assert WRAP_MODULUS_S["us"] / 60 == pytest.approx(71.58, abs=0.01)
+    glitch = t.copy()
+    glitch[100] = 0.25  # one bad time stamp is neither a reset nor a wrap
+    assert [e.kind for e in classify_time_steps(glitch).events] == ["backwards"]
+    stream = TimeRepairStream("us")
+    parts = [stream.repair(wrapped[k:k + 333])[0] for k in range(0, wrapped.size, 333)]
+    np.testing.assert_allclose(np.concatenate(parts), d.time_s, atol=1e-9)
+
+
+def test_burst_helper_cuts_a_continuous_run(clean):
+    bursts = cut_bursts(clean, 5.0, 300.0)
+    assert len(bursts) == 24 * 50
