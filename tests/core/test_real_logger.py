@@ -1,0 +1,93 @@
+"""The real PAN cold-test recording: 25 bursts of 5 s every 300 s, ms time, 50 Hz.
+
+The reality check of the time axis: its bursts are segments, a warm-up is seconds
+from power-on, windows stay inside a burst, and the gap modes differ visibly.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from hrgtc.cli import app
+from hrgtc.core.timeline import Timeline
+from hrgtc.drift.features import FeatureSettings, parse_terms
+from hrgtc.drift.windows import window_means
+from hrgtc.errors import CalibrationError
+from hrgtc.recording import ReadOptions
+
+PAN = Path(__file__).resolve().parents[1] / "data" / "pan-cold-test" / "pan_tvc_cold_2020-03-07.csv"
+COLUMNS = {"time_s": "time (ms)", "temperature_c": "temp", "rate_dph_x": "gyrox rad/s",
+           "rate_dph_y": "gyroy rad/s", "rate_dph_z": "gyroz rad/s"}
+ARGS = ["--time-unit", "ms", "--thermometer", "sensor", "--rate-unit", "radps",
+        "--col", ",".join(f"{k}={v}" for k, v in COLUMNS.items()),
+        "--temp-scale", "-0.01", "--temp-offset", "660", "--spikes", "drop"]
+runner = CliRunner()
+
+
+def options(**more) -> ReadOptions:
+    return ReadOptions(columns=COLUMNS, units={"time": "ms", "rate": "radps"},
+                       thermometer="sensor", temp_scale=-0.01, temp_offset_c=660.0,
+                       spikes="drop", axis="x", **more)
+
+
+def test_info_header_gives_span_recorded_duration_and_25_segments():
+    result = runner.invoke(app, ["info", str(PAN), *ARGS, "--gaps", "bridge", "--json"])
+    assert result.exit_code == 0, result.stderr
+    timeline = json.loads(result.stdout)["timeline"]
+    assert timeline["segments"] == 25
+    assert timeline["recorded_s"] == pytest.approx(125.0)
+    assert timeline["burst_length_s"] == pytest.approx(5.0)
+    assert timeline["burst_period_s"] == pytest.approx(305.0, abs=0.1)
+    assert timeline["bursty"] is True
+    text = runner.invoke(app, ["info", str(PAN), *ARGS, "--gaps", "bridge"]).stdout
+    assert "recorded 125 s" in " ".join(text.split()) and "25 segment(s)" in text
+
+
+def test_the_bursts_are_segments_and_the_warm_up_is_seconds_from_power_on():
+    run = options(gaps="bridge").read(PAN)
+    line = Timeline.from_time(run.time_s, 1.0 / run.sample_rate_hz)
+    assert line.n_segments == 25 and line.samples_per_segment.tolist() == [250] * 25
+    settings = FeatureSettings(reference_freq_hz=20.0, sample_rate_hz=50.0, rate_tau_s=1.0,
+                               warmup_s=3.0)  # shorter than the first burst's 5 s
+    windows = window_means([run], settings, parse_terms(["f", "df"]), 4.0)
+    # the warm-up drops 3 s of the first burst (150 samples), nothing of the other 24; the
+    # 1 s remainders of 24 bursts are under half a window: dropped and counted
+    assert windows.dropped == {"warmup": 150, "partial_windows": 24 * 50}
+    assert windows.segments == 25
+    # 4 s windows in 5 s bursts: one full window per burst; the first burst's 2 s after the
+    # warm-up are half a window: kept
+    assert windows.time_s.size == 1 + 24
+    # no window mean mixes two bursts: each centre lies inside a burst
+    inside = [np.any((run.time_s.min() <= c) & (np.abs(line.start_s - c) < 5.0)) for c in
+              windows.time_s]
+    assert all(inside)
+
+
+def test_split_restarts_the_filter_per_burst_and_says_so_bridge_carries_on():
+    run = options(gaps="split").read(PAN)
+    settings = FeatureSettings(reference_freq_hz=20.0, sample_rate_hz=50.0, rate_tau_s=10.0,
+                               warmup_s=50.0)
+    with pytest.raises(CalibrationError, match=r"after every gap .*--gaps bridge"):
+        window_means([run], settings, parse_terms(["f", "df"]), 10.0, gaps="split")
+    bridged = window_means([run], settings, parse_terms(["f", "df"]), 10.0, gaps="bridge")
+    assert bridged.dropped["warmup"] == 250  # the first burst (15 s to 20 s) only
+    assert bridged.time_s.size == 24
+
+
+def test_evaluate_split_on_a_burst_file_refuses_instead_of_settling_figures(tmp_path):
+    model = tmp_path / "pan.json"
+    result = runner.invoke(app, ["calibrate", "--drift", str(PAN), *ARGS, "--gaps", "bridge",
+                                 "--terms", "f", "-o", str(model)])
+    assert result.exit_code == 0, result.stderr
+    split = runner.invoke(app, ["evaluate", str(PAN), "--model", str(model), *ARGS,
+                                "--gaps", "split", "--json"])
+    assert split.exit_code == 2
+    assert "--gaps bridge" in " ".join(split.stderr.split())
+    bridge = runner.invoke(app, ["evaluate", str(PAN), "--model", str(model), *ARGS,
+                                 "--gaps", "bridge", "--json"])
+    assert bridge.exit_code == 0, bridge.stderr
