@@ -31,6 +31,7 @@ from typing import Any
 
 import numpy as np
 
+from hrgtc.core.accounting import Accounting
 from hrgtc.drift.cross_validation import (
     CrossValidation,
     cross_validate,
@@ -148,6 +149,8 @@ class DriftModel(ParsedTerms):
     orientations: tuple[tuple[float, ...], ...] = ()
     pruning: dict[str, Any] | None = None
     _terms: tuple[Term, ...] = field(default=(), repr=False, compare=False)
+    #: Samples read, used and left out by reason in training (not kept in the model file).
+    accounting: Accounting | None = field(default=None, repr=False, compare=False)
 
     @property
     def history(self) -> tuple[Any, ...]:
@@ -248,6 +251,8 @@ class DriftModel(ParsedTerms):
             f"{self.n_windows} windows of {self.window_s:g} s ({self.n_samples} samples)",
             "Steps:",
         ]
+        if self.accounting is not None:
+            lines.insert(1, f"Training {self.accounting.summary()}")
         for n, step in enumerate(self.history, start=1):
             lines.append(f"  {n:>2}. {step.action:<8} {step.term:<10} F = {step.fstat:<12.5g} "
                          f"p = {step.pvalue:.3g}")
@@ -625,6 +630,7 @@ def fit(
         offsets_dph=group_offsets,
         orientations=groups.orientations,
         pruning=pruning,
+        accounting=_accounting(windows),
     )
 
 
@@ -638,3 +644,12 @@ def _variable_text(variable: str, sensor: bool) -> str:
         return _SENSOR_VARIABLES[variable]
     unit = variable_unit(variable)
     return f"{variable} in {unit.replace('Hz', '°C') if sensor else unit}"
+
+
+def _accounting(windows: TrainingWindows) -> Accounting:
+    """What training read and left out (warm-up, partial windows, ...)."""
+    accounting = Accounting(read=windows.n_samples)
+    for reason, count in windows.dropped.items():
+        accounting.drop(reason, count)
+    accounting.drop("motion", windows.n_not_at_rest)
+    return accounting
