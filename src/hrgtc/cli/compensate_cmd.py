@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -250,8 +251,10 @@ def evaluate_command(
         else:
             render_evaluation(results[""], sensor[""])
     elif json_output:
+        summary = [{k: None if isinstance(v, float) and not math.isfinite(v) else v
+                    for k, v in row.items()} for row in axis_summary(results)]  # NaN: no figure
         print_json({"unit": model.unit, "axes": {a: r.to_dict() for a, r in results.items()},
-                    "summary": axis_summary(results)})
+                    "summary": summary})
     else:
         for axis, result in results.items():
             console.rule(f"axis {axis}")

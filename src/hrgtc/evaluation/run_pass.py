@@ -511,6 +511,21 @@ def run_pass(
     for key, series in full.items():
         stability[key] = series.bias_stability()
         mean[key], rms[key] = series.mean(), series.rms()
+        if series.segments > 1:
+            longest = series.longest_segment_s
+            missing = [tau for tau, value in stability[key].items()
+                       if math.isnan(value) and tau > longest]
+            if missing:
+                notes.append(
+                    f"{key}: bias stability at τ = {', '.join(f'{t:g}' for t in missing)} s not "
+                    f"estimable: τ-means never span a gap and the longest of the "
+                    f"{series.segments} segments holds {longest:.6g} s (means of bursts across "
+                    "the gaps would carry the dead time's bias)")
+            if allan:
+                notes.append(
+                    f"{key}: Allan deviation pooled over {series.segments} segments, no difference "
+                    f"across a gap; τ beyond {longest / 2:.6g} s (half the longest segment) not "
+                    "estimable")
         intervals[key] = bias_stability_intervals(stability[key], n_used, fs, confidence)
         if not allan:
             continue

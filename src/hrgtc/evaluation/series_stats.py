@@ -33,6 +33,7 @@ Memory: at most :data:`FULL_SAMPLES` floats for the Allan deviation plus
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 
@@ -110,6 +111,11 @@ class _SecondDifferenceSums:
     def __init__(self, largest: int) -> None:
         self.factors = 2 ** np.arange(int(math.log2(max(largest, 1))) + 1)
         self.sums = np.zeros(self.factors.size)
+        self.counts = np.zeros(self.factors.size, dtype=np.int64)  # terms summed per factor
+        self._tail = np.empty(0)
+
+    def break_segment(self) -> None:
+        """A gap: no second difference reaches across it."""
         self._tail = np.empty(0)
 
     def push(self, values: np.ndarray) -> None:
@@ -127,6 +133,7 @@ class _SecondDifferenceSums:
             term = phase[start + 2 * m: stop + 2 * m] - 2.0 * phase[start + m: stop + m]
             term += phase[start:stop]
             self.sums[k] += float(np.dot(term, term))
+            self.counts[k] += stop - start
         keep = 2 * int(self.factors[-1])
         self._tail = np.array(data[-keep:])
 
@@ -170,13 +177,55 @@ class SeriesStatistics:
                 block *= 2
             largest = block // 2
         self._largest_exact = largest
+        self.segments = 1  # contiguous segments pushed (break_segment adds one)
+        self._segment_samples = 0
+        self._longest = 0
+        self._full_breaks: list[int] = []  # sample indices where a segment starts
+        self._coarse_crosses_gaps = False
 
-    def push(self, values: np.ndarray) -> None:
-        """Add the next samples."""
+    def push(self, values: np.ndarray, breaks: Sequence[int] = ()) -> None:
+        """Add the next samples; ``breaks``: indices in ``values`` where a segment starts
+        after a gap (no τ-block and no Allan difference reaches across it)."""
         values = np.asarray(values, dtype=np.float64)
+        cuts = sorted({int(b) for b in breaks if 0 <= b < values.size})
+        if not cuts:
+            self._push(values)
+            return
+        edges = [0, *[c for c in cuts if c > 0], values.size]
+        for k in range(len(edges) - 1):
+            if k > 0 or cuts[0] == 0:
+                self.break_segment()
+            self._push(values[edges[k]:edges[k + 1]])
+
+    def break_segment(self) -> None:
+        """A gap before the next sample: the partial τ-blocks are dropped (a block never
+        spans a gap) and the Allan differences restart."""
+        if self.n == 0:
+            return
+        self.segments += 1
+        self._longest = max(self._longest, self._segment_samples)
+        self._segment_samples = 0
+        for means in self._stability.values():
+            means._carry = np.empty(0)
+        if not self.allan:
+            return
+        if self._full is not None:
+            self._full_breaks.append(self.n)
+        else:
+            self._exact.break_segment()
+            self._decimated._carry = np.empty(0)
+            self._coarse_crosses_gaps = True
+
+    @property
+    def longest_segment_s(self) -> float:
+        """Duration of the longest contiguous segment pushed. [s]"""
+        return max(self._longest, self._segment_samples) / self.sample_rate_hz
+
+    def _push(self, values: np.ndarray) -> None:
         self.n += values.size
         self._sum += float(np.sum(values))
         self._sum_squares += float(np.dot(values, values))
+        self._segment_samples += values.size
         for means in self._stability.values():
             means.push(values)
         if not self.allan:
@@ -187,9 +236,15 @@ class SeriesStatistics:
                 held = np.concatenate(self._full)
                 self._full = None
                 self._exact = _SecondDifferenceSums(self._largest_exact)
-                self._exact.push(held)
                 self._decimated = _BlockMeans(2)
-                self._decimated.push(held)
+                edges = [0, *self._full_breaks, held.size]
+                for k in range(len(edges) - 1):
+                    if k:
+                        self._exact.break_segment()
+                        self._decimated._carry = np.empty(0)
+                        self._coarse_crosses_gaps = True
+                    self._exact.push(held[edges[k]:edges[k + 1]])
+                    self._decimated.push(held[edges[k]:edges[k + 1]])
                 self._shrink()
             return
         self._exact.push(values)
@@ -221,11 +276,17 @@ class SeriesStatistics:
         fs = self.sample_rate_hz
         if self._full is not None:
             values = np.concatenate(self._full) if self._full else np.empty(0)
+            if self._full_breaks:
+                return _pooled_allan(values, self._full_breaks, fs)
             return allan_deviation(values, fs, taus="octave")
         block = self._decimated.rows
         coarse = allan_deviation(self._decimated.means(), fs / block, taus="octave")
+        if self._coarse_crosses_gaps:  # block means across gaps: those τ are not estimable
+            coarse = AllanResult(taus_s=np.empty(0), deviation=np.empty(0),
+                                 counts=np.empty(0, dtype=np.int64), overlapping=True,
+                                 sample_rate_hz=fs, n_samples=self.n)
         small = self._exact.factors < block
-        counts = self.n + 1 - 2 * self._exact.factors[small]
+        counts = self._exact.counts[small]
         usable = counts > 1
         m = self._exact.factors[small][usable].astype(np.float64)
         fine = np.sqrt(self._exact.sums[small][usable] / (2.0 * counts[usable])) / m
@@ -234,3 +295,29 @@ class SeriesStatistics:
             deviation=np.concatenate([fine, coarse.deviation]),
             counts=np.concatenate([counts[usable], coarse.counts]),
             overlapping=True, sample_rate_hz=fs, n_samples=self.n)
+
+
+def _pooled_allan(values: np.ndarray, breaks: Sequence[int], fs: float) -> AllanResult:
+    """Overlapping Allan deviation pooled over the segments between ``breaks``.
+
+    Each octave τ's squared second differences are summed inside every segment long
+    enough for it and divided by their total count: no difference crosses a gap. A τ
+    longer than every segment (2m + 1 samples) is not estimable from the samples and is
+    left out (burst means with dead time would give a biased estimate).
+    """
+    edges = [0, *breaks, values.size]
+    sums: dict[int, float] = {}
+    counts: dict[int, int] = {}
+    for a, b in itertools.pairwise(edges):
+        if b - a < 3:
+            continue
+        part = allan_deviation(values[a:b], fs, taus="octave")
+        for tau, dev, count in zip(part.taus_s, part.deviation, part.counts, strict=True):
+            m = round(tau * fs)
+            sums[m] = sums.get(m, 0.0) + float(dev) ** 2 * int(count)
+            counts[m] = counts.get(m, 0) + int(count)
+    factors = np.array(sorted(m for m in counts if counts[m] > 1), dtype=np.int64)
+    total = np.array([counts[m] for m in factors], dtype=np.int64)
+    deviation = np.array([math.sqrt(sums[m] / counts[m]) for m in factors])
+    return AllanResult(taus_s=factors / fs, deviation=deviation, counts=total,
+                       overlapping=True, sample_rate_hz=fs, n_samples=int(values.size))

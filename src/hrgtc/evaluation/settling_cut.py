@@ -36,6 +36,8 @@ class SettlingCut:
         self.restart_at_gaps = restart_at_gaps
         self.held: dict[str, list[np.ndarray]] = {key: [] for key in series}
         self.held_masks: list[np.ndarray] = []
+        self.held_times: list[np.ndarray] = []
+        self._last_kept: float | None = None
         self.masks: list[np.ndarray] | None = [] if keep_mask else None
         self.rows = 0
         self.settled_rows = 0
@@ -66,23 +68,31 @@ class SettlingCut:
         mask = self._settled(time)
         self.rows += time.size
         if self.flushed:
-            self._feed(values, mask)
+            self._feed(values, mask, time)
             return
         for key, array in values.items():
             self.held[key].append(array)
         self.held_masks.append(mask)
+        self.held_times.append(time)
         self.settled_rows += int(mask.sum())
         if self.settled_rows >= self.minimum:
             self._flush(np.concatenate(self.held_masks))
 
-    def _feed(self, values: dict[str, np.ndarray], mask: np.ndarray) -> None:
+    def _feed(self, values: dict[str, np.ndarray], mask: np.ndarray, time: np.ndarray) -> None:
         self.cut += int(mask.size - np.count_nonzero(mask))
         if self.masks is not None:
             self.masks.append(mask)
+        kept = time[mask]
+        if not kept.size:
+            return
+        # where the samples fed are not contiguous (a gap): τ-blocks and Allan differences
+        # restart there
+        breaks = np.flatnonzero(is_gap(np.diff(kept), self.period_s)) + 1
+        if self._last_kept is not None and is_gap(kept[0] - self._last_kept, self.period_s):
+            breaks = np.concatenate([[0], breaks])
+        self._last_kept = float(kept[-1])
         for key, array in values.items():
-            rest = array[mask]
-            if rest.size:
-                self.series[key].push(rest)
+            self.series[key].push(array[mask], breaks.tolist())
 
     def finish(self, name: str = "run") -> int:
         """Feed what is still held back; the number of samples left out (settling)."""
@@ -105,6 +115,7 @@ class SettlingCut:
     def _flush(self, mask: np.ndarray) -> None:
         held = {key: np.concatenate(parts) if parts else np.empty(0)
                 for key, parts in self.held.items()}
-        self.held, self.held_masks = {}, []
+        time = np.concatenate(self.held_times) if self.held_times else np.empty(0)
+        self.held, self.held_masks, self.held_times = {}, [], []
         self.flushed = True
-        self._feed(held, mask)
+        self._feed(held, mask, time)

@@ -1,0 +1,58 @@
+"""Bias stability and Allan deviation never reach across a gap (segments pushed apart)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from hrgtc.evaluation.allan import allan_deviation
+from hrgtc.evaluation.series_stats import SeriesStatistics
+
+
+def _segments(seed=0, sizes=(1234, 777, 2048)):
+    rng = np.random.default_rng(seed)
+    # each segment sits at its own level: a difference across a gap would see the step
+    return [rng.normal(0.0, 1.0, n) + 100.0 * k for k, n in enumerate(sizes)]
+
+
+def _manual_oadev(parts, m):
+    total = count = 0.0
+    for x in parts:
+        phase = np.concatenate([[0.0], np.cumsum(x)])
+        if phase.size <= 2 * m:
+            continue
+        d = phase[2 * m:] - 2 * phase[m:-m] + phase[:-2 * m]
+        total += float(np.sum(d * d))
+        count += d.size
+    return np.sqrt(total / (2.0 * count)) / m, int(count)
+
+
+def test_tau_blocks_never_span_a_gap_and_allan_is_pooled_within_segments():
+    parts = _segments()
+    stats = SeriesStatistics(10.0, (1.0, 10.0), allan=True)
+    for k, part in enumerate(parts):
+        stats.push(part, [0] if k else [])
+    assert stats.segments == 3 and stats.longest_segment_s == pytest.approx(204.8)
+    means = np.concatenate([p[: p.size // 10 * 10].reshape(-1, 10).mean(axis=1) for p in parts])
+    assert stats.bias_stability()[1.0] == pytest.approx(np.std(means, ddof=1), rel=1e-12)
+    curve = stats.allan_deviation()
+    for tau, dev, n in zip(curve.taus_s, curve.deviation, curve.counts, strict=True):
+        m = round(tau * 10.0)
+        expected, count = _manual_oadev(parts, m)
+        assert dev == pytest.approx(expected, rel=1e-9) and n == count
+    # no τ beyond the longest segment's reach, and the step of 100 between segments is
+    # nowhere to be seen (white noise of σ 1: ADEV(τ0) ≈ 1)
+    assert curve.taus_s.max() * 10.0 * 2 < 2048
+    assert curve.deviation[0] == pytest.approx(1.0, rel=0.1)
+    joined = allan_deviation(np.concatenate(parts), 10.0, taus="octave")
+    assert joined.deviation[-1] > 5.0  # what reaching across the gaps would have reported
+
+
+def test_breaks_inside_one_push_and_in_the_decimated_path():
+    parts = _segments(1, sizes=(3000, 2500, 4000))
+    one = SeriesStatistics(10.0, (1.0,), allan=True, full_samples=2048)
+    one.push(np.concatenate(parts), [3000, 5500])
+    fine = one.allan_deviation()
+    for tau, dev, n in zip(fine.taus_s, fine.deviation, fine.counts, strict=True):
+        expected, count = _manual_oadev(parts, round(tau * 10.0))
+        assert dev == pytest.approx(expected, rel=1e-9) and n == count
