@@ -121,6 +121,7 @@ def calibrate_instrument(
     cross_axis: bool = False,
     read_options: ReadOptions | None = None,
     progress: StageProgress | None = None,
+    validate_options: ReadOptions | None = None,
     **settings: Any,
 ) -> InstrumentCalibration:
     """Calibrate every axis of an instrument (a single-axis file: the one axis).
@@ -154,6 +155,10 @@ def calibrate_instrument(
         Column mapping, units, metadata overrides for every file.
     progress
         Optional ``callback(stage, done, total)``; stages are prefixed with the axis.
+    validate_options
+        Reading options of the ``validate`` runs when they differ (a held-out last part
+        of the training file: ``start`` where the training's ``end`` is); default
+        ``read_options``.
     settings
         Further keyword arguments of :func:`hrgtc.calibration.calibrate`.
     """
@@ -192,8 +197,10 @@ def calibrate_instrument(
                                  else str(segment_table)})
     models = {axis: dataclasses.replace(m, provenance=record) for axis, m in models.items()}
     instrument = InstrumentModel(models, unit, record)
+    held_out = options if validate_options is None else dataclasses.replace(
+        validate_options, thermometer=thermometer)
     validation = {axis: tuple(evaluate(path, models[axis], allan=False,
-                                       read_options=axis_options(options, axis))
+                                       read_options=axis_options(held_out, axis))
                               for path in validate) for axis in axes}
     checks = tuple(check_scale_factor(path, instrument, options, table)
                    for path in validate_rate_tables)

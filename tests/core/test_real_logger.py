@@ -91,3 +91,21 @@ def test_evaluate_split_on_a_burst_file_refuses_instead_of_settling_figures(tmp_
     bridge = runner.invoke(app, ["evaluate", str(PAN), "--model", str(model), *ARGS,
                                  "--gaps", "bridge", "--json"])
     assert bridge.exit_code == 0, bridge.stderr
+
+
+def test_holdout_trains_on_the_first_bursts_and_validates_on_the_last(tmp_path):
+    model = tmp_path / "held.json"
+    result = runner.invoke(app, ["calibrate", "--drift", str(PAN), *ARGS, "--gaps", "bridge",
+                                 "--holdout-fraction", "0.25", "--window-s", "5", "--json",
+                                 "-o", str(model)])
+    assert result.exit_code == 0, result.stderr
+    document, _ = json.JSONDecoder().raw_decode(result.stdout)
+    for entry in document["axes"].values():
+        (held,) = entry["validation"]
+        assert held["n_samples"] == 6 * 250  # the last quarter: 6 whole bursts of 25
+        # trained on the first 19 bursts, the first inside the 50 s warm-up: 18 windows of 5 s
+        assert entry["drift"]["n_windows"] == 18
+    both = runner.invoke(app, ["calibrate", "--drift", str(PAN), "--drift", str(PAN), *ARGS,
+                               "--gaps", "bridge", "--holdout-s", "30", "-o", str(model),
+                               "--force"])
+    assert both.exit_code == 2 and "exactly one --drift" in " ".join(both.stderr.split())

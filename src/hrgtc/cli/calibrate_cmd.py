@@ -179,6 +179,12 @@ def calibrate_command(
     temp_ref_lag_s: float = typer.Option(
         None, "--temp-ref-lag-s", help="The reference's lag behind the sensor [s; default: "
         "fitted within ±1800 s]."),
+    holdout_s: float = typer.Option(
+        None, "--holdout-s", help="Hold out the last SECONDS of recorded time of the --drift "
+        "file (cut at a segment start: a burst is never split) and validate on it [s]."),
+    holdout_fraction: float = typer.Option(
+        None, "--holdout-fraction", help="Hold out this share of the --drift file's recorded "
+        "time at its end (e.g. 0.25) and validate on it."),
     force: ForceOption = False,
     strict: StrictOption = False,
     json_output: JsonOption = False,
@@ -243,8 +249,14 @@ def calibrate_command(
                 stages[stage] = True
                 error_console.print(f"[dim]… {stage}[/]")
 
+        validate_options = None
+        if holdout_s is not None or holdout_fraction is not None:
+            inputs, validate_options, validate = _holdout(
+                inputs, soaks, drift, validate, holdout_s, holdout_fraction)
+            if not json_output:
+                error_console.print(f"[dim]… held out {drift[0]} from {inputs.end} s on[/]")
         calibration = calibrate_instrument(
-            soaks, drift, validate or (), order=order,
+            soaks, drift, validate or (), validate_options=validate_options, order=order,
             terms=None if terms is None else [t.strip() for t in terms.split(",") if t.strip()],
             window_s=window_s, penter=penter, premove=premove, reference_c=reference_c,
             rate_tau_s=rate_tau_s, rate_tau2_s=rate_tau2_s, aux=_aux_mapping(aux or []),
@@ -283,6 +295,29 @@ def calibrate_command(
                 warn_ranges([v.ranges], json_output, strict=False)
     if strict and beyond:
         raise typer.Exit(STRICT_EXIT)
+
+
+def _holdout(inputs: ReadOptions, soaks: list[Path], drift: list[Path],
+             validate: list[Path] | None, holdout_s: float | None,
+             holdout_fraction: float | None) -> tuple[ReadOptions, ReadOptions, list[Path]]:
+    """Train on the first part of the one --drift file, validate on its last part (by time)."""
+    import dataclasses
+
+    from hrgtc.core.timeline import holdout_rows
+    from hrgtc.errors import InputError
+
+    if len(drift) != 1 or soaks or validate:
+        raise InputError("--holdout-s/--holdout-fraction hold out the end of one --drift file: "
+                         "give exactly one --drift and no --soak or --validate (or split the "
+                         "files yourself with --start/--end)")
+    if inputs.start is not None or inputs.end is not None:
+        raise InputError("--holdout-s/--holdout-fraction and --start/--end together: slice the "
+                         "file first, or use --end for training and --validate with --start")
+    time = inputs.read(drift[0], keep=["time_s"]).time_s
+    cut = holdout_rows(time, holdout_s, holdout_fraction)
+    at = f"{time[cut] - time[0]:.9g}"
+    return (dataclasses.replace(inputs, end=at), dataclasses.replace(inputs, start=at),
+            [drift[0]])
 
 
 def render_instrument(calibration: InstrumentCalibration) -> None:
