@@ -181,6 +181,8 @@ def render_evaluation(result: Evaluation, sensor: bool = False) -> None:
         console.print(result.directions.summary(sensor=sensor), markup=False)
     for note in result.notes:
         console.print(note)
+    if result.accounting is not None:
+        console.print(result.accounting.summary(), markup=False)
 
 
 @app.command("evaluate")

@@ -29,6 +29,7 @@ import numpy as np
 from hrgtc.compensate import Compensator
 from hrgtc.compensate.compensator import check_recording_noise, with_model_band
 from hrgtc.compensate.ranges import RangeReport
+from hrgtc.core.accounting import Accounting
 from hrgtc.drift.features import FeatureStream
 from hrgtc.drift.rest import run_rest
 from hrgtc.errors import HrgtcError, InputError, RecordingError
@@ -146,6 +147,9 @@ class Evaluation:
         Two-sided level of the intervals (0.683: 1σ).
     deviation
         Which deviation ``allan`` holds (a key of :data:`DEVIATIONS`).
+    accounting
+        Samples read, left out of the figures (the settling time) and flagged
+        (outside the calibrated temperature range), see :class:`hrgtc.core.Accounting`.
     directions
         Heating and cooling apart (:mod:`hrgtc.evaluation.heating_cooling`).
     mean_dph, rms_dph
@@ -180,6 +184,7 @@ class Evaluation:
     mean_dph: dict[str, float] = field(default_factory=dict)
     rms_dph: dict[str, float] = field(default_factory=dict)
     n_not_at_rest: int = 0
+    accounting: Accounting | None = None
 
     @property
     def name(self) -> str:
@@ -278,6 +283,7 @@ class Evaluation:
             "ranges": None if self.ranges is None else self.ranges.to_dict(),
             "notes": list(self.notes),
             "heating_cooling": None if self.directions is None else self.directions.to_dict(),
+            "accounting": None if self.accounting is None else self.accounting.to_dict(),
         }
 
     def allan_csv(self) -> str:
@@ -560,7 +566,18 @@ def run_pass(
         bias_stability_interval_dph=intervals, confidence=float(confidence),
         deviation=deviation, directions=split.result(), mean_dph=mean, rms_dph=rms,
         n_not_at_rest=left_out,
+        accounting=_accounting(n, cut.cut, frequency, left_out),
     )
+
+
+def _accounting(read: int, settling: int, frequency: Compensator,
+                not_at_rest: int = 0) -> Accounting:
+    """Samples read, left out of the figures (settling, motion) and flagged (out of range)."""
+    accounting = Accounting(read=read)
+    accounting.drop("warmup", settling)
+    accounting.drop("motion", not_at_rest)
+    accounting.flag("out_of_range", round(frequency.out_of_range_fraction * read))
+    return accounting
 
 
 def evaluate(
