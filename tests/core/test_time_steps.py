@@ -137,3 +137,20 @@ def test_classifier_cases_directly():
 def test_burst_helper_cuts_a_continuous_run(clean):
     bursts = cut_bursts(clean, 5.0, 300.0)
     assert len(bursts) == 24 * 50
+
+
+def test_info_names_what_the_time_repair_did(clean, tmp_path):
+    from typer.testing import CliRunner
+
+    from hrgtc.cli import app
+
+    ticks = np.round((clean.time_s[:20_000] - clean.time_s[0] + 4000.0) / 1e-6).astype(np.int64)
+    short = Recording({k: clean[k][:20_000] for k in clean.names}, clean.metadata)
+    path = _csv(short, tmp_path / "wrapped.csv", ticks % 2**32, fmt="%d")
+    args = ["info", str(path), "--col", "time_s=t,freq_hz=f,rate_dph=w", "--time-unit", "us"]
+    result = CliRunner().invoke(app, [*args, "--json"])
+    assert result.exit_code == 0, result.stderr
+    timeline = __import__("json").loads(result.stdout)["timeline"]
+    assert timeline["segments"] == 1 and "wrapped (1 time(s)" in timeline["repairs"][0]
+    text = " ".join(CliRunner().invoke(app, args).stdout.split())
+    assert "time: row 2950: the 32-bit us time counter wrapped" in text
