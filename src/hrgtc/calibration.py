@@ -108,6 +108,7 @@ class CalibrationResult:
                 "pruning": d.pruning,
                 "cross_validation": None if d.cross_validation is None
                 else d.cross_validation.to_dict(),
+                "accounting": None if d.accounting is None else d.accounting.to_dict(),
             },
             "housing": None if self.model.housing is None else {
                 "selected_terms": list(self.model.housing.selected),
