@@ -15,7 +15,7 @@ from hrgtc.errors import InputError
 PAN = Path(__file__).resolve().parents[1] / "data" / "pan-cold-test" / "pan_tvc_cold_2020-03-07.csv"
 ARGS = ["--time-unit", "ms", "--thermometer", "sensor", "--rate-unit", "radps", "--col",
         "time_s=time (ms),temperature_c=temp,rate_dph_x=gyrox rad/s,rate_dph_y=gyroy rad/s,"
-        "rate_dph_z=gyroz rad/s", "--temp-scale", "-0.01", "--temp-offset", "660",
+        "rate_dph_z=gyroz rad/s", "--temp-scale", "0.00587", "--temp-offset", "24.28",
         "--gaps", "bridge"]
 
 

@@ -25,13 +25,13 @@ COLUMNS = {"time_s": "time (ms)", "temperature_c": "temp", "rate_dph_x": "gyrox 
            "rate_dph_y": "gyroy rad/s", "rate_dph_z": "gyroz rad/s"}
 ARGS = ["--time-unit", "ms", "--thermometer", "sensor", "--rate-unit", "radps",
         "--col", ",".join(f"{k}={v}" for k, v in COLUMNS.items()),
-        "--temp-scale", "-0.01", "--temp-offset", "660", "--spikes", "drop"]
+        "--temp-scale", "0.00587", "--temp-offset", "24.28", "--spikes", "drop"]
 runner = CliRunner()
 
 
 def options(**more) -> ReadOptions:
     return ReadOptions(columns=COLUMNS, units={"time": "ms", "rate": "radps"},
-                       thermometer="sensor", temp_scale=-0.01, temp_offset_c=660.0,
+                       thermometer="sensor", temp_scale=0.00587, temp_offset_c=24.28,
                        spikes="drop", axis="x", **more)
 
 
