@@ -24,7 +24,7 @@ from hrgtc.cli._app import warning_cause
 DATA = Path(__file__).parents[1] / "data" / "pan-cold-test"
 RUN = DATA / "pan_tvc_cold_2020-03-07.csv"
 LOG = DATA / "pan_etu_cold_handlog_2020-03-07.csv"
-READ = ["--thermometer", "sensor", "--time-unit", "ms", "--rate-unit", "rad/s", "--gaps", "split",
+READ = ["--thermometer", "sensor", "--time-unit", "ms", "--rate-unit", "rad/s", "--gaps", "bridge",
         "--col", "time_s=time (ms),rate_dph_x=gyrox rad/s,rate_dph_y=gyroy rad/s,"
         "rate_dph_z=gyroz rad/s,temperature_c=temp"]
 REF = ["--temp-ref", str(LOG), "--temp-ref-col", "time_s=Time", "--temp-ref-col",

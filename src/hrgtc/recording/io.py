@@ -41,7 +41,6 @@ from typing import Any
 import numpy as np
 
 from hrgtc.core.time_steps import TimeRepairStream
-from hrgtc.core.timeline import parse_time_bound
 from hrgtc.errors import InputError, RecordingError
 from hrgtc.progress import Progress
 from hrgtc.recording.axes import axis_view
@@ -67,6 +66,7 @@ from hrgtc.recording.spikes import (
     SpikeFilter,
     check_spike_policy,
 )
+from hrgtc.recording.time_axis import _repair_extra, _repair_time, _time_repairer, _TimeSlice
 from hrgtc.recording.validation import (
     HEURISTIC_ROWS,
     GapPolicy,
@@ -155,72 +155,6 @@ def _metadata(
 
 
 # -- reading -------------------------------------------------------------------
-def _time_repairer(plan: Any) -> TimeRepairStream:
-    return TimeRepairStream(plan.units.get("time", "s"), naive_clock=plan.time_is_timestamp)
-
-
-def _repair_time(part: dict[str, np.ndarray], repairer: TimeRepairStream,
-                 ) -> dict[str, np.ndarray]:
-    """``part`` with its time axis repaired (unwrapped, resets shifted, duplicates out)."""
-    time = part.get("time_s")
-    if time is None or not len(time):
-        return part
-    others = [values for name, values in part.items() if name != "time_s"]
-    repaired, keep = repairer.repair(time, others)
-    if keep.all():
-        return part if repaired is time else {**part, "time_s": repaired}
-    return {name: repaired if name == "time_s" else values[keep]
-            for name, values in part.items()}
-
-
-class _TimeSlice:
-    """``--start/--end``: keep the rows from ``start`` to before ``end``, seconds since the
-    file's first sample or ISO clock times (a file with clock times); counts the rest."""
-
-    def __init__(self, start: str | float | None, end: str | float | None, plan: Any) -> None:
-        self.start, self.end, self.plan = start, end, plan
-        self.first: float | None = None
-        self.low = self.high = None
-        self.dropped = 0
-
-    @property
-    def active(self) -> bool:
-        return self.start is not None or self.end is not None
-
-    def apply(self, part: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
-        time = part.get("time_s")
-        if not self.active or time is None or not len(time):
-            return part
-        if self.first is None:
-            self.first = float(time[0])
-            origin = (None if self.plan.time_origin_ns is None
-                      else str(np.datetime64(self.plan.time_origin_ns, "ns")))
-            self.low = parse_time_bound(self.start, origin)
-            self.high = parse_time_bound(self.end, origin)
-            if self.low is not None and self.high is not None and not self.high > self.low:
-                raise InputError(f"--end ({self.end}) must be after --start ({self.start})")
-        since = time - self.first
-        keep = np.ones(len(time), dtype=bool)
-        if self.low is not None:
-            keep &= since >= self.low
-        if self.high is not None:
-            keep &= since < self.high
-        if keep.all():
-            return part
-        self.dropped += int(len(time) - np.count_nonzero(keep))
-        return {name: values[keep] for name, values in part.items()}
-
-
-def _repair_extra(repairer: TimeRepairStream) -> dict[str, Any]:
-    extra: dict[str, Any] = {}
-    repaired = [event.message for event in repairer.events if event.repaired]
-    if repaired:
-        extra["time_repairs"] = repaired
-    if repairer.duplicates:
-        extra["duplicates_dropped"] = repairer.duplicates
-    return extra
-
-
 def read(
     path: str | Path,
     columns: Mapping[str, str] | Iterable[str] | None = None,
