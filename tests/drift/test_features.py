@@ -56,20 +56,22 @@ def test_rate_of_a_ramp_is_its_slope_after_the_transient():
 
 
 def test_rate_filter_equals_its_transfer_function():
-    # Independent check: the exact discretisation of s/(tau s + 1)^2 as one IIR filter.
+    # Independent check for uniform steps: the first-order-hold discretisation of
+    # s/(tau s + 1)^2 as one IIR filter. Each stage is H = (p + q z^-1) / (1 - e z^-1)
+    # with e = exp(-r), a = 1 - e, p = 1 - a/r, q = a - p (r = dt/tau), so
+    # 1 - H = (1 - p)(1 - z^-1) / (1 - e z^-1) and rate = H (1 - H) x / tau.
     fs, tau = 20.0, 5.0
     rng = np.random.default_rng(3)
     x = np.cumsum(rng.normal(size=5000)) * 1e-3
     rate, _, _ = causal_rate(x, tau, fs)
-    a = -np.expm1(-1 / (tau * fs))
-    b1 = 1 - a
-    # y1 = H x with H = a / (1 - b1 z^-1); rate = g (y1 - H y1) = g H (1 - H) x, with the
-    # ramp gain g = a fs / b1; (1 - H) = (1 - a - b1 z^-1) / (1 - b1 z^-1).
-    gain = a * fs / b1
-    num = gain * a * np.array([1.0 - a, -b1])
-    den = np.polymul([1.0, -b1], [1.0, -b1])
+    r = 1 / (tau * fs)
+    a = -np.expm1(-r)
+    e, p = 1 - a, 1 - a / r
+    q = a - p
+    num = np.polymul([p, q], [1.0 - p, -(1.0 - p)]) / tau
+    den = np.polymul([1.0, -e], [1.0, -e])
     expected = signal.lfilter(num, den, x - x[0])
-    np.testing.assert_allclose(rate, expected, atol=1e-15 * np.max(np.abs(x)) + 1e-18)
+    np.testing.assert_allclose(rate, expected, atol=1e-12 * np.max(np.abs(x)))
 
 
 @settings(max_examples=30, deadline=None)
@@ -140,18 +142,22 @@ def test_grammar_knows_d2_g_and_aux_channels():
 
 
 def test_d2_is_the_rate_filter_with_its_own_time_constant():
-    # independent: both low-pass stages by scipy.signal.lfilter with alpha = 1 - exp(-1/(tau fs)),
-    # started at the first sample, and the ramp gain alpha fs / (1 - alpha)
+    # independent: both first-order-hold stages by scipy.signal.lfilter, b = [p, q],
+    # a = [1, -e] (e = exp(-r), p = 1 - (1 - e)/r, q = 1 - e - p, r = 1/(tau fs)),
+    # started at rest on the first sample; the rate is (y1 - y2) / tau
     run = _lagged_run()
     fs, tau2 = 5.0, 120.0
     s = FeatureSettings(reference_freq_hz=4432.0, sample_rate_hz=fs, rate_tau_s=3.0,
                         rate_tau2_s=tau2)
     values = compute_variables(run, s, ("f", "df", "d2"))
     f = run.freq_hz - 4432.0
-    alpha = 1.0 - np.exp(-1.0 / (tau2 * fs))
-    y1 = signal.lfilter([alpha], [1.0, alpha - 1.0], f, zi=[(1.0 - alpha) * f[0]])[0]
-    y2 = signal.lfilter([alpha], [1.0, alpha - 1.0], y1, zi=[(1.0 - alpha) * f[0]])[0]
-    expected = (y1 - y2) * alpha * fs / (1.0 - alpha)
+    r = 1.0 / (tau2 * fs)
+    e = np.exp(-r)
+    p = 1.0 - (1.0 - e) / r
+    q = 1.0 - e - p
+    y1 = signal.lfilter([p, q], [1.0, -e], f, zi=[(q + e) * f[0]])[0]
+    y2 = signal.lfilter([p, q], [1.0, -e], y1, zi=[(q + e) * f[0]])[0]
+    expected = (y1 - y2) / tau2
     np.testing.assert_allclose(values["d2"], expected, rtol=1e-9, atol=1e-15)
     assert not np.allclose(values["d2"], values["df"])  # a slower filter, not df again
     # the slow filter lags more: on the exponential approach its rate is behind df's

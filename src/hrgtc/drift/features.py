@@ -7,12 +7,12 @@ df/dt comes from a causal filter whose settings are stored in the model file,
 so deployment computes the same numbers sample by sample as training did.
 
 The rate filter (:mod:`hrgtc.drift.rate_filter`) is the derivative of a twice low-passed signal,
-D(s) = s / (tau s + 1)^2: y1 follows f through the exact one-step update of a
-first-order lag with time constant tau, y2 follows y1 likewise, and the rate
-is (y1 - y2) divided by the stages' ramp lag (tau in the continuous limit).
-Two state variables per input, no differencing of noisy samples. The gain is
-set so that the steady response to a ramp is exactly its slope; the group
-delay at low frequency is 2 tau.
+D(s) = s / (tau s + 1)^2: y1 follows f through the exact update of a first-order lag
+over each step's own Δt (the samples' times, so jittered clocks, bursts and gaps
+are handled: a gap is bridged with its Δt), y2 follows y1 likewise, and the rate
+is (y1 - y2) / tau. Two state variables per input, no differencing of noisy
+samples; the response to a ramp is exactly its slope once settled, whatever the
+steps; the group delay at low frequency is 2 tau.
 
 Variables of the grammar (all relative to the reference point):
 
@@ -63,6 +63,7 @@ from hrgtc.drift.rate_filter import (  # noqa: F401  (re-exported: imported from
     RateFilterState,
     causal_rate,
     rate_filter_coefficients,
+    restart_mask,
 )
 from hrgtc.drift.variables import AUX_PREFIX, DRIFT_VARIABLES, FIXED
 from hrgtc.drift.variables import variable as _registered
@@ -445,14 +446,22 @@ class FeatureStream:
         self._states: dict[str, RateFilterState] = {}
         self.samples_seen = 0
 
-    def _rate(self, key: str, level: np.ndarray, tau_s: float) -> np.ndarray:
-        rate, _, self._states[key] = causal_rate(level, tau_s, self.settings.sample_rate_hz,
-                                                 self._states.get(key))
+    def _rate(self, key: str, level: np.ndarray, tau_s: float, time_s: np.ndarray,
+              restart: np.ndarray | None) -> np.ndarray:
+        rate, _, self._states[key] = causal_rate(level, tau_s, state=self._states.get(key),
+                                                 time_s=time_s, restart=restart)
         return rate
 
-    def process(self, chunk: Recording) -> dict[str, np.ndarray]:
-        """Variables of the next chunk of the run, keyed by variable name."""
+    def process(self, chunk: Recording, restart: np.ndarray | None = None
+                ) -> dict[str, np.ndarray]:
+        """Variables of the next chunk of the run, keyed by variable name.
+
+        Each step of the rate filters uses its own Δt from ``chunk.time_s`` (a gap is
+        bridged with the gap's Δt); ``restart`` (a boolean mask of the chunk's rows,
+        e.g. the segment starts of ``--gaps split``) starts them at rest on those rows.
+        """
         s = self.settings
+        time_s = chunk.time_s
         base: dict[str, np.ndarray] = {}
         if any(v in ("f", "df", "dpos", "d2") for v in self.variables):
             base["f"] = chunk["freq_hz"] - s.reference_freq_hz
@@ -469,11 +478,12 @@ class FeatureStream:
             elif is_aux(v):
                 out[v] = self._aux(chunk, v)
             elif v == "d2":
-                out[v] = self._rate("f2", base["f"], s.rate_tau2_s)
+                out[v] = self._rate("f2", base["f"], s.rate_tau2_s, time_s, restart)
             else:
                 source = _RATE_OF[v]
                 if source not in rates:
-                    rates[source] = self._rate(source, base[source], s.rate_tau_s)
+                    rates[source] = self._rate(source, base[source], s.rate_tau_s, time_s,
+                                               restart)
                 rate = rates[source]
                 out[v] = heating_part(rate, s.switch_hz_per_s) if v == "dpos" else rate
         self.samples_seen += len(chunk)

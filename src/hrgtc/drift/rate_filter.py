@@ -1,12 +1,44 @@
-"""The causal rate filter of the drift model's df/dt (and dh/dt, d2).
+"""The causal rate filter of the drift model's df/dt (and dh/dt, d2), on the time axis.
 
 The rate filter is the derivative of a twice low-passed signal,
-D(s) = s / (tau s + 1)^2: y1 follows x through the exact one-step update of a
-first-order lag with time constant tau, y2 follows y1 likewise, and the rate is
-(y1 - y2) divided by the stages' ramp lag (tau in the continuous limit). Two state
-variables per input, no differencing of noisy samples; the steady response to a
-ramp is exactly its slope. :mod:`hrgtc.drift.features` uses it for ``df``, ``dh``
-and ``d2`` (the same filter with its own time constant).
+D(s) = s / (tau s + 1)^2: y1 follows x through a first-order lag with time
+constant tau, y2 follows y1 likewise, and the rate is (y1 - y2) / tau. Two state
+variables per input, no differencing of noisy samples.
+
+Each step is the **exact** solution of the first-order lag over that step's own
+Δt for an input that moves linearly from the previous sample to this one (a
+first-order hold). With r = Δt/tau, a = 1 - exp(-r) and p = 1 - a/r::
+
+    y_n = y_{n-1} + a (x_{n-1} - y_{n-1}) + p (x_n - x_{n-1})
+
+Derivation: over the step x(t) = x_{n-1} + m (t - t_{n-1}), m = (x_n - x_{n-1})/Δt,
+and tau y' = x - y has the solution y(t) = x(t) - m tau + C exp(-(t - t_{n-1})/tau)
+with C = y_{n-1} - x_{n-1} + m tau; at t_n this is the update above. For a ramp of
+slope s the particular solution y = x - s tau holds at **every** step whatever its
+Δt, and the second stage, whose input y1 = x - s tau is again a ramp of slope s,
+gives y2 = y1 - s tau: (y1 - y2) / tau = s exactly, for uniform, jittered or
+gapped sampling alike. (The sample-count filter this replaces, y += alpha (x_n - y)
+with the gain alpha·fs/beta, was exact for uniform steps only; after a long gap it
+read the temperature as having jumped at the gap's start.) Across a gap the step
+is the gap's Δt: the temperature is taken to have moved in a straight line while
+the logger slept ("bridge"); ``restart`` starts the filter at rest on a sample
+instead (a "split" segment start, or a new run).
+
+The state is kept as differences, which are small and carry the rate (no
+cancellation of two levels): ``lag`` = x_{n-1} - y1 and ``difference`` = y1 - y2::
+
+    c1 = a lag + p (x_n - x_{n-1});   lag <- lag + (x_n - x_{n-1}) - c1
+    c2 = a difference + p c1;         difference <- difference + c1 - c2
+    rate = difference / tau
+
+The same statements run in the numba kernel (:mod:`hrgtc.compensate._kernel`),
+the streaming compensator and the C export (double and float32), so training and
+deployment compute the same df/dt.
+
+For r < :data:`SERIES_LIMIT`, p = r/2 - r^2/6 + r^3/24 - ... (its Taylor series, 9
+terms: exact to rounding), since (r - a)/r cancels. a and p depend only on Δt,
+so they are recomputed only when Δt moves by more than :data:`DT_REL_TOLERANCE`
+of itself (a timing error of 1e-6 Δt; logger clocks are far coarser).
 """
 
 from __future__ import annotations
@@ -15,64 +47,219 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from hrgtc.errors import InputError
 
+#: Below this r = Δt/tau the weight p comes from its Taylor series.
+SERIES_LIMIT = 0.1
+#: Terms of that series (the first neglected one is below 1e-16 of p at SERIES_LIMIT).
+SERIES_TERMS = 9
+#: A step whose Δt is within this share of the last one reuses its weights.
+DT_REL_TOLERANCE = 1e-6
+#: Slots of the filter state array: lag, difference, previous input, previous time,
+#: started (0/1), and the cached step: its Δt, a and p.
+LAG, DIFFERENCE, X_PREV, T_PREV, STARTED, DT, A, P = range(8)
+STATE_SIZE = 8
 
-def rate_filter_coefficients(tau_s: float, sample_rate_hz: float) -> tuple[float, float]:
-    """(alpha, beta) of one exact first-order low-pass step y += alpha (x - y)."""
+
+def _series_coefficients() -> tuple[float, ...]:
+    """(-1)^(k+1) / (k+1)! for k = 1..SERIES_TERMS: p(r) = sum_k c_k r^k."""
+    return tuple((-1.0) ** (k + 1) / math.factorial(k + 1) for k in range(1, SERIES_TERMS + 1))
+
+
+SERIES = _series_coefficients()
+_S1, _S2, _S3, _S4, _S5, _S6, _S7, _S8, _S9 = SERIES  # compiled in as constants
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def step_weights(dt_s, tau_s):  # pragma: no cover - compiled
+    """(a, p) of one step of length ``dt_s``: a = 1 - exp(-r), p = 1 - a/r, r = dt/tau."""
+    r = dt_s / tau_s
+    a = -math.expm1(-r)
+    if r < 0.1:  # SERIES_LIMIT; Horner, highest power first
+        p = _S9
+        p = p * r + _S8
+        p = p * r + _S7
+        p = p * r + _S6
+        p = p * r + _S5
+        p = p * r + _S4
+        p = p * r + _S3
+        p = p * r + _S2
+        p = p * r + _S1
+        p = p * r
+    else:
+        p = (r - a) / r
+    return a, p
+
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def filter_step(state, x, t, tau_s, restart):  # pragma: no cover - compiled
+    """Advance ``state`` (see :data:`LAG`) by one sample (x at time t); return the rate.
+
+    ``restart`` (or a state never started) puts the filter at rest on this sample
+    (rate 0). A step of zero or negative Δt moves nothing but the previous input.
+    """
+    if restart or state[4] == 0.0:
+        state[0] = 0.0
+        state[1] = 0.0
+        state[2] = x
+        state[3] = t
+        state[4] = 1.0
+        return 0.0
+    dt = t - state[3]
+    dt = 0.0 if not dt > 0.0 else dt
+    if not abs(dt - state[5]) <= 1e-6 * state[5]:  # DT_REL_TOLERANCE
+        a, p = step_weights(dt, tau_s)
+        state[5] = dt
+        state[6] = a
+        state[7] = p
+    a = state[6]
+    p = state[7]
+    delta = x - state[2]
+    c1 = a * state[0]
+    c1 = c1 + p * delta
+    lag = state[0] + delta
+    state[0] = lag - c1
+    c2 = a * state[1]
+    c2 = c2 + p * c1
+    difference = state[1] + c1
+    state[1] = difference - c2
+    state[2] = x
+    state[3] = t
+    return state[1] / tau_s
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def rate_pass(x, time_s, tau_s, restart, state, out_rate, out_lag):  # pragma: no cover
+    """:func:`filter_step` over arrays; ``restart`` an int8 mask (or empty: none)."""
+    has_restart = restart.size > 0
+    for i in range(x.size):
+        out_rate[i] = filter_step(state, x[i], time_s[i], tau_s,
+                                  has_restart and restart[i] != 0)
+        out_lag[i] = state[0]
+
+
+def new_state() -> np.ndarray:
+    """A filter that has seen nothing: it starts at rest on its first sample."""
+    state = np.zeros(STATE_SIZE)
+    state[DT] = -1.0  # no cached step yet
+    return state
+
+
+def check_tau(tau_s: float) -> float:
+    """``tau_s`` if it is a positive finite time constant, else InputError. [s]"""
     if not (tau_s > 0 and np.isfinite(tau_s)):
         raise InputError(f"rate filter time constant must be positive, got {tau_s} s")
+    return float(tau_s)
+
+
+def rate_filter_coefficients(tau_s: float, sample_rate_hz: float) -> tuple[float, float]:
+    """(a, p) of one step of 1/``sample_rate_hz`` (see the module docstring)."""
+    check_tau(tau_s)
     if not (sample_rate_hz > 0 and np.isfinite(sample_rate_hz)):
         raise InputError(f"sample rate must be positive, got {sample_rate_hz} Hz")
-    alpha = -math.expm1(-1.0 / (tau_s * sample_rate_hz))
-    return alpha, 1.0 - alpha
+    a, p = step_weights(1.0 / sample_rate_hz, float(tau_s))
+    return float(a), float(p)
 
 
 @dataclass
 class RateFilterState:
-    """State of :func:`causal_rate` for one signal: the two low-pass outputs."""
+    """State of :func:`causal_rate` for one signal (the array of :data:`LAG` slots)."""
 
-    y1: float | None = None
-    y2: float | None = None
+    values: np.ndarray | None = None
+
+    def copy(self) -> RateFilterState:
+        return RateFilterState(None if self.values is None else self.values.copy())
+
+
+def uniform_time(n: int, sample_rate_hz: float, state: RateFilterState | None = None) -> np.ndarray:
+    """Times of ``n`` samples at ``sample_rate_hz`` continuing ``state``'s last time. [s]"""
+    if not (sample_rate_hz > 0 and np.isfinite(sample_rate_hz)):
+        raise InputError(f"sample rate must be positive, got {sample_rate_hz} Hz")
+    start = 0.0
+    if state is not None and state.values is not None and state.values[STARTED]:
+        start = float(state.values[T_PREV]) + 1.0 / sample_rate_hz
+    return start + np.arange(n) / sample_rate_hz
 
 
 def causal_rate(
-    x: np.ndarray, tau_s: float, sample_rate_hz: float, state: RateFilterState | None = None
+    x: np.ndarray, tau_s: float, sample_rate_hz: float | None = None,
+    state: RateFilterState | None = None, *, time_s: np.ndarray | None = None,
+    restart: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, RateFilterState]:
     """Causal rate of ``x`` by a twice low-passed exact derivative, D(s) = s/(tau s + 1)^2.
 
     Parameters
     ----------
     x
-        Signal sampled at ``sample_rate_hz``. [unit]
+        Signal. [unit]
     tau_s
         Time constant of each low-pass stage. [s]
     sample_rate_hz
-        Sample rate. [Hz]
+        Sample rate, used only when ``time_s`` is not given (uniform steps). [Hz]
     state
         Filter state from the previous chunk; ``None`` starts at rest on the
         first sample (rate 0).
+    time_s
+        Time of each sample (non-decreasing, also across ``state``): each step uses
+        its own Δt, a gap is bridged with the gap's Δt. [s]
+    restart
+        Boolean mask: the filter restarts at rest on these samples (segment starts
+        of ``--gaps split``, new runs).
 
     Returns
     -------
     rate, smoothed, state
         The rate [unit/s], the once-smoothed signal y1 [unit] and the new state.
     """
-    from scipy import signal  # imported on use: it costs the CLI's start half a second
+    x = np.ascontiguousarray(x, dtype=np.float64)
+    tau = check_tau(tau_s)
+    values = new_state() if state is None or state.values is None else state.values.copy()
+    if time_s is None:
+        if sample_rate_hz is None:
+            raise InputError("causal_rate needs time_s or sample_rate_hz")
+        time = uniform_time(x.size, sample_rate_hz, RateFilterState(values))
+    else:
+        time = np.ascontiguousarray(time_s, dtype=np.float64)
+        if time.shape != x.shape:
+            raise InputError(f"time_s has {time.size} samples, the signal {x.size}")
+        check_time(time, values)
+    mask = np.zeros(0, dtype=np.int8)
+    if restart is not None:
+        mask = np.ascontiguousarray(restart, dtype=np.int8)
+        if mask.shape != x.shape:
+            raise InputError(f"restart mask has {mask.size} samples, the signal {x.size}")
+    rate = np.empty(x.size)
+    lag = np.empty(x.size)
+    if x.size:
+        rate_pass(x, time, tau, mask, values, rate, lag)
+    # lag after a step is x_n - y1_n (the state's "previous input" is x_n)
+    return rate, x - lag, RateFilterState(values)
 
-    x = np.asarray(x, dtype=np.float64)
-    state = RateFilterState() if state is None else RateFilterState(state.y1, state.y2)
-    if x.size == 0:
-        return np.empty(0), np.empty(0), state
-    alpha, beta = rate_filter_coefficients(tau_s, sample_rate_hz)
-    if state.y1 is None or state.y2 is None:
-        state.y1 = state.y2 = float(x[0])
-    b, a = [alpha], [1.0, -beta]
-    y1, _ = signal.lfilter(b, a, x, zi=[beta * state.y1])
-    y2, _ = signal.lfilter(b, a, y1, zi=[beta * state.y2])
-    # For a ramp of slope s the discrete stages lag by s·dt·beta/alpha (= s·tau in the
-    # continuous limit), so this gain makes the steady ramp response exactly s.
-    rate = (y1 - y2) * (alpha * sample_rate_hz / beta)
-    state.y1, state.y2 = float(y1[-1]), float(y2[-1])
-    return rate, y1, state
+
+def check_time(time_s: np.ndarray, state: np.ndarray | None = None) -> None:
+    """Raise when times go backwards or are not finite (the filter steps forward only)."""
+    if not time_s.size:
+        return
+    if not np.all(np.isfinite(time_s)):
+        row = int(np.flatnonzero(~np.isfinite(time_s))[0])
+        raise InputError(f"time_s is not finite at row {row}; the df/dt filter needs each "
+                         "sample's time")
+    steps = np.diff(time_s)
+    if steps.size and np.any(steps < 0):
+        row = int(np.flatnonzero(steps < 0)[0]) + 1
+        raise InputError(f"time_s goes backwards at row {row} ({time_s[row - 1]!r} -> "
+                         f"{time_s[row]!r} s); the df/dt filter steps forward in time")
+    if state is not None and state[STARTED] and time_s[0] < state[T_PREV]:
+        raise InputError(f"time_s goes backwards between chunks ({float(state[T_PREV])!r} -> "
+                         f"{float(time_s[0])!r} s); the df/dt filter steps forward in time")
+
+
+def restart_mask(n: int, rows: np.ndarray | list[int]) -> np.ndarray:
+    """Boolean mask of ``n`` samples, True at ``rows`` (segment starts, new runs)."""
+    mask = np.zeros(n, dtype=bool)
+    rows = np.asarray(rows, dtype=np.int64)
+    mask[rows[(rows >= 0) & (rows < n)]] = True
+    return mask
