@@ -400,7 +400,8 @@ def test_models_with_d2_and_aux_run_on_numpy_in_both_engines():
     run = lagged_run(seed=12, start_c=25.0, end_c=-25.0, hours=1.0, drive_amplitude_v=0.2)
     fused = assert_engines_agree(model, run)
     assert fused._plan is None  # it did fall back
-    out = fused.process(run)  # a second chunk: filter states carried
+    later = run.with_columns(time_s=run.time_s + run.time_s[-1] + run.time_s[1])
+    out = fused.process(later)  # a second chunk, one step later: filter states carried
     assert np.all(np.isfinite(out["rate_comp_dph"]))
     # the drift model explains the gradient and the drive: the residual is the white noise
     truth = Compensator(model, engine="numpy").process(run)

@@ -5,8 +5,9 @@ dozen numpy passes. Per sample it does, in the same floating-point operations
 and order as the numpy reference path (so results agree to rounding):
 
 * the causal df/dt (dh/dt) filter of :func:`hrgtc.drift.features.causal_rate`, two
-  exact first-order stages ``y = z + alpha x; z = beta y`` (scipy's ``lfilter``
-  in transposed direct form II), state carried across calls;
+  first-order stages updated exactly over each sample's own Δt (the samples'
+  times), by the very function the numpy path runs
+  (:func:`hrgtc.drift.rate_filter.filter_step`), state carried across calls;
 * the drift model of :func:`hrgtc.drift.features.tangent_extension`: each term a
   product of powers of the scaled variables, summed in term order, and beyond
   the training ranges the gradient at the clipped point times the excess;
@@ -53,7 +54,10 @@ from hrgtc.compensate._kernel_thermometer import (
     _start_and_step,
 )
 from hrgtc.drift import DriftModel
-from hrgtc.drift.features import rate_filter_coefficients, settle_rows
+from hrgtc.drift._rate_kernel import filter_step
+from hrgtc.drift.features import settle_rows
+from hrgtc.drift.rate_filter import STATE_SIZE, check_tau
+from hrgtc.drift.rate_filter import new_state as new_filter_state
 from hrgtc.drift.variables import unsupported
 from hrgtc.thermometry import Thermometer
 
@@ -87,9 +91,9 @@ class KernelPlan:
     Attributes
     ----------
     filter
-        ``[alpha, beta, gain, reference_freq_hz, reference_c, settle_rows]`` of the rate
-        filter (gain ``alpha * sample_rate_hz / beta`` turns y1 - y2 into a rate;
-        ``settle_rows`` samples at the start of a run are flagged, as training skips them).
+        ``[tau_s, 0, 1/tau_s, reference_freq_hz, reference_c, settle_rows]`` of the rate
+        filter (``settle_rows`` samples at the start of a run are flagged, as training
+        skips them).
     uses_housing
         Whether h/dh are computed (the recording then needs ``housing_c``).
     uses_gradient
@@ -158,7 +162,7 @@ def plan(drift: DriftModel, thermometer: Thermometer, variables: tuple[str, ...]
         Variables the compensator computes (``f``, ``df`` and the model's).
     """
     s = drift.settings
-    alpha, beta = rate_filter_coefficients(s.rate_tau_s, s.sample_rate_hz)
+    tau = check_tau(s.rate_tau_s)
     terms = drift._terms
     used = {v for t in terms for v in t.variables}
     n, nv = len(terms), len(ORDER)
@@ -187,8 +191,8 @@ def plan(drift: DriftModel, thermometer: Thermometer, variables: tuple[str, ...]
     inverse = thermometer._inverse
     a = np.asarray(thermometer.scaled_coefficients, dtype=np.float64)
     return KernelPlan(
-        filter=np.array([alpha, beta, alpha * s.sample_rate_hz / beta, s.reference_freq_hz,
-                         s.reference_c, float(settle_rows(s))]),
+        filter=np.array([tau, 0.0, 1.0 / tau, s.reference_freq_hz, s.reference_c,
+                         float(settle_rows(s))]),
         uses_housing=any(v in ("h", "dh") for v in variables),
         uses_gradient="g" in variables,
         exponents=exponents,
@@ -233,9 +237,15 @@ def _padded(coefficients: np.ndarray, size: int) -> np.ndarray:
     return out
 
 
+#: Slots of the kernel's state: the f filter's state, the h filter's, the samples seen.
+F_STATE = slice(0, STATE_SIZE)
+H_STATE = slice(STATE_SIZE, 2 * STATE_SIZE)
+SAMPLES = 2 * STATE_SIZE
+
+
 def new_state() -> np.ndarray:
-    """Filter state at rest: ``[y1_f, y2_f, y1_h, y2_h, started_f, started_h, samples]``."""
-    return np.zeros(7)
+    """Filter state at rest: two :func:`hrgtc.drift.rate_filter.new_state` and the samples."""
+    return np.concatenate([new_filter_state(), new_filter_state(), [0.0]])
 
 
 def new_extremes() -> np.ndarray:
@@ -275,7 +285,7 @@ def _term(exponents, k, x, m, out, factor):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def compensate_block(freq_hz, rate_dph, housing_c, filt, uses_housing, uses_gradient, state,
+def compensate_block(time_s, freq_hz, rate_dph, housing_c, filt, uses_housing, uses_gradient, state,
                      exponents, coefficients, intercept, scales, tangent, low, high, flagged,
                      d_factor, d_exponents, d_constant, therm, poly, slope, chebyshev,
                      grid_t, grid_f, out_rate, out_bias, out_temp, out_in_range, counts,
@@ -285,7 +295,7 @@ def compensate_block(freq_hz, rate_dph, housing_c, filt, uses_housing, uses_grad
     ``state`` (filter, samples seen), ``counts`` (int64, see :data:`OUT_OF_RANGE`) and
     ``extremes`` (see :data:`F_MIN`) are updated.
     """
-    alpha, beta, gain, ref_f, ref_h = filt[0], filt[1], filt[2], filt[3], filt[4]
+    tau, ref_f, ref_h = filt[0], filt[3], filt[4]
     centre, scale_c, map_offset, map_scale = therm[0], therm[1], therm[2], therm[3]
     t_low, t_high, f_low, f_high = therm[4], therm[5], therm[6], therm[7]
     f_cal_low, f_cal_high, one_step_limit, tolerance = therm[8], therm[9], therm[10], therm[11]
@@ -300,7 +310,8 @@ def compensate_block(freq_hz, rate_dph, housing_c, filt, uses_housing, uses_grad
     gradient = np.empty(TILE)
     ok = np.empty(TILE)
     rate_ok = np.empty(TILE)
-    y1f, y2f, y1h, y2h = state[0], state[1], state[2], state[3]
+    f_state = state[0:8]  # F_STATE, H_STATE
+    h_state = state[8:16]
     n = freq_hz.size
     for start in range(0, n, TILE):
         m = min(TILE, n - start)
@@ -341,27 +352,18 @@ def compensate_block(freq_hz, rate_dph, housing_c, filt, uses_housing, uses_grad
         counts[2] += n_lost
         # variables f, df (h, dh, g): features.FeatureStream; the filter is the only serial loop
         f, df = value[0], value[1]
+        time = time_s[start:start + m]
         for i in range(m):
             f[i] = freq[i] - ref_f
-        if state[4] == 0.0:
-            y1f = y2f = f[0]
-            state[4] = 1.0
         for i in range(m):
-            y1f = beta * y1f + alpha * f[i]
-            y2f = beta * y2f + alpha * y1f
-            df[i] = (y1f - y2f) * gain
+            df[i] = filter_step(f_state, f[i], time[i], tau, False)
         housing = housing_c[start:start + m]
         if uses_housing:
             h, dh = value[2], value[3]
             for i in range(m):
                 h[i] = housing[i] - ref_h
-            if state[5] == 0.0:
-                y1h = y2h = h[0]
-                state[5] = 1.0
             for i in range(m):
-                y1h = beta * y1h + alpha * h[i]
-                y2h = beta * y2h + alpha * y1h
-                dh[i] = (y1h - y2h) * gain
+                dh[i] = filter_step(h_state, h[i], time[i], tau, False)
         if uses_gradient:
             g = value[4]
             for i in range(m):
@@ -438,7 +440,7 @@ def compensate_block(freq_hz, rate_dph, housing_c, filt, uses_housing, uses_grad
                 counts[TEMPERATURE_OUT] += m - int(n_temperature)
         n_ok = 0.0
         n_rate_ok = 0.0
-        first = state[6] + start  # samples of the run before this tile
+        first = state[16] + start  # samples of the run before this tile (SAMPLES)
         n_settling = 0
         for i in range(m):
             settled = 1.0 if first + i >= filt[5] else 0.0
@@ -456,45 +458,33 @@ def compensate_block(freq_hz, rate_dph, housing_c, filt, uses_housing, uses_grad
                 lo = x[i] if x[i] < lo else lo
                 hi = x[i] if x[i] > hi else hi
             extremes[2 * v], extremes[2 * v + 1] = lo, hi
-    state[0], state[1], state[2], state[3] = y1f, y2f, y1h, y2h
-    state[6] += n
+    state[16] += n
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def advance_filter(freq_hz, housing_c, filt, uses_housing, state):  # pragma: no cover
+def advance_filter(time_s, freq_hz, housing_c, filt, uses_housing, state):  # pragma: no cover
     """Run only the rate filter over a block: ``state`` becomes the state at its end.
 
     The same operations as :func:`compensate_block`'s filter, so the state is the same
     bits; it lets the second half of a chunk start on another thread.
     """
-    alpha, beta, ref_f, ref_h = filt[0], filt[1], filt[3], filt[4]
-    if freq_hz.size == 0:
-        return
-    y1, y2 = state[0], state[1]
-    if state[4] == 0.0:
-        y1 = y2 = freq_hz[0] - ref_f
-        state[4] = 1.0
+    tau, ref_f, ref_h = filt[0], filt[3], filt[4]
+    f_state = state[0:8]
+    h_state = state[8:16]
     for i in range(freq_hz.size):
-        y1 = beta * y1 + alpha * (freq_hz[i] - ref_f)
-        y2 = beta * y2 + alpha * y1
-    state[0], state[1] = y1, y2
+        filter_step(f_state, freq_hz[i] - ref_f, time_s[i], tau, False)
     if uses_housing:
-        y1, y2 = state[2], state[3]
-        if state[5] == 0.0:
-            y1 = y2 = housing_c[0] - ref_h
-            state[5] = 1.0
         for i in range(housing_c.size):
-            y1 = beta * y1 + alpha * (housing_c[i] - ref_h)
-            y2 = beta * y2 + alpha * y1
-        state[2], state[3] = y1, y2
-    state[6] += freq_hz.size
+            filter_step(h_state, housing_c[i] - ref_h, time_s[i], tau, False)
+    state[16] += freq_hz.size
 
 
 #: Chunks of at least this many rows are split in two halves compensated on two threads.
 PARALLEL_ROWS = 1 << 18
 
 
-def run(block_plan: KernelPlan, state: np.ndarray, freq_hz: np.ndarray, rate_dph: np.ndarray,
+def run(block_plan: KernelPlan, state: np.ndarray, time_s: np.ndarray, freq_hz: np.ndarray,
+        rate_dph: np.ndarray,
         housing_c: np.ndarray | None, out: dict[str, np.ndarray], counts: np.ndarray,
         extremes: np.ndarray | None = None) -> None:
     """Compensate a chunk with a plan's arrays (outputs in ``out``, ``state`` advanced).
@@ -507,19 +497,22 @@ def run(block_plan: KernelPlan, state: np.ndarray, freq_hz: np.ndarray, rate_dph
     extremes = new_extremes() if extremes is None else extremes
     n = freq_hz.size
     if n < PARALLEL_ROWS or (os.cpu_count() or 1) < 2:
-        _call(block_plan, state, freq_hz, rate_dph, housing, out, counts, extremes, 0, n)
+        _call(block_plan, state, time_s, freq_hz, rate_dph, housing, out, counts, extremes, 0,
+              n)
         return
     middle = n // 2
     second = state.copy()
-    advance_filter(freq_hz[:middle], housing[:middle], block_plan.filter,
+    advance_filter(time_s[:middle], freq_hz[:middle], housing[:middle], block_plan.filter,
                    block_plan.uses_housing, second)
     second_counts = np.zeros_like(counts)
     second_extremes = new_extremes()
-    worker = threading.Thread(target=_call, args=(block_plan, second, freq_hz, rate_dph, housing,
-                                                  out, second_counts, second_extremes, middle, n))
+    worker = threading.Thread(target=_call, args=(block_plan, second, time_s, freq_hz, rate_dph,
+                                                  housing, out, second_counts, second_extremes,
+                                                  middle, n))
     worker.start()
     try:
-        _call(block_plan, state, freq_hz, rate_dph, housing, out, counts, extremes, 0, middle)
+        _call(block_plan, state, time_s, freq_hz, rate_dph, housing, out, counts, extremes, 0,
+              middle)
     finally:
         worker.join()
     state[:] = second
@@ -528,12 +521,13 @@ def run(block_plan: KernelPlan, state: np.ndarray, freq_hz: np.ndarray, rate_dph
     extremes[1::2] = np.maximum(extremes[1::2], second_extremes[1::2])
 
 
-def _call(p: KernelPlan, state: np.ndarray, freq_hz: np.ndarray, rate_dph: np.ndarray,
+def _call(p: KernelPlan, state: np.ndarray, time_s: np.ndarray, freq_hz: np.ndarray,
+          rate_dph: np.ndarray,
           housing_c: np.ndarray, out: dict[str, np.ndarray], counts: np.ndarray,
           extremes: np.ndarray, start: int, stop: int) -> None:
     part = slice(start, stop)
     compensate_block(
-        freq_hz[part], rate_dph[part], housing_c[part], p.filter, p.uses_housing,
+        time_s[part], freq_hz[part], rate_dph[part], housing_c[part], p.filter, p.uses_housing,
         p.uses_gradient, state, p.exponents, p.coefficients, p.intercept, p.scales, p.tangent,
         p.low, p.high, p.flagged, p.d_factor, p.d_exponents, p.d_constant, p.thermometer,
         p.poly, p.slope, p.chebyshev, p.grid_t, p.grid_f, out["rate_comp_dph"][part],

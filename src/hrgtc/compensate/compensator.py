@@ -39,6 +39,7 @@ from hrgtc.drift.features import (
     settle_rows,
 )
 from hrgtc.drift.offsets import label_offsets, sample_offsets
+from hrgtc.drift.rate_filter import check_time
 from hrgtc.errors import CalibrationError, ExtrapolationWarning, HrgtcWarning, InputError
 from hrgtc.files import check_writable
 from hrgtc.model import UnitModel
@@ -97,8 +98,10 @@ class Compensator:
     gaps
         ``"split"``: the df/dt filter restarts at rest after every gap (a time step
         longer than :data:`~hrgtc.recording.validation.GAP_PERIODS` sample periods),
-        as if each segment were its own run; ``"error"`` / ``"ignore"`` (default):
-        the chunks are taken as one continuous run.
+        as if each segment were its own run; any other policy (``"bridge"``,
+        ``"error"``, ``"ignore"``, default): the filter is carried across the gap with
+        the gap's Δt (each step of the filter uses the samples' times, also across
+        chunks, so a gap on a chunk boundary is no different).
 
     Examples
     --------
@@ -157,7 +160,7 @@ class Compensator:
         ``in_range`` 0, as at the start of a run.
         """
         self._stream = FeatureStream(self.drift.settings, self._variables, self.model.thermometer)
-        self._state = np.zeros(7)  # the fused engine's filter state (compensate._kernel)
+        self._state: np.ndarray | None = None  # the fused engine's state (compensate._kernel)
         self._segment_samples = 0  # samples since the filter (re)started
 
     def _gap_rows(self, chunk: Recording) -> list[int]:
@@ -281,8 +284,12 @@ class Compensator:
         counts = np.zeros(kernel.N_COUNTS, dtype=np.int64)
         freq = chunk.freq_hz
         housing = chunk["housing_c"] if self._plan.needs_housing else None
+        if self._state is None:
+            self._state = kernel.new_state()
+        time_s = np.ascontiguousarray(chunk.time_s, dtype=np.float64)
+        check_time(time_s, self._state[kernel.F_STATE])
         extremes = kernel.new_extremes()
-        kernel.run(self._plan, self._state, freq, chunk.rate_dph, housing, out, counts,
+        kernel.run(self._plan, self._state, time_s, freq, chunk.rate_dph, housing, out, counts,
                    extremes)
         self.samples += len(chunk)
         self._segment_samples += len(chunk)

@@ -31,7 +31,7 @@ cancellation of two levels): ``lag`` = x_{n-1} - y1 and ``difference`` = y1 - y2
     c2 = a difference + p c1;         difference <- difference + c1 - c2
     rate = difference / tau
 
-The same statements run in the numba kernel (:mod:`hrgtc.compensate._kernel`),
+The compiled step is :mod:`hrgtc.drift._rate_kernel`. The same statements run in the numba kernel (:mod:`hrgtc.compensate._kernel`),
 the streaming compensator and the C export (double and float32), so training and
 deployment compute the same df/dt.
 
@@ -47,7 +47,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
 from hrgtc.errors import InputError
 
@@ -63,82 +62,9 @@ LAG, DIFFERENCE, X_PREV, T_PREV, STARTED, DT, A, P = range(8)
 STATE_SIZE = 8
 
 
-def _series_coefficients() -> tuple[float, ...]:
+def series_coefficients() -> tuple[float, ...]:
     """(-1)^(k+1) / (k+1)! for k = 1..SERIES_TERMS: p(r) = sum_k c_k r^k."""
     return tuple((-1.0) ** (k + 1) / math.factorial(k + 1) for k in range(1, SERIES_TERMS + 1))
-
-
-SERIES = _series_coefficients()
-_S1, _S2, _S3, _S4, _S5, _S6, _S7, _S8, _S9 = SERIES  # compiled in as constants
-
-
-@njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def step_weights(dt_s, tau_s):  # pragma: no cover - compiled
-    """(a, p) of one step of length ``dt_s``: a = 1 - exp(-r), p = 1 - a/r, r = dt/tau."""
-    r = dt_s / tau_s
-    a = -math.expm1(-r)
-    if r < 0.1:  # SERIES_LIMIT; Horner, highest power first
-        p = _S9
-        p = p * r + _S8
-        p = p * r + _S7
-        p = p * r + _S6
-        p = p * r + _S5
-        p = p * r + _S4
-        p = p * r + _S3
-        p = p * r + _S2
-        p = p * r + _S1
-        p = p * r
-    else:
-        p = (r - a) / r
-    return a, p
-
-
-
-@njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def filter_step(state, x, t, tau_s, restart):  # pragma: no cover - compiled
-    """Advance ``state`` (see :data:`LAG`) by one sample (x at time t); return the rate.
-
-    ``restart`` (or a state never started) puts the filter at rest on this sample
-    (rate 0). A step of zero or negative Δt moves nothing but the previous input.
-    """
-    if restart or state[4] == 0.0:
-        state[0] = 0.0
-        state[1] = 0.0
-        state[2] = x
-        state[3] = t
-        state[4] = 1.0
-        return 0.0
-    dt = t - state[3]
-    dt = 0.0 if not dt > 0.0 else dt
-    if not abs(dt - state[5]) <= 1e-6 * state[5]:  # DT_REL_TOLERANCE
-        a, p = step_weights(dt, tau_s)
-        state[5] = dt
-        state[6] = a
-        state[7] = p
-    a = state[6]
-    p = state[7]
-    delta = x - state[2]
-    c1 = a * state[0]
-    c1 = c1 + p * delta
-    lag = state[0] + delta
-    state[0] = lag - c1
-    c2 = a * state[1]
-    c2 = c2 + p * c1
-    difference = state[1] + c1
-    state[1] = difference - c2
-    state[2] = x
-    state[3] = t
-    return state[1] / tau_s
-
-
-@njit(cache=True, nogil=True, error_model="numpy")
-def rate_pass(x, time_s, tau_s, restart, state, out_rate, out_lag):  # pragma: no cover
-    """:func:`filter_step` over arrays; ``restart`` an int8 mask (or empty: none)."""
-    has_restart = restart.size > 0
-    for i in range(x.size):
-        out_rate[i] = filter_step(state, x[i], time_s[i], tau_s,
-                                  has_restart and restart[i] != 0)
-        out_lag[i] = state[0]
 
 
 def new_state() -> np.ndarray:
@@ -160,6 +86,8 @@ def rate_filter_coefficients(tau_s: float, sample_rate_hz: float) -> tuple[float
     check_tau(tau_s)
     if not (sample_rate_hz > 0 and np.isfinite(sample_rate_hz)):
         raise InputError(f"sample rate must be positive, got {sample_rate_hz} Hz")
+    from hrgtc.drift._rate_kernel import step_weights  # numba: imported on use
+
     a, p = step_weights(1.0 / sample_rate_hz, float(tau_s))
     return float(a), float(p)
 
@@ -214,6 +142,8 @@ def causal_rate(
     rate, smoothed, state
         The rate [unit/s], the once-smoothed signal y1 [unit] and the new state.
     """
+    from hrgtc.drift._rate_kernel import rate_pass  # numba: imported on use (CLI start)
+
     x = np.ascontiguousarray(x, dtype=np.float64)
     tau = check_tau(tau_s)
     values = new_state() if state is None or state.values is None else state.values.copy()
