@@ -41,7 +41,7 @@ FLAGS = ["-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", "-pedantic"]
 STRICT = ["-Wshadow", "-Wconversion", "-Wdouble-promotion", "-Wstrict-prototypes",
           "-Wmissing-prototypes", "-Wcast-qual", "-Wfloat-equal"]
 
-# Reads rows of (freq_hz, rate_dph[, housing_c][, aux]) doubles, writes rows of 8 doubles:
+# Reads rows of (dt_s, freq_hz, rate_dph[, housing_c][, aux]) doubles, writes rows of 8 doubles:
 # rate_comp, bias, resonator_c_est, in_range, f, df, return value of step(), rate_in_range.
 # Prints the state's counters; replays the first samples after reset and fails (3) if they differ.
 DRIVER = r"""
@@ -59,18 +59,18 @@ static int same(double a, double b) { return a == b || (a != a && b != b); }
 static double step(PFX_state *s, const double *row, PFX_output *out)
 {
 #if UPFX_AUX_INPUTS
-    return PFX_step(s, row[0], row[1], row[2], row[3], out);
+    return PFX_step(s, row[0], row[1], row[2], row[3], row[4], out);
 #elif UPFX_USES_HOUSING
-    return PFX_step(s, row[0], row[1], row[2], out);
+    return PFX_step(s, row[0], row[1], row[2], row[3], out);
 #else
-    return PFX_step(s, row[0], row[1], out);
+    return PFX_step(s, row[0], row[1], row[2], out);
 #endif
 }
 
 int main(int argc, char **argv)
 {
-    const size_t columns = (UPFX_USES_HOUSING ? 3 : 2) + UPFX_AUX_INPUTS;
-    double row[4], record[8];
+    const size_t columns = (UPFX_USES_HOUSING ? 4 : 3) + UPFX_AUX_INPUTS;
+    double row[5], record[8];
     PFX_state state;
     PFX_output out, first[REPLAY];
     size_t n = 0, k;
@@ -139,8 +139,15 @@ def build(model, folder: Path, prefix: str) -> Path:
     return exe
 
 
-def run_driver(exe: Path, columns: list[np.ndarray], folder: Path, name: str):
+def run_driver(exe: Path, columns: list[np.ndarray], folder: Path, name: str,
+               time_s: np.ndarray | None = None):
+    """Run the driver on rows of ``columns``; the first input, dt_s, from ``time_s``
+    (default: uniform steps at the sample rate, as the recording's times)."""
     source, target = folder / f"{name}.in", folder / f"{name}.out"
+    if time_s is None:
+        raise TypeError("run_driver needs the recording's time_s")
+    dt = np.concatenate([[0.0], np.diff(time_s)])
+    columns = [dt, *columns]
     np.column_stack(columns).astype("<f8" if np.little_endian else ">f8").tofile(source)
     done = subprocess.run([str(exe), str(source), str(target)], capture_output=True, text=True,
                           timeout=60)
@@ -185,7 +192,7 @@ def test_c_matches_the_python_compensator(kind, request, tmp_path):
         inputs = [recording.freq_hz, recording.rate_dph]
     compensator = Compensator(model)
     expected = compensator.process(recording)
-    out, counters = run_driver(exe, inputs, tmp_path, "run")
+    out, counters = run_driver(exe, inputs, tmp_path, "run", recording.time_s)
 
     assert out.shape[0] == len(recording)
     assert counters == [compensator.samples, compensator.out_of_range,
@@ -221,7 +228,8 @@ def test_edge_models_compile_cleanly_and_agree(selected, housing_model, tmp_path
         columns.append(recording["housing_c"])
     compensator = Compensator(model)
     expected = compensator.process(recording)
-    out, counters = run_driver(build(model, tmp_path, "edge"), columns, tmp_path, "run")
+    out, counters = run_driver(build(model, tmp_path, "edge"), columns, tmp_path, "run",
+                               recording.time_s)
     assert counters == [compensator.samples, compensator.out_of_range,
                         compensator.rate_out_of_range]
     np.testing.assert_array_equal(out[:, 3] * out[:, 7], expected["in_range"])
@@ -233,7 +241,8 @@ def test_c_thermometer_gives_table2_and_nan_beyond(frequency_driver, tmp_path):
     beyond = np.array([4300.0, 4600.0, np.nan])  # outside the monotonic extension, not a number
     freq = np.concatenate([paper.TABLE2_FREQUENCY_HZ, beyond])
     rate = np.full(freq.size, 10.0)
-    out, _ = run_driver(frequency_driver, [freq, rate], tmp_path, "table2")
+    out, _ = run_driver(frequency_driver, [freq, rate], tmp_path, "table2",
+                        np.arange(freq.size) / 200.0)
     temperature = out[:, 2]
     # Table 2 of [1], printed to 3 (one value 4) decimals from the authors' own inversion
     np.testing.assert_allclose(temperature[:7], paper.TABLE2_CALCULATED_C, rtol=0, atol=1e-3)
@@ -345,12 +354,12 @@ def test_c_computes_d2_g_and_the_extra_channel_as_python_does(tmp_path):
     exe = build(model, tmp_path, "lag")
     header = (tmp_path / "lag_model.h").read_text()
     assert "#define LAG_AUX_INPUTS 1" in header and "double aux_drive" in header
-    assert "f2_y1" in header  # the second filter's state
+    assert "f2_filter" in header  # the second filter's state
     inputs = [recording.freq_hz, recording.rate_dph, recording["housing_c"],
               recording["drive_v"]]
     compensator = Compensator(model)
     expected = compensator.process(recording)
-    out, counters = run_driver(exe, inputs, tmp_path, "run")
+    out, counters = run_driver(exe, inputs, tmp_path, "run", recording.time_s)
     assert counters == [compensator.samples, compensator.out_of_range,
                         compensator.rate_out_of_range]
     assert 0 < compensator.out_of_range < len(recording)

@@ -29,23 +29,23 @@ FLAGS = ["-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", "-pedantic", "-Wshado
          "-Wconversion", "-Wdouble-promotion", "-Wmissing-prototypes"]
 AXES = ("x", "y", "z")
 
-# rows of (freq_x, rate_x, freq_y, rate_y, freq_z, rate_z) -> rows of the three rate_comp
+# rows of (dt_s, freq_x, rate_x, freq_y, rate_y, freq_z, rate_z) -> rows of the three rate_comp
 DRIVER = r"""
 #include <stdio.h>
 #include "imu_model.h"
 int main(int argc, char **argv)
 {
-    double row[6], record[3];
+    double row[7], record[3];
     imu_x_state sx; imu_y_state sy; imu_z_state sz;
     FILE *in, *result;
     if (argc != 3 || !(in = fopen(argv[1], "rb")) || !(result = fopen(argv[2], "wb"))) {
         return 2;
     }
     imu_x_init(&sx); imu_y_init(&sy); imu_z_init(&sz);
-    while (fread(row, sizeof(double), 6, in) == 6) {
-        record[0] = imu_x_step(&sx, row[0], row[1], NULL);
-        record[1] = imu_y_step(&sy, row[2], row[3], NULL);
-        record[2] = imu_z_step(&sz, row[4], row[5], NULL);
+    while (fread(row, sizeof(double), 7, in) == 7) {
+        record[0] = imu_x_step(&sx, row[0], row[1], row[2], NULL);
+        record[1] = imu_y_step(&sy, row[0], row[3], row[4], NULL);
+        record[2] = imu_z_step(&sz, row[0], row[5], row[6], NULL);
         fwrite(record, sizeof(double), 3, result);
     }
     fclose(result);
@@ -95,7 +95,8 @@ def test_every_axis_compiles_and_compensates_like_its_model(imu, tmp_path):
     subprocess.run([COMPILER, *FLAGS, "-I", str(tmp_path), *sources, str(tmp_path / "driver.c"),
                     "-o", str(exe), "-lm"], check=True, capture_output=True, text=True)
     recordings = runs()
-    columns = [c for a in AXES for c in (recordings[a].freq_hz, recordings[a].rate_dph)]
+    dt = np.concatenate([[0.0], np.diff(recordings[AXES[0]].time_s)])
+    columns = [dt, *(c for a in AXES for c in (recordings[a].freq_hz, recordings[a].rate_dph))]
     np.column_stack(columns).tofile(tmp_path / "in.bin")
     done = subprocess.run([str(exe), str(tmp_path / "in.bin"), str(tmp_path / "out.bin")],
                           capture_output=True, text=True, timeout=60)

@@ -11,7 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hrgtc.drift.features import is_aux, rate_filter_coefficients, variable_key
+from hrgtc.drift.features import is_aux, variable_key
+from hrgtc.drift.rate_filter import check_tau
 from hrgtc.drift.variables import refusal, supported
 from hrgtc.errors import CalibrationError, InputError
 from hrgtc.model import UnitModel
@@ -30,9 +31,9 @@ class CPlan:
         The drift terms use the housing thermistor (h, dh/dt).
     computed
         Variables the compensator computes: f and df, and h and dh where used.
-    alpha, beta, gain
-        Coefficients of each first-order stage of the causal df/dt filter and its
-        ramp gain (``alpha * fs / beta``).
+    tau_s
+        Time constant of each first-order stage of the causal df/dt filter; each step's
+        weights come from it and the step's Δt (:mod:`hrgtc.drift.rate_filter`). [s]
     increasing
         f(T) increases with temperature.
     grid_t, grid_f
@@ -49,8 +50,8 @@ class CPlan:
         ``"double"`` (C double throughout) or ``"single"`` (float32, centred frequency).
     gradient
         The terms use the housing - resonator gradient g = housing_c - T(freq_hz).
-    rate2, alpha2, beta2, gain2
-        The terms use the second df/dt filter ``d2``; its stage coefficients and gain.
+    rate2, tau2_s
+        The terms use the second df/dt filter ``d2``; its time constant. [s]
     aux
         Names of the user's extra channels the terms use (``a_NAME``), in grammar order:
         each is one more input of ``step()``.
@@ -58,9 +59,7 @@ class CPlan:
 
     housing: bool
     computed: list[str]
-    alpha: float
-    beta: float
-    gain: float
+    tau_s: float
     increasing: bool
     grid_t: np.ndarray
     grid_f: np.ndarray
@@ -72,9 +71,7 @@ class CPlan:
     precision: str = "double"
     gradient: bool = False
     rate2: bool = False
-    alpha2: float = 0.0
-    beta2: float = 0.0
-    gain2: float = 0.0
+    tau2_s: float = 0.0
     aux: tuple[str, ...] = ()
 
     @property
@@ -124,12 +121,8 @@ def plan_for(model: UnitModel, precision: str = "double") -> CPlan:
     # second rate filter, gradient and extra channels: levels (g, a_NAME) join in_range,
     # the rate d2 rate_in_range, as in the compensator
     computed += [v for v in variables_for_c(used) if v not in computed]
-    alpha, beta = rate_filter_coefficients(settings.rate_tau_s, settings.sample_rate_hz)
-    gain = alpha * settings.sample_rate_hz / beta  # the factor causal_rate applies
-    alpha2 = beta2 = gain2 = 0.0
-    if "d2" in used:
-        alpha2, beta2 = rate_filter_coefficients(settings.rate_tau2_s, settings.sample_rate_hz)
-        gain2 = alpha2 * settings.sample_rate_hz / beta2
+    tau = check_tau(settings.rate_tau_s)
+    tau2 = check_tau(settings.rate_tau2_s) if "d2" in used else 0.0
     for v in used:
         if v not in settings.scales:
             raise InputError(f"the drift model has no scale for variable {v!r}; it is corrupt")
@@ -148,9 +141,7 @@ def plan_for(model: UnitModel, precision: str = "double") -> CPlan:
     return CPlan(
         housing=housing,
         computed=computed,
-        alpha=alpha,
-        beta=beta,
-        gain=gain,
+        tau_s=tau,
         increasing=increasing,
         grid_t=grid_t,
         grid_f=grid_f,
@@ -162,9 +153,7 @@ def plan_for(model: UnitModel, precision: str = "double") -> CPlan:
         precision=precision,
         gradient="g" in used,
         rate2="d2" in used,
-        alpha2=alpha2,
-        beta2=beta2,
-        gain2=gain2,
+        tau2_s=tau2,
         aux=tuple(v[2:] for v in variables_for_c(used) if is_aux(v)),
     )
 

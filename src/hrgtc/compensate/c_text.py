@@ -19,6 +19,7 @@ from typing import Any
 from hrgtc.compensate.c_expr import array as _array
 from hrgtc.compensate.c_expr import term_expression as _term_expression
 from hrgtc.compensate.c_plan import TABLE_POINTS, CPlan
+from hrgtc.compensate.c_rate_filter import filter_functions, filter_struct
 from hrgtc.compensate.c_step import step_tail
 from hrgtc.compensate.c_thermometer import thermometer_functions
 from hrgtc.compensate.c_types import DOUBLE, ctype
@@ -125,9 +126,11 @@ def readme(model: UnitModel, plan: CPlan, prefix: str, origin: str,
         f"  f  = freq_hz - f_ref, f_ref = {settings.reference_freq_hz:.12g} Hz "
         f"(the thermometer at {settings.reference_c:g} degC)   [Hz]",
         "  df = df/dt by the causal filter D(s) = s/(tau s + 1)^2 (tau = "
-        f"{settings.rate_tau_s:g} s, fs = {settings.sample_rate_hz:g} Hz):",
-        "         y1 = a*f + b*y1;  y2 = a*y1 + b*y2;  df = (y1 - y2)*a*fs/b,",
-        "         a = 1 - exp(-1/(tau*fs)), b = 1 - a, y1 = y2 = f at the first sample   [Hz/s]",
+        f"{settings.rate_tau_s:g} s), each step exact over its own dt (the input moving "
+        "linearly over the step; a gap is bridged with its dt):",
+        "         y1 += a*(f_prev - y1) + p*(f - f_prev);  y2 += a*(y1_prev - y2) + p*(y1 - y1_prev);",
+        "         df = (y1 - y2)/tau,  a = 1 - exp(-dt/tau), p = 1 - a*tau/dt,",
+        "         y1 = y2 = f at the first sample   [Hz/s]",
     ]
     if plan.housing:
         lines.append(f"  h  = housing_c - {settings.reference_c:g} degC, dh = its rate by the "
@@ -167,8 +170,12 @@ def readme(model: UnitModel, plan: CPlan, prefix: str, origin: str,
         + ("; housing_c [degC] housing thermistor" if plan.housing_input else "")
         + "".join(f"; aux_{n} the logged {settings.aux_columns.get(n, '?')!r}"
                   for n in plan.aux)
-        + f". One call per sample at exactly {up}_SAMPLE_RATE_HZ "
-        f"({settings.sample_rate_hz:g} Hz): the filter is defined per sample.",
+        + "; dt_s [s] the time since the previous sample (any steps: jittered, bursts; "
+        f"ignored on the first sample after init/reset). The model was trained at "
+        f"{settings.sample_rate_hz:g} Hz ({up}_SAMPLE_RATE_HZ).",
+        f"  gaps:    pass the gap's length as dt_s to carry the filter across it (bridge), "
+        f"or call {p}_reset() to restart it at rest (split: the first {up}_SETTLE_ROWS "
+        "samples are then flagged again).",
         "  outputs: rate_comp_dph, bias_model_dph [deg/h]; resonator_c_est [degC];",
         "           f_hz [Hz]; df_hz_per_s [Hz/s]; in_range, rate_in_range 1/0.",
         "",
@@ -178,14 +185,15 @@ def readme(model: UnitModel, plan: CPlan, prefix: str, origin: str,
         f"  {p}_init(&gyro);                      // once; {p}_reset(&gyro) at a new run",
         "  for (;;) {                              // each sample",
         f"      {p}_output out;",
-        f"      double rate = {p}_step(&gyro, freq_hz, rate_dph, {housing_use}&out);",
+        f"      double rate = {p}_step(&gyro, dt_s, freq_hz, rate_dph, {housing_use}&out);",
         "      if (!out.in_range) { flag_sample(); }  // outside the calibration",
         "  }",
         f"  Build: cc -std=c99 -O2 -c {p}_model.c, link with -lm. Double precision is needed",
         "  (f is a few Hz out of 4.4 kHz). Do not use -ffast-math; with -ffp-contract=off (GCC's "
         "default under -std=c99) the filter and the thermometer round exactly as hrgtc does "
         "(fused multiply-add would change only the last bits).",
-        f"  The step signature: double {p}_step({p}_state *, double freq_hz, double rate_dph, "
+        f"  The step signature: double {p}_step({p}_state *, double dt_s, double freq_hz, "
+        "double rate_dph, "
         f"{housing_arg}{p}_output *out);",
         "",
         "REFERENCE",
@@ -212,12 +220,10 @@ def header(model: UnitModel, plan: CPlan, prefix: str, origin: str,
 
     p, up = prefix, prefix.upper()
     housing = plan.housing
-    state_h = "    double h_y1;                /* first low-pass stage of h [degC] */\n" \
-              "    double h_y2;                /* second low-pass stage of h [degC] */\n" \
+    state_h = f"    {p}_rate_filter h_filter;   /* dh/dt filter of h [degC] */\n" \
         if housing else ""
     if plan.rate2:  # the second df/dt filter (d2) has its own state
-        state_h += "    double f2_y1;               /* first stage of f, second filter [Hz] */\n" \
-                   "    double f2_y2;               /* second stage of f, second filter [Hz] */\n"
+        state_h += f"    {p}_rate_filter f2_filter;  /* second df/dt filter of f (d2) [Hz] */\n"
     out_h = "    double h_c;                 /* housing temperature change h [degC] */\n" \
             "    double dh_c_per_s;          /* its causal rate dh/dt [degC/s] */\n" \
         if housing else ""
@@ -236,7 +242,7 @@ def header(model: UnitModel, plan: CPlan, prefix: str, origin: str,
 extern "C" {{
 #endif
 
-/* Sample rate the df/dt filter was designed for: call {p}_step() at exactly this rate. [Hz] */
+/* Sample rate of the training runs; step() takes each sample's dt_s, any rate works. [Hz] */
 #define {up}_SAMPLE_RATE_HZ {_literal(model.drift.settings.sample_rate_hz, "sample_rate_hz")}
 /* Samples at the start of a run flagged (in_range 0) while the df/dt filter settles,
    as training leaves them out. */
@@ -248,10 +254,10 @@ extern "C" {{
 /* SHA-256 of the model this code was generated from. */
 #define {up}_MODEL_SHA256 "{sha256}"
 {k['define']}
+{filter_struct(p, False)}
 /* Filter state of one gyro; initialise with {p}_init(). */
 typedef struct {p}_state {{
-    double f_y1;                /* first low-pass stage of f [Hz] */
-    double f_y2;                /* second low-pass stage of f [Hz] */
+    {p}_rate_filter f_filter;   /* df/dt filter of f [Hz] */
 {state_h}    int started;                /* 0 until the first sample after init/reset */
     unsigned long samples;      /* samples since init/reset */
     unsigned long out_of_range; /* of which outside the calibrated temperature */
@@ -273,13 +279,16 @@ typedef struct {p}_output {{
 /* Set the state to the start of a run (before first use). */
 void {p}_init({p}_state *state);
 
-/* Start a new run: the df/dt filter restarts at rest on the next sample. */
+/* Start a new run (or a segment after a gap, split): the df/dt filter restarts at rest
+   on the next sample. */
 void {p}_reset({p}_state *state);
 
 /* Compensate one sample; returns rate_comp_dph and fills *out unless out is NULL.
-   freq_hz [Hz], rate_dph [deg/h]{", housing_c [degC]" if plan.housing_input else ""}\
+   dt_s [s] time since the previous sample (a gap's length bridges it), freq_hz [Hz],
+   rate_dph [deg/h]{", housing_c [degC]" if plan.housing_input else ""}\
 {"".join(", aux_" + n for n in plan.aux)}. */
-double {p}_step({p}_state *state, double freq_hz, double rate_dph{arg_h}, {p}_output *out);
+double {p}_step({p}_state *state, double dt_s, double freq_hz, double rate_dph{arg_h},
+                {p}_output *out);
 
 /* Bias model B of Eq. (22) from the variables. [deg/h] */
 double {p}_bias_dph(double f_hz, double df_hz_per_s{bias_h});
@@ -394,13 +403,13 @@ def source(model: UnitModel, plan: CPlan, prefix: str) -> str:
     reference_c = _literal(settings.reference_c, "reference_c")
     h = {
         "constants": f"static const double REFERENCE_C = {reference_c};\n",
-        "start": "        state->h_y1 = h_value;\n        state->h_y2 = h_value;\n",
-        "values": "    const double h_value = housing_c - REFERENCE_C;\n    double dh_value;\n",
-        "rate": "    dh_value = rate_update(&state->h_y1, &state->h_y2, h_value);\n",
+        "start": "        rate_start(&state->h_filter, h_value);\n",
+        "values": "    const double h_value = housing_c - REFERENCE_C;\n    double dh_value = 0.0;\n",
+        "rate": "        dh_value = rate_update(&state->h_filter, h_value, dt_s, RATE_TAU_S);\n",
         "out": "        out->h_c = h_value;\n        out->dh_c_per_s = dh_value;\n",
         "arg": ", double housing_c",
         "bias": ", h_value, dh_value",
-        "reset": "    state->h_y1 = 0.0;\n    state->h_y2 = 0.0;\n",
+        "reset": "    rate_start(&state->h_filter, 0.0);\n",
     }
     if not plan.housing:
         h = dict.fromkeys(h, "")
@@ -421,28 +430,14 @@ def source(model: UnitModel, plan: CPlan, prefix: str) -> str:
 
 #include <math.h>
 
-/* ---- frequency change and the causal df/dt filter (hrgtc.drift.features.causal_rate) ---- */
+/* ---- frequency change and the causal df/dt filter (hrgtc.drift.rate_filter) ---- */
 static const double REFERENCE_FREQ_HZ = \
 {_literal(settings.reference_freq_hz, 'reference_freq_hz')};
 {h['constants']}{extra['constants']}\
-static const double RATE_ALPHA = {_literal(plan.alpha, 'alpha')};
-static const double RATE_BETA = {_literal(plan.beta, 'beta')};
-static const double RATE_GAIN = {_literal(plan.gain, 'gain')};  /* alpha * fs / beta */
+/* time constant of each stage of the df/dt filter [s] */
+static const double RATE_TAU_S = {_literal(plan.tau_s, 'rate_tau_s')};
 
-/* One sample of two exact first-order lags; returns the rate. Separate statements keep
-   the rounding identical to hrgtc (no fused multiply-add within an expression). */
-static double rate_update(double *y1, double *y2, double x)
-{{
-    double a = RATE_ALPHA * x;
-    double b = RATE_BETA * *y1;
-    *y1 = a + b;
-    a = RATE_ALPHA * *y1;
-    b = RATE_BETA * *y2;
-    *y2 = a + b;
-    a = *y1 - *y2;
-    return a * RATE_GAIN;
-}}
-{extra['functions']}
+{filter_functions(p, False)}{extra['functions']}
 /* ---- the drift model, Eq. (22) of [1] (hrgtc.drift.DriftModel.predict) ---- */
 {_bias_function(model, plan, p)}{k['function']}
 /* ---- the thermometer, Eq. (18) of [1] (hrgtc.thermometry.Thermometer) ---- */
@@ -468,8 +463,7 @@ static const double TH_TOLERANCE_C = {_literal(plan.tolerance, 'tolerance')};
 {range_constants}
 void {p}_reset({p}_state *state)
 {{
-    state->f_y1 = 0.0;
-    state->f_y2 = 0.0;
+    rate_start(&state->f_filter, 0.0);
 {h['reset']}{extra['reset']}    state->started = 0;
     state->samples = 0UL;
     state->out_of_range = 0UL;
@@ -481,18 +475,18 @@ void {p}_init({p}_state *state)
     {p}_reset(state);
 }}
 
-double {p}_step({p}_state *state, double freq_hz, double rate_dph{h['arg']}, \
+double {p}_step({p}_state *state, double dt_s, double freq_hz, double rate_dph{h['arg']}, \
 {p}_output *out)
 {{
     const double f_value = freq_hz - REFERENCE_FREQ_HZ;
-{h['values']}{extra['values']}    double df_value, bias, compensated, temperature;
+{h['values']}{extra['values']}    double df_value = 0.0, bias, compensated, temperature;
     int in_range, rate_in_range, level_in_range;
-{k['declare']}    if (!state->started) {{  /* the filter starts at rest on the first sample */
-        state->f_y1 = f_value;
-        state->f_y2 = f_value;
+{k['declare']}    if (!state->started) {{  /* the filters start at rest on the first sample */
+        rate_start(&state->f_filter, f_value);
 {h['start']}{extra['start']}        state->started = 1;
-    }}
-    df_value = rate_update(&state->f_y1, &state->f_y2, f_value);
-{h['rate']}    temperature = {p}_temperature_c(freq_hz);
-{extra['rate']}    bias = {p}_bias_dph(f_value, df_value{h['bias']}{extra['bias']});
+    }} else {{  /* each filter steps over this sample's dt_s */
+        df_value = rate_update(&state->f_filter, f_value, dt_s, RATE_TAU_S);
+{h['rate']}{extra['rate']}    }}
+    temperature = {p}_temperature_c(freq_hz);
+{extra['gradient']}    bias = {p}_bias_dph(f_value, df_value{h['bias']}{extra['bias']});
 {tail}"""

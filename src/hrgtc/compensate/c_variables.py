@@ -4,8 +4,8 @@
 pieces of the variables added to the term grammar after the paper's:
 
 * ``d2``: the causal df/dt filter with its own time constant (``rate_tau2_s``) and its
-  own state in the state struct (``f2_y1``, ``f2_y2``), the same separate statements as
-  the first filter so the rounding is NumPy's;
+  own state in the state struct (``f2_filter``), the same ``rate_update`` as the first
+  filter so the rounding is hrgtc's;
 * ``g``: ``housing_c`` minus the resonator temperature of the C thermometer inverse
   (``step()`` then takes ``housing_c``);
 * ``a_NAME``: one more ``step()`` input ``aux_NAME`` per extra channel, minus its
@@ -60,35 +60,21 @@ def extra_variables(plan: CPlan, settings: Any, _literal: Callable[[float, str],
 
     ``_literal`` and ``_comment`` print a constant and a comment as :mod:`c_text` does.
     """
-    out = dict.fromkeys(("constants", "functions", "reset", "start", "values", "rate", "bias"),
-                        "")
-    if plan.rate2:
+    out = dict.fromkeys(("constants", "functions", "reset", "start", "values", "rate",
+                         "gradient", "bias"), "")
+    if plan.rate2:  # the same filter (rate_update), its own state and time constant
         out["constants"] += (
-            f"static const double RATE2_ALPHA = {_literal(plan.alpha2, 'alpha2')};\n"
-            f"static const double RATE2_BETA = {_literal(plan.beta2, 'beta2')};\n"
-            f"static const double RATE2_GAIN = {_literal(plan.gain2, 'gain2')};\n")
-        out["functions"] = """
-/* The second df/dt filter (variable d2, time constant rate_tau2_s): rate_update's steps. */
-static double rate2_update(double *y1, double *y2, double x)
-{
-    double a = RATE2_ALPHA * x;
-    double b = RATE2_BETA * *y1;
-    *y1 = a + b;
-    a = RATE2_ALPHA * *y1;
-    b = RATE2_BETA * *y2;
-    *y2 = a + b;
-    a = *y1 - *y2;
-    return a * RATE2_GAIN;
-}
-"""
-        out["reset"] += "    state->f2_y1 = 0.0;\n    state->f2_y2 = 0.0;\n"
-        out["start"] += "        state->f2_y1 = f_value;\n        state->f2_y2 = f_value;\n"
-        out["values"] += "    double d2_value;\n"
-        out["rate"] += "    d2_value = rate2_update(&state->f2_y1, &state->f2_y2, f_value);\n"
+            "/* time constant of each stage of the second df/dt filter (d2) [s] */\n"
+            f"static const double RATE2_TAU_S = {_literal(plan.tau2_s, 'rate_tau2_s')};\n")
+        out["reset"] += "    rate_start(&state->f2_filter, 0.0);\n"
+        out["start"] += "        rate_start(&state->f2_filter, f_value);\n"
+        out["values"] += "    double d2_value = 0.0;\n"
+        out["rate"] += ("        d2_value = rate_update(&state->f2_filter, f_value, dt_s, "
+                        "RATE2_TAU_S);\n")
         out["bias"] += ", d2_value"
     if plan.gradient:
         out["values"] += "    double g_value;\n"
-        out["rate"] += "    g_value = housing_c - temperature;  /* NaN beyond the inverse */\n"
+        out["gradient"] += "    g_value = housing_c - temperature;  /* NaN beyond the inverse */\n"
         out["bias"] += ", g_value"
     for name in plan.aux:
         centre = _literal(settings.aux_centres.get(name, 0.0), f"aux_centres[{name}]")

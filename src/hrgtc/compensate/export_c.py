@@ -3,14 +3,16 @@
 The generated code runs, sample by sample, exactly the computation of
 :class:`hrgtc.compensate.Compensator`: f = freq_hz - f_ref, the causal df/dt
 filter of :func:`hrgtc.drift.features.causal_rate` (started at rest on the first
-sample), the selected terms of the drift model on scaled variables (Eq. 22 of
+sample, each step exact over the sample's own Δt: ``step()`` takes ``dt_s``, the time
+since the previous sample, so jittered clocks and bursts are handled and a gap is
+bridged by passing its length; ``reset()`` restarts the filter), the selected terms of the drift model on scaled variables (Eq. 22 of
 [1]), the compensated rate, the resonator temperature by inverting the
 thermometer (Eq. 18 of [1], a safeguarded Newton iteration on a bracket taken
 from a small embedded table, as in Table 2) and the in-range flags (``in_range``:
 calibrated frequency range and training ranges of f and h; ``rate_in_range``:
 training ranges of df/dt and dh/dt, with their own counters). Every constant is
 printed with ``%.17g`` so it reads back to the same double; the code only
-needs ``math.h`` (``pow``, ``fabs``, ``NAN``), allocates nothing and does no I/O.
+needs ``math.h`` (``pow``, ``fabs``, ``expm1``, ``NAN``), allocates nothing and does no I/O.
 
 Housing-thermistor variables (``h``, ``dh``) are supported: when the selected
 terms use them, ``step()`` takes ``housing_c`` as well and the header defines
@@ -18,7 +20,7 @@ terms use them, ``step()`` takes ``housing_c`` as well and the header defines
 exported, not the classical housing baseline.
 
 The variables of issue 12 are supported too: ``d2`` (a second df/dt filter with its own
-state ``f2_y1``/``f2_y2`` and time constant), ``g`` (``housing_c`` minus the C thermometer
+state ``f2_filter`` and time constant), ``g`` (``housing_c`` minus the C thermometer
 inverse's temperature; ``step()`` then takes ``housing_c``) and ``a_NAME`` (one more
 ``step()`` input ``aux_NAME`` per channel, centred on its training mean;
 ``<PREFIX>_AUX_INPUTS`` counts them). The heating/cooling switch ``dpos`` is refused.
@@ -220,7 +222,8 @@ def umbrella_header(axes: dict[str, UnitModel], prefix: str, origin: str, sha256
  *   #include "{prefix}_model.h"
  *   static {first}_state gyro_{names[0]};
  *   {first}_init(&gyro_{names[0]});
- *   rate = {first}_step(&gyro_{names[0]}, {argument}, rate_dph, ..., &out);  // each sample
+ *   rate = {first}_step(&gyro_{names[0]}, dt_s, {argument}, rate_dph, ..., &out);  // each sample
+ *   (dt_s: seconds since the previous sample, shared by the axes sampled together)
  *   (and likewise for the other axes, each with its own frequency and rate)
  *   Build: cc -std=c99 -O2 -c {" ".join(f"{prefix}_{n}_model.c" for n in names)}, link -lm.
  *

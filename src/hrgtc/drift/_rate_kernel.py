@@ -52,6 +52,9 @@ def filter_step(state, x, t, tau_s, restart):  # pragma: no cover - compiled
         state[2] = x
         state[3] = t
         state[4] = 1.0
+        state[5] = -1.0  # no cached step: a restarted filter is a new one
+        state[6] = 0.0
+        state[7] = 0.0
         return 0.0
     dt = t - state[3]
     dt = 0.0 if not dt > 0.0 else dt
