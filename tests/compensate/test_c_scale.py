@@ -35,7 +35,7 @@ DRIVER = r"""
 #include "PFX_model.h"
 int main(int argc, char **argv)
 {
-    REAL row[2], record[3];
+    REAL row[3], record[3];
     PFX_state state;
     PFX_output out;
     FILE *in, *result;
@@ -43,8 +43,8 @@ int main(int argc, char **argv)
         return 2;
     }
     PFX_init(&state);
-    while (fread(row, sizeof(REAL), 2, in) == 2) {
-        record[0] = PFX_step(&state, row[0], row[1], &out);
+    while (fread(row, sizeof(REAL), 3, in) == 3) {  /* dt_s, frequency, rate */
+        record[0] = PFX_step(&state, row[0], row[1], row[2], &out);
         record[1] = out.bias_model_dph;
         record[2] = out.scale_model_ppm;
         fwrite(record, sizeof(REAL), 3, result);
@@ -64,7 +64,7 @@ def model():
     return with_scale_factor(UnitModel(thermometer=THERMOMETER, drift=fitted, unit="sf"), sf)
 
 
-def run(model, tmp_path: Path, precision: str, columns):
+def run(model, tmp_path: Path, precision: str, columns, time_s):
     real = "double" if precision == "double" else "float"
     dtype = np.float64 if precision == "double" else np.float32
     export_c(model, tmp_path, prefix="sfx", precision=precision)
@@ -74,7 +74,8 @@ def run(model, tmp_path: Path, precision: str, columns):
     subprocess.run([COMPILER, *FLAGS, "-I", str(tmp_path), str(tmp_path / "sfx_model.c"),
                     str(tmp_path / "driver.c"), "-o", str(exe), "-lm"], check=True,
                    capture_output=True, text=True)
-    np.column_stack(columns).astype(dtype).tofile(tmp_path / "in.bin")
+    dt = np.concatenate([[0.0], np.diff(time_s)])
+    np.column_stack([dt, *columns]).astype(dtype).tofile(tmp_path / "in.bin")
     done = subprocess.run([str(exe), str(tmp_path / "in.bin"), str(tmp_path / "out.bin")],
                           capture_output=True, text=True, timeout=60)
     assert done.returncode == 0, done.stderr
@@ -84,7 +85,8 @@ def run(model, tmp_path: Path, precision: str, columns):
 @needs_compiler
 def test_double_build_divides_by_the_scale_factor(model, tmp_path):
     recording = ramp_run(seed=7, start_c=25.0, end_c=-25.0, hours=3.0, input_rate_dph=3.6e5)
-    out = run(model, tmp_path, "double", [recording.freq_hz, recording.rate_dph])
+    out = run(model, tmp_path, "double", [recording.freq_hz, recording.rate_dph],
+              recording.time_s)
     k = model.scale_factor.ppm(recording.freq_hz)
     low, high = model.scale_factor.freq_range_hz
     beyond = (recording.freq_hz < low) | (recording.freq_hz > high)
@@ -107,7 +109,8 @@ def test_single_build_scale_factor_matches_mirror_and_double(model, tmp_path):
     recording = ramp_run(seed=7, start_c=25.0, end_c=-25.0, hours=3.0)
     centre = model.drift.settings.reference_freq_hz
     f32 = (recording.freq_hz - centre).astype(np.float32)
-    out = run(model, tmp_path, "single", [f32, recording.rate_dph.astype(np.float32)])
+    out = run(model, tmp_path, "single", [f32, recording.rate_dph.astype(np.float32)],
+              recording.time_s)
     k32 = mirror_scale(model, f32)
     np.testing.assert_allclose(out[:, 2], k32, rtol=0, atol=4 * np.spacing(np.float32(200.0)))
     plan = plan_for(model, "single")

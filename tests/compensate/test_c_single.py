@@ -60,9 +60,9 @@ DRIVER = r"""
 
 int main(int argc, char **argv)
 {
-    const size_t run_columns = UPFX_USES_HOUSING ? 3 : 2;
+    const size_t run_columns = UPFX_USES_HOUSING ? 4 : 3;  /* dt_s first */
     const size_t grid_columns = GRADIENT ? 3 : (UPFX_USES_HOUSING ? 4 : 2);
-    float row[4], record[8];
+    float row[5], record[8];
     PFX_state state;
     PFX_output out;
     FILE *in, *result;
@@ -85,9 +85,9 @@ int main(int argc, char **argv)
     } else {
         while (fread(row, sizeof(float), run_columns, in) == run_columns) {
 #if UPFX_USES_HOUSING
-            record[6] = PFX_step(&state, row[0], row[1], row[2], &out);
+            record[6] = PFX_step(&state, row[0], row[1], row[2], row[3], &out);
 #else
-            record[6] = PFX_step(&state, row[0], row[1], &out);
+            record[6] = PFX_step(&state, row[0], row[1], row[2], &out);
 #endif
             record[0] = out.rate_comp_dph;
             record[1] = out.bias_model_dph;
@@ -222,7 +222,8 @@ def test_float_build_streams_like_the_double_compensator(kind, models, tmp_path)
     recording = make(seed=8, start_c=25.0, end_c=-25.0, hours=3.0)  # leaves the ranges
     centre = model.drift.settings.reference_freq_hz
     f32 = (recording.freq_hz - centre).astype(F32)
-    columns = [f32, recording.rate_dph.astype(F32)]
+    dt32 = np.concatenate([[0.0], np.diff(recording.time_s)]).astype(F32)
+    columns = [dt32, f32, recording.rate_dph.astype(F32)]
     if kind != "frequency":
         columns.append(recording["housing_c"].astype(F32))
     out, counters = run_driver(exe, "run", columns, tmp_path, 8)
@@ -232,14 +233,14 @@ def test_float_build_streams_like_the_double_compensator(kind, models, tmp_path)
     # the mirror, step by step: the filter, then the bias and the thermometer
     plan = plan_for(model, "single")
     constants = float_constants(model, plan)
-    df32 = mirror_rate(constants, f32)
+    df32 = mirror_rate(constants, f32, dt32)
     np.testing.assert_array_equal(out[:, 5], df32)  # the filter: the same bits
     inputs = {"f": f32, "df": df32}
     if kind == "housing":
-        h32 = columns[2] - constants.reference_c
-        inputs.update(h=h32, dh=mirror_rate(constants, h32))
+        h32 = columns[3] - constants.reference_c
+        inputs.update(h=h32, dh=mirror_rate(constants, h32, dt32))
     if kind == "gradient":
-        inputs["g"] = mirror_gradient(constants, columns[2], f32, plan.increasing)
+        inputs["g"] = mirror_gradient(constants, columns[3], f32, plan.increasing)
         np.testing.assert_array_equal(out[:, 2], mirror_temperature(constants, f32,
                                                                     plan.increasing))
     scale = np.abs(model.drift.intercept_dph) + np.sum(np.abs(model.drift.scaled_coefficients))
@@ -264,12 +265,17 @@ def test_float_build_streams_like_the_double_compensator(kind, models, tmp_path)
                   <= bound_dph + 2 * rounding[inside])
 
 
-def test_float_filter_is_the_double_filter():
-    # a ramp then a hold, sampled at 200 Hz with tau = 10 s (alpha = 5e-4): the float32
+@pytest.mark.parametrize("jitter", [False, True], ids=["uniform", "jittered"])
+def test_float_filter_is_the_double_filter(jitter):
+    # a ramp then a hold, sampled at 200 Hz with tau = 10 s (a = 5e-4): the float32
     # filter (differences, compensated sums) keeps the rate to 5e-6 of its size; the two
-    # low-passed levels in float32 would lose ~1e-3 (2^-24 of f over alpha, each sample)
+    # low-passed levels in float32 would lose ~1e-3 (2^-24 of f over a, each sample).
+    # Jittered steps (each dt its own weights) and a 5 s gap bridged by its dt as well.
     fs, tau = 200.0, 10.0
     t = np.arange(0.0, 600.0, 1.0 / fs)
+    if jitter:
+        t = t + np.random.default_rng(4).uniform(0.0, 0.4 / fs, t.size)
+        t[t > 200.0] += 5.0
     f = -3.0 + np.minimum(t, 300.0) * -4e-3
     model = UnitModel(thermometer=THERMOMETER,
                       drift=drift.fit([ramp_run(seed=1, hours=3.0)], THERMOMETER))
@@ -277,11 +283,10 @@ def test_float_filter_is_the_double_filter():
     constants = float_constants(model, plan)
     from dataclasses import replace
 
-    from hrgtc.drift.features import rate_filter_coefficients
-    alpha, beta = rate_filter_coefficients(tau, fs)
-    constants = replace(constants, alpha=F32(alpha), gain=F32(alpha * fs / beta))
-    df32 = mirror_rate(constants, f.astype(F32))
-    df64 = causal_rate(f, tau, fs)[0]
+    constants = replace(constants, tau_s=tau, tau=F32(tau))
+    dt = np.concatenate([[0.0], np.diff(t)])
+    df32 = mirror_rate(constants, f.astype(F32), dt)
+    df64 = causal_rate(f, tau, time_s=t)[0]
     ramp = (t > 150.0) & (t < 300.0)
     np.testing.assert_allclose(df32[ramp], -4e-3, rtol=1e-5)
     np.testing.assert_allclose(df32, df64, rtol=0, atol=2e-8)
@@ -307,7 +312,14 @@ def test_double_default_unchanged_and_bad_precision(models, tmp_path):
     assert "float" not in double[1].read_text()
     single = export_c(model, tmp_path / "c", precision="single")
     code = single[1].read_text()
-    assert "double" not in code and "pow(" not in code and "fabs(" not in code
+    assert "pow(" not in code and "fabs(" not in code
+    # double only where the df/dt filter's weights are computed (once per distinct dt_s):
+    # rate_weights() and its constants; everything per sample is float
+    weights = code[code.index("static const double RATE_SERIES"):code.index("/* A step whose dt")]
+    rest = code.replace(weights, "").replace("static const double RATE_TAU_S", "")
+    rest = rest.replace("double tau_d", "").replace("double a, p;", "")
+    rest = rest.replace("rate_weights((double)dt", "")
+    assert "double" not in re.sub(r"/\*.*?\*/", "", rest, flags=re.S)
     assert re.search(r"= -?\d[^;]*f;", code)  # float literals
     with pytest.raises(InputError, match="precision 'half' is not one of double, single"):
         export_c(model, tmp_path / "d", precision="half")

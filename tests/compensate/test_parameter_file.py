@@ -10,6 +10,7 @@ run the model was not trained on (partly beyond its ranges: the tangent continua
 
 from __future__ import annotations
 
+import math
 import re
 
 import numpy as np
@@ -43,15 +44,21 @@ def parse(text: str) -> dict[str, float | str]:
     return out
 
 
-def rate_of(x, p, prefix=""):
-    """The header's step 2, sample by sample in plain Python floats."""
-    alpha, beta, gain = (p[prefix + k] for k in ("filter_alpha", "filter_beta", "filter_gain"))
+def rate_of(x, p, time_s, prefix=""):
+    """The header's step 2, sample by sample in plain Python floats (each step its own dt)."""
+    tau = p[prefix + "rate_tau_s"]
     y1 = y2 = x[0]
     out = np.empty_like(x)
-    for i, value in enumerate(x):
-        y1 = alpha * value + beta * y1
-        y2 = alpha * y1 + beta * y2
-        out[i] = (y1 - y2) * gain
+    out[0] = 0.0
+    for i in range(1, len(x)):
+        r = (time_s[i] - time_s[i - 1]) / tau
+        a = -math.expm1(-r)
+        weight = (sum((-1.0) ** (k + 1) * r ** k / math.factorial(k + 1) for k in range(1, 10))
+                  if r < 0.1 else 1.0 - a / r)
+        new_y1 = y1 + a * (x[i - 1] - y1) + weight * (x[i] - x[i - 1])
+        y2 = y2 + a * (y1 - y2) + weight * (new_y1 - y1)
+        y1 = new_y1
+        out[i] = (y1 - y2) / tau
     return out
 
 
@@ -135,10 +142,10 @@ def test_parameters_evaluated_by_hand_equal_the_compensator(kind, tmp_path):
 
     expected = Compensator(model).process(recording)
     values = {"f": recording.freq_hz - p["reference_freq_hz"]}
-    values["df"] = rate_of(values["f"], p)
+    values["df"] = rate_of(values["f"], p, recording.time_s)
     if kind == "housing":
         values["h"] = recording["housing_c"] - p["reference_c"]
-        values["dh"] = rate_of(values["h"], p)
+        values["dh"] = rate_of(values["h"], p, recording.time_s)
     bias = bias_from(p, values)
     beyond = values["f"] > p["range_f_high"]
     assert 0.01 < beyond.mean() < 0.5  # the tangent continuation is exercised
@@ -207,7 +214,7 @@ def test_parameters_with_a_scale_factor(tmp_path):
     k = scale_from(p, recording.freq_hz)
     np.testing.assert_allclose(k, sf.ppm(recording.freq_hz), rtol=1e-12, atol=1e-12 * 150)
     values = {"f": recording.freq_hz - p["reference_freq_hz"]}
-    values["df"] = rate_of(values["f"], p)
+    values["df"] = rate_of(values["f"], p, recording.time_s)
     bias = bias_from(p, values)
     expected_bias = Compensator(model).process(recording)["bias_model_dph"]
     np.testing.assert_allclose(bias, expected_bias, rtol=1e-12, atol=1e-12 * 100)

@@ -8,11 +8,12 @@ centre the drift model's reference frequency f_ref, so ``f`` is already the
 model's variable (a few Hz, resolved to ~1e-7 Hz) and the thermometer is written
 about the same centre (its constant term ``a0 - f_ref`` is taken in double at
 export time). The df/dt filter keeps its state as differences (the first stage's
-lag ``f - y1`` and ``y1 - y2``), which are small and carry the rate, instead of the
+lag ``f_prev - y1`` and ``y1 - y2``), which are small and carry the rate, instead of the
 two low-passed levels, whose difference would cancel float32's digits; each is
 updated by a small increment, with compensated (Kahan) summation so that rounding
-does not accumulate over the filter's 1/alpha samples of memory. It is
-algebraically the filter of :func:`hrgtc.drift.features.causal_rate`.
+does not accumulate over the filter's tau/dt samples of memory. It is the filter of
+:func:`hrgtc.drift.features.causal_rate` (each step exact over its own Δt, whose
+weights are computed in double and rounded to float once per distinct Δt).
 
 :func:`float_constants` rounds every constant once, so the C text
 (:mod:`hrgtc.compensate.c_single`) prints exactly these float32 values and the
@@ -27,6 +28,7 @@ compares them with the double model over dense grids of the trained ranges.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -34,9 +36,11 @@ import numpy as np
 from hrgtc.compensate.c_plan import CPlan
 from hrgtc.compensate.c_text import NEWTON_MAX_ITER
 from hrgtc.drift.features import Term
+from hrgtc.drift.rate_filter import DT_REL_TOLERANCE, SERIES_LIMIT, series_coefficients
 from hrgtc.model import UnitModel
 
 F32 = np.float32
+SERIES = series_coefficients()
 #: Points of the error grids: the frequency line, and the grid of the drift variables.
 TEMPERATURE_POINTS = 20001
 BIAS_POINTS = 250_000
@@ -53,8 +57,9 @@ class FloatConstants:
     ----------
     centre_hz
         CENTRE_HZ = f_ref, kept in double: the firmware subtracts it. [Hz]
-    alpha, gain
-        The df/dt filter's stage coefficient and ramp gain ``alpha * fs / (1 - alpha)``.
+    tau_s, tau
+        The df/dt filter's time constant, in double (its weights are computed in double)
+        and in float (the rate is the difference divided by it). [s]
     reference_c
         Origin of the housing variable h. [°C]
     th_centre_c, th_scale_c
@@ -73,8 +78,8 @@ class FloatConstants:
     """
 
     centre_hz: float
-    alpha: np.float32
-    gain: np.float32
+    tau_s: float
+    tau: np.float32
     reference_c: np.float32
     th_centre_c: np.float32
     th_scale_c: np.float32
@@ -108,8 +113,8 @@ def float_constants(model: UnitModel, plan: CPlan) -> FloatConstants:
                     16 * eps * float(np.sum(np.abs(centred))) / slope_min)
     return FloatConstants(
         centre_hz=centre,
-        alpha=F32(plan.alpha),
-        gain=F32(plan.gain),
+        tau_s=float(plan.tau_s),
+        tau=F32(plan.tau_s),
         reference_c=F32(settings.reference_c),
         th_centre_c=F32(thermometer.centre_c),
         th_scale_c=F32(thermometer.scale_c),
@@ -259,14 +264,30 @@ def mirror_gradient(c: FloatConstants, housing_c: np.ndarray, f_hz: np.ndarray,
     return (np.asarray(housing_c, dtype=F32) - temperature).astype(F32)
 
 
-def mirror_rate(c: FloatConstants, x: np.ndarray) -> np.ndarray:
+def step_weights64(dt_s: float, tau_s: float) -> tuple[float, float]:
+    """The C ``rate_weights()``: (a, p) of one step, in double, the same operations."""
+    r = dt_s / tau_s
+    a = -math.expm1(-r)
+    if r < SERIES_LIMIT:
+        q = SERIES[-1]
+        for coefficient in SERIES[-2::-1]:
+            q = q * r
+            q = q + coefficient
+        return a, q * r
+    return a, (r - a) / r
+
+
+def mirror_rate(c: FloatConstants, x: np.ndarray, dt_s: np.ndarray) -> np.ndarray:
     """The float build's causal rate of one signal (df/dt of f, or dh/dt), from rest. [/s]
 
-    Its ``rate_update()``: the lag ``x - y1`` and the difference ``y1 - y2`` of the two
-    stages, each updated by its small increment with compensated (Kahan) summation.
-    Runs along the last axis (rows of signals at once).
+    Its ``rate_update()``: the lag ``x_prev - y1`` and the difference ``y1 - y2`` of the
+    two stages, each updated by its small increment with compensated (Kahan) summation,
+    with the weights of each step's ``dt_s`` (float, as firmware passes it; the first is
+    ignored) computed in double and rounded to float when dt moves by more than the
+    tolerance. Runs along the last axis (rows of signals at once, one dt per column).
     """
     x = np.asarray(x, dtype=F32)
+    dt_s = np.asarray(dt_s, dtype=F32)
     out = np.empty_like(x)
     if x.shape[-1] == 0:
         return out
@@ -275,22 +296,27 @@ def mirror_rate(c: FloatConstants, x: np.ndarray) -> np.ndarray:
     lag_carry = np.zeros_like(previous)
     difference = np.zeros_like(previous)
     difference_carry = np.zeros_like(previous)
-    alpha, gain = c.alpha, c.gain
-    for i in range(x.shape[-1]):
+    tolerance = F32(DT_REL_TOLERANCE)
+    cached, a, p = F32(-1.0), F32(0.0), F32(0.0)
+    out[..., 0] = 0.0
+    for i in range(1, x.shape[-1]):
+        dt = dt_s[i] if dt_s[i] > 0 else F32(0.0)
+        if not abs(dt - cached) <= tolerance * cached:
+            a64, p64 = step_weights64(float(dt), c.tau_s)
+            cached, a, p = dt, F32(a64), F32(p64)
         delta = x[..., i] - previous
         previous = x[..., i]
-        s = lag + delta
-        a = alpha * s
-        increment = (delta - a) - lag_carry
+        c1 = a * lag + p * delta
+        increment = (delta - c1) - lag_carry
         total = lag + increment
         lag_carry = (total - lag) - increment
         lag = total
-        s = difference + a
-        increment = (a - alpha * s) - difference_carry
+        c2 = a * difference + p * c1
+        increment = (c1 - c2) - difference_carry
         total = difference + increment
         difference_carry = (total - difference) - increment
         difference = total
-        out[..., i] = difference * gain
+        out[..., i] = difference / c.tau
     return out
 
 
@@ -417,6 +443,7 @@ def _ramp_error(model: UnitModel, plan: CPlan, c: FloatConstants) -> float:
     fs, tau = settings.sample_rate_hz, settings.rate_tau_s
     samples = int(min(12 * tau * fs, 100_000))
     centred_time_s = (np.arange(samples) - samples / 2) / fs
+    dt32 = np.full(samples, F32(1.0 / fs))
     values64: dict[str, np.ndarray] = {}
     values32: dict[str, np.ndarray] = {}
     for level, rate in (("f", "df"), ("h", "dh")):
@@ -431,7 +458,7 @@ def _ramp_error(model: UnitModel, plan: CPlan, c: FloatConstants) -> float:
             x32 = x.astype(F32)
         values64[level], values32[level] = x, x32
         values64[rate] = np.vstack([causal_rate(row, tau, fs)[0] for row in x])
-        values32[rate] = mirror_rate(c, x32)
+        values32[rate] = mirror_rate(c, x32, dt32)
     if plan.gradient:  # g held at the middle of its range, through both inverses
         middle = 0.5 * sum(drift.ranges["g"]) if "g" in drift.ranges else 0.0
         values64["g"] = np.full(values64["f"].shape, middle)

@@ -20,7 +20,7 @@ from __future__ import annotations
 from hrgtc.compensate.c_types import DOUBLE, SINGLE
 from hrgtc.drift.rate_filter import DT_REL_TOLERANCE, SERIES_LIMIT, series_coefficients
 
-__all__ = ["filter_struct", "filter_functions"]
+__all__ = ["filter_functions", "filter_struct"]
 
 
 def filter_struct(p: str, single: bool) -> str:
@@ -53,8 +53,8 @@ typedef struct {p}_rate_filter {{
 def _weights() -> str:
     series = ", ".join(DOUBLE.literal(c, f"series[{k}]")
                        for k, c in enumerate(series_coefficients()))
-    return f"""/* Taylor series of p(r) = 1 - (1 - exp(-r))/r = sum_k RATE_SERIES[k] r^(k+1), used below
-   r = RATE_SERIES_LIMIT where the direct formula cancels. */
+    return f"""/* Taylor series of p(r) = 1 - (1 - exp(-r))/r = sum_k RATE_SERIES[k] r^(k+1),
+   used below r = RATE_SERIES_LIMIT where the direct formula cancels. */
 static const double RATE_SERIES[{len(series_coefficients())}] = {{{series}}};
 static const double RATE_SERIES_LIMIT = {DOUBLE.literal(SERIES_LIMIT, "series_limit")};
 

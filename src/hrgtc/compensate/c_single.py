@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from hrgtc.compensate.c_float32 import MARGIN, FloatAccuracy, FloatConstants
 from hrgtc.compensate.c_plan import TABLE_POINTS, CPlan
+from hrgtc.compensate.c_rate_filter import filter_functions, filter_struct
 from hrgtc.compensate.c_scale import scale_factor_of, scale_pieces
 from hrgtc.compensate.c_step import step_tail
 from hrgtc.compensate.c_text import NEWTON_MAX_ITER, _array, _bias_function, _comment, readme
@@ -41,8 +42,10 @@ def _sections(model: UnitModel, plan: CPlan, prefix: str, accuracy: FloatAccurac
         f"the macro {up}_CENTRED_HZ(freq_hz) does it) or in the units of your frequency "
         "counter; a float freq_hz would already have lost 0.5 mHz (2 mdegC) to rounding. "
         "The thermometer polynomial is written about the same centre and the df/dt filter "
-        "keeps its state as the differences f - y1 and y1 - y2, updated with compensated "
-        "(Kahan) sums (algebraically the same filter; float32 keeps their digits).",
+        "keeps its state as the differences f_prev - y1 and y1 - y2, updated with "
+        "compensated (Kahan) sums (algebraically the same filter; float32 keeps their "
+        "digits); its weights for each step's dt_s are computed in double (expm1) only "
+        "when dt_s changes by more than 1e-6 of itself.",
         "",
         "ACCURACY (float32 against hrgtc's double model, measured at export by evaluating "
         "this code's float32 operations in numpy)",
@@ -65,7 +68,10 @@ def _sections(model: UnitModel, plan: CPlan, prefix: str, accuracy: FloatAccurac
         f"  inputs:  f_hz = freq_hz - {up}_CENTRE_HZ [Hz]; rate_dph [deg/h] gyro output "
         "(input rate included)"
         + ("; housing_c [degC] housing thermistor" if plan.housing_input else "")
-        + f". One call per sample at exactly {up}_SAMPLE_RATE_HZ ({fs:g} Hz).",
+        + "; dt_s [s] the time since the previous sample (any steps; ignored on the first "
+        f"sample after init/reset). The model was trained at {fs:g} Hz.",
+        "  gaps:    pass the gap's length as dt_s to carry the filter across it (bridge), "
+        f"or call {p}_reset() to restart it (split).",
         "  outputs: rate_comp_dph, bias_model_dph [deg/h]; resonator_c_est [degC];",
         "           f_hz [Hz]; df_hz_per_s [Hz/s]; in_range, rate_in_range 1/0.",
         "",
@@ -75,7 +81,7 @@ def _sections(model: UnitModel, plan: CPlan, prefix: str, accuracy: FloatAccurac
         f"  {p}_init(&gyro);                      // once; {p}_reset(&gyro) at a new run",
         "  for (;;) {                              // each sample",
         f"      {p}_output out;",
-        f"      float rate = {p}_step(&gyro, {up}_CENTRED_HZ(freq_hz), rate_dph, "
+        f"      float rate = {p}_step(&gyro, dt_s, {up}_CENTRED_HZ(freq_hz), rate_dph, "
         f"{housing_use}&out);",
         "      if (!out.in_range) { flag_sample(); }  // outside the calibration",
         "  }",
@@ -84,7 +90,8 @@ def _sections(model: UnitModel, plan: CPlan, prefix: str, accuracy: FloatAccurac
         "would undo the filter's compensated sums); with "
         "-ffp-contract=off (GCC's default under -std=c99) the code rounds exactly as the "
         "mirror that measured the figures above (fused multiply-add changes only last bits).",
-        f"  The step signature: float {p}_step({p}_state *, float f_hz, float rate_dph, "
+        f"  The step signature: float {p}_step({p}_state *, float dt_s, float f_hz, "
+        "float rate_dph, "
         f"{housing_arg}{p}_output *out);",
         "",
     ]
@@ -96,11 +103,7 @@ def header(model: UnitModel, plan: CPlan, prefix: str, origin: str, sha256: str,
     p, up = prefix, prefix.upper()
     lit = SINGLE.literal
     housing = plan.housing
-    state_h = ("    float h_previous;           /* previous h [degC] */\n"
-               "    float h_lag;                /* h - y1 of the first low-pass stage [degC] */\n"
-               "    float h_lag_carry;          /* what its float sums rounded off [degC] */\n"
-               "    float h_difference;         /* y1 - y2 of the two stages [degC] */\n"
-               "    float h_difference_carry;   /* what its float sums rounded off [degC] */\n"
+    state_h = (f"    {p}_rate_filter h_filter;   /* dh/dt filter of h [degC] */\n"
                if housing else "")
     out_h = ("    float h_c;                  /* housing temperature change h [degC] */\n"
              "    float dh_c_per_s;           /* its causal rate dh/dt [degC/s] */\n"
@@ -130,7 +133,7 @@ extern "C" {{
    worst measured at export: resonator temperature [degC] and bias model [deg/h]. */
 #define {up}_MAX_ERROR_C {lit(accuracy.bound_c, "max_error_c")}
 #define {up}_MAX_ERROR_DPH {lit(accuracy.bound_dph, "max_error_dph")}
-/* Sample rate the df/dt filter was designed for: call {p}_step() at exactly this rate. [Hz] */
+/* Sample rate of the training runs; step() takes each sample's dt_s, any rate works. [Hz] */
 #define {up}_SAMPLE_RATE_HZ {lit(settings.sample_rate_hz, "sample_rate_hz")}
 /* Samples at the start of a run flagged (in_range 0) while the df/dt filter settles,
    as training leaves them out. */
@@ -140,13 +143,10 @@ extern "C" {{
 /* SHA-256 of the model this code was generated from. */
 #define {up}_MODEL_SHA256 "{sha256}"
 {k['define']}
+{filter_struct(p, True)}
 /* Filter state of one gyro; initialise with {p}_init(). */
 typedef struct {p}_state {{
-    float f_previous;           /* previous f [Hz] */
-    float f_lag;                /* f - y1 of the first low-pass stage [Hz] */
-    float f_lag_carry;          /* what its float sums rounded off [Hz] */
-    float f_difference;         /* y1 - y2 of the two stages [Hz] */
-    float f_difference_carry;   /* what its float sums rounded off [Hz] */
+    {p}_rate_filter f_filter;   /* df/dt filter of f [Hz] */
 {state_h}    int started;                /* 0 until the first sample after init/reset */
     unsigned long samples;      /* samples since init/reset */
     unsigned long out_of_range; /* of which outside the calibrated temperature */
@@ -168,12 +168,15 @@ typedef struct {p}_output {{
 /* Set the state to the start of a run (before first use). */
 void {p}_init({p}_state *state);
 
-/* Start a new run: the df/dt filter restarts at rest on the next sample. */
+/* Start a new run (or a segment after a gap, split): the df/dt filter restarts at rest
+   on the next sample. */
 void {p}_reset({p}_state *state);
 
 /* Compensate one sample; returns rate_comp_dph and fills *out unless out is NULL.
+   dt_s [s] time since the previous sample (a gap's length bridges it),
    f_hz = freq_hz - {up}_CENTRE_HZ [Hz], rate_dph [deg/h]{housing_in}. */
-float {p}_step({p}_state *state, float f_hz, float rate_dph{arg_h}, {p}_output *out);
+float {p}_step({p}_state *state, float dt_s, float f_hz, float rate_dph{arg_h},
+               {p}_output *out);
 
 /* Bias model B of Eq. (22) from the variables. [deg/h] */
 float {p}_bias_dph(float f_hz, float df_hz_per_s{bias_h});
@@ -217,19 +220,15 @@ def source(model: UnitModel, plan: CPlan, prefix: str, constants: FloatConstants
     above = "residual > 0.0f" if plan.increasing else "!(residual > 0.0f)"
     h = {
         "constants": f"static const float REFERENCE_C = {lit(c.reference_c, 'reference_c')};\n",
-        "start": "        state->h_previous = h_value;\n        state->h_lag = 0.0f;\n"
-                 "        state->h_lag_carry = 0.0f;\n        state->h_difference = 0.0f;\n"
-                 "        state->h_difference_carry = 0.0f;\n",
-        "values": "    const float h_value = housing_c - REFERENCE_C;\n    float dh_value;\n",
-        "rate": "    dh_value = rate_update(&state->h_previous, &state->h_lag, "
-                "&state->h_lag_carry,\n                           &state->h_difference, "
-                "&state->h_difference_carry, h_value);\n",
+        "start": "        rate_start(&state->h_filter, h_value);\n",
+        "values": "    const float h_value = housing_c - REFERENCE_C;\n"
+                  "    float dh_value = 0.0f;\n",
+        "rate": "        dh_value = rate_update(&state->h_filter, h_value, dt_s, RATE_TAU_S, "
+                "RATE_TAU);\n",
         "out": "        out->h_c = h_value;\n        out->dh_c_per_s = dh_value;\n",
         "arg": ", float housing_c",
         "bias": ", h_value, dh_value",
-        "reset": "    state->h_previous = 0.0f;\n    state->h_lag = 0.0f;\n"
-                 "    state->h_lag_carry = 0.0f;\n    state->h_difference = 0.0f;\n"
-                 "    state->h_difference_carry = 0.0f;\n",
+        "reset": "    rate_start(&state->h_filter, 0.0f);\n",
     }
     if not plan.housing:
         h = dict.fromkeys(h, "")
@@ -257,37 +256,12 @@ def source(model: UnitModel, plan: CPlan, prefix: str, constants: FloatConstants
 
 #include <math.h>
 
-/* ---- the causal df/dt filter (hrgtc.drift.features.causal_rate), kept as differences ---- */
-{h['constants']}static const float RATE_ALPHA = {lit(c.alpha, 'alpha')};
-static const float RATE_GAIN = {lit(c.gain, 'gain')};  /* alpha * fs / (1 - alpha) */
+/* ---- the causal df/dt filter (hrgtc.drift.rate_filter), kept as differences ---- */
+{h['constants']}/* time constant of each df/dt stage, in double (the weights) and float [s] */
+static const double RATE_TAU_S = {DOUBLE.literal(c.tau_s, 'rate_tau_s')};
+static const float RATE_TAU = {lit(c.tau, 'tau')};
 
-/* One sample of two exact first-order lags y1, y2 of x, held as lag = x - y1 and
-   difference = y1 - y2; returns the rate (y1 - y2) * gain. Each is updated by a small
-   increment (a fraction alpha of itself); compensated (Kahan) summation keeps what the
-   float sum rounds off in a carry, so the state does not drift by rounding. */
-static float rate_update(float *previous, float *lag, float *lag_carry, float *difference,
-                         float *difference_carry, float x)
-{{
-    const float delta = x - *previous;
-    float s, a, product, increment, sum;
-    *previous = x;
-    s = *lag + delta;           /* x - y1 before this sample's update */
-    a = RATE_ALPHA * s;         /* the change of y1 */
-    increment = delta - a;      /* the change of x - y1 */
-    increment = increment - *lag_carry;
-    sum = *lag + increment;
-    *lag_carry = (sum - *lag) - increment;
-    *lag = sum;
-    s = *difference + a;        /* y1 - y2 before y2's update */
-    product = RATE_ALPHA * s;   /* the change of y2 */
-    increment = a - product;    /* the change of y1 - y2 */
-    increment = increment - *difference_carry;
-    sum = *difference + increment;
-    *difference_carry = (sum - *difference) - increment;
-    *difference = sum;
-    return *difference * RATE_GAIN;
-}}
-
+{filter_functions(p, True)}
 /* ---- the drift model, Eq. (22) of [1] (hrgtc.drift.DriftModel.predict) ---- */
 {_bias_function(model, plan, p)}{k['function']}
 /* ---- the thermometer, Eq. (18) of [1], centred on {up}_CENTRE_HZ ---- */
@@ -312,11 +286,7 @@ static const float TH_TOLERANCE_C = {lit(c.tolerance, 'tolerance')};
 {range_constants}
 void {p}_reset({p}_state *state)
 {{
-    state->f_previous = 0.0f;
-    state->f_lag = 0.0f;
-    state->f_lag_carry = 0.0f;
-    state->f_difference = 0.0f;
-    state->f_difference_carry = 0.0f;
+    rate_start(&state->f_filter, 0.0f);
 {h['reset']}    state->started = 0;
     state->samples = 0UL;
     state->out_of_range = 0UL;
@@ -328,21 +298,18 @@ void {p}_init({p}_state *state)
     {p}_reset(state);
 }}
 
-float {p}_step({p}_state *state, float f_hz, float rate_dph{h['arg']}, {p}_output *out)
+float {p}_step({p}_state *state, float dt_s, float f_hz, float rate_dph{h['arg']},
+{p}_output *out)
 {{
     const float f_value = f_hz;
-{h['values']}{g['values']}    float df_value, bias, compensated, temperature;
+{h['values']}{g['values']}    float df_value = 0.0f, bias, compensated, temperature;
     int in_range, rate_in_range, level_in_range;
-{k['declare']}    if (!state->started) {{  /* the filter starts at rest on the first sample */
-        state->f_previous = f_value;
-        state->f_lag = 0.0f;
-        state->f_lag_carry = 0.0f;
-        state->f_difference = 0.0f;
-        state->f_difference_carry = 0.0f;
+{k['declare']}    if (!state->started) {{  /* the filters start at rest on the first sample */
+        rate_start(&state->f_filter, f_value);
 {h['start']}        state->started = 1;
-    }}
-    df_value = rate_update(&state->f_previous, &state->f_lag, &state->f_lag_carry,
-                           &state->f_difference, &state->f_difference_carry, f_value);
-{h['rate']}    temperature = {p}_temperature_c(f_value);
+    }} else {{  /* each filter steps over this sample's dt_s */
+        df_value = rate_update(&state->f_filter, f_value, dt_s, RATE_TAU_S, RATE_TAU);
+{h['rate']}    }}
+    temperature = {p}_temperature_c(f_value);
 {g['rate']}    bias = {p}_bias_dph(f_value, df_value{h['bias']}{g['bias']});
 {tail}"""

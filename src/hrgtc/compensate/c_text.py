@@ -128,7 +128,8 @@ def readme(model: UnitModel, plan: CPlan, prefix: str, origin: str,
         "  df = df/dt by the causal filter D(s) = s/(tau s + 1)^2 (tau = "
         f"{settings.rate_tau_s:g} s), each step exact over its own dt (the input moving "
         "linearly over the step; a gap is bridged with its dt):",
-        "         y1 += a*(f_prev - y1) + p*(f - f_prev);  y2 += a*(y1_prev - y2) + p*(y1 - y1_prev);",
+        "         y1 += a*(f_prev - y1) + p*(f - f_prev);",
+        "         y2 += a*(y1_prev - y2) + p*(y1 - y1_prev),",
         "         df = (y1 - y2)/tau,  a = 1 - exp(-dt/tau), p = 1 - a*tau/dt,",
         "         y1 = y2 = f at the first sample   [Hz/s]",
     ]
@@ -404,7 +405,8 @@ def source(model: UnitModel, plan: CPlan, prefix: str) -> str:
     h = {
         "constants": f"static const double REFERENCE_C = {reference_c};\n",
         "start": "        rate_start(&state->h_filter, h_value);\n",
-        "values": "    const double h_value = housing_c - REFERENCE_C;\n    double dh_value = 0.0;\n",
+        "values": "    const double h_value = housing_c - REFERENCE_C;\n"
+                  "    double dh_value = 0.0;\n",
         "rate": "        dh_value = rate_update(&state->h_filter, h_value, dt_s, RATE_TAU_S);\n",
         "out": "        out->h_c = h_value;\n        out->dh_c_per_s = dh_value;\n",
         "arg": ", double housing_c",

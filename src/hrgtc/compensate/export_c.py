@@ -5,7 +5,8 @@ The generated code runs, sample by sample, exactly the computation of
 filter of :func:`hrgtc.drift.features.causal_rate` (started at rest on the first
 sample, each step exact over the sample's own Δt: ``step()`` takes ``dt_s``, the time
 since the previous sample, so jittered clocks and bursts are handled and a gap is
-bridged by passing its length; ``reset()`` restarts the filter), the selected terms of the drift model on scaled variables (Eq. 22 of
+bridged by passing its length; ``reset()`` restarts the filter), the selected
+terms of the drift model on scaled variables (Eq. 22 of
 [1]), the compensated rate, the resonator temperature by inverting the
 thermometer (Eq. 18 of [1], a safeguarded Newton iteration on a bracket taken
 from a small embedded table, as in Table 2) and the in-range flags (``in_range``:

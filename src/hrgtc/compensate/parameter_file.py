@@ -46,12 +46,16 @@ def _number(value: float, name: str) -> str:
 def formula(key: str = "") -> list[str]:
     """The header's formula, with ``key`` the key prefix (``x_`` for axis x, '' for one)."""
     lines = [
-        "FORMULA (per sample, at exactly {k}sample_rate_hz; keys below are written <key>)",
+        "FORMULA (per sample, dt = its time since the previous sample [s], any steps; "
+        "keys below are written <key>)",
         "  1. f = freq_hz - <{k}reference_freq_hz>                                  [Hz]",
-        "  2. df/dt, a causal filter started at rest (y1 = y2 = f on the first sample):",
-        "       y1 = <{k}filter_alpha>*f  + <{k}filter_beta>*y1",
-        "       y2 = <{k}filter_alpha>*y1 + <{k}filter_beta>*y2",
-        "       df = (y1 - y2) * <{k}filter_gain>                                   [Hz/s]",
+        "  2. df/dt, a causal filter started at rest (y1 = y2 = f on the first sample),",
+        "     each step exact over its dt for an input moving linearly over the step",
+        "     (a gap is bridged with its dt): with tau = <{k}rate_tau_s>, r = dt/tau,",
+        "       a = 1 - exp(-r),  p = 1 - a/r  (= r/2 - r^2/6 + r^3/24 - ... for small r)",
+        "       y1' = y1 + a*(f_prev - y1) + p*(f - f_prev)",
+        "       y2' = y2 + a*(y1 - y2) + p*(y1' - y1)",
+        "       df = (y1' - y2') / tau                                              [Hz/s]",
         "     (when <{k}uses_housing> = 1: h = housing_c - <{k}reference_c> [degC] and dh its",
         "      rate by the same filter on its own y1, y2 [degC/s])",
         "     (when <{k}uses_rate2> = 1: d2, the rate of f by the same filter with",
@@ -117,7 +121,7 @@ def parameter_lines(model: UnitModel, plan: CPlan, key: str = "") -> list[str]:
         lines.extend([f"# {comment}", f"{key}{name} = {text}", ""])
 
     put("sample_rate_hz", settings.sample_rate_hz,
-        "Sample rate the df/dt filter is designed for: evaluate once per sample at it. [Hz]")
+        "Sample rate of the training runs (settle_rows counts samples at it). [Hz]")
     put("reference_freq_hz", settings.reference_freq_hz,
         f"f_ref: the thermometer's frequency at {settings.reference_c:g} degC; "
         "f = freq_hz - f_ref. [Hz]")
@@ -127,11 +131,6 @@ def parameter_lines(model: UnitModel, plan: CPlan, key: str = "") -> list[str]:
         "1 when the terms use the housing thermistor (h, dh): then housing_c is an input.")
     put("rate_tau_s", settings.rate_tau_s,
         "Time constant of each of the two low-pass stages of the df/dt filter. [s]")
-    put("filter_alpha", plan.alpha,
-        "Filter stage coefficient alpha = 1 - exp(-1/(rate_tau_s*sample_rate_hz)). [1]")
-    put("filter_beta", plan.beta, "Filter stage coefficient beta = 1 - alpha. [1]")
-    put("filter_gain", plan.gain,
-        "Ramp gain alpha*sample_rate_hz/beta: (y1 - y2)*gain is the rate. [1/s]")
     put("settle_rows", settle_rows(settings),
         "Samples at the start of a run flagged (in_range 0) while the filter settles. [1]")
     _extra_variable_lines(model, plan, put)

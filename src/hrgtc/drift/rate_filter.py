@@ -31,7 +31,8 @@ cancellation of two levels): ``lag`` = x_{n-1} - y1 and ``difference`` = y1 - y2
     c2 = a difference + p c1;         difference <- difference + c1 - c2
     rate = difference / tau
 
-The compiled step is :mod:`hrgtc.drift._rate_kernel`. The same statements run in the numba kernel (:mod:`hrgtc.compensate._kernel`),
+The compiled step is :mod:`hrgtc.drift._rate_kernel`; the same statements run in the
+numba kernel (:mod:`hrgtc.compensate._kernel`),
 the streaming compensator and the C export (double and float32), so training and
 deployment compute the same df/dt.
 
