@@ -370,3 +370,38 @@ def test_c_computes_d2_g_and_the_extra_channel_as_python_does(tmp_path):
     skip = 6000
     err = out[skip:, 1] - recording["bias_dph"][skip:]
     assert np.sqrt(np.mean(err ** 2)) < 0.5
+
+
+@needs_compiler
+def test_c_on_bursts_bridges_each_gap_with_its_dt(tmp_path):
+    # issue 20 item 2 in C: bursts of 5 s every 300 s cut from a continuous simulated
+    # recording; step() gets each sample's dt_s (the 295 s gaps too). C and the Python
+    # compensator agree sample by sample, and the C df/dt on the bursts is the continuous
+    # recording's within 1 % of its range after settling (tau = 300 s, the burst period;
+    # tests/drift/test_rate_filter.py states the bounds).
+    from hrgtc.recording import Recording
+
+    fitted = drift.fit([ramp_run(seed=1, hours=8.0)], THERMOMETER, rate_tau_s=300.0)
+    model = UnitModel(thermometer=THERMOMETER, drift=fitted, unit="bursts")
+    continuous = ramp_run(seed=7, hours=6.0)
+    continuous = continuous.with_columns(freq_hz=THERMOMETER.frequency(continuous["resonator_c"]))
+    rows = np.flatnonzero(np.mod(continuous.time_s, 300.0) < 5.0 - 1e-9)
+    bursts = Recording({n: continuous[n][rows] for n in continuous.names}, continuous.metadata,
+                       "bursts")
+    exe = build(model, tmp_path, "burst")
+    out, counters = run_driver(exe, [bursts.freq_hz, bursts.rate_dph], tmp_path, "run",
+                               bursts.time_s)
+    compensator = Compensator(model)
+    expected = compensator.process(bursts)
+    np.testing.assert_allclose(out[:, 1], expected["bias_model_dph"], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(out[:, 0], expected["rate_comp_dph"], rtol=0, atol=1e-9)
+    np.testing.assert_array_equal(out[:, 3] * out[:, 7], expected["in_range"])
+    from hrgtc.drift.features import compute_variables
+
+    df_continuous = compute_variables(continuous, fitted.settings, ("df",))["df"][rows]
+    settled = bursts.time_s > 600.0 + 10 * 300.0
+    span = np.ptp(df_continuous[settled])
+    assert span > 1e-4
+    assert np.max(np.abs(out[settled, 5] - df_continuous[settled])) < 0.01 * span
+    # the per-sample reading of the old filter would have been 60x too steep: not so here
+    assert np.median(np.abs(out[settled, 5])) < 2 * np.median(np.abs(df_continuous[settled]))
