@@ -412,3 +412,42 @@ def test_models_with_d2_and_aux_run_on_numpy_in_both_engines():
                                       run.metadata, "held-out.parquet")
     with pytest.raises(InputError, match=r"held-out\.parquet: no column 'drive_v'"):
         Compensator(model).process(without)
+
+
+@pytest.mark.parametrize("engine", ["fused", "numpy"])
+def test_a_gap_exactly_on_a_chunk_boundary(unit_model, run, engine):
+    # issue 21 item 8: chunks cut exactly at the first row after a gap. In "split" the
+    # filter restarts there (as in one batch); otherwise it is carried across the gap with
+    # the gap's dt, the previous time kept in its state. Either way streaming equals batch.
+    gap_row = 20_000
+    times = run.time_s.copy()
+    times[gap_row:] += 600.0  # the logger slept 10 min
+    gapped = run.with_columns(time_s=times)
+    for gaps in ("split", "ignore"):
+        batch = Compensator(unit_model, engine=engine, gaps=gaps).process(gapped)
+        streaming = Compensator(unit_model, engine=engine, gaps=gaps)
+        parts = [streaming.process(gapped.slice(0, gap_row)),
+                 streaming.process(gapped.slice(gap_row, len(gapped)))]
+        for name in OUTPUT_COLUMNS:
+            np.testing.assert_array_equal(np.concatenate([p[name] for p in parts]), batch[name])
+        if gaps == "split":
+            assert streaming.segments == 2
+            split = batch
+        else:
+            bridged = batch
+    # the restart is visible: the split filter settles again after the gap (flagged)
+    settle = round(unit_model.drift.settings.warmup_s * unit_model.drift.settings.sample_rate_hz)
+    assert np.all(split["in_range"][gap_row:gap_row + settle] == 0.0)
+    assert not np.array_equal(split["bias_model_dph"][gap_row:gap_row + 100],
+                              bridged["bias_model_dph"][gap_row:gap_row + 100])
+
+
+def test_a_step_of_exactly_two_periods_is_not_a_gap(unit_model, run):
+    # one dropped sample (a step of two periods, rounded up by the time stamps) is bridged
+    # even in "split": the compensator's gap test has the validator's tolerance
+    times = run.time_s.copy()
+    times[5000:] += 1.0 / run.sample_rate_hz * (1.0 + 1e-9)
+    dropped = run.with_columns(time_s=times)
+    compensator = Compensator(unit_model, gaps="split")
+    compensator.process(dropped)
+    assert compensator.segments == 1

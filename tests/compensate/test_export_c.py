@@ -389,8 +389,8 @@ def test_c_on_bursts_bridges_each_gap_with_its_dt(tmp_path):
     bursts = Recording({n: continuous[n][rows] for n in continuous.names}, continuous.metadata,
                        "bursts")
     exe = build(model, tmp_path, "burst")
-    out, counters = run_driver(exe, [bursts.freq_hz, bursts.rate_dph], tmp_path, "run",
-                               bursts.time_s)
+    out, _ = run_driver(exe, [bursts.freq_hz, bursts.rate_dph], tmp_path, "run",
+                        bursts.time_s)
     compensator = Compensator(model)
     expected = compensator.process(bursts)
     np.testing.assert_allclose(out[:, 1], expected["bias_model_dph"], rtol=0, atol=1e-9)
