@@ -86,3 +86,9 @@ class PrecisionWarning(HrgtcWarning):
 
 class UnitWarning(HrgtcWarning):
     """Values were reinterpreted on reading (e.g. a signed count stored unsigned, unwrapped)."""
+
+
+class RateFilterWarning(HrgtcWarning):
+    """The causal df/dt filter cannot follow the recording: its time constant is shorter
+    than the burst period of a duty-cycled logger, or the thermometer's quantisation
+    makes the df/dt noise larger than the df/dt signal."""

@@ -39,6 +39,7 @@ from hrgtc.drift.features import (
     settle_rows,
 )
 from hrgtc.drift.offsets import label_offsets, sample_offsets
+from hrgtc.drift.rate_checks import filtered_levels, rate_filter_problems, warn_rate_filter
 from hrgtc.drift.rate_filter import check_time
 from hrgtc.errors import CalibrationError, ExtrapolationWarning, HrgtcWarning, InputError
 from hrgtc.files import check_writable
@@ -190,6 +191,11 @@ class Compensator:
         """
         if self.samples == 0:
             self.drift.settings.check_sample_rate(chunk)
+            if self.gaps != "split":  # split restarts the filter at each gap instead
+                levels = filtered_levels(chunk, self.drift.variables)
+                warn_rate_filter(rate_filter_problems(
+                    chunk.time_s, levels, self.drift.settings.rate_tau_s,
+                    where=chunk.source or ""))
         if self.gaps == "split" and "time_s" in chunk:
             cuts = self._gap_rows(chunk)
             if cuts:

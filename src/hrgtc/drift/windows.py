@@ -29,6 +29,7 @@ import numpy as np
 
 from hrgtc.core.timeline import PARTIAL_WINDOW_FRACTION, is_gap
 from hrgtc.drift.features import FeatureSettings, FeatureStream, Term, design_matrix, variables_for
+from hrgtc.drift.rate_checks import filtered_levels, rate_filter_problems, warn_rate_filter
 from hrgtc.errors import CalibrationError, InputError
 from hrgtc.progress import Progress
 from hrgtc.recording import Recording
@@ -212,6 +213,7 @@ def window_means(
     left_out = 0
     sources: list[str] = []
     extra: tuple[str, ...] | None = None
+    problems: list[str] = []
     for index, source in enumerate(runs):
         stream = FeatureStream(settings, variables, thermometer)
         averager = _WindowMeans(window_rows)
@@ -226,6 +228,10 @@ def window_means(
             if input_rate is None:
                 input_rate = chunk.metadata.input_rate_dph
                 sources.append(chunk.source or f"run {index}")
+                levels = filtered_levels(chunk, variables_for(terms))
+                if levels and not split:  # the terms use a rate: can the filter follow?
+                    problems += rate_filter_problems(chunk.time_s, levels, settings.rate_tau_s,
+                                                     where=chunk.source or "")
             if extra is None:  # the accelerometer and label columns, where every run has them
                 extra = tuple(c for c in _EXTRA_COLUMNS if c in chunk)
             time = chunk.time_s
@@ -302,6 +308,7 @@ def window_means(
             out_terms.append(means[:, first + len(extra or ()):])
             out_run.append(np.full(means.shape[0], index))
         partial += averager.partial_dropped_rows
+    warn_rate_filter(problems)
     if not out_time:
         restart = " after every gap (--gaps split restarts the filter)" if split else ""
         raise CalibrationError(

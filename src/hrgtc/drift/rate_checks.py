@@ -1,0 +1,166 @@
+"""Checks that the causal df/dt filter can follow a recording (issue 20 item 2).
+
+Two ways a valid recording defeats the filter of :mod:`hrgtc.drift.rate_filter`:
+
+* **Bursts** (a duty-cycled logger: a few seconds of samples every few minutes). Across
+  a gap the filter takes the temperature as moving in a straight line, which is right
+  only if the filter's memory spans the gaps: with a time constant tau shorter than the
+  burst period, each burst's df/dt is the noisy rate of its own few seconds, and the
+  straight line across the gap is weighted as much as the whole recording's trend.
+  :func:`burst_period_s` finds the period from the gaps (time steps longer than
+  :data:`GAP_FACTOR` times the median step).
+* **Quantisation**. A temperature (or a raw count) that moves in steps of one LSB q is a
+  staircase; each step is a step input of size q to D(s) = s/(tau s + 1)^2, whose rate
+  response peaks at q/(e tau) (at t = tau). When the recording's own df/dt, estimated as
+  its span over its duration, is below that, the df/dt the model sees is mostly the
+  quantisation's. :func:`resolution` estimates q as the smallest step between distinct
+  values that recurs (not one rounding accident).
+
+:func:`rate_filter_problems` returns the messages; :func:`warn_rate_filter` issues each
+as a :class:`~hrgtc.errors.RateFilterWarning`, once per message.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Iterable, Mapping
+from typing import Any
+
+import numpy as np
+
+from hrgtc.errors import RateFilterWarning
+
+#: A time step longer than this many median steps is a gap between bursts.
+GAP_FACTOR = 2.0
+#: Fewer distinct values than this and no resolution is estimated.
+MIN_DISTINCT = 3
+#: The staircase's peak rate response to one LSB step: q / (e tau).
+STEP_PEAK = 1.0 / math.e
+
+
+def burst_period_s(time_s: np.ndarray) -> float | None:
+    """Median time between the starts of consecutive bursts, or None without gaps. [s]
+
+    With a single gap, the gap itself (plus one step) is the period.
+    """
+    time_s = np.asarray(time_s, dtype=np.float64)
+    if time_s.size < 3:
+        return None
+    steps = np.diff(time_s)
+    positive = steps[steps > 0]
+    if not positive.size:
+        return None
+    median = float(np.median(positive))
+    starts = np.flatnonzero(steps > GAP_FACTOR * median) + 1
+    if not starts.size:
+        return None
+    if starts.size == 1:
+        return float(steps[starts[0] - 1] + median)
+    return float(np.median(np.diff(time_s[starts])))
+
+
+def resolution(values: np.ndarray) -> float | None:
+    """The channel's quantisation step (LSB), or None when it looks continuous. [unit]
+
+    The smallest positive difference between sorted distinct values that occurs at least
+    twice (a continuous, noisy channel has as many distinct values as samples and steps
+    that never repeat to the bit).
+    """
+    values = np.asarray(values, dtype=np.float64)
+    values = values[np.isfinite(values)]
+    distinct = np.unique(values)
+    if distinct.size < MIN_DISTINCT or distinct.size > 0.5 * values.size:
+        return None
+    steps = np.diff(distinct)
+    smallest = float(np.min(steps))
+    # steps equal to the smallest within rounding of the values' magnitude
+    slack = 1e-9 * max(float(np.max(np.abs(distinct))), smallest)
+    if np.count_nonzero(np.abs(steps - smallest) <= slack) < 2:
+        return None
+    return smallest
+
+
+def rate_filter_problems(time_s: np.ndarray, levels: Mapping[str, np.ndarray], tau_s: float,
+                         units: Mapping[str, str] | None = None, where: str = "") -> list[str]:
+    """Why the df/dt filter of time constant ``tau_s`` cannot follow this recording.
+
+    Parameters
+    ----------
+    time_s
+        Sample times of (a representative part of) one run. [s]
+    levels
+        The filtered channels by name (e.g. ``{"freq_hz": ..., "housing_c": ...}``).
+    tau_s
+        Time constant of each stage of the rate filter. [s]
+    units
+        Unit of each channel for the messages.
+    where
+        Prefix of the messages (the file's name).
+    """
+    units = column_units() if units is None else units
+    prefix = f"{where}: " if where else ""
+    out = []
+    period = burst_period_s(time_s)
+    if period is not None and tau_s < period:
+        out.append(
+            f"{prefix}the df/dt filter's time constant {tau_s:g} s is shorter than the "
+            f"{period:g} s burst period of this duty-cycled recording, so df/dt cannot be "
+            f"followed across the gaps (each burst reads the rate of its own samples); "
+            f"pass --rate-tau-s {_round_up(period)} or more")
+    time_s = np.asarray(time_s, dtype=np.float64)
+    duration = float(time_s[-1] - time_s[0]) if time_s.size > 1 else 0.0
+    for name, values in levels.items():
+        q = resolution(values)
+        if q is None or duration <= 0:
+            continue
+        finite = np.asarray(values, dtype=np.float64)
+        finite = finite[np.isfinite(finite)]
+        signal = float(np.ptp(finite)) / duration
+        noise = STEP_PEAK * q / tau_s
+        if noise > signal:
+            unit = units.get(name, "")
+            needed = STEP_PEAK * q / signal if signal > 0 else math.inf
+            advice = (f"pass --rate-tau-s {_round_up(needed)} or more, or log the channel "
+                      "with a finer resolution" if math.isfinite(needed) else
+                      "the channel does not move at all: df/dt terms cannot be fitted")
+            out.append(
+                f"{prefix}{name} moves in steps of {q:.3g} {unit} (its resolution); through "
+                f"the df/dt filter (tau {tau_s:g} s) each step reads as a rate of up to "
+                f"{noise:.3g} {unit}/s (q/(e tau)), more than the recording's own rate of "
+                f"{signal:.3g} {unit}/s over its {duration:g} s, so df/dt is mostly "
+                f"quantisation noise; {advice}")
+    return out
+
+
+#: Recording column each rate variable filters, and its unit.
+_LEVEL_OF = {"df": ("freq_hz", "Hz"), "dpos": ("freq_hz", "Hz"), "d2": ("freq_hz", "Hz"),
+             "dh": ("housing_c", "°C")}
+
+
+def filtered_levels(chunk: Any, variables: Iterable[str]) -> dict[str, np.ndarray]:
+    """The recording columns the rate variables among ``variables`` filter (by column)."""
+    out = {}
+    for v in variables:
+        if v in _LEVEL_OF and _LEVEL_OF[v][0] in chunk:
+            out[_LEVEL_OF[v][0]] = chunk[_LEVEL_OF[v][0]]
+    return out
+
+
+def column_units() -> dict[str, str]:
+    """Unit of each filtered column, for the messages."""
+    return dict(_LEVEL_OF.values())
+
+
+def warn_rate_filter(messages: Iterable[str]) -> None:
+    """Issue each message once as a :class:`~hrgtc.errors.RateFilterWarning`."""
+    for message in dict.fromkeys(messages):
+        warnings.warn(message, RateFilterWarning, stacklevel=3)
+
+
+def _round_up(value: float) -> str:
+    """A round number of seconds at least ``value`` (two significant figures)."""
+    if value <= 0 or not math.isfinite(value):
+        return f"{value:g}"
+    magnitude = 10 ** math.floor(math.log10(value) - 1)
+    return f"{math.ceil(value / magnitude) * magnitude:g}"
