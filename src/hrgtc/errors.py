@@ -92,3 +92,8 @@ class RateFilterWarning(HrgtcWarning):
     """The causal df/dt filter cannot follow the recording: its time constant is shorter
     than the burst period of a duty-cycled logger, or the thermometer's quantisation
     makes the df/dt noise larger than the df/dt signal."""
+
+
+class SlowChannelWarning(HrgtcWarning):
+    """A channel logged slower than the file's rows was filled (held or interpolated) and
+    rows farther than the maximum age from its values were dropped as a gap."""

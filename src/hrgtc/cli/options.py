@@ -92,6 +92,14 @@ class SpikeFilterMode(StrEnum):
     off = "off"
 
 
+class SlowChannelPolicy(StrEnum):
+    """What to do with a channel logged slower than the file's rows (empty cells)."""
+
+    hold = "hold"
+    interpolate = "interpolate"
+    error = "error"
+
+
 class Thermometer(StrEnum):
     """What the thermometer of the gyro is."""
 
@@ -365,6 +373,26 @@ MotionOption = Annotated[
         rich_help_panel=_INPUT,
     ),
 ]
+SlowChannelsOption = Annotated[
+    SlowChannelPolicy | None,
+    typer.Option(
+        "--slow-channels",
+        help="A channel logged slower than the rows (e.g. a 1 Hz temperature in a 10 Hz "
+        "file: empty cells): hold its last value (hold, default), interpolate linearly in "
+        "time, or refuse the empty cells (error). What was done is reported.",
+        rich_help_panel=_INPUT,
+    ),
+]
+HoldMaxOption = Annotated[
+    float | None,
+    typer.Option(
+        "--hold-max-s",
+        metavar="S",
+        help="Longest time a slow channel's value is used for [s] (default 3 of its "
+        "periods); rows farther from a value are dropped as a gap in that channel.",
+        rich_help_panel=_INPUT,
+    ),
+]
 ForceOption = Annotated[bool, typer.Option("--force", help="Overwrite existing output files.")]
 #: Exit status of --strict when samples went beyond the trained ranges.
 STRICT_EXIT = 3
@@ -404,6 +432,8 @@ def recording_input(
     motion: MotionPolicy | str | None = None,
     start: str | None = None,
     end: str | None = None,
+    slow_channels: SlowChannelPolicy | str | None = None,
+    hold_max_s: float | None = None,
 ) -> ReadOptions:
     """Gather the values of the shared reading options into a :class:`ReadOptions`."""
     from hrgtc.recording import ReadOptions
@@ -434,6 +464,8 @@ def recording_input(
         motion=str(getattr(motion, "value", motion) or "exclude"),
         start=start,
         end=end,
+        slow_channels=str(getattr(slow_channels, "value", slow_channels) or "hold"),
+        hold_max_s=None if hold_max_s is None else float(hold_max_s),
     )
 
 
@@ -461,6 +493,8 @@ _READING_OPTIONS: tuple[tuple[str, Any], ...] = (
     ("motion", MotionOption),
     ("start", StartOption),
     ("end", EndOption),
+    ("slow_channels", SlowChannelsOption),
+    ("hold_max_s", HoldMaxOption),
 )
 
 

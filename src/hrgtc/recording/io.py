@@ -57,6 +57,7 @@ from hrgtc.recording.mapping import (
     plan_columns,
     table_columns,
 )
+from hrgtc.recording.resample import SlowChannels, fill_slow_channels
 from hrgtc.recording.schema import SCHEMA_VERSION, Metadata, Recording, concatenate
 from hrgtc.recording.spikes import (
     SPIKE_K,
@@ -177,6 +178,8 @@ def read(
     spike_window_s: float = SPIKE_WINDOW_S,
     start: str | float | None = None,
     end: str | float | None = None,
+    slow_channels: str = "hold",
+    hold_max_s: float | None = None,
 ) -> Recording:
     """Read a whole recording from Parquet, CSV or HDF5 (by suffix).
 
@@ -227,6 +230,10 @@ def read(
         since the file's first sample, or ISO clock times for a file with clock times
         (e.g. ``"2020-03-07T16:30"``). Rows left out are counted in
         ``extra["rows_sliced"]``; row numbers in later messages count the rows kept.
+    slow_channels, hold_max_s
+        A channel logged slower than the rows (empty cells): ``"hold"`` (default),
+        ``"interpolate"`` or ``"error"``, for at most ``hold_max_s`` seconds
+        (:mod:`hrgtc.recording.resample`).
 
     Returns
     -------
@@ -250,6 +257,7 @@ def read(
         robust.counts = plan.temperature_is_count and (temp_scale, temp_offset_c) == (1.0, 0.0)
         columns = table_columns(source.read(plan.read_names, plan.as_text))
         arrays = convert_columns(plan, columns, 0)
+        arrays, slow = fill_slow_channels(arrays, slow_channels, hold_max_s, str(path))
         if spike_filter_ is not None:
             arrays = spike_filter_.drop(arrays, 0)
         arrays = robust.apply(arrays, 0)
@@ -260,6 +268,7 @@ def read(
         meta = _metadata(plan, metadata, arrays.get("time_s"))
     if repairer.events or repairer.duplicates:
         meta = replace(meta, extra={**meta.extra, **_repair_extra(repairer)})
+    slow.warn()
     if spike_filter_ is not None and spike_filter_.dropped:
         meta = replace(meta, extra={**meta.extra, "spikes_dropped": spike_filter_.dropped})
         spike_filter_.warn()
@@ -326,6 +335,8 @@ def iter_chunks(
     time_repair: TimeRepairStream | None = None,
     start: str | float | None = None,
     end: str | float | None = None,
+    slow_channels: str = "hold",
+    hold_max_s: float | None = None,
 ) -> Iterator[Recording]:
     """Stream a recording in chunks of ``rows`` rows without loading the file.
 
@@ -361,6 +372,7 @@ def iter_chunks(
     rows = int(rows)
     validator = (RecordingValidator(gaps, freq_band_hz, freq_span_hz, thermometer)
                  if validate else None)
+    slow = SlowChannels(slow_channels, hold_max_s, str(path))
     with open_source(path) as source:
         plan = plan_columns(source, columns, units, temp_scale, temp_offset_c, thermometer,
                             rate_scale, temp_unwrap)
@@ -376,7 +388,7 @@ def iter_chunks(
         def converted() -> Iterator[dict[str, np.ndarray]]:
             nonlocal offset
             for table in source.iter_tables(plan.read_names, plan.as_text, rows):
-                part = convert_columns(plan, table_columns(table), offset)
+                part = slow.fill(convert_columns(plan, table_columns(table), offset), offset)
                 if spike_filter_ is not None:
                     part = spike_filter_.drop(part, offset)
                 part = robust.apply(part, offset)
@@ -384,6 +396,13 @@ def iter_chunks(
                 part = cut.apply(_repair_time(part, repairer))
                 if part.get("time_s") is None or len(part["time_s"]):
                     yield part
+            tail = slow.flush()  # rows held back by --slow-channels interpolate
+            if tail is not None:
+                if spike_filter_ is not None:
+                    tail = spike_filter_.drop(tail, offset)
+                tail = cut.apply(_repair_time(robust.apply(tail, offset), repairer))
+                if tail.get("time_s") is None or len(tail["time_s"]):
+                    yield tail
 
         pieces = _rechunk(converted(), rows)
         head: list[dict[str, np.ndarray]] = []
@@ -421,6 +440,7 @@ def iter_chunks(
         if spike_filter_ is not None:
             spike_filter_.warn()
         robust.warn()
+        slow.warn()
         if progress is not None:
             total = source.position()[1]
             progress(total, total)
@@ -479,6 +499,9 @@ class ReadOptions:
     start, end
         ``--start/--end``: the slice of the file to read, seconds since its first
         sample or ISO clock times (see :func:`read`). None: from the start / to the end.
+    slow_channels, hold_max_s
+        Channels logged slower than the rows: ``"hold"``, ``"interpolate"`` or
+        ``"error"``, values used for at most ``hold_max_s`` seconds (see :func:`read`).
     """
 
     columns: Mapping[str, str] | None = None
@@ -502,6 +525,8 @@ class ReadOptions:
     motion: str = "exclude"
     start: str | None = None
     end: str | None = None
+    slow_channels: str = "hold"
+    hold_max_s: float | None = None
 
     def keywords(self) -> dict[str, Any]:
         """The options as keyword arguments of :func:`read` and :func:`iter_chunks`.
@@ -516,7 +541,8 @@ class ReadOptions:
         defaults = {"temp_scale": 1.0, "temp_offset_c": 0.0, "spikes": "error",
                     "thermometer": "resonator", "rate_scale": None, "temp_unwrap": "auto",
                     "spike_filter": None, "spike_k": SPIKE_K, "spike_lsb": SPIKE_LSB,
-                    "spike_window_s": SPIKE_WINDOW_S}
+                    "spike_window_s": SPIKE_WINDOW_S, "slow_channels": "hold",
+                    "hold_max_s": None}
         words.update({key: getattr(self, key) for key, default in defaults.items()
                       if getattr(self, key) != default})
         words.update({key: getattr(self, key) for key in ("start", "end")
