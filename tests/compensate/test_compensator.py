@@ -414,6 +414,7 @@ def test_models_with_d2_and_aux_run_on_numpy_in_both_engines():
         Compensator(model).process(without)
 
 
+@pytest.mark.filterwarnings("ignore::hrgtc.errors.RateFilterWarning")  # tau 10 s, gap 600 s
 @pytest.mark.parametrize("engine", ["fused", "numpy"])
 def test_a_gap_exactly_on_a_chunk_boundary(unit_model, run, engine):
     # issue 21 item 8: chunks cut exactly at the first row after a gap. In "split" the

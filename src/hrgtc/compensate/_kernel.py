@@ -285,7 +285,8 @@ def _term(exponents, k, x, m, out, factor):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def compensate_block(time_s, freq_hz, rate_dph, housing_c, filt, uses_housing, uses_gradient, state,
+def compensate_block(time_s, restart, freq_hz, rate_dph, housing_c, filt, uses_housing,
+                     uses_gradient, state,
                      exponents, coefficients, intercept, scales, tangent, low, high, flagged,
                      d_factor, d_exponents, d_constant, therm, poly, slope, chebyshev,
                      grid_t, grid_f, out_rate, out_bias, out_temp, out_in_range, counts,
@@ -293,8 +294,11 @@ def compensate_block(time_s, freq_hz, rate_dph, housing_c, filt, uses_housing, u
     """Compensate one block in place; see the module docstring for what is computed.
 
     ``state`` (filter, samples seen), ``counts`` (int64, see :data:`OUT_OF_RANGE`) and
-    ``extremes`` (see :data:`F_MIN`) are updated.
+    ``extremes`` (see :data:`F_MIN`) are updated. ``restart`` (int8 per sample, or empty:
+    none) restarts the filters at rest on those samples and the settling count with them
+    (the segment starts of ``gaps="split"``).
     """
+    has_restart = restart.size > 0
     tau, ref_f, ref_h = filt[0], filt[3], filt[4]
     centre, scale_c, map_offset, map_scale = therm[0], therm[1], therm[2], therm[3]
     t_low, t_high, f_low, f_high = therm[4], therm[5], therm[6], therm[7]
@@ -356,14 +360,16 @@ def compensate_block(time_s, freq_hz, rate_dph, housing_c, filt, uses_housing, u
         for i in range(m):
             f[i] = freq[i] - ref_f
         for i in range(m):
-            df[i] = filter_step(f_state, f[i], time[i], tau, False)
+            df[i] = filter_step(f_state, f[i], time[i], tau,
+                                has_restart and restart[start + i] != 0)
         housing = housing_c[start:start + m]
         if uses_housing:
             h, dh = value[2], value[3]
             for i in range(m):
                 h[i] = housing[i] - ref_h
             for i in range(m):
-                dh[i] = filter_step(h_state, h[i], time[i], tau, False)
+                dh[i] = filter_step(h_state, h[i], time[i], tau,
+                                    has_restart and restart[start + i] != 0)
         if uses_gradient:
             g = value[4]
             for i in range(m):
@@ -440,14 +446,18 @@ def compensate_block(time_s, freq_hz, rate_dph, housing_c, filt, uses_housing, u
                 counts[TEMPERATURE_OUT] += m - int(n_temperature)
         n_ok = 0.0
         n_rate_ok = 0.0
-        first = state[16] + start  # samples of the run before this tile (SAMPLES)
+        since = state[16]  # samples since the filter (re)started (SAMPLES)
         n_settling = 0
         for i in range(m):
-            settled = 1.0 if first + i >= filt[5] else 0.0
+            if has_restart and restart[start + i] != 0:
+                since = 0.0
+            settled = 1.0 if since >= filt[5] else 0.0
+            since += 1.0
             out_in_range[start + i] = ok[i] * rate_ok[i] * settled
             n_ok += ok[i]
             n_rate_ok += rate_ok[i]
             n_settling += settled == 0.0
+        state[16] = since
         counts[0] += m - int(n_ok)
         counts[1] += m - int(n_rate_ok)
         counts[3] += n_settling
@@ -458,11 +468,11 @@ def compensate_block(time_s, freq_hz, rate_dph, housing_c, filt, uses_housing, u
                 lo = x[i] if x[i] < lo else lo
                 hi = x[i] if x[i] > hi else hi
             extremes[2 * v], extremes[2 * v + 1] = lo, hi
-    state[16] += n
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def advance_filter(time_s, freq_hz, housing_c, filt, uses_housing, state):  # pragma: no cover
+def advance_filter(time_s, restart, freq_hz, housing_c, filt, uses_housing,
+                   state):  # pragma: no cover
     """Run only the rate filter over a block: ``state`` becomes the state at its end.
 
     The same operations as :func:`compensate_block`'s filter, so the state is the same
@@ -471,12 +481,18 @@ def advance_filter(time_s, freq_hz, housing_c, filt, uses_housing, state):  # pr
     tau, ref_f, ref_h = filt[0], filt[3], filt[4]
     f_state = state[0:8]
     h_state = state[8:16]
+    has_restart = restart.size > 0
+    since = state[16]
     for i in range(freq_hz.size):
-        filter_step(f_state, freq_hz[i] - ref_f, time_s[i], tau, False)
+        again = has_restart and restart[i] != 0
+        filter_step(f_state, freq_hz[i] - ref_f, time_s[i], tau, again)
+        since = 0.0 if again else since
+        since += 1.0
     if uses_housing:
         for i in range(housing_c.size):
-            filter_step(h_state, housing_c[i] - ref_h, time_s[i], tau, False)
-    state[16] += freq_hz.size
+            filter_step(h_state, housing_c[i] - ref_h, time_s[i], tau,
+                        has_restart and restart[i] != 0)
+    state[16] = since
 
 
 #: Chunks of at least this many rows are split in two halves compensated on two threads.
@@ -486,33 +502,37 @@ PARALLEL_ROWS = 1 << 18
 def run(block_plan: KernelPlan, state: np.ndarray, time_s: np.ndarray, freq_hz: np.ndarray,
         rate_dph: np.ndarray,
         housing_c: np.ndarray | None, out: dict[str, np.ndarray], counts: np.ndarray,
-        extremes: np.ndarray | None = None) -> None:
+        extremes: np.ndarray | None = None, restart: np.ndarray | None = None) -> None:
     """Compensate a chunk with a plan's arrays (outputs in ``out``, ``state`` advanced).
 
-    A long chunk is cut in two: the filter alone runs over the first half to give the
-    state at the cut, then both halves are compensated at once on two threads (the
-    kernel releases the GIL). Results are the same bits as one call.
+    ``restart``: a boolean mask of the rows where the filters restart at rest (segment
+    starts of ``gaps="split"``), or None. A long chunk is cut in two: the filter alone
+    runs over the first half to give the state at the cut, then both halves are
+    compensated at once on two threads (the kernel releases the GIL). Results are the
+    same bits as one call.
     """
     housing = freq_hz if housing_c is None else housing_c
+    mask = (np.zeros(0, dtype=np.int8) if restart is None
+            else np.ascontiguousarray(restart, dtype=np.int8))
     extremes = new_extremes() if extremes is None else extremes
     n = freq_hz.size
     if n < PARALLEL_ROWS or (os.cpu_count() or 1) < 2:
-        _call(block_plan, state, time_s, freq_hz, rate_dph, housing, out, counts, extremes, 0,
-              n)
+        _call(block_plan, state, time_s, mask, freq_hz, rate_dph, housing, out, counts,
+              extremes, 0, n)
         return
     middle = n // 2
     second = state.copy()
-    advance_filter(time_s[:middle], freq_hz[:middle], housing[:middle], block_plan.filter,
-                   block_plan.uses_housing, second)
+    advance_filter(time_s[:middle], mask[:middle], freq_hz[:middle], housing[:middle],
+                   block_plan.filter, block_plan.uses_housing, second)
     second_counts = np.zeros_like(counts)
     second_extremes = new_extremes()
-    worker = threading.Thread(target=_call, args=(block_plan, second, time_s, freq_hz, rate_dph,
-                                                  housing, out, second_counts, second_extremes,
-                                                  middle, n))
+    worker = threading.Thread(target=_call, args=(block_plan, second, time_s, mask, freq_hz,
+                                                  rate_dph, housing, out, second_counts,
+                                                  second_extremes, middle, n))
     worker.start()
     try:
-        _call(block_plan, state, time_s, freq_hz, rate_dph, housing, out, counts, extremes, 0,
-              middle)
+        _call(block_plan, state, time_s, mask, freq_hz, rate_dph, housing, out, counts,
+              extremes, 0, middle)
     finally:
         worker.join()
     state[:] = second
@@ -521,13 +541,14 @@ def run(block_plan: KernelPlan, state: np.ndarray, time_s: np.ndarray, freq_hz: 
     extremes[1::2] = np.maximum(extremes[1::2], second_extremes[1::2])
 
 
-def _call(p: KernelPlan, state: np.ndarray, time_s: np.ndarray, freq_hz: np.ndarray,
-          rate_dph: np.ndarray,
+def _call(p: KernelPlan, state: np.ndarray, time_s: np.ndarray, restart: np.ndarray,
+          freq_hz: np.ndarray, rate_dph: np.ndarray,
           housing_c: np.ndarray, out: dict[str, np.ndarray], counts: np.ndarray,
           extremes: np.ndarray, start: int, stop: int) -> None:
     part = slice(start, stop)
     compensate_block(
-        time_s[part], freq_hz[part], rate_dph[part], housing_c[part], p.filter, p.uses_housing,
+        time_s[part], restart[part] if restart.size else restart, freq_hz[part],
+        rate_dph[part], housing_c[part], p.filter, p.uses_housing,
         p.uses_gradient, state, p.exponents, p.coefficients, p.intercept, p.scales, p.tangent,
         p.low, p.high, p.flagged, p.d_factor, p.d_exponents, p.d_constant, p.thermometer,
         p.poly, p.slope, p.chebyshev, p.grid_t, p.grid_f, out["rate_comp_dph"][part],

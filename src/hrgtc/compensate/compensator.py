@@ -17,7 +17,6 @@ fused one to.
 from __future__ import annotations
 
 import dataclasses
-import itertools
 import os
 import warnings
 from collections.abc import Mapping
@@ -40,7 +39,7 @@ from hrgtc.drift.features import (
 )
 from hrgtc.drift.offsets import label_offsets, sample_offsets
 from hrgtc.drift.rate_checks import filtered_levels, rate_filter_problems, warn_rate_filter
-from hrgtc.drift.rate_filter import check_time
+from hrgtc.drift.rate_filter import check_time, restart_mask
 from hrgtc.errors import CalibrationError, ExtrapolationWarning, HrgtcWarning, InputError
 from hrgtc.files import check_writable
 from hrgtc.model import UnitModel
@@ -196,27 +195,21 @@ class Compensator:
                 warn_rate_filter(rate_filter_problems(
                     chunk.time_s, levels, self.drift.settings.rate_tau_s,
                     where=chunk.source or ""))
+        restart = None
         if self.gaps == "split" and "time_s" in chunk:
             cuts = self._gap_rows(chunk)
-            if cuts:
-                bounds = [0, *[c for c in cuts if c > 0], len(chunk)]
-                pieces = []
-                for k, (start, stop) in enumerate(itertools.pairwise(bounds)):
-                    if k > 0 or cuts[0] == 0:
-                        self.restart()
-                        self.segments += 1
-                    pieces.append(self._process(chunk.slice(start, stop)))
-                return chunk.with_columns(**{
-                    name: np.concatenate([p[name] for p in pieces])
-                    for name in output_columns(self.model) if name in pieces[0]})
-        return self._process(chunk)
+            if cuts:  # the filters restart at rest on each segment's first row
+                restart = restart_mask(len(chunk), cuts)
+                self.segments += len(cuts)
+        return self._process(chunk, restart)
 
-    def _process(self, chunk: Recording) -> Recording:
+    def _process(self, chunk: Recording, restart: np.ndarray | None = None) -> Recording:
         n = len(chunk)
         out = {name: np.empty(n) for name in OUTPUT_COLUMNS}
-        if not (self.engine == "fused" and self._fused(chunk, out)):
+        if not (self.engine == "fused" and self._fused(chunk, out, restart)):
             for start in range(0, n, BLOCK_ROWS):
-                self._block(chunk.slice(start, start + BLOCK_ROWS), out, start)
+                self._block(chunk.slice(start, start + BLOCK_ROWS), out, start,
+                            None if restart is None else restart[start:start + BLOCK_ROWS])
         self._count_temperature_nan(out["resonator_c_est"], chunk)
         if "orientation" in self.drift.offset_mode:
             self._orientation_offsets(chunk, out)
@@ -275,7 +268,8 @@ class Compensator:
                 "the compensated mean is uncertain by that much", HrgtcWarning, stacklevel=4)
         self.unknown_orientation += count
 
-    def _fused(self, chunk: Recording, out: dict[str, np.ndarray]) -> bool:
+    def _fused(self, chunk: Recording, out: dict[str, np.ndarray],
+               restart: np.ndarray | None = None) -> bool:
         """Compensate ``chunk`` into ``out`` with the kernel; False if it cannot (order > 5)."""
         from hrgtc.compensate import _kernel as kernel
 
@@ -296,9 +290,9 @@ class Compensator:
         check_time(time_s, self._state[kernel.F_STATE])
         extremes = kernel.new_extremes()
         kernel.run(self._plan, self._state, time_s, freq, chunk.rate_dph, housing, out, counts,
-                   extremes)
+                   extremes, restart)
         self.samples += len(chunk)
-        self._segment_samples += len(chunk)
+        self._segment_samples = int(self._state[kernel.SAMPLES])
         self.out_of_range += int(counts[kernel.OUT_OF_RANGE])
         self.rate_out_of_range += int(counts[kernel.RATE_OUT_OF_RANGE])
         self.settling += int(counts[kernel.SETTLING])
@@ -320,9 +314,10 @@ class Compensator:
         kept[1] = min(kept[1], float(low))
         kept[2] = max(kept[2], float(high))
 
-    def _block(self, chunk: Recording, out: dict[str, np.ndarray], start: int) -> None:
+    def _block(self, chunk: Recording, out: dict[str, np.ndarray], start: int,
+               restart: np.ndarray | None = None) -> None:
         stop = start + len(chunk)
-        values = self._stream.process(chunk)
+        values = self._stream.process(chunk, restart)
         bias = self.drift.predict(values)
         thermometer = self.model.thermometer
         in_range = thermometer.in_range(chunk.freq_hz) & _in_training_range(
@@ -339,8 +334,13 @@ class Compensator:
                 outside = int(np.count_nonzero(~((x >= low) & (x <= high))))
                 self._track(v, outside, np.nanmin(x) if np.isfinite(x).any() else np.inf,
                             np.nanmax(x) if np.isfinite(x).any() else -np.inf)
-        settled = self._segment_samples + np.arange(len(chunk)) >= self._settle_rows
-        self._segment_samples += len(chunk)
+        since = self._segment_samples + np.arange(len(chunk))
+        if restart is not None and restart.any():  # samples since the segment's start
+            rows = np.arange(len(chunk))
+            last = np.maximum.accumulate(np.where(restart, rows, -1))
+            since = np.where(last >= 0, rows - last, since)
+        settled = since >= self._settle_rows
+        self._segment_samples = int(since[-1]) + 1 if len(chunk) else self._segment_samples
         np.subtract(chunk.rate_dph, bias, out=out["rate_comp_dph"][start:stop])
         out["bias_model_dph"][start:stop] = bias
         out["resonator_c_est"][start:stop] = thermometer.temperature(chunk.freq_hz, warn=False)

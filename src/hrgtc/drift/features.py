@@ -369,7 +369,8 @@ class FeatureSettings:
             where = f"{recording.source}: " if recording.source else ""
             raise InputError(
                 f"{where}sample rate {rate:g} Hz differs from the model's {self.sample_rate_hz:g} "
-                "Hz; the df/dt filter is defined per sample, so resample the recording or "
+                "Hz; the model's settling time and windows are counted in samples at its rate, "
+                "so resample the recording or "
                 "calibrate at this rate"
             )
 

@@ -37,6 +37,8 @@ GAP_FACTOR = 2.0
 MIN_DISTINCT = 3
 #: The staircase's peak rate response to one LSB step: q / (e tau).
 STEP_PEAK = 1.0 / math.e
+#: Rows of a run looked at (its start): enough bursts and LSB steps, and cheap.
+CHECK_ROWS = 200_000
 
 
 def burst_period_s(time_s: np.ndarray) -> float | None:
@@ -100,15 +102,20 @@ def rate_filter_problems(time_s: np.ndarray, levels: Mapping[str, np.ndarray], t
     """
     units = column_units() if units is None else units
     prefix = f"{where}: " if where else ""
+    time_s = np.asarray(time_s, dtype=np.float64)[:CHECK_ROWS]
+    levels = {name: np.asarray(values)[:CHECK_ROWS] for name, values in levels.items()}
     out = []
     period = burst_period_s(time_s)
     if period is not None and tau_s < period:
+        steps = np.diff(time_s)
+        single = np.count_nonzero(steps > GAP_FACTOR * np.median(steps[steps > 0])) == 1
+        what = (f"{period:g} s gap (with its last step) in this recording" if single else
+                f"{period:g} s burst period of this duty-cycled recording")
         out.append(
             f"{prefix}the df/dt filter's time constant {tau_s:g} s is shorter than the "
-            f"{period:g} s burst period of this duty-cycled recording, so df/dt cannot be "
-            f"followed across the gaps (each burst reads the rate of its own samples); "
-            f"pass --rate-tau-s {_round_up(period)} or more")
-    time_s = np.asarray(time_s, dtype=np.float64)
+            f"{what}, so df/dt cannot be followed across the gaps (the samples after a gap "
+            f"read the rate of their own few seconds); pass --rate-tau-s "
+            f"{_round_up(period)} or more, or --gaps split to restart the filter after each")
     duration = float(time_s[-1] - time_s[0]) if time_s.size > 1 else 0.0
     for name, values in levels.items():
         q = resolution(values)

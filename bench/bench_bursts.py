@@ -1,0 +1,136 @@
+"""What burst handling costs: a duty-cycled recording against a continuous one of as many samples.
+
+Issue 20's "Done when": burst handling costs < 10 % over a continuous file of the same
+length. Two passes are timed on both recordings, alternated, each the median of
+:data:`REPEATS`:
+
+* ``compensate``: :class:`hrgtc.compensate.Compensator` (fused kernel) over the whole
+  recording, the df/dt filter stepping over each sample's Δt and bridging the gaps
+  (the default), and with ``gaps="split"`` (the filter restarted at each burst through
+  the kernel's restart mask, reported beside it);
+* ``calibrate_features``: the feature pass of calibration,
+  :func:`hrgtc.drift.window_means` over the Eq. (21) candidates (the filter, the
+  window means and the rate-filter checks), which is what a burst file changes in
+  calibration (the regression runs on the window means).
+
+Both recordings carry the same simulated values (a cool-down of the paper's unit at
+50 Hz, logging a housing thermistor); the burst one gets the time axis of a logger that
+records 5 s every 300 s (the PAN cold test's), so only the time steps differ: the ratio
+isolates what gaps, per-step Δt and the burst checks cost. ``ratio`` is burst over
+continuous seconds (target <= 1.10).
+"""
+
+from __future__ import annotations
+
+import statistics
+import tempfile
+import time
+from pathlib import Path
+
+SAMPLE_RATE_HZ = 50.0
+BURST_S, PERIOD_S = 5.0, 300.0
+REPEATS = 5
+TARGET = 1.10
+
+
+def _model(folder: Path):
+    from hrgtc.calibration import calibrate
+    from hrgtc.simulate import simulate_files
+    from hrgtc.simulate import standard_profiles as profiles
+
+    soaks = simulate_files([profiles.soak(t, 2.0) for t in (-20.0, 0.0, 20.0, 40.0)],
+                           folder / "soaks", "parquet", sample_rate_hz=2.0, seed=1)
+    cool = simulate_files([profiles.cooldown(20.0, -20.0, 2.0)], folder / "cal", "parquet",
+                          sample_rate_hz=SAMPLE_RATE_HZ, seed=2)
+    return calibrate([w.path for w in soaks], [cool[0].path], drift_from_soaks=False).model
+
+
+def _recordings(samples: int):
+    import numpy as np
+
+    from hrgtc.recording import Recording
+    from hrgtc.simulate import simulate_run
+    from hrgtc.simulate import standard_profiles as profiles
+
+    hours = samples / SAMPLE_RATE_HZ / 3600.0
+    run = simulate_run(profiles.cooldown(20.0, -20.0, hours), sample_rate_hz=SAMPLE_RATE_HZ,
+                       seed=3)
+    n = min(samples, len(run))
+    keep = [name for name in run.names if name in ("time_s", "freq_hz", "rate_dph", "housing_c")]
+    continuous = Recording({k: np.ascontiguousarray(run[k][:n]) for k in keep}, run.metadata,
+                           "continuous")
+    per_burst = round(BURST_S * SAMPLE_RATE_HZ)
+    index = np.arange(n)
+    burst_time = (index // per_burst) * PERIOD_S + (index % per_burst) / SAMPLE_RATE_HZ
+    bursts = continuous.with_columns(time_s=burst_time)
+    return continuous, bursts
+
+
+def _time(function, *args) -> float:
+    start = time.perf_counter()
+    function(*args)
+    return time.perf_counter() - start
+
+
+def _compensate(model, recording, gaps):
+    import warnings
+
+    from hrgtc.compensate import Compensator
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # tau 10 s is shorter than the 300 s burst period
+        Compensator(model, gaps=gaps).process(recording)
+
+
+def _features(model, recording):
+    import warnings
+
+    from hrgtc.drift import window_means
+    from hrgtc.drift.features import EQ21
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the burst run warns about tau (reported once)
+        window_means([recording], model.drift.settings, EQ21, window_s=BURST_S)
+
+
+def _pairs(function, model, continuous, bursts, *extra) -> tuple[float, float, list[float]]:
+    seconds: dict[str, list[float]] = {"continuous": [], "bursts": []}
+    ratios = []
+    for k in range(REPEATS):
+        order = [("continuous", continuous), ("bursts", bursts)]
+        pair = {}
+        for name, recording in order if k % 2 == 0 else order[::-1]:
+            pair[name] = _time(function, model, recording, *extra)
+            seconds[name].append(pair[name])
+        ratios.append(pair["bursts"] / pair["continuous"])
+    return (statistics.median(seconds["continuous"]), statistics.median(seconds["bursts"]),
+            ratios)
+
+
+def run(quick: bool = False) -> list[dict]:
+    samples = 500_000 if quick else 5_000_000
+    with tempfile.TemporaryDirectory() as folder:
+        model = _model(Path(folder))
+    continuous, bursts = _recordings(samples)
+    _compensate(model, continuous.slice(0, 1000), "ignore")  # compile / load the kernel
+    _features(model, continuous.slice(0, 20_000))
+    results = []
+    for name, function, extra in (("bursts_compensate", _compensate, ("ignore",)),
+                                  ("bursts_compensate_split", _compensate, ("split",)),
+                                  ("bursts_calibrate_features", _features, ())):
+        plain, burst, ratios = _pairs(function, model, continuous, bursts, *extra)
+        results.append({
+            "name": name, "n": len(bursts), "seconds": round(burst, 3),
+            "rate": round(len(bursts) / burst), "continuous_seconds": round(plain, 3),
+            "ratio": round(statistics.median(ratios), 3),
+            "ratio_each_pair": [round(r, 3) for r in ratios], "target_ratio": TARGET,
+            "bursts": len(bursts) // round(BURST_S * SAMPLE_RATE_HZ),
+        })
+    return results
+
+
+if __name__ == "__main__":
+    import json
+
+    for line in run(quick=True):
+        print(json.dumps(line))
