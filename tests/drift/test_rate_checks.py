@@ -70,3 +70,23 @@ def test_training_on_bursts_with_a_short_tau_warns_once():
         slow = FeatureSettings(reference_freq_hz=4432.0, sample_rate_hz=10.0,
                                rate_tau_s=300.0, warmup_s=0.0)
         window_means([cut], slow, terms, window_s=5.0)
+
+
+def test_the_pan_cold_test_triggers_both_warnings_where_it_should():
+    # the real recording: 5 s bursts every ~305 s, a raw temperature count (LSB 1) falling
+    # 2126 counts in 2 h. tau 10 s: shorter than the burst period, the staircase below the
+    # signal; tau 1 s (found by trial in issue 20): quantisation dominates too; tau 310 s:
+    # silent.
+    from pathlib import Path
+
+    path = Path(__file__).parents[1] / "data" / "pan-cold-test" / "pan_tvc_cold_2020-03-07.csv"
+    data = np.genfromtxt(path, delimiter=",", skip_header=1)
+    time_s, count = data[:, 0] / 1000.0, data[:, 7]
+    assert burst_period_s(time_s) == pytest.approx(305.0, abs=1.0)
+    assert resolution(count) == 1.0
+    levels = {"temp": count}
+    at_10 = rate_filter_problems(time_s, levels, 10.0, units={"temp": "counts"})
+    assert len(at_10) == 1 and "--rate-tau-s 310 or more" in at_10[0]
+    at_1 = rate_filter_problems(time_s, levels, 1.0, units={"temp": "counts"})
+    assert len(at_1) == 2 and "temp moves in steps of 1 counts" in at_1[1]
+    assert rate_filter_problems(time_s, levels, 310.0, units={"temp": "counts"}) == []
