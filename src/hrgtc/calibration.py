@@ -265,8 +265,8 @@ def calibrate(
     if drift_from_soaks and len(extra) < len(soaks):
         warnings.warn(
             f"{len(soaks) - len(extra)} soak file(s) are not at the drift runs' "
-            f"{drift_rate:g} Hz and are left out of the drift fit (the df/dt filter is "
-            "defined per sample); they still calibrate the thermometer",
+            f"{drift_rate:g} Hz and are left out of the drift fit (its windows and settling "
+            "time are counted in samples at one rate); they still calibrate the thermometer",
             HrgtcWarning, stacklevel=2,
         )
     training = [*drifts, *(extra if drift_from_soaks else ())]

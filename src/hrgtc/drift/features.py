@@ -302,7 +302,8 @@ class FeatureSettings:
     reference_c
         Reference temperature (also the origin of ``h``). [°C]
     sample_rate_hz
-        Sample rate the filter was designed for. [Hz]
+        Sample rate of the training runs: the settling time and the windows are counted
+        in samples at it (the rate filter itself steps over each sample's Δt). [Hz]
     rate_tau_s
         Time constant of each stage of the rate filter. [s]
     warmup_s
