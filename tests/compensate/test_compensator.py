@@ -452,3 +452,17 @@ def test_a_step_of_exactly_two_periods_is_not_a_gap(unit_model, run):
     compensator = Compensator(unit_model, gaps="split")
     compensator.process(dropped)
     assert compensator.segments == 1
+
+
+@pytest.mark.parametrize("engine", ["fused", "numpy"])
+def test_the_seen_f_and_df_extremes_are_those_of_the_variables(unit_model, run, engine):
+    # issue 21 item 8: the extremes the range report is built from (f and df/dt seen), in
+    # both engines, against the batch variables computed independently, over two chunks
+    from hrgtc.drift.features import compute_variables
+
+    values = compute_variables(run, unit_model.drift.settings, ("f", "df"))
+    compensator = Compensator(unit_model, engine=engine)
+    compensator.process(run.slice(0, 12_345))
+    compensator.process(run.slice(12_345, len(run)))
+    expected = [values["f"].min(), values["f"].max(), values["df"].min(), values["df"].max()]
+    np.testing.assert_allclose(compensator._extremes, expected, rtol=1e-12, atol=1e-15)
