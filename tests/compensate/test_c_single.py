@@ -323,3 +323,25 @@ def test_double_default_unchanged_and_bad_precision(models, tmp_path):
     assert re.search(r"= -?\d[^;]*f;", code)  # float literals
     with pytest.raises(InputError, match="precision 'half' is not one of double, single"):
         export_c(model, tmp_path / "d", precision="half")
+
+
+@needs_compiler
+def test_float_build_on_bursts_bridges_the_gaps_like_the_double_filter(models, tmp_path):
+    # 5 s bursts every 300 s cut from a continuous run: the float build's df/dt (each step
+    # its own dt_s, the 295 s gaps too) is its mirror's bit for bit and the double
+    # filter's on the same bursts within 1e-4 of the df/dt range (float32 weights and sums)
+    model = models["frequency"]
+    exe = build(model, tmp_path, "fb")
+    recording = ramp_run(seed=8, start_c=25.0, end_c=-25.0, hours=6.0)
+    rows = np.flatnonzero(np.mod(recording.time_s, 300.0) < 5.0 - 1e-9)
+    time_s = recording.time_s[rows]
+    centre = model.drift.settings.reference_freq_hz
+    f64 = recording.freq_hz[rows] - centre
+    f32 = f64.astype(F32)
+    dt32 = np.concatenate([[0.0], np.diff(time_s)]).astype(F32)
+    out, _ = run_driver(exe, "run", [dt32, f32, recording.rate_dph[rows].astype(F32)],
+                        tmp_path, 8)
+    constants = float_constants(model, plan_for(model, "single"))
+    np.testing.assert_array_equal(out[:, 5], mirror_rate(constants, f32, dt32))
+    df64 = causal_rate(f64, model.drift.settings.rate_tau_s, time_s=time_s)[0]
+    assert np.max(np.abs(out[:, 5] - df64)) < 1e-4 * np.ptp(df64)
