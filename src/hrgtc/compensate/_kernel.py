@@ -7,7 +7,7 @@ and order as the numpy reference path (so results agree to rounding):
 * the causal df/dt (dh/dt) filter of :func:`hrgtc.drift.features.causal_rate`, two
   first-order stages updated exactly over each sample's own Δt (the samples'
   times), by the very function the numpy path runs
-  (:func:`hrgtc.drift.rate_filter.filter_step`), state carried across calls;
+  (:func:`hrgtc.drift._rate_kernel.filter_run`), state carried across calls;
 * the drift model of :func:`hrgtc.drift.features.tangent_extension`: each term a
   product of powers of the scaled variables, summed in term order, and beyond
   the training ranges the gradient at the clipped point times the excess;
@@ -54,7 +54,7 @@ from hrgtc.compensate._kernel_thermometer import (
     _start_and_step,
 )
 from hrgtc.drift import DriftModel
-from hrgtc.drift._rate_kernel import filter_step
+from hrgtc.drift._rate_kernel import filter_run
 from hrgtc.drift.features import settle_rows
 from hrgtc.drift.rate_filter import STATE_SIZE, check_tau
 from hrgtc.drift.rate_filter import new_state as new_filter_state
@@ -314,6 +314,7 @@ def compensate_block(time_s, restart, freq_hz, rate_dph, housing_c, filt, uses_h
     gradient = np.empty(TILE)
     ok = np.empty(TILE)
     rate_ok = np.empty(TILE)
+    no_lag = np.empty(0)
     f_state = state[0:8]  # F_STATE, H_STATE
     h_state = state[8:16]
     n = freq_hz.size
@@ -359,17 +360,14 @@ def compensate_block(time_s, restart, freq_hz, rate_dph, housing_c, filt, uses_h
         time = time_s[start:start + m]
         for i in range(m):
             f[i] = freq[i] - ref_f
-        for i in range(m):
-            df[i] = filter_step(f_state, f[i], time[i], tau,
-                                has_restart and restart[start + i] != 0)
+        marks = restart[start:start + m] if has_restart else restart
+        filter_run(f[:m], time, tau, marks, f_state, df[:m], no_lag)
         housing = housing_c[start:start + m]
         if uses_housing:
             h, dh = value[2], value[3]
             for i in range(m):
                 h[i] = housing[i] - ref_h
-            for i in range(m):
-                dh[i] = filter_step(h_state, h[i], time[i], tau,
-                                    has_restart and restart[start + i] != 0)
+            filter_run(h[:m], time, tau, marks, h_state, dh[:m], no_lag)
         if uses_gradient:
             g = value[4]
             for i in range(m):
@@ -482,16 +480,20 @@ def advance_filter(time_s, restart, freq_hz, housing_c, filt, uses_housing,
     f_state = state[0:8]
     h_state = state[8:16]
     has_restart = restart.size > 0
-    since = state[16]
-    for i in range(freq_hz.size):
-        again = has_restart and restart[i] != 0
-        filter_step(f_state, freq_hz[i] - ref_f, time_s[i], tau, again)
-        since = 0.0 if again else since
-        since += 1.0
+    n = freq_hz.size
+    scratch = np.empty(n)
+    level = np.empty(n)
+    for i in range(n):
+        level[i] = freq_hz[i] - ref_f
+    filter_run(level, time_s, tau, restart, f_state, scratch, scratch[:0])
     if uses_housing:
-        for i in range(housing_c.size):
-            filter_step(h_state, housing_c[i] - ref_h, time_s[i], tau,
-                        has_restart and restart[i] != 0)
+        for i in range(n):
+            level[i] = housing_c[i] - ref_h
+        filter_run(level, time_s, tau, restart, h_state, scratch, scratch[:0])
+    since = state[16]
+    for i in range(n):
+        since = 0.0 if has_restart and restart[i] != 0 else since
+        since += 1.0
     state[16] = since
 
 

@@ -38,52 +38,59 @@ def step_weights(dt_s, tau_s):  # pragma: no cover - compiled
     return a, p
 
 
+@njit(cache=True, nogil=True, error_model="numpy")
+def filter_run(x, time_s, tau_s, restart, state, out_rate, out_lag):  # pragma: no cover
+    """Advance ``state`` (the slots of :data:`hrgtc.drift.rate_filter.LAG`) over the samples
+    ``x`` at ``time_s``, writing each rate (and, unless ``out_lag`` is empty, the lag
+    x - y1 after the step).
 
-@njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def filter_step(state, x, t, tau_s, restart):  # pragma: no cover - compiled
-    """Advance ``state`` (see :data:`LAG`) by one sample (x at time t); return the rate.
-
-    ``restart`` (or a state never started) puts the filter at rest on this sample
-    (rate 0). A step of zero or negative Δt moves nothing but the previous input.
+    ``restart`` (int8 per sample, or empty: none), or a state never started, puts the
+    filter at rest on that sample (rate 0) with no cached step. A step of zero or
+    negative Δt moves nothing but the previous input. The state is held in locals over
+    the loop (registers), written back at the end.
     """
-    if restart or state[4] == 0.0:
-        state[0] = 0.0
-        state[1] = 0.0
-        state[2] = x
-        state[3] = t
-        state[4] = 1.0
-        state[5] = -1.0  # no cached step: a restarted filter is a new one
-        state[6] = 0.0
-        state[7] = 0.0
-        return 0.0
-    dt = t - state[3]
-    dt = 0.0 if not dt > 0.0 else dt
-    if not abs(dt - state[5]) <= _TOLERANCE * state[5]:
-        a, p = step_weights(dt, tau_s)
-        state[5] = dt
-        state[6] = a
-        state[7] = p
-    a = state[6]
-    p = state[7]
-    delta = x - state[2]
-    c1 = a * state[0]
-    c1 = c1 + p * delta
-    lag = state[0] + delta
-    state[0] = lag - c1
-    c2 = a * state[1]
-    c2 = c2 + p * c1
-    difference = state[1] + c1
-    state[1] = difference - c2
-    state[2] = x
-    state[3] = t
-    return state[1] / tau_s
+    has_restart = restart.size > 0
+    keep_lag = out_lag.size > 0
+    lag, difference, previous, t_prev = state[0], state[1], state[2], state[3]
+    started, dt_c, a, p = state[4], state[5], state[6], state[7]
+    for i in range(x.size):
+        xi = x[i]
+        ti = time_s[i]
+        if (has_restart and restart[i] != 0) or started == 0.0:
+            lag = 0.0
+            difference = 0.0
+            previous = xi
+            t_prev = ti
+            started = 1.0
+            dt_c = -1.0  # no cached step: a restarted filter is a new one
+            a = 0.0
+            p = 0.0
+            out_rate[i] = 0.0
+        else:
+            dt = ti - t_prev
+            dt = 0.0 if not dt > 0.0 else dt
+            if not abs(dt - dt_c) <= _TOLERANCE * dt_c:
+                a, p = step_weights(dt, tau_s)
+                dt_c = dt
+            delta = xi - previous
+            c1 = a * lag
+            c1 = c1 + p * delta
+            lag = lag + delta
+            lag = lag - c1
+            c2 = a * difference
+            c2 = c2 + p * c1
+            difference = difference + c1
+            difference = difference - c2
+            previous = xi
+            t_prev = ti
+            out_rate[i] = difference / tau_s
+        if keep_lag:
+            out_lag[i] = lag
+    state[0], state[1], state[2], state[3] = lag, difference, previous, t_prev
+    state[4], state[5], state[6], state[7] = started, dt_c, a, p
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
 def rate_pass(x, time_s, tau_s, restart, state, out_rate, out_lag):  # pragma: no cover
-    """:func:`filter_step` over arrays; ``restart`` an int8 mask (or empty: none)."""
-    has_restart = restart.size > 0
-    for i in range(x.size):
-        out_rate[i] = filter_step(state, x[i], time_s[i], tau_s,
-                                  has_restart and restart[i] != 0)
-        out_lag[i] = state[0]
+    """:func:`filter_run` over whole arrays (``causal_rate``)."""
+    filter_run(x, time_s, tau_s, restart, state, out_rate, out_lag)
