@@ -446,15 +446,24 @@ def compensate_block(time_s, restart, freq_hz, rate_dph, housing_c, filt, uses_h
         n_rate_ok = 0.0
         since = state[16]  # samples since the filter (re)started (SAMPLES)
         n_settling = 0
-        for i in range(m):
-            if has_restart and restart[start + i] != 0:
-                since = 0.0
-            settled = 1.0 if since >= filt[5] else 0.0
-            since += 1.0
-            out_in_range[start + i] = ok[i] * rate_ok[i] * settled
-            n_ok += ok[i]
-            n_rate_ok += rate_ok[i]
-            n_settling += settled == 0.0
+        if has_restart:  # the count restarts with the filter (serial)
+            for i in range(m):
+                if restart[start + i] != 0:
+                    since = 0.0
+                settled = 1.0 if since >= filt[5] else 0.0
+                since += 1.0
+                out_in_range[start + i] = ok[i] * rate_ok[i] * settled
+                n_ok += ok[i]
+                n_rate_ok += rate_ok[i]
+                n_settling += settled == 0.0
+        else:  # vectorised
+            for i in range(m):
+                settled = 1.0 if since + i >= filt[5] else 0.0
+                out_in_range[start + i] = ok[i] * rate_ok[i] * settled
+                n_ok += ok[i]
+                n_rate_ok += rate_ok[i]
+                n_settling += settled == 0.0
+            since += m
         state[16] = since
         counts[0] += m - int(n_ok)
         counts[1] += m - int(n_rate_ok)

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
 from hrgtc.drift.rate_filter import DT_REL_TOLERANCE, SERIES_LIMIT, series_coefficients
@@ -94,3 +95,19 @@ def filter_run(x, time_s, tau_s, restart, state, out_rate, out_lag):  # pragma: 
 def rate_pass(x, time_s, tau_s, restart, state, out_rate, out_lag):  # pragma: no cover
     """:func:`filter_run` over whole arrays (``causal_rate``)."""
     filter_run(x, time_s, tau_s, restart, state, out_rate, out_lag)
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def first_time_problem(time_s, t_prev, started):  # pragma: no cover - compiled
+    """(kind, row) of the first time the filter cannot step to: kind 1 not finite, 2 a
+    step back, 3 a step back from the previous chunk (``t_prev``); (0, -1) if none."""
+    for i in range(time_s.size):
+        t = time_s[i]
+        if not np.isfinite(t):
+            return 1, i
+        if i == 0:
+            if started != 0.0 and t < t_prev:
+                return 3, 0
+        elif t < time_s[i - 1]:
+            return 2, i
+    return 0, -1

@@ -172,18 +172,21 @@ def causal_rate(
 
 def check_time(time_s: np.ndarray, state: np.ndarray | None = None) -> None:
     """Raise when times go backwards or are not finite (the filter steps forward only)."""
+    from hrgtc.drift._rate_kernel import first_time_problem  # one compiled pass
+
     if not time_s.size:
         return
-    if not np.all(np.isfinite(time_s)):
-        row = int(np.flatnonzero(~np.isfinite(time_s))[0])
+    started = 0.0 if state is None else float(state[STARTED])
+    t_prev = 0.0 if state is None else float(state[T_PREV])
+    kind, row = first_time_problem(np.ascontiguousarray(time_s, dtype=np.float64), t_prev,
+                                   started)
+    if kind == 1:
         raise InputError(f"time_s is not finite at row {row}; the df/dt filter needs each "
                          "sample's time")
-    steps = np.diff(time_s)
-    if steps.size and np.any(steps < 0):
-        row = int(np.flatnonzero(steps < 0)[0]) + 1
+    if kind == 2:
         raise InputError(f"time_s goes backwards at row {row} ({time_s[row - 1]!r} -> "
                          f"{time_s[row]!r} s); the df/dt filter steps forward in time")
-    if state is not None and state[STARTED] and time_s[0] < state[T_PREV]:
+    if kind == 3 and state is not None:
         raise InputError(f"time_s goes backwards between chunks ({float(state[T_PREV])!r} -> "
                          f"{float(time_s[0])!r} s); the df/dt filter steps forward in time")
 
