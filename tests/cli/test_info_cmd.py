@@ -192,3 +192,29 @@ def test_info_of_a_messy_multi_axis_imu_file(tmp_path):
     with pytest.warns(SpikeWarning):
         result = runner.invoke(app, ["info", str(path), *PX4_ARGS, "--spikes", "drop"])
     assert "axes: x, y, z" in result.stdout
+
+
+def test_a_slow_housing_channel_is_held_or_refused_as_asked(tmp_path):
+    # issue 20 item 5 on the command line: housing_c logged at 20 Hz in a 200 Hz file
+    from hrgtc.errors import SlowChannelWarning
+
+    rec = recording(2000)
+    housing = rec["housing_c"].copy()
+    housing[np.arange(2000) % 10 != 0] = np.nan
+    path = tmp_path / "slow.csv"
+    write(rec.with_columns(housing_c=housing), path)
+    with pytest.warns(SlowChannelWarning, match=r"'housing_c' is logged every 0.05 s.*held"):
+        code, data, err = info_json(str(path))
+    assert code == 0, err
+    assert data["rows"] == 2000
+    code, data, err = info_json(str(path), "--slow-channels", "error")
+    assert code != 0 and not data["validation"]["ok"]
+    assert data["validation"]["problems"][0]["column"] == "housing_c"
+    # a value older than --hold-max-s is a gap in the channel: the row is dropped
+    housing[1000:1100] = np.nan  # 0.5 s without a reading, then values again
+    write(rec.with_columns(housing_c=housing), path, force=True)
+    with pytest.warns(SlowChannelWarning, match="dropped as a gap"):
+        code, data, err = info_json(str(path), "--hold-max-s", "0.1", "--gaps", "split")
+    assert code == 0, err
+    # the last value before the stop is row 990's; rows 991..1010 are within 0.1 s of it
+    assert data["rows"] == 2000 - (1100 - 1011)

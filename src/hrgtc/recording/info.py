@@ -263,6 +263,8 @@ def describe(
     spike_window_s: float = SPIKE_WINDOW_S,
     start: str | float | None = None,
     end: str | float | None = None,
+    slow_channels: str = "hold",
+    hold_max_s: float | None = None,
 ) -> RecordingInfo:
     """Summarise and validate a recording file in one streaming pass.
 
@@ -279,6 +281,8 @@ def describe(
         of the temperature, are not listed.
     start, end
         The slice read (``--start/--end``, see :func:`hrgtc.recording.read`).
+    slow_channels, hold_max_s
+        As for :func:`hrgtc.recording.read` (channels logged slower than the rows).
     rows
         Rows per chunk read.
     progress
@@ -312,6 +316,7 @@ def describe(
             spike_filter=spike_filter or "off", spike_k=spike_k, spike_lsb=spike_lsb,
             spike_window_s=spike_window_s,
             time_repair=repairer, start=start, end=end,
+            slow_channels=slow_channels, hold_max_s=hold_max_s,
         ):
             meta = chunk.metadata
             names = names or [n for n in chunk.names if n != SPIKE_COLUMN
