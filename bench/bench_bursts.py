@@ -30,7 +30,7 @@ from pathlib import Path
 
 SAMPLE_RATE_HZ = 50.0
 BURST_S, PERIOD_S = 5.0, 300.0
-REPEATS = 5
+REPEATS = 7
 TARGET = 1.10
 
 
