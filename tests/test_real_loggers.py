@@ -305,7 +305,6 @@ def test_orientation_offsets_do_not_bias_the_temperature_coefficient(handled):
         assert float(np.sqrt(np.mean(error**2))) <= 0.03 * float(np.ptp(thermal)) + slow_noise, a
 
 
-NEEDS_RATES = "needs channels at different rates: a slower temperature held or interpolated (dfdt)"
 
 
 def _drift_terms(model: dict) -> dict:
@@ -338,7 +337,6 @@ def test_time_defects_give_the_model_of_the_clean_file(tmp_path, variant):
             assert other[a][2][term] == pytest.approx(value, rel=1e-6)
 
 
-@pytest.mark.xfail(strict=True, reason=NEEDS_RATES)
 def test_slower_temperature_channel_gives_the_same_model(tmp_path):
     """A temperature logged at 1 Hz in a 10 Hz file (empty cells between) gives the model of
     the file with a temperature in every row: the same terms, and each coefficient within
