@@ -11,7 +11,7 @@ import math
 import numpy as np
 from numba import njit
 
-from hrgtc.drift.rate_filter import DT_REL_TOLERANCE, SERIES_LIMIT, series_coefficients
+from hrgtc.drift.rate_weights import DT_REL_TOLERANCE, SERIES_LIMIT, series_coefficients
 
 _S1, _S2, _S3, _S4, _S5, _S6, _S7, _S8, _S9 = series_coefficients()  # compiled in as constants
 _LIMIT = SERIES_LIMIT

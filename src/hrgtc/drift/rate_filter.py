@@ -44,28 +44,22 @@ of itself (a timing error of 1e-6 Δt; logger clocks are far coarser).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
+from hrgtc.drift.rate_weights import (  # noqa: F401  (re-exported: imported from here)
+    DT_REL_TOLERANCE,
+    SERIES_LIMIT,
+    SERIES_TERMS,
+    series_coefficients,
+)
 from hrgtc.errors import InputError
 
-#: Below this r = Δt/tau the weight p comes from its Taylor series.
-SERIES_LIMIT = 0.1
-#: Terms of that series (the first neglected one is below 1e-16 of p at SERIES_LIMIT).
-SERIES_TERMS = 9
-#: A step whose Δt is within this share of the last one reuses its weights.
-DT_REL_TOLERANCE = 1e-6
 #: Slots of the filter state array: lag, difference, previous input, previous time,
 #: started (0/1), and the cached step: its Δt, a and p.
 LAG, DIFFERENCE, X_PREV, T_PREV, STARTED, DT, A, P = range(8)
 STATE_SIZE = 8
-
-
-def series_coefficients() -> tuple[float, ...]:
-    """(-1)^(k+1) / (k+1)! for k = 1..SERIES_TERMS: p(r) = sum_k c_k r^k."""
-    return tuple((-1.0) ** (k + 1) / math.factorial(k + 1) for k in range(1, SERIES_TERMS + 1))
 
 
 def new_state() -> np.ndarray:
