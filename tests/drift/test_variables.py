@@ -116,7 +116,7 @@ def test_the_numba_kernel_computes_or_hands_over_to_numpy(name):
 
 # -- C double ------------------------------------------------------------------------------
 def _driver(prefix: str, inputs: list[str]) -> str:
-    args = "".join(f", row[{2 + k}]" for k in range(len(inputs)))
+    args = "".join(f", row[{3 + k}]" for k in range(len(inputs)))
     return f"""
 #include <stdio.h>
 #include "{prefix}_model.h"
@@ -128,8 +128,8 @@ int main(int argc, char **argv)
     FILE *in = fopen(argv[1], "rb"), *result = fopen(argv[2], "wb");
     (void)argc;
     {prefix}_init(&state);
-    while (fread(row, sizeof(double), {2 + len(inputs)}, in) == {2 + len(inputs)}) {{
-        {prefix}_step(&state, row[0], row[1]{args}, &out);
+    while (fread(row, sizeof(double), {3 + len(inputs)}, in) == {3 + len(inputs)}) {{
+        {prefix}_step(&state, row[0], row[1], row[2]{args}, &out);  /* dt_s first */
         record[0] = out.bias_model_dph;
         record[1] = out.in_range * out.rate_in_range;
         fwrite(record, sizeof(double), 2, result);
@@ -159,7 +159,8 @@ def test_the_c_export_computes_or_refuses(name, tmp_path):
     run = held_out()
     columns = {"housing_c": run["housing_c"] if "housing_c" in run else None,
                "aux_drive": run["drive_v"]}
-    table = np.column_stack([run.freq_hz, run.rate_dph, *[columns[c] for c in inputs]])
+    dt = np.concatenate([[0.0], np.diff(run.time_s)])
+    table = np.column_stack([dt, run.freq_hz, run.rate_dph, *[columns[c] for c in inputs]])
     table.astype(np.float64).tofile(tmp_path / "in.bin")
     subprocess.run([str(exe), str(tmp_path / "in.bin"), str(tmp_path / "out.bin")], check=True,
                    timeout=60)
@@ -193,14 +194,12 @@ def _evaluate_parameters(p, run):
     from compensate.test_parameter_file import bias_from, rate_of, temperature_from
 
     values = {"f": run.freq_hz - p["reference_freq_hz"]}
-    values["df"] = rate_of(values["f"], p)
+    values["df"] = rate_of(values["f"], p, run.time_s)
     if p.get("uses_housing") == 1.0:
         values["h"] = run["housing_c"] - p["reference_c"]
-        values["dh"] = rate_of(values["h"], p)
+        values["dh"] = rate_of(values["h"], p, run.time_s)
     if p.get("uses_rate2") == 1.0:
-        second = {k: p[k.replace("filter_", "filter2_")] for k in
-                  ("filter_alpha", "filter_beta", "filter_gain")}
-        values["d2"] = rate_of(values["f"], second)
+        values["d2"] = rate_of(values["f"], {"rate_tau_s": p["rate_tau2_s"]}, run.time_s)
     if p.get("uses_gradient") == 1.0:
         values["g"] = run["housing_c"] - temperature_from(p, run.freq_hz)
     for name in str(p.get("aux_names", "")).split():

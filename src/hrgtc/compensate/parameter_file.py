@@ -59,7 +59,7 @@ def formula(key: str = "") -> list[str]:
         "     (when <{k}uses_housing> = 1: h = housing_c - <{k}reference_c> [degC] and dh its",
         "      rate by the same filter on its own y1, y2 [degC/s])",
         "     (when <{k}uses_rate2> = 1: d2, the rate of f by the same filter with",
-        "      <{k}filter2_alpha>, <{k}filter2_beta>, <{k}filter2_gain>, on its own y1, y2 [Hz/s])",
+        "      tau = <{k}rate_tau2_s>, on its own y1, y2 [Hz/s])",
         "     (when <{k}uses_gradient> = 1: g = housing_c - T [degC], T the resonator",
         "      temperature of step 6, NaN where the inverse has no solution)",
         "     (for each NAME of <{k}aux_names>: a_NAME = aux_NAME - <{k}aux_centre_NAME>,",
@@ -200,11 +200,6 @@ def _extra_variable_lines(model: UnitModel, plan: CPlan, put: Any) -> None:
         put("uses_rate2", 1, "1: the terms use d2, the rate of f by the second filter.")
         put("rate_tau2_s", settings.rate_tau2_s,
             "Time constant of each of the two stages of the second df/dt filter. [s]")
-        put("filter2_alpha", plan.alpha2,
-            "Second filter's stage coefficient 1 - exp(-1/(rate_tau2_s*sample_rate_hz)). [1]")
-        put("filter2_beta", plan.beta2, "Second filter's beta = 1 - filter2_alpha. [1]")
-        put("filter2_gain", plan.gain2,
-            "Second filter's ramp gain filter2_alpha*sample_rate_hz/filter2_beta. [1/s]")
     if plan.gradient:
         put("uses_gradient", 1, "1: the terms use g = housing_c - T(freq_hz); housing_c is "
             "an input.")
