@@ -44,8 +44,6 @@ AXES = "xyz"
 SEED = 11
 #: The chamber program of the burst tests: a 2 h cool-down 22 -> 5 °C at 0.15 °C/min.
 PROFILE = cooldown(22.0, 5.0, hours=2.0, ramp_c_per_min=0.15)
-NEEDS_TIME = ("needs one notion of time: df/dt carried across gaps with each step's true Δt "
-              "and windows that never span a gap (dfdt + time)")
 NEEDS_MOTION = "needs the motion detector (--motion exclude by default) and per-orientation offsets"
 
 
@@ -122,7 +120,6 @@ def _drift_error(bias: dict, run, skip_s: float = 600.0) -> dict:
     return out
 
 
-@pytest.mark.xfail(strict=True, reason=NEEDS_TIME)
 def test_burst_recording_gives_the_model_of_the_continuous_recording(burst_pair):
     """Both models predict the continuous run's true drift equally well.
 
@@ -147,7 +144,6 @@ def test_burst_recording_gives_the_model_of_the_continuous_recording(burst_pair)
         assert rms_burst <= 1.2 * rms_cont + 3.0 * sigma, (a, rms_burst, rms_cont, sigma)
 
 
-@pytest.mark.xfail(strict=True, reason=NEEDS_TIME)
 def test_burst_recording_gives_the_figures_of_the_continuous_recording(burst_pair):
     """Compensated with the burst model, the continuous run's 10 s means scatter as with its
     own model (within 25 %: the 10 s figure of a 2 h run has ~720 windows, a 1σ
@@ -175,7 +171,7 @@ def test_burst_recording_gives_the_figures_of_the_continuous_recording(burst_pai
 
 @pytest.mark.parametrize("kind", [
     "continuous",
-    pytest.param("burst", marks=pytest.mark.xfail(strict=True, reason=NEEDS_TIME)),
+    "burst",
 ])
 def test_dfdt_range_in_the_model_is_the_true_one(burst_pair, kind):
     """The model's df/dt range (°C/s for a temperature sensor) spans the true dT/dt of the
@@ -191,7 +187,7 @@ def test_dfdt_range_in_the_model_is_the_true_one(burst_pair, kind):
 
 @pytest.mark.parametrize("kind", [
     "continuous",
-    pytest.param("burst", marks=pytest.mark.xfail(strict=True, reason=NEEDS_TIME)),
+    "burst",
 ])
 def test_model_flags_at_most_5_percent_of_its_own_training_file(burst_pair, kind):
     case = burst_pair[kind]
