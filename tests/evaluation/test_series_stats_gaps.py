@@ -33,8 +33,13 @@ def test_tau_blocks_never_span_a_gap_and_allan_is_pooled_within_segments():
     for k, part in enumerate(parts):
         stats.push(part, [0] if k else [])
     assert stats.segments == 3 and stats.longest_segment_s == pytest.approx(204.8)
-    means = np.concatenate([p[: p.size // 10 * 10].reshape(-1, 10).mean(axis=1) for p in parts])
+    # full τ-blocks of each segment, and its partial last block when it holds at least
+    # half τ less one sample (4 of 10: the tails 4, 7 and 8 all count)
+    means = np.concatenate([
+        np.r_[p[: p.size // 10 * 10].reshape(-1, 10).mean(axis=1),
+              [p[p.size // 10 * 10:].mean()] if p.size % 10 >= 4 else []] for p in parts])
     assert stats.bias_stability()[1.0] == pytest.approx(np.std(means, ddof=1), rel=1e-12)
+    assert stats.partial_blocks()[1.0] == 3
     curve = stats.allan_deviation()
     for tau, dev, n in zip(curve.taus_s, curve.deviation, curve.counts, strict=True):
         m = round(tau * 10.0)
@@ -56,3 +61,19 @@ def test_breaks_inside_one_push_and_in_the_decimated_path():
     for tau, dev, n in zip(fine.taus_s, fine.deviation, fine.counts, strict=True):
         expected, count = _manual_oadev(parts, round(tau * 10.0))
         assert dev == pytest.approx(expected, rel=1e-9) and n == count
+
+
+def test_bursts_shorter_than_tau_give_the_spread_of_their_burst_means():
+    """5 s bursts at 50 Hz every 300 s (the real cold test's logger): no 10 s block fits in
+    a burst, so τ = 10 s comes from the burst means (half τ or more), one burst that lost a
+    sample (a spike removed) included; a burst of a fifth of τ is left out."""
+    rng = np.random.default_rng(3)
+    bursts = [rng.normal(0.0, 1.0, 250) + 5.0 * np.sin(k) for k in range(12)]
+    bursts[4] = bursts[4][:249]
+    bursts.append(rng.normal(0.0, 1.0, 100) + 1000.0)  # 2 s: too short for τ = 10 s
+    stats = SeriesStatistics(50.0, (10.0,), allan=False)
+    for k, burst in enumerate(bursts):
+        stats.push(burst, [0] if k else [])
+    expected = np.std([b.mean() for b in bursts[:12]], ddof=1)
+    assert stats.bias_stability()[10.0] == pytest.approx(expected, rel=1e-12)
+    assert stats.partial_blocks()[10.0] == 12

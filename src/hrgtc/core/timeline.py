@@ -43,6 +43,17 @@ GAP_TOLERANCE = 1e-6
 PARTIAL_WINDOW_FRACTION = 0.5
 
 
+def min_partial_rows(rows: int) -> int:
+    """Samples a window of ``rows`` cut short by a gap must hold to be kept: half a window
+    (:data:`PARTIAL_WINDOW_FRACTION`) less one sample, so a burst of exactly half a window
+    that lost one sample (a spike removed) still counts; never fewer than two.
+
+    >>> min_partial_rows(500), min_partial_rows(3)
+    (249, 2)
+    """
+    return max(2, math.ceil(PARTIAL_WINDOW_FRACTION * rows) - 1)
+
+
 def gap_limit_s(period_s: float, gap_factor: float = GAP_FACTOR) -> float:
     """Longest time step that is not a gap. [s]
 

@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from hrgtc.core.timeline import PARTIAL_WINDOW_FRACTION, is_gap
+from hrgtc.core.timeline import is_gap, min_partial_rows
 from hrgtc.drift.features import FeatureSettings, FeatureStream, Term, design_matrix, variables_for
 from hrgtc.drift.rate_checks import filtered_levels, rate_filter_problems, warn_rate_filter
 from hrgtc.errors import CalibrationError, InputError
@@ -97,7 +97,7 @@ class _WindowMeans:
 
     def __init__(self, rows: int) -> None:
         self.rows = rows
-        self.min_rows = max(1, int(np.ceil(PARTIAL_WINDOW_FRACTION * rows)))
+        self.min_rows = min(rows, min_partial_rows(rows))
         self._carry: np.ndarray | None = None
         self.partial_dropped_rows = 0
 

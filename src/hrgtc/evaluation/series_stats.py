@@ -39,6 +39,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from hrgtc.core.timeline import min_partial_rows
 from hrgtc.errors import InputError
 from hrgtc.evaluation.allan import AllanResult, _block_length, allan_deviation
 
@@ -60,6 +61,7 @@ class _BlockMeans:
         self._carry = np.empty(0)
         self._means: list[np.ndarray] = []
         self.count = 0
+        self.partial = 0  # blocks closed short at a gap (kept from half a block)
         self.mean = 0.0
         self.m2 = 0.0
 
@@ -67,18 +69,29 @@ class _BlockMeans:
         data = np.concatenate([self._carry, values]) if self._carry.size else values
         blocks = data.size // self.rows
         if blocks:
-            means = data[: blocks * self.rows].reshape(blocks, self.rows).mean(axis=1)
-            if self.keep:
-                self._means.append(means)
-            else:  # Chan et al. [4]: merge (count, mean, M2) of this batch into the total
-                mean = float(np.mean(means))
-                m2 = float(np.sum((means - mean) ** 2))
-                total = self.count + blocks
-                delta = mean - self.mean
-                self.m2 += m2 + delta * delta * self.count * blocks / total
-                self.mean += delta * blocks / total
-            self.count += blocks
+            self._add(data[: blocks * self.rows].reshape(blocks, self.rows).mean(axis=1))
         self._carry = np.array(data[blocks * self.rows:])
+
+    def close_segment(self, min_rows: int) -> None:
+        """A gap follows: the partial block is kept as one mean when it holds at least
+        ``min_rows`` samples (the rule of the training windows), else dropped."""
+        if self._carry.size >= max(1, min_rows):
+            self._add(np.array([float(np.mean(self._carry))]))
+            self.partial += 1
+        self._carry = np.empty(0)
+
+    def _add(self, means: np.ndarray) -> None:
+        blocks = means.size
+        if self.keep:
+            self._means.append(means)
+        else:  # Chan et al. [4]: merge (count, mean, M2) of this batch into the total
+            mean = float(np.mean(means))
+            m2 = float(np.sum((means - mean) ** 2))
+            total = self.count + blocks
+            delta = mean - self.mean
+            self.m2 += m2 + delta * delta * self.count * blocks / total
+            self.mean += delta * blocks / total
+        self.count += blocks
 
     def std(self) -> float:
         """Sample standard deviation (ddof=1) of the block means, NaN below two blocks."""
@@ -206,7 +219,7 @@ class SeriesStatistics:
         self._longest = max(self._longest, self._segment_samples)
         self._segment_samples = 0
         for means in self._stability.values():
-            means._carry = np.empty(0)
+            means.close_segment(min_partial_rows(means.rows))
         if not self.allan:
             return
         if self._full is not None:
@@ -266,8 +279,21 @@ class SeriesStatistics:
         return math.sqrt(self._sum_squares / self.n) if self.n else math.nan
 
     def bias_stability(self) -> dict[float, float]:
-        """``{tau_s: 1σ of the τ-block means}``, NaN where fewer than two blocks fit. [°/h]"""
+        """``{tau_s: 1σ of the τ-block means}``, NaN where fewer than two blocks fit. [°/h]
+
+        A τ-block never spans a gap; in a recording of segments (bursts) the partial
+        block at each segment's end is kept as one mean when it covers at least half τ,
+        the rule of the training windows, so 5 s bursts give τ = 10 s figures from their
+        burst means (:meth:`partial_blocks` counts them) instead of none.
+        """
+        if self.segments > 1:
+            for means in self._stability.values():
+                means.close_segment(min_partial_rows(means.rows))
         return {tau: means.std() for tau, means in self._stability.items()}
+
+    def partial_blocks(self) -> dict[float, int]:
+        """``{tau_s: τ-blocks closed short at a gap}`` (kept from half τ)."""
+        return {tau: means.partial for tau, means in self._stability.items()}
 
     def allan_deviation(self) -> AllanResult:
         """Overlapping Allan deviation at octave τ (see the module docstring)."""
