@@ -31,7 +31,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from hrgtc.errors import RecordingError
-from hrgtc.recording.axes import axis_names, base_name
+from hrgtc.recording.axes import axis_names, base_name, split_axis
 from hrgtc.recording.schema import COLUMNS, Metadata
 
 SUFFIXES: dict[str, str] = {
@@ -225,8 +225,13 @@ class Hdf5Source(Source):
         self._datasets = {
             name: obj
             for name, obj in group.items()
-            if isinstance(obj, h5py.Dataset) and obj.ndim == 1
+            if isinstance(obj, h5py.Dataset) and obj.ndim == 1 and obj.dtype.names is None
         }
+        self.skipped = {  # datasets that are not a column: named if asked for
+            name: obj for name, obj in group.items()
+            if isinstance(obj, h5py.Dataset) and name not in self._datasets
+        }
+        self._refuse_shapes()
         self.names = list(self._datasets)
         lengths = {name: ds.shape[0] for name, ds in self._datasets.items()}
         if len(set(lengths.values())) > 1:
@@ -240,6 +245,24 @@ class Hdf5Source(Source):
             except ValueError:
                 pass
         self._done = 0
+
+    def _refuse_shapes(self) -> None:
+        """Refuse a recording column stored as a table, a matrix or a scalar."""
+        for name, ds in self.skipped.items():
+            if ds.dtype.names is not None:
+                fields = ", ".join(ds.dtype.names[:8])
+                why = (f"dataset {name!r} is a compound table (fields {fields}); hrgtc reads "
+                       "one 1-D dataset per column: store each field as its own dataset "
+                       f"(e.g. group['time_s'] = table['time_s']) in a group {HDF5_GROUP!r}")
+            elif is_column_name(name):
+                shape = "a scalar (shape ())" if ds.ndim == 0 else f"of shape {ds.shape}"
+                why = (f"dataset {name!r} is {shape}, not a 1-D column of one value per row; "
+                       "store one 1-D dataset per column (a 3-axis rate as rate_dph_x, "
+                       "rate_dph_y, rate_dph_z)")
+            else:
+                continue
+            self._file.close()
+            raise RecordingError(f"{self.path}: {why}")
 
     def _pick_group(self, h5py: Any) -> Any:
         root = self._file
@@ -288,6 +311,12 @@ class Hdf5Source(Source):
 
     def close(self) -> None:
         self._file.close()
+
+
+def is_column_name(name: str) -> bool:
+    """True for a recording contract column, per-axis ones (``rate_dph_x``) included."""
+    base, axis = split_axis(name)
+    return name in COLUMNS or (axis is not None and base in COLUMNS)
 
 
 def _attr_value(value: Any) -> Any:

@@ -87,6 +87,7 @@ from hrgtc.recording.checks import (
     _check_freq_unit,
     _check_rate_unit,
     _check_sample_rate,
+    _check_swapped,
     _check_time_unit,
     check_thermometer,
     finite_extremes,
@@ -391,7 +392,8 @@ class RecordingValidator:
                     count=count,
                 )
             )
-        unit_problem = any(p.kind == "freq_unit" for p in self._heuristics or [])
+        unit_problem = any(p.kind in ("freq_unit", "swapped_columns")
+                           for p in self._heuristics or [])
         for name, (row, value, count) in self._out_of_bounds.items():
             is_freq = base_name(name, self.axes) == "freq_hz"
             if is_freq and (self._heuristics is None or unit_problem):
@@ -539,6 +541,11 @@ class RecordingValidator:
             freq = sample[freq_name]
             problem = _check_freq_unit(freq, freq_name)
             finite = freq[np.isfinite(freq)]
+            if problem and rate_name in sample:
+                swapped = _check_swapped(freq, sample[rate_name], freq_name, rate_name)
+                if swapped is not None:
+                    problems.append(swapped)
+                    return problems  # the rate's unit check would only add noise
             if problem:
                 problems.append(problem)
             elif finite.size:
