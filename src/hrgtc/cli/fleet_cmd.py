@@ -48,6 +48,7 @@ def _finish(run: FleetRun, json_output: bool, written: str) -> None:
     if json_output:
         print_json({"summary": run.summary(), "counts": run.counts(), "seconds": run.seconds,
                     "where": run.where, "written": written,
+                    "workers_died": run.workers_died, "retried": list(run.retried),
                     "units": [{"unit": o.unit, "status": o.status, "error": o.error,
                                "seconds": o.seconds} for o in run.outcomes]})
     else:
