@@ -165,6 +165,13 @@ class ParquetSource(Source):
             raise RecordingError(f"{path}: not a readable Parquet file ({exc})") from None
         schema = self._file.schema_arrow
         self.names = list(schema.names)
+        for i, name in enumerate(self.names):
+            if name in self.names[:i]:
+                self._file.close()
+                raise RecordingError(
+                    f"{path}: columns {self.names.index(name) + 1} and {i + 1} are both named "
+                    f"{name!r}; hrgtc cannot tell which one is meant: write the file with "
+                    "unique column names")
         self.total_rows = self._file.metadata.num_rows
         raw = (schema.metadata or {}).get(METADATA_KEY)
         if raw is not None:
