@@ -97,17 +97,18 @@ def test_duplicated_column_names_are_refused_by_every_reader(tmp_path):
 
 # -- °C/h of the range report ----------------------------------------------------------------
 def test_the_range_report_gives_the_resonators_rate_in_degrees_per_hour(model):
-    run = ramp_run(seed=4, start_c=20.0, end_c=-20.0, hours=3.0)
-    compensator = Compensator(model, engine="numpy")
-    compensator.process(run)
-    seen = compensator.ranges().seen_rate_c_per_h
-    # truth: the simulated resonator temperature's own rate, °C/s * 3600
-    true_rate = np.diff(run["resonator_c"]) * run.metadata.sample_rate_hz * 3600.0
-    assert -25.0 < true_rate.min() < -10.0  # a cool-down of ~ -19 °C/h at its fastest
-    assert seen[0] == pytest.approx(true_rate.min(), rel=0.25)
-    assert seen[1] == pytest.approx(max(true_rate.max(), 0.0), abs=1.0)
+    for start_c, end_c in ((20.0, -20.0), (-20.0, 20.0)):  # a cool-down and a warm-up
+        run = ramp_run(seed=4, start_c=start_c, end_c=end_c, hours=3.0)
+        compensator = Compensator(model, engine="numpy")
+        compensator.process(run)
+        seen = compensator.ranges().seen_rate_c_per_h
+        # truth: the simulated resonator temperature's own rate, °C/s * 3600
+        true_rate = np.diff(run["resonator_c"]) * run.metadata.sample_rate_hz * 3600.0
+        fastest = true_rate.min() if end_c < start_c else true_rate.max()
+        assert 10.0 < abs(fastest) < 25.0  # ~ 19 °C/h at its fastest
+        assert seen[0 if end_c < start_c else 1] == pytest.approx(fastest, rel=0.25)
     trained = compensator.ranges().trained_rate_c_per_h
-    assert -25.0 < trained[0] < -10.0 and abs(trained[1]) < 2.0  # trained on a similar ramp
+    assert -25.0 < trained[0] < -10.0 and abs(trained[1]) < 2.0  # trained on a cool-down
 
 
 # -- a reversed training range in a model file -----------------------------------------------
@@ -123,7 +124,8 @@ def test_a_reversed_range_in_a_model_file_is_refused(model, tmp_path, place):
     data.pop("parameters_sha256")
     (tmp_path / "r.json").write_text(json.dumps(data))
     escaped = re.escape(place)
-    with pytest.raises(ModelFileError, match=rf"r.json.*{escaped}.*(reversed|not an ordered range)"):
+    with pytest.raises(ModelFileError,
+                       match=rf"r.json.*{escaped}.*(reversed|not an ordered range)"):
         load_model(tmp_path / "r.json")
 
 
