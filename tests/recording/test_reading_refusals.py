@@ -10,6 +10,8 @@ each of these read silently wrong or failed with a misleading message.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import h5py
 import numpy as np
 import pytest
@@ -181,3 +183,15 @@ def test_a_frequency_in_khz_is_still_named_as_khz(run, tmp_path):
     path = write(Recording(columns, run.metadata), tmp_path / "khz.parquet")
     with pytest.raises(RecordingError, match="freq_hz looks like kHz"):
         read(path)
+
+
+def test_a_spreadsheets_padding_of_empty_columns_is_left_out():
+    # the PAN hand log (tests/data/pan-cold-test) pads every line with 14 empty fields
+    from hrgtc.recording.io import open_source
+
+    handlog = (Path(__file__).resolve().parents[1] / "data" / "pan-cold-test"
+               / "pan_etu_cold_handlog_2020-03-07.csv")
+    with open_source(handlog) as source:
+        assert source.names == ["Time", "F2 (F)", "F3 (F)", "F4 (F)", "C1 (C)"]
+        table = source.read(["C1 (C)"], set())
+    assert table.column(0).to_pylist()[:3] == [21.5, 21.9, 22.2]  # the log's first rows

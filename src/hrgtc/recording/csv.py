@@ -67,18 +67,19 @@ class CsvSource(Source):
         self.delimiter = _sniff_delimiter(header)
         _refuse_space_separated(path, header)
         fields = [f.strip().strip('"').strip() for f in header.split(self.delimiter)]
-        # a delimiter at the end of every line (some loggers write one) is a line end,
-        # not a column without a name: it is read under a placeholder and left out
-        trailing = len(fields) > 1 and fields[-1] == ""
-        if trailing:
-            fields = fields[:-1]
+        # delimiters at the end of every line (a logger's line end, a spreadsheet's padding
+        # of empty columns) are not columns without a name: read under placeholders, left out
+        trailing = 0
+        while len(fields) - trailing > 1 and fields[-1 - trailing] == "":
+            trailing += 1
+        fields = fields[:len(fields) - trailing]
         self._header_rows = 1
         if all(_is_number(f) for f in fields):
             fields = [f"column_{i + 1}" for i in range(len(fields))]
             self._header_rows = 0
         _refuse_bad_names(path, fields, self.delimiter)
         self.names = fields
-        self._file_names = [*fields, TRAILING_COLUMN] if trailing else list(fields)
+        self._file_names = [*fields, *(f"{TRAILING_COLUMN} {i}" for i in range(trailing))]
         sidecar = Path(f"{path}.json")
         if sidecar.exists():
             try:
@@ -127,7 +128,8 @@ class CsvSource(Source):
             reader = pa_csv.open_csv(self._open(), **options)
         except pa.ArrowInvalid as exc:
             raise self._translate(exc, set()) from None
-        return {f.name: kind_of(f.type) for f in reader.schema if f.name != TRAILING_COLUMN}
+        return {f.name: kind_of(f.type) for f in reader.schema
+                if not f.name.startswith(TRAILING_COLUMN)}
 
     def read(self, names: Sequence[str], as_text: set[str]) -> pa.Table:
         try:
@@ -230,7 +232,7 @@ class CsvSource(Source):
         return "?", "?", "?"
 
 
-#: Name under which the empty field after a trailing delimiter is read (then dropped).
+#: Name (then a number) under which the empty fields after trailing delimiters are read.
 TRAILING_COLUMN = "\x00trailing delimiter"
 
 
