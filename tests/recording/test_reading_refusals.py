@@ -195,3 +195,16 @@ def test_a_spreadsheets_padding_of_empty_columns_is_left_out():
         assert source.names == ["Time", "F2 (F)", "F3 (F)", "F4 (F)", "C1 (C)"]
         table = source.read(["C1 (C)"], set())
     assert table.column(0).to_pylist()[:3] == [21.5, 21.9, 22.2]  # the log's first rows
+
+
+def test_an_axis_frequency_outside_the_models_band_is_a_plain_number(three_axis, tmp_path):
+    from hrgtc.recording import ReadOptions
+
+    columns = {k: np.array(three_axis[k]) for k in three_axis.names}
+    columns["freq_hz_y"][700] = 4500.25
+    path = write(Recording(columns, three_axis.metadata), tmp_path / "band.parquet")
+    options = ReadOptions(axis="y", freq_band_hz=(4400.0, 4450.0))
+    with pytest.raises(RecordingError, match=r"band.parquet: column freq_hz_y, row 700: 4500.25 "
+                       r"is outside the band") as caught:
+        list(options.chunks(path))
+    assert "np.float64" not in str(caught.value)
