@@ -69,7 +69,8 @@ def test_a_failed_sync_is_raised_by_close(tmp_path, monkeypatch):
     path.write_bytes(b"y" * 1000)
     behind = WriteBehind(path, poll_s=0.01)
     assert _wait_for(lambda: behind._error is not None)
-    with pytest.raises(OSError, match=r"out\.bin: writing to disk failed") as caught:
+    with pytest.raises(OSError, match=r"out\.bin: writing to disk failed: Input/output error$") \
+            as caught:
         behind.close()
     assert caught.value.errno == errno.EIO
     discarded = WriteBehind(path, poll_s=0.01)
@@ -90,3 +91,119 @@ def test_a_recording_writer_whose_sync_fails_leaves_nothing(tmp_path, monkeypatc
     with pytest.raises(OSError, match="writing to disk failed"):
         writer.close()
     assert list(tmp_path.iterdir()) == []  # no output, no temporary file
+
+
+# -- the checks before a write (issue 21: tests that catch plausible bugs, found by mutmut) --
+def test_check_writable_names_what_is_wrong(tmp_path, monkeypatch):
+    from collections import namedtuple
+
+    from hrgtc.errors import InputError
+    from hrgtc.files import check_writable
+
+    with pytest.raises(InputError, match=rf"^{tmp_path} is a directory; give a file name$"):
+        check_writable(tmp_path)
+    missing = tmp_path / "no" / "out.parquet"
+    with pytest.raises(InputError, match=rf"^{missing}: directory {missing.parent} does not "
+                       "exist; create it first$"):
+        check_writable(missing)
+    check_writable(tmp_path / "out.parquet", expected_bytes=1e3)  # room enough: no error
+    usage = namedtuple("usage", "total used free")
+    monkeypatch.setattr("shutil.disk_usage", lambda path: usage(0, 0, 2_500_000))
+    check_writable(tmp_path / "out.parquet")  # no estimate: free space not asked
+    check_writable(tmp_path / "out.parquet", expected_bytes=2_000_000)
+    with pytest.raises(InputError, match=rf"^{tmp_path}/out.parquet: 2.5 MB free in {tmp_path} "
+                       r"but the output needs about 3.0 MB; free some space or write elsewhere$"):
+        check_writable(tmp_path / "out.parquet", expected_bytes=3e6)
+    with pytest.raises(InputError, match="MB free"):
+        check_writable(tmp_path / "out.parquet", expected_bytes=2_400_000)  # 5 % to spare
+    monkeypatch.chdir(tmp_path)
+    check_writable("relative.parquet")  # the current directory: writable
+    monkeypatch.setattr(os, "access", lambda path, mode: False)
+    with pytest.raises(InputError, match=r"^out.parquet: directory . is not writable; choose "
+                       "another output path or fix its permissions$"):
+        check_writable("out.parquet")
+
+
+@pytest.mark.parametrize("code, text", [
+    (errno.ENOSPC, "the disk is full (no space left on device); free some space"),
+    (errno.EACCES, "permission denied; choose another path or fix its permissions"),
+    (errno.EPERM, "permission denied; choose another path or fix its permissions"),
+    (errno.EROFS, "read-only file system; write elsewhere"),
+    (errno.EIO, "Input/output error"),
+])
+def test_describe_os_error_names_the_file_and_the_fix(code, text):
+    from hrgtc.files import describe_os_error
+
+    named = OSError(code, os.strerror(code), "/data/out.parquet")
+    assert describe_os_error(named) == f"/data/out.parquet: {text}"
+    anonymous = OSError(code, os.strerror(code))
+    assert describe_os_error(anonymous, "model.json") == f"model.json: {text}"
+    assert describe_os_error(anonymous).startswith("file: ")
+
+
+def test_a_write_error_without_a_file_name_gets_the_outputs(tmp_path):
+    from hrgtc.files import naming_os_errors
+
+    target = tmp_path / "out.parquet"
+    for raised in (OSError(errno.ENOSPC, "No space left on device"),
+                   OSError("Error writing bytes to file. Detail: [errno 28] No space left on "
+                           "device"),
+                   OSError(errno.ENOSPC, "No space left", str(tmp_path / ".out.parquet.1.x.tmp"))):
+        with pytest.raises(OSError) as caught, naming_os_errors(target):
+            raise raised
+        assert (caught.value.errno, caught.value.filename) == (errno.ENOSPC, str(target))
+    other = OSError(errno.EACCES, "Permission denied", "/elsewhere/file")
+    with pytest.raises(OSError) as caught, naming_os_errors(target):
+        raise other
+    assert caught.value is other  # names its own file: left alone
+
+
+def test_pid_alive(monkeypatch):
+    from hrgtc import files
+
+    assert files._pid_alive(os.getpid())
+    assert not files._pid_alive(0) and not files._pid_alive(-5)
+    child = os.fork()
+    if child == 0:
+        os._exit(0)
+    os.waitpid(child, 0)
+    assert not files._pid_alive(child)  # reaped: no such process
+
+    def denied(pid, sig):
+        raise PermissionError(errno.EPERM, "Operation not permitted")
+
+    monkeypatch.setattr(os, "kill", denied)
+    assert files._pid_alive(1)  # another user's process: it may exist
+
+
+def test_a_signal_removes_the_temporary_files_then_runs_the_previous_handler(tmp_path):
+    import signal
+
+    from hrgtc import files
+
+    seen = []
+    previous = signal.signal(signal.SIGTERM, lambda signum, frame: seen.append(signum))
+    try:
+        temporary = tmp_path / ".out.tmp"
+        temporary.write_text("half")
+        with files.removed_on_signal(temporary):
+            assert signal.getsignal(signal.SIGTERM) is files._on_signal
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(0.01)
+        assert seen == [signal.SIGTERM] and not temporary.exists()
+        assert files._ACTIVE == set()
+        assert signal.getsignal(signal.SIGTERM) is not files._on_signal
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def test_file_sha256_reads_in_blocks(tmp_path):
+    import hashlib
+
+    from hrgtc.files import file_sha256
+
+    data = bytes(range(256)) * 40
+    path = tmp_path / "f.bin"
+    path.write_bytes(data)
+    assert file_sha256(path) == hashlib.sha256(data).hexdigest()
+    assert file_sha256(path, block_bytes=7) == hashlib.sha256(data).hexdigest()
