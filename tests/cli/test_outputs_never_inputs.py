@@ -137,3 +137,19 @@ def test_calibrate_refuses_a_compensated_file_as_training_input(files, tmp_path)
                              "-o", tmp_path / "m.json")
     assert code == 2 and "stripped.csv is already compensated" in stderr, stderr
     assert not (tmp_path / "m.json").exists()
+
+
+def test_fleet_commands_refuse_an_output_in_the_models_they_read(files, tmp_path):
+    _, model_path, _ = files
+    models = tmp_path / "models"
+    models.mkdir()
+    unit = models / "u1.json"
+    unit.write_bytes(model_path.read_bytes())
+    table = models / "fleet.parquet"
+    table.write_bytes(b"PAR1 stands in for the fleet table")
+    for args in (["fleet", "prior", models, "-o", unit, "--force"],
+                 ["fleet", "report", models, "-o", table, "--force"],
+                 ["fleet", "evaluate", tmp_path, "--models", models, "-o", table, "--force"]):
+        code, _, stderr = invoke(*args)
+        assert refused(code, stderr, unit.name if unit in args else table.name), (args, stderr)
+    assert unit.read_bytes() == model_path.read_bytes()
