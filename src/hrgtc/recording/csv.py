@@ -23,6 +23,9 @@ Strings are written bare when that reads back unchanged, else as JSON. Foreign
 files: comment lines of other forms are ignored, ``key: value`` lines of other
 keys go to ``extra``, the delimiter (``,``, ``;`` or tab) is sniffed from the
 header, and a file without a header gets columns ``column_1``, ``column_2``, ...
+Delimiters at the end of the lines (empty trailing columns) are left out. Refused,
+each with its own message: lines ending in CR alone, values separated by spaces,
+a column without a name, two columns of the same name (issue 21).
 A sidecar ``<file>.json`` (e.g. ``run.csv.json``) adds to or overrides the header.
 """
 

@@ -14,7 +14,9 @@ Layouts written by hrgtc:
 * HDF5: a group ``/recording`` with one 1-D float64 dataset per column (its unit
   in the attribute ``unit``) and the metadata as attributes of the group
   (``extra`` as a JSON string). Foreign files: the group ``recording`` if
-  present, else the root if it holds 1-D datasets, else the only group.
+  present, else the root if it holds 1-D datasets, else the only group. A dataset
+  named like a recording column that is not 1-D (an (N, 3) matrix, a scalar) and a
+  compound table are refused, never skipped (issue 21).
 """
 
 from __future__ import annotations

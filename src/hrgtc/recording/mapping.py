@@ -3,7 +3,9 @@
 * ``columns`` maps contract names to the file's names, e.g.
   ``{"time_s": "t", "freq_hz": "f_res", "rate_dph": "omega"}``, per-axis names
   included (``{"rate_dph_x": "gyro_x"}``, see :mod:`hrgtc.recording.axes`); other
-  columns keep their names (numeric ones are kept, text columns dropped);
+  columns keep their names (numeric ones are kept, text columns dropped). Axis sets
+  are explicit: a per-axis column of an axis without ``rate_dph_<axis>`` is an error
+  (:func:`check_axis_sets`), one shared ``temperature_c`` is legal;
 * ``units`` gives the units of ``time`` (``s``, ``ms``, ``us``, ``ns`` or
   ``timestamp``), ``freq`` (``Hz`` or ``kHz``), ``rate`` (``dph`` = °/h, ``dps`` =
   °/s, ``mdps`` = m°/s, ``radps`` = rad/s, ``mradps`` = mrad/s, ``drad``/``ddeg`` =
