@@ -81,8 +81,8 @@ def refuse_compensated_training(paths: Iterable[str | Path | None]) -> None:
     from hrgtc.recording.io import open_source
 
     for path in paths:
-        if path is None:
-            continue
+        if path is None or not Path(path).is_file():
+            continue  # a missing file is named by the reading that follows
         with open_source(path) as source:
             found = compensation_mark(source.metadata, list(source.names))
         if found is not None:
