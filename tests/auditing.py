@@ -90,8 +90,8 @@ def signature(command: str, stdout: str, out: Path) -> Any:
                 if n.startswith(("rate_comp_dph", "bias_model_dph", "in_range"))}
     if command == "info":
         data = json.loads(stdout)
-        return {"rows": data.get("rows"), "columns": [c.get("name") if isinstance(c, dict)
-                                                      else c for c in data.get("columns", [])]}
+        return {"rows": data.get("rows"), "columns": sorted(
+            str(c.get("name") if isinstance(c, dict) else c) for c in data.get("columns", []))}
     if command == "evaluate":
         return _strip(json.loads(stdout))
     if command == "calibrate":
