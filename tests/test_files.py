@@ -207,3 +207,53 @@ def test_file_sha256_reads_in_blocks(tmp_path):
     path.write_bytes(data)
     assert file_sha256(path) == hashlib.sha256(data).hexdigest()
     assert file_sha256(path, block_bytes=7) == hashlib.sha256(data).hexdigest()
+
+
+def test_a_sigterm_with_the_default_handler_removes_the_file_and_ends_the_process(tmp_path):
+    import signal
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    import hrgtc
+
+    temporary = tmp_path / ".out.parquet.tmp"
+    code = (
+        "import os, signal, time\n"
+        "from hrgtc.files import removed_on_signal\n"
+        f"path = {str(temporary)!r}\n"
+        "open(path, 'w').write('half')\n"
+        "with removed_on_signal(path):\n"
+        "    os.kill(os.getpid(), signal.SIGTERM)\n"
+        "    time.sleep(5)\n"
+        "print('survived')\n")
+    env = {**os.environ, "PYTHONPATH": str(Path(hrgtc.__file__).parents[1])}
+    result = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                            text=True, timeout=60)
+    assert result.returncode == -signal.SIGTERM, result.stderr  # died of the signal
+    assert "survived" not in result.stdout and not temporary.exists()
+
+
+def test_write_behind_starts_from_nothing_synced_in_a_named_daemon_thread(tmp_path):
+    path = tmp_path / "one.bin"
+    with open(path, "wb") as stream:
+        behind = WriteBehind(path, poll_s=0.01)
+        assert (behind.synced, behind.syncs) == (0, 0)
+        assert behind._thread.name == "hrgtc-write-behind" and behind._thread.daemon
+        stream.write(b"z")  # one byte: synced goes from 0 to 1
+        stream.flush()
+        assert _wait_for(lambda: behind.syncs == 1 and behind.synced == 1)
+        behind.close()
+
+
+def test_check_writable_asks_for_free_space_only_with_an_estimate(tmp_path, monkeypatch):
+    from collections import namedtuple
+
+    from hrgtc.errors import InputError
+    from hrgtc.files import check_writable
+
+    usage = namedtuple("usage", "total used free")
+    monkeypatch.setattr("shutil.disk_usage", lambda path: usage(0, 0, 0))
+    check_writable(tmp_path / "out.parquet")  # default: no estimate, a full disk passes
+    with pytest.raises(InputError, match=r"0.0 MB free .* needs about 0.0 MB"):
+        check_writable(tmp_path / "out.parquet", expected_bytes=1.0)
