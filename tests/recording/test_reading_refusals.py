@@ -208,3 +208,15 @@ def test_an_axis_frequency_outside_the_models_band_is_a_plain_number(three_axis,
                        r"is outside the band") as caught:
         list(options.chunks(path))
     assert "np.float64" not in str(caught.value)
+
+
+def test_a_file_without_a_header_line_says_so_when_columns_are_missing(run, tmp_path):
+    text = write(run, tmp_path / "r.csv").read_text().split("\n")
+    header = next(i for i, line in enumerate(text) if not line.startswith("#"))
+    path = tmp_path / "headless.csv"
+    path.write_text("\n".join(text[:header] + text[header + 1:]))  # metadata kept, names gone
+    with pytest.raises(RecordingError, match=r"headless.csv: required column\(s\) 'time_s', "
+                       r"'freq_hz', 'rate_dph' missing \(the file has no header line, so its "
+                       r"columns are \['column_1', 'column_2', 'column_3', 'column_4'\]\); .*"
+                       r"--col time_s="):
+        read(path)

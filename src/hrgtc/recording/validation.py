@@ -172,6 +172,7 @@ class RecordingValidator:
         self._sample_rows = 0
         self._heuristics: list[Problem] | None = None
         self.measured_sample_rate_hz: float | None = None
+        self._names: tuple[str, ...] = ()
 
     # -- feeding -------------------------------------------------------------
     def update(self, chunk: Recording) -> None:
@@ -184,6 +185,7 @@ class RecordingValidator:
             required = ("time_s", *(f"{name}{suffix}" for suffix in self._suffixes
                                     for name in ("freq_hz", "rate_dph")))
             self._missing = tuple(c for c in required if c not in chunk)
+            self._names = tuple(chunk.names)
             sampled = (*required, *(f"input_rate_dph{suffix}" for suffix in self._suffixes))
             self._sample = {name: [] for name in sampled if name in chunk}
         offset, n = self.rows, len(chunk)
@@ -371,10 +373,13 @@ class RecordingValidator:
             problems.append(Problem("empty", "the recording has no rows"))
         if self._missing:
             columns = "', '".join(self._missing)
+            headless = bool(self._names) and all(n.startswith("column_") for n in self._names)
+            found = (f"the file has no header line, so its columns are {list(self._names)}"
+                     if headless else f"the recording's columns are {list(self._names)}")
             problems.append(
                 Problem(
                     "missing_column",
-                    f"required column(s) '{columns}' missing; map your names with "
+                    f"required column(s) '{columns}' missing ({found}); map your names with "
                     f"--col {self._missing[0]}=<your column name> "
                     f"(columns={{'{self._missing[0]}': ...}})",
                     column=self._missing[0],
