@@ -257,3 +257,59 @@ def test_check_writable_asks_for_free_space_only_with_an_estimate(tmp_path, monk
     check_writable(tmp_path / "out.parquet")  # default: no estimate, a full disk passes
     with pytest.raises(InputError, match=r"0.0 MB free .* needs about 0.0 MB"):
         check_writable(tmp_path / "out.parquet", expected_bytes=1.0)
+
+
+# -- outputs never inputs, atomic text files (issue 21) --------------------------------------
+def test_refuse_input_names_the_output_and_the_input_it_is(tmp_path, monkeypatch):
+    from hrgtc.errors import InputError
+    from hrgtc.files import refuse_input
+
+    run = tmp_path / "run.csv"
+    run.write_text("time_s\n0\n")
+    link = tmp_path / "link.csv"
+    link.symlink_to(run)
+    fix = ("the output is an input of this command{}; writing it would replace the input, "
+           "so it is refused even with --force: give -o another file name")
+    with pytest.raises(InputError) as caught:
+        refuse_input(run, [None, tmp_path / "model.json", run])
+    assert str(caught.value) == f"{run}: " + fix.format("")
+    with pytest.raises(InputError) as caught:
+        refuse_input([tmp_path / "new.csv", link], [run])
+    assert str(caught.value) == f"{link}: " + fix.format(f" (the same file as {run})")
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(InputError, match=r"^run.csv: the output is an input .* \(the same "):
+        refuse_input("run.csv", [str(run)])
+    refuse_input(tmp_path / "new.csv", [run, None])  # not written yet: not an input
+    refuse_input(run, [None])  # no inputs
+
+
+def test_write_text_atomic_refuses_creates_folders_and_falls_back_without_hard_links(
+        tmp_path, monkeypatch):
+    from hrgtc import files
+    from hrgtc.errors import OutputExistsError
+
+    target = tmp_path / "a" / "b" / "prior.json"
+    files.write_text_atomic(target, "é first\n")  # missing folders are created
+    assert target.read_text(encoding="utf-8") == "é first\n"
+    with pytest.raises(OutputExistsError, match=r"prior.json exists; pass --force"):
+        files.write_text_atomic(target, "second\n")  # no force by default
+
+    def raced(source, destination):  # another writer created the target meanwhile
+        raise FileExistsError(errno.EEXIST, "File exists")
+
+    monkeypatch.setattr(os, "link", raced)
+    fresh = tmp_path / "fresh.txt"
+    with pytest.raises(OutputExistsError, match=rf"^{fresh} appeared while writing; pass --force"):
+        files.write_text_atomic(fresh, "x\n")
+    assert files._ACTIVE == set() and sorted(p.name for p in tmp_path.iterdir()) == ["a"]
+
+    def no_links(source, destination):  # a file system without hard links
+        raise PermissionError(errno.EPERM, "Operation not permitted")
+
+    monkeypatch.setattr(os, "link", no_links)
+    files.write_text_atomic(fresh, "no links\n")
+    assert fresh.read_text() == "no links\n"
+    with pytest.raises(OutputExistsError):
+        files.write_text_atomic(fresh, "again\n")
+    assert fresh.read_text() == "no links\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a", "fresh.txt"]
