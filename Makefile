@@ -5,7 +5,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test lint docs bench clean system
+.PHONY: demo test lint docs bench clean system mutation
 
 # Debian packages the tests exercise for real: headless Chromium opens the HTML report,
 # gcc compiles the C export. Installed with apt-get when missing (CI runs as root).
@@ -40,6 +40,15 @@ lint: $(STAMP)
 # The documentation site into build/site/ (strict: a broken link or a missing page fails).
 docs: $(STAMP)
 	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict
+
+# Mutation testing of recording/, compensate/ and files.py (pyproject's [tool.mutmut]); not
+# run by CI: the full set takes hours on 2 cores. MUTANTS narrows it, e.g.
+# make mutation MUTANTS='hrgtc.files.*'
+MUTANTS ?=
+mutation: $(STAMP)
+	$(BIN)/python -m pip install --quiet 'mutmut==3.8.1'
+	$(BIN)/mutmut run $(MUTANTS)
+	$(BIN)/mutmut results
 
 bench: $(STAMP)
 	$(BIN)/python bench/run.py

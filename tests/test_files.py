@@ -69,7 +69,8 @@ def test_a_failed_sync_is_raised_by_close(tmp_path, monkeypatch):
     path.write_bytes(b"y" * 1000)
     behind = WriteBehind(path, poll_s=0.01)
     assert _wait_for(lambda: behind._error is not None)
-    with pytest.raises(OSError, match=r"out\.bin: writing to disk failed") as caught:
+    with pytest.raises(OSError, match=r"out\.bin: writing to disk failed: Input/output error$") \
+            as caught:
         behind.close()
     assert caught.value.errno == errno.EIO
     discarded = WriteBehind(path, poll_s=0.01)
@@ -90,3 +91,225 @@ def test_a_recording_writer_whose_sync_fails_leaves_nothing(tmp_path, monkeypatc
     with pytest.raises(OSError, match="writing to disk failed"):
         writer.close()
     assert list(tmp_path.iterdir()) == []  # no output, no temporary file
+
+
+# -- the checks before a write (issue 21: tests that catch plausible bugs, found by mutmut) --
+def test_check_writable_names_what_is_wrong(tmp_path, monkeypatch):
+    from collections import namedtuple
+
+    from hrgtc.errors import InputError
+    from hrgtc.files import check_writable
+
+    with pytest.raises(InputError, match=rf"^{tmp_path} is a directory; give a file name$"):
+        check_writable(tmp_path)
+    missing = tmp_path / "no" / "out.parquet"
+    with pytest.raises(InputError, match=rf"^{missing}: directory {missing.parent} does not "
+                       "exist; create it first$"):
+        check_writable(missing)
+    check_writable(tmp_path / "out.parquet", expected_bytes=1e3)  # room enough: no error
+    usage = namedtuple("usage", "total used free")
+    monkeypatch.setattr("shutil.disk_usage", lambda path: usage(0, 0, 2_500_000))
+    check_writable(tmp_path / "out.parquet")  # no estimate: free space not asked
+    check_writable(tmp_path / "out.parquet", expected_bytes=2_000_000)
+    with pytest.raises(InputError, match=rf"^{tmp_path}/out.parquet: 2.5 MB free in {tmp_path} "
+                       r"but the output needs about 3.0 MB; free some space or write elsewhere$"):
+        check_writable(tmp_path / "out.parquet", expected_bytes=3e6)
+    with pytest.raises(InputError, match="MB free"):
+        check_writable(tmp_path / "out.parquet", expected_bytes=2_400_000)  # 5 % to spare
+    monkeypatch.chdir(tmp_path)
+    check_writable("relative.parquet")  # the current directory: writable
+    monkeypatch.setattr(os, "access", lambda path, mode: False)
+    with pytest.raises(InputError, match=r"^out.parquet: directory . is not writable; choose "
+                       "another output path or fix its permissions$"):
+        check_writable("out.parquet")
+
+
+@pytest.mark.parametrize("code, text", [
+    (errno.ENOSPC, "the disk is full (no space left on device); free some space"),
+    (errno.EACCES, "permission denied; choose another path or fix its permissions"),
+    (errno.EPERM, "permission denied; choose another path or fix its permissions"),
+    (errno.EROFS, "read-only file system; write elsewhere"),
+    (errno.EIO, "Input/output error"),
+])
+def test_describe_os_error_names_the_file_and_the_fix(code, text):
+    from hrgtc.files import describe_os_error
+
+    named = OSError(code, os.strerror(code), "/data/out.parquet")
+    assert describe_os_error(named) == f"/data/out.parquet: {text}"
+    anonymous = OSError(code, os.strerror(code))
+    assert describe_os_error(anonymous, "model.json") == f"model.json: {text}"
+    assert describe_os_error(anonymous).startswith("file: ")
+
+
+def test_a_write_error_without_a_file_name_gets_the_outputs(tmp_path):
+    from hrgtc.files import naming_os_errors
+
+    target = tmp_path / "out.parquet"
+    for raised in (OSError(errno.ENOSPC, "No space left on device"),
+                   OSError("Error writing bytes to file. Detail: [errno 28] No space left on "
+                           "device"),
+                   OSError(errno.ENOSPC, "No space left", str(tmp_path / ".out.parquet.1.x.tmp"))):
+        with pytest.raises(OSError) as caught, naming_os_errors(target):
+            raise raised
+        assert (caught.value.errno, caught.value.filename) == (errno.ENOSPC, str(target))
+    other = OSError(errno.EACCES, "Permission denied", "/elsewhere/file")
+    with pytest.raises(OSError) as caught, naming_os_errors(target):
+        raise other
+    assert caught.value is other  # names its own file: left alone
+
+
+def test_pid_alive(monkeypatch):
+    from hrgtc import files
+
+    assert files._pid_alive(os.getpid())
+    assert not files._pid_alive(0) and not files._pid_alive(-5)
+    child = os.fork()
+    if child == 0:
+        os._exit(0)
+    os.waitpid(child, 0)
+    assert not files._pid_alive(child)  # reaped: no such process
+
+    def denied(pid, sig):
+        raise PermissionError(errno.EPERM, "Operation not permitted")
+
+    monkeypatch.setattr(os, "kill", denied)
+    assert files._pid_alive(1)  # another user's process: it may exist
+
+
+def test_a_signal_removes_the_temporary_files_then_runs_the_previous_handler(tmp_path):
+    import signal
+
+    from hrgtc import files
+
+    seen = []
+    previous = signal.signal(signal.SIGTERM, lambda signum, frame: seen.append(signum))
+    try:
+        temporary = tmp_path / ".out.tmp"
+        temporary.write_text("half")
+        with files.removed_on_signal(temporary):
+            assert signal.getsignal(signal.SIGTERM) is files._on_signal
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(0.01)
+        assert seen == [signal.SIGTERM] and not temporary.exists()
+        assert files._ACTIVE == set()
+        assert signal.getsignal(signal.SIGTERM) is not files._on_signal
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def test_file_sha256_reads_in_blocks(tmp_path):
+    import hashlib
+
+    from hrgtc.files import file_sha256
+
+    data = bytes(range(256)) * 40
+    path = tmp_path / "f.bin"
+    path.write_bytes(data)
+    assert file_sha256(path) == hashlib.sha256(data).hexdigest()
+    assert file_sha256(path, block_bytes=7) == hashlib.sha256(data).hexdigest()
+
+
+def test_a_sigterm_with_the_default_handler_removes_the_file_and_ends_the_process(tmp_path):
+    import signal
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    import hrgtc
+
+    temporary = tmp_path / ".out.parquet.tmp"
+    code = (
+        "import os, signal, time\n"
+        "from hrgtc.files import removed_on_signal\n"
+        f"path = {str(temporary)!r}\n"
+        "open(path, 'w').write('half')\n"
+        "with removed_on_signal(path):\n"
+        "    os.kill(os.getpid(), signal.SIGTERM)\n"
+        "    time.sleep(5)\n"
+        "print('survived')\n")
+    env = {**os.environ, "PYTHONPATH": str(Path(hrgtc.__file__).parents[1])}
+    result = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                            text=True, timeout=60)
+    assert result.returncode == -signal.SIGTERM, result.stderr  # died of the signal
+    assert "survived" not in result.stdout and not temporary.exists()
+
+
+def test_write_behind_starts_from_nothing_synced_in_a_named_daemon_thread(tmp_path):
+    path = tmp_path / "one.bin"
+    with open(path, "wb") as stream:
+        behind = WriteBehind(path, poll_s=0.01)
+        assert (behind.synced, behind.syncs) == (0, 0)
+        assert behind._thread.name == "hrgtc-write-behind" and behind._thread.daemon
+        stream.write(b"z")  # one byte: synced goes from 0 to 1
+        stream.flush()
+        assert _wait_for(lambda: behind.syncs == 1 and behind.synced == 1)
+        behind.close()
+
+
+def test_check_writable_asks_for_free_space_only_with_an_estimate(tmp_path, monkeypatch):
+    from collections import namedtuple
+
+    from hrgtc.errors import InputError
+    from hrgtc.files import check_writable
+
+    usage = namedtuple("usage", "total used free")
+    monkeypatch.setattr("shutil.disk_usage", lambda path: usage(0, 0, 0))
+    check_writable(tmp_path / "out.parquet")  # default: no estimate, a full disk passes
+    with pytest.raises(InputError, match=r"0.0 MB free .* needs about 0.0 MB"):
+        check_writable(tmp_path / "out.parquet", expected_bytes=1.0)
+
+
+# -- outputs never inputs, atomic text files (issue 21) --------------------------------------
+def test_refuse_input_names_the_output_and_the_input_it_is(tmp_path, monkeypatch):
+    from hrgtc.errors import InputError
+    from hrgtc.files import refuse_input
+
+    run = tmp_path / "run.csv"
+    run.write_text("time_s\n0\n")
+    link = tmp_path / "link.csv"
+    link.symlink_to(run)
+    fix = ("the output is an input of this command{}; writing it would replace the input, "
+           "so it is refused even with --force: give -o another file name")
+    with pytest.raises(InputError) as caught:
+        refuse_input(run, [None, tmp_path / "model.json", run])
+    assert str(caught.value) == f"{run}: " + fix.format("")
+    with pytest.raises(InputError) as caught:
+        refuse_input([tmp_path / "new.csv", link], [run])
+    assert str(caught.value) == f"{link}: " + fix.format(f" (the same file as {run})")
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(InputError, match=r"^run.csv: the output is an input .* \(the same "):
+        refuse_input("run.csv", [str(run)])
+    refuse_input(tmp_path / "new.csv", [run, None])  # not written yet: not an input
+    refuse_input(run, [None])  # no inputs
+
+
+def test_write_text_atomic_refuses_creates_folders_and_falls_back_without_hard_links(
+        tmp_path, monkeypatch):
+    from hrgtc import files
+    from hrgtc.errors import OutputExistsError
+
+    target = tmp_path / "a" / "b" / "prior.json"
+    files.write_text_atomic(target, "é first\n")  # missing folders are created
+    assert target.read_text(encoding="utf-8") == "é first\n"
+    with pytest.raises(OutputExistsError, match=r"prior.json exists; pass --force"):
+        files.write_text_atomic(target, "second\n")  # no force by default
+
+    def raced(source, destination):  # another writer created the target meanwhile
+        raise FileExistsError(errno.EEXIST, "File exists")
+
+    monkeypatch.setattr(os, "link", raced)
+    fresh = tmp_path / "fresh.txt"
+    with pytest.raises(OutputExistsError, match=rf"^{fresh} appeared while writing; pass --force"):
+        files.write_text_atomic(fresh, "x\n")
+    assert files._ACTIVE == set() and sorted(p.name for p in tmp_path.iterdir()) == ["a"]
+
+    def no_links(source, destination):  # a file system without hard links
+        raise PermissionError(errno.EPERM, "Operation not permitted")
+
+    monkeypatch.setattr(os, "link", no_links)
+    files.write_text_atomic(fresh, "no links\n")
+    assert fresh.read_text() == "no links\n"
+    with pytest.raises(OutputExistsError):
+        files.write_text_atomic(fresh, "again\n")
+    assert fresh.read_text() == "no links\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a", "fresh.txt"]

@@ -38,6 +38,7 @@ from hrgtc.evaluation import Evaluation, evaluate
 from hrgtc.model import UnitModel, provenance
 from hrgtc.progress import StageProgress, for_stage
 from hrgtc.recording import ReadOptions
+from hrgtc.recording.marks import refuse_compensated_training
 from hrgtc.thermometry import fit as fit_thermometer
 from hrgtc.thermometry import identity
 from hrgtc.thermometry.plateaus import Plateau, find_plateaus, plateau_table
@@ -212,6 +213,7 @@ def calibrate(
     options = read_options or ReadOptions()
     if not drifts:
         raise InputError("no drift recordings given; pass --drift FILE (a cool-down or warm-up)")
+    refuse_compensated_training([*soaks, *drifts, *validate])
     if thermometer == "sensor":
         return _calibrate_sensor(soaks, drifts, validate, options, progress, order=order,
                                  terms=terms, window_s=window_s, penter=penter,

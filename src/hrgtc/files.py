@@ -57,6 +57,41 @@ def refuse_existing(paths: PathLike | Iterable[PathLike], force: bool,
                                 "pass --force (force=True) to overwrite")
 
 
+def _same_file(a: Path, b: Path) -> bool:
+    """True if ``a`` and ``b`` are one file (through links and relative paths)."""
+    try:
+        return os.path.samefile(a, b)
+    except OSError:  # one of them does not exist (yet): not the same file
+        return False
+
+
+def refuse_input(outputs: PathLike | Iterable[PathLike],
+                 inputs: Iterable[PathLike | None]) -> None:
+    """Raise :class:`InputError` if an output is one of the inputs, ``--force`` or not.
+
+    Compared by :func:`os.path.samefile`, so a symbolic or hard link, a relative
+    path or another spelling of an input is caught too. Writing the output would
+    replace the input (the raw recording, the model) by the result.
+
+    Parameters
+    ----------
+    outputs
+        One output path or several.
+    inputs
+        The files the command reads (None entries are skipped).
+    """
+    outputs = [outputs] if isinstance(outputs, str | os.PathLike) else list(outputs)
+    sources = [Path(i) for i in inputs if i is not None]
+    for output in outputs:
+        for source in sources:
+            if _same_file(Path(output), source):
+                same = "" if str(output) == str(source) else f" (the same file as {source})"
+                raise InputError(
+                    f"{output}: the output is an input of this command{same}; writing it "
+                    "would replace the input, so it is refused even with --force: give "
+                    "-o another file name")
+
+
 def current_umask() -> int:
     """The process's file-creation mask (read by setting and restoring it)."""
     mask = os.umask(0)
@@ -254,6 +289,28 @@ def check_writable(target: PathLike, expected_bytes: float = 0.0) -> None:
                 f"{expected_bytes / 1e6:.1f} MB; free some space or write elsewhere")
 
 
+@contextmanager
+def naming_os_errors(target: PathLike) -> Iterator[None]:
+    """Give an :class:`OSError` raised without a file name the name of ``target``.
+
+    Writers (pyarrow's, h5py's, a file's ``write``) report a full disk as
+    ``[Errno 28] No space left on device`` without saying which file, or name the
+    hidden temporary file that is removed at once; the message of
+    :func:`describe_os_error` then names the output being written.
+    """
+    try:
+        yield
+    except OSError as exc:
+        code = exc.errno
+        if code is None and "No space left" in str(exc):
+            code = errno.ENOSPC  # pyarrow's IOError carries the errno in its text only
+        name = Path(str(exc.filename)).name if exc.filename is not None else None
+        temporary = name is not None and name.startswith(f".{Path(target).name}.")
+        if code is not None and (name is None or temporary):
+            raise OSError(code, exc.strerror or os.strerror(code), str(target)) from exc
+        raise
+
+
 def describe_os_error(exc: OSError, what: str = "") -> str:
     """One line for an operating-system error while writing or reading ``what``."""
     name = exc.filename or what or "file"
@@ -411,7 +468,7 @@ def write_text_atomic(path: PathLike, text: str, force: bool = False) -> Path:
     target.parent.mkdir(parents=True, exist_ok=True)
     temporary = temporary_beside(target)
     try:
-        with open(temporary, "w", encoding="utf-8") as stream:
+        with naming_os_errors(target), open(temporary, "w", encoding="utf-8") as stream:
             stream.write(text)
             stream.flush()
             os.fsync(stream.fileno())

@@ -36,6 +36,7 @@ from hrgtc.evaluation import Evaluation, evaluate
 from hrgtc.model import InstrumentModel, UnitModel, provenance
 from hrgtc.progress import StageProgress
 from hrgtc.recording import ReadOptions, Recording, axis_names
+from hrgtc.recording.marks import refuse_compensated_training
 
 __all__ = ["InstrumentCalibration", "ScaleFactorCheck", "calibrate_instrument",
            "check_scale_factor"]
@@ -167,6 +168,8 @@ def calibrate_instrument(
     options = dataclasses.replace(read_options or ReadOptions(), thermometer=thermometer)
     if not drifts:
         raise InputError("no drift recordings given; pass --drift FILE (a cool-down or warm-up)")
+    refuse_compensated_training([*soaks, *drifts, *validate, *rate_tables,
+                                 *validate_rate_tables])
     axes = axis_names(options.head(drifts[0]).names) or ("",)
     table = read_segment_table(segment_table) if segment_table is not None else None
     results: dict[str, CalibrationResult] = {}

@@ -302,7 +302,8 @@ def test_missing_required_column(tmp_path):
     recording = make_recording()
     columns = {k: v for k, v in recording.columns.items() if k != "freq_hz"}
     path = write(Recording(columns, recording.metadata), tmp_path / "run.parquet")
-    with pytest.raises(RecordingError, match=r"'freq_hz' missing; .*--col freq_hz="):
+    with pytest.raises(RecordingError, match=r"'freq_hz' missing \(the recording's columns are "
+                       r"\['time_s', 'rate_dph'.*\]\); .*--col freq_hz="):
         read(path)
 
 

@@ -207,7 +207,7 @@ def calibrate_command(
     hrgtc calibrate --thermometer sensor --drift cooldown.csv --drift warmup.csv -o imu.json
     """
     from hrgtc.calibration import HOUSING_TERMS
-    from hrgtc.files import check_writable, refuse_existing
+    from hrgtc.files import check_writable, refuse_existing, refuse_input
     from hrgtc.instrument import calibrate_instrument
     from hrgtc.model import save_instrument
     from hrgtc.recording import ReadOptions
@@ -216,6 +216,8 @@ def calibrate_command(
 
     soaks = [*(soak or []), *(extra_soaks or [])]
     with library_errors():
+        refuse_input(output, [*soaks, *(drift or []), *(validate or []), *(rate_table or []),
+                              *(validate_rate_table or []), prior, segments, temp_ref])
         refuse_existing(output, force)
         check_writable(output, 1e6)  # before the fit, not after it
         stages: dict[str, object] = {}

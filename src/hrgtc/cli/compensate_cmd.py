@@ -95,6 +95,7 @@ def compensate_command(
     """
     from hrgtc.compensate import compensate_instrument_file
     from hrgtc.compensate.instrument import parse_axes
+    from hrgtc.files import refuse_input
     from hrgtc.model import load_instrument
     from hrgtc.recording import ReadOptions
     from hrgtc.thermometry.reference import options_with_map
@@ -105,6 +106,7 @@ def compensate_command(
                             "--spike-filter flag (a 'spike' column marks them) or off")
         raise typer.Exit(2)
     with library_errors(), progress_bar("compensating", enabled=not json_output) as progress:
+        refuse_input(output, [run, model_path])
         model = load_instrument(model_path)
         inputs = options_with_map(inputs, model.temperature_map)
         summary = compensate_instrument_file(run, output, model, force=force,
@@ -214,7 +216,7 @@ def evaluate_command(
     from hrgtc.compensate.instrument import match_axes, parse_axes, recording_axes
     from hrgtc.evaluation import evaluate
     from hrgtc.evaluation.run_pass import DEVIATIONS
-    from hrgtc.files import refuse_existing, write_text_atomic
+    from hrgtc.files import refuse_existing, refuse_input, write_text_atomic
     from hrgtc.model import load_instrument
     from hrgtc.recording import ReadOptions
     from hrgtc.thermometry.reference import options_with_map
@@ -227,6 +229,7 @@ def evaluate_command(
         raise typer.Exit(2)
     with library_errors():
         if allan_csv is not None:
+            refuse_input(allan_csv, [run, model_path])
             refuse_existing(allan_csv, force)
     results: dict[str, Evaluation] = {}
     with library_errors():

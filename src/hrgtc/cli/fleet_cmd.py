@@ -43,11 +43,19 @@ WorkersOption = Annotated[
 SETPOINTS_DEFAULT = "-20,-10,0,10,20,30,40"
 
 
+def _models_folder_inputs(models: Path) -> list[Path]:
+    """The files of a models folder that fleet commands read (never an output, see -o)."""
+    if not models.is_dir():
+        return []
+    return [p for p in models.iterdir() if p.suffix in (".json", ".parquet")]
+
+
 def _finish(run: FleetRun, json_output: bool, written: str) -> None:
     """Print the outcome per unit (or JSON) and exit 1 when some units failed."""
     if json_output:
         print_json({"summary": run.summary(), "counts": run.counts(), "seconds": run.seconds,
                     "where": run.where, "written": written,
+                    "workers_died": run.workers_died, "retried": list(run.retried),
                     "units": [{"unit": o.unit, "status": o.status, "error": o.error,
                                "seconds": o.seconds} for o in run.outcomes]})
     else:
@@ -167,9 +175,12 @@ def evaluate_command(
 
     Example: hrgtc fleet evaluate fleet/ --models models/
     """
+    from hrgtc.files import refuse_input
     from hrgtc.fleet import evaluate_fleet
 
     with library_errors():
+        if output is not None:
+            refuse_input(output, _models_folder_inputs(models))
         with progress_bar("units", enabled=not json_output) as progress:
             run = evaluate_fleet(root, models, output, read_options=inputs, allan=allan,
                                  force=force, scheduler=scheduler, workers=workers,
@@ -198,9 +209,11 @@ def report_command(
 
     Example: hrgtc fleet report models/ -o fleet.html
     """
+    from hrgtc.files import refuse_input
     from hrgtc.fleet import report_fleet
 
     with library_errors():
+        refuse_input(output, _models_folder_inputs(models))
         with progress_bar("units", enabled=not json_output and unit_reports is not None) as bar:
             path, run = report_fleet(models, output, source=root, unit_reports=unit_reports,
                                      read_options=inputs, force=force, scheduler=scheduler,
@@ -228,9 +241,11 @@ def prior_command(
     Example: hrgtc fleet prior models/ -o prior.json, then
     hrgtc calibrate --prior prior.json --soak s-20.parquet --soak s40.parquet --drift ...
     """
+    from hrgtc.files import refuse_input
     from hrgtc.fleet import build_prior
 
     with library_errors():
+        refuse_input(output, _models_folder_inputs(models))
         prior = build_prior(models, output, force=force, exclude=exclude or ())
     if json_output:
         print_json(prior.to_dict())

@@ -42,12 +42,13 @@ def report_command(
     from hrgtc.cli.compensate_cmd import note_unchecked
     from hrgtc.compensate.compensator import check_thermometer_kind
     from hrgtc.compensate.instrument import match_axes, parse_axes, recording_axes
-    from hrgtc.files import check_writable, refuse_existing
+    from hrgtc.files import check_writable, refuse_existing, refuse_input
     from hrgtc.model import load_instrument
     from hrgtc.recording import ReadOptions
     from hrgtc.report import build_report
 
     with library_errors(), progress_bar("report", enabled=not json_output) as progress:
+        refuse_input(output, [*runs, model, *(soak or [])])
         from hrgtc.model import load_instrument
         from hrgtc.thermometry.reference import options_with_map
 

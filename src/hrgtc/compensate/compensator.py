@@ -41,7 +41,7 @@ from hrgtc.drift.offsets import label_offsets, sample_offsets
 from hrgtc.drift.rate_checks import filtered_levels, rate_filter_problems, warn_rate_filter
 from hrgtc.drift.rate_filter import check_time, restart_mask
 from hrgtc.errors import CalibrationError, ExtrapolationWarning, HrgtcWarning, InputError
-from hrgtc.files import check_writable
+from hrgtc.files import check_writable, refuse_input
 from hrgtc.model import UnitModel
 from hrgtc.progress import Progress
 from hrgtc.recording import Recording
@@ -441,6 +441,7 @@ def compensate_file(
     else:
         options = read_options or rec_io.ReadOptions()
         added = compensator.columns
+    refuse_input(output, [source])
     refuse_compensated(source)
     check_writable(output, estimated_output_bytes(source, output, len(added)))
     chunks = options.chunks(source, rows=chunk_rows)

@@ -55,7 +55,7 @@ from hrgtc.compensate.c_plan import PRECISIONS, plan_for
 from hrgtc.compensate.c_text import _comment, header, source
 from hrgtc.compensate.parameter_file import instrument_parameter_text, parameter_text
 from hrgtc.errors import InputError
-from hrgtc.files import file_sha256, refuse_existing, write_text_atomic
+from hrgtc.files import file_sha256, refuse_existing, refuse_input, write_text_atomic
 from hrgtc.model import InstrumentModel, UnitModel, load_instrument
 
 #: What the export writes: C99 files, or the plain parameter file.
@@ -147,6 +147,7 @@ def export_c(
                              "longer than 32 characters; use a shorter --prefix")
     if output_format == "params":
         target = folder / f"{prefix}_params.txt"
+        refuse_input(target, [model] if isinstance(model, str | os.PathLike) else [])
         refuse_existing((target,), force)
         plans = {name: plan_for(unit) for name, unit in axes.items()}
         text = (parameter_text(axes[""], plans[""], origin, sha256) if single_axis else
@@ -161,6 +162,7 @@ def export_c(
         for name in axes:
             files[folder / f"{prefix}_{name}_model.h"] = ""
             files[folder / f"{prefix}_{name}_model.c"] = ""
+    refuse_input(tuple(files), [model] if isinstance(model, str | os.PathLike) else [])
     refuse_existing(tuple(files), force)
     if single_axis:
         texts = _c_texts(axes[""], prefix, origin, sha256, precision)

@@ -159,15 +159,19 @@ def recording_axes(path: str | os.PathLike[str],
     for a single-axis file. Reads the file's column names only; None when the file cannot
     be opened (reading it will say why)."""
     from hrgtc.errors import HrgtcError
-    from hrgtc.recording.mapping import parse_columns
+    from hrgtc.recording.mapping import check_axis_sets, parse_columns
 
     try:
-        with rec_io.open_source(path) as source:
-            names = list(source.names)
         mapping = parse_columns((options or rec_io.ReadOptions()).columns)
+        with rec_io.open_source(path) as source:
+            names = [*mapping, *(n for n in source.names if n not in mapping.values())]
+            axes = tuple(axis_names(names))
+            # an incomplete axis (freq_hz_z without rate_dph_z) is the reading's error to
+            # name, not an axis mismatch with the model (issue 21)
+            check_axis_sets(source, names, axes, mapping)
     except (HrgtcError, OSError, ValueError):
         return None
-    return tuple(axis_names([*mapping, *(n for n in names if n not in mapping.values())]))
+    return axes
 
 
 def parse_axes(text: str | Sequence[str] | None) -> tuple[str, ...] | None:

@@ -14,7 +14,9 @@ Where the tasks run:
 
 Only paths, settings and the small outcomes cross between the client and the
 workers; the workers read the data. Tasks never raise (:mod:`hrgtc.fleet.tasks`);
-a worker that dies (out of memory, killed) fails its unit, not the run.
+a worker that dies (out of memory, killed) fails its unit, not the run: Dask
+runs its unit again elsewhere (up to 3 deaths), and :class:`FleetRun` says how many
+workers died and which units were run again.
 Dask is imported only here and only when a cluster is used.
 """
 
@@ -31,7 +33,7 @@ from hrgtc._process import peak_rss_mb
 from hrgtc.fleet.tasks import UnitOutcome, error_record
 from hrgtc.progress import Progress
 
-__all__ = ["FleetRun", "Task", "run_tasks", "scheduler_address"]
+__all__ = ["FleetRun", "Task", "run_tasks", "scheduler_address", "worker_deaths"]
 
 #: ``(unit, function, args)``: one unit's task.
 Task = tuple[str, Callable[..., UnitOutcome], tuple[Any, ...]]
@@ -51,12 +53,20 @@ class FleetRun:
         ``"sequential"``, ``"local cluster of N workers"`` or the scheduler address.
     worker_peak_rss_mb
         Peak resident set size of each worker process (local cluster only). [MB]
+    workers_died
+        Worker processes that died during the run (out of memory, killed); Dask
+        runs the units they held again on another worker.
+    retried
+        The units whose task was running on a worker that died, so ran again (their
+        outcome is that of the last attempt; after 3 deaths the unit fails).
     """
 
     outcomes: tuple[UnitOutcome, ...]
     seconds: float
     where: str
     worker_peak_rss_mb: dict[str, float] = field(default_factory=dict)
+    workers_died: int = 0
+    retried: tuple[str, ...] = ()
 
     @property
     def failed(self) -> list[UnitOutcome]:
@@ -73,8 +83,13 @@ class FleetRun:
     def summary(self) -> str:
         """One line."""
         c = self.counts()
-        return (f"{len(self.outcomes)} units in {self.seconds:.1f} s ({self.where}): "
+        line = (f"{len(self.outcomes)} units in {self.seconds:.1f} s ({self.where}): "
                 f"{c['ok']} done, {c['skipped']} skipped (unchanged), {c['failed']} failed")
+        if self.workers_died:
+            units = ", ".join(self.retried) if self.retried else "none"
+            line += (f"; {self.workers_died} worker process(es) died during the run and "
+                     f"{len(self.retried)} unit(s) were run again: {units}")
+        return line
 
 
 def scheduler_address(scheduler: str | None = None) -> str | None:
@@ -100,16 +115,50 @@ def _sequential(tasks: Sequence[Task], progress: Progress | None) -> list[UnitOu
     return outcomes
 
 
+def worker_deaths(events: Sequence[tuple[float, Any]], keys: dict[str, str],
+                  since: float) -> tuple[int, tuple[str, ...]]:
+    """Workers that died since ``since`` and the units they were running, from scheduler events.
+
+    Parameters
+    ----------
+    events
+        The scheduler's ``"all"`` events, ``(time, message)`` (``Client.get_events``).
+    keys
+        Task key -> unit of this run.
+    since
+        Start of the run (``time.time()``). [s]
+
+    Returns
+    -------
+    (int, tuple of str)
+        Unexpected worker removals (a death, not a shutdown) and the units whose
+        task was processing on the worker, in name order.
+    """
+    died, units = 0, set()
+    for stamp, message in events:
+        if not isinstance(message, dict) or message.get("action") != "remove-worker":
+            continue
+        if stamp < since or message.get("expected"):
+            continue
+        mine = {keys[k] for k in message.get("processing-tasks", ()) if k in keys}
+        if mine or not keys:
+            died += 1
+        units |= mine
+    return died, tuple(sorted(units))
+
+
 def _on_cluster(client: Any, tasks: Sequence[Task], progress: Progress | None,
-                label: str) -> list[UnitOutcome]:
+                label: str) -> tuple[list[UnitOutcome], int, tuple[str, ...]]:
     from distributed import as_completed
 
     run_id = uuid.uuid4().hex[:8]
+    since = time.time()
     futures = {
         client.submit(function, *args, key=f"hrgtc-{label}-{unit}-{run_id}", pure=False,
                       retries=0): unit
         for unit, function, args in tasks
     }
+    keys = {future.key: unit for future, unit in futures.items()}
     outcomes = []
     for done, future in enumerate(as_completed(futures), start=1):
         unit = futures[future]
@@ -122,7 +171,12 @@ def _on_cluster(client: Any, tasks: Sequence[Task], progress: Progress | None,
         future.release()
         if progress is not None:
             progress(done, len(tasks))
-    return outcomes
+    try:
+        events = client.get_events("all")
+    except Exception:  # an old scheduler without events: nothing to say
+        events = ()
+    died, retried = worker_deaths(events, keys, since)
+    return outcomes, died, retried
 
 
 def run_tasks(tasks: Sequence[Task], *, scheduler: str | None = None, workers: int | None = None,
@@ -151,6 +205,7 @@ def run_tasks(tasks: Sequence[Task], *, scheduler: str | None = None, workers: i
         raise InputError(f"workers must be >= 0, got {workers}")
     address = None if workers == 0 and not scheduler else scheduler_address(scheduler)
     peaks: dict[str, float] = {}
+    died, retried = 0, ()
     if address is None and workers == 0:
         outcomes, where = _sequential(tasks, progress), "sequential"
     elif not tasks:
@@ -165,7 +220,8 @@ def run_tasks(tasks: Sequence[Task], *, scheduler: str | None = None, workers: i
                              "(dask scheduler) or drop --scheduler / DASK_SCHEDULER_ADDRESS")\
                 from exc
         with client:
-            outcomes, where = _on_cluster(client, tasks, progress, label), address
+            outcomes, died, retried = _on_cluster(client, tasks, progress, label)
+            where = address
     else:
         import logging
 
@@ -178,8 +234,8 @@ def run_tasks(tasks: Sequence[Task], *, scheduler: str | None = None, workers: i
                          host="127.0.0.1") as cluster,
             Client(cluster) as client,
         ):
-            outcomes = _on_cluster(client, tasks, progress, label)
+            outcomes, died, retried = _on_cluster(client, tasks, progress, label)
             peaks = {str(k): float(v) for k, v in client.run(peak_rss_mb).items()}
         where = f"local cluster of {n} worker{'s' if n > 1 else ''}"
     return FleetRun(tuple(sorted(outcomes, key=lambda o: o.unit)),
-                    time.perf_counter() - start, where, peaks)
+                    time.perf_counter() - start, where, peaks, died, retried)

@@ -59,6 +59,7 @@ class Problem:
     kind
         One of ``"empty"``, ``"missing_column"``, ``"not_finite"``, ``"time_order"``,
         ``"gap"``, ``"sample_rate"``, ``"freq_unit"``, ``"rate_unit"``, ``"time_unit"``,
+        ``"swapped_columns"``,
         ``"implausible"``.
     message
         Full sentence naming column, row, value and the fix.
@@ -272,6 +273,31 @@ def _check_freq_unit(freq: np.ndarray, name: str = "freq_hz") -> Problem | None:
     else:
         return None
     return Problem("freq_unit", message, column=name, value=f"{median:.6g}")
+
+
+def _check_swapped(freq: np.ndarray, rate: np.ndarray, freq_name: str = "freq_hz",
+                   rate_name: str = "rate_dph") -> Problem | None:
+    """A frequency column whose values are a rate's and a rate column that holds a frequency.
+
+    The rate column looks like a resonator frequency when its median lies in
+    :data:`FREQ_SAMPLE_RANGE_HZ` and it hardly moves (median absolute deviation
+    below 1 % of the median: a resonator moves ≈ 0.01 %/°C).
+    """
+    freq, rate = freq[np.isfinite(freq)], rate[np.isfinite(rate)]
+    if freq.size == 0 or rate.size == 0:
+        return None
+    median_rate = float(np.median(rate))
+    spread = float(np.median(np.abs(rate - median_rate)))
+    in_band = FREQ_SAMPLE_RANGE_HZ[0] <= median_rate <= FREQ_SAMPLE_RANGE_HZ[1]
+    median_freq = float(np.median(freq))
+    if not in_band or spread > 0.01 * median_rate or FREQ_SAMPLE_RANGE_HZ[0] <= median_freq:
+        return None
+    return Problem(
+        "swapped_columns",
+        f"columns '{freq_name}' (median {median_freq:.6g}) and '{rate_name}' (median "
+        f"{median_rate:.6g}, steady like a resonator frequency) look swapped; fix the header "
+        f"or map them: --col {freq_name}={rate_name} --col {rate_name}={freq_name}",
+        column=freq_name, value=f"{median_freq:.6g}")
 
 
 def _check_rate_unit(rate: np.ndarray, input_rate_dph: float,

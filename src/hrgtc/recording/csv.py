@@ -23,6 +23,9 @@ Strings are written bare when that reads back unchanged, else as JSON. Foreign
 files: comment lines of other forms are ignored, ``key: value`` lines of other
 keys go to ``extra``, the delimiter (``,``, ``;`` or tab) is sniffed from the
 header, and a file without a header gets columns ``column_1``, ``column_2``, ...
+Delimiters at the end of the lines (empty trailing columns) are left out. Refused,
+each with its own message: lines ending in CR alone, values separated by spaces,
+a column without a name, two columns of the same name (issue 21).
 A sidecar ``<file>.json`` (e.g. ``run.csv.json``) adds to or overrides the header.
 """
 
@@ -58,19 +61,28 @@ class CsvSource(Source):
 
     def __init__(self, path: Path) -> None:
         super().__init__(path)
+        _refuse_cr_only(path)
         self._offset, header, comments = _csv_head(path)
         self.metadata = _parse_comment_metadata(comments)
+        if not header:
+            raise RecordingError(f"{path}: no header line (only comments or nothing); the "
+                                 "first line that is not a '#' comment must name the columns")
         self.delimiter = _sniff_delimiter(header)
+        _refuse_space_separated(path, header)
         fields = [f.strip().strip('"').strip() for f in header.split(self.delimiter)]
+        # delimiters at the end of every line (a logger's line end, a spreadsheet's padding
+        # of empty columns) are not columns without a name: read under placeholders, left out
+        trailing = 0
+        while len(fields) - trailing > 1 and fields[-1 - trailing] == "":
+            trailing += 1
+        fields = fields[:len(fields) - trailing]
         self._header_rows = 1
-        if header and all(_is_number(f) for f in fields):
+        if all(_is_number(f) for f in fields):
             fields = [f"column_{i + 1}" for i in range(len(fields))]
             self._header_rows = 0
-        duplicated = sorted({f for f in fields if fields.count(f) > 1})
-        if not header or duplicated:
-            what = f"duplicate column names {duplicated}" if header else "no header line"
-            raise RecordingError(f"{path}: {what}; give every column a unique name")
+        _refuse_bad_names(path, fields, self.delimiter)
         self.names = fields
+        self._file_names = [*fields, *(f"{TRAILING_COLUMN} {i}" for i in range(trailing))]
         sidecar = Path(f"{path}.json")
         if sidecar.exists():
             try:
@@ -93,7 +105,7 @@ class CsvSource(Source):
         types = {n: pa.string() if n in as_text else pa.float64() for n in names}
         return {
             "read_options": pa_csv.ReadOptions(
-                column_names=self.names, skip_rows=self._header_rows, block_size=block
+                column_names=self._file_names, skip_rows=self._header_rows, block_size=block
             ),
             "parse_options": pa_csv.ParseOptions(delimiter=self.delimiter),
             "convert_options": pa_csv.ConvertOptions(
@@ -110,7 +122,8 @@ class CsvSource(Source):
     def kinds(self) -> dict[str, str]:
         options = {
             "read_options": pa_csv.ReadOptions(
-                column_names=self.names, skip_rows=self._header_rows, block_size=1 << 16
+                column_names=self._file_names, skip_rows=self._header_rows,
+                block_size=1 << 16
             ),
             "parse_options": pa_csv.ParseOptions(delimiter=self.delimiter),
         }
@@ -118,7 +131,8 @@ class CsvSource(Source):
             reader = pa_csv.open_csv(self._open(), **options)
         except pa.ArrowInvalid as exc:
             raise self._translate(exc, set()) from None
-        return {f.name: kind_of(f.type) for f in reader.schema}
+        return {f.name: kind_of(f.type) for f in reader.schema
+                if not f.name.startswith(TRAILING_COLUMN)}
 
     def read(self, names: Sequence[str], as_text: set[str]) -> pa.Table:
         try:
@@ -172,7 +186,7 @@ class CsvSource(Source):
             return self._invalid_utf8()
         conversion = re.search(r"CSV column #(\d+): CSV conversion error to \w+", text)
         if conversion:
-            name = self.names[int(conversion.group(1))]
+            name = self._file_names[int(conversion.group(1))]
             try:
                 row, value = self._locate_bad_value(name)
             except pa.ArrowInvalid:  # the bad value is not even text
@@ -204,7 +218,7 @@ class CsvSource(Source):
         return "?", "?"
 
     def _locate_bad_line(self) -> tuple[int | str, int | str, int | str]:
-        expected = len(self.names)
+        expected = len(self._file_names)
         line_no = 0
         row = -self._header_rows
         with open(self.path, "rb") as handle:
@@ -219,6 +233,51 @@ class CsvSource(Source):
                     return line_no, row, got
                 row += 1
         return "?", "?", "?"
+
+
+#: Name (then a number) under which the empty fields after trailing delimiters are read.
+TRAILING_COLUMN = "\x00trailing delimiter"
+
+
+def _refuse_cr_only(path: Path) -> None:
+    """Refuse a file whose lines end in a carriage return alone (classic Mac OS)."""
+    with open(path, "rb") as handle:
+        head = handle.read(1 << 16)
+    if b"\r" in head and b"\n" not in head:
+        raise RecordingError(
+            f"{path}: the lines end in a carriage return alone (CR, classic Mac OS line "
+            "ends), which this reader does not split; convert them to LF, e.g. "
+            f"tr '\\r' '\\n' < {path.name} > fixed.csv")
+
+
+def _refuse_space_separated(path: Path, header: str) -> None:
+    """Refuse a header separated by spaces: hrgtc reads ',', ';' or tab separated files."""
+    if any(d in header for d in (",", ";", "\t")):
+        return
+    words = header.split()
+    if len(words) > 1:
+        raise RecordingError(
+            f"{path}: the header line {header[:60]!r} is separated by spaces; hrgtc reads "
+            "values separated by ',', ';' or a tab: convert the file, e.g. "
+            f"tr -s ' ' ',' < {path.name} > fixed.csv")
+
+
+def _refuse_bad_names(path: Path, fields: Sequence[str], delimiter: str) -> None:
+    """Refuse a header with a column without a name or two columns of the same name."""
+    for i, name in enumerate(fields):
+        if not name:
+            before = f" after {fields[i - 1]!r}" if i else ""
+            raise RecordingError(
+                f"{path}: column {i + 1}{before} has no name in the header line (two "
+                f"delimiters {delimiter!r} in a row?); give every column a name")
+    seen: dict[str, int] = {}
+    for i, name in enumerate(fields):
+        if name in seen:
+            raise RecordingError(
+                f"{path}: columns {seen[name] + 1} and {i + 1} of the header are both named "
+                f"{name!r}; hrgtc cannot tell which one is meant: rename one of them (or "
+                "delete the copy)")
+        seen[name] = i
 
 
 #: Lines before the last one compared with it by :func:`_refuse_cut_tail`.

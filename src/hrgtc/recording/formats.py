@@ -14,7 +14,9 @@ Layouts written by hrgtc:
 * HDF5: a group ``/recording`` with one 1-D float64 dataset per column (its unit
   in the attribute ``unit``) and the metadata as attributes of the group
   (``extra`` as a JSON string). Foreign files: the group ``recording`` if
-  present, else the root if it holds 1-D datasets, else the only group.
+  present, else the root if it holds 1-D datasets, else the only group. A dataset
+  named like a recording column that is not 1-D (an (N, 3) matrix, a scalar) and a
+  compound table are refused, never skipped (issue 21).
 """
 
 from __future__ import annotations
@@ -31,7 +33,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from hrgtc.errors import RecordingError
-from hrgtc.recording.axes import axis_names, base_name
+from hrgtc.recording.axes import axis_names, base_name, split_axis
 from hrgtc.recording.schema import COLUMNS, Metadata
 
 SUFFIXES: dict[str, str] = {
@@ -165,6 +167,13 @@ class ParquetSource(Source):
             raise RecordingError(f"{path}: not a readable Parquet file ({exc})") from None
         schema = self._file.schema_arrow
         self.names = list(schema.names)
+        for i, name in enumerate(self.names):
+            if name in self.names[:i]:
+                self._file.close()
+                raise RecordingError(
+                    f"{path}: columns {self.names.index(name) + 1} and {i + 1} are both named "
+                    f"{name!r}; hrgtc cannot tell which one is meant: write the file with "
+                    "unique column names")
         self.total_rows = self._file.metadata.num_rows
         raw = (schema.metadata or {}).get(METADATA_KEY)
         if raw is not None:
@@ -225,8 +234,13 @@ class Hdf5Source(Source):
         self._datasets = {
             name: obj
             for name, obj in group.items()
-            if isinstance(obj, h5py.Dataset) and obj.ndim == 1
+            if isinstance(obj, h5py.Dataset) and obj.ndim == 1 and obj.dtype.names is None
         }
+        self.skipped = {  # datasets that are not a column: named if asked for
+            name: obj for name, obj in group.items()
+            if isinstance(obj, h5py.Dataset) and name not in self._datasets
+        }
+        self._refuse_shapes()
         self.names = list(self._datasets)
         lengths = {name: ds.shape[0] for name, ds in self._datasets.items()}
         if len(set(lengths.values())) > 1:
@@ -240,6 +254,24 @@ class Hdf5Source(Source):
             except ValueError:
                 pass
         self._done = 0
+
+    def _refuse_shapes(self) -> None:
+        """Refuse a recording column stored as a table, a matrix or a scalar."""
+        for name, ds in self.skipped.items():
+            if ds.dtype.names is not None:
+                fields = ", ".join(ds.dtype.names[:8])
+                why = (f"dataset {name!r} is a compound table (fields {fields}); hrgtc reads "
+                       "one 1-D dataset per column: store each field as its own dataset "
+                       f"(e.g. group['time_s'] = table['time_s']) in a group {HDF5_GROUP!r}")
+            elif is_column_name(name):
+                shape = "a scalar (shape ())" if ds.ndim == 0 else f"of shape {ds.shape}"
+                why = (f"dataset {name!r} is {shape}, not a 1-D column of one value per row; "
+                       "store one 1-D dataset per column (a 3-axis rate as rate_dph_x, "
+                       "rate_dph_y, rate_dph_z)")
+            else:
+                continue
+            self._file.close()
+            raise RecordingError(f"{self.path}: {why}")
 
     def _pick_group(self, h5py: Any) -> Any:
         root = self._file
@@ -288,6 +320,12 @@ class Hdf5Source(Source):
 
     def close(self) -> None:
         self._file.close()
+
+
+def is_column_name(name: str) -> bool:
+    """True for a recording contract column, per-axis ones (``rate_dph_x``) included."""
+    base, axis = split_axis(name)
+    return name in COLUMNS or (axis is not None and base in COLUMNS)
 
 
 def _attr_value(value: Any) -> Any:

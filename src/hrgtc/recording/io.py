@@ -596,9 +596,10 @@ class ReadOptions:
                     if bad.size:
                         raise RecordingError(
                             f"{path}: column freq_hz_{axis}, row {row + int(bad[0])}: "
-                            f"{freq[bad[0]]!r} is outside the band {band[0]:.6g}-{band[1]:.6g} "
-                            f"this axis of the model can reach ({bad.size} such rows in the "
-                            "chunk); is it another unit's file, or the wrong column?")
+                            f"{float(freq[bad[0]])!r} is outside the band "
+                            f"{band[0]:.6g}-{band[1]:.6g} this axis of the model can reach "
+                            f"({bad.size} such rows in the chunk); is it another unit's file, "
+                            "or the wrong column?")
                 row += len(chunk)
                 yield view
         finally:

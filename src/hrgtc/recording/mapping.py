@@ -3,7 +3,9 @@
 * ``columns`` maps contract names to the file's names, e.g.
   ``{"time_s": "t", "freq_hz": "f_res", "rate_dph": "omega"}``, per-axis names
   included (``{"rate_dph_x": "gyro_x"}``, see :mod:`hrgtc.recording.axes`); other
-  columns keep their names (numeric ones are kept, text columns dropped);
+  columns keep their names (numeric ones are kept, text columns dropped). Axis sets
+  are explicit: a per-axis column of an axis without ``rate_dph_<axis>`` is an error
+  (:func:`check_axis_sets`), one shared ``temperature_c`` is legal;
 * ``units`` gives the units of ``time`` (``s``, ``ms``, ``us``, ``ns`` or
   ``timestamp``), ``freq`` (``Hz`` or ``kHz``), ``rate`` (``dph`` = °/h, ``dps`` =
   °/s, ``mdps`` = m°/s, ``radps`` = rad/s, ``mradps`` = mrad/s, ``drad``/``ddeg`` =
@@ -204,6 +206,12 @@ def plan_columns(source: Source, columns: Any, units: Mapping[str, str] | None,
                              f"{value!r}; --temp-scale K --temp-offset C give "
                              "temperature_c = raw * K + C")
     for name, theirs in mapping.items():
+        skipped = getattr(source, "skipped", {})
+        if theirs not in source.names and theirs in skipped:
+            raise RecordingError(
+                f"{source.path}: dataset {theirs!r} (given for {name}) has shape "
+                f"{skipped[theirs].shape}, not one value per row; store it as a 1-D dataset "
+                "(each component of a matrix as its own column)")
         if theirs not in source.names:
             hint = difflib.get_close_matches(theirs, source.names, n=1)
             did = f" (did you mean {hint[0]!r}?)" if hint else ""
@@ -213,7 +221,9 @@ def plan_columns(source: Source, columns: Any, units: Mapping[str, str] | None,
             )
     kinds = source.kinds()
     pairs = [(theirs, name) for name, theirs in mapping.items()]
-    axes = axis_names([*mapping, *(n for n in source.names if n not in mapping.values())])
+    recording_names = [*mapping, *(n for n in source.names if n not in mapping.values())]
+    axes = axis_names(recording_names)
+    check_axis_sets(source, recording_names, axes, mapping)
     pairs += [(n, n) for n in source.names if is_contract_name(n, axes) and n not in mapping]
     order = {name: i for i, name in enumerate(COLUMNS)}
     pairs.sort(key=lambda pair: order.get(base_name(pair[1], axes), len(order)))
@@ -244,6 +254,33 @@ def plan_columns(source: Source, columns: Any, units: Mapping[str, str] | None,
                       temp_unwrap=temp_unwrap,
                       wrap_bits=int(temp_unwrap) if temp_unwrap in ("16", "32") else None,
                       wrap_decided=temp_unwrap != "auto")
+
+
+def check_axis_sets(source: Source, names: list[str], axes: tuple[str, ...],
+                    mapping: Mapping[str, str]) -> None:
+    """Refuse per-axis columns of an axis that has no ``rate_dph_<axis>`` column.
+
+    The axes of a file are those of its ``rate_dph_<axis>`` columns; a
+    ``freq_hz_z`` or ``temperature_c_z`` without ``rate_dph_z`` would otherwise be
+    carried along as an unknown column and the axis z dropped without a word. A
+    single-axis file may have columns that look per-axis (``temperature_c_ambient``)
+    except ``freq_hz_<axis>`` and ``rate_dph``-like ones beside no ``freq_hz``.
+    """
+    for name in names:
+        base, axis = split_axis(name)
+        if axis is None or axis in axes:
+            continue
+        if not axes and (base not in ("freq_hz", "input_rate_dph") or "freq_hz" in names):
+            continue  # a single-axis file's own column, e.g. temperature_c_ambient
+        theirs = mapping.get(name, name)
+        called = repr(theirs) if theirs == name else f"{theirs!r} ({name})"
+        known = f"the file's axes are {list(axes)}" if axes else "the file has no rate_dph_<axis>"
+        raise RecordingError(
+            f"{source.path}: column {called} belongs to axis {axis!r}, which has "
+            f"no 'rate_dph_{axis}' column ({known}): the axis would be dropped; add its "
+            f"rate column (or map yours with --col rate_dph_{axis}=<your column>), or "
+            f"remove {theirs!r} if the axis is not wanted"
+        )
 
 
 def _check_sensor_columns(source: Source, names: list[str]) -> None:

@@ -15,7 +15,7 @@ stripped of both cannot be told from a raw run.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -68,3 +68,25 @@ def refuse_compensated(path: str | Path) -> None:
         raise RecordingError(
             f"{path} is already compensated, by {describe_mark(found)}; compensating or "
             "evaluating it again would subtract the drift twice: use the original recording")
+
+
+def refuse_compensated_training(paths: Iterable[str | Path | None]) -> None:
+    """Raise RecordingError if a file given to train a model is a compensated output.
+
+    A model trained on a compensated run fits what the first model left (its rate
+    column may even be ``rate_comp_dph`` under another name), not the gyro's drift;
+    the thermometer of its soaks would be the same as the raw run's, so nothing
+    later would show it.
+    """
+    from hrgtc.recording.io import open_source
+
+    for path in paths:
+        if path is None or not Path(path).is_file():
+            continue  # a missing file is named by the reading that follows
+        with open_source(path) as source:
+            found = compensation_mark(source.metadata, list(source.names))
+        if found is not None:
+            raise RecordingError(
+                f"{path} is already compensated, by {describe_mark(found)}; a model trained "
+                "on it would fit what that compensation left, not the gyro's drift: "
+                "calibrate on the original (raw) recording")

@@ -87,6 +87,7 @@ from hrgtc.recording.checks import (
     _check_freq_unit,
     _check_rate_unit,
     _check_sample_rate,
+    _check_swapped,
     _check_time_unit,
     check_thermometer,
     finite_extremes,
@@ -171,6 +172,7 @@ class RecordingValidator:
         self._sample_rows = 0
         self._heuristics: list[Problem] | None = None
         self.measured_sample_rate_hz: float | None = None
+        self._names: tuple[str, ...] = ()
 
     # -- feeding -------------------------------------------------------------
     def update(self, chunk: Recording) -> None:
@@ -183,6 +185,7 @@ class RecordingValidator:
             required = ("time_s", *(f"{name}{suffix}" for suffix in self._suffixes
                                     for name in ("freq_hz", "rate_dph")))
             self._missing = tuple(c for c in required if c not in chunk)
+            self._names = tuple(chunk.names)
             sampled = (*required, *(f"input_rate_dph{suffix}" for suffix in self._suffixes))
             self._sample = {name: [] for name in sampled if name in chunk}
         offset, n = self.rows, len(chunk)
@@ -370,10 +373,13 @@ class RecordingValidator:
             problems.append(Problem("empty", "the recording has no rows"))
         if self._missing:
             columns = "', '".join(self._missing)
+            headless = bool(self._names) and all(n.startswith("column_") for n in self._names)
+            found = (f"the file has no header line, so its columns are {list(self._names)}"
+                     if headless else f"the recording's columns are {list(self._names)}")
             problems.append(
                 Problem(
                     "missing_column",
-                    f"required column(s) '{columns}' missing; map your names with "
+                    f"required column(s) '{columns}' missing ({found}); map your names with "
                     f"--col {self._missing[0]}=<your column name> "
                     f"(columns={{'{self._missing[0]}': ...}})",
                     column=self._missing[0],
@@ -391,7 +397,8 @@ class RecordingValidator:
                     count=count,
                 )
             )
-        unit_problem = any(p.kind == "freq_unit" for p in self._heuristics or [])
+        unit_problem = any(p.kind in ("freq_unit", "swapped_columns")
+                           for p in self._heuristics or [])
         for name, (row, value, count) in self._out_of_bounds.items():
             is_freq = base_name(name, self.axes) == "freq_hz"
             if is_freq and (self._heuristics is None or unit_problem):
@@ -539,6 +546,11 @@ class RecordingValidator:
             freq = sample[freq_name]
             problem = _check_freq_unit(freq, freq_name)
             finite = freq[np.isfinite(freq)]
+            if problem and rate_name in sample:
+                swapped = _check_swapped(freq, sample[rate_name], freq_name, rate_name)
+                if swapped is not None:
+                    problems.append(swapped)
+                    return problems  # the rate's unit check would only add noise
             if problem:
                 problems.append(problem)
             elif finite.size:

@@ -21,6 +21,7 @@ from hrgtc.files import (
     WriteBehind,
     forget_temporary,
     fsync_file,
+    naming_os_errors,
     publish,
     refuse_existing,
     temporary_beside,
@@ -120,7 +121,8 @@ class RecordingWriter:
         lengths = {a.shape for a in arrays.values()}
         if len(lengths) != 1 or len(next(iter(lengths))) != 1:
             raise RecordingError(f"{self.path}: chunk columns must be 1-D of one length")
-        self._sink.write(arrays)
+        with naming_os_errors(self.path):
+            self._sink.write(arrays)
         self.rows += len(arrays[self.columns[0]])
 
     def start_writeback(self) -> None:
@@ -142,9 +144,10 @@ class RecordingWriter:
             return self.path
         sink, self._sink = self._sink, None
         try:
-            sink.close()
-            self._stop_behind()  # after the last bytes, which it may still sync
-            fsync_file(self._tmp)
+            with naming_os_errors(self.path):
+                sink.close()
+                self._stop_behind()  # after the last bytes, which it may still sync
+                fsync_file(self._tmp)
             publish(self._tmp, self.path, self.force)
         except BaseException:
             self._stop_behind(discard=True)
