@@ -106,8 +106,13 @@ def trained_in(factor: float) -> Callable:
                    for k in run.names}
         meta = dataclasses.replace(run.metadata,
                                    input_rate_dph=run.metadata.input_rate_dph * factor)
+        from hrgtc.drift.training import TrainingStatistics
+
+        trained = Recording(columns, meta)
+        # what calibrate writes: the model carries the statistics of its training data
         model = UnitModel(thermometer=THERMOMETER, unit="FZ-1",
-                          drift=drift.fit([Recording(columns, meta)], THERMOMETER))
+                          drift=drift.fit([trained], THERMOMETER),
+                          training=TrainingStatistics.from_runs([trained]))
         return save_model(model, folder / "case.json", force=True)
     return make
 

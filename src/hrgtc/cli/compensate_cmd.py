@@ -94,6 +94,7 @@ def compensate_command(
     Example: hrgtc compensate warmup.parquet --model unit.json -o warmup_comp.parquet
     """
     from hrgtc.compensate import compensate_instrument_file
+    from hrgtc.compensate.compensator import check_thermometer_kind
     from hrgtc.compensate.instrument import parse_axes
     from hrgtc.files import refuse_input
     from hrgtc.model import load_instrument
@@ -109,6 +110,8 @@ def compensate_command(
         refuse_input(output, [run, model_path])
         model = load_instrument(model_path)
         inputs = options_with_map(inputs, model.temperature_map)
+        for unit_model in model.axes.values():  # the error names the model file
+            check_thermometer_kind(inputs, unit_model, model_path)
         summary = compensate_instrument_file(run, output, model, force=force,
                                              chunk_rows=chunk_rows, progress=progress,
                                              read_options=inputs, axes=parse_axes(axes))
@@ -236,7 +239,7 @@ def evaluate_command(
         model = load_instrument(model_path)
         inputs = options_with_map(inputs, model.temperature_map)
         for unit_model in model.axes.values():  # before reading the recording's axes
-            check_thermometer_kind(inputs, unit_model)
+            check_thermometer_kind(inputs, unit_model, model_path)
         model = match_axes(model, recording_axes(run, inputs), parse_axes(axes), str(run),
                            str(model_path))
     for axis, unit_model in model.axes.items():

@@ -57,7 +57,7 @@ def report_command(
         check_writable(output, 20e6)  # before the passes over the runs
         loaded = load_instrument(model)
         for unit_model in loaded.axes.values():  # before reading the recordings' axes
-            check_thermometer_kind(inputs or ReadOptions(), unit_model)
+            check_thermometer_kind(inputs or ReadOptions(), unit_model, model)
         chosen = parse_axes(axes)
         matched = [match_axes(loaded, recording_axes(r, inputs), chosen, str(r), str(model))
                    for r in runs]

@@ -530,7 +530,8 @@ def plausible_frequency_band(model: UnitModel,
     return low - margin, high + margin
 
 
-def check_thermometer_kind(options: rec_io.ReadOptions, model: UnitModel) -> None:
+def check_thermometer_kind(options: rec_io.ReadOptions, model: UnitModel,
+                           model_file: object = None) -> None:
     """Refuse to read a recording as the other kind of thermometer than the model's.
 
     A sensor-thermometer model (``calibrate --thermometer sensor``) reads the gyro's
@@ -541,24 +542,26 @@ def check_thermometer_kind(options: rec_io.ReadOptions, model: UnitModel) -> Non
     Raises
     ------
     InputError
-        The kinds differ: says which the model is and which option to pass.
+        The kinds differ: says which the model is (naming ``model_file`` when given)
+        and which option to pass.
     """
     model_kind = model.thermometer.source
     reading = options.thermometer
     if model_kind == reading:
         return
     low, high = model.thermometer.temperature_range_c
+    named = f"{model_file}: " if model_file is not None else ""
     if model_kind == "sensor":
         raise InputError(
-            f"the model of unit {model.unit!r} is a sensor-thermometer model (calibrated with "
-            f"--thermometer sensor on the gyro's temperature sensor, {low:g} to {high:g} °C), "
-            "but the recording is read as a resonator frequency (freq_hz); pass --thermometer "
-            "sensor (and --col temperature_c=... for the sensor's column), or use a model "
-            "calibrated on the resonator frequency")
+            f"{named}the model of unit {model.unit!r} is a sensor-thermometer model "
+            f"(calibrated with --thermometer sensor on the gyro's temperature sensor, {low:g} "
+            f"to {high:g} °C), but the recording is read as a resonator frequency (freq_hz); "
+            "pass --thermometer sensor (and --col temperature_c=... for the sensor's column), "
+            "or use a model calibrated on the resonator frequency")
     raise InputError(
-        f"the model of unit {model.unit!r} is a resonator-thermometer model (its thermometer "
-        "turns the resonator frequency into temperature), but the recording is read with "
-        "--thermometer sensor (a temperature sensor in the place of freq_hz); drop "
+        f"{named}the model of unit {model.unit!r} is a resonator-thermometer model (its "
+        "thermometer turns the resonator frequency into temperature), but the recording is "
+        "read with --thermometer sensor (a temperature sensor in the place of freq_hz); drop "
         "--thermometer sensor for this model, or calibrate one with --thermometer sensor")
 
 
