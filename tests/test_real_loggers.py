@@ -44,7 +44,6 @@ AXES = "xyz"
 SEED = 11
 #: The chamber program of the burst tests: a 2 h cool-down 22 -> 5 °C at 0.15 °C/min.
 PROFILE = cooldown(22.0, 5.0, hours=2.0, ramp_c_per_min=0.15)
-NEEDS_MOTION = "needs the motion detector (--motion exclude by default) and per-orientation offsets"
 
 
 def _logger(kind: str, **kw) -> Logger:
@@ -249,7 +248,6 @@ def test_handling_file_has_motion_the_truth_lists(handled):
     assert set(np.unique(run.truth["orientation"])) == {-1, 0, 1, 2}
 
 
-@pytest.mark.xfail(strict=True, reason=NEEDS_MOTION)
 def test_recording_with_handling_gives_the_model_of_its_still_samples(handled):
     """Trained on the handled file, the model predicts what the model of its still samples
     predicts, within 3 standard errors of a prediction of the still model plus 1 % of the
@@ -275,7 +273,6 @@ def test_recording_with_handling_gives_the_model_of_its_still_samples(handled):
         assert np.allclose(whole["ranges"]["df"], still["ranges"]["df"], atol=0.2 * span), a
 
 
-@pytest.mark.xfail(strict=True, reason=NEEDS_MOTION)
 def test_orientation_offsets_do_not_bias_the_temperature_coefficient(handled):
     """With an offset per orientation as a nuisance parameter, the model's drift along the
     run is the true thermal drift (the unit's bias law, without the g-sensitivity

@@ -97,10 +97,7 @@ SAMPLE = (
     "duplicated header name / 1-axis .csv",
     "rate x1/3600 (logged in °/h, declared °/s) / 1-axis .parquet",
     "bursts of 5 s every 30 s / 1-axis .csv",
-    pytest.param("one row missing (2 periods: not a gap) / 1-axis .h5", marks=pytest.mark.xfail(
-        strict=True, reason="evaluate's default spike filter drops the sample next to the "
-        "one-sample hole (its second difference doubles), which makes a 4-period gap: 'gap at "
-        "row 4999' for a file without one; passes with --spike-filter off")),
+    "one row missing (2 periods: not a gap) / 1-axis .h5",
     "NaN in rate_dph_x row 4321 / 3-axis .parquet",
     "drift.ranges.f reversed",
     "truncated at 50%",

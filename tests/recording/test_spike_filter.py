@@ -46,6 +46,20 @@ def test_gaussian_stream_without_spikes_gives_none():
     assert not find_spikes(time_s, 5.0 + 0.3 * rng.standard_normal(time_s.size)).any()
 
 
+def test_handling_at_a_low_sample_rate_is_motion_not_spikes():
+    """A unit turned by hand, logged at 2 Hz: for a few seconds every sample is hundreds of
+    σ from its neighbours, which do not agree with each other either. That is motion (the
+    motion detector's business), not a run of single-sample spikes: none is removed, so no
+    gap is made where the logger had none. A lone spike beside it is still found."""
+    rng = np.random.default_rng(7)
+    time_s = np.arange(4000) / 2.0
+    values = rng.standard_normal(time_s.size)
+    turning = slice(1000, 1012)
+    values[turning] += 2000.0 * np.sin(np.arange(12) * 2.3) + 500.0 * rng.standard_normal(12)
+    values[3000] += 60.0
+    np.testing.assert_array_equal(np.flatnonzero(find_spikes(time_s, values)), [3000])
+
+
 def test_quantised_pulse_stream_keeps_every_pulse_and_its_mean():
     rng = np.random.default_rng(3)
     time_s = np.arange(200_000) / 100.0

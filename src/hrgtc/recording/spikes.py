@@ -246,7 +246,9 @@ def find_spikes(time_s: np.ndarray, values: np.ndarray, *, k: float = SPIKE_K,
     -------
     numpy.ndarray
         True where ``|x[i] − x[i±1]|`` and ``|x[i] − (x[i−1] + x[i+1]) / 2|`` all exceed
-        ``max(k·σ_MAD, m·LSB)``; at a segment's edge, against the next two samples.
+        ``max(k·σ_MAD, m·LSB)`` while ``|x[i+1] − x[i−1]|`` does not (the neighbours agree:
+        one sample off a steady stream, not a stream in motion); at a segment's edge,
+        against the next two samples.
     """
     x = np.asarray(values, dtype=np.float64)
     t = np.asarray(time_s, dtype=np.float64)
@@ -272,7 +274,13 @@ def find_spikes(time_s: np.ndarray, values: np.ndarray, *, k: float = SPIKE_K,
         with np.errstate(invalid="ignore"):
             left = np.abs(np.diff(xs, prepend=np.nan))
             right = np.abs(np.diff(xs, append=np.nan))
-            inner = (left > limit) & (right > limit) & (np.abs(second) > limit)
+            # ... and its two neighbours agree with each other: a single sample off a
+            # steady stream, not a stream that moves (handling, a rotation), whose every
+            # sample is far from its neighbours
+            across = np.full(xs.size, np.inf)
+            across[1:-1] = np.abs(xs[2:] - xs[:-2])
+            inner = ((left > limit) & (right > limit) & (np.abs(second) > limit)
+                     & (across <= limit))
             # the edges: away from both of the next two samples, which agree
             inner[0] = (right[0] > limit[0]) & (abs(xs[0] - xs[2]) > limit[0]) & (
                 right[1] <= limit[0])
