@@ -78,18 +78,17 @@ def _commands(body: list[tuple[int, str]]) -> list[Command]:
 
 
 def _cases() -> list[pytest.param]:
-    """One case per block; a block whose commands repeat an earlier block's runs once."""
-    cases = []
-    seen: dict[tuple[str, ...], str] = {}
+    """One case per distinct block: a block whose commands repeat an earlier block's (the
+    README's quick start is the getting-started page's) is the same case, run once, its
+    id naming both places."""
+    cases: dict[tuple[str, ...], tuple[Path, list[Command], list[str]]] = {}
     for page in PAGES:
         for start, commands in console_blocks(page.read_text(encoding="utf-8")):
-            name = f"{page.relative_to(ROOT)}:{start}"
             key = tuple(f"{c.text} -> {c.exit_code}" for c in commands)
-            marks = [pytest.mark.skip(reason=f"the same commands as {seen[key]}")] \
-                if key in seen else []
-            seen.setdefault(key, name)
-            cases.append(pytest.param(page, commands, id=name, marks=marks))
-    return cases
+            cases.setdefault(key, (page, commands, []))[2].append(
+                f"{page.relative_to(ROOT)}:{start}")
+    return [pytest.param(page, commands, id="+".join(names))
+            for page, commands, names in cases.values()]
 
 
 def _environment() -> dict[str, str]:
