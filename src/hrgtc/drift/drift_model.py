@@ -400,7 +400,7 @@ def fit(
     aux_columns: Mapping[str, str] | None = None,
     warmup_s: float | None = None,
     autocorrelation: str = "newey-west",
-    hierarchical: bool = False,
+    hierarchical: bool = True,
     excitation_runs: int = 0,
     select: str = "guarded",
     progress: Progress | None = None,
@@ -453,6 +453,9 @@ def fit(
         residuals (bandwidth n^(1/3) windows), because bias instability and rate
         random walk keep 10 s means correlated and plain F-tests then admit terms
         that fit noise and extrapolate badly. ``"none"``: plain ``stepwisefit``.
+    hierarchical
+        Marginality (default): a term enters only after its lower-order parents and
+        leaves only after its children; False gives MATLAB's plain ``stepwisefit``.
     select
         ``"guarded"`` (default): the stepwise F-tests, then every selected term that does
         not carry over to held-out data is dropped (:func:`~hrgtc.drift.cross_validation.
