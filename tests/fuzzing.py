@@ -47,9 +47,13 @@ runner = CliRunner()
 
 
 def make_model() -> UnitModel:
-    """A model of the synthetic unit at 10 Hz (cool-down 20 -> -20 °C)."""
-    return UnitModel(thermometer=THERMOMETER,
-                     drift=drift.fit([ramp_run(seed=11, hours=3.0)], THERMOMETER), unit="FZ-1")
+    """A model of the synthetic unit at 10 Hz (cool-down 20 -> -20 °C), with the statistics
+    of its training data as ``calibrate`` writes them (the noise-ratio unit checks use them)."""
+    from hrgtc.drift.training import TrainingStatistics
+
+    run = ramp_run(seed=11, hours=3.0)
+    return UnitModel(thermometer=THERMOMETER, drift=drift.fit([run], THERMOMETER), unit="FZ-1",
+                     training=TrainingStatistics.from_runs([run]))
 
 
 def make_run(rows: int = 1200) -> Recording:
