@@ -391,3 +391,26 @@ def test_stale_temporary_files_of_dead_runs_are_removed_and_others_reported(file
         code = compensate(source, model_path, tmp_path / "out.parquet")[0]
     assert code == 0
     assert not stale.exists() and alive.exists() and old_style.exists()
+
+
+@pytest.mark.parametrize("command", ["compensate", "evaluate", "calibrate"])
+def test_time_in_ms_gets_the_time_unit_hint_not_thousands_of_gaps(tmp_path, command):
+    """Time logged in ms under 10 Hz metadata: every step is 1000 periods. Every command
+    says '--time-unit ms', as info does, not '8999 gaps ... pass --gaps bridge' (the reader
+    raised the gaps of its first chunk before the whole-file heuristics had run)."""
+    from hrgtc.recording import Recording, write
+
+    from fuzzing import make_model, make_run
+
+    run = make_run(9000)
+    columns = {k: run[k] for k in run.names}
+    columns["time_s"] = columns["time_s"] * 1000.0
+    path = write(Recording(columns, run.metadata), tmp_path / "ms.csv")
+    model = save_model(make_model(), tmp_path / "m.json")
+    args = {"compensate": [str(path), "--model", str(model), "-o", str(tmp_path / "o.csv")],
+            "evaluate": [str(path), "--model", str(model)],
+            "calibrate": ["--drift", str(path), "-o", str(tmp_path / "c.json")]}[command]
+    result = CliRunner().invoke(app, [command, *args])
+    assert result.exit_code == 2
+    text = " ".join(result.output.split())
+    assert "--time-unit ms" in text and "gap(s)" not in text, text

@@ -415,8 +415,11 @@ class RecordingValidator:
                 column=name, row=row, value=f"{value:.6g}", count=count))
         # a time unit or sample rate wrong for the whole file: its gaps and "rate changes"
         # are consequences, not news (one diagnosis, see hrgtc.core.time_steps)
-        whole_file = any(p.kind in ("sample_rate", "time_unit") and p.row is None
-                         for p in self._heuristics or [])
+        # (until the heuristics have run, a wrong unit cannot be ruled out: the gaps and
+        # rate changes wait for them, as the reader holds its chunks back until then)
+        whole_file = self._heuristics is None or any(
+            p.kind in ("sample_rate", "time_unit") and p.row is None
+            for p in self._heuristics)
         if self._rate_change is not None and not whole_file:
             row, measured = self._rate_change
             nominal = self.metadata.sample_rate_hz
