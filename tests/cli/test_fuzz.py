@@ -96,6 +96,8 @@ SAMPLE = (
     "spaces / 1-axis .csv",
     "duplicated header name / 1-axis .csv",
     "rate x1/3600 (logged in °/h, declared °/s) / 1-axis .parquet",
+    "rate_dph_y x3600 only / 3-axis .csv",
+    "time in ms / 3-axis .h5",
     "bursts of 5 s every 30 s / 1-axis .csv",
     "one row missing (2 periods: not a gap) / 1-axis .h5",
     "NaN in rate_dph_x row 4321 / 3-axis .parquet",

@@ -480,16 +480,19 @@ def compensate_file(
                                compensator.rate_out_of_range_fraction, compensator.ranges())
 
 
-def check_recording_noise(model: Any, chunk: Recording, source: str = "") -> None:
+def check_recording_noise(model: Any, chunk: Recording, source: str = "",
+                          axis: str | None = None) -> None:
     """Refuse a recording whose rate noise is a unit factor off the model's training data
     (:func:`hrgtc.drift.training.check_noise`), every axis of an instrument's.
 
     ``model`` is a :class:`UnitModel` or an :class:`~hrgtc.model.InstrumentModel`; axes
-    the chunk lacks are left to the compensator's own error.
+    the chunk lacks are left to the compensator's own error. ``axis``: the file's axis
+    a single-axis ``chunk`` (an axis view) was read from, named in the message.
     """
     from hrgtc.drift.training import check_noise
     from hrgtc.recording import axis_names, axis_view
 
+    axis_of_view = axis
     axes = getattr(model, "axes", None)
     units = {"": model} if axes is None else dict(axes)
     found = axis_names(chunk.names)
@@ -499,7 +502,8 @@ def check_recording_noise(model: Any, chunk: Recording, source: str = "") -> Non
             view = axis_view(chunk, axis)
             check_noise(unit.training, view.rate_dph, fs, source, f"rate_dph_{axis}")
         elif not axis and "rate_dph" in chunk:
-            check_noise(unit.training, chunk.rate_dph, fs, source)
+            column = "rate_dph" if axis_of_view is None else f"rate_dph_{axis_of_view}"
+            check_noise(unit.training, chunk.rate_dph, fs, source, column)
 
 
 #: Frequencies farther than this beyond the calibrated span are errors, not extrapolation. [°C]

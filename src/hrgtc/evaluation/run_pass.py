@@ -626,7 +626,7 @@ def evaluate(
     else:
         options = with_model_band(read_options or ReadOptions(), model)
         refuse_compensated(run)
-        check_recording_noise(model, options.head(run), str(run))
+        check_recording_noise(model, options.head(run), str(run), options.axis)
         rows = count_rows(run)  # cheap (metadata, or a scan of a CSV's bytes); plans the pass
         name, source, chunks = Path(run).name, str(run), options.chunks(run)
         fs = None
