@@ -361,10 +361,13 @@ def recording_cases() -> list[Case]:
                     {"*": error("time_s", f"row {row}"), "info": EITHER}, owner="time")
             add("rows 3000-3100 written twice", "time order",
                 edited(lambda c: {k: np.concatenate([v[:3100], v[3000:]]) for k, v in c.items()},
-                       fmt, axes), {"*": error("time_s", "row 3100"), "info": EITHER})
+                       fmt, axes), {"*": CORRECT, "info": EITHER})  # dropped and counted
             add("the run joined to itself", "time order",
                 edited(lambda c: {k: np.concatenate([v, v]) for k, v in c.items()}, fmt, axes),
-                {"*": error("time_s", "row 9000"), "info": EITHER}, owner="time")
+                # time back to its start: a restart read as a new segment (issue 20), or
+                # a step back named at its row (evaluate and calibrate on Parquet/HDF5 today)
+                {"*": Expect("error_or_same", ("time_s", "row 9000"), compare=False),
+                 "info": EITHER}, owner="time")
             add("temperature_c a raw count (x100 + 2000)", "temperature unit",
                 edited(lambda c: c | {"temperature_c": c["temperature_c"] * 100 + 2000}, fmt,
                        axes), {"*": error("temperature_c", "--temp-scale"), "info": EITHER})
