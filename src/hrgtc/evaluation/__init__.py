@@ -18,7 +18,8 @@ from hrgtc.evaluation.metrics import (
     residual_against_truth,
 )
 from hrgtc.evaluation.noise import NoiseTerms, noise_terms
-from hrgtc.evaluation.run_pass import BlockMeans, Evaluation, block_rows, evaluate, run_pass
+from hrgtc.evaluation.plot_blocks import BlockMeans, block_rows
+from hrgtc.evaluation.run_pass import Evaluation, evaluate, run_pass
 
 __all__ = [
     "DEFAULT_TAUS_S",

@@ -19,8 +19,8 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Callable, Iterable, Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -36,9 +36,13 @@ from hrgtc.errors import HrgtcError, InputError, RecordingError
 from hrgtc.evaluation.allan import (
     ONE_SIGMA,
     AllanResult,
-    allan_deviation,
-    confidence_interval,
-    equivalent_degrees_of_freedom,
+)
+from hrgtc.evaluation.deviation_curves import (
+    DEVIATIONS,
+    _curve,
+    _deviation,
+    _finite,
+    _with_interval,
 )
 from hrgtc.evaluation.heating_cooling import DirectionSplit, DirectionStats
 from hrgtc.evaluation.metrics import (
@@ -47,6 +51,7 @@ from hrgtc.evaluation.metrics import (
     table_to_json,
 )
 from hrgtc.evaluation.noise import NoiseTerms, noise_terms
+from hrgtc.evaluation.plot_blocks import BlockMeans, block_rows
 from hrgtc.evaluation.series_stats import SeriesStatistics
 from hrgtc.evaluation.settling_cut import SettlingCut
 from hrgtc.model import UnitModel
@@ -57,49 +62,8 @@ from hrgtc.recording.marks import compensation_mark, describe_mark, refuse_compe
 #: Series measured by a pass: output minus input rate, compensated by the
 #: frequency model, and by the housing-thermistor baseline.
 SERIES = ("raw", "compensated", "housing")
-#: Shortest plotting block. [s]
-BLOCK_S = 10.0
-#: ``--deviation`` names -> (kind of :func:`allan_deviation`, overlapping), after allantools.
-DEVIATIONS = {"adev": ("allan", False), "oadev": ("allan", True), "mdev": ("modified", True),
-              "hdev": ("hadamard", True), "tdev": ("time", True)}
 #: Prefix of the model's variables among the plotting blocks (``var_f``, ``var_df``, ...).
 VARIABLE_PREFIX = "var_"
-
-
-class BlockMeans:
-    """Means of consecutive blocks of ``rows`` samples, fed chunk by chunk."""
-
-    def __init__(self, rows: int) -> None:
-        self.rows = rows
-        self.offset = 0
-        self._parts: dict[str, list[tuple[int, np.ndarray]]] = {}
-
-    def push(self, columns: Mapping[str, np.ndarray]) -> None:
-        """Add the next rows (every column of one length)."""
-        n = len(next(iter(columns.values())))
-        index = (self.offset + np.arange(n)) // self.rows
-        first = int(index[0])
-        for name, values in {"_count": np.ones(n), **columns}.items():
-            sums = np.bincount(index - first, weights=np.asarray(values, dtype=np.float64))
-            self._parts.setdefault(name, []).append((first, sums))
-        self.offset += n
-
-    def means(self) -> dict[str, np.ndarray]:
-        """Block means of every column (the last block may be shorter)."""
-        blocks = -(-self.offset // self.rows)
-        totals = {}
-        for name, parts in self._parts.items():
-            total = np.zeros(blocks)
-            for first, sums in parts:
-                total[first : first + sums.size] += sums
-            totals[name] = total
-        count = totals.pop("_count")
-        return {name: total / count for name, total in totals.items()}
-
-
-def block_rows(rows: int, sample_rate_hz: float, max_points: int) -> int:
-    """Rows per plotting block: at least :data:`BLOCK_S`, at most ``max_points`` blocks."""
-    return max(round(BLOCK_S * sample_rate_hz), -(-rows // max(int(max_points), 1)), 1)
 
 
 @dataclass(frozen=True, eq=False)
@@ -333,37 +297,6 @@ class Evaluation:
         lines.extend(self.range_warnings())
         lines.extend(self.notes)
         return "\n".join(lines)
-
-
-def _finite(value: float | None) -> float | None:
-    return None if value is None or not math.isfinite(value) else float(value)
-
-
-def _curve(allan: AllanResult) -> dict[str, Any]:
-    """One deviation curve as JSON lists (lower/upper None where no interval)."""
-    def listed(values: np.ndarray | None) -> list[float | None]:
-        if values is None:
-            return [None] * allan.taus_s.size
-        return [_finite(float(v)) for v in values]
-
-    return {"tau_s": allan.taus_s.tolist(), "deviation": listed(allan.deviation),
-            "lower": listed(allan.lower), "upper": listed(allan.upper),
-            "n": allan.counts.tolist(), "kind": allan.kind, "overlapping": allan.overlapping}
-
-
-def _with_interval(result: AllanResult, n_samples: int, confidence: float) -> AllanResult:
-    """The overlapping Allan deviation with its chi-squared interval (SP 1065 simple edf)."""
-    m = np.rint(result.taus_s * result.sample_rate_hz).astype(np.int64)
-    edf = np.array([equivalent_degrees_of_freedom(n_samples + 1, int(k)) for k in m])
-    lower, upper = confidence_interval(result.deviation, edf, confidence)
-    return replace(result, lower=lower, upper=upper, confidence=float(confidence))
-
-
-def _deviation(values: np.ndarray, fs: float, deviation: str, confidence: float) -> AllanResult:
-    """The run's deviation curve with its confidence interval (SP 1065 Section 5.3)."""
-    kind, overlapping = DEVIATIONS[deviation]
-    return allan_deviation(values, fs, taus="octave", kind=kind, overlapping=overlapping,
-                           confidence=confidence)
 
 
 def run_pass(
