@@ -44,6 +44,7 @@ from hrgtc.simulate import units as _units
 from hrgtc.simulate.clock import unwrap_counter, wall_clock
 from hrgtc.simulate.duty import DutyCycle, duplicate_rows, simulate_kept
 from hrgtc.simulate.handling import Handling, hand_warming, handling_truth
+from hrgtc.simulate.logger_options import reading_options
 from hrgtc.simulate.profiles import Profile
 from hrgtc.simulate.reflog import ReferenceLog, TemperatureChannel, reference_log_text
 from hrgtc.simulate.units import MultiAxisUnit, Unit
@@ -576,33 +577,3 @@ def log_run(
                        rng.choice(rows.size, size=int(logger.duplicates), replace=False))
     info["hrgtc_options"] = reading_options(info, axes, logger)
     return LoggedRun(columns, kinds, truth, info, reference_text)
-
-
-def reading_options(info: Mapping[str, Any], axes: tuple[str | None, ...],
-                    logger: Logger) -> list[str]:
-    """The ``hrgtc`` reading options for a logged file (its column names and units)."""
-    roles = info["columns"]
-    cols = [f"time_s={roles['time']}"]
-    for axis in axes:
-        key = "" if axis is None else f"_{axis}"
-        cols.append(f"rate_dph{key}={roles[f'rate{key}']}")
-        if logger.frequency:
-            cols.append(f"freq_hz{key}={roles[f'freq{key}']}")
-    if logger.temperature is not None:
-        cols.append(f"temperature_c={roles['temperature']}")
-    if logger.accelerometer:
-        cols += [f"accel_{a}={roles[f'accel_{a}']}" for a in "xyz"]
-    options = []
-    for c in cols:
-        options += ["--col", c]
-    options += ["--time-unit", logger.time_unit, "--rate-unit", logger.rate_unit]
-    channel = logger.temperature
-    if channel is not None and channel.lsb_c is not None and channel.bits is None:
-        options += ["--temp-scale", f"{channel.lsb_c:.17g}",
-                    "--temp-offset", f"{channel.offset_c:.17g}"]
-    if not logger.frequency:
-        options += ["--thermometer", "sensor"]
-    if logger.kind == "burst" or logger.restarts_s:
-        # Filters carried across each gap with its duration (the temperature kept changing).
-        options += ["--gaps", "bridge"]
-    return options
