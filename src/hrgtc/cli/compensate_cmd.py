@@ -94,8 +94,8 @@ def compensate_command(
     Example: hrgtc compensate warmup.parquet --model unit.json -o warmup_comp.parquet
     """
     from hrgtc.compensate import compensate_instrument_file
-    from hrgtc.compensate.compensator import check_thermometer_kind
     from hrgtc.compensate.instrument import parse_axes
+    from hrgtc.compensate.model_fit import check_thermometer_kind
     from hrgtc.files import refuse_input
     from hrgtc.model import load_instrument
     from hrgtc.recording import ReadOptions
@@ -215,8 +215,8 @@ def evaluate_command(
     Example: hrgtc evaluate warmup.parquet --model unit.json --deviation oadev
     --allan-csv warmup_allan.csv --json
     """
-    from hrgtc.compensate.compensator import check_thermometer_kind
     from hrgtc.compensate.instrument import match_axes, parse_axes, recording_axes
+    from hrgtc.compensate.model_fit import check_thermometer_kind
     from hrgtc.evaluation import evaluate
     from hrgtc.evaluation.run_pass import DEVIATIONS
     from hrgtc.files import refuse_existing, refuse_input, write_text_atomic

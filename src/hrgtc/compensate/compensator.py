@@ -27,6 +27,10 @@ from typing import Any
 import numpy as np
 
 from hrgtc import recording as rec_io
+from hrgtc.compensate.model_fit import (
+    check_recording_noise,
+    with_model_band,
+)
 from hrgtc.compensate.ranges import RangeReport, range_report
 from hrgtc.core.timeline import is_gap
 from hrgtc.drift import DriftModel
@@ -478,109 +482,6 @@ def compensate_file(
     return CompensationSummary(str(source), str(output), compensator.samples,
                                compensator.out_of_range_fraction,
                                compensator.rate_out_of_range_fraction, compensator.ranges())
-
-
-def check_recording_noise(model: Any, chunk: Recording, source: str = "",
-                          axis: str | None = None) -> None:
-    """Refuse a recording whose rate noise is a unit factor off the model's training data
-    (:func:`hrgtc.drift.training.check_noise`), every axis of an instrument's.
-
-    ``model`` is a :class:`UnitModel` or an :class:`~hrgtc.model.InstrumentModel`; axes
-    the chunk lacks are left to the compensator's own error. ``axis``: the file's axis
-    a single-axis ``chunk`` (an axis view) was read from, named in the message.
-    """
-    from hrgtc.drift.training import check_noise
-    from hrgtc.recording import axis_names, axis_view
-
-    axis_of_view = axis
-    axes = getattr(model, "axes", None)
-    units = {"": model} if axes is None else dict(axes)
-    found = axis_names(chunk.names)
-    fs = chunk.metadata.sample_rate_hz
-    for axis, unit in units.items():
-        if axis and axis in found:
-            view = axis_view(chunk, axis)
-            check_noise(unit.training, view.rate_dph, fs, source, f"rate_dph_{axis}")
-        elif not axis and "rate_dph" in chunk:
-            column = "rate_dph" if axis_of_view is None else f"rate_dph_{axis_of_view}"
-            check_noise(unit.training, chunk.rate_dph, fs, source, column)
-
-
-#: Frequencies farther than this beyond the calibrated span are errors, not extrapolation. [°C]
-PLAUSIBLE_MARGIN_C = 100.0
-
-
-def frequency_span(model: UnitModel) -> tuple[float, float]:
-    """The frequencies the model was calibrated on: thermometer and drift training ranges. [Hz]"""
-    low, high = model.thermometer.frequency_range_hz
-    if "f" in model.drift.ranges:
-        reference = model.drift.settings.reference_freq_hz
-        f_low, f_high = model.drift.ranges["f"]
-        low, high = min(low, reference + f_low), max(high, reference + f_high)
-    return float(low), float(high)
-
-
-def plausible_frequency_band(model: UnitModel,
-                             margin_c: float = PLAUSIBLE_MARGIN_C) -> tuple[float, float]:
-    """The calibrated span widened by ``margin_c`` of temperature at the steepest slope. [Hz]
-
-    A sample outside it is no temperature this unit can reach in a test: a glitch,
-    another unit's file or a wrong column, reported as an error on reading.
-    """
-    low, high = frequency_span(model)
-    t_low, t_high = model.thermometer.temperature_range_c
-    slope = float(np.max(np.abs(model.thermometer.slope_hz_per_c(np.array([t_low, t_high])))))
-    margin = margin_c * max(slope, 1e-6 * high)
-    return low - margin, high + margin
-
-
-def check_thermometer_kind(options: rec_io.ReadOptions, model: UnitModel,
-                           model_file: object = None) -> None:
-    """Refuse to read a recording as the other kind of thermometer than the model's.
-
-    A sensor-thermometer model (``calibrate --thermometer sensor``) reads the gyro's
-    temperature sensor [°C] in the place of the frequency; applied to a frequency
-    recording, every sample would be "far outside the calibrated span" with no word of
-    why. The reverse (a resonator model on a sensor reading) likewise.
-
-    Raises
-    ------
-    InputError
-        The kinds differ: says which the model is (naming ``model_file`` when given)
-        and which option to pass.
-    """
-    model_kind = model.thermometer.source
-    reading = options.thermometer
-    if model_kind == reading:
-        return
-    low, high = model.thermometer.temperature_range_c
-    named = f"{model_file}: " if model_file is not None else ""
-    if model_kind == "sensor":
-        raise InputError(
-            f"{named}the model of unit {model.unit!r} is a sensor-thermometer model "
-            f"(calibrated with --thermometer sensor on the gyro's temperature sensor, {low:g} "
-            f"to {high:g} °C), but the recording is read as a resonator frequency (freq_hz); "
-            "pass --thermometer sensor (and --col temperature_c=... for the sensor's column), "
-            "or use a model calibrated on the resonator frequency")
-    raise InputError(
-        f"{named}the model of unit {model.unit!r} is a resonator-thermometer model (its "
-        "thermometer turns the resonator frequency into temperature), but the recording is "
-        "read with --thermometer sensor (a temperature sensor in the place of freq_hz); drop "
-        "--thermometer sensor for this model, or calibrate one with --thermometer sensor")
-
-
-def with_model_band(options: rec_io.ReadOptions, model: UnitModel) -> rec_io.ReadOptions:
-    """``options`` that check every frequency against the model's plausible band.
-
-    Raises
-    ------
-    InputError
-        The model's thermometer is not the kind the recording is read as
-        (:func:`check_thermometer_kind`).
-    """
-    check_thermometer_kind(options, model)
-    return dataclasses.replace(options, freq_band_hz=plausible_frequency_band(model),
-                               freq_span_hz=frequency_span(model))
 
 
 def compensated_metadata(metadata: rec_io.Metadata, model: UnitModel,

@@ -20,11 +20,10 @@ from hrgtc import recording as rec_io
 from hrgtc.compensate.compensator import (
     CompensationSummary,
     Compensator,
-    check_thermometer_kind,
     compensate_file,
     output_columns,
-    plausible_frequency_band,
 )
+from hrgtc.compensate.model_fit import check_thermometer_kind, plausible_frequency_band
 from hrgtc.compensate.ranges import RangeReport
 from hrgtc.errors import InputError, RecordingError
 from hrgtc.model import InstrumentModel, UnitModel, axis_suffix
@@ -53,7 +52,7 @@ class InstrumentCompensator:
         As :class:`~hrgtc.compensate.compensator.Compensator`, for every axis.
     bands_hz
         Axis -> plausible frequency band (see
-        :func:`~hrgtc.compensate.compensator.plausible_frequency_band`): a sample
+        :func:`~hrgtc.compensate.model_fit.plausible_frequency_band`): a sample
         outside is an error naming its column and row, as the reader does for a
         single-axis file. None: not checked here.
     partial

@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from hrgtc.compensate import Compensator
-from hrgtc.compensate.compensator import check_recording_noise, with_model_band
+from hrgtc.compensate.model_fit import check_recording_noise, with_model_band
 from hrgtc.compensate.ranges import RangeReport
 from hrgtc.core.accounting import Accounting
 from hrgtc.drift.features import FeatureStream
