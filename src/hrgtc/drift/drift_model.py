@@ -38,6 +38,7 @@ from hrgtc.drift.cross_validation import (
     guard_selection,
     select_terms,
 )
+from hrgtc.drift.drift_text import drift_equation, drift_summary
 from hrgtc.drift.features import (
     AUX_PREFIX,
     EQ21,
@@ -51,7 +52,6 @@ from hrgtc.drift.features import (
     linear_combination,
     parse_terms,
     tangent_extension,
-    variable_unit,
     variables_for,
 )
 from hrgtc.drift.offsets import fit_offsets, offset_groups, orientation_offset, project_off
@@ -232,13 +232,7 @@ class DriftModel(ParsedTerms):
         ``sensor``: the thermometer is a temperature sensor (no frequency output),
         so f is its temperature T in °C and df its rate dT/dt in °C/s, not Hz.
         """
-        parts = [f"B = {self.intercept_dph:.6g}"]
-        for name in self.selected:
-            value = self.coefficients[name]
-            sign = "-" if value < 0 else "+"
-            parts.append(f" {sign} {abs(value):.6g}·{name}")
-        units = ", ".join(_variable_text(v, sensor) for v in self.variables)
-        return "".join(parts) + f"   [°/h; {units}]"
+        return drift_equation(self, sensor)
 
     def summary(self, sensor: bool = False) -> str:
         """Stepwise history, coefficient table and fit statistics as text.
@@ -246,49 +240,7 @@ class DriftModel(ParsedTerms):
         ``sensor``: the equation's units are those of a temperature sensor (see
         :meth:`equation`).
         """
-        lines = [
-            f"Drift model: {len(self.selected)} of {len(self.candidates)} candidate terms, "
-            f"{self.n_windows} windows of {self.window_s:g} s ({self.n_samples} samples)",
-            "Steps:",
-        ]
-        if self.accounting is not None:
-            lines.insert(1, f"Training {self.accounting.summary()}")
-        for n, step in enumerate(self.history, start=1):
-            lines.append(f"  {n:>2}. {step.action:<8} {step.term:<10} F = {step.fstat:<12.5g} "
-                         f"p = {step.pvalue:.3g}")
-        lines.append(f"{'term':<10}{'coefficient':>16}{'std error':>14}{'p-value':>11}")
-        lines.append(
-            f"{'const':<10}{self.intercept_dph:>16.6g}{self.standard_errors['const']:>14.4g}"
-            f"{self.pvalues['const']:>11.3g}"
-        )
-        for name in self.selected:
-            lines.append(
-                f"{name:<10}{self.coefficients[name]:>16.6g}{self.standard_errors[name]:>14.4g}"
-                f"{self.pvalues[name]:>11.3g}"
-            )
-        lines.append(
-            f"residual std {self.residual_std_dph:.4g} °/h on {self.window_s:g} s means, "
-            f"R² {self.rsquared:.6f}"
-        )
-        if self.variance_inflation > 1.0 or self.bandwidth_windows:
-            lines.append(
-                f"F-tests corrected for autocorrelated residuals (Newey-West, "
-                f"{self.bandwidth_windows} windows): variance inflation "
-                f"{self.variance_inflation:.3g}"
-            )
-        if self.cross_validation is not None:
-            lines.append(self.cross_validation.summary())
-        if self.pruning is not None and self.pruning.get("dropped"):
-            p = self.pruning
-            lines.append(f"guarded selection: dropped {', '.join(p['dropped'])} (held-out RMS "
-                         f"over {p['folds']} {p['before_dph']:.4g} -> {p['after_dph']:.4g} °/h)")
-        if self.n_not_at_rest:
-            lines.append(f"{self.n_not_at_rest} training samples not at rest were left out")
-        if self.offsets_dph:
-            lines.append(f"offsets ({self.offset_mode}, nuisance, from the intercept) [°/h]: "
-                         + ", ".join(f"{k} {v:+.4g}" for k, v in self.offsets_dph.items()))
-        lines.append(self.equation(sensor))
-        return "\n".join(lines)
+        return drift_summary(self, sensor)
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types."""
@@ -635,18 +587,6 @@ def fit(
         pruning=pruning,
         accounting=_accounting(windows),
     )
-
-
-#: What f and its rates are when a temperature sensor takes the frequency's place.
-_SENSOR_VARIABLES = {"f": "f = T in °C", "df": "df = dT/dt in °C/s"}
-
-
-def _variable_text(variable: str, sensor: bool) -> str:
-    """``f in Hz`` for a resonator; ``f = T in °C`` (Hz read as °C) for a temperature sensor."""
-    if sensor and variable in _SENSOR_VARIABLES:
-        return _SENSOR_VARIABLES[variable]
-    unit = variable_unit(variable)
-    return f"{variable} in {unit.replace('Hz', '°C') if sensor else unit}"
 
 
 def _accounting(windows: TrainingWindows) -> Accounting:

@@ -57,6 +57,7 @@ from hrgtc.recording.mapping import (
     plan_columns,
     table_columns,
 )
+from hrgtc.recording.rechunk import rechunk
 from hrgtc.recording.resample import SlowChannels, fill_slow_channels
 from hrgtc.recording.schema import SCHEMA_VERSION, Metadata, Recording, concatenate
 from hrgtc.recording.spikes import (
@@ -284,32 +285,6 @@ def read(
     return recording
 
 
-def _rechunk(tables: Iterator[dict[str, np.ndarray]], rows: int) -> Iterator[dict[str, np.ndarray]]:
-    """Regroup column dicts into consecutive pieces of exactly ``rows`` rows (last shorter)."""
-    buffer: list[dict[str, np.ndarray]] = []
-    held = 0
-    for part in tables:
-        n = len(next(iter(part.values()))) if part else 0
-        if n == 0:
-            continue
-        buffer.append(part)
-        held += n
-        while held >= rows:
-            joined = buffer[0] if len(buffer) == 1 else _join(buffer)
-            yield {k: v[:rows] for k, v in joined.items()}
-            rest = {k: v[rows:] for k, v in joined.items()}
-            held -= rows
-            buffer = [rest] if held else []
-    if held:
-        yield _join(buffer)
-
-
-def _join(parts: list[dict[str, np.ndarray]]) -> dict[str, np.ndarray]:
-    if len(parts) == 1:
-        return parts[0]
-    return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
-
-
 def iter_chunks(
     path: str | Path,
     rows: int = 1_000_000,
@@ -404,7 +379,7 @@ def iter_chunks(
                 if tail.get("time_s") is None or len(tail["time_s"]):
                     yield tail
 
-        pieces = _rechunk(converted(), rows)
+        pieces = rechunk(converted(), rows)
         head: list[dict[str, np.ndarray]] = []
         held = 0
         for piece in pieces:  # hold back the first rows: metadata may be inferred from them
