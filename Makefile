@@ -43,7 +43,7 @@ docs: $(STAMP)
 
 # Mutation testing of recording/, compensate/ and files.py (pyproject's [tool.mutmut]); not
 # run by CI: the full set takes hours on 2 cores. MUTANTS narrows it, e.g.
-# make mutation MUTANTS='hrgtc.files.*'
+# make mutation MUTANTS='hrgtc.core.files.*'
 MUTANTS ?=
 mutation: $(STAMP)
 	$(BIN)/python -m pip install --quiet 'mutmut==3.8.1'

@@ -7,7 +7,7 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-from hrgtc._process import peak_rss_mb
+from hrgtc.core.process import peak_rss_mb
 
 
 def _target(queue: Any, function: Callable[..., Any], args: tuple[Any, ...]) -> None:

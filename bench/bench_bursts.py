@@ -35,7 +35,7 @@ TARGET = 1.10
 
 
 def _model(folder: Path):
-    from hrgtc.calibration import calibrate
+    from hrgtc.pipeline.calibration import calibrate
     from hrgtc.simulate import simulate_files
     from hrgtc.simulate import standard_profiles as profiles
 

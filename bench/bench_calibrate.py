@@ -19,7 +19,7 @@ SETPOINTS_C = (-20.0, -10.0, 0.0, 10.0, 20.0, 30.0, 40.0)
 
 
 def _calibrate(soaks: list[str], drifts: list[str]) -> dict:
-    from hrgtc.calibration import calibrate
+    from hrgtc.pipeline.calibration import calibrate
 
     result = calibrate(soaks, drifts)
     return {"selected": list(result.model.drift.selected),

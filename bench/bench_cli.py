@@ -3,7 +3,7 @@
 The target (issue 9): every ``--help`` returns in under 1 s on this project's
 2-core machine. Each figure is the median of several runs of a fresh process,
 beside two references measured in the same run: a bare ``python -c pass`` (the
-interpreter's own floor) and ``python -c "import hrgtc.calibration, hrgtc.report,
+interpreter's own floor) and ``python -c "import hrgtc.pipeline.calibration, hrgtc.report,
 hrgtc.simulate"`` (what every start cost when the commands imported the library
 eagerly).
 """
@@ -36,8 +36,9 @@ def _median_seconds(argv: list[str], repeat: int) -> float:
 def run(quick: bool = False) -> list[dict]:
     repeat = 3  # median of 3 fresh processes per figure (7 took minutes of make bench)
     floor = _median_seconds([sys.executable, "-c", "pass"], repeat)
-    eager = _median_seconds([sys.executable, "-c",
-                             "import hrgtc.calibration, hrgtc.report, hrgtc.simulate"], repeat)
+    eager = _median_seconds(
+        [sys.executable, "-c", "import hrgtc.pipeline.calibration, hrgtc.report, hrgtc.simulate"],
+        repeat)
     out = []
     cases = [["--help"], ["--version"], *([c, "--help"] for c in COMMANDS)]
     for args in cases:

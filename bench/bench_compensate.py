@@ -20,7 +20,7 @@
 
 The model is calibrated on a small simulated campaign (not timed); its runs log a housing
 thermistor, so the drift model's candidates are the gradient terms (``g = housing_c - T(f)``,
-:data:`hrgtc.calibration.GRADIENT_TERMS`), which the fused kernel computes. The run to
+:data:`hrgtc.pipeline.calibration.GRADIENT_TERMS`), which the fused kernel computes. The run to
 compensate is a simulated warm-up, 14 h at 200 Hz (10 M samples).
 """
 
@@ -41,7 +41,7 @@ MEMORY_REPEATS = 3
 
 
 def _model(folder: Path, sample_rate_hz: float):
-    from hrgtc.calibration import calibrate
+    from hrgtc.pipeline.calibration import calibrate
     from hrgtc.simulate import simulate_files
     from hrgtc.simulate import standard_profiles as profiles
 

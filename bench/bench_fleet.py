@@ -29,7 +29,7 @@ def _calibrate_repeatedly(soaks: list[str], drifts: list[str], validate: list[st
                           times: int) -> None:
     import warnings
 
-    from hrgtc.calibration import calibrate
+    from hrgtc.pipeline.calibration import calibrate
 
     warnings.simplefilter("ignore")
     for _ in range(times):

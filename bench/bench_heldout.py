@@ -79,7 +79,7 @@ def _measure(path: Path, model, fs: float, options: dict | None = None) -> dict:
 
 def _one_seed(unit: str, seed: int, folder: Path, fs: float, hours: float,
               calibrate_options: dict) -> list[dict]:
-    from hrgtc.calibration import calibrate
+    from hrgtc.pipeline.calibration import calibrate
     from hrgtc.simulate import simulate_files
     from hrgtc.simulate import standard_profiles as profiles
     from hrgtc.simulate.profiles import from_mapping

@@ -126,7 +126,7 @@ def instrument(axes: str) -> Callable:
 
 def sensor_model(material: Material, folder: Path) -> Path:
     """A sensor-thermometer model (calibrated on the recording's temperature_c)."""
-    from hrgtc.calibration import calibrate
+    from hrgtc.pipeline.calibration import calibrate
 
     result = calibrate([], [material.run_path("1")], thermometer="sensor")
     return save_model(result.model, folder / "case.json", force=True)

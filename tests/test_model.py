@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from hrgtc import drift
-from hrgtc.errors import ModelFileError, OutputExistsError
+from hrgtc.core.errors import ModelFileError, OutputExistsError
 from hrgtc.model import SCHEMA_VERSION, UnitModel, load_model, provenance, save_model
 
 from synthetic import THERMOMETER, ramp_run

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from hrgtc import drift
-from hrgtc.errors import ModelFileError
+from hrgtc.core.errors import ModelFileError
 from hrgtc.model import SCHEMA_VERSION, UnitModel, load_model, save_model
 from hrgtc.model_schema import MODEL_SCHEMA, derived_coefficients
 

@@ -31,8 +31,8 @@ import pyarrow.parquet as pq
 import pytest
 
 from hrgtc.compensate import Compensator
-from hrgtc.errors import ModelFileError, RecordingError
-from hrgtc.files import write_text_atomic
+from hrgtc.core.errors import ModelFileError, RecordingError
+from hrgtc.core.files import write_text_atomic
 from hrgtc.model import load_model, save_model
 from hrgtc.recording import Metadata, Recording, read, split_at_gaps, validate, write
 

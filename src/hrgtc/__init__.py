@@ -10,7 +10,7 @@ The pipeline, one package per stage, imports flowing one way::
               -> calibration, demo -> cli
 
 Importing ``hrgtc`` itself loads none of the stages (the command line starts fast);
-import the stage you need, e.g. ``from hrgtc.calibration import calibrate``.
+import the stage you need, e.g. ``from hrgtc.pipeline.calibration import calibrate``.
 
 [1] X. Wang, W. Wu, Z. Fang, B. Luo, Y. Li, Q. Jiang, "Temperature Drift
     Compensation for Hemispherical Resonator Gyro Based on Natural Frequency",
@@ -22,7 +22,7 @@ from __future__ import annotations
 import os
 from typing import TYPE_CHECKING
 
-from hrgtc._meta import PAPER_REFERENCE, __version__
+from hrgtc.core.meta import PAPER_REFERENCE, __version__
 
 if TYPE_CHECKING:
     from hrgtc.model import UnitModel

@@ -24,11 +24,11 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
+from hrgtc.core.errors import HrgtcError, ModelFileError
+from hrgtc.core.files import file_sha256, write_text_atomic
 from hrgtc.drift import DriftModel
 from hrgtc.drift.scale_factor import ScaleFactorModel
 from hrgtc.drift.training import TrainingStatistics
-from hrgtc.errors import HrgtcError, ModelFileError
-from hrgtc.files import file_sha256, write_text_atomic
 from hrgtc.model_schema import (
     SCHEMA_NAME,
     SCHEMA_VERSION,
@@ -303,7 +303,7 @@ def model_sha256(model: UnitModel) -> str:
 
 def provenance(inputs: Mapping[str, list[str]], settings: Mapping[str, Any]) -> dict[str, Any]:
     """Provenance record: input files (role, path, SHA-256), settings, version, UTC time."""
-    from hrgtc._meta import __version__
+    from hrgtc.core.meta import __version__
 
     files = []
     for role, paths in inputs.items():

@@ -37,8 +37,8 @@ from collections.abc import Mapping
 from fractions import Fraction
 from typing import Any
 
+from hrgtc.core.errors import InputError, ModelFileError
 from hrgtc.drift.features import parse_terms
-from hrgtc.errors import InputError, ModelFileError
 
 SCHEMA_NAME = "hrgtc.model"
 #: 2: strict JSON (statistics that are not finite are written ``null``).

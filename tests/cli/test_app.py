@@ -13,8 +13,8 @@ import sys
 
 from typer.testing import CliRunner
 
-from hrgtc._meta import __version__
 from hrgtc.cli import app
+from hrgtc.core.meta import __version__
 
 HEAVY = ("numpy", "scipy", "pyarrow", "matplotlib", "numba", "h5py", "hrgtc.recording",
          "hrgtc.thermometry", "hrgtc.drift", "hrgtc.model", "hrgtc.simulate")

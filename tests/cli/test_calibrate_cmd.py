@@ -16,7 +16,7 @@ runner = CliRunner()
 
 
 def test_unwritable_output_fails_at_once_not_after_the_fit(tmp_path, monkeypatch):
-    from hrgtc import files
+    from hrgtc.core import files
 
     run = write(make_run(), tmp_path / "run.parquet")
     args = ["calibrate", "--soak", str(run), "--drift", str(run)]

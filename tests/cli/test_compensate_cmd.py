@@ -285,7 +285,7 @@ def test_unwritable_directory_fails_before_the_work(files, tmp_path):
 
 
 def test_permission_and_full_disk_are_one_line_errors(files, tmp_path, monkeypatch):
-    from hrgtc import files as files_module
+    from hrgtc.core import files as files_module
     from hrgtc.recording import formats
 
     _, model_path, run = files
@@ -375,7 +375,7 @@ def test_temporary_files_are_removed_on_sigterm_and_sigint(tmp_path, signum):
 
 
 def test_stale_temporary_files_of_dead_runs_are_removed_and_others_reported(files, tmp_path):
-    from hrgtc.files import StaleTemporaryWarning
+    from hrgtc.core.files import StaleTemporaryWarning
 
     _, model_path, run = files
     dead = subprocess.Popen([sys.executable, "-c", "pass"])

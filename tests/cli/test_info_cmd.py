@@ -13,7 +13,7 @@ import pytest
 from typer.testing import CliRunner
 
 from hrgtc.cli import app
-from hrgtc.errors import SpikeWarning
+from hrgtc.core.errors import SpikeWarning
 from hrgtc.recording import Metadata, Recording, write
 
 runner = CliRunner()
@@ -196,7 +196,7 @@ def test_info_of_a_messy_multi_axis_imu_file(tmp_path):
 
 def test_a_slow_housing_channel_is_held_or_refused_as_asked(tmp_path):
     # issue 20 item 5 on the command line: housing_c logged at 20 Hz in a 200 Hz file
-    from hrgtc.errors import SlowChannelWarning
+    from hrgtc.core.errors import SlowChannelWarning
 
     rec = recording(2000)
     housing = rec["housing_c"].copy()

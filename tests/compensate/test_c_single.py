@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 from scipy import signal
 
-from hrgtc import drift, paper
+from hrgtc import drift
 from hrgtc.compensate import Compensator
 from hrgtc.compensate.c_float32 import (
     float_accuracy,
@@ -32,9 +32,10 @@ from hrgtc.compensate.c_float32 import (
 )
 from hrgtc.compensate.c_plan import plan_for
 from hrgtc.compensate.export_c import export_c
+from hrgtc.core.errors import InputError
 from hrgtc.drift.features import causal_rate
-from hrgtc.errors import InputError
 from hrgtc.model import UnitModel
+from hrgtc.thermometry import paper
 
 from synthetic import THERMOMETER, lagged_run, ramp_run
 
@@ -123,7 +124,7 @@ def models():
                           drift=drift.fit([ramp_run(seed=1)], THERMOMETER))
     fitted = drift.fit([housing_run(seed=3)], THERMOMETER,
                        terms=("f", "f^2", "df", "h", "dh", "f*dh", "f^3"))
-    # the default candidates with a housing thermistor (hrgtc.calibration.GRADIENT_TERMS),
+    # the default candidates with a housing thermistor (hrgtc.pipeline.calibration.GRADIENT_TERMS),
     # and df: g = housing_c - T(f), the temperature from the float inverse
     terms = ("f", "f^2", "f^3", "g", "f*g", "f^2*g", "df")
     # reference 20 °C pinned: centred on its data (about 0 °C) this model's float build

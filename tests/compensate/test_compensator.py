@@ -17,7 +17,7 @@ from scipy import signal
 from hrgtc import drift
 from hrgtc import recording as recording_io
 from hrgtc.compensate import OUTPUT_COLUMNS, Compensator, compensate, compensate_file
-from hrgtc.errors import InputError, RecordingError
+from hrgtc.core.errors import InputError, RecordingError
 from hrgtc.model import UnitModel
 from hrgtc.recording import concatenate
 
@@ -204,7 +204,7 @@ def test_fused_slow_path_of_the_thermometer(unit_model, run):
 
 
 # -- the gradient g = housing_c - T(freq_hz) in the fused kernel ---------------------------
-#: The default candidates with a housing thermistor (hrgtc.calibration.GRADIENT_TERMS).
+#: The default candidates with a housing thermistor (hrgtc.pipeline.calibration.GRADIENT_TERMS).
 GRADIENT_TERMS = ("f", "f^2", "f^3", "g", "f*g", "f^2*g")
 
 
@@ -414,7 +414,7 @@ def test_models_with_d2_and_aux_run_on_numpy_in_both_engines():
         Compensator(model).process(without)
 
 
-@pytest.mark.filterwarnings("ignore::hrgtc.errors.RateFilterWarning")  # tau 10 s, gap 600 s
+@pytest.mark.filterwarnings("ignore::hrgtc.core.errors.RateFilterWarning")  # tau 10 s, gap 600 s
 @pytest.mark.parametrize("engine", ["fused", "numpy"])
 def test_a_gap_exactly_on_a_chunk_boundary(unit_model, run, engine):
     # issue 21 item 8: chunks cut exactly at the first row after a gap. In "split" the

@@ -25,12 +25,13 @@ from scipy import signal
 from typer.testing import CliRunner
 
 import hrgtc.cli.export_cmd  # noqa: F401  (registers the command)
-from hrgtc import drift, paper, thermometry
+from hrgtc import drift, thermometry
 from hrgtc.cli._app import app
 from hrgtc.compensate import Compensator
 from hrgtc.compensate.export_c import export_c
-from hrgtc.errors import CalibrationError, InputError, OutputExistsError
+from hrgtc.core.errors import CalibrationError, InputError, OutputExistsError
 from hrgtc.model import UnitModel, save_model
+from hrgtc.thermometry import paper
 
 from synthetic import THERMOMETER, block_std, ramp_run, with_heating_extra
 

@@ -17,11 +17,12 @@ import numpy as np
 import pytest
 from scipy import signal
 
-from hrgtc import drift, paper
+from hrgtc import drift
 from hrgtc.compensate import Compensator
 from hrgtc.compensate.export_c import export_c
-from hrgtc.errors import InputError, OutputExistsError
+from hrgtc.core.errors import InputError, OutputExistsError
 from hrgtc.model import UnitModel
+from hrgtc.thermometry import paper
 
 from synthetic import THERMOMETER, ramp_run, scale_factor, with_scale_factor
 
@@ -229,18 +230,19 @@ def test_parameters_with_a_scale_factor(tmp_path):
 
 def test_params_export_of_every_model_the_demo_writes(paper_campaign, imu_campaign, tmp_path):
     """Issue 21: ``export-c --format params`` failed with KeyError 'g' on every model whose
-    runs log housing_c. The demo's two models, calibrated as :mod:`hrgtc.demo` does (default
+    runs log housing_c. The demo's two models, calibrated as :mod:`hrgtc.pipeline.demo` does
+    (default
     terms), on the shared simulated campaigns, exported through the CLI."""
     import warnings
 
     from typer.testing import CliRunner
 
     import hrgtc.cli.export_cmd  # noqa: F401  (registers the command)
-    from hrgtc.calibration import calibrate
     from hrgtc.cli._app import app
-    from hrgtc.errors import HrgtcWarning
-    from hrgtc.instrument import calibrate_instrument
+    from hrgtc.core.errors import HrgtcWarning
     from hrgtc.model import save_instrument, save_model
+    from hrgtc.pipeline.calibration import calibrate
+    from hrgtc.pipeline.instrument import calibrate_instrument
 
     files = paper_campaign
     unit = calibrate(files.soaks, [files.cooldown]).model

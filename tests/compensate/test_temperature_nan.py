@@ -14,7 +14,7 @@ import pytest
 
 from hrgtc import drift
 from hrgtc.compensate import Compensator
-from hrgtc.errors import ExtrapolationWarning
+from hrgtc.core.errors import ExtrapolationWarning
 from hrgtc.model import UnitModel
 
 from synthetic import THERMOMETER, ramp_run

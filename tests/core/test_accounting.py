@@ -10,7 +10,7 @@ from typer.testing import CliRunner
 
 from hrgtc.cli import app
 from hrgtc.core.accounting import REASONS, Accounting
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 
 PAN = Path(__file__).resolve().parents[1] / "data" / "pan-cold-test" / "pan_tvc_cold_2020-03-07.csv"
 ARGS = ["--time-unit", "ms", "--thermometer", "sensor", "--rate-unit", "radps", "--col",

@@ -14,10 +14,10 @@ import pytest
 from typer.testing import CliRunner
 
 from hrgtc.cli import app
+from hrgtc.core.errors import CalibrationError
 from hrgtc.core.timeline import Timeline
 from hrgtc.drift.features import FeatureSettings, parse_terms
 from hrgtc.drift.windows import window_means
-from hrgtc.errors import CalibrationError
 from hrgtc.recording import ReadOptions
 
 PAN = Path(__file__).resolve().parents[1] / "data" / "pan-cold-test" / "pan_tvc_cold_2020-03-07.csv"

@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 from bursts import cut_bursts, duplicated_rows, with_time, wrapped_counter_s
+from hrgtc.core.errors import RecordingError
 from hrgtc.core.time_steps import WRAP_MODULUS_S, TimeRepairStream, classify_time_steps
 from hrgtc.drift.features import EQ21, FeatureSettings
 from hrgtc.drift.windows import window_means
-from hrgtc.errors import RecordingError
 from hrgtc.recording import Metadata, Recording, iter_chunks, read, write
 from hrgtc.recording.validation import validate
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from hrgtc.core.errors import InputError
 from hrgtc.core.timeline import (
     Timeline,
     TimelineBuilder,
@@ -18,7 +19,6 @@ from hrgtc.core.timeline import (
     time_blocks,
     windows,
 )
-from hrgtc.errors import InputError
 
 
 def burst_times(bursts=25, burst_s=5.0, period_s=300.0, rate_hz=50.0, start_s=15.352):

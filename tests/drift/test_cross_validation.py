@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from hrgtc import drift
+from hrgtc.core.errors import InputError
 from hrgtc.drift.cross_validation import CrossValidation, cross_validate, select_terms
 from hrgtc.drift.stepwise import stepwise
-from hrgtc.errors import InputError
 
 from synthetic import THERMOMETER, ramp_run
 

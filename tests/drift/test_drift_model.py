@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from hrgtc import drift
-from hrgtc.errors import CalibrationError, InputError
+from hrgtc.core.errors import CalibrationError, InputError
 from hrgtc.recording import Metadata, Recording
 
 from synthetic import THERMOMETER, block_std, ramp_run, with_heating_extra

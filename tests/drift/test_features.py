@@ -10,6 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy import signal
 
+from hrgtc.core.errors import InputError
 from hrgtc.drift.features import (
     EQ21,
     FeatureSettings,
@@ -21,7 +22,6 @@ from hrgtc.drift.features import (
     parse_terms,
     required_columns,
 )
-from hrgtc.errors import InputError
 from hrgtc.recording import Metadata, Recording
 
 

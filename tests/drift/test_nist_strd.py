@@ -16,9 +16,9 @@ import pytest
 import statsmodels.api as sm
 
 import nist_strd_data as nist
+from hrgtc.core.errors import InputError, PrecisionWarning, RankDeficientError
 from hrgtc.drift.regression import EXTENDED_PRECISION, GramAccumulator, ols, refine
 from hrgtc.drift.stepwise import stepwise
-from hrgtc.errors import InputError, PrecisionWarning, RankDeficientError
 
 from exact import exact_least_squares
 

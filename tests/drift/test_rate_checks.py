@@ -8,10 +8,10 @@ import warnings
 import numpy as np
 import pytest
 
+from hrgtc.core.errors import RateFilterWarning
 from hrgtc.drift.features import FeatureSettings, parse_terms
 from hrgtc.drift.rate_checks import burst_period_s, rate_filter_problems, resolution
 from hrgtc.drift.windows import window_means
-from hrgtc.errors import RateFilterWarning
 
 from synthetic import ramp_run
 

@@ -10,6 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from hrgtc.core.errors import InputError
 from hrgtc.drift.features import FeatureSettings, compute_variables
 from hrgtc.drift.rate_filter import (
     SERIES_LIMIT,
@@ -17,7 +18,6 @@ from hrgtc.drift.rate_filter import (
     rate_filter_coefficients,
     restart_mask,
 )
-from hrgtc.errors import InputError
 
 from synthetic import THERMOMETER, ramp_run
 

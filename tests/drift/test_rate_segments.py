@@ -10,13 +10,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from hrgtc.core.errors import InputError
 from hrgtc.drift import (
     RateStep,
     find_rate_segments,
     read_segment_table,
     segment_scale_errors,
 )
-from hrgtc.errors import InputError
 from hrgtc.recording import Metadata, Recording
 
 FS = 10.0

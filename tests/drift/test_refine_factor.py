@@ -10,9 +10,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from hrgtc.core.errors import InputError
 from hrgtc.drift.regression import EXTENDED_PRECISION, QRAccumulator, ols, refine
 from hrgtc.drift.stepwise import stepwise
-from hrgtc.errors import InputError
 
 
 def _data(weighted: bool):

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from hrgtc import drift
-from hrgtc.errors import CalibrationError
+from hrgtc.core.errors import CalibrationError
 from hrgtc.recording import Metadata, Recording
 from hrgtc.thermometry import identity
 
@@ -170,7 +170,7 @@ def test_guarded_selection_does_not_extrapolate_high_order_terms():
 
 def test_compensation_applies_known_orientations_and_reports_an_unknown_one():
     from hrgtc.compensate import Compensator
-    from hrgtc.errors import HrgtcWarning
+    from hrgtc.core.errors import HrgtcWarning
     from hrgtc.model import UnitModel
 
     orientations = ([300.0, -200.0, 100.0], [[0, 0, 1], [1, 0, 0], [0, -1, 0]])

@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 import statsmodels.api as sm
 
+from hrgtc.core.errors import HrgtcWarning, InputError
 from hrgtc.drift import (
     SCALE_FACTOR_JSON_SCHEMA,
     FeatureSettings,
@@ -26,7 +27,6 @@ from hrgtc.drift import (
     group_segments,
     segment_scale_errors,
 )
-from hrgtc.errors import HrgtcWarning, InputError
 from hrgtc.recording import Metadata, Recording
 
 from synthetic import THERMOMETER

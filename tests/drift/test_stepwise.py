@@ -17,6 +17,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy import signal
 
+from hrgtc.core.errors import InputError, RankDeficientError
 from hrgtc.drift.regression import newey_west_inflation
 from hrgtc.drift.stepwise import (
     GramAccumulator,
@@ -27,7 +28,6 @@ from hrgtc.drift.stepwise import (
     stepwise,
     stepwise_from_accumulator,
 )
-from hrgtc.errors import InputError, RankDeficientError
 
 # Hald (1952) cement data, as tabulated in Draper & Smith, Applied Regression
 # Analysis, 3rd ed. (1998), and shipped as MATLAB's `hald` data set:

@@ -13,6 +13,7 @@ import math
 import numpy as np
 import pytest
 
+from hrgtc.core.errors import InputError
 from hrgtc.drift.training import (
     UNIT_FACTORS,
     TrainingStatistics,
@@ -20,7 +21,6 @@ from hrgtc.drift.training import (
     rate_noise_dph,
     unit_mistake,
 )
-from hrgtc.errors import InputError
 
 from synthetic import ramp_run
 
@@ -125,7 +125,7 @@ def test_a_noise_density_beyond_any_gyro_is_warned_about():
 
 def test_calibrate_refuses_rate_unit_dps_on_an_hrg(paper_campaign):
     """The issue's case: calibrate fitted a model on °/h data read with --rate-unit dps."""
-    from hrgtc.calibration import calibrate
+    from hrgtc.pipeline.calibration import calibrate
     from hrgtc.recording import ReadOptions
 
     files = paper_campaign

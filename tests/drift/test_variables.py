@@ -27,6 +27,7 @@ from hrgtc.compensate.c_plan import plan_for
 from hrgtc.compensate.c_variables import step_inputs
 from hrgtc.compensate.export_c import export_c
 from hrgtc.compensate.parameter_file import parameter_text
+from hrgtc.core.errors import InputError
 from hrgtc.drift.features import VARIABLES, FeatureSettings
 from hrgtc.drift.variables import (
     BACKENDS,
@@ -37,7 +38,6 @@ from hrgtc.drift.variables import (
     unit,
     variable,
 )
-from hrgtc.errors import InputError
 from hrgtc.model import UnitModel
 
 from synthetic import THERMOMETER, lagged_run, with_heating_extra

@@ -18,7 +18,7 @@ import allantools
 import numpy as np
 import pytest
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 from hrgtc.evaluation.allan import (
     ONE_SIGMA,
     allan_deviation,

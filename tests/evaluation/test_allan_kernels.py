@@ -22,7 +22,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 from hrgtc.evaluation.allan import (
     ONE_SIGMA,
     AllanResult,

@@ -9,11 +9,11 @@ import pytest
 from typer.testing import CliRunner
 
 from hrgtc import load_model, recording
-from hrgtc.calibration import calibrate
 from hrgtc.cli import app
 from hrgtc.evaluation import evaluate
 from hrgtc.evaluation.metrics import bias_stability
 from hrgtc.model import save_model
+from hrgtc.pipeline.calibration import calibrate
 
 
 @pytest.fixture(scope="module")

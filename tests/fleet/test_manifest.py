@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 from hrgtc.fleet.manifest import load_fleet, read_manifest, scan_root
 
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from hrgtc.errors import RecordingError
+from hrgtc.core.errors import RecordingError
 from hrgtc.recording import (
     COLUMNS,
     Metadata,

@@ -22,7 +22,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from hrgtc.errors import InputError, OutputExistsError, RecordingError
+from hrgtc.core.errors import InputError, OutputExistsError, RecordingError
 from hrgtc.recording import (
     Metadata,
     Recording,

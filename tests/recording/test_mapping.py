@@ -13,7 +13,7 @@ import math
 import numpy as np
 import pytest
 
-from hrgtc.errors import InputError, RecordingError
+from hrgtc.core.errors import InputError, RecordingError
 from hrgtc.recording import ReadOptions, axis_names, axis_view, parse_columns, read
 
 RATE_HZ = 100.0

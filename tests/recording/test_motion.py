@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 from hrgtc.recording.motion import (
     MotionSettings,
     detect_motion,

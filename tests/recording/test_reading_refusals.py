@@ -16,7 +16,7 @@ import h5py
 import numpy as np
 import pytest
 
-from hrgtc.errors import RecordingError
+from hrgtc.core.errors import RecordingError
 from hrgtc.recording import Recording, axis_names, read, write
 
 from synthetic import ramp_run

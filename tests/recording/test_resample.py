@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from hrgtc.errors import InputError, SlowChannelWarning
+from hrgtc.core.errors import InputError, SlowChannelWarning
 from hrgtc.recording.resample import SlowChannels, fill_slow_channels
 
 

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from hrgtc.errors import InputError, SpikeWarning
+from hrgtc.core.errors import InputError, SpikeWarning
 from hrgtc.recording import ReadOptions, read
 from hrgtc.recording.spikes import SPIKE_COLUMN, RobustSpikeFilter, find_spikes
 
@@ -116,7 +116,7 @@ def test_bad_settings_are_named():
 
 
 def test_impossible_values_stay_the_validation_s_business(tmp_path):
-    from hrgtc.errors import RecordingError
+    from hrgtc.core.errors import RecordingError
     from hrgtc.recording import Metadata, Recording, write
 
     rng = np.random.default_rng(6)

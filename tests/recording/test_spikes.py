@@ -11,7 +11,7 @@ import warnings
 import numpy as np
 import pytest
 
-from hrgtc.errors import InputError, RecordingError, SpikeWarning
+from hrgtc.core.errors import InputError, RecordingError, SpikeWarning
 from hrgtc.recording import ReadOptions, Recording, iter_chunks, read, write
 
 RATE_HZ = 100.0

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from hrgtc.cli.options import UNIT_HELP
-from hrgtc.errors import InputError, UnitWarning
+from hrgtc.core.errors import InputError, UnitWarning
 from hrgtc.recording import read
 from hrgtc.recording.mapping import parse_unit, to_contract_unit, unwrap_count, wrapped_count_bits
 from hrgtc.recording.units import UNITS, convert, find_unit, per_sample_steps, unit_help

@@ -12,7 +12,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from hrgtc.errors import RecordingError
+from hrgtc.core.errors import RecordingError
 from hrgtc.recording import Metadata, Recording, iter_chunks, write
 
 RATE_HZ = 200.0

@@ -16,13 +16,14 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from hrgtc import paper, recording
-from hrgtc.calibration import calibrate
+from hrgtc import recording
 from hrgtc.cli import app
 from hrgtc.compensate import compensate
-from hrgtc.errors import OutputExistsError
+from hrgtc.core.errors import OutputExistsError
 from hrgtc.model import save_model
+from hrgtc.pipeline.calibration import calibrate
 from hrgtc.report import build_report
+from hrgtc.thermometry import paper
 
 from campaign import SETPOINTS_C
 

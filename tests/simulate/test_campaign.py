@@ -21,13 +21,13 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from hrgtc import simulate
-from hrgtc.errors import InputError, OutputExistsError
+from hrgtc.core.errors import InputError, OutputExistsError
 from hrgtc.evaluation.metrics import allan_deviation, bias_stability, noise_terms
-from hrgtc.paper import TABLE1_FREQUENCY_HZ, TABLE1_TEMPERATURE_C
 from hrgtc.recording import read
 from hrgtc.simulate import profiles, standard_profiles, units
 from hrgtc.simulate.shell import FUSED_QUARTZ, Shell
 from hrgtc.simulate.thermal import ThermalNetwork
+from hrgtc.thermometry.paper import TABLE1_FREQUENCY_HZ, TABLE1_TEMPERATURE_C
 
 PAPER_RAW_BIAS_STABILITY_RANGE = (2.5, 3.5)  # around 3.0143 °/h, Section 4.2 of [1]
 PAPER_CONSTANT_BIAS_STABILITY_RANGE = (0.5, 0.65)  # around 0.5848 °/h, Section 4.2 of [1]

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from numpy.polynomial import Polynomial
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 from hrgtc.simulate.laws import (
     BiasLaw,
     PolynomialFrequencyLaw,

@@ -10,7 +10,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from hrgtc.errors import InputError, OutputExistsError
+from hrgtc.core.errors import InputError, OutputExistsError
 from hrgtc.simulate import constant, cooldown
 from hrgtc.simulate.handling import Handling, orientation_matrix
 from hrgtc.simulate.logged_files import csv_text, sidecar_paths, write_logged

@@ -23,7 +23,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import hrgtc.simulate.shell as shell_module
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 from hrgtc.simulate.shell import (
     DEFAULT_RADIUS_M,
     DEFAULT_SHELL,

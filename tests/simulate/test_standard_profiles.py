@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import yaml
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 from hrgtc.simulate import profiles, standard_profiles
 from hrgtc.simulate.profiles import Segment
 

@@ -16,11 +16,12 @@ import re
 import numpy as np
 import pytest
 
-from hrgtc import paper, simulate
-from hrgtc.errors import CalibrationError, InputError, RecordingError
+from hrgtc import simulate
+from hrgtc.core.errors import CalibrationError, InputError, RecordingError
 from hrgtc.recording import Metadata, Recording
 from hrgtc.simulate import units
 from hrgtc.thermometry import fit as fit_thermometer
+from hrgtc.thermometry import paper
 from hrgtc.thermometry.plateaus import (
     Plateau,
     TransientFit,

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from numpy.polynomial import Polynomial
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 from hrgtc.thermometry import fit
 from hrgtc.thermometry.prior import (
     ThermometerPrior,

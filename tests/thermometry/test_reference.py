@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from hrgtc.errors import CalibrationError, RecordingError
+from hrgtc.core.errors import CalibrationError, RecordingError
 from hrgtc.recording import ReadOptions
 from hrgtc.thermometry.reference import (
     TemperatureMap,
@@ -164,7 +164,7 @@ def test_real_cold_test_map_from_its_hand_log():
 
 
 def test_reference_columns_option():
-    from hrgtc.errors import InputError
+    from hrgtc.core.errors import InputError
     from hrgtc.thermometry.reference import parse_reference_columns
 
     assert parse_reference_columns(["time_s=Time", "temperature_c=C1 (C)"]) == {

@@ -11,7 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from hrgtc.errors import CalibrationError, ExtrapolationWarning, InputError
+from hrgtc.core.errors import CalibrationError, ExtrapolationWarning, InputError
 from hrgtc.thermometry import Thermometer, fit
 
 from exact import exact_polynomial_fit

@@ -25,8 +25,8 @@ from rich.progress import (
     TimeRemainingColumn,
 )
 
-from hrgtc.errors import HrgtcError
-from hrgtc.progress import Progress as ProgressCallback
+from hrgtc.core.errors import HrgtcError
+from hrgtc.core.progress import Progress as ProgressCallback
 
 app = typer.Typer(
     name="hrgtc",
@@ -96,7 +96,7 @@ def library_errors() -> Iterator[None]:
     except FileNotFoundError as exc:
         raise fail(f"{exc.filename or exc}: no such file") from exc
     except OSError as exc:
-        from hrgtc.files import describe_os_error
+        from hrgtc.core.files import describe_os_error
 
         raise fail(describe_os_error(exc)) from exc
     except UnicodeError as exc:
@@ -197,7 +197,7 @@ def _root(
 ) -> None:
     """Temperature-drift compensation of HRGs from the resonator's natural frequency."""
     if version:
-        from hrgtc._meta import __version__
+        from hrgtc.core.meta import __version__
 
         console.print(f"hrgtc {__version__}")
         raise typer.Exit()

@@ -20,8 +20,8 @@ from hrgtc.cli.options import (
 )
 
 if TYPE_CHECKING:
-    from hrgtc.calibration import CalibrationResult
-    from hrgtc.instrument import InstrumentCalibration
+    from hrgtc.pipeline.calibration import CalibrationResult
+    from hrgtc.pipeline.instrument import InstrumentCalibration
     from hrgtc.recording import ReadOptions
 
 #: The nine candidate terms of Eq. (21) of [1], as the default of --terms (written out so
@@ -206,10 +206,10 @@ def calibrate_command(
     A gyro without a frequency output (its temperature sensor as the thermometer):
     hrgtc calibrate --thermometer sensor --drift cooldown.csv --drift warmup.csv -o imu.json
     """
-    from hrgtc.calibration import HOUSING_TERMS
-    from hrgtc.files import check_writable, refuse_existing, refuse_input
-    from hrgtc.instrument import calibrate_instrument
+    from hrgtc.core.files import check_writable, refuse_existing, refuse_input
     from hrgtc.model import save_instrument
+    from hrgtc.pipeline.calibration import HOUSING_TERMS
+    from hrgtc.pipeline.instrument import calibrate_instrument
     from hrgtc.recording import ReadOptions
 
     inputs = (inputs or ReadOptions()).with_spike_default("drop")
@@ -305,8 +305,8 @@ def _holdout(inputs: ReadOptions, soaks: list[Path], drift: list[Path],
     """Train on the first part of the one --drift file, validate on its last part (by time)."""
     import dataclasses
 
+    from hrgtc.core.errors import InputError
     from hrgtc.core.timeline import holdout_rows
-    from hrgtc.errors import InputError
 
     if len(drift) != 1 or soaks or validate:
         raise InputError("--holdout-s/--holdout-fraction hold out the end of one --drift file: "
@@ -356,7 +356,7 @@ def render_instrument(calibration: InstrumentCalibration) -> None:
             f"{trial['held_out_10s_dph_without']:.4f} without: {verdict}"
             + (f" (terms {', '.join(trial['selected'])})" if trial["selected"] else ""))
     if not calibration.model.is_single_axis:
-        from hrgtc.instrument import summary_rows
+        from hrgtc.pipeline.instrument import summary_rows
 
         table = Table(title=f"{calibration.model.unit}: per-axis summary (held-out median, °/h)")
         for column in ("axis", "drift terms", "raw 10 s", "compensated 10 s",
@@ -377,7 +377,7 @@ def render_instrument(calibration: InstrumentCalibration) -> None:
 
 def _aux_mapping(items: list[str]) -> dict[str, str]:
     """``--aux NAME=COLUMN`` options as {NAME: COLUMN}."""
-    from hrgtc.errors import InputError
+    from hrgtc.core.errors import InputError
 
     out: dict[str, str] = {}
     for item in items:

@@ -94,9 +94,9 @@ def compensate_command(
     Example: hrgtc compensate warmup.parquet --model unit.json -o warmup_comp.parquet
     """
     from hrgtc.compensate import compensate_instrument_file
-    from hrgtc.compensate.instrument import parse_axes
     from hrgtc.compensate.model_fit import check_thermometer_kind
-    from hrgtc.files import refuse_input
+    from hrgtc.compensate.multi_axis import parse_axes
+    from hrgtc.core.files import refuse_input
     from hrgtc.model import load_instrument
     from hrgtc.recording import ReadOptions
     from hrgtc.thermometry.reference import options_with_map
@@ -138,7 +138,7 @@ def render_evaluation(result: Evaluation, sensor: bool = False) -> None:
     ``sensor``: the thermometer is a temperature sensor (a MEMS gyro, not an HRG):
     the compensated row says so and the paper's HRG figures are left out.
     """
-    from hrgtc import paper
+    from hrgtc.thermometry import paper
 
     table = Table(title=f"Bias stability of {result.file} (1σ of τ-s means, °/h; "
                   f"{result.confidence:.3g} chi-squared interval)")
@@ -215,11 +215,11 @@ def evaluate_command(
     Example: hrgtc evaluate warmup.parquet --model unit.json --deviation oadev
     --allan-csv warmup_allan.csv --json
     """
-    from hrgtc.compensate.instrument import match_axes, parse_axes, recording_axes
     from hrgtc.compensate.model_fit import check_thermometer_kind
+    from hrgtc.compensate.multi_axis import match_axes, parse_axes, recording_axes
+    from hrgtc.core.files import refuse_existing, refuse_input, write_text_atomic
     from hrgtc.evaluation import evaluate
     from hrgtc.evaluation.run_pass import DEVIATIONS
-    from hrgtc.files import refuse_existing, refuse_input, write_text_atomic
     from hrgtc.model import load_instrument
     from hrgtc.recording import ReadOptions
     from hrgtc.thermometry.reference import options_with_map
@@ -282,7 +282,7 @@ def evaluate_command(
 def scale_checks(run: Path, model: InstrumentModel, inputs: ReadOptions) -> tuple:
     """The scale-factor check of a rate-table run (it has input_rate_dph columns) when the
     model has a scale factor; () otherwise."""
-    from hrgtc.instrument import check_scale_factor
+    from hrgtc.pipeline.instrument import check_scale_factor
 
     if all(m.scale_factor is None for m in model.axes.values()):
         return ()

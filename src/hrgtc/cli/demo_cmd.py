@@ -28,8 +28,8 @@ def demo_command(
 
     Example: hrgtc demo -o demo-out --force
     """
-    from hrgtc import paper
-    from hrgtc.demo import DemoSettings, run_demo
+    from hrgtc.pipeline.demo import DemoSettings, run_demo
+    from hrgtc.thermometry import paper
 
     settings = DemoSettings.quick() if quick else DemoSettings()
     settings = DemoSettings(settings.sample_rate_hz, settings.soak_hours, settings.ramp_hours, seed,

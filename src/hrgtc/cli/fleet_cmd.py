@@ -175,7 +175,7 @@ def evaluate_command(
 
     Example: hrgtc fleet evaluate fleet/ --models models/
     """
-    from hrgtc.files import refuse_input
+    from hrgtc.core.files import refuse_input
     from hrgtc.fleet import evaluate_fleet
 
     with library_errors():
@@ -209,7 +209,7 @@ def report_command(
 
     Example: hrgtc fleet report models/ -o fleet.html
     """
-    from hrgtc.files import refuse_input
+    from hrgtc.core.files import refuse_input
     from hrgtc.fleet import report_fleet
 
     with library_errors():
@@ -241,7 +241,7 @@ def prior_command(
     Example: hrgtc fleet prior models/ -o prior.json, then
     hrgtc calibrate --prior prior.json --soak s-20.parquet --soak s40.parquet --drift ...
     """
-    from hrgtc.files import refuse_input
+    from hrgtc.core.files import refuse_input
     from hrgtc.fleet import build_prior
 
     with library_errors():

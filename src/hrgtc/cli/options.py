@@ -30,7 +30,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 
 if TYPE_CHECKING:
     from hrgtc.recording import ReadOptions

@@ -16,7 +16,7 @@ def paper_command(
 
     Example: hrgtc paper --json
     """
-    from hrgtc import paper
+    from hrgtc.thermometry import paper
 
     with library_errors():
         result = paper.reproduce()

@@ -40,9 +40,9 @@ def report_command(
     Example: hrgtc report --model unit.json cooldown.parquet warmup.parquet -o report.html
     """
     from hrgtc.cli.compensate_cmd import note_unchecked
-    from hrgtc.compensate.instrument import match_axes, parse_axes, recording_axes
     from hrgtc.compensate.model_fit import check_thermometer_kind
-    from hrgtc.files import check_writable, refuse_existing, refuse_input
+    from hrgtc.compensate.multi_axis import match_axes, parse_axes, recording_axes
+    from hrgtc.core.files import check_writable, refuse_existing, refuse_input
     from hrgtc.model import load_instrument
     from hrgtc.recording import ReadOptions
     from hrgtc.report import build_report

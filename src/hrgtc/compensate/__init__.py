@@ -19,7 +19,7 @@ from hrgtc.compensate.compensator import (
     compensate_file,
 )
 from hrgtc.compensate.export_c import export_c
-from hrgtc.compensate.instrument import (
+from hrgtc.compensate.multi_axis import (
     InstrumentCompensator,
     compensate_instrument_file,
     instrument_output_columns,

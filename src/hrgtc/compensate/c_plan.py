@@ -11,10 +11,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hrgtc.core.errors import CalibrationError, InputError
 from hrgtc.drift.features import is_aux, variable_key
 from hrgtc.drift.rate_filter import check_tau
 from hrgtc.drift.variables import refusal, supported
-from hrgtc.errors import CalibrationError, InputError
 from hrgtc.model import UnitModel
 
 #: Points of the embedded table that starts the thermometer's Newton iteration.

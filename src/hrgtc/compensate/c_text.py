@@ -76,8 +76,8 @@ def readme(model: UnitModel, plan: CPlan, prefix: str, origin: str,
 
     ``sections`` replace the UNITS and USAGE sections (the float32 build writes its own).
     """
-    from hrgtc._meta import PAPER_REFERENCE, __version__
     from hrgtc.compensate.c_scale import scale_pieces
+    from hrgtc.core.meta import PAPER_REFERENCE, __version__
 
     drift, thermometer, settings = model.drift, model.thermometer, model.drift.settings
     p, up = prefix, prefix.upper()

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from hrgtc.compensate.c_plan import CPlan
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 
 
 @dataclass(frozen=True)

@@ -32,6 +32,9 @@ from hrgtc.compensate.model_fit import (
     with_model_band,
 )
 from hrgtc.compensate.ranges import RangeReport, range_report
+from hrgtc.core.errors import CalibrationError, ExtrapolationWarning, HrgtcWarning, InputError
+from hrgtc.core.files import check_writable, refuse_input
+from hrgtc.core.progress import Progress
 from hrgtc.core.timeline import is_gap
 from hrgtc.drift import DriftModel
 from hrgtc.drift.features import (
@@ -44,10 +47,7 @@ from hrgtc.drift.features import (
 from hrgtc.drift.offsets import label_offsets, sample_offsets
 from hrgtc.drift.rate_checks import filtered_levels, rate_filter_problems, warn_rate_filter
 from hrgtc.drift.rate_filter import check_time, restart_mask
-from hrgtc.errors import CalibrationError, ExtrapolationWarning, HrgtcWarning, InputError
-from hrgtc.files import check_writable, refuse_input
 from hrgtc.model import UnitModel
-from hrgtc.progress import Progress
 from hrgtc.recording import Recording
 from hrgtc.recording.gaps import check_gap_policy
 from hrgtc.recording.marks import COMPENSATED_KEY, mark, refuse_compensated
@@ -422,8 +422,8 @@ def compensate_file(
 
     ``compensator``: another streaming compensator with the interface of
     :class:`Compensator` and a ``columns`` attribute (e.g. the
-    :class:`~hrgtc.compensate.instrument.InstrumentCompensator` of every axis, see
-    :func:`~hrgtc.compensate.instrument.compensate_instrument_file`); ``model`` then
+    :class:`~hrgtc.compensate.multi_axis.InstrumentCompensator` of every axis, see
+    :func:`~hrgtc.compensate.multi_axis.compensate_instrument_file`); ``model`` then
     only marks the output.
 
     The output is written atomically in the format of its suffix; it is never

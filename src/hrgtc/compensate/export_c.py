@@ -54,8 +54,8 @@ from hrgtc.compensate.c_float32 import float_accuracy, float_constants
 from hrgtc.compensate.c_plan import PRECISIONS, plan_for
 from hrgtc.compensate.c_text import _comment, header, source
 from hrgtc.compensate.parameter_file import instrument_parameter_text, parameter_text
-from hrgtc.errors import InputError
-from hrgtc.files import file_sha256, refuse_existing, refuse_input, write_text_atomic
+from hrgtc.core.errors import InputError
+from hrgtc.core.files import file_sha256, refuse_existing, refuse_input, write_text_atomic
 from hrgtc.model import InstrumentModel, UnitModel, load_instrument
 
 #: What the export writes: C99 files, or the plain parameter file.

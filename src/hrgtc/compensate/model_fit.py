@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from hrgtc import recording as rec_io
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 from hrgtc.model import UnitModel
 from hrgtc.recording import Recording
 

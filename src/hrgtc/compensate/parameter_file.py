@@ -22,9 +22,9 @@ from typing import Any
 from hrgtc.compensate.c_plan import CPlan
 from hrgtc.compensate.c_text import NEWTON_MAX_ITER, sensor_note
 from hrgtc.compensate.c_types import DOUBLE
+from hrgtc.core.errors import InputError
 from hrgtc.drift.features import settle_rows
 from hrgtc.drift.variables import ascii_unit, refusal, variable
-from hrgtc.errors import InputError
 from hrgtc.model import UnitModel
 
 #: Version of the file's layout (a key of the file).
@@ -239,7 +239,7 @@ def _scale_factor_lines(model: UnitModel, put: Any) -> None:
 
 
 def _head(model: UnitModel, origin: str, sha256: str, key: str = "") -> list[str]:
-    from hrgtc._meta import PAPER_REFERENCE, __version__
+    from hrgtc.core.meta import PAPER_REFERENCE, __version__
 
     prov = model.provenance
     return [

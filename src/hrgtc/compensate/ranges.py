@@ -21,9 +21,9 @@ from typing import Any
 
 import numpy as np
 
+from hrgtc.core.errors import ExtrapolationWarning
 from hrgtc.drift import DriftModel
 from hrgtc.drift.variables import is_aux, unit, variable
-from hrgtc.errors import ExtrapolationWarning
 from hrgtc.thermometry import Thermometer
 
 

@@ -13,32 +13,47 @@ held-out split means the same thing in ``info``, ``calibrate``, ``compensate`` a
   rate, a rate that really changes) and the repair that makes each the clean file;
 * :mod:`hrgtc.core.accounting` -- samples read, used, and dropped or flagged by reason.
 
-``core`` imports nothing from the other hrgtc stages except :mod:`hrgtc.errors`.
+It also holds what every stage needs and that depends on nothing else of hrgtc:
+
+* :mod:`hrgtc.core.errors` -- the exception and warning classes (one ``HrgtcError``,
+  one ``HrgtcWarning`` at the root);
+* :mod:`hrgtc.core.meta` -- the version and the paper's reference;
+* :mod:`hrgtc.core.files` -- atomic output files, never overwritten without ``force``;
+* :mod:`hrgtc.core.progress` -- the progress callback of long library functions;
+* :mod:`hrgtc.core.process` -- facts about the running process (peak memory).
+
+``core`` imports nothing from the other hrgtc stages. Its names are loaded on first use
+(PEP 562), so ``from hrgtc.core.errors import HrgtcError`` costs no numpy import and the
+command line starts at once.
 """
 
 from __future__ import annotations
 
-from hrgtc.core.accounting import REASONS, Accounting
-from hrgtc.core.time_steps import TimeDiagnosis, TimeEvent, classify_time_steps
-from hrgtc.core.timeline import (
-    GAP_FACTOR,
-    GAP_TOLERANCE,
-    Timeline,
-    TimelineBuilder,
-    gap_limit_s,
-    is_gap,
-    median_period_s,
-    parse_time_bound,
-    seconds_since_power_on,
-    segment_bounds,
-    slice_rows,
-    time_blocks,
-    windows,
-)
+import importlib
+from typing import Any
 
-__all__ = [
-    "GAP_FACTOR", "GAP_TOLERANCE", "REASONS", "Accounting", "TimeDiagnosis", "TimeEvent",
-    "Timeline", "TimelineBuilder", "classify_time_steps", "gap_limit_s", "is_gap",
-    "median_period_s", "parse_time_bound", "seconds_since_power_on", "segment_bounds",
-    "slice_rows", "time_blocks", "windows",
-]
+#: Public name -> the core module that defines it (loaded on first access).
+_NAMES = {
+    "REASONS": "accounting", "Accounting": "accounting",
+    "TimeDiagnosis": "time_steps", "TimeEvent": "time_steps", "classify_time_steps": "time_steps",
+    **{name: "timeline" for name in (
+        "GAP_FACTOR", "GAP_TOLERANCE", "Timeline", "TimelineBuilder", "gap_limit_s", "is_gap",
+        "median_period_s", "parse_time_bound", "seconds_since_power_on", "segment_bounds",
+        "slice_rows", "time_blocks", "windows",
+    )},
+}
+
+__all__ = sorted(_NAMES)
+
+
+def __getattr__(name: str) -> Any:
+    module = _NAMES.get(name)
+    if module is None:
+        raise AttributeError(f"module 'hrgtc.core' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f"hrgtc.core.{module}"), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_NAMES))

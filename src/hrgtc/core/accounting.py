@@ -15,7 +15,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 
 #: Reason -> how it reads in a report. One line per reason.
 REASONS: dict[str, str] = {

@@ -32,7 +32,7 @@ from typing import Any
 
 import numpy as np
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 
 GAP_FACTOR = 2.0  # a time step longer than this many sample periods is a gap
 #: Relative slack of the gap threshold: one missing sample (a step of exactly 2 periods)

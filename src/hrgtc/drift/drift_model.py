@@ -32,6 +32,8 @@ from typing import Any
 import numpy as np
 
 from hrgtc.core.accounting import Accounting
+from hrgtc.core.errors import CalibrationError, InputError
+from hrgtc.core.progress import Progress
 from hrgtc.drift.cross_validation import (
     CrossValidation,
     cross_validate,
@@ -59,8 +61,6 @@ from hrgtc.drift.regression import EXTENDED_PRECISION, newey_west_inflation
 from hrgtc.drift.rest import check_policy, reference_point, run_rest
 from hrgtc.drift.stepwise import StepwiseResult, stepwise
 from hrgtc.drift.windows import RunSource, TrainingWindows, _iter_run, window_means
-from hrgtc.errors import CalibrationError, InputError
-from hrgtc.progress import Progress
 from hrgtc.recording import Recording
 from hrgtc.recording.motion import MotionSettings
 from hrgtc.thermometry import Thermometer

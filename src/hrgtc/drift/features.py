@@ -59,6 +59,7 @@ from typing import Any
 
 import numpy as np
 
+from hrgtc.core.errors import InputError
 from hrgtc.drift.rate_filter import (  # noqa: F401  (re-exported: imported from here)
     RateFilterState,
     causal_rate,
@@ -67,7 +68,6 @@ from hrgtc.drift.rate_filter import (  # noqa: F401  (re-exported: imported from
 )
 from hrgtc.drift.variables import AUX_PREFIX, DRIFT_VARIABLES, FIXED
 from hrgtc.drift.variables import variable as _registered
-from hrgtc.errors import InputError
 from hrgtc.recording.schema import Recording
 
 #: Variable name -> (unit, description), from the one list of :mod:`hrgtc.drift.variables`.

@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 from hrgtc.recording.motion import orientation_labels
 
 #: Offset modes of a drift fit (``--offsets``).

@@ -20,7 +20,7 @@ divided by a power of two near its standard deviation there (exact), so data
 with a large offset (a frequency of 4425 Hz varying by mHz) lose nothing to the
 intercept. A subset whose centred, column-equilibrated triangular factor has a
 reciprocal condition number below ``tol`` raises
-:class:`~hrgtc.errors.RankDeficientError` naming the collinear columns.
+:class:`~hrgtc.core.errors.RankDeficientError` naming the collinear columns.
 
 [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
 """
@@ -36,7 +36,7 @@ import numpy as np
 from scipy import stats
 from scipy.linalg import lapack
 
-from hrgtc.errors import InputError, RankDeficientError
+from hrgtc.core.errors import InputError, RankDeficientError
 
 COLLINEARITY_TOL = 1e-12
 """Default ``tol``: smallest allowed reciprocal condition number (2-norm) of the

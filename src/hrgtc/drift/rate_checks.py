@@ -17,7 +17,7 @@ Two ways a valid recording defeats the filter of :mod:`hrgtc.drift.rate_filter`:
   values that recurs (not one rounding accident).
 
 :func:`rate_filter_problems` returns the messages; :func:`warn_rate_filter` issues each
-as a :class:`~hrgtc.errors.RateFilterWarning`, once per message.
+as a :class:`~hrgtc.core.errors.RateFilterWarning`, once per message.
 """
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from hrgtc.errors import RateFilterWarning
+from hrgtc.core.errors import RateFilterWarning
 
 #: A time step longer than this many median steps is a gap between bursts.
 GAP_FACTOR = 2.0
@@ -165,7 +165,7 @@ def column_units() -> dict[str, str]:
 
 
 def warn_rate_filter(messages: Iterable[str]) -> None:
-    """Issue each message once as a :class:`~hrgtc.errors.RateFilterWarning`."""
+    """Issue each message once as a :class:`~hrgtc.core.errors.RateFilterWarning`."""
     for message in dict.fromkeys(messages):
         warnings.warn(message, RateFilterWarning, stacklevel=3)
 

@@ -48,13 +48,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hrgtc.core.errors import InputError
 from hrgtc.drift.rate_weights import (  # noqa: F401  (re-exported: imported from here)
     DT_REL_TOLERANCE,
     SERIES_LIMIT,
     SERIES_TERMS,
     series_coefficients,
 )
-from hrgtc.errors import InputError
 
 #: Slots of the filter state array: lag, difference, previous input, previous time,
 #: started (0/1), and the cached step: its Δt, a and p.

@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 from hrgtc.recording import Recording
 
 __all__ = [

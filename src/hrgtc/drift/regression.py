@@ -33,6 +33,7 @@ import numpy as np
 from scipy import stats
 from scipy.linalg import solve_triangular
 
+from hrgtc.core.errors import InputError, PrecisionWarning
 from hrgtc.drift.qr_accumulator import (
     COLLINEARITY_TOL,
     OLSResult,
@@ -41,7 +42,6 @@ from hrgtc.drift.qr_accumulator import (
     _readonly,
     _validate_chunk,
 )
-from hrgtc.errors import InputError, PrecisionWarning
 
 GramAccumulator = QRAccumulator
 """The library's accumulator of regression statistics (the name callers use)."""
@@ -161,7 +161,7 @@ def refine(result: OLSResult, X: Any, y: Any, weights: Any = None, *,
     OLSResult
         ``result`` with refined coefficients. Where ``numpy.longdouble`` is no
         wider than float64 (:data:`EXTENDED_PRECISION` False), ``result``
-        itself, with a :class:`~hrgtc.errors.PrecisionWarning`.
+        itself, with a :class:`~hrgtc.core.errors.PrecisionWarning`.
 
     Examples
     --------

@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from hrgtc.errors import CalibrationError, InputError
+from hrgtc.core.errors import CalibrationError, InputError
 from hrgtc.recording.motion import (
     ACCEL_COLUMNS,
     MOTION_POLICIES,

@@ -34,6 +34,7 @@ from typing import Any
 
 import numpy as np
 
+from hrgtc.core.errors import HrgtcWarning, InputError
 from hrgtc.drift.features import (
     FeatureSettings,
     ParsedTerms,
@@ -44,7 +45,6 @@ from hrgtc.drift.features import (
 )
 from hrgtc.drift.rate_segments import RateSegment
 from hrgtc.drift.stepwise import Step, stepwise
-from hrgtc.errors import HrgtcWarning, InputError
 
 __all__ = [
     "SCALE_FACTOR_JSON_SCHEMA",

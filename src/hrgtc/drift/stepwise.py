@@ -31,6 +31,7 @@ from typing import Any
 
 import numpy as np
 
+from hrgtc.core.errors import HrgtcWarning, InputError, RankDeficientError
 from hrgtc.drift.qr_accumulator import _check_names, _resolve_terms, _solve
 from hrgtc.drift.regression import (
     COLLINEARITY_TOL,
@@ -40,7 +41,6 @@ from hrgtc.drift.regression import (
     ols_from_accumulator,
     refine,
 )
-from hrgtc.errors import HrgtcWarning, InputError, RankDeficientError
 
 __all__ = [
     "COLLINEARITY_TOL",
@@ -168,7 +168,7 @@ def stepwise(X: Any, y: Any, names: Sequence[str] | None = None, penter: float =
     max_steps
         Most steps to take; default no limit. A step that would return to a
         model already visited stops the search (``stop_reason == "cycle"``, with
-        an :class:`~hrgtc.errors.HrgtcWarning`), so it always ends.
+        an :class:`~hrgtc.core.errors.HrgtcWarning`), so it always ends.
     weights
         Optional non-negative weight per row.
     tol

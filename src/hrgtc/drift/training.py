@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 
 #: Unit factors a recording's noise ratio to the training data's is tested against: the
 #: factor, what it would mean when the recording is that much *larger*, and smaller.

@@ -27,11 +27,11 @@ from typing import Any
 
 import numpy as np
 
+from hrgtc.core.errors import CalibrationError, InputError
+from hrgtc.core.progress import Progress
 from hrgtc.core.timeline import is_gap, min_partial_rows
 from hrgtc.drift.features import FeatureSettings, FeatureStream, Term, design_matrix, variables_for
 from hrgtc.drift.rate_checks import filtered_levels, rate_filter_problems, warn_rate_filter
-from hrgtc.errors import CalibrationError, InputError
-from hrgtc.progress import Progress
 from hrgtc.recording import Recording
 
 RunSource = Recording | Callable[[], Iterator[Recording]]

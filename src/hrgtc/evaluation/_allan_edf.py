@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 
 #: Power-law noise exponents α of S_y(f) ∝ f^α with a simple edf, SP 1065 Table 5 [3].
 NOISE_ALPHAS = {

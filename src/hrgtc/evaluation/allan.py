@@ -32,7 +32,8 @@ from typing import Any
 
 import numpy as np
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
+from hrgtc.core.progress import Progress
 from hrgtc.evaluation._allan_edf import (
     NOISE_ALPHAS,
     ONE_SIGMA,
@@ -41,7 +42,6 @@ from hrgtc.evaluation._allan_edf import (
     equivalent_degrees_of_freedom,
     greenhall_edf,
 )
-from hrgtc.progress import Progress
 
 __all__ = [
     "KINDS", "NOISE_ALPHAS", "ONE_SIGMA", "AllanResult", "allan_deviation",

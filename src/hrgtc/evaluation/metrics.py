@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 from hrgtc.evaluation.allan import (
     FLICKER_FLOOR_FACTOR,
     ONE_SIGMA,

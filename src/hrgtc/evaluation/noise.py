@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 from hrgtc.evaluation.allan import FLICKER_FLOOR_FACTOR, SECONDS_PER_HOUR, AllanResult
 
 __all__ = ["RAMP_SLOPE", "NoiseTerms", "noise_terms"]

@@ -30,9 +30,10 @@ from hrgtc.compensate import Compensator
 from hrgtc.compensate.model_fit import check_recording_noise, with_model_band
 from hrgtc.compensate.ranges import RangeReport
 from hrgtc.core.accounting import Accounting
+from hrgtc.core.errors import HrgtcError, InputError, RecordingError
+from hrgtc.core.progress import Progress
 from hrgtc.drift.features import FeatureStream
 from hrgtc.drift.rest import run_rest
-from hrgtc.errors import HrgtcError, InputError, RecordingError
 from hrgtc.evaluation.allan import (
     ONE_SIGMA,
     AllanResult,
@@ -55,7 +56,6 @@ from hrgtc.evaluation.plot_blocks import BlockMeans, block_rows
 from hrgtc.evaluation.series_stats import SeriesStatistics
 from hrgtc.evaluation.settling_cut import SettlingCut
 from hrgtc.model import UnitModel
-from hrgtc.progress import Progress
 from hrgtc.recording import ReadOptions, Recording, count_rows
 from hrgtc.recording.marks import compensation_mark, describe_mark, refuse_compensated
 

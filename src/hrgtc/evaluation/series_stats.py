@@ -39,8 +39,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from hrgtc.core.errors import InputError
 from hrgtc.core.timeline import min_partial_rows
-from hrgtc.errors import InputError
 from hrgtc.evaluation.allan import AllanResult, _block_length, allan_deviation
 
 #: Samples kept at full resolution for the Allan deviation (32 MiB per series).

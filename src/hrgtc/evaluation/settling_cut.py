@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from hrgtc.core.errors import InputError
 from hrgtc.core.timeline import is_gap
-from hrgtc.errors import InputError
 from hrgtc.evaluation.series_stats import SeriesStatistics
 
 

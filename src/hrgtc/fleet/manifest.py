@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 from hrgtc.recording.formats import SUFFIXES
 
 __all__ = ["ROLES", "UnitFiles", "load_fleet", "read_manifest", "scan_root"]

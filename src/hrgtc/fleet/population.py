@@ -37,10 +37,10 @@ from typing import Any
 import numpy as np
 from numpy.polynomial import Polynomial
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 from hrgtc.simulate import units as simulated_units
 from hrgtc.simulate.laws import BiasLaw, PolynomialFrequencyLaw, table1_frequency_law
-from hrgtc.simulate.noise import GyroNoise
+from hrgtc.simulate.noise_sources import GyroNoise
 from hrgtc.simulate.thermal import ThermalNetwork
 from hrgtc.simulate.units import Unit
 

@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 from matplotlib.figure import Figure
 
-from hrgtc.files import refuse_existing, write_text_atomic
+from hrgtc.core.files import refuse_existing, write_text_atomic
 from hrgtc.report.figures import svg_data_uri
 
 __all__ = ["OUTLIER_Z", "build_fleet_report", "outliers", "robust_z"]

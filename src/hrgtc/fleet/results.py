@@ -21,12 +21,12 @@ from typing import TYPE_CHECKING, Any, Protocol
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from hrgtc.errors import InputError
-from hrgtc.files import publish, refuse_existing, temporary_beside
+from hrgtc.core.errors import InputError
+from hrgtc.core.files import publish, refuse_existing, temporary_beside
 
 if TYPE_CHECKING:
-    from hrgtc.calibration import CalibrationResult
     from hrgtc.evaluation import Evaluation
+    from hrgtc.pipeline.calibration import CalibrationResult
 
 __all__ = ["SCHEMA", "calibration_row", "evaluation_row", "read_table", "table", "write_table"]
 

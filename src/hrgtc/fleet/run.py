@@ -29,9 +29,9 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-from hrgtc._process import peak_rss_mb
+from hrgtc.core.process import peak_rss_mb
+from hrgtc.core.progress import Progress
 from hrgtc.fleet.tasks import UnitOutcome, error_record
-from hrgtc.progress import Progress
 
 __all__ = ["FleetRun", "Task", "run_tasks", "scheduler_address", "worker_deaths"]
 
@@ -198,7 +198,7 @@ def run_tasks(tasks: Sequence[Task], *, scheduler: str | None = None, workers: i
     label
         Part of the Dask task keys (what the dashboard shows).
     """
-    from hrgtc.errors import InputError
+    from hrgtc.core.errors import InputError
 
     start = time.perf_counter()
     if workers is not None and workers < 0:

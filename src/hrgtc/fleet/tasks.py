@@ -83,7 +83,7 @@ def error_record(exc: BaseException, paths: tuple[str, ...] = ()) -> dict[str, A
     row = _ROW.search(message)
     record = {"type": type(exc).__name__, "message": message, "file": file,
               "column": column, "row": int(row.group(1)) if row else None}
-    from hrgtc.errors import HrgtcError
+    from hrgtc.core.errors import HrgtcError
 
     if not isinstance(exc, HrgtcError):  # a bug or an unforeseen input: keep where it was
         record["traceback"] = traceback.format_exception(exc)[-3:]
@@ -106,7 +106,7 @@ def model_path(output_dir: str | Path, unit: str) -> Path:
 
 
 def _input_hashes(files: UnitFiles) -> list[dict[str, str]]:
-    from hrgtc.files import file_sha256
+    from hrgtc.core.files import file_sha256
 
     return [{"role": role, "path": path, "sha256": file_sha256(path)}
             for role, paths in files.roles().items() for path in paths]
@@ -132,7 +132,7 @@ def _resumable(files: UnitFiles, output_dir: str) -> UnitOutcome | None:
 def calibrate_unit(files: UnitFiles, output_dir: str, settings: Mapping[str, Any],
                    read_options: ReadOptions | None = None, resume: bool = False,
                    prior_path: str | None = None) -> UnitOutcome:
-    """Calibrate one unit (:func:`hrgtc.calibration.calibrate`) and write its model file.
+    """Calibrate one unit (:func:`hrgtc.pipeline.calibration.calibrate`) and write its model file.
 
     Writes ``<output_dir>/<unit>.json`` (the model) and ``<unit>.outcome.json``
     (its row), overwriting them: the driver has checked what may be overwritten.
@@ -147,9 +147,9 @@ def calibrate_unit(files: UnitFiles, output_dir: str, settings: Mapping[str, Any
                 return previous
         import warnings
 
-        from hrgtc.calibration import calibrate
         from hrgtc.fleet.results import calibration_row
         from hrgtc.model import save_model
+        from hrgtc.pipeline.calibration import calibrate
 
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # the table reports out-of-range shares
@@ -171,7 +171,7 @@ def calibrate_unit(files: UnitFiles, output_dir: str, settings: Mapping[str, Any
 
 
 def _write_outcome(output_dir: str, outcome: UnitOutcome) -> None:
-    from hrgtc.files import write_text_atomic
+    from hrgtc.core.files import write_text_atomic
 
     write_text_atomic(outcome_path(output_dir, outcome.unit),
                       json.dumps(outcome.to_dict(), indent=1, allow_nan=True) + "\n", force=True)
@@ -230,7 +230,7 @@ def simulate_unit(seed: int, index: int, root: str, sample_rate_hz: float, soak_
     start = time.perf_counter()
     name = f"s{seed}-u{index:04d}"
     try:
-        from hrgtc.files import write_text_atomic
+        from hrgtc.core.files import write_text_atomic
         from hrgtc.fleet.population import draw_unit, truth
         from hrgtc.simulate import simulate_files
         from hrgtc.simulate import standard_profiles as profiles

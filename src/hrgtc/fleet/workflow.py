@@ -15,13 +15,13 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from hrgtc.errors import InputError
-from hrgtc.files import refuse_existing
+from hrgtc.core.errors import InputError
+from hrgtc.core.files import refuse_existing
+from hrgtc.core.progress import Progress
 from hrgtc.fleet import tasks
 from hrgtc.fleet.manifest import UnitFiles, load_fleet
 from hrgtc.fleet.results import read_table, write_table
 from hrgtc.fleet.run import FleetRun, run_tasks
-from hrgtc.progress import Progress
 from hrgtc.recording import ReadOptions
 
 __all__ = ["FLEET_TABLE", "build_prior", "calibrate_fleet", "evaluate_fleet", "report_fleet",
@@ -73,7 +73,7 @@ def calibrate_fleet(source: PathLike | Sequence[UnitFiles], output: PathLike, *,
                     force: bool = False, prior: PathLike | None = None,
                     scheduler: str | None = None, workers: int | None = None,
                     progress: Progress | None = None) -> FleetRun:
-    """Calibrate every unit (:func:`hrgtc.calibration.calibrate` as one task per unit).
+    """Calibrate every unit (:func:`hrgtc.pipeline.calibration.calibrate` as one task per unit).
 
     Writes ``output/<unit>.json`` (models), ``output/<unit>.outcome.json`` and the
     fleet table ``output/fleet.parquet``. Existing models are refused unless
@@ -85,7 +85,7 @@ def calibrate_fleet(source: PathLike | Sequence[UnitFiles], output: PathLike, *,
     source
         A manifest, a fleet folder, or the units' files.
     settings
-        Keyword arguments of :func:`~hrgtc.calibration.calibrate` (order, terms, ...).
+        Keyword arguments of :func:`~hrgtc.pipeline.calibration.calibrate` (order, terms, ...).
     prior
         A prior file: every unit is calibrated with it (:mod:`hrgtc.thermometry.prior`).
     """

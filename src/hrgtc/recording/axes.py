@@ -35,7 +35,7 @@ import math
 import re
 from collections.abc import Iterable, Mapping
 
-from hrgtc.errors import RecordingError
+from hrgtc.core.errors import RecordingError
 from hrgtc.recording.schema import Metadata, Recording
 
 #: Contract columns that a multi-axis recording has once per axis, as ``<name>_<axis>``.

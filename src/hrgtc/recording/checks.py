@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from hrgtc.errors import InputError, RecordingError
+from hrgtc.core.errors import InputError, RecordingError
 from hrgtc.recording.gaps import Gap
 
 SAMPLE_RATE_TOLERANCE = 0.01  # relative disagreement of measured and nominal rate
@@ -130,7 +130,7 @@ class ValidationReport:
         return problems_message(self.source, self.problems)
 
     def raise_for_problems(self) -> None:
-        """Raise :class:`~hrgtc.errors.RecordingError` with :attr:`message` unless ok."""
+        """Raise :class:`~hrgtc.core.errors.RecordingError` with :attr:`message` unless ok."""
         if self.problems:
             raise RecordingError(self.message)
 

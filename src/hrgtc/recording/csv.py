@@ -41,7 +41,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.csv as pa_csv
 
-from hrgtc.errors import RecordingError
+from hrgtc.core.errors import RecordingError
 from hrgtc.recording.formats import (
     Sink,
     Source,

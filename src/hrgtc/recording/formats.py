@@ -32,7 +32,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from hrgtc.errors import RecordingError
+from hrgtc.core.errors import RecordingError
 from hrgtc.recording.axes import axis_names, base_name, split_axis
 from hrgtc.recording.schema import COLUMNS, Metadata
 

@@ -30,8 +30,8 @@ from typing import Any, Literal
 
 import numpy as np
 
+from hrgtc.core.errors import RecordingError
 from hrgtc.core.timeline import GAP_FACTOR, GAP_TOLERANCE, is_gap
-from hrgtc.errors import RecordingError
 from hrgtc.recording.schema import Recording
 
 GapPolicy = Literal["error", "split", "bridge", "ignore"]

@@ -15,10 +15,10 @@ from typing import Any
 
 import numpy as np
 
+from hrgtc.core.errors import RecordingError
+from hrgtc.core.progress import Progress
 from hrgtc.core.time_steps import TimeRepairStream
 from hrgtc.core.timeline import Timeline, TimelineBuilder
-from hrgtc.errors import RecordingError
-from hrgtc.progress import Progress
 from hrgtc.recording.axes import axis_names, base_name
 from hrgtc.recording.formats import format_of
 from hrgtc.recording.io import iter_chunks

@@ -16,7 +16,7 @@ Users' files are mapped onto the recording contract of DESIGN.md on reading:
   ``extra["thermometer"] = "sensor"``;
 * ``spikes``: ``"error"`` or ``"drop"`` (see :mod:`hrgtc.recording.spikes`); rows
   dropped are counted in ``extra["spikes_dropped"]`` (by :func:`read`) and a
-  :class:`~hrgtc.errors.SpikeWarning`;
+  :class:`~hrgtc.core.errors.SpikeWarning`;
 * odd time steps (see :mod:`hrgtc.core.time_steps`): a wrapped 32-bit µs/ms
   counter is unwrapped, a logger reset to about zero starts a new segment (later
   times follow after a gap), duplicated rows are dropped; :func:`read` lists what
@@ -40,9 +40,9 @@ from typing import Any
 
 import numpy as np
 
+from hrgtc.core.errors import InputError, RecordingError
+from hrgtc.core.progress import Progress
 from hrgtc.core.time_steps import TimeRepairStream
-from hrgtc.errors import InputError, RecordingError
-from hrgtc.progress import Progress
 from hrgtc.recording.axes import axis_view
 from hrgtc.recording.csv import CsvSource
 from hrgtc.recording.formats import (
@@ -216,14 +216,14 @@ def read(
         ``"auto"``: a raw temperature count (a count unit, ``temp_scale`` or
         ``temp_offset_c``) that sits just under 2^16 or 2^32 is a signed count stored
         unsigned and is unwrapped (65236 -> -300), with a
-        :class:`~hrgtc.errors.UnitWarning` and ``extra["temperature_count_bits"]``;
+        :class:`~hrgtc.core.errors.UnitWarning` and ``extra["temperature_count_bits"]``;
         ``"off"``: read as it is.
     spike_filter
         Single-sample spikes of plausible value in the rate and thermometer columns
         (:func:`hrgtc.recording.spikes.find_spikes`): ``"off"``, ``"drop"`` (rows
         removed, counted in ``extra["spikes_removed"]``) or ``"flag"`` (rows kept,
         a ``spike`` column 1.0 at them, counted in ``extra["spikes_flagged"]``);
-        one :class:`~hrgtc.errors.SpikeWarning` says how many and where.
+        one :class:`~hrgtc.core.errors.SpikeWarning` says how many and where.
     spike_k, spike_lsb, spike_window_s
         Threshold max(k·σ_MAD, m·LSB) and window [s] of the spike filter.
     start, end
@@ -329,7 +329,7 @@ def iter_chunks(
         state across chunks (time continuity, global row numbers); a chunk is
         yielded only after its rows (and the unit heuristics of the first
         :data:`~hrgtc.recording.validation.HEURISTIC_ROWS` rows) have passed, so a
-        bad file raises :class:`~hrgtc.errors.RecordingError` before bad data
+        bad file raises :class:`~hrgtc.core.errors.RecordingError` before bad data
         reach the caller. With ``gaps="split"`` gaps pass; split downstream. The time
         axis is repaired as by :func:`read` (``time_repair``: a
         :class:`~hrgtc.core.time_steps.TimeRepairStream` to use, whose events and counts

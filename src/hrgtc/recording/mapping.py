@@ -38,7 +38,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.compute as pc
 
-from hrgtc.errors import InputError, RecordingError, UnitWarning
+from hrgtc.core.errors import InputError, RecordingError, UnitWarning
 from hrgtc.recording.axes import AXIS_COLUMNS, axis_names, base_name, split_axis
 from hrgtc.recording.checks import check_thermometer
 from hrgtc.recording.csv import bad_number_hint

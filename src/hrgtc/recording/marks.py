@@ -19,7 +19,7 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
-from hrgtc.errors import RecordingError
+from hrgtc.core.errors import RecordingError
 
 #: Metadata key of the mark.
 COMPENSATED_KEY = "compensated_by"
@@ -29,7 +29,7 @@ COMPENSATED_COLUMNS = ("rate_comp_dph", "bias_model_dph")
 
 def mark(model_sha256: str, model_unit: str, drift: str = "frequency") -> dict[str, Any]:
     """The ``compensated_by`` record of an output compensated by one model."""
-    from hrgtc._meta import __version__
+    from hrgtc.core.meta import __version__
 
     return {"model_sha256": model_sha256, "model_unit": model_unit,
             "hrgtc_version": __version__, "drift": drift}

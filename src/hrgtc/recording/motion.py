@@ -41,7 +41,7 @@ from typing import Any
 
 import numpy as np
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 
 #: A gap: a time step larger than this many median periods.
 GAP_FACTOR = 2.0

@@ -23,7 +23,7 @@ refused by the validation as before (a dropout, not a logging rate).
 :class:`SlowChannels` works chunk by chunk (state carried: the last value and its time;
 ``interpolate`` holds back the rows after a chunk's last value until the next one) and
 reports what it did (:meth:`SlowChannels.summary`, a
-:class:`~hrgtc.errors.SlowChannelWarning`).
+:class:`~hrgtc.core.errors.SlowChannelWarning`).
 """
 
 from __future__ import annotations
@@ -35,7 +35,7 @@ from typing import Any
 
 import numpy as np
 
-from hrgtc.errors import InputError, SlowChannelWarning
+from hrgtc.core.errors import InputError, SlowChannelWarning
 
 #: What to do with a slow channel's empty cells.
 SLOW_MODES = ("hold", "interpolate", "error")
@@ -229,7 +229,7 @@ class SlowChannels:
         return {"mode": self.mode, "channels": [s.to_dict() for s in self.channels.values()]}
 
     def warn(self) -> None:
-        """Report each slow channel once as a :class:`~hrgtc.errors.SlowChannelWarning`."""
+        """Report each slow channel once as a :class:`~hrgtc.core.errors.SlowChannelWarning`."""
         for line in self.summary():
             warnings.warn(line, SlowChannelWarning, stacklevel=3)
 

@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from hrgtc.errors import RecordingError
+from hrgtc.core.errors import RecordingError
 
 SCHEMA_VERSION = 1
 

@@ -15,7 +15,7 @@ frequency 20 % away from the rest of the run. A *spike* here is a row with
 ``spikes="error"`` (the default) leaves them to the validation, whose error
 names the file, column, row and value; ``spikes="drop"`` removes those rows
 (:class:`SpikeFilter`) and says how many went, with the first of them, in a
-:class:`~hrgtc.errors.SpikeWarning`.
+:class:`~hrgtc.core.errors.SpikeWarning`.
 
 Plausible values can still be spikes: a MEMS logger's single sample at −0.10 rad/s
 in a stream at −0.065 ± 0.001 rad/s. :func:`find_spikes` is the robust,
@@ -47,7 +47,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from hrgtc.errors import InputError, SpikeWarning
+from hrgtc.core.errors import InputError, SpikeWarning
 from hrgtc.recording.axes import axis_names, base_name
 from hrgtc.recording.checks import _BOUNDS, FREQ_JUMP_FRACTION, TEMPERATURE_RANGE_C
 from hrgtc.recording.gaps import GAP_PERIODS, GAP_TOLERANCE
@@ -157,7 +157,7 @@ class SpikeFilter:
         return {name: values[keep] for name, values in columns.items()}
 
     def warn(self) -> None:
-        """Issue a :class:`~hrgtc.errors.SpikeWarning` saying how many rows were dropped."""
+        """Issue a :class:`~hrgtc.core.errors.SpikeWarning` saying how many rows were dropped."""
         if not self.dropped or self.first is None:
             return
         name, row, value = self.first
@@ -404,7 +404,7 @@ class RobustSpikeFilter:
                 f"windows); the first: column '{name}', row {row}, value {value:.6g}")
 
     def warn(self) -> None:
-        """One :class:`~hrgtc.errors.SpikeWarning` for the whole file (none without spikes)."""
+        """One :class:`~hrgtc.core.errors.SpikeWarning` for the whole file (none without spikes)."""
         text = self.summary()
         if text:
             warnings.warn(text, SpikeWarning, stacklevel=3)

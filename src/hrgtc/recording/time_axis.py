@@ -12,9 +12,9 @@ from typing import Any
 
 import numpy as np
 
+from hrgtc.core.errors import InputError
 from hrgtc.core.time_steps import TimeRepairStream
 from hrgtc.core.timeline import parse_time_bound
-from hrgtc.errors import InputError
 
 
 def _time_repairer(plan: Any) -> TimeRepairStream:

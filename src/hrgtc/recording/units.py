@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 
 __all__ = ["UNITS", "Unit", "convert", "find_unit", "unit_help"]
 

@@ -63,8 +63,8 @@ from typing import Any
 
 import numpy as np
 
+from hrgtc.core.errors import RecordingError
 from hrgtc.core.timeline import gap_limit_s, is_gap
-from hrgtc.errors import RecordingError
 from hrgtc.recording.axes import axis_input_rate_dph, axis_names, base_name
 from hrgtc.recording.checks import (
     _BOUNDS,
@@ -500,7 +500,7 @@ class RecordingValidator:
             column=name, row=row, value=f"{value:.6g}", count=count)
 
     def raise_for_problems(self) -> None:
-        """Raise :class:`~hrgtc.errors.RecordingError` if a problem was found so far."""
+        """Raise :class:`~hrgtc.core.errors.RecordingError` if a problem was found so far."""
         problems = self.problems
         if problems:
             raise RecordingError(problems_message(self.source, problems))
@@ -593,7 +593,7 @@ def validate(
         problems; ``"split"``: they are listed and the caller splits the recording
         with :func:`split_at_gaps`; ``"ignore"``: they are only listed.
     raise_errors
-        Raise :class:`~hrgtc.errors.RecordingError` on a problem (default) rather
+        Raise :class:`~hrgtc.core.errors.RecordingError` on a problem (default) rather
         than return a report with ``ok=False``.
     freq_band_hz, freq_span_hz
         Plausible frequencies given a model (every sample must lie in the band;

@@ -16,8 +16,8 @@ from typing import Any
 
 import numpy as np
 
-from hrgtc.errors import InputError, RecordingError
-from hrgtc.files import (
+from hrgtc.core.errors import InputError, RecordingError
+from hrgtc.core.files import (
     WriteBehind,
     forget_temporary,
     fsync_file,
@@ -126,7 +126,7 @@ class RecordingWriter:
         self.rows += len(arrays[self.columns[0]])
 
     def start_writeback(self) -> None:
-        """Make the rows written so far durable beside the work (:class:`~hrgtc.files.WriteBehind`).
+        """Make the rows written so far durable beside the work (a ``WriteBehind``).
 
         The first call starts a thread that syncs the file as it grows (each later
         call wakes it at once); :meth:`close` still waits for every byte (fsync)

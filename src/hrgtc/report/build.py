@@ -15,11 +15,11 @@ from collections.abc import Callable, Sequence
 from html import escape
 from pathlib import Path
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
+from hrgtc.core.files import refuse_existing, write_text_atomic
+from hrgtc.core.progress import Progress
 from hrgtc.evaluation import Evaluation, evaluate
-from hrgtc.files import refuse_existing, write_text_atomic
 from hrgtc.model import InstrumentModel, UnitModel, load_instrument
-from hrgtc.progress import Progress
 from hrgtc.recording import ReadOptions, count_rows
 from hrgtc.report.figures import trace_soak
 from hrgtc.report.html import (

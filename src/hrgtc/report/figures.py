@@ -30,11 +30,10 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
-from hrgtc import paper
 from hrgtc.evaluation import BlockMeans, Evaluation, block_rows
 from hrgtc.evaluation.allan import FLICKER_FLOOR_FACTOR
 from hrgtc.recording import ReadOptions, count_rows
-from hrgtc.thermometry import Thermometer
+from hrgtc.thermometry import Thermometer, paper
 from hrgtc.thermometry.plateaus import Plateau
 
 PathLike = str | os.PathLike[str]

@@ -29,12 +29,12 @@ from typing import Any
 import numpy as np
 
 import hrgtc.report.figures as figures
-from hrgtc import paper
+from hrgtc.core.files import file_sha256
 from hrgtc.drift.features import parse_terms
 from hrgtc.evaluation import Evaluation
-from hrgtc.files import file_sha256
 from hrgtc.model import UnitModel
 from hrgtc.report.figures import SoakTrace
+from hrgtc.thermometry import paper
 from hrgtc.thermometry.plateaus import Plateau
 
 __all__: list[str] = []  # the sections; build.build_report puts them together

@@ -14,7 +14,7 @@ the shared ``time_s``, ``chamber_c`` and ``housing_c``
 - :mod:`~hrgtc.simulate.thermal`: chamber -> housing -> resonator network;
 - :mod:`~hrgtc.simulate.laws`: frequency law (Table 1 / Eq. 18 of [1], or the
   shell model), bias law and scale-factor law in physical variables;
-- :mod:`~hrgtc.simulate.noise`: ARW, bias instability, rate random walk;
+- :mod:`~hrgtc.simulate.noise_sources`: ARW, bias instability, rate random walk;
 - :mod:`~hrgtc.simulate.units`: named simulated gyros (``paper-unit``, ``unit-b``) and
   the three-axis ``imu-3``;
 - :mod:`~hrgtc.simulate.campaign`: runs in chunks, with ground truth;
@@ -62,7 +62,7 @@ from hrgtc.simulate.laws import (
 )
 from hrgtc.simulate.logged_files import LoggedFiles, simulate_logged_files, write_logged
 from hrgtc.simulate.logger import LoggedRun, Logger, log_run
-from hrgtc.simulate.noise import GyroNoise
+from hrgtc.simulate.noise_sources import GyroNoise
 from hrgtc.simulate.output import WrittenFile, output_paths, simulate_files, simulate_to_file
 from hrgtc.simulate.profiles import Profile, Segment
 from hrgtc.simulate.reflog import ReferenceLog, TemperatureChannel

@@ -43,11 +43,11 @@ from typing import Any
 
 import numpy as np
 
-from hrgtc.errors import InputError
-from hrgtc.progress import Progress
+from hrgtc.core.errors import InputError
+from hrgtc.core.progress import Progress
 from hrgtc.recording import Metadata, Recording, concatenate
 from hrgtc.simulate import units as _units
-from hrgtc.simulate.noise import WhiteNoiseStream
+from hrgtc.simulate.noise_sources import WhiteNoiseStream
 from hrgtc.simulate.profiles import Profile
 from hrgtc.simulate.units import MultiAxisUnit, Unit
 

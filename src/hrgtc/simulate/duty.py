@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 from hrgtc.simulate.campaign import Seed, iter_run_chunks, row_count
 from hrgtc.simulate.profiles import Profile
 from hrgtc.simulate.units import MultiAxisUnit, Unit

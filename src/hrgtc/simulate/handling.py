@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 from hrgtc.simulate.units import EARTH_RATE_DPH
 
 __all__ = ["Handling", "HandlingTruth", "hand_warming", "handling_truth", "orientation_matrix"]

@@ -31,7 +31,7 @@ from typing import Any, Protocol
 import numpy as np
 from numpy.polynomial import Polynomial
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 from hrgtc.simulate.shell import Shell
 
 __all__ = [
@@ -111,7 +111,7 @@ def table1_frequency_law() -> PolynomialFrequencyLaw:
     >>> [round(c, 9) for c in law.coefficients]
     [4424.900952381, 0.371555556, -0.000970238, 1.5278e-05]
     """
-    from hrgtc.paper import TABLE1_FREQUENCY_HZ, TABLE1_TEMPERATURE_C
+    from hrgtc.thermometry.paper import TABLE1_FREQUENCY_HZ, TABLE1_TEMPERATURE_C
 
     poly = Polynomial.fit(TABLE1_TEMPERATURE_C, TABLE1_FREQUENCY_HZ, 3).convert()
     return PolynomialFrequencyLaw(

@@ -26,8 +26,8 @@ from typing import Any
 
 import numpy as np
 
-from hrgtc.errors import InputError
-from hrgtc.files import (
+from hrgtc.core.errors import InputError
+from hrgtc.core.files import (
     forget_temporary,
     fsync_file,
     publish,

@@ -39,7 +39,7 @@ from typing import Any
 
 import numpy as np
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 from hrgtc.simulate import units as _units
 from hrgtc.simulate.clock import unwrap_counter, wall_clock
 from hrgtc.simulate.duty import DutyCycle, duplicate_rows, simulate_kept

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 from hrgtc.simulate.handling import Handling
 from hrgtc.simulate.logger import Logger
 from hrgtc.simulate.mems import G_SENSITIVITY_DPH_PER_G, MEMS_UNIT

@@ -32,7 +32,7 @@ from __future__ import annotations
 import math
 
 from hrgtc.simulate.laws import BiasLaw, table1_frequency_law
-from hrgtc.simulate.noise import GyroNoise
+from hrgtc.simulate.noise_sources import GyroNoise
 from hrgtc.simulate.thermal import ThermalNetwork
 from hrgtc.simulate.units import EARTH_RATE_DPH, MultiAxisUnit, Unit, register
 

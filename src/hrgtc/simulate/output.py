@@ -17,9 +17,9 @@ from typing import Any
 
 import numpy as np
 
-from hrgtc.errors import InputError
-from hrgtc.files import refuse_existing
-from hrgtc.progress import Progress
+from hrgtc.core.errors import InputError
+from hrgtc.core.files import refuse_existing
+from hrgtc.core.progress import Progress
 from hrgtc.recording import RecordingWriter
 from hrgtc.recording.formats import FORMAT_SUFFIXES, SUFFIXES
 from hrgtc.simulate import units as _units

@@ -59,7 +59,7 @@ from typing import Any
 import numpy as np
 import yaml
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 
 __all__ = [
     "AXIS_NAME",

@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 from scipy.signal import lfilter, lfilter_zi
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 
 __all__ = [
     "ReferenceLog",

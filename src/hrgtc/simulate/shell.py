@@ -33,7 +33,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.integrate import quad
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 
 __all__ = [
     "DEFAULT_RADIUS_M",

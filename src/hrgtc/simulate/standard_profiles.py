@@ -25,7 +25,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 from hrgtc.simulate.profiles import (
     CHAMBER_MAX_C_PER_MIN,
     DEFAULT_RAMP_C_PER_MIN,

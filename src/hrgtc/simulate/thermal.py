@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 from scipy.signal import lfilter
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 
 __all__ = ["ThermalNetwork", "ThermalState", "first_order_hold_coefficients", "step_response"]
 

@@ -51,7 +51,7 @@ from dataclasses import dataclass, field
 from functools import cache
 from typing import Any
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 from hrgtc.simulate.laws import (
     BiasLaw,
     FrequencyLaw,
@@ -60,7 +60,7 @@ from hrgtc.simulate.laws import (
     frequency_law_from_dict,
     table1_frequency_law,
 )
-from hrgtc.simulate.noise import GyroNoise
+from hrgtc.simulate.noise_sources import GyroNoise
 from hrgtc.simulate.profiles import AXIS_NAME
 from hrgtc.simulate.shell import FUSED_QUARTZ, Shell
 from hrgtc.simulate.thermal import ThermalNetwork

@@ -40,8 +40,8 @@ from typing import Any
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
-from hrgtc.errors import CalibrationError, InputError, RecordingError
-from hrgtc.progress import Progress
+from hrgtc.core.errors import CalibrationError, InputError, RecordingError
+from hrgtc.core.progress import Progress
 from hrgtc.recording import Recording
 from hrgtc.thermometry.settling import MIN_FIT_POINTS, TransientFit, fit_transient
 

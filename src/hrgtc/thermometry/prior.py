@@ -39,7 +39,7 @@ from typing import Any
 
 import numpy as np
 
-from hrgtc.errors import CalibrationError, InputError
+from hrgtc.core.errors import CalibrationError, InputError
 from hrgtc.thermometry.thermometer import Thermometer, _scaled_to_raw_matrix
 
 __all__ = ["PriorFit", "ThermometerPrior", "fit_with_prior", "load_prior", "relative_coefficients"]
@@ -210,7 +210,7 @@ class ThermometerPrior:
 def save_prior(prior: ThermometerPrior, path: str | os.PathLike[str],
                force: bool = False) -> Path:
     """Write the prior file atomically (refuses to overwrite without ``force``)."""
-    from hrgtc.files import write_text_atomic
+    from hrgtc.core.files import write_text_atomic
 
     return write_text_atomic(path, json.dumps(prior.to_dict(), indent=2) + "\n", force=force)
 

@@ -43,7 +43,7 @@ from typing import Any
 
 import numpy as np
 
-from hrgtc.errors import CalibrationError, InputError, RecordingError
+from hrgtc.core.errors import CalibrationError, InputError, RecordingError
 
 __all__ = ["ReferenceLog", "TemperatureMap", "fit_count_map", "parse_clock", "read_reference_log"]
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 from hrgtc.thermometry.thermometer import Thermometer
 
 __all__ = ["identity"]

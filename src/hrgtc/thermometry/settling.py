@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import least_squares
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 
 __all__ = ["MIN_FIT_POINTS", "TransientFit", "fit_transient"]
 

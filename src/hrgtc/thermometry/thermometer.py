@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 from scipy import stats
 
-from hrgtc.errors import CalibrationError, ExtrapolationWarning, InputError
+from hrgtc.core.errors import CalibrationError, ExtrapolationWarning, InputError
 
 _GRID_POINTS = 2049
 _NEWTON_MAX_ITER = 60
@@ -213,7 +213,7 @@ class Thermometer:
         started from interpolation in a dense table of the polynomial.
         Frequencies outside the calibrated range are extrapolated along the
         polynomial as far as it stays monotonic (NaN beyond) and flagged with an
-        :class:`~hrgtc.errors.ExtrapolationWarning` giving their count and share.
+        :class:`~hrgtc.core.errors.ExtrapolationWarning` giving their count and share.
 
         Parameters
         ----------

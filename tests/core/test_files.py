@@ -1,4 +1,4 @@
-"""Tests of hrgtc.files.WriteBehind: the bytes reach the file unchanged, the thread syncs
+"""Tests of hrgtc.core.files.WriteBehind: the bytes reach the file unchanged, the thread syncs
 what the file grows by, and a failed sync is raised, never lost.
 
 Truth: the bytes written, read back; the synced offset against the file's size; an
@@ -14,7 +14,7 @@ import time
 import numpy as np
 import pytest
 
-from hrgtc.files import WriteBehind
+from hrgtc.core.files import WriteBehind
 from hrgtc.recording import Metadata, RecordingWriter
 
 
@@ -97,8 +97,8 @@ def test_a_recording_writer_whose_sync_fails_leaves_nothing(tmp_path, monkeypatc
 def test_check_writable_names_what_is_wrong(tmp_path, monkeypatch):
     from collections import namedtuple
 
-    from hrgtc.errors import InputError
-    from hrgtc.files import check_writable
+    from hrgtc.core.errors import InputError
+    from hrgtc.core.files import check_writable
 
     with pytest.raises(InputError, match=rf"^{tmp_path} is a directory; give a file name$"):
         check_writable(tmp_path)
@@ -132,7 +132,7 @@ def test_check_writable_names_what_is_wrong(tmp_path, monkeypatch):
     (errno.EIO, "Input/output error"),
 ])
 def test_describe_os_error_names_the_file_and_the_fix(code, text):
-    from hrgtc.files import describe_os_error
+    from hrgtc.core.files import describe_os_error
 
     named = OSError(code, os.strerror(code), "/data/out.parquet")
     assert describe_os_error(named) == f"/data/out.parquet: {text}"
@@ -142,7 +142,7 @@ def test_describe_os_error_names_the_file_and_the_fix(code, text):
 
 
 def test_a_write_error_without_a_file_name_gets_the_outputs(tmp_path):
-    from hrgtc.files import naming_os_errors
+    from hrgtc.core.files import naming_os_errors
 
     target = tmp_path / "out.parquet"
     for raised in (OSError(errno.ENOSPC, "No space left on device"),
@@ -159,7 +159,7 @@ def test_a_write_error_without_a_file_name_gets_the_outputs(tmp_path):
 
 
 def test_pid_alive(monkeypatch):
-    from hrgtc import files
+    from hrgtc.core import files
 
     assert files._pid_alive(os.getpid())
     assert not files._pid_alive(0) and not files._pid_alive(-5)
@@ -179,7 +179,7 @@ def test_pid_alive(monkeypatch):
 def test_a_signal_removes_the_temporary_files_then_runs_the_previous_handler(tmp_path):
     import signal
 
-    from hrgtc import files
+    from hrgtc.core import files
 
     seen = []
     previous = signal.signal(signal.SIGTERM, lambda signum, frame: seen.append(signum))
@@ -200,7 +200,7 @@ def test_a_signal_removes_the_temporary_files_then_runs_the_previous_handler(tmp
 def test_file_sha256_reads_in_blocks(tmp_path):
     import hashlib
 
-    from hrgtc.files import file_sha256
+    from hrgtc.core.files import file_sha256
 
     data = bytes(range(256)) * 40
     path = tmp_path / "f.bin"
@@ -220,7 +220,7 @@ def test_a_sigterm_with_the_default_handler_removes_the_file_and_ends_the_proces
     temporary = tmp_path / ".out.parquet.tmp"
     code = (
         "import os, signal, time\n"
-        "from hrgtc.files import removed_on_signal\n"
+        "from hrgtc.core.files import removed_on_signal\n"
         f"path = {str(temporary)!r}\n"
         "open(path, 'w').write('half')\n"
         "with removed_on_signal(path):\n"
@@ -249,8 +249,8 @@ def test_write_behind_starts_from_nothing_synced_in_a_named_daemon_thread(tmp_pa
 def test_check_writable_asks_for_free_space_only_with_an_estimate(tmp_path, monkeypatch):
     from collections import namedtuple
 
-    from hrgtc.errors import InputError
-    from hrgtc.files import check_writable
+    from hrgtc.core.errors import InputError
+    from hrgtc.core.files import check_writable
 
     usage = namedtuple("usage", "total used free")
     monkeypatch.setattr("shutil.disk_usage", lambda path: usage(0, 0, 0))
@@ -261,8 +261,8 @@ def test_check_writable_asks_for_free_space_only_with_an_estimate(tmp_path, monk
 
 # -- outputs never inputs, atomic text files (issue 21) --------------------------------------
 def test_refuse_input_names_the_output_and_the_input_it_is(tmp_path, monkeypatch):
-    from hrgtc.errors import InputError
-    from hrgtc.files import refuse_input
+    from hrgtc.core.errors import InputError
+    from hrgtc.core.files import refuse_input
 
     run = tmp_path / "run.csv"
     run.write_text("time_s\n0\n")
@@ -285,8 +285,8 @@ def test_refuse_input_names_the_output_and_the_input_it_is(tmp_path, monkeypatch
 
 def test_write_text_atomic_refuses_creates_folders_and_falls_back_without_hard_links(
         tmp_path, monkeypatch):
-    from hrgtc import files
-    from hrgtc.errors import OutputExistsError
+    from hrgtc.core import files
+    from hrgtc.core.errors import OutputExistsError
 
     target = tmp_path / "a" / "b" / "prior.json"
     files.write_text_atomic(target, "é first\n")  # missing folders are created

@@ -26,6 +26,8 @@ from typing import Any
 import numpy as np
 
 from hrgtc import drift as drift_model
+from hrgtc.core.errors import CalibrationError, ExtrapolationWarning, HrgtcWarning, InputError
+from hrgtc.core.progress import StageProgress, for_stage
 from hrgtc.drift.features import AUX_NAME, EQ21, parse_terms
 from hrgtc.drift.rest import run_rest
 from hrgtc.drift.training import (
@@ -33,10 +35,8 @@ from hrgtc.drift.training import (
     check_resonator_gyro,
     implausible_for_any_gyro,
 )
-from hrgtc.errors import CalibrationError, ExtrapolationWarning, HrgtcWarning, InputError
 from hrgtc.evaluation import Evaluation, evaluate
 from hrgtc.model import UnitModel, provenance
-from hrgtc.progress import StageProgress, for_stage
 from hrgtc.recording import ReadOptions
 from hrgtc.recording.marks import refuse_compensated_training
 from hrgtc.thermometry import fit as fit_thermometer

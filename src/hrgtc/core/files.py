@@ -23,7 +23,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-from hrgtc.errors import HrgtcWarning, InputError, OutputExistsError
+from hrgtc.core.errors import HrgtcWarning, InputError, OutputExistsError
 
 PathLike = str | os.PathLike[str]
 

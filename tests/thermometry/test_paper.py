@@ -7,8 +7,8 @@ import json
 import numpy as np
 from typer.testing import CliRunner
 
-from hrgtc import paper
 from hrgtc.cli import app
+from hrgtc.thermometry import paper
 
 
 def test_fitted_coefficients_rounded_equal_eq18():

@@ -38,7 +38,7 @@ from typing import Any
 import numpy as np
 from scipy.signal import lfilter
 
-from hrgtc.errors import InputError
+from hrgtc.core.errors import InputError
 
 __all__ = ["BIAS_INSTABILITY_FLOOR", "GyroNoise", "GyroNoiseStream", "WhiteNoiseStream"]
 

@@ -1,7 +1,7 @@
 """Calibrate a whole instrument: every axis of a multi-axis unit, bias and scale factor.
 
 A multi-axis recording holds one resonator per axis (``freq_hz_x``, ``rate_dph_x``,
-...). Each axis is calibrated as a single gyro (:func:`hrgtc.calibration.calibrate`
+...). Each axis is calibrated as a single gyro (:func:`hrgtc.pipeline.calibration.calibrate`
 on its single-axis view: its own thermometer and drift model), then, given rate-table
 runs, its scale-factor error against frequency is fitted
 (:func:`hrgtc.drift.scale_factor.fit_scale_factor`); held-out runs are evaluated per
@@ -20,8 +20,9 @@ from typing import Any
 
 import numpy as np
 
-from hrgtc.calibration import CalibrationResult, calibrate
 from hrgtc.compensate import InstrumentCompensator
+from hrgtc.core.errors import InputError
+from hrgtc.core.progress import StageProgress
 from hrgtc.drift import (
     ScaleFactorModel,
     find_rate_segments,
@@ -31,10 +32,9 @@ from hrgtc.drift import (
     read_segment_table,
 )
 from hrgtc.drift.scale_factor import TOLERANCE_SHARE
-from hrgtc.errors import InputError
 from hrgtc.evaluation import Evaluation, evaluate
 from hrgtc.model import InstrumentModel, UnitModel, provenance
-from hrgtc.progress import StageProgress
+from hrgtc.pipeline.calibration import CalibrationResult, calibrate
 from hrgtc.recording import ReadOptions, Recording, axis_names
 from hrgtc.recording.marks import refuse_compensated_training
 
@@ -130,7 +130,7 @@ def calibrate_instrument(
     Parameters
     ----------
     soaks, drifts, validate
-        As :func:`hrgtc.calibration.calibrate`, for every axis (a multi-axis file
+        As :func:`hrgtc.pipeline.calibration.calibrate`, for every axis (a multi-axis file
         holds every axis's columns).
     rate_tables
         Rate-table runs (known input rates at several temperatures; the input rate
@@ -161,7 +161,7 @@ def calibrate_instrument(
         of the training file: ``start`` where the training's ``end`` is); default
         ``read_options``.
     settings
-        Further keyword arguments of :func:`hrgtc.calibration.calibrate`.
+        Further keyword arguments of :func:`hrgtc.pipeline.calibration.calibrate`.
     """
     if thermometer not in ("resonator", "sensor"):
         raise InputError(f"thermometer must be 'resonator' or 'sensor', got {thermometer!r}")

@@ -25,7 +25,7 @@ from hrgtc.compensate.compensator import (
 )
 from hrgtc.compensate.model_fit import check_thermometer_kind, plausible_frequency_band
 from hrgtc.compensate.ranges import RangeReport
-from hrgtc.errors import InputError, RecordingError
+from hrgtc.core.errors import InputError, RecordingError
 from hrgtc.model import InstrumentModel, UnitModel, axis_suffix
 from hrgtc.recording import Recording, axis_names, axis_view
 from hrgtc.recording.axes import AXIS_PATTERN
@@ -157,7 +157,7 @@ def recording_axes(path: str | os.PathLike[str],
     """Axis names of a recording file as read with ``options`` (its column mapping); ()
     for a single-axis file. Reads the file's column names only; None when the file cannot
     be opened (reading it will say why)."""
-    from hrgtc.errors import HrgtcError
+    from hrgtc.core.errors import HrgtcError
     from hrgtc.recording.mapping import check_axis_sets, parse_columns
 
     try:

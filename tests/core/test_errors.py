@@ -1,4 +1,4 @@
-"""Tests of hrgtc.errors: messages say numbers as numbers (issue 21: ``np.float64(…)`` in
+"""Tests of hrgtc.core.errors: messages say numbers as numbers (issue 21: ``np.float64(…)`` in
 messages). The fix is at the root, in the base classes, so the test samples real errors
 raised with numpy scalars in their ``!r`` fields from several packages, and the cleaning
 itself."""
@@ -10,7 +10,7 @@ import warnings
 import numpy as np
 import pytest
 
-from hrgtc.errors import (
+from hrgtc.core.errors import (
     ExtrapolationWarning,
     HrgtcError,
     InputError,
@@ -50,7 +50,7 @@ def test_plain_leaves_other_text_alone():
 def test_a_sample_of_real_errors_has_no_numpy_repr():
     """Errors of the reading, drift, compensation and simulation packages raised with numpy
     scalars where users pass them (a value from an array) say plain numbers."""
-    from hrgtc.compensate.instrument import InstrumentCompensator
+    from hrgtc.compensate.multi_axis import InstrumentCompensator
     from hrgtc.drift.features import parse_term
     from hrgtc.model import InstrumentModel
     from hrgtc.recording import Metadata, Recording

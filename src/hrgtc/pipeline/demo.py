@@ -18,16 +18,16 @@ import warnings
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from hrgtc.calibration import CalibrationResult, calibrate
 from hrgtc.compensate import OUTPUT_COLUMNS, CompensationSummary, compensate_instrument_file
 from hrgtc.compensate.compensator import compensated_metadata
 from hrgtc.compensate.export_c import export_c
-from hrgtc.errors import HrgtcWarning
+from hrgtc.core.errors import HrgtcWarning
+from hrgtc.core.files import refuse_existing
+from hrgtc.core.progress import StageProgress, for_stage
 from hrgtc.evaluation import Evaluation, evaluate
-from hrgtc.files import refuse_existing
-from hrgtc.instrument import InstrumentCalibration, calibrate_instrument
 from hrgtc.model import save_instrument, save_model
-from hrgtc.progress import StageProgress, for_stage
+from hrgtc.pipeline.calibration import CalibrationResult, calibrate
+from hrgtc.pipeline.instrument import InstrumentCalibration, calibrate_instrument
 from hrgtc.recording import ReadOptions, RecordingWriter
 from hrgtc.report import build_report
 from hrgtc.simulate import simulate_files

@@ -13,11 +13,11 @@ import numpy as np
 import pytest
 
 from hrgtc.compensate import Compensator, InstrumentCompensator, compensate_instrument_file
+from hrgtc.core.errors import ModelFileError, RecordingError
 from hrgtc.drift import find_rate_segments
-from hrgtc.errors import ModelFileError, RecordingError
-from hrgtc.instrument import calibrate_instrument, steady_segments, summary_rows
 from hrgtc.model import InstrumentModel, load_instrument, load_model, save_instrument
 from hrgtc.model_schema import strict
+from hrgtc.pipeline.instrument import calibrate_instrument, steady_segments, summary_rows
 from hrgtc.recording import ReadOptions, axis_view, read
 
 AXES = ("x", "y", "z")
@@ -173,7 +173,7 @@ def test_cross_axis_candidates_are_judged_on_held_out_runs(imu_campaign):
 def test_an_axis_model_reads_another_axis_frequency(imu_campaign):
     """A model of axis x with y's frequency as a term compensates from the instrument's
     file: the view of axis x keeps freq_hz_y, the numpy and fused engines agree."""
-    from hrgtc.calibration import calibrate
+    from hrgtc.pipeline.calibration import calibrate
 
     files = imu_campaign
     options = ReadOptions(axis="x")

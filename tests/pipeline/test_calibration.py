@@ -1,4 +1,4 @@
-"""Tests of hrgtc.calibration and ``hrgtc calibrate`` on simulated campaigns of both units."""
+"""Tests of hrgtc.pipeline.calibration and ``hrgtc calibrate`` on simulated campaigns."""
 
 from __future__ import annotations
 
@@ -10,11 +10,11 @@ import pytest
 from typer.testing import CliRunner
 
 from hrgtc import recording
-from hrgtc.calibration import calibrate
 from hrgtc.cli import app
-from hrgtc.errors import CalibrationError, InputError
+from hrgtc.core.errors import CalibrationError, InputError
 from hrgtc.evaluation import evaluate
 from hrgtc.model import load_model
+from hrgtc.pipeline.calibration import calibrate
 from hrgtc.recording import Metadata, Recording
 from hrgtc.thermometry import fit
 from hrgtc.thermometry.plateaus import find_plateaus
@@ -218,7 +218,7 @@ def _imu_log(path, run) -> None:
 
 
 def test_sensor_thermometer_on_a_messy_imu_log(campaign_factory, tmp_path):
-    from hrgtc.instrument import calibrate_instrument
+    from hrgtc.pipeline.instrument import calibrate_instrument
     from hrgtc.recording import ReadOptions
 
     files = campaign_factory("paper-unit")
@@ -274,9 +274,9 @@ def test_sensor_thermometer_cli_needs_no_soaks(campaign_factory, tmp_path):
 def test_aux_channels_and_gradient_terms_need_their_columns():
     # --aux NAME=COLUMN adds a_NAME to the candidates; a training run without the column, or
     # gradient terms without housing_c, stop with the file and the column named
-    from hrgtc.calibration import GRADIENT_TERMS, candidate_terms
     from hrgtc.cli.calibrate_cmd import _aux_mapping
-    from hrgtc.errors import InputError
+    from hrgtc.core.errors import InputError
+    from hrgtc.pipeline.calibration import GRADIENT_TERMS, candidate_terms
 
     from synthetic import lagged_run, ramp_run
 
