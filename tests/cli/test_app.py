@@ -37,7 +37,7 @@ def test_help_keeps_units_and_defaults_in_brackets():
     result = CliRunner().invoke(app, ["calibrate", "--help"], terminal_width=200)
     assert result.exit_code == 0
     assert "Averaging window of the fit [s]." in result.output
-    assert "[default max(penter, 0.10)]" in result.output
+    assert "[default: (max(--penter, 0.1))]" in result.output
     assert "Reference temperature of f [°C]." in result.output
 
 

@@ -19,6 +19,8 @@ from hrgtc.model import InstrumentModel, load_instrument, load_model, save_instr
 from hrgtc.model_schema import strict
 from hrgtc.pipeline.instrument import calibrate_instrument, steady_segments, summary_rows
 from hrgtc.recording import ReadOptions, axis_view, read
+from hrgtc.settings.calibration import CalibrationSettings
+from hrgtc.settings.drift import DriftSettings
 
 AXES = ("x", "y", "z")
 
@@ -157,7 +159,7 @@ def test_cross_axis_candidates_are_judged_on_held_out_runs(imu_campaign):
     trial is kept only if the held-out warm-up improves by more than 2 %."""
     files = imu_campaign
     result = calibrate_instrument(files.soaks, [files.cooldown], [files.warmup],
-                                  cross_axis=True)
+                                  settings=CalibrationSettings(cross_axis=True))
     assert set(result.cross_axis) == set(AXES)
     for axis, trial in result.cross_axis.items():
         assert trial["channels"] == {f"f{b}": f"freq_hz_{b}" for b in AXES if b != axis}
@@ -177,9 +179,9 @@ def test_an_axis_model_reads_another_axis_frequency(imu_campaign):
 
     files = imu_campaign
     options = ReadOptions(axis="x")
+    drift = DriftSettings(terms=("f", "f^2", "g", "a_fy", "f*a_fy"), penter=0.5, premove=0.6)
     result = calibrate(files.soaks, [files.cooldown], read_options=options,
-                       terms=["f", "f^2", "g", "a_fy", "f*a_fy"], aux={"fy": "freq_hz_y"},
-                       penter=0.5, premove=0.6)
+                       settings=CalibrationSettings(drift=drift), aux={"fy": "freq_hz_y"})
     assert any("a_fy" in t for t in result.model.drift.selected)
     run = read(files.warmup)
     view = axis_view(run, "x")

@@ -18,15 +18,18 @@ from hrgtc.cli.options import (
     StrictOption,
     reading_options,
 )
+from hrgtc.cli.params import settings_options
+from hrgtc.settings.calibration import CalibrationSettings
+from hrgtc.settings.drift import EQ21_TERMS
+from hrgtc.settings.reading import ReadSettings
 
 if TYPE_CHECKING:
     from hrgtc.pipeline.calibration import CalibrationResult
     from hrgtc.pipeline.instrument import InstrumentCalibration
     from hrgtc.recording import ReadOptions
 
-#: The nine candidate terms of Eq. (21) of [1], as the default of --terms (written out so
-#: that --help needs no import of the library; a test holds it equal to drift.EQ21_TERMS).
-EQ21_DEFAULT = "f,f^2,f^3,df,df^2,df^3,f*df,f^2*df,f*df^2"
+#: The nine candidate terms of Eq. (21) of [1], as the default of --terms.
+EQ21_DEFAULT = ",".join(EQ21_TERMS)
 
 
 def render(result: CalibrationResult) -> None:
@@ -91,6 +94,7 @@ def _render_drift(result: CalibrationResult) -> None:
 
 @app.command("calibrate")
 @reading_options
+@settings_options(CalibrationSettings)
 def calibrate_command(
     extra_soaks: list[Path] = typer.Argument(
         None, metavar="[SOAK_FILES]...",
@@ -103,26 +107,6 @@ def calibrate_command(
     validate: list[Path] = typer.Option(
         None, "--validate", help="Held-out run: bias stability raw vs compensated."),
     output: Path = typer.Option(..., "-o", "--output", help="Model file to write (JSON)."),
-    order: int = typer.Option(3, help="Order of the thermometer polynomial f(T)."),
-    terms: str = typer.Option(
-        None, help="Candidate drift terms, comma separated [default: f,f^2,f^3,g,f*g,f^2*g "
-        "(g the housing - resonator gradient) when the runs log housing_c, else Eq. 21's "
-        f"{EQ21_DEFAULT}]. Variables: f, df, h, dh, dpos, d2, g, a_NAME (--aux)."),
-    window_s: float = typer.Option(10.0, "--window-s", help="Averaging window of the fit [s]."),
-    penter: float = typer.Option(0.05, help="Stepwise p-value to enter."),
-    premove: float = typer.Option(
-        None, help="Stepwise p-value to remove [default max(penter, 0.10)]."),
-    reference_c: float = typer.Option(
-        None, "--reference-c", help="Reference temperature of f [°C]. [default: the centre of "
-        "the still training data, so a temperature offset does not change the model]"),
-    drift_from_soaks: bool = typer.Option(
-        True, "--drift-from-soaks/--no-drift-from-soaks",
-        help="Also fit the drift model on the soaks' warming and cooling transients."),
-    rate_tau_s: float = typer.Option(
-        10.0, "--rate-tau-s", help="Time constant of each stage of the causal df/dt filter [s]."),
-    rate_tau2_s: float = typer.Option(
-        None, "--rate-tau2-s", help="Time constant of the second df/dt filter, variable d2 "
-        "(terms like d2, f*d2) [s; default 6 × --rate-tau-s]."),
     aux: list[str] = typer.Option(
         None, "--aux", metavar="NAME=COLUMN", help="An extra logged channel (drive amplitude, "
         "quadrature control voltage) as variable a_NAME, centred on its training mean; the "
@@ -130,18 +114,6 @@ def calibrate_command(
     prior: Path = typer.Option(
         None, "--prior", help="Population prior (hrgtc fleet prior): a Bayesian thermometer "
         "fit, so that 2 or 3 soaks suffice."),
-    select: str = typer.Option(
-        "guarded", "--select",
-        help="Term selection: 'guarded' (default: F-tests, then terms that do not carry over "
-        "to held-out runs, or to held-out time blocks of a single run, are dropped), "
-        "'stepwise' (F-tests only) or 'cv' (leave-one-run-out cross-validated bias "
-        "stability; needs two training runs or more)."),
-    offsets: str = typer.Option(
-        "auto", "--offsets",
-        help="Constant offsets that are nuisance parameters of the drift fit, not temperature "
-        "terms: auto (default: one per orientation when the runs log accel_x/y/z or an "
-        "orientation column, else none), none, run (one per training run: restarts), "
-        "orientation, run+orientation."),
     rate_table: list[Path] = typer.Option(
         None, "--rate-table", help="Rate-table run (known input rates at several temperatures: "
         "an input_rate_dph column or --segments): fits the scale factor against frequency."),
@@ -151,12 +123,6 @@ def calibrate_command(
     segments: Path = typer.Option(
         None, "--segments", help="CSV start_s,end_s,input_rate_dph of the rate-table holds, for "
         "files without an input_rate_dph column."),
-    scale_terms: str = typer.Option(
-        "f,f^2,f^3", "--scale-terms", help="Candidate terms of the scale-factor model."),
-    cross_axis: bool = typer.Option(
-        False, "--cross-axis", help="Several axes: also try the other resonators' frequencies "
-        "as candidate terms of each axis (gradients across the unit); kept per axis only where "
-        "the --validate runs improve by more than 2 %."),
     temp_ref: Path = typer.Option(
         None, "--temp-ref", help="Reference log of the temperature (sparse, e.g. a hand log "
         "every 5 min) written beside the first --drift run: fits its raw temperature count's "
@@ -189,6 +155,7 @@ def calibrate_command(
     strict: StrictOption = False,
     json_output: JsonOption = False,
     inputs: ReadOptions | None = None,
+    settings: CalibrationSettings | None = None,
 ) -> None:
     """Calibrate a gyro or a whole instrument: soak plateaus -> thermometer (Eq. 18), ramps ->
     drift model (Eq. 22), rate tables -> scale factor; every axis of a multi-axis file.
@@ -208,7 +175,6 @@ def calibrate_command(
     """
     from hrgtc.core.files import check_writable, refuse_existing, refuse_input
     from hrgtc.model import save_instrument
-    from hrgtc.pipeline.calibration import HOUSING_TERMS
     from hrgtc.pipeline.instrument import calibrate_instrument
     from hrgtc.recording import ReadOptions
 
@@ -239,8 +205,9 @@ def calibrate_command(
                 drift[0], temp_ref, inputs, columns=parse_reference_columns(temp_ref_col),
                 unit=temp_ref_unit,
                 start=temp_ref_start, tz=temp_ref_tz, lag_s=temp_ref_lag_s)
-            inputs = options_with_map(dataclasses.replace(inputs, temp_scale=1.0,
-                                                          temp_offset_c=0.0), temperature_map)
+            inputs = options_with_map(dataclasses.replace(
+                inputs, temp_scale=ReadSettings.temp_scale,
+                temp_offset_c=ReadSettings.temp_offset_c), temperature_map)
             if not json_output:
                 console.print("Temperature map: " + temperature_map.summary())
                 if temperature_map.extra.get("note"):
@@ -258,17 +225,11 @@ def calibrate_command(
             if not json_output:
                 error_console.print(f"[dim]… held out {drift[0]} from {inputs.end} s on[/]")
         calibration = calibrate_instrument(
-            soaks, drift, validate or (), validate_options=validate_options, order=order,
-            terms=None if terms is None else [t.strip() for t in terms.split(",") if t.strip()],
-            window_s=window_s, penter=penter, premove=premove, reference_c=reference_c,
-            rate_tau_s=rate_tau_s, rate_tau2_s=rate_tau2_s, aux=_aux_mapping(aux or []),
-            housing_terms=HOUSING_TERMS,
-            drift_from_soaks=drift_from_soaks, select=select, offsets=offsets,
-            read_options=inputs, progress=progress, prior=prior,
-            thermometer=inputs.thermometer, rate_tables=rate_table or (),
-            validate_rate_tables=validate_rate_table or (), segment_table=segments,
-            scale_terms=[t.strip() for t in scale_terms.split(",") if t.strip()],
-            cross_axis=cross_axis,
+            soaks, drift, validate or (), validate_options=validate_options,
+            settings=settings, aux=_aux_mapping(aux or []), read_options=inputs,
+            progress=progress, prior=prior, thermometer=inputs.thermometer,
+            rate_tables=rate_table or (), validate_rate_tables=validate_rate_table or (),
+            segment_table=segments,
         )
         model = calibration.model
         if temperature_map is not None:

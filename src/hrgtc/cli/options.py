@@ -22,7 +22,6 @@ start at once): the parsers of the reading options are imported when called.
 
 from __future__ import annotations
 
-import functools
 import inspect
 from collections.abc import Callable
 from enum import StrEnum
@@ -58,53 +57,6 @@ def _unit_callback(kind: str) -> Any:
             raise typer.BadParameter(str(exc)) from None
 
     return callback
-
-
-class GapPolicy(StrEnum):
-    """What to do with gaps longer than 2 sample periods."""
-
-    error = "error"
-    split = "split"
-    bridge = "bridge"
-    ignore = "ignore"
-
-
-class MotionPolicy(StrEnum):
-    """What calibration and evaluation do with samples not at rest."""
-
-    exclude = "exclude"
-    keep = "keep"
-    error = "error"
-
-
-class SpikePolicy(StrEnum):
-    """What to do with spikes (non-finite or physically impossible samples)."""
-
-    error = "error"
-    drop = "drop"
-
-
-class SpikeFilterMode(StrEnum):
-    """What to do with single-sample spikes of plausible value."""
-
-    drop = "drop"
-    flag = "flag"
-    off = "off"
-
-
-class SlowChannelPolicy(StrEnum):
-    """What to do with a channel logged slower than the file's rows (empty cells)."""
-
-    hold = "hold"
-    interpolate = "interpolate"
-    error = "error"
-
-
-class Thermometer(StrEnum):
-    """What the thermometer of the gyro is."""
-
-    resonator = "resonator"
-    sensor = "sensor"
 
 
 class OutputFormat(StrEnum):
@@ -193,16 +145,6 @@ RateUnitOption = Annotated[
         rich_help_panel=_INPUT,
     ),
 ]
-RateScaleOption = Annotated[
-    float | None,
-    typer.Option(
-        "--rate-scale",
-        metavar="K",
-        help="With --rate-unit lsb: the datasheet's sensitivity K in LSB per °/s "
-        "(rate [°/h] = count × 3600 / K).",
-        rich_help_panel=_INPUT,
-    ),
-]
 TempUnitOption = Annotated[
     str | None,
     typer.Option(
@@ -211,17 +153,6 @@ TempUnitOption = Annotated[
         help="Unit of the temperature columns, " + UNIT_HELP["temp"] + "; °F and K convert "
         "every temperature column, a count only temperature_c*; default C.",
         callback=_unit_callback("temp"),
-        rich_help_panel=_INPUT,
-    ),
-]
-TempUnwrapOption = Annotated[
-    str | None,
-    typer.Option(
-        "--temp-unwrap",
-        metavar="auto|off|16|32",
-        help="A raw temperature count that sits just under 2^16 or 2^32 is a signed count "
-        "stored unsigned and is unwrapped (65236 -> -300), with a warning (auto, default); "
-        "off reads it as it is; 16 or 32 always unwraps that width.",
         rich_help_panel=_INPUT,
     ),
 ]
@@ -252,147 +183,6 @@ InputRateOption = Annotated[
         rich_help_panel=_INPUT,
     ),
 ]
-GapsOption = Annotated[
-    GapPolicy,
-    typer.Option(
-        "--gaps",
-        help="Gaps longer than 2 sample periods: fail (error), process the segments "
-        "separately (split: filters restart), or carry the filters across each gap with its "
-        "duration (bridge; ignore is an old name for it). Windows and Allan never cross a gap.",
-        rich_help_panel=_INPUT,
-    ),
-]
-StartOption = Annotated[
-    str | None,
-    typer.Option(
-        "--start",
-        metavar="SECONDS|ISO",
-        help="Read from this time on: seconds since the file's first sample (e.g. 600) or, for "
-        "a file with clock times, an ISO time (e.g. 2020-03-07T16:30). Rows before are "
-        "counted, not used.",
-        rich_help_panel=_INPUT,
-    ),
-]
-EndOption = Annotated[
-    str | None,
-    typer.Option(
-        "--end",
-        metavar="SECONDS|ISO",
-        help="Read up to (not including) this time: seconds since the file's first sample or "
-        "an ISO clock time, as for --start.",
-        rich_help_panel=_INPUT,
-    ),
-]
-_ReadingGapsOption = Annotated[
-    GapPolicy | None,
-    typer.Option(
-        "--gaps",
-        help="Gaps longer than 2 sample periods: fail (error, default), process the segments "
-        "separately (split: the df/dt filter restarts after each gap), or carry the filters "
-        "across each gap with its duration (bridge, e.g. a burst logger; ignore is an old "
-        "name for it). Windows, bias stability and Allan deviation never cross a gap.",
-        rich_help_panel=_INPUT,
-    ),
-]
-TempScaleOption = Annotated[
-    float | None,
-    typer.Option(
-        "--temp-scale",
-        metavar="K",
-        help="Temperature logged as a raw sensor count: temperature_c = raw * K + C for every "
-        "temperature_c* column (with --temp-offset C); default 1.",
-        rich_help_panel=_INPUT,
-    ),
-]
-TempOffsetOption = Annotated[
-    float | None,
-    typer.Option(
-        "--temp-offset",
-        metavar="C",
-        help="Offset [°C] of --temp-scale: temperature_c = raw * K + C; default 0.",
-        rich_help_panel=_INPUT,
-    ),
-]
-SpikesOption = Annotated[
-    SpikePolicy | None,
-    typer.Option(
-        "--spikes",
-        help="Samples no gyro can produce (NaN, beyond 1000 °/s, impossible temperatures or "
-        "frequencies): fail naming the row (error, default) or drop those rows (drop: "
-        "their number is reported).",
-        rich_help_panel=_INPUT,
-    ),
-]
-SpikeFilterOption = Annotated[
-    SpikeFilterMode | None,
-    typer.Option(
-        "--spike-filter",
-        help="Single-sample spikes of plausible value in the rate and thermometer columns "
-        "(beyond max(k·σ_MAD, m·LSB) from both neighbours, σ_MAD over --spike-window-s "
-        "windows that never span a gap): remove their rows (drop; default of calibrate and "
-        "evaluate), mark them in a 'spike' column (flag; compensate's default, which never "
-        "drops) or leave them (off). Their number is reported.",
-        rich_help_panel=_INPUT,
-    ),
-]
-SpikeKOption = Annotated[
-    float | None,
-    typer.Option("--spike-k", metavar="K", help="Spike threshold in robust σ (MAD); default 8.",
-                 rich_help_panel=_INPUT),
-]
-SpikeLsbOption = Annotated[
-    float | None,
-    typer.Option("--spike-lsb", metavar="M",
-                 help="Spike threshold floor in steps of the channel's resolution (LSB), so a "
-                 "quantised stream keeps its pulses; default 4.", rich_help_panel=_INPUT),
-]
-SpikeWindowOption = Annotated[
-    float | None,
-    typer.Option("--spike-window-s", metavar="S",
-                 help="Window of the spike filter's σ_MAD [s]; default 10.",
-                 rich_help_panel=_INPUT),
-]
-ThermometerOption = Annotated[
-    Thermometer | None,
-    typer.Option(
-        "--thermometer",
-        help="The gyro's thermometer: its resonator frequency (resonator, default; freq_hz "
-        "columns) or, for gyros without a frequency output, its temperature sensor (sensor: "
-        "the temperature_c or temperature_c_<axis> column takes the place of freq_hz).",
-        rich_help_panel=_INPUT,
-    ),
-]
-MotionOption = Annotated[
-    MotionPolicy | None,
-    typer.Option(
-        "--motion",
-        help="Samples not at rest (handling, turning, shaking, clipping; found against the "
-        "local still level, the at-rest noise and any accel_x/y/z columns, with a guard time): "
-        "left out of calibration and evaluation and counted (exclude, default), used (keep), "
-        "or an error naming the first one (error).",
-        rich_help_panel=_INPUT,
-    ),
-]
-SlowChannelsOption = Annotated[
-    SlowChannelPolicy | None,
-    typer.Option(
-        "--slow-channels",
-        help="A channel logged slower than the rows (e.g. a 1 Hz temperature in a 10 Hz "
-        "file: empty cells): hold its last value (hold, default), interpolate linearly in "
-        "time, or refuse the empty cells (error). What was done is reported.",
-        rich_help_panel=_INPUT,
-    ),
-]
-HoldMaxOption = Annotated[
-    float | None,
-    typer.Option(
-        "--hold-max-s",
-        metavar="S",
-        help="Longest time a slow channel's value is used for [s] (default 3 of its "
-        "periods); rows farther from a value are dropped as a gap in that channel.",
-        rich_help_panel=_INPUT,
-    ),
-]
 ForceOption = Annotated[bool, typer.Option("--force", help="Overwrite existing output files.")]
 #: Exit status of --strict when samples went beyond the trained ranges.
 STRICT_EXIT = 3
@@ -417,116 +207,61 @@ def recording_input(
     sample_rate_hz: float | None = None,
     unit_name: str | None = None,
     input_rate_dph: float | None = None,
-    gaps: GapPolicy | str | None = None,
-    temp_scale: float | None = None,
-    temp_offset: float | None = None,
-    spikes: SpikePolicy | str | None = None,
-    thermometer: Thermometer | str | None = None,
-    rate_scale: float | None = None,
     temp_unit: str | None = None,
-    temp_unwrap: str | None = None,
-    spike_filter: SpikeFilterMode | str | None = None,
-    spike_k: float | None = None,
-    spike_lsb: float | None = None,
-    spike_window_s: float | None = None,
-    motion: MotionPolicy | str | None = None,
-    start: str | None = None,
-    end: str | None = None,
-    slow_channels: SlowChannelPolicy | str | None = None,
-    hold_max_s: float | None = None,
 ) -> ReadOptions:
-    """Gather the values of the shared reading options into a :class:`ReadOptions`."""
+    """A :class:`ReadOptions` of the column mapping, the units and the metadata overrides
+    (the other reading options are its fields, generated from
+    :class:`~hrgtc.settings.reading.ReadSettings`)."""
     from hrgtc.recording import ReadOptions
     from hrgtc.recording.mapping import parse_columns
 
     units = {"time": time_unit, "freq": freq_unit, "rate": rate_unit, "temp": temp_unit}
-    if temp_unwrap not in (None, "auto", "off", "16", "32"):
-        raise typer.BadParameter(f"--temp-unwrap must be auto, off, 16 or 32, got "
-                                 f"{temp_unwrap!r}")
     overrides = {"sample_rate_hz": sample_rate_hz, "unit": unit_name,
                  "input_rate_dph": input_rate_dph}
     return ReadOptions(
         columns=parse_columns(col) or None,
         units={k: v for k, v in units.items() if v is not None} or None,
         metadata={k: v for k, v in overrides.items() if v is not None} or None,
-        gaps=str(getattr(gaps, "value", gaps) or "error"),
-        temp_scale=1.0 if temp_scale is None else float(temp_scale),
-        temp_offset_c=0.0 if temp_offset is None else float(temp_offset),
-        spikes=str(getattr(spikes, "value", spikes) or "error"),
-        thermometer=str(getattr(thermometer, "value", thermometer) or "resonator"),
-        rate_scale=None if rate_scale is None else float(rate_scale),
-        temp_unwrap=temp_unwrap or "auto",
-        spike_filter=None if spike_filter is None else str(getattr(spike_filter, "value",
-                                                                   spike_filter)),
-        **{name: float(value) for name, value in (("spike_k", spike_k), ("spike_lsb", spike_lsb),
-                                                 ("spike_window_s", spike_window_s))
-           if value is not None},
-        motion=str(getattr(motion, "value", motion) or "exclude"),
-        start=start,
-        end=end,
-        slow_channels=str(getattr(slow_channels, "value", slow_channels) or "hold"),
-        hold_max_s=None if hold_max_s is None else float(hold_max_s),
     )
 
 
-#: The shared reading options, in the order they appear in ``--help``.
+#: The reading options that fill the mapping, units and metadata of a ReadOptions, in the
+#: order they appear in ``--help`` (before those generated from ReadSettings' fields).
 _READING_OPTIONS: tuple[tuple[str, Any], ...] = (
     ("col", ColumnsOption),
     ("time_unit", TimeUnitOption),
     ("freq_unit", FreqUnitOption),
     ("rate_unit", RateUnitOption),
-    ("rate_scale", RateScaleOption),
     ("sample_rate_hz", SampleRateOption),
     ("unit_name", UnitNameOption),
     ("input_rate_dph", InputRateOption),
-    ("gaps", _ReadingGapsOption),
-    ("temp_scale", TempScaleOption),
-    ("temp_offset", TempOffsetOption),
     ("temp_unit", TempUnitOption),
-    ("temp_unwrap", TempUnwrapOption),
-    ("spikes", SpikesOption),
-    ("spike_filter", SpikeFilterOption),
-    ("spike_k", SpikeKOption),
-    ("spike_lsb", SpikeLsbOption),
-    ("spike_window_s", SpikeWindowOption),
-    ("thermometer", ThermometerOption),
-    ("motion", MotionOption),
-    ("start", StartOption),
-    ("end", EndOption),
-    ("slow_channels", SlowChannelsOption),
-    ("hold_max_s", HoldMaxOption),
 )
 
 
 def reading_options(command: Callable[..., Any]) -> Callable[..., Any]:
-    """Give a command the shared reading options, defined once here.
+    """Give a command the shared reading options, defined once.
 
-    The decorated function takes ``inputs: ReadOptions`` (as its last
-    parameter) instead of the separate options; the command line still shows
-    ``--col``, ``--time-unit``, ``--freq-unit``, ``--rate-unit``, ``--sample-rate-hz``,
-    ``--unit-name``, ``--input-rate-dph``, ``--gaps``, ``--temp-scale``,
-    ``--temp-offset``, ``--spikes``, ``--thermometer``, ``--motion``, ``--start`` and
-    ``--end``.
+    The decorated function takes ``inputs: ReadOptions`` instead of the separate
+    options; the command line shows ``--col``, the unit options and the metadata
+    overrides declared here, then one option per field of
+    :class:`~hrgtc.settings.reading.ReadSettings` that names one (``--gaps``,
+    ``--spikes``, ``--spike-k``, ``--thermometer``, ``--motion``, ``--start``, ...), with
+    its default from the field.
     """
-    signature = inspect.signature(command)
-    namespace = command.__globals__
-    own = [p.replace(annotation=eval(p.annotation, namespace))
-           if isinstance(p.annotation, str) else p
-           for name, p in signature.parameters.items() if name != "inputs"]
-    added = [
-        inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=None, annotation=kind)
-        for name, kind in _READING_OPTIONS
-    ]
+    import dataclasses
 
-    @functools.wraps(command)
-    def wrapper(*args: Any, **kwargs: Any) -> Any:
-        values = {name: kwargs.pop(name, None) for name, _ in _READING_OPTIONS}
-        return command(*args, inputs=recording_input(**values), **kwargs)
+    from hrgtc.cli.params import add_parameters, option_parameter, option_settings
+    from hrgtc.settings.reading import ReadSettings
 
-    parameters = [
-        p.replace(kind=inspect.Parameter.KEYWORD_ONLY) for p in own
-    ] + added
-    wrapper.__signature__ = signature.replace(parameters=parameters)  # type: ignore[attr-defined]
-    wrapper.__annotations__ = {p.name: p.annotation for p in parameters}
-    del wrapper.__wrapped__  # Typer must see the new signature, not the wrapped one
-    return wrapper
+    generated = option_settings(ReadSettings)
+    added = [inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=None,
+                               annotation=kind) for name, kind in _READING_OPTIONS]
+    added += [option_parameter(s) for s in generated]
+
+    def make(values: dict[str, Any]) -> ReadOptions:
+        options = recording_input(**{name: values.get(name) for name, _ in _READING_OPTIONS})
+        return dataclasses.replace(options, **{s.name: values[s.name] for s in generated
+                                              if s.name in values})
+
+    return add_parameters(command, "inputs", added, make)

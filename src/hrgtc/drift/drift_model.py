@@ -63,16 +63,15 @@ from hrgtc.drift.stepwise import StepwiseResult, stepwise
 from hrgtc.drift.windows import RunSource, TrainingWindows, _iter_run, window_means
 from hrgtc.recording import Recording
 from hrgtc.recording.motion import MotionSettings
+from hrgtc.settings.drift import SELECTIONS, TAU2_FACTOR, WARMUP_FACTOR, DriftSettings
 from hrgtc.thermometry import Thermometer
+
+_DRIFT = DriftSettings
 
 #: Smallest training spread of df/dt, as a resonator temperature rate, for a drift model. [°C/h]
 MIN_RATE_SPAN_C_PER_H = 0.5
 #: Smallest training spread of the resonator temperature for a drift model. [°C]
 MIN_TEMPERATURE_SPAN_C = 1.0
-#: Default time constant of the second df/dt filter (``d2``) as a multiple of the first's.
-TAU2_FACTOR = 6.0
-#: Ways of choosing the terms (``select``): ``guarded`` is the default.
-SELECTIONS = ("guarded", "stepwise", "cv")
 
 
 @dataclass(frozen=True)
@@ -341,24 +340,24 @@ def fit(
     runs: Sequence[RunSource],
     thermometer: Thermometer,
     terms: Iterable[str | Term] = EQ21,
-    window_s: float = 10.0,
-    penter: float = 0.05,
+    window_s: float = _DRIFT.window_s,
+    penter: float = _DRIFT.penter,
     premove: float | None = None,
     *,
     initial: Iterable[str] | None = None,
     reference_c: float | None = None,
-    rate_tau_s: float = 10.0,
+    rate_tau_s: float = _DRIFT.rate_tau_s,
     rate_tau2_s: float | None = None,
     aux_columns: Mapping[str, str] | None = None,
     warmup_s: float | None = None,
     autocorrelation: str = "newey-west",
     hierarchical: bool = True,
     excitation_runs: int = 0,
-    select: str = "guarded",
+    select: str = _DRIFT.select,
     progress: Progress | None = None,
     motion: str = "exclude",
     motion_settings: MotionSettings | None = None,
-    offsets: str = "auto",
+    offsets: str = _DRIFT.offsets,
     gaps: str = "bridge",
     restart_each_segment: bool = False,
 ) -> DriftModel:
@@ -461,7 +460,7 @@ def fit(
     if unmapped:
         raise InputError(f"candidate variable(s) {unmapped} have no column; map each with "
                          "--aux NAME=COLUMN")
-    warmup = 5.0 * max(rate_tau_s, tau2) if warmup_s is None else warmup_s
+    warmup = WARMUP_FACTOR * max(rate_tau_s, tau2) if warmup_s is None else warmup_s
     check_policy(motion)
     rests = [run_rest(_iter_run(run), motion, motion_settings, warmup) for run in runs]
     keep = None if motion == "keep" else [r.keep for r in rests]

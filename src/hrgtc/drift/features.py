@@ -69,6 +69,8 @@ from hrgtc.drift.rate_filter import (  # noqa: F401  (re-exported: imported from
 from hrgtc.drift.variables import AUX_PREFIX, DRIFT_VARIABLES, FIXED
 from hrgtc.drift.variables import variable as _registered
 from hrgtc.recording.schema import Recording
+from hrgtc.settings.drift import EQ21_TERMS as _EQ21_TERMS
+from hrgtc.settings.drift import DriftSettings
 
 #: Variable name -> (unit, description), from the one list of :mod:`hrgtc.drift.variables`.
 VARIABLES: dict[str, tuple[str, str]] = {
@@ -266,7 +268,7 @@ class ParsedTerms:
 
 #: Eq. (21) of [1]: the nine candidate terms of the drift model, f = frequency
 #: change, df = its rate of change df/dt.
-EQ21_TERMS = ("f", "f^2", "f^3", "df", "df^2", "df^3", "f*df", "f^2*df", "f*df^2")
+EQ21_TERMS = _EQ21_TERMS
 #: The nine candidate terms of Eq. (21) of [1], parsed.
 EQ21 = parse_terms(EQ21_TERMS)
 
@@ -322,7 +324,7 @@ class FeatureSettings:
     reference_freq_hz: float
     sample_rate_hz: float
     reference_c: float = 20.0
-    rate_tau_s: float = 10.0
+    rate_tau_s: float = DriftSettings.rate_tau_s
     warmup_s: float = 600.0
     scales: dict[str, float] = field(default_factory=dict)
     switch_hz_per_s: float = 0.0

@@ -45,6 +45,7 @@ from hrgtc.drift.features import (
 )
 from hrgtc.drift.rate_segments import RateSegment
 from hrgtc.drift.stepwise import Step, stepwise
+from hrgtc.settings.drift import PREMOVE_FLOOR
 
 __all__ = [
     "SCALE_FACTOR_JSON_SCHEMA",
@@ -390,7 +391,7 @@ def fit_scale_factor(segments: Iterable[RateSegment], settings: FeatureSettings,
     x_f = (np.array([g.freq_hz for g in groups]) - reference) / scale
     factors = {t.name: t.scale_factor({"f": scale}) for t in candidates}
     history: tuple[Step, ...] = ()
-    premove = max(penter, 0.10) if premove is None else premove
+    premove = max(penter, PREMOVE_FLOOR) if premove is None else premove
     if len(groups) >= 3:
         # n groups fit the constant and at most n - 2 terms with a residual left over: the
         # lowest powers first (a cubic needs five temperatures).

@@ -41,6 +41,7 @@ from hrgtc.drift.regression import (
     ols_from_accumulator,
     refine,
 )
+from hrgtc.settings.drift import PREMOVE_FLOOR
 
 __all__ = [
     "COLLINEARITY_TOL",
@@ -254,7 +255,7 @@ def stepwise_from_accumulator(acc: GramAccumulator, names: Sequence[str] | None 
     """
     cand = _check_names(names, len(acc._require_data())) if names is not None \
         else acc._require_data()
-    premove = max(penter, 0.10) if premove is None else premove
+    premove = max(penter, PREMOVE_FLOOR) if premove is None else premove
     if not (0 < penter < 1 and 0 < premove < 1):
         raise InputError(f"penter and premove must lie in (0, 1), got {penter} and {premove}")
     if penter > premove:

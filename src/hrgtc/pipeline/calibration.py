@@ -39,6 +39,10 @@ from hrgtc.evaluation import Evaluation, evaluate
 from hrgtc.model import UnitModel, provenance
 from hrgtc.recording import ReadOptions
 from hrgtc.recording.marks import refuse_compensated_training
+from hrgtc.settings import to_dict
+from hrgtc.settings.calibration import CalibrationSettings
+from hrgtc.settings.drift import GRADIENT_TERMS, DriftSettings
+from hrgtc.settings.reading import ReadSettings
 from hrgtc.thermometry import fit as fit_thermometer
 from hrgtc.thermometry import identity
 from hrgtc.thermometry.plateaus import Plateau, find_plateaus, plateau_table
@@ -50,12 +54,6 @@ PathLike = str | os.PathLike[str]
 SOAK_COLUMNS = ("time_s", "freq_hz", "chamber_c")
 #: Classical baseline: cubic in housing temperature.
 HOUSING_TERMS = ("h", "h^2", "h^3")
-#: Default candidates when every training run logs ``housing_c``: the cubic in f of Eq. (21)
-#: of [1] with the housing - resonator gradient g = housing_c - T(f) in place of df/dt (the
-#: gradient is what makes the bias depend on the rate of change; measured, it carries over
-#: to held-out warm-ups and cycles where the df/dt terms fitted on a cool-down do not:
-#: bench/heldout_gradient.jsonl).
-GRADIENT_TERMS = ("f", "f^2", "f^3", "g", "f*g", "f^2*g")
 
 
 @dataclass(frozen=True)
@@ -125,24 +123,14 @@ def calibrate(
     drifts: Sequence[PathLike],
     validate: Sequence[PathLike] = (),
     *,
-    order: int = 3,
-    terms: Iterable[str] | None = None,
-    window_s: float = 10.0,
-    penter: float = 0.05,
-    premove: float | None = None,
-    reference_c: float | None = None,
-    rate_tau_s: float = 10.0,
-    rate_tau2_s: float | None = None,
+    settings: CalibrationSettings | None = None,
     aux: Mapping[str, str] | None = None,
     housing_terms: Iterable[str] | None = HOUSING_TERMS,
     plateau_options: Mapping[str, Any] | None = None,
-    drift_from_soaks: bool = True,
-    select: str = "guarded",
-    offsets: str = "auto",
     read_options: ReadOptions | None = None,
     progress: StageProgress | None = None,
     prior: ThermometerPrior | PathLike | None = None,
-    thermometer: str = "resonator",
+    thermometer: str = ReadSettings.thermometer,
 ) -> CalibrationResult:
     """Calibrate a unit: thermometer from soaks, drift model from ramps, held-out validation.
 
@@ -156,21 +144,15 @@ def calibrate(
         leave-one-run-out cross-validated bias stability, heating and cooling apart.
     validate
         Held-out runs: bias stability raw and compensated is reported for each.
-    order
-        Order of the thermometer polynomial (3 in [1]).
-    terms
-        Candidate terms of the drift model; default :data:`GRADIENT_TERMS` when every
-        training run logs ``housing_c``, else the nine of Eq. (21).
-    window_s, penter, premove
-        Drift fit on ``window_s`` means with these stepwise thresholds.
-    reference_c
-        Reference temperature of the frequency change f [°C]; default None: the mean
-        of the still training data (the model does not depend on a temperature offset).
-    rate_tau_s
-        Time constant of the causal df/dt filter stages. [s]
-    rate_tau2_s
-        Time constant of the second df/dt filter (variable ``d2``); default
-        :data:`hrgtc.drift.drift_model.TAU2_FACTOR` × ``rate_tau_s``. [s]
+    settings
+        The thermometer's order, the drift fit (candidate terms, window, stepwise
+        thresholds, df/dt filters, term selection, offsets) and whether the soaks join
+        the drift fit (:class:`~hrgtc.settings.calibration.CalibrationSettings`; its
+        defaults when None). The candidate terms default to :data:`GRADIENT_TERMS` when
+        every training run logs ``housing_c``, else the nine of Eq. (21). Soaks join the
+        drift fit by default: a single cool-down covers one curve in the (temperature,
+        rate) plane, along which the polynomial in f and the df/dt terms are confounded;
+        the soaks' warming and cooling transients add curves of both signs of df/dt.
     aux
         Extra logged channels, name -> column (``--aux NAME=COLUMN``): each becomes the
         variable ``a_NAME`` (the column minus its training mean) and the term
@@ -181,19 +163,6 @@ def calibrate(
         drift run has ``housing_c``; None to skip.
     plateau_options
         Keyword arguments of :func:`hrgtc.thermometry.plateaus.find_plateaus`.
-    drift_from_soaks
-        Also fit the drift model on the soak recordings (default). A single
-        cool-down covers one curve in the (temperature, rate) plane, along which
-        the polynomial in f and the df/dt terms are confounded; the soaks' warming
-        and cooling transients add curves of both signs of df/dt, without which a
-        cool-down model extrapolates badly to a warm-up.
-    offsets
-        Nuisance offsets of the drift fit (:mod:`hrgtc.drift.offsets`): ``"auto"``,
-        ``"none"``, ``"run"``, ``"orientation"``, ``"run+orientation"``.
-    select
-        ``"guarded"`` (F-tests, then terms that fail held-out runs or time blocks are
-        dropped; default), ``"stepwise"`` (F-tests) or ``"cv"`` (forward selection by
-        leave-one-run-out cross-validated bias stability), see :func:`hrgtc.drift.fit`.
     read_options
         Column mapping, units and metadata overrides for every file.
     progress
@@ -211,16 +180,13 @@ def calibrate(
         (:func:`hrgtc.thermometry.identity`); soaks are then optional training runs.
     """
     options = read_options or ReadOptions()
+    settings = settings or CalibrationSettings()
     if not drifts:
         raise InputError("no drift recordings given; pass --drift FILE (a cool-down or warm-up)")
     refuse_compensated_training([*soaks, *drifts, *validate])
     if thermometer == "sensor":
-        return _calibrate_sensor(soaks, drifts, validate, options, progress, order=order,
-                                 terms=terms, window_s=window_s, penter=penter,
-                                 premove=premove, reference_c=reference_c,
-                                 rate_tau_s=rate_tau_s, rate_tau2_s=rate_tau2_s,
-                                 aux_columns=aux, housing_terms=housing_terms, select=select,
-                                 offsets=offsets)
+        return _calibrate_sensor(soaks, drifts, validate, options, progress, settings, aux,
+                                 housing_terms)
     if thermometer != "resonator":
         raise InputError(f"thermometer must be 'resonator' or 'sensor', got {thermometer!r}")
     if not soaks:
@@ -243,6 +209,7 @@ def calibrate(
     temperatures, frequencies = plateau_table(plateaus)
     prior_fit = None
     if prior is None:
+        order = settings.thermometer.order
         thermometer = fit_thermometer(temperatures, frequencies, order=order)
     else:
         if not isinstance(prior, ThermometerPrior):
@@ -264,33 +231,22 @@ def calibrate(
     heads.update({str(path): options.head(path) for path in soaks if str(path) not in heads})
     drift_rate = heads[str(drifts[0])].metadata.sample_rate_hz
     extra = [p for p, r in zip(soaks, soak_rates, strict=True) if math.isclose(r, drift_rate)]
-    if drift_from_soaks and len(extra) < len(soaks):
+    if settings.drift_from_soaks and len(extra) < len(soaks):
         warnings.warn(
             f"{len(soaks) - len(extra)} soak file(s) are not at the drift runs' "
             f"{drift_rate:g} Hz and are left out of the drift fit (its windows and settling "
             "time are counted in samples at one rate); they still calibrate the thermometer",
             HrgtcWarning, stacklevel=2,
         )
-    training = [*drifts, *(extra if drift_from_soaks else ())]
+    training = [*drifts, *(extra if settings.drift_from_soaks else ())]
     training_heads = [heads[str(p)] for p in training]
-    terms = resolve_terms(terms, aux, training_heads)
+    settings = _with_terms(settings, resolve_terms(settings.drift.terms, aux, training_heads))
     model, housing = _fit_drift(training, heads, thermometer, options, progress, len(drifts),
-                                terms=terms, window_s=window_s, penter=penter, premove=premove,
-                                reference_c=reference_c, rate_tau_s=rate_tau_s,
-                                rate_tau2_s=rate_tau2_s, aux_columns=aux,
-                                housing_terms=housing_terms, select=select, offsets=offsets)
+                                settings.drift, aux, housing_terms)
     unit = heads[str(drifts[0])].metadata.unit
-    settings = {
-        "order": order, "terms": list(terms), "window_s": window_s, "penter": penter,
-        "premove": premove, "reference_c": reference_c, "rate_tau_s": rate_tau_s,
-        "rate_tau2_s": rate_tau2_s, "aux": dict(aux or {}),
-        "housing_terms": None if housing_terms is None else list(housing_terms),
-        "plateau_options": dict(plateau_options or {}), "drift_from_soaks": drift_from_soaks,
-        "select": select, "offsets": offsets, "motion": options.motion,
-        "columns": dict(options.columns or {}), "units": dict(options.units or {}),
-    }
+    record = _record(settings, aux, housing_terms, plateau_options, options, order=order)
     if prior_fit is not None:
-        settings["prior"] = {"units": prior_fit.prior.n_units,
+        record["prior"] = {"units": prior_fit.prior.n_units,
                              "range_c": list(prior_fit.prior.temperature_range_c),
                              "max_temperature_std_c": prior_fit.max_temperature_std_c}
     unit_model = UnitModel(
@@ -303,7 +259,7 @@ def calibrate(
         provenance=provenance(
             {"soak": [str(p) for p in soaks], "drift": [str(p) for p in drifts],
              "validate": [str(p) for p in validate]},
-            settings,
+            record,
         ),
     )
     validation = tuple(
@@ -313,27 +269,53 @@ def calibrate(
     return CalibrationResult(unit_model, tuple(plateaus), table, validation, prior_fit)
 
 
+def _with_terms(settings: CalibrationSettings, terms: Iterable[str]) -> CalibrationSettings:
+    """``settings`` with the drift fit's candidate terms resolved."""
+    drift = dataclasses.replace(settings.drift, terms=tuple(terms))
+    return dataclasses.replace(settings, drift=drift)
+
+
+def _record(settings: CalibrationSettings, aux: Mapping[str, str] | None,
+            housing_terms: Iterable[str] | None, plateau_options: Mapping[str, Any] | None,
+            options: ReadOptions, **extra: Any) -> dict[str, Any]:
+    """What a model file's provenance records of the settings: every field of ``settings``
+    (:func:`hrgtc.settings.to_dict`), the channels, the baseline and the reading."""
+    return {**to_dict(settings), **extra, "aux": dict(aux or {}),
+            "housing_terms": None if housing_terms is None else list(housing_terms),
+            "plateau_options": dict(plateau_options or {}), "motion": options.motion,
+            "columns": dict(options.columns or {}), "units": dict(options.units or {})}
+
+
+def _fit(runs: Sequence[Any], thermometer: Any, drift: DriftSettings,
+         aux: Mapping[str, str] | None, options: ReadOptions, progress: Any,
+         excitation_runs: int = 0) -> Any:
+    """:func:`hrgtc.drift.fit` with ``drift``'s settings on the runs read by ``options``."""
+    return drift_model.fit(
+        runs, thermometer, terms=drift.terms or drift_model.EQ21, window_s=drift.window_s,
+        penter=drift.penter, premove=drift.premove, reference_c=drift.reference_c,
+        rate_tau_s=drift.rate_tau_s, rate_tau2_s=drift.rate_tau2_s, warmup_s=drift.warmup_s,
+        select=drift.select, offsets=drift.offsets, aux_columns=aux,
+        excitation_runs=excitation_runs, progress=progress, motion=options.motion,
+        gaps=options.gaps)
+
+
 def _fit_drift(training: Sequence[PathLike], heads: Mapping[str, Any], thermometer: Any,
                options: ReadOptions, progress: StageProgress | None, excitation_runs: int,
-               *, housing_terms: Iterable[str] | None, **fit: Any) -> tuple[Any, Any]:
+               drift: DriftSettings, aux: Mapping[str, str] | None,
+               housing_terms: Iterable[str] | None) -> tuple[Any, Any]:
     """The drift model on ``training`` and the housing baseline when every run has
     ``housing_c`` (None otherwise, or when its fit fails: the baseline is optional)."""
     runs = [partial(options.chunks, path) for path in training]
-    fit.setdefault("gaps", options.gaps)
-    model = drift_model.fit(runs, thermometer, excitation_runs=excitation_runs,
-                            progress=for_stage(progress, "drift"), motion=options.motion,
-                            **fit)
+    model = _fit(runs, thermometer, drift, aux, options, for_stage(progress, "drift"),
+                 excitation_runs)
     housing = None
     if housing_terms is not None and all("housing_c" in heads[str(p)] for p in training):
-        # the baseline's own terms in h and dh/dt, with the defaults otherwise
-        baseline = {k: v for k, v in fit.items()
-                    if k not in ("select", "rate_tau2_s", "aux_columns")}
-        baseline["motion"] = options.motion
-        baseline["terms"] = housing_terms
+        # the baseline's own terms in h and dh/dt, with the default selection and d2 filter
+        baseline = dataclasses.replace(drift, terms=tuple(housing_terms),
+                                       select=DriftSettings.select, rate_tau2_s=None)
         try:
-            housing = drift_model.fit(runs, thermometer,
-                                      progress=for_stage(progress, "housing baseline"),
-                                      **baseline)
+            housing = _fit(runs, thermometer, baseline, None, options,
+                           for_stage(progress, "housing baseline"))
         except CalibrationError as exc:  # the baseline is optional: say why it is missing
             warnings.warn(f"no housing-thermistor baseline: {exc}", HrgtcWarning, stacklevel=2)
     return model, housing
@@ -341,7 +323,8 @@ def _fit_drift(training: Sequence[PathLike], heads: Mapping[str, Any], thermomet
 
 def _calibrate_sensor(soaks: Sequence[PathLike], drifts: Sequence[PathLike],
                       validate: Sequence[PathLike], options: ReadOptions,
-                      progress: StageProgress | None, *, order: int, **fit: Any
+                      progress: StageProgress | None, settings: CalibrationSettings,
+                      aux: Mapping[str, str] | None, housing_terms: Iterable[str] | None
                       ) -> CalibrationResult:
     """A gyro without a frequency output: its temperature sensor is the thermometer.
 
@@ -367,12 +350,10 @@ def _calibrate_sensor(soaks: Sequence[PathLike], drifts: Sequence[PathLike],
         message = implausible_for_any_gyro(head.rate_dph, head.metadata.sample_rate_hz)
         if message is not None:
             warnings.warn(f"{path}: column 'rate_dph': {message}", HrgtcWarning, stacklevel=3)
-    fit["terms"] = resolve_terms(fit["terms"], fit.get("aux_columns"),
-                                 [heads[str(p)] for p in training])
+    settings = _with_terms(settings, resolve_terms(settings.drift.terms, aux,
+                                                   [heads[str(p)] for p in training]))
     model, housing = _fit_drift(training, heads, thermometer, options, progress, len(drifts),
-                                **fit)
-    settings = {key: (list(v) if isinstance(v, tuple | list) else
-                      dict(v) if isinstance(v, Mapping) else v) for key, v in fit.items()}
+                                settings.drift, aux, housing_terms)
     unit_model = UnitModel(
         thermometer=thermometer, drift=model, housing=housing,
         unit=heads[str(drifts[0])].metadata.unit,
@@ -380,8 +361,7 @@ def _calibrate_sensor(soaks: Sequence[PathLike], drifts: Sequence[PathLike],
         provenance=provenance(
             {"soak": [str(p) for p in soaks], "drift": [str(p) for p in drifts],
              "validate": [str(p) for p in validate]},
-            {**settings, "thermometer": "sensor", "columns": dict(options.columns or {}),
-             "units": dict(options.units or {})},
+            _record(settings, aux, housing_terms, None, options, thermometer="sensor"),
         ),
     )
     validation = tuple(evaluate(path, unit_model, allan=False, read_options=options)

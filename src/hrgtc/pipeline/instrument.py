@@ -34,9 +34,12 @@ from hrgtc.drift import (
 from hrgtc.drift.scale_factor import TOLERANCE_SHARE
 from hrgtc.evaluation import Evaluation, evaluate
 from hrgtc.model import InstrumentModel, UnitModel, provenance
-from hrgtc.pipeline.calibration import CalibrationResult, calibrate
+from hrgtc.pipeline.calibration import HOUSING_TERMS, CalibrationResult, calibrate
 from hrgtc.recording import ReadOptions, Recording, axis_names
 from hrgtc.recording.marks import refuse_compensated_training
+from hrgtc.settings.calibration import CROSS_AXIS_GAIN, CalibrationSettings
+from hrgtc.settings.reading import ReadSettings
+from hrgtc.thermometry.prior import ThermometerPrior
 
 __all__ = ["InstrumentCalibration", "ScaleFactorCheck", "calibrate_instrument",
            "check_scale_factor"]
@@ -117,13 +120,14 @@ def calibrate_instrument(
     rate_tables: Sequence[PathLike] = (),
     validate_rate_tables: Sequence[PathLike] = (),
     segment_table: PathLike | None = None,
-    scale_terms: Sequence[str] = ("f", "f^2", "f^3"),
-    thermometer: str = "resonator",
-    cross_axis: bool = False,
+    settings: CalibrationSettings | None = None,
+    aux: Mapping[str, str] | None = None,
+    housing_terms: Sequence[str] | None = HOUSING_TERMS,
+    prior: ThermometerPrior | PathLike | None = None,
+    thermometer: str = ReadSettings.thermometer,
     read_options: ReadOptions | None = None,
     progress: StageProgress | None = None,
     validate_options: ReadOptions | None = None,
-    **settings: Any,
 ) -> InstrumentCalibration:
     """Calibrate every axis of an instrument (a single-axis file: the one axis).
 
@@ -141,13 +145,16 @@ def calibrate_instrument(
     segment_table
         CSV ``start_s,end_s,input_rate_dph`` of the rate-table runs' segments, for
         files without an input-rate column.
-    scale_terms
-        Candidate terms of the scale-factor model (in f, as the drift model's).
-    cross_axis
-        Also try the other resonators' frequencies as candidate terms of each axis's
-        drift model (a temperature difference across the unit is a gradient one resonator
-        alone cannot see); kept per axis only where the held-out ``validate`` runs' 10 s
-        bias stability improves by more than 2 % (the decision is in ``cross_axis``).
+    settings
+        The settings of :func:`hrgtc.pipeline.calibration.calibrate` for every axis, with
+        ``scale_terms`` (candidate terms of the scale-factor model, in f as the drift
+        model's) and ``cross_axis``: also try the other resonators' frequencies as
+        candidate terms of each axis's drift model (a temperature difference across the
+        unit is a gradient one resonator alone cannot see); kept per axis only where the
+        held-out ``validate`` runs' 10 s bias stability improves by more than
+        :data:`CROSS_AXIS_GAIN` (the decision is in ``cross_axis``).
+    aux, housing_terms, prior
+        As :func:`hrgtc.pipeline.calibration.calibrate`.
     thermometer
         ``"resonator"`` (the resonator's frequency, [1]) or ``"sensor"`` (a gyro
         without a frequency output: its temperature sensor, ``temperature_c``, is
@@ -160,9 +167,10 @@ def calibrate_instrument(
         Reading options of the ``validate`` runs when they differ (a held-out last part
         of the training file: ``start`` where the training's ``end`` is); default
         ``read_options``.
-    settings
-        Further keyword arguments of :func:`hrgtc.pipeline.calibration.calibrate`.
     """
+    settings = settings or CalibrationSettings()
+    scale_terms, cross_axis = settings.scale_terms, settings.cross_axis
+    fit = {"settings": settings, "aux": aux, "housing_terms": housing_terms, "prior": prior}
     if thermometer not in ("resonator", "sensor"):
         raise InputError(f"thermometer must be 'resonator' or 'sensor', got {thermometer!r}")
     options = dataclasses.replace(read_options or ReadOptions(), thermometer=thermometer)
@@ -178,11 +186,12 @@ def calibrate_instrument(
     for axis in axes:
         axis_read = axis_options(options, axis)
         staged = None if progress is None else _prefixed(progress, axis)
-        result = calibrate(soaks, drifts, (), read_options=axis_read, progress=staged,
-                           thermometer=thermometer, **settings)
+        result = calibrate(soaks, drifts, (), settings=settings, aux=aux,
+                           housing_terms=housing_terms, prior=prior, read_options=axis_read,
+                           progress=staged, thermometer=thermometer)
         if cross_axis and len(axes) > 1:
             result, crossed[axis] = _cross_axis(result, axis, axes, soaks, drifts, validate,
-                                                axis_read, staged, thermometer, settings)
+                                                axis_read, staged, thermometer, fit)
         model = result.model
         if rate_tables:
             model = dataclasses.replace(model, scale_factor=fit_axis_scale_factor(
@@ -211,14 +220,10 @@ def calibrate_instrument(
                                  tuple(c for group in checks for c in group), crossed)
 
 
-#: Cross-axis candidates are kept when the held-out 10 s bias stability drops by more.
-CROSS_AXIS_GAIN = 0.02
-
-
 def _cross_axis(result: CalibrationResult, axis: str, axes: Sequence[str],
                 soaks: Sequence[PathLike], drifts: Sequence[PathLike],
                 validate: Sequence[PathLike], options: ReadOptions, progress: Any,
-                thermometer: str, settings: Mapping[str, Any]
+                thermometer: str, fit: Mapping[str, Any]
                 ) -> tuple[CalibrationResult, dict[str, Any]]:
     """Refit ``axis`` with the other resonators' frequencies as candidates (``a_f<other>``:
     each a thermometer of its own part of the unit, so their differences are the gradients
@@ -228,9 +233,10 @@ def _cross_axis(result: CalibrationResult, axis: str, axes: Sequence[str],
     if not validate:
         return result, {"kept": False, "why": "no held-out run (--validate) to judge by",
                         "channels": others}
-    aux = {**dict(settings.get("aux") or {}), **others}
-    trial = calibrate(soaks, drifts, (), read_options=options, progress=progress,
-                      thermometer=thermometer, **{**settings, "aux": aux})
+    aux = {**dict(fit["aux"] or {}), **others}
+    trial = calibrate(soaks, drifts, (), settings=fit["settings"], aux=aux,
+                      housing_terms=fit["housing_terms"], prior=fit["prior"],
+                      read_options=options, progress=progress, thermometer=thermometer)
 
     def held_out(model: UnitModel) -> float:
         return float(np.median([evaluate(path, model, allan=False, read_options=options)

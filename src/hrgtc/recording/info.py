@@ -24,7 +24,7 @@ from hrgtc.recording.formats import format_of
 from hrgtc.recording.io import iter_chunks
 from hrgtc.recording.resolution import resolution
 from hrgtc.recording.schema import COLUMNS, Metadata
-from hrgtc.recording.spikes import SPIKE_COLUMN, SPIKE_K, SPIKE_LSB, SPIKE_WINDOW_S
+from hrgtc.recording.spikes import SPIKE_COLUMN
 from hrgtc.recording.validation import (
     GapPolicy,
     Problem,
@@ -32,7 +32,9 @@ from hrgtc.recording.validation import (
     ValidationReport,
     check_gap_policy,
 )
+from hrgtc.settings.reading import CHUNK_ROWS, ReadSettings
 
+_READ = ReadSettings
 TEMPERATURE_COLUMNS = ("chamber_c", "housing_c", "resonator_c", "temperature_c")
 SPAN_COLUMNS = (*TEMPERATURE_COLUMNS, "freq_hz")
 
@@ -247,24 +249,24 @@ def describe(
     columns: Mapping[str, str] | Iterable[str] | None = None,
     units: Mapping[str, str] | None = None,
     metadata: Mapping[str, Any] | Metadata | None = None,
-    gaps: GapPolicy | str = "error",
-    rows: int = 1_000_000,
+    gaps: GapPolicy | str = _READ.gaps,
+    rows: int = CHUNK_ROWS,
     progress: Progress | None = None,
     *,
-    temp_scale: float = 1.0,
-    temp_offset_c: float = 0.0,
-    spikes: str = "error",
-    thermometer: str = "resonator",
-    rate_scale: float | None = None,
-    temp_unwrap: str = "auto",
+    temp_scale: float = _READ.temp_scale,
+    temp_offset_c: float = _READ.temp_offset_c,
+    spikes: str = _READ.spikes,
+    thermometer: str = _READ.thermometer,
+    rate_scale: float | None = _READ.rate_scale,
+    temp_unwrap: str = _READ.temp_unwrap,
     spike_filter: str | None = "flag",
-    spike_k: float = SPIKE_K,
-    spike_lsb: float = SPIKE_LSB,
-    spike_window_s: float = SPIKE_WINDOW_S,
+    spike_k: float = _READ.spike_k,
+    spike_lsb: float = _READ.spike_lsb,
+    spike_window_s: float = _READ.spike_window_s,
     start: str | float | None = None,
     end: str | float | None = None,
-    slow_channels: str = "hold",
-    hold_max_s: float | None = None,
+    slow_channels: str = _READ.slow_channels,
+    hold_max_s: float | None = _READ.hold_max_s,
 ) -> RecordingInfo:
     """Summarise and validate a recording file in one streaming pass.
 

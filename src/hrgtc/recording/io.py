@@ -34,7 +34,7 @@ validated axis by axis; :func:`hrgtc.recording.axis_view` gives one axis.
 from __future__ import annotations
 
 from collections.abc import Iterable, Iterator, Mapping, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 from pathlib import Path
 from typing import Any
 
@@ -61,9 +61,6 @@ from hrgtc.recording.rechunk import rechunk
 from hrgtc.recording.resample import SlowChannels, fill_slow_channels
 from hrgtc.recording.schema import SCHEMA_VERSION, Metadata, Recording, concatenate
 from hrgtc.recording.spikes import (
-    SPIKE_K,
-    SPIKE_LSB,
-    SPIKE_WINDOW_S,
     RobustSpikeFilter,
     SpikeFilter,
     check_spike_policy,
@@ -78,6 +75,14 @@ from hrgtc.recording.validation import (
 )
 from hrgtc.recording.validation import validate as validate_recording
 from hrgtc.recording.writing import RecordingWriter, write
+from hrgtc.settings.reading import CHUNK_ROWS, ReadSettings
+
+_READ = ReadSettings
+#: The options of messy files, passed to :func:`read` only when they differ from their
+#: defaults.
+_MESSY = ("temp_scale", "temp_offset_c", "spikes", "thermometer", "rate_scale",
+          "temp_unwrap", "spike_filter", "spike_k", "spike_lsb", "spike_window_s",
+          "slow_channels", "hold_max_s")
 
 #: Metadata key counting the rows of robust spikes, by ``spike_filter``.
 _SPIKE_KEYS = {"drop": "spikes_removed", "flag": "spikes_flagged"}
@@ -162,25 +167,25 @@ def read(
     columns: Mapping[str, str] | Iterable[str] | None = None,
     units: Mapping[str, str] | None = None,
     validate: bool = True,
-    gaps: GapPolicy | str = "error",
+    gaps: GapPolicy | str = _READ.gaps,
     metadata: Mapping[str, Any] | Metadata | None = None,
     freq_band_hz: tuple[float, float] | None = None,
     freq_span_hz: tuple[float, float] | None = None,
     *,
-    temp_scale: float = 1.0,
-    temp_offset_c: float = 0.0,
-    spikes: str = "error",
-    thermometer: str = "resonator",
-    rate_scale: float | None = None,
-    temp_unwrap: str = "auto",
+    temp_scale: float = _READ.temp_scale,
+    temp_offset_c: float = _READ.temp_offset_c,
+    spikes: str = _READ.spikes,
+    thermometer: str = _READ.thermometer,
+    rate_scale: float | None = _READ.rate_scale,
+    temp_unwrap: str = _READ.temp_unwrap,
     spike_filter: str = "off",
-    spike_k: float = SPIKE_K,
-    spike_lsb: float = SPIKE_LSB,
-    spike_window_s: float = SPIKE_WINDOW_S,
+    spike_k: float = _READ.spike_k,
+    spike_lsb: float = _READ.spike_lsb,
+    spike_window_s: float = _READ.spike_window_s,
     start: str | float | None = None,
     end: str | float | None = None,
-    slow_channels: str = "hold",
-    hold_max_s: float | None = None,
+    slow_channels: str = _READ.slow_channels,
+    hold_max_s: float | None = _READ.hold_max_s,
 ) -> Recording:
     """Read a whole recording from Parquet, CSV or HDF5 (by suffix).
 
@@ -287,31 +292,31 @@ def read(
 
 def iter_chunks(
     path: str | Path,
-    rows: int = 1_000_000,
+    rows: int = CHUNK_ROWS,
     columns: Mapping[str, str] | Iterable[str] | None = None,
     units: Mapping[str, str] | None = None,
     validate: bool = True,
-    gaps: GapPolicy | str = "error",
+    gaps: GapPolicy | str = _READ.gaps,
     metadata: Mapping[str, Any] | Metadata | None = None,
     progress: Progress | None = None,
     freq_band_hz: tuple[float, float] | None = None,
     freq_span_hz: tuple[float, float] | None = None,
     *,
-    temp_scale: float = 1.0,
-    temp_offset_c: float = 0.0,
-    spikes: str = "error",
-    thermometer: str = "resonator",
-    rate_scale: float | None = None,
-    temp_unwrap: str = "auto",
+    temp_scale: float = _READ.temp_scale,
+    temp_offset_c: float = _READ.temp_offset_c,
+    spikes: str = _READ.spikes,
+    thermometer: str = _READ.thermometer,
+    rate_scale: float | None = _READ.rate_scale,
+    temp_unwrap: str = _READ.temp_unwrap,
     spike_filter: str = "off",
-    spike_k: float = SPIKE_K,
-    spike_lsb: float = SPIKE_LSB,
-    spike_window_s: float = SPIKE_WINDOW_S,
+    spike_k: float = _READ.spike_k,
+    spike_lsb: float = _READ.spike_lsb,
+    spike_window_s: float = _READ.spike_window_s,
     time_repair: TimeRepairStream | None = None,
     start: str | float | None = None,
     end: str | float | None = None,
-    slow_channels: str = "hold",
-    hold_max_s: float | None = None,
+    slow_channels: str = _READ.slow_channels,
+    hold_max_s: float | None = _READ.hold_max_s,
 ) -> Iterator[Recording]:
     """Stream a recording in chunks of ``rows`` rows without loading the file.
 
@@ -423,7 +428,7 @@ def iter_chunks(
 
 
 @dataclass(frozen=True)
-class ReadOptions:
+class ReadOptions(ReadSettings):
     """How to read a user's files: the reading options of every command, as one value.
 
     The command line's ``--col``, ``--time-unit``, ``--freq-unit``, ``--rate-unit``,
@@ -479,30 +484,6 @@ class ReadOptions:
         ``"error"``, values used for at most ``hold_max_s`` seconds (see :func:`read`).
     """
 
-    columns: Mapping[str, str] | None = None
-    units: Mapping[str, str] | None = None
-    metadata: Mapping[str, Any] | None = None
-    gaps: str = "error"
-    chunk_rows: int = 250_000
-    freq_band_hz: tuple[float, float] | None = None
-    freq_span_hz: tuple[float, float] | None = None
-    temp_scale: float = 1.0
-    temp_offset_c: float = 0.0
-    spikes: str = "error"
-    thermometer: str = "resonator"
-    axis: str | None = None
-    rate_scale: float | None = None
-    temp_unwrap: str = "auto"
-    spike_filter: str | None = None
-    spike_k: float = SPIKE_K
-    spike_lsb: float = SPIKE_LSB
-    spike_window_s: float = SPIKE_WINDOW_S
-    motion: str = "exclude"
-    start: str | None = None
-    end: str | None = None
-    slow_channels: str = "hold"
-    hold_max_s: float | None = None
-
     def keywords(self) -> dict[str, Any]:
         """The options as keyword arguments of :func:`read` and :func:`iter_chunks`.
 
@@ -513,11 +494,8 @@ class ReadOptions:
                  "gaps": self.gaps}
         if self.freq_band_hz is not None:
             words.update(freq_band_hz=self.freq_band_hz, freq_span_hz=self.freq_span_hz)
-        defaults = {"temp_scale": 1.0, "temp_offset_c": 0.0, "spikes": "error",
-                    "thermometer": "resonator", "rate_scale": None, "temp_unwrap": "auto",
-                    "spike_filter": None, "spike_k": SPIKE_K, "spike_lsb": SPIKE_LSB,
-                    "spike_window_s": SPIKE_WINDOW_S, "slow_channels": "hold",
-                    "hold_max_s": None}
+        defaults = {field.name: field.default for field in fields(ReadSettings)
+                    if field.name in _MESSY}
         words.update({key: getattr(self, key) for key, default in defaults.items()
                       if getattr(self, key) != default})
         words.update({key: getattr(self, key) for key in ("start", "end")

@@ -36,11 +36,10 @@ from typing import Any
 import numpy as np
 
 from hrgtc.core.errors import InputError, SlowChannelWarning
+from hrgtc.settings.reading import DEFAULT_MAX_AGE_PERIODS
 
 #: What to do with a slow channel's empty cells.
 SLOW_MODES = ("hold", "interpolate", "error")
-#: Default maximum age of a held value, in periods of the slow channel.
-DEFAULT_MAX_AGE_PERIODS = 3.0
 #: A channel with at least this share of empty cells (in the first rows) is slow.
 SLOW_FRACTION = 0.5
 #: Columns never treated as slow (the time axis and the gyro's own outputs).

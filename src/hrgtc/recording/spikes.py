@@ -52,14 +52,15 @@ from hrgtc.recording.axes import axis_names, base_name
 from hrgtc.recording.checks import _BOUNDS, FREQ_JUMP_FRACTION, TEMPERATURE_RANGE_C
 from hrgtc.recording.gaps import GAP_PERIODS, GAP_TOLERANCE
 from hrgtc.recording.resolution import resolution
+from hrgtc.settings.reading import ReadSettings
 
 SPIKE_POLICIES: tuple[str, ...] = ("error", "drop")
 #: What the robust filter does with the spikes it finds.
 SPIKE_FILTERS: tuple[str, ...] = ("off", "drop", "flag")
 #: Defaults of the robust filter: k (× σ_MAD), m (× LSB), window [s].
-SPIKE_K = 8.0
-SPIKE_LSB = 4.0
-SPIKE_WINDOW_S = 10.0
+SPIKE_K = ReadSettings.spike_k
+SPIKE_LSB = ReadSettings.spike_lsb
+SPIKE_WINDOW_S = ReadSettings.spike_window_s
 #: Fewest samples a window needs for its own σ_MAD (else its segment's).
 MIN_WINDOW_SAMPLES = 16
 #: Rows the resolution (LSB) of a channel is taken from (its first ones).

@@ -1,0 +1,72 @@
+"""The docs' option tables, generated from the settings dataclasses.
+
+A docs page holds ``<!-- options: KEY -->`` and ``<!-- /options -->`` around a table of
+the options generated from a settings class (:data:`DOCUMENTED`); regenerate them with::
+
+    PYTHONPATH=src python -m hrgtc.cli.options_tables docs/guide/*.md
+
+``tests/cli/test_params.py`` fails while a page's table differs from its class.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from hrgtc.cli.params import option_settings
+
+#: The settings classes whose options each command generates, by the docs page that lists them.
+DOCUMENTED = {
+    "calibrate": ("hrgtc.settings.calibration", "CalibrationSettings"),
+    "reading": ("hrgtc.settings.reading", "ReadSettings"),
+}
+
+
+def options_table(cls: type) -> str:
+    """A Markdown table of the options generated from ``cls``: option, default, meaning."""
+    rows = ["| option | default | meaning |", "|---|---|---|"]
+    for s in option_settings(cls):
+        text = s.full_help().replace("|", "\\|")
+        rows.append(f"| `{s.option}` | {s.shown_default().replace('|', chr(92) + '|')} "
+                    f"| {text} |")
+    return "\n".join(rows)
+
+
+def settings_class(key: str) -> type:
+    """The settings class of a docs table (a key of :data:`DOCUMENTED`)."""
+    import importlib
+
+    module, name = DOCUMENTED[key]
+    return getattr(importlib.import_module(module), name)  # type: ignore[no-any-return]
+
+
+def update_docs(text: str) -> str:
+    """``text`` with every ``<!-- options: KEY -->`` ... ``<!-- /options -->`` table
+    regenerated from its settings class."""
+    import re
+
+    def table(match: re.Match[str]) -> str:
+        body = options_table(settings_class(match.group(2)))
+        return f"{match.group(1)}\n{body}\n{match.group(3)}"
+
+    return re.sub(r"(<!-- options: (\w+) -->)\n(?:.*?\n)?(<!-- /options -->)", table, text,
+                  flags=re.S)
+
+
+def main(paths: Sequence[str]) -> int:
+    """Regenerate the option tables of the docs pages ``paths`` in place."""
+    from pathlib import Path
+
+    for path in paths:
+        page = Path(path)
+        text = page.read_text(encoding="utf-8")
+        new = update_docs(text)
+        if new != text:
+            page.write_text(new, encoding="utf-8")
+            print(f"updated {page}")  # a developer's tool, run by hand
+    return 0
+
+
+if __name__ == "__main__":
+    import sys
+
+    raise SystemExit(main(sys.argv[1:]))

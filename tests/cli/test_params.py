@@ -1,0 +1,147 @@
+"""Typed parameters (issue 22): every default is written once, in a settings dataclass, and
+``--help``, the docs' option tables and a fresh model file show that same default."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import re
+from pathlib import Path
+
+import pytest
+import typer.main
+from typer.testing import CliRunner
+
+from hrgtc.cli import app
+from hrgtc.cli.options_tables import DOCUMENTED, settings_class, update_docs
+from hrgtc.cli.params import _value, option_settings
+from hrgtc.settings import Setting, format_value, settings_of
+from hrgtc.settings.calibration import CalibrationSettings
+from hrgtc.settings.drift import EQ21_TERMS, TAU2_FACTOR, WARMUP_FACTOR, DriftSettings
+from hrgtc.settings.reading import ReadSettings
+
+DOCS = Path(__file__).resolve().parents[2] / "docs"
+#: The docs page of each table of :data:`hrgtc.cli.options_tables.DOCUMENTED`.
+PAGES = {"calibrate": DOCS / "guide" / "calibrate.md", "reading": DOCS / "guide" / "index.md"}
+#: The commands whose options each settings class generates.
+COMMANDS = {"calibrate": ["calibrate"],
+            "reading": ["info", "calibrate", "compensate", "evaluate", "report"]}
+CASES = [(key, s) for key in DOCUMENTED for s in option_settings(settings_class(key))]
+
+
+def _click_option(command: str, setting: Setting):
+    import click
+
+    group = typer.main.get_command(app)
+    cmd = group.commands[command]  # type: ignore[attr-defined]
+    ctx = click.Context(cmd, info_name=command)
+    first = setting.option.split("/")[0].split()[0]
+    (param,) = [p for p in cmd.params if first in p.opts]
+    return param, param.get_help_record(ctx)
+
+
+def test_every_option_has_a_table():
+    assert set(DOCUMENTED) == set(PAGES) == set(COMMANDS)
+    assert len(CASES) >= 27  # 14 of calibrate, 16 of reading
+
+
+@pytest.mark.parametrize(("key", "setting"), CASES, ids=[s.option for _, s in CASES])
+def test_help_shows_the_dataclass_default(key, setting):
+    for command in COMMANDS[key]:
+        param, (_, text) = _click_option(command, setting)
+        # the value a command passes on when the option is not given
+        assert _value(setting, param.default) == setting.default, (command, setting.option)
+        shown = re.search(r"\[default: (.*?)\]$", " ".join(text.split()))
+        if setting.default is None and setting.default_text is None:
+            assert shown is None
+        elif isinstance(setting.default, bool) and "/" not in setting.option:
+            assert shown is None and setting.default is False  # a flag: off unless given
+        elif isinstance(setting.default, bool):
+            assert shown is not None and shown.group(1) == (
+                setting.option.split("/")[0 if setting.default else 1].strip().lstrip("-"))
+        elif setting.default_text is not None:
+            assert shown is not None and shown.group(1) == f"({setting.default_text})"
+        else:
+            assert shown is not None and shown.group(1) == format_value(setting.default)
+        assert setting.help.rstrip(".").split(" [")[0][:40] in " ".join(text.split())
+
+
+@pytest.mark.parametrize("key", sorted(DOCUMENTED))
+def test_docs_tables_are_generated_from_the_dataclasses(key):
+    page = PAGES[key].read_text(encoding="utf-8")
+    assert update_docs(page) == page, (
+        f"{PAGES[key]} is stale: PYTHONPATH=src python -m hrgtc.cli.options_tables {PAGES[key]}")
+    block = page.split(f"<!-- options: {key} -->")[1].split("<!-- /options -->")[0]
+    rows = {}
+    for line in block.strip().splitlines()[2:]:
+        option, default, _ = (c.strip() for c in re.split(r"(?<!\\)\|", line)[1:4])
+        rows[option.strip("`")] = default.replace("\\|", "|")
+    expected = {s.option: s.shown_default() for s in option_settings(settings_class(key))}
+    assert rows == expected
+    assert rows["--rate-tau-s" if key == "calibrate" else "--spike-k"] == (
+        "10.0" if key == "calibrate" else "8.0")
+
+
+def test_stale_docs_table_is_found():
+    page = PAGES["calibrate"].read_text(encoding="utf-8")
+    stale = page.replace("| `--rate-tau-s` | 10.0 |", "| `--rate-tau-s` | 12.0 |")
+    assert stale != page and update_docs(stale) == page
+
+
+def test_derived_help_follows_its_constant():
+    """The help of --rate-tau2-s and --warmup-s comes from the constants the fit uses."""
+    by_name = {s.name: s for s in settings_of(DriftSettings)}
+    assert by_name["rate_tau2_s"].default_text == f"{TAU2_FACTOR:g} × --rate-tau-s"
+    assert by_name["warmup_s"].default_text.startswith(f"{WARMUP_FACTOR:g} ×")
+    assert DriftSettings().tau2_s(True) == TAU2_FACTOR * DriftSettings.rate_tau_s
+    assert DriftSettings(rate_tau_s=20.0).warmup(0.0) == WARMUP_FACTOR * 20.0
+    assert EQ21_TERMS[0] == "f" and len(EQ21_TERMS) == 9  # Eq. (21) of [1]: nine terms
+
+
+def test_library_defaults_come_from_the_dataclasses():
+    """``drift.fit``, ``read``, ``iter_chunks`` and ``describe`` take the fields' defaults."""
+    import inspect
+
+    from hrgtc.drift import FeatureSettings, fit
+    from hrgtc.recording import ReadOptions, describe, iter_chunks, read
+
+    fit_defaults = inspect.signature(fit).parameters
+    for name in ("window_s", "penter", "rate_tau_s", "select", "offsets"):
+        assert fit_defaults[name].default == getattr(DriftSettings(), name)
+    assert FeatureSettings(1.0, 1.0).rate_tau_s == DriftSettings().rate_tau_s
+    fields = {f.name: f.default for f in dataclasses.fields(ReadSettings)}
+    for function in (read, iter_chunks, describe):
+        for name, p in inspect.signature(function).parameters.items():
+            if name in fields and name not in ("spike_filter", "columns", "units",
+                                               "metadata", "freq_band_hz", "freq_span_hz"):
+                assert p.default == fields[name], (function.__name__, name)
+    assert issubclass(ReadOptions, ReadSettings)
+    assert ReadOptions().keywords() == {"columns": None, "units": None, "metadata": None,
+                                        "gaps": "error"}
+
+
+@pytest.mark.slow
+def test_fresh_model_file_records_the_defaults(paper_campaign, tmp_path):
+    """``hrgtc calibrate`` with no option of the fit: the model file's provenance holds
+    every field's default, the drift model's feature settings its filter."""
+    files = paper_campaign
+    out = tmp_path / "unit.json"
+    result = CliRunner().invoke(app, ["calibrate", *[a for s in files.soaks for a in
+                                                     ("--soak", str(s))],
+                                      "--drift", str(files.cooldown), "-o", str(out), "--json"])
+    assert result.exit_code == 0, result.output
+    model = json.loads(out.read_text())
+    recorded = model["provenance"]["settings"]
+    for setting in settings_of(CalibrationSettings):
+        value = recorded[setting.name]
+        if setting.name == "terms":  # None: resolved to the default candidates
+            assert tuple(value) in (EQ21_TERMS, ("f", "f^2", "f^3", "g", "f*g", "f^2*g"))
+            continue
+        expected = (list(setting.default) if isinstance(setting.default, tuple)
+                    else setting.default)
+        assert value == expected, setting.name
+    assert recorded["motion"] == ReadSettings.motion
+    (axis,) = model["axes"].values() if "axes" in model else (model,)
+    features = axis["drift"]["settings"]
+    assert features["rate_tau_s"] == DriftSettings.rate_tau_s
+    assert features["warmup_s"] == WARMUP_FACTOR * DriftSettings.rate_tau_s
