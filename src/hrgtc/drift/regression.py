@@ -63,8 +63,6 @@ EXTENDED_PRECISION = bool(np.finfo(np.longdouble).eps < np.finfo(np.float64).eps
 x86-64 Linux, IEEE quad on aarch64 Linux). Where it does not (Windows, Apple
 silicon), :func:`refine` returns the fit unchanged with a :class:`PrecisionWarning`."""
 
-_REFINE_BLOCK_ROWS = 65_536
-"""Rows converted to extended precision at a time when computing residuals."""
 _REFINE_MAX_STEPS = 10
 
 
@@ -118,14 +116,14 @@ def refine(result: OLSResult, X: Any, y: Any, weights: Any = None, *,
 
         f = b - r - A x,    g = -A' r,
 
-    in extended precision (``numpy.longdouble``) and solves for corrections with
+    in double-double arithmetic (about 106 bits, one compiled pass over the rows:
+    :mod:`hrgtc.drift._extended_kernel`) and solves for corrections with
     the float64 factors: h = R^-T g, dr = Q h + (I - Q Q') f, R dx = Q' f - h
     (A. Bjorck, BIT 7, 257-278, 1967, doi:10.1007/BF01939321; Bjorck, Numerical
     Methods for Least Squares Problems, SIAM 1996, Sec. 2.9). Refining r with x
     is what removes the eps * cond(A)^2 * |r| / |x| term of the forward error;
     refining x alone against the same float64 solve does not. The columns are
-    first centred and scaled by powers of two (in extended precision, so the
-    problem is not changed) and the intercept restored at the end.
+    first centred and scaled by powers of two (exactly, so the problem is not changed) and the intercept restored at the end.
 
     Standard errors, residual_std and rsquared stay those of ``result`` (from
     the triangular factor); ``params``, ``tvalues`` and ``pvalues`` change.
@@ -196,29 +194,18 @@ def refine(result: OLSResult, X: Any, y: Any, weights: Any = None, *,
                          f"columns but X has {X.shape[0]} rows and {k}; pass the "
                          "accumulator of these rows and columns")
     assert factor.shift_ is not None and factor.scale_ is not None and factor.r_ is not None
+    from hrgtc.drift._extended_kernel import add_to, residual_pass
+
     shift, scale = factor.shift_, factor.scale_
-    inverse = 1.0 / scale  # powers of two: exact in float64 and in extended precision
-    shift_ld, inverse_ld = shift.astype(np.longdouble), inverse.astype(np.longdouble)
-    root_w = None if w is None else np.sqrt(w.astype(np.longdouble))
-
-    def rows(start: int, stop: int) -> tuple[np.ndarray, np.ndarray]:
-        """Centred, scaled (and weighted) design and response of some rows, extended."""
-        a = np.empty((stop - start, k + 1), dtype=np.longdouble)
-        a[:, 0] = 1.0
-        np.subtract(X[start:stop], shift_ld[:k], out=a[:, 1:])
-        a[:, 1:] *= inverse_ld[:k]
-        b = (y[start:stop] - shift_ld[k]) * inverse_ld[k]
-        if root_w is not None:
-            a *= root_w[start:stop, None]
-            b = b * root_w[start:stop]
-        return a, b
-
+    inverse = 1.0 / scale  # powers of two: exact in float64 and in double-double
     n = X.shape[0]
     eps = np.finfo(np.float64).eps
-    blocks = [(s, min(s + _REFINE_BLOCK_ROWS, n)) for s in range(0, n, _REFINE_BLOCK_ROWS)]
+    X_c = np.ascontiguousarray(X, dtype=np.float64)
+    y_c = np.ascontiguousarray(y, dtype=np.float64)
+    w_c = np.empty(0) if w is None else np.ascontiguousarray(w, dtype=np.float64)
     # The float64 factorization only preconditions the refinement: its design is formed in
     # float64 (no extended pass), its solution x0 is then corrected against residuals
-    # computed in extended precision.
+    # computed in double-double (hrgtc.drift._extended_kernel).
     design = np.empty((n, k + 1))
     design[:, 0] = 1.0
     np.subtract(X, shift[:k], out=design[:, 1:])
@@ -234,7 +221,7 @@ def refine(result: OLSResult, X: Any, y: Any, weights: Any = None, *,
     seminormal = 16.0 * (k + 1) * eps * cond * cond < 1e-3
     if seminormal:
         q = None
-        x = solve_triangular(r_factor, factor.r_[:k + 1, k + 1]).astype(np.longdouble)
+        x_hi = solve_triangular(r_factor, factor.r_[:k + 1, k + 1])
         # each step shrinks the error of x by about c (k + 1) eps cond(A)^2
         contraction = min(1.0, 16.0 * (k + 1) * eps * cond * cond)
     else:
@@ -242,31 +229,27 @@ def refine(result: OLSResult, X: Any, y: Any, weights: Any = None, *,
         if w is not None:
             response *= np.sqrt(w)
         q, r_factor = np.linalg.qr(design)
-        x = solve_triangular(r_factor, q.T @ response).astype(np.longdouble)
+        x_hi = solve_triangular(r_factor, q.T @ response)
         del response, design
         # each step shrinks the error of x by about c (k + 1) eps cond(A) (Bjorck 1967)
         contraction = min(1.0, 16.0 * (k + 1) * eps * cond)
+    x_hi = np.ascontiguousarray(x_hi, dtype=np.float64)
+    x_lo = np.zeros(k + 1)
     # One extended pass gives r0 = b - A x0 and g = -A' r0 together; the first
     # augmented residual f = b - r0 - A x0 is then zero by construction, and every
     # later pass computes f and g of the current (r, x) at once. Where the contraction
     # factor is tiny, the correction just applied leaves an error below float64
     # resolution and the next pass over the rows is skipped.
-    resid = np.empty(n, dtype=np.longdouble)
+    r_hi, r_lo = np.empty(n), np.empty(n)
     f = np.zeros(n)
-    g = np.zeros(k + 1, dtype=np.longdouble)
-    for start, stop in blocks:
-        a, b = rows(start, stop)
-        resid[start:stop] = b - a @ x
-        g -= a.T @ resid[start:stop]
+    g_hi, g_lo = np.empty(k + 1), np.empty(k + 1)
+    residual_pass(X_c, y_c, shift, inverse, w_c, x_hi, x_lo, r_hi, r_lo, f, g_hi, g_lo, True)
     previous = np.inf
     for step in range(max_steps):
         if step:
-            g = np.zeros(k + 1, dtype=np.longdouble)
-            for start, stop in blocks:
-                a, b = rows(start, stop)
-                f[start:stop] = b - resid[start:stop] - a @ x
-                g -= a.T @ resid[start:stop]
-        h = solve_triangular(r_factor, g.astype(np.float64), trans="T")
+            residual_pass(X_c, y_c, shift, inverse, w_c, x_hi, x_lo, r_hi, r_lo, f, g_hi, g_lo,
+                          False)
+        h = solve_triangular(r_factor, g_hi + g_lo, trans="T")
         if q is None:  # Q' f = R^-T A' f
             d = solve_triangular(r_factor, design.T @ f, trans="T") if step \
                 else np.zeros(k + 1)
@@ -276,14 +259,16 @@ def refine(result: OLSResult, X: Any, y: Any, weights: Any = None, *,
         size = float(np.max(np.abs(dx)))
         if size >= previous:  # no longer contracting: cond(A) * eps too large to gain more
             break
-        x += dx
+        add_to(x_hi, x_lo, dx)
         if q is None:  # dr = Q h + (I - Q Q') f = f - A dx
-            resid += f - design @ dx
+            add_to(r_hi, r_lo, f - design @ dx)
         else:
-            resid += f + q @ (h - d)
+            add_to(r_hi, r_lo, f + q @ (h - d))
         previous = size
-        if contraction * size <= eps * float(np.max(np.abs(x))):
+        if contraction * size <= eps * float(np.max(np.abs(x_hi))):
             break
+    x = x_hi.astype(np.longdouble) + x_lo.astype(np.longdouble)
+    shift_ld = shift.astype(np.longdouble)
     scale_ld = scale.astype(np.longdouble)
     sy = scale_ld[k]
     slopes = sy * x[1:] / scale_ld[:k]
