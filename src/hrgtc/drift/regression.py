@@ -123,7 +123,8 @@ def refine(result: OLSResult, X: Any, y: Any, weights: Any = None, *,
     Methods for Least Squares Problems, SIAM 1996, Sec. 2.9). Refining r with x
     is what removes the eps * cond(A)^2 * |r| / |x| term of the forward error;
     refining x alone against the same float64 solve does not. The columns are
-    first centred and scaled by powers of two (exactly, so the problem is not changed) and the intercept restored at the end.
+    first centred and scaled by powers of two (exactly, so the problem is not
+    changed) and the intercept restored at the end.
 
     Standard errors, residual_std and rsquared stay those of ``result`` (from
     the triangular factor); ``params``, ``tvalues`` and ``pvalues`` change.
