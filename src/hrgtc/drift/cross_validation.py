@@ -28,6 +28,8 @@ from typing import Any
 
 import numpy as np
 
+from hrgtc.core.timeline import time_blocks
+
 #: Windows whose |df/dt| is below this share of the largest are neither heating nor cooling.
 RATE_DEADBAND = 0.05
 
@@ -195,29 +197,65 @@ def select_terms(x_scaled: np.ndarray, bias_dph: np.ndarray, run: np.ndarray,
     return tuple(n for n in names if n in chosen)
 
 
-#: Contiguous time blocks of a single training run for blocked cross-validation.
+#: Contiguous time blocks a single training run is cut into for blocked cross-validation.
 TIME_BLOCKS = 5
 #: A term is pruned when the held-out score without it is within this share of the best.
 PRUNE_TOLERANCE = 0.01
+#: Description of the folds of a single run (stored in the model's ``pruning`` record).
+EXTREME_BLOCKS = "coldest and hottest time blocks"
 
 
-def folds_of(run: np.ndarray, time_s: np.ndarray, blocks: int = TIME_BLOCKS
-             ) -> tuple[np.ndarray, str]:
-    """Cross-validation folds of training windows: the runs when there are two or more,
-    else the first and the last of ``blocks`` contiguous time blocks of the one run (equal
-    numbers of windows; fold -1, the middle, is never left out).
+def folds_of(run: np.ndarray, time_s: np.ndarray, temperature: np.ndarray | None = None,
+             blocks: int = TIME_BLOCKS) -> tuple[np.ndarray, str]:
+    """Cross-validation folds of training windows.
 
-    Returns the fold of each window and a description (``"runs"`` or ``"end time blocks"``).
+    With two runs or more the folds are the runs. A single run is cut into ``blocks``
+    contiguous blocks of its time axis (:func:`hrgtc.core.timeline.time_blocks`: about
+    equal numbers of windows, cut at the gaps between bursts where possible); the block
+    with the lowest mean ``temperature`` (fold 0) and the one with the highest (fold 1)
+    are left out, each predicted from all the other windows. A term then earns its
+    place only by predicting temperatures beyond the range it was fitted on, which is
+    what a model does on a later, colder or warmer run. On a monotonic ramp these are
+    the first and the last block; on a cycle the cold extreme may lie in the middle.
+    Without ``temperature``, the first and the last block. Fold -1 is never left out.
+
+    Parameters
+    ----------
+    run
+        Run index of each window.
+    time_s
+        Window centre times. [s]
+    temperature
+        Window means of the thermometer variable (a frequency or a temperature; only
+        its order matters). [Hz or °C]
+    blocks
+        Number of time blocks.
+
+    Returns
+    -------
+    folds, kind
+        The fold of each window, and ``"runs"`` or :data:`EXTREME_BLOCKS`.
     """
+    run = np.asarray(run)
     if np.unique(run).size >= 2:
-        return np.asarray(run), "runs"
+        return run, "runs"
+    time_s = np.asarray(time_s, dtype=np.float64)
+    folds = np.full(time_s.size, -1, dtype=np.int64)
+    count = min(blocks, time_s.size)
+    if count < 2:
+        return folds, EXTREME_BLOCKS
     order = np.argsort(time_s, kind="stable")
-    folds = np.empty(run.size, dtype=np.int64)
-    folds[order] = np.minimum(np.arange(run.size) * blocks // max(run.size, 1), blocks - 1)
-    # only the first and the last block are left out, each predicted from all the rest:
-    # the model has to extrapolate in time (and, on a ramp, in temperature), as on a later run
-    folds = np.where(folds == 0, 0, np.where(folds == blocks - 1, 1, -1))
-    return folds, "end time blocks"
+    ranges = time_blocks(time_s[order], count)
+    coldest, hottest = 0, count - 1
+    if temperature is not None:
+        sorted_temperature = np.asarray(temperature, dtype=np.float64)[order]
+        means = np.array([np.mean(sorted_temperature[a:b]) for a, b in ranges])
+        if np.all(np.isfinite(means)) and np.ptp(means) > 0.0:
+            coldest, hottest = int(np.argmin(means)), int(np.argmax(means))
+    for fold, block in enumerate((coldest, hottest)):
+        start, stop = ranges[block]
+        folds[order[start:stop]] = fold
+    return folds, EXTREME_BLOCKS
 
 
 def held_out_rms(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarray,
@@ -276,13 +314,16 @@ def prune_terms(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarray,
 def guard_selection(x_scaled: np.ndarray, bias_dph: np.ndarray, run: np.ndarray,
                     time_s: np.ndarray, names: Sequence[str], selected: Sequence[str],
                     parents: Mapping[str, Sequence[str]] | None = None,
-                    keep: Sequence[str] = ()) -> tuple[tuple[str, ...] | None, dict[str, Any]]:
-    """The guarded selection: :func:`prune_terms` on the folds of :func:`folds_of`.
+                    keep: Sequence[str] = (), temperature: np.ndarray | None = None,
+                    ) -> tuple[tuple[str, ...] | None, dict[str, Any]]:
+    """The guarded selection: :func:`prune_terms` on the folds of :func:`folds_of`
+    (``temperature``: the window means of the thermometer variable, which pick the
+    coldest and the hottest block of a single run).
 
     Returns the terms to refit (None when nothing was dropped) and the record of the check
     (``folds``, ``dropped``, ``before_dph``, ``after_dph``) stored in the model.
     """
-    folds, kind = folds_of(run, time_s)
+    folds, kind = folds_of(run, time_s, temperature)
     kept, before, after = prune_terms(x_scaled, bias_dph, folds, names, selected,
                                       parents=parents, keep=keep)
     record = {"folds": kind, "dropped": [t for t in selected if t not in kept],
