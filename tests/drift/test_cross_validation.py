@@ -74,3 +74,44 @@ def test_drift_fit_reports_cross_validation_per_run():
         drift.fit([cool], THERMOMETER, select="cv")
     with pytest.raises(InputError, match="select must be"):
         drift.fit([cool, warm], THERMOMETER, select="lasso")
+
+
+def test_folds_of_one_run_are_its_coldest_and_hottest_time_blocks():
+    from hrgtc.drift.cross_validation import EXTREME_BLOCKS, folds_of
+
+    time_s = np.arange(20) * 60.0
+    ramp = np.linspace(25.0, 5.0, 20)  # a cool-down: the first block is the hottest
+    folds, kind = folds_of(np.zeros(20, dtype=int), time_s, ramp, blocks=5)
+    assert kind == EXTREME_BLOCKS
+    assert folds.tolist() == [1] * 4 + [-1] * 12 + [0] * 4
+    cycle = 15.0 + 10.0 * np.cos(2.0 * np.pi * time_s / time_s[-1])  # coldest in the middle
+    folds, _ = folds_of(np.zeros(20, dtype=int), time_s, cycle, blocks=5)
+    assert set(np.flatnonzero(folds == 0)) == {8, 9, 10, 11}
+    assert set(np.flatnonzero(folds == 1)) in ({0, 1, 2, 3}, {16, 17, 18, 19})
+    # a missing burst (a gap in the window times) is where a block ends
+    gapped = np.r_[np.arange(7), np.arange(12, 25)] * 60.0
+    folds, _ = folds_of(np.zeros(20, dtype=int), gapped, ramp, blocks=2)
+    assert folds.tolist() == [1] * 7 + [0] * 13
+    runs = np.repeat([0, 1], 10)
+    assert folds_of(runs, time_s, ramp)[1] == "runs"
+
+
+def test_pruning_follows_the_path_past_a_rise_to_the_model_that_generalises():
+    from hrgtc.drift.cross_validation import held_out_rms, prune_terms
+
+    # truth: a line in f plus a random walk (a gyro's slow noise), which the cubic and
+    # the square fit in the middle of the run; predicting the end blocks, f, f², f³ is
+    # worse than f alone, and f, f² worse still: a stop at the first rise keeps all three
+    n = 60
+    f = np.linspace(-1.0, 1.0, n)
+    x = np.column_stack([f, f**2, f**3])
+    y = f + np.cumsum(np.random.default_rng(1).normal(0.0, 0.05, n))
+    folds = np.full(n, -1)
+    folds[:12], folds[-12:] = 1, 0
+    names = ("f", "f^2", "f^3")
+    parents = {"f^3": ["f^2"], "f^2": ["f"]}
+    scores = {t: held_out_rms(x, y, folds, names, t) for t in [("f",), ("f", "f^2"), names]}
+    assert scores[("f", "f^2")] > scores[names] > 2.0 * scores[("f",)]
+    assert prune_terms(x, y, folds, names, names, parents=parents)[0] == names
+    kept, before, after = prune_terms(x, y, folds, names, names, parents=parents, through=True)
+    assert kept == ("f",) and after == pytest.approx(scores[("f",)]) and after < before

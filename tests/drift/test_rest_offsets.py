@@ -163,7 +163,7 @@ def test_guarded_selection_does_not_extrapolate_high_order_terms():
         if seed in (12, 15):  # the trap is real, and the guard gets out of it
             assert {"f^2", "f^3"} & set(plain.selected)
             assert not {"f^2", "f^3"} & set(guarded.selected)
-            assert guarded.pruning["folds"] == "end time blocks"
+            assert guarded.pruning["folds"] == "coldest and hottest time blocks"
             assert error(guarded) < 0.6 * error(plain)
     assert sum(g > 1.2 for g in gains) >= 4
 

@@ -28,6 +28,9 @@ from typing import Any
 
 import numpy as np
 
+from hrgtc.core.timeline import time_blocks
+from hrgtc.drift.regression import newey_west_inflation
+
 #: Windows whose |df/dt| is below this share of the largest are neither heating nor cooling.
 RATE_DEADBAND = 0.05
 
@@ -195,29 +198,65 @@ def select_terms(x_scaled: np.ndarray, bias_dph: np.ndarray, run: np.ndarray,
     return tuple(n for n in names if n in chosen)
 
 
-#: Contiguous time blocks of a single training run for blocked cross-validation.
+#: Contiguous time blocks a single training run is cut into for blocked cross-validation.
 TIME_BLOCKS = 5
 #: A term is pruned when the held-out score without it is within this share of the best.
 PRUNE_TOLERANCE = 0.01
+#: Description of the folds of a single run (stored in the model's ``pruning`` record).
+EXTREME_BLOCKS = "coldest and hottest time blocks"
 
 
-def folds_of(run: np.ndarray, time_s: np.ndarray, blocks: int = TIME_BLOCKS
-             ) -> tuple[np.ndarray, str]:
-    """Cross-validation folds of training windows: the runs when there are two or more,
-    else the first and the last of ``blocks`` contiguous time blocks of the one run (equal
-    numbers of windows; fold -1, the middle, is never left out).
+def folds_of(run: np.ndarray, time_s: np.ndarray, temperature: np.ndarray | None = None,
+             blocks: int = TIME_BLOCKS) -> tuple[np.ndarray, str]:
+    """Cross-validation folds of training windows.
 
-    Returns the fold of each window and a description (``"runs"`` or ``"end time blocks"``).
+    With two runs or more the folds are the runs. A single run is cut into ``blocks``
+    contiguous blocks of its time axis (:func:`hrgtc.core.timeline.time_blocks`: about
+    equal numbers of windows, cut at the gaps between bursts where possible); the block
+    with the lowest mean ``temperature`` (fold 0) and the one with the highest (fold 1)
+    are left out, each predicted from all the other windows. A term then earns its
+    place only by predicting temperatures beyond the range it was fitted on, which is
+    what a model does on a later, colder or warmer run. On a monotonic ramp these are
+    the first and the last block; on a cycle the cold extreme may lie in the middle.
+    Without ``temperature``, the first and the last block. Fold -1 is never left out.
+
+    Parameters
+    ----------
+    run
+        Run index of each window.
+    time_s
+        Window centre times. [s]
+    temperature
+        Window means of the thermometer variable (a frequency or a temperature; only
+        its order matters). [Hz or °C]
+    blocks
+        Number of time blocks.
+
+    Returns
+    -------
+    folds, kind
+        The fold of each window, and ``"runs"`` or :data:`EXTREME_BLOCKS`.
     """
+    run = np.asarray(run)
     if np.unique(run).size >= 2:
-        return np.asarray(run), "runs"
+        return run, "runs"
+    time_s = np.asarray(time_s, dtype=np.float64)
+    folds = np.full(time_s.size, -1, dtype=np.int64)
+    count = min(blocks, time_s.size)
+    if count < 2:
+        return folds, EXTREME_BLOCKS
     order = np.argsort(time_s, kind="stable")
-    folds = np.empty(run.size, dtype=np.int64)
-    folds[order] = np.minimum(np.arange(run.size) * blocks // max(run.size, 1), blocks - 1)
-    # only the first and the last block are left out, each predicted from all the rest:
-    # the model has to extrapolate in time (and, on a ramp, in temperature), as on a later run
-    folds = np.where(folds == 0, 0, np.where(folds == blocks - 1, 1, -1))
-    return folds, "end time blocks"
+    ranges = time_blocks(time_s[order], count)
+    coldest, hottest = 0, count - 1
+    if temperature is not None:
+        sorted_temperature = np.asarray(temperature, dtype=np.float64)[order]
+        means = np.array([np.mean(sorted_temperature[a:b]) for a, b in ranges])
+        if np.all(np.isfinite(means)) and np.ptp(means) > 0.0:
+            coldest, hottest = int(np.argmin(means)), int(np.argmax(means))
+    for fold, block in enumerate((coldest, hottest)):
+        start, stop = ranges[block]
+        folds[order[start:stop]] = fold
+    return folds, EXTREME_BLOCKS
 
 
 def held_out_rms(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarray,
@@ -235,17 +274,26 @@ def prune_terms(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarray,
                 names: Sequence[str], selected: Sequence[str],
                 tolerance: float = PRUNE_TOLERANCE,
                 parents: Mapping[str, Sequence[str]] | None = None,
-                keep: Sequence[str] = ()) -> tuple[tuple[str, ...], float, float]:
+                keep: Sequence[str] = (), through: bool = False,
+                ) -> tuple[tuple[str, ...], float, float]:
     """Drop selected terms that do not carry over to held-out folds.
 
-    From ``selected`` (the stepwise terms), the term whose removal gives the lowest
-    :func:`held_out_rms` is removed while that score stays within ``tolerance`` of the
-    best score seen: a term that only fits the training folds (a cubic that runs away
-    outside the temperatures it was fitted on) goes; a term the held-out folds need
-    stays. Only removals: the result is never richer than ``selected``. With
-    ``parents`` (term -> its lower-order parents), a term is removed only once no kept
-    term has it as a parent: the highest orders go first (marginality). Terms in
-    ``keep`` (the user's starting model) are never removed.
+    Backward elimination by :func:`held_out_rms`: from ``selected`` (the stepwise
+    terms), the term whose removal gives the lowest held-out score is removed, then the
+    next. Without ``through`` it stops at the first step that raises the score beyond
+    ``tolerance`` of the best seen. With ``through`` the path is followed to its end
+    (only ``keep`` left) and, of its nested models, the smallest one whose score is
+    within ``tolerance`` of the lowest, or within one standard error of it
+    (:func:`_within_one_error`), is taken: a group of terms that helps only together
+    (``f·df`` propping up a poor ``df``) goes with the rest when the smaller model
+    predicts the held-out folds better, where a stop at the first rise keeps them all.
+
+    A term that only fits the training folds (a cubic that runs away outside the
+    temperatures it was fitted on) goes; a term the held-out folds need stays. Only
+    removals: the result is never richer than ``selected``. With ``parents`` (term ->
+    its lower-order parents), a term is removed only once no kept term has it as a
+    parent: the highest orders go first (marginality). Terms in ``keep`` (the user's
+    starting model) are never removed.
 
     Returns
     -------
@@ -256,35 +304,79 @@ def prune_terms(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarray,
     before = held_out_rms(x_scaled, bias_dph, folds, names, chosen)
     if not math.isfinite(before):
         return tuple(chosen), before, before
-    best = current = before
+    path = [(tuple(chosen), before)]
     while chosen:
         leaves = [n for n in chosen if n not in keep
                   and not any(n in (parents or {}).get(c, ()) for c in chosen if c != n)]
         trial = {n: held_out_rms(x_scaled, bias_dph, folds, names,
                                  [c for c in chosen if c != n]) for n in leaves}
+        trial = {n: v for n, v in trial.items() if math.isfinite(v)}
         if not trial:
             break
         name = min(trial, key=trial.__getitem__)
-        if not trial[name] <= best * (1.0 + tolerance):
+        if not through and not trial[name] <= min(s for _, s in path) * (1.0 + tolerance):
             break
         chosen.remove(name)
-        current = trial[name]
-        best = min(best, current)
-    return tuple(chosen), before, current
+        path.append((tuple(chosen), trial[name]))
+    if not through:
+        return path[-1][0], before, path[-1][1]
+    best = min(range(len(path)), key=lambda k: path[k][1])
+    reference = _held_out_residuals(x_scaled, bias_dph, folds, _columns(names, path[best][0]))
+    for terms, score in reversed(path[best:]):  # the smallest first
+        if score <= path[best][1] * (1.0 + tolerance) or _within_one_error(
+                _held_out_residuals(x_scaled, bias_dph, folds, _columns(names, terms)),
+                reference, folds):
+            return terms, before, score
+    return path[best][0], before, path[best][1]
+
+
+def _columns(names: Sequence[str], terms: Sequence[str]) -> list[int]:
+    return [list(names).index(t) for t in terms]
+
+
+def _within_one_error(smaller: np.ndarray, best: np.ndarray, folds: np.ndarray) -> bool:
+    """Is the held-out mean square of ``smaller`` within one standard error of ``best``'s?
+
+    Both are held-out residuals of the same windows. The difference of their squares is
+    averaged as :func:`held_out_rms` averages (each fold's mean, then over folds); its
+    standard error counts the correlation of neighbouring windows (Newey-West, as the
+    F-tests do). The one-standard-error rule of Breiman et al. (Classification and
+    Regression Trees, 1984; Hastie, Tibshirani and Friedman, The Elements of Statistical
+    Learning, 2nd ed., Section 7.10): the simplest model the held-out data cannot tell
+    from the best.
+    """
+    excess, variance, count = 0.0, 0.0, 0
+    for fold in np.unique(folds[folds >= 0]):
+        inside = (folds == fold) & np.isfinite(smaller) & np.isfinite(best)
+        d = smaller[inside] ** 2 - best[inside] ** 2
+        if d.size < 2:
+            continue
+        inflation, _ = newey_west_inflation(d)
+        excess += float(np.mean(d))
+        variance += inflation * float(np.var(d, ddof=1)) / d.size
+        count += 1
+    if count == 0:
+        return False
+    return excess / count <= math.sqrt(variance) / count
 
 
 def guard_selection(x_scaled: np.ndarray, bias_dph: np.ndarray, run: np.ndarray,
                     time_s: np.ndarray, names: Sequence[str], selected: Sequence[str],
                     parents: Mapping[str, Sequence[str]] | None = None,
-                    keep: Sequence[str] = ()) -> tuple[tuple[str, ...] | None, dict[str, Any]]:
-    """The guarded selection: :func:`prune_terms` on the folds of :func:`folds_of`.
+                    keep: Sequence[str] = (), temperature: np.ndarray | None = None,
+                    ) -> tuple[tuple[str, ...] | None, dict[str, Any]]:
+    """The guarded selection: :func:`prune_terms` on the folds of :func:`folds_of`
+    (``temperature``: the window means of the thermometer variable, which pick the
+    coldest and the hottest block of a single run).
 
     Returns the terms to refit (None when nothing was dropped) and the record of the check
     (``folds``, ``dropped``, ``before_dph``, ``after_dph``) stored in the model.
     """
-    folds, kind = folds_of(run, time_s)
+    folds, kind = folds_of(run, time_s, temperature)
+    # across runs a fold's complement may lack what one run alone excites (a heating-only
+    # term when the one warm-up is left out): there, stop at the first rise
     kept, before, after = prune_terms(x_scaled, bias_dph, folds, names, selected,
-                                      parents=parents, keep=keep)
+                                      parents=parents, keep=keep, through=kind != "runs")
     record = {"folds": kind, "dropped": [t for t in selected if t not in kept],
               "before_dph": before, "after_dph": after}
     return (kept if len(kept) < len(selected) else None), record

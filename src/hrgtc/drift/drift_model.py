@@ -535,7 +535,8 @@ def fit(
     elif select == "guarded" and result.selected:
         chosen, pruning = guard_selection(
             x_scaled, bias, windows.run, windows.time_s, names, result.selected,
-            parents=hierarchy(candidates), keep=[parse_terms([t])[0].name for t in initial or ()])
+            parents=hierarchy(candidates), keep=[parse_terms([t])[0].name for t in initial or ()],
+            temperature=windows.variables.get("f"))
     if chosen is not None:
         history = result.history
         result = stepwise(x_scaled, bias, names=names, penter=penter,
