@@ -21,9 +21,9 @@ from pathlib import Path
 from hrgtc.calibration import CalibrationResult, calibrate
 from hrgtc.compensate import OUTPUT_COLUMNS, CompensationSummary, compensate_instrument_file
 from hrgtc.compensate.compensator import compensated_metadata
-from hrgtc.compensate.export_c import export_c
 from hrgtc.errors import HrgtcWarning
 from hrgtc.evaluation import Evaluation, evaluate
+from hrgtc.export.export_c import export_c
 from hrgtc.files import refuse_existing
 from hrgtc.instrument import InstrumentCalibration, calibrate_instrument
 from hrgtc.model import save_instrument, save_model

@@ -23,10 +23,6 @@ import pytest
 from hrgtc import drift
 from hrgtc.compensate import Compensator
 from hrgtc.compensate import _kernel as kernel
-from hrgtc.compensate.c_plan import plan_for
-from hrgtc.compensate.c_variables import step_inputs
-from hrgtc.compensate.export_c import export_c
-from hrgtc.compensate.parameter_file import parameter_text
 from hrgtc.drift.features import VARIABLES, FeatureSettings
 from hrgtc.drift.variables import (
     BACKENDS,
@@ -38,6 +34,10 @@ from hrgtc.drift.variables import (
     variable,
 )
 from hrgtc.errors import InputError
+from hrgtc.export.c.plan import plan_for
+from hrgtc.export.c.variables import step_inputs
+from hrgtc.export.export_c import export_c
+from hrgtc.export.parameter_file import parameter_text
 from hrgtc.model import UnitModel
 
 from synthetic import THERMOMETER, lagged_run, with_heating_extra
@@ -191,7 +191,7 @@ def test_the_float32_export_computes_or_refuses(name, tmp_path):
 # -- the parameter file --------------------------------------------------------------------
 def _evaluate_parameters(p, run):
     """The parameter file's formula, from its numbers alone (steps 1-4 and 6)."""
-    from compensate.test_parameter_file import bias_from, rate_of, temperature_from
+    from export.test_parameter_file import bias_from, rate_of, temperature_from
 
     values = {"f": run.freq_hz - p["reference_freq_hz"]}
     values["df"] = rate_of(values["f"], p, run.time_s)
@@ -210,7 +210,7 @@ def _evaluate_parameters(p, run):
 
 @pytest.mark.parametrize("name", NAMES)
 def test_the_parameter_file_computes_or_refuses(name, tmp_path):
-    from compensate.test_parameter_file import parse
+    from export.test_parameter_file import parse
 
     model = model_using(name)
     if not variable(name).supports("params"):

@@ -1,6 +1,6 @@
 """C text of the firmware export: the README block, the header and the source.
 
-:mod:`hrgtc.compensate.export_c` decides what to export (the validated numbers of a
+:mod:`hrgtc.export.export_c` decides what to export (the validated numbers of a
 :class:`~hrgtc.model.UnitModel`); this module prints them as C99. Constants are
 printed with ``%.17g`` so they read back to the same double. Products and sums are
 separate statements, so a compiler that contracts ``a*b + c`` within an expression
@@ -16,14 +16,15 @@ import textwrap
 from pathlib import Path
 from typing import Any
 
-from hrgtc.compensate.c_expr import array as _array
-from hrgtc.compensate.c_expr import term_expression as _term_expression
-from hrgtc.compensate.c_plan import TABLE_POINTS, CPlan
-from hrgtc.compensate.c_rate_filter import filter_functions, filter_struct
-from hrgtc.compensate.c_step import step_tail
-from hrgtc.compensate.c_thermometer import thermometer_functions
-from hrgtc.compensate.c_types import DOUBLE, ctype
-from hrgtc.compensate.c_variables import (
+from hrgtc.drift.features import settle_rows
+from hrgtc.export.c.expr import array as _array
+from hrgtc.export.c.expr import term_expression as _term_expression
+from hrgtc.export.c.plan import TABLE_POINTS, CPlan
+from hrgtc.export.c.rate_filter import filter_functions, filter_struct
+from hrgtc.export.c.step import step_tail
+from hrgtc.export.c.thermometer import thermometer_functions
+from hrgtc.export.c.types import DOUBLE, ctype
+from hrgtc.export.c.variables import (
     RATES,
     bias_params,
     cname,
@@ -31,7 +32,6 @@ from hrgtc.compensate.c_variables import (
     levels,
     step_inputs,
 )
-from hrgtc.drift.features import settle_rows
 from hrgtc.model import UnitModel
 
 #: Iteration cap of the thermometer inverse (as :meth:`Thermometer.temperature`).
@@ -77,7 +77,7 @@ def readme(model: UnitModel, plan: CPlan, prefix: str, origin: str,
     ``sections`` replace the UNITS and USAGE sections (the float32 build writes its own).
     """
     from hrgtc._meta import PAPER_REFERENCE, __version__
-    from hrgtc.compensate.c_scale import scale_pieces
+    from hrgtc.export.c.scale import scale_pieces
 
     drift, thermometer, settings = model.drift, model.thermometer, model.drift.settings
     p, up = prefix, prefix.upper()
@@ -217,7 +217,7 @@ def readme(model: UnitModel, plan: CPlan, prefix: str, origin: str,
 def header(model: UnitModel, plan: CPlan, prefix: str, origin: str,
             sha256: str) -> str:
     """Text of ``<prefix>_model.h``: README block, state and output structs, prototypes."""
-    from hrgtc.compensate.c_scale import scale_pieces
+    from hrgtc.export.c.scale import scale_pieces
 
     p, up = prefix, prefix.upper()
     housing = plan.housing
@@ -378,7 +378,7 @@ def _bias_function(model: UnitModel, plan: CPlan, prefix: str) -> str:
 
 def source(model: UnitModel, plan: CPlan, prefix: str) -> str:
     """Text of ``<prefix>_model.c``: filter, drift model, thermometer inverse, step()."""
-    from hrgtc.compensate.c_scale import scale_pieces
+    from hrgtc.export.c.scale import scale_pieces
 
     p, up = prefix, prefix.upper()
     drift, th = model.drift, model.thermometer

@@ -2,28 +2,28 @@
 
 For FPU-only microcontrollers (Cortex-M4F and the like: single precision in hardware,
 double in software). The same computation as the double build of
-:mod:`hrgtc.compensate.c_text`, in ``float`` throughout (``f`` literals, ``powf``,
+:mod:`hrgtc.export.c.text`, in ``float`` throughout (``f`` literals, ``powf``,
 ``fabsf``), with the frequency entering centred, the thermometer written about the
 same centre and the df/dt filter kept as differences (see
-:mod:`hrgtc.compensate.c_float32`, whose numpy mirror evaluates exactly these
+:mod:`hrgtc.export.c.float32`, whose numpy mirror evaluates exactly these
 statements). The drift terms are printed by the shared
-:func:`hrgtc.compensate.c_text._bias_function` with the float :class:`CType`.
+:func:`hrgtc.export.c.text._bias_function` with the float :class:`CType`.
 
 [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
 """
 
 from __future__ import annotations
 
-from hrgtc.compensate.c_float32 import MARGIN, FloatAccuracy, FloatConstants
-from hrgtc.compensate.c_plan import TABLE_POINTS, CPlan
-from hrgtc.compensate.c_rate_filter import filter_functions, filter_struct
-from hrgtc.compensate.c_scale import scale_factor_of, scale_pieces
-from hrgtc.compensate.c_step import step_tail
-from hrgtc.compensate.c_text import NEWTON_MAX_ITER, _array, _bias_function, _comment, readme
-from hrgtc.compensate.c_thermometer import thermometer_functions
-from hrgtc.compensate.c_types import DOUBLE, SINGLE
-from hrgtc.compensate.c_variables import bias_params
 from hrgtc.drift.features import settle_rows
+from hrgtc.export.c.float32 import MARGIN, FloatAccuracy, FloatConstants
+from hrgtc.export.c.plan import TABLE_POINTS, CPlan
+from hrgtc.export.c.rate_filter import filter_functions, filter_struct
+from hrgtc.export.c.scale import scale_factor_of, scale_pieces
+from hrgtc.export.c.step import step_tail
+from hrgtc.export.c.text import NEWTON_MAX_ITER, _array, _bias_function, _comment, readme
+from hrgtc.export.c.thermometer import thermometer_functions
+from hrgtc.export.c.types import DOUBLE, SINGLE
+from hrgtc.export.c.variables import bias_params
 from hrgtc.model import UnitModel
 
 

@@ -1,6 +1,6 @@
 """C text of the drift-model variables beyond f, df, h and dh (issue 12).
 
-:mod:`hrgtc.compensate.c_text` prints the firmware export; this module gives it the
+:mod:`hrgtc.export.c.text` prints the firmware export; this module gives it the
 pieces of the variables added to the term grammar after the paper's:
 
 * ``d2``: the causal df/dt filter with its own time constant (``rate_tau2_s``) and its
@@ -20,8 +20,8 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from hrgtc.compensate.c_plan import CPlan
 from hrgtc.drift.features import is_aux
+from hrgtc.export.c.plan import CPlan
 
 
 def cname(variable: str) -> str:
@@ -58,7 +58,7 @@ def extra_variables(plan: CPlan, settings: Any, _literal: Callable[[float, str],
                     _comment: Callable[[Any], str]) -> dict[str, str]:
     """C pieces of the second rate filter (d2), the gradient (g) and the extra channels.
 
-    ``_literal`` and ``_comment`` print a constant and a comment as :mod:`c_text` does.
+    ``_literal`` and ``_comment`` print a constant and a comment as :mod:`hrgtc.export.c.text` does.
     """
     out = dict.fromkeys(("constants", "functions", "reset", "start", "values", "rate",
                          "gradient", "bias"), "")
