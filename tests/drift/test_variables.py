@@ -29,6 +29,8 @@ from hrgtc.drift.variables import (
     DRIFT_VARIABLES,
     FIXED,
     ascii_unit,
+    docs_table,
+    settings_schema,
     supported,
     unit,
     variable,
@@ -98,6 +100,53 @@ def test_the_list_is_the_grammar_and_the_kernel_layout():
     # units: a sensor-thermometer model reads °C in the place of Hz
     assert unit("df") == "Hz/s" and unit("df", "sensor") == "°C/s"
     assert ascii_unit("dh") == "degC/s" and unit("g", "sensor") == "°C"
+
+
+def test_the_registry_is_one_module_per_variable():
+    """Each module of the package declares one variable; the registry finds them all."""
+    import pkgutil
+
+    import hrgtc.drift.variables as package
+
+    modules = {m.name for m in pkgutil.iter_modules(package.__path__)} - {"registry", "spec"}
+    assert len(modules) == len(DRIFT_VARIABLES)
+    assert [v.order for v in DRIFT_VARIABLES] == sorted(v.order for v in DRIFT_VARIABLES)
+    assert DRIFT_VARIABLES[-1].name == "a_NAME"  # the user's channels come last in terms
+
+
+def test_the_docs_table_is_the_registry():
+    """docs/reliability.md's table of variables and backends is generated from the list."""
+    from pathlib import Path
+
+    docs = Path(__file__).parents[2] / "docs" / "reliability.md"
+    assert docs_table() in docs.read_text(encoding="utf-8"), (
+        "update docs/reliability.md's table with hrgtc.drift.variables.docs_table()")
+
+
+def test_the_model_schema_takes_each_variables_settings():
+    """The settings a variable owns are in the model file's JSON Schema, as it declares them."""
+    from hrgtc.model_schema import MODEL_SCHEMA
+
+    text = repr(MODEL_SCHEMA)
+    for v in DRIFT_VARIABLES:
+        for key, schema in v.settings_schema.items():
+            assert f"'{key}': {schema!r}" in text, (v.name, key)
+    assert set(settings_schema()) == {"switch_hz_per_s", "rate_tau2_s", "aux_columns",
+                                      "aux_centres"}
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_each_check_names_what_is_missing(name):
+    """A variable whose settings are incomplete is refused with its module's message."""
+    from hrgtc.drift.features import FeatureStream
+
+    bare = FeatureSettings(reference_freq_hz=4400.0, sample_rate_hz=1.0)
+    used = SPELLING.get(name, name)
+    if variable(used).check(bare, None, used) is None:
+        FeatureStream(bare, (used,))  # nothing missing: accepted
+        return
+    with pytest.raises(InputError, match=used if used != "g" else "thermometer"):
+        FeatureStream(bare, (used,))
 
 
 # -- numpy and numba --------------------------------------------------------------------

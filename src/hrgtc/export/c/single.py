@@ -23,7 +23,7 @@ from hrgtc.export.c.step import step_tail
 from hrgtc.export.c.text import NEWTON_MAX_ITER, _array, _bias_function, _comment, readme
 from hrgtc.export.c.thermometer import thermometer_functions
 from hrgtc.export.c.types import DOUBLE, SINGLE
-from hrgtc.export.c.variables import bias_params
+from hrgtc.export.c.variables import bias_params, extra_variables
 from hrgtc.model import UnitModel
 
 
@@ -111,6 +111,7 @@ def header(model: UnitModel, plan: CPlan, prefix: str, origin: str, sha256: str,
     arg_h = ", float housing_c" if plan.housing_input else ""
     bias_h = "".join(f", float {name}" for _, name in bias_params(plan)[2:])
     settings = model.drift.settings
+    state_h += extra_variables(plan, settings, lit, _comment, ctype=SINGLE, prefix=p)["state"]
     k = scale_pieces(model, plan, prefix)
     out_h += k["field"]
     housing_in = ", housing_c [degC]" if plan.housing_input else ""
@@ -234,11 +235,10 @@ def source(model: UnitModel, plan: CPlan, prefix: str, constants: FloatConstants
         h = dict.fromkeys(h, "")
     if plan.housing_input:
         h["arg"] = ", float housing_c"
-    # the gradient g = housing_c - T(f): the temperature is computed before the bias
-    g = {"values": "    float g_value;\n" if plan.gradient else "",
-         "rate": "    g_value = housing_c - temperature;  /* NaN beyond the inverse */\n"
-                 if plan.gradient else "",
-         "bias": ", g_value" if plan.gradient else ""}
+    # the variables beyond f, df, h, dh, each from its module (g = housing_c - T(f) needs
+    # the temperature, computed before the bias)
+    g = extra_variables(plan, model.drift.settings, lit, _comment, ctype=SINGLE, prefix=p)
+    h["constants"] += g["constants"]
     n_th = c.th_coefficients.size
     thermometer_text = thermometer_functions(
         p=p, n_th=n_th, above=above, real="float", fabs="fabsf", half="0.5f",
@@ -287,7 +287,7 @@ static const float TH_TOLERANCE_C = {lit(c.tolerance, 'tolerance')};
 void {p}_reset({p}_state *state)
 {{
     rate_start(&state->f_filter, 0.0f);
-{h['reset']}    state->started = 0;
+{h['reset']}{g['reset']}    state->started = 0;
     state->samples = 0UL;
     state->out_of_range = 0UL;
     state->rate_out_of_range = 0UL;
@@ -306,10 +306,10 @@ float {p}_step({p}_state *state, float dt_s, float f_hz, float rate_dph{h['arg']
     int in_range, rate_in_range, level_in_range;
 {k['declare']}    if (!state->started) {{  /* the filters start at rest on the first sample */
         rate_start(&state->f_filter, f_value);
-{h['start']}        state->started = 1;
+{h['start']}{g['start']}        state->started = 1;
     }} else {{  /* each filter steps over this sample's dt_s */
         df_value = rate_update(&state->f_filter, f_value, dt_s, RATE_TAU_S, RATE_TAU);
-{h['rate']}    }}
+{h['rate']}{g['rate']}    }}
     temperature = {p}_temperature_c(f_value);
-{g['rate']}    bias = {p}_bias_dph(f_value, df_value{h['bias']}{g['bias']});
+{g['gradient']}    bias = {p}_bias_dph(f_value, df_value{h['bias']}{g['bias']});
 {tail}"""

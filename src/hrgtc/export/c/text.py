@@ -223,8 +223,9 @@ def header(model: UnitModel, plan: CPlan, prefix: str, origin: str,
     housing = plan.housing
     state_h = f"    {p}_rate_filter h_filter;   /* dh/dt filter of h [degC] */\n" \
         if housing else ""
-    if plan.rate2:  # the second df/dt filter (d2) has its own state
-        state_h += f"    {p}_rate_filter f2_filter;  /* second df/dt filter of f (d2) [Hz] */\n"
+    # the state of the variables beyond f, df, h, dh (d2's filter)
+    state_h += extra_variables(plan, model.drift.settings, _literal, _comment,
+                               prefix=p)["state"]
     out_h = "    double h_c;                 /* housing temperature change h [degC] */\n" \
             "    double dh_c_per_s;          /* its causal rate dh/dt [degC/s] */\n" \
         if housing else ""
@@ -416,7 +417,7 @@ def source(model: UnitModel, plan: CPlan, prefix: str) -> str:
     if not plan.housing:
         h = dict.fromkeys(h, "")
     h["arg"] = "".join(f", double {name}" for name in step_inputs(plan))
-    extra = extra_variables(plan, settings, _literal, _comment)
+    extra = extra_variables(plan, settings, _literal, _comment, prefix=p)
     n_th = len(plan.th_coefficients)
     thermometer_text = thermometer_functions(
         p=p, n_th=n_th, above=above, real="double", fabs="fabs", half="0.5",

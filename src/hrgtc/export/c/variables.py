@@ -21,7 +21,9 @@ from collections.abc import Callable
 from typing import Any
 
 from hrgtc.drift.features import is_aux
-from hrgtc.export.c.plan import CPlan
+from hrgtc.drift.variables import variable
+from hrgtc.export.c.plan import CPlan, variables_for_c
+from hrgtc.export.c.types import DOUBLE, CType
 
 
 def cname(variable: str) -> str:
@@ -34,11 +36,10 @@ def bias_params(plan: CPlan) -> list[tuple[str, str]]:
     out = [("f", "f_hz"), ("df", "df_hz_per_s")]
     if plan.housing:
         out += [("h", "h_c"), ("dh", "dh_c_per_s")]
-    if plan.rate2:
-        out.append(("d2", "d2_hz_per_s"))
-    if plan.gradient:
-        out.append(("g", "g_c"))
-    return out + [(f"a_{name}", f"a_{name}") for name in plan.aux]
+    for v in variables_for_c(set(plan.computed)):  # d2, g, a_NAME: their modules name them
+        code = variable(v).c_code
+        out.append((v, v if code is None else code.parameter(v)))
+    return out
 
 
 def step_inputs(plan: CPlan) -> list[str]:
@@ -55,27 +56,21 @@ RATES = ("df", "dh", "d2")
 
 
 def extra_variables(plan: CPlan, settings: Any, _literal: Callable[[float, str], str],
-                    _comment: Callable[[Any], str]) -> dict[str, str]:
-    """C pieces of the second rate filter (d2), the gradient (g) and the extra channels.
+                    _comment: Callable[[Any], str], ctype: CType = DOUBLE,
+                    prefix: str = "hrgtc") -> dict[str, str]:
+    """C pieces of the variables beyond f, df, h and dh (d2, g, the extra channels).
 
-    ``_literal`` and ``_comment`` print a constant and a comment as :mod:`hrgtc.export.c.text` does.
+    Each variable's module in :mod:`hrgtc.drift.variables` writes its own pieces
+    (``c_code``), in grammar order; ``_literal`` and ``_comment`` print a constant and a
+    comment as :mod:`hrgtc.export.c.text` does.
     """
-    out = dict.fromkeys(("constants", "functions", "reset", "start", "values", "rate",
-                         "gradient", "bias"), "")
-    if plan.rate2:  # the same filter (rate_update), its own state and time constant
-        out["constants"] += (
-            "/* time constant of each stage of the second df/dt filter (d2) [s] */\n"
-            f"static const double RATE2_TAU_S = {_literal(plan.tau2_s, 'rate_tau2_s')};\n")
-        out["reset"] += "    rate_start(&state->f2_filter, 0.0);\n"
-        out["start"] += "        rate_start(&state->f2_filter, f_value);\n"
-        out["values"] += "    double d2_value = 0.0;\n"
-        out["rate"] += ("        d2_value = rate_update(&state->f2_filter, f_value, dt_s, "
-                        "RATE2_TAU_S);\n")
-        out["bias"] += ", d2_value"
-    if plan.gradient:
-        out["values"] += "    double g_value;\n"
-        out["gradient"] += "    g_value = housing_c - temperature;  /* NaN beyond the inverse */\n"
-        out["bias"] += ", g_value"
+    out = dict.fromkeys(SLOTS, "")
+    for v in variables_for_c(set(plan.computed)):
+        code = variable(v).c_code
+        if code is None:  # the extra channels: their C is written here
+            continue
+        for slot, text in code.pieces(ctype, DOUBLE, v, settings, prefix, _comment).items():
+            out[slot] += text
     for name in plan.aux:
         centre = _literal(settings.aux_centres.get(name, 0.0), f"aux_centres[{name}]")
         out["constants"] += (f"/* training mean of aux_{name}, the logged column "
@@ -84,3 +79,8 @@ def extra_variables(plan: CPlan, settings: Any, _literal: Callable[[float, str],
         out["values"] += f"    const double a_{name}_value = aux_{name} - AUX_CENTRE_{name};\n"
         out["bias"] += f", a_{name}_value"
     return out
+
+
+#: The slots of a variable's C pieces (:class:`hrgtc.drift.variables.spec.CCode`).
+SLOTS = ("constants", "functions", "state", "reset", "start", "values", "rate", "gradient",
+         "bias")
