@@ -61,6 +61,10 @@ class CCode:
     def parameter(self, name: str) -> str:
         return "d2_hz_per_s"
 
+    def readme(self, name: str, settings: Any) -> str:
+        return (f"  d2 = df/dt by the same filter with tau2 = {settings.rate_tau2_s:g} s "
+                "(its own state)   [Hz/s]")
+
     def firmware_value(self, value: np.ndarray, name: str, settings: Any) -> np.ndarray:
         return np.asarray(value).astype(np.float32)
 

@@ -48,6 +48,9 @@ class CCode:
     def parameter(self, name: str) -> str:
         return "g_c"
 
+    def readme(self, name: str, settings: Any) -> str:
+        return "  g  = housing_c - resonator_c_est, the housing - resonator gradient   [degC]"
+
     def firmware_value(self, value: np.ndarray, name: str, settings: Any) -> np.ndarray:
         # the float mirror replaces it by float32(housing_c) - T32(f): both inverses
         # (hrgtc.export.c.float32's gradient inputs)

@@ -73,15 +73,18 @@ class CCode(Protocol):
 
     def pieces(self, ctype: Any, double: Any, name: str, settings: Any, prefix: str,
                comment: Callable[[Any], str]) -> dict[str, str]:
-        """Text of the slots ``constants``, ``state``, ``reset``, ``start``, ``values``,
-        ``rate`` (each filter step), ``gradient`` (after the temperature) and ``bias``
-        (the argument of ``bias_dph()``)."""
+        """Text of (some of) the slots ``constants``, ``state``, ``reset``, ``start``,
+        ``values``, ``rate`` (each filter step), ``gradient`` (after the temperature) and
+        ``bias`` (the argument of ``bias_dph()``); a slot left out is empty."""
 
     def inputs(self, name: str) -> tuple[str, ...]:
         """Inputs of ``step()`` it reads beyond freq_hz and rate_dph (``housing_c``)."""
 
     def parameter(self, name: str) -> str:
         """Its parameter of ``bias_dph()`` (``d2_hz_per_s``)."""
+
+    def readme(self, name: str, settings: Any) -> str:
+        """Its line of THE MODEL in the generated header's README block."""
 
     def firmware_value(self, value: np.ndarray, name: str, settings: Any) -> np.ndarray:
         """The float32 value the float build computes where the double model has ``value``

@@ -30,11 +30,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from hrgtc.drift.features import Term
 from hrgtc.drift.rate_filter import DT_REL_TOLERANCE, SERIES_LIMIT, series_coefficients
+from hrgtc.drift.variables import variable
 from hrgtc.export.c.plan import CPlan
 from hrgtc.export.c.text import NEWTON_MAX_ITER
 from hrgtc.model import UnitModel
@@ -154,11 +156,11 @@ def mirror_bias(model: UnitModel, c: FloatConstants,
                 values: dict[str, np.ndarray]) -> np.ndarray:
     """``<prefix>_bias_dph()`` of the float build. [°/h]
 
-    ``values`` maps the variables (f [Hz], df [Hz/s], h [°C], dh [°C/s], g [°C]) to float32
-    arrays.
+    ``values`` maps the model's variables (f [Hz], df [Hz/s], h [°C], dh [°C/s], g [°C],
+    a_NAME [its unit] ...) to float32 arrays.
     """
     drift = model.drift
-    used = [v for v in ("f", "df", "h", "dh", "g") if v in drift.variables and drift.selected]
+    used = list(drift.variables) if drift.selected else []
     n = np.asarray(next(iter(values.values()))).shape
     raw = {v: np.asarray(values[v], dtype=F32) for v in used}
     held, x = {}, {}
@@ -391,7 +393,7 @@ def float_accuracy(model: UnitModel, plan: CPlan, c: FloatConstants) -> FloatAcc
     n = values["f"].size
     for v in plan.computed:
         values.setdefault(v, np.zeros(n))
-    inputs = {v: x.astype(F32) for v, x in values.items()}
+    inputs = {v: _firmware(v, x, drift.settings) for v, x in values.items()}
     if plan.gradient:
         values, inputs = _gradient_inputs(model, plan, c, values, inputs)
     b64 = drift.predict({v: values[v] for v in drift.variables} or values)
@@ -406,6 +408,16 @@ def float_accuracy(model: UnitModel, plan: CPlan, c: FloatConstants) -> FloatAcc
     return FloatAccuracy(temperature_c=temperature_error, bias_dph=bias_error,
                          ramp_bias_dph=_ramp_error(model, plan, c), grid_points=n,
                          scale_ppm=scale_error)
+
+
+def _firmware(name: str, value: np.ndarray, settings: Any) -> np.ndarray:
+    """The float32 value of variable ``name`` the float build computes where the double
+    model has ``value``: its module's ``firmware_value`` (a_NAME: the logged value in float
+    minus the float centre), else ``value`` rounded to float32."""
+    code = variable(name).c_code
+    if code is None:
+        return np.asarray(value).astype(F32)
+    return code.firmware_value(value, name, settings)
 
 
 def _gradient_inputs(model: UnitModel, plan: CPlan, c: FloatConstants,
@@ -463,6 +475,11 @@ def _ramp_error(model: UnitModel, plan: CPlan, c: FloatConstants) -> float:
         middle = 0.5 * sum(drift.ranges["g"]) if "g" in drift.ranges else 0.0
         values64["g"] = np.full(values64["f"].shape, middle)
         values64, values32 = _gradient_inputs(model, plan, c, values64, values32)
+    for v in drift.variables:  # the other levels (a_NAME) held at the middle of their range
+        if v not in values64:
+            middle = 0.5 * sum(drift.ranges[v]) if v in drift.ranges else 0.0
+            values64[v] = np.full(values64["f"].shape, middle)
+            values32[v] = _firmware(v, values64[v], settings)
     worst = 0.0
     for row in range(9):
         b64 = drift.predict({v: values64[v][row] for v in drift.variables})

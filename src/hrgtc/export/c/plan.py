@@ -93,7 +93,7 @@ def plan_for(model: UnitModel, precision: str = "double") -> CPlan:
     ------
     InputError
         An unknown precision, or a model with a variable the export does not compute
-        (:mod:`hrgtc.drift.variables` says which: ``dpos``; ``d2`` and ``a_NAME`` in float32).
+        (:mod:`hrgtc.drift.variables` says which: ``dpos``; ``d2`` in float32).
     CalibrationError
         A thermometer that is not monotonic over its calibrated range.
     """

@@ -30,6 +30,7 @@ from hrgtc.export.c.variables import (
     cname,
     extra_variables,
     levels,
+    readme_lines,
     step_inputs,
 )
 from hrgtc.model import UnitModel
@@ -136,16 +137,7 @@ def readme(model: UnitModel, plan: CPlan, prefix: str, origin: str,
     if plan.housing:
         lines.append(f"  h  = housing_c - {settings.reference_c:g} degC, dh = its rate by the "
                      "same filter   [degC, degC/s]")
-    if plan.rate2:
-        lines.append(f"  d2 = df/dt by the same filter with tau2 = {settings.rate_tau2_s:g} s "
-                     "(its own state)   [Hz/s]")
-    if plan.gradient:
-        lines.append("  g  = housing_c - resonator_c_est, the housing - resonator gradient   "
-                     "[degC]")
-    for name in plan.aux:
-        lines.append(f"  a_{name} = aux_{name} - {settings.aux_centres.get(name, 0.0):.12g}: "
-                     f"the logged column {settings.aux_columns.get(name, '?')!r} minus its "
-                     "training mean   [its unit]")
+    lines += readme_lines(plan, settings)  # d2, g, a_NAME: each from its module
     lines += [
         "  The code evaluates B on the scaled variables v/scale_v with the exact (%.17g)",
         "  coefficients of the model file; algebraically the same polynomial. Beyond a",

@@ -1,7 +1,10 @@
-"""C text of the drift-model variables beyond f, df, h and dh (issue 12).
+"""C text of the drift-model variables beyond f, df, h and dh, gathered from their modules.
 
-:mod:`hrgtc.export.c.text` prints the firmware export; this module gives it the
-pieces of the variables added to the term grammar after the paper's:
+:mod:`hrgtc.export.c.text` (double) and :mod:`hrgtc.export.c.single` (float32) print the
+firmware export's skeleton (f, df and the housing's h, dh); every other variable writes
+its own pieces in its module of :mod:`hrgtc.drift.variables` (its ``c_code``: constants,
+state, filter steps, ``step()`` inputs, the argument of ``bias_dph()``, its README line),
+in both precisions, and this module puts them together in grammar order:
 
 * ``d2``: the causal df/dt filter with its own time constant (``rate_tau2_s``) and its
   own state in the state struct (``f2_filter``), the same ``rate_update`` as the first
@@ -12,7 +15,8 @@ pieces of the variables added to the term grammar after the paper's:
   training mean.
 
 Levels (f, h, g, a_NAME) are checked against their training ranges for ``in_range``,
-rates (df, dh, d2) for ``rate_in_range``, as in :class:`hrgtc.compensate.Compensator`.
+rates (df, dh, d2) for ``rate_in_range``, as in :class:`hrgtc.compensate.Compensator`
+(the kinds the registry gives).
 """
 
 from __future__ import annotations
@@ -21,7 +25,7 @@ from collections.abc import Callable
 from typing import Any
 
 from hrgtc.drift.features import is_aux
-from hrgtc.drift.variables import variable
+from hrgtc.drift.variables import DRIFT_VARIABLES, variable
 from hrgtc.export.c.plan import CPlan, variables_for_c
 from hrgtc.export.c.types import DOUBLE, CType
 
@@ -37,22 +41,30 @@ def bias_params(plan: CPlan) -> list[tuple[str, str]]:
     if plan.housing:
         out += [("h", "h_c"), ("dh", "dh_c_per_s")]
     for v in variables_for_c(set(plan.computed)):  # d2, g, a_NAME: their modules name them
-        code = variable(v).c_code
-        out.append((v, v if code is None else code.parameter(v)))
+        out.append((v, variable(v).c_code.parameter(v)))
     return out
 
 
 def step_inputs(plan: CPlan) -> list[str]:
     """``step()``'s inputs after freq_hz and rate_dph: housing_c, then each extra channel."""
-    return (["housing_c"] if plan.housing_input else []) + [f"aux_{n}" for n in plan.aux]
+    out = ["housing_c"] if plan.housing_input else []
+    for v in variables_for_c(set(plan.computed)):  # each variable's module names its inputs
+        out += [i for i in variable(v).c_code.inputs(v) if i not in out]
+    return out
+
+
+def readme_lines(plan: CPlan, settings: Any) -> list[str]:
+    """THE MODEL's lines of the variables beyond f, df, h and dh, from their modules."""
+    return [variable(v).c_code.readme(v, settings) for v in variables_for_c(set(plan.computed))]
 
 
 def levels(plan: CPlan) -> tuple[str, ...]:
     """Variables checked as levels (``in_range``); the rates are :data:`RATES`."""
-    return ("f", "h", "g", *(f"a_{n}" for n in plan.aux))
+    return tuple(v for v in plan.computed if variable(v).kind == "level")
 
 
-RATES = ("df", "dh", "d2")
+#: The rates (checked for ``rate_in_range``), as the registry's kinds say.
+RATES = tuple(v.name for v in DRIFT_VARIABLES if v.kind == "rate")
 
 
 def extra_variables(plan: CPlan, settings: Any, _literal: Callable[[float, str], str],
@@ -67,17 +79,8 @@ def extra_variables(plan: CPlan, settings: Any, _literal: Callable[[float, str],
     out = dict.fromkeys(SLOTS, "")
     for v in variables_for_c(set(plan.computed)):
         code = variable(v).c_code
-        if code is None:  # the extra channels: their C is written here
-            continue
         for slot, text in code.pieces(ctype, DOUBLE, v, settings, prefix, _comment).items():
             out[slot] += text
-    for name in plan.aux:
-        centre = _literal(settings.aux_centres.get(name, 0.0), f"aux_centres[{name}]")
-        out["constants"] += (f"/* training mean of aux_{name}, the logged column "
-                             f"{_comment(settings.aux_columns.get(name, '?'))} */\n"
-                             f"static const double AUX_CENTRE_{name} = {centre};\n")
-        out["values"] += f"    const double a_{name}_value = aux_{name} - AUX_CENTRE_{name};\n"
-        out["bias"] += f", a_{name}_value"
     return out
 
 
