@@ -3,7 +3,8 @@
 The rate filter of ``df`` with its own time constant and state, so a fit can mix a fast
 and a slow rate (a thermal lag between the resonator and the part of the gyro whose
 temperature drives the bias). In C the same ``rate_update`` as df's filter, its own state
-``f2_filter`` and constant ``RATE2_TAU_S``, so the rounding is hrgtc's.
+``f2_filter`` and constant ``RATE2_TAU_S``, so the rounding is hrgtc's; the float32 build
+runs the float filter of df (differences, compensated sums) with ``RATE2_TAU``.
 """
 
 from __future__ import annotations
@@ -72,6 +73,7 @@ class CCode:
 VARIABLE = DriftVariable(
     name="d2", unit="Hz/s", sensor_unit="°C/s", kind="rate",
     description="causal rate of f through a second filter of time constant rate_tau2_s",
-    backends=frozenset({"numpy", "c_double", "params"}), columns=("freq_hz",),
+    backends=frozenset({"numpy", "c_double", "c_float32", "params"}), columns=("freq_hz",),
     compute=compute, order=5, check=check,
-    settings_schema={"rate_tau2_s": {"type": "number", "minimum": 0}}, c_code=CCode())
+    settings_schema={"rate_tau2_s": {"type": "number", "minimum": 0}}, c_code=CCode(),
+    rate_of=("f", "rate_tau2_s"))

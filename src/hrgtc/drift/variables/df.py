@@ -22,4 +22,4 @@ def compute(inputs: Inputs, name: str) -> np.ndarray:
 VARIABLE = DriftVariable(
     name="df", unit="Hz/s", sensor_unit="°C/s", kind="rate",
     description="causal rate of f (two first-order stages of time constant rate_tau_s)",
-    backends=ALL, columns=("freq_hz",), compute=compute, order=1)
+    backends=ALL, columns=("freq_hz",), compute=compute, order=1, rate_of=("f", "rate_tau_s"))

@@ -15,4 +15,4 @@ def compute(inputs: Inputs, name: str) -> np.ndarray:
 VARIABLE = DriftVariable(
     name="dh", unit="°C/s", sensor_unit="°C/s", kind="rate",
     description="causal rate of h (the same filter as df)",
-    backends=ALL, columns=("housing_c",), compute=compute, order=3)
+    backends=ALL, columns=("housing_c",), compute=compute, order=3, rate_of=("h", "rate_tau_s"))

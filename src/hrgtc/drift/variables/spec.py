@@ -125,6 +125,9 @@ class DriftVariable:
         Its C pieces (:class:`CCode`), for a variable beyond f, df, h and dh.
     order
         Position in the grammar (the order of a term's factors).
+    rate_of
+        For a plain causal rate: (the level it is the rate of, the settings field of the
+        filter's time constant), e.g. ``("f", "rate_tau2_s")`` for d2.
     """
 
     name: str
@@ -139,6 +142,7 @@ class DriftVariable:
     check: Callable[[Any, Any, str], str | None] = _nothing
     settings_schema: Mapping[str, dict[str, Any]] = field(default_factory=dict)
     c_code: CCode | None = None
+    rate_of: tuple[str, str] | None = None
 
     def unit_for(self, thermometer_source: str = "resonator") -> str:
         """The unit for a model whose thermometer is ``"resonator"`` or ``"sensor"``."""

@@ -279,7 +279,8 @@ def step_weights64(dt_s: float, tau_s: float) -> tuple[float, float]:
     return a, (r - a) / r
 
 
-def mirror_rate(c: FloatConstants, x: np.ndarray, dt_s: np.ndarray) -> np.ndarray:
+def mirror_rate(c: FloatConstants, x: np.ndarray, dt_s: np.ndarray,
+                tau_s: float | None = None) -> np.ndarray:
     """The float build's causal rate of one signal (df/dt of f, or dh/dt), from rest. [/s]
 
     Its ``rate_update()``: the lag ``x_prev - y1`` and the difference ``y1 - y2`` of the
@@ -287,7 +288,11 @@ def mirror_rate(c: FloatConstants, x: np.ndarray, dt_s: np.ndarray) -> np.ndarra
     with the weights of each step's ``dt_s`` (float, as firmware passes it; the first is
     ignored) computed in double and rounded to float when dt moves by more than the
     tolerance. Runs along the last axis (rows of signals at once, one dt per column).
+    ``tau_s``: the filter's time constant (default the df/dt filter's; d2's
+    ``rate_tau2_s``). [s]
     """
+    tau64 = c.tau_s if tau_s is None else float(tau_s)
+    tau32 = F32(tau64)
     x = np.asarray(x, dtype=F32)
     dt_s = np.asarray(dt_s, dtype=F32)
     out = np.empty_like(x)
@@ -304,7 +309,7 @@ def mirror_rate(c: FloatConstants, x: np.ndarray, dt_s: np.ndarray) -> np.ndarra
     for i in range(1, x.shape[-1]):
         dt = dt_s[i] if dt_s[i] > 0 else F32(0.0)
         if not abs(dt - cached) <= tolerance * cached:
-            a64, p64 = step_weights64(float(dt), c.tau_s)
+            a64, p64 = step_weights64(float(dt), tau64)
             cached, a, p = dt, F32(a64), F32(p64)
         delta = x[..., i] - previous
         previous = x[..., i]
@@ -318,7 +323,7 @@ def mirror_rate(c: FloatConstants, x: np.ndarray, dt_s: np.ndarray) -> np.ndarra
         total = difference + increment
         difference_carry = (total - difference) - increment
         difference = total
-        out[..., i] = difference / c.tau
+        out[..., i] = difference / tau32
     return out
 
 
@@ -446,7 +451,7 @@ def _ramp_error(model: UnitModel, plan: CPlan, c: FloatConstants) -> float:
     passes it), from rest, for 12 filter time constants.
     """
     drift = model.drift
-    rated = [v for v in ("df", "dh") if v in drift.variables and v in drift.ranges]
+    rated = [v for v in drift.variables if variable(v).kind == "rate" and v in drift.ranges]
     if not rated:
         return 0.0
     from hrgtc.drift.features import causal_rate
@@ -475,6 +480,13 @@ def _ramp_error(model: UnitModel, plan: CPlan, c: FloatConstants) -> float:
         middle = 0.5 * sum(drift.ranges["g"]) if "g" in drift.ranges else 0.0
         values64["g"] = np.full(values64["f"].shape, middle)
         values64, values32 = _gradient_inputs(model, plan, c, values64, values32)
+    for v in drift.variables:  # the other rates (d2) through their own float and double filters
+        spec = variable(v)
+        if v not in values64 and spec.rate_of is not None and spec.rate_of[0] in values64:
+            level, field = spec.rate_of
+            tau_v = float(getattr(settings, field))
+            values64[v] = np.vstack([causal_rate(row, tau_v, fs)[0] for row in values64[level]])
+            values32[v] = mirror_rate(c, values32[level], dt32, tau_v)
     for v in drift.variables:  # the other levels (a_NAME) held at the middle of their range
         if v not in values64:
             middle = 0.5 * sum(drift.ranges[v]) if v in drift.ranges else 0.0
