@@ -13,7 +13,7 @@ import numpy as np
 
 from hrgtc.drift.features import is_aux, variable_key
 from hrgtc.drift.rate_filter import check_tau
-from hrgtc.drift.variables import refusal, supported
+from hrgtc.drift.variables import refusal, supported, variable
 from hrgtc.errors import CalibrationError, InputError
 from hrgtc.model import UnitModel
 
@@ -159,5 +159,6 @@ def plan_for(model: UnitModel, precision: str = "double") -> CPlan:
 
 
 def variables_for_c(used: set[str]) -> list[str]:
-    """The variables beyond f, df, h, dh the C code computes, in grammar order."""
-    return [v for v in sorted(used, key=variable_key) if v == "d2" or v == "g" or is_aux(v)]
+    """The variables beyond f, df, h, dh the C code computes, in grammar order: those whose
+    module in :mod:`hrgtc.drift.variables` writes its C pieces (``c_code``)."""
+    return [v for v in sorted(used, key=variable_key) if variable(v).c_code is not None]
