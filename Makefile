@@ -41,7 +41,7 @@ lint: $(STAMP)
 docs: $(STAMP)
 	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict
 
-# Mutation testing of recording/, compensate/ and files.py (pyproject's [tool.mutmut]); not
+# Mutation testing of recording/, compensate/, export/ and files.py (pyproject's [tool.mutmut]); not
 # run by CI: the full set takes hours on 2 cores. MUTANTS narrows it, e.g.
 # make mutation MUTANTS='hrgtc.core.files.*'
 MUTANTS ?=

@@ -39,6 +39,7 @@ from typing import Any
 
 from hrgtc.core.errors import InputError, ModelFileError
 from hrgtc.drift.features import parse_terms
+from hrgtc.drift.variables import settings_schema as variable_settings_schema
 
 SCHEMA_NAME = "hrgtc.model"
 #: 2: strict JSON (statistics that are not finite are written ``null``).
@@ -106,10 +107,9 @@ _DRIFT = {
                 "rate_tau_s": _POSITIVE,
                 "warmup_s": {"type": "number", "minimum": 0},
                 "scales": {"type": "object", "additionalProperties": _POSITIVE},
-                "switch_hz_per_s": {"type": "number", "minimum": 0},
-                "rate_tau2_s": {"type": "number", "minimum": 0},
-                "aux_columns": {"type": "object", "additionalProperties": {"type": "string"}},
-                "aux_centres": {"type": "object", "additionalProperties": _FINITE},
+                # the settings a drift variable owns (d2's rate_tau2_s, a_NAME's columns
+                # and centres, ...): each variable's module in hrgtc.drift.variables
+                **variable_settings_schema(),
             },
         },
         "candidates": {"type": "array", "items": _TERM, "minItems": 1},

@@ -15,7 +15,7 @@ from typer.testing import CliRunner
 
 from hrgtc import drift
 from hrgtc.cli import app
-from hrgtc.compensate.export_c import export_c
+from hrgtc.export.export_c import export_c
 from hrgtc.model import InstrumentModel, UnitModel, save_instrument, save_model
 
 from synthetic import THERMOMETER, ramp_run

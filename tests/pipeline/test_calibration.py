@@ -248,7 +248,7 @@ def test_sensor_thermometer_on_a_messy_imu_log(campaign_factory, tmp_path):
     (held_out,) = result.validation[""]
     assert held_out.raw_10s / held_out.compensated_10s > 2.5  # no frequency needed
     # the firmware export says that its "Hz" are degrees here (its text is the resonator's)
-    from hrgtc.compensate.export_c import export_c
+    from hrgtc.export.export_c import export_c
 
     for fmt, suffix in (("c", "_model.h"), ("params", "_params.txt")):
         (text,) = [p.read_text() for p in export_c(model, tmp_path / fmt, output_format=fmt)

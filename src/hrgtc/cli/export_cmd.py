@@ -55,7 +55,7 @@ def export_c_command(
 
     Example: hrgtc export-c unit.json -o firmware/ --precision single
     """
-    from hrgtc.compensate import export_c
+    from hrgtc.export import export_c
 
     if output_format is ExportFormat.params and precision is Precision.single:
         raise typer.BadParameter("--precision applies to --format c only; the parameter file "

@@ -66,8 +66,10 @@ from hrgtc.drift.rate_filter import (  # noqa: F401  (re-exported: imported from
     rate_filter_coefficients,
     restart_mask,
 )
-from hrgtc.drift.variables import AUX_PREFIX, DRIFT_VARIABLES, FIXED
+from hrgtc.drift.variables import AUX_PREFIX, DRIFT_VARIABLES, FIXED, Inputs
 from hrgtc.drift.variables import variable as _registered
+from hrgtc.drift.variables.aux import centre as _aux_centre
+from hrgtc.drift.variables.dpos import heating_part  # noqa: F401  (re-exported)
 from hrgtc.recording.schema import Recording
 from hrgtc.settings.drift import EQ21_TERMS as _EQ21_TERMS
 from hrgtc.settings.drift import DriftSettings
@@ -75,9 +77,6 @@ from hrgtc.settings.drift import DriftSettings
 #: Variable name -> (unit, description), from the one list of :mod:`hrgtc.drift.variables`.
 VARIABLES: dict[str, tuple[str, str]] = {
     v.name: (v.unit, v.description) for v in DRIFT_VARIABLES if v.name in FIXED}
-_SOURCE_COLUMN = {"f": "freq_hz", "h": "housing_c"}
-#: The level each rate-like variable is the rate of.
-_RATE_OF = {"df": "f", "dh": "h", "dpos": "f", "d2": "f"}
 #: Variables that are levels (checked against the calibrated/training range as ``in_range``)
 #: and rates of change (``rate_in_range``); ``a_NAME`` channels are levels too.
 LEVEL_VARIABLES = tuple(v for v in FIXED if _registered(v).kind == "level")
@@ -281,14 +280,10 @@ def hierarchy(terms: Sequence[Term]) -> dict[str, list[str]]:
 
 def required_columns(terms: Sequence[Term]) -> tuple[str, ...]:
     """Recording columns the terms need (``freq_hz`` and/or ``housing_c``; not a_NAME's)."""
-    needed = []
+    needed: list[str] = []
     for term in terms:
         for v in term.variables:
-            if is_aux(v):
-                continue
-            level = _RATE_OF.get(v, v)
-            columns = ("freq_hz", "housing_c") if v == "g" else (_SOURCE_COLUMN[level],)
-            needed.extend(c for c in columns if c not in needed)
+            needed.extend(c for c in _registered(v).columns if c not in needed)
     return tuple(needed)
 
 
@@ -378,17 +373,6 @@ class FeatureSettings:
             )
 
 
-def heating_part(rate: np.ndarray, switch: float) -> np.ndarray:
-    """``dpos``: the smooth positive part rate·(1 + tanh(rate/δ))/2 of a rate. [unit of rate]
-
-    Examples
-    --------
-    >>> [round(float(x), 4) for x in heating_part(np.array([-1.0, 0.0, 1.0]), 0.1)]
-    [-0.0, 0.0, 1.0]
-    """
-    return rate * (1.0 + np.tanh(rate / switch)) / 2.0
-
-
 def settle_rows(settings: FeatureSettings) -> int:
     """Samples at the start of a run left out while the df/dt filter settles.
 
@@ -430,20 +414,10 @@ class FeatureStream:
         self.reset()
 
     def _check(self) -> None:
-        s, used = self.settings, self.variables
-        if "dpos" in used and not s.switch_hz_per_s > 0.0:
-            raise InputError("the variable dpos needs switch_hz_per_s > 0 in the feature "
-                             "settings (drift.fit sets it from the training df/dt)")
-        if "d2" in used and not s.rate_tau2_s > 0.0:
-            raise InputError("the variable d2 needs rate_tau2_s > 0 in the feature settings "
-                             "(the second df/dt filter's time constant, --rate-tau2-s)")
-        if "g" in used and self.thermometer is None:
-            raise InputError("the variable g (housing - resonator gradient) needs the unit's "
-                             "thermometer for T(f)")
-        unmapped = [v for v in used if is_aux(v) and v[len(AUX_PREFIX):] not in s.aux_columns]
-        if unmapped:
-            raise InputError(f"variable(s) {unmapped} have no column: map each with "
-                             "--aux NAME=COLUMN")
+        for v in self.variables:  # what each variable needs (its module's check)
+            missing = _registered(v).check(self.settings, self.thermometer, v)
+            if missing is not None:
+                raise InputError(missing)
 
     def reset(self) -> None:
         """Forget the filter state (start of a new run)."""
@@ -464,51 +438,18 @@ class FeatureStream:
         bridged with the gap's Δt); ``restart`` (a boolean mask of the chunk's rows,
         e.g. the segment starts of ``--gaps split``) starts them at rest on those rows.
         """
-        s = self.settings
         time_s = chunk.time_s
-        base: dict[str, np.ndarray] = {}
-        if any(v in ("f", "df", "dpos", "d2") for v in self.variables):
-            base["f"] = chunk["freq_hz"] - s.reference_freq_hz
-        if any(v in ("h", "dh") for v in self.variables):
-            base["h"] = chunk["housing_c"] - s.reference_c
-        out: dict[str, np.ndarray] = {}
-        rates: dict[str, np.ndarray] = {}
-        for v in self.variables:
-            if v in base:
-                out[v] = base[v]
-            elif v == "g":
-                resonator = self.thermometer.temperature(chunk["freq_hz"], warn=False)
-                out[v] = chunk["housing_c"] - resonator
-            elif is_aux(v):
-                out[v] = self._aux(chunk, v)
-            elif v == "d2":
-                out[v] = self._rate("f2", base["f"], s.rate_tau2_s, time_s, restart)
-            else:
-                source = _RATE_OF[v]
-                if source not in rates:
-                    rates[source] = self._rate(source, base[source], s.rate_tau_s, time_s,
-                                               restart)
-                rate = rates[source]
-                out[v] = heating_part(rate, s.switch_hz_per_s) if v == "dpos" else rate
+        # each variable's numpy reference (its module's compute), sharing levels and filters
+        inputs = Inputs(chunk, self.settings, self.thermometer, _registered,
+                        lambda key, level, tau: self._rate(key, level, tau, time_s, restart))
+        out = {v: inputs.value(v) for v in self.variables}
         self.samples_seen += len(chunk)
         return out
-
-    def _aux(self, chunk: Recording, variable: str) -> np.ndarray:
-        name = variable[len(AUX_PREFIX):]
-        column = self.settings.aux_columns[name]
-        if column not in chunk:
-            where = f"{chunk.source}: " if chunk.source else ""
-            raise InputError(
-                f"{where}no column {column!r}, which the extra channel {name!r} (variable "
-                f"{variable}) reads; the model was calibrated with --aux {name}={column}: log "
-                f"that channel, or rename the file's column to {column!r} (--col)"
-            )
-        return np.asarray(chunk[column], dtype=np.float64) - aux_centre(self.settings, name)
 
 
 def aux_centre(settings: FeatureSettings, name: str) -> float:
     """Training mean of the extra channel ``name`` (0 before it is known). [column unit]"""
-    return float(settings.aux_centres.get(name, 0.0))
+    return _aux_centre(settings, name)
 
 
 def compute_variables(

@@ -20,11 +20,11 @@ from pathlib import Path
 
 from hrgtc.compensate import OUTPUT_COLUMNS, CompensationSummary, compensate_instrument_file
 from hrgtc.compensate.compensator import compensated_metadata
-from hrgtc.compensate.export_c import export_c
 from hrgtc.core.errors import HrgtcWarning
 from hrgtc.core.files import refuse_existing
 from hrgtc.core.progress import StageProgress, for_stage
 from hrgtc.evaluation import Evaluation, evaluate
+from hrgtc.export.export_c import export_c
 from hrgtc.model import save_instrument, save_model
 from hrgtc.pipeline.calibration import CalibrationResult, calibrate
 from hrgtc.pipeline.instrument import InstrumentCalibration, calibrate_instrument

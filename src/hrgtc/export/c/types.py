@@ -1,7 +1,7 @@
 """The C floating type of the firmware export: double, or float32 for FPU-only MCUs.
 
 Every constant, variable declaration and ``math.h`` call that
-:mod:`hrgtc.compensate.c_text` and :mod:`hrgtc.compensate.c_single` print goes
+:mod:`hrgtc.export.c.text` and :mod:`hrgtc.export.c.single` print goes
 through one :class:`CType`, so a term is written once for both builds.
 """
 
@@ -12,8 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hrgtc.compensate.c_plan import CPlan
 from hrgtc.core.errors import InputError
+from hrgtc.export.c.plan import CPlan
 
 
 @dataclass(frozen=True)

@@ -11,11 +11,11 @@ so those files stay as they were.
 
 from __future__ import annotations
 
-from hrgtc.compensate.c_expr import array as _array
-from hrgtc.compensate.c_expr import term_expression as _term_expression
-from hrgtc.compensate.c_plan import CPlan
-from hrgtc.compensate.c_types import CType, ctype
 from hrgtc.drift.scale_factor import ScaleFactorModel
+from hrgtc.export.c.expr import array as _array
+from hrgtc.export.c.expr import term_expression as _term_expression
+from hrgtc.export.c.plan import CPlan
+from hrgtc.export.c.types import CType, ctype
 from hrgtc.model import UnitModel
 
 PIECES = ("define", "field", "prototype", "function", "declare", "apply", "out", "readme")

@@ -1,4 +1,4 @@
-"""Tests of the float32 firmware export (hrgtc.compensate.c_single, c_float32).
+"""Tests of the float32 firmware export (hrgtc.export.c.single, float32).
 
 The float build is compiled with gcc under strict warnings and run (a) on the grid
 of the trained ranges, through ``<prefix>_bias_dph`` and ``<prefix>_temperature_c``,
@@ -22,7 +22,9 @@ from scipy import signal
 
 from hrgtc import drift
 from hrgtc.compensate import Compensator
-from hrgtc.compensate.c_float32 import (
+from hrgtc.core.errors import InputError
+from hrgtc.drift.features import causal_rate
+from hrgtc.export.c.float32 import (
     float_accuracy,
     float_constants,
     mirror_bias,
@@ -30,10 +32,8 @@ from hrgtc.compensate.c_float32 import (
     mirror_rate,
     mirror_temperature,
 )
-from hrgtc.compensate.c_plan import plan_for
-from hrgtc.compensate.export_c import export_c
-from hrgtc.core.errors import InputError
-from hrgtc.drift.features import causal_rate
+from hrgtc.export.c.plan import plan_for
+from hrgtc.export.export_c import export_c
 from hrgtc.model import UnitModel
 from hrgtc.thermometry import paper
 

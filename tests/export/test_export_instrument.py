@@ -17,8 +17,8 @@ import pytest
 
 from hrgtc import drift
 from hrgtc.compensate import Compensator
-from hrgtc.compensate.export_c import export_c
 from hrgtc.core.errors import InputError
+from hrgtc.export.export_c import export_c
 from hrgtc.model import InstrumentModel, UnitModel, save_instrument
 
 from synthetic import THERMOMETER, ramp_run, scale_factor, with_scale_factor

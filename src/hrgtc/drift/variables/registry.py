@@ -1,14 +1,18 @@
-"""The drift variables: one list, with each variable's unit, kind, backends and docs line.
+"""The drift-variable registry: every variable of the term grammar, one module each.
 
-Every way hrgtc computes the drift model reads this list to know what it can do, so a
-variable cannot be known to one backend and missing from another without a test
-saying so (``tests/drift/test_variables.py`` is generated from :data:`DRIFT_VARIABLES`):
+Each module of this package (``f``, ``df``, ``h``, ``dh``, ``dpos``, ``d2``, ``g``, ``aux``
+for the extra channels ``a_NAME``) builds one :class:`~hrgtc.drift.variables.spec.DriftVariable`
+with its unit, kind, docs line, backends, numpy reference, settings and C pieces;
+:data:`DRIFT_VARIABLES` collects them in grammar order (a package entry point could add
+more later). Every way hrgtc computes the drift model reads this list to know what it
+can do, so a variable cannot be known to one backend and missing from another without a
+test saying so (``tests/drift/test_variables.py`` is generated from it):
 
 =============  =============================================================
 backend        what it is
 =============  =============================================================
-``numpy``      the reference: :class:`hrgtc.drift.features.FeatureStream` and
-               :meth:`hrgtc.drift.DriftModel.predict` (every variable)
+``numpy``      the reference: :class:`hrgtc.drift.features.FeatureStream` (each
+               variable's ``compute``) and :meth:`hrgtc.drift.DriftModel.predict`
 ``numba``      the fused kernel of :mod:`hrgtc.compensate._kernel`; a model with
                a variable it lacks runs on the numpy engine (same numbers)
 ``c_double``   ``hrgtc export-c`` (C99, double)
@@ -24,18 +28,24 @@ thermometer is the gyro's temperature sensor (``calibrate --thermometer sensor``
 that sensor in the place of the frequency, so f is in °C and its rates in °C/s
 (:attr:`DriftVariable.sensor_unit`).
 
-This is the seed of the variable registry of issue 22: adding a variable starts here.
-
 [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
 """
 
 from __future__ import annotations
 
+import importlib
+import pkgutil
 import re
-from dataclasses import dataclass
+import sys
+from typing import Any
 
-#: The backends, in the order of the table above.
-BACKENDS = ("numpy", "numba", "c_double", "c_float32", "params")
+from hrgtc.drift.variables.aux import AUX_PREFIX
+from hrgtc.drift.variables.spec import BACKENDS, DriftVariable
+
+__all__ = ["AUX_PREFIX", "BACKENDS", "BACKEND_NAMES", "DRIFT_VARIABLES", "FIXED",
+           "DriftVariable", "ascii_unit", "docs_table", "is_aux", "refusal",
+           "settings_schema", "supported", "unit", "unsupported", "variable"]
+
 #: What each backend is called in messages.
 BACKEND_NAMES = {
     "numpy": "the numpy compensator",
@@ -50,79 +60,31 @@ _INSTEAD = {
     "c_float32": "export it with --precision double, or calibrate without {v} terms",
     "params": "export C (--format c), or calibrate without {v} terms",
 }
-_ALL = frozenset(BACKENDS)
+
+#: Modules of the package that are not variables.
+_NOT_VARIABLES = frozenset({"registry", "spec"})
 
 
-@dataclass(frozen=True)
-class DriftVariable:
-    """One variable of the drift model's term grammar.
-
-    Attributes
-    ----------
-    name
-        Its spelling in terms (``a_NAME`` stands for every extra channel).
-    unit
-        Unit with the resonator as thermometer (an HRG) (:func:`ascii_unit` for exports).
-    sensor_unit
-        Unit when the thermometer is the gyro's temperature sensor.
-    kind
-        ``"level"`` (checked for ``in_range``) or ``"rate"`` (``rate_in_range``).
-    description
-        The docs line: what the variable is.
-    backends
-        Where it is computed (see :data:`BACKENDS`).
-    columns
-        Recording columns it reads (``a_NAME``: the mapped column, not named here).
-    """
-
-    name: str
-    unit: str
-    sensor_unit: str
-    kind: str
-    description: str
-    backends: frozenset[str]
-    columns: tuple[str, ...]
-
-    def unit_for(self, thermometer_source: str = "resonator") -> str:
-        """The unit for a model whose thermometer is ``"resonator"`` or ``"sensor"``."""
-        return self.sensor_unit if thermometer_source == "sensor" else self.unit
-
-    def supports(self, backend: str) -> bool:
-        """Whether ``backend`` computes this variable."""
-        if backend not in BACKENDS:
-            raise ValueError(f"unknown backend {backend!r}; one of {', '.join(BACKENDS)}")
-        return backend in self.backends
+def _discover() -> tuple[DriftVariable, ...]:
+    """The ``VARIABLE`` of every module of this package, in grammar order."""
+    package = sys.modules[__package__]
+    found = []
+    for info in pkgutil.iter_modules(package.__path__):
+        if info.name in _NOT_VARIABLES or info.name.startswith("_"):
+            continue
+        module = importlib.import_module(f"{__package__}.{info.name}")
+        found.append(module.VARIABLE)
+    found.sort(key=lambda v: v.order)
+    orders = [v.order for v in found]
+    if len(set(orders)) != len(orders) or len({v.name for v in found}) != len(found):
+        raise RuntimeError(f"drift variables with the same order or name: {found}")
+    return tuple(found)
 
 
-#: Every drift variable, in the grammar's order (the order of terms' factors).
-DRIFT_VARIABLES: tuple[DriftVariable, ...] = (
-    DriftVariable("f", "Hz", "°C", "level",
-                  "frequency change freq_hz - f_ref (f_ref: the thermometer at reference_c)",
-                  _ALL, ("freq_hz",)),
-    DriftVariable("df", "Hz/s", "°C/s", "rate",
-                  "causal rate of f (two first-order stages of time constant rate_tau_s)",
-                  _ALL, ("freq_hz",)),
-    DriftVariable("h", "°C", "°C", "level",
-                  "housing temperature change housing_c - reference_c", _ALL, ("housing_c",)),
-    DriftVariable("dh", "°C/s", "°C/s", "rate",
-                  "causal rate of h (the same filter as df)", _ALL, ("housing_c",)),
-    DriftVariable("dpos", "Hz/s", "°C/s", "rate",
-                  "heating/cooling switch: the heating part of df, df*(1 + tanh(df/delta))/2 "
-                  "(delta: switch_hz_per_s)",
-                  frozenset({"numpy"}), ("freq_hz",)),
-    DriftVariable("d2", "Hz/s", "°C/s", "rate",
-                  "causal rate of f through a second filter of time constant rate_tau2_s",
-                  frozenset({"numpy", "c_double", "params"}), ("freq_hz",)),
-    DriftVariable("g", "°C", "°C", "level",
-                  "housing - resonator gradient housing_c - T(freq_hz), T the thermometer's "
-                  "inverse", _ALL, ("freq_hz", "housing_c")),
-    DriftVariable("a_NAME", "unit of its column", "unit of its column", "level",
-                  "an extra logged channel (--aux NAME=COLUMN) minus its training mean",
-                  frozenset({"numpy", "c_double", "params"}), ()),
-)
+#: Every drift variable, in the grammar's order (the order of terms' factors): the
+#: ``VARIABLE`` of each module of this package.
+DRIFT_VARIABLES: tuple[DriftVariable, ...] = _discover()
 _BY_NAME = {v.name: v for v in DRIFT_VARIABLES}
-#: Prefix of the user's extra channels.
-AUX_PREFIX = "a_"
 _AUX_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9]*$")
 #: The fixed variables' names (every one but ``a_NAME``), in grammar order.
 FIXED = tuple(v.name for v in DRIFT_VARIABLES if v.name != "a_NAME")
@@ -182,3 +144,34 @@ def refusal(names: object, backend: str, terms: object = ()) -> str | None:
     instead = _INSTEAD.get(backend, "use another backend").format(v=listed)
     return (f"the drift model uses {listed}{used}, which {BACKEND_NAMES[backend]} does not "
             f"compute ({what}); {instead}")
+
+
+def settings_schema() -> dict[str, dict[str, Any]]:
+    """The feature settings the variables own: field -> its JSON Schema in the model file.
+
+    :mod:`hrgtc.model_schema` puts these beside the settings every model has, under
+    ``drift.settings.properties``.
+    """
+    out: dict[str, dict[str, Any]] = {}
+    for v in DRIFT_VARIABLES:
+        out.update(v.settings_schema)
+    return out
+
+
+def docs_table() -> str:
+    """The docs' table of the variables and their backends (Markdown), from the registry.
+
+    ``docs/reliability.md`` holds it; a test keeps the two equal.
+    """
+    said = {"numpy": "yes", "numba": "yes", "c_double": "yes", "c_float32": "yes",
+            "params": "yes"}
+    missing = {"numba": "numpy instead"}
+    rows = ["| variable | unit (resonator / sensor) | numpy | numba kernel | C double "
+            "| C float32 | parameter file |",
+            "|---|---|---|---|---|---|---|"]
+    for v in DRIFT_VARIABLES:
+        units = v.unit if v.unit == v.sensor_unit else f"{v.unit} / {v.sensor_unit}"
+        units = "its column's" if v.name == "a_NAME" else units
+        cells = [said[b] if v.supports(b) else missing.get(b, "refused") for b in BACKENDS]
+        rows.append(f"| `{v.name}` | {units} | " + " | ".join(cells) + " |")
+    return "\n".join(rows)

@@ -1,6 +1,6 @@
 """C text of the firmware export: the README block, the header and the source.
 
-:mod:`hrgtc.compensate.export_c` decides what to export (the validated numbers of a
+:mod:`hrgtc.export.export_c` decides what to export (the validated numbers of a
 :class:`~hrgtc.model.UnitModel`); this module prints them as C99. Constants are
 printed with ``%.17g`` so they read back to the same double. Products and sums are
 separate statements, so a compiler that contracts ``a*b + c`` within an expression
@@ -16,22 +16,23 @@ import textwrap
 from pathlib import Path
 from typing import Any
 
-from hrgtc.compensate.c_expr import array as _array
-from hrgtc.compensate.c_expr import term_expression as _term_expression
-from hrgtc.compensate.c_plan import TABLE_POINTS, CPlan
-from hrgtc.compensate.c_rate_filter import filter_functions, filter_struct
-from hrgtc.compensate.c_step import step_tail
-from hrgtc.compensate.c_thermometer import thermometer_functions
-from hrgtc.compensate.c_types import DOUBLE, ctype
-from hrgtc.compensate.c_variables import (
+from hrgtc.drift.features import settle_rows
+from hrgtc.export.c.expr import array as _array
+from hrgtc.export.c.expr import term_expression as _term_expression
+from hrgtc.export.c.plan import TABLE_POINTS, CPlan
+from hrgtc.export.c.rate_filter import filter_functions, filter_struct
+from hrgtc.export.c.step import step_tail
+from hrgtc.export.c.thermometer import thermometer_functions
+from hrgtc.export.c.types import DOUBLE, ctype
+from hrgtc.export.c.variables import (
     RATES,
     bias_params,
     cname,
     extra_variables,
     levels,
+    readme_lines,
     step_inputs,
 )
-from hrgtc.drift.features import settle_rows
 from hrgtc.model import UnitModel
 
 #: Iteration cap of the thermometer inverse (as :meth:`Thermometer.temperature`).
@@ -76,8 +77,8 @@ def readme(model: UnitModel, plan: CPlan, prefix: str, origin: str,
 
     ``sections`` replace the UNITS and USAGE sections (the float32 build writes its own).
     """
-    from hrgtc.compensate.c_scale import scale_pieces
     from hrgtc.core.meta import PAPER_REFERENCE, __version__
+    from hrgtc.export.c.scale import scale_pieces
 
     drift, thermometer, settings = model.drift, model.thermometer, model.drift.settings
     p, up = prefix, prefix.upper()
@@ -136,16 +137,7 @@ def readme(model: UnitModel, plan: CPlan, prefix: str, origin: str,
     if plan.housing:
         lines.append(f"  h  = housing_c - {settings.reference_c:g} degC, dh = its rate by the "
                      "same filter   [degC, degC/s]")
-    if plan.rate2:
-        lines.append(f"  d2 = df/dt by the same filter with tau2 = {settings.rate_tau2_s:g} s "
-                     "(its own state)   [Hz/s]")
-    if plan.gradient:
-        lines.append("  g  = housing_c - resonator_c_est, the housing - resonator gradient   "
-                     "[degC]")
-    for name in plan.aux:
-        lines.append(f"  a_{name} = aux_{name} - {settings.aux_centres.get(name, 0.0):.12g}: "
-                     f"the logged column {settings.aux_columns.get(name, '?')!r} minus its "
-                     "training mean   [its unit]")
+    lines += readme_lines(plan, settings)  # d2, g, a_NAME: each from its module
     lines += [
         "  The code evaluates B on the scaled variables v/scale_v with the exact (%.17g)",
         "  coefficients of the model file; algebraically the same polynomial. Beyond a",
@@ -217,14 +209,15 @@ def readme(model: UnitModel, plan: CPlan, prefix: str, origin: str,
 def header(model: UnitModel, plan: CPlan, prefix: str, origin: str,
             sha256: str) -> str:
     """Text of ``<prefix>_model.h``: README block, state and output structs, prototypes."""
-    from hrgtc.compensate.c_scale import scale_pieces
+    from hrgtc.export.c.scale import scale_pieces
 
     p, up = prefix, prefix.upper()
     housing = plan.housing
     state_h = f"    {p}_rate_filter h_filter;   /* dh/dt filter of h [degC] */\n" \
         if housing else ""
-    if plan.rate2:  # the second df/dt filter (d2) has its own state
-        state_h += f"    {p}_rate_filter f2_filter;  /* second df/dt filter of f (d2) [Hz] */\n"
+    # the state of the variables beyond f, df, h, dh (d2's filter)
+    state_h += extra_variables(plan, model.drift.settings, _literal, _comment,
+                               prefix=p)["state"]
     out_h = "    double h_c;                 /* housing temperature change h [degC] */\n" \
             "    double dh_c_per_s;          /* its causal rate dh/dt [degC/s] */\n" \
         if housing else ""
@@ -378,7 +371,7 @@ def _bias_function(model: UnitModel, plan: CPlan, prefix: str) -> str:
 
 def source(model: UnitModel, plan: CPlan, prefix: str) -> str:
     """Text of ``<prefix>_model.c``: filter, drift model, thermometer inverse, step()."""
-    from hrgtc.compensate.c_scale import scale_pieces
+    from hrgtc.export.c.scale import scale_pieces
 
     p, up = prefix, prefix.upper()
     drift, th = model.drift, model.thermometer
@@ -416,7 +409,7 @@ def source(model: UnitModel, plan: CPlan, prefix: str) -> str:
     if not plan.housing:
         h = dict.fromkeys(h, "")
     h["arg"] = "".join(f", double {name}" for name in step_inputs(plan))
-    extra = extra_variables(plan, settings, _literal, _comment)
+    extra = extra_variables(plan, settings, _literal, _comment, prefix=p)
     n_th = len(plan.th_coefficients)
     thermometer_text = thermometer_functions(
         p=p, n_th=n_th, above=above, real="double", fabs="fabs", half="0.5",

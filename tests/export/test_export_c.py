@@ -1,4 +1,4 @@
-"""Tests of hrgtc.compensate.export_c: the firmware C99 export against the Python compensator.
+"""Tests of hrgtc.export.export_c: the firmware C99 export against the Python compensator.
 
 The generated C is compiled with the system compiler under strict warnings, run
 on a recording the model was not trained on, and compared with
@@ -28,8 +28,8 @@ import hrgtc.cli.export_cmd  # noqa: F401  (registers the command)
 from hrgtc import drift, thermometry
 from hrgtc.cli._app import app
 from hrgtc.compensate import Compensator
-from hrgtc.compensate.export_c import export_c
 from hrgtc.core.errors import CalibrationError, InputError, OutputExistsError
+from hrgtc.export.export_c import export_c
 from hrgtc.model import UnitModel, save_model
 from hrgtc.thermometry import paper
 

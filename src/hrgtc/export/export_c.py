@@ -30,13 +30,13 @@ With ``-ffp-contract=off`` (GCC's default under ``-std=c99``) the filter, the
 thermometer polynomial and the terms round exactly as NumPy does; what remains
 (the order of the final sum, the Newton iteration's last step) is at the
 rounding level: about 1e-14 °/h and 3e-12 °C. The C text is printed by
-:mod:`hrgtc.compensate.c_text`.
+:mod:`hrgtc.export.c.text`.
 
 ``precision="single"`` writes the float32 build for FPU-only microcontrollers
-(:mod:`hrgtc.compensate.c_single`; centred frequency input), whose worst error against
+(:mod:`hrgtc.export.c.single`; centred frequency input), whose worst error against
 the double model is measured at export by its numpy float32 mirror
-(:mod:`hrgtc.compensate.c_float32`) and stated in the header. ``output_format="params"``
-writes the plain parameter file of :mod:`hrgtc.compensate.parameter_file` instead.
+(:mod:`hrgtc.export.c.float32`) and stated in the header. ``output_format="params"``
+writes the plain parameter file of :mod:`hrgtc.export.parameter_file` instead.
 
 [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
 """
@@ -49,13 +49,13 @@ import os
 import re
 from pathlib import Path
 
-from hrgtc.compensate import c_single
-from hrgtc.compensate.c_float32 import float_accuracy, float_constants
-from hrgtc.compensate.c_plan import PRECISIONS, plan_for
-from hrgtc.compensate.c_text import _comment, header, source
-from hrgtc.compensate.parameter_file import instrument_parameter_text, parameter_text
 from hrgtc.core.errors import InputError
 from hrgtc.core.files import file_sha256, refuse_existing, refuse_input, write_text_atomic
+from hrgtc.export.c import single as c_single
+from hrgtc.export.c.float32 import float_accuracy, float_constants
+from hrgtc.export.c.plan import PRECISIONS, plan_for
+from hrgtc.export.c.text import _comment, header, source
+from hrgtc.export.parameter_file import instrument_parameter_text, parameter_text
 from hrgtc.model import InstrumentModel, UnitModel, load_instrument
 
 #: What the export writes: C99 files, or the plain parameter file.
@@ -97,12 +97,12 @@ def export_c(
         ``"double"`` (default): C double throughout. ``"single"``: float32 for FPU-only
         microcontrollers, with the frequency entering centred (``f_hz = freq_hz -
         <PREFIX>_CENTRE_HZ``) and the worst error against the double model over the
-        calibrated range, measured at export (:mod:`hrgtc.compensate.c_float32`), stated
+        calibrated range, measured at export (:mod:`hrgtc.export.c.float32`), stated
         in the header and as ``<PREFIX>_MAX_ERROR_C`` / ``<PREFIX>_MAX_ERROR_DPH``.
     output_format
         ``"c"`` (default): the header and source. ``"params"``: one plain parameter file
         ``<prefix>_params.txt`` of ``key = value`` lines, every number documented
-        (:mod:`hrgtc.compensate.parameter_file`); ``precision`` does not apply.
+        (:mod:`hrgtc.export.parameter_file`); ``precision`` does not apply.
 
     Returns
     -------

@@ -16,7 +16,7 @@ does not accumulate over the filter's tau/dt samples of memory. It is the filter
 weights are computed in double and rounded to float once per distinct Δt).
 
 :func:`float_constants` rounds every constant once, so the C text
-(:mod:`hrgtc.compensate.c_single`) prints exactly these float32 values and the
+(:mod:`hrgtc.export.c.single`) prints exactly these float32 values and the
 mirror below computes with them; :func:`mirror_bias`, :func:`mirror_temperature`
 and :func:`mirror_rate` evaluate the generated code's operations one by one in
 ``numpy.float32`` (the order of the C statements), :func:`mirror_gradient` the
@@ -30,13 +30,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
-from hrgtc.compensate.c_plan import CPlan
-from hrgtc.compensate.c_text import NEWTON_MAX_ITER
 from hrgtc.drift.features import Term
 from hrgtc.drift.rate_filter import DT_REL_TOLERANCE, SERIES_LIMIT, series_coefficients
+from hrgtc.drift.variables import variable
+from hrgtc.export.c.plan import CPlan
+from hrgtc.export.c.text import NEWTON_MAX_ITER
 from hrgtc.model import UnitModel
 
 F32 = np.float32
@@ -154,11 +156,11 @@ def mirror_bias(model: UnitModel, c: FloatConstants,
                 values: dict[str, np.ndarray]) -> np.ndarray:
     """``<prefix>_bias_dph()`` of the float build. [°/h]
 
-    ``values`` maps the variables (f [Hz], df [Hz/s], h [°C], dh [°C/s], g [°C]) to float32
-    arrays.
+    ``values`` maps the model's variables (f [Hz], df [Hz/s], h [°C], dh [°C/s], g [°C],
+    a_NAME [its unit] ...) to float32 arrays.
     """
     drift = model.drift
-    used = [v for v in ("f", "df", "h", "dh", "g") if v in drift.variables and drift.selected]
+    used = list(drift.variables) if drift.selected else []
     n = np.asarray(next(iter(values.values()))).shape
     raw = {v: np.asarray(values[v], dtype=F32) for v in used}
     held, x = {}, {}
@@ -277,7 +279,8 @@ def step_weights64(dt_s: float, tau_s: float) -> tuple[float, float]:
     return a, (r - a) / r
 
 
-def mirror_rate(c: FloatConstants, x: np.ndarray, dt_s: np.ndarray) -> np.ndarray:
+def mirror_rate(c: FloatConstants, x: np.ndarray, dt_s: np.ndarray,
+                tau_s: float | None = None) -> np.ndarray:
     """The float build's causal rate of one signal (df/dt of f, or dh/dt), from rest. [/s]
 
     Its ``rate_update()``: the lag ``x_prev - y1`` and the difference ``y1 - y2`` of the
@@ -285,7 +288,11 @@ def mirror_rate(c: FloatConstants, x: np.ndarray, dt_s: np.ndarray) -> np.ndarra
     with the weights of each step's ``dt_s`` (float, as firmware passes it; the first is
     ignored) computed in double and rounded to float when dt moves by more than the
     tolerance. Runs along the last axis (rows of signals at once, one dt per column).
+    ``tau_s``: the filter's time constant (default the df/dt filter's; d2's
+    ``rate_tau2_s``). [s]
     """
+    tau64 = c.tau_s if tau_s is None else float(tau_s)
+    tau32 = F32(tau64)
     x = np.asarray(x, dtype=F32)
     dt_s = np.asarray(dt_s, dtype=F32)
     out = np.empty_like(x)
@@ -302,7 +309,7 @@ def mirror_rate(c: FloatConstants, x: np.ndarray, dt_s: np.ndarray) -> np.ndarra
     for i in range(1, x.shape[-1]):
         dt = dt_s[i] if dt_s[i] > 0 else F32(0.0)
         if not abs(dt - cached) <= tolerance * cached:
-            a64, p64 = step_weights64(float(dt), c.tau_s)
+            a64, p64 = step_weights64(float(dt), tau64)
             cached, a, p = dt, F32(a64), F32(p64)
         delta = x[..., i] - previous
         previous = x[..., i]
@@ -316,7 +323,7 @@ def mirror_rate(c: FloatConstants, x: np.ndarray, dt_s: np.ndarray) -> np.ndarra
         total = difference + increment
         difference_carry = (total - difference) - increment
         difference = total
-        out[..., i] = difference / c.tau
+        out[..., i] = difference / tau32
     return out
 
 
@@ -391,7 +398,7 @@ def float_accuracy(model: UnitModel, plan: CPlan, c: FloatConstants) -> FloatAcc
     n = values["f"].size
     for v in plan.computed:
         values.setdefault(v, np.zeros(n))
-    inputs = {v: x.astype(F32) for v, x in values.items()}
+    inputs = {v: _firmware(v, x, drift.settings) for v, x in values.items()}
     if plan.gradient:
         values, inputs = _gradient_inputs(model, plan, c, values, inputs)
     b64 = drift.predict({v: values[v] for v in drift.variables} or values)
@@ -406,6 +413,16 @@ def float_accuracy(model: UnitModel, plan: CPlan, c: FloatConstants) -> FloatAcc
     return FloatAccuracy(temperature_c=temperature_error, bias_dph=bias_error,
                          ramp_bias_dph=_ramp_error(model, plan, c), grid_points=n,
                          scale_ppm=scale_error)
+
+
+def _firmware(name: str, value: np.ndarray, settings: Any) -> np.ndarray:
+    """The float32 value of variable ``name`` the float build computes where the double
+    model has ``value``: its module's ``firmware_value`` (a_NAME: the logged value in float
+    minus the float centre), else ``value`` rounded to float32."""
+    code = variable(name).c_code
+    if code is None:
+        return np.asarray(value).astype(F32)
+    return code.firmware_value(value, name, settings)
 
 
 def _gradient_inputs(model: UnitModel, plan: CPlan, c: FloatConstants,
@@ -434,7 +451,7 @@ def _ramp_error(model: UnitModel, plan: CPlan, c: FloatConstants) -> float:
     passes it), from rest, for 12 filter time constants.
     """
     drift = model.drift
-    rated = [v for v in ("df", "dh") if v in drift.variables and v in drift.ranges]
+    rated = [v for v in drift.variables if variable(v).kind == "rate" and v in drift.ranges]
     if not rated:
         return 0.0
     from hrgtc.drift.features import causal_rate
@@ -463,6 +480,18 @@ def _ramp_error(model: UnitModel, plan: CPlan, c: FloatConstants) -> float:
         middle = 0.5 * sum(drift.ranges["g"]) if "g" in drift.ranges else 0.0
         values64["g"] = np.full(values64["f"].shape, middle)
         values64, values32 = _gradient_inputs(model, plan, c, values64, values32)
+    for v in drift.variables:  # the other rates (d2) through their own float and double filters
+        spec = variable(v)
+        if v not in values64 and spec.rate_of is not None and spec.rate_of[0] in values64:
+            level, field = spec.rate_of
+            tau_v = float(getattr(settings, field))
+            values64[v] = np.vstack([causal_rate(row, tau_v, fs)[0] for row in values64[level]])
+            values32[v] = mirror_rate(c, values32[level], dt32, tau_v)
+    for v in drift.variables:  # the other levels (a_NAME) held at the middle of their range
+        if v not in values64:
+            middle = 0.5 * sum(drift.ranges[v]) if v in drift.ranges else 0.0
+            values64[v] = np.full(values64["f"].shape, middle)
+            values32[v] = _firmware(v, values64[v], settings)
     worst = 0.0
     for row in range(9):
         b64 = drift.predict({v: values64[v][row] for v in drift.variables})

@@ -17,8 +17,8 @@ filter as differences with compensated (Kahan) sums, as before.
 
 from __future__ import annotations
 
-from hrgtc.compensate.c_types import DOUBLE, SINGLE
 from hrgtc.drift.rate_filter import DT_REL_TOLERANCE, SERIES_LIMIT, series_coefficients
+from hrgtc.export.c.types import DOUBLE, SINGLE
 
 __all__ = ["filter_functions", "filter_struct"]
 

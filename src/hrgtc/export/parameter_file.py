@@ -7,7 +7,7 @@ header comment giving the formula to evaluate, step by step, in the order
 :class:`hrgtc.compensate.Compensator` computes it. Numbers are printed with
 ``%.17g`` so they read back to the same double.
 
-The computation written out in the header is the one of :mod:`hrgtc.compensate.export_c`:
+The computation written out in the header is the one of :mod:`hrgtc.export.export_c`:
 the causal df/dt filter of :func:`hrgtc.drift.features.causal_rate`, the drift model of
 Eq. (22) of [1] on scaled variables, continued along its tangent beyond the training
 ranges, and the thermometer of Eq. (18) (its inverse gives Table 2).
@@ -19,12 +19,12 @@ from __future__ import annotations
 
 from typing import Any
 
-from hrgtc.compensate.c_plan import CPlan
-from hrgtc.compensate.c_text import NEWTON_MAX_ITER, sensor_note
-from hrgtc.compensate.c_types import DOUBLE
 from hrgtc.core.errors import InputError
 from hrgtc.drift.features import settle_rows
 from hrgtc.drift.variables import ascii_unit, refusal, variable
+from hrgtc.export.c.plan import CPlan
+from hrgtc.export.c.text import NEWTON_MAX_ITER, sensor_note
+from hrgtc.export.c.types import DOUBLE
 from hrgtc.model import UnitModel
 
 #: Version of the file's layout (a key of the file).

@@ -14,7 +14,7 @@ import numpy as np
 from hrgtc.core.errors import CalibrationError, InputError
 from hrgtc.drift.features import is_aux, variable_key
 from hrgtc.drift.rate_filter import check_tau
-from hrgtc.drift.variables import refusal, supported
+from hrgtc.drift.variables import refusal, supported, variable
 from hrgtc.model import UnitModel
 
 #: Points of the embedded table that starts the thermometer's Newton iteration.
@@ -93,7 +93,7 @@ def plan_for(model: UnitModel, precision: str = "double") -> CPlan:
     ------
     InputError
         An unknown precision, or a model with a variable the export does not compute
-        (:mod:`hrgtc.drift.variables` says which: ``dpos``; ``d2`` and ``a_NAME`` in float32).
+        (:mod:`hrgtc.drift.variables` says which: ``dpos``; ``d2`` in float32).
     CalibrationError
         A thermometer that is not monotonic over its calibrated range.
     """
@@ -159,5 +159,6 @@ def plan_for(model: UnitModel, precision: str = "double") -> CPlan:
 
 
 def variables_for_c(used: set[str]) -> list[str]:
-    """The variables beyond f, df, h, dh the C code computes, in grammar order."""
-    return [v for v in sorted(used, key=variable_key) if v == "d2" or v == "g" or is_aux(v)]
+    """The variables beyond f, df, h, dh the C code computes, in grammar order: those whose
+    module in :mod:`hrgtc.drift.variables` writes its C pieces (``c_code``)."""
+    return [v for v in sorted(used, key=variable_key) if variable(v).c_code is not None]

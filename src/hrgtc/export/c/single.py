@@ -2,37 +2,38 @@
 
 For FPU-only microcontrollers (Cortex-M4F and the like: single precision in hardware,
 double in software). The same computation as the double build of
-:mod:`hrgtc.compensate.c_text`, in ``float`` throughout (``f`` literals, ``powf``,
+:mod:`hrgtc.export.c.text`, in ``float`` throughout (``f`` literals, ``powf``,
 ``fabsf``), with the frequency entering centred, the thermometer written about the
 same centre and the df/dt filter kept as differences (see
-:mod:`hrgtc.compensate.c_float32`, whose numpy mirror evaluates exactly these
+:mod:`hrgtc.export.c.float32`, whose numpy mirror evaluates exactly these
 statements). The drift terms are printed by the shared
-:func:`hrgtc.compensate.c_text._bias_function` with the float :class:`CType`.
+:func:`hrgtc.export.c.text._bias_function` with the float :class:`CType`.
 
 [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
 """
 
 from __future__ import annotations
 
-from hrgtc.compensate.c_float32 import MARGIN, FloatAccuracy, FloatConstants
-from hrgtc.compensate.c_plan import TABLE_POINTS, CPlan
-from hrgtc.compensate.c_rate_filter import filter_functions, filter_struct
-from hrgtc.compensate.c_scale import scale_factor_of, scale_pieces
-from hrgtc.compensate.c_step import step_tail
-from hrgtc.compensate.c_text import NEWTON_MAX_ITER, _array, _bias_function, _comment, readme
-from hrgtc.compensate.c_thermometer import thermometer_functions
-from hrgtc.compensate.c_types import DOUBLE, SINGLE
-from hrgtc.compensate.c_variables import bias_params
 from hrgtc.drift.features import settle_rows
+from hrgtc.export.c.float32 import MARGIN, FloatAccuracy, FloatConstants
+from hrgtc.export.c.plan import TABLE_POINTS, CPlan
+from hrgtc.export.c.rate_filter import filter_functions, filter_struct
+from hrgtc.export.c.scale import scale_factor_of, scale_pieces
+from hrgtc.export.c.step import step_tail
+from hrgtc.export.c.text import NEWTON_MAX_ITER, _array, _bias_function, _comment, readme
+from hrgtc.export.c.thermometer import thermometer_functions
+from hrgtc.export.c.types import DOUBLE, SINGLE
+from hrgtc.export.c.variables import RATES, bias_params, extra_variables, levels, step_inputs
 from hrgtc.model import UnitModel
 
 
 def _sections(model: UnitModel, plan: CPlan, prefix: str, accuracy: FloatAccuracy) -> list[str]:
     """UNITS, USAGE and ACCURACY of the float build's README block."""
     p, up = prefix, prefix.upper()
-    fs = model.drift.settings.sample_rate_hz
-    housing_use = "housing_c, " if plan.housing_input else ""
-    housing_arg = "float housing_c, " if plan.housing_input else ""
+    settings = model.drift.settings
+    fs = settings.sample_rate_hz
+    housing_use = "".join(f"{name}, " for name in step_inputs(plan))
+    housing_arg = "".join(f"float {name}, " for name in step_inputs(plan))
     return [
         "FLOAT32 BUILD (for FPU-only microcontrollers, e.g. Cortex-M4F)",
         "  Everything is float: constants, state, arithmetic (powf, fabsf). The frequency "
@@ -68,6 +69,8 @@ def _sections(model: UnitModel, plan: CPlan, prefix: str, accuracy: FloatAccurac
         f"  inputs:  f_hz = freq_hz - {up}_CENTRE_HZ [Hz]; rate_dph [deg/h] gyro output "
         "(input rate included)"
         + ("; housing_c [degC] housing thermistor" if plan.housing_input else "")
+        + "".join(f"; aux_{n} the logged {settings.aux_columns.get(n, '?')!r} (float)"
+                  for n in plan.aux)
         + "; dt_s [s] the time since the previous sample (any steps; ignored on the first "
         f"sample after init/reset). The model was trained at {fs:g} Hz.",
         "  gaps:    pass the gap's length as dt_s to carry the filter across it (bridge), "
@@ -108,12 +111,14 @@ def header(model: UnitModel, plan: CPlan, prefix: str, origin: str, sha256: str,
     out_h = ("    float h_c;                  /* housing temperature change h [degC] */\n"
              "    float dh_c_per_s;           /* its causal rate dh/dt [degC/s] */\n"
              if housing else "")
-    arg_h = ", float housing_c" if plan.housing_input else ""
+    arg_h = "".join(f", float {name}" for name in step_inputs(plan))
     bias_h = "".join(f", float {name}" for _, name in bias_params(plan)[2:])
     settings = model.drift.settings
+    state_h += extra_variables(plan, settings, lit, _comment, ctype=SINGLE, prefix=p)["state"]
     k = scale_pieces(model, plan, prefix)
     out_h += k["field"]
-    housing_in = ", housing_c [degC]" if plan.housing_input else ""
+    housing_in = ((", housing_c [degC]" if plan.housing_input else "")
+                  + "".join(f", aux_{n}" for n in plan.aux))
     sections = _sections(model, plan, prefix, accuracy)
     return f"""{readme(model, plan, prefix, origin, sha256, sections)}
 #ifndef {up}_MODEL_H
@@ -232,20 +237,18 @@ def source(model: UnitModel, plan: CPlan, prefix: str, constants: FloatConstants
     }
     if not plan.housing:
         h = dict.fromkeys(h, "")
-    if plan.housing_input:
-        h["arg"] = ", float housing_c"
-    # the gradient g = housing_c - T(f): the temperature is computed before the bias
-    g = {"values": "    float g_value;\n" if plan.gradient else "",
-         "rate": "    g_value = housing_c - temperature;  /* NaN beyond the inverse */\n"
-                 if plan.gradient else "",
-         "bias": ", g_value" if plan.gradient else ""}
+    h["arg"] = "".join(f", float {name}" for name in step_inputs(plan))
+    # the variables beyond f, df, h, dh, each from its module (g = housing_c - T(f) needs
+    # the temperature, computed before the bias)
+    g = extra_variables(plan, model.drift.settings, lit, _comment, ctype=SINGLE, prefix=p)
+    h["constants"] += g["constants"]
     n_th = c.th_coefficients.size
     thermometer_text = thermometer_functions(
         p=p, n_th=n_th, above=above, real="float", fabs="fabsf", half="0.5f",
         fn=f"{p}_centred_frequency_hz", arg="f_hz")
     k = scale_pieces(model, plan, prefix)
-    level_test = f"{p}_frequency_in_range(f_value)" + checks(("f", "h", "g"))
-    tail = step_tail(up=up, level_test=level_test, rate_test="1" + checks(("df", "dh")),
+    level_test = f"{p}_frequency_in_range(f_value)" + checks(levels(plan))
+    tail = step_tail(up=up, level_test=level_test, rate_test="1" + checks(RATES),
                      h=h, k=k)
     return f"""/* {p}_model.c -- generated by hrgtc export-c --precision single for unit \
 {_comment(model.unit)};
@@ -287,7 +290,7 @@ static const float TH_TOLERANCE_C = {lit(c.tolerance, 'tolerance')};
 void {p}_reset({p}_state *state)
 {{
     rate_start(&state->f_filter, 0.0f);
-{h['reset']}    state->started = 0;
+{h['reset']}{g['reset']}    state->started = 0;
     state->samples = 0UL;
     state->out_of_range = 0UL;
     state->rate_out_of_range = 0UL;
@@ -306,10 +309,10 @@ float {p}_step({p}_state *state, float dt_s, float f_hz, float rate_dph{h['arg']
     int in_range, rate_in_range, level_in_range;
 {k['declare']}    if (!state->started) {{  /* the filters start at rest on the first sample */
         rate_start(&state->f_filter, f_value);
-{h['start']}        state->started = 1;
+{h['start']}{g['start']}        state->started = 1;
     }} else {{  /* each filter steps over this sample's dt_s */
         df_value = rate_update(&state->f_filter, f_value, dt_s, RATE_TAU_S, RATE_TAU);
-{h['rate']}    }}
+{h['rate']}{g['rate']}    }}
     temperature = {p}_temperature_c(f_value);
-{g['rate']}    bias = {p}_bias_dph(f_value, df_value{h['bias']}{g['bias']});
+{g['gradient']}    bias = {p}_bias_dph(f_value, df_value{h['bias']}{g['bias']});
 {tail}"""

@@ -1,4 +1,4 @@
-"""Tests of hrgtc.compensate.parameter_file: the plain key = value export, read back.
+"""Tests of hrgtc.export.parameter_file: the plain key = value export, read back.
 
 The file is parsed by a small parser written here (not hrgtc's), the compensation is
 evaluated from the parsed numbers alone with plain numpy, following the formula the
@@ -19,8 +19,8 @@ from scipy import signal
 
 from hrgtc import drift
 from hrgtc.compensate import Compensator
-from hrgtc.compensate.export_c import export_c
 from hrgtc.core.errors import InputError, OutputExistsError
+from hrgtc.export.export_c import export_c
 from hrgtc.model import UnitModel
 from hrgtc.thermometry import paper
 

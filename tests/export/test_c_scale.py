@@ -1,4 +1,4 @@
-"""Tests of hrgtc.compensate.c_scale: the scale-factor correction in the C export.
+"""Tests of hrgtc.export.c.scale: the scale-factor correction in the C export.
 
 Both builds are compiled with gcc and run on a cool-down that leaves the rate-table
 frequency range (the tangent continuation); truth is the library's own pieces: the
@@ -17,9 +17,9 @@ import pytest
 
 from hrgtc import drift
 from hrgtc.compensate import Compensator
-from hrgtc.compensate.c_float32 import float_accuracy, float_constants, mirror_scale
-from hrgtc.compensate.c_plan import plan_for
-from hrgtc.compensate.export_c import export_c
+from hrgtc.export.c.float32 import float_accuracy, float_constants, mirror_scale
+from hrgtc.export.c.plan import plan_for
+from hrgtc.export.export_c import export_c
 from hrgtc.model import UnitModel
 
 from synthetic import THERMOMETER, ramp_run, scale_factor, with_scale_factor

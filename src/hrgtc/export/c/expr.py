@@ -1,16 +1,16 @@
 """C expressions shared by the export's text modules: array initialisers and drift terms.
 
-:mod:`hrgtc.compensate.c_text` (header, source) and :mod:`hrgtc.compensate.c_scale`
-(the scale-factor pieces that ``c_text`` inserts) both print these; they live here so
-that ``c_scale`` does not import ``c_text`` back (no import circle).
+:mod:`hrgtc.export.c.text` (header, source) and :mod:`hrgtc.export.c.scale`
+(the scale-factor pieces that ``text`` inserts) both print these; they live here so
+that ``scale`` does not import ``text`` back (no import circle).
 """
 
 from __future__ import annotations
 
 from typing import Any
 
-from hrgtc.compensate.c_types import DOUBLE, CType
 from hrgtc.drift.features import Term
+from hrgtc.export.c.types import DOUBLE, CType
 
 __all__ = ["array", "factor", "term_expression"]
 
