@@ -53,7 +53,7 @@ def test_white_noise_burst_means_match_theory_within_their_interval():
     99 % interval (the coverage of the interval is tested below), the uncorrected one √r
     larger."""
     rng = np.random.default_rng(4)
-    fs, burst, period, count = 50.0, 250, 3000, 600
+    fs, burst, count = 50.0, 250, 600  # 5 s bursts every 60 s
     samples = rng.normal(size=(count, burst))  # only the bursts are recorded
     means = samples.mean(axis=1)
     result = burst_mean_allan(means, np.full(count, burst / fs), np.arange(count) * 60.0,
