@@ -26,7 +26,8 @@ What :func:`burst_mean_allan` reports, at τ = M·T:
 * N (terms) and the chi-squared interval with the white-noise edf of the burst means
   (SP 1065 Table 5, as for a record of that many samples), exact for white rate noise.
 
-The burst starts must keep one period: a start-to-start step more than
+The burst starts must keep one period: a burst shorter than half the median burst (cut
+by the settling time, say) is left out, and a start-to-start step more than
 :data:`PERIOD_TOLERANCE` off the median period (a missing burst, a pause) starts a new
 run of bursts, and the deviation is pooled within those runs (no difference across a
 missing burst). With fewer than three regular bursts the τ beyond a burst are not
@@ -206,6 +207,11 @@ def burst_mean_allan(means: Any, durations_s: Any, starts_s: Any, *,
     if y.size < 3 or not np.all(np.isfinite(starts)):
         raise InputError(f"{y.size} bursts with known start times; burst means need at "
                          "least 3 at a regular period")
+    full = durations >= 0.5 * float(np.median(durations))  # a burst cut short (settling):
+    y, durations, starts = y[full], durations[full], starts[full]  # left out, breaks the run
+    if y.size < 3:
+        raise InputError(f"{y.size} bursts of at least half the median length; burst means "
+                         "need at least 3 at a regular period")
     steps = np.diff(starts)
     period = float(np.median(steps))
     regular = np.abs(steps / period - 1.0) <= tolerance
