@@ -162,16 +162,18 @@ class BurstAllanResult:
         head = (f"burst means ({self.bursts} bursts of {self.burst_s:.4g} s every "
                 f"{self.period_s:.4g} s, dead-time ratio r = {self.dead_time_ratio:.4g}"
                 + (f", pooled within {self.runs} runs" if self.runs > 1 else "")
-                + "): Allan deviation corrected for white rate noise (÷√r); biased by the "
-                "dead time for other noise: expected/true ×flicker, ×random walk")
+                + "): Allan deviation corrected for white rate noise (÷√r, exact for angle "
+                "random walk); the dead time biases it for other noise: it would read the true "
+                "σ times the factor given for flicker (bias instability) and random-walk rate "
+                "noise; the true σ lies between the corrected and the uncorrected value")
         out = [head]
         for k, tau in enumerate(self.taus_s):
             out.append(
                 f"  τ = {tau:g} s: {self.deviation[k]:.4g} {unit} "
                 f"({self.lower[k]:.3g}–{self.upper[k]:.3g}, {self.confidence:.3g}), "
                 f"N = {int(self.counts[k])}, uncorrected {self.raw_deviation[k]:.4g}; "
-                f"×{self.bias_flicker[k]:.3g} flicker, ×{self.bias_random_walk[k]:.3g} "
-                "random walk")
+                f"×{self.bias_flicker[k]:.3g} if flicker, ×{self.bias_random_walk[k]:.3g} "
+                "if random walk")
         return out
 
 
