@@ -367,9 +367,11 @@ def run_pass(
     deviation
         The deviation curve: ``"oadev"`` (overlapping Allan, default), ``"adev"``
         (non-overlapping), ``"mdev"``, ``"hdev"``, ``"tdev"`` (:data:`DEVIATIONS`).
-        Noise terms are read off the Allan deviations only; the chi-squared interval
-        (simple edf, white rate noise, SP 1065 Table 5) is given for ``"oadev"`` and
-        ``"adev"``.
+        Noise terms are read off the Allan deviations only. Every curve is pooled within
+        the segments (no difference across a gap) with its chi-squared interval from the
+        pooled edf (:mod:`~hrgtc.evaluation.allan_segments`); τ beyond a burst comes from
+        burst means with the dead time's bias stated (``burst_allan``) or a note says why
+        it is not estimable.
     confidence
         Two-sided level of the intervals (bias stability and Allan deviation).
     keep
