@@ -69,3 +69,28 @@ def test_too_few_points_on_a_slope_say_how_many():
     terms = noise_terms(allan)
     assert terms.rrw_dph_per_rt_h is None
     assert terms.rrw_reason.startswith("no +½ slope: 1 point(s) right of the minimum")
+
+
+def test_terms_carry_the_interval_and_n_of_the_points_they_are_read_from():
+    q, sigma = 0.01, 1.0
+    rng = np.random.default_rng(2)
+    rate = rng.normal(0.0, sigma, N) + np.cumsum(rng.normal(0.0, q, N))
+    allan = allan_deviation(rate, FS, confidence=0.683)
+    terms = noise_terms(allan)
+    usable = allan.blocks >= 8
+    k = int(np.flatnonzero(usable)[np.argmin(allan.deviation[usable])])
+    low, high = terms.bias_instability_interval
+    assert low == pytest.approx(allan.lower[k] / 0.664) and high == pytest.approx(
+        allan.upper[k] / 0.664)
+    assert terms.bias_instability_n == allan.counts[k]
+    for term, value in (("arw", terms.arw_deg_per_rt_h), ("rrw", terms.rrw_dph_per_rt_h)):
+        low, high = getattr(terms, f"{term}_interval")
+        assert low < value < high
+        first, last = getattr(terms, f"{term}_taus_s")
+        fitted = (allan.taus_s >= first) & (allan.taus_s <= last)
+        assert getattr(terms, f"{term}_n") == int(allan.counts[fitted].min())
+        assert re.fullmatch(r"\S+ \(\S+–\S+, N \d+\)", terms.text(term))
+    # the truth of the white part is inside the ARW interval
+    low, high = terms.arw_interval
+    assert low < sigma / math.sqrt(FS) / 60.0 < high
+    assert NoiseTerms.from_dict(json.loads(json.dumps(terms.to_dict()))) == terms

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from hrgtc.core.errors import InputError
 from hrgtc.evaluation.allan import allan_deviation
 from hrgtc.evaluation.series_stats import SeriesStatistics
 
@@ -77,3 +78,49 @@ def test_bursts_shorter_than_tau_give_the_spread_of_their_burst_means():
     expected = np.std([b.mean() for b in bursts[:12]], ddof=1)
     assert stats.bias_stability()[10.0] == pytest.approx(expected, rel=1e-12)
     assert stats.partial_blocks()[10.0] == 12
+
+
+def test_pooled_interval_uses_the_segments_edf_in_both_paths():
+    from hrgtc.evaluation.allan import deviation_edf
+    from hrgtc.evaluation.allan_segments import pooled_edf
+
+    parts = _segments(4, sizes=(1500, 900, 2600))
+    lengths = [p.size for p in parts]
+    for full in (1 << 22, 2048):  # samples held, and the exact running sums past the cap
+        stats = SeriesStatistics(10.0, (1.0,), allan=True, full_samples=full)
+        for k, part in enumerate(parts):
+            stats.push(part, [0] if k else [])
+        curve = stats.allan_deviation(confidence=0.683)
+        assert curve.segments == 3 and stats.segment_lengths() == lengths
+        for tau, edf, low, dev, high in zip(curve.taus_s, curve.edf, curve.lower,
+                                            curve.deviation, curve.upper, strict=True):
+            m = round(tau * 10.0)
+            assert edf == pytest.approx(pooled_edf("allan", lengths, m), rel=1e-12)
+            assert low < dev < high
+        # the edf of one record of the total length (what was used before) is larger at
+        # long τ (the decimated path keeps only the short τ of its exact sums)
+        m = round(curve.taus_s[-1] * 10.0)
+        if full > 4096:
+            assert deviation_edf("allan", sum(lengths) + 1, m) > 1.3 * curve.edf[-1]
+
+
+def test_burst_means_beyond_a_segment_from_pushed_times():
+    """White rate noise σ = 1 at 50 Hz in 5 s bursts every 60 s: the burst-mean Allan
+    deviation at τ = 60 s is σ/√(τ·fs) within its 99 % interval, with r = 12 stated."""
+    rng = np.random.default_rng(12)
+    stats = SeriesStatistics(50.0, (10.0,), allan=True)
+    for k in range(300):
+        stats.push(rng.normal(size=250) + 3.0, [0] if k else [],
+                   time_s=60.0 * k + np.arange(250) / 50.0)
+    result = stats.burst_allan(confidence=0.99)
+    assert result.dead_time_ratio == pytest.approx(12.0) and result.bursts == 300
+    assert result.counts[0] == 299
+    theory = 1.0 / np.sqrt(60.0 * 50.0)
+    assert result.lower[0] < theory < result.upper[0]
+    lines = result.lines()
+    assert "r = 12" in lines[0] and "N = 299" in lines[1] and "random walk" in lines[1]
+    assert stats.segment_starts() == [250 * k for k in range(1, 300)]
+    one = SeriesStatistics(50.0, (10.0,), allan=True)
+    one.push(rng.normal(size=500))
+    with pytest.raises(InputError, match="one contiguous segment"):
+        one.burst_allan(0.683)

@@ -286,7 +286,9 @@ def test_intervals_and_noise_reasons_in_the_tables(unit, report):
     row10 = next(row for row in page.table(f"Bias stability of {files.cooldown.name}")
                  if row[0] == "10")
     low, high = result.stability_interval("raw", 10.0)
-    bounds = row10[1].split("(")[1].rstrip(")").split("–")
+    inside = row10[1].split("(")[1].rstrip(")")  # "low–high, N blocks"
+    bounds = inside.split(", N ")[0].split("–")
+    assert int(inside.split(", N ")[1]) == result.bias_stability_blocks["raw"][10.0]
     assert float(bounds[0]) == pytest.approx(low, rel=1e-2)
     assert float(bounds[1]) == pytest.approx(high, rel=1e-2)
     noise = page.table(f"Allan noise terms of {files.cooldown.name}")

@@ -133,6 +133,12 @@ class AllanResult:
         Confidence interval of the deviation at each τ, or None. [unit of deviation]
     confidence
         Confidence level of ``lower`` / ``upper`` (e.g. 0.683), or None.
+    segments
+        Contiguous segments the deviation was pooled over (1: one record; see
+        :mod:`hrgtc.evaluation.allan_segments`). No difference reaches across a gap and
+        ``counts`` is the sum of the segments' terms.
+    edf
+        Equivalent degrees of freedom of each τ behind ``lower`` / ``upper``, or None.
     """
 
     taus_s: np.ndarray
@@ -145,11 +151,13 @@ class AllanResult:
     lower: np.ndarray | None = None
     upper: np.ndarray | None = None
     confidence: float | None = None
+    segments: int = 1
+    edf: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         for name, dtype in (
             ("taus_s", np.float64), ("deviation", np.float64), ("counts", int),
-            ("lower", np.float64), ("upper", np.float64),
+            ("lower", np.float64), ("upper", np.float64), ("edf", np.float64),
         ):
             if getattr(self, name) is None:
                 continue
@@ -183,7 +191,8 @@ class AllanResult:
             header += f"  {'lower':>12}  {'upper':>12}   ({self.confidence:.3g} confidence)"
         lines = [
             f"{name} deviation, {spacing}; {self.n_samples} samples at "
-            f"{self.sample_rate_hz:g} Hz",
+            f"{self.sample_rate_hz:g} Hz"
+            + (f", pooled within {self.segments} segments" if self.segments > 1 else ""),
             header,
         ]
         for k, (t, d, c) in enumerate(zip(self.taus_s, self.deviation, self.counts, strict=True)):
@@ -263,16 +272,27 @@ def _overlapping_deviation(
         np.ascontiguousarray(values), "modified" if kind == "time" else kind, kept, report
     )
     counts = counts[counts > 1]
-    m = kept.astype(np.float64)
-    if kind == "allan":  # SP 1065 Eq. (11)
-        deviation = np.sqrt(sums / (2.0 * counts)) / m
-    elif kind == "hadamard":  # Eq. (20)
-        deviation = np.sqrt(sums / (6.0 * counts)) / m
-    else:  # Eq. (14); time deviation Eq. (15): τ·mod σ/√3
-        deviation = np.sqrt(sums / (2.0 * counts)) / (m * m)
-        if kind == "time":
-            deviation = deviation * (m / fs) / math.sqrt(3.0)
-    return kept, deviation, counts
+    return kept, deviation_from_sums(kind, sums, counts, kept, fs), counts
+
+
+def deviation_from_sums(kind: str, sums: np.ndarray, counts: np.ndarray, factors: np.ndarray,
+                        fs: float) -> np.ndarray:
+    """The deviation of ``kind`` from its sums of squared stencil terms and their counts.
+
+    ``sums`` are those of :func:`_allan_kernels.sums_of_squares` (of ``"modified"`` for
+    the time deviation); a pooled sum over segments divided by its pooled count gives the
+    pooled deviation.
+    """
+    m = np.asarray(factors, dtype=np.float64)
+    counts = np.asarray(counts, dtype=np.float64)
+    if kind == "allan":  # SP 1065 Eq. (11) (and Eq. 6-7: the same on every m-th point)
+        return np.sqrt(sums / (2.0 * counts)) / m
+    if kind == "hadamard":  # Eq. (20)
+        return np.sqrt(sums / (6.0 * counts)) / m
+    deviation = np.sqrt(sums / (2.0 * counts)) / (m * m)  # Eq. (14)
+    if kind == "time":  # Eq. (15): τ·mod σ/√3
+        deviation = deviation * (m / fs) / math.sqrt(3.0)
+    return deviation
 
 
 def _normal_allan(
@@ -408,7 +428,7 @@ def allan_deviation(
             f"no averaging time in taus={taus!r} fits a record of {n} samples at {fs:g} Hz "
             f"with at least 2 terms; use taus between {1.0 / fs:g} s and {(n - 1) / (2 * fs):g} s"
         )
-    lower = upper = None
+    lower = upper = edf = None
     if confidence is not None:
         # non-overlapping: the τ-means form a record of n // m samples read at m = 1, where
         # the overlapping and the normal estimator coincide
@@ -427,4 +447,5 @@ def allan_deviation(
         lower=lower,
         upper=upper,
         confidence=None if confidence is None else float(confidence),
+        edf=edf,
     )

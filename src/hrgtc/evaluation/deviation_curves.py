@@ -4,17 +4,14 @@ and its JSON form."""
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
-from hrgtc.evaluation.allan import (
-    AllanResult,
-    allan_deviation,
-    confidence_interval,
-    equivalent_degrees_of_freedom,
-)
+from hrgtc.evaluation.allan import AllanResult
+from hrgtc.evaluation.allan_segments import pooled_deviation
+from hrgtc.evaluation.metrics import bias_stability_interval
+from hrgtc.evaluation.series_stats import SeriesStatistics
 
 #: ``--deviation`` names -> (kind of :func:`allan_deviation`, overlapping), after allantools.
 DEVIATIONS = {"adev": ("allan", False), "oadev": ("allan", True), "mdev": ("modified", True),
@@ -37,16 +34,39 @@ def _curve(allan: AllanResult) -> dict[str, Any]:
             "n": allan.counts.tolist(), "kind": allan.kind, "overlapping": allan.overlapping}
 
 
-def _with_interval(result: AllanResult, n_samples: int, confidence: float) -> AllanResult:
-    """The overlapping Allan deviation with its chi-squared interval (SP 1065 simple edf)."""
-    m = np.rint(result.taus_s * result.sample_rate_hz).astype(np.int64)
-    edf = np.array([equivalent_degrees_of_freedom(n_samples + 1, int(k)) for k in m])
-    lower, upper = confidence_interval(result.deviation, edf, confidence)
-    return replace(result, lower=lower, upper=upper, confidence=float(confidence))
-
-
-def _deviation(values: np.ndarray, fs: float, deviation: str, confidence: float) -> AllanResult:
-    """The run's deviation curve with its confidence interval (SP 1065 Section 5.3)."""
+def _deviation(values: np.ndarray, fs: float, deviation: str, confidence: float,
+               breaks: list[int] | None = None) -> AllanResult:
+    """The run's deviation curve, pooled within the segments that start at ``breaks``,
+    with its confidence interval (SP 1065 Section 5.3; pooled edf)."""
     kind, overlapping = DEVIATIONS[deviation]
-    return allan_deviation(values, fs, taus="octave", kind=kind, overlapping=overlapping,
-                           confidence=confidence)
+    return pooled_deviation(values, fs, breaks or [], "octave", overlapping, kind=kind,
+                            confidence=confidence)
+
+
+def stability_intervals(table: dict[float, float], blocks: dict[float, int],
+                        confidence: float) -> dict[float, tuple[float, float]]:
+    """The chi-squared interval of each bias stability from its own number of τ-blocks."""
+    return {tau: bias_stability_interval(value, blocks.get(tau, 0), confidence)
+            for tau, value in table.items()}
+
+
+def segment_notes(key: str, series: SeriesStatistics, stability: dict[float, float],
+                  allan: bool) -> list[str]:
+    """What a recording of segments does to the figures of one series (none for one)."""
+    if series.segments < 2:
+        return []
+    notes = []
+    longest = series.longest_segment_s
+    missing = [tau for tau, value in stability.items() if math.isnan(value) and tau > longest]
+    if missing:
+        notes.append(
+            f"{key}: bias stability at τ = {', '.join(f'{t:g}' for t in missing)} s not "
+            f"estimable: τ-means never span a gap and the longest of the "
+            f"{series.segments} segments holds {longest:.6g} s (means of bursts across "
+            "the gaps would carry the dead time's bias)")
+    if allan:
+        notes.append(
+            f"{key}: deviation pooled within {series.segments} segments, no difference "
+            f"across a gap (N: terms summed over the segments; interval from their pooled "
+            f"edf); τ beyond {longest / 2:.6g} s (half the longest segment) not in the curve")
+    return notes

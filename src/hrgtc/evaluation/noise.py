@@ -60,6 +60,13 @@ class NoiseTerms:
         The smallest usable deviation σ_min (an upper bound of 0.664·B). [°/h]
     arw_reason, bias_instability_reason, rrw_reason
         Why a term is None (None when it was read).
+    arw_interval, bias_instability_interval, rrw_interval
+        Confidence interval of each term read, where the deviation carries one: the
+        bias instability's is the interval of σ_min over 0.664; a fitted line's is the
+        fit's weighted mean of its points' log-interval half-widths (the points share
+        their data, so treating them as fully correlated is the conservative choice).
+    arw_n, bias_instability_n, rrw_n
+        Terms behind each (the fewest among a line's points).
     """
 
     arw_deg_per_rt_h: float | None
@@ -73,6 +80,12 @@ class NoiseTerms:
     arw_reason: str | None = None
     bias_instability_reason: str | None = None
     rrw_reason: str | None = None
+    arw_interval: tuple[float, float] | None = None
+    bias_instability_interval: tuple[float, float] | None = None
+    rrw_interval: tuple[float, float] | None = None
+    arw_n: int | None = None
+    bias_instability_n: int | None = None
+    rrw_n: int | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types (τ ranges as lists)."""
@@ -95,7 +108,11 @@ class NoiseTerms:
                  "rrw": self.rrw_dph_per_rt_h}[term]
         if value is None:
             return getattr(self, f"{term}_reason") or "n/a"
-        return f"{value:.{digits}g}"
+        bounds, n = getattr(self, f"{term}_interval"), getattr(self, f"{term}_n")
+        if bounds is None:
+            return f"{value:.{digits}g}"
+        return (f"{value:.{digits}g} ({bounds[0]:.{digits - 1}g}–{bounds[1]:.{digits - 1}g}"
+                f", N {n})")
 
     def summary(self) -> str:
         """Three lines, one per noise term, with the τ range each was read from."""
@@ -181,6 +198,11 @@ def noise_terms(
     usable = allan.blocks >= min_blocks
     taus = allan.taus_s[usable]
     dev = allan.deviation[usable]
+    counts = allan.counts[usable]
+    ci = allan.lower is not None and allan.upper is not None
+    if ci:  # log half-widths of each point's interval
+        log_low = np.log(allan.lower[usable] / dev)
+        log_high = np.log(allan.upper[usable] / dev)
     if taus.size < 3:
         raise InputError(
             f"noise terms need at least 3 averaging times with >= {min_blocks} blocks each, "
@@ -199,13 +221,16 @@ def noise_terms(
     tol = slope_tolerance
     last = taus.size - 1
 
-    arw = arw_taus = arw_reason = None
+    arw = arw_taus = arw_reason = arw_ci = arw_n = None
     pick = (index <= i_min) & (np.abs(slope + 0.5) <= tol)
     if pick.sum() >= min_points:
         log_n = np.average(log_dev[pick] + 0.5 * log_tau[pick], weights=weights[pick])
         # weighted least squares of ln σ = ln N − ½ ln τ; ARW = σ(1 h) = N/60
         arw = math.exp(log_n) / math.sqrt(SECONDS_PER_HOUR)
         arw_taus = (float(taus[pick][0]), float(taus[pick][-1]))
+        if ci:
+            arw_ci = _line_interval(arw, log_low, log_high, weights, pick)
+            arw_n = int(counts[pick].min())
     elif i_min == 0:
         arw_reason = (f"no −½ slope: the curve does not fall from its first τ ({taus[0]:g} s; "
                       f"it goes as {_law(slope[0])})")
@@ -215,7 +240,7 @@ def noise_terms(
                       f"{_law(float(np.median(slope[: i_min + 1])))} there")
 
     floor = i_min < last
-    bias = bias_reason = None
+    bias = bias_reason = bias_ci = bias_n = None
     if not floor:
         bound = dev[last] / FLICKER_FLOOR_FACTOR
         bias_reason = (f"no flat minimum: the curve still falls as {_law(slope[last])} at the "
@@ -226,8 +251,12 @@ def noise_terms(
         bias_reason = f"no flat minimum: the curve goes as {_law(slope[i_min])} at its minimum"
     else:
         bias = float(dev[i_min]) / FLICKER_FLOOR_FACTOR
+        if ci:
+            bias_ci = (bias * math.exp(float(log_low[i_min])),
+                       bias * math.exp(float(log_high[i_min])))
+            bias_n = int(counts[i_min])
 
-    rrw = rrw_taus = rrw_reason = None
+    rrw = rrw_taus = rrw_reason = rrw_ci = rrw_n = None
     pick = (index > i_min) & (np.abs(slope - 0.5) <= tol)
     rising = (index > i_min) & (slope >= 0.5 - tol)
     rise = (float(np.polyfit(log_tau[rising], log_dev[rising], 1)[0]) if rising.sum() >= 2
@@ -247,6 +276,9 @@ def noise_terms(
         log_k = np.average(log_dev[pick] - 0.5 * log_tau[pick], weights=weights[pick])
         rrw = math.exp(log_k) * math.sqrt(3.0 * SECONDS_PER_HOUR)
         rrw_taus = (float(taus[pick][0]), float(taus[pick][-1]))
+        if ci:
+            rrw_ci = _line_interval(rrw, log_low, log_high, weights, pick)
+            rrw_n = int(counts[pick].min())
 
     return NoiseTerms(
         arw_deg_per_rt_h=arw,
@@ -260,4 +292,15 @@ def noise_terms(
         arw_reason=arw_reason,
         bias_instability_reason=bias_reason,
         rrw_reason=rrw_reason,
+        arw_interval=arw_ci, bias_instability_interval=bias_ci, rrw_interval=rrw_ci,
+        arw_n=arw_n, bias_instability_n=bias_n, rrw_n=rrw_n,
     )
+
+
+def _line_interval(value: float, log_low: np.ndarray, log_high: np.ndarray,
+                   weights: np.ndarray, pick: np.ndarray) -> tuple[float, float]:
+    """A fitted line's interval: its points' log half-widths averaged with the fit's weights
+    (the points share their data: as if fully correlated, the conservative choice)."""
+    low = float(np.average(log_low[pick], weights=weights[pick]))
+    high = float(np.average(log_high[pick], weights=weights[pick]))
+    return value * math.exp(low), value * math.exp(high)

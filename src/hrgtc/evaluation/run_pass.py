@@ -38,19 +38,17 @@ from hrgtc.evaluation.allan import (
     ONE_SIGMA,
     AllanResult,
 )
+from hrgtc.evaluation.burst_allan import BurstAllanResult
 from hrgtc.evaluation.deviation_curves import (
     DEVIATIONS,
     _curve,
     _deviation,
     _finite,
-    _with_interval,
+    segment_notes,
+    stability_intervals,
 )
 from hrgtc.evaluation.heating_cooling import DirectionSplit, DirectionStats
-from hrgtc.evaluation.metrics import (
-    DEFAULT_TAUS_S,
-    bias_stability_intervals,
-    table_to_json,
-)
+from hrgtc.evaluation.metrics import DEFAULT_TAUS_S, table_to_json
 from hrgtc.evaluation.noise import NoiseTerms, noise_terms
 from hrgtc.evaluation.plot_blocks import BlockMeans, block_rows
 from hrgtc.evaluation.series_stats import SeriesStatistics
@@ -122,6 +120,12 @@ class Evaluation:
         are not (a +136 °/h mean residual is not a 36 °/h bias stability). [°/h]
     n_not_at_rest
         Samples left out of the figures because they were not at rest.
+    bias_stability_blocks
+        ``{series: {tau_s: N}}``: the τ-blocks behind each bias stability (partial blocks
+        at gaps included); its interval has N − 1 degrees of freedom.
+    burst_allan
+        ``{series: result}``: the Allan deviation beyond a segment from burst means
+        (:mod:`hrgtc.evaluation.burst_allan`), for recordings of regular bursts only.
     """
 
     file: str
@@ -149,6 +153,8 @@ class Evaluation:
     rms_dph: dict[str, float] = field(default_factory=dict)
     n_not_at_rest: int = 0
     accounting: Accounting | None = None
+    bias_stability_blocks: dict[str, dict[float, int]] = field(default_factory=dict)
+    burst_allan: dict[str, BurstAllanResult] = field(default_factory=dict)
 
     @property
     def name(self) -> str:
@@ -171,14 +177,18 @@ class Evaluation:
         return None if bounds is None or math.isnan(bounds[0]) else bounds
 
     def stability_text(self, series: str, tau_s: float, digits: int = 4) -> str:
-        """A bias stability with its interval, e.g. ``0.957 (0.93–0.99)``; ``-`` if none."""
+        """A bias stability with its interval and N, e.g. ``0.957 (0.93–0.99, N 360)``;
+        ``-`` if none."""
         value = self.stability(series, tau_s)
         if value is None:
             return "-"
+        count = self.bias_stability_blocks.get(series, {}).get(float(tau_s))
+        n = "" if count is None else f"N {count}"
         bounds = self.stability_interval(series, tau_s)
         if bounds is None:
-            return f"{value:.{digits}g}"
-        return f"{value:.{digits}g} ({bounds[0]:.{digits - 1}g}–{bounds[1]:.{digits - 1}g})"
+            return f"{value:.{digits}g}" + (f" ({n})" if n else "")
+        return (f"{value:.{digits}g} ({bounds[0]:.{digits - 1}g}–{bounds[1]:.{digits - 1}g}"
+                + (f", {n})" if n else ")"))
 
     @property
     def prediction_std_dph(self) -> dict[str, float] | None:
@@ -240,6 +250,9 @@ class Evaluation:
                 k: {f"{t:g}": (None if math.isnan(b[0]) else [float(b[0]), float(b[1])])
                     for t, b in row.items()}
                 for k, row in self.bias_stability_interval_dph.items()},
+            "bias_stability_n": {k: {f"{t:g}": int(c) for t, c in row.items()}
+                                 for k, row in self.bias_stability_blocks.items()},
+            "allan_burst_means": {k: b.to_dict() for k, b in self.burst_allan.items()},
             "prediction_std_dph": self.prediction_std_dph,
             "out_of_range_fraction": self.out_of_range_fraction,
             "rate_out_of_range_fraction": self.rate_out_of_range_fraction,
@@ -354,9 +367,11 @@ def run_pass(
     deviation
         The deviation curve: ``"oadev"`` (overlapping Allan, default), ``"adev"``
         (non-overlapping), ``"mdev"``, ``"hdev"``, ``"tdev"`` (:data:`DEVIATIONS`).
-        Noise terms are read off the Allan deviations only; the chi-squared interval
-        (simple edf, white rate noise, SP 1065 Table 5) is given for ``"oadev"`` and
-        ``"adev"``.
+        Noise terms are read off the Allan deviations only. Every curve is pooled within
+        the segments (no difference across a gap) with its chi-squared interval from the
+        pooled edf (:mod:`~hrgtc.evaluation.allan_segments`); τ beyond a burst comes from
+        burst means with the dead time's bias stated (``burst_allan``) or a note says why
+        it is not estimable.
     confidence
         Two-sided level of the intervals (bias stability and Allan deviation).
     keep
@@ -435,7 +450,7 @@ def run_pass(
     if metadata is None:
         raise InputError(f"{name}: the run holds no samples")
     fs = metadata.sample_rate_hz
-    n_used = frequency.samples - cut.finish(name)
+    cut.finish(name)
     n = frequency.samples
     if n < 2 * round(10.0 * fs):
         raise InputError(f"{name}: {n / fs:.1f} s is too short for a 10 s bias stability "
@@ -447,33 +462,29 @@ def run_pass(
     notes: list[str] = []
     mean: dict[str, float] = {}
     rms: dict[str, float] = {}
+    blocks: dict[str, dict[float, int]] = {}
+    bursts: dict[str, BurstAllanResult] = {}
     for key, series in full.items():
         stability[key] = series.bias_stability()
+        blocks[key] = series.blocks()
         mean[key], rms[key] = series.mean(), series.rms()
-        if series.segments > 1:
-            longest = series.longest_segment_s
-            missing = [tau for tau, value in stability[key].items()
-                       if math.isnan(value) and tau > longest]
-            if missing:
-                notes.append(
-                    f"{key}: bias stability at τ = {', '.join(f'{t:g}' for t in missing)} s not "
-                    f"estimable: τ-means never span a gap and the longest of the "
-                    f"{series.segments} segments holds {longest:.6g} s (means of bursts across "
-                    "the gaps would carry the dead time's bias)")
-            if allan:
-                notes.append(
-                    f"{key}: Allan deviation pooled over {series.segments} segments, no difference "
-                    f"across a gap; τ beyond {longest / 2:.6g} s (half the longest segment) not "
-                    "estimable")
-        intervals[key] = bias_stability_intervals(stability[key], n_used, fs, confidence)
+        notes.extend(segment_notes(key, series, stability[key], allan))
+        intervals[key] = stability_intervals(stability[key], blocks[key], confidence)
         if not allan:
             continue
+        if series.segments > 1:
+            try:
+                bursts[key] = series.burst_allan(confidence)
+                notes.extend(f"{key}: {line}" if k == 0 else line
+                             for k, line in enumerate(bursts[key].lines()))
+            except HrgtcError as exc:
+                notes.append(f"{key}: Allan deviation beyond a segment not estimable ({exc})")
         try:
             if deviation == "oadev":
-                deviations[key] = _with_interval(series.allan_deviation(), n_used, confidence)
+                deviations[key] = series.allan_deviation(confidence)
             else:  # the other deviations need the whole series (held in memory for them)
                 deviations[key] = _deviation(np.concatenate(whole[key])[cut.kept()], fs,
-                                             deviation, confidence)
+                                             deviation, confidence, series.segment_starts())
             if deviations[key].kind == "allan":
                 terms[key] = noise_terms(deviations[key])
         except HrgtcError as exc:
@@ -500,6 +511,7 @@ def run_pass(
         deviation=deviation, directions=split.result(), mean_dph=mean, rms_dph=rms,
         n_not_at_rest=left_out,
         accounting=_accounting(n, cut.cut, frequency, left_out),
+        bias_stability_blocks=blocks, burst_allan=bursts,
     )
 
 

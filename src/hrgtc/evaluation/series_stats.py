@@ -33,15 +33,22 @@ Memory: at most :data:`FULL_SAMPLES` floats for the Allan deviation plus
 
 from __future__ import annotations
 
-import itertools
 import math
 from collections.abc import Sequence
+from dataclasses import replace
 
 import numpy as np
 
 from hrgtc.core.errors import InputError
 from hrgtc.core.timeline import min_partial_rows
-from hrgtc.evaluation.allan import AllanResult, _block_length, allan_deviation
+from hrgtc.evaluation.allan import (
+    AllanResult,
+    _block_length,
+    allan_deviation,
+    confidence_interval,
+)
+from hrgtc.evaluation.allan_segments import pooled_deviation, pooled_edf
+from hrgtc.evaluation.burst_allan import BurstAllanResult, burst_mean_allan
 
 #: Samples kept at full resolution for the Allan deviation (32 MiB per series).
 FULL_SAMPLES = 1 << 22
@@ -195,20 +202,25 @@ class SeriesStatistics:
         self._longest = 0
         self._full_breaks: list[int] = []  # sample indices where a segment starts
         self._coarse_crosses_gaps = False
+        # per segment: [time of its first sample (NaN if not given), samples, sum]
+        self._segments: list[list[float]] = []
 
-    def push(self, values: np.ndarray, breaks: Sequence[int] = ()) -> None:
+    def push(self, values: np.ndarray, breaks: Sequence[int] = (),
+             time_s: np.ndarray | None = None) -> None:
         """Add the next samples; ``breaks``: indices in ``values`` where a segment starts
-        after a gap (no τ-block and no Allan difference reaches across it)."""
+        after a gap (no τ-block and no Allan difference reaches across it); ``time_s``:
+        their times [s] (for the burst means beyond a segment)."""
         values = np.asarray(values, dtype=np.float64)
         cuts = sorted({int(b) for b in breaks if 0 <= b < values.size})
         if not cuts:
-            self._push(values)
+            self._push(values, time_s)
             return
         edges = [0, *[c for c in cuts if c > 0], values.size]
         for k in range(len(edges) - 1):
             if k > 0 or cuts[0] == 0:
                 self.break_segment()
-            self._push(values[edges[k]:edges[k + 1]])
+            self._push(values[edges[k]:edges[k + 1]],
+                       None if time_s is None else time_s[edges[k]:edges[k + 1]])
 
     def break_segment(self) -> None:
         """A gap before the next sample: the partial τ-blocks are dropped (a block never
@@ -234,7 +246,13 @@ class SeriesStatistics:
         """Duration of the longest contiguous segment pushed. [s]"""
         return max(self._longest, self._segment_samples) / self.sample_rate_hz
 
-    def _push(self, values: np.ndarray) -> None:
+    def _push(self, values: np.ndarray, time_s: np.ndarray | None = None) -> None:
+        if not values.size:
+            return
+        if self._segment_samples == 0:
+            self._segments.append([math.nan if time_s is None else float(time_s[0]), 0, 0.0])
+        self._segments[-1][1] += values.size
+        self._segments[-1][2] += float(np.sum(values))
         self.n += values.size
         self._sum += float(np.sum(values))
         self._sum_squares += float(np.dot(values, values))
@@ -291,20 +309,38 @@ class SeriesStatistics:
                 means.close_segment(min_partial_rows(means.rows))
         return {tau: means.std() for tau, means in self._stability.items()}
 
+    def blocks(self) -> dict[float, int]:
+        """``{tau_s: τ-blocks behind the bias stability}`` (partial ones at gaps included):
+        the N of each figure, whose interval has N − 1 degrees of freedom."""
+        self.bias_stability()  # closes the partial blocks of a segmented series
+        return {tau: means.count for tau, means in self._stability.items()}
+
     def partial_blocks(self) -> dict[float, int]:
         """``{tau_s: τ-blocks closed short at a gap}`` (kept from half τ)."""
         return {tau: means.partial for tau, means in self._stability.items()}
 
-    def allan_deviation(self) -> AllanResult:
-        """Overlapping Allan deviation at octave τ (see the module docstring)."""
+    def segment_lengths(self) -> list[int]:
+        """Samples of each contiguous segment pushed."""
+        return [int(seg[1]) for seg in self._segments]
+
+    def segment_starts(self) -> list[int]:
+        """Indices (in the samples pushed) where a segment starts after a gap."""
+        return np.cumsum(self.segment_lengths())[:-1].tolist()
+
+    def allan_deviation(self, confidence: float | None = None) -> AllanResult:
+        """Overlapping Allan deviation at octave τ (see the module docstring), pooled within
+        segments; with ``confidence`` its chi-squared interval from the pooled edf
+        (:func:`~hrgtc.evaluation.allan_segments.pooled_edf`: the segments' own edfs, not
+        one of the whole sample count)."""
         if not self.allan:
             raise InputError("the Allan deviation was not kept (allan=False)")
         fs = self.sample_rate_hz
         if self._full is not None:
             values = np.concatenate(self._full) if self._full else np.empty(0)
             if self._full_breaks:
-                return _pooled_allan(values, self._full_breaks, fs)
-            return allan_deviation(values, fs, taus="octave")
+                return pooled_deviation(values, fs, self._full_breaks, "octave",
+                                        confidence=confidence)
+            return allan_deviation(values, fs, taus="octave", confidence=confidence)
         block = self._decimated.rows
         coarse = allan_deviation(self._decimated.means(), fs / block, taus="octave")
         if self._coarse_crosses_gaps:  # block means across gaps: those τ are not estimable
@@ -316,34 +352,34 @@ class SeriesStatistics:
         usable = counts > 1
         m = self._exact.factors[small][usable].astype(np.float64)
         fine = np.sqrt(self._exact.sums[small][usable] / (2.0 * counts[usable])) / m
-        return AllanResult(
+        result = AllanResult(
             taus_s=np.concatenate([m / fs, coarse.taus_s]),
             deviation=np.concatenate([fine, coarse.deviation]),
             counts=np.concatenate([counts[usable], coarse.counts]),
-            overlapping=True, sample_rate_hz=fs, n_samples=self.n)
+            overlapping=True, sample_rate_hz=fs, n_samples=self.n,
+            segments=len(self._segments))
+        if confidence is None:
+            return result
+        lengths = self.segment_lengths()
+        edf = np.array([pooled_edf("allan", lengths, int(k)) for k in
+                        np.rint(result.taus_s * fs).astype(np.int64)])
+        lower, upper = confidence_interval(result.deviation, edf, confidence)
+        return replace(result, lower=lower, upper=upper, confidence=float(confidence), edf=edf)
 
+    def burst_allan(self, confidence: float) -> BurstAllanResult:
+        """Allan deviation beyond a segment from the segments' means, with the dead-time
+        ratio and its bias (:func:`~hrgtc.evaluation.burst_allan.burst_mean_allan`).
 
-def _pooled_allan(values: np.ndarray, breaks: Sequence[int], fs: float) -> AllanResult:
-    """Overlapping Allan deviation pooled over the segments between ``breaks``.
-
-    Each octave τ's squared second differences are summed inside every segment long
-    enough for it and divided by their total count: no difference crosses a gap. A τ
-    longer than every segment (2m + 1 samples) is not estimable from the samples and is
-    left out (burst means with dead time would give a biased estimate).
-    """
-    edges = [0, *breaks, values.size]
-    sums: dict[int, float] = {}
-    counts: dict[int, int] = {}
-    for a, b in itertools.pairwise(edges):
-        if b - a < 3:
-            continue
-        part = allan_deviation(values[a:b], fs, taus="octave")
-        for tau, dev, count in zip(part.taus_s, part.deviation, part.counts, strict=True):
-            m = round(tau * fs)
-            sums[m] = sums.get(m, 0.0) + float(dev) ** 2 * int(count)
-            counts[m] = counts.get(m, 0) + int(count)
-    factors = np.array(sorted(m for m in counts if counts[m] > 1), dtype=np.int64)
-    total = np.array([counts[m] for m in factors], dtype=np.int64)
-    deviation = np.array([math.sqrt(sums[m] / counts[m]) for m in factors])
-    return AllanResult(taus_s=factors / fs, deviation=deviation, counts=total,
-                       overlapping=True, sample_rate_hz=fs, n_samples=int(values.size))
+        Raises
+        ------
+        InputError
+            Not estimable: one segment, no times pushed, or no regular period.
+        """
+        if len(self._segments) < 2:
+            raise InputError("one contiguous segment: the pooled deviation covers every τ")
+        table = np.array(self._segments, dtype=np.float64)
+        starts, samples, sums = table[:, 0], table[:, 1], table[:, 2]
+        if not np.all(np.isfinite(starts)):
+            raise InputError("the segments' start times were not given")
+        return burst_mean_allan(sums / samples, samples / self.sample_rate_hz, starts,
+                                confidence=confidence)

@@ -92,7 +92,7 @@ class SettlingCut:
             breaks = np.concatenate([[0], breaks])
         self._last_kept = float(kept[-1])
         for key, array in values.items():
-            self.series[key].push(array[mask], breaks.tolist())
+            self.series[key].push(array[mask], breaks.tolist(), kept)
 
     def finish(self, name: str = "run") -> int:
         """Feed what is still held back; the number of samples left out (settling)."""
