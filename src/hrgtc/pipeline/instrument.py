@@ -37,6 +37,7 @@ from hrgtc.model import InstrumentModel, UnitModel, provenance
 from hrgtc.pipeline.calibration import HOUSING_TERMS, CalibrationResult, calibrate
 from hrgtc.recording import ReadOptions, Recording, axis_names
 from hrgtc.recording.marks import refuse_compensated_training
+from hrgtc.recording.read_once import ReadOnce
 from hrgtc.settings.calibration import CROSS_AXIS_GAIN, CalibrationSettings
 from hrgtc.settings.reading import ReadSettings
 from hrgtc.thermometry.prior import ThermometerPrior
@@ -178,7 +179,10 @@ def calibrate_instrument(
         raise InputError("no drift recordings given; pass --drift FILE (a cool-down or warm-up)")
     refuse_compensated_training([*soaks, *drifts, *validate, *rate_tables,
                                  *validate_rate_tables])
-    axes = axis_names(options.head(drifts[0]).names) or ("",)
+    axes = _axes_of(drifts[0], options)
+    if len(axes) > 1:  # every axis calibrated from one reading of each file
+        options = ReadOnce(**{f.name: getattr(options, f.name)
+                              for f in dataclasses.fields(ReadOptions)})
     table = read_segment_table(segment_table) if segment_table is not None else None
     results: dict[str, CalibrationResult] = {}
     models: dict[str, UnitModel] = {}
@@ -209,8 +213,8 @@ def calibrate_instrument(
                                  else str(segment_table)})
     models = {axis: dataclasses.replace(m, provenance=record) for axis, m in models.items()}
     instrument = InstrumentModel(models, unit, record)
-    held_out = options if validate_options is None else dataclasses.replace(
-        validate_options, thermometer=thermometer)
+    held_out = options if validate_options is None else _same_cache(dataclasses.replace(
+        validate_options, thermometer=thermometer), options)
     validation = {axis: tuple(evaluate(path, models[axis], allan=False,
                                        read_options=axis_options(held_out, axis))
                               for path in validate) for axis in axes}
@@ -218,6 +222,25 @@ def calibrate_instrument(
                    for path in validate_rate_tables)
     return InstrumentCalibration(instrument, results, validation,
                                  tuple(c for group in checks for c in group), crossed)
+
+
+def _axes_of(path: PathLike, options: ReadOptions) -> tuple[str, ...]:
+    """The axes of a recording (``("",)``: single-axis), from its column names."""
+    from hrgtc.compensate.multi_axis import recording_axes
+
+    found = recording_axes(path, options)
+    if found is None:  # the file cannot be opened: reading it says why
+        found = tuple(axis_names(options.head(path).names))
+    return found or ("",)
+
+
+def _same_cache(options: ReadOptions, cached: ReadOptions) -> ReadOptions:
+    """``options`` reading through the files already read by ``cached`` (a
+    :class:`ReadOnce`), if it is one."""
+    if not isinstance(cached, ReadOnce) or isinstance(options, ReadOnce):
+        return options
+    return ReadOnce(**{f.name: getattr(options, f.name)
+                       for f in dataclasses.fields(ReadOptions)}, cache=cached.cache)
 
 
 def _cross_axis(result: CalibrationResult, axis: str, axes: Sequence[str],
