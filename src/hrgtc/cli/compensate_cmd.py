@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
-import math
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -31,6 +29,7 @@ if TYPE_CHECKING:
     from hrgtc.compensate.ranges import RangeReport
     from hrgtc.evaluation import Evaluation
     from hrgtc.model import InstrumentModel
+    from hrgtc.pipeline.instrument import InstrumentEvaluation
     from hrgtc.recording import ReadOptions
 
 
@@ -94,12 +93,10 @@ def compensate_command(
     Example: hrgtc compensate warmup.parquet --model unit.json -o warmup_comp.parquet
     """
     from hrgtc.compensate import compensate_instrument_file
-    from hrgtc.compensate.model_fit import check_thermometer_kind
     from hrgtc.compensate.multi_axis import parse_axes
     from hrgtc.core.files import refuse_input
     from hrgtc.model import load_instrument
     from hrgtc.recording import ReadOptions
-    from hrgtc.thermometry.reference import options_with_map
 
     inputs = (inputs or ReadOptions()).with_spike_default("flag")
     if inputs.spike_filter == "drop":
@@ -109,12 +106,10 @@ def compensate_command(
     with library_errors(), progress_bar("compensating", enabled=not json_output) as progress:
         refuse_input(output, [run, model_path])
         model = load_instrument(model_path)
-        inputs = options_with_map(inputs, model.temperature_map)
-        for unit_model in model.axes.values():  # the error names the model file
-            check_thermometer_kind(inputs, unit_model, model_path)
         summary = compensate_instrument_file(run, output, model, force=force,
                                              chunk_rows=chunk_rows, progress=progress,
-                                             read_options=inputs, axes=parse_axes(axes))
+                                             read_options=inputs, axes=parse_axes(axes),
+                                             model_source=str(model_path))
     if json_output:
         print_json(summary.to_dict())
     else:
@@ -215,17 +210,14 @@ def evaluate_command(
     Example: hrgtc evaluate warmup.parquet --model unit.json --deviation oadev
     --allan-csv warmup_allan.csv --json
     """
-    from hrgtc.compensate.model_fit import check_thermometer_kind
-    from hrgtc.compensate.multi_axis import match_axes, parse_axes, recording_axes
+    from hrgtc.compensate.multi_axis import parse_axes
     from hrgtc.core.files import refuse_existing, refuse_input, write_text_atomic
-    from hrgtc.evaluation import evaluate
     from hrgtc.evaluation.run_pass import DEVIATIONS
     from hrgtc.model import load_instrument
+    from hrgtc.pipeline.instrument import evaluate_instrument
     from hrgtc.recording import ReadOptions
-    from hrgtc.thermometry.reference import options_with_map
 
     inputs = (inputs or ReadOptions()).with_spike_default("drop")
-
     if deviation not in DEVIATIONS:
         error_console.print(f"error: --deviation {deviation!r} is not known; use one of "
                             f"{', '.join(DEVIATIONS)}")
@@ -234,62 +226,40 @@ def evaluate_command(
         if allan_csv is not None:
             refuse_input(allan_csv, [run, model_path])
             refuse_existing(allan_csv, force)
-    results: dict[str, Evaluation] = {}
-    with library_errors():
         model = load_instrument(model_path)
-        inputs = options_with_map(inputs, model.temperature_map)
-        for unit_model in model.axes.values():  # before reading the recording's axes
-            check_thermometer_kind(inputs, unit_model, model_path)
-        model = match_axes(model, recording_axes(run, inputs), parse_axes(axes), str(run),
-                           str(model_path))
-    for axis, unit_model in model.axes.items():
-        label = "evaluating" + (f" axis {axis}" if axis else "")
-        with library_errors(), progress_bar(label, enabled=not json_output) as progress:
-            results[axis] = evaluate(
-                run, unit_model, progress=progress, deviation=deviation,
-                read_options=dataclasses.replace(inputs, axis=axis or None),
-                max_points=PREDICTION_BLOCKS)
-    with library_errors():
+        with progress_bar("evaluating", enabled=not json_output) as progress:
+            result = evaluate_instrument(
+                run, model, axes=parse_axes(axes), read_options=inputs, deviation=deviation,
+                max_points=PREDICTION_BLOCKS, progress=progress, model_source=str(model_path))
         if allan_csv is not None:
-            write_text_atomic(allan_csv, allan_text(results), force=force)
+            write_text_atomic(allan_csv, result.allan_csv(), force=force)
+    render_instrument_evaluation(result, json_output)
+    note_unchecked(model, model_path)
+    warn_ranges([r.ranges for r in result.axes.values()], json_output, strict,
+                list(result.axes))
+
+
+def render_instrument_evaluation(result: InstrumentEvaluation, json_output: bool) -> None:
+    """``hrgtc evaluate``'s output: each axis's table, the instrument's summary and the
+    scale-factor check (or the JSON document, the scale check on stderr)."""
+    model = result.model
     sensor = {axis: m.thermometer.source == "sensor" for axis, m in model.axes.items()}
-    if model.is_single_axis:
-        if json_output:
-            print_json(results[""].to_dict())
-        else:
-            render_evaluation(results[""], sensor[""])
-    elif json_output:
-        summary = [{k: None if isinstance(v, float) and not math.isfinite(v) else v
-                    for k, v in row.items()} for row in axis_summary(results)]  # NaN: no figure
-        print_json({"unit": model.unit, "axes": {a: r.to_dict() for a, r in results.items()},
-                    "summary": summary})
+    if json_output:
+        print_json(result.to_dict())
+    elif model.is_single_axis:
+        render_evaluation(result.axes[""], sensor[""])
     else:
-        for axis, result in results.items():
+        for axis, evaluation in result.axes.items():
             console.rule(f"axis {axis}")
-            render_evaluation(result, sensor[axis])
-        render_axis_summary(model.unit, results)
-    checks = scale_checks(run, model, inputs)
+            render_evaluation(evaluation, sensor[axis])
+        render_axis_summary(model.unit, result)
+    checks = result.scale_checks
     if checks and json_output:
         error_console.print("scale factor: " + "; ".join(
             f"axis {c.axis or '-'} {c.raw_max_ppm:.1f} → {c.compensated_max_ppm:.1f} ppm"
             for c in checks))
     elif checks:
         render_scale_checks(checks)
-    note_unchecked(model, model_path)
-    warn_ranges([r.ranges for r in results.values()], json_output, strict, list(results))
-
-
-def scale_checks(run: Path, model: InstrumentModel, inputs: ReadOptions) -> tuple:
-    """The scale-factor check of a rate-table run (it has input_rate_dph columns) when the
-    model has a scale factor; () otherwise."""
-    from hrgtc.pipeline.instrument import check_scale_factor
-
-    if all(m.scale_factor is None for m in model.axes.values()):
-        return ()
-    names = inputs.head(run).names
-    if not any(n == "input_rate_dph" or n.startswith("input_rate_dph_") for n in names):
-        return ()
-    return check_scale_factor(run, model, inputs)
 
 
 def render_scale_checks(checks: tuple) -> None:
@@ -305,37 +275,13 @@ def render_scale_checks(checks: tuple) -> None:
     console.print(table)
 
 
-def allan_text(results: dict[str, Evaluation]) -> str:
-    """The Allan CSV of every axis (an ``axis`` column first when there are several)."""
-    if list(results) == [""]:
-        return results[""].allan_csv()
-    lines: list[str] = []
-    for axis, result in results.items():
-        header, *rows = result.allan_csv().splitlines()
-        if not lines:
-            lines.append("axis," + header)
-        lines.extend(f"{axis},{row}" for row in rows)
-    return "\n".join(lines) + "\n"
-
-
-def axis_summary(results: dict[str, Evaluation]) -> list[dict[str, float | str]]:
-    """One row per axis: 10 s bias stability raw and compensated, improvement, ranges."""
-    return [{"axis": axis, "raw_10s_dph": r.raw_10s, "compensated_10s_dph": r.compensated_10s,
-             "improvement_10s": r.improvement_10s,
-             "compensated_mean_dph": r.mean_dph.get("compensated", float("nan")),
-             "compensated_rms_dph": r.rms_dph.get("compensated", float("nan")),
-             "out_of_range_fraction": r.out_of_range_fraction,
-             "rate_out_of_range_fraction": r.rate_out_of_range_fraction}
-            for axis, r in results.items()]
-
-
-def render_axis_summary(unit: str, results: dict[str, Evaluation]) -> None:
+def render_axis_summary(unit: str, result: InstrumentEvaluation) -> None:
     """The instrument's summary table: one row per axis."""
     table = Table(title=f"{unit}: 10 s bias stability per axis (°/h)")
     for column in ("axis", "raw", "compensated", "improvement", "comp. mean", "comp. RMS",
                    "beyond T", "beyond df/dt"):
         table.add_column(column, justify="right")
-    for row in axis_summary(results):
+    for row in result.axis_summary():
         table.add_row(str(row["axis"]), f"{row['raw_10s_dph']:.4f}",
                       f"{row['compensated_10s_dph']:.4f}", f"{row['improvement_10s']:.2f}×",
                       f"{row['compensated_mean_dph']:+.4g}", f"{row['compensated_rms_dph']:.4g}",

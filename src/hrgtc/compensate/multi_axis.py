@@ -260,6 +260,7 @@ def compensate_instrument_file(
     drift: str = "frequency",
     read_options: rec_io.ReadOptions | None = None,
     axes: Sequence[str] | None = None,
+    model_source: str = "",
     **options: Any,
 ) -> CompensationSummary:
     """Compensate every axis of a recording file into a new file (bounded memory).
@@ -270,18 +271,19 @@ def compensate_instrument_file(
     ``compensate_file``. The model's temperature map (a raw count's map to °C from
     ``calibrate --temp-ref``) is applied unless ``read_options`` give their own
     scale and offset. The model's and the recording's axes must agree unless ``axes``
-    names those to compensate (:func:`match_axes`).
+    names those to compensate (:func:`match_axes`). ``model_source`` (the model file)
+    is named in the errors.
     """
     from hrgtc.thermometry.reference import options_with_map
 
     read_options = options_with_map(read_options, model.temperature_map)
     reading = read_options or rec_io.ReadOptions()
     for unit in model.axes.values():  # before reading: a model of the other thermometer kind
-        check_thermometer_kind(reading, unit)
+        check_thermometer_kind(reading, unit, model_source or None)
     found = recording_axes(source, reading)
     partial = bool(axes)
     if found is not None:
-        model = match_axes(model, found, axes, str(source))
+        model = match_axes(model, found, axes, str(source), model_source)
     if model.is_single_axis:
         return compensate_file(source, output, model.axes[""], drift=drift,
                                read_options=read_options, **options)

@@ -384,39 +384,76 @@ def run_pass(
     InputError
         The run holds no samples, or is shorter than two 10 s blocks.
     """
-    if deviation not in DEVIATIONS:
-        raise InputError(f"deviation={deviation!r} is not known; use one of {tuple(DEVIATIONS)}")
-    frequency = Compensator(model, gaps=gaps)
-    features = None
-    if block_rows:
-        features = FeatureStream(model.drift.settings, model.drift.variables, model.thermometer)
-    housing: Compensator | None = None
-    means = BlockMeans(block_rows) if block_rows else None
-    full: dict[str, SeriesStatistics] = {}
-    whole: dict[str, list[np.ndarray]] = {}  # only for deviations the streaming cannot give
-    squared_error = 0.0
-    left_out = 0
-    truth = False
-    metadata = None
-    for chunk in chunks:
-        if metadata is None:
-            metadata = chunk.metadata
-            truth = "bias_dph" in chunk
+    return RunPass(model, name, source=source, taus_s=taus_s, allan=allan,
+                   block_rows=block_rows, on_output=on_output, progress=progress,
+                   total_rows=total_rows, gaps=gaps, deviation=deviation,
+                   confidence=confidence, keep=keep).fit(chunks)
+
+
+class RunPass:
+    """The state of one pass over a run: :meth:`partial_fit` each consecutive chunk, then
+    :meth:`result`. :func:`run_pass` is "a new pass, then every chunk"; a pass per axis of a
+    multi-axis recording lets one reading of the file feed every axis
+    (:func:`hrgtc.evaluation.instrument_pass.evaluate_axes`). The parameters are those of
+    :func:`run_pass`."""
+
+    def __init__(self, model: UnitModel, name: str, *, source: str = "",
+                 taus_s: Sequence[float] = DEFAULT_TAUS_S, allan: bool = True,
+                 block_rows: int | None = None,
+                 on_output: Callable[[Recording], None] | None = None,
+                 progress: Progress | None = None, total_rows: int = 0,
+                 gaps: str = "ignore", deviation: str = "oadev",
+                 confidence: float = ONE_SIGMA, keep: np.ndarray | None = None) -> None:
+        if deviation not in DEVIATIONS:
+            raise InputError(
+                f"deviation={deviation!r} is not known; use one of {tuple(DEVIATIONS)}")
+        self.model, self.name, self.source = model, name, source
+        self.taus_s, self.allan, self.gaps = taus_s, allan, gaps
+        self.deviation, self.confidence, self.keep = deviation, confidence, keep
+        self.on_output, self.progress, self.total_rows = on_output, progress, total_rows
+        self.frequency = Compensator(model, gaps=gaps)
+        self.features = None
+        if block_rows:
+            self.features = FeatureStream(model.drift.settings, model.drift.variables,
+                                          model.thermometer)
+        self.housing: Compensator | None = None
+        self.means = BlockMeans(block_rows) if block_rows else None
+        self.full: dict[str, SeriesStatistics] = {}
+        # only for deviations the streaming cannot give
+        self.whole: dict[str, list[np.ndarray]] = {}
+        self.squared_error = 0.0
+        self.left_out = 0
+        self.truth = False
+        self.metadata: Any = None
+
+    def fit(self, chunks: Iterable[Recording]) -> Evaluation:
+        """Every chunk of the run, then the result."""
+        for chunk in chunks:
+            self.partial_fit(chunk)
+        return self.result()
+
+    def partial_fit(self, chunk: Recording) -> RunPass:
+        """Compensate and measure the next chunk of the run."""
+        model, gaps, allan, deviation = self.model, self.gaps, self.allan, self.deviation
+        if self.metadata is None:
+            self.metadata = metadata = chunk.metadata
+            self.truth = "bias_dph" in chunk
             if model.housing is not None and "housing_c" in chunk:
-                housing = Compensator(model, "housing", gaps=gaps)
-            keys = SERIES if housing is not None else SERIES[:2]
-            full = {key: SeriesStatistics(metadata.sample_rate_hz, taus_s, allan,
-                                          expected_samples=total_rows)
-                    for key in keys}
-            cut = SettlingCut(full, model.drift.settings.warmup_s,
-                               1.0 / metadata.sample_rate_hz,
-                               2 * round(10.0 * metadata.sample_rate_hz),
-                               restart_at_gaps=gaps == "split",
-                               keep_mask=allan and deviation != "oadev")
-            split = DirectionSplit(model, metadata.sample_rate_hz)
+                self.housing = Compensator(model, "housing", gaps=gaps)
+            keys = SERIES if self.housing is not None else SERIES[:2]
+            self.full = {key: SeriesStatistics(metadata.sample_rate_hz, self.taus_s, allan,
+                                               expected_samples=self.total_rows)
+                         for key in keys}
+            self.cut = SettlingCut(self.full, model.drift.settings.warmup_s,
+                                   1.0 / metadata.sample_rate_hz,
+                                   2 * round(10.0 * metadata.sample_rate_hz),
+                                   restart_at_gaps=gaps == "split",
+                                   keep_mask=allan and deviation != "oadev")
+            self.split = DirectionSplit(model, metadata.sample_rate_hz)
+        metadata, frequency, housing = self.metadata, self.frequency, self.housing
         out = frequency.process(chunk)
-        if on_output is not None:
-            on_output(out)
+        if self.on_output is not None:
+            self.on_output(out)
         raw = chunk.rate_dph - metadata.input_rate_dph
         comp = out["rate_comp_dph"] - metadata.input_rate_dph
         pushed = {"raw": raw, "compensated": comp}
@@ -427,92 +464,103 @@ def run_pass(
             comp_h = housing.process(chunk)["rate_comp_dph"] - metadata.input_rate_dph
             pushed["housing"] = comp_h
             columns["comp_housing_dph"] = comp_h
-        if keep is not None:
-            kept = keep[frequency.samples - len(chunk):frequency.samples]
-            left_out += int(np.count_nonzero(~kept))
+        if self.keep is not None:
+            kept = self.keep[frequency.samples - len(chunk):frequency.samples]
+            self.left_out += int(np.count_nonzero(~kept))
             pushed = {key: values[kept] for key, values in pushed.items()}
-        cut.push(pushed, chunk.time_s if keep is None else chunk.time_s[kept])
+        self.cut.push(pushed, chunk.time_s if self.keep is None else chunk.time_s[kept])
         if allan and deviation != "oadev":
             for key, values in pushed.items():
-                whole.setdefault(key, []).append(values)
-        split.push(chunk, raw, comp, out["bias_model_dph"] - chunk["bias_dph"] if truth else None)
+                self.whole.setdefault(key, []).append(values)
+        truth = self.truth
+        self.split.push(chunk, raw, comp,
+                        out["bias_model_dph"] - chunk["bias_dph"] if truth else None)
         if truth:
             columns["true_dph"] = chunk["bias_dph"]
-            squared_error += float(np.sum((out["bias_model_dph"] - chunk["bias_dph"]) ** 2))
-        if means is not None:
+            self.squared_error += float(np.sum((out["bias_model_dph"] - chunk["bias_dph"]) ** 2))
+        if self.means is not None:
             columns.update({k: chunk[k] for k in ("resonator_c", "housing_c", "chamber_c")
                             if k in chunk})
-            assert features is not None
-            columns.update({VARIABLE_PREFIX + k: v for k, v in features.process(chunk).items()})
-            means.push(columns)
-        if progress is not None:
-            progress(frequency.samples, total_rows)
-    if metadata is None:
-        raise InputError(f"{name}: the run holds no samples")
-    fs = metadata.sample_rate_hz
-    cut.finish(name)
-    n = frequency.samples
-    if n < 2 * round(10.0 * fs):
-        raise InputError(f"{name}: {n / fs:.1f} s is too short for a 10 s bias stability "
-                         "(it needs at least 20 s)")
-    stability: dict[str, dict[float, float]] = {}
-    intervals: dict[str, dict[float, tuple[float, float]]] = {}
-    deviations: dict[str, AllanResult] = {}
-    terms: dict[str, NoiseTerms] = {}
-    notes: list[str] = []
-    mean: dict[str, float] = {}
-    rms: dict[str, float] = {}
-    blocks: dict[str, dict[float, int]] = {}
-    bursts: dict[str, BurstAllanResult] = {}
-    for key, series in full.items():
-        stability[key] = series.bias_stability()
-        blocks[key] = series.blocks()
-        mean[key], rms[key] = series.mean(), series.rms()
-        notes.extend(segment_notes(key, series, stability[key], allan))
-        intervals[key] = stability_intervals(stability[key], blocks[key], confidence)
-        if not allan:
-            continue
-        if series.segments > 1:
+            assert self.features is not None
+            columns.update({VARIABLE_PREFIX + k: v
+                            for k, v in self.features.process(chunk).items()})
+            self.means.push(columns)
+        if self.progress is not None:
+            self.progress(frequency.samples, self.total_rows)
+        return self
+
+    def result(self) -> Evaluation:
+        """The figures of the run so far (call once, after the last chunk)."""
+        model, name, allan, deviation = self.model, self.name, self.allan, self.deviation
+        confidence, frequency, means = self.confidence, self.frequency, self.means
+        metadata, full, whole, truth = self.metadata, self.full, self.whole, self.truth
+        if metadata is None:
+            raise InputError(f"{name}: the run holds no samples")
+        cut, split, left_out = self.cut, self.split, self.left_out
+        fs = metadata.sample_rate_hz
+        cut.finish(name)
+        n = frequency.samples
+        if n < 2 * round(10.0 * fs):
+            raise InputError(f"{name}: {n / fs:.1f} s is too short for a 10 s bias stability "
+                             "(it needs at least 20 s)")
+        stability: dict[str, dict[float, float]] = {}
+        intervals: dict[str, dict[float, tuple[float, float]]] = {}
+        deviations: dict[str, AllanResult] = {}
+        terms: dict[str, NoiseTerms] = {}
+        notes: list[str] = []
+        mean: dict[str, float] = {}
+        rms: dict[str, float] = {}
+        blocks: dict[str, dict[float, int]] = {}
+        bursts: dict[str, BurstAllanResult] = {}
+        for key, series in full.items():
+            stability[key] = series.bias_stability()
+            blocks[key] = series.blocks()
+            mean[key], rms[key] = series.mean(), series.rms()
+            notes.extend(segment_notes(key, series, stability[key], allan))
+            intervals[key] = stability_intervals(stability[key], blocks[key], confidence)
+            if not allan:
+                continue
+            if series.segments > 1:
+                try:
+                    bursts[key] = series.burst_allan(confidence)
+                    notes.extend(f"{key}: {line}" if k == 0 else line
+                                 for k, line in enumerate(bursts[key].lines()))
+                except HrgtcError as exc:
+                    notes.append(f"{key}: Allan deviation beyond a segment not estimable ({exc})")
             try:
-                bursts[key] = series.burst_allan(confidence)
-                notes.extend(f"{key}: {line}" if k == 0 else line
-                             for k, line in enumerate(bursts[key].lines()))
+                if deviation == "oadev":
+                    deviations[key] = series.allan_deviation(confidence)
+                else:  # the other deviations need the whole series (held in memory for them)
+                    deviations[key] = _deviation(np.concatenate(whole[key])[cut.kept()], fs,
+                                                 deviation, confidence, series.segment_starts())
+                if deviations[key].kind == "allan":
+                    terms[key] = noise_terms(deviations[key])
             except HrgtcError as exc:
-                notes.append(f"{key}: Allan deviation beyond a segment not estimable ({exc})")
-        try:
-            if deviation == "oadev":
-                deviations[key] = series.allan_deviation(confidence)
-            else:  # the other deviations need the whole series (held in memory for them)
-                deviations[key] = _deviation(np.concatenate(whole[key])[cut.kept()], fs,
-                                             deviation, confidence, series.segment_starts())
-            if deviations[key].kind == "allan":
-                terms[key] = noise_terms(deviations[key])
-        except HrgtcError as exc:
-            notes.append(f"{key}: no Allan noise terms ({exc})")
-    if frequency.unknown_orientation:
-        notes.append(f"{frequency.unknown_orientation} samples in an orientation the model was "
-                     "not trained in: their offset is unknown (the training mean is used)")
-    if allan and deviation not in ("adev", "oadev"):
-        notes.append(f"noise terms are read off the Allan deviation; --deviation {deviation} "
-                     "gives the curve only")
-    kept = None if means is None else means.means()
-    if kept is not None and model.drift.terms:
-        values_at = {k.removeprefix(VARIABLE_PREFIX): v for k, v in kept.items()
-                     if k.startswith(VARIABLE_PREFIX)}
-        kept["model_std_dph"] = model.drift.prediction_std(values_at)
-    return Evaluation(
-        name, n, float(fs), stability, deviations, terms, frequency.out_of_range_fraction,
-        frequency.rate_out_of_range_fraction,
-        math.sqrt(squared_error / n) if truth else None,
-        source=source, unit=metadata.unit, input_rate_dph=metadata.input_rate_dph,
-        block_s=None if means is None else means.rows / fs,
-        blocks=kept, notes=tuple(notes), ranges=frequency.ranges(),
-        bias_stability_interval_dph=intervals, confidence=float(confidence),
-        deviation=deviation, directions=split.result(), mean_dph=mean, rms_dph=rms,
-        n_not_at_rest=left_out,
-        accounting=_accounting(n, cut.cut, frequency, left_out),
-        bias_stability_blocks=blocks, burst_allan=bursts,
-    )
+                notes.append(f"{key}: no Allan noise terms ({exc})")
+        if frequency.unknown_orientation:
+            notes.append(f"{frequency.unknown_orientation} samples in an orientation the model was "
+                         "not trained in: their offset is unknown (the training mean is used)")
+        if allan and deviation not in ("adev", "oadev"):
+            notes.append(f"noise terms are read off the Allan deviation; --deviation {deviation} "
+                         "gives the curve only")
+        kept = None if means is None else means.means()
+        if kept is not None and model.drift.terms:
+            values_at = {k.removeprefix(VARIABLE_PREFIX): v for k, v in kept.items()
+                         if k.startswith(VARIABLE_PREFIX)}
+            kept["model_std_dph"] = model.drift.prediction_std(values_at)
+        return Evaluation(
+            name, n, float(fs), stability, deviations, terms, frequency.out_of_range_fraction,
+            frequency.rate_out_of_range_fraction,
+            math.sqrt(self.squared_error / n) if truth else None,
+            source=self.source, unit=metadata.unit, input_rate_dph=metadata.input_rate_dph,
+            block_s=None if means is None else means.rows / fs,
+            blocks=kept, notes=tuple(notes), ranges=frequency.ranges(),
+            bias_stability_interval_dph=intervals, confidence=float(confidence),
+            deviation=deviation, directions=split.result(), mean_dph=mean, rms_dph=rms,
+            n_not_at_rest=left_out,
+            accounting=_accounting(n, cut.cut, frequency, left_out),
+            bias_stability_blocks=blocks, burst_allan=bursts,
+        )
 
 
 def _accounting(read: int, settling: int, frequency: Compensator,

@@ -37,12 +37,13 @@ from hrgtc.model import InstrumentModel, UnitModel, provenance
 from hrgtc.pipeline.calibration import HOUSING_TERMS, CalibrationResult, calibrate
 from hrgtc.recording import ReadOptions, Recording, axis_names
 from hrgtc.recording.marks import refuse_compensated_training
+from hrgtc.recording.read_once import ReadOnce
 from hrgtc.settings.calibration import CROSS_AXIS_GAIN, CalibrationSettings
 from hrgtc.settings.reading import ReadSettings
 from hrgtc.thermometry.prior import ThermometerPrior
 
-__all__ = ["InstrumentCalibration", "ScaleFactorCheck", "calibrate_instrument",
-           "check_scale_factor"]
+__all__ = ["InstrumentCalibration", "InstrumentEvaluation", "ScaleFactorCheck",
+           "calibrate_instrument", "check_scale_factor", "evaluate_instrument"]
 
 PathLike = str | os.PathLike[str]
 
@@ -178,7 +179,10 @@ def calibrate_instrument(
         raise InputError("no drift recordings given; pass --drift FILE (a cool-down or warm-up)")
     refuse_compensated_training([*soaks, *drifts, *validate, *rate_tables,
                                  *validate_rate_tables])
-    axes = axis_names(options.head(drifts[0]).names) or ("",)
+    axes = _axes_of(drifts[0], options)
+    if len(axes) > 1:  # every axis calibrated from one reading of each file
+        options = ReadOnce(**{f.name: getattr(options, f.name)
+                              for f in dataclasses.fields(ReadOptions)})
     table = read_segment_table(segment_table) if segment_table is not None else None
     results: dict[str, CalibrationResult] = {}
     models: dict[str, UnitModel] = {}
@@ -209,8 +213,8 @@ def calibrate_instrument(
                                  else str(segment_table)})
     models = {axis: dataclasses.replace(m, provenance=record) for axis, m in models.items()}
     instrument = InstrumentModel(models, unit, record)
-    held_out = options if validate_options is None else dataclasses.replace(
-        validate_options, thermometer=thermometer)
+    held_out = options if validate_options is None else _same_cache(dataclasses.replace(
+        validate_options, thermometer=thermometer), options)
     validation = {axis: tuple(evaluate(path, models[axis], allan=False,
                                        read_options=axis_options(held_out, axis))
                               for path in validate) for axis in axes}
@@ -218,6 +222,25 @@ def calibrate_instrument(
                    for path in validate_rate_tables)
     return InstrumentCalibration(instrument, results, validation,
                                  tuple(c for group in checks for c in group), crossed)
+
+
+def _axes_of(path: PathLike, options: ReadOptions) -> tuple[str, ...]:
+    """The axes of a recording (``("",)``: single-axis), from its column names."""
+    from hrgtc.compensate.multi_axis import recording_axes
+
+    found = recording_axes(path, options)
+    if found is None:  # the file cannot be opened: reading it says why
+        found = tuple(axis_names(options.head(path).names))
+    return found or ("",)
+
+
+def _same_cache(options: ReadOptions, cached: ReadOptions) -> ReadOptions:
+    """``options`` reading through the files already read by ``cached`` (a
+    :class:`ReadOnce`), if it is one."""
+    if not isinstance(cached, ReadOnce) or isinstance(options, ReadOnce):
+        return options
+    return ReadOnce(**{f.name: getattr(options, f.name)
+                       for f in dataclasses.fields(ReadOptions)}, cache=cached.cache)
 
 
 def _cross_axis(result: CalibrationResult, axis: str, axes: Sequence[str],
@@ -355,3 +378,119 @@ def summary_rows(calibration: InstrumentCalibration) -> list[Mapping[str, Any]]:
                                           default=None),
         })
     return rows
+
+
+@dataclass(frozen=True, eq=False)
+class InstrumentEvaluation:
+    """What :func:`evaluate_instrument` measured: each axis's figures and the scale-factor
+    check of a rate-table run (the result of ``hrgtc evaluate``).
+
+    Attributes
+    ----------
+    model
+        The instrument's model as applied (its axes those evaluated).
+    axes
+        Axis (``""`` for a single-axis model) -> :class:`~hrgtc.evaluation.Evaluation`.
+    scale_checks
+        Scale-factor error at each temperature of a rate-table run, raw and compensated
+        (empty unless the run has ``input_rate_dph`` columns and the model a scale factor).
+    """
+
+    model: InstrumentModel
+    axes: dict[str, Evaluation]
+    scale_checks: tuple[ScaleFactorCheck, ...] = ()
+
+    def axis_summary(self) -> list[dict[str, float | str]]:
+        """One row per axis: 10 s bias stability raw and compensated, improvement, mean and
+        RMS of the compensated output, shares beyond the trained ranges. [°/h]"""
+        return [{"axis": axis, "raw_10s_dph": r.raw_10s,
+                 "compensated_10s_dph": r.compensated_10s,
+                 "improvement_10s": r.improvement_10s,
+                 "compensated_mean_dph": r.mean_dph.get("compensated", float("nan")),
+                 "compensated_rms_dph": r.rms_dph.get("compensated", float("nan")),
+                 "out_of_range_fraction": r.out_of_range_fraction,
+                 "rate_out_of_range_fraction": r.rate_out_of_range_fraction}
+                for axis, r in self.axes.items()]
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types (the layout of ``hrgtc evaluate --json``): a single-axis model's
+        evaluation as it is; else the unit, each axis and the summary (NaN: None)."""
+        if self.model.is_single_axis:
+            return self.axes[""].to_dict()
+        summary = [{k: None if isinstance(v, float) and not np.isfinite(v) else v
+                    for k, v in row.items()} for row in self.axis_summary()]
+        return {"unit": self.model.unit,
+                "axes": {a: r.to_dict() for a, r in self.axes.items()}, "summary": summary}
+
+    def allan_csv(self) -> str:
+        """The deviation curves of every axis as CSV (an ``axis`` column first when there
+        are several): series, tau_s, deviation, lower, upper, n."""
+        if list(self.axes) == [""]:
+            return self.axes[""].allan_csv()
+        lines: list[str] = []
+        for axis, result in self.axes.items():
+            header, *rows = result.allan_csv().splitlines()
+            if not lines:
+                lines.append("axis," + header)
+            lines.extend(f"{axis},{row}" for row in rows)
+        return "\n".join(lines) + "\n"
+
+
+def evaluate_instrument(
+    run: PathLike,
+    model: InstrumentModel,
+    *,
+    axes: Sequence[str] | None = None,
+    read_options: ReadOptions | None = None,
+    deviation: str = "oadev",
+    allan: bool = True,
+    max_points: int | None = None,
+    progress: Any = None,
+    model_source: str = "",
+) -> InstrumentEvaluation:
+    """Raw vs compensated figures of every axis of a run, the file read once for all axes.
+
+    The model's temperature map (``calibrate --temp-ref``) is applied unless
+    ``read_options`` give their own scale and offset; the model's and the run's axes must
+    agree unless ``axes`` names those to evaluate
+    (:func:`hrgtc.compensate.multi_axis.match_axes`). Each axis is measured as
+    :func:`hrgtc.evaluation.evaluate` measures a single-axis run
+    (:func:`hrgtc.evaluation.instrument_pass.evaluate_axes`); a rate-table run (with
+    ``input_rate_dph`` columns) of a model with a scale factor also gets its scale-factor
+    check (:func:`check_scale_factor`, which reads the run again: its holds are found on
+    the whole compensated run).
+
+    Parameters
+    ----------
+    run
+        The recording file.
+    model
+        The instrument's model (a single-axis model is the one-axis case).
+    axes
+        The axes to evaluate (``--axes``); None: all of them.
+    read_options
+        How to read the run.
+    deviation, allan, max_points
+        As :func:`hrgtc.evaluation.evaluate`.
+    progress
+        ``progress(rows done, rows)`` of the reading.
+    model_source
+        The model file's name, for the messages.
+    """
+    from hrgtc.compensate.model_fit import check_thermometer_kind
+    from hrgtc.compensate.multi_axis import match_axes, recording_axes
+    from hrgtc.evaluation.instrument_pass import evaluate_axes
+    from hrgtc.thermometry.reference import options_with_map
+
+    options = options_with_map(read_options or ReadOptions(), model.temperature_map)
+    for unit_model in model.axes.values():  # before reading the recording's axes
+        check_thermometer_kind(options, unit_model, model_source or None)
+    model = match_axes(model, recording_axes(run, options), axes, str(run), model_source)
+    results = evaluate_axes(run, model, read_options=options, deviation=deviation,
+                            allan=allan, max_points=max_points, progress=progress)
+    checks: tuple[ScaleFactorCheck, ...] = ()
+    if any(m.scale_factor is not None for m in model.axes.values()):
+        names = options.head(run).names
+        if any(n == "input_rate_dph" or n.startswith("input_rate_dph_") for n in names):
+            checks = check_scale_factor(run, model, options)
+    return InstrumentEvaluation(model, results, checks)
