@@ -22,6 +22,7 @@ from typing import Any
 
 from hrgtc.fleet.manifest import UnitFiles
 from hrgtc.recording import ReadOptions
+from hrgtc.settings.fleet import FleetEvaluation
 
 __all__ = ["UnitOutcome", "calibrate_unit", "evaluate_unit", "report_unit", "simulate_unit"]
 
@@ -178,7 +179,7 @@ def _write_outcome(output_dir: str, outcome: UnitOutcome) -> None:
 
 
 def evaluate_unit(files: UnitFiles, models_dir: str, read_options: ReadOptions | None = None,
-                  allan: bool = True) -> UnitOutcome:
+                  allan: bool = FleetEvaluation.allan) -> UnitOutcome:
     """Evaluate one unit's validation runs (or its drift runs without any) with its model."""
     start = time.perf_counter()
     try:

@@ -23,6 +23,7 @@ from hrgtc.fleet.manifest import UnitFiles, load_fleet
 from hrgtc.fleet.results import read_table, write_table
 from hrgtc.fleet.run import FleetRun, run_tasks
 from hrgtc.recording import ReadOptions
+from hrgtc.settings.fleet import SETPOINTS_C, FleetEvaluation, FleetSimulation
 
 __all__ = ["FLEET_TABLE", "build_prior", "calibrate_fleet", "evaluate_fleet", "report_fleet",
            "simulate_fleet"]
@@ -32,18 +33,18 @@ PathLike = str | os.PathLike[str]
 FLEET_TABLE = "fleet.parquet"
 #: The evaluation table written beside the models by ``fleet evaluate``.
 EVALUATION_TABLE = "evaluation.parquet"
-#: Chamber set-points of the paper's soaks (Table 1 of [1]). [°C]
-SETPOINTS_C = (-20.0, -10.0, 0.0, 10.0, 20.0, 30.0, 40.0)
+_SIM = FleetSimulation
 
 
 def _fleet(source: PathLike | Sequence[UnitFiles]) -> list[UnitFiles]:
     return list(source) if not isinstance(source, str | os.PathLike) else load_fleet(source)
 
 
-def simulate_fleet(output: PathLike, units: int, seed: int = 1, *,
-                   sample_rate_hz: float = 10.0, soak_hours: float = 5.0,
-                   ramp_hours: float = 5.0, setpoints_c: Sequence[float] = SETPOINTS_C,
-                   file_format: str = "parquet", force: bool = False,
+def simulate_fleet(output: PathLike, units: int, seed: int = _SIM.seed, *,
+                   sample_rate_hz: float = _SIM.sample_rate_hz, soak_hours: float = _SIM.soak_hours,
+                   ramp_hours: float = _SIM.ramp_hours,
+                   setpoints_c: Sequence[float] = SETPOINTS_C,
+                   file_format: str = _SIM.file_format, force: bool = False,
                    scheduler: str | None = None, workers: int | None = None,
                    progress: Progress | None = None) -> FleetRun:
     """Simulate ``units`` units of the population of ``seed`` under ``output/<unit>/``.
@@ -108,7 +109,8 @@ def calibrate_fleet(source: PathLike | Sequence[UnitFiles], output: PathLike, *,
 
 def evaluate_fleet(source: PathLike | Sequence[UnitFiles], models: PathLike,
                    output: PathLike | None = None, *, read_options: ReadOptions | None = None,
-                   allan: bool = True, force: bool = False, scheduler: str | None = None,
+                   allan: bool = FleetEvaluation.allan, force: bool = False,
+                   scheduler: str | None = None,
                    workers: int | None = None, progress: Progress | None = None) -> FleetRun:
     """Evaluate each unit's held-out runs with its model; write the evaluation table.
 

@@ -294,7 +294,8 @@ def _fit(runs: Sequence[Any], thermometer: Any, drift: DriftSettings,
         runs, thermometer, terms=drift.terms or drift_model.EQ21, window_s=drift.window_s,
         penter=drift.penter, premove=drift.premove, reference_c=drift.reference_c,
         rate_tau_s=drift.rate_tau_s, rate_tau2_s=drift.rate_tau2_s, warmup_s=drift.warmup_s,
-        select=drift.select, offsets=drift.offsets, aux_columns=aux,
+        select=drift.select, offsets=drift.offsets, autocorrelation=drift.autocorrelation,
+        hierarchical=drift.hierarchical, aux_columns=aux,
         excitation_runs=excitation_runs, progress=progress, motion=options.motion,
         gaps=options.gaps)
 

@@ -105,7 +105,7 @@ class Setting:
 def format_value(value: Any) -> str:
     """A default as text: a tuple of terms comma separated, None as "none"."""
     if isinstance(value, tuple):
-        return ",".join(str(v) for v in value)
+        return ",".join(f"{v:g}" if isinstance(v, float) else str(v) for v in value)
     if value is None:
         return "none"
     if isinstance(value, bool):
