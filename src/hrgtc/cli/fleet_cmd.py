@@ -17,7 +17,7 @@ from rich.table import Table
 from hrgtc.cli._app import app, console, error_console, library_errors, print_json, progress_bar
 from hrgtc.cli.options import ForceOption, JsonOption, reading_options
 from hrgtc.cli.params import option, split_values
-from hrgtc.settings.calibration import ThermometerSettings
+from hrgtc.settings.calibration import CalibrationSettings, ThermometerSettings
 from hrgtc.settings.drift import DriftSettings
 from hrgtc.settings.fleet import FleetEvaluation, FleetSimulation
 
@@ -137,9 +137,9 @@ def calibrate_command(
     """
     from hrgtc.fleet import calibrate_fleet, load_fleet
 
-    settings: dict[str, object] = {"order": order}
-    if terms is not None:
-        settings["terms"] = [t.strip() for t in terms.split(",") if t.strip()]
+    settings = CalibrationSettings(
+        thermometer=ThermometerSettings(order=order),
+        drift=DriftSettings(terms=None if terms is None else split_values(terms, str)))
     with library_errors():
         fleet = load_fleet(root, unit)
         with progress_bar("units", enabled=not json_output) as progress:

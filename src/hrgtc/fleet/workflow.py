@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import json
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -23,6 +23,7 @@ from hrgtc.fleet.manifest import UnitFiles, load_fleet
 from hrgtc.fleet.results import read_table, write_table
 from hrgtc.fleet.run import FleetRun, run_tasks
 from hrgtc.recording import ReadOptions
+from hrgtc.settings.calibration import CalibrationSettings
 from hrgtc.settings.fleet import SETPOINTS_C, FleetEvaluation, FleetSimulation
 
 __all__ = ["FLEET_TABLE", "build_prior", "calibrate_fleet", "evaluate_fleet", "report_fleet",
@@ -69,7 +70,7 @@ def simulate_fleet(output: PathLike, units: int, seed: int = _SIM.seed, *,
 
 
 def calibrate_fleet(source: PathLike | Sequence[UnitFiles], output: PathLike, *,
-                    settings: Mapping[str, Any] | None = None,
+                    settings: CalibrationSettings | None = None,
                     read_options: ReadOptions | None = None, resume: bool = False,
                     force: bool = False, prior: PathLike | None = None,
                     scheduler: str | None = None, workers: int | None = None,
@@ -86,7 +87,8 @@ def calibrate_fleet(source: PathLike | Sequence[UnitFiles], output: PathLike, *,
     source
         A manifest, a fleet folder, or the units' files.
     settings
-        Keyword arguments of :func:`~hrgtc.pipeline.calibration.calibrate` (order, terms, ...).
+        The calibration's settings (thermometer order, candidate terms, ...), the same for
+        every unit; None: the defaults.
     prior
         A prior file: every unit is calibrated with it (:mod:`hrgtc.thermometry.prior`).
     """
@@ -98,7 +100,7 @@ def calibrate_fleet(source: PathLike | Sequence[UnitFiles], output: PathLike, *,
                         "nothing was calibrated; --resume skips unchanged units")
     out.mkdir(parents=True, exist_ok=True)
     work = [(u.unit, tasks.calibrate_unit,
-             (u, str(out), dict(settings or {}), read_options, resume,
+             (u, str(out), settings or CalibrationSettings(), read_options, resume,
               None if prior is None else str(prior)))
             for u in fleet]
     run = run_tasks(work, scheduler=scheduler, workers=workers, progress=progress,
