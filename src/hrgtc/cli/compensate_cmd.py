@@ -24,6 +24,8 @@ from hrgtc.cli.options import (
     StrictOption,
     reading_options,
 )
+from hrgtc.cli.params import option
+from hrgtc.settings.compensation import CompensateSettings, EvaluationSettings
 
 if TYPE_CHECKING:
     from hrgtc.compensate.ranges import RangeReport
@@ -77,7 +79,7 @@ def compensate_command(
     run: Path = typer.Argument(..., help="Recording to compensate (.parquet, .csv, .h5)."),
     model_path: Path = typer.Option(..., "--model", "-m", help="Model file from 'calibrate'."),
     output: Path = typer.Option(..., "-o", "--output", help="Output recording (format by suffix)."),
-    chunk_rows: int = typer.Option(1 << 20, "--chunk-rows", help="Rows per processing chunk."),
+    chunk_rows: int = option(CompensateSettings, "chunk_rows"),
     force: ForceOption = False,
     strict: StrictOption = False,
     json_output: JsonOption = False,
@@ -190,10 +192,7 @@ def render_evaluation(result: Evaluation, sensor: bool = False) -> None:
 def evaluate_command(
     run: Path = typer.Argument(..., help="Recording to evaluate."),
     model_path: Path = typer.Option(..., "--model", "-m", help="Model file from 'calibrate'."),
-    deviation: str = typer.Option(
-        "oadev", "--deviation",
-        help="Deviation curve: oadev (overlapping Allan), adev (non-overlapping), mdev "
-             "(modified), hdev (Hadamard), tdev (time). Noise terms come from adev/oadev."),
+    deviation: str = option(EvaluationSettings, "deviation"),
     allan_csv: Path | None = typer.Option(
         None, "--allan-csv",
         help="Also write the curves: series, tau_s, deviation, lower, upper, n."),

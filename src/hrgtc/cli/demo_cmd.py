@@ -11,6 +11,8 @@ from hrgtc.cli._app import app, console, error_console, library_errors, print_js
 from hrgtc.cli.calibrate_cmd import render, render_instrument
 from hrgtc.cli.compensate_cmd import render_evaluation
 from hrgtc.cli.options import ForceOption, JsonOption
+from hrgtc.cli.params import option
+from hrgtc.settings.fleet import DemoSettings
 
 
 @app.command("demo")
@@ -18,7 +20,7 @@ def demo_command(
     output: Path = typer.Option(Path("demo-out"), "-o", "--output", help="Folder to write into."),
     quick: bool = typer.Option(
         False, "--quick", help="5 Hz and 3 h soaks instead of 200 Hz and 5 h (for tests)."),
-    seed: int = typer.Option(2012, help="Seed of the simulated campaign."),
+    seed: int = option(DemoSettings, "seed"),
     force: ForceOption = False,
     json_output: JsonOption = False,
 ) -> None:
@@ -28,12 +30,10 @@ def demo_command(
 
     Example: hrgtc demo -o demo-out --force
     """
-    from hrgtc.pipeline.demo import DemoSettings, run_demo
+    from hrgtc.pipeline.demo import run_demo
     from hrgtc.thermometry import paper
 
-    settings = DemoSettings.quick() if quick else DemoSettings()
-    settings = DemoSettings(settings.sample_rate_hz, settings.soak_hours, settings.ramp_hours, seed,
-                            settings.instrument_rate_hz)
+    settings = DemoSettings.quick(seed) if quick else DemoSettings(seed=seed)
     seen: set[str] = set()
 
     def progress(stage: str, done: float, total: float) -> None:

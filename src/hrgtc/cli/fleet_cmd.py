@@ -15,8 +15,11 @@ import typer
 from rich.table import Table
 
 from hrgtc.cli._app import app, console, error_console, library_errors, print_json, progress_bar
-from hrgtc.cli.calibrate_cmd import EQ21_DEFAULT
-from hrgtc.cli.options import ForceOption, JsonOption, OutputFormat, reading_options
+from hrgtc.cli.options import ForceOption, JsonOption, reading_options
+from hrgtc.cli.params import option, split_values
+from hrgtc.settings.calibration import CalibrationSettings, ThermometerSettings
+from hrgtc.settings.drift import DriftSettings
+from hrgtc.settings.fleet import FleetEvaluation, FleetSimulation
 
 if TYPE_CHECKING:
     from hrgtc.fleet import FleetRun
@@ -39,8 +42,6 @@ WorkersOption = Annotated[
     typer.Option("--workers", min=0,
                  help="Worker processes of the local cluster [default: one per core]; 0 runs "
                  "the units here, one after the other.", rich_help_panel=_CLUSTER)]
-#: Chamber set-points of the paper (Table 1), written out for --help.
-SETPOINTS_DEFAULT = "-20,-10,0,10,20,30,40"
 
 
 def _models_folder_inputs(models: Path) -> list[Path]:
@@ -77,21 +78,15 @@ def _finish(run: FleetRun, json_output: bool, written: str) -> None:
 
 @fleet_app.command("simulate")
 def simulate_command(
-    units: Annotated[int, typer.Option("--units", min=1, help="Number of units.")] = 32,
-    seed: Annotated[int, typer.Option(min=0, help="Seed of the population.")] = 1,
+    units: int = option(FleetSimulation, "units"),
+    seed: int = option(FleetSimulation, "seed"),
     output: Annotated[Path, typer.Option("-o", "--output", help="Fleet folder to write.")] = Path(
         "fleet"),
-    sample_rate_hz: Annotated[float, typer.Option("--sample-rate-hz", "--rate-hz",
-                                                  help="Sample rate [Hz].")] = 10.0,
-    soak_hours: Annotated[float, typer.Option("--soak-hours", help="Length of each soak [h].")
-                          ] = 5.0,
-    ramp_hours: Annotated[float, typer.Option("--ramp-hours",
-                                              help="Length of the cool-down and warm-up [h].")
-                          ] = 5.0,
-    setpoints: Annotated[str, typer.Option(help="Soak set-points, comma separated [°C].")
-                         ] = SETPOINTS_DEFAULT,
-    file_format: Annotated[OutputFormat, typer.Option("--format", help="File format.")
-                           ] = OutputFormat.parquet,
+    sample_rate_hz: float = option(FleetSimulation, "sample_rate_hz"),
+    soak_hours: float = option(FleetSimulation, "soak_hours"),
+    ramp_hours: float = option(FleetSimulation, "ramp_hours"),
+    setpoints: str = option(FleetSimulation, "setpoints_c"),
+    file_format: str = option(FleetSimulation, "file_format"),
     scheduler: SchedulerOption = None,
     workers: WorkersOption = None,
     force: ForceOption = False,
@@ -104,11 +99,11 @@ def simulate_command(
     from hrgtc.fleet import simulate_fleet
 
     with library_errors():
-        points = [float(v) for v in setpoints.split(",") if v.strip()]
+        points = list(split_values(setpoints))
         with progress_bar("units", enabled=not json_output) as progress:
             run = simulate_fleet(output, units, seed, sample_rate_hz=sample_rate_hz,
                                  soak_hours=soak_hours, ramp_hours=ramp_hours,
-                                 setpoints_c=points, file_format=file_format.value, force=force,
+                                 setpoints_c=points, file_format=file_format, force=force,
                                  scheduler=scheduler, workers=workers, progress=progress)
     _finish(run, json_output, str(output))
 
@@ -120,10 +115,8 @@ def calibrate_command(
         help="Fleet folder (ROOT/<unit>/{soaks,drift,validate}/) or manifest (.csv, .yaml).")],
     output: Annotated[Path, typer.Option("-o", "--output", help="Models folder.")] = Path(
         "models"),
-    order: Annotated[int, typer.Option(help="Order of the thermometer polynomial f(T).")] = 3,
-    terms: Annotated[str | None, typer.Option(
-        help="Candidate drift terms [default: as calibrate: f,f^2,f^3,g,f*g,f^2*g when the "
-        f"runs log housing_c, else Eq. 21's {EQ21_DEFAULT}].")] = None,
+    order: int = option(ThermometerSettings, "order"),
+    terms: str | None = option(DriftSettings, "terms"),
     prior: Annotated[Path | None, typer.Option(
         "--prior", help="Population prior (hrgtc fleet prior): fit each thermometer with it.")
     ] = None,
@@ -144,9 +137,9 @@ def calibrate_command(
     """
     from hrgtc.fleet import calibrate_fleet, load_fleet
 
-    settings: dict[str, object] = {"order": order}
-    if terms is not None:
-        settings["terms"] = [t.strip() for t in terms.split(",") if t.strip()]
+    settings = CalibrationSettings(
+        thermometer=ThermometerSettings(order=order),
+        drift=DriftSettings(terms=None if terms is None else split_values(terms, str)))
     with library_errors():
         fleet = load_fleet(root, unit)
         with progress_bar("units", enabled=not json_output) as progress:
@@ -163,8 +156,7 @@ def evaluate_command(
     models: Annotated[Path, typer.Option("--models", help="Models folder.")] = Path("models"),
     output: Annotated[Path | None, typer.Option(
         "-o", "--output", help="Evaluation table [default: MODELS/evaluation.parquet].")] = None,
-    allan: Annotated[bool, typer.Option("--allan/--no-allan",
-                                        help="Also compute the Allan noise terms.")] = True,
+    allan: bool = option(FleetEvaluation, "allan"),
     scheduler: SchedulerOption = None,
     workers: WorkersOption = None,
     force: ForceOption = False,

@@ -18,6 +18,13 @@ from hrgtc.cli.params import option_settings
 DOCUMENTED = {
     "calibrate": ("hrgtc.settings.calibration", "CalibrationSettings"),
     "reading": ("hrgtc.settings.reading", "ReadSettings"),
+    "compensate": ("hrgtc.settings.compensation", "CompensateSettings"),
+    "evaluate": ("hrgtc.settings.compensation", "EvaluationSettings"),
+    "report": ("hrgtc.settings.compensation", "ReportSettings"),
+    "export": ("hrgtc.settings.export", "ExportSettings"),
+    "fleet_simulate": ("hrgtc.settings.fleet", "FleetSimulation"),
+    "fleet_evaluate": ("hrgtc.settings.fleet", "FleetEvaluation"),
+    "demo": ("hrgtc.settings.fleet", "DemoSettings"),
 }
 
 
@@ -25,7 +32,7 @@ def options_table(cls: type) -> str:
     """A Markdown table of the options generated from ``cls``: option, default, meaning."""
     rows = ["| option | default | meaning |", "|---|---|---|"]
     for s in option_settings(cls):
-        text = s.full_help().replace("|", "\\|")
+        text = s.full_help().replace("|", "\\|").replace("<", "&lt;")
         rows.append(f"| `{s.option}` | {s.shown_default().replace('|', chr(92) + '|')} "
                     f"| {text} |")
     return "\n".join(rows)
@@ -46,9 +53,10 @@ def update_docs(text: str) -> str:
 
     def table(match: re.Match[str]) -> str:
         body = options_table(settings_class(match.group(2)))
-        return f"{match.group(1)}\n{body}\n{match.group(3)}"
+        return f"{match.group(1)}\n{body}\n{match.group(4)}"
 
-    return re.sub(r"(<!-- options: (\w+) -->)\n(?:.*?\n)?(<!-- /options -->)", table, text,
+    # lazy: an empty block ends at its own closing marker, not at a later table's
+    return re.sub(r"(<!-- options: (\w+) -->)\n(.*?)(<!-- /options -->)", table, text,
                   flags=re.S)
 
 

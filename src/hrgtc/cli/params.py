@@ -17,6 +17,7 @@ start-up keeps ``hrgtc --help`` quick.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import inspect
 import types
@@ -26,7 +27,7 @@ from typing import Any
 
 import typer
 
-from hrgtc.settings import Setting, build, settings_of
+from hrgtc.settings import Setting, build, format_value, settings_of
 
 
 def _is_terms(kind: Any) -> bool:
@@ -40,34 +41,71 @@ def parameter_name(setting: Setting) -> str:
     return setting.name
 
 
-def option_parameter(setting: Setting) -> inspect.Parameter:
-    """The keyword parameter (with its ``typer.Option``) of one setting."""
+def _option_info(setting: Setting, **extra: Any) -> Any:
+    """The ``typer.Option`` of one setting: its names, help, default and panel."""
     assert setting.option is not None
     default: Any = setting.default
-    annotation: Any = setting.type
-    if _is_terms(setting.type):
-        annotation = str | None
-        default = None if default is None else ",".join(default)
+    if _is_terms(setting.type) and default is not None:
+        default = format_value(default)
     show: bool | str = True
     if setting.default_text is not None:
         show = setting.default_text
     elif setting.default is None:
         show = False
+    return typer.Option(default, *setting.option.split(), help=setting.full_help(),
+                        show_default=show, metavar=setting.metavar,
+                        rich_help_panel=setting.panel, **extra)
+
+
+def option_parameter(setting: Setting) -> inspect.Parameter:
+    """The keyword parameter (with its ``typer.Option``) of one setting."""
+    annotation: Any = setting.type
+    if _is_terms(setting.type):
+        annotation = str | None
     if setting.choices:  # typer checks a Literal's values and lists them
         annotation = typing.Literal[setting.choices]  # type: ignore[valid-type]
         if setting.default is None:
             annotation = typing.Optional[annotation]  # noqa: UP045 (a runtime type)
-    option = typer.Option(default, *setting.option.split(), help=setting.full_help(),
-                          show_default=show, metavar=setting.metavar,
-                          rich_help_panel=setting.panel)
     return inspect.Parameter(parameter_name(setting), inspect.Parameter.KEYWORD_ONLY,
-                             default=option, annotation=annotation)
+                             default=_option_info(setting), annotation=annotation)
+
+
+def option(cls: type, name: str) -> Any:
+    """The ``typer.Option`` of the field ``name`` of the settings class ``cls``, for a
+    command that keeps its own parameter (``deviation: str = option(EvaluationSettings,
+    "deviation")``): the default, help, unit and choices come from the field.
+
+    A sequence field (a tuple) is given comma separated: the parameter is ``str`` and the
+    command splits it (:func:`split_values`).
+    """
+    (setting,) = [s for s in settings_of(cls) if s.path == (name,)]
+    if not setting.choices:
+        return _option_info(setting)
+    choices = setting.choices
+
+    def check(value: Any) -> Any:
+        if value is not None and value not in choices:
+            raise typer.BadParameter(f"{value!r} is not one of {', '.join(choices)}")
+        return value
+
+    metavar = setting.metavar or "[" + "|".join(choices) + "]"
+    return _option_info(dataclasses.replace(setting, metavar=metavar), callback=check)
+
+
+def split_values(text: str, kind: type = float) -> tuple[Any, ...]:
+    """A comma-separated option value as a tuple of ``kind`` (``"-20,0,20"``)."""
+    try:
+        return tuple(kind(v) for v in text.split(",") if v.strip())
+    except ValueError:
+        raise typer.BadParameter(f"{text!r} is not a comma-separated list of "
+                                 f"{kind.__name__} values, e.g. -20,0,20") from None
 
 
 def _value(setting: Setting, value: Any) -> Any:
     """A command-line value as the settings class takes it (terms: a tuple)."""
     if _is_terms(setting.type) and isinstance(value, str):
-        return tuple(t.strip() for t in value.split(",") if t.strip())
+        kind = float if "float" in str(setting.type) else str
+        return tuple(kind(t.strip()) for t in value.split(",") if t.strip())
     return value
 
 

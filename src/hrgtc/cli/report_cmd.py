@@ -9,6 +9,8 @@ import typer
 
 from hrgtc.cli._app import app, console, library_errors, print_json, progress_bar
 from hrgtc.cli.options import AxesOption, ForceOption, JsonOption, reading_options
+from hrgtc.cli.params import option
+from hrgtc.settings.compensation import ReportSettings
 
 if TYPE_CHECKING:
     from hrgtc.recording import ReadOptions
@@ -26,8 +28,7 @@ def report_command(
         None, "--soak", help="Soak recording for Figs. 3 and 5 (repeat); default: the soaks "
         "named in the model file, where they still exist."),
     title: str = typer.Option(None, "--title", help="Page title (default: names the unit)."),
-    max_points: int = typer.Option(
-        20_000, "--max-points", help="Most points per plotted curve (block means >= 10 s)."),
+    max_points: int = option(ReportSettings, "max_points"),
     force: ForceOption = False,
     json_output: JsonOption = False,
     axes: AxesOption = None,

@@ -51,12 +51,13 @@ from hrgtc.model import UnitModel
 from hrgtc.recording import Recording
 from hrgtc.recording.gaps import check_gap_policy
 from hrgtc.recording.marks import COMPENSATED_KEY, mark, refuse_compensated
+from hrgtc.settings.compensation import CompensateSettings
 
 #: Rows worked on at once: small enough for the temporaries to stay in cache.
 BLOCK_ROWS = 1 << 17
 #: Rows per chunk of :func:`compensate_file`: one Parquet row group, so chunks are read
 #: without joining batches and written without waiting for the next chunk.
-FILE_CHUNK_ROWS = 1 << 20
+FILE_CHUNK_ROWS = CompensateSettings.chunk_rows
 #: Columns added by compensation.
 OUTPUT_COLUMNS = ("rate_comp_dph", "bias_model_dph", "resonator_c_est", "in_range")
 #: Column added when the model has a scale factor: its error at each sample's frequency.

@@ -480,7 +480,11 @@ def write_text_atomic(path: PathLike, text: str, force: bool = False) -> Path:
     return target
 
 
-def file_sha256(path: PathLike, block_bytes: int = 1 << 20) -> str:
+#: Bytes read at a time when a file is hashed.
+HASH_BLOCK_BYTES = 1 << 20
+
+
+def file_sha256(path: PathLike, block_bytes: int = HASH_BLOCK_BYTES) -> str:
     """SHA-256 of a file, read in blocks."""
     digest = hashlib.sha256()
     with open(path, "rb") as handle:

@@ -45,7 +45,7 @@ from hrgtc.drift.features import (
 )
 from hrgtc.drift.rate_segments import RateSegment
 from hrgtc.drift.stepwise import Step, stepwise
-from hrgtc.settings.drift import PREMOVE_FLOOR
+from hrgtc.settings.drift import PENTER, PREMOVE_FLOOR
 
 __all__ = [
     "SCALE_FACTOR_JSON_SCHEMA",
@@ -160,7 +160,7 @@ class ScaleFactorModel(ParsedTerms):
     groups: tuple[ScaleGroup, ...]
     history: tuple[Step, ...] = ()
     weighted: bool = False
-    penter: float = 0.05
+    penter: float = PENTER
     premove: float = 0.10
     _terms: tuple[Term, ...] = field(default=(), repr=False, compare=False)
 
@@ -281,7 +281,7 @@ class ScaleFactorModel(ParsedTerms):
                                    fstat=_float(s["fstat"]), pvalue=_float(s["pvalue"]))
                               for s in data.get("history", ())),
                 weighted=bool(data.get("weighted", False)),
-                penter=float(data.get("penter", 0.05)),
+                penter=float(data.get("penter", PENTER)),
                 premove=float(data.get("premove", 0.10)),
             )
         except (KeyError, TypeError, ValueError, IndexError) as exc:
@@ -340,7 +340,7 @@ def fit_group(group: Sequence[RateSegment], number: int) -> ScaleGroup:
 
 
 def fit_scale_factor(segments: Iterable[RateSegment], settings: FeatureSettings,
-                     terms: Iterable[str] = SCALE_TERMS, penter: float = 0.05,
+                     terms: Iterable[str] = SCALE_TERMS, penter: float = PENTER,
                      premove: float | None = None, *, tolerance_hz: float | None = None,
                      weighted: bool = True) -> ScaleFactorModel:
     """Fit the scale-factor error k_ppm(f) from rate-table segments at several temperatures.

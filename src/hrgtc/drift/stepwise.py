@@ -41,7 +41,7 @@ from hrgtc.drift.regression import (
     ols_from_accumulator,
     refine,
 )
-from hrgtc.settings.drift import PREMOVE_FLOOR
+from hrgtc.settings.drift import PENTER, PREMOVE_FLOOR
 
 __all__ = [
     "COLLINEARITY_TOL",
@@ -142,7 +142,7 @@ class StepwiseResult:
                    penter=float(data["penter"]), premove=float(data["premove"]))
 
 
-def stepwise(X: Any, y: Any, names: Sequence[str] | None = None, penter: float = 0.05,
+def stepwise(X: Any, y: Any, names: Sequence[str] | None = None, penter: float = PENTER,
              premove: float | None = None, initial: Iterable[str | int | bool] | None = None,
              max_steps: int | None = None, *, weights: Any = None,
              tol: float = COLLINEARITY_TOL,
@@ -220,7 +220,7 @@ _refine = refine  # ``stepwise`` has a parameter of the same name
 
 
 def stepwise_from_accumulator(acc: GramAccumulator, names: Sequence[str] | None = None,
-                              penter: float = 0.05, premove: float | None = None,
+                              penter: float = PENTER, premove: float | None = None,
                               initial: Iterable[str | int | bool] | None = None,
                               max_steps: int | None = None, *,
                               tol: float = COLLINEARITY_TOL,

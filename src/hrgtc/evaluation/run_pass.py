@@ -56,6 +56,9 @@ from hrgtc.evaluation.settling_cut import SettlingCut
 from hrgtc.model import UnitModel
 from hrgtc.recording import ReadOptions, Recording, count_rows
 from hrgtc.recording.marks import compensation_mark, describe_mark, refuse_compensated
+from hrgtc.settings.compensation import EvaluationSettings
+
+_EVAL = EvaluationSettings
 
 #: Series measured by a pass: output minus input rate, compensated by the
 #: frequency model, and by the housing-thermistor baseline.
@@ -147,7 +150,7 @@ class Evaluation:
     bias_stability_interval_dph: dict[str, dict[float, tuple[float, float]]] = field(
         default_factory=dict)
     confidence: float = ONE_SIGMA
-    deviation: str = "oadev"
+    deviation: str = _EVAL.deviation
     directions: DirectionStats | None = None
     mean_dph: dict[str, float] = field(default_factory=dict)
     rms_dph: dict[str, float] = field(default_factory=dict)
@@ -325,7 +328,7 @@ def run_pass(
     progress: Progress | None = None,
     total_rows: int = 0,
     gaps: str = "ignore",
-    deviation: str = "oadev",
+    deviation: str = _EVAL.deviation,
     confidence: float = ONE_SIGMA,
     keep: np.ndarray | None = None,
 ) -> Evaluation:
@@ -583,7 +586,7 @@ def evaluate(
     max_points: int | None = None,
     on_output: Callable[[Recording], None] | None = None,
     progress: Progress | None = None,
-    deviation: str = "oadev",
+    deviation: str = _EVAL.deviation,
     confidence: float = ONE_SIGMA,
 ) -> Evaluation:
     """Raw vs compensated bias stability, Allan noise terms and range shares of one run.

@@ -57,9 +57,11 @@ from hrgtc.export.c.plan import PRECISIONS, plan_for
 from hrgtc.export.c.text import _comment, header, source
 from hrgtc.export.parameter_file import instrument_parameter_text, parameter_text
 from hrgtc.model import InstrumentModel, UnitModel, load_instrument
+from hrgtc.settings.export import EXPORT_FORMATS, ExportSettings
 
 #: What the export writes: C99 files, or the plain parameter file.
-FORMATS = ("c", "params")
+FORMATS = EXPORT_FORMATS
+_EXPORT = ExportSettings
 _PREFIX = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,31}$")
 
 
@@ -67,10 +69,10 @@ _PREFIX = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,31}$")
 def export_c(
     model: UnitModel | InstrumentModel | str | os.PathLike[str],
     outdir: str | os.PathLike[str],
-    prefix: str = "hrgtc",
+    prefix: str = _EXPORT.prefix,
     force: bool = False,
-    precision: str = "double",
-    output_format: str = "c",
+    precision: str = _EXPORT.precision,
+    output_format: str = _EXPORT.output_format,
 ) -> list[Path]:
     """Write the unit's compensation as C99 files ``<prefix>_model.h`` and ``<prefix>_model.c``.
 

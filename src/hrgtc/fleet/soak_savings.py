@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from hrgtc.fleet.population import draw_unit, true_frequency_hz, truth
+from hrgtc.settings.fleet import SETPOINTS_C
 from hrgtc.simulate import simulate_run
 from hrgtc.simulate import standard_profiles as profiles
 from hrgtc.thermometry import fit
@@ -28,7 +29,6 @@ from hrgtc.thermometry.prior import ThermometerPrior, fit_with_prior
 
 __all__ = ["SUBSETS", "measure_prior", "soak_points"]
 
-SETPOINTS_C = (-20.0, -10.0, 0.0, 10.0, 20.0, 30.0, 40.0)
 #: The soaks kept for the prior fits. [°C] Two soaks inside the range: what two soaks
 #: cannot see is mostly the curvature, whose error vanishes at the soaks, and soaks near
 #: z = ±0.7 (as Chebyshev nodes) halve its largest value over the range compared with

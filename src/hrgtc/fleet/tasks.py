@@ -22,6 +22,8 @@ from typing import Any
 
 from hrgtc.fleet.manifest import UnitFiles
 from hrgtc.recording import ReadOptions
+from hrgtc.settings.calibration import CalibrationSettings
+from hrgtc.settings.fleet import FleetEvaluation
 
 __all__ = ["UnitOutcome", "calibrate_unit", "evaluate_unit", "report_unit", "simulate_unit"]
 
@@ -129,7 +131,7 @@ def _resumable(files: UnitFiles, output_dir: str) -> UnitOutcome | None:
     return UnitOutcome(files.unit, "skipped", outcome.row, None, 0.0)
 
 
-def calibrate_unit(files: UnitFiles, output_dir: str, settings: Mapping[str, Any],
+def calibrate_unit(files: UnitFiles, output_dir: str, settings: CalibrationSettings,
                    read_options: ReadOptions | None = None, resume: bool = False,
                    prior_path: str | None = None) -> UnitOutcome:
     """Calibrate one unit (:func:`hrgtc.pipeline.calibration.calibrate`) and write its model file.
@@ -154,7 +156,7 @@ def calibrate_unit(files: UnitFiles, output_dir: str, settings: Mapping[str, Any
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # the table reports out-of-range shares
             result = calibrate(files.soaks, files.drifts, files.validate,
-                               read_options=read_options, prior=prior_path, **dict(settings))
+                               read_options=read_options, prior=prior_path, settings=settings)
         target = model_path(output_dir, files.unit)
         save_model(result.model, target, force=True)
         outcome = UnitOutcome(files.unit, "ok", calibration_row(result, str(target)), None,
@@ -178,7 +180,7 @@ def _write_outcome(output_dir: str, outcome: UnitOutcome) -> None:
 
 
 def evaluate_unit(files: UnitFiles, models_dir: str, read_options: ReadOptions | None = None,
-                  allan: bool = True) -> UnitOutcome:
+                  allan: bool = FleetEvaluation.allan) -> UnitOutcome:
     """Evaluate one unit's validation runs (or its drift runs without any) with its model."""
     start = time.perf_counter()
     try:

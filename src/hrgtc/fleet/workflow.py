@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import json
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -23,6 +23,8 @@ from hrgtc.fleet.manifest import UnitFiles, load_fleet
 from hrgtc.fleet.results import read_table, write_table
 from hrgtc.fleet.run import FleetRun, run_tasks
 from hrgtc.recording import ReadOptions
+from hrgtc.settings.calibration import CalibrationSettings
+from hrgtc.settings.fleet import SETPOINTS_C, FleetEvaluation, FleetSimulation
 
 __all__ = ["FLEET_TABLE", "build_prior", "calibrate_fleet", "evaluate_fleet", "report_fleet",
            "simulate_fleet"]
@@ -32,18 +34,18 @@ PathLike = str | os.PathLike[str]
 FLEET_TABLE = "fleet.parquet"
 #: The evaluation table written beside the models by ``fleet evaluate``.
 EVALUATION_TABLE = "evaluation.parquet"
-#: Chamber set-points of the paper's soaks (Table 1 of [1]). [°C]
-SETPOINTS_C = (-20.0, -10.0, 0.0, 10.0, 20.0, 30.0, 40.0)
+_SIM = FleetSimulation
 
 
 def _fleet(source: PathLike | Sequence[UnitFiles]) -> list[UnitFiles]:
     return list(source) if not isinstance(source, str | os.PathLike) else load_fleet(source)
 
 
-def simulate_fleet(output: PathLike, units: int, seed: int = 1, *,
-                   sample_rate_hz: float = 10.0, soak_hours: float = 5.0,
-                   ramp_hours: float = 5.0, setpoints_c: Sequence[float] = SETPOINTS_C,
-                   file_format: str = "parquet", force: bool = False,
+def simulate_fleet(output: PathLike, units: int, seed: int = _SIM.seed, *,
+                   sample_rate_hz: float = _SIM.sample_rate_hz, soak_hours: float = _SIM.soak_hours,
+                   ramp_hours: float = _SIM.ramp_hours,
+                   setpoints_c: Sequence[float] = SETPOINTS_C,
+                   file_format: str = _SIM.file_format, force: bool = False,
                    scheduler: str | None = None, workers: int | None = None,
                    progress: Progress | None = None) -> FleetRun:
     """Simulate ``units`` units of the population of ``seed`` under ``output/<unit>/``.
@@ -68,7 +70,7 @@ def simulate_fleet(output: PathLike, units: int, seed: int = 1, *,
 
 
 def calibrate_fleet(source: PathLike | Sequence[UnitFiles], output: PathLike, *,
-                    settings: Mapping[str, Any] | None = None,
+                    settings: CalibrationSettings | None = None,
                     read_options: ReadOptions | None = None, resume: bool = False,
                     force: bool = False, prior: PathLike | None = None,
                     scheduler: str | None = None, workers: int | None = None,
@@ -85,7 +87,8 @@ def calibrate_fleet(source: PathLike | Sequence[UnitFiles], output: PathLike, *,
     source
         A manifest, a fleet folder, or the units' files.
     settings
-        Keyword arguments of :func:`~hrgtc.pipeline.calibration.calibrate` (order, terms, ...).
+        The calibration's settings (thermometer order, candidate terms, ...), the same for
+        every unit; None: the defaults.
     prior
         A prior file: every unit is calibrated with it (:mod:`hrgtc.thermometry.prior`).
     """
@@ -97,7 +100,7 @@ def calibrate_fleet(source: PathLike | Sequence[UnitFiles], output: PathLike, *,
                         "nothing was calibrated; --resume skips unchanged units")
     out.mkdir(parents=True, exist_ok=True)
     work = [(u.unit, tasks.calibrate_unit,
-             (u, str(out), dict(settings or {}), read_options, resume,
+             (u, str(out), settings or CalibrationSettings(), read_options, resume,
               None if prior is None else str(prior)))
             for u in fleet]
     run = run_tasks(work, scheduler=scheduler, workers=workers, progress=progress,
@@ -108,7 +111,8 @@ def calibrate_fleet(source: PathLike | Sequence[UnitFiles], output: PathLike, *,
 
 def evaluate_fleet(source: PathLike | Sequence[UnitFiles], models: PathLike,
                    output: PathLike | None = None, *, read_options: ReadOptions | None = None,
-                   allan: bool = True, force: bool = False, scheduler: str | None = None,
+                   allan: bool = FleetEvaluation.allan, force: bool = False,
+                   scheduler: str | None = None,
                    workers: int | None = None, progress: Progress | None = None) -> FleetRun:
     """Evaluate each unit's held-out runs with its model; write the evaluation table.
 

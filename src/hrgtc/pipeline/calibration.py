@@ -45,7 +45,7 @@ from hrgtc.settings.drift import GRADIENT_TERMS, DriftSettings
 from hrgtc.settings.reading import ReadSettings
 from hrgtc.thermometry import fit as fit_thermometer
 from hrgtc.thermometry import identity
-from hrgtc.thermometry.plateaus import Plateau, find_plateaus, plateau_table
+from hrgtc.thermometry.plateaus import Plateau, plateau_table, plateaus_from_recordings
 from hrgtc.thermometry.prior import PriorFit, ThermometerPrior, fit_with_prior, load_prior
 
 PathLike = str | os.PathLike[str]
@@ -126,7 +126,6 @@ def calibrate(
     settings: CalibrationSettings | None = None,
     aux: Mapping[str, str] | None = None,
     housing_terms: Iterable[str] | None = HOUSING_TERMS,
-    plateau_options: Mapping[str, Any] | None = None,
     read_options: ReadOptions | None = None,
     progress: StageProgress | None = None,
     prior: ThermometerPrior | PathLike | None = None,
@@ -161,8 +160,6 @@ def calibrate(
     housing_terms
         Terms of the classical housing-thermistor baseline, fitted when every
         drift run has ``housing_c``; None to skip.
-    plateau_options
-        Keyword arguments of :func:`hrgtc.thermometry.plateaus.find_plateaus`.
     read_options
         Column mapping, units and metadata overrides for every file.
     progress
@@ -203,7 +200,7 @@ def calibrate(
     for number, path in enumerate(soaks):
         soak = options.read(path, keep=SOAK_COLUMNS)
         soak_rates.append(soak.metadata.sample_rate_hz)
-        plateaus.extend(find_plateaus(soak, **dict(plateau_options or {})))
+        plateaus.extend(plateaus_from_recordings([soak], settings.plateaus))
         if progress is not None:
             progress("soaks", number + 1, len(soaks))
     temperatures, frequencies = plateau_table(plateaus)
@@ -244,7 +241,7 @@ def calibrate(
     model, housing = _fit_drift(training, heads, thermometer, options, progress, len(drifts),
                                 settings.drift, aux, housing_terms)
     unit = heads[str(drifts[0])].metadata.unit
-    record = _record(settings, aux, housing_terms, plateau_options, options, order=order)
+    record = _record(settings, aux, housing_terms, options, order=order)
     if prior_fit is not None:
         record["prior"] = {"units": prior_fit.prior.n_units,
                              "range_c": list(prior_fit.prior.temperature_range_c),
@@ -276,13 +273,13 @@ def _with_terms(settings: CalibrationSettings, terms: Iterable[str]) -> Calibrat
 
 
 def _record(settings: CalibrationSettings, aux: Mapping[str, str] | None,
-            housing_terms: Iterable[str] | None, plateau_options: Mapping[str, Any] | None,
-            options: ReadOptions, **extra: Any) -> dict[str, Any]:
+            housing_terms: Iterable[str] | None, options: ReadOptions,
+            **extra: Any) -> dict[str, Any]:
     """What a model file's provenance records of the settings: every field of ``settings``
     (:func:`hrgtc.settings.to_dict`), the channels, the baseline and the reading."""
     return {**to_dict(settings), **extra, "aux": dict(aux or {}),
             "housing_terms": None if housing_terms is None else list(housing_terms),
-            "plateau_options": dict(plateau_options or {}), "motion": options.motion,
+            "motion": options.motion,
             "columns": dict(options.columns or {}), "units": dict(options.units or {})}
 
 
@@ -294,7 +291,8 @@ def _fit(runs: Sequence[Any], thermometer: Any, drift: DriftSettings,
         runs, thermometer, terms=drift.terms or drift_model.EQ21, window_s=drift.window_s,
         penter=drift.penter, premove=drift.premove, reference_c=drift.reference_c,
         rate_tau_s=drift.rate_tau_s, rate_tau2_s=drift.rate_tau2_s, warmup_s=drift.warmup_s,
-        select=drift.select, offsets=drift.offsets, aux_columns=aux,
+        select=drift.select, offsets=drift.offsets, autocorrelation=drift.autocorrelation,
+        hierarchical=drift.hierarchical, aux_columns=aux,
         excitation_runs=excitation_runs, progress=progress, motion=options.motion,
         gaps=options.gaps)
 

@@ -30,29 +30,13 @@ from hrgtc.pipeline.calibration import CalibrationResult, calibrate
 from hrgtc.pipeline.instrument import InstrumentCalibration, calibrate_instrument
 from hrgtc.recording import ReadOptions, RecordingWriter
 from hrgtc.report import build_report
+from hrgtc.settings.compensation import ReportSettings
+from hrgtc.settings.fleet import SETPOINTS_C, DemoSettings
 from hrgtc.simulate import simulate_files
 from hrgtc.simulate import standard_profiles as profiles
 
-SETPOINTS_C = (-20.0, -10.0, 0.0, 10.0, 20.0, 30.0, 40.0)  # Section 3 of [1]
 #: Most points per curve in the report's figures.
-REPORT_POINTS = 20_000
-
-
-@dataclass(frozen=True)
-class DemoSettings:
-    """Sample rate and durations of the simulated campaign."""
-
-    sample_rate_hz: float = 200.0  # Section 3 of [1]: 200 Hz
-    soak_hours: float = 5.0  # "4-5 h" per soak
-    ramp_hours: float = 5.0
-    seed: int = 2012
-    #: Sample rate of the three-axis part (None: skip it). [Hz]
-    instrument_rate_hz: float | None = 10.0
-
-    @classmethod
-    def quick(cls) -> DemoSettings:
-        """Lower rate and shorter soaks (settled-value extrapolation does the rest)."""
-        return cls(sample_rate_hz=5.0, soak_hours=3.0, ramp_hours=5.0, instrument_rate_hz=1.0)
+REPORT_POINTS = ReportSettings.max_points
 
 
 @dataclass(frozen=True)

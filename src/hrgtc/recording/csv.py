@@ -52,7 +52,12 @@ from hrgtc.recording.formats import (
 )
 from hrgtc.recording.schema import Metadata
 
+#: Bytes per block of the CSV reader (pyarrow's block size).
 CSV_BLOCK_BYTES = 8 << 20
+#: Bytes of a CSV file's start that estimate its bytes per row (for the progress bar).
+SAMPLE_BYTES = 1 << 20
+#: Bytes per block when a CSV file's lines are counted.
+COUNT_BLOCK_BYTES = 4 << 20
 _STRING_KEYS = ("unit", "profile")
 
 
@@ -98,7 +103,7 @@ class CsvSource(Source):
         self._rows_done = 0
         with open(path, "rb") as handle:  # bytes per row from the first MiB, for progress
             handle.seek(self._offset)
-            sample = handle.read(1 << 20)
+            sample = handle.read(SAMPLE_BYTES)
         self._bytes_per_row = len(sample) / max(sample.count(b"\n"), 1)
 
     def _options(self, names: Sequence[str], as_text: set[str], block: int) -> dict[str, Any]:
@@ -153,7 +158,7 @@ class CsvSource(Source):
         rows, last = 0, b"\n"  # non-empty lines; "\r" is not content
         with open(self.path, "rb") as handle:
             handle.seek(self._offset)
-            while block := handle.read(4 << 20):
+            while block := handle.read(COUNT_BLOCK_BYTES):
                 block = block.replace(b"\r", b"")
                 if not block:
                     continue

@@ -35,6 +35,7 @@ import pyarrow.parquet as pq
 from hrgtc.core.errors import RecordingError
 from hrgtc.recording.axes import axis_names, base_name, split_axis
 from hrgtc.recording.schema import COLUMNS, Metadata
+from hrgtc.settings.compensation import ROW_GROUP_ROWS
 
 SUFFIXES: dict[str, str] = {
     ".parquet": "parquet",
@@ -47,7 +48,7 @@ SUFFIXES: dict[str, str] = {
 FORMAT_SUFFIXES: dict[str, str] = {"parquet": ".parquet", "csv": ".csv", "h5": ".h5"}
 METADATA_KEY = b"hrgtc"
 HDF5_GROUP = "recording"
-PARQUET_ROW_GROUP_ROWS = 1 << 20
+PARQUET_ROW_GROUP_ROWS = ROW_GROUP_ROWS
 HDF5_CHUNK_ROWS = 1 << 16
 
 

@@ -55,6 +55,7 @@ from hrgtc.recording.mapping import (
     ColumnPlan,
     convert_columns,
     plan_columns,
+    scales_temperature,
     table_columns,
 )
 from hrgtc.recording.rechunk import rechunk
@@ -260,7 +261,8 @@ def read(
     with open_source(path) as source:
         plan = plan_columns(source, columns, units, temp_scale, temp_offset_c, thermometer,
                             rate_scale, temp_unwrap)
-        robust.counts = plan.temperature_is_count and (temp_scale, temp_offset_c) == (1.0, 0.0)
+        robust.counts = plan.temperature_is_count and not scales_temperature(temp_scale,
+                                                                           temp_offset_c)
         columns = table_columns(source.read(plan.read_names, plan.as_text))
         arrays = convert_columns(plan, columns, 0)
         arrays, slow = fill_slow_channels(arrays, slow_channels, hold_max_s, str(path))
@@ -356,7 +358,8 @@ def iter_chunks(
     with open_source(path) as source:
         plan = plan_columns(source, columns, units, temp_scale, temp_offset_c, thermometer,
                             rate_scale, temp_unwrap)
-        robust.counts = plan.temperature_is_count and (temp_scale, temp_offset_c) == (1.0, 0.0)
+        robust.counts = plan.temperature_is_count and not scales_temperature(temp_scale,
+                                                                           temp_offset_c)
         offset = 0
         repairer = _time_repairer(plan)
         if time_repair is not None:  # the caller's, to read what was repaired

@@ -45,6 +45,15 @@ from hrgtc.recording.csv import bad_number_hint
 from hrgtc.recording.formats import Source, first_failing
 from hrgtc.recording.schema import COLUMNS
 from hrgtc.recording.units import UNITS, find_unit, median_period, per_sample_steps, unit_of
+from hrgtc.settings.reading import TEMP_UNWRAPS, ReadSettings
+
+_READ = ReadSettings
+
+
+def scales_temperature(temp_scale: float, temp_offset_c: float) -> bool:
+    """True when ``temp_scale``/``temp_offset_c`` differ from the defaults (the identity):
+    ``temperature_c*`` is then a raw count mapped to °C."""
+    return (temp_scale, temp_offset_c) != (_READ.temp_scale, _READ.temp_offset_c)
 
 #: kind -> canonical unit -> accepted spellings (compared case-insensitively); from
 #: the one table of units, :data:`hrgtc.recording.units.UNITS`.
@@ -146,12 +155,12 @@ class ColumnPlan:
     time_origin_ns: int | None = None
     time_origin_s: float | None = None
     read_names: list[str] = field(default_factory=list)
-    temp_scale: float = 1.0
-    temp_offset_c: float = 0.0
-    thermometer: str = "resonator"
+    temp_scale: float = _READ.temp_scale
+    temp_offset_c: float = _READ.temp_offset_c
+    thermometer: str = _READ.thermometer
     axes: tuple[str, ...] = ()
-    rate_scale: float | None = None
-    temp_unwrap: str = "auto"
+    rate_scale: float | None = _READ.rate_scale
+    temp_unwrap: str = _READ.temp_unwrap
     previous_time_s: float | None = None
     period_s: float | None = None
     wrap_bits: int | None = None
@@ -160,14 +169,15 @@ class ColumnPlan:
     @property
     def temperature_is_count(self) -> bool:
         """True when ``temperature_c*`` holds a raw count (a count unit, a scale or an offset)."""
-        return (self.units.get("temp") == "count" or self.temp_scale != 1.0
-                or self.temp_offset_c != 0.0)
+        return (self.units.get("temp") == "count"
+                or scales_temperature(self.temp_scale, self.temp_offset_c))
 
 
 def plan_columns(source: Source, columns: Any, units: Mapping[str, str] | None,
-                 temp_scale: float = 1.0, temp_offset_c: float = 0.0,
-                 thermometer: str = "resonator", rate_scale: float | None = None,
-                 temp_unwrap: str = "auto") -> ColumnPlan:
+                 temp_scale: float = _READ.temp_scale,
+                 temp_offset_c: float = _READ.temp_offset_c,
+                 thermometer: str = _READ.thermometer, rate_scale: float | None = _READ.rate_scale,
+                 temp_unwrap: str = _READ.temp_unwrap) -> ColumnPlan:
     """Decide which of the file's columns become which recording columns, in which unit.
 
     Contract columns come first in the order of :data:`hrgtc.recording.COLUMNS`
@@ -193,10 +203,10 @@ def plan_columns(source: Source, columns: Any, units: Mapping[str, str] | None,
         raise InputError(f"--rate-scale {rate_scale!r} is the LSB per °/s of a raw count; give "
                          "it with --rate-unit lsb (the rate unit is "
                          f"{rate_unit.symbol})")
-    if temp_unwrap not in ("auto", "off", "16", "32"):
+    if temp_unwrap not in TEMP_UNWRAPS:
         raise InputError(f"temp_unwrap must be 'auto', 'off', '16' or '32', got {temp_unwrap!r}")
-    if canon.get("temp") not in (None, "C", "count") and (temp_scale != 1.0
-                                                            or temp_offset_c != 0.0):
+    if canon.get("temp") not in (None, "C", "count") and scales_temperature(temp_scale,
+                                                                            temp_offset_c):
         raise InputError(f"--temp-scale/--temp-offset map a raw count to °C; with --temp-unit "
                          f"{canon['temp']} the temperature is not a count: drop one of them")
     for name, value in (("temp_scale", temp_scale), ("temp_offset_c", temp_offset_c)):
@@ -358,7 +368,7 @@ def _temperature_values(plan: ColumnPlan, values: np.ndarray, base: str,
                 "really counts that high", UnitWarning, stacklevel=4)
     if plan.wrap_bits is not None:
         values = unwrap_count(values, plan.wrap_bits)
-    if plan.temp_scale != 1.0 or plan.temp_offset_c != 0.0:
+    if scales_temperature(plan.temp_scale, plan.temp_offset_c):
         return values * plan.temp_scale + plan.temp_offset_c
     return values
 

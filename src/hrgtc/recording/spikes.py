@@ -101,7 +101,8 @@ class SpikeFilter:
         from 0), None without any.
     """
 
-    def __init__(self, thermometer: str = "resonator", source: str | None = None) -> None:
+    def __init__(self, thermometer: str = ReadSettings.thermometer,
+                 source: str | None = None) -> None:
         self.sensor = thermometer == "sensor"
         self.source = source
         self.dropped = 0
@@ -330,7 +331,7 @@ class RobustSpikeFilter:
         ``(column, row, value)`` of the first spike (file row), None without any.
     """
 
-    def __init__(self, mode: str = "drop", thermometer: str = "resonator",
+    def __init__(self, mode: str = "drop", thermometer: str = ReadSettings.thermometer,
                  source: str | None = None, *, k: float = SPIKE_K,
                  lsb_multiple: float = SPIKE_LSB, window_s: float = SPIKE_WINDOW_S) -> None:
         check_spike_filter(mode)

@@ -105,6 +105,7 @@ from hrgtc.recording.gaps import (
 )
 from hrgtc.recording.schema import Metadata, Recording
 from hrgtc.recording.time_checks import _change_row, _step_diagnosis
+from hrgtc.settings.reading import ReadSettings
 
 __all__ = [
     "DEG_PER_RAD_X3600", "FREQ_JUMP_FRACTION", "FREQ_MAX_HZ", "FREQ_SAMPLE_RANGE_HZ",
@@ -136,7 +137,7 @@ class RecordingValidator:
     def __init__(self, gaps: GapPolicy | str = "error",
                  freq_band_hz: tuple[float, float] | None = None,
                  freq_span_hz: tuple[float, float] | None = None,
-                 thermometer: str = "resonator") -> None:
+                 thermometer: str = ReadSettings.thermometer) -> None:
         self.gaps = check_gap_policy(gaps)
         self.freq_band_hz = freq_band_hz
         self.freq_span_hz = freq_span_hz
@@ -580,7 +581,7 @@ def validate(
     recording: Recording, gaps: GapPolicy | str = "error", *, raise_errors: bool = True,
     freq_band_hz: tuple[float, float] | None = None,
     freq_span_hz: tuple[float, float] | None = None,
-    thermometer: str = "resonator",
+    thermometer: str = ReadSettings.thermometer,
 ) -> ValidationReport:
     """Check a recording against the recording contract (see the module docstring).
 

@@ -40,6 +40,7 @@ from hrgtc.report.html import (
     _temperature_share,
     _thermometer,
 )
+from hrgtc.settings.compensation import ReportSettings
 from hrgtc.thermometry.plateaus import Plateau
 
 __all__ = ["build_report"]
@@ -62,7 +63,7 @@ def build_report(
     soaks: Sequence[PathLike] | None = None,
     title: str | None = None,
     force: bool = False,
-    max_points: int = 20_000,
+    max_points: int = ReportSettings.max_points,
     read_options: ReadOptions | None = None,
     progress: Progress | None = None,
 ) -> Path:

@@ -33,6 +33,7 @@ from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 from hrgtc.evaluation import BlockMeans, Evaluation, block_rows
 from hrgtc.evaluation.allan import FLICKER_FLOOR_FACTOR
 from hrgtc.recording import ReadOptions, count_rows
+from hrgtc.settings.compensation import ReportSettings
 from hrgtc.thermometry import Thermometer, paper
 from hrgtc.thermometry.plateaus import Plateau
 
@@ -130,7 +131,7 @@ class SoakTrace:
 
 
 def trace_soak(
-    path: PathLike, thermometer: Thermometer, *, max_points: int = 20_000,
+    path: PathLike, thermometer: Thermometer, *, max_points: int = ReportSettings.max_points,
     read_options: ReadOptions | None = None, on_chunk: Callable[[int], None] | None = None,
 ) -> SoakTrace:
     """Block means of a soak recording, streamed (blocks of >= 10 s, at most ``max_points``)."""

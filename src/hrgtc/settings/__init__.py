@@ -20,8 +20,12 @@ field in one of these classes (docs/architecture.md, "Adding a parameter").
 
 * :mod:`hrgtc.settings.reading` -- reading a user's files (``--gaps``, ``--spikes``, ...);
 * :mod:`hrgtc.settings.drift` -- the drift fit (``--window-s``, ``--rate-tau-s``, ...);
-* :mod:`hrgtc.settings.calibration` -- the calibration chain (thermometer order,
-  soaks in the drift fit, scale-factor terms, cross-axis terms) and its drift fit.
+* :mod:`hrgtc.settings.calibration` -- the calibration chain (thermometer order, plateau
+  finder, soaks in the drift fit, scale-factor terms, cross-axis terms) and its drift fit;
+* :mod:`hrgtc.settings.compensation` -- compensation chunks, the evaluation's deviation
+  curve, the report's points;
+* :mod:`hrgtc.settings.export` -- the firmware export (prefix, precision, format);
+* :mod:`hrgtc.settings.fleet` -- the simulated fleet, its evaluation and the demo.
 """
 
 from __future__ import annotations
@@ -105,7 +109,7 @@ class Setting:
 def format_value(value: Any) -> str:
     """A default as text: a tuple of terms comma separated, None as "none"."""
     if isinstance(value, tuple):
-        return ",".join(str(v) for v in value)
+        return ",".join(f"{v:g}" if isinstance(v, float) else str(v) for v in value)
     if value is None:
         return "none"
     if isinstance(value, bool):

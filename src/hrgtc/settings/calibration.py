@@ -21,6 +21,34 @@ class ThermometerSettings:
 
 
 @dataclass(frozen=True)
+class PlateauSettings:
+    """How the soak plateaus are found and settled (:func:`hrgtc.thermometry.find_plateaus`).
+
+    Not command-line options: the model file's provenance records them.
+    """
+
+    slope_threshold_hz_per_h: float = setting(
+        0.01, "A stretch is settled once its frequency drifts less than this (0.01 Hz/h = "
+        "0.027 °C/h at 0.37 Hz/°C: within ~0.02 °C of equilibrium behind the ~40 min "
+        "resonator time constant of [1]).", unit="Hz/h", cli=None)
+    min_duration_s: float = setting(
+        1800.0, "Shortest stable chamber stretch: ~0.75 resonator time constants, long "
+        "enough to resolve 0.01 Hz/h under mHz frequency noise.", unit="s", cli=None)
+    chamber_tolerance_c: float = setting(
+        0.5, "What a climatic chamber holds around its set-point.", unit="°C", cli=None)
+    block_s: float = setting(10.0, "Block means the plateau finder works on.", unit="s",
+                             cli=None)
+    extrapolate: bool = setting(
+        True, "A soak that has not settled is extrapolated by its settling curve.", cli=None)
+    hz_per_c: float = setting(
+        0.37, "Approximate df/dT, the linear term of Eq. (18) of [1].", unit="Hz/°C",
+        cli=None)
+    max_fit_std_c: float = setting(
+        0.01, "Largest standard error of an extrapolated f_inf, in resonator temperature.",
+        unit="°C", cli=None)
+
+
+@dataclass(frozen=True)
 class CalibrationSettings:
     """Everything ``hrgtc calibrate`` tunes: the thermometer, the drift fit and the chain.
 
@@ -28,6 +56,7 @@ class CalibrationSettings:
     """
 
     thermometer: ThermometerSettings = field(default_factory=ThermometerSettings)
+    plateaus: PlateauSettings = field(default_factory=PlateauSettings)
     drift: DriftSettings = field(default_factory=DriftSettings)
     drift_from_soaks: bool = setting(
         True, "Also fit the drift model on the soaks' warming and cooling transients.",

@@ -21,6 +21,8 @@ GRADIENT_TERMS = ("f", "f^2", "f^3", "g", "f*g", "f^2*g")
 TAU2_FACTOR = 6.0
 #: The warm-up left out of each run is this many of the longest filter time constant.
 WARMUP_FACTOR = 5.0
+#: A term enters the stepwise model below this p-value (MATLAB ``stepwisefit``'s default).
+PENTER = 0.05
 #: A term leaves the stepwise model above this p-value unless ``premove`` says otherwise
 #: (``max(penter, PREMOVE_FLOOR)``, MATLAB ``stepwisefit``).
 PREMOVE_FLOOR = 0.10
@@ -28,6 +30,8 @@ PREMOVE_FLOOR = 0.10
 SELECTIONS = ("guarded", "stepwise", "cv")
 #: Nuisance offsets of the drift fit (:mod:`hrgtc.drift.offsets`).
 OFFSET_MODES = ("auto", "none", "run", "orientation", "run+orientation")
+#: How the stepwise F-tests account for correlated window residuals.
+AUTOCORRELATIONS = ("newey-west", "none")
 
 _FIT = "Drift model"
 
@@ -46,7 +50,7 @@ class DriftSettings:
         default_text=f"{','.join(GRADIENT_TERMS)} (g the housing - resonator gradient) when "
         f"the runs log housing_c, else Eq. 21's {','.join(EQ21_TERMS)}", panel=_FIT)
     window_s: float = setting(10.0, "Averaging window of the fit.", unit="s", panel=_FIT)
-    penter: float = setting(0.05, "Stepwise p-value to enter.", panel=_FIT)
+    penter: float = setting(PENTER, "Stepwise p-value to enter.", panel=_FIT)
     premove: float | None = setting(
         None, "Stepwise p-value to remove.", default_text=f"max(--penter, {PREMOVE_FLOOR:g})",
         panel=_FIT)
@@ -72,6 +76,16 @@ class DriftSettings:
         "temperature terms: auto (one per orientation when the runs log accel_x/y/z or an "
         "orientation column, else none), none, run (one per training run: restarts), "
         "orientation, run+orientation.", choices=OFFSET_MODES, panel=_FIT)
+    autocorrelation: str = setting(
+        "newey-west", "Stepwise F-tests on correlated window means: divide each F by the "
+        "long-run / plain variance ratio of the full candidate model's residuals "
+        "(newey-west, bandwidth n^(1/3) windows: bias instability keeps 10 s means "
+        "correlated, and plain F-tests admit terms that fit noise), or plain F-tests (none, "
+        "MATLAB stepwisefit).", choices=AUTOCORRELATIONS, panel=_FIT)
+    hierarchical: bool = setting(
+        True, "Marginality: a term enters only after its lower-order parents (f before f^2, "
+        "f and df before f*df) and leaves only after its children; off gives MATLAB's plain "
+        "stepwisefit.", cli="--hierarchical/--no-hierarchical", panel=_FIT)
 
     def tau2_s(self, uses_d2: bool) -> float:
         """The second filter's time constant (0 when no candidate uses ``d2``). [s]"""

@@ -27,9 +27,10 @@ SLOW_MODES = ("hold", "interpolate", "error")
 THERMOMETERS = ("resonator", "sensor")
 #: Signed temperature counts stored unsigned.
 TEMP_UNWRAPS = ("auto", "off", "16", "32")
-#: Rows per chunk when :func:`hrgtc.recording.iter_chunks` or
-#: :func:`hrgtc.recording.describe` stream a file.
-CHUNK_ROWS = 1_000_000
+#: Rows per chunk when :func:`hrgtc.recording.iter_chunks`, :func:`hrgtc.recording.describe`
+#: or :meth:`hrgtc.recording.ReadOptions.chunks` stream a file (about 20 MB of float64
+#: columns for a ten-column file).
+CHUNK_ROWS = 250_000
 #: Default maximum age of a held value of a slow channel, in periods of the channel.
 DEFAULT_MAX_AGE_PERIODS = 3.0
 
@@ -49,7 +50,7 @@ class ReadSettings:
         "across each gap with its duration (bridge, e.g. a burst logger; ignore is an old name "
         "for it). Windows, bias stability and Allan deviation never cross a gap.",
         choices=GAP_POLICIES, panel=_INPUT)
-    chunk_rows: int = 250_000
+    chunk_rows: int = CHUNK_ROWS
     freq_band_hz: tuple[float, float] | None = None
     freq_span_hz: tuple[float, float] | None = None
     temp_scale: float = setting(

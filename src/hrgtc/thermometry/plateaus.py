@@ -32,6 +32,7 @@ the mean of the settled stretch; with ``extrapolate=False`` always that mean.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass
@@ -43,6 +44,7 @@ from numpy.lib.stride_tricks import sliding_window_view
 from hrgtc.core.errors import CalibrationError, InputError, RecordingError
 from hrgtc.core.progress import Progress
 from hrgtc.recording import Recording
+from hrgtc.settings.calibration import PlateauSettings
 from hrgtc.thermometry.settling import MIN_FIT_POINTS, TransientFit, fit_transient
 
 __all__ = [
@@ -55,19 +57,20 @@ __all__ = [
     "plateaus_from_recordings",
 ]
 
+_PLATEAU = PlateauSettings
 #: Approximate df/dT, the linear term of Eq. (18) of [1]. [Hz/°C]
-DEFAULT_HZ_PER_C = 0.37
+DEFAULT_HZ_PER_C = _PLATEAU.hz_per_c
 #: 0.01 Hz/h = 0.027 °C/h at 0.37 Hz/°C. A first-order tail is slope x tau from equilibrium,
 #: so with the ~40 min resonator time constant behind the 15,000 s settling of [1] the soak
 #: is then within ~0.02 °C of it, the table tolerance of issue 4. [Hz/h]
-DEFAULT_SLOPE_THRESHOLD_HZ_PER_H = 0.01
+DEFAULT_SLOPE_THRESHOLD_HZ_PER_H = _PLATEAU.slope_threshold_hz_per_h
 #: 30 min: ~0.75 resonator time constants, and long enough to resolve 0.01 Hz/h under mHz
 #: frequency noise (the slope's standard error is then ~1e-4 Hz/h at 200 Hz). [s]
-DEFAULT_MIN_DURATION_S = 1800.0
+DEFAULT_MIN_DURATION_S = _PLATEAU.min_duration_s
 #: What a climatic chamber holds around its set-point. [°C]
-DEFAULT_CHAMBER_TOLERANCE_C = 0.5
+DEFAULT_CHAMBER_TOLERANCE_C = _PLATEAU.chamber_tolerance_c
 #: Largest standard error of an extrapolated f_inf, in resonator temperature. [°C]
-DEFAULT_MAX_FIT_STD_C = 0.01
+DEFAULT_MAX_FIT_STD_C = _PLATEAU.max_fit_std_c
 
 
 @dataclass(frozen=True)
@@ -314,8 +317,8 @@ def find_plateaus(
     slope_threshold_hz_per_h: float = DEFAULT_SLOPE_THRESHOLD_HZ_PER_H,
     min_duration_s: float = DEFAULT_MIN_DURATION_S,
     chamber_tolerance_c: float = DEFAULT_CHAMBER_TOLERANCE_C,
-    block_s: float = 10.0,
-    extrapolate: bool = True,
+    block_s: float = _PLATEAU.block_s,
+    extrapolate: bool = _PLATEAU.extrapolate,
     hz_per_c: float = DEFAULT_HZ_PER_C,
     max_fit_std_c: float = DEFAULT_MAX_FIT_STD_C,
     progress: Progress | None = None,
@@ -379,14 +382,13 @@ def find_plateaus(
     >>> abs(plateau.settled_freq_hz - 4421.0731) < 0.004
     True
     """
-    options = {
-        "slope_threshold_hz_per_h": slope_threshold_hz_per_h, "min_duration_s": min_duration_s,
-        "chamber_tolerance_c": chamber_tolerance_c, "block_s": block_s,
-        "extrapolate": extrapolate, "hz_per_c": hz_per_c, "max_fit_std_c": max_fit_std_c,
-    }  # fmt: skip
+    chosen = PlateauSettings(
+        slope_threshold_hz_per_h=slope_threshold_hz_per_h, min_duration_s=min_duration_s,
+        chamber_tolerance_c=chamber_tolerance_c, block_s=block_s, extrapolate=extrapolate,
+        hz_per_c=hz_per_c, max_fit_std_c=max_fit_std_c)
     if not isinstance(recording, Recording):
-        return plateaus_from_recordings(recording, progress=progress, **options)
-    settings = _settings(options)
+        return plateaus_from_recordings(recording, chosen, progress=progress)
+    settings = _settings(dataclasses.asdict(chosen))
     blocks = _blocks(recording, settings.block_s)
     segments = _chamber_segments(blocks.chamber_c, settings.tolerance_c, settings.window)
     if not segments:
@@ -471,15 +473,16 @@ def _segment_plateau(
 
 def plateaus_from_recordings(
     recordings: Sequence[Recording],
+    settings: PlateauSettings | None = None,
     *,
     progress: Progress | None = None,
-    **options: Any,
 ) -> list[Plateau]:
     """:func:`find_plateaus` of each recording (e.g. one file per soak), concatenated.
 
-    ``options`` are the keyword arguments of :func:`find_plateaus`; ``progress``
-    is called with (done, total) recordings.
+    ``settings`` are the plateau finder's (:func:`find_plateaus` with its fields as
+    keywords, the defaults when None); ``progress`` is called with (done, total) recordings.
     """
+    words = dataclasses.asdict(settings or PlateauSettings())
     items = list(recordings)
     if not items:
         raise InputError("no recordings given; pass at least one soak recording")
@@ -490,7 +493,7 @@ def plateaus_from_recordings(
                 f"recordings[{number}] is a {type(item).__name__}, not a Recording; "
                 "read files with hrgtc.recording.read"
             )
-        plateaus.extend(find_plateaus(item, **options))
+        plateaus.extend(find_plateaus(item, **words))
         if progress is not None:
             progress(float(number + 1), float(len(items)))
     return plateaus

@@ -16,6 +16,7 @@ from hrgtc.drift.features import is_aux, variable_key
 from hrgtc.drift.rate_filter import check_tau
 from hrgtc.drift.variables import refusal, supported, variable
 from hrgtc.model import UnitModel
+from hrgtc.settings import export as settings_export
 
 #: Points of the embedded table that starts the thermometer's Newton iteration.
 TABLE_POINTS = 33
@@ -81,7 +82,7 @@ class CPlan:
 
 
 #: The precisions the export writes.
-PRECISIONS = ("double", "single")
+PRECISIONS = settings_export.PRECISIONS
 #: The variables the float32 build computes (its filter and mirror know these).
 SINGLE_VARIABLES = supported("c_float32")
 

@@ -28,6 +28,7 @@ from hrgtc.drift.features import is_aux
 from hrgtc.drift.variables import DRIFT_VARIABLES, variable
 from hrgtc.export.c.plan import CPlan, variables_for_c
 from hrgtc.export.c.types import DOUBLE, CType
+from hrgtc.settings.export import ExportSettings
 
 
 def cname(variable: str) -> str:
@@ -69,7 +70,7 @@ RATES = tuple(v.name for v in DRIFT_VARIABLES if v.kind == "rate")
 
 def extra_variables(plan: CPlan, settings: Any, _literal: Callable[[float, str], str],
                     _comment: Callable[[Any], str], ctype: CType = DOUBLE,
-                    prefix: str = "hrgtc") -> dict[str, str]:
+                    prefix: str = ExportSettings.prefix) -> dict[str, str]:
     """C pieces of the variables beyond f, df, h and dh (d2, g, the extra channels).
 
     Each variable's module in :mod:`hrgtc.drift.variables` writes its own pieces

@@ -1,0 +1,55 @@
+"""Settings of the fleet stage: the simulated population and the demo's campaign."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from hrgtc.settings import setting
+
+#: Chamber set-points of Table 1 of [1]. [°C]
+#:
+#: [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
+SETPOINTS_C = (-20.0, -10.0, 0.0, 10.0, 20.0, 30.0, 40.0)
+#: File formats of simulated runs.
+FILE_FORMATS = ("parquet", "csv", "h5")
+
+
+@dataclass(frozen=True)
+class FleetSimulation:
+    """The population ``hrgtc fleet simulate`` writes (:func:`hrgtc.fleet.simulate_fleet`)."""
+
+    units: int = setting(32, "Number of units.")
+    seed: int = setting(1, "Seed of the population.")
+    sample_rate_hz: float = setting(10.0, "Sample rate.", unit="Hz",
+                                    cli="--sample-rate-hz --rate-hz")
+    soak_hours: float = setting(5.0, "Length of each soak.", unit="h")
+    ramp_hours: float = setting(5.0, "Length of the cool-down and warm-up.", unit="h")
+    setpoints_c: tuple[float, ...] = setting(
+        SETPOINTS_C, "Soak set-points, comma separated.", unit="°C", cli="--setpoints")
+    file_format: str = setting("parquet", "File format.", cli="--format",
+                               choices=FILE_FORMATS)
+
+
+@dataclass(frozen=True)
+class FleetEvaluation:
+    """What ``hrgtc fleet evaluate`` computes (:func:`hrgtc.fleet.evaluate_fleet`)."""
+
+    allan: bool = setting(True, "Also compute the Allan noise terms.", cli="--allan/--no-allan")
+
+
+@dataclass(frozen=True)
+class DemoSettings:
+    """Sample rate and durations of the simulated campaign of ``hrgtc demo``."""
+
+    sample_rate_hz: float = 200.0  # Section 3 of [1]: 200 Hz
+    soak_hours: float = 5.0  # "4-5 h" per soak
+    ramp_hours: float = 5.0
+    seed: int = setting(2012, "Seed of the simulated campaign.")
+    #: Sample rate of the three-axis part (None: skip it). [Hz]
+    instrument_rate_hz: float | None = 10.0
+
+    @classmethod
+    def quick(cls, seed: int | None = None) -> DemoSettings:
+        """Lower rate and shorter soaks (settled-value extrapolation does the rest)."""
+        return cls(sample_rate_hz=5.0, soak_hours=3.0, ramp_hours=5.0, instrument_rate_hz=1.0,
+                   seed=cls.seed if seed is None else seed)
