@@ -255,6 +255,30 @@ def test_a_model_with_more_axes_than_the_recording(axis_files, tmp_path):
     assert code == 0, stderr
 
 
+@pytest.mark.parametrize("command", ["compensate", "evaluate", "report"])
+def test_a_header_less_multi_axis_csv_says_it_has_no_header_line(axis_files, tmp_path,
+                                                                  command):
+    """A 3-axis CSV whose header line is gone read as a single-axis file against a 3-axis
+    model ("the recording is single-axis (freq_hz, rate_dph) and the model has axes x, y,
+    z"): the axis mismatch is not the problem, the missing header is."""
+    from hrgtc.model import InstrumentModel, save_instrument
+    from hrgtc.recording import read
+
+    _, xyz, _, _ = axis_files
+    unit = make_model()
+    model = save_instrument(InstrumentModel({a: unit for a in "xyz"}, "imu"),
+                            tmp_path / "xyz.json")
+    csv = write(read(xyz), tmp_path / "xyz.csv")
+    lines = csv.read_text().split("\n")
+    header = next(i for i, line in enumerate(lines) if not line.startswith("#"))
+    csv.write_text("\n".join(lines[:header] + lines[header + 1:]))
+    code, stdout, stderr = invoke(*COMMANDS[command](csv, model, tmp_path))
+    message = squash(stderr)
+    assert code == 2, (stdout, stderr)
+    assert "no header line" in message and "--col" in message
+    assert "single-axis" not in message
+
+
 # -- the recording's noise against the training data's (Deliver 2) ------------------------------
 @pytest.fixture(scope="module")
 def checked_model(tmp_path_factory):
