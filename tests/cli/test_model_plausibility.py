@@ -325,6 +325,52 @@ def test_a_rate_table_run_and_a_biased_mems_file_are_accepted(checked_model, tmp
     assert code == 0, stderr
 
 
+def _with_temperature(axes: str):
+    """make_run's rows with the resonator temperature as ``temperature_c``, on one axis or
+    on x, y, z (one shared temperature)."""
+    from hrgtc.recording import Recording
+
+    from synthetic import ramp_run
+
+    run = ramp_run(seed=3, start_c=10.0, end_c=5.0, hours=3000 / 36000.0)
+    columns = {"time_s": run["time_s"]}
+    for suffix in ([""] if axes == "1" else ["_x", "_y", "_z"]):
+        columns |= {f"freq_hz{suffix}": run["freq_hz"], f"rate_dph{suffix}": run["rate_dph"]}
+    columns["temperature_c"] = run["resonator_c"]
+    return Recording(columns, run.metadata)
+
+
+@pytest.mark.parametrize("axes", ["1", "3"])
+@pytest.mark.parametrize("command", ["compensate", "evaluate", "report"])
+def test_swapped_rate_and_temperature_headers_are_named(checked_model, tmp_path, command,
+                                                        axes):
+    """Issue 21's audit: with the headers rate_dph and temperature_c swapped, a temperature
+    was compensated as the rate (exit 0): its noise, 5e-5 of the training rate's, is no
+    unit factor. The temperature column has the rate's noise: the swap is named."""
+    from hrgtc.model import InstrumentModel, load_model, save_instrument
+    from hrgtc.recording import Recording
+
+    run = _with_temperature(axes)
+    rate = "rate_dph" if axes == "1" else "rate_dph_x"
+    swapped = {({rate: "temperature_c", "temperature_c": rate}).get(k, k): run[k]
+               for k in run.names}
+    run_path = write(Recording(swapped, run.metadata), tmp_path / "swapped.parquet")
+    model = checked_model
+    if axes == "3":
+        unit = load_model(checked_model)
+        model = save_instrument(InstrumentModel({a: unit for a in "xyz"}, "imu"),
+                                tmp_path / "xyz.json")
+    code, stdout, stderr = invoke(*COMMANDS[command](run_path, model, tmp_path))
+    message = squash(stderr)
+    assert code == 2, (stdout, stderr)
+    assert "swapped.parquet" in message
+    assert f"headers {rate} and temperature_c look swapped" in message
+    # the undamaged file passes
+    good = write(run, tmp_path / "good.parquet")
+    code, _, stderr = invoke(*COMMANDS[command](good, model, tmp_path), "--force")
+    assert code == 0, stderr
+
+
 def test_an_older_model_without_statistics_loads_and_says_so_once(files, tmp_path):
     _, model_path, run_path = files
     data = json.loads(model_path.read_text())
