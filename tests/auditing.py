@@ -7,7 +7,8 @@ through ``info``, ``compensate``, ``evaluate``, ``calibrate --thermometer sensor
 * ``clear``: exit 2, one ``error:`` line naming an input file and every string the case
   expects (column, row, the option of the fix);
 * ``correct``: exit 0 on a case that must be accepted, with the undamaged file's result
-  (compensated rates, bias stabilities, model coefficients, rows) where that is compared;
+  (compensated rates, bias stabilities, model coefficients, rows) where that is compared,
+  and the expectation's strings in its output (a dropped row reported in the accounting);
 * ``misleading``: an error that does not name what the case expects, or that refuses a
   valid file;
 * ``silent``: exit 0 where an error was due, or a result that differs from the undamaged
@@ -120,8 +121,10 @@ class Outcome:
 
 
 def classify(expect: Expect, code: int, text: str, crashed: bool, inputs: Iterable[Path],
-             same: bool | None) -> str:
-    """One of :data:`CLASSES` for an outcome (see the module docstring)."""
+             same: bool | None, output: str = "") -> str:
+    """One of :data:`CLASSES` for an outcome (see the module docstring). ``output``: what
+    an accepted case printed (its ``--json`` and warnings), which must hold every string
+    of a ``"correct"`` expectation's ``names`` (a drop it must report)."""
     if crashed or "Traceback" in text or "internal error" in text:
         return "traceback"
     if code == 0:
@@ -129,6 +132,8 @@ def classify(expect: Expect, code: int, text: str, crashed: bool, inputs: Iterab
             return "silent"
         if expect.compare and same is False:
             return "silent"
+        if expect.outcome == "correct" and not all(n in output for n in expect.names):
+            return "silent"  # accepted, but what it left out is not reported
         return "correct"
     if code != expect.code or not text.startswith("error:"):
         return "misleading"
@@ -197,7 +202,7 @@ class Audit:
                 except (OSError, ValueError, KeyError) as exc:
                     same, stderr = False, f"result unreadable: {exc}"
             verdict = classify(expect, code, stderr if code else "", crashed,
-                               (recording, model), same)
+                               (recording, model), same, stdout + stderr)
             if expect.outcome == "error_or_same" and verdict == "misleading":
                 verdict = "clear" if code == 2 and path.name in stderr else verdict
             outcome = Outcome(case, command, verdict,

@@ -255,6 +255,30 @@ def test_a_model_with_more_axes_than_the_recording(axis_files, tmp_path):
     assert code == 0, stderr
 
 
+@pytest.mark.parametrize("command", ["compensate", "evaluate", "report"])
+def test_a_header_less_multi_axis_csv_says_it_has_no_header_line(axis_files, tmp_path,
+                                                                  command):
+    """A 3-axis CSV whose header line is gone read as a single-axis file against a 3-axis
+    model ("the recording is single-axis (freq_hz, rate_dph) and the model has axes x, y,
+    z"): the axis mismatch is not the problem, the missing header is."""
+    from hrgtc.model import InstrumentModel, save_instrument
+    from hrgtc.recording import read
+
+    _, xyz, _, _ = axis_files
+    unit = make_model()
+    model = save_instrument(InstrumentModel({a: unit for a in "xyz"}, "imu"),
+                            tmp_path / "xyz.json")
+    csv = write(read(xyz), tmp_path / "xyz.csv")
+    lines = csv.read_text().split("\n")
+    header = next(i for i, line in enumerate(lines) if not line.startswith("#"))
+    csv.write_text("\n".join(lines[:header] + lines[header + 1:]))
+    code, stdout, stderr = invoke(*COMMANDS[command](csv, model, tmp_path))
+    message = squash(stderr)
+    assert code == 2, (stdout, stderr)
+    assert "no header line" in message and "--col" in message
+    assert "single-axis" not in message
+
+
 # -- the recording's noise against the training data's (Deliver 2) ------------------------------
 @pytest.fixture(scope="module")
 def checked_model(tmp_path_factory):
@@ -298,6 +322,52 @@ def test_a_rate_table_run_and_a_biased_mems_file_are_accepted(checked_model, tmp
     assert code == 0, stderr
     assert "note:" not in stderr  # the model has statistics: the check ran
     code, _, stderr = invoke("evaluate", run_path, "-m", checked_model, "--json")
+    assert code == 0, stderr
+
+
+def _with_temperature(axes: str):
+    """make_run's rows with the resonator temperature as ``temperature_c``, on one axis or
+    on x, y, z (one shared temperature)."""
+    from hrgtc.recording import Recording
+
+    from synthetic import ramp_run
+
+    run = ramp_run(seed=3, start_c=10.0, end_c=5.0, hours=3000 / 36000.0)
+    columns = {"time_s": run["time_s"]}
+    for suffix in ([""] if axes == "1" else ["_x", "_y", "_z"]):
+        columns |= {f"freq_hz{suffix}": run["freq_hz"], f"rate_dph{suffix}": run["rate_dph"]}
+    columns["temperature_c"] = run["resonator_c"]
+    return Recording(columns, run.metadata)
+
+
+@pytest.mark.parametrize("axes", ["1", "3"])
+@pytest.mark.parametrize("command", ["compensate", "evaluate", "report"])
+def test_swapped_rate_and_temperature_headers_are_named(checked_model, tmp_path, command,
+                                                        axes):
+    """Issue 21's audit: with the headers rate_dph and temperature_c swapped, a temperature
+    was compensated as the rate (exit 0): its noise, 5e-5 of the training rate's, is no
+    unit factor. The temperature column has the rate's noise: the swap is named."""
+    from hrgtc.model import InstrumentModel, load_model, save_instrument
+    from hrgtc.recording import Recording
+
+    run = _with_temperature(axes)
+    rate = "rate_dph" if axes == "1" else "rate_dph_x"
+    swapped = {({rate: "temperature_c", "temperature_c": rate}).get(k, k): run[k]
+               for k in run.names}
+    run_path = write(Recording(swapped, run.metadata), tmp_path / "swapped.parquet")
+    model = checked_model
+    if axes == "3":
+        unit = load_model(checked_model)
+        model = save_instrument(InstrumentModel({a: unit for a in "xyz"}, "imu"),
+                                tmp_path / "xyz.json")
+    code, stdout, stderr = invoke(*COMMANDS[command](run_path, model, tmp_path))
+    message = squash(stderr)
+    assert code == 2, (stdout, stderr)
+    assert "swapped.parquet" in message
+    assert f"headers {rate} and temperature_c look swapped" in message
+    # the undamaged file passes
+    good = write(run, tmp_path / "good.parquet")
+    code, _, stderr = invoke(*COMMANDS[command](good, model, tmp_path), "--force")
     assert code == 0, stderr
 
 

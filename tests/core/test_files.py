@@ -313,3 +313,70 @@ def test_write_text_atomic_refuses_creates_folders_and_falls_back_without_hard_l
         files.write_text_atomic(fresh, "again\n")
     assert fresh.read_text() == "no links\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a", "fresh.txt"]
+
+
+# -- mutants of files.py that no test killed (make mutation, issue 21) -------------------------
+@pytest.fixture
+def no_kill(monkeypatch):
+    """os.kill recorded instead of sent; the SIGTERM handler restored afterwards."""
+    import signal
+
+    from hrgtc.core import files
+
+    calls = []
+    monkeypatch.setattr(files.os, "kill", lambda pid, signum: calls.append((pid, signum)))
+    handler = signal.getsignal(signal.SIGTERM)
+    yield calls
+    signal.signal(signal.SIGTERM, handler)
+    files._PREVIOUS.clear()
+
+
+def test_on_signal_calls_a_previous_handler_with_the_signal_and_frame(no_kill, monkeypatch):
+    import signal
+
+    from hrgtc.core import files
+
+    seen = []
+    monkeypatch.setitem(files._PREVIOUS, signal.SIGTERM, lambda *args: seen.append(args))
+    files._on_signal(signal.SIGTERM, "the frame")
+    assert seen == [(signal.SIGTERM, "the frame")] and no_kill == []
+
+
+@pytest.mark.parametrize("registered", [True, False])
+def test_on_signal_without_a_previous_handler_dies_of_the_signal(no_kill, monkeypatch,
+                                                                  registered):
+    """The default action (or no handler recorded) re-sends the same signal to itself."""
+    import signal
+
+    from hrgtc.core import files
+
+    if registered:
+        monkeypatch.setitem(files._PREVIOUS, signal.SIGTERM, signal.SIG_DFL)
+    files._on_signal(signal.SIGTERM, None)
+    assert no_kill == [(os.getpid(), signal.SIGTERM)]
+
+
+def test_check_writable_asks_for_write_and_search_permission(tmp_path, monkeypatch):
+    """As root, os.access always says yes: the mode asked for is checked by a stand-in."""
+    from hrgtc.core import files
+    from hrgtc.core.errors import InputError
+
+    monkeypatch.setattr(files.os, "access", lambda path, mode: not mode & os.W_OK)
+    with pytest.raises(InputError, match="is not writable"):
+        files.check_writable(tmp_path / "out.parquet")
+
+
+def test_check_writable_free_space_edge_and_figures(tmp_path, monkeypatch):
+    """Exactly 5 % to spare is enough; less is refused, the figures in MB (1e6 bytes)."""
+    import shutil
+    from collections import namedtuple
+
+    from hrgtc.core import files
+    from hrgtc.core.errors import InputError
+
+    usage = namedtuple("usage", "total used free")
+    monkeypatch.setattr(shutil, "disk_usage", lambda path: usage(0, 0, 105))
+    files.check_writable(tmp_path / "out.parquet", 100.0)  # 105 free, 1.05 × 100: enough
+    monkeypatch.setattr(shutil, "disk_usage", lambda path: usage(0, 0, 1_050_000))
+    with pytest.raises(InputError, match=r"1\.1 MB free in .* needs about 1\.1 MB"):
+        files.check_writable(tmp_path / "out.parquet", 1_050_000.0)

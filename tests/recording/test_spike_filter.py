@@ -131,3 +131,38 @@ def test_impossible_values_stay_the_validation_s_business(tmp_path):
     with pytest.warns(SpikeWarning, match=r"1 row\(s\) .* removed"):
         rec = read(path, spike_filter="drop", spikes="drop")
     assert len(rec) == n - 2
+
+
+def test_spikes_evaluate_drops_are_counted_in_its_accounting(tmp_path):
+    """Issue 21's audit: a single-sample frequency glitch of 6 % (an excursion from both
+    neighbours, not a step) is a spike, and evaluate's default filter drops it; the drop
+    was only a warning: the JSON accounting read 8999 of the 9000 rows and counted no
+    spike. Every row read is accounted for, the dropped one under 'spikes', in the JSON
+    and in the plain output's samples line."""
+    import json
+
+    from typer.testing import CliRunner
+
+    from hrgtc.cli import app
+    from hrgtc.model import save_model
+    from hrgtc.recording import Recording, write
+
+    from fuzzing import make_model
+    from synthetic import ramp_run
+
+    run = ramp_run(seed=3, start_c=10.0, end_c=5.0, hours=0.1)
+    columns = {k: np.array(run[k]) for k in ("time_s", "freq_hz", "rate_dph")}
+    columns["freq_hz"][2500] *= 1.06
+    path = write(Recording(columns, run.metadata), tmp_path / "glitch.parquet")
+    model = save_model(make_model(), tmp_path / "model.json")
+    runner = CliRunner()
+    result = runner.invoke(app, ["evaluate", str(path), "-m", str(model), "--json"])
+    assert result.exit_code == 0, result.stderr
+    accounting = json.loads(result.stdout)["accounting"]
+    assert accounting["read"] == len(run) == 3600
+    assert accounting["dropped"]["spikes"] == 1
+    assert accounting["used"] == 3600 - 1 - accounting["dropped"]["warmup"]
+    plain = runner.invoke(app, ["evaluate", str(path), "-m", str(model)])
+    assert plain.exit_code == 0, plain.stderr
+    line = " ".join(plain.stdout.split())
+    assert "samples: 3600 read" in line and "1 spikes" in line

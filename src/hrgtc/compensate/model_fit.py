@@ -5,6 +5,7 @@ the band of plausible frequencies the reader enforces."""
 from __future__ import annotations
 
 import dataclasses
+import math
 from typing import Any
 
 import numpy as np
@@ -35,10 +36,62 @@ def check_recording_noise(model: Any, chunk: Recording, source: str = "",
     for axis, unit in units.items():
         if axis and axis in found:
             view = axis_view(chunk, axis)
-            check_noise(unit.training, view.rate_dph, fs, source, f"rate_dph_{axis}")
+            column = f"rate_dph_{axis}"
+            ratio = check_noise(unit.training, view.rate_dph, fs, source, column)
         elif not axis and "rate_dph" in chunk:
             column = "rate_dph" if axis_of_view is None else f"rate_dph_{axis_of_view}"
-            check_noise(unit.training, chunk.rate_dph, fs, source, column)
+            ratio = check_noise(unit.training, chunk.rate_dph, fs, source, column)
+        else:
+            continue
+        check_swapped_rate(unit.training, chunk, column, ratio, source)
+
+
+#: A gyro's rate is never this much quieter than its training data's: the noise floor is
+#: the sensor's own (a noisier recording, under vibration, is legitimate).
+QUIETER_THAN_TRAINING = 10.0
+#: A column whose noise is within this factor of the training rate's has the rate's noise.
+SAME_NOISE = 2.5
+
+
+def check_swapped_rate(statistics: Any, chunk: Recording, column: str, ratio: float,
+                       source: str = "") -> None:
+    """Refuse a rate column as quiet as a temperature while another column has the rate's
+    noise: swapped headers (``rate_dph`` and ``temperature_c``, issue 21's audit).
+
+    ``ratio`` is the rate column's noise over the training rate's
+    (:func:`hrgtc.drift.training.check_noise`, NaN for a constant or quantised column).
+    A temperature's sample-to-sample noise is some 1e-4 of a gyro rate's; alone, a quiet
+    rate is not refused (an older or synthetic model may have another noise), only when
+    another column of the recording has the rate's noise in its place.
+
+    Raises
+    ------
+    InputError
+        Names the file, both columns and their noise ratios.
+    """
+    from hrgtc.drift.training import rate_noise_dph
+
+    if statistics is None or not statistics.rate_noise_dph > 0.0:
+        return
+    values = chunk[column] if column in chunk else chunk.rate_dph
+    quiet = (ratio < 1.0 / QUIETER_THAN_TRAINING if math.isfinite(ratio)
+             else rate_noise_dph(values) == 0.0)
+    if not quiet:
+        return
+    fs = chunk.metadata.sample_rate_hz
+    for name in chunk.names:
+        if name == "time_s" or name.startswith(("rate_dph", "freq_hz")):
+            continue
+        other = statistics.noise_ratio(chunk[name], fs)
+        if math.isfinite(other) and 1.0 / SAME_NOISE <= other <= SAME_NOISE:
+            where = f"{source}: " if source else ""
+            shown = f"{ratio:.3g}×" if math.isfinite(ratio) else "none of"
+            raise InputError(
+                f"{where}the headers {column} and {name} look swapped: column {column!r} "
+                f"has {shown} the noise of the model's training rate (a temperature's, "
+                f"not a gyro's) and column {name!r} {other:.3g}× (the rate's); fix the "
+                f"header line of the file, or map the columns with --col {column}={name} "
+                f"--col {name}={column}")
 
 
 #: Frequencies farther than this beyond the calibrated span are errors, not extrapolation. [°C]

@@ -163,6 +163,8 @@ def recording_axes(path: str | os.PathLike[str],
     try:
         mapping = parse_columns((options or rec_io.ReadOptions()).columns)
         with rec_io.open_source(path) as source:
+            if not mapping and _header_less(source.names):
+                return None  # no axis can be told: reading says the header line is missing
             names = [*mapping, *(n for n in source.names if n not in mapping.values())]
             axes = tuple(axis_names(names))
             # an incomplete axis (freq_hz_z without rate_dph_z) is the reading's error to
@@ -171,6 +173,11 @@ def recording_axes(path: str | os.PathLike[str],
     except (HrgtcError, OSError, ValueError):
         return None
     return axes
+
+
+def _header_less(names: Sequence[str]) -> bool:
+    """True for the names a CSV without a header line gets (``column_1``, ``column_2``, ...)."""
+    return bool(names) and all(n == f"column_{i}" for i, n in enumerate(names, start=1))
 
 
 def parse_axes(text: str | Sequence[str] | None) -> tuple[str, ...] | None:

@@ -270,7 +270,7 @@ def check_writable(target: PathLike, expected_bytes: float = 0.0) -> None:
         The directory is missing, not writable, or has too little free space.
     """
     target = Path(target)
-    directory = target.parent if str(target.parent) else Path(".")
+    directory = target.parent  # "." for a bare file name
     if target.is_dir():
         raise InputError(f"{target} is a directory; give a file name")
     if not directory.is_dir():

@@ -252,3 +252,75 @@ def implausible_for_any_gyro(rate_dph: Any, sample_rate_hz: float) -> str | None
     side = "above the noisiest" if density > high else "below the quietest"
     return (f"the rate's noise density {density:.4g} °/h/√Hz is {side} gyro's ({low:g} to "
             f"{high:g} °/h/√Hz): check --rate-unit (°/h, °/s, rad/s)")
+
+
+# -- calibrate --thermometer sensor: is the thermometer a temperature? ------------------------
+#: A temperature whose sample-to-sample noise is this share of its span is no temperature
+#: (a thermal mass changes smoothly: 0.002 on a real MEMS recording, 4e-5 on the
+#: simulator); a rate at rest is mostly noise (white noise alone: 0.205).
+ROUGH_TEMPERATURE = 0.02
+#: ... and it must be this many times rougher than the rate column.
+SWAP_CONTRAST = 10.0
+
+
+class ChannelShape:
+    """How smooth a column is, over a whole run read in chunks: the median of the chunks'
+    MAD of sample-to-sample differences over the span between the 1st and 99th
+    percentiles (the lowest and highest of the chunks')."""
+
+    def __init__(self) -> None:
+        self._noises: list[float] = []
+        self._low, self._high = math.inf, -math.inf
+
+    def add(self, values: Any) -> None:
+        """One chunk of the column's values."""
+        finite = np.asarray(values, dtype=np.float64)
+        finite = finite[np.isfinite(finite)]
+        noise = rate_noise_dph(finite)
+        if not math.isfinite(noise):
+            return
+        self._noises.append(noise)
+        low, high = np.percentile(finite, [1.0, 99.0])
+        self._low, self._high = min(self._low, float(low)), max(self._high, float(high))
+
+    @property
+    def noise(self) -> float:
+        """Median over the chunks of the MAD of sample-to-sample differences (NaN: none)."""
+        return float(np.median(self._noises)) if self._noises else math.nan
+
+    @property
+    def span(self) -> float:
+        """Span between the 1st and 99th percentiles (NaN: no chunk)."""
+        return self._high - self._low if self._noises else math.nan
+
+    @property
+    def smoothness(self) -> float:
+        """noise / span: small for a temperature, about 0.2 for a rate at rest (NaN when
+        the column is constant)."""
+        return self.noise / self.span if self.span > 0.0 else math.nan
+
+
+def check_sensor_swap(temperature: ChannelShape, rate: ChannelShape, source: str = "",
+                      temperature_column: str = "temperature_c",
+                      rate_column: str = "rate_dph") -> None:
+    """Refuse a sensor thermometer that is as rough as a rate while the rate column is as
+    smooth as a temperature: swapped headers (issue 21's audit found them reported as "a
+    run that spans only 0.7 °C").
+
+    Raises
+    ------
+    InputError
+        Names the file, both columns, their noise and span, and the fix.
+    """
+    rough, smooth = temperature.smoothness, rate.smoothness
+    if not (rough > ROUGH_TEMPERATURE and rough > SWAP_CONTRAST * smooth):
+        return
+    where = f"{source}: " if source else ""
+    raise InputError(
+        f"{where}the headers {rate_column} and {temperature_column} look swapped: the "
+        f"thermometer column {temperature_column!r} changes by {temperature.noise:.3g} from "
+        f"sample to sample over a span of {temperature.span:.3g} (a rate's noise; a "
+        f"temperature changes smoothly) and {rate_column!r} by {rate.noise:.3g} over "
+        f"{rate.span:.3g} (a temperature's); fix the header line of the file, or map the "
+        f"columns with --col {rate_column}={temperature_column} "
+        f"--col {temperature_column}={rate_column}")

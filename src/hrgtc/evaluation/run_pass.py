@@ -619,12 +619,16 @@ def evaluate(
         rows = len(run)
         name, source, chunks = Path(run.source or "recording").name, run.source or "", [run]
         fs = run.sample_rate_hz
+        extra = run.metadata.extra
+        dropped = {"spikes": int(extra.get("spikes_dropped", 0))
+                   + int(extra.get("spikes_removed", 0))}
     else:
         options = with_model_band(read_options or ReadOptions(), model)
         refuse_compensated(run)
         check_recording_noise(model, options.head(run), str(run), options.axis)
         rows = count_rows(run)  # cheap (metadata, or a scan of a CSV's bytes); plans the pass
-        name, source, chunks = Path(run).name, str(run), options.chunks(run)
+        dropped = {}  # filled by the reading: the rows of spikes removed
+        name, source, chunks = Path(run).name, str(run), options.chunks(run, dropped=dropped)
         fs = None
     keep = None
     if motion != "keep":  # one pass of the detector's columns first
@@ -635,7 +639,11 @@ def evaluate(
         if fs is None:
             fs = options.head(run).sample_rate_hz  # (tiny chunks would each be validated)
         blocks = block_rows(rows, fs, max_points)
-    return run_pass(model, chunks, name, source=source, taus_s=taus_s, allan=allan,
-                    block_rows=blocks, on_output=on_output, progress=progress,
-                    total_rows=rows, gaps=gaps, deviation=deviation,
-                    confidence=confidence, keep=keep)
+    result = run_pass(model, chunks, name, source=source, taus_s=taus_s, allan=allan,
+                      block_rows=blocks, on_output=on_output, progress=progress,
+                      total_rows=rows, gaps=gaps, deviation=deviation,
+                      confidence=confidence, keep=keep)
+    if result.accounting is not None and dropped.get("spikes"):  # read, then left out
+        result.accounting.add_read(dropped["spikes"])
+        result.accounting.drop("spikes", dropped["spikes"])
+    return result

@@ -31,8 +31,10 @@ from hrgtc.core.progress import StageProgress, for_stage
 from hrgtc.drift.features import AUX_NAME, EQ21, parse_terms
 from hrgtc.drift.rest import run_rest
 from hrgtc.drift.training import (
+    ChannelShape,
     TrainingStatistics,
     check_resonator_gyro,
+    check_sensor_swap,
     implausible_for_any_gyro,
 )
 from hrgtc.evaluation import Evaluation, evaluate
@@ -319,6 +321,25 @@ def _fit_drift(training: Sequence[PathLike], heads: Mapping[str, Any], thermomet
     return model, housing
 
 
+def _sensor_columns(path: PathLike, options: ReadOptions) -> tuple[str, str]:
+    """The file's names of the sensor thermometer and of the rate (of ``options.axis``)."""
+    from hrgtc.recording import open_source
+    from hrgtc.recording.mapping import parse_columns
+
+    axis = options.axis
+    mapping = parse_columns(options.columns)
+    rate = f"rate_dph_{axis}" if axis else "rate_dph"
+    ours = [f"temperature_c_{axis}", "temperature_c"] if axis else ["temperature_c"]
+    try:
+        with open_source(path) as source:
+            names = set(source.names)
+    except (OSError, ValueError):
+        names = set()
+    temperature = next((mapping.get(n, n) for n in ours if n in mapping or n in names),
+                       "temperature_c")
+    return temperature, mapping.get(rate, rate)
+
+
 def _calibrate_sensor(soaks: Sequence[PathLike], drifts: Sequence[PathLike],
                       validate: Sequence[PathLike], options: ReadOptions,
                       progress: StageProgress | None, settings: CalibrationSettings,
@@ -335,12 +356,16 @@ def _calibrate_sensor(soaks: Sequence[PathLike], drifts: Sequence[PathLike],
     for path in training:  # the range of the samples the fit uses: those at rest
         keep = run_rest(options.chunks(path), options.motion).keep
         row = 0
+        temperature, rate = ChannelShape(), ChannelShape()
         for chunk in options.chunks(path):
             used = chunk.freq_hz[keep[row:row + len(chunk)]]
             row += len(chunk)
+            temperature.add(chunk.freq_hz)
+            rate.add(chunk.rate_dph)
             if used.size:
                 low = min(low, float(np.min(used)))
                 high = max(high, float(np.max(used)))
+        check_sensor_swap(temperature, rate, str(path), *_sensor_columns(path, options))
     thermometer = identity((low, high))
     heads = {str(path): options.head(path) for path in training}
     for path in drifts:  # any gyro: only a density beyond every gyro's can be told

@@ -319,6 +319,7 @@ def iter_chunks(
     end: str | float | None = None,
     slow_channels: str = _READ.slow_channels,
     hold_max_s: float | None = _READ.hold_max_s,
+    dropped: dict[str, int] | None = None,
 ) -> Iterator[Recording]:
     """Stream a recording in chunks of ``rows`` rows without loading the file.
 
@@ -328,6 +329,10 @@ def iter_chunks(
         Rows per chunk (the last chunk may be shorter).
     progress
         Called as ``progress(done, total)`` after each chunk (rows, or bytes for CSV).
+    dropped
+        A dict the caller reads once the chunks are exhausted: its ``"spikes"`` is
+        then the count of rows the spike filters removed (``spikes="drop"`` and
+        ``spike_filter="drop"``), for the caller's :class:`~hrgtc.core.Accounting`.
 
     Yields
     ------
@@ -424,6 +429,10 @@ def iter_chunks(
             spike_filter_.warn()
         robust.warn()
         slow.warn()
+        if dropped is not None:
+            dropped["spikes"] = dropped.get("spikes", 0) + (
+                (spike_filter_.dropped if spike_filter_ is not None else 0)
+                + (robust.rows if robust.mode == "drop" else 0))
         if progress is not None:
             total = source.position()[1]
             progress(total, total)
@@ -529,15 +538,18 @@ class ReadOptions(ReadSettings):
         finally:
             chunks.close()
 
-    def chunks(self, path: str | Path, rows: int | None = None) -> Iterator[Recording]:
-        """Stream the file in chunks (:func:`iter_chunks`); with ``axis``, that axis's view."""
+    def chunks(self, path: str | Path, rows: int | None = None,
+               dropped: dict[str, int] | None = None) -> Iterator[Recording]:
+        """Stream the file in chunks (:func:`iter_chunks`); with ``axis``, that axis's view.
+        ``dropped``: filled with the rows the spike filters removed (see there)."""
         if self.axis is None:
-            return iter_chunks(path, rows=rows or self.chunk_rows, **self.keywords())
+            return iter_chunks(path, rows=rows or self.chunk_rows, dropped=dropped,
+                               **self.keywords())
         words = self.keywords()
         words.pop("freq_band_hz", None)
         words.pop("freq_span_hz", None)
-        return self._axis_chunks(iter_chunks(path, rows=rows or self.chunk_rows, **words),
-                                 str(path))
+        return self._axis_chunks(iter_chunks(path, rows=rows or self.chunk_rows,
+                                             dropped=dropped, **words), str(path))
 
     def _axis_chunks(self, chunks: Iterator[Recording], path: str) -> Iterator[Recording]:
         axis = str(self.axis)
