@@ -188,11 +188,12 @@ def calibrate(
                                  housing_terms)
     if thermometer != "resonator":
         raise InputError(f"thermometer must be 'resonator' or 'sensor', got {thermometer!r}")
+    # the drifts' heads first: a file's own reading problem (time in ms, a wrong unit) is
+    # named before what is missing beside it
+    heads = {str(path): options.head(path) for path in drifts}
     if not soaks:
         raise InputError("no soak recordings given; pass --soak FILE for each soak "
                          "(a gyro without a frequency output: --thermometer sensor)")
-
-    heads = {str(path): options.head(path) for path in drifts}
     for path in drifts:  # an HRG: a noise or bias only a MEMS gyro has is a unit mistake
         head = heads[str(path)]
         check_resonator_gyro(head.rate_dph, head.metadata.sample_rate_hz,
@@ -384,7 +385,7 @@ def _calibrate_sensor(soaks: Sequence[PathLike], drifts: Sequence[PathLike],
         provenance=provenance(
             {"soak": [str(p) for p in soaks], "drift": [str(p) for p in drifts],
              "validate": [str(p) for p in validate]},
-            _record(settings, aux, housing_terms, None, options, thermometer="sensor"),
+            _record(settings, aux, housing_terms, options, thermometer="sensor"),
         ),
     )
     validation = tuple(evaluate(path, unit_model, allan=False, read_options=options)
