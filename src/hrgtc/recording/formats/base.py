@@ -1,65 +1,41 @@
-"""File formats of recordings: the source and sink interfaces, Parquet and HDF5.
+"""What every file format provides: a source (a reader of streams), a sink (a writer), a ``Format``.
 
-A *source* opens a file, lists its columns and raw metadata, and reads the
-columns asked for as :class:`pyarrow.Table` objects, whole or in batches, without
-loading more than a batch. A *sink* writes float64 columns chunk by chunk to a
-(temporary) path; :mod:`hrgtc.recording.io` makes that atomic.
+A file format is one module of this package (or of a lab's own package, found through
+the ``hrgtc.formats`` entry point group) that declares one :class:`Format`: its name,
+its suffixes, a sniff of the file's first bytes, a reader and, where it has one, a
+writer. :mod:`hrgtc.recording.formats.registry` collects the formats; everything that
+picks a format by suffix or content asks it.
 
-Layouts written by hrgtc:
+A reader opens a file as one or more *streams*. A stream is a :class:`Source`: a table
+of columns on its own time axis (the column :attr:`Source.time_column`), its raw
+metadata, and reading of the columns asked for as :class:`pyarrow.Table` objects, whole
+or in batches, without loading more than a batch. A logger that writes its channels at
+different rates gives one stream per rate; :mod:`hrgtc.recording.align` joins them onto
+one time axis (one stream: nothing to do). :class:`TableSource` is a stream over columns
+already in memory, all a small reader needs to return.
 
-* Parquet: one float64 column per recording column; the metadata as JSON in the
-  schema metadata under the key ``b"hrgtc"``; each field's unit in the field
-  metadata (``b"unit"``).
-* CSV: see :mod:`hrgtc.recording.csv`.
-* HDF5: a group ``/recording`` with one 1-D float64 dataset per column (its unit
-  in the attribute ``unit``) and the metadata as attributes of the group
-  (``extra`` as a JSON string). Foreign files: the group ``recording`` if
-  present, else the root if it holds 1-D datasets, else the only group. A dataset
-  named like a recording column that is not 1-D (an (N, 3) matrix, a scalar) and a
-  compound table are refused, never skipped (issue 21).
+A *sink* writes float64 columns chunk by chunk to a (temporary) path;
+:mod:`hrgtc.recording.writing` makes that atomic.
 """
 
 from __future__ import annotations
 
 import bisect
 import json
-import math
 from collections.abc import Callable, Iterator, Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pyarrow as pa
-import pyarrow.parquet as pq
 
 from hrgtc.errors import RecordingError
-from hrgtc.recording.axes import axis_names, base_name, split_axis
+from hrgtc.recording.axes import base_name, split_axis
 from hrgtc.recording.schema import COLUMNS, Metadata
 
-SUFFIXES: dict[str, str] = {
-    ".parquet": "parquet",
-    ".pq": "parquet",
-    ".csv": "csv",
-    ".h5": "hdf5",
-    ".hdf5": "hdf5",
-}
-#: Output format name (CLI ``--format``) -> suffix.
-FORMAT_SUFFIXES: dict[str, str] = {"parquet": ".parquet", "csv": ".csv", "h5": ".h5"}
-METADATA_KEY = b"hrgtc"
-HDF5_GROUP = "recording"
-PARQUET_ROW_GROUP_ROWS = 1 << 20
-HDF5_CHUNK_ROWS = 1 << 16
-
-
-def format_of(path: str | Path) -> str:
-    """``"parquet"``, ``"csv"`` or ``"hdf5"`` from the suffix of ``path``."""
-    suffix = Path(path).suffix.lower()
-    if suffix not in SUFFIXES:
-        known = ", ".join(SUFFIXES)
-        raise RecordingError(
-            f"{path}: unknown file type {suffix or '(no suffix)'!r}; use one of {known}"
-        )
-    return SUFFIXES[suffix]
+#: Bytes of the head of a file given to each format's sniff.
+SNIFF_BYTES = 4096
 
 
 def kind_of(dtype: pa.DataType) -> str:
@@ -110,9 +86,17 @@ def first_failing(array: pa.Array | pa.ChunkedArray, convert: Callable[[Any], An
     return bisect.bisect_left(range(low, high + 1), True, key=fails) - 1
 
 
+
 # -- sources -------------------------------------------------------------------
 class Source:
-    """An open recording file: column names, raw metadata and batched reading."""
+    """One stream of an open recording file: column names, raw metadata and batched reading.
+
+    A subclass sets :attr:`names`, :attr:`metadata` and :attr:`total_rows` in its
+    ``__init__`` and implements :meth:`kinds` and :meth:`read`; :meth:`iter_tables`
+    slices :meth:`read` unless the format can read in batches (it should, for files of
+    millions of rows). A file of several streams names each (:attr:`stream`) and its time
+    column (:attr:`time_column`, in seconds times :attr:`time_unit_s`).
+    """
 
     format = ""
 
@@ -121,6 +105,12 @@ class Source:
         self.names: list[str] = []
         self.metadata: dict[str, Any] = {}
         self.total_rows: int | None = None
+        #: Name of the stream within the file ("" for a file of one stream).
+        self.stream = ""
+        #: The column of the stream's time axis.
+        self.time_column = "time_s"
+        #: Seconds per unit of :attr:`time_column` (1e-6 for a logger's µs counter).
+        self.time_unit_s = 1.0
 
     def kinds(self) -> dict[str, str]:
         """Column name -> kind (see :func:`kind_of`)."""
@@ -132,7 +122,9 @@ class Source:
 
     def iter_tables(self, names: Sequence[str], as_text: set[str], rows: int) -> Iterator[pa.Table]:
         """The same, in consecutive tables of at most about ``rows`` rows."""
-        raise NotImplementedError
+        table = self.read(names, as_text)
+        for start in range(0, table.num_rows, max(int(rows), 1)):
+            yield table.slice(start, rows)
 
     def count_rows(self) -> int:
         """Number of data rows."""
@@ -152,206 +144,137 @@ class Source:
         self.close()
 
 
-class ParquetSource(Source):
-    format = "parquet"
-
-    def __init__(self, path: Path) -> None:
-        super().__init__(path)
-        try:
-            # pre_buffer off keeps batch reads small; page CRCs (written by ParquetSink) are
-            # verified, so a flipped bit is an error rather than a wrong number
-            self._file = pq.ParquetFile(path, pre_buffer=False, page_checksum_verification=True)
-        except (pa.ArrowInvalid, OSError) as exc:
-            if isinstance(exc, FileNotFoundError):
-                raise
-            raise RecordingError(f"{path}: not a readable Parquet file ({exc})") from None
-        schema = self._file.schema_arrow
-        self.names = list(schema.names)
-        for i, name in enumerate(self.names):
-            if name in self.names[:i]:
-                self._file.close()
-                raise RecordingError(
-                    f"{path}: columns {self.names.index(name) + 1} and {i + 1} are both named "
-                    f"{name!r}; hrgtc cannot tell which one is meant: write the file with "
-                    "unique column names")
-        self.total_rows = self._file.metadata.num_rows
-        raw = (schema.metadata or {}).get(METADATA_KEY)
-        if raw is not None:
-            try:
-                self.metadata = dict(loads_json(raw))
-            except (ValueError, TypeError):
-                raise RecordingError(f"{path}: the hrgtc metadata is not valid JSON") from None
-        self._done = 0
-
-    def kinds(self) -> dict[str, str]:
-        return {f.name: kind_of(f.type) for f in self._file.schema_arrow}
-
-    def read(self, names: Sequence[str], as_text: set[str]) -> pa.Table:
-        try:
-            return self._file.read(columns=list(names))
-        except (pa.ArrowException, OSError) as exc:
-            raise self._corrupt(exc) from None
-
-    def iter_tables(self, names: Sequence[str], as_text: set[str], rows: int) -> Iterator[pa.Table]:
-        batches = self._file.iter_batches(batch_size=rows, columns=list(names))
-        while True:
-            try:
-                batch = next(batches)
-            except StopIteration:
-                return
-            except (pa.ArrowException, OSError) as exc:
-                raise self._corrupt(exc) from None
-            self._done += batch.num_rows
-            yield pa.Table.from_batches([batch])
-
-    def _corrupt(self, exc: Exception) -> RecordingError:
-        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        return RecordingError(
-            f"{self.path}: the Parquet data are corrupt near row {self._done} ({first}); "
-            "the file was damaged after it was written: restore it from its source")
-
-    def position(self) -> tuple[float, float]:
-        return (float(self._done), float(self.total_rows or 0))
-
-    def close(self) -> None:
-        self._file.close()
-
-
-class Hdf5Source(Source):
-    format = "hdf5"
-
-    def __init__(self, path: Path) -> None:
-        import h5py
-
-        super().__init__(path)
-        if not path.exists():
-            raise FileNotFoundError(2, "No such file or directory", str(path))
-        try:
-            self._file = h5py.File(path, "r")
-        except OSError as exc:
-            raise RecordingError(f"{path}: not a readable HDF5 file ({exc})") from None
-        group = self._pick_group(h5py)
-        self._datasets = {
-            name: obj
-            for name, obj in group.items()
-            if isinstance(obj, h5py.Dataset) and obj.ndim == 1 and obj.dtype.names is None
-        }
-        self.skipped = {  # datasets that are not a column: named if asked for
-            name: obj for name, obj in group.items()
-            if isinstance(obj, h5py.Dataset) and name not in self._datasets
-        }
-        self._refuse_shapes()
-        self.names = list(self._datasets)
-        lengths = {name: ds.shape[0] for name, ds in self._datasets.items()}
-        if len(set(lengths.values())) > 1:
-            self._file.close()
-            raise RecordingError(f"{path}: datasets of different lengths {lengths}")
-        self.total_rows = next(iter(lengths.values()), 0)
-        self.metadata = {k: _attr_value(v) for k, v in group.attrs.items()}
-        if isinstance(self.metadata.get("extra"), str):
-            try:
-                self.metadata["extra"] = loads_json(self.metadata["extra"])
-            except ValueError:
-                pass
-        self._done = 0
-
-    def _refuse_shapes(self) -> None:
-        """Refuse a recording column stored as a table, a matrix or a scalar."""
-        for name, ds in self.skipped.items():
-            if ds.dtype.names is not None:
-                fields = ", ".join(ds.dtype.names[:8])
-                why = (f"dataset {name!r} is a compound table (fields {fields}); hrgtc reads "
-                       "one 1-D dataset per column: store each field as its own dataset "
-                       f"(e.g. group['time_s'] = table['time_s']) in a group {HDF5_GROUP!r}")
-            elif is_column_name(name):
-                shape = "a scalar (shape ())" if ds.ndim == 0 else f"of shape {ds.shape}"
-                why = (f"dataset {name!r} is {shape}, not a 1-D column of one value per row; "
-                       "store one 1-D dataset per column (a 3-axis rate as rate_dph_x, "
-                       "rate_dph_y, rate_dph_z)")
-            else:
-                continue
-            self._file.close()
-            raise RecordingError(f"{self.path}: {why}")
-
-    def _pick_group(self, h5py: Any) -> Any:
-        root = self._file
-        if HDF5_GROUP in root and isinstance(root[HDF5_GROUP], h5py.Group):
-            return root[HDF5_GROUP]
-        if any(isinstance(o, h5py.Dataset) and o.ndim == 1 for o in root.values()):
-            return root
-        groups = [name for name, o in root.items() if isinstance(o, h5py.Group)]
-        if len(groups) == 1:
-            return root[groups[0]]
-        self._file.close()
-        raise RecordingError(
-            f"{self.path}: no group {HDF5_GROUP!r} and no 1-D datasets at the root "
-            f"(groups: {groups}); store one dataset per column in a group {HDF5_GROUP!r}"
-        )
-
-    def kinds(self) -> dict[str, str]:
-        kinds = {}
-        for name, ds in self._datasets.items():
-            char = ds.dtype.kind
-            kinds[name] = "numeric" if char in "fiub" else "string" if char in "SUO" else "other"
-        return kinds
-
-    def _table(self, names: Sequence[str], start: int, stop: int) -> pa.Table:
-        arrays = {}
-        for name in names:
-            values = self._datasets[name][start:stop]
-            if values.dtype.kind in "SO":
-                values = [
-                    v.decode("utf-8", "replace") if isinstance(v, bytes) else v for v in values
-                ]
-            arrays[name] = pa.array(values)
-        return pa.table(arrays)
-
-    def read(self, names: Sequence[str], as_text: set[str]) -> pa.Table:
-        return self._table(names, 0, self.total_rows)
-
-    def iter_tables(self, names: Sequence[str], as_text: set[str], rows: int) -> Iterator[pa.Table]:
-        for start in range(0, self.total_rows, rows):
-            stop = min(start + rows, self.total_rows)
-            self._done = stop
-            yield self._table(names, start, stop)
-
-    def position(self) -> tuple[float, float]:
-        return (float(self._done), float(self.total_rows or 0))
-
-    def close(self) -> None:
-        self._file.close()
-
-
 def is_column_name(name: str) -> bool:
     """True for a recording contract column, per-axis ones (``rate_dph_x``) included."""
     base, axis = split_axis(name)
     return name in COLUMNS or (axis is not None and base in COLUMNS)
 
 
-def _attr_value(value: Any) -> Any:
-    if isinstance(value, bytes):
-        return value.decode("utf-8", "replace")
-    if isinstance(value, np.generic):
-        value = value.item()
-    if isinstance(value, float) and not math.isfinite(value):
-        return str(value)
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    return value
-
-
-# -- sinks ---------------------------------------------------------------------
 def column_unit(name: str, axes: Sequence[str] = ()) -> str | None:
     """Unit of a contract column, per-axis ones (``rate_dph_x`` of ``axes``) included; else None."""
     base = base_name(name, axes)
     return COLUMNS[base][0] if base in COLUMNS else None
 
 
-def _field_metadata(name: str, axes: Sequence[str]) -> dict[bytes, bytes] | None:
-    unit = column_unit(name, axes)
-    return {b"unit": unit.encode()} if unit else None
+class TableSource(Source):
+    """A stream over columns already in memory: what a small reader returns.
+
+    Parameters
+    ----------
+    path
+        The file the columns were read from (named in messages).
+    columns
+        Column name -> 1-D array (numbers, or text for clock times), all of one length;
+        or a :class:`pyarrow.Table`.
+    metadata
+        The file's raw metadata (``sample_rate_hz``, ``unit``, ``extra`` ...).
+    stream, time_column, time_unit_s
+        See :class:`Source`.
+    """
+
+    format = "table"
+
+    def __init__(self, path: str | Path, columns: Mapping[str, Any] | pa.Table,
+                 metadata: Mapping[str, Any] | None = None, *, stream: str = "",
+                 time_column: str = "time_s", time_unit_s: float = 1.0) -> None:
+        super().__init__(Path(path))
+        self._table = columns if isinstance(columns, pa.Table) else pa.table(
+            {name: pa.array(np.asarray(values) if not isinstance(values, pa.Array) else values)
+             for name, values in columns.items()})
+        self.names = list(self._table.column_names)
+        self.metadata = dict(metadata or {})
+        self.total_rows = self._table.num_rows
+        self.stream, self.time_column, self.time_unit_s = stream, time_column, float(time_unit_s)
+        self._done = 0
+
+    def kinds(self) -> dict[str, str]:
+        return {f.name: kind_of(f.type) for f in self._table.schema}
+
+    def read(self, names: Sequence[str], as_text: set[str]) -> pa.Table:
+        self._done = self._table.num_rows
+        return self._table.select(list(names))
+
+    def iter_tables(self, names: Sequence[str], as_text: set[str], rows: int) -> Iterator[pa.Table]:
+        table = self._table.select(list(names))
+        for start in range(0, table.num_rows, max(int(rows), 1)):
+            self._done = min(start + rows, table.num_rows)
+            yield table.slice(start, rows)
+
+    def position(self) -> tuple[float, float]:
+        return (float(self._done), float(self.total_rows or 0))
 
 
+Reader = Callable[[Path], "Source | Sequence[Source]"]
+Sniff = Callable[[bytes], bool]
+
+
+@dataclass(frozen=True)
+class Format:
+    """A file format: its name, suffixes, sniff, reader and (optional) writer.
+
+    Parameters
+    ----------
+    name
+        Short name, shown by ``hrgtc info`` and in messages (``"csv"``).
+    suffixes
+        File suffixes, lower case with the dot (``(".csv",)``); the first is the one
+        written.
+    reader
+        ``reader(path)`` opens the file: a :class:`Source`, or a list of them for a
+        file whose channels are on several time axes (joined by
+        :func:`hrgtc.recording.align.align`). A missing file raises FileNotFoundError,
+        an unreadable one :class:`~hrgtc.errors.RecordingError` naming the file.
+    sniff
+        ``sniff(head)``: True when the first :data:`SNIFF_BYTES` bytes of a file are
+        certainly this format (a signature); None: the format is known by its suffix
+        only. A file of unknown suffix is read by the format whose sniff accepts it.
+    sink
+        Writer class (``Sink(path, metadata, names)``) or None if the format is read only.
+    output_name
+        The name of the format for ``--format`` of the commands that write
+        (``"h5"`` for HDF5); default :attr:`name`.
+    description
+        One line for listings.
+    """
+
+    name: str
+    suffixes: tuple[str, ...]
+    reader: Reader
+    sniff: Sniff | None = None
+    sink: type[Sink] | None = None
+    output_name: str = ""
+    description: str = ""
+
+    def __post_init__(self) -> None:
+        if not self.name or not self.suffixes:
+            raise ValueError(f"a file format needs a name and at least one suffix, got "
+                             f"{self.name!r} {self.suffixes!r}")
+        bad = [s for s in self.suffixes if not s.startswith(".") or s != s.lower()]
+        if bad:
+            raise ValueError(f"format {self.name!r}: suffixes must be lower case and start "
+                             f"with a dot, got {bad}")
+        if not self.output_name:
+            object.__setattr__(self, "output_name", self.name)
+
+    def open(self, path: str | Path) -> list[Source]:
+        """The file's streams (one for most formats)."""
+        opened = self.reader(Path(path))
+        streams = [opened] if isinstance(opened, Source) else list(opened)
+        if not streams:
+            raise RecordingError(f"{path}: the {self.name} reader found no stream of columns")
+        return streams
+
+    def accepts(self, head: bytes) -> bool:
+        """True when :attr:`sniff` recognises ``head`` (never raises)."""
+        if self.sniff is None:
+            return False
+        try:
+            return bool(self.sniff(head))
+        except Exception:  # a plugin's sniff must not break the choice of another format
+            return False
+
+
+# -- sinks ---------------------------------------------------------------------
 class Sink:
     """Writes float64 columns chunk by chunk to ``path``."""
 
@@ -365,92 +288,6 @@ class Sink:
     def close(self) -> None:
         raise NotImplementedError
 
-
-def _arrow_float64(values: np.ndarray) -> pa.Array:
-    """A float64 numpy array as an Arrow array over the same memory (no pandas import)."""
-    values = np.ascontiguousarray(values, dtype=np.float64)
-    return pa.Array.from_buffers(pa.float64(), len(values), [None, pa.py_buffer(values)])
-
-
-class ParquetSink(Sink):
-    def __init__(self, path: Path, metadata: Metadata, names: Sequence[str]) -> None:
-        super().__init__(path, metadata, names)
-        axes = axis_names(names)
-        # Columns are declared non-nullable (a sample is a float, NaN included, never
-        # missing): the writer then encodes no definition levels, which cost a third of
-        # the write (151 -> 102 ms per million rows of 11 columns), and readers skip them.
-        fields = [pa.field(n, pa.float64(), nullable=False, metadata=_field_metadata(n, axes))
-                  for n in names]
-        self._schema = pa.schema(fields, metadata={METADATA_KEY: metadata_json(metadata)})
-        # Float gyro data does not compress as it is (snappy saved 0 % on simulated runs
-        # and cost a third of the write speed), but with its bytes split into streams
-        # (BYTE_STREAM_SPLIT: sign/exponent bytes apart from the noisy mantissa bytes) LZ4
-        # halves it: 202 -> 95 MB for a 3.6 M-row run, 317 -> 165 MB compensated, read
-        # twice as fast, and half the bytes to wait for at the fsync of a durable write.
-        # Page checksums (CRC32) let every reader detect a flipped bit. Min/max statistics
-        # are kept for time_s only (a query by time skips row groups; min/max of every
-        # other column cost 12 % of the write and nothing reads them).
-        self._writer = pq.ParquetWriter(
-            str(path), self._schema, use_dictionary=False, compression="lz4",
-            use_byte_stream_split=True, write_page_checksum=True,
-            write_statistics=[n for n in names if n == "time_s"] or False)
-        self._pending: list[pa.Table] = []
-        self._pending_rows = 0
-
-    def write(self, columns: Mapping[str, np.ndarray]) -> None:
-        arrays = [_arrow_float64(columns[n]) for n in self.names]
-        table = pa.Table.from_arrays(arrays, schema=self._schema)
-        self._pending.append(table)
-        self._pending_rows += table.num_rows
-        if self._pending_rows >= PARQUET_ROW_GROUP_ROWS:
-            self._flush()
-
-    def _flush(self) -> None:
-        if self._pending:
-            self._writer.write_table(
-                pa.concat_tables(self._pending), row_group_size=PARQUET_ROW_GROUP_ROWS
-            )
-        self._pending, self._pending_rows = [], 0
-
-    def close(self) -> None:
-        self._flush()
-        self._writer.close()
-
     def abort(self) -> None:
-        self._pending = []
-        self._writer.close()
-
-
-class Hdf5Sink(Sink):
-    def __init__(self, path: Path, metadata: Metadata, names: Sequence[str]) -> None:
-        import h5py
-
-        super().__init__(path, metadata, names)
-        metadata_json(metadata)
-        self._file = h5py.File(path, "w")
-        group = self._file.create_group(HDF5_GROUP, track_order=True)
-        for key, value in metadata.to_dict().items():
-            group.attrs[key] = json.dumps(value) if key == "extra" else value
-        self._datasets = {}
-        axes = axis_names(names)
-        for name in names:
-            ds = group.create_dataset(
-                name, shape=(0,), maxshape=(None,), dtype="f8", chunks=(HDF5_CHUNK_ROWS,)
-            )
-            if column_unit(name, axes):
-                ds.attrs["unit"] = column_unit(name, axes)
-            self._datasets[name] = ds
-        self._rows = 0
-
-    def write(self, columns: Mapping[str, np.ndarray]) -> None:
-        n = len(columns[self.names[0]]) if self.names else 0
-        for name, ds in self._datasets.items():
-            ds.resize((self._rows + n,))
-            ds[self._rows :] = columns[name]
-        self._rows += n
-
-    def close(self) -> None:
-        self._file.close()
-
-    def abort(self) -> None:
-        self._file.close()
+        """Discard what was written (the caller removes the file)."""
+        self.close()
