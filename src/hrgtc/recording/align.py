@@ -180,14 +180,14 @@ class AlignedSource(Source):
         for name in slow:
             state = self.slow.channels[name]
             sample_time, sample_values = self._samples[name]
-            values, too_old = resample_channel(time_s, sample_time, sample_values,
+            values, too_old, exact = resample_channel(time_s, sample_time, sample_values,
                                                self.slow.mode, state.max_age_s)
             filled[name] = values
             dropped = int(np.count_nonzero(too_old))
             if dropped and state.first_dropped_row is None:
                 state.first_dropped_row = self._offset + int(np.argmax(too_old))
             state.dropped += dropped
-            state.filled += n - dropped
+            state.filled += n - dropped - exact
             keep &= ~too_old
         self._offset += n
         arrays = []

@@ -240,7 +240,7 @@ def channel_period(time_s: np.ndarray) -> float:
 
 
 def resample_channel(time_s: np.ndarray, sample_time_s: np.ndarray, sample_values: np.ndarray,
-                     mode: str, max_age_s: float) -> tuple[np.ndarray, np.ndarray]:
+                     mode: str, max_age_s: float) -> tuple[np.ndarray, np.ndarray, int]:
     """A channel logged on its own time axis, at the times ``time_s`` of another.
 
     The rule of :class:`SlowChannels` for a channel of another stream: at each time,
@@ -261,15 +261,16 @@ def resample_channel(time_s: np.ndarray, sample_time_s: np.ndarray, sample_value
 
     Returns
     -------
-    values, too_old
-        The channel at ``time_s`` and the mask of the times too far from a value (to be
-        dropped as a gap in the channel).
+    values, too_old, exact
+        The channel at ``time_s``, the mask of the times too far from a value (to be
+        dropped as a gap in the channel), and the number of times that are times of a
+        value (not filled).
     """
     last = np.searchsorted(sample_time_s, time_s, side="right") - 1
     known = last >= 0
     at = np.maximum(last, 0)
     if sample_time_s.size == 0:
-        return np.full(time_s.shape, np.nan), np.ones(time_s.shape, dtype=bool)
+        return np.full(time_s.shape, np.nan), np.ones(time_s.shape, dtype=bool), 0
     before_time = np.where(known, sample_time_s[at], -math.inf)
     values = np.where(known, sample_values[at], math.nan)
     if mode == "interpolate":
@@ -280,7 +281,7 @@ def resample_channel(time_s: np.ndarray, sample_time_s: np.ndarray, sample_value
             share = np.where(inside, (time_s - before_time) / span, 0.0)
         values = np.where(inside, values + share * (sample_values[nxt] - values), values)
     too_old = ~(time_s - before_time <= max_age_s)
-    return values, too_old
+    return values, too_old, int(np.count_nonzero(before_time == time_s))
 
 
 def fill_slow_channels(arrays: dict[str, np.ndarray], mode: str = "hold",
