@@ -109,25 +109,16 @@ def test_content_of_another_format_than_the_suffix_says_is_refused(tmp_path):
 
 
 # -- a lab's own format through an entry point -----------------------------------------
-PLUGIN = '''
-"""A lab's logger: a line 'MYLAB1', then rows 'time freq rate' separated by spaces."""
-import numpy as np
-
-from hrgtc.errors import RecordingError
-from hrgtc.recording.formats import Format, TableSource
-
-
-def read_mylab(path):
-    with open(path, encoding="utf-8") as handle:
-        if handle.readline().strip() != "MYLAB1":
-            raise RecordingError(f"{path}: not a MYLAB1 file (first line)")
-        rows = np.loadtxt(handle, ndmin=2)
-    columns = {"time_s": rows[:, 0], "freq_hz": rows[:, 1], "rate_dph": rows[:, 2]}
-    return TableSource(path, columns, {"unit": "mylab gyro"})
+def documented_plugin() -> str:
+    """The example module of docs/architecture.md ("Adding a file format"), as written there."""
+    text = (Path(__file__).resolve().parents[2] / "docs" / "architecture.md").read_text(
+        encoding="utf-8")
+    section = text[text.index("### Adding a file format"):]
+    return section[section.index("```python\n") + 10:section.index("\n```", section.index(
+        "```python\n"))] + "\n"
 
 
-FORMAT = Format("mylab", (".mylab",), read_mylab, sniff=lambda head: head.startswith(b"MYLAB1"))
-'''
+PLUGIN = documented_plugin()
 
 
 @pytest.fixture
