@@ -12,9 +12,12 @@ point group ``hrgtc.formats`` of its ``pyproject.toml``::
     [project.entry-points."hrgtc.formats"]
     mylab = "mylab_hrgtc:FORMAT"
 
-The entry points are loaded once, on the first use of the registry. A format that fails
-to load is left out with a :class:`~hrgtc.errors.FormatPluginWarning` (reading the other
-formats goes on); two formats may not claim one suffix.
+The entry points are loaded once, when a file's suffix is not one of the formats
+registered so far or when every format is listed (the scan of the installed
+distributions costs some milliseconds, which reading a Parquet, CSV or HDF5 file does
+not pay). A format that fails to load is left out with a
+:class:`~hrgtc.errors.FormatPluginWarning` (reading the other formats goes on); two
+formats may not claim one suffix.
 """
 
 from __future__ import annotations
@@ -119,6 +122,17 @@ def suffixes() -> dict[str, str]:
     return {suffix: fmt.name for fmt in formats() for suffix in fmt.suffixes}
 
 
+def _by_suffix(suffix: str) -> Format | None:
+    """The format of ``suffix``: of those registered so far, else after loading the plugins."""
+    for fmt in _formats.values():
+        if suffix in fmt.suffixes:
+            return fmt
+    if not _plugins_loaded:
+        load_plugins()
+        return _by_suffix(suffix)
+    return None
+
+
 def output_suffixes() -> dict[str, str]:
     """Output name (``--format``) -> the suffix written, of every format with a writer."""
     return {fmt.output_name: fmt.suffixes[0] for fmt in formats() if fmt.sink is not None}
@@ -126,7 +140,7 @@ def output_suffixes() -> dict[str, str]:
 
 def is_recording(path: str | Path) -> bool:
     """True when the suffix of ``path`` is that of a registered format."""
-    return Path(path).suffix.lower() in suffixes()
+    return _by_suffix(Path(path).suffix.lower()) is not None
 
 
 def _listing() -> str:
@@ -155,12 +169,12 @@ def format_for(path: str | Path) -> Format:
     """
     path = Path(path)
     suffix = path.suffix.lower()
-    by_suffix = suffixes()
-    if suffix in by_suffix:
-        fmt = _formats[by_suffix[suffix]]
+    fmt = _by_suffix(suffix)
+    if fmt is not None:
         head = _head(path) if path.is_file() else None
         if head and fmt.sniff is not None and not fmt.accepts(head):
-            other = next((f for f in formats() if f is not fmt and f.accepts(head)), None)
+            other = next((f for f in _formats.values() if f is not fmt and f.accepts(head)),
+                         None)
             if other is not None:
                 raise RecordingError(
                     f"{path}: the file's content is {other.name} (its first bytes), not "
@@ -172,7 +186,7 @@ def format_for(path: str | Path) -> Format:
         found = [fmt for fmt in formats() if fmt.accepts(head)]
         if len(found) == 1:
             return found[0]
-    known = ", ".join(by_suffix)
+    known = ", ".join(suffixes())
     raise RecordingError(
         f"{path}: unknown file type {suffix or '(no suffix)'!r}; use one of {known} "
         f"(registered formats: {_listing()})")
@@ -198,8 +212,7 @@ def writable(path: str | Path) -> Format:
     """
     path = Path(path)
     suffix = path.suffix.lower()
-    name = suffixes().get(suffix)
-    fmt = None if name is None else _formats[name]
+    fmt = _by_suffix(suffix)
     if fmt is not None and fmt.sink is not None:
         return fmt
     can = ", ".join(f"{f.suffixes[0]} ({f.name})" for f in formats() if f.sink is not None)
