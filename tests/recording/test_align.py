@@ -7,6 +7,7 @@ column is empty between its values, read through the existing slow-channel path.
 
 from __future__ import annotations
 
+import json
 import warnings
 
 import h5py
@@ -129,3 +130,22 @@ def test_a_stream_time_axis_in_microseconds(tmp_path):
         warnings.simplefilter("ignore", SlowChannelWarning)
         table = align([fast, slow]).read(["time_s", "housing_c"], set())
     np.testing.assert_array_equal(table.column("housing_c").to_numpy(), np.floor(t))
+
+
+def test_hrgtc_info_aligns_the_streams_of_an_hdf5_file(tmp_path):
+    from typer.testing import CliRunner
+
+    from hrgtc.cli import app
+
+    gyro, thermo_time, housing, _ = gyro_and_thermometer()
+    path = two_stream_h5(tmp_path / "two.h5", gyro, thermo_time, housing)
+    runner = CliRunner()
+    with pytest.warns(SlowChannelWarning):
+        result = runner.invoke(app, ["info", str(path), "--json"])
+    assert result.exit_code == 0, result.output
+    info = json.loads(result.output)
+    assert info["format"] == "hdf5" and info["rows"] == N - 3  # before the first value: dropped
+    housing_c = next(c for c in info["columns"] if c["name"] == "housing_c")
+    assert housing_c["min"] == float(housing.min()) and housing_c["max"] == float(housing.max())
+    refused = runner.invoke(app, ["info", str(path), "--slow-channels", "error"])
+    assert "2 streams on their own time axes (gyro, thermal)" in refused.output
