@@ -13,6 +13,8 @@ import warnings
 import h5py
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from hrgtc.errors import RecordingError, SlowChannelWarning
 from hrgtc.recording import Metadata, Recording, iter_chunks, read, write
@@ -149,3 +151,54 @@ def test_hrgtc_info_aligns_the_streams_of_an_hdf5_file(tmp_path):
     assert housing_c["min"] == float(housing.min()) and housing_c["max"] == float(housing.max())
     refused = runner.invoke(app, ["info", str(path), "--slow-channels", "error"])
     assert "2 streams on their own time axes (gyro, thermal)" in refused.output
+
+
+def brute_force(time_s, sample_time, sample_values, mode, max_age_s):
+    """Row by row, in plain Python: the value each row gets, or None for a row dropped."""
+    out = []
+    for t in time_s:
+        before = [i for i, s in enumerate(sample_time) if s <= t]
+        if not before or t - sample_time[before[-1]] > max_age_s:
+            out.append(None)
+            continue
+        i = before[-1]
+        value = sample_values[i]
+        if mode == "interpolate" and i + 1 < len(sample_time) and sample_time[i + 1] > \
+                sample_time[i]:
+            share = (t - sample_time[i]) / (sample_time[i + 1] - sample_time[i])
+            value = value + share * (sample_values[i + 1] - value)
+        out.append(value)
+    return out
+
+
+@settings(max_examples=40, deadline=None)
+@given(slow_times=st.lists(st.floats(0.0, 12.0), min_size=1, max_size=15, unique=True),
+       mode=st.sampled_from(["hold", "interpolate"]), max_age_s=st.floats(0.05, 5.0),
+       rows=st.integers(1, 40))
+def test_aligned_rows_equal_a_row_by_row_computation(slow_times, mode, max_age_s, rows):
+    time_s = np.arange(100) / 8.0  # 8 Hz, 12.4 s
+    sample_time = np.sort(np.asarray(slow_times))
+    sample_values = np.cos(sample_time) * 10.0
+    fast = TableSource("run", {"time_s": time_s, "rate_dph": np.arange(100.0)})
+    slow = TableSource("run", {"time_s": sample_time[::-1].copy(),  # unsorted on disk
+                               "housing_c": sample_values[::-1].copy()})
+    aligned = align([fast, slow], mode, max_age_s)
+    tables = list(aligned.iter_tables(["time_s", "rate_dph", "housing_c"], set(), rows))
+    got = np.concatenate([t.column("housing_c").to_numpy() for t in tables])
+    kept = np.concatenate([t.column("rate_dph").to_numpy() for t in tables]).astype(int)
+    expected = brute_force(time_s, sample_time, sample_values, mode, max_age_s)
+    assert kept.tolist() == [i for i, v in enumerate(expected) if v is not None]
+    np.testing.assert_allclose(got, [v for v in expected if v is not None], rtol=0, atol=1e-9)
+    state = aligned.slow.channels["housing_c"]
+    assert state.dropped == expected.count(None)
+
+
+def test_a_channel_of_one_value_needs_a_maximum_age():
+    fast = TableSource("run.h5", {"time_s": np.arange(10.0), "rate_dph": np.zeros(10)})
+    slow = TableSource("run.h5", {"time_s": np.array([2.0]), "housing_c": np.array([20.0])},
+                       stream="thermal")
+    with pytest.raises(RecordingError, match=r"run\.h5: column 'housing_c' of the stream "
+                       r"'thermal' has 1 value\(s\) .* give --hold-max-s SECONDS"):
+        align([fast, slow]).read(["time_s", "housing_c"], set())
+    table = align([fast, slow], max_age_s=100.0).read(["time_s", "housing_c"], set())
+    assert table.column("housing_c").to_pylist() == [20.0] * 8  # rows 0 and 1: before it

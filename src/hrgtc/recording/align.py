@@ -158,6 +158,12 @@ class AlignedSource(Source):
                     sample_time, sample_values = sample_time[order], sample_values[order]
                 self._samples[name] = (sample_time, sample_values)
                 period = channel_period(sample_time)
+                if self._max_age_s is None and not period > 0:
+                    where = f" of the stream {other.stream!r}" if other.stream else ""
+                    raise RecordingError(
+                        f"{other.path}: column {name!r}{where} has {sample_time.size} value(s) "
+                        "at distinct times fewer than 2, so its period, and how long a value "
+                        "may be held, is unknown; give --hold-max-s SECONDS")
                 age = (self._max_age_s if self._max_age_s is not None
                        else DEFAULT_MAX_AGE_PERIODS * period)
                 self.slow.channels[name] = ChannelFill(name, period, float(age))
