@@ -22,9 +22,11 @@ from hrgtc.recording import Metadata, Recording, RecordingWriter, iter_chunks, r
 from hrgtc.recording.formats import (
     ENTRY_POINT_GROUP,
     Format,
+    Sink,
     TableSource,
     format_for,
     formats,
+    metadata_json,
     open_streams,
     registry,
 )
@@ -187,3 +189,44 @@ def test_a_broken_plugin_is_left_out_with_a_warning(plugin_dir, monkeypatch):
     finally:
         registry.unregister("mylab")
         sys.modules.pop("mylab_hrgtc", None)
+
+
+class NpzSink(Sink):
+    """numpy's .npz: chunks gathered, written at close; the metadata as JSON."""
+
+    def __init__(self, path, metadata, names):
+        super().__init__(path, metadata, names)
+        self.metadata, self.parts = metadata, []
+
+    def write(self, columns):
+        self.parts.append({n: np.array(columns[n]) for n in self.names})
+
+    def close(self):
+        arrays = {n: np.concatenate([p[n] for p in self.parts]) for n in self.names}
+        with open(self.path, "wb") as handle:  # np.savez would add a suffix to the temp name
+            np.savez(handle, __metadata__=np.array(metadata_json(self.metadata)), **arrays)
+
+
+def read_npz(path):
+    with np.load(path) as data:
+        columns = {n: data[n] for n in data.files if n != "__metadata__"}
+        metadata = json.loads(str(data["__metadata__"]))
+    return TableSource(path, columns, metadata)
+
+
+def test_a_format_registered_at_run_time_writes_and_reads_through_the_registry(tmp_path):
+    npz = Format("npz", (".npz",), read_npz, sink=NpzSink,
+                 sniff=lambda head: head.startswith(b"PK\x03\x04"))
+    registry.register(npz)
+    try:
+        original = recording()
+        path = write(original, tmp_path / "run.npz")  # the writer chosen by the suffix
+        back = read(path)
+        for name in original.names:
+            assert np.array_equal(back[name], original[name]), name
+        assert back.metadata == original.metadata
+        assert registry.output_suffixes()["npz"] == ".npz"
+    finally:
+        registry.unregister("npz")
+    with pytest.raises(RecordingError, match=r"unknown file type '\.npz'"):
+        read(path)
