@@ -25,8 +25,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from unittest import mock
 
-from hrgtc.recording.csv import CsvSource
 from hrgtc.recording.formats import Hdf5Source, ParquetSource
+from hrgtc.recording.formats.csv import CsvSource
 
 
 @dataclass
@@ -62,9 +62,9 @@ def count_reads() -> Iterator[ReadCounts]:
     for cls in (ParquetSource, CsvSource, Hdf5Source):
         init, iter_tables, read = cls.__init__, cls.iter_tables, cls.read
 
-        def counted_init(self, path, _init=init):
+        def counted_init(self, path, *args, _init=init, **kwargs):
             counts.opens[str(Path(path).resolve())] += 1
-            _init(self, path)
+            _init(self, path, *args, **kwargs)
 
         def counted_iter(self, names, as_text, rows, _iter=iter_tables):
             key = str(Path(self.path).resolve())

@@ -69,9 +69,9 @@ class OutputFormat(StrEnum):
     @property
     def suffix(self) -> str:
         """File suffix of the format, e.g. ``".parquet"``."""
-        from hrgtc.recording.formats import FORMAT_SUFFIXES
+        from hrgtc.recording.formats.registry import output_suffixes
 
-        return FORMAT_SUFFIXES[self.value]
+        return output_suffixes()[self.value]
 
 
 _INPUT = "Input recordings"

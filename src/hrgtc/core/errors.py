@@ -97,3 +97,8 @@ class RateFilterWarning(HrgtcWarning):
 class SlowChannelWarning(HrgtcWarning):
     """A channel logged slower than the file's rows was filled (held or interpolated) and
     rows farther than the maximum age from its values were dropped as a gap."""
+
+
+class FormatPluginWarning(HrgtcWarning):
+    """A file format of another package (entry point ``hrgtc.formats``) could not be loaded
+    and was left out; the other formats are read as usual."""

@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from hrgtc.core.errors import InputError
-from hrgtc.recording.formats import SUFFIXES
+from hrgtc.recording.formats.registry import is_recording
 
 __all__ = ["ROLES", "UnitFiles", "load_fleet", "read_manifest", "scan_root"]
 
@@ -134,7 +134,7 @@ def scan_root(root: PathLike) -> list[UnitFiles]:
     for unit_dir in sorted(p for p in root.iterdir() if p.is_dir()):
         for role, folder in ROLES.items():
             for file in sorted((unit_dir / folder).glob("*")):
-                if file.suffix.lower() in SUFFIXES and file.is_file():
+                if is_recording(file) and file.is_file():
                     entries.append((unit_dir.name, role, str(file)))
     if not entries:
         raise InputError(f"{root}: no unit folders with soaks/, drift/ or validate/ recordings; "

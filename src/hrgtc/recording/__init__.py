@@ -6,8 +6,9 @@ and gives a validated :class:`Recording` in the contract of DESIGN.md — whole
 description of it (:func:`describe`). :class:`RecordingWriter` and :func:`write`
 write recordings atomically.
 
-Modules: ``schema`` (the type and its columns), ``formats`` and ``csv`` (file
-formats), ``axes`` (multi-axis recordings: :func:`axis_names`,
+Modules: ``schema`` (the type and its columns), ``formats`` (the file formats,
+one module each, and their registry), ``align`` (the streams of a file on one time
+axis), ``axes`` (multi-axis recordings: :func:`axis_names`,
 :func:`axis_view`), ``mapping`` (user columns and units), ``validation`` (the contract's
 checks), ``checks`` (the single checks and unit heuristics), ``gaps`` (gap
 policies), ``spikes`` (implausible samples: an error, or dropped), ``io``

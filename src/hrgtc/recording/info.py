@@ -20,7 +20,7 @@ from hrgtc.core.progress import Progress
 from hrgtc.core.time_steps import TimeRepairStream
 from hrgtc.core.timeline import Timeline, TimelineBuilder
 from hrgtc.recording.axes import axis_names, base_name
-from hrgtc.recording.formats import format_of
+from hrgtc.recording.formats.registry import format_of
 from hrgtc.recording.io import iter_chunks
 from hrgtc.recording.resolution import resolution
 from hrgtc.recording.schema import COLUMNS, Metadata

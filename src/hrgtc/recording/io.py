@@ -4,7 +4,8 @@
 of a fixed number of rows without loading the file, :func:`write` and
 :class:`RecordingWriter` write one atomically (a temporary file in the same
 directory, fsync, rename) and never overwrite without ``force=True``. The file
-format follows the suffix (see :mod:`hrgtc.recording.formats`).
+format follows the suffix or the content (see :mod:`hrgtc.recording.formats.registry`);
+the streams of a file on several time axes are joined by :mod:`hrgtc.recording.align`.
 
 Users' files are mapped onto the recording contract of DESIGN.md on reading:
 
@@ -43,14 +44,10 @@ import numpy as np
 from hrgtc.core.errors import InputError, RecordingError
 from hrgtc.core.progress import Progress
 from hrgtc.core.time_steps import TimeRepairStream
+from hrgtc.recording.align import align, warn_alignment
 from hrgtc.recording.axes import axis_view
-from hrgtc.recording.csv import CsvSource
-from hrgtc.recording.formats import (
-    Hdf5Source,
-    ParquetSource,
-    Source,
-    format_of,
-)
+from hrgtc.recording.formats.base import Source
+from hrgtc.recording.formats.registry import open_streams
 from hrgtc.recording.mapping import (
     ColumnPlan,
     convert_columns,
@@ -88,15 +85,20 @@ _MESSY = ("temp_scale", "temp_offset_c", "spikes", "thermometer", "rate_scale",
 #: Metadata key counting the rows of robust spikes, by ``spike_filter``.
 _SPIKE_KEYS = {"drop": "spikes_removed", "flag": "spikes_flagged"}
 
-SOURCES: dict[str, type[Source]] = {"parquet": ParquetSource, "csv": CsvSource, "hdf5": Hdf5Source}
-
 __all__ = ["ReadOptions", "RecordingWriter", "count_rows", "iter_chunks", "open_source", "read",
            "write"]
 
 
-def open_source(path: str | Path) -> Source:
-    """Open a recording file for reading, the format chosen by its suffix."""
-    return SOURCES[format_of(path)](Path(path))
+def open_source(path: str | Path, slow_channels: str = "hold",
+                hold_max_s: float | None = None) -> Source:
+    """Open a recording file for reading as one stream.
+
+    The format is chosen by the registry (:func:`~hrgtc.recording.formats.format_for`:
+    by suffix, else by content); a file of several streams is aligned onto one time
+    axis (:func:`hrgtc.recording.align.align`, ``slow_channels`` and ``hold_max_s`` as
+    in :func:`read`).
+    """
+    return align(open_streams(path), slow_channels, hold_max_s)
 
 
 def count_rows(path: str | Path) -> int:
@@ -188,12 +190,13 @@ def read(
     slow_channels: str = _READ.slow_channels,
     hold_max_s: float | None = _READ.hold_max_s,
 ) -> Recording:
-    """Read a whole recording from Parquet, CSV or HDF5 (by suffix).
+    """Read a whole recording from Parquet, CSV, HDF5 or a registered format.
 
     Parameters
     ----------
     path
-        ``.parquet``/``.pq``, ``.csv`` or ``.h5``/``.hdf5`` file.
+        ``.parquet``/``.pq``, ``.csv`` or ``.h5``/``.hdf5`` file, or one of a format
+        registered by another package (:mod:`hrgtc.recording.formats.registry`).
     columns
         Contract name -> the file's column name (or ``"time_s=t"`` strings).
     units
@@ -238,9 +241,10 @@ def read(
         (e.g. ``"2020-03-07T16:30"``). Rows left out are counted in
         ``extra["rows_sliced"]``; row numbers in later messages count the rows kept.
     slow_channels, hold_max_s
-        A channel logged slower than the rows (empty cells): ``"hold"`` (default),
-        ``"interpolate"`` or ``"error"``, for at most ``hold_max_s`` seconds
-        (:mod:`hrgtc.recording.resample`).
+        A channel logged slower than the rows (empty cells), or a stream of the file on
+        its own time axis: ``"hold"`` (default), ``"interpolate"`` or ``"error"``, for at
+        most ``hold_max_s`` seconds (:mod:`hrgtc.recording.resample`,
+        :mod:`hrgtc.recording.align`).
 
     Returns
     -------
@@ -258,7 +262,7 @@ def read(
     spike_filter_ = SpikeFilter(thermometer, str(path)) if spikes == "drop" else None
     robust = RobustSpikeFilter(spike_filter, thermometer, str(path), k=spike_k,
                                lsb_multiple=spike_lsb, window_s=spike_window_s)
-    with open_source(path) as source:
+    with open_source(path, slow_channels, hold_max_s) as source:
         plan = plan_columns(source, columns, units, temp_scale, temp_offset_c, thermometer,
                             rate_scale, temp_unwrap)
         robust.counts = plan.temperature_is_count and not scales_temperature(temp_scale,
@@ -276,6 +280,7 @@ def read(
         meta = _metadata(plan, metadata, arrays.get("time_s"))
     if repairer.events or repairer.duplicates:
         meta = replace(meta, extra={**meta.extra, **_repair_extra(repairer)})
+    warn_alignment(source)
     slow.warn()
     if spike_filter_ is not None and spike_filter_.dropped:
         meta = replace(meta, extra={**meta.extra, "spikes_dropped": spike_filter_.dropped})
@@ -360,7 +365,7 @@ def iter_chunks(
     validator = (RecordingValidator(gaps, freq_band_hz, freq_span_hz, thermometer)
                  if validate else None)
     slow = SlowChannels(slow_channels, hold_max_s, str(path))
-    with open_source(path) as source:
+    with open_source(path, slow_channels, hold_max_s) as source:
         plan = plan_columns(source, columns, units, temp_scale, temp_offset_c, thermometer,
                             rate_scale, temp_unwrap)
         robust.counts = plan.temperature_is_count and not scales_temperature(temp_scale,
@@ -428,6 +433,7 @@ def iter_chunks(
         if spike_filter_ is not None:
             spike_filter_.warn()
         robust.warn()
+        warn_alignment(source)
         slow.warn()
         if dropped is not None:
             dropped["spikes"] = dropped.get("spikes", 0) + (

@@ -41,8 +41,8 @@ import pyarrow.compute as pc
 from hrgtc.core.errors import InputError, RecordingError, UnitWarning
 from hrgtc.recording.axes import AXIS_COLUMNS, axis_names, base_name, split_axis
 from hrgtc.recording.checks import check_thermometer
-from hrgtc.recording.csv import bad_number_hint
-from hrgtc.recording.formats import Source, first_failing
+from hrgtc.recording.formats.base import Source, first_failing
+from hrgtc.recording.formats.csv import bad_number_hint
 from hrgtc.recording.schema import COLUMNS
 from hrgtc.recording.units import UNITS, find_unit, median_period, per_sample_steps, unit_of
 from hrgtc.settings.reading import TEMP_UNWRAPS, ReadSettings

@@ -233,6 +233,56 @@ class SlowChannels:
             warnings.warn(line, SlowChannelWarning, stacklevel=3)
 
 
+def channel_period(time_s: np.ndarray) -> float:
+    """The period of a channel: the median step between the times of its values. [s]"""
+    return float(np.median(np.diff(time_s))) if time_s.size >= 2 else math.nan
+
+
+def resample_channel(time_s: np.ndarray, sample_time_s: np.ndarray, sample_values: np.ndarray,
+                     mode: str, max_age_s: float) -> tuple[np.ndarray, np.ndarray, int]:
+    """A channel logged on its own time axis, at the times ``time_s`` of another.
+
+    The rule of :class:`SlowChannels` for a channel of another stream: at each time,
+    the channel's last value at or before it (``"hold"``), or the straight line to its
+    next value (``"interpolate"``; after the last value, the last value); a time farther
+    than ``max_age_s`` after the last value, or before the first, is too old.
+
+    Parameters
+    ----------
+    time_s
+        The times to give values at. [s]
+    sample_time_s, sample_values
+        The channel's times (increasing) and finite values. [s], [unit]
+    mode
+        ``"hold"`` or ``"interpolate"``.
+    max_age_s
+        Longest time a value is used for. [s]
+
+    Returns
+    -------
+    values, too_old, exact
+        The channel at ``time_s``, the mask of the times too far from a value (to be
+        dropped as a gap in the channel), and the number of times that are times of a
+        value (not filled).
+    """
+    last = np.searchsorted(sample_time_s, time_s, side="right") - 1
+    known = last >= 0
+    at = np.maximum(last, 0)
+    if sample_time_s.size == 0:
+        return np.full(time_s.shape, np.nan), np.ones(time_s.shape, dtype=bool), 0
+    before_time = np.where(known, sample_time_s[at], -math.inf)
+    values = np.where(known, sample_values[at], math.nan)
+    if mode == "interpolate":
+        nxt = np.minimum(at + 1, sample_time_s.size - 1)
+        span = sample_time_s[nxt] - before_time
+        inside = known & (nxt > at) & (span > 0)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            share = np.where(inside, (time_s - before_time) / span, 0.0)
+        values = np.where(inside, values + share * (sample_values[nxt] - values), values)
+    too_old = ~(time_s - before_time <= max_age_s)
+    return values, too_old, int(np.count_nonzero(before_time == time_s))
+
+
 def fill_slow_channels(arrays: dict[str, np.ndarray], mode: str = "hold",
                        max_age_s: float | None = None,
                        source: str = "") -> tuple[dict[str, np.ndarray], SlowChannels]:

@@ -2,8 +2,8 @@
 
 Rows go to a temporary file in the same directory, which is synced and renamed
 to its name when complete; an existing file is never overwritten without
-``force=True``. The file format follows the suffix (see
-:mod:`hrgtc.recording.formats`).
+``force=True``. The file format follows the suffix (the format of the registry,
+:func:`hrgtc.recording.formats.writable`, that has a writer).
 """
 
 from __future__ import annotations
@@ -26,13 +26,11 @@ from hrgtc.core.files import (
     refuse_existing,
     temporary_beside,
 )
-from hrgtc.recording.csv import CsvSink
-from hrgtc.recording.formats import Hdf5Sink, ParquetSink, Sink, format_of
+from hrgtc.recording.formats.base import Sink
+from hrgtc.recording.formats.registry import writable
 from hrgtc.recording.schema import Metadata, Recording
 
-SINKS: dict[str, type[Sink]] = {"parquet": ParquetSink, "csv": CsvSink, "hdf5": Hdf5Sink}
-
-__all__ = ["SINKS", "RecordingWriter", "write"]
+__all__ = ["RecordingWriter", "write"]
 
 
 def _remove(path: str) -> None:
@@ -85,7 +83,7 @@ class RecordingWriter:
         self.columns = list(columns)
         self.force = bool(force)
         self.rows = 0
-        fmt = format_of(self.path)
+        sink_class = writable(self.path).sink
         if len(set(self.columns)) != len(self.columns) or not self.columns:
             raise InputError(f"{self.path}: column names must be unique and non-empty")
         self._check_target()
@@ -97,7 +95,7 @@ class RecordingWriter:
         self._behind: WriteBehind | None = None
         self._cleanup = weakref.finalize(self, _remove, tmp)
         try:
-            self._sink: Sink | None = SINKS[fmt](Path(tmp), metadata, self.columns)
+            self._sink: Sink | None = sink_class(Path(tmp), metadata, self.columns)
         except BaseException:
             self._cleanup()
             raise

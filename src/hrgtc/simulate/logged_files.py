@@ -36,6 +36,7 @@ from hrgtc.core.files import (
     write_text_atomic,
 )
 from hrgtc.recording import Metadata, Recording, RecordingWriter
+from hrgtc.recording.formats.registry import formats, is_recording, output_suffixes
 from hrgtc.simulate.logger import LoggedRun, Logger, log_run
 from hrgtc.simulate.output import output_paths
 from hrgtc.simulate.profiles import Profile
@@ -169,11 +170,12 @@ def write_logged(run: LoggedRun, path: str | Path, file_format: str | None = Non
     """
     path = Path(path)
     suffix = path.suffix.lower()
-    by_suffix = {".csv": "csv", ".parquet": "parquet", ".pq": "parquet", ".h5": "h5",
-                 ".hdf5": "h5"}
+    writers = output_suffixes()
+    by_suffix = {s: f.output_name for f in formats() if f.output_name in writers
+                 for s in f.suffixes}
     fmt = file_format or by_suffix.get(suffix)
-    if fmt not in ("csv", "parquet", "h5") or (suffix in by_suffix and by_suffix[suffix] != fmt):
-        raise InputError(f"output {path}: give a .csv, .parquet or .h5 file (format "
+    if fmt not in writers or (suffix in by_suffix and by_suffix[suffix] != fmt):
+        raise InputError(f"output {path}: give a {', '.join(writers.values())} file (format "
                          f"{file_format!r} and suffix {suffix!r} must agree)")
     if fmt != "csv" and "str" in run.kinds.values():
         raise InputError(f"output {path}: wall-clock timestamps are written to CSV only; "
@@ -228,8 +230,7 @@ def simulate_logged_files(
     if not profiles:
         raise InputError("no runs to simulate; give at least one profile")
     paths = output_paths(profiles, output, file_format or (
-        None if Path(output).suffix.lower() in (".csv", ".parquet", ".pq", ".h5", ".hdf5")
-        else "csv"))
+        None if is_recording(output) else "csv"))
     targets = []
     for path in paths:
         side = sidecar_paths(path)

@@ -21,7 +21,7 @@ from hrgtc.core.errors import InputError
 from hrgtc.core.files import refuse_existing
 from hrgtc.core.progress import Progress
 from hrgtc.recording import RecordingWriter
-from hrgtc.recording.formats import FORMAT_SUFFIXES, SUFFIXES
+from hrgtc.recording.formats.registry import formats, output_suffixes
 from hrgtc.simulate import units as _units
 from hrgtc.simulate.campaign import (
     DEFAULT_CHUNK_ROWS,
@@ -139,12 +139,13 @@ def output_paths(
     (default Parquet).
     """
     output = Path(output)
-    if file_format is not None and file_format not in FORMAT_SUFFIXES:
+    writers = output_suffixes()
+    if file_format is not None and file_format not in writers:
         raise InputError(
-            f"unknown format {file_format!r}; choose one of {', '.join(FORMAT_SUFFIXES)}"
+            f"unknown format {file_format!r}; choose one of {', '.join(writers)}"
         )
     suffix = output.suffix.lower()
-    by_suffix = {s: "h5" if f == "hdf5" else f for s, f in SUFFIXES.items()}
+    by_suffix = {s: fmt.output_name for fmt in formats() for s in fmt.suffixes}
     if suffix in by_suffix:
         if len(profiles) != 1:
             raise InputError(
@@ -157,7 +158,7 @@ def output_paths(
                 "make them agree or drop --format"
             )
         return [output]
-    chosen = FORMAT_SUFFIXES[file_format or "parquet"]
+    chosen = writers[file_format or "parquet"]
     names = [p.name for p in profiles]
     unsafe = [n for n in names if Path(n).name != n or n in ("", ".", "..")]
     if unsafe:

@@ -42,7 +42,8 @@ import pyarrow as pa
 import pyarrow.csv as pa_csv
 
 from hrgtc.core.errors import RecordingError
-from hrgtc.recording.formats import (
+from hrgtc.recording.formats.base import (
+    Format,
     Sink,
     Source,
     first_failing,
@@ -445,3 +446,12 @@ class CsvSink(Sink):
             self._writer.close()
         finally:
             self._handle.close()
+
+
+def sniff(head: bytes) -> bool:
+    """True for a CSV file written by hrgtc (its first line); other CSV is known by its suffix."""
+    return head.removeprefix(b"\xef\xbb\xbf").startswith(b"# hrgtc recording")
+
+
+FORMAT = Format("csv", (".csv",), CsvSource, sniff, CsvSink,
+                description="text, one column per channel, '# key: value' metadata lines")
