@@ -35,27 +35,37 @@ class ReadOnce(ReadOptions):
     slice (``start``/``end``) or mapping is another reading.
     """
 
-    cache: dict[Any, Recording] = field(default_factory=dict, compare=False, repr=False)
+    cache: dict[Any, tuple[Recording, dict[str, int]]] = field(
+        default_factory=dict, compare=False, repr=False)
 
-    def _whole(self, path: str | Path) -> Recording:
+    def _whole(self, path: str | Path, dropped: dict[str, int] | None = None) -> Recording:
+        """The file, read the first time; ``dropped`` gets the rows its reading removed."""
         words = self.keywords()
         words.pop("freq_band_hz", None)
         words.pop("freq_span_hz", None)
         key = (str(Path(path).resolve()), repr(sorted(words.items())), self.chunk_rows)
         if key not in self.cache:
-            self.cache[key] = concatenate(list(iter_chunks(path, rows=self.chunk_rows,
-                                                           **words)))
-        return self.cache[key]
+            removed: dict[str, int] = {}
+            whole = concatenate(list(iter_chunks(path, rows=self.chunk_rows, dropped=removed,
+                                                 **words)))
+            self.cache[key] = (whole, removed)
+        whole, removed = self.cache[key]
+        if dropped is not None:
+            for reason, count in removed.items():
+                dropped[reason] = dropped.get(reason, 0) + count
+        return whole
 
     def _cached(self) -> bool:
         # a single-axis reading with a plausible band is checked by the reader itself
         return self.axis is not None or self.freq_band_hz is None
 
-    def chunks(self, path: str | Path, rows: int | None = None) -> Iterator[Recording]:
-        """The file's rows in chunks of ``rows`` (with ``axis``: that axis's views)."""
+    def chunks(self, path: str | Path, rows: int | None = None,
+               dropped: dict[str, int] | None = None) -> Iterator[Recording]:
+        """The file's rows in chunks of ``rows`` (with ``axis``: that axis's views);
+        ``dropped`` gets the rows the reading removed, as the streamed reading reports."""
         if not self._cached():
-            return super().chunks(path, rows)
-        whole = self._whole(path)
+            return super().chunks(path, rows, dropped)
+        whole = self._whole(path, dropped)
         size = rows or self.chunk_rows
         pieces = (whole.slice(start, min(start + size, len(whole)))
                   for start in range(0, len(whole), size))
