@@ -17,6 +17,7 @@ fused one to.
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
 import warnings
 from collections.abc import Mapping
@@ -39,7 +40,6 @@ from hrgtc.drift.features import (
     RATE_VARIABLES,
     FeatureStream,
     is_aux,
-    settle_rows,
 )
 from hrgtc.drift.offsets import label_offsets, sample_offsets
 from hrgtc.drift.rate_checks import filtered_levels, rate_filter_problems, warn_rate_filter
@@ -142,7 +142,6 @@ class Compensator:
         """Start a new run: the df/dt filter restarts at rest on the next sample."""
         self.restart()
         self._extremes = np.array([np.inf, -np.inf, np.inf, -np.inf])  # f, df min/max
-        self._settle_rows = settle_rows(self.drift.settings)
         self.samples = 0
         self.out_of_range = 0
         self.rate_out_of_range = 0
@@ -165,7 +164,7 @@ class Compensator:
         """
         self._stream = FeatureStream(self.drift.settings, self._variables, self.model.thermometer)
         self._state: np.ndarray | None = None  # the fused engine's state (compensate._kernel)
-        self._segment_samples = 0  # samples since the filter (re)started
+        self._origin_s = math.nan  # time the filter (re)started (NaN: at the next sample)
 
     def _gap_rows(self, chunk: Recording) -> list[int]:
         """Rows of ``chunk`` that start a new segment (``gaps="split"``)."""
@@ -296,7 +295,7 @@ class Compensator:
         kernel.run(self._plan, self._state, time_s, freq, chunk.rate_dph, housing, out, counts,
                    extremes, restart)
         self.samples += len(chunk)
-        self._segment_samples = int(self._state[kernel.SAMPLES])
+        self._origin_s = float(self._state[kernel.ORIGIN])
         self.out_of_range += int(counts[kernel.OUT_OF_RANGE])
         self.rate_out_of_range += int(counts[kernel.RATE_OUT_OF_RANGE])
         self.settling += int(counts[kernel.SETTLING])
@@ -310,6 +309,22 @@ class Compensator:
             e[0], e[1] = min(e[0], extremes[0]), max(e[1], extremes[1])
             e[2], e[3] = min(e[2], extremes[2]), max(e[3], extremes[3])
         return True
+
+    def _settled(self, time_s: np.ndarray, restart: np.ndarray | None) -> np.ndarray:
+        """True where the df/dt filter has settled: ``warmup_s`` seconds on the time axis since
+        it (re)started (the run's first sample, or a restart row), as training's warm-up skip."""
+        time_s = np.asarray(time_s, dtype=np.float64)
+        if not time_s.size:
+            return np.ones(0, dtype=bool)
+        if math.isnan(self._origin_s):
+            self._origin_s = float(time_s[0])
+        origin = np.full(time_s.size, self._origin_s)
+        if restart is not None and restart.any():  # the time of each row's (re)start
+            rows = np.arange(time_s.size)
+            last = np.maximum.accumulate(np.where(restart, rows, -1))
+            origin = np.where(last >= 0, time_s[np.maximum(last, 0)], origin)
+        self._origin_s = float(origin[-1])
+        return time_s - origin >= self.drift.settings.warmup_s
 
     def _track(self, variable: str, outside: int, low: float, high: float) -> None:
         """Add a block's samples outside ``variable``'s range and its extremes."""
@@ -338,13 +353,7 @@ class Compensator:
                 outside = int(np.count_nonzero(~((x >= low) & (x <= high))))
                 self._track(v, outside, np.nanmin(x) if np.isfinite(x).any() else np.inf,
                             np.nanmax(x) if np.isfinite(x).any() else -np.inf)
-        since = self._segment_samples + np.arange(len(chunk))
-        if restart is not None and restart.any():  # samples since the segment's start
-            rows = np.arange(len(chunk))
-            last = np.maximum.accumulate(np.where(restart, rows, -1))
-            since = np.where(last >= 0, rows - last, since)
-        settled = since >= self._settle_rows
-        self._segment_samples = int(since[-1]) + 1 if len(chunk) else self._segment_samples
+        settled = self._settled(chunk.time_s, restart)
         np.subtract(chunk.rate_dph, bias, out=out["rate_comp_dph"][start:stop])
         out["bias_model_dph"][start:stop] = bias
         out["resonator_c_est"][start:stop] = thermometer.temperature(chunk.freq_hz, warn=False)
