@@ -154,3 +154,36 @@ def test_info_names_what_the_time_repair_did(clean, tmp_path):
     assert timeline["segments"] == 1 and "wrapped (1 time(s)" in timeline["repairs"][0]
     text = " ".join(CliRunner().invoke(app, args).stdout.split())
     assert "time: row 2950: the 32-bit us time counter wrapped" in text
+
+
+def test_a_reset_is_a_new_run_its_own_warm_up_filter_and_offset_group(clean, tmp_path):
+    """A logger reset starts a new run (issue 20 items 1, 3, 13): the reader lists it
+    (``restarts_s``, in every chunk from the one holding it), and training skips the warm-up
+    after it again, restarts the df/dt filter there and gives it its own power-on run (the
+    groups of ``--offsets run``) -- the windows of two files. A gap does not, unless each
+    segment is said to be a restart."""
+    time = clean.time_s.copy()
+    time[36_000:] = time[36_000:] - time[36_000] + 0.0  # the logger restarts at 0
+    path = _csv(clean, tmp_path / "reset.csv", time)
+    run = read(path, gaps="bridge", **READ)
+    (restart,) = run.metadata.extra["restarts_s"]
+    assert restart == run.time_s[36_000]
+    for rows in (1000, 36_000, 50_000):
+        chunks = list(iter_chunks(path, rows=rows, gaps="bridge", **READ))
+        holding = [c for c in chunks if c.time_s[-1] >= restart]
+        assert all(c.metadata.extra["restarts_s"] == [restart] for c in holding)
+    windows = _windows(run)
+    first, second = clean.slice(0, 36_000), clean.slice(36_000, len(clean))
+    settings = FeatureSettings(reference_freq_hz=4432.0, sample_rate_hz=10.0, warmup_s=100.0)
+    apart = window_means([first, second], settings, list(EQ21[:4]), 10.0)
+    assert windows.dropped["warmup"] == 2 * 1000  # 100 s at 10 Hz after each power-on
+    np.testing.assert_allclose(windows.terms, apart.terms, rtol=1e-9, atol=1e-15)
+    np.testing.assert_array_equal(windows.power_run, apart.run)
+    assert windows.power_runs == (f"{path} run 1", f"{path} run 2")
+    # bursts: one power-on run, unless each segment is a restart
+    bursts = cut_bursts(clean, burst_s=600.0, period_s=1200.0)
+    one = window_means([bursts], settings, list(EQ21[:4]), 10.0)
+    each = window_means([bursts], settings, list(EQ21[:4]), 10.0, restart_each_segment=True)
+    assert set(one.power_run.tolist()) == {0}
+    assert sorted(set(each.power_run.tolist())) == list(range(6))
+    assert each.dropped["warmup"] == 6 * 1000

@@ -33,7 +33,7 @@ from hrgtc.compensate.model_fit import (
     with_model_band,
 )
 from hrgtc.compensate.ranges import RangeReport, range_report
-from hrgtc.core.timeline import is_gap
+from hrgtc.core.timeline import RESTARTS_KEY, is_gap, restart_rows
 from hrgtc.drift import DriftModel
 from hrgtc.drift.features import (
     LEVEL_VARIABLES,
@@ -195,15 +195,24 @@ class Compensator:
             self.drift.settings.check_sample_rate(chunk)
             if self.gaps != "split":  # split restarts the filter at each gap instead
                 levels = filtered_levels(chunk, self.drift.variables)
+                # up to a logger restart (the filter restarts there)
+                head = restart_rows(chunk.time_s, chunk.metadata.extra.get(RESTARTS_KEY))
+                stop = int(head[0]) if head.size else len(chunk)
                 warn_rate_filter(rate_filter_problems(
-                    chunk.time_s, levels, self.drift.settings.rate_tau_s,
-                    where=chunk.source or ""))
+                    chunk.time_s[:stop], {k: v[:stop] for k, v in levels.items()},
+                    self.drift.settings.rate_tau_s, where=chunk.source or ""))
         restart = None
+        cuts: list[int] = []
         if self.gaps == "split" and "time_s" in chunk:
             cuts = self._gap_rows(chunk)
-            if cuts:  # the filters restart at rest on each segment's first row
-                restart = restart_mask(len(chunk), cuts)
-                self.segments += len(cuts)
+            self.segments += len(cuts)
+        if "time_s" in chunk:  # a logger restart is a new run: the filter restarts at rest
+            rows = restart_rows(chunk.time_s, chunk.metadata.extra.get(RESTARTS_KEY))
+            if self.samples == 0:
+                rows = rows[rows > 0]
+            cuts = sorted(set(cuts) | set(rows.tolist()))
+        if cuts:  # the filters restart at rest on each segment's (run's) first row
+            restart = restart_mask(len(chunk), cuts)
         return self._process(chunk, restart)
 
     def _process(self, chunk: Recording, restart: np.ndarray | None = None) -> Recording:

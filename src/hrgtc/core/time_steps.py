@@ -408,6 +408,8 @@ class TimeRepairStream:
         self._kept = 0  # rows kept
         self._events: dict[str, list[Any]] = {}
         self.restarts: list[int] = []
+        #: Repaired time of each restart's first sample (a new run starts there). [s]
+        self.restart_times_s: list[float] = []
         self.duplicates = 0
 
     def repair(self, time_s: np.ndarray, columns: list[np.ndarray] | None = None,
@@ -455,6 +457,8 @@ class TimeRepairStream:
             else:
                 state[2] += event.count
         self.restarts += [base_kept + r for r in diagnosis.restarts]
+        kept_times = repaired[keep]
+        self.restart_times_s += [float(kept_times[r - pre]) for r in diagnosis.restarts]
         self.duplicates += int((~keep).sum())
         self._advance(time_s, columns, keep,
                       float(diagnosis.offset_s[-1]) if time_s.size else 0.0)

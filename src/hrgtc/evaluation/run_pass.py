@@ -30,6 +30,7 @@ from hrgtc.compensate import Compensator
 from hrgtc.compensate.model_fit import check_recording_noise, with_model_band
 from hrgtc.compensate.ranges import RangeReport
 from hrgtc.core.accounting import Accounting
+from hrgtc.core.timeline import RESTARTS_KEY
 from hrgtc.drift.features import FeatureStream
 from hrgtc.drift.rest import run_rest
 from hrgtc.errors import HrgtcError, InputError, RecordingError
@@ -416,7 +417,8 @@ def run_pass(
             kept = keep[frequency.samples - len(chunk):frequency.samples]
             left_out += int(np.count_nonzero(~kept))
             pushed = {key: values[kept] for key, values in pushed.items()}
-        cut.push(pushed, chunk.time_s if keep is None else chunk.time_s[kept])
+        cut.push(pushed, chunk.time_s if keep is None else chunk.time_s[kept],
+                 chunk.metadata.extra.get(RESTARTS_KEY))
         if allan and deviation != "oadev":
             for key, values in pushed.items():
                 whole.setdefault(key, []).append(values)

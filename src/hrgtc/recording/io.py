@@ -68,7 +68,13 @@ from hrgtc.recording.spikes import (
     SpikeFilter,
     check_spike_policy,
 )
-from hrgtc.recording.time_axis import _repair_extra, _repair_time, _time_repairer, _TimeSlice
+from hrgtc.recording.time_axis import (
+    _repair_extra,
+    _repair_time,
+    _restarts_extra,
+    _time_repairer,
+    _TimeSlice,
+)
 from hrgtc.recording.validation import (
     HEURISTIC_ROWS,
     GapPolicy,
@@ -395,10 +401,14 @@ def iter_chunks(
         meta = _metadata(plan, metadata, time_head)
         pending: list[Recording] = []
 
+        def chunk_meta() -> Metadata:  # with the logger restarts found so far (new runs)
+            restarts = _restarts_extra(repairer)
+            return replace(meta, extra={**meta.extra, **restarts}) if restarts else meta
+
         def chunks() -> Iterator[Recording]:
-            yield from (Recording(p, meta, source=str(path)) for p in head)
+            yield from (Recording(p, chunk_meta(), source=str(path)) for p in head)
             head.clear()
-            yield from (Recording(p, meta, source=str(path)) for p in pieces)
+            yield from (Recording(p, chunk_meta(), source=str(path)) for p in pieces)
 
         for chunk in chunks():
             if validator is not None:

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from hrgtc.core.time_steps import TimeRepairStream
-from hrgtc.core.timeline import parse_time_bound
+from hrgtc.core.timeline import RESTARTS_KEY, parse_time_bound
 from hrgtc.errors import InputError
 
 
@@ -80,4 +80,11 @@ def _repair_extra(repairer: TimeRepairStream) -> dict[str, Any]:
         extra["time_repairs"] = repaired
     if repairer.duplicates:
         extra["duplicates_dropped"] = repairer.duplicates
+    extra.update(_restarts_extra(repairer))
     return extra
+
+
+def _restarts_extra(repairer: TimeRepairStream) -> dict[str, Any]:
+    """``{"restarts_s": [...]}``: the times where the logger restarted (each starts a new
+    run: its own warm-up, df/dt filter and, with ``--offsets run``, offset); empty if none."""
+    return {RESTARTS_KEY: list(repairer.restart_times_s)} if repairer.restart_times_s else {}
