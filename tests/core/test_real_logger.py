@@ -130,6 +130,25 @@ def test_compensate_flags_the_first_warmup_seconds_not_samples_on_a_burst_file(t
     assert out.exit_code == 0, out.stderr
     document, _ = json.JSONDecoder().raw_decode(out.stdout[out.stdout.index("{"):])
     assert document["ranges"]["settling_fraction"] == pytest.approx(by_hand / 6250)
+    # compensate's accounting (item 7): flagged by reason, never dropped
+    accounting = document["accounting"]
+    assert accounting["read"] == accounting["used"] == 6250 and accounting["dropped"] == {}
+    flagged = accounting["flagged"]
+    assert flagged["warmup"] == by_hand and flagged["spikes"] == 3  # the three known spikes
+    assert flagged["out_of_range"] == round(document["out_of_range_fraction"] * 6250)
+    assert flagged["rate_out_of_range"] == round(document["rate_out_of_range_fraction"] * 6250)
+    lines = PAN.read_text().splitlines(keepends=True)  # rows 100-109 sent twice
+    doubled = tmp_path / "doubled.csv"
+    doubled.write_text("".join(lines[:111] + lines[101:111] + lines[111:]))
+    again = runner.invoke(app, ["compensate", str(doubled), "--model", str(model), *ARGS,
+                                "--gaps", "bridge", "--json", "-o", str(tmp_path / "d.parquet")])
+    assert again.exit_code == 0, again.stderr
+    counted, _ = json.JSONDecoder().raw_decode(again.stdout[again.stdout.index("{"):])
+    assert counted["accounting"]["read"] == 6260 and counted["rows"] == 6250
+    assert counted["accounting"]["dropped"] == {"duplicates": 10}
+    text = runner.invoke(app, ["compensate", str(PAN), "--model", str(model), *ARGS, "--gaps",
+                               "bridge", "-o", str(tmp_path / "t.parquet")]).stdout
+    assert "samples: 6250 read, 6250 used, flagged 250 warm-up" in " ".join(text.split())
     unit = load_instrument(model).axes["x"]
     for engine in ("fused", "numpy"):  # the kernel and the numpy reference agree
         compensator = Compensator(unit, engine=engine, gaps="bridge")

@@ -33,6 +33,8 @@ from hrgtc.compensate.model_fit import (
     with_model_band,
 )
 from hrgtc.compensate.ranges import RangeReport, range_report
+from hrgtc.core.accounting import Accounting
+from hrgtc.core.time_steps import TimeRepairStream
 from hrgtc.core.timeline import RESTARTS_KEY, is_gap, restart_rows
 from hrgtc.drift import DriftModel
 from hrgtc.drift.features import (
@@ -51,6 +53,7 @@ from hrgtc.progress import Progress
 from hrgtc.recording import Recording
 from hrgtc.recording.gaps import check_gap_policy
 from hrgtc.recording.marks import COMPENSATED_KEY, mark, refuse_compensated
+from hrgtc.recording.spikes import SPIKE_COLUMN
 
 #: Rows worked on at once: small enough for the temporaries to stay in cache.
 BLOCK_ROWS = 1 << 17
@@ -412,6 +415,7 @@ class CompensationSummary:
     out_of_range_fraction: float
     rate_out_of_range_fraction: float
     ranges: RangeReport | None = None
+    accounting: Accounting | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -421,6 +425,7 @@ class CompensationSummary:
             "out_of_range_fraction": self.out_of_range_fraction,
             "rate_out_of_range_fraction": self.rate_out_of_range_fraction,
             "ranges": None if self.ranges is None else self.ranges.to_dict(),
+            "accounting": None if self.accounting is None else self.accounting.to_dict(),
         }
 
 
@@ -466,7 +471,9 @@ def compensate_file(
     refuse_input(output, [source])
     refuse_compensated(source)
     check_writable(output, estimated_output_bytes(source, output, len(added)))
-    chunks = options.chunks(source, rows=chunk_rows)
+    repair = TimeRepairStream()  # what the reader dropped (duplicated rows)
+    chunks = options.chunks(source, rows=chunk_rows, time_repair=repair)
+    spikes = 0
     try:
         first = next(chunks)
         copies = sensor_copies((*first.names, *added), first.metadata)
@@ -482,6 +489,8 @@ def compensate_file(
             chunk: Recording | None = first
             while chunk is not None:
                 result = compensator.process(chunk)
+                if SPIKE_COLUMN in chunk:
+                    spikes += int(np.count_nonzero(chunk[SPIKE_COLUMN]))
                 if copies:
                     result = Recording({n: result[n] for n in names}, result.metadata,
                                        result.source)
@@ -497,9 +506,34 @@ def compensate_file(
                 pending.result()
     finally:
         chunks.close()
+    accounting = compensation_accounting(compensator, spikes, repair.duplicates)
     return CompensationSummary(str(source), str(output), compensator.samples,
                                compensator.out_of_range_fraction,
-                               compensator.rate_out_of_range_fraction, compensator.ranges())
+                               compensator.rate_out_of_range_fraction, compensator.ranges(),
+                               accounting)
+
+
+def compensation_accounting(compensator: Any, spikes: int = 0,
+                            duplicates: int = 0) -> Accounting:
+    """Samples read, dropped (duplicated rows, by the reader) and flagged by reason.
+
+    ``compensate`` never drops a sample it read: spikes (the ``spike`` column), samples
+    beyond the trained temperature (``out_of_range``) or df/dt (``rate_out_of_range``)
+    and those of the df/dt filter's settling (``warmup``) are flagged (``in_range`` 0).
+    With several axes, the axis with the most samples beyond its ranges (the one the
+    summary line names).
+    """
+    axes = getattr(compensator, "axes", None)
+    if axes:
+        compensator = max(axes.values(), key=lambda c: sum(c.ranges().shares().values()))
+    accounting = Accounting(read=compensator.samples + duplicates)
+    accounting.drop("duplicates", duplicates)
+    accounting.flag("warmup", compensator.settling)
+    accounting.flag("spikes", spikes)
+    accounting.flag("out_of_range", compensator.temperature_out)
+    accounting.flag("rate_out_of_range",
+                    compensator.variable_ranges.get("df", [compensator.rate_out_of_range])[0])
+    return accounting
 
 
 def compensated_metadata(metadata: rec_io.Metadata, model: UnitModel,

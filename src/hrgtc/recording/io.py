@@ -558,11 +558,15 @@ class ReadOptions:
         finally:
             chunks.close()
 
-    def chunks(self, path: str | Path, rows: int | None = None) -> Iterator[Recording]:
-        """Stream the file in chunks (:func:`iter_chunks`); with ``axis``, that axis's view."""
+    def chunks(self, path: str | Path, rows: int | None = None,
+               time_repair: TimeRepairStream | None = None) -> Iterator[Recording]:
+        """Stream the file in chunks (:func:`iter_chunks`); with ``axis``, that axis's view.
+        ``time_repair``: a stream whose counts (duplicates dropped) the caller reads after."""
         if self.axis is None:
-            return iter_chunks(path, rows=rows or self.chunk_rows, **self.keywords())
+            return iter_chunks(path, rows=rows or self.chunk_rows, time_repair=time_repair,
+                               **self.keywords())
         words = self.keywords()
+        words["time_repair"] = time_repair
         words.pop("freq_band_hz", None)
         words.pop("freq_span_hz", None)
         return self._axis_chunks(iter_chunks(path, rows=rows or self.chunk_rows, **words),
