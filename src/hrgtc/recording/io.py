@@ -33,6 +33,7 @@ validated axis by axis; :func:`hrgtc.recording.axis_view` gives one axis.
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -45,6 +46,7 @@ from hrgtc.errors import InputError, RecordingError
 from hrgtc.progress import Progress
 from hrgtc.recording.axes import axis_view
 from hrgtc.recording.csv import CsvSource
+from hrgtc.recording.file_rows import take_file_rows, with_file_rows
 from hrgtc.recording.formats import (
     Hdf5Source,
     ParquetSource,
@@ -263,7 +265,7 @@ def read(
                             rate_scale, temp_unwrap)
         robust.counts = plan.temperature_is_count and (temp_scale, temp_offset_c) == (1.0, 0.0)
         columns = table_columns(source.read(plan.read_names, plan.as_text))
-        arrays = convert_columns(plan, columns, 0)
+        arrays = with_file_rows(convert_columns(plan, columns, 0), 0)
         arrays, slow = fill_slow_channels(arrays, slow_channels, hold_max_s, str(path))
         if spike_filter_ is not None:
             arrays = spike_filter_.drop(arrays, 0)
@@ -271,7 +273,7 @@ def read(
         repairer = _time_repairer(plan)
         arrays = _repair_time(arrays, repairer)
         cut = _TimeSlice(start, end, plan)
-        arrays = cut.apply(arrays)
+        arrays, file_rows = take_file_rows(cut.apply(arrays))
         meta = _metadata(plan, metadata, arrays.get("time_s"))
     if repairer.events or repairer.duplicates:
         meta = replace(meta, extra={**meta.extra, **_repair_extra(repairer)})
@@ -287,7 +289,7 @@ def read(
     recording = Recording(arrays, meta, source=str(path))
     if validate:
         validate_recording(recording, gaps, freq_band_hz=freq_band_hz, freq_span_hz=freq_span_hz,
-                           thermometer=thermometer)
+                           thermometer=thermometer, file_rows=file_rows)
     return recording
 
 
@@ -369,7 +371,8 @@ def iter_chunks(
         def converted() -> Iterator[dict[str, np.ndarray]]:
             nonlocal offset
             for table in source.iter_tables(plan.read_names, plan.as_text, rows):
-                part = slow.fill(convert_columns(plan, table_columns(table), offset), offset)
+                part = slow.fill(with_file_rows(convert_columns(plan, table_columns(table),
+                                                                offset), offset), offset)
                 if spike_filter_ is not None:
                     part = spike_filter_.drop(part, offset)
                 part = robust.apply(part, offset)
@@ -405,14 +408,16 @@ def iter_chunks(
             restarts = _restarts_extra(repairer)
             return replace(meta, extra={**meta.extra, **restarts}) if restarts else meta
 
-        def chunks() -> Iterator[Recording]:
-            yield from (Recording(p, chunk_meta(), source=str(path)) for p in head)
+        def chunks() -> Iterator[tuple[Recording, np.ndarray | None]]:
+            held, parts = list(head), pieces
             head.clear()
-            yield from (Recording(p, chunk_meta(), source=str(path)) for p in pieces)
+            for p in itertools.chain(held, parts):  # the file rows go to the validator
+                part, file_rows = take_file_rows(p)
+                yield Recording(part, chunk_meta(), source=str(path)), file_rows
 
-        for chunk in chunks():
+        for chunk, file_rows in chunks():
             if validator is not None:
-                validator.update(chunk)
+                validator.update(chunk, file_rows)
                 validator.raise_for_problems()
             pending.append(chunk)
             if validator is None or validator.heuristics_done:

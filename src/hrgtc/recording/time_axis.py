@@ -15,6 +15,7 @@ import numpy as np
 from hrgtc.core.time_steps import TimeRepairStream
 from hrgtc.core.timeline import RESTARTS_KEY, parse_time_bound
 from hrgtc.errors import InputError
+from hrgtc.recording.file_rows import ROW_KEY
 
 
 def _time_repairer(plan: Any) -> TimeRepairStream:
@@ -27,7 +28,8 @@ def _repair_time(part: dict[str, np.ndarray], repairer: TimeRepairStream,
     time = part.get("time_s")
     if time is None or not len(time):
         return part
-    others = [values for name, values in part.items() if name != "time_s"]
+    others = [values for name, values in part.items()  # the file row is no value
+              if name not in ("time_s", ROW_KEY)]
     repaired, keep = repairer.repair(time, others)
     if keep.all():
         return part if repaired is time else {**part, "time_s": repaired}
