@@ -9,7 +9,7 @@ from bursts import cut_bursts, duplicated_rows, with_time, wrapped_counter_s
 from hrgtc.core.time_steps import WRAP_MODULUS_S, TimeRepairStream, classify_time_steps
 from hrgtc.drift.features import EQ21, FeatureSettings
 from hrgtc.drift.windows import window_means
-from hrgtc.errors import RecordingError
+from hrgtc.errors import InputError, RecordingError
 from hrgtc.recording import Metadata, Recording, iter_chunks, read, write
 from hrgtc.recording.validation import validate
 
@@ -187,3 +187,65 @@ def test_a_reset_is_a_new_run_its_own_warm_up_filter_and_offset_group(clean, tmp
     assert set(one.power_run.tolist()) == {0}
     assert sorted(set(each.power_run.tolist())) == list(range(6))
     assert each.dropped["warmup"] == 6 * 1000
+
+
+def _local_clock_csv(path, utc_start: str, n: int, zone: str):
+    """A 1 Hz file whose clock times are written in local time of ``zone`` (no offset), and
+    the clean times in seconds since the first sample."""
+    import zoneinfo
+    from datetime import UTC, datetime, timedelta
+
+    start = datetime.fromisoformat(utc_start).replace(tzinfo=UTC)
+    local = [(start + timedelta(seconds=k)).astimezone(zoneinfo.ZoneInfo(zone))
+             .replace(tzinfo=None).isoformat() for k in range(n)]
+    rng = np.random.default_rng(4)
+    freq = 4428.5 + rng.normal(0, 0.002, n)
+    rate = 10 + rng.normal(0, 2, n)
+    path.write_text("t,f,w\n" + "".join(f"{t},{float(f)!r},{float(w)!r}\n" for t, f, w in
+                                        zip(local, freq, rate, strict=True)))
+    return np.arange(n, dtype=np.float64), freq, rate, local
+
+
+@pytest.mark.parametrize(("utc_start", "name"), [
+    ("2026-10-25T00:10:00", "autumn"),  # 03:00 CEST -> 02:00 CET: the hour 02:xx twice
+    ("2026-03-29T00:40:00", "spring"),  # 02:00 CET -> 03:00 CEST: the hour 02:xx skipped
+])
+@pytest.mark.parametrize("rows", [None, 700, 1800])
+def test_clock_times_read_in_their_zone_are_the_clean_file(tmp_path, utc_start, name, rows):
+    """``--tz`` (issue 20 item 3): clock times written in local time across a daylight saving
+    change read as the clean file (seconds, exactly), whole or in chunks (the repeated hour
+    cut anywhere); without it the step is an error naming --tz."""
+    n = 3600
+    clean_s, freq, rate, local = _local_clock_csv(tmp_path / f"{name}.csv", utc_start, n,
+                                                  "Europe/Berlin")
+    path = tmp_path / f"{name}.csv"
+    options = {"columns": READ["columns"], "units": {"time": "timestamp"},
+               "metadata": {"sample_rate_hz": 1.0}}
+    if rows is None:
+        run = read(path, tz="Europe/Berlin", **options)
+    else:
+        chunks = list(iter_chunks(path, rows=rows, tz="Europe/Berlin", **options))
+        run = Recording({k: np.concatenate([c[k] for c in chunks]) for k in chunks[0].names},
+                        chunks[0].metadata)
+    np.testing.assert_array_equal(run.time_s, clean_s)
+    np.testing.assert_array_equal(run.freq_hz, freq)
+    np.testing.assert_array_equal(run.rate_dph, rate)
+    assert run.metadata.extra["time_zone"] == "Europe/Berlin"
+    with pytest.raises(RecordingError, match=r"daylight saving.*--tz"):
+        read(path, **options)
+
+
+def test_tz_errors_name_the_fix(tmp_path):
+    _local_clock_csv(tmp_path / "c.csv", "2026-10-25T00:10:00", 100, "Europe/Berlin")
+    options = {"columns": READ["columns"], "metadata": {"sample_rate_hz": 1.0}}
+    with pytest.raises(InputError, match=r"--tz 'Mars/Olympus' is not a time zone"):
+        read(tmp_path / "c.csv", units={"time": "timestamp"}, tz="Mars/Olympus", **options)
+    seconds = tmp_path / "s.csv"
+    seconds.write_text("t,f,w\n" + "".join(f"{k},4428.5,10\n" for k in range(100)))
+    with pytest.raises(InputError, match=r"drop --tz"):
+        read(seconds, tz="Europe/Berlin", **options)
+    # a clock time in the hour skipped in spring does not exist there: the row is named
+    skipped = tmp_path / "skipped.csv"
+    skipped.write_text("t,f,w\n2026-03-29T01:59:59,4428.5,10\n2026-03-29T02:00:00,4428.5,10\n")
+    with pytest.raises(RecordingError, match=r"row 1: 2026-03-29 02:00:00 does not exist"):
+        read(skipped, units={"time": "timestamp"}, tz="Europe/Berlin", **options)

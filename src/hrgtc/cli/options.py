@@ -262,6 +262,17 @@ GapsOption = Annotated[
         rich_help_panel=_INPUT,
     ),
 ]
+TzOption = Annotated[
+    str | None,
+    typer.Option(
+        "--tz",
+        metavar="ZONE",
+        help="Time zone the clock times (--time-unit timestamp) were written in, an IANA name "
+        "(e.g. Europe/Berlin): they are read as UTC, so the daylight-saving step is gone; "
+        "--start/--end clock times too. Default: none (a 3600 s step is an error).",
+        rich_help_panel=_INPUT,
+    ),
+]
 StartOption = Annotated[
     str | None,
     typer.Option(
@@ -434,6 +445,7 @@ def recording_input(
     end: str | None = None,
     slow_channels: SlowChannelPolicy | str | None = None,
     hold_max_s: float | None = None,
+    tz: str | None = None,
 ) -> ReadOptions:
     """Gather the values of the shared reading options into a :class:`ReadOptions`."""
     from hrgtc.recording import ReadOptions
@@ -466,6 +478,7 @@ def recording_input(
         end=end,
         slow_channels=str(getattr(slow_channels, "value", slow_channels) or "hold"),
         hold_max_s=None if hold_max_s is None else float(hold_max_s),
+        tz=tz,
     )
 
 
@@ -473,6 +486,7 @@ def recording_input(
 _READING_OPTIONS: tuple[tuple[str, Any], ...] = (
     ("col", ColumnsOption),
     ("time_unit", TimeUnitOption),
+    ("tz", TzOption),
     ("freq_unit", FreqUnitOption),
     ("rate_unit", RateUnitOption),
     ("rate_scale", RateScaleOption),

@@ -15,7 +15,8 @@ says which it is:
     shifted to follow the earlier run after a gap.
 ``dst``
     A step of about ±3600 s in naive clock times: daylight saving time began or
-    ended. Not repairable without the time zone: a problem naming ``--tz``.
+    ended. Not repairable without the time zone: a problem naming ``--tz`` (with
+    ``--tz ZONE`` the clock times are read as UTC and the step is gone).
 ``duplicate``
     Rows repeated with the same time and the same values (a logger that re-sent a
     block): dropped and counted.
@@ -304,8 +305,8 @@ def _event(kind: str, row: int, count: int, detail: Any) -> TimeEvent:
         sign = "back" if detail < 0 else "forward"
         return TimeEvent(kind, row, count,
                          f"row {row}: the clock time jumps {sign} by 3600 s ({count} time(s)): "
-                         "daylight saving time in clock times without a time zone; convert "
-                         "the time column to UTC (or to seconds) before reading", False)
+                         "daylight saving time in clock times without a time zone; pass --tz "
+                         "with the zone they were written in (e.g. --tz Europe/Berlin)", False)
     if kind == "duplicate_time":
         return TimeEvent(kind, row, count,
                          f"row {row}: the same time as the row before with other values "
@@ -401,6 +402,8 @@ class TimeRepairStream:
     def __init__(self, time_unit: str | None = "s", naive_clock: bool = False) -> None:
         self.time_unit = time_unit
         self.naive_clock = naive_clock
+        #: The file, for the messages of the reader.
+        self.source = ""
         self._shift = 0.0
         self._last: tuple[float, np.ndarray | None] | None = None
         self._period: float | None = None

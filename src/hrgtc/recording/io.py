@@ -157,6 +157,8 @@ def _metadata(
         extra["temperature_count_bits"] = plan.wrap_bits
     if plan.time_origin_ns is not None and "time_origin" not in extra:
         extra["time_origin"] = str(np.datetime64(plan.time_origin_ns, "ns"))
+        if plan.tz is not None:  # clock times read in a zone: the origin is UTC
+            extra["time_zone"] = plan.tz
     data["extra"] = extra
     try:
         return Metadata.from_dict(data)
@@ -189,6 +191,7 @@ def read(
     end: str | float | None = None,
     slow_channels: str = "hold",
     hold_max_s: float | None = None,
+    tz: str | None = None,
 ) -> Recording:
     """Read a whole recording from Parquet, CSV or HDF5 (by suffix).
 
@@ -243,6 +246,12 @@ def read(
         A channel logged slower than the rows (empty cells): ``"hold"`` (default),
         ``"interpolate"`` or ``"error"``, for at most ``hold_max_s`` seconds
         (:mod:`hrgtc.recording.resample`).
+    tz
+        The IANA time zone (``"Europe/Berlin"``) naive clock times of the time column
+        (``units={"time": "timestamp"}``) were written in: they are read as UTC, so the
+        step of daylight saving time disappears (the repeated hour when it ends is
+        resolved in order); ``--start/--end`` clock times are read in it too. None:
+        clock times without a zone, and a ±3600 s step is an error naming ``--tz``.
 
     Returns
     -------
@@ -262,7 +271,7 @@ def read(
                                lsb_multiple=spike_lsb, window_s=spike_window_s)
     with open_source(path) as source:
         plan = plan_columns(source, columns, units, temp_scale, temp_offset_c, thermometer,
-                            rate_scale, temp_unwrap)
+                            rate_scale, temp_unwrap, tz)
         robust.counts = plan.temperature_is_count and (temp_scale, temp_offset_c) == (1.0, 0.0)
         columns = table_columns(source.read(plan.read_names, plan.as_text))
         arrays = with_file_rows(convert_columns(plan, columns, 0), 0)
@@ -320,6 +329,7 @@ def iter_chunks(
     end: str | float | None = None,
     slow_channels: str = "hold",
     hold_max_s: float | None = None,
+    tz: str | None = None,
 ) -> Iterator[Recording]:
     """Stream a recording in chunks of ``rows`` rows without loading the file.
 
@@ -358,13 +368,14 @@ def iter_chunks(
     slow = SlowChannels(slow_channels, hold_max_s, str(path))
     with open_source(path) as source:
         plan = plan_columns(source, columns, units, temp_scale, temp_offset_c, thermometer,
-                            rate_scale, temp_unwrap)
+                            rate_scale, temp_unwrap, tz)
         robust.counts = plan.temperature_is_count and (temp_scale, temp_offset_c) == (1.0, 0.0)
         offset = 0
         repairer = _time_repairer(plan)
         if time_repair is not None:  # the caller's, to read what was repaired
             time_repair.time_unit, time_repair.naive_clock = (repairer.time_unit,
                                                               repairer.naive_clock)
+            time_repair.source = repairer.source
             repairer = time_repair
         cut = _TimeSlice(start, end, plan)
 
@@ -492,6 +503,8 @@ class ReadOptions:
     slow_channels, hold_max_s
         Channels logged slower than the rows: ``"hold"``, ``"interpolate"`` or
         ``"error"``, values used for at most ``hold_max_s`` seconds (see :func:`read`).
+    tz
+        ``--tz``: the IANA time zone naive clock times were written in (see :func:`read`).
     """
 
     columns: Mapping[str, str] | None = None
@@ -517,6 +530,7 @@ class ReadOptions:
     end: str | None = None
     slow_channels: str = "hold"
     hold_max_s: float | None = None
+    tz: str | None = None
 
     def keywords(self) -> dict[str, Any]:
         """The options as keyword arguments of :func:`read` and :func:`iter_chunks`.
@@ -535,7 +549,7 @@ class ReadOptions:
                     "hold_max_s": None}
         words.update({key: getattr(self, key) for key, default in defaults.items()
                       if getattr(self, key) != default})
-        words.update({key: getattr(self, key) for key in ("start", "end")
+        words.update({key: getattr(self, key) for key in ("start", "end", "tz")
                       if getattr(self, key) is not None})
         return words
 
