@@ -216,7 +216,7 @@ def test_clock_times_read_in_their_zone_are_the_clean_file(tmp_path, utc_start, 
     change read as the clean file (seconds, exactly), whole or in chunks (the repeated hour
     cut anywhere); without it the step is an error naming --tz."""
     n = 3600
-    clean_s, freq, rate, local = _local_clock_csv(tmp_path / f"{name}.csv", utc_start, n,
+    clean_s, freq, rate, _local = _local_clock_csv(tmp_path / f"{name}.csv", utc_start, n,
                                                   "Europe/Berlin")
     path = tmp_path / f"{name}.csv"
     options = {"columns": READ["columns"], "units": {"time": "timestamp"},

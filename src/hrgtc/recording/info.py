@@ -265,6 +265,7 @@ def describe(
     end: str | float | None = None,
     slow_channels: str = "hold",
     hold_max_s: float | None = None,
+    tz: str | None = None,
 ) -> RecordingInfo:
     """Summarise and validate a recording file in one streaming pass.
 
@@ -283,6 +284,8 @@ def describe(
         The slice read (``--start/--end``, see :func:`hrgtc.recording.read`).
     slow_channels, hold_max_s
         As for :func:`hrgtc.recording.read` (channels logged slower than the rows).
+    tz
+        The time zone clock times were written in (``--tz``, see :func:`hrgtc.recording.read`).
     rows
         Rows per chunk read.
     progress
@@ -316,7 +319,7 @@ def describe(
             spike_filter=spike_filter or "off", spike_k=spike_k, spike_lsb=spike_lsb,
             spike_window_s=spike_window_s,
             time_repair=repairer, start=start, end=end,
-            slow_channels=slow_channels, hold_max_s=hold_max_s,
+            slow_channels=slow_channels, hold_max_s=hold_max_s, tz=tz,
         ):
             meta = chunk.metadata
             names = names or [n for n in chunk.names if n != SPIKE_COLUMN
