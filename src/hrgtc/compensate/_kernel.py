@@ -53,6 +53,7 @@ from hrgtc.compensate._kernel_thermometer import (
     _newton_scalar,
     _start_and_step,
 )
+from hrgtc.core.timeline import settle_threshold_s
 from hrgtc.drift import DriftModel
 from hrgtc.drift._rate_kernel import filter_run
 from hrgtc.drift.rate_filter import STATE_SIZE, check_tau
@@ -90,9 +91,10 @@ class KernelPlan:
     Attributes
     ----------
     filter
-        ``[tau_s, 0, 1/tau_s, reference_freq_hz, reference_c, warmup_s]`` of the rate
+        ``[tau_s, 0, 1/tau_s, reference_freq_hz, reference_c, settle_s]`` of the rate
         filter (the samples of the first ``warmup_s`` seconds after the filter (re)started,
-        on the time axis, are flagged, as training skips them).
+        on the time axis, are flagged, as training skips them; ``settle_s`` is
+        :func:`hrgtc.core.timeline.settle_threshold_s`).
     uses_housing
         Whether h/dh are computed (the recording then needs ``housing_c``).
     uses_gradient
@@ -191,7 +193,7 @@ def plan(drift: DriftModel, thermometer: Thermometer, variables: tuple[str, ...]
     a = np.asarray(thermometer.scaled_coefficients, dtype=np.float64)
     return KernelPlan(
         filter=np.array([tau, 0.0, 1.0 / tau, s.reference_freq_hz, s.reference_c,
-                         float(s.warmup_s)]),
+                         settle_threshold_s(s.warmup_s)]),
         uses_housing=any(v in ("h", "dh") for v in variables),
         uses_gradient="g" in variables,
         exponents=exponents,

@@ -35,7 +35,7 @@ from hrgtc.compensate.model_fit import (
 from hrgtc.compensate.ranges import RangeReport, range_report
 from hrgtc.core.accounting import Accounting
 from hrgtc.core.time_steps import TimeRepairStream
-from hrgtc.core.timeline import RESTARTS_KEY, is_gap, restart_rows
+from hrgtc.core.timeline import RESTARTS_KEY, is_gap, restart_rows, settle_threshold_s
 from hrgtc.drift import DriftModel
 from hrgtc.drift.features import (
     LEVEL_VARIABLES,
@@ -336,7 +336,7 @@ class Compensator:
             last = np.maximum.accumulate(np.where(restart, rows, -1))
             origin = np.where(last >= 0, time_s[np.maximum(last, 0)], origin)
         self._origin_s = float(origin[-1])
-        return time_s - origin >= self.drift.settings.warmup_s
+        return time_s - origin >= settle_threshold_s(self.drift.settings.warmup_s)
 
     def _track(self, variable: str, outside: int, low: float, high: float) -> None:
         """Add a block's samples outside ``variable``'s range and its extremes."""

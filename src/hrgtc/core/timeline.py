@@ -273,6 +273,23 @@ def restart_rows(time_s: np.ndarray, restarts_s: Any = ()) -> np.ndarray:
     return np.flatnonzero(np.isin(np.asarray(time_s, dtype=np.float64), times))
 
 
+#: Relative slack of the settling test: a sample ``warmup_s`` after the filter started is
+#: settled whether its time comes from a difference of times (Python) or a sum of steps
+#: (the C export's ``dt_s``), whose roundings differ in the last digits.
+SETTLE_TOLERANCE = 1e-9
+
+
+def settle_threshold_s(warmup_s: float) -> float:
+    """Seconds since the df/dt filter (re)started from which a sample is settled: ``warmup_s``
+    less a relative :data:`SETTLE_TOLERANCE`. Training, the compensator (numpy, numba, C)
+    and the evaluation all compare ``elapsed >= settle_threshold_s(warmup_s)``. [s]
+
+    >>> settle_threshold_s(50.0) < 50.0 < settle_threshold_s(50.0) + 1e-6
+    True
+    """
+    return float(warmup_s) * (1.0 - SETTLE_TOLERANCE)
+
+
 def seconds_since_power_on(time_s: np.ndarray, bounds: np.ndarray | None = None,
                            restart_each_segment: bool = False) -> np.ndarray:
     """Time since the logger (and the gyro) started, for the warm-up skip. [s]

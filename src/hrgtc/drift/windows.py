@@ -33,7 +33,13 @@ from typing import Any
 
 import numpy as np
 
-from hrgtc.core.timeline import RESTARTS_KEY, is_gap, min_partial_rows, restart_rows
+from hrgtc.core.timeline import (
+    RESTARTS_KEY,
+    is_gap,
+    min_partial_rows,
+    restart_rows,
+    settle_threshold_s,
+)
 from hrgtc.drift.features import FeatureSettings, FeatureStream, Term, design_matrix, variables_for
 from hrgtc.drift.rate_checks import filtered_levels, rate_filter_problems, warn_rate_filter
 from hrgtc.errors import CalibrationError, InputError
@@ -304,7 +310,7 @@ def window_means(
                 lengths = np.diff(np.append(power_starts, len(time)))
                 origin[power_starts[0]:] = np.repeat(time[power_starts], lengths)
                 power_on = float(time[power_starts[-1]])
-            settled = time - origin >= settings.warmup_s
+            settled = time - origin >= settle_threshold_s(settings.warmup_s)
             # the power-on run of each row (a new one at each restart)
             run_of_row = np.full(len(time), float(power))
             for r in power_starts:

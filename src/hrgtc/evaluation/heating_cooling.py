@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 
+from hrgtc.core.timeline import RESTARTS_KEY, restart_rows, settle_threshold_s
 from hrgtc.drift.cross_validation import heating_mask
 from hrgtc.drift.features import FeatureStream
 from hrgtc.model import UnitModel
@@ -135,7 +136,13 @@ class DirectionSplit:
         if time.size and self._origin_s is None:
             self._origin_s = float(time[0])
         if time.size:  # the df/dt filter's settling, in seconds on the time axis
-            block = block[time - self._origin_s >= self._warmup_s]
+            origin = np.full(time.size, self._origin_s)
+            restarts = restart_rows(time, freq_chunk.metadata.extra.get(RESTARTS_KEY))
+            if restarts.size:  # a logger restart: the filter settles again
+                lengths = np.diff(np.append(restarts, time.size))
+                origin[restarts[0]:] = np.repeat(time[restarts], lengths)
+                self._origin_s = float(time[restarts[-1]])
+            block = block[time - origin >= settle_threshold_s(self._warmup_s)]
         if self._carry is not None and self._carry.shape[0]:
             block = np.concatenate([self._carry, block])
         complete = block.shape[0] // self.rows

@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from hrgtc.core.timeline import is_gap, restart_rows
+from hrgtc.core.timeline import is_gap, restart_rows, settle_threshold_s
 from hrgtc.errors import InputError
 from hrgtc.evaluation.series_stats import SeriesStatistics
 
@@ -63,7 +63,7 @@ class SettlingCut:
             origin[starts[0]:] = np.repeat(time[starts], lengths)
             self._origin = float(time[starts[-1]])
         self._last = float(time[-1])
-        return time - origin >= self.warmup_s
+        return time - origin >= settle_threshold_s(self.warmup_s)
 
     def push(self, values: dict[str, np.ndarray], time: np.ndarray,
              restarts_s: Any = ()) -> None:
