@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from hrgtc.errors import InputError, RecordingError, SpikeWarning
-from hrgtc.recording import ReadOptions, Recording, iter_chunks, read, write
+from hrgtc.recording import ReadOptions, Recording, describe, iter_chunks, read, write
 
 RATE_HZ = 100.0
 N = 500
@@ -110,3 +110,8 @@ def test_a_later_error_names_the_file_row_after_spikes_were_dropped(tmp_path, ro
     message = " ".join(str(info.value).split())
     assert "column 'time_s', row 470:" in message, message
     assert "row 466" not in message  # the row among the rows kept (four spikes before it)
+    if rows is not None:  # info validates the chunks itself: the same rows
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", SpikeWarning)
+            report = describe(path, rows=rows, spikes="drop").validation
+        assert "column 'time_s', row 470:" in " ".join(report.message.split())

@@ -310,6 +310,7 @@ def describe(
     names: list[str] = []
     builder: TimelineBuilder | None = None
     repairer = TimeRepairStream()  # filled by iter_chunks: what the time repair did
+    file_rows: list[Any] = []  # the file row of each row of the chunk (messages name them)
     try:
         fmt = format_of(path)
         for chunk in iter_chunks(
@@ -320,13 +321,14 @@ def describe(
             spike_window_s=spike_window_s,
             time_repair=repairer, start=start, end=end,
             slow_channels=slow_channels, hold_max_s=hold_max_s, tz=tz,
+            file_rows=file_rows.append,
         ):
             meta = chunk.metadata
             names = names or [n for n in chunk.names if n != SPIKE_COLUMN
                               and not _sensor_copy(n, chunk.names, thermometer)]
             if SPIKE_COLUMN in chunk:
                 spike_rows = (spike_rows or 0) + int(np.count_nonzero(chunk[SPIKE_COLUMN]))
-            validator.update(chunk)
+            validator.update(chunk, file_rows.pop() if file_rows else None)
             if "time_s" in chunk:
                 if builder is None:
                     builder = TimelineBuilder(1.0 / meta.sample_rate_hz)

@@ -34,7 +34,7 @@ validated axis by axis; :func:`hrgtc.recording.axis_view` gives one axis.
 from __future__ import annotations
 
 import itertools
-from collections.abc import Iterable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -247,11 +247,8 @@ def read(
         ``"interpolate"`` or ``"error"``, for at most ``hold_max_s`` seconds
         (:mod:`hrgtc.recording.resample`).
     tz
-        The IANA time zone (``"Europe/Berlin"``) naive clock times of the time column
-        (``units={"time": "timestamp"}``) were written in: they are read as UTC, so the
-        step of daylight saving time disappears (the repeated hour when it ends is
-        resolved in order); ``--start/--end`` clock times are read in it too. None:
-        clock times without a zone, and a ±3600 s step is an error naming ``--tz``.
+        IANA zone (``"Europe/Berlin"``) the naive clock times were written in: read as
+        UTC, the daylight saving step is gone (:class:`~hrgtc.recording.time_axis.ZoneClock`).
 
     Returns
     -------
@@ -330,6 +327,7 @@ def iter_chunks(
     slow_channels: str = "hold",
     hold_max_s: float | None = None,
     tz: str | None = None,
+    file_rows: Callable[[np.ndarray | None], None] | None = None,
 ) -> Iterator[Recording]:
     """Stream a recording in chunks of ``rows`` rows without loading the file.
 
@@ -337,6 +335,8 @@ def iter_chunks(
 
     rows
         Rows per chunk (the last chunk may be shorter).
+    file_rows
+        Called with the file rows of the next chunk's rows before it is yielded.
     progress
         Called as ``progress(done, total)`` after each chunk (rows, or bytes for CSV).
 
@@ -426,9 +426,11 @@ def iter_chunks(
                 part, file_rows = take_file_rows(p)
                 yield Recording(part, chunk_meta(), source=str(path)), file_rows
 
-        for chunk, file_rows in chunks():
+        for chunk, rows_of_file in chunks():
+            if file_rows is not None:
+                file_rows(rows_of_file)
             if validator is not None:
-                validator.update(chunk, file_rows)
+                validator.update(chunk, rows_of_file)
                 validator.raise_for_problems()
             pending.append(chunk)
             if validator is None or validator.heuristics_done:
