@@ -540,6 +540,9 @@ def compensated_metadata(metadata: rec_io.Metadata, model: UnitModel,
                          drift: str = "frequency") -> rec_io.Metadata:
     """``metadata`` with the mark of compensation by ``model`` (:mod:`hrgtc.recording.marks`)."""
     extra = {**metadata.extra, COMPENSATED_KEY: mark(model.sha256, model.unit, drift)}
+    # the restarts known when the output is opened are those of the first chunk only: none
+    # are written rather than some (its time axis is the repaired one)
+    extra.pop(RESTARTS_KEY, None)
     return dataclasses.replace(metadata, extra=extra)
 
 
