@@ -249,3 +249,21 @@ def test_tz_errors_name_the_fix(tmp_path):
     skipped.write_text("t,f,w\n2026-03-29T01:59:59,4428.5,10\n2026-03-29T02:00:00,4428.5,10\n")
     with pytest.raises(RecordingError, match=r"row 1: 2026-03-29 02:00:00 does not exist"):
         read(skipped, units={"time": "timestamp"}, tz="Europe/Berlin", **options)
+
+
+def test_a_one_hour_pause_in_clock_times_with_their_zone_is_a_gap(tmp_path):
+    """Clock times that carry their zone (``Z``, an offset) have no daylight saving step: a
+    pause of one hour is a gap; the same times without a zone are an error naming --tz."""
+    start = np.datetime64("2026-06-01T10:00:00")
+    stamps = start + np.r_[np.arange(100), 3700 + np.arange(100)].astype("timedelta64[s]")
+    options = {"columns": READ["columns"], "units": {"time": "timestamp"},
+               "metadata": {"sample_rate_hz": 1.0}, "gaps": "bridge"}
+    for suffix, fails in (("Z", False), ("+02:00", False), ("", True)):
+        path = tmp_path / f"pause{len(suffix)}.csv"
+        path.write_text("t,f,w\n" + "".join(f"{s}{suffix},4428.5,10\n" for s in stamps))
+        if fails:
+            with pytest.raises(RecordingError, match=r"row 100: .*forward by 3600 s.*--tz"):
+                read(path, **options)
+        else:
+            run = read(path, **options)
+            assert run.time_s[100] - run.time_s[99] == 3601.0

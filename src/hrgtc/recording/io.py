@@ -277,7 +277,7 @@ def read(
             arrays = spike_filter_.drop(arrays, 0)
         arrays = robust.apply(arrays, 0)
         repairer = _time_repairer(plan)
-        arrays = _repair_time(arrays, repairer)
+        arrays = _repair_time(arrays, repairer, plan)
         cut = _TimeSlice(start, end, plan)
         arrays, file_rows = take_file_rows(cut.apply(arrays))
         meta = _metadata(plan, metadata, arrays.get("time_s"))
@@ -388,14 +388,14 @@ def iter_chunks(
                     part = spike_filter_.drop(part, offset)
                 part = robust.apply(part, offset)
                 offset += table.num_rows
-                part = cut.apply(_repair_time(part, repairer))
+                part = cut.apply(_repair_time(part, repairer, plan))
                 if part.get("time_s") is None or len(part["time_s"]):
                     yield part
             tail = slow.flush()  # rows held back by --slow-channels interpolate
             if tail is not None:
                 if spike_filter_ is not None:
                     tail = spike_filter_.drop(tail, offset)
-                tail = cut.apply(_repair_time(robust.apply(tail, offset), repairer))
+                tail = cut.apply(_repair_time(robust.apply(tail, offset), repairer, plan))
                 if tail.get("time_s") is None or len(tail["time_s"]):
                     yield tail
 

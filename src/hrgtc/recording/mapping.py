@@ -158,6 +158,7 @@ class ColumnPlan:
     wrap_bits: int | None = None
     wrap_decided: bool = False
     tz: str | None = None  # --tz: the zone naive clock times were written in
+    time_aware: bool = False  # the clock times carry their zone (UTC, an offset, epoch)
     zone_clock: Any = None  # its ZoneClock (hrgtc.recording.time_axis), state across chunks
 
     @property
@@ -468,13 +469,15 @@ def _time_seconds(
         return to_contract_unit(seconds, plan.units.get("time", "s"))
     if pa.types.is_floating(column.type) or pa.types.is_integer(column.type):
         seconds = _to_float(plan, column, theirs, row_offset)  # epoch seconds
+        plan.time_aware = True
         if plan.time_origin_s is None:
             finite = seconds[np.isfinite(seconds)]
             plan.time_origin_s = float(finite[0]) if finite.size else None
         return seconds - (plan.time_origin_s or 0.0)
     stamps = _timestamps_ns(plan, column, theirs, row_offset)
     valid = ~np.asarray(stamps.is_null().to_numpy(zero_copy_only=False), dtype=bool)
-    if plan.zone_clock is not None and getattr(stamps.type, "tz", None) is None:
+    plan.time_aware = getattr(stamps.type, "tz", None) is not None
+    if plan.zone_clock is not None and not plan.time_aware:
         ns = plan.zone_clock.utc_ns(stamps, theirs, row_offset)  # --tz: local clock -> UTC
     else:
         ns = np.asarray(stamps.cast(pa.int64()).fill_null(0).to_numpy(zero_copy_only=False),

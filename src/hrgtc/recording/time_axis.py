@@ -27,11 +27,13 @@ def _time_repairer(plan: Any) -> TimeRepairStream:
 
 
 def _repair_time(part: dict[str, np.ndarray], repairer: TimeRepairStream,
-                 ) -> dict[str, np.ndarray]:
+                 plan: Any = None) -> dict[str, np.ndarray]:
     """``part`` with its time axis repaired (unwrapped, resets shifted, duplicates out)."""
     time = part.get("time_s")
     if time is None or not len(time):
         return part
+    if getattr(plan, "time_aware", False):  # UTC or an offset in each time: no DST step
+        repairer.naive_clock = False
     others = [values for name, values in part.items()  # the file row is no value
               if name not in ("time_s", ROW_KEY)]
     repaired, keep = repairer.repair(time, others)
