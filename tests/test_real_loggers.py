@@ -378,11 +378,6 @@ def test_hand_log_gives_the_true_count_map(tmp_path):
     assert abs(fitted["lag_s"] - reference["lag_s"]) <= 60.0, fitted
 
 
-NEEDS_RUNS = ("needs restarts read as new runs (time) and an offset per run as a nuisance "
-              "parameter (motion: --offsets run)")
-
-
-@pytest.mark.xfail(strict=True, reason=NEEDS_RUNS)
 def test_restarts_with_turn_on_offsets_give_the_thermal_drift(tmp_path):
     """Power cycled twice (the ms clock back to about 0, a new turn-on offset of ~200 °/h
     each time, and a warm-up transient), a cool-down gives the true thermal drift once

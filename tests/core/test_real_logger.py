@@ -14,10 +14,12 @@ import pytest
 from typer.testing import CliRunner
 
 from hrgtc.cli import app
+from hrgtc.compensate import Compensator
 from hrgtc.core.errors import CalibrationError
 from hrgtc.core.timeline import Timeline
 from hrgtc.drift.features import FeatureSettings, parse_terms
 from hrgtc.drift.windows import window_means
+from hrgtc.model import load_instrument
 from hrgtc.recording import ReadOptions
 
 PAN = Path(__file__).resolve().parents[1] / "data" / "pan-cold-test" / "pan_tvc_cold_2020-03-07.csv"
@@ -109,3 +111,47 @@ def test_holdout_trains_on_the_first_bursts_and_validates_on_the_last(tmp_path):
                                "--gaps", "bridge", "--holdout-s", "30", "-o", str(model),
                                "--force"])
     assert both.exit_code == 2 and "exactly one --drift" in " ".join(both.stderr.split())
+
+
+def test_compensate_flags_the_first_warmup_seconds_not_samples_on_a_burst_file(tmp_path):
+    """The compensator's own settling is seconds on the time axis (issue 20 item 1): with
+    ``--gaps bridge`` the 50 s warm-up (5 × tau 10 s) flags the samples within 50 s of the
+    first one: the first burst (15 s to 20 s, 250 samples of 6250) -- as training skips
+    them -- not 50 s × 50 Hz = 2,500 samples (40 % of the file, ten bursts)."""
+    model = tmp_path / "pan.json"
+    result = runner.invoke(app, ["calibrate", "--drift", str(PAN), *ARGS, "--gaps", "bridge",
+                                 "--terms", "f", "-o", str(model)])
+    assert result.exit_code == 0, result.stderr
+    run = options(gaps="bridge").read(PAN)
+    by_hand = int(np.count_nonzero(run.time_s - run.time_s[0] < 50.0))
+    assert by_hand == 250
+    out = runner.invoke(app, ["compensate", str(PAN), "--model", str(model), *ARGS,
+                              "--gaps", "bridge", "--json", "-o", str(tmp_path / "c.parquet")])
+    assert out.exit_code == 0, out.stderr
+    document, _ = json.JSONDecoder().raw_decode(out.stdout[out.stdout.index("{"):])
+    assert document["ranges"]["settling_fraction"] == pytest.approx(by_hand / 6250)
+    # compensate's accounting (item 7): flagged by reason, never dropped
+    accounting = document["accounting"]
+    assert accounting["read"] == accounting["used"] == 6250 and accounting["dropped"] == {}
+    flagged = accounting["flagged"]
+    assert flagged["warmup"] == by_hand and flagged["spikes"] == 3  # the three known spikes
+    assert flagged["out_of_range"] == round(document["out_of_range_fraction"] * 6250)
+    assert flagged["rate_out_of_range"] == round(document["rate_out_of_range_fraction"] * 6250)
+    lines = PAN.read_text().splitlines(keepends=True)  # rows 100-109 sent twice
+    doubled = tmp_path / "doubled.csv"
+    doubled.write_text("".join(lines[:111] + lines[101:111] + lines[111:]))
+    again = runner.invoke(app, ["compensate", str(doubled), "--model", str(model), *ARGS,
+                                "--gaps", "bridge", "--json", "-o", str(tmp_path / "d.parquet")])
+    assert again.exit_code == 0, again.stderr
+    counted, _ = json.JSONDecoder().raw_decode(again.stdout[again.stdout.index("{"):])
+    assert counted["accounting"]["read"] == 6260 and counted["rows"] == 6250
+    assert counted["accounting"]["dropped"] == {"duplicates": 10}
+    text = runner.invoke(app, ["compensate", str(PAN), "--model", str(model), *ARGS, "--gaps",
+                               "bridge", "-o", str(tmp_path / "t.parquet")]).stdout
+    assert "samples: 6250 read, 6250 used, flagged 250 warm-up" in " ".join(text.split())
+    unit = load_instrument(model).axes["x"]
+    for engine in ("fused", "numpy"):  # the kernel and the numpy reference agree
+        compensator = Compensator(unit, engine=engine, gaps="bridge")
+        flags = compensator.process(run)["in_range"]
+        assert compensator.settling == by_hand, engine
+        assert not flags[:by_hand].any()

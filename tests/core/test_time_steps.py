@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from bursts import cut_bursts, duplicated_rows, with_time, wrapped_counter_s
-from hrgtc.core.errors import RecordingError
+from hrgtc.core.errors import InputError, RecordingError
 from hrgtc.core.time_steps import WRAP_MODULUS_S, TimeRepairStream, classify_time_steps
 from hrgtc.drift.features import EQ21, FeatureSettings
 from hrgtc.drift.windows import window_means
@@ -154,3 +154,116 @@ def test_info_names_what_the_time_repair_did(clean, tmp_path):
     assert timeline["segments"] == 1 and "wrapped (1 time(s)" in timeline["repairs"][0]
     text = " ".join(CliRunner().invoke(app, args).stdout.split())
     assert "time: row 2950: the 32-bit us time counter wrapped" in text
+
+
+def test_a_reset_is_a_new_run_its_own_warm_up_filter_and_offset_group(clean, tmp_path):
+    """A logger reset starts a new run (issue 20 items 1, 3, 13): the reader lists it
+    (``restarts_s``, in every chunk from the one holding it), and training skips the warm-up
+    after it again, restarts the df/dt filter there and gives it its own power-on run (the
+    groups of ``--offsets run``) -- the windows of two files. A gap does not, unless each
+    segment is said to be a restart."""
+    time = clean.time_s.copy()
+    time[36_000:] = time[36_000:] - time[36_000] + 0.0  # the logger restarts at 0
+    path = _csv(clean, tmp_path / "reset.csv", time)
+    run = read(path, gaps="bridge", **READ)
+    (restart,) = run.metadata.extra["restarts_s"]
+    assert restart == run.time_s[36_000]
+    for rows in (1000, 36_000, 50_000):
+        chunks = list(iter_chunks(path, rows=rows, gaps="bridge", **READ))
+        holding = [c for c in chunks if c.time_s[-1] >= restart]
+        assert all(c.metadata.extra["restarts_s"] == [restart] for c in holding)
+    windows = _windows(run)
+    first, second = clean.slice(0, 36_000), clean.slice(36_000, len(clean))
+    settings = FeatureSettings(reference_freq_hz=4432.0, sample_rate_hz=10.0, warmup_s=100.0)
+    apart = window_means([first, second], settings, list(EQ21[:4]), 10.0)
+    assert windows.dropped["warmup"] == 2 * 1000  # 100 s at 10 Hz after each power-on
+    np.testing.assert_allclose(windows.terms, apart.terms, rtol=1e-9, atol=1e-15)
+    np.testing.assert_array_equal(windows.power_run, apart.run)
+    assert windows.power_runs == (f"{path} run 1", f"{path} run 2")
+    # bursts: one power-on run, unless each segment is a restart
+    bursts = cut_bursts(clean, burst_s=600.0, period_s=1200.0)
+    one = window_means([bursts], settings, list(EQ21[:4]), 10.0)
+    each = window_means([bursts], settings, list(EQ21[:4]), 10.0, restart_each_segment=True)
+    assert set(one.power_run.tolist()) == {0}
+    assert sorted(set(each.power_run.tolist())) == list(range(6))
+    assert each.dropped["warmup"] == 6 * 1000
+
+
+def _local_clock_csv(path, utc_start: str, n: int, zone: str):
+    """A 1 Hz file whose clock times are written in local time of ``zone`` (no offset), and
+    the clean times in seconds since the first sample."""
+    import zoneinfo
+    from datetime import UTC, datetime, timedelta
+
+    start = datetime.fromisoformat(utc_start).replace(tzinfo=UTC)
+    local = [(start + timedelta(seconds=k)).astimezone(zoneinfo.ZoneInfo(zone))
+             .replace(tzinfo=None).isoformat() for k in range(n)]
+    rng = np.random.default_rng(4)
+    freq = 4428.5 + rng.normal(0, 0.002, n)
+    rate = 10 + rng.normal(0, 2, n)
+    path.write_text("t,f,w\n" + "".join(f"{t},{float(f)!r},{float(w)!r}\n" for t, f, w in
+                                        zip(local, freq, rate, strict=True)))
+    return np.arange(n, dtype=np.float64), freq, rate, local
+
+
+@pytest.mark.parametrize(("utc_start", "name"), [
+    ("2026-10-25T00:10:00", "autumn"),  # 03:00 CEST -> 02:00 CET: the hour 02:xx twice
+    ("2026-03-29T00:40:00", "spring"),  # 02:00 CET -> 03:00 CEST: the hour 02:xx skipped
+])
+@pytest.mark.parametrize("rows", [None, 700, 1800])
+def test_clock_times_read_in_their_zone_are_the_clean_file(tmp_path, utc_start, name, rows):
+    """``--tz`` (issue 20 item 3): clock times written in local time across a daylight saving
+    change read as the clean file (seconds, exactly), whole or in chunks (the repeated hour
+    cut anywhere); without it the step is an error naming --tz."""
+    n = 3600
+    clean_s, freq, rate, _local = _local_clock_csv(tmp_path / f"{name}.csv", utc_start, n,
+                                                  "Europe/Berlin")
+    path = tmp_path / f"{name}.csv"
+    options = {"columns": READ["columns"], "units": {"time": "timestamp"},
+               "metadata": {"sample_rate_hz": 1.0}}
+    if rows is None:
+        run = read(path, tz="Europe/Berlin", **options)
+    else:
+        chunks = list(iter_chunks(path, rows=rows, tz="Europe/Berlin", **options))
+        run = Recording({k: np.concatenate([c[k] for c in chunks]) for k in chunks[0].names},
+                        chunks[0].metadata)
+    np.testing.assert_array_equal(run.time_s, clean_s)
+    np.testing.assert_array_equal(run.freq_hz, freq)
+    np.testing.assert_array_equal(run.rate_dph, rate)
+    assert run.metadata.extra["time_zone"] == "Europe/Berlin"
+    with pytest.raises(RecordingError, match=r"daylight saving.*--tz"):
+        read(path, **options)
+
+
+def test_tz_errors_name_the_fix(tmp_path):
+    _local_clock_csv(tmp_path / "c.csv", "2026-10-25T00:10:00", 100, "Europe/Berlin")
+    options = {"columns": READ["columns"], "metadata": {"sample_rate_hz": 1.0}}
+    with pytest.raises(InputError, match=r"--tz 'Mars/Olympus' is not a time zone"):
+        read(tmp_path / "c.csv", units={"time": "timestamp"}, tz="Mars/Olympus", **options)
+    seconds = tmp_path / "s.csv"
+    seconds.write_text("t,f,w\n" + "".join(f"{k},4428.5,10\n" for k in range(100)))
+    with pytest.raises(InputError, match=r"drop --tz"):
+        read(seconds, tz="Europe/Berlin", **options)
+    # a clock time in the hour skipped in spring does not exist there: the row is named
+    skipped = tmp_path / "skipped.csv"
+    skipped.write_text("t,f,w\n2026-03-29T01:59:59,4428.5,10\n2026-03-29T02:00:00,4428.5,10\n")
+    with pytest.raises(RecordingError, match=r"row 1: 2026-03-29 02:00:00 does not exist"):
+        read(skipped, units={"time": "timestamp"}, tz="Europe/Berlin", **options)
+
+
+def test_a_one_hour_pause_in_clock_times_with_their_zone_is_a_gap(tmp_path):
+    """Clock times that carry their zone (``Z``, an offset) have no daylight saving step: a
+    pause of one hour is a gap; the same times without a zone are an error naming --tz."""
+    start = np.datetime64("2026-06-01T10:00:00")
+    stamps = start + np.r_[np.arange(100), 3700 + np.arange(100)].astype("timedelta64[s]")
+    options = {"columns": READ["columns"], "units": {"time": "timestamp"},
+               "metadata": {"sample_rate_hz": 1.0}, "gaps": "bridge"}
+    for suffix, fails in (("Z", False), ("+02:00", False), ("", True)):
+        path = tmp_path / f"pause{len(suffix)}.csv"
+        path.write_text("t,f,w\n" + "".join(f"{s}{suffix},4428.5,10\n" for s in stamps))
+        if fails:
+            with pytest.raises(RecordingError, match=r"row 100: .*forward by 3600 s.*--tz"):
+                read(path, **options)
+        else:
+            run = read(path, **options)
+            assert run.time_s[100] - run.time_s[99] == 3601.0

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from hrgtc.core.errors import InputError, RecordingError, SpikeWarning
-from hrgtc.recording import ReadOptions, Recording, iter_chunks, read, write
+from hrgtc.recording import ReadOptions, Recording, describe, iter_chunks, read, write
 
 RATE_HZ = 100.0
 N = 500
@@ -86,3 +86,32 @@ def test_unknown_spike_policy(tmp_path):
     path, _ = spiky_csv(tmp_path)
     with pytest.raises(InputError, match=r"spikes must be one of \['error', 'drop'\]"):
         read(path, spikes="interpolate")
+
+
+@pytest.mark.parametrize("rows", [None, 64, 1000])
+def test_a_later_error_names_the_file_row_after_spikes_were_dropped(tmp_path, rows):
+    """Spikes dropped before validation (rows 37, 211, 402 and 450 of the file) do not shift
+    a later problem's row: it is the row of the file (0 = the first data row, as in every
+    message), read whole or in chunks (issue 20 item 10)."""
+    path, _ = spiky_csv(tmp_path)
+    lines = path.read_text().splitlines()
+    header = 2  # the metadata comment and the column names
+    fields = lines[header + 470].split(",")
+    fields[0] = repr(float(fields[0]) - 1.0)  # data row 470: the time steps back 1 s
+    lines[header + 470] = ",".join(fields)
+    path.write_text("\n".join(lines) + "\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SpikeWarning)
+        with pytest.raises(RecordingError) as info:
+            if rows is None:
+                read(path, spikes="drop")
+            else:
+                list(iter_chunks(path, rows=rows, spikes="drop"))
+    message = " ".join(str(info.value).split())
+    assert "column 'time_s', row 470:" in message, message
+    assert "row 466" not in message  # the row among the rows kept (four spikes before it)
+    if rows is not None:  # info validates the chunks itself: the same rows
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", SpikeWarning)
+            report = describe(path, rows=rows, spikes="drop").validation
+        assert "column 'time_s', row 470:" in " ".join(report.message.split())

@@ -121,6 +121,8 @@ def compensate_command(
                   "training range") if summary.ranges is None else \
             f"beyond the trained ranges: {summary.ranges.shares_text()}"
         console.print(f"wrote {summary.output}: {summary.rows} rows; {shares}{axes}")
+        if summary.accounting is not None:  # flagged, never dropped
+            console.print(summary.accounting.summary(), markup=False)
     note_unchecked(model, model_path)
     warn_ranges([summary.ranges], json_output, strict)
 

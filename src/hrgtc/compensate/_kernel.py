@@ -53,9 +53,9 @@ from hrgtc.compensate._kernel_thermometer import (
     _newton_scalar,
     _start_and_step,
 )
+from hrgtc.core.timeline import settle_threshold_s
 from hrgtc.drift import DriftModel
 from hrgtc.drift._rate_kernel import filter_run
-from hrgtc.drift.features import settle_rows
 from hrgtc.drift.rate_filter import STATE_SIZE, check_tau
 from hrgtc.drift.rate_filter import new_state as new_filter_state
 from hrgtc.drift.variables import unsupported
@@ -91,9 +91,10 @@ class KernelPlan:
     Attributes
     ----------
     filter
-        ``[tau_s, 0, 1/tau_s, reference_freq_hz, reference_c, settle_rows]`` of the rate
-        filter (``settle_rows`` samples at the start of a run are flagged, as training
-        skips them).
+        ``[tau_s, 0, 1/tau_s, reference_freq_hz, reference_c, settle_s]`` of the rate
+        filter (the samples of the first ``warmup_s`` seconds after the filter (re)started,
+        on the time axis, are flagged, as training skips them; ``settle_s`` is
+        :func:`hrgtc.core.timeline.settle_threshold_s`).
     uses_housing
         Whether h/dh are computed (the recording then needs ``housing_c``).
     uses_gradient
@@ -192,7 +193,7 @@ def plan(drift: DriftModel, thermometer: Thermometer, variables: tuple[str, ...]
     a = np.asarray(thermometer.scaled_coefficients, dtype=np.float64)
     return KernelPlan(
         filter=np.array([tau, 0.0, 1.0 / tau, s.reference_freq_hz, s.reference_c,
-                         float(settle_rows(s))]),
+                         settle_threshold_s(s.warmup_s)]),
         uses_housing=any(v in ("h", "dh") for v in variables),
         uses_gradient="g" in variables,
         exponents=exponents,
@@ -237,15 +238,17 @@ def _padded(coefficients: np.ndarray, size: int) -> np.ndarray:
     return out
 
 
-#: Slots of the kernel's state: the f filter's state, the h filter's, the samples seen.
+#: Slots of the kernel's state: the f filter's state, the h filter's, and the time the
+#: filter (re)started (NaN before the first sample: the settling counts from there). [s]
 F_STATE = slice(0, STATE_SIZE)
 H_STATE = slice(STATE_SIZE, 2 * STATE_SIZE)
-SAMPLES = 2 * STATE_SIZE
+ORIGIN = 2 * STATE_SIZE
 
 
 def new_state() -> np.ndarray:
-    """Filter state at rest: two :func:`hrgtc.drift.rate_filter.new_state` and the samples."""
-    return np.concatenate([new_filter_state(), new_filter_state(), [0.0]])
+    """Filter state at rest: two :func:`hrgtc.drift.rate_filter.new_state` and the time the
+    filter started (NaN: not yet)."""
+    return np.concatenate([new_filter_state(), new_filter_state(), [np.nan]])
 
 
 def new_extremes() -> np.ndarray:
@@ -295,8 +298,8 @@ def compensate_block(time_s, restart, freq_hz, rate_dph, housing_c, filt, uses_h
 
     ``state`` (filter, samples seen), ``counts`` (int64, see :data:`OUT_OF_RANGE`) and
     ``extremes`` (see :data:`F_MIN`) are updated. ``restart`` (int8 per sample, or empty:
-    none) restarts the filters at rest on those samples and the settling count with them
-    (the segment starts of ``gaps="split"``).
+    none) restarts the filters at rest on those samples and the settling time with them
+    (the segment starts of ``gaps="split"``, and restarts of the logger).
     """
     has_restart = restart.size > 0
     tau, ref_f, ref_h = filt[0], filt[3], filt[4]
@@ -444,27 +447,21 @@ def compensate_block(time_s, restart, freq_hz, rate_dph, housing_c, filt, uses_h
                 counts[TEMPERATURE_OUT] += m - int(n_temperature)
         n_ok = 0.0
         n_rate_ok = 0.0
-        since = state[16]  # samples since the filter (re)started (SAMPLES)
+        # settling: seconds since the filter (re)started, on the time axis (ORIGIN), as
+        # training's warm-up skip (drift.windows: time - origin >= warmup_s)
+        origin = state[16]
+        if origin != origin and m > 0:  # NaN: the run's first sample
+            origin = time[0]
         n_settling = 0
-        if has_restart:  # the count restarts with the filter (serial)
-            for i in range(m):
-                if restart[start + i] != 0:
-                    since = 0.0
-                settled = 1.0 if since >= filt[5] else 0.0
-                since += 1.0
-                out_in_range[start + i] = ok[i] * rate_ok[i] * settled
-                n_ok += ok[i]
-                n_rate_ok += rate_ok[i]
-                n_settling += settled == 0.0
-        else:  # vectorised
-            for i in range(m):
-                settled = 1.0 if since + i >= filt[5] else 0.0
-                out_in_range[start + i] = ok[i] * rate_ok[i] * settled
-                n_ok += ok[i]
-                n_rate_ok += rate_ok[i]
-                n_settling += settled == 0.0
-            since += m
-        state[16] = since
+        for i in range(m):
+            if has_restart and restart[start + i] != 0:
+                origin = time[i]
+            settled = 1.0 if time[i] - origin >= filt[5] else 0.0
+            out_in_range[start + i] = ok[i] * rate_ok[i] * settled
+            n_ok += ok[i]
+            n_rate_ok += rate_ok[i]
+            n_settling += settled == 0.0
+        state[16] = origin
         counts[0] += m - int(n_ok)
         counts[1] += m - int(n_rate_ok)
         counts[3] += n_settling
@@ -499,11 +496,12 @@ def advance_filter(time_s, restart, freq_hz, housing_c, filt, uses_housing,
         for i in range(n):
             level[i] = housing_c[i] - ref_h
         filter_run(level, time_s, tau, restart, h_state, scratch, scratch[:0])
-    since = state[16]
+    origin = state[16]
+    if origin != origin and n > 0:  # NaN: the run's first sample
+        origin = time_s[0]
     for i in range(n):
-        since = 0.0 if has_restart and restart[i] != 0 else since
-        since += 1.0
-    state[16] = since
+        origin = time_s[i] if has_restart and restart[i] != 0 else origin
+    state[16] = origin
 
 
 #: Chunks of at least this many rows are split in two halves compensated on two threads.

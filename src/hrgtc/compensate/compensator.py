@@ -17,6 +17,7 @@ fused one to.
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
 import warnings
 from collections.abc import Mapping
@@ -32,17 +33,18 @@ from hrgtc.compensate.model_fit import (
     with_model_band,
 )
 from hrgtc.compensate.ranges import RangeReport, range_report
+from hrgtc.core.accounting import Accounting
 from hrgtc.core.errors import CalibrationError, ExtrapolationWarning, HrgtcWarning, InputError
 from hrgtc.core.files import check_writable, refuse_input
 from hrgtc.core.progress import Progress
-from hrgtc.core.timeline import is_gap
+from hrgtc.core.time_steps import TimeRepairStream
+from hrgtc.core.timeline import RESTARTS_KEY, is_gap, restart_rows, settle_threshold_s
 from hrgtc.drift import DriftModel
 from hrgtc.drift.features import (
     LEVEL_VARIABLES,
     RATE_VARIABLES,
     FeatureStream,
     is_aux,
-    settle_rows,
 )
 from hrgtc.drift.offsets import label_offsets, sample_offsets
 from hrgtc.drift.rate_checks import filtered_levels, rate_filter_problems, warn_rate_filter
@@ -51,6 +53,7 @@ from hrgtc.model import UnitModel
 from hrgtc.recording import Recording
 from hrgtc.recording.gaps import check_gap_policy
 from hrgtc.recording.marks import COMPENSATED_KEY, mark, refuse_compensated
+from hrgtc.recording.spikes import SPIKE_COLUMN
 from hrgtc.settings.compensation import CompensateSettings
 
 #: Rows worked on at once: small enough for the temporaries to stay in cache.
@@ -143,7 +146,6 @@ class Compensator:
         """Start a new run: the df/dt filter restarts at rest on the next sample."""
         self.restart()
         self._extremes = np.array([np.inf, -np.inf, np.inf, -np.inf])  # f, df min/max
-        self._settle_rows = settle_rows(self.drift.settings)
         self.samples = 0
         self.out_of_range = 0
         self.rate_out_of_range = 0
@@ -166,7 +168,7 @@ class Compensator:
         """
         self._stream = FeatureStream(self.drift.settings, self._variables, self.model.thermometer)
         self._state: np.ndarray | None = None  # the fused engine's state (compensate._kernel)
-        self._segment_samples = 0  # samples since the filter (re)started
+        self._origin_s = math.nan  # time the filter (re)started (NaN: at the next sample)
 
     def _gap_rows(self, chunk: Recording) -> list[int]:
         """Rows of ``chunk`` that start a new segment (``gaps="split"``)."""
@@ -197,15 +199,24 @@ class Compensator:
             self.drift.settings.check_sample_rate(chunk)
             if self.gaps != "split":  # split restarts the filter at each gap instead
                 levels = filtered_levels(chunk, self.drift.variables)
+                # up to a logger restart (the filter restarts there)
+                head = restart_rows(chunk.time_s, chunk.metadata.extra.get(RESTARTS_KEY))
+                stop = int(head[0]) if head.size else len(chunk)
                 warn_rate_filter(rate_filter_problems(
-                    chunk.time_s, levels, self.drift.settings.rate_tau_s,
-                    where=chunk.source or ""))
+                    chunk.time_s[:stop], {k: v[:stop] for k, v in levels.items()},
+                    self.drift.settings.rate_tau_s, where=chunk.source or ""))
         restart = None
+        cuts: list[int] = []
         if self.gaps == "split" and "time_s" in chunk:
             cuts = self._gap_rows(chunk)
-            if cuts:  # the filters restart at rest on each segment's first row
-                restart = restart_mask(len(chunk), cuts)
-                self.segments += len(cuts)
+            self.segments += len(cuts)
+        if "time_s" in chunk:  # a logger restart is a new run: the filter restarts at rest
+            rows = restart_rows(chunk.time_s, chunk.metadata.extra.get(RESTARTS_KEY))
+            if self.samples == 0:
+                rows = rows[rows > 0]
+            cuts = sorted(set(cuts) | set(rows.tolist()))
+        if cuts:  # the filters restart at rest on each segment's (run's) first row
+            restart = restart_mask(len(chunk), cuts)
         return self._process(chunk, restart)
 
     def _process(self, chunk: Recording, restart: np.ndarray | None = None) -> Recording:
@@ -297,7 +308,7 @@ class Compensator:
         kernel.run(self._plan, self._state, time_s, freq, chunk.rate_dph, housing, out, counts,
                    extremes, restart)
         self.samples += len(chunk)
-        self._segment_samples = int(self._state[kernel.SAMPLES])
+        self._origin_s = float(self._state[kernel.ORIGIN])
         self.out_of_range += int(counts[kernel.OUT_OF_RANGE])
         self.rate_out_of_range += int(counts[kernel.RATE_OUT_OF_RANGE])
         self.settling += int(counts[kernel.SETTLING])
@@ -311,6 +322,22 @@ class Compensator:
             e[0], e[1] = min(e[0], extremes[0]), max(e[1], extremes[1])
             e[2], e[3] = min(e[2], extremes[2]), max(e[3], extremes[3])
         return True
+
+    def _settled(self, time_s: np.ndarray, restart: np.ndarray | None) -> np.ndarray:
+        """True where the df/dt filter has settled: ``warmup_s`` seconds on the time axis since
+        it (re)started (the run's first sample, or a restart row), as training's warm-up skip."""
+        time_s = np.asarray(time_s, dtype=np.float64)
+        if not time_s.size:
+            return np.ones(0, dtype=bool)
+        if math.isnan(self._origin_s):
+            self._origin_s = float(time_s[0])
+        origin = np.full(time_s.size, self._origin_s)
+        if restart is not None and restart.any():  # the time of each row's (re)start
+            rows = np.arange(time_s.size)
+            last = np.maximum.accumulate(np.where(restart, rows, -1))
+            origin = np.where(last >= 0, time_s[np.maximum(last, 0)], origin)
+        self._origin_s = float(origin[-1])
+        return time_s - origin >= settle_threshold_s(self.drift.settings.warmup_s)
 
     def _track(self, variable: str, outside: int, low: float, high: float) -> None:
         """Add a block's samples outside ``variable``'s range and its extremes."""
@@ -339,13 +366,7 @@ class Compensator:
                 outside = int(np.count_nonzero(~((x >= low) & (x <= high))))
                 self._track(v, outside, np.nanmin(x) if np.isfinite(x).any() else np.inf,
                             np.nanmax(x) if np.isfinite(x).any() else -np.inf)
-        since = self._segment_samples + np.arange(len(chunk))
-        if restart is not None and restart.any():  # samples since the segment's start
-            rows = np.arange(len(chunk))
-            last = np.maximum.accumulate(np.where(restart, rows, -1))
-            since = np.where(last >= 0, rows - last, since)
-        settled = since >= self._settle_rows
-        self._segment_samples = int(since[-1]) + 1 if len(chunk) else self._segment_samples
+        settled = self._settled(chunk.time_s, restart)
         np.subtract(chunk.rate_dph, bias, out=out["rate_comp_dph"][start:stop])
         out["bias_model_dph"][start:stop] = bias
         out["resonator_c_est"][start:stop] = thermometer.temperature(chunk.freq_hz, warn=False)
@@ -395,6 +416,7 @@ class CompensationSummary:
     out_of_range_fraction: float
     rate_out_of_range_fraction: float
     ranges: RangeReport | None = None
+    accounting: Accounting | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -404,6 +426,7 @@ class CompensationSummary:
             "out_of_range_fraction": self.out_of_range_fraction,
             "rate_out_of_range_fraction": self.rate_out_of_range_fraction,
             "ranges": None if self.ranges is None else self.ranges.to_dict(),
+            "accounting": None if self.accounting is None else self.accounting.to_dict(),
         }
 
 
@@ -449,7 +472,9 @@ def compensate_file(
     refuse_input(output, [source])
     refuse_compensated(source)
     check_writable(output, estimated_output_bytes(source, output, len(added)))
-    chunks = options.chunks(source, rows=chunk_rows)
+    repair = TimeRepairStream()  # what the reader dropped (duplicated rows)
+    chunks = options.chunks(source, rows=chunk_rows, time_repair=repair)
+    spikes = 0
     try:
         first = next(chunks)
         copies = sensor_copies((*first.names, *added), first.metadata)
@@ -465,6 +490,8 @@ def compensate_file(
             chunk: Recording | None = first
             while chunk is not None:
                 result = compensator.process(chunk)
+                if SPIKE_COLUMN in chunk:
+                    spikes += int(np.count_nonzero(chunk[SPIKE_COLUMN]))
                 if copies:
                     result = Recording({n: result[n] for n in names}, result.metadata,
                                        result.source)
@@ -480,15 +507,43 @@ def compensate_file(
                 pending.result()
     finally:
         chunks.close()
+    accounting = compensation_accounting(compensator, spikes, repair.duplicates)
     return CompensationSummary(str(source), str(output), compensator.samples,
                                compensator.out_of_range_fraction,
-                               compensator.rate_out_of_range_fraction, compensator.ranges())
+                               compensator.rate_out_of_range_fraction, compensator.ranges(),
+                               accounting)
+
+
+def compensation_accounting(compensator: Any, spikes: int = 0,
+                            duplicates: int = 0) -> Accounting:
+    """Samples read, dropped (duplicated rows, by the reader) and flagged by reason.
+
+    ``compensate`` never drops a sample it read: spikes (the ``spike`` column), samples
+    beyond the trained temperature (``out_of_range``) or df/dt (``rate_out_of_range``)
+    and those of the df/dt filter's settling (``warmup``) are flagged (``in_range`` 0).
+    With several axes, the axis with the most samples beyond its ranges (the one the
+    summary line names).
+    """
+    axes = getattr(compensator, "axes", None)
+    if axes:
+        compensator = max(axes.values(), key=lambda c: sum(c.ranges().shares().values()))
+    accounting = Accounting(read=compensator.samples + duplicates)
+    accounting.drop("duplicates", duplicates)
+    accounting.flag("warmup", compensator.settling)
+    accounting.flag("spikes", spikes)
+    accounting.flag("out_of_range", compensator.temperature_out)
+    accounting.flag("rate_out_of_range",
+                    compensator.variable_ranges.get("df", [compensator.rate_out_of_range])[0])
+    return accounting
 
 
 def compensated_metadata(metadata: rec_io.Metadata, model: UnitModel,
                          drift: str = "frequency") -> rec_io.Metadata:
     """``metadata`` with the mark of compensation by ``model`` (:mod:`hrgtc.recording.marks`)."""
     extra = {**metadata.extra, COMPENSATED_KEY: mark(model.sha256, model.unit, drift)}
+    # the restarts known when the output is opened are those of the first chunk only: none
+    # are written rather than some (its time axis is the repaired one)
+    extra.pop(RESTARTS_KEY, None)
     return dataclasses.replace(metadata, extra=extra)
 
 

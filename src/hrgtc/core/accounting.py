@@ -27,6 +27,7 @@ REASONS: dict[str, str] = {
     "spikes": "spikes",
     "motion": "motion (not at rest)",
     "out_of_range": "out of the calibrated range",
+    "rate_out_of_range": "df/dt beyond its training range",
     "held_out": "held out for validation",
 }
 DROPPED_WARNING_FRACTION = 0.10

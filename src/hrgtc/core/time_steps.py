@@ -15,7 +15,8 @@ says which it is:
     shifted to follow the earlier run after a gap.
 ``dst``
     A step of about ±3600 s in naive clock times: daylight saving time began or
-    ended. Not repairable without the time zone: a problem naming ``--tz``.
+    ended. Not repairable without the time zone: a problem naming ``--tz`` (with
+    ``--tz ZONE`` the clock times are read as UTC and the step is gone).
 ``duplicate``
     Rows repeated with the same time and the same values (a logger that re-sent a
     block): dropped and counted.
@@ -304,8 +305,8 @@ def _event(kind: str, row: int, count: int, detail: Any) -> TimeEvent:
         sign = "back" if detail < 0 else "forward"
         return TimeEvent(kind, row, count,
                          f"row {row}: the clock time jumps {sign} by 3600 s ({count} time(s)): "
-                         "daylight saving time in clock times without a time zone; convert "
-                         "the time column to UTC (or to seconds) before reading", False)
+                         "daylight saving time in clock times without a time zone; pass --tz "
+                         "with the zone they were written in (e.g. --tz Europe/Berlin)", False)
     if kind == "duplicate_time":
         return TimeEvent(kind, row, count,
                          f"row {row}: the same time as the row before with other values "
@@ -401,6 +402,8 @@ class TimeRepairStream:
     def __init__(self, time_unit: str | None = "s", naive_clock: bool = False) -> None:
         self.time_unit = time_unit
         self.naive_clock = naive_clock
+        #: The file, for the messages of the reader.
+        self.source = ""
         self._shift = 0.0
         self._last: tuple[float, np.ndarray | None] | None = None
         self._period: float | None = None
@@ -408,6 +411,8 @@ class TimeRepairStream:
         self._kept = 0  # rows kept
         self._events: dict[str, list[Any]] = {}
         self.restarts: list[int] = []
+        #: Repaired time of each restart's first sample (a new run starts there). [s]
+        self.restart_times_s: list[float] = []
         self.duplicates = 0
 
     def repair(self, time_s: np.ndarray, columns: list[np.ndarray] | None = None,
@@ -455,6 +460,8 @@ class TimeRepairStream:
             else:
                 state[2] += event.count
         self.restarts += [base_kept + r for r in diagnosis.restarts]
+        kept_times = repaired[keep]
+        self.restart_times_s += [float(kept_times[r - pre]) for r in diagnosis.restarts]
         self.duplicates += int((~keep).sum())
         self._advance(time_s, columns, keep,
                       float(diagnosis.offset_s[-1]) if time_s.size else 0.0)

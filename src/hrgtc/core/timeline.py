@@ -250,6 +250,46 @@ def _duration(seconds: float) -> str:
     return f"{seconds:.6g} s"
 
 
+#: Key of a recording's ``metadata.extra`` listing the times [s] where the logger restarted
+#: (its clock reset to about zero, :mod:`hrgtc.core.time_steps`): each starts a new run.
+RESTARTS_KEY = "restarts_s"
+
+
+def restart_rows(time_s: np.ndarray, restarts_s: Any = ()) -> np.ndarray:
+    """Rows of ``time_s`` that start a new run after a logger restart.
+
+    ``restarts_s`` are the (repaired) times of the restarts' first samples, as the reader
+    lists them in ``metadata.extra["restarts_s"]`` (:data:`RESTARTS_KEY`); a chunk holds
+    the rows of those that fall in it.
+
+    Examples
+    --------
+    >>> restart_rows(np.array([0.0, 1.0, 50.0, 51.0]), [50.0]).tolist()
+    [2]
+    """
+    times = np.asarray(list(restarts_s or ()), dtype=np.float64)
+    if not times.size:
+        return np.empty(0, dtype=np.int64)
+    return np.flatnonzero(np.isin(np.asarray(time_s, dtype=np.float64), times))
+
+
+#: Relative slack of the settling test: a sample ``warmup_s`` after the filter started is
+#: settled whether its time comes from a difference of times (Python) or a sum of steps
+#: (the C export's ``dt_s``), whose roundings differ in the last digits.
+SETTLE_TOLERANCE = 1e-9
+
+
+def settle_threshold_s(warmup_s: float) -> float:
+    """Seconds since the df/dt filter (re)started from which a sample is settled: ``warmup_s``
+    less a relative :data:`SETTLE_TOLERANCE`. Training, the compensator (numpy, numba, C)
+    and the evaluation all compare ``elapsed >= settle_threshold_s(warmup_s)``. [s]
+
+    >>> settle_threshold_s(50.0) < 50.0 < settle_threshold_s(50.0) + 1e-6
+    True
+    """
+    return float(warmup_s) * (1.0 - SETTLE_TOLERANCE)
+
+
 def seconds_since_power_on(time_s: np.ndarray, bounds: np.ndarray | None = None,
                            restart_each_segment: bool = False) -> np.ndarray:
     """Time since the logger (and the gyro) started, for the warm-up skip. [s]

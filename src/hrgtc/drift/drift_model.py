@@ -498,8 +498,10 @@ def fit(
         scales[v] = magnitude if magnitude > 0 else 1.0
     settings = FeatureSettings(**{**settings.to_dict(), "scales": scales})
     factors = np.array([t.scale_factor(scales) for t in candidates])
-    groups = offset_groups(offsets, windows.run, windows.sources, windows.accel,
-                           windows.orientation)
+    powered = windows.power_run is not None  # a logger restart starts a run of its own
+    groups = offset_groups(offsets, windows.power_run if powered else windows.run,
+                           windows.power_runs if powered else windows.sources,
+                           windows.accel, windows.orientation)
     x_full = windows.terms / factors
     bias = windows.bias_dph
     x_scaled = x_full

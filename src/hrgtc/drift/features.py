@@ -374,12 +374,13 @@ class FeatureSettings:
 
 
 def settle_rows(settings: FeatureSettings) -> int:
-    """Samples at the start of a run left out while the df/dt filter settles.
+    """Samples in the first ``warmup_s`` of a continuous run (the C export's count).
 
-    Training skips them (``warmup_s``, 5 tau by default); the compensator flags them
-    (``in_range`` 0) and the evaluation leaves them out of its figures, the same way.
-    The filter starts at rest on the first sample, whose noise then reads as a rate
-    for a few tau.
+    Training skips the first ``warmup_s`` seconds (5 tau by default) after the filter
+    (re)starts, on the time axis; the compensator flags them (``in_range`` 0) and the
+    evaluation leaves them out of its figures, the same way, in seconds (a burst file's
+    gaps count as the time they last). On a continuous file this many samples. The filter
+    starts at rest on the first sample, whose noise then reads as a rate for a few tau.
     """
     return max(round(settings.warmup_s * settings.sample_rate_hz), 0)
 

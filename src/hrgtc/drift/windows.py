@@ -12,6 +12,12 @@ Time, not samples (see :mod:`hrgtc.core.timeline`):
   first sample (a duty-cycled logger does not restart the gyro); with
   ``gaps="split"`` the filter restarts after every gap, so each segment settles for
   ``warmup_s`` again; ``restart_each_segment=True`` says each segment is a power-on;
+* a *run* is a file, or the part of one after a logger restart (its clock reset to
+  about zero, listed by the reader in ``metadata.extra["restarts_s"]``, see
+  :func:`hrgtc.core.timeline.restart_rows`): a restart starts the df/dt filter again at
+  rest and the warm-up again, and gets its own offset with ``offsets="run"``
+  (:attr:`TrainingWindows.power_run`); so does every segment when the user says each
+  segment is a restart (``gaps="split"`` or ``restart_each_segment=True``);
 * a window never spans a gap: the partial window at the end of a segment (and of the
   run) is kept when it holds at least half a window
   (:data:`~hrgtc.core.timeline.PARTIAL_WINDOW_FRACTION`), else dropped; a window never
@@ -29,7 +35,13 @@ import numpy as np
 
 from hrgtc.core.errors import CalibrationError, InputError
 from hrgtc.core.progress import Progress
-from hrgtc.core.timeline import is_gap, min_partial_rows
+from hrgtc.core.timeline import (
+    RESTARTS_KEY,
+    is_gap,
+    min_partial_rows,
+    restart_rows,
+    settle_threshold_s,
+)
 from hrgtc.drift.features import FeatureSettings, FeatureStream, Term, design_matrix, variables_for
 from hrgtc.drift.rate_checks import filtered_levels, rate_filter_problems, warn_rate_filter
 from hrgtc.recording import Recording
@@ -71,6 +83,13 @@ class TrainingWindows:
         reasons of :data:`hrgtc.core.accounting.REASONS`).
     segments
         Contiguous segments found in the runs (gaps split them).
+    power_run
+        Index of the power-on run of each window: a file, or the part of one after a
+        logger restart (every segment, when each is said to be a restart); the groups of
+        ``offsets="run"``. None: the file index :attr:`run`.
+    power_runs
+        Name of each power-on run (the file's, with `` run K`` for the parts of a file
+        that restarted).
     """
 
     time_s: np.ndarray
@@ -85,6 +104,8 @@ class TrainingWindows:
     orientation: np.ndarray | None = None
     dropped: dict[str, int] = field(default_factory=dict)
     segments: int = 0
+    power_run: np.ndarray | None = None
+    power_runs: tuple[str, ...] = ()
 
 
 class _WindowMeans:
@@ -206,7 +227,8 @@ def window_means(
         raise InputError(f"window_s={window_s} s holds no sample at {settings.sample_rate_hz} Hz")
     period = 1.0 / settings.sample_rate_hz
     split = gaps == "split"
-    out_terms, out_bias, out_time, out_run = [], [], [], []
+    out_terms, out_bias, out_time, out_run, out_power = [], [], [], [], []
+    power_names: list[str] = []
     out_vars: dict[str, list[np.ndarray]] = {v: [] for v in variables}
     out_extra: list[np.ndarray] = []
     total = warm = segments = partial = 0
@@ -214,6 +236,19 @@ def window_means(
     sources: list[str] = []
     extra: tuple[str, ...] | None = None
     problems: list[str] = []
+
+    def collect(means: np.ndarray, index: int) -> None:
+        """Keep window means: columns time, power-on run, bias, variables, extra, terms."""
+        out_time.append(means[:, 0])
+        out_power.append(np.round(means[:, 1]).astype(np.int64))
+        out_bias.append(means[:, 2])
+        for k, v in enumerate(variables):
+            out_vars[v].append(means[:, 3 + k])
+        first = 3 + len(variables)
+        out_extra.append(means[:, first:first + len(extra or ())])
+        out_terms.append(means[:, first + len(extra or ()):])
+        out_run.append(np.full(means.shape[0], index))
+
     for index, source in enumerate(runs):
         stream = FeatureStream(settings, variables, thermometer)
         averager = _WindowMeans(window_rows)
@@ -223,15 +258,22 @@ def window_means(
         last_time: float | None = None
         power_on: float | None = None  # time the warm-up counts from
         last_used = True  # the previous row was used (not left out as not at rest)
+        power = len(power_names)  # index of the power-on run of the next row
+        first_power = power
         for chunk in _iter_run(source):
             settings.check_sample_rate(chunk)
             if input_rate is None:
                 input_rate = chunk.metadata.input_rate_dph
                 sources.append(chunk.source or f"run {index}")
+                power_names.append(sources[-1])
                 levels = filtered_levels(chunk, variables_for(terms))
                 if levels and not split:  # the terms use a rate: can the filter follow?
-                    problems += rate_filter_problems(chunk.time_s, levels, settings.rate_tau_s,
-                                                     where=chunk.source or "")
+                    # (up to a logger restart: the filter restarts there)
+                    head = restart_rows(chunk.time_s, chunk.metadata.extra.get(RESTARTS_KEY))
+                    stop = int(head[0]) if head.size else len(chunk)
+                    problems += rate_filter_problems(
+                        chunk.time_s[:stop], {k: v[:stop] for k, v in levels.items()},
+                        settings.rate_tau_s, where=chunk.source or "")
             if extra is None:  # the accelerometer and label columns, where every run has them
                 extra = tuple(c for c in _EXTRA_COLUMNS if c in chunk)
             time = chunk.time_s
@@ -243,13 +285,20 @@ def window_means(
                 segments += 1
             elif is_gap(time[0] - last_time, period):
                 starts = np.concatenate([[0], starts])
+            # logger restarts (new runs): always; every segment when each is a restart
+            restarts = restart_rows(time, chunk.metadata.extra.get(RESTARTS_KEY))
+            if last_time is None:
+                restarts = restarts[restarts > 0]
+            starts = np.union1d(starts, restarts).astype(np.int64)
             segments += starts.size
             last_time = float(time[-1])
-            if split and starts.size:  # the filter restarts after each gap
-                edges = [0, *starts[starts > 0].tolist(), len(chunk)]
+            power_starts = starts if (split or restart_each_segment) else restarts
+            fresh = starts if split else restarts  # rows where the filter restarts at rest
+            if fresh.size:
+                edges = [0, *fresh[fresh > 0].tolist(), len(chunk)]
                 parts = []
                 for k in range(len(edges) - 1):
-                    if k > 0 or starts[0] == 0:
+                    if k > 0 or fresh[0] == 0:
                         stream = FeatureStream(settings, variables, thermometer)
                     parts.append(stream.process(chunk.slice(edges[k], edges[k + 1])))
                 values = {v: np.concatenate([p[v] for p in parts]) for v in parts[0]}
@@ -257,15 +306,23 @@ def window_means(
                 values = stream.process(chunk)
             # seconds since power-on (or since the filter restarted): the warm-up skip
             origin = np.full(len(time), power_on)
-            if (split or restart_each_segment) and starts.size:
-                lengths = np.diff(np.append(starts, len(time)))
-                origin[starts[0]:] = np.repeat(time[starts], lengths)
-                power_on = float(time[starts[-1]])
-            settled = time - origin >= settings.warmup_s
+            if power_starts.size:
+                lengths = np.diff(np.append(power_starts, len(time)))
+                origin[power_starts[0]:] = np.repeat(time[power_starts], lengths)
+                power_on = float(time[power_starts[-1]])
+            settled = time - origin >= settle_threshold_s(settings.warmup_s)
+            # the power-on run of each row (a new one at each restart)
+            run_of_row = np.full(len(time), float(power))
+            for r in power_starts:
+                power += 1
+                run_of_row[r:] = power
+            while len(power_names) <= power:
+                power_names.append(f"{sources[-1]} run {len(power_names) - first_power + 1}")
             rate = chunk["input_rate_dph"] if "input_rate_dph" in chunk else input_rate
             block = np.column_stack(
                 [
                     chunk.time_s,
+                    run_of_row,
                     chunk.rate_dph - rate,
                     *(values[v] for v in variables),
                     *(chunk[c] if c in chunk else np.full(len(chunk), np.nan) for c in extra),
@@ -286,27 +343,15 @@ def window_means(
             warm += int(np.count_nonzero(~settled))
             means = averager.push(block[use], breaks, cuts)
             if means.shape[0]:
-                out_time.append(means[:, 0])
-                out_bias.append(means[:, 1])
-                for k, v in enumerate(variables):
-                    out_vars[v].append(means[:, 2 + k])
-                first = 2 + len(variables)
-                out_extra.append(means[:, first:first + len(extra)])
-                out_terms.append(means[:, first + len(extra):])
-                out_run.append(np.full(means.shape[0], index))
+                collect(means, index)
             total += len(chunk)
             if progress is not None:
                 progress(total, 0)
         means = averager.flush()
         if means.shape[0]:
-            out_time.append(means[:, 0])
-            out_bias.append(means[:, 1])
-            for k, v in enumerate(variables):
-                out_vars[v].append(means[:, 2 + k])
-            first = 2 + len(variables)
-            out_extra.append(means[:, first:first + len(extra or ())])
-            out_terms.append(means[:, first + len(extra or ()):])
-            out_run.append(np.full(means.shape[0], index))
+            collect(means, index)
+        if power > first_power:  # the file restarted: name its first run too
+            power_names[first_power] = f"{sources[-1]} run 1"
         partial += averager.partial_dropped_rows
     warn_rate_filter(problems)
     if not out_time:
@@ -336,4 +381,6 @@ def window_means(
         sources=tuple(sources),
         dropped=dropped,
         segments=segments,
+        power_run=np.concatenate(out_power),
+        power_runs=tuple(power_names),
     )

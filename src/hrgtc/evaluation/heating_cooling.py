@@ -29,8 +29,9 @@ from typing import Any
 
 import numpy as np
 
+from hrgtc.core.timeline import RESTARTS_KEY, restart_rows, settle_threshold_s
 from hrgtc.drift.cross_validation import heating_mask
-from hrgtc.drift.features import FeatureStream, settle_rows
+from hrgtc.drift.features import FeatureStream
 from hrgtc.model import UnitModel
 
 #: The block length of the split. [s]
@@ -111,7 +112,8 @@ class DirectionSplit:
         settings = model.drift.settings
         self.rows = max(round(BLOCK_S * sample_rate_hz), 1)
         self.block_s = self.rows / sample_rate_hz
-        self._skip = settle_rows(settings)
+        self._warmup_s = float(settings.warmup_s)
+        self._origin_s: float | None = None  # the run's first sample: the warm-up counts from it
         self._stream = FeatureStream(settings, ("df",))
         slope = float(model.thermometer.slope_hz_per_c(settings.reference_c))
         self.slope_sign = 1.0 if slope >= 0 else -1.0
@@ -130,9 +132,17 @@ class DirectionSplit:
         if self._truth:
             columns.append(residual_dph if residual_dph is not None else np.full(df.size, np.nan))
         block = np.column_stack(columns)
-        if self._skip:
-            dropped = min(self._skip, block.shape[0])
-            block, self._skip = block[dropped:], self._skip - dropped
+        time = np.asarray(freq_chunk.time_s, dtype=np.float64)
+        if time.size and self._origin_s is None:
+            self._origin_s = float(time[0])
+        if time.size:  # the df/dt filter's settling, in seconds on the time axis
+            origin = np.full(time.size, self._origin_s)
+            restarts = restart_rows(time, freq_chunk.metadata.extra.get(RESTARTS_KEY))
+            if restarts.size:  # a logger restart: the filter settles again
+                lengths = np.diff(np.append(restarts, time.size))
+                origin[restarts[0]:] = np.repeat(time[restarts], lengths)
+                self._origin_s = float(time[restarts[-1]])
+            block = block[time - origin >= settle_threshold_s(self._warmup_s)]
         if self._carry is not None and self._carry.shape[0]:
             block = np.concatenate([self._carry, block])
         complete = block.shape[0] // self.rows

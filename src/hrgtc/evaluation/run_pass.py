@@ -32,6 +32,7 @@ from hrgtc.compensate.ranges import RangeReport
 from hrgtc.core.accounting import Accounting
 from hrgtc.core.errors import HrgtcError, InputError, RecordingError
 from hrgtc.core.progress import Progress
+from hrgtc.core.timeline import RESTARTS_KEY
 from hrgtc.drift.features import FeatureStream
 from hrgtc.drift.rest import run_rest
 from hrgtc.evaluation.allan import (
@@ -471,7 +472,8 @@ class RunPass:
             kept = self.keep[frequency.samples - len(chunk):frequency.samples]
             self.left_out += int(np.count_nonzero(~kept))
             pushed = {key: values[kept] for key, values in pushed.items()}
-        self.cut.push(pushed, chunk.time_s if self.keep is None else chunk.time_s[kept])
+        self.cut.push(pushed, chunk.time_s if self.keep is None else chunk.time_s[kept],
+                      chunk.metadata.extra.get(RESTARTS_KEY))
         if allan and deviation != "oadev":
             for key, values in pushed.items():
                 self.whole.setdefault(key, []).append(values)

@@ -7,10 +7,12 @@ the same samples (:class:`SettlingCut`).
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from hrgtc.core.errors import InputError
-from hrgtc.core.timeline import is_gap
+from hrgtc.core.timeline import is_gap, restart_rows, settle_threshold_s
 from hrgtc.evaluation.series_stats import SeriesStatistics
 
 
@@ -46,26 +48,31 @@ class SettlingCut:
         self._origin: float | None = None
         self._last: float | None = None
 
-    def _settled(self, time: np.ndarray) -> np.ndarray:
+    def _settled(self, time: np.ndarray, restarts_s: Any = ()) -> np.ndarray:
         if self._origin is None:
             self._origin = float(time[0])
         origin = np.full(time.size, self._origin)
+        starts = restart_rows(time, restarts_s)  # a logger restart: a new run settles again
         if self.restart_at_gaps:
-            starts = np.flatnonzero(is_gap(np.diff(time), self.period_s)) + 1
+            gaps = np.flatnonzero(is_gap(np.diff(time), self.period_s)) + 1
             if self._last is not None and is_gap(time[0] - self._last, self.period_s):
-                starts = np.concatenate([[0], starts])
-            if starts.size:
-                lengths = np.diff(np.append(starts, time.size))
-                origin[starts[0]:] = np.repeat(time[starts], lengths)
-                self._origin = float(time[starts[-1]])
+                gaps = np.concatenate([[0], gaps])
+            starts = np.union1d(starts, gaps).astype(np.int64)
+        if starts.size:
+            lengths = np.diff(np.append(starts, time.size))
+            origin[starts[0]:] = np.repeat(time[starts], lengths)
+            self._origin = float(time[starts[-1]])
         self._last = float(time[-1])
-        return time - origin >= self.warmup_s
+        return time - origin >= settle_threshold_s(self.warmup_s)
 
-    def push(self, values: dict[str, np.ndarray], time: np.ndarray) -> None:
-        """The next rows of every series (one length) and their times [s]."""
+    def push(self, values: dict[str, np.ndarray], time: np.ndarray,
+             restarts_s: Any = ()) -> None:
+        """The next rows of every series (one length) and their times [s]; ``restarts_s``:
+        times of logger restarts (``metadata.extra["restarts_s"]``), where the df/dt filter
+        settles again."""
         if not time.size:
             return
-        mask = self._settled(time)
+        mask = self._settled(time, restarts_s)
         self.rows += time.size
         if self.flushed:
             self._feed(values, mask, time)

@@ -20,6 +20,7 @@ from __future__ import annotations
 from typing import Any
 
 from hrgtc.core.errors import InputError
+from hrgtc.core.timeline import settle_threshold_s
 from hrgtc.drift.features import settle_rows
 from hrgtc.drift.variables import ascii_unit, refusal, variable
 from hrgtc.export.c.plan import CPlan
@@ -89,7 +90,7 @@ def formula(key: str = "") -> list[str]:
         "       sum_j <{k}thermometer_raw_coefficient_j> * T^j, Eq. (18) of [1].",
         "  7. in_range = freq_hz in [<{k}calibrated_freq_low_hz>, <{k}calibrated_freq_high_hz>]",
         "     and every variable computed (f, df, h, dh, d2, g, a_NAME) in its range and at",
-        "     least <{k}settle_rows> samples seen.",
+        "     at least <{k}settle_s> seconds (the sum of dt) since the start of the run.",
     ]
     return [line.replace("{k}", key) for line in lines]
 
@@ -131,8 +132,11 @@ def parameter_lines(model: UnitModel, plan: CPlan, key: str = "") -> list[str]:
         "1 when the terms use the housing thermistor (h, dh): then housing_c is an input.")
     put("rate_tau_s", settings.rate_tau_s,
         "Time constant of each of the two low-pass stages of the df/dt filter. [s]")
+    put("settle_s", settle_threshold_s(settings.warmup_s),
+        "Seconds at the start of a run (the sum of dt) flagged (in_range 0) while the filter "
+        "settles, as training leaves them out. [s]")
     put("settle_rows", settle_rows(settings),
-        "Samples at the start of a run flagged (in_range 0) while the filter settles. [1]")
+        "settle_s in samples at the training rate (a continuous run). [1]")
     _extra_variable_lines(model, plan, put)
     for v in plan.computed:
         if v in settings.scales and v in drift.variables:

@@ -267,6 +267,7 @@ def describe(
     end: str | float | None = None,
     slow_channels: str = _READ.slow_channels,
     hold_max_s: float | None = _READ.hold_max_s,
+    tz: str | None = _READ.tz,
 ) -> RecordingInfo:
     """Summarise and validate a recording file in one streaming pass.
 
@@ -285,6 +286,8 @@ def describe(
         The slice read (``--start/--end``, see :func:`hrgtc.recording.read`).
     slow_channels, hold_max_s
         As for :func:`hrgtc.recording.read` (channels logged slower than the rows).
+    tz
+        The time zone clock times were written in (``--tz``, see :func:`hrgtc.recording.read`).
     rows
         Rows per chunk read.
     progress
@@ -309,6 +312,7 @@ def describe(
     names: list[str] = []
     builder: TimelineBuilder | None = None
     repairer = TimeRepairStream()  # filled by iter_chunks: what the time repair did
+    file_rows: list[Any] = []  # the file row of each row of the chunk (messages name them)
     try:
         fmt = format_of(path)
         for chunk in iter_chunks(
@@ -318,14 +322,15 @@ def describe(
             spike_filter=spike_filter or "off", spike_k=spike_k, spike_lsb=spike_lsb,
             spike_window_s=spike_window_s,
             time_repair=repairer, start=start, end=end,
-            slow_channels=slow_channels, hold_max_s=hold_max_s,
+            slow_channels=slow_channels, hold_max_s=hold_max_s, tz=tz,
+            file_rows=file_rows.append,
         ):
             meta = chunk.metadata
             names = names or [n for n in chunk.names if n != SPIKE_COLUMN
                               and not _sensor_copy(n, chunk.names, thermometer)]
             if SPIKE_COLUMN in chunk:
                 spike_rows = (spike_rows or 0) + int(np.count_nonzero(chunk[SPIKE_COLUMN]))
-            validator.update(chunk)
+            validator.update(chunk, file_rows.pop() if file_rows else None)
             if "time_s" in chunk:
                 if builder is None:
                     builder = TimelineBuilder(1.0 / meta.sample_rate_hz)

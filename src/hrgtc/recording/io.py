@@ -34,7 +34,8 @@ validated axis by axis; :func:`hrgtc.recording.axis_view` gives one axis.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator, Mapping, Sequence
+import itertools
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
 from typing import Any
@@ -46,6 +47,7 @@ from hrgtc.core.progress import Progress
 from hrgtc.core.time_steps import TimeRepairStream
 from hrgtc.recording.align import align, warn_alignment
 from hrgtc.recording.axes import axis_view
+from hrgtc.recording.file_rows import take_file_rows, with_file_rows
 from hrgtc.recording.formats.base import Source
 from hrgtc.recording.formats.registry import open_streams
 from hrgtc.recording.mapping import (
@@ -63,7 +65,13 @@ from hrgtc.recording.spikes import (
     SpikeFilter,
     check_spike_policy,
 )
-from hrgtc.recording.time_axis import _repair_extra, _repair_time, _time_repairer, _TimeSlice
+from hrgtc.recording.time_axis import (
+    _repair_extra,
+    _repair_time,
+    _restarts_extra,
+    _time_repairer,
+    _TimeSlice,
+)
 from hrgtc.recording.validation import (
     HEURISTIC_ROWS,
     GapPolicy,
@@ -157,6 +165,8 @@ def _metadata(
         extra["temperature_count_bits"] = plan.wrap_bits
     if plan.time_origin_ns is not None and "time_origin" not in extra:
         extra["time_origin"] = str(np.datetime64(plan.time_origin_ns, "ns"))
+        if plan.tz is not None:  # clock times read in a zone: the origin is UTC
+            extra["time_zone"] = plan.tz
     data["extra"] = extra
     try:
         return Metadata.from_dict(data)
@@ -189,6 +199,7 @@ def read(
     end: str | float | None = None,
     slow_channels: str = _READ.slow_channels,
     hold_max_s: float | None = _READ.hold_max_s,
+    tz: str | None = _READ.tz,
 ) -> Recording:
     """Read a whole recording from Parquet, CSV, HDF5 or a registered format.
 
@@ -245,6 +256,9 @@ def read(
         its own time axis: ``"hold"`` (default), ``"interpolate"`` or ``"error"``, for at
         most ``hold_max_s`` seconds (:mod:`hrgtc.recording.resample`,
         :mod:`hrgtc.recording.align`).
+    tz
+        IANA zone (``"Europe/Berlin"``) the naive clock times were written in: read as
+        UTC, the daylight saving step is gone (:class:`~hrgtc.recording.time_axis.ZoneClock`).
 
     Returns
     -------
@@ -264,19 +278,19 @@ def read(
                                lsb_multiple=spike_lsb, window_s=spike_window_s)
     with open_source(path, slow_channels, hold_max_s) as source:
         plan = plan_columns(source, columns, units, temp_scale, temp_offset_c, thermometer,
-                            rate_scale, temp_unwrap)
+                            rate_scale, temp_unwrap, tz)
         robust.counts = plan.temperature_is_count and not scales_temperature(temp_scale,
                                                                            temp_offset_c)
         columns = table_columns(source.read(plan.read_names, plan.as_text))
-        arrays = convert_columns(plan, columns, 0)
+        arrays = with_file_rows(convert_columns(plan, columns, 0), 0)
         arrays, slow = fill_slow_channels(arrays, slow_channels, hold_max_s, str(path))
         if spike_filter_ is not None:
             arrays = spike_filter_.drop(arrays, 0)
         arrays = robust.apply(arrays, 0)
         repairer = _time_repairer(plan)
-        arrays = _repair_time(arrays, repairer)
+        arrays = _repair_time(arrays, repairer, plan)
         cut = _TimeSlice(start, end, plan)
-        arrays = cut.apply(arrays)
+        arrays, file_rows = take_file_rows(cut.apply(arrays))
         meta = _metadata(plan, metadata, arrays.get("time_s"))
     if repairer.events or repairer.duplicates:
         meta = replace(meta, extra={**meta.extra, **_repair_extra(repairer)})
@@ -293,7 +307,7 @@ def read(
     recording = Recording(arrays, meta, source=str(path))
     if validate:
         validate_recording(recording, gaps, freq_band_hz=freq_band_hz, freq_span_hz=freq_span_hz,
-                           thermometer=thermometer)
+                           thermometer=thermometer, file_rows=file_rows)
     return recording
 
 
@@ -325,6 +339,8 @@ def iter_chunks(
     slow_channels: str = _READ.slow_channels,
     hold_max_s: float | None = _READ.hold_max_s,
     dropped: dict[str, int] | None = None,
+    tz: str | None = _READ.tz,
+    file_rows: Callable[[np.ndarray | None], None] | None = None,
 ) -> Iterator[Recording]:
     """Stream a recording in chunks of ``rows`` rows without loading the file.
 
@@ -332,6 +348,8 @@ def iter_chunks(
 
     rows
         Rows per chunk (the last chunk may be shorter).
+    file_rows
+        Called with the file rows of the next chunk's rows before it is yielded.
     progress
         Called as ``progress(done, total)`` after each chunk (rows, or bytes for CSV).
     dropped
@@ -367,7 +385,7 @@ def iter_chunks(
     slow = SlowChannels(slow_channels, hold_max_s, str(path))
     with open_source(path, slow_channels, hold_max_s) as source:
         plan = plan_columns(source, columns, units, temp_scale, temp_offset_c, thermometer,
-                            rate_scale, temp_unwrap)
+                            rate_scale, temp_unwrap, tz)
         robust.counts = plan.temperature_is_count and not scales_temperature(temp_scale,
                                                                            temp_offset_c)
         offset = 0
@@ -375,25 +393,27 @@ def iter_chunks(
         if time_repair is not None:  # the caller's, to read what was repaired
             time_repair.time_unit, time_repair.naive_clock = (repairer.time_unit,
                                                               repairer.naive_clock)
+            time_repair.source = repairer.source
             repairer = time_repair
         cut = _TimeSlice(start, end, plan)
 
         def converted() -> Iterator[dict[str, np.ndarray]]:
             nonlocal offset
             for table in source.iter_tables(plan.read_names, plan.as_text, rows):
-                part = slow.fill(convert_columns(plan, table_columns(table), offset), offset)
+                part = slow.fill(with_file_rows(convert_columns(plan, table_columns(table),
+                                                                offset), offset), offset)
                 if spike_filter_ is not None:
                     part = spike_filter_.drop(part, offset)
                 part = robust.apply(part, offset)
                 offset += table.num_rows
-                part = cut.apply(_repair_time(part, repairer))
+                part = cut.apply(_repair_time(part, repairer, plan))
                 if part.get("time_s") is None or len(part["time_s"]):
                     yield part
             tail = slow.flush()  # rows held back by --slow-channels interpolate
             if tail is not None:
                 if spike_filter_ is not None:
                     tail = spike_filter_.drop(tail, offset)
-                tail = cut.apply(_repair_time(robust.apply(tail, offset), repairer))
+                tail = cut.apply(_repair_time(robust.apply(tail, offset), repairer, plan))
                 if tail.get("time_s") is None or len(tail["time_s"]):
                     yield tail
 
@@ -413,14 +433,22 @@ def iter_chunks(
         meta = _metadata(plan, metadata, time_head)
         pending: list[Recording] = []
 
-        def chunks() -> Iterator[Recording]:
-            yield from (Recording(p, meta, source=str(path)) for p in head)
-            head.clear()
-            yield from (Recording(p, meta, source=str(path)) for p in pieces)
+        def chunk_meta() -> Metadata:  # with the logger restarts found so far (new runs)
+            restarts = _restarts_extra(repairer)
+            return replace(meta, extra={**meta.extra, **restarts}) if restarts else meta
 
-        for chunk in chunks():
+        def chunks() -> Iterator[tuple[Recording, np.ndarray | None]]:
+            held, parts = list(head), pieces
+            head.clear()
+            for p in itertools.chain(held, parts):  # the file rows go to the validator
+                part, file_rows = take_file_rows(p)
+                yield Recording(part, chunk_meta(), source=str(path)), file_rows
+
+        for chunk, rows_of_file in chunks():
+            if file_rows is not None:
+                file_rows(rows_of_file)
             if validator is not None:
-                validator.update(chunk)
+                validator.update(chunk, rows_of_file)
                 validator.raise_for_problems()
             pending.append(chunk)
             if validator is None or validator.heuristics_done:
@@ -500,6 +528,8 @@ class ReadOptions(ReadSettings):
     slow_channels, hold_max_s
         Channels logged slower than the rows: ``"hold"``, ``"interpolate"`` or
         ``"error"``, values used for at most ``hold_max_s`` seconds (see :func:`read`).
+    tz
+        ``--tz``: the IANA time zone naive clock times were written in (see :func:`read`).
     """
 
     def keywords(self) -> dict[str, Any]:
@@ -516,7 +546,7 @@ class ReadOptions(ReadSettings):
                     if field.name in _MESSY}
         words.update({key: getattr(self, key) for key, default in defaults.items()
                       if getattr(self, key) != default})
-        words.update({key: getattr(self, key) for key in ("start", "end")
+        words.update({key: getattr(self, key) for key in ("start", "end", "tz")
                       if getattr(self, key) is not None})
         return words
 
@@ -545,13 +575,17 @@ class ReadOptions(ReadSettings):
             chunks.close()
 
     def chunks(self, path: str | Path, rows: int | None = None,
-               dropped: dict[str, int] | None = None) -> Iterator[Recording]:
+               dropped: dict[str, int] | None = None,
+               time_repair: TimeRepairStream | None = None) -> Iterator[Recording]:
         """Stream the file in chunks (:func:`iter_chunks`); with ``axis``, that axis's view.
-        ``dropped``: filled with the rows the spike filters removed (see there)."""
+        ``dropped``: filled with the rows the spike filters removed (see there);
+        ``time_repair``: a stream whose counts (duplicates dropped) the caller reads after."""
         if self.axis is None:
             return iter_chunks(path, rows=rows or self.chunk_rows, dropped=dropped,
+                               time_repair=time_repair,
                                **self.keywords())
         words = self.keywords()
+        words["time_repair"] = time_repair
         words.pop("freq_band_hz", None)
         words.pop("freq_span_hz", None)
         return self._axis_chunks(iter_chunks(path, rows=rows or self.chunk_rows,

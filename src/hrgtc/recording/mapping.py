@@ -44,6 +44,7 @@ from hrgtc.recording.checks import check_thermometer
 from hrgtc.recording.formats.base import Source, first_failing
 from hrgtc.recording.formats.csv import bad_number_hint
 from hrgtc.recording.schema import COLUMNS
+from hrgtc.recording.time_axis import ZoneClock, check_zone
 from hrgtc.recording.units import UNITS, find_unit, median_period, per_sample_steps, unit_of
 from hrgtc.settings.reading import TEMP_UNWRAPS, ReadSettings
 
@@ -165,6 +166,9 @@ class ColumnPlan:
     period_s: float | None = None
     wrap_bits: int | None = None
     wrap_decided: bool = False
+    tz: str | None = None  # --tz: the zone naive clock times were written in
+    time_aware: bool = False  # the clock times carry their zone (UTC, an offset, epoch)
+    zone_clock: Any = None  # its ZoneClock (hrgtc.recording.time_axis), state across chunks
 
     @property
     def temperature_is_count(self) -> bool:
@@ -177,7 +181,8 @@ def plan_columns(source: Source, columns: Any, units: Mapping[str, str] | None,
                  temp_scale: float = _READ.temp_scale,
                  temp_offset_c: float = _READ.temp_offset_c,
                  thermometer: str = _READ.thermometer, rate_scale: float | None = _READ.rate_scale,
-                 temp_unwrap: str = _READ.temp_unwrap) -> ColumnPlan:
+                 temp_unwrap: str = _READ.temp_unwrap,
+                 tz: str | None = _READ.tz) -> ColumnPlan:
     """Decide which of the file's columns become which recording columns, in which unit.
 
     Contract columns come first in the order of :data:`hrgtc.recording.COLUMNS`
@@ -186,7 +191,9 @@ def plan_columns(source: Source, columns: Any, units: Mapping[str, str] | None,
     rate logged as a raw count (``units={"rate": "lsb"}``); ``temp_unwrap``
     (``"auto"`` or ``"off"``) whether a raw temperature count that sits just
     under 2^16 or 2^32 is read as a signed count stored unsigned (``"16"``, ``"32"``:
-    always, as a model's temperature map says).
+    always, as a model's temperature map says). ``tz``: the IANA zone the naive clock
+    times of the time column were written in (``--tz``): read as UTC, so a daylight
+    saving step disappears (:class:`hrgtc.recording.time_axis.ZoneClock`).
     """
     mapping = parse_columns(columns)
     canon = parse_units(units)
@@ -257,7 +264,15 @@ def plan_columns(source: Source, columns: Any, units: Mapping[str, str] | None,
                 "map another column to it"
             )
     names = list(dict.fromkeys(theirs for theirs, _ in pairs))
+    zone = check_zone(tz)
+    if zone is not None and not stamped:
+        raise InputError(f"--tz {zone} says in which time zone clock times were written, but "
+                         f"the time column {time_file!r} counts "
+                         f"{canon.get('time', 's')}; drop --tz, or pass --time-unit timestamp "
+                         "if it holds clock times")
     return ColumnPlan(source, pairs, as_text, canon, stamped, read_names=names, axes=axes,
+                      tz=zone,
+                      zone_clock=None if zone is None else ZoneClock(zone, str(source.path)),
                       temp_scale=float(temp_scale), temp_offset_c=float(temp_offset_c),
                       thermometer=thermometer,
                       rate_scale=None if rate_scale is None else float(rate_scale),
@@ -465,13 +480,19 @@ def _time_seconds(
         return to_contract_unit(seconds, plan.units.get("time", "s"))
     if pa.types.is_floating(column.type) or pa.types.is_integer(column.type):
         seconds = _to_float(plan, column, theirs, row_offset)  # epoch seconds
+        plan.time_aware = True
         if plan.time_origin_s is None:
             finite = seconds[np.isfinite(seconds)]
             plan.time_origin_s = float(finite[0]) if finite.size else None
         return seconds - (plan.time_origin_s or 0.0)
-    stamps = _timestamps_ns(plan, column, theirs, row_offset).cast(pa.int64())
+    stamps = _timestamps_ns(plan, column, theirs, row_offset)
     valid = ~np.asarray(stamps.is_null().to_numpy(zero_copy_only=False), dtype=bool)
-    ns = np.asarray(stamps.fill_null(0).to_numpy(zero_copy_only=False), dtype=np.int64)
+    plan.time_aware = getattr(stamps.type, "tz", None) is not None
+    if plan.zone_clock is not None and not plan.time_aware:
+        ns = plan.zone_clock.utc_ns(stamps, theirs, row_offset)  # --tz: local clock -> UTC
+    else:
+        ns = np.asarray(stamps.cast(pa.int64()).fill_null(0).to_numpy(zero_copy_only=False),
+                        dtype=np.int64)
     if plan.time_origin_ns is None and valid.any():
         plan.time_origin_ns = int(ns[np.argmax(valid)])
     seconds = (ns - (plan.time_origin_ns or 0)) / 1e9

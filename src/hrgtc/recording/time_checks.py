@@ -50,7 +50,7 @@ _STEP_FIX = {
     "duplicate_time": "two records with the same time and other values: drop one or fix the "
                       "time column",
     "dst": "a step of 3600 s in clock times without a time zone is daylight saving time: "
-           "convert the time column to UTC (or to seconds) before reading",
+           "pass --tz with the zone they were written in (e.g. --tz Europe/Berlin)",
     "backwards": "neither a counter wrap, a reset to zero nor a duplicated block (two files "
                  "joined out of order? sorting would interleave them): split the file at "
                  "that row",
@@ -70,7 +70,8 @@ def _step_diagnosis(time: np.ndarray, previous: np.ndarray, i: int, period: floa
     if chunk is not None:
         others = [chunk[name][low:high] for name in chunk.names if name != "time_s"]
         values = np.column_stack(others) if others else None
-    naive = bool(metadata is not None and metadata.extra.get("time_origin"))
+    naive = bool(metadata is not None and metadata.extra.get("time_origin")
+                 and not metadata.extra.get("time_zone"))
     diagnosis = classify_time_steps(window, time_unit=None, naive_clock=naive, values=values,
                                     period_s=period, rate_events=False)
     row = i - low

@@ -94,6 +94,7 @@ from hrgtc.recording.checks import (
     measured_sample_rate,
     problems_message,
 )
+from hrgtc.recording.file_rows import FileRows
 from hrgtc.recording.gaps import (
     GAP_PERIODS,
     GAP_POLICIES,
@@ -159,6 +160,7 @@ class RecordingValidator:
         self._steps_usable = True  # every carried step finite, positive and no gap
         self._rate_change: tuple[int, float] | None = None
         self.rows = 0
+        self._file_rows = FileRows()  # rows seen -> rows of the file
         self.source: str | None = None
         self.metadata: Metadata | None = None
         self._missing: tuple[str, ...] = ()
@@ -176,8 +178,11 @@ class RecordingValidator:
         self._names: tuple[str, ...] = ()
 
     # -- feeding -------------------------------------------------------------
-    def update(self, chunk: Recording) -> None:
-        """Check the next chunk (rows continue from the previous chunk)."""
+    def update(self, chunk: Recording, file_rows: np.ndarray | None = None) -> None:
+        """Check the next chunk (rows continue from the previous chunk); ``file_rows``: the
+        file row of each of its rows when the reader left rows out (messages name those)."""
+        if file_rows is not None:
+            self._file_rows.update(self.rows, file_rows)
         if self.metadata is None:
             self.metadata = chunk.metadata
             self.source = chunk.source
@@ -464,7 +469,7 @@ class RecordingValidator:
                 )
             )
         problems += self._heuristics or []
-        return problems
+        return [self._file_rows.problem(p) for p in problems]
 
     def _bounds_problem(self, name: str, row: int, value: float, count: int) -> Problem:
         base = base_name(name, self.axes)
@@ -582,6 +587,7 @@ def validate(
     freq_band_hz: tuple[float, float] | None = None,
     freq_span_hz: tuple[float, float] | None = None,
     thermometer: str = ReadSettings.thermometer,
+    file_rows: np.ndarray | None = None,
 ) -> ValidationReport:
     """Check a recording against the recording contract (see the module docstring).
 
@@ -602,6 +608,9 @@ def validate(
     thermometer
         ``"resonator"`` (default) or ``"sensor"``: ``freq_hz`` holds a temperature
         sensor's reading [°C], checked as a temperature.
+    file_rows
+        The file row of each row when the reader left rows out before (spikes,
+        duplicates, a slice): the messages name rows of the file.
 
     Returns
     -------
@@ -613,7 +622,7 @@ def validate(
         Message names the file, column, first bad row, the bad value and the fix.
     """
     validator = RecordingValidator(gaps, freq_band_hz, freq_span_hz, thermometer)
-    validator.update(recording)
+    validator.update(recording, file_rows)
     report = validator.finish()
     if raise_errors:
         report.raise_for_problems()

@@ -115,3 +115,8 @@ class ReadSettings:
         None, "Longest time a slow channel's value is used for; rows farther from a value "
         "are dropped as a gap in that channel.", unit="s", metavar="S",
         default_text=f"{DEFAULT_MAX_AGE_PERIODS:g} of the channel's periods", panel=_INPUT)
+    tz: str | None = setting(
+        None, "Time zone the clock times (--time-unit timestamp) were written in, an IANA "
+        "name (e.g. Europe/Berlin): they are read as UTC, so the daylight-saving step is gone; "
+        "--start/--end clock times too.", metavar="ZONE",
+        default_text="none (a 3600 s step is an error)", panel=_INPUT)

@@ -14,6 +14,7 @@ statements). The drift terms are printed by the shared
 
 from __future__ import annotations
 
+from hrgtc.core.timeline import settle_threshold_s
 from hrgtc.drift.features import settle_rows
 from hrgtc.export.c.float32 import MARGIN, FloatAccuracy, FloatConstants
 from hrgtc.export.c.plan import TABLE_POINTS, CPlan
@@ -140,9 +141,11 @@ extern "C" {{
 #define {up}_MAX_ERROR_DPH {lit(accuracy.bound_dph, "max_error_dph")}
 /* Sample rate of the training runs; step() takes each sample's dt_s, any rate works. [Hz] */
 #define {up}_SAMPLE_RATE_HZ {lit(settings.sample_rate_hz, "sample_rate_hz")}
-/* Samples at the start of a run flagged (in_range 0) while the df/dt filter settles,
-   as training leaves them out. */
+/* SETTLE_S in samples at the training rate (on a continuous run; in_range uses SETTLE_S). */
 #define {up}_SETTLE_ROWS {settle_rows(settings)}UL
+/* Seconds since init/reset (the sum of dt_s) from which the filter has settled:
+   samples before are flagged (in_range 0), as training leaves them out. [s] */
+#define {up}_SETTLE_S {lit(settle_threshold_s(settings.warmup_s), "settle_s")}
 /* 1 when {p}_step() takes the housing temperature (the model uses h, dh or g terms). */
 #define {up}_USES_HOUSING {1 if plan.housing_input else 0}
 /* SHA-256 of the model this code was generated from. */
@@ -154,6 +157,7 @@ typedef struct {p}_state {{
     {p}_rate_filter f_filter;   /* df/dt filter of f [Hz] */
 {state_h}    int started;                /* 0 until the first sample after init/reset */
     unsigned long samples;      /* samples since init/reset */
+    float elapsed_s;            /* seconds since init/reset, up to SETTLE_S [s] */
     unsigned long out_of_range; /* of which outside the calibrated temperature */
     unsigned long rate_out_of_range; /* of which with rate_in_range == 0 */
 }} {p}_state;
@@ -292,6 +296,7 @@ void {p}_reset({p}_state *state)
     rate_start(&state->f_filter, 0.0f);
 {h['reset']}{g['reset']}    state->started = 0;
     state->samples = 0UL;
+    state->elapsed_s = 0.0f;
     state->out_of_range = 0UL;
     state->rate_out_of_range = 0UL;
 }}

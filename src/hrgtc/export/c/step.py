@@ -30,7 +30,9 @@ def step_tail(*, up: str, level_test: str, rate_test: str, h: Mapping[str, str],
     level_in_range = {level_test};
     rate_in_range = {rate_test};
     /* in_range: calibrated temperature, trained df/dt, and the filter settled */
-    in_range = level_in_range && rate_in_range && state->samples >= {up}_SETTLE_ROWS;
+    /* settled: SETTLE_S seconds since init/reset, the sum of the steps' dt_s */
+    if (state->samples > 0UL && state->elapsed_s < {up}_SETTLE_S) state->elapsed_s += dt_s;
+    in_range = level_in_range && rate_in_range && state->elapsed_s >= {up}_SETTLE_S;
     state->samples += 1UL;
     state->out_of_range += level_in_range ? 0UL : 1UL;
     state->rate_out_of_range += rate_in_range ? 0UL : 1UL;

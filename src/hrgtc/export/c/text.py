@@ -16,6 +16,7 @@ import textwrap
 from pathlib import Path
 from typing import Any
 
+from hrgtc.core.timeline import settle_threshold_s
 from hrgtc.drift.features import settle_rows
 from hrgtc.export.c.expr import array as _array
 from hrgtc.export.c.expr import term_expression as _term_expression
@@ -151,8 +152,9 @@ def readme(model: UnitModel, plan: CPlan, prefix: str, origin: str,
         f"  in_range = 1 when freq_hz is in the calibrated range [{f_low:.10g}, {f_high:.10g}] "
         f"Hz ({thermometer.temperature_range_c[0]:g} to {thermometer.temperature_range_c[1]:g} "
         f"degC), the training ranges of the levels hold: {ranges(levels(plan))}, rate_in_range "
-        f"is 1 and the filter has settled (the first {settle_rows(settings)} samples of a run, "
-        "which training leaves out too, are 0); else 0.",
+        f"is 1 and the filter has settled (the samples of the first {settings.warmup_s:g} s "
+        f"of a run, the sum of dt_s ({up}_SETTLE_S), which training leaves out too, are 0); "
+        "else 0.",
         f"  rate_in_range = 1 when the rates are in their training ranges: "
         f"{ranges(RATES)}; else 0 (a model trained on a cool-down has seen only "
         "negative df/dt).",
@@ -167,8 +169,8 @@ def readme(model: UnitModel, plan: CPlan, prefix: str, origin: str,
         f"ignored on the first sample after init/reset). The model was trained at "
         f"{settings.sample_rate_hz:g} Hz ({up}_SAMPLE_RATE_HZ).",
         f"  gaps:    pass the gap's length as dt_s to carry the filter across it (bridge), "
-        f"or call {p}_reset() to restart it at rest (split: the first {up}_SETTLE_ROWS "
-        "samples are then flagged again).",
+        f"or call {p}_reset() to restart it at rest (split: the samples of the first "
+        f"{up}_SETTLE_S seconds are then flagged again).",
         "  outputs: rate_comp_dph, bias_model_dph [deg/h]; resonator_c_est [degC];",
         "           f_hz [Hz]; df_hz_per_s [Hz/s]; in_range, rate_in_range 1/0.",
         "",
@@ -238,9 +240,11 @@ extern "C" {{
 
 /* Sample rate of the training runs; step() takes each sample's dt_s, any rate works. [Hz] */
 #define {up}_SAMPLE_RATE_HZ {_literal(model.drift.settings.sample_rate_hz, "sample_rate_hz")}
-/* Samples at the start of a run flagged (in_range 0) while the df/dt filter settles,
-   as training leaves them out. */
+/* SETTLE_S in samples at the training rate (on a continuous run; in_range uses SETTLE_S). */
 #define {up}_SETTLE_ROWS {settle}UL
+/* Seconds since init/reset (the sum of dt_s) from which the filter has settled:
+   samples before are flagged (in_range 0), as training leaves them out. [s] */
+#define {up}_SETTLE_S {settle_threshold_s(model.drift.settings.warmup_s)!r}
 /* 1 when {p}_step() takes the housing temperature (the model uses h, dh or g terms). */
 #define {up}_USES_HOUSING {1 if plan.housing_input else 0}
 /* Extra logged channels {p}_step() takes after housing_c (aux_NAME, --aux NAME=COLUMN). */
@@ -254,6 +258,7 @@ typedef struct {p}_state {{
     {p}_rate_filter f_filter;   /* df/dt filter of f [Hz] */
 {state_h}    int started;                /* 0 until the first sample after init/reset */
     unsigned long samples;      /* samples since init/reset */
+    double elapsed_s;           /* seconds since init/reset, up to SETTLE_S [s] */
     unsigned long out_of_range; /* of which outside the calibrated temperature */
     unsigned long rate_out_of_range; /* of which with rate_in_range == 0 */
 }} {p}_state;
@@ -461,6 +466,7 @@ void {p}_reset({p}_state *state)
     rate_start(&state->f_filter, 0.0);
 {h['reset']}{extra['reset']}    state->started = 0;
     state->samples = 0UL;
+    state->elapsed_s = 0.0;
     state->out_of_range = 0UL;
     state->rate_out_of_range = 0UL;
 }}

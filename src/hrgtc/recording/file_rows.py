@@ -1,0 +1,91 @@
+"""Row numbers of the file, whatever the reader left out before validation.
+
+The reader drops rows before the validator sees them: spikes (``--spikes drop``, the
+robust ``--spike-filter drop``), duplicated rows (the time repair) and the rows
+outside ``--start/--end``. A later problem's row must still name the row of the
+file (0 = the first data row, as every message of the validator), so the reader
+carries each row's file row in a private column (:data:`ROW_KEY`) through those
+stages, takes it off before the :class:`~hrgtc.recording.Recording` is built, and
+hands it to the validator, which keeps it as a sparse map (:class:`FileRows`: one
+entry per run of rows left out, not one per row) and rewrites the rows of its
+problems with it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+
+import numpy as np
+
+from hrgtc.recording.checks import Problem
+
+#: Private column of the reader's parts: the file row of each row (float64, so it
+#: passes every stage as the other columns do). Never in a Recording.
+ROW_KEY = "__file_row__"
+
+
+def with_file_rows(part: dict[str, np.ndarray], offset: int) -> dict[str, np.ndarray]:
+    """``part`` (rows ``offset`` on of the file) with its file rows in :data:`ROW_KEY`."""
+    n = len(next(iter(part.values()))) if part else 0
+    return {**part, ROW_KEY: np.arange(offset, offset + n, dtype=np.float64)}
+
+
+def take_file_rows(part: dict[str, np.ndarray]) -> tuple[dict[str, np.ndarray],
+                                                          np.ndarray | None]:
+    """``part`` without :data:`ROW_KEY`, and the file rows it held (None if none)."""
+    if ROW_KEY not in part:
+        return part, None
+    rows = part[ROW_KEY]
+    return {k: v for k, v in part.items() if k != ROW_KEY}, rows
+
+
+class FileRows:
+    """The file row of each row the validator saw, as a sparse map.
+
+    ``shift = file row - row seen`` only grows, by the rows left out before it; the
+    map keeps the rows seen where it changes.
+
+    Examples
+    --------
+    >>> rows = FileRows()
+    >>> rows.update(0, np.array([0.0, 1.0, 3.0, 4.0]))  # file row 2 was dropped
+    >>> rows.update(4, np.array([5.0, 9.0]))            # rows 6-8 too
+    >>> [rows.file_row(k) for k in range(6)]
+    [0, 1, 3, 4, 5, 9]
+    """
+
+    def __init__(self) -> None:
+        self._at: list[int] = [0]
+        self._shift: list[int] = [0]
+
+    def update(self, offset: int, file_rows: np.ndarray) -> None:
+        """The file rows of the next ``len(file_rows)`` rows seen, from row ``offset`` on."""
+        if not len(file_rows):
+            return
+        shift = np.asarray(file_rows, dtype=np.int64) - np.arange(offset, offset + len(file_rows))
+        changes = np.flatnonzero(np.diff(shift)) + 1
+        if shift[0] != self._shift[-1]:
+            changes = np.concatenate([[0], changes])
+        self._at += (offset + changes).tolist()
+        self._shift += shift[changes].tolist()
+
+    def file_row(self, row: int) -> int:
+        """The file row of row ``row`` seen."""
+        k = int(np.searchsorted(self._at, row, side="right")) - 1
+        return int(row + self._shift[max(k, 0)])
+
+    @property
+    def identity(self) -> bool:
+        """True while no row was left out."""
+        return self._shift[-1] == 0 and len(self._shift) == 1
+
+    def problem(self, problem: Problem) -> Problem:
+        """``problem`` with its row (and the rows its message names) rows of the file."""
+        if problem.row is None or self.identity:
+            return problem
+        row = self.file_row(problem.row)
+        if row == problem.row:
+            return problem
+        message = re.sub(rf"\brow {problem.row}\b", f"row {row}", problem.message)
+        return dataclasses.replace(problem, row=row, message=message)
