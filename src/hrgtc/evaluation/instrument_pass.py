@@ -31,7 +31,7 @@ from hrgtc.drift.rest import run_rest
 from hrgtc.evaluation.allan import ONE_SIGMA
 from hrgtc.evaluation.metrics import DEFAULT_TAUS_S
 from hrgtc.evaluation.plot_blocks import block_rows
-from hrgtc.evaluation.run_pass import Evaluation, RunPass
+from hrgtc.evaluation.run_pass import Evaluation, RunPass, count_dropped
 from hrgtc.model import InstrumentModel
 from hrgtc.recording import ReadOptions, Recording, axis_view, count_rows
 from hrgtc.recording.marks import refuse_compensated
@@ -98,7 +98,8 @@ def evaluate_axes(
               for axis, unit in model.axes.items()}
     bands = {axis: plausible_frequency_band(unit) for axis, unit in model.axes.items()}
     done = 0
-    for chunk in options.chunks(run):
+    dropped: dict[str, int] = {}  # filled by the reading: the rows of spikes removed
+    for chunk in options.chunks(run, dropped=dropped):
         for axis, state in passes.items():
             view = chunk if single else axis_view(chunk, axis)
             if not single:
@@ -107,7 +108,7 @@ def evaluate_axes(
         done += len(chunk)
         if progress is not None:
             progress(done, rows)
-    return {axis: state.result() for axis, state in passes.items()}
+    return {axis: count_dropped(state.result(), dropped) for axis, state in passes.items()}
 
 
 def _rest_masks(chunks: Iterator[Recording], model: InstrumentModel, motion: str,

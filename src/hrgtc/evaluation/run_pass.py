@@ -645,7 +645,13 @@ def evaluate(
                       block_rows=blocks, on_output=on_output, progress=progress,
                       total_rows=rows, gaps=gaps, deviation=deviation,
                       confidence=confidence, keep=keep)
-    if result.accounting is not None and dropped.get("spikes"):  # read, then left out
+    return count_dropped(result, dropped)
+
+
+def count_dropped(result: Evaluation, dropped: dict[str, int]) -> Evaluation:
+    """``result`` with the rows the reading removed as spikes counted: read, then left out
+    (the pass saw only the rows that reached it)."""
+    if result.accounting is not None and dropped.get("spikes"):
         result.accounting.add_read(dropped["spikes"])
         result.accounting.drop("spikes", dropped["spikes"])
     return result
