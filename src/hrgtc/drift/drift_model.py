@@ -223,7 +223,7 @@ class DriftModel(ParsedTerms):
         """
         self.settings.check_sample_rate(recording)
         stream = FeatureStream(self.settings, self.variables, thermometer)
-        return self.predict(stream.process(recording))
+        return self.predict(stream.transform(recording))
 
     def orientation_offset(self, accel: Any) -> float | None:
         """Offset from ``intercept_dph`` of the orientation of a mean accelerometer vector;

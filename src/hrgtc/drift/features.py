@@ -453,7 +453,7 @@ class FeatureStream:
                                                  time_s=time_s, restart=restart)
         return rate
 
-    def process(self, chunk: Recording, restart: np.ndarray | None = None
+    def transform(self, chunk: Recording, restart: np.ndarray | None = None
                 ) -> dict[str, np.ndarray]:
         """Variables of the next chunk of the run, keyed by variable name.
 
@@ -513,7 +513,7 @@ def compute_variables(
     thermometer: Any = None,
 ) -> dict[str, np.ndarray]:
     """Batch form of :class:`FeatureStream`: the variables of a whole run."""
-    return FeatureStream(settings, variables, thermometer).process(recording)
+    return FeatureStream(settings, variables, thermometer).transform(recording)
 
 
 def linear_combination(

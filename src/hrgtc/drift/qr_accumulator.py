@@ -180,8 +180,6 @@ class QRAccumulator:
         self.sum_weights_ += float(X.shape[0]) if w is None else float(w.sum())
         return self
 
-    update = partial_fit
-
     def _fold_rows(self, X: np.ndarray, y: np.ndarray, w: np.ndarray | None) -> np.ndarray:
         """R of the stored factor stacked on the shifted, scaled, weighted rows [1, X, y].
 

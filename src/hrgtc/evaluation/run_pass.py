@@ -399,7 +399,7 @@ def run_pass(
                                restart_at_gaps=gaps == "split",
                                keep_mask=allan and deviation != "oadev")
             split = DirectionSplit(model, metadata.sample_rate_hz)
-        out = frequency.process(chunk)
+        out = frequency.transform(chunk)
         if on_output is not None:
             on_output(out)
         raw = chunk.rate_dph - metadata.input_rate_dph
@@ -409,18 +409,19 @@ def run_pass(
                    "comp_dph": comp, "temperature_c": out["resonator_c_est"],
                    "in_range": out["in_range"]}
         if housing is not None:
-            comp_h = housing.process(chunk)["rate_comp_dph"] - metadata.input_rate_dph
+            comp_h = housing.transform(chunk)["rate_comp_dph"] - metadata.input_rate_dph
             pushed["housing"] = comp_h
             columns["comp_housing_dph"] = comp_h
         if keep is not None:
             kept = keep[frequency.samples - len(chunk):frequency.samples]
             left_out += int(np.count_nonzero(~kept))
             pushed = {key: values[kept] for key, values in pushed.items()}
-        cut.push(pushed, chunk.time_s if keep is None else chunk.time_s[kept])
+        cut.partial_fit(pushed, chunk.time_s if keep is None else chunk.time_s[kept])
         if allan and deviation != "oadev":
             for key, values in pushed.items():
                 whole.setdefault(key, []).append(values)
-        split.push(chunk, raw, comp, out["bias_model_dph"] - chunk["bias_dph"] if truth else None)
+        split.partial_fit(chunk, raw, comp,
+                          out["bias_model_dph"] - chunk["bias_dph"] if truth else None)
         if truth:
             columns["true_dph"] = chunk["bias_dph"]
             squared_error += float(np.sum((out["bias_model_dph"] - chunk["bias_dph"]) ** 2))
@@ -428,8 +429,8 @@ def run_pass(
             columns.update({k: chunk[k] for k in ("resonator_c", "housing_c", "chamber_c")
                             if k in chunk})
             assert features is not None
-            columns.update({VARIABLE_PREFIX + k: v for k, v in features.process(chunk).items()})
-            means.push(columns)
+            columns.update({VARIABLE_PREFIX + k: v for k, v in features.transform(chunk).items()})
+            means.partial_fit(columns)
         if progress is not None:
             progress(frequency.samples, total_rows)
     if metadata is None:

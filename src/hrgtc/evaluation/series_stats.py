@@ -65,7 +65,7 @@ class _BlockMeans:
         self.mean = 0.0
         self.m2 = 0.0
 
-    def push(self, values: np.ndarray) -> None:
+    def partial_fit(self, values: np.ndarray) -> None:
         data = np.concatenate([self._carry, values]) if self._carry.size else values
         blocks = data.size // self.rows
         if blocks:
@@ -131,7 +131,7 @@ class _SecondDifferenceSums:
         """A gap: no second difference reaches across it."""
         self._tail = np.empty(0)
 
-    def push(self, values: np.ndarray) -> None:
+    def partial_fit(self, values: np.ndarray) -> None:
         data = np.concatenate([self._tail, values]) if self._tail.size else values
         old = self._tail.size
         centred = data - np.mean(data)  # a constant offset leaves second differences unchanged
@@ -196,7 +196,7 @@ class SeriesStatistics:
         self._full_breaks: list[int] = []  # sample indices where a segment starts
         self._coarse_crosses_gaps = False
 
-    def push(self, values: np.ndarray, breaks: Sequence[int] = ()) -> None:
+    def partial_fit(self, values: np.ndarray, breaks: Sequence[int] = ()) -> None:
         """Add the next samples; ``breaks``: indices in ``values`` where a segment starts
         after a gap (no τ-block and no Allan difference reaches across it)."""
         values = np.asarray(values, dtype=np.float64)
@@ -240,7 +240,7 @@ class SeriesStatistics:
         self._sum_squares += float(np.dot(values, values))
         self._segment_samples += values.size
         for means in self._stability.values():
-            means.push(values)
+            means.partial_fit(values)
         if not self.allan:
             return
         if self._full is not None:
@@ -256,12 +256,12 @@ class SeriesStatistics:
                         self._exact.break_segment()
                         self._decimated._carry = np.empty(0)
                         self._coarse_crosses_gaps = True
-                    self._exact.push(held[edges[k]:edges[k + 1]])
-                    self._decimated.push(held[edges[k]:edges[k + 1]])
+                    self._exact.partial_fit(held[edges[k]:edges[k + 1]])
+                    self._decimated.partial_fit(held[edges[k]:edges[k + 1]])
                 self._shrink()
             return
-        self._exact.push(values)
-        self._decimated.push(values)
+        self._exact.partial_fit(values)
+        self._decimated.partial_fit(values)
         self._shrink()
 
     def _shrink(self) -> None:

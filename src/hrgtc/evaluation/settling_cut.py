@@ -61,7 +61,7 @@ class SettlingCut:
         self._last = float(time[-1])
         return time - origin >= self.warmup_s
 
-    def push(self, values: dict[str, np.ndarray], time: np.ndarray) -> None:
+    def partial_fit(self, values: dict[str, np.ndarray], time: np.ndarray) -> None:
         """The next rows of every series (one length) and their times [s]."""
         if not time.size:
             return
@@ -92,7 +92,7 @@ class SettlingCut:
             breaks = np.concatenate([[0], breaks])
         self._last_kept = float(kept[-1])
         for key, array in values.items():
-            self.series[key].push(array[mask], breaks.tolist())
+            self.series[key].partial_fit(array[mask], breaks.tolist())
 
     def finish(self, name: str = "run") -> int:
         """Feed what is still held back; the number of samples left out (settling)."""

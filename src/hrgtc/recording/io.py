@@ -402,7 +402,7 @@ def iter_chunks(
 
         for chunk in chunks():
             if validator is not None:
-                validator.update(chunk)
+                validator.partial_fit(chunk)
                 validator.raise_for_problems()
             pending.append(chunk)
             if validator is None or validator.heuristics_done:

@@ -124,7 +124,7 @@ class RecordingValidator:
 
     Time continuity and row numbers run over the whole recording; the unit and
     sample-rate heuristics look at its first :data:`HEURISTIC_ROWS` rows.
-    ``validate(recording)`` is "a new validator, one update, finish".
+    ``validate(recording)`` is "a new validator, one partial_fit, finish".
 
     Parameters
     ----------
@@ -175,7 +175,7 @@ class RecordingValidator:
         self._names: tuple[str, ...] = ()
 
     # -- feeding -------------------------------------------------------------
-    def update(self, chunk: Recording) -> None:
+    def partial_fit(self, chunk: Recording) -> None:
         """Check the next chunk (rows continue from the previous chunk)."""
         if self.metadata is None:
             self.metadata = chunk.metadata
@@ -612,7 +612,7 @@ def validate(
         Message names the file, column, first bad row, the bad value and the fix.
     """
     validator = RecordingValidator(gaps, freq_band_hz, freq_span_hz, thermometer)
-    validator.update(recording)
+    validator.partial_fit(recording)
     report = validator.finish()
     if raise_errors:
         report.raise_for_problems()
