@@ -82,7 +82,7 @@ def empty() -> Any:
     return msgspec.field(default_factory=dict)
 
 
-def dump(result: Any, record: type[Record], **given: Any) -> dict[str, Any]:
+def dump(result: Any, record: type[Record], /, **given: Any) -> dict[str, Any]:
     """A result's record as strict JSON types (lists, ``None`` for what is not finite).
 
     Each field of ``record`` is read off ``result`` by name (a field the result lacks
@@ -90,8 +90,7 @@ def dump(result: Any, record: type[Record], **given: Any) -> dict[str, Any]:
     ``given``: field values to use instead (a part that serialises itself).
     """
     try:
-        value = msgspec.convert(_View(result, given) if given else result, record,
-                                from_attributes=True)
+        value = msgspec.convert(_View(result, given), record, from_attributes=True)
     except msgspec.ValidationError as exc:
         raise InputError(f"{type(result).__name__} does not fit its record "
                          f"{record.__name__}: {exc}") from exc
@@ -112,15 +111,30 @@ def _plain(value: Any) -> Any:
 
 
 class _View:
-    """``result``'s attributes, some replaced by ``given``."""
+    """``result``'s attributes as plain Python (numpy scalars and arrays by ``tolist``,
+    nested results viewed alike), some replaced by ``given``."""
 
     def __init__(self, result: Any, given: dict[str, Any]) -> None:
         self._result, self._given = result, given
 
     def __getattr__(self, name: str) -> Any:
         if name in self._given:
-            return self._given[name]
-        return getattr(self._result, name)
+            return _plain_value(self._given[name])
+        return _plain_value(getattr(self._result, name))
+
+
+def _plain_value(value: Any) -> Any:
+    if isinstance(value, str | int | float | bool | None):
+        return value.item() if hasattr(value, "item") else value
+    if hasattr(value, "tolist"):
+        return value.tolist()
+    if isinstance(value, dict):
+        return {k: _plain_value(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_plain_value(v) for v in value]
+    if hasattr(value, "__dataclass_fields__"):
+        return _View(value, {})
+    return value
 
 
 def load(data: Any, record: type[Record], what: str) -> dict[str, Any]:

@@ -61,7 +61,7 @@ from hrgtc.drift.features import (
 from hrgtc.drift.offsets import fit_offsets, offset_groups, orientation_offset, project_off
 from hrgtc.drift.regression import EXTENDED_PRECISION, newey_west_inflation
 from hrgtc.drift.rest import check_policy, reference_point, run_rest
-from hrgtc.drift.stepwise import StepwiseResult, stepwise
+from hrgtc.drift.stepwise import StepwiseRecord, StepwiseResult, stepwise
 from hrgtc.drift.windows import RunSource, TrainingWindows, _iter_run, window_means
 from hrgtc.errors import CalibrationError, InputError
 from hrgtc.progress import Progress
@@ -281,7 +281,7 @@ class DriftModelRecord(records.Record, kw_only=True):
     standard_errors: dict[str, records.Statistic]
     pvalues: dict[str, records.Statistic]
     scaled_coefficients: tuple[float, ...]
-    stepwise: dict[str, Any]
+    stepwise: StepwiseRecord
     ranges: dict[str, records.Range]
     window_s: records.Positive
     n_windows: records.Count
