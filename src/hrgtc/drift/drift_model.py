@@ -36,6 +36,7 @@ from hrgtc.core import records
 from hrgtc.core.accounting import Accounting
 from hrgtc.drift.cross_validation import (
     CrossValidation,
+    CrossValidationRecord,
     cross_validate,
     guard_selection,
     select_terms,
@@ -248,9 +249,7 @@ class DriftModel(ParsedTerms):
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types, as :class:`DriftModelRecord` writes them (NaN -> None)."""
-        return records.dump(self, DriftModelRecord, stepwise=self.stepwise.to_dict(),
-                            cross_validation=None if self.cross_validation is None
-                            else self.cross_validation.to_dict())
+        return records.dump(self, DriftModelRecord)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> DriftModel:
@@ -262,7 +261,8 @@ class DriftModel(ParsedTerms):
             return cls(**{**values, "settings": FeatureSettings(**values["settings"]),
                           "stepwise": StepwiseResult.from_dict(values["stepwise"]),
                           "cross_validation": None if validation is None
-                          else CrossValidation.from_dict(validation),
+                          else CrossValidation(sources=tuple(validation["per_run_dph"]),
+                                               **validation),
                           "pruning": None if values["pruning"] is None
                           else dict(values["pruning"])})
         except (KeyError, TypeError, ValueError, IndexError) as exc:
@@ -291,7 +291,7 @@ class DriftModelRecord(records.Record, kw_only=True):
     variance_inflation: records.Statistic = 1.0
     bandwidth_windows: records.Count = 0
     selection: str = "stepwise"
-    cross_validation: dict[str, Any] | None = None
+    cross_validation: CrossValidationRecord | None = None
     n_not_at_rest: int = 0
     offset_mode: str = "none"
     offsets_dph: dict[str, float] = records.empty()

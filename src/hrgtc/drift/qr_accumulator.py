@@ -441,9 +441,7 @@ class OLSResult:
 
     def to_dict(self) -> dict[str, Any]:
         """Plain-JSON form (NaN -> null), as :class:`OLSResultRecord`."""
-        arrays = ("params", "bse", "tvalues", "pvalues", "cov_params")
-        return records.dump(self, OLSResultRecord,
-                            **{k: np.asarray(getattr(self, k)).tolist() for k in arrays})
+        return records.dump(self, OLSResultRecord)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> OLSResult:

@@ -124,7 +124,7 @@ class StepwiseResult:
 
     def to_dict(self) -> dict[str, Any]:
         """Plain-JSON form (NaN p-values become null), as :class:`StepwiseRecord`."""
-        return records.dump(self, StepwiseRecord, result=self.result.to_dict())
+        return records.dump(self, StepwiseRecord)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> StepwiseResult:
