@@ -67,11 +67,14 @@ class AxisRecord(records.Record, kw_only=True):
     """What one axis holds: the parts of a single-axis model file (at its top level), or
     of one axis of a multi-axis file (under ``axes``)."""
 
+    # scale_factor and training are written only when known: older files hash alike
+    omit_when_default = ("scale_factor", "training")
+
     thermometer: ThermometerRecord
     drift: DriftModelRecord
     housing: DriftModelRecord | None = None
-    scale_factor: ScaleFactorRecord | None = None
     plateaus: tuple[dict[str, Any], ...] = ()
+    scale_factor: ScaleFactorRecord | None = None
     #: Optional: files written before it still load (the noise check is then skipped).
     training: TrainingStatisticsRecord | None = None
 

@@ -95,12 +95,37 @@ def dump(result: Any, record: type[Record], /, **given: Any) -> dict[str, Any]:
         raise InputError(f"{type(result).__name__} does not fit its record "
                          f"{record.__name__}: {exc}") from exc
     document = _strict(msgspec.to_builtins(value, enc_hook=_plain))
-    defaults = msgspec.structs.fields(record)
-    for field in defaults:
-        if field.name in record.omit_when_default and document.get(field.name) == _strict(
-                field.default):
-            del document[field.name]
+    _omit_defaults(document, record)
     return document
+
+
+def _omit_defaults(document: Any, kind: Any) -> None:
+    """Drop the fields of ``omit_when_default`` that hold their default, at every depth."""
+    while get_origin(kind) is Annotated:
+        kind = get_args(kind)[0]
+    if isinstance(kind, type) and issubclass(kind, Record):
+        if not isinstance(document, dict):
+            return
+        for field in msgspec.structs.fields(kind):
+            if field.name not in document:
+                continue
+            if field.name in kind.omit_when_default and document[field.name] == _strict(
+                    field.default):
+                del document[field.name]
+            else:
+                _omit_defaults(document[field.name], field.type)
+        return
+    args = [a for a in get_args(kind) if a is not Ellipsis]
+    if isinstance(document, dict) and get_origin(kind) is dict:
+        for item in document.values():
+            _omit_defaults(item, args[-1])
+    elif isinstance(document, list) and args:
+        for item in document:
+            _omit_defaults(item, args[0])
+    elif args:  # X | None: the record among the union's members
+        for member in args:
+            if isinstance(member, type) and issubclass(member, Record):
+                _omit_defaults(document, member)
 
 
 def _plain(value: Any) -> Any:
