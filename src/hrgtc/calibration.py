@@ -133,9 +133,13 @@ class CalibrationResult:
         if model.housing is not None:
             sections.append(("housing-thermistor baseline",
                              _drift_figures("housing", model.housing)))
+        notes: list[str] = []
         for k, run in enumerate(self.validation):
-            sections.append((f"held-out run {run.file}", _validation_figures(k, run)))
-        return Summary(f"calibration of {model.unit}", tuple(sections))
+            figures = run.figures(f"validation[{k}]")
+            sections.append((f"held-out run {run.file}",
+                             tuple(f for _, part in figures.sections for f in part)))
+            notes.extend(figures.notes)
+        return Summary(f"calibration of {model.unit}", tuple(sections), tuple(notes))
 
 
 def _thermometer_figures(thermometer: Any, table: Sequence[Mapping[str, float]]
@@ -178,20 +182,6 @@ def _drift_figures(key: str, model: Any) -> tuple[Figure, ...]:
                        model.residual_std_dph, "°/h", digits=4),
                 Figure(f"{key}.rsquared", "R²", model.rsquared, digits=6),
                 Figure(f"{key}.n_windows", f"windows of {model.window_s:g} s", model.n_windows)]
-    return tuple(figures)
-
-
-def _validation_figures(k: int, run: Evaluation) -> tuple[Figure, ...]:
-    """Bias stability raw and compensated at each τ with its confidence interval."""
-    figures = []
-    kind = f"{run.confidence:.1%} CI"
-    for series, row in run.bias_stability_dph.items():
-        for tau_s, value in row.items():
-            figures.append(Figure(f"validation[{k}].bias_stability_dph.{series}.{tau_s:g}",
-                                  f"bias stability {series}, {tau_s:g} s", value, "°/h",
-                                  run.stability_interval(series, tau_s), kind, digits=4))
-    figures.append(Figure(f"validation[{k}].improvement_10s", "improvement at 10 s",
-                          run.improvement_10s, "×", digits=3))
     return tuple(figures)
 
 

@@ -30,6 +30,7 @@ from hrgtc.compensate import Compensator
 from hrgtc.compensate.model_fit import check_recording_noise, with_model_band
 from hrgtc.compensate.ranges import RangeReport
 from hrgtc.core.accounting import Accounting
+from hrgtc.core.summary import Summary
 from hrgtc.drift.features import FeatureStream
 from hrgtc.drift.rest import run_rest
 from hrgtc.errors import HrgtcError, InputError, RecordingError
@@ -52,6 +53,7 @@ from hrgtc.evaluation.metrics import (
 )
 from hrgtc.evaluation.noise import NoiseTerms, noise_terms
 from hrgtc.evaluation.plot_blocks import BlockMeans, block_rows
+from hrgtc.evaluation.run_figures import run_figures
 from hrgtc.evaluation.series_stats import SeriesStatistics
 from hrgtc.evaluation.settling_cut import SettlingCut
 from hrgtc.model import UnitModel
@@ -267,6 +269,10 @@ class Evaluation:
     def range_warnings(self) -> list[str]:
         """Lines on samples beyond the trained temperature and df/dt (empty if none)."""
         return [] if self.ranges is None else self.ranges.warnings()
+
+    def figures(self, key: str = "evaluation") -> Summary:
+        """The figures as a structured summary: value, unit, interval (:mod:`run_figures`)."""
+        return run_figures(self, key)
 
     def summary(self) -> str:
         """A small text table."""
