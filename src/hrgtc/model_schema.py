@@ -1,5 +1,10 @@
 """The JSON Schema of the model file, and the checks a schema cannot express.
 
+The schema is not written by hand: :data:`MODEL_SCHEMA` is generated from the typed
+records of the file's parts (:class:`FileRecord`, :class:`AxisRecord` and the records
+beside each result: ``ThermometerRecord``, ``DriftModelRecord``, ``ScaleFactorRecord``,
+...; see :mod:`hrgtc.core.records`), the same definitions that write and read them.
+
 A model file is trusted by nothing: :func:`check_document` validates it with
 ``jsonschema`` (Draft 2020-12) against :data:`MODEL_SCHEMA` and then checks what
 a schema cannot say: every term is known and parsable, the selected terms are
@@ -178,61 +183,11 @@ def check_schema(data: Any, source: str) -> None:
         raise _fail(source, _path(error.absolute_path), message)
 
 
-def _number(value: Any) -> float:
-    """A statistic as a float: None and the non-standard constants become NaN / ±inf."""
-    if value is None or value == "NaN":
-        return math.nan
-    if value == "Infinity":
-        return math.inf
-    if value == "-Infinity":
-        return -math.inf
-    return float(value)
-
-
-def restore_statistics(data: dict[str, Any]) -> dict[str, Any]:
-    """A copy of a checked document with every statistic a float (NaN where missing)."""
-    data = json.loads(json.dumps(data))
-    for part in axis_parts(data).values():
-        _restore_axis(part)
-    return data
-
-
 def axis_parts(data: Mapping[str, Any]) -> dict[str, Any]:
     """Axis name -> the object holding that axis's parts (``""`` -> the document itself
     for a single-axis file)."""
     axes = data.get("axes")
     return {"": data} if axes is None else dict(axes)
-
-
-def _restore_axis(data: dict[str, Any]) -> None:
-    therm = data["thermometer"]
-    therm["standard_errors"] = [_number(v) for v in therm["standard_errors"]]
-    therm["rsquared"] = _number(therm["rsquared"])
-    if "residual_std_hz" in therm:
-        therm["residual_std_hz"] = _number(therm["residual_std_hz"])
-    if therm.get("scaled_covariance") is not None:
-        therm["scaled_covariance"] = [[_number(v) for v in row]
-                                      for row in therm["scaled_covariance"]]
-    for key in ("drift", "housing"):
-        drift = data.get(key)
-        if drift is None:
-            continue
-        for name in ("standard_errors", "pvalues"):
-            drift[name] = {k: _number(v) for k, v in drift[name].items()}
-        for name in ("residual_std_dph", "rsquared", "variance_inflation"):
-            if name in drift:
-                drift[name] = _number(drift[name])
-        drift["stepwise"] = _numbers_in(drift["stepwise"])
-
-
-def _numbers_in(value: Any) -> Any:
-    if isinstance(value, dict):
-        return {k: _numbers_in(v) for k, v in value.items()}
-    if isinstance(value, list):
-        return [_numbers_in(v) for v in value]
-    if value in ("NaN", "Infinity", "-Infinity"):
-        return _number(value)
-    return value
 
 
 def strict(value: Any) -> Any:
@@ -409,7 +364,7 @@ def _check_scale_bounds(sf: Mapping[str, Any], where: str, source: str) -> None:
 
 
 def check_document(data: Any, source: str, non_standard: bool = False) -> dict[str, Any]:
-    """Validate a parsed model file; return it with statistics as floats, coefficients derived.
+    """Validate a parsed model file; return a copy with the coefficients derived.
 
     Parameters
     ----------
@@ -437,7 +392,8 @@ def check_document(data: Any, source: str, non_standard: bool = False) -> dict[s
             f"{source}: model file was changed after it was written (its content no longer "
             "matches its parameters_sha256): damaged or edited; recreate it with 'hrgtc "
             "calibrate' (after a deliberate edit, delete the parameters_sha256 line)")
-    restored = restore_statistics(data)
+    # a copy; the statistics ("NaN", null) are read as floats by the parts' records
+    restored = json.loads(json.dumps(data))
     kept = axis_parts(restored)
     for axis, part in axis_parts(data).items():
         at = f"axes.{axis}." if axis else ""
