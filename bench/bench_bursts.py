@@ -80,7 +80,7 @@ def _compensate(model, recording, gaps):
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # tau 10 s is shorter than the 300 s burst period
-        Compensator(model, gaps=gaps).process(recording)
+        Compensator(model, gaps=gaps).transform(recording)
 
 
 def _features(model, recording):

@@ -266,7 +266,7 @@ def run(quick: bool = False) -> list[dict]:
         del reference
         start = time.perf_counter()
         compensator = Compensator(model)
-        parts = [compensator.process(recording.slice(a, a + 100_000))
+        parts = [compensator.transform(recording.slice(a, a + 100_000))
                  for a in range(0, n, 100_000)]
         seconds = time.perf_counter() - start
         streamed = concatenate(parts)

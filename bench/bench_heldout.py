@@ -60,7 +60,7 @@ def _measure(path: Path, model, fs: float, options: dict | None = None) -> dict:
     from hrgtc.compensate import Compensator
 
     run = recording.read(path)
-    out = Compensator(model).process(run)
+    out = Compensator(model).transform(run)
     skip = round(model.drift.settings.warmup_s * fs)  # the first seconds, as in training
     offset = run.metadata.input_rate_dph
     raw = (run.rate_dph - offset)[skip:]

@@ -75,7 +75,7 @@ class Fixture:
         self.csv_text = self.csv_path.read_text()
         self.parquet_path = write(self.run, folder / "run.parquet", force=True)
         self.parquet_bytes = self.parquet_path.read_bytes()
-        self.expected = Compensator(self.model, engine="numpy").process(self.run)
+        self.expected = Compensator(self.model, engine="numpy").transform(self.run)
 
 
 # -- corruptions ---------------------------------------------------------------------------
@@ -276,7 +276,7 @@ def judge_data(fixture: Fixture, run: Path) -> str:
     stacked = np.column_stack(list(columns.values()))
     repeated = np.r_[False, np.all(stacked[1:] == stacked[:-1], axis=1)]
     columns = {name: values[~repeated] for name, values in columns.items()}
-    truth = Compensator(fixture.model, engine="numpy").process(
+    truth = Compensator(fixture.model, engine="numpy").transform(
         Recording(columns, Metadata(**{**fixture.run.metadata.to_dict()})))
     out = pq.read_table(output)
     for name in ("rate_comp_dph", "bias_model_dph", "in_range"):

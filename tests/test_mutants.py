@@ -100,7 +100,7 @@ def test_the_range_report_gives_the_resonators_rate_in_degrees_per_hour(model):
     for start_c, end_c in ((20.0, -20.0), (-20.0, 20.0)):  # a cool-down and a warm-up
         run = ramp_run(seed=4, start_c=start_c, end_c=end_c, hours=3.0)
         compensator = Compensator(model, engine="numpy")
-        compensator.process(run)
+        compensator.transform(run)
         seen = compensator.ranges().seen_rate_c_per_h
         # truth: the simulated resonator temperature's own rate, °C/s * 3600
         true_rate = np.diff(run["resonator_c"]) * run.metadata.sample_rate_hz * 3600.0
@@ -173,5 +173,5 @@ def test_the_training_range_includes_its_lower_edge_in_compensation(model):
         run = Recording({"time_s": np.arange(n) / 10.0, "freq_hz": freq,
                          "rate_dph": np.full(n, 10.0)}, Metadata(sample_rate_hz=10.0))
         compensator = Compensator(dataclasses.replace(model, drift=drift), engine="numpy")
-        compensator.process(run)
+        compensator.transform(run)
         assert compensator.ranges().temperature_fraction == outside

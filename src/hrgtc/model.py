@@ -24,6 +24,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
+from hrgtc.core import records
 from hrgtc.core.errors import HrgtcError, ModelFileError
 from hrgtc.core.files import file_sha256, write_text_atomic
 from hrgtc.drift import DriftModel
@@ -32,6 +33,7 @@ from hrgtc.drift.training import TrainingStatistics
 from hrgtc.model_schema import (
     SCHEMA_NAME,
     SCHEMA_VERSION,
+    AxisRecord,
     axis_parts,
     check_document,
     parameters_sha256,
@@ -85,18 +87,9 @@ class UnitModel:
     training: TrainingStatistics | None = None
 
     def parts(self) -> dict[str, Any]:
-        """The axis's parts of the model file (thermometer, drift, housing, ...)."""
-        parts: dict[str, Any] = {
-            "thermometer": self.thermometer.to_dict(),
-            "drift": self.drift.to_dict(),
-            "housing": None if self.housing is None else self.housing.to_dict(),
-            "plateaus": list(self.plateaus),
-        }
-        if self.scale_factor is not None:
-            parts["scale_factor"] = self.scale_factor.to_dict()
-        if self.training is not None:  # written only when known: older files hash alike
-            parts["training"] = self.training.to_dict()
-        return parts
+        """The axis's parts of the model file (thermometer, drift, housing, ...), as
+        :class:`hrgtc.model_schema.AxisRecord` writes them."""
+        return records.dump(self, AxisRecord)
 
     def to_dict(self) -> dict[str, Any]:
         """The model file's JSON document."""

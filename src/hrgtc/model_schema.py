@@ -1,5 +1,10 @@
 """The JSON Schema of the model file, and the checks a schema cannot express.
 
+The schema is not written by hand: :data:`MODEL_SCHEMA` is generated from the typed
+records of the file's parts (:class:`FileRecord`, :class:`AxisRecord` and the records
+beside each result: ``ThermometerRecord``, ``DriftModelRecord``, ``ScaleFactorRecord``,
+...; see :mod:`hrgtc.core.records`), the same definitions that write and read them.
+
 A model file is trusted by nothing: :func:`check_document` validates it with
 ``jsonschema`` (Draft 2020-12) against :data:`MODEL_SCHEMA` and then checks what
 a schema cannot say: every term is known and parsable, the selected terms are
@@ -35,11 +40,18 @@ import json
 import math
 from collections.abc import Mapping
 from fractions import Fraction
-from typing import Any
+from typing import Annotated, Any, Literal
 
+from msgspec import Meta
+
+from hrgtc.core import records
 from hrgtc.core.errors import InputError, ModelFileError
+from hrgtc.drift.drift_model import DriftModelRecord
 from hrgtc.drift.features import parse_terms
-from hrgtc.drift.variables import settings_schema as variable_settings_schema
+from hrgtc.drift.scale_factor import ScaleFactorRecord
+from hrgtc.drift.training import TrainingStatisticsRecord
+from hrgtc.thermometry.reference import TemperatureMapRecord
+from hrgtc.thermometry.thermometer import ThermometerRecord
 
 SCHEMA_NAME = "hrgtc.model"
 #: 2: strict JSON (statistics that are not finite are written ``null``).
@@ -56,156 +68,66 @@ BIAS_BOUND_DPH = 3.6e7
 #: Largest scale-factor error any one term may give over the rate tables' range. [ppm]
 SCALE_BOUND_PPM = 1e6
 
-_FINITE = {"type": "number"}
-_STAT = {"anyOf": [{"type": "number"}, {"type": "null"},
-                   {"enum": ["NaN", "Infinity", "-Infinity"]}]}
-_POSITIVE = {"type": "number", "exclusiveMinimum": 0}
-_VARIABLE = r"(?:[a-z][a-z0-9]*|a_[A-Za-z][A-Za-z0-9]*)"
-_TERM = {"type": "string",
-         "pattern": rf"^{_VARIABLE}(\^[0-9]+)?(\*{_VARIABLE}(\^[0-9]+)?)*$"}
-_RANGE = {"type": "array", "items": _FINITE, "minItems": 2, "maxItems": 2}
+class AxisRecord(records.Record, kw_only=True):
+    """What one axis holds: the parts of a single-axis model file (at its top level), or
+    of one axis of a multi-axis file (under ``axes``)."""
 
-_THERMOMETER = {
-    "type": "object",
-    "required": ["order", "n_points", "coefficients", "standard_errors", "rsquared",
-                 "temperature_range_c", "centre_c", "scale_c", "scaled_coefficients"],
-    "properties": {
-        "kind": {"const": "hrgtc.Thermometer"},
-        "source": {"enum": ["resonator", "sensor"]},
-        "order": {"type": "integer", "minimum": 1, "maximum": 12},
-        "n_points": {"type": "integer", "minimum": 2},
-        "coefficients": {"type": "array", "items": _FINITE, "minItems": 2},
-        "standard_errors": {"type": "array", "items": _STAT},
-        "residual_std_hz": _STAT,
-        "rsquared": _STAT,
-        "temperature_range_c": _RANGE,
-        "centre_c": _FINITE,
-        "scale_c": _POSITIVE,
-        "scaled_coefficients": {"type": "array", "items": _FINITE, "minItems": 2},
-        "scaled_covariance": {"anyOf": [{"type": "null"},
-                                        {"type": "array", "items": {"type": "array",
-                                                                    "items": _STAT}}]},
-    },
-}
+    # scale_factor and training are written only when known: older files hash alike
+    omit_when_default = ("scale_factor", "training")
 
-_DRIFT = {
-    "type": "object",
-    "required": ["settings", "candidates", "selected", "intercept_dph", "coefficients",
-                 "standard_errors", "pvalues", "scaled_coefficients", "stepwise", "ranges",
-                 "window_s", "n_windows", "n_samples", "residual_std_dph", "rsquared"],
-    "properties": {
-        "kind": {"const": "hrgtc.DriftModel"},
-        "settings": {
-            "type": "object",
-            "required": ["reference_freq_hz", "sample_rate_hz", "reference_c", "rate_tau_s",
-                         "warmup_s"],
-            "properties": {
-                # A sensor thermometer reads °C in the place of f: any finite reference.
-                "reference_freq_hz": _FINITE,
-                "sample_rate_hz": _POSITIVE,
-                "reference_c": _FINITE,
-                "rate_tau_s": _POSITIVE,
-                "warmup_s": {"type": "number", "minimum": 0},
-                "scales": {"type": "object", "additionalProperties": _POSITIVE},
-                # the settings a drift variable owns (d2's rate_tau2_s, a_NAME's columns
-                # and centres, ...): each variable's module in hrgtc.drift.variables
-                **variable_settings_schema(),
-            },
-        },
-        "candidates": {"type": "array", "items": _TERM, "minItems": 1},
-        "selected": {"type": "array", "items": _TERM},
-        "intercept_dph": _FINITE,
-        "coefficients": {"type": "object", "additionalProperties": _FINITE},
-        "standard_errors": {"type": "object", "additionalProperties": _STAT},
-        "pvalues": {"type": "object", "additionalProperties": _STAT},
-        "scaled_coefficients": {"type": "array", "items": _FINITE},
-        "stepwise": {"type": "object"},
-        "ranges": {"type": "object", "additionalProperties": _RANGE},
-        "window_s": _POSITIVE,
-        "n_windows": {"type": "integer", "minimum": 0},
-        "n_samples": {"type": "integer", "minimum": 0},
-        "residual_std_dph": _STAT,
-        "rsquared": _STAT,
-        "variance_inflation": _STAT,
-        "bandwidth_windows": {"type": "integer", "minimum": 0},
-    },
-}
-
-def _scale_factor_schema() -> dict[str, Any]:
-    from hrgtc.drift.scale_factor import SCALE_FACTOR_JSON_SCHEMA
-
-    return SCALE_FACTOR_JSON_SCHEMA
+    thermometer: ThermometerRecord
+    drift: DriftModelRecord
+    housing: DriftModelRecord | None = None
+    plateaus: tuple[dict[str, Any], ...] = ()
+    scale_factor: ScaleFactorRecord | None = None
+    #: Optional: files written before it still load (the noise check is then skipped).
+    training: TrainingStatisticsRecord | None = None
 
 
-#: Statistics of the training data (:class:`hrgtc.drift.training.TrainingStatistics`);
-#: optional (files written before it still load; the noise check is then skipped).
-_TRAINING = {
-    "type": "object",
-    "required": ["sample_rate_hz", "rate_noise_dph", "rate_level_dph", "samples", "runs"],
-    "properties": {
-        "sample_rate_hz": _POSITIVE,
-        "rate_noise_dph": {"type": "number", "minimum": 0},
-        "rate_level_dph": _FINITE,
-        "samples": {"type": "integer", "minimum": 0},
-        "runs": {"type": "integer", "minimum": 0},
-    },
-}
+class FileRecord(records.Record, kw_only=True):
+    """The model file's own fields, beside one axis's parts (:class:`AxisRecord`) or ``axes``."""
 
-#: What one axis holds: the parts of a single-axis model file.
-_AXIS_PARTS = {
-    "thermometer": _THERMOMETER,
-    "drift": _DRIFT,
-    "housing": {"anyOf": [{"type": "null"}, _DRIFT]},
-    "scale_factor": {"anyOf": [{"type": "null"}, _scale_factor_schema()]},
-    "plateaus": {"type": "array", "items": {"type": "object"}},
-    "training": {"anyOf": [{"type": "null"}, _TRAINING]},
-}
+    schema: Literal["hrgtc.model"]
+    schema_version: Annotated[int, Meta(ge=1, le=SCHEMA_VERSION)]
+    unit: str = "unknown"
+    axes: Annotated[dict[Annotated[str, Meta(pattern=AXIS_PATTERN)], AxisRecord],
+                    Meta(min_length=1)] = records.empty()
+    provenance: dict[str, Any] = records.empty()
+    parameters_sha256: Annotated[str, Meta(pattern="^[0-9a-f]{64}$")] = ""
+    #: Optional: a raw temperature count's map to °C (calibrate --temp-ref).
+    temperature_map: TemperatureMapRecord | None = None
 
-#: JSON Schema (Draft 2020-12) of the model file, versions 1 to 3. A single-axis file
-#: holds one axis's parts at the top level; a multi-axis file (version 3) holds them
-#: under ``axes``, one object per axis name.
-MODEL_SCHEMA: dict[str, Any] = {
-    "$schema": "https://json-schema.org/draft/2020-12/schema",
-    "$id": "https://hrgtc.invalid/schema/model.json",
-    "title": "hrgtc model file",
-    "type": "object",
-    "required": ["schema", "schema_version"],
-    "oneOf": [
-        {"required": ["thermometer", "drift"], "not": {"required": ["axes"]}},
-        {"required": ["axes"], "not": {"anyOf": [{"required": ["thermometer"]},
-                                                  {"required": ["drift"]}]}},
-    ],
-    "properties": {
-        "schema": {"const": SCHEMA_NAME},
-        "schema_version": {"type": "integer", "minimum": 1, "maximum": SCHEMA_VERSION},
-        "unit": {"type": "string"},
-        **_AXIS_PARTS,
-        "axes": {
-            "type": "object",
-            "minProperties": 1,
-            "propertyNames": {"pattern": AXIS_PATTERN},
-            "additionalProperties": {
-                "type": "object",
-                "required": ["thermometer", "drift"],
-                "properties": _AXIS_PARTS,
-            },
-        },
-        "provenance": {"type": "object"},
-        "parameters_sha256": {"type": "string", "pattern": "^[0-9a-f]{64}$"},
-        # optional: a raw temperature count's map to °C (calibrate --temp-ref)
-        "temperature_map": {
-            "type": ["object", "null"],
-            "required": ["scale_c_per_count", "offset_c"],
-            "properties": {
-                "scale_c_per_count": {"type": "number"},
-                "offset_c": {"type": "number"},
-                "count_bits": {"enum": [16, 32, None]},
-                "lag_s": {"type": "number"},
-                "points": {"type": "integer", "minimum": 0},
-            },
-        },
-    },
-}
+
+def _model_schema() -> dict[str, Any]:
+    """The model file's JSON Schema, generated from :class:`FileRecord` and :class:`AxisRecord`
+    (and the records of the parts: thermometer, drift model, scale factor, ...)."""
+    _, definitions = records.schema_components([FileRecord, AxisRecord])
+    top, axis = definitions.pop("FileRecord"), definitions["AxisRecord"]
+    properties = {**top["properties"], **axis["properties"]}
+    for name in ("axes", "provenance", "parameters_sha256"):  # absent, never a default
+        properties[name].pop("default", None)
+    return {
+        "$schema": "https://json-schema.org/draft/2020-12/schema",
+        "$id": "https://hrgtc.invalid/schema/model.json",
+        "title": "hrgtc model file",
+        "description": top.get("description", ""),
+        "type": "object",
+        "required": top["required"],
+        # one axis at the top level, or several under axes: never both
+        "oneOf": [
+            {"required": ["thermometer", "drift"], "not": {"required": ["axes"]}},
+            {"required": ["axes"], "not": {"anyOf": [{"required": ["thermometer"]},
+                                                      {"required": ["drift"]}]}},
+        ],
+        "properties": properties,
+        "$defs": definitions,
+    }
+
+
+#: JSON Schema (Draft 2020-12) of the model file, versions 1 to 3, generated from the
+#: records of its parts. A single-axis file holds one axis's parts at the top level; a
+#: multi-axis file (version 3) holds them under ``axes``, one object per axis name.
+MODEL_SCHEMA: dict[str, Any] = _model_schema()
 #: Keys left out of :func:`parameters_sha256`.
 UNHASHED = ("provenance", "parameters_sha256")
 
@@ -261,61 +183,11 @@ def check_schema(data: Any, source: str) -> None:
         raise _fail(source, _path(error.absolute_path), message)
 
 
-def _number(value: Any) -> float:
-    """A statistic as a float: None and the non-standard constants become NaN / ±inf."""
-    if value is None or value == "NaN":
-        return math.nan
-    if value == "Infinity":
-        return math.inf
-    if value == "-Infinity":
-        return -math.inf
-    return float(value)
-
-
-def restore_statistics(data: dict[str, Any]) -> dict[str, Any]:
-    """A copy of a checked document with every statistic a float (NaN where missing)."""
-    data = json.loads(json.dumps(data))
-    for part in axis_parts(data).values():
-        _restore_axis(part)
-    return data
-
-
 def axis_parts(data: Mapping[str, Any]) -> dict[str, Any]:
     """Axis name -> the object holding that axis's parts (``""`` -> the document itself
     for a single-axis file)."""
     axes = data.get("axes")
     return {"": data} if axes is None else dict(axes)
-
-
-def _restore_axis(data: dict[str, Any]) -> None:
-    therm = data["thermometer"]
-    therm["standard_errors"] = [_number(v) for v in therm["standard_errors"]]
-    therm["rsquared"] = _number(therm["rsquared"])
-    if "residual_std_hz" in therm:
-        therm["residual_std_hz"] = _number(therm["residual_std_hz"])
-    if therm.get("scaled_covariance") is not None:
-        therm["scaled_covariance"] = [[_number(v) for v in row]
-                                      for row in therm["scaled_covariance"]]
-    for key in ("drift", "housing"):
-        drift = data.get(key)
-        if drift is None:
-            continue
-        for name in ("standard_errors", "pvalues"):
-            drift[name] = {k: _number(v) for k, v in drift[name].items()}
-        for name in ("residual_std_dph", "rsquared", "variance_inflation"):
-            if name in drift:
-                drift[name] = _number(drift[name])
-        drift["stepwise"] = _numbers_in(drift["stepwise"])
-
-
-def _numbers_in(value: Any) -> Any:
-    if isinstance(value, dict):
-        return {k: _numbers_in(v) for k, v in value.items()}
-    if isinstance(value, list):
-        return [_numbers_in(v) for v in value]
-    if value in ("NaN", "Infinity", "-Infinity"):
-        return _number(value)
-    return value
 
 
 def strict(value: Any) -> Any:
@@ -492,7 +364,7 @@ def _check_scale_bounds(sf: Mapping[str, Any], where: str, source: str) -> None:
 
 
 def check_document(data: Any, source: str, non_standard: bool = False) -> dict[str, Any]:
-    """Validate a parsed model file; return it with statistics as floats, coefficients derived.
+    """Validate a parsed model file; return a copy with the coefficients derived.
 
     Parameters
     ----------
@@ -520,7 +392,8 @@ def check_document(data: Any, source: str, non_standard: bool = False) -> dict[s
             f"{source}: model file was changed after it was written (its content no longer "
             "matches its parameters_sha256): damaged or edited; recreate it with 'hrgtc "
             "calibrate' (after a deliberate edit, delete the parameters_sha256 line)")
-    restored = restore_statistics(data)
+    # a copy; the statistics ("NaN", null) are read as floats by the parts' records
+    restored = json.loads(json.dumps(data))
     kept = axis_parts(restored)
     for axis, part in axis_parts(data).items():
         at = f"axes.{axis}." if axis else ""

@@ -196,7 +196,7 @@ def test_gaps_option_on_every_command_that_reads(files, tmp_path, model):
     assert code == 0 and json.loads(stdout)["rows"] == len(run)
     out = read(tmp_path / "a.parquet", gaps="ignore")
     # split: the df/dt filter restarts after the gap, as for two runs
-    second = Compensator(model).process(read(gapped, gaps="ignore").slice(1500, len(run)))
+    second = Compensator(model).transform(read(gapped, gaps="ignore").slice(1500, len(run)))
     np.testing.assert_allclose(out.slice(1500, len(run))["bias_model_dph"],
                                second["bias_model_dph"], rtol=0, atol=1e-9)
     assert compensate(gapped, model_path, tmp_path / "b.parquet", "--gaps", "ignore")[0] == 0

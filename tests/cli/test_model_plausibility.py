@@ -218,7 +218,7 @@ def test_axes_says_which_to_compensate(axis_files, tmp_path):
                              "--axes", "z")
     assert code == 0, stderr
     out = read(tmp_path / "z.parquet")
-    expected = Compensator(make_model()).process(make_run(rows=3000))
+    expected = Compensator(make_model()).transform(make_run(rows=3000))
     np_equal = (out["rate_comp_dph_z"] == expected["rate_comp_dph"]).all()
     assert np_equal and "rate_comp_dph_x" not in out
     code, _, stderr = invoke("evaluate", xyz, "-m", single, "--axes", "y", "--json")

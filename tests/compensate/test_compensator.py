@@ -40,7 +40,7 @@ def test_any_chunking_equals_batch(unit_model, run, cuts):
     batch = compensate(run, unit_model)
     compensator = Compensator(unit_model)
     bounds = [0, *sorted(cuts), len(run)]
-    parts = [compensator.process(run.slice(a, b)) for a, b in itertools.pairwise(bounds)]
+    parts = [compensator.transform(run.slice(a, b)) for a, b in itertools.pairwise(bounds)]
     streamed = concatenate(parts)
     for name in ("rate_comp_dph", "bias_model_dph", "resonator_c_est", "in_range"):
         np.testing.assert_allclose(streamed[name], batch[name], rtol=0, atol=1e-12)
@@ -57,7 +57,7 @@ def test_compensated_is_raw_minus_model(unit_model, run):
 def test_out_of_range_samples_are_counted(unit_model):
     hot = ramp_run(seed=23, start_c=20.0, end_c=60.0, hours=1.0)
     compensator = Compensator(unit_model)
-    out = compensator.process(hot)
+    out = compensator.transform(hot)
     assert compensator.out_of_range_fraction > 0.2
     assert compensator.settling == round(unit_model.drift.settings.warmup_s * hot.sample_rate_hz)
     # in_range is 0 beyond the trained temperature, beyond the trained df/dt, and while
@@ -76,7 +76,7 @@ def test_range_report_says_how_far_df_dt_went(unit_model, engine):
     """A warm-up at 4x the training rate: in_range 0 there, the ratio of rates reported."""
     fast = ramp_run(seed=24, start_c=0.0, end_c=10.0, hours=1.0, ramp_hours=0.1)
     compensator = Compensator(unit_model, engine=engine)
-    out = compensator.process(fast)
+    out = compensator.transform(fast)
     report = compensator.ranges()
     assert report.rate_fraction > 0.0
     assert report.rate_excess_ratio > 1.0
@@ -91,11 +91,11 @@ def test_samples_beyond_the_df_range_are_never_in_range(unit_model, engine):
     # on a cool-down); those samples are extrapolated and must not be flagged in range
     fast = ramp_run(seed=29, start_c=-10.0, end_c=15.0, hours=0.5)
     compensator = Compensator(unit_model, engine=engine)
-    out = compensator.process(fast)
+    out = compensator.transform(fast)
     low, high = unit_model.drift.ranges["df"]
     from hrgtc.drift.features import FeatureStream
 
-    values = FeatureStream(unit_model.drift.settings, ("f", "df")).process(fast)
+    values = FeatureStream(unit_model.drift.settings, ("f", "df")).transform(fast)
     beyond = (values["df"] < low) | (values["df"] > high)
     assert beyond.mean() > 0.5
     assert compensator.rate_out_of_range == int(beyond.sum())
@@ -119,7 +119,7 @@ def housing_run(seed, **kwargs):
 
 def assert_engines_agree(model, recording, drift_kind="frequency", temperature_atol=1e-12):
     fused, numpy_ = Compensator(model, drift_kind), Compensator(model, drift_kind, "numpy")
-    a, b = fused.process(recording), numpy_.process(recording)
+    a, b = fused.transform(recording), numpy_.transform(recording)
     for name in ("rate_comp_dph", "bias_model_dph"):
         np.testing.assert_allclose(a[name], b[name], rtol=0, atol=1e-9)
     np.testing.assert_allclose(a["resonator_c_est"], b["resonator_c_est"], rtol=0,
@@ -180,7 +180,7 @@ def test_fused_streaming_is_exact_across_any_chunk_boundaries(unit_model, hot_ho
     batch = compensate(hot_housing_run, model)
     compensator = Compensator(model)
     bounds = [0, *sorted(cuts), len(hot_housing_run)]
-    streamed = concatenate([compensator.process(hot_housing_run.slice(a, b))
+    streamed = concatenate([compensator.transform(hot_housing_run.slice(a, b))
                             for a, b in itertools.pairwise(bounds)])
     for name in ("rate_comp_dph", "bias_model_dph", "resonator_c_est", "in_range"):
         np.testing.assert_array_equal(streamed[name], batch[name])
@@ -197,7 +197,7 @@ def test_fused_slow_path_of_the_thermometer(unit_model, run):
     strict = plan.thermometer.copy()
     strict[10:12] = 0.0  # one_step_limit, tolerance
     compensator._plan = dataclasses.replace(plan, thermometer=strict)
-    out = compensator.process(run.slice(0, 2000))
+    out = compensator.transform(run.slice(0, 2000))
     np.testing.assert_allclose(out["resonator_c_est"],
                                THERMOMETER.temperature(run.freq_hz[:2000], warn=False),
                                rtol=0, atol=1e-11)
@@ -256,7 +256,7 @@ def test_fused_gradient_chunked_equals_batch(gradient_model, steep_gradient_run,
     batch = compensate(steep_gradient_run, gradient_model)
     compensator = Compensator(gradient_model)
     bounds = [0, *sorted(cuts), len(steep_gradient_run)]
-    streamed = concatenate([compensator.process(steep_gradient_run.slice(a, b))
+    streamed = concatenate([compensator.transform(steep_gradient_run.slice(a, b))
                             for a, b in itertools.pairwise(bounds)])
     for name in OUTPUT_COLUMNS:
         np.testing.assert_array_equal(streamed[name], batch[name])
@@ -285,7 +285,7 @@ def test_fused_gradient_through_the_slow_path_of_the_thermometer(gradient_model,
     strict[10:12] = 0.0  # one_step_limit, tolerance
     compensator._plan = dataclasses.replace(plan, thermometer=strict)
     part = steep_gradient_run.slice(0, 3000)
-    out = compensator.process(part)
+    out = compensator.transform(part)
     reference = compensate(part, gradient_model, engine="numpy")
     np.testing.assert_allclose(out["resonator_c_est"], reference["resonator_c_est"],
                                rtol=0, atol=1e-11)
@@ -318,7 +318,7 @@ def test_file_to_file_equals_batch_and_leaves_no_temporary(unit_model, run, tmp_
     for name in written.names:
         np.testing.assert_array_equal(written[name], batch[name])
     compensator = Compensator(unit_model)
-    compensator.process(run)
+    compensator.transform(run)
     assert (summary.rows, summary.out_of_range_fraction, summary.rate_out_of_range_fraction) == (
         len(run), compensator.out_of_range_fraction, compensator.rate_out_of_range_fraction)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out.parquet", "run.parquet"]
@@ -352,10 +352,10 @@ def test_two_threads_give_the_bits_of_one_call(unit_model, monkeypatch):
                                      scales={"f": 10.0, "df": 1e-3, "h": 20.0, "dh": 1e-2}))
     model = UnitModel(THERMOMETER, fitted)
     split = assert_engines_agree(model, long_run)
-    a = Compensator(model).process(long_run)
+    a = Compensator(model).transform(long_run)
     monkeypatch.setattr(kernel, "PARALLEL_ROWS", len(long_run) + 1)
     whole = Compensator(model)
-    b = whole.process(long_run)
+    b = whole.transform(long_run)
     for name in OUTPUT_COLUMNS:
         np.testing.assert_array_equal(a[name], b[name])
     assert (split.out_of_range, split.rate_out_of_range) == (whole.out_of_range,
@@ -382,7 +382,7 @@ def test_a_model_with_the_heating_switch_runs_on_numpy_in_both_engines(run):
     assert "dpos" in fitted.variables
     model = UnitModel(THERMOMETER, fitted)
     fused, numpy_engine = Compensator(model), Compensator(model, engine="numpy")
-    a, b = fused.process(run), numpy_engine.process(run)
+    a, b = fused.transform(run), numpy_engine.transform(run)
     assert fused._plan is None  # fell back: the kernel does not compute dpos
     for name in OUTPUT_COLUMNS:
         np.testing.assert_array_equal(a[name], b[name])
@@ -401,17 +401,17 @@ def test_models_with_d2_and_aux_run_on_numpy_in_both_engines():
     fused = assert_engines_agree(model, run)
     assert fused._plan is None  # it did fall back
     later = run.with_columns(time_s=run.time_s + run.time_s[-1] + run.time_s[1])
-    out = fused.process(later)  # a second chunk, one step later: filter states carried
+    out = fused.transform(later)  # a second chunk, one step later: filter states carried
     assert np.all(np.isfinite(out["rate_comp_dph"]))
     # the drift model explains the gradient and the drive: the residual is the white noise
-    truth = Compensator(model, engine="numpy").process(run)
+    truth = Compensator(model, engine="numpy").transform(run)
     skip = 6000
     err = truth["bias_model_dph"][skip:] - run["bias_dph"][skip:]
     assert np.sqrt(np.mean(err ** 2)) < 0.5
     without = recording_io.Recording({k: run[k] for k in run.names if k != "drive_v"},
                                       run.metadata, "held-out.parquet")
     with pytest.raises(InputError, match=r"held-out\.parquet: no column 'drive_v'"):
-        Compensator(model).process(without)
+        Compensator(model).transform(without)
 
 
 @pytest.mark.filterwarnings("ignore::hrgtc.core.errors.RateFilterWarning")  # tau 10 s, gap 600 s
@@ -425,10 +425,10 @@ def test_a_gap_exactly_on_a_chunk_boundary(unit_model, run, engine):
     times[gap_row:] += 600.0  # the logger slept 10 min
     gapped = run.with_columns(time_s=times)
     for gaps in ("split", "ignore"):
-        batch = Compensator(unit_model, engine=engine, gaps=gaps).process(gapped)
+        batch = Compensator(unit_model, engine=engine, gaps=gaps).transform(gapped)
         streaming = Compensator(unit_model, engine=engine, gaps=gaps)
-        parts = [streaming.process(gapped.slice(0, gap_row)),
-                 streaming.process(gapped.slice(gap_row, len(gapped)))]
+        parts = [streaming.transform(gapped.slice(0, gap_row)),
+                 streaming.transform(gapped.slice(gap_row, len(gapped)))]
         for name in OUTPUT_COLUMNS:
             np.testing.assert_array_equal(np.concatenate([p[name] for p in parts]), batch[name])
         if gaps == "split":
@@ -450,7 +450,7 @@ def test_a_step_of_exactly_two_periods_is_not_a_gap(unit_model, run):
     times[5000:] += 1.0 / run.sample_rate_hz * (1.0 + 1e-9)
     dropped = run.with_columns(time_s=times)
     compensator = Compensator(unit_model, gaps="split")
-    compensator.process(dropped)
+    compensator.transform(dropped)
     assert compensator.segments == 1
 
 
@@ -462,7 +462,7 @@ def test_the_seen_f_and_df_extremes_are_those_of_the_variables(unit_model, run, 
 
     values = compute_variables(run, unit_model.drift.settings, ("f", "df"))
     compensator = Compensator(unit_model, engine=engine)
-    compensator.process(run.slice(0, 12_345))
-    compensator.process(run.slice(12_345, len(run)))
+    compensator.transform(run.slice(0, 12_345))
+    compensator.transform(run.slice(12_345, len(run)))
     expected = [values["f"].min(), values["f"].max(), values["df"].min(), values["df"].max()]
     np.testing.assert_allclose(compensator._extremes, expected, rtol=1e-12, atol=1e-15)

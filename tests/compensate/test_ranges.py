@@ -49,10 +49,10 @@ def hot_housing(model, hours=1.5):
 def test_the_gradient_beyond_its_range_is_not_called_a_temperature(gradient_model, engine):
     run = hot_housing(gradient_model)
     compensator = Compensator(gradient_model, engine=engine)
-    compensator.process(run)
+    compensator.transform(run)
     report = compensator.ranges()
     # the truth: g recomputed, and the resonator temperature well inside the calibration
-    g = FeatureStream(gradient_model.drift.settings, ("g",), THERMOMETER).process(run)["g"]
+    g = FeatureStream(gradient_model.drift.settings, ("g",), THERMOMETER).transform(run)["g"]
     low, high = gradient_model.drift.ranges["g"]
     beyond = int(np.count_nonzero((g < low) | (g > high)))
     assert beyond > 0.5 * len(run)
@@ -85,8 +85,8 @@ def test_the_engines_count_every_variable_alike(gradient_model, hours):
     a, b = Compensator(gradient_model, engine="fused"), Compensator(gradient_model,
                                                                     engine="numpy")
     for c in (a, b):
-        c.process(run.slice(0, 20_000))
-        c.process(run.slice(20_000, len(run)))
+        c.transform(run.slice(0, 20_000))
+        c.transform(run.slice(20_000, len(run)))
     assert a._plan is not None  # the kernel did run
     assert a.temperature_out == b.temperature_out
     for name, (outside, low, high) in b.variable_ranges.items():
@@ -108,7 +108,7 @@ def test_rates_in_degrees_per_hour_are_the_simulated_ones(unit_model):
     assert trained_high < 1.0
     fast = ramp_run(seed=24, start_c=0.0, end_c=10.0, hours=1.0, ramp_hours=0.1)
     compensator = Compensator(unit_model)
-    compensator.process(fast)
+    compensator.transform(fast)
     seen = compensator.ranges().seen_rate_c_per_h
     true = np.gradient(fast["resonator_c"], fast.time_s) * 3600.0
     assert seen[1] == pytest.approx(true.max(), rel=0.15)  # the filter lags and smooths a bit
@@ -147,6 +147,6 @@ def test_samples_at_the_lower_calibration_edge_are_flagged_in_range(unit_model, 
                          "freq_hz": np.full(rows, freq), "rate_dph": np.zeros(rows)},
                         Metadata(sample_rate_hz=settings.sample_rate_hz))
         compensator = Compensator(wide, engine=engine)
-        out = compensator.process(run)
+        out = compensator.transform(run)
         assert (out["in_range"][-100:] == expected).all(), (freq, expected)
         assert compensator.temperature_out == (0 if expected else rows)

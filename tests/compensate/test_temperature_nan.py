@@ -27,7 +27,7 @@ def test_nan_temperature_estimate_warns_once_and_is_counted(engine):
     compensator = Compensator(model, engine=engine)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        parts = [compensator.process(hot.slice(a, a + 9000)) for a in range(0, len(hot), 9000)]
+        parts = [compensator.transform(hot.slice(a, a + 9000)) for a in range(0, len(hot), 9000)]
     estimate = np.concatenate([p["resonator_c_est"] for p in parts])
     nan = np.isnan(estimate)
     assert nan.any() and compensator.temperature_nan == int(nan.sum())

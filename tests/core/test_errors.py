@@ -72,7 +72,7 @@ def test_a_sample_of_real_errors_has_no_numpy_repr():
     compensator = InstrumentCompensator(InstrumentModel({"x": make_model()}),
                                         bands_hz={"x": (4000.0, 5000.0)})
     with pytest.raises(HrgtcError) as raised:
-        compensator.process(Recording(columns, run.metadata))
+        compensator.transform(Recording(columns, run.metadata))
     messages.append(str(raised.value))
     for message in messages:
         assert "np." not in message, message

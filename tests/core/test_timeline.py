@@ -56,7 +56,7 @@ def test_the_builder_chunk_by_chunk_gives_the_whole_timeline():
     for size in (1, 7, 250, 251, 1000):
         builder = TimelineBuilder(0.02)
         for first in range(0, time.size, size):
-            builder.update(time[first:first + size])
+            builder.partial_fit(time[first:first + size])
         built = builder.timeline()
         np.testing.assert_array_equal(built.bounds, whole.bounds)
         np.testing.assert_array_equal(built.start_s, whole.start_s)

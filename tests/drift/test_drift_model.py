@@ -182,4 +182,4 @@ def test_heating_switch_dpos_carries_a_heating_only_rate_term(cooldown):
     assert errors[0] < 0.7 * errors[1]
     assert heating_part(np.array([-5.0 * delta]), delta)[0] == pytest.approx(0.0, abs=1e-3 * delta)
     with pytest.raises(InputError, match="switch_hz_per_s"):
-        drift.features.FeatureStream(plain.settings, ("f", "dpos")).process(cooldown)
+        drift.features.FeatureStream(plain.settings, ("f", "dpos")).transform(cooldown)

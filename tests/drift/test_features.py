@@ -92,7 +92,7 @@ def test_chunked_stream_equals_batch(cuts):
     batch = compute_variables(rec, s, ("f", "df", "h", "dh"))
     stream = FeatureStream(s, ("f", "df", "h", "dh"))
     bounds = [0, *sorted(cuts), n]
-    parts = [stream.process(rec.slice(a, b)) for a, b in itertools.pairwise(bounds)]
+    parts = [stream.transform(rec.slice(a, b)) for a, b in itertools.pairwise(bounds)]
     for v in batch:
         np.testing.assert_allclose(np.concatenate([p[v] for p in parts]), batch[v],
                                    rtol=1e-12, atol=1e-15)

@@ -178,7 +178,7 @@ def test_compensation_applies_known_orientations_and_reports_an_unknown_one():
     model = UnitModel(thermometer=THERMOMETER, unit="mems",
                       drift=quiet_fit([run], THERMOMETER, terms=("f", "f^2", "df")))
     later, _ = mems_run(7, orientations=orientations)
-    out = Compensator(model).process(later)
+    out = Compensator(model).transform(later)
     residual = out["bias_model_dph"] - later["bias_dph"]
     parts = np.array_split(residual[600:], 3)  # after the df/dt filter settles
     for part, offset in zip(parts, orientations[0], strict=True):
@@ -187,7 +187,7 @@ def test_compensation_applies_known_orientations_and_reports_an_unknown_one():
     turned, _ = mems_run(8, orientations=([0.0], [[0, 1, 0]]))
     compensator = Compensator(model)
     with pytest.warns(HrgtcWarning, match="never seen in training"):
-        compensator.process(turned)
+        compensator.transform(turned)
     assert compensator.unknown_orientation == len(turned)
 
 
@@ -238,12 +238,12 @@ def test_user_orientation_labels_give_an_offset_each_like_an_hrg_turned_on_its_t
     from hrgtc.model import UnitModel
 
     unit = UnitModel(thermometer=THERMOMETER, drift=model, unit="hrg")
-    out = Compensator(unit).process(run)
+    out = Compensator(unit).transform(run)
     step = out["rate_comp_dph"][label == 2.0].mean() - out["rate_comp_dph"][label == 1.0].mean()
     assert abs(step) < 0.2  # the 12 °/h step is taken out
     relabelled = Recording({**run.columns, "orientation": np.full(len(run), 3.0)},
                            run.metadata, run.source)
     compensator = Compensator(unit)
     with pytest.warns(UserWarning, match="never seen in training"):
-        compensator.process(relabelled)
+        compensator.transform(relabelled)
     assert compensator.unknown_orientation == len(run)

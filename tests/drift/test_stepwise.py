@@ -174,7 +174,7 @@ def test_chunked_and_merged_accumulation_equal_one_shot():
     assert merged.n_ == 1000
     chunked = GramAccumulator()
     for rows in np.array_split(np.arange(1000), 13):
-        chunked.update(X[rows], y[rows])
+        chunked.partial_fit(X[rows], y[rows])
     for acc in (merged, chunked):
         res = ols_from_accumulator(acc)
         np.testing.assert_allclose(res.params, one.params, rtol=1e-12)

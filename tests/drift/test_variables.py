@@ -83,7 +83,7 @@ def held_out():
 
 
 def reference(model):
-    return Compensator(model, engine="numpy").process(held_out())
+    return Compensator(model, engine="numpy").transform(held_out())
 
 
 # -- the list itself --------------------------------------------------------------------
@@ -155,7 +155,7 @@ def test_the_numba_kernel_computes_or_hands_over_to_numpy(name):
     model = model_using(name)
     expected = reference(model)
     fused = Compensator(model, engine="fused")
-    got = fused.process(held_out())
+    got = fused.transform(held_out())
     # the kernel ran exactly when the list says it computes the variable
     assert (fused._plan is not None) == variable(name).supports("numba")
     np.testing.assert_allclose(got["bias_model_dph"], expected["bias_model_dph"], rtol=1e-9,

@@ -80,10 +80,10 @@ def test_chunking_does_not_change_the_split(model):
     run = cycle_run(seed=4)
     whole, parts = DirectionSplit(model, FS), DirectionSplit(model, FS)
     comp = run.rate_dph - model.drift.predict_recording(run)
-    whole.push(run, run.rate_dph, comp)
+    whole.partial_fit(run, run.rate_dph, comp)
     for start in range(0, len(run), 7777):
         stop = min(start + 7777, len(run))
-        parts.push(run.slice(start, stop), run.rate_dph[start:stop], comp[start:stop])
+        parts.partial_fit(run.slice(start, stop), run.rate_dph[start:stop], comp[start:stop])
     a, b = whole.result(), parts.result()
     assert a.blocks == b.blocks and a.residual_rms_dph is None
     for d in ("heating", "cooling"):

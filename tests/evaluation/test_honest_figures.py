@@ -35,7 +35,7 @@ def test_a_constant_offset_shows_in_the_mean_not_in_the_bias_stability(model):
     assert moved.mean_dph["compensated"] - plain.mean_dph["compensated"] == \
         pytest.approx(136.0, rel=1e-9)
     # the figures are those of the compensated output after the filter settles, by numpy
-    out = Compensator(model).process(shifted)
+    out = Compensator(model).transform(shifted)
     comp = (out["rate_comp_dph"] - run.metadata.input_rate_dph)[settle_rows(model.drift.settings):]
     assert moved.mean_dph["compensated"] == pytest.approx(float(np.mean(comp)), rel=1e-9)
     assert moved.rms_dph["compensated"] == pytest.approx(float(np.sqrt(np.mean(comp ** 2))),

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 
 import numpy as np
 import pytest
@@ -41,6 +42,23 @@ def test_evaluation_against_metrics_by_hand(setup):
     assert result.residual_rms_dph == pytest.approx(truth, rel=1e-12)
     assert result.improvement_10s == pytest.approx(result.raw_10s / result.compensated_10s)
     assert set(result.bias_stability_dph) == {"raw", "compensated", "housing"}
+
+
+def test_figures_carry_the_runs_numbers_with_units_and_intervals(setup):
+    """The structured summary holds the same bias stabilities, intervals and levels as
+    the result's fields, and its text carries them."""
+    files, model, _ = setup
+    result = evaluate(files.warmup, model)
+    figures = result.figures()
+    for series, row in result.bias_stability_dph.items():
+        for tau_s, value in row.items():
+            figure = figures[f"evaluation.bias_stability_dph.{series}.{tau_s:g}"]
+            assert (figure.unit, figure.interval) == (
+                "°/h", result.stability_interval(series, tau_s))
+            assert figure.value == value or (math.isnan(figure.value) and math.isnan(value))
+        assert figures[f"evaluation.rms_dph.{series}"].value == result.rms_dph[series]
+    assert figures["evaluation.residual_rms_dph"].value == result.residual_rms_dph
+    assert f"improvement at 10 s: {result.improvement_10s:.3g} ×" in figures.text()
 
 
 def test_evaluate_command_json_layout(setup):

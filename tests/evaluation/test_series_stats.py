@@ -26,7 +26,7 @@ def _feed(values, stats, seed=0):
     start = 0
     while start < values.size:
         stop = min(values.size, start + int(rng.integers(1, 40_000)))
-        stats.push(values[start:stop])
+        stats.partial_fit(values[start:stop])
         start = stop
     return stats
 
@@ -74,7 +74,7 @@ def test_memory_is_bounded_by_the_cap_not_the_length():
     tracemalloc.start()
     try:
         for _ in range(32):
-            stats.push(rng.normal(0.0, 2.0, 1 << 17))
+            stats.partial_fit(rng.normal(0.0, 2.0, 1 << 17))
         stats.allan_deviation()
         _, peak = tracemalloc.get_traced_memory()
     finally:

@@ -32,7 +32,7 @@ def test_tau_blocks_never_span_a_gap_and_allan_is_pooled_within_segments():
     parts = _segments()
     stats = SeriesStatistics(10.0, (1.0, 10.0), allan=True)
     for k, part in enumerate(parts):
-        stats.push(part, [0] if k else [])
+        stats.partial_fit(part, [0] if k else [])
     assert stats.segments == 3 and stats.longest_segment_s == pytest.approx(204.8)
     # full τ-blocks of each segment, and its partial last block when it holds at least
     # half τ less one sample (4 of 10: the tails 4, 7 and 8 all count)
@@ -57,7 +57,7 @@ def test_tau_blocks_never_span_a_gap_and_allan_is_pooled_within_segments():
 def test_breaks_inside_one_push_and_in_the_decimated_path():
     parts = _segments(1, sizes=(3000, 2500, 4000))
     one = SeriesStatistics(10.0, (1.0,), allan=True, full_samples=2048)
-    one.push(np.concatenate(parts), [3000, 5500])
+    one.partial_fit(np.concatenate(parts), [3000, 5500])
     fine = one.allan_deviation()
     for tau, dev, n in zip(fine.taus_s, fine.deviation, fine.counts, strict=True):
         expected, count = _manual_oadev(parts, round(tau * 10.0))
@@ -74,7 +74,7 @@ def test_bursts_shorter_than_tau_give_the_spread_of_their_burst_means():
     bursts.append(rng.normal(0.0, 1.0, 100) + 1000.0)  # 2 s: too short for τ = 10 s
     stats = SeriesStatistics(50.0, (10.0,), allan=False)
     for k, burst in enumerate(bursts):
-        stats.push(burst, [0] if k else [])
+        stats.partial_fit(burst, [0] if k else [])
     expected = np.std([b.mean() for b in bursts[:12]], ddof=1)
     assert stats.bias_stability()[10.0] == pytest.approx(expected, rel=1e-12)
     assert stats.partial_blocks()[10.0] == 12
@@ -89,7 +89,7 @@ def test_pooled_interval_uses_the_segments_edf_in_both_paths():
     for full in (1 << 22, 2048):  # samples held, and the exact running sums past the cap
         stats = SeriesStatistics(10.0, (1.0,), allan=True, full_samples=full)
         for k, part in enumerate(parts):
-            stats.push(part, [0] if k else [])
+            stats.partial_fit(part, [0] if k else [])
         curve = stats.allan_deviation(confidence=0.683)
         assert curve.segments == 3 and stats.segment_lengths() == lengths
         for tau, edf, low, dev, high in zip(curve.taus_s, curve.edf, curve.lower,
@@ -110,7 +110,7 @@ def test_burst_means_beyond_a_segment_from_pushed_times():
     rng = np.random.default_rng(12)
     stats = SeriesStatistics(50.0, (10.0,), allan=True)
     for k in range(300):
-        stats.push(rng.normal(size=250) + 3.0, [0] if k else [],
+        stats.partial_fit(rng.normal(size=250) + 3.0, [0] if k else [],
                    time_s=60.0 * k + np.arange(250) / 50.0)
     result = stats.burst_allan(confidence=0.99)
     assert result.dead_time_ratio == pytest.approx(12.0) and result.bursts == 300
@@ -121,6 +121,6 @@ def test_burst_means_beyond_a_segment_from_pushed_times():
     assert "r = 12" in lines[0] and "N = 299" in lines[1] and "random walk" in lines[1]
     assert stats.segment_starts() == [250 * k for k in range(1, 300)]
     one = SeriesStatistics(50.0, (10.0,), allan=True)
-    one.push(rng.normal(size=500))
+    one.partial_fit(rng.normal(size=500))
     with pytest.raises(InputError, match="one contiguous segment"):
         one.burst_allan(0.683)

@@ -92,7 +92,7 @@ def test_double_build_divides_by_the_scale_factor(model, tmp_path):
     beyond = (recording.freq_hz < low) | (recording.freq_hz > high)
     assert 0.05 < beyond.mean() < 0.95  # the tangent continuation is exercised
     np.testing.assert_allclose(out[:, 2], k, rtol=0, atol=1e-9)
-    compensated = Compensator(model).process(recording)
+    compensated = Compensator(model).transform(recording)
     bias = compensated["bias_model_dph"]
     np.testing.assert_allclose(out[:, 1], bias, rtol=0, atol=1e-9)
     expected = (recording.rate_dph - bias) / (1.0 + 1e-6 * k)

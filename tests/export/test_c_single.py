@@ -229,7 +229,7 @@ def test_float_build_streams_like_the_double_compensator(kind, models, tmp_path)
         columns.append(recording["housing_c"].astype(F32))
     out, counters = run_driver(exe, "run", columns, tmp_path, 8)
     compensator = Compensator(model)
-    expected = compensator.process(recording)
+    expected = compensator.transform(recording)
 
     # the mirror, step by step: the filter, then the bias and the thermometer
     plan = plan_for(model, "single")

@@ -192,7 +192,7 @@ def test_c_matches_the_python_compensator(kind, request, tmp_path):
         exe = request.getfixturevalue("frequency_driver")
         inputs = [recording.freq_hz, recording.rate_dph]
     compensator = Compensator(model)
-    expected = compensator.process(recording)
+    expected = compensator.transform(recording)
     out, counters = run_driver(exe, inputs, tmp_path, "run", recording.time_s)
 
     assert out.shape[0] == len(recording)
@@ -228,7 +228,7 @@ def test_edge_models_compile_cleanly_and_agree(selected, housing_model, tmp_path
     if model.drift.variables != ("f",):
         columns.append(recording["housing_c"])
     compensator = Compensator(model)
-    expected = compensator.process(recording)
+    expected = compensator.transform(recording)
     out, counters = run_driver(build(model, tmp_path, "edge"), columns, tmp_path, "run",
                                recording.time_s)
     assert counters == [compensator.samples, compensator.out_of_range,
@@ -359,7 +359,7 @@ def test_c_computes_d2_g_and_the_extra_channel_as_python_does(tmp_path):
     inputs = [recording.freq_hz, recording.rate_dph, recording["housing_c"],
               recording["drive_v"]]
     compensator = Compensator(model)
-    expected = compensator.process(recording)
+    expected = compensator.transform(recording)
     out, counters = run_driver(exe, inputs, tmp_path, "run", recording.time_s)
     assert counters == [compensator.samples, compensator.out_of_range,
                         compensator.rate_out_of_range]
@@ -393,7 +393,7 @@ def test_c_on_bursts_bridges_each_gap_with_its_dt(tmp_path):
     out, _ = run_driver(exe, [bursts.freq_hz, bursts.rate_dph], tmp_path, "run",
                         bursts.time_s)
     compensator = Compensator(model)
-    expected = compensator.process(bursts)
+    expected = compensator.transform(bursts)
     np.testing.assert_allclose(out[:, 1], expected["bias_model_dph"], rtol=0, atol=1e-9)
     np.testing.assert_allclose(out[:, 0], expected["rate_comp_dph"], rtol=0, atol=1e-9)
     np.testing.assert_array_equal(out[:, 3] * out[:, 7], expected["in_range"])

@@ -75,7 +75,7 @@ def runs():
 
 def expected_rate(model, recording):
     """The axis's Compensator, which is the contract's (rate - B) / (1 + 1e-6 k)."""
-    out = Compensator(model).process(recording)
+    out = Compensator(model).transform(recording)
     sf = model.scale_factor
     k = 0.0 if sf is None else sf.ppm(recording.freq_hz)
     np.testing.assert_allclose(out["rate_comp_dph"],

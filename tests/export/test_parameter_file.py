@@ -141,7 +141,7 @@ def test_parameters_evaluated_by_hand_equal_the_compensator(kind, tmp_path):
     assert p["n_terms"] == len(fitted.selected)
     assert [p[f"term_{k}"] for k in range(1, len(fitted.selected) + 1)] == list(fitted.selected)
 
-    expected = Compensator(model).process(recording)
+    expected = Compensator(model).transform(recording)
     values = {"f": recording.freq_hz - p["reference_freq_hz"]}
     values["df"] = rate_of(values["f"], p, recording.time_s)
     if kind == "housing":
@@ -217,7 +217,7 @@ def test_parameters_with_a_scale_factor(tmp_path):
     values = {"f": recording.freq_hz - p["reference_freq_hz"]}
     values["df"] = rate_of(values["f"], p, recording.time_s)
     bias = bias_from(p, values)
-    expected_bias = Compensator(model).process(recording)["bias_model_dph"]
+    expected_bias = Compensator(model).transform(recording)["bias_model_dph"]
     np.testing.assert_allclose(bias, expected_bias, rtol=1e-12, atol=1e-12 * 100)
     # the contract's law, from the library's own pieces
     np.testing.assert_allclose((recording.rate_dph - bias) / (1 + 1e-6 * k),

@@ -85,6 +85,37 @@ def test_housing_baseline_is_kept(calibrated):
     assert result.model.housing.selected[0] == "h"
 
 
+def test_summary_gives_each_figure_its_value_unit_and_interval(calibrated):
+    """The structured summary carries the model's own numbers, ±1σ from the standard
+    errors, the bias stabilities with their intervals; all three renderings show them."""
+    _, _, result = calibrated
+    summary = result.summary()
+    model, (validation,) = result.model, result.validation
+    c1 = summary["thermometer.coefficients[1]"]
+    se = model.thermometer.standard_errors[1]
+    assert c1.value == model.thermometer.coefficients[1] and c1.unit == "Hz/°C^1"
+    assert c1.interval == pytest.approx((c1.value - se, c1.value + se), rel=1e-12)
+    for term in model.drift.selected:
+        k = summary[f"drift.coefficients.{term}"]
+        assert k.value == model.drift.coefficients[term]
+        assert k.interval[1] - k.interval[0] == pytest.approx(
+            2 * model.drift.standard_errors[term], rel=1e-9)
+        assert summary[f"drift.pvalues.{term}"].value == model.drift.pvalues[term]
+    stability = summary["validation[0].bias_stability_dph.compensated.10"]
+    assert (stability.value, stability.unit) == (validation.compensated_10s, "°/h")
+    assert stability.interval == validation.stability_interval("compensated", 10.0)
+    assert stability.interval[0] < stability.value < stability.interval[1]
+    low, high = model.thermometer.temperature_range_c
+    assert summary["thermometer.temperature_range_c"].interval == (low, high)
+    text, rows, page = summary.text(), summary.rows(), summary.html()
+    assert f"{validation.compensated_10s:.4g} °/h" in text
+    assert ("drift model (Eq. 22)", "B0", f"{model.drift.intercept_dph:.6g}", "°/h") == (
+        rows[[r[1] for r in rows].index("B0")][:4])
+    assert f"<td>{model.drift.intercept_dph:.6g}</td>" in page
+    assert json.loads(json.dumps(summary.to_dict(), allow_nan=False))["title"] == (
+        f"calibration of {model.unit}")
+
+
 def test_validation_of_the_training_run_is_the_papers_shape(calibrated):
     unit, files, result = calibrated
     run = evaluate(files.cooldown, result.model)

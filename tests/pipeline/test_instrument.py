@@ -80,10 +80,10 @@ def test_scale_factor_model_against_the_simulators_truth(calibration, imu_campai
 
 def test_instrument_compensator_equals_each_axis_alone(calibration, imu_campaign):
     run = read(imu_campaign.warmup)
-    together = InstrumentCompensator(calibration.model).process(run)
+    together = InstrumentCompensator(calibration.model).transform(run)
     for axis in AXES:
         unit = calibration.model.axes[axis]
-        alone = Compensator(unit).process(axis_view(run, axis))
+        alone = Compensator(unit).transform(axis_view(run, axis))
         for name in ("rate_comp_dph", "bias_model_dph", "resonator_c_est", "in_range",
                      "scale_model_ppm"):
             np.testing.assert_array_equal(together[f"{name}_{axis}"], alone[name])
@@ -99,7 +99,7 @@ def test_file_to_file_in_chunks_equals_batch(calibration, imu_campaign, tmp_path
     summary = compensate_instrument_file(imu_campaign.warmup, output, calibration.model,
                                          chunk_rows=7_001)
     written = read(output)
-    batch = InstrumentCompensator(calibration.model).process(read(imu_campaign.warmup))
+    batch = InstrumentCompensator(calibration.model).transform(read(imu_campaign.warmup))
     assert summary.rows == len(batch)
     for name in batch.names:
         np.testing.assert_array_equal(written[name], batch[name])
@@ -108,7 +108,7 @@ def test_file_to_file_in_chunks_equals_batch(calibration, imu_campaign, tmp_path
 def test_a_single_axis_file_is_refused_by_a_three_axis_model(calibration, campaign_factory):
     single = campaign_factory("paper-unit", sample_rate_hz=2.0)
     with pytest.raises(RecordingError, match="no columns of axis x, y, z"):
-        InstrumentCompensator(calibration.model).process(read(single.warmup))
+        InstrumentCompensator(calibration.model).transform(read(single.warmup))
 
 
 def test_model_file_round_trip_and_checks(calibration, tmp_path):
@@ -185,8 +185,8 @@ def test_an_axis_model_reads_another_axis_frequency(imu_campaign):
     assert any("a_fy" in t for t in result.model.drift.selected)
     run = read(files.warmup)
     view = axis_view(run, "x")
-    fused = Compensator(result.model).process(view)
-    reference = Compensator(result.model, engine="numpy").process(view)
+    fused = Compensator(result.model).transform(view)
+    reference = Compensator(result.model, engine="numpy").transform(view)
     np.testing.assert_allclose(fused["rate_comp_dph"], reference["rate_comp_dph"], atol=1e-9)
     centre = result.model.drift.settings.aux_centres["fy"]
     assert abs(centre - np.mean(axis_view(read(files.cooldown), "y").freq_hz)) < 10.0

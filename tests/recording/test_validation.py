@@ -83,7 +83,7 @@ def test_the_sample_rate_check_by_block_end_times_equals_summing_every_step(star
     for size in (N, rows):
         validator = RecordingValidator()
         for first in range(0, N, size):
-            validator.update(whole.slice(first, min(first + size, N)))
+            validator.partial_fit(whole.slice(first, min(first + size, N)))
         found.append(validator._rate_change)
     if found[0] is None:
         assert found[1] is None

@@ -114,7 +114,7 @@ class Compensator:
     Examples
     --------
     >>> # comp = Compensator(load_model("unit.json"))
-    >>> # for chunk in iter_chunks("run.parquet"): out = comp.process(chunk)
+    >>> # for chunk in iter_chunks("run.parquet"): out = comp.transform(chunk)
     """
 
     def __init__(self, model: UnitModel, drift: str = "frequency", engine: str = "fused",
@@ -182,7 +182,7 @@ class Compensator:
         self._last_time = float(time[-1])
         return rows
 
-    def process(self, chunk: Recording) -> Recording:
+    def transform(self, chunk: Recording) -> Recording:
         """The next chunk of the run with the :data:`OUTPUT_COLUMNS` added.
 
         ``in_range`` is 1.0 where the frequency is inside the thermometer's calibrated
@@ -349,7 +349,7 @@ class Compensator:
     def _block(self, chunk: Recording, out: dict[str, np.ndarray], start: int,
                restart: np.ndarray | None = None) -> None:
         stop = start + len(chunk)
-        values = self._stream.process(chunk, restart)
+        values = self._stream.transform(chunk, restart)
         bias = self.drift.predict(values)
         thermometer = self.model.thermometer
         in_range = thermometer.in_range(chunk.freq_hz) & _in_training_range(
@@ -403,7 +403,7 @@ class Compensator:
 def compensate(recording: Recording, model: UnitModel, drift: str = "frequency",
                engine: str = "fused") -> Recording:
     """Batch compensation of a whole run: a new :class:`Compensator`, one chunk."""
-    return Compensator(model, drift, engine).process(recording)
+    return Compensator(model, drift, engine).transform(recording)
 
 
 @dataclass(frozen=True)
@@ -489,7 +489,7 @@ def compensate_file(
             pending = None
             chunk: Recording | None = first
             while chunk is not None:
-                result = compensator.process(chunk)
+                result = compensator.transform(chunk)
                 if SPIKE_COLUMN in chunk:
                     spikes += int(np.count_nonzero(chunk[SPIKE_COLUMN]))
                 if copies:

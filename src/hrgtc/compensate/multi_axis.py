@@ -74,10 +74,10 @@ class InstrumentCompensator:
         self.columns = instrument_output_columns(model)
         self._rows = 0
 
-    def process(self, chunk: Recording) -> Recording:
+    def transform(self, chunk: Recording) -> Recording:
         """The next chunk with every axis's output columns added."""
         if self.model.is_single_axis:
-            result = self.axes[""].process(chunk)
+            result = self.axes[""].transform(chunk)
             self._rows += len(chunk)
             return result
         found = axis_names(chunk.names)
@@ -101,7 +101,7 @@ class InstrumentCompensator:
         for axis, compensator in self.axes.items():
             view = axis_view(chunk, axis)
             self._check_band(axis, view)
-            result = compensator.process(view)
+            result = compensator.transform(view)
             for name in output_columns(compensator.model):
                 added[f"{name}_{axis}"] = result[name]
         self._rows += len(chunk)

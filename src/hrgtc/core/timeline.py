@@ -561,7 +561,7 @@ class TimelineBuilder:
         self._stop_s: list[np.ndarray] = []
         self._last: float | None = None
 
-    def update(self, time_s: np.ndarray) -> None:
+    def partial_fit(self, time_s: np.ndarray) -> None:
         """The next chunk's sample times. [s]"""
         time_s = np.asarray(time_s, dtype=np.float64)
         if not time_s.size:

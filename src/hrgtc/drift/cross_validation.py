@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from hrgtc.core import records
 from hrgtc.core.timeline import time_blocks
 from hrgtc.drift.regression import newey_west_inflation
 
@@ -63,22 +64,14 @@ class CrossValidation:
     score_dph: float
 
     def to_dict(self) -> dict[str, Any]:
-        def clean(v: float) -> float | None:
-            return v if math.isfinite(v) else None
-
-        return {"terms": list(self.terms), "per_run_dph": {k: clean(v) for k, v in
-                                                            self.per_run_dph.items()},
-                "heating_dph": clean(self.heating_dph), "cooling_dph": clean(self.cooling_dph),
-                "score_dph": clean(self.score_dph)}
+        """Plain JSON types (NaN -> null), as :class:`CrossValidationRecord`."""
+        return records.dump(self, CrossValidationRecord)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> CrossValidation:
-        def value(v: Any) -> float:
-            return math.nan if v is None else float(v)
-
-        per_run = {str(k): value(v) for k, v in data["per_run_dph"].items()}
-        return cls(tuple(data["terms"]), tuple(per_run), per_run, value(data["heating_dph"]),
-                   value(data["cooling_dph"]), value(data["score_dph"]))
+        """Inverse of :meth:`to_dict` (the sources are the keys of ``per_run_dph``)."""
+        values = records.load(data, CrossValidationRecord, "cross-validation")
+        return cls(sources=tuple(values["per_run_dph"]), **values)
 
     def summary(self) -> str:
         """The per-run table as text."""
@@ -91,6 +84,16 @@ class CrossValidation:
                      f"RMS over runs {self.score_dph:.4f}")
         return "\n".join(lines)
 
+
+
+class CrossValidationRecord(records.Record, kw_only=True):
+    """A :class:`CrossValidation` in a file (the drift model's ``cross_validation``)."""
+
+    terms: tuple[str, ...]
+    per_run_dph: dict[str, records.Statistic]
+    heating_dph: records.Statistic
+    cooling_dph: records.Statistic
+    score_dph: records.Statistic
 
 def _std(values: np.ndarray) -> float:
     return float(np.std(values, ddof=1)) if values.size > 2 else math.nan

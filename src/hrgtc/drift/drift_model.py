@@ -27,15 +27,18 @@ import dataclasses
 import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Annotated, Any, Literal
 
 import numpy as np
+from msgspec import Meta
 
+from hrgtc.core import records
 from hrgtc.core.accounting import Accounting
 from hrgtc.core.errors import CalibrationError, InputError
 from hrgtc.core.progress import Progress
 from hrgtc.drift.cross_validation import (
     CrossValidation,
+    CrossValidationRecord,
     cross_validate,
     guard_selection,
     select_terms,
@@ -46,9 +49,11 @@ from hrgtc.drift.features import (
     EQ21,
     SWITCH_FRACTION,
     FeatureSettings,
+    FeatureSettingsRecord,
     FeatureStream,
     ParsedTerms,
     Term,
+    TermName,
     hierarchy,
     is_aux,
     linear_combination,
@@ -59,7 +64,7 @@ from hrgtc.drift.features import (
 from hrgtc.drift.offsets import fit_offsets, offset_groups, orientation_offset, project_off
 from hrgtc.drift.regression import EXTENDED_PRECISION, newey_west_inflation
 from hrgtc.drift.rest import check_policy, reference_point, run_rest
-from hrgtc.drift.stepwise import StepwiseResult, stepwise
+from hrgtc.drift.stepwise import StepwiseRecord, StepwiseResult, stepwise
 from hrgtc.drift.windows import RunSource, TrainingWindows, _iter_run, window_means
 from hrgtc.recording import Recording
 from hrgtc.recording.motion import MotionSettings
@@ -218,7 +223,7 @@ class DriftModel(ParsedTerms):
         """
         self.settings.check_sample_rate(recording)
         stream = FeatureStream(self.settings, self.variables, thermometer)
-        return self.predict(stream.process(recording))
+        return self.predict(stream.transform(recording))
 
     def orientation_offset(self, accel: Any) -> float | None:
         """Offset from ``intercept_dph`` of the orientation of a mean accelerometer vector;
@@ -242,71 +247,55 @@ class DriftModel(ParsedTerms):
         return drift_summary(self, sensor)
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types."""
-        return {
-            "kind": "hrgtc.DriftModel",
-            "settings": self.settings.to_dict(),
-            "candidates": list(self.candidates),
-            "selected": list(self.selected),
-            "intercept_dph": self.intercept_dph,
-            "coefficients": dict(self.coefficients),
-            "standard_errors": dict(self.standard_errors),
-            "pvalues": dict(self.pvalues),
-            "scaled_coefficients": list(self.scaled_coefficients),
-            "stepwise": self.stepwise.to_dict(),
-            "ranges": {k: list(v) for k, v in self.ranges.items()},
-            "window_s": self.window_s,
-            "n_windows": self.n_windows,
-            "n_samples": self.n_samples,
-            "residual_std_dph": self.residual_std_dph,
-            "rsquared": self.rsquared,
-            "variance_inflation": self.variance_inflation,
-            "bandwidth_windows": self.bandwidth_windows,
-            "selection": self.selection,
-            "cross_validation": None if self.cross_validation is None
-            else self.cross_validation.to_dict(),
-            "n_not_at_rest": self.n_not_at_rest,
-            "offset_mode": self.offset_mode,
-            "offsets_dph": dict(self.offsets_dph),
-            "orientations": [list(v) for v in self.orientations],
-            "pruning": None if self.pruning is None else dict(self.pruning),
-        }
+        """Plain JSON types, as :class:`DriftModelRecord` writes them (NaN -> None)."""
+        return records.dump(self, DriftModelRecord)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> DriftModel:
-        """Inverse of :meth:`to_dict`."""
+        """Inverse of :meth:`to_dict` (checked against :class:`DriftModelRecord`)."""
+        values = records.load(data, DriftModelRecord, "drift-model")
+        values.pop("kind")
+        validation = values["cross_validation"]
         try:
-            return cls(
-                settings=FeatureSettings.from_dict(data["settings"]),
-                candidates=tuple(data["candidates"]),
-                selected=tuple(data["selected"]),
-                intercept_dph=float(data["intercept_dph"]),
-                coefficients={k: float(v) for k, v in data["coefficients"].items()},
-                standard_errors={k: float(v) for k, v in data["standard_errors"].items()},
-                pvalues={k: float(v) for k, v in data["pvalues"].items()},
-                scaled_coefficients=tuple(float(v) for v in data["scaled_coefficients"]),
-                stepwise=StepwiseResult.from_dict(data["stepwise"]),
-                ranges={k: (float(v[0]), float(v[1])) for k, v in data["ranges"].items()},
-                window_s=float(data["window_s"]),
-                n_windows=int(data["n_windows"]),
-                n_samples=int(data["n_samples"]),
-                residual_std_dph=float(data["residual_std_dph"]),
-                rsquared=float(data["rsquared"]),
-                variance_inflation=float(data.get("variance_inflation", 1.0)),
-                bandwidth_windows=int(data.get("bandwidth_windows", 0)),
-                selection=str(data.get("selection", "stepwise")),
-                cross_validation=None if data.get("cross_validation") is None
-                else CrossValidation.from_dict(data["cross_validation"]),
-                n_not_at_rest=int(data.get("n_not_at_rest", 0)),
-                offset_mode=str(data.get("offset_mode", "none")),
-                offsets_dph={str(k): float(v)
-                             for k, v in dict(data.get("offsets_dph") or {}).items()},
-                orientations=tuple(tuple(float(x) for x in v)
-                                   for v in data.get("orientations") or ()),
-                pruning=None if data.get("pruning") is None else dict(data["pruning"]),
-            )
+            return cls(**{**values, "settings": FeatureSettings(**values["settings"]),
+                          "stepwise": StepwiseResult.from_dict(values["stepwise"]),
+                          "cross_validation": None if validation is None
+                          else CrossValidation(sources=tuple(validation["per_run_dph"]),
+                                               **validation),
+                          "pruning": None if values["pruning"] is None
+                          else dict(values["pruning"])})
         except (KeyError, TypeError, ValueError, IndexError) as exc:
             raise InputError(f"not a valid drift-model record: {exc!r}") from exc
+
+
+class DriftModelRecord(records.Record, kw_only=True):
+    """A :class:`DriftModel` in a file (the model file's ``drift`` and ``housing``)."""
+
+    kind: Literal["hrgtc.DriftModel"] = "hrgtc.DriftModel"
+    settings: FeatureSettingsRecord
+    candidates: Annotated[tuple[TermName, ...], Meta(min_length=1)]
+    selected: tuple[TermName, ...]
+    intercept_dph: float
+    coefficients: dict[str, float]
+    standard_errors: dict[str, records.Statistic]
+    pvalues: dict[str, records.Statistic]
+    scaled_coefficients: tuple[float, ...]
+    stepwise: StepwiseRecord
+    ranges: dict[str, records.Range]
+    window_s: records.Positive
+    n_windows: records.Count
+    n_samples: records.Count
+    residual_std_dph: records.Statistic
+    rsquared: records.Statistic
+    variance_inflation: records.Statistic = 1.0
+    bandwidth_windows: records.Count = 0
+    selection: str = "stepwise"
+    cross_validation: CrossValidationRecord | None = None
+    n_not_at_rest: int = 0
+    offset_mode: str = "none"
+    offsets_dph: dict[str, float] = records.empty()
+    orientations: tuple[tuple[float, ...], ...] = ()
+    pruning: dict[str, Any] | None = None
 
 
 def _check_excitation(windows: TrainingWindows, thermometer: Thermometer,

@@ -55,10 +55,12 @@ import math
 import re
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Annotated, Any
 
 import numpy as np
+from msgspec import Meta
 
+from hrgtc.core import records
 from hrgtc.core.errors import InputError
 from hrgtc.drift.rate_filter import (  # noqa: F401  (re-exported: imported from here)
     RateFilterState,
@@ -328,37 +330,13 @@ class FeatureSettings:
     aux_centres: dict[str, float] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
-        return {
-            "reference_freq_hz": self.reference_freq_hz,
-            "sample_rate_hz": self.sample_rate_hz,
-            "reference_c": self.reference_c,
-            "rate_tau_s": self.rate_tau_s,
-            "warmup_s": self.warmup_s,
-            "scales": dict(self.scales),
-            "switch_hz_per_s": self.switch_hz_per_s,
-            "rate_tau2_s": self.rate_tau2_s,
-            "aux_columns": dict(self.aux_columns),
-            "aux_centres": dict(self.aux_centres),
-        }
+        """Plain JSON types, as :class:`FeatureSettingsRecord` writes them."""
+        return records.dump(self, FeatureSettingsRecord)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> FeatureSettings:
-        try:
-            return cls(
-                reference_freq_hz=float(data["reference_freq_hz"]),
-                sample_rate_hz=float(data["sample_rate_hz"]),
-                reference_c=float(data["reference_c"]),
-                rate_tau_s=float(data["rate_tau_s"]),
-                warmup_s=float(data["warmup_s"]),
-                scales={str(k): float(v) for k, v in dict(data.get("scales", {})).items()},
-                switch_hz_per_s=float(data.get("switch_hz_per_s", 0.0)),
-                rate_tau2_s=float(data.get("rate_tau2_s", 0.0)),
-                aux_columns={str(k): str(v) for k, v in dict(data.get("aux_columns", {})).items()},
-                aux_centres={str(k): float(v)
-                             for k, v in dict(data.get("aux_centres", {})).items()},
-            )
-        except (KeyError, TypeError, ValueError) as exc:
-            raise InputError(f"not a valid feature-settings record: {exc!r}") from exc
+        """Inverse of :meth:`to_dict` (checked against :class:`FeatureSettingsRecord`)."""
+        return cls(**records.load(data, FeatureSettingsRecord, "feature-settings"))
 
     def check_sample_rate(self, recording: Recording) -> None:
         """Raise when a recording's rate differs from the one the filter was built for."""
@@ -371,6 +349,27 @@ class FeatureSettings:
                 "so resample the recording or "
                 "calibrate at this rate"
             )
+
+
+#: A drift term as the model file writes it (``f^2*df``, ``a_drive``); parsed on loading.
+_VARIABLE = r"(?:[a-z][a-z0-9]*|a_[A-Za-z][A-Za-z0-9]*)"
+TermName = Annotated[str, Meta(pattern=rf"^{_VARIABLE}(\^[0-9]+)?(\*{_VARIABLE}(\^[0-9]+)?)*$")]
+
+
+class FeatureSettingsRecord(records.Record, kw_only=True):
+    """:class:`FeatureSettings` in a file (the drift model's ``settings``)."""
+
+    # A sensor thermometer reads °C in the place of f: any finite reference.
+    reference_freq_hz: float
+    sample_rate_hz: records.Positive
+    reference_c: float
+    rate_tau_s: records.Positive
+    warmup_s: records.NonNegative
+    scales: dict[str, records.Positive] = records.empty()
+    switch_hz_per_s: records.NonNegative = 0.0
+    rate_tau2_s: records.NonNegative = 0.0
+    aux_columns: dict[str, str] = records.empty()
+    aux_centres: dict[str, float] = records.empty()
 
 
 def settle_rows(settings: FeatureSettings) -> int:
@@ -431,7 +430,7 @@ class FeatureStream:
                                                  time_s=time_s, restart=restart)
         return rate
 
-    def process(self, chunk: Recording, restart: np.ndarray | None = None
+    def transform(self, chunk: Recording, restart: np.ndarray | None = None
                 ) -> dict[str, np.ndarray]:
         """Variables of the next chunk of the run, keyed by variable name.
 
@@ -458,7 +457,7 @@ def compute_variables(
     thermometer: Any = None,
 ) -> dict[str, np.ndarray]:
     """Batch form of :class:`FeatureStream`: the variables of a whole run."""
-    return FeatureStream(settings, variables, thermometer).process(recording)
+    return FeatureStream(settings, variables, thermometer).transform(recording)
 
 
 def linear_combination(

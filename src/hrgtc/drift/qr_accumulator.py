@@ -28,14 +28,15 @@ reciprocal condition number below ``tol`` raises
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
-from dataclasses import dataclass, fields
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from scipy import stats
 from scipy.linalg import lapack
 
+from hrgtc.core import records
 from hrgtc.core.errors import InputError, RankDeficientError
 
 COLLINEARITY_TOL = 1e-12
@@ -179,8 +180,6 @@ class QRAccumulator:
         self.n_ += X.shape[0]
         self.sum_weights_ += float(X.shape[0]) if w is None else float(w.sum())
         return self
-
-    update = partial_fit
 
     def _fold_rows(self, X: np.ndarray, y: np.ndarray, w: np.ndarray | None) -> np.ndarray:
         """R of the stored factor stacked on the shifted, scaled, weighted rows [1, X, y].
@@ -441,19 +440,31 @@ class OLSResult:
         return "\n".join(lines)
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain-JSON form."""
-        out = {f.name: getattr(self, f.name) for f in fields(self)}
-        return {k: v.tolist() if isinstance(v, np.ndarray) else list(v) if isinstance(v, tuple)
-                else v for k, v in out.items()}
+        """Plain-JSON form (NaN -> null), as :class:`OLSResultRecord`."""
+        return records.dump(self, OLSResultRecord)
 
     @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> OLSResult:
-        """Inverse of :meth:`to_dict`."""
-        arrays = {k: _readonly(data[k]) for k in ("params", "bse", "tvalues", "pvalues",
-                                                   "cov_params")}
-        return cls(names=tuple(data["names"]), residual_std=float(data["residual_std"]),
-                   rsquared=float(data["rsquared"]), nobs=int(data["nobs"]),
-                   df_resid=int(data["df_resid"]), **arrays)
+    def from_dict(cls, data: Mapping[str, Any]) -> OLSResult:
+        """Inverse of :meth:`to_dict` (checked against :class:`OLSResultRecord`)."""
+        values = records.load(data, OLSResultRecord, "least-squares fit")
+        arrays = {k: _readonly(values[k]) for k in ("params", "bse", "tvalues", "pvalues",
+                                                     "cov_params")}
+        return cls(**{**values, **arrays})
+
+
+class OLSResultRecord(records.Record, kw_only=True):
+    """An :class:`OLSResult` in a file (the final fit of a stepwise record)."""
+
+    names: tuple[str, ...]
+    params: tuple[records.Statistic, ...]
+    bse: tuple[records.Statistic, ...]
+    tvalues: tuple[records.Statistic, ...]
+    pvalues: tuple[records.Statistic, ...]
+    cov_params: tuple[tuple[records.Statistic, ...], ...]
+    residual_std: records.Statistic
+    rsquared: records.Statistic
+    nobs: records.Count
+    df_resid: int
 
 
 def _solve(acc: QRAccumulator, idx: list[int], names: tuple[str, ...], tol: float,

@@ -29,11 +29,13 @@ from __future__ import annotations
 import math
 import warnings
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import asdict, dataclass, field
-from typing import Any
+from dataclasses import dataclass, field
+from typing import Annotated, Any, Literal
 
 import numpy as np
+from msgspec import Meta
 
+from hrgtc.core import records
 from hrgtc.core.errors import HrgtcWarning, InputError
 from hrgtc.drift.features import (
     FeatureSettings,
@@ -60,13 +62,6 @@ SCALE_TERMS = ("f", "f^2", "f^3")
 #: Default grouping tolerance as a share of the drift model's frequency scale.
 TOLERANCE_SHARE = 0.02
 
-
-def _nullable(value: float) -> float | None:
-    return value if math.isfinite(value) else None
-
-
-def _float(value: Any) -> float:
-    return math.nan if value is None else float(value)
 
 
 @dataclass(frozen=True)
@@ -96,16 +91,13 @@ class ScaleGroup:
     rows: int
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain-JSON form (a NaN standard error becomes null)."""
-        out = asdict(self)
-        out["k_se_ppm"] = _nullable(self.k_se_ppm)
-        return out
+        """Plain-JSON form (a NaN standard error becomes null), as :class:`ScaleGroupRecord`."""
+        return records.dump(self, ScaleGroupRecord)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> ScaleGroup:
-        return cls(freq_hz=float(data["freq_hz"]), k_ppm=float(data["k_ppm"]),
-                   k_se_ppm=_float(data["k_se_ppm"]), bias_dph=float(data["bias_dph"]),
-                   n=int(data["n"]), rows=int(data["rows"]))
+        """Inverse of :meth:`to_dict`."""
+        return cls(**records.load(data, ScaleGroupRecord, "scale-group"))
 
 
 @dataclass(frozen=True, eq=False)
@@ -233,59 +225,67 @@ class ScaleFactorModel(ParsedTerms):
         return "\n".join(lines)
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (statistics that are not finite become null)."""
-        return {
-            "kind": "hrgtc.ScaleFactorModel",
-            "reference_hz": self.reference_hz,
-            "scale_hz": self.scale_hz,
-            "candidates": list(self.candidates),
-            "selected": list(self.selected),
-            "intercept_ppm": self.intercept_ppm,
-            "coefficients_ppm": dict(self.coefficients_ppm),
-            "standard_errors_ppm": {k: _nullable(v) for k, v in self.standard_errors_ppm.items()},
-            "pvalues": {k: _nullable(v) for k, v in self.pvalues.items()},
-            "scaled_coefficients": list(self.scaled_coefficients),
-            "covariance": [[_nullable(v) for v in row] for row in self.covariance],
-            "freq_range_hz": list(self.freq_range_hz),
-            "input_rate_range_dph": list(self.input_rate_range_dph),
-            "residual_ppm": _nullable(self.residual_ppm),
-            "groups": [g.to_dict() for g in self.groups],
-            "history": [{**s.to_dict(), "pvalue": _nullable(s.pvalue),
-                         "fstat": _nullable(s.fstat)} for s in self.history],
-            "weighted": self.weighted,
-            "penter": self.penter,
-            "premove": self.premove,
-        }
+        """Plain JSON types (statistics that are not finite become null), as
+        :class:`ScaleFactorRecord` writes them."""
+        return records.dump(self, ScaleFactorRecord)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> ScaleFactorModel:
-        """Inverse of :meth:`to_dict`."""
-        try:
-            return cls(
-                reference_hz=float(data["reference_hz"]),
-                scale_hz=float(data["scale_hz"]),
-                candidates=tuple(str(t) for t in data["candidates"]),
-                selected=tuple(str(t) for t in data["selected"]),
-                intercept_ppm=float(data["intercept_ppm"]),
-                coefficients_ppm={k: float(v) for k, v in data["coefficients_ppm"].items()},
-                standard_errors_ppm={k: _float(v) for k, v in data["standard_errors_ppm"].items()},
-                pvalues={k: _float(v) for k, v in data["pvalues"].items()},
-                scaled_coefficients=tuple(float(v) for v in data["scaled_coefficients"]),
-                covariance=tuple(tuple(_float(v) for v in row) for row in data["covariance"]),
-                freq_range_hz=(float(data["freq_range_hz"][0]), float(data["freq_range_hz"][1])),
-                input_rate_range_dph=(float(data["input_rate_range_dph"][0]),
-                                      float(data["input_rate_range_dph"][1])),
-                residual_ppm=_float(data["residual_ppm"]),
-                groups=tuple(ScaleGroup.from_dict(g) for g in data["groups"]),
-                history=tuple(Step(action=str(s["action"]), term=str(s["term"]),
-                                   fstat=_float(s["fstat"]), pvalue=_float(s["pvalue"]))
-                              for s in data.get("history", ())),
-                weighted=bool(data.get("weighted", False)),
-                penter=float(data.get("penter", PENTER)),
-                premove=float(data.get("premove", 0.10)),
-            )
-        except (KeyError, TypeError, ValueError, IndexError) as exc:
-            raise InputError(f"not a valid scale-factor record: {exc!r}") from exc
+        """Inverse of :meth:`to_dict` (checked against :class:`ScaleFactorRecord`)."""
+        values = records.load(data, ScaleFactorRecord, "scale-factor")
+        values.pop("kind")
+        return cls(**{**values, "groups": tuple(ScaleGroup(**g) for g in values["groups"]),
+                      "history": tuple(Step(**h) for h in values["history"])})
+
+
+#: A term of k(f): a power of f.
+_FTerm = Annotated[str, Meta(pattern=r"^f(\^[0-9]+)?$")]
+#: A stepwise threshold, a p-value strictly between 0 and 1.
+_Threshold = Annotated[float, Meta(gt=0, lt=1)]
+
+
+class ScaleGroupRecord(records.Record, kw_only=True, forbid_unknown_fields=True):
+    """A :class:`ScaleGroup` in a file."""
+
+    freq_hz: float
+    k_ppm: float
+    k_se_ppm: records.Statistic
+    bias_dph: float
+    n: Annotated[int, Meta(ge=2)]
+    rows: Annotated[int, Meta(ge=1)]
+
+
+class ScaleStepRecord(records.Record, kw_only=True, forbid_unknown_fields=True):
+    """One step of the scale factor's stepwise selection in a file."""
+
+    action: Literal["added", "removed"]
+    term: _FTerm
+    fstat: records.Statistic
+    pvalue: records.Statistic
+
+
+class ScaleFactorRecord(records.Record, kw_only=True, forbid_unknown_fields=True):
+    """A :class:`ScaleFactorModel` in a file (the model file's ``scale_factor``)."""
+
+    kind: Literal["hrgtc.ScaleFactorModel"] = "hrgtc.ScaleFactorModel"
+    reference_hz: float
+    scale_hz: records.Positive
+    candidates: Annotated[tuple[_FTerm, ...], Meta(min_length=1)]
+    selected: tuple[_FTerm, ...]
+    intercept_ppm: float
+    coefficients_ppm: dict[str, float]
+    standard_errors_ppm: dict[str, records.Statistic]
+    pvalues: dict[str, records.Statistic]
+    scaled_coefficients: tuple[float, ...]
+    covariance: tuple[tuple[records.Statistic, ...], ...]
+    freq_range_hz: records.Range
+    input_rate_range_dph: records.Range
+    residual_ppm: records.Statistic
+    groups: Annotated[tuple[ScaleGroupRecord, ...], Meta(min_length=1)]
+    history: tuple[ScaleStepRecord, ...] = ()
+    weighted: bool = False
+    penter: _Threshold = PENTER
+    premove: _Threshold = 0.10
 
 
 def group_segments(segments: Sequence[RateSegment],
@@ -444,51 +444,8 @@ def fit_scale_factor(segments: Iterable[RateSegment], settings: FeatureSettings,
         penter=float(penter), premove=float(premove))
 
 
-_NUMBER = {"type": "number"}
-_STAT = {"type": ["number", "null"]}
-_PAIR = {"type": "array", "items": _NUMBER, "minItems": 2, "maxItems": 2}
-_TERM = {"type": "string", "pattern": r"^f(\^[0-9]+)?$"}
-
-#: JSON Schema (Draft 2020-12) of :meth:`ScaleFactorModel.to_dict`.
-SCALE_FACTOR_JSON_SCHEMA: dict[str, Any] = {
-    "$schema": "https://json-schema.org/draft/2020-12/schema",
-    "$id": "https://hrgtc.invalid/schema/scale-factor.json",
-    "title": "hrgtc scale-factor model",
-    "type": "object",
-    "required": ["reference_hz", "scale_hz", "candidates", "selected", "intercept_ppm",
-                 "coefficients_ppm", "standard_errors_ppm", "pvalues", "scaled_coefficients",
-                 "covariance", "freq_range_hz", "input_rate_range_dph", "residual_ppm",
-                 "groups"],
-    "properties": {
-        "kind": {"const": "hrgtc.ScaleFactorModel"},
-        "reference_hz": _NUMBER,
-        "scale_hz": {"type": "number", "exclusiveMinimum": 0},
-        "candidates": {"type": "array", "items": _TERM, "minItems": 1},
-        "selected": {"type": "array", "items": _TERM},
-        "intercept_ppm": _NUMBER,
-        "coefficients_ppm": {"type": "object", "additionalProperties": _NUMBER},
-        "standard_errors_ppm": {"type": "object", "additionalProperties": _STAT},
-        "pvalues": {"type": "object", "additionalProperties": _STAT},
-        "scaled_coefficients": {"type": "array", "items": _NUMBER},
-        "covariance": {"type": "array", "items": {"type": "array", "items": _STAT}},
-        "freq_range_hz": _PAIR,
-        "input_rate_range_dph": _PAIR,
-        "residual_ppm": _STAT,
-        "groups": {"type": "array", "minItems": 1, "items": {
-            "type": "object",
-            "required": ["freq_hz", "k_ppm", "k_se_ppm", "bias_dph", "n", "rows"],
-            "properties": {"freq_hz": _NUMBER, "k_ppm": _NUMBER, "k_se_ppm": _STAT,
-                           "bias_dph": _NUMBER, "n": {"type": "integer", "minimum": 2},
-                           "rows": {"type": "integer", "minimum": 1}},
-            "additionalProperties": False}},
-        "history": {"type": "array", "items": {
-            "type": "object", "required": ["action", "term", "fstat", "pvalue"],
-            "properties": {"action": {"enum": ["added", "removed"]}, "term": _TERM,
-                           "fstat": _STAT, "pvalue": _STAT},
-            "additionalProperties": False}},
-        "weighted": {"type": "boolean"},
-        "penter": {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1},
-        "premove": {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1},
-    },
-    "additionalProperties": False,
-}
+#: JSON Schema (Draft 2020-12) of :meth:`ScaleFactorModel.to_dict`, generated from
+#: :class:`ScaleFactorRecord`.
+SCALE_FACTOR_JSON_SCHEMA: dict[str, Any] = records.json_schema(
+    ScaleFactorRecord, "hrgtc scale-factor model",
+    "https://hrgtc.invalid/schema/scale-factor.json")

@@ -26,13 +26,14 @@ import dataclasses
 import math
 import warnings
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import asdict, dataclass
-from typing import Any
+from dataclasses import dataclass
+from typing import Any, Literal
 
 import numpy as np
 
+from hrgtc.core import records
 from hrgtc.core.errors import HrgtcWarning, InputError, RankDeficientError
-from hrgtc.drift.qr_accumulator import _check_names, _resolve_terms, _solve
+from hrgtc.drift.qr_accumulator import OLSResultRecord, _check_names, _resolve_terms, _solve
 from hrgtc.drift.regression import (
     COLLINEARITY_TOL,
     GramAccumulator,
@@ -71,8 +72,8 @@ class Step:
     pvalue: float
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain-JSON form."""
-        return asdict(self)
+        """Plain-JSON form (:class:`StepRecord`)."""
+        return records.dump(self, StepRecord)
 
 
 @dataclass(frozen=True, eq=False)
@@ -123,23 +124,38 @@ class StepwiseResult:
         return "\n".join(lines)
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain-JSON form (NaN p-values become null)."""
-        return {"history": [s.to_dict() for s in self.history], "selected": list(self.selected),
-                "result": self.result.to_dict(), "candidates": list(self.candidates),
-                "excluded_pvalues": [None if math.isnan(p) else p for p in self.excluded_pvalues],
-                "penter": self.penter, "premove": self.premove, "stop_reason": self.stop_reason,
-                "variance_inflation": self.variance_inflation}
+        """Plain-JSON form (NaN p-values become null), as :class:`StepwiseRecord`."""
+        return records.dump(self, StepwiseRecord)
 
     @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> StepwiseResult:
-        """Inverse of :meth:`to_dict`."""
-        return cls(history=tuple(Step(**s) for s in data["history"]),
-                   selected=tuple(data["selected"]), result=OLSResult.from_dict(data["result"]),
-                   candidates=tuple(data["candidates"]), stop_reason=str(data["stop_reason"]),
-                   variance_inflation=float(data.get("variance_inflation", 1.0)),
-                   excluded_pvalues=tuple(math.nan if p is None else float(p)
-                                          for p in data["excluded_pvalues"]),
-                   penter=float(data["penter"]), premove=float(data["premove"]))
+    def from_dict(cls, data: Mapping[str, Any]) -> StepwiseResult:
+        """Inverse of :meth:`to_dict` (checked against :class:`StepwiseRecord`)."""
+        values = records.load(data, StepwiseRecord, "stepwise")
+        return cls(**{**values, "history": tuple(Step(**s) for s in values["history"]),
+                      "result": OLSResult.from_dict(values["result"])})
+
+
+class StepRecord(records.Record, kw_only=True):
+    """A :class:`Step` in a file."""
+
+    action: Literal["added", "removed"]
+    term: str
+    fstat: records.Statistic
+    pvalue: records.Statistic
+
+
+class StepwiseRecord(records.Record, kw_only=True):
+    """A :class:`StepwiseResult` in a file (the drift model's ``stepwise``)."""
+
+    history: tuple[StepRecord, ...]
+    selected: tuple[str, ...]
+    result: OLSResultRecord
+    candidates: tuple[str, ...]
+    excluded_pvalues: tuple[records.Statistic, ...]
+    penter: float
+    premove: float
+    stop_reason: Literal["converged", "max_steps", "cycle"]
+    variance_inflation: records.Statistic = 1.0
 
 
 def stepwise(X: Any, y: Any, names: Sequence[str] | None = None, penter: float = PENTER,

@@ -31,6 +31,7 @@ from typing import Any
 
 import numpy as np
 
+from hrgtc.core import records
 from hrgtc.core.errors import InputError
 
 #: Unit factors a recording's noise ratio to the training data's is tested against: the
@@ -110,17 +111,13 @@ class TrainingStatistics:
                    len(noises))
 
     def to_dict(self) -> dict[str, Any]:
-        return {"sample_rate_hz": self.sample_rate_hz, "rate_noise_dph": self.rate_noise_dph,
-                "rate_level_dph": self.rate_level_dph, "samples": self.samples,
-                "runs": self.runs}
+        """Plain JSON types, as :class:`TrainingStatisticsRecord` writes them."""
+        return records.dump(self, TrainingStatisticsRecord)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> TrainingStatistics:
-        try:
-            return cls(float(data["sample_rate_hz"]), float(data["rate_noise_dph"]),
-                       float(data["rate_level_dph"]), int(data["samples"]), int(data["runs"]))
-        except (KeyError, TypeError, ValueError) as exc:
-            raise InputError(f"not a valid training-statistics record: {exc!r}") from exc
+        """Inverse of :meth:`to_dict` (checked against :class:`TrainingStatisticsRecord`)."""
+        return cls(**records.load(data, TrainingStatisticsRecord, "training-statistics"))
 
     def noise_ratio(self, rate_dph: Any, sample_rate_hz: float) -> float:
         """The recording's rate noise over the training data's, at the training rate (NaN
@@ -129,6 +126,17 @@ class TrainingStatistics:
         if not (noise > 0.0 and self.rate_noise_dph > 0.0 and sample_rate_hz > 0.0):
             return math.nan
         return noise * math.sqrt(self.sample_rate_hz / sample_rate_hz) / self.rate_noise_dph
+
+
+class TrainingStatisticsRecord(records.Record, kw_only=True):
+    """:class:`TrainingStatistics` in a file (the model file's ``training``, optional: files
+    written before it still load; the noise check is then skipped)."""
+
+    sample_rate_hz: records.Positive
+    rate_noise_dph: records.NonNegative
+    rate_level_dph: float
+    samples: records.Count
+    runs: records.Count
 
 
 def unit_mistake(ratio: float) -> tuple[float, str] | None:

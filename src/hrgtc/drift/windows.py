@@ -122,7 +122,7 @@ class _WindowMeans:
         self._carry: np.ndarray | None = None
         self.partial_dropped_rows = 0
 
-    def push(self, block: np.ndarray, breaks: Sequence[int] = (),
+    def partial_fit(self, block: np.ndarray, breaks: Sequence[int] = (),
              cuts: Sequence[int] = ()) -> np.ndarray:
         """Window means of ``block``; ``breaks``: its rows that start a new segment,
         ``cuts``: its rows that follow left-out samples."""
@@ -300,10 +300,10 @@ def window_means(
                 for k in range(len(edges) - 1):
                     if k > 0 or fresh[0] == 0:
                         stream = FeatureStream(settings, variables, thermometer)
-                    parts.append(stream.process(chunk.slice(edges[k], edges[k + 1])))
+                    parts.append(stream.transform(chunk.slice(edges[k], edges[k + 1])))
                 values = {v: np.concatenate([p[v] for p in parts]) for v in parts[0]}
             else:
-                values = stream.process(chunk)
+                values = stream.transform(chunk)
             # seconds since power-on (or since the filter restarted): the warm-up skip
             origin = np.full(len(time), power_on)
             if power_starts.size:
@@ -341,7 +341,7 @@ def window_means(
             cuts = sorted({int(before[i]) for i in np.flatnonzero(rested & ~previous)})
             last_used = bool(rested[-1])
             warm += int(np.count_nonzero(~settled))
-            means = averager.push(block[use], breaks, cuts)
+            means = averager.partial_fit(block[use], breaks, cuts)
             if means.shape[0]:
                 collect(means, index)
             total += len(chunk)

@@ -121,11 +121,11 @@ class DirectionSplit:
         self._means: list[np.ndarray] = []
         self._truth: bool | None = None
 
-    def push(self, freq_chunk: Any, raw_dph: np.ndarray, compensated_dph: np.ndarray,
+    def partial_fit(self, freq_chunk: Any, raw_dph: np.ndarray, compensated_dph: np.ndarray,
              residual_dph: np.ndarray | None = None) -> None:
         """The next chunk: the recording (for df/dt), raw and compensated output [°/h] and,
         on a simulated run, model minus true bias [°/h]."""
-        df = self._stream.process(freq_chunk)["df"]
+        df = self._stream.transform(freq_chunk)["df"]
         if self._truth is None:
             self._truth = residual_dph is not None
         columns = [df, raw_dph, compensated_dph]

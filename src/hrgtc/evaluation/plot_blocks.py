@@ -19,7 +19,7 @@ class BlockMeans:
         self.offset = 0
         self._parts: dict[str, list[tuple[int, np.ndarray]]] = {}
 
-    def push(self, columns: Mapping[str, np.ndarray]) -> None:
+    def partial_fit(self, columns: Mapping[str, np.ndarray]) -> None:
         """Add the next rows (every column of one length)."""
         n = len(next(iter(columns.values())))
         index = (self.offset + np.arange(n)) // self.rows

@@ -32,6 +32,7 @@ from hrgtc.compensate.ranges import RangeReport
 from hrgtc.core.accounting import Accounting
 from hrgtc.core.errors import HrgtcError, InputError, RecordingError
 from hrgtc.core.progress import Progress
+from hrgtc.core.summary import Summary
 from hrgtc.core.timeline import RESTARTS_KEY
 from hrgtc.drift.features import FeatureStream
 from hrgtc.drift.rest import run_rest
@@ -52,6 +53,7 @@ from hrgtc.evaluation.heating_cooling import DirectionSplit, DirectionStats
 from hrgtc.evaluation.metrics import DEFAULT_TAUS_S, table_to_json
 from hrgtc.evaluation.noise import NoiseTerms, noise_terms
 from hrgtc.evaluation.plot_blocks import BlockMeans, block_rows
+from hrgtc.evaluation.run_figures import run_figures
 from hrgtc.evaluation.series_stats import SeriesStatistics
 from hrgtc.evaluation.settling_cut import SettlingCut
 from hrgtc.model import UnitModel
@@ -285,6 +287,10 @@ class Evaluation:
         """Lines on samples beyond the trained temperature and df/dt (empty if none)."""
         return [] if self.ranges is None else self.ranges.warnings()
 
+    def figures(self, key: str = "evaluation") -> Summary:
+        """The figures as a structured summary: value, unit, interval (:mod:`run_figures`)."""
+        return run_figures(self, key)
+
     def summary(self) -> str:
         """A small text table."""
         def fmt(v: float) -> str:
@@ -455,7 +461,7 @@ class RunPass:
                                    keep_mask=allan and deviation != "oadev")
             self.split = DirectionSplit(model, metadata.sample_rate_hz)
         metadata, frequency, housing = self.metadata, self.frequency, self.housing
-        out = frequency.process(chunk)
+        out = frequency.transform(chunk)
         if self.on_output is not None:
             self.on_output(out)
         raw = chunk.rate_dph - metadata.input_rate_dph
@@ -465,20 +471,20 @@ class RunPass:
                    "comp_dph": comp, "temperature_c": out["resonator_c_est"],
                    "in_range": out["in_range"]}
         if housing is not None:
-            comp_h = housing.process(chunk)["rate_comp_dph"] - metadata.input_rate_dph
+            comp_h = housing.transform(chunk)["rate_comp_dph"] - metadata.input_rate_dph
             pushed["housing"] = comp_h
             columns["comp_housing_dph"] = comp_h
         if self.keep is not None:
             kept = self.keep[frequency.samples - len(chunk):frequency.samples]
             self.left_out += int(np.count_nonzero(~kept))
             pushed = {key: values[kept] for key, values in pushed.items()}
-        self.cut.push(pushed, chunk.time_s if self.keep is None else chunk.time_s[kept],
+        self.cut.partial_fit(pushed, chunk.time_s if self.keep is None else chunk.time_s[kept],
                       chunk.metadata.extra.get(RESTARTS_KEY))
         if allan and deviation != "oadev":
             for key, values in pushed.items():
                 self.whole.setdefault(key, []).append(values)
         truth = self.truth
-        self.split.push(chunk, raw, comp,
+        self.split.partial_fit(chunk, raw, comp,
                         out["bias_model_dph"] - chunk["bias_dph"] if truth else None)
         if truth:
             columns["true_dph"] = chunk["bias_dph"]
@@ -488,8 +494,8 @@ class RunPass:
                             if k in chunk})
             assert self.features is not None
             columns.update({VARIABLE_PREFIX + k: v
-                            for k, v in self.features.process(chunk).items()})
-            self.means.push(columns)
+                            for k, v in self.features.transform(chunk).items()})
+            self.means.partial_fit(columns)
         if self.progress is not None:
             self.progress(frequency.samples, self.total_rows)
         return self

@@ -72,7 +72,7 @@ class _BlockMeans:
         self.mean = 0.0
         self.m2 = 0.0
 
-    def push(self, values: np.ndarray) -> None:
+    def partial_fit(self, values: np.ndarray) -> None:
         data = np.concatenate([self._carry, values]) if self._carry.size else values
         blocks = data.size // self.rows
         if blocks:
@@ -138,7 +138,7 @@ class _SecondDifferenceSums:
         """A gap: no second difference reaches across it."""
         self._tail = np.empty(0)
 
-    def push(self, values: np.ndarray) -> None:
+    def partial_fit(self, values: np.ndarray) -> None:
         data = np.concatenate([self._tail, values]) if self._tail.size else values
         old = self._tail.size
         centred = data - np.mean(data)  # a constant offset leaves second differences unchanged
@@ -205,7 +205,7 @@ class SeriesStatistics:
         # per segment: [time of its first sample (NaN if not given), samples, sum]
         self._segments: list[list[float]] = []
 
-    def push(self, values: np.ndarray, breaks: Sequence[int] = (),
+    def partial_fit(self, values: np.ndarray, breaks: Sequence[int] = (),
              time_s: np.ndarray | None = None) -> None:
         """Add the next samples; ``breaks``: indices in ``values`` where a segment starts
         after a gap (no τ-block and no Allan difference reaches across it); ``time_s``:
@@ -258,7 +258,7 @@ class SeriesStatistics:
         self._sum_squares += float(np.dot(values, values))
         self._segment_samples += values.size
         for means in self._stability.values():
-            means.push(values)
+            means.partial_fit(values)
         if not self.allan:
             return
         if self._full is not None:
@@ -274,12 +274,12 @@ class SeriesStatistics:
                         self._exact.break_segment()
                         self._decimated._carry = np.empty(0)
                         self._coarse_crosses_gaps = True
-                    self._exact.push(held[edges[k]:edges[k + 1]])
-                    self._decimated.push(held[edges[k]:edges[k + 1]])
+                    self._exact.partial_fit(held[edges[k]:edges[k + 1]])
+                    self._decimated.partial_fit(held[edges[k]:edges[k + 1]])
                 self._shrink()
             return
-        self._exact.push(values)
-        self._decimated.push(values)
+        self._exact.partial_fit(values)
+        self._decimated.partial_fit(values)
         self._shrink()
 
     def _shrink(self) -> None:

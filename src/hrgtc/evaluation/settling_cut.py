@@ -65,7 +65,7 @@ class SettlingCut:
         self._last = float(time[-1])
         return time - origin >= settle_threshold_s(self.warmup_s)
 
-    def push(self, values: dict[str, np.ndarray], time: np.ndarray,
+    def partial_fit(self, values: dict[str, np.ndarray], time: np.ndarray,
              restarts_s: Any = ()) -> None:
         """The next rows of every series (one length) and their times [s]; ``restarts_s``:
         times of logger restarts (``metadata.extra["restarts_s"]``), where the df/dt filter
@@ -99,7 +99,7 @@ class SettlingCut:
             breaks = np.concatenate([[0], breaks])
         self._last_kept = float(kept[-1])
         for key, array in values.items():
-            self.series[key].push(array[mask], breaks.tolist(), kept)
+            self.series[key].partial_fit(array[mask], breaks.tolist(), kept)
 
     def finish(self, name: str = "run") -> int:
         """Feed what is still held back; the number of samples left out (settling)."""

@@ -318,7 +318,7 @@ def check_scale_factor(path: PathLike, model: InstrumentModel, options: ReadOpti
                        table: Any = None) -> tuple[ScaleFactorCheck, ...]:
     """Scale-factor error of a held-out rate-table run, each axis, before and after."""
     checks = []
-    compensated = InstrumentCompensator(model).process(options.read(path))
+    compensated = InstrumentCompensator(model).transform(options.read(path))
     for axis, unit_model in model.axes.items():
         sf = unit_model.scale_factor
         if sf is None:

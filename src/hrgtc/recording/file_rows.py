@@ -49,8 +49,8 @@ class FileRows:
     Examples
     --------
     >>> rows = FileRows()
-    >>> rows.update(0, np.array([0.0, 1.0, 3.0, 4.0]))  # file row 2 was dropped
-    >>> rows.update(4, np.array([5.0, 9.0]))            # rows 6-8 too
+    >>> rows.partial_fit(0, np.array([0.0, 1.0, 3.0, 4.0]))  # file row 2 was dropped
+    >>> rows.partial_fit(4, np.array([5.0, 9.0]))            # rows 6-8 too
     >>> [rows.file_row(k) for k in range(6)]
     [0, 1, 3, 4, 5, 9]
     """
@@ -59,7 +59,7 @@ class FileRows:
         self._at: list[int] = [0]
         self._shift: list[int] = [0]
 
-    def update(self, offset: int, file_rows: np.ndarray) -> None:
+    def partial_fit(self, offset: int, file_rows: np.ndarray) -> None:
         """The file rows of the next ``len(file_rows)`` rows seen, from row ``offset`` on."""
         if not len(file_rows):
             return

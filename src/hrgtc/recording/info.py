@@ -330,11 +330,11 @@ def describe(
                               and not _sensor_copy(n, chunk.names, thermometer)]
             if SPIKE_COLUMN in chunk:
                 spike_rows = (spike_rows or 0) + int(np.count_nonzero(chunk[SPIKE_COLUMN]))
-            validator.update(chunk, file_rows.pop() if file_rows else None)
+            validator.partial_fit(chunk, file_rows.pop() if file_rows else None)
             if "time_s" in chunk:
                 if builder is None:
                     builder = TimelineBuilder(1.0 / meta.sample_rate_hz)
-                builder.update(chunk.time_s)
+                builder.partial_fit(chunk.time_s)
             for name in names:
                 values = chunk[name]
                 finite = values[np.isfinite(values)]

@@ -448,7 +448,7 @@ def iter_chunks(
             if file_rows is not None:
                 file_rows(rows_of_file)
             if validator is not None:
-                validator.update(chunk, rows_of_file)
+                validator.partial_fit(chunk, rows_of_file)
                 validator.raise_for_problems()
             pending.append(chunk)
             if validator is None or validator.heuristics_done:

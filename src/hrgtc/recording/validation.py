@@ -126,7 +126,7 @@ class RecordingValidator:
 
     Time continuity and row numbers run over the whole recording; the unit and
     sample-rate heuristics look at its first :data:`HEURISTIC_ROWS` rows.
-    ``validate(recording)`` is "a new validator, one update, finish".
+    ``validate(recording)`` is "a new validator, one partial_fit, finish".
 
     Parameters
     ----------
@@ -178,11 +178,11 @@ class RecordingValidator:
         self._names: tuple[str, ...] = ()
 
     # -- feeding -------------------------------------------------------------
-    def update(self, chunk: Recording, file_rows: np.ndarray | None = None) -> None:
+    def partial_fit(self, chunk: Recording, file_rows: np.ndarray | None = None) -> None:
         """Check the next chunk (rows continue from the previous chunk); ``file_rows``: the
         file row of each of its rows when the reader left rows out (messages name those)."""
         if file_rows is not None:
-            self._file_rows.update(self.rows, file_rows)
+            self._file_rows.partial_fit(self.rows, file_rows)
         if self.metadata is None:
             self.metadata = chunk.metadata
             self.source = chunk.source
@@ -622,7 +622,7 @@ def validate(
         Message names the file, column, first bad row, the bad value and the fix.
     """
     validator = RecordingValidator(gaps, freq_band_hz, freq_span_hz, thermometer)
-    validator.update(recording, file_rows)
+    validator.partial_fit(recording, file_rows)
     report = validator.finish()
     if raise_errors:
         report.raise_for_problems()

@@ -141,7 +141,7 @@ def trace_soak(
         if means is None:
             means = BlockMeans(block_rows(rows, chunk.sample_rate_hz, max_points))
             block_s = means.rows / chunk.sample_rate_hz
-        means.push({k: chunk[k] for k in ("time_s", "freq_hz", "chamber_c", "resonator_c")
+        means.partial_fit({k: chunk[k] for k in ("time_s", "freq_hz", "chamber_c", "resonator_c")
                      if k in chunk})
         if on_chunk is not None:
             on_chunk(len(chunk))

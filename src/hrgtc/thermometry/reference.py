@@ -39,10 +39,11 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
+from hrgtc.core import records
 from hrgtc.core.errors import CalibrationError, InputError, RecordingError
 
 __all__ = ["ReferenceLog", "TemperatureMap", "fit_count_map", "parse_clock", "read_reference_log"]
@@ -163,6 +164,22 @@ class TemperatureMap:
                    str(data.get("reference") or ""),
                    {k: v for k, v in data.items() if k not in known})
 
+
+
+class TemperatureMapRecord(records.Record, kw_only=True):
+    """A :class:`TemperatureMap` in a file (the model file's optional ``temperature_map``):
+    its JSON Schema. Its ``to_dict``/``from_dict`` stay by hand: they keep keys this
+    version does not know (``extra``) and name the fix in their messages."""
+
+    scale_c_per_count: float
+    offset_c: float
+    count_bits: Literal[16, 32, None] = None
+    lag_s: float = 0.0
+    residual_rms_c: records.Statistic = None
+    residual_max_c: records.Statistic = None
+    points: records.Count = 0
+    count_range: tuple[records.Statistic, records.Statistic] | None = None
+    reference: str = ""
 
 def _finite_or_none(value: float) -> float | None:
     return float(value) if value is not None and math.isfinite(value) else None

@@ -20,15 +20,18 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Mapping
 from dataclasses import dataclass
 from fractions import Fraction
 from functools import cached_property
 from math import comb
-from typing import Any
+from typing import Annotated, Any, Literal
 
 import numpy as np
+from msgspec import Meta
 from scipy import stats
 
+from hrgtc.core import records
 from hrgtc.core.errors import CalibrationError, ExtrapolationWarning, InputError
 
 _GRID_POINTS = 2049
@@ -401,66 +404,38 @@ class Thermometer:
         return "\n".join(lines)
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (NaN standard errors become None)."""
-
-        def clean(values: tuple[float, ...]) -> list[float | None]:
-            return [None if not np.isfinite(v) else float(v) for v in values]
-
-        document = {
-            "kind": "hrgtc.Thermometer",
-            "order": self.order,
-            "n_points": self.n_points,
-            "coefficients": list(self.coefficients),
-            "standard_errors": clean(self.standard_errors),
-            "residual_std_hz": (None if not np.isfinite(self.residual_std_hz)
-                                else self.residual_std_hz),
-            "rsquared": self.rsquared,
-            "temperature_range_c": list(self.temperature_range_c),
-            "centre_c": self.centre_c,
-            "scale_c": self.scale_c,
-            "scaled_coefficients": list(self.scaled_coefficients),
-            "scaled_covariance": (
-                None
-                if self.scaled_covariance is None
-                else [list(row) for row in self.scaled_covariance]
-            ),
-        }
-        if self.source != "resonator":  # written only when not the default: old files hash alike
-            document["source"] = self.source
-        return document
+        """Plain JSON types, as :class:`ThermometerRecord` writes them (NaN -> None)."""
+        return records.dump(self, ThermometerRecord)
 
     @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> Thermometer:
-        """Inverse of :meth:`to_dict`."""
-        try:
-            covariance = data.get("scaled_covariance")
+    def from_dict(cls, data: Mapping[str, Any]) -> Thermometer:
+        """Inverse of :meth:`to_dict` (checked against :class:`ThermometerRecord`)."""
+        if isinstance(data, Mapping) and "residual_std" in data and "residual_std_hz" not in data:
+            data = {**data, "residual_std_hz": data["residual_std"]}  # its name before 0.1
+        values = records.load(data, ThermometerRecord, "thermometer")
+        values.pop("kind")
+        return cls(**values)
 
-            def restore(values: list[float | None]) -> tuple[float, ...]:
-                return tuple(float("nan") if v is None else float(v) for v in values)
 
-            return cls(
-                coefficients=tuple(float(c) for c in data["coefficients"]),
-                standard_errors=restore(data["standard_errors"]),
-                residual_std_hz=_optional(data.get("residual_std_hz", data.get("residual_std"))),
-                rsquared=float(data["rsquared"]),
-                temperature_range_c=(
-                    float(data["temperature_range_c"][0]),
-                    float(data["temperature_range_c"][1]),
-                ),
-                order=int(data["order"]),
-                n_points=int(data["n_points"]),
-                centre_c=float(data["centre_c"]),
-                scale_c=float(data["scale_c"]),
-                scaled_coefficients=tuple(float(c) for c in data["scaled_coefficients"]),
-                scaled_covariance=(
-                    None
-                    if covariance is None
-                    else tuple(tuple(float(v) for v in row) for row in covariance)
-                ),
-                source=str(data.get("source", "resonator")),
-            )
-        except (KeyError, TypeError, ValueError, IndexError) as exc:
-            raise InputError(f"not a valid thermometer record: {exc!r}") from exc
+class ThermometerRecord(records.Record, kw_only=True):
+    """A :class:`Thermometer` in a file (the model file's ``thermometer``): field names and
+    bounds, from which its ``to_dict``/``from_dict`` and its JSON Schema are generated."""
+
+    omit_when_default = ("source",)  # written only for a sensor: older files hash alike
+
+    kind: Literal["hrgtc.Thermometer"] = "hrgtc.Thermometer"
+    order: Annotated[int, Meta(ge=1, le=12)]
+    n_points: Annotated[int, Meta(ge=2)]
+    coefficients: Annotated[tuple[float, ...], Meta(min_length=2)]
+    standard_errors: tuple[records.Statistic, ...]
+    residual_std_hz: records.Statistic = None
+    rsquared: records.Statistic
+    temperature_range_c: records.Range
+    centre_c: float
+    scale_c: records.Positive
+    scaled_coefficients: Annotated[tuple[float, ...], Meta(min_length=2)]
+    scaled_covariance: tuple[tuple[records.Statistic, ...], ...] | None = None
+    source: Literal["resonator", "sensor"] = "resonator"
 
 
 def fit(temperatures_c: Any, frequencies_hz: Any, order: int = 3) -> Thermometer:
@@ -579,8 +554,3 @@ def fit(temperatures_c: Any, frequencies_hz: Any, order: int = 3) -> Thermometer
         scaled_coefficients=tuple(float(v) for v in a),
         scaled_covariance=covariance,
     )
-
-
-def _optional(value: Any) -> float:
-    """A number from a model file; None (JSON null) is NaN."""
-    return float("nan") if value is None else float(value)

@@ -1,0 +1,157 @@
+"""A result's summary as data: each figure a value, a unit and an interval.
+
+A result's ``summary()`` builds a :class:`Summary` (sections of :class:`Figure` s) before
+any text; the renderers format that one structure: :meth:`Summary.text` (plain text, what
+``summary()`` printed before), :meth:`Summary.rows` (the cells of a rich or HTML table:
+section, figure, value, unit, interval) and :meth:`Summary.html` (a table for the report).
+:meth:`Summary.to_dict` is the ``--json`` form. See docs/architecture.md ("One result
+contract"), after statsmodels' ``summary()``, which returns tables its renderers format.
+"""
+
+from __future__ import annotations
+
+import html
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+__all__ = ["Figure", "Summary"]
+
+
+def _number(value: float, digits: int) -> str:
+    if isinstance(value, bool) or not isinstance(value, float | int):
+        return str(value)
+    if isinstance(value, int):
+        return str(value)
+    if math.isnan(value):
+        return "-"
+    return f"{value:.{digits}g}"
+
+
+@dataclass(frozen=True)
+class Figure:
+    """One figure of a result.
+
+    Attributes
+    ----------
+    name
+        Machine key, stable across versions (``"drift.coefficients.f"``).
+    label
+        What a reader sees (``"k of f"``).
+    value
+        The number (NaN: not available), or a count or a word.
+    unit
+        Its unit (``"°/h"``, ``"Hz"``, ``""`` for a pure number).
+    interval
+        (low, high) around the value, or None.
+    interval_kind
+        What the interval is: ``"±1σ"`` (value ± one standard error), ``"68.3 % CI"``,
+        ``"range"`` (the span of the data), ...
+    digits
+        Significant digits of the text forms.
+    """
+
+    name: str
+    label: str
+    value: float | int | str
+    unit: str = ""
+    interval: tuple[float, float] | None = None
+    interval_kind: str = ""
+    digits: int = 6
+
+    @classmethod
+    def with_error(cls, name: str, label: str, value: float, error: float, unit: str = "",
+                   digits: int = 6) -> Figure:
+        """A value ± one standard error (no interval when the error is not finite)."""
+        interval = (value - error, value + error) if math.isfinite(error) else None
+        return cls(name, label, value, unit, interval, "±1σ" if interval else "", digits)
+
+    def value_text(self) -> str:
+        """The value with its unit (``"3.21 °/h"``)."""
+        text = _number(self.value, self.digits)
+        return f"{text} {self.unit}" if self.unit and text != "-" else text
+
+    def interval_text(self) -> str:
+        """The interval as ``± e`` for a symmetric ±1σ, else ``[low, high] (kind)``."""
+        if self.interval is None:
+            return ""
+        low, high = self.interval
+        if self.interval_kind == "±1σ" and isinstance(self.value, float | int):
+            return f"± {_number((high - low) / 2.0, 3)}"
+        text = f"[{_number(low, self.digits)}, {_number(high, self.digits)}]"
+        return f"{text} ({self.interval_kind})" if self.interval_kind else text
+
+    def text(self) -> str:
+        """``label: value unit ± e``."""
+        interval = self.interval_text()
+        return f"{self.label}: {self.value_text()}" + (f" {interval}" if interval else "")
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types (NaN -> None)."""
+        def clean(v: Any) -> Any:
+            return None if isinstance(v, float) and not math.isfinite(v) else v
+
+        return {"name": self.name, "label": self.label, "value": clean(self.value),
+                "unit": self.unit,
+                "interval": None if self.interval is None else [clean(v) for v in self.interval],
+                "interval_kind": self.interval_kind}
+
+
+@dataclass(frozen=True)
+class Summary:
+    """A result's figures in titled sections.
+
+    Attributes
+    ----------
+    title
+        What the result is (``"calibration of SN-001"``).
+    sections
+        (heading, figures) in reading order.
+    notes
+        Lines the figures cannot say (warnings, why a figure is missing).
+    """
+
+    title: str
+    sections: tuple[tuple[str, tuple[Figure, ...]], ...] = ()
+    notes: tuple[str, ...] = field(default=())
+
+    def figures(self) -> dict[str, Figure]:
+        """Every figure by its name."""
+        return {f.name: f for _, figures in self.sections for f in figures}
+
+    def __getitem__(self, name: str) -> Figure:
+        return self.figures()[name]
+
+    def rows(self) -> list[tuple[str, str, str, str, str]]:
+        """Table cells, one row per figure: (section, label, value, unit, interval)."""
+        return [(heading, f.label, _number(f.value, f.digits), f.unit, f.interval_text())
+                for heading, figures in self.sections for f in figures]
+
+    def text(self) -> str:
+        """Plain text: the title, then each section's figures one per line."""
+        lines = [self.title]
+        for heading, figures in self.sections:
+            lines.append(f"{heading}:")
+            lines.extend(f"  {f.text()}" for f in figures)
+        lines.extend(self.notes)
+        return "\n".join(lines)
+
+    def html(self) -> str:
+        """An HTML table (escaped), one row per figure, a header row per section."""
+        out = [f"<table class=\"summary\"><caption>{html.escape(self.title)}</caption>"]
+        for heading, figures in self.sections:
+            out.append(f"<tr><th colspan=\"4\">{html.escape(heading)}</th></tr>")
+            for f in figures:
+                cells = (f.label, _number(f.value, f.digits), f.unit, f.interval_text())
+                out.append("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in cells)
+                           + "</tr>")
+        out.append("</table>")
+        out.extend(f"<p>{html.escape(n)}</p>" for n in self.notes)
+        return "\n".join(out)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types: title, sections with their figures, notes."""
+        return {"title": self.title,
+                "sections": [{"heading": h, "figures": [f.to_dict() for f in figures]}
+                             for h, figures in self.sections],
+                "notes": list(self.notes)}

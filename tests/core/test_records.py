@@ -1,0 +1,176 @@
+"""Tests of hrgtc.core.records: one typed record per result gives its JSON, checks and schema.
+
+Truth: the golden model files of every schema version (written by earlier commits), the
+JSON Schema validator (jsonschema, independent of msgspec) and round trips.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+import math
+import re
+from pathlib import Path
+
+import jsonschema
+import msgspec
+import pytest
+
+from hrgtc.core import records
+from hrgtc.core.errors import InputError
+from hrgtc.drift import DriftModel
+from hrgtc.drift.scale_factor import ScaleFactorModel
+from hrgtc.model_schema import MODEL_SCHEMA, check_document
+from hrgtc.thermometry import Thermometer
+from hrgtc.thermometry.thermometer import ThermometerRecord
+
+GOLDEN = Path(__file__).parents[1] / "data" / "golden-models"
+V1 = GOLDEN / "v1" / "unit-resonator-48c2395.json"
+IMU = GOLDEN / "v3" / "instrument-imu3-scale-factor-ee60050.json"
+
+
+def _document(path=V1):
+    return json.loads(path.read_text())
+
+
+def test_a_statistic_that_is_not_finite_is_written_null_and_read_back_nan():
+    data = _document()["thermometer"]
+    thermometer = Thermometer.from_dict(data)
+    nan = msgspec.structs.replace(msgspec.convert(thermometer, ThermometerRecord,
+                                                  from_attributes=True), rsquared=math.nan)
+    written = records.dump(nan, ThermometerRecord)
+    assert written["rsquared"] is None
+    again = Thermometer.from_dict(written)
+    assert math.isnan(again.rsquared)
+    assert again.coefficients == thermometer.coefficients
+    # version 1 spelled it "NaN"; the record reads that too
+    assert math.isnan(Thermometer.from_dict({**data, "rsquared": "NaN"}).rsquared)
+
+
+def test_round_trips_are_exact_for_every_part():
+    document = _document(IMU)["axes"]["x"]
+    assert Thermometer.from_dict(document["thermometer"]).to_dict() == document["thermometer"]
+    checked = check_document(_document(IMU), "imu")["axes"]["x"]
+    drift = DriftModel.from_dict(checked["drift"])
+    assert drift.to_dict()["coefficients"] == document["drift"]["coefficients"]
+    assert drift.to_dict()["settings"] == document["drift"]["settings"]
+    assert ScaleFactorModel.from_dict(document["scale_factor"]).to_dict() == (
+        document["scale_factor"])
+
+
+def test_source_is_written_only_for_a_sensor_thermometer():
+    data = _document()["thermometer"]
+    assert "source" not in Thermometer.from_dict(data).to_dict()
+    sensor = Thermometer.from_dict({**data, "source": "sensor"}).to_dict()
+    assert sensor["source"] == "sensor"
+
+
+@pytest.mark.parametrize("part, change, place", [
+    ("thermometer", {"order": 0}, r"Expected `int` >= 1 - at `\$.order`"),
+    ("thermometer", {"scale_c": -1.0}, r"> 0.0 - at `\$.scale_c`"),
+    ("thermometer", {"source": "chamber"}, r"at `\$.source`"),
+    ("thermometer", {"temperature_range_c": [1.0]}, r"length 2, got 1 - at "
+                                                    r"`\$.temperature_range_c`"),
+])
+def test_a_record_names_the_place_of_what_does_not_fit(part, change, place):
+    data = {**_document()[part], **change}
+    with pytest.raises(InputError, match=rf"not a valid thermometer record: .*{place}"):
+        Thermometer.from_dict(data)
+
+
+def test_a_nested_place_is_named_from_the_part():
+    data = copy.deepcopy(_document()["drift"])
+    data["settings"]["rate_tau_s"] = 0.0
+    with pytest.raises(InputError, match=r"drift-model record: .* at `\$.settings.rate_tau_s`"):
+        DriftModel.from_dict(data)
+
+
+def test_the_schema_is_the_records():
+    """Every record of the model file is in the schema with exactly its fields, and what
+    it requires is what has no default."""
+    definitions = MODEL_SCHEMA["$defs"]
+    assert {"ThermometerRecord", "DriftModelRecord", "FeatureSettingsRecord",
+            "ScaleFactorRecord", "TrainingStatisticsRecord", "AxisRecord"} <= set(definitions)
+    for name, schema in definitions.items():
+        record = next(r for r in _records() if r.__name__ == name)
+        fields = msgspec.structs.fields(record)
+        assert set(schema["properties"]) == {f.name for f in fields}, name
+        required = {f.name for f in fields if f.required}
+        assert set(schema.get("required", ())) == required, name
+
+
+def _records():
+    found, todo = [], [records.Record]
+    while todo:
+        for sub in todo.pop().__subclasses__():
+            found.append(sub)
+            todo.append(sub)
+    return found
+
+
+@pytest.mark.parametrize("where, value", [
+    (("thermometer", "order"), 13),
+    (("thermometer", "n_points"), 1),
+    (("drift", "window_s"), 0.0),
+    (("drift", "candidates"), []),
+    (("drift", "selected"), ["f**2"]),
+    (("drift", "settings", "scales", "f"), 0.0),
+    (("drift", "n_windows"), -1),
+    (("training", "runs"), -2),
+])
+def test_schema_and_record_refuse_the_same_values(where, value):
+    """Two independent validators (jsonschema on the generated schema, msgspec on the
+    record) agree on each bound."""
+    document = _document(GOLDEN / "v2" / "unit-g-d2-aux-ee60050.json")
+    target = document
+    for key in where[:-1]:
+        target = target[key]
+    target[where[-1]] = value
+    error = jsonschema.exceptions.best_match(
+        jsonschema.Draft202012Validator(MODEL_SCHEMA).iter_errors(document))
+    assert error is not None and list(error.absolute_path)[:len(where)] == list(where)
+    part = {"thermometer": Thermometer, "drift": DriftModel}.get(where[0])
+    if part is None:
+        from hrgtc.drift.training import TrainingStatistics
+
+        part = TrainingStatistics
+    # msgspec names a mapping's key as [...]: scales.f -> scales[...]
+    place = ".".join(where[1:]).replace(".scales.f", ".scales[...]")
+    with pytest.raises(InputError, match=re.escape(f"at `$.{place}")):
+        part.from_dict(document[where[0]])
+
+
+def _pairs():
+    from hrgtc.drift.cross_validation import CrossValidation, CrossValidationRecord
+    from hrgtc.drift.drift_model import DriftModelRecord
+    from hrgtc.drift.features import FeatureSettings, FeatureSettingsRecord
+    from hrgtc.drift.qr_accumulator import OLSResult, OLSResultRecord
+    from hrgtc.drift.scale_factor import ScaleFactorRecord, ScaleGroup, ScaleGroupRecord
+    from hrgtc.drift.stepwise import Step, StepRecord, StepwiseRecord, StepwiseResult
+    from hrgtc.drift.training import TrainingStatistics, TrainingStatisticsRecord
+    from hrgtc.model import UnitModel
+    from hrgtc.model_schema import AxisRecord
+
+    # (result, record, the result's fields a file does not hold)
+    return [(Thermometer, ThermometerRecord, set()),
+            (FeatureSettings, FeatureSettingsRecord, set()),
+            (TrainingStatistics, TrainingStatisticsRecord, set()),
+            (DriftModel, DriftModelRecord, {"_terms", "accounting"}),
+            (ScaleFactorModel, ScaleFactorRecord, {"_terms"}),
+            (ScaleGroup, ScaleGroupRecord, set()),
+            (Step, StepRecord, set()),
+            (StepwiseResult, StepwiseRecord, set()),
+            (OLSResult, OLSResultRecord, set()),
+            (CrossValidation, CrossValidationRecord, {"sources"}),  # the keys of per_run_dph
+            (UnitModel, AxisRecord, {"unit", "provenance"})]  # the file's, not the axis's
+
+
+@pytest.mark.parametrize("result, record, left_out", _pairs(),
+                         ids=[p[1].__name__ for p in _pairs()])
+def test_a_result_and_its_record_have_the_same_fields(result, record, left_out):
+    """A field added to a result but not to its record would silently not be written."""
+    import dataclasses
+
+    fields = {f.name for f in dataclasses.fields(result)} - left_out
+    written = {f.name for f in msgspec.structs.fields(record)} - {"kind"}
+    assert fields == written

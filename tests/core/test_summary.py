@@ -1,0 +1,34 @@
+"""Tests of hrgtc.core.summary: figures with value, unit and interval, and their renderings."""
+
+from __future__ import annotations
+
+import json
+import math
+
+from hrgtc.core.summary import Figure, Summary
+
+
+def test_a_value_with_its_standard_error():
+    figure = Figure.with_error("drift.intercept_dph", "B0", 1.25, 0.05, "°/h")
+    assert figure.interval == (1.2, 1.3)
+    assert figure.interval_kind == "±1σ"
+    assert figure.text() == "B0: 1.25 °/h ± 0.05"
+    assert Figure.with_error("x", "x", 1.0, math.nan).interval is None
+
+
+def test_an_interval_that_is_not_symmetric_is_written_as_bounds():
+    figure = Figure("s", "bias stability", 0.957, "°/h", (0.93, 0.99), "68.3% CI", digits=3)
+    assert figure.text() == "bias stability: 0.957 °/h [0.93, 0.99] (68.3% CI)"
+
+
+def test_missing_values_are_null_in_json_and_a_dash_in_text():
+    summary = Summary("t", (("a", (Figure("a.x", "x", math.nan, "Hz"), Figure("a.n", "n", 7))),))
+    assert summary.text().splitlines() == ["t", "a:", "  x: -", "  n: 7"]
+    data = json.loads(json.dumps(summary.to_dict(), allow_nan=False))
+    assert data["sections"][0]["figures"][0]["value"] is None
+    assert summary.rows() == [("a", "x", "-", "Hz", ""), ("a", "n", "7", "", "")]
+
+
+def test_html_is_escaped():
+    page = Summary("<unit>", (("s", (Figure("s.t", "terms", "f<df"),)),)).html()
+    assert "&lt;unit&gt;" in page and "<td>f&lt;df</td>" in page
