@@ -253,6 +253,7 @@ void hrgtc_x_reset(hrgtc_x_state *state)
     rate_start(&state->f_filter, 0.0);
     state->started = 0;
     state->samples = 0UL;
+    state->elapsed_s = 0.0;
     state->out_of_range = 0UL;
     state->rate_out_of_range = 0UL;
 }
@@ -282,7 +283,9 @@ double hrgtc_x_step(hrgtc_x_state *state, double dt_s, double freq_hz, double ra
     rate_in_range = 1
         && df_value >= RANGE_DF_LOW && df_value <= RANGE_DF_HIGH;
     /* in_range: calibrated temperature, trained df/dt, and the filter settled */
-    in_range = level_in_range && rate_in_range && state->samples >= HRGTC_X_SETTLE_ROWS;
+    /* settled: SETTLE_S seconds since init/reset, the sum of the steps' dt_s */
+    if (state->samples > 0UL && state->elapsed_s < HRGTC_X_SETTLE_S) state->elapsed_s += dt_s;
+    in_range = level_in_range && rate_in_range && state->elapsed_s >= HRGTC_X_SETTLE_S;
     state->samples += 1UL;
     state->out_of_range += level_in_range ? 0UL : 1UL;
     state->rate_out_of_range += rate_in_range ? 0UL : 1UL;

@@ -50,8 +50,9 @@
  *   NaN beyond the monotonic extension -70 to 110 degC.
  *   in_range = 1 when freq_hz is in the calibrated range [4421.073109, 4442.962814] Hz (-10 to
  *              50 degC), the training ranges of the levels hold: f in [-5.19455, 9.69802],
- *              rate_in_range is 1 and the filter has settled (the first 250 samples of a run,
- *              which training leaves out too, are 0); else 0.
+ *              rate_in_range is 1 and the filter has settled (the samples of the first 50 s of
+ *              a run, the sum of dt_s (HRGTC_X_SETTLE_S), which training leaves out too, are
+ *              0); else 0.
  *   rate_in_range = 1 when the rates are in their training ranges: df in [-0.00365717,
  *                   4.47708e-06]; else 0 (a model trained on a cool-down has seen only
  *                   negative df/dt).
@@ -62,8 +63,8 @@
  *            bursts; ignored on the first sample after init/reset). The model was trained at 5
  *            Hz (HRGTC_X_SAMPLE_RATE_HZ).
  *   gaps:    pass the gap's length as dt_s to carry the filter across it (bridge), or call
- *            hrgtc_x_reset() to restart it at rest (split: the first HRGTC_X_SETTLE_ROWS
- *            samples are then flagged again).
+ *            hrgtc_x_reset() to restart it at rest (split: the samples of the first
+ *            HRGTC_X_SETTLE_S seconds are then flagged again).
  *   outputs: rate_comp_dph, bias_model_dph [deg/h]; resonator_c_est [degC];
  *            f_hz [Hz]; df_hz_per_s [Hz/s]; in_range, rate_in_range 1/0.
  *
@@ -98,9 +99,11 @@ extern "C" {
 
 /* Sample rate of the training runs; step() takes each sample's dt_s, any rate works. [Hz] */
 #define HRGTC_X_SAMPLE_RATE_HZ 5.0
-/* Samples at the start of a run flagged (in_range 0) while the df/dt filter settles,
-   as training leaves them out. */
+/* SETTLE_S in samples at the training rate (on a continuous run; in_range uses SETTLE_S). */
 #define HRGTC_X_SETTLE_ROWS 250UL
+/* Seconds since init/reset (the sum of dt_s) from which the filter has settled:
+   samples before are flagged (in_range 0), as training leaves them out. [s] */
+#define HRGTC_X_SETTLE_S 49.99999995
 /* 1 when hrgtc_x_step() takes the housing temperature (the model uses h, dh or g terms). */
 #define HRGTC_X_USES_HOUSING 0
 /* Extra logged channels hrgtc_x_step() takes after housing_c (aux_NAME, --aux NAME=COLUMN). */
@@ -125,6 +128,7 @@ typedef struct hrgtc_x_state {
     hrgtc_x_rate_filter f_filter;   /* df/dt filter of f [Hz] */
     int started;                /* 0 until the first sample after init/reset */
     unsigned long samples;      /* samples since init/reset */
+    double elapsed_s;           /* seconds since init/reset, up to SETTLE_S [s] */
     unsigned long out_of_range; /* of which outside the calibrated temperature */
     unsigned long rate_out_of_range; /* of which with rate_in_range == 0 */
 } hrgtc_x_state;

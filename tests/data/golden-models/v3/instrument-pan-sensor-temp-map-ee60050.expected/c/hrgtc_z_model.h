@@ -43,8 +43,9 @@
  *   NaN beyond the monotonic extension -2.36497 to 35.0735 degC.
  *   in_range = 1 when freq_hz is in the calibrated range [10.11451808, 22.5940037] Hz (10.1145
  *              to 22.594 degC), the training ranges of the levels hold: f in [-5.93166,
- *              6.16595], rate_in_range is 1 and the filter has settled (the first 250 samples
- *              of a run, which training leaves out too, are 0); else 0.
+ *              6.16595], rate_in_range is 1 and the filter has settled (the samples of the
+ *              first 5 s of a run, the sum of dt_s (HRGTC_Z_SETTLE_S), which training leaves
+ *              out too, are 0); else 0.
  *   rate_in_range = 1 when the rates are in their training ranges: df in [-0.0104881,
  *                   0.0137136]; else 0 (a model trained on a cool-down has seen only negative
  *                   df/dt).
@@ -55,8 +56,8 @@
  *            bursts; ignored on the first sample after init/reset). The model was trained at
  *            50 Hz (HRGTC_Z_SAMPLE_RATE_HZ).
  *   gaps:    pass the gap's length as dt_s to carry the filter across it (bridge), or call
- *            hrgtc_z_reset() to restart it at rest (split: the first HRGTC_Z_SETTLE_ROWS
- *            samples are then flagged again).
+ *            hrgtc_z_reset() to restart it at rest (split: the samples of the first
+ *            HRGTC_Z_SETTLE_S seconds are then flagged again).
  *   outputs: rate_comp_dph, bias_model_dph [deg/h]; resonator_c_est [degC];
  *            f_hz [Hz]; df_hz_per_s [Hz/s]; in_range, rate_in_range 1/0.
  *
@@ -91,9 +92,11 @@ extern "C" {
 
 /* Sample rate of the training runs; step() takes each sample's dt_s, any rate works. [Hz] */
 #define HRGTC_Z_SAMPLE_RATE_HZ 50.000000000045475
-/* Samples at the start of a run flagged (in_range 0) while the df/dt filter settles,
-   as training leaves them out. */
+/* SETTLE_S in samples at the training rate (on a continuous run; in_range uses SETTLE_S). */
 #define HRGTC_Z_SETTLE_ROWS 250UL
+/* Seconds since init/reset (the sum of dt_s) from which the filter has settled:
+   samples before are flagged (in_range 0), as training leaves them out. [s] */
+#define HRGTC_Z_SETTLE_S 4.9999999950000005
 /* 1 when hrgtc_z_step() takes the housing temperature (the model uses h, dh or g terms). */
 #define HRGTC_Z_USES_HOUSING 0
 /* Extra logged channels hrgtc_z_step() takes after housing_c (aux_NAME, --aux NAME=COLUMN). */
@@ -116,6 +119,7 @@ typedef struct hrgtc_z_state {
     hrgtc_z_rate_filter f_filter;   /* df/dt filter of f [Hz] */
     int started;                /* 0 until the first sample after init/reset */
     unsigned long samples;      /* samples since init/reset */
+    double elapsed_s;           /* seconds since init/reset, up to SETTLE_S [s] */
     unsigned long out_of_range; /* of which outside the calibrated temperature */
     unsigned long rate_out_of_range; /* of which with rate_in_range == 0 */
 } hrgtc_z_state;
