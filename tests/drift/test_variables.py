@@ -23,7 +23,7 @@ import pytest
 from hrgtc import drift
 from hrgtc.compensate import Compensator
 from hrgtc.compensate import _kernel as kernel
-from hrgtc.core.errors import InputError
+from hrgtc.core.errors import HrgtcError, InputError
 from hrgtc.drift.features import VARIABLES, FeatureSettings
 from hrgtc.drift.variables import (
     BACKENDS,
@@ -124,15 +124,26 @@ def test_the_docs_table_is_the_registry():
 
 
 def test_the_model_schema_takes_each_variables_settings():
-    """The settings a variable owns are in the model file's JSON Schema, as it declares them."""
+    """The settings a variable owns are fields of the model file's record and JSON Schema,
+    with the types and bounds its module declares (a negative time constant is refused)."""
+    from hrgtc.core import records
+    from hrgtc.drift.features import FeatureSettingsRecord
     from hrgtc.model_schema import MODEL_SCHEMA
 
     text = repr(MODEL_SCHEMA)
+    owned = settings_schema()
+    assert set(owned) == {"switch_hz_per_s", "rate_tau2_s", "aux_columns", "aux_centres"}
     for v in DRIFT_VARIABLES:
-        for key, schema in v.settings_schema.items():
-            assert f"'{key}': {schema!r}" in text, (v.name, key)
-    assert set(settings_schema()) == {"switch_hz_per_s", "rate_tau2_s", "aux_columns",
-                                      "aux_centres"}
+        for key, _, _ in v.settings_fields:
+            assert key in FeatureSettingsRecord.__struct_fields__, (v.name, key)
+            assert f"'{key}': {owned[key]!r}" in text, (v.name, key)
+    assert owned["rate_tau2_s"]["minimum"] == 0
+    base = {"reference_freq_hz": 4425.0, "sample_rate_hz": 200.0, "reference_c": 20.0,
+            "rate_tau_s": 10.0, "warmup_s": 50.0}
+    assert records.load({**base, "rate_tau2_s": 60.0}, FeatureSettingsRecord,
+                        "feature-settings")["rate_tau2_s"] == 60.0
+    with pytest.raises(HrgtcError, match="rate_tau2_s"):
+        records.load({**base, "rate_tau2_s": -1.0}, FeatureSettingsRecord, "feature-settings")
 
 
 @pytest.mark.parametrize("name", NAMES)

@@ -57,6 +57,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Annotated, Any
 
+import msgspec
 import numpy as np
 from msgspec import Meta
 
@@ -69,6 +70,7 @@ from hrgtc.drift.rate_filter import (  # noqa: F401  (re-exported: imported from
     restart_mask,
 )
 from hrgtc.drift.variables import AUX_PREFIX, DRIFT_VARIABLES, FIXED, Inputs
+from hrgtc.drift.variables import settings_fields as variable_settings_fields
 from hrgtc.drift.variables import variable as _registered
 from hrgtc.drift.variables.aux import centre as _aux_centre
 from hrgtc.drift.variables.dpos import heating_part  # noqa: F401  (re-exported)
@@ -356,20 +358,24 @@ _VARIABLE = r"(?:[a-z][a-z0-9]*|a_[A-Za-z][A-Za-z0-9]*)"
 TermName = Annotated[str, Meta(pattern=rf"^{_VARIABLE}(\^[0-9]+)?(\*{_VARIABLE}(\^[0-9]+)?)*$")]
 
 
-class FeatureSettingsRecord(records.Record, kw_only=True):
-    """:class:`FeatureSettings` in a file (the drift model's ``settings``)."""
-
-    # A sensor thermometer reads °C in the place of f: any finite reference.
-    reference_freq_hz: float
-    sample_rate_hz: records.Positive
-    reference_c: float
-    rate_tau_s: records.Positive
-    warmup_s: records.NonNegative
-    scales: dict[str, records.Positive] = records.empty()
-    switch_hz_per_s: records.NonNegative = 0.0
-    rate_tau2_s: records.NonNegative = 0.0
-    aux_columns: dict[str, str] = records.empty()
-    aux_centres: dict[str, float] = records.empty()
+#: :class:`FeatureSettings` in a file (the drift model's ``settings``): the settings every
+#: model has, then those the drift variables own (each variable's ``settings_fields`` in
+#: :mod:`hrgtc.drift.variables`), so a variable's setting is declared once, in its module.
+FeatureSettingsRecord = msgspec.defstruct(
+    "FeatureSettingsRecord",
+    [
+        # A sensor thermometer reads °C in the place of f: any finite reference.
+        ("reference_freq_hz", float),
+        ("sample_rate_hz", records.Positive),
+        ("reference_c", float),
+        ("rate_tau_s", records.Positive),
+        ("warmup_s", records.NonNegative),
+        ("scales", dict[str, records.Positive], records.empty()),
+        *variable_settings_fields(),
+    ],
+    bases=(records.Record,), kw_only=True, module=__name__,
+    namespace={"__doc__": ":class:`FeatureSettings` in a file (the drift model's "
+               "``settings``)."})
 
 
 def settle_rows(settings: FeatureSettings) -> int:

@@ -16,6 +16,7 @@ from hrgtc.drift.variables.registry import (
     docs_table,
     is_aux,
     refusal,
+    settings_fields,
     settings_schema,
     supported,
     unit,
@@ -26,4 +27,4 @@ from hrgtc.drift.variables.spec import Inputs
 
 __all__ = ["AUX_PREFIX", "BACKENDS", "BACKEND_NAMES", "DRIFT_VARIABLES", "FIXED",
            "DriftVariable", "Inputs", "ascii_unit", "docs_table", "is_aux", "refusal",
-           "settings_schema", "supported", "unit", "unsupported", "variable"]
+           "settings_fields", "settings_schema", "supported", "unit", "unsupported", "variable"]

@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from hrgtc.core import records
 from hrgtc.core.errors import InputError
 from hrgtc.drift.variables.spec import DriftVariable, Inputs
 
@@ -86,7 +87,5 @@ VARIABLE = DriftVariable(
     description="an extra logged channel (--aux NAME=COLUMN) minus its training mean",
     backends=frozenset({"numpy", "c_double", "c_float32", "params"}), columns=(),
     compute=compute, order=7, check=check, c_code=CCode(),
-    settings_schema={"aux_columns": {"type": "object",
-                                     "additionalProperties": {"type": "string"}},
-                     "aux_centres": {"type": "object",
-                                     "additionalProperties": {"type": "number"}}})
+    settings_fields=(("aux_columns", dict[str, str], records.empty()),
+                     ("aux_centres", dict[str, float], records.empty())))

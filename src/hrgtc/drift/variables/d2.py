@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from hrgtc.core import records
 from hrgtc.drift.variables.spec import DriftVariable, Inputs
 
 
@@ -75,5 +76,5 @@ VARIABLE = DriftVariable(
     description="causal rate of f through a second filter of time constant rate_tau2_s",
     backends=frozenset({"numpy", "c_double", "c_float32", "params"}), columns=("freq_hz",),
     compute=compute, order=5, check=check,
-    settings_schema={"rate_tau2_s": {"type": "number", "minimum": 0}}, c_code=CCode(),
+    settings_fields=(("rate_tau2_s", records.NonNegative, 0.0),), c_code=CCode(),
     rate_of=("f", "rate_tau2_s"))

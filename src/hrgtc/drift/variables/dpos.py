@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from hrgtc.core import records
 from hrgtc.drift.variables.spec import DriftVariable, Inputs
 
 
@@ -43,4 +44,4 @@ VARIABLE = DriftVariable(
     description="heating/cooling switch: the heating part of df, df*(1 + tanh(df/delta))/2 "
                 "(delta: switch_hz_per_s)",
     backends=frozenset({"numpy"}), columns=("freq_hz",), compute=compute, order=4,
-    check=check, settings_schema={"switch_hz_per_s": {"type": "number", "minimum": 0}})
+    check=check, settings_fields=(("switch_hz_per_s", records.NonNegative, 0.0),))

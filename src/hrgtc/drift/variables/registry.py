@@ -44,7 +44,7 @@ from hrgtc.drift.variables.spec import BACKENDS, DriftVariable
 
 __all__ = ["AUX_PREFIX", "BACKENDS", "BACKEND_NAMES", "DRIFT_VARIABLES", "FIXED",
            "DriftVariable", "ascii_unit", "docs_table", "is_aux", "refusal",
-           "settings_schema", "supported", "unit", "unsupported", "variable"]
+           "settings_fields", "settings_schema", "supported", "unit", "unsupported", "variable"]
 
 #: What each backend is called in messages.
 BACKEND_NAMES = {
@@ -146,16 +146,23 @@ def refusal(names: object, backend: str, terms: object = ()) -> str | None:
             f"compute ({what}); {instead}")
 
 
-def settings_schema() -> dict[str, dict[str, Any]]:
-    """The feature settings the variables own: field -> its JSON Schema in the model file.
+def settings_fields() -> list[tuple[str, Any, Any]]:
+    """The feature settings the variables own, ``(field, type, default)`` each:
+    :class:`hrgtc.drift.features.FeatureSettingsRecord` (the model file's
+    ``drift.settings``) is generated with them beside the settings every model has."""
+    return [entry for v in DRIFT_VARIABLES for entry in v.settings_fields]
 
-    :mod:`hrgtc.model_schema` puts these beside the settings every model has, under
-    ``drift.settings.properties``.
-    """
-    out: dict[str, dict[str, Any]] = {}
-    for v in DRIFT_VARIABLES:
-        out.update(v.settings_schema)
-    return out
+
+def settings_schema() -> dict[str, dict[str, Any]]:
+    """The JSON Schema of each setting a variable owns, as the model file's schema has it."""
+    import msgspec
+
+    from hrgtc.core import records
+
+    part = msgspec.defstruct("VariableSettings", settings_fields(), bases=(records.Record,),
+                             kw_only=True)
+    (_, components) = msgspec.json.schema_components([part])
+    return dict(components["VariableSettings"]["properties"])
 
 
 def docs_table() -> str:

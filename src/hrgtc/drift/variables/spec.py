@@ -4,7 +4,8 @@ Each variable of the term grammar is one module of :mod:`hrgtc.drift.variables` 
 one :class:`DriftVariable`: its name, units, kind and docs line, the backends that compute
 it, its numpy reference (``compute``: how it is made from the recording's columns, the
 settings and the other variables), what it needs of the settings (``check``), the
-settings it owns in the model file (``settings_schema``: its entry in the JSON Schema),
+settings it owns in the model file (``settings_fields``: their types, bounds and defaults,
+from which the model file's record and JSON Schema are generated),
 and, for the variables beyond the paper's f, df, h and dh, its pieces of the C export
 (``c_code``, in double and in float32). The registry (:mod:`hrgtc.drift.variables.registry`)
 collects the modules; every consumer reads the entries from it.
@@ -12,8 +13,8 @@ collects the modules; every consumer reads the entries from it.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any, Protocol
 
 import numpy as np
@@ -119,8 +120,10 @@ class DriftVariable:
         The numpy reference: ``compute(inputs, name)`` -> its values over a chunk.
     check
         ``check(settings, thermometer, name)`` -> what is missing to compute it, or None.
-    settings_schema
-        The feature settings it owns: field -> JSON Schema of the model file.
+    settings_fields
+        The feature settings it owns, as ``(field, type, default)`` of the model file's
+        record (:class:`hrgtc.drift.features.FeatureSettingsRecord` is generated with them,
+        and so its JSON Schema).
     c_code
         Its C pieces (:class:`CCode`), for a variable beyond f, df, h and dh.
     order
@@ -140,7 +143,7 @@ class DriftVariable:
     compute: Callable[[Inputs, str], np.ndarray]
     order: int
     check: Callable[[Any, Any, str], str | None] = _nothing
-    settings_schema: Mapping[str, dict[str, Any]] = field(default_factory=dict)
+    settings_fields: tuple[tuple[str, Any, Any], ...] = ()
     c_code: CCode | None = None
     rate_of: tuple[str, str] | None = None
 
