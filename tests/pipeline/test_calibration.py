@@ -222,9 +222,16 @@ def test_frequency_in_khz_is_caught(tmp_path):
     _assert_refused(tmp_path, ["--soak", *soaks, "--drift", soaks[0]], "kHz")
 
 
-def test_library_refuses_empty_inputs():
+def test_library_refuses_empty_inputs(tmp_path):
+    """What is missing is named once the given files have been read (a drift file's own
+    reading problem, such as time in ms, is named first)."""
+    from hrgtc.recording import write
+
+    from fuzzing import make_run
+
+    drift = write(make_run(600), tmp_path / "drift.parquet")
     with pytest.raises(InputError, match="no soak recordings"):
-        calibrate([], ["x.parquet"])
+        calibrate([], [drift])
     with pytest.raises(InputError, match="no drift recordings"):
         calibrate(["x.parquet"], [])
 
