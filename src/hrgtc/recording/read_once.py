@@ -35,27 +35,40 @@ class ReadOnce(ReadOptions):
     slice (``start``/``end``) or mapping is another reading.
     """
 
-    cache: dict[Any, Recording] = field(default_factory=dict, compare=False, repr=False)
+    cache: dict[Any, Any] = field(default_factory=dict, compare=False, repr=False)
 
-    def _whole(self, path: str | Path) -> Recording:
+    def _key(self, path: str | Path) -> tuple[Any, ...]:
         words = self.keywords()
         words.pop("freq_band_hz", None)
         words.pop("freq_span_hz", None)
-        key = (str(Path(path).resolve()), repr(sorted(words.items())), self.chunk_rows)
+        return (str(Path(path).resolve()), repr(sorted(words.items())), self.chunk_rows)
+
+    def _whole(self, path: str | Path) -> Recording:
+        key = self._key(path)
         if key not in self.cache:
+            words = self.keywords()
+            words.pop("freq_band_hz", None)
+            words.pop("freq_span_hz", None)
+            dropped: dict[str, int] = {}
             self.cache[key] = concatenate(list(iter_chunks(path, rows=self.chunk_rows,
-                                                           **words)))
+                                                           dropped=dropped, **words)))
+            self.cache[("dropped", *key)] = dropped
         return self.cache[key]
 
     def _cached(self) -> bool:
         # a single-axis reading with a plausible band is checked by the reader itself
         return self.axis is not None or self.freq_band_hz is None
 
-    def chunks(self, path: str | Path, rows: int | None = None) -> Iterator[Recording]:
-        """The file's rows in chunks of ``rows`` (with ``axis``: that axis's views)."""
+    def chunks(self, path: str | Path, rows: int | None = None,
+               dropped: dict[str, int] | None = None) -> Iterator[Recording]:
+        """The file's rows in chunks of ``rows`` (with ``axis``: that axis's views);
+        ``dropped`` gets the rows the spike filters removed from the one reading."""
         if not self._cached():
-            return super().chunks(path, rows)
+            return super().chunks(path, rows, dropped)
         whole = self._whole(path)
+        if dropped is not None:
+            for what, count in self.cache[("dropped", *self._key(path))].items():
+                dropped[what] = dropped.get(what, 0) + count
         size = rows or self.chunk_rows
         pieces = (whole.slice(start, min(start + size, len(whole)))
                   for start in range(0, len(whole), size))
