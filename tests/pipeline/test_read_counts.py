@@ -152,3 +152,18 @@ def test_reading_once_gives_the_same_instrument_model(campaign, monkeypatch):
     for axis in once.validation:
         assert [v.to_dict() for v in once.validation[axis]] == \
             [v.to_dict() for v in streamed.validation[axis]]
+
+
+def test_report_reads_each_run_and_soak_once(campaign):
+    """``hrgtc report`` evaluates every axis of a run from one reading
+    (:func:`hrgtc.evaluation.instrument_pass.evaluate_axes`) and traces every axis of a soak
+    from one reading: two passes over a run (the at-rest detector's columns, then the
+    measuring pass) and one over a soak; before: 2 passes and 2 heads of a run per axis
+    (6 and 6 for three axes), one pass of a soak per axis (3 for three axes)."""
+    output = campaign["model"].with_name("report.html")
+    counts = _counts(["report", campaign["warm"], "-m", campaign["model"], "--soak",
+                      campaign["soaks"][0], "-o", output, "--force"])
+    table = counts.table([campaign["warm"], campaign["soaks"][0]])
+    assert {k: table[campaign["warm"].name][k] for k in ("passes", "heads")} == {
+        "passes": 2, "heads": 1}
+    assert table[campaign["soaks"][0].name]["passes"] == 1
