@@ -251,7 +251,8 @@ def _cross_axis(result: CalibrationResult, axis: str, axes: Sequence[str],
     """Refit ``axis`` with the other resonators' frequencies as candidates (``a_f<other>``:
     each a thermometer of its own part of the unit, so their differences are the gradients
     across it) and keep that model only if it lowers the median held-out 10 s bias
-    stability by more than :data:`CROSS_AXIS_GAIN`."""
+    stability by more than :data:`CROSS_AXIS_GAIN`. The thermometer (plateaus, Tables 1-2)
+    is ``result``'s: only the drift model is fitted again."""
     others = {f"f{b}": f"freq_hz_{b}" for b in axes if b != axis}
     if not validate:
         return result, {"kept": False, "why": "no held-out run (--validate) to judge by",
@@ -259,7 +260,8 @@ def _cross_axis(result: CalibrationResult, axis: str, axes: Sequence[str],
     aux = {**dict(fit["aux"] or {}), **others}
     trial = calibrate(soaks, drifts, (), settings=fit["settings"], aux=aux,
                       housing_terms=fit["housing_terms"], prior=fit["prior"],
-                      read_options=options, progress=progress, thermometer=thermometer)
+                      read_options=options, progress=progress, thermometer=thermometer,
+                      soak_fit=result.soak_fit)  # the same thermometer: the drift fit only
 
     def held_out(model: UnitModel) -> float:
         return float(np.median([evaluate(path, model, allan=False, read_options=options)
