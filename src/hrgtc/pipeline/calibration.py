@@ -455,6 +455,25 @@ def _sensor_thermometer(training: Sequence[PathLike], options: ReadOptions) -> S
                 high = max(high, float(np.max(used)))
         check_sensor_swap(temperature, rate, str(path), *_sensor_columns(path, options))
     return SoakFit(identity((low, high)))
+def parse_aux(items: Iterable[str]) -> dict[str, str]:
+    """``NAME=COLUMN`` items (``--aux``) as ``{NAME: COLUMN}``, spaces around each trimmed.
+
+    Raises
+    ------
+    InputError
+        An item without ``=`` or with an empty side, or a name given twice.
+    """
+    out: dict[str, str] = {}
+    for item in items:
+        name, sep, column = item.partition("=")
+        if not sep or not name.strip() or not column.strip():
+            raise InputError(f"--aux {item!r}: write NAME=COLUMN, e.g. --aux drive=drive_amp_v")
+        if name.strip() in out:
+            raise InputError(f"--aux {name.strip()!r} given twice")
+        out[name.strip()] = column.strip()
+    return out
+
+
 def candidate_terms(terms: Iterable[str], aux: Mapping[str, str] | None,
                     heads: Sequence[Any]) -> tuple[str, ...]:
     """The drift fit's candidates: ``terms``, plus ``a_NAME`` for each mapped channel.
