@@ -227,10 +227,11 @@ def calibrate(
                                  housing_terms, soak_fit)
     if thermometer != "resonator":
         raise InputError(f"thermometer must be 'resonator' or 'sensor', got {thermometer!r}")
-    heads = {str(path): options.head(path) for path in drifts}  # a file's own errors first
     if not soaks:
         raise InputError("no soak recordings given; pass --soak FILE for each soak "
                          "(a gyro without a frequency output: --thermometer sensor)")
+
+    heads = {str(path): options.head(path) for path in drifts}
     for path in drifts:  # an HRG: a noise or bias only a MEMS gyro has is a unit mistake
         head = heads[str(path)]
         check_resonator_gyro(head.rate_dph, head.metadata.sample_rate_hz,
