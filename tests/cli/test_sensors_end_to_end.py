@@ -84,6 +84,24 @@ def test_cold_test_with_its_hand_log_end_to_end(tmp_path, monkeypatch):
     assert "(axes x, y, z)" in result.output
 
 
+def test_calibrate_prints_a_range_warning_common_to_the_axes_once(tmp_path, monkeypatch):
+    """Held out on the colder 40 % of the cold test, every axis (one shared temperature
+    column) is beyond the trained temperature and df/dt alike: each warning once, naming
+    the axes (issue 20 item 11; before: the same two lines once per axis)."""
+    from hrgtc.cli import _app
+
+    monkeypatch.setattr(_app.console, "width", 200)
+    result = runner.invoke(app, ["calibrate", "--drift", str(RUN), *READ, *REF,
+                                 "--holdout-fraction", "0.4", "-o", str(tmp_path / "pan.json")],
+                           terminal_width=200)
+    assert result.exit_code == 0, result.output
+    tail = result.output[result.output.index("Model written to"):]
+    assert tail.count("beyond the trained temperature") == 1, tail
+    assert tail.count("beyond the trained df/dt") == 1, tail
+    assert tail.count("(axes x, y, z)") == 2, tail
+    assert "axis x:" not in tail and "pan_tvc_cold_2020-03-07.csv:" in tail
+
+
 def test_one_cause_per_warning_whatever_the_axis():
     texts = [f"11.{k}% of samples of axis {a} beyond the trained temperature on rate_dph_{a}"
              for k, a in enumerate("xyz")]

@@ -312,9 +312,8 @@ def test_sensor_thermometer_cli_needs_no_soaks(campaign_factory, tmp_path):
 def test_aux_channels_and_gradient_terms_need_their_columns():
     # --aux NAME=COLUMN adds a_NAME to the candidates; a training run without the column, or
     # gradient terms without housing_c, stop with the file and the column named
-    from hrgtc.cli.calibrate_cmd import _aux_mapping
     from hrgtc.core.errors import InputError
-    from hrgtc.pipeline.calibration import GRADIENT_TERMS, candidate_terms
+    from hrgtc.pipeline.calibration import GRADIENT_TERMS, candidate_terms, parse_aux
 
     from synthetic import lagged_run, ramp_run
 
@@ -329,6 +328,6 @@ def test_aux_channels_and_gradient_terms_need_their_columns():
         candidate_terms(GRADIENT_TERMS, None, [bare])
     with pytest.raises(InputError, match="not usable"):
         candidate_terms(("f",), {"drive_1": "drive_v"}, [run])
-    assert _aux_mapping(["drive=drive_v", " quad = q_v "]) == {"drive": "drive_v", "quad": "q_v"}
+    assert parse_aux(["drive=drive_v", " quad = q_v "]) == {"drive": "drive_v", "quad": "q_v"}
     with pytest.raises(InputError, match="write NAME=COLUMN"):
-        _aux_mapping(["drive"])
+        parse_aux(["drive"])

@@ -20,6 +20,7 @@ from hrgtc.model_schema import strict
 from hrgtc.pipeline.instrument import calibrate_instrument, steady_segments, summary_rows
 from hrgtc.recording import ReadOptions, axis_view, read
 from hrgtc.settings.calibration import CalibrationSettings
+from hrgtc.settings.compensation import CompensateSettings
 from hrgtc.settings.drift import DriftSettings
 
 AXES = ("x", "y", "z")
@@ -97,7 +98,7 @@ def test_instrument_compensator_equals_each_axis_alone(calibration, imu_campaign
 def test_file_to_file_in_chunks_equals_batch(calibration, imu_campaign, tmp_path):
     output = tmp_path / "warm_comp.parquet"
     summary = compensate_instrument_file(imu_campaign.warmup, output, calibration.model,
-                                         chunk_rows=7_001)
+                                         settings=CompensateSettings(chunk_rows=7_001))
     written = read(output)
     batch = InstrumentCompensator(calibration.model).transform(read(imu_campaign.warmup))
     assert summary.rows == len(batch)

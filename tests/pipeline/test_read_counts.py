@@ -152,3 +152,67 @@ def test_reading_once_gives_the_same_instrument_model(campaign, monkeypatch):
     for axis in once.validation:
         assert [v.to_dict() for v in once.validation[axis]] == \
             [v.to_dict() for v in streamed.validation[axis]]
+
+
+def test_report_reads_each_run_and_soak_once(campaign):
+    """``hrgtc report`` evaluates every axis of a run from one reading
+    (:func:`hrgtc.evaluation.instrument_pass.evaluate_axes`) and traces every axis of a soak
+    from one reading: two passes over a run (the at-rest detector's columns, then the
+    measuring pass) and one over a soak; before: 2 passes and 2 heads of a run per axis
+    (6 and 6 for three axes), one pass of a soak per axis (3 for three axes)."""
+    output = campaign["model"].with_name("report.html")
+    counts = _counts(["report", campaign["warm"], "-m", campaign["model"], "--soak",
+                      campaign["soaks"][0], "-o", output, "--force"])
+    table = counts.table([campaign["warm"], campaign["soaks"][0]])
+    assert {k: table[campaign["warm"].name][k] for k in ("passes", "heads")} == {
+        "passes": 2, "heads": 1}
+    assert table[campaign["soaks"][0].name]["passes"] == 1
+
+
+def test_cross_axis_fits_the_thermometer_once(campaign, monkeypatch):
+    """``--cross-axis`` reuses each axis's thermometer (plateaus, Tables 1-2) for the trial
+    with the other resonators' frequencies: one thermometer fit and one plateau search per
+    axis and soak (before: two), and the same model as the old path that calibrated each
+    axis twice from scratch (coefficients to 1e-12)."""
+    import hrgtc.pipeline.calibration as calibration
+    import hrgtc.pipeline.instrument as instrument
+    from hrgtc.settings.calibration import CalibrationSettings
+
+    if "imu" not in str(campaign["cool"]):
+        pytest.skip("cross-axis terms need several axes")
+    calls = {"thermometer": 0, "plateaus": 0}
+
+    def counted(name, function):
+        def wrapper(*args, **words):
+            calls[name] += 1
+            return function(*args, **words)
+        return wrapper
+
+    monkeypatch.setattr(calibration, "fit_thermometer",
+                        counted("thermometer", calibration.fit_thermometer))
+    monkeypatch.setattr(calibration, "plateaus_from_recordings",
+                        counted("plateaus", calibration.plateaus_from_recordings))
+    settings = CalibrationSettings(cross_axis=True)
+    args = (campaign["soaks"], [campaign["cool"]], [campaign["warm"]])
+    once = calibrate_instrument(*args, settings=settings)
+    axes = len(once.model.axes)
+    assert calls == {"thermometer": axes, "plateaus": axes * len(campaign["soaks"])}
+    plain = instrument.calibrate
+
+    def from_scratch(*words, soak_fit=None, **more):  # the old path: calibrate everything
+        return plain(*words, **more)
+
+    monkeypatch.setattr(instrument, "calibrate", from_scratch)
+    twice = calibrate_instrument(*args, settings=settings)
+    assert calls["thermometer"] == 3 * axes
+    assert once.cross_axis == twice.cross_axis
+    for axis, model in once.model.axes.items():
+        other = twice.model.axes[axis]
+        np.testing.assert_allclose(model.thermometer.coefficients_high_first,
+                                   other.thermometer.coefficients_high_first, rtol=1e-12)
+        assert model.drift.selected == other.drift.selected
+        assert model.drift.coefficients == pytest.approx(other.drift.coefficients,
+                                                         rel=1e-12)
+        assert model.drift.intercept_dph == pytest.approx(other.drift.intercept_dph,
+                                                          rel=1e-12)
+    assert once.to_dict() == twice.to_dict()

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -21,7 +20,6 @@ from hrgtc.cli.options import (
 from hrgtc.cli.params import settings_options
 from hrgtc.settings.calibration import CalibrationSettings
 from hrgtc.settings.drift import EQ21_TERMS
-from hrgtc.settings.reading import ReadSettings
 
 if TYPE_CHECKING:
     from hrgtc.pipeline.calibration import CalibrationResult
@@ -175,6 +173,7 @@ def calibrate_command(
     """
     from hrgtc.core.files import check_writable, refuse_existing, refuse_input
     from hrgtc.model import save_instrument
+    from hrgtc.pipeline.calibration import parse_aux
     from hrgtc.pipeline.instrument import calibrate_instrument
     from hrgtc.recording import ReadOptions
 
@@ -195,19 +194,12 @@ def calibrate_command(
         if temp_ref is None and stray:
             raise fail(f"{stray[0]} describes a reference log: give the log with --temp-ref")
         if temp_ref is not None:
-            from hrgtc.thermometry.reference import (
-                map_from_reference,
-                options_with_map,
-                parse_reference_columns,
-            )
+            from hrgtc.thermometry.reference import map_from_reference, parse_reference_columns
 
             temperature_map = map_from_reference(
                 drift[0], temp_ref, inputs, columns=parse_reference_columns(temp_ref_col),
                 unit=temp_ref_unit,
                 start=temp_ref_start, tz=temp_ref_tz, lag_s=temp_ref_lag_s)
-            inputs = options_with_map(dataclasses.replace(
-                inputs, temp_scale=ReadSettings.temp_scale,
-                temp_offset_c=ReadSettings.temp_offset_c), temperature_map)
             if not json_output:
                 console.print("Temperature map: " + temperature_map.summary())
                 if temperature_map.extra.get("note"):
@@ -218,69 +210,28 @@ def calibrate_command(
                 stages[stage] = True
                 error_console.print(f"[dim]… {stage}[/]")
 
-        validate_options = None
-        if holdout_s is not None or holdout_fraction is not None:
-            inputs, validate_options, validate = _holdout(
-                inputs, soaks, drift, validate, holdout_s, holdout_fraction)
-            if not json_output:
-                error_console.print(f"[dim]… held out {drift[0]} from {inputs.end} s on[/]")
         calibration = calibrate_instrument(
-            soaks, drift, validate or (), validate_options=validate_options,
-            settings=settings, aux=_aux_mapping(aux or []), read_options=inputs,
+            soaks, drift, validate or (), holdout_s=holdout_s, holdout_fraction=holdout_fraction,
+            settings=settings, aux=parse_aux(aux or []), read_options=inputs,
             progress=progress, prior=prior, thermometer=inputs.thermometer,
             rate_tables=rate_table or (), validate_rate_tables=validate_rate_table or (),
-            segment_table=segments,
+            segment_table=segments, temperature_map=temperature_map,
         )
-        model = calibration.model
-        if temperature_map is not None:
-            model = dataclasses.replace(model, temperature_map=temperature_map.to_dict())
-        save_instrument(model, output, force=force)
-    single = calibration.model.is_single_axis
+        save_instrument(calibration.model, output, force=force)
     if json_output:
-        document = (calibration.axes[""].to_dict() if single and not calibration.scale_checks
-                    and calibration.model.axes[""].scale_factor is None
-                    else calibration.to_dict())
-        if single:
-            document["validation"] = [v.to_dict() for v in calibration.validation[""]]
-        if temperature_map is not None:
-            document["temperature_map"] = temperature_map.to_dict()
-        print_json({**document, "model_file": str(output)})
+        print_json({**calibration.document(), "model_file": str(output)})
     else:
         render_instrument(calibration)
         console.print(f"Model written to {output}")
-    beyond = False
-    for axis, runs in calibration.validation.items():  # beyond the trained ranges: --strict
-        for v in runs:
-            if v.range_warnings():
-                beyond = True
-                where = f"{v.file}" + (f", axis {axis}" if axis else "")
-                (error_console if json_output else console).print(f"{where}:")
-                warn_ranges([v.ranges], json_output, strict=False)
+    beyond = calibration.range_reports()
+    for file, reports in beyond.items():  # beyond the trained ranges: --strict
+        axes = [axis for axis in reports if axis]
+        (error_console if json_output else console).print(
+            f"{file}:" if len(axes) != 1 else f"{file}, axis {axes[0]}:")
+        warn_ranges(list(reports.values()), json_output, strict=False,
+                    labels=list(reports) if len(axes) > 1 else None)
     if strict and beyond:
         raise typer.Exit(STRICT_EXIT)
-
-
-def _holdout(inputs: ReadOptions, soaks: list[Path], drift: list[Path],
-             validate: list[Path] | None, holdout_s: float | None,
-             holdout_fraction: float | None) -> tuple[ReadOptions, ReadOptions, list[Path]]:
-    """Train on the first part of the one --drift file, validate on its last part (by time)."""
-    import dataclasses
-
-    from hrgtc.core.errors import InputError
-    from hrgtc.core.timeline import holdout_rows
-
-    if len(drift) != 1 or soaks or validate:
-        raise InputError("--holdout-s/--holdout-fraction hold out the end of one --drift file: "
-                         "give exactly one --drift and no --soak or --validate (or split the "
-                         "files yourself with --start/--end)")
-    if inputs.start is not None or inputs.end is not None:
-        raise InputError("--holdout-s/--holdout-fraction and --start/--end together: slice the "
-                         "file first, or use --end for training and --validate with --start")
-    time = inputs.read(drift[0], keep=["time_s"]).time_s
-    cut = holdout_rows(time, holdout_s, holdout_fraction)
-    at = f"{time[cut] - time[0]:.9g}"
-    return (dataclasses.replace(inputs, end=at), dataclasses.replace(inputs, start=at),
-            [drift[0]])
 
 
 def render_instrument(calibration: InstrumentCalibration) -> None:
@@ -334,18 +285,3 @@ def render_instrument(calibration: InstrumentCalibration) -> None:
                           number(row["scale_raw_max_ppm"], 1),
                           number(row["scale_residual_max_ppm"], 1))
         console.print(table)
-
-
-def _aux_mapping(items: list[str]) -> dict[str, str]:
-    """``--aux NAME=COLUMN`` options as {NAME: COLUMN}."""
-    from hrgtc.core.errors import InputError
-
-    out: dict[str, str] = {}
-    for item in items:
-        name, sep, column = item.partition("=")
-        if not sep or not name.strip() or not column.strip():
-            raise InputError(f"--aux {item!r}: write NAME=COLUMN, e.g. --aux drive=drive_amp_v")
-        if name.strip() in out:
-            raise InputError(f"--aux {name.strip()!r} given twice")
-        out[name.strip()] = column.strip()
-    return out

@@ -109,7 +109,8 @@ def compensate_command(
         refuse_input(output, [run, model_path])
         model = load_instrument(model_path)
         summary = compensate_instrument_file(run, output, model, force=force,
-                                             chunk_rows=chunk_rows, progress=progress,
+                                             settings=CompensateSettings(chunk_rows),
+                                             progress=progress,
                                              read_options=inputs, axes=parse_axes(axes),
                                              model_source=str(model_path))
     if json_output:

@@ -26,9 +26,11 @@ from hrgtc.compensate.compensator import (
 from hrgtc.compensate.model_fit import check_thermometer_kind, plausible_frequency_band
 from hrgtc.compensate.ranges import RangeReport
 from hrgtc.core.errors import InputError, RecordingError
+from hrgtc.core.progress import Progress
 from hrgtc.model import InstrumentModel, UnitModel, axis_suffix
 from hrgtc.recording import Recording, axis_names, axis_view
 from hrgtc.recording.axes import AXIS_PATTERN
+from hrgtc.settings.compensation import CompensateSettings
 
 __all__ = ["InstrumentCompensator", "compensate_instrument_file",
            "instrument_output_columns", "match_axes", "parse_axes", "recording_axes"]
@@ -268,12 +270,15 @@ def compensate_instrument_file(
     read_options: rec_io.ReadOptions | None = None,
     axes: Sequence[str] | None = None,
     model_source: str = "",
-    **options: Any,
+    force: bool = False,
+    settings: CompensateSettings | None = None,
+    progress: Progress | None = None,
 ) -> CompensationSummary:
     """Compensate every axis of a recording file into a new file (bounded memory).
 
-    As :func:`~hrgtc.compensate.compensator.compensate_file` (``options`` are its
-    keyword arguments); each axis's frequency is checked against that axis's
+    As :func:`~hrgtc.compensate.compensator.compensate_file` (``force``, ``progress``;
+    ``settings`` its chunk size, :class:`~hrgtc.settings.compensation.CompensateSettings`
+    defaults when None); each axis's frequency is checked against that axis's
     plausible band. A single-axis model is compensated exactly as by
     ``compensate_file``. The model's temperature map (a raw count's map to °C from
     ``calibrate --temp-ref``) is applied unless ``read_options`` give their own
@@ -283,6 +288,7 @@ def compensate_instrument_file(
     """
     from hrgtc.thermometry.reference import options_with_map
 
+    chunk_rows = (settings or CompensateSettings()).chunk_rows
     read_options = options_with_map(read_options, model.temperature_map)
     reading = read_options or rec_io.ReadOptions()
     for unit in model.axes.values():  # before reading: a model of the other thermometer kind
@@ -293,10 +299,12 @@ def compensate_instrument_file(
         model = match_axes(model, found, axes, str(source), model_source)
     if model.is_single_axis:
         return compensate_file(source, output, model.axes[""], drift=drift,
-                               read_options=read_options, **options)
+                               read_options=read_options, force=force,
+                               chunk_rows=chunk_rows, progress=progress)
     compensator = InstrumentCompensator(
         model, drift, gaps=reading.gaps,
         bands_hz={axis: plausible_frequency_band(unit) for axis, unit in model.axes.items()},
         partial=partial)
     return compensate_file(source, output, model, drift=drift,  # type: ignore[arg-type]
-                           read_options=reading, compensator=compensator, **options)
+                           read_options=reading, compensator=compensator, force=force,
+                           chunk_rows=chunk_rows, progress=progress)

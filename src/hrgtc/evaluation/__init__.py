@@ -10,6 +10,7 @@ merit themselves.
 """
 
 from hrgtc.evaluation.allan import AllanResult, allan_deviation
+from hrgtc.evaluation.evaluation_result import Evaluation
 from hrgtc.evaluation.metrics import (
     DEFAULT_TAUS_S,
     ResidualResult,
@@ -19,7 +20,7 @@ from hrgtc.evaluation.metrics import (
 )
 from hrgtc.evaluation.noise import NoiseTerms, noise_terms
 from hrgtc.evaluation.plot_blocks import BlockMeans, block_rows
-from hrgtc.evaluation.run_pass import Evaluation, evaluate, run_pass
+from hrgtc.evaluation.run_pass import evaluate, run_pass
 
 __all__ = [
     "DEFAULT_TAUS_S",

@@ -29,9 +29,10 @@ from hrgtc.core.errors import RecordingError
 from hrgtc.core.progress import Progress
 from hrgtc.drift.rest import run_rest
 from hrgtc.evaluation.allan import ONE_SIGMA
+from hrgtc.evaluation.evaluation_result import Evaluation
 from hrgtc.evaluation.metrics import DEFAULT_TAUS_S
 from hrgtc.evaluation.plot_blocks import block_rows
-from hrgtc.evaluation.run_pass import Evaluation, RunPass, count_dropped
+from hrgtc.evaluation.run_pass import RunPass, count_dropped
 from hrgtc.model import InstrumentModel
 from hrgtc.recording import ReadOptions, Recording, axis_view, count_rows
 from hrgtc.recording.marks import refuse_compensated

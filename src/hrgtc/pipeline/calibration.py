@@ -60,6 +60,36 @@ HOUSING_TERMS = ("h", "h^2", "h^3")
 
 
 @dataclass(frozen=True)
+class SoakFit:
+    """The thermometer of a unit and its evidence (:func:`fit_soaks`).
+
+    Attributes
+    ----------
+    thermometer
+        Frequency -> temperature (Eq. 18 form), or the identity of a gyro without a
+        frequency output (its range that of the training runs).
+    plateaus
+        One per soak, in input order (none for a sensor thermometer).
+    table
+        The unit's Tables 1 and 2 (see :class:`CalibrationResult`).
+    prior_fit
+        The posterior when a population prior was given.
+    order
+        The thermometer polynomial's order (None for a sensor thermometer).
+    sample_rates_hz
+        Each soak file's sample rate (a soak joins the drift fit only at the drift
+        runs' rate).
+    """
+
+    thermometer: Any
+    plateaus: tuple[Plateau, ...] = ()
+    table: tuple[dict[str, float], ...] = ()
+    prior_fit: PriorFit | None = None
+    order: int | None = None
+    sample_rates_hz: tuple[float, ...] = ()
+
+
+@dataclass(frozen=True)
 class CalibrationResult:
     """What :func:`calibrate` produced: the model and the evidence.
 
@@ -81,6 +111,8 @@ class CalibrationResult:
     table: tuple[dict[str, float], ...]
     validation: tuple[Evaluation, ...] = field(default=())
     prior_fit: PriorFit | None = None
+    #: The thermometer fit this calibration used (``calibrate(soak_fit=...)`` reuses it).
+    soak_fit: SoakFit | None = field(default=None, compare=False, repr=False)
 
     def to_dict(self) -> dict[str, Any]:
         """The layout of ``hrgtc calibrate --json``."""
@@ -197,6 +229,7 @@ def calibrate(
     progress: StageProgress | None = None,
     prior: ThermometerPrior | PathLike | None = None,
     thermometer: str = ReadSettings.thermometer,
+    soak_fit: SoakFit | None = None,
 ) -> CalibrationResult:
     """Calibrate a unit: thermometer from soaks, drift model from ramps, held-out validation.
 
@@ -242,6 +275,12 @@ def calibrate(
         ``"sensor"``: a gyro without a frequency output, whose temperature sensor
         (``temperature_c``, read in the place of ``freq_hz``) is the thermometer
         (:func:`hrgtc.thermometry.identity`); soaks are then optional training runs.
+    soak_fit
+        The thermometer already fitted on these soaks (and drift runs) with these
+        settings (:attr:`CalibrationResult.soak_fit` of an earlier calibration, or
+        :func:`fit_soaks`): its plateaus, Tables 1-2 and thermometer are reused and only
+        the drift model is fitted (``--cross-axis`` refits the drift model with more
+        candidate terms on the same files).
     """
     options = read_options or ReadOptions()
     settings = settings or CalibrationSettings()
@@ -250,7 +289,7 @@ def calibrate(
     refuse_compensated_training([*soaks, *drifts, *validate])
     if thermometer == "sensor":
         return _calibrate_sensor(soaks, drifts, validate, options, progress, settings, aux,
-                                 housing_terms)
+                                 housing_terms, soak_fit)
     if thermometer != "resonator":
         raise InputError(f"thermometer must be 'resonator' or 'sensor', got {thermometer!r}")
     # the drifts' heads first: a file's own reading problem (time in ms, a wrong unit) is
@@ -263,6 +302,64 @@ def calibrate(
         head = heads[str(path)]
         check_resonator_gyro(head.rate_dph, head.metadata.sample_rate_hz,
                              head.metadata.input_rate_dph or 0.0, str(path))
+    fitted = soak_fit or fit_soaks(soaks, settings=settings, prior=prior,
+                                   read_options=options, progress=progress)
+    thermometer_fit, plateaus, table = fitted.thermometer, fitted.plateaus, fitted.table
+    prior_fit, soak_rates = fitted.prior_fit, fitted.sample_rates_hz
+
+    heads.update({str(path): options.head(path) for path in soaks if str(path) not in heads})
+    drift_rate = heads[str(drifts[0])].metadata.sample_rate_hz
+    extra = [p for p, r in zip(soaks, soak_rates, strict=True) if math.isclose(r, drift_rate)]
+    if settings.drift_from_soaks and len(extra) < len(soaks):
+        warnings.warn(
+            f"{len(soaks) - len(extra)} soak file(s) are not at the drift runs' "
+            f"{drift_rate:g} Hz and are left out of the drift fit (its windows and settling "
+            "time are counted in samples at one rate); they still calibrate the thermometer",
+            HrgtcWarning, stacklevel=2,
+        )
+    training = [*drifts, *(extra if settings.drift_from_soaks else ())]
+    training_heads = [heads[str(p)] for p in training]
+    settings = _with_terms(settings, resolve_terms(settings.drift.terms, aux, training_heads))
+    model, housing = _fit_drift(training, heads, thermometer_fit, options, progress,
+                                len(drifts), settings.drift, aux, housing_terms)
+    unit = heads[str(drifts[0])].metadata.unit
+    record = _record(settings, aux, housing_terms, options, order=fitted.order)
+    if prior_fit is not None:
+        record["prior"] = {"units": prior_fit.prior.n_units,
+                             "range_c": list(prior_fit.prior.temperature_range_c),
+                             "max_temperature_std_c": prior_fit.max_temperature_std_c}
+    unit_model = UnitModel(
+        thermometer=thermometer_fit,
+        drift=model,
+        housing=housing,
+        unit=unit,
+        training=TrainingStatistics.from_runs(training_heads),
+        plateaus=tuple(p.to_dict() for p in plateaus),
+        provenance=provenance(
+            {"soak": [str(p) for p in soaks], "drift": [str(p) for p in drifts],
+             "validate": [str(p) for p in validate]},
+            record,
+        ),
+    )
+    validation = tuple(
+        evaluate(path, unit_model, allan=False, read_options=options)
+        for path in validate
+    )
+    return CalibrationResult(unit_model, tuple(plateaus), table, validation, prior_fit,
+                             fitted)
+
+
+def fit_soaks(soaks: Sequence[PathLike], *, settings: CalibrationSettings | None = None,
+              prior: ThermometerPrior | PathLike | None = None,
+              read_options: ReadOptions | None = None,
+              progress: StageProgress | None = None) -> SoakFit:
+    """The thermometer from the soaks: plateaus -> Table 1 -> Eq. 18 form -> Table 2.
+
+    Parameters are those of :func:`calibrate` (``settings.plateaus`` finds the plateaus,
+    ``settings.thermometer.order`` is the polynomial's order unless a prior gives it).
+    """
+    options = read_options or ReadOptions()
+    settings = settings or CalibrationSettings()
     plateaus: list[Plateau] = []
     soak_rates: list[float] = []
     for number, path in enumerate(soaks):
@@ -292,46 +389,7 @@ def calibrate(
          "error_c": float(e - t)}
         for t, f, e in zip(temperatures, frequencies, from_freq, strict=True)
     )
-
-    heads.update({str(path): options.head(path) for path in soaks if str(path) not in heads})
-    drift_rate = heads[str(drifts[0])].metadata.sample_rate_hz
-    extra = [p for p, r in zip(soaks, soak_rates, strict=True) if math.isclose(r, drift_rate)]
-    if settings.drift_from_soaks and len(extra) < len(soaks):
-        warnings.warn(
-            f"{len(soaks) - len(extra)} soak file(s) are not at the drift runs' "
-            f"{drift_rate:g} Hz and are left out of the drift fit (its windows and settling "
-            "time are counted in samples at one rate); they still calibrate the thermometer",
-            HrgtcWarning, stacklevel=2,
-        )
-    training = [*drifts, *(extra if settings.drift_from_soaks else ())]
-    training_heads = [heads[str(p)] for p in training]
-    settings = _with_terms(settings, resolve_terms(settings.drift.terms, aux, training_heads))
-    model, housing = _fit_drift(training, heads, thermometer, options, progress, len(drifts),
-                                settings.drift, aux, housing_terms)
-    unit = heads[str(drifts[0])].metadata.unit
-    record = _record(settings, aux, housing_terms, options, order=order)
-    if prior_fit is not None:
-        record["prior"] = {"units": prior_fit.prior.n_units,
-                             "range_c": list(prior_fit.prior.temperature_range_c),
-                             "max_temperature_std_c": prior_fit.max_temperature_std_c}
-    unit_model = UnitModel(
-        thermometer=thermometer,
-        drift=model,
-        housing=housing,
-        unit=unit,
-        training=TrainingStatistics.from_runs(training_heads),
-        plateaus=tuple(p.to_dict() for p in plateaus),
-        provenance=provenance(
-            {"soak": [str(p) for p in soaks], "drift": [str(p) for p in drifts],
-             "validate": [str(p) for p in validate]},
-            record,
-        ),
-    )
-    validation = tuple(
-        evaluate(path, unit_model, allan=False, read_options=options)
-        for path in validate
-    )
-    return CalibrationResult(unit_model, tuple(plateaus), table, validation, prior_fit)
+    return SoakFit(thermometer, tuple(plateaus), table, prior_fit, order, tuple(soak_rates))
 
 
 def _with_terms(settings: CalibrationSettings, terms: Iterable[str]) -> CalibrationSettings:
@@ -409,8 +467,8 @@ def _sensor_columns(path: PathLike, options: ReadOptions) -> tuple[str, str]:
 def _calibrate_sensor(soaks: Sequence[PathLike], drifts: Sequence[PathLike],
                       validate: Sequence[PathLike], options: ReadOptions,
                       progress: StageProgress | None, settings: CalibrationSettings,
-                      aux: Mapping[str, str] | None, housing_terms: Iterable[str] | None
-                      ) -> CalibrationResult:
+                      aux: Mapping[str, str] | None, housing_terms: Iterable[str] | None,
+                      soak_fit: SoakFit | None = None) -> CalibrationResult:
     """A gyro without a frequency output: its temperature sensor is the thermometer.
 
     Every run (soaks included) trains the drift model in (T, dT/dt); the identity
@@ -418,21 +476,8 @@ def _calibrate_sensor(soaks: Sequence[PathLike], drifts: Sequence[PathLike],
     """
     options = dataclasses.replace(options, thermometer="sensor")
     training = [*drifts, *soaks]
-    low, high = math.inf, -math.inf
-    for path in training:  # the range of the samples the fit uses: those at rest
-        keep = run_rest(options.chunks(path), options.motion).keep
-        row = 0
-        temperature, rate = ChannelShape(), ChannelShape()
-        for chunk in options.chunks(path):
-            used = chunk.freq_hz[keep[row:row + len(chunk)]]
-            row += len(chunk)
-            temperature.add(chunk.freq_hz)
-            rate.add(chunk.rate_dph)
-            if used.size:
-                low = min(low, float(np.min(used)))
-                high = max(high, float(np.max(used)))
-        check_sensor_swap(temperature, rate, str(path), *_sensor_columns(path, options))
-    thermometer = identity((low, high))
+    fitted = soak_fit or _sensor_thermometer(training, options)
+    thermometer = fitted.thermometer
     heads = {str(path): options.head(path) for path in training}
     for path in drifts:  # any gyro: only a density beyond every gyro's can be told
         head = heads[str(path)]
@@ -455,7 +500,46 @@ def _calibrate_sensor(soaks: Sequence[PathLike], drifts: Sequence[PathLike],
     )
     validation = tuple(evaluate(path, unit_model, allan=False, read_options=options)
                        for path in validate)
-    return CalibrationResult(unit_model, (), (), validation, None)
+    return CalibrationResult(unit_model, (), (), validation, None, fitted)
+
+
+def _sensor_thermometer(training: Sequence[PathLike], options: ReadOptions) -> SoakFit:
+    """The identity thermometer over the training runs' temperatures at rest (each run's
+    sensor and rate columns checked for a swap on the way)."""
+    low, high = math.inf, -math.inf
+    for path in training:  # the range of the samples the fit uses: those at rest
+        keep = run_rest(options.chunks(path), options.motion).keep
+        row = 0
+        temperature, rate = ChannelShape(), ChannelShape()
+        for chunk in options.chunks(path):
+            used = chunk.freq_hz[keep[row:row + len(chunk)]]
+            row += len(chunk)
+            temperature.add(chunk.freq_hz)
+            rate.add(chunk.rate_dph)
+            if used.size:
+                low = min(low, float(np.min(used)))
+                high = max(high, float(np.max(used)))
+        check_sensor_swap(temperature, rate, str(path), *_sensor_columns(path, options))
+    return SoakFit(identity((low, high)))
+def parse_aux(items: Iterable[str]) -> dict[str, str]:
+    """``NAME=COLUMN`` items (``--aux``) as ``{NAME: COLUMN}``, spaces around each trimmed.
+
+    Raises
+    ------
+    InputError
+        An item without ``=`` or with an empty side, or a name given twice.
+    """
+    out: dict[str, str] = {}
+    for item in items:
+        name, sep, column = item.partition("=")
+        if not sep or not name.strip() or not column.strip():
+            raise InputError(f"--aux {item!r}: write NAME=COLUMN, e.g. --aux drive=drive_amp_v")
+        if name.strip() in out:
+            raise InputError(f"--aux {name.strip()!r} given twice")
+        out[name.strip()] = column.strip()
+    return out
+
+
 def candidate_terms(terms: Iterable[str], aux: Mapping[str, str] | None,
                     heads: Sequence[Any]) -> tuple[str, ...]:
     """The drift fit's candidates: ``terms``, plus ``a_NAME`` for each mapped channel.

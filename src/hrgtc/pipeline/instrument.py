@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from hrgtc.compensate import InstrumentCompensator
+from hrgtc.compensate.ranges import RangeReport
 from hrgtc.core.errors import InputError
 from hrgtc.core.progress import StageProgress
 from hrgtc.drift import (
@@ -41,9 +42,11 @@ from hrgtc.recording.read_once import ReadOnce
 from hrgtc.settings.calibration import CROSS_AXIS_GAIN, CalibrationSettings
 from hrgtc.settings.reading import ReadSettings
 from hrgtc.thermometry.prior import ThermometerPrior
+from hrgtc.thermometry.reference import TemperatureMap
 
 __all__ = ["InstrumentCalibration", "InstrumentEvaluation", "ScaleFactorCheck",
-           "calibrate_instrument", "check_scale_factor", "evaluate_instrument"]
+           "calibrate_instrument", "check_scale_factor", "evaluate_instrument",
+           "holdout_split"]
 
 PathLike = str | os.PathLike[str]
 
@@ -107,6 +110,31 @@ class InstrumentCalibration:
                 "scale_factor_checks": [c.to_dict() for c in self.scale_checks],
                 "cross_axis": dict(self.cross_axis)}
 
+    def document(self) -> dict[str, Any]:
+        """The document of ``hrgtc calibrate --json``: a single-axis unit without a scale
+        factor as :meth:`CalibrationResult.to_dict` (with its held-out runs), else
+        :meth:`to_dict`; the temperature map (``--temp-ref``) when the model has one."""
+        single = self.model.is_single_axis
+        if single and not self.scale_checks and self.model.axes[""].scale_factor is None:
+            document = self.axes[""].to_dict()
+        else:
+            document = self.to_dict()
+        if single:
+            document["validation"] = [v.to_dict() for v in self.validation[""]]
+        if self.model.temperature_map is not None:
+            document["temperature_map"] = dict(self.model.temperature_map)
+        return document
+
+    def range_reports(self) -> dict[str, dict[str, RangeReport]]:
+        """Held-out file -> axis -> its range report, where any axis went beyond the
+        trained temperature or df/dt (``--strict`` fails then)."""
+        out: dict[str, dict[str, RangeReport]] = {}
+        for axis, runs in self.validation.items():
+            for run in runs:
+                if run.ranges is not None and run.range_warnings():
+                    out.setdefault(run.file, {})[axis] = run.ranges
+        return out
+
 
 def axis_options(options: ReadOptions, axis: str) -> ReadOptions:
     """``options`` reading the single-axis view of ``axis`` ("" : the file as it is)."""
@@ -129,6 +157,9 @@ def calibrate_instrument(
     read_options: ReadOptions | None = None,
     progress: StageProgress | None = None,
     validate_options: ReadOptions | None = None,
+    temperature_map: TemperatureMap | None = None,
+    holdout_s: float | None = None,
+    holdout_fraction: float | None = None,
 ) -> InstrumentCalibration:
     """Calibrate every axis of an instrument (a single-axis file: the one axis).
 
@@ -175,6 +206,15 @@ def calibrate_instrument(
     if thermometer not in ("resonator", "sensor"):
         raise InputError(f"thermometer must be 'resonator' or 'sensor', got {thermometer!r}")
     options = dataclasses.replace(read_options or ReadOptions(), thermometer=thermometer)
+    if temperature_map is not None:
+        options = _through_map(options, temperature_map)
+        validate_options = (None if validate_options is None
+                            else _through_map(validate_options, temperature_map))
+    if holdout_s is not None or holdout_fraction is not None:
+        options, validate_options, validate = holdout_split(
+            options, soaks, drifts, validate, holdout_s, holdout_fraction)
+        if progress is not None:
+            progress(f"held out {drifts[0]} from {options.end} s on", 1.0, 1.0)
     if not drifts:
         raise InputError("no drift recordings given; pass --drift FILE (a cool-down or warm-up)")
     refuse_compensated_training([*soaks, *drifts, *validate, *rate_tables,
@@ -212,7 +252,8 @@ def calibrate_instrument(
                                  "segment_table": None if segment_table is None
                                  else str(segment_table)})
     models = {axis: dataclasses.replace(m, provenance=record) for axis, m in models.items()}
-    instrument = InstrumentModel(models, unit, record)
+    instrument = InstrumentModel(models, unit, record, None if temperature_map is None
+                                 else temperature_map.to_dict())
     held_out = options if validate_options is None else _same_cache(dataclasses.replace(
         validate_options, thermometer=thermometer), options)
     validation = {axis: tuple(evaluate(path, models[axis], allan=False,
@@ -222,6 +263,50 @@ def calibrate_instrument(
                    for path in validate_rate_tables)
     return InstrumentCalibration(instrument, results, validation,
                                  tuple(c for group in checks for c in group), crossed)
+
+
+def _through_map(options: ReadOptions, temperature_map: TemperatureMap) -> ReadOptions:
+    """``options`` reading the raw count through ``temperature_map`` (in the place of the
+    reading's temperature scale and offset)."""
+    from hrgtc.thermometry.reference import options_with_map
+
+    return options_with_map(dataclasses.replace(
+        options, temp_scale=ReadSettings.temp_scale,
+        temp_offset_c=ReadSettings.temp_offset_c), temperature_map)
+
+
+def holdout_split(read_options: ReadOptions, soaks: Sequence[PathLike],
+                  drifts: Sequence[PathLike], validate: Sequence[PathLike],
+                  holdout_s: float | None = None, holdout_fraction: float | None = None
+                  ) -> tuple[ReadOptions, ReadOptions, list[PathLike]]:
+    """Train on the first part of the one drift file, validate on its last part (by time).
+
+    The cut is :func:`hrgtc.core.timeline.holdout_rows` of the file's time stamps (the
+    last ``holdout_s`` seconds or ``holdout_fraction`` of the recorded time, at a segment
+    start: a burst is never split).
+
+    Returns
+    -------
+    tuple
+        The training reading options (``end`` at the cut), the held-out run's
+        (``start`` at the cut) and the held-out runs (the drift file), for
+        :func:`calibrate_instrument`'s ``read_options``, ``validate_options`` and
+        ``validate``.
+    """
+    from hrgtc.core.timeline import holdout_rows
+
+    if len(drifts) != 1 or soaks or validate:
+        raise InputError("--holdout-s/--holdout-fraction hold out the end of one --drift file: "
+                         "give exactly one --drift and no --soak or --validate (or split the "
+                         "files yourself with --start/--end)")
+    if read_options.start is not None or read_options.end is not None:
+        raise InputError("--holdout-s/--holdout-fraction and --start/--end together: slice the "
+                         "file first, or use --end for training and --validate with --start")
+    time = read_options.read(drifts[0], keep=["time_s"]).time_s
+    cut = holdout_rows(time, holdout_s, holdout_fraction)
+    at = f"{time[cut] - time[0]:.9g}"
+    return (dataclasses.replace(read_options, end=at),
+            dataclasses.replace(read_options, start=at), [drifts[0]])
 
 
 def _axes_of(path: PathLike, options: ReadOptions) -> tuple[str, ...]:
@@ -251,7 +336,8 @@ def _cross_axis(result: CalibrationResult, axis: str, axes: Sequence[str],
     """Refit ``axis`` with the other resonators' frequencies as candidates (``a_f<other>``:
     each a thermometer of its own part of the unit, so their differences are the gradients
     across it) and keep that model only if it lowers the median held-out 10 s bias
-    stability by more than :data:`CROSS_AXIS_GAIN`."""
+    stability by more than :data:`CROSS_AXIS_GAIN`. The thermometer (plateaus, Tables 1-2)
+    is ``result``'s: only the drift model is fitted again."""
     others = {f"f{b}": f"freq_hz_{b}" for b in axes if b != axis}
     if not validate:
         return result, {"kept": False, "why": "no held-out run (--validate) to judge by",
@@ -259,7 +345,8 @@ def _cross_axis(result: CalibrationResult, axis: str, axes: Sequence[str],
     aux = {**dict(fit["aux"] or {}), **others}
     trial = calibrate(soaks, drifts, (), settings=fit["settings"], aux=aux,
                       housing_terms=fit["housing_terms"], prior=fit["prior"],
-                      read_options=options, progress=progress, thermometer=thermometer)
+                      read_options=options, progress=progress, thermometer=thermometer,
+                      soak_fit=result.soak_fit)  # the same thermometer: the drift fit only
 
     def held_out(model: UnitModel) -> float:
         return float(np.median([evaluate(path, model, allan=False, read_options=options)

@@ -35,25 +35,25 @@ class ReadOnce(ReadOptions):
     slice (``start``/``end``) or mapping is another reading.
     """
 
-    cache: dict[Any, tuple[Recording, dict[str, int]]] = field(
-        default_factory=dict, compare=False, repr=False)
+    cache: dict[Any, Any] = field(default_factory=dict, compare=False, repr=False)
 
-    def _whole(self, path: str | Path, dropped: dict[str, int] | None = None) -> Recording:
-        """The file, read the first time; ``dropped`` gets the rows its reading removed."""
+    def _key(self, path: str | Path) -> tuple[Any, ...]:
         words = self.keywords()
         words.pop("freq_band_hz", None)
         words.pop("freq_span_hz", None)
-        key = (str(Path(path).resolve()), repr(sorted(words.items())), self.chunk_rows)
+        return (str(Path(path).resolve()), repr(sorted(words.items())), self.chunk_rows)
+
+    def _whole(self, path: str | Path) -> Recording:
+        key = self._key(path)
         if key not in self.cache:
-            removed: dict[str, int] = {}
-            whole = concatenate(list(iter_chunks(path, rows=self.chunk_rows, dropped=removed,
-                                                 **words)))
-            self.cache[key] = (whole, removed)
-        whole, removed = self.cache[key]
-        if dropped is not None:
-            for reason, count in removed.items():
-                dropped[reason] = dropped.get(reason, 0) + count
-        return whole
+            words = self.keywords()
+            words.pop("freq_band_hz", None)
+            words.pop("freq_span_hz", None)
+            dropped: dict[str, int] = {}
+            self.cache[key] = concatenate(list(iter_chunks(path, rows=self.chunk_rows,
+                                                           dropped=dropped, **words)))
+            self.cache[("dropped", *key)] = dropped
+        return self.cache[key]
 
     def _cached(self) -> bool:
         # a single-axis reading with a plausible band is checked by the reader itself
@@ -62,10 +62,13 @@ class ReadOnce(ReadOptions):
     def chunks(self, path: str | Path, rows: int | None = None,
                dropped: dict[str, int] | None = None) -> Iterator[Recording]:
         """The file's rows in chunks of ``rows`` (with ``axis``: that axis's views);
-        ``dropped`` gets the rows the reading removed, as the streamed reading reports."""
+        ``dropped`` gets the rows the spike filters removed from the one reading."""
         if not self._cached():
             return super().chunks(path, rows, dropped)
-        whole = self._whole(path, dropped)
+        whole = self._whole(path)
+        if dropped is not None:
+            for what, count in self.cache[("dropped", *self._key(path))].items():
+                dropped[what] = dropped.get(what, 0) + count
         size = rows or self.chunk_rows
         pieces = (whole.slice(start, min(start + size, len(whole)))
                   for start in range(0, len(whole), size))

@@ -1,10 +1,12 @@
 """Build the HTML report of a unit or of a whole instrument (one section per axis).
 
 :func:`build_report` reads the soaks and runs chunk by chunk, evaluates each run
-(:func:`hrgtc.evaluation.evaluate` with plotting blocks) and writes one
+(every axis as :func:`hrgtc.evaluation.evaluate` with plotting blocks) and writes one
 self-contained page with the sections of :mod:`hrgtc.report.html`. A multi-axis
 model gives the instrument's summary (one row per axis and run) and then every
-axis's sections, each reading its single-axis view of the files.
+axis's sections; each file is read once for all the axes
+(:func:`hrgtc.evaluation.instrument_pass.evaluate_axes`,
+:func:`hrgtc.report.figures.trace_soak_axes`).
 """
 
 from __future__ import annotations
@@ -18,10 +20,11 @@ from pathlib import Path
 from hrgtc.core.errors import InputError
 from hrgtc.core.files import refuse_existing, write_text_atomic
 from hrgtc.core.progress import Progress
-from hrgtc.evaluation import Evaluation, evaluate
+from hrgtc.evaluation import Evaluation
+from hrgtc.evaluation.instrument_pass import evaluate_axes
 from hrgtc.model import InstrumentModel, UnitModel, load_instrument
 from hrgtc.recording import ReadOptions, count_rows
-from hrgtc.report.figures import trace_soak
+from hrgtc.report.figures import SoakTrace, trace_soak_axes
 from hrgtc.report.html import (
     _CSS,
     DOI,
@@ -127,7 +130,9 @@ def build_report(
             raise InputError(f"{run.file}: the evaluation kept no plotting blocks (or the model "
                              "has several axes); evaluate it with max_points, or pass the file")
     files = [run for run in runs if not isinstance(run, Evaluation)]
-    total = len(instrument.axes) * sum(count_rows(p) for p in [*soak_paths, *files])
+    traced = {axis: m.thermometer for axis, m in instrument.axes.items()
+              if m.thermometer.source != "sensor"}
+    total = sum(count_rows(p) for p in [*(soak_paths if traced else ()), *files])
     done = 0
 
     def advance(rows: int) -> None:
@@ -139,18 +144,24 @@ def build_report(
     page = _Page()
     _header(page, dataclasses.replace(first, unit=instrument.unit), title
             or f"Temperature compensation report — unit {instrument.unit}", model_path)
+    evaluations: dict[str, list[Evaluation]] = {axis: [] for axis in instrument.axes}
+    for run in runs:  # every axis of a run from one reading
+        found = ({"": run} if isinstance(run, Evaluation) else
+                 _evaluate_run(run, instrument, options, max_points, advance))
+        for axis, result in found.items():
+            evaluations[axis].append(result)
+    traces: dict[str, list[SoakTrace]] = {axis: [] for axis in traced}
+    for path in soak_paths if traced else ():  # every axis of a soak from one reading
+        for axis, trace in trace_soak_axes(path, traced, max_points=max_points,
+                                           read_options=soak_options,
+                                           on_chunk=advance).items():
+            traces[axis].append(trace)
     sections: dict[str, list[str]] = {}
-    evaluations: dict[str, list[Evaluation]] = {}
     for axis, unit_model in instrument.axes.items():
         axis_page = _Page()
         axis_page.count = page.count
-        read = dataclasses.replace(options, axis=axis or None)
-        soak_read = dataclasses.replace(soak_options, axis=axis or None)
-        evaluations[axis] = [run if isinstance(run, Evaluation) else
-                             _evaluate_run(run, unit_model, read, max_points, advance)
-                             for run in runs]
-        _unit_sections(axis_page, unit_model, evaluations[axis], soak_paths, soak_read,
-                       missing, max_points, advance)
+        _unit_sections(axis_page, unit_model, evaluations[axis], traces.get(axis, []),
+                       missing)
         page.count = axis_page.count
         sections[axis] = axis_page.parts
     if instrument.is_single_axis:
@@ -177,15 +188,11 @@ def build_report(
 
 
 def _unit_sections(page: _Page, model: UnitModel, evaluations: Sequence[Evaluation],
-                   soak_paths: Sequence[str], soak_options: ReadOptions, missing: list[str],
-                   max_points: int, advance: Callable[[int], None]) -> None:
+                   traces: Sequence[SoakTrace], missing: list[str]) -> None:
     """One axis's sections: Figs. 3-5 and Tables 1-2, its runs, drift and scale factor."""
     plateaus = [Plateau.from_dict(p) for p in model.plateaus]
     table = _table_rows(model, plateaus)
     sensor = model.thermometer.source == "sensor"
-    traces = [] if sensor else [
-        trace_soak(p, model.thermometer, max_points=max_points, read_options=soak_options,
-                   on_chunk=advance) for p in soak_paths]
     if sensor:
         low, high = model.thermometer.temperature_range_c
         page.note(f"No frequency output: the gyro's temperature sensor is the thermometer "
@@ -230,9 +237,10 @@ def _instrument_summary(page: _Page, model: InstrumentModel,
                                    for a in model.axes) + "</ol></nav></section>")
 
 
-def _evaluate_run(path: PathLike, model: UnitModel, options: ReadOptions, max_points: int,
-                  advance: Callable[[int], None]) -> Evaluation:
-    """The one run pass of :func:`hrgtc.evaluation.evaluate`, with plotting blocks."""
+def _evaluate_run(path: PathLike, model: InstrumentModel, options: ReadOptions,
+                  max_points: int, advance: Callable[[int], None]) -> dict[str, Evaluation]:
+    """Every axis of a run from one reading
+    (:func:`hrgtc.evaluation.instrument_pass.evaluate_axes`), with plotting blocks."""
     seen = 0
 
     def progress(done: float, _total: float) -> None:
@@ -240,4 +248,5 @@ def _evaluate_run(path: PathLike, model: UnitModel, options: ReadOptions, max_po
         advance(int(done) - seen)
         seen = int(done)
 
-    return evaluate(path, model, read_options=options, max_points=max_points, progress=progress)
+    return evaluate_axes(path, model, read_options=options, max_points=max_points,
+                         progress=progress)

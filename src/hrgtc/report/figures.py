@@ -135,21 +135,45 @@ def trace_soak(
     read_options: ReadOptions | None = None, on_chunk: Callable[[int], None] | None = None,
 ) -> SoakTrace:
     """Block means of a soak recording, streamed (blocks of >= 10 s, at most ``max_points``)."""
-    means: BlockMeans | None = None
+    return trace_soak_axes(path, {"": thermometer}, max_points=max_points,
+                           read_options=read_options, on_chunk=on_chunk)[""]
+
+
+def trace_soak_axes(
+    path: PathLike, thermometers: Mapping[str, Thermometer], *,
+    max_points: int = ReportSettings.max_points, read_options: ReadOptions | None = None,
+    on_chunk: Callable[[int], None] | None = None,
+) -> dict[str, SoakTrace]:
+    """:func:`trace_soak` of every axis of a soak from one reading of the file.
+
+    ``thermometers`` maps each axis (``""``: the file as ``read_options`` read it) to its
+    thermometer; each axis is traced on its single-axis view of the chunks.
+    """
+    from hrgtc.recording import axis_view
+
+    means: dict[str, BlockMeans] = {}
     rows = count_rows(path)
+    block_s = 0.0
     for chunk in (read_options or ReadOptions()).chunks(path):
-        if means is None:
-            means = BlockMeans(block_rows(rows, chunk.sample_rate_hz, max_points))
-            block_s = means.rows / chunk.sample_rate_hz
-        means.partial_fit({k: chunk[k] for k in ("time_s", "freq_hz", "chamber_c", "resonator_c")
-                     if k in chunk})
+        if not means:
+            size = block_rows(rows, chunk.sample_rate_hz, max_points)
+            means = {axis: BlockMeans(size) for axis in thermometers}
+            block_s = size / chunk.sample_rate_hz
+        for axis, state in means.items():
+            view = axis_view(chunk, axis) if axis else chunk
+            state.partial_fit({k: view[k] for k in ("time_s", "freq_hz", "chamber_c",
+                                                    "resonator_c") if k in view})
         if on_chunk is not None:
             on_chunk(len(chunk))
-    assert means is not None  # iter_chunks raises on an empty file
-    b = means.means()
-    return SoakTrace(str(path), Path(path).name, block_s, b["time_s"], b["freq_hz"],
-                     thermometer.temperature(b["freq_hz"], warn=False),
-                     b.get("chamber_c"), b.get("resonator_c"))
+    assert means  # iter_chunks raises on an empty file
+    traces = {}
+    for axis, state in means.items():
+        b = state.means()
+        traces[axis] = SoakTrace(str(path), Path(path).name, block_s, b["time_s"],
+                                 b["freq_hz"],
+                                 thermometers[axis].temperature(b["freq_hz"], warn=False),
+                                 b.get("chamber_c"), b.get("resonator_c"))
+    return traces
 
 
 # -- Fig. 3: settling of the soaks -----------------------------------------------------
