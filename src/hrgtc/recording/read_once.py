@@ -15,13 +15,14 @@ calibration), not to stream a long run.
 from __future__ import annotations
 
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
 
 from hrgtc.core.errors import InputError
 from hrgtc.recording.io import ReadOptions, iter_chunks
 from hrgtc.recording.schema import Recording, concatenate
+from hrgtc.settings.reading import ReadSettings
 
 __all__ = ["ReadOnce"]
 
@@ -38,13 +39,11 @@ class ReadOnce(ReadOptions):
     cache: dict[Any, Recording] = field(default_factory=dict, compare=False, repr=False)
 
     def _whole(self, path: str | Path) -> Recording:
-        words = self.keywords()
-        words.pop("freq_band_hz", None)
-        words.pop("freq_span_hz", None)
-        key = (str(Path(path).resolve()), repr(sorted(words.items())), self.chunk_rows)
+        whole = replace(self, axis=None, freq_band_hz=None, freq_span_hz=None, motion="keep")
+        key = (str(Path(path).resolve()),
+               repr([getattr(whole, f.name) for f in fields(ReadSettings)]))
         if key not in self.cache:
-            self.cache[key] = concatenate(list(iter_chunks(path, rows=self.chunk_rows,
-                                                           **words)))
+            self.cache[key] = concatenate(list(iter_chunks(path, whole)))
         return self.cache[key]
 
     def _cached(self) -> bool:
