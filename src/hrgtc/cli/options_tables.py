@@ -33,6 +33,8 @@ def options_table(cls: type) -> str:
     rows = ["| option | default | meaning |", "|---|---|---|"]
     for s in option_settings(cls):
         text = s.full_help().replace("|", "\\|").replace("<", "&lt;")
+        if s.range_text() is not None:
+            text += f" Range: {s.range_text()}."
         rows.append(f"| `{s.option}` | {s.shown_default().replace('|', chr(92) + '|')} "
                     f"| {text} |")
     return "\n".join(rows)

@@ -52,6 +52,10 @@ def _option_info(setting: Setting, **extra: Any) -> Any:
         show = setting.default_text
     elif setting.default is None:
         show = False
+    if setting.min is not None:  # click's IntRange/FloatRange: "0 is not in the range x>=1"
+        extra.setdefault("min", setting.min)
+    if setting.max is not None:
+        extra.setdefault("max", setting.max)
     return typer.Option(default, *setting.option.split(), help=setting.full_help(),
                         show_default=show, metavar=setting.metavar,
                         rich_help_panel=setting.panel, **extra)
