@@ -129,7 +129,7 @@ def test_one_options_object_or_its_fields_by_name(tmp_path):
     for function in (read, describe, lambda p, **kw: list(iter_chunks(p, **kw))):
         with pytest.raises(TypeError, match=r"spike_treshold.*are columns, units, .*spike_k"):
             function(path, spike_treshold=3.0)
-    with pytest.raises(TypeError, match="options must be ReadOptions.*columns="):
+    with pytest.raises(TypeError, match=r"options must be ReadOptions.*columns="):
         read(path, mapping)
 
 
