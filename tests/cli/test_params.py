@@ -27,14 +27,15 @@ PAGES = {"calibrate": DOCS / "guide" / "calibrate.md", "reading": DOCS / "guide"
          "evaluate": DOCS / "guide" / "evaluate.md", "report": DOCS / "guide" / "report.md",
          "export": DOCS / "guide" / "export-c.md", "demo": DOCS / "guide" / "demo.md",
          "fleet_simulate": DOCS / "guide" / "fleet.md",
-         "fleet_evaluate": DOCS / "guide" / "fleet.md"}
+         "fleet_evaluate": DOCS / "guide" / "fleet.md",
+         "simulate": DOCS / "guide" / "simulate.md"}
 #: The commands whose options each settings class generates.
 COMMANDS = {"calibrate": ["calibrate"],
             "reading": ["info", "calibrate", "compensate", "evaluate", "report",
                         "fleet calibrate", "fleet evaluate", "fleet report"],
             "compensate": ["compensate"], "evaluate": ["evaluate"], "report": ["report"],
             "export": ["export-c"], "demo": ["demo"], "fleet_simulate": ["fleet simulate"],
-            "fleet_evaluate": ["fleet evaluate"]}
+            "fleet_evaluate": ["fleet evaluate"], "simulate": ["simulate"]}
 CASES = [(key, s) for key in DOCUMENTED for s in option_settings(settings_class(key))]
 
 

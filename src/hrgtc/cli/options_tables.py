@@ -25,6 +25,7 @@ DOCUMENTED = {
     "fleet_simulate": ("hrgtc.settings.fleet", "FleetSimulation"),
     "fleet_evaluate": ("hrgtc.settings.fleet", "FleetEvaluation"),
     "demo": ("hrgtc.settings.fleet", "DemoSettings"),
+    "simulate": ("hrgtc.settings.simulation", "SimulationSettings"),
 }
 
 
