@@ -43,18 +43,32 @@ class ReadOnce(ReadOptions):
         key = (str(Path(path).resolve()),
                repr([getattr(whole, f.name) for f in fields(ReadSettings)]))
         if key not in self.cache:
-            self.cache[key] = concatenate(list(iter_chunks(path, whole)))
+            dropped: dict[str, int] = {}
+            self.cache[key] = concatenate(list(iter_chunks(path, whole, dropped=dropped)))
+            self.cache[("dropped", *key)] = dropped  # type: ignore[assignment]
         return self.cache[key]
+
+    def _dropped(self, path: str | Path) -> dict[str, int]:
+        """The rows the spike filters removed from the file's one reading."""
+        whole = replace(self, axis=None, freq_band_hz=None, freq_span_hz=None, motion="keep")
+        key = (str(Path(path).resolve()),
+               repr([getattr(whole, f.name) for f in fields(ReadSettings)]))
+        return self.cache.get(("dropped", *key), {})  # type: ignore[return-value]
 
     def _cached(self) -> bool:
         # a single-axis reading with a plausible band is checked by the reader itself
         return self.axis is not None or self.freq_band_hz is None
 
-    def chunks(self, path: str | Path, rows: int | None = None) -> Iterator[Recording]:
-        """The file's rows in chunks of ``rows`` (with ``axis``: that axis's views)."""
+    def chunks(self, path: str | Path, rows: int | None = None,
+               dropped: dict[str, int] | None = None) -> Iterator[Recording]:
+        """The file's rows in chunks of ``rows`` (with ``axis``: that axis's views);
+        ``dropped`` as for :meth:`~hrgtc.recording.ReadOptions.chunks`."""
         if not self._cached():
-            return super().chunks(path, rows)
+            return super().chunks(path, rows, dropped)
         whole = self._whole(path)
+        if dropped is not None:
+            spikes = self._dropped(path).get("spikes", 0)
+            dropped["spikes"] = dropped.get("spikes", 0) + spikes
         size = rows or self.chunk_rows
         pieces = (whole.slice(start, min(start + size, len(whole)))
                   for start in range(0, len(whole), size))
