@@ -43,13 +43,13 @@ def test_help_keeps_units_and_defaults_in_brackets():
 
 def test_written_out_defaults_equal_the_library():
     from hrgtc.cli.calibrate_cmd import EQ21_DEFAULT
-    from hrgtc.cli.simulate_cmd import (
+    from hrgtc.drift import EQ21_TERMS
+    from hrgtc.settings.simulation import (
         DEFAULT_INPUT_RATE_DPH,
         DEFAULT_UNIT,
         PROFILE_KINDS,
         UNIT_NAMES,
     )
-    from hrgtc.drift import EQ21_TERMS
     from hrgtc.simulate import campaign, standard_profiles, units
 
     assert EQ21_DEFAULT == ",".join(EQ21_TERMS)

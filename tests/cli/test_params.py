@@ -27,14 +27,15 @@ PAGES = {"calibrate": DOCS / "guide" / "calibrate.md", "reading": DOCS / "guide"
          "evaluate": DOCS / "guide" / "evaluate.md", "report": DOCS / "guide" / "report.md",
          "export": DOCS / "guide" / "export-c.md", "demo": DOCS / "guide" / "demo.md",
          "fleet_simulate": DOCS / "guide" / "fleet.md",
-         "fleet_evaluate": DOCS / "guide" / "fleet.md"}
+         "fleet_evaluate": DOCS / "guide" / "fleet.md",
+         "simulate": DOCS / "guide" / "simulate.md"}
 #: The commands whose options each settings class generates.
 COMMANDS = {"calibrate": ["calibrate"],
             "reading": ["info", "calibrate", "compensate", "evaluate", "report",
                         "fleet calibrate", "fleet evaluate", "fleet report"],
             "compensate": ["compensate"], "evaluate": ["evaluate"], "report": ["report"],
             "export": ["export-c"], "demo": ["demo"], "fleet_simulate": ["fleet simulate"],
-            "fleet_evaluate": ["fleet evaluate"]}
+            "fleet_evaluate": ["fleet evaluate"], "simulate": ["simulate"]}
 CASES = [(key, s) for key in DOCUMENTED for s in option_settings(settings_class(key))]
 
 
@@ -61,7 +62,9 @@ def test_help_shows_the_dataclass_default(key, setting):
         param, (_, text) = _click_option(command, setting)
         # the value a command passes on when the option is not given
         assert _value(setting, param.default) == setting.default, (command, setting.option)
-        shown = re.search(r"\[default: (.*?)\]$", " ".join(text.split()))
+        # "[default: 32; x>=1]": click adds a number's range after the default
+        shown = re.search(r"\[default: (.*?)(; [-\d.]*<?=?x[<>]?=?[-\d.]*)?\]$",
+                          " ".join(text.split()))
         if setting.default is None and setting.default_text is None:
             assert shown is None
         elif isinstance(setting.default, bool) and "/" not in setting.option:
@@ -74,6 +77,9 @@ def test_help_shows_the_dataclass_default(key, setting):
         else:
             assert shown is not None and shown.group(1) == format_value(setting.default)
         assert setting.help.rstrip(".").split(" [")[0][:40] in " ".join(text.split())
+        if setting.min is not None or setting.max is not None:  # click's range, e.g. x>=1
+            bounds = [f"{b:g}" for b in (setting.min, setting.max) if b is not None]
+            assert shown.group(2) and all(b in shown.group(2) for b in bounds), setting.option
 
 
 @pytest.mark.parametrize("key", sorted(DOCUMENTED))
@@ -93,6 +99,22 @@ def test_docs_tables_are_generated_from_the_dataclasses(key):
                  "--setpoints", "-20,-10,0,10,20,30,40")}  # Table 1 of [1]
     if key in known:
         assert rows[known[key][0]] == known[key][1]
+
+
+def test_a_value_out_of_range_is_refused_naming_the_range(tmp_path):
+    """``fleet simulate --units 0`` and ``--seed -1`` are refused before anything runs (the
+    ``min`` of the field), naming the option and the bound; the docs list the range."""
+    by_name = {s.name: s for s in option_settings(settings_class("fleet_simulate"))}
+    assert (by_name["units"].min, by_name["seed"].min) == (1, 0)
+    for args, bound in ((["--units", "0"], "1"), (["--seed", "-1"], "0")):
+        result = CliRunner().invoke(app, ["fleet", "simulate", *args,
+                                          "-o", str(tmp_path / "fleet")])
+        assert result.exit_code == 2, result.output
+        message = " ".join(result.output.split())
+        assert f"Invalid value for '{args[0]}'" in message and bound in message
+        assert not (tmp_path / "fleet").exists()
+    page = PAGES["fleet_simulate"].read_text(encoding="utf-8")
+    assert "| `--units` | 32 | Number of units. Range: ≥ 1. |" in page
 
 
 def test_stale_docs_table_is_found():
@@ -122,15 +144,10 @@ def test_library_defaults_come_from_the_dataclasses():
     for name in ("window_s", "penter", "rate_tau_s", "select", "offsets"):
         assert fit_defaults[name].default == getattr(DriftSettings(), name)
     assert FeatureSettings(1.0, 1.0).rate_tau_s == DriftSettings().rate_tau_s
-    fields = {f.name: f.default for f in dataclasses.fields(ReadSettings)}
-    for function in (read, iter_chunks, describe):
-        for name, p in inspect.signature(function).parameters.items():
-            if name in fields and name not in ("spike_filter", "columns", "units",
-                                               "metadata", "freq_band_hz", "freq_span_hz"):
-                assert p.default == fields[name], (function.__name__, name)
+    fields = {f.name for f in dataclasses.fields(ReadSettings)}
+    for function in (read, iter_chunks, describe):  # one options object, no field repeated
+        assert not fields & set(inspect.signature(function).parameters), function.__name__
     assert issubclass(ReadOptions, ReadSettings)
-    assert ReadOptions().keywords() == {"columns": None, "units": None, "metadata": None,
-                                        "gaps": "error"}
 
 
 @pytest.mark.slow

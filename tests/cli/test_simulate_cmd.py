@@ -116,7 +116,7 @@ def test_profile_file_and_unit_b(tmp_path):
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        (["--unit", "unit-z"], "unknown simulated unit 'unit-z'; choose one of paper-unit"),
+        (["--unit", "unit-z"], "'unit-z' is not one of 'paper-unit', 'unit-b', 'imu-3', 'mems-3'"),
         (["--profile", "sock"], "unknown profile 'sock'"),
         (["--profile", "soak", "--temperature", "3"], "do not apply to profile 'soak'"),
         (["--profile", "cooldown", "--start", "-20", "--end", "20"], "needs end_c < start_c"),
@@ -132,7 +132,7 @@ def test_errors_exit_2_with_a_message(tmp_path, args, message):
 
 def test_bad_setpoints_list(tmp_path):
     code, _, err = run("--setpoints=-20,warm", "-o", str(tmp_path))
-    assert code == 2 and "comma-separated list of temperatures" in err
+    assert code == 2 and "'-20,warm' is not a comma-separated list of float values" in err
 
 
 def test_ratetable_single_axis_reads_back_with_its_input_rate(tmp_path):

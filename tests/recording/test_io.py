@@ -102,6 +102,37 @@ def test_chunked_read_equals_whole_read(tmp_path, suffix, rows):
         assert same_bits(joined[name], whole[name])
 
 
+def test_one_options_object_or_its_fields_by_name(tmp_path):
+    """``read``, ``iter_chunks`` and ``describe`` take one ReadOptions and any of its
+    fields by name (the name given wins); a name that is no reading option is refused,
+    naming the options there are; a column mapping by position is refused."""
+    from hrgtc.recording import ReadOptions, describe
+
+    recording = make_recording(n=400)
+    recording = recording.with_columns(rate_dph=recording.rate_dph / 3600.0)  # in °/s
+    path = write_csv(tmp_path / "run.csv", "t,f,w", np.column_stack(
+        [recording.time_s, recording.freq_hz, recording.rate_dph]))
+    mapping = {"time_s": "t", "freq_hz": "f", "rate_dph": "w"}
+    options = ReadOptions(columns=mapping, units={"rate": "dps"},
+                          metadata={"sample_rate_hz": RATE_HZ}, start="0.5")
+    by_object = read(path, options)
+    by_name = read(path, columns=mapping, units={"rate": "dps"},
+                   metadata={"sample_rate_hz": RATE_HZ}, start="0.5")
+    overridden = read(path, options, start="1.0")
+    assert len(by_object) == len(by_name) == 300 and len(overridden) == 200  # 200 Hz
+    assert np.allclose(by_object.rate_dph, recording.rate_dph[100:] * 3600.0, rtol=1e-12)
+    assert same_bits(by_object.rate_dph, by_name.rate_dph)
+    chunks = list(iter_chunks(path, options, rows=64))
+    assert [len(c) for c in chunks] == [64] * 4 + [44]
+    assert same_bits(concatenate(chunks).freq_hz, by_object.freq_hz)
+    assert describe(path, options).rows == describe(path, options, start=None).rows - 100
+    for function in (read, describe, lambda p, **kw: list(iter_chunks(p, **kw))):
+        with pytest.raises(TypeError, match=r"spike_treshold.*are columns, units, .*spike_k"):
+            function(path, spike_treshold=3.0)
+    with pytest.raises(TypeError, match=r"options must be ReadOptions.*columns="):
+        read(path, mapping)
+
+
 @pytest.mark.parametrize("suffix", SUFFIXES)
 def test_writer_streams_chunks_and_file_mode_follows_umask(tmp_path, suffix):
     recording = make_recording(n=1000)

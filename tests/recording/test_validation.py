@@ -84,7 +84,7 @@ def test_the_sample_rate_check_by_block_end_times_equals_summing_every_step(star
         validator = RecordingValidator()
         for first in range(0, N, size):
             validator.partial_fit(whole.slice(first, min(first + size, N)))
-        found.append(validator._rate_change)
+        found.append(validator.time_axis.rate_change)
     if found[0] is None:
         assert found[1] is None
     else:

@@ -105,3 +105,26 @@ def test_build_ratetable_defaults_and_options():
 def test_rate_table_errors(call, match):
     with pytest.raises(InputError, match=match):
         call()
+
+
+def test_each_kind_takes_its_defaults_from_the_one_table(monkeypatch):
+    """``build`` takes a kind's defaults from settings.simulation.PROFILE_DEFAULTS, the
+    table the help of ``hrgtc simulate`` is generated from: the explicit values of the
+    table give the same runs, and a value changed in the table changes the run."""
+    from hrgtc.settings.simulation import PROFILE_DEFAULTS, REQUIRED, per_kind
+
+    for kind, defaults in PROFILE_DEFAULTS.items():
+        required = {k: 20.0 - 40.0 * i for i, k in enumerate(
+            k for k, v in defaults.items() if v == REQUIRED)}  # a ramp: 20 -> -20 °C
+        given = {k: v for k, v in defaults.items() if v != REQUIRED}
+        default = standard_profiles.build(kind, **required)
+        explicit = standard_profiles.build(kind, **given, **required)
+        assert [p.duration_s for p in default] == [p.duration_s for p in explicit], kind
+    (cooldown,) = standard_profiles.build("cooldown")
+    assert cooldown.duration_s == pytest.approx(5.0 * 3600.0)  # Fig. 6 of [1]: 5 h
+    assert [p.duration_s for p in standard_profiles.build("soak")] == [5.0 * 3600.0] * 7
+    monkeypatch.setitem(PROFILE_DEFAULTS, "soak", {**PROFILE_DEFAULTS["soak"], "hours": 2.0})
+    assert [p.duration_s for p in standard_profiles.build("soak")] == [2.0 * 3600.0] * 7
+    assert "soak 2.0" in per_kind("hours") and "ratetable 3.0" in per_kind("hours")
+    with pytest.raises(InputError, match=r"a ramp needs start_c \(--start\)"):
+        standard_profiles.build("ramp", end_c=5.0)

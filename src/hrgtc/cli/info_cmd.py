@@ -29,7 +29,7 @@ def info(
     from hrgtc.recording import describe
 
     with library_errors():
-        result = describe(file, **inputs.keywords())
+        result = describe(file, inputs)
     if json_output:
         print_json(result.to_dict())
     else:

@@ -25,6 +25,7 @@ DOCUMENTED = {
     "fleet_simulate": ("hrgtc.settings.fleet", "FleetSimulation"),
     "fleet_evaluate": ("hrgtc.settings.fleet", "FleetEvaluation"),
     "demo": ("hrgtc.settings.fleet", "DemoSettings"),
+    "simulate": ("hrgtc.settings.simulation", "SimulationSettings"),
 }
 
 
@@ -33,6 +34,8 @@ def options_table(cls: type) -> str:
     rows = ["| option | default | meaning |", "|---|---|---|"]
     for s in option_settings(cls):
         text = s.full_help().replace("|", "\\|").replace("<", "&lt;")
+        if s.range_text() is not None:
+            text += f" Range: {s.range_text()}."
         rows.append(f"| `{s.option}` | {s.shown_default().replace('|', chr(92) + '|')} "
                     f"| {text} |")
     return "\n".join(rows)

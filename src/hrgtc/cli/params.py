@@ -52,6 +52,10 @@ def _option_info(setting: Setting, **extra: Any) -> Any:
         show = setting.default_text
     elif setting.default is None:
         show = False
+    if setting.min is not None:  # click's IntRange/FloatRange: "0 is not in the range x>=1"
+        extra.setdefault("min", setting.min)
+    if setting.max is not None:
+        extra.setdefault("max", setting.max)
     return typer.Option(default, *setting.option.split(), help=setting.full_help(),
                         show_default=show, metavar=setting.metavar,
                         rich_help_panel=setting.panel, **extra)
@@ -95,7 +99,7 @@ def option(cls: type, name: str) -> Any:
 def split_values(text: str, kind: type = float) -> tuple[Any, ...]:
     """A comma-separated option value as a tuple of ``kind`` (``"-20,0,20"``)."""
     try:
-        return tuple(kind(v) for v in text.split(",") if v.strip())
+        return tuple(kind(v.strip()) for v in text.split(",") if v.strip())
     except ValueError:
         raise typer.BadParameter(f"{text!r} is not a comma-separated list of "
                                  f"{kind.__name__} values, e.g. -20,0,20") from None
@@ -105,7 +109,7 @@ def _value(setting: Setting, value: Any) -> Any:
     """A command-line value as the settings class takes it (terms: a tuple)."""
     if _is_terms(setting.type) and isinstance(value, str):
         kind = float if "float" in str(setting.type) else str
-        return tuple(kind(t.strip()) for t in value.split(",") if t.strip())
+        return split_values(value, kind)  # a bad number: a usage error naming the value
     return value
 
 

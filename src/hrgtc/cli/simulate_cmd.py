@@ -12,19 +12,12 @@ from rich.table import Table
 
 from hrgtc.cli._app import app, console, library_errors, print_json, progress_bar
 from hrgtc.cli.options import ForceOption, JsonOption, OutputFormat
-
-# Written out so that --help needs no import of the simulator (it starts at once); a test
-# holds them equal to hrgtc.simulate's KINDS, unit names, DEFAULT_UNIT and input rate.
-PROFILE_KINDS = ("soak", "cooldown", "warmup", "constant", "ramp", "ratetable")
-UNIT_NAMES = ("paper-unit", "unit-b", "imu-3", "mems-3")
-DEFAULT_UNIT = "paper-unit"
-DEFAULT_INPUT_RATE_DPH = 10.0
+from hrgtc.cli.params import settings_options
+from hrgtc.settings.simulation import DEFAULT_SAMPLE_RATE_HZ, DEFAULT_UNIT, SimulationSettings
 
 LOGGER_KINDS = ("continuous", "burst", "pan-cold", "fridge-3day")
 LOGGER_RATE_UNITS = ("dph", "dps", "radps", "mradps")
 
-_PROFILE = "Profile"
-_RUN = "Run"
 _LOGGER = "Logger (files as a real logger writes them, with ground truth)"
 
 
@@ -41,117 +34,8 @@ def _numbers(value: str | None, example: str = "-20,-10,0,10",
 
 
 @app.command("simulate")
+@settings_options(SimulationSettings, "settings")
 def simulate_command(
-    profile: Annotated[
-        str | None,
-        typer.Option(
-            "--profile",
-            metavar="|".join(PROFILE_KINDS) + "|FILE.yaml",
-            help="Chamber program: soak (one run per set-point), cooldown, warmup, constant, "
-            "ramp, ratetable (plateaus from --setpoints, each soaked --hours then the "
-            "--rates held --rate-hold-s each, axis after axis), or a JSON/YAML profile file "
-            "(list of {setpoint_c, hold_h | ramp_c_per_min[, table_rate_dps, axis]} segments). "
-            "Default soak, or the --logger preset's program.",
-            rich_help_panel=_PROFILE,
-        ),
-    ] = None,
-    setpoints: Annotated[
-        str | None,
-        typer.Option(
-            "--setpoints",
-            metavar="T1,T2,...",
-            help="Soak set-points [°C]; default -20,-10,0,10,20,30,40 (Table 1 of the paper); "
-            "rate-table plateaus, default -10,10,30,50. "
-            "Write --setpoints=-20,... when the list starts with a minus sign.",
-            rich_help_panel=_PROFILE,
-        ),
-    ] = None,
-    hours: Annotated[
-        float | None,
-        typer.Option(
-            help="Hours per soak, or of the cool-down/warm-up/constant run (default 5); "
-            "hold after a ramp (default 0); soak at each rate-table plateau (default 3).",
-            rich_help_panel=_PROFILE,
-        ),
-    ] = None,
-    start: Annotated[
-        float | None,
-        typer.Option(
-            help="Start temperature of cooldown (20), warmup (-20) or ramp [°C].",
-            rich_help_panel=_PROFILE,
-        ),
-    ] = None,
-    end: Annotated[
-        float | None,
-        typer.Option(
-            help="End temperature of cooldown (-20), warmup (20) or ramp [°C].",
-            rich_help_panel=_PROFILE,
-        ),
-    ] = None,
-    temperature: Annotated[
-        float | None,
-        typer.Option(help="Temperature of a constant run [°C] (20).", rich_help_panel=_PROFILE),
-    ] = None,
-    ramp_rate: Annotated[
-        float | None,
-        typer.Option(
-            "--ramp-rate",
-            help="Chamber ramp rate of cooldown, warmup or ramp [°C/min] (1).",
-            rich_help_panel=_PROFILE,
-        ),
-    ] = None,
-    rates: Annotated[
-        str | None,
-        typer.Option(
-            "--rates",
-            metavar="W1,W2,...",
-            help="Rate-table rates [°/s]; default 0,10,-10,50,-50,100,-100,300,-300.",
-            rich_help_panel=_PROFILE,
-        ),
-    ] = None,
-    rate_hold_s: Annotated[
-        float | None,
-        typer.Option(
-            "--rate-hold-s",
-            help="Rate table: seconds each rate is held (60).",
-            rich_help_panel=_PROFILE,
-        ),
-    ] = None,
-    single_file: Annotated[
-        bool,
-        typer.Option(
-            "--single-file",
-            help="Soaks: one file visiting all set-points in sequence.",
-            rich_help_panel=_PROFILE,
-        ),
-    ] = False,
-    unit: Annotated[
-        str | None,
-        typer.Option(
-            help=f"Simulated gyro: {', '.join(UNIT_NAMES)} (default {DEFAULT_UNIT}, or the "
-            "--logger preset's mems-3).", rich_help_panel=_RUN
-        ),
-    ] = None,
-    sample_rate_hz: Annotated[
-        float | None,
-        typer.Option("--sample-rate-hz", "--rate-hz",
-                     help="Sample rate [Hz] (default 200, or the --logger preset's).",
-                     rich_help_panel=_RUN)
-    ] = None,
-    seed: Annotated[
-        int, typer.Option(min=0, help="Random seed; the same seed gives the same files.",
-                          rich_help_panel=_RUN)
-    ] = 0,
-    input_rate_dph: Annotated[
-        float | None,
-        typer.Option(
-            "--input-rate-dph",
-            help=f"Known constant rate on the sensitive axis (e.g. Earth rate) [°/h]; "
-            f"default {DEFAULT_INPUT_RATE_DPH:g}, or each axis's Earth-rate component for a "
-            "multi-axis unit (a value given applies to every axis).",
-            rich_help_panel=_RUN,
-        ),
-    ] = None,
     logger: Annotated[
         str | None,
         typer.Option(
@@ -316,6 +200,7 @@ def simulate_command(
     ] = None,
     force: ForceOption = False,
     json_output: JsonOption = False,
+    settings: SimulationSettings | None = None,
 ) -> None:
     """Simulate chamber runs of a gyro with ground truth (resonator_c, bias_dph) to files.
 
@@ -340,30 +225,23 @@ def simulate_command(
     """
     from hrgtc.simulate import MultiAxisUnit, simulate_files, standard_profiles, units
 
+    settings = settings or SimulationSettings()
+    seed, input_rate_dph = settings.seed, settings.input_rate_dph
+    sample_rate_hz = settings.sample_rate_hz
     with library_errors():
         chosen = None
         if logger is not None and logger not in ("continuous", "burst"):
             from hrgtc.simulate.logger_presets import preset
 
             chosen = preset(logger)
-        unit = unit or (chosen.unit if chosen is not None else DEFAULT_UNIT)
+        unit = settings.unit or (chosen.unit if chosen is not None else DEFAULT_UNIT)
         gyro = units.get(unit)
-        if chosen is not None and profile is None:
+        if chosen is not None and settings.profile is None:
             runs = [chosen.profile]
         else:
             runs = standard_profiles.build(
-                profile or "soak",
-                setpoints_c=_numbers(setpoints),
-                hours=hours,
-                start_c=start,
-                end_c=end,
-                temperature_c=temperature,
-                ramp_c_per_min=ramp_rate,
-                single_file=single_file,
-                rates_dps=_numbers(rates, "0,10,-10,100,-100", "rates"),
-                rate_hold_s=rate_hold_s,
-                axes=gyro.axis_names if isinstance(gyro, MultiAxisUnit) else None,
-            )
+                settings.profile or "soak", **settings.profile_options(),
+                axes=gyro.axis_names if isinstance(gyro, MultiAxisUnit) else None)
         if logger is not None:
             from hrgtc.simulate.logged_files import simulate_logged_files
 
@@ -405,7 +283,7 @@ def simulate_command(
                           + " ".join(shlex.quote(o) for o in first), markup=False,
                           highlight=False, soft_wrap=True)
             return
-        sample_rate_hz = 200.0 if sample_rate_hz is None else sample_rate_hz
+        sample_rate_hz = DEFAULT_SAMPLE_RATE_HZ if sample_rate_hz is None else sample_rate_hz
         with progress_bar("simulating") as progress:
             written = simulate_files(
                 runs,
@@ -440,7 +318,7 @@ def _logger_spec(base: Any, kind: str, unit: str, **given: Any) -> Any:
 
     mems = unit == MEMS_UNIT
     if base is None:
-        base = Logger(kind=kind, sample_rate_hz=200.0, frequency=not mems,
+        base = Logger(kind=kind, sample_rate_hz=DEFAULT_SAMPLE_RATE_HZ, frequency=not mems,
                       temperature=TemperatureChannel(decimals=2) if mems else None)
     temperature = {"lsb_c": given.pop("temp_lsb"), "offset_c": given.pop("temp_offset"),
                    "bits": given.pop("temp_bits"), "rate_hz": given.pop("temp_rate_hz")}

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -26,15 +26,13 @@ from hrgtc.recording.resolution import resolution
 from hrgtc.recording.schema import COLUMNS, Metadata
 from hrgtc.recording.spikes import SPIKE_COLUMN
 from hrgtc.recording.validation import (
-    GapPolicy,
     Problem,
     RecordingValidator,
     ValidationReport,
     check_gap_policy,
 )
-from hrgtc.settings.reading import CHUNK_ROWS, ReadSettings
+from hrgtc.settings.reading import ReadSettings, with_fields
 
-_READ = ReadSettings
 TEMPERATURE_COLUMNS = ("chamber_c", "housing_c", "resonator_c", "temperature_c")
 SPAN_COLUMNS = (*TEMPERATURE_COLUMNS, "freq_hz")
 
@@ -244,52 +242,21 @@ def _hours(seconds: float | None) -> str:
     return "?" if seconds is None else f"{seconds / 3600.0:.3g} h"
 
 
-def describe(
-    path: str | Path,
-    columns: Mapping[str, str] | Iterable[str] | None = None,
-    units: Mapping[str, str] | None = None,
-    metadata: Mapping[str, Any] | Metadata | None = None,
-    gaps: GapPolicy | str = _READ.gaps,
-    rows: int = CHUNK_ROWS,
-    progress: Progress | None = None,
-    *,
-    temp_scale: float = _READ.temp_scale,
-    temp_offset_c: float = _READ.temp_offset_c,
-    spikes: str = _READ.spikes,
-    thermometer: str = _READ.thermometer,
-    rate_scale: float | None = _READ.rate_scale,
-    temp_unwrap: str = _READ.temp_unwrap,
-    spike_filter: str | None = "flag",
-    spike_k: float = _READ.spike_k,
-    spike_lsb: float = _READ.spike_lsb,
-    spike_window_s: float = _READ.spike_window_s,
-    start: str | float | None = None,
-    end: str | float | None = None,
-    slow_channels: str = _READ.slow_channels,
-    hold_max_s: float | None = _READ.hold_max_s,
-    tz: str | None = _READ.tz,
-) -> RecordingInfo:
+def describe(path: str | Path, options: ReadSettings | None = None, *,
+             rows: int | None = None, progress: Progress | None = None,
+             **fields: Any) -> RecordingInfo:
     """Summarise and validate a recording file in one streaming pass.
 
     Parameters
     ----------
-    path, columns, units, metadata, gaps
-        As for :func:`hrgtc.recording.read`.
-    temp_scale, temp_offset_c, spikes, thermometer, rate_scale, temp_unwrap
-        As for :func:`hrgtc.recording.read` (messy IMU files).
-    spike_filter, spike_k, spike_lsb, spike_window_s
-        The robust spike filter (see :func:`hrgtc.recording.read`); by default the
-        spikes are flagged and counted (``metadata["extra"]["spikes_flagged"]``), no
-        row is dropped. For the sensor thermometer the ``freq_hz*`` columns, copies
-        of the temperature, are not listed.
-    start, end
-        The slice read (``--start/--end``, see :func:`hrgtc.recording.read`).
-    slow_channels, hold_max_s
-        As for :func:`hrgtc.recording.read` (channels logged slower than the rows).
-    tz
-        The time zone clock times were written in (``--tz``, see :func:`hrgtc.recording.read`).
+    path, options, **fields
+        As for :func:`hrgtc.recording.read`: how to read the file, one
+        :class:`~hrgtc.recording.ReadOptions` and any of its fields by name. The robust
+        spike filter (``spike_filter``) flags and counts by default (None):
+        ``metadata["extra"]["spikes_flagged"]``, no row dropped. For the sensor
+        thermometer the ``freq_hz*`` columns, copies of the temperature, are not listed.
     rows
-        Rows per chunk read.
+        Rows per chunk read; None: ``options.chunk_rows``.
     progress
         Optional ``progress(done, total)`` callback.
 
@@ -299,11 +266,14 @@ def describe(
         Never raises on a bad or unreadable file (except a missing file): the
         problem is in ``validation`` with ``ok=False``.
     """
-    check_gap_policy(gaps)
-    validator = RecordingValidator(gaps, thermometer=thermometer)
+    opts = with_fields(options, fields, "describe")
+    opts = replace(opts, spike_filter=opts.spike_filter or "flag")
+    thermometer = opts.thermometer
+    check_gap_policy(opts.gaps)
+    validator = RecordingValidator(opts.gaps, thermometer=thermometer)
     ranges: dict[str, list[float]] = {}
     steps: dict[str, float] = {}
-    spike_rows: int | None = None if (spike_filter or "off") == "off" else 0
+    spike_rows: int | None = None if opts.spike_filter == "off" else 0
     first_time: float | None = None
     last_time: float | None = None
     meta: Metadata | None = None
@@ -315,16 +285,8 @@ def describe(
     file_rows: list[Any] = []  # the file row of each row of the chunk (messages name them)
     try:
         fmt = format_of(path)
-        for chunk in iter_chunks(
-            path, rows, columns, units, validate=False, metadata=metadata, progress=progress,
-            temp_scale=temp_scale, temp_offset_c=temp_offset_c, spikes=spikes,
-            thermometer=thermometer, rate_scale=rate_scale, temp_unwrap=temp_unwrap,
-            spike_filter=spike_filter or "off", spike_k=spike_k, spike_lsb=spike_lsb,
-            spike_window_s=spike_window_s,
-            time_repair=repairer, start=start, end=end,
-            slow_channels=slow_channels, hold_max_s=hold_max_s, tz=tz,
-            file_rows=file_rows.append,
-        ):
+        for chunk in iter_chunks(path, opts, rows=rows, validate=False, progress=progress,
+                                 time_repair=repairer, file_rows=file_rows.append):
             meta = chunk.metadata
             names = names or [n for n in chunk.names if n != SPIKE_COLUMN
                               and not _sensor_copy(n, chunk.names, thermometer)]
@@ -366,8 +328,8 @@ def describe(
             measured_sample_rate_hz=report.measured_sample_rate_hz,
             gap_policy=report.gap_policy,
         )
-    raw_count = (dict(units or {}).get("temp") in ("count", "counts", "lsb", "raw")
-                 and (temp_scale, temp_offset_c) == (1.0, 0.0))
+    raw_count = (dict(opts.units or {}).get("temp") in ("count", "counts", "lsb", "raw")
+                 and (opts.temp_scale, opts.temp_offset_c) == (1.0, 0.0))
     duration = None
     if first_time is not None and meta is not None:
         duration = last_time - first_time + 1.0 / meta.sample_rate_hz

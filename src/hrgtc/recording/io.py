@@ -35,8 +35,8 @@ validated axis by axis; :func:`hrgtc.recording.axis_view` gives one axis.
 from __future__ import annotations
 
 import itertools
-from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
-from dataclasses import dataclass, fields, replace
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -74,21 +74,13 @@ from hrgtc.recording.time_axis import (
 )
 from hrgtc.recording.validation import (
     HEURISTIC_ROWS,
-    GapPolicy,
     RecordingValidator,
     check_gap_policy,
     measured_sample_rate,
 )
 from hrgtc.recording.validation import validate as validate_recording
 from hrgtc.recording.writing import RecordingWriter, write
-from hrgtc.settings.reading import CHUNK_ROWS, ReadSettings
-
-_READ = ReadSettings
-#: The options of messy files, passed to :func:`read` only when they differ from their
-#: defaults.
-_MESSY = ("temp_scale", "temp_offset_c", "spikes", "thermometer", "rate_scale",
-          "temp_unwrap", "spike_filter", "spike_k", "spike_lsb", "spike_window_s",
-          "slow_channels", "hold_max_s")
+from hrgtc.settings.reading import ReadSettings, with_fields
 
 #: Metadata key counting the rows of robust spikes, by ``spike_filter``.
 _SPIKE_KEYS = {"drop": "spikes_removed", "flag": "spikes_flagged"}
@@ -175,32 +167,8 @@ def _metadata(
 
 
 # -- reading -------------------------------------------------------------------
-def read(
-    path: str | Path,
-    columns: Mapping[str, str] | Iterable[str] | None = None,
-    units: Mapping[str, str] | None = None,
-    validate: bool = True,
-    gaps: GapPolicy | str = _READ.gaps,
-    metadata: Mapping[str, Any] | Metadata | None = None,
-    freq_band_hz: tuple[float, float] | None = None,
-    freq_span_hz: tuple[float, float] | None = None,
-    *,
-    temp_scale: float = _READ.temp_scale,
-    temp_offset_c: float = _READ.temp_offset_c,
-    spikes: str = _READ.spikes,
-    thermometer: str = _READ.thermometer,
-    rate_scale: float | None = _READ.rate_scale,
-    temp_unwrap: str = _READ.temp_unwrap,
-    spike_filter: str = "off",
-    spike_k: float = _READ.spike_k,
-    spike_lsb: float = _READ.spike_lsb,
-    spike_window_s: float = _READ.spike_window_s,
-    start: str | float | None = None,
-    end: str | float | None = None,
-    slow_channels: str = _READ.slow_channels,
-    hold_max_s: float | None = _READ.hold_max_s,
-    tz: str | None = _READ.tz,
-) -> Recording:
+def read(path: str | Path, options: ReadSettings | None = None, *, validate: bool = True,
+         **fields: Any) -> Recording:
     """Read a whole recording from Parquet, CSV, HDF5 or a registered format.
 
     Parameters
@@ -208,57 +176,35 @@ def read(
     path
         ``.parquet``/``.pq``, ``.csv`` or ``.h5``/``.hdf5`` file, or one of a format
         registered by another package (:mod:`hrgtc.recording.formats.registry`).
-    columns
-        Contract name -> the file's column name (or ``"time_s=t"`` strings).
-    units
-        ``{"time": "s"|"ms"|"timestamp", "freq": "Hz"|"kHz", "rate": "dph"|"dps"|"radps"}``
-        (also ``°/h``, ``°/s``, ``rad/s``); converted to s, Hz and °/h.
+    options
+        How to read the file (:class:`ReadOptions`, its fields described there); None:
+        the defaults.
     validate
         Check the recording (:func:`hrgtc.recording.validate`) and raise on a problem.
-    gaps
-        Gap policy of the validation: ``"error"``, ``"split"`` or ``"ignore"``.
-    metadata
-        Keys that complete or override the file's metadata (e.g.
-        ``{"sample_rate_hz": 200, "unit": "SN 12"}``), or a whole :class:`Metadata`.
-    freq_band_hz, freq_span_hz
-        With a model: frequencies outside ``freq_band_hz`` are errors (instead of the
-        physical range), ``freq_span_hz`` (the calibrated span) is named in the message.
-    temp_scale, temp_offset_c
-        ``temperature_c* = raw * temp_scale + temp_offset_c`` (a raw sensor count). [°C]
-    spikes
-        ``"error"`` (the validation names file, column, row and value) or ``"drop"``
-        (rows with a non-finite or implausible value are removed, and counted).
-    thermometer
-        ``"resonator"`` or ``"sensor"``: ``freq_hz`` is the ``temperature_c`` column.
-    rate_scale
-        LSB per °/s of a rate logged as a raw count (``units={"rate": "lsb"}``).
-    temp_unwrap
-        ``"auto"``: a raw temperature count (a count unit, ``temp_scale`` or
-        ``temp_offset_c``) that sits just under 2^16 or 2^32 is a signed count stored
-        unsigned and is unwrapped (65236 -> -300), with a
-        :class:`~hrgtc.core.errors.UnitWarning` and ``extra["temperature_count_bits"]``;
-        ``"off"``: read as it is.
-    spike_filter
-        Single-sample spikes of plausible value in the rate and thermometer columns
-        (:func:`hrgtc.recording.spikes.find_spikes`): ``"off"``, ``"drop"`` (rows
-        removed, counted in ``extra["spikes_removed"]``) or ``"flag"`` (rows kept,
-        a ``spike`` column 1.0 at them, counted in ``extra["spikes_flagged"]``);
-        one :class:`~hrgtc.core.errors.SpikeWarning` says how many and where.
-    spike_k, spike_lsb, spike_window_s
-        Threshold max(k·σ_MAD, m·LSB) and window [s] of the spike filter.
-    start, end
-        Keep only the rows from ``start`` to before ``end`` (``--start/--end``): seconds
-        since the file's first sample, or ISO clock times for a file with clock times
-        (e.g. ``"2020-03-07T16:30"``). Rows left out are counted in
-        ``extra["rows_sliced"]``; row numbers in later messages count the rows kept.
-    slow_channels, hold_max_s
-        A channel logged slower than the rows (empty cells), or a stream of the file on
-        its own time axis: ``"hold"`` (default), ``"interpolate"`` or ``"error"``, for at
-        most ``hold_max_s`` seconds (:mod:`hrgtc.recording.resample`,
-        :mod:`hrgtc.recording.align`).
-    tz
-        IANA zone (``"Europe/Berlin"``) the naive clock times were written in: read as
-        UTC, the daylight saving step is gone (:class:`~hrgtc.recording.time_axis.ZoneClock`).
+    **fields
+        Any field of :class:`ReadOptions` by name, in place of that of ``options``
+        (``read(path, columns={"time_s": "t"}, units={"rate": "dps"}, spikes="drop")``).
+        ``spike_filter`` None (the default) is ``"off"``; with ``axis``, that axis's view
+        (:func:`~hrgtc.recording.axis_view`) of the file validated as a whole.
+
+    Notes
+    -----
+    What reading does with the options: ``columns`` and ``units`` map the file's
+    columns and units onto the contract's (converted to s, Hz and °/h); ``metadata``
+    completes or overrides the file's (e.g. ``{"sample_rate_hz": 200, "unit": "SN
+    12"}``, or a whole :class:`Metadata`); ``spikes="drop"`` removes the rows with a
+    non-finite or implausible value and counts them (``extra["spikes_dropped"]``);
+    ``temp_unwrap="auto"`` unwraps a signed temperature count stored unsigned, with a
+    :class:`~hrgtc.core.errors.UnitWarning` and ``extra["temperature_count_bits"]``;
+    ``spike_filter`` ``"drop"`` or ``"flag"`` removes or flags single-sample spikes
+    (:func:`hrgtc.recording.spikes.find_spikes`, counted in ``extra["spikes_removed"]``
+    or ``extra["spikes_flagged"]``, one :class:`~hrgtc.core.errors.SpikeWarning`);
+    ``start``/``end`` keep a slice (rows left out counted in ``extra["rows_sliced"]``;
+    row numbers in later messages count the rows kept); ``slow_channels`` fills the
+    empty cells of channels logged slower than the rows, or joins the streams of a file on
+    their own time axes (:mod:`hrgtc.recording.resample`, :mod:`hrgtc.recording.align`);
+    ``tz`` reads naive clock times in that zone as UTC, so the daylight-saving step is gone
+    (:class:`~hrgtc.recording.time_axis.ZoneClock`).
 
     Returns
     -------
@@ -271,87 +217,86 @@ def read(
         Unreadable file, unknown suffix, unknown column, or a validation problem;
         the message names the file, column and row and says how to fix it.
     """
-    check_gap_policy(gaps)
-    check_spike_policy(spikes)
-    spike_filter_ = SpikeFilter(thermometer, str(path)) if spikes == "drop" else None
-    robust = RobustSpikeFilter(spike_filter, thermometer, str(path), k=spike_k,
-                               lsb_multiple=spike_lsb, window_s=spike_window_s)
-    with open_source(path, slow_channels, hold_max_s) as source:
-        plan = plan_columns(source, columns, units, temp_scale, temp_offset_c, thermometer,
-                            rate_scale, temp_unwrap, tz)
-        robust.counts = plan.temperature_is_count and not scales_temperature(temp_scale,
-                                                                           temp_offset_c)
-        columns = table_columns(source.read(plan.read_names, plan.as_text))
-        arrays = with_file_rows(convert_columns(plan, columns, 0), 0)
-        arrays, slow = fill_slow_channels(arrays, slow_channels, hold_max_s, str(path))
-        if spike_filter_ is not None:
-            arrays = spike_filter_.drop(arrays, 0)
+    opts = with_fields(options, fields, "read")
+    if opts.axis is not None:  # one axis of a multi-axis file
+        return concatenate(list(iter_chunks(path, opts, validate=validate)))
+    spike_filter, robust = _spike_filters(opts, path)
+    with open_source(path, opts.slow_channels, opts.hold_max_s) as source:
+        plan = _plan(source, opts, robust)
+        arrays = with_file_rows(convert_columns(plan, table_columns(
+            source.read(plan.read_names, plan.as_text)), 0), 0)
+        arrays, slow = fill_slow_channels(arrays, opts.slow_channels, opts.hold_max_s, str(path))
+        if spike_filter is not None:
+            arrays = spike_filter.drop(arrays, 0)
         arrays = robust.apply(arrays, 0)
         repairer = _time_repairer(plan)
         arrays = _repair_time(arrays, repairer, plan)
-        cut = _TimeSlice(start, end, plan)
+        cut = _TimeSlice(opts.start, opts.end, plan)
         arrays, file_rows = take_file_rows(cut.apply(arrays))
-        meta = _metadata(plan, metadata, arrays.get("time_s"))
+        meta = _metadata(plan, opts.metadata, arrays.get("time_s"))
     if repairer.events or repairer.duplicates:
         meta = replace(meta, extra={**meta.extra, **_repair_extra(repairer)})
     warn_alignment(source)
     slow.warn()
-    if spike_filter_ is not None and spike_filter_.dropped:
-        meta = replace(meta, extra={**meta.extra, "spikes_dropped": spike_filter_.dropped})
-        spike_filter_.warn()
-    if spike_filter != "off":
-        meta = replace(meta, extra={**meta.extra, _SPIKE_KEYS[spike_filter]: robust.rows})
+    if spike_filter is not None and spike_filter.dropped:
+        meta = replace(meta, extra={**meta.extra, "spikes_dropped": spike_filter.dropped})
+        spike_filter.warn()
+    if robust.mode != "off":
+        meta = replace(meta, extra={**meta.extra, _SPIKE_KEYS[robust.mode]: robust.rows})
         robust.warn()
     if cut.dropped:
         meta = replace(meta, extra={**meta.extra, "rows_sliced": cut.dropped})
     recording = Recording(arrays, meta, source=str(path))
     if validate:
-        validate_recording(recording, gaps, freq_band_hz=freq_band_hz, freq_span_hz=freq_span_hz,
-                           thermometer=thermometer, file_rows=file_rows)
+        validate_recording(recording, opts.gaps, freq_band_hz=opts.freq_band_hz,
+                           freq_span_hz=opts.freq_span_hz, thermometer=opts.thermometer,
+                           file_rows=file_rows)
     return recording
 
 
-def iter_chunks(
-    path: str | Path,
-    rows: int = CHUNK_ROWS,
-    columns: Mapping[str, str] | Iterable[str] | None = None,
-    units: Mapping[str, str] | None = None,
-    validate: bool = True,
-    gaps: GapPolicy | str = _READ.gaps,
-    metadata: Mapping[str, Any] | Metadata | None = None,
-    progress: Progress | None = None,
-    freq_band_hz: tuple[float, float] | None = None,
-    freq_span_hz: tuple[float, float] | None = None,
-    *,
-    temp_scale: float = _READ.temp_scale,
-    temp_offset_c: float = _READ.temp_offset_c,
-    spikes: str = _READ.spikes,
-    thermometer: str = _READ.thermometer,
-    rate_scale: float | None = _READ.rate_scale,
-    temp_unwrap: str = _READ.temp_unwrap,
-    spike_filter: str = "off",
-    spike_k: float = _READ.spike_k,
-    spike_lsb: float = _READ.spike_lsb,
-    spike_window_s: float = _READ.spike_window_s,
-    time_repair: TimeRepairStream | None = None,
-    start: str | float | None = None,
-    end: str | float | None = None,
-    slow_channels: str = _READ.slow_channels,
-    hold_max_s: float | None = _READ.hold_max_s,
-    dropped: dict[str, int] | None = None,
-    tz: str | None = _READ.tz,
-    file_rows: Callable[[np.ndarray | None], None] | None = None,
-) -> Iterator[Recording]:
+def _spike_filters(opts: ReadSettings, path: str | Path,
+                   default: str = "off") -> tuple[SpikeFilter | None, RobustSpikeFilter]:
+    """The filters of ``spikes="drop"`` (None otherwise) and of ``spike_filter`` (its
+    ``default`` when None), after checking the policies."""
+    check_gap_policy(opts.gaps)
+    check_spike_policy(opts.spikes)
+    drop = SpikeFilter(opts.thermometer, str(path)) if opts.spikes == "drop" else None
+    robust = RobustSpikeFilter(opts.spike_filter or default, opts.thermometer, str(path),
+                               k=opts.spike_k, lsb_multiple=opts.spike_lsb,
+                               window_s=opts.spike_window_s)
+    return drop, robust
+
+
+def _plan(source: Source, opts: ReadSettings, robust: RobustSpikeFilter) -> ColumnPlan:
+    """How to read the columns of ``source`` with ``opts`` (the robust filter told
+    whether the temperature is a raw count)."""
+    plan = plan_columns(source, opts.columns, opts.units, opts.temp_scale, opts.temp_offset_c,
+                        opts.thermometer, opts.rate_scale, opts.temp_unwrap, opts.tz)
+    robust.counts = plan.temperature_is_count and not scales_temperature(opts.temp_scale,
+                                                                       opts.temp_offset_c)
+    return plan
+
+
+def iter_chunks(path: str | Path, options: ReadSettings | None = None, *,
+                rows: int | None = None, validate: bool = True,
+                progress: Progress | None = None, time_repair: TimeRepairStream | None = None,
+                dropped: dict[str, int] | None = None,
+                file_rows: Callable[[np.ndarray | None], None] | None = None,
+                **fields: Any) -> Iterator[Recording]:
     """Stream a recording in chunks of ``rows`` rows without loading the file.
 
-    Parameters are those of :func:`read`, plus:
+    Parameters are those of :func:`read` (``options``, ``validate`` and any field of
+    :class:`ReadOptions` by name), plus:
 
     rows
-        Rows per chunk (the last chunk may be shorter).
+        Rows per chunk (the last chunk may be shorter); None: ``options.chunk_rows``.
     file_rows
         Called with the file rows of the next chunk's rows before it is yielded.
     progress
         Called as ``progress(done, total)`` after each chunk (rows, or bytes for CSV).
+    time_repair
+        A :class:`~hrgtc.core.time_steps.TimeRepairStream` to repair the time axis with,
+        whose events and counts the caller reads afterwards.
     dropped
         A dict the caller reads once the chunks are exhausted: its ``"spikes"`` is
         then the count of rows the spike filters removed (``spikes="drop"`` and
@@ -366,28 +311,30 @@ def iter_chunks(
         :data:`~hrgtc.recording.validation.HEURISTIC_ROWS` rows) have passed, so a
         bad file raises :class:`~hrgtc.core.errors.RecordingError` before bad data
         reach the caller. With ``gaps="split"`` gaps pass; split downstream. The time
-        axis is repaired as by :func:`read` (``time_repair``: a
-        :class:`~hrgtc.core.time_steps.TimeRepairStream` to use, whose events and counts
-        the caller reads afterwards) and sliced by ``start``/``end``. With
+        axis is repaired as by :func:`read` and sliced by ``start``/``end``. With
+        ``axis``, each chunk's view of that axis, its frequency checked against
+        ``freq_band_hz`` (the file validated as a whole, without the band). With
         ``spikes="drop"`` the rows of spikes are left out before the chunks are cut
         (the rows of later problems then count the rows kept).
     """
-    check_gap_policy(gaps)
-    check_spike_policy(spikes)
-    spike_filter_ = SpikeFilter(thermometer, str(path)) if spikes == "drop" else None
-    robust = RobustSpikeFilter(spike_filter, thermometer, str(path), k=spike_k,
-                               lsb_multiple=spike_lsb, window_s=spike_window_s)
+    opts = with_fields(options, fields, "iter_chunks")
+    rows = opts.chunk_rows if rows is None else rows
+    if opts.axis is not None:  # the views of one axis, the file validated as a whole
+        whole = replace(opts, axis=None, freq_band_hz=None, freq_span_hz=None)
+        yield from _axis_views(iter_chunks(path, whole, rows=rows, validate=validate,
+                                           progress=progress, time_repair=time_repair,
+                                           dropped=dropped, file_rows=file_rows),
+                               opts.axis, opts.freq_band_hz, str(path))
+        return
+    spike_filter, robust = _spike_filters(opts, path)
     if int(rows) < 1:
         raise InputError(f"rows must be a positive number of rows per chunk, got {rows!r}")
     rows = int(rows)
-    validator = (RecordingValidator(gaps, freq_band_hz, freq_span_hz, thermometer)
-                 if validate else None)
-    slow = SlowChannels(slow_channels, hold_max_s, str(path))
-    with open_source(path, slow_channels, hold_max_s) as source:
-        plan = plan_columns(source, columns, units, temp_scale, temp_offset_c, thermometer,
-                            rate_scale, temp_unwrap, tz)
-        robust.counts = plan.temperature_is_count and not scales_temperature(temp_scale,
-                                                                           temp_offset_c)
+    validator = (RecordingValidator(opts.gaps, opts.freq_band_hz, opts.freq_span_hz,
+                                    opts.thermometer) if validate else None)
+    slow = SlowChannels(opts.slow_channels, opts.hold_max_s, str(path))
+    with open_source(path, opts.slow_channels, opts.hold_max_s) as source:
+        plan = _plan(source, opts, robust)
         offset = 0
         repairer = _time_repairer(plan)
         if time_repair is not None:  # the caller's, to read what was repaired
@@ -395,15 +342,15 @@ def iter_chunks(
                                                               repairer.naive_clock)
             time_repair.source = repairer.source
             repairer = time_repair
-        cut = _TimeSlice(start, end, plan)
+        cut = _TimeSlice(opts.start, opts.end, plan)
 
         def converted() -> Iterator[dict[str, np.ndarray]]:
             nonlocal offset
             for table in source.iter_tables(plan.read_names, plan.as_text, rows):
                 part = slow.fill(with_file_rows(convert_columns(plan, table_columns(table),
                                                                 offset), offset), offset)
-                if spike_filter_ is not None:
-                    part = spike_filter_.drop(part, offset)
+                if spike_filter is not None:
+                    part = spike_filter.drop(part, offset)
                 part = robust.apply(part, offset)
                 offset += table.num_rows
                 part = cut.apply(_repair_time(part, repairer, plan))
@@ -411,8 +358,8 @@ def iter_chunks(
                     yield part
             tail = slow.flush()  # rows held back by --slow-channels interpolate
             if tail is not None:
-                if spike_filter_ is not None:
-                    tail = spike_filter_.drop(tail, offset)
+                if spike_filter is not None:
+                    tail = spike_filter.drop(tail, offset)
                 tail = cut.apply(_repair_time(robust.apply(tail, offset), repairer, plan))
                 if tail.get("time_s") is None or len(tail["time_s"]):
                     yield tail
@@ -430,7 +377,7 @@ def iter_chunks(
             if head and "time_s" in head[0]
             else (np.empty(0) if not head else None)
         )
-        meta = _metadata(plan, metadata, time_head)
+        meta = _metadata(plan, opts.metadata, time_head)
         pending: list[Recording] = []
 
         def chunk_meta() -> Metadata:  # with the logger restarts found so far (new runs)
@@ -458,14 +405,14 @@ def iter_chunks(
                 progress(*source.position())
         if validator is not None:
             validator.finish().raise_for_problems()
-        if spike_filter_ is not None:
-            spike_filter_.warn()
+        if spike_filter is not None:
+            spike_filter.warn()
         robust.warn()
         warn_alignment(source)
         slow.warn()
         if dropped is not None:
             dropped["spikes"] = dropped.get("spikes", 0) + (
-                (spike_filter_.dropped if spike_filter_ is not None else 0)
+                (spike_filter.dropped if spike_filter is not None else 0)
                 + (robust.rows if robust.mode == "drop" else 0))
         if progress is not None:
             total = source.position()[1]
@@ -532,34 +479,14 @@ class ReadOptions(ReadSettings):
         ``--tz``: the IANA time zone naive clock times were written in (see :func:`read`).
     """
 
-    def keywords(self) -> dict[str, Any]:
-        """The options as keyword arguments of :func:`read` and :func:`iter_chunks`.
-
-        The options of messy files (``temp_scale``, ``temp_offset_c``, ``spikes``,
-        ``thermometer``) only when they differ from their defaults.
-        """
-        words = {"columns": self.columns, "units": self.units, "metadata": self.metadata,
-                 "gaps": self.gaps}
-        if self.freq_band_hz is not None:
-            words.update(freq_band_hz=self.freq_band_hz, freq_span_hz=self.freq_span_hz)
-        defaults = {field.name: field.default for field in fields(ReadSettings)
-                    if field.name in _MESSY}
-        words.update({key: getattr(self, key) for key, default in defaults.items()
-                      if getattr(self, key) != default})
-        words.update({key: getattr(self, key) for key in ("start", "end", "tz")
-                      if getattr(self, key) is not None})
-        return words
-
     def with_spike_default(self, mode: str) -> ReadOptions:
         """These options with ``spike_filter`` set to ``mode`` unless the user chose one."""
         return self if self.spike_filter is not None else replace(self, spike_filter=mode)
 
     def read(self, path: str | Path, keep: Sequence[str] | None = None) -> Recording:
         """The whole file; with ``keep``, streamed keeping only those columns (less memory)."""
-        if keep is None and self.axis is None:
-            return read(path, **self.keywords())
         if keep is None:
-            return concatenate(list(self.chunks(path)))
+            return read(path, self)
         parts = [Recording({k: c[k] for k in keep if k in c}, c.metadata, c.source)
                  for c in self.chunks(path)]
         return concatenate(parts)
@@ -580,35 +507,31 @@ class ReadOptions(ReadSettings):
         """Stream the file in chunks (:func:`iter_chunks`); with ``axis``, that axis's view.
         ``dropped``: filled with the rows the spike filters removed (see there);
         ``time_repair``: a stream whose counts (duplicates dropped) the caller reads after."""
-        if self.axis is None:
-            return iter_chunks(path, rows=rows or self.chunk_rows, dropped=dropped,
-                               time_repair=time_repair,
-                               **self.keywords())
-        words = self.keywords()
-        words["time_repair"] = time_repair
-        words.pop("freq_band_hz", None)
-        words.pop("freq_span_hz", None)
-        return self._axis_chunks(iter_chunks(path, rows=rows or self.chunk_rows,
-                                             dropped=dropped, **words), str(path))
+        return iter_chunks(path, self, rows=rows, dropped=dropped, time_repair=time_repair)
 
     def _axis_chunks(self, chunks: Iterator[Recording], path: str) -> Iterator[Recording]:
-        axis = str(self.axis)
-        row = 0
-        try:
-            for chunk in chunks:
-                view = axis_view(chunk, axis)
-                band = self.freq_band_hz
-                if band is not None and len(view):
-                    freq = view.freq_hz
-                    bad = np.flatnonzero(~((freq >= band[0]) & (freq <= band[1])))
-                    if bad.size:
-                        raise RecordingError(
-                            f"{path}: column freq_hz_{axis}, row {row + int(bad[0])}: "
-                            f"{float(freq[bad[0]])!r} is outside the band "
-                            f"{band[0]:.6g}-{band[1]:.6g} this axis of the model can reach "
-                            f"({bad.size} such rows in the chunk); is it another unit's file, "
-                            "or the wrong column?")
-                row += len(chunk)
-                yield view
-        finally:
-            chunks.close()
+        return _axis_views(chunks, str(self.axis), self.freq_band_hz, path)
+
+
+def _axis_views(chunks: Iterator[Recording], axis: str, band: tuple[float, float] | None,
+                path: str) -> Iterator[Recording]:
+    """The view of ``axis`` of each of ``chunks`` (read from ``path``), its frequency
+    checked against the plausible ``band`` of that axis of a model (None: unchecked)."""
+    row = 0
+    try:
+        for chunk in chunks:
+            view = axis_view(chunk, axis)
+            if band is not None and len(view):
+                freq = view.freq_hz
+                bad = np.flatnonzero(~((freq >= band[0]) & (freq <= band[1])))
+                if bad.size:
+                    raise RecordingError(
+                        f"{path}: column freq_hz_{axis}, row {row + int(bad[0])}: "
+                        f"{float(freq[bad[0]])!r} is outside the band "
+                        f"{band[0]:.6g}-{band[1]:.6g} this axis of the model can reach "
+                        f"({bad.size} such rows in the chunk); is it another unit's file, "
+                        "or the wrong column?")
+            row += len(chunk)
+            yield view
+    finally:
+        chunks.close()  # type: ignore[attr-defined]

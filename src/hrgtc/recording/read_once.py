@@ -15,13 +15,14 @@ calibration), not to stream a long run.
 from __future__ import annotations
 
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
 
 from hrgtc.core.errors import InputError
 from hrgtc.recording.io import ReadOptions, iter_chunks
 from hrgtc.recording.schema import Recording, concatenate
+from hrgtc.settings.reading import ReadSettings
 
 __all__ = ["ReadOnce"]
 
@@ -37,23 +38,22 @@ class ReadOnce(ReadOptions):
 
     cache: dict[Any, Any] = field(default_factory=dict, compare=False, repr=False)
 
-    def _key(self, path: str | Path) -> tuple[Any, ...]:
-        words = self.keywords()
-        words.pop("freq_band_hz", None)
-        words.pop("freq_span_hz", None)
-        return (str(Path(path).resolve()), repr(sorted(words.items())), self.chunk_rows)
-
     def _whole(self, path: str | Path) -> Recording:
-        key = self._key(path)
+        whole = replace(self, axis=None, freq_band_hz=None, freq_span_hz=None, motion="keep")
+        key = (str(Path(path).resolve()),
+               repr([getattr(whole, f.name) for f in fields(ReadSettings)]))
         if key not in self.cache:
-            words = self.keywords()
-            words.pop("freq_band_hz", None)
-            words.pop("freq_span_hz", None)
             dropped: dict[str, int] = {}
-            self.cache[key] = concatenate(list(iter_chunks(path, rows=self.chunk_rows,
-                                                           dropped=dropped, **words)))
-            self.cache[("dropped", *key)] = dropped
+            self.cache[key] = concatenate(list(iter_chunks(path, whole, dropped=dropped)))
+            self.cache[("dropped", *key)] = dropped  # type: ignore[assignment]
         return self.cache[key]
+
+    def _dropped(self, path: str | Path) -> dict[str, int]:
+        """The rows the spike filters removed from the file's one reading."""
+        whole = replace(self, axis=None, freq_band_hz=None, freq_span_hz=None, motion="keep")
+        key = (str(Path(path).resolve()),
+               repr([getattr(whole, f.name) for f in fields(ReadSettings)]))
+        return self.cache.get(("dropped", *key), {})  # type: ignore[return-value]
 
     def _cached(self) -> bool:
         # a single-axis reading with a plausible band is checked by the reader itself
@@ -62,13 +62,13 @@ class ReadOnce(ReadOptions):
     def chunks(self, path: str | Path, rows: int | None = None,
                dropped: dict[str, int] | None = None) -> Iterator[Recording]:
         """The file's rows in chunks of ``rows`` (with ``axis``: that axis's views);
-        ``dropped`` gets the rows the spike filters removed from the one reading."""
+        ``dropped`` as for :meth:`~hrgtc.recording.ReadOptions.chunks`."""
         if not self._cached():
             return super().chunks(path, rows, dropped)
         whole = self._whole(path)
         if dropped is not None:
-            for what, count in self.cache[("dropped", *self._key(path))].items():
-                dropped[what] = dropped.get(what, 0) + count
+            spikes = self._dropped(path).get("spikes", 0)
+            dropped["spikes"] = dropped.get("spikes", 0) + spikes
         size = rows or self.chunk_rows
         pieces = (whole.slice(start, min(start + size, len(whole)))
                   for start in range(0, len(whole), size))

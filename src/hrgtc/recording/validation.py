@@ -47,7 +47,9 @@ output) ``freq_hz`` holds a temperature: it is checked against
 :data:`TEMPERATURE_RANGE_C`, without the kHz heuristic or the 5 % jump rule. With
 an ``input_rate_dph`` column the rate-unit heuristic runs on rate - input rate.
 
-The single checks and heuristics are in :mod:`hrgtc.recording.checks`.
+The single checks and heuristics are in :mod:`hrgtc.recording.checks`, the checks of
+the time axis carried across chunks (order, gaps, the sample rate throughout) in
+:mod:`hrgtc.recording.time_continuity`.
 
 Rows are numbered from 0 (the first data row), over the whole file also when it
 is validated chunk by chunk.
@@ -64,7 +66,6 @@ from typing import Any
 import numpy as np
 
 from hrgtc.core.errors import RecordingError
-from hrgtc.core.timeline import gap_limit_s, is_gap
 from hrgtc.recording.axes import axis_input_rate_dph, axis_names, base_name
 from hrgtc.recording.checks import (
     _BOUNDS,
@@ -98,14 +99,13 @@ from hrgtc.recording.file_rows import FileRows
 from hrgtc.recording.gaps import (
     GAP_PERIODS,
     GAP_POLICIES,
-    MAX_LISTED_GAPS,
     Gap,
     GapPolicy,
     check_gap_policy,
     split_at_gaps,
 )
 from hrgtc.recording.schema import Metadata, Recording
-from hrgtc.recording.time_checks import _change_row, _step_diagnosis
+from hrgtc.recording.time_continuity import TimeContinuity
 from hrgtc.settings.reading import ReadSettings
 
 __all__ = [
@@ -154,28 +154,19 @@ class RecordingValidator:
         self._jump: dict[str, list[Any]] = {}  # frequency column -> [row, value, count]
         self.axes: tuple[str, ...] = ()
         self._suffixes: tuple[str, ...] = ("",)
-        self._steps = np.empty(0)
-        self._steps_start = 0
-        self._history = np.empty(0)  # steps of the last complete block checked
-        self._steps_usable = True  # every carried step finite, positive and no gap
-        self._rate_change: tuple[int, float] | None = None
         self.rows = 0
         self._file_rows = FileRows()  # rows seen -> rows of the file
         self.source: str | None = None
         self.metadata: Metadata | None = None
         self._missing: tuple[str, ...] = ()
-        self._last_time: float | None = None
         self._not_finite: dict[str, list[Any]] = {}  # column -> [row, value, count]
-        self._time_order: tuple[int, float, float] | None = None
-        self._time_order_count = 0
-        self._time_order_kind = ""
-        self._gaps: list[Gap] = []
-        self._n_gaps = 0
         self._sample: dict[str, list[np.ndarray]] = {}
         self._sample_rows = 0
         self._heuristics: list[Problem] | None = None
         self.measured_sample_rate_hz: float | None = None
         self._names: tuple[str, ...] = ()
+        #: Order, gaps and the sample rate of the time axis, over the whole recording.
+        self.time_axis = TimeContinuity()
 
     # -- feeding -------------------------------------------------------------
     def partial_fit(self, chunk: Recording, file_rows: np.ndarray | None = None) -> None:
@@ -216,7 +207,7 @@ class RecordingValidator:
             if base_name(name, self.axes) in self._bounds:
                 self._check_bounds(name, values, offset)
         if "time_s" in chunk and n:
-            self._check_time(chunk.time_s, offset, chunk)
+            self.time_axis.partial_fit(chunk.time_s, offset, self.metadata, chunk)
         if self._heuristics is None:
             self._collect_sample(chunk)
         self.rows += n
@@ -259,103 +250,6 @@ class RecordingValidator:
                 self._jump[name] = [offset + first, float(freq[first]), int(bad.sum())]
             else:
                 state[2] += int(bad.sum())
-
-    def _check_rate_throughout(self, step: np.ndarray, offset: int,
-                               time: np.ndarray | None = None) -> None:
-        """Mean time step of each block of :data:`RATE_CHECK_ROWS` rows (gaps left out).
-
-        ``time``: the chunk's times, given when every step is known finite, positive
-        and no gap (``step[i] = time[i] - time[i - 1]``); then a block's sum of steps
-        is the difference of the times at its ends, and the steps are not summed.
-        """
-        if self._rate_change is not None:
-            return
-        rows = RATE_CHECK_ROWS
-        period = 1.0 / self.metadata.sample_rate_hz
-        carried = self._steps
-        base = self._steps_start if carried.size else offset
-        blocks = (carried.size + step.size) // rows
-        new_steps = step
-        if time is not None and self._steps_usable:
-            ends = np.arange(1, blocks + 1) * rows - carried.size  # block ends within step
-            starts = np.maximum(ends - rows, 0)
-            # a block's steps add up to its last time minus the time before its first
-            # step (time[0] - step[0]: the previous chunk's last), plus the carried steps
-            before = np.where(starts > 0, time[np.maximum(starts - 1, 0)], time[0] - step[0])
-            sums = time[ends - 1] - before
-            if blocks:
-                sums[0] += carried.sum()
-            counts = np.full(blocks, rows)
-            rest = step[ends[-1]:] if blocks else np.concatenate([carried, step])
-        else:
-            if carried.size:
-                step = np.concatenate([carried, step])
-            part = step[:blocks * rows].reshape(blocks, rows)
-            with np.errstate(invalid="ignore"):
-                usable = np.isfinite(part) & (part > 0) & (part <= gap_limit_s(period))
-            counts = usable.sum(axis=1)
-            sums = np.where(usable, part, 0.0).sum(axis=1)
-            rest = step[blocks * rows:]
-        if blocks:
-            with np.errstate(divide="ignore", invalid="ignore"):
-                measured = 1.0 / (sums / counts)
-                # mostly gaps or disorder: left to those checks
-                changed = (counts >= rows // 2) & (
-                    np.abs(measured * period - 1.0) > SAMPLE_RATE_TOLERANCE)
-            if changed.any():
-                k = int(np.argmax(changed))
-                # the change may have begun in the block before (checked earlier, still in
-                # tolerance): search from there, with the last block's steps kept
-                history = self._history
-                combined = np.concatenate([history, carried, new_steps])
-                at, rate = _change_row(combined, k + (1 if history.size else 0), rows, period)
-                self._rate_change = (base - history.size + at, rate)
-                self._steps = np.empty(0)
-                return
-        if blocks:  # the steps of the last complete block, for the search above
-            end = blocks * rows - carried.size  # its end within new_steps
-            self._history = (new_steps[end - rows:end].copy() if end >= rows else
-                             np.concatenate([carried, new_steps[:end]])[-rows:])
-        self._steps = rest.copy()
-        self._steps_start = base + blocks * rows
-        with np.errstate(invalid="ignore"):
-            self._steps_usable = bool(np.all(np.isfinite(rest) & (rest > 0)
-                                             & (rest <= gap_limit_s(period))))
-
-    def _check_time(self, time: np.ndarray, offset: int, chunk: Recording | None = None) -> None:
-        period = 1.0 / self.metadata.sample_rate_hz
-        if self._last_time is not None:  # fast path: steps all positive and no gap
-            step = np.empty_like(time)
-            step[0] = time[0] - self._last_time
-            np.subtract(time[1:], time[:-1], out=step[1:])
-            extremes = finite_extremes(step)
-            if extremes is not None and extremes[0] > 0.0 and (
-                    extremes[1] <= gap_limit_s(period)):
-                self._last_time = float(time[-1])
-                self._check_rate_throughout(step, offset, time=time)
-                return
-        previous = np.empty_like(time)
-        previous[0] = np.nan if self._last_time is None else self._last_time
-        previous[1:] = time[:-1]
-        self._last_time = float(time[-1])
-        with np.errstate(invalid="ignore"):
-            step = time - previous
-            backwards = step <= 0
-        if backwards.any():
-            self._time_order_count += int(backwards.sum())
-            if self._time_order is None:
-                i = int(np.argmax(backwards))
-                self._time_order = (offset + i, float(time[i]), float(previous[i]))
-                self._time_order_kind = _step_diagnosis(time, previous, i, period,
-                                                        self.metadata, chunk)
-        with np.errstate(invalid="ignore"):
-            long = np.flatnonzero(is_gap(step, period) & np.isfinite(step))
-        self._n_gaps += long.size
-        self._check_rate_throughout(step, offset)
-        room = MAX_LISTED_GAPS - len(self._gaps)
-        self._gaps += [
-            Gap(float(previous[i]), float(step[i]), offset + int(i)) for i in long[:room]
-        ]
 
     def _collect_sample(self, chunk: Recording) -> None:
         take = min(len(chunk), HEURISTIC_ROWS - self._sample_rows)
@@ -426,48 +320,7 @@ class RecordingValidator:
         whole_file = self._heuristics is None or any(
             p.kind in ("sample_rate", "time_unit") and p.row is None
             for p in self._heuristics)
-        if self._rate_change is not None and not whole_file:
-            row, measured = self._rate_change
-            nominal = self.metadata.sample_rate_hz
-            problems.append(Problem(
-                "sample_rate",
-                f"column 'time_s', row {row}: the time step changes to {measured:.6g} Hz but "
-                f"the metadata (and the start of the file) say {nominal:g} Hz; the sample rate "
-                f"changes within the file: split it at row {row} and process the parts "
-                "separately (or resample)",
-                column="time_s", row=row, value=f"{measured:.6g}"))
-        if self._time_order is not None:
-            row, now, before = self._time_order
-            what = "a duplicate time" if now == before else "a step back in time"
-            problems.append(
-                Problem(
-                    "time_order",
-                    f"column 'time_s', row {row}: {now!r} s after {before!r} s is {what} "
-                    f"(time must increase strictly; {self._time_order_count} bad step(s)); "
-                    f"{self._time_order_kind}",
-                    column="time_s",
-                    row=row,
-                    value=repr(now),
-                    count=self._time_order_count,
-                )
-            )
-        if self._n_gaps and self.gaps == "error" and not whole_file:
-            first = self._gaps[0]
-            period = 1.0 / self.metadata.sample_rate_hz
-            problems.append(
-                Problem(
-                    "gap",
-                    f"column 'time_s', row {first.row}: {self._n_gaps} gap(s) longer than "
-                    f"{GAP_PERIODS:g} sample periods ({GAP_PERIODS * period:.6g} s), the first "
-                    f"{first.duration_s:.6g} s after t = {first.start_time_s:.6g} s; "
-                    "pass --gaps bridge (filters carry across gaps, e.g. a burst logger) or "
-                    "--gaps split (each segment a separate run)",
-                    column="time_s",
-                    row=first.row,
-                    value=f"{first.duration_s:.6g}",
-                    count=self._n_gaps,
-                )
-            )
+        problems += self.time_axis.problems(self.gaps, whole_file)
         problems += self._heuristics or []
         return [self._file_rows.problem(p) for p in problems]
 
@@ -521,8 +374,8 @@ class RecordingValidator:
         return ValidationReport(
             ok=not problems,
             problems=problems,
-            gaps=tuple(self._gaps),
-            n_gaps=self._n_gaps,
+            gaps=tuple(self.time_axis.gaps),
+            n_gaps=self.time_axis.n_gaps,
             rows=self.rows,
             source=self.source,
             measured_sample_rate_hz=self.measured_sample_rate_hz,

@@ -38,7 +38,8 @@ __all__ = ["Setting", "build", "format_value", "setting", "settings_of", "to_dic
 
 def setting(default: Any, help: str, *, unit: str | None = None, cli: str | None = "",
             choices: tuple[str, ...] | None = None, default_text: str | None = None,
-            metavar: str | None = None, panel: str | None = None) -> Any:
+            metavar: str | None = None, panel: str | None = None, min: float | None = None,
+            max: float | None = None) -> Any:
     """A dataclass field with its default and what the command line and docs say of it.
 
     Parameters
@@ -60,9 +61,13 @@ def setting(default: Any, help: str, *, unit: str | None = None, cli: str | None
         place of the value.
     metavar, panel
         The option's metavar and its ``--help`` panel.
+    min, max
+        The smallest and largest value a number takes (inclusive; None: unbounded): the
+        option refuses a value outside, naming the range, and the docs list it.
     """
     meta = {"help": help, "unit": unit, "cli": cli, "choices": choices,
-            "default_text": default_text, "metavar": metavar, "panel": panel}
+            "default_text": default_text, "metavar": metavar, "panel": panel,
+            "min": min, "max": max}
     return dataclasses.field(default=default, metadata=meta)
 
 
@@ -84,6 +89,8 @@ class Setting:
     metavar: str | None
     panel: str | None
     type: Any
+    min: float | None = None
+    max: float | None = None
 
     @property
     def name(self) -> str:
@@ -95,6 +102,16 @@ class Setting:
         if self.default_text is not None:
             return self.default_text
         return format_value(self.default)
+
+    def range_text(self) -> str | None:
+        """The values a number takes (``"≥ 1"``, ``"0 to 1"``), None when unbounded."""
+        if self.min is not None and self.max is not None:
+            return f"{self.min:g} to {self.max:g}"
+        if self.min is not None:
+            return f"≥ {self.min:g}"
+        if self.max is not None:
+            return f"≤ {self.max:g}"
+        return None
 
     def full_help(self) -> str:
         """The help with the unit in brackets before its last full stop (``Averaging window
@@ -138,7 +155,7 @@ def settings_of(cls: type, prefix: tuple[str, ...] = ()) -> list[Setting]:
         option = None if cli is None else (cli or "--" + field.name.replace("_", "-"))
         out.append(Setting((*prefix, field.name), field.default, meta["help"], meta["unit"],
                            option, meta["choices"], meta["default_text"], meta["metavar"],
-                           meta["panel"], kind))
+                           meta["panel"], kind, meta.get("min"), meta.get("max")))
     return out
 
 

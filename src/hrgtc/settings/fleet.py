@@ -18,8 +18,8 @@ FILE_FORMATS = ("parquet", "csv", "h5")
 class FleetSimulation:
     """The population ``hrgtc fleet simulate`` writes (:func:`hrgtc.fleet.simulate_fleet`)."""
 
-    units: int = setting(32, "Number of units.")
-    seed: int = setting(1, "Seed of the population.")
+    units: int = setting(32, "Number of units.", min=1)
+    seed: int = setting(1, "Seed of the population.", min=0)
     sample_rate_hz: float = setting(10.0, "Sample rate.", unit="Hz",
                                     cli="--sample-rate-hz --rate-hz")
     soak_hours: float = setting(5.0, "Length of each soak.", unit="h")

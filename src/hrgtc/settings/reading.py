@@ -7,7 +7,8 @@ options (``--gaps``, ``--spikes``, ``--spike-k``, ...) from the fields that name
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+import dataclasses
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -41,7 +42,7 @@ _INPUT = "Input recordings"
 class ReadSettings:
     """How to read a user's files; see :class:`hrgtc.recording.ReadOptions`."""
 
-    columns: Mapping[str, str] | None = None
+    columns: Mapping[str, str] | Sequence[str] | None = None
     units: Mapping[str, str] | None = None
     metadata: Mapping[str, Any] | None = None
     gaps: str = setting(
@@ -120,3 +121,32 @@ class ReadSettings:
         "name (e.g. Europe/Berlin): they are read as UTC, so the daylight-saving step is gone; "
         "--start/--end clock times too.", metavar="ZONE",
         default_text="none (a 3600 s step is an error)", panel=_INPUT)
+
+
+def with_fields(options: ReadSettings | None, fields: Mapping[str, Any],
+                caller: str) -> ReadSettings:
+    """``options`` (the defaults when None) with ``fields`` in place of their values.
+
+    The functions that read (:func:`hrgtc.recording.read`, ``iter_chunks``,
+    ``describe``) take one options object and, for convenience, any of its fields by
+    name (``read(path, spikes="drop")``); this is where those names are checked, so the
+    list of reading options is written once, in :class:`ReadSettings`.
+
+    Raises
+    ------
+    TypeError
+        ``options`` is not reading options (e.g. a column mapping given by position), or
+        a name in ``fields`` is not a field of :class:`ReadSettings`; the message lists them.
+    """
+    if options is not None and not isinstance(options, ReadSettings):
+        raise TypeError(f"{caller}(path, options): options must be ReadOptions (or None), "
+                        f"not {type(options).__name__}; give a column mapping by name "
+                        "(columns=...)")
+    names = [field.name for field in dataclasses.fields(ReadSettings)]
+    unknown = sorted(set(fields) - set(names))
+    if unknown:
+        raise TypeError(f"{caller}() got unknown reading option(s) {', '.join(unknown)}; the "
+                        f"reading options (hrgtc.settings.reading.ReadSettings) are "
+                        f"{', '.join(names)}")
+    base = ReadSettings() if options is None else options
+    return dataclasses.replace(base, **fields) if fields else base

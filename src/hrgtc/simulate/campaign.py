@@ -43,6 +43,7 @@ from typing import Any
 
 import numpy as np
 
+import hrgtc.settings.simulation as _settings
 from hrgtc.core.errors import InputError
 from hrgtc.core.progress import Progress
 from hrgtc.recording import Metadata, Recording, concatenate
@@ -71,7 +72,7 @@ COLUMNS = ("time_s", "freq_hz", "rate_dph", "chamber_c", "housing_c", "resonator
 #: Rows per generated chunk (~60 MB of columns).
 DEFAULT_CHUNK_ROWS = 1 << 19
 #: Default known input rate on the sensitive axis, e.g. an Earth-rate component. [°/h]
-DEFAULT_INPUT_RATE_DPH = 10.0
+DEFAULT_INPUT_RATE_DPH = _settings.DEFAULT_INPUT_RATE_DPH
 
 Seed = int | np.random.SeedSequence | np.random.Generator
 

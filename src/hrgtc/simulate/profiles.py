@@ -59,6 +59,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+import hrgtc.settings.simulation as _settings
 from hrgtc.core.errors import InputError
 
 __all__ = [
@@ -72,12 +73,12 @@ __all__ = [
     "load",
 ]
 
-#: Room temperature at which soaks start, as in Fig. 3 of [1]. [°C]
-ROOM_TEMPERATURE_C = 20.0
+#: Room temperature at which soaks start, as in Fig. 3 of [1] (hrgtc.settings.simulation). [°C]
+ROOM_TEMPERATURE_C = _settings.ROOM_TEMPERATURE_C
 #: Default maximum rate of change of the chamber air temperature. [°C/min]
 CHAMBER_MAX_C_PER_MIN = 2.0
 #: Default ramp rate of the cool-down and warm-up runs (Fig. 6 of [1]). [°C/min]
-DEFAULT_RAMP_C_PER_MIN = 1.0
+DEFAULT_RAMP_C_PER_MIN = _settings.DEFAULT_RAMP_C_PER_MIN
 #: An axis name: a letter, then letters or digits (the suffix of per-axis columns).
 AXIS_NAME = re.compile(r"[A-Za-z][A-Za-z0-9]*")
 #: Keys of a segment in a profile file.

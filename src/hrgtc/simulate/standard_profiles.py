@@ -26,6 +26,13 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from hrgtc.core.errors import InputError
+from hrgtc.settings.simulation import (
+    DEFAULT_PLATEAUS_C,
+    DEFAULT_TABLE_RATES_DPS,
+    PROFILE_DEFAULTS,
+    PROFILE_KINDS,
+    REQUIRED,
+)
 from hrgtc.simulate.profiles import (
     CHAMBER_MAX_C_PER_MIN,
     DEFAULT_RAMP_C_PER_MIN,
@@ -295,10 +302,6 @@ def constant(temperature_c: float, hours: float) -> Profile:
     )
 
 
-#: Plateau temperatures of :func:`rate_table` by default. [°C]
-DEFAULT_PLATEAUS_C = (-10.0, 10.0, 30.0, 50.0)
-#: Table rates of :func:`rate_table` by default: 0, ±10, ±50, ±100, ±300 °/s. [°/s]
-DEFAULT_TABLE_RATES_DPS = (0.0, 10.0, -10.0, 50.0, -50.0, 100.0, -100.0, 300.0, -300.0)
 
 
 def rate_table(
@@ -377,7 +380,7 @@ def rate_table(
 
 
 #: Profile kinds known to :func:`build` (besides a path to a profile file).
-KINDS = ("soak", "cooldown", "warmup", "constant", "ramp", "ratetable")
+KINDS = PROFILE_KINDS
 
 
 def build(
@@ -402,28 +405,30 @@ def build(
         ``"soak"``, ``"cooldown"``, ``"warmup"``, ``"constant"``, ``"ramp"``,
         ``"ratetable"``, or the path of a JSON/YAML profile file.
     setpoints_c
-        Soak set-points (default -20, -10, ..., 40 as in Table 1 of [1]), or the
-        plateaus of a rate table (default -10, 10, 30, 50). [°C]
+        Soak set-points, or the plateaus of a rate table. [°C]
     hours
-        Hours per soak (also at each rate-table plateau, default 3), or duration
-        of a cool-down/warm-up/constant run (default 5); hold after a ramp
-        (default 0). [h]
+        Hours per soak (also at each rate-table plateau), or duration of a
+        cool-down/warm-up/constant run; hold after a ramp. [h]
     start_c, end_c
-        Start and end temperatures of a cool-down (default 20, -20), warm-up
-        (-20, 20) or ramp (required). [°C]
+        Start and end temperatures of a cool-down, warm-up or ramp (the start of a rate
+        table too). [°C]
     temperature_c
-        Temperature of a constant run (default 20). [°C]
+        Temperature of a constant run. [°C]
     ramp_c_per_min
-        Ramp rate of a cool-down, warm-up or ramp (default 1). [°C/min]
+        Ramp rate of a cool-down, warm-up or ramp. [°C/min]
     single_file
         Soaks: one run visiting all set-points instead of one run per set-point.
     rates_dps
-        Rate table: the rates (default 0, ±10, ±50, ±100, ±300). [°/s]
+        Rate table: the rates. [°/s]
     rate_hold_s
-        Rate table: time each rate is held (default 60). [s]
+        Rate table: time each rate is held. [s]
     axes
         Rate table: the axes of a multi-axis unit, turned one at a time (ignored
         by the other kinds); None for a single-axis unit.
+
+    A parameter None takes its kind's default, written once in
+    :data:`hrgtc.settings.simulation.PROFILE_DEFAULTS` (the help of ``hrgtc simulate``
+    shows the same table); a parameter that does not apply to the kind is an error.
 
     Returns
     -------
@@ -439,14 +444,7 @@ def build(
         "rates_dps": rates_dps,
         "rate_hold_s": rate_hold_s,
     }
-    allowed = {
-        "soak": {"setpoints_c"},
-        "cooldown": {"start_c", "end_c", "ramp_c_per_min"},
-        "warmup": {"start_c", "end_c", "ramp_c_per_min"},
-        "constant": {"temperature_c"},
-        "ramp": {"start_c", "end_c", "ramp_c_per_min"},
-        "ratetable": {"setpoints_c", "start_c", "rates_dps", "rate_hold_s"},
-    }
+    allowed = {kind: set(defaults) - {"hours"} for kind, defaults in PROFILE_DEFAULTS.items()}
     if kind not in KINDS:
         path = Path(kind)
         if path.suffix.lower() not in (".json", ".yaml", ".yml"):
@@ -461,41 +459,29 @@ def build(
     if extra or (single_file and kind != "soak"):
         names = extra + (["single_file"] if single_file and kind != "soak" else [])
         raise InputError(f"option(s) {names} do not apply to profile {kind!r}")
+    if kind in PROFILE_DEFAULTS:
+        value = {**PROFILE_DEFAULTS[kind],
+                 **{k: v for k, v in {**given, "hours": hours}.items() if v is not None}}
+        missing = [name for name, v in value.items() if v == REQUIRED]
+        if missing:
+            options = ", ".join("--" + name.removesuffix("_c") for name in missing)
+            raise InputError(f"a {kind} needs {' and '.join(missing)} ({options})")
     if kind == "soak":
-        points = list(setpoints_c) if setpoints_c is not None else [-20, -10, 0, 10, 20, 30, 40]
-        hold = 5.0 if hours is None else hours
+        points, hold = list(value["setpoints_c"]), value["hours"]
         return [soak_series(points, hold)] if single_file else soak_campaign(points, hold)
     if kind in ("cooldown", "warmup"):
         function = cooldown if kind == "cooldown" else warmup
-        room = ROOM_TEMPERATURE_C
-        defaults = (room, -20.0) if kind == "cooldown" else (-20.0, room)
-        return [
-            function(
-                defaults[0] if start_c is None else start_c,
-                defaults[1] if end_c is None else end_c,
-                5.0 if hours is None else hours,
-                DEFAULT_RAMP_C_PER_MIN if ramp_c_per_min is None else ramp_c_per_min,
-            )
-        ]
+        return [function(value["start_c"], value["end_c"], value["hours"],
+                         value["ramp_c_per_min"])]
     if kind == "constant":
-        temp = ROOM_TEMPERATURE_C if temperature_c is None else temperature_c
-        return [constant(temp, 5.0 if hours is None else hours)]
+        return [constant(value["temperature_c"], value["hours"])]
     if kind == "ramp":
-        if start_c is None or end_c is None:
-            raise InputError("a ramp needs start_c and end_c (--start, --end)")
-        rate = DEFAULT_RAMP_C_PER_MIN if ramp_c_per_min is None else ramp_c_per_min
-        return [ramp(start_c, end_c, rate, 0.0 if hours is None else hours)]
+        return [ramp(value["start_c"], value["end_c"], value["ramp_c_per_min"],
+                     value["hours"])]
     if kind == "ratetable":
-        return [
-            rate_table(
-                DEFAULT_PLATEAUS_C if setpoints_c is None else list(setpoints_c),
-                DEFAULT_TABLE_RATES_DPS if rates_dps is None else list(rates_dps),
-                60.0 if rate_hold_s is None else rate_hold_s,
-                3.0 if hours is None else hours,
-                axes=axes,
-                start_c=ROOM_TEMPERATURE_C if start_c is None else start_c,
-            )
-        ]
+        return [rate_table(list(value["setpoints_c"]), list(value["rates_dps"]),
+                           value["rate_hold_s"], value["hours"], axes=axes,
+                           start_c=value["start_c"])]
     if hours is not None:
         raise InputError(f"option hours does not apply to the profile file {kind}")
     return [load(kind)]

@@ -51,6 +51,7 @@ from dataclasses import dataclass, field
 from functools import cache
 from typing import Any
 
+import hrgtc.settings.simulation as _settings
 from hrgtc.core.errors import InputError
 from hrgtc.simulate.laws import (
     BiasLaw,
@@ -76,7 +77,7 @@ __all__ = [
     "unit_from_dict",
 ]
 
-DEFAULT_UNIT = "paper-unit"
+DEFAULT_UNIT = _settings.DEFAULT_UNIT
 #: Earth's rotation rate, 360° per sidereal day (23.9345 h). [°/h]
 EARTH_RATE_DPH = 360.0 / 23.9344696
 

@@ -37,7 +37,7 @@ import datetime as dt
 import math
 import re
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Literal
 
@@ -518,10 +518,8 @@ def _read_raw(options: Any, recording: str | Path) -> Any:
     """The recording with its raw count, not validated (a count is no temperature in °C)."""
     from hrgtc.recording import read
 
-    words = options.keywords()
-    words.pop("freq_band_hz", None)
-    words.pop("freq_span_hz", None)
-    return read(recording, validate=False, **words)
+    return read(recording, replace(options, freq_band_hz=None, freq_span_hz=None),
+                validate=False)
 
 
 def options_with_map(read_options: Any, temperature_map: TemperatureMap | Mapping[str, Any]

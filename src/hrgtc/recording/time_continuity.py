@@ -1,0 +1,208 @@
+"""The checks of a recording's time axis, chunk by chunk: order, gaps and the sample rate.
+
+Part of :class:`hrgtc.recording.validation.RecordingValidator` (see there for the whole
+contract): time must increase strictly (a step back or a duplicate is diagnosed by
+:func:`~hrgtc.recording.time_checks._step_diagnosis`), a step longer than
+:data:`~hrgtc.recording.gaps.GAP_PERIODS` sample periods is a gap (listed, an error or not
+by the gap policy), and the mean step of every block of
+:data:`~hrgtc.recording.checks.RATE_CHECK_ROWS` rows (gaps left out) must agree with the
+metadata's sample rate (the row where it changes is found by
+:func:`~hrgtc.recording.time_checks._change_row`). The state carries across chunks, so
+rows are numbered over the whole recording.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hrgtc.core.timeline import gap_limit_s, is_gap
+from hrgtc.recording.checks import (
+    RATE_CHECK_ROWS,
+    SAMPLE_RATE_TOLERANCE,
+    Problem,
+    finite_extremes,
+)
+from hrgtc.recording.gaps import GAP_PERIODS, MAX_LISTED_GAPS, Gap
+from hrgtc.recording.schema import Metadata, Recording
+from hrgtc.recording.time_checks import _change_row, _step_diagnosis
+
+__all__ = ["TimeContinuity"]
+
+
+class TimeContinuity:
+    """Order, gaps and the sample rate of a recording's time axis, over all its chunks.
+
+    Attributes
+    ----------
+    gaps
+        The first :data:`~hrgtc.recording.gaps.MAX_LISTED_GAPS` gaps.
+    n_gaps
+        Number of gaps.
+    rate_change
+        ``(row, new rate [Hz])`` where the sample rate first changes, None if it holds.
+    """
+
+    def __init__(self) -> None:
+        self.metadata: Metadata | None = None
+        self._steps = np.empty(0)
+        self._steps_start = 0
+        self._history = np.empty(0)  # steps of the last complete block checked
+        self._steps_usable = True  # every carried step finite, positive and no gap
+        self.rate_change: tuple[int, float] | None = None
+        self._last_time: float | None = None
+        self._time_order: tuple[int, float, float] | None = None
+        self._time_order_count = 0
+        self._time_order_kind = ""
+        self.gaps: list[Gap] = []
+        self.n_gaps = 0
+
+    def partial_fit(self, time: np.ndarray, offset: int, metadata: Metadata,
+               chunk: Recording | None = None) -> None:
+        """Check the times of the next chunk, its first row ``offset`` of the recording
+        (``chunk``: the chunk itself, for the diagnosis of a step back)."""
+        self.metadata = metadata
+        period = 1.0 / self.metadata.sample_rate_hz
+        if self._last_time is not None:  # fast path: steps all positive and no gap
+            step = np.empty_like(time)
+            step[0] = time[0] - self._last_time
+            np.subtract(time[1:], time[:-1], out=step[1:])
+            extremes = finite_extremes(step)
+            if extremes is not None and extremes[0] > 0.0 and (
+                    extremes[1] <= gap_limit_s(period)):
+                self._last_time = float(time[-1])
+                self._check_rate(step, offset, time=time)
+                return
+        previous = np.empty_like(time)
+        previous[0] = np.nan if self._last_time is None else self._last_time
+        previous[1:] = time[:-1]
+        self._last_time = float(time[-1])
+        with np.errstate(invalid="ignore"):
+            step = time - previous
+            backwards = step <= 0
+        if backwards.any():
+            self._time_order_count += int(backwards.sum())
+            if self._time_order is None:
+                i = int(np.argmax(backwards))
+                self._time_order = (offset + i, float(time[i]), float(previous[i]))
+                self._time_order_kind = _step_diagnosis(time, previous, i, period,
+                                                        self.metadata, chunk)
+        with np.errstate(invalid="ignore"):
+            long = np.flatnonzero(is_gap(step, period) & np.isfinite(step))
+        self.n_gaps += long.size
+        self._check_rate(step, offset)
+        room = MAX_LISTED_GAPS - len(self.gaps)
+        self.gaps += [
+            Gap(float(previous[i]), float(step[i]), offset + int(i)) for i in long[:room]
+        ]
+
+    def _check_rate(self, step: np.ndarray, offset: int,
+                    time: np.ndarray | None = None) -> None:
+        """Mean time step of each block of :data:`RATE_CHECK_ROWS` rows (gaps left out).
+
+        ``time``: the chunk's times, given when every step is known finite, positive
+        and no gap (``step[i] = time[i] - time[i - 1]``); then a block's sum of steps
+        is the difference of the times at its ends, and the steps are not summed.
+        """
+        if self.rate_change is not None:
+            return
+        rows = RATE_CHECK_ROWS
+        period = 1.0 / self.metadata.sample_rate_hz
+        carried = self._steps
+        base = self._steps_start if carried.size else offset
+        blocks = (carried.size + step.size) // rows
+        new_steps = step
+        if time is not None and self._steps_usable:
+            ends = np.arange(1, blocks + 1) * rows - carried.size  # block ends within step
+            starts = np.maximum(ends - rows, 0)
+            # a block's steps add up to its last time minus the time before its first
+            # step (time[0] - step[0]: the previous chunk's last), plus the carried steps
+            before = np.where(starts > 0, time[np.maximum(starts - 1, 0)], time[0] - step[0])
+            sums = time[ends - 1] - before
+            if blocks:
+                sums[0] += carried.sum()
+            counts = np.full(blocks, rows)
+            rest = step[ends[-1]:] if blocks else np.concatenate([carried, step])
+        else:
+            if carried.size:
+                step = np.concatenate([carried, step])
+            part = step[:blocks * rows].reshape(blocks, rows)
+            with np.errstate(invalid="ignore"):
+                usable = np.isfinite(part) & (part > 0) & (part <= gap_limit_s(period))
+            counts = usable.sum(axis=1)
+            sums = np.where(usable, part, 0.0).sum(axis=1)
+            rest = step[blocks * rows:]
+        if blocks:
+            with np.errstate(divide="ignore", invalid="ignore"):
+                measured = 1.0 / (sums / counts)
+                # mostly gaps or disorder: left to those checks
+                changed = (counts >= rows // 2) & (
+                    np.abs(measured * period - 1.0) > SAMPLE_RATE_TOLERANCE)
+            if changed.any():
+                k = int(np.argmax(changed))
+                # the change may have begun in the block before (checked earlier, still in
+                # tolerance): search from there, with the last block's steps kept
+                history = self._history
+                combined = np.concatenate([history, carried, new_steps])
+                at, rate = _change_row(combined, k + (1 if history.size else 0), rows, period)
+                self.rate_change = (base - history.size + at, rate)
+                self._steps = np.empty(0)
+                return
+        if blocks:  # the steps of the last complete block, for the search above
+            end = blocks * rows - carried.size  # its end within new_steps
+            self._history = (new_steps[end - rows:end].copy() if end >= rows else
+                             np.concatenate([carried, new_steps[:end]])[-rows:])
+        self._steps = rest.copy()
+        self._steps_start = base + blocks * rows
+        with np.errstate(invalid="ignore"):
+            self._steps_usable = bool(np.all(np.isfinite(rest) & (rest > 0)
+                                             & (rest <= gap_limit_s(period))))
+
+    def problems(self, gap_policy: str, whole_file: bool) -> list[Problem]:
+        """The problems of the time axis so far. ``whole_file``: a time unit or sample
+        rate wrong for the whole file (or not yet ruled out) was found, of which gaps and
+        rate changes are consequences, not news; ``gap_policy`` ``"error"``: gaps are
+        problems."""
+        problems: list[Problem] = []
+        if self.rate_change is not None and not whole_file:
+            row, measured = self.rate_change
+            nominal = self.metadata.sample_rate_hz
+            problems.append(Problem(
+                "sample_rate",
+                f"column 'time_s', row {row}: the time step changes to {measured:.6g} Hz but "
+                f"the metadata (and the start of the file) say {nominal:g} Hz; the sample rate "
+                f"changes within the file: split it at row {row} and process the parts "
+                "separately (or resample)",
+                column="time_s", row=row, value=f"{measured:.6g}"))
+        if self._time_order is not None:
+            row, now, before = self._time_order
+            what = "a duplicate time" if now == before else "a step back in time"
+            problems.append(
+                Problem(
+                    "time_order",
+                    f"column 'time_s', row {row}: {now!r} s after {before!r} s is {what} "
+                    f"(time must increase strictly; {self._time_order_count} bad step(s)); "
+                    f"{self._time_order_kind}",
+                    column="time_s",
+                    row=row,
+                    value=repr(now),
+                    count=self._time_order_count,
+                )
+            )
+        if self.n_gaps and gap_policy == "error" and not whole_file:
+            first = self.gaps[0]
+            period = 1.0 / self.metadata.sample_rate_hz
+            problems.append(
+                Problem(
+                    "gap",
+                    f"column 'time_s', row {first.row}: {self.n_gaps} gap(s) longer than "
+                    f"{GAP_PERIODS:g} sample periods ({GAP_PERIODS * period:.6g} s), the first "
+                    f"{first.duration_s:.6g} s after t = {first.start_time_s:.6g} s; "
+                    "pass --gaps bridge (filters carry across gaps, e.g. a burst logger) or "
+                    "--gaps split (each segment a separate run)",
+                    column="time_s",
+                    row=first.row,
+                    value=f"{first.duration_s:.6g}",
+                    count=self.n_gaps,
+                )
+            )
+        return problems
