@@ -169,7 +169,13 @@ def test_report_reads_each_run_and_soak_once(campaign):
     assert table[campaign["soaks"][0].name]["passes"] == 1
 
 
-def test_cross_axis_fits_the_thermometer_once(campaign, monkeypatch):
+@pytest.fixture(scope="module")
+def imu_campaign(tmp_path_factory):
+    """A 3-axis campaign only: cross-axis terms need the other axes' resonators."""
+    return _campaign(tmp_path_factory.mktemp("imu-3-cross"), "imu-3")
+
+
+def test_cross_axis_fits_the_thermometer_once(imu_campaign, monkeypatch):
     """``--cross-axis`` reuses each axis's thermometer (plateaus, Tables 1-2) for the trial
     with the other resonators' frequencies: one thermometer fit and one plateau search per
     axis and soak (before: two), and the same model as the old path that calibrated each
@@ -178,8 +184,7 @@ def test_cross_axis_fits_the_thermometer_once(campaign, monkeypatch):
     import hrgtc.pipeline.instrument as instrument
     from hrgtc.settings.calibration import CalibrationSettings
 
-    if "imu" not in str(campaign["cool"]):
-        pytest.skip("cross-axis terms need several axes")
+    campaign = imu_campaign
     calls = {"thermometer": 0, "plateaus": 0}
 
     def counted(name, function):
