@@ -133,61 +133,19 @@ PREDICTION_BLOCKS = 2000
 
 
 def render_evaluation(result: Evaluation, sensor: bool = False) -> None:
-    """Bias stability table raw / compensated / housing, beside the paper's figures.
+    """The run's figures (its :meth:`~hrgtc.evaluation.Evaluation.figures`) as tables,
+    beside the paper's figures; the range warnings are :func:`warn_ranges`'s.
 
     ``sensor``: the thermometer is a temperature sensor (a MEMS gyro, not an HRG):
-    the compensated row says so and the paper's HRG figures are left out.
+    the compensated rows say so and the paper's HRG figures are left out.
     """
+    from hrgtc.cli.summary_tables import print_summary
     from hrgtc.thermometry import paper
 
-    table = Table(title=f"Bias stability of {result.file} (1σ of τ-s means, °/h; "
-                  f"{result.confidence:.3g} chi-squared interval)")
-    table.add_column("output")
-    taus = list(result.bias_stability_dph["raw"])
-    for tau in taus:
-        table.add_column(f"τ = {tau:g} s", justify="right")
-    labels = {"raw": "raw", "compensated": ("compensated (temperature sensor)" if sensor
-                                            else "compensated (frequency, Eq. 22)"),
-              "housing": "compensated (housing thermistor)"}
-    for name in result.bias_stability_dph:
-        table.add_row(labels.get(name, name), *(result.stability_text(name, t) for t in taus))
+    print_summary(result.figures(sensor=sensor, warnings=False), console)
     if not sensor:  # the paper's figures are an HRG's
-        table.add_row("paper, Section 4.2 (10 s)", *(
-            f"{paper.BIAS_STABILITY_RAW_DPH} → {paper.BIAS_STABILITY_COMPENSATED_DPH}"
-            if t == 10.0 else "" for t in taus))
-    console.print(table)
-    console.print("offset and spread the bias stability does not show: " + "; ".join(
-        f"{name} {result.offset_text(name)}" for name in result.bias_stability_dph),
-        markup=False)
-    if result.noise:
-        allan = Table(title="Allan noise terms (IEEE Std 952)")
-        for column in ("output", "ARW (°/√h)", "bias instability (°/h)", "RRW (°/h/√h)"):
-            allan.add_column(column, justify="right")
-        for name, terms in result.noise.items():
-            allan.add_row(labels.get(name, name), terms.text("arw"),
-                          terms.text("bias_instability"), terms.text("rrw"))
-        console.print(allan)
-    shares = (f"outside the calibrated range: {result.out_of_range_fraction:.2%}; df/dt "
-              f"beyond training: {result.rate_out_of_range_fraction:.2%}"
-              if result.ranges is None else
-              f"beyond the trained ranges: {result.ranges.shares_text()}")
-    console.print(f"improvement at 10 s: {result.improvement_10s:.2f}×; compensated "
-                  f"{result.offset_text()}; {shares}")
-    if result.prediction_std_dph is not None:
-        std = result.prediction_std_dph
-        console.print(f"1σ of the drift model line (coefficient covariance): median "
-                      f"{std['median']:.4g} °/h, max {std['max']:.4g} °/h")
-    if result.residual_rms_dph is not None:
-        console.print(f"RMS of true bias minus model: {result.residual_rms_dph:.4f} °/h")
-    if result.n_not_at_rest:
-        console.print(f"{result.n_not_at_rest} samples not at rest left out of the figures "
-                      f"({result.n_not_at_rest / result.n_samples:.1%}; --motion keep uses them)")
-    if result.directions is not None:
-        console.print(result.directions.summary(sensor=sensor), markup=False)
-    for note in result.notes:
-        console.print(note)
-    if result.accounting is not None:
-        console.print(result.accounting.summary(), markup=False)
+        console.print(f"paper, Section 4.2 (10 s): {paper.BIAS_STABILITY_RAW_DPH} → "
+                      f"{paper.BIAS_STABILITY_COMPENSATED_DPH} °/h", markup=False)
 
 
 @app.command("evaluate")

@@ -245,36 +245,15 @@ class Evaluation:
         """Lines on samples beyond the trained temperature and df/dt (empty if none)."""
         return [] if self.ranges is None else self.ranges.warnings()
 
-    def figures(self, key: str = "evaluation") -> Summary:
-        """The figures as a structured summary: value, unit, interval (:mod:`run_figures`)."""
-        return run_figures(self, key)
+    def figures(self, key: str = "evaluation", sensor: bool = False,
+                warnings: bool = True) -> Summary:
+        """The figures as a structured summary: value, unit, interval (:mod:`run_figures`).
+
+        ``sensor``: the thermometer is a temperature sensor (the labels say so);
+        ``warnings``: the range warnings among its notes.
+        """
+        return run_figures(self, key, sensor=sensor, warnings=warnings)
 
     def summary(self) -> str:
-        """A small text table."""
-        def fmt(v: float) -> str:
-            return "    -   " if math.isnan(v) else f"{v:8.4f}"
-
-        taus = list(self.bias_stability_dph["raw"])
-        lines = [f"{self.file}: {self.n_samples} samples at {self.sample_rate_hz:g} Hz",
-                 "bias stability [°/h]  " + "".join(f"{f'{t:g} s':>9}" for t in taus)
-                 + f"{'mean':>10}{'RMS':>9}"]
-        for name, row in self.bias_stability_dph.items():
-            lines.append(f"  {name:<19}" + "".join(f" {fmt(row[t])}" for t in taus)
-                         + f"  {fmt(self.mean_dph.get(name, math.nan))}"
-                         + f" {fmt(self.rms_dph.get(name, math.nan))}")
-        if self.bias_stability_interval_dph:
-            lines.append(f"  ({self.confidence:.3g} intervals at 10 s: " + ", ".join(
-                f"{k} {self.stability_text(k, 10.0)}" for k in self.bias_stability_dph) + ")")
-        shares = self.ranges.shares_text() if self.ranges else (
-            f"{self.out_of_range_fraction:.1%}, df/dt {self.rate_out_of_range_fraction:.1%}")
-        lines.append(f"improvement at 10 s: {self.improvement_10s:.2f}×; compensated "
-                     f"{self.offset_text()}; beyond the trained ranges: {shares}")
-        if self.residual_rms_dph is not None:
-            lines.append(f"RMS of true bias minus model: {self.residual_rms_dph:.4f} °/h")
-        if self.n_not_at_rest:
-            lines.append(f"{self.n_not_at_rest} samples not at rest left out of the figures "
-                         f"({self.n_not_at_rest / self.n_samples:.1%})")
-        lines.extend([] if self.directions is None else [self.directions.summary()])
-        lines.extend(self.range_warnings())
-        lines.extend(self.notes)
-        return "\n".join(lines)
+        """The figures as plain text (:meth:`figures` rendered by ``Summary.text``)."""
+        return self.figures().text()

@@ -322,68 +322,40 @@ def _run(page: _Page, k: int, run: Evaluation, model: UnitModel) -> None:
                 f"<b>Fig. 6(a)</b> of [1]; (b) compensated output, mirrors <b>Fig. 6(b)</b>; "
                 f"(c) temperatures. {run.block_s:g} s means; red shading: samples outside the "
                 f"calibrated range.", f"raw and compensated output of {run.name}")
-    housing = "housing" in run.bias_stability_dph
-    rows = []
     hrg = model.thermometer.source != "sensor"  # the paper's figures are an HRG's
-    for tau in run.bias_stability_dph["raw"]:
-        paper_cells = ((_number(paper.BIAS_STABILITY_RAW_DPH, 5),
-                        _number(paper.BIAS_STABILITY_COMPENSATED_DPH, 4)) if tau == 10.0
-                       else ("–", "–")) if hrg else ()
-        rows.append((f"{tau:g}", _stability(run, "raw", tau),
-                     _stability(run, "compensated", tau), _number(_ratio(run, tau), 3),
-                     *([_stability(run, "housing", tau)] if housing else []), *paper_cells))
-    headers = ["τ [s]", "raw [°/h]", "compensated [°/h]", "improvement [×]",
-               *(["housing baseline [°/h]"] if housing else []),
-               *(["paper raw [°/h]", "paper compensated [°/h]"] if hrg else [])]
-    page.add(_table(headers, rows, f"Bias stability of {run.name}: 1σ of τ-second means "
-                        "of output − input rate with its "
-                        f"{run.confidence:.3g} chi-squared interval, (blocks − 1) degrees "
-                        "of freedom" + (" (paper [1], Section 4.2: 3.0143 → 0.5848 °/h "
-                                        "on its cool-down)" if hrg else "")))
-    facts = [(f"{name} mean and RMS (the offset a bias stability does not show)",
-              f"{_number(run.mean_dph.get(name))} and {_number(run.rms_dph.get(name))} °/h")
-             for name in run.bias_stability_dph if name in run.mean_dph]
-    if run.ranges is None:
-        facts += [("samples outside the calibrated range (f, T)",
-                   f"{run.out_of_range_fraction:.2%}"),
-                  ("samples with df/dt outside its training range",
-                   f"{run.rate_out_of_range_fraction:.2%}")]
-    else:  # one share per variable: a gradient beyond its range is not a temperature
-        facts += [(f"samples beyond the trained {name}" if name in ("temperature", "df/dt")
-                   else f"samples beyond the trained range of {name}", f"{share:.2%}")
-                  for name, share in run.ranges.shares().items()]
-    if run.prediction_std_dph is not None:
-        facts.append(("1σ of the drift model line (coefficient covariance), median / max "
-                      "[°/h]", f"{_number(run.prediction_std_dph['median'])} / "
-                      f"{_number(run.prediction_std_dph['max'])}"))
-    if run.residual_rms_dph is not None:
-        facts.append(("RMS of model − true bias (simulator) [°/h]",
-                      _number(run.residual_rms_dph)))
-    if model.housing is not None and not housing:
-        facts.append(("housing baseline", "not applied: the run has no housing_c column"))
-    page.add(_table(("quantity", "value"), facts, f"Range and residual of {run.name}"))
+    summary = run.figures(sensor=not hrg, warnings=False)
     for line in run.range_warnings():  # where the reader looks, not only in the JSON
         page.add(f'<p class="warning"><b>Beyond the calibration.</b> '
                  f"{escape(line.removeprefix('warning: '))}</p>")
-    if run.allan:
-        page.figure(figures.allan_figure(run),
-                    f"Deviation ({run.deviation}) of the output before and after compensation "
-                    f"(octave τ) with its {run.confidence:.3g} chi-squared interval where "
-                    "SP 1065 gives one; squares mark a flat bias-instability minimum.",
-                    f"Allan deviation of {run.name}")
-        names = {"raw": "raw", "compensated": "compensated", "housing": "housing baseline"}
-        rows = [(names[key], n.text("arw"), n.text("bias_instability"), n.text("rrw"))
-                for key, n in run.noise.items()]  # _table escapes the cells
-        page.add(_table(("output", "ARW [°/√h]", "bias instability [°/h]",
-                             "RRW [°/h/√h]"), rows,
-                            f"Allan noise terms of {run.name} (IEEE Std 952-1997, Annex C)"))
+    captions = {"bias stability": f" with its {run.confidence:.3g} chi-squared interval, "
+                "(blocks − 1) degrees of freedom" + (
+                    " (paper [1], Section 4.2: 3.0143 → 0.5848 °/h on its cool-down)"
+                    if hrg else ""),
+                "Allan noise terms": " (IEEE Std 952-1997, Annex C)"}
+    rows = summary.rows()
+    for heading, _ in summary.sections:
+        if heading.startswith("Allan") and run.allan:
+            _allan_figure(page, run)
+        head, _, detail = heading.partition(" (")
+        caption = (f"{head[:1].upper()}{head[1:]} of {run.name}"
+                   + (f" ({detail}" if detail else "") + captions.get(head, ""))
+        page.add(_table(("figure", "value", "unit", "interval"),
+                        [row[1:] for row in rows if row[0] == heading], caption))
+    if run.allan and not run.noise:
+        _allan_figure(page, run)
+    if model.housing is not None and "housing" not in run.bias_stability_dph:
+        page.note("Housing baseline not applied: the run has no housing_c column.")
+    for note in summary.notes:
+        page.note(escape(note))
     page.add("</section>")
 
 
-def _stability(run: Evaluation, series: str, tau_s: float) -> str:
-    """A bias stability with its interval, "–" where there is none."""
-    text = run.stability_text(series, tau_s)
-    return "–" if text == "-" else text
+def _allan_figure(page: _Page, run: Evaluation) -> None:
+    page.figure(figures.allan_figure(run),
+                f"Deviation ({run.deviation}) of the output before and after compensation "
+                f"(octave τ) with its {run.confidence:.3g} chi-squared interval where "
+                "SP 1065 gives one; squares mark a flat bias-instability minimum.",
+                f"Allan deviation of {run.name}")
 
 
 def _excluded(d: Any) -> str:

@@ -1,0 +1,132 @@
+"""Tests of hrgtc.evaluation.run_figures: one run's figures, the same in every renderer.
+
+The plain text (``Evaluation.summary()``), the CLI's rich tables (``hrgtc evaluate``), the
+HTML report's run section and the ``--json`` document (``Evaluation.to_dict()``) are parsed
+back and must give every figure of the run's :class:`~hrgtc.core.summary.Summary` with the
+same value, so the renderers cannot drift apart.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import re
+from html.parser import HTMLParser
+
+import pytest
+from rich.console import Console
+
+import hrgtc.cli.compensate_cmd as compensate_cmd
+from hrgtc.core.summary import Figure
+from hrgtc.evaluation import evaluate
+from hrgtc.pipeline.calibration import calibrate
+
+
+@pytest.fixture(scope="module")
+def run(paper_campaign):
+    files = paper_campaign
+    model = calibrate(files.soaks, [files.cooldown]).model
+    return evaluate(files.warmup, model, max_points=300), model
+
+
+def _agrees(figure: Figure, cell: str) -> bool:
+    """``cell`` (a renderer's value, possibly followed by unit and interval) shows
+    ``figure``'s value."""
+    if isinstance(figure.value, str):
+        return cell.startswith(figure.value)
+    token = cell.split()[0] if cell.split() else ""
+    if isinstance(figure.value, float) and math.isnan(figure.value):
+        return token == "-"
+    return float(token) == pytest.approx(float(figure.value), rel=10.0 ** (1 - figure.digits))
+
+
+def _json_value(document: dict, name: str):
+    """The value at a figure's name (``bias_stability_dph.raw.10``, ``ranges.variables[0]
+    .fraction``) in the ``--json`` document; a τ of ``0.5`` is one key."""
+    node, pending = document, ""
+    for token in name.removeprefix("evaluation.").split("."):
+        pending = f"{pending}.{token}" if pending else token
+        key, index = re.match(r"([^\[]+)((?:\[\d+\])*)$", pending).groups()
+        if key not in node:  # the first part of a key with a dot (τ = 0.5)
+            continue
+        node, pending = node[key], ""
+        for k in re.findall(r"\d+", index):
+            node = node[int(k)]
+    assert not pending, name
+    return node
+
+
+class _Tables(HTMLParser):
+    def __init__(self, text: str) -> None:
+        super().__init__()
+        self.rows: list[list[str]] = []
+        self._cell: list[str] | None = None
+        self.feed(text)
+
+    def handle_starttag(self, tag, attrs):
+        if tag == "tr":
+            self.rows.append([])
+        elif tag == "td":
+            self._cell = []
+
+    def handle_data(self, data):
+        if self._cell is not None:
+            self._cell.append(data)
+
+    def handle_endtag(self, tag):
+        if tag == "td" and self._cell is not None:
+            self.rows[-1].append("".join(self._cell).strip())
+            self._cell = None
+
+
+def test_text_rich_html_and_json_show_the_same_figures(run, monkeypatch):
+    from hrgtc.report.html import _Page, _run
+
+    result, model = run
+    summary = result.figures(warnings=False)
+    figures = list(summary.figures().values())
+    labels = [f.label for f in figures]
+    assert len(set(labels)) == len(labels)  # a label names one figure in a table
+    # the run has every kind of section the renderers must carry
+    names = set(summary.figures())
+    for part in ("bias_stability_dph.raw.10", "allan.compensated.arw_deg_per_rt_h",
+                 "ranges.temperature_fraction", "heating_cooling.heating.compensated_dph",
+                 "accounting.read", "prediction_std_dph.median", "mean_dph.compensated"):
+        assert f"evaluation.{part}" in names
+
+    text = [line.strip() for line in result.summary().splitlines()]
+    out = io.StringIO()
+    monkeypatch.setattr(compensate_cmd, "console", Console(file=out, width=400))
+    compensate_cmd.render_evaluation(result)
+    rich = {cells[0]: cells[1:] for line in out.getvalue().splitlines()
+            if len(cells := [c.strip() for c in line.split("│")[1:-1]]) == 4}
+    page = _Page()
+    _run(page, 1, result, model.axes[""] if hasattr(model, "axes") else model)
+    html = {row[0]: row[1:] for row in _Tables("".join(page.parts)).rows if len(row) == 4}
+    document = result.to_dict()
+
+    for figure in figures:
+        line = next(v for v in text if v.startswith(f"{figure.label}: "))
+        assert _agrees(figure, line.removeprefix(f"{figure.label}: ")), (figure, line)
+        assert _agrees(figure, rich[figure.label][0]), (figure, rich[figure.label])
+        assert _agrees(figure, html[figure.label][0]), (figure, html[figure.label])
+        for cells in (rich[figure.label], html[figure.label]):
+            assert cells[1:] == [figure.unit, figure.interval_text()]
+        if figure.interval is not None:  # the interval in the text too
+            assert figure.interval_text() in line
+        value = _json_value(document, figure.name)
+        if isinstance(figure.value, str):
+            assert value is None  # a noise term that could not be read: its reason instead
+        elif value is None:
+            assert math.isnan(figure.value)
+        else:
+            assert value == pytest.approx(figure.value, rel=1e-12)
+    assert set(rich) >= set(labels) and set(html) >= set(labels)
+
+
+def test_bias_stability_figures_carry_the_block_count(run):
+    result, _ = run
+    figure = result.figures()["evaluation.bias_stability_dph.compensated.10"]
+    n = result.bias_stability_blocks["compensated"][10.0]
+    assert figure.interval == result.stability_interval("compensated", 10.0)
+    assert figure.interval_kind.endswith(f"N {n}") and n > 100
