@@ -43,7 +43,7 @@ def test_a_constant_offset_shows_in_the_mean_not_in_the_bias_stability(model):
     assert moved.rms_dph["compensated"] > 136.0 > 10 * moved.compensated_10s
     data = moved.to_dict()
     assert data["mean_dph"]["compensated"] == pytest.approx(moved.mean_dph["compensated"])
-    assert "compensated mean +1" in moved.summary()
+    assert "compensated (frequency, Eq. 22) mean: 136" in moved.summary()
 
 
 def test_handling_is_left_out_of_the_figures_and_counted(model):

@@ -160,11 +160,12 @@ def test_bias_stability_table_against_numpy(unit, report):
     def stability(rate):
         return np.std(rate[settle: settle + n * m].reshape(n, m).mean(axis=1), ddof=1)
 
-    row10 = next(row for row in page.table(f"Bias stability of {files.cooldown.name}")
-                 if row[0] == "10")
-    assert _number(row10[1]) == pytest.approx(stability(run.rate_dph), rel=1e-3)
-    assert _number(row10[2]) == pytest.approx(stability(compensated["rate_comp_dph"]), rel=1e-3)
-    assert _number(row10[1]) > 2 * _number(row10[2])
+    rows = {row[0]: row for row in page.table(f"Bias stability of {files.cooldown.name}")}
+    raw10 = _number(rows["raw, τ = 10 s"][1])
+    comp10 = _number(rows["compensated (frequency, Eq. 22), τ = 10 s"][1])
+    assert raw10 == pytest.approx(stability(run.rate_dph), rel=1e-3)
+    assert comp10 == pytest.approx(stability(compensated["rate_comp_dph"]), rel=1e-3)
+    assert raw10 > 2 * comp10
 
 
 def test_numbers_agree_with_hrgtc_evaluate(unit, report):
@@ -284,17 +285,19 @@ def test_intervals_and_noise_reasons_in_the_tables(unit, report):
     _, _, page, _ = report
     result = evaluate(files.cooldown, model)
     row10 = next(row for row in page.table(f"Bias stability of {files.cooldown.name}")
-                 if row[0] == "10")
+                 if row[0] == "raw, τ = 10 s")
     low, high = result.stability_interval("raw", 10.0)
-    inside = row10[1].split("(")[1].rstrip(")")  # "low–high, N blocks"
-    bounds = inside.split(", N ")[0].split("–")
-    assert int(inside.split(", N ")[1]) == result.bias_stability_blocks["raw"][10.0]
+    bounds, inside = row10[3].split("] (")  # "[low, high] (68.3% CI, N blocks)"
+    bounds = bounds.lstrip("[").split(", ")
+    assert int(inside.rstrip(")").split(", N ")[1]) == result.bias_stability_blocks["raw"][10.0]
     assert float(bounds[0]) == pytest.approx(low, rel=1e-2)
     assert float(bounds[1]) == pytest.approx(high, rel=1e-2)
     noise = page.table(f"Allan noise terms of {files.cooldown.name}")
-    cells = [cell for row in noise for cell in row[1:]]
-    expected = [result.noise[k].text(t) for k in result.noise
-                for t in ("arw", "bias_instability", "rrw")]
+    cells = [row[1] for row in noise]  # each term's value, or the reason it is missing
+    fields = {"arw": "arw_deg_per_rt_h", "bias_instability": "bias_instability_dph",
+              "rrw": "rrw_dph_per_rt_h"}
+    expected = [result.noise[k].text(t).split(" (")[0] if getattr(result.noise[k], fields[t])
+                is not None else result.noise[k].text(t) for k in result.noise for t in fields]
     assert cells == expected
     assert any(cell.startswith("no ") for cell in cells) or all(
         n.rrw_reason is None for n in result.noise.values())

@@ -19,9 +19,12 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+import msgspec
 import numpy as np
 
+from hrgtc.core import records
 from hrgtc.core.errors import ExtrapolationWarning
+from hrgtc.core.records import Count, Record, Statistic
 from hrgtc.drift import DriftModel
 from hrgtc.drift.variables import is_aux, unit, variable
 from hrgtc.thermometry import Thermometer
@@ -67,23 +70,30 @@ class VariableRange:
                 f"{self.seen[1]:.4g} {self.unit})")
 
     def to_dict(self) -> dict[str, Any]:
-        return {"variable": self.name, "unit": self.unit, "fraction": self.fraction,
-                "trained": _pair(self.trained), "seen": _pair(self.seen),
-                "excess": self.excess}
+        """Plain JSON types (:class:`VariableRangeRecord`)."""
+        return records.dump(self, VariableRangeRecord, variable=self.name)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> VariableRange:
-        return cls(str(data["variable"]), str(data["unit"]), float(data["fraction"]),
-                   _unpair(data["trained"]), _unpair(data["seen"]))
+        """Inverse of :meth:`to_dict`."""
+        values = records.load(data, VariableRangeRecord, "variable range")
+        return cls(values["variable"], values["unit"], values["fraction"], values["trained"],
+                   values["seen"])
 
 
-def _pair(values: tuple[float, float]) -> list[float | None]:
-    return [v if math.isfinite(v) else None for v in values]
+#: (min, max) of a range; either may be null (not finite).
+Pair = tuple[Statistic, Statistic]
 
 
-def _unpair(values: Any) -> tuple[float, float]:
-    low, high = values
-    return (math.nan if low is None else float(low), math.nan if high is None else float(high))
+class VariableRangeRecord(Record):
+    """The record of :class:`VariableRange` (``excess`` written, not read back)."""
+
+    variable: str
+    unit: str
+    fraction: float
+    trained: Pair
+    seen: Pair
+    excess: Statistic = None
 
 
 @dataclass(frozen=True)
@@ -180,34 +190,17 @@ class RangeReport:
         return lines
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types."""
-        pair = _pair
-        ratio = self.rate_excess_ratio
-        return {
-            "samples": self.samples,
-            "temperature_fraction": self.temperature_fraction,
-            "rate_fraction": self.rate_fraction,
-            "settling_fraction": self.settling_fraction,
-            "trained_c": pair(self.trained_c),
-            "seen_c": pair(self.seen_c),
-            "temperature_excess_c": self.temperature_excess_c,
-            "trained_rate_c_per_h": pair(self.trained_rate_c_per_h),
-            "seen_rate_c_per_h": pair(self.seen_rate_c_per_h),
-            "rate_excess_ratio": ratio if math.isfinite(ratio) else None,
-            "variables": [v.to_dict() for v in self.variables],
-        }
+        """Plain JSON types (:class:`RangeReportRecord`; what is not finite as null)."""
+        return records.dump(self, RangeReportRecord,
+                            variables=[v.to_dict() for v in self.variables])
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> RangeReport:
-        def pair(key: str) -> tuple[float, float]:
-            low, high = data[key]
-            return (math.nan if low is None else float(low), math.nan if high is None
-                    else float(high))
-
-        return cls(int(data["samples"]), float(data["temperature_fraction"]),
-                   float(data["rate_fraction"]), float(data["settling_fraction"]),
-                   pair("trained_c"), pair("seen_c"), pair("trained_rate_c_per_h"),
-                   pair("seen_rate_c_per_h"),
+        """Inverse of :meth:`to_dict`."""
+        values = records.load(data, RangeReportRecord, "range report")
+        return cls(values["samples"], values["temperature_fraction"], values["rate_fraction"],
+                   values["settling_fraction"], values["trained_c"], values["seen_c"],
+                   values["trained_rate_c_per_h"], values["seen_rate_c_per_h"],
                    tuple(VariableRange.from_dict(v) for v in data.get("variables", ())))
 
 
@@ -288,3 +281,19 @@ def variable_unit(name: str, source: str, aux_columns: Mapping[str, str]) -> str
     if is_aux(name):
         return f"(unit of {aux_columns.get(name[2:], name[2:])})"
     return unit(name, source)
+
+
+class RangeReportRecord(Record):
+    """The record of :class:`RangeReport` (the excesses written, not read back)."""
+
+    samples: Count
+    temperature_fraction: float
+    rate_fraction: float
+    settling_fraction: float
+    trained_c: Pair
+    seen_c: Pair
+    temperature_excess_c: Statistic = None
+    trained_rate_c_per_h: Pair = (None, None)
+    seen_rate_c_per_h: Pair = (None, None)
+    rate_excess_ratio: Statistic = None
+    variables: list[VariableRangeRecord] = msgspec.field(default_factory=list)

@@ -15,7 +15,9 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+from hrgtc.core import records
 from hrgtc.core.errors import InputError
+from hrgtc.core.records import Count, Record
 
 #: Reason -> how it reads in a report. One line per reason.
 REASONS: dict[str, str] = {
@@ -124,17 +126,28 @@ class Accounting:
         return f"{line} -- warning: {warning}" if warning else line
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types."""
-        return {"read": self.read, "used": self.used, "dropped": dict(self.dropped),
-                "flagged": dict(self.flagged), "dropped_fraction": self.dropped_fraction,
-                "warning": self.warning}
+        """Plain JSON types (:class:`AccountingRecord`)."""
+        return records.dump(self, AccountingRecord)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> Accounting:
-        """Inverse of :meth:`to_dict`."""
-        out = cls(read=int(data["read"]))
-        for reason, count in dict(data.get("dropped", {})).items():
-            out.drop(str(reason), int(count))
-        for reason, count in dict(data.get("flagged", {})).items():
-            out.flag(str(reason), int(count))
+        """Inverse of :meth:`to_dict` (each reason checked by :meth:`drop` / :meth:`flag`)."""
+        values = records.load(data, AccountingRecord, "sample accounting")
+        out = cls(read=values["read"])
+        for reason, count in values["dropped"].items():
+            out.drop(reason, count)
+        for reason, count in values["flagged"].items():
+            out.flag(reason, count)
         return out
+
+
+class AccountingRecord(Record):
+    """The record of :class:`Accounting`: what it holds, then what follows from it
+    (``used``, ``dropped_fraction``, ``warning``: written, not read back)."""
+
+    read: Count
+    used: Count = 0
+    dropped: dict[str, Count] = records.empty()
+    flagged: dict[str, Count] = records.empty()
+    dropped_fraction: float = 0.0
+    warning: str | None = None

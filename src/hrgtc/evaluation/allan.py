@@ -27,13 +27,15 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import asdict, dataclass, fields
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from hrgtc.core import records
 from hrgtc.core.errors import InputError
 from hrgtc.core.progress import Progress
+from hrgtc.core.records import Count, Positive, Record, Statistic
 from hrgtc.evaluation._allan_edf import (
     NOISE_ALPHAS,
     ONE_SIGMA,
@@ -172,13 +174,13 @@ class AllanResult:
         return self.n_samples // np.maximum(m, 1)
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (arrays as lists)."""
-        return {k: v.tolist() if isinstance(v, np.ndarray) else v for k, v in asdict(self).items()}
+        """Plain JSON types (:class:`AllanResultRecord`; arrays as lists, NaN as null)."""
+        return records.dump(self, AllanResultRecord)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> AllanResult:
         """Inverse of :meth:`to_dict` (optional fields may be missing)."""
-        return cls(**{f.name: data[f.name] for f in fields(cls) if f.name in data})
+        return cls(**records.load(data, AllanResultRecord, "Allan deviation"))
 
     def summary(self) -> str:
         """A text table of τ, deviation, confidence interval (if any) and the number of terms."""
@@ -202,6 +204,23 @@ class AllanResult:
             lines.append(line)
         return "\n".join(lines)
 
+
+
+class AllanResultRecord(Record):
+    """The record of :class:`AllanResult` (its ``to_dict``, ``from_dict``)."""
+
+    taus_s: list[float]
+    deviation: list[Statistic]
+    counts: list[Count]
+    overlapping: bool
+    sample_rate_hz: Positive
+    n_samples: Count
+    kind: str = "allan"
+    lower: list[Statistic] | None = None
+    upper: list[Statistic] | None = None
+    confidence: float | None = None
+    segments: int = 1
+    edf: list[Statistic] | None = None
 
 def _averaging_factors(taus: str | Sequence[float] | np.ndarray, n: int, fs: float) -> np.ndarray:
     """Integer averaging factors m (τ = m / fs) the way ``allantools.tau_generator`` makes them.

@@ -19,12 +19,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import asdict, dataclass, fields
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from hrgtc.core import records
 from hrgtc.core.errors import InputError
+from hrgtc.core.records import Record, Statistic
 from hrgtc.evaluation.allan import FLICKER_FLOOR_FACTOR, SECONDS_PER_HOUR, AllanResult
 
 __all__ = ["RAMP_SLOPE", "NoiseTerms", "noise_terms"]
@@ -88,16 +90,13 @@ class NoiseTerms:
     rrw_n: int | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (τ ranges as lists)."""
-        return {k: list(v) if isinstance(v, tuple) else v for k, v in asdict(self).items()}
+        """Plain JSON types (:class:`NoiseTermsRecord`; τ ranges as lists, NaN as null)."""
+        return records.dump(self, NoiseTermsRecord)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> NoiseTerms:
         """Inverse of :meth:`to_dict`."""
-        names = {f.name for f in fields(cls)}
-        return cls(
-            **{k: tuple(v) if isinstance(v, list) else v for k, v in data.items() if k in names}
-        )
+        return cls(**records.load(data, NoiseTermsRecord, "noise terms"))
 
     def text(self, term: str, digits: int = 4) -> str:
         """One term as text: the number, or the reason it is missing.
@@ -138,6 +137,28 @@ class NoiseTerms:
             ]
         )
 
+
+
+class NoiseTermsRecord(Record):
+    """The record of :class:`NoiseTerms` (its ``to_dict``, ``from_dict``)."""
+
+    arw_deg_per_rt_h: float | None
+    bias_instability_dph: float | None
+    rrw_dph_per_rt_h: float | None
+    arw_taus_s: tuple[float, float] | None
+    bias_instability_tau_s: Statistic
+    rrw_taus_s: tuple[float, float] | None
+    floor_reached: bool
+    minimum_dph: Statistic = None
+    arw_reason: str | None = None
+    bias_instability_reason: str | None = None
+    rrw_reason: str | None = None
+    arw_interval: tuple[Statistic, Statistic] | None = None
+    bias_instability_interval: tuple[Statistic, Statistic] | None = None
+    rrw_interval: tuple[Statistic, Statistic] | None = None
+    arw_n: int | None = None
+    bias_instability_n: int | None = None
+    rrw_n: int | None = None
 
 def _law(slope: float) -> str:
     """A local log-log slope as a power of τ, e.g. ``τ^1.0``."""
