@@ -130,3 +130,21 @@ def test_bias_stability_figures_carry_the_block_count(run):
     n = result.bias_stability_blocks["compensated"][10.0]
     assert figure.interval == result.stability_interval("compensated", 10.0)
     assert figure.interval_kind.endswith(f"N {n}") and n > 100
+
+
+def test_the_evaluations_parts_round_trip_through_their_records(run):
+    """NoiseTerms, AllanResult, RangeReport and Accounting: to_dict -> JSON -> from_dict
+    gives the same document, and a bad value is refused naming its place."""
+    import json
+
+    from hrgtc.core.errors import InputError
+    from hrgtc.evaluation.allan import AllanResult
+
+    result, _ = run
+    parts = [*result.noise.values(), *result.allan.values(), result.ranges, result.accounting]
+    for part in parts:
+        document = json.loads(json.dumps(part.to_dict(), allow_nan=False))
+        assert type(part).from_dict(document).to_dict() == document
+    bad = result.allan["raw"].to_dict() | {"n_samples": -1}
+    with pytest.raises(InputError, match=r"n_samples"):
+        AllanResult.from_dict(bad)

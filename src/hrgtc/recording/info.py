@@ -13,10 +13,13 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
+import msgspec
 import numpy as np
 
+from hrgtc.core import records
 from hrgtc.core.errors import RecordingError
 from hrgtc.core.progress import Progress
+from hrgtc.core.records import Count, Record
 from hrgtc.core.time_steps import TimeRepairStream
 from hrgtc.core.timeline import Timeline, TimelineBuilder
 from hrgtc.recording.axes import axis_names, base_name
@@ -62,15 +65,25 @@ class ColumnSummary:
     resolution: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types."""
-        return {"name": self.name, "unit": self.unit, "min": self.minimum, "max": self.maximum,
-                "resolution": self.resolution}
+        """Plain JSON types (:class:`ColumnSummaryRecord`)."""
+        return records.dump(self, ColumnSummaryRecord, min=self.minimum, max=self.maximum)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> ColumnSummary:
         """Inverse of :meth:`to_dict`."""
-        return cls(str(data["name"]), str(data["unit"]), data.get("min"), data.get("max"),
-                   data.get("resolution"))
+        values = records.load(data, ColumnSummaryRecord, "column summary")
+        return cls(values["name"], values["unit"], values["min"], values["max"],
+                   values["resolution"])
+
+
+class ColumnSummaryRecord(Record):
+    """The record of :class:`ColumnSummary` (``min`` / ``max``: its minimum, maximum)."""
+
+    name: str
+    unit: str
+    min: float | None = None
+    max: float | None = None
+    resolution: float | None = None
 
 
 @dataclass(frozen=True)
@@ -186,26 +199,11 @@ class RecordingInfo:
         return "\n".join(lines)
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types."""
-        spans = {col.name: [col.minimum, col.maximum] for col in self._span_columns()}
-        return {
-            "path": self.path,
-            "format": self.format,
-            "rows": self.rows,
-            "start_time_s": self.start_time_s,
-            "end_time_s": self.end_time_s,
-            "duration_s": self.duration_s,
-            "sample_rate_hz": self.sample_rate_hz,
-            "sample_rate_inferred": self.sample_rate_inferred,
-            "measured_sample_rate_hz": self.measured_sample_rate_hz,
-            "columns": [c.to_dict() for c in self.columns],
-            "spans": spans,
-            "metadata": self.metadata,
-            "validation": self.validation.to_dict(),
-            "axes": list(self.axes),
-            "spike_rows": self.spike_rows,
-            "timeline": self.timeline,
-        }
+        """Plain JSON types (:class:`RecordingInfoRecord`)."""
+        return records.dump(
+            self, RecordingInfoRecord, columns=[c.to_dict() for c in self.columns],
+            spans={col.name: [col.minimum, col.maximum] for col in self._span_columns()},
+            validation=self.validation.to_dict())
 
     def _span_columns(self) -> list[ColumnSummary]:
         """Temperature and frequency columns (per axis too), in the order of SPAN_COLUMNS."""
@@ -215,23 +213,33 @@ class RecordingInfo:
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> RecordingInfo:
         """Inverse of :meth:`to_dict` (``spans`` are derived, not read)."""
-        return cls(
-            path=str(data["path"]),
-            format=data.get("format"),
-            rows=int(data["rows"]),
-            start_time_s=data.get("start_time_s"),
-            end_time_s=data.get("end_time_s"),
-            duration_s=data.get("duration_s"),
-            sample_rate_hz=data.get("sample_rate_hz"),
-            sample_rate_inferred=bool(data.get("sample_rate_inferred", False)),
-            measured_sample_rate_hz=data.get("measured_sample_rate_hz"),
-            columns=tuple(ColumnSummary.from_dict(c) for c in data["columns"]),
-            metadata=data.get("metadata"),
-            validation=ValidationReport.from_dict(data["validation"]),
-            axes=tuple(data.get("axes") or ()),
-            spike_rows=data.get("spike_rows"),
-            timeline=data.get("timeline"),
-        )
+        values = records.load(data, RecordingInfoRecord, "recording info")
+        values.pop("spans")
+        return cls(**values | {
+            "columns": tuple(ColumnSummary.from_dict(c) for c in data["columns"]),
+            "validation": ValidationReport.from_dict(data["validation"])})
+
+
+class RecordingInfoRecord(Record, kw_only=True):
+    """The record of :class:`RecordingInfo` (``spans``, the temperature and frequency
+    columns' (min, max), written, not read back)."""
+
+    path: str
+    format: str | None = None
+    rows: Count
+    start_time_s: float | None = None
+    end_time_s: float | None = None
+    duration_s: float | None = None
+    sample_rate_hz: float | None = None
+    sample_rate_inferred: bool = False
+    measured_sample_rate_hz: float | None = None
+    columns: list[ColumnSummaryRecord]
+    spans: dict[str, tuple[float | None, float | None]] = records.empty()
+    metadata: dict[str, Any] | None = None
+    validation: dict[str, Any]
+    axes: list[str] = msgspec.field(default_factory=list)
+    spike_rows: int | None = None
+    timeline: dict[str, Any] | None = None
 
 
 def _num(value: Any) -> str:
