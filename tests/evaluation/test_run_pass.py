@@ -180,7 +180,7 @@ def test_intervals_deviation_kinds_and_allan_csv(setup, tmp_path):
     oadev = CliRunner().invoke(app, ["evaluate", str(files.warmup), "--model", str(model_path),
                                      "--allan-csv", str(csv_path), "--force"])
     assert oadev.exit_code == 0, oadev.output
-    assert "(" in oadev.stdout and "–" in oadev.stdout  # "0.957 (0.93–0.99)"
+    assert "] (68.3% CI, N " in oadev.stdout  # "[0.93, 0.99] (68.3% CI, N 1795)"
     first = csv_path.read_text().splitlines()[1].split(",")
     assert float(first[3]) < float(first[2]) < float(first[4])
     bad = CliRunner().invoke(app, ["evaluate", str(files.warmup), "--model", str(model_path),

@@ -113,7 +113,7 @@ def _model(run: Any, key: str) -> tuple[Figure, ...]:
                       "training range", run.rate_out_of_range_fraction, digits=3)]
     if run.ranges is not None:  # one share per variable: a gradient is not a temperature
         figures.append(Figure(f"{key}.ranges.temperature_fraction",
-                              "share beyond the trained temperature",
+                              "share of samples with the temperature out of its trained range",
                               run.ranges.temperature_fraction, digits=3))
         figures += [Figure(f"{key}.ranges.variables[{k}].fraction",
                            f"share beyond the trained range of {v.name}", v.fraction, digits=3)
