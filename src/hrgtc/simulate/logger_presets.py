@@ -137,7 +137,8 @@ def with_options(base: Logger, unit: str, values: Mapping[str, Any]) -> Logger:
     unit's die sensor, an HRG's housing thermistor); ``reference_log`` True or a
     ``reference_lag_s`` adds a hand log, False removes it; a handling option on a logger
     without handling adds it (one orientation unless ``orientations`` says more; a MEMS
-    unit's g-sensitivity).
+    unit's g-sensitivity); ``accelerometer`` False drops the accelerometer columns with
+    their names.
     """
     given = {k: v for k, v in values.items() if v is not None}
     mems = unit == MEMS_UNIT
@@ -159,6 +160,9 @@ def with_options(base: Logger, unit: str, values: Mapping[str, Any]) -> Logger:
             orientations=PLAIN_LOGGER["orientations"],
             g_sensitivity_dph_per_g=G_SENSITIVITY_DPH_PER_G if mems else {})
         base = replace(base, handling=replace(start, **handling))
+    if given.get("accelerometer") is False:  # the preset's names of its columns go too
+        given["columns"] = {role: name for role, name in base.columns.items()
+                            if not role.startswith("accel_")}
     if "jitter_ms" in given:
         given["jitter_s"] = given.pop("jitter_ms") * 1e-3
     return replace(base, **{_LOGGER_FIELDS.get(k, k): v for k, v in given.items()})
