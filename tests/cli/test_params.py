@@ -28,14 +28,16 @@ PAGES = {"calibrate": DOCS / "guide" / "calibrate.md", "reading": DOCS / "guide"
          "export": DOCS / "guide" / "export-c.md", "demo": DOCS / "guide" / "demo.md",
          "fleet_simulate": DOCS / "guide" / "fleet.md",
          "fleet_evaluate": DOCS / "guide" / "fleet.md",
-         "simulate": DOCS / "guide" / "simulate.md"}
+         "simulate": DOCS / "guide" / "simulate.md",
+         "simulate_logger": DOCS / "real-loggers" / "simulate.md"}
 #: The commands whose options each settings class generates.
 COMMANDS = {"calibrate": ["calibrate"],
             "reading": ["info", "calibrate", "compensate", "evaluate", "report",
                         "fleet calibrate", "fleet evaluate", "fleet report"],
             "compensate": ["compensate"], "evaluate": ["evaluate"], "report": ["report"],
             "export": ["export-c"], "demo": ["demo"], "fleet_simulate": ["fleet simulate"],
-            "fleet_evaluate": ["fleet evaluate"], "simulate": ["simulate"]}
+            "fleet_evaluate": ["fleet evaluate"], "simulate": ["simulate"],
+            "simulate_logger": ["simulate"]}
 CASES = [(key, s) for key in DOCUMENTED for s in option_settings(settings_class(key))]
 
 
@@ -96,7 +98,8 @@ def test_docs_tables_are_generated_from_the_dataclasses(key):
     assert rows == expected
     known = {"calibrate": ("--rate-tau-s", "10.0"), "reading": ("--spike-k", "8.0"),
              "evaluate": ("--deviation", "oadev"), "fleet_simulate": (
-                 "--setpoints", "-20,-10,0,10,20,30,40")}  # Table 1 of [1]
+                 "--setpoints", "-20,-10,0,10,20,30,40"),  # Table 1 of [1]
+             "simulate_logger": ("--period-s", "300.0; pan-cold 305.0")}
     if key in known:
         assert rows[known[key][0]] == known[key][1]
 
@@ -115,6 +118,64 @@ def test_a_value_out_of_range_is_refused_naming_the_range(tmp_path):
         assert not (tmp_path / "fleet").exists()
     page = PAGES["fleet_simulate"].read_text(encoding="utf-8")
     assert "| `--units` | 32 | Number of units. Range: ≥ 1. |" in page
+
+
+def _logger_value(logger, name):
+    """The value of ``--logger`` option ``name`` in a simulator ``Logger`` (the inverse of
+    ``logger_presets.with_options``, read off the objects the simulator uses)."""
+    from hrgtc.simulate.handling import Handling
+    from hrgtc.simulate.reflog import ReferenceLog, TemperatureChannel
+
+    temperature = logger.temperature or TemperatureChannel()
+    handling = logger.handling or Handling(orientations=1)
+    reference = logger.reference_log or ReferenceLog()
+    inside = {"temp_lsb": temperature.lsb_c, "temp_offset": temperature.offset_c,
+              "temp_bits": temperature.bits, "temp_rate_hz": temperature.rate_hz,
+              "reference_log": logger.reference_log is not None,
+              "reference_lag_s": reference.lag_s, "orientations": handling.orientations,
+              "handling_max_dps": handling.max_rate_dps,
+              "hand_warming_c": handling.hand_warming_c, "jitter_ms": logger.jitter_s * 1e3,
+              "wall_start": logger.start, "tz": logger.timezone, "restarts": logger.restarts_s}
+    return inside[name] if name in inside else getattr(logger, name)
+
+
+@pytest.mark.parametrize("kind", ["continuous", "burst", "pan-cold", "fridge-3day"])
+def test_logger_defaults_shown_are_the_simulators(kind):
+    """Each ``--logger`` option's default text names, for each logger, the value the
+    simulator's logger really has when the option is not given (the plain logger's
+    ``Logger`` defaults, a preset's values), and the preset's unit and sample rate."""
+    from hrgtc.settings.simulation import (
+        LOGGER_KINDS,
+        PLAIN_LOGGER,
+        PRESET_CHANGES,
+        LoggerSettings,
+    )
+    from hrgtc.simulate.logger_presets import plain_logger, preset
+
+    assert LOGGER_KINDS == ("continuous", "burst", "pan-cold", "fridge-3day")
+    values = {**PLAIN_LOGGER, **PRESET_CHANGES.get(kind, {})}
+    if kind in PRESET_CHANGES:
+        chosen = preset(kind)
+        logger, unit = chosen.logger, chosen.unit
+    else:
+        unit = PLAIN_LOGGER["unit"]
+        logger = plain_logger(kind, unit)
+    assert unit == values["unit"] and logger.sample_rate_hz == values["sample_rate_hz"]
+    assert logger.kind == values.get("kind", kind)
+    for setting in option_settings(LoggerSettings):
+        if setting.name == "logger":
+            continue
+        value, expected = _logger_value(logger, setting.name), values[setting.name]
+        assert value == (pytest.approx(expected) if isinstance(value, float) else expected), (
+            kind, setting.option, value)
+        # "300.0; pan-cold 305.0": the plain logger's, then "preset[/preset] value"
+        plain, *others = setting.default_text.split("; ")
+        shown = {"plain": plain}
+        for part in others:
+            presets, text = part.split(" ")
+            shown.update(dict.fromkeys(presets.split("/"), text))
+        assert shown.get(kind, plain) == (format_value(expected) if expected != () else "none"), (
+            kind, setting.option, setting.default_text)
 
 
 def test_stale_docs_table_is_found():

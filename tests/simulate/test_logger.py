@@ -455,6 +455,23 @@ def test_cli_logger_burst_and_preset_overrides(tmp_path):
     assert info["rows"] == 6 * 250  # 1800 s: bursts at 0, 305, ..., 1525 s
 
 
+def test_cli_preset_without_its_accelerometer(tmp_path):
+    """``--logger fridge-3day --no-accelerometer`` writes the file without the
+    accelerometer columns (it failed: the preset's names of those columns were kept)."""
+    from typer.testing import CliRunner
+
+    from hrgtc.cli import app
+
+    result = CliRunner().invoke(app, ["simulate", "--logger", "fridge-3day",
+                                      "--no-accelerometer", "--profile", "constant",
+                                      "--hours", "0.1", "-o", str(tmp_path / "f.csv"), "--json"])
+    assert result.exit_code == 0, result.output
+    header = (tmp_path / "f.csv").read_text().splitlines()[0].split(",")
+    assert header == ["timestamp_ms", "gx_mrad_s", "gy_mrad_s", "gz_mrad_s", "temp_C"]
+    info = json.loads((tmp_path / "f.truth.json").read_text())
+    assert info["logger"]["accelerometer"] is False and info["rows"] == 360
+
+
 def test_true_dfdt_from_the_slow_track_matches_the_samples():
     """The truth's dT/dt and df/dt (from a ~1 Hz track of the whole run) agree with the
     derivative of the kept samples' noiseless resonator temperature and frequency law."""

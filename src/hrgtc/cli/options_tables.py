@@ -3,7 +3,7 @@
 A docs page holds ``<!-- options: KEY -->`` and ``<!-- /options -->`` around a table of
 the options generated from a settings class (:data:`DOCUMENTED`); regenerate them with::
 
-    PYTHONPATH=src python -m hrgtc.cli.options_tables docs/guide/*.md
+    PYTHONPATH=src python -m hrgtc.cli.options_tables docs/guide/*.md docs/real-loggers/*.md
 
 ``tests/cli/test_params.py`` fails while a page's table differs from its class.
 """
@@ -26,6 +26,7 @@ DOCUMENTED = {
     "fleet_evaluate": ("hrgtc.settings.fleet", "FleetEvaluation"),
     "demo": ("hrgtc.settings.fleet", "DemoSettings"),
     "simulate": ("hrgtc.settings.simulation", "SimulationSettings"),
+    "simulate_logger": ("hrgtc.settings.simulation", "LoggerSettings"),
 }
 
 

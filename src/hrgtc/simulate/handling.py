@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from hrgtc.core.errors import InputError
+from hrgtc.settings.simulation import PLAIN_LOGGER as _PLAIN
 from hrgtc.simulate.units import EARTH_RATE_DPH
 
 __all__ = ["Handling", "HandlingTruth", "hand_warming", "handling_truth", "orientation_matrix"]
@@ -92,14 +93,14 @@ class Handling:
 
     orientations: int = 3
     handling_s: float = 60.0
-    max_rate_dps: float = 300.0
+    max_rate_dps: float = _PLAIN["handling_max_dps"]
     change_times_s: tuple[float, ...] | None = None
     latitude_deg: float = 40.0
     g_sensitivity_dph_per_g: Mapping[str, tuple[float, float, float]] = field(
         default_factory=dict
     )
     accel_noise_g: float = 0.002
-    hand_warming_c: float = 0.0
+    hand_warming_c: float = _PLAIN["hand_warming_c"]
     hand_warming_tau_s: float = 600.0
 
     def __post_init__(self) -> None:

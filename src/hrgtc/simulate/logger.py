@@ -40,6 +40,8 @@ from typing import Any
 import numpy as np
 
 from hrgtc.core.errors import InputError
+from hrgtc.settings.simulation import LOGGER_RATE_UNITS, LOGGER_TIME_UNITS
+from hrgtc.settings.simulation import PLAIN_LOGGER as _PLAIN
 from hrgtc.simulate import units as _units
 from hrgtc.simulate.clock import unwrap_counter, wall_clock
 from hrgtc.simulate.duty import DutyCycle, duplicate_rows, simulate_kept
@@ -60,12 +62,12 @@ __all__ = [
 ]
 
 #: °/h -> the rate unit written: value_written = rate_dph * factor.
-RATE_FACTORS = {
-    "dph": 1.0,
-    "dps": 1.0 / 3600.0,
-    "radps": math.pi / 180.0 / 3600.0,
-    "mradps": 1000.0 * math.pi / 180.0 / 3600.0,
-}
+RATE_FACTORS = dict(zip(LOGGER_RATE_UNITS, (
+    1.0,
+    1.0 / 3600.0,
+    math.pi / 180.0 / 3600.0,
+    1000.0 * math.pi / 180.0 / 3600.0,
+), strict=True))
 #: s -> the time unit written.
 TIME_FACTORS = {"s": 1.0, "ms": 1e3, "us": 1e6}
 _RATE_LABELS = {"dph": "deg/h", "dps": "deg/s", "radps": "rad/s", "mradps": "mrad/s"}
@@ -138,36 +140,36 @@ class Logger:
 
     kind: str = "continuous"
     sample_rate_hz: float = 50.0
-    burst_s: float = 5.0
-    period_s: float = 300.0
-    time_unit: str = "s"
-    counter_bits: int | None = None
-    clock_start_s: float = 0.0
-    jitter_s: float = 0.0
-    start: str = "2020-03-07T15:44:40"
-    timezone: str | None = None
-    restarts_s: tuple[float, ...] = ()
+    burst_s: float = _PLAIN["burst_s"]
+    period_s: float = _PLAIN["period_s"]
+    time_unit: str = _PLAIN["time_unit"]
+    counter_bits: int | None = _PLAIN["counter_bits"]
+    clock_start_s: float = _PLAIN["clock_start_s"]
+    jitter_s: float = _PLAIN["jitter_ms"] * 1e-3
+    start: str = _PLAIN["wall_start"]
+    timezone: str | None = _PLAIN["tz"]
+    restarts_s: tuple[float, ...] = _PLAIN["restarts"]
     restart_off_s: float = 10.0
-    run_offset_dph: float = 0.0
-    warmup_dph: float = 0.0
-    warmup_tau_s: float = 120.0
-    rate_unit: str = "dph"
-    rate_digits: int | None = None
+    run_offset_dph: float = _PLAIN["run_offset_dph"]
+    warmup_dph: float = _PLAIN["warmup_dph"]
+    warmup_tau_s: float = _PLAIN["warmup_tau_s"]
+    rate_unit: str = _PLAIN["rate_unit"]
+    rate_digits: int | None = _PLAIN["rate_digits"]
     frequency: bool = True
     temperature: TemperatureChannel | None = None
     reference_log: ReferenceLog | None = None
-    duplicates: int = 0
-    spikes: int = 0
-    spike_dph: float = 0.0
+    duplicates: int = _PLAIN["duplicates"]
+    spikes: int = _PLAIN["spikes"]
+    spike_dph: float = _PLAIN["spike_dph"]
     handling: Handling | None = None
-    accelerometer: bool = False
+    accelerometer: bool = _PLAIN["accelerometer"]
     accel_unit: str = "g"
     columns: Mapping[str, str] = field(default_factory=dict)
     extra_columns: Mapping[str, tuple[float, float]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         choices = {"kind": ("continuous", "burst"),
-                   "time_unit": (*TIME_FACTORS, "timestamp"),
+                   "time_unit": LOGGER_TIME_UNITS,
                    "rate_unit": tuple(RATE_FACTORS), "accel_unit": ("g", "mps2")}
         for name, allowed in choices.items():
             if getattr(self, name) not in allowed:

@@ -23,6 +23,7 @@ import numpy as np
 from scipy.signal import lfilter, lfilter_zi
 
 from hrgtc.core.errors import InputError
+from hrgtc.settings.simulation import PLAIN_LOGGER as _PLAIN
 
 __all__ = [
     "ReferenceLog",
@@ -58,11 +59,11 @@ class TemperatureChannel:
         the housing thermistor.
     """
 
-    lsb_c: float | None = None
-    offset_c: float = 0.0
-    bits: int | None = None
+    lsb_c: float | None = _PLAIN["temp_lsb"]
+    offset_c: float = _PLAIN["temp_offset"]
+    bits: int | None = _PLAIN["temp_bits"]
     decimals: int = 2
-    rate_hz: float | None = None
+    rate_hz: float | None = _PLAIN["temp_rate_hz"]
     noise_c: float = 0.0
     source: str = "die"
 
@@ -179,7 +180,7 @@ class ReferenceLog:
     start: str = "2020-03-07T15:43:00"
     dates: bool = False
     fahrenheit: bool = False
-    lag_s: float = 0.0
+    lag_s: float = _PLAIN["reference_lag_s"]
     decimals: int = 1
     blank_fraction: float = 0.05
     trailing_rows: int = 5
