@@ -22,7 +22,7 @@ from typing import Any
 from hrgtc.core.errors import InputError
 from hrgtc.core.timeline import settle_threshold_s
 from hrgtc.drift.features import settle_rows
-from hrgtc.drift.variables import ascii_unit, refusal, variable
+from hrgtc.drift.variables import DRIFT_VARIABLES, ascii_unit, refusal, variable
 from hrgtc.export.c.plan import CPlan
 from hrgtc.export.c.text import NEWTON_MAX_ITER, sensor_note
 from hrgtc.export.c.types import DOUBLE
@@ -197,24 +197,13 @@ def parameter_lines(model: UnitModel, plan: CPlan, key: str = "") -> list[str]:
 
 
 def _extra_variable_lines(model: UnitModel, plan: CPlan, put: Any) -> None:
-    """Keys of the second rate filter (d2), the gradient (g) and the extra channels (a_NAME),
-    written only for a model that uses them (older files' keys unchanged)."""
-    settings = model.drift.settings
-    if plan.rate2:
-        put("uses_rate2", 1, "1: the terms use d2, the rate of f by the second filter.")
-        put("rate_tau2_s", settings.rate_tau2_s,
-            "Time constant of each of the two stages of the second df/dt filter. [s]")
-    if plan.gradient:
-        put("uses_gradient", 1, "1: the terms use g = housing_c - T(freq_hz); housing_c is "
-            "an input.")
-    if plan.aux:
-        put("aux_names", " ".join(plan.aux),
-            "Extra logged channels the terms use (a_NAME = aux_NAME - aux_centre_NAME).")
-        for name in plan.aux:
-            column = settings.aux_columns.get(name, "?")
-            put(f"aux_column_{name}", column, f"The logged column aux_{name} is read from.")
-            put(f"aux_centre_{name}", settings.aux_centres.get(name, 0.0),
-                f"Training mean of aux_{name}, subtracted. [unit of the column {column}]")
+    """The keys of the variables beyond f, df, h and dh the terms use (d2, g, a_NAME), in
+    grammar order, each written by its module's ``params`` (:mod:`hrgtc.drift.variables`);
+    a model without them has none of these keys (older files' keys unchanged)."""
+    for entry in DRIFT_VARIABLES:
+        names = tuple(n for n in plan.computed if variable(n) is entry)
+        if names and entry.params is not None:
+            entry.params(names, model.drift.settings, put)
 
 
 def _scale_factor_lines(model: UnitModel, put: Any) -> None:

@@ -16,7 +16,7 @@ import numpy as np
 
 from hrgtc.core import records
 from hrgtc.core.errors import InputError
-from hrgtc.drift.variables.spec import DriftVariable, Inputs
+from hrgtc.drift.variables.spec import DriftVariable, Inputs, Put
 
 #: Prefix of the user's extra channels.
 AUX_PREFIX = "a_"
@@ -82,10 +82,23 @@ class CCode:
         return (logged - np.float32(mean)).astype(np.float32)
 
 
+def params(names: tuple[str, ...], settings: Any, put: Put) -> None:
+    """The extra channels' keys of the parameter file: their names, then each one's column
+    and training mean."""
+    channels = [name[len(AUX_PREFIX):] for name in names]
+    put("aux_names", " ".join(channels),
+        "Extra logged channels the terms use (a_NAME = aux_NAME - aux_centre_NAME).")
+    for name in channels:
+        column = settings.aux_columns.get(name, "?")
+        put(f"aux_column_{name}", column, f"The logged column aux_{name} is read from.")
+        put(f"aux_centre_{name}", settings.aux_centres.get(name, 0.0),
+            f"Training mean of aux_{name}, subtracted. [unit of the column {column}]")
+
+
 VARIABLE = DriftVariable(
     name="a_NAME", unit="unit of its column", sensor_unit="unit of its column", kind="level",
     description="an extra logged channel (--aux NAME=COLUMN) minus its training mean",
     backends=frozenset({"numpy", "c_double", "c_float32", "params"}), columns=(),
     compute=compute, order=7, check=check, c_code=CCode(),
     settings_fields=(("aux_columns", dict[str, str], records.empty()),
-                     ("aux_centres", dict[str, float], records.empty())))
+                     ("aux_centres", dict[str, float], records.empty())), params=params)

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from hrgtc.core import records
-from hrgtc.drift.variables.spec import DriftVariable, Inputs
+from hrgtc.drift.variables.spec import DriftVariable, Inputs, Put
 
 
 def compute(inputs: Inputs, name: str) -> np.ndarray:
@@ -71,10 +71,17 @@ class CCode:
         return np.asarray(value).astype(np.float32)
 
 
+def params(names: tuple[str, ...], settings: Any, put: Put) -> None:
+    """d2's keys of the parameter file: the flag and the second filter's time constant."""
+    put("uses_rate2", 1, "1: the terms use d2, the rate of f by the second filter.")
+    put("rate_tau2_s", settings.rate_tau2_s,
+        "Time constant of each of the two stages of the second df/dt filter. [s]")
+
+
 VARIABLE = DriftVariable(
     name="d2", unit="Hz/s", sensor_unit="°C/s", kind="rate",
     description="causal rate of f through a second filter of time constant rate_tau2_s",
     backends=frozenset({"numpy", "c_double", "c_float32", "params"}), columns=("freq_hz",),
     compute=compute, order=5, check=check,
     settings_fields=(("rate_tau2_s", records.NonNegative, 0.0),), c_code=CCode(),
-    rate_of=("f", "rate_tau2_s"))
+    rate_of=("f", "rate_tau2_s"), params=params)

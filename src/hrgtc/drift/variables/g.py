@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from hrgtc.drift.variables.spec import ALL, DriftVariable, Inputs
+from hrgtc.drift.variables.spec import ALL, DriftVariable, Inputs, Put
 
 
 def compute(inputs: Inputs, name: str) -> np.ndarray:
@@ -57,9 +57,15 @@ class CCode:
         return np.asarray(value).astype(np.float32)
 
 
+def params(names: tuple[str, ...], settings: Any, put: Put) -> None:
+    """g's key of the parameter file: the flag (housing_c becomes an input)."""
+    put("uses_gradient", 1, "1: the terms use g = housing_c - T(freq_hz); housing_c is "
+        "an input.")
+
+
 VARIABLE = DriftVariable(
     name="g", unit="°C", sensor_unit="°C", kind="level",
     description="housing - resonator gradient housing_c - T(freq_hz), T the thermometer's "
                 "inverse",
     backends=ALL, columns=("freq_hz", "housing_c"), compute=compute, order=6, check=check,
-    c_code=CCode())
+    c_code=CCode(), params=params)

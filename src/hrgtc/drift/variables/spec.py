@@ -7,7 +7,8 @@ settings and the other variables), what it needs of the settings (``check``), th
 settings it owns in the model file (``settings_fields``: their types, bounds and defaults,
 from which the model file's record and JSON Schema are generated),
 and, for the variables beyond the paper's f, df, h and dh, its pieces of the C export
-(``c_code``, in double and in float32). The registry (:mod:`hrgtc.drift.variables.registry`)
+(``c_code``, in double and in float32) and its keys of the parameter file (``params``).
+The registry (:mod:`hrgtc.drift.variables.registry`)
 collects the modules; every consumer reads the entries from it.
 """
 
@@ -92,6 +93,11 @@ class CCode(Protocol):
         (the float mirror's input, :mod:`hrgtc.export.c.float32`)."""
 
 
+#: ``put(key, value, comment)``: writes one ``key = value`` line of the parameter file,
+#: with its ``#`` comment above it.
+Put = Callable[[str, Any, str], None]
+
+
 def _nothing(settings: Any, thermometer: Any, name: str) -> str | None:
     return None
 
@@ -131,6 +137,11 @@ class DriftVariable:
     rate_of
         For a plain causal rate: (the level it is the rate of, the settings field of the
         filter's time constant), e.g. ``("f", "rate_tau2_s")`` for d2.
+    params
+        Its keys of the parameter file (``hrgtc export-c --format params``), for a variable
+        beyond f, df, h and dh: ``params(names, settings, put)`` writes them with ``put``
+        (:data:`Put`), ``names`` the model's variables of this entry (``a_drive``,
+        ``a_tilt``: every extra channel at once), called once per model in grammar order.
     """
 
     name: str
@@ -146,6 +157,7 @@ class DriftVariable:
     settings_fields: tuple[tuple[str, Any, Any], ...] = ()
     c_code: CCode | None = None
     rate_of: tuple[str, str] | None = None
+    params: Callable[[tuple[str, ...], Any, Put], None] | None = None
 
     def unit_for(self, thermometer_source: str = "resonator") -> str:
         """The unit for a model whose thermometer is ``"resonator"`` or ``"sensor"``."""
