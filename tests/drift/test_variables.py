@@ -115,12 +115,26 @@ def test_the_registry_is_one_module_per_variable():
 
 
 def test_the_docs_table_is_the_registry():
-    """docs/reliability.md's table of variables and backends is generated from the list."""
+    """docs/reliability.md's table of variables and backends is generated from the list,
+    between its markers, by the docs' table generator (a new variable is a regeneration,
+    not a hand-written row)."""
     from pathlib import Path
 
+    from hrgtc.cli.options_tables import update_docs
+
     docs = Path(__file__).parents[2] / "docs" / "reliability.md"
-    assert docs_table() in docs.read_text(encoding="utf-8"), (
-        "update docs/reliability.md's table with hrgtc.drift.variables.docs_table()")
+    page = docs.read_text(encoding="utf-8")
+    assert update_docs(page) == page, (
+        "docs/reliability.md is stale: PYTHONPATH=src python -m hrgtc.cli.options_tables "
+        "docs/reliability.md")
+    block = page.split("<!-- table: drift_variables -->\n")[1].split("\n<!-- /table -->")[0]
+    assert block == docs_table()
+    rows = block.splitlines()[2:]
+    assert [r.split("`")[1] for r in rows] == [v.name for v in DRIFT_VARIABLES]
+    # a stale page (a row missing, a cell changed) is rewritten to the registry's table
+    d2 = next(r for r in rows if r.startswith("| `d2` |"))
+    for stale in (page.replace(d2 + "\n", ""), page.replace(d2, d2.replace("yes", "no"))):
+        assert stale != page and update_docs(stale) == page
 
 
 def test_the_model_schema_takes_each_variables_settings():

@@ -1,11 +1,15 @@
-"""The docs' option tables, generated from the settings dataclasses.
+"""The docs' generated tables: the option tables and the registries' tables.
 
 A docs page holds ``<!-- options: KEY -->`` and ``<!-- /options -->`` around a table of
-the options generated from a settings class (:data:`DOCUMENTED`); regenerate them with::
+the options generated from a settings class (:data:`DOCUMENTED`), and
+``<!-- table: KEY -->`` and ``<!-- /table -->`` around a table a registry writes
+(:data:`TABLES`: the drift variables and their backends); regenerate them with::
 
-    PYTHONPATH=src python -m hrgtc.cli.options_tables docs/guide/*.md docs/real-loggers/*.md
+    PYTHONPATH=src python -m hrgtc.cli.options_tables docs/guide/*.md docs/real-loggers/*.md \
+        docs/reliability.md
 
-``tests/cli/test_params.py`` fails while a page's table differs from its class.
+``tests/cli/test_params.py`` fails while a page's option table differs from its class,
+``tests/drift/test_variables.py`` while the variables' table differs from the registry.
 """
 
 from __future__ import annotations
@@ -29,6 +33,11 @@ DOCUMENTED = {
     "simulate_logger": ("hrgtc.settings.simulation", "LoggerSettings"),
 }
 
+#: The tables a registry writes, by key: (module, function returning the Markdown).
+TABLES = {
+    "drift_variables": ("hrgtc.drift.variables", "docs_table"),
+}
+
 
 def options_table(cls: type) -> str:
     """A Markdown table of the options generated from ``cls``: option, default, meaning."""
@@ -50,17 +59,31 @@ def settings_class(key: str) -> type:
     return getattr(importlib.import_module(module), name)  # type: ignore[no-any-return]
 
 
+def registry_table(key: str) -> str:
+    """The Markdown of a registry's table (a key of :data:`TABLES`)."""
+    import importlib
+
+    module, name = TABLES[key]
+    return str(getattr(importlib.import_module(module), name)())
+
+
 def update_docs(text: str) -> str:
     """``text`` with every ``<!-- options: KEY -->`` ... ``<!-- /options -->`` table
-    regenerated from its settings class."""
+    regenerated from its settings class, and every ``<!-- table: KEY -->`` ...
+    ``<!-- /table -->`` from its registry."""
     import re
 
-    def table(match: re.Match[str]) -> str:
+    def options(match: re.Match[str]) -> str:
         body = options_table(settings_class(match.group(2)))
         return f"{match.group(1)}\n{body}\n{match.group(4)}"
 
+    def table(match: re.Match[str]) -> str:
+        return f"{match.group(1)}\n{registry_table(match.group(2))}\n{match.group(4)}"
+
     # lazy: an empty block ends at its own closing marker, not at a later table's
-    return re.sub(r"(<!-- options: (\w+) -->)\n(.*?)(<!-- /options -->)", table, text,
+    text = re.sub(r"(<!-- options: (\w+) -->)\n(.*?)(<!-- /options -->)", options, text,
+                  flags=re.S)
+    return re.sub(r"(<!-- table: (\w+) -->)\n(.*?)(<!-- /table -->)", table, text,
                   flags=re.S)
 
 
