@@ -160,6 +160,36 @@ def test_the_model_schema_takes_each_variables_settings():
         records.load({**base, "rate_tau2_s": -1.0}, FeatureSettingsRecord, "feature-settings")
 
 
+def test_the_feature_settings_take_each_variables_settings():
+    """FeatureSettings is generated with the settings the variables own: each is a field
+    with its module's default (a fresh dict for a mapping), after the common ones, and a
+    model file's settings read back to an equal object."""
+    import dataclasses
+    import pickle
+
+    from hrgtc.drift.features import FeatureSettings
+
+    fields = {f.name: f for f in dataclasses.fields(FeatureSettings)}
+    common = ["reference_freq_hz", "sample_rate_hz", "reference_c", "rate_tau_s",
+              "warmup_s", "scales"]
+    owned = [key for v in DRIFT_VARIABLES for key, _, _ in v.settings_fields]
+    assert list(fields) == common + owned
+    made = FeatureSettings(4425.0, 200.0)  # positional, as before the generation
+    for v in DRIFT_VARIABLES:
+        for key, _, default in v.settings_fields:
+            value = getattr(made, key)
+            expected = default if isinstance(default, float) else default.default_factory()
+            assert value == expected and type(value) is type(expected), (v.name, key)
+    assert made.aux_columns is not FeatureSettings(4425.0, 200.0).aux_columns
+    full = FeatureSettings(4425.0, 200.0, rate_tau2_s=60.0, switch_hz_per_s=0.01,
+                           aux_columns={"drive": "drive_v"}, aux_centres={"drive": 1.5})
+    assert FeatureSettings.from_dict(full.to_dict()) == full
+    assert full.to_dict()["rate_tau2_s"] == 60.0 and full.rate_tau2_s == 60.0
+    assert pickle.loads(pickle.dumps(full)) == full  # workers receive it pickled
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        full.rate_tau2_s = 1.0  # type: ignore[misc]
+
+
 @pytest.mark.parametrize("name", NAMES)
 def test_each_check_names_what_is_missing(name):
     """A variable whose settings are incomplete is refused with its module's message."""

@@ -54,7 +54,7 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, make_dataclass
 from typing import Annotated, Any
 
 import msgspec
@@ -292,9 +292,53 @@ def required_columns(terms: Sequence[Term]) -> tuple[str, ...]:
 
 
 # -- feature settings and computation ---------------------------------------------------
-@dataclass(frozen=True)
-class FeatureSettings:
-    """Everything needed to compute the drift-model variables from a recording.
+class _FeatureSettingsMethods:
+    """What :class:`FeatureSettings` does beyond holding its fields."""
+
+    reference_freq_hz: float
+    sample_rate_hz: float
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types, as :class:`FeatureSettingsRecord` writes them."""
+        return records.dump(self, FeatureSettingsRecord)
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> FeatureSettings:
+        """Inverse of :meth:`to_dict` (checked against :class:`FeatureSettingsRecord`)."""
+        return cls(**records.load(data, FeatureSettingsRecord,  # type: ignore[no-any-return]
+                                  "feature-settings"))
+
+    def check_sample_rate(self, recording: Recording) -> None:
+        """Raise when a recording's rate differs from the one the filter was built for."""
+        rate = recording.metadata.sample_rate_hz
+        if not math.isclose(rate, self.sample_rate_hz, rel_tol=1e-6):
+            where = f"{recording.source}: " if recording.source else ""
+            raise InputError(
+                f"{where}sample rate {rate:g} Hz differs from the model's {self.sample_rate_hz:g} "
+                "Hz; the model's settling time and windows are counted in samples at its rate, "
+                "so resample the recording or "
+                "calibrate at this rate"
+            )
+
+
+#: The settings every model has, as fields of :func:`dataclasses.make_dataclass`.
+_COMMON_SETTINGS: tuple[tuple[str, Any] | tuple[str, Any, Any], ...] = (
+    ("reference_freq_hz", float),
+    ("sample_rate_hz", float),
+    ("reference_c", float, 20.0),
+    ("rate_tau_s", float, DriftSettings.rate_tau_s),
+    ("warmup_s", float, 600.0),
+    ("scales", dict[str, float], field(default_factory=dict)),
+)
+#: The type of msgspec's ``field(default_factory=...)`` (``records.empty()``).
+_MSGSPEC_FIELD = type(msgspec.field())
+
+_FEATURE_SETTINGS_DOC = """Everything needed to compute the drift-model variables from a recording.
+
+    A frozen dataclass generated from the settings every model has and those the drift
+    variables own (each variable's ``settings_fields`` in :mod:`hrgtc.drift.variables`), so
+    a variable's setting is declared once, in its module (as :data:`FeatureSettingsRecord`,
+    the model file's record, is).
 
     Attributes
     ----------
@@ -311,46 +355,34 @@ class FeatureSettings:
         Start of each run discarded in training while the filter settles. [s]
     scales
         Variable -> scale used internally so every variable is of order one.
-    switch_hz_per_s
-        δ of the heating/cooling switch ``dpos`` (0: not used). [Hz/s]
-    rate_tau2_s
-        Time constant of each stage of the second rate filter, ``d2`` (0: not used). [s]
-    aux_columns, aux_centres
-        Extra channel name -> the recording column it reads, and its training mean,
-        subtracted (``a_NAME = column - centre``). [column unit]
-    """
+"""
 
-    reference_freq_hz: float
-    sample_rate_hz: float
-    reference_c: float = 20.0
-    rate_tau_s: float = DriftSettings.rate_tau_s
-    warmup_s: float = 600.0
-    scales: dict[str, float] = field(default_factory=dict)
-    switch_hz_per_s: float = 0.0
-    rate_tau2_s: float = 0.0
-    aux_columns: dict[str, str] = field(default_factory=dict)
-    aux_centres: dict[str, float] = field(default_factory=dict)
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types, as :class:`FeatureSettingsRecord` writes them."""
-        return records.dump(self, FeatureSettingsRecord)
+def _variable_setting(name: str, kind: Any, default: Any) -> tuple[str, Any, Any]:
+    """A variable's ``(field, type, default)`` as a dataclass field (a msgspec
+    ``default_factory`` becomes the dataclass's)."""
+    if isinstance(default, _MSGSPEC_FIELD):
+        return (name, kind, field(default_factory=default.default_factory))
+    return (name, kind, field(default=default))
 
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> FeatureSettings:
-        """Inverse of :meth:`to_dict` (checked against :class:`FeatureSettingsRecord`)."""
-        return cls(**records.load(data, FeatureSettingsRecord, "feature-settings"))
 
-    def check_sample_rate(self, recording: Recording) -> None:
-        """Raise when a recording's rate differs from the one the filter was built for."""
-        rate = recording.metadata.sample_rate_hz
-        if not math.isclose(rate, self.sample_rate_hz, rel_tol=1e-6):
-            where = f"{recording.source}: " if recording.source else ""
-            raise InputError(
-                f"{where}sample rate {rate:g} Hz differs from the model's {self.sample_rate_hz:g} "
-                "Hz; the model's settling time and windows are counted in samples at its rate, "
-                "so resample the recording or "
-                "calibrate at this rate"
-            )
+def _feature_settings_doc() -> str:
+    """The docstring, with a line for each setting a variable owns (its variable's)."""
+    lines = [_FEATURE_SETTINGS_DOC.rstrip("\n")]
+    for v in DRIFT_VARIABLES:
+        for name, _, _ in v.settings_fields:
+            lines += [f"    {name}", f"        A setting of ``{v.name}``: {v.description}."]
+    return "\n".join(lines) + "\n    "
+
+
+#: Everything needed to compute the drift-model variables from a recording: the common
+#: settings, then those the variables own, in grammar order (their modules' fields).
+FeatureSettings = make_dataclass(
+    "FeatureSettings",
+    [*_COMMON_SETTINGS, *(_variable_setting(*entry) for entry in variable_settings_fields())],
+    bases=(_FeatureSettingsMethods,), frozen=True,
+    namespace={"__module__": __name__, "__qualname__": "FeatureSettings",
+               "__doc__": _feature_settings_doc()})
 
 
 #: A drift term as the model file writes it (``f^2*df``, ``a_drive``); parsed on loading.
