@@ -168,7 +168,8 @@ def settings_schema() -> dict[str, dict[str, Any]]:
 def docs_table() -> str:
     """The docs' table of the variables and their backends (Markdown), from the registry.
 
-    ``docs/reliability.md`` holds it; a test keeps the two equal.
+    ``docs/reliability.md`` holds it between ``<!-- table: drift_variables -->`` markers,
+    written by :mod:`hrgtc.cli.options_tables`; a test fails while the two differ.
     """
     said = {"numpy": "yes", "numba": "yes", "c_double": "yes", "c_float32": "yes",
             "params": "yes"}
