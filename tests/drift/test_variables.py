@@ -160,6 +160,18 @@ def test_the_model_schema_takes_each_variables_settings():
         records.load({**base, "rate_tau2_s": -1.0}, FeatureSettingsRecord, "feature-settings")
 
 
+def test_each_parameter_file_variable_writes_its_keys():
+    """A variable beyond f, df, h and dh (one with C pieces) that claims the parameter file
+    writes its keys itself (``params``), and only such a variable has the hook: the
+    parameter file has no per-variable code to fall back on."""
+    for v in DRIFT_VARIABLES:
+        if v.c_code is not None and v.supports("params"):
+            assert v.params is not None, v.name
+        if v.params is not None:
+            assert v.supports("params") and v.c_code is not None, v.name
+    assert {v.name for v in DRIFT_VARIABLES if v.params} == {"d2", "g", "a_NAME"}
+
+
 def test_the_feature_settings_take_each_variables_settings():
     """FeatureSettings is generated with the settings the variables own: each is a field
     with its module's default (a fresh dict for a mapping), after the common ones, and a
