@@ -18,6 +18,7 @@ from hrgtc.cli.options import (
     reading_options,
 )
 from hrgtc.cli.params import settings_options
+from hrgtc.cli.summary_tables import print_summary
 from hrgtc.settings.calibration import CalibrationSettings
 from hrgtc.settings.drift import EQ21_TERMS
 
@@ -31,63 +32,24 @@ EQ21_DEFAULT = ",".join(EQ21_TERMS)
 
 
 def render(result: CalibrationResult) -> None:
-    """Print the unit's Table 1, Eq. 18 form, Table 2 form, steps and Eq. 22 form."""
-    th = result.model.thermometer
-    if th.source == "sensor":
-        low, high = th.temperature_range_c
-        console.print(f"Thermometer: the gyro's temperature sensor (no frequency output), "
-                      f"trained {low:.2f} to {high:.2f} °C; drift terms in T and dT/dt")
-        _render_drift(result)
-        return
-    table = Table(title="The unit's Table 1 (plateaus) and Table 2 (temperature from frequency)")
-    for column in ("chamber (°C)", "settled freq (Hz)", "method", "unsettled (°C)",
-                   "T from freq (°C)", "error (°C)"):
-        table.add_column(column, justify="right")
-    for row, plateau in zip(result.table, result.plateaus, strict=True):
-        table.add_row(
-            f"{row['chamber_c']:.3f}", f"{row['freq_hz']:.4f}", plateau.method,
-            f"{plateau.residual_unsettled_c:+.4f}", f"{row['temperature_from_freq_c']:.4f}",
-            f"{row['error_c']:+.4f}",
-        )
-    console.print(table)
-    if th.order == 3:
-        c3, c2, c1, c0 = th.coefficients_high_first
-        console.print(
-            f"Eq. (18) form: f = {c3:.4e}·T³ {c2:+.4e}·T² {c1:+.6f}·T {c0:+.4f}  [Hz, T in °C]"
-        )
-    else:
-        console.print(th.summary().splitlines()[-1])
-    _render_drift(result)
-
-
-def _render_drift(result: CalibrationResult) -> None:
-    th = result.model.thermometer
-    if result.prior_fit is not None:
-        fit = result.prior_fit
-        low, high = th.temperature_range_c
-        console.print(f"Thermometer from the prior of {fit.prior.n_units} units: temperature "
-                      f"uncertainty ≤ {fit.max_temperature_std_c:.4f} °C (1σ) over {low:g} to "
-                      f"{high:g} °C")
-    console.print(result.model.drift.summary(sensor=th.source == "sensor"))
-    if result.model.housing is not None:
-        console.print("Housing-thermistor baseline: " + result.model.housing.equation())
-    if result.validation:
-        val = Table(title="Held-out validation: 10 s bias stability (°/h)")
-        for column in ("file", "raw", "compensated", "improvement", "comp. mean",
-                       "comp. RMS", "beyond T", "beyond df/dt"):
-            val.add_column(column, justify="right")
-        for v in result.validation:
-            val.add_row(v.file, f"{v.raw_10s:.4f}", f"{v.compensated_10s:.4f}",
-                        f"{v.raw_10s / v.compensated_10s:.2f}×",
-                        f"{v.mean_dph.get('compensated', float('nan')):+.4g}",
-                        f"{v.rms_dph.get('compensated', float('nan')):.4g}",
-                        f"{v.out_of_range_fraction:.1%}",
-                        f"{v.rate_out_of_range_fraction:.1%}")
-        console.print(val)
-        for v in result.validation:
-            if v.directions is not None:
-                console.print(f"{v.file}: " + v.directions.summary(sensor=th.source == "sensor"),
-                              markup=False)
+    """Print the unit's Table 1 and Table 2 (a frequency thermometer), then the
+    calibration's summary (:meth:`CalibrationResult.summary`: thermometer, drift model,
+    stepwise steps, housing baseline and held-out runs, a table each, and the Eq. 18 and
+    Eq. 22 forms); the range warnings are printed apart."""
+    if result.model.thermometer.source != "sensor":
+        table = Table(title="The unit's Table 1 (plateaus) and Table 2 "
+                      "(temperature from frequency)")
+        for column in ("chamber (°C)", "settled freq (Hz)", "method", "unsettled (°C)",
+                       "T from freq (°C)", "error (°C)"):
+            table.add_column(column, justify="right")
+        for row, plateau in zip(result.table, result.plateaus, strict=True):
+            table.add_row(
+                f"{row['chamber_c']:.3f}", f"{row['freq_hz']:.4f}", plateau.method,
+                f"{plateau.residual_unsettled_c:+.4f}", f"{row['temperature_from_freq_c']:.4f}",
+                f"{row['error_c']:+.4f}",
+            )
+        console.print(table)
+    print_summary(result.summary(warnings=False), console)
 
 
 @app.command("calibrate")

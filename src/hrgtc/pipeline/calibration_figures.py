@@ -1,0 +1,125 @@
+"""A calibration's figures as a structured summary (:class:`hrgtc.core.summary.Summary`).
+
+The thermometer (Eq. 18: order, coefficients ± 1σ, residual, R², calibrated range, the
+largest Table 2 error, the prior's temperature uncertainty), the drift model (Eq. 22:
+candidates, terms, intercept and coefficients ± 1σ with p-values, residual, R², windows,
+samples), its stepwise steps (F and p of each), the housing baseline and each held-out run
+(:func:`hrgtc.evaluation.run_figures.run_figures`): the one structure the plain text, the
+CLI's rich tables (``hrgtc calibrate``), the HTML report and the JSON render. The equations
+and what a figure cannot say (autocorrelation correction, cross-validation) are its notes.
+See docs/architecture.md ("One result contract").
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+from hrgtc.core.summary import Figure, Summary
+from hrgtc.drift.drift_text import drift_notes
+
+__all__ = ["calibration_summary", "thermometer_equation"]
+
+
+def calibration_summary(result: Any, warnings: bool = True) -> Summary:
+    """The figures of a :class:`~hrgtc.pipeline.calibration.CalibrationResult` (not
+    imported here, which would close a circle); ``warnings``: the held-out runs' range
+    warnings among the notes (the CLI prints them apart)."""
+    model = result.model
+    th = model.thermometer
+    sensor = th.source == "sensor"
+    sections = [("thermometer (Eq. 18)",
+                 _thermometer_figures(th, result.table, result.prior_fit)),
+                ("drift model (Eq. 22)", _drift_figures("drift", model.drift)),
+                ("stepwise steps", _step_figures("drift", model.drift))]
+    notes: list[str] = []
+    if sensor:
+        notes.append("thermometer: the gyro's temperature sensor (no frequency output); "
+                     "drift terms in T and dT/dt")
+    else:
+        notes.append(thermometer_equation(th))
+    if model.drift.accounting is not None:
+        notes.append("drift training " + model.drift.accounting.summary())
+    notes += [*drift_notes(model.drift), "Eq. (22) form: " + model.drift.equation(sensor)]
+    if model.housing is not None:
+        sections.append(("housing-thermistor baseline",
+                         _drift_figures("housing", model.housing)))
+        notes.append("housing-thermistor baseline: " + model.housing.equation())
+    for k, run in enumerate(result.validation):
+        figures = run.figures(f"validation[{k}]", sensor=sensor, warnings=warnings)
+        sections += [(f"held-out run {run.file}: {heading}", part)
+                     for heading, part in figures.sections]
+        notes.extend(figures.notes)
+    return Summary(f"calibration of {model.unit}", tuple(sections), tuple(notes))
+
+
+def thermometer_equation(thermometer: Any) -> str:
+    """The thermometer in Eq. (18) form with numbers (``f = 1.5e-05·T³ ...  [Hz, T in °C]``)."""
+    if thermometer.order == 3:
+        c3, c2, c1, c0 = thermometer.coefficients_high_first
+        return (f"Eq. (18) form: f = {c3:.4e}·T³ {c2:+.4e}·T² {c1:+.6f}·T {c0:+.4f}  "
+                "[Hz, T in °C]")
+    return thermometer.summary().splitlines()[-1]
+
+
+def _thermometer_figures(thermometer: Any, table: Sequence[Mapping[str, float]],
+                         prior_fit: Any = None) -> tuple[Figure, ...]:
+    """Order, coefficients ± 1σ, residual, R², calibrated range, worst Table 2 error."""
+    sensor = thermometer.source == "sensor"
+    unit = "°C" if sensor else "Hz"
+    low, high = thermometer.temperature_range_c
+    figures = [Figure("thermometer.order", "order", thermometer.order),
+               Figure("thermometer.n_points", "soak plateaus", thermometer.n_points)]
+    for k, (c, se) in enumerate(zip(thermometer.coefficients, thermometer.standard_errors,
+                                    strict=True)):
+        figures.append(Figure.with_error(f"thermometer.coefficients[{k}]", f"c{k}", c, se,
+                                         unit if k == 0 else f"{unit}/°C^{k}"))
+    figures += [Figure("thermometer.residual_std_hz", "residual std",
+                       thermometer.residual_std_hz, unit, digits=4),
+                Figure("thermometer.rsquared", "R²", thermometer.rsquared, digits=10),
+                Figure("thermometer.temperature_range_c", "calibrated temperatures",
+                       high - low, "°C", (low, high), "range", digits=4)]
+    errors = [abs(row["error_c"]) for row in table if math.isfinite(row.get("error_c", math.nan))]
+    if errors:
+        figures.append(Figure("thermometer.max_error_c", "largest Table 2 error", max(errors),
+                              "°C", digits=3))
+    if prior_fit is not None:
+        figures += [Figure("thermometer.prior.n_units", "units of the prior",
+                           prior_fit.prior.n_units),
+                    Figure("thermometer.prior.max_temperature_std_c",
+                           "largest temperature 1σ (prior fit)",
+                           prior_fit.max_temperature_std_c, "°C", digits=4)]
+    return tuple(figures)
+
+
+def _drift_figures(key: str, model: Any) -> tuple[Figure, ...]:
+    """Candidates, terms, intercept and coefficients ± 1σ with p-values, residual, R²,
+    windows, samples."""
+    figures = [Figure(f"{key}.candidates", "candidate terms", ", ".join(model.candidates)),
+               Figure(f"{key}.selected", "terms", ", ".join(model.selected) or "(none)"),
+               Figure.with_error(f"{key}.intercept_dph", "B0", model.intercept_dph,
+                                 model.standard_errors.get("const", math.nan), "°/h")]
+    for term in model.terms:
+        name = term.name
+        figures.append(Figure.with_error(
+            f"{key}.coefficients.{name}", f"k of {name}", model.coefficients[name],
+            model.standard_errors.get(name, math.nan), f"°/h per {term.unit}"))
+        figures.append(Figure(f"{key}.pvalues.{name}", f"p of {name}",
+                              model.pvalues.get(name, math.nan), digits=3))
+    figures += [Figure(f"{key}.residual_std_dph", "residual std (window means)",
+                       model.residual_std_dph, "°/h", digits=4),
+                Figure(f"{key}.rsquared", "R²", model.rsquared, digits=6),
+                Figure(f"{key}.n_windows", f"windows of {model.window_s:g} s", model.n_windows),
+                Figure(f"{key}.n_samples", "training samples", model.n_samples)]
+    return tuple(figures)
+
+
+def _step_figures(key: str, model: Any) -> tuple[Figure, ...]:
+    """F and p of each stepwise step (``history[k]`` of ``--json``)."""
+    figures = []
+    for n, step in enumerate(model.history):
+        what = f"{n + 1}. {step.action} {step.term}"
+        figures += [Figure(f"{key}.history[{n}].fstat", f"{what}: F", step.fstat, digits=5),
+                    Figure(f"{key}.history[{n}].pvalue", f"{what}: p", step.pvalue, digits=3)]
+    return tuple(figures)
