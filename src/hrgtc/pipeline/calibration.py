@@ -39,8 +39,8 @@ from hrgtc.drift.training import (
     implausible_for_any_gyro,
 )
 from hrgtc.evaluation import Evaluation, evaluate
+from hrgtc.evaluation.calibration_figures import calibration_summary
 from hrgtc.model import UnitModel, provenance
-from hrgtc.pipeline.calibration_figures import calibration_summary
 from hrgtc.recording import ReadOptions
 from hrgtc.recording.marks import refuse_compensated_training
 from hrgtc.settings import to_dict
@@ -159,9 +159,10 @@ class CalibrationResult:
 
         Render it with ``.text()``, ``.rows()`` (a table) or ``.html()``; ``.to_dict()`` is
         plain JSON. ``warnings``: the held-out runs' range warnings among its notes (see
-        :func:`hrgtc.pipeline.calibration_figures.calibration_summary`).
+        :func:`hrgtc.evaluation.calibration_figures.calibration_summary`).
         """
-        return calibration_summary(self, warnings)
+        return calibration_summary(self.model, self.table, self.validation, self.prior_fit,
+                                   warnings)
 
 
 def calibrate(

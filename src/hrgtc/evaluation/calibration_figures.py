@@ -22,15 +22,19 @@ from hrgtc.drift.drift_text import drift_notes
 __all__ = ["calibration_summary", "thermometer_equation"]
 
 
-def calibration_summary(result: Any, warnings: bool = True) -> Summary:
-    """The figures of a :class:`~hrgtc.pipeline.calibration.CalibrationResult` (not
-    imported here, which would close a circle); ``warnings``: the held-out runs' range
-    warnings among the notes (the CLI prints them apart)."""
-    model = result.model
+def calibration_summary(model: Any, table: Sequence[Mapping[str, float]] = (),
+                        validation: Sequence[Any] = (), prior_fit: Any = None,
+                        warnings: bool = True) -> Summary:
+    """The figures of a calibration: a :class:`~hrgtc.model.UnitModel`, its Table 2 rows
+    (``error_c``), the held-out :class:`~hrgtc.evaluation.Evaluation` s and the prior's fit
+    (what :meth:`hrgtc.pipeline.calibration.CalibrationResult.summary` holds; the report
+    passes a model file's). ``warnings``: the held-out runs' range warnings among the notes
+    (the CLI prints them apart).
+    """
     th = model.thermometer
     sensor = th.source == "sensor"
     sections = [("thermometer (Eq. 18)",
-                 _thermometer_figures(th, result.table, result.prior_fit)),
+                 _thermometer_figures(th, table, prior_fit)),
                 ("drift model (Eq. 22)", _drift_figures("drift", model.drift)),
                 ("stepwise steps", _step_figures("drift", model.drift))]
     notes: list[str] = []
@@ -46,7 +50,7 @@ def calibration_summary(result: Any, warnings: bool = True) -> Summary:
         sections.append(("housing-thermistor baseline",
                          _drift_figures("housing", model.housing)))
         notes.append("housing-thermistor baseline: " + model.housing.equation())
-    for k, run in enumerate(result.validation):
+    for k, run in enumerate(validation):
         figures = run.figures(f"validation[{k}]", sensor=sensor, warnings=warnings)
         sections += [(f"held-out run {run.file}: {heading}", part)
                      for heading, part in figures.sections]
