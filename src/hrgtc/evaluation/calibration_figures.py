@@ -79,6 +79,9 @@ def _thermometer_figures(thermometer: Any, table: Sequence[Mapping[str, float]],
                                     strict=True)):
         figures.append(Figure.with_error(f"thermometer.coefficients[{k}]", f"c{k}", c, se,
                                          unit if k == 0 else f"{unit}/°C^{k}"))
+        if k < len(thermometer.pvalues):
+            figures.append(Figure(f"thermometer.pvalues[{k}]", f"p of c{k}",
+                                  float(thermometer.pvalues[k]), digits=3))
     figures += [Figure("thermometer.residual_std_hz", "residual std",
                        thermometer.residual_std_hz, unit, digits=4),
                 Figure("thermometer.rsquared", "R²", thermometer.rsquared, digits=10),
