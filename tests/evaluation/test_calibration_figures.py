@@ -156,3 +156,35 @@ def test_the_prior_fit_is_a_figure(result):
     figure = summary["thermometer.prior.max_temperature_std_c"]
     assert (figure.value, figure.unit) == (0.0125, "°C")
     assert summary["thermometer.prior.n_units"].value == 7
+
+
+def test_the_reports_calibration_tables_show_the_summarys_figures(result):
+    """The report's thermometer, stepwise and drift-model tables (from the model file's
+    unit, as ``hrgtc report`` reads it) hold every figure of those sections."""
+    from hrgtc.report.html import _drift_model, _Page, _table_rows, _thermometer
+    from hrgtc.thermometry.plateaus import Plateau
+
+    model = result.model
+    plateaus = [Plateau.from_dict(p) for p in model.plateaus]
+    table = _table_rows(model, plateaus)
+    page = _Page()
+    _thermometer(page, model, plateaus, table)
+    _drift_model(page, model)
+    cells = {}
+    for caption, body in re.findall(r"<caption>(.*?)</caption>(.*?)</table>", "".join(page.parts)):
+        for row in re.findall(r"<tr>(.*?)</tr>", body):
+            found = [unescape(c) for c in re.findall(r"<td[^>]*>(.*?)</td>", row)]
+            if len(found) == 4:
+                cells[(unescape(caption).split(" (")[0].split(":")[0], found[0])] = found[1:]
+    summary = result.summary()
+    captions = {"thermometer (Eq. 18)": "Thermometer", "stepwise steps": "Stepwise steps",
+                "drift model (Eq. 22)": "The final model"}
+    shown = 0
+    for heading, caption in captions.items():
+        for figure in dict(summary.sections)[heading]:
+            row = cells[(caption, figure.label)]
+            assert _agrees(figure, row[0]), (figure, row)
+            assert row[1:] == [figure.unit, figure.interval_text()], (figure, row)
+            shown += 1
+    assert shown > 20
+
