@@ -197,7 +197,9 @@ def calibrate_command(
 
 
 def render_instrument(calibration: InstrumentCalibration) -> None:
-    """Each axis as :func:`render`, its scale factor, then the instrument's summary."""
+    """Each axis as :func:`render`, its scale factor, then the instrument's summary
+    (:meth:`InstrumentCalibration.summary`: held-out rate tables, cross-axis trials and
+    each axis's held-out medians)."""
     from dataclasses import replace
 
     for axis, result in calibration.axes.items():
@@ -207,43 +209,6 @@ def render_instrument(calibration: InstrumentCalibration) -> None:
         render(replace(result, model=model, validation=calibration.validation.get(axis, ())))
         if model.scale_factor is not None:
             console.print(model.scale_factor.summary())
-    if calibration.scale_checks:
-        table = Table(title="Held-out rate tables: scale-factor error (ppm) at each "
-                      "temperature, raw → compensated")
-        for column in ("file", "axis", "temperatures", "raw → compensated", "largest |error|"):
-            table.add_column(column, justify="right")
-        for check in calibration.scale_checks:
-            pairs = ", ".join(f"{r:+.1f} → {c:+.1f}"
-                              for r, c in zip(check.raw_ppm, check.compensated_ppm, strict=True))
-            table.add_row(Path(check.file).name, check.axis or "-", str(len(check.raw_ppm)),
-                          pairs, f"{check.raw_max_ppm:.1f} → {check.compensated_max_ppm:.1f}")
-        console.print(table)
-    for axis, trial in calibration.cross_axis.items():
-        if "why" in trial:
-            console.print(f"axis {axis}: cross-axis terms not tried: {trial['why']}")
-            continue
-        verdict = "kept" if trial["kept"] else "not kept"
-        console.print(
-            f"axis {axis}: with the other resonators' frequencies "
-            f"({', '.join(trial['channels'].values())}) held-out 10 s bias stability "
-            f"{trial['held_out_10s_dph_with']:.4f} °/h against "
-            f"{trial['held_out_10s_dph_without']:.4f} without: {verdict}"
-            + (f" (terms {', '.join(trial['selected'])})" if trial["selected"] else ""))
-    if not calibration.model.is_single_axis:
-        from hrgtc.pipeline.instrument import summary_rows
-
-        table = Table(title=f"{calibration.model.unit}: per-axis summary (held-out median, °/h)")
-        for column in ("axis", "drift terms", "raw 10 s", "compensated 10 s",
-                       "scale terms", "scale raw max ppm", "scale residual max ppm"):
-            table.add_column(column, justify="right")
-
-        def number(value: float | None, digits: int) -> str:
-            return "–" if value is None else f"{value:.{digits}f}"
-
-        for row in summary_rows(calibration):
-            table.add_row(row["axis"], ",".join(row["terms"]),
-                          number(row["raw_10s_dph"], 4), number(row["compensated_10s_dph"], 4),
-                          "–" if row["scale_terms"] is None else ",".join(row["scale_terms"]),
-                          number(row["scale_raw_max_ppm"], 1),
-                          number(row["scale_residual_max_ppm"], 1))
-        console.print(table)
+    summary = calibration.summary()
+    if summary.sections or summary.notes:  # rate tables, cross-axis trials, the axes
+        print_summary(summary, console)

@@ -16,10 +16,12 @@ import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+import numpy as np
+
 from hrgtc.core.summary import Figure, Summary
 from hrgtc.drift.drift_text import drift_notes
 
-__all__ = ["calibration_summary", "thermometer_equation"]
+__all__ = ["calibration_summary", "instrument_summary", "thermometer_equation"]
 
 
 def calibration_summary(model: Any, table: Sequence[Mapping[str, float]] = (),
@@ -130,3 +132,72 @@ def _step_figures(key: str, model: Any) -> tuple[Figure, ...]:
         figures += [Figure(f"{key}.history[{n}].fstat", f"{what}: F", step.fstat, digits=5),
                     Figure(f"{key}.history[{n}].pvalue", f"{what}: p", step.pvalue, digits=3)]
     return tuple(figures)
+
+
+def instrument_summary(calibration: Any) -> Summary:
+    """What an :class:`~hrgtc.pipeline.instrument.InstrumentCalibration` shows beside its
+    axes' own summaries: each held-out rate table's scale-factor error at each temperature
+    raw and compensated (``scale_factor_checks[i]`` of ``--json``), each cross-axis trial
+    (``cross_axis.<axis>``) and, for several axes, each axis's held-out median 10 s bias
+    stability and scale-factor figures (``axes.<axis>``)."""
+    sections: list[tuple[str, tuple[Figure, ...]]] = []
+    notes: list[str] = []
+    for i, check in enumerate(calibration.scale_checks):
+        key = f"scale_factor_checks[{i}]"
+        figures = [Figure(f"{key}.n_temperatures", "temperatures", len(check.raw_ppm))]
+        for k, (freq, raw, comp) in enumerate(zip(check.freq_hz, check.raw_ppm,
+                                                  check.compensated_ppm, strict=True)):
+            figures += [Figure(f"{key}.raw_ppm[{k}]", f"at {freq:.8g} Hz: raw", raw, "ppm",
+                               digits=4),
+                        Figure(f"{key}.compensated_ppm[{k}]", f"at {freq:.8g} Hz: compensated",
+                               comp, "ppm", digits=4)]
+        figures += [Figure(f"{key}.raw_max_ppm", "largest |error|, raw", check.raw_max_ppm,
+                           "ppm", digits=4),
+                    Figure(f"{key}.compensated_max_ppm", "largest |error|, compensated",
+                           check.compensated_max_ppm, "ppm", digits=4)]
+        name = str(check.file).replace("\\", "/").rsplit("/", 1)[-1]
+        sections.append((f"held-out rate table {name}"
+                         + (f", axis {check.axis}" if check.axis else "")
+                         + ": scale-factor error", tuple(figures)))
+    for axis, trial in calibration.cross_axis.items():
+        if "why" in trial:
+            notes.append(f"axis {axis}: cross-axis terms not tried: {trial['why']}")
+            continue
+        key = f"cross_axis.{axis}"
+        sections.append((f"axis {axis}: cross-axis terms (the other resonators' frequencies)", (
+            Figure(f"{key}.channels", "channels", ", ".join(trial["channels"].values())),
+            Figure(f"{key}.held_out_10s_dph_with", "held-out 10 s bias stability, with",
+                   trial["held_out_10s_dph_with"], "°/h", digits=4),
+            Figure(f"{key}.held_out_10s_dph_without", "held-out 10 s bias stability, without",
+                   trial["held_out_10s_dph_without"], "°/h", digits=4),
+            Figure(f"{key}.kept", "kept", "kept" if trial["kept"] else "not kept"),
+            Figure(f"{key}.selected", "terms", ", ".join(trial["selected"]) or "(none)"))))
+    if not calibration.model.is_single_axis:
+        for axis, unit_model in calibration.model.axes.items():
+            sections.append((f"axis {axis}: summary (held-out median)",
+                             _axis_figures(calibration, axis, unit_model)))
+    return Summary(f"instrument {calibration.model.unit}", tuple(sections), tuple(notes))
+
+
+def _axis_figures(calibration: Any, axis: str, unit_model: Any) -> tuple[Figure, ...]:
+    key = f"axes.{axis or '-'}"
+    runs = calibration.validation.get(axis, ())
+    checks = [c for c in calibration.scale_checks if c.axis == axis]
+
+    def median(values: list[float]) -> float:
+        return float(np.median(values)) if values else math.nan
+
+    sf = unit_model.scale_factor
+    return (Figure(f"{key}.drift_terms", "drift terms", ", ".join(unit_model.drift.selected)
+                   or "(none)"),
+            Figure(f"{key}.raw_10s_dph", "raw 10 s", median([v.raw_10s for v in runs]), "°/h",
+                   digits=4),
+            Figure(f"{key}.compensated_10s_dph", "compensated 10 s",
+                   median([v.compensated_10s for v in runs]), "°/h", digits=4),
+            Figure(f"{key}.scale_terms", "scale-factor terms",
+                   "-" if sf is None else ", ".join(sf.selected) or "(none)"),
+            Figure(f"{key}.scale_raw_max_ppm", "scale-factor error raw, largest",
+                   max((c.raw_max_ppm for c in checks), default=math.nan), "ppm", digits=4),
+            Figure(f"{key}.scale_residual_max_ppm", "scale-factor error compensated, largest",
+                   max((c.compensated_max_ppm for c in checks), default=math.nan), "ppm",
+                   digits=4))
