@@ -171,6 +171,11 @@ def test_cross_axis_candidates_are_judged_on_held_out_runs(imu_campaign):
         assert held_out.compensated_10s == pytest.approx(chosen, rel=1e-12)
         uses = any("a_f" in t for t in result.model.axes[axis].drift.selected)
         assert uses == (gain and bool(trial["selected"]))
+        figures = result.summary().figures()  # the trial, as hrgtc calibrate prints it
+        for which in ("with", "without"):
+            key = f"held_out_10s_dph_{which}"
+            assert figures[f"cross_axis.{axis}.{key}"].value == trial[key]
+        assert figures[f"cross_axis.{axis}.kept"].value == ("kept" if gain else "not kept")
 
 
 def test_an_axis_model_reads_another_axis_frequency(imu_campaign):
@@ -191,3 +196,40 @@ def test_an_axis_model_reads_another_axis_frequency(imu_campaign):
     np.testing.assert_allclose(fused["rate_comp_dph"], reference["rate_comp_dph"], atol=1e-9)
     centre = result.model.drift.settings.aux_centres["fy"]
     assert abs(centre - np.mean(axis_view(read(files.cooldown), "y").freq_hz)) < 10.0
+
+
+def test_the_instrument_summary_shows_the_rate_tables_and_the_axes(calibration, monkeypatch):
+    """``InstrumentCalibration.summary()``: the held-out rate tables' errors (places of the
+    ``--json`` document), each axis's held-out medians (``summary_rows``), and
+    ``hrgtc calibrate`` prints every one of its figures in its table."""
+    import io
+    import re
+
+    from rich.console import Console
+
+    import hrgtc.cli.calibrate_cmd as calibrate_cmd
+
+    summary = calibration.summary()
+    document = json.loads(json.dumps(calibration.to_dict()))
+    checks = [f for f in summary.figures().values() if f.name.startswith("scale_factor_")]
+    assert len(checks) >= 2 * sum(len(c.raw_ppm) for c in calibration.scale_checks) + 2
+    for figure in checks:
+        if figure.name.endswith(".n_temperatures"):  # a count, not a place of the document
+            index = int(re.search(r"\[(\d+)\]", figure.name).group(1))
+            assert figure.value == len(calibration.scale_checks[index].raw_ppm) >= 2
+            continue
+        node = document
+        for token in re.findall(r"[^.\[\]]+|\[\d+\]", figure.name):
+            node = node[int(token[1:-1])] if token.startswith("[") else node[token]
+        assert node == pytest.approx(figure.value, rel=1e-12), figure
+    for row in summary_rows(calibration):
+        for field in ("raw_10s_dph", "compensated_10s_dph", "scale_raw_max_ppm",
+                      "scale_residual_max_ppm"):
+            assert summary[f"axes.{row['axis']}.{field}"].value == pytest.approx(row[field])
+        assert summary[f"axes.{row['axis']}.drift_terms"].value == ", ".join(row["terms"])
+    out = io.StringIO()
+    monkeypatch.setattr(calibrate_cmd, "console", Console(file=out, width=400))
+    calibrate_cmd.render_instrument(calibration)
+    lines = [[c.strip() for c in line.split("│")[1:-1]] for line in out.getvalue().splitlines()]
+    for heading, label, value, unit, interval in summary.rows():
+        assert [label, value, unit, interval] in lines, (heading, label)

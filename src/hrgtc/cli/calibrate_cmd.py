@@ -18,6 +18,7 @@ from hrgtc.cli.options import (
     reading_options,
 )
 from hrgtc.cli.params import settings_options
+from hrgtc.cli.summary_tables import print_summary
 from hrgtc.settings.calibration import CalibrationSettings
 from hrgtc.settings.drift import EQ21_TERMS
 
@@ -31,63 +32,24 @@ EQ21_DEFAULT = ",".join(EQ21_TERMS)
 
 
 def render(result: CalibrationResult) -> None:
-    """Print the unit's Table 1, Eq. 18 form, Table 2 form, steps and Eq. 22 form."""
-    th = result.model.thermometer
-    if th.source == "sensor":
-        low, high = th.temperature_range_c
-        console.print(f"Thermometer: the gyro's temperature sensor (no frequency output), "
-                      f"trained {low:.2f} to {high:.2f} °C; drift terms in T and dT/dt")
-        _render_drift(result)
-        return
-    table = Table(title="The unit's Table 1 (plateaus) and Table 2 (temperature from frequency)")
-    for column in ("chamber (°C)", "settled freq (Hz)", "method", "unsettled (°C)",
-                   "T from freq (°C)", "error (°C)"):
-        table.add_column(column, justify="right")
-    for row, plateau in zip(result.table, result.plateaus, strict=True):
-        table.add_row(
-            f"{row['chamber_c']:.3f}", f"{row['freq_hz']:.4f}", plateau.method,
-            f"{plateau.residual_unsettled_c:+.4f}", f"{row['temperature_from_freq_c']:.4f}",
-            f"{row['error_c']:+.4f}",
-        )
-    console.print(table)
-    if th.order == 3:
-        c3, c2, c1, c0 = th.coefficients_high_first
-        console.print(
-            f"Eq. (18) form: f = {c3:.4e}·T³ {c2:+.4e}·T² {c1:+.6f}·T {c0:+.4f}  [Hz, T in °C]"
-        )
-    else:
-        console.print(th.summary().splitlines()[-1])
-    _render_drift(result)
-
-
-def _render_drift(result: CalibrationResult) -> None:
-    th = result.model.thermometer
-    if result.prior_fit is not None:
-        fit = result.prior_fit
-        low, high = th.temperature_range_c
-        console.print(f"Thermometer from the prior of {fit.prior.n_units} units: temperature "
-                      f"uncertainty ≤ {fit.max_temperature_std_c:.4f} °C (1σ) over {low:g} to "
-                      f"{high:g} °C")
-    console.print(result.model.drift.summary(sensor=th.source == "sensor"))
-    if result.model.housing is not None:
-        console.print("Housing-thermistor baseline: " + result.model.housing.equation())
-    if result.validation:
-        val = Table(title="Held-out validation: 10 s bias stability (°/h)")
-        for column in ("file", "raw", "compensated", "improvement", "comp. mean",
-                       "comp. RMS", "beyond T", "beyond df/dt"):
-            val.add_column(column, justify="right")
-        for v in result.validation:
-            val.add_row(v.file, f"{v.raw_10s:.4f}", f"{v.compensated_10s:.4f}",
-                        f"{v.raw_10s / v.compensated_10s:.2f}×",
-                        f"{v.mean_dph.get('compensated', float('nan')):+.4g}",
-                        f"{v.rms_dph.get('compensated', float('nan')):.4g}",
-                        f"{v.out_of_range_fraction:.1%}",
-                        f"{v.rate_out_of_range_fraction:.1%}")
-        console.print(val)
-        for v in result.validation:
-            if v.directions is not None:
-                console.print(f"{v.file}: " + v.directions.summary(sensor=th.source == "sensor"),
-                              markup=False)
+    """Print the unit's Table 1 and Table 2 (a frequency thermometer), then the
+    calibration's summary (:meth:`CalibrationResult.summary`: thermometer, drift model,
+    stepwise steps, housing baseline and held-out runs, a table each, and the Eq. 18 and
+    Eq. 22 forms); the range warnings are printed apart."""
+    if result.model.thermometer.source != "sensor":
+        table = Table(title="The unit's Table 1 (plateaus) and Table 2 "
+                      "(temperature from frequency)")
+        for column in ("chamber (°C)", "settled freq (Hz)", "method", "unsettled (°C)",
+                       "T from freq (°C)", "error (°C)"):
+            table.add_column(column, justify="right")
+        for row, plateau in zip(result.table, result.plateaus, strict=True):
+            table.add_row(
+                f"{row['chamber_c']:.3f}", f"{row['freq_hz']:.4f}", plateau.method,
+                f"{plateau.residual_unsettled_c:+.4f}", f"{row['temperature_from_freq_c']:.4f}",
+                f"{row['error_c']:+.4f}",
+            )
+        console.print(table)
+    print_summary(result.summary(warnings=False), console)
 
 
 @app.command("calibrate")
@@ -235,7 +197,9 @@ def calibrate_command(
 
 
 def render_instrument(calibration: InstrumentCalibration) -> None:
-    """Each axis as :func:`render`, its scale factor, then the instrument's summary."""
+    """Each axis as :func:`render`, its scale factor, then the instrument's summary
+    (:meth:`InstrumentCalibration.summary`: held-out rate tables, cross-axis trials and
+    each axis's held-out medians)."""
     from dataclasses import replace
 
     for axis, result in calibration.axes.items():
@@ -245,43 +209,6 @@ def render_instrument(calibration: InstrumentCalibration) -> None:
         render(replace(result, model=model, validation=calibration.validation.get(axis, ())))
         if model.scale_factor is not None:
             console.print(model.scale_factor.summary())
-    if calibration.scale_checks:
-        table = Table(title="Held-out rate tables: scale-factor error (ppm) at each "
-                      "temperature, raw → compensated")
-        for column in ("file", "axis", "temperatures", "raw → compensated", "largest |error|"):
-            table.add_column(column, justify="right")
-        for check in calibration.scale_checks:
-            pairs = ", ".join(f"{r:+.1f} → {c:+.1f}"
-                              for r, c in zip(check.raw_ppm, check.compensated_ppm, strict=True))
-            table.add_row(Path(check.file).name, check.axis or "-", str(len(check.raw_ppm)),
-                          pairs, f"{check.raw_max_ppm:.1f} → {check.compensated_max_ppm:.1f}")
-        console.print(table)
-    for axis, trial in calibration.cross_axis.items():
-        if "why" in trial:
-            console.print(f"axis {axis}: cross-axis terms not tried: {trial['why']}")
-            continue
-        verdict = "kept" if trial["kept"] else "not kept"
-        console.print(
-            f"axis {axis}: with the other resonators' frequencies "
-            f"({', '.join(trial['channels'].values())}) held-out 10 s bias stability "
-            f"{trial['held_out_10s_dph_with']:.4f} °/h against "
-            f"{trial['held_out_10s_dph_without']:.4f} without: {verdict}"
-            + (f" (terms {', '.join(trial['selected'])})" if trial["selected"] else ""))
-    if not calibration.model.is_single_axis:
-        from hrgtc.pipeline.instrument import summary_rows
-
-        table = Table(title=f"{calibration.model.unit}: per-axis summary (held-out median, °/h)")
-        for column in ("axis", "drift terms", "raw 10 s", "compensated 10 s",
-                       "scale terms", "scale raw max ppm", "scale residual max ppm"):
-            table.add_column(column, justify="right")
-
-        def number(value: float | None, digits: int) -> str:
-            return "–" if value is None else f"{value:.{digits}f}"
-
-        for row in summary_rows(calibration):
-            table.add_row(row["axis"], ",".join(row["terms"]),
-                          number(row["raw_10s_dph"], 4), number(row["compensated_10s_dph"], 4),
-                          "–" if row["scale_terms"] is None else ",".join(row["scale_terms"]),
-                          number(row["scale_raw_max_ppm"], 1),
-                          number(row["scale_residual_max_ppm"], 1))
-        console.print(table)
+    summary = calibration.summary()
+    if summary.sections or summary.notes:  # rate tables, cross-axis trials, the axes
+        print_summary(summary, console)

@@ -57,6 +57,15 @@ def drift_summary(model: Any, sensor: bool = False) -> str:
         f"residual std {model.residual_std_dph:.4g} °/h on {model.window_s:g} s means, "
         f"R² {model.rsquared:.6f}"
     )
+    lines.extend(drift_notes(model))
+    lines.append(drift_equation(model, sensor))
+    return "\n".join(lines)
+
+
+def drift_notes(model: Any) -> list[str]:
+    """What a fit's figures cannot say: the autocorrelation correction, the
+    cross-validation, the guarded selection, the samples not at rest, the offsets."""
+    lines: list[str] = []
     if model.variance_inflation > 1.0 or model.bandwidth_windows:
         lines.append(
             f"F-tests corrected for autocorrelated residuals (Newey-West, "
@@ -74,5 +83,4 @@ def drift_summary(model: Any, sensor: bool = False) -> str:
     if model.offsets_dph:
         lines.append(f"offsets ({model.offset_mode}, nuisance, from the intercept) [°/h]: "
                      + ", ".join(f"{k} {v:+.4g}" for k, v in model.offsets_dph.items()))
-    lines.append(drift_equation(model, sensor))
-    return "\n".join(lines)
+    return lines

@@ -28,7 +28,7 @@ import numpy as np
 from hrgtc import drift as drift_model
 from hrgtc.core.errors import CalibrationError, ExtrapolationWarning, HrgtcWarning, InputError
 from hrgtc.core.progress import StageProgress, for_stage
-from hrgtc.core.summary import Figure, Summary
+from hrgtc.core.summary import Summary
 from hrgtc.drift.features import AUX_NAME, EQ21, parse_terms
 from hrgtc.drift.rest import run_rest
 from hrgtc.drift.training import (
@@ -39,6 +39,7 @@ from hrgtc.drift.training import (
     implausible_for_any_gyro,
 )
 from hrgtc.evaluation import Evaluation, evaluate
+from hrgtc.evaluation.calibration_figures import calibration_summary
 from hrgtc.model import UnitModel, provenance
 from hrgtc.recording import ReadOptions
 from hrgtc.recording.marks import refuse_compensated_training
@@ -152,69 +153,16 @@ class CalibrationResult:
             "prior": None if self.prior_fit is None else self.prior_fit.to_dict(),
         }
 
-    def summary(self) -> Summary:
+    def summary(self, warnings: bool = True) -> Summary:
         """The calibration's figures, each a value, a unit and an interval (±1σ of a
         coefficient, the confidence interval of a bias stability, the span of the data).
 
         Render it with ``.text()``, ``.rows()`` (a table) or ``.html()``; ``.to_dict()`` is
-        plain JSON.
+        plain JSON. ``warnings``: the held-out runs' range warnings among its notes (see
+        :func:`hrgtc.evaluation.calibration_figures.calibration_summary`).
         """
-        model = self.model
-        sections = [("thermometer (Eq. 18)", _thermometer_figures(model.thermometer, self.table)),
-                    ("drift model (Eq. 22)", _drift_figures("drift", model.drift))]
-        if model.housing is not None:
-            sections.append(("housing-thermistor baseline",
-                             _drift_figures("housing", model.housing)))
-        notes: list[str] = []
-        for k, run in enumerate(self.validation):
-            figures = run.figures(f"validation[{k}]")
-            sections.append((f"held-out run {run.file}",
-                             tuple(f for _, part in figures.sections for f in part)))
-            notes.extend(figures.notes)
-        return Summary(f"calibration of {model.unit}", tuple(sections), tuple(notes))
-
-
-def _thermometer_figures(thermometer: Any, table: Sequence[Mapping[str, float]]
-                         ) -> tuple[Figure, ...]:
-    """Order, coefficients ± 1σ, residual, R², calibrated range, worst Table 2 error."""
-    sensor = thermometer.source == "sensor"
-    unit = "°C" if sensor else "Hz"
-    low, high = thermometer.temperature_range_c
-    figures = [Figure("thermometer.order", "order", thermometer.order),
-               Figure("thermometer.n_points", "soak plateaus", thermometer.n_points)]
-    for k, (c, se) in enumerate(zip(thermometer.coefficients, thermometer.standard_errors,
-                                    strict=True)):
-        figures.append(Figure.with_error(f"thermometer.coefficients[{k}]", f"c{k}", c, se,
-                                         unit if k == 0 else f"{unit}/°C^{k}"))
-    figures += [Figure("thermometer.residual_std_hz", "residual std",
-                       thermometer.residual_std_hz, unit, digits=4),
-                Figure("thermometer.rsquared", "R²", thermometer.rsquared, digits=10),
-                Figure("thermometer.temperature_range_c", "calibrated temperatures",
-                       high - low, "°C", (low, high), "range", digits=4)]
-    errors = [abs(row["error_c"]) for row in table if math.isfinite(row.get("error_c", math.nan))]
-    if errors:
-        figures.append(Figure("thermometer.max_error_c", "largest Table 2 error", max(errors),
-                              "°C", digits=3))
-    return tuple(figures)
-
-
-def _drift_figures(key: str, model: Any) -> tuple[Figure, ...]:
-    """Terms, intercept and coefficients ± 1σ with p-values, residual, R², windows."""
-    figures = [Figure(f"{key}.selected", "terms", ", ".join(model.selected) or "(none)"),
-               Figure.with_error(f"{key}.intercept_dph", "B0", model.intercept_dph,
-                                 model.standard_errors.get("const", math.nan), "°/h")]
-    for term in model.terms:
-        name = term.name
-        figures.append(Figure.with_error(
-            f"{key}.coefficients.{name}", f"k of {name}", model.coefficients[name],
-            model.standard_errors.get(name, math.nan), f"°/h per {term.unit}"))
-        figures.append(Figure(f"{key}.pvalues.{name}", f"p of {name}",
-                              model.pvalues.get(name, math.nan), digits=3))
-    figures += [Figure(f"{key}.residual_std_dph", "residual std (window means)",
-                       model.residual_std_dph, "°/h", digits=4),
-                Figure(f"{key}.rsquared", "R²", model.rsquared, digits=6),
-                Figure(f"{key}.n_windows", f"windows of {model.window_s:g} s", model.n_windows)]
-    return tuple(figures)
+        return calibration_summary(self.model, self.table, self.validation, self.prior_fit,
+                                   warnings)
 
 
 def calibrate(

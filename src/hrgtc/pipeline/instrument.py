@@ -24,6 +24,7 @@ from hrgtc.compensate import InstrumentCompensator
 from hrgtc.compensate.ranges import RangeReport
 from hrgtc.core.errors import InputError
 from hrgtc.core.progress import StageProgress
+from hrgtc.core.summary import Summary
 from hrgtc.drift import (
     ScaleFactorModel,
     find_rate_segments,
@@ -34,6 +35,7 @@ from hrgtc.drift import (
 )
 from hrgtc.drift.scale_factor import TOLERANCE_SHARE
 from hrgtc.evaluation import Evaluation, evaluate
+from hrgtc.evaluation.calibration_figures import instrument_summary
 from hrgtc.model import InstrumentModel, UnitModel, provenance
 from hrgtc.pipeline.calibration import HOUSING_TERMS, CalibrationResult, calibrate
 from hrgtc.recording import ReadOptions, Recording, axis_names
@@ -96,6 +98,12 @@ class InstrumentCalibration:
     scale_checks: tuple[ScaleFactorCheck, ...] = ()
     #: Axis -> the cross-axis trial (channels, held-out figures with and without, kept).
     cross_axis: dict[str, dict[str, Any]] = field(default_factory=dict)
+
+    def summary(self) -> Summary:
+        """The instrument's figures beside its axes' own (held-out rate tables, cross-axis
+        trials, each axis's held-out medians); see
+        :func:`hrgtc.evaluation.calibration_figures.instrument_summary`."""
+        return instrument_summary(self)
 
     def to_dict(self) -> dict[str, Any]:
         """The layout of ``hrgtc calibrate --json`` (one entry per axis)."""

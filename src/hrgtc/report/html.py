@@ -30,8 +30,9 @@ import numpy as np
 
 import hrgtc.report.figures as figures
 from hrgtc.core.files import file_sha256
-from hrgtc.drift.features import parse_terms
+from hrgtc.core.summary import Summary
 from hrgtc.evaluation import Evaluation
+from hrgtc.evaluation.calibration_figures import calibration_summary
 from hrgtc.model import UnitModel
 from hrgtc.report.figures import SoakTrace
 from hrgtc.thermometry import paper
@@ -162,13 +163,7 @@ def _summary(page: _Page, runs: Sequence[Evaluation]) -> None:
     """The result at a glance: 10 s bias stability of each run beside the paper's."""
     if not runs:
         return
-    rows = [(r.name, _number(r.stability("raw", 10.0)),
-             _number(r.stability("compensated", 10.0)),
-             _number(_ratio(r, 10.0), 3),
-             _number(r.stability("housing", 10.0)),
-             f"{_temperature_share(r):.1%}",
-             _number(r.mean_dph.get("compensated")), _number(r.rms_dph.get("compensated")))
-            for r in runs]
+    rows = [_glance(r) for r in runs]
     rows.append(("paper [1], Section 4.2 (its cool-down)", _number(paper.BIAS_STABILITY_RAW_DPH,
                  5), _number(paper.BIAS_STABILITY_COMPENSATED_DPH, 4), _number(
                  paper.BIAS_STABILITY_RAW_DPH / paper.BIAS_STABILITY_COMPENSATED_DPH, 3), "–",
@@ -179,9 +174,31 @@ def _summary(page: _Page, runs: Sequence[Evaluation]) -> None:
                     "At a glance: 10 s bias stability, raw and compensated"))
 
 
-def _ratio(run: Evaluation, tau_s: float) -> float | None:
-    raw, comp = run.stability("raw", tau_s), run.stability("compensated", tau_s)
-    return raw / comp if raw is not None and comp else None
+def _glance(run: Evaluation) -> tuple[str, ...]:
+    """A run's row of "At a glance", from its summary's figures (``run.figures()``)."""
+    figures = run.figures(warnings=False).figures()
+
+    def cell(name: str, percent: bool = False) -> str:
+        figure = figures.get(f"evaluation.{name}")
+        if figure is None or not isinstance(figure.value, float | int):
+            return "–"
+        if percent:
+            return f"{figure.value:.1%}"
+        return _number(figure.value, figure.digits)
+
+    share = ("ranges.temperature_fraction" if run.ranges is not None  # not other variables'
+             else "out_of_range_fraction")
+    return (run.name, *(cell(f"bias_stability_dph.{s}.10") for s in ("raw", "compensated")),
+            cell("improvement_10s"), cell("bias_stability_dph.housing.10"),
+            cell(share, percent=True), cell("mean_dph.compensated"),
+            cell("rms_dph.compensated"))
+
+
+def _section_table(page: _Page, summary: Summary, heading: str, caption: str) -> None:
+    """One section of a calibration's summary as a table (figure, value, unit, interval)."""
+    rows = [row[1:] for row in summary.rows() if row[0] == heading]
+    if rows:
+        page.add(_table(("figure", "value", "unit", "interval"), rows, caption))
 
 
 def _match(plateaus: Sequence[Plateau], source: str) -> list[Plateau]:
@@ -256,16 +273,17 @@ def _thermometer(page: _Page, model: UnitModel, plateaus: Sequence[Plateau],
             for r in table]
     page.add(_table(("temperature [°C]", "natural frequency [Hz]", "residual [mHz]"),
                         rows, "The unit's Table 1"))
+    summary = calibration_summary(model, table)
+    _section_table(page, summary, "thermometer (Eq. 18)",
+                   "Thermometer (Eq. 18): coefficients c0 (constant) to c3 (T³) ± 1σ, p-values, "
+                   "fit")
     high = th.coefficients_high_first
-    pvals = tuple(reversed(th.pvalues))
     printed = dict(enumerate(reversed(paper.EQ18_PRINTED_HIGH_FIRST)))
     powers = range(th.order, -1, -1)
-    rows = [(_power("T", n) or "const", "Hz" + (f"/{_power('°C', n)}" if n else ""),
-             _number(c, 10), _number(se, 3), _pvalue(p), _number(printed.get(n), 7))
-            for n, c, se, p in zip(powers, high, reversed(th.standard_errors), pvals,
-                                   strict=True)]
-    page.add(_table(("term", "unit", "coefficient", "std error", "p-value",
-                         "Eq. 18 of [1]"), rows, "Coefficients, highest power first"))
+    rows = [(f"c{n}", _power("T", n) or "const", _number(c, 10), _number(printed.get(n), 7))
+            for n, c in zip(powers, high, strict=True)]
+    page.add(_table(("coefficient", "term", "this unit", "Eq. 18 of [1]"), rows,
+                    "Coefficients beside the paper's, highest power first"))
     terms = " ".join(f"{'−' if c < 0 else '+'} {abs(c):.7g}" + (f"·{_power('T', n)}" if n else "")
                      for n, c in zip(powers, high, strict=True))
     page.add(f'<p class="eq">f = {terms.lstrip("+ ")} &nbsp;[Hz, T in °C]</p>',
@@ -375,18 +393,13 @@ def _drift_model(page: _Page, model: UnitModel) -> None:
              f"</code>. Fitted on {d.n_windows} means of {d.window_s:g} s ({d.n_samples} "
              f"samples); p-to-enter {d.stepwise.penter:g}, p-to-remove {d.stepwise.premove:g}; "
              f"stopped: {escape(d.stepwise.stop_reason)}.{_excluded(d)}</p>")
-    rows = [(n, s.action, s.term, _number(s.fstat, 5), _pvalue(s.pvalue))
-            for n, s in enumerate(d.history, start=1)]
-    page.add(_table(("step", "action", "term", "F", "p-value"), rows, "Stepwise steps"))
-    rows = [("B0 (const)", "°/h", _number(d.intercept_dph, 6), _number(d.standard_errors["const"],
-             3), _pvalue(d.pvalues["const"]), "yes")]
-    for name in d.selected:
-        unit = parse_terms([name])[0].unit
-        rows.append((name, f"°/h per {unit}", _number(d.coefficients[name], 6),
-                     _number(d.standard_errors[name], 3), _pvalue(d.pvalues[name]),
-                     "yes" if name in paper.EQ22_TERMS else "no"))
-    page.add(_table(("term", "coefficient unit", "coefficient", "std error", "p-value",
-                         "kept in Eq. 22 of [1]"), rows, "The final model"),
+    summary = calibration_summary(model)
+    _section_table(page, summary, "stepwise steps", "Stepwise steps")
+    _section_table(page, summary, "drift model (Eq. 22)",
+                   "The final model: coefficients ± 1σ, p-values, fit")
+    kept = [n for n in d.selected if n in paper.EQ22_TERMS]
+    page.add(f"<p>Terms also kept in Eq. 22 of [1]: "
+             f"{escape(', '.join(kept) or 'none')}.</p>",
              f'<p class="eq">{escape(d.equation(model.thermometer.source == "sensor"))}</p>',
              f'<p class="muted">Eq. (22) form. Residual std {_number(d.residual_std_dph)} °/h on '
              f"{d.window_s:g} s means, R² {d.rsquared:.6f}.</p>")
@@ -395,8 +408,9 @@ def _drift_model(page: _Page, model: UnitModel) -> None:
                   f"(Newey–West, {d.bandwidth_windows} windows): variance inflation "
                   f"{d.variance_inflation:.3g}.")
     if model.housing is not None:
-        page.add(f'<p>Classical baseline (housing thermistor): </p><p class="eq">'
-                 f"{escape(model.housing.equation())}</p>")
+        _section_table(page, summary, "housing-thermistor baseline",
+                       "Classical baseline (housing thermistor)")
+        page.add(f'<p class="eq">{escape(model.housing.equation())}</p>')
     page.add("</section>")
 
 

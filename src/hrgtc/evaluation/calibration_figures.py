@@ -1,0 +1,203 @@
+"""A calibration's figures as a structured summary (:class:`hrgtc.core.summary.Summary`).
+
+The thermometer (Eq. 18: order, coefficients ± 1σ, residual, R², calibrated range, the
+largest Table 2 error, the prior's temperature uncertainty), the drift model (Eq. 22:
+candidates, terms, intercept and coefficients ± 1σ with p-values, residual, R², windows,
+samples), its stepwise steps (F and p of each), the housing baseline and each held-out run
+(:func:`hrgtc.evaluation.run_figures.run_figures`): the one structure the plain text, the
+CLI's rich tables (``hrgtc calibrate``), the HTML report and the JSON render. The equations
+and what a figure cannot say (autocorrelation correction, cross-validation) are its notes.
+See docs/architecture.md ("One result contract").
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from hrgtc.core.summary import Figure, Summary
+from hrgtc.drift.drift_text import drift_notes
+
+__all__ = ["calibration_summary", "instrument_summary", "thermometer_equation"]
+
+
+def calibration_summary(model: Any, table: Sequence[Mapping[str, float]] = (),
+                        validation: Sequence[Any] = (), prior_fit: Any = None,
+                        warnings: bool = True) -> Summary:
+    """The figures of a calibration: a :class:`~hrgtc.model.UnitModel`, its Table 2 rows
+    (``error_c``), the held-out :class:`~hrgtc.evaluation.Evaluation` s and the prior's fit
+    (what :meth:`hrgtc.pipeline.calibration.CalibrationResult.summary` holds; the report
+    passes a model file's). ``warnings``: the held-out runs' range warnings among the notes
+    (the CLI prints them apart).
+    """
+    th = model.thermometer
+    sensor = th.source == "sensor"
+    sections = [("thermometer (Eq. 18)",
+                 _thermometer_figures(th, table, prior_fit)),
+                ("drift model (Eq. 22)", _drift_figures("drift", model.drift)),
+                ("stepwise steps", _step_figures("drift", model.drift))]
+    notes: list[str] = []
+    if sensor:
+        notes.append("thermometer: the gyro's temperature sensor (no frequency output); "
+                     "drift terms in T and dT/dt")
+    else:
+        notes.append(thermometer_equation(th))
+    if model.drift.accounting is not None:
+        notes.append("drift training " + model.drift.accounting.summary())
+    notes += [*drift_notes(model.drift), "Eq. (22) form: " + model.drift.equation(sensor)]
+    if model.housing is not None:
+        sections.append(("housing-thermistor baseline",
+                         _drift_figures("housing", model.housing)))
+        notes.append("housing-thermistor baseline: " + model.housing.equation())
+    for k, run in enumerate(validation):
+        figures = run.figures(f"validation[{k}]", sensor=sensor, warnings=warnings)
+        sections += [(f"held-out run {run.file}: {heading}", part)
+                     for heading, part in figures.sections]
+        notes.extend(figures.notes)
+    return Summary(f"calibration of {model.unit}", tuple(sections), tuple(notes))
+
+
+def thermometer_equation(thermometer: Any) -> str:
+    """The thermometer in Eq. (18) form with numbers (``f = 1.5e-05·T³ ...  [Hz, T in °C]``)."""
+    if thermometer.order == 3:
+        c3, c2, c1, c0 = thermometer.coefficients_high_first
+        return (f"Eq. (18) form: f = {c3:.4e}·T³ {c2:+.4e}·T² {c1:+.6f}·T {c0:+.4f}  "
+                "[Hz, T in °C]")
+    return thermometer.summary().splitlines()[-1]
+
+
+def _thermometer_figures(thermometer: Any, table: Sequence[Mapping[str, float]],
+                         prior_fit: Any = None) -> tuple[Figure, ...]:
+    """Order, coefficients ± 1σ, residual, R², calibrated range, worst Table 2 error."""
+    sensor = thermometer.source == "sensor"
+    unit = "°C" if sensor else "Hz"
+    low, high = thermometer.temperature_range_c
+    figures = [Figure("thermometer.order", "order", thermometer.order),
+               Figure("thermometer.n_points", "soak plateaus", thermometer.n_points)]
+    for k, (c, se) in enumerate(zip(thermometer.coefficients, thermometer.standard_errors,
+                                    strict=True)):
+        figures.append(Figure.with_error(f"thermometer.coefficients[{k}]", f"c{k}", c, se,
+                                         unit if k == 0 else f"{unit}/°C^{k}"))
+        if k < len(thermometer.pvalues):
+            figures.append(Figure(f"thermometer.pvalues[{k}]", f"p of c{k}",
+                                  float(thermometer.pvalues[k]), digits=3))
+    figures += [Figure("thermometer.residual_std_hz", "residual std",
+                       thermometer.residual_std_hz, unit, digits=4),
+                Figure("thermometer.rsquared", "R²", thermometer.rsquared, digits=10),
+                Figure("thermometer.temperature_range_c", "calibrated temperatures",
+                       high - low, "°C", (low, high), "range", digits=4)]
+    errors = [abs(row["error_c"]) for row in table if math.isfinite(row.get("error_c", math.nan))]
+    if errors:
+        figures.append(Figure("thermometer.max_error_c", "largest Table 2 error", max(errors),
+                              "°C", digits=3))
+    if prior_fit is not None:
+        figures += [Figure("thermometer.prior.n_units", "units of the prior",
+                           prior_fit.prior.n_units),
+                    Figure("thermometer.prior.max_temperature_std_c",
+                           "largest temperature 1σ (prior fit)",
+                           prior_fit.max_temperature_std_c, "°C", digits=4)]
+    return tuple(figures)
+
+
+def _drift_figures(key: str, model: Any) -> tuple[Figure, ...]:
+    """Candidates, terms, intercept and coefficients ± 1σ with p-values, residual, R²,
+    windows, samples."""
+    figures = [Figure(f"{key}.candidates", "candidate terms", ", ".join(model.candidates)),
+               Figure(f"{key}.selected", "terms", ", ".join(model.selected) or "(none)"),
+               Figure.with_error(f"{key}.intercept_dph", "B0", model.intercept_dph,
+                                 model.standard_errors.get("const", math.nan), "°/h")]
+    for term in model.terms:
+        name = term.name
+        figures.append(Figure.with_error(
+            f"{key}.coefficients.{name}", f"k of {name}", model.coefficients[name],
+            model.standard_errors.get(name, math.nan), f"°/h per {term.unit}"))
+        figures.append(Figure(f"{key}.pvalues.{name}", f"p of {name}",
+                              model.pvalues.get(name, math.nan), digits=3))
+    figures += [Figure(f"{key}.residual_std_dph", "residual std (window means)",
+                       model.residual_std_dph, "°/h", digits=4),
+                Figure(f"{key}.rsquared", "R²", model.rsquared, digits=6),
+                Figure(f"{key}.n_windows", f"windows of {model.window_s:g} s", model.n_windows),
+                Figure(f"{key}.n_samples", "training samples", model.n_samples)]
+    return tuple(figures)
+
+
+def _step_figures(key: str, model: Any) -> tuple[Figure, ...]:
+    """F and p of each stepwise step (``history[k]`` of ``--json``)."""
+    figures = []
+    for n, step in enumerate(model.history):
+        what = f"{n + 1}. {step.action} {step.term}"
+        figures += [Figure(f"{key}.history[{n}].fstat", f"{what}: F", step.fstat, digits=5),
+                    Figure(f"{key}.history[{n}].pvalue", f"{what}: p", step.pvalue, digits=3)]
+    return tuple(figures)
+
+
+def instrument_summary(calibration: Any) -> Summary:
+    """What an :class:`~hrgtc.pipeline.instrument.InstrumentCalibration` shows beside its
+    axes' own summaries: each held-out rate table's scale-factor error at each temperature
+    raw and compensated (``scale_factor_checks[i]`` of ``--json``), each cross-axis trial
+    (``cross_axis.<axis>``) and, for several axes, each axis's held-out median 10 s bias
+    stability and scale-factor figures (``axes.<axis>``)."""
+    sections: list[tuple[str, tuple[Figure, ...]]] = []
+    notes: list[str] = []
+    for i, check in enumerate(calibration.scale_checks):
+        key = f"scale_factor_checks[{i}]"
+        figures = [Figure(f"{key}.n_temperatures", "temperatures", len(check.raw_ppm))]
+        for k, (freq, raw, comp) in enumerate(zip(check.freq_hz, check.raw_ppm,
+                                                  check.compensated_ppm, strict=True)):
+            figures += [Figure(f"{key}.raw_ppm[{k}]", f"at {freq:.8g} Hz: raw", raw, "ppm",
+                               digits=4),
+                        Figure(f"{key}.compensated_ppm[{k}]", f"at {freq:.8g} Hz: compensated",
+                               comp, "ppm", digits=4)]
+        figures += [Figure(f"{key}.raw_max_ppm", "largest |error|, raw", check.raw_max_ppm,
+                           "ppm", digits=4),
+                    Figure(f"{key}.compensated_max_ppm", "largest |error|, compensated",
+                           check.compensated_max_ppm, "ppm", digits=4)]
+        name = str(check.file).replace("\\", "/").rsplit("/", 1)[-1]
+        sections.append((f"held-out rate table {name}"
+                         + (f", axis {check.axis}" if check.axis else "")
+                         + ": scale-factor error", tuple(figures)))
+    for axis, trial in calibration.cross_axis.items():
+        if "why" in trial:
+            notes.append(f"axis {axis}: cross-axis terms not tried: {trial['why']}")
+            continue
+        key = f"cross_axis.{axis}"
+        sections.append((f"axis {axis}: cross-axis terms (the other resonators' frequencies)", (
+            Figure(f"{key}.channels", "channels", ", ".join(trial["channels"].values())),
+            Figure(f"{key}.held_out_10s_dph_with", "held-out 10 s bias stability, with",
+                   trial["held_out_10s_dph_with"], "°/h", digits=4),
+            Figure(f"{key}.held_out_10s_dph_without", "held-out 10 s bias stability, without",
+                   trial["held_out_10s_dph_without"], "°/h", digits=4),
+            Figure(f"{key}.kept", "kept", "kept" if trial["kept"] else "not kept"),
+            Figure(f"{key}.selected", "terms", ", ".join(trial["selected"]) or "(none)"))))
+    if not calibration.model.is_single_axis:
+        for axis, unit_model in calibration.model.axes.items():
+            sections.append((f"axis {axis}: summary (held-out median)",
+                             _axis_figures(calibration, axis, unit_model)))
+    return Summary(f"instrument {calibration.model.unit}", tuple(sections), tuple(notes))
+
+
+def _axis_figures(calibration: Any, axis: str, unit_model: Any) -> tuple[Figure, ...]:
+    key = f"axes.{axis or '-'}"
+    runs = calibration.validation.get(axis, ())
+    checks = [c for c in calibration.scale_checks if c.axis == axis]
+
+    def median(values: list[float]) -> float:
+        return float(np.median(values)) if values else math.nan
+
+    sf = unit_model.scale_factor
+    return (Figure(f"{key}.drift_terms", "drift terms", ", ".join(unit_model.drift.selected)
+                   or "(none)"),
+            Figure(f"{key}.raw_10s_dph", "raw 10 s", median([v.raw_10s for v in runs]), "°/h",
+                   digits=4),
+            Figure(f"{key}.compensated_10s_dph", "compensated 10 s",
+                   median([v.compensated_10s for v in runs]), "°/h", digits=4),
+            Figure(f"{key}.scale_terms", "scale-factor terms",
+                   "-" if sf is None else ", ".join(sf.selected) or "(none)"),
+            Figure(f"{key}.scale_raw_max_ppm", "scale-factor error raw, largest",
+                   max((c.raw_max_ppm for c in checks), default=math.nan), "ppm", digits=4),
+            Figure(f"{key}.scale_residual_max_ppm", "scale-factor error compensated, largest",
+                   max((c.compensated_max_ppm for c in checks), default=math.nan), "ppm",
+                   digits=4))
