@@ -466,3 +466,30 @@ def test_the_seen_f_and_df_extremes_are_those_of_the_variables(unit_model, run, 
     compensator.transform(run.slice(12_345, len(run)))
     expected = [values["f"].min(), values["f"].max(), values["df"].min(), values["df"].max()]
     np.testing.assert_allclose(compensator._extremes, expected, rtol=1e-12, atol=1e-15)
+
+
+@pytest.mark.parametrize("suffix", ["parquet", "csv", "h5"])
+def test_the_output_carries_the_restarts_of_every_chunk(unit_model, run, tmp_path, suffix):
+    """A clock reset to about zero (a logger restart) in the third chunk: the compensated
+    file lists it in its metadata (written at close), so that a reading of the output knows
+    its runs -- its time axis is the repaired one, where the reset no longer shows."""
+    time = run.time_s.copy()
+    reset = 25_000
+    time[reset:] = time[reset:] - time[reset] + 0.35  # the clock restarts at 0.35 s
+    source = recording_io.write(run.with_columns(time_s=time), tmp_path / "reset.parquet")
+    restarts = recording_io.read(source, gaps="bridge").metadata.extra["restarts_s"]
+    assert len(restarts) == 1
+    out = tmp_path / f"out.{suffix}"
+    compensate_file(source, out, unit_model, chunk_rows=10_000,
+                    read_options=recording_io.ReadOptions(gaps="bridge"))
+    written = recording_io.read(out, gaps="bridge")
+    assert written.metadata.extra["restarts_s"] == pytest.approx(restarts, rel=0, abs=1e-9)
+    # a reading of the output (chunk by chunk, as evaluate and calibrate read) finds the
+    # restart at the reset's row: a new run starts there
+    from hrgtc.core.timeline import RESTARTS_KEY, restart_rows
+
+    rows, offset = [], 0
+    for chunk in recording_io.ReadOptions(gaps="bridge").chunks(out, rows=7_000):
+        rows.extend(offset + restart_rows(chunk.time_s, chunk.metadata.extra[RESTARTS_KEY]))
+        offset += len(chunk)
+    assert rows == [reset]

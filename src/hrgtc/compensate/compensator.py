@@ -488,7 +488,9 @@ def compensate_file(
             ahead = reading.submit(next, chunks, None)
             pending = None
             chunk: Recording | None = first
+            restarts: set[float] = set()  # every chunk's restarts, written at close
             while chunk is not None:
+                restarts.update(chunk.metadata.extra.get(RESTARTS_KEY) or ())
                 result = compensator.transform(chunk)
                 if SPIKE_COLUMN in chunk:
                     spikes += int(np.count_nonzero(chunk[SPIKE_COLUMN]))
@@ -505,6 +507,9 @@ def compensate_file(
                     ahead = reading.submit(next, chunks, None)
             if pending is not None:
                 pending.result()
+            if restarts:
+                writer.set_metadata(dataclasses.replace(metadata, extra={
+                    **metadata.extra, RESTARTS_KEY: sorted(restarts)}))
     finally:
         chunks.close()
     accounting = compensation_accounting(compensator, spikes, repair.duplicates)
@@ -542,7 +547,7 @@ def compensated_metadata(metadata: rec_io.Metadata, model: UnitModel,
     """``metadata`` with the mark of compensation by ``model`` (:mod:`hrgtc.recording.marks`)."""
     extra = {**metadata.extra, COMPENSATED_KEY: mark(model.sha256, model.unit, drift)}
     # the restarts known when the output is opened are those of the first chunk only: none
-    # are written rather than some (its time axis is the repaired one)
+    # are written then, and all at close (compensate_file; its time axis is the repaired one)
     extra.pop(RESTARTS_KEY, None)
     return dataclasses.replace(metadata, extra=extra)
 
