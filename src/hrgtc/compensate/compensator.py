@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from hrgtc import recording as rec_io
+from hrgtc.compensate.at_rest import RestFlags
 from hrgtc.compensate.model_fit import (
     check_recording_noise,
     with_model_band,
@@ -477,6 +478,11 @@ def compensate_file(
     spikes = 0
     try:
         first = next(chunks)
+        flags = None  # samples not at rest: flagged, found in one pass first (at_rest.py)
+        if options.motion != "keep":
+            flags = RestFlags(options.chunks(source), list(getattr(model, "axes", None) or [""]),
+                              options.motion, os.path.basename(os.fspath(source)))
+            added = (*added, *flags.columns)
         copies = sensor_copies((*first.names, *added), first.metadata)
         names = tuple(n for n in (*first.names, *added) if n not in copies)
         check_recording_noise(model, first, str(source))
@@ -492,6 +498,8 @@ def compensate_file(
             while chunk is not None:
                 restarts.update(chunk.metadata.extra.get(RESTARTS_KEY) or ())
                 result = compensator.transform(chunk)
+                if flags is not None:
+                    result = result.with_columns(**flags.take(len(chunk)))
                 if SPIKE_COLUMN in chunk:
                     spikes += int(np.count_nonzero(chunk[SPIKE_COLUMN]))
                 if copies:
@@ -512,7 +520,8 @@ def compensate_file(
                     **metadata.extra, RESTARTS_KEY: sorted(restarts)}))
     finally:
         chunks.close()
-    accounting = compensation_accounting(compensator, spikes, repair.duplicates)
+    accounting = compensation_accounting(compensator, spikes, repair.duplicates,
+                                         0 if flags is None else flags.n_not_at_rest)
     return CompensationSummary(str(source), str(output), compensator.samples,
                                compensator.out_of_range_fraction,
                                compensator.rate_out_of_range_fraction, compensator.ranges(),
@@ -520,7 +529,7 @@ def compensate_file(
 
 
 def compensation_accounting(compensator: Any, spikes: int = 0,
-                            duplicates: int = 0) -> Accounting:
+                            duplicates: int = 0, not_at_rest: int = 0) -> Accounting:
     """Samples read, dropped (duplicated rows, by the reader) and flagged by reason.
 
     ``compensate`` never drops a sample it read: spikes (the ``spike`` column), samples
@@ -536,6 +545,7 @@ def compensation_accounting(compensator: Any, spikes: int = 0,
     accounting.drop("duplicates", duplicates)
     accounting.flag("warmup", compensator.settling)
     accounting.flag("spikes", spikes)
+    accounting.flag("motion", not_at_rest)
     accounting.flag("out_of_range", compensator.temperature_out)
     accounting.flag("rate_out_of_range",
                     compensator.variable_ranges.get("df", [compensator.rate_out_of_range])[0])
