@@ -534,8 +534,9 @@ def compensation_accounting(compensator: Any, spikes: int = 0,
 
     ``compensate`` never drops a sample it read: spikes (the ``spike`` column), samples
     beyond the trained temperature (``out_of_range``) or df/dt (``rate_out_of_range``)
-    and those of the df/dt filter's settling (``warmup``) are flagged (``in_range`` 0).
-    With several axes, the axis with the most samples beyond its ranges (the one the
+    and those of the df/dt filter's settling (``warmup``) are flagged (``in_range`` 0), and
+    ``not_at_rest`` samples (on any axis; the ``at_rest`` columns) as ``motion``. With
+    several axes, the axis with the most samples beyond its ranges (the one the
     summary line names).
     """
     axes = getattr(compensator, "axes", None)
