@@ -153,3 +153,14 @@ def test_no_block_is_said_once_with_the_reason(model):
     text = found.summary()
     assert text.count("\n") == 0 and "no 10 s block (bursts of at most 3 s" in text
     assert found.to_dict()["reason"] == found.reason
+
+
+def test_a_run_shorter_than_half_a_block_after_the_settling_says_so(model):
+    run = cycle_run(seed=7).slice(0, round((model.drift.settings.warmup_s + 3.0) * FS))
+    split = DirectionSplit(model, FS)
+    split.partial_fit(run, run.rate_dph, run.rate_dph)
+    assert split.result().reason == (
+        "the settled run (3 s) is shorter than half the 10 s block (4.8 s)")
+    early = DirectionSplit(model, FS)
+    early.partial_fit(run.slice(0, 10), run.rate_dph[:10], run.rate_dph[:10])
+    assert "past the df/dt filter's" in early.result().reason

@@ -259,9 +259,9 @@ class DirectionSplit:
                     "time")
         if not means.shape[0]:
             longest = self.longest_segment_rows * self._period_s
-            what = "bursts" if self.segments > 1 else "the settled run"
-            return (f"{what} of at most {longest:.3g} s are shorter than half the "
-                    f"{self.block_s:g} s block ({half:.3g} s)")
+            what = (f"bursts of at most {longest:.3g} s are" if self.segments > 1
+                    else f"the settled run ({longest:.3g} s) is")
+            return f"{what} shorter than half the {self.block_s:g} s block ({half:.3g} s)"
         return (f"the temperature rate of all {means.shape[0]} blocks is within the dead band "
                 f"({RATE_DEADBAND:.0%} of its largest magnitude): neither heating nor cooling")
 
