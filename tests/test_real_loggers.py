@@ -298,6 +298,33 @@ def test_orientation_offsets_do_not_bias_the_temperature_coefficient(handled):
         assert float(np.sqrt(np.mean(error**2))) <= 0.03 * float(np.ptp(thermal)) + slow_noise, a
 
 
+def test_compensate_flags_the_handling_as_the_detector_of_calibrate_finds_it(handled):
+    """``compensate`` never drops a sample but flags those not at rest: ``at_rest_<axis>``
+    of the output equals :func:`hrgtc.drift.rest.run_rest`'s mask of each axis on the same
+    rows (read back from the output, which carries the source's columns), every handled
+    sample of the truth is 0 on some axis, and the accounting counts them as flagged."""
+    from hrgtc.drift.rest import run_rest
+    from hrgtc.recording import ReadOptions, axis_view
+
+    run = handled["run"]
+    _handled_model(handled, "handled")
+    out = handled["dir"] / "handled_flags.parquet"
+    _, report = _bias_model(handled["path"], handled["options"], handled["dir"] / "handled.json",
+                            out)
+    table = pq.read_table(out)
+    assert table.num_rows == run.truth["time_s"].size  # nothing dropped
+    still_any = np.ones(table.num_rows, dtype=bool)
+    reading = ReadOptions(gaps="bridge", thermometer="sensor")
+    for a in AXES:
+        flags = table[f"at_rest_{a}"].to_numpy()
+        views = (axis_view(chunk, a) for chunk in reading.chunks(out))
+        expected = run_rest(views, "exclude").keep
+        np.testing.assert_array_equal(flags, expected.astype(float), err_msg=a)
+        still_any &= expected
+    assert not still_any[run.truth["motion"]].any()
+    assert report["accounting"]["flagged"]["motion"] == int(np.count_nonzero(~still_any))
+
+
 
 
 def _drift_terms(model: dict) -> dict:

@@ -314,9 +314,10 @@ def test_file_to_file_equals_batch_and_leaves_no_temporary(unit_model, run, tmp_
     summary = compensate_file(source, output, unit_model, chunk_rows=7_001)
     batch = compensate(run, unit_model)
     written = recording_io.read(output)
-    assert written.names == (*run.names, *OUTPUT_COLUMNS)
-    for name in written.names:
+    assert written.names == (*run.names, *OUTPUT_COLUMNS, "at_rest")  # at rest: all 1
+    for name in batch.names:
         np.testing.assert_array_equal(written[name], batch[name])
+    assert np.all(written["at_rest"] == 1.0)
     compensator = Compensator(unit_model)
     compensator.transform(run)
     assert (summary.rows, summary.out_of_range_fraction, summary.rate_out_of_range_fraction) == (
@@ -326,7 +327,8 @@ def test_file_to_file_equals_batch_and_leaves_no_temporary(unit_model, run, tmp_
 
 def test_file_to_file_bad_row_late_in_the_file_leaves_nothing(unit_model, tmp_path):
     # past the validator's first 100 000 rows: rejected by the read-ahead thread while
-    # earlier chunks are already compensated and written
+    # earlier chunks are already compensated and written (--motion keep: no detector's
+    # pass, which would meet the row first)
     long_run = ramp_run(seed=26, hours=5.0)
     rate = long_run.rate_dph.copy()
     rate[150_000] = np.nan
@@ -334,7 +336,8 @@ def test_file_to_file_bad_row_late_in_the_file_leaves_nothing(unit_model, tmp_pa
     written = []
     with pytest.raises(RecordingError, match="rate_dph"):
         compensate_file(source, tmp_path / "out.parquet", unit_model, chunk_rows=20_000,
-                        progress=lambda done, total: written.append(done))
+                        progress=lambda done, total: written.append(done),
+                        read_options=recording_io.ReadOptions(motion="keep"))
     assert written and max(written) >= 120_000
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.parquet"]
 
@@ -466,3 +469,58 @@ def test_the_seen_f_and_df_extremes_are_those_of_the_variables(unit_model, run, 
     compensator.transform(run.slice(12_345, len(run)))
     expected = [values["f"].min(), values["f"].max(), values["df"].min(), values["df"].max()]
     np.testing.assert_allclose(compensator._extremes, expected, rtol=1e-12, atol=1e-15)
+
+
+@pytest.mark.parametrize("suffix", ["parquet", "csv", "h5"])
+def test_the_output_carries_the_restarts_of_every_chunk(unit_model, run, tmp_path, suffix):
+    """A clock reset to about zero (a logger restart) in the third chunk: the compensated
+    file lists it in its metadata (written at close), so that a reading of the output knows
+    its runs -- its time axis is the repaired one, where the reset no longer shows."""
+    time = run.time_s.copy()
+    reset = 25_000
+    time[reset:] = time[reset:] - time[reset] + 0.35  # the clock restarts at 0.35 s
+    source = recording_io.write(run.with_columns(time_s=time), tmp_path / "reset.parquet")
+    restarts = recording_io.read(source, gaps="bridge").metadata.extra["restarts_s"]
+    assert len(restarts) == 1
+    out = tmp_path / f"out.{suffix}"
+    compensate_file(source, out, unit_model, chunk_rows=10_000,
+                    read_options=recording_io.ReadOptions(gaps="bridge"))
+    written = recording_io.read(out, gaps="bridge")
+    assert written.metadata.extra["restarts_s"] == pytest.approx(restarts, rel=0, abs=1e-9)
+    # a reading of the output (chunk by chunk, as evaluate and calibrate read) finds the
+    # restart at the reset's row: a new run starts there
+    from hrgtc.core.timeline import RESTARTS_KEY, restart_rows
+
+    rows, offset = [], 0
+    for chunk in recording_io.ReadOptions(gaps="bridge").chunks(out, rows=7_000):
+        rows.extend(offset + restart_rows(chunk.time_s, chunk.metadata.extra[RESTARTS_KEY]))
+        offset += len(chunk)
+    assert rows == [reset]
+
+
+def test_samples_not_at_rest_are_flagged_as_run_rest_finds_them(unit_model, run, tmp_path):
+    """Three handling bursts (5 s at up to 40,000 °/h) in a run: ``compensate`` drops none,
+    writes ``at_rest`` 0 exactly where the detector of calibration and evaluation
+    (:func:`hrgtc.drift.rest.run_rest`) marks the file, and counts them as flagged."""
+    from hrgtc.drift.rest import run_rest
+
+    rate = run.rate_dph.copy()
+    t = run.time_s - run.time_s[0]
+    truth = np.zeros(t.size, dtype=bool)
+    for start_s in (900.0, 1800.0, 2700.0):
+        inside = (t >= start_s) & (t < start_s + 5.0)
+        rate[inside] += 40_000.0 * np.sin(np.pi * (t[inside] - start_s) / 5.0)
+        truth |= inside
+    source = recording_io.write(run.with_columns(rate_dph=rate), tmp_path / "handled.parquet")
+    summary = compensate_file(source, tmp_path / "out.parquet", unit_model, chunk_rows=7_000)
+    out = recording_io.read(tmp_path / "out.parquet")
+    expected = run_rest(recording_io.ReadOptions().chunks(source), "exclude").keep
+    assert len(out) == len(run)  # nothing dropped
+    np.testing.assert_array_equal(out["at_rest"], expected.astype(float))
+    assert not expected[truth].any()  # every handled sample is flagged
+    assert np.count_nonzero(~expected) < 3 * truth.sum() + 3 * 2 * 300  # bursts and guards
+    assert summary.accounting.flagged["motion"] == int(np.count_nonzero(~expected))
+    keep = compensate_file(source, tmp_path / "keep.parquet", unit_model,
+                           read_options=recording_io.ReadOptions(motion="keep"))
+    assert "at_rest" not in recording_io.read(tmp_path / "keep.parquet")
+    assert keep.accounting.flagged.get("motion", 0) == 0

@@ -7,7 +7,7 @@ import pytest
 from scipy import signal
 
 from hrgtc import drift
-from hrgtc.drift.features import causal_rate
+from hrgtc.drift.features import FeatureStream, causal_rate
 from hrgtc.evaluation import evaluate
 from hrgtc.evaluation.heating_cooling import DirectionSplit
 from hrgtc.model import UnitModel
@@ -89,3 +89,78 @@ def test_chunking_does_not_change_the_split(model):
     for d in ("heating", "cooling"):
         assert a.compensated_dph[d] == pytest.approx(b.compensated_dph[d], rel=1e-12)
         assert a.raw_dph[d] > a.compensated_dph[d]  # the model removes the thermal drift
+
+
+def burst_run(run, burst_s, period_s=60.0):
+    """The rows of ``run`` in bursts of ``burst_s`` every ``period_s`` (a duty-cycled logger)."""
+    keep = np.mod(run.time_s - run.time_s[0], period_s) < burst_s - 1e-9
+    return Recording({k: run[k][keep] for k in run.columns}, run.metadata, source="bursts")
+
+
+@pytest.mark.parametrize("burst_s", [5.0, 15.0])
+def test_blocks_never_span_a_gap_and_match_the_burst_means_by_hand(model, burst_s):
+    """5 s bursts every 60 s: one block mean per burst (the partial block kept from half a
+    block less one sample); 15 s bursts: a full 10 s block and a 5 s partial one per burst.
+    Before the blocks were on the time axis, a "10 s block" joined two bursts 60 s apart."""
+    run = burst_run(cycle_run(seed=5), burst_s)
+    comp = run.rate_dph - model.drift.predict_recording(run)
+    split = DirectionSplit(model, FS)
+    for start in range(0, len(run), 1234):  # chunks that cut bursts too
+        stop = min(start + 1234, len(run))
+        split.partial_fit(run.slice(start, stop), run.rate_dph[start:stop], comp[start:stop])
+    found = split.result()
+    # by hand: df/dt from the model's causal filter over the whole file (true Δt across the
+    # gaps), the settling in seconds, then each burst cut into 50-row blocks and a tail
+    df = FeatureStream(model.drift.settings, ("df",)).transform(run)["df"]
+    settled = run.time_s - run.time_s[0] >= model.drift.settings.warmup_s
+    burst = np.floor((run.time_s - run.time_s[0]) / 60.0).astype(int)
+    rows = round(10.0 * FS)
+    df_means, raw_means, comp_means, partial = [], [], [], 0
+    for b in np.unique(burst[settled]):
+        idx = np.flatnonzero(settled & (burst == b))
+        for k in range(0, idx.size, rows):
+            part = idx[k:k + rows]
+            if part.size < rows:
+                if part.size < 24:  # half of 50 rows less one
+                    continue
+                partial += 1
+            df_means.append(df[part].mean())
+            raw_means.append(run.rate_dph[part].mean())
+            comp_means.append(comp[part].mean())
+    df_means, raw_means, comp_means = map(np.array, (df_means, raw_means, comp_means))
+    assert partial == np.unique(burst[settled]).size  # every burst ends in a partial block
+    band = 0.05 * np.max(np.abs(df_means))
+    heating, cooling = df_means > band, df_means < -band
+    assert found.blocks == {"heating": int(heating.sum()), "cooling": int(cooling.sum())}
+    assert found.partial_blocks == partial and found.reason is None
+    for name, mask in (("heating", heating), ("cooling", cooling)):
+        assert found.raw_dph[name] == pytest.approx(np.std(raw_means[mask], ddof=1), rel=1e-9)
+        assert found.compensated_dph[name] == pytest.approx(
+            np.std(comp_means[mask], ddof=1), rel=1e-9)
+    assert f"{partial} blocks cut short by a gap" in found.summary()
+
+
+def test_no_block_is_said_once_with_the_reason(model):
+    """3 s bursts (15 rows) are shorter than half a 10 s block: one line that says so, not an
+    empty line per direction."""
+    run = burst_run(cycle_run(seed=6), 3.0)
+    comp = run.rate_dph - model.drift.predict_recording(run)
+    split = DirectionSplit(model, FS)
+    split.partial_fit(run, run.rate_dph, comp)
+    found = split.result()
+    assert found.blocks == {"heating": 0, "cooling": 0}
+    assert found.reason == "bursts of at most 3 s are shorter than half the 10 s block (4.8 s)"
+    text = found.summary()
+    assert text.count("\n") == 0 and "no 10 s block (bursts of at most 3 s" in text
+    assert found.to_dict()["reason"] == found.reason
+
+
+def test_a_run_shorter_than_half_a_block_after_the_settling_says_so(model):
+    run = cycle_run(seed=7).slice(0, round((model.drift.settings.warmup_s + 3.0) * FS))
+    split = DirectionSplit(model, FS)
+    split.partial_fit(run, run.rate_dph, run.rate_dph)
+    assert split.result().reason == (
+        "the settled run (3 s) is shorter than half the 10 s block (4.8 s)")
+    early = DirectionSplit(model, FS)
+    early.partial_fit(run.slice(0, 10), run.rate_dph[:10], run.rate_dph[:10])
+    assert "past the df/dt filter's" in early.result().reason

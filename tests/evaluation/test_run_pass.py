@@ -170,7 +170,7 @@ def test_intervals_deviation_kinds_and_allan_csv(setup, tmp_path):
     assert low < data["bias_stability_dph"]["raw"]["10"] < high
     assert data["prediction_std_dph"]["max"] >= data["prediction_std_dph"]["median"] > 0.0
     rows = csv_path.read_text().splitlines()
-    assert rows[0] == "series,tau_s,deviation,lower,upper,n"
+    assert rows[0] == "series,tau_s,deviation,lower,upper,n,edf"
     raw_rows = [r.split(",") for r in rows[1:] if r.startswith("raw,")]
     assert [float(r[2]) for r in raw_rows] == pytest.approx(
         list(np.asarray(data["allan_curve"]["raw"]["deviation"], dtype=float)))
@@ -186,3 +186,37 @@ def test_intervals_deviation_kinds_and_allan_csv(setup, tmp_path):
     bad = CliRunner().invoke(app, ["evaluate", str(files.warmup), "--model", str(model_path),
                                    "--deviation", "xdev"])
     assert bad.exit_code == 2
+
+
+def test_allan_csv_carries_the_pooled_edf_behind_its_intervals(setup):
+    """``--allan-csv`` has an ``edf`` column: on bursts (segments of 400 samples every 1000)
+    the pooled edf of the segments (Satterthwaite over SP 1065 Table 5), and the interval of
+    each row is the chi-squared interval of that many degrees of freedom."""
+    from scipy.stats import chi2
+
+    from hrgtc.evaluation.allan_segments import pooled_edf
+    from hrgtc.evaluation.metrics import ONE_SIGMA
+    from hrgtc.recording import Recording
+
+    files, model, _ = setup
+    run = recording.read(files.warmup)
+    keep = np.arange(len(run)) % 1000 < 400
+    bursts = Recording({k: run[k][keep] for k in run.columns}, run.metadata, source="bursts")
+    result = evaluate(bursts, model, max_points=500)
+    header, *rows = result.allan_csv().splitlines()
+    assert header == "series,tau_s,deviation,lower,upper,n,edf"
+    table = [r.split(",") for r in rows if r.startswith("compensated,")]
+    curve = result.allan["compensated"]
+    assert curve.segments > 1 and len(table) == curve.taus_s.size
+    # the segments as the evaluation feeds them: bursts less the df/dt filter's settling
+    fs = run.metadata.sample_rate_hz
+    settled = bursts.time_s - bursts.time_s[0] >= model.drift.settings.warmup_s
+    burst = np.flatnonzero(keep) // 1000
+    lengths = [int(np.count_nonzero(settled & (burst == b))) for b in np.unique(burst)]
+    lengths = [n for n in lengths if n]
+    alpha = 1.0 - ONE_SIGMA
+    for row, tau in zip(table, curve.taus_s, strict=True):
+        dev, low, high, edf = float(row[2]), float(row[3]), float(row[4]), float(row[6])
+        assert edf == pytest.approx(pooled_edf("allan", lengths, round(tau * fs)), rel=1e-12)
+        assert low == pytest.approx(dev * math.sqrt(edf / chi2.ppf(1 - alpha / 2, edf)), rel=1e-9)
+        assert high == pytest.approx(dev * math.sqrt(edf / chi2.ppf(alpha / 2, edf)), rel=1e-9)

@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from hrgtc import recording as rec_io
+from hrgtc.compensate.at_rest import RestFlags
 from hrgtc.compensate.model_fit import (
     check_recording_noise,
     with_model_band,
@@ -477,6 +478,11 @@ def compensate_file(
     spikes = 0
     try:
         first = next(chunks)
+        flags = None  # samples not at rest: flagged, found in one pass first (at_rest.py)
+        if options.motion != "keep":
+            flags = RestFlags(options.chunks(source), list(getattr(model, "axes", None) or [""]),
+                              options.motion, os.path.basename(os.fspath(source)))
+            added = (*added, *flags.columns)
         copies = sensor_copies((*first.names, *added), first.metadata)
         names = tuple(n for n in (*first.names, *added) if n not in copies)
         check_recording_noise(model, first, str(source))
@@ -488,8 +494,12 @@ def compensate_file(
             ahead = reading.submit(next, chunks, None)
             pending = None
             chunk: Recording | None = first
+            restarts: set[float] = set()  # every chunk's restarts, written at close
             while chunk is not None:
+                restarts.update(chunk.metadata.extra.get(RESTARTS_KEY) or ())
                 result = compensator.transform(chunk)
+                if flags is not None:
+                    result = result.with_columns(**flags.take(len(chunk)))
                 if SPIKE_COLUMN in chunk:
                     spikes += int(np.count_nonzero(chunk[SPIKE_COLUMN]))
                 if copies:
@@ -505,9 +515,13 @@ def compensate_file(
                     ahead = reading.submit(next, chunks, None)
             if pending is not None:
                 pending.result()
+            if restarts:
+                writer.set_metadata(dataclasses.replace(metadata, extra={
+                    **metadata.extra, RESTARTS_KEY: sorted(restarts)}))
     finally:
         chunks.close()
-    accounting = compensation_accounting(compensator, spikes, repair.duplicates)
+    accounting = compensation_accounting(compensator, spikes, repair.duplicates,
+                                         0 if flags is None else flags.n_not_at_rest)
     return CompensationSummary(str(source), str(output), compensator.samples,
                                compensator.out_of_range_fraction,
                                compensator.rate_out_of_range_fraction, compensator.ranges(),
@@ -515,13 +529,14 @@ def compensate_file(
 
 
 def compensation_accounting(compensator: Any, spikes: int = 0,
-                            duplicates: int = 0) -> Accounting:
+                            duplicates: int = 0, not_at_rest: int = 0) -> Accounting:
     """Samples read, dropped (duplicated rows, by the reader) and flagged by reason.
 
     ``compensate`` never drops a sample it read: spikes (the ``spike`` column), samples
     beyond the trained temperature (``out_of_range``) or df/dt (``rate_out_of_range``)
-    and those of the df/dt filter's settling (``warmup``) are flagged (``in_range`` 0).
-    With several axes, the axis with the most samples beyond its ranges (the one the
+    and those of the df/dt filter's settling (``warmup``) are flagged (``in_range`` 0), and
+    ``not_at_rest`` samples (on any axis; the ``at_rest`` columns) as ``motion``. With
+    several axes, the axis with the most samples beyond its ranges (the one the
     summary line names).
     """
     axes = getattr(compensator, "axes", None)
@@ -531,6 +546,7 @@ def compensation_accounting(compensator: Any, spikes: int = 0,
     accounting.drop("duplicates", duplicates)
     accounting.flag("warmup", compensator.settling)
     accounting.flag("spikes", spikes)
+    accounting.flag("motion", not_at_rest)
     accounting.flag("out_of_range", compensator.temperature_out)
     accounting.flag("rate_out_of_range",
                     compensator.variable_ranges.get("df", [compensator.rate_out_of_range])[0])
@@ -542,7 +558,7 @@ def compensated_metadata(metadata: rec_io.Metadata, model: UnitModel,
     """``metadata`` with the mark of compensation by ``model`` (:mod:`hrgtc.recording.marks`)."""
     extra = {**metadata.extra, COMPENSATED_KEY: mark(model.sha256, model.unit, drift)}
     # the restarts known when the output is opened are those of the first chunk only: none
-    # are written rather than some (its time axis is the repaired one)
+    # are written then, and all at close (compensate_file; its time axis is the repaired one)
     extra.pop(RESTARTS_KEY, None)
     return dataclasses.replace(metadata, extra=extra)
 

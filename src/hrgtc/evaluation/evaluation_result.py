@@ -228,17 +228,21 @@ class Evaluation:
         }
 
     def allan_csv(self) -> str:
-        """The deviation curves as CSV text: series, tau_s, deviation, lower, upper, n.
+        """The deviation curves as CSV text: series, tau_s, deviation, lower, upper, n, edf.
 
-        ``lower`` / ``upper`` are empty where the curve has no interval (mdev, hdev, tdev).
+        ``lower`` / ``upper`` are empty where the curve has no interval (mdev, hdev, tdev);
+        ``edf`` is the equivalent degrees of freedom of the interval (pooled over the
+        segments of a recording with gaps, :func:`hrgtc.evaluation.allan_segments.pooled_edf`),
+        empty where there is none.
         """
-        lines = ["series,tau_s,deviation,lower,upper,n"]
+        lines = ["series,tau_s,deviation,lower,upper,n,edf"]
         for key, curve in self.allan.items():
             for k, tau in enumerate(curve.taus_s):
                 bounds = ("", "") if curve.lower is None or curve.upper is None else (
                     repr(float(curve.lower[k])), repr(float(curve.upper[k])))
+                edf = "" if curve.edf is None else repr(float(curve.edf[k]))
                 lines.append(f"{key},{float(tau)!r},{float(curve.deviation[k])!r},"
-                             f"{bounds[0]},{bounds[1]},{int(curve.counts[k])}")
+                             f"{bounds[0]},{bounds[1]},{int(curve.counts[k])},{edf}")
         return "\n".join(lines) + "\n"
 
     def range_warnings(self) -> list[str]:

@@ -6,7 +6,14 @@ cool-down may hold on cooling and fall short on heating. :class:`DirectionSplit`
 takes a run chunk by chunk, as :func:`~hrgtc.evaluation.run_pass.run_pass` does,
 keeps the means of its 10 s blocks (raw and compensated output, model minus true
 bias where the run is simulated, and df/dt from the model's causal filter) and at
-the end splits the blocks by the sign of the resonator temperature's rate:
+the end splits the blocks by the sign of the resonator temperature's rate.
+
+The blocks lie on the time axis (:mod:`hrgtc.core.timeline`), as the bias stability's:
+a block never spans a gap or a logger restart, and the partial block a gap cuts short
+is kept from half a block less one sample (:func:`~hrgtc.core.timeline.min_partial_rows`),
+so a burst logger (5 s bursts every 300 s) gives one block mean per burst instead of
+blocks that join two bursts 300 s apart. When no block is possible the result says why
+once (:attr:`DirectionStats.reason`). The split:
 
 * heating where df/dt · sign(df/dT) > 0, cooling where < 0, with the same dead band
   (5 % of the run's largest |df/dt|, :data:`hrgtc.drift.cross_validation.RATE_DEADBAND`)
@@ -29,8 +36,14 @@ from typing import Any
 
 import numpy as np
 
-from hrgtc.core.timeline import RESTARTS_KEY, restart_rows, settle_threshold_s
-from hrgtc.drift.cross_validation import heating_mask
+from hrgtc.core.timeline import (
+    RESTARTS_KEY,
+    is_gap,
+    min_partial_rows,
+    restart_rows,
+    settle_threshold_s,
+)
+from hrgtc.drift.cross_validation import RATE_DEADBAND, heating_mask
 from hrgtc.drift.features import FeatureStream
 from hrgtc.model import UnitModel
 
@@ -55,6 +68,10 @@ class DirectionStats:
     residual_rms_dph
         Direction -> RMS of the block means of model minus true bias (None on a
         recorded run without ``bias_dph``). [°/h]
+    partial_blocks
+        Blocks (of either direction or neither) closed short at a gap and kept.
+    reason
+        Why neither direction has a block (None when one has).
     """
 
     block_s: float
@@ -62,6 +79,8 @@ class DirectionStats:
     raw_dph: dict[str, float]
     compensated_dph: dict[str, float]
     residual_rms_dph: dict[str, float] | None = None
+    partial_blocks: int = 0
+    reason: str | None = None
 
     def improvement(self, direction: str) -> float:
         """raw / compensated bias stability of one direction (NaN when either is missing)."""
@@ -78,14 +97,21 @@ class DirectionStats:
                     "improvement": clean(self.improvement(d)),
                     "residual_rms_dph": None if self.residual_rms_dph is None
                     else clean(self.residual_rms_dph[d])}
-                for d in DIRECTIONS} | {"block_s": self.block_s}
+                for d in DIRECTIONS} | {"block_s": self.block_s,
+                                        "partial_blocks": self.partial_blocks,
+                                        "reason": self.reason}
 
     def summary(self, sensor: bool = False) -> str:
         """One line per direction (``sensor``: the thermometer is a temperature sensor)."""
+        what = "temperature" if sensor else "resonator temperature"
+        title = f"heating and cooling apart (sign of the {what} rate)"
+        if self.reason is not None:
+            return f"{title}: no {self.block_s:g} s block ({self.reason})"
         lines = []
         for d in DIRECTIONS:
             if not self.blocks[d]:
-                lines.append(f"  {d}: no {self.block_s:g} s block")
+                total = sum(self.blocks.values())
+                lines.append(f"  {d}: none of the {total} blocks of {self.block_s:g} s")
                 continue
             line = (f"  {d}: {self.blocks[d]} blocks, {self.block_s:g} s bias stability raw "
                     f"{self.raw_dph[d]:.4g} -> compensated {self.compensated_dph[d]:.4g} °/h "
@@ -93,8 +119,10 @@ class DirectionStats:
             if self.residual_rms_dph is not None:
                 line += f", RMS model - true bias {self.residual_rms_dph[d]:.4g} °/h"
             lines.append(line)
-        what = "temperature" if sensor else "resonator temperature"
-        return f"heating and cooling apart (sign of the {what} rate):\n" + "\n".join(lines)
+        if self.partial_blocks:
+            lines.append(f"  ({self.partial_blocks} blocks cut short by a gap, kept from half "
+                         "a block)")
+        return f"{title}:\n" + "\n".join(lines)
 
 
 class DirectionSplit:
@@ -105,21 +133,31 @@ class DirectionSplit:
     model
         The unit's model (its df/dt filter and the thermometer's slope sign).
     sample_rate_hz
-        The run's sample rate. [Hz]
+        The run's sample rate: its period is the gap test's (:func:`~hrgtc.core.timeline.is_gap`).
+        [Hz]
     """
 
     def __init__(self, model: UnitModel, sample_rate_hz: float) -> None:
         settings = model.drift.settings
         self.rows = max(round(BLOCK_S * sample_rate_hz), 1)
         self.block_s = self.rows / sample_rate_hz
+        self.min_rows = min(self.rows, min_partial_rows(self.rows))
+        self._period_s = 1.0 / float(sample_rate_hz)
         self._warmup_s = float(settings.warmup_s)
         self._origin_s: float | None = None  # the run's first sample: the warm-up counts from it
         self._stream = FeatureStream(settings, ("df",))
         slope = float(model.thermometer.slope_hz_per_c(settings.reference_c))
         self.slope_sign = 1.0 if slope >= 0 else -1.0
-        self._carry: np.ndarray | None = None
+        self._carry: np.ndarray | None = None  # the open block's rows (within a segment)
+        self._last_s: float | None = None  # time of the last settled row
         self._means: list[np.ndarray] = []
         self._truth: bool | None = None
+        self.segments = 0  # contiguous segments of settled rows
+        self.partial = 0  # blocks closed short at a gap and kept
+        self.dropped_rows = 0  # rows of partial blocks shorter than half a block
+        self.settled_rows = 0
+        self._segment_rows = 0
+        self.longest_segment_rows = 0
 
     def partial_fit(self, freq_chunk: Any, raw_dph: np.ndarray, compensated_dph: np.ndarray,
              residual_dph: np.ndarray | None = None) -> None:
@@ -133,26 +171,70 @@ class DirectionSplit:
             columns.append(residual_dph if residual_dph is not None else np.full(df.size, np.nan))
         block = np.column_stack(columns)
         time = np.asarray(freq_chunk.time_s, dtype=np.float64)
-        if time.size and self._origin_s is None:
+        if not time.size:
+            return
+        if self._origin_s is None:
             self._origin_s = float(time[0])
-        if time.size:  # the df/dt filter's settling, in seconds on the time axis
-            origin = np.full(time.size, self._origin_s)
-            restarts = restart_rows(time, freq_chunk.metadata.extra.get(RESTARTS_KEY))
-            if restarts.size:  # a logger restart: the filter settles again
-                lengths = np.diff(np.append(restarts, time.size))
-                origin[restarts[0]:] = np.repeat(time[restarts], lengths)
-                self._origin_s = float(time[restarts[-1]])
-            block = block[time - origin >= settle_threshold_s(self._warmup_s)]
+        # the df/dt filter's settling, in seconds on the time axis
+        origin = np.full(time.size, self._origin_s)
+        restarts = restart_rows(time, freq_chunk.metadata.extra.get(RESTARTS_KEY))
+        if restarts.size:  # a logger restart: the filter settles again, and a block ends
+            lengths = np.diff(np.append(restarts, time.size))
+            origin[restarts[0]:] = np.repeat(time[restarts], lengths)
+            self._origin_s = float(time[restarts[-1]])
+        settled = time - origin >= settle_threshold_s(self._warmup_s)
+        starts = np.zeros(time.size, dtype=bool)  # rows that start a segment
+        starts[restarts] = True
+        kept_time, block, starts = time[settled], block[settled], starts[settled]
+        if not kept_time.size:
+            return
+        self.settled_rows += kept_time.size
+        starts[1:] |= is_gap(np.diff(kept_time), self._period_s)
+        if self._last_s is None:
+            starts[0] = True
+        else:
+            starts[0] |= bool(is_gap(kept_time[0] - self._last_s, self._period_s))
+        self._last_s = float(kept_time[-1])
+        edges = [*np.flatnonzero(starts).tolist(), kept_time.size]
+        if edges[0] != 0:
+            edges.insert(0, 0)
+        for k in range(len(edges) - 1):
+            if starts[edges[k]]:
+                self._close_segment()
+            self._push(block[edges[k]:edges[k + 1]])
+
+    def _push(self, rows: np.ndarray) -> None:
+        """Rows of the open segment: full blocks become means, the rest is carried."""
+        self._segment_rows += rows.shape[0]
         if self._carry is not None and self._carry.shape[0]:
-            block = np.concatenate([self._carry, block])
-        complete = block.shape[0] // self.rows
-        self._carry = block[complete * self.rows:].copy()
+            rows = np.concatenate([self._carry, rows])
+        complete = rows.shape[0] // self.rows
+        self._carry = rows[complete * self.rows:].copy()
         if complete:
-            used = block[: complete * self.rows]
-            self._means.append(used.reshape(complete, self.rows, block.shape[1]).mean(axis=1))
+            used = rows[: complete * self.rows]
+            self._means.append(used.reshape(complete, self.rows, rows.shape[1]).mean(axis=1))
+
+    def _close_segment(self) -> None:
+        """A gap (or the run's end in a segmented run): the partial block is kept from half a
+        block less one sample, else dropped; a new segment starts."""
+        if self._segment_rows:
+            self.longest_segment_rows = max(self.longest_segment_rows, self._segment_rows)
+        if self._carry is not None and self._carry.shape[0]:
+            if self._carry.shape[0] >= self.min_rows:
+                self._means.append(self._carry.mean(axis=0, keepdims=True))
+                self.partial += 1
+            else:
+                self.dropped_rows += self._carry.shape[0]
+        self._carry = None
+        self._segment_rows = 0
+        self.segments += 1
 
     def result(self) -> DirectionStats:
-        """The split of the blocks so far."""
+        """The split of the blocks so far (call once, after the last chunk)."""
+        if self.segments > 1:  # a segmented run: its last burst's partial block counts too
+            self._close_segment()
+        else:
+            self.longest_segment_rows = max(self.longest_segment_rows, self._segment_rows)
         width = 4 if self._truth else 3
         means = np.concatenate(self._means) if self._means else np.empty((0, width))
         heating, cooling = heating_mask(means[:, 0], self.slope_sign)
@@ -165,7 +247,23 @@ class DirectionSplit:
                 values = means[mask, 3]
                 resid[direction] = float(np.sqrt(np.mean(values ** 2))) if values.size \
                     else math.nan
-        return DirectionStats(self.block_s, blocks, raw, comp, resid if self._truth else None)
+        return DirectionStats(self.block_s, blocks, raw, comp, resid if self._truth else None,
+                              partial_blocks=self.partial,
+                              reason=None if any(blocks.values()) else self._reason(means))
+
+    def _reason(self, means: np.ndarray) -> str:
+        """Why no block is heating or cooling."""
+        half = self.min_rows * self._period_s
+        if not self.settled_rows:
+            return (f"no sample is past the df/dt filter's {self._warmup_s:g} s settling "
+                    "time")
+        if not means.shape[0]:
+            longest = self.longest_segment_rows * self._period_s
+            what = (f"bursts of at most {longest:.3g} s are" if self.segments > 1
+                    else f"the settled run ({longest:.3g} s) is")
+            return f"{what} shorter than half the {self.block_s:g} s block ({half:.3g} s)"
+        return (f"the temperature rate of all {means.shape[0]} blocks is within the dead band "
+                f"({RATE_DEADBAND:.0%} of its largest magnitude): neither heating nor cooling")
 
 
 def _std(values: np.ndarray) -> float:

@@ -519,7 +519,7 @@ class InstrumentEvaluation:
 
     def allan_csv(self) -> str:
         """The deviation curves of every axis as CSV (an ``axis`` column first when there
-        are several): series, tau_s, deviation, lower, upper, n."""
+        are several): series, tau_s, deviation, lower, upper, n, edf."""
         if list(self.axes) == [""]:
             return self.axes[""].allan_csv()
         lines: list[str] = []

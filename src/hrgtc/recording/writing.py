@@ -26,7 +26,7 @@ from hrgtc.core.files import (
     refuse_existing,
     temporary_beside,
 )
-from hrgtc.recording.formats.base import Sink
+from hrgtc.recording.formats.base import Sink, metadata_json
 from hrgtc.recording.formats.registry import writable
 from hrgtc.recording.schema import Metadata, Recording
 
@@ -122,6 +122,21 @@ class RecordingWriter:
         with naming_os_errors(self.path):
             self._sink.write(arrays)
         self.rows += len(arrays[self.columns[0]])
+
+    def set_metadata(self, metadata: Metadata) -> None:
+        """The metadata the file is closed with, in place of that it was opened with: what is
+        known only after the last row (the restarts a reader met, ``extra["restarts_s"]``).
+
+        Parquet writes it in the footer's key-value metadata (which readers take before the
+        schema's copy), HDF5 in the group's attributes; CSV's header is the file's first
+        bytes, so the rows are copied once after the new header at :meth:`close` (only when
+        the header changed).
+        """
+        if self._sink is None:
+            raise InputError(f"{self.path}: the writer is closed")
+        metadata_json(metadata)  # fail now on non-JSON extra, not at close
+        self.metadata = metadata
+        self._sink.set_metadata(metadata)
 
     def start_writeback(self) -> None:
         """Make the rows written so far durable beside the work (a ``WriteBehind``).

@@ -288,6 +288,11 @@ class Sink:
     def close(self) -> None:
         raise NotImplementedError
 
+    def set_metadata(self, metadata: Metadata) -> None:
+        """The metadata the file ends with, replacing that it was opened with (called before
+        :meth:`close`; e.g. the restarts of a logger, known only once every row is read)."""
+        raise NotImplementedError(f"{type(self).__name__} cannot change its metadata")
+
     def abort(self) -> None:
         """Discard what was written (the caller removes the file)."""
         self.close()

@@ -32,7 +32,9 @@ A sidecar ``<file>.json`` (e.g. ``run.csv.json``) adds to or overrides the heade
 from __future__ import annotations
 
 import json
+import os
 import re
+import shutil
 from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -42,6 +44,7 @@ import pyarrow as pa
 import pyarrow.csv as pa_csv
 
 from hrgtc.core.errors import RecordingError
+from hrgtc.core.files import forget_temporary, temporary_beside
 from hrgtc.recording.formats.base import (
     Format,
     Sink,
@@ -427,7 +430,9 @@ class CsvSink(Sink):
     def __init__(self, path: Path, metadata: Metadata, names: Sequence[str]) -> None:
         super().__init__(path, metadata, names)
         self._handle = open(path, "wb")  # closed in close() / abort()
-        self._handle.write(csv_header(metadata, names))
+        self._header = csv_header(metadata, names)
+        self._final: bytes | None = None  # the header set at close (set_metadata)
+        self._handle.write(self._header)
         self._schema = pa.schema([pa.field(n, pa.float64()) for n in names])
         self._writer = pa_csv.CSVWriter(
             self._handle, self._schema, write_options=pa_csv.WriteOptions(include_header=False)
@@ -437,15 +442,38 @@ class CsvSink(Sink):
         arrays = [pa.array(columns[n]) for n in self.names]
         self._writer.write_table(pa.Table.from_arrays(arrays, schema=self._schema))
 
+    def set_metadata(self, metadata: Metadata) -> None:
+        header = csv_header(metadata, self.names)
+        self._final = None if header == self._header else header
+
     def close(self) -> None:
         self._writer.close()
         self._handle.close()
+        if self._final is not None:  # the header is the file's first bytes: copy the rows
+            _replace_header(self.path, len(self._header), self._final)
 
     def abort(self) -> None:
         try:
             self._writer.close()
         finally:
             self._handle.close()
+
+
+def _replace_header(path: Path, old_bytes: int, header: bytes) -> None:
+    """``path`` with its first ``old_bytes`` (the header) replaced by ``header``: the rows
+    copied after it into a file beside, which then takes ``path``'s place."""
+    beside = Path(temporary_beside(path))  # removed on a signal, as the writer's own
+    try:
+        with open(path, "rb") as source, open(beside, "wb") as target:
+            target.write(header)
+            source.seek(old_bytes)
+            shutil.copyfileobj(source, target, COUNT_BLOCK_BYTES)
+        os.replace(beside, path)
+    except BaseException:
+        beside.unlink(missing_ok=True)
+        raise
+    finally:
+        forget_temporary(beside)
 
 
 def sniff(head: bytes) -> bool:

@@ -204,8 +204,8 @@ class Hdf5Sink(Sink):
         metadata_json(metadata)
         self._file = h5py.File(path, "w")
         group = self._file.create_group(HDF5_GROUP, track_order=True)
-        for key, value in metadata.to_dict().items():
-            group.attrs[key] = json.dumps(value) if key == "extra" else value
+        self._group = group
+        self.set_metadata(metadata)
         self._datasets = {}
         axes = axis_names(names)
         for name in names:
@@ -223,6 +223,11 @@ class Hdf5Sink(Sink):
             ds.resize((self._rows + n,))
             ds[self._rows :] = columns[name]
         self._rows += n
+
+    def set_metadata(self, metadata: Metadata) -> None:
+        metadata_json(metadata)
+        for key, value in metadata.to_dict().items():
+            self._group.attrs[key] = json.dumps(value) if key == "extra" else value
 
     def close(self) -> None:
         self._file.close()

@@ -57,7 +57,10 @@ class ParquetSource(Source):
                     f"{name!r}; hrgtc cannot tell which one is meant: write the file with "
                     "unique column names")
         self.total_rows = self._file.metadata.num_rows
-        raw = (schema.metadata or {}).get(METADATA_KEY)
+        # the file's key-value metadata first: it holds what the writer set at close
+        # (ParquetSink.set_metadata), the Arrow schema's copy what it was opened with
+        raw = (self._file.metadata.metadata or {}).get(METADATA_KEY,
+                                                       (schema.metadata or {}).get(METADATA_KEY))
         if raw is not None:
             try:
                 self.metadata = dict(loads_json(raw))
@@ -149,6 +152,10 @@ class ParquetSink(Sink):
                 pa.concat_tables(self._pending), row_group_size=PARQUET_ROW_GROUP_ROWS
             )
         self._pending, self._pending_rows = [], 0
+
+    def set_metadata(self, metadata: Metadata) -> None:
+        # the file's key-value metadata, written with the footer (the schema's is fixed)
+        self._writer.add_key_value_metadata({METADATA_KEY: metadata_json(metadata)})
 
     def close(self) -> None:
         self._flush()
