@@ -36,6 +36,7 @@ TARGET = 1.10
 
 def _model(folder: Path):
     from hrgtc.pipeline.calibration import calibrate
+    from hrgtc.settings.calibration import CalibrationSettings
     from hrgtc.simulate import simulate_files
     from hrgtc.simulate import standard_profiles as profiles
 
@@ -43,7 +44,8 @@ def _model(folder: Path):
                            folder / "soaks", "parquet", sample_rate_hz=2.0, seed=1)
     cool = simulate_files([profiles.cooldown(20.0, -20.0, 2.0)], folder / "cal", "parquet",
                           sample_rate_hz=SAMPLE_RATE_HZ, seed=2)
-    return calibrate([w.path for w in soaks], [cool[0].path], drift_from_soaks=False).model
+    return calibrate([w.path for w in soaks], [cool[0].path],
+                     settings=CalibrationSettings(drift_from_soaks=False)).model
 
 
 def _recordings(samples: int):

@@ -42,6 +42,7 @@ MEMORY_REPEATS = 3
 
 def _model(folder: Path, sample_rate_hz: float):
     from hrgtc.pipeline.calibration import calibrate
+    from hrgtc.settings.calibration import CalibrationSettings
     from hrgtc.simulate import simulate_files
     from hrgtc.simulate import standard_profiles as profiles
 
@@ -49,7 +50,8 @@ def _model(folder: Path, sample_rate_hz: float):
                            "parquet", sample_rate_hz=5.0, seed=1)
     cool = simulate_files([profiles.cooldown(20.0, -20.0, 5.0)], folder / "cal", "parquet",
                           sample_rate_hz=sample_rate_hz, seed=2)
-    return calibrate([w.path for w in soaks], [cool[0].path], drift_from_soaks=False).model
+    return calibrate([w.path for w in soaks], [cool[0].path],
+                     settings=CalibrationSettings(drift_from_soaks=False)).model
 
 
 def plain_script(model_path: str, source: str, output: str, rows: int = 1 << 20) -> int:

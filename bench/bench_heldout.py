@@ -94,7 +94,7 @@ def _one_seed(unit: str, seed: int, folder: Path, fs: float, hours: float,
     cool = sim(profiles.cooldown(20.0, -20.0, 5.0), "cool", 1)
     warm = sim(profiles.warmup(-20.0, 20.0, 5.0), "warm", 2)
     cycle = sim(from_mapping(CYCLE), "cycle", 3)
-    result = calibrate(soaks, [cool], **calibrate_options)
+    result = calibrate(soaks, [cool], **_calibrate_keywords(calibrate_options))
     rows = []
     for name, path in (("warmup", warm), ("cycle", cycle)):
         row = {"unit": unit, "seed": seed, "run": name, **_measure(path, result.model, fs)}
@@ -131,6 +131,20 @@ def _summaries(rows: list[dict], label: str, seconds: float) -> list[dict]:
                                     and line["ratio_worst"] <= TARGET_WORST)
             out.append(line)
     return out
+
+
+def _calibrate_keywords(options: dict) -> dict:
+    """``calibrate``'s keywords from the options given here: the drift fit's settings
+    (terms, rate_tau2_s, select, ...) into its ``settings``, the rest (aux, ...) as they are."""
+    import dataclasses
+
+    from hrgtc.settings.calibration import CalibrationSettings
+    from hrgtc.settings.drift import DriftSettings
+
+    names = {f.name for f in dataclasses.fields(DriftSettings)}
+    drift = DriftSettings(**{k: v for k, v in options.items() if k in names})
+    return {"settings": CalibrationSettings(drift=drift),
+            **{k: v for k, v in options.items() if k not in names}}
 
 
 def heldout(calibrate_options: dict | None = None, seeds: tuple[int, ...] = (1, 2, 3, 4, 5),
