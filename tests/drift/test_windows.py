@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
+from hrgtc.core.timeline import min_partial_rows
 from hrgtc.drift.features import FeatureSettings, parse_terms
 from hrgtc.drift.windows import window_means
 from hrgtc.recording import Recording
@@ -33,3 +35,59 @@ def test_each_run_starts_its_own_filter_even_with_a_short_warm_up():
     shared = window_means([joined], settings, terms, window_s=10.0)
     leaked = shared.variables["df"][np.searchsorted(shared.time_s, second.time_s[0])]
     assert abs(leaked - alone.variables["df"][0]) > 10 * np.std(alone.variables["df"][-20:])
+
+
+def _reference_window_means(rows, chunks):
+    """Window means one segment at a time, the plain way (the definition)."""
+    min_rows = min(rows, min_partial_rows(rows))
+    out, carry, dropped = [], None, 0
+    for block, breaks, cuts in chunks:
+        marks = {int(b): "break" for b in breaks}
+        marks.update({int(c): "cut" for c in cuts if int(c) not in marks})
+        edges = [0, *sorted(m for m in marks if m > 0), block.shape[0]]
+        for k in range(len(edges) - 1):
+            kind = marks.get(edges[k])
+            if kind == "break" and carry is not None and carry.shape[0]:
+                if carry.shape[0] >= min_rows:
+                    out.append(carry.mean(axis=0))
+                else:
+                    dropped += carry.shape[0]
+                carry = None
+            elif kind == "cut" and carry is not None:
+                dropped += carry.shape[0]
+                carry = None
+            part = block[edges[k]:edges[k + 1]]
+            if carry is not None:
+                part = np.concatenate([carry, part])
+            complete = part.shape[0] // rows
+            if complete:
+                out.extend(part[: complete * rows].reshape(complete, rows, -1).mean(axis=1))
+            carry = part[complete * rows:]
+    return np.array(out), dropped
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_window_means_of_many_segments_equal_the_plain_definition(seed):
+    """Thousands of short segments per chunk (a burst file) are averaged all at once; the
+    windows, the partial windows kept at breaks and the rows dropped are those of taking
+    one segment at a time."""
+    from hrgtc.drift.windows import _WindowMeans
+
+    rng = np.random.default_rng(seed)
+    rows = int(rng.integers(3, 40))
+    chunks = []
+    for _ in range(int(rng.integers(1, 5))):
+        n = int(rng.integers(1, 3000))
+        block = rng.normal(size=(n, 3)) + rng.normal(size=3) * 100.0
+        marks = np.unique(rng.integers(0, n, size=int(rng.integers(0, n // 5 + 2))))
+        is_cut = rng.random(marks.size) < 0.3
+        chunks.append((block, marks[~is_cut], marks[is_cut]))
+    means = _WindowMeans(rows)
+    got = [means.partial_fit(block, breaks, cuts) for block, breaks, cuts in chunks]
+    got = np.concatenate([g for g in got if g.shape[0]]) if any(g.shape[0] for g in got) \
+        else np.empty((0, 3))
+    expected, dropped = _reference_window_means(rows, chunks)
+    assert got.shape[0] == expected.shape[0]
+    if expected.size:
+        np.testing.assert_allclose(got, expected, rtol=1e-12, atol=1e-9)
+    assert means.partial_dropped_rows == dropped
