@@ -39,5 +39,5 @@ def test_split_at_gaps_uses_the_threshold_it_is_given():
     assert [len(s) for s in split_at_gaps(run, max_gap_periods=5.0)] == [40, 20]
     assert [len(s) for s in split_at_gaps(run, max_gap_periods=20.0)] == [60]
     first, second = split_at_gaps(run, max_gap_periods=5.0)
-    assert first.time_s[-1] == 1.9
+    assert first.time_s[-1] == 4.1
     assert second.time_s[0] == 5.2  # times are not shifted
