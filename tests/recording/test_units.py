@@ -206,3 +206,8 @@ def test_median_period_ignores_zero_negative_and_infinite_steps():
     assert median_period(np.array([0.0, 2.0, np.inf])) == 2.0
     assert median_period(np.array([5.0])) is None
     assert median_period(np.array([1.0, 1.0])) is None
+
+
+def test_find_unit_ignores_case_and_spaces():
+    assert find_unit("rate", " RAD / S ").name == "radps"
+    assert find_unit("rate", "Δθ °/sample").name == "ddeg"
