@@ -210,4 +210,11 @@ def test_median_period_ignores_zero_negative_and_infinite_steps():
 
 def test_find_unit_ignores_case_and_spaces():
     assert find_unit("rate", " RAD / S ").name == "radps"
-    assert find_unit("rate", "Δθ °/sample").name == "ddeg"
+
+
+@pytest.mark.parametrize(("text", "name"), [("Δθdeg", "ddeg"), ("Δθrad", "drad"),
+                                            ("Δθ °/sample", "ddeg"), ("m°/s", "mdps")])
+def test_find_unit_accepts_its_spellings_with_a_capital_and_the_symbols_it_shows(text, name):
+    """The table's "Δθdeg" and the symbols the error message lists are accepted (a capital
+    Δ was compared with the lower-cased input and never matched)."""
+    assert find_unit("rate", text).name == name
