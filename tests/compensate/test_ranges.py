@@ -150,3 +150,59 @@ def test_samples_at_the_lower_calibration_edge_are_flagged_in_range(unit_model, 
         out = compensator.process(run)
         assert (out["in_range"][-100:] == expected).all(), (freq, expected)
         assert compensator.temperature_out == (0 if expected else rows)
+
+
+# -- mutants of ranges.py that no test killed (make mutation, issue 21) ----------------------
+def test_a_variable_warning_says_the_variable_its_ranges_and_how_far():
+    from hrgtc.compensate.ranges import VariableRange
+
+    beyond = VariableRange("dh", "°C/h", 0.725, (-1.0, 2.0), (-0.5, 3.5))
+    assert beyond.warning() == (
+        "warning: 72.5% of samples beyond the trained range of dh (causal rate of h) -1 to 2 "
+        "°C/h, up to 1.5 °C/h beyond (seen -0.5 to 3.5 °C/h)")
+
+
+def _report(variables=()):
+    return RangeReport(samples=1000, temperature_fraction=0.0, rate_fraction=0.012,
+                       settling_fraction=0.05, trained_c=(10.0, 30.0), seen_c=(12.0, 29.0),
+                       trained_rate_c_per_h=(-3.0, 3.0), seen_rate_c_per_h=(-3.6, 2.0),
+                       variables=variables)
+
+
+def test_range_reports_round_trip_through_json_with_missing_bounds():
+    from hrgtc.compensate.ranges import VariableRange
+
+    nan = float("nan")
+    g = VariableRange("g", "°C", 0.725, (nan, 2.0), (-0.5, nan))
+    report = _report((g,))
+    data = json.loads(json.dumps(report.to_dict(), allow_nan=False))
+    assert data["variables"] == [{"variable": "g", "unit": "°C", "fraction": 0.725,
+                                  "trained": [None, 2.0], "seen": [-0.5, None],
+                                  "excess": 0.0}]
+    assert data["temperature_excess_c"] == 0.0 and data["trained_c"] == [10.0, 30.0]
+    back = RangeReport.from_dict(data)
+    assert back.to_dict() == data
+    (g_back,) = back.variables
+    assert np.isnan(g_back.trained[0]) and g_back.trained[1] == 2.0
+    assert g_back.seen[0] == -0.5 and np.isnan(g_back.seen[1])
+    data["seen_c"] = [None, None]
+    assert all(np.isnan(RangeReport.from_dict(data).seen_c))
+    del data["variables"]  # a report written before variables were reported
+    assert RangeReport.from_dict(data).variables == ()
+
+
+def test_shares_name_temperature_df_dt_then_every_variable():
+    from hrgtc.compensate.ranges import VariableRange
+
+    report = _report((VariableRange("g", "°C", 0.725, (-1.0, 2.0), (-0.5, 3.5)),))
+    assert report.shares() == {"temperature": 0.0, "df/dt": 0.012, "g": 0.725}
+    assert report.shares_text() == "temperature 0.0%, df/dt 1.2%, g 72.5%"
+
+
+def test_variable_unit_of_an_extra_channel_and_of_a_sensor_model():
+    from hrgtc.compensate.ranges import variable_unit
+
+    assert variable_unit("a_pressure", "resonator", {"pressure": "hPa"}) == "(unit of hPa)"
+    assert variable_unit("a_pressure", "resonator", {}) == "(unit of pressure)"
+    assert variable_unit("d2", "sensor", {}) == "°C/s"
+    assert variable_unit("d2", "resonator", {}) == "Hz/s"
