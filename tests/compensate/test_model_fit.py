@@ -66,3 +66,49 @@ def test_swapped_rate_and_temperature_headers_are_named(model):
     with pytest.raises(InputError, match=r"^run\.csv: the headers rate_dph and housing_c "
                                          r"look swapped"):
         check_recording_noise(model, swapped, "run.csv")
+
+
+def _swapped(run: Recording, rate_dph: np.ndarray, housing_c: np.ndarray) -> Recording:
+    return Recording({"time_s": run.time_s, "freq_hz": run.freq_hz, "rate_dph": rate_dph,
+                      "housing_c": housing_c}, Metadata(sample_rate_hz=10.0))
+
+
+def test_the_swapped_headers_message_names_both_columns_their_noise_and_the_fix(model):
+    import re
+
+    run = make_run()
+    housing_c = 20.0 + np.cumsum(np.random.default_rng(2).normal(0.0, 1e-4, len(run)))
+    with pytest.raises(InputError) as caught:
+        check_recording_noise(model, _swapped(run, housing_c, run.rate_dph), "run.csv")
+    assert re.fullmatch(
+        r"run\.csv: the headers rate_dph and housing_c look swapped: column 'rate_dph' has "
+        r"[0-9.e-]+× the noise of the model's training rate \(a temperature's, not a gyro's\) "
+        r"and column 'housing_c' [0-9.]+× \(the rate's\); fix the header line of the file, "
+        r"or map the columns with --col rate_dph=housing_c --col housing_c=rate_dph",
+        str(caught.value))
+    constant = np.full(len(run), 10.0)  # a constant (or quantised) column: no noise at all
+    with pytest.raises(InputError, match=r"column 'rate_dph' has none of the noise"):
+        check_recording_noise(model, _swapped(run, constant, run.rate_dph), "run.csv")
+
+
+def test_a_quiet_rate_alone_or_a_model_without_statistics_is_not_refused(model):
+    import dataclasses
+
+    run = make_run()
+    rng = np.random.default_rng(3)
+    quiet_rate = 10.0 + rng.normal(0.0, 0.1, len(run))  # 1/20 the noise: no unit factor
+    housing_c = 20.0 + np.cumsum(rng.normal(0.0, 1e-4, len(run)))
+    check_recording_noise(model, _swapped(run, quiet_rate, housing_c), "run.csv")
+    bare = dataclasses.replace(model, training=None)  # a model written before the statistics
+    check_recording_noise(bare, _swapped(run, housing_c, run.rate_dph), "run.csv")
+
+
+def test_swapped_headers_on_an_axis_of_an_instrument_are_named(model):
+    run = make_run()
+    housing_c = 20.0 + np.cumsum(np.random.default_rng(2).normal(0.0, 1e-4, len(run)))
+    three = _three_axis(run, {})
+    columns = {n: three[n] for n in three.names}
+    columns["rate_dph_y"], columns["housing_c"] = housing_c, run.rate_dph
+    instrument = InstrumentModel({a: model for a in "xyz"}, unit="FZ-3")
+    with pytest.raises(InputError, match=r"the headers rate_dph_y and housing_c look swapped"):
+        check_recording_noise(instrument, Recording(columns, run.metadata), "run.csv")
