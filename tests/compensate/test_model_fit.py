@@ -112,3 +112,69 @@ def test_swapped_headers_on_an_axis_of_an_instrument_are_named(model):
     instrument = InstrumentModel({a: model for a in "xyz"}, unit="FZ-3")
     with pytest.raises(InputError, match=r"the headers rate_dph_y and housing_c look swapped"):
         check_recording_noise(instrument, Recording(columns, run.metadata), "run.csv")
+
+
+# -- the calibrated span, the plausible band, the thermometer's kind --------------------------
+def test_the_calibrated_span_covers_the_thermometer_and_the_trained_f(model):
+    import dataclasses
+
+    from hrgtc.compensate.model_fit import frequency_span
+
+    thermometer_span = model.thermometer.frequency_range_hz
+    assert frequency_span(model) == thermometer_span  # the training stayed inside
+    reference = model.drift.settings.reference_freq_hz
+    wider = dataclasses.replace(model.drift, ranges={**model.drift.ranges, "f": (-20.0, 20.0)})
+    assert frequency_span(dataclasses.replace(model, drift=wider)) == (
+        reference - 20.0, reference + 20.0)
+    no_f = dataclasses.replace(model.drift, ranges={k: v for k, v in model.drift.ranges.items()
+                                                    if k != "f"})
+    assert frequency_span(dataclasses.replace(model, drift=no_f)) == thermometer_span
+
+
+def test_the_plausible_band_is_the_span_widened_by_100_c_at_the_steepest_slope(model):
+    from hrgtc.compensate.model_fit import plausible_frequency_band
+
+    thermometer = model.thermometer
+    low, high = thermometer.frequency_range_hz
+    t_low, t_high = thermometer.temperature_range_c
+    h = 1e-3  # slope by central differences of f(T), not the thermometer's own slope
+    slopes = [abs(float(thermometer.frequency(t + h) - thermometer.frequency(t - h))) / (2 * h)
+              for t in (t_low, t_high)]
+    margin = 100.0 * max(slopes)
+    band = plausible_frequency_band(model)
+    assert band == pytest.approx((low - margin, high + margin), rel=1e-9)
+    assert plausible_frequency_band(model, margin_c=10.0) == pytest.approx(
+        (low - margin / 10.0, high + margin / 10.0), rel=1e-9)
+
+
+def test_a_model_of_the_other_thermometer_kind_is_refused_naming_the_file_and_option(model):
+    import dataclasses
+
+    from hrgtc.compensate.model_fit import check_thermometer_kind, with_model_band
+    from hrgtc.recording.io import ReadOptions
+
+    resonator, sensor = ReadOptions(), ReadOptions(thermometer="sensor")
+    check_thermometer_kind(resonator, model)
+    with pytest.raises(InputError) as caught:
+        check_thermometer_kind(sensor, model, "m.json")
+    assert str(caught.value) == (
+        "m.json: the model of unit 'FZ-1' is a resonator-thermometer model (its thermometer "
+        "turns the resonator frequency into temperature), but the recording is read with "
+        "--thermometer sensor (a temperature sensor in the place of freq_hz); drop "
+        "--thermometer sensor for this model, or calibrate one with --thermometer sensor")
+    sensor_model = dataclasses.replace(
+        model, thermometer=dataclasses.replace(model.thermometer, source="sensor"))
+    check_thermometer_kind(sensor, sensor_model)
+    with pytest.raises(InputError) as caught:
+        check_thermometer_kind(resonator, sensor_model)
+    assert str(caught.value) == (
+        "the model of unit 'FZ-1' is a sensor-thermometer model (calibrated with "
+        "--thermometer sensor on the gyro's temperature sensor, -20 to 40 °C), but the "
+        "recording is read as a resonator frequency (freq_hz); pass --thermometer sensor (and "
+        "--col temperature_c=... for the sensor's column), or use a model calibrated on the "
+        "resonator frequency")
+    with pytest.raises(InputError, match="is a resonator-thermometer model"):
+        with_model_band(sensor, model)
+    banded = with_model_band(resonator, model)
+    assert banded.freq_span_hz == model.thermometer.frequency_range_hz
+    assert banded.freq_band_hz[0] < banded.freq_span_hz[0]
