@@ -178,3 +178,49 @@ def test_a_model_of_the_other_thermometer_kind_is_refused_naming_the_file_and_op
     banded = with_model_band(resonator, model)
     assert banded.freq_span_hz == model.thermometer.frequency_range_hz
     assert banded.freq_band_hz[0] < banded.freq_span_hz[0]
+
+
+def test_the_noise_check_skips_axes_the_recording_lacks_and_checks_the_others(model):
+    instrument = InstrumentModel({a: model for a in "xyz"}, unit="FZ-3")
+    three = _three_axis(make_run(), {"z": 3600.0})
+    yz = Recording({n: three[n] for n in three.names if not n.endswith("_x")}, three.metadata)
+    with pytest.raises(InputError, match=r"column 'rate_dph_z': its noise"):
+        check_recording_noise(instrument, yz, "run.csv")  # x missing: z still checked
+    y_only = Recording({n: three[n] for n in three.names if not n.endswith(("_x", "_z"))},
+                       three.metadata)
+    check_recording_noise(instrument, y_only, "run.csv")  # left to the compensator's error
+    run = make_run()
+    scaled = Recording({**{n: run[n] for n in run.names}, "rate_dph": run.rate_dph * 3600.0},
+                       run.metadata)
+    check_recording_noise(instrument, scaled, "run.csv")  # single-axis file: likewise
+
+
+def test_swapped_headers_without_a_file_name_and_at_other_noise_levels(model):
+    import dataclasses
+
+    run = make_run()
+    housing_c = 20.0 + np.cumsum(np.random.default_rng(2).normal(0.0, 1e-4, len(run)))
+    with pytest.raises(InputError, match=r"^the headers rate_dph and housing_c look swapped"):
+        check_recording_noise(model, _swapped(run, housing_c, run.rate_dph))
+    # the other column at half the rate's noise still has "the rate's" noise (within 2.5×)
+    with pytest.raises(InputError, match=r"column 'housing_c' 0\.4\d\d× \(the rate's\)"):
+        check_recording_noise(model, _swapped(run, housing_c, 0.5 * run.rate_dph), "run.csv")
+    # a constant rate column of an axis view: named by the file's axis
+    constant = np.full(len(run), 10.0)
+    with pytest.raises(InputError, match=r"headers rate_dph_z and housing_c look swapped"):
+        check_recording_noise(model, _swapped(run, constant, run.rate_dph), "run.csv", axis="z")
+    # a quiet gyro (0.5 °/h of training noise, below 1 °/h) is checked all the same
+    quiet = dataclasses.replace(model, training=dataclasses.replace(
+        model.training, rate_noise_dph=model.training.rate_noise_dph / 4.0))
+    with pytest.raises(InputError, match=r"look swapped"):
+        check_recording_noise(quiet, _swapped(run, housing_c / 10.0, 0.25 * run.rate_dph),
+                              "run.csv")
+
+
+def test_a_rate_at_a_seventh_of_the_training_noise_is_not_a_temperature(model):
+    run = make_run()
+    rng = np.random.default_rng(4)
+    rate = 10.0 + rng.normal(0.0, 2.0 / 7.0, len(run))  # 1/7 of the noise: not 10× quieter
+    with_noise = Recording({"time_s": run.time_s, "freq_hz": run.freq_hz, "rate_dph": rate,
+                            "housing_c": run.rate_dph}, Metadata(sample_rate_hz=10.0))
+    check_recording_noise(model, with_noise, "run.csv")
