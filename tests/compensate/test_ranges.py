@@ -170,6 +170,8 @@ def _report(variables=()):
 
 
 def test_range_reports_round_trip_through_json_with_missing_bounds():
+    import dataclasses
+
     from hrgtc.compensate.ranges import VariableRange
 
     nan = float("nan")
@@ -180,6 +182,9 @@ def test_range_reports_round_trip_through_json_with_missing_bounds():
                                   "trained": [None, 2.0], "seen": [-0.5, None],
                                   "excess": 0.0}]
     assert data["temperature_excess_c"] == 0.0 and data["trained_c"] == [10.0, 30.0]
+    assert data["rate_excess_ratio"] == pytest.approx(1.2)
+    untrained = dataclasses.replace(report, trained_rate_c_per_h=(0.0, 0.0))
+    assert untrained.to_dict()["rate_excess_ratio"] is None  # JSON has no infinity
     back = RangeReport.from_dict(data)
     assert back.to_dict() == data
     (g_back,) = back.variables
@@ -244,8 +249,8 @@ def test_temperatures_far_beyond_the_thermometer_continue_along_its_chord():
     t = _temperature(THERMOMETER, far)
     assert t.dtype == np.float64 and np.isfinite(t).all()
     np.testing.assert_allclose(t, [low - 1000.0, high + 1000.0], rtol=1e-9)
-    inside = np.array([f_low, f_high])
-    np.testing.assert_allclose(_temperature(THERMOMETER, inside), [low, high], atol=1e-6)
+    inside = np.array([f_low, float(THERMOMETER.frequency(10.0)), f_high])
+    np.testing.assert_allclose(_temperature(THERMOMETER, inside), [low, 10.0, high], atol=1e-6)
 
 
 def test_range_report_from_the_compensators_counts_and_extremes(gradient_model):
@@ -273,3 +278,31 @@ def test_range_report_from_the_compensators_counts_and_extremes(gradient_model):
     empty = range_report(model.drift, THERMOMETER, 0, np.zeros(4), extremes, h_seen)
     assert np.isnan(empty.seen_c).all() and np.isnan(empty.variables[0].seen).all()
     assert empty.temperature_fraction == 0.0 and empty.variables[0].fraction == 0.0
+
+
+def test_rates_are_reported_per_hour_of_resonator_temperature(gradient_model):
+    import dataclasses
+    import math
+
+    from hrgtc.compensate.ranges import range_report
+
+    model = gradient_model
+    ranges = {**model.drift.ranges, "dh": (-1e-4, 2e-4)}  # °C/s
+    drift_dh = dataclasses.replace(model.drift, ranges=ranges)
+    extremes = np.array([-5.0, 4.0, np.nan, 3e-3])  # df min unknown: f's extremes still used
+    report = range_report(drift_dh, THERMOMETER, 1000, np.array([0, 12, 0, 0]), extremes,
+                          {"dh": (100, -3e-4, 1e-4)})
+    assert np.isfinite(report.seen_c).all()
+    (dh,) = report.variables
+    assert dh.unit == "°C/h" and dh.fraction == 0.1
+    assert dh.trained == pytest.approx((-0.36, 0.72), rel=1e-12)
+    assert dh.seen == pytest.approx((-1.08, 0.36), rel=1e-12)
+    # df/dt [Hz/s] as a resonator temperature rate [°C/h] at the middle of the trained span
+    slope = float(THERMOMETER.slope_hz_per_c(0.5 * sum(report.trained_c)))
+    df_low, df_high = model.drift.ranges["df"]
+    assert report.trained_rate_c_per_h == pytest.approx(
+        tuple(sorted((df_low / slope * 3600.0, df_high / slope * 3600.0))), rel=1e-12)
+    no_df = dataclasses.replace(model.drift, ranges={k: v for k, v in model.drift.ranges.items()
+                                                     if k != "df"})
+    untrained = range_report(no_df, THERMOMETER, 1000, np.zeros(4), extremes)
+    assert untrained.trained_rate_c_per_h == (-math.inf, math.inf)
