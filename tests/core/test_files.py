@@ -431,6 +431,10 @@ def test_refuse_existing_names_every_existing_output_and_the_note(tmp_path):
         refuse_existing(str(a), force=False, note="nothing was written")
     assert str(one.value) == (f"{a} exists; nothing was written; pass --force (force=True) "
                               "to overwrite it")
+    with pytest.raises(OutputExistsError) as single:
+        refuse_existing([free, a], force=False)
+    assert str(single.value) == (f"1 output file(s) exist: {a}; pass --force (force=True) "
+                                 "to overwrite")
     with pytest.raises(OutputExistsError) as two:
         refuse_existing([free, a, b], force=False)
     assert str(two.value) == (f"2 output file(s) exist: {a} and {b}; pass --force "
