@@ -585,3 +585,19 @@ def test_file_sha256_never_reads_a_whole_file_at_once(tmp_path, monkeypatch):
     path.write_bytes(b"x" * 100)
     files.file_sha256(path, block_bytes=40)
     assert sizes == [40, 40, 40, 40]
+
+
+def test_a_stale_temporary_that_cannot_be_removed_is_reported_by_name(tmp_path, monkeypatch):
+    from pathlib import Path
+
+    from hrgtc.core import files
+
+    name = f".out.csv.{_dead_pid()}.k3j_x.tmp"
+    (tmp_path / name).write_text("half")
+
+    def refused(self, missing_ok=False):
+        raise PermissionError(errno.EACCES, "Permission denied", str(self))
+
+    monkeypatch.setattr(Path, "unlink", refused)
+    with pytest.warns(files.StaleTemporaryWarning, match=rf"1 temporary file\(s\) .* \({name}\)"):
+        assert files.clean_stale_temporaries(tmp_path / "out.csv") == []
