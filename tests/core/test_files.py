@@ -601,3 +601,20 @@ def test_a_stale_temporary_that_cannot_be_removed_is_reported_by_name(tmp_path, 
     monkeypatch.setattr(Path, "unlink", refused)
     with pytest.warns(files.StaleTemporaryWarning, match=rf"1 temporary file\(s\) .* \({name}\)"):
         assert files.clean_stale_temporaries(tmp_path / "out.csv") == []
+
+
+def test_stale_temporaries_of_older_versions_are_counted_and_three_named(tmp_path):
+    import re
+
+    from hrgtc.core import files
+
+    names = [f".out.csv.old{i}.tmp" for i in range(4)]  # no PID: older hrgtc
+    for name in names:
+        (tmp_path / name).write_text("half")
+    with pytest.warns(files.StaleTemporaryWarning) as caught:
+        files.clean_stale_temporaries(tmp_path / "out.csv")
+    assert caught[0].filename == __file__  # said where the caller is
+    message = str(caught[0].message)
+    listed = re.search(r"4 temporary file\(s\) of an interrupted earlier write of out\.csv "
+                       r"remain \((.*)\); remove them", message).group(1).split(", ")
+    assert len(listed) == 3 and set(listed) < set(names)
