@@ -43,11 +43,12 @@ docs: $(STAMP)
 
 # Mutation testing of recording/, compensate/, export/ and files.py (pyproject's [tool.mutmut]); not
 # run by CI: the full set takes hours on 2 cores. MUTANTS narrows it, e.g.
-# make mutation MUTANTS='hrgtc.core.files.*'
+# make mutation MUTANTS='hrgtc.core.files.*' (JOBS: parallel mutants, default 2)
 MUTANTS ?=
+JOBS ?= 2
 mutation: $(STAMP)
 	$(BIN)/python -m pip install --quiet 'mutmut==3.8.1'
-	$(BIN)/mutmut run $(MUTANTS)
+	$(BIN)/mutmut run --max-children $(JOBS) $(MUTANTS)
 	$(BIN)/mutmut results
 
 bench: $(STAMP)

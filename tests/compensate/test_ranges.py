@@ -150,3 +150,159 @@ def test_samples_at_the_lower_calibration_edge_are_flagged_in_range(unit_model, 
         out = compensator.transform(run)
         assert (out["in_range"][-100:] == expected).all(), (freq, expected)
         assert compensator.temperature_out == (0 if expected else rows)
+
+
+# -- mutants of ranges.py that no test killed (make mutation, issue 21) ----------------------
+def test_a_variable_warning_says_the_variable_its_ranges_and_how_far():
+    from hrgtc.compensate.ranges import VariableRange
+
+    beyond = VariableRange("dh", "°C/h", 0.725, (-1.0, 2.0), (-0.5, 3.5))
+    assert beyond.warning() == (
+        "warning: 72.5% of samples beyond the trained range of dh (causal rate of h) -1 to 2 "
+        "°C/h, up to 1.5 °C/h beyond (seen -0.5 to 3.5 °C/h)")
+
+
+def _report(variables=()):
+    return RangeReport(samples=1000, temperature_fraction=0.0, rate_fraction=0.012,
+                       settling_fraction=0.05, trained_c=(10.0, 30.0), seen_c=(12.0, 29.0),
+                       trained_rate_c_per_h=(-3.0, 3.0), seen_rate_c_per_h=(-3.6, 2.0),
+                       variables=variables)
+
+
+def test_range_reports_round_trip_through_json_with_missing_bounds():
+    import dataclasses
+
+    from hrgtc.compensate.ranges import VariableRange
+
+    nan = float("nan")
+    g = VariableRange("g", "°C", 0.725, (nan, 2.0), (-0.5, nan))
+    report = _report((g,))
+    data = json.loads(json.dumps(report.to_dict(), allow_nan=False))
+    assert data["variables"] == [{"variable": "g", "unit": "°C", "fraction": 0.725,
+                                  "trained": [None, 2.0], "seen": [-0.5, None],
+                                  "excess": 0.0}]
+    assert data["temperature_excess_c"] == 0.0 and data["trained_c"] == [10.0, 30.0]
+    assert data["rate_excess_ratio"] == pytest.approx(1.2)
+    untrained = dataclasses.replace(report, trained_rate_c_per_h=(0.0, 0.0))
+    assert untrained.to_dict()["rate_excess_ratio"] is None  # JSON has no infinity
+    back = RangeReport.from_dict(data)
+    assert back.to_dict() == data
+    (g_back,) = back.variables
+    assert np.isnan(g_back.trained[0]) and g_back.trained[1] == 2.0
+    assert g_back.seen[0] == -0.5 and np.isnan(g_back.seen[1])
+    data["seen_c"] = [None, None]
+    assert all(np.isnan(RangeReport.from_dict(data).seen_c))
+    del data["variables"]  # a report written before variables were reported
+    assert RangeReport.from_dict(data).variables == ()
+
+
+def test_shares_name_temperature_df_dt_then_every_variable():
+    from hrgtc.compensate.ranges import VariableRange
+
+    report = _report((VariableRange("g", "°C", 0.725, (-1.0, 2.0), (-0.5, 3.5)),))
+    assert report.shares() == {"temperature": 0.0, "df/dt": 0.012, "g": 0.725}
+    assert report.shares_text() == "temperature 0.0%, df/dt 1.2%, g 72.5%"
+
+
+def test_variable_unit_of_an_extra_channel_and_of_a_sensor_model():
+    from hrgtc.compensate.ranges import variable_unit
+
+    assert variable_unit("a_pressure", "resonator", {"pressure": "hPa"}) == "(unit of hPa)"
+    assert variable_unit("a_pressure", "resonator", {}) == "(unit of pressure)"
+    assert variable_unit("d2", "sensor", {}) == "°C/s"
+    assert variable_unit("d2", "resonator", {}) == "Hz/s"
+
+
+def test_the_warning_lines_say_each_excursion_once_and_nothing_inside():
+    from hrgtc.compensate.ranges import VariableRange
+
+    inside = VariableRange("g", "°C", 0.0, (-1.0, 2.0), (-0.5, 1.5))
+    beyond = VariableRange("h", "°C", 0.25, (-1.0, 2.0), (-0.5, 3.5))
+    report = RangeReport(samples=1000, temperature_fraction=0.1, rate_fraction=0.012,
+                         settling_fraction=0.05, trained_c=(10.0, 30.0), seen_c=(8.0, 29.0),
+                         trained_rate_c_per_h=(-3.0, 3.0), seen_rate_c_per_h=(-3.6, 2.0),
+                         variables=(inside, beyond))
+    assert report.warnings() == [
+        "warning: 10.0% of samples beyond the trained temperature 10.00 to 30.00 °C, up to "
+        "2.00 °C beyond (seen 8.00 to 29.00 °C)",
+        "warning: 1.2% of samples beyond the trained df/dt -3.0 to +3.0 °C/h (seen -3.6 to "
+        "+2.0 °C/h, up to 1.20× the largest trained on that side); train on runs this fast "
+        "(calibrate --drift takes several)",
+        beyond.warning()]
+    untrained = RangeReport(samples=1000, temperature_fraction=0.0, rate_fraction=0.5,
+                            settling_fraction=0.0, trained_c=(10.0, 30.0), seen_c=(12.0, 29.0),
+                            trained_rate_c_per_h=(0.0, 0.0), seen_rate_c_per_h=(-3.6, 2.0))
+    assert untrained.warnings() == [  # no largest trained df/dt to compare with
+        "warning: 50.0% of samples beyond the trained df/dt +0.0 to +0.0 °C/h (seen -3.6 to "
+        "+2.0 °C/h); train on runs this fast (calibrate --drift takes several)"]
+    assert RangeReport(1000, 0.0, 0.0, 0.0, (10.0, 30.0), (12.0, 29.0), (-3.0, 3.0),
+                       (-1.0, 1.0), (inside,)).warnings() == []
+
+
+def test_temperatures_far_beyond_the_thermometer_continue_along_its_chord():
+    from hrgtc.compensate.ranges import _temperature
+
+    low, high = THERMOMETER.temperature_range_c
+    f_low, f_high = float(THERMOMETER.frequency(low)), float(THERMOMETER.frequency(high))
+    chord = (f_high - f_low) / (high - low)  # Hz/°C, may be negative
+    far = np.array([f_low - 1000.0 * chord, f_high + 1000.0 * chord])
+    t = _temperature(THERMOMETER, far)
+    assert t.dtype == np.float64 and np.isfinite(t).all()
+    np.testing.assert_allclose(t, [low - 1000.0, high + 1000.0], rtol=1e-9)
+    inside = np.array([f_low, float(THERMOMETER.frequency(10.0)), f_high])
+    np.testing.assert_allclose(_temperature(THERMOMETER, inside), [low, 10.0, high], atol=1e-6)
+
+
+def test_range_report_from_the_compensators_counts_and_extremes(gradient_model):
+    import dataclasses
+
+    from hrgtc.compensate.ranges import _temperature, range_report
+
+    model = gradient_model
+    f_ref = model.drift.settings.reference_freq_hz
+    counts = np.array([100, 12, 0, 50])
+    extremes = np.array([-5.0, 4.0, -1e-4, 2e-4])  # f min, f max [Hz], df min, max [Hz/s]
+    h_seen = {"g": (250, -0.5, 3.5)}
+    report = range_report(model.drift, THERMOMETER, 1000, counts, extremes, h_seen)
+    seen = _temperature(THERMOMETER, extremes[:2] + f_ref)
+    assert report.seen_c == (float(seen[0]), float(seen[1]))
+    assert report.temperature_fraction == 0.1 and report.rate_fraction == 0.012
+    assert report.settling_fraction == 0.05
+    (h,) = report.variables
+    assert (h.name, h.unit, h.fraction, h.seen) == ("g", "°C", 0.25, (-0.5, 3.5))
+    assert h.trained == model.drift.ranges["g"]
+    no_f = dataclasses.replace(model.drift, ranges={k: v for k, v in model.drift.ranges.items()
+                                                    if k != "f"})
+    untrained = range_report(no_f, THERMOMETER, 1000, counts, extremes)
+    assert untrained.trained_c == THERMOMETER.temperature_range_c  # the calibrated span
+    empty = range_report(model.drift, THERMOMETER, 0, np.zeros(4), extremes, h_seen)
+    assert np.isnan(empty.seen_c).all() and np.isnan(empty.variables[0].seen).all()
+    assert empty.temperature_fraction == 0.0 and empty.variables[0].fraction == 0.0
+
+
+def test_rates_are_reported_per_hour_of_resonator_temperature(gradient_model):
+    import dataclasses
+    import math
+
+    from hrgtc.compensate.ranges import range_report
+
+    model = gradient_model
+    ranges = {**model.drift.ranges, "dh": (-1e-4, 2e-4)}  # °C/s
+    drift_dh = dataclasses.replace(model.drift, ranges=ranges)
+    extremes = np.array([-5.0, 4.0, np.nan, 3e-3])  # df min unknown: f's extremes still used
+    report = range_report(drift_dh, THERMOMETER, 1000, np.array([0, 12, 0, 0]), extremes,
+                          {"dh": (100, -3e-4, 1e-4)})
+    assert np.isfinite(report.seen_c).all()
+    (dh,) = report.variables
+    assert dh.unit == "°C/h" and dh.fraction == 0.1
+    assert dh.trained == pytest.approx((-0.36, 0.72), rel=1e-12)
+    assert dh.seen == pytest.approx((-1.08, 0.36), rel=1e-12)
+    # df/dt [Hz/s] as a resonator temperature rate [°C/h] at the middle of the trained span
+    slope = float(THERMOMETER.slope_hz_per_c(0.5 * sum(report.trained_c)))
+    df_low, df_high = model.drift.ranges["df"]
+    assert report.trained_rate_c_per_h == pytest.approx(
+        tuple(sorted((df_low / slope * 3600.0, df_high / slope * 3600.0))), rel=1e-12)
+    no_df = dataclasses.replace(model.drift, ranges={k: v for k, v in model.drift.ranges.items()
+                                                     if k != "df"})
+    untrained = range_report(no_df, THERMOMETER, 1000, np.zeros(4), extremes)
+    assert untrained.trained_rate_c_per_h == (-math.inf, math.inf)

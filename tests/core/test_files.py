@@ -380,3 +380,241 @@ def test_check_writable_free_space_edge_and_figures(tmp_path, monkeypatch):
     monkeypatch.setattr(shutil, "disk_usage", lambda path: usage(0, 0, 1_050_000))
     with pytest.raises(InputError, match=r"1\.1 MB free in .* needs about 1\.1 MB"):
         files.check_writable(tmp_path / "out.parquet", 1_050_000.0)
+
+
+def test_write_text_atomic_writes_utf8_whatever_the_locale(tmp_path, monkeypatch):
+    """Model files and notes are UTF-8 on every machine: a text ``open`` without an
+    encoding would follow the locale (simulated here as Latin-1)."""
+    import builtins
+
+    from hrgtc.core import files
+
+    def latin1_locale_open(file, mode="r", *args, encoding=None, **kwargs):
+        if "b" not in mode and encoding is None:
+            encoding = "latin-1"
+        return builtins.open(file, mode, *args, encoding=encoding, **kwargs)
+
+    monkeypatch.setattr(files, "open", latin1_locale_open, raising=False)
+    target = files.write_text_atomic(tmp_path / "note.txt", "± 0.5 °C/h\n")
+    assert target.read_bytes() == "± 0.5 °C/h\n".encode()
+
+
+def test_write_text_atomic_a_failed_open_names_the_output_and_keeps_its_error(
+        tmp_path, monkeypatch):
+    """A disk full before the temporary file exists: the error is the disk's, naming the
+    output (not a FileNotFoundError from removing a temporary file that was never made)."""
+    from hrgtc.core import files
+
+    def full_disk(*args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(files, "open", full_disk, raising=False)
+    target = tmp_path / "model.json"
+    with pytest.raises(OSError) as caught:
+        files.write_text_atomic(target, "{}\n")
+    assert caught.value.errno == errno.ENOSPC
+    assert caught.value.filename == str(target)
+    assert files._ACTIVE == set() and list(tmp_path.iterdir()) == []
+
+
+def test_refuse_existing_names_every_existing_output_and_the_note(tmp_path):
+    from hrgtc.core.errors import OutputExistsError
+    from hrgtc.core.files import refuse_existing
+
+    a, b, c, free = (tmp_path / n for n in ("a.csv", "b.csv", "c.csv", "free.csv"))
+    for path in (a, b, c):
+        path.write_text("x")
+    refuse_existing([a, b, free], force=True)  # --force: nothing is checked
+    refuse_existing(free, force=False)
+    refuse_existing([free, str(free)], force=False)
+    with pytest.raises(OutputExistsError) as one:
+        refuse_existing(str(a), force=False, note="nothing was written")
+    assert str(one.value) == (f"{a} exists; nothing was written; pass --force (force=True) "
+                              "to overwrite it")
+    with pytest.raises(OutputExistsError) as single:
+        refuse_existing([free, a], force=False)
+    assert str(single.value) == (f"1 output file(s) exist: {a}; pass --force (force=True) "
+                                 "to overwrite")
+    with pytest.raises(OutputExistsError) as two:
+        refuse_existing([free, a, b], force=False)
+    assert str(two.value) == (f"2 output file(s) exist: {a} and {b}; pass --force "
+                              "(force=True) to overwrite")
+    with pytest.raises(OutputExistsError) as three:
+        refuse_existing((p for p in (a, b, c)), force=False, note="nothing was written")
+    assert str(three.value) == (f"3 output file(s) exist: {a}, {b} and {c}; nothing was "
+                                "written; pass --force (force=True) to overwrite")
+
+
+def _dead_pid() -> int:
+    child = os.fork()
+    if child == 0:
+        os._exit(0)
+    os.waitpid(child, 0)
+    return child
+
+
+def test_clean_stale_temporaries_removes_only_those_of_dead_writers(tmp_path):
+    from hrgtc.core import files
+
+    target = tmp_path / "out.csv"
+    dead, alive, mine = _dead_pid(), os.getppid(), os.getpid()
+    names = {
+        "dead": f".out.csv.{dead}.k3j_x.tmp",  # removed
+        "alive": f".out.csv.{alive}.a8f2.tmp",  # another process still writes it
+        "mine": f".out.csv.{mine}.zz.tmp",  # this process's own
+        "old": ".out.csv.q1w2e3.tmp",  # older hrgtc: no PID, reported
+        "other": f".other.csv.{dead}.k3j_x.tmp",  # another output's
+        "plain": f"out.csv.{dead}.tmp",  # not hidden: not ours
+        "active": f".out.csv.{dead}.active.tmp",  # registered in this process
+    }
+    for name in names.values():
+        (tmp_path / name).write_text("half")
+    files._ACTIVE.add(str(tmp_path / names["active"]))
+    try:
+        with pytest.warns(files.StaleTemporaryWarning) as caught:
+            removed = files.clean_stale_temporaries(target)
+    finally:
+        files._ACTIVE.discard(str(tmp_path / names["active"]))
+    assert removed == [tmp_path / names["dead"]]
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
+        n for k, n in names.items() if k != "dead")
+    assert len(caught) == 1
+    assert str(caught[0].message) == (
+        f"{tmp_path}: 1 temporary file(s) of an interrupted earlier write of out.csv remain "
+        f"({names['old']}); remove them if no other program is writing that file")
+    assert files.clean_stale_temporaries(tmp_path / "missing" / "out.csv") == []
+
+
+def test_temporary_beside_has_the_permissions_of_an_ordinary_file(tmp_path, monkeypatch):
+    from hrgtc.core import files
+
+    for umask, mode in ((0o022, 0o644), (0o077, 0o600), (0o002, 0o664)):
+        old = os.umask(umask)
+        try:
+            temporary = files.temporary_beside(tmp_path / "out.csv")
+        finally:
+            os.umask(old)
+        assert os.stat(temporary).st_mode & 0o777 == mode
+        os.unlink(temporary)
+        files.forget_temporary(temporary)
+
+    def refused(path, mode):
+        raise PermissionError(errno.EPERM, "Operation not permitted", path)
+
+    monkeypatch.setattr(os, "chmod", refused)
+    with pytest.raises(PermissionError):
+        files.temporary_beside(tmp_path / "out.csv")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_signal_handlers_are_installed_once_in_the_main_thread_and_leave_ignored_ones(
+        tmp_path):
+    import signal
+    import threading
+
+    from hrgtc.core import files
+
+    saved = {s: signal.getsignal(s) for s in (signal.SIGTERM, signal.SIGINT)}
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)  # e.g. started by nohup
+    made: list[str] = []
+    try:
+        made.append(files.temporary_beside(tmp_path / "a.csv"))
+        made.append(files.temporary_beside(tmp_path / "b.csv"))  # installed already
+        assert signal.getsignal(signal.SIGTERM) == signal.SIG_IGN  # left alone
+        assert signal.getsignal(signal.SIGINT) is files._on_signal
+        assert files._PREVIOUS == {signal.SIGINT: saved[signal.SIGINT]}
+        for path in made:
+            files.forget_temporary(path)
+        assert signal.getsignal(signal.SIGINT) == saved[signal.SIGINT]
+
+        errors: list[BaseException] = []
+
+        def worker() -> None:  # a fleet worker thread cannot set signal handlers
+            try:
+                made.append(files.temporary_beside(tmp_path / "c.csv"))
+            except BaseException as exc:
+                errors.append(exc)
+
+        thread = threading.Thread(target=worker)
+        thread.start()
+        thread.join()
+        assert errors == [] and files._PREVIOUS == {}
+        assert signal.getsignal(signal.SIGINT) == saved[signal.SIGINT]
+    finally:
+        for path in made:
+            files.forget_temporary(path)
+        for signum, handler in saved.items():
+            signal.signal(signum, handler)
+        files._PREVIOUS.clear()
+
+
+def test_pid_alive_sends_no_signal(monkeypatch):
+    """Signal 0 only asks whether the process exists; any other would hit it."""
+    from hrgtc.core import files
+
+    sent = []
+    monkeypatch.setattr(os, "kill", lambda pid, signum: sent.append((pid, signum)))
+    assert files._pid_alive(12345)
+    assert sent == [(12345, 0)]
+
+
+def test_file_sha256_never_reads_a_whole_file_at_once(tmp_path, monkeypatch):
+    import builtins
+
+    from hrgtc.core import files
+
+    sizes = []
+
+    class Recorded:
+        def __init__(self, handle):
+            self.handle = handle
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            self.handle.close()
+
+        def read(self, size=-1):
+            sizes.append(size)
+            return self.handle.read(size)
+
+    monkeypatch.setattr(files, "open", lambda *a, **k: Recorded(builtins.open(*a, **k)),
+                        raising=False)
+    path = tmp_path / "f.bin"
+    path.write_bytes(b"x" * 100)
+    files.file_sha256(path, block_bytes=40)
+    assert sizes == [40, 40, 40, 40]
+
+
+def test_a_stale_temporary_that_cannot_be_removed_is_reported_by_name(tmp_path, monkeypatch):
+    from pathlib import Path
+
+    from hrgtc.core import files
+
+    name = f".out.csv.{_dead_pid()}.k3j_x.tmp"
+    (tmp_path / name).write_text("half")
+
+    def refused(self, missing_ok=False):
+        raise PermissionError(errno.EACCES, "Permission denied", str(self))
+
+    monkeypatch.setattr(Path, "unlink", refused)
+    with pytest.warns(files.StaleTemporaryWarning, match=rf"1 temporary file\(s\) .* \({name}\)"):
+        assert files.clean_stale_temporaries(tmp_path / "out.csv") == []
+
+
+def test_stale_temporaries_of_older_versions_are_counted_and_three_named(tmp_path):
+    import re
+
+    from hrgtc.core import files
+
+    names = [f".out.csv.old{i}.tmp" for i in range(4)]  # no PID: older hrgtc
+    for name in names:
+        (tmp_path / name).write_text("half")
+    with pytest.warns(files.StaleTemporaryWarning) as caught:
+        files.clean_stale_temporaries(tmp_path / "out.csv")
+    assert caught[0].filename == __file__  # said where the caller is
+    message = str(caught[0].message)
+    listed = re.search(r"4 temporary file\(s\) of an interrupted earlier write of out\.csv "
+                       r"remain \((.*)\); remove them", message).group(1).split(", ")
+    assert len(listed) == 3 and set(listed) < set(names)

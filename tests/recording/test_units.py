@@ -167,3 +167,54 @@ def test_real_recording_count_is_unwrapped_with_a_warning():
                 temp_scale=0.01, temp_unwrap="off", thermometer="sensor", gaps="split",
                 validate=False)
     assert kept["temperature_c"][0] == pytest.approx(652.36)
+
+
+# -- mutants of units.py that no test killed (make mutation, issue 21) -------------------------
+def test_find_unit_names_the_kinds_for_an_unknown_kind():
+    with pytest.raises(InputError) as caught:
+        find_unit("speed", "m/s")
+    assert str(caught.value) == ("unknown unit kind 'speed'; use one of "
+                                 "['time', 'freq', 'rate', 'temp']")
+
+
+@pytest.mark.parametrize(("name", "symbol"), [("ddeg", "Δθ °/sample"), ("lsb", "LSB")])
+def test_convert_refuses_per_sample_and_scaled_units(name, symbol):
+    with pytest.raises(InputError) as caught:
+        convert(np.ones(3), "rate", name)
+    assert str(caught.value) == (f"{symbol} needs the time steps or a scale; read it through "
+                                 "a recording with its options")
+
+
+def test_convert_gives_float64_whatever_the_input():
+    out = convert(np.array([1.0, 2.0], dtype=np.float32), "rate", "radps")
+    assert out.dtype == np.float64
+    assert out[1] == 2.0 * 648000.0 / math.pi  # float32 would be off in the 8th digit
+
+
+def test_per_sample_steps_takes_the_period_for_zero_steps_and_gaps_but_not_two_periods():
+    period = 0.5
+    time_s = np.array([0.0, 0.5, 0.5, 1.5, 3.0, 3.5])  # steps 0.5, 0, 1.0 (2 periods), 1.5
+    assert per_sample_steps(time_s, None, period).tolist() == [0.5, 0.5, 0.5, 1.0, 0.5, 0.5]
+    assert per_sample_steps(time_s, -1.0, period).tolist() == [1.0, 0.5, 0.5, 1.0, 0.5, 0.5]
+
+
+def test_median_period_ignores_zero_negative_and_infinite_steps():
+    from hrgtc.recording.units import median_period
+
+    assert median_period(np.array([0.0, 1.0, -4.0, -9.0, -14.0, -13.0])) == 1.0
+    assert median_period(np.array([0.0, 0.0, 0.0, 0.0, 1.0])) == 1.0
+    assert median_period(np.array([0.0, 2.0, np.inf])) == 2.0
+    assert median_period(np.array([5.0])) is None
+    assert median_period(np.array([1.0, 1.0])) is None
+
+
+def test_find_unit_ignores_case_and_spaces():
+    assert find_unit("rate", " RAD / S ").name == "radps"
+
+
+@pytest.mark.parametrize(("text", "name"), [("Δθdeg", "ddeg"), ("Δθrad", "drad"),
+                                            ("Δθ °/sample", "ddeg"), ("m°/s", "mdps")])
+def test_find_unit_accepts_its_spellings_with_a_capital_and_the_symbols_it_shows(text, name):
+    """The table's "Δθdeg" and the symbols the error message lists are accepted (a capital
+    Δ was compared with the lower-cased input and never matched)."""
+    assert find_unit("rate", text).name == name

@@ -123,7 +123,10 @@ def find_unit(kind: str, text: str) -> Unit:
         raise InputError(f"unknown unit kind {kind!r}; use one of {list(_BY_KIND)}")
     wanted = str(text).strip().lower().replace(" ", "")
     for unit in _BY_KIND[kind].values():
-        if wanted == unit.name.lower() or wanted in unit.spellings:
+        # spellings and symbols compared as typed ones are: lower case, no spaces ("Δθdeg",
+        # "Δθ °/sample" lower to "δθ...", which a capital Δ in the table never matched)
+        spellings = {s.lower().replace(" ", "") for s in (*unit.spellings, unit.symbol)}
+        if wanted == unit.name.lower() or wanted in spellings:
             return unit
     known = ", ".join(u.name if u.name == u.symbol else f"{u.name} ({u.symbol})"
                       for u in _BY_KIND[kind].values())
