@@ -130,61 +130,16 @@ class _WindowMeans:
         marks.update({int(c): "cut" for c in cuts if 0 <= c < block.shape[0]
                       and int(c) not in marks})
         edges = [0, *sorted(m for m in marks if m > 0), block.shape[0]]
-        kind = marks.get(0)
-        if kind == "break":
-            out = [self.flush()]
-        else:
-            if kind == "cut":
+        out = []
+        for k in range(len(edges) - 1):
+            kind = marks.get(edges[k])
+            if kind == "break":
+                out.append(self.flush())
+            elif kind == "cut":
                 self.drop()
-            out = []
-        # the first segment may continue the window of the previous chunk (the carry)
-        out.append(self._push(block[: edges[1]]))
-        if len(edges) > 2:  # the later segments lie inside the block: all at once
-            out.append(self._segments(block, edges, marks))
+            out.append(self._push(block[edges[k]:edges[k + 1]]))
         out = [o for o in out if o.shape[0]]
         return np.concatenate(out) if out else np.empty((0, block.shape[1]))
-
-    def _segments(self, block: np.ndarray, edges: list[int], marks: dict[int, str]) -> np.ndarray:
-        """Window means of the segments of ``block`` after its first (``edges[1:]``), the
-        same as one :meth:`_push` / :meth:`flush` / :meth:`drop` per segment, with the
-        sums of every window in one ``numpy.add.reduceat`` (a burst file has thousands
-        of short segments per chunk)."""
-        starts: list[int] = []
-        stops: list[int] = []
-        tail = None  # where the previous segment's partial window starts in the block
-        for k in range(1, len(edges) - 1):
-            a, b = edges[k], edges[k + 1]
-            keep = marks[a] == "break"
-            if tail is None:  # the first segment's partial window is the carry
-                if keep:
-                    flushed = self.flush()
-                    if flushed.shape[0]:
-                        starts.append(-1)  # placeholder: its mean comes first
-                        stops.append(-1)
-                        first = flushed
-                else:
-                    self.drop()
-            elif a > tail:
-                if keep and a - tail >= self.min_rows:
-                    starts.append(tail)
-                    stops.append(a)
-                else:
-                    self.partial_dropped_rows += a - tail
-            complete = (b - a) // self.rows
-            starts.extend(range(a, a + complete * self.rows, self.rows))
-            stops.extend(range(a + self.rows, a + (complete + 1) * self.rows, self.rows))
-            tail = a + complete * self.rows
-        self._carry = block[tail:].copy()
-        rows = [(s, e) for s, e in zip(starts, stops, strict=True) if s >= 0]
-        means = np.empty((0, block.shape[1]))
-        if rows:
-            index = np.array(rows, dtype=np.int64).ravel()
-            sums = np.add.reduceat(block, index[index < block.shape[0]], axis=0)[::2]
-            lengths = np.array([e - s for s, e in rows], dtype=np.float64)
-            means = sums[: len(rows)] / lengths[:, None]
-        if starts and starts[0] == -1:
-            means = np.concatenate([first, means])
-        return means
 
     def _push(self, block: np.ndarray) -> np.ndarray:
         if self._carry is not None and self._carry.shape[0]:
