@@ -25,7 +25,6 @@ from hrgtc.compensate.model_fit import (
     plausible_frequency_band,
     with_model_band,
 )
-from hrgtc.core.errors import RecordingError
 from hrgtc.core.progress import Progress
 from hrgtc.drift.rest import run_rest
 from hrgtc.evaluation.allan import ONE_SIGMA
@@ -35,6 +34,7 @@ from hrgtc.evaluation.plot_blocks import block_rows
 from hrgtc.evaluation.run_pass import RunPass, count_dropped
 from hrgtc.model import InstrumentModel
 from hrgtc.recording import ReadOptions, Recording, axis_view, count_rows
+from hrgtc.recording.io import check_axis_band
 from hrgtc.recording.marks import refuse_compensated
 from hrgtc.recording.motion import ACCEL_COLUMNS
 
@@ -104,7 +104,7 @@ def evaluate_axes(
         for axis, state in passes.items():
             view = chunk if single else axis_view(chunk, axis)
             if not single:
-                _check_band(view, axis, bands[axis], done, source)
+                check_axis_band(view, axis, bands[axis], done, source)
             state.partial_fit(view)
         done += len(chunk)
         if progress is not None:
@@ -125,20 +125,4 @@ def _rest_masks(chunks: Iterator[Recording], model: InstrumentModel, motion: str
             parts[axis].append(Recording({k: view[k] for k in REST_COLUMNS if k in view},
                                          view.metadata, view.source))
     return {axis: run_rest(views, motion, name=name).keep for axis, views in parts.items()}
-
-
-def _check_band(view: Recording, axis: str, band: tuple[float, float], row: int,
-                path: str) -> None:
-    """The error of :meth:`hrgtc.recording.ReadOptions.chunks` for a frequency outside the
-    band the axis can reach."""
-    if not len(view):
-        return
-    freq = view.freq_hz
-    bad = np.flatnonzero(~((freq >= band[0]) & (freq <= band[1])))
-    if bad.size:
-        raise RecordingError(
-            f"{path}: column freq_hz_{axis}, row {row + int(bad[0])}: "
-            f"{float(freq[bad[0]])!r} is outside the band {band[0]:.6g}-{band[1]:.6g} this "
-            f"axis of the model can reach ({bad.size} such rows in the chunk); is it another "
-            "unit's file, or the wrong column?")
 

@@ -521,17 +521,25 @@ def _axis_views(chunks: Iterator[Recording], axis: str, band: tuple[float, float
     try:
         for chunk in chunks:
             view = axis_view(chunk, axis)
-            if band is not None and len(view):
-                freq = view.freq_hz
-                bad = np.flatnonzero(~((freq >= band[0]) & (freq <= band[1])))
-                if bad.size:
-                    raise RecordingError(
-                        f"{path}: column freq_hz_{axis}, row {row + int(bad[0])}: "
-                        f"{float(freq[bad[0]])!r} is outside the band "
-                        f"{band[0]:.6g}-{band[1]:.6g} this axis of the model can reach "
-                        f"({bad.size} such rows in the chunk); is it another unit's file, "
-                        "or the wrong column?")
+            if band is not None:
+                check_axis_band(view, axis, band, row, path)
             row += len(chunk)
             yield view
     finally:
         chunks.close()  # type: ignore[attr-defined]
+
+
+def check_axis_band(view: Recording, axis: str, band: tuple[float, float], row: int,
+                    path: str) -> None:
+    """Refuse a frequency of ``axis``'s view (whose first row is ``row`` of ``path``)
+    outside the ``band`` that axis of a model can reach."""
+    if not len(view):
+        return
+    freq = view.freq_hz
+    bad = np.flatnonzero(~((freq >= band[0]) & (freq <= band[1])))
+    if bad.size:
+        raise RecordingError(
+            f"{path}: column freq_hz_{axis}, row {row + int(bad[0])}: "
+            f"{float(freq[bad[0]])!r} is outside the band {band[0]:.6g}-{band[1]:.6g} this "
+            f"axis of the model can reach ({bad.size} such rows in the chunk); is it another "
+            "unit's file, or the wrong column?")
