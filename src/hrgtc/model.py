@@ -34,8 +34,10 @@ from hrgtc.model_schema import (
     SCHEMA_NAME,
     SCHEMA_VERSION,
     AxisRecord,
+    FileRecord,
     axis_parts,
     check_document,
+    file_document,
     parameters_sha256,
     parse_model_json,
     strict,
@@ -92,15 +94,11 @@ class UnitModel:
         return records.dump(self, AxisRecord)
 
     def to_dict(self) -> dict[str, Any]:
-        """The model file's JSON document."""
+        """The model file's JSON document: :class:`~hrgtc.model_schema.FileRecord`'s fields
+        with the axis's parts (:class:`~hrgtc.model_schema.AxisRecord`) at the top level."""
         parts = self.parts()
-        return {
-            "schema": SCHEMA_NAME,
-            "schema_version": SCHEMA_VERSION if "scale_factor" in parts else _PLAIN_VERSION,
-            "unit": self.unit,
-            **parts,
-            "provenance": dict(self.provenance),
-        }
+        version = SCHEMA_VERSION if "scale_factor" in parts else _PLAIN_VERSION
+        return file_document(_head(self, version), parts)
 
     @classmethod
     def from_parts(cls, data: Mapping[str, Any], unit: str,
@@ -148,9 +146,9 @@ class UnitModel:
                 "hrgtc.model.load_instrument, or pick one axis with InstrumentModel.axes[name]"
             )
         data = check_document(strict(dict(data)), source, non_standard)
+        head = _read_head(data, source)
         try:
-            return cls.from_parts(data, str(data.get("unit", "unknown")),
-                                  data.get("provenance", {}))
+            return cls.from_parts(data, head["unit"], head["provenance"])
         except KeyError as exc:
             raise ModelFileError(f"{source}: model file is missing {exc}; it is corrupt") from exc
         except HrgtcError as exc:
@@ -217,21 +215,15 @@ class InstrumentModel:
         return tuple(self.axes)
 
     def to_dict(self) -> dict[str, Any]:
-        """The model file's JSON document."""
+        """The model file's JSON document (:class:`~hrgtc.model_schema.FileRecord`): one
+        axis's parts at the top level, or each axis's under ``axes``; the temperature map
+        as it was read or fitted (keys a newer version wrote are kept)."""
         if self.is_single_axis:
-            document = self.axes[""].to_dict()
-            document.update(unit=self.unit, provenance=dict(self.provenance))
-        else:
-            document = {
-                "schema": SCHEMA_NAME,
-                "schema_version": SCHEMA_VERSION,
-                "unit": self.unit,
-                "axes": {name: model.parts() for name, model in self.axes.items()},
-                "provenance": dict(self.provenance),
-            }
-        if self.temperature_map is not None:
-            document["temperature_map"] = dict(self.temperature_map)
-        return document
+            axis = replace(self.axes[""], unit=self.unit, provenance=self.provenance)
+            parts = axis.parts()
+            version = SCHEMA_VERSION if "scale_factor" in parts else _PLAIN_VERSION
+            return file_document(_head(axis, version), parts, self.temperature_map)
+        return file_document(_head(self, SCHEMA_VERSION), None, self.temperature_map)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any], source: str = "model",
@@ -252,8 +244,8 @@ class InstrumentModel:
                 f"understands ({SCHEMA_VERSION}); upgrade hrgtc"
             )
         checked = check_document(strict(dict(data)), source, non_standard)
-        unit = str(checked.get("unit", "unknown"))
-        provenance = dict(checked.get("provenance", {}))
+        head = _read_head(checked, source)
+        unit, provenance = head["unit"], head["provenance"]
         try:
             axes = {name: UnitModel.from_parts(part, unit, provenance)
                     for name, part in axis_parts(checked).items()}
@@ -267,6 +259,25 @@ class InstrumentModel:
     def sha256(self) -> str:
         """SHA-256 of the parameters as canonical JSON (see :func:`model_sha256`)."""
         return parameters_sha256(self.to_dict())
+
+
+def _head(model: UnitModel | InstrumentModel, version: int) -> dict[str, Any]:
+    """The file's own fields (:class:`~hrgtc.model_schema.FileRecord`) of ``model``: a
+    :class:`UnitModel` has no ``axes``; an instrument's axes are dumped by their record
+    (:class:`~hrgtc.model_schema.AxisRecord`)."""
+    return records.dump(model, FileRecord, schema=SCHEMA_NAME, schema_version=version,
+                        temperature_map=None)
+
+
+def _read_head(checked: Mapping[str, Any], source: str) -> dict[str, Any]:
+    """The file's own fields of a checked document, read by :class:`FileRecord` (each
+    axis's parts are read by the records of the parts, :meth:`UnitModel.from_parts`)."""
+    try:
+        return records.load({k: checked[k] for k in ("schema", "schema_version", "unit",
+                                                     "provenance") if k in checked},
+                            FileRecord, "model file")
+    except HrgtcError as exc:
+        raise ModelFileError(f"{source}: {exc}") from None
 
 
 def _temperature_map(data: Any, source: str) -> dict[str, Any] | None:

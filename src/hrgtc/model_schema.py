@@ -85,7 +85,14 @@ class AxisRecord(records.Record, kw_only=True):
 
 
 class FileRecord(records.Record, kw_only=True):
-    """The model file's own fields, beside one axis's parts (:class:`AxisRecord`) or ``axes``."""
+    """The model file's own fields, beside one axis's parts (:class:`AxisRecord`) or ``axes``.
+
+    A single-axis file holds its axis's parts at the place of ``axes``
+    (:func:`file_document`); ``temperature_map`` is written as the map wrote it.
+    """
+
+    # absent unless used: a single-axis file, a file before it is hashed, no map
+    omit_when_default = ("axes", "parameters_sha256", "temperature_map")
 
     schema: Literal["hrgtc.model"]
     schema_version: Annotated[int, Meta(ge=1, le=SCHEMA_VERSION)]
@@ -96,6 +103,23 @@ class FileRecord(records.Record, kw_only=True):
     parameters_sha256: Annotated[str, Meta(pattern="^[0-9a-f]{64}$")] = ""
     #: Optional: a raw temperature count's map to °C (calibrate --temp-ref).
     temperature_map: TemperatureMapRecord | None = None
+
+
+def file_document(head: Mapping[str, Any], parts: Mapping[str, Any] | None = None,
+                  temperature_map: Mapping[str, Any] | None = None) -> dict[str, Any]:
+    """A model file's document: its :class:`FileRecord` fields (``records.dump``), with a
+    single axis's parts (:class:`AxisRecord`) where ``axes`` would be, and the map last.
+
+    The keys keep the order files have always had (``json.dumps`` writes them in order).
+    """
+    document: dict[str, Any] = {}
+    for key, value in head.items():
+        if key == "provenance" and parts is not None:
+            document.update(parts)
+        document[key] = value
+    if temperature_map is not None:
+        document["temperature_map"] = dict(temperature_map)
+    return document
 
 
 def _model_schema() -> dict[str, Any]:

@@ -110,7 +110,7 @@ def _omit_defaults(document: Any, kind: Any) -> None:
             if field.name not in document:
                 continue
             if field.name in kind.omit_when_default and document[field.name] == _strict(
-                    field.default):
+                    _default(field)):
                 del document[field.name]
             else:
                 _omit_defaults(document[field.name], field.type)
@@ -126,6 +126,11 @@ def _omit_defaults(document: Any, kind: Any) -> None:
         for member in args:
             if isinstance(member, type) and issubclass(member, Record):
                 _omit_defaults(document, member)
+
+
+def _default(field: Any) -> Any:
+    """A field's default (a new one of its factory's: ``records.empty()``)."""
+    return field.default_factory() if field.default is msgspec.NODEFAULT else field.default
 
 
 def _plain(value: Any) -> Any:
