@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from hrgtc.core import records
 from hrgtc.thermometry import Thermometer, fit
 
 # Table 1 of [1]: chamber set-point and settled natural frequency of each soak.
@@ -69,29 +70,37 @@ class Reproduction:
     table2_computed_c: tuple[float, ...]
 
     def to_dict(self) -> dict[str, Any]:
-        """The layout of ``hrgtc paper --json``."""
-        return {
-            "eq18": {
-                "coefficients_high_first": list(self.coefficients_high_first),
-                "rounded_high_first": list(self.rounded_high_first),
-                "published_high_first": list(EQ18_PRINTED_HIGH_FIRST),
-            },
-            "table2": [
-                {
-                    "frequency_hz": float(f),
-                    "actual_c": float(t),
-                    "published_c": float(p),
-                    "computed_c": float(c),
-                }
-                for f, t, p, c in zip(
-                    TABLE2_FREQUENCY_HZ,
-                    TABLE2_ACTUAL_C,
-                    TABLE2_CALCULATED_C,
-                    self.table2_computed_c,
-                    strict=True,
-                )
-            ],
-        }
+        """The layout of ``hrgtc paper --json`` (:class:`ReproductionRecord`): Eq. (18) as
+        fitted, rounded and printed, and Table 2 published beside recomputed."""
+        rows = zip(TABLE2_FREQUENCY_HZ, TABLE2_ACTUAL_C, TABLE2_CALCULATED_C,
+                   self.table2_computed_c, strict=True)
+        return records.dump(self, ReproductionRecord, eq18=self, table2=[
+            {"frequency_hz": f, "actual_c": t, "published_c": p, "computed_c": c}
+            for f, t, p, c in rows])
+
+
+class Eq18Record(records.Record, kw_only=True):
+    """Eq. (18) of [1]: coefficients of T^3, T^2, T, 1 fitted, rounded as printed, printed."""
+
+    coefficients_high_first: tuple[float, ...]
+    rounded_high_first: tuple[float, ...]
+    published_high_first: tuple[float, ...] = EQ18_PRINTED_HIGH_FIRST
+
+
+class Table2RowRecord(records.Record, kw_only=True):
+    """A row of Table 2 of [1]: frequency, actual, published and recomputed temperature."""
+
+    frequency_hz: float
+    actual_c: float
+    published_c: float
+    computed_c: records.Statistic
+
+
+class ReproductionRecord(records.Record, kw_only=True):
+    """A :class:`Reproduction` in ``hrgtc paper --json`` (written only)."""
+
+    eq18: Eq18Record
+    table2: tuple[Table2RowRecord, ...]
 
 
 def round_significant(value: float, digits: int) -> float:

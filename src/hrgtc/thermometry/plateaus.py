@@ -35,17 +35,23 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
+from hrgtc.core import records
 from hrgtc.core.errors import CalibrationError, InputError, RecordingError
 from hrgtc.core.progress import Progress
 from hrgtc.recording import Recording
 from hrgtc.settings.calibration import PlateauSettings
-from hrgtc.thermometry.settling import MIN_FIT_POINTS, TransientFit, fit_transient
+from hrgtc.thermometry.settling import (
+    MIN_FIT_POINTS,
+    TransientFit,
+    TransientFitRecord,
+    fit_transient,
+)
 
 __all__ = [
     "DEFAULT_HZ_PER_C",
@@ -149,20 +155,39 @@ class Plateau:
         return "\n".join(lines)
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (the fit nested)."""
-        data = asdict(self)
-        data["fit"] = None if self.fit is None else self.fit.to_dict()
-        return data
+        """Plain JSON types (the fit nested), as :class:`PlateauRecord` writes them
+        (NaN -> None)."""
+        return records.dump(self, PlateauRecord)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> Plateau:
-        """Inverse of :meth:`to_dict`."""
-        try:
-            values = dict(data)
-            fit = values.pop("fit", None)
-            return cls(**values, fit=None if fit is None else TransientFit.from_dict(fit))
-        except (KeyError, TypeError, ValueError) as exc:
-            raise InputError(f"not a valid plateau record: {exc!r}") from exc
+        """Inverse of :meth:`to_dict` (checked against :class:`PlateauRecord`)."""
+        values = records.load(data, PlateauRecord, "plateau")
+        fit = values.pop("fit")
+        return cls(**values, fit=None if fit is None else TransientFit(**fit))
+
+
+class PlateauRecord(records.Record, kw_only=True):
+    """A :class:`Plateau` in a file (one row of a model file's ``plateaus``, the unit's
+    Table 1): field names and bounds, from which its ``to_dict``/``from_dict`` and JSON
+    Schema are generated. Its measured numbers are ``null`` when not finite."""
+
+    chamber_c: float
+    freq_hz: records.Statistic
+    freq_std_hz: records.Statistic
+    n_samples: records.Count
+    start_s: float
+    end_s: float
+    slope_hz_per_h: records.Statistic
+    settled: bool
+    settled_freq_hz: records.Statistic
+    settled_freq_std_hz: records.Statistic
+    method: str
+    residual_unsettled_c: records.Statistic
+    hz_per_c: records.Statistic
+    segment_start_s: float
+    fit: TransientFitRecord | None = None
+    source: str | None = None
 
 
 # -- block means, chamber segments and slopes -----------------------------------------

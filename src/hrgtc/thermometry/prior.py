@@ -31,14 +31,16 @@ from __future__ import annotations
 import json
 import math
 import os
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any, Literal
 
 import numpy as np
+from msgspec import Meta
 
+from hrgtc.core import records
 from hrgtc.core.errors import CalibrationError, InputError
 from hrgtc.thermometry.thermometer import Thermometer, _scaled_to_raw_matrix
 
@@ -46,6 +48,8 @@ __all__ = ["PriorFit", "ThermometerPrior", "fit_with_prior", "load_prior", "rela
 
 SCHEMA_NAME = "hrgtc.thermometer-prior"
 SCHEMA_VERSION = 1
+#: The basis the prior's coefficients are in (written into the file for its reader).
+BASIS = "f(T) = a0 (1 + sum_k b_k z^k), z = (T - centre_c) / scale_c"
 #: A unit whose soaks lie this far (in prior standard deviations) from the prior's
 #: prediction is not of the prior's kind.
 KIND_SIGMAS = 8.0
@@ -161,40 +165,22 @@ class ThermometerPrior:
         )
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (the prior file)."""
-        return {
-            "schema": SCHEMA_NAME, "schema_version": SCHEMA_VERSION, "order": self.order,
-            "centre_c": self.centre_c, "scale_c": self.scale_c,
-            "temperature_range_c": list(self.temperature_range_c),
-            "basis": "f(T) = a0 (1 + sum_k b_k z^k), z = (T - centre_c) / scale_c",
-            "mean": list(self.mean), "covariance": [list(r) for r in self.covariance],
-            "nominal_freq_hz": self.nominal_freq_hz,
-            "nominal_freq_std_hz": self.nominal_freq_std_hz,
-            "point_std_hz": self.point_std_hz, "n_units": self.n_units,
-            "units": list(self.units),
-        }
+        """Plain JSON types (the prior file), as :class:`ThermometerPriorRecord` writes them."""
+        return records.dump(self, ThermometerPriorRecord)
 
     @classmethod
-    def from_dict(cls, data: dict[str, Any], source: str = "prior") -> ThermometerPrior:
-        """Inverse of :meth:`to_dict`."""
-        if not isinstance(data, dict) or data.get("schema") != SCHEMA_NAME:
+    def from_dict(cls, data: Mapping[str, Any], source: str = "prior") -> ThermometerPrior:
+        """Inverse of :meth:`to_dict` (checked against :class:`ThermometerPriorRecord`)."""
+        if not isinstance(data, Mapping) or data.get("schema") != SCHEMA_NAME:
             raise InputError(f"{source}: not an hrgtc prior file; create one with "
                              "'hrgtc fleet prior MODELS -o prior.json'")
         try:
-            return cls(
-                order=int(data["order"]), centre_c=float(data["centre_c"]),
-                scale_c=float(data["scale_c"]),
-                temperature_range_c=(float(data["temperature_range_c"][0]),
-                                     float(data["temperature_range_c"][1])),
-                mean=tuple(float(v) for v in data["mean"]),
-                covariance=tuple(tuple(float(v) for v in r) for r in data["covariance"]),
-                nominal_freq_hz=float(data["nominal_freq_hz"]),
-                nominal_freq_std_hz=float(data["nominal_freq_std_hz"]),
-                point_std_hz=float(data["point_std_hz"]),
-                units=tuple(str(u) for u in data.get("units", ())),
-            )
-        except (KeyError, TypeError, ValueError, IndexError) as exc:
-            raise InputError(f"{source}: prior file is corrupt: {exc!r}") from exc
+            values = records.load(data, ThermometerPriorRecord, "thermometer-prior")
+        except InputError as exc:
+            raise InputError(f"{source}: prior file is corrupt: {exc}") from None
+        for derived in ("schema", "schema_version", "basis", "n_units"):
+            values.pop(derived)
+        return cls(**values)
 
     def summary(self) -> str:
         """A few lines of text."""
@@ -270,12 +256,48 @@ class PriorFit:
         return float(np.max(self.band()["std_c"]))
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types."""
-        return {"prior_units": self.prior.n_units, "temperatures_c": list(self.temperatures_c),
-                "frequencies_hz": list(self.frequencies_hz),
-                "point_std_hz": list(self.point_std_hz), "max_sigma": self.max_sigma,
-                "max_temperature_std_c": self.max_temperature_std_c,
-                "temperature_band": self.band(13)}
+        """Plain JSON types, as :class:`PriorFitRecord` writes them (NaN -> None)."""
+        return records.dump(self, PriorFitRecord, prior_units=self.prior.n_units,
+                            temperature_band=self.band(13))
+
+
+class ThermometerPriorRecord(records.Record, kw_only=True):
+    """A :class:`ThermometerPrior` in its file (``hrgtc fleet prior``): field names and
+    bounds, from which its ``to_dict``/``from_dict`` and its JSON Schema are generated."""
+
+    schema: Literal["hrgtc.thermometer-prior"] = SCHEMA_NAME
+    schema_version: Annotated[int, Meta(ge=1, le=SCHEMA_VERSION)] = SCHEMA_VERSION
+    order: Annotated[int, Meta(ge=1, le=12)]
+    centre_c: float
+    scale_c: records.Positive
+    temperature_range_c: records.Range
+    #: What ``mean`` and ``covariance`` are coefficients of (text for the reader).
+    basis: str = BASIS
+    mean: tuple[float, ...]
+    covariance: tuple[tuple[float, ...], ...]
+    nominal_freq_hz: float
+    nominal_freq_std_hz: records.NonNegative
+    point_std_hz: records.NonNegative
+    n_units: records.Count = 0
+    units: tuple[str, ...] = ()
+
+
+class PriorFitRecord(records.Record, kw_only=True):
+    """A :class:`PriorFit` in a JSON document (``calibrate --prior --json``); written only."""
+
+    prior_units: records.Count
+    temperatures_c: tuple[float, ...]
+    frequencies_hz: tuple[float, ...]
+    point_std_hz: tuple[float, ...]
+    max_sigma: records.Statistic
+    max_temperature_std_c: records.Statistic
+    temperature_band: dict[str, tuple[records.Statistic, ...]]
+
+
+#: JSON Schema (Draft 2020-12) of the prior file, generated from :class:`ThermometerPriorRecord`.
+PRIOR_JSON_SCHEMA: dict[str, Any] = records.json_schema(
+    ThermometerPriorRecord, "hrgtc thermometer prior",
+    "https://hrgtc.invalid/schema/thermometer-prior.json")
 
 
 def _design(z: np.ndarray, order: int) -> np.ndarray:

@@ -41,6 +41,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Literal
 
+import msgspec
 import numpy as np
 
 from hrgtc.core import records
@@ -132,44 +133,32 @@ class TemperatureMap:
                 f"°C), reference lag {self.lag_s:+.0f} s")
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (the model file's ``temperature_map``)."""
-        return {"scale_c_per_count": self.scale_c_per_count, "offset_c": self.offset_c,
-                "count_bits": self.count_bits, "lag_s": self.lag_s,
-                "residual_rms_c": _finite_or_none(self.residual_rms_c),
-                "residual_max_c": _finite_or_none(self.residual_max_c),
-                "points": self.points,
-                "count_range": [_finite_or_none(v) for v in self.count_range],
-                "reference": self.reference, **self.extra}
+        """Plain JSON types (the model file's ``temperature_map``), as
+        :class:`TemperatureMapRecord` writes them (NaN -> None), then the keys of ``extra``."""
+        return {**records.dump(self, TemperatureMapRecord), **self.extra}
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> TemperatureMap:
-        """Inverse of :meth:`to_dict`; a scale of 0 or a non-finite number is refused."""
-        try:
-            scale, offset = float(data["scale_c_per_count"]), float(data["offset_c"])
-        except (KeyError, TypeError, ValueError) as exc:
-            raise InputError(f"temperature_map needs numbers scale_c_per_count and offset_c "
-                             f"({exc})") from None
+        """Inverse of :meth:`to_dict` (checked against :class:`TemperatureMapRecord`; keys
+        it does not know are kept in ``extra``); a scale of 0 or a non-finite number is
+        refused."""
+        if not isinstance(data, Mapping):
+            raise InputError(f"temperature_map is {data!r}, not an object")
+        values = records.load(data, TemperatureMapRecord, "temperature_map")
+        scale, offset = values["scale_c_per_count"], values["offset_c"]
         if not (math.isfinite(scale) and math.isfinite(offset) and scale != 0.0):
             raise InputError(f"temperature_map scale {scale!r} / offset {offset!r}: a finite "
                              "scale other than 0 and a finite offset are needed")
-        bits = data.get("count_bits")
-        if bits not in (None, 16, 32):
-            raise InputError(f"temperature_map count_bits must be 16, 32 or null, got {bits!r}")
-        known = {"scale_c_per_count", "offset_c", "count_bits", "lag_s", "residual_rms_c",
-                 "residual_max_c", "points", "count_range", "reference"}
-        low, high = [*list(data.get("count_range") or []), None, None][:2]
-        return cls(scale, offset, bits, float(data.get("lag_s") or 0.0),
-                   _nan(data.get("residual_rms_c")), _nan(data.get("residual_max_c")),
-                   int(data.get("points") or 0), (_nan(low), _nan(high)),
-                   str(data.get("reference") or ""),
-                   {k: v for k, v in data.items() if k not in known})
-
+        if values["count_range"] is None:
+            values["count_range"] = (math.nan, math.nan)
+        known = {f.name for f in msgspec.structs.fields(TemperatureMapRecord)}
+        return cls(**values, extra={k: v for k, v in data.items() if k not in known})
 
 
 class TemperatureMapRecord(records.Record, kw_only=True):
     """A :class:`TemperatureMap` in a file (the model file's optional ``temperature_map``):
-    its JSON Schema. Its ``to_dict``/``from_dict`` stay by hand: they keep keys this
-    version does not know (``extra``) and name the fix in their messages."""
+    field names and bounds, from which its ``to_dict``/``from_dict`` and its JSON Schema
+    are generated (keys a newer version wrote are kept beside it, in ``extra``)."""
 
     scale_c_per_count: float
     offset_c: float
@@ -180,13 +169,6 @@ class TemperatureMapRecord(records.Record, kw_only=True):
     points: records.Count = 0
     count_range: tuple[records.Statistic, records.Statistic] | None = None
     reference: str = ""
-
-def _finite_or_none(value: float) -> float | None:
-    return float(value) if value is not None and math.isfinite(value) else None
-
-
-def _nan(value: Any) -> float:
-    return math.nan if value is None else float(value)
 
 
 # -- reading the log ---------------------------------------------------------------

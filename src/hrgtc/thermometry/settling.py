@@ -27,12 +27,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from scipy.optimize import least_squares
 
+from hrgtc.core import records
 from hrgtc.core.errors import InputError
 
 __all__ = ["MIN_FIT_POINTS", "TransientFit", "fit_transient"]
@@ -117,22 +118,33 @@ class TransientFit:
         )
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types."""
-        data = asdict(self)
-        data.update({k: list(data[k]) for k in ("tau_s", "weights", "poly_hz")})
-        return data
+        """Plain JSON types, as :class:`TransientFitRecord` writes them (NaN -> None)."""
+        return records.dump(self, TransientFitRecord)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> TransientFit:
-        """Inverse of :meth:`to_dict`."""
-        try:
-            values = dict(data)
-            values.update(
-                {k: tuple(map(float, values[k])) for k in ("tau_s", "weights", "poly_hz")}
-            )
-            return cls(**values)
-        except (KeyError, TypeError, ValueError) as exc:
-            raise InputError(f"not a valid transient-fit record: {exc!r}") from exc
+        """Inverse of :meth:`to_dict` (checked against :class:`TransientFitRecord`)."""
+        return cls(**records.load(data, TransientFitRecord, "transient-fit"))
+
+
+class TransientFitRecord(records.Record, kw_only=True):
+    """A :class:`TransientFit` in a file (each plateau of a model file's ``plateaus``):
+    field names and bounds, from which its ``to_dict``/``from_dict`` and JSON Schema come.
+    Its numbers are statistics of a fit (``null`` when not finite: an unusable fit)."""
+
+    model: str
+    f_inf_hz: records.Statistic
+    f_inf_std_hz: records.Statistic
+    tau_s: tuple[records.Statistic, ...]
+    weights: tuple[records.Statistic, ...]
+    poly_hz: tuple[records.Statistic, ...]
+    start_s: float
+    end_s: float
+    n_blocks: records.Count
+    rms_hz: records.Statistic
+    aic: records.Statistic
+    usable: bool
+    reason: str = ""
 
 
 def _basis(tt: np.ndarray, params: np.ndarray, exps: int) -> tuple[np.ndarray, np.ndarray]:
