@@ -16,10 +16,13 @@ import re
 import time
 import traceback
 from collections.abc import Mapping
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any, Literal
 
+from msgspec import Meta
+
+from hrgtc.core import records
 from hrgtc.fleet.manifest import UnitFiles
 from hrgtc.recording import ReadOptions
 from hrgtc.settings.calibration import CalibrationSettings
@@ -63,15 +66,47 @@ class UnitOutcome:
     cpu_seconds: float = 0.0
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types."""
-        return asdict(self)
+        """Plain JSON types (the unit's outcome file), as :class:`UnitOutcomeRecord` writes
+        them (strict JSON: a number that is not finite becomes None)."""
+        return records.dump(self, UnitOutcomeRecord)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> UnitOutcome:
-        """Inverse of :meth:`to_dict`."""
-        return cls(str(data["unit"]), str(data["status"]), dict(data.get("row") or {}),
-                   data.get("error"), float(data.get("seconds", 0.0)),
-                   float(data.get("cpu_seconds", 0.0)))
+        """Inverse of :meth:`to_dict` (checked against :class:`UnitOutcomeRecord`)."""
+        values = records.load(data, UnitOutcomeRecord, "unit-outcome")
+        error = values["error"]
+        if error is not None:  # as error_record gives it: a traceback only when there is one
+            values["error"] = {k: v for k, v in error.items()
+                               if k != "traceback" or v is not None}
+        return cls(**values)
+
+
+class ErrorRecord(records.Record, kw_only=True):
+    """Why a unit failed (:func:`error_record`): the error's type and message, and the
+    file, column and row the message names (None where it names none)."""
+
+    omit_when_default = ("traceback",)
+
+    type: str
+    message: str
+    file: str | None = None
+    column: str | None = None
+    row: Annotated[int, Meta(ge=0)] | None = None
+    #: The last lines of the traceback of an error that is not hrgtc's own (a bug).
+    traceback: tuple[str, ...] | None = None
+
+
+class UnitOutcomeRecord(records.Record, kw_only=True):
+    """A :class:`UnitOutcome` in its file (``<unit>.outcome.json`` beside the model): field
+    names and bounds, from which its ``to_dict``/``from_dict`` and JSON Schema come."""
+
+    unit: str
+    status: Literal["ok", "skipped", "failed"]
+    #: The unit's row of the fleet table (:mod:`hrgtc.fleet.results`).
+    row: dict[str, Any] = records.empty()
+    error: ErrorRecord | None = None
+    seconds: records.NonNegative = 0.0
+    cpu_seconds: records.NonNegative = 0.0
 
 
 def error_record(exc: BaseException, paths: tuple[str, ...] = ()) -> dict[str, Any]:
@@ -88,7 +123,7 @@ def error_record(exc: BaseException, paths: tuple[str, ...] = ()) -> dict[str, A
     from hrgtc.core.errors import HrgtcError
 
     if not isinstance(exc, HrgtcError):  # a bug or an unforeseen input: keep where it was
-        record["traceback"] = traceback.format_exception(exc)[-3:]
+        record["traceback"] = tuple(traceback.format_exception(exc)[-3:])
     return record
 
 
