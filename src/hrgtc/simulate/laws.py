@@ -26,13 +26,15 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, Protocol
+from typing import Annotated, Any, Literal, Protocol
 
 import numpy as np
+from msgspec import Meta
 from numpy.polynomial import Polynomial
 
+from hrgtc.core import records
 from hrgtc.core.errors import InputError
-from hrgtc.simulate.shell import Shell
+from hrgtc.simulate.shell import Shell, ShellRecord
 
 __all__ = [
     "BiasLaw",
@@ -89,17 +91,23 @@ class PolynomialFrequencyLaw:
         return out
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types."""
-        return {
-            "kind": "polynomial",
-            "coefficients": list(self.coefficients),
-            "source": self.source,
-        }
+        """Plain JSON types, as :class:`PolynomialFrequencyLawRecord` writes them."""
+        return records.dump(self, PolynomialFrequencyLawRecord)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> PolynomialFrequencyLaw:
-        """Inverse of :meth:`to_dict`."""
-        return cls(tuple(data["coefficients"]), source=str(data.get("source", "")))
+        """Inverse of :meth:`to_dict` (checked against its record)."""
+        values = records.load(data, PolynomialFrequencyLawRecord, "polynomial frequency law")
+        values.pop("kind")
+        return cls(**values)
+
+
+class PolynomialFrequencyLawRecord(records.Record, kw_only=True):
+    """A :class:`PolynomialFrequencyLaw` in the simulator's ground truth."""
+
+    kind: Literal["polynomial"] = "polynomial"
+    coefficients: Annotated[tuple[float, ...], Meta(min_length=1)]
+    source: str = ""
 
 
 def table1_frequency_law() -> PolynomialFrequencyLaw:
@@ -136,13 +144,21 @@ class ShellFrequencyLaw:
         return np.asarray(self.shell.frequency_hz(np.asarray(temperature_c, dtype=np.float64)))
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types."""
-        return {"kind": "shell", "shell": self.shell.to_dict()}
+        """Plain JSON types, as :class:`ShellFrequencyLawRecord` writes them."""
+        return records.dump(self, ShellFrequencyLawRecord)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> ShellFrequencyLaw:
-        """Inverse of :meth:`to_dict`."""
+        """Inverse of :meth:`to_dict` (the shell checked by its record)."""
+        records.load(data, ShellFrequencyLawRecord, "shell frequency law")
         return cls(Shell.from_dict(data["shell"]))
+
+
+class ShellFrequencyLawRecord(records.Record, kw_only=True):
+    """A :class:`ShellFrequencyLaw` in the simulator's ground truth."""
+
+    kind: Literal["shell"] = "shell"
+    shell: ShellRecord
 
 
 def frequency_law_from_dict(data: Mapping[str, Any]) -> FrequencyLaw:
@@ -214,13 +230,20 @@ class ScaleFactorLaw:
         return out
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types."""
-        return {"coefficients_ppm": list(self.coefficients_ppm), "reference_c": self.reference_c}
+        """Plain JSON types, as :class:`ScaleFactorLawRecord` writes them."""
+        return records.dump(self, ScaleFactorLawRecord)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> ScaleFactorLaw:
-        """Inverse of :meth:`to_dict`."""
-        return cls(tuple(data["coefficients_ppm"]), float(data.get("reference_c", 20.0)))
+        """Inverse of :meth:`to_dict` (checked against its record)."""
+        return cls(**records.load(data, ScaleFactorLawRecord, "scale-factor law"))
+
+
+class ScaleFactorLawRecord(records.Record, kw_only=True):
+    """A :class:`ScaleFactorLaw` in the simulator's ground truth."""
+
+    coefficients_ppm: Annotated[tuple[float, ...], Meta(min_length=1)]
+    reference_c: float = 20.0
 
 
 @dataclass(frozen=True)
@@ -318,18 +341,22 @@ class BiasLaw:
         return out
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types."""
-        return {
-            "bias0_dph": self.bias0_dph,
-            "reference_c": self.reference_c,
-            "temperature_dph": list(self.temperature_dph),
-            "gradient_dph_per_c": self.gradient_dph_per_c,
-            "gradient_temperature_dph_per_c2": self.gradient_temperature_dph_per_c2,
-            "hysteresis_dph": self.hysteresis_dph,
-            "hysteresis_width_c": self.hysteresis_width_c,
-        }
+        """Plain JSON types, as :class:`BiasLawRecord` writes them."""
+        return records.dump(self, BiasLawRecord)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> BiasLaw:
-        """Inverse of :meth:`to_dict`."""
-        return cls(**{**data, "temperature_dph": tuple(data["temperature_dph"])})
+        """Inverse of :meth:`to_dict` (checked against its record)."""
+        return cls(**records.load(data, BiasLawRecord, "bias law"))
+
+
+class BiasLawRecord(records.Record, kw_only=True):
+    """A :class:`BiasLaw` in the simulator's ground truth."""
+
+    bias0_dph: float
+    reference_c: float = 20.0
+    temperature_dph: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    gradient_dph_per_c: float = 0.0
+    gradient_temperature_dph_per_c2: float = 0.0
+    hysteresis_dph: float = 0.0
+    hysteresis_width_c: records.Positive = 1.0

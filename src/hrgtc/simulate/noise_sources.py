@@ -32,12 +32,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import asdict, dataclass
-from typing import Any
+from dataclasses import dataclass
+from typing import Annotated, Any
 
 import numpy as np
+from msgspec import Meta
 from scipy.signal import lfilter
 
+from hrgtc.core import records
 from hrgtc.core.errors import InputError
 
 __all__ = ["BIAS_INSTABILITY_FLOOR", "GyroNoise", "GyroNoiseStream", "WhiteNoiseStream"]
@@ -155,13 +157,24 @@ class GyroNoise:
         return GyroNoiseStream(self, sample_rate_hz, white_rng, slow_rng)
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types."""
-        return asdict(self)
+        """Plain JSON types, as :class:`GyroNoiseRecord` writes them."""
+        return records.dump(self, GyroNoiseRecord)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> GyroNoise:
-        """Inverse of :meth:`to_dict`."""
-        return cls(**data)
+        """Inverse of :meth:`to_dict` (checked against its record)."""
+        return cls(**records.load(data, GyroNoiseRecord, "gyro noise"))
+
+
+class GyroNoiseRecord(records.Record, kw_only=True, forbid_unknown_fields=True):
+    """A :class:`GyroNoise` in the simulator's ground truth."""
+
+    arw_deg_per_sqrt_h: records.NonNegative
+    bias_instability_dph: records.NonNegative
+    rrw_dph_per_sqrt_h: records.NonNegative
+    flicker_tau_min_s: records.Positive = 1.0
+    flicker_tau_max_s: records.Positive = 1.0e5
+    flicker_per_decade: Annotated[int, Meta(ge=1)] = 2
 
 
 class WhiteNoiseStream:

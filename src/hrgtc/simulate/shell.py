@@ -33,6 +33,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.integrate import quad
 
+from hrgtc.core import records
 from hrgtc.core.errors import InputError
 
 __all__ = [
@@ -313,8 +314,8 @@ class Material:
         object.__setattr__(self, "name", str(self.name))
 
     def to_dict(self) -> dict[str, Any]:
-        """Return the material as a dict of JSON types."""
-        return dataclasses.asdict(self)
+        """Return the material as a dict of JSON types (:class:`MaterialRecord`)."""
+        return records.dump(self, MaterialRecord)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> Material:
@@ -323,7 +324,21 @@ class Material:
         unknown = sorted(set(data) - known)
         if unknown:
             raise InputError(f"unknown Material field(s) {unknown}; allowed: {sorted(known)}")
-        return cls(**dict(data))
+        return cls(**records.load(data, MaterialRecord, "material"))
+
+
+class MaterialRecord(records.Record, kw_only=True):
+    """A :class:`Material` in the simulator's ground truth (its bounds are the material's
+    own checks)."""
+
+    youngs_modulus_pa: float
+    poisson: float
+    density_kg_m3: float
+    youngs_tc_per_c: float = 0.0
+    poisson_tc_per_c: float = 0.0
+    expansion_per_c: float = 0.0
+    reference_temperature_c: float = 20.0
+    name: str = "custom"
 
 
 #: Fused quartz (vitreous silica) near room temperature.
@@ -534,8 +549,9 @@ class Shell:
         return _as_output(np.asarray(freq))
 
     def to_dict(self) -> dict[str, Any]:
-        """Return the shell as a dict of JSON types (material nested)."""
-        return dataclasses.asdict(self)
+        """Return the shell as a dict of JSON types (material nested), as
+        :class:`ShellRecord` writes it."""
+        return records.dump(self, ShellRecord)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> Shell:
@@ -544,7 +560,18 @@ class Shell:
             raise InputError(
                 "Shell dict lacks a 'material' mapping; expected Shell.to_dict() output"
             )
-        return cls(**{**data, "material": Material.from_dict(data["material"])})
+        material = Material.from_dict(data["material"])
+        values = records.load({**data, "material": material.to_dict()}, ShellRecord, "shell")
+        return cls(**{**values, "material": material})
+
+
+class ShellRecord(records.Record, kw_only=True):
+    """A :class:`Shell` in the simulator's ground truth (a ``shell`` frequency law)."""
+
+    radius_m: float
+    thickness_m: float
+    material: MaterialRecord
+    n: int = 2
 
 
 #: Geometry of the documented example (DESIGN.md): r = 15 mm, h = 0.78 mm. With

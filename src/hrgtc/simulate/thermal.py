@@ -28,12 +28,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from scipy.signal import lfilter
 
+from hrgtc.core import records
 from hrgtc.core.errors import InputError
 
 __all__ = ["ThermalNetwork", "ThermalState", "first_order_hold_coefficients", "step_response"]
@@ -188,13 +189,20 @@ class ThermalNetwork:
         return housing, resonator, new_state
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types."""
-        return asdict(self)
+        """Plain JSON types, as :class:`ThermalNetworkRecord` writes them."""
+        return records.dump(self, ThermalNetworkRecord)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> ThermalNetwork:
-        """Inverse of :meth:`to_dict`."""
-        return cls(**data)
+        """Inverse of :meth:`to_dict` (checked against its record)."""
+        return cls(**records.load(data, ThermalNetworkRecord, "thermal network"))
+
+
+class ThermalNetworkRecord(records.Record, kw_only=True, forbid_unknown_fields=True):
+    """A :class:`ThermalNetwork` in the simulator's ground truth."""
+
+    tau_housing_s: records.Positive
+    tau_resonator_s: records.Positive
 
 
 def step_response(network: ThermalNetwork, step_c: float, time_s: Any) -> np.ndarray:

@@ -1,0 +1,65 @@
+"""The simulator's ground truth through its records: the same JSON text as before them.
+
+Truth: ``tests/data/simulate-truth/units.json``, written by the commit before the
+records (c8c688c, ``make.py`` beside it): every standard unit's ``to_dict`` as JSON text.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import jsonschema
+import pytest
+
+from hrgtc.core import records
+from hrgtc.core.errors import InputError
+from hrgtc.simulate import units
+from hrgtc.simulate.laws import (
+    BiasLaw,
+    BiasLawRecord,
+    PolynomialFrequencyLawRecord,
+    ScaleFactorLawRecord,
+    ShellFrequencyLawRecord,
+)
+from hrgtc.simulate.noise_sources import GyroNoise, GyroNoiseRecord
+from hrgtc.simulate.thermal import ThermalNetwork, ThermalNetworkRecord
+
+TRUTH = Path(__file__).parents[1] / "data" / "simulate-truth" / "units.json"
+
+
+def test_every_standard_unit_writes_the_same_truth_as_before():
+    expected = TRUTH.read_text(encoding="utf-8")
+    truth = {name: units.get(name).to_dict() for name in units.names()}
+    assert json.dumps(truth, indent=1) + "\n" == expected
+
+
+@pytest.mark.parametrize("name", units.names())
+def test_truth_round_trips_and_fits_the_records_schemas(name):
+    unit = units.get(name)
+    written = json.loads(json.dumps(unit.to_dict()))
+    assert units.unit_from_dict(written).to_dict() == written
+    axes = written["axes"].values() if "axes" in written else [written]
+    law_records = {"polynomial": PolynomialFrequencyLawRecord, "shell": ShellFrequencyLawRecord}
+    for axis in axes:
+        for part, record in ((axis["thermal"], ThermalNetworkRecord),
+                             (axis["bias_law"], BiasLawRecord),
+                             (axis["gyro_noise"], GyroNoiseRecord),
+                             (axis["frequency_law"], law_records[axis["frequency_law"]["kind"]]),
+                             (axis.get("scale_factor_law"), ScaleFactorLawRecord)):
+            if part is not None:
+                schema = records.json_schema(record, "t", "https://hrgtc.invalid/t.json")
+                jsonschema.Draft202012Validator(schema).validate(part)
+
+
+def test_truth_refusals_name_the_place():
+    with pytest.raises(InputError, match=r"`\$.tau_housing_s`"):
+        ThermalNetwork.from_dict({"tau_housing_s": 0.0, "tau_resonator_s": 2400.0})
+    with pytest.raises(InputError, match=r"unknown field `colour`"):
+        ThermalNetwork.from_dict({"tau_housing_s": 720.0, "tau_resonator_s": 2400.0,
+                                  "colour": "red"})
+    with pytest.raises(InputError, match=r"`\$.flicker_per_decade`"):
+        GyroNoise.from_dict({"arw_deg_per_sqrt_h": 0.02, "bias_instability_dph": 0.2,
+                             "rrw_dph_per_sqrt_h": 0.1, "flicker_per_decade": 0})
+    with pytest.raises(InputError, match=r"`\$.temperature_dph`"):
+        BiasLaw.from_dict({"bias0_dph": 1.0, "temperature_dph": [0.1, 0.2]})
