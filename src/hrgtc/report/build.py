@@ -21,6 +21,7 @@ from hrgtc.core.errors import InputError
 from hrgtc.core.files import refuse_existing, write_text_atomic
 from hrgtc.core.progress import Progress
 from hrgtc.evaluation import Evaluation
+from hrgtc.evaluation.calibration_figures import thermometer_tables
 from hrgtc.evaluation.instrument_pass import evaluate_axes
 from hrgtc.model import InstrumentModel, UnitModel, load_instrument
 from hrgtc.recording import ReadOptions, count_rows
@@ -198,9 +199,10 @@ def _unit_sections(page: _Page, model: UnitModel, evaluations: Sequence[Evaluati
         page.note(f"No frequency output: the gyro's temperature sensor is the thermometer "
                   f"(trained {low:.2f} to {high:.2f} °C); Figs. 3-5 do not apply.")
     else:
-        _settling(page, plateaus, traces, missing)
-        _thermometer(page, model, plateaus, table)
-        _temperature(page, table, traces)
+        tables = thermometer_tables(model.thermometer, plateaus)
+        _settling(page, plateaus, traces, missing, tables)
+        _thermometer(page, model, plateaus, table, tables)
+        _temperature(page, table, traces, tables)
     page.add('<section id="runs"><h2>4. Runs: raw and compensated output</h2>')
     if not evaluations:
         page.note("No runs given.")

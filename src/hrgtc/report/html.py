@@ -32,7 +32,14 @@ import hrgtc.report.figures as figures
 from hrgtc.core.files import file_sha256
 from hrgtc.core.summary import Summary
 from hrgtc.evaluation import Evaluation
-from hrgtc.evaluation.calibration_figures import calibration_summary
+from hrgtc.evaluation.calibration_figures import (
+    EQ18,
+    PLATEAUS,
+    TABLE1,
+    TABLE2,
+    calibration_summary,
+    power_text,
+)
 from hrgtc.model import UnitModel
 from hrgtc.report.figures import SoakTrace
 from hrgtc.thermometry import paper
@@ -201,6 +208,14 @@ def _section_table(page: _Page, summary: Summary, heading: str, caption: str) ->
         page.add(_table(("figure", "value", "unit", "interval"), rows, caption))
 
 
+def _grid_table(summary: Summary, heading: str, caption: str,
+                columns: Sequence[str] | None = None) -> str:
+    """A section of table cells of ``summary`` (:meth:`Summary.grid`) as a table; a missing
+    number shows as "–"."""
+    headers, rows = summary.grid(heading, columns)
+    return _table(headers, [["–" if c == "-" else c for c in row] for row in rows], caption)
+
+
 def _match(plateaus: Sequence[Plateau], source: str) -> list[Plateau]:
     """Plateaus found in ``source``: the same file, else the same file name."""
     same = [p for p in plateaus if p.source and os.path.realpath(p.source)
@@ -209,7 +224,8 @@ def _match(plateaus: Sequence[Plateau], source: str) -> list[Plateau]:
 
 
 def _settling(page: _Page, plateaus: Sequence[Plateau], traces: Sequence[SoakTrace],
-              missing: Sequence[str]) -> None:
+              missing: Sequence[str], tables: Summary) -> None:
+    """Fig. 3 and the plateaus (``tables``: :func:`thermometer_tables` of the unit)."""
     page.add('<section id="settling"><h2>1. Settling of the soaks</h2>')
     if missing:
         page.note("Soak recordings not found: " + ", ".join(
@@ -231,21 +247,8 @@ def _settling(page: _Page, plateaus: Sequence[Plateau], traces: Sequence[SoakTra
     else:
         page.note("No soak recordings and no stored settling fits: the settling figure "
                   "cannot be drawn.")
-    rows = [(_number(p.chamber_c, fixed=3), _number(p.settled_freq_hz, fixed=5),
-             _number(1e3 * p.settled_freq_std_hz, 2), p.method, "yes" if p.settled else "no",
-             _number(p.slope_hz_per_h, 3, sign=True), _number(p.residual_unsettled_c, fixed=4,
-                                                           sign=True),
-             Path(p.source).name if p.source else "–") for p in plateaus]
-    page.add(_table(("chamber [°C]", "settled frequency [Hz]", "std error [mHz]", "from",
-                         "settled by slope", "final slope [Hz/h]", "unsettled at end [°C]",
-                         "soak file"), rows, "Plateaus of the unit (from the model file)"),
+    page.add(_grid_table(tables, PLATEAUS, "Plateaus of the unit (from the model file)"),
              "</section>")
-
-
-def _power(symbol: str, n: int) -> str:
-    """``T³`` style powers (plain text, for tables and equations)."""
-    digits = str.maketrans("0123456789", "⁰¹²³⁴⁵⁶⁷⁸⁹")
-    return "" if n == 0 else symbol if n == 1 else symbol + str(n).translate(digits)
 
 
 def _table_rows(model: UnitModel, plateaus: Sequence[Plateau]) -> list[dict[str, float]]:
@@ -257,7 +260,9 @@ def _table_rows(model: UnitModel, plateaus: Sequence[Plateau]) -> list[dict[str,
 
 
 def _thermometer(page: _Page, model: UnitModel, plateaus: Sequence[Plateau],
-                 table: Sequence[Mapping[str, float]]) -> None:
+                 table: Sequence[Mapping[str, float]], tables: Summary) -> None:
+    """Fig. 4, Table 1, the thermometer's figures and Eq. 18 beside the paper's
+    (``tables``: :func:`thermometer_tables` of the unit)."""
     th = model.thermometer
     page.add('<section id="thermometer"><h2>2. Frequency–temperature fit</h2>')
     if plateaus:
@@ -268,23 +273,15 @@ def _thermometer(page: _Page, model: UnitModel, plateaus: Sequence[Plateau],
             "<b>Fig. 4</b> of [1]. Right: residuals f − f<sub>fit</sub> in mHz (error bars: "
             "standard error of each settled frequency) and their equivalent in °C.",
             "frequency-temperature fit and residuals")
-    rows = [(_number(r["chamber_c"], fixed=3), _number(r["freq_hz"], fixed=5),
-             _number(1e3 * (r["freq_hz"] - th.frequency(r["chamber_c"])), fixed=3, sign=True))
-            for r in table]
-    page.add(_table(("temperature [°C]", "natural frequency [Hz]", "residual [mHz]"),
-                        rows, "The unit's Table 1"))
+    page.add(_grid_table(tables, TABLE1, "The unit's Table 1"))
     summary = calibration_summary(model, table)
     _section_table(page, summary, "thermometer (Eq. 18)",
                    "Thermometer (Eq. 18): coefficients c0 (constant) to c3 (T³) ± 1σ, p-values, "
                    "fit")
-    high = th.coefficients_high_first
-    printed = dict(enumerate(reversed(paper.EQ18_PRINTED_HIGH_FIRST)))
-    powers = range(th.order, -1, -1)
-    rows = [(f"c{n}", _power("T", n) or "const", _number(c, 10), _number(printed.get(n), 7))
-            for n, c in zip(powers, high, strict=True)]
-    page.add(_table(("coefficient", "term", "this unit", "Eq. 18 of [1]"), rows,
-                    "Coefficients beside the paper's, highest power first"))
-    terms = " ".join(f"{'−' if c < 0 else '+'} {abs(c):.7g}" + (f"·{_power('T', n)}" if n else "")
+    page.add(_grid_table(tables, EQ18, "Coefficients beside the paper's, highest power first"))
+    high, powers = th.coefficients_high_first, range(th.order, -1, -1)
+    terms = " ".join(f"{'−' if c < 0 else '+'} {abs(c):.7g}"
+                     + (f"·{power_text('T', n)}" if n else "")
                      for n, c in zip(powers, high, strict=True))
     page.add(f'<p class="eq">f = {terms.lstrip("+ ")} &nbsp;[Hz, T in °C]</p>',
              f'<p class="muted">Eq. (18) form. Residual std {_number(1e3 * th.residual_std_hz, 3)} '
@@ -294,19 +291,16 @@ def _thermometer(page: _Page, model: UnitModel, plateaus: Sequence[Plateau],
 
 
 def _temperature(page: _Page, table: Sequence[Mapping[str, float]],
-                 traces: Sequence[SoakTrace]) -> None:
+                 traces: Sequence[SoakTrace], tables: Summary) -> None:
+    """Fig. 5(a), Table 2 (``tables``: :func:`thermometer_tables` of the unit) and
+    Fig. 5(b)."""
     page.add('<section id="temperature"><h2>3. Temperature from frequency</h2>')
     if table:
         page.figure(figures.temperature_error_figure(table),
                     "Temperature from frequency (inverse of Eq. 18) minus the chamber "
                     "temperature at each plateau, mirrors <b>Fig. 5(a)</b> of [1]; open circles: "
                     "the paper's unit (Table 2 of [1]).", "temperature error at each plateau")
-    rows = [(_number(r["freq_hz"], fixed=5), _number(r["chamber_c"], fixed=3),
-             _number(r["temperature_c"], fixed=4), _number(r["error_c"], fixed=4, sign=True))
-            for r in table]
-    page.add(_table(("frequency [Hz]", "chamber temperature [°C]",
-                         "temperature from frequency [°C]", "error [°C]"), rows,
-                        "The unit's Table 2"))
+    page.add(_grid_table(tables, TABLE2, "The unit's Table 2"))
     if traces:
         page.figure(figures.soak_temperature_figure(traces),
                     "Resonator temperature from frequency during each soak, mirrors "
