@@ -161,7 +161,7 @@ def test_round_trip_and_schema(model):
         jsonschema.validate(broken, SCALE_FACTOR_JSON_SCHEMA)
     with pytest.raises(InputError, match="scale-factor record"):
         ScaleFactorModel.from_dict({k: v for k, v in data.items() if k != "groups"})
-    assert "temperature groups" in model.summary()
+    assert "temperature groups" in model.summary().text()
 
 
 def test_extrapolation_is_tangent(model):

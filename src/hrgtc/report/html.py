@@ -40,6 +40,7 @@ from hrgtc.evaluation.calibration_figures import (
     calibration_summary,
     power_text,
 )
+from hrgtc.evaluation.glance_figures import GLANCE, glance_summary
 from hrgtc.model import UnitModel
 from hrgtc.report.figures import SoakTrace
 from hrgtc.thermometry import paper
@@ -161,44 +162,12 @@ def _header(page: _Page, model: UnitModel, title: str, model_path: str | None) -
              '(Eq. 21–22)</a></li></ol></nav>')
 
 
-def _temperature_share(run: Evaluation) -> float:
-    """Share of the run beyond the calibrated temperatures (not other variables' ranges)."""
-    return run.out_of_range_fraction if run.ranges is None else run.ranges.temperature_fraction
-
-
 def _summary(page: _Page, runs: Sequence[Evaluation]) -> None:
-    """The result at a glance: 10 s bias stability of each run beside the paper's."""
-    if not runs:
-        return
-    rows = [_glance(r) for r in runs]
-    rows.append(("paper [1], Section 4.2 (its cool-down)", _number(paper.BIAS_STABILITY_RAW_DPH,
-                 5), _number(paper.BIAS_STABILITY_COMPENSATED_DPH, 4), _number(
-                 paper.BIAS_STABILITY_RAW_DPH / paper.BIAS_STABILITY_COMPENSATED_DPH, 3), "–",
-                 "–", "–", "–"))
-    page.add(_table(("run", "raw [°/h]", "compensated [°/h]", "improvement [×]",
-                     "housing baseline [°/h]", "outside calibrated range",
-                     "compensated mean [°/h]", "compensated RMS [°/h]"), rows,
-                    "At a glance: 10 s bias stability, raw and compensated"))
-
-
-def _glance(run: Evaluation) -> tuple[str, ...]:
-    """A run's row of "At a glance", from its summary's figures (``run.figures()``)."""
-    figures = run.figures(warnings=False).figures()
-
-    def cell(name: str, percent: bool = False) -> str:
-        figure = figures.get(f"evaluation.{name}")
-        if figure is None or not isinstance(figure.value, float | int):
-            return "–"
-        if percent:
-            return f"{figure.value:.1%}"
-        return _number(figure.value, figure.digits)
-
-    share = ("ranges.temperature_fraction" if run.ranges is not None  # not other variables'
-             else "out_of_range_fraction")
-    return (run.name, *(cell(f"bias_stability_dph.{s}.10") for s in ("raw", "compensated")),
-            cell("improvement_10s"), cell("bias_stability_dph.housing.10"),
-            cell(share, percent=True), cell("mean_dph.compensated"),
-            cell("rms_dph.compensated"))
+    """The result at a glance: 10 s bias stability of each run beside the paper's
+    (:func:`~hrgtc.evaluation.glance_figures.glance_summary`)."""
+    if runs:
+        page.add(_grid_table(glance_summary(runs), GLANCE,
+                             "At a glance: 10 s bias stability, raw and compensated"))
 
 
 def _section_table(page: _Page, summary: Summary, heading: str, caption: str) -> None:
@@ -418,11 +387,13 @@ def _scale_factor(page: _Page, model: UnitModel) -> None:
              f"by least squares, then k(f) by stepwise regression over candidates "
              f"<code>{escape(', '.join(sf.candidates))}</code>. Compensation applies "
              f"rate_comp = (rate − bias(f, ḟ)) / (1 + k(f)·10⁻⁶).</p>")
-    rows = [(_number(g.freq_hz, 10), _number(g.k_ppm, 5), _number(g.k_se_ppm, 3),
-             _number(float(sf.ppm(np.array([g.freq_hz]))[0]), 5), str(g.n))
-            for g in sf.groups]
-    page.add(_table(("mean frequency [Hz]", "k [ppm]", "std error [ppm]", "model k [ppm]",
-                     "holds"), rows, "Temperature groups of the rate-table holds"),
+    summary = sf.summary()
+    shown = summary.figures()
+    page.add(_grid_table(summary, "scale-factor temperature groups",
+                         "Temperature groups of the rate-table holds",
+                         ("mean frequency", "k", "std error", "model k", "holds")),
              f'<p class="eq">{escape(sf.equation())}</p>',
-             f'<p class="muted">Residual {_number(sf.residual_ppm)} ppm RMS over the groups; '
-             f"|input| up to {sf.input_rate_range_dph[1] / 3600:.4g} °/s.</p></section>")
+             f'<p class="muted">Residual {shown["scale_factor.residual_ppm"].number()} ppm '
+             f"RMS over the groups; "
+             f"|input| up to {shown['scale_factor.input_rate_max_dps'].number()} °/s.</p>"
+             "</section>")
