@@ -12,6 +12,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from rich.table import Table
+from rich.text import Text
 
 if TYPE_CHECKING:
     from rich.console import Console
@@ -30,17 +31,17 @@ def summary_tables(summary: Summary) -> list[Table]:
     for heading, figures in summary.sections:
         if not figures:
             continue
-        table = Table(title=heading, title_justify="left")
+        table = Table(title=Text(heading), title_justify="left")
         if summary.is_grid(heading):
             headers, rows = summary.grid(heading)
-            for column in headers:
-                table.add_column(column, justify="right")
+            for column in headers:  # Text: "[mHz]" is a unit, not rich markup
+                table.add_column(Text(column), justify="right")
         else:
             for column in COLUMNS:
                 table.add_column(column, justify="left" if column == "figure" else "right")
             rows = [[f.label, f.number(), f.unit, f.interval_text()] for f in figures]
         for row in rows:
-            table.add_row(*row)
+            table.add_row(*(Text(cell) for cell in row))
         tables.append(table)
     return tables
 
