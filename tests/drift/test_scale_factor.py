@@ -161,7 +161,7 @@ def test_round_trip_and_schema(model):
         jsonschema.validate(broken, SCALE_FACTOR_JSON_SCHEMA)
     with pytest.raises(InputError, match="scale-factor record"):
         ScaleFactorModel.from_dict({k: v for k, v in data.items() if k != "groups"})
-    assert "temperature groups" in model.summary()
+    assert "temperature groups" in model.summary().text()
 
 
 def test_extrapolation_is_tangent(model):
@@ -242,3 +242,32 @@ def test_frequency_scale_defaults_to_the_largest_offset(train):
     freq = THERMOMETER.frequency(np.array(HELD_OUT_C))
     reference = fit_scale_factor(segments, SETTINGS)
     np.testing.assert_allclose(fitted.ppm(freq), reference.ppm(freq), rtol=1e-9)
+
+
+def test_summary_agrees_in_text_rich_html_and_json(model):
+    """``ScaleFactorModel.summary()`` (what ``hrgtc calibrate`` prints and the report's
+    scale-factor table shows): every figure the same in the text, the rich tables, the HTML
+    and the model file's record, where its name is a place (``scale_factor.groups[0].k_ppm``);
+    the model's k at each group is :meth:`ppm` there."""
+    import io
+    import json
+
+    from rich.console import Console
+
+    from hrgtc.cli.summary_tables import print_summary
+    from summary_checks import check_renderings
+
+    summary = model.summary()
+    out = io.StringIO()
+    print_summary(summary, Console(file=out, width=400))
+    document = {"scale_factor": json.loads(json.dumps(model.to_dict()))}
+    places = check_renderings(summary, out.getvalue(), document)
+    assert places == 5 * len(model.groups) + 2 * len(model.selected) + 6
+    figures = summary.figures()
+    for k, g in enumerate(model.groups):
+        assert figures[f"scale_factor.groups[{k}].model_ppm"].value == pytest.approx(
+            float(model.ppm(g.freq_hz)[0]), rel=1e-12)
+    headers, _ = summary.grid("scale-factor temperature groups")
+    assert headers == ["mean frequency [Hz]", "k [ppm]", "std error [ppm]", "model k [ppm]",
+                       "bias [°/h]", "holds"]
+    assert model.equation() in summary.text() and "[ppm]" in out.getvalue()

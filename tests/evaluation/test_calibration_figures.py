@@ -168,7 +168,7 @@ def test_the_reports_calibration_tables_show_the_summarys_figures(result):
     plateaus = [Plateau.from_dict(p) for p in model.plateaus]
     table = _table_rows(model, plateaus)
     page = _Page()
-    _thermometer(page, model, plateaus, table)
+    _thermometer(page, model, plateaus, table, result.tables())
     _drift_model(page, model)
     cells = {}
     for caption, body in re.findall(r"<caption>(.*?)</caption>(.*?)</table>", "".join(page.parts)):

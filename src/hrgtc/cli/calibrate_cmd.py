@@ -6,7 +6,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import typer
-from rich.table import Table
 
 from hrgtc.cli._app import app, console, error_console, fail, library_errors, print_json
 from hrgtc.cli.compensate_cmd import warn_ranges
@@ -32,23 +31,13 @@ EQ21_DEFAULT = ",".join(EQ21_TERMS)
 
 
 def render(result: CalibrationResult) -> None:
-    """Print the unit's Table 1 and Table 2 (a frequency thermometer), then the
-    calibration's summary (:meth:`CalibrationResult.summary`: thermometer, drift model,
-    stepwise steps, housing baseline and held-out runs, a table each, and the Eq. 18 and
-    Eq. 22 forms); the range warnings are printed apart."""
+    """Print the unit's Table 1, Table 2 and plateaus (a frequency thermometer:
+    :meth:`CalibrationResult.tables`), then the calibration's summary
+    (:meth:`CalibrationResult.summary`: thermometer, drift model, stepwise steps, housing
+    baseline and held-out runs, a table each, and the Eq. 18 and Eq. 22 forms); the range
+    warnings are printed apart."""
     if result.model.thermometer.source != "sensor":
-        table = Table(title="The unit's Table 1 (plateaus) and Table 2 "
-                      "(temperature from frequency)")
-        for column in ("chamber (°C)", "settled freq (Hz)", "method", "unsettled (°C)",
-                       "T from freq (°C)", "error (°C)"):
-            table.add_column(column, justify="right")
-        for row, plateau in zip(result.table, result.plateaus, strict=True):
-            table.add_row(
-                f"{row['chamber_c']:.3f}", f"{row['freq_hz']:.4f}", plateau.method,
-                f"{plateau.residual_unsettled_c:+.4f}", f"{row['temperature_from_freq_c']:.4f}",
-                f"{row['error_c']:+.4f}",
-            )
-        console.print(table)
+        print_summary(result.tables(), console, notes=False)  # the Eq. 18 form comes below
     print_summary(result.summary(warnings=False), console)
 
 
@@ -208,7 +197,7 @@ def render_instrument(calibration: InstrumentCalibration) -> None:
         model = calibration.model.axes[axis]
         render(replace(result, model=model, validation=calibration.validation.get(axis, ())))
         if model.scale_factor is not None:
-            console.print(model.scale_factor.summary())
+            print_summary(model.scale_factor.summary(), console)
     summary = calibration.summary()
     if summary.sections or summary.notes:  # rate tables, cross-axis trials, the axes
         print_summary(summary, console)

@@ -3,8 +3,10 @@
 A result's ``summary()`` builds a :class:`Summary` (sections of :class:`Figure` s) before
 any text; the renderers format that one structure: :meth:`Summary.text` (plain text, what
 ``summary()`` printed before), :meth:`Summary.rows` (the cells of a rich or HTML table:
-section, figure, value, unit, interval) and :meth:`Summary.html` (a table for the report).
-:meth:`Summary.to_dict` is the ``--json`` form. See docs/architecture.md ("One result
+section, figure, value, unit, interval), :meth:`Summary.grid` (a section whose figures are
+the cells of a table, Table 1 or a list of temperature groups: its columns and rows) and
+:meth:`Summary.html` (a table for the report). :meth:`Summary.to_dict` is the ``--json``
+form. See docs/architecture.md ("One result
 contract"), after statsmodels' ``summary()``, which returns tables its renderers format.
 """
 
@@ -12,20 +14,21 @@ from __future__ import annotations
 
 import html
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 __all__ = ["Figure", "Summary"]
 
 
-def _number(value: float, digits: int) -> str:
+def _number(value: float, digits: int, spec: str = "") -> str:
     if isinstance(value, bool) or not isinstance(value, float | int):
         return str(value)
-    if isinstance(value, int):
+    if isinstance(value, int) and not spec:
         return str(value)
     if math.isnan(value):
         return "-"
-    return f"{value:.{digits}g}"
+    return f"{value:{spec or f'.{digits}g'}}"
 
 
 @dataclass(frozen=True)
@@ -49,6 +52,12 @@ class Figure:
         ``"range"`` (the span of the data), ...
     digits
         Significant digits of the text forms.
+    spec
+        A format spec of the value's text instead of ``digits`` significant digits
+        (``"+.4f"``: the printed decimals of a table, ``".1%"``: a share).
+    row, column
+        The figure's place in a table (:meth:`Summary.grid`): which row (a key, not shown)
+        and which column (its header; the unit is added in brackets). Empty: not a cell.
     """
 
     name: str
@@ -58,6 +67,9 @@ class Figure:
     interval: tuple[float, float] | None = None
     interval_kind: str = ""
     digits: int = 6
+    spec: str = ""
+    row: str = ""
+    column: str = ""
 
     @classmethod
     def with_error(cls, name: str, label: str, value: float, error: float, unit: str = "",
@@ -66,9 +78,17 @@ class Figure:
         interval = (value - error, value + error) if math.isfinite(error) else None
         return cls(name, label, value, unit, interval, "±1σ" if interval else "", digits)
 
+    def number(self) -> str:
+        """The value as a table shows it (``spec`` or ``digits``; NaN: ``"-"``)."""
+        return _number(self.value, self.digits, self.spec)
+
+    def header(self) -> str:
+        """The column header of a table cell: ``column [unit]``."""
+        return f"{self.column} [{self.unit}]" if self.unit else self.column
+
     def value_text(self) -> str:
         """The value with its unit (``"3.21 °/h"``)."""
-        text = _number(self.value, self.digits)
+        text = self.number()
         return f"{text} {self.unit}" if self.unit and text != "-" else text
 
     def interval_text(self) -> str:
@@ -124,8 +144,29 @@ class Summary:
 
     def rows(self) -> list[tuple[str, str, str, str, str]]:
         """Table cells, one row per figure: (section, label, value, unit, interval)."""
-        return [(heading, f.label, _number(f.value, f.digits), f.unit, f.interval_text())
+        return [(heading, f.label, f.number(), f.unit, f.interval_text())
                 for heading, figures in self.sections for f in figures]
+
+    def is_grid(self, heading: str) -> bool:
+        """Whether the section ``heading`` is a table of cells (every figure has a column)."""
+        figures = dict(self.sections)[heading]
+        return bool(figures) and all(f.column for f in figures)
+
+    def grid(self, heading: str, columns: Sequence[str] | None = None,
+             ) -> tuple[list[str], list[list[str]]]:
+        """The section ``heading`` as a table: its column headers (``column [unit]``, in
+        order of appearance) and one list of cells per row (``Figure.row``, in order; a
+        cell a row lacks is ``""``). The cells are :meth:`Figure.number` s. ``columns``:
+        only these columns (``Figure.column``), in this order."""
+        figures = dict(self.sections)[heading]
+        if columns is not None:
+            figures = tuple(sorted((f for f in figures if f.column in columns),
+                                   key=lambda f: list(columns).index(f.column)))
+        headers = list(dict.fromkeys(f.header() for f in figures))
+        rows: dict[str, list[str]] = {}
+        for f in figures:
+            rows.setdefault(f.row, [""] * len(headers))[headers.index(f.header())] = f.number()
+        return headers, list(rows.values())
 
     def text(self) -> str:
         """Plain text: the title, then each section's figures one per line."""
@@ -140,14 +181,25 @@ class Summary:
         """An HTML table (escaped), one row per figure, a header row per section."""
         out = [f"<table class=\"summary\"><caption>{html.escape(self.title)}</caption>"]
         for heading, figures in self.sections:
+            if self.is_grid(heading):
+                out.append(self._html_grid(heading))
+                continue
             out.append(f"<tr><th colspan=\"4\">{html.escape(heading)}</th></tr>")
             for f in figures:
-                cells = (f.label, _number(f.value, f.digits), f.unit, f.interval_text())
+                cells = (f.label, f.number(), f.unit, f.interval_text())
                 out.append("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in cells)
                            + "</tr>")
         out.append("</table>")
         out.extend(f"<p>{html.escape(n)}</p>" for n in self.notes)
         return "\n".join(out)
+
+    def _html_grid(self, heading: str) -> str:
+        headers, rows = self.grid(heading)
+        return "\n".join([
+            f"<tr><th colspan=\"{len(headers)}\">{html.escape(heading)}</th></tr>",
+            "<tr>" + "".join(f"<th>{html.escape(h)}</th>" for h in headers) + "</tr>",
+            *("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in row) + "</tr>"
+              for row in rows)])
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types: title, sections with their figures, notes."""

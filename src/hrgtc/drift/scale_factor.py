@@ -37,6 +37,7 @@ from msgspec import Meta
 
 from hrgtc.core import records
 from hrgtc.core.errors import HrgtcWarning, InputError
+from hrgtc.core.summary import Figure, Summary
 from hrgtc.drift.features import (
     FeatureSettings,
     ParsedTerms,
@@ -204,25 +205,53 @@ class ScaleFactorModel(ParsedTerms):
             parts.append(f" {'-' if value < 0 else '+'} {abs(value):.6g}·{name}")
         return "".join(parts) + f"   [ppm; f = freq_hz - {self.reference_hz:.10g} Hz]"
 
-    def summary(self) -> str:
-        """Groups, coefficient table and fit quality as text."""
-        lines = [f"Scale-factor model: {len(self.selected)} of {len(self.candidates)} candidate "
-                 f"terms, {len(self.groups)} temperature groups"
-                 f"{' (weighted 1/se²)' if self.weighted else ''}",
-                 f"{'freq_hz':>16}{'k ppm':>12}{'se ppm':>10}{'bias °/h':>12}{'segments':>10}"]
-        for g in self.groups:
-            lines.append(f"{g.freq_hz:>16.10g}{g.k_ppm:>12.5g}{g.k_se_ppm:>10.3g}"
-                         f"{g.bias_dph:>12.5g}{g.n:>10d}")
-        lines.append(f"{'term':<10}{'coefficient':>16}{'std error':>14}{'p-value':>11}")
-        for name, value in (("const", self.intercept_ppm),
-                            *((n, self.coefficients_ppm[n]) for n in self.selected)):
-            lines.append(f"{name:<10}{value:>16.6g}{self.standard_errors_ppm[name]:>14.4g}"
-                         f"{self.pvalues[name]:>11.3g}")
-        lines.append(f"residual {self.residual_ppm:.4g} ppm rms over the groups; frequency "
-                     f"{self.freq_range_hz[0]:.10g} to {self.freq_range_hz[1]:.10g} Hz, |input| "
-                     f"up to {self.input_rate_range_dph[1] / 3600.0:.6g} °/s")
-        lines.append(self.equation())
-        return "\n".join(lines)
+    def summary(self, key: str = "scale_factor") -> Summary:
+        """The model's figures (:class:`~hrgtc.core.summary.Summary`): its temperature
+        groups as a table (mean frequency, k ± its standard error, the model's k, bias,
+        holds), k(f)'s intercept and coefficients ± 1σ with p-values, the residual and the
+        calibrated frequencies; the equation is its note. Render it with ``.text()``, as
+        rich tables (``hrgtc calibrate``) or in the report; a figure's name after ``key``
+        is its place in :meth:`to_dict` (``scale_factor.groups[0].k_ppm``)."""
+        groups: list[Figure] = []
+        for k, g in enumerate(self.groups):
+            model_ppm = float(self.ppm(np.array([g.freq_hz]))[0])
+            cells = (("freq_hz", "mean frequency", g.freq_hz, "Hz", 10),
+                     ("k_ppm", "k", g.k_ppm, "ppm", 5),
+                     ("k_se_ppm", "std error", g.k_se_ppm, "ppm", 3),
+                     ("model_ppm", "model k", model_ppm, "ppm", 5),
+                     ("bias_dph", "bias", g.bias_dph, "°/h", 5),
+                     ("n", "holds", g.n, "", 6))
+            groups += [Figure(f"{key}.groups[{k}].{name}", f"group {k + 1}, {column}", value,
+                              unit, digits=digits, row=str(k), column=column)
+                       for name, column, value, unit, digits in cells]
+        fit = [Figure(f"{key}.candidates", "candidate terms", ", ".join(self.candidates)),
+               Figure(f"{key}.selected", "terms", ", ".join(self.selected) or "(none)"),
+               Figure.with_error(f"{key}.intercept_ppm", "k at f_ref (c0)", self.intercept_ppm,
+                                 self.standard_errors_ppm.get("const", math.nan), "ppm")]
+        if "const" in self.pvalues:
+            fit.append(Figure(f"{key}.pvalues.const", "p of c0", self.pvalues["const"],
+                              digits=3))
+        for term in self.terms:
+            name = term.name
+            fit += [Figure.with_error(f"{key}.coefficients_ppm.{name}", f"k of {name}",
+                                      self.coefficients_ppm[name],
+                                      self.standard_errors_ppm.get(name, math.nan),
+                                      f"ppm per {term.unit}"),
+                    Figure(f"{key}.pvalues.{name}", f"p of {name}",
+                           self.pvalues.get(name, math.nan), digits=3)]
+        low, high = self.freq_range_hz
+        fit += [Figure(f"{key}.residual_ppm", "residual (RMS over the groups)",
+                       self.residual_ppm, "ppm", digits=4),
+                Figure(f"{key}.freq_range_hz", "calibrated frequencies", high - low, "Hz",
+                       (low, high), "range", digits=10),
+                Figure(f"{key}.input_rate_max_dps", "largest |input rate|",
+                       self.input_rate_range_dph[1] / 3600.0, "°/s", digits=4)]
+        title = (f"scale-factor model: {len(self.selected)} of {len(self.candidates)} "
+                 f"candidate terms, {len(self.groups)} temperature groups"
+                 f"{' (weighted 1/se²)' if self.weighted else ''}")
+        return Summary(title, (("scale-factor temperature groups", tuple(groups)),
+                               ("scale-factor model k(f)", tuple(fit))),
+                       (self.equation(),))
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types (statistics that are not finite become null), as

@@ -12,6 +12,7 @@ See docs/architecture.md ("One result contract").
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Mapping, Sequence
 from typing import Any
@@ -21,7 +22,12 @@ import numpy as np
 from hrgtc.core.summary import Figure, Summary
 from hrgtc.drift.drift_text import drift_notes
 
-__all__ = ["calibration_summary", "instrument_summary", "thermometer_equation"]
+__all__ = ["calibration_summary", "instrument_summary", "power_text", "thermometer_equation",
+           "thermometer_tables"]
+
+#: Headings of :func:`thermometer_tables`' sections.
+TABLE1, TABLE2, PLATEAUS, EQ18 = ("Table 1", "Table 2", "plateaus",
+                                  "Eq. 18 beside the paper's")
 
 
 def calibration_summary(model: Any, table: Sequence[Mapping[str, float]] = (),
@@ -67,6 +73,94 @@ def thermometer_equation(thermometer: Any) -> str:
         return (f"Eq. (18) form: f = {c3:.4e}·T³ {c2:+.4e}·T² {c1:+.6f}·T {c0:+.4f}  "
                 "[Hz, T in °C]")
     return thermometer.summary().splitlines()[-1]
+
+
+def thermometer_tables(thermometer: Any, plateaus: Sequence[Any]) -> Summary:
+    """A frequency thermometer's tables as cells (:meth:`Summary.grid`), printed to the
+    digits the report and ``hrgtc calibrate`` show.
+
+    ``Table 1``: each plateau's chamber temperature, settled frequency and the fit's residual
+    (mHz); ``Table 2``: frequency, chamber temperature, temperature from frequency (the
+    inverse of Eq. 18) and its error (``thermometer.table[k]`` of ``hrgtc calibrate
+    --json``); ``plateaus``: how each settled frequency was found (``plateaus[k]`` of the
+    model file); ``Eq. 18 beside the paper's``: the coefficients, highest power first,
+    beside Eq. (18) of [1] as printed. No sections for the gyro's own temperature sensor.
+    ``plateaus``: :class:`~hrgtc.thermometry.plateaus.Plateau` s, in the thermometer's
+    Table 1 order (``CalibrationResult.plateaus``, a model file's ``plateaus``).
+    """
+    from hrgtc.thermometry import paper
+
+    title = "the unit's Table 1 and Table 2"
+    if thermometer.source == "sensor":
+        return Summary(title, notes=("thermometer: the gyro's temperature sensor (no "
+                                     "frequency output): no Table 1 or Table 2",))
+    chamber = np.array([p.chamber_c for p in plateaus], dtype=np.float64)
+    freq = np.array([p.settled_freq_hz for p in plateaus], dtype=np.float64)
+    estimate = thermometer.temperature(freq, warn=False) if freq.size else freq
+    table1: list[Figure] = []
+    table2: list[Figure] = []
+    found: list[Figure] = []
+    for k, (p, t, f, e) in enumerate(zip(plateaus, chamber, freq, estimate, strict=True)):
+        cell = functools.partial(_cell, k)
+        residual = 1e3 * (float(f) - float(thermometer.frequency(float(t))))
+        table1 += [cell(f"table1[{k}].chamber_c", "temperature", float(t), "°C", ".3f"),
+                   cell(f"table1[{k}].freq_hz", "natural frequency", float(f), "Hz", ".5f"),
+                   cell(f"table1[{k}].residual_mhz", "residual", residual, "mHz", "+.3f")]
+        key = f"thermometer.table[{k}]"
+        table2 += [cell(f"{key}.freq_hz", "frequency", float(f), "Hz", ".5f"),
+                   cell(f"{key}.chamber_c", "chamber temperature", float(t), "°C", ".3f"),
+                   cell(f"{key}.temperature_from_freq_c", "temperature from frequency",
+                        float(e), "°C", ".4f"),
+                   cell(f"{key}.error_c", "error", float(e - t), "°C", "+.4f")]
+        source = str(p.source).replace("\\", "/").rsplit("/", 1)[-1] if p.source else "–"
+        found += [cell(f"plateaus[{k}].chamber_c", "chamber", _float(p.chamber_c), "°C", ".3f"),
+                  cell(f"plateaus[{k}].settled_freq_hz", "settled frequency",
+                       _float(p.settled_freq_hz), "Hz", ".5f"),
+                  cell(f"plateaus[{k}].settled_freq_std_mhz", "std error",
+                       1e3 * _float(p.settled_freq_std_hz), "mHz", digits=2),
+                  cell(f"plateaus[{k}].method", "from", p.method),
+                  cell(f"plateaus[{k}].settled", "settled by slope",
+                       "yes" if p.settled else "no"),
+                  cell(f"plateaus[{k}].slope_hz_per_h", "final slope",
+                       _float(p.slope_hz_per_h), "Hz/h", "+.3g"),
+                  cell(f"plateaus[{k}].residual_unsettled_c", "unsettled at end",
+                       _float(p.residual_unsettled_c), "°C", "+.4f"),
+                  cell(f"plateaus[{k}].source", "soak file", source)]
+    printed = dict(enumerate(reversed(paper.EQ18_PRINTED_HIGH_FIRST)))
+    eq18: list[Figure] = []
+    for i, (n, c) in enumerate(zip(range(thermometer.order, -1, -1),
+                                   thermometer.coefficients_high_first, strict=True)):
+        label, row = f"c{n}", str(i)
+        eq18 += [Figure(f"eq18[{i}].coefficient", f"{label}, coefficient", label, row=row,
+                        column="coefficient"),
+                 Figure(f"eq18[{i}].term", f"{label}, term", power_text("T", n) or "const",
+                        row=row, column="term"),
+                 Figure(f"thermometer.coefficients_high_first[{i}]", f"{label}, this unit",
+                        float(c), digits=10, row=row, column="this unit"),
+                 Figure(f"eq18[{i}].printed", f"{label}, Eq. 18 of [1]",
+                        float(printed.get(n, math.nan)), digits=7, row=row,
+                        column="Eq. 18 of [1]")]
+    return Summary(title, ((TABLE1, tuple(table1)), (TABLE2, tuple(table2)),
+                           (PLATEAUS, tuple(found)), (EQ18, tuple(eq18))),
+                   (thermometer_equation(thermometer),))
+
+
+def _float(value: Any) -> float:
+    """A number of a plateau; NaN (shown "-") where it has none."""
+    return math.nan if value is None else float(value)
+
+
+def _cell(k: int, name: str, column: str, value: Any, unit: str = "", spec: str = "",
+          digits: int = 6) -> Figure:
+    """Plateau ``k``'s cell in ``column`` of a table."""
+    return Figure(name, f"plateau {k + 1}, {column}", value, unit, digits=digits, spec=spec,
+                  row=str(k), column=column)
+
+
+def power_text(symbol: str, n: int) -> str:
+    """``T³`` style powers (plain text, for tables and equations)."""
+    digits = str.maketrans("0123456789", "⁰¹²³⁴⁵⁶⁷⁸⁹")
+    return "" if n == 0 else symbol if n == 1 else symbol + str(n).translate(digits)
 
 
 def _thermometer_figures(thermometer: Any, table: Sequence[Mapping[str, float]],

@@ -39,7 +39,7 @@ from hrgtc.drift.training import (
     implausible_for_any_gyro,
 )
 from hrgtc.evaluation import Evaluation, evaluate
-from hrgtc.evaluation.calibration_figures import calibration_summary
+from hrgtc.evaluation.calibration_figures import calibration_summary, thermometer_tables
 from hrgtc.model import UnitModel, provenance
 from hrgtc.recording import ReadOptions
 from hrgtc.recording.marks import refuse_compensated_training
@@ -163,6 +163,13 @@ class CalibrationResult:
         """
         return calibration_summary(self.model, self.table, self.validation, self.prior_fit,
                                    warnings)
+
+    def tables(self) -> Summary:
+        """The unit's Table 1, Table 2, plateaus and Eq. 18 beside the paper's as table
+        cells (:func:`hrgtc.evaluation.calibration_figures.thermometer_tables`), what
+        ``hrgtc calibrate`` prints and the report shows; Table 2's figures are the places
+        ``thermometer.table[k]`` of :meth:`to_dict`."""
+        return thermometer_tables(self.model.thermometer, self.plateaus)
 
 
 def calibrate(

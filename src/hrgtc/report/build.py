@@ -21,6 +21,8 @@ from hrgtc.core.errors import InputError
 from hrgtc.core.files import refuse_existing, write_text_atomic
 from hrgtc.core.progress import Progress
 from hrgtc.evaluation import Evaluation
+from hrgtc.evaluation.calibration_figures import thermometer_tables
+from hrgtc.evaluation.glance_figures import GLANCE, instrument_glance_summary
 from hrgtc.evaluation.instrument_pass import evaluate_axes
 from hrgtc.model import InstrumentModel, UnitModel, load_instrument
 from hrgtc.recording import ReadOptions, count_rows
@@ -30,17 +32,15 @@ from hrgtc.report.html import (
     DOI,
     REFERENCE,
     _drift_model,
+    _grid_table,
     _header,
-    _number,
     _Page,
     _run,
     _scale_factor,
     _settling,
     _summary,
-    _table,
     _table_rows,
     _temperature,
-    _temperature_share,
     _thermometer,
 )
 from hrgtc.settings.compensation import ReportSettings
@@ -198,9 +198,10 @@ def _unit_sections(page: _Page, model: UnitModel, evaluations: Sequence[Evaluati
         page.note(f"No frequency output: the gyro's temperature sensor is the thermometer "
                   f"(trained {low:.2f} to {high:.2f} °C); Figs. 3-5 do not apply.")
     else:
-        _settling(page, plateaus, traces, missing)
-        _thermometer(page, model, plateaus, table)
-        _temperature(page, table, traces)
+        tables = thermometer_tables(model.thermometer, plateaus)
+        _settling(page, plateaus, traces, missing, tables)
+        _thermometer(page, model, plateaus, table, tables)
+        _temperature(page, table, traces, tables)
     page.add('<section id="runs"><h2>4. Runs: raw and compensated output</h2>')
     if not evaluations:
         page.note("No runs given.")
@@ -214,25 +215,10 @@ def _unit_sections(page: _Page, model: UnitModel, evaluations: Sequence[Evaluati
 def _instrument_summary(page: _Page, model: InstrumentModel,
                         evaluations: dict[str, list[Evaluation]]) -> None:
     """The instrument at a glance: each axis's 10 s bias stability per run, scale factor."""
-    rows = []
-    for axis, runs in evaluations.items():
-        sf = model.axes[axis].scale_factor
-        scale = "–" if sf is None else f"{_number(sf.residual_ppm, 3)} ppm RMS"
-        for run in runs:
-            raw, comp = run.stability("raw", 10.0), run.stability("compensated", 10.0)
-            rows.append((axis, run.name, _number(raw), _number(comp),
-                         _number(raw / comp if raw is not None and comp else None, 3),
-                         f"{_temperature_share(run):.1%}", scale,
-                         _number(run.mean_dph.get("compensated")),
-                         _number(run.rms_dph.get("compensated"))))
-        if not runs:
-            rows.append((axis, "–", "–", "–", "–", "–", scale, "–", "–"))
     page.add(f'<section id="instrument"><h2>Instrument {escape(model.unit)}: '
              f"{len(model.axes)} axes</h2>",
-             _table(("axis", "run", "raw [°/h]", "compensated [°/h]", "improvement [×]",
-                     "outside calibrated range", "scale-factor fit residual",
-                     "compensated mean [°/h]", "compensated RMS [°/h]"), rows,
-                    "At a glance: 10 s bias stability per axis and run"),
+             _grid_table(instrument_glance_summary(model, evaluations), GLANCE,
+                         "At a glance: 10 s bias stability per axis and run"),
              "<nav><ol>" + "".join(f'<li><a href="#axis-{escape(a)}">Axis {escape(a)}</a></li>'
                                    for a in model.axes) + "</ol></nav></section>")
 

@@ -32,7 +32,15 @@ import hrgtc.report.figures as figures
 from hrgtc.core.files import file_sha256
 from hrgtc.core.summary import Summary
 from hrgtc.evaluation import Evaluation
-from hrgtc.evaluation.calibration_figures import calibration_summary
+from hrgtc.evaluation.calibration_figures import (
+    EQ18,
+    PLATEAUS,
+    TABLE1,
+    TABLE2,
+    calibration_summary,
+    power_text,
+)
+from hrgtc.evaluation.glance_figures import GLANCE, glance_summary
 from hrgtc.model import UnitModel
 from hrgtc.report.figures import SoakTrace
 from hrgtc.thermometry import paper
@@ -154,44 +162,12 @@ def _header(page: _Page, model: UnitModel, title: str, model_path: str | None) -
              '(Eq. 21–22)</a></li></ol></nav>')
 
 
-def _temperature_share(run: Evaluation) -> float:
-    """Share of the run beyond the calibrated temperatures (not other variables' ranges)."""
-    return run.out_of_range_fraction if run.ranges is None else run.ranges.temperature_fraction
-
-
 def _summary(page: _Page, runs: Sequence[Evaluation]) -> None:
-    """The result at a glance: 10 s bias stability of each run beside the paper's."""
-    if not runs:
-        return
-    rows = [_glance(r) for r in runs]
-    rows.append(("paper [1], Section 4.2 (its cool-down)", _number(paper.BIAS_STABILITY_RAW_DPH,
-                 5), _number(paper.BIAS_STABILITY_COMPENSATED_DPH, 4), _number(
-                 paper.BIAS_STABILITY_RAW_DPH / paper.BIAS_STABILITY_COMPENSATED_DPH, 3), "–",
-                 "–", "–", "–"))
-    page.add(_table(("run", "raw [°/h]", "compensated [°/h]", "improvement [×]",
-                     "housing baseline [°/h]", "outside calibrated range",
-                     "compensated mean [°/h]", "compensated RMS [°/h]"), rows,
-                    "At a glance: 10 s bias stability, raw and compensated"))
-
-
-def _glance(run: Evaluation) -> tuple[str, ...]:
-    """A run's row of "At a glance", from its summary's figures (``run.figures()``)."""
-    figures = run.figures(warnings=False).figures()
-
-    def cell(name: str, percent: bool = False) -> str:
-        figure = figures.get(f"evaluation.{name}")
-        if figure is None or not isinstance(figure.value, float | int):
-            return "–"
-        if percent:
-            return f"{figure.value:.1%}"
-        return _number(figure.value, figure.digits)
-
-    share = ("ranges.temperature_fraction" if run.ranges is not None  # not other variables'
-             else "out_of_range_fraction")
-    return (run.name, *(cell(f"bias_stability_dph.{s}.10") for s in ("raw", "compensated")),
-            cell("improvement_10s"), cell("bias_stability_dph.housing.10"),
-            cell(share, percent=True), cell("mean_dph.compensated"),
-            cell("rms_dph.compensated"))
+    """The result at a glance: 10 s bias stability of each run beside the paper's
+    (:func:`~hrgtc.evaluation.glance_figures.glance_summary`)."""
+    if runs:
+        page.add(_grid_table(glance_summary(runs), GLANCE,
+                             "At a glance: 10 s bias stability, raw and compensated"))
 
 
 def _section_table(page: _Page, summary: Summary, heading: str, caption: str) -> None:
@@ -199,6 +175,14 @@ def _section_table(page: _Page, summary: Summary, heading: str, caption: str) ->
     rows = [row[1:] for row in summary.rows() if row[0] == heading]
     if rows:
         page.add(_table(("figure", "value", "unit", "interval"), rows, caption))
+
+
+def _grid_table(summary: Summary, heading: str, caption: str,
+                columns: Sequence[str] | None = None) -> str:
+    """A section of table cells of ``summary`` (:meth:`Summary.grid`) as a table; a missing
+    number shows as "–"."""
+    headers, rows = summary.grid(heading, columns)
+    return _table(headers, [["–" if c == "-" else c for c in row] for row in rows], caption)
 
 
 def _match(plateaus: Sequence[Plateau], source: str) -> list[Plateau]:
@@ -209,7 +193,8 @@ def _match(plateaus: Sequence[Plateau], source: str) -> list[Plateau]:
 
 
 def _settling(page: _Page, plateaus: Sequence[Plateau], traces: Sequence[SoakTrace],
-              missing: Sequence[str]) -> None:
+              missing: Sequence[str], tables: Summary) -> None:
+    """Fig. 3 and the plateaus (``tables``: :func:`thermometer_tables` of the unit)."""
     page.add('<section id="settling"><h2>1. Settling of the soaks</h2>')
     if missing:
         page.note("Soak recordings not found: " + ", ".join(
@@ -231,21 +216,8 @@ def _settling(page: _Page, plateaus: Sequence[Plateau], traces: Sequence[SoakTra
     else:
         page.note("No soak recordings and no stored settling fits: the settling figure "
                   "cannot be drawn.")
-    rows = [(_number(p.chamber_c, fixed=3), _number(p.settled_freq_hz, fixed=5),
-             _number(1e3 * p.settled_freq_std_hz, 2), p.method, "yes" if p.settled else "no",
-             _number(p.slope_hz_per_h, 3, sign=True), _number(p.residual_unsettled_c, fixed=4,
-                                                           sign=True),
-             Path(p.source).name if p.source else "–") for p in plateaus]
-    page.add(_table(("chamber [°C]", "settled frequency [Hz]", "std error [mHz]", "from",
-                         "settled by slope", "final slope [Hz/h]", "unsettled at end [°C]",
-                         "soak file"), rows, "Plateaus of the unit (from the model file)"),
+    page.add(_grid_table(tables, PLATEAUS, "Plateaus of the unit (from the model file)"),
              "</section>")
-
-
-def _power(symbol: str, n: int) -> str:
-    """``T³`` style powers (plain text, for tables and equations)."""
-    digits = str.maketrans("0123456789", "⁰¹²³⁴⁵⁶⁷⁸⁹")
-    return "" if n == 0 else symbol if n == 1 else symbol + str(n).translate(digits)
 
 
 def _table_rows(model: UnitModel, plateaus: Sequence[Plateau]) -> list[dict[str, float]]:
@@ -257,7 +229,9 @@ def _table_rows(model: UnitModel, plateaus: Sequence[Plateau]) -> list[dict[str,
 
 
 def _thermometer(page: _Page, model: UnitModel, plateaus: Sequence[Plateau],
-                 table: Sequence[Mapping[str, float]]) -> None:
+                 table: Sequence[Mapping[str, float]], tables: Summary) -> None:
+    """Fig. 4, Table 1, the thermometer's figures and Eq. 18 beside the paper's
+    (``tables``: :func:`thermometer_tables` of the unit)."""
     th = model.thermometer
     page.add('<section id="thermometer"><h2>2. Frequency–temperature fit</h2>')
     if plateaus:
@@ -268,23 +242,15 @@ def _thermometer(page: _Page, model: UnitModel, plateaus: Sequence[Plateau],
             "<b>Fig. 4</b> of [1]. Right: residuals f − f<sub>fit</sub> in mHz (error bars: "
             "standard error of each settled frequency) and their equivalent in °C.",
             "frequency-temperature fit and residuals")
-    rows = [(_number(r["chamber_c"], fixed=3), _number(r["freq_hz"], fixed=5),
-             _number(1e3 * (r["freq_hz"] - th.frequency(r["chamber_c"])), fixed=3, sign=True))
-            for r in table]
-    page.add(_table(("temperature [°C]", "natural frequency [Hz]", "residual [mHz]"),
-                        rows, "The unit's Table 1"))
+    page.add(_grid_table(tables, TABLE1, "The unit's Table 1"))
     summary = calibration_summary(model, table)
     _section_table(page, summary, "thermometer (Eq. 18)",
                    "Thermometer (Eq. 18): coefficients c0 (constant) to c3 (T³) ± 1σ, p-values, "
                    "fit")
-    high = th.coefficients_high_first
-    printed = dict(enumerate(reversed(paper.EQ18_PRINTED_HIGH_FIRST)))
-    powers = range(th.order, -1, -1)
-    rows = [(f"c{n}", _power("T", n) or "const", _number(c, 10), _number(printed.get(n), 7))
-            for n, c in zip(powers, high, strict=True)]
-    page.add(_table(("coefficient", "term", "this unit", "Eq. 18 of [1]"), rows,
-                    "Coefficients beside the paper's, highest power first"))
-    terms = " ".join(f"{'−' if c < 0 else '+'} {abs(c):.7g}" + (f"·{_power('T', n)}" if n else "")
+    page.add(_grid_table(tables, EQ18, "Coefficients beside the paper's, highest power first"))
+    high, powers = th.coefficients_high_first, range(th.order, -1, -1)
+    terms = " ".join(f"{'−' if c < 0 else '+'} {abs(c):.7g}"
+                     + (f"·{power_text('T', n)}" if n else "")
                      for n, c in zip(powers, high, strict=True))
     page.add(f'<p class="eq">f = {terms.lstrip("+ ")} &nbsp;[Hz, T in °C]</p>',
              f'<p class="muted">Eq. (18) form. Residual std {_number(1e3 * th.residual_std_hz, 3)} '
@@ -294,19 +260,16 @@ def _thermometer(page: _Page, model: UnitModel, plateaus: Sequence[Plateau],
 
 
 def _temperature(page: _Page, table: Sequence[Mapping[str, float]],
-                 traces: Sequence[SoakTrace]) -> None:
+                 traces: Sequence[SoakTrace], tables: Summary) -> None:
+    """Fig. 5(a), Table 2 (``tables``: :func:`thermometer_tables` of the unit) and
+    Fig. 5(b)."""
     page.add('<section id="temperature"><h2>3. Temperature from frequency</h2>')
     if table:
         page.figure(figures.temperature_error_figure(table),
                     "Temperature from frequency (inverse of Eq. 18) minus the chamber "
                     "temperature at each plateau, mirrors <b>Fig. 5(a)</b> of [1]; open circles: "
                     "the paper's unit (Table 2 of [1]).", "temperature error at each plateau")
-    rows = [(_number(r["freq_hz"], fixed=5), _number(r["chamber_c"], fixed=3),
-             _number(r["temperature_c"], fixed=4), _number(r["error_c"], fixed=4, sign=True))
-            for r in table]
-    page.add(_table(("frequency [Hz]", "chamber temperature [°C]",
-                         "temperature from frequency [°C]", "error [°C]"), rows,
-                        "The unit's Table 2"))
+    page.add(_grid_table(tables, TABLE2, "The unit's Table 2"))
     if traces:
         page.figure(figures.soak_temperature_figure(traces),
                     "Resonator temperature from frequency during each soak, mirrors "
@@ -424,11 +387,13 @@ def _scale_factor(page: _Page, model: UnitModel) -> None:
              f"by least squares, then k(f) by stepwise regression over candidates "
              f"<code>{escape(', '.join(sf.candidates))}</code>. Compensation applies "
              f"rate_comp = (rate − bias(f, ḟ)) / (1 + k(f)·10⁻⁶).</p>")
-    rows = [(_number(g.freq_hz, 10), _number(g.k_ppm, 5), _number(g.k_se_ppm, 3),
-             _number(float(sf.ppm(np.array([g.freq_hz]))[0]), 5), str(g.n))
-            for g in sf.groups]
-    page.add(_table(("mean frequency [Hz]", "k [ppm]", "std error [ppm]", "model k [ppm]",
-                     "holds"), rows, "Temperature groups of the rate-table holds"),
+    summary = sf.summary()
+    shown = summary.figures()
+    page.add(_grid_table(summary, "scale-factor temperature groups",
+                         "Temperature groups of the rate-table holds",
+                         ("mean frequency", "k", "std error", "model k", "holds")),
              f'<p class="eq">{escape(sf.equation())}</p>',
-             f'<p class="muted">Residual {_number(sf.residual_ppm)} ppm RMS over the groups; '
-             f"|input| up to {sf.input_rate_range_dph[1] / 3600:.4g} °/s.</p></section>")
+             f'<p class="muted">Residual {shown["scale_factor.residual_ppm"].number()} ppm '
+             f"RMS over the groups; "
+             f"|input| up to {shown['scale_factor.input_rate_max_dps'].number()} °/s.</p>"
+             "</section>")
