@@ -137,7 +137,9 @@ def _declaration(path: Path) -> tuple[int, list[tuple[str, Any, Any]]] | None:
         raise RuntimeError(f"{path}: a drift variable's module declares its options as one "
                            "top-level class Options and its VARIABLE with a literal order=")
     try:
-        exec(compile(ast.Module([declaration], []), str(path), "exec"), namespace)
+        # dont_inherit: the annotations are evaluated here, in the declaration's namespace
+        exec(compile(ast.Module([declaration], []), str(path), "exec", dont_inherit=True),
+             namespace)
     except NameError as exc:
         raise RuntimeError(
             f"{path}: its Options declaration uses {exc.name!r}, which is not a literal "
