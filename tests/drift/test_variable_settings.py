@@ -28,6 +28,7 @@ from hrgtc.settings.drift import (
     VARIABLE_OPTIONS,
     WARMUP_FACTOR,
     DriftSettings,
+    declared_variables,
     variable_modules,
     variable_options,
 )
@@ -62,6 +63,18 @@ def test_drift_settings_take_each_modules_declared_options():
     assert order[start:start + len(declared)] == [name for name, _, _ in declared]
 
 
+def test_the_text_declares_what_the_registry_holds():
+    """Each module's name and order as read from its text are its ``VARIABLE``'s, and the
+    ``--terms`` help lists the variables from them, in grammar order."""
+    from hrgtc.settings import settings_of
+
+    read = [(d.name, d.order) for d in declared_variables()]
+    assert read == [(v.name, v.order) for v in DRIFT_VARIABLES]
+    (terms,) = [s for s in settings_of(DriftSettings) if s.name == "terms"]
+    listed = terms.help.split("Variables: ")[1].rstrip(".").replace(" (--aux)", "")
+    assert listed.split(", ") == [v.name for v in DRIFT_VARIABLES]
+
+
 def test_the_settings_read_no_variable_module():
     """``hrgtc.settings.drift`` reads the declarations as text: neither numpy nor a variable
     module is imported (so ``hrgtc --help`` stays quick)."""
@@ -89,7 +102,10 @@ def test_declarations_are_read_in_grammar_order_from_text(tmp_path):
             'default_text=f"{FACTOR:g} × --rate-tau-s", panel="Mine")', 9,
             before="FACTOR = 3.0\nNOT_LITERAL = np.pi")
     (tmp_path / "spec.py").write_text("class Options:\n    x: int = 1\n", encoding="utf-8")
-    (tmp_path / "plain.py").write_text("import numpy\n", encoding="utf-8")
+    (tmp_path / "plain.py").write_text("import numpy\n\nVARIABLE = make(name='plain', order=5)\n",
+                                       encoding="utf-8")
+    assert [(d.name, d.order) for d in declared_variables(tmp_path)] == [
+        ("zeta", 2), ("plain", 5), ("alpha", 9)]
     found = variable_options(tmp_path)
     assert [(name, kind) for name, kind, _ in found] == [("zeta_s", float),
                                                          ("alpha_s", float | None)]
@@ -104,6 +120,9 @@ def test_a_declaration_that_needs_the_module_is_refused(tmp_path):
         variable_options(tmp_path)
     _module(tmp_path, "bad", '    bad_s: float = 3.0', 3)
     with pytest.raises(RuntimeError, match=r"bad\.py: Options\.bad_s is not a setting"):
+        variable_options(tmp_path)
+    (tmp_path / "bad.py").write_text("import numpy\n", encoding="utf-8")
+    with pytest.raises(RuntimeError, match=r"bad\.py: .*VARIABLE = DriftVariable.*literal name"):
         variable_options(tmp_path)
 
 

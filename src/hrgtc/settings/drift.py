@@ -48,14 +48,130 @@ AUTOCORRELATIONS = ("newey-west", "none")
 _FIT = "Drift model"
 
 
+#: The drift variables' modules (``hrgtc/drift/variables/``), read as text here.
+VARIABLES_DIRECTORY = Path(__file__).resolve().parent.parent / "drift" / "variables"
+#: Modules of that package that are not variables.
+NOT_VARIABLES = frozenset({"registry", "spec"})
+
+
+def variable_modules(directory: Path | str = VARIABLES_DIRECTORY) -> list[str]:
+    """Names of the drift variables' modules in ``directory`` (the registry's scan too)."""
+    return [info.name for info in pkgutil.iter_modules([str(directory)])
+            if info.name not in NOT_VARIABLES and not info.name.startswith("_")]
+
+
+@dataclass(frozen=True)
+class Declared:
+    """What this module reads of one drift variable's module, from its text.
+
+    Attributes
+    ----------
+    name, order
+        The literal ``name=`` and ``order=`` of its ``VARIABLE``.
+    options
+        Its ``class Options``, as ``(field, type, dataclasses.Field)`` (the panel, when it
+        names none, the drift model's).
+    """
+
+    name: str
+    order: int
+    options: tuple[tuple[str, Any, Any], ...]
+
+
+def _identity(path: Path, text: str) -> tuple[str, int]:
+    """The literal ``name=`` and ``order=`` of the module's ``VARIABLE = DriftVariable(...)``
+    (only the text from that statement on is parsed)."""
+    start = text.find("\nVARIABLE = ")
+    found: dict[str, Any] = {}
+    if start >= 0:
+        node = ast.parse(text[start + 1:], str(path)).body[0]
+        if isinstance(node, ast.Assign) and isinstance(node.value, ast.Call):
+            found = {k.arg: ast.literal_eval(k.value) for k in node.value.keywords
+                     if k.arg in ("name", "order")}
+    if not (isinstance(found.get("name"), str) and isinstance(found.get("order"), int)):
+        raise RuntimeError(f"{path}: a drift variable's module has a top-level VARIABLE = "
+                           "DriftVariable(...) with a literal name= and order=")
+    return found["name"], found["order"]
+
+
+def _options(path: Path, text: str) -> tuple[tuple[str, Any, Any], ...]:
+    """The ``Options`` class of one variable's module, run alone.
+
+    Only the class statement runs, with :func:`~hrgtc.settings.setting` and the module's
+    top-level constants whose values are literals (``TAU2_FACTOR = 6.0``); the module
+    itself is not imported (it loads numpy).
+    """
+    if "\nclass Options" not in text:
+        return ()
+    namespace: dict[str, Any] = {"setting": setting}
+    declaration = None
+    for node in ast.parse(text, str(path)).body:
+        if isinstance(node, ast.ClassDef) and node.name == "Options":
+            declaration = node
+        elif (isinstance(node, ast.Assign) and len(node.targets) == 1
+              and isinstance(node.targets[0], ast.Name)):
+            try:
+                namespace[node.targets[0].id] = ast.literal_eval(node.value)
+            except ValueError:  # not a literal: not available to the declaration
+                pass
+    if declaration is None:
+        raise RuntimeError(f"{path}: a drift variable's options are one top-level "
+                           "class Options")
+    try:
+        # dont_inherit: the annotations are evaluated here, in the declaration's namespace
+        exec(compile(ast.Module([declaration], []), str(path), "exec", dont_inherit=True),
+             namespace)
+    except NameError as exc:
+        raise RuntimeError(
+            f"{path}: its Options declaration uses {exc.name!r}, which is not a literal "
+            "constant of the module; hrgtc.settings.drift reads the declaration without "
+            "importing the module, so it may use only setting(...), builtins and "
+            "top-level constants such as NAME = 6.0") from None
+    options = namespace["Options"]
+    fields = []
+    for name, kind in options.__annotations__.items():
+        declared = options.__dict__.get(name)
+        if not isinstance(declared, dataclasses.Field) or "help" not in declared.metadata:
+            raise RuntimeError(f"{path}: Options.{name} is not a setting(...) with a help")
+        meta = {**declared.metadata, "panel": declared.metadata["panel"] or _FIT}
+        fields.append((name, kind, dataclasses.field(default=declared.default, metadata=meta)))
+    return tuple(fields)
+
+
+def declared_variables(directory: Path | str = VARIABLES_DIRECTORY) -> list[Declared]:
+    """The drift variables as their modules' text declares them, in grammar order.
+
+    Read without importing the modules (they load numpy), so that ``hrgtc --help`` stays
+    quick; ``tests/drift/test_variable_settings.py`` checks that the imported modules
+    declare the same.
+    """
+    found = []
+    for module in variable_modules(directory):
+        path = Path(directory) / f"{module}.py"
+        text = path.read_text(encoding="utf-8")
+        found.append(Declared(*_identity(path, text), _options(path, text)))
+    return sorted(found, key=lambda d: d.order)
+
+
+def variable_options(directory: Path | str = VARIABLES_DIRECTORY) -> list[tuple[str, Any, Any]]:
+    """The options the drift variables declare (each module's ``Options``), in grammar
+    order, as ``(field, type, dataclasses.Field)`` of :func:`dataclasses.make_dataclass`."""
+    return [entry for d in declared_variables(directory) for entry in d.options]
+
+
+_DECLARED = declared_variables()
+#: The variables of the term grammar, as ``--terms``'s help lists them (a_NAME with the
+#: option that maps its channels).
+_GRAMMAR = ", ".join(d.name + (" (--aux)" if d.name == "a_NAME" else "") for d in _DECLARED)
+
+
 @dataclass(frozen=True)
 class _Common:
     """The fields of :data:`DriftSettings` that are not a drift variable's (in this order,
     the variables' options after ``rate_tau_s``)."""
 
     terms: tuple[str, ...] | None = setting(
-        None, "Candidate drift terms, comma separated. Variables: f, df, h, dh, dpos, d2, g, "
-        "a_NAME (--aux).",
+        None, f"Candidate drift terms, comma separated. Variables: {_GRAMMAR}.",
         default_text=f"{','.join(GRADIENT_TERMS)} (g the housing - resonator gradient) when "
         f"the runs log housing_c, else Eq. 21's {','.join(EQ21_TERMS)}", panel=_FIT)
     window_s: float = setting(10.0, "Averaging window of the fit.", unit="s", panel=_FIT)
@@ -94,82 +210,6 @@ class _Common:
         "stepwisefit.", cli="--hierarchical/--no-hierarchical", panel=_FIT)
 
 
-#: The drift variables' modules (``hrgtc/drift/variables/``), read as text here.
-VARIABLES_DIRECTORY = Path(__file__).resolve().parent.parent / "drift" / "variables"
-#: Modules of that package that are not variables.
-NOT_VARIABLES = frozenset({"registry", "spec"})
-
-
-def variable_modules(directory: Path | str = VARIABLES_DIRECTORY) -> list[str]:
-    """Names of the drift variables' modules in ``directory`` (the registry's scan too)."""
-    return [info.name for info in pkgutil.iter_modules([str(directory)])
-            if info.name not in NOT_VARIABLES and not info.name.startswith("_")]
-
-
-def _declaration(path: Path) -> tuple[int, list[tuple[str, Any, Any]]] | None:
-    """The ``Options`` class of one variable's module, run alone: ``(order, fields)``.
-
-    Only the class statement runs, with :func:`~hrgtc.settings.setting` and the module's
-    top-level constants whose values are literals (``TAU2_FACTOR = 6.0``); the module
-    itself is not imported (it loads numpy). ``order`` is the ``order=`` of its
-    ``VARIABLE``, so the options come in the grammar's order.
-    """
-    text = path.read_text(encoding="utf-8")
-    if "\nclass Options" not in text:
-        return None
-    tree = ast.parse(text, str(path))
-    namespace: dict[str, Any] = {"setting": setting}
-    declaration, order = None, None
-    for node in tree.body:
-        if isinstance(node, ast.ClassDef) and node.name == "Options":
-            declaration = node
-        elif (isinstance(node, ast.Assign) and len(node.targets) == 1
-              and isinstance(node.targets[0], ast.Name)):
-            if node.targets[0].id == "VARIABLE" and isinstance(node.value, ast.Call):
-                order = next((ast.literal_eval(k.value) for k in node.value.keywords
-                              if k.arg == "order"), None)
-            else:
-                try:
-                    namespace[node.targets[0].id] = ast.literal_eval(node.value)
-                except ValueError:  # not a literal: not available to the declaration
-                    pass
-    if declaration is None or not isinstance(order, int):
-        raise RuntimeError(f"{path}: a drift variable's module declares its options as one "
-                           "top-level class Options and its VARIABLE with a literal order=")
-    try:
-        # dont_inherit: the annotations are evaluated here, in the declaration's namespace
-        exec(compile(ast.Module([declaration], []), str(path), "exec", dont_inherit=True),
-             namespace)
-    except NameError as exc:
-        raise RuntimeError(
-            f"{path}: its Options declaration uses {exc.name!r}, which is not a literal "
-            "constant of the module; hrgtc.settings.drift reads the declaration without "
-            "importing the module, so it may use only setting(...), builtins and "
-            "top-level constants such as NAME = 6.0") from None
-    options = namespace["Options"]
-    fields = []
-    for name, kind in options.__annotations__.items():
-        declared = options.__dict__.get(name)
-        if not isinstance(declared, dataclasses.Field) or "help" not in declared.metadata:
-            raise RuntimeError(f"{path}: Options.{name} is not a setting(...) with a help")
-        meta = {**declared.metadata, "panel": declared.metadata["panel"] or _FIT}
-        fields.append((name, kind, dataclasses.field(default=declared.default, metadata=meta)))
-    return order, fields
-
-
-def variable_options(directory: Path | str = VARIABLES_DIRECTORY) -> list[tuple[str, Any, Any]]:
-    """The options the drift variables declare (each module's ``Options``), in grammar
-    order, as ``(field, type, dataclasses.Field)`` of :func:`dataclasses.make_dataclass`.
-
-    Read from the modules' text without importing them (they load numpy), so that
-    ``hrgtc --help`` stays quick; ``tests/drift/test_variables.py`` checks that the
-    imported modules declare the same.
-    """
-    found = [d for name in variable_modules(directory)
-             if (d := _declaration(Path(directory) / f"{name}.py")) is not None]
-    return [entry for _, fields in sorted(found, key=lambda d: d[0]) for entry in fields]
-
-
 def _fields(variables: list[tuple[str, Any, Any]]) -> list[tuple[str, Any, Any]]:
     """:class:`_Common`'s fields with the variables' options after ``rate_tau_s``."""
     hints = typing.get_type_hints(_Common)
@@ -193,7 +233,7 @@ def _variable_values(self: Any) -> dict[str, Any]:
     return {name: getattr(self, name) for name in VARIABLE_OPTIONS}
 
 
-_VARIABLE_FIELDS = variable_options()
+_VARIABLE_FIELDS = [entry for d in _DECLARED for entry in d.options]
 #: Names of the fields of :data:`DriftSettings` that the drift variables declare.
 VARIABLE_OPTIONS = tuple(name for name, _, _ in _VARIABLE_FIELDS)
 
