@@ -13,7 +13,8 @@ from __future__ import annotations
 
 import ast
 import dataclasses
-import pkgutil
+import os
+import re
 import typing
 from dataclasses import dataclass
 from pathlib import Path
@@ -55,9 +56,10 @@ NOT_VARIABLES = frozenset({"registry", "spec"})
 
 
 def variable_modules(directory: Path | str = VARIABLES_DIRECTORY) -> list[str]:
-    """Names of the drift variables' modules in ``directory`` (the registry's scan too)."""
-    return [info.name for info in pkgutil.iter_modules([str(directory)])
-            if info.name not in NOT_VARIABLES and not info.name.startswith("_")]
+    """Names of the drift variables' modules in ``directory``, sorted (the registry's scan
+    too): every ``NAME.py`` but ``_*``, ``registry`` and ``spec``."""
+    names = (name[:-3] for name in os.listdir(directory) if name.endswith(".py"))
+    return sorted(n for n in names if n not in NOT_VARIABLES and not n.startswith("_"))
 
 
 @dataclass(frozen=True)
@@ -101,11 +103,19 @@ def _options(path: Path, text: str) -> tuple[tuple[str, Any, Any], ...]:
     top-level constants whose values are literals (``TAU2_FACTOR = 6.0``); the module
     itself is not imported (it loads numpy).
     """
-    if "\nclass Options" not in text:
+    start = text.find("\nclass Options")
+    if start < 0:
         return ()
+    # the text up to the class's end (the next line at the margin) holds what it may use
+    end = re.search(r"\n(?=[^\s#])", text[text.index("\n", start + 1):])
+    head = text if end is None else text[:text.index("\n", start + 1) + end.start()]
+    try:
+        tree = ast.parse(head, str(path))
+    except SyntaxError:  # a line at the margin inside the class (a string): all of it
+        tree = ast.parse(text, str(path))
     namespace: dict[str, Any] = {"setting": setting}
     declaration = None
-    for node in ast.parse(text, str(path)).body:
+    for node in tree.body:
         if isinstance(node, ast.ClassDef) and node.name == "Options":
             declaration = node
         elif (isinstance(node, ast.Assign) and len(node.targets) == 1
