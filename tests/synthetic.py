@@ -112,5 +112,5 @@ def lagged_model():
 
     fitted = drift.fit([lagged_run(seed=5), lagged_run(seed=6, start_c=-20.0, end_c=20.0)],
                        THERMOMETER, terms=LAGGED_TERMS, initial=LAGGED_TERMS, premove=0.999999,
-                       rate_tau2_s=120.0, aux_columns={"drive": "drive_v"})
+                       options={"rate_tau2_s": 120.0}, aux_columns={"drive": "drive_v"})
     return UnitModel(thermometer=THERMOMETER, drift=fitted, unit="synthetic-lagged")

@@ -17,7 +17,7 @@ from hrgtc.cli.options_tables import DOCUMENTED, settings_class, update_docs
 from hrgtc.cli.params import _value, option_settings
 from hrgtc.settings import Setting, format_value, settings_of
 from hrgtc.settings.calibration import CalibrationSettings
-from hrgtc.settings.drift import EQ21_TERMS, TAU2_FACTOR, WARMUP_FACTOR, DriftSettings
+from hrgtc.settings.drift import EQ21_TERMS, WARMUP_FACTOR, DriftSettings
 from hrgtc.settings.reading import ReadSettings
 
 DOCS = Path(__file__).resolve().parents[2] / "docs"
@@ -186,10 +186,13 @@ def test_stale_docs_table_is_found():
 
 def test_derived_help_follows_its_constant():
     """The help of --rate-tau2-s and --warmup-s comes from the constants the fit uses."""
+    from hrgtc.drift.variables.d2 import TAU2_FACTOR, derive
+
     by_name = {s.name: s for s in settings_of(DriftSettings)}
     assert by_name["rate_tau2_s"].default_text == f"{TAU2_FACTOR:g} × --rate-tau-s"
     assert by_name["warmup_s"].default_text.startswith(f"{WARMUP_FACTOR:g} ×")
-    assert DriftSettings().tau2_s(True) == TAU2_FACTOR * DriftSettings.rate_tau_s
+    given = {**DriftSettings().variable_options(), "rate_tau_s": DriftSettings.rate_tau_s}
+    assert derive(("d2",), given) == {"rate_tau2_s": TAU2_FACTOR * DriftSettings.rate_tau_s}
     assert DriftSettings(rate_tau_s=20.0).warmup(0.0) == WARMUP_FACTOR * 20.0
     assert EQ21_TERMS[0] == "f" and len(EQ21_TERMS) == 9  # Eq. (21) of [1]: nine terms
 

@@ -71,7 +71,7 @@ def model_using(name: str) -> UnitModel:
             runs = [with_heating_extra(r) for r in runs]
         terms = _terms(name)
         fitted = drift.fit(runs, THERMOMETER, terms=terms, initial=terms, premove=0.999999,
-                           rate_tau2_s=120.0, aux_columns={"drive": "drive_v"})
+                           options={"rate_tau2_s": 120.0}, aux_columns={"drive": "drive_v"})
         assert set(fitted.selected) == set(terms)
         _MODELS[name] = UnitModel(thermometer=THERMOMETER, drift=fitted, unit=f"uses-{name}")
     return _MODELS[name]

@@ -45,9 +45,7 @@ from hrgtc.drift.cross_validation import (
 )
 from hrgtc.drift.drift_text import drift_equation, drift_summary
 from hrgtc.drift.features import (
-    AUX_PREFIX,
     EQ21,
-    SWITCH_FRACTION,
     FeatureSettings,
     FeatureSettingsRecord,
     FeatureStream,
@@ -55,7 +53,6 @@ from hrgtc.drift.features import (
     Term,
     TermName,
     hierarchy,
-    is_aux,
     linear_combination,
     parse_terms,
     tangent_extension,
@@ -65,10 +62,12 @@ from hrgtc.drift.offsets import fit_offsets, offset_groups, orientation_offset, 
 from hrgtc.drift.regression import EXTENDED_PRECISION, newey_west_inflation
 from hrgtc.drift.rest import check_policy, reference_point, run_rest
 from hrgtc.drift.stepwise import StepwiseRecord, StepwiseResult, stepwise
+from hrgtc.drift.variables import DriftVariable
+from hrgtc.drift.variables import variable as registered
 from hrgtc.drift.windows import RunSource, TrainingWindows, _iter_run, window_means
 from hrgtc.recording import Recording
 from hrgtc.recording.motion import MotionSettings
-from hrgtc.settings.drift import SELECTIONS, TAU2_FACTOR, WARMUP_FACTOR, DriftSettings
+from hrgtc.settings.drift import SELECTIONS, VARIABLE_OPTIONS, WARMUP_FACTOR, DriftSettings
 from hrgtc.thermometry import Thermometer
 
 _DRIFT = DriftSettings
@@ -325,6 +324,30 @@ def _check_excitation(windows: TrainingWindows, thermometer: Thermometer,
             )
 
 
+def _given_options(options: Mapping[str, Any] | None, rate_tau_s: float,
+                   aux_columns: Mapping[str, str] | None) -> dict[str, Any]:
+    """What the variables' ``derive`` read: the options they declare (defaults for those
+    not given), ``rate_tau_s`` and ``aux_columns``."""
+    given = dict(options or {})
+    unknown = sorted(set(given) - set(VARIABLE_OPTIONS))
+    if unknown:
+        raise InputError(f"unknown drift variable option(s) {unknown}; the variables declare "
+                         f"{', '.join(VARIABLE_OPTIONS) or 'none'}")
+    return {**DriftSettings().variable_options(), **given, "rate_tau_s": rate_tau_s,
+            "aux_columns": dict(aux_columns or {})}
+
+
+def _entries(variables: Sequence[str]) -> list[tuple[DriftVariable, tuple[str, ...]]]:
+    """The registry's entries of ``variables``, each with its names (``a_NAME``: every
+    channel), in grammar order."""
+    entries: dict[str, tuple[DriftVariable, list[str]]] = {}
+    for name in variables:
+        entry = registered(name)
+        entries.setdefault(entry.name, (entry, []))[1].append(name)
+    return [(entry, tuple(names)) for entry, names in
+            sorted(entries.values(), key=lambda e: e[0].order)]
+
+
 def fit(
     runs: Sequence[RunSource],
     thermometer: Thermometer,
@@ -336,7 +359,7 @@ def fit(
     initial: Iterable[str] | None = None,
     reference_c: float | None = None,
     rate_tau_s: float = _DRIFT.rate_tau_s,
-    rate_tau2_s: float | None = None,
+    options: Mapping[str, Any] | None = None,
     aux_columns: Mapping[str, str] | None = None,
     warmup_s: float | None = None,
     autocorrelation: str = _DRIFT.autocorrelation,
@@ -374,9 +397,12 @@ def fit(
         stored as ``settings.reference_c``.
     rate_tau_s
         Time constant of each stage of the causal df/dt filter. [s]
-    rate_tau2_s
-        Time constant of the second df/dt filter, variable ``d2``; default
-        :data:`TAU2_FACTOR` × ``rate_tau_s`` when a candidate uses ``d2``. [s]
+    options
+        The options the drift variables declare (the fields of
+        :data:`~hrgtc.settings.drift.DriftSettings` from their modules' ``Options``), by
+        name: ``{"rate_tau2_s": 120.0}`` for the second df/dt filter of ``d2`` (default
+        ``TAU2_FACTOR`` × ``rate_tau_s``); an option not given takes its default. Each
+        variable the candidates use takes its settings from them (its ``derive``).
     aux_columns
         Extra channel name -> recording column, for candidates in ``a_NAME``; each is
         centred on its training mean (stored in the settings).
@@ -441,15 +467,14 @@ def fit(
     finally:
         head.close()
     variables = variables_for(candidates)
-    tau2 = 0.0
-    if "d2" in variables:
-        tau2 = TAU2_FACTOR * rate_tau_s if rate_tau2_s is None else float(rate_tau2_s)
-    aux = {str(k): str(v) for k, v in dict(aux_columns or {}).items()}
-    unmapped = [v for v in variables if is_aux(v) and v[len(AUX_PREFIX):] not in aux]
-    if unmapped:
-        raise InputError(f"candidate variable(s) {unmapped} have no column; map each with "
-                         "--aux NAME=COLUMN")
-    warmup = WARMUP_FACTOR * max(rate_tau_s, tau2) if warmup_s is None else warmup_s
+    given = _given_options(options, rate_tau_s, aux_columns)
+    used = _entries(variables)
+    derived: dict[str, Any] = {}
+    for entry, own in used:  # the settings each variable takes from the options
+        if entry.derive is not None:
+            derived.update(entry.derive(own, given))
+    taus = [derived[e.rate_of[1]] for e, _ in used if e.rate_of and e.rate_of[1] in derived]
+    warmup = WARMUP_FACTOR * max([rate_tau_s, *taus]) if warmup_s is None else warmup_s
     check_policy(motion)
     rests = [run_rest(_iter_run(run), motion, motion_settings, warmup) for run in runs]
     keep = None if motion == "keep" else [r.keep for r in rests]
@@ -460,19 +485,17 @@ def fit(
         reference_c=float(reference_c),
         rate_tau_s=rate_tau_s,
         warmup_s=warmup,
-        rate_tau2_s=tau2,
-        aux_columns=aux,
+        **derived,
     )
-    first_pass = [v for v in variables if is_aux(v)] + (["df"] if "dpos" in variables else [])
-    if first_pass:  # δ of the heating/cooling switch and the channels' centres: a first pass
-        means = window_means(runs, settings, parse_terms(first_pass), window_s,
+    passes = [(e.first_pass, own) for e, own in used if e.first_pass is not None]
+    if passes:  # what the variables learn from the runs (dpos's switch, the channels' centres)
+        reads = tuple(dict.fromkeys(v for p, own in passes for v in p.reads(own)))
+        means = window_means(runs, settings, parse_terms(reads), window_s,
                              keep=keep, gaps=gaps,
                              restart_each_segment=restart_each_segment).variables
-        update: dict[str, Any] = {"aux_centres": {
-            v[len(AUX_PREFIX):]: float(np.mean(means[v])) for v in first_pass if is_aux(v)}}
-        if "dpos" in variables:
-            spread = float(np.std(means["df"]))
-            update["switch_hz_per_s"] = SWITCH_FRACTION * spread if spread > 0.0 else 1.0
+        update: dict[str, Any] = {}
+        for first_pass, own in passes:
+            update.update(first_pass.derive(own, means))
         settings = FeatureSettings(**{**settings.to_dict(), **update})
     # df/dt's training range is kept for the range warnings even when no candidate uses it
     tracked = ("df",) if "f" in variables else ()

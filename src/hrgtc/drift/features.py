@@ -73,7 +73,10 @@ from hrgtc.drift.variables import AUX_PREFIX, DRIFT_VARIABLES, FIXED, Inputs
 from hrgtc.drift.variables import settings_fields as variable_settings_fields
 from hrgtc.drift.variables import variable as _registered
 from hrgtc.drift.variables.aux import centre as _aux_centre
-from hrgtc.drift.variables.dpos import heating_part  # noqa: F401  (re-exported)
+from hrgtc.drift.variables.dpos import (  # noqa: F401  (re-exported)
+    SWITCH_FRACTION,
+    heating_part,
+)
 from hrgtc.recording.schema import Recording
 from hrgtc.settings.drift import EQ21_TERMS as _EQ21_TERMS
 from hrgtc.settings.drift import DriftSettings
@@ -87,8 +90,6 @@ LEVEL_VARIABLES = tuple(v for v in FIXED if _registered(v).kind == "level")
 RATE_VARIABLES = tuple(v for v in FIXED if _registered(v).kind == "rate" and v != "dpos")
 #: An extra channel's name (the part after ``a_``): a letter, then letters and digits.
 AUX_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9]*$")
-#: δ of ``dpos`` as a share of the std of the training windows' df/dt.
-SWITCH_FRACTION = 0.1
 _TERM_FACTOR = re.compile(
     r"^\s*([a-z][a-z0-9]*|a_[A-Za-z][A-Za-z0-9]*)\s*(?:\^\s*(\d+))?\s*$")
 

@@ -371,7 +371,7 @@ def _fit(runs: Sequence[Any], thermometer: Any, drift: DriftSettings,
     return drift_model.fit(
         runs, thermometer, terms=drift.terms or drift_model.EQ21, window_s=drift.window_s,
         penter=drift.penter, premove=drift.premove, reference_c=drift.reference_c,
-        rate_tau_s=drift.rate_tau_s, rate_tau2_s=drift.rate_tau2_s, warmup_s=drift.warmup_s,
+        rate_tau_s=drift.rate_tau_s, options=drift.variable_options(), warmup_s=drift.warmup_s,
         select=drift.select, offsets=drift.offsets, autocorrelation=drift.autocorrelation,
         hierarchical=drift.hierarchical, aux_columns=aux,
         excitation_runs=excitation_runs, progress=progress, motion=options.motion,
@@ -389,9 +389,11 @@ def _fit_drift(training: Sequence[PathLike], heads: Mapping[str, Any], thermomet
                  excitation_runs)
     housing = None
     if housing_terms is not None and all("housing_c" in heads[str(p)] for p in training):
-        # the baseline's own terms in h and dh/dt, with the default selection and d2 filter
+        # the baseline's own terms in h and dh/dt, with the default selection and the
+        # variables' default options (d2's filter)
         baseline = dataclasses.replace(drift, terms=tuple(housing_terms),
-                                       select=DriftSettings.select, rate_tau2_s=None)
+                                       select=DriftSettings.select,
+                                       **DriftSettings().variable_options())
         try:
             housing = _fit(runs, thermometer, baseline, None, options,
                            for_stage(progress, "housing baseline"))

@@ -9,14 +9,14 @@ mirror rounds the logged value to float as firmware passes it.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
 
 from hrgtc.core import records
 from hrgtc.core.errors import InputError
-from hrgtc.drift.variables.spec import DriftVariable, Inputs, Put
+from hrgtc.drift.variables.spec import DriftVariable, FirstPass, Inputs, Put
 
 #: Prefix of the user's extra channels.
 AUX_PREFIX = "a_"
@@ -95,10 +95,32 @@ def params(names: tuple[str, ...], settings: Any, put: Put) -> None:
             f"Training mean of aux_{name}, subtracted. [unit of the column {column}]")
 
 
+def columns(names: tuple[str, ...], given: Mapping[str, Any]) -> dict[str, Any]:
+    """The channels' columns, from ``--aux NAME=COLUMN`` (``given["aux_columns"]``).
+
+    Raises
+    ------
+    InputError
+        A candidate's channel has no column.
+    """
+    mapped = {str(k): str(v) for k, v in dict(given.get("aux_columns") or {}).items()}
+    unmapped = [n for n in names if n[len(AUX_PREFIX):] not in mapped]
+    if unmapped:
+        raise InputError(f"candidate variable(s) {unmapped} have no column; map each with "
+                         "--aux NAME=COLUMN")
+    return {"aux_columns": mapped}
+
+
+def centres(names: tuple[str, ...], means: Mapping[str, np.ndarray]) -> dict[str, Any]:
+    """Each channel's training mean, from the first pass's window means. [column unit]"""
+    return {"aux_centres": {n[len(AUX_PREFIX):]: float(np.mean(means[n])) for n in names}}
+
+
 VARIABLE = DriftVariable(
     name="a_NAME", unit="unit of its column", sensor_unit="unit of its column", kind="level",
     description="an extra logged channel (--aux NAME=COLUMN) minus its training mean",
     backends=frozenset({"numpy", "c_double", "c_float32", "params"}), columns=(),
     compute=compute, order=7, check=check, c_code=CCode(),
     settings_fields=(("aux_columns", dict[str, str], records.empty()),
-                     ("aux_centres", dict[str, float], records.empty())), params=params)
+                     ("aux_centres", dict[str, float], records.empty())), params=params,
+    derive=columns, first_pass=FirstPass(reads=lambda names: names, derive=centres))

@@ -9,13 +9,30 @@ runs the float filter of df (differences, compensated sums) with ``RATE2_TAU``.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
 
 from hrgtc.core import records
 from hrgtc.drift.variables.spec import DriftVariable, Inputs, Put
+from hrgtc.settings import setting
+
+#: The second filter is this many times slower than the first by default.
+TAU2_FACTOR = 6.0
+
+
+class Options:
+    """d2's command-line option, a field of ``DriftSettings`` (``hrgtc calibrate
+    --rate-tau2-s``).
+
+    :mod:`hrgtc.settings.drift` runs this class statement alone, from this file's text
+    (``hrgtc --help`` loads no numpy): it may use ``setting`` and literal constants above.
+    """
+
+    rate_tau2_s: float | None = setting(
+        None, "Time constant of the second df/dt filter, variable d2 (terms like d2, f*d2).",
+        unit="s", default_text=f"{TAU2_FACTOR:g} × --rate-tau-s")
 
 
 def compute(inputs: Inputs, name: str) -> np.ndarray:
@@ -71,6 +88,13 @@ class CCode:
         return np.asarray(value).astype(np.float32)
 
 
+def derive(names: tuple[str, ...], given: Mapping[str, Any]) -> dict[str, Any]:
+    """The second filter's time constant: ``--rate-tau2-s``, else :data:`TAU2_FACTOR` ×
+    ``--rate-tau-s``. [s]"""
+    tau2 = given["rate_tau2_s"]
+    return {"rate_tau2_s": TAU2_FACTOR * given["rate_tau_s"] if tau2 is None else float(tau2)}
+
+
 def params(names: tuple[str, ...], settings: Any, put: Put) -> None:
     """d2's keys of the parameter file: the flag and the second filter's time constant."""
     put("uses_rate2", 1, "1: the terms use d2, the rate of f by the second filter.")
@@ -84,4 +108,4 @@ VARIABLE = DriftVariable(
     backends=frozenset({"numpy", "c_double", "c_float32", "params"}), columns=("freq_hz",),
     compute=compute, order=5, check=check,
     settings_fields=(("rate_tau2_s", records.NonNegative, 0.0),), c_code=CCode(),
-    rate_of=("f", "rate_tau2_s"), params=params)
+    rate_of=("f", "rate_tau2_s"), params=params, derive=derive)

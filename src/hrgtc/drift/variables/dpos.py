@@ -9,10 +9,16 @@ refuse it.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from typing import Any
+
 import numpy as np
 
 from hrgtc.core import records
-from hrgtc.drift.variables.spec import DriftVariable, Inputs
+from hrgtc.drift.variables.spec import DriftVariable, FirstPass, Inputs
+
+#: δ of ``dpos`` as a share of the std of the training windows' df/dt.
+SWITCH_FRACTION = 0.1
 
 
 def heating_part(rate: np.ndarray, switch: float) -> np.ndarray:
@@ -39,9 +45,17 @@ def check(settings, thermometer, name: str) -> str | None:
     return None
 
 
+def switch(names: tuple[str, ...], means: Mapping[str, np.ndarray]) -> dict[str, Any]:
+    """δ from the first pass: :data:`SWITCH_FRACTION` × the std of the training windows'
+    df/dt (1 Hz/s when df/dt does not vary). [Hz/s]"""
+    spread = float(np.std(means["df"]))
+    return {"switch_hz_per_s": SWITCH_FRACTION * spread if spread > 0.0 else 1.0}
+
+
 VARIABLE = DriftVariable(
     name="dpos", unit="Hz/s", sensor_unit="°C/s", kind="rate",
     description="heating/cooling switch: the heating part of df, df*(1 + tanh(df/delta))/2 "
                 "(delta: switch_hz_per_s)",
     backends=frozenset({"numpy"}), columns=("freq_hz",), compute=compute, order=4,
-    check=check, settings_fields=(("switch_hz_per_s", records.NonNegative, 0.0),))
+    check=check, settings_fields=(("switch_hz_per_s", records.NonNegative, 0.0),),
+    first_pass=FirstPass(reads=lambda names: ("df",), derive=switch))

@@ -34,13 +34,13 @@ that sensor in the place of the frequency, so f is in °C and its rates in °C/s
 from __future__ import annotations
 
 import importlib
-import pkgutil
 import re
 import sys
 from typing import Any
 
 from hrgtc.drift.variables.aux import AUX_PREFIX
 from hrgtc.drift.variables.spec import BACKENDS, DriftVariable
+from hrgtc.settings.drift import variable_modules
 
 __all__ = ["AUX_PREFIX", "BACKENDS", "BACKEND_NAMES", "DRIFT_VARIABLES", "FIXED",
            "DriftVariable", "ascii_unit", "docs_table", "is_aux", "refusal",
@@ -61,19 +61,16 @@ _INSTEAD = {
     "params": "export C (--format c), or calibrate without {v} terms",
 }
 
-#: Modules of the package that are not variables.
-_NOT_VARIABLES = frozenset({"registry", "spec"})
-
 
 def _discover() -> tuple[DriftVariable, ...]:
-    """The ``VARIABLE`` of every module of this package, in grammar order."""
+    """The ``VARIABLE`` of every module of this package, in grammar order (the modules
+    :func:`hrgtc.settings.drift.variable_modules` lists, which also reads their options)."""
     package = sys.modules[__package__]
     found = []
-    for info in pkgutil.iter_modules(package.__path__):
-        if info.name in _NOT_VARIABLES or info.name.startswith("_"):
-            continue
-        module = importlib.import_module(f"{__package__}.{info.name}")
-        found.append(module.VARIABLE)
+    for directory in package.__path__:
+        for name in variable_modules(directory):
+            module = importlib.import_module(f"{__package__}.{name}")
+            found.append(module.VARIABLE)
     found.sort(key=lambda v: v.order)
     orders = [v.order for v in found]
     if len(set(orders)) != len(orders) or len({v.name for v in found}) != len(found):

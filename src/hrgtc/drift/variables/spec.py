@@ -5,7 +5,9 @@ one :class:`DriftVariable`: its name, units, kind and docs line, the backends th
 it, its numpy reference (``compute``: how it is made from the recording's columns, the
 settings and the other variables), what it needs of the settings (``check``), the
 settings it owns in the model file (``settings_fields``: their types, bounds and defaults,
-from which the model file's record and JSON Schema are generated),
+from which the model file's record and JSON Schema are generated), where the fit gives
+them their values (``derive`` from the fit's options, ``first_pass`` from the training
+runs; a command-line option of its own is its module's ``class Options``),
 and, for the variables beyond the paper's f, df, h and dh, its pieces of the C export
 (``c_code``, in double and in float32) and its keys of the parameter file (``params``).
 The registry (:mod:`hrgtc.drift.variables.registry`)
@@ -14,7 +16,7 @@ collects the modules; every consumer reads the entries from it.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any, Protocol
 
@@ -98,6 +100,31 @@ class CCode(Protocol):
 Put = Callable[[str, Any, str], None]
 
 
+#: ``derive(names, given)``: the feature settings a variable takes from the fit's options.
+#: ``names`` are the candidates' variables of this entry (``a_drive``, ``a_tilt``),
+#: ``given`` the fit's options by name: ``rate_tau_s``, ``aux_columns`` (``--aux``) and
+#: the options the variables declare (their modules' ``Options``: ``rate_tau2_s``).
+Derive = Callable[[tuple[str, ...], Mapping[str, Any]], dict[str, Any]]
+
+
+@dataclass(frozen=True)
+class FirstPass:
+    """Feature settings a variable learns from a first pass over the training runs.
+
+    Attributes
+    ----------
+    reads
+        ``reads(names)``: the variables whose training window means it needs (``df``
+        for dpos's switch, the channels themselves for their centres).
+    derive
+        ``derive(names, means)``: the settings, from those window means (variable ->
+        its windows' means over every run).
+    """
+
+    reads: Callable[[tuple[str, ...]], tuple[str, ...]]
+    derive: Callable[[tuple[str, ...], Mapping[str, np.ndarray]], dict[str, Any]]
+
+
 def _nothing(settings: Any, thermometer: Any, name: str) -> str | None:
     return None
 
@@ -142,6 +169,16 @@ class DriftVariable:
         beyond f, df, h and dh: ``params(names, settings, put)`` writes them with ``put``
         (:data:`Put`), ``names`` the model's variables of this entry (``a_drive``,
         ``a_tilt``: every extra channel at once), called once per model in grammar order.
+    derive
+        Where the fit takes its settings' values from the fit's options (:data:`Derive`):
+        d2's ``rate_tau2_s`` from ``--rate-tau2-s``. Called by
+        :func:`hrgtc.drift.fit` for each variable the candidates use, before the warm-up
+        is known (the longest of ``rate_tau_s`` and the derived time constants of the
+        ``rate_of`` variables sets it).
+    first_pass
+        What it learns from a first pass over the runs (:class:`FirstPass`): dpos's
+        ``switch_hz_per_s``, the extra channels' ``aux_centres``; one pass serves every
+        variable that has one.
     """
 
     name: str
@@ -158,6 +195,8 @@ class DriftVariable:
     c_code: CCode | None = None
     rate_of: tuple[str, str] | None = None
     params: Callable[[tuple[str, ...], Any, Put], None] | None = None
+    derive: Derive | None = None
+    first_pass: FirstPass | None = None
 
     def unit_for(self, thermometer_source: str = "resonator") -> str:
         """The unit for a model whose thermometer is ``"resonator"`` or ``"sensor"``."""
