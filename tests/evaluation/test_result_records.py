@@ -1,0 +1,86 @@
+"""The evaluation's results as records: each document equals the hand-written one it
+replaced (:mod:`tests.legacy_documents`, key for key and in order), validates against its
+record's JSON Schema (jsonschema, independent of msgspec) and, where the result reads one
+back, round-trips.
+
+Truth: the hand-written documents of the commit before the records, and the JSON Schema
+validator.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from tests import legacy_documents as legacy
+from tests.bursts import cut_bursts
+
+from hrgtc import recording
+from hrgtc.evaluation import evaluate
+from hrgtc.evaluation.burst_allan import burst_mean_allan
+from hrgtc.evaluation.heating_cooling import DirectionStats
+from hrgtc.evaluation.metrics import residual_against_truth
+from hrgtc.pipeline.calibration import calibrate
+
+pytestmark = pytest.mark.filterwarnings("ignore::hrgtc.core.errors.RateFilterWarning")
+
+
+def same(document, reference):
+    """Equal after a JSON round trip, with the same keys in the same order at every depth."""
+    assert json.dumps(document, allow_nan=False) == json.dumps(legacy.strict(reference),
+                                                               allow_nan=False)
+
+
+@pytest.fixture(scope="module")
+def evaluations(paper_campaign):
+    files = paper_campaign
+    model = calibrate(files.soaks, [files.cooldown]).model
+    whole = evaluate(files.warmup, model, max_points=300)
+    run = cut_bursts(recording.read(files.warmup), burst_s=60.0, period_s=600.0)
+    bursts = evaluate(run, model, deviation="mdev")
+    return {"whole": whole, "bursts": bursts}
+
+
+def _residual():
+    rng = np.random.default_rng(3)
+    truth = np.cumsum(rng.normal(size=4000)) * 0.01
+    return residual_against_truth(bias_model_dph=truth + rng.normal(size=4000),
+                                  true_bias_dph=truth, sample_rate_hz=10.0,
+                                  taus_s=(1.0, 10.0, 1000.0))
+
+
+def _bursts():
+    rng = np.random.default_rng(5)
+    starts = np.arange(40) * 300.0
+    starts[20:] += 300.0  # a missing burst: two runs
+    return burst_mean_allan(rng.normal(size=40), np.full(40, 5.0), starts)
+
+
+def _directions():
+    return [DirectionStats(10.0, {"heating": 12, "cooling": 2},
+                           {"heating": 0.5, "cooling": float("nan")},
+                           {"heating": 0.25, "cooling": float("nan")},
+                           {"heating": 0.1, "cooling": 0.2}, partial_blocks=3),
+            DirectionStats(10.0, {"heating": 0, "cooling": 0},
+                           {"heating": float("nan"), "cooling": float("nan")},
+                           {"heating": float("nan"), "cooling": float("nan")},
+                           reason="the run is shorter than a block")]
+
+
+def test_evaluation_documents_are_the_hand_written_ones(evaluations):
+    for result in evaluations.values():
+        same(result.to_dict(), legacy.evaluation(result))
+    bursts = evaluations["bursts"]
+    assert bursts.burst_allan and bursts.directions is not None
+    assert bursts.ranges is not None and bursts.accounting is not None
+
+
+def test_part_documents_are_the_hand_written_ones():
+    result = _residual()
+    same(result.to_dict(), legacy.residual(result))
+    result = _bursts()
+    assert result.runs == 2
+    same(result.to_dict(), legacy.burst_allan(result))
+    for stats in _directions():
+        same(stats.to_dict(), legacy.directions(stats))
