@@ -9,18 +9,24 @@ validator.
 
 from __future__ import annotations
 
+import copy
 import json
+import math
 
+import jsonschema
 import numpy as np
 import pytest
 from tests import legacy_documents as legacy
 from tests.bursts import cut_bursts
 
 from hrgtc import recording
+from hrgtc.core import records
+from hrgtc.core.errors import InputError
 from hrgtc.evaluation import evaluate
-from hrgtc.evaluation.burst_allan import burst_mean_allan
-from hrgtc.evaluation.heating_cooling import DirectionStats
-from hrgtc.evaluation.metrics import residual_against_truth
+from hrgtc.evaluation.burst_allan import BurstAllanRecord, BurstAllanResult, burst_mean_allan
+from hrgtc.evaluation.evaluation_result import evaluation_json_schema
+from hrgtc.evaluation.heating_cooling import DirectionStats, DirectionStatsRecord
+from hrgtc.evaluation.metrics import ResidualRecord, ResidualResult, residual_against_truth
 from hrgtc.pipeline.calibration import calibrate
 
 pytestmark = pytest.mark.filterwarnings("ignore::hrgtc.core.errors.RateFilterWarning")
@@ -84,3 +90,56 @@ def test_part_documents_are_the_hand_written_ones():
     same(result.to_dict(), legacy.burst_allan(result))
     for stats in _directions():
         same(stats.to_dict(), legacy.directions(stats))
+
+
+def _valid(document, record, title):
+    schema = records.json_schema(record, title, "https://hrgtc.invalid/schema/test.json")
+    jsonschema.Draft202012Validator.check_schema(schema)
+    jsonschema.validate(json.loads(json.dumps(document, allow_nan=False)), schema)
+    return schema
+
+
+def test_evaluation_documents_validate_against_their_schema(evaluations):
+    schema = evaluation_json_schema()
+    jsonschema.Draft202012Validator.check_schema(schema)
+    for result in evaluations.values():
+        document = json.loads(json.dumps(result.to_dict(), allow_nan=False))
+        jsonschema.validate(document, schema)
+    # the schema holds the records of its parts, and refuses what they refuse
+    assert {"NoiseTermsRecord", "BurstAllanRecord", "DirectionStatsRecord",
+            "DeviationCurveRecord", "RangeReportRecord", "AccountingRecord"} <= set(
+        schema["$defs"])
+    broken = copy.deepcopy(document)
+    broken["out_of_range_fraction"] = 1.5
+    with pytest.raises(jsonschema.ValidationError, match=r"1\.5"):
+        jsonschema.validate(broken, schema)
+    broken = copy.deepcopy(document)
+    broken["allan_burst_means"]["raw"]["counts"][0] = -1
+    with pytest.raises(jsonschema.ValidationError):
+        jsonschema.validate(broken, schema)
+    del broken["allan_burst_means"]
+    with pytest.raises(jsonschema.ValidationError, match="allan_burst_means"):
+        jsonschema.validate(broken, schema)
+
+
+def test_parts_validate_and_round_trip():
+    residual = _residual()
+    document = residual.to_dict()
+    _valid(document, ResidualRecord, "residual")
+    assert math.isnan(residual.bias_stability_dph[1000.0])  # written null, read back NaN
+    back = ResidualResult.from_dict(json.loads(json.dumps(document)))
+    assert back.to_dict() == document and back.n_samples == residual.n_samples
+    assert math.isnan(back.bias_stability_dph[1000.0])
+
+    bursts = _bursts()
+    document = bursts.to_dict()
+    _valid(document, BurstAllanRecord, "burst means")
+    back = BurstAllanResult.from_dict(json.loads(json.dumps(document)))
+    assert back.to_dict() == document
+    np.testing.assert_array_equal(back.deviation, bursts.deviation)
+    assert back.counts.dtype.kind == "i"
+    with pytest.raises(InputError, match=r"burst-mean Allan deviation record: .*`\$.runs`"):
+        BurstAllanResult.from_dict({**document, "runs": 0})
+
+    for stats in _directions():
+        _valid(stats.to_dict(), DirectionStatsRecord, "directions")

@@ -8,12 +8,15 @@ validator.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import json
 
+import jsonschema
 import pytest
 from tests import legacy_documents as legacy
 
+from hrgtc.pipeline.documents import calibrate_json_schema, evaluate_json_schema
 from hrgtc.pipeline.instrument import calibrate_instrument, evaluate_instrument
 
 # the imu campaign's 4 rate-table temperatures leave a term out; not what these tests are about
@@ -69,3 +72,40 @@ def test_instrument_documents_are_the_hand_written_ones(imu, imu_campaign):
     evaluation = evaluate_instrument(imu_campaign.rate_table_heldout, imu.model)
     assert evaluation.scale_checks
     same(evaluation.to_dict(), legacy.instrument_evaluation(evaluation))
+
+
+def _checked(document, schema):
+    document = json.loads(json.dumps(document, allow_nan=False))
+    jsonschema.validate(document, schema)
+    return document
+
+
+def test_documents_validate_against_their_schemas(single, imu, imu_campaign):
+    schema = calibrate_json_schema()
+    jsonschema.Draft202012Validator.check_schema(schema)
+    for calibration in (single, _mapped(single), imu, _mapped(imu)):
+        _checked(calibration.document(), schema)
+    assert "temperature_map" not in single.document()
+    assert _mapped(single).document()["temperature_map"]["probe"] == "PT100"  # kept as is
+    document = _checked(imu.document(), schema)
+    assert "validation" not in document  # only a single axis has it at the top
+    assert {"ScaleFactorRecord", "StepRecord", "EvaluationRecord", "Table1Row"} <= set(
+        schema["$defs"])
+    broken = copy.deepcopy(document)
+    broken["axes"]["x"]["drift"]["n_windows"] = -1
+    with pytest.raises(jsonschema.ValidationError):
+        jsonschema.validate(broken, schema)
+    broken = copy.deepcopy(document)
+    del broken["axes"]["y"]["thermometer"]["table"]
+    with pytest.raises(jsonschema.ValidationError):
+        jsonschema.validate(broken, schema)
+
+    schema = evaluate_json_schema()
+    evaluation = evaluate_instrument(imu_campaign.warmup, imu.model)
+    document = _checked(evaluation.to_dict(), schema)
+    assert [row["axis"] for row in document["summary"]] == ["x", "y", "z"]
+    _checked(single.validation[""][0].to_dict(), schema)
+    broken = copy.deepcopy(document)
+    broken["summary"][0]["out_of_range_fraction"] = -0.1
+    with pytest.raises(jsonschema.ValidationError):
+        jsonschema.validate(broken, schema)
