@@ -10,10 +10,12 @@ validator.
 from __future__ import annotations
 
 import copy
+import dataclasses
 import json
 import math
 
 import jsonschema
+import msgspec
 import numpy as np
 import pytest
 from tests import legacy_documents as legacy
@@ -22,9 +24,9 @@ from tests.bursts import cut_bursts
 from hrgtc import recording
 from hrgtc.core import records
 from hrgtc.core.errors import InputError
-from hrgtc.evaluation import evaluate
+from hrgtc.evaluation import Evaluation, evaluate
 from hrgtc.evaluation.burst_allan import BurstAllanRecord, BurstAllanResult, burst_mean_allan
-from hrgtc.evaluation.evaluation_result import evaluation_json_schema
+from hrgtc.evaluation.evaluation_result import EvaluationRecord, evaluation_json_schema
 from hrgtc.evaluation.heating_cooling import DirectionStats, DirectionStatsRecord
 from hrgtc.evaluation.metrics import ResidualRecord, ResidualResult, residual_against_truth
 from hrgtc.pipeline.calibration import calibrate
@@ -143,3 +145,24 @@ def test_parts_validate_and_round_trip():
 
     for stats in _directions():
         _valid(stats.to_dict(), DirectionStatsRecord, "directions")
+
+
+#: Evaluation field -> where its document holds it (None: not in the document).
+EVALUATION_PLACES = {"noise": "allan", "allan": "allan_curve",
+                     "bias_stability_blocks": "bias_stability_n",
+                     "burst_allan": "allan_burst_means", "directions": "heating_cooling",
+                     "source": None, "unit": None, "input_rate_dph": None, "block_s": None,
+                     "blocks": None}
+
+
+@pytest.mark.parametrize("result, record, places", [
+    (ResidualResult, ResidualRecord, {}),
+    (BurstAllanResult, BurstAllanRecord, {}),
+    (Evaluation, EvaluationRecord, EVALUATION_PLACES),
+], ids=["residual", "burst-means", "evaluation"])
+def test_every_field_of_a_result_has_its_place_in_the_record(result, record, places):
+    """A field added to a result but not to its record would silently not be written."""
+    fields = {places.get(f.name, f.name) for f in dataclasses.fields(result)} - {None}
+    written = {f.name for f in msgspec.structs.fields(record)}
+    derived = {"bias_stability_10s_dph", "improvement_10s", "prediction_std_dph"}
+    assert fields == written - (derived if result is Evaluation else set())
