@@ -38,13 +38,8 @@ from hrgtc.drift.scale_factor import TOLERANCE_SHARE
 from hrgtc.evaluation import Evaluation, evaluate
 from hrgtc.evaluation.calibration_figures import instrument_summary
 from hrgtc.model import InstrumentModel, UnitModel, provenance
+from hrgtc.pipeline import documents
 from hrgtc.pipeline.calibration import HOUSING_TERMS, CalibrationResult, calibrate
-from hrgtc.pipeline.documents import (
-    CalibrationDocumentRecord,
-    InstrumentCalibrationRecord,
-    InstrumentEvaluationRecord,
-    ScaleFactorCheckRecord,
-)
 from hrgtc.recording import ReadOptions, Recording, axis_names
 from hrgtc.recording.marks import refuse_compensated_training
 from hrgtc.recording.read_once import ReadOnce
@@ -90,7 +85,7 @@ class ScaleFactorCheck:
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types (:class:`ScaleFactorCheckRecord`; NaN as null)."""
-        return records.dump(self, ScaleFactorCheckRecord)
+        return records.dump(self, documents.ScaleFactorCheckRecord)
 
 
 @dataclass(frozen=True)
@@ -113,7 +108,7 @@ class InstrumentCalibration:
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types (:class:`InstrumentCalibrationRecord`, the layout of ``hrgtc
         calibrate --json``: one entry per axis, ``"-"`` for a single axis)."""
-        return records.dump(self, InstrumentCalibrationRecord, **self._parts(),
+        return records.dump(self, documents.InstrumentCalibrationRecord, **self._parts(),
                             validation=None)
 
     def _parts(self) -> dict[str, Any]:
@@ -136,10 +131,10 @@ class InstrumentCalibration:
         single = self.model.is_single_axis
         validation = [v.to_dict() for v in self.validation[""]] if single else None
         if single and not self.scale_checks and self.model.axes[""].scale_factor is None:
-            return records.dump(self.axes[""], CalibrationDocumentRecord,
+            return records.dump(self.axes[""], documents.CalibrationDocumentRecord,
                                 **{**self.axes[""].document_parts(), "validation": validation},
                                 temperature_map=self.model.temperature_map)
-        return records.dump(self, InstrumentCalibrationRecord, **self._parts(),
+        return records.dump(self, documents.InstrumentCalibrationRecord, **self._parts(),
                             validation=validation, temperature_map=self.model.temperature_map)
 
     def range_reports(self) -> dict[str, dict[str, RangeReport]]:
@@ -523,7 +518,7 @@ class InstrumentEvaluation:
         None). Its JSON Schema: :func:`hrgtc.pipeline.documents.evaluate_json_schema`."""
         if self.model.is_single_axis:
             return self.axes[""].to_dict()
-        return records.dump(self, InstrumentEvaluationRecord, unit=self.model.unit,
+        return records.dump(self, documents.InstrumentEvaluationRecord, unit=self.model.unit,
                             axes={a: r.to_dict() for a, r in self.axes.items()},
                             summary=self.axis_summary())
 
