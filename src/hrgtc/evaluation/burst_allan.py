@@ -44,16 +44,21 @@ estimable (an :class:`~hrgtc.core.errors.InputError` saying why).
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
-from typing import Any
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Annotated, Any
 
 import numpy as np
+from msgspec import Meta
 
+from hrgtc.core import records
 from hrgtc.core.errors import InputError
+from hrgtc.core.records import Count, Positive, Record, Statistic
 from hrgtc.evaluation._allan_edf import ONE_SIGMA
 from hrgtc.evaluation.allan_segments import pooled_deviation
 
-__all__ = ["PERIOD_TOLERANCE", "BurstAllanResult", "burst_mean_allan", "dead_time_bias"]
+__all__ = ["PERIOD_TOLERANCE", "BurstAllanRecord", "BurstAllanResult", "burst_mean_allan",
+           "dead_time_bias"]
 
 #: A burst start more than this share of the period off the median period breaks the run.
 PERIOD_TOLERANCE = 0.1
@@ -149,13 +154,15 @@ class BurstAllanResult:
     bias_random_walk: np.ndarray
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (arrays as lists, NaN as None)."""
-        def plain(value: Any) -> Any:
-            if isinstance(value, np.ndarray):
-                return [None if isinstance(v, float) and not math.isfinite(v) else v
-                        for v in value.tolist()]
-            return value
-        return {k: plain(v) for k, v in asdict(self).items()}
+        """Plain JSON types (:class:`BurstAllanRecord`; arrays as lists, NaN as None)."""
+        return records.dump(self, BurstAllanRecord)
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> BurstAllanResult:
+        """Inverse of :meth:`to_dict` (lists as arrays, null as NaN)."""
+        values = records.load(data, BurstAllanRecord, "burst-mean Allan deviation")
+        return cls(**{k: np.array(v) if isinstance(v, tuple) else v
+                      for k, v in values.items()})
 
     def lines(self, unit: str = "°/h") -> list[str]:
         """One line per τ: value, interval, N and the bias statement."""
@@ -175,6 +182,26 @@ class BurstAllanResult:
                 f"×{self.bias_flicker[k]:.3g} if flicker, ×{self.bias_random_walk[k]:.3g} "
                 "if random walk")
         return out
+
+
+class BurstAllanRecord(Record):
+    """The record of :class:`BurstAllanResult` (its ``to_dict``, ``from_dict``)."""
+
+    taus_s: list[Positive]
+    deviation: list[Statistic]
+    raw_deviation: list[Statistic]
+    lower: list[Statistic]
+    upper: list[Statistic]
+    counts: list[Count]
+    edf: list[Statistic]
+    confidence: Annotated[float, Meta(gt=0, lt=1)]
+    period_s: Positive
+    burst_s: Positive
+    dead_time_ratio: Annotated[float, Meta(ge=1)]
+    bursts: Count
+    runs: Annotated[int, Meta(ge=1)]
+    bias_flicker: list[Statistic]
+    bias_random_walk: list[Statistic]
 
 
 def burst_mean_allan(means: Any, durations_s: Any, starts_s: Any, *,

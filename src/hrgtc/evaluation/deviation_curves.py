@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 
+from hrgtc.core.records import Count, Positive, Record, Statistic
 from hrgtc.evaluation.allan import AllanResult
 from hrgtc.evaluation.allan_segments import pooled_deviation
 from hrgtc.evaluation.metrics import bias_stability_interval
@@ -32,6 +33,19 @@ def _curve(allan: AllanResult) -> dict[str, Any]:
     return {"tau_s": allan.taus_s.tolist(), "deviation": listed(allan.deviation),
             "lower": listed(allan.lower), "upper": listed(allan.upper),
             "n": allan.counts.tolist(), "kind": allan.kind, "overlapping": allan.overlapping}
+
+
+class DeviationCurveRecord(Record):
+    """One deviation curve of an evaluation (``allan_curve``: :func:`_curve`): τ, the
+    deviation, its interval (null where the kind has none) and the terms behind each."""
+
+    tau_s: list[Positive]
+    deviation: list[Statistic]
+    lower: list[Statistic]
+    upper: list[Statistic]
+    n: list[Count]
+    kind: str
+    overlapping: bool
 
 
 def _deviation(values: np.ndarray, fs: float, deviation: str, confidence: float,

@@ -9,23 +9,27 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from functools import cache
+from typing import Annotated, Any
 
 import numpy as np
+from msgspec import Meta
 
-from hrgtc.compensate.ranges import RangeReport
-from hrgtc.core.accounting import Accounting
+from hrgtc.compensate.ranges import RangeReport, RangeReportRecord
+from hrgtc.core import records
+from hrgtc.core.accounting import Accounting, AccountingRecord
+from hrgtc.core.records import Count, NonNegative, Positive, Record, Statistic
 from hrgtc.core.summary import Summary
 from hrgtc.evaluation.allan import ONE_SIGMA, AllanResult
-from hrgtc.evaluation.burst_allan import BurstAllanResult
-from hrgtc.evaluation.deviation_curves import _curve, _finite
-from hrgtc.evaluation.heating_cooling import DirectionStats
-from hrgtc.evaluation.metrics import table_to_json
-from hrgtc.evaluation.noise import NoiseTerms
+from hrgtc.evaluation.burst_allan import BurstAllanRecord, BurstAllanResult
+from hrgtc.evaluation.deviation_curves import DeviationCurveRecord, _curve
+from hrgtc.evaluation.heating_cooling import DirectionStats, DirectionStatsRecord
+from hrgtc.evaluation.metrics import StabilityTable, table_to_json
+from hrgtc.evaluation.noise import NoiseTerms, NoiseTermsRecord
 from hrgtc.evaluation.run_figures import run_figures
 from hrgtc.settings.compensation import EvaluationSettings
 
-__all__ = ["Evaluation"]
+__all__ = ["Evaluation", "EvaluationRecord", "evaluation_json_schema"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -189,43 +193,23 @@ class Evaluation:
         return self.raw_10s / self.compensated_10s
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (the layout of ``hrgtc evaluate --json``)."""
+        """Plain JSON types (:class:`EvaluationRecord`, the layout of ``hrgtc evaluate
+        --json``; τ keys as text, what is not finite as null)."""
         table: dict[str, Any] = {k: table_to_json(v) for k, v in self.bias_stability_dph.items()}
         table.setdefault("housing", None)
-        noise = {k: {name: (_finite(value) if isinstance(value, float) else value)
-                     for name, value in terms.to_dict().items()}
-                 for k, terms in self.noise.items()}
-        return {
-            "file": self.file,
-            "n_samples": self.n_samples,
-            "sample_rate_hz": self.sample_rate_hz,
-            "bias_stability_dph": table,
-            "bias_stability_10s_dph": {"raw": _finite(self.raw_10s),
-                                       "compensated": _finite(self.compensated_10s)},
-            "improvement_10s": _finite(self.improvement_10s),
-            "mean_dph": {k: _finite(v) for k, v in self.mean_dph.items()},
-            "rms_dph": {k: _finite(v) for k, v in self.rms_dph.items()},
-            "n_not_at_rest": self.n_not_at_rest,
-            "allan": noise,
-            "deviation": self.deviation,
-            "allan_curve": {k: _curve(a) for k, a in self.allan.items()},
-            "confidence": self.confidence,
-            "bias_stability_interval_dph": {
-                k: {f"{t:g}": (None if math.isnan(b[0]) else [float(b[0]), float(b[1])])
-                    for t, b in row.items()}
+        return records.dump(
+            self, EvaluationRecord, bias_stability_dph=table,
+            bias_stability_10s_dph={"raw": self.raw_10s, "compensated": self.compensated_10s},
+            allan=self.noise, allan_curve={k: _curve(a) for k, a in self.allan.items()},
+            bias_stability_interval_dph={
+                k: {f"{t:g}": None if math.isnan(b[0]) else b for t, b in row.items()}
                 for k, row in self.bias_stability_interval_dph.items()},
-            "bias_stability_n": {k: {f"{t:g}": int(c) for t, c in row.items()}
-                                 for k, row in self.bias_stability_blocks.items()},
-            "allan_burst_means": {k: b.to_dict() for k, b in self.burst_allan.items()},
-            "prediction_std_dph": self.prediction_std_dph,
-            "out_of_range_fraction": self.out_of_range_fraction,
-            "rate_out_of_range_fraction": self.rate_out_of_range_fraction,
-            "residual_rms_dph": self.residual_rms_dph,
-            "ranges": None if self.ranges is None else self.ranges.to_dict(),
-            "notes": list(self.notes),
-            "heating_cooling": None if self.directions is None else self.directions.to_dict(),
-            "accounting": None if self.accounting is None else self.accounting.to_dict(),
-        }
+            bias_stability_n={k: {f"{t:g}": c for t, c in row.items()}
+                              for k, row in self.bias_stability_blocks.items()},
+            allan_burst_means=self.burst_allan,
+            ranges=None if self.ranges is None else self.ranges.to_dict(),
+            heating_cooling=None if self.directions is None else self.directions.to_dict(),
+            accounting=None if self.accounting is None else self.accounting.to_dict())
 
     def allan_csv(self) -> str:
         """The deviation curves as CSV text: series, tau_s, deviation, lower, upper, n, edf.
@@ -261,3 +245,64 @@ class Evaluation:
     def summary(self) -> str:
         """The figures as plain text (:meth:`figures` rendered by ``Summary.text``)."""
         return self.figures().text()
+
+
+#: A share of the samples.
+Fraction = Annotated[float, Meta(ge=0, le=1)]
+
+
+class TenSecondRecord(Record):
+    """The 10 s bias stability of the raw and the compensated output. [°/h]"""
+
+    raw: Statistic
+    compensated: Statistic
+
+
+class PredictionStdRecord(Record):
+    """Median and maximum over a run of the model line's 1σ. [°/h]"""
+
+    median: NonNegative
+    max: NonNegative
+
+
+class EvaluationRecord(Record):
+    """The record of :class:`Evaluation` (its ``to_dict``: ``hrgtc evaluate --json``).
+
+    Its fields are the evaluation's figures under their JSON names: ``allan`` holds the
+    noise terms (:class:`NoiseTerms`) and ``allan_curve`` the deviation curves; a table
+    keyed by τ has τ as text (``"10"``); ``bias_stability_dph`` always has ``housing``
+    (null without a housing baseline).
+    """
+
+    file: str
+    n_samples: Count
+    sample_rate_hz: Positive
+    bias_stability_dph: dict[str, StabilityTable | None]
+    bias_stability_10s_dph: TenSecondRecord
+    improvement_10s: Statistic
+    mean_dph: dict[str, Statistic]
+    rms_dph: dict[str, Statistic]
+    n_not_at_rest: Count
+    allan: dict[str, NoiseTermsRecord]
+    deviation: str
+    allan_curve: dict[str, DeviationCurveRecord]
+    confidence: Annotated[float, Meta(gt=0, lt=1)]
+    bias_stability_interval_dph: dict[str, dict[str, tuple[Statistic, Statistic] | None]]
+    bias_stability_n: dict[str, dict[str, Count]]
+    allan_burst_means: dict[str, BurstAllanRecord]
+    prediction_std_dph: PredictionStdRecord | None
+    out_of_range_fraction: Fraction
+    rate_out_of_range_fraction: Fraction
+    residual_rms_dph: Statistic
+    ranges: RangeReportRecord | None
+    notes: list[str]
+    heating_cooling: DirectionStatsRecord | None
+    accounting: AccountingRecord | None
+
+
+@cache
+def evaluation_json_schema() -> dict[str, Any]:
+    """JSON Schema (Draft 2020-12) of :meth:`Evaluation.to_dict` (``hrgtc evaluate --json``
+    of a single-axis model), generated from :class:`EvaluationRecord`."""
+    return records.json_schema(EvaluationRecord, "hrgtc evaluation",
+                               "https://hrgtc.invalid/schema/evaluation.json")

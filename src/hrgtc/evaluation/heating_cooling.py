@@ -36,6 +36,8 @@ from typing import Any
 
 import numpy as np
 
+from hrgtc.core import records
+from hrgtc.core.records import Count, Positive, Record, Statistic
 from hrgtc.core.timeline import (
     RESTARTS_KEY,
     is_gap,
@@ -88,18 +90,12 @@ class DirectionStats:
         return self.raw_dph[direction] / comp if comp > 0 else math.nan
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types: one entry per direction."""
-        def clean(v: float) -> float | None:
-            return float(v) if math.isfinite(v) else None
-
-        return {d: {"blocks": self.blocks[d], "raw_dph": clean(self.raw_dph[d]),
-                    "compensated_dph": clean(self.compensated_dph[d]),
-                    "improvement": clean(self.improvement(d)),
-                    "residual_rms_dph": None if self.residual_rms_dph is None
-                    else clean(self.residual_rms_dph[d])}
-                for d in DIRECTIONS} | {"block_s": self.block_s,
-                                        "partial_blocks": self.partial_blocks,
-                                        "reason": self.reason}
+        """Plain JSON types (:class:`DirectionStatsRecord`): one entry per direction."""
+        return records.dump(self, DirectionStatsRecord, **{d: {
+            "blocks": self.blocks[d], "raw_dph": self.raw_dph[d],
+            "compensated_dph": self.compensated_dph[d], "improvement": self.improvement(d),
+            "residual_rms_dph": None if self.residual_rms_dph is None
+            else self.residual_rms_dph[d]} for d in DIRECTIONS})
 
     def summary(self, sensor: bool = False) -> str:
         """One line per direction (``sensor``: the thermometer is a temperature sensor)."""
@@ -123,6 +119,27 @@ class DirectionStats:
             lines.append(f"  ({self.partial_blocks} blocks cut short by a gap, kept from half "
                          "a block)")
         return f"{title}:\n" + "\n".join(lines)
+
+
+class DirectionRecord(Record):
+    """One direction of :class:`DirectionStatsRecord`. [°/h]"""
+
+    blocks: Count
+    raw_dph: Statistic
+    compensated_dph: Statistic
+    improvement: Statistic
+    #: null on a recorded run without ``bias_dph``
+    residual_rms_dph: Statistic
+
+
+class DirectionStatsRecord(Record):
+    """The record of :class:`DirectionStats` (its ``to_dict``)."""
+
+    heating: DirectionRecord
+    cooling: DirectionRecord
+    block_s: Positive
+    partial_blocks: Count
+    reason: str | None = None
 
 
 class DirectionSplit:

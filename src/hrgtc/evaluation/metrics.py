@@ -17,12 +17,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Mapping
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from hrgtc.core import records
 from hrgtc.core.errors import InputError
+from hrgtc.core.records import Count, Record, Statistic
 from hrgtc.evaluation.allan import (
     FLICKER_FLOOR_FACTOR,
     ONE_SIGMA,
@@ -203,13 +205,16 @@ class ResidualResult:
     n_samples: int
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types; τ keys become strings and NaN becomes None."""
-        return {**asdict(self), "bias_stability_dph": table_to_json(self.bias_stability_dph)}
+        """Plain JSON types (:class:`ResidualRecord`; τ keys as text, NaN as None)."""
+        return records.dump(self, ResidualRecord,
+                            bias_stability_dph=table_to_json(self.bias_stability_dph))
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> ResidualResult:
         """Inverse of :meth:`to_dict`."""
-        return cls(**{**data, "bias_stability_dph": table_from_json(data["bias_stability_dph"])})
+        values = records.load(data, ResidualRecord, "model-residual")
+        return cls(**{**values, "bias_stability_dph": table_from_json(
+            values["bias_stability_dph"])})
 
     def summary(self) -> str:
         """One line with RMS, mean and maximum, one with the bias stabilities."""
@@ -221,6 +226,20 @@ class ResidualResult:
             f"mean {self.mean_dph:.4g} deg/h, max |.| {self.max_abs_dph:.4g} deg/h\n"
             f"bias stability of the residual [deg/h]: {stability}"
         )
+
+
+#: A bias-stability table as JSON: τ as text (``"10"``) -> 1σ, null where not estimable. [°/h]
+StabilityTable = dict[str, Statistic]
+
+
+class ResidualRecord(Record):
+    """The record of :class:`ResidualResult` (its ``to_dict``, ``from_dict``)."""
+
+    rms_dph: Statistic
+    mean_dph: Statistic
+    max_abs_dph: Statistic
+    bias_stability_dph: StabilityTable
+    n_samples: Count
 
 
 def residual_against_truth(

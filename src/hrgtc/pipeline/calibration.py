@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from hrgtc import drift as drift_model
+from hrgtc.core import records
 from hrgtc.core.errors import CalibrationError, ExtrapolationWarning, HrgtcWarning, InputError
 from hrgtc.core.progress import StageProgress, for_stage
 from hrgtc.core.summary import Summary
@@ -41,6 +42,7 @@ from hrgtc.drift.training import (
 from hrgtc.evaluation import Evaluation, evaluate
 from hrgtc.evaluation.calibration_figures import calibration_summary, thermometer_tables
 from hrgtc.model import UnitModel, provenance
+from hrgtc.pipeline.documents import CalibrationDriftRecord, CalibrationRecord
 from hrgtc.recording import ReadOptions
 from hrgtc.recording.marks import refuse_compensated_training
 from hrgtc.settings import to_dict
@@ -116,39 +118,27 @@ class CalibrationResult:
     soak_fit: SoakFit | None = field(default=None, compare=False, repr=False)
 
     def to_dict(self) -> dict[str, Any]:
-        """The layout of ``hrgtc calibrate --json``."""
-        d = self.model.drift
+        """Plain JSON types (:class:`CalibrationRecord`, the layout of ``hrgtc calibrate
+        --json``; what is not finite as null)."""
+        return records.dump(self, CalibrationRecord, **self.document_parts())
+
+    def document_parts(self) -> dict[str, Any]:
+        """The parts of :class:`CalibrationRecord` that are not attributes of the result
+        (the thermometer, drift-model and housing sections, the held-out runs, the prior)."""
+        thermometer, d, housing = self.model.thermometer, self.model.drift, self.model.housing
         return {
             "thermometer": {
-                "coefficients_high_first": list(self.model.thermometer.coefficients_high_first),
-                "standard_errors_high_first": [
-                    None if not np.isfinite(v) else v
-                    for v in reversed(self.model.thermometer.standard_errors)
-                ],
-                "table": [dict(row) for row in self.table],
-            },
-            "drift": {
-                "selected_terms": list(d.selected),
-                "history": [s.to_dict() for s in d.history],
-                "intercept_dph": d.intercept_dph,
-                "coefficients": dict(d.coefficients),
-                "standard_errors": dict(d.standard_errors),
-                "pvalues": dict(d.pvalues),
-                "window_s": d.window_s,
-                "n_windows": d.n_windows,
-                "selection": d.selection,
-                "n_not_at_rest": d.n_not_at_rest,
-                "offset_mode": d.offset_mode,
-                "offsets_dph": dict(d.offsets_dph),
-                "pruning": d.pruning,
-                "cross_validation": None if d.cross_validation is None
+                "coefficients_high_first": thermometer.coefficients_high_first,
+                "standard_errors_high_first": list(reversed(thermometer.standard_errors)),
+                "table": self.table},
+            "drift": records.dump(
+                d, CalibrationDriftRecord, selected_terms=d.selected,
+                history=[s.to_dict() for s in d.history],
+                cross_validation=None if d.cross_validation is None
                 else d.cross_validation.to_dict(),
-                "accounting": None if d.accounting is None else d.accounting.to_dict(),
-            },
-            "housing": None if self.model.housing is None else {
-                "selected_terms": list(self.model.housing.selected),
-                "coefficients": dict(self.model.housing.coefficients),
-            },
+                accounting=None if d.accounting is None else d.accounting.to_dict()),
+            "housing": None if housing is None else {"selected_terms": housing.selected,
+                                                     "coefficients": housing.coefficients},
             "validation": [v.to_dict() for v in self.validation],
             "prior": None if self.prior_fit is None else self.prior_fit.to_dict(),
         }

@@ -22,6 +22,7 @@ import numpy as np
 
 from hrgtc.compensate import InstrumentCompensator
 from hrgtc.compensate.ranges import RangeReport
+from hrgtc.core import records
 from hrgtc.core.errors import InputError
 from hrgtc.core.progress import StageProgress
 from hrgtc.core.summary import Summary
@@ -37,6 +38,7 @@ from hrgtc.drift.scale_factor import TOLERANCE_SHARE
 from hrgtc.evaluation import Evaluation, evaluate
 from hrgtc.evaluation.calibration_figures import instrument_summary
 from hrgtc.model import InstrumentModel, UnitModel, provenance
+from hrgtc.pipeline import documents
 from hrgtc.pipeline.calibration import HOUSING_TERMS, CalibrationResult, calibrate
 from hrgtc.recording import ReadOptions, Recording, axis_names
 from hrgtc.recording.marks import refuse_compensated_training
@@ -82,10 +84,8 @@ class ScaleFactorCheck:
                 else float("nan"))
 
     def to_dict(self) -> dict[str, Any]:
-        return {"file": self.file, "axis": self.axis, "freq_hz": list(self.freq_hz),
-                "holds": list(self.holds), "raw_ppm": list(self.raw_ppm),
-                "compensated_ppm": list(self.compensated_ppm),
-                "raw_max_ppm": self.raw_max_ppm, "compensated_max_ppm": self.compensated_max_ppm}
+        """Plain JSON types (:class:`ScaleFactorCheckRecord`; NaN as null)."""
+        return records.dump(self, documents.ScaleFactorCheckRecord)
 
 
 @dataclass(frozen=True)
@@ -106,32 +106,36 @@ class InstrumentCalibration:
         return instrument_summary(self)
 
     def to_dict(self) -> dict[str, Any]:
-        """The layout of ``hrgtc calibrate --json`` (one entry per axis)."""
+        """Plain JSON types (:class:`InstrumentCalibrationRecord`, the layout of ``hrgtc
+        calibrate --json``: one entry per axis, ``"-"`` for a single axis)."""
+        return records.dump(self, documents.InstrumentCalibrationRecord, **self._parts(),
+                            validation=None)
+
+    def _parts(self) -> dict[str, Any]:
         axes = {}
         for axis, result in self.axes.items():
-            entry = result.to_dict()
-            entry["validation"] = [v.to_dict() for v in self.validation.get(axis, ())]
             sf = self.model.axes[axis].scale_factor
-            entry["scale_factor"] = None if sf is None else sf.to_dict()
-            axes[axis or "-"] = entry
+            axes[axis or "-"] = {
+                **result.document_parts(),
+                "validation": [v.to_dict() for v in self.validation.get(axis, ())],
+                "scale_factor": None if sf is None else sf.to_dict()}
         return {"unit": self.model.unit, "axes": axes,
-                "scale_factor_checks": [c.to_dict() for c in self.scale_checks],
-                "cross_axis": dict(self.cross_axis)}
+                "scale_factor_checks": [c.to_dict() for c in self.scale_checks]}
 
     def document(self) -> dict[str, Any]:
         """The document of ``hrgtc calibrate --json``: a single-axis unit without a scale
-        factor as :meth:`CalibrationResult.to_dict` (with its held-out runs), else
-        :meth:`to_dict`; the temperature map (``--temp-ref``) when the model has one."""
+        factor as :meth:`CalibrationResult.to_dict` (with its held-out runs;
+        :class:`CalibrationDocumentRecord`), else :meth:`to_dict` (with the held-out runs of
+        a single axis); the temperature map (``--temp-ref``) when the model has one. Its
+        JSON Schema: :func:`hrgtc.pipeline.documents.calibrate_json_schema`."""
         single = self.model.is_single_axis
+        validation = [v.to_dict() for v in self.validation[""]] if single else None
         if single and not self.scale_checks and self.model.axes[""].scale_factor is None:
-            document = self.axes[""].to_dict()
-        else:
-            document = self.to_dict()
-        if single:
-            document["validation"] = [v.to_dict() for v in self.validation[""]]
-        if self.model.temperature_map is not None:
-            document["temperature_map"] = dict(self.model.temperature_map)
-        return document
+            return records.dump(self.axes[""], documents.CalibrationDocumentRecord,
+                                **{**self.axes[""].document_parts(), "validation": validation},
+                                temperature_map=self.model.temperature_map)
+        return records.dump(self, documents.InstrumentCalibrationRecord, **self._parts(),
+                            validation=validation, temperature_map=self.model.temperature_map)
 
     def range_reports(self) -> dict[str, dict[str, RangeReport]]:
         """Held-out file -> axis -> its range report, where any axis went beyond the
@@ -509,13 +513,14 @@ class InstrumentEvaluation:
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types (the layout of ``hrgtc evaluate --json``): a single-axis model's
-        evaluation as it is; else the unit, each axis and the summary (NaN: None)."""
+        evaluation as it is (:class:`~hrgtc.evaluation.evaluation_result.EvaluationRecord`);
+        else the unit, each axis and the summary (:class:`InstrumentEvaluationRecord`; NaN:
+        None). Its JSON Schema: :func:`hrgtc.pipeline.documents.evaluate_json_schema`."""
         if self.model.is_single_axis:
             return self.axes[""].to_dict()
-        summary = [{k: None if isinstance(v, float) and not np.isfinite(v) else v
-                    for k, v in row.items()} for row in self.axis_summary()]
-        return {"unit": self.model.unit,
-                "axes": {a: r.to_dict() for a, r in self.axes.items()}, "summary": summary}
+        return records.dump(self, documents.InstrumentEvaluationRecord, unit=self.model.unit,
+                            axes={a: r.to_dict() for a, r in self.axes.items()},
+                            summary=self.axis_summary())
 
     def allan_csv(self) -> str:
         """The deviation curves of every axis as CSV (an ``axis`` column first when there
