@@ -165,9 +165,7 @@ def beyond_slow_noise(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndar
     ``observed_ratio`` under the smaller model plus that noise is simulated
     (:func:`null_ratios`). Returns (chance below ``level``, the chance, the noise).
     """
-    import os
-    cols = columns_big if os.environ.get("SN_BIG") else columns_small
-    design = np.column_stack([np.ones(x_scaled.shape[0]), x_scaled[:, list(cols)]])
+    design = np.column_stack([np.ones(x_scaled.shape[0]), x_scaled[:, list(columns_small)]])
     noise = slow_noise(design, bias_dph, time_s)
     ratios = null_ratios(x_scaled, folds, time_s, columns_small, columns_big, noise)
     ratios = ratios[np.isfinite(ratios)]
