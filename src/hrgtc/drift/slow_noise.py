@@ -7,13 +7,15 @@ than the line, then runs away beyond the trained temperatures. The one-standard-
 rule of :func:`hrgtc.drift.cross_validation.prune_terms` cannot see this: within a block
 the walk is one offset, not many independent errors.
 
-Here the residual of the training windows gives the slow noise: its variogram
-``γ(h) = ½ E[(e(t + h) − e(t))²] = s² + ½ q h`` (white window means of variance ``s²``
-and a random walk of ``q`` per second, [2]). Under the smaller model plus that noise the
-held-out residuals of both models are linear in the noise alone (the smaller model's terms
-are in both), so the ratio of their held-out RMS under the null is simulated exactly, on
-the same windows and folds. A term is kept only if the observed ratio is rarer than
-:data:`SLOW_NOISE_LEVEL` under that null: curvature must beat the slow noise.
+Here the training windows give the slow noise: white window means of variance ``s²`` plus
+a random walk of ``q`` per second ([2]: its variance grows linearly in time), estimated by
+restricted maximum likelihood under the smaller model (:func:`slow_noise`; the null's
+nuisance parameters estimated under the null, as a parametric bootstrap does). Under the
+smaller model plus that noise the held-out residuals of both models are linear in the
+noise alone (the smaller model's terms are in both), so the ratio of their held-out RMS
+under the null is simulated exactly, on the same windows and folds. A term is kept only
+if the observed ratio is rarer than :data:`SLOW_NOISE_LEVEL` under that null: curvature
+must beat the slow noise.
 
 [1] Docs: docs/real-loggers/motion.md (the guarded selection).
 [2] IEEE Std 952-1997 Annex C (random walk: variance growing linearly in time).
@@ -160,8 +162,8 @@ def beyond_slow_noise(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndar
                       level: float = SLOW_NOISE_LEVEL) -> tuple[bool, float, SlowNoise]:
     """Does the bigger model's held-out gain beat the slow noise?
 
-    The noise is estimated (:func:`slow_noise`) from the bigger model's residual on all
-    training windows; the chance of a held-out RMS ratio (bigger / smaller) at or below
+    The noise is estimated (:func:`slow_noise`) about the smaller model on all training
+    windows; the chance of a held-out RMS ratio (bigger / smaller) at or below
     ``observed_ratio`` under the smaller model plus that noise is simulated
     (:func:`null_ratios`). Returns (chance below ``level``, the chance, the noise).
     """
