@@ -31,6 +31,7 @@ import numpy as np
 from hrgtc.core import records
 from hrgtc.core.timeline import time_blocks
 from hrgtc.drift.regression import newey_west_inflation
+from hrgtc.drift.slow_noise import SLOW_NOISE_LEVEL, beyond_slow_noise
 
 #: Windows whose |df/dt| is below this share of the largest are neither heating nor cooling.
 RATE_DEADBAND = 0.05
@@ -205,6 +206,8 @@ def select_terms(x_scaled: np.ndarray, bias_dph: np.ndarray, run: np.ndarray,
 TIME_BLOCKS = 5
 #: A term is pruned when the held-out score without it is within this share of the best.
 PRUNE_TOLERANCE = 0.01
+#: The line in the thermometer variable, which the slow-noise test never removes.
+LINE_TERM = "f"
 #: Description of the folds of a single run (stored in the model's ``pruning`` record).
 EXTREME_BLOCKS = "coldest and hottest time blocks"
 
@@ -309,18 +312,14 @@ def prune_terms(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarray,
         return tuple(chosen), before, before
     path = [(tuple(chosen), before)]
     while chosen:
-        leaves = [n for n in chosen if n not in keep
-                  and not any(n in (parents or {}).get(c, ()) for c in chosen if c != n)]
-        trial = {n: held_out_rms(x_scaled, bias_dph, folds, names,
-                                 [c for c in chosen if c != n]) for n in leaves}
-        trial = {n: v for n, v in trial.items() if math.isfinite(v)}
-        if not trial:
+        step = _next_removal(x_scaled, bias_dph, folds, names, chosen, parents, keep)
+        if step is None:
             break
-        name = min(trial, key=trial.__getitem__)
-        if not through and not trial[name] <= min(s for _, s in path) * (1.0 + tolerance):
+        name, score = step
+        if not through and not score <= min(s for _, s in path) * (1.0 + tolerance):
             break
         chosen.remove(name)
-        path.append((tuple(chosen), trial[name]))
+        path.append((tuple(chosen), score))
     if not through:
         return path[-1][0], before, path[-1][1]
     best = min(range(len(path)), key=lambda k: path[k][1])
@@ -331,6 +330,72 @@ def prune_terms(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarray,
                 reference, folds):
             return terms, before, score
     return path[best][0], before, path[best][1]
+
+
+def _next_removal(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarray,
+                  names: Sequence[str], chosen: Sequence[str],
+                  parents: Mapping[str, Sequence[str]] | None, keep: Sequence[str],
+                  ) -> tuple[str, float] | None:
+    """The term of ``chosen`` (no parent of another, not in ``keep``) whose removal gives
+    the lowest :func:`held_out_rms`, and that score; None when no term can go."""
+    leaves = [n for n in chosen if n not in keep
+              and not any(n in (parents or {}).get(c, ()) for c in chosen if c != n)]
+    trial = {n: held_out_rms(x_scaled, bias_dph, folds, names,
+                             [c for c in chosen if c != n]) for n in leaves}
+    trial = {n: v for n, v in trial.items() if math.isfinite(v)}
+    if not trial:
+        return None
+    name = min(trial, key=trial.__getitem__)
+    return name, trial[name]
+
+
+def prune_slow_noise(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarray,
+                     time_s: np.ndarray, names: Sequence[str], selected: Sequence[str],
+                     parents: Mapping[str, Sequence[str]] | None = None,
+                     keep: Sequence[str] = (), level: float = SLOW_NOISE_LEVEL,
+                     ) -> tuple[tuple[str, ...], list[dict[str, Any]]]:
+    """Backward elimination of terms whose held-out gain does not beat the training
+    residual's slow noise (:func:`hrgtc.drift.slow_noise.beyond_slow_noise`): on one ramp
+    a random walk in the bias looks like curvature to the coldest and the hottest block,
+    and a term kept for it runs away beyond them.
+
+    Each step tests every removable term (not in ``keep``, no parent of a kept term): the
+    chance, under the model without it plus slow noise estimated under that model, of a
+    held-out RMS ratio (with / without) as low as observed. The term with the largest
+    chance goes while that chance reaches ``level``.
+
+    Returns the kept terms (candidate order) and one record per term removed, and one for
+    the last step's most doubtful term kept (``term``, ``ratio``, ``chance``,
+    ``white_dph``, ``walk_dph_per_sqrt_h``, ``kept``).
+    """
+    chosen = [n for n in names if n in set(selected)]
+    tests: list[dict[str, Any]] = []
+    while chosen:
+        score = held_out_rms(x_scaled, bias_dph, folds, names, chosen)
+        leaves = [n for n in chosen if n not in keep
+                  and not any(n in (parents or {}).get(c, ()) for c in chosen if c != n)]
+        trial = {}
+        for name in leaves:
+            rest = [c for c in chosen if c != name]
+            smaller = held_out_rms(x_scaled, bias_dph, folds, names, rest)
+            if not (math.isfinite(score) and math.isfinite(smaller)):
+                continue
+            ratio = score / smaller if smaller > 0.0 else math.inf
+            beyond, chance, noise = beyond_slow_noise(
+                x_scaled, bias_dph, folds, time_s, _columns(names, rest),
+                _columns(names, chosen), ratio, level)
+            trial[name] = {"term": name, "ratio": ratio, "chance": chance,
+                           "white_dph": noise.white_dph,
+                           "walk_dph_per_sqrt_h": noise.over(3600.0), "kept": beyond}
+        if not trial:
+            break
+        doubt = max(trial.values(), key=lambda r: -1.0 if math.isnan(r["chance"])
+                    else r["chance"])
+        tests.append(doubt)
+        if doubt["kept"]:
+            break
+        chosen.remove(doubt["term"])
+    return tuple(chosen), tests
 
 
 def _columns(names: Sequence[str], terms: Sequence[str]) -> list[int]:
@@ -380,6 +445,14 @@ def guard_selection(x_scaled: np.ndarray, bias_dph: np.ndarray, run: np.ndarray,
     # term when the one warm-up is left out): there, stop at the first rise
     kept, before, after = prune_terms(x_scaled, bias_dph, folds, names, selected,
                                       parents=parents, keep=keep, through=kind != "runs")
+    tests = None
+    if kind != "runs" and kept:  # one ramp: the extreme blocks are its ends, walk and all
+        # the line in the thermometer variable stays: the test is of what goes beyond it
+        kept, tests = prune_slow_noise(x_scaled, bias_dph, folds, time_s, names, kept,
+                                       parents=parents, keep=[*keep, LINE_TERM])
+        after = held_out_rms(x_scaled, bias_dph, folds, names, kept)
     record = {"folds": kind, "dropped": [t for t in selected if t not in kept],
               "before_dph": before, "after_dph": after}
+    if tests:
+        record["slow_noise"] = tests
     return (kept if len(kept) < len(selected) else None), record

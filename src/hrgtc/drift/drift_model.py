@@ -427,7 +427,9 @@ def fit(
         not carry over to held-out data is dropped (:func:`~hrgtc.drift.cross_validation.
         prune_terms`; folds are the runs, or five contiguous time blocks of a single
         run): a cubic fitted on the temperatures of the training part does not survive
-        the held-out block beyond them. ``"stepwise"``: the F-tests alone. ``"cv"``:
+        the held-out block beyond them. On a single run a term beyond the line in ``f``
+        must also beat the slow noise (random walk) of the training windows
+        (:mod:`hrgtc.drift.slow_noise`). ``"stepwise"``: the F-tests alone. ``"cv"``:
         forward selection by leave-one-run-out cross-validated bias stability
         (:mod:`hrgtc.drift.cross_validation`; needs two runs or more). Either way the
         selected model is cross-validated when there are two runs or more.
