@@ -44,7 +44,7 @@ from hrgtc.recording.read_once import ReadOnce
 from hrgtc.settings.calibration import CROSS_AXIS_GAIN, CalibrationSettings
 from hrgtc.settings.reading import ReadSettings
 from hrgtc.thermometry.prior import ThermometerPrior
-from hrgtc.thermometry.reference import TemperatureMap
+from hrgtc.thermometry.reference import TemperatureMap, TemperatureReference
 
 __all__ = ["InstrumentCalibration", "InstrumentEvaluation", "ScaleFactorCheck",
            "calibrate_instrument", "check_scale_factor", "evaluate_instrument",
@@ -166,6 +166,7 @@ def calibrate_instrument(
     progress: StageProgress | None = None,
     validate_options: ReadOptions | None = None,
     temperature_map: TemperatureMap | None = None,
+    temperature_reference: TemperatureReference | None = None,
     holdout_s: float | None = None,
     holdout_fraction: float | None = None,
 ) -> InstrumentCalibration:
@@ -207,6 +208,15 @@ def calibrate_instrument(
         Reading options of the ``validate`` runs when they differ (a held-out last part
         of the training file: ``start`` where the training's ``end`` is); default
         ``read_options``.
+    temperature_map
+        A fitted map of the raw temperature count to °C, applied to every file and
+        stored in the model.
+    temperature_reference
+        A reference log to fit that map from, on the first of ``drifts`` (all of it,
+        before a hold-out split); not with ``temperature_map``.
+    holdout_s, holdout_fraction
+        Train on the first part of the one drift file, validate on its end
+        (:func:`holdout_split`).
     """
     settings = settings or CalibrationSettings()
     scale_terms, cross_axis = settings.scale_terms, settings.cross_axis
@@ -214,6 +224,11 @@ def calibrate_instrument(
     if thermometer not in ("resonator", "sensor"):
         raise InputError(f"thermometer must be 'resonator' or 'sensor', got {thermometer!r}")
     options = dataclasses.replace(read_options or ReadOptions(), thermometer=thermometer)
+    if temperature_reference is not None:
+        if temperature_map is not None or not drifts:
+            raise InputError("a reference log (--temp-ref) needs a --drift run to map and no "
+                             "temperature map of its own")
+        temperature_map = temperature_reference.fit(drifts[0], options)
     if temperature_map is not None:
         options = _through_map(options, temperature_map)
         validate_options = (None if validate_options is None
