@@ -136,8 +136,14 @@ def test_the_library_call_gives_the_cli_s_model_with_its_reference_log(tmp_path)
         document["provenance"].pop("created_utc")
     assert library == cli
     assert library["temperature_map"]["points"] == 24  # the map was fitted, not left out
+    # the provenance names the log and how it was read
+    assert {"role": "temperature_reference", "path": str(LOG)} == {
+        k: v for k, v in library["provenance"]["inputs"][-1].items() if k != "sha256"}
+    assert library["provenance"]["settings"]["temperature_reference"] == {
+        "path": str(LOG), "columns": {"time_s": "Time", "temperature_c": "C1 (C)"},
+        "unit": None, "start": "15:45", "tz": None, "lag_s": None}
 
-    with pytest.raises(InputError, match="reference log"):
+    with pytest.raises(InputError, match="a temperature map or a reference log"):
         calibrate_instrument([], [RUN], thermometer="sensor", read_options=options,
                              temperature_reference=reference,
                              temperature_map=reference.fit(RUN, options))

@@ -546,6 +546,11 @@ class TemperatureReference:
     tz: str | None = None
     lag_s: float | None = None
 
+    def to_dict(self) -> dict[str, Any]:
+        """How the log was read, as plain JSON types (a model file's provenance)."""
+        return {"path": str(self.path), "columns": dict(self.columns or {}), "unit": self.unit,
+                "start": self.start, "tz": self.tz, "lag_s": self.lag_s}
+
     def fit(self, recording: str | Path, read_options: Any = None) -> TemperatureMap:
         """The count → °C map of ``recording``'s raw temperature
         (:func:`map_from_reference`)."""
