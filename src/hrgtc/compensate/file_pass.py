@@ -89,7 +89,8 @@ def compensate_file(
 
     The output is written atomically in the format of its suffix; it is never
     overwritten without ``force``. ``read_options`` says how to read ``source``
-    (column mapping, units, metadata).
+    (column mapping, units, metadata); every row read is written (spikes are flagged
+    with ``spike_filter="flag"``, never dropped: ``"drop"`` is refused).
 
     Three stages overlap, each one chunk ahead of the next (pyarrow, h5py and the
     fused kernel release the GIL): a thread reads and validates the next chunk,
@@ -99,6 +100,9 @@ def compensate_file(
     before the atomic rename finds one chunk left to wait for. At most three chunks
     are held at a time.
     """
+    if read_options is not None and read_options.spike_filter == "drop":
+        raise InputError("compensate flags spikes, it never drops a row: use --spike-filter "
+                         "flag (a 'spike' column marks them) or off")
     if compensator is None:
         options = with_model_band(read_options or rec_io.ReadOptions(), model)
         compensator = Compensator(model, drift, gaps=options.gaps)
