@@ -12,6 +12,7 @@ the interface is one edit.
 
 from __future__ import annotations
 
+from hrgtc.core.errors import InputError
 from hrgtc.core.timeline import settle_threshold_s
 from hrgtc.drift.features import settle_rows
 from hrgtc.export.c.expr import comment
@@ -67,7 +68,8 @@ def header(model: UnitModel, plan: CPlan, prefix: str, readme: str, sha256: str,
     rates = " and ".join(v for v in plan.computed if v in ("df", "dh"))
     settle_s = settle_threshold_s(settings.warmup_s)
     if single:
-        assert centre_hz is not None and bounds is not None
+        if centre_hz is None or bounds is None:
+            raise InputError("the float32 header needs its centre_hz and error bounds")
         defines = f"""\
 /* This is the float32 build (hrgtc export-c --precision single). */
 #define {up}_SINGLE_PRECISION 1
