@@ -414,3 +414,14 @@ def test_time_in_ms_gets_the_time_unit_hint_not_thousands_of_gaps(tmp_path, comm
     assert result.exit_code == 2
     text = " ".join(result.output.split())
     assert "--time-unit ms" in text and "gap(s)" not in text, text
+
+
+def test_compensate_refuses_to_drop_spikes(files, tmp_path):
+    """The library's refusal (compensate_file), through the command: exit 2, the fix."""
+    _, model_path, run = files
+    run_path = write(run, tmp_path / "run.parquet")
+    code, _, stderr = compensate(run_path, model_path, tmp_path / "out.parquet",
+                                 "--spike-filter", "drop")
+    assert code == 2
+    assert "never drops a row: use --spike-filter flag" in " ".join(one_error_line(stderr).split())
+    assert not (tmp_path / "out.parquet").exists()

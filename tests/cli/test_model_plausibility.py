@@ -227,6 +227,26 @@ def test_axes_says_which_to_compensate(axis_files, tmp_path):
     assert code == 0, stderr
 
 
+def test_the_report_s_library_call_checks_the_axes_itself(axis_files, sensor_model_path,
+                                                         files, tmp_path):
+    """``build_report`` matches the model's axes to each run and checks the thermometer
+    kind before reading (the command used to do it before the call): an in-memory model
+    gets the command's refusals, and ``axes`` picks the axes to show."""
+    from hrgtc.core.errors import InputError
+    from hrgtc.model import load_instrument
+    from hrgtc.report import build_report
+
+    _, xyz, xy, _ = axis_files
+    model = load_instrument(xy)
+    with pytest.raises(InputError, match="pass --axes x,y"):
+        build_report(model, [xyz], tmp_path / "r.html")
+    assert not (tmp_path / "r.html").exists()
+    page = build_report(model, [xyz], tmp_path / "r.html", axes=("x",)).read_text()
+    assert 'id="axis-x"' in page and 'id="axis-y"' not in page  # the x axis alone
+    with pytest.raises(InputError, match="is a sensor-thermometer model"):
+        build_report(load_instrument(sensor_model_path), [files[2]], tmp_path / "s.html")
+
+
 @pytest.mark.parametrize("axes, match", [
     ("x,w", "has no axis w"),
     ("z", "the model .*xy.json has no axis z"),

@@ -20,6 +20,7 @@ from typer.testing import CliRunner
 
 from hrgtc.cli import app
 from hrgtc.cli._app import warning_cause
+from hrgtc.core.errors import InputError
 
 DATA = Path(__file__).parents[1] / "data" / "pan-cold-test"
 RUN = DATA / "pan_tvc_cold_2020-03-07.csv"
@@ -100,6 +101,52 @@ def test_calibrate_prints_a_range_warning_common_to_the_axes_once(tmp_path, monk
     assert tail.count("beyond the trained df/dt") == 1, tail
     assert tail.count("(axes x, y, z)") == 2, tail
     assert "axis x:" not in tail and "pan_tvc_cold_2020-03-07.csv:" in tail
+
+
+def test_the_library_call_gives_the_cli_s_model_with_its_reference_log(tmp_path):
+    """``calibrate_instrument`` fits the ``--temp-ref`` map itself (a
+    :class:`TemperatureReference`), on the whole drift file before the hold-out split:
+    one library call writes the model file the command writes, map and all."""
+    from hrgtc.model import save_instrument
+    from hrgtc.pipeline.instrument import calibrate_instrument
+    from hrgtc.recording import ReadOptions
+    from hrgtc.settings.calibration import CalibrationSettings
+    from hrgtc.settings.drift import DriftSettings
+    from hrgtc.thermometry.reference import TemperatureReference
+
+    result = runner.invoke(app, ["calibrate", "--drift", str(RUN), *READ, *REF,
+                                 "--rate-tau-s", "1", "--window-s", "5",
+                                 "--holdout-fraction", "0.4", "-o", str(tmp_path / "cli.json")])
+    assert result.exit_code == 0, result.output
+    options = ReadOptions(
+        columns={"time_s": "time (ms)", "rate_dph_x": "gyrox rad/s",
+                 "rate_dph_y": "gyroy rad/s", "rate_dph_z": "gyroz rad/s",
+                 "temperature_c": "temp"},
+        units={"time": "ms", "rate": "radps"}, gaps="bridge", spike_filter="drop")
+    reference = TemperatureReference(LOG, {"time_s": "Time", "temperature_c": "C1 (C)"},
+                                     start="15:45")
+    calibration = calibrate_instrument(
+        [], [RUN], thermometer="sensor", read_options=options, holdout_fraction=0.4,
+        settings=CalibrationSettings(drift=DriftSettings(rate_tau_s=1.0, window_s=5.0)),
+        temperature_reference=reference)
+    save_instrument(calibration.model, tmp_path / "library.json")
+    cli, library = (json.loads((tmp_path / name).read_text())
+                    for name in ("cli.json", "library.json"))
+    for document in (cli, library):
+        document["provenance"].pop("created_utc")
+    assert library == cli
+    assert library["temperature_map"]["points"] == 24  # the map was fitted, not left out
+    # the provenance names the log and how it was read
+    assert {"role": "temperature_reference", "path": str(LOG)} == {
+        k: v for k, v in library["provenance"]["inputs"][-1].items() if k != "sha256"}
+    assert library["provenance"]["settings"]["temperature_reference"] == {
+        "path": str(LOG), "columns": {"time_s": "Time", "temperature_c": "C1 (C)"},
+        "unit": None, "start": "15:45", "tz": None, "lag_s": None}
+
+    with pytest.raises(InputError, match="a temperature map or a reference log"):
+        calibrate_instrument([], [RUN], thermometer="sensor", read_options=options,
+                             temperature_reference=reference,
+                             temperature_map=reference.fit(RUN, options))
 
 
 def test_one_cause_per_warning_whatever_the_axis():

@@ -16,9 +16,15 @@ from scipy import signal
 
 from hrgtc import drift
 from hrgtc import recording as recording_io
-from hrgtc.compensate import OUTPUT_COLUMNS, Compensator, compensate, compensate_file
+from hrgtc.compensate import (
+    OUTPUT_COLUMNS,
+    Compensator,
+    compensate,
+    compensate_file,
+    compensate_instrument_file,
+)
 from hrgtc.core.errors import InputError, RecordingError
-from hrgtc.model import UnitModel
+from hrgtc.model import InstrumentModel, UnitModel
 from hrgtc.recording import concatenate
 
 from synthetic import THERMOMETER, ramp_run, with_heating_extra
@@ -323,6 +329,19 @@ def test_file_to_file_equals_batch_and_leaves_no_temporary(unit_model, run, tmp_
     assert (summary.rows, summary.out_of_range_fraction, summary.rate_out_of_range_fraction) == (
         len(run), compensator.out_of_range_fraction, compensator.rate_out_of_range_fraction)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out.parquet", "run.parquet"]
+
+
+def test_file_to_file_refuses_to_drop_spikes(unit_model, run, tmp_path):
+    """Compensation writes every row it reads: the library refuses ``spike_filter="drop"``
+    as the command does (it used to drop the spikes' rows from a library call)."""
+    source = recording_io.write(run, tmp_path / "run.parquet")
+    for compensate_any in (compensate_file, compensate_instrument_file):
+        with pytest.raises(InputError, match="never drops a row: use --spike-filter flag"):
+            compensate_any(source, tmp_path / "out.parquet",
+                           InstrumentModel.single(unit_model)
+                           if compensate_any is compensate_instrument_file else unit_model,
+                           read_options=recording_io.ReadOptions(spike_filter="drop"))
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.parquet"]
 
 
 def test_file_to_file_bad_row_late_in_the_file_leaves_nothing(unit_model, tmp_path):

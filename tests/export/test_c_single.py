@@ -346,3 +346,36 @@ def test_float_build_on_bursts_bridges_the_gaps_like_the_double_filter(models, t
     np.testing.assert_array_equal(out[:, 5], mirror_rate(constants, f32, dt32))
     df64 = causal_rate(f64, model.drift.settings.rate_tau_s, time_s=time_s)[0]
     assert np.max(np.abs(out[:, 5] - df64)) < 1e-4 * np.ptp(df64)
+
+
+@pytest.mark.parametrize("kind", ["frequency", "housing", "gradient"])
+def test_both_builds_declare_the_same_interface_from_one_template(kind, models, tmp_path):
+    """The double and the float header are one template (``export.c.header``): the same
+    defines (the float build's own five besides), the same struct fields and the same
+    functions, with ``double`` for ``float`` and the float build's centred frequency.
+    Before, two copies had drifted: the float header lacked ``AUX_INPUTS`` and said
+    "levels and rates" where the double one names them."""
+    model = models[kind]
+    double = export_c(model, tmp_path / "d")[0].read_text()
+    single = export_c(model, tmp_path / "s", precision="single")[0].read_text()
+
+    def interface(text: str) -> tuple[set[str], list[str], list[str]]:
+        body = text[text.index("#ifndef HRGTC_MODEL_H"):]
+        defines = set(re.findall(r"^#define (\w+)", body, flags=re.M))
+        structs = body[body.index("typedef struct hrgtc_state"):]  # the filter's own differs
+        fields = re.findall(r"^    (?:\w+ )+\**(\w+);", structs, flags=re.M)
+        functions = re.findall(r"^\w+ (hrgtc_\w+)\(", body, flags=re.M)
+        return defines, fields, functions
+
+    d_defines, d_fields, d_functions = interface(double)
+    s_defines, s_fields, s_functions = interface(single)
+    own = {"HRGTC_SINGLE_PRECISION", "HRGTC_CENTRE_HZ", "HRGTC_CENTRED_HZ",
+           "HRGTC_MAX_ERROR_C", "HRGTC_MAX_ERROR_DPH"}
+    assert s_defines == d_defines | own and not own & d_defines
+    assert s_fields == d_fields
+    assert [f.replace("centred_", "") for f in s_functions] == d_functions
+    names = r"1: frequency calibrated, (.*) and rates in training"
+    assert re.search(names, single).group(1) == re.search(names, double).group(1) != "levels"
+    assert "float" not in double.split("#ifndef")[1] and "double" not in re.sub(
+        r"/\*.*?\*/", "", single.split("#ifndef")[1].replace("((float)((freq_hz)", ""),
+        flags=re.S)

@@ -184,6 +184,10 @@ def test_parameter_thermometer_gives_table2(tmp_path):
         export_c(model, tmp_path, output_format="params")
     with pytest.raises(InputError, match="format 'json' is not one of c, params"):
         export_c(model, tmp_path, output_format="json")
+    # the library refuses what the command refuses (it used to write doubles silently)
+    with pytest.raises(InputError, match="--precision applies to --format c only"):
+        export_c(model, tmp_path / "single", output_format="params", precision="single")
+    assert not (tmp_path / "single").exists()
 
 
 def scale_from(p, freq_hz):

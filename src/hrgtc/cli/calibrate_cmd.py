@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import typer
 
@@ -127,6 +127,7 @@ def calibrate_command(
     from hrgtc.pipeline.calibration import parse_aux
     from hrgtc.pipeline.instrument import calibrate_instrument
     from hrgtc.recording import ReadOptions
+    from hrgtc.thermometry.reference import TemperatureReference, parse_reference_columns
 
     inputs = (inputs or ReadOptions()).with_spike_default("drop")
 
@@ -137,24 +138,15 @@ def calibrate_command(
         refuse_existing(output, force)
         check_writable(output, 1e6)  # before the fit, not after it
         stages: dict[str, object] = {}
-        temperature_map = None
         ref_options = {"--temp-ref-col": temp_ref_col, "--temp-ref-start": temp_ref_start,
                        "--temp-ref-unit": temp_ref_unit, "--temp-ref-tz": temp_ref_tz,
                        "--temp-ref-lag-s": temp_ref_lag_s}
         stray = [name for name, value in ref_options.items() if value not in (None, [])]
         if temp_ref is None and stray:
             raise fail(f"{stray[0]} describes a reference log: give the log with --temp-ref")
-        if temp_ref is not None:
-            from hrgtc.thermometry.reference import map_from_reference, parse_reference_columns
-
-            temperature_map = map_from_reference(
-                drift[0], temp_ref, inputs, columns=parse_reference_columns(temp_ref_col),
-                unit=temp_ref_unit,
-                start=temp_ref_start, tz=temp_ref_tz, lag_s=temp_ref_lag_s)
-            if not json_output:
-                console.print("Temperature map: " + temperature_map.summary())
-                if temperature_map.extra.get("note"):
-                    console.print(f"[yellow]note:[/] {temperature_map.extra['note']}")
+        reference = None if temp_ref is None else TemperatureReference(
+            temp_ref, parse_reference_columns(temp_ref_col), unit=temp_ref_unit,
+            start=temp_ref_start, tz=temp_ref_tz, lag_s=temp_ref_lag_s)
 
         def progress(stage: str, done: float, total: float) -> None:
             if not json_output and stage not in stages:
@@ -166,12 +158,13 @@ def calibrate_command(
             settings=settings, aux=parse_aux(aux or []), read_options=inputs,
             progress=progress, prior=prior, thermometer=inputs.thermometer,
             rate_tables=rate_table or (), validate_rate_tables=validate_rate_table or (),
-            segment_table=segments, temperature_map=temperature_map,
+            segment_table=segments, temperature_reference=reference,
         )
         save_instrument(calibration.model, output, force=force)
     if json_output:
         print_json({**calibration.document(), "model_file": str(output)})
     else:
+        render_map(calibration.model.temperature_map)
         render_instrument(calibration)
         console.print(f"Model written to {output}")
     beyond = calibration.range_reports()
@@ -183,6 +176,18 @@ def calibrate_command(
                     labels=list(reports) if len(axes) > 1 else None)
     if strict and beyond:
         raise typer.Exit(STRICT_EXIT)
+
+
+def render_map(stored: dict[str, Any] | None) -> None:
+    """The model's temperature map (``--temp-ref``): its line and its note, if any."""
+    if stored is None:
+        return
+    from hrgtc.thermometry.reference import TemperatureMap
+
+    temperature_map = TemperatureMap.from_dict(stored)
+    console.print("Temperature map: " + temperature_map.summary())
+    if temperature_map.extra.get("note"):
+        console.print(f"[yellow]note:[/] {temperature_map.extra['note']}")
 
 
 def render_instrument(calibration: InstrumentCalibration) -> None:

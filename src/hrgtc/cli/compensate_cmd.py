@@ -101,10 +101,6 @@ def compensate_command(
     from hrgtc.recording import ReadOptions
 
     inputs = (inputs or ReadOptions()).with_spike_default("flag")
-    if inputs.spike_filter == "drop":
-        error_console.print("error: compensate flags spikes, it never drops a row: use "
-                            "--spike-filter flag (a 'spike' column marks them) or off")
-        raise typer.Exit(2)
     with library_errors(), progress_bar("compensating", enabled=not json_output) as progress:
         refuse_input(output, [run, model_path])
         model = load_instrument(model_path)

@@ -34,9 +34,6 @@ def export_c_command(
     """
     from hrgtc.export import export_c
 
-    if output_format == "params" and precision == "single":
-        raise typer.BadParameter("--precision applies to --format c only; the parameter file "
-                                 "holds doubles (%.17g)", param_hint="'--precision'")
     with library_errors():
         files = export_c(model, output, prefix=prefix, force=force,
                          precision=precision, output_format=output_format)

@@ -41,31 +41,19 @@ def report_command(
     Example: hrgtc report --model unit.json cooldown.parquet warmup.parquet -o report.html
     """
     from hrgtc.cli.compensate_cmd import note_unchecked
-    from hrgtc.compensate.model_fit import check_thermometer_kind
-    from hrgtc.compensate.multi_axis import match_axes, parse_axes, recording_axes
+    from hrgtc.compensate.multi_axis import parse_axes
     from hrgtc.core.files import check_writable, refuse_existing, refuse_input
     from hrgtc.model import load_instrument
-    from hrgtc.recording import ReadOptions
     from hrgtc.report import build_report
 
     with library_errors(), progress_bar("report", enabled=not json_output) as progress:
         refuse_input(output, [*runs, model, *(soak or [])])
-        from hrgtc.model import load_instrument
-        from hrgtc.thermometry.reference import options_with_map
-
-        inputs = options_with_map(inputs, load_instrument(model).temperature_map)
         refuse_existing(output, force)
         check_writable(output, 20e6)  # before the passes over the runs
-        loaded = load_instrument(model)
-        for unit_model in loaded.axes.values():  # before reading the recordings' axes
-            check_thermometer_kind(inputs or ReadOptions(), unit_model, model)
-        chosen = parse_axes(axes)
-        matched = [match_axes(loaded, recording_axes(r, inputs), chosen, str(r), str(model))
-                   for r in runs]
-        chosen_model = model if matched[0] is loaded else matched[0]
-        path = build_report(chosen_model, runs, output, soaks=soak or None, title=title,
+        path = build_report(model, runs, output, soaks=soak or None, title=title,
                             force=force, max_points=max_points, progress=progress,
-                            read_options=inputs)
+                            read_options=inputs, axes=parse_axes(axes))
+        loaded = load_instrument(model)
     note_unchecked(loaded, model)
     size = path.stat().st_size
     if json_output:

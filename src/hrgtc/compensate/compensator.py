@@ -2,8 +2,9 @@
 
 The streaming :class:`Compensator` keeps the causal df/dt filter's state
 between chunks, so a file of any size is compensated in bounded memory and
-any chunking gives the batch result. The batch :func:`compensate` is "reset,
-then one chunk". Eq. (22) of [1] applied as in Section 4.2 (Fig. 6).
+any chunking gives the batch result (file to file:
+:func:`hrgtc.compensate.file_pass.compensate_file`). The batch :func:`compensate`
+is "reset, then one chunk". Eq. (22) of [1] applied as in Section 4.2 (Fig. 6).
 
 Two engines compute the same numbers: ``"fused"`` (default) runs one compiled
 pass per chunk (:mod:`hrgtc.compensate._kernel`, numba, imported on first use);
@@ -16,29 +17,15 @@ fused one to.
 
 from __future__ import annotations
 
-import dataclasses
 import math
-import os
 import warnings
 from collections.abc import Mapping
-from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from hrgtc import recording as rec_io
-from hrgtc.compensate.at_rest import RestFlags
-from hrgtc.compensate.model_fit import (
-    check_recording_noise,
-    with_model_band,
-)
 from hrgtc.compensate.ranges import RangeReport, range_report
-from hrgtc.core.accounting import Accounting
 from hrgtc.core.errors import CalibrationError, ExtrapolationWarning, HrgtcWarning, InputError
-from hrgtc.core.files import check_writable, refuse_input
-from hrgtc.core.progress import Progress
-from hrgtc.core.time_steps import TimeRepairStream
 from hrgtc.core.timeline import RESTARTS_KEY, is_gap, restart_rows, settle_threshold_s
 from hrgtc.drift import DriftModel
 from hrgtc.drift.features import (
@@ -53,15 +40,9 @@ from hrgtc.drift.rate_filter import check_time, restart_mask
 from hrgtc.model import UnitModel
 from hrgtc.recording import Recording
 from hrgtc.recording.gaps import check_gap_policy
-from hrgtc.recording.marks import COMPENSATED_KEY, mark, refuse_compensated
-from hrgtc.recording.spikes import SPIKE_COLUMN
-from hrgtc.settings.compensation import CompensateSettings
 
 #: Rows worked on at once: small enough for the temporaries to stay in cache.
 BLOCK_ROWS = 1 << 17
-#: Rows per chunk of :func:`compensate_file`: one Parquet row group, so chunks are read
-#: without joining batches and written without waiting for the next chunk.
-FILE_CHUNK_ROWS = CompensateSettings.chunk_rows
 #: Columns added by compensation.
 OUTPUT_COLUMNS = ("rate_comp_dph", "bias_model_dph", "resonator_c_est", "in_range")
 #: Column added when the model has a scale factor: its error at each sample's frequency.
@@ -405,194 +386,3 @@ def compensate(recording: Recording, model: UnitModel, drift: str = "frequency",
                engine: str = "fused") -> Recording:
     """Batch compensation of a whole run: a new :class:`Compensator`, one chunk."""
     return Compensator(model, drift, engine).transform(recording)
-
-
-@dataclass(frozen=True)
-class CompensationSummary:
-    """What :func:`compensate_file` did."""
-
-    source: str
-    output: str
-    rows: int
-    out_of_range_fraction: float
-    rate_out_of_range_fraction: float
-    ranges: RangeReport | None = None
-    accounting: Accounting | None = None
-
-    def to_dict(self) -> dict[str, Any]:
-        return {
-            "source": self.source,
-            "output": self.output,
-            "rows": self.rows,
-            "out_of_range_fraction": self.out_of_range_fraction,
-            "rate_out_of_range_fraction": self.rate_out_of_range_fraction,
-            "ranges": None if self.ranges is None else self.ranges.to_dict(),
-            "accounting": None if self.accounting is None else self.accounting.to_dict(),
-        }
-
-
-def compensate_file(
-    source: str | os.PathLike[str],
-    output: str | os.PathLike[str],
-    model: UnitModel,
-    *,
-    force: bool = False,
-    read_options: rec_io.ReadOptions | None = None,
-    chunk_rows: int = FILE_CHUNK_ROWS,
-    drift: str = "frequency",
-    progress: Progress | None = None,
-    compensator: Any = None,
-) -> CompensationSummary:
-    """Compensate a recording file into a new file, chunk by chunk (bounded memory).
-
-    ``compensator``: another streaming compensator with the interface of
-    :class:`Compensator` and a ``columns`` attribute (e.g. the
-    :class:`~hrgtc.compensate.multi_axis.InstrumentCompensator` of every axis, see
-    :func:`~hrgtc.compensate.multi_axis.compensate_instrument_file`); ``model`` then
-    only marks the output.
-
-    The output is written atomically in the format of its suffix; it is never
-    overwritten without ``force``. ``read_options`` says how to read ``source``
-    (column mapping, units, metadata).
-
-    Three stages overlap, each one chunk ahead of the next (pyarrow, h5py and the
-    fused kernel release the GIL): a thread reads and validates the next chunk,
-    this thread compensates the current one, and a writer thread writes the previous
-    one, starts its write to disk and waits for the one before
-    (:meth:`~hrgtc.recording.RecordingWriter.start_writeback`), so that the fsync
-    before the atomic rename finds one chunk left to wait for. At most three chunks
-    are held at a time.
-    """
-    if compensator is None:
-        options = with_model_band(read_options or rec_io.ReadOptions(), model)
-        compensator = Compensator(model, drift, gaps=options.gaps)
-        added = output_columns(model)
-    else:
-        options = read_options or rec_io.ReadOptions()
-        added = compensator.columns
-    refuse_input(output, [source])
-    refuse_compensated(source)
-    check_writable(output, estimated_output_bytes(source, output, len(added)))
-    repair = TimeRepairStream()  # what the reader dropped (duplicated rows)
-    chunks = options.chunks(source, rows=chunk_rows, time_repair=repair)
-    spikes = 0
-    try:
-        first = next(chunks)
-        flags = None  # samples not at rest: flagged, found in one pass first (at_rest.py)
-        if options.motion != "keep":
-            flags = RestFlags(options.chunks(source), list(getattr(model, "axes", None) or [""]),
-                              options.motion, os.path.basename(os.fspath(source)))
-            added = (*added, *flags.columns)
-        copies = sensor_copies((*first.names, *added), first.metadata)
-        names = tuple(n for n in (*first.names, *added) if n not in copies)
-        check_recording_noise(model, first, str(source))
-        total = rec_io.count_rows(source)
-        metadata = compensated_metadata(first.metadata, model, drift)
-        with rec_io.RecordingWriter(output, metadata, names, force=force) as writer, \
-                ThreadPoolExecutor(max_workers=1) as reading, \
-                ThreadPoolExecutor(max_workers=1) as writing:
-            ahead = reading.submit(next, chunks, None)
-            pending = None
-            chunk: Recording | None = first
-            restarts: set[float] = set()  # every chunk's restarts, written at close
-            while chunk is not None:
-                restarts.update(chunk.metadata.extra.get(RESTARTS_KEY) or ())
-                result = compensator.transform(chunk)
-                if flags is not None:
-                    result = result.with_columns(**flags.take(len(chunk)))
-                if SPIKE_COLUMN in chunk:
-                    spikes += int(np.count_nonzero(chunk[SPIKE_COLUMN]))
-                if copies:
-                    result = Recording({n: result[n] for n in names}, result.metadata,
-                                       result.source)
-                if pending is not None:
-                    pending.result()
-                pending = writing.submit(_write, writer, result)
-                if progress is not None:
-                    progress(compensator.samples, total)
-                chunk = ahead.result()
-                if chunk is not None:
-                    ahead = reading.submit(next, chunks, None)
-            if pending is not None:
-                pending.result()
-            if restarts:
-                writer.set_metadata(dataclasses.replace(metadata, extra={
-                    **metadata.extra, RESTARTS_KEY: sorted(restarts)}))
-    finally:
-        chunks.close()
-    accounting = compensation_accounting(compensator, spikes, repair.duplicates,
-                                         0 if flags is None else flags.n_not_at_rest)
-    return CompensationSummary(str(source), str(output), compensator.samples,
-                               compensator.out_of_range_fraction,
-                               compensator.rate_out_of_range_fraction, compensator.ranges(),
-                               accounting)
-
-
-def compensation_accounting(compensator: Any, spikes: int = 0,
-                            duplicates: int = 0, not_at_rest: int = 0) -> Accounting:
-    """Samples read, dropped (duplicated rows, by the reader) and flagged by reason.
-
-    ``compensate`` never drops a sample it read: spikes (the ``spike`` column), samples
-    beyond the trained temperature (``out_of_range``) or df/dt (``rate_out_of_range``)
-    and those of the df/dt filter's settling (``warmup``) are flagged (``in_range`` 0), and
-    ``not_at_rest`` samples (on any axis; the ``at_rest`` columns) as ``motion``. With
-    several axes, the axis with the most samples beyond its ranges (the one the
-    summary line names).
-    """
-    axes = getattr(compensator, "axes", None)
-    if axes:
-        compensator = max(axes.values(), key=lambda c: sum(c.ranges().shares().values()))
-    accounting = Accounting(read=compensator.samples + duplicates)
-    accounting.drop("duplicates", duplicates)
-    accounting.flag("warmup", compensator.settling)
-    accounting.flag("spikes", spikes)
-    accounting.flag("motion", not_at_rest)
-    accounting.flag("out_of_range", compensator.temperature_out)
-    accounting.flag("rate_out_of_range",
-                    compensator.variable_ranges.get("df", [compensator.rate_out_of_range])[0])
-    return accounting
-
-
-def compensated_metadata(metadata: rec_io.Metadata, model: UnitModel,
-                         drift: str = "frequency") -> rec_io.Metadata:
-    """``metadata`` with the mark of compensation by ``model`` (:mod:`hrgtc.recording.marks`)."""
-    extra = {**metadata.extra, COMPENSATED_KEY: mark(model.sha256, model.unit, drift)}
-    # the restarts known when the output is opened are those of the first chunk only: none
-    # are written then, and all at close (compensate_file; its time axis is the repaired one)
-    extra.pop(RESTARTS_KEY, None)
-    return dataclasses.replace(metadata, extra=extra)
-
-
-def estimated_output_bytes(source: str | os.PathLike[str], output: str | os.PathLike[str],
-                           added_columns: int) -> float:
-    """Rough size of ``output``, a copy of ``source`` with ``added_columns`` more columns.
-
-    Counted as 8-byte floats (Parquet, HDF5) or about 20 characters (CSV) per value;
-    used to refuse a run that would fill the disk before it starts.
-    """
-    try:
-        with rec_io.open_source(source) as opened:
-            columns = len(opened.names) + added_columns
-        rows = rec_io.count_rows(source)
-    except (InputError, OSError):
-        return 0.0
-    per_value = 20.0 if str(output).lower().endswith(".csv") else 8.0
-    return rows * columns * per_value
-
-
-def sensor_copies(names: tuple[str, ...], metadata: rec_io.Metadata) -> set[str]:
-    """Columns a sensor thermometer's output would only copy its temperature into.
-
-    With ``--thermometer sensor`` the ``freq_hz*`` columns hold the temperature
-    sensor's reading and ``resonator_c_est*`` the same again (the thermometer is the
-    identity): neither is written; ``temperature_c*`` is.
-    """
-    if metadata.extra.get("thermometer") != "sensor":
-        return set()
-    return {n for n in names if n.startswith(("freq_hz", "resonator_c_est"))}
-
-
-def _write(writer: rec_io.RecordingWriter, chunk: Recording) -> None:
-    writer.write(chunk)
-    writer.start_writeback()
-

@@ -17,12 +17,8 @@ from typing import Any
 import numpy as np
 
 from hrgtc import recording as rec_io
-from hrgtc.compensate.compensator import (
-    CompensationSummary,
-    Compensator,
-    compensate_file,
-    output_columns,
-)
+from hrgtc.compensate.compensator import Compensator, output_columns
+from hrgtc.compensate.file_pass import CompensationSummary, compensate_file
 from hrgtc.compensate.model_fit import check_thermometer_kind, plausible_frequency_band
 from hrgtc.compensate.ranges import RangeReport
 from hrgtc.core.errors import InputError, RecordingError
@@ -276,7 +272,7 @@ def compensate_instrument_file(
 ) -> CompensationSummary:
     """Compensate every axis of a recording file into a new file (bounded memory).
 
-    As :func:`~hrgtc.compensate.compensator.compensate_file` (``force``, ``progress``;
+    As :func:`~hrgtc.compensate.file_pass.compensate_file` (``force``, ``progress``;
     ``settings`` its chunk size, :class:`~hrgtc.settings.compensation.CompensateSettings`
     defaults when None); each axis's frequency is checked against that axis's
     plausible band. A single-axis model is compensated exactly as by

@@ -104,7 +104,8 @@ def export_c(
     output_format
         ``"c"`` (default): the header and source. ``"params"``: one plain parameter file
         ``<prefix>_params.txt`` of ``key = value`` lines, every number documented
-        (:mod:`hrgtc.export.parameter_file`); ``precision`` does not apply.
+        (:mod:`hrgtc.export.parameter_file`); ``precision`` does not apply (``"single"``
+        is refused).
 
     Returns
     -------
@@ -118,8 +119,8 @@ def export_c(
     Raises
     ------
     InputError
-        A prefix that is not a C identifier, an unknown precision, or non-finite model
-        constants.
+        A prefix that is not a C identifier, an unknown precision, ``"single"`` with the
+        parameter file, or non-finite model constants.
     CalibrationError
         A thermometer that is not monotonic over its calibrated range.
     OutputExistsError
@@ -138,6 +139,9 @@ def export_c(
     if precision not in PRECISIONS:
         raise InputError(f"precision {precision!r} is not one of {', '.join(PRECISIONS)}; "
                          "use 'double' (the default) or 'single' (float32 for FPU-only MCUs)")
+    if output_format == "params" and precision != "double":
+        raise InputError("--precision applies to --format c only; the parameter file holds "
+                         "doubles (%.17g): leave --precision at double")
     axes, origin, sha256 = _axes_of(model)
     folder = Path(outdir)
     if folder.exists() and not folder.is_dir():

@@ -19,7 +19,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from hrgtc.compensate import OUTPUT_COLUMNS, CompensationSummary, compensate_instrument_file
-from hrgtc.compensate.compensator import compensated_metadata
+from hrgtc.compensate.file_pass import compensated_metadata
 from hrgtc.core.errors import HrgtcWarning
 from hrgtc.core.files import refuse_existing
 from hrgtc.core.progress import StageProgress, for_stage

@@ -40,13 +40,14 @@ from hrgtc.evaluation.calibration_figures import instrument_summary
 from hrgtc.model import InstrumentModel, UnitModel, provenance
 from hrgtc.pipeline import documents
 from hrgtc.pipeline.calibration import HOUSING_TERMS, CalibrationResult, calibrate
+from hrgtc.pipeline.holdout import holdout_split
 from hrgtc.recording import ReadOptions, Recording, axis_names
 from hrgtc.recording.marks import refuse_compensated_training
 from hrgtc.recording.read_once import ReadOnce
 from hrgtc.settings.calibration import CROSS_AXIS_GAIN, CalibrationSettings
 from hrgtc.settings.reading import ReadSettings
 from hrgtc.thermometry.prior import ThermometerPrior
-from hrgtc.thermometry.reference import TemperatureMap
+from hrgtc.thermometry.reference import TemperatureMap, TemperatureReference
 
 __all__ = ["InstrumentCalibration", "InstrumentEvaluation", "ScaleFactorCheck",
            "calibrate_instrument", "check_scale_factor", "evaluate_instrument",
@@ -170,6 +171,7 @@ def calibrate_instrument(
     progress: StageProgress | None = None,
     validate_options: ReadOptions | None = None,
     temperature_map: TemperatureMap | None = None,
+    temperature_reference: TemperatureReference | None = None,
     holdout_s: float | None = None,
     holdout_fraction: float | None = None,
 ) -> InstrumentCalibration:
@@ -211,6 +213,11 @@ def calibrate_instrument(
         Reading options of the ``validate`` runs when they differ (a held-out last part
         of the training file: ``start`` where the training's ``end`` is); default
         ``read_options``.
+    temperature_map, temperature_reference
+        A map of the raw temperature count to °C (applied to every file, stored in the
+        model), or the reference log to fit it from on the whole first drift run.
+    holdout_s, holdout_fraction
+        Validate on the end of the one drift file (:func:`holdout_split`).
     """
     settings = settings or CalibrationSettings()
     scale_terms, cross_axis = settings.scale_terms, settings.cross_axis
@@ -218,6 +225,10 @@ def calibrate_instrument(
     if thermometer not in ("resonator", "sensor"):
         raise InputError(f"thermometer must be 'resonator' or 'sensor', got {thermometer!r}")
     options = dataclasses.replace(read_options or ReadOptions(), thermometer=thermometer)
+    if temperature_reference is not None and temperature_map is not None:
+        raise InputError("give a temperature map or a reference log to fit one, not both")
+    if temperature_reference is not None and drifts:  # all of the first run, before a split
+        temperature_map = temperature_reference.fit(drifts[0], options)
     if temperature_map is not None:
         options = _through_map(options, temperature_map)
         validate_options = (None if validate_options is None
@@ -257,12 +268,16 @@ def calibrate_instrument(
     inputs = {"soak": [str(p) for p in soaks], "drift": [str(p) for p in drifts],
               "validate": [str(p) for p in validate],
               "rate_table": [str(p) for p in rate_tables],
-              "validate_rate_table": [str(p) for p in validate_rate_tables]}
+              "validate_rate_table": [str(p) for p in validate_rate_tables],
+              "temperature_reference": [] if temperature_reference is None
+              else [str(temperature_reference.path)]}
     first = next(iter(results.values())).model.provenance.get("settings", {})
+    reference = {} if temperature_reference is None else {
+        "temperature_reference": temperature_reference.to_dict()}
     record = provenance(inputs, {**first, "axes": list(axes), "thermometer": thermometer,
                                  "scale_terms": list(scale_terms),
                                  "segment_table": None if segment_table is None
-                                 else str(segment_table)})
+                                 else str(segment_table), **reference})
     models = {axis: dataclasses.replace(m, provenance=record) for axis, m in models.items()}
     instrument = InstrumentModel(models, unit, record, None if temperature_map is None
                                  else temperature_map.to_dict())
@@ -285,40 +300,6 @@ def _through_map(options: ReadOptions, temperature_map: TemperatureMap) -> ReadO
     return options_with_map(dataclasses.replace(
         options, temp_scale=ReadSettings.temp_scale,
         temp_offset_c=ReadSettings.temp_offset_c), temperature_map)
-
-
-def holdout_split(read_options: ReadOptions, soaks: Sequence[PathLike],
-                  drifts: Sequence[PathLike], validate: Sequence[PathLike],
-                  holdout_s: float | None = None, holdout_fraction: float | None = None
-                  ) -> tuple[ReadOptions, ReadOptions, list[PathLike]]:
-    """Train on the first part of the one drift file, validate on its last part (by time).
-
-    The cut is :func:`hrgtc.core.timeline.holdout_rows` of the file's time stamps (the
-    last ``holdout_s`` seconds or ``holdout_fraction`` of the recorded time, at a segment
-    start: a burst is never split).
-
-    Returns
-    -------
-    tuple
-        The training reading options (``end`` at the cut), the held-out run's
-        (``start`` at the cut) and the held-out runs (the drift file), for
-        :func:`calibrate_instrument`'s ``read_options``, ``validate_options`` and
-        ``validate``.
-    """
-    from hrgtc.core.timeline import holdout_rows
-
-    if len(drifts) != 1 or soaks or validate:
-        raise InputError("--holdout-s/--holdout-fraction hold out the end of one --drift file: "
-                         "give exactly one --drift and no --soak or --validate (or split the "
-                         "files yourself with --start/--end)")
-    if read_options.start is not None or read_options.end is not None:
-        raise InputError("--holdout-s/--holdout-fraction and --start/--end together: slice the "
-                         "file first, or use --end for training and --validate with --start")
-    time = read_options.read(drifts[0], keep=["time_s"]).time_s
-    cut = holdout_rows(time, holdout_s, holdout_fraction)
-    at = f"{time[cut] - time[0]:.9g}"
-    return (dataclasses.replace(read_options, end=at),
-            dataclasses.replace(read_options, start=at), [drifts[0]])
 
 
 def _axes_of(path: PathLike, options: ReadOptions) -> tuple[str, ...]:

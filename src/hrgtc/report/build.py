@@ -17,6 +17,8 @@ from collections.abc import Callable, Sequence
 from html import escape
 from pathlib import Path
 
+from hrgtc.compensate.model_fit import check_thermometer_kind
+from hrgtc.compensate.multi_axis import match_axes, recording_axes
 from hrgtc.core.errors import InputError
 from hrgtc.core.files import refuse_existing, write_text_atomic
 from hrgtc.core.progress import Progress
@@ -45,6 +47,7 @@ from hrgtc.report.html import (
 )
 from hrgtc.settings.compensation import ReportSettings
 from hrgtc.thermometry.plateaus import Plateau
+from hrgtc.thermometry.reference import options_with_map
 
 __all__ = ["build_report"]
 
@@ -69,6 +72,8 @@ def build_report(
     max_points: int = ReportSettings.max_points,
     read_options: ReadOptions | None = None,
     progress: Progress | None = None,
+    axes: Sequence[str] | None = None,
+    model_source: str = "",
 ) -> Path:
     """Write the report: one self-contained HTML file with Figs. 3-6 and Tables 1-2 of [1].
 
@@ -90,9 +95,17 @@ def build_report(
     max_points
         Most points per plotted curve; plots use block means of at least 10 s.
     read_options
-        How to read the runs and the given soaks (column mapping, units, metadata).
+        How to read the runs and the given soaks (column mapping, units, metadata); the
+        model's temperature map (``--temp-ref``) applies unless they give their own
+        scale and offset.
     progress
         Optional ``callback(rows_done, rows_total)``.
+    axes
+        The axes to show (``--axes``); None: all. The model's and each run's axes must
+        agree unless ``axes`` names those to show
+        (:func:`hrgtc.compensate.multi_axis.match_axes`).
+    model_source
+        The model's name in messages (default: its path when ``model`` is one).
 
     Returns
     -------
@@ -105,7 +118,8 @@ def build_report(
         ``output`` exists and ``force`` is False (checked before any work).
     InputError
         An evaluation given in ``runs`` kept no plotting blocks, or was given for a
-        multi-axis model.
+        multi-axis model; the runs are read as the other kind of thermometer than the
+        model's; the model's and a run's axes differ (checked before any run is read).
     """
     target = Path(output)
     refuse_existing(target, force)
@@ -116,7 +130,8 @@ def build_report(
         instrument = model
     else:
         model_path, instrument = str(model), load_instrument(model)
-    options = read_options or ReadOptions()
+    options = options_with_map(read_options or ReadOptions(), instrument.temperature_map)
+    instrument = _check_axes(instrument, runs, options, axes, model_source or model_path or "")
     first = next(iter(instrument.axes.values()))
     soak_paths, missing = _soak_files(first) if soaks is None else ([str(p) for p in soaks], [])
     if soaks is None:
@@ -185,6 +200,19 @@ def build_report(
     if progress is not None:
         progress(total, total)
     return written
+
+
+def _check_axes(model: InstrumentModel, runs: Sequence[PathLike | Evaluation],
+                options: ReadOptions, axes: Sequence[str] | None,
+                model_source: str) -> InstrumentModel:
+    """The model's axes to show, checked against every run file (its thermometer kind,
+    then its axes: :func:`hrgtc.compensate.multi_axis.match_axes`); the first run's
+    match."""
+    for unit_model in model.axes.values():  # before reading the recordings' axes
+        check_thermometer_kind(options, unit_model, model_source or None)
+    matched = [match_axes(model, recording_axes(run, options), axes, str(run), model_source)
+               for run in runs if not isinstance(run, Evaluation)]
+    return matched[0] if matched else model
 
 
 def _unit_sections(page: _Page, model: UnitModel, evaluations: Sequence[Evaluation],

@@ -47,7 +47,8 @@ import numpy as np
 from hrgtc.core import records
 from hrgtc.core.errors import CalibrationError, InputError, RecordingError
 
-__all__ = ["ReferenceLog", "TemperatureMap", "fit_count_map", "parse_clock", "read_reference_log"]
+__all__ = ["ReferenceLog", "TemperatureMap", "TemperatureReference", "fit_count_map",
+           "parse_clock", "read_reference_log"]
 
 #: Default columns of a reference log, and the ``--temp-ref-col`` names.
 REFERENCE_COLUMNS = ("time_s", "temperature_c")
@@ -494,6 +495,50 @@ def map_from_reference(recording: str | Path, reference: str | Path,
                              tz)
     bits = run.metadata.extra.get("temperature_count_bits")
     return fit_count_map(run.time_s, run[names[0]], log, lag_s=lag_s, count_bits=bits)
+
+
+@dataclass(frozen=True)
+class TemperatureReference:
+    """A reference log of the temperature and how to read it (``hrgtc calibrate
+    --temp-ref`` and its ``--temp-ref-*`` options): what
+    :func:`hrgtc.pipeline.instrument.calibrate_instrument` fits the count's map from.
+
+    Attributes
+    ----------
+    path
+        The reference log (CSV), written beside the first drift recording.
+    columns
+        Its columns by our names (``{"time_s": "Time", "temperature_c": "C1 (C)"}``);
+        None: ``time_s`` and ``temperature_c``.
+    unit
+        ``"C"`` or ``"F"``; None: F when the temperature column's header says so.
+    start
+        Clock time of the recording's t = 0 (``"15:40"`` or an ISO date-time) when the
+        log has clock times; None: the recording's first time stamp.
+    tz
+        Time zone of naive clock times (``"+01:00"``, ``"Europe/Berlin"``).
+    lag_s
+        The reference's lag behind the sensor; None: fitted. [s]
+    """
+
+    path: str | Path
+    columns: Mapping[str, str] | None = None
+    unit: str | None = None
+    start: str | None = None
+    tz: str | None = None
+    lag_s: float | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        """How the log was read, as plain JSON types (a model file's provenance)."""
+        return {"path": str(self.path), "columns": dict(self.columns or {}), "unit": self.unit,
+                "start": self.start, "tz": self.tz, "lag_s": self.lag_s}
+
+    def fit(self, recording: str | Path, read_options: Any = None) -> TemperatureMap:
+        """The count → °C map of ``recording``'s raw temperature
+        (:func:`map_from_reference`)."""
+        return map_from_reference(recording, self.path, read_options, columns=self.columns,
+                                  unit=self.unit, start=self.start, tz=self.tz,
+                                  lag_s=self.lag_s)
 
 
 def _read_raw(options: Any, recording: str | Path) -> Any:

@@ -1,4 +1,5 @@
-"""C expressions shared by the export's text modules: array initialisers and drift terms.
+"""C expressions shared by the export's text modules: array initialisers, drift terms and
+comment text.
 
 :mod:`hrgtc.export.c.text` (header, source) and :mod:`hrgtc.export.c.scale`
 (the scale-factor pieces that ``text`` inserts) both print these; they live here so
@@ -7,12 +8,20 @@ that ``scale`` does not import ``text`` back (no import circle).
 
 from __future__ import annotations
 
+import re
 from typing import Any
 
 from hrgtc.drift.features import Term
 from hrgtc.export.c.types import DOUBLE, CType
 
-__all__ = ["array", "factor", "term_expression"]
+__all__ = ["array", "comment", "factor", "term_expression"]
+
+
+def comment(text: Any) -> str:
+    """Text safe inside a C block comment: ASCII only, no ``*/``, one line."""
+    ascii_text = str(text).encode("ascii", "backslashreplace").decode("ascii")
+    ascii_text = re.sub(r"[\x00-\x1f\x7f]", " ", ascii_text)
+    return ascii_text.replace("*/", "* /").replace("/*", "/ *")
 
 
 def array(values: Any, name: str, t: CType = DOUBLE) -> str:

@@ -14,17 +14,16 @@ statements). The drift terms are printed by the shared
 
 from __future__ import annotations
 
-from hrgtc.core.timeline import settle_threshold_s
-from hrgtc.drift.features import settle_rows
 from hrgtc.export.c.float32 import MARGIN, FloatAccuracy, FloatConstants
+from hrgtc.export.c.header import header as template
 from hrgtc.export.c.plan import TABLE_POINTS, CPlan
-from hrgtc.export.c.rate_filter import filter_functions, filter_struct
+from hrgtc.export.c.rate_filter import filter_functions
 from hrgtc.export.c.scale import scale_factor_of, scale_pieces
 from hrgtc.export.c.step import step_tail
 from hrgtc.export.c.text import NEWTON_MAX_ITER, _array, _bias_function, _comment, readme
 from hrgtc.export.c.thermometer import thermometer_functions
 from hrgtc.export.c.types import DOUBLE, SINGLE
-from hrgtc.export.c.variables import RATES, bias_params, extra_variables, levels, step_inputs
+from hrgtc.export.c.variables import RATES, extra_variables, levels, step_inputs
 from hrgtc.model import UnitModel
 
 
@@ -103,109 +102,12 @@ def _sections(model: UnitModel, plan: CPlan, prefix: str, accuracy: FloatAccurac
 
 def header(model: UnitModel, plan: CPlan, prefix: str, origin: str, sha256: str,
            constants: FloatConstants, accuracy: FloatAccuracy) -> str:
-    """Text of the float build's ``<prefix>_model.h``."""
-    p, up = prefix, prefix.upper()
-    lit = SINGLE.literal
-    housing = plan.housing
-    state_h = (f"    {p}_rate_filter h_filter;   /* dh/dt filter of h [degC] */\n"
-               if housing else "")
-    out_h = ("    float h_c;                  /* housing temperature change h [degC] */\n"
-             "    float dh_c_per_s;           /* its causal rate dh/dt [degC/s] */\n"
-             if housing else "")
-    arg_h = "".join(f", float {name}" for name in step_inputs(plan))
-    bias_h = "".join(f", float {name}" for _, name in bias_params(plan)[2:])
-    settings = model.drift.settings
-    state_h += extra_variables(plan, settings, lit, _comment, ctype=SINGLE, prefix=p)["state"]
-    k = scale_pieces(model, plan, prefix)
-    out_h += k["field"]
-    housing_in = ((", housing_c [degC]" if plan.housing_input else "")
-                  + "".join(f", aux_{n}" for n in plan.aux))
-    sections = _sections(model, plan, prefix, accuracy)
-    return f"""{readme(model, plan, prefix, origin, sha256, sections)}
-#ifndef {up}_MODEL_H
-#define {up}_MODEL_H
-
-#ifdef __cplusplus
-extern "C" {{
-#endif
-
-/* This is the float32 build (hrgtc export-c --precision single). */
-#define {up}_SINGLE_PRECISION 1
-/* Centre of the frequency input: f_ref, the thermometer at {settings.reference_c:g} degC. [Hz] */
-#define {up}_CENTRE_HZ {DOUBLE.literal(constants.centre_hz, "centre_hz")}
-/* The centred frequency {p}_step() takes, from a double freq_hz. [Hz] */
-#define {up}_CENTRED_HZ(freq_hz) ((float)((freq_hz) - {up}_CENTRE_HZ))
-/* Bound of the float32 error against the double model over the calibrated range, from the
-   worst measured at export: resonator temperature [degC] and bias model [deg/h]. */
-#define {up}_MAX_ERROR_C {lit(accuracy.bound_c, "max_error_c")}
-#define {up}_MAX_ERROR_DPH {lit(accuracy.bound_dph, "max_error_dph")}
-/* Sample rate of the training runs; step() takes each sample's dt_s, any rate works. [Hz] */
-#define {up}_SAMPLE_RATE_HZ {lit(settings.sample_rate_hz, "sample_rate_hz")}
-/* SETTLE_S in samples at the training rate (on a continuous run; in_range uses SETTLE_S). */
-#define {up}_SETTLE_ROWS {settle_rows(settings)}UL
-/* Seconds since init/reset (the sum of dt_s) from which the filter has settled:
-   samples before are flagged (in_range 0), as training leaves them out. [s] */
-#define {up}_SETTLE_S {lit(settle_threshold_s(settings.warmup_s), "settle_s")}
-/* 1 when {p}_step() takes the housing temperature (the model uses h, dh or g terms). */
-#define {up}_USES_HOUSING {1 if plan.housing_input else 0}
-/* SHA-256 of the model this code was generated from. */
-#define {up}_MODEL_SHA256 "{sha256}"
-{k['define']}
-{filter_struct(p, True)}
-/* Filter state of one gyro; initialise with {p}_init(). */
-typedef struct {p}_state {{
-    {p}_rate_filter f_filter;   /* df/dt filter of f [Hz] */
-{state_h}    int started;                /* 0 until the first sample after init/reset */
-    unsigned long samples;      /* samples since init/reset */
-    float elapsed_s;            /* seconds since init/reset, up to SETTLE_S [s] */
-    unsigned long out_of_range; /* of which outside the calibrated temperature */
-    unsigned long rate_out_of_range; /* of which with rate_in_range == 0 */
-}} {p}_state;
-
-/* Everything one step computes. */
-typedef struct {p}_output {{
-    float rate_comp_dph;        /* compensated rate, rate_dph - bias_model_dph [deg/h] */
-    float bias_model_dph;       /* modelled bias B, Eq. (22) [deg/h] */
-    float resonator_c_est;      /* resonator temperature from frequency [degC] (NaN: beyond) */
-    float f_hz;                 /* frequency change f = freq_hz - f_ref [Hz] */
-    float df_hz_per_s;          /* its causal rate df/dt [Hz/s] */
-{out_h}    int in_range;               /* 1: frequency calibrated, levels and rates in training
-                                   range, filter settled */
-    int rate_in_range;          /* 1: rates in training range (else extrapolated in time) */
-}} {p}_output;
-
-/* Set the state to the start of a run (before first use). */
-void {p}_init({p}_state *state);
-
-/* Start a new run (or a segment after a gap, split): the df/dt filter restarts at rest
-   on the next sample. */
-void {p}_reset({p}_state *state);
-
-/* Compensate one sample; returns rate_comp_dph and fills *out unless out is NULL.
-   dt_s [s] time since the previous sample (a gap's length bridges it),
-   f_hz = freq_hz - {up}_CENTRE_HZ [Hz], rate_dph [deg/h]{housing_in}. */
-float {p}_step({p}_state *state, float dt_s, float f_hz, float rate_dph{arg_h},
-               {p}_output *out);
-
-/* Bias model B of Eq. (22) from the variables. [deg/h] */
-float {p}_bias_dph(float f_hz, float df_hz_per_s{bias_h});
-
-{k['prototype']}/* Thermometer, Eq. (18) form, centred: f(T) - {up}_CENTRE_HZ. [Hz] from [degC] */
-float {p}_centred_frequency_hz(float temperature_c);
-
-/* Its inverse: resonator temperature from f_hz = freq_hz - {up}_CENTRE_HZ; NaN beyond the
-   monotonic extension. */
-float {p}_temperature_c(float f_hz);
-
-/* 1 when f_hz = freq_hz - {up}_CENTRE_HZ lies in the calibrated frequency range, else 0. */
-int {p}_frequency_in_range(float f_hz);
-
-#ifdef __cplusplus
-}}
-#endif
-
-#endif /* {up}_MODEL_H */
-"""
+    """Text of the float build's ``<prefix>_model.h`` (the template both builds share,
+    :func:`hrgtc.export.c.header.header`, in float, with the centre and error bounds)."""
+    text = readme(model, plan, prefix, origin, sha256,
+                  _sections(model, plan, prefix, accuracy))
+    return template(model, plan, prefix, text, sha256, SINGLE, centre_hz=constants.centre_hz,
+                    bounds=(accuracy.bound_c, accuracy.bound_dph))
 
 
 def source(model: UnitModel, plan: CPlan, prefix: str, constants: FloatConstants) -> str:

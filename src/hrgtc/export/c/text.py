@@ -1,5 +1,7 @@
 """C text of the firmware export: the README block, the header and the source.
 
+The header is the template both builds share (:mod:`hrgtc.export.c.header`).
+
 :mod:`hrgtc.export.export_c` decides what to export (the validated numbers of a
 :class:`~hrgtc.model.UnitModel`); this module prints them as C99. Constants are
 printed with ``%.17g`` so they read back to the same double. Products and sums are
@@ -14,14 +16,13 @@ from __future__ import annotations
 import re
 import textwrap
 from pathlib import Path
-from typing import Any
 
-from hrgtc.core.timeline import settle_threshold_s
-from hrgtc.drift.features import settle_rows
 from hrgtc.export.c.expr import array as _array
+from hrgtc.export.c.expr import comment as _comment
 from hrgtc.export.c.expr import term_expression as _term_expression
+from hrgtc.export.c.header import header as template
 from hrgtc.export.c.plan import TABLE_POINTS, CPlan
-from hrgtc.export.c.rate_filter import filter_functions, filter_struct
+from hrgtc.export.c.rate_filter import filter_functions
 from hrgtc.export.c.step import step_tail
 from hrgtc.export.c.thermometer import thermometer_functions
 from hrgtc.export.c.types import DOUBLE, ctype
@@ -44,13 +45,6 @@ _WIDTH = 92
 def _literal(value: float, name: str) -> str:
     """``%.17g`` text of a finite double as a C double literal (reads back exactly)."""
     return DOUBLE.literal(value, name)
-
-
-def _comment(text: Any) -> str:
-    """Text safe inside a C block comment: ASCII only, no ``*/``, one line."""
-    ascii_text = str(text).encode("ascii", "backslashreplace").decode("ascii")
-    ascii_text = re.sub(r"[\x00-\x1f\x7f]", " ", ascii_text)
-    return ascii_text.replace("*/", "* /").replace("/*", "/ *")
 
 
 def sensor_note(model: UnitModel) -> list[str]:
@@ -209,104 +203,10 @@ def readme(model: UnitModel, plan: CPlan, prefix: str, origin: str,
 
 
 def header(model: UnitModel, plan: CPlan, prefix: str, origin: str,
-            sha256: str) -> str:
-    """Text of ``<prefix>_model.h``: README block, state and output structs, prototypes."""
-    from hrgtc.export.c.scale import scale_pieces
-
-    p, up = prefix, prefix.upper()
-    housing = plan.housing
-    state_h = f"    {p}_rate_filter h_filter;   /* dh/dt filter of h [degC] */\n" \
-        if housing else ""
-    # the state of the variables beyond f, df, h, dh (d2's filter)
-    state_h += extra_variables(plan, model.drift.settings, _literal, _comment,
-                               prefix=p)["state"]
-    out_h = "    double h_c;                 /* housing temperature change h [degC] */\n" \
-            "    double dh_c_per_s;          /* its causal rate dh/dt [degC/s] */\n" \
-        if housing else ""
-    arg_h = "".join(f", double {name}" for name in step_inputs(plan))
-    bias_h = "".join(f", double {name}" for _, name in bias_params(plan)[2:])
-    levels = " and ".join(v for v in plan.computed if v in ("f", "h"))
-    settle = settle_rows(model.drift.settings)
-    k = scale_pieces(model, plan, prefix)
-    out_h += k["field"]
-    rates = " and ".join(v for v in plan.computed if v in ("df", "dh"))
-    return f"""{readme(model, plan, prefix, origin, sha256)}
-#ifndef {up}_MODEL_H
-#define {up}_MODEL_H
-
-#ifdef __cplusplus
-extern "C" {{
-#endif
-
-/* Sample rate of the training runs; step() takes each sample's dt_s, any rate works. [Hz] */
-#define {up}_SAMPLE_RATE_HZ {_literal(model.drift.settings.sample_rate_hz, "sample_rate_hz")}
-/* SETTLE_S in samples at the training rate (on a continuous run; in_range uses SETTLE_S). */
-#define {up}_SETTLE_ROWS {settle}UL
-/* Seconds since init/reset (the sum of dt_s) from which the filter has settled:
-   samples before are flagged (in_range 0), as training leaves them out. [s] */
-#define {up}_SETTLE_S {settle_threshold_s(model.drift.settings.warmup_s)!r}
-/* 1 when {p}_step() takes the housing temperature (the model uses h, dh or g terms). */
-#define {up}_USES_HOUSING {1 if plan.housing_input else 0}
-/* Extra logged channels {p}_step() takes after housing_c (aux_NAME, --aux NAME=COLUMN). */
-#define {up}_AUX_INPUTS {len(plan.aux)}
-/* SHA-256 of the model this code was generated from. */
-#define {up}_MODEL_SHA256 "{sha256}"
-{k['define']}
-{filter_struct(p, False)}
-/* Filter state of one gyro; initialise with {p}_init(). */
-typedef struct {p}_state {{
-    {p}_rate_filter f_filter;   /* df/dt filter of f [Hz] */
-{state_h}    int started;                /* 0 until the first sample after init/reset */
-    unsigned long samples;      /* samples since init/reset */
-    double elapsed_s;           /* seconds since init/reset, up to SETTLE_S [s] */
-    unsigned long out_of_range; /* of which outside the calibrated temperature */
-    unsigned long rate_out_of_range; /* of which with rate_in_range == 0 */
-}} {p}_state;
-
-/* Everything one step computes. */
-typedef struct {p}_output {{
-    double rate_comp_dph;       /* compensated rate, rate_dph - bias_model_dph [deg/h] */
-    double bias_model_dph;      /* modelled bias B, Eq. (22) [deg/h] */
-    double resonator_c_est;     /* resonator temperature from frequency [degC] (NaN: beyond) */
-    double f_hz;                /* frequency change f = freq_hz - f_ref [Hz] */
-    double df_hz_per_s;         /* its causal rate df/dt [Hz/s] */
-{out_h}    int in_range;               /* 1: frequency calibrated, {levels} and rates in training
-                                   range, filter settled */
-    int rate_in_range;          /* 1: {rates} in training range (else extrapolated in time) */
-}} {p}_output;
-
-/* Set the state to the start of a run (before first use). */
-void {p}_init({p}_state *state);
-
-/* Start a new run (or a segment after a gap, split): the df/dt filter restarts at rest
-   on the next sample. */
-void {p}_reset({p}_state *state);
-
-/* Compensate one sample; returns rate_comp_dph and fills *out unless out is NULL.
-   dt_s [s] time since the previous sample (a gap's length bridges it), freq_hz [Hz],
-   rate_dph [deg/h]{", housing_c [degC]" if plan.housing_input else ""}\
-{"".join(", aux_" + n for n in plan.aux)}. */
-double {p}_step({p}_state *state, double dt_s, double freq_hz, double rate_dph{arg_h},
-                {p}_output *out);
-
-/* Bias model B of Eq. (22) from the variables. [deg/h] */
-double {p}_bias_dph(double f_hz, double df_hz_per_s{bias_h});
-
-{k['prototype']}/* Thermometer f(T), Eq. (18) form. [Hz] from [degC] */
-double {p}_frequency_hz(double temperature_c);
-
-/* Its inverse: resonator temperature from frequency; NaN beyond the monotonic extension. */
-double {p}_temperature_c(double freq_hz);
-
-/* 1 when freq_hz lies in the calibrated frequency range, else 0. */
-int {p}_frequency_in_range(double freq_hz);
-
-#ifdef __cplusplus
-}}
-#endif
-
-#endif /* {up}_MODEL_H */
-"""
+           sha256: str) -> str:
+    """Text of ``<prefix>_model.h``: README block, state and output structs, prototypes
+    (the template both builds share, :func:`hrgtc.export.c.header.header`)."""
+    return template(model, plan, prefix, readme(model, plan, prefix, origin, sha256), sha256)
 
 
 def _bias_function(model: UnitModel, plan: CPlan, prefix: str) -> str:
