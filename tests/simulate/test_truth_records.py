@@ -89,3 +89,17 @@ def test_unit_refusals_name_the_place():
         units.unit_from_dict({**imu, "axes": {**imu["axes"], "x": x}})
     with pytest.raises(InputError, match=r"`\$.axes`"):
         units.unit_from_dict({**imu, "axes": {}})
+
+
+def test_a_written_file_round_trips_and_refuses_a_negative_row_count():
+    from hrgtc.simulate.output import WrittenFile, WrittenFileRecord
+
+    written = WrittenFile(path="runs/soak.parquet", rows=1200, profile="soak 20 C, 5 h")
+    document = written.to_dict()
+    assert json.dumps(document) == ('{"path": "runs/soak.parquet", "rows": 1200, '
+                                    '"profile": "soak 20 C, 5 h"}')
+    assert WrittenFile.from_dict(json.loads(json.dumps(document))) == written
+    schema = records.json_schema(WrittenFileRecord, "w", "https://hrgtc.invalid/w.json")
+    jsonschema.Draft202012Validator(schema).validate(document)
+    with pytest.raises(InputError, match=r"`\$.rows`"):
+        WrittenFile.from_dict({**document, "rows": -1})
