@@ -87,3 +87,21 @@ def test_input_refusals_name_the_place():
     with pytest.raises(InputError, match=r"`\$.rows`"):
         LoggedFiles.from_dict({**simulate_inputs.logged_files()["without"].to_dict(),
                                "rows": -1})
+
+
+def test_a_logged_runs_sidecar_is_its_record():
+    from hrgtc.simulate.logger import log_run
+    from hrgtc.simulate.logger_records import LoggedRunRecord
+    from hrgtc.simulate.standard_profiles import constant
+
+    logger = simulate_inputs.loggers()["every-part"]
+    logger = Logger.from_dict({**logger.to_dict(), "sample_rate_hz": 5.0, "spikes": 2,
+                               "restarts_s": [900.0], "accelerometer": True})
+    info = json.loads(json.dumps(log_run(constant(20.0, 0.5), "imu-3", logger, seed=4).info))
+    _schema(LoggedRunRecord).validate(info)
+    assert records.dump(None, LoggedRunRecord, **info) == info  # round trip
+    assert info["handling_windows"] and "from" in info["handling_windows"][0]
+    assert info["temperature"]["reference_log"]["readings"]
+    with pytest.raises(InputError, match=r"`\$.segments\[0\].first_row`"):
+        records.load({**info, "segments": [{**info["segments"][0], "first_row": -1}]},
+                     LoggedRunRecord, "sidecar")

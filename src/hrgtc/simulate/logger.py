@@ -48,7 +48,7 @@ from hrgtc.simulate.clock import unwrap_counter, wall_clock
 from hrgtc.simulate.duty import DutyCycle, duplicate_rows, simulate_kept
 from hrgtc.simulate.handling import Handling, hand_warming, handling_truth
 from hrgtc.simulate.logger_options import reading_options
-from hrgtc.simulate.logger_records import LoggerRecord
+from hrgtc.simulate.logger_records import LoggedRunRecord, LoggerRecord
 from hrgtc.simulate.profiles import Profile
 from hrgtc.simulate.reflog import ReferenceLog, TemperatureChannel, reference_log_text
 from hrgtc.simulate.units import MultiAxisUnit, Unit
@@ -582,4 +582,5 @@ def log_run(
         duplicate_rows(columns, truth, info,
                        rng.choice(rows.size, size=int(logger.duplicates), replace=False))
     info["hrgtc_options"] = reading_options(info, axes, logger)
+    info = records.dump(None, LoggedRunRecord, **info)  # its record's order, types and checks
     return LoggedRun(columns, kinds, truth, info, reference_text)
