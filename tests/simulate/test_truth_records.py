@@ -63,3 +63,43 @@ def test_truth_refusals_name_the_place():
                              "rrw_dph_per_sqrt_h": 0.1, "flicker_per_decade": 0})
     with pytest.raises(InputError, match=r"`\$.temperature_dph`"):
         BiasLaw.from_dict({"bias0_dph": 1.0, "temperature_dph": [0.1, 0.2]})
+
+
+@pytest.mark.parametrize("name", units.names())
+def test_a_whole_unit_fits_its_records_schema(name):
+    written = json.loads(json.dumps(units.get(name).to_dict()))
+    record = units.MultiAxisUnitRecord if "axes" in written else units.UnitRecord
+    schema = records.json_schema(record, "unit", "https://hrgtc.invalid/unit.json")
+    jsonschema.Draft202012Validator(schema).validate(written)
+    # the frequency law is one of two kinds, told by its tag
+    laws = schema["$defs"]["UnitRecord"]["properties"]["frequency_law"]
+    assert laws["discriminator"]["propertyName"] == "kind"
+    assert sorted(laws["discriminator"]["mapping"]) == ["polynomial", "shell"]
+
+
+def test_unit_refusals_name_the_place():
+    paper = units.get("paper-unit").to_dict()
+    with pytest.raises(InputError, match=r"Invalid value 'spline' - at `\$.frequency_law.kind`"):
+        units.unit_from_dict({**paper, "frequency_law": {"kind": "spline"}})
+    with pytest.raises(InputError, match=r"`\$.housing_noise_c`"):
+        units.unit_from_dict({**paper, "housing_noise_c": -1.0})
+    imu = units.get("imu-3").to_dict()
+    x = {**imu["axes"]["x"], "bias_law": {"bias0_dph": 1.0, "temperature_dph": [0.1]}}
+    with pytest.raises(InputError, match=r"axis 'x' record: .* - at `\$.bias_law.temperature_dph`"):
+        units.unit_from_dict({**imu, "axes": {**imu["axes"], "x": x}})
+    with pytest.raises(InputError, match=r"`\$.axes`"):
+        units.unit_from_dict({**imu, "axes": {}})
+
+
+def test_a_written_file_round_trips_and_refuses_a_negative_row_count():
+    from hrgtc.simulate.output import WrittenFile, WrittenFileRecord
+
+    written = WrittenFile(path="runs/soak.parquet", rows=1200, profile="soak 20 C, 5 h")
+    document = written.to_dict()
+    assert json.dumps(document) == ('{"path": "runs/soak.parquet", "rows": 1200, '
+                                    '"profile": "soak 20 C, 5 h"}')
+    assert WrittenFile.from_dict(json.loads(json.dumps(document))) == written
+    schema = records.json_schema(WrittenFileRecord, "w", "https://hrgtc.invalid/w.json")
+    jsonschema.Draft202012Validator(schema).validate(document)
+    with pytest.raises(InputError, match=r"`\$.rows`"):
+        WrittenFile.from_dict({**document, "rows": -1})

@@ -32,19 +32,21 @@ is the same whatever the size of the fleet.
 from __future__ import annotations
 
 from dataclasses import replace
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 from numpy.polynomial import Polynomial
 
+from hrgtc.core import records
 from hrgtc.core.errors import InputError
 from hrgtc.simulate import units as simulated_units
 from hrgtc.simulate.laws import BiasLaw, PolynomialFrequencyLaw, table1_frequency_law
 from hrgtc.simulate.noise_sources import GyroNoise
 from hrgtc.simulate.thermal import ThermalNetwork
-from hrgtc.simulate.units import Unit
+from hrgtc.simulate.units import Unit, UnitRecord
 
-__all__ = ["SPREAD", "draw_unit", "draw_units", "relative_law"]
+__all__ = ["SPREAD", "DrawRecord", "FleetTruthRecord", "draw_unit", "draw_units",
+           "relative_law"]
 
 #: 1-sigma unit-to-unit spread (module docstring for the sources).
 SPREAD: dict[str, float] = {
@@ -137,13 +139,38 @@ def draw_units(n: int, seed: int, first: int = 0,
     return [draw_unit(seed, k, spread) for k in range(first, first + n)]
 
 
+class DrawRecord(records.Record, kw_only=True):
+    """How a population unit was drawn (:func:`draw_unit`): its seed and index, the drawn
+    f(20 °C) and temperature-coefficient scales, the relative law and the spreads."""
+
+    seed: int
+    index: records.Count
+    f20_hz: records.Positive
+    tc_scale: float
+    tc_quadratic: float
+    tc_cubic: float
+    relative_law_x_minus_20: list[float]
+    spread: dict[str, float]
+
+
+class FleetTruthRecord(records.Record, kw_only=True):
+    """A population unit's ``truth.json``: the unit (:class:`UnitRecord`) and its draw."""
+
+    schema: Literal["hrgtc.fleet-truth"] = "hrgtc.fleet-truth"
+    unit: UnitRecord
+    draw: DrawRecord
+
+
 def truth(unit: Unit, draw: dict) -> dict[str, Any]:
-    """The unit's ground truth as written beside its files (``truth.json``)."""
-    return {"schema": "hrgtc.fleet-truth", "unit": unit.to_dict(), "draw": draw}
+    """The unit's ground truth as written beside its files (``truth.json``), as
+    :class:`FleetTruthRecord` writes it."""
+    return records.dump(unit, FleetTruthRecord, unit=unit.to_dict(), draw=draw)
 
 
 def true_frequency_hz(truth_record: dict[str, Any], temperature_c: Any) -> np.ndarray:
-    """The true f(T) of a unit from its ``truth.json`` record. [Hz]"""
+    """The true f(T) of a unit from its ``truth.json`` record (checked against
+    :class:`FleetTruthRecord`). [Hz]"""
+    records.load(truth_record, FleetTruthRecord, "fleet truth")
     law = truth_record["unit"]["frequency_law"]
     if law.get("kind") != "polynomial":
         raise InputError("truth record without a polynomial frequency law")

@@ -16,11 +16,24 @@ import math
 import os
 from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Protocol
+from types import UnionType
+from typing import (
+    TYPE_CHECKING,
+    Annotated,
+    Any,
+    Literal,
+    Protocol,
+    Union,
+    get_args,
+    get_origin,
+    get_type_hints,
+)
 
+import msgspec
 import pyarrow as pa
 import pyarrow.parquet as pq
 
+from hrgtc.core import records
 from hrgtc.core.errors import InputError
 from hrgtc.core.files import publish, refuse_existing, temporary_beside
 
@@ -28,7 +41,17 @@ if TYPE_CHECKING:
     from hrgtc.evaluation import Evaluation
     from hrgtc.pipeline.calibration import CalibrationResult
 
-__all__ = ["SCHEMA", "calibration_row", "evaluation_row", "read_table", "table", "write_table"]
+__all__ = [
+    "SCHEMA",
+    "FleetRowRecord",
+    "arrow_schema",
+    "calibration_row",
+    "evaluation_row",
+    "read_table",
+    "row_json_schema",
+    "table",
+    "write_table",
+]
 
 
 class Outcome(Protocol):
@@ -49,24 +72,80 @@ class Outcome(Protocol):
     @property
     def seconds(self) -> float: ...
 
-_F = pa.float64()
-_LF = pa.list_(pa.float64())
-_LS = pa.list_(pa.string())
-SCHEMA = pa.schema([
-    ("unit", pa.string()), ("status", pa.string()), ("seconds", _F),
-    ("error_type", pa.string()), ("error_message", pa.string()), ("error_file", pa.string()),
-    ("error_column", pa.string()), ("error_row", pa.int64()),
-    ("model_file", pa.string()), ("n_soaks", pa.int64()),
-    ("temperature_low_c", _F), ("temperature_high_c", _F),
-    ("centre_c", _F), ("scale_c", _F),
-    ("coefficients_high_first", _LF), ("freq_centre_hz", _F), ("relative_coefficients", _LF),
-    ("f20_hz", _F), ("tcf_ppm_per_c", _F),
-    ("soak_temperatures_c", _LF), ("settled_freqs_hz", _LF), ("table_max_error_c", _F),
-    ("terms_kept", _LS), ("n_terms", pa.int64()),
-    ("runs", _LS), ("raw_10s_dph", _LF), ("compensated_10s_dph", _LF),
-    ("improvement_10s", _LF), ("out_of_range_fraction", _LF),
-    ("rate_out_of_range_fraction", _LF), ("median_improvement_10s", _F),
-])
+class FleetRowRecord(records.Record, kw_only=True):
+    """A unit's row of the fleet table: its columns in order, their types and bounds.
+
+    The one definition of the table: :data:`SCHEMA` (the Arrow schema, every column
+    nullable) and the table's JSON Schema (:func:`row_json_schema`) come from it, and
+    :func:`table` checks each row against it. ``None`` where a unit has no value
+    (a failed unit's results, a run's statistic that is not finite).
+    """
+
+    unit: str
+    status: Literal["ok", "skipped", "failed"]
+    seconds: records.NonNegative
+    error_type: str | None = None
+    error_message: str | None = None
+    error_file: str | None = None
+    error_column: str | None = None
+    error_row: records.Count | None = None
+    model_file: str | None = None
+    n_soaks: records.Count | None = None
+    temperature_low_c: float | None = None
+    temperature_high_c: float | None = None
+    centre_c: float | None = None
+    scale_c: records.Positive | None = None
+    coefficients_high_first: list[float] | None = None
+    freq_centre_hz: float | None = None
+    relative_coefficients: list[float] | None = None
+    f20_hz: float | None = None
+    tcf_ppm_per_c: float | None = None
+    soak_temperatures_c: list[float] | None = None
+    settled_freqs_hz: list[float] | None = None
+    table_max_error_c: records.NonNegative | None = None
+    terms_kept: list[str] | None = None
+    n_terms: records.Count | None = None
+    runs: list[str] | None = None
+    raw_10s_dph: list[float | None] | None = None
+    compensated_10s_dph: list[float | None] | None = None
+    improvement_10s: list[float | None] | None = None
+    out_of_range_fraction: list[float] | None = None
+    rate_out_of_range_fraction: list[float] | None = None
+    median_improvement_10s: float | None = None
+
+
+def _arrow_type(kind: Any) -> pa.DataType:
+    """The Arrow type of a record field's type (``X | None``: nullable ``X``)."""
+    while get_origin(kind) is Annotated:
+        kind = get_args(kind)[0]
+    members = [m for m in get_args(kind) if m is not type(None)]
+    if get_origin(kind) is Literal and all(isinstance(m, str) for m in members):
+        return pa.string()
+    if get_origin(kind) in (Union, UnionType) and len(members) == 1:
+        return _arrow_type(members[0])
+    if get_origin(kind) is list:
+        return pa.list_(_arrow_type(members[0]))
+    scalars = {str: pa.string(), float: pa.float64(), int: pa.int64(), bool: pa.bool_()}
+    if kind in scalars:
+        return scalars[kind]
+    raise TypeError(f"no Arrow type for a record field of type {kind!r}")
+
+
+def arrow_schema(record: type[records.Record]) -> pa.Schema:
+    """The Arrow schema of a record of table rows: a nullable column per field, in order."""
+    hints = get_type_hints(record, include_extras=True)
+    return pa.schema([(field.name, _arrow_type(hints[field.name]))
+                      for field in msgspec.structs.fields(record)])
+
+
+#: The fleet table's Arrow schema, from :class:`FleetRowRecord`.
+SCHEMA = arrow_schema(FleetRowRecord)
+
+
+def row_json_schema() -> dict[str, Any]:
+    """The JSON Schema of a fleet table row (:class:`FleetRowRecord`)."""
+    return records.json_schema(FleetRowRecord, "hrgtc fleet table row",
+                               "https://hrgtc.invalid/schemas/fleet-row.json")
 
 
 def _num(value: Any) -> float | None:
@@ -125,6 +204,7 @@ def table(outcomes: Sequence[Outcome]) -> pa.Table:
                    error_type=error.get("type"), error_message=error.get("message"),
                    error_file=error.get("file"), error_column=error.get("column"),
                    error_row=error.get("row"))
+        records.load(row, FleetRowRecord, f"fleet table row of unit {outcome.unit!r}")
         rows.append(row)
     return pa.Table.from_pylist(rows, schema=SCHEMA)
 

@@ -24,16 +24,19 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import asdict, dataclass, field
-from typing import Any
+from dataclasses import dataclass, field
+from typing import Annotated, Any
 
 import numpy as np
+from msgspec import Meta
 
+from hrgtc.core import records
 from hrgtc.core.errors import InputError
 from hrgtc.settings.simulation import PLAIN_LOGGER as _PLAIN
 from hrgtc.simulate.units import EARTH_RATE_DPH
 
-__all__ = ["Handling", "HandlingTruth", "hand_warming", "handling_truth", "orientation_matrix"]
+__all__ = ["Handling", "HandlingRecord", "HandlingTruth", "hand_warming", "handling_truth",
+           "orientation_matrix"]
 
 _BODY = {"x": 0, "y": 1, "z": 2}
 _SECONDS_PER_HOUR = 3600.0
@@ -139,12 +142,27 @@ class Handling:
         return starts
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types."""
-        out = asdict(self)
-        out["change_times_s"] = None if self.change_times_s is None else list(self.change_times_s)
-        out["g_sensitivity_dph_per_g"] = {a: list(g) for a, g in
-                                          self.g_sensitivity_dph_per_g.items()}
-        return out
+        """Plain JSON types, as :class:`HandlingRecord` writes them."""
+        return records.dump(self, HandlingRecord)
+
+    @classmethod
+    def from_dict(cls, data: Any) -> Handling:
+        """Inverse of :meth:`to_dict` (checked against its record)."""
+        return cls(**records.load(data, HandlingRecord, "handling"))
+
+
+class HandlingRecord(records.Record, kw_only=True, forbid_unknown_fields=True):
+    """A :class:`Handling` in a logger's sidecar."""
+
+    orientations: Annotated[int, Meta(ge=1)]
+    handling_s: records.Positive
+    max_rate_dps: records.Positive
+    change_times_s: tuple[float, ...] | None
+    latitude_deg: float
+    g_sensitivity_dph_per_g: dict[str, tuple[float, float, float]]
+    accel_noise_g: float
+    hand_warming_c: float
+    hand_warming_tau_s: float
 
 
 def hand_warming(time_s: np.ndarray, handling: Handling, duration_s: float) -> np.ndarray:

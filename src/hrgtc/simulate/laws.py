@@ -26,7 +26,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Annotated, Any, Literal, Protocol
+from typing import Annotated, Any, Protocol
 
 import numpy as np
 from msgspec import Meta
@@ -97,15 +97,15 @@ class PolynomialFrequencyLaw:
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> PolynomialFrequencyLaw:
         """Inverse of :meth:`to_dict` (checked against its record)."""
-        values = records.load(data, PolynomialFrequencyLawRecord, "polynomial frequency law")
-        values.pop("kind")
-        return cls(**values)
+        return cls(**records.load(data, PolynomialFrequencyLawRecord,
+                                  "polynomial frequency law"))
 
 
-class PolynomialFrequencyLawRecord(records.Record, kw_only=True):
-    """A :class:`PolynomialFrequencyLaw` in the simulator's ground truth."""
+class PolynomialFrequencyLawRecord(records.Record, kw_only=True, tag_field="kind",
+                                   tag="polynomial"):
+    """A :class:`PolynomialFrequencyLaw` in the simulator's ground truth (``kind``
+    ``polynomial``, written first: the tag of :data:`FrequencyLawRecord`)."""
 
-    kind: Literal["polynomial"] = "polynomial"
     coefficients: Annotated[tuple[float, ...], Meta(min_length=1)]
     source: str = ""
 
@@ -154,20 +154,25 @@ class ShellFrequencyLaw:
         return cls(Shell.from_dict(data["shell"]))
 
 
-class ShellFrequencyLawRecord(records.Record, kw_only=True):
-    """A :class:`ShellFrequencyLaw` in the simulator's ground truth."""
+class ShellFrequencyLawRecord(records.Record, kw_only=True, tag_field="kind", tag="shell"):
+    """A :class:`ShellFrequencyLaw` in the simulator's ground truth (``kind`` ``shell``)."""
 
-    kind: Literal["shell"] = "shell"
     shell: ShellRecord
+
+
+#: A frequency law in a unit's ground truth: one of the two kinds, told by its ``kind``
+#: (a msgspec tagged union; its JSON Schema has a ``discriminator``).
+FrequencyLawRecord = PolynomialFrequencyLawRecord | ShellFrequencyLawRecord
 
 
 def frequency_law_from_dict(data: Mapping[str, Any]) -> FrequencyLaw:
     """A frequency law from its :meth:`to_dict` form (``kind`` polynomial or shell)."""
     kinds: dict[str, Any] = {
-        "polynomial": PolynomialFrequencyLaw,
-        "shell": ShellFrequencyLaw,
+        record.__struct_config__.tag: law
+        for record, law in ((PolynomialFrequencyLawRecord, PolynomialFrequencyLaw),
+                            (ShellFrequencyLawRecord, ShellFrequencyLaw))
     }
-    kind = data.get("kind")
+    kind = data.get("kind") if isinstance(data, Mapping) else None
     if kind not in kinds:
         raise InputError(f"frequency law kind {kind!r} is unknown; use one of {sorted(kinds)}")
     return kinds[kind].from_dict(data)

@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from hrgtc.core import records
 from hrgtc.core.errors import InputError
 from hrgtc.core.files import (
     forget_temporary,
@@ -44,6 +45,7 @@ from hrgtc.simulate.units import MultiAxisUnit, Unit
 
 __all__ = [
     "LoggedFiles",
+    "LoggedFilesRecord",
     "csv_text",
     "sidecar_paths",
     "simulate_logged_files",
@@ -72,8 +74,23 @@ class LoggedFiles:
     rows: int
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types."""
-        return dict(self.__dict__)
+        """Plain JSON types, as :class:`LoggedFilesRecord` writes them."""
+        return records.dump(self, LoggedFilesRecord)
+
+    @classmethod
+    def from_dict(cls, data: Any) -> LoggedFiles:
+        """Inverse of :meth:`to_dict` (checked against its record)."""
+        return cls(**records.load(data, LoggedFilesRecord, "logged files"))
+
+
+class LoggedFilesRecord(records.Record, kw_only=True):
+    """A :class:`LoggedFiles` (``hrgtc simulate --logger ... --json``)."""
+
+    path: str
+    truth_json: str
+    truth_csv: str
+    reference_log: str | None
+    rows: records.Count
 
 
 def sidecar_paths(path: str | Path) -> dict[str, Path]:

@@ -33,12 +33,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from datetime import datetime, timedelta
 from typing import Any
 
 import numpy as np
 
+from hrgtc.core import records
 from hrgtc.core.errors import InputError
 from hrgtc.settings.simulation import LOGGER_RATE_UNITS, LOGGER_TIME_UNITS
 from hrgtc.settings.simulation import PLAIN_LOGGER as _PLAIN
@@ -47,6 +48,7 @@ from hrgtc.simulate.clock import unwrap_counter, wall_clock
 from hrgtc.simulate.duty import DutyCycle, duplicate_rows, simulate_kept
 from hrgtc.simulate.handling import Handling, hand_warming, handling_truth
 from hrgtc.simulate.logger_options import reading_options
+from hrgtc.simulate.logger_records import LoggedRunRecord, LoggerRecord
 from hrgtc.simulate.profiles import Profile
 from hrgtc.simulate.reflog import ReferenceLog, TemperatureChannel, reference_log_text
 from hrgtc.simulate.units import MultiAxisUnit, Unit
@@ -231,16 +233,18 @@ class Logger:
         return names
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types."""
-        out = asdict(self)
-        out["restarts_s"] = list(self.restarts_s)
-        out["temperature"] = None if self.temperature is None else self.temperature.to_dict()
-        out["reference_log"] = (None if self.reference_log is None
-                                else self.reference_log.to_dict())
-        out["handling"] = None if self.handling is None else self.handling.to_dict()
-        out["columns"] = dict(self.columns)
-        out["extra_columns"] = {k: list(v) for k, v in self.extra_columns.items()}
-        return out
+        """Plain JSON types, as :class:`~hrgtc.simulate.logger_records.LoggerRecord`
+        writes them."""
+        return records.dump(self, LoggerRecord)
+
+    @classmethod
+    def from_dict(cls, data: Any) -> Logger:
+        """Inverse of :meth:`to_dict` (checked against its record)."""
+        values = records.load(data, LoggerRecord, "logger")
+        parts = {"temperature": TemperatureChannel, "reference_log": ReferenceLog,
+                 "handling": Handling}
+        return cls(**{**values, **{name: None if values[name] is None else part(**values[name])
+                                   for name, part in parts.items()}})
 
 
 @dataclass
@@ -578,4 +582,5 @@ def log_run(
         duplicate_rows(columns, truth, info,
                        rng.choice(rows.size, size=int(logger.duplicates), replace=False))
     info["hrgtc_options"] = reading_options(info, axes, logger)
+    info = records.dump(None, LoggedRunRecord, **info)  # its record's order, types and checks
     return LoggedRun(columns, kinds, truth, info, reference_text)

@@ -11,12 +11,13 @@ from __future__ import annotations
 import threading
 from collections.abc import Mapping, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from hrgtc.core import records
 from hrgtc.core.errors import InputError
 from hrgtc.core.files import refuse_existing
 from hrgtc.core.progress import Progress
@@ -36,7 +37,7 @@ from hrgtc.simulate.campaign import (
 from hrgtc.simulate.profiles import Profile
 from hrgtc.simulate.units import MultiAxisUnit, Unit
 
-__all__ = ["WrittenFile", "output_paths", "simulate_files", "simulate_to_file"]
+__all__ = ["WrittenFile", "WrittenFileRecord", "output_paths", "simulate_files", "simulate_to_file"]
 
 
 @dataclass(frozen=True)
@@ -58,17 +59,25 @@ class WrittenFile:
     profile: str
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types."""
-        return asdict(self)
+        """Plain JSON types, as :class:`WrittenFileRecord` writes them."""
+        return records.dump(self, WrittenFileRecord)
 
     @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> WrittenFile:
-        """Inverse of :meth:`to_dict`."""
-        return cls(path=str(data["path"]), rows=int(data["rows"]), profile=str(data["profile"]))
+    def from_dict(cls, data: Mapping[str, Any]) -> WrittenFile:
+        """Inverse of :meth:`to_dict` (checked against its record)."""
+        return cls(**records.load(data, WrittenFileRecord, "written file"))
 
     def summary(self) -> str:
         """One line."""
         return f"{self.path}: {self.rows} rows ({self.profile})"
+
+
+class WrittenFileRecord(records.Record, kw_only=True):
+    """A :class:`WrittenFile` (``hrgtc simulate --json``)."""
+
+    path: str
+    rows: records.Count
+    profile: str
 
 
 def simulate_to_file(

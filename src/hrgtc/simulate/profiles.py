@@ -54,12 +54,14 @@ import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any
 
+import msgspec
 import numpy as np
 import yaml
 
 import hrgtc.settings.simulation as _settings
+from hrgtc.core import records
 from hrgtc.core.errors import InputError
 
 __all__ = [
@@ -68,7 +70,9 @@ __all__ = [
     "DEFAULT_RAMP_C_PER_MIN",
     "ROOM_TEMPERATURE_C",
     "Profile",
+    "ProfileRecord",
     "Segment",
+    "SegmentRecord",
     "from_mapping",
     "load",
 ]
@@ -81,8 +85,34 @@ CHAMBER_MAX_C_PER_MIN = 2.0
 DEFAULT_RAMP_C_PER_MIN = _settings.DEFAULT_RAMP_C_PER_MIN
 #: An axis name: a letter, then letters or digits (the suffix of per-axis columns).
 AXIS_NAME = re.compile(r"[A-Za-z][A-Za-z0-9]*")
-#: Keys of a segment in a profile file.
-SEGMENT_KEYS = ("setpoint_c", "hold_h", "ramp_c_per_min", "table_rate_dps", "axis")
+
+
+class SegmentRecord(records.Record, kw_only=True, forbid_unknown_fields=True):
+    """A :class:`Segment` in a profile file: ``setpoint_c`` and one of ``hold_h`` and
+    ``ramp_c_per_min`` (the segment checks which), the others written only when given."""
+
+    setpoint_c: float
+    hold_h: records.Positive | None = None
+    ramp_c_per_min: records.Positive | None = None
+    table_rate_dps: float | None = None
+    axis: Annotated[str, msgspec.Meta(pattern=r"^[A-Za-z][A-Za-z0-9]*$")] | None = None
+
+    omit_when_default = ("hold_h", "ramp_c_per_min", "table_rate_dps", "axis")
+
+
+class ProfileRecord(records.Record, kw_only=True, forbid_unknown_fields=True):
+    """A :class:`Profile` (a profile file's mapping form, a recording's ``chamber_program``)."""
+
+    name: str = "profile"
+    description: str = ""
+    start_c: float = ROOM_TEMPERATURE_C
+    chamber_max_c_per_min: records.Positive = CHAMBER_MAX_C_PER_MIN
+    setpoint_c: float | None = None
+    segments: Annotated[list[SegmentRecord], msgspec.Meta(min_length=1)]
+
+
+#: Keys of a segment in a profile file (:class:`SegmentRecord`'s fields).
+SEGMENT_KEYS = tuple(f.name for f in msgspec.structs.fields(SegmentRecord))
 
 
 def finite_number(name: str, value: Any, unit: str, where: str = "") -> float:
@@ -160,18 +190,8 @@ class Segment:
             object.__setattr__(self, "ramp_c_per_min", rate)
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types, the schema of profile files."""
-        out: dict[str, Any] = {"setpoint_c": self.setpoint_c}
-        if self.hold_h is not None:
-            out["hold_h"] = self.hold_h
-        else:
-            assert self.ramp_c_per_min is not None
-            out["ramp_c_per_min"] = self.ramp_c_per_min
-        if self.table_rate_dps is not None:
-            out["table_rate_dps"] = self.table_rate_dps
-        if self.axis is not None:
-            out["axis"] = self.axis
-        return out
+        """Plain JSON types, the schema of profile files (:class:`SegmentRecord`)."""
+        return records.dump(self, SegmentRecord)
 
 
 @dataclass(frozen=True)
@@ -325,19 +345,15 @@ class Profile:
         return np.interp(np.asarray(time_s, dtype=np.float64), times, temps)
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types; :func:`from_mapping` reads it back."""
-        return {
-            "name": self.name,
-            "description": self.description,
-            "start_c": self.start_c,
-            "chamber_max_c_per_min": self.chamber_max_c_per_min,
-            "setpoint_c": self.setpoint_c,
-            "segments": [s.to_dict() for s in self.segments],
-        }
+        """Plain JSON types, as :class:`ProfileRecord` writes them; :func:`from_mapping`
+        reads it back."""
+        return records.dump(self, ProfileRecord)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> Profile:
-        """Inverse of :meth:`to_dict`."""
+        """Inverse of :meth:`to_dict` (checked against :class:`ProfileRecord`, then built
+        by :func:`from_mapping`, which checks what a segment needs)."""
+        records.load(data, ProfileRecord, "profile")
         return from_mapping(data)
 
     def summary(self) -> str:

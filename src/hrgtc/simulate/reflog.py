@@ -15,19 +15,23 @@ probe optionally lagging behind the sensor.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from datetime import datetime, timedelta
-from typing import Any
+from typing import Annotated, Any, Literal
 
 import numpy as np
+from msgspec import Meta
 from scipy.signal import lfilter, lfilter_zi
 
+from hrgtc.core import records
 from hrgtc.core.errors import InputError
 from hrgtc.settings.simulation import PLAIN_LOGGER as _PLAIN
 
 __all__ = [
     "ReferenceLog",
+    "ReferenceLogRecord",
     "TemperatureChannel",
+    "TemperatureChannelRecord",
     "count_to_celsius",
     "first_order_lag",
     "reference_log_text",
@@ -107,8 +111,25 @@ class TemperatureChannel:
         }
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types."""
-        return asdict(self)
+        """Plain JSON types, as :class:`TemperatureChannelRecord` writes them."""
+        return records.dump(self, TemperatureChannelRecord)
+
+    @classmethod
+    def from_dict(cls, data: Any) -> TemperatureChannel:
+        """Inverse of :meth:`to_dict` (checked against its record)."""
+        return cls(**records.load(data, TemperatureChannelRecord, "temperature channel"))
+
+
+class TemperatureChannelRecord(records.Record, kw_only=True, forbid_unknown_fields=True):
+    """A :class:`TemperatureChannel` in a logger's sidecar."""
+
+    lsb_c: float | None
+    offset_c: float
+    bits: Annotated[int, Meta(ge=2, le=64)] | None
+    decimals: int
+    rate_hz: records.Positive | None
+    noise_c: float
+    source: Literal["die", "housing"]
 
 
 def count_to_celsius(written: np.ndarray, lsb_c: float, offset_c: float = 0.0,
@@ -206,8 +227,29 @@ class ReferenceLog:
         return "C1 (F)" if self.fahrenheit else "C1 (C)"
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types."""
-        return asdict(self)
+        """Plain JSON types, as :class:`ReferenceLogRecord` writes them."""
+        return records.dump(self, ReferenceLogRecord)
+
+    @classmethod
+    def from_dict(cls, data: Any) -> ReferenceLog:
+        """Inverse of :meth:`to_dict` (checked against its record)."""
+        return cls(**records.load(data, ReferenceLogRecord, "reference log"))
+
+
+class ReferenceLogRecord(records.Record, kw_only=True, forbid_unknown_fields=True):
+    """A :class:`ReferenceLog` in a logger's sidecar."""
+
+    every_s: Annotated[float, Meta(ge=60.0)]
+    start: str
+    dates: bool
+    fahrenheit: bool
+    lag_s: records.NonNegative
+    decimals: int
+    blank_fraction: float
+    trailing_rows: int
+    empty_columns: int
+    bom: bool
+    crlf: bool
 
 
 def _fahrenheit(celsius: np.ndarray) -> np.ndarray:

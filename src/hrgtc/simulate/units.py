@@ -49,29 +49,37 @@ import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from functools import cache
-from typing import Any
+from typing import Annotated, Any
+
+from msgspec import Meta
 
 import hrgtc.settings.simulation as _settings
+from hrgtc.core import records
 from hrgtc.core.errors import InputError
 from hrgtc.simulate.laws import (
     BiasLaw,
+    BiasLawRecord,
     FrequencyLaw,
+    FrequencyLawRecord,
     ScaleFactorLaw,
+    ScaleFactorLawRecord,
     ShellFrequencyLaw,
     frequency_law_from_dict,
     table1_frequency_law,
 )
-from hrgtc.simulate.noise_sources import GyroNoise
+from hrgtc.simulate.noise_sources import GyroNoise, GyroNoiseRecord
 from hrgtc.simulate.profiles import AXIS_NAME
 from hrgtc.simulate.shell import FUSED_QUARTZ, Shell
-from hrgtc.simulate.thermal import ThermalNetwork
+from hrgtc.simulate.thermal import ThermalNetwork, ThermalNetworkRecord
 
 __all__ = [
     "AXIS_NAME",
     "DEFAULT_UNIT",
     "EARTH_RATE_DPH",
     "MultiAxisUnit",
+    "MultiAxisUnitRecord",
     "Unit",
+    "UnitRecord",
     "get",
     "names",
     "unit_from_dict",
@@ -127,35 +135,22 @@ class Unit:
             object.__setattr__(self, attribute, value)
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (the simulator's ground truth for a recording)."""
-        out = {
-            "name": self.name,
-            "description": self.description,
-            "thermal": self.thermal.to_dict(),
-            "frequency_law": self.frequency_law.to_dict(),
-            "bias_law": self.bias_law.to_dict(),
-            "gyro_noise": self.gyro_noise.to_dict(),
-            "frequency_noise_hz": self.frequency_noise_hz,
-            "housing_noise_c": self.housing_noise_c,
-        }
-        if self.scale_factor_law is not None:  # absent: the dict of a unit without one
-            out["scale_factor_law"] = self.scale_factor_law.to_dict()
-        return out
+        """Plain JSON types (the simulator's ground truth for a recording), as
+        :class:`UnitRecord` writes them (no ``scale_factor_law`` when None)."""
+        return records.dump(self, UnitRecord, frequency_law=self.frequency_law.to_dict())
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> Unit:
-        """Inverse of :meth:`to_dict`."""
-        law = data.get("scale_factor_law")
+        """Inverse of :meth:`to_dict` (checked against :class:`UnitRecord`)."""
+        values = records.load(data, UnitRecord, "simulated unit")
+        law = values["scale_factor_law"]
         return cls(
-            name=str(data["name"]),
-            description=str(data["description"]),
-            thermal=ThermalNetwork.from_dict(data["thermal"]),
-            frequency_law=frequency_law_from_dict(data["frequency_law"]),
-            bias_law=BiasLaw.from_dict(data["bias_law"]),
-            gyro_noise=GyroNoise.from_dict(data["gyro_noise"]),
-            frequency_noise_hz=float(data["frequency_noise_hz"]),
-            housing_noise_c=float(data["housing_noise_c"]),
-            scale_factor_law=None if law is None else ScaleFactorLaw.from_dict(law),
+            **{**values,
+               "thermal": ThermalNetwork(**values["thermal"]),
+               "frequency_law": frequency_law_from_dict(data["frequency_law"]),
+               "bias_law": BiasLaw(**values["bias_law"]),
+               "gyro_noise": GyroNoise(**values["gyro_noise"]),
+               "scale_factor_law": None if law is None else ScaleFactorLaw(**law)},
         )
 
     def summary(self) -> str:
@@ -254,25 +249,21 @@ class MultiAxisUnit:
         return next(iter(self.axes.values())).thermal
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (the simulator's ground truth for a recording)."""
-        return {
-            "name": self.name,
-            "description": self.description,
-            "axes": {axis: gyro.to_dict() for axis, gyro in self.axes.items()},
-            "input_rate_dph": dict(self.input_rate_dph),
-            "housing_noise_c": self.housing_noise_c,
-        }
+        """Plain JSON types (the simulator's ground truth for a recording), as
+        :class:`MultiAxisUnitRecord` writes them."""
+        return records.dump(self, MultiAxisUnitRecord,
+                            axes={axis: gyro.to_dict() for axis, gyro in self.axes.items()})
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> MultiAxisUnit:
-        """Inverse of :meth:`to_dict`."""
-        return cls(
-            name=str(data["name"]),
-            description=str(data["description"]),
-            axes={str(a): Unit.from_dict(g) for a, g in data["axes"].items()},
-            input_rate_dph=dict(data.get("input_rate_dph") or {}),
-            housing_noise_c=float(data.get("housing_noise_c", 0.01)),
-        )
+        """Inverse of :meth:`to_dict` (checked against :class:`MultiAxisUnitRecord`; an
+        axis's refusal names the axis, which msgspec's place ``$.axes[...]`` does not)."""
+        axes = data.get("axes") if isinstance(data, Mapping) else None
+        for axis, gyro in (axes.items() if isinstance(axes, Mapping) else ()):
+            records.load(gyro, UnitRecord, f"simulated unit's axis {axis!r}")
+        values = records.load(data, MultiAxisUnitRecord, "simulated multi-axis unit")
+        return cls(**{**values, "axes": {str(a): Unit.from_dict(g)
+                                         for a, g in data["axes"].items()}})
 
     def summary(self) -> str:
         """The unit's parameters as text, axis by axis."""
@@ -281,6 +272,32 @@ class MultiAxisUnit:
             lines.append(f"axis {axis} (input {self.input_rate_dph[axis]:g} °/h):")
             lines += ["  " + line for line in gyro.summary().splitlines()]
         return "\n".join(lines)
+
+
+class UnitRecord(records.Record, kw_only=True):
+    """A :class:`Unit` in the simulator's ground truth (a recording's ``unit_parameters``)."""
+
+    name: str
+    description: str
+    thermal: ThermalNetworkRecord
+    frequency_law: FrequencyLawRecord
+    bias_law: BiasLawRecord
+    gyro_noise: GyroNoiseRecord
+    frequency_noise_hz: records.NonNegative
+    housing_noise_c: records.NonNegative
+    scale_factor_law: ScaleFactorLawRecord | None = None
+
+    omit_when_default = ("scale_factor_law",)
+
+
+class MultiAxisUnitRecord(records.Record, kw_only=True):
+    """A :class:`MultiAxisUnit` in the simulator's ground truth."""
+
+    name: str
+    description: str
+    axes: Annotated[dict[str, UnitRecord], Meta(min_length=1)]
+    input_rate_dph: dict[str, float] = records.empty()
+    housing_noise_c: records.NonNegative = 0.01
 
 
 def unit_from_dict(data: Mapping[str, Any]) -> Unit | MultiAxisUnit:
