@@ -133,6 +133,8 @@ def check_renderings(summary: Any, rich_text: str, document: Any) -> int:
                 assert value == pytest.approx(list(figure.interval), rel=1e-12), figure
             elif isinstance(value, list) and isinstance(figure.value, str):
                 assert figure.value == (", ".join(value) or "(none)"), figure
+            elif isinstance(value, str):  # a word or a file
+                assert figure.value == value, figure
             elif value is None:
                 assert isinstance(figure.value, str) or math.isnan(figure.value), figure
             else:
