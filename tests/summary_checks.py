@@ -49,7 +49,8 @@ def text_cells(summary: Any) -> dict[tuple[str, str], str]:
 
 
 def rich_tables(text: str) -> dict[str, tuple[list[str], list[list[str]]]]:
-    """title -> (header, rows) of the rich tables printed (``width`` wide enough)."""
+    """title -> (header, rows) of the rich tables printed (``width`` wide enough); a title
+    is the lines since the table before, joined (rich wraps a title wider than its table)."""
     tables: dict[str, tuple[list[str], list[list[str]]]] = {}
     title, header, rows = "", [], []
     for line in text.splitlines():
@@ -62,7 +63,7 @@ def rich_tables(text: str) -> dict[str, tuple[list[str], list[list[str]]]]:
             tables[title] = (header, rows)
             title, header, rows = "", [], []
         elif stripped and stripped[0] not in "┏┡━─":
-            title = stripped
+            title = f"{title} {stripped}" if title else stripped
     return tables
 
 
@@ -107,7 +108,11 @@ def check_renderings(summary: Any, rich_text: str, document: Any) -> int:
     """Every figure of ``summary`` agrees in the text, the rich tables, the HTML and (where
     its name is a place) ``document``; returns how many figures were places of it."""
     text = text_cells(summary)
-    rich = rich_tables(rich_text)
+    printed = rich_tables(rich_text)
+    # a table's title, after what was printed before it (the summary's title, a wrap)
+    rich = {h: next(table for title, table in printed.items()
+                    if title == h or title.endswith(f" {h}"))
+            for h, figures in summary.sections if figures}
     html = html_tables(summary.html())
     places = 0
     for heading, figures in summary.sections:
@@ -128,6 +133,8 @@ def check_renderings(summary: Any, rich_text: str, document: Any) -> int:
                 assert value == pytest.approx(list(figure.interval), rel=1e-12), figure
             elif isinstance(value, list) and isinstance(figure.value, str):
                 assert figure.value == (", ".join(value) or "(none)"), figure
+            elif isinstance(value, str):  # a word or a file
+                assert figure.value == value, figure
             elif value is None:
                 assert isinstance(figure.value, str) or math.isnan(figure.value), figure
             else:

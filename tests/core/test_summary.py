@@ -32,3 +32,16 @@ def test_missing_values_are_null_in_json_and_a_dash_in_text():
 def test_html_is_escaped():
     page = Summary("<unit>", (("s", (Figure("s.t", "terms", "f<df"),)),)).html()
     assert "&lt;unit&gt;" in page and "<td>f&lt;df</td>" in page
+
+
+def test_a_table_cell_keeps_its_place_and_format_in_json():
+    cell = Figure("table1[0].freq_hz", "plateau 1, natural frequency", 4416.97, "Hz",
+                  spec=".2f", row="0", column="natural frequency")
+    data = cell.to_dict()
+    assert (data["spec"], data["row"], data["column"]) == (".2f", "0", "natural frequency")
+    # a figure that is no cell keeps the keys it always had (the --json documents)
+    assert set(Figure("a.n", "n", 7).to_dict()) == {"name", "label", "value", "unit",
+                                                     "interval", "interval_kind"}
+    # the JSON form gives the same cell back
+    again = Figure(**{k: v for k, v in data.items() if k != "interval"})
+    assert again == cell and again.number() == "4416.97"

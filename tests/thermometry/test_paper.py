@@ -2,13 +2,18 @@
 
 from __future__ import annotations
 
+import io
 import json
 
 import numpy as np
+from rich.console import Console
 from typer.testing import CliRunner
 
 from hrgtc.cli import app
+from hrgtc.cli.summary_tables import print_summary
+from hrgtc.evaluation.calibration_figures import paper_tables
 from hrgtc.thermometry import paper
+from summary_checks import check_renderings
 
 
 def test_fitted_coefficients_rounded_equal_eq18():
@@ -52,3 +57,43 @@ def test_paper_command_tables():
     result = CliRunner().invoke(app, ["paper"])
     assert result.exit_code == 0, result.output
     assert "4424.901" in result.stdout and "-10.058" in result.stdout
+
+
+def _printed_tables() -> str:
+    out = io.StringIO()
+    print_summary(paper_tables(paper.reproduce()), Console(file=out, width=400))
+    return out.getvalue()
+
+
+def test_paper_tables_agree_in_text_rich_html_and_json():
+    """``hrgtc paper`` prints a Summary: its text, rich tables and HTML give each figure the
+    same value, and each figure with a place in ``hrgtc paper --json`` has its value there."""
+    result = paper.reproduce()
+    document = json.loads(json.dumps(result.to_dict(), allow_nan=False))
+    places = check_renderings(paper_tables(result), _printed_tables(), document)
+    assert places == 7 * 4 + 4 * 3  # Table 2's four columns, Eq. (18) three times
+
+
+def test_paper_tables_show_the_printed_digits():
+    tables = paper_tables(paper.reproduce())
+    (table1, eq18, table2, stability) = (h for h, _ in tables.sections)
+    # Table 1 of [1]: temperatures and frequencies as printed
+    assert [r[:2] for r in tables.grid(table1)[1]] == [
+        ["-20", "4416.97"], ["-10", "4421.05"], ["0", "4424.90"], ["10", "4428.56"],
+        ["20", "4432.07"], ["30", "4435.56"], ["40", "4439.20"]]
+    # Table 2 of [1]: the calculated temperatures as printed (10.070, -0.0026)
+    headers, rows = tables.grid(table2)
+    published = [r[headers.index("Table 2 of [1] [°C]")] for r in rows]
+    assert published == ["-19.976", "-10.058", "-0.0026", "10.070", "20.011", "29.924",
+                         "40.031"]
+    assert all(abs(float(r[headers.index("hrgtc − [1] [°C]")])) < 0.001 for r in rows)
+    # Eq. (18) of [1], and the refit rounded to its printed digits, equal to the digit
+    headers, rows = tables.grid(eq18)
+    expected = ["1.528e-05", "-0.0009702", "0.3716", "4424.901"]
+    assert [r[headers.index("Eq. 18 of [1]")] for r in rows] == expected
+    assert [r[headers.index("fitted, printed digits")] for r in rows] == expected
+    # Section 4.2 of [1]: 3.0143 -> 0.5848 °/h
+    assert [row[2] for row in tables.rows() if row[0] == stability] == ["3.0143", "0.5848"]
+    printed = _printed_tables()
+    assert all(text in printed for text in ("4424.901", "-0.0026", "10.070", "3.0143",
+                                            "0.5848"))

@@ -107,14 +107,18 @@ class Figure:
         return f"{self.label}: {self.value_text()}" + (f" {interval}" if interval else "")
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (NaN -> None)."""
+        """Plain JSON types (NaN -> None); ``spec``, ``row`` and ``column`` only when set
+        (a figure that is no table cell keeps the keys it always had)."""
         def clean(v: Any) -> Any:
             return None if isinstance(v, float) and not math.isfinite(v) else v
 
-        return {"name": self.name, "label": self.label, "value": clean(self.value),
-                "unit": self.unit,
-                "interval": None if self.interval is None else [clean(v) for v in self.interval],
-                "interval_kind": self.interval_kind}
+        out = {"name": self.name, "label": self.label, "value": clean(self.value),
+               "unit": self.unit,
+               "interval": None if self.interval is None else [clean(v) for v in self.interval],
+               "interval_kind": self.interval_kind}
+        out.update({key: value for key, value in (("spec", self.spec), ("row", self.row),
+                                                  ("column", self.column)) if value})
+        return out
 
 
 @dataclass(frozen=True)

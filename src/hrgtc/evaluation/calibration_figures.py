@@ -22,8 +22,8 @@ import numpy as np
 from hrgtc.core.summary import Figure, Summary
 from hrgtc.drift.drift_text import drift_notes
 
-__all__ = ["calibration_summary", "instrument_summary", "power_text", "thermometer_equation",
-           "thermometer_tables"]
+__all__ = ["calibration_summary", "instrument_summary", "paper_tables", "power_text",
+           "thermometer_equation", "thermometer_tables"]
 
 #: Headings of :func:`thermometer_tables`' sections.
 TABLE1, TABLE2, PLATEAUS, EQ18 = ("Table 1", "Table 2", "plateaus",
@@ -88,8 +88,6 @@ def thermometer_tables(thermometer: Any, plateaus: Sequence[Any]) -> Summary:
     ``plateaus``: :class:`~hrgtc.thermometry.plateaus.Plateau` s, in the thermometer's
     Table 1 order (``CalibrationResult.plateaus``, a model file's ``plateaus``).
     """
-    from hrgtc.thermometry import paper
-
     title = "the unit's Table 1 and Table 2"
     if thermometer.source == "sensor":
         return Summary(title, notes=("thermometer: the gyro's temperature sensor (no "
@@ -126,23 +124,85 @@ def thermometer_tables(thermometer: Any, plateaus: Sequence[Any]) -> Summary:
                   cell(f"plateaus[{k}].residual_unsettled_c", "unsettled at end",
                        _float(p.residual_unsettled_c), "°C", "+.4f"),
                   cell(f"plateaus[{k}].source", "soak file", source)]
-    printed = dict(enumerate(reversed(paper.EQ18_PRINTED_HIGH_FIRST)))
-    eq18: list[Figure] = []
-    for i, (n, c) in enumerate(zip(range(thermometer.order, -1, -1),
-                                   thermometer.coefficients_high_first, strict=True)):
-        label, row = f"c{n}", str(i)
-        eq18 += [Figure(f"eq18[{i}].coefficient", f"{label}, coefficient", label, row=row,
-                        column="coefficient"),
-                 Figure(f"eq18[{i}].term", f"{label}, term", power_text("T", n) or "const",
-                        row=row, column="term"),
-                 Figure(f"thermometer.coefficients_high_first[{i}]", f"{label}, this unit",
-                        float(c), digits=10, row=row, column="this unit"),
-                 Figure(f"eq18[{i}].printed", f"{label}, Eq. 18 of [1]",
-                        float(printed.get(n, math.nan)), digits=7, row=row,
-                        column="Eq. 18 of [1]")]
+    eq18 = _eq18_cells(thermometer.order, [("thermometer.coefficients_high_first", "this unit",
+                                            10, thermometer.coefficients_high_first)])
     return Summary(title, ((TABLE1, tuple(table1)), (TABLE2, tuple(table2)),
                            (PLATEAUS, tuple(found)), (EQ18, tuple(eq18))),
                    (thermometer_equation(thermometer),))
+
+
+def _eq18_cells(order: int, columns: Sequence[tuple[str, str, int, Sequence[float]]],
+                printed_name: str = "eq18[{i}].printed") -> list[Figure]:
+    """Eq. 18's rows, highest power first: coefficient, term, each of ``columns`` (the name
+    of its values, ``name[i]``; header; significant digits; the values, highest power
+    first) and Eq. (18) of [1] as printed (``printed_name``, ``{i}`` the row)."""
+    from hrgtc.thermometry import paper
+
+    printed = dict(enumerate(reversed(paper.EQ18_PRINTED_HIGH_FIRST)))
+    cells: list[Figure] = []
+    for i, n in enumerate(range(order, -1, -1)):
+        label, row = f"c{n}", str(i)
+        cells += [Figure(f"eq18[{i}].coefficient", f"{label}, coefficient", label, row=row,
+                         column="coefficient"),
+                  Figure(f"eq18[{i}].term", f"{label}, term", power_text("T", n) or "const",
+                         row=row, column="term")]
+        for name, header, digits, values in columns:
+            cells.append(Figure(f"{name}[{i}]", f"{label}, {header}", float(values[i]),
+                                digits=digits, row=row, column=header))
+        cells.append(Figure(printed_name.format(i=i), f"{label}, Eq. 18 of [1]",
+                            float(printed.get(n, math.nan)), digits=7, row=row,
+                            column="Eq. 18 of [1]"))
+    return cells
+
+
+def paper_tables(reproduction: Any) -> Summary:
+    """``hrgtc paper``: Table 1 of [1] with the fit's residuals, Eq. (18) refitted (full
+    precision, rounded to the printed digits, as printed), Table 2 recomputed beside the
+    printed one, and the bias stability Section 4.2 of [1] reports. Each number of [1] is
+    shown to the digit it is printed with; a figure's name is its place in ``hrgtc paper
+    --json`` where it has one (``table2[k].computed_c``, ``eq18.rounded_high_first[i]``).
+    ``reproduction``: :func:`hrgtc.thermometry.paper.reproduce`'s.
+    """
+    from hrgtc.thermometry import paper
+
+    th = reproduction.thermometer
+    table1: list[Figure] = []
+    table2: list[Figure] = []
+    rows = zip(paper.TABLE1_TEMPERATURE_C, paper.TABLE1_FREQUENCY_HZ, paper.TABLE2_CALCULATED_C,
+               paper.TABLE2_CALCULATED_DECIMALS, reproduction.table2_computed_c, strict=True)
+    for k, (t, f, published, decimals, computed) in enumerate(rows):
+        cell = functools.partial(_cell, k)
+        residual = 1e3 * (float(f) - float(th.frequency(float(t))))
+        table1 += [cell(f"table1[{k}].chamber_c", "temperature", float(t), "°C", ".0f"),
+                   cell(f"table1[{k}].freq_hz", "natural frequency", float(f), "Hz",
+                        f".{paper.TABLE1_FREQUENCY_DECIMALS}f"),
+                   cell(f"table1[{k}].residual_mhz", "fit residual", residual, "mHz", "+.1f")]
+        table2 += [cell(f"table2[{k}].frequency_hz", "frequency", float(f), "Hz",
+                        f".{paper.TABLE1_FREQUENCY_DECIMALS}f"),
+                   cell(f"table2[{k}].actual_c", "actual", float(t), "°C", ".0f"),
+                   cell(f"table2[{k}].published_c", "Table 2 of [1]", float(published), "°C",
+                        f".{decimals}f"),
+                   cell(f"table2[{k}].computed_c", "hrgtc", float(computed), "°C", ".4f"),
+                   cell(f"table2[{k}].difference_c", "hrgtc − [1]",
+                        float(computed) - float(published), "°C", "+.4f")]
+    eq18 = _eq18_cells(th.order, [
+        ("eq18.coefficients_high_first", "fitted", 9, reproduction.coefficients_high_first),
+        ("eq18.rounded_high_first", "fitted, printed digits", 7,
+         reproduction.rounded_high_first)], printed_name="eq18.published_high_first[{i}]")
+    stability = (Figure("bias_stability_dph.raw", "raw", paper.BIAS_STABILITY_RAW_DPH, "°/h",
+                        spec=".4f"),
+                 Figure("bias_stability_dph.compensated", "compensated",
+                        paper.BIAS_STABILITY_COMPENSATED_DPH, "°/h", spec=".4f"))
+    return Summary(
+        "Wang et al. (2012), doi:10.3390/s120506434: Table 1 -> Eq. (18) -> Table 2, recomputed",
+        (("Table 1 of [1]: settled frequency of each soak", tuple(table1)),
+         ("Eq. (18): f = c3·T³ + c2·T² + c1·T + c0, least squares on Table 1", tuple(eq18)),
+         ("Table 2 of [1]: temperature from the frequency by inverting the fit",
+          tuple(table2)),
+         ("Section 4.2 of [1]: 1σ bias stability of the cool-down (as printed)", stability)),
+        (thermometer_equation(th),
+         "Section 4.2's bias stability is the paper's, as printed: it needs the paper's "
+         "recordings; hrgtc demo runs the same campaign on the simulated paper-unit."))
 
 
 def _float(value: Any) -> float:

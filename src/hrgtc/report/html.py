@@ -29,7 +29,6 @@ from typing import Any
 import numpy as np
 
 import hrgtc.report.figures as figures
-from hrgtc.core.files import file_sha256
 from hrgtc.core.summary import Summary
 from hrgtc.evaluation import Evaluation
 from hrgtc.evaluation.calibration_figures import (
@@ -43,6 +42,7 @@ from hrgtc.evaluation.calibration_figures import (
 from hrgtc.evaluation.glance_figures import GLANCE, glance_summary
 from hrgtc.model import UnitModel
 from hrgtc.report.figures import SoakTrace
+from hrgtc.report.tables import INPUTS, SOAK_ERROR, provenance_summary, soak_error_summary
 from hrgtc.thermometry import paper
 from hrgtc.thermometry.plateaus import Plateau
 
@@ -144,16 +144,9 @@ def _header(page: _Page, model: UnitModel, title: str, model_path: str | None) -
              f"{datetime.now(UTC).isoformat(timespec='seconds')}.</p>",
              f'<p class="muted">Method and figures after [1] {REFERENCE}, doi:'
              f'<a href="https://doi.org/{DOI}">{DOI}</a>.</p></header>')
-    rows = []
-    for item in prov.get("inputs", []):
-        path = Path(str(item.get("path", "")))
-        digest = str(item.get("sha256", ""))
-        state = "missing" if not path.is_file() else (
-            "unchanged" if file_sha256(path) == digest else "CHANGED since calibration")
-        rows.append((item.get("role", "?"), str(path), digest[:12], state))
-    if rows:
-        page.add(_table(("role", "file", "SHA-256 (first 12)", "on disk now"), rows,
-                            "Model inputs (provenance)"))
+    inputs = provenance_summary(prov)
+    if inputs.sections:
+        page.add(_grid_table(inputs, INPUTS, INPUTS))
     page.add('<nav><ol><li><a href="#settling">Settling of the soaks (Fig. 3)</a></li>'
              '<li><a href="#thermometer">Frequency–temperature fit (Fig. 4, Table 1, Eq. 18)'
              '</a></li><li><a href="#temperature">Temperature from frequency (Fig. 5, '
@@ -275,19 +268,9 @@ def _temperature(page: _Page, table: Sequence[Mapping[str, float]],
                     "Resonator temperature from frequency during each soak, mirrors "
                     "<b>Fig. 5(b)</b> of [1], beside the chamber and (simulated soaks) the true "
                     "resonator temperature.", "temperature from frequency during each soak")
-        rows = []
-        for t in traces:
-            if t.resonator_c is not None:
-                error = t.temperature_c - t.resonator_c
-                last = t.time_s >= t.time_s[-1] - 3600.0
-                rows.append((t.name, _number(np.sqrt(np.nanmean(error**2)), 3),
-                             _number(np.nanmax(np.abs(error)), 3),
-                             _number(np.nanmax(np.abs(error[last])), 3)))
-        if rows:
-            page.add(_table(("soak", "rms error [°C]", "max |error| [°C]",
-                                 "max |error|, last hour [°C]"), rows,
-                                "Temperature from frequency minus the true resonator "
-                                "temperature (block means)"))
+        errors = soak_error_summary(traces)
+        if errors.sections:
+            page.add(_grid_table(errors, SOAK_ERROR, SOAK_ERROR))
     else:
         page.note("No soak recordings: the temperature-vs-time figure (Fig. 5(b)) needs them.")
     page.add("</section>")

@@ -22,6 +22,8 @@ from hrgtc.thermometry import Thermometer, fit
 # Table 1 of [1]: chamber set-point and settled natural frequency of each soak.
 TABLE1_TEMPERATURE_C = np.array([-20.0, -10.0, 0.0, 10.0, 20.0, 30.0, 40.0])
 TABLE1_FREQUENCY_HZ = np.array([4416.97, 4421.05, 4424.90, 4428.56, 4432.07, 4435.56, 4439.20])
+# Decimals Table 1 of [1] prints each frequency with.
+TABLE1_FREQUENCY_DECIMALS = 2
 
 # Eq. (18) of [1] as printed, highest power first: T^3, T^2, T, 1.
 EQ18_PRINTED_HIGH_FIRST = (1.528e-5, -9.702e-4, 0.3716, 4424.901)
@@ -32,6 +34,8 @@ EQ18_PRINTED_SIGNIFICANT_DIGITS = (4, 4, 4, 7)
 TABLE2_FREQUENCY_HZ = TABLE1_FREQUENCY_HZ
 TABLE2_ACTUAL_C = TABLE1_TEMPERATURE_C
 TABLE2_CALCULATED_C = np.array([-19.976, -10.058, -0.0026, 10.070, 20.011, 29.924, 40.031])
+# Decimals Table 2 of [1] prints each calculated temperature with (10.070: three).
+TABLE2_CALCULATED_DECIMALS = (3, 3, 4, 3, 3, 3, 3)
 TABLE2_ERROR_C = np.array([-0.024, 0.0578, 0.0026, -0.070, -0.011, 0.076, -0.031])
 
 # Eq. (22) of [1]: the terms stepwise regression kept.
