@@ -22,6 +22,8 @@ field in one of these classes (docs/architecture.md, "Adding a parameter").
 * :mod:`hrgtc.settings.drift` -- the drift fit (``--window-s``, ``--rate-tau-s``, ...);
 * :mod:`hrgtc.settings.calibration` -- the calibration chain (thermometer order, plateau
   finder, soaks in the drift fit, scale-factor terms, cross-axis terms) and its drift fit;
+* :mod:`hrgtc.settings.inputs` -- what calibration is given beside its recordings (``--aux``,
+  the ``--temp-ref`` log, the ``--holdout-*`` end of the drift file);
 * :mod:`hrgtc.settings.compensation` -- compensation chunks, the evaluation's deviation
   curve, the report's points;
 * :mod:`hrgtc.settings.export` -- the firmware export (prefix, precision, format);
