@@ -18,11 +18,15 @@ from hrgtc.cli.params import _value, option_settings
 from hrgtc.settings import Setting, format_value, settings_of
 from hrgtc.settings.calibration import CalibrationSettings
 from hrgtc.settings.drift import EQ21_TERMS, WARMUP_FACTOR, DriftSettings
+from hrgtc.settings.inputs import CalibrationInputs
 from hrgtc.settings.reading import ReadSettings
 
 DOCS = Path(__file__).resolve().parents[2] / "docs"
 #: The docs page of each table of :data:`hrgtc.cli.options_tables.DOCUMENTED`.
 PAGES = {"calibrate": DOCS / "guide" / "calibrate.md", "reading": DOCS / "guide" / "index.md",
+         "calibrate_inputs": DOCS / "guide" / "calibrate.md",
+         "temperature_reference": DOCS / "real-loggers" / "sensors.md",
+         "holdout": DOCS / "real-loggers" / "time.md",
          "compensate": DOCS / "guide" / "compensate.md",
          "evaluate": DOCS / "guide" / "evaluate.md", "report": DOCS / "guide" / "report.md",
          "export": DOCS / "guide" / "export-c.md", "demo": DOCS / "guide" / "demo.md",
@@ -31,7 +35,8 @@ PAGES = {"calibrate": DOCS / "guide" / "calibrate.md", "reading": DOCS / "guide"
          "simulate": DOCS / "guide" / "simulate.md",
          "simulate_logger": DOCS / "real-loggers" / "simulate.md"}
 #: The commands whose options each settings class generates.
-COMMANDS = {"calibrate": ["calibrate"],
+COMMANDS = {"calibrate": ["calibrate"], "calibrate_inputs": ["calibrate"],
+            "temperature_reference": ["calibrate"], "holdout": ["calibrate"],
             "reading": ["info", "calibrate", "compensate", "evaluate", "report",
                         "fleet calibrate", "fleet evaluate", "fleet report"],
             "compensate": ["compensate"], "evaluate": ["evaluate"], "report": ["report"],
@@ -55,7 +60,9 @@ def _click_option(command: str, setting: Setting):
 
 def test_every_option_has_a_table():
     assert set(DOCUMENTED) == set(PAGES) == set(COMMANDS)
-    assert len(CASES) >= 44  # 16 of calibrate, 16 of reading, 12 of the other commands
+    # 16 of calibrate, 9 of its inputs (again 6 + 2 on their pages), 16 of reading, 12 of
+    # the other commands
+    assert len(CASES) >= 61
 
 
 @pytest.mark.parametrize(("key", "setting"), CASES, ids=[s.option for _, s in CASES])
@@ -67,8 +74,8 @@ def test_help_shows_the_dataclass_default(key, setting):
         # "[default: 32; x>=1]": click adds a number's range after the default
         shown = re.search(r"\[default: (.*?)(; [-\d.]*<?=?x[<>]?=?[-\d.]*)?\]$",
                           " ".join(text.split()))
-        if setting.default is None and setting.default_text is None:
-            assert shown is None
+        if setting.default in (None, ()) and setting.default_text is None:
+            assert shown is None  # not given: none (a repeated option: no item)
         elif isinstance(setting.default, bool) and "/" not in setting.option:
             assert shown is None and setting.default is False  # a flag: off unless given
         elif isinstance(setting.default, bool):
@@ -214,6 +221,51 @@ def test_library_defaults_come_from_the_dataclasses():
     assert issubclass(ReadOptions, ReadSettings)
 
 
+#: The fields of TemperatureReferenceSettings, by the key of TemperatureReference.to_dict.
+REFERENCE_FIELDS = {"reference_log": "path", "reference_columns": "columns",
+                    "reference_unit": "unit", "reference_start": "start", "reference_tz": "tz",
+                    "reference_lag_s": "lag_s"}
+
+
+def test_reference_defaults_are_the_libraries():
+    """What a model file records of a reference log given alone (``--temp-ref LOG``) holds
+    the other fields' defaults; the lag's default text names the library's search range;
+    ``calibrate_instrument`` defaults to no channel, no log and no holdout."""
+    import inspect
+
+    from hrgtc.pipeline.calibration import parse_aux
+    from hrgtc.pipeline.instrument import calibrate_instrument
+    from hrgtc.settings.inputs import TemperatureReferenceSettings
+    from hrgtc.thermometry.reference import (
+        MAX_LAG_S,
+        TemperatureReference,
+        fit_count_map,
+        parse_reference_columns,
+    )
+
+    defaults = TemperatureReferenceSettings(reference_log=Path("log.csv"))
+    recorded = TemperatureReference(
+        defaults.reference_log, parse_reference_columns(list(defaults.reference_columns)),
+        unit=defaults.reference_unit, start=defaults.reference_start,
+        tz=defaults.reference_tz, lag_s=defaults.reference_lag_s).to_dict()
+    library = TemperatureReference("log.csv").to_dict()
+    assert recorded == library
+    assert set(REFERENCE_FIELDS.values()) == set(library)
+    for name, key in REFERENCE_FIELDS.items():
+        value = getattr(defaults, name)
+        expected = {} if value == () else str(value) if isinstance(value, Path) else value
+        assert library[key] == expected, name
+    assert inspect.signature(fit_count_map).parameters["max_lag_s"].default == MAX_LAG_S
+    by_name = {s.name: s for s in settings_of(TemperatureReferenceSettings)}
+    assert by_name["reference_lag_s"].default_text == f"fitted within ±{MAX_LAG_S:g} s"
+    library_defaults = inspect.signature(calibrate_instrument).parameters
+    given = CalibrationInputs()
+    assert parse_aux(given.aux) == dict(library_defaults["aux"].default or {})
+    assert library_defaults["temperature_reference"].default is given.reference.reference_log
+    for name in ("holdout_s", "holdout_fraction"):
+        assert library_defaults[name].default == getattr(given.holdout, name)
+
+
 @pytest.mark.slow
 def test_fresh_model_file_records_the_defaults(paper_campaign, tmp_path):
     """``hrgtc calibrate`` with no option of the fit: the model file's provenance holds
@@ -235,6 +287,13 @@ def test_fresh_model_file_records_the_defaults(paper_campaign, tmp_path):
                     else setting.default)
         assert value == expected, setting.name
     assert recorded["motion"] == ReadSettings.motion
+    given = {s.name: s.default for s in settings_of(CalibrationInputs)}
+    assert set(given) == {"aux", "holdout_s", "holdout_fraction", *REFERENCE_FIELDS}
+    assert recorded["aux"] == dict(given["aux"]) == {}  # () given: no channel
+    assert (recorded["holdout_s"], recorded["holdout_fraction"]) == (
+        given["holdout_s"], given["holdout_fraction"])
+    # no log: no temperature_reference (its fields' defaults: test_reference_defaults_...)
+    assert given["reference_log"] is None and "temperature_reference" not in recorded
     (axis,) = model["axes"].values() if "axes" in model else (model,)
     features = axis["drift"]["settings"]
     assert features["rate_tau_s"] == DriftSettings.rate_tau_s

@@ -142,6 +142,9 @@ def test_the_library_call_gives_the_cli_s_model_with_its_reference_log(tmp_path)
     assert library["provenance"]["settings"]["temperature_reference"] == {
         "path": str(LOG), "columns": {"time_s": "Time", "temperature_c": "C1 (C)"},
         "unit": None, "start": "15:45", "tz": None, "lag_s": None}
+    # and the held-out share of the drift file (--holdout-fraction)
+    settings = library["provenance"]["settings"]
+    assert (settings["holdout_s"], settings["holdout_fraction"]) == (None, 0.4)
 
     with pytest.raises(InputError, match="a temperature map or a reference log"):
         calibrate_instrument([], [RUN], thermometer="sensor", read_options=options,

@@ -20,6 +20,7 @@ from hrgtc.cli.params import settings_options
 from hrgtc.cli.summary_tables import print_summary
 from hrgtc.settings.calibration import CalibrationSettings
 from hrgtc.settings.drift import EQ21_TERMS
+from hrgtc.settings.inputs import CalibrationInputs
 
 if TYPE_CHECKING:
     from hrgtc.pipeline.calibration import CalibrationResult
@@ -44,6 +45,7 @@ def render(result: CalibrationResult) -> None:
 @app.command("calibrate")
 @reading_options
 @settings_options(CalibrationSettings)
+@settings_options(CalibrationInputs, "given")
 def calibrate_command(
     extra_soaks: list[Path] = typer.Argument(
         None, metavar="[SOAK_FILES]...",
@@ -56,10 +58,6 @@ def calibrate_command(
     validate: list[Path] = typer.Option(
         None, "--validate", help="Held-out run: bias stability raw vs compensated."),
     output: Path = typer.Option(..., "-o", "--output", help="Model file to write (JSON)."),
-    aux: list[str] = typer.Option(
-        None, "--aux", metavar="NAME=COLUMN", help="An extra logged channel (drive amplitude, "
-        "quadrature control voltage) as variable a_NAME, centred on its training mean; the "
-        "term a_NAME joins the candidates. compensate/evaluate read the same column."),
     prior: Path = typer.Option(
         None, "--prior", help="Population prior (hrgtc fleet prior): a Bayesian thermometer "
         "fit, so that 2 or 3 soaks suffice."),
@@ -72,39 +70,12 @@ def calibrate_command(
     segments: Path = typer.Option(
         None, "--segments", help="CSV start_s,end_s,input_rate_dph of the rate-table holds, for "
         "files without an input_rate_dph column."),
-    temp_ref: Path = typer.Option(
-        None, "--temp-ref", help="Reference log of the temperature (sparse, e.g. a hand log "
-        "every 5 min) written beside the first --drift run: fits its raw temperature count's "
-        "map to °C (residual printed, the reference's lag fitted), stores it in the model and "
-        "compensation applies it. Columns time_s (seconds, clock times HH:MM[:SS] or dates) "
-        "and temperature_c by default (--temp-ref-col)."),
-    temp_ref_col: list[str] = typer.Option(
-        None, "--temp-ref-col", metavar="NAME=THEIRS", help="The reference log's columns, e.g. "
-        "--temp-ref-col time_s=Time --temp-ref-col 'temperature_c=C1 (C)'."),
-    temp_ref_start: str = typer.Option(
-        None, "--temp-ref-start", metavar="CLOCK", help="Clock time of the recording's t = 0 "
-        "(15:40, or 2020-03-07T15:40:00+01:00) when the log has clock times; default: the "
-        "recording's first time stamp."),
-    temp_ref_unit: str = typer.Option(
-        None, "--temp-ref-unit", metavar="C|F", help="Unit of the reference temperature "
-        "[default: F when its header says (F), °F or degF, else C]."),
-    temp_ref_tz: str = typer.Option(
-        None, "--temp-ref-tz", metavar="ZONE", help="Time zone of naive clock times (+01:00, "
-        "Europe/Berlin) when the other side carries a UTC offset."),
-    temp_ref_lag_s: float = typer.Option(
-        None, "--temp-ref-lag-s", help="The reference's lag behind the sensor [s; default: "
-        "fitted within ±1800 s]."),
-    holdout_s: float = typer.Option(
-        None, "--holdout-s", help="Hold out the last SECONDS of recorded time of the --drift "
-        "file (cut at a segment start: a burst is never split) and validate on it [s]."),
-    holdout_fraction: float = typer.Option(
-        None, "--holdout-fraction", help="Hold out this share of the --drift file's recorded "
-        "time at its end (e.g. 0.25) and validate on it."),
     force: ForceOption = False,
     strict: StrictOption = False,
     json_output: JsonOption = False,
     inputs: ReadOptions | None = None,
     settings: CalibrationSettings | None = None,
+    given: CalibrationInputs | None = None,
 ) -> None:
     """Calibrate a gyro or a whole instrument: soak plateaus -> thermometer (Eq. 18), ramps ->
     drift model (Eq. 22), rate tables -> scale factor; every axis of a multi-axis file.
@@ -130,23 +101,23 @@ def calibrate_command(
     from hrgtc.thermometry.reference import TemperatureReference, parse_reference_columns
 
     inputs = (inputs or ReadOptions()).with_spike_default("drop")
+    given = given or CalibrationInputs()
+    ref = given.reference
 
     soaks = [*(soak or []), *(extra_soaks or [])]
     with library_errors():
         refuse_input(output, [*soaks, *(drift or []), *(validate or []), *(rate_table or []),
-                              *(validate_rate_table or []), prior, segments, temp_ref])
+                              *(validate_rate_table or []), prior, segments, ref.reference_log])
         refuse_existing(output, force)
         check_writable(output, 1e6)  # before the fit, not after it
         stages: dict[str, object] = {}
-        ref_options = {"--temp-ref-col": temp_ref_col, "--temp-ref-start": temp_ref_start,
-                       "--temp-ref-unit": temp_ref_unit, "--temp-ref-tz": temp_ref_tz,
-                       "--temp-ref-lag-s": temp_ref_lag_s}
-        stray = [name for name, value in ref_options.items() if value not in (None, [])]
-        if temp_ref is None and stray:
-            raise fail(f"{stray[0]} describes a reference log: give the log with --temp-ref")
-        reference = None if temp_ref is None else TemperatureReference(
-            temp_ref, parse_reference_columns(temp_ref_col), unit=temp_ref_unit,
-            start=temp_ref_start, tz=temp_ref_tz, lag_s=temp_ref_lag_s)
+        if ref.reference_log is None and ref.described():
+            raise fail(f"{ref.described()[0]} describes a reference log: give the log with "
+                       "--temp-ref")
+        reference = None if ref.reference_log is None else TemperatureReference(
+            ref.reference_log, parse_reference_columns(list(ref.reference_columns)),
+            unit=ref.reference_unit, start=ref.reference_start, tz=ref.reference_tz,
+            lag_s=ref.reference_lag_s)
 
         def progress(stage: str, done: float, total: float) -> None:
             if not json_output and stage not in stages:
@@ -154,8 +125,9 @@ def calibrate_command(
                 error_console.print(f"[dim]… {stage}[/]")
 
         calibration = calibrate_instrument(
-            soaks, drift, validate or (), holdout_s=holdout_s, holdout_fraction=holdout_fraction,
-            settings=settings, aux=parse_aux(aux or []), read_options=inputs,
+            soaks, drift, validate or (), holdout_s=given.holdout.holdout_s,
+            holdout_fraction=given.holdout.holdout_fraction, settings=settings,
+            aux=parse_aux(given.aux), read_options=inputs,
             progress=progress, prior=prior, thermometer=inputs.thermometer,
             rate_tables=rate_table or (), validate_rate_tables=validate_rate_table or (),
             segment_table=segments, temperature_reference=reference,

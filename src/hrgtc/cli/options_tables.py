@@ -21,6 +21,9 @@ from hrgtc.cli.params import option_settings
 #: The settings classes whose options each command generates, by the docs page that lists them.
 DOCUMENTED = {
     "calibrate": ("hrgtc.settings.calibration", "CalibrationSettings"),
+    "calibrate_inputs": ("hrgtc.settings.inputs", "CalibrationInputs"),
+    "temperature_reference": ("hrgtc.settings.inputs", "TemperatureReferenceSettings"),
+    "holdout": ("hrgtc.settings.inputs", "HoldoutSettings"),
     "reading": ("hrgtc.settings.reading", "ReadSettings"),
     "compensate": ("hrgtc.settings.compensation", "CompensateSettings"),
     "evaluate": ("hrgtc.settings.compensation", "EvaluationSettings"),

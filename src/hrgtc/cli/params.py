@@ -45,12 +45,14 @@ def _option_info(setting: Setting, **extra: Any) -> Any:
     """The ``typer.Option`` of one setting: its names, help, default and panel."""
     assert setting.option is not None
     default: Any = setting.default
-    if _is_terms(setting.type) and default is not None:
+    if setting.multiple:  # given once per item; not given: None, the field's ()
+        default = None
+    elif _is_terms(setting.type) and default is not None:
         default = format_value(default)
     show: bool | str = True
     if setting.default_text is not None:
         show = setting.default_text
-    elif setting.default is None:
+    elif setting.default in (None, ()):
         show = False
     if setting.min is not None:  # click's IntRange/FloatRange: "0 is not in the range x>=1"
         extra.setdefault("min", setting.min)
@@ -64,7 +66,9 @@ def _option_info(setting: Setting, **extra: Any) -> Any:
 def option_parameter(setting: Setting) -> inspect.Parameter:
     """The keyword parameter (with its ``typer.Option``) of one setting."""
     annotation: Any = setting.type
-    if _is_terms(setting.type):
+    if setting.multiple:
+        annotation = list[str] | None
+    elif _is_terms(setting.type):
         annotation = str | None
     if setting.choices:  # typer checks a Literal's values and lists them
         annotation = typing.Literal[setting.choices]  # type: ignore[valid-type]
@@ -106,7 +110,10 @@ def split_values(text: str, kind: type = float) -> tuple[Any, ...]:
 
 
 def _value(setting: Setting, value: Any) -> Any:
-    """A command-line value as the settings class takes it (terms: a tuple)."""
+    """A command-line value as the settings class takes it (terms, a repeated option: a
+    tuple)."""
+    if setting.multiple:
+        return tuple(value or ())
     if _is_terms(setting.type) and isinstance(value, str):
         kind = float if "float" in str(setting.type) else str
         return split_values(value, kind)  # a bad number: a usage error naming the value

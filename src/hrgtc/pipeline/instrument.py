@@ -277,7 +277,8 @@ def calibrate_instrument(
     record = provenance(inputs, {**first, "axes": list(axes), "thermometer": thermometer,
                                  "scale_terms": list(scale_terms),
                                  "segment_table": None if segment_table is None
-                                 else str(segment_table), **reference})
+                                 else str(segment_table), "holdout_s": holdout_s,
+                                 "holdout_fraction": holdout_fraction, **reference})
     models = {axis: dataclasses.replace(m, provenance=record) for axis, m in models.items()}
     instrument = InstrumentModel(models, unit, record, None if temperature_map is None
                                  else temperature_map.to_dict())

@@ -22,6 +22,8 @@ field in one of these classes (docs/architecture.md, "Adding a parameter").
 * :mod:`hrgtc.settings.drift` -- the drift fit (``--window-s``, ``--rate-tau-s``, ...);
 * :mod:`hrgtc.settings.calibration` -- the calibration chain (thermometer order, plateau
   finder, soaks in the drift fit, scale-factor terms, cross-axis terms) and its drift fit;
+* :mod:`hrgtc.settings.inputs` -- what calibration is given beside its recordings (``--aux``,
+  the ``--temp-ref`` log, the ``--holdout-*`` end of the drift file);
 * :mod:`hrgtc.settings.compensation` -- compensation chunks, the evaluation's deviation
   curve, the report's points;
 * :mod:`hrgtc.settings.export` -- the firmware export (prefix, precision, format);
@@ -39,7 +41,7 @@ __all__ = ["Setting", "build", "format_value", "setting", "settings_of", "to_dic
 def setting(default: Any, help: str, *, unit: str | None = None, cli: str | None = "",
             choices: tuple[str, ...] | None = None, default_text: str | None = None,
             metavar: str | None = None, panel: str | None = None, min: float | None = None,
-            max: float | None = None) -> Any:
+            max: float | None = None, multiple: bool = False) -> Any:
     """A dataclass field with its default and what the command line and docs say of it.
 
     Parameters
@@ -64,10 +66,13 @@ def setting(default: Any, help: str, *, unit: str | None = None, cli: str | None
     min, max
         The smallest and largest value a number takes (inclusive; None: unbounded): the
         option refuses a value outside, naming the range, and the docs list it.
+    multiple
+        A tuple field whose option is given once per item (``--aux a=x --aux b=y``), not
+        comma separated; its default is ``()``.
     """
     meta = {"help": help, "unit": unit, "cli": cli, "choices": choices,
             "default_text": default_text, "metavar": metavar, "panel": panel,
-            "min": min, "max": max}
+            "min": min, "max": max, "multiple": multiple}
     return dataclasses.field(default=default, metadata=meta)
 
 
@@ -91,6 +96,7 @@ class Setting:
     type: Any
     min: float | None = None
     max: float | None = None
+    multiple: bool = False
 
     @property
     def name(self) -> str:
@@ -101,7 +107,7 @@ class Setting:
         """The default as ``--help`` and the docs show it."""
         if self.default_text is not None:
             return self.default_text
-        return format_value(self.default)
+        return format_value(None if self.default == () else self.default)
 
     def range_text(self) -> str | None:
         """The values a number takes (``"≥ 1"``, ``"0 to 1"``), None when unbounded."""
@@ -155,7 +161,8 @@ def settings_of(cls: type, prefix: tuple[str, ...] = ()) -> list[Setting]:
         option = None if cli is None else (cli or "--" + field.name.replace("_", "-"))
         out.append(Setting((*prefix, field.name), field.default, meta["help"], meta["unit"],
                            option, meta["choices"], meta["default_text"], meta["metavar"],
-                           meta["panel"], kind, meta.get("min"), meta.get("max")))
+                           meta["panel"], kind, meta.get("min"), meta.get("max"),
+                           meta.get("multiple", False)))
     return out
 
 

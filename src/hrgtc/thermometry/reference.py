@@ -46,14 +46,15 @@ import numpy as np
 
 from hrgtc.core import records
 from hrgtc.core.errors import CalibrationError, InputError, RecordingError
+from hrgtc.settings.inputs import MAX_LAG_S
 
 __all__ = ["ReferenceLog", "TemperatureMap", "TemperatureReference", "fit_count_map",
            "parse_clock", "read_reference_log"]
 
 #: Default columns of a reference log, and the ``--temp-ref-col`` names.
 REFERENCE_COLUMNS = ("time_s", "temperature_c")
-#: Largest lag tried either way by default, and its step. [s]
-MAX_LAG_S = 1800.0
+#: Largest lag tried either way by default (``--temp-ref-lag-s``'s default text names it),
+#: and its step. [s]
 LAG_STEP_S = 10.0
 #: Largest time between two count windows a reference point is interpolated across. [s]
 MAX_INTERPOLATION_S = 1800.0
