@@ -37,8 +37,9 @@ def test_each_run_starts_its_own_filter_even_with_a_short_warm_up():
     assert abs(leaked - alone.variables["df"][0]) > 10 * np.std(alone.variables["df"][-20:])
 
 
-def _reference_window_means(rows, chunks):
-    """Window means one segment at a time, the plain way (the definition)."""
+def _reference_window_means(rows, chunks, flush=False):
+    """Window means one segment at a time, the plain way (the definition); ``flush``: the
+    run ends after the chunks (its last partial window kept when long enough)."""
     min_rows = min(rows, min_partial_rows(rows))
     out, carry, dropped = [], None, 0
     for block, breaks, cuts in chunks:
@@ -63,7 +64,33 @@ def _reference_window_means(rows, chunks):
             if complete:
                 out.extend(part[: complete * rows].reshape(complete, rows, -1).mean(axis=1))
             carry = part[complete * rows:]
+    if flush and carry is not None and carry.shape[0]:
+        if carry.shape[0] >= min_rows:
+            out.append(carry.mean(axis=0))
+        else:
+            dropped += carry.shape[0]
     return np.array(out), dropped
+
+
+def _check_against_the_definition(rows, chunks):
+    from hrgtc.drift.windows import _WindowMeans
+
+    means = _WindowMeans(rows)
+    got = [means.partial_fit(block, breaks, cuts) for block, breaks, cuts in chunks]
+    got = [g for g in got if g.shape[0]]
+    got = np.concatenate(got) if got else np.empty((0, 3))
+    expected, dropped = _reference_window_means(rows, chunks)
+    assert got.shape[0] == expected.shape[0]
+    if expected.size:
+        np.testing.assert_allclose(got, expected, rtol=1e-12, atol=1e-9)
+    assert means.partial_dropped_rows == dropped
+    # and the end of the run: the last segment's partial window
+    tail = means.flush()
+    expected, dropped = _reference_window_means(rows, chunks, flush=True)
+    assert got.shape[0] + tail.shape[0] == expected.shape[0]
+    if tail.shape[0]:
+        np.testing.assert_allclose(tail, expected[-1:], rtol=1e-12, atol=1e-9)
+    assert means.partial_dropped_rows == dropped
 
 
 @pytest.mark.parametrize("seed", range(6))
@@ -71,8 +98,6 @@ def test_window_means_of_many_segments_equal_the_plain_definition(seed):
     """Thousands of short segments per chunk (a burst file) are averaged all at once; the
     windows, the partial windows kept at breaks and the rows dropped are those of taking
     one segment at a time."""
-    from hrgtc.drift.windows import _WindowMeans
-
     rng = np.random.default_rng(seed)
     rows = int(rng.integers(3, 40))
     chunks = []
@@ -82,12 +107,44 @@ def test_window_means_of_many_segments_equal_the_plain_definition(seed):
         marks = np.unique(rng.integers(0, n, size=int(rng.integers(0, n // 5 + 2))))
         is_cut = rng.random(marks.size) < 0.3
         chunks.append((block, marks[~is_cut], marks[is_cut]))
-    means = _WindowMeans(rows)
-    got = [means.partial_fit(block, breaks, cuts) for block, breaks, cuts in chunks]
-    got = np.concatenate([g for g in got if g.shape[0]]) if any(g.shape[0] for g in got) \
-        else np.empty((0, 3))
-    expected, dropped = _reference_window_means(rows, chunks)
-    assert got.shape[0] == expected.shape[0]
-    if expected.size:
-        np.testing.assert_allclose(got, expected, rtol=1e-12, atol=1e-9)
-    assert means.partial_dropped_rows == dropped
+    _check_against_the_definition(rows, chunks)
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_window_means_across_short_chunks_equal_the_plain_definition(seed):
+    """Chunks shorter than a window (a window and a segment spanning several chunks, the
+    carry growing over them), empty chunks, breaks and cuts at a chunk's first row, a row
+    marked both (a break), segments shorter than a window, column-major blocks (as
+    window_means builds them): the plain definition still."""
+    rng = np.random.default_rng(1000 + seed)
+    rows = int(rng.integers(1, 12))
+    chunks = []
+    for _ in range(int(rng.integers(1, 30))):
+        n = int(rng.integers(0, 3 * rows + 2))
+        block = rng.normal(size=(n, 3)) + rng.normal(size=3) * 100.0
+        if rng.random() < 0.5:
+            block = np.asfortranarray(block)
+        breaks = np.flatnonzero(rng.random(n) < rng.choice([0.0, 0.05, 0.3]))
+        cuts = np.flatnonzero(rng.random(n) < rng.choice([0.0, 0.05, 0.3]))
+        chunks.append((block, breaks, cuts))
+    _check_against_the_definition(rows, chunks)
+
+
+def test_window_means_of_bursts_one_window_long_each():
+    """The burst bench's case: each burst exactly one window, a break at each burst, in one
+    chunk and split across chunks mid-burst: every burst is one window, nothing dropped."""
+    from hrgtc.drift.windows import _WindowMeans
+
+    rows, bursts = 25, 40
+    block = np.asfortranarray(np.arange(rows * bursts * 2, dtype=float).reshape(-1, 2))
+    starts = np.arange(0, rows * bursts, rows)
+    whole = _WindowMeans(rows)
+    got = whole.partial_fit(block, starts)
+    np.testing.assert_array_equal(got, block.reshape(bursts, rows, 2).mean(axis=1))
+    split = _WindowMeans(rows)
+    cut = rows * 7 + 11
+    parts = [split.partial_fit(block[:cut], starts),
+             split.partial_fit(block[cut:], starts[starts >= cut] - cut)]
+    np.testing.assert_allclose(np.concatenate(parts), got, rtol=1e-15)
+    assert whole.flush().shape[0] == 0 and split.flush().shape[0] == 0
+    assert whole.partial_dropped_rows == split.partial_dropped_rows == 0
