@@ -200,7 +200,7 @@ def detect_motion_reference(
     reasons = {r: np.zeros(n, dtype=bool) for r in REASONS}
     segment = segments_of(time_s)
     if n == 0:
-        return MotionMask(np.zeros(0, dtype=bool), reasons, segment, {}, s)
+        return MotionMask(np.zeros(0, dtype=bool), reasons, np.zeros(0, dtype=bool), {}, s)
     period = _period(time_s, segment)
     prepared = [_prepare(name, values, segment) for name, values in arrays.items()]
     base_rows = _rows(s.baseline_s, period, 8)
@@ -224,7 +224,7 @@ def detect_motion_reference(
         moving[a:b] = _dilate(found[a:b], after, before)
     reasons["guard"] = moving & ~found
     noise = {c.name: c.sigma for c in prepared}
-    return MotionMask(moving, reasons, segment, noise, s)
+    return MotionMask(moving, reasons, np.diff(segment) != 0, noise, s)
 
 
 def _channel_tests(channel: _Channel, t: np.ndarray, values: np.ndarray, base_rows: int,

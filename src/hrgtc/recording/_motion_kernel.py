@@ -171,6 +171,17 @@ def first_not_finite(values: np.ndarray) -> int:
 
 
 @njit(**_JIT)
+def find_breaks(time_s: np.ndarray, gap_s: float) -> np.ndarray:
+    """``breaks[i]``: the step from sample i to i + 1 is longer than ``gap_s`` or does not
+    go forward."""
+    out = np.empty(max(time_s.size - 1, 0), dtype=np.bool_)
+    for i in range(out.size):
+        step = time_s[i + 1] - time_s[i]
+        out[i] = (step > gap_s) | (step <= 0)
+    return out
+
+
+@njit(**_JIT)
 def segment_index(breaks: np.ndarray) -> np.ndarray:
     """Segment of each sample (``breaks[i]``: a new segment at sample i + 1)."""
     out = np.empty(breaks.size + 1, dtype=np.int64)
@@ -185,22 +196,6 @@ def segment_index(breaks: np.ndarray) -> np.ndarray:
     return out
 
 
-@njit(inline="always", **_JIT)
-def _mark_runs(test: np.ndarray, minimum: int, out: np.ndarray) -> None:
-    """OR into ``out`` the runs of at least ``minimum`` consecutive True of ``test``."""
-    m = test.size
-    start = -1
-    for i in range(m + 1):
-        on = i < m and test[i]
-        if on and start < 0:
-            start = i
-        elif not on and start >= 0:
-            if i - start >= minimum:
-                for j in range(start, i):
-                    out[j] = True
-            start = -1
-
-
 @njit(**_JIT)
 def _small_median(values: np.ndarray) -> float:
     """Median of at most five values (an odd count: the middle one)."""
@@ -209,48 +204,72 @@ def _small_median(values: np.ndarray) -> float:
 
 
 @njit(**_JIT)
-def baseline(t: np.ndarray, values: np.ndarray, edges: np.ndarray,
-             baseline_blocks: int) -> np.ndarray:
-    """The robust running level of one segment (``motion._baseline``'s definition)."""
+def _anchors(t: np.ndarray, values: np.ndarray, edges: np.ndarray,
+             baseline_blocks: int) -> tuple:
+    """``(medians, centres, slopes)`` of the baseline of one segment: the running median
+    of the block medians at the block centres, and the slopes between them."""
     blocks = edges.size - 1
-    m = values.size
     medians = np.empty(blocks)
     centres = np.empty(blocks)
     for k in range(blocks):
         a, b = edges[k], edges[k + 1]
         medians[k] = median(values[a:b])
         centres[k] = 0.5 * (t[a] + t[b - 1])
-    if blocks >= 3:
+    if blocks >= 3:  # symmetric windows (shrinking at the ends)
         half = baseline_blocks // 2
         running = np.empty(blocks)
         for k in range(blocks):
             r = min(half, k, blocks - 1 - k)
             running[k] = _small_median(medians[k - r:k + r + 1])
         medians = running
-    level = np.empty(m)
-    if blocks == 1:
-        for i in range(m):
-            level[i] = medians[0]
-        return level
     slopes = (medians[1:] - medians[:-1]) / (centres[1:] - centres[:-1])
-    last = blocks - 1
+    return medians, centres, slopes
+
+
+@njit(inline="always", **_JIT)
+def _level_at(x: float, j: int, medians: np.ndarray, centres: np.ndarray,
+              slopes: np.ndarray) -> tuple:
+    """``(level, j)``: the baseline at time ``x`` (np.interp's arithmetic, the end slopes
+    continued beyond the outer centres); ``j`` the interval of the last call (the times
+    of a segment increase)."""
+    last = medians.size - 1
+    if last == 0:
+        return medians[0], j
+    if x < centres[0]:
+        return medians[0] + slopes[0] * (x - centres[0]), j
+    if x > centres[last]:
+        return medians[last] + slopes[last - 1] * (x - centres[last]), j
+    if x == centres[last]:
+        return medians[last], j
+    while centres[j + 1] <= x:
+        j += 1
+    if centres[j] == x:
+        return medians[j], j
+    return slopes[j] * (x - centres[j]) + medians[j], j
+
+
+@njit(**_JIT)
+def baseline(t: np.ndarray, values: np.ndarray, edges: np.ndarray,
+             baseline_blocks: int) -> np.ndarray:
+    """The robust running level of one segment (``motion._baseline``'s definition)."""
+    medians, centres, slopes = _anchors(t, values, edges, baseline_blocks)
+    level = np.empty(values.size)
     j = 0
-    for i in range(m):  # np.interp's arithmetic; t increases inside a segment
-        x = t[i]
-        if x < centres[0]:  # beyond the outer centres: the end slopes continued
-            level[i] = medians[0] + slopes[0] * (x - centres[0])
-        elif x > centres[last]:
-            level[i] = medians[last] + slopes[last - 1] * (x - centres[last])
-        elif x == centres[last]:
-            level[i] = medians[last]
-        else:
-            while centres[j + 1] <= x:
-                j += 1
-            if centres[j] == x:
-                level[i] = medians[j]
-            else:
-                level[i] = slopes[j] * (x - centres[j]) + medians[j]
+    for i in range(values.size):
+        level[i], j = _level_at(t[i], j, medians, centres, slopes)
     return level
+
+
+@njit(inline="always", **_JIT)
+def _run_step(on: bool, i: int, start: int, minimum: int, out: np.ndarray) -> int:
+    """One sample of a streamed run finder: the start of the current run of True (-1:
+    none); a run of at least ``minimum`` is OR-ed into ``out`` when it ends."""
+    if on:
+        return i if start < 0 else start
+    if start >= 0 and i - start >= minimum:
+        for k in range(start, i):
+            out[k] = True
+    return -1
 
 
 @njit(**_JIT)
@@ -305,26 +324,31 @@ def _variance_test(values: np.ndarray, var_rows: int, centre: float, mad_to_sigm
 @njit(**_JIT)
 def segment_tests(t: np.ndarray, values: np.ndarray, edges: np.ndarray, baseline_blocks: int,
                   var_rows: int, min_run: int, level_limit: float, diff_sigma: float,
-                  diff_centre: float, mad_to_sigma: float, variance_limit: float, clip_limit: float,
-                  extremes: np.ndarray,
-                  clip_samples: int, sigma_positive: bool, level: np.ndarray,
-                  variance: np.ndarray, clipped: np.ndarray) -> None:
+                  diff_centre: float, mad_to_sigma: float, variance_limit: float,
+                  clip_limit: float, extremes: np.ndarray, clip_samples: int,
+                  sigma_positive: bool, level: np.ndarray, variance: np.ndarray,
+                  clipped: np.ndarray) -> None:
     """Level, variance and clipping tests of one channel over one segment, OR-ed into
-    ``level``, ``variance`` and ``clipped`` (views of the segment)."""
+    ``level``, ``variance`` and ``clipped`` (views of the segment). ``extremes``: the
+    channel's maximum and minimum over the whole recording."""
     m = values.size
-    base = baseline(t, values, edges, baseline_blocks)
-    test = np.zeros(m, dtype=np.bool_)
-    if sigma_positive:
-        for i in range(m):
-            test[i] = abs(values[i] - base[i]) > level_limit
-        _mark_runs(test, min_run, level)
+    medians, centres, slopes = _anchors(t, values, edges, baseline_blocks)
+    high, low = extremes[0], extremes[1]
+    j = 0
+    run_level = run_high = run_low = -1
+    for i in range(m + 1):
+        on_level = on_high = on_low = False
+        if i < m:
+            base, j = _level_at(t[i], j, medians, centres, slopes)
+            v = values[i]
+            on_level = sigma_positive and abs(v - base) > level_limit
+            on_high = v == high and abs(high - base) > clip_limit
+            on_low = v == low and abs(low - base) > clip_limit
+        run_level = _run_step(on_level, i, run_level, min_run, level)
+        run_high = _run_step(on_high, i, run_high, clip_samples, clipped)
+        run_low = _run_step(on_low, i, run_low, clip_samples, clipped)
     if diff_sigma > 0 and m >= var_rows:
         _variance_test(values, var_rows, diff_centre, mad_to_sigma, variance_limit, variance)
-    for e in range(extremes.size):
-        extreme = extremes[e]
-        for i in range(m):
-            test[i] = values[i] == extreme and abs(extreme - base[i]) > clip_limit
-        _mark_runs(test, clip_samples, clipped)
 
 
 @njit(**_JIT)

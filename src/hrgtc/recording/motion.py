@@ -33,6 +33,7 @@ The same detector finds the still periods of an in-field update:
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 from collections.abc import Mapping, Sequence
@@ -129,8 +130,9 @@ class MotionMask:
         True where the sample is not at rest (any reason), one per sample.
     reasons
         Reason (:data:`REASONS`) -> boolean mask; a sample may have several.
-    segment
-        Index of the contiguous segment of each sample (a gap starts a new one).
+    breaks
+        ``breaks[i]``: sample i + 1 starts a new contiguous segment (a gap, or a step
+        that does not go forward); :attr:`segment` numbers the segments.
     noise
         Channel -> robust σ of its at-rest noise (sample to sample). [channel unit]
     settings
@@ -139,13 +141,22 @@ class MotionMask:
 
     moving: np.ndarray
     reasons: dict[str, np.ndarray]
-    segment: np.ndarray
+    breaks: np.ndarray
     noise: dict[str, float] = field(default_factory=dict)
     settings: MotionSettings = field(default_factory=MotionSettings)
 
     @property
     def n_samples(self) -> int:
         return int(self.moving.size)
+
+    @functools.cached_property
+    def segment(self) -> np.ndarray:
+        """Index of the contiguous segment of each sample (a gap starts a new one); computed
+        when first asked for (eight bytes a sample)."""
+        segment = np.zeros(self.moving.size, dtype=np.int64)
+        if self.moving.size > 1:
+            np.cumsum(self.breaks, out=segment[1:])
+        return segment
 
     @property
     def n_moving(self) -> int:
@@ -174,7 +185,7 @@ class MotionMask:
         what an in-field update of the bias uses.
         """
         still = self.still.astype(np.int8)
-        breaks = np.flatnonzero(np.diff(self.segment) != 0) + 1
+        breaks = np.flatnonzero(self.breaks) + 1
         edges = np.diff(np.concatenate([[0], still, [0]]))
         starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
         out: list[tuple[int, int]] = []
@@ -239,17 +250,18 @@ def _difference_median(x: np.ndarray, breaks: np.ndarray, mode: int,
     return float(np.median(kernel.gather(x, breaks, mode, centre, count))), count
 
 
-def _breaks(time_s: np.ndarray, gap_factor: float = GAP_FACTOR) -> np.ndarray:
-    """``breaks[i]``: sample i + 1 starts a new segment (a gap or a step not forward)."""
+def _breaks(time_s: np.ndarray, gap_factor: float = GAP_FACTOR) -> tuple[np.ndarray, float]:
+    """``(breaks, period)``: ``breaks[i]`` when sample i + 1 starts a new segment (a step
+    longer than ``gap_factor`` median forward steps, or not forward), and the median
+    forward step (1 if none). [s]"""
     from hrgtc.recording import _motion_kernel as kernel
 
     if time_s.size < 2:
-        return np.zeros(0, dtype=bool)
+        return np.zeros(0, dtype=bool), 1.0
     median, count = _difference_median(time_s, np.zeros(time_s.size - 1, dtype=bool),
                                         kernel.FORWARD)
     period = float(median) if count else 1.0
-    step = np.diff(time_s)
-    return (step > gap_factor * period) | (step <= 0)
+    return kernel.find_breaks(time_s, gap_factor * period), period
 
 
 def segments_of(time_s: np.ndarray, gap_factor: float = GAP_FACTOR) -> np.ndarray:
@@ -262,10 +274,10 @@ def segments_of(time_s: np.ndarray, gap_factor: float = GAP_FACTOR) -> np.ndarra
     """
     from hrgtc.recording import _motion_kernel as kernel
 
-    time_s = np.asarray(time_s, dtype=np.float64)
+    time_s = np.ascontiguousarray(time_s, dtype=np.float64)
     if time_s.size < 2:
         return np.zeros(time_s.size, dtype=np.int64)
-    return kernel.segment_index(_breaks(time_s, gap_factor))
+    return kernel.segment_index(_breaks(time_s, gap_factor)[0])
 
 
 def _bounds(breaks: np.ndarray, n: int) -> list[tuple[int, int]]:
@@ -275,12 +287,14 @@ def _bounds(breaks: np.ndarray, n: int) -> list[tuple[int, int]]:
     return [(int(a), int(b)) for a, b in zip(starts, stops, strict=True)]
 
 
-def _period(time_s: np.ndarray, breaks: np.ndarray) -> float:
-    """Median time step inside the segments. [s]"""
+def _period(time_s: np.ndarray, breaks: np.ndarray, forward: float) -> float:
+    """Median time step inside the segments (``forward``: the median forward step). [s]"""
     from hrgtc.recording import _motion_kernel as kernel
 
     if time_s.size < 2:
         return 1.0
+    if not breaks.any():  # the steps inside segments are all the forward steps
+        return forward
     median, count = _difference_median(time_s, breaks, kernel.INSIDE_FORWARD)
     return float(median) if count else 1.0
 
@@ -397,9 +411,9 @@ def detect_motion(
                              "repair non-finite samples first (--spikes drop)")
     reasons = {r: np.zeros(n, dtype=bool) for r in REASONS}
     if n == 0:
-        return MotionMask(np.zeros(0, dtype=bool), reasons, np.zeros(0, dtype=np.int64), {}, s)
-    breaks = _breaks(time_s)
-    period = _period(time_s, breaks)
+        return MotionMask(np.zeros(0, dtype=bool), reasons, np.zeros(0, dtype=bool), {}, s)
+    breaks, forward = _breaks(time_s)
+    period = _period(time_s, breaks, forward)
     prepared = [_prepare(name, values, breaks) for name, values in arrays.items()]
     base_rows = _rows(s.baseline_s, period, 8)
     var_rows = _rows(s.window_s, period, VARIANCE_MIN_SAMPLES)
@@ -424,7 +438,7 @@ def detect_motion(
         kernel.dilate(found[a:b], after, before, moving[a:b])
     reasons["guard"] = moving & ~found
     noise = {c.name: c.sigma for c in prepared}
-    return MotionMask(moving, reasons, kernel.segment_index(breaks), noise, s)
+    return MotionMask(moving, reasons, breaks, noise, s)
 
 
 def recording_motion(recording: Any, settings: MotionSettings | None = None) -> MotionMask:
