@@ -1,7 +1,7 @@
 """Compiled loops of the at-rest detector (:mod:`hrgtc.recording.motion`).
 
 Each function computes, bit for bit, what the detector's numpy definition computes
-(kept in ``tests/recording/motion_reference.py`` and compared on the fixtures), in one
+(kept in ``tests/motion_reference.py`` and compared on the fixtures), in one
 or two passes over the samples instead of a numpy temporary per step:
 
 - :func:`difference_sample`, :func:`bracket`, :func:`gather`: the pieces of

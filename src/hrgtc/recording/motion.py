@@ -214,7 +214,7 @@ class MotionMask:
 # --------------------------------------------------------------------------- helpers
 # The loops are compiled (hrgtc.recording._motion_kernel, imported when first used: numba
 # is slow to import); their numpy definitions are kept beside the tests that compare
-# them (tests/recording/motion_reference.py).
+# them (tests/motion_reference.py).
 #: Differences sampled to bracket the middle ranks of their median.
 _SAMPLE = 65_536
 
