@@ -12,7 +12,7 @@ or two passes over the samples instead of a numpy temporary per step:
 - :func:`segment_tests`: the level, variance and clipping tests of one channel over
   one segment (block medians, their running median, the interpolated baseline, the
   runs of at least ``min_run`` samples), OR-ed into the reason masks;
-- :func:`dilate`: the guard around each run, inside one segment.
+- :func:`guard`: the guard around each run, inside its segment.
 
 The median of an even count is the mean of the two middle values, ``(a + b) / 2``,
 as ``np.median`` computes it (a zero's sign may differ where both middle values are
@@ -248,18 +248,6 @@ def _level_at(x: float, j: int, medians: np.ndarray, centres: np.ndarray,
     return slopes[j] * (x - centres[j]) + medians[j], j
 
 
-@njit(**_JIT)
-def baseline(t: np.ndarray, values: np.ndarray, edges: np.ndarray,
-             baseline_blocks: int) -> np.ndarray:
-    """The robust running level of one segment (``motion._baseline``'s definition)."""
-    medians, centres, slopes = _anchors(t, values, edges, baseline_blocks)
-    level = np.empty(values.size)
-    j = 0
-    for i in range(values.size):
-        level[i], j = _level_at(t[i], j, medians, centres, slopes)
-    return level
-
-
 @njit(inline="always", **_JIT)
 def _run_step(on: bool, i: int, start: int, minimum: int, out: np.ndarray) -> int:
     """One sample of a streamed run finder: the start of the current run of True (-1:
@@ -352,16 +340,22 @@ def segment_tests(t: np.ndarray, values: np.ndarray, edges: np.ndarray, baseline
 
 
 @njit(**_JIT)
-def dilate(found: np.ndarray, after: int, before: int, out: np.ndarray) -> None:
-    """``out`` = ``found`` with each True run extended ``after`` samples after it and
-    ``before`` before it (one segment)."""
-    m = found.size
-    start = -1
-    for i in range(m + 1):
-        on = i < m and found[i]
-        if on and start < 0:
-            start = i
-        elif not on and start >= 0:
-            for j in range(max(start - before, 0), min(i + after, m)):
-                out[j] = True
-            start = -1
+def guard(level: np.ndarray, variance: np.ndarray, clipped: np.ndarray, accel: np.ndarray,
+          starts: np.ndarray, stops: np.ndarray, after: int, before: int, moving: np.ndarray,
+          guarded: np.ndarray) -> None:
+    """``moving``: the samples found by any test, each run extended by the guard inside its
+    segment (``starts``, ``stops``); ``guarded``: those marked by the guard alone."""
+    for k in range(starts.size):
+        a, b = starts[k], stops[k]
+        start = -1
+        for i in range(a, b + 1):
+            on = i < b and (level[i] | variance[i] | clipped[i] | accel[i])
+            if on and start < 0:
+                start = i
+            elif not on and start >= 0:
+                for j in range(max(start - before, a), min(i + after, b)):
+                    moving[j] = True
+                start = -1
+    for i in range(moving.size):
+        guarded[i] = moving[i] & ~(level[i] | variance[i] | clipped[i] | accel[i])
+

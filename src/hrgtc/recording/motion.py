@@ -431,12 +431,12 @@ def detect_motion(
                 s.variance_ratio * channel.diff_sigma,
                 s.threshold * max(channel.sigma, channel.lsb), extremes, int(s.clip_samples),
                 channel.sigma > 0, *(o[a:b] for o in outputs))
-    found = reasons["level"] | reasons["variance"] | reasons["clipped"] | reasons["accelerometer"]
     after, before = _rows(s.guard_s, period, 0), _rows(s.guard_before_s, period, 0)
     moving = np.zeros(n, dtype=bool)
-    for a, b in bounds:  # a guard never reaches across a gap
-        kernel.dilate(found[a:b], after, before, moving[a:b])
-    reasons["guard"] = moving & ~found
+    starts, stops = (np.array(side, dtype=np.int64) for side in zip(*bounds, strict=True))
+    kernel.guard(reasons["level"], reasons["variance"], reasons["clipped"],  # never across
+                 reasons["accelerometer"], starts, stops, after, before, moving,  # a gap
+                 reasons["guard"])
     noise = {c.name: c.sigma for c in prepared}
     return MotionMask(moving, reasons, breaks, noise, s)
 
