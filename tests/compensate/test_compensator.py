@@ -543,3 +543,22 @@ def test_samples_not_at_rest_are_flagged_as_run_rest_finds_them(unit_model, run,
                            read_options=recording_io.ReadOptions(motion="keep"))
     assert "at_rest" not in recording_io.read(tmp_path / "keep.parquet")
     assert keep.accounting.flagged.get("motion", 0) == 0
+
+
+@pytest.mark.parametrize("column", ["rate_dph", "time_s"])
+def test_a_bad_sample_gets_the_validators_error_whatever_the_motion_pass(unit_model, run,
+                                                                          tmp_path, column):
+    """The at-rest pass reads the file unvalidated (the compensating pass validates it);
+    a bad sample past the first chunk still stops ``compensate`` with the validator's
+    error, the one ``--motion keep`` gives, not the detector's."""
+    values = run[column].copy()
+    values[20_000] = np.nan
+    source = recording_io.write(run.with_columns(**{column: values}), tmp_path / "bad.parquet")
+    errors = []
+    for motion in ("keep", "exclude"):
+        with pytest.raises(RecordingError) as caught:
+            compensate_file(source, tmp_path / f"{motion}.parquet", unit_model, chunk_rows=7_000,
+                            read_options=recording_io.ReadOptions(motion=motion))
+        errors.append(str(caught.value))
+    assert errors[0] == errors[1]
+    assert "20000" in errors[0] or "20,000" in errors[0] or "20001" in errors[0]

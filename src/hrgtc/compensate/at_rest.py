@@ -11,23 +11,29 @@ local. Its level and variance tests compare a sample with the at-rest noise of t
 of block medians centred on it; a streamed flag with a bounded delay would have to
 estimate that noise from the samples seen so far, and its verdicts would differ from
 those of calibration and evaluation on the same file. So, as ``evaluate`` does
-(:func:`hrgtc.evaluation.instrument_pass.evaluate_axes`), one pass reads only the
-detector's columns (time, rate, known input rate, accelerometer axes: at most seven
-floats a sample and axis), :func:`hrgtc.drift.rest.run_rest` marks the samples, and
-the compensating pass then writes the flags: equal to ``run_rest``'s mask by
-construction. The cost: a second reading of those columns and their memory (a
-3-day 1 Hz file: 260,000 rows, 8 MB). ``--motion keep`` skips the pass and writes no
-flag; ``--motion error`` stops at the first moving sample, naming it.
+(:func:`hrgtc.evaluation.instrument_pass.evaluate_axes`), one pass keeps only the
+detector's columns (time, rate, known input rate, accelerometer axes),
+:class:`hrgtc.drift.rest.RestPass` (:func:`~hrgtc.drift.rest.run_rest` a chunk at a
+time) marks the samples, and the compensating pass then writes the flags: equal to
+``run_rest``'s mask by construction.
+
+The cost (issue 20, ``docs/benchmarks.md``): a second reading of the file, without
+its validation (the compensating pass validates every sample; if the unvalidated
+pass fails, the file is read again validated, so a bad file gets the validator's
+error), and the detector's columns in memory, once (time and rate: 16 bytes a sample
+and axis; a 3-day 1 Hz file: 260,000 rows, 4 MB). The detector's loops are compiled
+(:mod:`hrgtc.recording._motion_kernel`). ``--motion keep`` skips the pass and writes
+no flag; ``--motion error`` stops at the first moving sample, naming it.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 
 import numpy as np
 
-from hrgtc.core.errors import InputError
-from hrgtc.drift.rest import run_rest
+from hrgtc.core.errors import CalibrationError, InputError
+from hrgtc.drift.rest import RestPass
 from hrgtc.recording import Recording, axis_view
 from hrgtc.recording.motion import ACCEL_COLUMNS
 
@@ -50,7 +56,8 @@ class RestFlags:
     Parameters
     ----------
     chunks
-        The file's chunks, read with the options of the compensating pass (the same rows).
+        The file's chunks, read with the options of the compensating pass (the same rows),
+        unvalidated.
     axes
         The model's axes (``[""]`` for a single-axis model).
     policy
@@ -58,22 +65,38 @@ class RestFlags:
         ``"keep"`` needs no flags).
     name
         The file's name, for the errors.
+    validated
+        The same chunks, validated: read if reading or marking ``chunks`` fails.
+    rows
+        The file's rows if known (the detector's buffers are sized once).
     """
 
     def __init__(self, chunks: Iterable[Recording], axes: Sequence[str], policy: str,
-                 name: str) -> None:
+                 name: str, validated: Callable[[], Iterable[Recording]] | None = None,
+                 rows: int | None = None) -> None:
         self.axes = tuple(axes)
         self.columns = rest_columns(self.axes)
-        parts: dict[str, list[Recording]] = {axis: [] for axis in self.axes}
-        for chunk in chunks:
-            for axis in self.axes:
-                view = axis_view(chunk, axis) if axis else chunk
-                parts[axis].append(Recording(
-                    {k: view[k] for k in _DETECTOR_COLUMNS if k in view}, view.metadata,
-                    view.source))
-        self.still = {axis: run_rest(views, policy, name=name).keep
-                      for axis, views in parts.items()}
+        self._policy, self._name, self._rows = policy, name, rows
+        try:
+            self.still = self._find(chunks)
+        except CalibrationError:  # --motion error: a moving sample
+            raise
+        except Exception:
+            if validated is None:
+                raise
+            # read unvalidated: a bad file raises what the validated reading raises
+            self.still = self._find(validated())
         self.rows = 0  # rows handed out so far
+
+    def _find(self, chunks: Iterable[Recording]) -> dict[str, np.ndarray]:
+        passes = {axis: RestPass(self._policy, name=self._name, rows=self._rows)
+                  for axis in self.axes}
+        for chunk in chunks:
+            for axis, rest in passes.items():
+                view = axis_view(chunk, axis) if axis else chunk
+                rest.partial_fit(Recording({k: view[k] for k in _DETECTOR_COLUMNS if k in view},
+                                           view.metadata, view.source))
+        return {axis: rest.finish().keep for axis, rest in passes.items()}
 
     @property
     def n_not_at_rest(self) -> int:

@@ -118,15 +118,17 @@ def compensate_file(
     spikes = 0
     try:
         first = next(chunks)
+        total = rec_io.count_rows(source)
         flags = None  # samples not at rest: flagged, found in one pass first (at_rest.py)
         if options.motion != "keep":
-            flags = RestFlags(options.chunks(source), list(getattr(model, "axes", None) or [""]),
-                              options.motion, os.path.basename(os.fspath(source)))
+            flags = RestFlags(rec_io.iter_chunks(source, options, validate=False),
+                              list(getattr(model, "axes", None) or [""]), options.motion,
+                              os.path.basename(os.fspath(source)),
+                              validated=lambda: options.chunks(source), rows=total)
             added = (*added, *flags.columns)
         copies = sensor_copies((*first.names, *added), first.metadata)
         names = tuple(n for n in (*first.names, *added) if n not in copies)
         check_recording_noise(model, first, str(source))
-        total = rec_io.count_rows(source)
         metadata = compensated_metadata(first.metadata, model, drift)
         with rec_io.RecordingWriter(output, metadata, names, force=force) as writer, \
                 ThreadPoolExecutor(max_workers=1) as reading, \

@@ -33,6 +33,7 @@ The same detector finds the still periods of an in-field update:
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 from collections.abc import Mapping, Sequence
@@ -129,8 +130,9 @@ class MotionMask:
         True where the sample is not at rest (any reason), one per sample.
     reasons
         Reason (:data:`REASONS`) -> boolean mask; a sample may have several.
-    segment
-        Index of the contiguous segment of each sample (a gap starts a new one).
+    breaks
+        ``breaks[i]``: sample i + 1 starts a new contiguous segment (a gap, or a step
+        that does not go forward); :attr:`segment` numbers the segments.
     noise
         Channel -> robust σ of its at-rest noise (sample to sample). [channel unit]
     settings
@@ -139,13 +141,22 @@ class MotionMask:
 
     moving: np.ndarray
     reasons: dict[str, np.ndarray]
-    segment: np.ndarray
+    breaks: np.ndarray
     noise: dict[str, float] = field(default_factory=dict)
     settings: MotionSettings = field(default_factory=MotionSettings)
 
     @property
     def n_samples(self) -> int:
         return int(self.moving.size)
+
+    @functools.cached_property
+    def segment(self) -> np.ndarray:
+        """Index of the contiguous segment of each sample (a gap starts a new one); computed
+        when first asked for (eight bytes a sample)."""
+        segment = np.zeros(self.moving.size, dtype=np.int64)
+        if self.moving.size > 1:
+            np.cumsum(self.breaks, out=segment[1:])
+        return segment
 
     @property
     def n_moving(self) -> int:
@@ -174,7 +185,7 @@ class MotionMask:
         what an in-field update of the bias uses.
         """
         still = self.still.astype(np.int8)
-        breaks = np.flatnonzero(np.diff(self.segment) != 0) + 1
+        breaks = np.flatnonzero(self.breaks) + 1
         edges = np.diff(np.concatenate([[0], still, [0]]))
         starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
         out: list[tuple[int, int]] = []
@@ -201,6 +212,58 @@ class MotionMask:
 
 
 # --------------------------------------------------------------------------- helpers
+# The loops are compiled (hrgtc.recording._motion_kernel, imported when first used: numba
+# is slow to import); their numpy definitions are kept beside the tests that compare
+# them (tests/motion_reference.py).
+#: Differences sampled to bracket the middle ranks of their median.
+_SAMPLE = 65_536
+
+
+def _difference_median(x: np.ndarray, breaks: np.ndarray, mode: int,
+                       centre: float = 0.0) -> tuple[float, int]:
+    """``(np.median(d), d.size)`` of the first differences ``d`` of ``x`` that ``mode``
+    selects (``hrgtc.recording._motion_kernel``: forward steps, steps inside segments,
+    or their absolute deviations from ``centre``), without building ``d``: a sorted
+    sample of them brackets the middle ranks, one pass counts what lies below and
+    keeps what lies between, and the middle values are picked from those (exact; all
+    of ``d`` is gathered only if the bracket missed). ``(nan, 0)``: none selected."""
+    from hrgtc.recording import _motion_kernel as kernel
+
+    count, sample = kernel.difference_sample(x, breaks, mode, centre, _SAMPLE)
+    if count == 0:
+        return math.nan, 0
+    middle = ((count - 1) // 2, count // 2)
+    if sample.size >= 64 and count > 4 * sample.size:
+        sample.sort()
+        margin = 4 * math.isqrt(sample.size) + 16
+        lo = sample[max(int(middle[0] / count * sample.size) - margin, 0)]
+        hi = sample[min(int(middle[1] / count * sample.size) + margin, sample.size - 1)]
+        below, equal_lo, between, equal_hi = kernel.bracket(x, breaks, mode, centre, lo, hi)
+        ranks = [k - below for k in middle]
+        if all(0 <= r < equal_lo + between.size + equal_hi for r in ranks):
+            inner = sorted({r - equal_lo for r in ranks if 0 <= r - equal_lo < between.size})
+            if inner:
+                between.partition(inner)
+            picked = [lo if r < equal_lo else between[r - equal_lo]
+                      if r < equal_lo + between.size else hi for r in ranks]
+            return float(np.mean(picked)), count  # np.median's mean of the middle values
+    return float(np.median(kernel.gather(x, breaks, mode, centre, count))), count
+
+
+def _breaks(time_s: np.ndarray, gap_factor: float = GAP_FACTOR) -> tuple[np.ndarray, float]:
+    """``(breaks, period)``: ``breaks[i]`` when sample i + 1 starts a new segment (a step
+    longer than ``gap_factor`` median forward steps, or not forward), and the median
+    forward step (1 if none). [s]"""
+    from hrgtc.recording import _motion_kernel as kernel
+
+    if time_s.size < 2:
+        return np.zeros(0, dtype=bool), 1.0
+    median, count = _difference_median(time_s, np.zeros(time_s.size - 1, dtype=bool),
+                                        kernel.FORWARD)
+    period = float(median) if count else 1.0
+    return kernel.find_breaks(time_s, gap_factor * period), period
+
+
 def segments_of(time_s: np.ndarray, gap_factor: float = GAP_FACTOR) -> np.ndarray:
     """Segment index of each sample: a new segment after each gap or backward step.
 
@@ -209,37 +272,35 @@ def segments_of(time_s: np.ndarray, gap_factor: float = GAP_FACTOR) -> np.ndarra
     >>> segments_of(np.array([0.0, 1.0, 2.0, 10.0, 11.0])).tolist()
     [0, 0, 0, 1, 1]
     """
-    time_s = np.asarray(time_s, dtype=np.float64)
+    from hrgtc.recording import _motion_kernel as kernel
+
+    time_s = np.ascontiguousarray(time_s, dtype=np.float64)
     if time_s.size < 2:
         return np.zeros(time_s.size, dtype=np.int64)
-    step = np.diff(time_s)
-    forward = step[step > 0]
-    period = float(np.median(forward)) if forward.size else 1.0
-    breaks = (step > gap_factor * period) | (step <= 0)
-    return np.concatenate([[0], np.cumsum(breaks)]).astype(np.int64)
+    return kernel.segment_index(_breaks(time_s, gap_factor)[0])
 
 
-def _bounds(segment: np.ndarray) -> list[tuple[int, int]]:
-    edges = np.flatnonzero(np.diff(segment) != 0) + 1
+def _bounds(breaks: np.ndarray, n: int) -> list[tuple[int, int]]:
+    edges = np.flatnonzero(breaks) + 1
     starts = np.concatenate([[0], edges])
-    stops = np.concatenate([edges, [segment.size]])
+    stops = np.concatenate([edges, [n]])
     return [(int(a), int(b)) for a, b in zip(starts, stops, strict=True)]
 
 
-def _period(time_s: np.ndarray, segment: np.ndarray) -> float:
-    step = np.diff(time_s)[np.diff(segment) == 0]
-    step = step[step > 0]
-    return float(np.median(step)) if step.size else 1.0
+def _period(time_s: np.ndarray, breaks: np.ndarray, forward: float) -> float:
+    """Median time step inside the segments (``forward``: the median forward step). [s]"""
+    from hrgtc.recording import _motion_kernel as kernel
+
+    if time_s.size < 2:
+        return 1.0
+    if not breaks.any():  # the steps inside segments are all the forward steps
+        return forward
+    median, count = _difference_median(time_s, breaks, kernel.INSIDE_FORWARD)
+    return float(median) if count else 1.0
 
 
 def _rows(seconds: float, period: float, minimum: int = 1) -> int:
     return max(round(seconds / period), minimum)
-
-
-def _mad(rows: np.ndarray) -> np.ndarray:
-    """Median absolute deviation of each row (no consistency factor)."""
-    centre = np.median(rows, axis=1, keepdims=True)
-    return np.median(np.abs(rows - centre), axis=1)
 
 
 def _resolution(values: np.ndarray) -> float:
@@ -251,51 +312,10 @@ def _resolution(values: np.ndarray) -> float:
     return float(np.min(np.diff(distinct)))
 
 
-def _baseline(time_s: np.ndarray, values: np.ndarray, rows: int) -> np.ndarray:
-    """Robust running level of one segment: block medians, their running median, interpolated."""
-    n = values.size
+def _block_edges(n: int, rows: int) -> np.ndarray:
+    """Edges of the baseline blocks of a segment of ``n`` samples (about ``rows`` each)."""
     blocks = max(n // rows, 1)
-    edges = np.linspace(0, n, blocks + 1).astype(np.int64)
-    medians = np.array([np.median(values[a:b]) for a, b in itertools.pairwise(edges)]) \
-        if blocks < 64 or n % blocks else np.median(values.reshape(blocks, -1), axis=1)
-    centres = np.array([0.5 * (time_s[a] + time_s[b - 1]) for a, b in
-                        itertools.pairwise(edges)])
-    if blocks >= 3:  # symmetric windows (shrinking at the ends): a linear drift is kept
-        half = BASELINE_BLOCKS // 2
-        reach = [min(half, k, blocks - 1 - k) for k in range(blocks)]
-        medians = np.array([np.median(medians[k - r:k + r + 1]) for k, r in enumerate(reach)])
-    level = np.interp(time_s, centres, medians)
-    if blocks >= 2:  # beyond the outer block centres: continue the end slopes
-        head = time_s < centres[0]
-        tail = time_s > centres[-1]
-        slope0 = (medians[1] - medians[0]) / (centres[1] - centres[0])
-        slope1 = (medians[-1] - medians[-2]) / (centres[-1] - centres[-2])
-        level[head] = medians[0] + slope0 * (time_s[head] - centres[0])
-        level[tail] = medians[-1] + slope1 * (time_s[tail] - centres[-1])
-    return level
-
-
-def _runs(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    edges = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
-    return np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
-
-
-def _long_runs(mask: np.ndarray, minimum: int) -> np.ndarray:
-    """``mask`` keeping only runs of at least ``minimum`` consecutive True."""
-    out = np.zeros_like(mask)
-    for a, b in zip(*_runs(mask), strict=True):
-        if b - a >= minimum:
-            out[a:b] = True
-    return out
-
-
-def _dilate(mask: np.ndarray, after: int, before: int) -> np.ndarray:
-    """Extend each True run by ``after`` samples after it and ``before`` before it."""
-    out = mask.copy()
-    n = mask.size
-    for a, b in zip(*_runs(mask), strict=True):
-        out[max(a - before, 0):min(b + after, n)] = True
-    return out
+    return np.linspace(0, n, blocks + 1).astype(np.int64)
 
 
 @dataclass
@@ -305,18 +325,24 @@ class _Channel:
     sigma: float = 0.0
     diff_sigma: float = 0.0
     lsb: float = 0.0
+    diff_centre: float = 0.0  # median first difference inside segments
 
 
-def _prepare(name: str, values: np.ndarray, segment: np.ndarray) -> _Channel:
+def _prepare(name: str, values: np.ndarray, breaks: np.ndarray) -> _Channel:
     """A channel's at-rest noise: robust σ of its first differences inside segments."""
-    same = np.diff(segment) == 0
-    diffs = np.diff(values)[same]
+    from hrgtc.recording import _motion_kernel as kernel
+
     lsb = _resolution(values)
-    diff_sigma = MAD_TO_SIGMA * float(np.median(np.abs(diffs - np.median(diffs)))) \
-        if diffs.size else 0.0
+    diff_sigma = centre = 0.0
+    if values.size >= 2:
+        centre, count = _difference_median(values, breaks, kernel.INSIDE)
+        if count:
+            diff_sigma = MAD_TO_SIGMA * _difference_median(values, breaks, kernel.DEVIATION,
+                                                           centre)[0]
     # white noise: a difference has twice the variance of a sample; the quantum floors it
     sigma = max(diff_sigma / math.sqrt(2.0), lsb)
-    return _Channel(name, values, sigma, max(diff_sigma, lsb), lsb)
+    return _Channel(name, values, sigma, max(diff_sigma, lsb), lsb,
+                    float(centre) if diff_sigma else 0.0)
 
 
 # --------------------------------------------------------------------------- detection
@@ -358,87 +384,61 @@ def detect_motion(
     >>> bool(mask.moving[3000:3030].all()), bool(mask.moving[:2900].any())
     (True, False)
     """
+    from hrgtc.recording import _motion_kernel as kernel
+
     s = settings or MotionSettings()
-    time_s = np.asarray(time_s, dtype=np.float64)
+    time_s = np.ascontiguousarray(time_s, dtype=np.float64)
     if time_s.ndim != 1:
         raise InputError("time_s must be one-dimensional")
     n = time_s.size
     channels = dict(rates) if isinstance(rates, Mapping) else {"rate": rates}
     arrays: dict[str, np.ndarray] = {}
     for name, values in channels.items():
-        arrays[name] = np.asarray(values, dtype=np.float64)
-        if input_rate is not None:
+        arrays[name] = np.ascontiguousarray(values, dtype=np.float64)
+        if input_rate is not None and not (np.ndim(input_rate) == 0 and input_rate == 0):
             arrays[name] = arrays[name] - np.asarray(input_rate, dtype=np.float64)
     accel_names = []
     for name, values in dict(accel or {}).items():
-        arrays[name] = np.asarray(values, dtype=np.float64)
+        arrays[name] = np.ascontiguousarray(values, dtype=np.float64)
         accel_names.append(name)
     for name, values in arrays.items():
         if values.shape != (n,):
             raise InputError(f"motion channel {name!r} has {values.size} samples, time_s has "
                              f"{n}; give one value per sample")
-        if not np.all(np.isfinite(values)):
-            row = int(np.flatnonzero(~np.isfinite(values))[0])
+        row = int(kernel.first_not_finite(values))
+        if row >= 0:
             raise InputError(f"motion channel {name!r} is not finite at row {row}; drop or "
                              "repair non-finite samples first (--spikes drop)")
     reasons = {r: np.zeros(n, dtype=bool) for r in REASONS}
-    segment = segments_of(time_s)
     if n == 0:
-        return MotionMask(np.zeros(0, dtype=bool), reasons, segment, {}, s)
-    period = _period(time_s, segment)
-    prepared = [_prepare(name, values, segment) for name, values in arrays.items()]
+        return MotionMask(np.zeros(0, dtype=bool), reasons, np.zeros(0, dtype=bool), {}, s)
+    breaks, forward = _breaks(time_s)
+    period = _period(time_s, breaks, forward)
+    prepared = [_prepare(name, values, breaks) for name, values in arrays.items()]
     base_rows = _rows(s.baseline_s, period, 8)
     var_rows = _rows(s.window_s, period, VARIANCE_MIN_SAMPLES)
     min_run = max(_rows(s.min_motion_s, period), 2)
-    for a, b in _bounds(segment):
-        t = time_s[a:b]
-        for channel in prepared:
-            level_mask, var_mask, clip_mask = _channel_tests(
-                channel, t, channel.values[a:b], base_rows, var_rows, min_run, s)
-            if channel.name in accel_names:
-                reasons["accelerometer"][a:b] |= level_mask | var_mask | clip_mask
-            else:
-                reasons["level"][a:b] |= level_mask
-                reasons["variance"][a:b] |= var_mask
-                reasons["clipped"][a:b] |= clip_mask
-    found = reasons["level"] | reasons["variance"] | reasons["clipped"] | reasons["accelerometer"]
+    bounds = _bounds(breaks, n)
+    for channel in prepared:
+        extremes = np.array([np.max(channel.values), np.min(channel.values)])
+        outputs = ((reasons["accelerometer"],) * 3 if channel.name in accel_names else
+                   (reasons["level"], reasons["variance"], reasons["clipped"]))
+        for a, b in bounds:
+            kernel.segment_tests(
+                time_s[a:b], channel.values[a:b], _block_edges(b - a, base_rows),
+                BASELINE_BLOCKS, var_rows, min_run, s.threshold * channel.sigma,
+                channel.diff_sigma, channel.diff_centre, MAD_TO_SIGMA,
+                s.variance_ratio * channel.diff_sigma,
+                s.threshold * max(channel.sigma, channel.lsb), extremes, int(s.clip_samples),
+                channel.sigma > 0, *(o[a:b] for o in outputs))
     after, before = _rows(s.guard_s, period, 0), _rows(s.guard_before_s, period, 0)
     moving = np.zeros(n, dtype=bool)
-    for a, b in _bounds(segment):  # a guard never reaches across a gap
-        moving[a:b] = _dilate(found[a:b], after, before)
-    reasons["guard"] = moving & ~found
+    starts, stops = (np.array(side, dtype=np.int64) for side in zip(*bounds, strict=True))
+    kernel.guard(reasons["level"], reasons["variance"], reasons["clipped"],  # never across
+                 reasons["accelerometer"], starts, stops, after, before, moving,  # a gap
+                 reasons["guard"])
     noise = {c.name: c.sigma for c in prepared}
-    return MotionMask(moving, reasons, segment, noise, s)
-
-
-def _channel_tests(channel: _Channel, t: np.ndarray, values: np.ndarray, base_rows: int,
-                   var_rows: int, min_run: int, s: MotionSettings
-                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Level, variance and clipping tests of one channel over one segment."""
-    m = values.size
-    baseline = _baseline(t, values, base_rows)
-    deviation = values - baseline
-    level = np.zeros(m, dtype=bool)
-    if channel.sigma > 0:
-        level = _long_runs(np.abs(deviation) > s.threshold * channel.sigma, min_run)
-    variance = np.zeros(m, dtype=bool)
-    if channel.diff_sigma > 0 and m >= var_rows:
-        # blocks of var_rows samples (the last takes the remainder); differences inside each
-        blocks = m // var_rows
-        d = np.diff(values)
-        whole = d[: (blocks - 1) * var_rows].reshape(blocks - 1, var_rows) if blocks > 1 \
-            else np.empty((0, var_rows))
-        spreads = list(_mad(whole)) if whole.size else []
-        spreads.append(float(_mad(d[(blocks - 1) * var_rows:][None, :])[0]))
-        loud = MAD_TO_SIGMA * np.asarray(spreads) > s.variance_ratio * channel.diff_sigma
-        for k in np.flatnonzero(loud):
-            variance[k * var_rows: m if k == blocks - 1 else (k + 1) * var_rows] = True
-    clipped = np.zeros(m, dtype=bool)
-    for extreme in (float(np.max(channel.values)), float(np.min(channel.values))):
-        at = values == extreme
-        far = np.abs(extreme - baseline) > s.threshold * max(channel.sigma, channel.lsb)
-        clipped |= _long_runs(at & far, int(s.clip_samples))
-    return level, variance, clipped
+    return MotionMask(moving, reasons, breaks, noise, s)
 
 
 def recording_motion(recording: Any, settings: MotionSettings | None = None) -> MotionMask:
