@@ -164,7 +164,7 @@ def parameter_lines(model: UnitModel, plan: CPlan, key: str = "") -> list[str]:
             f"Coefficient of term {k} ({term.name}) on the scaled variables. [deg/h]")
         put(f"coefficient_raw_{k}", drift.coefficients[term.name],
             f"Coefficient of term {k} ({term.name}) on the raw variables, Eq. (22) form. "
-            f"[deg/h per {term.unit}]".replace("·", " "))
+            f"[deg/h per {term.unit_for(th.source)}]".replace("·", " "))
     _scale_factor_lines(model, put)
     put("thermometer_order", th.order, "Order of the thermometer polynomial F(T) (Eq. 18).")
     put("thermometer_centre_c", th.centre_c,
