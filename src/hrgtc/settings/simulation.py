@@ -240,7 +240,8 @@ class LoggerSettings:
     clock_start_s: float | None = setting(
         None, "Clock reading at the first sample after each power-on (--restarts start "
         "from it again: keep it small with restarts, or hrgtc reads a gap, not a reset); "
-        "near 4295 s (2^32 µs) to see a µs wrap early.", unit="s", default_text=per_preset("clock_start_s"), panel=_LOGGER)
+        "near 4295 s (2^32 µs) to see a µs wrap early.", unit="s",
+        default_text=per_preset("clock_start_s"), panel=_LOGGER)
     jitter_ms: float | None = setting(
         None, "Rms Gaussian jitter of each time stamp.", unit="ms",
         default_text=per_preset("jitter_ms"), panel=_LOGGER)
