@@ -200,3 +200,17 @@ def test_a_sensor_model_s_units_are_degrees_not_hertz(tmp_path):
     params = (tmp_path / "fw" / "hrgtc_params.txt").read_text()
     assert "on the raw variables, Eq. (22) form. [deg/h per °C]" in params
     assert "Eq. (22) form. [deg/h per Hz" not in params
+
+
+def test_no_rate_variation_on_a_sensor_is_said_in_degrees_with_the_option(tmp_path):
+    """The first 60 % of the cold test through a 310 s filter has no dT/dt to fit: the
+    refusal said "(..., 0.000124 Hz/s)" on a MEMS gyro and "drop the df terms" without
+    the option that does it."""
+    result = runner.invoke(app, ["calibrate", "--drift", str(RUN), *READ, "--temp-scale",
+                                 "0.00586994", "--temp-offset", "24.2787", "--rate-tau-s",
+                                 "310", "--holdout-fraction", "0.4",
+                                 "-o", str(tmp_path / "pan.json")], terminal_width=200)
+    assert result.exit_code == 2
+    message = " ".join(result.output.split())
+    assert "shows no dT/dt variation (span 0.448 °C/h)" in message, message
+    assert "Hz" not in message and "--terms f,f^2,f^3" in message
