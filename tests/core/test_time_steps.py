@@ -292,3 +292,19 @@ def test_a_duplicated_row_after_a_wrap_or_a_reset_is_found(event):
     assert kinds.get("duplicate") == 3 and "duplicate_time" not in kinds, found.events
     assert np.count_nonzero(~found.keep) == 3
     np.testing.assert_array_equal(time_s[found.keep], raw)
+
+
+def test_a_daylight_saving_step_across_a_burst_logger_s_pause_is_named():
+    """Clocks back by 1 h while a burst logger pauses: the step is -3600 s + the pause
+    (-3544.9 s for 5 s of every 60 s at 10 Hz). It was "a step back in time ... two
+    files joined out of order? split the file", not the missing --tz."""
+    burst = np.arange(50) * 0.1
+    times = np.concatenate([k * 60.0 + burst for k in range(100)])
+    clock = times.copy()
+    clock[times >= 3000.0] -= 3600.0  # 03:00 local comes again at the 51st burst
+    found = classify_time_steps(clock, time_unit="timestamp", naive_clock=True)
+    (event,) = [e for e in found.events if e.kind == "dst"]
+    assert event.row == 2500 and not event.repaired
+    assert "jumps back by 3544.9 s (1 h less a pause of 55.1 s)" in event.message
+    assert "--tz" in event.message
+    assert not [e for e in found.events if e.kind == "backwards"]

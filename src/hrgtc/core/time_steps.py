@@ -237,7 +237,10 @@ def classify_time_steps(time_s: np.ndarray, *, nominal_period_s: float | None = 
             since = row
             cumulative += modulus
             shifts.append((row, cumulative))
-        elif naive_clock and abs(abs(s) - DST_STEP_S) <= limit:
+        elif naive_clock and (abs(abs(s) - DST_STEP_S) <= limit
+                              or -DST_STEP_S - limit <= s < -0.5 * DST_STEP_S):
+            # the clocks going back by 1 h, on a burst logger across a pause (-3600 s +
+            # the pause): the zone is missing, not the file joined out of order
             note("dst", row, detail=s)
             since = row
         elif s <= 0.0:
@@ -312,8 +315,10 @@ def _event(kind: str, row: int, count: int, detail: Any) -> TimeEvent:
                          "dropped", True)
     if kind == "dst":
         sign = "back" if detail < 0 else "forward"
+        jump = ("3600 s" if abs(abs(detail) - DST_STEP_S) <= 1.0 else
+                f"{abs(detail):.6g} s (1 h less a pause of {DST_STEP_S - abs(detail):.6g} s)")
         return TimeEvent(kind, row, count,
-                         f"row {row}: the clock time jumps {sign} by 3600 s ({count} time(s)): "
+                         f"row {row}: the clock time jumps {sign} by {jump} ({count} time(s)): "
                          "daylight saving time in clock times without a time zone; pass --tz "
                          "with the zone they were written in (e.g. --tz Europe/Berlin)", False)
     if kind == "duplicate_time":
