@@ -214,7 +214,7 @@ def _drift_figures(key: str, model: Any, source: str = "resonator") -> tuple[Fig
                        model.residual_std_dph, "°/h", digits=4),
                 Figure(f"{key}.rsquared", "R²", model.rsquared, digits=6),
                 Figure(f"{key}.n_windows", f"windows of {model.window_s:g} s", model.n_windows),
-                Figure(f"{key}.n_samples", "training samples", model.n_samples)]
+                Figure(f"{key}.n_samples", "training samples read", model.n_samples)]
     return tuple(figures)
 
 
