@@ -80,10 +80,12 @@ def offsets_note(model: UnitModel) -> list[str]:
              f"  the training samples, so a unit in one {kind} reads its offset in",
              f"  rate_comp_dph; add it in the firmware if the unit knows its {kind} [deg/h]:"]
     directions = list(drift.orientations or ())
-    for k, (name, value) in enumerate(drift.offsets_dph.items()):
+    for name, value in drift.offsets_dph.items():
         where = ""
-        if kind == "orientation" and k < len(directions):
-            where = " (gravity along " + ", ".join(f"{c:+.3f}" for c in directions[k]) + ")"
+        index = name.removeprefix("orientation ")
+        if index != name and index.isdigit() and int(index) < len(directions):
+            where = (" (gravity along "
+                     + ", ".join(f"{c:+.3f}" for c in directions[int(index)]) + ")")
         lines.append(f"    {name}: {value:+.6g}{where}")
     return [*lines, ""]
 
