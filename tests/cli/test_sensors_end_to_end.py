@@ -178,3 +178,42 @@ def test_reference_options_without_a_reference_log_are_refused(tmp_path):
                                  "15:45", "-o", str(tmp_path / "m.json")])
     assert result.exit_code == 2
     assert "--temp-ref-start describes a reference log" in result.output
+
+
+def test_a_sensor_model_s_units_are_degrees_not_hertz(tmp_path):
+    """On a MEMS gyro f is T in °C and df is dT/dt in °C/s: the coefficient table, the
+    quantisation warning and the parameter file said "°/h per Hz", "freq_hz moves in
+    steps of 0.00587 Hz" and "[deg/h per Hz]" (while the equation line said °C)."""
+    scaled = [*READ, "--temp-scale", "0.00586994", "--temp-offset", "24.2787"]
+    with pytest.warns(Warning) as caught:
+        result = runner.invoke(app, ["calibrate", "--drift", str(RUN), *scaled,
+                                     "--rate-tau-s", "1", "--window-s", "5",
+                                     "-o", str(tmp_path / "pan.json")], terminal_width=200)
+    assert result.exit_code == 0, result.output
+    out = " ".join(result.output.split())
+    assert "°/h per °C" in out and "°/h per °C/s" in out  # f on y, df on y (the data's)
+    assert "per Hz" not in out and "(Hz)" not in out
+    messages = [str(w.message) for w in caught]
+    steps = [m for m in messages if "moves in steps of" in m]
+    assert steps and all("temperature_c moves in steps of 0.00587 °C" in m for m in steps)
+    assert not any("freq_hz" in m or " Hz/s" in m for m in steps)
+    done = runner.invoke(app, ["export-c", str(tmp_path / "pan.json"), "--format", "params",
+                               "-o", str(tmp_path / "fw")])
+    assert done.exit_code == 0, done.output
+    params = (tmp_path / "fw" / "hrgtc_params.txt").read_text()
+    assert "on the raw variables, Eq. (22) form. [deg/h per °C]" in params
+    assert "Eq. (22) form. [deg/h per Hz" not in params
+
+
+def test_no_rate_variation_on_a_sensor_is_said_in_degrees_with_the_option(tmp_path):
+    """The first 60 % of the cold test through a 310 s filter has no dT/dt to fit: the
+    refusal said "(..., 0.000124 Hz/s)" on a MEMS gyro and "drop the df terms" without
+    the option that does it."""
+    result = runner.invoke(app, ["calibrate", "--drift", str(RUN), *READ, "--temp-scale",
+                                 "0.00586994", "--temp-offset", "24.2787", "--rate-tau-s",
+                                 "310", "--holdout-fraction", "0.4",
+                                 "-o", str(tmp_path / "pan.json")], terminal_width=200)
+    assert result.exit_code == 2
+    message = " ".join(result.output.split())
+    assert "shows no dT/dt variation (span 0.448 °C/h)" in message, message
+    assert "Hz" not in message and "--terms f,f^2,f^3" in message

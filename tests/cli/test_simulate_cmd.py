@@ -167,3 +167,19 @@ def test_ratetable_on_imu3_writes_per_axis_columns(tmp_path):
     turning = {a: values[:, header.index(f"input_rate_dph_{a}")] > 1000.0 for a in "xyz"}
     assert [int(np.flatnonzero(turning[a])[0]) for a in "xyz"] == [72, 82, 92]
     assert all(turning[a].sum() == 10 for a in "xyz")
+
+
+@pytest.mark.parametrize("logger", ["pan-cold", "fridge-3day"])
+def test_a_preset_refuses_profile_options_it_would_ignore(tmp_path, logger):
+    # --hours with a preset and no --profile used to be dropped in silence (the preset's
+    # own 2 h / 72 h program was written); now it says what to pass.
+    code, _, err = run("--logger", logger, "--hours", "0.01", "--rate-hz", "1",
+                       "-o", str(tmp_path / "x.csv"))
+    assert code == 2
+    assert "--hours" in err and "--profile" in err
+    assert not (tmp_path / "x.csv").exists()
+    code, _, err = run("--logger", logger, "--hours", "0.1", "--profile", "constant",
+                          "--rate-hz", "1", "--spikes", "0", "-o", str(tmp_path / "y.csv"))
+    assert code == 0, err
+    truth = json.loads((tmp_path / "y.truth.json").read_text())
+    assert truth["chamber_program"]["segments"][-1]["hold_h"] == 0.1

@@ -267,3 +267,44 @@ def test_a_one_hour_pause_in_clock_times_with_their_zone_is_a_gap(tmp_path):
         else:
             run = read(path, **options)
             assert run.time_s[100] - run.time_s[99] == 3601.0
+
+
+@pytest.mark.parametrize("event", ["wrap", "reset"])
+def test_a_duplicated_row_after_a_wrap_or_a_reset_is_found(event):
+    """Rows sent twice after a µs counter wrapped (or the logger restarted) were looked up
+    by a binary search over the whole, no longer increasing, file: not found, they stayed
+    as "duplicate time" errors (`hrgtc simulate --time-unit us --counter-bits 32
+    --restarts 5000 --duplicates 4`: 1 of 4 dropped, calibrate refused the file)."""
+    period = 0.2
+    true_s = 3000.0 + period * np.arange(8000)  # crosses 2^32 µs = 4294.97 s at row 6475
+    if event == "wrap":
+        raw = np.mod(np.round(true_s * 1e6), 2.0**32) / 1e6
+    else:  # a reset at row 6000: the clock starts again from 0.2 s
+        raw = true_s.copy()
+        raw[6000:] = period * (1 + np.arange(2000))
+    rng = np.random.default_rng(1)
+    values = rng.normal(size=(raw.size, 2))
+    copies = [6800, 7200, 7900]  # each row written again right after itself
+    time_s = np.insert(raw, [c + 1 for c in copies], raw[copies])
+    rows = np.insert(values, [c + 1 for c in copies], values[copies], axis=0)
+    found = classify_time_steps(time_s, time_unit="us", values=rows)
+    kinds = {e.kind: e.count for e in found.events}
+    assert kinds.get("duplicate") == 3 and "duplicate_time" not in kinds, found.events
+    assert np.count_nonzero(~found.keep) == 3
+    np.testing.assert_array_equal(time_s[found.keep], raw)
+
+
+def test_a_daylight_saving_step_across_a_burst_logger_s_pause_is_named():
+    """Clocks back by 1 h while a burst logger pauses: the step is -3600 s + the pause
+    (-3544.9 s for 5 s of every 60 s at 10 Hz). It was "a step back in time ... two
+    files joined out of order? split the file", not the missing --tz."""
+    burst = np.arange(50) * 0.1
+    times = np.concatenate([k * 60.0 + burst for k in range(100)])
+    clock = times.copy()
+    clock[times >= 3000.0] -= 3600.0  # 03:00 local comes again at the 51st burst
+    found = classify_time_steps(clock, time_unit="timestamp", naive_clock=True)
+    (event,) = [e for e in found.events if e.kind == "dst"]
+    assert event.row == 2500 and not event.repaired
+    assert "jumps back by 3544.9 s (1 h less a pause of 55.1 s)" in event.message
+    assert "--tz" in event.message
+    assert not [e for e in found.events if e.kind == "backwards"]

@@ -90,3 +90,23 @@ def test_the_pan_cold_test_triggers_both_warnings_where_it_should():
     at_1 = rate_filter_problems(time_s, levels, 1.0, units={"temp": "counts"})
     assert len(at_1) == 2 and "temp moves in steps of 1 counts" in at_1[1]
     assert rate_filter_problems(time_s, levels, 310.0, units={"temp": "counts"}) == []
+
+
+def test_a_sensor_s_temperature_is_named_as_such_in_degrees():
+    # --thermometer sensor fills freq_hz with the temperature column: the message names
+    # temperature_c in °C, not freq_hz in Hz.
+    t = np.arange(7200.0)
+    level = np.round((21.5 - 12.0 * t / 7200.0) / 0.1) * 0.1
+    (sensor,) = rate_filter_problems(t, {"freq_hz": level}, 10.0, thermometer_source="sensor")
+    assert "temperature_c moves in steps of 0.1 °C" in sensor and "°C/s" in sensor
+    assert "freq_hz" not in sensor and "Hz" not in sensor
+    (resonator,) = rate_filter_problems(t, {"freq_hz": level}, 10.0)
+    assert "freq_hz moves in steps of 0.1 Hz" in resonator
+
+
+def test_a_term_s_unit_follows_the_thermometer():
+    from hrgtc.drift.features import parse_terms
+
+    (term,) = parse_terms(["f^2*df"])
+    assert term.unit == term.unit_for("resonator") == "(Hz)^2·Hz/s"
+    assert term.unit_for("sensor") == "(°C)^2·°C/s"

@@ -188,3 +188,14 @@ def test_the_reports_calibration_tables_show_the_summarys_figures(result):
             shown += 1
     assert shown > 20
 
+
+
+def test_the_training_sample_count_says_it_is_what_was_read(result):
+    """The table's "training samples" was the samples read (181439 on a 3-day fridge
+    run) right above the accounting's "181140 used": named "read", it is the accounting's
+    first figure."""
+    summary = result.summary(warnings=False)
+    (figure,) = [f for _, figures in summary.sections for f in figures
+                 if f.name == "drift.n_samples"]
+    assert figure.label == "training samples read"
+    assert figure.value == result.model.drift.accounting.read

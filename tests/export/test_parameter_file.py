@@ -270,3 +270,36 @@ def test_params_export_of_every_model_the_demo_writes(paper_campaign, imu_campai
         p = parse((tmp_path / path.stem / "hrgtc_params.txt").read_text())
         keys = [k for k in p if k.endswith("range_g_high")]
         assert keys, "the gradient's range is written"
+
+
+def test_exports_say_the_orientation_offsets_they_do_not_apply(tmp_path):
+    """A model fitted with --offsets orientation (a MEMS unit turned between still
+    periods): compensate adds each sample's orientation offset (from its accelerometer),
+    the C code and the parameter file apply none, and said nothing of it (a firmware
+    user lost up to 400 °/h in silence on the fridge-3day logger)."""
+    import dataclasses
+    from pathlib import Path
+
+    from typer.testing import CliRunner
+
+    from hrgtc.cli import app
+    from hrgtc.model import load_model, save_model
+
+    golden = (Path(__file__).parents[1] / "data" / "golden-models" / "v2"
+              / "unit-sensor-thermometer-ee60050.json")
+    model = load_model(golden)
+    offsets = {"orientation 0": 136.5, "orientation 1": -96.9, "orientation 2": -399.6}
+    turned = dataclasses.replace(model, drift=dataclasses.replace(
+        model.drift, offset_mode="orientation", offsets_dph=offsets,
+        orientations=((0.0, 0.0, 1.0), (0.0, 1.0, 0.0), (-1.0, 0.0, 0.0))))
+    path = save_model(turned, tmp_path / "turned.json")
+    for fmt, name in (("c", "hrgtc_model.h"), ("params", "hrgtc_params.txt")):
+        done = CliRunner().invoke(app, ["export-c", str(path), "--format", fmt,
+                                        "-o", str(tmp_path / fmt)])
+        assert done.exit_code == 0, done.output
+        text = (tmp_path / fmt / name).read_text()
+        assert "OFFSETS NOT APPLIED HERE (calibrate --offsets orientation)" in text, name
+        assert "orientation 2: -399.6 (gravity along -1.000, +0.000, +0.000)" in text, name
+    plain = CliRunner().invoke(app, ["export-c", str(golden), "-o", str(tmp_path / "plain")])
+    assert plain.exit_code == 0
+    assert "OFFSETS" not in (tmp_path / "plain" / "hrgtc_model.h").read_text()

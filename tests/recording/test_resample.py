@@ -118,3 +118,29 @@ def test_a_decimated_temperature_channel_gives_the_same_model(tmp_path):
     error_full = np.sqrt(np.mean((bias_full[late] - truth) ** 2))
     assert np.sqrt(np.mean((bias_held[late] - truth) ** 2)) < 1.5 * error_full
     assert abs(model_held.residual_std_dph / model_full.residual_std_dph - 1.0) < 0.10
+
+
+@pytest.mark.parametrize("chunk_rows", [None, 333])
+def test_one_column_under_two_names_is_filled_under_both_and_reported_once(chunk_rows):
+    """--thermometer sensor reads the temperature column as freq_hz_<axis> too (the same
+    array): each name is filled, the column reported once by its own name (before: a
+    second warning named 'freq_hz_x', the sensor's internal name)."""
+    arrays, truth = file_rows()
+    temperature = arrays.pop("housing_c")
+    arrays.update(temperature_c=temperature, freq_hz_x=temperature, freq_hz_y=temperature)
+    if chunk_rows is None:
+        out, slow = fill_slow_channels(arrays, "hold")
+    else:
+        slow = SlowChannels("hold")
+        parts = [slow.fill({k: v[s:s + chunk_rows] for k, v in arrays.items()}, s)
+                 for s in range(0, 1000, chunk_rows)]
+        out = {k: np.concatenate([p[k] for p in parts]) for k in arrays}
+    held = truth[(np.arange(1000) // 10) * 10]
+    for name in ("temperature_c", "freq_hz_x", "freq_hz_y"):
+        np.testing.assert_array_equal(out[name], held)
+    (line,) = slow.summary()
+    assert "column 'temperature_c'" in line and "900 cells filled" in line
+    assert [c["column"] for c in slow.to_dict()["channels"]] == ["temperature_c"]
+    with pytest.warns(SlowChannelWarning) as caught:
+        slow.warn()
+    assert len(caught) == 1

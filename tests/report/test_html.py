@@ -127,6 +127,38 @@ def test_every_section_and_figure(report):
     assert "10.3390/s120506434" in text and "Sensors" in text
     assert "3.0143" in text and "0.5848" in text  # Section 4.2 of [1], beside the unit's numbers
     assert "Stepwise steps" in page.tables and "Newey" in text
+    assert _dead_links(text, page) == []
+
+
+def _dead_links(text: str, page: _Page) -> list[str]:
+    """In-page links (href="#id") with no element of that id."""
+    return [h for h in re.findall(r'href="#([^"]*)"', text) if h not in page.ids]
+
+
+def test_a_sensor_instrument_s_contents_link_to_sections_it_has(tmp_path):
+    """A three-axis MEMS gyro (the real cold test): no soaks, no frequency, sections per axis
+    (x-runs, ...). The contents listed "Settling of the soaks", "Frequency–temperature fit"
+    and "Temperature from frequency" and linked to #settling ... #model, none of which
+    existed (issue 20, a new user's report)."""
+    data = Path(__file__).parents[1] / "data" / "pan-cold-test" / "pan_tvc_cold_2020-03-07.csv"
+    read = ["--thermometer", "sensor", "--time-unit", "ms", "--rate-unit", "rad/s", "--gaps",
+            "bridge", "--temp-scale", "0.00586994", "--temp-offset", "24.2787", "--col",
+            "time_s=time (ms),rate_dph_x=gyrox rad/s,rate_dph_y=gyroy rad/s,"
+            "rate_dph_z=gyroz rad/s,temperature_c=temp"]
+    runner = CliRunner()
+    done = runner.invoke(app, ["calibrate", "--drift", str(data), *read, "--rate-tau-s", "310",
+                               "-o", str(tmp_path / "pan.json")])
+    assert done.exit_code == 0, done.output
+    done = runner.invoke(app, ["report", "--model", str(tmp_path / "pan.json"), str(data),
+                               *read, "-o", str(tmp_path / "pan.html")])
+    assert done.exit_code == 0, done.output
+    text = (tmp_path / "pan.html").read_text(encoding="utf-8")
+    page = _Page(text)
+    assert _dead_links(text, page) == []
+    assert "x-runs" in page.ids and "x-model" in page.ids
+    for absent in ("Settling of the soaks", "Frequency–temperature fit",
+                   "Temperature from frequency"):
+        assert absent not in text
 
 
 def test_tables_hold_the_units_plateaus(report):

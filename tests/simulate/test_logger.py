@@ -102,6 +102,10 @@ def test_wall_clock_timestamps_step_at_daylight_saving(tmp_path):
     assert stamps[i - 1] == "2021-03-28T01:59:59.000" and stamps[i] == "2021-03-28T03:00:00.000"
     assert np.array_equal(run.truth["clock_s"], run.truth["time_s"])  # no reset at restart
     assert "--time-unit" in run.info["hrgtc_options"] and "timestamp" in run.info["hrgtc_options"]
+    # the zone the clock times were written in, or the reader sees a 1 h step
+    # (the suggested reading options left it out)
+    options = run.info["hrgtc_options"]
+    assert options[options.index("--tz") + 1] == "Europe/Berlin"
     text = csv_text(run.columns, run.kinds).splitlines()
     assert text[1].startswith("2021-03-28T01:59:00.000,")
     with pytest.raises(InputError, match="CSV only"):

@@ -84,6 +84,7 @@ def simulate_command(
         unit = settings.unit or (chosen.unit if chosen is not None else DEFAULT_UNIT)
         gyro = units.get(unit)
         if chosen is not None and settings.profile is None:
+            _no_profile_options_without_profile(logger, settings)
             runs = [chosen.profile]
         else:
             runs = standard_profiles.build(
@@ -140,3 +141,20 @@ def simulate_command(
         table.add_row(w.path, f"{w.rows:,}", w.profile)
     console.print(table)
 
+
+
+def _no_profile_options_without_profile(logger: str, settings: SimulationSettings) -> None:
+    """Refuse profile options a preset's own chamber program would silently ignore."""
+    from hrgtc.core.errors import InputError
+
+    flags = {"setpoints_c": "--setpoints", "hours": "--hours", "start_c": "--start",
+             "end_c": "--end", "temperature_c": "--temperature",
+             "ramp_c_per_min": "--ramp-rate", "rates_dps": "--rates",
+             "rate_hold_s": "--rate-hold-s", "single_file": "--single-file"}
+    options = settings.profile_options()
+    given = [flag for name, flag in flags.items() if options.get(name) not in (None, False)]
+    if given:
+        raise InputError(
+            f"--logger {logger} runs its own chamber program, which {', '.join(given)} "
+            f"would not change; pass --profile (e.g. --profile cooldown or --profile "
+            f"constant) to replace the program, or leave {', '.join(given)} out")

@@ -186,7 +186,8 @@ class Compensator:
                 stop = int(head[0]) if head.size else len(chunk)
                 warn_rate_filter(rate_filter_problems(
                     chunk.time_s[:stop], {k: v[:stop] for k, v in levels.items()},
-                    self.drift.settings.rate_tau_s, where=chunk.source or ""))
+                    self.drift.settings.rate_tau_s, where=chunk.source or "",
+                    thermometer_source=self.model.thermometer.source))
         restart = None
         cuts: list[int] = []
         if self.gaps == "split" and "time_s" in chunk:

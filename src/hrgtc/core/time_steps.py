@@ -216,6 +216,7 @@ def classify_time_steps(time_s: np.ndarray, *, nominal_period_s: float | None = 
             odd |= forward
     cumulative = 0.0
     shifts: list[tuple[int, float]] = []  # (row, offset from that row on)
+    since = 0  # first row of the raw times' current increasing stretch (after a wrap, ...)
     for i in np.flatnonzero(odd):
         row = int(i) + 1
         if not keep[row]:
@@ -233,18 +234,24 @@ def classify_time_steps(time_s: np.ndarray, *, nominal_period_s: float | None = 
         modulus = next((m for m in moduli if 0.0 < s + m <= max(limit, WRAP_GAP * m)), None)
         if modulus is not None and goes_on:
             note("wrap", row, detail=modulus)
+            since = row
             cumulative += modulus
             shifts.append((row, cumulative))
-        elif naive_clock and abs(abs(s) - DST_STEP_S) <= limit:
+        elif naive_clock and (abs(abs(s) - DST_STEP_S) <= limit
+                              or -DST_STEP_S - limit <= s < -0.5 * DST_STEP_S):
+            # the clocks going back by 1 h, on a burst logger across a pause (-3600 s +
+            # the pause): the zone is missing, not the file joined out of order
             note("dst", row, detail=s)
+            since = row
         elif s <= 0.0:
-            count = _duplicate_block(raw, keep, values, row)
+            count = _duplicate_block(raw, keep, values, row, since)
             if count:
                 note("duplicate", row, count)
             elif s == 0.0:
                 note("duplicate_time", row)
             elif goes_on and before > 0.0 and -limit <= after <= RESET_FRACTION * before:
                 note("reset", row)
+                since = row
                 restarts.append(row)
                 # follow the earlier run after a gap of 10 gap limits (its length is unknown)
                 cumulative += before - after + 10.0 * limit
@@ -268,14 +275,19 @@ def classify_time_steps(time_s: np.ndarray, *, nominal_period_s: float | None = 
 
 
 def _duplicate_block(raw: np.ndarray, keep: np.ndarray, values: np.ndarray | None,
-                     row: int) -> int:
-    """Rows from ``row`` on that repeat earlier rows (same time, same values); marks them."""
+                     row: int, since: int = 0) -> int:
+    """Rows from ``row`` on that repeat earlier rows (same time, same values); marks them.
+
+    The earlier rows are looked up in ``raw[since:row]``, the stretch since the last wrap,
+    reset or clock jump, where the raw times increase (a binary search over the whole
+    file, whose µs counter wrapped or restarted, finds the wrong rows).
+    """
     end = row
     before = raw[row - 1]
     n = raw.size
     while end < n and raw[end] <= before:
         end += 1
-    earlier = np.searchsorted(raw[:row], raw[row:end], side="left")
+    earlier = since + np.searchsorted(raw[since:row], raw[row:end], side="left")
     earlier = np.minimum(earlier, row - 1)
     same = raw[earlier] == raw[row:end]
     if not same.all():
@@ -303,8 +315,10 @@ def _event(kind: str, row: int, count: int, detail: Any) -> TimeEvent:
                          "dropped", True)
     if kind == "dst":
         sign = "back" if detail < 0 else "forward"
+        jump = ("3600 s" if abs(abs(detail) - DST_STEP_S) <= 1.0 else
+                f"{abs(detail):.6g} s (1 h less a pause of {DST_STEP_S - abs(detail):.6g} s)")
         return TimeEvent(kind, row, count,
-                         f"row {row}: the clock time jumps {sign} by 3600 s ({count} time(s)): "
+                         f"row {row}: the clock time jumps {sign} by {jump} ({count} time(s)): "
                          "daylight saving time in clock times without a time zone; pass --tz "
                          "with the zone they were written in (e.g. --tz Europe/Berlin)", False)
     if kind == "duplicate_time":

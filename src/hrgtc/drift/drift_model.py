@@ -303,24 +303,30 @@ def _check_excitation(windows: TrainingWindows, thermometer: Thermometer,
     slope = float(np.max(np.abs(thermometer.slope_hz_per_c(thermometer.temperature_range_c))))
     mask = slice(None) if run is None else windows.run == run
     what = "the drift runs" if run is None else f"drift run {windows.sources[run]}"
+    sensor = thermometer.source == "sensor"  # f is T in °C: no frequency to quote
     if "f" in variables:
         f = windows.variables["f"][mask]
         span_c = (float(f.max()) - float(f.min())) / slope
         if span_c < MIN_TEMPERATURE_SPAN_C:
             raise CalibrationError(
-                f"{what} spans only {span_c:.3g} °C of resonator temperature "
-                f"({float(f.max() - f.min()):.3g} Hz); a drift model needs a temperature "
-                f"change of at least {MIN_TEMPERATURE_SPAN_C:g} °C: use a cool-down or warm-up run"
+                f"{what} spans only {span_c:.3g} °C of "
+                + ("temperature" if sensor else
+                   f"resonator temperature ({float(f.max() - f.min()):.3g} Hz)")
+                + f"; a drift model needs a temperature change of at least "
+                f"{MIN_TEMPERATURE_SPAN_C:g} °C: use a cool-down or warm-up run"
             )
     if "df" in variables:
         df = windows.variables["df"][mask]
         span_c_per_h = (float(df.max()) - float(df.min())) / slope * 3600.0
         if span_c_per_h < MIN_RATE_SPAN_C_PER_H:
             raise CalibrationError(
-                f"{what} shows no df/dt variation (span {span_c_per_h:.3g} °C/h, "
-                f"{float(df.max() - df.min()):.3g} Hz/s); the rate terms cannot be identified: "
-                "train on a ramp (cool-down or warm-up), not on a soak or constant temperature, "
-                "or drop the df terms"
+                f"{what} shows no "
+                + ("dT/dt" if sensor else "df/dt")
+                + f" variation (span {span_c_per_h:.3g} °C/h"
+                + ("" if sensor else f", {float(df.max() - df.min()):.3g} Hz/s")
+                + "); the rate terms cannot be identified: train on a ramp (cool-down or "
+                "warm-up), not on a soak or constant temperature, or drop the df terms "
+                "(--terms f,f^2,f^3)"
             )
 
 

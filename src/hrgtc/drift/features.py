@@ -139,10 +139,16 @@ class Term:
 
     @property
     def unit(self) -> str:
-        """Unit of the term's value, e.g. ``Hz^2·Hz/s``."""
+        """Unit of the term's value, e.g. ``Hz^2·Hz/s`` (a resonator thermometer's)."""
+        return self.unit_for("resonator")
+
+    def unit_for(self, thermometer_source: str = "resonator") -> str:
+        """Unit of the term's value for a model whose thermometer is ``"resonator"``
+        (``Hz^2·Hz/s``) or ``"sensor"`` (f is T in °C: ``(°C)^2·°C/s``)."""
         parts = []
         for v, p in self.powers:
-            unit = variable_unit(v)
+            unit = (variable_unit(v) if v not in VARIABLES or thermometer_source != "sensor"
+                    else _registered(v).unit_for(thermometer_source))
             parts.append(unit if p == 1 else f"({unit})^{p}")
         return "·".join(parts)
 

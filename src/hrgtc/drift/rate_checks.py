@@ -89,7 +89,8 @@ def resolution(values: np.ndarray) -> float | None:
 
 
 def rate_filter_problems(time_s: np.ndarray, levels: Mapping[str, np.ndarray], tau_s: float,
-                         units: Mapping[str, str] | None = None, where: str = "") -> list[str]:
+                         units: Mapping[str, str] | None = None, where: str = "",
+                         thermometer_source: str = "resonator") -> list[str]:
     """Why the df/dt filter of time constant ``tau_s`` cannot follow this recording.
 
     Parameters
@@ -104,8 +105,15 @@ def rate_filter_problems(time_s: np.ndarray, levels: Mapping[str, np.ndarray], t
         Unit of each channel for the messages.
     where
         Prefix of the messages (the file's name).
+    thermometer_source
+        ``"sensor"``: ``freq_hz`` holds the temperature sensor's column, named
+        ``temperature_c`` in °C in the messages.
     """
     units = column_units() if units is None else units
+    if thermometer_source == "sensor":
+        units = {**units, "temperature_c": "°C"}
+        levels = {("temperature_c" if name == "freq_hz" else name): values
+                  for name, values in levels.items()}
     prefix = f"{where}: " if where else ""
     time_s = np.asarray(time_s, dtype=np.float64)[:CHECK_ROWS]
     levels = {name: np.asarray(values)[:CHECK_ROWS] for name, values in levels.items()}

@@ -329,7 +329,8 @@ def window_means(
                     stop = int(head[0]) if head.size else len(chunk)
                     problems += rate_filter_problems(
                         chunk.time_s[:stop], {k: v[:stop] for k, v in levels.items()},
-                        settings.rate_tau_s, where=chunk.source or "")
+                        settings.rate_tau_s, where=chunk.source or "",
+                        thermometer_source=getattr(thermometer, "source", "resonator"))
             if extra is None:  # the accelerometer and label columns, where every run has them
                 extra = tuple(c for c in _EXTRA_COLUMNS if c in chunk)
             time = chunk.time_s

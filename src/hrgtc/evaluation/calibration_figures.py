@@ -43,7 +43,7 @@ def calibration_summary(model: Any, table: Sequence[Mapping[str, float]] = (),
     sensor = th.source == "sensor"
     sections = [("thermometer (Eq. 18)",
                  _thermometer_figures(th, table, prior_fit)),
-                ("drift model (Eq. 22)", _drift_figures("drift", model.drift)),
+                ("drift model (Eq. 22)", _drift_figures("drift", model.drift, th.source)),
                 ("stepwise steps", _step_figures("drift", model.drift))]
     notes: list[str] = []
     if sensor:
@@ -256,9 +256,9 @@ def _thermometer_figures(thermometer: Any, table: Sequence[Mapping[str, float]],
     return tuple(figures)
 
 
-def _drift_figures(key: str, model: Any) -> tuple[Figure, ...]:
+def _drift_figures(key: str, model: Any, source: str = "resonator") -> tuple[Figure, ...]:
     """Candidates, terms, intercept and coefficients ± 1σ with p-values, residual, R²,
-    windows, samples."""
+    windows, samples; ``source``: the thermometer's (a sensor's f is in °C, not Hz)."""
     figures = [Figure(f"{key}.candidates", "candidate terms", ", ".join(model.candidates)),
                Figure(f"{key}.selected", "terms", ", ".join(model.selected) or "(none)"),
                Figure.with_error(f"{key}.intercept_dph", "B0", model.intercept_dph,
@@ -267,14 +267,14 @@ def _drift_figures(key: str, model: Any) -> tuple[Figure, ...]:
         name = term.name
         figures.append(Figure.with_error(
             f"{key}.coefficients.{name}", f"k of {name}", model.coefficients[name],
-            model.standard_errors.get(name, math.nan), f"°/h per {term.unit}"))
+            model.standard_errors.get(name, math.nan), f"°/h per {term.unit_for(source)}"))
         figures.append(Figure(f"{key}.pvalues.{name}", f"p of {name}",
                               model.pvalues.get(name, math.nan), digits=3))
     figures += [Figure(f"{key}.residual_std_dph", "residual std (window means)",
                        model.residual_std_dph, "°/h", digits=4),
                 Figure(f"{key}.rsquared", "R²", model.rsquared, digits=6),
                 Figure(f"{key}.n_windows", f"windows of {model.window_s:g} s", model.n_windows),
-                Figure(f"{key}.n_samples", "training samples", model.n_samples)]
+                Figure(f"{key}.n_samples", "training samples read", model.n_samples)]
     return tuple(figures)
 
 

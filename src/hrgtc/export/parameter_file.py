@@ -24,7 +24,7 @@ from hrgtc.core.timeline import settle_threshold_s
 from hrgtc.drift.features import settle_rows
 from hrgtc.drift.variables import DRIFT_VARIABLES, ascii_unit, refusal, variable
 from hrgtc.export.c.plan import CPlan
-from hrgtc.export.c.text import NEWTON_MAX_ITER, sensor_note
+from hrgtc.export.c.text import NEWTON_MAX_ITER, offsets_note, sensor_note
 from hrgtc.export.c.types import DOUBLE
 from hrgtc.model import UnitModel
 
@@ -164,7 +164,7 @@ def parameter_lines(model: UnitModel, plan: CPlan, key: str = "") -> list[str]:
             f"Coefficient of term {k} ({term.name}) on the scaled variables. [deg/h]")
         put(f"coefficient_raw_{k}", drift.coefficients[term.name],
             f"Coefficient of term {k} ({term.name}) on the raw variables, Eq. (22) form. "
-            f"[deg/h per {term.unit}]".replace("·", " "))
+            f"[deg/h per {term.unit_for(th.source)}]".replace("·", " "))
     _scale_factor_lines(model, put)
     put("thermometer_order", th.order, "Order of the thermometer polynomial F(T) (Eq. 18).")
     put("thermometer_centre_c", th.centre_c,
@@ -249,6 +249,7 @@ def _head(model: UnitModel, origin: str, sha256: str, key: str = "") -> list[str
         f"exported by:     hrgtc {__version__}",
         "",
         *sensor_note(model),
+        *offsets_note(model),
         *formula(key),
         "",
         f"[1] {PAPER_REFERENCE}",

@@ -69,6 +69,7 @@ class ChannelFill:
     first_dropped_row: int | None = None
     last_time: float = -math.inf
     last_value: float = math.nan
+    alias_of: str | None = None  # the same cells under another name (a sensor's freq_hz)
 
     def to_dict(self) -> dict[str, Any]:
         return {"column": self.column, "period_s": self.period_s, "max_age_s": self.max_age_s,
@@ -124,7 +125,8 @@ class SlowChannels:
                 continue
             age = self.max_age_s if self.max_age_s is not None else \
                 DEFAULT_MAX_AGE_PERIODS * period
-            self.channels[name] = ChannelFill(name, period, float(age))
+            alias = next((c for c in self.channels if _same_cells(arrays[c], values)), None)
+            self.channels[name] = ChannelFill(name, period, float(age), alias_of=alias)
 
     # -- filling ----------------------------------------------------------------------
     def fill(self, arrays: dict[str, np.ndarray], offset: int = 0) -> dict[str, np.ndarray]:
@@ -211,7 +213,7 @@ class SlowChannels:
         """One line per slow channel: its period, the choice and the rows filled/dropped."""
         where = f"{self.source}: " if self.source else ""
         lines = []
-        for s in self.channels.values():
+        for s in self._reported():
             how = ("held (last value)" if self.mode == "hold" else
                    "interpolated linearly in time")
             line = (f"{where}column '{s.column}' is logged every {s.period_s:g} s, slower than "
@@ -225,12 +227,23 @@ class SlowChannels:
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types: the mode and each slow channel's figures."""
-        return {"mode": self.mode, "channels": [s.to_dict() for s in self.channels.values()]}
+        return {"mode": self.mode, "channels": [s.to_dict() for s in self._reported()]}
+
+    def _reported(self) -> list[ChannelFill]:
+        """The channels to report: not a second name of the same cells (``--thermometer
+        sensor`` reads its temperature column as ``freq_hz_<axis>`` too)."""
+        return [s for s in self.channels.values() if s.alias_of is None]
 
     def warn(self) -> None:
         """Report each slow channel once as a :class:`~hrgtc.core.errors.SlowChannelWarning`."""
         for line in self.summary():
             warnings.warn(line, SlowChannelWarning, stacklevel=3)
+
+
+def _same_cells(a: np.ndarray, b: np.ndarray) -> bool:
+    """Whether two columns are the same array (one column mapped under two names)."""
+    return a is b or (a.shape == b.shape and a.strides == b.strides
+                      and a.__array_interface__["data"][0] == b.__array_interface__["data"][0])
 
 
 def channel_period(time_s: np.ndarray) -> float:

@@ -158,7 +158,8 @@ def build_report(
 
     page = _Page()
     _header(page, dataclasses.replace(first, unit=instrument.unit), title
-            or f"Temperature compensation report — unit {instrument.unit}", model_path)
+            or f"Temperature compensation report — unit {instrument.unit}", model_path,
+            "" if instrument.is_single_axis else next(iter(instrument.axes)))
     evaluations: dict[str, list[Evaluation]] = {axis: [] for axis in instrument.axes}
     for run in runs:  # every axis of a run from one reading
         found = ({"": run} if isinstance(run, Evaluation) else

@@ -134,7 +134,19 @@ class _Page:
 
 
 # -- sections --------------------------------------------------------------------------------
-def _header(page: _Page, model: UnitModel, title: str, model_path: str | None) -> None:
+#: The sections of one axis: link id, title, whether a sensor model (no frequency) has it.
+_SECTIONS = (("settling", "Settling of the soaks (Fig. 3)", False),
+             ("thermometer", "Frequency–temperature fit (Fig. 4, Table 1, Eq. 18)", False),
+             ("temperature", "Temperature from frequency (Fig. 5, Table 2)", False),
+             ("runs", "Runs: raw and compensated output (Fig. 6), Allan deviation", True),
+             ("model", "Drift model: stepwise regression (Eq. 21–22)", True))
+
+
+def _header(page: _Page, model: UnitModel, title: str, model_path: str | None,
+            axis: str = "") -> None:
+    """Title, provenance and the contents: the sections the axes have (a sensor model has
+    no Figs. 3-5), linked to the first axis's (``axis``: its id prefix) when there are
+    several."""
     prov = model.provenance
     page.add(f"<header><h1>{escape(title)}</h1>",
              f"<p>Unit <b>{escape(model.unit)}</b>. Model file "
@@ -147,12 +159,12 @@ def _header(page: _Page, model: UnitModel, title: str, model_path: str | None) -
     inputs = provenance_summary(prov)
     if inputs.sections:
         page.add(_grid_table(inputs, INPUTS, INPUTS))
-    page.add('<nav><ol><li><a href="#settling">Settling of the soaks (Fig. 3)</a></li>'
-             '<li><a href="#thermometer">Frequency–temperature fit (Fig. 4, Table 1, Eq. 18)'
-             '</a></li><li><a href="#temperature">Temperature from frequency (Fig. 5, '
-             'Table 2)</a></li><li><a href="#runs">Runs: raw and compensated output (Fig. 6),'
-             ' Allan deviation</a></li><li><a href="#model">Drift model: stepwise regression '
-             '(Eq. 21–22)</a></li></ol></nav>')
+    sensor = model.thermometer.source == "sensor"
+    prefix = f"{axis}-" if axis else ""
+    items = "".join(f'<li><a href="#{prefix}{key}">{escape(text)}'
+                    + (f" (axis {escape(axis)})" if axis else "") + "</a></li>"
+                    for key, text, with_sensor in _SECTIONS if with_sensor or not sensor)
+    page.add(f"<nav><ol>{items}</ol></nav>")
 
 
 def _summary(page: _Page, runs: Sequence[Evaluation]) -> None:

@@ -238,8 +238,10 @@ class LoggerSettings:
         "every 71.6 min); none: no wrap.", default_text=per_preset("counter_bits"),
         panel=_LOGGER)
     clock_start_s: float | None = setting(
-        None, "Clock reading at the first sample; near 4295 s (2^32 µs) to see a µs wrap "
-        "early.", unit="s", default_text=per_preset("clock_start_s"), panel=_LOGGER)
+        None, "Clock reading at the first sample after each power-on (--restarts start "
+        "from it again: keep it small with restarts, or hrgtc reads a gap, not a reset); "
+        "near 4295 s (2^32 µs) to see a µs wrap early.", unit="s",
+        default_text=per_preset("clock_start_s"), panel=_LOGGER)
     jitter_ms: float | None = setting(
         None, "Rms Gaussian jitter of each time stamp.", unit="ms",
         default_text=per_preset("jitter_ms"), panel=_LOGGER)

@@ -28,6 +28,9 @@ def reading_options(info: Mapping[str, Any], axes: tuple[str | None, ...],
     for c in cols:
         options += ["--col", c]
     options += ["--time-unit", logger.time_unit, "--rate-unit", logger.rate_unit]
+    if logger.time_unit == "timestamp" and logger.timezone is not None:
+        # local clock times: a daylight-saving change is a ±1 h step without the zone
+        options += ["--tz", logger.timezone]
     channel = logger.temperature
     if channel is not None and channel.lsb_c is not None and channel.bits is None:
         options += ["--temp-scale", f"{channel.lsb_c:.17g}",

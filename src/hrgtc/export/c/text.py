@@ -66,6 +66,30 @@ def sensor_note(model: UnitModel) -> list[str]:
     ]
 
 
+def offsets_note(model: UnitModel) -> list[str]:
+    """Lines that say the export applies none of the model's per-run or per-orientation
+    offsets (``calibrate --offsets``): its intercept is their mean over the training
+    samples. Empty when the model has none."""
+    drift = model.drift
+    if not drift.offsets_dph:
+        return []
+    kind = drift.offset_mode  # "run" or "orientation"
+    lines = [f"OFFSETS NOT APPLIED HERE (calibrate --offsets {kind})",
+             f"  The fit gave each {kind} a constant offset (a nuisance parameter, from the",
+             "  intercept), which this file does not apply: its intercept is their mean over",
+             f"  the training samples, so a unit in one {kind} reads its offset in",
+             f"  rate_comp_dph; add it in the firmware if the unit knows its {kind} [deg/h]:"]
+    directions = list(drift.orientations or ())
+    for name, value in drift.offsets_dph.items():
+        where = ""
+        index = name.removeprefix("orientation ")
+        if index != name and index.isdigit() and int(index) < len(directions):
+            where = (" (gravity along "
+                     + ", ".join(f"{c:+.3f}" for c in directions[int(index)]) + ")")
+        lines.append(f"    {name}: {value:+.6g}{where}")
+    return [*lines, ""]
+
+
 def readme(model: UnitModel, plan: CPlan, prefix: str, origin: str,
             sha256: str, sections: list[str] | None = None) -> str:
     """The README comment block at the top of the header: what, provenance, Eq. (22), units, use.
@@ -115,7 +139,7 @@ def readme(model: UnitModel, plan: CPlan, prefix: str, origin: str,
 
     housing_arg = "".join(f"double {name}, " for name in step_inputs(plan))
     housing_use = "".join(f"{name}, " for name in step_inputs(plan))
-    lines += ["", *sensor_note(model)]
+    lines += ["", *sensor_note(model), *offsets_note(model)]
     lines += [
         "THE MODEL (Eq. (22) form of [1]; coefficients rounded here for reading)",
         f"  B = {drift.intercept_dph:.10g}{terms}   [deg/h]",
