@@ -130,7 +130,7 @@ EXPECTED: dict[str, dict[str, str]] = {
     "timestamp": {
         "run.csv": "b3f12767f28797f452ffefcd04de2bbbd619eb23fb35e37c124cd9d08d8ccebf",
         "run.truth.csv": "800a3eba3bc9e66a0dd458aea44143419205ef8269dbf6982857c915c5adabdd",
-        "run.truth.json": "5886fa0f35a8e4ea9d717f6edec279bb360a199283074c33d6a16fc92f54cbde",
+        "run.truth.json": "2cd8076d72e17faace5ff4b801f06e49c36ea4a89d2366661a42e3d398d22c4b",
     },
 }
 

@@ -72,7 +72,8 @@ def test_provenance_table(provenance):
     assert provenance_summary({"inputs": []}).sections == ()
     # the report's table is these cells
     page = _Page()
-    model = type("M", (), {"provenance": provenance, "unit": "SN-1"})()
+    model = type("M", (), {"provenance": provenance, "unit": "SN-1",
+                          "thermometer": type("T", (), {"source": "frequency"})()})()
     _header(page, model, "t", None)
     assert _report_table("".join(page.parts), INPUTS) == (headers, rows)
 
