@@ -405,7 +405,7 @@ double {p}_step({p}_state *state, double dt_s, double freq_hz, double rate_dph{h
 {{
     const double f_value = freq_hz - REFERENCE_FREQ_HZ;
 {h['values']}{extra['values']}    double df_value = 0.0, bias, compensated, temperature;
-    int in_range, rate_in_range, level_in_range;
+    int in_range, rate_in_range, level_in_range, settled;
 {k['declare']}    if (!state->started) {{  /* the filters start at rest on the first sample */
         rate_start(&state->f_filter, f_value);
 {h['start']}{extra['start']}        state->started = 1;
