@@ -383,7 +383,7 @@ static const double TH_TOLERANCE_C = {_literal(plan.tolerance, 'tolerance')};
 #define TH_MAX_ITER {NEWTON_MAX_ITER}
 
 {thermometer_text}/* ---- streaming compensation (hrgtc.compensate.Compensator) ---- */
-/* training ranges of the drift model's variables (window means) */
+/* training ranges of the drift model's variables (as the model file stores them) */
 {range_constants}
 void {p}_reset({p}_state *state)
 {{

@@ -283,7 +283,7 @@ double hrgtc_temperature_c(double freq_hz)
 }
 
 /* ---- streaming compensation (hrgtc.compensate.Compensator) ---- */
-/* training ranges of the drift model's variables (window means) */
+/* training ranges of the drift model's variables (as the model file stores them) */
 static const double RANGE_F_LOW = -11.384319400217628;
 static const double RANGE_F_HIGH = 9.5811396140122085;
 static const double RANGE_DF_LOW = -0.0034483185341946799;

@@ -247,7 +247,7 @@ double hrgtc_temperature_c(double freq_hz)
 }
 
 /* ---- streaming compensation (hrgtc.compensate.Compensator) ---- */
-/* training ranges of the drift model's variables (window means) */
+/* training ranges of the drift model's variables (as the model file stores them) */
 static const double RANGE_F_LOW = -14.640340379464506;
 static const double RANGE_F_HIGH = 5.8754298720929725;
 static const double RANGE_DF_LOW = -0.0034483261003142888;

@@ -220,7 +220,7 @@ double hrgtc_temperature_c(double freq_hz)
 }
 
 /* ---- streaming compensation (hrgtc.compensate.Compensator) ---- */
-/* training ranges of the drift model's variables (window means) */
+/* training ranges of the drift model's variables (as the model file stores them) */
 static const double RANGE_F_LOW = -20.003300054078125;
 static const double RANGE_F_HIGH = 20.004211063387864;
 static const double RANGE_DF_LOW = -0.016117797931623545;

@@ -251,7 +251,7 @@ double hrgtc_x_temperature_c(double freq_hz)
 }
 
 /* ---- streaming compensation (hrgtc.compensate.Compensator) ---- */
-/* training ranges of the drift model's variables (window means) */
+/* training ranges of the drift model's variables (as the model file stores them) */
 static const double RANGE_F_LOW = -14.892622149620275;
 static const double RANGE_F_HIGH = -5.2489742283796656e-05;
 static const double RANGE_DF_LOW = -0.0036574681105409628;

@@ -275,7 +275,7 @@ double hrgtc_y_temperature_c(double freq_hz)
 }
 
 /* ---- streaming compensation (hrgtc.compensate.Compensator) ---- */
-/* training ranges of the drift model's variables (window means) */
+/* training ranges of the drift model's variables (as the model file stores them) */
 static const double RANGE_F_LOW = -18.03076281873069;
 static const double RANGE_F_HIGH = 4.379667063403758e-05;
 static const double RANGE_DF_LOW = -0.0039834028107303332;

@@ -256,7 +256,7 @@ double hrgtc_z_temperature_c(double freq_hz)
 }
 
 /* ---- streaming compensation (hrgtc.compensate.Compensator) ---- */
-/* training ranges of the drift model's variables (window means) */
+/* training ranges of the drift model's variables (as the model file stores them) */
 static const double RANGE_F_LOW = -25.862139075767374;
 static const double RANGE_F_HIGH = -0.00011360335298377322;
 static const double RANGE_DF_LOW = -0.0051316643201148862;

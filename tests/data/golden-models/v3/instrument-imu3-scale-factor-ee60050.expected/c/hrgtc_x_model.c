@@ -242,7 +242,7 @@ double hrgtc_x_temperature_c(double freq_hz)
 }
 
 /* ---- streaming compensation (hrgtc.compensate.Compensator) ---- */
-/* training ranges of the drift model's variables (window means) */
+/* training ranges of the drift model's variables (as the model file stores them) */
 static const double RANGE_F_LOW = -5.1945500064938646;
 static const double RANGE_F_HIGH = 9.6980196533841259;
 static const double RANGE_DF_LOW = -0.0036571680436547713;

@@ -247,7 +247,7 @@ double hrgtc_y_temperature_c(double freq_hz)
 }
 
 /* ---- streaming compensation (hrgtc.compensate.Compensator) ---- */
-/* training ranges of the drift model's variables (window means) */
+/* training ranges of the drift model's variables (as the model file stores them) */
 static const double RANGE_F_LOW = -6.8737495105847843;
 static const double RANGE_F_HIGH = 11.157057104816539;
 static const double RANGE_DF_LOW = -0.0039834494938277565;

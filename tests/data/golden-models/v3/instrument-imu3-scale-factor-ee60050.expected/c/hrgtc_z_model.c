@@ -251,7 +251,7 @@ double hrgtc_z_temperature_c(double freq_hz)
 }
 
 /* ---- streaming compensation (hrgtc.compensate.Compensator) ---- */
-/* training ranges of the drift model's variables (window means) */
+/* training ranges of the drift model's variables (as the model file stores them) */
 static const double RANGE_F_LOW = -10.676154273951651;
 static const double RANGE_F_HIGH = 15.185871198462737;
 static const double RANGE_DF_LOW = -0.0051320081696409571;

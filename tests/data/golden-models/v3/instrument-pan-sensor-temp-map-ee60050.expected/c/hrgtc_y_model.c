@@ -228,7 +228,7 @@ double hrgtc_y_temperature_c(double freq_hz)
 }
 
 /* ---- streaming compensation (hrgtc.compensate.Compensator) ---- */
-/* training ranges of the drift model's variables (window means) */
+/* training ranges of the drift model's variables (as the model file stores them) */
 static const double RANGE_F_LOW = -5.9316577356278666;
 static const double RANGE_F_HIGH = 6.1659532778321999;
 static const double RANGE_DF_LOW = -0.010488063419574341;
