@@ -81,14 +81,21 @@ def test_cold_test_model_flags_nothing_of_its_own_training_file(tmp_path):
     _assert_inside(report)
 
 
-def test_burst_model_flags_nothing_of_its_own_training_file(tmp_path):
-    """A simulated burst logger (5 s every 60 s at 10 Hz, ms time, rad/s) on a cool-down."""
-    logger = Logger(kind="burst", sample_rate_hz=10.0, burst_s=5.0, period_s=60.0,
-                    time_unit="ms", rate_unit="radps", frequency=False,
-                    temperature=TemperatureChannel(decimals=3, noise_c=0.005))
+@pytest.mark.parametrize(("kind", "time_unit", "decimals"), [
+    ("burst", "ms", 3),  # was 1.9 % and 2.5 %
+    ("continuous", "us", 2),  # many samples exactly at the coldest 0.01 °C step
+])
+def test_logger_model_flags_nothing_of_its_own_training_file(tmp_path, kind, time_unit,
+                                                             decimals):
+    """A simulated logger (bursts of 5 s every 60 s, or continuous, at 10 Hz, rad/s) on a
+    cool-down: the temperature logged in steps, so the coldest step holds many samples at
+    exactly the trained minimum (a round-off below it flagged them, issue 20)."""
+    logger = Logger(kind=kind, sample_rate_hz=10.0, burst_s=5.0, period_s=60.0,
+                    time_unit=time_unit, rate_unit="radps", frequency=False,
+                    temperature=TemperatureChannel(decimals=decimals, noise_c=0.005))
     run = log_run(cooldown(22.0, 5.0, hours=2.0, ramp_c_per_min=0.15), "mems-3", logger,
                   seed=11)
-    files = write_logged(run, tmp_path / "burst.csv")
+    files = write_logged(run, tmp_path / f"{kind}.csv")
     report = _own_file(Path(files.path), run.info["hrgtc_options"], [], tmp_path)
     for axis in report["axes"].values() if "axes" in report else [report]:
         _assert_inside(axis)
