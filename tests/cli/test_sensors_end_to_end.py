@@ -80,9 +80,10 @@ def test_cold_test_with_its_hand_log_end_to_end(tmp_path, monkeypatch):
     assert "compensated (temperature sensor)" in result.output
     assert "3.0143" not in result.output and "Eq. 22" not in result.output
     assert "resonator temperature rate" not in result.output
-    # the same range warning of the three axes: once, naming them
-    assert result.output.count("beyond the trained temperature") == 1
-    assert "(axes x, y, z)" in result.output
+    # its own training file is inside the trained ranges (issue 20: they are the used
+    # samples' extremes, and the settling samples are not counted out of range); a range
+    # warning common to the axes is said once: the calibrate test below
+    assert "beyond the trained" not in result.output
 
 
 def test_calibrate_prints_a_range_warning_common_to_the_axes_once(tmp_path, monkeypatch):

@@ -29,6 +29,7 @@ from hrgtc import drift, thermometry
 from hrgtc.cli._app import app
 from hrgtc.compensate import Compensator
 from hrgtc.core.errors import CalibrationError, InputError, OutputExistsError
+from hrgtc.core.timeline import settle_threshold_s
 from hrgtc.export.export_c import export_c
 from hrgtc.model import UnitModel, save_model
 from hrgtc.thermometry import paper
@@ -203,7 +204,11 @@ def test_c_matches_the_python_compensator(kind, request, tmp_path):
     assert 0 < compensator.rate_out_of_range < len(recording)
     np.testing.assert_array_equal(out[:, 3] * out[:, 7], in_range)  # the file's flag: both
     assert set(np.unique(out[:, 7])) <= {0.0, 1.0}
-    assert int(np.count_nonzero(out[:, 7] == 0.0)) == compensator.rate_out_of_range
+    # counted once settled (issue 20: a settling sample is counted as such only)
+    settled = recording.time_s - recording.time_s[0] >= settle_threshold_s(
+        model.drift.settings.warmup_s)
+    assert compensator.settling == int(np.count_nonzero(~settled)) > 0
+    assert int(np.count_nonzero((out[:, 7] == 0.0) & settled)) == compensator.rate_out_of_range
     np.testing.assert_allclose(out[:, 0], expected["rate_comp_dph"], rtol=0, atol=1e-9)
     np.testing.assert_array_equal(out[:, 6], out[:, 0])  # return value == out->rate_comp_dph
     np.testing.assert_allclose(out[:, 1], expected["bias_model_dph"], rtol=0, atol=1e-9)

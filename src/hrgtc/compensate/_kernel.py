@@ -68,9 +68,10 @@ from hrgtc.thermometry import Thermometer
 ORDER = ("f", "df", "h", "dh", "g")
 #: Indices of the rates in :data:`ORDER` (flagged in the rate count; the others are levels).
 RATES = (1, 3)
-#: Slots of ``counts``: samples outside the f/h/g ranges, outside the df/dh ranges,
-#: samples whose Newton iteration did not converge (solved by the bracketed slow path),
-#: and samples of the filter's settling time at the start of the run.
+#: Slots of ``counts``: settled samples outside the f/h/g ranges, outside the df/dh
+#: ranges, samples whose Newton iteration did not converge (solved by the bracketed slow
+#: path), and samples of the filter's settling time at the start of the run (the range
+#: counts and ``extremes`` leave those out: they are flagged by that reason only).
 OUT_OF_RANGE, RATE_OUT_OF_RANGE, NOT_CONVERGED, SETTLING = 0, 1, 2, 3
 #: Then ``counts[VARIABLE_OUT + v]``: samples outside the training range of variable v of
 #: :data:`ORDER` (each apart, so the range report can say which variable left its range),
@@ -317,6 +318,7 @@ def compensate_block(time_s, restart, freq_hz, rate_dph, housing_c, filt, uses_h
     gradient = np.empty(TILE)
     ok = np.empty(TILE)
     rate_ok = np.empty(TILE)
+    settled = np.empty(TILE)
     no_lag = np.empty(0)
     f_state = state[0:8]  # F_STATE, H_STATE
     h_state = state[8:16]
@@ -424,7 +426,22 @@ def compensate_block(time_s, restart, freq_hz, rate_dph, housing_c, filt, uses_h
         for i in range(m):
             out_bias[start + i] = bias[i]
             out_rate[start + i] = rate[i] - bias[i]
-        # flags: Compensator._block (1.0 inside, 0.0 outside; NaN is outside)
+        # settling: seconds since the filter (re)started, on the time axis (ORIGIN), as
+        # training's warm-up skip (drift.windows: time - origin >= warmup_s); a settling
+        # sample is flagged by that reason only, not counted out of range as well
+        origin = state[16]
+        if origin != origin and m > 0:  # NaN: the run's first sample
+            origin = time[0]
+        n_settling = 0
+        for i in range(m):
+            if has_restart and restart[start + i] != 0:
+                origin = time[i]
+            settled[i] = 1.0 if time[i] - origin >= filt[5] else 0.0
+            n_settling += settled[i] == 0.0
+        n_settled = m - n_settling
+        state[16] = origin
+        # flags: Compensator._block (1.0 inside, 0.0 outside; NaN is outside); counted
+        # on the settled samples
         for i in range(m):
             fi = freq[i]
             ok[i] = 1.0 if (fi >= f_cal_low) & (fi <= f_cal_high) else 0.0
@@ -437,40 +454,30 @@ def compensate_block(time_s, restart, freq_hz, rate_dph, housing_c, filt, uses_h
                 for i in range(m):
                     inside = (x[i] >= lo) & (x[i] <= hi)
                     flag[i] = flag[i] if inside else 0.0
-                    n_out += not inside
+                    n_out += (not inside) & (settled[i] != 0.0)
                 if counts.size > VARIABLE_OUT + v:
                     counts[VARIABLE_OUT + v] += n_out
             if v == 0 and counts.size > TEMPERATURE_OUT:  # calibrated span and f's range
                 n_temperature = 0.0
                 for i in range(m):
-                    n_temperature += ok[i]
-                counts[TEMPERATURE_OUT] += m - int(n_temperature)
+                    n_temperature += ok[i] * settled[i]
+                counts[TEMPERATURE_OUT] += n_settled - int(n_temperature)
         n_ok = 0.0
         n_rate_ok = 0.0
-        # settling: seconds since the filter (re)started, on the time axis (ORIGIN), as
-        # training's warm-up skip (drift.windows: time - origin >= warmup_s)
-        origin = state[16]
-        if origin != origin and m > 0:  # NaN: the run's first sample
-            origin = time[0]
-        n_settling = 0
         for i in range(m):
-            if has_restart and restart[start + i] != 0:
-                origin = time[i]
-            settled = 1.0 if time[i] - origin >= filt[5] else 0.0
-            out_in_range[start + i] = ok[i] * rate_ok[i] * settled
-            n_ok += ok[i]
-            n_rate_ok += rate_ok[i]
-            n_settling += settled == 0.0
-        state[16] = origin
-        counts[0] += m - int(n_ok)
-        counts[1] += m - int(n_rate_ok)
+            out_in_range[start + i] = ok[i] * rate_ok[i] * settled[i]
+            n_ok += ok[i] * settled[i]
+            n_rate_ok += rate_ok[i] * settled[i]
+        counts[0] += n_settled - int(n_ok)
+        counts[1] += n_settled - int(n_rate_ok)
         counts[3] += n_settling
-        for v in range(min(nv, extremes.size // 2)):  # the range warnings say how far
+        for v in range(min(nv, extremes.size // 2)):  # how far the settled samples went
             x = value[v]
             lo, hi = extremes[2 * v], extremes[2 * v + 1]
             for i in range(m):
-                lo = x[i] if x[i] < lo else lo
-                hi = x[i] if x[i] > hi else hi
+                if settled[i] != 0.0:
+                    lo = x[i] if x[i] < lo else lo
+                    hi = x[i] if x[i] > hi else hi
             extremes[2 * v], extremes[2 * v + 1] = lo, hi
 
 

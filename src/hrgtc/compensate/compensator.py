@@ -172,8 +172,10 @@ class Compensator:
         dh/dt, d2) is inside its training range (a model trained on a cool-down has seen only
         negative df/dt), and the df/dt filter has settled (the first ``warmup_s`` of the
         run, which training leaves out too); else 0.0. The three are counted separately
-        (:attr:`out_of_range_fraction`, :attr:`rate_out_of_range_fraction`,
-        :attr:`settling`) and :meth:`ranges` says how far the run went. Large chunks
+        and each sample once: a settling sample in :attr:`settling` only, the settled
+        ones outside a range in :attr:`out_of_range_fraction` and
+        :attr:`rate_out_of_range_fraction`; :meth:`ranges` says how far the settled
+        samples went. Large chunks
         are worked through in blocks of :data:`BLOCK_ROWS` rows, which keeps the
         temporaries in cache.
         """
@@ -341,38 +343,43 @@ class Compensator:
         rate_in_range = _in_training_range(self.drift, values, RATE_VARIABLES)
         temperature = thermometer.in_range(chunk.freq_hz) & _in_training_range(
             self.drift, values, ("f",))
-        self.temperature_out += int(np.count_nonzero(~temperature))
+        # a sample of the settling time is flagged by that reason only: the range counts
+        # and the extremes seen are of the settled samples
+        settled = self._settled(chunk.time_s, restart)
+        self.temperature_out += int(np.count_nonzero(~temperature & settled))
         if len(chunk):
             for v in self.variable_ranges:
-                x = values[v]
+                x = values[v][settled]
                 low, high = self.drift.ranges[v]
                 outside = int(np.count_nonzero(~((x >= low) & (x <= high))))
-                self._track(v, outside, np.nanmin(x) if np.isfinite(x).any() else np.inf,
-                            np.nanmax(x) if np.isfinite(x).any() else -np.inf)
-        settled = self._settled(chunk.time_s, restart)
+                finite = np.isfinite(x).any()
+                self._track(v, outside, np.nanmin(x) if finite else np.inf,
+                            np.nanmax(x) if finite else -np.inf)
         np.subtract(chunk.rate_dph, bias, out=out["rate_comp_dph"][start:stop])
         out["bias_model_dph"][start:stop] = bias
         out["resonator_c_est"][start:stop] = thermometer.temperature(chunk.freq_hz, warn=False)
         out["in_range"][start:stop] = in_range & rate_in_range & settled
         self.samples += len(chunk)
-        self.out_of_range += int(np.count_nonzero(~in_range))
-        self.rate_out_of_range += int(np.count_nonzero(~rate_in_range))
+        self.out_of_range += int(np.count_nonzero(~in_range & settled))
+        self.rate_out_of_range += int(np.count_nonzero(~rate_in_range & settled))
         self.settling += int(np.count_nonzero(~settled))
-        if len(chunk):
+        if settled.any():
             e = self._extremes
             for k, v in enumerate(("f", "df")):
-                e[2 * k] = min(e[2 * k], float(np.min(values[v])))
-                e[2 * k + 1] = max(e[2 * k + 1], float(np.max(values[v])))
+                e[2 * k] = min(e[2 * k], float(np.min(values[v][settled])))
+                e[2 * k + 1] = max(e[2 * k + 1], float(np.max(values[v][settled])))
 
     @property
     def out_of_range_fraction(self) -> float:
         """Share of the samples so far outside the calibrated temperature range or a level
-        variable's training range (f, h, g, a_NAME); :meth:`ranges` gives each apart."""
+        variable's training range (f, h, g, a_NAME), after the settling time (a settling
+        sample is counted in :attr:`settling` only); :meth:`ranges` gives each apart."""
         return self.out_of_range / self.samples if self.samples else 0.0
 
     @property
     def rate_out_of_range_fraction(self) -> float:
-        """Share of the samples so far whose df/dt (dh/dt) is outside its training range."""
+        """Share of the samples so far, after the settling time, whose df/dt (dh/dt) is
+        outside its training range."""
         return self.rate_out_of_range / self.samples if self.samples else 0.0
 
     def ranges(self) -> RangeReport:

@@ -44,7 +44,8 @@ class VariableRange:
     fraction
         Share of the samples outside the training range.
     trained, seen
-        (min, max) of the training window means and of the samples seen. [unit]
+        (min, max) of the training samples (window means in models fitted before
+        issue 20) and of the settled samples seen. [unit]
     """
 
     name: str
@@ -105,13 +106,16 @@ class RangeReport:
     samples
         Samples seen.
     temperature_fraction
-        Share outside the calibrated temperature range (thermometer and drift training).
+        Share of the samples that are settled and outside the calibrated temperature
+        range (thermometer and drift training); a settling sample is counted in
+        ``settling_fraction`` only.
     rate_fraction
-        Share whose df/dt is outside its training range.
+        Share of the samples that are settled and whose df/dt is outside its training
+        range.
     settling_fraction
         Share in the filter's settling time at the start (flagged, left out of figures).
     trained_c, seen_c
-        (min, max) trained and seen resonator temperature. [°C]
+        (min, max) trained and seen (settled samples) resonator temperature. [°C]
     trained_rate_c_per_h, seen_rate_c_per_h
         (min, max) trained and seen df/dt as a resonator temperature rate. [°C/h]
     variables

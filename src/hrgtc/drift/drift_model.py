@@ -101,7 +101,8 @@ class DriftModel(ParsedTerms):
     stepwise
         The stepwise regression on scaled window means (steps, final fit).
     ranges
-        Variable -> (min, max) of its training window means.
+        Variable -> (min, max) of the training samples used (after the warm-up, at
+        rest); models fitted before issue 20 stored the extremes of the window means.
     window_s
         Window length of the fit. [s]
     n_windows, n_samples
@@ -577,8 +578,9 @@ def fit(
     errors.update({n: float(bse[k + 1] / selected_factor[n]) for k, n in enumerate(selected)})
     pv = {"const": float(pvalues[0])}
     pv.update({n: float(pvalues[k + 1]) for k, n in enumerate(selected)})
-    ranges = {v: (float(windows.variables[v].min()), float(windows.variables[v].max()))
-              for v in windows.variables}
+    # the extremes of the samples used (not of the window means, which are narrower):
+    # the model's own training file is inside its ranges by construction
+    ranges = {v: windows.extremes[v] for v in windows.variables}
     intercept, group_offsets = fit_offsets(groups, windows.bias_dph, x_full, names, selected,
                                            params, float(params[0]))
     return DriftModel(

@@ -22,7 +22,11 @@ Time, not samples (see :mod:`hrgtc.core.timeline`):
   run) is kept when it holds at least half a window
   (:data:`~hrgtc.core.timeline.PARTIAL_WINDOW_FRACTION`), else dropped; a window never
   reaches across samples left out as not at rest either (its partial start is dropped);
-* rows left out are counted by reason in :attr:`TrainingWindows.dropped`.
+* rows left out are counted by reason in :attr:`TrainingWindows.dropped`;
+* the extremes of each variable over the samples used (settled, at rest, in the file:
+  spikes removed by the reader are not) are kept in :attr:`TrainingWindows.extremes`:
+  the model's trained ranges, so its own training file is inside them by construction
+  (the window means' extremes are narrower than the samples').
 """
 
 from __future__ import annotations
@@ -90,6 +94,9 @@ class TrainingWindows:
     power_runs
         Name of each power-on run (the file's, with `` run K`` for the parts of a file
         that restarted).
+    extremes
+        Variable -> (min, max) over the samples used: after the warm-up, at rest (NaN
+        ignored; ``(inf, -inf)`` when none is finite). The trained ranges.
     """
 
     time_s: np.ndarray
@@ -106,6 +113,7 @@ class TrainingWindows:
     segments: int = 0
     power_run: np.ndarray | None = None
     power_runs: tuple[str, ...] = ()
+    extremes: dict[str, tuple[float, float]] = field(default_factory=dict)
 
 
 class _WindowMeans:
@@ -287,6 +295,9 @@ def window_means(
     power_names: list[str] = []
     out_vars: dict[str, list[np.ndarray]] = {v: [] for v in variables}
     out_extra: list[np.ndarray] = []
+    # per variable: smallest and largest used sample (the trained ranges)
+    lowest = np.full(len(variables), np.inf)
+    highest = np.full(len(variables), -np.inf)
     total = warm = segments = partial = 0
     left_out = 0
     sources: list[str] = []
@@ -400,6 +411,10 @@ def window_means(
                 (t.evaluate(values, cache) for t in terms),  # the design matrix's columns
                 len(terms),
             )
+            if block.shape[0]:  # down the block's contiguous columns; NaN ignored
+                columns = block[:, 3:3 + len(variables)]
+                np.fmin(lowest, np.fmin.reduce(columns, axis=0), out=lowest)
+                np.fmax(highest, np.fmax.reduce(columns, axis=0), out=highest)
             means = averager.partial_fit(block, before[starts], cuts)
             if means.shape[0]:
                 collect(means, index)
@@ -442,4 +457,5 @@ def window_means(
         segments=segments,
         power_run=np.concatenate(out_power),
         power_runs=tuple(power_names),
+        extremes={v: (float(lowest[k]), float(highest[k])) for k, v in enumerate(variables)},
     )

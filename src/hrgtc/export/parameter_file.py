@@ -146,8 +146,8 @@ def parameter_lines(model: UnitModel, plan: CPlan, key: str = "") -> list[str]:
     for v in plan.computed:
         if v in drift.ranges:
             low, high = drift.ranges[v]
-            put(f"range_{v}_low", low, f"Training range of {v}, low end (window means); "
-                "the model is continued along its tangent below it. "
+            put(f"range_{v}_low", low, f"Training range of {v}, low end (as the model file "
+                "stores it); the model is continued along its tangent below it. "
                 f"[{_unit(model, v)}]")
             put(f"range_{v}_high", high, f"Training range of {v}, high end. "
                 f"[{_unit(model, v)}]")

@@ -191,7 +191,7 @@ static const float TH_TOLERANCE_C = {lit(c.tolerance, 'tolerance')};
 #define TH_MAX_ITER {NEWTON_MAX_ITER}
 
 {thermometer_text}/* ---- streaming compensation (hrgtc.compensate.Compensator) ---- */
-/* training ranges of the drift model's variables (window means) */
+/* training ranges of the drift model's variables (as the model file stores them) */
 {range_constants}
 void {p}_reset({p}_state *state)
 {{
@@ -213,7 +213,7 @@ float {p}_step({p}_state *state, float dt_s, float f_hz, float rate_dph{h['arg']
 {{
     const float f_value = f_hz;
 {h['values']}{g['values']}    float df_value = 0.0f, bias, compensated, temperature;
-    int in_range, rate_in_range, level_in_range;
+    int in_range, rate_in_range, level_in_range, settled;
 {k['declare']}    if (!state->started) {{  /* the filters start at rest on the first sample */
         rate_start(&state->f_filter, f_value);
 {h['start']}{g['start']}        state->started = 1;

@@ -32,10 +32,12 @@ def step_tail(*, up: str, level_test: str, rate_test: str, h: Mapping[str, str],
     /* in_range: calibrated temperature, trained df/dt, and the filter settled */
     /* settled: SETTLE_S seconds since init/reset, the sum of the steps' dt_s */
     if (state->samples > 0UL && state->elapsed_s < {up}_SETTLE_S) state->elapsed_s += dt_s;
-    in_range = level_in_range && rate_in_range && state->elapsed_s >= {up}_SETTLE_S;
+    settled = state->elapsed_s >= {up}_SETTLE_S;
+    in_range = level_in_range && rate_in_range && settled;
     state->samples += 1UL;
-    state->out_of_range += level_in_range ? 0UL : 1UL;
-    state->rate_out_of_range += rate_in_range ? 0UL : 1UL;
+    /* counted once settled (a settling sample is flagged as such, not out of range) */
+    state->out_of_range += (level_in_range || !settled) ? 0UL : 1UL;
+    state->rate_out_of_range += (rate_in_range || !settled) ? 0UL : 1UL;
 {k['apply']}    if (out) {{
         out->rate_comp_dph = compensated;
         out->bias_model_dph = bias;

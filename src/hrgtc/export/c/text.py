@@ -383,7 +383,7 @@ static const double TH_TOLERANCE_C = {_literal(plan.tolerance, 'tolerance')};
 #define TH_MAX_ITER {NEWTON_MAX_ITER}
 
 {thermometer_text}/* ---- streaming compensation (hrgtc.compensate.Compensator) ---- */
-/* training ranges of the drift model's variables (window means) */
+/* training ranges of the drift model's variables (as the model file stores them) */
 {range_constants}
 void {p}_reset({p}_state *state)
 {{
@@ -405,7 +405,7 @@ double {p}_step({p}_state *state, double dt_s, double freq_hz, double rate_dph{h
 {{
     const double f_value = freq_hz - REFERENCE_FREQ_HZ;
 {h['values']}{extra['values']}    double df_value = 0.0, bias, compensated, temperature;
-    int in_range, rate_in_range, level_in_range;
+    int in_range, rate_in_range, level_in_range, settled;
 {k['declare']}    if (!state->started) {{  /* the filters start at rest on the first sample */
         rate_start(&state->f_filter, f_value);
 {h['start']}{extra['start']}        state->started = 1;

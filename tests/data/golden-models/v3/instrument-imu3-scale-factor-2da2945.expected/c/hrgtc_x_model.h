@@ -129,8 +129,8 @@ typedef struct hrgtc_x_state {
     int started;                /* 0 until the first sample after init/reset */
     unsigned long samples;      /* samples since init/reset */
     double elapsed_s;           /* seconds since init/reset, up to SETTLE_S [s] */
-    unsigned long out_of_range; /* of which outside the calibrated temperature */
-    unsigned long rate_out_of_range; /* of which with rate_in_range == 0 */
+    unsigned long out_of_range; /* of which settled, outside the calibrated temperature */
+    unsigned long rate_out_of_range; /* of which settled, with rate_in_range == 0 */
 } hrgtc_x_state;
 
 /* Everything one step computes. */

@@ -275,7 +275,7 @@ double hrgtc_y_temperature_c(double freq_hz)
 }
 
 /* ---- streaming compensation (hrgtc.compensate.Compensator) ---- */
-/* training ranges of the drift model's variables (window means) */
+/* training ranges of the drift model's variables (as the model file stores them) */
 static const double RANGE_F_LOW = -18.03076281873069;
 static const double RANGE_F_HIGH = 4.379667063403758e-05;
 static const double RANGE_DF_LOW = -0.0039834028107303332;
@@ -300,7 +300,7 @@ double hrgtc_y_step(hrgtc_y_state *state, double dt_s, double freq_hz, double ra
 {
     const double f_value = freq_hz - REFERENCE_FREQ_HZ;
     double df_value = 0.0, bias, compensated, temperature;
-    int in_range, rate_in_range, level_in_range;
+    int in_range, rate_in_range, level_in_range, settled;
     double scale, product, divisor;
     if (!state->started) {  /* the filters start at rest on the first sample */
         rate_start(&state->f_filter, f_value);
@@ -318,10 +318,12 @@ double hrgtc_y_step(hrgtc_y_state *state, double dt_s, double freq_hz, double ra
     /* in_range: calibrated temperature, trained df/dt, and the filter settled */
     /* settled: SETTLE_S seconds since init/reset, the sum of the steps' dt_s */
     if (state->samples > 0UL && state->elapsed_s < HRGTC_Y_SETTLE_S) state->elapsed_s += dt_s;
-    in_range = level_in_range && rate_in_range && state->elapsed_s >= HRGTC_Y_SETTLE_S;
+    settled = state->elapsed_s >= HRGTC_Y_SETTLE_S;
+    in_range = level_in_range && rate_in_range && settled;
     state->samples += 1UL;
-    state->out_of_range += level_in_range ? 0UL : 1UL;
-    state->rate_out_of_range += rate_in_range ? 0UL : 1UL;
+    /* counted once settled (a settling sample is flagged as such, not out of range) */
+    state->out_of_range += (level_in_range || !settled) ? 0UL : 1UL;
+    state->rate_out_of_range += (rate_in_range || !settled) ? 0UL : 1UL;
     scale = hrgtc_y_scale_ppm(freq_hz);
     product = 9.9999999999999995e-07 * scale;
     divisor = 1.0 + product;

@@ -220,7 +220,7 @@ double hrgtc_z_temperature_c(double freq_hz)
 }
 
 /* ---- streaming compensation (hrgtc.compensate.Compensator) ---- */
-/* training ranges of the drift model's variables (window means) */
+/* training ranges of the drift model's variables (as the model file stores them) */
 static const double RANGE_F_LOW = -5.9316577356278666;
 static const double RANGE_F_HIGH = 6.1659532778321999;
 static const double RANGE_DF_LOW = -0.010488063419574341;
@@ -245,7 +245,7 @@ double hrgtc_z_step(hrgtc_z_state *state, double dt_s, double freq_hz, double ra
 {
     const double f_value = freq_hz - REFERENCE_FREQ_HZ;
     double df_value = 0.0, bias, compensated, temperature;
-    int in_range, rate_in_range, level_in_range;
+    int in_range, rate_in_range, level_in_range, settled;
     if (!state->started) {  /* the filters start at rest on the first sample */
         rate_start(&state->f_filter, f_value);
         state->started = 1;
@@ -262,10 +262,12 @@ double hrgtc_z_step(hrgtc_z_state *state, double dt_s, double freq_hz, double ra
     /* in_range: calibrated temperature, trained df/dt, and the filter settled */
     /* settled: SETTLE_S seconds since init/reset, the sum of the steps' dt_s */
     if (state->samples > 0UL && state->elapsed_s < HRGTC_Z_SETTLE_S) state->elapsed_s += dt_s;
-    in_range = level_in_range && rate_in_range && state->elapsed_s >= HRGTC_Z_SETTLE_S;
+    settled = state->elapsed_s >= HRGTC_Z_SETTLE_S;
+    in_range = level_in_range && rate_in_range && settled;
     state->samples += 1UL;
-    state->out_of_range += level_in_range ? 0UL : 1UL;
-    state->rate_out_of_range += rate_in_range ? 0UL : 1UL;
+    /* counted once settled (a settling sample is flagged as such, not out of range) */
+    state->out_of_range += (level_in_range || !settled) ? 0UL : 1UL;
+    state->rate_out_of_range += (rate_in_range || !settled) ? 0UL : 1UL;
     if (out) {
         out->rate_comp_dph = compensated;
         out->bias_model_dph = bias;
