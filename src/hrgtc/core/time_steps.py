@@ -40,11 +40,14 @@ Every command reads this one diagnosis (through the recording validator), so
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
+from hrgtc.core import records
+from hrgtc.core.records import Count, Record
 from hrgtc.core.timeline import GAP_FACTOR, gap_limit_s, median_period_s
 
 #: Modulus of a 32-bit counter in seconds, per time unit of the raw column.
@@ -88,9 +91,23 @@ class TimeEvent:
     repaired: bool
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types."""
-        return {"kind": self.kind, "row": self.row, "count": self.count,
-                "message": self.message, "repaired": self.repaired}
+        """Plain JSON types (:class:`TimeEventRecord`)."""
+        return records.dump(self, TimeEventRecord)
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> TimeEvent:
+        """Inverse of :meth:`to_dict`."""
+        return cls(**records.load(data, TimeEventRecord, "time event"))
+
+
+class TimeEventRecord(Record):
+    """The record of :class:`TimeEvent`."""
+
+    kind: str
+    row: Count
+    count: Count
+    message: str
+    repaired: bool
 
 
 @dataclass(frozen=True)
@@ -135,10 +152,19 @@ class TimeDiagnosis:
         return next((e for e in self.events if e.kind == kind), None)
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (without the arrays)."""
-        return {"events": [e.to_dict() for e in self.events],
-                "restarts": list(self.restarts), "duplicates": self.duplicates,
-                "period_s": self.period_s if math.isfinite(self.period_s) else None}
+        """Plain JSON types, without the arrays (:class:`TimeDiagnosisRecord`; written,
+        not read back: the arrays are not in it)."""
+        return records.dump(self, TimeDiagnosisRecord)
+
+
+class TimeDiagnosisRecord(Record):
+    """The record of :class:`TimeDiagnosis` (``duplicates``: rows dropped; ``period_s``
+    ``null`` when unknown)."""
+
+    events: list[TimeEventRecord]
+    restarts: list[Count]
+    duplicates: Count
+    period_s: float | None = None
 
 
 def _same_rows(values: np.ndarray | None, a: np.ndarray, b: np.ndarray) -> np.ndarray:

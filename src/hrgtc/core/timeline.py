@@ -32,7 +32,9 @@ from typing import Any
 
 import numpy as np
 
+from hrgtc.core import records
 from hrgtc.core.errors import InputError
+from hrgtc.core.records import Count, Record
 
 GAP_FACTOR = 2.0  # a time step longer than this many sample periods is a gap
 #: Relative slack of the gap threshold: one missing sample (a step of exactly 2 periods)
@@ -217,20 +219,10 @@ class Timeline:
         return np.searchsorted(self.bounds[:, 0], np.asarray(rows), side="right") - 1
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types: the summary (not every bound) plus the first bounds."""
-        def number(x: float) -> float | None:
-            return float(x) if math.isfinite(x) else None
-        return {
-            "segments": self.n_segments,
-            "samples": self.n_samples,
-            "period_s": number(self.period_s),
-            "gap_factor": self.gap_factor,
-            "span_s": self.span_s,
-            "recorded_s": self.recorded_s,
-            "burst_length_s": number(self.burst_length_s),
-            "burst_period_s": number(self.burst_period_s),
-            "bursty": self.is_bursty,
-        }
+        """Plain JSON types: the summary, not every bound (:class:`TimelineRecord`; written,
+        not read back: the bounds are not in it)."""
+        return records.dump(self, TimelineRecord, segments=self.n_segments,
+                            samples=self.n_samples, bursty=self.is_bursty)
 
     def summary(self) -> str:
         """One line: span, recorded duration, segments and the burst structure."""
@@ -240,6 +232,21 @@ class Timeline:
             line += (f"; segments of {_duration(self.burst_length_s)} (median) every "
                      f"{_duration(self.burst_period_s)}")
         return line
+
+
+class TimelineRecord(Record, kw_only=True):
+    """The record of :class:`Timeline` (``null``: a figure that is not defined, e.g. the
+    burst period of one segment)."""
+
+    segments: Count
+    samples: Count
+    period_s: float | None = None
+    gap_factor: float
+    span_s: float
+    recorded_s: float
+    burst_length_s: float | None = None
+    burst_period_s: float | None = None
+    bursty: bool
 
 
 def _duration(seconds: float) -> str:

@@ -276,23 +276,35 @@ class QRAccumulator:
         return self.names_
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain-JSON form of the statistics (for saving a long accumulation)."""
-        def listed(a: np.ndarray | None) -> list[Any] | None:
-            return None if a is None else a.tolist()
-        return {"names": list(self.names_ or ()), "n": self.n_,
-                "sum_weights": self.sum_weights_, "shift": listed(self.shift_),
-                "scale": listed(self.scale_), "r": listed(self.r_)}
+        """Plain-JSON form of the statistics, for saving a long accumulation
+        (:class:`QRAccumulatorRecord`; every float as written, so a round trip is exact)."""
+        return records.dump(self, QRAccumulatorRecord, names=list(self.names_ or ()),
+                            n=self.n_, sum_weights=self.sum_weights_, shift=self.shift_,
+                            scale=self.scale_, r=self.r_)
 
     @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> QRAccumulator:
+    def from_dict(cls, data: Mapping[str, Any]) -> QRAccumulator:
         """Inverse of :meth:`to_dict`."""
-        acc = cls(data["names"] or None)
-        acc.n_, acc.sum_weights_ = int(data["n"]), float(data["sum_weights"])
-        if data["r"] is not None:
-            acc.shift_ = np.asarray(data["shift"], dtype=np.float64)
-            acc.scale_ = np.asarray(data["scale"], dtype=np.float64)
-            acc.r_ = np.asarray(data["r"], dtype=np.float64)
+        values = records.load(data, QRAccumulatorRecord, "QR accumulator")
+        acc = cls(list(values["names"]) or None)
+        acc.n_, acc.sum_weights_ = values["n"], values["sum_weights"]
+        if values["r"] is not None:
+            acc.shift_ = np.asarray(values["shift"], dtype=np.float64)
+            acc.scale_ = np.asarray(values["scale"], dtype=np.float64)
+            acc.r_ = np.asarray(values["r"], dtype=np.float64)
         return acc
+
+
+class QRAccumulatorRecord(records.Record, kw_only=True):
+    """The record of :class:`QRAccumulator`'s state (``shift``, ``scale``: of the columns
+    [X, y]; ``r``: the triangular factor of [1, X, y]; all three ``null`` before any row)."""
+
+    names: list[str]
+    n: records.Count
+    sum_weights: records.NonNegative
+    shift: list[float] | None = None
+    scale: list[records.Positive] | None = None
+    r: list[list[float]] | None = None
 
 
 def _shift_and_scale(X: np.ndarray, y: np.ndarray, w: np.ndarray | None

@@ -17,13 +17,15 @@ from __future__ import annotations
 import csv
 import math
 from collections.abc import Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from hrgtc.core import records
 from hrgtc.core.errors import InputError
+from hrgtc.core.records import Count, Record
 from hrgtc.recording import Recording
 
 __all__ = [
@@ -89,8 +91,25 @@ class RateSegment:
     first_row: int = 0
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain-JSON form."""
-        return asdict(self)
+        """Plain-JSON form (:class:`RateSegmentRecord`)."""
+        return records.dump(self, RateSegmentRecord)
+
+    @classmethod
+    def from_dict(cls, data: Any) -> RateSegment:
+        """Inverse of :meth:`to_dict`."""
+        return cls(**records.load(data, RateSegmentRecord, "rate segment"))
+
+
+class RateSegmentRecord(Record):
+    """The record of :class:`RateSegment`."""
+
+    start_s: float
+    end_s: float
+    input_rate_dph: float
+    rate_dph: float
+    freq_hz: float
+    rows: Count
+    first_row: Count = 0
 
 
 def read_segment_table(path: str | Path) -> tuple[RateStep, ...]:
@@ -279,9 +298,23 @@ class SegmentScaleErrors:
         return "\n".join(lines)
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain-JSON form."""
-        return {"segments": [s.to_dict() for s in self.segments],
-                "error_ppm": [float(e) for e in self.error_ppm]}
+        """Plain-JSON form (:class:`SegmentScaleErrorsRecord`)."""
+        return records.dump(self, SegmentScaleErrorsRecord)
+
+    @classmethod
+    def from_dict(cls, data: Any) -> SegmentScaleErrors:
+        """Inverse of :meth:`to_dict`."""
+        values = records.load(data, SegmentScaleErrorsRecord, "segment scale errors")
+        return cls(tuple(RateSegment(**s) for s in values["segments"]),
+                   np.asarray(values["error_ppm"], dtype=np.float64))
+
+
+class SegmentScaleErrorsRecord(Record):
+    """The record of :class:`SegmentScaleErrors` (``error_ppm``: one per segment, ``null``
+    where not finite)."""
+
+    segments: list[RateSegmentRecord]
+    error_ppm: list[records.Statistic]
 
 
 def segment_scale_errors(recording: Recording, bias_dph: Any = None, *,

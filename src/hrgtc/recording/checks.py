@@ -11,13 +11,15 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from hrgtc.core import records
 from hrgtc.core.errors import InputError, RecordingError
-from hrgtc.recording.gaps import Gap
+from hrgtc.core.records import Count, Record
+from hrgtc.recording.gaps import Gap, GapPolicy, GapRecord
 
 SAMPLE_RATE_TOLERANCE = 0.01  # relative disagreement of measured and nominal rate
 KHZ_BELOW_HZ = 100.0
@@ -81,13 +83,24 @@ class Problem:
     count: int = 1
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types."""
-        return asdict(self)
+        """Plain JSON types (:class:`ProblemRecord`)."""
+        return records.dump(self, ProblemRecord)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> Problem:
         """Inverse of :meth:`to_dict`."""
-        return cls(**dict(data))
+        return cls(**records.load(data, ProblemRecord, "problem"))
+
+
+class ProblemRecord(Record):
+    """The record of :class:`Problem`."""
+
+    kind: str
+    message: str
+    column: str | None = None
+    row: Count | None = None
+    value: str | None = None
+    count: Count = 1
 
 
 @dataclass(frozen=True)
@@ -122,7 +135,7 @@ class ValidationReport:
     rows: int
     source: str | None
     measured_sample_rate_hz: float | None
-    gap_policy: str = "error"
+    gap_policy: GapPolicy = "error"
 
     @property
     def message(self) -> str:
@@ -153,16 +166,28 @@ class ValidationReport:
         return "\n".join(lines)
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types."""
-        data = asdict(self)
-        return {**data, "problems": list(data["problems"]), "gaps": list(data["gaps"])}
+        """Plain JSON types (:class:`ValidationReportRecord`)."""
+        return records.dump(self, ValidationReportRecord)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> ValidationReport:
         """Inverse of :meth:`to_dict`."""
-        problems = tuple(Problem.from_dict(p) for p in data["problems"])
-        gaps = tuple(Gap.from_dict(g) for g in data["gaps"])
-        return cls(**{**data, "problems": problems, "gaps": gaps})
+        values = records.load(data, ValidationReportRecord, "validation report")
+        return cls(**values | {"problems": tuple(Problem(**p) for p in values["problems"]),
+                               "gaps": tuple(Gap(**g) for g in values["gaps"])})
+
+
+class ValidationReportRecord(Record, kw_only=True):
+    """The record of :class:`ValidationReport`."""
+
+    ok: bool
+    problems: list[ProblemRecord]
+    gaps: list[GapRecord]
+    n_gaps: Count
+    rows: Count
+    source: str | None = None
+    measured_sample_rate_hz: float | None = None
+    gap_policy: GapPolicy = "error"
 
 
 def problems_message(source: str | None, problems: tuple[Problem, ...] | list[Problem]) -> str:

@@ -25,20 +25,33 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Mapping
-from dataclasses import asdict, dataclass
-from typing import Any, Literal
+from dataclasses import dataclass
+from typing import Annotated, Any, Literal
 
 import numpy as np
+from msgspec import Meta
 
+from hrgtc.core import records
 from hrgtc.core.errors import RecordingError
+from hrgtc.core.records import Count, Record
 from hrgtc.core.timeline import GAP_FACTOR, GAP_TOLERANCE, is_gap
 from hrgtc.recording.schema import Recording
 
 GapPolicy = Literal["error", "split", "bridge", "ignore"]
 GAP_POLICIES: tuple[str, ...] = ("error", "split", "bridge", "ignore")
 GAP_PERIODS = GAP_FACTOR  # a time step longer than this many sample periods is a gap
-__all__ = ["GAP_PERIODS", "GAP_POLICIES", "GAP_TOLERANCE", "MAX_LISTED_GAPS", "Gap",
-           "GapPolicy", "check_gap_policy", "filter_restarts_at_gaps", "split_at_gaps"]
+__all__ = [
+    "GAP_PERIODS",
+    "GAP_POLICIES",
+    "GAP_TOLERANCE",
+    "MAX_LISTED_GAPS",
+    "Gap",
+    "GapPolicy",
+    "GapRecord",
+    "check_gap_policy",
+    "filter_restarts_at_gaps",
+    "split_at_gaps",
+]
 MAX_LISTED_GAPS = 1000
 
 
@@ -61,13 +74,21 @@ class Gap:
     row: int
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types."""
-        return asdict(self)
+        """Plain JSON types (:class:`GapRecord`)."""
+        return records.dump(self, GapRecord)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> Gap:
         """Inverse of :meth:`to_dict`."""
-        return cls(**dict(data))
+        return cls(**records.load(data, GapRecord, "gap"))
+
+
+class GapRecord(Record):
+    """The record of :class:`Gap`."""
+
+    start_time_s: float
+    duration_s: Annotated[float, Meta(ge=0)]
+    row: Count
 
 
 def check_gap_policy(gaps: str) -> str:

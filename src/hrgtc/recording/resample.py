@@ -31,11 +31,13 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
+from hrgtc.core import records
 from hrgtc.core.errors import InputError, SlowChannelWarning
+from hrgtc.core.records import Count, Positive, Record
 from hrgtc.settings.reading import DEFAULT_MAX_AGE_PERIODS
 
 #: What to do with a slow channel's empty cells.
@@ -72,9 +74,19 @@ class ChannelFill:
     alias_of: str | None = None  # the same cells under another name (a sensor's freq_hz)
 
     def to_dict(self) -> dict[str, Any]:
-        return {"column": self.column, "period_s": self.period_s, "max_age_s": self.max_age_s,
-                "filled": self.filled, "dropped": self.dropped,
-                "first_dropped_row": self.first_dropped_row}
+        """Plain JSON types (:class:`ChannelFillRecord`: the figures, not the state)."""
+        return records.dump(self, ChannelFillRecord)
+
+
+class ChannelFillRecord(Record):
+    """The record of :class:`ChannelFill`."""
+
+    column: str
+    period_s: Positive
+    max_age_s: Positive
+    filled: Count = 0
+    dropped: Count = 0
+    first_dropped_row: Count | None = None
 
 
 @dataclass
@@ -226,8 +238,9 @@ class SlowChannels:
         return lines
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types: the mode and each slow channel's figures."""
-        return {"mode": self.mode, "channels": [s.to_dict() for s in self._reported()]}
+        """Plain JSON types: the mode and each slow channel's figures
+        (:class:`SlowChannelsRecord`)."""
+        return records.dump(self, SlowChannelsRecord, channels=self._reported())
 
     def _reported(self) -> list[ChannelFill]:
         """The channels to report: not a second name of the same cells (``--thermometer
@@ -238,6 +251,14 @@ class SlowChannels:
         """Report each slow channel once as a :class:`~hrgtc.core.errors.SlowChannelWarning`."""
         for line in self.summary():
             warnings.warn(line, SlowChannelWarning, stacklevel=3)
+
+
+class SlowChannelsRecord(Record):
+    """The record of :class:`SlowChannels`: the mode and the channels reported (not a
+    second name of the same cells)."""
+
+    mode: Literal["hold", "interpolate", "error"]
+    channels: list[ChannelFillRecord]
 
 
 def _same_cells(a: np.ndarray, b: np.ndarray) -> bool:

@@ -530,9 +530,16 @@ class TemperatureReference:
     lag_s: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        """How the log was read, as plain JSON types (a model file's provenance)."""
-        return {"path": str(self.path), "columns": dict(self.columns or {}), "unit": self.unit,
-                "start": self.start, "tz": self.tz, "lag_s": self.lag_s}
+        """How the log was read, as plain JSON types (a model file's provenance;
+        :class:`TemperatureReferenceRecord`)."""
+        return records.dump(self, TemperatureReferenceRecord, path=str(self.path),
+                            columns=dict(self.columns or {}))
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> TemperatureReference:
+        """Inverse of :meth:`to_dict` (no columns: None, the default names)."""
+        values = records.load(data, TemperatureReferenceRecord, "temperature reference")
+        return cls(**values | {"columns": values["columns"] or None})
 
     def fit(self, recording: str | Path, read_options: Any = None) -> TemperatureMap:
         """The count → °C map of ``recording``'s raw temperature
@@ -540,6 +547,18 @@ class TemperatureReference:
         return map_from_reference(recording, self.path, read_options, columns=self.columns,
                                   unit=self.unit, start=self.start, tz=self.tz,
                                   lag_s=self.lag_s)
+
+
+class TemperatureReferenceRecord(records.Record, kw_only=True):
+    """The record of :class:`TemperatureReference` (``columns``: ours -> the log's;
+    empty for the default names)."""
+
+    path: str
+    columns: dict[str, str] = records.empty()
+    unit: str | None = None
+    start: str | None = None
+    tz: str | None = None
+    lag_s: float | None = None
 
 
 def _read_raw(options: Any, recording: str | Path) -> Any:
