@@ -197,7 +197,14 @@ def compensation_accounting(compensator: Any, spikes: int = 0,
 
 def compensated_metadata(metadata: rec_io.Metadata, model: UnitModel,
                          drift: str = "frequency") -> rec_io.Metadata:
-    """``metadata`` with the mark of compensation by ``model`` (:mod:`hrgtc.recording.marks`)."""
+    """``metadata`` with the mark of compensation by ``model`` (:mod:`hrgtc.recording.marks`).
+
+    Its ``drift`` says what drove the model: ``"frequency"`` (the resonator's), ``"sensor
+    temperature"`` (a model of the gyro's temperature sensor, ``--thermometer sensor``) or
+    ``"housing"`` (the housing-thermistor baseline).
+    """
+    if drift == "frequency" and model.thermometer.source == "sensor":
+        drift = "sensor temperature"
     extra = {**metadata.extra, COMPENSATED_KEY: mark(model.sha256, model.unit, drift)}
     # the restarts known when the output is opened are those of the first chunk only: none
     # are written then, and all at close (compensate_file; its time axis is the repaired one)

@@ -1,0 +1,96 @@
+"""Words that fit the sensor (issue 20 item 11): on a model of the gyro's temperature sensor
+(``--thermometer sensor``) the outputs say "sensor", not resonator, Hz or a cubic fit; on a
+resonator model they keep the resonator's words, unchanged.
+
+Truth: the committed golden model files (a resonator model, a sensor model, the PAN cold
+test's sensor model with its ``temperature_map``) and the real cold test itself.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from typer.testing import CliRunner
+
+from hrgtc.cli import app
+from hrgtc.compensate.file_pass import compensated_metadata
+from hrgtc.evaluation.calibration_figures import (
+    SENSOR_THERMOMETER,
+    THERMOMETER,
+    calibration_summary,
+)
+from hrgtc.model import load_instrument, load_model
+from hrgtc.recording import Metadata
+
+GOLDEN = Path(__file__).parents[1] / "data" / "golden-models"
+RESONATOR = GOLDEN / "v2" / "unit-resonator-254ab6c.json"
+SENSOR = GOLDEN / "v2" / "unit-sensor-thermometer-ee60050.json"
+PAN_MODEL = GOLDEN / "v3" / "instrument-pan-sensor-temp-map-ee60050.json"
+DATA = Path(__file__).parents[1] / "data" / "pan-cold-test"
+RUN = DATA / "pan_tvc_cold_2020-03-07.csv"
+LOG = DATA / "pan_etu_cold_handlog_2020-03-07.csv"
+READ = ["--thermometer", "sensor", "--time-unit", "ms", "--rate-unit", "rad/s", "--gaps", "bridge",
+        "--col", "time_s=time (ms),rate_dph_x=gyrox rad/s,rate_dph_y=gyroy rad/s,"
+        "rate_dph_z=gyroz rad/s,temperature_c=temp"]
+REF = ["--temp-ref", str(LOG), "--temp-ref-col", "time_s=Time", "--temp-ref-col",
+       "temperature_c=C1 (C)", "--temp-ref-start", "15:45"]
+runner = CliRunner()
+
+
+def test_the_compensated_mark_says_what_drove_the_model():
+    """``compensated_by.drift``: "sensor temperature" for a sensor model (was "frequency")."""
+    metadata = Metadata(sample_rate_hz=5.0)
+    sensor = compensated_metadata(metadata, load_model(SENSOR))
+    assert sensor.extra["compensated_by"]["drift"] == "sensor temperature"
+    resonator = compensated_metadata(metadata, load_model(RESONATOR))
+    assert resonator.extra["compensated_by"]["drift"] == "frequency"
+    housing = compensated_metadata(metadata, load_model(RESONATOR), "housing")
+    assert housing.extra["compensated_by"]["drift"] == "housing"
+
+
+def _section(summary, heading):
+    return {row[1]: row[2:] for row in summary.rows() if row[0] == heading}
+
+
+def test_a_sensor_thermometer_shows_no_cubic_fit():
+    """No "soak plateaus 2", c0 0, c1 1 °C/°C^1 for a sensor: what the thermometer is, the
+    temperatures trained on and, with a reference log, its map."""
+    model = load_model(SENSOR)
+    summary = calibration_summary(model)
+    assert THERMOMETER not in [row[0] for row in summary.rows()]
+    rows = _section(summary, SENSOR_THERMOMETER)
+    assert rows["thermometer"][0] == "temperature sensor, read directly"
+    assert not {"soak plateaus", "order", "c0", "c1", "R²"} & set(rows)
+    low, high = model.thermometer.temperature_range_c
+    assert "trained temperatures" in rows
+    assert f"{high - low:.4g}" in str(rows["trained temperatures"][0])
+
+    pan = load_instrument(PAN_MODEL)
+    mapped = _section(calibration_summary(pan.axes["x"], temperature_map=pan.temperature_map),
+                      SENSOR_THERMOMETER)
+    assert mapped["thermometer"][0] == "sensor count, mapped to °C"
+    assert mapped["reference log"][0] == pan.temperature_map["reference"]
+    assert mapped["map scale"][:2] == (f"{pan.temperature_map['scale_c_per_count']:.6g}",
+                                       "°C/count")
+    assert mapped["reference points"][0] == str(pan.temperature_map["points"])
+
+    resonator = _section(calibration_summary(load_model(RESONATOR)), THERMOMETER)
+    assert {"soak plateaus", "order", "c0", "c3"} <= set(resonator)
+    assert resonator["c1"][1] == "Hz/°C^1"
+
+
+def test_calibrate_on_the_cold_test_prints_its_map_as_the_thermometer(tmp_path, monkeypatch):
+    from hrgtc.cli import _app
+
+    monkeypatch.setattr(_app.console, "width", 200)
+    result = runner.invoke(app, ["calibrate", "--drift", str(RUN), *READ, *REF,
+                                 "--rate-tau-s", "310",
+                                 "-o", str(tmp_path / "pan.json")], terminal_width=200)
+    assert result.exit_code == 0, result.output
+    out = result.output
+    assert out.count(SENSOR_THERMOMETER) == 3 and "Eq. 18" not in out
+    assert "soak plateaus" not in out and "°C/°C^1" not in out
+    assert "map scale" in out and "0.00586994" in out and "°C/count" in out
+    model = json.loads((tmp_path / "pan.json").read_text())
+    assert model["temperature_map"]["points"] == 24
