@@ -94,3 +94,42 @@ def test_calibrate_on_the_cold_test_prints_its_map_as_the_thermometer(tmp_path, 
     assert "map scale" in out and "0.00586994" in out and "°C/count" in out
     model = json.loads((tmp_path / "pan.json").read_text())
     assert model["temperature_map"]["points"] == 24
+
+
+def _export(model: Path, kind: str, folder: Path) -> dict[str, str]:
+    result = runner.invoke(app, ["export-c", str(model), "-o", str(folder), "--format", kind],
+                           terminal_width=400)
+    assert result.exit_code == 0, result.output
+    def prose(text: str) -> str:  # the comment lines joined, their "*" or "#" left out
+        return " ".join(" ".join(line.strip().removeprefix("*").removeprefix("#").split())
+                        for line in text.splitlines())
+
+    return {p.name: prose(p.read_text()) for p in folder.iterdir()}
+
+
+def test_the_exports_of_a_sensor_model_speak_of_the_sensor(tmp_path):
+    """The C header and the parameter file: "gyro temperature-drift compensation
+    (temperature sensor)", the sensor's reading in °C and its temperature, not "HRG" and a
+    "resonator temperature"; a resonator model keeps its words."""
+    for model in (SENSOR, PAN_MODEL):
+        for kind in ("c", "params"):
+            texts = _export(model, kind, tmp_path / model.stem / kind)
+            for name, text in texts.items():
+                if not name.endswith((".h", ".txt")):
+                    continue
+                assert "gyro temperature-drift compensation (temperature sensor)" in text, name
+                assert "HRG" not in text.replace("HRGTC", ""), name
+                assert "resonator temperature" not in text, name
+                assert "resonator natural frequency" not in text, name
+        header = _export(model, "c", tmp_path / model.stem / "again")
+        readme = next(t for n, t in header.items()
+                      if n.endswith("_model.h") and "Thermometer" in t)
+        assert "freq_hz [degC] the temperature sensor's reading" in readme
+        assert "Thermometer: the gyro's temperature sensor, freq = +1*T +0" in readme
+    c = _export(RESONATOR, "c", tmp_path / "resonator" / "c")["hrgtc_model.h"]
+    assert "hrgtc_model.h -- HRG temperature-drift compensation of unit" in c
+    assert "the resonator temperature from the frequency (inverse of Eq. (18)" in c
+    assert "freq_hz [Hz] resonator natural frequency" in c and "(temperature sensor)" not in c
+    params = _export(RESONATOR, "params", tmp_path / "resonator" / "params")["hrgtc_params.txt"]
+    assert "hrgtc parameter file -- HRG temperature-drift compensation of unit" in params
+    assert "6. resonator temperature:" in params
