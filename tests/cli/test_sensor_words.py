@@ -45,6 +45,8 @@ def test_the_compensated_mark_says_what_drove_the_model():
     assert sensor.extra["compensated_by"]["drift"] == "sensor temperature"
     resonator = compensated_metadata(metadata, load_model(RESONATOR))
     assert resonator.extra["compensated_by"]["drift"] == "frequency"
+    instrument = compensated_metadata(metadata, load_instrument(PAN_MODEL))
+    assert instrument.extra["compensated_by"]["drift"] == "sensor temperature"
     housing = compensated_metadata(metadata, load_model(RESONATOR), "housing")
     assert housing.extra["compensated_by"]["drift"] == "housing"
 
@@ -94,6 +96,13 @@ def test_calibrate_on_the_cold_test_prints_its_map_as_the_thermometer(tmp_path, 
     assert "map scale" in out and "0.00586994" in out and "°C/count" in out
     model = json.loads((tmp_path / "pan.json").read_text())
     assert model["temperature_map"]["points"] == 24
+    # the compensated file's mark: what drove the model (an instrument of sensor axes)
+    result = runner.invoke(app, ["compensate", str(RUN), "--model", str(tmp_path / "pan.json"),
+                                 *READ, "-o", str(tmp_path / "out.csv")])
+    assert result.exit_code == 0, result.output
+    head = [line for line in (tmp_path / "out.csv").read_text().splitlines()[:40]
+            if line.startswith("#")]
+    assert '"drift": "sensor temperature"' in "\n".join(head)
 
 
 def _export(model: Path, kind: str, folder: Path) -> dict[str, str]:

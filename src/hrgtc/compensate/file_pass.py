@@ -29,7 +29,7 @@ from hrgtc.core.files import check_writable, refuse_input
 from hrgtc.core.progress import Progress
 from hrgtc.core.time_steps import TimeRepairStream
 from hrgtc.core.timeline import RESTARTS_KEY
-from hrgtc.model import UnitModel
+from hrgtc.model import InstrumentModel, UnitModel
 from hrgtc.recording import Recording
 from hrgtc.recording.marks import COMPENSATED_KEY, mark, refuse_compensated
 from hrgtc.recording.spikes import SPIKE_COLUMN
@@ -195,7 +195,7 @@ def compensation_accounting(compensator: Any, spikes: int = 0,
     return accounting
 
 
-def compensated_metadata(metadata: rec_io.Metadata, model: UnitModel,
+def compensated_metadata(metadata: rec_io.Metadata, model: UnitModel | InstrumentModel,
                          drift: str = "frequency") -> rec_io.Metadata:
     """``metadata`` with the mark of compensation by ``model`` (:mod:`hrgtc.recording.marks`).
 
@@ -203,7 +203,8 @@ def compensated_metadata(metadata: rec_io.Metadata, model: UnitModel,
     temperature"`` (a model of the gyro's temperature sensor, ``--thermometer sensor``) or
     ``"housing"`` (the housing-thermistor baseline).
     """
-    if drift == "frequency" and model.thermometer.source == "sensor":
+    units = model.axes.values() if isinstance(model, InstrumentModel) else [model]
+    if drift == "frequency" and all(u.thermometer.source == "sensor" for u in units):
         drift = "sensor temperature"
     extra = {**metadata.extra, COMPENSATED_KEY: mark(model.sha256, model.unit, drift)}
     # the restarts known when the output is opened are those of the first chunk only: none
