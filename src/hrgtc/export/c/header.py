@@ -181,5 +181,9 @@ void {p}_reset({p}_state *state);
         text = (text.replace("resonator temperature from frequency", "sensor temperature")
                 .replace("resonator temperature from f_hz", "sensor temperature from f_hz")
                 .replace("worst measured at export: resonator temperature",
-                         "worst measured at export: sensor temperature"))
+                         "worst measured at export: sensor temperature")
+                .replace("/* Thermometer f(T), Eq. (18) form. [Hz] from [degC] */",
+                         "/* Thermometer f(T) = T, the identity. [degC] from [degC] */")
+                .replace("/* Thermometer, Eq. (18) form, centred:",
+                         "/* Thermometer f(T) = T, the identity, centred:"))
     return text

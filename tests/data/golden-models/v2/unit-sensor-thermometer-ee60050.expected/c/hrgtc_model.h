@@ -156,7 +156,7 @@ double hrgtc_step(hrgtc_state *state, double dt_s, double freq_hz, double rate_d
 /* Bias model B of Eq. (22) from the variables. [deg/h] */
 double hrgtc_bias_dph(double f_hz, double df_hz_per_s);
 
-/* Thermometer f(T), Eq. (18) form. [Hz] from [degC] */
+/* Thermometer f(T) = T, the identity. [degC] from [degC] */
 double hrgtc_frequency_hz(double temperature_c);
 
 /* Its inverse: sensor temperature; NaN beyond the monotonic extension. */

@@ -153,7 +153,7 @@ double hrgtc_y_step(hrgtc_y_state *state, double dt_s, double freq_hz, double ra
 /* Bias model B of Eq. (22) from the variables. [deg/h] */
 double hrgtc_y_bias_dph(double f_hz, double df_hz_per_s);
 
-/* Thermometer f(T), Eq. (18) form. [Hz] from [degC] */
+/* Thermometer f(T) = T, the identity. [degC] from [degC] */
 double hrgtc_y_frequency_hz(double temperature_c);
 
 /* Its inverse: sensor temperature; NaN beyond the monotonic extension. */
