@@ -8,6 +8,7 @@ test's sensor model with its ``temperature_map``) and the real cold test itself.
 
 from __future__ import annotations
 
+import html
 import json
 from pathlib import Path
 
@@ -103,6 +104,15 @@ def test_calibrate_on_the_cold_test_prints_its_map_as_the_thermometer(tmp_path, 
     head = [line for line in (tmp_path / "out.csv").read_text().splitlines()[:40]
             if line.startswith("#")]
     assert '"drift": "sensor temperature"' in "\n".join(head)
+    # the report: the same thermometer table (no Eq. 18 fit), the run's recorded time
+    result = runner.invoke(app, ["report", "--model", str(tmp_path / "pan.json"), str(RUN),
+                                 *READ, "-o", str(tmp_path / "pan.html")])
+    assert result.exit_code == 0, result.output
+    page = html.unescape((tmp_path / "pan.html").read_text(encoding="utf-8"))
+    assert page.count("Thermometer: the gyro's temperature sensor, its count mapped to °C "
+                      "by the reference log") == 3
+    assert "<td>map scale</td>" in page and "soak plateaus" not in page
+    assert "(0.0347 h recorded, in bursts of 5 s every 305 s)" in page
 
 
 def _export(model: Path, kind: str, folder: Path) -> dict[str, str]:
