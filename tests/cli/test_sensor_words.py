@@ -104,7 +104,19 @@ def test_calibrate_on_the_cold_test_prints_its_map_as_the_thermometer(tmp_path, 
     head = [line for line in (tmp_path / "out.csv").read_text().splitlines()[:40]
             if line.startswith("#")]
     assert '"drift": "sensor temperature"' in "\n".join(head)
-    # the report: the same thermometer table (no Eq. 18 fit), the run's recorded time
+    # the report: the same thermometer table (no Eq. 18 fit), the run's recorded time, the
+    # run figure's legends
+    from hrgtc.report import figures
+
+    legends: list[str] = []
+    drawn = figures.run_figure
+
+    def run_figure(*args, **kwargs):
+        figure = drawn(*args, **kwargs)
+        legends.extend(t.get_text() for ax in figure.axes for t in ax.get_legend().get_texts())
+        return figure
+
+    monkeypatch.setattr(figures, "run_figure", run_figure)
     result = runner.invoke(app, ["report", "--model", str(tmp_path / "pan.json"), str(RUN),
                                  *READ, "-o", str(tmp_path / "pan.html")])
     assert result.exit_code == 0, result.output
@@ -113,6 +125,9 @@ def test_calibrate_on_the_cold_test_prints_its_map_as_the_thermometer(tmp_path, 
                       "by the reference log") == 3
     assert "<td>map scale</td>" in page and "soak plateaus" not in page
     assert "(0.0347 h recorded, in bursts of 5 s every 305 s)" in page
+    assert len(legends) > 3 and "temperature sensor" in legends
+    assert not [t for t in legends if "resonator" in t or "frequency" in t], legends
+    assert any(t.startswith("compensated, temperature-sensor model") for t in legends)
 
 
 def _export(model: Path, kind: str, folder: Path) -> dict[str, str]:
@@ -152,3 +167,29 @@ def test_the_exports_of_a_sensor_model_speak_of_the_sensor(tmp_path):
     params = _export(RESONATOR, "params", tmp_path / "resonator" / "params")["hrgtc_params.txt"]
     assert "hrgtc parameter file -- HRG temperature-drift compensation of unit" in params
     assert "6. resonator temperature:" in params
+
+
+def test_the_run_figure_names_the_thermometer():
+    """The report's run figure: "temperature sensor" and "temperature-sensor model" for a
+    sensor; a resonator's run keeps "resonator, from frequency" and "frequency model"."""
+    import types
+
+    import numpy as np
+
+    from hrgtc.report.figures import run_figure
+
+    n = 12
+    blocks = {"time_s": 10.0 * np.arange(n), "raw_dph": np.linspace(0, 1, n),
+              "model_dph": np.linspace(0, 1, n), "comp_dph": np.zeros(n),
+              "temperature_c": np.linspace(20, 10, n), "in_range": np.ones(n)}
+    run = types.SimpleNamespace(blocks=blocks, block_s=10.0, stability=lambda *_: 1.0)
+
+    def legends(sensor):
+        figure = run_figure(run, sensor)
+        return [t.get_text() for ax in figure.axes for t in ax.get_legend().get_texts()]
+
+    sensor, resonator = legends(True), legends(False)
+    assert "temperature sensor" in sensor and "resonator, from frequency" not in sensor
+    assert "compensated, temperature-sensor model (10 s stability 1 °/h)" in sensor
+    assert "resonator, from frequency" in resonator
+    assert "compensated, frequency model (10 s stability 1 °/h)" in resonator

@@ -303,7 +303,7 @@ def _run(page: _Page, k: int, run: Evaluation, model: UnitModel) -> None:
              f'<p class="muted">{escape(run.source)}: unit {escape(run.unit)}, {run.n_samples} '
              f"samples at {run.sample_rate_hz:g} Hz ({_recorded(run)}), input "
              f"rate {run.input_rate_dph:g} °/h.</p>")
-    page.figure(figures.run_figure(run),
+    page.figure(figures.run_figure(run, model.thermometer.source == "sensor"),
                 f"(a) Gyro output minus the input rate with the drift model (red), mirrors "
                 f"<b>Fig. 6(a)</b> of [1]; (b) compensated output, mirrors <b>Fig. 6(b)</b>; "
                 f"(c) temperatures. {run.block_s:g} s means; red shading: samples outside the "
