@@ -218,3 +218,20 @@ def test_a_slow_housing_channel_is_held_or_refused_as_asked(tmp_path):
     assert code == 0, err
     # the last value before the stop is row 990's; rows 991..1010 are within 0.1 s of it
     assert data["rows"] == 2000 - (1100 - 1011)
+
+
+def test_info_shows_only_the_metadata_a_file_sets(tmp_path):
+    """A plain CSV (no metadata header) has no profile: no "profile ''", no "input rate 0";
+    a file that sets them shows them."""
+    rec = recording()
+    named = write(rec, tmp_path / "named.parquet")
+    text = " ".join(runner.invoke(app, ["info", str(named)]).stdout.split())
+    assert "unit SN-3, profile 'ramp', input rate 9.67 °/h" in text
+    plain = tmp_path / "plain.csv"
+    plain.write_text("time_s,freq_hz,rate_dph\n" + "".join(
+        f"{k / RATE_HZ},{4425.0 + 1e-3 * k},{12.0 + (k % 3)}\n" for k in range(400)))
+    result = runner.invoke(app, ["info", str(plain)])
+    assert result.exit_code == 0, result.stderr
+    text = " ".join(result.stdout.split())
+    assert "profile" not in text and "input rate" not in text
+    assert "unit unknown" in text

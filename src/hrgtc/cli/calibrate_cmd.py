@@ -31,15 +31,16 @@ if TYPE_CHECKING:
 EQ21_DEFAULT = ",".join(EQ21_TERMS)
 
 
-def render(result: CalibrationResult) -> None:
+def render(result: CalibrationResult, temperature_map: dict[str, Any] | None = None) -> None:
     """Print the unit's Table 1, Table 2 and plateaus (a frequency thermometer:
     :meth:`CalibrationResult.tables`), then the calibration's summary
     (:meth:`CalibrationResult.summary`: thermometer, drift model, stepwise steps, housing
     baseline and held-out runs, a table each, and the Eq. 18 and Eq. 22 forms); the range
-    warnings are printed apart."""
+    warnings are printed apart. ``temperature_map``: the instrument's map of a sensor's raw
+    count (``--temp-ref``), shown as the sensor thermometer's figures."""
     if result.model.thermometer.source != "sensor":
         print_summary(result.tables(), console, notes=False)  # the Eq. 18 form comes below
-    print_summary(result.summary(warnings=False), console)
+    print_summary(result.summary(warnings=False, temperature_map=temperature_map), console)
 
 
 @app.command("calibrate")
@@ -172,7 +173,8 @@ def render_instrument(calibration: InstrumentCalibration) -> None:
         if axis:
             console.rule(f"axis {axis}")
         model = calibration.model.axes[axis]
-        render(replace(result, model=model, validation=calibration.validation.get(axis, ())))
+        render(replace(result, model=model, validation=calibration.validation.get(axis, ())),
+               calibration.model.temperature_map)
         if model.scale_factor is not None:
             print_summary(model.scale_factor.summary(), console)
     summary = calibration.summary()

@@ -29,7 +29,7 @@ from hrgtc.core.files import check_writable, refuse_input
 from hrgtc.core.progress import Progress
 from hrgtc.core.time_steps import TimeRepairStream
 from hrgtc.core.timeline import RESTARTS_KEY
-from hrgtc.model import UnitModel
+from hrgtc.model import InstrumentModel, UnitModel
 from hrgtc.recording import Recording
 from hrgtc.recording.marks import COMPENSATED_KEY, mark, refuse_compensated
 from hrgtc.recording.spikes import SPIKE_COLUMN
@@ -195,9 +195,17 @@ def compensation_accounting(compensator: Any, spikes: int = 0,
     return accounting
 
 
-def compensated_metadata(metadata: rec_io.Metadata, model: UnitModel,
+def compensated_metadata(metadata: rec_io.Metadata, model: UnitModel | InstrumentModel,
                          drift: str = "frequency") -> rec_io.Metadata:
-    """``metadata`` with the mark of compensation by ``model`` (:mod:`hrgtc.recording.marks`)."""
+    """``metadata`` with the mark of compensation by ``model`` (:mod:`hrgtc.recording.marks`).
+
+    Its ``drift`` says what drove the model: ``"frequency"`` (the resonator's), ``"sensor
+    temperature"`` (a model of the gyro's temperature sensor, ``--thermometer sensor``) or
+    ``"housing"`` (the housing-thermistor baseline).
+    """
+    units = model.axes.values() if isinstance(model, InstrumentModel) else [model]
+    if drift == "frequency" and all(u.thermometer.source == "sensor" for u in units):
+        drift = "sensor temperature"
     extra = {**metadata.extra, COMPENSATED_KEY: mark(model.sha256, model.unit, drift)}
     # the restarts known when the output is opened are those of the first chunk only: none
     # are written then, and all at close (compensate_file; its time axis is the repaired one)

@@ -30,19 +30,26 @@ TABLE1, TABLE2, PLATEAUS, EQ18 = ("Table 1", "Table 2", "plateaus",
                                   "Eq. 18 beside the paper's")
 
 
+#: Heading of the thermometer's section: a resonator's fit (Eq. 18) or the gyro's sensor.
+THERMOMETER, SENSOR_THERMOMETER = "thermometer (Eq. 18)", "thermometer (temperature sensor)"
+
+
 def calibration_summary(model: Any, table: Sequence[Mapping[str, float]] = (),
                         validation: Sequence[Any] = (), prior_fit: Any = None,
-                        warnings: bool = True) -> Summary:
+                        warnings: bool = True,
+                        temperature_map: Mapping[str, Any] | None = None) -> Summary:
     """The figures of a calibration: a :class:`~hrgtc.model.UnitModel`, its Table 2 rows
     (``error_c``), the held-out :class:`~hrgtc.evaluation.Evaluation` s and the prior's fit
     (what :meth:`hrgtc.pipeline.calibration.CalibrationResult.summary` holds; the report
     passes a model file's). ``warnings``: the held-out runs' range warnings among the notes
-    (the CLI prints them apart).
+    (the CLI prints them apart). ``temperature_map``: the instrument's map of a raw sensor
+    count to °C (a model file's ``temperature_map``, ``--temp-ref``), shown as the sensor
+    thermometer's figures (a sensor has no Eq. 18 fit: no plateaus, no coefficients).
     """
     th = model.thermometer
     sensor = th.source == "sensor"
-    sections = [("thermometer (Eq. 18)",
-                 _thermometer_figures(th, table, prior_fit)),
+    sections = [(SENSOR_THERMOMETER, _sensor_figures(th, temperature_map)) if sensor else
+                (THERMOMETER, _thermometer_figures(th, table, prior_fit)),
                 ("drift model (Eq. 22)", _drift_figures("drift", model.drift, th.source)),
                 ("stepwise steps", _step_figures("drift", model.drift))]
     notes: list[str] = []
@@ -253,6 +260,35 @@ def _thermometer_figures(thermometer: Any, table: Sequence[Mapping[str, float]],
                     Figure("thermometer.prior.max_temperature_std_c",
                            "largest temperature 1σ (prior fit)",
                            prior_fit.max_temperature_std_c, "°C", digits=4)]
+    return tuple(figures)
+
+
+def _sensor_figures(thermometer: Any,
+                    temperature_map: Mapping[str, Any] | None) -> tuple[Figure, ...]:
+    """A sensor thermometer: what it is (the sensor read directly, or its raw count through
+    the reference log's map: scale, offset, residual, points, lag) and the temperatures
+    trained on. No order, plateaus or c0/c1: ``f = T`` is no fit."""
+    low, high = thermometer.temperature_range_c
+    if temperature_map is None:
+        figures = [Figure("thermometer.source", "thermometer",
+                          "temperature sensor, read directly")]
+    else:
+        figures = [
+            Figure("thermometer.source", "thermometer", "sensor count, mapped to °C"),
+            Figure("temperature_map.reference", "reference log",
+                   str(temperature_map.get("reference") or "-")),
+            Figure("temperature_map.scale_c_per_count", "map scale",
+                   float(temperature_map["scale_c_per_count"]), "°C/count", digits=6),
+            Figure("temperature_map.offset_c", "map offset",
+                   float(temperature_map["offset_c"]), "°C", digits=6),
+            Figure("temperature_map.residual_rms_c", "map residual RMS",
+                   _float(temperature_map.get("residual_rms_c")), "°C", digits=3),
+            Figure("temperature_map.points", "reference points",
+                   temperature_map.get("points", "-")),
+            Figure("temperature_map.lag_s", "reference lag",
+                   _float(temperature_map.get("lag_s")), "s", spec="+.0f")]
+    figures.append(Figure("thermometer.temperature_range_c", "trained temperatures",
+                          high - low, "°C", (low, high), "range", digits=4))
     return tuple(figures)
 
 

@@ -143,16 +143,18 @@ class CalibrationResult:
             "prior": None if self.prior_fit is None else self.prior_fit.to_dict(),
         }
 
-    def summary(self, warnings: bool = True) -> Summary:
+    def summary(self, warnings: bool = True,
+                temperature_map: Mapping[str, Any] | None = None) -> Summary:
         """The calibration's figures, each a value, a unit and an interval (±1σ of a
         coefficient, the confidence interval of a bias stability, the span of the data).
 
         Render it with ``.text()``, ``.rows()`` (a table) or ``.html()``; ``.to_dict()`` is
         plain JSON. ``warnings``: the held-out runs' range warnings among its notes (see
-        :func:`hrgtc.evaluation.calibration_figures.calibration_summary`).
+        :func:`hrgtc.evaluation.calibration_figures.calibration_summary`);
+        ``temperature_map``: the instrument's map of a sensor's raw count, if any.
         """
         return calibration_summary(self.model, self.table, self.validation, self.prior_fit,
-                                   warnings)
+                                   warnings, temperature_map)
 
     def tables(self) -> Summary:
         """The unit's Table 1, Table 2, plateaus and Eq. 18 beside the paper's as table

@@ -152,10 +152,13 @@ class RecordingInfo:
         lines = [f"{self.path} ({self.format or 'unknown format'})"]
         meta = self.metadata or {}
         if meta:
-            lines.append(
-                f"  unit {meta.get('unit')!s}, profile {meta.get('profile')!r}, "
-                f"input rate {_num(meta.get('input_rate_dph'))} °/h"
-            )
+            # a field the file does not set (a plain CSV's empty profile) is not shown
+            parts = [f"unit {meta.get('unit')!s}"]
+            if meta.get("profile"):
+                parts.append(f"profile {meta['profile']!r}")
+            if meta.get("profile") or meta.get("input_rate_dph"):
+                parts.append(f"input rate {_num(meta.get('input_rate_dph'))} °/h")
+            lines.append("  " + ", ".join(parts))
         lines.append(f"  rows: {self.rows}")
         if self.axes:
             lines.append(f"  axes: {', '.join(self.axes)} ({len(self.axes)}-axis recording; "

@@ -7,8 +7,10 @@ metadata (Parquet schema metadata, CSV header, HDF5 attributes)::
      "drift": "frequency"}
 
 and with the columns ``rate_comp_dph`` and ``bias_model_dph`` beside the raw
-``rate_dph``. :func:`compensation_mark` finds either: the metadata survive a
-renaming of the columns (``--col rate_dph=rate_comp_dph``), the column names
+``rate_dph``. ``drift`` says what drove the model: ``"frequency"``, ``"sensor
+temperature"`` (a model of the gyro's temperature sensor) or ``"housing"``.
+:func:`compensation_mark` finds either: the metadata survive a renaming of the
+columns (``--col rate_dph=rate_comp_dph``), the column names
 survive a tool that drops the metadata (e.g. a spreadsheet's CSV export). A file
 stripped of both cannot be told from a raw run.
 """

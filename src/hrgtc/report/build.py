@@ -16,6 +16,7 @@ import os
 from collections.abc import Callable, Sequence
 from html import escape
 from pathlib import Path
+from typing import Any
 
 from hrgtc.compensate.model_fit import check_thermometer_kind
 from hrgtc.compensate.multi_axis import match_axes, recording_axes
@@ -23,7 +24,11 @@ from hrgtc.core.errors import InputError
 from hrgtc.core.files import refuse_existing, write_text_atomic
 from hrgtc.core.progress import Progress
 from hrgtc.evaluation import Evaluation
-from hrgtc.evaluation.calibration_figures import thermometer_tables
+from hrgtc.evaluation.calibration_figures import (
+    SENSOR_THERMOMETER,
+    calibration_summary,
+    thermometer_tables,
+)
 from hrgtc.evaluation.glance_figures import GLANCE, instrument_glance_summary
 from hrgtc.evaluation.instrument_pass import evaluate_axes
 from hrgtc.model import InstrumentModel, UnitModel, load_instrument
@@ -39,6 +44,7 @@ from hrgtc.report.html import (
     _Page,
     _run,
     _scale_factor,
+    _section_table,
     _settling,
     _summary,
     _table_rows,
@@ -177,7 +183,7 @@ def build_report(
         axis_page = _Page()
         axis_page.count = page.count
         _unit_sections(axis_page, unit_model, evaluations[axis], traces.get(axis, []),
-                       missing)
+                       missing, instrument.temperature_map)
         page.count = axis_page.count
         sections[axis] = axis_page.parts
     if instrument.is_single_axis:
@@ -217,8 +223,10 @@ def _check_axes(model: InstrumentModel, runs: Sequence[PathLike | Evaluation],
 
 
 def _unit_sections(page: _Page, model: UnitModel, evaluations: Sequence[Evaluation],
-                   traces: Sequence[SoakTrace], missing: list[str]) -> None:
-    """One axis's sections: Figs. 3-5 and Tables 1-2, its runs, drift and scale factor."""
+                   traces: Sequence[SoakTrace], missing: list[str],
+                   temperature_map: dict[str, Any] | None = None) -> None:
+    """One axis's sections: Figs. 3-5 and Tables 1-2 (a sensor thermometer: what it is and
+    the map of its count, ``temperature_map``), its runs, drift and scale factor."""
     plateaus = [Plateau.from_dict(p) for p in model.plateaus]
     table = _table_rows(model, plateaus)
     sensor = model.thermometer.source == "sensor"
@@ -226,6 +234,10 @@ def _unit_sections(page: _Page, model: UnitModel, evaluations: Sequence[Evaluati
         low, high = model.thermometer.temperature_range_c
         page.note(f"No frequency output: the gyro's temperature sensor is the thermometer "
                   f"(trained {low:.2f} to {high:.2f} °C); Figs. 3-5 do not apply.")
+        _section_table(page, calibration_summary(model, temperature_map=temperature_map),
+                       SENSOR_THERMOMETER, "Thermometer: the gyro's temperature sensor"
+                       + (", its count mapped to °C by the reference log" if temperature_map
+                          else ", read directly"))
     else:
         tables = thermometer_tables(model.thermometer, plateaus)
         _settling(page, plateaus, traces, missing, tables)

@@ -320,12 +320,13 @@ def _spans(mask: np.ndarray) -> list[tuple[int, int]]:
 
 
 @_styled
-def run_figure(run: Evaluation) -> Figure:
+def run_figure(run: Evaluation, sensor: bool = False) -> Figure:
     """Raw output with the model, compensated output and temperatures of one run.
 
     Mirrors Fig. 6(a) (output, blue, and model, red) and Fig. 6(b) (compensated
-    output) of [1]; a third panel shows the resonator temperature from frequency.
-    Stretches with samples outside the calibrated range are shaded.
+    output) of [1]; a third panel shows the resonator temperature from frequency
+    (``sensor``: the thermometer is the gyro's temperature sensor, and the legends
+    say so). Stretches with samples outside the calibrated range are shaded.
     """
     b = run.blocks
     hours = _hours(b["time_s"])
@@ -344,13 +345,15 @@ def run_figure(run: Evaluation) -> Figure:
     raw_ax.set_ylabel("bias [°/h]")
     raw_ax.set_title(f"(a) raw output and model, {run.block_s:g} s means", fontsize=9)
     comp_ax.plot(hours, b["comp_dph"], color=COMPENSATED,
-                 label=f"compensated, frequency model ({_at10(run, 'compensated')})")
+                 label=f"compensated, {'temperature-sensor' if sensor else 'frequency'} model "
+                 f"({_at10(run, 'compensated')})")
     if "comp_housing_dph" in b:
         comp_ax.plot(hours, b["comp_housing_dph"], color=HOUSING, lw=0.9,
                      label=f"compensated, housing thermistor ({_at10(run, 'housing')})")
     comp_ax.set_ylabel("bias [°/h]")
     comp_ax.set_title("(b) compensated output", fontsize=9)
-    temp_ax.plot(hours, b["temperature_c"], color=RAW, label="resonator, from frequency")
+    temp_ax.plot(hours, b["temperature_c"], color=RAW,
+                 label="temperature sensor" if sensor else "resonator, from frequency")
     for key, label, colour, style in (
         ("resonator_c", "resonator, true", TRUTH, "--"),
         ("housing_c", "housing thermistor", HOUSING, "-"),

@@ -288,12 +288,22 @@ def _temperature(page: _Page, table: Sequence[Mapping[str, float]],
     page.add("</section>")
 
 
+def _recorded(run: Evaluation) -> str:
+    """How long the run recorded: its samples' time; for a burst logger also its bursts
+    and their spacing (the span is many times the recorded time)."""
+    text = f"{run.duration_s / 3600:.3g} h recorded"
+    burst = next(iter(run.burst_allan.values()), None)
+    if burst is not None:
+        text += f", in bursts of {burst.burst_s:.3g} s every {burst.period_s:.4g} s"
+    return text
+
+
 def _run(page: _Page, k: int, run: Evaluation, model: UnitModel) -> None:
     page.add(f'<section id="run-{k}"><h3>4.{k} Run <code>{escape(run.name)}</code></h3>',
              f'<p class="muted">{escape(run.source)}: unit {escape(run.unit)}, {run.n_samples} '
-             f"samples at {run.sample_rate_hz:g} Hz ({run.duration_s / 3600:.2f} h), input "
+             f"samples at {run.sample_rate_hz:g} Hz ({_recorded(run)}), input "
              f"rate {run.input_rate_dph:g} °/h.</p>")
-    page.figure(figures.run_figure(run),
+    page.figure(figures.run_figure(run, model.thermometer.source == "sensor"),
                 f"(a) Gyro output minus the input rate with the drift model (red), mirrors "
                 f"<b>Fig. 6(a)</b> of [1]; (b) compensated output, mirrors <b>Fig. 6(b)</b>; "
                 f"(c) temperatures. {run.block_s:g} s means; red shading: samples outside the "

@@ -108,7 +108,7 @@ double {p}_temperature_c(double freq_hz);
 /* 1 when freq_hz lies in the calibrated frequency range, else 0. */
 int {p}_frequency_in_range(double freq_hz);
 """
-    return f"""{readme}
+    text = f"""{readme}
 #ifndef {up}_MODEL_H
 #define {up}_MODEL_H
 
@@ -177,3 +177,13 @@ void {p}_reset({p}_state *state);
 
 #endif /* {up}_MODEL_H */
 """
+    if model.thermometer.source == "sensor":  # its thermometer is the identity on °C
+        text = (text.replace("resonator temperature from frequency", "sensor temperature")
+                .replace("resonator temperature from f_hz", "sensor temperature from f_hz")
+                .replace("worst measured at export: resonator temperature",
+                         "worst measured at export: sensor temperature")
+                .replace("/* Thermometer f(T), Eq. (18) form. [Hz] from [degC] */",
+                         "/* Thermometer f(T) = T, the identity. [degC] from [degC] */")
+                .replace("/* Thermometer, Eq. (18) form, centred:",
+                         "/* Thermometer f(T) = T, the identity, centred:"))
+    return text
