@@ -419,9 +419,11 @@ def detect_motion(
     var_rows = _rows(s.window_s, period, VARIANCE_MIN_SAMPLES)
     min_run = max(_rows(s.min_motion_s, period), 2)
     bounds = _bounds(breaks, n)
+    stepped = {"level": np.zeros(n, dtype=bool), "accelerometer": np.zeros(n, dtype=bool)}
     for channel in prepared:
         extremes = np.array([np.max(channel.values), np.min(channel.values)])
-        outputs = ((reasons["accelerometer"],) * 3 if channel.name in accel_names else
+        kind = "accelerometer" if channel.name in accel_names else "level"
+        outputs = ((reasons["accelerometer"],) * 3 if kind == "accelerometer" else
                    (reasons["level"], reasons["variance"], reasons["clipped"]))
         for a, b in bounds:
             kernel.segment_tests(
@@ -430,10 +432,19 @@ def detect_motion(
                 channel.diff_sigma, channel.diff_centre, MAD_TO_SIGMA,
                 s.variance_ratio * channel.diff_sigma,
                 s.threshold * max(channel.sigma, channel.lsb), extremes, int(s.clip_samples),
-                channel.sigma > 0, *(o[a:b] for o in outputs))
+                channel.sigma > 0, *(o[a:b] for o in outputs), stepped[kind][a:b])
+    starts, stops = (np.array(side, dtype=np.int64) for side in zip(*bounds, strict=True))
+    # a step of the still level (a new orientation's offset) bends the interpolated
+    # baseline for up to a block either side; within a block of motion found it is what
+    # that motion left, at rest; a step with no motion near (a rate table starting, which
+    # a gyro alone cannot tell from a new offset) stays motion
+    near, _ = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
+    kernel.guard(reasons["level"], reasons["variance"], reasons["clipped"],
+                 reasons["accelerometer"], starts, stops, base_rows, base_rows, near, _)
+    for kind, runs in stepped.items():
+        kernel.isolated_runs(runs, near, reasons[kind])
     after, before = _rows(s.guard_s, period, 0), _rows(s.guard_before_s, period, 0)
     moving = np.zeros(n, dtype=bool)
-    starts, stops = (np.array(side, dtype=np.int64) for side in zip(*bounds, strict=True))
     kernel.guard(reasons["level"], reasons["variance"], reasons["clipped"],  # never across
                  reasons["accelerometer"], starts, stops, after, before, moving,  # a gap
                  reasons["guard"])
