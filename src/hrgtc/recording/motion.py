@@ -91,7 +91,7 @@ class MotionSettings:
     variance_ratio: float = 3.0
     min_motion_s: float = 0.1
     guard_s: float = 5.0
-    guard_before_s: float = 1.0
+    guard_before_s: float = 2.0
     clip_samples: int = 3
 
     def __post_init__(self) -> None:
