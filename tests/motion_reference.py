@@ -221,7 +221,8 @@ def detect_motion_reference(
                    "accelerometer": np.zeros(b - a, dtype=bool)}
         for channel in prepared:
             level_mask, var_mask, clip_mask, step_mask = _channel_tests(
-                channel, t, channel.values[a:b], base_rows, var_rows, min_run, s)
+                channel, t, channel.values[a:b], base_rows, var_rows, min_run, s,
+                channel.name in accel_names)
             if channel.name in accel_names:
                 reasons["accelerometer"][a:b] |= level_mask | var_mask | clip_mask
                 stepped["accelerometer"] |= step_mask
@@ -249,7 +250,7 @@ def detect_motion_reference(
 
 
 def _channel_tests(channel: _Channel, t: np.ndarray, values: np.ndarray, base_rows: int,
-                   var_rows: int, min_run: int, s: MotionSettings
+                   var_rows: int, min_run: int, s: MotionSettings, held: bool = False
                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Level, variance and clipping tests of one channel over one segment, and the runs
     off the interpolated baseline alone (a step of the still level bends it)."""
@@ -260,7 +261,12 @@ def _channel_tests(channel: _Channel, t: np.ndarray, values: np.ndarray, base_ro
     stepped = np.zeros(m, dtype=bool)
     if channel.sigma > 0:  # off the baseline and off both anchors around it (a step is not)
         limit = s.threshold * channel.sigma
-        level = _long_runs((np.abs(deviation) > limit) & (np.abs(values - left) > limit)
+        # an accelerometer's still level never drifts: anchors that disagree are a step,
+        # and between them only a sample near one of them is at rest
+        off = np.abs(deviation) > limit
+        if held:
+            off |= np.abs(right - left) > limit
+        level = _long_runs(off & (np.abs(values - left) > limit)
                            & (np.abs(values - right) > limit), min_run)
         stepped = _long_runs(np.abs(deviation) > limit, min_run)
     variance = np.zeros(m, dtype=bool)

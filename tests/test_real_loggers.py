@@ -483,3 +483,37 @@ def test_handling_pulses_are_not_spikes_and_true_spikes_are_found(tmp_path, seed
             found += (row + np.flatnonzero(chunk["spike"])).tolist()
             row += len(chunk)
     assert len(truth) == 5 and found == truth
+
+
+def test_a_file_in_a_new_orientation_is_still_reported_unknown(handled):
+    """The same unit turned to a fourth orientation (upside down) the model never saw: its
+    still samples there are counted as an unknown orientation and warned about; its
+    handling samples are not (they are motion)."""
+    import re
+
+    from hrgtc.drift.rest import run_rest
+    from hrgtc.recording import ReadOptions, axis_view
+
+    _handled_model(handled, "handled")
+    logger = Logger(kind="continuous", sample_rate_hz=2.0, time_unit="ms", rate_unit="radps",
+                    frequency=False, temperature=TemperatureChannel(decimals=3, noise_c=0.005),
+                    handling=Handling(orientations=4, handling_s=60.0, max_rate_dps=500.0,
+                                      change_times_s=(600.0, 1200.0, 1800.0),
+                                      g_sensitivity_dph_per_g=G_SENSITIVITY_DPH_PER_G),
+                    accelerometer=True)
+    run = log_run(cooldown(20.0, 12.0, hours=1.0, ramp_c_per_min=0.15), "mems-3", logger, 5)
+    path, options, _ = _write(handled["dir"], "upside_down", run)
+    model = str(handled["dir"] / "handled.json")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        report = _cli("evaluate", str(path), "--model", model, *options)
+    assert any("never seen in training" in str(w.message) for w in caught)
+    reading = ReadOptions(columns=dict(o.split("=", 1) for o in options if "=" in o),
+                          units={"time": "ms", "rate": "radps"}, thermometer="sensor")
+    new = run.truth["orientation"] == 3
+    for a in AXES:
+        notes = " ".join(report["axes"][a]["notes"]) if "axes" in report else ""
+        counted = [int(n) for n in re.findall(r"(\d+) samples in an orientation", notes)]
+        still = run_rest((axis_view(c, a) for c in reading.chunks(path)), "exclude").keep
+        assert counted == [int(np.count_nonzero(new & still))], a
+        assert 0.95 * new.sum() < counted[0] <= new.sum(), a

@@ -327,12 +327,14 @@ def segment_tests(t: np.ndarray, values: np.ndarray, edges: np.ndarray, baseline
                   diff_centre: float, mad_to_sigma: float, variance_limit: float,
                   clip_limit: float, extremes: np.ndarray, clip_samples: int,
                   sigma_positive: bool, level: np.ndarray, variance: np.ndarray,
-                  clipped: np.ndarray, stepped: np.ndarray) -> None:
+                  clipped: np.ndarray, stepped: np.ndarray, held: bool = False) -> None:
     """Level, variance and clipping tests of one channel over one segment, OR-ed into
     ``level``, ``variance`` and ``clipped`` (views of the segment). ``extremes``: the
     channel's maximum and minimum over the whole recording. ``stepped``: the runs off the
     interpolated baseline alone (a step of the still level bends it; see
-    :func:`isolated_runs`)."""
+    :func:`isolated_runs`). ``held``: a channel whose still level never drifts between two
+    anchors (an accelerometer: gravity), so anchors that disagree are a step and a sample
+    between them is at rest only near one of them (a tilt along the interpolation is not)."""
     m = values.size
     medians, centres, slopes = _anchors(t, values, edges, baseline_blocks)
     high, low = extremes[0], extremes[1]
@@ -347,8 +349,9 @@ def segment_tests(t: np.ndarray, values: np.ndarray, edges: np.ndarray, baseline
             # still level between two anchors (a new orientation) is not motion
             left, right = _held(t[i], j, medians, centres)
             on_step = sigma_positive and abs(v - base) > level_limit
-            on_level = (on_step and abs(v - left) > level_limit
-                        and abs(v - right) > level_limit)
+            on_level = ((on_step or (sigma_positive and held
+                                     and abs(right - left) > level_limit))
+                        and abs(v - left) > level_limit and abs(v - right) > level_limit)
             on_high = v == high and abs(high - base) > clip_limit
             on_low = v == low and abs(low - base) > clip_limit
         run_level = _run_step(on_level, i, run_level, min_run, level)

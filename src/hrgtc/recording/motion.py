@@ -432,7 +432,8 @@ def detect_motion(
                 channel.diff_sigma, channel.diff_centre, MAD_TO_SIGMA,
                 s.variance_ratio * channel.diff_sigma,
                 s.threshold * max(channel.sigma, channel.lsb), extremes, int(s.clip_samples),
-                channel.sigma > 0, *(o[a:b] for o in outputs), stepped[kind][a:b])
+                channel.sigma > 0, *(o[a:b] for o in outputs), stepped[kind][a:b],
+                kind == "accelerometer")
     starts, stops = (np.array(side, dtype=np.int64) for side in zip(*bounds, strict=True))
     # a step of the still level (a new orientation's offset) bends the interpolated
     # baseline for up to a block either side; within a block of motion found it is what
