@@ -8,7 +8,9 @@ trained ranges. :func:`detect_motion` marks every sample that is not at rest:
 - **level**: the rate (minus the known input rate) against the *local* still
   baseline, a robust running level (median of ``baseline_s`` blocks, then a
   running median of those over :data:`BASELINE_BLOCKS` blocks, interpolated in
-  time), not against zero: a MEMS axis may sit several °/s from zero at rest. A
+  time) and against the two anchors around the sample (a step of the still level,
+  a new orientation, is at rest when motion is found within a block of it), not
+  against zero: a MEMS axis may sit several °/s from zero at rest. A
   sample is moving when it lies more than ``threshold`` robust σ from the
   baseline for at least ``min_motion_s`` (and two samples): an isolated
   single-sample excursion is a spike (the spike filter's business), not motion.
@@ -439,9 +441,10 @@ def detect_motion(
     # baseline for up to a block either side; within a block of motion found it is what
     # that motion left, at rest; a step with no motion near (a rate table starting, which
     # a gyro alone cannot tell from a new offset) stays motion
-    near, _ = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
+    near = np.zeros(n, dtype=bool)
     kernel.guard(reasons["level"], reasons["variance"], reasons["clipped"],
-                 reasons["accelerometer"], starts, stops, base_rows, base_rows, near, _)
+                 reasons["accelerometer"], starts, stops, base_rows, base_rows, near,
+                 np.zeros(n, dtype=bool))
     for kind, runs in stepped.items():
         kernel.isolated_runs(runs, near, reasons[kind])
     after, before = _rows(s.guard_s, period, 0), _rows(s.guard_before_s, period, 0)
