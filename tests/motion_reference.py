@@ -75,8 +75,10 @@ def _resolution(values: np.ndarray) -> float:
     return float(np.min(np.diff(distinct)))
 
 
-def _baseline(time_s: np.ndarray, values: np.ndarray, rows: int) -> np.ndarray:
-    """Robust running level of one segment: block medians, their running median, interpolated."""
+def _baseline(time_s: np.ndarray, values: np.ndarray, rows: int, held: bool = False
+              ) -> np.ndarray | tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Robust running level of one segment: block medians, their running median, interpolated.
+    ``held``: also the anchors on either side of each sample (the outer one beyond the ends)."""
     n = values.size
     blocks = max(n // rows, 1)
     edges = np.linspace(0, n, blocks + 1).astype(np.int64)
@@ -96,7 +98,14 @@ def _baseline(time_s: np.ndarray, values: np.ndarray, rows: int) -> np.ndarray:
         slope1 = (medians[-1] - medians[-2]) / (centres[-1] - centres[-2])
         level[head] = medians[0] + slope0 * (time_s[head] - centres[0])
         level[tail] = medians[-1] + slope1 * (time_s[tail] - centres[-1])
-    return level
+    if not held:
+        return level
+    j = np.clip(np.searchsorted(centres, time_s, side="right") - 1, 0, medians.size - 1)
+    left, right = medians[j], medians[np.minimum(j + 1, medians.size - 1)]
+    outside = (time_s <= centres[0]) | (time_s >= centres[-1])
+    left = np.where(time_s <= centres[0], medians[0], left)
+    right = np.where(outside, left, right)
+    return level, left, right
 
 
 def _runs(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -208,15 +217,28 @@ def detect_motion_reference(
     min_run = max(_rows(s.min_motion_s, period), 2)
     for a, b in _bounds(segment):
         t = time_s[a:b]
+        stepped = {"level": np.zeros(b - a, dtype=bool),
+                   "accelerometer": np.zeros(b - a, dtype=bool)}
         for channel in prepared:
-            level_mask, var_mask, clip_mask = _channel_tests(
-                channel, t, channel.values[a:b], base_rows, var_rows, min_run, s)
+            level_mask, var_mask, clip_mask, step_mask = _channel_tests(
+                channel, t, channel.values[a:b], base_rows, var_rows, min_run, s,
+                channel.name in accel_names)
             if channel.name in accel_names:
                 reasons["accelerometer"][a:b] |= level_mask | var_mask | clip_mask
+                stepped["accelerometer"] |= step_mask
             else:
                 reasons["level"][a:b] |= level_mask
                 reasons["variance"][a:b] |= var_mask
                 reasons["clipped"][a:b] |= clip_mask
+                stepped["level"] |= step_mask
+        # a step of the still level: motion only when no motion was found within a block
+        near = _dilate(reasons["level"][a:b] | reasons["variance"][a:b]
+                       | reasons["clipped"][a:b] | reasons["accelerometer"][a:b],
+                       base_rows, base_rows)
+        for kind, runs in stepped.items():
+            for start, stop in zip(*_runs(runs), strict=True):
+                if not near[start:stop].any():
+                    reasons[kind][a + start:a + stop] = True
     found = reasons["level"] | reasons["variance"] | reasons["clipped"] | reasons["accelerometer"]
     after, before = _rows(s.guard_s, period, 0), _rows(s.guard_before_s, period, 0)
     moving = np.zeros(n, dtype=bool)
@@ -228,15 +250,25 @@ def detect_motion_reference(
 
 
 def _channel_tests(channel: _Channel, t: np.ndarray, values: np.ndarray, base_rows: int,
-                   var_rows: int, min_run: int, s: MotionSettings
-                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Level, variance and clipping tests of one channel over one segment."""
+                   var_rows: int, min_run: int, s: MotionSettings, held: bool = False
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Level, variance and clipping tests of one channel over one segment, and the runs
+    off the interpolated baseline alone (a step of the still level bends it)."""
     m = values.size
-    baseline = _baseline(t, values, base_rows)
+    baseline, left, right = _baseline(t, values, base_rows, held=True)
     deviation = values - baseline
     level = np.zeros(m, dtype=bool)
-    if channel.sigma > 0:
-        level = _long_runs(np.abs(deviation) > s.threshold * channel.sigma, min_run)
+    stepped = np.zeros(m, dtype=bool)
+    if channel.sigma > 0:  # off the baseline and off both anchors around it (a step is not)
+        limit = s.threshold * channel.sigma
+        # an accelerometer's still level never drifts: anchors that disagree are a step,
+        # and between them only a sample near one of them is at rest
+        off = np.abs(deviation) > limit
+        if held:
+            off |= np.abs(right - left) > limit
+        level = _long_runs(off & (np.abs(values - left) > limit)
+                           & (np.abs(values - right) > limit), min_run)
+        stepped = _long_runs(np.abs(deviation) > limit, min_run)
     variance = np.zeros(m, dtype=bool)
     if channel.diff_sigma > 0 and m >= var_rows:
         # blocks of var_rows samples (the last takes the remainder); differences inside each
@@ -254,4 +286,4 @@ def _channel_tests(channel: _Channel, t: np.ndarray, values: np.ndarray, base_ro
         at = values == extreme
         far = np.abs(extreme - baseline) > s.threshold * max(channel.sigma, channel.lsb)
         clipped |= _long_runs(at & far, int(s.clip_samples))
-    return level, variance, clipped
+    return level, variance, clipped, stepped

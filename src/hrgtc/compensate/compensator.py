@@ -164,8 +164,13 @@ class Compensator:
         self._last_time = float(time[-1])
         return rows
 
-    def transform(self, chunk: Recording) -> Recording:
+    def transform(self, chunk: Recording, at_rest: np.ndarray | None = None) -> Recording:
         """The next chunk of the run with the :data:`OUTPUT_COLUMNS` added.
+
+        ``at_rest``: True for each sample of ``chunk`` at rest (the motion detector's
+        mask, :class:`~hrgtc.compensate.at_rest.RestFlags`); None: all. A sample not at
+        rest still gets an offset, but is not counted in :attr:`unknown_orientation` nor
+        warned about: a unit mid-rotation is in no orientation (docs/real-loggers/motion.md).
 
         ``in_range`` is 1.0 where the frequency is inside the thermometer's calibrated
         range and the drift model's training range of f (and of h, g, a_NAME), df/dt (and
@@ -202,9 +207,10 @@ class Compensator:
             cuts = sorted(set(cuts) | set(rows.tolist()))
         if cuts:  # the filters restart at rest on each segment's (run's) first row
             restart = restart_mask(len(chunk), cuts)
-        return self._process(chunk, restart)
+        return self._process(chunk, restart, at_rest)
 
-    def _process(self, chunk: Recording, restart: np.ndarray | None = None) -> Recording:
+    def _process(self, chunk: Recording, restart: np.ndarray | None = None,
+                 at_rest: np.ndarray | None = None) -> Recording:
         n = len(chunk)
         out = {name: np.empty(n) for name in OUTPUT_COLUMNS}
         if not (self.engine == "fused" and self._fused(chunk, out, restart)):
@@ -213,7 +219,7 @@ class Compensator:
                             None if restart is None else restart[start:start + BLOCK_ROWS])
         self._count_temperature_nan(out["resonator_c_est"], chunk)
         if "orientation" in self.drift.offset_mode:
-            self._orientation_offsets(chunk, out)
+            self._orientation_offsets(chunk, out, at_rest)
         if self.scale_factor is not None:
             # rate = input * (1 + k) + bias, so input = (rate - bias) / (1 + k).
             ppm = self.scale_factor.ppm(chunk.freq_hz)
@@ -240,10 +246,13 @@ class Compensator:
                 ExtrapolationWarning, stacklevel=4)
         self.temperature_nan += int(np.count_nonzero(bad))
 
-    def _orientation_offsets(self, chunk: Recording, out: dict[str, np.ndarray]) -> None:
+    def _orientation_offsets(self, chunk: Recording, out: dict[str, np.ndarray],
+                             at_rest: np.ndarray | None = None) -> None:
         """Add each sample's trained orientation offset (:mod:`hrgtc.drift.offsets`) to the
         bias; an orientation never seen in training keeps the mean offset and is counted in
-        :attr:`unknown_orientation` (and warned about once), not guessed."""
+        :attr:`unknown_orientation` (and warned about once), not guessed. Samples not at
+        rest (``at_rest`` False: handling, the accelerometer mid-rotation) keep it too but
+        are not counted: they are flagged as motion instead."""
         axes = ("accel_x", "accel_y", "accel_z")
         labelled = not self.drift.orientations  # the user's orientation column
         readable = "orientation" in chunk if labelled else all(a in chunk for a in axes)
@@ -257,6 +266,11 @@ class Compensator:
             out["rate_comp_dph"] -= offset
         else:
             unknown = np.ones(len(chunk), dtype=bool)
+        if at_rest is not None:
+            if len(at_rest) != len(chunk):
+                raise InputError(f"at_rest has {len(at_rest)} values for a chunk of "
+                                 f"{len(chunk)} rows; give one per row")
+            unknown = unknown & np.asarray(at_rest, dtype=bool)
         count = int(np.count_nonzero(unknown))
         if count and not self.unknown_orientation:
             spread = max(self.drift.offsets_dph.values()) - min(self.drift.offsets_dph.values())

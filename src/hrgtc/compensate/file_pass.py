@@ -139,9 +139,10 @@ def compensate_file(
             restarts: set[float] = set()  # every chunk's restarts, written at close
             while chunk is not None:
                 restarts.update(chunk.metadata.extra.get(RESTARTS_KEY) or ())
-                result = compensator.transform(chunk)
-                if flags is not None:
-                    result = result.with_columns(**flags.take(len(chunk)))
+                taken = None if flags is None else flags.take(len(chunk))
+                result = compensator.transform(chunk, _at_rest(flags, taken, compensator))
+                if taken is not None:
+                    result = result.with_columns(**taken)
                 if SPIKE_COLUMN in chunk:
                     spikes += int(np.count_nonzero(chunk[SPIKE_COLUMN]))
                 if copies:
@@ -168,6 +169,19 @@ def compensate_file(
                                compensator.out_of_range_fraction,
                                compensator.rate_out_of_range_fraction, compensator.ranges(),
                                accounting)
+
+
+def _at_rest(flags: RestFlags | None, taken: dict[str, np.ndarray] | None,
+             compensator: Any) -> Any:
+    """The at-rest mask of a chunk as ``compensator.transform`` takes it: one array for a
+    :class:`Compensator`, axis -> array for an instrument's (None without flags)."""
+    if flags is None or taken is None:
+        return None
+    masks = {axis: taken[column] > 0.5 for axis, column in zip(flags.axes, flags.columns,
+                                                               strict=True)}
+    if isinstance(compensator, Compensator):
+        return masks.get("", None if len(masks) != 1 else next(iter(masks.values())))
+    return masks
 
 
 def compensation_accounting(compensator: Any, spikes: int = 0,

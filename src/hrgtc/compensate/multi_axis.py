@@ -11,7 +11,7 @@ A single-axis model is the one-axis case: the plain single-axis columns, unchang
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -72,10 +72,16 @@ class InstrumentCompensator:
         self.columns = instrument_output_columns(model)
         self._rows = 0
 
-    def transform(self, chunk: Recording) -> Recording:
-        """The next chunk with every axis's output columns added."""
+    def transform(self, chunk: Recording,
+                  at_rest: Mapping[str, np.ndarray] | None = None) -> Recording:
+        """The next chunk with every axis's output columns added.
+
+        ``at_rest``: axis (``""`` for a single axis) -> True for each sample of ``chunk``
+        at rest on that axis (see :meth:`Compensator.transform`); None: all.
+        """
+        rest = dict(at_rest or {})
         if self.model.is_single_axis:
-            result = self.axes[""].transform(chunk)
+            result = self.axes[""].transform(chunk, rest.get(""))
             self._rows += len(chunk)
             return result
         found = axis_names(chunk.names)
@@ -99,7 +105,7 @@ class InstrumentCompensator:
         for axis, compensator in self.axes.items():
             view = axis_view(chunk, axis)
             self._check_band(axis, view)
-            result = compensator.transform(view)
+            result = compensator.transform(view, rest.get(axis))
             for name in output_columns(compensator.model):
                 added[f"{name}_{axis}"] = result[name]
         self._rows += len(chunk)

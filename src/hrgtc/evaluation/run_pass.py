@@ -206,7 +206,9 @@ class RunPass:
                                    keep_mask=allan and deviation != "oadev")
             self.split = DirectionSplit(model, metadata.sample_rate_hz)
         metadata, frequency, housing = self.metadata, self.frequency, self.housing
-        out = frequency.transform(chunk)
+        done = frequency.samples  # rows before this chunk; the at-rest mask of its own
+        kept = None if self.keep is None else self.keep[done:done + len(chunk)]
+        out = frequency.transform(chunk, kept)  # (moving samples are no unknown orientation)
         if self.on_output is not None:
             self.on_output(out)
         raw = chunk.rate_dph - metadata.input_rate_dph
@@ -219,11 +221,10 @@ class RunPass:
             comp_h = housing.transform(chunk)["rate_comp_dph"] - metadata.input_rate_dph
             pushed["housing"] = comp_h
             columns["comp_housing_dph"] = comp_h
-        if self.keep is not None:
-            kept = self.keep[frequency.samples - len(chunk):frequency.samples]
+        if kept is not None:
             self.left_out += int(np.count_nonzero(~kept))
             pushed = {key: values[kept] for key, values in pushed.items()}
-        self.cut.partial_fit(pushed, chunk.time_s if self.keep is None else chunk.time_s[kept],
+        self.cut.partial_fit(pushed, chunk.time_s if kept is None else chunk.time_s[kept],
                       chunk.metadata.extra.get(RESTARTS_KEY))
         if allan and deviation != "oadev":
             for key, values in pushed.items():

@@ -249,6 +249,18 @@ def _level_at(x: float, j: int, medians: np.ndarray, centres: np.ndarray,
 
 
 @njit(inline="always", **_JIT)
+def _held(x: float, j: int, medians: np.ndarray, centres: np.ndarray) -> tuple:
+    """``(left, right)``: the baseline anchors on either side of time ``x`` (the outer one
+    twice beyond the outer centres); ``j`` the interval :func:`_level_at` found."""
+    last = medians.size - 1
+    if last == 0 or x <= centres[0]:
+        return medians[0], medians[0]
+    if x >= centres[last]:
+        return medians[last], medians[last]
+    return medians[j], medians[j + 1]
+
+
+@njit(inline="always", **_JIT)
 def _run_step(on: bool, i: int, start: int, minimum: int, out: np.ndarray) -> int:
     """One sample of a streamed run finder: the start of the current run of True (-1:
     none); a run of at least ``minimum`` is OR-ed into ``out`` when it ends."""
@@ -315,24 +327,35 @@ def segment_tests(t: np.ndarray, values: np.ndarray, edges: np.ndarray, baseline
                   diff_centre: float, mad_to_sigma: float, variance_limit: float,
                   clip_limit: float, extremes: np.ndarray, clip_samples: int,
                   sigma_positive: bool, level: np.ndarray, variance: np.ndarray,
-                  clipped: np.ndarray) -> None:
+                  clipped: np.ndarray, stepped: np.ndarray, held: bool = False) -> None:
     """Level, variance and clipping tests of one channel over one segment, OR-ed into
     ``level``, ``variance`` and ``clipped`` (views of the segment). ``extremes``: the
-    channel's maximum and minimum over the whole recording."""
+    channel's maximum and minimum over the whole recording. ``stepped``: the runs off the
+    interpolated baseline alone (a step of the still level bends it; see
+    :func:`isolated_runs`). ``held``: a channel whose still level never drifts between two
+    anchors (an accelerometer: gravity), so anchors that disagree are a step and a sample
+    between them is at rest only near one of them (a tilt along the interpolation is not)."""
     m = values.size
     medians, centres, slopes = _anchors(t, values, edges, baseline_blocks)
     high, low = extremes[0], extremes[1]
     j = 0
-    run_level = run_high = run_low = -1
+    run_level = run_high = run_low = run_step = -1
     for i in range(m + 1):
-        on_level = on_high = on_low = False
+        on_level = on_high = on_low = on_step = False
         if i < m:
             base, j = _level_at(t[i], j, medians, centres, slopes)
             v = values[i]
-            on_level = sigma_positive and abs(v - base) > level_limit
+            # off the interpolated baseline and off both anchors around it: a step of the
+            # still level between two anchors (a new orientation) is not motion
+            left, right = _held(t[i], j, medians, centres)
+            on_step = sigma_positive and abs(v - base) > level_limit
+            on_level = ((on_step or (sigma_positive and held
+                                     and abs(right - left) > level_limit))
+                        and abs(v - left) > level_limit and abs(v - right) > level_limit)
             on_high = v == high and abs(high - base) > clip_limit
             on_low = v == low and abs(low - base) > clip_limit
         run_level = _run_step(on_level, i, run_level, min_run, level)
+        run_step = _run_step(on_step, i, run_step, min_run, stepped)
         run_high = _run_step(on_high, i, run_high, clip_samples, clipped)
         run_low = _run_step(on_low, i, run_low, clip_samples, clipped)
     if diff_sigma > 0 and m >= var_rows:
@@ -359,3 +382,22 @@ def guard(level: np.ndarray, variance: np.ndarray, clipped: np.ndarray, accel: n
     for i in range(moving.size):
         guarded[i] = moving[i] & ~(level[i] | variance[i] | clipped[i] | accel[i])
 
+
+
+@njit(**_JIT)
+def isolated_runs(stepped: np.ndarray, near: np.ndarray, out: np.ndarray) -> None:
+    """OR into ``out`` each run of ``stepped`` none of whose samples is ``near``."""
+    n = stepped.size
+    start = -1
+    touched = False
+    for i in range(n + 1):
+        on = i < n and stepped[i]
+        if on:
+            if start < 0:
+                start, touched = i, False
+            touched |= near[i]
+        elif start >= 0:
+            if not touched:
+                for k in range(start, i):
+                    out[k] = True
+            start = -1

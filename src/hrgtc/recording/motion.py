@@ -8,7 +8,9 @@ trained ranges. :func:`detect_motion` marks every sample that is not at rest:
 - **level**: the rate (minus the known input rate) against the *local* still
   baseline, a robust running level (median of ``baseline_s`` blocks, then a
   running median of those over :data:`BASELINE_BLOCKS` blocks, interpolated in
-  time), not against zero: a MEMS axis may sit several °/s from zero at rest. A
+  time) and against the two anchors around the sample (a step of the still level,
+  a new orientation, is at rest when motion is found within a block of it), not
+  against zero: a MEMS axis may sit several °/s from zero at rest. A
   sample is moving when it lies more than ``threshold`` robust σ from the
   baseline for at least ``min_motion_s`` (and two samples): an isolated
   single-sample excursion is a spike (the spike filter's business), not motion.
@@ -91,7 +93,7 @@ class MotionSettings:
     variance_ratio: float = 3.0
     min_motion_s: float = 0.1
     guard_s: float = 5.0
-    guard_before_s: float = 1.0
+    guard_before_s: float = 2.0
     clip_samples: int = 3
 
     def __post_init__(self) -> None:
@@ -419,9 +421,11 @@ def detect_motion(
     var_rows = _rows(s.window_s, period, VARIANCE_MIN_SAMPLES)
     min_run = max(_rows(s.min_motion_s, period), 2)
     bounds = _bounds(breaks, n)
+    stepped = {"level": np.zeros(n, dtype=bool), "accelerometer": np.zeros(n, dtype=bool)}
     for channel in prepared:
         extremes = np.array([np.max(channel.values), np.min(channel.values)])
-        outputs = ((reasons["accelerometer"],) * 3 if channel.name in accel_names else
+        kind = "accelerometer" if channel.name in accel_names else "level"
+        outputs = ((reasons["accelerometer"],) * 3 if kind == "accelerometer" else
                    (reasons["level"], reasons["variance"], reasons["clipped"]))
         for a, b in bounds:
             kernel.segment_tests(
@@ -430,10 +434,21 @@ def detect_motion(
                 channel.diff_sigma, channel.diff_centre, MAD_TO_SIGMA,
                 s.variance_ratio * channel.diff_sigma,
                 s.threshold * max(channel.sigma, channel.lsb), extremes, int(s.clip_samples),
-                channel.sigma > 0, *(o[a:b] for o in outputs))
+                channel.sigma > 0, *(o[a:b] for o in outputs), stepped[kind][a:b],
+                kind == "accelerometer")
+    starts, stops = (np.array(side, dtype=np.int64) for side in zip(*bounds, strict=True))
+    # a step of the still level (a new orientation's offset) bends the interpolated
+    # baseline for up to a block either side; within a block of motion found it is what
+    # that motion left, at rest; a step with no motion near (a rate table starting, which
+    # a gyro alone cannot tell from a new offset) stays motion
+    near = np.zeros(n, dtype=bool)
+    kernel.guard(reasons["level"], reasons["variance"], reasons["clipped"],
+                 reasons["accelerometer"], starts, stops, base_rows, base_rows, near,
+                 np.zeros(n, dtype=bool))
+    for kind, runs in stepped.items():
+        kernel.isolated_runs(runs, near, reasons[kind])
     after, before = _rows(s.guard_s, period, 0), _rows(s.guard_before_s, period, 0)
     moving = np.zeros(n, dtype=bool)
-    starts, stops = (np.array(side, dtype=np.int64) for side in zip(*bounds, strict=True))
     kernel.guard(reasons["level"], reasons["variance"], reasons["clipped"],  # never across
                  reasons["accelerometer"], starts, stops, after, before, moving,  # a gap
                  reasons["guard"])

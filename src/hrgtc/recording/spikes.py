@@ -37,13 +37,18 @@ resolution (:func:`hrgtc.recording.resolution.resolution`): a quantised or
 pulse-type stream, whose MAD is 0, keeps its pulses, and nothing symmetric about the
 mean is removed, so the mean is not biased. With k = 8, a Gaussian stream of 10^8
 samples loses none in expectation.
+
+A rate excursion where the logged accelerometer moves across the sample (its samples
+on either side disagree, :func:`moving_across`) is not a spike: it is a rotation shorter
+than the sample period, caught by one sample (a unit turned by hand, logged at 1 Hz),
+and the motion detector marks it (docs/real-loggers/motion.md).
 """
 
 from __future__ import annotations
 
 import itertools
 import warnings
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 
 import numpy as np
 
@@ -51,6 +56,7 @@ from hrgtc.core.errors import InputError, SpikeWarning
 from hrgtc.recording.axes import axis_names, base_name
 from hrgtc.recording.checks import _BOUNDS, FREQ_JUMP_FRACTION, TEMPERATURE_RANGE_C
 from hrgtc.recording.gaps import GAP_PERIODS, GAP_TOLERANCE
+from hrgtc.recording.motion import ACCEL_COLUMNS
 from hrgtc.recording.resolution import resolution
 from hrgtc.settings.reading import ReadSettings
 
@@ -71,7 +77,7 @@ _MAD_TO_SIGMA = 1.482602218505602  # 1 / Φ^-1(3/4): MAD of a Gaussian -> its σ
 _SECOND_DIFF = 1.224744871391589  # sqrt(1.5): σ of x[i] − (x[i−1] + x[i+1]) / 2 in σ of x
 
 __all__ = ["SPIKE_FILTERS", "SPIKE_POLICIES", "RobustSpikeFilter", "SpikeFilter",
-           "check_spike_policy", "find_spikes"]
+           "check_spike_policy", "find_spikes", "moving_across"]
 
 
 def check_spike_policy(spikes: str) -> str:
@@ -223,6 +229,56 @@ def _window_sigmas(second: np.ndarray, bounds: np.ndarray) -> np.ndarray:
     return sigmas
 
 
+def _segment_limits(t: np.ndarray, x: np.ndarray, k: float, lsb_multiple: float,
+                    window_s: float, lsb: float | None) -> Iterator[tuple[int, int, np.ndarray,
+                                                                           np.ndarray, np.ndarray]]:
+    """Per contiguous segment of at least 3 samples: ``(start, stop, values, second
+    differences, threshold max(k·σ_MAD, m·LSB) of each sample)`` (see :func:`find_spikes`)."""
+    if lsb is None:
+        lsb = resolution(x[:RESOLUTION_ROWS])
+    floor = lsb_multiple * float(lsb or 0.0)
+    for start, stop in _segments(t):
+        if stop - start < 3:
+            continue
+        xs = x[start:stop]
+        second = np.empty_like(xs)
+        second[1:-1] = xs[1:-1] - 0.5 * (xs[:-2] + xs[2:])
+        second[0], second[-1] = second[1], second[-2]
+        ts = t[start:stop]
+        with np.errstate(invalid="ignore"):
+            origin = float(np.nanmin(ts)) if np.isfinite(ts).any() else 0.0
+            block = np.floor((ts - origin) / window_s)
+        edges = np.flatnonzero(np.diff(block)) + 1
+        bounds = np.array([0, *edges.tolist(), len(xs)])
+        sigmas = _window_sigmas(second, bounds)
+        yield start, stop, xs, second, np.repeat(np.maximum(k * sigmas, floor), np.diff(bounds))
+
+
+def moving_across(time_s: np.ndarray, values: np.ndarray, *, k: float = SPIKE_K,
+                  lsb_multiple: float = SPIKE_LSB, window_s: float = SPIKE_WINDOW_S,
+                  lsb: float | None = None) -> np.ndarray:
+    """Samples across which a channel moves: a boolean mask, True where the samples on
+    either side of it disagree, ``|x[i+1] − x[i−1]|`` or ``|x[i+2] − x[i−2]|`` beyond the
+    threshold of :func:`find_spikes` (never across a gap; the sample itself is not used).
+
+    An accelerometer that moves across a sample says the unit was being turned there: a
+    single-sample rate excursion at that sample is a fast rotation caught by one sample
+    (a handling pulse shorter than the sample period), not a spike. A glitch that hits
+    every column of one row leaves the accelerometer's neighbours in agreement.
+    """
+    x = np.asarray(values, dtype=np.float64)
+    t = np.asarray(time_s, dtype=np.float64)
+    moving = np.zeros(x.size, dtype=bool)
+    for start, stop, xs, _, limit in _segment_limits(t, x, k, lsb_multiple, window_s, lsb):
+        across = np.zeros(xs.size)
+        with np.errstate(invalid="ignore"):
+            across[1:-1] = np.abs(xs[2:] - xs[:-2])
+            if xs.size >= 5:
+                across[2:-2] = np.maximum(across[2:-2], np.abs(xs[4:] - xs[:-4]))
+            moving[start:stop] = across > limit
+    return moving
+
+
 def find_spikes(time_s: np.ndarray, values: np.ndarray, *, k: float = SPIKE_K,
                 lsb_multiple: float = SPIKE_LSB, window_s: float = SPIKE_WINDOW_S,
                 lsb: float | None = None) -> np.ndarray:
@@ -254,25 +310,8 @@ def find_spikes(time_s: np.ndarray, values: np.ndarray, *, k: float = SPIKE_K,
     """
     x = np.asarray(values, dtype=np.float64)
     t = np.asarray(time_s, dtype=np.float64)
-    if lsb is None:
-        lsb = resolution(x[:RESOLUTION_ROWS])
-    floor = lsb_multiple * float(lsb or 0.0)
     spikes = np.zeros(x.size, dtype=bool)
-    for start, stop in _segments(t):
-        if stop - start < 3:
-            continue
-        xs = x[start:stop]
-        second = np.empty_like(xs)
-        second[1:-1] = xs[1:-1] - 0.5 * (xs[:-2] + xs[2:])
-        second[0], second[-1] = second[1], second[-2]
-        ts = t[start:stop]
-        with np.errstate(invalid="ignore"):
-            origin = float(np.nanmin(ts)) if np.isfinite(ts).any() else 0.0
-            block = np.floor((ts - origin) / window_s)
-        edges = np.flatnonzero(np.diff(block)) + 1
-        bounds = np.array([0, *edges.tolist(), len(xs)])
-        sigmas = _window_sigmas(second, bounds)
-        limit = np.repeat(np.maximum(k * sigmas, floor), np.diff(bounds))
+    for start, stop, xs, second, limit in _segment_limits(t, x, k, lsb_multiple, window_s, lsb):
         with np.errstate(invalid="ignore"):
             left = np.abs(np.diff(xs, prepend=np.nan))
             right = np.abs(np.diff(xs, append=np.nan))
@@ -345,6 +384,9 @@ class RobustSpikeFilter:
         self.found: dict[str, int] = {}
         self.counts = False  # True: temperature_c holds a raw count (no °C bounds)
         self.rows = 0
+        #: Single-sample rate excursions not taken for spikes: the accelerometer moved
+        #: across them (a rotation caught by one sample; the motion detector's business).
+        self.in_motion = 0
         self.first: tuple[str, int, float] | None = None
         self._lsb: dict[str, float | None] = {}
 
@@ -356,12 +398,16 @@ class RobustSpikeFilter:
         axes = axis_names(columns)
         time_s = columns["time_s"]
         marked = np.zeros(len(time_s), dtype=bool)
+        turning = self._turning(columns, time_s)
         for name in _filtered_columns(columns, axes, self.sensor):
             values = columns[name]
             if name not in self._lsb:  # the resolution of the first rows holds for the file
                 self._lsb[name] = resolution(values[:RESOLUTION_ROWS])
             mask = find_spikes(time_s, values, k=self.k, lsb_multiple=self.lsb_multiple,
                                window_s=self.window_s, lsb=self._lsb[name])
+            if turning is not None and base_name(name, axes) == "rate_dph" and mask.any():
+                self.in_motion += int(np.count_nonzero(mask & turning))
+                mask &= ~turning  # a rotation caught by one sample: the motion detector's
             bounds = self._bounds(name, axes)
             if bounds is not None and mask.any():  # impossible values: --spikes says
                 with np.errstate(invalid="ignore"):
@@ -382,6 +428,22 @@ class RobustSpikeFilter:
             return out
         keep = ~marked
         return {name: values[keep] for name, values in out.items()}
+
+    def _turning(self, columns: Mapping[str, np.ndarray], time_s: np.ndarray
+                 ) -> np.ndarray | None:
+        """Rows across which an accelerometer column moves (:func:`moving_across`); None
+        without accelerometer columns."""
+        names = [c for c in ACCEL_COLUMNS if c in columns]
+        if not names:
+            return None
+        turning = np.zeros(len(time_s), dtype=bool)
+        for name in names:
+            values = columns[name]
+            if name not in self._lsb:
+                self._lsb[name] = resolution(values[:RESOLUTION_ROWS])
+            turning |= moving_across(time_s, values, k=self.k, lsb_multiple=self.lsb_multiple,
+                                     window_s=self.window_s, lsb=self._lsb[name])
+        return turning
 
     def _bounds(self, name: str, axes: tuple[str, ...]) -> tuple[float, float] | None:
         """Physical bounds of a column: values beyond are for ``spikes``, not this filter."""
