@@ -166,7 +166,9 @@ def test_the_training_range_includes_its_lower_edge_in_compensation(model):
     edge = reference + low
     low = edge - reference  # the f that the compensator computes at that frequency
     drift = dataclasses.replace(model.drift, ranges={**model.drift.ranges, "f": (low, high)})
-    n = 400
+    # 120 s at 10 Hz: the first 50 s settle (counted as settling, never as out of range),
+    # then 10 s mid-range and 60 s at the edge or one ulp below it (half of all samples)
+    n = 1200
     for f_edge, outside in ((edge, 0.0), (np.nextafter(edge, -np.inf), 0.5)):
         freq = np.full(n, f_edge)
         freq[: n // 2] = reference + 0.5 * (low + high)
