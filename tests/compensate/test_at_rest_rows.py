@@ -149,3 +149,32 @@ def test_take_refuses_other_rows_than_the_detector_saw():
     flags = RestFlags(chunks_of(accel), [""], "exclude", "run.parquet")
     with pytest.raises(FlagsMisaligned, match="columns"):
         flags.take(run.slice(0, CHUNK))
+
+
+def test_only_reads_the_detectors_columns_of_every_axis(tmp_path):
+    """``iter_chunks(only=)``: the detector's columns of every axis (``rate_dph_x``,
+    ``rate_dph_y``) and the accelerometer's, nothing else, with the whole reading's values;
+    a sensor thermometer's temperature too (its ``freq_hz`` is filled from it)."""
+    from hrgtc.compensate.at_rest import DETECTOR_COLUMNS
+
+    run = handled()
+    n = len(run)
+    columns = {"time_s": run.time_s, "rate_dph_x": run.rate_dph, "rate_dph_y": -run.rate_dph,
+               "freq_hz_x": run.freq_hz, "freq_hz_y": run.freq_hz + 1.0,
+               "accel_x": np.zeros(n), "accel_y": np.zeros(n), "accel_z": np.ones(n),
+               "chamber_c": run["chamber_c"]}
+    source = recording_io.write(Recording(columns, run.metadata), tmp_path / "xy.parquet")
+    whole = recording_io.read(source)
+    parts = list(recording_io.iter_chunks(source, rows=CHUNK, only=DETECTOR_COLUMNS,
+                                          validate=False))
+    assert parts[0].names == ("time_s", "rate_dph_x", "rate_dph_y", "accel_x", "accel_y",
+                              "accel_z")
+    for name in parts[0].names:
+        np.testing.assert_array_equal(np.concatenate([p[name] for p in parts]), whole[name])
+    sensor = recording_io.write(Recording({"time_s": run.time_s, "rate_dph": run.rate_dph,
+                                           "temperature_c": run["resonator_c"],
+                                           "chamber_c": run["chamber_c"]}, run.metadata),
+                                tmp_path / "sensor.parquet")
+    part = next(recording_io.iter_chunks(sensor, rows=CHUNK, only=DETECTOR_COLUMNS,
+                                         thermometer="sensor", validate=False))
+    assert set(part.names) == {"time_s", "rate_dph", "freq_hz", "temperature_c"}

@@ -17,8 +17,8 @@ detector's columns (time, rate, known input rate, accelerometer axes),
 time) marks the samples, and the compensating pass then writes the flags: equal to
 ``run_rest``'s mask by construction.
 
-The cost (issue 20, ``docs/benchmarks.md``): a second reading of the file, without
-its validation (the compensating pass validates every sample; if the unvalidated
+The cost (issue 20, ``docs/benchmarks.md``): a second reading of the detector's
+columns, without their validation (the compensating pass validates every sample; if the unvalidated
 pass fails, the file is read again validated, so a bad file gets the validator's
 error), and the detector's columns in memory, once (time and rate: 16 bytes a sample
 and axis; a 3-day 1 Hz file: 260,000 rows, 4 MB). The detector's loops are compiled

@@ -308,7 +308,8 @@ def iter_chunks(path: str | Path, options: ReadSettings | None = None, *,
         then differ from those of the whole file's: a row the reader drops because of
         another column (``spikes="drop"``, a gap of a slow channel, a duplicated row told
         from a duplicated time by the other columns) is kept. For a pass whose result
-        the caller checks against the whole file's rows (``hrgtc.compensate.at_rest``).
+        the caller checks against the whole file's rows (``hrgtc.compensate.at_rest``), with
+        ``validate=False`` (the validation asks for every column).
 
     Yields
     ------
