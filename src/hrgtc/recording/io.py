@@ -355,12 +355,15 @@ def iter_chunks(path: str | Path, options: ReadSettings | None = None, *,
             time_repair.source = repairer.source
             repairer = time_repair
         cut = _TimeSlice(opts.start, opts.end, plan)
+        numbered = validator is not None or file_rows is not None
 
         def converted() -> Iterator[dict[str, np.ndarray]]:
             nonlocal offset
             for table in source.iter_tables(plan.read_names, plan.as_text, rows):
-                part = slow.fill(with_file_rows(convert_columns(plan, table_columns(table),
-                                                                offset), offset), offset)
+                part = convert_columns(plan, table_columns(table), offset)
+                if numbered:  # the file rows, for the validator's messages
+                    part = with_file_rows(part, offset)
+                part = slow.fill(part, offset)
                 if spike_filter is not None:
                     part = spike_filter.drop(part, offset)
                 part = robust.apply(part, offset)
