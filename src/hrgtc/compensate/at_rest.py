@@ -17,13 +17,25 @@ detector's columns (time, rate, known input rate, accelerometer axes),
 time) marks the samples, and the compensating pass then writes the flags: equal to
 ``run_rest``'s mask by construction.
 
-The cost (issue 20, ``docs/benchmarks.md``): a second reading of the file, without
-its validation (the compensating pass validates every sample; if the unvalidated
+The cost (issue 20, ``docs/benchmarks.md``): a second reading of the detector's
+columns, without their validation (the compensating pass validates every sample; if the unvalidated
 pass fails, the file is read again validated, so a bad file gets the validator's
 error), and the detector's columns in memory, once (time and rate: 16 bytes a sample
 and axis; a 3-day 1 Hz file: 260,000 rows, 4 MB). The detector's loops are compiled
 (:mod:`hrgtc.recording._motion_kernel`). ``--motion keep`` skips the pass and writes
 no flag; ``--motion error`` stops at the first moving sample, naming it.
+
+The pass reads only the detector's columns (:data:`DETECTOR_COLUMNS`, ``iter_chunks(...,
+only=)``), and the spike filter's flags, which change no row, are not computed in it.
+Reading fewer columns can give other rows: the reader drops a row because of a column
+the pass does not read (a gap of a slow channel, ``--spikes drop``, a duplicated row
+told from a duplicated time by its other values). So the flags are never trusted to
+line up: :meth:`RestFlags.take` compares the detector's columns of each chunk the
+compensating pass reads with those the detector saw at the same rows, bit for bit, and
+the row counts at the end; equal columns give the detector the same input, hence the
+same flags. A difference raises :class:`FlagsMisaligned`, on which
+:func:`~hrgtc.compensate.file_pass.compensate_file` discards its output and starts again
+with the pass reading every column (a slower, correct run, never misaligned flags).
 """
 
 from __future__ import annotations
@@ -37,12 +49,16 @@ from hrgtc.drift.rest import RestPass
 from hrgtc.recording import Recording, axis_view
 from hrgtc.recording.motion import ACCEL_COLUMNS
 
-__all__ = ["AT_REST_COLUMN", "RestFlags", "rest_columns"]
+__all__ = ["AT_REST_COLUMN", "DETECTOR_COLUMNS", "FlagsMisaligned", "RestFlags", "rest_columns"]
 
 #: The flag column of a single-axis output (``at_rest_<axis>`` per axis otherwise).
 AT_REST_COLUMN = "at_rest"
-#: The columns the detector reads (:func:`hrgtc.drift.rest.run_rest`).
-_DETECTOR_COLUMNS = ("time_s", "rate_dph", "input_rate_dph", *ACCEL_COLUMNS)
+#: The columns the detector reads (:func:`hrgtc.drift.rest.run_rest`), without their axis.
+DETECTOR_COLUMNS = ("time_s", "rate_dph", "input_rate_dph", *ACCEL_COLUMNS)
+
+
+class FlagsMisaligned(InputError):
+    """The rows of the detector's pass are not those of the compensating pass."""
 
 
 def rest_columns(axes: Sequence[str]) -> tuple[str, ...]:
@@ -56,8 +72,9 @@ class RestFlags:
     Parameters
     ----------
     chunks
-        The file's chunks, read with the options of the compensating pass (the same rows),
-        unvalidated.
+        The file's chunks, read with the options of the compensating pass, unvalidated,
+        perhaps only the detector's columns (:meth:`take` checks that the rows are the
+        compensating pass's).
     axes
         The model's axes (``[""]`` for a single-axis model).
     policy
@@ -77,6 +94,7 @@ class RestFlags:
         self.axes = tuple(axes)
         self.columns = rest_columns(self.axes)
         self._policy, self._name, self._rows = policy, name, rows
+        self._seen: dict[str, dict[str, np.ndarray]] = {}  # the detector's columns by axis
         try:
             self.still = self._find(chunks)
         except CalibrationError:  # --motion error: a moving sample
@@ -94,8 +112,9 @@ class RestFlags:
         for chunk in chunks:
             for axis, rest in passes.items():
                 view = axis_view(chunk, axis) if axis else chunk
-                rest.partial_fit(Recording({k: view[k] for k in _DETECTOR_COLUMNS if k in view},
+                rest.partial_fit(Recording({k: view[k] for k in DETECTOR_COLUMNS if k in view},
                                            view.metadata, view.source))
+        self._seen = {axis: rest.columns for axis, rest in passes.items()}  # for take()
         return {axis: rest.finish().keep for axis, rest in passes.items()}
 
     @property
@@ -104,16 +123,47 @@ class RestFlags:
         still = np.logical_and.reduce([self.still[a] for a in self.axes])
         return int(still.size - np.count_nonzero(still))
 
-    def take(self, rows: int) -> dict[str, np.ndarray]:
-        """The flags (1.0 at rest, 0.0 not) of the next ``rows`` samples, by column."""
-        start, stop = self.rows, self.rows + rows
+    def take(self, chunk: Recording) -> dict[str, np.ndarray]:
+        """The flags (1.0 at rest, 0.0 not) of the next chunk's samples, by column.
+
+        Raises :class:`FlagsMisaligned` unless the chunk's detector columns are, bit for
+        bit, those the detector saw at the same rows.
+        """
+        start, stop = self.rows, self.rows + len(chunk)
         flags = {}
-        for axis, column in zip(self.axes, self.columns, strict=True):
-            still = self.still[axis]
+        for i, (axis, column) in enumerate(zip(self.axes, self.columns, strict=True)):
+            still, seen = self.still[axis], self._seen[axis]
+            view = axis_view(chunk, axis) if axis else chunk
             if stop > still.size:
-                raise InputError(
-                    f"the recording gave {stop} rows to compensate but {still.size} to the "
-                    "motion detector's pass; it changed while it was read")
+                self._misaligned(f"{stop} rows to compensate but {still.size} to the detector")
+            theirs = {k for k in DETECTOR_COLUMNS if k in view}
+            if theirs != set(seen):
+                self._misaligned(f"columns {sorted(theirs)} to compensate but {sorted(seen)} "
+                                 "to the detector")
+            for name, values in seen.items():
+                if (name != "time_s" or i == 0) and not _same(view[name], values[start:stop]):
+                    self._misaligned(f"other values of {name} in rows {start}-{stop - 1}")
             flags[column] = still[start:stop].astype(np.float64)
         self.rows = stop
         return flags
+
+    def finish(self) -> None:
+        """Check that every row the detector saw was compensated (after the last
+        :meth:`take`)."""
+        size = self.still[self.axes[0]].size
+        if self.rows != size:
+            self._misaligned(f"{self.rows} rows compensated but {size} to the detector")
+
+    def _misaligned(self, what: str) -> None:
+        raise FlagsMisaligned(
+            f"{self._name}: the motion detector's pass and the compensating pass read other "
+            f"rows ({what}); the at_rest flags would not line up, none are written. Was the "
+            "file changed while it was read?")
+
+
+def _same(a: np.ndarray, b: np.ndarray) -> bool:
+    """Whether two float64 columns hold the same bits (NaN included)."""
+    a = np.ascontiguousarray(a, dtype=np.float64)
+    b = np.ascontiguousarray(b, dtype=np.float64)
+    return a.shape == b.shape and bool(np.array_equal(a.view(np.int64), b.view(np.int64)))
+

@@ -10,6 +10,7 @@ dropped and flagged is counted (:func:`compensation_accounting`).
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import os
 from concurrent.futures import ThreadPoolExecutor
@@ -19,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from hrgtc import recording as rec_io
-from hrgtc.compensate.at_rest import RestFlags
+from hrgtc.compensate.at_rest import DETECTOR_COLUMNS, FlagsMisaligned, RestFlags
 from hrgtc.compensate.compensator import Compensator, output_columns
 from hrgtc.compensate.model_fit import check_recording_noise, with_model_band
 from hrgtc.compensate.ranges import RangeReport
@@ -107,12 +108,40 @@ def compensate_file(
         options = with_model_band(read_options or rec_io.ReadOptions(), model)
         compensator = Compensator(model, drift, gaps=options.gaps)
         added = output_columns(model)
+
+        def spare() -> Any:
+            return Compensator(model, drift, gaps=options.gaps)
     else:
         options = read_options or rec_io.ReadOptions()
         added = compensator.columns
+        # its state before any chunk, for a second run (below)
+        copied = copy.deepcopy(compensator) if options.motion == "exclude" else None
+
+        def spare() -> Any:
+            return copied
     refuse_input(output, [source])
     refuse_compensated(source)
     check_writable(output, estimated_output_bytes(source, output, len(added)))
+    # the detector's pass reads its columns only, unless rows may be dropped because of
+    # others (--spikes drop); --motion error names a row: read as the compensation reads
+    only = DETECTOR_COLUMNS if options.motion == "exclude" and options.spikes != "drop" else None
+    run = (source, output, model, options, added, force, chunk_rows, drift, progress)
+    try:
+        return _compensate(*run, compensator, only)
+    except FlagsMisaligned:
+        if only is None:
+            raise
+    # the rows differed (at_rest.py): none were kept; again, the pass reading every column
+    return _compensate(*run, spare(), None)
+
+
+def _compensate(source: str | os.PathLike[str], output: str | os.PathLike[str],
+                model: UnitModel, options: rec_io.ReadOptions, added: tuple[str, ...],
+                force: bool, chunk_rows: int, drift: str, progress: Progress | None,
+                compensator: Any, only: tuple[str, ...] | None) -> CompensationSummary:
+    """One run of :func:`compensate_file`, the detector's pass reading ``only`` those
+    columns (None: all); raises :class:`FlagsMisaligned` before the output is kept if
+    its rows were not those compensated."""
     repair = TimeRepairStream()  # what the reader dropped (duplicated rows)
     chunks = options.chunks(source, rows=chunk_rows, time_repair=repair)
     spikes = 0
@@ -121,10 +150,16 @@ def compensate_file(
         total = rec_io.count_rows(source)
         flags = None  # samples not at rest: flagged, found in one pass first (at_rest.py)
         if options.motion != "keep":
-            flags = RestFlags(rec_io.iter_chunks(source, options, validate=False),
+            # duplicated rows in the first chunk: told apart by all the columns
+            only = None if repair.duplicates else only
+            # the spike filter's flags change no row: not computed in the detector's pass
+            quick = dataclasses.replace(options, spike_filter="off")
+            flags = RestFlags(rec_io.iter_chunks(source, quick, rows=chunk_rows,
+                                                 validate=False, only=only),
                               list(getattr(model, "axes", None) or [""]), options.motion,
                               os.path.basename(os.fspath(source)),
-                              validated=lambda: options.chunks(source), rows=total)
+                              validated=lambda: options.chunks(source, rows=chunk_rows),
+                              rows=total)
             added = (*added, *flags.columns)
         copies = sensor_copies((*first.names, *added), first.metadata)
         names = tuple(n for n in (*first.names, *added) if n not in copies)
@@ -139,7 +174,7 @@ def compensate_file(
             restarts: set[float] = set()  # every chunk's restarts, written at close
             while chunk is not None:
                 restarts.update(chunk.metadata.extra.get(RESTARTS_KEY) or ())
-                taken = None if flags is None else flags.take(len(chunk))
+                taken = None if flags is None else flags.take(chunk)
                 result = compensator.transform(chunk, _at_rest(flags, taken, compensator))
                 if taken is not None:
                     result = result.with_columns(**taken)
@@ -158,6 +193,8 @@ def compensate_file(
                     ahead = reading.submit(next, chunks, None)
             if pending is not None:
                 pending.result()
+            if flags is not None:
+                flags.finish()  # every row the detector saw compensated, or no output
             if restarts:
                 writer.set_metadata(dataclasses.replace(metadata, extra={
                     **metadata.extra, RESTARTS_KEY: sorted(restarts)}))

@@ -108,9 +108,15 @@ class RestPass:
             self._filled[column] = filled + values.size
         return self
 
+    @property
+    def columns(self) -> dict[str, np.ndarray]:
+        """The columns gathered so far (views of the buffers; :meth:`finish` drops the
+        buffers, not these views)."""
+        return {k: b[:self._filled[k]] for k, b in self._buffers.items()}
+
     def finish(self) -> RunRest:
         """The run's still samples and still ``freq_hz`` centre (see :func:`run_rest`)."""
-        columns = {k: b[:self._filled[k]] for k, b in self._buffers.items()}
+        columns = self.columns
         self._buffers, self._filled = {}, {}
         return _run_rest(columns, self.policy, self.settings, self.warmup_s, self.source,
                          self.input_rate)

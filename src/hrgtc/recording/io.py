@@ -35,7 +35,7 @@ validated axis by axis; :func:`hrgtc.recording.axis_view` gives one axis.
 from __future__ import annotations
 
 import itertools
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Collection, Iterator, Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -282,6 +282,7 @@ def iter_chunks(path: str | Path, options: ReadSettings | None = None, *,
                 progress: Progress | None = None, time_repair: TimeRepairStream | None = None,
                 dropped: dict[str, int] | None = None,
                 file_rows: Callable[[np.ndarray | None], None] | None = None,
+                only: Collection[str] | None = None,
                 **fields: Any) -> Iterator[Recording]:
     """Stream a recording in chunks of ``rows`` rows without loading the file.
 
@@ -301,6 +302,14 @@ def iter_chunks(path: str | Path, options: ReadSettings | None = None, *,
         A dict the caller reads once the chunks are exhausted: its ``"spikes"`` is
         then the count of rows the spike filters removed (``spikes="drop"`` and
         ``spike_filter="drop"``), for the caller's :class:`~hrgtc.core.Accounting`.
+    only
+        Read only the file's columns of these contract names (``"rate_dph"`` stands for
+        every axis's; :meth:`~hrgtc.recording.mapping.ColumnPlan.only`). The rows may
+        then differ from those of the whole file's: a row the reader drops because of
+        another column (``spikes="drop"``, a gap of a slow channel, a duplicated row told
+        from a duplicated time by the other columns) is kept. For a pass whose result
+        the caller checks against the whole file's rows (``hrgtc.compensate.at_rest``), with
+        ``validate=False`` (the validation asks for every column).
 
     Yields
     ------
@@ -323,7 +332,8 @@ def iter_chunks(path: str | Path, options: ReadSettings | None = None, *,
         whole = replace(opts, axis=None, freq_band_hz=None, freq_span_hz=None)
         yield from _axis_views(iter_chunks(path, whole, rows=rows, validate=validate,
                                            progress=progress, time_repair=time_repair,
-                                           dropped=dropped, file_rows=file_rows),
+                                           dropped=dropped, file_rows=file_rows,
+                                           only=only),
                                opts.axis, opts.freq_band_hz, str(path))
         return
     spike_filter, robust = _spike_filters(opts, path)
@@ -335,6 +345,8 @@ def iter_chunks(path: str | Path, options: ReadSettings | None = None, *,
     slow = SlowChannels(opts.slow_channels, opts.hold_max_s, str(path))
     with open_source(path, opts.slow_channels, opts.hold_max_s) as source:
         plan = _plan(source, opts, robust)
+        if only is not None:
+            plan = plan.only(only)
         offset = 0
         repairer = _time_repairer(plan)
         if time_repair is not None:  # the caller's, to read what was repaired
@@ -343,12 +355,15 @@ def iter_chunks(path: str | Path, options: ReadSettings | None = None, *,
             time_repair.source = repairer.source
             repairer = time_repair
         cut = _TimeSlice(opts.start, opts.end, plan)
+        numbered = validator is not None or file_rows is not None
 
         def converted() -> Iterator[dict[str, np.ndarray]]:
             nonlocal offset
             for table in source.iter_tables(plan.read_names, plan.as_text, rows):
-                part = slow.fill(with_file_rows(convert_columns(plan, table_columns(table),
-                                                                offset), offset), offset)
+                part = convert_columns(plan, table_columns(table), offset)
+                if numbered:  # the file rows, for the validator's messages
+                    part = with_file_rows(part, offset)
+                part = slow.fill(part, offset)
                 if spike_filter is not None:
                     part = spike_filter.drop(part, offset)
                 part = robust.apply(part, offset)

@@ -31,7 +31,7 @@ import difflib
 import math
 import warnings
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -169,6 +169,17 @@ class ColumnPlan:
     tz: str | None = None  # --tz: the zone naive clock times were written in
     time_aware: bool = False  # the clock times carry their zone (UTC, an offset, epoch)
     zone_clock: Any = None  # its ZoneClock (hrgtc.recording.time_axis), state across chunks
+
+    def only(self, bases: Iterable[str]) -> ColumnPlan:
+        """This plan reading only the columns whose contract name (without its axis) is
+        one of ``bases``, plus the temperature a sensor thermometer's ``freq_hz`` is
+        filled from (:func:`sensor_frequency`); the file's other columns are not read."""
+        wanted = set(bases)
+        if self.thermometer == "sensor":
+            wanted |= {"freq_hz", "temperature_c"}
+        pairs = [(theirs, name) for theirs, name in self.pairs
+                 if base_name(name, self.axes) in wanted]
+        return replace(self, pairs=pairs, read_names=list(dict.fromkeys(t for t, _ in pairs)))
 
     @property
     def temperature_is_count(self) -> bool:
