@@ -133,8 +133,8 @@ def refine(result: OLSResult, X: Any, y: Any, weights: Any = None, *,
     cond(R)^2 eps is small Q is not formed and Q h, Q' f are applied as A R^-1 h and
     R^-T A' f (the corrected seminormal equations, Bjorck, BIT 27, 303-313, 1987), so
     the corrections become dx = R^-1 R^-T (A' f - g), dr = f - A dx; otherwise Q comes
-    from a Householder QR of A. Memory: the float64 design (as large as X), Q as well
-    in the second case, plus a few vectors.
+    from a Householder QR of A. Memory: the float64 design (as large as X) and Q only
+    in the second case (the first applies A from X), plus a few vectors.
 
     Parameters
     ----------
@@ -207,12 +207,7 @@ def refine(result: OLSResult, X: Any, y: Any, weights: Any = None, *,
     # The float64 factorization only preconditions the refinement: its design is formed in
     # float64 (no extended pass), its solution x0 is then corrected against residuals
     # computed in double-double (hrgtc.drift._extended_kernel).
-    design = np.empty((n, k + 1))
-    design[:, 0] = 1.0
-    np.subtract(X, shift[:k], out=design[:, 1:])
-    design[:, 1:] *= inverse[:k]
-    if w is not None:
-        design *= np.sqrt(w)[:, None]
+    root_w = None if w is None else np.sqrt(w)
     r_factor = factor.r_[:k + 1, :k + 1]
     cond = float(np.linalg.cond(r_factor))
     # Well-conditioned (cond^2 eps small): the corrections solve the corrected seminormal
@@ -228,10 +223,10 @@ def refine(result: OLSResult, X: Any, y: Any, weights: Any = None, *,
     else:
         response = (y - shift[k]) * inverse[k]
         if w is not None:
-            response *= np.sqrt(w)
-        q, r_factor = np.linalg.qr(design)
+            response *= root_w
+        q, r_factor = np.linalg.qr(_design(X_c, shift[:k], inverse[:k], root_w))
         x_hi = solve_triangular(r_factor, q.T @ response)
-        del response, design
+        del response
         # each step shrinks the error of x by about c (k + 1) eps cond(A) (Bjorck 1967)
         contraction = min(1.0, 16.0 * (k + 1) * eps * cond)
     x_hi = np.ascontiguousarray(x_hi, dtype=np.float64)
@@ -252,8 +247,8 @@ def refine(result: OLSResult, X: Any, y: Any, weights: Any = None, *,
                           False)
         h = solve_triangular(r_factor, g_hi + g_lo, trans="T")
         if q is None:  # Q' f = R^-T A' f
-            d = solve_triangular(r_factor, design.T @ f, trans="T") if step \
-                else np.zeros(k + 1)
+            d = solve_triangular(r_factor, _design_t(X_c, shift[:k], inverse[:k], root_w, f),
+                                 trans="T") if step else np.zeros(k + 1)
         else:
             d = q.T @ f
         dx = solve_triangular(r_factor, d - h)
@@ -262,7 +257,7 @@ def refine(result: OLSResult, X: Any, y: Any, weights: Any = None, *,
             break
         add_to(x_hi, x_lo, dx)
         if q is None:  # dr = Q h + (I - Q Q') f = f - A dx
-            add_to(r_hi, r_lo, f - design @ dx)
+            add_to(r_hi, r_lo, f - _design_times(X_c, shift[:k], inverse[:k], root_w, dx))
         else:
             add_to(r_hi, r_lo, f + q @ (h - d))
         previous = size
@@ -283,6 +278,37 @@ def refine(result: OLSResult, X: Any, y: Any, weights: Any = None, *,
 
 
 _refine_module_level = refine  # ``ols`` has a parameter of the same name
+
+
+# The float64 design A = sqrt(w) [1, (X - shift) / scale] of :func:`refine`, applied
+# without forming it (a float64 copy as large as X): A v and A' f from X itself. These
+# only precondition the refinement; its residuals are computed in double-double.
+def _design(X: np.ndarray, shift: np.ndarray, inverse: np.ndarray,
+            root_w: np.ndarray | None) -> np.ndarray:
+    design = np.empty((X.shape[0], X.shape[1] + 1))
+    design[:, 0] = 1.0
+    np.subtract(X, shift, out=design[:, 1:])
+    design[:, 1:] *= inverse
+    if root_w is not None:
+        design *= root_w[:, None]
+    return design
+
+
+def _design_times(X: np.ndarray, shift: np.ndarray, inverse: np.ndarray,
+                  root_w: np.ndarray | None, v: np.ndarray) -> np.ndarray:
+    slopes = inverse * v[1:]
+    out = X @ slopes
+    out += v[0] - float(shift @ slopes)
+    if root_w is not None:
+        out *= root_w
+    return out
+
+
+def _design_t(X: np.ndarray, shift: np.ndarray, inverse: np.ndarray,
+              root_w: np.ndarray | None, f: np.ndarray) -> np.ndarray:
+    g = f if root_w is None else f * root_w
+    total = float(g.sum())
+    return np.concatenate([[total], inverse * (X.T @ g - shift * total)])
 
 
 def newey_west_inflation(residuals: Any, bandwidth: int | None = None) -> tuple[float, int]:
