@@ -115,3 +115,17 @@ def test_time_blocks_cut_at_burst_bounds_and_holdout_never_splits_a_burst():
     assert holdout_rows(continuous, holdout_fraction=0.3) == 700
     with pytest.raises(InputError, match="exactly one"):
         holdout_rows(continuous)
+
+
+@pytest.mark.parametrize("sizes", [[1, 1, 98], [98, 1, 1], [1, 97, 1, 1], [2, 2, 2, 94]])
+def test_time_blocks_of_very_unequal_segments_are_contiguous_and_nonempty(sizes):
+    # window means of a real file with motion left out: a few long still periods and
+    # short pieces between them (issue 27: the CATS tag's file crashed here, IndexError)
+    starts = np.cumsum([0, *sizes[:-1]]) * 1000.0
+    time = np.concatenate([s + np.arange(k, dtype=float) for s, k in zip(starts, sizes)])
+    for count in (2, 3):
+        blocks = time_blocks(time, count)
+        assert len(blocks) == count
+        assert blocks[0][0] == 0 and blocks[-1][1] == time.size
+        assert all(a < b for a, b in blocks)
+        assert all(b == c for (_, b), (c, _) in zip(blocks, blocks[1:]))

@@ -7,6 +7,7 @@ Commands live in their own modules of this package and register themselves on
 from __future__ import annotations
 
 import json
+import os
 import re
 import sys
 import warnings
@@ -107,11 +108,13 @@ def library_errors() -> Iterator[None]:
     except KeyboardInterrupt:
         raise fail("interrupted; nothing was written", 130) from None
     except Exception as exc:
+        if os.environ.get("HRGTC_TRACEBACK"):  # for a bug report: the whole traceback
+            raise
         module = type(exc).__module__.split(".")[0]
         if module in ("pyarrow", "h5py"):
             raise fail(f"{module} cannot read or write a file: {_first_line(exc)}") from exc
         raise fail(f"internal error {type(exc).__name__}: {_first_line(exc)} "
-                   "(a bug in hrgtc; please report it with the command line)") from exc
+                   "(a bug in hrgtc; please report it with the command line; HRGTC_TRACEBACK=1 shows where)") from exc
 
 
 @contextmanager

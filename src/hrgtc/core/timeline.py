@@ -497,14 +497,16 @@ def time_blocks(time_s: np.ndarray, n_blocks: int, bounds: np.ndarray | None = N
         cumulative = np.cumsum(sizes)
         targets = np.arange(1, n_blocks) * n / n_blocks
         # the segment end nearest each target, one per block
+        ends = cumulative[:-1]
         cuts = []
         for target in targets:
-            k = int(np.argmin(np.abs(cumulative[:-1] - target)))
-            cut = int(cumulative[k])
-            if cuts and cut <= cuts[-1]:
-                later = cumulative[:-1][cumulative[:-1] > cuts[-1]]
-                cut = int(later[0])
-            cuts.append(cut)
+            after = cuts[-1] if cuts else 0
+            later = ends[ends > after]
+            if later.size:  # the segment end nearest the target, after the last cut
+                cut = int(later[np.argmin(np.abs(later - target))])
+            else:  # no segment end left (segments of very unequal sizes): cut inside one
+                cut = max(after + 1, round(float(target)))
+            cuts.append(min(cut, n - (n_blocks - 1 - len(cuts))))
     else:
         cuts = [round(k * n / n_blocks) for k in range(1, n_blocks)]
     edges = [0, *cuts, n]
