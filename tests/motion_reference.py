@@ -245,6 +245,13 @@ def detect_motion_reference(
     for a, b in _bounds(segment):  # a guard never reaches across a gap
         moving[a:b] = _dilate(found[a:b], after, before)
     reasons["guard"] = moving & ~found
+    reasons["short_still"] = np.zeros(n, dtype=bool)
+    for a, b in _bounds(segment):  # still runs next to motion, shorter than min_still_s
+        if s.min_still_s > 0 and moving[a:b].any():
+            for start, stop in zip(*_runs(~moving[a:b]), strict=True):
+                if time_s[a + stop - 1] - time_s[a + start] < s.min_still_s:
+                    reasons["short_still"][a + start:a + stop] = True
+    moving |= reasons["short_still"]
     noise = {c.name: c.sigma for c in prepared}
     return MotionMask(moving, reasons, np.diff(segment) != 0, noise, s)
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -122,10 +124,12 @@ def test_time_blocks_of_very_unequal_segments_are_contiguous_and_nonempty(sizes)
     # window means of a real file with motion left out: a few long still periods and
     # short pieces between them (issue 27: the CATS tag's file crashed here, IndexError)
     starts = np.cumsum([0, *sizes[:-1]]) * 1000.0
-    time = np.concatenate([s + np.arange(k, dtype=float) for s, k in zip(starts, sizes)])
+    time = np.concatenate([s + np.arange(k, dtype=float)
+                           for s, k in zip(starts, sizes, strict=True)])
     for count in (2, 3):
         blocks = time_blocks(time, count)
         assert len(blocks) == count
         assert blocks[0][0] == 0 and blocks[-1][1] == time.size
         assert all(a < b for a, b in blocks)
-        assert all(b == c for (_, b), (c, _) in zip(blocks, blocks[1:]))
+        pairs = itertools.pairwise(blocks)
+        assert all(b == c for (_, b), (c, _) in pairs)

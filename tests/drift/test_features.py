@@ -108,14 +108,6 @@ def test_design_matrix_scaling_is_exact():
     np.testing.assert_allclose(scaled * factors, raw, rtol=1e-13)
 
 
-def test_sample_rate_mismatch_is_refused():
-    rec = Recording({"time_s": [0.0, 0.1], "freq_hz": [1.0, 1.0], "rate_dph": [0.0, 0.0]},
-                    Metadata(sample_rate_hz=10.0), source="run.parquet")
-    s = FeatureSettings(reference_freq_hz=1.0, sample_rate_hz=200.0)
-    with pytest.raises(InputError, match=r"run.parquet: sample rate 10 Hz differs.*200 Hz"):
-        s.check_sample_rate(rec)
-
-
 # -- the second rate filter, the gradient and the user's channels (issue 12, item 2) ------
 def _lagged_run(n=6000, fs=5.0, seed=3):
     from synthetic import THERMOMETER

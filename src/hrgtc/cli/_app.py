@@ -114,7 +114,8 @@ def library_errors() -> Iterator[None]:
         if module in ("pyarrow", "h5py"):
             raise fail(f"{module} cannot read or write a file: {_first_line(exc)}") from exc
         raise fail(f"internal error {type(exc).__name__}: {_first_line(exc)} "
-                   "(a bug in hrgtc; please report it with the command line; HRGTC_TRACEBACK=1 shows where)") from exc
+                   "(a bug in hrgtc; please report it with the command line; "
+                   "HRGTC_TRACEBACK=1 shows where)") from exc
 
 
 @contextmanager

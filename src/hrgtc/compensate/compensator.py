@@ -185,7 +185,6 @@ class Compensator:
         temporaries in cache.
         """
         if self.samples == 0:
-            self.drift.settings.check_sample_rate(chunk)
             if self.gaps != "split":  # split restarts the filter at each gap instead
                 levels = filtered_levels(chunk, self.drift.variables)
                 # up to a logger restart (the filter restarts there)

@@ -221,7 +221,6 @@ class DriftModel(ParsedTerms):
 
         ``thermometer`` (the unit's) is needed when the terms use the gradient ``g``.
         """
-        self.settings.check_sample_rate(recording)
         stream = FeatureStream(self.settings, self.variables, thermometer)
         return self.predict(stream.transform(recording))
 

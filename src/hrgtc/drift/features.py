@@ -315,18 +315,6 @@ class _FeatureSettingsMethods:
         return cls(**records.load(data, FeatureSettingsRecord,  # type: ignore[no-any-return]
                                   "feature-settings"))
 
-    def check_sample_rate(self, recording: Recording) -> None:
-        """Raise when a recording's rate differs from the one the filter was built for."""
-        rate = recording.metadata.sample_rate_hz
-        if not math.isclose(rate, self.sample_rate_hz, rel_tol=1e-6):
-            where = f"{recording.source}: " if recording.source else ""
-            raise InputError(
-                f"{where}sample rate {rate:g} Hz differs from the model's {self.sample_rate_hz:g} "
-                "Hz; the model's settling time and windows are counted in samples at its rate, "
-                "so resample the recording or "
-                "calibrate at this rate"
-            )
-
 
 #: The settings every model has, as fields of :func:`dataclasses.make_dataclass`.
 _COMMON_SETTINGS: tuple[tuple[str, Any] | tuple[str, Any, Any], ...] = (
@@ -354,8 +342,11 @@ _FEATURE_SETTINGS_DOC = """Everything needed to compute the drift-model variable
     reference_c
         Reference temperature (also the origin of ``h``). [°C]
     sample_rate_hz
-        Sample rate of the training runs: the settling time and the windows are counted
-        in samples at it (the rate filter itself steps over each sample's Δt). [Hz]
+        Sample rate of the (first) training run, for the C export's fixed-rate filter
+        and its settling count. Python's compensation does not depend on it: the settling
+        time is in seconds on the time axis and the rate filter steps over each sample's
+        own Δt, so a model applies to a recording at any rate (a real clock drifts by
+        tenths of a percent between runs). [Hz]
     rate_tau_s
         Time constant of each stage of the rate filter. [s]
     warmup_s

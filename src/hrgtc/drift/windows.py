@@ -286,10 +286,8 @@ def window_means(
     """
     variables = variables_for(terms)
     variables += tuple(v for v in extra_variables if v not in variables)
-    window_rows = round(window_s * settings.sample_rate_hz)
-    if window_rows < 1:
-        raise InputError(f"window_s={window_s} s holds no sample at {settings.sample_rate_hz} Hz")
-    period = 1.0 / settings.sample_rate_hz
+    if not window_s > 0:
+        raise InputError(f"window_s must be a positive number of seconds, got {window_s!r}")
     split = gaps == "split"
     out_terms, out_bias, out_time, out_run, out_power = [], [], [], [], []
     power_names: list[str] = []
@@ -318,7 +316,7 @@ def window_means(
 
     for index, source in enumerate(runs):
         stream = FeatureStream(settings, variables, thermometer)
-        averager = _WindowMeans(window_rows)
+        averager: _WindowMeans | None = None  # windows in rows at this run's own rate
         input_rate = None
         run_keep = None if keep is None else keep[index]
         row = 0
@@ -328,7 +326,15 @@ def window_means(
         power = len(power_names)  # index of the power-on run of the next row
         first_power = power
         for chunk in _iter_run(source):
-            settings.check_sample_rate(chunk)
+            if averager is None:
+                rate_hz = chunk.metadata.sample_rate_hz
+                window_rows = round(window_s * rate_hz)
+                if window_rows < 1:
+                    raise InputError(f"window_s={window_s:g} s holds no sample at {rate_hz:g} Hz "
+                                     f"({chunk.source or 'run ' + str(index)}); pass a longer "
+                                     "--window-s")
+                averager = _WindowMeans(window_rows)
+                period = 1.0 / rate_hz
             if input_rate is None:
                 input_rate = chunk.metadata.input_rate_dph
                 sources.append(chunk.source or f"run {index}")
@@ -421,6 +427,8 @@ def window_means(
             total += len(chunk)
             if progress is not None:
                 progress(total, 0)
+        if averager is None:  # a run without rows
+            continue
         means = averager.flush()
         if means.shape[0]:
             collect(means, index)

@@ -191,6 +191,11 @@ class RecordingInfo:
             step = "" if col.resolution is None else f"  (steps of {col.resolution:.3g})"
             lines.append(f"    {col.name:<16} {unit:<8} {_num(col.minimum)} .. "
                          f"{_num(col.maximum)}{step}")
+        found = (self.metadata or {}).get("extra", {}).get("columns_found") or {}
+        if found:
+            lines.append("  found by name: " + ", ".join(
+                f"{theirs!r} as {name}" for name, theirs in found.items())
+                + " (the accelerometer: motion and orientation; --col accel_x=... to choose)")
         if self.spike_rows is not None:
             lines.append(f"  single-sample spikes: {self.spike_rows} row(s) (calibrate and "
                          "evaluate remove them, compensate flags them; --spike-filter)")

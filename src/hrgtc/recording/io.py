@@ -124,6 +124,8 @@ def _metadata(
         raise RecordingError(f"{path}: metadata extra is {data.get('extra')!r}, not a JSON "
                              "object of key/value pairs; fix or remove it")
     extra = dict(data.get("extra") or {})
+    if plan.found:  # said by info, kept in the outputs' metadata
+        extra["columns_found"] = dict(plan.found)
     if (override or {}).get("sample_rate_hz") is not None:
         extra.pop("sample_rate_inferred", None)
     try:

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import difflib
 import math
+import re
 import warnings
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
@@ -169,6 +170,8 @@ class ColumnPlan:
     tz: str | None = None  # --tz: the zone naive clock times were written in
     time_aware: bool = False  # the clock times carry their zone (UTC, an offset, epoch)
     zone_clock: Any = None  # its ZoneClock (hrgtc.recording.time_axis), state across chunks
+    #: Columns found by their common names, not mapped by the user (the accelerometer's)
+    found: dict[str, str] = field(default_factory=dict)
 
     def only(self, bases: Iterable[str]) -> ColumnPlan:
         """This plan reading only the columns whose contract name (without its axis) is
@@ -186,6 +189,41 @@ class ColumnPlan:
         """True when ``temperature_c*`` holds a raw count (a count unit, a scale or an offset)."""
         return (self.units.get("temp") == "count"
                 or scales_temperature(self.temp_scale, self.temp_offset_c))
+
+
+#: Prefixes of an accelerometer's columns in loggers' files (compared case-insensitively):
+#: ``acc_x``, ``accel_x``, ``ax``, ``a_x``, ``AccX``, ``accelerometer.x``, ``imu_acc_x``,
+#: with or without a unit after the axis (``acc_x [m/s^2]``, ``acc_x_m_s2``, ``accX(g)``).
+_ACCEL_NAME = re.compile(
+    r"^(?:imu[ _.\-]?)?(?:acc|accel|accl|acceleration|accelerometer|a)[ _.\-]?([xyz])"
+    r"(?:$|[ _.\-\[(].*$)", re.IGNORECASE)
+
+
+def find_accelerometer(names: Iterable[str], taken: Iterable[str],
+                       kinds: Mapping[str, str] | None = None) -> dict[str, str]:
+    """The file's accelerometer columns under their common names, as a column mapping
+    ``{"accel_x": theirs, ...}``: all three axes, exactly one numeric column each, and none
+    mapped or named ``accel_*`` already; else ``{}`` (the motion detector then uses the gyro).
+
+    Examples
+    --------
+    >>> find_accelerometer(["time_s", "acc_x [m/s^2]", "acc_y [m/s^2]", "acc_z [m/s^2]"], [])
+    {'accel_x': 'acc_x [m/s^2]', 'accel_y': 'acc_y [m/s^2]', 'accel_z': 'acc_z [m/s^2]'}
+    >>> find_accelerometer(["ax", "ay", "az", "a_x", "a_y", "a_z"], [])  # which? none
+    {}
+    """
+    names = list(names)
+    taken = set(taken)
+    if any(n.startswith("accel_") for n in (*names, *taken)):
+        return {}
+    found: dict[str, list[str]] = {}
+    for name in names:
+        match = _ACCEL_NAME.match(name.strip())
+        if match and name not in taken and (kinds is None or kinds.get(name) == "numeric"):
+            found.setdefault(match.group(1).lower(), []).append(name)
+    if sorted(found) != ["x", "y", "z"] or any(len(v) != 1 for v in found.values()):
+        return {}
+    return {f"accel_{axis}": found[axis][0] for axis in "xyz"}
 
 
 def plan_columns(source: Source, columns: Any, units: Mapping[str, str] | None,
@@ -248,6 +286,8 @@ def plan_columns(source: Source, columns: Any, units: Mapping[str, str] | None,
                 f"the file's columns are {source.names}"
             )
     kinds = source.kinds()
+    found = find_accelerometer(source.names, mapping.values(), kinds)
+    mapping = {**mapping, **found}
     pairs = [(theirs, name) for name, theirs in mapping.items()]
     recording_names = [*mapping, *(n for n in source.names if n not in mapping.values())]
     axes = axis_names(recording_names)
@@ -289,7 +329,7 @@ def plan_columns(source: Source, columns: Any, units: Mapping[str, str] | None,
                       rate_scale=None if rate_scale is None else float(rate_scale),
                       temp_unwrap=temp_unwrap,
                       wrap_bits=int(temp_unwrap) if temp_unwrap in ("16", "32") else None,
-                      wrap_decided=temp_unwrap != "auto")
+                      wrap_decided=temp_unwrap != "auto", found=found)
 
 
 def check_axis_sets(source: Source, names: list[str], axes: tuple[str, ...],

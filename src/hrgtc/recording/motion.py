@@ -57,7 +57,7 @@ VARIANCE_MIN_SAMPLES = 32
 #: What calibration and evaluation do with moving samples (``--motion``).
 MOTION_POLICIES = ("exclude", "keep", "error")
 #: Reasons a sample is marked, in the order they are reported.
-REASONS = ("level", "variance", "clipped", "accelerometer", "guard")
+REASONS = ("level", "variance", "clipped", "accelerometer", "guard", "short_still")
 #: Columns read as accelerometer axes when present.
 ACCEL_COLUMNS = ("accel_x", "accel_y", "accel_z")
 
@@ -83,6 +83,13 @@ class MotionSettings:
     guard_s, guard_before_s
         Samples this long after / before motion are marked too (the unit settling;
         the motion's onset below the threshold). [s]
+    min_still_s
+        A still stretch next to motion (between two handlings, or from the start or to
+        the end of a segment) shorter than this is not at rest either (reason
+        ``short_still``): a unit put down for a moment between handlings has not settled
+        (the hand's warmth, a thermal gradient), and its few samples would set the
+        trained ranges. Stretches between gaps only (a burst logger's bursts) are never
+        marked. [s]
     clip_samples
         Equal consecutive samples at a channel's extreme that make a clipped plateau.
     """
@@ -95,6 +102,7 @@ class MotionSettings:
     guard_s: float = 5.0
     guard_before_s: float = 2.0
     clip_samples: int = 3
+    min_still_s: float = 300.0
 
     def __post_init__(self) -> None:
         for name in ("baseline_s", "window_s", "threshold", "variance_ratio"):
@@ -102,7 +110,7 @@ class MotionSettings:
             if not (isinstance(value, int | float) and math.isfinite(value) and value > 0):
                 raise InputError(f"motion setting {name} must be a positive number, got "
                                  f"{value!r}")
-        for name in ("min_motion_s", "guard_s", "guard_before_s"):
+        for name in ("min_motion_s", "guard_s", "guard_before_s", "min_still_s"):
             value = getattr(self, name)
             if not (isinstance(value, int | float) and math.isfinite(value) and value >= 0):
                 raise InputError(f"motion setting {name} must be a number of seconds >= 0, "
@@ -452,8 +460,28 @@ def detect_motion(
     kernel.guard(reasons["level"], reasons["variance"], reasons["clipped"],  # never across
                  reasons["accelerometer"], starts, stops, after, before, moving,  # a gap
                  reasons["guard"])
+    _short_still(time_s, moving, starts, stops, s.min_still_s, reasons["short_still"])
     noise = {c.name: c.sigma for c in prepared}
     return MotionMask(moving, reasons, breaks, noise, s)
+
+
+def _short_still(time_s: np.ndarray, moving: np.ndarray, starts: np.ndarray,
+                 stops: np.ndarray, min_still_s: float, marked: np.ndarray) -> None:
+    """Mark (in ``moving`` and ``marked``) the still stretches of each segment
+    ``[starts[k], stops[k])`` that touch motion and last less than ``min_still_s``."""
+    if min_still_s <= 0 or not moving.any():
+        return
+    for a, b in zip(starts.tolist(), stops.tolist(), strict=True):
+        part = moving[a:b]
+        if not part.any():
+            continue  # no motion in the segment: a burst, a quiet run
+        # still runs [lo, hi) within the segment (the padding ends every run); each
+        # touches motion, as the segment has some
+        change = np.flatnonzero(np.diff(np.concatenate([[0], (~part).astype(np.int8), [0]])))
+        for lo, hi in zip(change[::2].tolist(), change[1::2].tolist(), strict=True):
+            if time_s[a + hi - 1] - time_s[a + lo] < min_still_s:
+                moving[a + lo:a + hi] = True
+                marked[a + lo:a + hi] = True
 
 
 def recording_motion(recording: Any, settings: MotionSettings | None = None) -> MotionMask:

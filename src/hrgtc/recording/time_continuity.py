@@ -55,14 +55,24 @@ class TimeContinuity:
         self._time_order_kind = ""
         self.gaps: list[Gap] = []
         self.n_gaps = 0
+        self._last_file_row: float | None = None
 
     def partial_fit(self, time: np.ndarray, offset: int, metadata: Metadata,
-               chunk: Recording | None = None) -> None:
+               chunk: Recording | None = None, file_rows: np.ndarray | None = None) -> None:
         """Check the times of the next chunk, its first row ``offset`` of the recording
-        (``chunk``: the chunk itself, for the diagnosis of a step back)."""
+        (``chunk``: the chunk itself, for the diagnosis of a step back).
+
+        ``file_rows``: the file row of each row, when the reader left rows out (spikes,
+        duplicated rows). A step over rows the reader removed is judged per file row: the
+        file's own time steps decide what a gap is and what the rate is, so rows the tool
+        removed are never turned into gaps or a change of rate (they are counted where
+        they were removed).
+        """
         self.metadata = metadata
         period = 1.0 / self.metadata.sample_rate_hz
-        if self._last_time is not None:  # fast path: steps all positive and no gap
+        spans = self._spans(file_rows)
+        # fast path: steps all positive and no gap
+        if spans is None and self._last_time is not None:
             step = np.empty_like(time)
             step[0] = time[0] - self._last_time
             np.subtract(time[1:], time[:-1], out=step[1:])
@@ -72,6 +82,26 @@ class TimeContinuity:
                 self._last_time = float(time[-1])
                 self._check_rate(step, offset, time=time)
                 return
+        self._partial_fit_spans(time, offset, period, chunk, spans)
+
+    def _spans(self, file_rows: np.ndarray | None) -> np.ndarray | None:
+        """File rows each step of the chunk spans (1: no row left out between), None when
+        no row was left out."""
+        if file_rows is None or not len(file_rows):
+            return None
+        previous = self._last_file_row
+        self._last_file_row = float(file_rows[-1])
+        spans = np.empty(len(file_rows))
+        spans[0] = 1.0 if previous is None else file_rows[0] - previous
+        np.subtract(file_rows[1:], file_rows[:-1], out=spans[1:])
+        if not (spans > 1.0).any():
+            return None
+        return np.maximum(spans, 1.0)
+
+    def _partial_fit_spans(self, time: np.ndarray, offset: int, period: float,
+                           chunk: Recording | None, spans: np.ndarray | None) -> None:
+        """:meth:`partial_fit` step by step: order on the steps as they are, gaps and rate
+        on each step divided by the file rows it spans (``spans``; None: one each)."""
         previous = np.empty_like(time)
         previous[0] = np.nan if self._last_time is None else self._last_time
         previous[1:] = time[:-1]
@@ -86,10 +116,15 @@ class TimeContinuity:
                 self._time_order = (offset + i, float(time[i]), float(previous[i]))
                 self._time_order_kind = _step_diagnosis(time, previous, i, period,
                                                         self.metadata, chunk)
+        per_row = step
+        if spans is not None:  # a step over removed rows, as long as those rows took
+            with np.errstate(invalid="ignore"):  # (a duplicated row took no time)
+                rows_taken = np.clip(np.round(step / period), 1.0, spans)
+            per_row = np.where(np.isfinite(rows_taken), step / rows_taken, step)
         with np.errstate(invalid="ignore"):
-            long = np.flatnonzero(is_gap(step, period) & np.isfinite(step))
+            long = np.flatnonzero(is_gap(per_row, period) & np.isfinite(per_row))
         self.n_gaps += long.size
-        self._check_rate(step, offset)
+        self._check_rate(per_row, offset)
         room = MAX_LISTED_GAPS - len(self.gaps)
         self.gaps += [
             Gap(float(previous[i]), float(step[i]), offset + int(i)) for i in long[:room]

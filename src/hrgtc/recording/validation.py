@@ -207,7 +207,7 @@ class RecordingValidator:
             if base_name(name, self.axes) in self._bounds:
                 self._check_bounds(name, values, offset)
         if "time_s" in chunk and n:
-            self.time_axis.partial_fit(chunk.time_s, offset, self.metadata, chunk)
+            self.time_axis.partial_fit(chunk.time_s, offset, self.metadata, chunk, file_rows)
         if self._heuristics is None:
             self._collect_sample(chunk)
         self.rows += n
