@@ -297,4 +297,8 @@ def test_fresh_model_file_records_the_defaults(paper_campaign, tmp_path):
     (axis,) = model["axes"].values() if "axes" in model else (model,)
     features = axis["drift"]["settings"]
     assert features["rate_tau_s"] == DriftSettings.rate_tau_s
-    assert features["warmup_s"] == WARMUP_FACTOR * DriftSettings.rate_tau_s
+    rate_free = not any(v in term for term in axis["drift"]["selected"]
+                        for v in ("df", "dh", "d2"))
+    # no rate term chosen: no filter to wait for, the warm-up is trained on (0 s)
+    assert features["warmup_s"] == (0.0 if rate_free else
+                                    WARMUP_FACTOR * DriftSettings.rate_tau_s)

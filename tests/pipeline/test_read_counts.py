@@ -9,6 +9,8 @@ head on a long file reads its first rows only.
 
 from __future__ import annotations
 
+import json
+
 import dataclasses
 import math
 from pathlib import Path
@@ -134,8 +136,12 @@ def test_calibrate_reads_each_file_once_for_every_axis(campaign):
         assert passes == [1, 1, 1]
         counts = _counts([*args, "--cross-axis"])
         assert [counts.of(f)[1] for f in files] == [1, 1, 1]
-    else:
-        assert passes == [5, 6, 2]
+    else:  # the window means once more when the terms chosen use no rate: their
+        # warm-up samples are trained on too (docs/real-loggers/corpus.md)
+        model = json.loads(campaign["model"].with_name("m.json").read_text())
+        terms = model["drift"]["selected"]
+        rate_free = not any("df" in t or "d2" in t or "dh" in t for t in terms)
+        assert passes == ([7, 8, 2] if rate_free else [5, 6, 2])
 
 
 def test_reading_once_gives_the_same_instrument_model(campaign, monkeypatch):

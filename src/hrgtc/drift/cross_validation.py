@@ -432,15 +432,28 @@ def guard_selection(x_scaled: np.ndarray, bias_dph: np.ndarray, run: np.ndarray,
                     time_s: np.ndarray, names: Sequence[str], selected: Sequence[str],
                     parents: Mapping[str, Sequence[str]] | None = None,
                     keep: Sequence[str] = (), temperature: np.ndarray | None = None,
+                    line_floor: bool = False,
                     ) -> tuple[tuple[str, ...] | None, dict[str, Any]]:
     """The guarded selection: :func:`prune_terms` on the folds of :func:`folds_of`
     (``temperature``: the window means of the thermometer variable, which pick the
-    coldest and the hottest block of a single run).
+    coldest and the hottest block of a single run). ``line_floor``: on a single run, the
+    line in the thermometer variable (:data:`LINE_TERM`, significant on its own) is kept
+    whatever the other terms.
 
     Returns the terms to refit (None when nothing was dropped) and the record of the check
     (``folds``, ``dropped``, ``before_dph``, ``after_dph``) stored in the model.
     """
     folds, kind = folds_of(run, time_s, temperature)
+    original = set(selected)
+    if line_floor and kind != "runs" and LINE_TERM in names:
+        # one long run: a line in the thermometer variable that is significant on its own
+        # is the floor, kept whatever the joint F-tests said (the held-out blocks of one
+        # run cannot tell a slope from the hysteresis of its ramps; a real chamber cycle's
+        # axis did worse held out without it than the plain line,
+        # docs/real-loggers/corpus.md)
+        keep = list(dict.fromkeys([*keep, LINE_TERM]))
+        if LINE_TERM not in selected:
+            selected = [LINE_TERM, *selected]
     # across runs a fold's complement may lack what one run alone excites (a heating-only
     # term when the one warm-up is left out): there, stop at the first rise
     kept, before, after = prune_terms(x_scaled, bias_dph, folds, names, selected,
@@ -455,4 +468,4 @@ def guard_selection(x_scaled: np.ndarray, bias_dph: np.ndarray, run: np.ndarray,
               "before_dph": before, "after_dph": after}
     if tests:
         record["slow_noise"] = tests
-    return (kept if len(kept) < len(selected) else None), record
+    return (tuple(kept) if set(kept) != original else None), record

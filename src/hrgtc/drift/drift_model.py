@@ -40,6 +40,7 @@ from hrgtc.drift.cross_validation import (
     CrossValidation,
     CrossValidationRecord,
     cross_validate,
+    LINE_TERM,
     guard_selection,
     select_terms,
 )
@@ -497,11 +498,18 @@ def fit(
     if select == "cv":  # from the stepwise terms, one-term changes that cross-validate better
         chosen = select_terms(*cv_args, windows.sources, rate, slope_sign, parents=parents,
                               initial=result.selected)
-    elif select == "guarded" and result.selected:
+    elif select == "guarded" and (result.selected or np.unique(windows.run).size == 1):
+        line_floor = False
+        if np.unique(windows.run).size == 1 and LINE_TERM in names:
+            # the line on its own, by a plain F-test: the one term physics expects is the
+            # floor unless the data cannot tell it from no slope at all
+            k = list(names).index(LINE_TERM)
+            line_floor = stepwise(x_scaled[:, [k]], bias, names=[LINE_TERM], penter=penter,
+                                  premove=premove).selected == (LINE_TERM,)
         chosen, pruning = guard_selection(
             x_scaled, bias, windows.run, windows.time_s, names, result.selected,
             parents=hierarchy(candidates), keep=[parse_terms([t])[0].name for t in initial or ()],
-            temperature=windows.variables.get("f"))
+            temperature=windows.variables.get("f"), line_floor=line_floor)
     if chosen is not None:
         history = result.history
         result = stepwise(x_scaled, bias, names=names, penter=penter,
@@ -509,6 +517,30 @@ def fit(
                           max_steps=0, refine=EXTENDED_PRECISION)
         if select == "guarded":  # the F-test steps stay on record; the pruning is in `pruning`
             result = dataclasses.replace(result, history=history)
+    settled_extremes = None
+    chosen_terms = [t for t in candidates if t.name in result.selected]
+    if warmup_s is None and settings.warmup_s > 0 and not any(
+            entry.rate_of for entry, _ in registry_entries(variables_for(chosen_terms))):
+        # no rate term chosen: nothing waits for the df/dt filter to settle, so the run's
+        # first warmup_s (at rest, and often its most extreme temperature) is trained on
+        # too, and the compensation flags no settling (docs/real-loggers/corpus.md)
+        settings = FeatureSettings(**{**settings.to_dict(), "warmup_s": 0.0})
+        settled_extremes = windows.extremes
+        windows = window_means(runs, settings, candidates, window_s, progress, thermometer,
+                               tracked, keep=keep, gaps=gaps,
+                               restart_each_segment=restart_each_segment)
+        groups = offset_groups(offsets, windows.power_run if powered else windows.run,
+                               windows.power_runs if powered else windows.sources,
+                               windows.accel, windows.orientation)
+        x_full = windows.terms / factors
+        x_scaled, bias = x_full, windows.bias_dph
+        if groups.mode != "none":
+            x_scaled, bias = project_off(groups, x_full, windows.bias_dph)
+        history = result.history
+        result = dataclasses.replace(
+            stepwise(x_scaled, bias, names=names, penter=penter, premove=premove,
+                     initial=result.selected, variance_inflation=inflation, max_steps=0,
+                     refine=EXTENDED_PRECISION), history=history)
     ols = result.result
     selected = result.selected
     selected_factor = {t.name: t.scale_factor(scales) for t in candidates}
@@ -523,6 +555,10 @@ def fit(
     # the extremes of the samples used (not of the window means, which are narrower):
     # the model's own training file is inside its ranges by construction
     ranges = {v: windows.extremes[v] for v in windows.variables}
+    if settled_extremes is not None:  # the rates' ranges of the settled filter only
+        rates = {e.name for e, _ in registry_entries(list(ranges)) if e.rate_of}
+        ranges.update({v: settled_extremes[v] for v in ranges
+                       if v in settled_extremes and v in rates})
     intercept, group_offsets = fit_offsets(groups, windows.bias_dph, x_full, names, selected,
                                            params, float(params[0]))
     return DriftModel(
