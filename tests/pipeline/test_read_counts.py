@@ -9,9 +9,8 @@ head on a long file reads its first rows only.
 
 from __future__ import annotations
 
-import json
-
 import dataclasses
+import json
 import math
 from pathlib import Path
 

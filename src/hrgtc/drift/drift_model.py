@@ -37,10 +37,10 @@ from hrgtc.core.accounting import Accounting
 from hrgtc.core.errors import InputError
 from hrgtc.core.progress import Progress
 from hrgtc.drift.cross_validation import (
+    LINE_TERM,
     CrossValidation,
     CrossValidationRecord,
     cross_validate,
-    LINE_TERM,
     guard_selection,
     select_terms,
 )
