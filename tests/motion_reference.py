@@ -26,6 +26,7 @@ from hrgtc.recording.motion import (
     MotionMask,
     MotionSettings,
 )
+from hrgtc.settings.reading import DROPOUT_S
 
 
 # --------------------------------------------------------------------------- helpers
@@ -246,7 +247,9 @@ def detect_motion_reference(
         moving[a:b] = _dilate(found[a:b], after, before)
     reasons["guard"] = moving & ~found
     reasons["short_still"] = np.zeros(n, dtype=bool)
-    for a, b in _bounds(segment):  # still runs next to motion, shorter than min_still_s
+    # still runs next to motion, shorter than min_still_s, judged across dropouts
+    joined = np.cumsum(np.r_[0, np.diff(time_s) > max(GAP_FACTOR * period, DROPOUT_S)])
+    for a, b in _bounds(joined):
         if s.min_still_s > 0 and moving[a:b].any():
             for start, stop in zip(*_runs(~moving[a:b]), strict=True):
                 if time_s[a + stop - 1] - time_s[a + start] < s.min_still_s:

@@ -84,7 +84,7 @@ def test_split_restarts_the_filter_per_burst_and_says_so_bridge_carries_on():
 def test_evaluate_split_on_a_burst_file_refuses_instead_of_settling_figures(tmp_path):
     model = tmp_path / "pan.json"
     result = runner.invoke(app, ["calibrate", "--drift", str(PAN), *ARGS, "--gaps", "bridge",
-                                 "--terms", "f", "-o", str(model)])
+                                 "--terms", "f", "--warmup-s", "50", "-o", str(model)])
     assert result.exit_code == 0, result.stderr
     split = runner.invoke(app, ["evaluate", str(PAN), "--model", str(model), *ARGS,
                                 "--gaps", "split", "--json"])
@@ -99,7 +99,7 @@ def test_holdout_trains_on_the_first_bursts_and_validates_on_the_last(tmp_path):
     model = tmp_path / "held.json"
     result = runner.invoke(app, ["calibrate", "--drift", str(PAN), *ARGS, "--gaps", "bridge",
                                  "--holdout-fraction", "0.25", "--window-s", "5", "--json",
-                                 "-o", str(model)])
+                                 "--warmup-s", "50", "-o", str(model)])
     assert result.exit_code == 0, result.stderr
     document, _ = json.JSONDecoder().raw_decode(result.stdout)
     for entry in document["axes"].values():
@@ -120,7 +120,7 @@ def test_compensate_flags_the_first_warmup_seconds_not_samples_on_a_burst_file(t
     them -- not 50 s × 50 Hz = 2,500 samples (40 % of the file, ten bursts)."""
     model = tmp_path / "pan.json"
     result = runner.invoke(app, ["calibrate", "--drift", str(PAN), *ARGS, "--gaps", "bridge",
-                                 "--terms", "f", "-o", str(model)])
+                                 "--terms", "f", "--warmup-s", "50", "-o", str(model)])
     assert result.exit_code == 0, result.stderr
     run = options(gaps="bridge").read(PAN)
     by_hand = int(np.count_nonzero(run.time_s - run.time_s[0] < 50.0))

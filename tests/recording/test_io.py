@@ -341,14 +341,22 @@ def test_missing_required_column(tmp_path):
 def test_gaps_error_split_and_ignore(tmp_path):
     recording = make_recording(n=400)
     time = recording.time_s.copy()
-    time[250:] += 1.5  # 1.5 s without samples before row 250
+    short = time.copy()
+    short[250:] += 1.5  # 1.5 s without samples before row 250: a dropout, bridged, counted
+    path = write(recording.with_columns(time_s=short), tmp_path / "dropout.csv")
+    assert len(read(path)) == 400
+    report = validate(read(path, validate=False))
+    assert report.ok and (report.n_gaps, report.n_dropouts, report.dropout_s) == (1, 1, 5.0)
+    time[250:] += 7.5  # 7.5 s: longer than a dropout, the choice changes the result
     path = write(recording.with_columns(time_s=time), tmp_path / "gappy.csv")
-    with pytest.raises(RecordingError, match=r"row 250: 1 gap.*1\.505 s after t = 1\.245 s.*split"):
+    with pytest.raises(RecordingError, match=r"row 250: 1 gap.*7\.505 s after t = 1\.245 s.*split"):
         read(path)
+    with pytest.raises(RecordingError, match=r"row 250: 1 gap"):
+        read(path.with_name("dropout.csv"), dropout_s=1.0)
     whole = read(path, gaps="split")
     report = validate(whole, gaps="split")
     assert report.ok and report.n_gaps == 1
-    assert (report.gaps[0].row, report.gaps[0].duration_s) == (250, pytest.approx(1.505))
+    assert (report.gaps[0].row, report.gaps[0].duration_s) == (250, pytest.approx(7.505))
     segments = split_at_gaps(whole)
     assert [len(s) for s in segments] == [250, 150]
     assert same_bits(segments[1].time_s, time[250:])

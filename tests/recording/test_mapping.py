@@ -131,8 +131,8 @@ def test_without_the_sensor_option_a_frequency_column_is_required(tmp_path):
 def test_bursts_in_a_multi_axis_file(tmp_path):
     path, _ = imu_csv(tmp_path)
     lines = path.read_text().splitlines()
-    # a burst logger: 100 rows, a 2 s pause, the rest
-    t = np.arange(N) / RATE_HZ + np.where(np.arange(N) >= 100, 2.0, 0.0)
+    # a burst logger: 100 rows, a 20 s pause (longer than a dropout), the rest
+    t = np.arange(N) / RATE_HZ + np.where(np.arange(N) >= 100, 20.0, 0.0)
     fixed = [lines[0]] + [",".join([repr(float(t[i])), *line.split(",")[1:]])
                           for i, line in enumerate(lines[1:])]
     path.write_text("\n".join(fixed) + "\n")

@@ -35,7 +35,7 @@ DEFECTS = {  # kind -> (change the columns at row, what the message says)
     "jump": (lambda c, r: c["freq_hz"].__setitem__(r, 4425.0 * 1.06), r"'freq_hz', row {row}:"),
     "back": (lambda c, r: c["time_s"].__setitem__(r, c["time_s"][r] - 0.02),
              r"'time_s', row {row}:"),
-    "gap": (lambda c, r: c["time_s"].__setitem__(slice(r, None), c["time_s"][r:] + 1.0),
+    "gap": (lambda c, r: c["time_s"].__setitem__(slice(r, None), c["time_s"][r:] + 10.0),
             r"row {row}: 1 gap"),
 }
 

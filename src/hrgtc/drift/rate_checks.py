@@ -43,10 +43,17 @@ CHECK_ROWS = 100_000
 QUICK_ROWS = 4096
 
 
-def burst_period_s(time_s: np.ndarray) -> float | None:
+#: A gap no longer than this fraction of the df/dt filter's time constant is a dropout: the
+#: filter carries across it with its Δt and df/dt moves by less than its noise (the default
+#: of ``--dropout-s``, :data:`hrgtc.settings.reading.DROPOUT_S`, is this of the default τ).
+DROPOUT_FRACTION_OF_TAU = 0.5
+
+
+def burst_period_s(time_s: np.ndarray, min_gap_s: float = 0.0) -> float | None:
     """Median time between the starts of consecutive bursts, or None without gaps. [s]
 
-    With a single gap, the gap itself (plus one step) is the period.
+    With a single gap, the gap itself (plus one step) is the period. Gaps no longer than
+    ``min_gap_s`` (dropouts of a continuous logger) start no burst. [s]
     """
     time_s = np.asarray(time_s, dtype=np.float64)
     if time_s.size < 3:
@@ -56,7 +63,7 @@ def burst_period_s(time_s: np.ndarray) -> float | None:
     if not positive.size:
         return None
     median = float(np.median(positive))
-    starts = np.flatnonzero(steps > GAP_FACTOR * median) + 1
+    starts = np.flatnonzero(steps > max(GAP_FACTOR * median, min_gap_s)) + 1
     if not starts.size:
         return None
     if starts.size == 1:
@@ -118,10 +125,12 @@ def rate_filter_problems(time_s: np.ndarray, levels: Mapping[str, np.ndarray], t
     time_s = np.asarray(time_s, dtype=np.float64)[:CHECK_ROWS]
     levels = {name: np.asarray(values)[:CHECK_ROWS] for name, values in levels.items()}
     out = []
-    period = burst_period_s(time_s)
+    # a dropout shorter than half of tau moves the filter by less than its noise
+    period = burst_period_s(time_s, DROPOUT_FRACTION_OF_TAU * tau_s)
     if period is not None and tau_s < period:
         steps = np.diff(time_s)
-        single = np.count_nonzero(steps > GAP_FACTOR * np.median(steps[steps > 0])) == 1
+        single = np.count_nonzero(steps > max(GAP_FACTOR * np.median(steps[steps > 0]),
+                                              DROPOUT_FRACTION_OF_TAU * tau_s)) == 1
         what = (f"{period:g} s gap (with its last step) in this recording" if single else
                 f"{period:g} s burst period of this duty-cycled recording")
         out.append(

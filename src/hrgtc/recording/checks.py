@@ -126,6 +126,9 @@ class ValidationReport:
         rows, None with fewer than 2 rows. [Hz]
     gap_policy
         ``"error"``, ``"split"`` or ``"ignore"``.
+    n_dropouts, dropout_s
+        Gaps no longer than ``dropout_s`` (bridged and counted whatever the policy) and
+        that limit. [s]
     """
 
     ok: bool
@@ -136,6 +139,8 @@ class ValidationReport:
     source: str | None
     measured_sample_rate_hz: float | None
     gap_policy: GapPolicy = "error"
+    n_dropouts: int = 0
+    dropout_s: float = 0.0
 
     @property
     def message(self) -> str:
@@ -154,8 +159,15 @@ class ValidationReport:
         if self.measured_sample_rate_hz is not None:
             lines.append(f"  measured sample rate: {self.measured_sample_rate_hz:.6g} Hz")
         lines += [f"  problem: {p.message}" for p in self.problems]
+        if self.n_dropouts:
+            lines.append(f"  dropouts: {self.n_dropouts} gap(s) no longer than "
+                         f"{self.dropout_s:g} s, bridged (they change no result)")
         if self.n_gaps:
-            lines.append(f"  gaps: {self.n_gaps} (policy {self.gap_policy})")
+            longer = self.n_gaps - self.n_dropouts
+            lines.append(f"  gaps: {self.n_gaps} " + (
+                "(all dropouts)" if not longer else
+                f"(policy {self.gap_policy} for the {longer} longer than {self.dropout_s:g} s)"
+                if self.n_dropouts else f"(policy {self.gap_policy})"))
             lines += [
                 f"    row {g.row}: {g.duration_s:.6g} s without samples after t = "
                 f"{g.start_time_s:.6g} s"
@@ -188,6 +200,8 @@ class ValidationReportRecord(Record, kw_only=True):
     source: str | None = None
     measured_sample_rate_hz: float | None = None
     gap_policy: GapPolicy = "error"
+    n_dropouts: Count = 0
+    dropout_s: float = 0.0
 
 
 def problems_message(source: str | None, problems: tuple[Problem, ...] | list[Problem]) -> str:

@@ -286,7 +286,7 @@ def describe(path: str | Path, options: ReadSettings | None = None, *,
     opts = replace(opts, spike_filter=opts.spike_filter or "flag")
     thermometer = opts.thermometer
     check_gap_policy(opts.gaps)
-    validator = RecordingValidator(opts.gaps, thermometer=thermometer)
+    validator = RecordingValidator(opts.gaps, thermometer=thermometer, dropout_s=opts.dropout_s)
     ranges: dict[str, list[float]] = {}
     steps: dict[str, float] = {}
     spike_rows: int | None = None if opts.spike_filter == "off" else 0

@@ -252,7 +252,7 @@ def read(path: str | Path, options: ReadSettings | None = None, *, validate: boo
     if validate:
         validate_recording(recording, opts.gaps, freq_band_hz=opts.freq_band_hz,
                            freq_span_hz=opts.freq_span_hz, thermometer=opts.thermometer,
-                           file_rows=file_rows)
+                           file_rows=file_rows, dropout_s=opts.dropout_s)
     return recording
 
 
@@ -343,7 +343,7 @@ def iter_chunks(path: str | Path, options: ReadSettings | None = None, *,
         raise InputError(f"rows must be a positive number of rows per chunk, got {rows!r}")
     rows = int(rows)
     validator = (RecordingValidator(opts.gaps, opts.freq_band_hz, opts.freq_span_hz,
-                                    opts.thermometer) if validate else None)
+                                    opts.thermometer, opts.dropout_s) if validate else None)
     slow = SlowChannels(opts.slow_channels, opts.hold_max_s, str(path))
     with open_source(path, opts.slow_channels, opts.hold_max_s) as source:
         plan = _plan(source, opts, robust)

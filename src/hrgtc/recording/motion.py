@@ -45,6 +45,7 @@ from typing import Any
 import numpy as np
 
 from hrgtc.core.errors import InputError
+from hrgtc.settings.reading import DROPOUT_S
 
 #: A gap: a time step larger than this many median periods.
 GAP_FACTOR = 2.0
@@ -460,7 +461,10 @@ def detect_motion(
     kernel.guard(reasons["level"], reasons["variance"], reasons["clipped"],  # never across
                  reasons["accelerometer"], starts, stops, after, before, moving,  # a gap
                  reasons["guard"])
-    _short_still(time_s, moving, starts, stops, s.min_still_s, reasons["short_still"])
+    # stretches judged across dropouts (a lost record is no pause between handlings)
+    joined = np.flatnonzero(np.diff(time_s) > max(GAP_FACTOR * period, DROPOUT_S)) + 1
+    _short_still(time_s, moving, np.r_[0, joined], np.r_[joined, n], s.min_still_s,
+                 reasons["short_still"])
     noise = {c.name: c.sigma for c in prepared}
     return MotionMask(moving, reasons, breaks, noise, s)
 

@@ -13,6 +13,8 @@ rows are numbered over the whole recording.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from hrgtc.core.timeline import gap_limit_s, is_gap
@@ -22,7 +24,7 @@ from hrgtc.recording.checks import (
     Problem,
     finite_extremes,
 )
-from hrgtc.recording.gaps import GAP_PERIODS, MAX_LISTED_GAPS, Gap
+from hrgtc.recording.gaps import MAX_LISTED_GAPS, Gap
 from hrgtc.recording.schema import Metadata, Recording
 from hrgtc.recording.time_checks import _change_row, _step_diagnosis
 
@@ -55,6 +57,8 @@ class TimeContinuity:
         self._time_order_kind = ""
         self.gaps: list[Gap] = []
         self.n_gaps = 0
+        #: Gaps by duration (for the dropouts: those no longer than ``dropout_s``). [s]
+        self._gap_durations: list[np.ndarray] = []
         self._last_file_row: float | None = None
 
     def partial_fit(self, time: np.ndarray, offset: int, metadata: Metadata,
@@ -124,6 +128,8 @@ class TimeContinuity:
         with np.errstate(invalid="ignore"):
             long = np.flatnonzero(is_gap(per_row, period) & np.isfinite(per_row))
         self.n_gaps += long.size
+        if long.size:
+            self._gap_durations.append(step[long].copy())
         self._check_rate(per_row, offset)
         room = MAX_LISTED_GAPS - len(self.gaps)
         self.gaps += [
@@ -192,11 +198,21 @@ class TimeContinuity:
             self._steps_usable = bool(np.all(np.isfinite(rest) & (rest > 0)
                                              & (rest <= gap_limit_s(period))))
 
-    def problems(self, gap_policy: str, whole_file: bool) -> list[Problem]:
+    def dropouts(self, dropout_s: float) -> tuple[int, float]:
+        """Number of gaps no longer than ``dropout_s`` (bridged and counted whatever the
+        policy), and the longest of them. [s]"""
+        if not self._gap_durations:
+            return 0, 0.0
+        durations = np.concatenate(self._gap_durations)
+        short = durations[durations <= dropout_s]
+        return int(short.size), float(short.max()) if short.size else 0.0
+
+    def problems(self, gap_policy: str, whole_file: bool,
+                 dropout_s: float = 0.0) -> list[Problem]:
         """The problems of the time axis so far. ``whole_file``: a time unit or sample
         rate wrong for the whole file (or not yet ruled out) was found, of which gaps and
-        rate changes are consequences, not news; ``gap_policy`` ``"error"``: gaps are
-        problems."""
+        rate changes are consequences, not news; ``gap_policy`` ``"error"``: gaps longer
+        than ``dropout_s`` (the dropouts change no result) are problems."""
         problems: list[Problem] = []
         if self.rate_change is not None and not whole_file:
             row, measured = self.rate_change
@@ -223,21 +239,33 @@ class TimeContinuity:
                     count=self._time_order_count,
                 )
             )
-        if self.n_gaps and gap_policy == "error" and not whole_file:
-            first = self.gaps[0]
-            period = 1.0 / self.metadata.sample_rate_hz
+        n_dropouts = self.dropouts(dropout_s)[0]
+        n_long = self.n_gaps - n_dropouts
+        if n_long and gap_policy == "error" and not whole_file:
+            durations = np.concatenate(self._gap_durations)
+            first = next((g for g in self.gaps if g.duration_s > dropout_s), None)
+            if first is None:  # beyond the gaps listed: the first long one's duration only
+                first = Gap(math.nan, float(durations[durations > dropout_s][0]), -1)
+            where = (f"column 'time_s', row {first.row}: " if first.row >= 0
+                     else "column 'time_s': ")
+            after = ("" if math.isnan(first.start_time_s)
+                     else f" after t = {first.start_time_s:.6g} s")
+            total = float(durations[durations > dropout_s].sum())
+            bridged = (f" ({n_dropouts} shorter dropout(s) are bridged and counted)"
+                       if n_dropouts else "")
             problems.append(
                 Problem(
                     "gap",
-                    f"column 'time_s', row {first.row}: {self.n_gaps} gap(s) longer than "
-                    f"{GAP_PERIODS:g} sample periods ({GAP_PERIODS * period:.6g} s), the first "
-                    f"{first.duration_s:.6g} s after t = {first.start_time_s:.6g} s; "
-                    "pass --gaps bridge (filters carry across gaps, e.g. a burst logger) or "
-                    "--gaps split (each segment a separate run)",
+                    f"{where}{n_long} gap(s) longer than {dropout_s:g} s (a dropout; "
+                    f"{total:.6g} s without samples in all), the first {first.duration_s:.6g} s"
+                    f"{after}{bridged}; the choice changes the result: pass --gaps bridge "
+                    "(the filters carry across each gap with its duration, e.g. a burst logger) "
+                    "or --gaps split (the df/dt filter restarts after each and its warm-up is "
+                    "left out again)",
                     column="time_s",
-                    row=first.row,
+                    row=first.row if first.row >= 0 else None,
                     value=f"{first.duration_s:.6g}",
-                    count=self.n_gaps,
+                    count=n_long,
                 )
             )
         return problems

@@ -138,8 +138,10 @@ class RecordingValidator:
     def __init__(self, gaps: GapPolicy | str = "error",
                  freq_band_hz: tuple[float, float] | None = None,
                  freq_span_hz: tuple[float, float] | None = None,
-                 thermometer: str = ReadSettings.thermometer) -> None:
+                 thermometer: str = ReadSettings.thermometer,
+                 dropout_s: float = ReadSettings.dropout_s) -> None:
         self.gaps = check_gap_policy(gaps)
+        self.dropout_s = float(dropout_s)
         self.freq_band_hz = freq_band_hz
         self.freq_span_hz = freq_span_hz
         self.thermometer = check_thermometer(thermometer)
@@ -320,7 +322,7 @@ class RecordingValidator:
         whole_file = self._heuristics is None or any(
             p.kind in ("sample_rate", "time_unit") and p.row is None
             for p in self._heuristics)
-        problems += self.time_axis.problems(self.gaps, whole_file)
+        problems += self.time_axis.problems(self.gaps, whole_file, self.dropout_s)
         problems += self._heuristics or []
         return [self._file_rows.problem(p) for p in problems]
 
@@ -380,6 +382,8 @@ class RecordingValidator:
             source=self.source,
             measured_sample_rate_hz=self.measured_sample_rate_hz,
             gap_policy=self.gaps,
+            n_dropouts=self.time_axis.dropouts(self.dropout_s)[0],
+            dropout_s=self.dropout_s,
         )
 
     # -- heuristics ----------------------------------------------------------
@@ -441,6 +445,7 @@ def validate(
     freq_span_hz: tuple[float, float] | None = None,
     thermometer: str = ReadSettings.thermometer,
     file_rows: np.ndarray | None = None,
+    dropout_s: float = ReadSettings.dropout_s,
 ) -> ValidationReport:
     """Check a recording against the recording contract (see the module docstring).
 
@@ -464,6 +469,9 @@ def validate(
     file_rows
         The file row of each row when the reader left rows out before (spikes,
         duplicates, a slice): the messages name rows of the file.
+    dropout_s
+        Gaps no longer than this are dropouts, bridged and counted whatever ``gaps``
+        says (they change no result). [s]
 
     Returns
     -------
@@ -474,7 +482,7 @@ def validate(
     RecordingError
         Message names the file, column, first bad row, the bad value and the fix.
     """
-    validator = RecordingValidator(gaps, freq_band_hz, freq_span_hz, thermometer)
+    validator = RecordingValidator(gaps, freq_band_hz, freq_span_hz, thermometer, dropout_s)
     validator.partial_fit(recording, file_rows)
     report = validator.finish()
     if raise_errors:

@@ -197,7 +197,8 @@ class _Common:
         10.0, "Time constant of each stage of the causal df/dt filter.", unit="s", panel=_FIT)
     warmup_s: float | None = setting(
         None, "Start of each run left out while the df/dt filters settle.", unit="s",
-        default_text=f"{WARMUP_FACTOR:g} × the longest filter time constant", panel=_FIT)
+        default_text=f"{WARMUP_FACTOR:g} × the longest filter time constant; 0 when the "
+        "terms chosen use no rate (no filter to wait for)", panel=_FIT)
     select: str = setting(
         "guarded", "Term selection: guarded (F-tests, then terms that do not carry over to "
         "held-out runs, or to held-out time blocks of a single run, are dropped), stepwise "

@@ -32,6 +32,9 @@ TEMP_UNWRAPS = ("auto", "off", "16", "32")
 #: or :meth:`hrgtc.recording.ReadOptions.chunks` stream a file (about 20 MB of float64
 #: columns for a ten-column file).
 CHUNK_ROWS = 250_000
+#: Longest gap that is a dropout, bridged and counted by default: half the df/dt filter's
+#: default time constant (:class:`hrgtc.settings.drift.DriftSettings`, 10 s). [s]
+DROPOUT_S = 5.0
 #: Default maximum age of a held value of a slow channel, in periods of the channel.
 DEFAULT_MAX_AGE_PERIODS = 3.0
 
@@ -51,6 +54,11 @@ class ReadSettings:
         "across each gap with its duration (bridge, e.g. a burst logger; ignore is an old name "
         "for it). Windows, bias stability and Allan deviation never cross a gap.",
         choices=GAP_POLICIES, panel=_INPUT)
+    dropout_s: float = setting(
+        DROPOUT_S, "Gaps no longer than this are dropouts (a lost record, a late time stamp): "
+        "bridged and counted whatever --gaps says, as they change no result (the df/dt "
+        "filter's default τ is 10 s: a dropout of half of it moves df/dt by less than its "
+        "noise). Only longer gaps need --gaps.", unit="s", metavar="S", panel=_INPUT)
     chunk_rows: int = CHUNK_ROWS
     freq_band_hz: tuple[float, float] | None = None
     freq_span_hz: tuple[float, float] | None = None
