@@ -225,6 +225,8 @@ def read(path: str | Path, options: ReadSettings | None = None, *, validate: boo
         plan = _plan(source, opts, robust)
         arrays = with_file_rows(convert_columns(plan, table_columns(
             source.read(plan.read_names, plan.as_text)), 0), 0)
+        if validate and plan.map_problem:  # before any check judges the mapped values
+            raise RecordingError(plan.map_problem)
         arrays, slow = fill_slow_channels(arrays, opts.slow_channels, opts.hold_max_s, str(path))
         if spike_filter is not None:
             arrays = spike_filter.drop(arrays, 0)
@@ -361,6 +363,8 @@ def iter_chunks(path: str | Path, options: ReadSettings | None = None, *,
             nonlocal offset
             for table in source.iter_tables(plan.read_names, plan.as_text, rows):
                 part = convert_columns(plan, table_columns(table), offset)
+                if validate and plan.map_problem:  # before the spike filters judge it
+                    raise RecordingError(plan.map_problem)
                 if numbered:  # the file rows, for the validator's messages
                     part = with_file_rows(part, offset)
                 part = slow.fill(part, offset)

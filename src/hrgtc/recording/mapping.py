@@ -40,7 +40,7 @@ import pyarrow.compute as pc
 
 from hrgtc.core.errors import InputError, RecordingError, UnitWarning
 from hrgtc.recording.axes import AXIS_COLUMNS, axis_names, base_name, split_axis
-from hrgtc.recording.checks import check_thermometer
+from hrgtc.recording.checks import TEMPERATURE_RANGE_C, check_thermometer
 from hrgtc.recording.formats.base import Source, first_failing
 from hrgtc.recording.formats.csv import bad_number_hint
 from hrgtc.recording.schema import COLUMNS
@@ -169,6 +169,10 @@ class ColumnPlan:
     tz: str | None = None  # --tz: the zone naive clock times were written in
     time_aware: bool = False  # the clock times carry their zone (UTC, an offset, epoch)
     zone_clock: Any = None  # its ZoneClock (hrgtc.recording.time_axis), state across chunks
+    #: What the count map gave when no thermometer reads that (:func:`map_problem`): the
+    #: reader raises it before any impossible-value check judges the mapped values.
+    map_problem: str | None = None
+    map_checked: bool = False
 
     def only(self, bases: Iterable[str]) -> ColumnPlan:
         """This plan reading only the columns whose contract name (without its axis) is
@@ -373,7 +377,7 @@ _WRAP_WIDTHS = ((16, 2.0**12), (32, 2.0**24))
 
 
 def _temperature_values(plan: ColumnPlan, values: np.ndarray, base: str,
-                        theirs: str) -> np.ndarray:
+                        theirs: str, row_offset: int = 0) -> np.ndarray:
     """A temperature column in °C: °F or K converted; a raw count unwrapped, scaled, offset."""
     temp = plan.units.get("temp", "C")
     if temp in ("F", "K"):
@@ -392,11 +396,63 @@ def _temperature_values(plan: ColumnPlan, values: np.ndarray, base: str,
                 f"values from 2^{bits - 1} on taken minus 2^{bits} ({first[0]:.0f} -> "
                 f"{unwrap_count(first, bits)[0]:.0f}); pass --temp-unwrap off if your sensor "
                 "really counts that high", UnitWarning, stacklevel=4)
+    raw = values
     if plan.wrap_bits is not None:
         values = unwrap_count(values, plan.wrap_bits)
     if scales_temperature(plan.temp_scale, plan.temp_offset_c):
-        return values * plan.temp_scale + plan.temp_offset_c
+        mapped = values * plan.temp_scale + plan.temp_offset_c
+        if not plan.map_checked and np.isfinite(mapped).any():
+            plan.map_checked = True
+            plan.map_problem = map_problem(plan, raw, mapped, theirs, row_offset)
+        return mapped
     return values
+
+
+def map_problem(plan: ColumnPlan, raw: np.ndarray, mapped: np.ndarray, theirs: str,
+                row_offset: int) -> str | None:
+    """What a count map (``--temp-scale``/``--temp-offset``, or a model's map) gave when
+    the median of its first chunk is a temperature no thermometer reads, and the option
+    that fixes it (None when the map gives possible temperatures).
+
+    A map written for the unsigned count of a sensor whose count was unwrapped (65236 ->
+    −300) gives −362 °C instead of 22 °C; ``--temp-unwrap off`` reads the count as it is
+    (and ``--temp-unwrap 16`` the other way round). A single impossible value is a spike,
+    left to ``--spikes``; a whole column of them is the map's.
+    """
+    low, high = TEMPERATURE_RANGE_C
+    finite = np.isfinite(mapped)
+    median = float(np.median(mapped[finite]))
+    if low <= median <= high:
+        return None
+    i = int(np.argmax(finite))
+    scale, offset = plan.temp_scale, plan.temp_offset_c
+
+    def plausible(counts: np.ndarray) -> float | None:
+        value = float(np.median(counts[np.isfinite(counts)])) * scale + offset
+        return value if low <= value <= high else None
+
+    if plan.wrap_bits is not None:
+        as_is = plausible(raw)
+        fix = (f"the count was read as a signed {plan.wrap_bits}-bit number stored unsigned "
+               f"({raw[i]:.0f} -> {unwrap_count(raw[i:i + 1], plan.wrap_bits)[0]:.0f}); "
+               + (f"read as it is, the map gives {as_is:.4g} °C: if the scale and offset are "
+                  "for the unsigned count, pass --temp-unwrap off" if as_is is not None else
+                  "check --temp-scale/--temp-offset (temperature_c = count × K + C), or pass "
+                  "--temp-unwrap off if they are for the unsigned count"))
+    else:
+        bits = next((b for b, _ in _WRAP_WIDTHS
+                     if np.all(raw[np.isfinite(raw)] < 2.0**b)
+                     and plausible(unwrap_count(raw, b)) is not None), None)
+        fix = (f"read as a signed {bits}-bit count stored unsigned, the map gives "
+               f"{plausible(unwrap_count(raw, bits)):.4g} °C: pass --temp-unwrap {bits}"
+               if bits is not None else
+               "check --temp-scale/--temp-offset (temperature_c = count × K + C; calibrate "
+               "--temp-ref LOG fits them to a reference log)")
+    return (f"{plan.source.path}: column {theirs!r} (temperature_c): the count map "
+            f"temperature_c = count × {scale:.6g} {'-' if offset < 0 else '+'} {abs(offset):.6g} "
+            f"gives {median:.4g} °C "
+            f"(median; row {row_offset + i}: {raw[i]:.6g} -> {mapped[i]:.4g} °C), outside "
+            f"the {low:g} to {high:g} °C a thermometer reads; {fix}")
 
 
 def wrapped_count_bits(values: np.ndarray) -> int | None:
@@ -537,7 +593,7 @@ def convert_columns(
             if kind == "rate":
                 out[name] = _rate_values(plan, values, out.get("time_s"), theirs)
             elif kind == "temp":
-                out[name] = _temperature_values(plan, values, base, theirs)
+                out[name] = _temperature_values(plan, values, base, theirs, row_offset)
             elif kind:
                 out[name] = to_contract_unit(values, plan.units.get(kind, ""))
             else:
