@@ -316,17 +316,19 @@ def recording_cases() -> list[Case]:
                                   axes))
 
             for factor, unit in ((3600.0, "°/s"), (180 / np.pi, "rad/s"), (1000.0, "m°/h")):
+                # calibrate --thermometer sensor too: the file logs freq_hz, an HRG's
+                # rate has no MEMS noise (issue 27)
                 add(f"rate x{factor:.4g} (logged in {unit})", "unit up",
                     scaled("rate_dph", factor, fmt, axes),
                     {"*": error(rate), "info": EITHER,
-                     "calibrate": error(rate, detectable=False)}, owner="relmodel")
+                     "calibrate": error(rate, "freq_hz")}, owner="relmodel")
             if axes == "3":  # one channel of the three misconfigured
                 for factor in (3600.0, 180 / np.pi, 1000.0):
                     add(f"rate_dph_y x{factor:.4g} only", "unit up",
                         edited(lambda c, f=factor: c | {"rate_dph_y": c["rate_dph_y"] * f},
                                fmt, axes),
                         {"*": error("rate_dph_y"), "info": EITHER,
-                         "calibrate": error("rate_dph_y", detectable=False)}, owner="relmodel")
+                         "calibrate": error("rate_dph_y", "freq_hz_y")}, owner="relmodel")
             add("rate x1/3600 (logged in °/h, declared °/s)", "unit down",
                 scaled("rate_dph", 1 / 3600.0, fmt, axes),
                 {"*": error(rate, "--rate-unit"), "info": EITHER})
@@ -397,10 +399,9 @@ def recording_cases() -> list[Case]:
                      "time_s/rate_dph": (("time_s", rate), ("time_s",), "main"),
                      "rate_dph/temperature_c": ((rate, "temperature_c"), (rate,), "relmodel")}
             for label, ((a, b), names, owner) in swaps.items():
+                # calibrate --thermometer sensor too: the file's own freq_hz is checked
+                # against the rate (issue 27)
                 expect = {"*": error(*names), "info": EITHER}
-                if label == "freq_hz/rate_dph":  # the sensor thermometer reads no frequency:
-                    # a steady 4428 °/h is a MEMS gyro's plausible bias
-                    expect["calibrate"] = error(rate, detectable=False)
                 add(f"headers {label} swapped", "swapped headers",
                     edited(renamed({a: b, b: a}), fmt, axes), expect, owner=owner)
             add("headers chamber_c/temperature_c swapped", "swapped headers",

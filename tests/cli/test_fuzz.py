@@ -90,6 +90,7 @@ SAMPLE = (
     "freq_hz stored scalar / 1-axis .h5",
     "rate_dph stored compound / 1-axis .h5",
     "headers freq_hz/rate_dph swapped / 1-axis .csv",
+    "rate x57.3 (logged in rad/s) / 1-axis .parquet",
     "compensated file / 1-axis .parquet",
     "CR-only line ends / 1-axis .csv",
     "trailing delimiter / 3-axis .csv",

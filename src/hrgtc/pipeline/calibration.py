@@ -430,6 +430,7 @@ def _calibrate_sensor(soaks: Sequence[PathLike], drifts: Sequence[PathLike],
     heads = {str(path): options.head(path) for path in training}
     for path in drifts:  # any gyro: only a density beyond every gyro's can be told
         head = heads[str(path)]
+        _check_logged_resonator(path, head, options)
         message = implausible_for_any_gyro(head.rate_dph, head.metadata.sample_rate_hz)
         if message is not None:
             warnings.warn(f"{path}: column 'rate_dph': {message}", HrgtcWarning, stacklevel=3)
@@ -450,6 +451,39 @@ def _calibrate_sensor(soaks: Sequence[PathLike], drifts: Sequence[PathLike],
     validation = tuple(evaluate(path, unit_model, allan=False, read_options=options)
                        for path in validate)
     return CalibrationResult(unit_model, (), (), validation, None, fitted)
+
+
+def _check_logged_resonator(path: PathLike, head: Any, options: ReadOptions) -> None:
+    """A file that logs a resonator frequency beside the temperature sensor is an HRG's:
+    its rate must have an HRG's noise and bias (a rate ×3600, ×1000 or ×57.3 has a MEMS
+    gyro's, issue 27), and its frequency and rate columns must not be swapped."""
+    from hrgtc.recording.checks import FREQ_SAMPLE_RANGE_HZ, _check_swapped
+
+    logged = options.logged_frequency(path)
+    if logged is None:
+        return
+    name, freq = logged
+    rate = f"rate_dph_{options.axis}" if options.axis else "rate_dph"
+    rate = dict(_sensor_rate_mapping(options)).get(rate, rate)
+    swapped = _check_swapped(freq, np.asarray(head.rate_dph), name, rate)
+    if swapped is not None:
+        raise InputError(f"{path}: {swapped.message}")
+    finite = freq[np.isfinite(freq)]
+    median = float(np.median(finite)) if finite.size else math.nan
+    if not FREQ_SAMPLE_RANGE_HZ[0] <= median <= FREQ_SAMPLE_RANGE_HZ[1]:
+        return
+    check_resonator_gyro(
+        head.rate_dph, head.metadata.sample_rate_hz, head.metadata.input_rate_dph or 0.0,
+        str(path), rate,
+        hrg=(f"the file logs a resonator frequency (column {name!r}, median {median:.6g} Hz: "
+             "an HRG)", f"if {name!r} is not this gyro's resonator, rename that column"),
+        levels=False)
+
+
+def _sensor_rate_mapping(options: ReadOptions) -> dict[str, str]:
+    from hrgtc.recording.mapping import parse_columns
+
+    return parse_columns(options.columns)
 
 
 def _sensor_thermometer(training: Sequence[PathLike], options: ReadOptions) -> SoakFit:
