@@ -368,3 +368,19 @@ def test_sensor_thermometer_on_an_hrg_file_refuses_swapped_frequency_and_rate(tm
     with pytest.raises(InputError, match=r"swapped.parquet: columns 'freq_hz' .* and 'rate_dph' "
                                          r".* look swapped.*--col freq_hz=rate_dph"):
         calibrate([], [path], thermometer="sensor")
+
+
+@pytest.mark.parametrize("rows", [2, 5, 10])
+def test_a_drift_run_shorter_than_the_warm_up_is_called_too_short(tmp_path, rows):
+    """Issue 27's audit: a 2-10-row file got "the drift runs hold no sample at rest after
+    the 50 s warm-up; see --motion", naming no file and blaming motion."""
+    from corruptions import base_run
+
+    run = base_run("1")
+    columns = {k: np.array(run[k])[:rows] for k in run.names}
+    path = recording.write(Recording(columns, run.metadata), tmp_path / "short.csv")
+    with pytest.raises(CalibrationError) as raised:
+        calibrate([], [path], thermometer="sensor")
+    assert str(raised.value).startswith(
+        f"{path}: {rows} rows ({(rows - 1) / 10:g} s) is too short to train on; at its 10 Hz, "
+        "more than 501 rows: a drift run must last longer than the 50 s warm-up")
