@@ -78,6 +78,29 @@ def test_a_single_axis_file_may_keep_a_column_that_only_looks_per_axis(run, tmp_
     assert axis_names(back.names) == () and "temperature_c_ambient" in back.names
 
 
+def test_a_plain_rate_beside_per_axis_rates_is_ambiguous(run, tmp_path):
+    """Issue 27's audit: a single-axis file with a stray rate_dph_x became a one-axis
+    instrument 'x', its rate_dph ignored."""
+    columns = {**{k: run[k] for k in run.names}, "rate_dph_x": run["rate_dph"]}
+    path = write(Recording(columns, run.metadata), tmp_path / "stray.csv")
+    with pytest.raises(RecordingError, match=r"stray.csv: column 'rate_dph' has no axis, beside "
+                       r"the per-axis rate column\(s\) \['rate_dph_x'\] of axes \['x'\]: hrgtc "
+                       r"cannot tell whether the file is one gyro's"):
+        read(path)
+
+
+def test_a_plain_frequency_beside_per_axis_ones_is_ambiguous(three_axis, tmp_path):
+    """Issue 27's audit: a 3-axis file with an extra plain freq_hz was read, the plain
+    column taken for a temperature (4417.9 °C) by the sensor thermometer."""
+    columns = {**{k: three_axis[k] for k in three_axis.names},
+               "freq_hz": three_axis["freq_hz_x"]}
+    path = write(Recording(columns, three_axis.metadata), tmp_path / "extra.parquet")
+    for thermometer in ("resonator", "sensor"):
+        with pytest.raises(RecordingError, match=r"extra.parquet: column 'freq_hz' has no axis.*"
+                           r"whose resonator it is; remove or rename 'freq_hz'"):
+            read(path, thermometer=thermometer)
+
+
 @pytest.mark.parametrize("shape", ["n3", "n1", "scalar"])
 def test_an_hdf5_column_that_is_not_1d_is_an_error_naming_it(three_axis, run, tmp_path, shape):
     source = three_axis if shape == "n3" else run

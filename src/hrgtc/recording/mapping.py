@@ -304,8 +304,25 @@ def check_axis_sets(source: Source, names: list[str], axes: tuple[str, ...],
     ``freq_hz_z`` or ``temperature_c_z`` without ``rate_dph_z`` would otherwise be
     carried along as an unknown column and the axis z dropped without a word. A
     single-axis file may have columns that look per-axis (``temperature_c_ambient``)
-    except ``freq_hz_<axis>`` and ``rate_dph``-like ones beside no ``freq_hz``.
+    except ``freq_hz_<axis>`` and ``rate_dph``-like ones beside no ``freq_hz``. A
+    ``rate_dph`` or ``freq_hz`` without an axis beside per-axis rates is ambiguous (one
+    gyro, or the axes? whose resonator?) and refused too (issue 27's audit: a stray
+    ``rate_dph_x`` made a single-axis file a one-axis instrument ``x``).
     """
+    if axes:
+        for plain in ("rate_dph", "freq_hz"):
+            if plain not in names:
+                continue
+            theirs = mapping.get(plain, plain)
+            called = repr(theirs) if theirs == plain else f"{theirs!r} ({plain})"
+            per_axis = [mapping.get(f"rate_dph_{a}", f"rate_dph_{a}") for a in axes]
+            raise RecordingError(
+                f"{source.path}: column {called} has no axis, beside the per-axis rate "
+                f"column(s) {per_axis} of axes {list(axes)}: hrgtc cannot tell "
+                + ("whether the file is one gyro's (rate_dph) or an instrument's"
+                   if plain == "rate_dph" else "whose resonator it is")
+                + f"; remove or rename {theirs!r} (e.g. {plain}_ref) if it is another "
+                "channel, or the per-axis columns if the file is a single gyro's")
     for name in names:
         base, axis = split_axis(name)
         if axis is None or axis in axes:
