@@ -439,14 +439,16 @@ def recording_cases() -> list[Case]:
 
 
 def hdf5_byte_strings(name: str, axes: str) -> Callable:
-    """An HDF5 recording whose ``name`` holds its numbers as byte strings (b'4428.27...')."""
+    """An HDF5 recording whose ``name`` holds its numbers as fixed-length byte strings,
+    space-padded as MATLAB and Fortran write them (b'4428.27...   ')."""
     def make(material: Material, folder: Path) -> Path:
         path = write(material.runs[axes], folder / "case.h5", force=True)
         with h5py.File(path, "a") as handle:
             group = handle["recording"]
             values = group[name][:]
             del group[name]
-            group[name] = np.array([repr(float(v)).encode() for v in values], dtype="S32")
+            group[name] = np.array([repr(float(v)).ljust(32).encode() for v in values],
+                                   dtype="S32")
         return path
     return make
 

@@ -101,6 +101,19 @@ def test_a_plain_frequency_beside_per_axis_ones_is_ambiguous(three_axis, tmp_pat
             read(path, thermometer=thermometer)
 
 
+@pytest.mark.parametrize("pad", ["", "   ", "\0\0"])
+def test_hdf5_numbers_as_padded_byte_strings_are_read(run, tmp_path, pad):
+    """Issue 27's audit: fixed-length byte strings padded with spaces (as MATLAB and
+    Fortran write them) got "'4417.677   ' is not a number"."""
+    path = write(run, tmp_path / "bytes.h5")
+    with h5py.File(path, "a") as handle:
+        values = handle["recording/freq_hz"][:]
+        del handle["recording/freq_hz"]
+        handle["recording/freq_hz"] = np.array([(repr(float(v)) + pad).encode()
+                                                for v in values], dtype="S32")
+    np.testing.assert_array_equal(read(path)["freq_hz"], run["freq_hz"])
+
+
 @pytest.mark.parametrize("shape", ["n3", "n1", "scalar"])
 def test_an_hdf5_column_that_is_not_1d_is_an_error_naming_it(three_axis, run, tmp_path, shape):
     source = three_axis if shape == "n3" else run

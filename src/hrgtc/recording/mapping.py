@@ -503,6 +503,9 @@ def _to_float(
     plan: ColumnPlan, column: pa.ChunkedArray, theirs: str, row_offset: int
 ) -> np.ndarray:
     if _is_text(column):
+        # numbers as text padded with spaces: HDF5 fixed-length strings as MATLAB and
+        # Fortran write them (issue 27's audit: "'4417.677   ' is not a number")
+        column = pc.utf8_trim_whitespace(column)
         try:
             column = column.cast(pa.float64())
         except (pa.ArrowInvalid, pa.ArrowTypeError):
