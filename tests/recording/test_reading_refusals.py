@@ -114,6 +114,21 @@ def test_hdf5_numbers_as_padded_byte_strings_are_read(run, tmp_path, pad):
     np.testing.assert_array_equal(read(path)["freq_hz"], run["freq_hz"])
 
 
+@pytest.mark.parametrize(("stray", "what"), [
+    ("\r", r"a carriage return \(\\r\) inside the line at character 4 splits it"),
+    ('"', r'a quote \(\"\) without its closing one at character 4 runs into the lines')])
+def test_a_stray_cr_or_quote_inside_a_csv_row_is_named_at_its_line(run, tmp_path, stray, what):
+    """Issue 27's audit: "line ? (row ?): expected 5 fields, got ?"."""
+    lines = write(run, tmp_path / "ok.csv").read_text().split("\n")
+    header = next(i for i, line in enumerate(lines) if not line.startswith("#"))
+    lines[header + 1 + 100] = lines[header + 1 + 100].replace(",", "," + stray, 1)
+    path = tmp_path / "stray.csv"
+    path.write_bytes("\n".join(lines).encode())
+    with pytest.raises(RecordingError, match=rf"stray.csv: line {header + 102} \(row 100\): "
+                                             rf"expected 4 fields; {what}"):
+        read(path)
+
+
 @pytest.mark.parametrize("shape", ["n3", "n1", "scalar"])
 def test_an_hdf5_column_that_is_not_1d_is_an_error_naming_it(three_axis, run, tmp_path, shape):
     source = three_axis if shape == "n3" else run
