@@ -538,7 +538,7 @@ class ReadOptions(ReadSettings):
                       spikes="error", start=None, end=None)
         name = f"freq_hz_{self.axis}" if self.axis else "freq_hz"
         chunks = iter_chunks(path, own, rows=HEURISTIC_ROWS, validate=False,
-                             only=("freq_hz", "rate_dph"))
+                             only=("time_s", "freq_hz", "rate_dph"))
         try:
             head = next(chunks, None)
         finally:
