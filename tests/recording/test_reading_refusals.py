@@ -129,6 +129,22 @@ def test_a_stray_cr_or_quote_inside_a_csv_row_is_named_at_its_line(run, tmp_path
         read(path)
 
 
+def test_an_upper_case_header_reads_as_the_contract_names(three_axis, tmp_path):
+    """Issue 27's audit: RATE_DPH_X, ... was "single-axis (freq_hz, rate_dph)" against a
+    3-axis model, and "required column(s) 'time_s' ... missing" for info."""
+    from hrgtc.compensate.multi_axis import recording_axes
+
+    lines = write(three_axis, tmp_path / "imu.csv").read_text().split("\n")
+    header = next(i for i, line in enumerate(lines) if not line.startswith("#"))
+    lines[header] = lines[header].upper()
+    path = tmp_path / "upper.csv"
+    path.write_text("\n".join(lines))
+    back = read(path)
+    assert sorted(back.names) == sorted(three_axis.names)
+    np.testing.assert_array_equal(back["rate_dph_z"], three_axis["rate_dph_z"])
+    assert recording_axes(path) == ("x", "y", "z")
+
+
 @pytest.mark.parametrize("shape", ["n3", "n1", "scalar"])
 def test_an_hdf5_column_that_is_not_1d_is_an_error_naming_it(three_axis, run, tmp_path, shape):
     source = three_axis if shape == "n3" else run

@@ -251,6 +251,7 @@ def plan_columns(source: Source, columns: Any, units: Mapping[str, str] | None,
                 f"{source.path}: column {theirs!r} (given for {name}) not found{did}; "
                 f"the file's columns are {source.names}"
             )
+    mapping = with_other_case(mapping, source.names)
     kinds = source.kinds()
     pairs = [(theirs, name) for name, theirs in mapping.items()]
     recording_names = [*mapping, *(n for n in source.names if n not in mapping.values())]
@@ -294,6 +295,22 @@ def plan_columns(source: Source, columns: Any, units: Mapping[str, str] | None,
                       temp_unwrap=temp_unwrap,
                       wrap_bits=int(temp_unwrap) if temp_unwrap in ("16", "32") else None,
                       wrap_decided=temp_unwrap != "auto")
+
+
+def with_other_case(mapping: Mapping[str, str], names: Iterable[str]) -> dict[str, str]:
+    """``mapping`` with the file's contract names written in another case mapped too
+    (``RATE_DPH_X`` -> ``rate_dph_x``: issue 27's audit found an upper-case 3-axis
+    header read as "single-axis"), unless the name is mapped or exists as written."""
+    names = list(names)
+    out = dict(mapping)
+    taken = set(names) | set(out) | set(out.values())
+    for name in names:
+        lower = name.lower()
+        if lower != name and lower not in taken and is_contract_name(lower) and sum(
+                n.lower() == lower for n in names) == 1:
+            out[lower] = name
+            taken.add(lower)
+    return out
 
 
 def check_axis_sets(source: Source, names: list[str], axes: tuple[str, ...],
