@@ -407,7 +407,8 @@ def recording_cases() -> list[Case]:
             add("headers chamber_c/temperature_c swapped", "swapped headers",
                 edited(renamed({"chamber_c": "temperature_c", "temperature_c": "chamber_c"}),
                        fmt, axes),
-                {"*": CORRECT, "calibrate": error("temperature_c", detectable=False)})
+                # calibrate --thermometer sensor: the set-point is a noise-free ramp (issue 27)
+                {"*": CORRECT, "calibrate": error("temperature_c", "chamber_c", "swapped")})
             if fmt == ".h5":
                 for name, shape in ((rate, "n3"), (rate, "n1"), (freq, "scalar"),
                                     ("time_s", "n1"), (rate, "compound")):

@@ -343,3 +343,50 @@ def check_sensor_swap(temperature: ChannelShape, rate: ChannelShape, source: str
         f"{rate.span:.3g} (a temperature's); fix the header line of the file, or map the "
         f"columns with --col {rate_column}={temperature_column} "
         f"--col {temperature_column}={rate_column}")
+
+
+# -- calibrate --thermometer sensor: a chamber set-point taken for the thermometer -------------
+#: Share of the moving samples of a column whose second difference is 0 (to 1e-9 of its
+#: span) for it to be a noise-free ramp: a set-point, computed, never measured.
+SETPOINT_SHARE = 0.99
+
+
+def is_setpoint_ramp(values: Any) -> bool:
+    """True for a column that moves (half its steps or more) as noise-free straight ramps:
+    a chamber's set-point. A measured temperature has noise, or steps of its resolution
+    between equal samples (a second difference at each step)."""
+    finite = np.asarray(values, dtype=np.float64)
+    finite = finite[np.isfinite(finite)]
+    span = float(np.ptp(finite)) if finite.size else 0.0
+    if finite.size < 100 or span <= 0.0:
+        return False
+    steps = np.diff(finite)
+    moving = steps != 0.0
+    if np.count_nonzero(moving) < 0.5 * steps.size:
+        return False
+    both = moving[1:] & moving[:-1]
+    flat = np.abs(np.diff(steps)[both]) <= 1e-9 * span
+    return bool(flat.size) and float(np.mean(flat)) >= SETPOINT_SHARE
+
+
+def check_setpoint_thermometer(temperature: Any, chamber: Any, source: str = "",
+                               temperature_column: str = "temperature_c",
+                               chamber_column: str = "chamber_c") -> None:
+    """Refuse a sensor thermometer that is a noise-free ramp beside a ``chamber_c`` that
+    is not: the set-point and the sensor's headers swapped (issue 27's audit: fitted
+    without a word, the gyro's drift against a temperature running ahead of it).
+
+    Raises
+    ------
+    InputError
+        Names the file, both columns and the fix.
+    """
+    if chamber is None or not is_setpoint_ramp(temperature) or is_setpoint_ramp(chamber):
+        return
+    where = f"{source}: " if source else ""
+    raise InputError(
+        f"{where}the headers {chamber_column} and {temperature_column} look swapped: the "
+        f"thermometer column {temperature_column!r} moves as noise-free straight ramps (a "
+        f"chamber's set-point; no sensor reads without noise) while {chamber_column!r} has a "
+        f"measurement's noise; fix the header line of the file, or map the columns with "
+        f"--col {temperature_column}={chamber_column} --col {chamber_column}={temperature_column}")

@@ -37,6 +37,7 @@ from hrgtc.drift.training import (
     TrainingStatistics,
     check_resonator_gyro,
     check_sensor_swap,
+    check_setpoint_thermometer,
     implausible_for_any_gyro,
 )
 from hrgtc.evaluation import Evaluation, evaluate
@@ -44,6 +45,7 @@ from hrgtc.evaluation.calibration_figures import calibration_summary, thermomete
 from hrgtc.model import UnitModel, provenance
 from hrgtc.pipeline.documents import CalibrationDriftRecord, CalibrationRecord
 from hrgtc.recording import ReadOptions
+from hrgtc.recording.mapping import parse_columns
 from hrgtc.recording.marks import refuse_compensated_training
 from hrgtc.settings import to_dict
 from hrgtc.settings.calibration import CalibrationSettings
@@ -431,6 +433,11 @@ def _calibrate_sensor(soaks: Sequence[PathLike], drifts: Sequence[PathLike],
     for path in drifts:  # any gyro: only a density beyond every gyro's can be told
         head = heads[str(path)]
         _check_logged_resonator(path, head, options)
+        chamber = head["chamber_c"] if "chamber_c" in head else None
+        check_setpoint_thermometer(head.freq_hz, chamber, str(path),
+                                   *_sensor_columns(path, options)[:1],
+                                   parse_columns(options.columns).get("chamber_c",
+                                                                      "chamber_c"))
         message = implausible_for_any_gyro(head.rate_dph, head.metadata.sample_rate_hz)
         if message is not None:
             warnings.warn(f"{path}: column 'rate_dph': {message}", HrgtcWarning, stacklevel=3)
@@ -481,8 +488,6 @@ def _check_logged_resonator(path: PathLike, head: Any, options: ReadOptions) -> 
 
 
 def _sensor_rate_mapping(options: ReadOptions) -> dict[str, str]:
-    from hrgtc.recording.mapping import parse_columns
-
     return parse_columns(options.columns)
 
 
