@@ -104,6 +104,13 @@ SAMPLE = (
     "NaN in rate_dph_x row 4321 / 3-axis .parquet",
     "drift.ranges.f reversed",
     "truncated at 50%",
+    # issue 27's audit
+    "stray rate_dph_x beside rate_dph / 1-axis .csv",
+    "upper-case header / 3-axis .csv",
+    "stray CR inside row 500 / 1-axis .csv",
+    "only 5 rows / 1-axis .parquet",
+    "headers chamber_c/temperature_c swapped / 1-axis .parquet",
+    "duplicate key 'intercept_dph' in drift",
 )
 
 
