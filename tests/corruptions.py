@@ -316,17 +316,19 @@ def recording_cases() -> list[Case]:
                                   axes))
 
             for factor, unit in ((3600.0, "°/s"), (180 / np.pi, "rad/s"), (1000.0, "m°/h")):
+                # calibrate --thermometer sensor too: the file logs freq_hz, an HRG's
+                # rate has no MEMS noise (issue 27)
                 add(f"rate x{factor:.4g} (logged in {unit})", "unit up",
                     scaled("rate_dph", factor, fmt, axes),
                     {"*": error(rate), "info": EITHER,
-                     "calibrate": error(rate, detectable=False)}, owner="relmodel")
+                     "calibrate": error(rate, "freq_hz")}, owner="relmodel")
             if axes == "3":  # one channel of the three misconfigured
                 for factor in (3600.0, 180 / np.pi, 1000.0):
                     add(f"rate_dph_y x{factor:.4g} only", "unit up",
                         edited(lambda c, f=factor: c | {"rate_dph_y": c["rate_dph_y"] * f},
                                fmt, axes),
                         {"*": error("rate_dph_y"), "info": EITHER,
-                         "calibrate": error("rate_dph_y", detectable=False)}, owner="relmodel")
+                         "calibrate": error("rate_dph_y", "freq_hz_y")}, owner="relmodel")
             add("rate x1/3600 (logged in °/h, declared °/s)", "unit down",
                 scaled("rate_dph", 1 / 3600.0, fmt, axes),
                 {"*": error(rate, "--rate-unit"), "info": EITHER})
@@ -397,16 +399,16 @@ def recording_cases() -> list[Case]:
                      "time_s/rate_dph": (("time_s", rate), ("time_s",), "main"),
                      "rate_dph/temperature_c": ((rate, "temperature_c"), (rate,), "relmodel")}
             for label, ((a, b), names, owner) in swaps.items():
+                # calibrate --thermometer sensor too: the file's own freq_hz is checked
+                # against the rate (issue 27)
                 expect = {"*": error(*names), "info": EITHER}
-                if label == "freq_hz/rate_dph":  # the sensor thermometer reads no frequency:
-                    # a steady 4428 °/h is a MEMS gyro's plausible bias
-                    expect["calibrate"] = error(rate, detectable=False)
                 add(f"headers {label} swapped", "swapped headers",
                     edited(renamed({a: b, b: a}), fmt, axes), expect, owner=owner)
             add("headers chamber_c/temperature_c swapped", "swapped headers",
                 edited(renamed({"chamber_c": "temperature_c", "temperature_c": "chamber_c"}),
                        fmt, axes),
-                {"*": CORRECT, "calibrate": error("temperature_c", detectable=False)})
+                # calibrate --thermometer sensor: the set-point is a noise-free ramp (issue 27)
+                {"*": CORRECT, "calibrate": error("temperature_c", "chamber_c", "swapped")})
             if fmt == ".h5":
                 for name, shape in ((rate, "n3"), (rate, "n1"), (freq, "scalar"),
                                     ("time_s", "n1"), (rate, "compound")):
@@ -434,6 +436,71 @@ def recording_cases() -> list[Case]:
                     {"*": error("z"), "info": Expect("correct", compare=False),
                      "calibrate": Expect("correct", compare=False)}, owner="relmodel")
         cases += _csv_layout_cases(axes)
+    return cases + _second_audit_cases()
+
+
+def hdf5_byte_strings(name: str, axes: str) -> Callable:
+    """An HDF5 recording whose ``name`` holds its numbers as fixed-length byte strings,
+    space-padded as MATLAB and Fortran write them (b'4428.27...   ')."""
+    def make(material: Material, folder: Path) -> Path:
+        path = write(material.runs[axes], folder / "case.h5", force=True)
+        with h5py.File(path, "a") as handle:
+            group = handle["recording"]
+            values = group[name][:]
+            del group[name]
+            group[name] = np.array([repr(float(v)).ljust(32).encode() for v in values],
+                                   dtype="S32")
+        return path
+    return make
+
+
+def first_rows(count: int) -> Callable:
+    return lambda columns: {k: v[:count] for k, v in columns.items()}
+
+
+def on_data_line(row: int, change: Callable[[str], str]) -> Callable[[str], str]:
+    """The CSV text with data row ``row`` (0 = the first after the header) changed."""
+    return on_lines(lambda ls, h: [change(line) if i == h + 1 + row else line
+                                   for i, line in enumerate(ls)])
+
+
+def _second_audit_cases() -> list[Case]:
+    """The cases of issue 27's independent audit (item 7) that the corpus lacked."""
+    cases: list[Case] = []
+
+    def add(name: str, family: str, make: Callable, expect: dict[str, Expect], axes: str,
+            fmt: str) -> None:
+        cases.append(Case(f"{name} / {axes}-axis {fmt}", family, "recording", make, expect,
+                          "audit27", axes))
+
+    for fmt in FORMATS:
+        # a single-axis file with a stray per-axis rate: one axis x, or the plain rate?
+        add("stray rate_dph_x beside rate_dph", "axis set", edited(
+            lambda c: c | {"rate_dph_x": c["rate_dph"].copy()}, fmt, "1"),
+            {"*": error("rate_dph", "rate_dph_x")}, "1", fmt)
+        # a 3-axis file with a plain freq_hz beside freq_hz_x/y/z: whose is it?
+        add("extra plain freq_hz", "axis set", edited(
+            lambda c: c | {"freq_hz": c["freq_hz_x"].copy()}, fmt, "3"),
+            {"*": error("freq_hz")}, "3", fmt)
+        for count in (2, 5, 10):
+            for axes in ("1", "3"):
+                # compensate: the rows are compensated, whatever their number
+                add(f"only {count} rows", "too short", edited(first_rows(count), fmt, axes),
+                    {"*": error("too short"), "calibrate": error(f"{count} rows", "too short"),
+                     "info": Expect("either", compare=False),
+                     "compensate": Expect("correct", compare=False)}, axes, fmt)
+    for axes in ("1", "3"):
+        freq = _first("freq_hz", axes)
+        add(f"{freq} as byte strings", "axis reshaped", hdf5_byte_strings(freq, axes),
+            {"*": CORRECT}, axes, ".h5")
+        add("upper-case header", "csv layout", csv_text(on_lines(lambda ls, h: [
+            *ls[:h], ls[h].upper(), *ls[h + 1:]]), axes), {"*": CORRECT}, axes, ".csv")
+        add("stray CR inside row 500", "csv layout", csv_text(on_data_line(
+            500, lambda line: line.replace(",", ",\r", 1)), axes),
+            {"*": error("row 500")}, axes, ".csv")
+        add("stray quote in row 500", "csv layout", csv_text(on_data_line(
+            500, lambda line: line.replace(",", ',"', 1)), axes),
+            {"*": error("row 500")}, axes, ".csv")
     return cases
 
 

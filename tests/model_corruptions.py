@@ -55,6 +55,35 @@ def absurd(term: str, value: float) -> Callable[[dict], None]:
     return change
 
 
+def text_edit(change: Callable[[str], str]) -> Callable:
+    """The single-axis model file (hash removed) with ``change`` applied to its text."""
+    def make(material: Material, folder: Path) -> Path:
+        data = json.loads(material.model_path.read_text())
+        data.pop(HASH_KEY, None)
+        path = folder / "case.json"
+        path.write_text(change(json.dumps(data, indent=1)))
+        return path
+    return make
+
+
+def duplicated_key(key: str, inside: str | None) -> Callable[[str], str]:
+    """A second ``key`` (another value) written before the first: json keeps the last."""
+    def change(text: str) -> str:
+        data = json.loads(text)
+        value = (data[inside] if inside else data)[key]
+        other = json.dumps(value + "-other" if isinstance(value, str) else value * 2 + 1)
+        anchor = f'"{inside}": {{' if inside else "{"
+        at = text.index(anchor) + len(anchor)
+        return f'{text[:at]}\n "{key}": {other},{text[at:]}'
+    return change
+
+
+def unknown_key(key: str, inside: str | None) -> Callable[[dict], None]:
+    def change(data: dict) -> None:
+        (data[inside] if inside else data)[key] = 1.0
+    return change
+
+
 def reversed_range(path: str) -> Callable[[dict], None]:
     def change(data: dict) -> None:
         *parents, last = path.split(".")
@@ -181,6 +210,16 @@ def model_cases() -> list[Case]:
         json_edit(lambda d: d.update(unit="FZ-1 renamed")), {"*": CORRECT,
                                                             "export-c": Expect("correct",
                                                                                compare=False)})
+    # issue 27's audit: keys another JSON reader reads otherwise, or that nothing reads
+    for key, inside in (("unit", None), ("intercept_dph", "drift")):
+        add(f"duplicate key {key!r}" + (f" in {inside}" if inside else ""), "json keys",
+            text_edit(duplicated_key(key, inside)), {"*": error(key, "twice")})
+    for key, inside in (("units", None), ("intercept", "drift"), ("scale", "thermometer")):
+        add(f"unknown key {key!r}" + (f" in {inside}" if inside else ""), "json keys",
+            json_edit(unknown_key(key, inside)), {"*": error(key)})
+    for section in ("drift", "thermometer"):
+        add(f"{section} section missing", "missing field", json_edit(deleted(section)),
+            {"*": error(section)})
     for i in range(20):
         add(f"truncated at {i / 20:.0%}", "damaged bytes", byte_damage("truncate", i / 20),
             {"*": error("model")})

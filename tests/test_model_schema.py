@@ -226,3 +226,46 @@ def test_a_thermometer_beyond_any_hrg_frequency_is_refused(tmp_path, document):
     with pytest.raises(ModelFileError, match=r"thermometer.scaled_coefficients: F\(T\) over the "
                                              r"calibrated .* outside any HRG's resonator"):
         load_model(_write(tmp_path, document))
+
+
+# -- issue 27's audit: keys written twice or unknown, sections missing ---------------------------
+def test_a_key_written_twice_is_refused_naming_it_and_its_line(tmp_path, document):
+    """The last of two values won (another JSON reader takes the first): accepted silently."""
+    text = json.dumps(document, indent=1)
+    at = text.index('"drift": {') + len('"drift": {')
+    text = text[:at] + '\n "intercept_dph": 99.0,' + text[at:]
+    path = _write(tmp_path, None, text=text)
+    line = text[:text.index('"intercept_dph"', at + 30)].count("\n") + 1
+    with pytest.raises(ModelFileError) as raised:
+        load_model(path)
+    assert str(raised.value).startswith(
+        f"{path}: the key 'intercept_dph' is written twice in one object (again on line "
+        f"{line}): JSON readers disagree on which value counts")
+
+
+@pytest.mark.parametrize(("where", "key"), [((), "units"), (("drift",), "intercept"),
+                                            (("thermometer",), "scale"),
+                                            (("drift", "settings"), "tau")])
+def test_an_unknown_key_is_refused_naming_it_and_its_place(tmp_path, document, where, key):
+    node = document
+    for part in where:
+        node = node[part]
+    node[key] = 1.0
+    shown = ".".join(where) or "(top level)"
+    with pytest.raises(ModelFileError, match=rf"unit.json: model file is invalid at "
+                                             rf"{re.escape(shown)}: unknown key '{key}' "):
+        load_model(_write(tmp_path, document))
+
+
+def test_free_objects_keep_any_key(tmp_path, document):
+    document["provenance"] = {"anything": {"nested": 1}}
+    assert load_model(_write(tmp_path, document)).unit == "SN-1"
+
+
+@pytest.mark.parametrize("section", ["drift", "thermometer"])
+def test_a_missing_section_is_named(tmp_path, document, section):
+    """It was "invalid at (top level): {'schema': ..." quoting the document, not the key."""
+    del document[section]
+    with pytest.raises(ModelFileError, match=rf"at \(top level\): the required section "
+                                             rf"'{section}' is missing"):
+        load_model(_write(tmp_path, document))

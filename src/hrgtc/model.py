@@ -34,6 +34,7 @@ from hrgtc.model_schema import (
     SCHEMA_NAME,
     SCHEMA_VERSION,
     AxisRecord,
+    DuplicateKeyError,
     FileRecord,
     axis_parts,
     check_document,
@@ -382,6 +383,8 @@ def _read_document(path: str | os.PathLike[str]) -> tuple[Any, bool]:
         raise ModelFileError(f"{source}: cannot read model file: {exc}") from exc
     try:
         data, non_standard = parse_model_json(text)
+    except DuplicateKeyError as exc:
+        raise ModelFileError(exc.describe(source, text)) from None
     except json.JSONDecodeError as exc:
         raise ModelFileError(
             f"{source}: not a JSON document (line {exc.lineno}, column {exc.colno}: {exc.msg}); "

@@ -179,7 +179,33 @@ def parse_model_json(text: str) -> tuple[Any, bool]:
         seen.append(name)
         return name
 
-    return json.loads(text, parse_constant=constant), bool(seen)
+    def unique(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+        document = dict(pairs)
+        if len(document) < len(pairs):
+            names = [k for k, _ in pairs]
+            raise DuplicateKeyError(next(k for k in names if names.count(k) > 1))
+        return document
+
+    return json.loads(text, parse_constant=constant, object_pairs_hook=unique), bool(seen)
+
+
+class DuplicateKeyError(ValueError):
+    """A key written twice in one object of a model file: JSON readers disagree on which
+    value counts (Python's keeps the last, others the first), so none is taken."""
+
+    def __init__(self, key: str) -> None:
+        super().__init__(key)
+        self.key = key
+
+    def describe(self, source: str, text: str) -> str:
+        """The error's sentence for ``source``, with the line of the key's second use."""
+        needle = json.dumps(self.key) + ":"
+        first = text.find(needle)
+        second = text.find(needle, first + 1) if first >= 0 else -1
+        line = f" (again on line {text.count(chr(10), 0, second) + 1})" if second >= 0 else ""
+        return (f"{source}: the key {self.key!r} is written twice in one object{line}: JSON "
+                "readers disagree on which value counts (one keeps the first, another the "
+                "last); delete one of them, or recreate the file with 'hrgtc calibrate'")
 
 
 def _path(parts: Any) -> str:
@@ -195,9 +221,20 @@ def _fail(source: str, where: str, message: str) -> ModelFileError:
 
 
 def check_schema(data: Any, source: str) -> None:
-    """Validate ``data`` against :data:`MODEL_SCHEMA`; the first error names its place."""
+    """Validate ``data`` against :data:`MODEL_SCHEMA`; the first error names its place.
+
+    A missing section of a single-axis file (``thermometer``, ``drift``) is named as such
+    (the schema's "one axis or several" alternative would only quote the whole document),
+    and a key the schema does not know is refused (:func:`unknown_key`).
+    """
     import jsonschema
 
+    if isinstance(data, dict) and "axes" not in data and data.get("schema") == "hrgtc.model":
+        for section in ("thermometer", "drift"):
+            if section not in data:
+                raise _fail(source, "(top level)",
+                            f"the required section {section!r} is missing (a single-axis "
+                            "model holds 'thermometer' and 'drift', a multi-axis one 'axes')")
     validator = jsonschema.Draft202012Validator(MODEL_SCHEMA)
     error = jsonschema.exceptions.best_match(validator.iter_errors(data))
     if error is not None:
@@ -205,6 +242,50 @@ def check_schema(data: Any, source: str) -> None:
         if len(message) > 200:
             message = message[:200] + "..."
         raise _fail(source, _path(error.absolute_path), message)
+    found = unknown_key(data, MODEL_SCHEMA, ())
+    if found is not None:
+        where, key, known = found
+        raise _fail(source, _path(where) if where else "(top level)",
+                    f"unknown key {key!r} (known here: {', '.join(known)}); a misspelt "
+                    "key is ignored by hrgtc but not by the reader of the file")
+
+
+#: Objects whose keys are free: the provenance (free-form) and the temperature map (keys
+#: a newer version wrote are kept, ``thermometry.reference.TemperatureMapRecord``).
+_OPEN_OBJECTS = ("provenance", "temperature_map")
+
+
+def unknown_key(value: Any, schema: Mapping[str, Any], where: tuple[Any, ...]
+                ) -> tuple[tuple[Any, ...], str, list[str]] | None:
+    """The first key of ``value`` that its (already valid) schema does not know:
+    ``(place, key, known keys)``, None when every key is known."""
+    while "$ref" in schema:
+        schema = MODEL_SCHEMA["$defs"][schema["$ref"].rsplit("/", 1)[1]]
+    if "anyOf" in schema and value is not None:
+        branches = [b for b in schema["anyOf"] if b.get("type") != "null"]
+        schema = branches[0] if len(branches) == 1 else {}
+    if isinstance(value, dict):
+        properties = schema.get("properties")
+        if properties is not None:
+            for key, item in value.items():
+                if key not in properties:
+                    return where, key, list(properties)
+                if key in _OPEN_OBJECTS and not where:
+                    continue
+                found = unknown_key(item, properties[key], (*where, key))
+                if found is not None:
+                    return found
+        elif isinstance(schema.get("additionalProperties"), dict):
+            for key, item in value.items():
+                found = unknown_key(item, schema["additionalProperties"], (*where, key))
+                if found is not None:
+                    return found
+    elif isinstance(value, list) and isinstance(schema.get("items"), dict):
+        for i, item in enumerate(value):
+            found = unknown_key(item, schema["items"], (*where, i))
+            if found is not None:
+                return found
+    return None
 
 
 def axis_parts(data: Mapping[str, Any]) -> dict[str, Any]:

@@ -90,6 +90,7 @@ SAMPLE = (
     "freq_hz stored scalar / 1-axis .h5",
     "rate_dph stored compound / 1-axis .h5",
     "headers freq_hz/rate_dph swapped / 1-axis .csv",
+    "rate x57.3 (logged in rad/s) / 1-axis .parquet",
     "compensated file / 1-axis .parquet",
     "CR-only line ends / 1-axis .csv",
     "trailing delimiter / 3-axis .csv",
@@ -103,6 +104,13 @@ SAMPLE = (
     "NaN in rate_dph_x row 4321 / 3-axis .parquet",
     "drift.ranges.f reversed",
     "truncated at 50%",
+    # issue 27's audit
+    "stray rate_dph_x beside rate_dph / 1-axis .csv",
+    "upper-case header / 3-axis .csv",
+    "stray CR inside row 500 / 1-axis .csv",
+    "only 5 rows / 1-axis .parquet",
+    "headers chamber_c/temperature_c swapped / 1-axis .parquet",
+    "duplicate key 'intercept_dph' in drift",
 )
 
 

@@ -220,3 +220,17 @@ def test_no_rate_variation_on_a_sensor_is_said_in_degrees_with_the_option(tmp_pa
     message = " ".join(result.output.split())
     assert "shows no dT/dt variation (span 0.448 °C/h)" in message, message
     assert "Hz" not in message and "--terms f,f^2,f^3" in message
+
+
+def test_a_map_for_the_unsigned_count_names_what_it_gave_and_the_option(tmp_path):
+    """Issue 27: --temp-scale/--temp-offset written for the unsigned count (65236, not
+    -300) gave -357 °C and, with --spikes drop, a bare "the recording has no rows"."""
+    unsigned = ["--temp-scale", "0.00586994",
+                "--temp-offset", f"{24.2787 - 0.00586994 * 65536:.4f}"]
+    result = runner.invoke(app, ["calibrate", "--drift", str(RUN), *READ, *unsigned,
+                                 "--spikes", "drop", "-o", str(tmp_path / "pan.json")])
+    assert result.exit_code == 2
+    message = " ".join(result.output.split())
+    assert "no rows" not in message
+    assert "pan_tvc_cold_2020-03-07.csv: column 'temp' (temperature_c)" in message
+    assert "row 0: 65236 -> -362.2 °C" in message and "--temp-unwrap off" in message

@@ -227,3 +227,29 @@ def test_the_pan_mems_recording_is_no_swap_and_its_swap_is_found():
         check_sensor_swap(temperature, rate, "pan.csv", "temp", f"rate_dph_{axis}")
         with pytest.raises(InputError, match="look swapped"):
             check_sensor_swap(rate, temperature, "pan.csv", "temp", f"rate_dph_{axis}")
+
+
+def test_a_chamber_set_point_taken_for_the_thermometer_is_refused(tmp_path):
+    """Issue 27's audit: chamber_c and temperature_c swapped were fitted without a word
+    by calibrate --thermometer sensor (the set-point runs ahead of the gyro)."""
+    from hrgtc.drift.training import check_setpoint_thermometer, is_setpoint_ramp
+    from hrgtc.pipeline.calibration import calibrate
+    from hrgtc.recording import Recording, write
+
+    from corruptions import base_run
+
+    run = base_run("1")
+    assert is_setpoint_ramp(run["chamber_c"]) and not is_setpoint_ramp(run["temperature_c"])
+    # a measured temperature at 0.01 °C resolution, steady or moving, is no set-point
+    rng = np.random.default_rng(2)
+    slow = np.round(20.0 + np.cumsum(rng.normal(0.0, 0.002, 5000)), 2)
+    assert not is_setpoint_ramp(slow)
+    assert not is_setpoint_ramp(np.round(np.linspace(20.0, 30.0, 5000), 2))
+    check_setpoint_thermometer(run["temperature_c"], run["chamber_c"])  # as logged: fine
+    columns = {k: np.array(run[k]) for k in run.names}
+    columns["chamber_c"], columns["temperature_c"] = columns["temperature_c"], columns["chamber_c"]
+    path = write(Recording(columns, run.metadata), tmp_path / "swapped.csv")
+    with pytest.raises(InputError, match=r"swapped.csv: the headers chamber_c and temperature_c "
+                                         r"look swapped: .*noise-free straight ramps.*"
+                                         r"--col temperature_c=chamber_c"):
+        calibrate([], [path], thermometer="sensor")

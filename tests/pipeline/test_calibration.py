@@ -331,3 +331,56 @@ def test_aux_channels_and_gradient_terms_need_their_columns():
     assert parse_aux(["drive=drive_v", " quad = q_v "]) == {"drive": "drive_v", "quad": "q_v"}
     with pytest.raises(InputError, match="write NAME=COLUMN"):
         parse_aux(["drive"])
+
+
+@pytest.mark.parametrize(("factor", "likely"), [(3600.0, "values × 3600"),
+                                                (180 / np.pi, "values × 57.2958"),
+                                                (1000.0, "values × ")])  # the nearest factor
+def test_sensor_thermometer_on_an_hrg_file_refuses_a_mems_noise(tmp_path, factor, likely):
+    """Issue 27's audit: a file that logs freq_hz is an HRG's; with --thermometer sensor
+    its rate read ×3600 (°/h data declared °/s), ×57.3 or ×1000 (noise only a MEMS gyro
+    has) was fitted with a warning at most. The resonator path's noise check applies."""
+    from corruptions import base_run
+
+    run = base_run("1")
+    columns = {k: np.array(run[k]) for k in run.names}
+    columns["rate_dph"] = columns["rate_dph"] * factor
+    path = recording.write(Recording(columns, run.metadata), tmp_path / "hrg.parquet")
+    with pytest.raises(InputError) as raised:
+        calibrate([], [path], thermometer="sensor")
+    message = str(raised.value)
+    assert message.startswith(f"{path}: column 'rate_dph': a noise density of")
+    assert "the file logs a resonator frequency (column 'freq_hz', median 4428" in message
+    assert likely in message and "check --rate-unit" in message
+    # the level of a biased run may differ: a 4 °/s offset alone is no unit mistake
+    columns["rate_dph"] = np.array(run["rate_dph"]) + 4 * 3600.0
+    biased = recording.write(Recording(columns, run.metadata), tmp_path / "biased.parquet")
+    assert calibrate([], [biased], thermometer="sensor").model is not None
+
+
+def test_sensor_thermometer_on_an_hrg_file_refuses_swapped_frequency_and_rate(tmp_path):
+    from corruptions import base_run
+
+    run = base_run("1")
+    columns = {k: np.array(run[k]) for k in run.names}
+    columns["freq_hz"], columns["rate_dph"] = columns["rate_dph"], columns["freq_hz"]
+    path = recording.write(Recording(columns, run.metadata), tmp_path / "swapped.parquet")
+    with pytest.raises(InputError, match=r"swapped.parquet: columns 'freq_hz' .* and 'rate_dph' "
+                                         r".* look swapped.*--col freq_hz=rate_dph"):
+        calibrate([], [path], thermometer="sensor")
+
+
+@pytest.mark.parametrize("rows", [2, 5, 10])
+def test_a_drift_run_shorter_than_the_warm_up_is_called_too_short(tmp_path, rows):
+    """Issue 27's audit: a 2-10-row file got "the drift runs hold no sample at rest after
+    the 50 s warm-up; see --motion", naming no file and blaming motion."""
+    from corruptions import base_run
+
+    run = base_run("1")
+    columns = {k: np.array(run[k])[:rows] for k in run.names}
+    path = recording.write(Recording(columns, run.metadata), tmp_path / "short.csv")
+    with pytest.raises(CalibrationError) as raised:
+        calibrate([], [path], thermometer="sensor")
+    assert str(raised.value).startswith(
+        f"{path}: {rows} rows ({(rows - 1) / 10:g} s) is too short to train on; at its 10 Hz, "
+        "more than 501 rows: a drift run must last longer than the 50 s warm-up")

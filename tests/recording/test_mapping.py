@@ -104,6 +104,34 @@ def test_temperature_from_a_raw_count(tmp_path):
         read(path, columns=cols, units={"rate": "radps"}, temp_scale=0.0)
 
 
+@pytest.mark.parametrize("spikes", ["error", "drop"])
+def test_a_count_map_that_gives_impossible_temperatures_says_what_it_gave(tmp_path, spikes):
+    """Issue 27: a scale and offset written for the unsigned count of a sensor whose count
+    is unwrapped (65236 -> -300) gave -357 °C, and with --spikes drop a bare "the
+    recording has no rows" (every row judged impossible before anything said why). The
+    map's result is named, with the option that fixes it, before any check judges it."""
+    unsigned = np.round(np.linspace(65236.0, 65000.0, N))  # -300 ... -536 signed
+    path, _ = imu_csv(tmp_path, temp=unsigned)
+    cols = parse_columns(IMU_COLS)
+    scale, offset = 0.00586994, 24.2787 - 0.00586994 * 65536.0  # for the unsigned count
+    with pytest.warns(UserWarning, match="signed 16-bit"), pytest.raises(RecordingError) as caught:
+        read(path, columns=cols, units={"rate": "radps"}, thermometer="sensor",
+             temp_scale=scale, temp_offset_c=offset, spikes=spikes)
+    message = str(caught.value)
+    assert message.startswith(f"{path}: column 'temp' (temperature_c): the count map ")
+    assert "row 0: 65236 -> -362.2 °C" in message, message
+    assert "read as it is, the map gives 21.83 °C" in message
+    assert message.endswith("pass --temp-unwrap off")
+    rec = read(path, columns=cols, units={"rate": "radps"}, thermometer="sensor",
+               temp_scale=scale, temp_offset_c=offset, spikes=spikes, temp_unwrap="off")
+    assert rec["temperature_c"][0] == pytest.approx(65236.0 * scale + offset)
+    # the other way round: a map for the signed count, the count read as it is
+    with pytest.raises(RecordingError, match=r"gives 676.2 °C .* the map gives 20.82 °C: "
+                                             r"pass --temp-unwrap 16$"):
+        read(path, columns=cols, units={"rate": "radps"}, thermometer="sensor",
+             temp_scale=0.01, temp_offset_c=25.0, temp_unwrap="off", spikes=spikes)
+
+
 def test_per_axis_temperatures_are_each_axis_thermometer(tmp_path):
     extra = {"tx": np.full(N, 20.0), "ty": np.full(N, 21.0), "tz": np.full(N, 22.0)}
     path, _ = imu_csv(tmp_path, extra=extra)

@@ -78,6 +78,73 @@ def test_a_single_axis_file_may_keep_a_column_that_only_looks_per_axis(run, tmp_
     assert axis_names(back.names) == () and "temperature_c_ambient" in back.names
 
 
+def test_a_plain_rate_beside_per_axis_rates_is_ambiguous(run, tmp_path):
+    """Issue 27's audit: a single-axis file with a stray rate_dph_x became a one-axis
+    instrument 'x', its rate_dph ignored."""
+    columns = {**{k: run[k] for k in run.names}, "rate_dph_x": run["rate_dph"]}
+    path = write(Recording(columns, run.metadata), tmp_path / "stray.csv")
+    with pytest.raises(RecordingError, match=r"stray.csv: column 'rate_dph' has no axis, beside "
+                       r"the per-axis rate column\(s\) \['rate_dph_x'\] of axes \['x'\]: hrgtc "
+                       r"cannot tell whether the file is one gyro's"):
+        read(path)
+
+
+def test_a_plain_frequency_beside_per_axis_ones_is_ambiguous(three_axis, tmp_path):
+    """Issue 27's audit: a 3-axis file with an extra plain freq_hz was read, the plain
+    column taken for a temperature (4417.9 °C) by the sensor thermometer."""
+    columns = {**{k: three_axis[k] for k in three_axis.names},
+               "freq_hz": three_axis["freq_hz_x"]}
+    path = write(Recording(columns, three_axis.metadata), tmp_path / "extra.parquet")
+    for thermometer in ("resonator", "sensor"):
+        with pytest.raises(RecordingError, match=r"extra.parquet: column 'freq_hz' has no axis.*"
+                           r"whose resonator it is; remove or rename 'freq_hz'"):
+            read(path, thermometer=thermometer)
+
+
+@pytest.mark.parametrize("pad", ["", "   ", "\0\0"])
+def test_hdf5_numbers_as_padded_byte_strings_are_read(run, tmp_path, pad):
+    """Issue 27's audit: fixed-length byte strings padded with spaces (as MATLAB and
+    Fortran write them) got "'4417.677   ' is not a number"."""
+    path = write(run, tmp_path / "bytes.h5")
+    with h5py.File(path, "a") as handle:
+        values = handle["recording/freq_hz"][:]
+        del handle["recording/freq_hz"]
+        handle["recording/freq_hz"] = np.array([(repr(float(v)) + pad).encode()
+                                                for v in values], dtype="S32")
+    np.testing.assert_array_equal(read(path)["freq_hz"], run["freq_hz"])
+
+
+@pytest.mark.parametrize(("stray", "what"), [
+    ("\r", r"a carriage return \(\\r\) inside the line at character 4 splits it"),
+    ('"', r'a quote \(\"\) without its closing one at character 4 runs into the lines')])
+def test_a_stray_cr_or_quote_inside_a_csv_row_is_named_at_its_line(run, tmp_path, stray, what):
+    """Issue 27's audit: "line ? (row ?): expected 5 fields, got ?"."""
+    lines = write(run, tmp_path / "ok.csv").read_text().split("\n")
+    header = next(i for i, line in enumerate(lines) if not line.startswith("#"))
+    lines[header + 1 + 100] = lines[header + 1 + 100].replace(",", "," + stray, 1)
+    path = tmp_path / "stray.csv"
+    path.write_bytes("\n".join(lines).encode())
+    with pytest.raises(RecordingError, match=rf"stray.csv: line {header + 102} \(row 100\): "
+                                             rf"expected 4 fields; {what}"):
+        read(path)
+
+
+def test_an_upper_case_header_reads_as_the_contract_names(three_axis, tmp_path):
+    """Issue 27's audit: RATE_DPH_X, ... was "single-axis (freq_hz, rate_dph)" against a
+    3-axis model, and "required column(s) 'time_s' ... missing" for info."""
+    from hrgtc.compensate.multi_axis import recording_axes
+
+    lines = write(three_axis, tmp_path / "imu.csv").read_text().split("\n")
+    header = next(i for i, line in enumerate(lines) if not line.startswith("#"))
+    lines[header] = lines[header].upper()
+    path = tmp_path / "upper.csv"
+    path.write_text("\n".join(lines))
+    back = read(path)
+    assert sorted(back.names) == sorted(three_axis.names)
+    np.testing.assert_array_equal(back["rate_dph_z"], three_axis["rate_dph_z"])
+    assert recording_axes(path) == ("x", "y", "z")
+
+
 @pytest.mark.parametrize("shape", ["n3", "n1", "scalar"])
 def test_an_hdf5_column_that_is_not_1d_is_an_error_naming_it(three_axis, run, tmp_path, shape):
     source = three_axis if shape == "n3" else run

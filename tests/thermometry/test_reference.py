@@ -163,6 +163,20 @@ def test_real_cold_test_map_from_its_hand_log():
     assert earlier.lag_s == fitted.lag_s + 900.0
 
 
+def test_the_map_is_fitted_whatever_the_spikes_policy():
+    """Issue 27: with --spikes drop the raw count (-300, unwrapped) was judged an
+    impossible temperature before the map was fitted: every row dropped, "the recording
+    has no rows". Impossible temperatures are judged after the map."""
+    from dataclasses import replace
+
+    cols = {"time_s": "Time", "temperature_c": "C1 (C)"}
+    with pytest.warns(UserWarning, match="signed 16-bit count"):
+        fitted = map_from_reference(PAN, HANDLOG, replace(PAN_OPTIONS, spikes="drop"),
+                                    columns=cols, start="15:45")
+    assert fitted.points == 24 and fitted.lag_s == 440.0
+    assert fitted.scale_c_per_count == pytest.approx(0.005870, rel=1e-3)
+
+
 def test_reference_columns_option():
     from hrgtc.core.errors import InputError
     from hrgtc.thermometry.reference import parse_reference_columns

@@ -162,13 +162,14 @@ def recording_axes(path: str | os.PathLike[str],
     for a single-axis file. Reads the file's column names only; None when the file cannot
     be opened (reading it will say why)."""
     from hrgtc.core.errors import HrgtcError
-    from hrgtc.recording.mapping import check_axis_sets, parse_columns
+    from hrgtc.recording.mapping import check_axis_sets, parse_columns, with_other_case
 
     try:
         mapping = parse_columns((options or rec_io.ReadOptions()).columns)
         with rec_io.open_source(path) as source:
             if not mapping and _header_less(source.names):
                 return None  # no axis can be told: reading says the header line is missing
+            mapping = with_other_case(mapping, source.names)  # as reading maps them
             names = [*mapping, *(n for n in source.names if n not in mapping.values())]
             axes = tuple(axis_names(names))
             # an incomplete axis (freq_hz_z without rate_dph_z) is the reading's error to

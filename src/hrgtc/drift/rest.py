@@ -44,6 +44,8 @@ class RunRest:
         Sum and number of the still ``freq_hz`` values after the warm-up (the centre).
     accel
         Whether the run logs the three accelerometer axes.
+    duration_s
+        From the run's first to its last sample (NaN without any). [s]
     """
 
     source: str
@@ -53,6 +55,7 @@ class RunRest:
     freq_count: int = 0
     accel: bool = False
     counts: dict[str, int] = field(default_factory=dict)
+    duration_s: float = math.nan
 
     @property
     def n_moving(self) -> int:
@@ -173,7 +176,8 @@ def _run_rest(columns: dict[str, np.ndarray], policy: str, settings: MotionSetti
     total = float(np.sum(freq[used])) if freq is not None else 0.0
     counts = {} if mask is None else mask.counts()
     return RunRest(source, keep, mask, total, int(np.count_nonzero(used)) if freq is not None
-                   else 0, accel, counts)
+                   else 0, accel, counts,
+                   float(time_s[-1] - time_s[0]) if time_s.size else math.nan)
 
 
 def training_centre(rests: Sequence[RunRest]) -> float | None:
@@ -182,6 +186,26 @@ def training_centre(rests: Sequence[RunRest]) -> float | None:
     if count == 0:
         return None
     return sum(r.freq_sum for r in rests) / count
+
+
+def check_long_enough(rests: Sequence[RunRest], warmup_s: float) -> None:
+    """Refuse training runs that all end within the df/dt filter's warm-up: too short,
+    not "no sample at rest" (issue 27's audit: a 2-10-row file), naming each run, its
+    rows and the rows it would need at its own rate."""
+    short = [r for r in rests if not r.duration_s > warmup_s]
+    if not rests or len(short) < len(rests):
+        return
+    parts = []
+    for run in short:
+        rows = run.keep.size
+        period = run.duration_s / (rows - 1) if rows > 1 and run.duration_s > 0 else math.nan
+        needed = (f"; at its {1.0 / period:.4g} Hz, more than {math.ceil(warmup_s / period) + 1} "
+                  "rows" if math.isfinite(period) else "")
+        duration = f"{run.duration_s:g} s" if math.isfinite(run.duration_s) else "no time"
+        parts.append(f"{run.source}: {rows} rows ({duration}) is too short to train on{needed}")
+    raise CalibrationError(
+        "; ".join(parts) + f": a drift run must last longer than the {warmup_s:g} s warm-up "
+        "of the df/dt filter (left out of the fit), in practice hours of a temperature ramp")
 
 
 def reference_point(rests: Sequence[RunRest], thermometer: Any, reference_c: float | None,
@@ -196,6 +220,7 @@ def reference_point(rests: Sequence[RunRest], thermometer: Any, reference_c: flo
     if reference_c is None:
         centre = training_centre(rests)
         if centre is None:
+            check_long_enough(rests, warmup_s)
             raise CalibrationError("the drift runs hold no sample at rest after the "
                                    f"{warmup_s:g} s warm-up; see --motion")
         reference_c = float(thermometer.temperature(np.array([centre]), warn=False)[0])

@@ -180,9 +180,10 @@ def check_noise(statistics: TrainingStatistics | None, rate_dph: Any, sample_rat
 
 
 # -- without a model: the sensor class (calibrate) ------------------------------------------
-#: Angle random walk of 1 °/√h (60 °/h/√Hz): beyond any HRG (navigation and tactical HRGs
-#: have 0.0002-0.05 °/√h), typical of a MEMS gyro. [°/h/√Hz]
-HRG_MAX_NOISE_DENSITY = 60.0
+#: Angle random walk of 0.25 °/√h (15 °/h/√Hz): beyond any HRG (navigation and tactical
+#: HRGs have 0.0002-0.05 °/√h), typical of a MEMS gyro; an HRG's rate read ×57.3 (rad/s
+#: declared) has it from 0.005 °/√h on (issue 27). [°/h/√Hz]
+HRG_MAX_NOISE_DENSITY = 15.0
 #: A bias of 1 °/s at rest: beyond any HRG (a few °/h at most), common in MEMS gyros. [°/h]
 HRG_MAX_BIAS_DPH = 3600.0
 #: Noise densities of any gyro, from the best HRG/FOG (ARW 1e-4 °/√h = 0.006 °/h/√Hz) to the
@@ -214,11 +215,23 @@ def _likely_unit(density: float, bias_dph: float) -> str:
     return f"{best[2]} (values × {best[1]:.6g})"
 
 
+#: Why a unit is an HRG, and the way out when it is not: the resonator thermometer.
+RESONATOR_THERMOMETER = ("this unit is calibrated with its resonator as thermometer (an HRG)",
+                         "for a MEMS gyro use --thermometer sensor")
+
+
 def check_resonator_gyro(rate_dph: Any, sample_rate_hz: float, input_rate_dph: float = 0.0,
-                         source: str = "", column: str = "rate_dph") -> None:
+                         source: str = "", column: str = "rate_dph",
+                         hrg: tuple[str, str] = RESONATOR_THERMOMETER,
+                         levels: bool = True) -> None:
     """Refuse the training data of an HRG (resonator thermometer) whose noise or bias only a
     MEMS gyro could have: a unit mistake that makes values larger (``--rate-unit dps`` on
     °/h data makes the bias stability 4208 instead of 1.2 °/h).
+
+    ``hrg``: why the unit is an HRG and what to do if it is not (its resonator is the
+    thermometer, or the file logs a resonator frequency beside a temperature sensor);
+    ``levels`` False: the noise only (the level of a biased run may differ, its noise
+    may not).
 
     Raises
     ------
@@ -230,7 +243,7 @@ def check_resonator_gyro(rate_dph: Any, sample_rate_hz: float, input_rate_dph: f
     finite = rate[np.isfinite(rate)]
     bias = float(np.median(finite)) - input_rate_dph if finite.size else math.nan
     noisy = density > HRG_MAX_NOISE_DENSITY
-    biased = abs(bias) > HRG_MAX_BIAS_DPH
+    biased = levels and abs(bias) > HRG_MAX_BIAS_DPH
     if not (noisy or biased):
         return
     where = f"{source}: " if source else ""
@@ -240,10 +253,8 @@ def check_resonator_gyro(rate_dph: Any, sample_rate_hz: float, input_rate_dph: f
         + [f"a bias of {bias:.4g} °/h at rest (an HRG has at most {HRG_MAX_BIAS_DPH:g})"]
         * biased)
     raise InputError(
-        f"{where}column {column!r}: {what}: only a MEMS gyro could have that, and this unit "
-        f"is calibrated with its resonator as thermometer (an HRG). Likely "
-        f"{_likely_unit(density, bias)}: check --rate-unit; for a MEMS gyro use "
-        "--thermometer sensor")
+        f"{where}column {column!r}: {what}: only a MEMS gyro could have that, and {hrg[0]}. "
+        f"Likely {_likely_unit(density, bias)}: check --rate-unit; {hrg[1]}")
 
 
 def implausible_for_any_gyro(rate_dph: Any, sample_rate_hz: float) -> str | None:
@@ -332,3 +343,50 @@ def check_sensor_swap(temperature: ChannelShape, rate: ChannelShape, source: str
         f"{rate.span:.3g} (a temperature's); fix the header line of the file, or map the "
         f"columns with --col {rate_column}={temperature_column} "
         f"--col {temperature_column}={rate_column}")
+
+
+# -- calibrate --thermometer sensor: a chamber set-point taken for the thermometer -------------
+#: Share of the moving samples of a column whose second difference is 0 (to 1e-9 of its
+#: span) for it to be a noise-free ramp: a set-point, computed, never measured.
+SETPOINT_SHARE = 0.99
+
+
+def is_setpoint_ramp(values: Any) -> bool:
+    """True for a column that moves (half its steps or more) as noise-free straight ramps:
+    a chamber's set-point. A measured temperature has noise, or steps of its resolution
+    between equal samples (a second difference at each step)."""
+    finite = np.asarray(values, dtype=np.float64)
+    finite = finite[np.isfinite(finite)]
+    span = float(np.ptp(finite)) if finite.size else 0.0
+    if finite.size < 100 or span <= 0.0:
+        return False
+    steps = np.diff(finite)
+    moving = steps != 0.0
+    if np.count_nonzero(moving) < 0.5 * steps.size:
+        return False
+    both = moving[1:] & moving[:-1]
+    flat = np.abs(np.diff(steps)[both]) <= 1e-9 * span
+    return bool(flat.size) and float(np.mean(flat)) >= SETPOINT_SHARE
+
+
+def check_setpoint_thermometer(temperature: Any, chamber: Any, source: str = "",
+                               temperature_column: str = "temperature_c",
+                               chamber_column: str = "chamber_c") -> None:
+    """Refuse a sensor thermometer that is a noise-free ramp beside a ``chamber_c`` that
+    is not: the set-point and the sensor's headers swapped (issue 27's audit: fitted
+    without a word, the gyro's drift against a temperature running ahead of it).
+
+    Raises
+    ------
+    InputError
+        Names the file, both columns and the fix.
+    """
+    if chamber is None or not is_setpoint_ramp(temperature) or is_setpoint_ramp(chamber):
+        return
+    where = f"{source}: " if source else ""
+    raise InputError(
+        f"{where}the headers {chamber_column} and {temperature_column} look swapped: the "
+        f"thermometer column {temperature_column!r} moves as noise-free straight ramps (a "
+        f"chamber's set-point; no sensor reads without noise) while {chamber_column!r} has a "
+        f"measurement's noise; fix the header line of the file, or map the columns with "
+        f"--col {temperature_column}={chamber_column} --col {chamber_column}={temperature_column}")

@@ -37,6 +37,7 @@ from hrgtc.drift.training import (
     TrainingStatistics,
     check_resonator_gyro,
     check_sensor_swap,
+    check_setpoint_thermometer,
     implausible_for_any_gyro,
 )
 from hrgtc.evaluation import Evaluation, evaluate
@@ -44,6 +45,7 @@ from hrgtc.evaluation.calibration_figures import calibration_summary, thermomete
 from hrgtc.model import UnitModel, provenance
 from hrgtc.pipeline.documents import CalibrationDriftRecord, CalibrationRecord
 from hrgtc.recording import ReadOptions
+from hrgtc.recording.mapping import parse_columns
 from hrgtc.recording.marks import refuse_compensated_training
 from hrgtc.settings import to_dict
 from hrgtc.settings.calibration import CalibrationSettings
@@ -430,6 +432,12 @@ def _calibrate_sensor(soaks: Sequence[PathLike], drifts: Sequence[PathLike],
     heads = {str(path): options.head(path) for path in training}
     for path in drifts:  # any gyro: only a density beyond every gyro's can be told
         head = heads[str(path)]
+        _check_logged_resonator(path, head, options)
+        chamber = head["chamber_c"] if "chamber_c" in head else None
+        check_setpoint_thermometer(head.freq_hz, chamber, str(path),
+                                   *_sensor_columns(path, options)[:1],
+                                   parse_columns(options.columns).get("chamber_c",
+                                                                      "chamber_c"))
         message = implausible_for_any_gyro(head.rate_dph, head.metadata.sample_rate_hz)
         if message is not None:
             warnings.warn(f"{path}: column 'rate_dph': {message}", HrgtcWarning, stacklevel=3)
@@ -450,6 +458,37 @@ def _calibrate_sensor(soaks: Sequence[PathLike], drifts: Sequence[PathLike],
     validation = tuple(evaluate(path, unit_model, allan=False, read_options=options)
                        for path in validate)
     return CalibrationResult(unit_model, (), (), validation, None, fitted)
+
+
+def _check_logged_resonator(path: PathLike, head: Any, options: ReadOptions) -> None:
+    """A file that logs a resonator frequency beside the temperature sensor is an HRG's:
+    its rate must have an HRG's noise and bias (a rate ×3600, ×1000 or ×57.3 has a MEMS
+    gyro's, issue 27), and its frequency and rate columns must not be swapped."""
+    from hrgtc.recording.checks import FREQ_SAMPLE_RANGE_HZ, _check_swapped
+
+    logged = options.logged_frequency(path)
+    if logged is None:
+        return
+    name, freq = logged
+    rate = f"rate_dph_{options.axis}" if options.axis else "rate_dph"
+    rate = dict(_sensor_rate_mapping(options)).get(rate, rate)
+    swapped = _check_swapped(freq, np.asarray(head.rate_dph), name, rate)
+    if swapped is not None:
+        raise InputError(f"{path}: {swapped.message}")
+    finite = freq[np.isfinite(freq)]
+    median = float(np.median(finite)) if finite.size else math.nan
+    if not FREQ_SAMPLE_RANGE_HZ[0] <= median <= FREQ_SAMPLE_RANGE_HZ[1]:
+        return
+    check_resonator_gyro(
+        head.rate_dph, head.metadata.sample_rate_hz, head.metadata.input_rate_dph or 0.0,
+        str(path), rate,
+        hrg=(f"the file logs a resonator frequency (column {name!r}, median {median:.6g} Hz: "
+             "an HRG)", f"if {name!r} is not this gyro's resonator, rename that column"),
+        levels=False)
+
+
+def _sensor_rate_mapping(options: ReadOptions) -> dict[str, str]:
+    return parse_columns(options.columns)
 
 
 def _sensor_thermometer(training: Sequence[PathLike], options: ReadOptions) -> SoakFit:

@@ -53,6 +53,7 @@ from hrgtc.recording.formats.registry import open_streams
 from hrgtc.recording.mapping import (
     ColumnPlan,
     convert_columns,
+    parse_columns,
     plan_columns,
     scales_temperature,
     table_columns,
@@ -227,6 +228,8 @@ def read(path: str | Path, options: ReadSettings | None = None, *, validate: boo
         plan = _plan(source, opts, robust)
         arrays = with_file_rows(convert_columns(plan, table_columns(
             source.read(plan.read_names, plan.as_text)), 0), 0)
+        if validate and plan.map_problem:  # before any check judges the mapped values
+            raise RecordingError(plan.map_problem)
         arrays, slow = fill_slow_channels(arrays, opts.slow_channels, opts.hold_max_s, str(path))
         if spike_filter is not None:
             arrays = spike_filter.drop(arrays, 0)
@@ -363,6 +366,8 @@ def iter_chunks(path: str | Path, options: ReadSettings | None = None, *,
             nonlocal offset
             for table in source.iter_tables(plan.read_names, plan.as_text, rows):
                 part = convert_columns(plan, table_columns(table), offset)
+                if validate and plan.map_problem:  # before the spike filters judge it
+                    raise RecordingError(plan.map_problem)
                 if numbered:  # the file rows, for the validator's messages
                     part = with_file_rows(part, offset)
                 part = slow.fill(part, offset)
@@ -525,6 +530,24 @@ class ReadOptions(ReadSettings):
         ``dropped``: filled with the rows the spike filters removed (see there);
         ``time_repair``: a stream whose counts (duplicates dropped) the caller reads after."""
         return iter_chunks(path, self, rows=rows, dropped=dropped, time_repair=time_repair)
+
+    def logged_frequency(self, path: str | Path) -> tuple[str, np.ndarray] | None:
+        """The resonator frequency the file logs for this axis (its first rows), also
+        when the temperature sensor is the thermometer (``freq_hz`` is then filled from
+        ``temperature_c``): ``(column, values)``, None without one. A file that logs a
+        resonator frequency is an HRG's, whatever the thermometer chosen."""
+        own = replace(self, thermometer="resonator", axis=None, spike_filter="off",
+                      spikes="error", start=None, end=None)
+        name = f"freq_hz_{self.axis}" if self.axis else "freq_hz"
+        chunks = iter_chunks(path, own, rows=HEURISTIC_ROWS, validate=False,
+                             only=("time_s", "freq_hz", "rate_dph"))
+        try:
+            head = next(chunks, None)
+        finally:
+            chunks.close()
+        if head is None or name not in head:
+            return None
+        return parse_columns(self.columns).get(name, name), np.asarray(head[name])
 
     def _axis_chunks(self, chunks: Iterator[Recording], path: str) -> Iterator[Recording]:
         return _axis_views(chunks, str(self.axis), self.freq_band_hz, path)

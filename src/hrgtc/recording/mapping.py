@@ -45,6 +45,7 @@ from hrgtc.recording.checks import check_thermometer
 from hrgtc.recording.formats.base import Source, first_failing
 from hrgtc.recording.formats.csv import bad_number_hint
 from hrgtc.recording.schema import COLUMNS
+from hrgtc.recording.temperature_count import map_problem, unwrap_count, wrapped_count_bits
 from hrgtc.recording.time_axis import ZoneClock, check_zone
 from hrgtc.recording.units import UNITS, find_unit, median_period, per_sample_steps, unit_of
 from hrgtc.settings.reading import TEMP_UNWRAPS, ReadSettings
@@ -172,6 +173,10 @@ class ColumnPlan:
     zone_clock: Any = None  # its ZoneClock (hrgtc.recording.time_axis), state across chunks
     #: Columns found by their common names, not mapped by the user (the accelerometer's)
     found: dict[str, str] = field(default_factory=dict)
+    #: What the count map gave when no thermometer reads that (:func:`map_problem`): the
+    #: reader raises it before any impossible-value check judges the mapped values.
+    map_problem: str | None = None
+    map_checked: bool = False
 
     def only(self, bases: Iterable[str]) -> ColumnPlan:
         """This plan reading only the columns whose contract name (without its axis) is
@@ -285,6 +290,7 @@ def plan_columns(source: Source, columns: Any, units: Mapping[str, str] | None,
                 f"{source.path}: column {theirs!r} (given for {name}) not found{did}; "
                 f"the file's columns are {source.names}"
             )
+    mapping = with_other_case(mapping, source.names)
     kinds = source.kinds()
     found = find_accelerometer(source.names, mapping.values(), kinds)
     mapping = {**mapping, **found}
@@ -332,6 +338,22 @@ def plan_columns(source: Source, columns: Any, units: Mapping[str, str] | None,
                       wrap_decided=temp_unwrap != "auto", found=found)
 
 
+def with_other_case(mapping: Mapping[str, str], names: Iterable[str]) -> dict[str, str]:
+    """``mapping`` with the file's contract names written in another case mapped too
+    (``RATE_DPH_X`` -> ``rate_dph_x``: issue 27's audit found an upper-case 3-axis
+    header read as "single-axis"), unless the name is mapped or exists as written."""
+    names = list(names)
+    out = dict(mapping)
+    taken = set(names) | set(out) | set(out.values())
+    for name in names:
+        lower = name.lower()
+        if lower != name and lower not in taken and is_contract_name(lower) and sum(
+                n.lower() == lower for n in names) == 1:
+            out[lower] = name
+            taken.add(lower)
+    return out
+
+
 def check_axis_sets(source: Source, names: list[str], axes: tuple[str, ...],
                     mapping: Mapping[str, str]) -> None:
     """Refuse per-axis columns of an axis that has no ``rate_dph_<axis>`` column.
@@ -340,8 +362,25 @@ def check_axis_sets(source: Source, names: list[str], axes: tuple[str, ...],
     ``freq_hz_z`` or ``temperature_c_z`` without ``rate_dph_z`` would otherwise be
     carried along as an unknown column and the axis z dropped without a word. A
     single-axis file may have columns that look per-axis (``temperature_c_ambient``)
-    except ``freq_hz_<axis>`` and ``rate_dph``-like ones beside no ``freq_hz``.
+    except ``freq_hz_<axis>`` and ``rate_dph``-like ones beside no ``freq_hz``. A
+    ``rate_dph`` or ``freq_hz`` without an axis beside per-axis rates is ambiguous (one
+    gyro, or the axes? whose resonator?) and refused too (issue 27's audit: a stray
+    ``rate_dph_x`` made a single-axis file a one-axis instrument ``x``).
     """
+    if axes:
+        for plain in ("rate_dph", "freq_hz"):
+            if plain not in names:
+                continue
+            theirs = mapping.get(plain, plain)
+            called = repr(theirs) if theirs == plain else f"{theirs!r} ({plain})"
+            per_axis = [mapping.get(f"rate_dph_{a}", f"rate_dph_{a}") for a in axes]
+            raise RecordingError(
+                f"{source.path}: column {called} has no axis, beside the per-axis rate "
+                f"column(s) {per_axis} of axes {list(axes)}: hrgtc cannot tell "
+                + ("whether the file is one gyro's (rate_dph) or an instrument's"
+                   if plain == "rate_dph" else "whose resonator it is")
+                + f"; remove or rename {theirs!r} (e.g. {plain}_ref) if it is another "
+                "channel, or the per-axis columns if the file is a single gyro's")
     for name in names:
         base, axis = split_axis(name)
         if axis is None or axis in axes:
@@ -408,12 +447,8 @@ def _rate_values(plan: ColumnPlan, values: np.ndarray, time_s: np.ndarray | None
     return unit.apply(values) / steps
 
 
-#: A signed count stored unsigned: widths tried and how close under 2^bits it must sit.
-_WRAP_WIDTHS = ((16, 2.0**12), (32, 2.0**24))
-
-
 def _temperature_values(plan: ColumnPlan, values: np.ndarray, base: str,
-                        theirs: str) -> np.ndarray:
+                        theirs: str, row_offset: int = 0) -> np.ndarray:
     """A temperature column in °C: °F or K converted; a raw count unwrapped, scaled, offset."""
     temp = plan.units.get("temp", "C")
     if temp in ("F", "K"):
@@ -432,34 +467,16 @@ def _temperature_values(plan: ColumnPlan, values: np.ndarray, base: str,
                 f"values from 2^{bits - 1} on taken minus 2^{bits} ({first[0]:.0f} -> "
                 f"{unwrap_count(first, bits)[0]:.0f}); pass --temp-unwrap off if your sensor "
                 "really counts that high", UnitWarning, stacklevel=4)
+    raw = values
     if plan.wrap_bits is not None:
         values = unwrap_count(values, plan.wrap_bits)
     if scales_temperature(plan.temp_scale, plan.temp_offset_c):
-        return values * plan.temp_scale + plan.temp_offset_c
+        mapped = values * plan.temp_scale + plan.temp_offset_c
+        if not plan.map_checked and np.isfinite(mapped).any():
+            plan.map_checked = True
+            plan.map_problem = map_problem(plan, raw, mapped, theirs, row_offset)
+        return mapped
     return values
-
-
-def wrapped_count_bits(values: np.ndarray) -> int | None:
-    """16 or 32 when a raw count looks like a signed count stored unsigned, else None.
-
-    That is: whole numbers in [0, 2^bits) with the median within 2^12 (2^24 for 32
-    bits) under 2^bits, i.e. small negative numbers read as unsigned ones.
-    """
-    finite = values[np.isfinite(values)]
-    if finite.size == 0 or np.any(finite != np.round(finite)) or finite.min() < 0:
-        return None
-    middle = float(np.median(finite))
-    for bits, near in _WRAP_WIDTHS:
-        top = 2.0**bits
-        if finite.max() < top and top - near <= middle < top:
-            return bits
-    return None
-
-
-def unwrap_count(values: np.ndarray, bits: int) -> np.ndarray:
-    """A signed ``bits``-bit count stored unsigned, signed again (65236 -> -300 for 16 bits)."""
-    half, full = 2.0 ** (bits - 1), 2.0**bits
-    return np.where(values >= half, values - full, values)
 
 
 def _is_text(column: pa.ChunkedArray) -> bool:
@@ -470,6 +487,9 @@ def _to_float(
     plan: ColumnPlan, column: pa.ChunkedArray, theirs: str, row_offset: int
 ) -> np.ndarray:
     if _is_text(column):
+        # numbers as text padded with spaces: HDF5 fixed-length strings as MATLAB and
+        # Fortran write them (issue 27's audit: "'4417.677   ' is not a number")
+        column = pc.utf8_trim_whitespace(column)
         try:
             column = column.cast(pa.float64())
         except (pa.ArrowInvalid, pa.ArrowTypeError):
@@ -577,7 +597,7 @@ def convert_columns(
             if kind == "rate":
                 out[name] = _rate_values(plan, values, out.get("time_s"), theirs)
             elif kind == "temp":
-                out[name] = _temperature_values(plan, values, base, theirs)
+                out[name] = _temperature_values(plan, values, base, theirs, row_offset)
             elif kind:
                 out[name] = to_contract_unit(values, plan.units.get(kind, ""))
             else:

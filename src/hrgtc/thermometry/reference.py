@@ -485,7 +485,9 @@ def map_from_reference(recording: str | Path, reference: str | Path,
     options = replace(read_options or ReadOptions(), temp_scale=1.0, temp_offset_c=0.0,
                       units={**dict((read_options.units if read_options else None) or {}),
                              "temp": "count"},
-                      spike_filter="off", gaps="split")
+                      spike_filter="off", spikes="error", gaps="split")
+    # spikes="error" and no validation: the count has no physical bounds, impossible
+    # temperatures are judged after the map (a count of -300 is no -300 °C)
     run = _read_raw(options, recording)
     names = [n for n in run.names if n == "temperature_c" or n.startswith("temperature_c_")]
     if not names:

@@ -206,10 +206,10 @@ class CsvSource(Source):
             )
         fields = re.search(r"Expected (\d+) columns, got (\d+)", text)
         if fields:
-            line, row, got = self._locate_bad_line()
+            line, row, what = self._locate_bad_line()
             return RecordingError(
-                f"{self.path}: line {line} (row {row}): expected {fields.group(1)} fields, got "
-                f"{got}; the line is truncated or malformed, repair or delete it"
+                f"{self.path}: line {line} (row {row}): expected {fields.group(1)} fields"
+                f"{what}; repair or delete it"
             )
         return RecordingError(f"{self.path}: cannot parse the CSV ({text})")
 
@@ -226,10 +226,15 @@ class CsvSource(Source):
             offset += batch.num_rows
         return "?", "?"
 
-    def _locate_bad_line(self) -> tuple[int | str, int | str, int | str]:
+    def _locate_bad_line(self) -> tuple[int | str, int | str, str]:
+        """``(line, row, what is wrong)`` of the first data line the parser cannot split
+        into the header's fields: too few or too many delimiters, a carriage return inside
+        the line (which ends a line for the parser, not for a text editor), or a quote
+        without its closing one (the field then runs on into the lines after it)."""
         expected = len(self._file_names)
         line_no = 0
         row = -self._header_rows
+        delimiter = self.delimiter.encode()
         with open(self.path, "rb") as handle:
             handle.seek(self._offset)
             line_no = _count_lines(self.path, self._offset)
@@ -237,11 +242,22 @@ class CsvSource(Source):
                 line_no += 1
                 if not raw.strip():
                     continue
-                got = raw.count(self.delimiter.encode()) + 1
-                if row >= 0 and got != expected:
-                    return line_no, row, got
+                if row >= 0:
+                    body = raw.rstrip(b"\r\n")
+                    cr, quote = body.find(b"\r"), body.find(b'"')
+                    if cr >= 0:
+                        return line_no, row, ("; a carriage return (\\r) inside the line at "
+                                              f"character {cr + 1} splits it")
+                    if body.count(b'"') % 2:
+                        return line_no, row, ("; a quote (\") without its closing one at "
+                                              f"character {quote + 1} runs into the lines "
+                                              "after it")
+                    got = body.count(delimiter) + 1
+                    if got != expected:
+                        return line_no, row, (f", got {got}; the line is truncated or "
+                                              "malformed")
                 row += 1
-        return "?", "?", "?"
+        return "?", "?", ", got another number; the line is truncated or malformed"
 
 
 #: Name (then a number) under which the empty fields after trailing delimiters are read.
