@@ -29,7 +29,6 @@ from __future__ import annotations
 
 import difflib
 import math
-import re
 import warnings
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
@@ -40,6 +39,7 @@ import pyarrow as pa
 import pyarrow.compute as pc
 
 from hrgtc.core.errors import InputError, RecordingError, UnitWarning
+from hrgtc.recording.accelerometer import find_accelerometer
 from hrgtc.recording.axes import AXIS_COLUMNS, axis_names, base_name, split_axis
 from hrgtc.recording.checks import check_thermometer
 from hrgtc.recording.formats.base import Source, first_failing
@@ -194,41 +194,6 @@ class ColumnPlan:
         """True when ``temperature_c*`` holds a raw count (a count unit, a scale or an offset)."""
         return (self.units.get("temp") == "count"
                 or scales_temperature(self.temp_scale, self.temp_offset_c))
-
-
-#: Prefixes of an accelerometer's columns in loggers' files (compared case-insensitively):
-#: ``acc_x``, ``accel_x``, ``ax``, ``a_x``, ``AccX``, ``accelerometer.x``, ``imu_acc_x``,
-#: with or without a unit after the axis (``acc_x [m/s^2]``, ``acc_x_m_s2``, ``accX(g)``).
-_ACCEL_NAME = re.compile(
-    r"^(?:imu[ _.\-]?)?(?:acc|accel|accl|acceleration|accelerometer|a)[ _.\-]?([xyz])"
-    r"(?:$|[ _.\-\[(].*$)", re.IGNORECASE)
-
-
-def find_accelerometer(names: Iterable[str], taken: Iterable[str],
-                       kinds: Mapping[str, str] | None = None) -> dict[str, str]:
-    """The file's accelerometer columns under their common names, as a column mapping
-    ``{"accel_x": theirs, ...}``: all three axes, exactly one numeric column each, and none
-    mapped or named ``accel_*`` already; else ``{}`` (the motion detector then uses the gyro).
-
-    Examples
-    --------
-    >>> find_accelerometer(["time_s", "acc_x [m/s^2]", "acc_y [m/s^2]", "acc_z [m/s^2]"], [])
-    {'accel_x': 'acc_x [m/s^2]', 'accel_y': 'acc_y [m/s^2]', 'accel_z': 'acc_z [m/s^2]'}
-    >>> find_accelerometer(["ax", "ay", "az", "a_x", "a_y", "a_z"], [])  # which? none
-    {}
-    """
-    names = list(names)
-    taken = set(taken)
-    if any(n.startswith("accel_") for n in (*names, *taken)):
-        return {}
-    found: dict[str, list[str]] = {}
-    for name in names:
-        match = _ACCEL_NAME.match(name.strip())
-        if match and name not in taken and (kinds is None or kinds.get(name) == "numeric"):
-            found.setdefault(match.group(1).lower(), []).append(name)
-    if sorted(found) != ["x", "y", "z"] or any(len(v) != 1 for v in found.values()):
-        return {}
-    return {f"accel_{axis}": found[axis][0] for axis in "xyz"}
 
 
 def plan_columns(source: Source, columns: Any, units: Mapping[str, str] | None,
