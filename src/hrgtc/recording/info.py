@@ -287,6 +287,9 @@ def describe(path: str | Path, options: ReadSettings | None = None, *,
     thermometer = opts.thermometer
     check_gap_policy(opts.gaps)
     validator = RecordingValidator(opts.gaps, thermometer=thermometer, dropout_s=opts.dropout_s)
+    if (dict(opts.units or {}).get("temp") == "count"
+            and (opts.temp_scale, opts.temp_offset_c) == (1.0, 0.0)):
+        validator.count_temperatures()  # a raw count, no map: not judged as °C
     ranges: dict[str, list[float]] = {}
     steps: dict[str, float] = {}
     spike_rows: int | None = None if opts.spike_filter == "off" else 0

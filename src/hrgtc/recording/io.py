@@ -225,7 +225,7 @@ def read(path: str | Path, options: ReadSettings | None = None, *, validate: boo
         return concatenate(list(iter_chunks(path, opts, validate=validate)))
     spike_filter, robust = _spike_filters(opts, path)
     with open_source(path, opts.slow_channels, opts.hold_max_s) as source:
-        plan = _plan(source, opts, robust)
+        plan = _plan(source, opts, robust, spike_filter)
         arrays = with_file_rows(convert_columns(plan, table_columns(
             source.read(plan.read_names, plan.as_text)), 0), 0)
         if validate and plan.map_problem:  # before any check judges the mapped values
@@ -255,7 +255,8 @@ def read(path: str | Path, options: ReadSettings | None = None, *, validate: boo
     if validate:
         validate_recording(recording, opts.gaps, freq_band_hz=opts.freq_band_hz,
                            freq_span_hz=opts.freq_span_hz, thermometer=opts.thermometer,
-                           file_rows=file_rows, dropout_s=opts.dropout_s)
+                           file_rows=file_rows, dropout_s=opts.dropout_s,
+                           temperature_counts=robust.counts)
     return recording
 
 
@@ -272,13 +273,16 @@ def _spike_filters(opts: ReadSettings, path: str | Path,
     return drop, robust
 
 
-def _plan(source: Source, opts: ReadSettings, robust: RobustSpikeFilter) -> ColumnPlan:
-    """How to read the columns of ``source`` with ``opts`` (the robust filter told
-    whether the temperature is a raw count)."""
+def _plan(source: Source, opts: ReadSettings, robust: RobustSpikeFilter,
+          drop: SpikeFilter | None = None) -> ColumnPlan:
+    """How to read the columns of ``source`` with ``opts`` (the spike filters told
+    whether the temperature is a raw count, not yet in °C)."""
     plan = plan_columns(source, opts.columns, opts.units, opts.temp_scale, opts.temp_offset_c,
                         opts.thermometer, opts.rate_scale, opts.temp_unwrap, opts.tz)
     robust.counts = plan.temperature_is_count and not scales_temperature(opts.temp_scale,
                                                                        opts.temp_offset_c)
+    if drop is not None:
+        drop.counts = robust.counts
     return plan
 
 
@@ -349,7 +353,9 @@ def iter_chunks(path: str | Path, options: ReadSettings | None = None, *,
                                     opts.thermometer, opts.dropout_s) if validate else None)
     slow = SlowChannels(opts.slow_channels, opts.hold_max_s, str(path))
     with open_source(path, opts.slow_channels, opts.hold_max_s) as source:
-        plan = _plan(source, opts, robust)
+        plan = _plan(source, opts, robust, spike_filter)
+        if validator is not None and robust.counts:
+            validator.count_temperatures()
         if only is not None:
             plan = plan.only(only)
         offset = 0

@@ -115,9 +115,14 @@ class SpikeFilter:
         self.first: tuple[str, int, float] | None = None
         self._reference: dict[str, float] = {}
         self._axes: tuple[str, ...] = ()
+        #: The temperature is a raw count not mapped to °C (--temp-unit count alone, or a
+        #: --temp-ref log mapping it later): it has no °C bounds to be judged by here.
+        self.counts = False
 
     def _bounds(self, name: str) -> tuple[float, float] | None:
         base = base_name(name, self._axes)
+        if self.counts and (base == "temperature_c" or (base == "freq_hz" and self.sensor)):
+            return None
         if base == "freq_hz" and self.sensor:
             return TEMPERATURE_RANGE_C
         bounds = _BOUNDS.get(base)

@@ -152,6 +152,7 @@ class RecordingValidator:
         elif self.thermometer == "sensor":  # freq_hz holds the sensor's temperature
             self._bounds["freq_hz"] = (*TEMPERATURE_RANGE_C, "°C")
         self._out_of_bounds: dict[str, list[Any]] = {}  # column -> [row, value, count]
+        self.temperature_counts = False  # see count_temperatures
         self._freq_reference: dict[str, float] = {}  # frequency column -> median of first rows
         self._jump: dict[str, list[Any]] = {}  # frequency column -> [row, value, count]
         self.axes: tuple[str, ...] = ()
@@ -169,6 +170,15 @@ class RecordingValidator:
         self._names: tuple[str, ...] = ()
         #: Order, gaps and the sample rate of the time axis, over the whole recording.
         self.time_axis = TimeContinuity()
+
+    def count_temperatures(self) -> None:
+        """The temperature columns hold a raw count, not yet mapped to °C (``--temp-unit
+        count`` alone, or a count a ``--temp-ref`` log maps later): no °C bounds judge them
+        (a map's result is judged where it is applied)."""
+        self.temperature_counts = True
+        self._bounds.pop("temperature_c", None)
+        if self.thermometer == "sensor":
+            self._bounds.pop("freq_hz", None)
 
     # -- feeding -------------------------------------------------------------
     def partial_fit(self, chunk: Recording, file_rows: np.ndarray | None = None) -> None:
@@ -446,6 +456,7 @@ def validate(
     thermometer: str = ReadSettings.thermometer,
     file_rows: np.ndarray | None = None,
     dropout_s: float = ReadSettings.dropout_s,
+    temperature_counts: bool = False,
 ) -> ValidationReport:
     """Check a recording against the recording contract (see the module docstring).
 
@@ -472,6 +483,8 @@ def validate(
     dropout_s
         Gaps no longer than this are dropouts, bridged and counted whatever ``gaps``
         says (they change no result). [s]
+    temperature_counts
+        The temperature columns hold a raw count not yet mapped to °C: no °C bounds.
 
     Returns
     -------
@@ -483,6 +496,8 @@ def validate(
         Message names the file, column, first bad row, the bad value and the fix.
     """
     validator = RecordingValidator(gaps, freq_band_hz, freq_span_hz, thermometer, dropout_s)
+    if temperature_counts:
+        validator.count_temperatures()
     validator.partial_fit(recording, file_rows)
     report = validator.finish()
     if raise_errors:
