@@ -89,9 +89,13 @@ def test_a_daylight_saving_step_in_clock_times_is_named(tmp_path):
 
 
 @pytest.mark.parametrize(("time_factor", "rate_hz", "hint"), [
-    (1000.0, 200.0, "looks like milliseconds: pass --time-unit ms"),
+    # the time in ms, or the metadata wrong: both named, with what each means
+    (1000.0, 200.0, "either the time column is in milliseconds (pass --time-unit ms: every "
+                    "duration then shrinks 1000 times) or the metadata's rate is wrong and the "
+                    "steps are right: pass --rate-hz 0.2"),
     (1.0, 100.0, "the rate does not change within the file: fix the metadata (--rate-hz 200)"),
-    (1e-3, 200.0, "already in seconds (drop --time-unit ms)"),
+    (1e-3, 200.0, "if you passed --time-unit ms, the time column is already in seconds "
+                  "(drop it); or the metadata's rate is wrong"),
 ])
 def test_a_wrong_time_unit_or_rate_gives_one_hint_not_gaps_or_rate_changes(time_factor,
                                                                           rate_hz, hint):

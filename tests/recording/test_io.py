@@ -373,7 +373,8 @@ def test_sample_rate_disagreeing_with_metadata(tmp_path):
         read(path, metadata={"sample_rate_hz": 202.5})  # 1.25 % off
     in_ms = recording.with_columns(time_s=recording.time_s * 1000.0)
     write(in_ms, tmp_path / "ms.parquet")
-    with pytest.raises(RecordingError, match=r"looks like milliseconds: pass --time-unit ms"):
+    with pytest.raises(RecordingError, match=r"in milliseconds \(pass --time-unit ms.* or the "
+                       r"metadata's rate is wrong.*--rate-hz 0\.2"):
         read(tmp_path / "ms.parquet")
     assert read(tmp_path / "ms.parquet", units={"time": "ms"}).time_s[1] == 0.005
 

@@ -104,3 +104,20 @@ def test_bursts_without_motion_are_never_short_still():
     t = np.concatenate([k * 300.0 + np.arange(0.0, 5.0, 0.02) for k in range(20)])
     rate = 40.0 + np.random.default_rng(4).standard_normal(t.size)
     assert not detect_motion(t, rate).moving.any()
+
+
+def test_a_jittery_clock_is_no_rate_change_and_a_real_change_is_told_in_digits_that_differ():
+    rng = np.random.default_rng(5)
+    # a slow logger's clock: steps of 9-21 s, median 10 s, mean 3 % longer (skewed)
+    steps = np.where(rng.random(30000) < 0.03, rng.uniform(19.0, 21.0, 30000),
+                     rng.normal(10.0, 0.02, 30000))
+    time_s = np.cumsum(steps)
+    validator = _validate(time_s / 10.0, np.arange(time_s.size, dtype=float))  # 1 Hz scale
+    assert validator.time_axis.rate_change is None
+    # a real change, 1 % faster from row 5000: its message says two different rates
+    time_s = np.r_[np.arange(5000.0), 5000.0 + np.arange(5000.0) / 1.0125]
+    validator = _validate(time_s, np.arange(time_s.size, dtype=float))
+    (problem,) = [p for p in validator.time_axis.problems("error", False)
+                  if p.kind == "sample_rate"]
+    assert "changes to 1.01 Hz but the metadata (and the start of the file) say 1 Hz" in \
+        problem.message or "changes to 1.012 Hz" in problem.message, problem.message

@@ -253,13 +253,18 @@ def _check_sample_rate(nominal_hz: float, measured_hz: float | None) -> Problem 
         return None
     fix = (f"every step says so, the rate does not change within the file: fix the metadata "
            f"(--rate-hz {measured_hz:.6g})")
-    if abs(measured_hz * 1000.0 / nominal_hz - 1.0) <= 0.05:
-        fix = "the time column looks like milliseconds: pass --time-unit ms"
-    elif abs(measured_hz * 1e6 / nominal_hz - 1.0) <= 0.05:
-        fix = "the time column looks like microseconds: pass --time-unit us"
-    elif abs(measured_hz / 1000.0 / nominal_hz - 1.0) <= 0.05:
-        fix = ("the steps are 1000 times shorter than the sample period: the time column is "
-               "already in seconds (drop --time-unit ms)")
+    wrong_rate = f"or the metadata's rate is wrong and the steps are right: pass --rate-hz " \
+        f"{measured_hz:.6g}"
+    for factor, unit, name in ((1000.0, "ms", "milliseconds"), (1e6, "us", "microseconds")):
+        if abs(measured_hz * factor / nominal_hz - 1.0) <= 0.05:
+            fix = (f"either the time column is in {name} (pass --time-unit {unit}: every "
+                   f"duration then shrinks {factor:g} times) {wrong_rate}")
+            break
+    else:
+        if abs(measured_hz / 1000.0 / nominal_hz - 1.0) <= 0.05:
+            fix = ("the steps are 1000 times shorter than the metadata's period: if you passed "
+                   f"--time-unit ms, the time column is already in seconds (drop it); "
+                   f"{wrong_rate}")
     return Problem(
         "sample_rate",
         f"column 'time_s': the median time step {1.0 / measured_hz:.6g} s means "

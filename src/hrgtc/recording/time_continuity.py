@@ -178,6 +178,9 @@ class TimeContinuity:
                 # mostly gaps or disorder: left to those checks
                 changed = (counts >= rows // 2) & (
                     np.abs(measured * period - 1.0) > SAMPLE_RATE_TOLERANCE)
+            if changed.any():  # a jittery clock's skewed steps move the mean, not the median
+                changed &= self._median_off(np.concatenate([carried, new_steps]), blocks,
+                                            rows, period)
             if changed.any():
                 k = int(np.argmax(changed))
                 # the change may have begun in the block before (checked earlier, still in
@@ -207,6 +210,16 @@ class TimeContinuity:
         short = durations[durations <= dropout_s]
         return int(short.size), float(short.max()) if short.size else 0.0
 
+    @staticmethod
+    def _median_off(steps: np.ndarray, blocks: int, rows: int, period: float) -> np.ndarray:
+        """For each block of ``rows`` steps: is the median of its usable steps off the
+        nominal ``period`` beyond the tolerance too?"""
+        part = steps[:blocks * rows].reshape(blocks, rows)
+        with np.errstate(invalid="ignore"):
+            usable = np.isfinite(part) & (part > 0) & (part <= gap_limit_s(period))
+            medians = np.nanmedian(np.where(usable, part, np.nan), axis=1)
+            return np.abs(medians / period - 1.0) > SAMPLE_RATE_TOLERANCE
+
     def problems(self, gap_policy: str, whole_file: bool,
                  dropout_s: float = 0.0) -> list[Problem]:
         """The problems of the time axis so far. ``whole_file``: a time unit or sample
@@ -217,13 +230,14 @@ class TimeContinuity:
         if self.rate_change is not None and not whole_file:
             row, measured = self.rate_change
             nominal = self.metadata.sample_rate_hz
+            now, then = _distinct(measured, nominal)
             problems.append(Problem(
                 "sample_rate",
-                f"column 'time_s', row {row}: the time step changes to {measured:.6g} Hz but "
-                f"the metadata (and the start of the file) say {nominal:g} Hz; the sample rate "
+                f"column 'time_s', row {row}: the time step changes to {now} Hz but "
+                f"the metadata (and the start of the file) say {then} Hz; the sample rate "
                 f"changes within the file: split it at row {row} and process the parts "
                 "separately (or resample)",
-                column="time_s", row=row, value=f"{measured:.6g}"))
+                column="time_s", row=row, value=now))
         if self._time_order is not None:
             row, now, before = self._time_order
             what = "a duplicate time" if now == before else "a step back in time"
@@ -269,3 +283,17 @@ class TimeContinuity:
                 )
             )
         return problems
+
+
+def _distinct(a: float, b: float) -> tuple[str, str]:
+    """``a`` and ``b`` written with the fewest significant digits (at least 3) that tell them
+    apart, so a message never says "changes to 1 Hz ... say 1 Hz".
+
+    >>> _distinct(0.99, 1.0), _distinct(1.97728, 1.97939)
+    (('0.99', '1'), ('1.977', '1.979'))
+    """
+    for digits in range(3, 17):
+        left, right = f"{a:.{digits}g}", f"{b:.{digits}g}"
+        if left != right:
+            return left, right
+    return f"{a!r}", f"{b!r}"
