@@ -175,6 +175,13 @@ def test_cold_test_held_out_is_within_the_interval_of_a_line_and_never_worse_tha
                                from_s)
         low, high = bias_stability_interval(line, n)
         found[axis] = (figures["compensated"], line, n)
+        # the accounting starts from the file's rows (issue 27): the trained and the held-out
+        # part read every row of the file between them, and drop its three spikes
+        trained_rows = document["axes"][axis]["drift"]["accounting"]
+        held_rows = document["axes"][axis]["validation"][0]["accounting"]
+        assert trained_rows["read"] + held_rows["read"] == time_s.size
+        assert trained_rows["dropped"].get("spikes", 0) == sum(r < cut for r in SPIKES)
+        assert held_rows["dropped"].get("spikes", 0) == sum(r >= cut for r in SPIKES)
         assert figures["compensated"] <= figures["raw"] * (1.0 + 1e-9), (axis, figures)
         if axis == "y":  # the df/dt term earns its place: better than the whole interval
             assert figures["compensated"] < low, (axis, figures, line, n)

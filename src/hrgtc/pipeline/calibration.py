@@ -20,7 +20,6 @@ import os
 import warnings
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
-from functools import partial
 from typing import Any
 
 import numpy as np
@@ -372,15 +371,35 @@ def _fit(runs: Sequence[Any], thermometer: Any, drift: DriftSettings,
         gaps=options.gaps)
 
 
+class _CountedRun:
+    """A training run's chunks, counting the rows the spike filters removed in the last
+    pass over it (the fit reads a run several times)."""
+
+    def __init__(self, options: ReadOptions, path: PathLike) -> None:
+        self.options, self.path, self._dropped = options, path, {}
+
+    def __call__(self) -> Any:
+        self._dropped = {}
+        return self.options.chunks(self.path, dropped=self._dropped)
+
+    @property
+    def spikes(self) -> int:
+        return int(self._dropped.get("spikes", 0))
+
+
 def _fit_drift(training: Sequence[PathLike], heads: Mapping[str, Any], thermometer: Any,
                options: ReadOptions, progress: StageProgress | None, excitation_runs: int,
                drift: DriftSettings, aux: Mapping[str, str] | None,
                housing_terms: Iterable[str] | None) -> tuple[Any, Any]:
     """The drift model on ``training`` and the housing baseline when every run has
     ``housing_c`` (None otherwise, or when its fit fails: the baseline is optional)."""
-    runs = [partial(options.chunks, path) for path in training]
+    runs = [_CountedRun(options, path) for path in training]
     model = _fit(runs, thermometer, drift, aux, options, for_stage(progress, "drift"),
                  excitation_runs)
+    spikes = sum(run.spikes for run in runs)
+    if spikes and model.accounting is not None:  # the accounting starts from the file's rows
+        model.accounting.add_read(spikes)
+        model.accounting.drop("spikes", spikes)
     housing = None
     if housing_terms is not None and all("housing_c" in heads[str(p)] for p in training):
         # the baseline's own terms in h and dh/dt, with the default selection and the
