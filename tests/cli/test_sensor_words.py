@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import html
 import json
+import re
 from pathlib import Path
 
 from typer.testing import CliRunner
@@ -193,3 +194,71 @@ def test_the_run_figure_names_the_thermometer():
     assert "compensated, temperature-sensor model (10 s stability 1 °/h)" in sensor
     assert "resonator, from frequency" in resonator
     assert "compensated, frequency model (10 s stability 1 °/h)" in resonator
+
+
+#: What a sensor model's outputs must not say: the paper's equation, table and figure
+#: numbers, and the resonator's words (the C and column names ``resonator_c_est``,
+#: ``resonator_c_<axis>`` are names of the interface, the same for both, and are left out).
+PAPER_WORDS = re.compile(r"Eq\.|Eq \(|Eqs\.|Table [0-9]|Fig\. ?[0-9]|resonator|natural frequency"
+                         r"|frequency model", re.IGNORECASE)
+INTERFACE_NAMES = re.compile(r"resonator_c\w*")
+
+
+def _paper_words(text: str) -> list[str]:
+    """Each place of ``text`` that says a paper number or a resonator word, with context."""
+    text = INTERFACE_NAMES.sub("", re.sub(r"data:image/[^\"']*", "", text))
+    return [text[max(0, m.start() - 60):m.end() + 30] for m in PAPER_WORDS.finditer(text)]
+
+
+def test_no_paper_numbers_or_resonator_words_in_any_output_of_a_sensor_model(tmp_path,
+                                                                            monkeypatch):
+    """Every command on the real cold test's sensor model (issue 27 item 6: ``calibrate``
+    printed "drift model (Eq. 22)" and "Eq. (22) form" for a MEMS temperature sensor):
+    calibrate (text and --json), info, compensate (its output and the file's mark),
+    evaluate, report (HTML), export-c (C double and single, parameter file) and simulate
+    of a sensor logger (README "Real loggers") say no equation, table or figure number of
+    the paper and no resonator word."""
+    from hrgtc.cli import _app
+
+    monkeypatch.setattr(_app.console, "width", 200)
+    monkeypatch.chdir(tmp_path)
+    outputs: dict[str, str] = {}
+
+    def run(name: str, *args: str) -> None:
+        result = runner.invoke(app, list(args), terminal_width=200)
+        assert result.exit_code == 0, (name, result.output)
+        outputs[name] = result.output
+
+    model = str(tmp_path / "pan.json")
+    calibrate = ["calibrate", "--drift", str(RUN), *READ, *REF, "--holdout-fraction", "0.4"]
+    run("calibrate", *calibrate, "-o", model)
+    run("calibrate --json", *calibrate, "-o", str(tmp_path / "again.json"), "--json")
+    scaled = [*READ, "--temp-scale", "0.00586994", "--temp-offset", "24.2787"]
+    run("info", "info", str(RUN), *scaled)
+    run("info --json", "info", str(RUN), *scaled, "--json")
+    run("compensate", "compensate", str(RUN), "--model", model, *READ, "-o", "out.csv")
+    run("compensate --json", "compensate", str(RUN), "--model", model, *READ, "-o",
+        "out2.csv", "--json")
+    outputs["compensated file's comments"] = "\n".join(
+        line for line in Path("out.csv").read_text().splitlines() if line.startswith("#"))
+    run("evaluate", "evaluate", str(RUN), "--model", model, *READ)
+    run("evaluate --json", "evaluate", str(RUN), "--model", model, *READ, "--json")
+    run("report", "report", "--model", model, str(RUN), *READ, "-o", "pan.html")
+    run("export-c", "export-c", model, "-o", "c")
+    run("export-c single", "export-c", model, "-o", "c32", "--precision", "single")
+    run("export-c params", "export-c", model, "-o", "params", "--format", "params")
+    logger = ["simulate", "--logger", "burst", "--unit", "mems-3", "--profile", "cooldown",
+              "--start", "22", "--end", "5", "--hours", "0.5", "--rate-hz", "50", "--burst-s",
+              "5", "--period-s", "300", "--time-unit", "ms", "--rate-unit", "radps",
+              "--rate-digits", "3", "--spikes", "3"]
+    run("simulate --logger", *logger, "-o", "cold.csv")
+    run("simulate --logger --json", *logger, "-o", "cold2.csv", "--json")
+    written = [Path("pan.html"), *Path("c").iterdir(), *Path("c32").iterdir(),
+               *Path("params").iterdir(), *Path().glob("cold.*")]
+    for path in written:
+        outputs[str(path)] = path.read_text(encoding="utf-8")
+    assert len(written) >= 3 + 2 * 6 + 1 + 3  # report, 2 C builds x 3 axes, params, logger
+    assert "drift model (temperature sensor)" in outputs["calibrate"]
+    assert "drift model: B = " in " ".join(outputs["calibrate"].split())
+    found = {name: hits for name, text in outputs.items() if (hits := _paper_words(text))}
+    assert not found, found

@@ -204,8 +204,8 @@ def test_a_sensor_model_s_units_are_degrees_not_hertz(tmp_path):
                                "-o", str(tmp_path / "fw")])
     assert done.exit_code == 0, done.output
     params = (tmp_path / "fw" / "hrgtc_params.txt").read_text()
-    assert "on the raw variables, Eq. (22) form. [deg/h per °C]" in params
-    assert "Eq. (22) form. [deg/h per Hz" not in params
+    assert "on the raw variables. [deg/h per °C]" in params
+    assert "[deg/h per Hz" not in params and "Eq. (22)" not in params
 
 
 def test_no_rate_variation_on_a_sensor_is_said_in_degrees_with_the_option(tmp_path):

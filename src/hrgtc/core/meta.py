@@ -16,5 +16,9 @@ PAPER_REFERENCE = (
     "Hemispherical Resonator Gyro Based on Natural Frequency', Sensors 12(5), 6434-6446, 2012. "
     "doi:10.3390/s120506434"
 )
+#: The paper cited without its title, as a model of a gyro's own temperature sensor cites it
+#: (``--thermometer sensor``): the method, a stepwise drift model in the thermometer and its
+#: rate, is the paper's; the resonator and natural frequency of its title are not the sensor's.
+PAPER_CITATION = "X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434"
 #: DOI of the paper. [1]
 PAPER_DOI = "10.3390/s120506434"

@@ -22,8 +22,8 @@ import numpy as np
 from hrgtc.core.summary import Figure, Summary
 from hrgtc.drift.drift_text import drift_notes
 
-__all__ = ["calibration_summary", "instrument_summary", "paper_tables", "power_text",
-           "thermometer_equation", "thermometer_tables"]
+__all__ = ["calibration_summary", "drift_form", "drift_heading", "instrument_summary",
+           "paper_tables", "power_text", "thermometer_equation", "thermometer_tables"]
 
 #: Headings of :func:`thermometer_tables`' sections.
 TABLE1, TABLE2, PLATEAUS, EQ18 = ("Table 1", "Table 2", "plateaus",
@@ -32,6 +32,21 @@ TABLE1, TABLE2, PLATEAUS, EQ18 = ("Table 1", "Table 2", "plateaus",
 
 #: Heading of the thermometer's section: a resonator's fit (Eq. 18) or the gyro's sensor.
 THERMOMETER, SENSOR_THERMOMETER = "thermometer (Eq. 18)", "thermometer (temperature sensor)"
+
+#: Heading of the drift model's section: the paper's Eq. 22 on a resonator's frequency, or
+#: the same stepwise model on the gyro's temperature sensor (no equation of [1] is its).
+DRIFT, SENSOR_DRIFT = "drift model (Eq. 22)", "drift model (temperature sensor)"
+
+
+def drift_heading(sensor: bool) -> str:
+    """The drift model's section heading in the words of its thermometer."""
+    return SENSOR_DRIFT if sensor else DRIFT
+
+
+def drift_form(model: Any, sensor: bool) -> str:
+    """The drift model with numbers, introduced as the paper's "Eq. (22) form" on a
+    resonator and as "drift model" on a temperature sensor."""
+    return ("drift model: " if sensor else "Eq. (22) form: ") + model.equation(sensor)
 
 
 def calibration_summary(model: Any, table: Sequence[Mapping[str, float]] = (),
@@ -50,7 +65,7 @@ def calibration_summary(model: Any, table: Sequence[Mapping[str, float]] = (),
     sensor = th.source == "sensor"
     sections = [(SENSOR_THERMOMETER, _sensor_figures(th, temperature_map)) if sensor else
                 (THERMOMETER, _thermometer_figures(th, table, prior_fit)),
-                ("drift model (Eq. 22)", _drift_figures("drift", model.drift, th.source)),
+                (drift_heading(sensor), _drift_figures("drift", model.drift, th.source)),
                 ("stepwise steps", _step_figures("drift", model.drift))]
     notes: list[str] = []
     if sensor:
@@ -60,7 +75,7 @@ def calibration_summary(model: Any, table: Sequence[Mapping[str, float]] = (),
         notes.append(thermometer_equation(th))
     if model.drift.accounting is not None:
         notes.append("drift training " + model.drift.accounting.summary())
-    notes += [*drift_notes(model.drift), "Eq. (22) form: " + model.drift.equation(sensor)]
+    notes += [*drift_notes(model.drift), drift_form(model.drift, sensor)]
     if model.housing is not None:
         sections.append(("housing-thermistor baseline",
                          _drift_figures("housing", model.housing)))

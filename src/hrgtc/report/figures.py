@@ -334,7 +334,8 @@ def run_figure(run: Evaluation, sensor: bool = False) -> Figure:
     raw_ax, comp_ax, temp_ax = figure.subplots(3, 1, sharex=True, height_ratios=(1.2, 1.2, 0.8))
     raw_ax.plot(hours, b["raw_dph"], color=RAW,
                 label=f"output − input rate ({_at10(run, 'raw')})")
-    raw_ax.plot(hours, b["model_dph"], color=MODEL, label="drift model (Eq. 22 form)")
+    raw_ax.plot(hours, b["model_dph"], color=MODEL,
+                label="drift model" if sensor else "drift model (Eq. 22 form)")
     if "model_std_dph" in b:  # 1σ of the fitted line from the coefficients' covariance
         raw_ax.fill_between(hours, b["model_dph"] - b["model_std_dph"],
                             b["model_dph"] + b["model_std_dph"], color=MODEL, alpha=0.25, lw=0,

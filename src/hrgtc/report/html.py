@@ -37,6 +37,7 @@ from hrgtc.evaluation.calibration_figures import (
     TABLE1,
     TABLE2,
     calibration_summary,
+    drift_heading,
     power_text,
 )
 from hrgtc.evaluation.glance_figures import GLANCE, glance_summary
@@ -56,6 +57,14 @@ REFERENCE = (
     "6434–6446, 2012"
 )
 DOI = "10.3390/s120506434"
+#: [1] without its title, as a sensor model's report cites it (the method is the paper's; the
+#: resonator and natural frequency of its title are not the sensor's).
+CITATION = "X. Wang et al., <i>Sensors</i> 12(5), 6434–6446, 2012"
+
+
+def reference(sensor: bool) -> str:
+    """[1] as the report cites it: in full, or without its title on a sensor model."""
+    return CITATION if sensor else REFERENCE
 
 
 # -- HTML pieces ----------------------------------------------------------------------------
@@ -134,12 +143,15 @@ class _Page:
 
 
 # -- sections --------------------------------------------------------------------------------
-#: The sections of one axis: link id, title, whether a sensor model (no frequency) has it.
-_SECTIONS = (("settling", "Settling of the soaks (Fig. 3)", False),
-             ("thermometer", "Frequency–temperature fit (Fig. 4, Table 1, Eq. 18)", False),
-             ("temperature", "Temperature from frequency (Fig. 5, Table 2)", False),
-             ("runs", "Runs: raw and compensated output (Fig. 6), Allan deviation", True),
-             ("model", "Drift model: stepwise regression (Eq. 21–22)", True))
+#: The sections of one axis: link id, title, and its title on a sensor model (no frequency;
+#: None: it has no such section, and no figure or equation of [1] is its).
+_SECTIONS = (("settling", "Settling of the soaks (Fig. 3)", None),
+             ("thermometer", "Frequency–temperature fit (Fig. 4, Table 1, Eq. 18)", None),
+             ("temperature", "Temperature from frequency (Fig. 5, Table 2)", None),
+             ("runs", "Runs: raw and compensated output (Fig. 6), Allan deviation",
+              "Runs: raw and compensated output, Allan deviation"),
+             ("model", "Drift model: stepwise regression (Eq. 21–22)",
+              "Drift model: stepwise regression"))
 
 
 def _header(page: _Page, model: UnitModel, title: str, model_path: str | None,
@@ -148,30 +160,32 @@ def _header(page: _Page, model: UnitModel, title: str, model_path: str | None,
     no Figs. 3-5), linked to the first axis's (``axis``: its id prefix) when there are
     several."""
     prov = model.provenance
+    sensor = model.thermometer.source == "sensor"
     page.add(f"<header><h1>{escape(title)}</h1>",
              f"<p>Unit <b>{escape(model.unit)}</b>. Model file "
              f"<code>{escape(model_path or '(in memory)')}</code>, written by hrgtc "
              f"{escape(str(prov.get('hrgtc_version', '?')))} on "
              f"{escape(str(prov.get('created_utc', '?')))}. Report generated "
              f"{datetime.now(UTC).isoformat(timespec='seconds')}.</p>",
-             f'<p class="muted">Method and figures after [1] {REFERENCE}, doi:'
-             f'<a href="https://doi.org/{DOI}">{DOI}</a>.</p></header>')
+             f'<p class="muted">{"Method" if sensor else "Method and figures"} after '
+             f'[1] {reference(sensor)}, doi:<a href="https://doi.org/{DOI}">{DOI}</a>.</p>'
+             "</header>")
     inputs = provenance_summary(prov)
     if inputs.sections:
         page.add(_grid_table(inputs, INPUTS, INPUTS))
-    sensor = model.thermometer.source == "sensor"
     prefix = f"{axis}-" if axis else ""
-    items = "".join(f'<li><a href="#{prefix}{key}">{escape(text)}'
+    items = "".join(f'<li><a href="#{prefix}{key}">{escape(sensor_text if sensor else text)}'
                     + (f" (axis {escape(axis)})" if axis else "") + "</a></li>"
-                    for key, text, with_sensor in _SECTIONS if with_sensor or not sensor)
+                    for key, text, sensor_text in _SECTIONS if sensor_text or not sensor)
     page.add(f"<nav><ol>{items}</ol></nav>")
 
 
-def _summary(page: _Page, runs: Sequence[Evaluation]) -> None:
+def _summary(page: _Page, runs: Sequence[Evaluation], sensor: bool = False) -> None:
     """The result at a glance: 10 s bias stability of each run beside the paper's
-    (:func:`~hrgtc.evaluation.glance_figures.glance_summary`)."""
+    (:func:`~hrgtc.evaluation.glance_figures.glance_summary`; ``sensor``: a temperature
+    sensor's model, not beside the paper's HRG)."""
     if runs:
-        page.add(_grid_table(glance_summary(runs), GLANCE,
+        page.add(_grid_table(glance_summary(runs, paper_row=not sensor), GLANCE,
                              "At a glance: 10 s bias stability, raw and compensated"))
 
 
@@ -303,12 +317,14 @@ def _run(page: _Page, k: int, run: Evaluation, model: UnitModel) -> None:
              f'<p class="muted">{escape(run.source)}: unit {escape(run.unit)}, {run.n_samples} '
              f"samples at {run.sample_rate_hz:g} Hz ({_recorded(run)}), input "
              f"rate {run.input_rate_dph:g} °/h.</p>")
-    page.figure(figures.run_figure(run, model.thermometer.source == "sensor"),
-                f"(a) Gyro output minus the input rate with the drift model (red), mirrors "
-                f"<b>Fig. 6(a)</b> of [1]; (b) compensated output, mirrors <b>Fig. 6(b)</b>; "
-                f"(c) temperatures. {run.block_s:g} s means; red shading: samples outside the "
-                f"calibrated range.", f"raw and compensated output of {run.name}")
     hrg = model.thermometer.source != "sensor"  # the paper's figures are an HRG's
+    mirrors = (" mirrors <b>Fig. 6(a)</b> of [1];", " mirrors <b>Fig. 6(b)</b>;") if hrg else (
+        "", "")
+    page.figure(figures.run_figure(run, not hrg),
+                f"(a) Gyro output minus the input rate with the drift model (red),{mirrors[0]} "
+                f"(b) compensated output,{mirrors[1]} (c) temperatures. {run.block_s:g} s "
+                f"means; red shading: samples outside the calibrated range.",
+                f"raw and compensated output of {run.name}")
     summary = run.figures(sensor=not hrg, warnings=False)
     for line in run.range_warnings():  # where the reader looks, not only in the JSON
         page.add(f'<p class="warning"><b>Beyond the calibration.</b> '
@@ -355,22 +371,27 @@ def _excluded(d: Any) -> str:
 
 
 def _drift_model(page: _Page, model: UnitModel) -> None:
+    """The drift model: its candidates, steps and coefficients; on a resonator beside the
+    paper's Eq. 21-22, on a temperature sensor in its own words."""
     d = model.drift
+    sensor = model.thermometer.source == "sensor"
     page.add('<section id="model"><h2>5. Drift model: stepwise regression</h2>',
-             f"<p>Candidates (Eq. 21 of [1] by default): <code>{escape(', '.join(d.candidates))}"
+             f"<p>Candidates{'' if sensor else ' (Eq. 21 of [1] by default)'}: "
+             f"<code>{escape(', '.join(d.candidates))}"
              f"</code>. Fitted on {d.n_windows} means of {d.window_s:g} s ({d.n_samples} "
              f"samples); p-to-enter {d.stepwise.penter:g}, p-to-remove {d.stepwise.premove:g}; "
              f"stopped: {escape(d.stepwise.stop_reason)}.{_excluded(d)}</p>")
     summary = calibration_summary(model)
     _section_table(page, summary, "stepwise steps", "Stepwise steps")
-    _section_table(page, summary, "drift model (Eq. 22)",
+    _section_table(page, summary, drift_heading(sensor),
                    "The final model: coefficients ± 1σ, p-values, fit")
     kept = [n for n in d.selected if n in paper.EQ22_TERMS]
-    page.add(f"<p>Terms also kept in Eq. 22 of [1]: "
-             f"{escape(', '.join(kept) or 'none')}.</p>",
-             f'<p class="eq">{escape(d.equation(model.thermometer.source == "sensor"))}</p>',
-             f'<p class="muted">Eq. (22) form. Residual std {_number(d.residual_std_dph)} °/h on '
-             f"{d.window_s:g} s means, R² {d.rsquared:.6f}.</p>")
+    if not sensor:
+        page.add(f"<p>Terms also kept in Eq. 22 of [1]: {escape(', '.join(kept) or 'none')}.</p>")
+    page.add(f'<p class="eq">{escape(d.equation(sensor))}</p>',
+             f'<p class="muted">{"" if sensor else "Eq. (22) form. "}Residual std '
+             f"{_number(d.residual_std_dph)} °/h on {d.window_s:g} s means, R² "
+             f"{d.rsquared:.6f}.</p>")
     if d.variance_inflation > 1.0:
         page.note(f"F-tests and standard errors corrected for autocorrelated window residuals "
                   f"(Newey–West, {d.bandwidth_windows} windows): variance inflation "

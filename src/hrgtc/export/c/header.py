@@ -177,13 +177,44 @@ void {p}_reset({p}_state *state);
 
 #endif /* {up}_MODEL_H */
 """
-    if model.thermometer.source == "sensor":  # its thermometer is the identity on °C
-        text = (text.replace("resonator temperature from frequency", "sensor temperature")
-                .replace("resonator temperature from f_hz", "sensor temperature from f_hz")
-                .replace("worst measured at export: resonator temperature",
-                         "worst measured at export: sensor temperature")
-                .replace("/* Thermometer f(T), Eq. (18) form. [Hz] from [degC] */",
-                         "/* Thermometer f(T) = T, the identity. [degC] from [degC] */")
-                .replace("/* Thermometer, Eq. (18) form, centred:",
-                         "/* Thermometer f(T) = T, the identity, centred:"))
+    return sensor_words(model, text)
+
+
+#: The export's words for a resonator's thermometer and the paper's equation numbers, and
+#: what a model of the gyro's temperature sensor says instead: its thermometer is the
+#: identity on °C, no fit of Eq. (18), and its drift model is in T and dT/dt, not the
+#: paper's Eq. (22) of a resonator's frequency.
+_SENSOR_WORDS = (
+    ("resonator temperature from frequency", "sensor temperature"),
+    ("resonator temperature from f_hz", "sensor temperature from f_hz"),
+    ("worst measured at export: resonator temperature",
+     "worst measured at export: sensor temperature"),
+    ("/* Thermometer f(T), Eq. (18) form. [Hz] from [degC] */",
+     "/* Thermometer f(T) = T, the identity. [degC] from [degC] */"),
+    ("/* Thermometer, Eq. (18) form, centred:", "/* Thermometer f(T) = T, the identity, centred:"),
+    ("modelled bias B, Eq. (22) [deg/h]", "modelled bias B [deg/h]"),
+    ("Bias model B of Eq. (22) from", "Bias model B from"),
+    ("the drift model, Eq. (22) of [1] (", "the drift model ("),
+    ("the thermometer, Eq. (18) of [1] (",
+     "the thermometer, f(T) = T, the identity ("),
+    ("the thermometer, Eq. (18) of [1], centred on",
+     "the thermometer, f(T) = T, the identity, centred on"),
+    ("/ TH_SCALE_C [Hz] */", "/ TH_SCALE_C [degC] */"),
+    (", Eq. (22) of [1])", ")"),
+    (", Eq. (18) of [1].", "."),
+    ("the drift model (Eq. 22).", "the drift model."),
+    ("on the raw variables, Eq. (22) form.", "on the raw variables."),
+    ("polynomial F(T) (Eq. 18).", "polynomial F(T) (1: the identity F(T) = T)."),
+    ("The same F(T) in T (Eq. 18):", "The same F(T) in T:"),
+)
+
+
+def sensor_words(model: UnitModel, text: str) -> str:
+    """``text`` (a C header or source, a parameter file's lines) in the words of a model of
+    the gyro's temperature sensor (``--thermometer sensor``); a resonator's model keeps the
+    paper's words, unchanged."""
+    if model.thermometer.source != "sensor":
+        return text
+    for old, new in _SENSOR_WORDS:
+        text = text.replace(old, new)
     return text

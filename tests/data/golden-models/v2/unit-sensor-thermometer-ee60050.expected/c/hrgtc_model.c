@@ -76,7 +76,7 @@ static double rate_update(hrgtc_rate_filter *s, double x, double dt, double tau)
     return s->difference / tau;
 }
 
-/* ---- the drift model, Eq. (22) of [1] (hrgtc.drift.DriftModel.predict) ---- */
+/* ---- the drift model (hrgtc.drift.DriftModel.predict) ---- */
 static const double INTERCEPT_DPH = -5.1646712150629597;
 static const double SCALE_F = 20.004211063387864;
 static const double CLAMP_F_LOW = -20.003300054078125;
@@ -108,10 +108,10 @@ double hrgtc_bias_dph(double f_hz, double df_hz_per_s)
     return INTERCEPT_DPH + sum;
 }
 
-/* ---- the thermometer, Eq. (18) of [1] (hrgtc.thermometry.Thermometer) ---- */
+/* ---- the thermometer, f(T) = T, the identity (hrgtc.thermometry.Thermometer) ---- */
 static const double TH_CENTRE_C = -2.407900700163168e-06;
 static const double TH_SCALE_C = 20.038926481740717;
-/* f(T) = sum_k TH_COEFFICIENTS[k] z^k, z = (T - TH_CENTRE_C) / TH_SCALE_C [Hz] */
+/* f(T) = sum_k TH_COEFFICIENTS[k] z^k, z = (T - TH_CENTRE_C) / TH_SCALE_C [degC] */
 static const double TH_COEFFICIENTS[2] = {
     -2.407900700163168e-06, 20.038926481740717,
 };

@@ -76,7 +76,7 @@ static double rate_update(hrgtc_y_rate_filter *s, double x, double dt, double ta
     return s->difference / tau;
 }
 
-/* ---- the drift model, Eq. (22) of [1] (hrgtc.drift.DriftModel.predict) ---- */
+/* ---- the drift model (hrgtc.drift.DriftModel.predict) ---- */
 static const double INTERCEPT_DPH = 12286.618021287411;
 static const double SCALE_F = 6.1659532778321999;
 static const double CLAMP_F_LOW = -5.9316577356278666;
@@ -116,10 +116,10 @@ double hrgtc_y_bias_dph(double f_hz, double df_hz_per_s)
     return INTERCEPT_DPH + sum;
 }
 
-/* ---- the thermometer, Eq. (18) of [1] (hrgtc.thermometry.Thermometer) ---- */
+/* ---- the thermometer, f(T) = T, the identity (hrgtc.thermometry.Thermometer) ---- */
 static const double TH_CENTRE_C = 16.354260892594269;
 static const double TH_SCALE_C = 6.2397428107255939;
-/* f(T) = sum_k TH_COEFFICIENTS[k] z^k, z = (T - TH_CENTRE_C) / TH_SCALE_C [Hz] */
+/* f(T) = sum_k TH_COEFFICIENTS[k] z^k, z = (T - TH_CENTRE_C) / TH_SCALE_C [degC] */
 static const double TH_COEFFICIENTS[2] = {
     16.354260892594269, 6.2397428107255939,
 };
