@@ -121,3 +121,18 @@ def test_a_jittery_clock_is_no_rate_change_and_a_real_change_is_told_in_digits_t
                   if p.kind == "sample_rate"]
     assert "changes to 1.01 Hz but the metadata (and the start of the file) say 1 Hz" in \
         problem.message or "changes to 1.012 Hz" in problem.message, problem.message
+
+
+def test_a_slow_logger_of_clock_times_is_not_told_its_time_is_in_milliseconds(tmp_path):
+    from hrgtc.recording import read
+
+    rng = np.random.default_rng(7)
+    seconds = np.cumsum(rng.uniform(9.0, 11.0, 400))  # a 0.1 Hz logger, jittery clock
+    stamps = np.datetime64("2024-05-01T10:00:00") + (seconds * 1e3).astype("timedelta64[ms]")
+    rows = [f"{s},{20 + 0.01 * k:.3f},{50 + 3 * rng.standard_normal():.4f}"
+            for k, s in enumerate(stamps.astype(str))]
+    path = tmp_path / "slow.csv"
+    path.write_text("clock,temp,gyro\n" + "\n".join(rows) + "\n")
+    recording = read(path, columns={"time_s": "clock", "temperature_c": "temp",
+                                    "rate_dph": "gyro"}, thermometer="sensor")
+    assert len(recording) == 400 and 0.09 < recording.sample_rate_hz < 0.11

@@ -404,7 +404,10 @@ class RecordingValidator:
         if "time_s" in sample and self.metadata is not None:
             self.measured_sample_rate_hz = measured_sample_rate(sample["time_s"])
             problem = _check_sample_rate(self.metadata.sample_rate_hz, self.measured_sample_rate_hz)
-            if problem is None and self.metadata.extra.get("sample_rate_inferred"):
+            # clock times carry their unit: a slow logger of clock times is just slow
+            clock = bool(self.metadata.extra.get("time_origin"))
+            if (problem is None and self.metadata.extra.get("sample_rate_inferred")
+                    and not clock):
                 problem = _check_time_unit(self.measured_sample_rate_hz, sample["time_s"])
             if problem:
                 problems.append(problem)
