@@ -76,7 +76,8 @@ def test_a_step_just_over_two_periods_is_a_gap():
     run = _recording(t)
     assert [len(s) for s in split_at_gaps(run)] == [100, 100]
     with pytest.raises(RecordingError, match=r"column 'time_s', row 100: 1 gap"):
-        validate(run, gaps="error")
+        validate(run, gaps="error", dropout_s=0.0)  # no dropout: the gap itself refused
+    assert validate(run, gaps="error").n_dropouts == 1  # 0.2 s: a dropout, bridged
 
 
 # -- duplicated column names -----------------------------------------------------------------

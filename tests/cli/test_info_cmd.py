@@ -124,7 +124,7 @@ def test_column_and_unit_options_map_a_foreign_file(tmp_path):
 def test_gap_option_and_bad_options(tmp_path):
     rec = recording()
     time = rec.time_s.copy()
-    time[700:] += 3.0
+    time[700:] += 30.0  # longer than a dropout (5 s)
     path = write(rec.with_columns(time_s=time), tmp_path / "gap.h5")
     code, data, _ = info_json(str(path))
     assert code == 2 and data["validation"]["problems"][0]["kind"] == "gap"

@@ -517,15 +517,15 @@ def fit(
                           max_steps=0, refine=EXTENDED_PRECISION)
         if select == "guarded":  # the F-test steps stay on record; the pruning is in `pruning`
             result = dataclasses.replace(result, history=history)
-    settled_extremes = None
     chosen_terms = [t for t in candidates if t.name in result.selected]
     if warmup_s is None and settings.warmup_s > 0 and not any(
             entry.rate_of for entry, _ in registry_entries(variables_for(chosen_terms))):
         # no rate term chosen: nothing waits for the df/dt filter to settle, so the run's
         # first warmup_s (at rest, and often its most extreme temperature) is trained on
         # too, and the compensation flags no settling (docs/real-loggers/corpus.md)
+        # (df/dt's range, kept for the warnings, then spans the filter's start too: the
+        # model's own file stays inside it)
         settings = FeatureSettings(**{**settings.to_dict(), "warmup_s": 0.0})
-        settled_extremes = windows.extremes
         windows = window_means(runs, settings, candidates, window_s, progress, thermometer,
                                tracked, keep=keep, gaps=gaps,
                                restart_each_segment=restart_each_segment)
@@ -555,10 +555,6 @@ def fit(
     # the extremes of the samples used (not of the window means, which are narrower):
     # the model's own training file is inside its ranges by construction
     ranges = {v: windows.extremes[v] for v in windows.variables}
-    if settled_extremes is not None:  # the rates' ranges of the settled filter only
-        rates = {e.name for e, _ in registry_entries(list(ranges)) if e.rate_of}
-        ranges.update({v: settled_extremes[v] for v in ranges
-                       if v in settled_extremes and v in rates})
     intercept, group_offsets = fit_offsets(groups, windows.bias_dph, x_full, names, selected,
                                            params, float(params[0]))
     return DriftModel(
