@@ -13,16 +13,19 @@ by ``tests/recording/test_spike_kernel.py``), without a numpy temporary per step
 - :func:`spike_mask`: the single-sample test of :func:`~hrgtc.recording.spikes.find_spikes`;
   :func:`across_mask`: the test of :func:`~hrgtc.recording.spikes.moving_across`.
 
-The medians are order statistics (``np.median`` in numba selects the same values as
-numpy's partition) and the mean of the two middle values of an even count is
-``(a + b) / 2``, as numpy computes it; they are taken of absolute values and positive
-steps, so no zero's sign can differ. ``fastmath`` is off: no product is fused into an add.
+The medians are order statistics (a selection in place, or the at-rest detector's
+bracketing median for the gap test, give the values numpy's partition gives) and the
+mean of the two middle values of an even count is ``(a + b) / 2``, as numpy computes
+it; they are taken of absolute values and positive steps, so no zero's sign can differ.
+``fastmath`` is off: no product is fused into an add.
 """
 
 from __future__ import annotations
 
 import numpy as np
 from numba import njit
+
+from hrgtc.recording._motion_kernel import median as _long_median
 
 _JIT = {"cache": True, "nogil": True, "fastmath": False}
 
@@ -52,7 +55,7 @@ def segment_stops(t: np.ndarray, gap_periods: float, tolerance: float) -> np.nda
         out = np.empty(1, dtype=np.int64)
         out[0] = n
         return out
-    limit = gap_periods * np.median(positive[:count]) * tolerance
+    limit = gap_periods * _long_median(positive[:count]) * tolerance
     stops = np.empty(n, dtype=np.int64)
     s = 0
     for i in range(n - 1):
@@ -64,8 +67,59 @@ def segment_stops(t: np.ndarray, gap_periods: float, tolerance: float) -> np.nda
 
 
 @njit(**_JIT)
-def _sigma_of(values: np.ndarray, mad_to_sigma: float, second_diff: float) -> float:
-    return mad_to_sigma * np.median(values) / second_diff
+def _select(a: np.ndarray, n: int, k: int) -> float:
+    """The k-th smallest of ``a[:n]`` (no NaN), ``a`` reordered in place so that every
+    value after index k is at least it (Hoare's partition, median-of-three pivot: a run of
+    equal values, as a quantised channel gives, splits in the middle)."""
+    lo = 0
+    hi = n - 1
+    while hi > lo:
+        mid = (lo + hi) >> 1
+        if a[mid] < a[lo]:
+            a[mid], a[lo] = a[lo], a[mid]
+        if a[hi] < a[lo]:
+            a[hi], a[lo] = a[lo], a[hi]
+        if a[hi] < a[mid]:
+            a[hi], a[mid] = a[mid], a[hi]
+        pivot = a[mid]
+        i = lo
+        j = hi
+        while i <= j:
+            while a[i] < pivot:
+                i += 1
+            while pivot < a[j]:
+                j -= 1
+            if i <= j:
+                a[i], a[j] = a[j], a[i]
+                i += 1
+                j -= 1
+        if k <= j:
+            hi = j
+        elif k >= i:
+            lo = i
+        else:
+            return a[k]
+    return a[k]
+
+
+@njit(**_JIT)
+def _median(a: np.ndarray, n: int) -> float:
+    """``np.median(a[:n])`` (no NaN; ``a`` reordered): the middle value, or the mean
+    ``(a + b) / 2`` of the two middle values of an even count, as numpy computes it."""
+    half = n >> 1
+    if n & 1:
+        return _select(a, n, half)
+    low = _select(a, n, half - 1)
+    high = a[half]
+    for i in range(half + 1, n):
+        if a[i] < high:
+            high = a[i]
+    return (low + high) / 2
+
+
+@njit(**_JIT)
+def _sigma_of(values: np.ndarray, n: int, mad_to_sigma: float, second_diff: float) -> float:
+    return mad_to_sigma * _median(values, n) / second_diff
 
 
 @njit(**_JIT)
@@ -90,13 +144,6 @@ def segment_limits(ts: np.ndarray, xs: np.ndarray, k: float, floor: float, windo
             origin = v
     if not any_finite:
         origin = 0.0
-    # |second| of the finite values; how many are finite in the segment and each window
-    magnitude = np.empty(n)
-    finite_count = 0
-    for i in range(n):
-        if np.isfinite(second[i]):
-            magnitude[finite_count] = abs(second[i])
-            finite_count += 1
     whole = -1.0  # the segment's σ, computed when a window needs it
     a = 0
     previous = np.floor((ts[0] - origin) / window_s)
@@ -115,11 +162,16 @@ def segment_limits(ts: np.ndarray, xs: np.ndarray, k: float, floor: float, windo
                 work[m] = abs(second[i])
                 m += 1
         if m >= min_window:
-            sigma = _sigma_of(work[:m], mad_to_sigma, second_diff)
+            sigma = _sigma_of(work, m, mad_to_sigma, second_diff)
         else:
-            if whole < 0.0:
-                whole = (_sigma_of(magnitude[:finite_count], mad_to_sigma, second_diff)
-                         if finite_count else 0.0)
+            if whole < 0.0:  # |second| of the segment's finite values
+                whole_work = np.empty(n)
+                count = 0
+                for i in range(n):
+                    if np.isfinite(second[i]):
+                        whole_work[count] = abs(second[i])
+                        count += 1
+                whole = _sigma_of(whole_work, count, mad_to_sigma, second_diff) if count else 0.0
             sigma = whole
         value = k * sigma
         if value != value or floor != floor:  # np.maximum: NaN if either is NaN
