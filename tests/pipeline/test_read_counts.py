@@ -123,7 +123,8 @@ def test_calibrate_reads_each_file_once_for_every_axis(campaign):
     ReadOnce`), with --cross-axis too; before: 5-6 passes per axis of each file (15-18 for
     three axes, 33-39 with --cross-axis). A single-axis calibration still streams each
     file several times (plateaus, at-rest pass, window means, held-out evaluation),
-    holding none of them whole."""
+    holding none of them whole; the housing baseline takes the drift fit's at-rest pass
+    (issue 27: one pass fewer of each training file than the 5 and 6 before)."""
     args = ["calibrate", "--soak", *campaign["soaks"], "--drift", campaign["cool"],
             "--validate", campaign["warm"], "-o", campaign["model"].with_name("m.json"),
             "--force"]
@@ -135,7 +136,7 @@ def test_calibrate_reads_each_file_once_for_every_axis(campaign):
         counts = _counts([*args, "--cross-axis"])
         assert [counts.of(f)[1] for f in files] == [1, 1, 1]
     else:
-        assert passes == [5, 6, 2]
+        assert passes == [4, 5, 2]
 
 
 def test_reading_once_gives_the_same_instrument_model(campaign, monkeypatch):
