@@ -19,7 +19,11 @@ process's own (``wait4``).
   default options and with ``--motion keep`` against ``bench/plain_compensate.py``, a
   pyarrow streaming script (goal <= 1).
 
-``--quick``: small sizes, 3 repeats.
+``--quick``: small sizes, 3 repeats. With ``HRGTC_BENCH_BEFORE=/path/to/src`` (the ``src``
+folder of an earlier checkout, e.g. ``git archive COMMIT src | tar -x -C /tmp/before``)
+every hrgtc command is also run from that tree in the same alternation, and each line
+gains ``before_seconds`` and ``before_ratio`` (and ``before_motion_keep_*``): before and
+after against the same reference in the same run.
 """
 
 from __future__ import annotations
@@ -36,6 +40,15 @@ from pathlib import Path
 BENCH_DIR = Path(__file__).resolve().parent
 PYTHON = sys.executable
 HRGTC = str(Path(sys.executable).with_name("hrgtc"))
+BEFORE = os.environ.get("HRGTC_BENCH_BEFORE")
+
+
+def before(argv: list[str]) -> list[str]:
+    """``argv`` run on the hrgtc of :data:`BEFORE` (its ``src`` first on the path)."""
+    if argv[0] == HRGTC:
+        argv = [PYTHON, "-c", "import sys; sys.argv[0] = 'hrgtc'; from hrgtc.cli import main; "
+                "sys.exit(main())", *argv[1:]]
+    return ["env", f"PYTHONPATH={BEFORE}", *argv]
 
 
 def _run(argv: list[str]) -> tuple[float, float]:
@@ -53,10 +66,26 @@ def _run(argv: list[str]) -> tuple[float, float]:
     return seconds, round(usage.ru_maxrss / 1024.0, 1)
 
 
+def _label(argv: list[str]) -> str:
+    """A command's short name: its program and first words (a ``-c`` script by its
+    first import)."""
+    words = []
+    for arg in argv[:4]:
+        if "\n" in arg:
+            arg = next((line for line in arg.splitlines() if "allan" in line), "<script>")
+            arg = f"<{arg.strip()}>"
+        words.append(Path(arg).name if arg in (PYTHON, HRGTC) or arg.endswith(".py") else arg)
+    return " ".join(words)
+
+
 def compare(name: str, ours: list[str], theirs: list[str], repeats: int,
             more: dict[str, list[str]] | None = None, **extra: object) -> dict:
     """Alternate ``ours`` and ``theirs`` (and each of ``more``) ``repeats`` times."""
-    commands = {"ours": ours, "theirs": theirs, **(more or {})}
+    more = dict(more or {})
+    if BEFORE:
+        more.update({f"before_{k}" if k else "before": before(argv)
+                     for k, argv in (("", ours), *more.items())})
+    commands = {"ours": ours, "theirs": theirs, **more}
     runs: dict[str, list[tuple[float, float]]] = {key: [] for key in commands}
     for argv in commands.values():  # one untimed run each: page cache and compiled
         _run(argv)  # kernels, as a user's second call finds them
@@ -75,9 +104,8 @@ def compare(name: str, ours: list[str], theirs: list[str], repeats: int,
             "ratio_each_pair": [round(r, 3) for r in pairs],
             "peak_rss_mb": max(m for _, m in runs["ours"]),
             "reference_peak_rss_mb": max(m for _, m in runs["theirs"]),
-            "command": " ".join(Path(a).name if a in (PYTHON, HRGTC) else a for a in ours[:2]),
-            "reference": " ".join(Path(a).name if a == PYTHON else a for a in theirs[:3])}
-    for key in more or {}:
+            "command": _label(ours), "reference": _label(theirs)}
+    for key in more:
         key_pairs = [a / b for a, b in zip(seconds[key], seconds["theirs"], strict=True)]
         line[f"{key}_seconds"] = round(median[key], 3)
         line[f"{key}_ratio"] = round(statistics.median(key_pairs), 3)
