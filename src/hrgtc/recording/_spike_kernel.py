@@ -117,22 +117,110 @@ def _median(a: np.ndarray, n: int) -> float:
     return (low + high) / 2
 
 
-@njit(**_JIT)
-def _sigma_of(values: np.ndarray, n: int, mad_to_sigma: float, second_diff: float) -> float:
-    return mad_to_sigma * _median(values, n) / second_diff
+#: Values of a window sampled to bracket its middle ranks, and the bracket's margin in
+#: sample ranks (about 2.5 standard errors of a sample quantile).
+_SAMPLE = 64
+_MARGIN = 10
 
 
 @njit(**_JIT)
-def segment_limits(ts: np.ndarray, xs: np.ndarray, k: float, floor: float, window_s: float,
-                   min_window: int, mad_to_sigma: float, second_diff: float,
-                   second: np.ndarray, limit: np.ndarray) -> None:
-    """Fill ``second`` (the second differences) and ``limit`` (the threshold of each
-    sample) of one segment of at least 3 samples."""
+def _bracketed_median(a: np.ndarray, n: int, between: np.ndarray) -> float:
+    """``np.median(a[:n])`` (no NaN; ``a`` reordered), mostly without branches: a sorted
+    sample of about 64 values brackets the middle ranks, one pass counts what lies below
+    the bracket and keeps what lies inside it (in ``between``), and the middle values are
+    selected among those (among all of them if the bracket missed). A selection on
+    random values mispredicts a branch at every other comparison; the pass does not."""
+    if n <= 4 * _SAMPLE:
+        return _median(a, n)
+    sample = np.sort(a[:n:n // _SAMPLE])
+    size = sample.size
+    k_lo = (n - 1) // 2
+    k_hi = n // 2
+    lo = sample[max(k_lo * size // n - _MARGIN, 0)]
+    hi = sample[min(k_hi * size // n + _MARGIN, size - 1)]
+    below = 0
+    equal_lo = 0
+    equal_hi = 0
+    kept = 0
+    for i in range(n):
+        v = a[i]
+        below += v < lo
+        equal_lo += v == lo
+        equal_hi += (v == hi) & (hi != lo)
+        between[kept] = v
+        kept += (lo < v) & (v < hi)
+    r_lo = k_lo - below
+    r_hi = k_hi - below
+    if r_lo < 0 or r_hi >= equal_lo + kept + equal_hi:
+        return _median(a, n)
+    picked = np.empty(2)
+    for j in range(2):
+        r = r_lo if j == 0 else r_hi
+        if r < equal_lo:
+            picked[j] = lo
+        elif r < equal_lo + kept:
+            picked[j] = _select(between, kept, r - equal_lo)
+        else:
+            picked[j] = hi
+    if k_lo == k_hi:
+        return picked[0]
+    return (picked[0] + picked[1]) / 2
+
+
+@njit(**_JIT)
+def _sigma_of(values: np.ndarray, n: int, mad_to_sigma: float, second_diff: float,
+              between: np.ndarray) -> float:
+    return mad_to_sigma * _bracketed_median(values, n, between) / second_diff
+
+
+#: What :func:`segment_tests` tests: single-sample spikes, or motion across a sample.
+SPIKE = 0
+ACROSS = 1
+
+
+@njit(inline="always", **_JIT)
+def _second(xs: np.ndarray, i: int, n: int) -> float:
+    """``x[i] − (x[i−1] + x[i+1]) / 2``; at a segment's edges, that of the next sample in."""
+    j = min(max(i, 1), n - 2)
+    return xs[j] - 0.5 * (xs[j - 1] + xs[j + 1])
+
+
+@njit(inline="always", **_JIT)
+def _test(xs: np.ndarray, i: int, n: int, q: float, mode: int) -> bool:
+    """The test ``mode`` of sample i of a segment of n >= 3 samples, threshold q."""
+    if mode == SPIKE:
+        if i == 0:  # away from both of the next two samples, which agree
+            return ((abs(xs[1] - xs[0]) > q) & (abs(xs[0] - xs[2]) > q)
+                    & (abs(xs[2] - xs[1]) <= q))
+        if i == n - 1:
+            return ((abs(xs[n - 1] - xs[n - 2]) > q) & (abs(xs[n - 1] - xs[n - 3]) > q)
+                    & (abs(xs[n - 2] - xs[n - 3]) <= q))
+        return ((abs(xs[i] - xs[i - 1]) > q) & (abs(xs[i + 1] - xs[i]) > q)
+                & (abs(_second(xs, i, n)) > q) & (abs(xs[i + 1] - xs[i - 1]) <= q))
+    if i == 0 or i == n - 1:
+        return 0.0 > q  # the edges: never for a threshold >= 0
+    across = abs(xs[i + 1] - xs[i - 1])
+    if n >= 5 and 2 <= i < n - 2:
+        wide = abs(xs[i + 2] - xs[i - 2])
+        if across != across or wide != wide:  # np.maximum: NaN if either is NaN
+            across = np.nan
+        elif wide > across:
+            across = wide
+    return across > q
+
+
+@njit(**_JIT)
+def segment_tests(ts: np.ndarray, xs: np.ndarray, k: float, floor: float, window_s: float,
+                  min_window: int, mad_to_sigma: float, second_diff: float, mode: int,
+                  out: np.ndarray) -> None:
+    """The test ``mode`` of every sample of one segment of at least 3 samples, into ``out``.
+
+    Window by window: the window's σ_MAD from its absolute finite second differences (the
+    segment's when it has fewer than ``min_window``), the threshold
+    ``max(k·σ_MAD, floor)``, then the test of each of its samples; no array as long as
+    the segment is filled (a fresh array costs its page faults).
+    """
     n = xs.size
-    for i in range(1, n - 1):
-        second[i] = xs[i] - 0.5 * (xs[i - 1] + xs[i + 1])
-    second[0] = second[1]
-    second[n - 1] = second[n - 2]
     # the window origin: the smallest time that is not NaN (0 without a finite one)
     any_finite = False
     origin = np.inf
@@ -147,7 +235,8 @@ def segment_limits(ts: np.ndarray, xs: np.ndarray, k: float, floor: float, windo
     whole = -1.0  # the segment's σ, computed when a window needs it
     a = 0
     previous = np.floor((ts[0] - origin) / window_s)
-    work = np.empty(n)
+    work = np.empty(n)  # only a window's length is touched, unless the segment's σ is needed
+    between = np.empty(n)
     for b in range(1, n + 1):
         if b < n:
             block = np.floor((ts[b] - origin) / window_s)
@@ -158,20 +247,20 @@ def segment_limits(ts: np.ndarray, xs: np.ndarray, k: float, floor: float, windo
         # the window a:b
         m = 0
         for i in range(a, b):
-            if np.isfinite(second[i]):
-                work[m] = abs(second[i])
-                m += 1
+            second = _second(xs, i, n)
+            work[m] = abs(second)
+            m += np.isfinite(second)
         if m >= min_window:
-            sigma = _sigma_of(work, m, mad_to_sigma, second_diff)
+            sigma = _sigma_of(work, m, mad_to_sigma, second_diff, between)
         else:
             if whole < 0.0:  # |second| of the segment's finite values
-                whole_work = np.empty(n)
                 count = 0
                 for i in range(n):
-                    if np.isfinite(second[i]):
-                        whole_work[count] = abs(second[i])
-                        count += 1
-                whole = _sigma_of(whole_work, count, mad_to_sigma, second_diff) if count else 0.0
+                    second = _second(xs, i, n)
+                    work[count] = abs(second)
+                    count += np.isfinite(second)
+                whole = (_sigma_of(work, count, mad_to_sigma, second_diff, between)
+                         if count else 0.0)
             sigma = whole
         value = k * sigma
         if value != value or floor != floor:  # np.maximum: NaN if either is NaN
@@ -179,8 +268,22 @@ def segment_limits(ts: np.ndarray, xs: np.ndarray, k: float, floor: float, windo
         else:
             threshold = value if value >= floor else floor
         for i in range(a, b):
-            limit[i] = threshold
+            out[i] = _test(xs, i, n, threshold, mode)
         a = b
+
+
+@njit(**_JIT)
+def _channel_test(t: np.ndarray, x: np.ndarray, k: float, floor: float, window_s: float,
+                  gap_periods: float, tolerance: float, min_window: int, mad_to_sigma: float,
+                  second_diff: float, mode: int) -> np.ndarray:
+    out = np.zeros(x.size, dtype=np.bool_)
+    start = 0
+    for stop in segment_stops(t, gap_periods, tolerance):
+        if stop - start >= 3:
+            segment_tests(t[start:stop], x[start:stop], k, floor, window_s, min_window,
+                          mad_to_sigma, second_diff, mode, out[start:stop])
+        start = stop
+    return out
 
 
 @njit(**_JIT)
@@ -188,36 +291,8 @@ def spike_mask(t: np.ndarray, x: np.ndarray, k: float, floor: float, window_s: f
                gap_periods: float, tolerance: float, min_window: int, mad_to_sigma: float,
                second_diff: float) -> np.ndarray:
     """:func:`hrgtc.recording.spikes.find_spikes` of one channel, given its LSB floor."""
-    n = x.size
-    spikes = np.zeros(n, dtype=np.bool_)
-    stops = segment_stops(t, gap_periods, tolerance)
-    second = np.empty(n)
-    limit = np.empty(n)
-    start = 0
-    for stop in stops:
-        size = stop - start
-        if size >= 3:
-            xs = x[start:stop]
-            sc = second[start:stop]
-            lim = limit[start:stop]
-            segment_limits(t[start:stop], xs, k, floor, window_s, min_window, mad_to_sigma,
-                           second_diff, sc, lim)
-            for i in range(1, size - 1):
-                left = abs(xs[i] - xs[i - 1])
-                right = abs(xs[i + 1] - xs[i])
-                across = abs(xs[i + 1] - xs[i - 1])
-                q = lim[i]
-                spikes[start + i] = ((left > q) & (right > q) & (abs(sc[i]) > q)
-                                     & (across <= q))
-            q = lim[0]
-            spikes[start] = ((abs(xs[1] - xs[0]) > q) & (abs(xs[0] - xs[2]) > q)
-                             & (abs(xs[2] - xs[1]) <= q))
-            q = lim[size - 1]
-            spikes[stop - 1] = ((abs(xs[size - 1] - xs[size - 2]) > q)
-                                & (abs(xs[size - 1] - xs[size - 3]) > q)
-                                & (abs(xs[size - 2] - xs[size - 3]) <= q))
-        start = stop
-    return spikes
+    return _channel_test(t, x, k, floor, window_s, gap_periods, tolerance, min_window,
+                         mad_to_sigma, second_diff, SPIKE)
 
 
 @njit(**_JIT)
@@ -225,31 +300,5 @@ def across_mask(t: np.ndarray, x: np.ndarray, k: float, floor: float, window_s: 
                 gap_periods: float, tolerance: float, min_window: int, mad_to_sigma: float,
                 second_diff: float) -> np.ndarray:
     """:func:`hrgtc.recording.spikes.moving_across` of one channel, given its LSB floor."""
-    n = x.size
-    moving = np.zeros(n, dtype=np.bool_)
-    stops = segment_stops(t, gap_periods, tolerance)
-    second = np.empty(n)
-    limit = np.empty(n)
-    start = 0
-    for stop in stops:
-        size = stop - start
-        if size >= 3:
-            xs = x[start:stop]
-            lim = limit[start:stop]
-            segment_limits(t[start:stop], xs, k, floor, window_s, min_window, mad_to_sigma,
-                           second_diff, second[start:stop], lim)
-            for i in range(1, size - 1):
-                across = abs(xs[i + 1] - xs[i - 1])
-                if size >= 5 and 2 <= i < size - 2:
-                    wide = abs(xs[i + 2] - xs[i - 2])
-                    # np.maximum: NaN if either is NaN
-                    if across != across or wide != wide:
-                        across = np.nan
-                    elif wide > across:
-                        across = wide
-                moving[start + i] = across > lim[i]
-            # the edges: 0 > limit is never True for a limit >= 0
-            moving[start] = 0.0 > lim[0]
-            moving[stop - 1] = 0.0 > lim[size - 1]
-        start = stop
-    return moving
+    return _channel_test(t, x, k, floor, window_s, gap_periods, tolerance, min_window,
+                         mad_to_sigma, second_diff, ACROSS)
