@@ -8,7 +8,8 @@
 * file to file: ``compensate_file`` (validation, atomic write, fsync) against
   :func:`plain_script`, a plain pyarrow + numpy script that reads the same
   columns with ``ParquetFile.iter_batches``, computes the same outputs with the
-  same kernel and writes them with ``ParquetWriter`` (ratio target <= 1), each in
+  same kernel and writes them with ``ParquetWriter`` (``bench/plain_compensate.py``;
+  ratio target <= 1), each in
   a fresh process, alternated, the median of the pairs. The script leaves its
   output in the page cache, while ``compensate_file`` validates every sample,
   writes page checksums and waits for its fsync before the atomic rename; so the
@@ -34,6 +35,7 @@ import time
 from pathlib import Path
 
 from _child import measure
+from plain_compensate import plain_script
 
 SETPOINTS_C = (-20.0, -10.0, 0.0, 10.0, 20.0, 30.0, 40.0)
 FILE_PAIRS = 7
@@ -52,48 +54,6 @@ def _model(folder: Path, sample_rate_hz: float):
                           sample_rate_hz=sample_rate_hz, seed=2)
     return calibrate([w.path for w in soaks], [cool[0].path],
                      settings=CalibrationSettings(drift_from_soaks=False)).model
-
-
-def plain_script(model_path: str, source: str, output: str, rows: int = 1 << 20) -> int:
-    """The baseline: read, compensate with the fused kernel, write; no validation, no fsync.
-
-    Written as a user would with pyarrow and numpy, with pyarrow's fastest writer
-    options for float columns (uncompressed, no dictionary: less work per row than
-    hrgtc's byte-stream split, LZ4 and page checksums, for a file 1.6x larger; pyarrow's
-    defaults, snappy and dictionary, cost 2.7x more), so it is the strictest baseline.
-    """
-    import numpy as np
-    import pyarrow as pa
-    import pyarrow.parquet as pq
-
-    from hrgtc.compensate import OUTPUT_COLUMNS
-    from hrgtc.compensate import _kernel as kernel
-    from hrgtc.model import load_model
-
-    model = load_model(model_path)
-    variables = tuple(dict.fromkeys(("f", "df", *model.drift.variables)))
-    plan = kernel.plan(model.drift, model.thermometer, variables)
-    state, counts = kernel.new_state(), np.zeros(4, dtype=np.int64)
-    extremes = kernel.new_extremes()
-    writer = None
-    done = 0
-    for batch in pq.ParquetFile(source).iter_batches(batch_size=rows):
-        out = {name: np.empty(batch.num_rows) for name in OUTPUT_COLUMNS}
-        housing = batch.column("housing_c").to_numpy() if plan.needs_housing else None
-        kernel.run(plan, state, batch.column("time_s").to_numpy(),
-                   batch.column("freq_hz").to_numpy(),
-                   batch.column("rate_dph").to_numpy(), housing, out, counts, extremes)
-        table = pa.Table.from_batches([batch])
-        for name in OUTPUT_COLUMNS:
-            table = table.append_column(name, pa.array(out[name]))
-        if writer is None:
-            writer = pq.ParquetWriter(output, table.schema, compression="none",
-                                      use_dictionary=False)
-        writer.write_table(table)
-        done += batch.num_rows
-    if writer is not None:
-        writer.close()
-    return done
 
 
 def _warm(model_path: str) -> None:

@@ -20,14 +20,23 @@ import the stage you need, e.g. ``from hrgtc.pipeline.calibration import calibra
 from __future__ import annotations
 
 import os
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
-from hrgtc.core.meta import PAPER_REFERENCE, __version__
+from hrgtc.core.meta import PAPER_REFERENCE
 
 if TYPE_CHECKING:
     from hrgtc.model import UnitModel
 
 __all__ = ["PAPER_REFERENCE", "__version__", "load_model"]
+
+
+def __getattr__(name: str) -> Any:
+    """``hrgtc.__version__``, looked up on first use (:mod:`hrgtc.core.meta`)."""
+    if name != "__version__":
+        raise AttributeError(f"module 'hrgtc' has no attribute {name!r}")
+    from hrgtc.core import meta
+
+    return meta.__version__
 
 
 def load_model(path: str | os.PathLike[str]) -> UnitModel:

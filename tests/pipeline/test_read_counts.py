@@ -124,7 +124,8 @@ def test_calibrate_reads_each_file_once_for_every_axis(campaign):
     ReadOnce`), with --cross-axis too; before: 5-6 passes per axis of each file (15-18 for
     three axes, 33-39 with --cross-axis). A single-axis calibration still streams each
     file several times (plateaus, at-rest pass, window means, held-out evaluation),
-    holding none of them whole."""
+    holding none of them whole; the housing baseline takes the drift fit's at-rest pass
+    (issue 27: one pass fewer of each training file than the 5 and 6 before)."""
     args = ["calibrate", "--soak", *campaign["soaks"], "--drift", campaign["cool"],
             "--validate", campaign["warm"], "-o", campaign["model"].with_name("m.json"),
             "--force"]
@@ -140,7 +141,7 @@ def test_calibrate_reads_each_file_once_for_every_axis(campaign):
         model = json.loads(campaign["model"].with_name("m.json").read_text())
         terms = model["drift"]["selected"]
         rate_free = not any("df" in t or "d2" in t or "dh" in t for t in terms)
-        assert passes == ([7, 8, 2] if rate_free else [5, 6, 2])
+        assert passes == ([6, 7, 2] if rate_free else [4, 5, 2])
 
 
 def test_reading_once_gives_the_same_instrument_model(campaign, monkeypatch):

@@ -13,21 +13,16 @@ import sys
 import warnings
 from collections.abc import Iterator
 from contextlib import contextmanager
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import typer
-from rich.console import Console
-from rich.progress import (
-    BarColumn,
-    MofNCompleteColumn,
-    Progress,
-    TextColumn,
-    TimeElapsedColumn,
-    TimeRemainingColumn,
-)
 
 from hrgtc.core.errors import HrgtcError
-from hrgtc.core.progress import Progress as ProgressCallback
+
+if TYPE_CHECKING:
+    from rich.console import Console
+
+    from hrgtc.core.progress import Progress as ProgressCallback
 
 app = typer.Typer(
     name="hrgtc",
@@ -40,8 +35,51 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
 )
 
-console = Console(highlight=False)
-error_console = Console(stderr=True, highlight=False, soft_wrap=True)
+
+
+class LazyConsole:
+    """A rich ``Console`` made on first use, every attribute its console's.
+
+    rich's import is a sixth of ``hrgtc --help``'s start, which prints no rich output
+    (the help is plain text); a command's first print makes the console, as the module
+    did at import before. Pass :meth:`real` where rich itself needs a ``Console``.
+    """
+
+    def __init__(self, **options: Any) -> None:
+        object.__setattr__(self, "_options", options)
+        object.__setattr__(self, "_console", None)
+        object.__setattr__(self, "_replaced", {})
+
+    def real(self) -> Console:
+        """The console itself (made now if not yet)."""
+        made = object.__getattribute__(self, "_console")
+        if made is None:
+            from rich.console import Console
+
+            made = Console(**object.__getattribute__(self, "_options"))
+            object.__setattr__(self, "_console", made)
+        return made
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.real(), name)
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        console = self.real()
+        object.__getattribute__(self, "_replaced").setdefault(name, getattr(console, name))
+        setattr(console, name, value)
+
+    def __delattr__(self, name: str) -> None:
+        """Give back the value ``name`` had before it was first set (as pytest's
+        ``monkeypatch`` undoes an attribute that is not in the instance's ``__dict__``)."""
+        replaced = object.__getattribute__(self, "_replaced")
+        if name not in replaced:
+            raise AttributeError(f"{name!r} was never set on the console")
+        setattr(self.real(), name, replaced.pop(name))
+
+
+console: Console = LazyConsole(highlight=False)  # type: ignore[assignment]
+error_console: Console = LazyConsole(  # type: ignore[assignment]
+    stderr=True, highlight=False, soft_wrap=True)
 
 
 def print_json(data: Any) -> None:
@@ -129,13 +167,22 @@ def progress_bar(
     if not enabled:
         yield lambda done, total: None
         return
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
+
     progress = Progress(
         TextColumn("{task.description}"),
         BarColumn(),
         MofNCompleteColumn(),
         TimeElapsedColumn(),
         TimeRemainingColumn(),
-        console=error_console,
+        console=getattr(error_console, "real", lambda: error_console)(),
         transient=True,
     )
     with progress:

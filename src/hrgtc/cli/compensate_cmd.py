@@ -6,7 +6,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import typer
-from rich.table import Table
 
 from hrgtc.cli._app import (
     app,
@@ -220,6 +219,7 @@ def render_instrument_evaluation(result: InstrumentEvaluation, json_output: bool
 
 def render_scale_checks(checks: tuple) -> None:
     """Scale-factor error at each temperature of a rate-table run, raw → compensated."""
+    from rich.table import Table  # imported by the command, not by --help
     table = Table(title="Scale-factor error (ppm) at each temperature of the rate table "
                   "(slope of rate − Ω against Ω, IEEE Std 1431), raw → compensated")
     for column in ("axis", "frequency (Hz)", "holds", "raw", "compensated"):
@@ -233,6 +233,7 @@ def render_scale_checks(checks: tuple) -> None:
 
 def render_axis_summary(unit: str, result: InstrumentEvaluation) -> None:
     """The instrument's summary table: one row per axis."""
+    from rich.table import Table  # imported by the command, not by --help
     table = Table(title=f"{unit}: 10 s bias stability per axis (°/h)")
     for column in ("axis", "raw", "compensated", "improvement", "comp. mean", "comp. RMS",
                    "beyond T", "beyond df/dt"):

@@ -5,7 +5,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import typer
-from rich.table import Table
 
 from hrgtc.cli._app import app, console, error_console, library_errors, print_json
 from hrgtc.cli.calibrate_cmd import render, render_instrument
@@ -62,6 +61,7 @@ def demo_command(
     render(result.calibration)
     render_evaluation(result.training)
     render_evaluation(result.validation)
+    from rich.table import Table  # imported by the command, not by --help
     table = Table(title="10 s bias stability, raw → compensated (°/h)")
     for column in ("run", "raw", "compensated", "improvement"):
         table.add_column(column, justify="right")

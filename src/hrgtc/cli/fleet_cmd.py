@@ -12,7 +12,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
 import typer
-from rich.table import Table
 
 from hrgtc.cli._app import app, console, error_console, library_errors, print_json, progress_bar
 from hrgtc.cli.options import ForceOption, JsonOption, reading_options
@@ -61,6 +60,7 @@ def _finish(run: FleetRun, json_output: bool, written: str) -> None:
                                "seconds": o.seconds} for o in run.outcomes]})
     else:
         if run.failed:
+            from rich.table import Table  # imported by the command, not by --help
             table = Table(title="Failed units")
             for column in ("unit", "error", "file", "column", "row", "message"):
                 table.add_column(column)

@@ -8,7 +8,6 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.table import Table
 
 from hrgtc.cli._app import app, console, library_errors, print_json, progress_bar
 from hrgtc.cli.options import ForceOption, JsonOption, OutputFormat
@@ -105,6 +104,7 @@ def simulate_command(
             if json_output:
                 print_json([w.to_dict() for w in logged])
                 return
+            from rich.table import Table  # imported by the command, not by --help
             table = Table(title=f"simulated {unit} through a {logger} logger, "
                           f"{spec.sample_rate_hz:g} Hz, seed {seed}")
             for column in ("file", "rows", "truth"):
@@ -134,6 +134,7 @@ def simulate_command(
     if json_output:
         print_json([w.to_dict() for w in written])
         return
+    from rich.table import Table  # imported by the command, not by --help
     table = Table(title=f"simulated {unit}, {sample_rate_hz:g} Hz, seed {seed}")
     for column in ("file", "rows", "profile"):
         table.add_column(column, justify="right" if column == "rows" else "left")

@@ -11,11 +11,9 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from rich.table import Table
-from rich.text import Text
-
 if TYPE_CHECKING:
     from rich.console import Console
+    from rich.table import Table
 
     from hrgtc.core.summary import Summary
 
@@ -27,6 +25,9 @@ COLUMNS = ("figure", "value", "unit", "interval")
 def summary_tables(summary: Summary) -> list[Table]:
     """One table per section of ``summary``, titled by its heading, a row per figure (a
     section of table cells: its columns and rows, :meth:`Summary.grid`)."""
+    from rich.table import Table  # rich is imported by a command, not by --help
+    from rich.text import Text
+
     tables = []
     for heading, figures in summary.sections:
         if not figures:

@@ -4,12 +4,23 @@ Imports nothing of hrgtc, so any module may take ``__version__`` from here
 without importing the package's stages.
 """
 
-from importlib.metadata import PackageNotFoundError, version
+from typing import Any
 
-try:
-    __version__ = version("hrgtc")
-except PackageNotFoundError:  # pragma: no cover - running from a source tree
-    __version__ = "0.0.0"
+
+def __getattr__(name: str) -> Any:
+    """``__version__`` from the installed package's metadata, looked up on first use:
+    ``importlib.metadata`` costs a third of ``hrgtc --help``'s start (PEP 562)."""
+    if name != "__version__":
+        raise AttributeError(f"module 'hrgtc.core.meta' has no attribute {name!r}")
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        value = version("hrgtc")
+    except PackageNotFoundError:  # pragma: no cover - running from a source tree
+        value = "0.0.0"
+    globals()["__version__"] = value
+    return value
+
 
 PAPER_REFERENCE = (
     "X. Wang, W. Wu, Z. Fang, B. Luo, Y. Li, Q. Jiang, 'Temperature Drift Compensation for "

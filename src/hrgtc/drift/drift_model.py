@@ -322,6 +322,7 @@ def fit(
     offsets: str = _DRIFT.offsets,
     gaps: str = "bridge",
     restart_each_segment: bool = False,
+    rest_cache: dict[tuple[int, str, Any, float], Any] | None = None,
 ) -> DriftModel:
     """Fit the drift model of Eq. (21)-(22) of [1] by stepwise regression on window means.
 
@@ -399,6 +400,10 @@ def fit(
         filter after every gap, ``"bridge"`` (default) carries it across; windows never
         span a gap; the warm-up counts from the run's start (from every segment's with
         ``restart_each_segment``).
+    rest_cache
+        A dict shared by fits on the same ``runs`` (the drift model and the housing
+        baseline): each run's pass of the at-rest detector is kept there, by run, policy,
+        settings and warm-up, and a later fit takes it instead of reading the run again.
 
     Returns
     -------
@@ -428,7 +433,15 @@ def fit(
     taus = [derived[e.rate_of[1]] for e, _ in used if e.rate_of and e.rate_of[1] in derived]
     warmup = WARMUP_FACTOR * max([rate_tau_s, *taus]) if warmup_s is None else warmup_s
     check_policy(motion)
-    rests = [run_rest(_iter_run(run), motion, motion_settings, warmup) for run in runs]
+    rests = []
+    for number, run in enumerate(runs):
+        key = (number, motion, motion_settings, float(warmup))
+        if rest_cache is not None and key in rest_cache:
+            rests.append(rest_cache[key])
+            continue
+        rests.append(run_rest(_iter_run(run), motion, motion_settings, warmup))
+        if rest_cache is not None:
+            rest_cache[key] = rests[-1]
     keep = None if motion == "keep" else [r.keep for r in rests]
     reference_freq, reference_c = reference_point(rests, thermometer, reference_c, warmup)
     settings = FeatureSettings(

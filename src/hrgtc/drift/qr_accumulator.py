@@ -33,8 +33,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy import stats
-from scipy.linalg import lapack
 
 from hrgtc.core import records
 from hrgtc.core.errors import InputError, RankDeficientError
@@ -189,6 +187,8 @@ class QRAccumulator:
         place, and ``dtpqrt`` replaces R by the R of [R; block]. Starting from
         R = 0 gives the R of the first block.
         """
+        from scipy.linalg import lapack  # imported on first use: a faster start
+
         assert self.shift_ is not None and self.scale_ is not None
         rows, p = X.shape
         inverse = 1.0 / self.scale_  # powers of two: exact
@@ -525,6 +525,8 @@ def _solve(acc: QRAccumulator, idx: list[int], names: tuple[str, ...], tol: floa
                 f"columns {involved} are collinear: condition number of their centred, "
                 f"equilibrated triangular factor {cond:.3g} exceeds {1 / tol:.3g}; drop one "
                 "of them or combine them")
+    from scipy.linalg import lapack  # imported on first use: a faster start
+
     tri_inv, info = lapack.dtrtri(rs[:k + 1, :k + 1])  # small: LAPACK directly, no BLAS threads
     if info != 0:
         raise RankDeficientError(f"the triangular factor of columns {[names[j] for j in idx]} "
@@ -543,6 +545,8 @@ def _solve(acc: QRAccumulator, idx: list[int], names: tuple[str, ...], tol: floa
     params = np.concatenate([[intercept], slopes])
     with np.errstate(divide="ignore", invalid="ignore"):
         tvalues = params / bse
+    from scipy import stats  # imported on first use: a faster start
+
     pvalues = 2.0 * stats.t.sf(np.abs(tvalues), df)
     return OLSResult(names=("const", *(names[j] for j in idx)), params=_readonly(params),
                      bse=_readonly(bse), tvalues=_readonly(tvalues), pvalues=_readonly(pvalues),

@@ -30,8 +30,6 @@ from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
-from scipy import stats
-from scipy.linalg import solve_triangular
 
 from hrgtc.core.errors import InputError, PrecisionWarning
 from hrgtc.drift.qr_accumulator import (
@@ -195,6 +193,8 @@ def refine(result: OLSResult, X: Any, y: Any, weights: Any = None, *,
                          f"columns but X has {X.shape[0]} rows and {k}; pass the "
                          "accumulator of these rows and columns")
     assert factor.shift_ is not None and factor.scale_ is not None and factor.r_ is not None
+    from scipy.linalg import solve_triangular  # imported on first use: a faster start
+
     from hrgtc.drift._extended_kernel import add_to, residual_pass
 
     shift, scale = factor.shift_, factor.scale_
@@ -272,6 +272,8 @@ def refine(result: OLSResult, X: Any, y: Any, weights: Any = None, *,
     params = np.concatenate([[intercept], slopes]).astype(np.float64)
     with np.errstate(divide="ignore", invalid="ignore"):
         tvalues = params / result.bse
+    from scipy import stats  # imported on first use: a faster start
+
     pvalues = 2.0 * stats.t.sf(np.abs(tvalues), result.df_resid)
     return dataclasses.replace(result, params=_readonly(params), tvalues=_readonly(tvalues),
                                pvalues=_readonly(pvalues))

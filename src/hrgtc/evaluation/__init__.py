@@ -9,18 +9,35 @@ merit themselves.
 [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
 """
 
-from hrgtc.evaluation.allan import AllanResult, allan_deviation
-from hrgtc.evaluation.evaluation_result import Evaluation
-from hrgtc.evaluation.metrics import (
-    DEFAULT_TAUS_S,
-    ResidualResult,
-    bias_stability,
-    bias_stability_table,
-    residual_against_truth,
-)
-from hrgtc.evaluation.noise import NoiseTerms, noise_terms
-from hrgtc.evaluation.plot_blocks import BlockMeans, block_rows
-from hrgtc.evaluation.run_pass import evaluate, run_pass
+import importlib
+from typing import Any
+
+#: Public name -> the module of this package that defines it, imported on first use
+#: (PEP 562): ``hrgtc.evaluation.allan`` alone costs no drift model, scipy or pyarrow.
+#: (``run_pass`` is the function until the module of that name is imported by its path.)
+_NAMES = {
+    "AllanResult": "allan", "allan_deviation": "allan",
+    "Evaluation": "evaluation_result",
+    "DEFAULT_TAUS_S": "metrics", "ResidualResult": "metrics", "bias_stability": "metrics",
+    "bias_stability_table": "metrics", "residual_against_truth": "metrics",
+    "NoiseTerms": "noise", "noise_terms": "noise",
+    "BlockMeans": "plot_blocks", "block_rows": "plot_blocks",
+    "evaluate": "run_pass", "run_pass": "run_pass",
+}
+
+
+def __getattr__(name: str) -> Any:
+    module = _NAMES.get(name)
+    if module is None:
+        raise AttributeError(f"module 'hrgtc.evaluation' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f"hrgtc.evaluation.{module}"), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_NAMES))
+
 
 __all__ = [
     "DEFAULT_TAUS_S",

@@ -359,8 +359,9 @@ def _record(settings: CalibrationSettings, aux: Mapping[str, str] | None,
 
 def _fit(runs: Sequence[Any], thermometer: Any, drift: DriftSettings,
          aux: Mapping[str, str] | None, options: ReadOptions, progress: Any,
-         excitation_runs: int = 0) -> Any:
-    """:func:`hrgtc.drift.fit` with ``drift``'s settings on the runs read by ``options``."""
+         excitation_runs: int = 0, rest_cache: dict[Any, Any] | None = None) -> Any:
+    """:func:`hrgtc.drift.fit` with ``drift``'s settings on the runs read by ``options``
+    (``rest_cache``: the at-rest passes shared by fits on the same runs)."""
     return drift_model.fit(
         runs, thermometer, terms=drift.terms or drift_model.EQ21, window_s=drift.window_s,
         penter=drift.penter, premove=drift.premove, reference_c=drift.reference_c,
@@ -368,7 +369,7 @@ def _fit(runs: Sequence[Any], thermometer: Any, drift: DriftSettings,
         select=drift.select, offsets=drift.offsets, autocorrelation=drift.autocorrelation,
         hierarchical=drift.hierarchical, aux_columns=aux,
         excitation_runs=excitation_runs, progress=progress, motion=options.motion,
-        gaps=options.gaps)
+        gaps=options.gaps, rest_cache=rest_cache)
 
 
 class _CountedRun:
@@ -394,8 +395,9 @@ def _fit_drift(training: Sequence[PathLike], heads: Mapping[str, Any], thermomet
     """The drift model on ``training`` and the housing baseline when every run has
     ``housing_c`` (None otherwise, or when its fit fails: the baseline is optional)."""
     runs = [_CountedRun(options, path) for path in training]
+    rest_cache: dict[Any, Any] = {}  # one pass of the at-rest detector per run, not per fit
     model = _fit(runs, thermometer, drift, aux, options, for_stage(progress, "drift"),
-                 excitation_runs)
+                 excitation_runs, rest_cache)
     spikes = sum(run.spikes for run in runs)
     if spikes and model.accounting is not None:  # the accounting starts from the file's rows
         model.accounting.add_read(spikes)
@@ -409,7 +411,7 @@ def _fit_drift(training: Sequence[PathLike], heads: Mapping[str, Any], thermomet
                                        **DriftSettings().variable_options())
         try:
             housing = _fit(runs, thermometer, baseline, None, options,
-                           for_stage(progress, "housing baseline"))
+                           for_stage(progress, "housing baseline"), rest_cache=rest_cache)
         except CalibrationError as exc:  # the baseline is optional: say why it is missing
             warnings.warn(f"no housing-thermistor baseline: {exc}", HrgtcWarning, stacklevel=2)
     return model, housing

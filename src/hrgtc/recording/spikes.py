@@ -46,9 +46,8 @@ and the motion detector marks it (docs/real-loggers/motion.md).
 
 from __future__ import annotations
 
-import itertools
 import warnings
-from collections.abc import Iterator, Mapping
+from collections.abc import Mapping
 
 import numpy as np
 
@@ -182,81 +181,22 @@ class SpikeFilter:
 
 
 # -- the robust, time-windowed filter -------------------------------------------------
-def _segments(time_s: np.ndarray) -> list[tuple[int, int]]:
-    """``[start, stop)`` of the contiguous segments: split where a step > 2 median periods."""
-    n = len(time_s)
-    if n < 2:
-        return [(0, n)] if n else []
-    steps = np.diff(time_s)
-    positive = steps[np.isfinite(steps) & (steps > 0)]
-    if not positive.size:
-        return [(0, n)]
-    limit = GAP_PERIODS * float(np.median(positive)) * (1.0 + GAP_TOLERANCE)
-    cuts = np.flatnonzero(~(steps <= limit)) + 1
-    bounds = [0, *cuts.tolist(), n]
-    return [(a, b) for a, b in itertools.pairwise(bounds) if b > a]
+# The loops are compiled (hrgtc.recording._spike_kernel, imported when first used: numba
+# costs the import of a command that never filters); their numpy definition is kept in
+# tests/spikes_reference.py and the masks are compared bit for bit.
+def _channel_mask(which: str, time_s: np.ndarray, values: np.ndarray, k: float,
+                  lsb_multiple: float, window_s: float, lsb: float | None) -> np.ndarray:
+    """The compiled test ``which`` (``"spike"`` or ``"across"``) of one channel."""
+    from hrgtc.recording import _spike_kernel as kernel
 
-
-def _sigma(second: np.ndarray) -> float:
-    """σ of the samples from the MAD of their second differences (0 for a constant).
-
-    The MAD about 0: second differences carry no level and no linear trend.
-    """
-    return _MAD_TO_SIGMA * float(np.median(np.abs(second))) / _SECOND_DIFF
-
-
-def _window_sigmas(second: np.ndarray, bounds: np.ndarray) -> np.ndarray:
-    """σ_MAD of each window ``bounds[i]:bounds[i+1]`` of the second differences.
-
-    Windows of equal length are done together (one median per row of a 2-D view);
-    a window with fewer than :data:`MIN_WINDOW_SAMPLES` finite values takes its
-    segment's σ.
-    """
-    sizes = np.diff(bounds)
-    sigmas = np.full(sizes.size, np.nan)
-    finite = np.isfinite(second)
-    if finite.all():
-        for size in np.unique(sizes):
-            which = np.flatnonzero(sizes == size)
-            if size < MIN_WINDOW_SAMPLES:
-                continue
-            rows = np.abs(second[bounds[which][:, None] + np.arange(size)])
-            sigmas[which] = _MAD_TO_SIGMA * np.median(rows, axis=1) / _SECOND_DIFF
-    else:
-        for i, (a, b) in enumerate(itertools.pairwise(bounds.tolist())):
-            part = second[a:b][finite[a:b]]
-            if part.size >= MIN_WINDOW_SAMPLES:
-                sigmas[i] = _sigma(part)
-    short = np.isnan(sigmas)
-    if short.any():
-        whole = second[finite]
-        sigmas[short] = _sigma(whole) if whole.size else 0.0
-    return sigmas
-
-
-def _segment_limits(t: np.ndarray, x: np.ndarray, k: float, lsb_multiple: float,
-                    window_s: float, lsb: float | None) -> Iterator[tuple[int, int, np.ndarray,
-                                                                           np.ndarray, np.ndarray]]:
-    """Per contiguous segment of at least 3 samples: ``(start, stop, values, second
-    differences, threshold max(k·σ_MAD, m·LSB) of each sample)`` (see :func:`find_spikes`)."""
+    x = np.ascontiguousarray(values, dtype=np.float64)
+    t = np.ascontiguousarray(time_s, dtype=np.float64)
     if lsb is None:
         lsb = resolution(x[:RESOLUTION_ROWS])
     floor = lsb_multiple * float(lsb or 0.0)
-    for start, stop in _segments(t):
-        if stop - start < 3:
-            continue
-        xs = x[start:stop]
-        second = np.empty_like(xs)
-        second[1:-1] = xs[1:-1] - 0.5 * (xs[:-2] + xs[2:])
-        second[0], second[-1] = second[1], second[-2]
-        ts = t[start:stop]
-        with np.errstate(invalid="ignore"):
-            origin = float(np.nanmin(ts)) if np.isfinite(ts).any() else 0.0
-            block = np.floor((ts - origin) / window_s)
-        edges = np.flatnonzero(np.diff(block)) + 1
-        bounds = np.array([0, *edges.tolist(), len(xs)])
-        sigmas = _window_sigmas(second, bounds)
-        yield start, stop, xs, second, np.repeat(np.maximum(k * sigmas, floor), np.diff(bounds))
+    test = kernel.spike_mask if which == "spike" else kernel.across_mask
+    return test(t, x, float(k), floor, float(window_s), float(GAP_PERIODS),
+                1.0 + GAP_TOLERANCE, MIN_WINDOW_SAMPLES, _MAD_TO_SIGMA, _SECOND_DIFF)
 
 
 def moving_across(time_s: np.ndarray, values: np.ndarray, *, k: float = SPIKE_K,
@@ -271,17 +211,7 @@ def moving_across(time_s: np.ndarray, values: np.ndarray, *, k: float = SPIKE_K,
     (a handling pulse shorter than the sample period), not a spike. A glitch that hits
     every column of one row leaves the accelerometer's neighbours in agreement.
     """
-    x = np.asarray(values, dtype=np.float64)
-    t = np.asarray(time_s, dtype=np.float64)
-    moving = np.zeros(x.size, dtype=bool)
-    for start, stop, xs, _, limit in _segment_limits(t, x, k, lsb_multiple, window_s, lsb):
-        across = np.zeros(xs.size)
-        with np.errstate(invalid="ignore"):
-            across[1:-1] = np.abs(xs[2:] - xs[:-2])
-            if xs.size >= 5:
-                across[2:-2] = np.maximum(across[2:-2], np.abs(xs[4:] - xs[:-4]))
-            moving[start:stop] = across > limit
-    return moving
+    return _channel_mask("across", time_s, values, k, lsb_multiple, window_s, lsb)
 
 
 def find_spikes(time_s: np.ndarray, values: np.ndarray, *, k: float = SPIKE_K,
@@ -313,27 +243,7 @@ def find_spikes(time_s: np.ndarray, values: np.ndarray, *, k: float = SPIKE_K,
         one sample off a steady stream, not a stream in motion); at a segment's edge,
         against the next two samples.
     """
-    x = np.asarray(values, dtype=np.float64)
-    t = np.asarray(time_s, dtype=np.float64)
-    spikes = np.zeros(x.size, dtype=bool)
-    for start, stop, xs, second, limit in _segment_limits(t, x, k, lsb_multiple, window_s, lsb):
-        with np.errstate(invalid="ignore"):
-            left = np.abs(np.diff(xs, prepend=np.nan))
-            right = np.abs(np.diff(xs, append=np.nan))
-            # ... and its two neighbours agree with each other: a single sample off a
-            # steady stream, not a stream that moves (handling, a rotation), whose every
-            # sample is far from its neighbours
-            across = np.full(xs.size, np.inf)
-            across[1:-1] = np.abs(xs[2:] - xs[:-2])
-            inner = ((left > limit) & (right > limit) & (np.abs(second) > limit)
-                     & (across <= limit))
-            # the edges: away from both of the next two samples, which agree
-            inner[0] = (right[0] > limit[0]) & (abs(xs[0] - xs[2]) > limit[0]) & (
-                right[1] <= limit[0])
-            inner[-1] = (left[-1] > limit[-1]) & (abs(xs[-1] - xs[-3]) > limit[-1]) & (
-                left[-2] <= limit[-1])
-        spikes[start:stop] = inner
-    return spikes
+    return _channel_mask("spike", time_s, values, k, lsb_multiple, window_s, lsb)
 
 
 def _filtered_columns(columns: Mapping[str, np.ndarray], axes: tuple[str, ...],

@@ -31,7 +31,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from hrgtc.core import records
 from hrgtc.core.errors import InputError
@@ -255,6 +254,8 @@ def fit_transient(time_s: Any, freq_hz: Any) -> TransientFit:
     ratio = (math.log(_RATIO_BOUNDS[0]), math.log(_RATIO_BOUNDS[1]))
     bounds = {1: ([log_tau[0]], [log_tau[1]]), 2: ([log_tau[0], ratio[0], -np.inf],
                                                    [log_tau[1], ratio[1], np.inf])}  # fmt: skip
+    from scipy.optimize import least_squares  # imported on first use: a faster start
+
     fitted: dict[str, np.ndarray] = {}
     for name, (exps, degree) in _MODELS.items():
         if n <= 2 * (exps + degree + 1):

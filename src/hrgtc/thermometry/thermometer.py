@@ -29,7 +29,6 @@ from typing import Annotated, Any, Literal
 
 import numpy as np
 from msgspec import Meta
-from scipy import stats
 
 from hrgtc.core import records
 from hrgtc.core.errors import CalibrationError, ExtrapolationWarning, InputError
@@ -142,6 +141,8 @@ class Thermometer:
 
         NaN where the fit has no residual degrees of freedom (as ``standard_errors``).
         """
+        from scipy import stats  # imported on first use: a faster start
+
         dof = self.n_points - self.order - 1
         out = []
         for c, se in zip(self.coefficients, self.standard_errors, strict=True):
