@@ -20,6 +20,7 @@ from hrgtc.core.errors import InputError
 from hrgtc.recording.motion import (
     BASELINE_BLOCKS,
     GAP_FACTOR,
+    HANDLING_S,
     MAD_TO_SIGMA,
     REASONS,
     VARIANCE_MIN_SAMPLES,
@@ -247,13 +248,21 @@ def detect_motion_reference(
         moving[a:b] = _dilate(found[a:b], after, before)
     reasons["guard"] = moving & ~found
     reasons["short_still"] = np.zeros(n, dtype=bool)
-    # still runs next to motion, shorter than min_still_s, judged across dropouts
+    # still runs next to handling (a moving run of guards + HANDLING_S or more), shorter
+    # than min_still_s, judged across dropouts
     joined = np.cumsum(np.r_[0, np.diff(time_s) > max(GAP_FACTOR * period, DROPOUT_S)])
+    handling_s = s.guard_s + s.guard_before_s + HANDLING_S
     for a, b in _bounds(joined):
-        if s.min_still_s > 0 and moving[a:b].any():
-            for start, stop in zip(*_runs(~moving[a:b]), strict=True):
-                if time_s[a + stop - 1] - time_s[a + start] < s.min_still_s:
-                    reasons["short_still"][a + start:a + stop] = True
+        if s.min_still_s <= 0 or not moving[a:b].any():
+            continue
+        runs = sorted([(lo, hi, False) for lo, hi in zip(*_runs(~moving[a:b]), strict=True)]
+                      + [(lo, hi, True) for lo, hi in zip(*_runs(moving[a:b]), strict=True)])
+        for k, (lo, hi, is_moving) in enumerate(runs):
+            if is_moving or time_s[a + hi - 1] - time_s[a + lo] >= s.min_still_s:
+                continue
+            near = [runs[j] for j in (k - 1, k + 1) if 0 <= j < len(runs)]
+            if any(time_s[a + h - 1] - time_s[a + low] >= handling_s for low, h, _ in near):
+                reasons["short_still"][a + lo:a + hi] = True
     moving |= reasons["short_still"]
     noise = {c.name: c.sigma for c in prepared}
     return MotionMask(moving, reasons, np.diff(segment) != 0, noise, s)

@@ -136,3 +136,19 @@ def test_a_slow_logger_of_clock_times_is_not_told_its_time_is_in_milliseconds(tm
     recording = read(path, columns={"time_s": "clock", "temperature_c": "temp",
                                     "rate_dph": "gyro"}, thermometer="sensor")
     assert len(recording) == 400 and 0.09 < recording.sample_rate_hz < 0.11
+
+
+def test_a_blank_in_a_column_nothing_reads_refuses_nothing(tmp_path):
+    # a fuzzed real file (issue 27): blanks in the logger's own status word refused the file
+    from hrgtc.recording import read
+
+    n = 600
+    rng = np.random.default_rng(8)
+    status = np.where(rng.random(n) < 0.05, "", "0")
+    rows = [f"{k},{20 + 0.001 * k:.3f},{50 + 3 * rng.standard_normal():.3f},{s}"
+            for k, s in enumerate(status)]
+    path = tmp_path / "status.csv"
+    path.write_text("t,temp,gyro,status\n" + "\n".join(rows) + "\n")
+    recording = read(path, columns={"time_s": "t", "temperature_c": "temp", "rate_dph": "gyro"},
+                     thermometer="sensor")
+    assert len(recording) == n and np.isnan(recording["status"]).sum() == (status == "").sum()

@@ -516,8 +516,12 @@ def _sensor_thermometer(training: Sequence[PathLike], options: ReadOptions) -> S
     """The identity thermometer over the training runs' temperatures at rest (each run's
     sensor and rate columns checked for a swap on the way)."""
     low, high = math.inf, -math.inf
+    why = []
     for path in training:  # the range of the samples the fit uses: those at rest
-        keep = run_rest(options.chunks(path), options.motion).keep
+        rest = run_rest(options.chunks(path), options.motion)
+        keep = rest.keep
+        if rest.mask is not None and not keep.any():
+            why.append(f"{path}: {rest.mask.summary()}")
         row = 0
         temperature, rate = ChannelShape(), ChannelShape()
         for chunk in options.chunks(path):
@@ -529,6 +533,11 @@ def _sensor_thermometer(training: Sequence[PathLike], options: ReadOptions) -> S
                 low = min(low, float(np.min(used)))
                 high = max(high, float(np.max(used)))
         check_sensor_swap(temperature, rate, str(path), *_sensor_columns(path, options))
+    if why and not math.isfinite(low):
+        raise CalibrationError(
+            "no sample of the training runs is at rest, so there is nothing to train on ("
+            + "; ".join(why) + "); if the gyro was still, its rate may be too coarse for the "
+            "motion detector (a few LSB of noise): check --rate-unit, or pass --motion keep")
     return SoakFit(identity((low, high)))
 def parse_aux(items: Iterable[str]) -> dict[str, str]:
     """``NAME=COLUMN`` items (``--aux``) as ``{NAME: COLUMN}``, spaces around each trimmed.

@@ -57,6 +57,9 @@ BASELINE_BLOCKS = 5
 VARIANCE_MIN_SAMPLES = 32
 #: What calibration and evaluation do with moving samples (``--motion``).
 MOTION_POLICIES = ("exclude", "keep", "error")
+#: Motion found for at least this long (beyond its guards) is handling, next to which a
+#: short still pause is not at rest (:attr:`MotionSettings.min_still_s`). [s]
+HANDLING_S = 5.0
 #: Reasons a sample is marked, in the order they are reported.
 REASONS = ("level", "variance", "clipped", "accelerometer", "guard", "short_still")
 #: Columns read as accelerometer axes when present.
@@ -85,11 +88,12 @@ class MotionSettings:
         Samples this long after / before motion are marked too (the unit settling;
         the motion's onset below the threshold). [s]
     min_still_s
-        A still stretch next to motion (between two handlings, or from the start or to
-        the end of a segment) shorter than this is not at rest either (reason
-        ``short_still``): a unit put down for a moment between handlings has not settled
-        (the hand's warmth, a thermal gradient), and its few samples would set the
-        trained ranges. Stretches between gaps only (a burst logger's bursts) are never
+        A still stretch next to handling (motion lasting :data:`HANDLING_S` beyond its
+        guards), between two handlings or from the start or to the end of a segment,
+        shorter than this is not at rest either (reason ``short_still``): a unit put down
+        for a moment between handlings has not settled (the hand's warmth, a thermal
+        gradient), and its few samples would set the trained ranges. Stretches between gaps
+        only (a burst logger's bursts) or between scattered single marks are never
         marked. [s]
     clip_samples
         Equal consecutive samples at a channel's extreme that make a clipped plateau.
@@ -464,28 +468,38 @@ def detect_motion(
     # stretches judged across dropouts (a lost record is no pause between handlings)
     joined = np.flatnonzero(np.diff(time_s) > max(GAP_FACTOR * period, DROPOUT_S)) + 1
     _short_still(time_s, moving, np.r_[0, joined], np.r_[joined, n], s.min_still_s,
-                 reasons["short_still"])
+                 s.guard_s + s.guard_before_s + HANDLING_S, reasons["short_still"])
     noise = {c.name: c.sigma for c in prepared}
     return MotionMask(moving, reasons, breaks, noise, s)
 
 
 def _short_still(time_s: np.ndarray, moving: np.ndarray, starts: np.ndarray,
-                 stops: np.ndarray, min_still_s: float, marked: np.ndarray) -> None:
+                 stops: np.ndarray, min_still_s: float, handling_s: float,
+                 marked: np.ndarray) -> None:
     """Mark (in ``moving`` and ``marked``) the still stretches of each segment
-    ``[starts[k], stops[k])`` that touch motion and last less than ``min_still_s``."""
+    ``[starts[k], stops[k])`` next to handling (a stretch of motion, guards included, of at
+    least ``handling_s``) that last less than ``min_still_s``. Scattered single marks (a
+    coarse channel's steps, each with its guard) are no handling: the still stretches
+    between them stay at rest."""
     if min_still_s <= 0 or not moving.any():
         return
     for a, b in zip(starts.tolist(), stops.tolist(), strict=True):
         part = moving[a:b]
         if not part.any():
             continue  # no motion in the segment: a burst, a quiet run
-        # still runs [lo, hi) within the segment (the padding ends every run); each
-        # touches motion, as the segment has some
-        change = np.flatnonzero(np.diff(np.concatenate([[0], (~part).astype(np.int8), [0]])))
-        for lo, hi in zip(change[::2].tolist(), change[1::2].tolist(), strict=True):
-            if time_s[a + hi - 1] - time_s[a + lo] < min_still_s:
-                moving[a + lo:a + hi] = True
-                marked[a + lo:a + hi] = True
+        # the runs of the segment, alternately still and moving (the padding ends each)
+        edges = np.flatnonzero(np.diff(np.concatenate([[-1], part.astype(np.int8), [-1]])))
+        lows, highs = edges[:-1], edges[1:]
+        still = ~part[lows]
+        span = time_s[a + highs - 1] - time_s[a + lows]
+        handling = ~still & (span >= handling_s)
+        before = np.concatenate([[False], handling[:-1]])
+        after = np.concatenate([handling[1:], [False]])
+        for lo, hi in zip(lows[still & (before | after) & (span < min_still_s)].tolist(),
+                          highs[still & (before | after) & (span < min_still_s)].tolist(),
+                          strict=True):
+            moving[a + lo:a + hi] = True
+            marked[a + lo:a + hi] = True
 
 
 def recording_motion(recording: Any, settings: MotionSettings | None = None) -> MotionMask:

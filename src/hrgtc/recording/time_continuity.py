@@ -270,7 +270,7 @@ class TimeContinuity:
             problems.append(
                 Problem(
                     "gap",
-                    f"{where}{n_long} gap(s) longer than {dropout_s:g} s (a dropout; "
+                    f"{where}{n_long} gap(s) longer than a dropout ({dropout_s:g} s; "
                     f"{total:.6g} s without samples in all), the first {first.duration_s:.6g} s"
                     f"{after}{bridged}; the choice changes the result: pass --gaps bridge "
                     "(the filters carry across each gap with its duration, e.g. a burst logger) "

@@ -104,7 +104,7 @@ from hrgtc.recording.gaps import (
     check_gap_policy,
     split_at_gaps,
 )
-from hrgtc.recording.schema import Metadata, Recording
+from hrgtc.recording.schema import COLUMNS, Metadata, Recording
 from hrgtc.recording.time_continuity import TimeContinuity
 from hrgtc.settings.reading import ReadSettings
 
@@ -201,6 +201,9 @@ class RecordingValidator:
         for name in chunk.names:
             if self._sensor_copy(name, chunk):
                 continue  # the temperature column it copies is checked (and named) itself
+            if base_name(name, self.axes) not in COLUMNS:
+                continue  # a column of the file's own (a status word, a magnetometer): carried
+                # along, read by nothing, so a blank in it refuses nothing
             values = chunk[name]
             low, high, _ = self._bounds.get(base_name(name, self.axes), (-np.inf, np.inf, ""))
             extremes = finite_extremes(values)
