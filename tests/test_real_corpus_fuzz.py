@@ -16,6 +16,7 @@ import pytest
 from typer.testing import CliRunner
 
 from hrgtc.cli import app
+
 from real_corpus import CORPUS
 
 CHAMBER = next(f for f in CORPUS if f.name == "tofupilot-imu-chamber")
@@ -62,5 +63,5 @@ def test_a_corrupted_real_file_gets_a_clear_answer(kind, tmp_path):
         assert "internal error" not in result.output, (kind, command[0], result.output)
         assert result.exit_code in (0, 2), (kind, command[0], result.output)
         if result.exit_code == 2:
-            assert "error" in result.output and str(path.name) in result.output or (
+            assert ("error" in result.output and str(path.name) in result.output) or (
                 "rows" in result.output), (kind, command[0], result.output)
