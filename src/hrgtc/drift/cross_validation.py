@@ -32,6 +32,7 @@ from hrgtc.core import records
 from hrgtc.core.timeline import time_blocks
 from hrgtc.drift.regression import newey_west_inflation
 from hrgtc.drift.slow_noise import SLOW_NOISE_LEVEL, beyond_slow_noise
+from hrgtc.drift.stepwise import stepwise
 
 #: Windows whose |df/dt| is below this share of the largest are neither heating nor cooling.
 RATE_DEADBAND = 0.05
@@ -428,24 +429,36 @@ def _within_one_error(smaller: np.ndarray, best: np.ndarray, folds: np.ndarray) 
     return excess / count <= math.sqrt(variance) / count
 
 
+def _line_admitted(x_scaled: np.ndarray, bias_dph: np.ndarray, names: Sequence[str],
+                   line_test: tuple[float, float] | None) -> bool:
+    """Does a plain F-test ``(penter, premove)`` admit the line on its own? The one term
+    physics expects is the floor of one run unless the data cannot tell it from no slope."""
+    if line_test is None or LINE_TERM not in names:
+        return False
+    k = list(names).index(LINE_TERM)
+    penter, premove = line_test
+    return stepwise(x_scaled[:, [k]], bias_dph, names=[LINE_TERM], penter=penter,
+                    premove=premove).selected == (LINE_TERM,)
+
+
 def guard_selection(x_scaled: np.ndarray, bias_dph: np.ndarray, run: np.ndarray,
                     time_s: np.ndarray, names: Sequence[str], selected: Sequence[str],
                     parents: Mapping[str, Sequence[str]] | None = None,
                     keep: Sequence[str] = (), temperature: np.ndarray | None = None,
-                    line_floor: bool = False,
+                    line_test: tuple[float, float] | None = None,
                     ) -> tuple[tuple[str, ...] | None, dict[str, Any]]:
     """The guarded selection: :func:`prune_terms` on the folds of :func:`folds_of`
     (``temperature``: the window means of the thermometer variable, which pick the
-    coldest and the hottest block of a single run). ``line_floor``: on a single run, the
-    line in the thermometer variable (:data:`LINE_TERM`, significant on its own) is kept
-    whatever the other terms.
+    coldest and the hottest block of a single run). ``line_test``: ``(penter, premove)``
+    of a plain F-test of the line in the thermometer variable (:data:`LINE_TERM`) on its
+    own; on a single run, a line it admits is kept whatever the other terms.
 
     Returns the terms to refit (None when nothing was dropped) and the record of the check
     (``folds``, ``dropped``, ``before_dph``, ``after_dph``) stored in the model.
     """
     folds, kind = folds_of(run, time_s, temperature)
     original = set(selected)
-    if line_floor and kind != "runs" and LINE_TERM in names:
+    if kind != "runs" and _line_admitted(x_scaled, bias_dph, names, line_test):
         # one long run: a line in the thermometer variable that is significant on its own
         # is the floor, kept whatever the joint F-tests said (the held-out blocks of one
         # run cannot tell a slope from the hysteresis of its ramps; a real chamber cycle's

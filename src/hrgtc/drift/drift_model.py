@@ -37,7 +37,6 @@ from hrgtc.core.accounting import Accounting
 from hrgtc.core.errors import InputError
 from hrgtc.core.progress import Progress
 from hrgtc.drift.cross_validation import (
-    LINE_TERM,
     CrossValidation,
     CrossValidationRecord,
     cross_validate,
@@ -512,17 +511,10 @@ def fit(
         chosen = select_terms(*cv_args, windows.sources, rate, slope_sign, parents=parents,
                               initial=result.selected)
     elif select == "guarded" and (result.selected or np.unique(windows.run).size == 1):
-        line_floor = False
-        if np.unique(windows.run).size == 1 and LINE_TERM in names:
-            # the line on its own, by a plain F-test: the one term physics expects is the
-            # floor unless the data cannot tell it from no slope at all
-            k = list(names).index(LINE_TERM)
-            line_floor = stepwise(x_scaled[:, [k]], bias, names=[LINE_TERM], penter=penter,
-                                  premove=premove).selected == (LINE_TERM,)
         chosen, pruning = guard_selection(
             x_scaled, bias, windows.run, windows.time_s, names, result.selected,
             parents=hierarchy(candidates), keep=[parse_terms([t])[0].name for t in initial or ()],
-            temperature=windows.variables.get("f"), line_floor=line_floor)
+            temperature=windows.variables.get("f"), line_test=(penter, premove))
     if chosen is not None:
         history = result.history
         result = stepwise(x_scaled, bias, names=names, penter=penter,

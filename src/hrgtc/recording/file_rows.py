@@ -89,3 +89,35 @@ class FileRows:
             return problem
         message = re.sub(rf"\brow {problem.row}\b", f"row {row}", problem.message)
         return dataclasses.replace(problem, row=row, message=message)
+
+
+class RemovedInSlice:
+    """The rows a filter removed that lie inside a ``--start/--end`` slice.
+
+    A filter that needs the neighbours of a row (the spike filters) runs before the slice
+    is cut, so its count covers the whole file; the accounting of the part read counts
+    only those between the first and the last file row the slice kept.
+    """
+
+    def __init__(self) -> None:
+        self._removed: list[np.ndarray] = []
+        self._first, self._last = np.inf, -np.inf
+
+    def filtered(self, before: dict[str, np.ndarray], after: dict[str, np.ndarray]) -> None:
+        """Note the file rows of ``before`` (a part with :data:`ROW_KEY`) not in ``after``."""
+        rows = before.get(ROW_KEY)
+        if rows is not None and len(after[ROW_KEY]) < len(rows):
+            self._removed.append(np.setdiff1d(rows, after[ROW_KEY]))
+
+    def kept(self, file_rows: np.ndarray | None) -> None:
+        """Note the file rows of a part the slice kept."""
+        if file_rows is not None and len(file_rows):
+            self._first = min(self._first, float(file_rows[0]))
+            self._last = max(self._last, float(file_rows[-1]))
+
+    @property
+    def count(self) -> int:
+        """Removed rows between the first and the last row kept."""
+        rows = np.concatenate(self._removed) if self._removed else np.empty(0)
+        return int(np.count_nonzero((rows >= self._first) & (rows <= self._last)))
+

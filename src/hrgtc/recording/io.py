@@ -35,7 +35,6 @@ validated axis by axis; :func:`hrgtc.recording.axis_view` gives one axis.
 from __future__ import annotations
 
 import itertools
-import math
 from collections.abc import Callable, Collection, Iterator, Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -48,7 +47,7 @@ from hrgtc.core.progress import Progress
 from hrgtc.core.time_steps import TimeRepairStream
 from hrgtc.recording.align import align, warn_alignment
 from hrgtc.recording.axes import axis_view
-from hrgtc.recording.file_rows import ROW_KEY, take_file_rows, with_file_rows
+from hrgtc.recording.file_rows import RemovedInSlice, take_file_rows, with_file_rows
 from hrgtc.recording.formats.base import Source
 from hrgtc.recording.formats.registry import open_streams
 from hrgtc.recording.mapping import (
@@ -368,8 +367,7 @@ def iter_chunks(path: str | Path, options: ReadSettings | None = None, *,
             repairer = time_repair
         cut = _TimeSlice(opts.start, opts.end, plan)
         numbered = validator is not None or file_rows is not None
-        removed: list[np.ndarray] = []  # file rows the spike filters removed (with a slice)
-        kept_rows = [math.inf, -math.inf]  # first and last file row the slice kept
+        in_slice = RemovedInSlice()  # the spikes inside --start/--end, for the accounting
 
         def converted() -> Iterator[dict[str, np.ndarray]]:
             nonlocal offset
@@ -380,12 +378,12 @@ def iter_chunks(path: str | Path, options: ReadSettings | None = None, *,
                 if numbered:  # the file rows, for the validator's messages
                     part = with_file_rows(part, offset)
                 part = slow.fill(part, offset)
-                before = part.get(ROW_KEY)
+                before = part
                 if spike_filter is not None:
                     part = spike_filter.drop(part, offset)
                 part = robust.apply(part, offset)
-                if before is not None and cut.active and len(part[ROW_KEY]) < len(before):
-                    removed.append(np.setdiff1d(before, part[ROW_KEY]))  # their file rows
+                if cut.active and numbered:
+                    in_slice.filtered(before, part)
                 offset += table.num_rows
                 part = cut.apply(_repair_time(part, repairer, plan))
                 if part.get("time_s") is None or len(part["time_s"]):
@@ -423,9 +421,7 @@ def iter_chunks(path: str | Path, options: ReadSettings | None = None, *,
             head.clear()
             for p in itertools.chain(held, parts):  # the file rows go to the validator
                 part, file_rows = take_file_rows(p)
-                if file_rows is not None and len(file_rows):
-                    kept_rows[0] = min(kept_rows[0], float(file_rows[0]))
-                    kept_rows[1] = max(kept_rows[1], float(file_rows[-1]))
+                in_slice.kept(file_rows)
                 yield Recording(part, chunk_meta(), source=str(path)), file_rows
 
         for chunk, rows_of_file in chunks():
@@ -451,8 +447,7 @@ def iter_chunks(path: str | Path, options: ReadSettings | None = None, *,
             spikes = ((spike_filter.dropped if spike_filter is not None else 0)
                       + (robust.rows if robust.mode == "drop" else 0))
             if cut.active and numbered:  # the spikes inside the slice read, not the file's
-                rows = np.concatenate(removed) if removed else np.empty(0)
-                spikes = int(np.count_nonzero((rows >= kept_rows[0]) & (rows <= kept_rows[1])))
+                spikes = in_slice.count
             dropped["spikes"] = dropped.get("spikes", 0) + spikes
         if progress is not None:
             total = source.position()[1]
