@@ -390,8 +390,11 @@ def recording_cases() -> list[Case]:
             add("one row missing (2 periods: not a gap)", "gaps",
                 edited(rows_removed(5000, 5001), fmt, axes),
                 {"*": Expect("correct", compare=False)})
+            # a duty-cycled logger's file: its gaps are bridged by default (a GapWarning
+            # says so; no row is left out) (issue 27: the cold test needed --gaps bridge)
             add("bursts of 5 s every 30 s", "gaps", edited(bursts(5.0, 30.0), fmt, axes),
-                {"*": error("time_s", "row 50", "--gaps split"), "info": EITHER})
+                {"*": Expect("correct", compare=False),
+                 "info": Expect("either", compare=False)})
             add("compensated file", "compensated", compensated(fmt, axes),
                 {"*": error("already compensated"), "info": Expect("either", compare=False)},
                 owner="relread")

@@ -86,7 +86,7 @@ def test_validation_report_layout_round_trip_and_refusals():
         '2.5, "duration_s": 5.0, "row": 3}, {"start_time_s": 20.0, "duration_s": 3.0, '
         '"row": 9}], "n_gaps": 2, "rows": 12, "source": "run.csv", '
         '"measured_sample_rate_hz": null, "gap_policy": "split", "n_dropouts": 0, '
-        '"dropout_s": 0.0}')
+        '"dropout_s": 0.0, "duty_cycled": false}')
     _valid(written, ValidationReportRecord)
     again = ValidationReport.from_dict(json.loads(json.dumps(written)))
     assert again == report and again.to_dict() == written

@@ -30,3 +30,21 @@ def test_info_does_not_judge_a_raw_count_as_degrees():
     info = describe(RUN, spikes="drop", **OPTIONS)
     assert info.ok, info.validation.message
     assert info.rows == 6250
+
+
+def test_calibrate_asks_for_the_map_of_a_raw_count(tmp_path):
+    # before: a model in counts was written, and its own loader called it corrupt
+    from typer.testing import CliRunner
+
+    from hrgtc.cli import app
+
+    result = CliRunner().invoke(app, [
+        "calibrate", "--drift", str(RUN), "--col", "time_s=time (ms)",
+        "--col", "rate_dph_x=gyrox rad/s", "--col", "rate_dph_y=gyroy rad/s",
+        "--col", "rate_dph_z=gyroz rad/s", "--col", "temperature_c=temp", "--time-unit", "ms",
+        "--rate-unit", "radps", "--temp-unit", "count", "--thermometer", "sensor",
+        "-o", str(tmp_path / "m.json")])
+    assert result.exit_code == 2
+    said = " ".join(result.output.split())
+    assert "raw count" in said and "--temp-ref LOG" in said and "--temp-scale" in said
+    assert not (tmp_path / "m.json").exists()

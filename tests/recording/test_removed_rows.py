@@ -152,3 +152,24 @@ def test_a_blank_in_a_column_nothing_reads_refuses_nothing(tmp_path):
     recording = read(path, columns={"time_s": "t", "temperature_c": "temp", "rate_dph": "gyro"},
                      thermometer="sensor")
     assert len(recording) == n and np.isnan(recording["status"]).sum() == (status == "").sum()
+
+
+def test_a_duty_cycled_logger_is_bridged_by_default_and_said_so():
+    from pathlib import Path
+
+    from hrgtc.core.errors import GapWarning
+    from hrgtc.recording import read
+
+    cold = Path(__file__).resolve().parents[1] / "data" / "pan-cold-test" / \
+        "pan_tvc_cold_2020-03-07.csv"
+    columns = {"time_s": "time (ms)", "rate_dph_x": "gyrox rad/s", "rate_dph_y": "gyroy rad/s",
+               "rate_dph_z": "gyroz rad/s", "temperature_c": "temp"}
+    with pytest.warns(GapWarning, match="a duty-cycled logger .*24 gaps.*--gaps split"):
+        recording = read(cold, columns=columns, thermometer="sensor",
+                         units={"time": "ms", "rate": "radps", "temp": "count"})
+    assert len(recording) == 6250
+    # two pauses of a continuous logger are no duty cycle: the choice is the user's
+    time_s = np.r_[np.arange(0.0, 1000.0), np.arange(1100.0, 2000.0), np.arange(2100.0, 3000.0)]
+    validator = _validate(time_s, np.arange(time_s.size, dtype=float))
+    assert [p.kind for p in validator.time_axis.problems("error", False, 5.0)] == ["gap"]
+    assert not validator.time_axis.duty_cycled(5.0)

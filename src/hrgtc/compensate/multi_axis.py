@@ -122,7 +122,7 @@ class InstrumentCompensator:
             where = f"{view.source}: " if view.source else ""
             raise RecordingError(
                 f"{where}column freq_hz_{axis}, row {row}: {float(freq[bad[0]])!r} Hz is outside "
-                f"the band {band[0]:.6g}-{band[1]:.6g} Hz this axis can reach ({bad.size} such "
+                f"the band {band[0]:.6g} to {band[1]:.6g} Hz this axis can reach ({bad.size} such "
                 "rows in this chunk); is it another unit's file, or the wrong column?"
             )
 

@@ -94,6 +94,10 @@ class RateFilterWarning(HrgtcWarning):
     makes the df/dt noise larger than the df/dt signal."""
 
 
+class GapWarning(HrgtcWarning):
+    """A recording's gaps were bridged without being asked: a duty-cycled logger's."""
+
+
 class SlowChannelWarning(HrgtcWarning):
     """A channel logged slower than the file's rows was filled (held or interpolated) and
     rows farther than the maximum age from its values were dropped as a gap."""

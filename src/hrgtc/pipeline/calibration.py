@@ -44,7 +44,7 @@ from hrgtc.evaluation.calibration_figures import calibration_summary, thermomete
 from hrgtc.model import UnitModel, provenance
 from hrgtc.pipeline.documents import CalibrationDriftRecord, CalibrationRecord
 from hrgtc.recording import ReadOptions
-from hrgtc.recording.mapping import parse_columns
+from hrgtc.recording.mapping import parse_columns, scales_temperature
 from hrgtc.recording.marks import refuse_compensated_training
 from hrgtc.settings import to_dict
 from hrgtc.settings.calibration import CalibrationSettings
@@ -447,6 +447,13 @@ def _calibrate_sensor(soaks: Sequence[PathLike], drifts: Sequence[PathLike],
     thermometer's range is that of the training runs' temperatures.
     """
     options = dataclasses.replace(options, thermometer="sensor")
+    if (dict(options.units or {}).get("temp") == "count"
+            and not scales_temperature(options.temp_scale, options.temp_offset_c)):
+        raise InputError(
+            f"{drifts[0] if drifts else soaks[0]}: the temperature is a raw count "
+            "(--temp-unit count) with no map to °C, and a model's thermometer, ranges and "
+            "exports are in °C: give the datasheet's --temp-scale K --temp-offset C, or "
+            "fit the map to a reference log written beside the run with --temp-ref LOG")
     training = [*drifts, *soaks]
     fitted = soak_fit or _sensor_thermometer(training, options)
     thermometer = fitted.thermometer

@@ -10,6 +10,7 @@ and the rate unit from the median magnitude and the noise of 1 s block means.
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -17,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from hrgtc.core import records
-from hrgtc.core.errors import InputError, RecordingError
+from hrgtc.core.errors import GapWarning, InputError, RecordingError
 from hrgtc.core.records import Count, Record
 from hrgtc.recording.gaps import Gap, GapPolicy, GapRecord
 
@@ -129,6 +130,8 @@ class ValidationReport:
     n_dropouts, dropout_s
         Gaps no longer than ``dropout_s`` (bridged and counted whatever the policy) and
         that limit. [s]
+    duty_cycled
+        The gaps are a duty-cycled logger's: bridged by default (policy ``"error"``).
     """
 
     ok: bool
@@ -141,6 +144,7 @@ class ValidationReport:
     gap_policy: GapPolicy = "error"
     n_dropouts: int = 0
     dropout_s: float = 0.0
+    duty_cycled: bool = False
 
     @property
     def message(self) -> str:
@@ -151,6 +155,15 @@ class ValidationReport:
         """Raise :class:`~hrgtc.core.errors.RecordingError` with :attr:`message` unless ok."""
         if self.problems:
             raise RecordingError(self.message)
+
+    def warn_bridged(self) -> None:
+        """Say, once, that a duty-cycled logger's gaps were bridged by default."""
+        if self.duty_cycled and self.gap_policy == "error" and not self.problems:
+            warnings.warn(GapWarning(
+                f"{self.source or 'recording'}: a duty-cycled logger (bursts much shorter "
+                f"than their period, {self.n_gaps - self.n_dropouts} gaps): the filters carry "
+                "across each gap with its duration (--gaps bridge, the default for such a "
+                "logger); pass --gaps split to restart them after each"), stacklevel=3)
 
     def summary(self) -> str:
         """Human-readable text (does not print)."""
@@ -164,6 +177,10 @@ class ValidationReport:
                          f"{self.dropout_s:g} s, bridged (they change no result)")
         if self.n_gaps:
             longer = self.n_gaps - self.n_dropouts
+            if self.duty_cycled and self.gap_policy == "error":
+                lines.append("  a duty-cycled logger (bursts much shorter than their period): "
+                             "its gaps are bridged, the filters carry across each with its "
+                             "duration (--gaps split restarts them)")
             lines.append(f"  gaps: {self.n_gaps} " + (
                 "(all dropouts)" if not longer else
                 f"(policy {self.gap_policy} for the {longer} longer than {self.dropout_s:g} s)"
@@ -202,6 +219,7 @@ class ValidationReportRecord(Record, kw_only=True):
     gap_policy: GapPolicy = "error"
     n_dropouts: Count = 0
     dropout_s: float = 0.0
+    duty_cycled: bool = False
 
 
 def problems_message(source: str | None, problems: tuple[Problem, ...] | list[Problem]) -> str:

@@ -256,7 +256,7 @@ def read(path: str | Path, options: ReadSettings | None = None, *, validate: boo
         validate_recording(recording, opts.gaps, freq_band_hz=opts.freq_band_hz,
                            freq_span_hz=opts.freq_span_hz, thermometer=opts.thermometer,
                            file_rows=file_rows, dropout_s=opts.dropout_s,
-                           temperature_counts=robust.counts)
+                           temperature_counts=robust.counts).warn_bridged()
     return recording
 
 
@@ -437,7 +437,9 @@ def iter_chunks(path: str | Path, options: ReadSettings | None = None, *,
             if progress is not None:
                 progress(*source.position())
         if validator is not None:
-            validator.finish().raise_for_problems()
+            report = validator.finish()
+            report.raise_for_problems()
+            report.warn_bridged()
         if spike_filter is not None:
             spike_filter.warn()
         robust.warn()
@@ -593,6 +595,6 @@ def check_axis_band(view: Recording, axis: str, band: tuple[float, float], row: 
     if bad.size:
         raise RecordingError(
             f"{path}: column freq_hz_{axis}, row {row + int(bad[0])}: "
-            f"{float(freq[bad[0]])!r} is outside the band {band[0]:.6g}-{band[1]:.6g} this "
+            f"{float(freq[bad[0]])!r} is outside the band {band[0]:.6g} to {band[1]:.6g} this "
             f"axis of the model can reach ({bad.size} such rows in the chunk); is it another "
             "unit's file, or the wrong column?")

@@ -220,6 +220,21 @@ class TimeContinuity:
             medians = np.nanmedian(np.where(usable, part, np.nan), axis=1)
             return np.abs(medians / period - 1.0) > SAMPLE_RATE_TOLERANCE
 
+    def duty_cycled(self, dropout_s: float = 0.0) -> bool:
+        """A duty-cycled logger: three gaps or more longer than ``dropout_s``, its bursts
+        between them much shorter than the time from one burst's start to the next's
+        (:meth:`hrgtc.core.timeline.Timeline.is_bursty`'s rule). There the filters carry
+        across each gap by default (``--gaps bridge``): restarting them would leave each
+        burst inside the df/dt filter's warm-up."""
+        long = [g for g in self.gaps if g.duration_s > dropout_s]
+        if len(long) < 3:
+            return False
+        ends = np.array([g.start_time_s + g.duration_s for g in long[:-1]])  # a burst starts
+        starts = np.array([g.start_time_s for g in long[1:]])  # the next one stops
+        bursts = starts - ends
+        periods = np.diff([g.start_time_s for g in long])
+        return bool(np.median(bursts) < 0.5 * np.median(periods))
+
     def problems(self, gap_policy: str, whole_file: bool,
                  dropout_s: float = 0.0) -> list[Problem]:
         """The problems of the time axis so far. ``whole_file``: a time unit or sample
@@ -255,7 +270,8 @@ class TimeContinuity:
             )
         n_dropouts = self.dropouts(dropout_s)[0]
         n_long = self.n_gaps - n_dropouts
-        if n_long and gap_policy == "error" and not whole_file:
+        if n_long and gap_policy == "error" and not whole_file and not self.duty_cycled(
+                dropout_s):
             durations = np.concatenate(self._gap_durations)
             first = next((g for g in self.gaps if g.duration_s > dropout_s), None)
             if first is None:  # beyond the gaps listed: the first long one's duration only

@@ -397,6 +397,7 @@ class RecordingValidator:
             gap_policy=self.gaps,
             n_dropouts=self.time_axis.dropouts(self.dropout_s)[0],
             dropout_s=self.dropout_s,
+            duty_cycled=self.time_axis.duty_cycled(self.dropout_s),
         )
 
     # -- heuristics ----------------------------------------------------------
