@@ -29,8 +29,7 @@ command line starts at once.
 
 from __future__ import annotations
 
-import importlib
-from typing import Any
+from hrgtc.core.lazy import lazy_names
 
 #: Public name -> the core module that defines it (loaded on first access).
 _NAMES = {
@@ -46,14 +45,4 @@ _NAMES = {
 __all__ = sorted(_NAMES)
 
 
-def __getattr__(name: str) -> Any:
-    module = _NAMES.get(name)
-    if module is None:
-        raise AttributeError(f"module 'hrgtc.core' has no attribute {name!r}")
-    value = getattr(importlib.import_module(f"hrgtc.core.{module}"), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_NAMES))
+__getattr__, __dir__ = lazy_names(__name__, _NAMES, globals())

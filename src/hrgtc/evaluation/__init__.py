@@ -9,8 +9,7 @@ merit themselves.
 [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
 """
 
-import importlib
-from typing import Any
+from hrgtc.core.lazy import lazy_names
 
 #: Public name -> the module of this package that defines it, imported on first use
 #: (PEP 562): ``hrgtc.evaluation.allan`` alone costs no drift model, scipy or pyarrow.
@@ -26,17 +25,7 @@ _NAMES = {
 }
 
 
-def __getattr__(name: str) -> Any:
-    module = _NAMES.get(name)
-    if module is None:
-        raise AttributeError(f"module 'hrgtc.evaluation' has no attribute {name!r}")
-    value = getattr(importlib.import_module(f"hrgtc.evaluation.{module}"), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_NAMES))
+__getattr__, __dir__ = lazy_names(__name__, _NAMES, globals())
 
 
 __all__ = [
