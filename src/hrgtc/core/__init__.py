@@ -24,12 +24,14 @@ It also holds what every stage needs and that depends on nothing else of hrgtc:
 
 ``core`` imports nothing from the other hrgtc stages. Its names are loaded on first use
 (PEP 562), so ``from hrgtc.core.errors import HrgtcError`` costs no numpy import and the
-command line starts at once.
+command line starts at once; :func:`lazy_names` gives another package the same.
 """
 
 from __future__ import annotations
 
-from hrgtc.core.lazy import lazy_names
+import importlib
+from collections.abc import Callable, Mapping, MutableMapping
+from typing import Any
 
 #: Public name -> the core module that defines it (loaded on first access).
 _NAMES = {
@@ -43,6 +45,26 @@ _NAMES = {
 }
 
 __all__ = sorted(_NAMES)
+
+
+def lazy_names(package: str, names: Mapping[str, str], namespace: MutableMapping[str, Any],
+               ) -> tuple[Callable[[str], Any], Callable[[], list[str]]]:
+    """The ``__getattr__`` and ``__dir__`` of ``package``: ``names`` maps each public name to
+    its module (relative to the package); a name is imported when first asked for and kept
+    in the package's ``namespace`` (its ``globals()``)."""
+
+    def __getattr__(name: str) -> Any:
+        module = names.get(name)
+        if module is None:
+            raise AttributeError(f"module {package!r} has no attribute {name!r}")
+        value = getattr(importlib.import_module(f"{package}.{module}"), name)
+        namespace[name] = value
+        return value
+
+    def __dir__() -> list[str]:
+        return sorted(set(namespace) | set(names))
+
+    return __getattr__, __dir__
 
 
 __getattr__, __dir__ = lazy_names(__name__, _NAMES, globals())

@@ -9,7 +9,7 @@ merit themselves.
 [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
 """
 
-from hrgtc.core.lazy import lazy_names
+from hrgtc.core import lazy_names
 
 #: Public name -> the module of this package that defines it, imported on first use
 #: (PEP 562): ``hrgtc.evaluation.allan`` alone costs no drift model, scipy or pyarrow.
