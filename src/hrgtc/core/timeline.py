@@ -56,6 +56,16 @@ def min_partial_rows(rows: int) -> int:
     return max(2, math.ceil(PARTIAL_WINDOW_FRACTION * rows) - 1)
 
 
+def is_bursty(segments: int, length_s: float, period_s: float) -> bool:
+    """A duty-cycled logger: three segments or more, their (median) length much shorter
+    than the (median) time from one segment's start to the next's.
+
+    >>> is_bursty(25, 5.0, 300.0), is_bursty(3, 900.0, 1000.0), is_bursty(2, 5.0, 300.0)
+    (True, False, False)
+    """
+    return segments >= 3 and length_s < 0.5 * period_s
+
+
 def gap_limit_s(period_s: float, gap_factor: float = GAP_FACTOR) -> float:
     """Longest time step that is not a gap. [s]
 
@@ -212,7 +222,7 @@ class Timeline:
     @property
     def is_bursty(self) -> bool:
         """Several segments, each much shorter than the time between their starts."""
-        return self.n_segments >= 3 and self.burst_length_s < 0.5 * self.burst_period_s
+        return is_bursty(self.n_segments, self.burst_length_s, self.burst_period_s)
 
     def segment_of(self, rows: np.ndarray) -> np.ndarray:
         """Index of the segment of each row."""

@@ -297,6 +297,21 @@ class DriftModelRecord(records.Record, kw_only=True):
     pruning: dict[str, Any] | None = None
 
 
+def _design(windows: Any, offsets: str, factors: np.ndarray) -> tuple[Any, np.ndarray,
+                                                                        np.ndarray, np.ndarray]:
+    """The offset groups, the scaled design matrix and, with the offsets projected off
+    (Frisch-Waugh-Lovell: they are always in), the design and bias the selection sees."""
+    powered = windows.power_run is not None  # a logger restart starts a run of its own
+    groups = offset_groups(offsets, windows.power_run if powered else windows.run,
+                           windows.power_runs if powered else windows.sources,
+                           windows.accel, windows.orientation)
+    x_full = windows.terms / factors
+    x_scaled, bias = x_full, windows.bias_dph
+    if groups.mode != "none":
+        x_scaled, bias = project_off(groups, x_full, windows.bias_dph)
+    return groups, x_full, x_scaled, bias
+
+
 def fit(
     runs: Sequence[RunSource],
     thermometer: Thermometer,
@@ -474,15 +489,7 @@ def fit(
         scales[v] = magnitude if magnitude > 0 else 1.0
     settings = FeatureSettings(**{**settings.to_dict(), "scales": scales})
     factors = np.array([t.scale_factor(scales) for t in candidates])
-    powered = windows.power_run is not None  # a logger restart starts a run of its own
-    groups = offset_groups(offsets, windows.power_run if powered else windows.run,
-                           windows.power_runs if powered else windows.sources,
-                           windows.accel, windows.orientation)
-    x_full = windows.terms / factors
-    bias = windows.bias_dph
-    x_scaled = x_full
-    if groups.mode != "none":  # the offsets are always in: project them off (FWL)
-        x_scaled, bias = project_off(groups, x_full, windows.bias_dph)
+    groups, x_full, x_scaled, bias = _design(windows, offsets, factors)
     if autocorrelation == "newey-west":
         design = np.column_stack([np.ones(x_scaled.shape[0]), x_scaled])
         solution = np.linalg.lstsq(design, bias, rcond=None)[0]
@@ -534,13 +541,7 @@ def fit(
         windows = window_means(runs, settings, candidates, window_s, progress, thermometer,
                                tracked, keep=keep, gaps=gaps,
                                restart_each_segment=restart_each_segment)
-        groups = offset_groups(offsets, windows.power_run if powered else windows.run,
-                               windows.power_runs if powered else windows.sources,
-                               windows.accel, windows.orientation)
-        x_full = windows.terms / factors
-        x_scaled, bias = x_full, windows.bias_dph
-        if groups.mode != "none":
-            x_scaled, bias = project_off(groups, x_full, windows.bias_dph)
+        groups, x_full, x_scaled, bias = _design(windows, offsets, factors)
         history = result.history
         result = dataclasses.replace(
             stepwise(x_scaled, bias, names=names, penter=penter, premove=premove,

@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from hrgtc.core.timeline import gap_limit_s, is_gap
+from hrgtc.core.timeline import gap_limit_s, is_bursty, is_gap
 from hrgtc.recording.checks import (
     RATE_CHECK_ROWS,
     SAMPLE_RATE_TOLERANCE,
@@ -227,13 +227,13 @@ class TimeContinuity:
         across each gap by default (``--gaps bridge``): restarting them would leave each
         burst inside the df/dt filter's warm-up."""
         long = [g for g in self.gaps if g.duration_s > dropout_s]
-        if len(long) < 3:
+        if len(long) < 2:
             return False
         ends = np.array([g.start_time_s + g.duration_s for g in long[:-1]])  # a burst starts
         starts = np.array([g.start_time_s for g in long[1:]])  # the next one stops
-        bursts = starts - ends
-        periods = np.diff([g.start_time_s for g in long])
-        return bool(np.median(bursts) < 0.5 * np.median(periods))
+        # the bursts between the gaps (the first and the last segments are cut by the file)
+        return is_bursty(len(long) + 1, float(np.median(starts - ends)),
+                         float(np.median(np.diff([g.start_time_s for g in long]))))
 
     def problems(self, gap_policy: str, whole_file: bool,
                  dropout_s: float = 0.0) -> list[Problem]:
