@@ -59,7 +59,7 @@ def test_the_builder_chunk_by_chunk_gives_the_whole_timeline():
         builder = TimelineBuilder(0.02)
         for first in range(0, time.size, size):
             builder.partial_fit(time[first:first + size])
-        built = builder.timeline()
+        built = builder.finish()
         np.testing.assert_array_equal(built.bounds, whole.bounds)
         np.testing.assert_array_equal(built.start_s, whole.start_s)
         np.testing.assert_array_equal(built.stop_s, whole.stop_s)

@@ -175,11 +175,11 @@ def test_channel_shape_of_a_temperature_and_of_a_rate():
     run = ramp_run(seed=3, start_c=10.0, end_c=0.0, hours=0.25, ramp_hours=0.5)
     temperature, rate = ChannelShape(), ChannelShape()
     for start in range(0, len(run), 1000):
-        temperature.add(run["resonator_c"][start:start + 1000])
-        rate.add(run.rate_dph[start:start + 1000])
+        temperature.partial_fit(run["resonator_c"][start:start + 1000])
+        rate.partial_fit(run.rate_dph[start:start + 1000])
     assert temperature.smoothness < 1e-3
     white = ChannelShape()
-    white.add(np.random.default_rng(2).normal(5.0, 2.0, 50_000))
+    white.partial_fit(np.random.default_rng(2).normal(5.0, 2.0, 50_000))
     assert white.smoothness == pytest.approx(0.6745 * math.sqrt(2.0) / (2 * 2.326), rel=0.05)
     assert 0.05 < rate.smoothness < 0.3  # noise plus the simulator's slow drift
 
@@ -191,8 +191,8 @@ def test_swapped_rate_and_temperature_of_a_sensor_gyro_are_named():
 
     run = ramp_run(seed=3, start_c=10.0, end_c=0.0, hours=0.25, ramp_hours=0.5)
     temperature, rate = ChannelShape(), ChannelShape()
-    temperature.add(run["resonator_c"])
-    rate.add(run.rate_dph)
+    temperature.partial_fit(run["resonator_c"])
+    rate.partial_fit(run.rate_dph)
     check_sensor_swap(temperature, rate, "run.csv", "temperature_c", "rate_dph")  # no error
     with pytest.raises(InputError) as raised:
         check_sensor_swap(rate, temperature, "run.csv", "temperature_c", "rate_dph")
@@ -222,8 +222,8 @@ def test_the_pan_mems_recording_is_no_swap_and_its_swap_is_found():
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             for chunk in options.chunks(pan):
-                temperature.add(chunk.freq_hz)
-                rate.add(chunk.rate_dph)
+                temperature.partial_fit(chunk.freq_hz)
+                rate.partial_fit(chunk.rate_dph)
         check_sensor_swap(temperature, rate, "pan.csv", "temp", f"rate_dph_{axis}")
         with pytest.raises(InputError, match="look swapped"):
             check_sensor_swap(rate, temperature, "pan.csv", "temp", f"rate_dph_{axis}")

@@ -76,7 +76,7 @@ def _check_against_the_definition(rows, chunks):
     from hrgtc.drift.windows import _WindowMeans
 
     means = _WindowMeans(rows)
-    got = [means.partial_fit(block, breaks, cuts) for block, breaks, cuts in chunks]
+    got = [means.transform(block, breaks, cuts) for block, breaks, cuts in chunks]
     got = [g for g in got if g.shape[0]]
     got = np.concatenate(got) if got else np.empty((0, 3))
     expected, dropped = _reference_window_means(rows, chunks)
@@ -139,12 +139,12 @@ def test_window_means_of_bursts_one_window_long_each():
     block = np.asfortranarray(np.arange(rows * bursts * 2, dtype=float).reshape(-1, 2))
     starts = np.arange(0, rows * bursts, rows)
     whole = _WindowMeans(rows)
-    got = whole.partial_fit(block, starts)
+    got = whole.transform(block, starts)
     np.testing.assert_array_equal(got, block.reshape(bursts, rows, 2).mean(axis=1))
     split = _WindowMeans(rows)
     cut = rows * 7 + 11
-    parts = [split.partial_fit(block[:cut], starts),
-             split.partial_fit(block[cut:], starts[starts >= cut] - cut)]
+    parts = [split.transform(block[:cut], starts),
+             split.transform(block[cut:], starts[starts >= cut] - cut)]
     np.testing.assert_allclose(np.concatenate(parts), got, rtol=1e-15)
     assert whole.flush().shape[0] == 0 and split.flush().shape[0] == 0
     assert whole.partial_dropped_rows == split.partial_dropped_rows == 0

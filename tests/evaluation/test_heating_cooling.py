@@ -84,7 +84,7 @@ def test_chunking_does_not_change_the_split(model):
     for start in range(0, len(run), 7777):
         stop = min(start + 7777, len(run))
         parts.partial_fit(run.slice(start, stop), run.rate_dph[start:stop], comp[start:stop])
-    a, b = whole.result(), parts.result()
+    a, b = whole.finish(), parts.finish()
     assert a.blocks == b.blocks and a.residual_rms_dph is None
     for d in ("heating", "cooling"):
         assert a.compensated_dph[d] == pytest.approx(b.compensated_dph[d], rel=1e-12)
@@ -108,7 +108,7 @@ def test_blocks_never_span_a_gap_and_match_the_burst_means_by_hand(model, burst_
     for start in range(0, len(run), 1234):  # chunks that cut bursts too
         stop = min(start + 1234, len(run))
         split.partial_fit(run.slice(start, stop), run.rate_dph[start:stop], comp[start:stop])
-    found = split.result()
+    found = split.finish()
     # by hand: df/dt from the model's causal filter over the whole file (true Δt across the
     # gaps), the settling in seconds, then each burst cut into 50-row blocks and a tail
     df = FeatureStream(model.drift.settings, ("df",)).transform(run)["df"]
@@ -147,7 +147,7 @@ def test_no_block_is_said_once_with_the_reason(model):
     comp = run.rate_dph - model.drift.predict_recording(run)
     split = DirectionSplit(model, FS)
     split.partial_fit(run, run.rate_dph, comp)
-    found = split.result()
+    found = split.finish()
     assert found.blocks == {"heating": 0, "cooling": 0}
     assert found.reason == "bursts of at most 3 s are shorter than half the 10 s block (4.8 s)"
     text = found.summary()
@@ -159,8 +159,8 @@ def test_a_run_shorter_than_half_a_block_after_the_settling_says_so(model):
     run = cycle_run(seed=7).slice(0, round((model.drift.settings.warmup_s + 3.0) * FS))
     split = DirectionSplit(model, FS)
     split.partial_fit(run, run.rate_dph, run.rate_dph)
-    assert split.result().reason == (
+    assert split.finish().reason == (
         "the settled run (3 s) is shorter than half the 10 s block (4.8 s)")
     early = DirectionSplit(model, FS)
     early.partial_fit(run.slice(0, 10), run.rate_dph[:10], run.rate_dph[:10])
-    assert "past the df/dt filter's" in early.result().reason
+    assert "past the df/dt filter's" in early.finish().reason

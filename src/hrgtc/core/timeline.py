@@ -28,7 +28,7 @@ from __future__ import annotations
 import itertools
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Self
 
 import numpy as np
 
@@ -580,11 +580,11 @@ class TimelineBuilder:
         self._stop_s: list[np.ndarray] = []
         self._last: float | None = None
 
-    def partial_fit(self, time_s: np.ndarray) -> None:
+    def partial_fit(self, time_s: np.ndarray) -> Self:
         """The next chunk's sample times. [s]"""
         time_s = np.asarray(time_s, dtype=np.float64)
         if not time_s.size:
-            return
+            return self
         starts = np.flatnonzero(is_gap(np.diff(time_s), self.period_s, self.gap_factor)) + 1
         if self._last is None or is_gap(time_s[0] - self._last, self.period_s, self.gap_factor):
             starts = np.concatenate([[0], starts])
@@ -597,8 +597,9 @@ class TimelineBuilder:
             self._start_s.append(time_s[starts])
         self._rows += time_s.size
         self._last = float(time_s[-1])
+        return self
 
-    def timeline(self) -> Timeline:
+    def finish(self) -> Timeline:
         """The timeline of the times seen so far."""
         if not self._start_rows:
             return Timeline(np.empty((0, 2), dtype=np.int64), np.empty(0), np.empty(0),

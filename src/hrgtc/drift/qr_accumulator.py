@@ -237,6 +237,10 @@ class QRAccumulator:
         merged.sum_weights_ = sum(a.sum_weights_ for a in parts)
         return merged
 
+    def finish(self) -> OLSResult:
+        """The fit on every column (:meth:`fit` fits a subset of them)."""
+        return self.fit()
+
     def fit(self, columns: Sequence[str | int] | None = None, *,
             tol: float = COLLINEARITY_TOL, variance_inflation: float = 1.0) -> OLSResult:
         """Fit y on the constant and ``columns`` (names or indices; default all).

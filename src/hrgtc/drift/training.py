@@ -27,7 +27,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Self
 
 import numpy as np
 
@@ -291,16 +291,21 @@ class ChannelShape:
         self._noises: list[float] = []
         self._low, self._high = math.inf, -math.inf
 
-    def add(self, values: Any) -> None:
+    def partial_fit(self, values: Any) -> Self:
         """One chunk of the column's values."""
         finite = np.asarray(values, dtype=np.float64)
         finite = finite[np.isfinite(finite)]
         noise = rate_noise_dph(finite)
         if not math.isfinite(noise):
-            return
+            return self
         self._noises.append(noise)
         low, high = np.percentile(finite, [1.0, 99.0])
         self._low, self._high = min(self._low, float(low)), max(self._high, float(high))
+        return self
+
+    def finish(self) -> Self:
+        """The shape of every chunk taken (read with :attr:`smoothness`)."""
+        return self
 
     @property
     def noise(self) -> float:

@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Self
 
 import numpy as np
 
@@ -177,7 +177,7 @@ class DirectionSplit:
         self.longest_segment_rows = 0
 
     def partial_fit(self, freq_chunk: Any, raw_dph: np.ndarray, compensated_dph: np.ndarray,
-             residual_dph: np.ndarray | None = None) -> None:
+             residual_dph: np.ndarray | None = None) -> Self:
         """The next chunk: the recording (for df/dt), raw and compensated output [°/h] and,
         on a simulated run, model minus true bias [°/h]."""
         df = self._stream.transform(freq_chunk)["df"]
@@ -189,7 +189,7 @@ class DirectionSplit:
         block = np.column_stack(columns)
         time = np.asarray(freq_chunk.time_s, dtype=np.float64)
         if not time.size:
-            return
+            return self
         if self._origin_s is None:
             self._origin_s = float(time[0])
         # the df/dt filter's settling, in seconds on the time axis
@@ -204,7 +204,7 @@ class DirectionSplit:
         starts[restarts] = True
         kept_time, block, starts = time[settled], block[settled], starts[settled]
         if not kept_time.size:
-            return
+            return self
         self.settled_rows += kept_time.size
         starts[1:] |= is_gap(np.diff(kept_time), self._period_s)
         if self._last_s is None:
@@ -219,6 +219,7 @@ class DirectionSplit:
             if starts[edges[k]]:
                 self._close_segment()
             self._push(block[edges[k]:edges[k + 1]])
+        return self
 
     def _push(self, rows: np.ndarray) -> None:
         """Rows of the open segment: full blocks become means, the rest is carried."""
@@ -246,7 +247,7 @@ class DirectionSplit:
         self._segment_rows = 0
         self.segments += 1
 
-    def result(self) -> DirectionStats:
+    def finish(self) -> DirectionStats:
         """The split of the blocks so far (call once, after the last chunk)."""
         if self.segments > 1:  # a segmented run: its last burst's partial block counts too
             self._close_segment()

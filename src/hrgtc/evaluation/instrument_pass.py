@@ -109,7 +109,7 @@ def evaluate_axes(
         done += len(chunk)
         if progress is not None:
             progress(done, rows)
-    return {axis: count_dropped(state.result(), dropped) for axis, state in passes.items()}
+    return {axis: count_dropped(state.finish(), dropped) for axis, state in passes.items()}
 
 
 def _rest_masks(chunks: Iterator[Recording], model: InstrumentModel, motion: str,

@@ -4,6 +4,7 @@ chunk by chunk, that the report's figures draw (never the raw samples of a long 
 from __future__ import annotations
 
 from collections.abc import Mapping
+from typing import Self
 
 import numpy as np
 
@@ -19,7 +20,7 @@ class BlockMeans:
         self.offset = 0
         self._parts: dict[str, list[tuple[int, np.ndarray]]] = {}
 
-    def partial_fit(self, columns: Mapping[str, np.ndarray]) -> None:
+    def partial_fit(self, columns: Mapping[str, np.ndarray]) -> Self:
         """Add the next rows (every column of one length)."""
         n = len(next(iter(columns.values())))
         index = (self.offset + np.arange(n)) // self.rows
@@ -28,8 +29,9 @@ class BlockMeans:
             sums = np.bincount(index - first, weights=np.asarray(values, dtype=np.float64))
             self._parts.setdefault(name, []).append((first, sums))
         self.offset += n
+        return self
 
-    def means(self) -> dict[str, np.ndarray]:
+    def finish(self) -> dict[str, np.ndarray]:
         """Block means of every column (the last block may be shorter)."""
         blocks = -(-self.offset // self.rows)
         totals = {}

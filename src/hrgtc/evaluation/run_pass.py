@@ -185,7 +185,7 @@ class RunPass:
         """Every chunk of the run, then the result."""
         for chunk in chunks:
             self.partial_fit(chunk)
-        return self.result()
+        return self.finish()
 
     def partial_fit(self, chunk: Recording) -> RunPass:
         """Compensate and measure the next chunk of the run."""
@@ -203,7 +203,7 @@ class RunPass:
                                    1.0 / metadata.sample_rate_hz,
                                    2 * round(10.0 * metadata.sample_rate_hz),
                                    restart_at_gaps=gaps == "split",
-                                   keep_mask=allan and deviation != "oadev")
+                                   keep_mask=allan and deviation != "oadev", name=self.name)
             self.split = DirectionSplit(model, metadata.sample_rate_hz)
         metadata, frequency, housing = self.metadata, self.frequency, self.housing
         done = frequency.samples  # rows before this chunk; the at-rest mask of its own
@@ -246,7 +246,7 @@ class RunPass:
             self.progress(frequency.samples, self.total_rows)
         return self
 
-    def result(self) -> Evaluation:
+    def finish(self) -> Evaluation:
         """The figures of the run so far (call once, after the last chunk)."""
         model, name, allan, deviation = self.model, self.name, self.allan, self.deviation
         confidence, frequency, means = self.confidence, self.frequency, self.means
@@ -255,7 +255,7 @@ class RunPass:
             raise InputError(f"{name}: the run holds no samples")
         cut, split, left_out = self.cut, self.split, self.left_out
         fs = metadata.sample_rate_hz
-        cut.finish(name)
+        cut.finish()
         n = frequency.samples
         if n < 2 * round(10.0 * fs):
             raise InputError(f"{name}: {n / fs:.1f} s is too short for a 10 s bias stability "
@@ -300,7 +300,7 @@ class RunPass:
         if allan and deviation not in ("adev", "oadev"):
             notes.append(f"noise terms are read off the Allan deviation; --deviation {deviation} "
                          "gives the curve only")
-        kept = None if means is None else means.means()
+        kept = None if means is None else means.finish()
         if kept is not None and model.drift.terms:
             values_at = {k.removeprefix(VARIABLE_PREFIX): v for k, v in kept.items()
                          if k.startswith(VARIABLE_PREFIX)}
@@ -313,7 +313,7 @@ class RunPass:
             block_s=None if means is None else means.rows / fs,
             blocks=kept, notes=tuple(notes), ranges=frequency.ranges(),
             bias_stability_interval_dph=intervals, confidence=float(confidence),
-            deviation=deviation, directions=split.result(), mean_dph=mean, rms_dph=rms,
+            deviation=deviation, directions=split.finish(), mean_dph=mean, rms_dph=rms,
             n_not_at_rest=left_out,
             accounting=_accounting(n, cut.cut, frequency, left_out),
             bias_stability_blocks=blocks, burst_allan=bursts,

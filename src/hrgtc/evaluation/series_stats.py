@@ -36,6 +36,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import replace
+from typing import Self
 
 import numpy as np
 
@@ -72,12 +73,17 @@ class _BlockMeans:
         self.mean = 0.0
         self.m2 = 0.0
 
-    def partial_fit(self, values: np.ndarray) -> None:
+    def partial_fit(self, values: np.ndarray) -> Self:
         data = np.concatenate([self._carry, values]) if self._carry.size else values
         blocks = data.size // self.rows
         if blocks:
             self._add(data[: blocks * self.rows].reshape(blocks, self.rows).mean(axis=1))
         self._carry = np.array(data[blocks * self.rows:])
+        return self
+
+    def finish(self) -> np.ndarray:
+        """The means of the complete blocks (the open one is not a block yet)."""
+        return self.means()
 
     def close_segment(self, min_rows: int) -> None:
         """A gap follows: the partial block is kept as one mean when it holds at least
@@ -138,7 +144,7 @@ class _SecondDifferenceSums:
         """A gap: no second difference reaches across it."""
         self._tail = np.empty(0)
 
-    def partial_fit(self, values: np.ndarray) -> None:
+    def partial_fit(self, values: np.ndarray) -> Self:
         data = np.concatenate([self._tail, values]) if self._tail.size else values
         old = self._tail.size
         centred = data - np.mean(data)  # a constant offset leaves second differences unchanged
@@ -156,6 +162,11 @@ class _SecondDifferenceSums:
             self.counts[k] += stop - start
         keep = 2 * int(self.factors[-1])
         self._tail = np.array(data[-keep:])
+        return self
+
+    def finish(self) -> tuple[np.ndarray, np.ndarray]:
+        """The sums of squared second differences per octave factor and their counts."""
+        return self.sums, self.counts
 
 
 class SeriesStatistics:
@@ -206,7 +217,7 @@ class SeriesStatistics:
         self._segments: list[list[float]] = []
 
     def partial_fit(self, values: np.ndarray, breaks: Sequence[int] = (),
-             time_s: np.ndarray | None = None) -> None:
+                    time_s: np.ndarray | None = None) -> Self:
         """Add the next samples; ``breaks``: indices in ``values`` where a segment starts
         after a gap (no τ-block and no Allan difference reaches across it); ``time_s``:
         their times [s] (for the burst means beyond a segment)."""
@@ -214,13 +225,18 @@ class SeriesStatistics:
         cuts = sorted({int(b) for b in breaks if 0 <= b < values.size})
         if not cuts:
             self._push(values, time_s)
-            return
+            return self
         edges = [0, *[c for c in cuts if c > 0], values.size]
         for k in range(len(edges) - 1):
             if k > 0 or cuts[0] == 0:
                 self.break_segment()
             self._push(values[edges[k]:edges[k + 1]],
                        None if time_s is None else time_s[edges[k]:edges[k + 1]])
+        return self
+
+    def finish(self) -> Self:
+        """The statistics (read with :meth:`bias_stability`, :meth:`allan_deviation`, ...)."""
+        return self
 
     def break_segment(self) -> None:
         """A gap before the next sample: the partial τ-blocks are dropped (a block never

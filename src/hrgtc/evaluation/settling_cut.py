@@ -7,7 +7,7 @@ the same samples (:class:`SettlingCut`).
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Self
 
 import numpy as np
 
@@ -30,8 +30,9 @@ class SettlingCut:
 
     def __init__(self, series: dict[str, SeriesStatistics], warmup_s: float, period_s: float,
                  minimum: int, restart_at_gaps: bool = False, keep_mask: bool = False,
-                 ) -> None:
+                 name: str = "run") -> None:
         self.series = series
+        self.name = name  # the run, in the error of :meth:`finish`
         self.warmup_s = float(warmup_s)
         self.period_s = float(period_s)
         self.minimum = minimum
@@ -66,17 +67,17 @@ class SettlingCut:
         return time - origin >= settle_threshold_s(self.warmup_s)
 
     def partial_fit(self, values: dict[str, np.ndarray], time: np.ndarray,
-             restarts_s: Any = ()) -> None:
+             restarts_s: Any = ()) -> Self:
         """The next rows of every series (one length) and their times [s]; ``restarts_s``:
         times of logger restarts (``metadata.extra["restarts_s"]``), where the df/dt filter
         settles again."""
         if not time.size:
-            return
+            return self
         mask = self._settled(time, restarts_s)
         self.rows += time.size
         if self.flushed:
             self._feed(values, mask, time)
-            return
+            return self
         for key, array in values.items():
             self.held[key].append(array)
         self.held_masks.append(mask)
@@ -84,6 +85,7 @@ class SettlingCut:
         self.settled_rows += int(mask.sum())
         if self.settled_rows >= self.minimum:
             self._flush(np.concatenate(self.held_masks))
+        return self
 
     def _feed(self, values: dict[str, np.ndarray], mask: np.ndarray, time: np.ndarray) -> None:
         self.cut += int(mask.size - np.count_nonzero(mask))
@@ -101,13 +103,13 @@ class SettlingCut:
         for key, array in values.items():
             self.series[key].partial_fit(array[mask], breaks.tolist(), kept)
 
-    def finish(self, name: str = "run") -> int:
+    def finish(self) -> int:
         """Feed what is still held back; the number of samples left out (settling)."""
         if not self.flushed:
             if self.restart_at_gaps and self.settled_rows < self.minimum:
                 raise InputError(
-                    f"{name}: only {self.settled_rows} of {self.rows} samples are past the df/dt "
-                    f"filter's {self.warmup_s:g} s settling time: --gaps split restarts the "
+                    f"{self.name}: only {self.settled_rows} of {self.rows} samples are past the "
+                    f"df/dt filter's {self.warmup_s:g} s settling time: --gaps split restarts the "
                     "filter after every gap and the segments are shorter than that; use --gaps "
                     "bridge (the filter carries across gaps, e.g. a burst logger)")
             mask = np.zeros(self.rows, dtype=bool)

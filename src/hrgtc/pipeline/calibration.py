@@ -534,8 +534,8 @@ def _sensor_thermometer(training: Sequence[PathLike], options: ReadOptions) -> S
         for chunk in options.chunks(path):
             used = chunk.freq_hz[keep[row:row + len(chunk)]]
             row += len(chunk)
-            temperature.add(chunk.freq_hz)
-            rate.add(chunk.rate_dph)
+            temperature.partial_fit(chunk.freq_hz)
+            rate.partial_fit(chunk.rate_dph)
             if used.size:
                 low = min(low, float(np.min(used)))
                 high = max(high, float(np.max(used)))

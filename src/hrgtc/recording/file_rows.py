@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import dataclasses
 import re
+from typing import Self
 
 import numpy as np
 
@@ -48,9 +49,8 @@ class FileRows:
 
     Examples
     --------
-    >>> rows = FileRows()
-    >>> rows.partial_fit(0, np.array([0.0, 1.0, 3.0, 4.0]))  # file row 2 was dropped
-    >>> rows.partial_fit(4, np.array([5.0, 9.0]))            # rows 6-8 too
+    >>> rows = FileRows().partial_fit(0, np.array([0.0, 1.0, 3.0, 4.0]))  # row 2 dropped
+    >>> rows = rows.partial_fit(4, np.array([5.0, 9.0]))  # rows 6-8 too
     >>> [rows.file_row(k) for k in range(6)]
     [0, 1, 3, 4, 5, 9]
     """
@@ -59,16 +59,21 @@ class FileRows:
         self._at: list[int] = [0]
         self._shift: list[int] = [0]
 
-    def partial_fit(self, offset: int, file_rows: np.ndarray) -> None:
+    def partial_fit(self, offset: int, file_rows: np.ndarray) -> Self:
         """The file rows of the next ``len(file_rows)`` rows seen, from row ``offset`` on."""
         if not len(file_rows):
-            return
+            return self
         shift = np.asarray(file_rows, dtype=np.int64) - np.arange(offset, offset + len(file_rows))
         changes = np.flatnonzero(np.diff(shift)) + 1
         if shift[0] != self._shift[-1]:
             changes = np.concatenate([[0], changes])
         self._at += (offset + changes).tolist()
         self._shift += shift[changes].tolist()
+        return self
+
+    def finish(self) -> Self:
+        """The map of the rows seen (read with :meth:`file_row` and :meth:`problem`)."""
+        return self
 
     def file_row(self, row: int) -> int:
         """The file row of row ``row`` seen."""

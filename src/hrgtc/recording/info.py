@@ -352,7 +352,7 @@ def describe(path: str | Path, options: ReadSettings | None = None, *,
     duration = None
     if first_time is not None and meta is not None:
         duration = last_time - first_time + 1.0 / meta.sample_rate_hz
-    timeline: Timeline | None = None if builder is None else builder.timeline()
+    timeline: Timeline | None = None if builder is None else builder.finish()
     return RecordingInfo(
         path=str(path),
         format=fmt,

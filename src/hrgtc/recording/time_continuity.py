@@ -14,6 +14,7 @@ rows are numbered over the whole recording.
 from __future__ import annotations
 
 import math
+from typing import Self
 
 import numpy as np
 
@@ -62,7 +63,8 @@ class TimeContinuity:
         self._last_file_row: float | None = None
 
     def partial_fit(self, time: np.ndarray, offset: int, metadata: Metadata,
-               chunk: Recording | None = None, file_rows: np.ndarray | None = None) -> None:
+                    chunk: Recording | None = None, file_rows: np.ndarray | None = None,
+                    ) -> Self:
         """Check the times of the next chunk, its first row ``offset`` of the recording
         (``chunk``: the chunk itself, for the diagnosis of a step back).
 
@@ -85,8 +87,13 @@ class TimeContinuity:
                     extremes[1] <= gap_limit_s(period)):
                 self._last_time = float(time[-1])
                 self._check_rate(step, offset, time=time)
-                return
+                return self
         self._partial_fit_spans(time, offset, period, chunk, spans)
+        return self
+
+    def finish(self) -> Self:
+        """The checks of every chunk (read with :meth:`problems`, :meth:`dropouts`)."""
+        return self
 
     def _spans(self, file_rows: np.ndarray | None) -> np.ndarray | None:
         """File rows each step of the chunk spans (1: no row left out between), None when

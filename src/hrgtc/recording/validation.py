@@ -61,7 +61,7 @@ is validated chunk by chunk.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Self
 
 import numpy as np
 
@@ -181,7 +181,7 @@ class RecordingValidator:
             self._bounds.pop("freq_hz", None)
 
     # -- feeding -------------------------------------------------------------
-    def partial_fit(self, chunk: Recording, file_rows: np.ndarray | None = None) -> None:
+    def partial_fit(self, chunk: Recording, file_rows: np.ndarray | None = None) -> Self:
         """Check the next chunk (rows continue from the previous chunk); ``file_rows``: the
         file row of each of its rows when the reader left rows out (messages name those)."""
         if file_rows is not None:
@@ -226,6 +226,7 @@ class RecordingValidator:
         if self._heuristics is None:
             self._collect_sample(chunk)
         self.rows += n
+        return self
 
     def _sensor_copy(self, name: str, chunk: Recording) -> bool:
         """True for ``freq_hz*`` of the sensor thermometer: a copy of a temperature column."""

@@ -168,7 +168,7 @@ def trace_soak_axes(
     assert means  # iter_chunks raises on an empty file
     traces = {}
     for axis, state in means.items():
-        b = state.means()
+        b = state.finish()
         traces[axis] = SoakTrace(str(path), Path(path).name, block_s, b["time_s"],
                                  b["freq_hz"],
                                  thermometers[axis].temperature(b["freq_hz"], warn=False),
