@@ -70,7 +70,7 @@ def test_partial_fit_returns_self_and_finish_takes_nothing(cls):
 
 def test_the_protocol_is_the_behaviour():
     """Two real accumulators, fed and finished through the protocol alone."""
-    from hrgtc.core.timeline import TimelineBuilder
+    from hrgtc.core.timeline_builder import TimelineBuilder
     from hrgtc.drift.qr_accumulator import QRAccumulator
 
     builder = TimelineBuilder(0.1)

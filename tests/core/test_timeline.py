@@ -10,7 +10,6 @@ import pytest
 from hrgtc.core.errors import InputError
 from hrgtc.core.timeline import (
     Timeline,
-    TimelineBuilder,
     gap_limit_s,
     holdout_rows,
     is_gap,
@@ -21,6 +20,7 @@ from hrgtc.core.timeline import (
     time_blocks,
     windows,
 )
+from hrgtc.core.timeline_builder import TimelineBuilder
 
 
 def burst_times(bursts=25, burst_s=5.0, period_s=300.0, rate_hz=50.0, start_s=15.352):

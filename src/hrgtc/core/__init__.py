@@ -11,7 +11,10 @@ held-out split means the same thing in ``info``, ``calibrate``, ``compensate`` a
 * :mod:`hrgtc.core.time_steps` -- the one classifier of odd time steps (counter
   wraps, resets, daylight-saving steps, duplicates, a wrong time unit or sample
   rate, a rate that really changes) and the repair that makes each the clean file;
-* :mod:`hrgtc.core.accounting` -- samples read, used, and dropped or flagged by reason.
+* :mod:`hrgtc.core.accounting` -- samples read, used, and dropped or flagged by reason;
+* :mod:`hrgtc.core.timeline_builder` -- a timeline built chunk by chunk;
+* :mod:`hrgtc.core.estimator` -- the one contract of the streaming accumulators
+  (``partial_fit(chunk) -> self``, ``finish() -> result``).
 
 It also holds what every stage needs and that depends on nothing else of hrgtc:
 
@@ -36,9 +39,10 @@ from typing import Any
 #: Public name -> the core module that defines it (loaded on first access).
 _NAMES = {
     "REASONS": "accounting", "Accounting": "accounting",
+    "TimelineBuilder": "timeline_builder",
     "TimeDiagnosis": "time_steps", "TimeEvent": "time_steps", "classify_time_steps": "time_steps",
     **{name: "timeline" for name in (
-        "GAP_FACTOR", "GAP_TOLERANCE", "Timeline", "TimelineBuilder", "gap_limit_s", "is_gap",
+        "GAP_FACTOR", "GAP_TOLERANCE", "Timeline", "gap_limit_s", "is_gap",
         "median_period_s", "parse_time_bound", "seconds_since_power_on", "segment_bounds",
         "slice_rows", "time_blocks", "windows",
     )},

@@ -21,7 +21,8 @@ from hrgtc.core.errors import RecordingError
 from hrgtc.core.progress import Progress
 from hrgtc.core.records import Count, Record
 from hrgtc.core.time_steps import TimeRepairStream
-from hrgtc.core.timeline import Timeline, TimelineBuilder
+from hrgtc.core.timeline import Timeline
+from hrgtc.core.timeline_builder import TimelineBuilder
 from hrgtc.recording.axes import axis_names, base_name
 from hrgtc.recording.formats.registry import format_of
 from hrgtc.recording.io import iter_chunks
