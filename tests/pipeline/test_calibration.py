@@ -313,7 +313,7 @@ def test_aux_channels_and_gradient_terms_need_their_columns():
     # --aux NAME=COLUMN adds a_NAME to the candidates; a training run without the column, or
     # gradient terms without housing_c, stop with the file and the column named
     from hrgtc.core.errors import InputError
-    from hrgtc.pipeline.calibration import GRADIENT_TERMS, candidate_terms, parse_aux
+    from hrgtc.pipeline.terms import GRADIENT_TERMS, candidate_terms, parse_aux
 
     from synthetic import lagged_run, ramp_run
 

@@ -96,8 +96,8 @@ def calibrate_command(
     """
     from hrgtc.core.files import check_writable, refuse_existing, refuse_input
     from hrgtc.model import save_instrument
-    from hrgtc.pipeline.calibration import parse_aux
     from hrgtc.pipeline.instrument import calibrate_instrument
+    from hrgtc.pipeline.terms import parse_aux
     from hrgtc.recording import ReadOptions
     from hrgtc.thermometry.reference import TemperatureReference, parse_reference_columns
 

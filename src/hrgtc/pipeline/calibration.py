@@ -29,7 +29,6 @@ from hrgtc.core import records
 from hrgtc.core.errors import CalibrationError, ExtrapolationWarning, HrgtcWarning, InputError
 from hrgtc.core.progress import StageProgress, for_stage
 from hrgtc.core.summary import Summary
-from hrgtc.drift.features import AUX_NAME, EQ21, parse_terms
 from hrgtc.drift.rest import run_rest
 from hrgtc.drift.training import (
     ChannelShape,
@@ -43,12 +42,13 @@ from hrgtc.evaluation import Evaluation, evaluate
 from hrgtc.evaluation.calibration_figures import calibration_summary, thermometer_tables
 from hrgtc.model import UnitModel, provenance
 from hrgtc.pipeline.documents import CalibrationDriftRecord, CalibrationRecord
+from hrgtc.pipeline.terms import resolve_terms
 from hrgtc.recording import ReadOptions
 from hrgtc.recording.mapping import parse_columns, scales_temperature
 from hrgtc.recording.marks import refuse_compensated_training
 from hrgtc.settings import to_dict
 from hrgtc.settings.calibration import CalibrationSettings
-from hrgtc.settings.drift import GRADIENT_TERMS, DriftSettings
+from hrgtc.settings.drift import DriftSettings
 from hrgtc.settings.reading import ReadSettings
 from hrgtc.thermometry import fit as fit_thermometer
 from hrgtc.thermometry import identity
@@ -546,57 +546,3 @@ def _sensor_thermometer(training: Sequence[PathLike], options: ReadOptions) -> S
             + "; ".join(why) + "); if the gyro was still, its rate may be too coarse for the "
             "motion detector (a few LSB of noise): check --rate-unit, or pass --motion keep")
     return SoakFit(identity((low, high)))
-def parse_aux(items: Iterable[str]) -> dict[str, str]:
-    """``NAME=COLUMN`` items (``--aux``) as ``{NAME: COLUMN}``, spaces around each trimmed.
-
-    Raises
-    ------
-    InputError
-        An item without ``=`` or with an empty side, or a name given twice.
-    """
-    out: dict[str, str] = {}
-    for item in items:
-        name, sep, column = item.partition("=")
-        if not sep or not name.strip() or not column.strip():
-            raise InputError(f"--aux {item!r}: write NAME=COLUMN, e.g. --aux drive=drive_amp_v")
-        if name.strip() in out:
-            raise InputError(f"--aux {name.strip()!r} given twice")
-        out[name.strip()] = column.strip()
-    return out
-
-
-def candidate_terms(terms: Iterable[str], aux: Mapping[str, str] | None,
-                    heads: Sequence[Any]) -> tuple[str, ...]:
-    """The drift fit's candidates: ``terms``, plus ``a_NAME`` for each mapped channel.
-
-    Every training run must log each mapped column (the error names the file and the
-    column); gradient terms (``g``) need ``housing_c`` in every run.
-    """
-    out = [str(t) for t in terms]
-    used = {v for t in parse_terms(out) for v in t.variables}
-    for name, column in dict(aux or {}).items():
-        if not AUX_NAME.match(str(name)):
-            raise InputError(f"--aux name {name!r} is not usable; use a letter followed by "
-                             "letters or digits, e.g. --aux drive=drive_amplitude_v")
-        for head in heads:
-            if column not in head:
-                raise InputError(f"{head.source}: no column {column!r} for --aux "
-                                 f"{name}={column}; columns: {', '.join(head.names)}")
-        if f"a_{name}" not in used:
-            out.append(f"a_{name}")
-    if "g" in used:
-        for head in heads:
-            if "housing_c" not in head:
-                raise InputError(f"{head.source}: no column 'housing_c', which the gradient "
-                                 "terms (g) need; drop them or log the housing thermistor")
-    return tuple(out)
-
-
-def resolve_terms(terms: Iterable[str] | None, aux: Mapping[str, str] | None,
-                  heads: Sequence[Any]) -> tuple[str, ...]:
-    """The candidates of a drift fit: ``terms``, or by default the gradient set when every
-    training run logs ``housing_c`` (Eq. 21's nine otherwise), and the ``--aux`` channels."""
-    if terms is None:
-        housed = all("housing_c" in head for head in heads)
-        terms = GRADIENT_TERMS if housed else tuple(t.name for t in EQ21)
-    return candidate_terms(terms, aux, heads)
