@@ -58,17 +58,20 @@ def _machine_ceiling(unit) -> dict:
 
 def run(quick: bool = False) -> list[dict]:
     from hrgtc.fleet import calibrate_fleet, simulate_fleet
+    from hrgtc.settings.fleet import FleetCluster, FleetSimulation
 
     units, rate_hz = (8, 2.0) if quick else (10, 10.0)
     results = []
     with tempfile.TemporaryDirectory() as tmp:
         root = Path(tmp)
-        simulated = simulate_fleet(root / "fleet", units, seed=1, sample_rate_hz=rate_hz,
-                                   workers=2)
+        simulated = simulate_fleet(
+            root / "fleet", FleetSimulation(units=units, seed=1, sample_rate_hz=rate_hz),
+            cluster=FleetCluster(workers=2))
         rows = sum(o.row["rows"] for o in simulated.outcomes)
         seconds = {}
         for workers in (1, 2):
-            run = calibrate_fleet(root / "fleet", root / f"models-{workers}", workers=workers)
+            run = calibrate_fleet(root / "fleet", root / f"models-{workers}",
+                                  cluster=FleetCluster(workers=workers))
             assert not run.failed, run.failed
             seconds[workers] = run.seconds
             peaks = sorted(run.worker_peak_rss_mb.values())

@@ -233,8 +233,8 @@ def test_reference_defaults_are_the_libraries():
     ``calibrate_instrument`` defaults to no channel, no log and no holdout."""
     import inspect
 
-    from hrgtc.pipeline.calibration import parse_aux
     from hrgtc.pipeline.instrument import calibrate_instrument
+    from hrgtc.pipeline.terms import parse_aux
     from hrgtc.settings.inputs import TemperatureReferenceSettings
     from hrgtc.thermometry.reference import (
         MAX_LAG_S,

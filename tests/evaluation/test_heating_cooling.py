@@ -12,6 +12,7 @@ from hrgtc.evaluation import evaluate
 from hrgtc.evaluation.heating_cooling import DirectionSplit
 from hrgtc.model import UnitModel
 from hrgtc.recording import Metadata, Recording
+from hrgtc.settings.compensation import EvaluationSettings
 
 from synthetic import THERMOMETER, law, ramp_run
 
@@ -46,7 +47,7 @@ def model():
 
 def test_split_by_hand_and_by_the_resonator_temperature(model):
     run = cycle_run(seed=3, heating_extra_dph_per_c_per_h=0.8)
-    result = evaluate(run, model, allan=False)
+    result = evaluate(run, model, settings=EvaluationSettings(allan=False))
     split = result.directions
     assert split is not None
     # by hand: 10 s block means after the settling, df/dt from the filter, 5 % dead band

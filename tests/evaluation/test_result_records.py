@@ -30,6 +30,7 @@ from hrgtc.evaluation.evaluation_result import EvaluationRecord, evaluation_json
 from hrgtc.evaluation.heating_cooling import DirectionStats, DirectionStatsRecord
 from hrgtc.evaluation.metrics import ResidualRecord, ResidualResult, residual_against_truth
 from hrgtc.pipeline.calibration import calibrate
+from hrgtc.settings.compensation import EvaluationSettings
 
 pytestmark = pytest.mark.filterwarnings("ignore::hrgtc.core.errors.RateFilterWarning")
 
@@ -46,7 +47,7 @@ def evaluations(paper_campaign):
     model = calibrate(files.soaks, [files.cooldown]).model
     whole = evaluate(files.warmup, model, max_points=300)
     run = cut_bursts(recording.read(files.warmup), burst_s=60.0, period_s=600.0)
-    bursts = evaluate(run, model, deviation="mdev")
+    bursts = evaluate(run, model, settings=EvaluationSettings(deviation="mdev"))
     return {"whole": whole, "bursts": bursts}
 
 

@@ -15,6 +15,7 @@ from hrgtc.evaluation import evaluate
 from hrgtc.evaluation.metrics import bias_stability
 from hrgtc.model import save_model
 from hrgtc.pipeline.calibration import calibrate
+from hrgtc.settings.compensation import EvaluationSettings
 
 
 @pytest.fixture(scope="module")
@@ -134,7 +135,7 @@ def test_range_warnings_in_plain_output_and_strict_exit(setup, tmp_path, command
 
 def test_evaluation_ranges_cover_temperature_and_df_dt(setup):
     files, model, _ = setup
-    result = evaluate(files.warmup, model, allan=False)
+    result = evaluate(files.warmup, model, settings=EvaluationSettings(allan=False))
     data = result.to_dict()["ranges"]
     assert data["rate_fraction"] == pytest.approx(result.rate_out_of_range_fraction)
     assert data["rate_fraction"] > 0.0 and data["rate_excess_ratio"] > 1.0

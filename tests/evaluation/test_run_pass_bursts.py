@@ -16,6 +16,7 @@ from hrgtc.evaluation import evaluate
 from hrgtc.evaluation.allan_segments import pooled_edf
 from hrgtc.model import save_model
 from hrgtc.pipeline.calibration import calibrate
+from hrgtc.settings.compensation import EvaluationSettings
 
 # a 10 s df/dt filter on 600 s bursts is warned about; not what these tests are about
 pytestmark = pytest.mark.filterwarnings("ignore::hrgtc.core.errors.RateFilterWarning")
@@ -35,7 +36,7 @@ def bursts(tmp_path_factory, paper_campaign):
 @pytest.mark.parametrize("deviation", ["oadev", "mdev", "hdev", "tdev", "adev"])
 def test_every_deviation_is_pooled_within_bursts(bursts, deviation):
     run, model, _, _ = bursts
-    result = evaluate(run, model, deviation=deviation)
+    result = evaluate(run, model, settings=EvaluationSettings(deviation=deviation))
     curve = result.allan["raw"]
     assert curve.segments > 10
     # no τ longer than a burst (120 samples at 2 Hz): no term reaches across a gap

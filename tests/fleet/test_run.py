@@ -13,6 +13,7 @@ import pytest
 from hrgtc.fleet import calibrate_fleet, load_fleet, report_fleet, simulate_fleet
 from hrgtc.fleet.report import outliers, robust_z
 from hrgtc.fleet.results import read_table
+from hrgtc.settings.fleet import FleetCluster, FleetSimulation
 
 # Tiny rates and short soaks: the physics does not depend on the rate.
 SMALL = {"sample_rate_hz": 1.0, "soak_hours": 2.5, "ramp_hours": 2.0,
@@ -23,7 +24,8 @@ SMALL = {"sample_rate_hz": 1.0, "soak_hours": 2.5, "ramp_hours": 2.0,
 def fleet_root(tmp_path_factory) -> Path:
     """Three simulated units and a fourth whose first soak is a corrupt file, in a manifest."""
     root = tmp_path_factory.mktemp("fleet")
-    run = simulate_fleet(root / "data", 3, seed=5, workers=0, **SMALL)
+    run = simulate_fleet(root / "data", FleetSimulation(units=3, seed=5, **SMALL),
+                         cluster=FleetCluster(workers=0))
     assert run.counts()["ok"] == 3
     bad = root / "data" / "s5-bad"
     shutil.copytree(root / "data" / "s5-u0000", bad)
@@ -44,8 +46,8 @@ def _models(folder: Path) -> dict[str, dict]:
 
 
 def test_local_cluster_equals_sequential_and_a_bad_unit_fails_alone(fleet_root, tmp_path):
-    sequential = calibrate_fleet(fleet_root, tmp_path / "seq", workers=0)
-    parallel = calibrate_fleet(fleet_root, tmp_path / "par", workers=2)
+    sequential = calibrate_fleet(fleet_root, tmp_path / "seq", cluster=FleetCluster(workers=0))
+    parallel = calibrate_fleet(fleet_root, tmp_path / "par", cluster=FleetCluster(workers=2))
     assert parallel.where == "local cluster of 2 workers"
     assert len(parallel.worker_peak_rss_mb) == 2
     for run in (sequential, parallel):
@@ -75,18 +77,18 @@ def test_local_cluster_equals_sequential_and_a_bad_unit_fails_alone(fleet_root, 
 def test_resume_skips_unchanged_units_and_redoes_changed_ones(fleet_root, tmp_path):
     data = tmp_path / "data"
     shutil.copytree(fleet_root, data)
-    first = calibrate_fleet(data, tmp_path / "models", workers=0)
+    first = calibrate_fleet(data, tmp_path / "models", cluster=FleetCluster(workers=0))
     assert first.counts()["failed"] == 1
     with pytest.raises(Exception, match="exist"):
-        calibrate_fleet(data, tmp_path / "models", workers=0)
-    again = calibrate_fleet(data, tmp_path / "models", workers=0, resume=True)
+        calibrate_fleet(data, tmp_path / "models", cluster=FleetCluster(workers=0))
+    again = calibrate_fleet(data, tmp_path / "models", cluster=FleetCluster(workers=0), resume=True)
     assert again.counts() == {"ok": 0, "skipped": 3, "failed": 1}
     # repair the bad unit's file and change another unit's drift run
     shutil.copy(fleet_root / "s5-u0000" / "soaks" / "soak_-20C.parquet",
                 data / "s5-bad" / "soaks" / "soak_-20C.parquet")
     shutil.copy(fleet_root / "s5-u0002" / "validate" / "warmup_-20C_to_20C.parquet",
                 data / "s5-u0001" / "validate" / "warmup_-20C_to_20C.parquet")
-    third = calibrate_fleet(data, tmp_path / "models", workers=0, resume=True)
+    third = calibrate_fleet(data, tmp_path / "models", cluster=FleetCluster(workers=0), resume=True)
     status = {o.unit: o.status for o in third.outcomes}
     assert status == {"s5-bad": "ok", "s5-u0000": "skipped", "s5-u0001": "ok",
                       "s5-u0002": "skipped"}
@@ -108,7 +110,7 @@ def test_an_existing_cluster_from_the_environment_runs_the_same_code(fleet_root,
                                                                      monkeypatch):
     from distributed import LocalCluster
 
-    sequential = calibrate_fleet(fleet_root, tmp_path / "seq", workers=0)
+    sequential = calibrate_fleet(fleet_root, tmp_path / "seq", cluster=FleetCluster(workers=0))
     with LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
                       dashboard_address=None, host="127.0.0.1") as cluster:
         monkeypatch.setenv("DASK_SCHEDULER_ADDRESS", cluster.scheduler_address)

@@ -17,6 +17,7 @@ import pytest
 
 from hrgtc.fleet.run import FleetRun, run_tasks, worker_deaths
 from hrgtc.fleet.tasks import UnitOutcome
+from hrgtc.settings.fleet import FleetCluster
 
 cloudpickle.register_pickle_by_value(sys.modules[__name__])  # the workers cannot import tests
 
@@ -33,7 +34,7 @@ def _dies_once(unit: str, marker: str) -> UnitOutcome:
 def test_a_worker_that_dies_is_reported_with_the_unit_run_again(tmp_path):
     marker = str(tmp_path / "attempt")
     tasks = [(u, _dies_once, (u, marker)) for u in ("u0", "u1", "u2")]
-    run = run_tasks(tasks, workers=2)
+    run = run_tasks(tasks, cluster=FleetCluster(workers=2))
     assert run.counts() == {"ok": 3, "skipped": 0, "failed": 0}  # Dask ran it again
     assert run.workers_died == 1
     assert run.retried == ("u1",)

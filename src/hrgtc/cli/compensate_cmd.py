@@ -184,7 +184,8 @@ def evaluate_command(
         model = load_instrument(model_path)
         with progress_bar("evaluating", enabled=not json_output) as progress:
             result = evaluate_instrument(
-                run, model, axes=parse_axes(axes), read_options=inputs, deviation=deviation,
+                run, model, axes=parse_axes(axes), read_options=inputs,
+                settings=EvaluationSettings(deviation=deviation),
                 max_points=PREDICTION_BLOCKS, progress=progress, model_source=str(model_path))
         if allan_csv is not None:
             write_text_atomic(allan_csv, result.allan_csv(), force=force)

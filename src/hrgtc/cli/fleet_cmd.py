@@ -15,10 +15,10 @@ import typer
 
 from hrgtc.cli._app import app, console, error_console, library_errors, print_json, progress_bar
 from hrgtc.cli.options import ForceOption, JsonOption, reading_options
-from hrgtc.cli.params import option, split_values
+from hrgtc.cli.params import option, settings_options, split_values
 from hrgtc.settings.calibration import CalibrationSettings, ThermometerSettings
 from hrgtc.settings.drift import DriftSettings
-from hrgtc.settings.fleet import FleetEvaluation, FleetSimulation
+from hrgtc.settings.fleet import FleetCluster, FleetEvaluation, FleetSimulation
 
 if TYPE_CHECKING:
     from hrgtc.fleet import FleetRun
@@ -29,19 +29,6 @@ fleet_app = typer.Typer(
     help="Many units: simulate, calibrate, evaluate and report them as tasks on Dask, and "
     "build the population prior that cuts chamber time.")
 app.add_typer(fleet_app)
-
-_CLUSTER = "Cluster"
-SchedulerOption = Annotated[
-    str | None,
-    typer.Option("--scheduler", metavar="tcp://HOST:8786",
-                 help="Address of an existing Dask scheduler (default: DASK_SCHEDULER_ADDRESS, "
-                 "else a local cluster on this machine).", rich_help_panel=_CLUSTER)]
-WorkersOption = Annotated[
-    int | None,
-    typer.Option("--workers", min=0,
-                 help="Worker processes of the local cluster [default: one per core]; 0 runs "
-                 "the units here, one after the other.", rich_help_panel=_CLUSTER)]
-
 
 def _models_folder_inputs(models: Path) -> list[Path]:
     """The files of a models folder that fleet commands read (never an output, see -o)."""
@@ -77,20 +64,15 @@ def _finish(run: FleetRun, json_output: bool, written: str) -> None:
 
 
 @fleet_app.command("simulate")
+@settings_options(FleetSimulation)
+@settings_options(FleetCluster, "cluster")
 def simulate_command(
-    units: int = option(FleetSimulation, "units"),
-    seed: int = option(FleetSimulation, "seed"),
     output: Annotated[Path, typer.Option("-o", "--output", help="Fleet folder to write.")] = Path(
         "fleet"),
-    sample_rate_hz: float = option(FleetSimulation, "sample_rate_hz"),
-    soak_hours: float = option(FleetSimulation, "soak_hours"),
-    ramp_hours: float = option(FleetSimulation, "ramp_hours"),
-    setpoints: str = option(FleetSimulation, "setpoints_c"),
-    file_format: str = option(FleetSimulation, "file_format"),
-    scheduler: SchedulerOption = None,
-    workers: WorkersOption = None,
     force: ForceOption = False,
     json_output: JsonOption = False,
+    settings: FleetSimulation | None = None,
+    cluster: FleetCluster | None = None,
 ) -> None:
     """Simulate a population of units, each with its truth (truth.json) beside its files.
 
@@ -99,17 +81,15 @@ def simulate_command(
     from hrgtc.fleet import simulate_fleet
 
     with library_errors():
-        points = list(split_values(setpoints))
         with progress_bar("units", enabled=not json_output) as progress:
-            run = simulate_fleet(output, units, seed, sample_rate_hz=sample_rate_hz,
-                                 soak_hours=soak_hours, ramp_hours=ramp_hours,
-                                 setpoints_c=points, file_format=file_format, force=force,
-                                 scheduler=scheduler, workers=workers, progress=progress)
+            run = simulate_fleet(output, settings, force=force, cluster=cluster,
+                                 progress=progress)
     _finish(run, json_output, str(output))
 
 
 @fleet_app.command("calibrate")
 @reading_options
+@settings_options(FleetCluster, "cluster")
 def calibrate_command(
     root: Annotated[Path, typer.Argument(
         help="Fleet folder (ROOT/<unit>/{soaks,drift,validate}/) or manifest (.csv, .yaml).")],
@@ -125,11 +105,10 @@ def calibrate_command(
     resume: Annotated[bool, typer.Option(
         "--resume", help="Skip units whose model exists and whose inputs are unchanged "
         "(SHA-256).")] = False,
-    scheduler: SchedulerOption = None,
-    workers: WorkersOption = None,
     force: ForceOption = False,
     json_output: JsonOption = False,
     inputs: ReadOptions | None = None,
+    cluster: FleetCluster | None = None,
 ) -> None:
     """Calibrate every unit of a fleet: a model per unit and the fleet table (fleet.parquet).
 
@@ -144,24 +123,25 @@ def calibrate_command(
         fleet = load_fleet(root, unit)
         with progress_bar("units", enabled=not json_output) as progress:
             run = calibrate_fleet(fleet, output, settings=settings, read_options=inputs,
-                                  resume=resume, force=force, prior=prior, scheduler=scheduler,
-                                  workers=workers, progress=progress)
+                                  resume=resume, force=force, prior=prior, cluster=cluster,
+                                  progress=progress)
     _finish(run, json_output, f"{output}/<unit>.json, {output}/fleet.parquet")
 
 
 @fleet_app.command("evaluate")
 @reading_options
+@settings_options(FleetEvaluation)
+@settings_options(FleetCluster, "cluster")
 def evaluate_command(
     root: Annotated[Path, typer.Argument(help="Fleet folder or manifest.")],
     models: Annotated[Path, typer.Option("--models", help="Models folder.")] = Path("models"),
     output: Annotated[Path | None, typer.Option(
         "-o", "--output", help="Evaluation table [default: MODELS/evaluation.parquet].")] = None,
-    allan: bool = option(FleetEvaluation, "allan"),
-    scheduler: SchedulerOption = None,
-    workers: WorkersOption = None,
     force: ForceOption = False,
     json_output: JsonOption = False,
     inputs: ReadOptions | None = None,
+    settings: FleetEvaluation | None = None,
+    cluster: FleetCluster | None = None,
 ) -> None:
     """Evaluate each unit's held-out runs (validate/, else drift/) with its model.
 
@@ -174,14 +154,14 @@ def evaluate_command(
         if output is not None:
             refuse_input(output, _models_folder_inputs(models))
         with progress_bar("units", enabled=not json_output) as progress:
-            run = evaluate_fleet(root, models, output, read_options=inputs, allan=allan,
-                                 force=force, scheduler=scheduler, workers=workers,
-                                 progress=progress)
+            run = evaluate_fleet(root, models, output, read_options=inputs, settings=settings,
+                                 force=force, cluster=cluster, progress=progress)
     _finish(run, json_output, str(output or models / "evaluation.parquet"))
 
 
 @fleet_app.command("report")
 @reading_options
+@settings_options(FleetCluster, "cluster")
 def report_command(
     models: Annotated[Path, typer.Argument(help="Models folder (with fleet.parquet).")],
     output: Annotated[Path, typer.Option("-o", "--output", help="Fleet report (HTML).")] = Path(
@@ -191,11 +171,10 @@ def report_command(
     )] = None,
     root: Annotated[Path | None, typer.Option(
         "--root", help="Fleet folder or manifest (for --unit-reports).")] = None,
-    scheduler: SchedulerOption = None,
-    workers: WorkersOption = None,
     force: ForceOption = False,
     json_output: JsonOption = False,
     inputs: ReadOptions | None = None,
+    cluster: FleetCluster | None = None,
 ) -> None:
     """Write the fleet report: distributions, outliers (robust z), failed units with reasons.
 
@@ -208,8 +187,8 @@ def report_command(
         refuse_input(output, _models_folder_inputs(models))
         with progress_bar("units", enabled=not json_output and unit_reports is not None) as bar:
             path, run = report_fleet(models, output, source=root, unit_reports=unit_reports,
-                                     read_options=inputs, force=force, scheduler=scheduler,
-                                     workers=workers, progress=bar)
+                                     read_options=inputs, force=force, cluster=cluster,
+                                     progress=bar)
     if run is not None:
         _finish(run, json_output, f"{path}, {unit_reports}/<unit>.html")
     elif json_output:

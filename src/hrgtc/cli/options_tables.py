@@ -31,6 +31,7 @@ DOCUMENTED = {
     "export": ("hrgtc.settings.export", "ExportSettings"),
     "fleet_simulate": ("hrgtc.settings.fleet", "FleetSimulation"),
     "fleet_evaluate": ("hrgtc.settings.fleet", "FleetEvaluation"),
+    "fleet_cluster": ("hrgtc.settings.fleet", "FleetCluster"),
     "demo": ("hrgtc.settings.fleet", "DemoSettings"),
     "simulate": ("hrgtc.settings.simulation", "SimulationSettings"),
     "simulate_logger": ("hrgtc.settings.simulation", "LoggerSettings"),

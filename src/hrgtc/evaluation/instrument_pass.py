@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -27,16 +27,15 @@ from hrgtc.compensate.model_fit import (
 )
 from hrgtc.core.progress import Progress
 from hrgtc.drift.rest import run_rest
-from hrgtc.evaluation.allan import ONE_SIGMA
 from hrgtc.evaluation.evaluation_result import Evaluation
-from hrgtc.evaluation.metrics import DEFAULT_TAUS_S
 from hrgtc.evaluation.plot_blocks import block_rows
-from hrgtc.evaluation.run_pass import RunPass, count_dropped
+from hrgtc.evaluation.run_pass import RunPass, RunPlan, count_dropped
 from hrgtc.model import InstrumentModel
 from hrgtc.recording import ReadOptions, Recording, axis_view, count_rows
 from hrgtc.recording.io import check_axis_band
 from hrgtc.recording.marks import refuse_compensated
 from hrgtc.recording.motion import ACCEL_COLUMNS
+from hrgtc.settings.compensation import EvaluationSettings
 
 __all__ = ["evaluate_axes"]
 
@@ -48,13 +47,10 @@ def evaluate_axes(
     run: str | os.PathLike[str],
     model: InstrumentModel,
     *,
-    taus_s: Sequence[float] = DEFAULT_TAUS_S,
-    allan: bool = True,
+    settings: EvaluationSettings | None = None,
     read_options: ReadOptions | None = None,
     max_points: int | None = None,
     progress: Progress | None = None,
-    deviation: str = "oadev",
-    confidence: float = ONE_SIGMA,
 ) -> dict[str, Evaluation]:
     """Evaluate every axis of ``model`` on a recording file read once.
 
@@ -66,7 +62,7 @@ def evaluate_axes(
         :func:`hrgtc.compensate.multi_axis.match_axes`).
     model
         The instrument's model (its axes are those evaluated).
-    taus_s, allan, read_options, max_points, deviation, confidence
+    settings, read_options, max_points
         As :func:`hrgtc.evaluation.evaluate`, for every axis.
     progress
         ``progress(rows done, rows of the file)`` for the one reading.
@@ -93,9 +89,8 @@ def evaluate_axes(
     fs = head.sample_rate_hz
     keep = _rest_masks(options.chunks(run), model, options.motion, name)
     blocks = None if max_points is None else block_rows(rows, fs, max_points)
-    passes = {axis: RunPass(unit, name, source=source, taus_s=taus_s, allan=allan,
-                            block_rows=blocks, total_rows=rows, gaps=options.gaps,
-                            deviation=deviation, confidence=confidence, keep=keep.get(axis))
+    passes = {axis: RunPass(unit, RunPlan(name, source, rows, options.gaps, blocks,
+                                          keep.get(axis)), settings)
               for axis, unit in model.axes.items()}
     bands = {axis: plausible_frequency_band(unit) for axis, unit in model.axes.items()}
     done = 0

@@ -38,6 +38,7 @@ from hrgtc.evaluation.allan import (
     confidence_interval,
 )
 from hrgtc.evaluation.noise import NoiseTerms, noise_terms
+from hrgtc.settings.compensation import BIAS_STABILITY_TAUS_S
 
 __all__ = [
     "DEFAULT_TAUS_S", "FLICKER_FLOOR_FACTOR", "SECONDS_PER_HOUR", "TAU_SPACINGS",
@@ -47,8 +48,8 @@ __all__ = [
     "table_to_json",
 ]
 
-#: Averaging times of every bias-stability table (DESIGN.md, "Metrics"). [s]
-DEFAULT_TAUS_S = (1.0, 10.0, 100.0)
+#: Averaging times of every bias-stability table (docs/method.md, "Metrics"). [s]
+DEFAULT_TAUS_S = BIAS_STABILITY_TAUS_S
 
 
 # --------------------------------------------------------------------------- bias stability

@@ -21,7 +21,8 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -35,10 +36,7 @@ from hrgtc.core.progress import Progress
 from hrgtc.core.timeline import RESTARTS_KEY
 from hrgtc.drift.features import FeatureStream
 from hrgtc.drift.rest import run_rest
-from hrgtc.evaluation.allan import (
-    ONE_SIGMA,
-    AllanResult,
-)
+from hrgtc.evaluation.allan import AllanResult
 from hrgtc.evaluation.burst_allan import BurstAllanResult
 from hrgtc.evaluation.deviation_curves import (
     DEVIATIONS,
@@ -48,7 +46,6 @@ from hrgtc.evaluation.deviation_curves import (
 )
 from hrgtc.evaluation.evaluation_result import Evaluation
 from hrgtc.evaluation.heating_cooling import DirectionSplit
-from hrgtc.evaluation.metrics import DEFAULT_TAUS_S
 from hrgtc.evaluation.noise import NoiseTerms, noise_terms
 from hrgtc.evaluation.plot_blocks import BlockMeans, block_rows
 from hrgtc.evaluation.series_stats import SeriesStatistics
@@ -58,8 +55,6 @@ from hrgtc.recording import ReadOptions, Recording, count_rows
 from hrgtc.recording.marks import compensation_mark, describe_mark, refuse_compensated
 from hrgtc.settings.compensation import EvaluationSettings
 
-_EVAL = EvaluationSettings
-
 #: Series measured by a pass: output minus input rate, compensated by the
 #: frequency model, and by the housing-thermistor baseline.
 SERIES = ("raw", "compensated", "housing")
@@ -67,22 +62,48 @@ SERIES = ("raw", "compensated", "housing")
 VARIABLE_PREFIX = "var_"
 
 
+@dataclass(frozen=True)
+class RunPlan:
+    """What a pass over a run knows before it reads the run.
+
+    Attributes
+    ----------
+    name
+        The run's name in the results.
+    source
+        Where the run came from (a path), kept in the result.
+    total_rows
+        Rows of the run, for the progress callback (0 when not known).
+    gaps
+        ``"split"``: the df/dt filter restarts after each gap (see
+        :class:`~hrgtc.compensate.Compensator`) and settles again: the figures leave out
+        the first ``warmup_s`` after every gap (an error when nothing is left);
+        otherwise the filter carries across and only the run's first ``warmup_s`` is
+        left out. The statistics run over the joined segments.
+    block_rows
+        Keep block means of this many rows for plotting (None: keep none).
+    keep
+        True for each sample of the run at rest (:func:`hrgtc.drift.rest.run_rest`): the
+        others are compensated and written but left out of every figure, and counted
+        (``n_not_at_rest``). None: every sample counts.
+    """
+
+    name: str
+    source: str = ""
+    total_rows: int = 0
+    gaps: str = "ignore"
+    block_rows: int | None = None
+    keep: np.ndarray | None = field(default=None, repr=False)
+
+
 def run_pass(
     model: UnitModel,
     chunks: Iterable[Recording],
-    name: str,
+    plan: RunPlan | str,
+    settings: EvaluationSettings | None = None,
     *,
-    source: str = "",
-    taus_s: Sequence[float] = DEFAULT_TAUS_S,
-    allan: bool = True,
-    block_rows: int | None = None,
     on_output: Callable[[Recording], None] | None = None,
     progress: Progress | None = None,
-    total_rows: int = 0,
-    gaps: str = "ignore",
-    deviation: str = _EVAL.deviation,
-    confidence: float = ONE_SIGMA,
-    keep: np.ndarray | None = None,
 ) -> Evaluation:
     """Compensate one run given as consecutive chunks, once, and measure it.
 
@@ -95,77 +116,55 @@ def run_pass(
         The unit's model.
     chunks
         The run, as consecutive chunks (e.g. :func:`hrgtc.recording.iter_chunks`).
-    name
-        The run's name in the results.
-    source
-        Where the run came from (a path), kept in the result.
-    taus_s
-        Averaging times of the bias stability (Section 4.2 of [1] uses 10 s). [s]
-    allan
-        Also compute the Allan deviations and noise terms (ARW, bias instability, RRW).
-    block_rows
-        Keep block means of this many rows for plotting (None: keep none).
+    plan
+        What is known of the run before reading it (:class:`RunPlan`; a name alone: a
+        plan with that name).
+    settings
+        What is measured (:class:`~hrgtc.settings.compensation.EvaluationSettings`): the
+        bias stability's averaging times, the Allan deviations and noise terms or not,
+        the deviation curve (``"oadev"``, ``"adev"``, ``"mdev"``, ``"hdev"``, ``"tdev"``;
+        noise terms are read off the Allan deviations only; every curve is pooled within
+        the segments, no difference across a gap, with its chi-squared interval from the
+        pooled edf, :mod:`~hrgtc.evaluation.allan_segments`; τ beyond a burst comes from
+        burst means with the dead time's bias stated, ``burst_allan``, or a note says why
+        it is not estimable) and the two-sided level of the intervals.
     on_output
         Called with every compensated chunk (the input columns plus
         ``rate_comp_dph``, ``bias_model_dph``, ``resonator_c_est``, ``in_range``), e.g.
         a :class:`~hrgtc.recording.RecordingWriter`'s ``write``.
     progress
-        ``progress(samples done, total_rows)``.
-    total_rows
-        Rows of the run, for the progress callback (0 when not known).
-    gaps
-        ``"split"``: the df/dt filter restarts after each gap (see
-        :class:`~hrgtc.compensate.Compensator`) and settles again: the figures leave out
-        the first ``warmup_s`` after every gap (an error when nothing is left);
-        otherwise the filter carries across and only the run's first ``warmup_s`` is
-        left out. The statistics run over the joined segments.
-    deviation
-        The deviation curve: ``"oadev"`` (overlapping Allan, default), ``"adev"``
-        (non-overlapping), ``"mdev"``, ``"hdev"``, ``"tdev"`` (:data:`DEVIATIONS`).
-        Noise terms are read off the Allan deviations only. Every curve is pooled within
-        the segments (no difference across a gap) with its chi-squared interval from the
-        pooled edf (:mod:`~hrgtc.evaluation.allan_segments`); τ beyond a burst comes from
-        burst means with the dead time's bias stated (``burst_allan``) or a note says why
-        it is not estimable.
-    confidence
-        Two-sided level of the intervals (bias stability and Allan deviation).
-    keep
-        True for each sample of the run at rest (:func:`hrgtc.drift.rest.run_rest`): the
-        others are compensated and written but left out of every figure, and counted
-        (``n_not_at_rest``). None: every sample counts.
+        ``progress(samples done, plan.total_rows)``.
 
     Raises
     ------
     InputError
         The run holds no samples, or is shorter than two 10 s blocks.
     """
-    return RunPass(model, name, source=source, taus_s=taus_s, allan=allan,
-                   block_rows=block_rows, on_output=on_output, progress=progress,
-                   total_rows=total_rows, gaps=gaps, deviation=deviation,
-                   confidence=confidence, keep=keep).fit(chunks)
+    return RunPass(model, plan, settings, on_output=on_output, progress=progress).fit(chunks)
 
 
 class RunPass:
     """The state of one pass over a run: :meth:`partial_fit` each consecutive chunk, then
-    :meth:`result`. :func:`run_pass` is "a new pass, then every chunk"; a pass per axis of a
+    :meth:`finish`. :func:`run_pass` is "a new pass, then every chunk"; a pass per axis of a
     multi-axis recording lets one reading of the file feed every axis
     (:func:`hrgtc.evaluation.instrument_pass.evaluate_axes`). The parameters are those of
     :func:`run_pass`."""
 
-    def __init__(self, model: UnitModel, name: str, *, source: str = "",
-                 taus_s: Sequence[float] = DEFAULT_TAUS_S, allan: bool = True,
-                 block_rows: int | None = None,
+    def __init__(self, model: UnitModel, plan: RunPlan | str,
+                 settings: EvaluationSettings | None = None, *,
                  on_output: Callable[[Recording], None] | None = None,
-                 progress: Progress | None = None, total_rows: int = 0,
-                 gaps: str = "ignore", deviation: str = "oadev",
-                 confidence: float = ONE_SIGMA, keep: np.ndarray | None = None) -> None:
+                 progress: Progress | None = None) -> None:
+        plan = RunPlan(plan) if isinstance(plan, str) else plan
+        settings = settings or EvaluationSettings()
+        deviation = settings.deviation
         if deviation not in DEVIATIONS:
             raise InputError(
                 f"deviation={deviation!r} is not known; use one of {tuple(DEVIATIONS)}")
-        self.model, self.name, self.source = model, name, source
-        self.taus_s, self.allan, self.gaps = taus_s, allan, gaps
-        self.deviation, self.confidence, self.keep = deviation, confidence, keep
-        self.on_output, self.progress, self.total_rows = on_output, progress, total_rows
+        self.model, self.name, self.source = model, plan.name, plan.source
+        self.taus_s, self.allan, self.gaps = settings.taus_s, settings.allan, plan.gaps
+        self.deviation, self.confidence, self.keep = deviation, settings.confidence, plan.keep
+        self.on_output, self.progress, self.total_rows = on_output, progress, plan.total_rows
+        gaps, block_rows = plan.gaps, plan.block_rows
         self.frequency = Compensator(model, gaps=gaps)
         self.features = None
         if block_rows:
@@ -334,14 +333,11 @@ def evaluate(
     run: Recording | str | os.PathLike[str],
     model: UnitModel,
     *,
-    taus_s: Sequence[float] = DEFAULT_TAUS_S,
-    allan: bool = True,
+    settings: EvaluationSettings | None = None,
     read_options: ReadOptions | None = None,
     max_points: int | None = None,
     on_output: Callable[[Recording], None] | None = None,
     progress: Progress | None = None,
-    deviation: str = _EVAL.deviation,
-    confidence: float = ONE_SIGMA,
 ) -> Evaluation:
     """Raw vs compensated bias stability, Allan noise terms and range shares of one run.
 
@@ -351,15 +347,15 @@ def evaluate(
         A :class:`~hrgtc.recording.Recording` or a file, read chunk by chunk.
     model
         The unit's model.
-    taus_s
-        Averaging times of the bias stability (Section 4.2 of [1] uses 10 s). [s]
-    allan
-        Also compute the Allan noise terms (ARW, bias instability, RRW).
+    settings
+        What is measured (:class:`~hrgtc.settings.compensation.EvaluationSettings`; the
+        defaults: bias stability at 1, 10 and 100 s, the overlapping Allan deviation and
+        its noise terms, 1σ intervals).
     read_options
         How to read a file (column mapping, units, metadata, chunk size).
     max_points
         Keep at most this many plotting blocks (of at least 10 s); None keeps none.
-    on_output, progress, deviation, confidence
+    on_output, progress
         As for :func:`run_pass`.
     """
     gaps = (read_options or ReadOptions()).gaps
@@ -393,10 +389,8 @@ def evaluate(
         if fs is None:
             fs = options.head(run).sample_rate_hz  # (tiny chunks would each be validated)
         blocks = block_rows(rows, fs, max_points)
-    result = run_pass(model, chunks, name, source=source, taus_s=taus_s, allan=allan,
-                      block_rows=blocks, on_output=on_output, progress=progress,
-                      total_rows=rows, gaps=gaps, deviation=deviation,
-                      confidence=confidence, keep=keep)
+    plan = RunPlan(name, source, rows, gaps, blocks, keep)
+    result = run_pass(model, chunks, plan, settings, on_output=on_output, progress=progress)
     return count_dropped(result, dropped)
 
 

@@ -32,6 +32,7 @@ from typing import Any
 from hrgtc.core.process import peak_rss_mb
 from hrgtc.core.progress import Progress
 from hrgtc.fleet.tasks import UnitOutcome, error_record
+from hrgtc.settings.fleet import FleetCluster
 
 __all__ = ["FleetRun", "Task", "run_tasks", "scheduler_address", "worker_deaths"]
 
@@ -179,7 +180,7 @@ def _on_cluster(client: Any, tasks: Sequence[Task], progress: Progress | None,
     return outcomes, died, retried
 
 
-def run_tasks(tasks: Sequence[Task], *, scheduler: str | None = None, workers: int | None = None,
+def run_tasks(tasks: Sequence[Task], *, cluster: FleetCluster | None = None,
               progress: Progress | None = None, label: str = "unit") -> FleetRun:
     """Run one task per unit (module docstring for where) and gather the outcomes.
 
@@ -188,11 +189,11 @@ def run_tasks(tasks: Sequence[Task], *, scheduler: str | None = None, workers: i
     tasks
         ``(unit, function, args)`` each; ``function(*args)`` returns a
         :class:`~hrgtc.fleet.tasks.UnitOutcome` and must be importable by the workers.
-    scheduler
-        Address of an existing Dask scheduler (default ``DASK_SCHEDULER_ADDRESS``).
-    workers
-        Local cluster size (default: cores, at most one per unit); 0 runs the tasks
-        here, one after the other.
+    cluster
+        Where the tasks run: ``cluster.scheduler``, the address of an existing Dask
+        scheduler (default ``DASK_SCHEDULER_ADDRESS``); else a local cluster of
+        ``cluster.workers`` processes (default: cores, at most one per unit); 0 workers
+        runs the tasks here, one after the other.
     progress
         ``progress(units_done, units_total)``.
     label
@@ -201,6 +202,7 @@ def run_tasks(tasks: Sequence[Task], *, scheduler: str | None = None, workers: i
     from hrgtc.core.errors import InputError
 
     start = time.perf_counter()
+    scheduler, workers = (cluster or FleetCluster()).scheduler, (cluster or FleetCluster()).workers
     if workers is not None and workers < 0:
         raise InputError(f"workers must be >= 0, got {workers}")
     address = None if workers == 0 and not scheduler else scheduler_address(scheduler)

@@ -26,6 +26,7 @@ from hrgtc.core import records
 from hrgtc.fleet.manifest import UnitFiles
 from hrgtc.recording import ReadOptions
 from hrgtc.settings.calibration import CalibrationSettings
+from hrgtc.settings.compensation import EvaluationSettings
 from hrgtc.settings.fleet import FleetEvaluation
 
 __all__ = ["UnitOutcome", "calibrate_unit", "evaluate_unit", "report_unit", "simulate_unit"]
@@ -229,7 +230,8 @@ def evaluate_unit(files: UnitFiles, models_dir: str, read_options: ReadOptions |
         runs = files.validate or files.drifts
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            evaluations = [evaluate(run, model, allan=allan, read_options=read_options)
+            settings = EvaluationSettings(allan=allan)
+            evaluations = [evaluate(run, model, settings=settings, read_options=read_options)
                            for run in runs]
         return UnitOutcome(files.unit, "ok", evaluation_row(evaluations), None,
                            time.perf_counter() - start)

@@ -24,7 +24,7 @@ from hrgtc.fleet.results import read_table, write_table
 from hrgtc.fleet.run import FleetRun, run_tasks
 from hrgtc.recording import ReadOptions
 from hrgtc.settings.calibration import CalibrationSettings
-from hrgtc.settings.fleet import SETPOINTS_C, FleetEvaluation, FleetSimulation
+from hrgtc.settings.fleet import FleetCluster, FleetEvaluation, FleetSimulation
 
 __all__ = ["FLEET_TABLE", "build_prior", "calibrate_fleet", "evaluate_fleet", "report_fleet",
            "simulate_fleet"]
@@ -34,46 +34,46 @@ PathLike = str | os.PathLike[str]
 FLEET_TABLE = "fleet.parquet"
 #: The evaluation table written beside the models by ``fleet evaluate``.
 EVALUATION_TABLE = "evaluation.parquet"
-_SIM = FleetSimulation
 
 
 def _fleet(source: PathLike | Sequence[UnitFiles]) -> list[UnitFiles]:
     return list(source) if not isinstance(source, str | os.PathLike) else load_fleet(source)
 
 
-def simulate_fleet(output: PathLike, units: int, seed: int = _SIM.seed, *,
-                   sample_rate_hz: float = _SIM.sample_rate_hz, soak_hours: float = _SIM.soak_hours,
-                   ramp_hours: float = _SIM.ramp_hours,
-                   setpoints_c: Sequence[float] = SETPOINTS_C,
-                   file_format: str = _SIM.file_format, force: bool = False,
-                   scheduler: str | None = None, workers: int | None = None,
+def simulate_fleet(output: PathLike, settings: FleetSimulation | None = None, *,
+                   force: bool = False, cluster: FleetCluster | None = None,
                    progress: Progress | None = None) -> FleetRun:
-    """Simulate ``units`` units of the population of ``seed`` under ``output/<unit>/``.
+    """Simulate ``settings.units`` units of the population of ``settings.seed`` under
+    ``output/<unit>/``.
 
-    Unit k gets soaks at ``setpoints_c`` (``soaks/``), a cool-down (``drift/``),
+    Unit k gets soaks at ``settings.setpoints_c`` (``soaks/``), a cool-down (``drift/``),
     a warm-up (``validate/``) and its ground truth (``truth.json``): the drawn
     frequency law, thermal constants, bias law and noise
-    (:mod:`hrgtc.fleet.population`).
+    (:mod:`hrgtc.fleet.population`). ``cluster``: where the units run (default: a local
+    Dask cluster, one worker per core).
     """
+    settings = settings or FleetSimulation()
+    units = settings.units
     if not isinstance(units, int) or units < 1:
         raise InputError(f"--units must be a positive integer, got {units!r}")
     root = Path(output)
     if not force and root.is_dir() and any(root.iterdir()):
         raise InputError(f"{root} is not empty; pass --force to overwrite or give a new folder")
     root.mkdir(parents=True, exist_ok=True)
+    seed = settings.seed
     work = [(f"s{seed}-u{k:04d}", tasks.simulate_unit,
-             (seed, k, str(root), sample_rate_hz, soak_hours,
-              tuple(float(t) for t in setpoints_c), ramp_hours, file_format, force))
+             (seed, k, str(root), settings.sample_rate_hz, settings.soak_hours,
+              tuple(float(t) for t in settings.setpoints_c), settings.ramp_hours,
+              settings.file_format, force))
             for k in range(units)]
-    return run_tasks(work, scheduler=scheduler, workers=workers, progress=progress,
-                     label="simulate")
+    return run_tasks(work, cluster=cluster, progress=progress, label="simulate")
 
 
 def calibrate_fleet(source: PathLike | Sequence[UnitFiles], output: PathLike, *,
                     settings: CalibrationSettings | None = None,
                     read_options: ReadOptions | None = None, resume: bool = False,
                     force: bool = False, prior: PathLike | None = None,
-                    scheduler: str | None = None, workers: int | None = None,
+                    cluster: FleetCluster | None = None,
                     progress: Progress | None = None) -> FleetRun:
     """Calibrate every unit (:func:`hrgtc.pipeline.calibration.calibrate` as one task per unit).
 
@@ -91,6 +91,8 @@ def calibrate_fleet(source: PathLike | Sequence[UnitFiles], output: PathLike, *,
         every unit; None: the defaults.
     prior
         A prior file: every unit is calibrated with it (:mod:`hrgtc.thermometry.prior`).
+    cluster
+        Where the units run (default: a local Dask cluster, one worker per core).
     """
     fleet = _fleet(source)
     out = Path(output)
@@ -103,27 +105,27 @@ def calibrate_fleet(source: PathLike | Sequence[UnitFiles], output: PathLike, *,
              (u, str(out), settings or CalibrationSettings(), read_options, resume,
               None if prior is None else str(prior)))
             for u in fleet]
-    run = run_tasks(work, scheduler=scheduler, workers=workers, progress=progress,
-                    label="calibrate")
+    run = run_tasks(work, cluster=cluster, progress=progress, label="calibrate")
     write_table(run.outcomes, out / FLEET_TABLE, force=True)
     return run
 
 
 def evaluate_fleet(source: PathLike | Sequence[UnitFiles], models: PathLike,
                    output: PathLike | None = None, *, read_options: ReadOptions | None = None,
-                   allan: bool = FleetEvaluation.allan, force: bool = False,
-                   scheduler: str | None = None,
-                   workers: int | None = None, progress: Progress | None = None) -> FleetRun:
+                   settings: FleetEvaluation | None = None, force: bool = False,
+                   cluster: FleetCluster | None = None,
+                   progress: Progress | None = None) -> FleetRun:
     """Evaluate each unit's held-out runs with its model; write the evaluation table.
 
-    ``output`` defaults to ``<models>/evaluation.parquet``.
+    ``output`` defaults to ``<models>/evaluation.parquet``; ``settings``: what is computed
+    (default: the Allan noise terms too).
     """
     fleet = _fleet(source)
     target = Path(output) if output is not None else Path(models) / EVALUATION_TABLE
     refuse_existing(target, force)
+    allan = (settings or FleetEvaluation()).allan
     work = [(u.unit, tasks.evaluate_unit, (u, str(models), read_options, allan)) for u in fleet]
-    run = run_tasks(work, scheduler=scheduler, workers=workers, progress=progress,
-                    label="evaluate")
+    run = run_tasks(work, cluster=cluster, progress=progress, label="evaluate")
     write_table(run.outcomes, target, force=force)
     return run
 
@@ -132,7 +134,7 @@ def report_fleet(models: PathLike, output: PathLike, *, table: PathLike | None =
                  source: PathLike | Sequence[UnitFiles] | None = None,
                  unit_reports: PathLike | None = None,
                  read_options: ReadOptions | None = None, force: bool = False,
-                 scheduler: str | None = None, workers: int | None = None,
+                 cluster: FleetCluster | None = None,
                  progress: Progress | None = None) -> tuple[Path, FleetRun | None]:
     """Write the fleet report from the fleet table; optionally each unit's report as tasks.
 
@@ -161,8 +163,7 @@ def report_fleet(models: PathLike, output: PathLike, *, table: PathLike | None =
         Path(unit_reports).mkdir(parents=True, exist_ok=True)
         work = [(u.unit, tasks.report_unit, (u, str(models), str(unit_reports), read_options,
                                               force)) for u in fleet]
-        run = run_tasks(work, scheduler=scheduler, workers=workers, progress=progress,
-                        label="report")
+        run = run_tasks(work, cluster=cluster, progress=progress, label="report")
     return build_fleet_report(rows, output, force=force), run
 
 

@@ -48,6 +48,7 @@ from hrgtc.recording.mapping import parse_columns, scales_temperature
 from hrgtc.recording.marks import refuse_compensated_training
 from hrgtc.settings import to_dict
 from hrgtc.settings.calibration import CalibrationSettings
+from hrgtc.settings.compensation import BIAS_ONLY
 from hrgtc.settings.drift import DriftSettings
 from hrgtc.settings.reading import ReadSettings
 from hrgtc.thermometry import fit as fit_thermometer
@@ -290,7 +291,7 @@ def calibrate(
         ),
     )
     validation = tuple(
-        evaluate(path, unit_model, allan=False, read_options=options)
+        evaluate(path, unit_model, settings=BIAS_ONLY, read_options=options)
         for path in validate
     )
     return CalibrationResult(unit_model, tuple(plateaus), table, validation, prior_fit,
@@ -483,7 +484,7 @@ def _calibrate_sensor(soaks: Sequence[PathLike], drifts: Sequence[PathLike],
             _record(settings, aux, housing_terms, options, thermometer="sensor"),
         ),
     )
-    validation = tuple(evaluate(path, unit_model, allan=False, read_options=options)
+    validation = tuple(evaluate(path, unit_model, settings=BIAS_ONLY, read_options=options)
                        for path in validate)
     return CalibrationResult(unit_model, (), (), validation, None, fitted)
 

@@ -45,6 +45,7 @@ from hrgtc.recording import ReadOptions, Recording, axis_names
 from hrgtc.recording.marks import refuse_compensated_training
 from hrgtc.recording.read_once import ReadOnce
 from hrgtc.settings.calibration import CROSS_AXIS_GAIN, CalibrationSettings
+from hrgtc.settings.compensation import BIAS_ONLY, EvaluationSettings
 from hrgtc.settings.reading import ReadSettings
 from hrgtc.thermometry.prior import ThermometerPrior
 from hrgtc.thermometry.reference import TemperatureMap, TemperatureReference
@@ -284,7 +285,7 @@ def calibrate_instrument(
                                  else temperature_map.to_dict())
     held_out = options if validate_options is None else _same_cache(dataclasses.replace(
         validate_options, thermometer=thermometer), options)
-    validation = {axis: tuple(evaluate(path, models[axis], allan=False,
+    validation = {axis: tuple(evaluate(path, models[axis], settings=BIAS_ONLY,
                                        read_options=axis_options(held_out, axis))
                               for path in validate) for axis in axes}
     checks = tuple(check_scale_factor(path, instrument, options, table)
@@ -343,7 +344,7 @@ def _cross_axis(result: CalibrationResult, axis: str, axes: Sequence[str],
                       soak_fit=result.soak_fit)  # the same thermometer: the drift fit only
 
     def held_out(model: UnitModel) -> float:
-        return float(np.median([evaluate(path, model, allan=False, read_options=options)
+        return float(np.median([evaluate(path, model, settings=BIAS_ONLY, read_options=options)
                                 .compensated_10s for path in validate]))
 
     without, with_ = held_out(result.model), held_out(trial.model)
@@ -524,8 +525,7 @@ def evaluate_instrument(
     *,
     axes: Sequence[str] | None = None,
     read_options: ReadOptions | None = None,
-    deviation: str = "oadev",
-    allan: bool = True,
+    settings: EvaluationSettings | None = None,
     max_points: int | None = None,
     progress: Any = None,
     model_source: str = "",
@@ -552,7 +552,7 @@ def evaluate_instrument(
         The axes to evaluate (``--axes``); None: all of them.
     read_options
         How to read the run.
-    deviation, allan, max_points
+    settings, max_points
         As :func:`hrgtc.evaluation.evaluate`.
     progress
         ``progress(rows done, rows)`` of the reading.
@@ -568,8 +568,8 @@ def evaluate_instrument(
     for unit_model in model.axes.values():  # before reading the recording's axes
         check_thermometer_kind(options, unit_model, model_source or None)
     model = match_axes(model, recording_axes(run, options), axes, str(run), model_source)
-    results = evaluate_axes(run, model, read_options=options, deviation=deviation,
-                            allan=allan, max_points=max_points, progress=progress)
+    results = evaluate_axes(run, model, settings=settings, read_options=options,
+                            max_points=max_points, progress=progress)
     checks: tuple[ScaleFactorCheck, ...] = ()
     if any(m.scale_factor is not None for m in model.axes.values()):
         names = options.head(run).names

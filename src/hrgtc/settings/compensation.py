@@ -12,6 +12,10 @@ from hrgtc.settings import setting
 ROW_GROUP_ROWS = 1 << 20
 #: Deviation curves of the evaluation (:mod:`hrgtc.evaluation.deviation_curves`).
 DEVIATIONS = ("oadev", "adev", "mdev", "hdev", "tdev")
+#: Averaging times of the bias stability an evaluation reports. [s]
+BIAS_STABILITY_TAUS_S = (1.0, 10.0, 100.0)
+#: The 1σ two-sided level, erf(1/√2): the intervals' default coverage.
+ONE_SIGMA = 0.6826894921370859
 
 
 @dataclass(frozen=True)
@@ -29,6 +33,19 @@ class EvaluationSettings:
         "oadev", "Deviation curve: oadev (overlapping Allan), adev (non-overlapping), mdev "
         "(modified), hdev (Hadamard), tdev (time). Noise terms come from adev/oadev.",
         choices=DEVIATIONS)
+    taus_s: tuple[float, ...] = setting(
+        BIAS_STABILITY_TAUS_S, "Averaging times of the bias stability (Section 4.2 of the "
+        "paper uses 10 s).", unit="s", cli=None)
+    allan: bool = setting(True, "Also compute the Allan deviations and noise terms (ARW, "
+                          "bias instability, RRW).", cli=None)
+    confidence: float = setting(
+        ONE_SIGMA, "Two-sided level of the intervals (bias stability and Allan deviation).",
+        cli=None)
+
+
+#: What the evaluations of held-out runs measure inside ``calibrate``: the bias stability
+#: only (no Allan deviations or noise terms).
+BIAS_ONLY = EvaluationSettings(allan=False)
 
 
 @dataclass(frozen=True)

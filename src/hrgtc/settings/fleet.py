@@ -31,6 +31,18 @@ class FleetSimulation:
 
 
 @dataclass(frozen=True)
+class FleetCluster:
+    """Where a fleet command runs its tasks, one per unit (:func:`hrgtc.fleet.run.run_tasks`)."""
+
+    scheduler: str | None = setting(
+        None, "Address of an existing Dask scheduler (default: DASK_SCHEDULER_ADDRESS, else a "
+        "local cluster on this machine).", metavar="tcp://HOST:8786", panel="Cluster")
+    workers: int | None = setting(
+        None, "Worker processes of the local cluster; 0 runs the units here, one after the "
+        "other.", default_text="one per core", panel="Cluster", min=0)
+
+
+@dataclass(frozen=True)
 class FleetEvaluation:
     """What ``hrgtc fleet evaluate`` computes (:func:`hrgtc.fleet.evaluate_fleet`)."""
 
