@@ -33,7 +33,6 @@ from hrgtc.core.timeline import time_blocks
 from hrgtc.drift.regression import newey_west_inflation
 from hrgtc.drift.slow_noise import SLOW_NOISE_LEVEL, beyond_slow_noise
 from hrgtc.drift.stepwise import stepwise
-from hrgtc.drift.tangent_folds import Continuation
 
 #: Windows whose |df/dt| is below this share of the largest are neither heating nor cooling.
 RATE_DEADBAND = 0.05
@@ -110,11 +109,8 @@ def heating_mask(rate: np.ndarray, slope_sign: float) -> tuple[np.ndarray, np.nd
 
 
 def _held_out_residuals(x: np.ndarray, y: np.ndarray, run: np.ndarray,
-                        columns: Sequence[int],
-                        extension: Mapping[int, np.ndarray] | None = None) -> np.ndarray:
-    """Residual of every window when its own run is left out of the fit (NaN: not possible).
-    ``extension``: per fold, what the tangent continuation adds to its windows' columns
-    (:func:`hrgtc.drift.tangent_folds.tangent_corrections`)."""
+                        columns: Sequence[int]) -> np.ndarray:
+    """Residual of every window when its own run is left out of the fit (NaN: not possible)."""
     out = np.full(y.size, np.nan)
     design = np.column_stack([np.ones(y.size), x[:, list(columns)]])
     for r in np.unique(run):
@@ -125,11 +121,7 @@ def _held_out_residuals(x: np.ndarray, y: np.ndarray, run: np.ndarray,
         if np.count_nonzero(train) <= design.shape[1] + 1:
             continue
         solution = np.linalg.lstsq(design[train], y[train], rcond=None)[0]
-        predicted = design[test]
-        if extension and int(r) in extension:
-            predicted = predicted + np.column_stack([
-                np.zeros(np.count_nonzero(test)), extension[int(r)][test][:, list(columns)]])
-        out[test] = y[test] - predicted @ solution
+        out[test] = y[test] - design[test] @ solution
     return out
 
 
@@ -275,13 +267,11 @@ def folds_of(run: np.ndarray, time_s: np.ndarray, temperature: np.ndarray | None
 
 
 def held_out_rms(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarray,
-                 names: Sequence[str], terms: Sequence[str],
-                 extension: Mapping[int, np.ndarray] | None = None) -> float:
+                 names: Sequence[str], terms: Sequence[str]) -> float:
     """Root mean square over folds of each left-out fold's residual RMS (offset included:
-    a term that extrapolates badly shows in the level as much as in the slope); with
-    ``extension``, each fold predicted along the tangent beyond the others' ranges. [°/h]"""
+    a term that extrapolates badly shows in the level as much as in the slope). [°/h]"""
     columns = [list(names).index(t) for t in terms]
-    residual = _held_out_residuals(x_scaled, bias_dph, folds, columns, extension)
+    residual = _held_out_residuals(x_scaled, bias_dph, folds, columns)
     per_fold = [float(np.mean(residual[(folds == f) & np.isfinite(residual)] ** 2))
                 for f in np.unique(folds) if np.any((folds == f) & np.isfinite(residual))]
     return float(np.sqrt(np.mean(per_fold))) if per_fold else math.nan
@@ -292,7 +282,6 @@ def prune_terms(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarray,
                 tolerance: float = PRUNE_TOLERANCE,
                 parents: Mapping[str, Sequence[str]] | None = None,
                 keep: Sequence[str] = (), through: bool = False,
-                extension: Mapping[int, np.ndarray] | None = None,
                 ) -> tuple[tuple[str, ...], float, float]:
     """Drop selected terms that do not carry over to held-out folds.
 
@@ -311,9 +300,7 @@ def prune_terms(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarray,
     removals: the result is never richer than ``selected``. With ``parents`` (term ->
     its lower-order parents), a term is removed only once no kept term has it as a
     parent: the highest orders go first (marginality). Terms in ``keep`` (the user's
-    starting model) are never removed. With ``extension`` (per fold, the tangent
-    continuation's change to its columns, :mod:`hrgtc.drift.tangent_folds`) every held-out
-    figure is the compensation's prediction beyond the fitted range.
+    starting model) are never removed.
 
     Returns
     -------
@@ -321,13 +308,12 @@ def prune_terms(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarray,
         The kept terms (candidate order) and the held-out RMS before and after. [°/h]
     """
     chosen = [n for n in names if n in set(selected)]
-    before = held_out_rms(x_scaled, bias_dph, folds, names, chosen, extension)
+    before = held_out_rms(x_scaled, bias_dph, folds, names, chosen)
     if not math.isfinite(before):
         return tuple(chosen), before, before
     path = [(tuple(chosen), before)]
     while chosen:
-        step = _next_removal(x_scaled, bias_dph, folds, names, chosen, parents, keep,
-                             extension)
+        step = _next_removal(x_scaled, bias_dph, folds, names, chosen, parents, keep)
         if step is None:
             break
         name, score = step
@@ -338,12 +324,10 @@ def prune_terms(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarray,
     if not through:
         return path[-1][0], before, path[-1][1]
     best = min(range(len(path)), key=lambda k: path[k][1])
-    reference = _held_out_residuals(x_scaled, bias_dph, folds, _columns(names, path[best][0]),
-                                    extension)
+    reference = _held_out_residuals(x_scaled, bias_dph, folds, _columns(names, path[best][0]))
     for terms, score in reversed(path[best:]):  # the smallest first
         if score <= path[best][1] * (1.0 + tolerance) or _within_one_error(
-                _held_out_residuals(x_scaled, bias_dph, folds, _columns(names, terms),
-                                    extension),
+                _held_out_residuals(x_scaled, bias_dph, folds, _columns(names, terms)),
                 reference, folds):
             return terms, before, score
     return path[best][0], before, path[best][1]
@@ -352,14 +336,13 @@ def prune_terms(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarray,
 def _next_removal(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarray,
                   names: Sequence[str], chosen: Sequence[str],
                   parents: Mapping[str, Sequence[str]] | None, keep: Sequence[str],
-                  extension: Mapping[int, np.ndarray] | None = None,
                   ) -> tuple[str, float] | None:
     """The term of ``chosen`` (no parent of another, not in ``keep``) whose removal gives
     the lowest :func:`held_out_rms`, and that score; None when no term can go."""
     leaves = [n for n in chosen if n not in keep
               and not any(n in (parents or {}).get(c, ()) for c in chosen if c != n)]
     trial = {n: held_out_rms(x_scaled, bias_dph, folds, names,
-                             [c for c in chosen if c != n], extension) for n in leaves}
+                             [c for c in chosen if c != n]) for n in leaves}
     trial = {n: v for n, v in trial.items() if math.isfinite(v)}
     if not trial:
         return None
@@ -371,7 +354,6 @@ def prune_slow_noise(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarr
                      time_s: np.ndarray, names: Sequence[str], selected: Sequence[str],
                      parents: Mapping[str, Sequence[str]] | None = None,
                      keep: Sequence[str] = (), level: float = SLOW_NOISE_LEVEL,
-                     extension: Mapping[int, np.ndarray] | None = None,
                      ) -> tuple[tuple[str, ...], list[dict[str, Any]]]:
     """Backward elimination of terms whose held-out gain does not beat the training
     residual's slow noise (:func:`hrgtc.drift.slow_noise.beyond_slow_noise`): on one ramp
@@ -385,25 +367,24 @@ def prune_slow_noise(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarr
 
     Returns the kept terms (candidate order) and one record per term removed, and one for
     the last step's most doubtful term kept (``term``, ``ratio``, ``chance``,
-    ``white_dph``, ``walk_dph_per_sqrt_h``, ``kept``). ``extension``: as in
-    :func:`prune_terms`, for the observed ratios and the simulated ones alike.
+    ``white_dph``, ``walk_dph_per_sqrt_h``, ``kept``).
     """
     chosen = [n for n in names if n in set(selected)]
     tests: list[dict[str, Any]] = []
     while chosen:
-        score = held_out_rms(x_scaled, bias_dph, folds, names, chosen, extension)
+        score = held_out_rms(x_scaled, bias_dph, folds, names, chosen)
         leaves = [n for n in chosen if n not in keep
                   and not any(n in (parents or {}).get(c, ()) for c in chosen if c != n)]
         trial = {}
         for name in leaves:
             rest = [c for c in chosen if c != name]
-            smaller = held_out_rms(x_scaled, bias_dph, folds, names, rest, extension)
+            smaller = held_out_rms(x_scaled, bias_dph, folds, names, rest)
             if not (math.isfinite(score) and math.isfinite(smaller)):
                 continue
             ratio = score / smaller if smaller > 0.0 else math.inf
             beyond, chance, noise = beyond_slow_noise(
                 x_scaled, bias_dph, folds, time_s, _columns(names, rest),
-                _columns(names, chosen), ratio, level, extension)
+                _columns(names, chosen), ratio, level)
             trial[name] = {"term": name, "ratio": ratio, "chance": chance,
                            "white_dph": noise.white_dph,
                            "walk_dph_per_sqrt_h": noise.over(3600.0), "kept": beyond}
@@ -465,25 +446,18 @@ def guard_selection(x_scaled: np.ndarray, bias_dph: np.ndarray, run: np.ndarray,
                     parents: Mapping[str, Sequence[str]] | None = None,
                     keep: Sequence[str] = (), temperature: np.ndarray | None = None,
                     line_test: tuple[float, float] | None = None,
-                    continuation: Continuation | None = None,
                     ) -> tuple[tuple[str, ...] | None, dict[str, Any]]:
     """The guarded selection: :func:`prune_terms` on the folds of :func:`folds_of`
     (``temperature``: the window means of the thermometer variable, which pick the
     coldest and the hottest block of a single run). ``line_test``: ``(penter, premove)``
     of a plain F-test of the line in the thermometer variable (:data:`LINE_TERM`) on its
     own; on a single run, a line it admits is kept whatever the other terms.
-    ``continuation`` (the candidate terms, window variables and scales): on a single run,
-    each held-out block is predicted as compensation predicts beyond the trained range,
-    along the tangent at the edge of the other windows' ranges
-    (:mod:`hrgtc.drift.tangent_folds`).
 
     Returns the terms to refit (None when nothing was dropped) and the record of the check
     (``folds``, ``dropped``, ``before_dph``, ``after_dph``) stored in the model.
     """
     folds, kind = folds_of(run, time_s, temperature)
     original = set(selected)
-    extension = (continuation.corrections(folds)
-                 if continuation is not None and kind != "runs" else None)
     if kind != "runs" and _line_admitted(x_scaled, bias_dph, names, line_test):
         # one long run: a line in the thermometer variable that is significant on its own
         # is the floor, kept whatever the joint F-tests said (the held-out blocks of one
@@ -496,15 +470,13 @@ def guard_selection(x_scaled: np.ndarray, bias_dph: np.ndarray, run: np.ndarray,
     # across runs a fold's complement may lack what one run alone excites (a heating-only
     # term when the one warm-up is left out): there, stop at the first rise
     kept, before, after = prune_terms(x_scaled, bias_dph, folds, names, selected,
-                                      parents=parents, keep=keep, through=kind != "runs",
-                                      extension=extension)
+                                      parents=parents, keep=keep, through=kind != "runs")
     tests = None
     if kind != "runs" and kept:  # one ramp: the extreme blocks are its ends, walk and all
         # the line in the thermometer variable stays: the test is of what goes beyond it
         kept, tests = prune_slow_noise(x_scaled, bias_dph, folds, time_s, names, kept,
-                                       parents=parents, keep=[*keep, LINE_TERM],
-                                       extension=extension)
-        after = held_out_rms(x_scaled, bias_dph, folds, names, kept, extension)
+                                       parents=parents, keep=[*keep, LINE_TERM])
+        after = held_out_rms(x_scaled, bias_dph, folds, names, kept)
     record = {"folds": kind, "dropped": [t for t in selected if t not in kept],
               "before_dph": before, "after_dph": after}
     if tests:

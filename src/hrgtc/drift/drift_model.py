@@ -68,7 +68,6 @@ from hrgtc.drift.offsets import fit_offsets, offset_groups, orientation_offset, 
 from hrgtc.drift.regression import EXTENDED_PRECISION, newey_west_inflation
 from hrgtc.drift.rest import check_policy, reference_point, run_rest
 from hrgtc.drift.stepwise import StepwiseRecord, StepwiseResult, stepwise
-from hrgtc.drift.tangent_folds import Continuation
 from hrgtc.drift.windows import RunSource, _iter_run, window_means
 from hrgtc.recording import Recording
 from hrgtc.recording.motion import MotionSettings
@@ -522,8 +521,7 @@ def fit(
         chosen, pruning = guard_selection(
             x_scaled, bias, windows.run, windows.time_s, names, result.selected,
             parents=hierarchy(candidates), keep=[parse_terms([t])[0].name for t in initial or ()],
-            temperature=windows.variables.get("f"), line_test=(penter, premove),
-            continuation=Continuation(candidates, windows.variables, scales))
+            temperature=windows.variables.get("f"), line_test=(penter, premove))
     if chosen is not None:
         history = result.history
         result = stepwise(x_scaled, bias, names=names, penter=penter,

@@ -24,7 +24,7 @@ must beat the slow noise.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -113,11 +113,9 @@ def slow_noise(design: np.ndarray, bias_dph: np.ndarray, time_s: np.ndarray,
     return SlowNoise(math.sqrt(white), float(ratios[best]) * white)
 
 
-def _operators(x: np.ndarray, folds: np.ndarray, columns: Sequence[int],
-               extension: Mapping[int, np.ndarray] | None = None):
+def _operators(x: np.ndarray, folds: np.ndarray, columns: Sequence[int]):
     """Per held-out fold: (test rows, train rows, the map of training noise to the fit's
-    prediction on the test rows; with ``extension``, the prediction along the tangent,
-    :mod:`hrgtc.drift.tangent_folds`)."""
+    prediction on the test rows)."""
     design = np.column_stack([np.ones(x.shape[0]), x[:, list(columns)]])
     out = []
     for fold in np.unique(folds[folds >= 0]):
@@ -125,39 +123,25 @@ def _operators(x: np.ndarray, folds: np.ndarray, columns: Sequence[int],
         train = ~test
         if np.count_nonzero(train) <= design.shape[1] + 1:
             continue
-        predicted = design[test]
-        if extension and int(fold) in extension:
-            predicted = predicted + np.column_stack([
-                np.zeros(np.count_nonzero(test)), extension[int(fold)][test][:, list(columns)]])
-        out.append((test, train, predicted @ np.linalg.pinv(design[train])))
+        out.append((test, train, design[test] @ np.linalg.pinv(design[train])))
     return out
 
 
-def _held_out_rms(operators, noise: np.ndarray, signal: np.ndarray | None = None) -> np.ndarray:
+def _held_out_rms(operators, noise: np.ndarray) -> np.ndarray:
     """Held-out RMS (as :func:`~hrgtc.drift.cross_validation.held_out_rms`) of each column
-    of ``noise`` (plus ``signal``, the same in every column)."""
-    per_fold = []
-    for test, train, prediction in operators:
-        residual = noise[test] - prediction @ noise[train]
-        if signal is not None:
-            residual = residual + (signal[test] - prediction @ signal[train])[:, None]
-        per_fold.append(np.mean(residual ** 2, axis=0))
+    of ``noise``."""
+    per_fold = [np.mean((noise[test] - prediction @ noise[train]) ** 2, axis=0)
+                for test, train, prediction in operators]
     return np.sqrt(np.mean(per_fold, axis=0))
 
 
 def null_ratios(x_scaled: np.ndarray, folds: np.ndarray, time_s: np.ndarray,
                 columns_small: Sequence[int], columns_big: Sequence[int], noise: SlowNoise,
-                draws: int = NULL_DRAWS, seed: int = 0,
-                extension: Mapping[int, np.ndarray] | None = None,
-                signal: np.ndarray | None = None) -> np.ndarray:
+                draws: int = NULL_DRAWS, seed: int = 0) -> np.ndarray:
     """Held-out RMS of the bigger model over the smaller's when the truth is the smaller
-    model plus ``noise``, ``draws`` times (windows in ``time_s`` order get the walk).
-
-    With ``extension`` the held-out windows are predicted along the tangent; the smaller
-    model's own ``signal`` (its fit to the windows) then leaves a residual of its own
-    beyond the fitted range, added to every draw (a parametric bootstrap)."""
-    small = _operators(x_scaled, folds, columns_small, extension)
-    big = _operators(x_scaled, folds, columns_big, extension)
+    model plus ``noise``, ``draws`` times (windows in ``time_s`` order get the walk)."""
+    small = _operators(x_scaled, folds, columns_small)
+    big = _operators(x_scaled, folds, columns_big)
     if not small or len(small) != len(big):
         return np.empty(0)
     rng = np.random.default_rng(seed)
@@ -167,33 +151,25 @@ def null_ratios(x_scaled: np.ndarray, folds: np.ndarray, time_s: np.ndarray,
     walk = np.empty((t.size, draws))
     walk[order] = np.cumsum(steps[:, None] * rng.standard_normal((t.size, draws)), axis=0)
     simulated = walk + noise.white_dph * rng.standard_normal((t.size, draws))
-    below = _held_out_rms(small, simulated, signal)
+    below = _held_out_rms(small, simulated)
     with np.errstate(invalid="ignore", divide="ignore"):
-        return _held_out_rms(big, simulated, signal) / below
+        return _held_out_rms(big, simulated) / below
 
 
 def beyond_slow_noise(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarray,
                       time_s: np.ndarray, columns_small: Sequence[int],
                       columns_big: Sequence[int], observed_ratio: float,
-                      level: float = SLOW_NOISE_LEVEL,
-                      extension: Mapping[int, np.ndarray] | None = None,
-                      ) -> tuple[bool, float, SlowNoise]:
+                      level: float = SLOW_NOISE_LEVEL) -> tuple[bool, float, SlowNoise]:
     """Does the bigger model's held-out gain beat the slow noise?
 
     The noise is estimated (:func:`slow_noise`) about the smaller model on all training
     windows; the chance of a held-out RMS ratio (bigger / smaller) at or below
     ``observed_ratio`` under the smaller model plus that noise is simulated
-    (:func:`null_ratios`; with ``extension``, predicted along the tangent beyond the fitted
-    range, the smaller model's fit as the signal). Returns (chance below ``level``, the
-    chance, the noise).
+    (:func:`null_ratios`). Returns (chance below ``level``, the chance, the noise).
     """
     design = np.column_stack([np.ones(x_scaled.shape[0]), x_scaled[:, list(columns_small)]])
     noise = slow_noise(design, bias_dph, time_s)
-    signal = None
-    if extension:
-        signal = design @ np.linalg.lstsq(design, bias_dph, rcond=None)[0]
-    ratios = null_ratios(x_scaled, folds, time_s, columns_small, columns_big, noise,
-                         extension=extension, signal=signal)
+    ratios = null_ratios(x_scaled, folds, time_s, columns_small, columns_big, noise)
     ratios = ratios[np.isfinite(ratios)]
     if not ratios.size or not math.isfinite(observed_ratio):
         return True, math.nan, noise
