@@ -109,10 +109,8 @@ def heating_mask(rate: np.ndarray, slope_sign: float) -> tuple[np.ndarray, np.nd
 
 
 def _held_out_residuals(x: np.ndarray, y: np.ndarray, run: np.ndarray,
-                        columns: Sequence[int], centred: bool = False) -> np.ndarray:
-    """Residual of every window when its own run is left out of the fit (NaN: not possible);
-    ``centred``: less the mean of its fold's residuals (the level of a held-out block is
-    a nuisance, :func:`held_out_rms`)."""
+                        columns: Sequence[int]) -> np.ndarray:
+    """Residual of every window when its own run is left out of the fit (NaN: not possible)."""
     out = np.full(y.size, np.nan)
     design = np.column_stack([np.ones(y.size), x[:, list(columns)]])
     for r in np.unique(run):
@@ -124,8 +122,6 @@ def _held_out_residuals(x: np.ndarray, y: np.ndarray, run: np.ndarray,
             continue
         solution = np.linalg.lstsq(design[train], y[train], rcond=None)[0]
         out[test] = y[test] - design[test] @ solution
-        if centred:
-            out[test] -= np.mean(out[test])
     return out
 
 
@@ -271,19 +267,11 @@ def folds_of(run: np.ndarray, time_s: np.ndarray, temperature: np.ndarray | None
 
 
 def held_out_rms(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarray,
-                 names: Sequence[str], terms: Sequence[str], centred: bool = False) -> float:
-    """Root mean square over folds of each left-out fold's residual RMS. [°/h]
-
-    Across runs the offset is included: a term that extrapolates badly shows in the level
-    as much as in the slope. ``centred`` (the blocks of one run): each fold's mean residual
-    is taken off first, so a held-out block is judged on how the prediction follows it
-    (its course in T and df/dt), not on its level. Within one run the level of a block is
-    where its slow noise sits (a random walk moves a whole block: a square bent towards
-    that level runs away beyond it), and the offset of a new orientation or restart is
-    unknown to any model; the evaluations judge alike (bias stability is a spread, the
-    corpus takes each still period's mean off, docs/real-loggers/corpus.md)."""
+                 names: Sequence[str], terms: Sequence[str]) -> float:
+    """Root mean square over folds of each left-out fold's residual RMS (offset included:
+    a term that extrapolates badly shows in the level as much as in the slope). [°/h]"""
     columns = [list(names).index(t) for t in terms]
-    residual = _held_out_residuals(x_scaled, bias_dph, folds, columns, centred)
+    residual = _held_out_residuals(x_scaled, bias_dph, folds, columns)
     per_fold = [float(np.mean(residual[(folds == f) & np.isfinite(residual)] ** 2))
                 for f in np.unique(folds) if np.any((folds == f) & np.isfinite(residual))]
     return float(np.sqrt(np.mean(per_fold))) if per_fold else math.nan
@@ -293,7 +281,7 @@ def prune_terms(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarray,
                 names: Sequence[str], selected: Sequence[str],
                 tolerance: float = PRUNE_TOLERANCE,
                 parents: Mapping[str, Sequence[str]] | None = None,
-                keep: Sequence[str] = (), through: bool = False, centred: bool = False,
+                keep: Sequence[str] = (), through: bool = False,
                 ) -> tuple[tuple[str, ...], float, float]:
     """Drop selected terms that do not carry over to held-out folds.
 
@@ -312,7 +300,7 @@ def prune_terms(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarray,
     removals: the result is never richer than ``selected``. With ``parents`` (term ->
     its lower-order parents), a term is removed only once no kept term has it as a
     parent: the highest orders go first (marginality). Terms in ``keep`` (the user's
-    starting model) are never removed. ``centred``: as in :func:`held_out_rms`.
+    starting model) are never removed.
 
     Returns
     -------
@@ -320,13 +308,12 @@ def prune_terms(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarray,
         The kept terms (candidate order) and the held-out RMS before and after. [°/h]
     """
     chosen = [n for n in names if n in set(selected)]
-    before = held_out_rms(x_scaled, bias_dph, folds, names, chosen, centred)
+    before = held_out_rms(x_scaled, bias_dph, folds, names, chosen)
     if not math.isfinite(before):
         return tuple(chosen), before, before
     path = [(tuple(chosen), before)]
     while chosen:
-        step = _next_removal(x_scaled, bias_dph, folds, names, chosen, parents, keep,
-                             centred)
+        step = _next_removal(x_scaled, bias_dph, folds, names, chosen, parents, keep)
         if step is None:
             break
         name, score = step
@@ -337,12 +324,10 @@ def prune_terms(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarray,
     if not through:
         return path[-1][0], before, path[-1][1]
     best = min(range(len(path)), key=lambda k: path[k][1])
-    reference = _held_out_residuals(x_scaled, bias_dph, folds, _columns(names, path[best][0]),
-                                    centred)
+    reference = _held_out_residuals(x_scaled, bias_dph, folds, _columns(names, path[best][0]))
     for terms, score in reversed(path[best:]):  # the smallest first
         if score <= path[best][1] * (1.0 + tolerance) or _within_one_error(
-                _held_out_residuals(x_scaled, bias_dph, folds, _columns(names, terms),
-                                    centred),
+                _held_out_residuals(x_scaled, bias_dph, folds, _columns(names, terms)),
                 reference, folds):
             return terms, before, score
     return path[best][0], before, path[best][1]
@@ -351,13 +336,13 @@ def prune_terms(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarray,
 def _next_removal(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarray,
                   names: Sequence[str], chosen: Sequence[str],
                   parents: Mapping[str, Sequence[str]] | None, keep: Sequence[str],
-                  centred: bool = False) -> tuple[str, float] | None:
+                  ) -> tuple[str, float] | None:
     """The term of ``chosen`` (no parent of another, not in ``keep``) whose removal gives
     the lowest :func:`held_out_rms`, and that score; None when no term can go."""
     leaves = [n for n in chosen if n not in keep
               and not any(n in (parents or {}).get(c, ()) for c in chosen if c != n)]
     trial = {n: held_out_rms(x_scaled, bias_dph, folds, names,
-                             [c for c in chosen if c != n], centred) for n in leaves}
+                             [c for c in chosen if c != n]) for n in leaves}
     trial = {n: v for n, v in trial.items() if math.isfinite(v)}
     if not trial:
         return None
@@ -369,7 +354,7 @@ def prune_slow_noise(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarr
                      time_s: np.ndarray, names: Sequence[str], selected: Sequence[str],
                      parents: Mapping[str, Sequence[str]] | None = None,
                      keep: Sequence[str] = (), level: float = SLOW_NOISE_LEVEL,
-                     centred: bool = False) -> tuple[tuple[str, ...], list[dict[str, Any]]]:
+                     ) -> tuple[tuple[str, ...], list[dict[str, Any]]]:
     """Backward elimination of terms whose held-out gain does not beat the training
     residual's slow noise (:func:`hrgtc.drift.slow_noise.beyond_slow_noise`): on one ramp
     a random walk in the bias looks like curvature to the coldest and the hottest block,
@@ -382,25 +367,24 @@ def prune_slow_noise(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarr
 
     Returns the kept terms (candidate order) and one record per term removed, and one for
     the last step's most doubtful term kept (``term``, ``ratio``, ``chance``,
-    ``white_dph``, ``walk_dph_per_sqrt_h``, ``kept``). ``centred``: as in
-    :func:`held_out_rms`, for the observed ratios and the simulated ones alike.
+    ``white_dph``, ``walk_dph_per_sqrt_h``, ``kept``).
     """
     chosen = [n for n in names if n in set(selected)]
     tests: list[dict[str, Any]] = []
     while chosen:
-        score = held_out_rms(x_scaled, bias_dph, folds, names, chosen, centred)
+        score = held_out_rms(x_scaled, bias_dph, folds, names, chosen)
         leaves = [n for n in chosen if n not in keep
                   and not any(n in (parents or {}).get(c, ()) for c in chosen if c != n)]
         trial = {}
         for name in leaves:
             rest = [c for c in chosen if c != name]
-            smaller = held_out_rms(x_scaled, bias_dph, folds, names, rest, centred)
+            smaller = held_out_rms(x_scaled, bias_dph, folds, names, rest)
             if not (math.isfinite(score) and math.isfinite(smaller)):
                 continue
             ratio = score / smaller if smaller > 0.0 else math.inf
             beyond, chance, noise = beyond_slow_noise(
                 x_scaled, bias_dph, folds, time_s, _columns(names, rest),
-                _columns(names, chosen), ratio, level, centred)
+                _columns(names, chosen), ratio, level)
             trial[name] = {"term": name, "ratio": ratio, "chance": chance,
                            "white_dph": noise.white_dph,
                            "walk_dph_per_sqrt_h": noise.over(3600.0), "kept": beyond}
@@ -465,8 +449,7 @@ def guard_selection(x_scaled: np.ndarray, bias_dph: np.ndarray, run: np.ndarray,
                     ) -> tuple[tuple[str, ...] | None, dict[str, Any]]:
     """The guarded selection: :func:`prune_terms` on the folds of :func:`folds_of`
     (``temperature``: the window means of the thermometer variable, which pick the
-    coldest and the hottest block of a single run; their held-out figures are
-    ``centred``, :func:`held_out_rms`). ``line_test``: ``(penter, premove)``
+    coldest and the hottest block of a single run). ``line_test``: ``(penter, premove)``
     of a plain F-test of the line in the thermometer variable (:data:`LINE_TERM`) on its
     own; on a single run, a line it admits is kept whatever the other terms.
 
@@ -486,18 +469,14 @@ def guard_selection(x_scaled: np.ndarray, bias_dph: np.ndarray, run: np.ndarray,
             selected = [LINE_TERM, *selected]
     # across runs a fold's complement may lack what one run alone excites (a heating-only
     # term when the one warm-up is left out): there, stop at the first rise
-    # one run: each held-out block judged on how it is followed, its level aside
-    centred = kind != "runs"
     kept, before, after = prune_terms(x_scaled, bias_dph, folds, names, selected,
-                                      parents=parents, keep=keep, through=kind != "runs",
-                                      centred=centred)
+                                      parents=parents, keep=keep, through=kind != "runs")
     tests = None
     if kind != "runs" and kept:  # one ramp: the extreme blocks are its ends, walk and all
         # the line in the thermometer variable stays: the test is of what goes beyond it
         kept, tests = prune_slow_noise(x_scaled, bias_dph, folds, time_s, names, kept,
-                                       parents=parents, keep=[*keep, LINE_TERM],
-                                       centred=centred)
-        after = held_out_rms(x_scaled, bias_dph, folds, names, kept, centred)
+                                       parents=parents, keep=[*keep, LINE_TERM])
+        after = held_out_rms(x_scaled, bias_dph, folds, names, kept)
     record = {"folds": kind, "dropped": [t for t in selected if t not in kept],
               "before_dph": before, "after_dph": after}
     if tests:

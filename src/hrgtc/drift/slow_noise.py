@@ -127,24 +127,19 @@ def _operators(x: np.ndarray, folds: np.ndarray, columns: Sequence[int]):
     return out
 
 
-def _held_out_rms(operators, noise: np.ndarray, centred: bool = False) -> np.ndarray:
-    """Held-out RMS (as :func:`~hrgtc.drift.cross_validation.held_out_rms`, ``centred``
-    alike) of each column of ``noise``."""
-    per_fold = []
-    for test, train, prediction in operators:
-        residual = noise[test] - prediction @ noise[train]
-        if centred:
-            residual = residual - np.mean(residual, axis=0)
-        per_fold.append(np.mean(residual ** 2, axis=0))
+def _held_out_rms(operators, noise: np.ndarray) -> np.ndarray:
+    """Held-out RMS (as :func:`~hrgtc.drift.cross_validation.held_out_rms`) of each column
+    of ``noise``."""
+    per_fold = [np.mean((noise[test] - prediction @ noise[train]) ** 2, axis=0)
+                for test, train, prediction in operators]
     return np.sqrt(np.mean(per_fold, axis=0))
 
 
 def null_ratios(x_scaled: np.ndarray, folds: np.ndarray, time_s: np.ndarray,
                 columns_small: Sequence[int], columns_big: Sequence[int], noise: SlowNoise,
-                draws: int = NULL_DRAWS, seed: int = 0, centred: bool = False) -> np.ndarray:
+                draws: int = NULL_DRAWS, seed: int = 0) -> np.ndarray:
     """Held-out RMS of the bigger model over the smaller's when the truth is the smaller
-    model plus ``noise``, ``draws`` times (windows in ``time_s`` order get the walk);
-    ``centred``: each fold's mean residual taken off, as the observed ratio's."""
+    model plus ``noise``, ``draws`` times (windows in ``time_s`` order get the walk)."""
     small = _operators(x_scaled, folds, columns_small)
     big = _operators(x_scaled, folds, columns_big)
     if not small or len(small) != len(big):
@@ -156,16 +151,15 @@ def null_ratios(x_scaled: np.ndarray, folds: np.ndarray, time_s: np.ndarray,
     walk = np.empty((t.size, draws))
     walk[order] = np.cumsum(steps[:, None] * rng.standard_normal((t.size, draws)), axis=0)
     simulated = walk + noise.white_dph * rng.standard_normal((t.size, draws))
-    below = _held_out_rms(small, simulated, centred)
+    below = _held_out_rms(small, simulated)
     with np.errstate(invalid="ignore", divide="ignore"):
-        return _held_out_rms(big, simulated, centred) / below
+        return _held_out_rms(big, simulated) / below
 
 
 def beyond_slow_noise(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndarray,
                       time_s: np.ndarray, columns_small: Sequence[int],
                       columns_big: Sequence[int], observed_ratio: float,
-                      level: float = SLOW_NOISE_LEVEL, centred: bool = False,
-                      ) -> tuple[bool, float, SlowNoise]:
+                      level: float = SLOW_NOISE_LEVEL) -> tuple[bool, float, SlowNoise]:
     """Does the bigger model's held-out gain beat the slow noise?
 
     The noise is estimated (:func:`slow_noise`) about the smaller model on all training
@@ -175,8 +169,7 @@ def beyond_slow_noise(x_scaled: np.ndarray, bias_dph: np.ndarray, folds: np.ndar
     """
     design = np.column_stack([np.ones(x_scaled.shape[0]), x_scaled[:, list(columns_small)]])
     noise = slow_noise(design, bias_dph, time_s)
-    ratios = null_ratios(x_scaled, folds, time_s, columns_small, columns_big, noise,
-                         centred=centred)
+    ratios = null_ratios(x_scaled, folds, time_s, columns_small, columns_big, noise)
     ratios = ratios[np.isfinite(ratios)]
     if not ratios.size or not math.isfinite(observed_ratio):
         return True, math.nan, noise
