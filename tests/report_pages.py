@@ -12,6 +12,6 @@ def one_axis_page(model, evaluations=(), traces=()) -> str:
     """The page of ``model`` (a unit model) with these runs (evaluations with plotting
     blocks) and soak traces, as ``build_report`` renders it."""
     axis = axis_report("", "", model, evaluations, traces)
-    report = PaperReport("test page", model.unit, None, model.provenance, "now", axis.sensor,
-                         None, True, None, (axis,))
+    report = PaperReport("test page", model.unit, None, "?", "?", "now", axis.sensor, None,
+                         True, None, (axis,))
     return render(KINDS["paper"].template, report=report)

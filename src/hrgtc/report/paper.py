@@ -18,7 +18,7 @@ the scale factor; a sensor thermometer's model in its own words. The figures are
 from __future__ import annotations
 
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
@@ -138,7 +138,8 @@ class PaperReport:
     title: str
     unit: str
     model_path: str | None
-    provenance: Mapping[str, Any]  # the first axis's (version, date)
+    model_version: str  # the hrgtc that wrote the model file ("?": not recorded)
+    model_created_utc: str
     generated_utc: str
     sensor: bool  # the first axis's thermometer is a temperature sensor
     inputs: Table | None  # the model's inputs (provenance)
@@ -175,7 +176,8 @@ def paper_report(inputs: ReportInputs) -> PaperReport:
     counter.finish()
     return PaperReport(
         inputs.title or f"Temperature compensation report — unit {instrument.unit}",
-        instrument.unit, inputs.model_path, first.provenance, generated, sensor,
+        instrument.unit, inputs.model_path, str(first.provenance.get("hrgtc_version", "?")),
+        str(first.provenance.get("created_utc", "?")), generated, sensor,
         grid_table(provenance, INPUTS, INPUTS) if provenance.sections else None, single,
         glance, axes)
 
