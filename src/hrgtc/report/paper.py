@@ -162,7 +162,8 @@ def paper_report(inputs: ReportInputs) -> PaperReport:
     traces = trace_soaks(inputs, traced, counter.advance)
     single = instrument.is_single_axis
     axes = tuple(axis_report(axis, "" if single else f"{axis}-", model, evaluations[axis],
-                       traces.get(axis, []), inputs.missing_soaks, instrument.temperature_map)
+                             traces.get(axis, []), inputs.missing_soaks,
+                             instrument.temperature_map)
                  for axis, model in instrument.axes.items())
     sensor = first.thermometer.source == "sensor"
     if single:
