@@ -161,17 +161,11 @@ def test_the_prior_fit_is_a_figure(result):
 def test_the_reports_calibration_tables_show_the_summarys_figures(result):
     """The report's thermometer, stepwise and drift-model tables (from the model file's
     unit, as ``hrgtc report`` reads it) hold every figure of those sections."""
-    from hrgtc.report.html import _drift_model, _Page, _table_rows, _thermometer
-    from hrgtc.thermometry.plateaus import Plateau
+    from report_pages import one_axis_page
 
-    model = result.model
-    plateaus = [Plateau.from_dict(p) for p in model.plateaus]
-    table = _table_rows(model, plateaus)
-    page = _Page()
-    _thermometer(page, model, plateaus, table, result.tables())
-    _drift_model(page, model)
+    page = one_axis_page(result.model)
     cells = {}
-    for caption, body in re.findall(r"<caption>(.*?)</caption>(.*?)</table>", "".join(page.parts)):
+    for caption, body in re.findall(r"<caption>(.*?)</caption>(.*?)</table>", page):
         for row in re.findall(r"<tr>(.*?)</tr>", body):
             found = [unescape(c) for c in re.findall(r"<td[^>]*>(.*?)</td>", row)]
             if len(found) == 4:

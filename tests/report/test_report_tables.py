@@ -19,16 +19,15 @@ from rich.console import Console
 
 from hrgtc.cli.summary_tables import print_summary
 from hrgtc.core.files import file_sha256
-from hrgtc.core.summary import Figure, Summary
-from hrgtc.evaluation.calibration_figures import TABLE2
 from hrgtc.report.figures import SoakTrace
-from hrgtc.report.html import _header, _Page, _temperature
+from hrgtc.report.render import macros
 from hrgtc.report.tables import (
     CHANGED,
     INPUTS,
     MISSING,
     SOAK_ERROR,
     UNCHANGED,
+    grid_table,
     provenance_summary,
     soak_error_summary,
 )
@@ -48,6 +47,16 @@ def _report_table(page: str, caption: str) -> tuple[list[str], list[list[str]]]:
     rows = [[unescape(c) for c in re.findall(r"<td[^>]*>(.*?)</td>", row)]
             for row in re.findall(r"<tr>(.*?)</tr>", table.split("</thead>")[1])]
     return head, rows
+
+
+def _unit_model():
+    """A resonator's unit model (a golden model file, with its plateaus)."""
+    from pathlib import Path
+
+    from hrgtc.model import load_model
+
+    return load_model(Path(__file__).parents[1] / "data" / "golden-models" / "v2"
+                      / "unit-resonator-254ab6c.json")
 
 
 @pytest.fixture
@@ -70,12 +79,9 @@ def test_provenance_table(provenance):
     assert [r[3] for r in rows] == [UNCHANGED, CHANGED, MISSING]
     assert [r[2] for r in rows] == [i["sha256"][:12] for i in provenance["inputs"]]
     assert provenance_summary({"inputs": []}).sections == ()
-    # the report's table is these cells
-    page = _Page()
-    model = type("M", (), {"provenance": provenance, "unit": "SN-1",
-                          "thermometer": type("T", (), {"source": "frequency"})()})()
-    _header(page, model, "t", None)
-    assert _report_table("".join(page.parts), INPUTS) == (headers, rows)
+    # the report's table is these cells (the paper report's header shows grid_table's)
+    page = str(macros().table(grid_table(summary, INPUTS, INPUTS)))
+    assert _report_table(page, INPUTS) == (headers, rows)
 
 
 def test_soak_error_table():
@@ -97,8 +103,8 @@ def test_soak_error_table():
     document = {"soaks": [{"rms_error_c": float(np.sqrt(np.mean(error**2)))}]}
     assert check_renderings(summary, _rich(summary), json.loads(json.dumps(document))) == 1
     assert soak_error_summary([untrue]).sections == ()
-    # the report's table is these cells
-    page = _Page()
-    table2 = Summary("t", ((TABLE2, (Figure("e", "e", 0.1, row="0", column="error"),)),))
-    _temperature(page, [], [trace], table2)
-    assert _report_table("".join(page.parts), SOAK_ERROR) == (headers, rows)
+    # the report's table is these cells, in the page of a unit with this soak
+    from report_pages import one_axis_page
+
+    page = one_axis_page(_unit_model(), traces=[trace])
+    assert _report_table(page, SOAK_ERROR) == (headers, rows)

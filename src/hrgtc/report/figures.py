@@ -4,9 +4,10 @@
 reduce it to plotting blocks (block means of at least 10 s); a run is also
 compensated (Eq. 22 of [1]) and its bias stability and Allan deviation computed
 at the full rate. One function per figure turns that data (or the model) into a
-:class:`matplotlib.figure.Figure`; :func:`svg_data_uri` makes it an ``<img>``
-source. Figures are built on ``Figure`` objects directly with the Agg backend,
-never through ``pyplot``, so no global figure state is shared between them.
+:class:`matplotlib.figure.Figure`; :func:`plot` makes it a :class:`Plot`, the
+``<img>`` source (:func:`svg_data_uri`) and its alternative text. Figures are built on
+``Figure`` objects directly with the Agg backend, never through ``pyplot``, so no global
+figure state is shared between them.
 
 [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
 """
@@ -65,6 +66,19 @@ def svg_data_uri(figure: Figure) -> str:
     buffer = io.BytesIO()
     figure.savefig(buffer, format="svg", metadata={"Date": None})
     return "data:image/svg+xml;base64," + base64.b64encode(buffer.getvalue()).decode("ascii")
+
+
+@dataclass(frozen=True)
+class Plot:
+    """A drawn figure as a report embeds it: its SVG ``data:`` URI and its alternative text."""
+
+    uri: str
+    alt: str
+
+
+def plot(figure: Figure, alt: str) -> Plot:
+    """``figure`` drawn for the page (:func:`svg_data_uri`), with its alternative text."""
+    return Plot(svg_data_uri(figure), alt)
 
 
 def _figure(width_in: float, height_in: float) -> Figure:

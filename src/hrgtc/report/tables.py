@@ -6,11 +6,16 @@ still has it) and, for simulated soaks, how far the temperature from frequency i
 true resonator temperature. Each is a :class:`~hrgtc.core.summary.Summary` of table cells
 (:meth:`~hrgtc.core.summary.Summary.grid`), rendered like the other tables; see
 docs/architecture.md ("One result contract").
+
+A table as a report shows it is a :class:`Table` (caption, headers, rows of cells as text),
+taken from a summary by :func:`grid_table` (a section of cells) or :func:`section_table` (a
+section of figures: figure, value, unit, interval); the templates lay it out.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -19,7 +24,8 @@ import numpy as np
 from hrgtc.core.files import file_sha256
 from hrgtc.core.summary import Figure, Summary
 
-__all__ = ["INPUTS", "SOAK_ERROR", "provenance_summary", "soak_error_summary"]
+__all__ = ["INPUTS", "SOAK_ERROR", "Table", "grid_table", "provenance_summary", "section_table",
+           "soak_error_summary"]
 
 #: Headings of the sections.
 INPUTS = "Model inputs (provenance)"
@@ -27,6 +33,35 @@ SOAK_ERROR = "Temperature from frequency minus the true resonator temperature (b
 
 #: What :func:`provenance_summary` says of a file on disk now.
 MISSING, UNCHANGED, CHANGED = "missing", "unchanged", "CHANGED since calibration"
+
+
+@dataclass(frozen=True)
+class Table:
+    """A table of the report: its caption, column headers and rows of cells (text)."""
+
+    caption: str
+    headers: tuple[str, ...]
+    rows: tuple[tuple[str, ...], ...]
+
+
+#: The columns of a section of figures (:func:`section_table`).
+FIGURE_COLUMNS = ("figure", "value", "unit", "interval")
+
+
+def grid_table(summary: Summary, heading: str, caption: str,
+               columns: Sequence[str] | None = None) -> Table:
+    """A section of table cells of ``summary`` (:meth:`Summary.grid`); a missing number
+    shows as "–"."""
+    headers, rows = summary.grid(heading, columns)
+    return Table(caption, tuple(headers),
+                 tuple(tuple("–" if c == "-" else c for c in row) for row in rows))
+
+
+def section_table(summary: Summary, heading: str, caption: str) -> Table | None:
+    """One section of ``summary`` as a table (figure, value, unit, interval); None when the
+    summary has no such figures."""
+    rows = tuple(tuple(row[1:]) for row in summary.rows() if row[0] == heading)
+    return Table(caption, FIGURE_COLUMNS, rows) if rows else None
 
 
 def provenance_summary(provenance: Mapping[str, Any]) -> Summary:

@@ -1,23 +1,11 @@
-"""The HTML report's sections: the evidence of a calibration, like [1].
-
-:func:`hrgtc.report.build.build_report` reads the unit's soaks and any number of runs chunk by
-chunk (:func:`~hrgtc.report.figures.trace_soak`, and the one run pass of
-:func:`hrgtc.evaluation.evaluate`), decimates them to block means for plotting,
-compensates each run with the unit's model (and with the housing-thermistor
-baseline when there is one), and writes one HTML document:
-the settling of each soak (Fig. 3 of [1]), the frequency-temperature fit (Fig. 4,
-Table 1, Eq. 18), the temperature from frequency (Fig. 5, Table 2), raw and
-compensated output of each run (Fig. 6) with bias stability and Allan deviation,
-and the stepwise drift model (Eq. 21-22). Figures (:mod:`hrgtc.report.figures`)
-are embedded as SVG ``data:`` URIs; the page loads no external resource.
-
-[1] X. Wang, W. Wu, Z. Fang, B. Luo, Y. Li, Q. Jiang, "Temperature Drift
-    Compensation for Hemispherical Resonator Gyro Based on Natural Frequency",
-    Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
-"""
+"""The report as hrgtc wrote it before it was data, then templates (issue 28, item 5): the
+f-string sections of ``hrgtc.report.html`` and the body of ``build_report`` at commit 8b58650,
+kept to check that the templates show the same page (``tests/report/test_templates.py``).
+Not maintained: it renders what the report showed then."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 from collections.abc import Iterable, Mapping, Sequence
@@ -34,20 +22,23 @@ from hrgtc.evaluation import Evaluation
 from hrgtc.evaluation.calibration_figures import (
     EQ18,
     PLATEAUS,
+    SENSOR_THERMOMETER,
     TABLE1,
     TABLE2,
     calibration_summary,
     drift_heading,
     power_text,
+    thermometer_tables,
 )
-from hrgtc.evaluation.glance_figures import GLANCE, glance_summary
-from hrgtc.model import UnitModel
+from hrgtc.evaluation.glance_figures import GLANCE, glance_summary, instrument_glance_summary
+from hrgtc.model import InstrumentModel, UnitModel
 from hrgtc.report.figures import SoakTrace
+from hrgtc.report.inputs import ReportInputs, evaluate_runs, trace_soaks
 from hrgtc.report.tables import INPUTS, SOAK_ERROR, provenance_summary, soak_error_summary
 from hrgtc.thermometry import paper
 from hrgtc.thermometry.plateaus import Plateau
 
-__all__: list[str] = []  # the sections; build.build_report puts them together
+__all__ = ["legacy_html"]
 
 PathLike = str | os.PathLike[str]
 
@@ -423,3 +414,88 @@ def _scale_factor(page: _Page, model: UnitModel) -> None:
              f"RMS over the groups; "
              f"|input| up to {shown['scale_factor.input_rate_max_dps'].number()} °/s.</p>"
              "</section>")
+
+
+def legacy_html(inputs: ReportInputs) -> str:
+    """The page ``build_report`` wrote from ``inputs`` before the templates (its body at
+    8b58650, with the reading of the runs and soaks it shares with the new one)."""
+    instrument = inputs.instrument
+    first = next(iter(instrument.axes.values()))
+    traced = {axis: m.thermometer for axis, m in instrument.axes.items()
+              if m.thermometer.source != "sensor"}
+    title = inputs.title
+    page = _Page()
+    _header(page, dataclasses.replace(first, unit=instrument.unit), title
+            or f"Temperature compensation report — unit {instrument.unit}", inputs.model_path,
+            "" if instrument.is_single_axis else next(iter(instrument.axes)))
+    evaluations = evaluate_runs(inputs, lambda rows: None)
+    traces = trace_soaks(inputs, traced, lambda rows: None)
+    sections: dict[str, list[str]] = {}
+    for axis, unit_model in instrument.axes.items():
+        axis_page = _Page()
+        axis_page.count = page.count
+        _unit_sections(axis_page, unit_model, evaluations[axis], traces.get(axis, []),
+                       list(inputs.missing_soaks), instrument.temperature_map)
+        page.count = axis_page.count
+        sections[axis] = axis_page.parts
+    if instrument.is_single_axis:
+        _summary(page, evaluations[""], first.thermometer.source == "sensor")
+        page.add(*sections[""])
+    else:
+        _instrument_summary(page, instrument, evaluations)
+        for axis, parts in sections.items():
+            html = "\n".join(parts).replace(' id="', f' id="{axis}-').replace(
+                'href="#', f'href="#{axis}-')
+            page.add(f'<section id="axis-{escape(axis)}"><h2 class="axis">Axis '
+                     f"{escape(axis)}</h2>", html, "</section>")
+    body = "\n".join(page.parts)
+    title_text = title or f"Temperature compensation report — unit {instrument.unit}"
+    return (f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
+            f'<meta name="viewport" content="width=device-width, initial-scale=1">'
+            f"<title>{escape(title_text)}</title>"
+            f"<style>{_CSS}</style></head><body>\n{body}\n<footer class=\"muted\"><p>[1] "
+            f"{reference(first.thermometer.source == 'sensor')}. doi:{DOI}. Generated by "
+            "hrgtc.</p></footer></body></html>\n")
+
+
+def _unit_sections(page: _Page, model: UnitModel, evaluations: Sequence[Evaluation],
+                   traces: Sequence[SoakTrace], missing: list[str],
+                   temperature_map: dict[str, Any] | None = None) -> None:
+    """One axis's sections: Figs. 3-5 and Tables 1-2 (a sensor thermometer: what it is and
+    the map of its count, ``temperature_map``), its runs, drift and scale factor."""
+    plateaus = [Plateau.from_dict(p) for p in model.plateaus]
+    table = _table_rows(model, plateaus)
+    sensor = model.thermometer.source == "sensor"
+    if sensor:
+        low, high = model.thermometer.temperature_range_c
+        page.note(f"No frequency output: the gyro's temperature sensor is the thermometer "
+                  f"(trained {low:.2f} to {high:.2f} °C); no soak settling, frequency fit or "
+                  "temperature from frequency to show.")
+        _section_table(page, calibration_summary(model, temperature_map=temperature_map),
+                       SENSOR_THERMOMETER, "Thermometer: the gyro's temperature sensor"
+                       + (", its count mapped to °C by the reference log" if temperature_map
+                          else ", read directly"))
+    else:
+        tables = thermometer_tables(model.thermometer, plateaus)
+        _settling(page, plateaus, traces, missing, tables)
+        _thermometer(page, model, plateaus, table, tables)
+        _temperature(page, table, traces, tables)
+    page.add('<section id="runs"><h2>4. Runs: raw and compensated output</h2>')
+    if not evaluations:
+        page.note("No runs given.")
+    for k, run in enumerate(evaluations, start=1):
+        _run(page, k, run, model)
+    page.add("</section>")
+    _drift_model(page, model)
+    _scale_factor(page, model)
+
+
+def _instrument_summary(page: _Page, model: InstrumentModel,
+                        evaluations: dict[str, list[Evaluation]]) -> None:
+    """The instrument at a glance: each axis's 10 s bias stability per run, scale factor."""
+    page.add(f'<section id="instrument"><h2>Instrument {escape(model.unit)}: '
+             f"{len(model.axes)} axes</h2>",
+             _grid_table(instrument_glance_summary(model, evaluations), GLANCE,
+                         "At a glance: 10 s bias stability per axis and run"),
+             "<nav><ol>" + "".join(f'<li><a href="#axis-{escape(a)}">Axis {escape(a)}</a></li>'
+                                   for a in model.axes) + "</ol></nav></section>")
