@@ -155,7 +155,9 @@ class Audit:
 
     def _invoke(self, args: list[str]) -> tuple[int, str, str, bool]:
         with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
+            # every warning reaches the command's own once-per-cause printing, as on a
+            # terminal (Python's registry would hide a repeat from an earlier case)
+            warnings.simplefilter("always")
             result = runner.invoke(app, args)
         crashed = result.exception is not None and not isinstance(result.exception, SystemExit)
         return result.exit_code, result.stdout, result.stderr.strip(), crashed

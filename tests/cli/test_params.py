@@ -32,6 +32,7 @@ PAGES = {"calibrate": DOCS / "guide" / "calibrate.md", "reading": DOCS / "guide"
          "export": DOCS / "guide" / "export-c.md", "demo": DOCS / "guide" / "demo.md",
          "fleet_simulate": DOCS / "guide" / "fleet.md",
          "fleet_evaluate": DOCS / "guide" / "fleet.md",
+         "fleet_cluster": DOCS / "guide" / "fleet.md",
          "simulate": DOCS / "guide" / "simulate.md",
          "simulate_logger": DOCS / "real-loggers" / "simulate.md"}
 #: The commands whose options each settings class generates.
@@ -41,7 +42,10 @@ COMMANDS = {"calibrate": ["calibrate"], "calibrate_inputs": ["calibrate"],
                         "fleet calibrate", "fleet evaluate", "fleet report"],
             "compensate": ["compensate"], "evaluate": ["evaluate"], "report": ["report"],
             "export": ["export-c"], "demo": ["demo"], "fleet_simulate": ["fleet simulate"],
-            "fleet_evaluate": ["fleet evaluate"], "simulate": ["simulate"],
+            "fleet_evaluate": ["fleet evaluate"],
+            "fleet_cluster": ["fleet simulate", "fleet calibrate", "fleet evaluate",
+                              "fleet report"],
+            "simulate": ["simulate"],
             "simulate_logger": ["simulate"]}
 CASES = [(key, s) for key in DOCUMENTED for s in option_settings(settings_class(key))]
 

@@ -95,7 +95,8 @@ class RateFilterWarning(HrgtcWarning):
 
 
 class GapWarning(HrgtcWarning):
-    """A recording's gaps were bridged without being asked: a duty-cycled logger's."""
+    """A recording's time axis was mended without being asked: a duty-cycled logger's
+    gaps or short dropouts bridged, a logger restart read as a new run."""
 
 
 class SlowChannelWarning(HrgtcWarning):

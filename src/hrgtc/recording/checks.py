@@ -157,7 +157,13 @@ class ValidationReport:
             raise RecordingError(self.message)
 
     def warn_bridged(self) -> None:
-        """Say, once, that a duty-cycled logger's gaps were bridged by default."""
+        """Say, once, that short dropouts or a duty-cycled logger's gaps were bridged by
+        default (the result goes on; the user is told what was mended)."""
+        if self.n_dropouts and not self.problems:
+            warnings.warn(GapWarning(
+                f"{self.source or 'recording'}: {self.n_dropouts} dropout(s) no longer than "
+                f"{self.dropout_s:g} s (--dropout-s) bridged: the filters carry across each "
+                "with its duration"), stacklevel=3)
         if self.duty_cycled and self.gap_policy == "error" and not self.problems:
             warnings.warn(GapWarning(
                 f"{self.source or 'recording'}: a duty-cycled logger (bursts much shorter "

@@ -69,9 +69,10 @@ from hrgtc.recording.spikes import (
 from hrgtc.recording.time_axis import (
     _repair_extra,
     _repair_time,
-    _restarts_extra,
     _time_repairer,
     _TimeSlice,
+    warn_restarts,
+    with_restarts,
 )
 from hrgtc.recording.validation import (
     HEURISTIC_ROWS,
@@ -241,6 +242,7 @@ def read(path: str | Path, options: ReadSettings | None = None, *, validate: boo
         meta = _metadata(plan, opts.metadata, arrays.get("time_s"))
     if repairer.events or repairer.duplicates:
         meta = replace(meta, extra={**meta.extra, **_repair_extra(repairer)})
+    warn_restarts(repairer)
     warn_alignment(source)
     slow.warn()
     if spike_filter is not None and spike_filter.dropped:
@@ -412,17 +414,13 @@ def iter_chunks(path: str | Path, options: ReadSettings | None = None, *,
         meta = _metadata(plan, opts.metadata, time_head)
         pending: list[Recording] = []
 
-        def chunk_meta() -> Metadata:  # with the logger restarts found so far (new runs)
-            restarts = _restarts_extra(repairer)
-            return replace(meta, extra={**meta.extra, **restarts}) if restarts else meta
-
         def chunks() -> Iterator[tuple[Recording, np.ndarray | None]]:
             held, parts = list(head), pieces
             head.clear()
             for p in itertools.chain(held, parts):  # the file rows go to the validator
                 part, file_rows = take_file_rows(p)
                 in_slice.kept(file_rows)
-                yield Recording(part, chunk_meta(), source=str(path)), file_rows
+                yield Recording(part, with_restarts(meta, repairer), source=str(path)), file_rows
 
         for chunk, rows_of_file in chunks():
             if file_rows is not None:
@@ -440,6 +438,7 @@ def iter_chunks(path: str | Path, options: ReadSettings | None = None, *,
             report = validator.finish()
             report.raise_for_problems()
             report.warn_bridged()
+        warn_restarts(repairer)
         if spike_filter is not None:
             spike_filter.warn()
         robust.warn()

@@ -8,11 +8,13 @@ new segment, duplicated rows dropped; see :mod:`hrgtc.core.time_steps`) and then
 
 from __future__ import annotations
 
+import warnings
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
-from hrgtc.core.errors import InputError, RecordingError
+from hrgtc.core.errors import GapWarning, InputError, RecordingError
 from hrgtc.core.time_steps import TimeRepairStream
 from hrgtc.core.timeline import RESTARTS_KEY, parse_time_bound
 from hrgtc.recording.file_rows import ROW_KEY
@@ -96,6 +98,23 @@ def _repair_extra(repairer: TimeRepairStream) -> dict[str, Any]:
         extra["duplicates_dropped"] = repairer.duplicates
     extra.update(_restarts_extra(repairer))
     return extra
+
+
+def warn_restarts(repairer: TimeRepairStream) -> None:
+    """Say, once per reading, that the logger restarted (each restart starts a new run: the
+    df/dt filter settles again and its warm-up is left out again)."""
+    event = next((e for e in repairer.events if e.kind == "reset"), None)
+    if event is not None:
+        where = repairer.source
+        warnings.warn(GapWarning(
+            f"{where + ': ' if where else ''}column 'time_s', {event.message}; the df/dt "
+            "filter settles again after it"), stacklevel=3)
+
+
+def with_restarts(metadata: Any, repairer: TimeRepairStream) -> Any:
+    """``metadata`` with the logger restarts found so far (each a new run)."""
+    restarts = _restarts_extra(repairer)
+    return replace(metadata, extra={**metadata.extra, **restarts}) if restarts else metadata
 
 
 def _restarts_extra(repairer: TimeRepairStream) -> dict[str, Any]:
