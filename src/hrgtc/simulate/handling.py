@@ -239,6 +239,27 @@ def _orientation_offsets(handling: Handling, axes: Sequence[str]) -> list[dict[s
     return out
 
 
+def _rate_pulses(tw: np.ndarray, start: float, end: float, max_rate_dps: float,
+                 rng: np.random.Generator) -> np.ndarray:
+    """The body rates of one handling window: three cosine pulses per body axis. [°/s]
+
+    ``tw`` holds the window's sample times; the result is ``(3, tw.size)``, scaled so that
+    its peak is 80 to 100 % of ``max_rate_dps``.
+    """
+    pulses = np.zeros((3, tw.size))
+    for i in range(3):  # body axes x, y, z
+        for _ in range(3):
+            half = rng.uniform(0.5, 3.0)
+            centre = rng.uniform(start + half, max(start + half, end - half))
+            shape = np.where(np.abs(tw - centre) < half,
+                             np.cos(0.5 * np.pi * (tw - centre) / half), 0.0)
+            pulses[i] += rng.choice((-1.0, 1.0)) * rng.uniform(0.3, 1.0) * shape
+    peak = float(np.max(np.abs(pulses))) if tw.size else 0.0
+    if peak > 0.0:
+        pulses *= max_rate_dps * rng.uniform(0.8, 1.0) / peak
+    return pulses
+
+
 def handling_truth(
     time_s: np.ndarray,
     axes: Sequence[str],
@@ -295,17 +316,7 @@ def handling_truth(
         motion[rows] = True
         orientation[rows] = -1
         tw = t[rows]
-        pulses = np.zeros((3, rows.size))
-        for i in range(3):  # body axes x, y, z
-            for _ in range(3):
-                half = rng.uniform(0.5, 3.0)
-                centre = rng.uniform(start + half, max(start + half, end - half))
-                shape = np.where(np.abs(tw - centre) < half,
-                                 np.cos(0.5 * np.pi * (tw - centre) / half), 0.0)
-                pulses[i] += rng.choice((-1.0, 1.0)) * rng.uniform(0.3, 1.0) * shape
-        peak = float(np.max(np.abs(pulses))) if rows.size else 0.0
-        if peak > 0.0:
-            pulses *= handling.max_rate_dps * rng.uniform(0.8, 1.0) / peak
+        pulses = _rate_pulses(tw, start, end, handling.max_rate_dps, rng)
         for a in axes:
             motion_dph[a][rows] = pulses[_BODY[a]] * _SECONDS_PER_HOUR
         s = np.clip((tw - start) / handling.handling_s, 0.0, 1.0)
