@@ -271,18 +271,9 @@ def simulate_files(
     shared = _SharedProgress([row_count(p, fs) for p in profiles], progress)
     with ThreadPoolExecutor(max_workers=max(1, min(int(workers), len(profiles)))) as pool:
         futures = [
-            pool.submit(
-                simulate_to_file,
-                profile,
-                path,
-                unit,
-                fs,
-                np.random.SeedSequence(seed, spawn_key=(k,)),
-                settings.input_rate_dph,
-                settings.chunk_rows,
-                force,
-                shared.reporter(k),
-            )
+            pool.submit(simulate_to_file, profile, path, unit, fs,
+                        np.random.SeedSequence(seed, spawn_key=(k,)), settings.input_rate_dph,
+                        settings.chunk_rows, force, shared.reporter(k))
             for k, (profile, path) in enumerate(zip(profiles, paths, strict=True))
         ]
         try:
