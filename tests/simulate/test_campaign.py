@@ -368,6 +368,20 @@ def test_campaign_files_round_trip_and_refuse_to_overwrite(tmp_path):
     assert not np.array_equal(read(written[1].path).rate_dph, back.rate_dph)
 
 
+def test_campaign_files_take_the_run_settings_whole(tmp_path):
+    """``run=SimulatedRun(...)`` and the same fields by keyword write the same file; a
+    keyword that is no field of it is refused."""
+    runs = [simulate.constant(20.0, 0.01)]
+    run = simulate.SimulatedRun(sample_rate_hz=10.0, seed=3, chunk_rows=100)
+    (whole,) = simulate.simulate_files(runs, tmp_path / "whole", run=run)
+    (keywords,) = simulate.simulate_files(runs, tmp_path / "keywords", sample_rate_hz=10.0,
+                                          seed=3, chunk_rows=100)
+    for name in simulate.COLUMNS:
+        assert np.array_equal(read(whole.path)[name], read(keywords.path)[name]), name
+    with pytest.raises(TypeError, match=r"\['sample_rate'\]"):
+        simulate.simulate_files(runs, tmp_path / "bad", sample_rate=10.0)
+
+
 @pytest.mark.parametrize("file_format", ["csv", "h5"])
 def test_other_formats(tmp_path, file_format):
     runs = [simulate.constant(20.0, 0.01)]

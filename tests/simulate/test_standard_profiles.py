@@ -128,3 +128,19 @@ def test_each_kind_takes_its_defaults_from_the_one_table(monkeypatch):
     assert "soak 2.0" in per_kind("hours") and "ratetable 3.0" in per_kind("hours")
     with pytest.raises(InputError, match=r"a ramp needs start_c \(--start\)"):
         standard_profiles.build("ramp", end_c=5.0)
+
+
+def test_build_takes_the_simulation_settings_whole():
+    """``build(kind, SimulationSettings(...))`` is ``build(kind, **the same fields)``; a
+    keyword overrides the settings' field; a keyword that is no profile option is refused."""
+    from hrgtc.settings.simulation import SimulationSettings
+
+    settings = SimulationSettings(setpoints_c=(-10.0, 30.0), hours=1.0, single_file=True)
+    (whole,) = standard_profiles.build("soak", settings)
+    (keywords,) = standard_profiles.build("soak", setpoints_c=[-10.0, 30.0], hours=1.0,
+                                          single_file=True)
+    assert whole == keywords
+    assert [p.duration_s for p in standard_profiles.build("soak", settings, hours=2.0,
+                                                          single_file=False)] == [7200.0] * 2
+    with pytest.raises(TypeError, match=r"\['seed'\]"):
+        standard_profiles.build("soak", seed=1)

@@ -217,17 +217,6 @@ def classify_time_steps(time_s: np.ndarray, *, nominal_period_s: float | None = 
     (['wrap'], True)
     """
     raw = np.asarray(time_s, dtype=np.float64)
-    n = raw.size
-    events: dict[str, list[Any]] = {}  # kind -> [first row, count, detail]
-
-    def note(kind: str, row: int, count: int = 1, detail: Any = None) -> None:
-        if kind in events:
-            events[kind][1] += count
-        else:
-            events[kind] = [row, count, detail]
-
-    keep = np.ones(n, dtype=bool)
-    restarts: list[int] = []
     step = np.diff(raw)
     period = median_period_s(raw) if period_s is None else float(period_s)
     moduli = tuple(WRAP_MODULUS_S.values()) if time_unit is None else tuple(
@@ -240,64 +229,113 @@ def classify_time_steps(time_s: np.ndarray, *, nominal_period_s: float | None = 
             limit = gap_limit_s(period, gap_factor)
             forward = np.abs(step - DST_STEP_S) <= limit
             odd |= forward
-    cumulative = 0.0
-    shifts: list[tuple[int, float]] = []  # (row, offset from that row on)
-    since = 0  # first row of the raw times' current increasing stretch (after a wrap, ...)
+    walk = _StepWalk(raw, values, period, gap_factor, moduli, naive_clock)
     for i in np.flatnonzero(odd):
-        row = int(i) + 1
-        if not keep[row]:
-            continue
-        before, after, s = float(raw[row - 1]), float(raw[row]), float(step[i])
+        walk.visit(int(i) + 1, float(step[i]))
+    offset = np.zeros(raw.size)
+    for row, value in walk.shifts:
+        offset[row:] = value
+    repaired = raw + offset
+    keep = walk.keep
+    kept_index = np.flatnonzero(keep)
+    repaired = repaired[keep]
+    restart_rows = tuple(int(np.searchsorted(kept_index, r)) for r in walk.restarts)
+    good_period = median_period_s(repaired)
+    out = [_event(kind, row, count, detail)
+           for kind, (row, count, detail) in walk.events.items()]
+    if rate_events:
+        out += _rate_events(repaired, kept_index, good_period, nominal_period_s, gap_factor,
+                            time_unit or "s")
+    out.sort(key=lambda e: e.row)
+    return TimeDiagnosis(repaired, keep, restart_rows, tuple(out), good_period, offset)
+
+
+@dataclass
+class _StepWalk:
+    """The walk of :func:`classify_time_steps` over the odd steps, in row order.
+
+    It reads the raw times, the other columns (``values``), the period the steps are
+    judged by, the gap factor, the counter moduli a wrap may have and whether the times
+    are naive clock times; it gathers the rows kept, the events (kind -> [first row,
+    count, detail]), the rows where the clock restarted and the offsets to add from a row
+    on (``shifts``), with the running offset and the first row of the raw times' current
+    increasing stretch (after a wrap, ...) (``since``).
+    """
+
+    raw: np.ndarray
+    values: np.ndarray | None
+    period: float
+    gap_factor: float
+    moduli: tuple[float, ...]
+    naive_clock: bool
+    keep: np.ndarray = field(init=False)
+    events: dict[str, list[Any]] = field(default_factory=dict)
+    restarts: list[int] = field(default_factory=list)
+    shifts: list[tuple[int, float]] = field(default_factory=list)
+    cumulative: float = 0.0
+    since: int = 0
+
+    def __post_init__(self) -> None:
+        self.keep = np.ones(self.raw.size, dtype=bool)
+
+    def note(self, kind: str, row: int, count: int = 1, detail: Any = None) -> None:
+        """Count one more event of ``kind`` (its first row and detail kept)."""
+        if kind in self.events:
+            self.events[kind][1] += count
+        else:
+            self.events[kind] = [row, count, detail]
+
+    def visit(self, row: int, s: float) -> None:
+        """Judge the odd step ``s`` [s] into ``row``: a wrap, daylight saving, a duplicate,
+        a reset or a step backwards."""
+        raw, n = self.raw, self.raw.size
+        if not self.keep[row]:
+            return
+        before, after = float(raw[row - 1]), float(raw[row])
         if not (math.isfinite(before) and math.isfinite(after)):
-            continue  # a non-finite time is the validation's to report
-        limit = gap_limit_s(period, gap_factor) if math.isfinite(period) else 0.0
+            return  # a non-finite time is the validation's to report
+        period = self.period
+        limit = gap_limit_s(period, self.gap_factor) if math.isfinite(period) else 0.0
         # a wrap or a reset goes on from there: the next step is an ordinary one (a single
         # glitched time is neither)
         goes_on = row + 1 >= n or 0.0 < raw[row + 1] - after <= max(limit, 0.0) or (
             not math.isfinite(limit))
         # a wrap lands where the counter would have been: a step of one period (or a gap
         # of up to 1 % of the counter's range) past 2^32 units
-        modulus = next((m for m in moduli if 0.0 < s + m <= max(limit, WRAP_GAP * m)), None)
+        modulus = next((m for m in self.moduli if 0.0 < s + m <= max(limit, WRAP_GAP * m)),
+                       None)
         if modulus is not None and goes_on:
-            note("wrap", row, detail=modulus)
-            since = row
-            cumulative += modulus
-            shifts.append((row, cumulative))
-        elif naive_clock and (abs(abs(s) - DST_STEP_S) <= limit
-                              or -DST_STEP_S - limit <= s < -0.5 * DST_STEP_S):
+            self.note("wrap", row, detail=modulus)
+            self.since = row
+            self.cumulative += modulus
+            self.shifts.append((row, self.cumulative))
+        elif self.naive_clock and (abs(abs(s) - DST_STEP_S) <= limit
+                                   or -DST_STEP_S - limit <= s < -0.5 * DST_STEP_S):
             # the clocks going back by 1 h, on a burst logger across a pause (-3600 s +
             # the pause): the zone is missing, not the file joined out of order
-            note("dst", row, detail=s)
-            since = row
+            self.note("dst", row, detail=s)
+            self.since = row
         elif s <= 0.0:
-            count = _duplicate_block(raw, keep, values, row, since)
-            if count:
-                note("duplicate", row, count)
-            elif s == 0.0:
-                note("duplicate_time", row)
-            elif goes_on and before > 0.0 and -limit <= after <= RESET_FRACTION * before:
-                note("reset", row)
-                since = row
-                restarts.append(row)
-                # follow the earlier run after a gap of 10 gap limits (its length is unknown)
-                cumulative += before - after + 10.0 * limit
-                shifts.append((row, cumulative))
-            else:
-                note("backwards", row, detail=(before, after))
-    offset = np.zeros(n)
-    for row, value in shifts:
-        offset[row:] = value
-    repaired = raw + offset
-    kept_index = np.flatnonzero(keep)
-    repaired = repaired[keep]
-    restart_rows = tuple(int(np.searchsorted(kept_index, r)) for r in restarts)
-    good_period = median_period_s(repaired)
-    out = [_event(kind, row, count, detail) for kind, (row, count, detail) in events.items()]
-    if rate_events:
-        out += _rate_events(repaired, kept_index, good_period, nominal_period_s, gap_factor,
-                            time_unit or "s")
-    out.sort(key=lambda e: e.row)
-    return TimeDiagnosis(repaired, keep, restart_rows, tuple(out), good_period, offset)
+            self._backwards(row, s, before, after, limit, goes_on)
+
+    def _backwards(self, row: int, s: float, before: float, after: float, limit: float,
+                   goes_on: bool) -> None:
+        """A step ``s`` <= 0 that is no wrap: duplicate rows, a duplicate time, a reset
+        (the clock restarted near zero) or a step backwards."""
+        count = _duplicate_block(self.raw, self.keep, self.values, row, self.since)
+        if count:
+            self.note("duplicate", row, count)
+        elif s == 0.0:
+            self.note("duplicate_time", row)
+        elif goes_on and before > 0.0 and -limit <= after <= RESET_FRACTION * before:
+            self.note("reset", row)
+            self.since = row
+            self.restarts.append(row)
+            # follow the earlier run after a gap of 10 gap limits (its length is unknown)
+            self.cumulative += before - after + 10.0 * limit
+            self.shifts.append((row, self.cumulative))
+        else:
+            self.note("backwards", row, detail=(before, after))
 
 
 def _duplicate_block(raw: np.ndarray, keep: np.ndarray, values: np.ndarray | None,

@@ -17,6 +17,7 @@ References
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -182,6 +183,32 @@ def greenhall_edf(n_phase: int, m: int, noise_alpha: int = 0, d: int = 2, *,
         For an α outside :data:`NOISE_ALPHAS`, d outside 1..3, α + 2d <= 1 (the
         variance does not converge) or an m the record cannot hold.
     """
+    alpha = _checked_alpha(noise_alpha, d)
+    n, m = float(n_phase), int(m)
+    f = 1.0 if modified else float(m)  # filter factor
+    s = float(m) if overlapping else 1.0  # stride factor
+    length = m / f + m * d  # length of the filter applied to the phase
+    if m < 1 or n < length + 1:
+        raise InputError(f"m={m} needs at least {length + 1:g} phase points, got {n_phase}")
+    m_terms = 1.0 + math.floor(s * (n - length) / m)
+    terms = _Terms(m=m, m_terms=m_terms, s=s, j=min(m_terms, (d + 1) * s), r=m_terms / s,
+                   alpha=alpha, d=d)
+    if modified:  # case 1
+        inverse = _inverse_modified(terms)
+    elif alpha <= 0:  # case 2
+        inverse = _inverse_phase_like(terms)
+    elif alpha == 1:  # case 3
+        inverse = _inverse_flicker_pm(terms)
+    else:  # case 4, α = 2 unmodified
+        if math.ceil(terms.r) <= d:
+            return math.nan
+        a0 = math.comb(4 * d, 2 * d) / math.comb(2 * d, d) ** 2
+        inverse = (a0 - d / (2.0 * terms.r)) / m_terms
+    return 1.0 / inverse
+
+
+def _checked_alpha(noise_alpha: int, d: int) -> int:
+    """``noise_alpha`` as an int, once it and ``d`` are known to give a convergent edf."""
     if noise_alpha not in NOISE_ALPHAS:
         raise InputError(
             f"noise_alpha={noise_alpha!r} has no edf here; use one of {sorted(NOISE_ALPHAS)}")
@@ -191,55 +218,69 @@ def greenhall_edf(n_phase: int, m: int, noise_alpha: int = 0, d: int = 2, *,
     if alpha + 2 * d <= 1:
         raise InputError(f"noise_alpha={alpha} with d={d}: the variance does not converge "
                          "(alpha + 2d must exceed 1); use a higher-order deviation")
-    n, m = float(n_phase), int(m)
-    f = 1.0 if modified else float(m)  # filter factor
-    s = float(m) if overlapping else 1.0  # stride factor
-    length = m / f + m * d  # length of the filter applied to the phase
-    if m < 1 or n < length + 1:
-        raise InputError(f"m={m} needs at least {length + 1:g} phase points, got {n_phase}")
-    m_terms = 1.0 + math.floor(s * (n - length) / m)
-    j = min(m_terms, (d + 1) * s)
-    r = m_terms / s
+    return alpha
+
+
+@dataclass(frozen=True)
+class _Terms:
+    """What Greenhall's cases read (SP 1065 Section 5.3.3 [3]).
+
+    ``m`` the averaging factor, ``m_terms`` the number of summands M, ``s`` the stride
+    factor S, ``j = min(M, (d + 1) S)``, ``r = M / S``, ``alpha`` and ``d`` as in
+    :func:`greenhall_edf`.
+    """
+
+    m: int
+    m_terms: float
+    s: float
+    j: float
+    r: float
+    alpha: int
+    d: int
+
+
+def _inverse_modified(t: _Terms) -> float:
+    """1 / edf of a modified variance, case 1 of [4] (Table 1 beyond J_max)."""
+    alpha, d, r = t.alpha, t.d, t.r
     j_max = float(GREENHALL_J_MAX)
-    if modified:  # case 1
-        if j <= j_max:
-            inverse = _basic_sum(j, m_terms, s, 1.0, alpha, d) / (_sz(0.0, 1.0, alpha, d) ** 2
-                                                                  * m_terms)
-        elif r > d + 1:
-            a0, a1 = _table(_TABLE1, alpha, d)
-            inverse = (a0 - a1 / r) / r
-        else:
-            inverse = _basic_sum(j_max, j_max, j_max / r, 1.0, alpha, d) / (
-                _sz(0.0, 1.0, alpha, d) ** 2 * j_max)
-    elif alpha <= 0:  # case 2
-        if j <= j_max:
-            f_eff = float(m) if m * (d + 1) <= j_max else math.inf
-            inverse = _basic_sum(j, m_terms, s, f_eff, alpha, d) / (
-                _sz(0.0, f_eff, alpha, d) ** 2 * m_terms)
-        elif r > d + 1:
-            a0, a1 = _table(_TABLE2, alpha, d)
-            inverse = (a0 - a1 / r) / r
-        else:
-            inverse = _basic_sum(j_max, j_max, j_max / r, math.inf, alpha, d) / (
-                _sz(0.0, math.inf, alpha, d) ** 2 * j_max)
-    elif alpha == 1:  # case 3
-        if j <= j_max:
-            inverse = _basic_sum(j, m_terms, s, float(m), 1, d) / (_sz(0.0, float(m), 1, d) ** 2
-                                                                   * m_terms)
-        elif r > d + 1:
-            a0, a1 = _table(_TABLE2, 1, d)
-            b0, b1 = _TABLE3[d - 1]
-            inverse = (a0 - a1 / r) / ((b0 + b1 * math.log(m)) ** 2 * r)
-        else:
-            b0, b1 = _TABLE3[d - 1]
-            inverse = _basic_sum(j_max, j_max, j_max / r, j_max / r, 1, d) / (
-                (b0 + b1 * math.log(m)) ** 2 * j_max)
-    else:  # case 4, α = 2 unmodified
-        if math.ceil(r) <= d:
-            return math.nan
-        a0 = math.comb(4 * d, 2 * d) / math.comb(2 * d, d) ** 2
-        inverse = (a0 - d / (2.0 * r)) / m_terms
-    return 1.0 / inverse
+    if t.j <= j_max:
+        return _basic_sum(t.j, t.m_terms, t.s, 1.0, alpha, d) / (_sz(0.0, 1.0, alpha, d) ** 2
+                                                                 * t.m_terms)
+    if r > d + 1:
+        a0, a1 = _table(_TABLE1, alpha, d)
+        return (a0 - a1 / r) / r
+    return _basic_sum(j_max, j_max, j_max / r, 1.0, alpha, d) / (
+        _sz(0.0, 1.0, alpha, d) ** 2 * j_max)
+
+
+def _inverse_phase_like(t: _Terms) -> float:
+    """1 / edf of an unmodified variance for α <= 0, case 2 of [4] (Table 2 beyond J_max)."""
+    alpha, d, r, m = t.alpha, t.d, t.r, t.m
+    j_max = float(GREENHALL_J_MAX)
+    if t.j <= j_max:
+        f_eff = float(m) if m * (d + 1) <= j_max else math.inf
+        return _basic_sum(t.j, t.m_terms, t.s, f_eff, alpha, d) / (
+            _sz(0.0, f_eff, alpha, d) ** 2 * t.m_terms)
+    if r > d + 1:
+        a0, a1 = _table(_TABLE2, alpha, d)
+        return (a0 - a1 / r) / r
+    return _basic_sum(j_max, j_max, j_max / r, math.inf, alpha, d) / (
+        _sz(0.0, math.inf, alpha, d) ** 2 * j_max)
+
+
+def _inverse_flicker_pm(t: _Terms) -> float:
+    """1 / edf of an unmodified variance for α = 1, case 3 of [4] (Tables 2 and 3)."""
+    d, r, m = t.d, t.r, t.m
+    j_max = float(GREENHALL_J_MAX)
+    if t.j <= j_max:
+        return _basic_sum(t.j, t.m_terms, t.s, float(m), 1, d) / (_sz(0.0, float(m), 1, d) ** 2
+                                                                  * t.m_terms)
+    b0, b1 = _TABLE3[d - 1]
+    if r > d + 1:
+        a0, a1 = _table(_TABLE2, 1, d)
+        return (a0 - a1 / r) / ((b0 + b1 * math.log(m)) ** 2 * r)
+    return _basic_sum(j_max, j_max, j_max / r, j_max / r, 1, d) / (
+        (b0 + b1 * math.log(m)) ** 2 * j_max)
 
 
 def deviation_edf(kind: str, n_phase: int, m: int, noise_alpha: int = 0) -> float:

@@ -13,6 +13,22 @@
 - The noise terms read off the deviation (ARW, bias instability, RRW) are in
   :mod:`hrgtc.evaluation.noise`.
 
+The statistics of :func:`allan_deviation`'s ``kind``, on the phase ``x`` of the rate
+(N samples, averaging factor m): ``"allan"`` (Eq. 6-7 and 11), ``"modified"`` (mod σ,
+Eq. 14: the m second differences from j to j+m−1 summed before squaring, divided by
+2·n·m⁴, n = N+2−3m), ``"hadamard"`` (Eq. 20: third differences x[i+3m] − 3x[i+2m] +
+3x[i+m] − x[i], divided by 6·n·m², n = N+1−3m) and ``"time"`` (Eq. 15: τ·mod σ/√3).
+
+The overlapping statistics run in fused numba kernels (``_allan_kernels``)
+that never store the phase: extra memory is ~1/32 of the input, the values
+are exact to ~1e-14 relative also at 10^8 samples (compensated
+arithmetic; ``allantools`` itself drifts to ~1e-12 there), 7-9× faster
+than ``allantools.oadev`` at 10^8 samples on two threads (5× and more with
+``taus="all"`` on records of 10^4 to 4·10^4 samples), identical bit
+for bit from run to run. The first call of a statistic in a fresh
+environment compiles its kernels (~10 s, and ~6 s more for the many-τ
+kernel; cached in ``__pycache__`` afterwards).
+
 References
 ----------
 [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
@@ -341,17 +357,10 @@ def _normal_allan(
     return np.asarray(kept_m, dtype=np.int64), np.asarray(deviations), np.asarray(counts)
 
 
-def allan_deviation(
-    rate: Any,
-    sample_rate_hz: float,
-    taus: str | Sequence[float] | np.ndarray = "octave",
-    overlapping: bool = True,
-    *,
-    kind: str = "allan",
-    confidence: float | None = None,
-    noise_alpha: int = 0,
-    progress: Progress | None = None,
-) -> AllanResult:
+def allan_deviation(rate: Any, sample_rate_hz: float,
+                    taus: str | Sequence[float] | np.ndarray = "octave", overlapping: bool = True,
+                    *, kind: str = "allan", confidence: float | None = None,
+                    noise_alpha: int = 0, progress: Progress | None = None) -> AllanResult:
     """Allan deviation of rate (frequency-type) data, NIST SP 1065 Eq. (6)-(11) [3].
 
     The rate, mean removed, is summed into an angle ("phase") series
@@ -364,21 +373,8 @@ def allan_deviation(
     terms) or every m-th (``overlapping=False``, Eq. 6-7, n = floor(N/m)−1
     terms). As in allantools, τ with fewer than two terms are dropped.
 
-    ``kind`` selects another overlapping statistic of the same phase:
-    ``"modified"`` (mod σ, Eq. 14: the m second differences from j to j+m−1
-    summed before squaring, divided by 2·n·m⁴, n = N+2−3m), ``"hadamard"``
-    (Eq. 20: third differences x[i+3m] − 3x[i+2m] + 3x[i+m] − x[i], divided by
-    6·n·m², n = N+1−3m) or ``"time"`` (Eq. 15: τ·mod σ/√3).
-
-    The overlapping statistics run in fused numba kernels (``_allan_kernels``)
-    that never store the phase: extra memory is ~1/32 of the input, the values
-    are exact to ~1e-14 relative also at 10^8 samples (compensated
-    arithmetic; ``allantools`` itself drifts to ~1e-12 there), 7-9× faster
-    than ``allantools.oadev`` at 10^8 samples on two threads (5× and more with
-    ``taus="all"`` on records of 10^4 to 4·10^4 samples), identical bit
-    for bit from run to run. The first call of a statistic in a fresh
-    environment compiles its kernels (~10 s, and ~6 s more for the many-τ
-    kernel; cached in ``__pycache__`` afterwards).
+    ``kind`` selects another overlapping statistic of the same phase (the formulas, and
+    the speed, memory and accuracy of the kernels: module docstring).
 
     Parameters
     ----------
@@ -398,12 +394,9 @@ def allan_deviation(
         One of :data:`KINDS`.
     confidence
         If given (e.g. :data:`ONE_SIGMA`), the result carries the chi-squared
-        confidence interval of each τ (:func:`confidence_interval`). The edf is
-        the simple one of SP 1065 Table 5 for the Allan deviation
-        (:func:`equivalent_degrees_of_freedom`) and Greenhall's (SP 1065 Section
-        5.3.3, :func:`greenhall_edf`) for the modified, time and Hadamard ones
-        (:func:`deviation_edf`). For the normal (non-overlapping) deviation the edf is
-        that of the record of ``n // m`` τ-means at m = 1, where both estimators agree.
+        confidence interval of each τ (:func:`confidence_interval`), with the edf of
+        :func:`deviation_edf` (SP 1065 Table 5 for Allan, Greenhall's for the others);
+        for the normal deviation, that of the ``n // m`` τ-means at m = 1.
     noise_alpha
         Power-law exponent α of the dominant noise for the edf, one of
         :data:`NOISE_ALPHAS`; 0 (white FM) is white rate noise, i.e. angle random walk.
@@ -429,42 +422,48 @@ def allan_deviation(
     [0.707107, 0.0]
     """
     fs = _check_sample_rate(sample_rate_hz)
+    _check_kind(kind, overlapping)
+    values = _as_rate(rate, "rate", minimum=3)
+    n = values.size
+    factors = _averaging_factors(taus, n + 1, fs)
+    kept, deviation, counts = (_overlapping_deviation(values, kind, factors, fs, progress)
+                               if overlapping else _normal_allan(values, factors, progress))
+    if kept.size == 0:
+        raise _no_tau_fits(taus, n, fs)
+    edf = None if confidence is None else _edf(kind, overlapping, n, kept, noise_alpha)
+    lower, upper = (None, None) if edf is None else confidence_interval(deviation, edf,
+                                                                        confidence)
+    return AllanResult(taus_s=kept.astype(np.float64) / fs, deviation=deviation, counts=counts,
+                       overlapping=overlapping, sample_rate_hz=fs, n_samples=n, kind=kind,
+                       lower=lower, upper=upper, edf=edf,
+                       confidence=None if confidence is None else float(confidence))
+
+
+def _no_tau_fits(taus: Any, n: int, fs: float) -> InputError:
+    """The error of ``taus`` of which none fits ``n`` samples at ``fs`` Hz with 2 terms."""
+    return InputError(
+        f"no averaging time in taus={taus!r} fits a record of {n} samples at {fs:g} Hz "
+        f"with at least 2 terms; use taus between {1.0 / fs:g} s and {(n - 1) / (2 * fs):g} s"
+    )
+
+
+def _check_kind(kind: str, overlapping: bool) -> None:
+    """Refuse an unknown ``kind`` and a normal (non-overlapping) form other than Allan's."""
     if kind not in KINDS:
         raise InputError(f"kind={kind!r} is not a known deviation; use one of {KINDS}")
     if not overlapping and kind != "allan":
         raise InputError(
             f"kind={kind!r} is computed in its overlapping form only; pass overlapping=True"
         )
-    values = _as_rate(rate, "rate", minimum=3)
-    n = values.size
-    factors = _averaging_factors(taus, n + 1, fs)
-    if overlapping:
-        kept, deviation, counts = _overlapping_deviation(values, kind, factors, fs, progress)
-    else:
-        kept, deviation, counts = _normal_allan(values, factors, progress)
-    if kept.size == 0:
-        raise InputError(
-            f"no averaging time in taus={taus!r} fits a record of {n} samples at {fs:g} Hz "
-            f"with at least 2 terms; use taus between {1.0 / fs:g} s and {(n - 1) / (2 * fs):g} s"
-        )
-    lower = upper = edf = None
-    if confidence is not None:
-        # non-overlapping: the τ-means form a record of n // m samples read at m = 1, where
-        # the overlapping and the normal estimator coincide
-        edf = np.array([deviation_edf(kind, n + 1, int(m), noise_alpha) if overlapping
-                        else equivalent_degrees_of_freedom(n // m + 1, 1, noise_alpha)
-                        for m in kept])
-        lower, upper = confidence_interval(deviation, edf, confidence)
-    return AllanResult(
-        taus_s=kept.astype(np.float64) / fs,
-        deviation=deviation,
-        counts=counts,
-        overlapping=overlapping,
-        sample_rate_hz=fs,
-        n_samples=n,
-        kind=kind,
-        lower=lower,
-        upper=upper,
-        confidence=None if confidence is None else float(confidence),
-        edf=edf,
-    )
+
+
+def _edf(kind: str, overlapping: bool, n: int, kept: np.ndarray, noise_alpha: int,
+         ) -> np.ndarray:
+    """Equivalent degrees of freedom at each kept averaging factor of ``n`` rate samples.
+
+    Non-overlapping: the τ-means form a record of n // m samples read at m = 1, where the
+    overlapping and the normal estimator coincide.
+    """
+    return np.array([deviation_edf(kind, n + 1, int(m), noise_alpha) if overlapping
+                     else equivalent_degrees_of_freedom(n // m + 1, 1, noise_alpha)
+                     for m in kept])

@@ -53,10 +53,10 @@ from hrgtc.evaluation._allan_edf import (
 )
 from hrgtc.evaluation.allan import (
     _CHUNK,
-    KINDS,
     AllanResult,
     _as_rate,
     _averaging_factors,
+    _check_kind,
     _check_sample_rate,
     _sum_squared_second_differences,
     allan_deviation,
@@ -193,6 +193,25 @@ def _segment_sums(values: np.ndarray, kind: str, overlapping: bool,
                                                      buffer) for m in factors.tolist()])
 
 
+def _pooled_sums(values: np.ndarray, edges: Sequence[int], kind: str, overlapping: bool,
+                 factors: np.ndarray, progress: Progress | None,
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """The sums of squared stencil terms at each factor, and their numbers, over the
+    segments ``values[edges[i]:edges[i + 1]]``; ``progress`` after each segment."""
+    sums = np.zeros(factors.size)
+    counts = np.zeros(factors.size, dtype=np.int64)
+    pieces = len(edges) - 1
+    for done, (a, b) in enumerate(itertools.pairwise(edges), start=1):
+        terms = segment_terms(kind, overlapping, b - a, factors)
+        has = terms >= 1
+        if has.any():
+            sums[has] += _segment_sums(values[a:b], kind, overlapping, factors[has])
+            counts[has] += terms[has]
+        if progress is not None:
+            progress(float(done), float(pieces))
+    return sums, counts
+
+
 def pooled_deviation(
     rate: Any,
     sample_rate_hz: float,
@@ -244,11 +263,7 @@ def pooled_deviation(
     [0.7071067811865476]
     """
     fs = _check_sample_rate(sample_rate_hz)
-    if kind not in KINDS:
-        raise InputError(f"kind={kind!r} is not a known deviation; use one of {KINDS}")
-    if not overlapping and kind != "allan":
-        raise InputError(
-            f"kind={kind!r} is computed in its overlapping form only; pass overlapping=True")
+    _check_kind(kind, overlapping)
     values = _as_rate(rate, "rate", minimum=3)
     edges = segment_edges(breaks, values.size)
     if len(edges) == 2 and values.size >= SMALL_SEGMENT:
@@ -256,17 +271,8 @@ def pooled_deviation(
                                noise_alpha=noise_alpha, progress=progress)
     lengths = np.diff(edges)
     factors = _averaging_factors(taus, int(lengths.max()) + 1, fs)
-    sums = np.zeros(factors.size)
-    counts = np.zeros(factors.size, dtype=np.int64)
+    sums, counts = _pooled_sums(values, edges, kind, overlapping, factors, progress)
     pieces = len(edges) - 1
-    for done, (a, b) in enumerate(itertools.pairwise(edges), start=1):
-        terms = segment_terms(kind, overlapping, b - a, factors)
-        has = terms >= 1
-        if has.any():
-            sums[has] += _segment_sums(values[a:b], kind, overlapping, factors[has])
-            counts[has] += terms[has]
-        if progress is not None:
-            progress(float(done), float(pieces))
     keep = counts > 1
     if not keep.any():
         raise InputError(

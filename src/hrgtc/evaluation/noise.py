@@ -216,12 +216,76 @@ def noise_terms(
     InputError
         If fewer than 3 usable τ remain or the deviation is not positive.
     """
+    c = _curve(allan, min_blocks)
+    arw = _arw(c, slope_tolerance, min_points)
+    bias = _bias(c, slope_tolerance)
+    rrw = _rrw(c, slope_tolerance, min_points)
+    return NoiseTerms(
+        arw_deg_per_rt_h=arw.value,
+        bias_instability_dph=bias.value,
+        rrw_dph_per_rt_h=rrw.value,
+        arw_taus_s=arw.taus,
+        bias_instability_tau_s=float(c.taus[c.i_min]),
+        rrw_taus_s=rrw.taus,
+        floor_reached=c.floor,
+        minimum_dph=float(c.dev[c.i_min]),
+        arw_reason=arw.reason,
+        bias_instability_reason=bias.reason,
+        rrw_reason=rrw.reason,
+        arw_interval=arw.interval, bias_instability_interval=bias.interval,
+        rrw_interval=rrw.interval,
+        arw_n=arw.n, bias_instability_n=bias.n, rrw_n=rrw.n,
+    )
+
+
+@dataclass(frozen=True)
+class _Curve:
+    """The usable part of an Allan deviation, as :func:`noise_terms` reads it.
+
+    ``taus``, ``dev``, ``counts`` and ``weights`` (the τ-blocks) at the τ with enough
+    blocks, their logs, the local log-log ``slope``, the index ``i_min`` of the minimum
+    and whether it is inside the usable τ (``floor``); ``log_low`` and ``log_high`` the log
+    half-widths of each point's interval (None without intervals).
+    """
+
+    taus: np.ndarray
+    dev: np.ndarray
+    counts: np.ndarray
+    weights: np.ndarray
+    log_tau: np.ndarray
+    log_dev: np.ndarray
+    slope: np.ndarray
+    i_min: int
+    floor: bool
+    log_low: np.ndarray | None
+    log_high: np.ndarray | None
+
+    @property
+    def index(self) -> np.ndarray:
+        return np.arange(self.taus.size)
+
+
+@dataclass(frozen=True)
+class _Term:
+    """One noise term: its value (None with a ``reason``), the τ range it was read from,
+    its interval and the smallest number of terms behind it."""
+
+    value: float | None = None
+    taus: Any = None
+    reason: str | None = None
+    interval: tuple[Statistic, Statistic] | None = None
+    n: int | None = None
+
+
+def _curve(allan: AllanResult, min_blocks: int) -> _Curve:
+    """The usable τ of ``allan`` (at least ``min_blocks`` blocks), refused when fewer than
+    3 or not all positive."""
     usable = allan.blocks >= min_blocks
     taus = allan.taus_s[usable]
     dev = allan.deviation[usable]
     counts = allan.counts[usable]
-    ci = allan.lower is not None and allan.upper is not None
-    if ci:  # log half-widths of each point's interval
+    log_low = log_high = None
+    if allan.lower is not None and allan.upper is not None:  # log half-widths of each interval
         log_low = np.log(allan.lower[usable] / dev)
         log_high = np.log(allan.upper[usable] / dev)
     if taus.size < 3:
@@ -235,87 +299,82 @@ def noise_terms(
             "the Allan deviation has zero values (constant rate?); noise terms need a noisy record"
         )
     log_tau, log_dev = np.log(taus), np.log(dev)
-    slope = np.gradient(log_dev, log_tau)
-    weights = allan.blocks[usable].astype(np.float64)
     i_min = int(np.argmin(dev))
-    index = np.arange(taus.size)
-    tol = slope_tolerance
-    last = taus.size - 1
+    return _Curve(taus, dev, counts, allan.blocks[usable].astype(np.float64), log_tau,
+                  log_dev, np.gradient(log_dev, log_tau), i_min, i_min < taus.size - 1,
+                  log_low, log_high)
 
-    arw = arw_taus = arw_reason = arw_ci = arw_n = None
-    pick = (index <= i_min) & (np.abs(slope + 0.5) <= tol)
+
+def _arw(c: _Curve, tol: float, min_points: int) -> _Term:
+    """ARW: the line of slope −½ left of the minimum, read at τ = 1 h. [°/√h]"""
+    taus, slope, weights, i_min = c.taus, c.slope, c.weights, c.i_min
+    pick = (c.index <= i_min) & (np.abs(slope + 0.5) <= tol)
     if pick.sum() >= min_points:
-        log_n = np.average(log_dev[pick] + 0.5 * log_tau[pick], weights=weights[pick])
+        log_n = np.average(c.log_dev[pick] + 0.5 * c.log_tau[pick], weights=weights[pick])
         # weighted least squares of ln σ = ln N − ½ ln τ; ARW = σ(1 h) = N/60
         arw = math.exp(log_n) / math.sqrt(SECONDS_PER_HOUR)
         arw_taus = (float(taus[pick][0]), float(taus[pick][-1]))
-        if ci:
-            arw_ci = _line_interval(arw, log_low, log_high, weights, pick)
-            arw_n = int(counts[pick].min())
-    elif i_min == 0:
-        arw_reason = (f"no −½ slope: the curve does not fall from its first τ ({taus[0]:g} s; "
-                      f"it goes as {_law(slope[0])})")
-    else:
-        arw_reason = (f"no −½ slope: {int(pick.sum())} point(s) left of the minimum within "
-                      f"±{tol:g} of −½ (needs {min_points}); the curve goes as "
-                      f"{_law(float(np.median(slope[: i_min + 1])))} there")
+        if c.log_low is None or c.log_high is None:
+            return _Term(arw, arw_taus)
+        return _Term(arw, arw_taus, None, _line_interval(arw, c.log_low, c.log_high, weights,
+                                                         pick), int(c.counts[pick].min()))
+    if i_min == 0:
+        return _Term(reason=f"no −½ slope: the curve does not fall from its first τ "
+                            f"({taus[0]:g} s; it goes as {_law(slope[0])})")
+    return _Term(reason=f"no −½ slope: {int(pick.sum())} point(s) left of the minimum within "
+                        f"±{tol:g} of −½ (needs {min_points}); the curve goes as "
+                        f"{_law(float(np.median(slope[: i_min + 1])))} there")
 
-    floor = i_min < last
-    bias = bias_reason = bias_ci = bias_n = None
-    if not floor:
+
+def _bias(c: _Curve, tol: float) -> _Term:
+    """Bias instability: the flat minimum over 0.664. [°/h]"""
+    taus, dev, slope, i_min = c.taus, c.dev, c.slope, c.i_min
+    last = taus.size - 1
+    if not c.floor:
         bound = dev[last] / FLICKER_FLOOR_FACTOR
-        bias_reason = (f"no flat minimum: the curve still falls as {_law(slope[last])} at the "
-                       f"longest usable τ ({taus[last]:g} s); B < {bound:.4g} °/h")
-    elif i_min == 0:
-        bias_reason = f"no flat minimum: the curve rises from its first τ ({taus[0]:g} s)"
-    elif abs(slope[i_min]) > tol:
-        bias_reason = f"no flat minimum: the curve goes as {_law(slope[i_min])} at its minimum"
-    else:
-        bias = float(dev[i_min]) / FLICKER_FLOOR_FACTOR
-        if ci:
-            bias_ci = (bias * math.exp(float(log_low[i_min])),
-                       bias * math.exp(float(log_high[i_min])))
-            bias_n = int(counts[i_min])
+        return _Term(reason=f"no flat minimum: the curve still falls as {_law(slope[last])} "
+                            f"at the longest usable τ ({taus[last]:g} s); B < {bound:.4g} °/h")
+    if i_min == 0:
+        return _Term(reason=f"no flat minimum: the curve rises from its first τ ({taus[0]:g} s)")
+    if abs(slope[i_min]) > tol:
+        return _Term(reason=f"no flat minimum: the curve goes as {_law(slope[i_min])} at its "
+                            "minimum")
+    bias = float(dev[i_min]) / FLICKER_FLOOR_FACTOR
+    if c.log_low is None or c.log_high is None:
+        return _Term(bias)
+    return _Term(bias, None, None, (bias * math.exp(float(c.log_low[i_min])),
+                                    bias * math.exp(float(c.log_high[i_min]))),
+                 int(c.counts[i_min]))
 
-    rrw = rrw_taus = rrw_reason = rrw_ci = rrw_n = None
-    pick = (index > i_min) & (np.abs(slope - 0.5) <= tol)
-    rising = (index > i_min) & (slope >= 0.5 - tol)
-    rise = (float(np.polyfit(log_tau[rising], log_dev[rising], 1)[0]) if rising.sum() >= 2
-            else math.nan)
-    if floor and rise > RAMP_SLOPE:
-        rrw_reason = (f"no +½ slope: the curve rises as {_law(rise)} after its minimum (up to "
-                      f"τ = {taus[last]:g} s) — a thermal ramp, not rate random walk")
-    elif not floor:
-        rrw_reason = (f"no +½ slope: the curve does not rise within the usable τ "
-                      f"(up to {taus[last]:g} s)")
-    elif pick.sum() < min_points:
-        rrw_reason = (f"no +½ slope: {int(pick.sum())} point(s) right of the minimum within "
-                      f"±{tol:g} of +½ (needs {min_points}); the curve goes as "
-                      f"{_law(float(np.median(slope[i_min + 1:])))} there")
-    else:
-        # ln σ = ln(K_s/√3) + ½ ln τ, K in °/h/√s; σ at τ = 3 h equals K_s·60.
-        log_k = np.average(log_dev[pick] - 0.5 * log_tau[pick], weights=weights[pick])
-        rrw = math.exp(log_k) * math.sqrt(3.0 * SECONDS_PER_HOUR)
-        rrw_taus = (float(taus[pick][0]), float(taus[pick][-1]))
-        if ci:
-            rrw_ci = _line_interval(rrw, log_low, log_high, weights, pick)
-            rrw_n = int(counts[pick].min())
 
-    return NoiseTerms(
-        arw_deg_per_rt_h=arw,
-        bias_instability_dph=bias,
-        rrw_dph_per_rt_h=rrw,
-        arw_taus_s=arw_taus,
-        bias_instability_tau_s=float(taus[i_min]),
-        rrw_taus_s=rrw_taus,
-        floor_reached=floor,
-        minimum_dph=float(dev[i_min]),
-        arw_reason=arw_reason,
-        bias_instability_reason=bias_reason,
-        rrw_reason=rrw_reason,
-        arw_interval=arw_ci, bias_instability_interval=bias_ci, rrw_interval=rrw_ci,
-        arw_n=arw_n, bias_instability_n=bias_n, rrw_n=rrw_n,
-    )
+def _rrw(c: _Curve, tol: float, min_points: int) -> _Term:
+    """RRW: the line of slope +½ right of the minimum, read at τ = 3 h, unless a ramp
+    dominates there. [°/h/√h]"""
+    taus, slope, weights, i_min = c.taus, c.slope, c.weights, c.i_min
+    last = taus.size - 1
+    pick = (c.index > i_min) & (np.abs(slope - 0.5) <= tol)
+    rising = (c.index > i_min) & (slope >= 0.5 - tol)
+    rise = (float(np.polyfit(c.log_tau[rising], c.log_dev[rising], 1)[0])
+            if rising.sum() >= 2 else math.nan)
+    if c.floor and rise > RAMP_SLOPE:
+        return _Term(reason=f"no +½ slope: the curve rises as {_law(rise)} after its minimum "
+                            f"(up to τ = {taus[last]:g} s) — a thermal ramp, not rate random "
+                            "walk")
+    if not c.floor:
+        return _Term(reason=f"no +½ slope: the curve does not rise within the usable τ "
+                            f"(up to {taus[last]:g} s)")
+    if pick.sum() < min_points:
+        return _Term(reason=f"no +½ slope: {int(pick.sum())} point(s) right of the minimum "
+                            f"within ±{tol:g} of +½ (needs {min_points}); the curve goes as "
+                            f"{_law(float(np.median(slope[i_min + 1:])))} there")
+    # ln σ = ln(K_s/√3) + ½ ln τ, K in °/h/√s; σ at τ = 3 h equals K_s·60.
+    log_k = np.average(c.log_dev[pick] - 0.5 * c.log_tau[pick], weights=weights[pick])
+    rrw = math.exp(log_k) * math.sqrt(3.0 * SECONDS_PER_HOUR)
+    rrw_taus = (float(taus[pick][0]), float(taus[pick][-1]))
+    if c.log_low is None or c.log_high is None:
+        return _Term(rrw, rrw_taus)
+    return _Term(rrw, rrw_taus, None, _line_interval(rrw, c.log_low, c.log_high, weights,
+                                                     pick), int(c.counts[pick].min()))
 
 
 def _line_interval(value: float, log_low: np.ndarray, log_high: np.ndarray,

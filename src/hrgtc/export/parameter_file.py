@@ -112,8 +112,7 @@ def parameter_lines(model: UnitModel, plan: CPlan, key: str = "") -> list[str]:
     key
         Prefix of every key (``x_`` for axis x of an instrument; '' for a single gyro).
     """
-    drift, th = model.drift, model.thermometer
-    settings = drift.settings
+    drift = model.drift
     refused = refusal(drift.variables, "params", drift.selected)
     if refused is not None:
         raise InputError(refused)
@@ -128,6 +127,18 @@ def parameter_lines(model: UnitModel, plan: CPlan, key: str = "") -> list[str]:
             text = _number(value, key + name)
         lines.extend([f"# {sensor_words(model, comment)}", f"{key}{name} = {text}", ""])
 
+    _settings_lines(model, plan, put)
+    _extra_variable_lines(model, plan, put)
+    _scale_and_range_lines(model, plan, put)
+    _term_lines(model, put)
+    _scale_factor_lines(model, put)
+    _thermometer_lines(model, plan, put)
+    return lines
+
+
+def _settings_lines(model: UnitModel, plan: CPlan, put: Any) -> None:
+    """The keys of the drift settings the compensation needs: rate, references, filter."""
+    settings = model.drift.settings
     put("sample_rate_hz", settings.sample_rate_hz,
         "Sample rate of the training runs (settle_rows counts samples at it). [Hz]")
     put("reference_freq_hz", settings.reference_freq_hz,
@@ -144,7 +155,12 @@ def parameter_lines(model: UnitModel, plan: CPlan, key: str = "") -> list[str]:
         "settles, as training leaves them out. [s]")
     put("settle_rows", settle_rows(settings),
         "settle_s in samples at the training rate (a continuous run). [1]")
-    _extra_variable_lines(model, plan, put)
+
+
+def _scale_and_range_lines(model: UnitModel, plan: CPlan, put: Any) -> None:
+    """The scale of each computed variable, then its training range."""
+    drift = model.drift
+    settings = drift.settings
     for v in plan.computed:
         if v in settings.scales and v in drift.variables:
             put(f"scale_{v}", settings.scales[v],
@@ -158,6 +174,11 @@ def parameter_lines(model: UnitModel, plan: CPlan, key: str = "") -> list[str]:
                 f"[{_unit(model, v)}]")
             put(f"range_{v}_high", high, f"Training range of {v}, high end. "
                 f"[{_unit(model, v)}]")
+
+
+def _term_lines(model: UnitModel, put: Any) -> None:
+    """B0 and each selected term of Eq. (22): its name, scaled and raw coefficients."""
+    drift, th = model.drift, model.thermometer
     put("intercept_dph", drift.intercept_dph, "B0: the bias at f = df = 0 (h = dh = 0). [deg/h]")
     put("n_terms", len(drift.terms), "Number of selected terms of the drift model (Eq. 22).")
     for k, (term, scaled) in enumerate(zip(drift.terms, drift.scaled_coefficients,
@@ -172,7 +193,11 @@ def parameter_lines(model: UnitModel, plan: CPlan, key: str = "") -> list[str]:
         put(f"coefficient_raw_{k}", drift.coefficients[term.name],
             f"Coefficient of term {k} ({term.name}) on the raw variables, Eq. (22) form. "
             f"[deg/h per {term.unit_for(th.source)}]".replace("·", " "))
-    _scale_factor_lines(model, put)
+
+
+def _thermometer_lines(model: UnitModel, plan: CPlan, put: Any) -> None:
+    """The thermometer F(T) (Eq. 18), its calibrated ranges and its inverse's interval."""
+    th = model.thermometer
     put("thermometer_order", th.order, "Order of the thermometer polynomial F(T) (Eq. 18).")
     put("thermometer_centre_c", th.centre_c,
         "z = (T - thermometer_centre_c) / thermometer_scale_c. [degC]")
@@ -200,7 +225,6 @@ def parameter_lines(model: UnitModel, plan: CPlan, key: str = "") -> list[str]:
     put("inverse_tolerance_c", plan.tolerance,
         "Stop Newton's iteration when a step changes T by at most this. [degC]")
     put("inverse_max_iterations", NEWTON_MAX_ITER, "Iteration cap of the inverse. [1]")
-    return lines
 
 
 def _extra_variable_lines(model: UnitModel, plan: CPlan, put: Any) -> None:

@@ -63,7 +63,13 @@ from hrgtc.simulate.laws import (
 from hrgtc.simulate.logged_files import LoggedFiles, simulate_logged_files, write_logged
 from hrgtc.simulate.logger import LoggedRun, Logger, log_run
 from hrgtc.simulate.noise_sources import GyroNoise
-from hrgtc.simulate.output import WrittenFile, output_paths, simulate_files, simulate_to_file
+from hrgtc.simulate.output import (
+    SimulatedRun,
+    WrittenFile,
+    output_paths,
+    simulate_files,
+    simulate_to_file,
+)
 from hrgtc.simulate.profiles import Profile, Segment
 from hrgtc.simulate.reflog import ReferenceLog, TemperatureChannel
 from hrgtc.simulate.standard_profiles import (
@@ -95,6 +101,7 @@ __all__ = [
     "ScaleFactorLaw",
     "Segment",
     "ShellFrequencyLaw",
+    "SimulatedRun",
     "TemperatureChannel",
     "ThermalNetwork",
     "Unit",

@@ -38,7 +38,8 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator, Mapping
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import Future, ThreadPoolExecutor
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -293,28 +294,13 @@ def iter_run_chunks(
     metadata = run_metadata(profile, unit, fs, seed, input_rate_dph)
     rates = input_rates_dph(unit, input_rate_dph)
     total = row_count(profile, fs)
-    multi = isinstance(unit, MultiAxisUnit)
     gyros: dict[str | None, Unit] = (
         dict(unit.axes) if isinstance(unit, MultiAxisUnit) else {None: unit}
     )
-    if multi:  # the housing thermistor, then (white, slow, frequency) per axis
-        housing_rng, *rngs = _generators(seed, 1 + 3 * len(gyros))
-    else:  # the order of the first single-axis runs
-        white, slow, freq_rng, housing_rng = _generators(seed, 4)
-        rngs = [white, slow, freq_rng]
-    streams = {
-        axis: (
-            gyro.gyro_noise.stream(fs, rngs[3 * k], rngs[3 * k + 1]),
-            WhiteNoiseStream(gyro.frequency_noise_hz, rngs[3 * k + 2]),
-        )
-        for k, (axis, gyro) in enumerate(gyros.items())
-    }
-    housing_noise = WhiteNoiseStream(unit.housing_noise_c, housing_rng)
-    states = {axis: gyro.thermal.initial_state(profile.start_c) for axis, gyro in gyros.items()}
-    times, temps = profile.breakpoints()
-    table = profile.has_rate_table
-    names = run_columns(profile, unit)
-    dt = 1.0 / fs
+    streams, housing_noise = _noise_streams(unit, gyros, fs, seed)
+    run = _Run(profile, *profile.breakpoints(), gyros, rates, fs, run_columns(profile, unit),
+               metadata,
+               {axis: gyro.thermal.initial_state(profile.start_c) for axis, gyro in gyros.items()})
 
     def draw_noise(count: int) -> tuple[dict[str | None, tuple[np.ndarray, np.ndarray]],
                                          np.ndarray]:
@@ -327,45 +313,93 @@ def iter_run_chunks(
         for start in range(0, total, int(chunk_rows)):
             stop = min(total, start + int(chunk_rows))
             noise = pool.submit(draw_noise, stop - start)
-            time_s = np.arange(start, stop, dtype=np.float64) / fs
-            chamber = np.interp(time_s, times, temps)
-            physics = {}
-            for axis, gyro in gyros.items():
-                housing, resonator, states[axis] = gyro.thermal.response(chamber, dt, states[axis])
-                bias = gyro.bias_law.bias_dph(resonator, housing)
-                freq = gyro.frequency_law.frequency_hz(resonator)
-                physics[axis] = (housing, resonator, bias, freq)
-            drawn, housing_logged = noise.result()
-            housing_logged += physics[next(iter(gyros))][0]  # the axes share the housing
-            axis_columns: dict[str, np.ndarray] = {}
-            for axis, gyro in gyros.items():
-                _, resonator, bias, freq = physics[axis]
-                rate, freq_error = drawn[axis]
-                freq += freq_error
-                rate += bias
-                suffix = "" if axis is None else f"_{axis}"
-                axis_columns[f"freq_hz{suffix}"] = freq
-                axis_columns[f"rate_dph{suffix}"] = rate
-                axis_columns[f"resonator_c{suffix}"] = resonator
-                axis_columns[f"bias_dph{suffix}"] = bias
-                applied: float | np.ndarray = rates[axis]
-                if table:
-                    applied = profile.table_rate_dps(time_s, axis) * _SECONDS_PER_HOUR
-                    applied += rates[axis]
-                if gyro.scale_factor_law is not None:
-                    # rate = input (1 + k 1e-6) + bias + noise
-                    scale = gyro.scale_factor_law.ppm(resonator)
-                    axis_columns[f"scale_ppm{suffix}"] = scale
-                    rate += applied * (1.0 + scale * 1e-6)
-                else:
-                    rate += applied
-                if table:
-                    axis_columns[f"input_rate_dph{suffix}"] = np.asarray(applied)
-            axis_columns.update(time_s=time_s, chamber_c=chamber, housing_c=housing_logged)
-            columns = {name: axis_columns[name] for name in names}
-            yield Recording(columns, metadata)
+            yield _chunk(run, start, stop, noise)
             if progress is not None:
                 progress(float(stop), float(total))
+
+
+@dataclass
+class _Run:
+    """What each chunk of :func:`iter_run_chunks` reads, and the thermal state it advances.
+
+    ``times``, ``temps`` are the chamber program's corners (:meth:`Profile.breakpoints`),
+    ``gyros`` maps each axis (None for a single-axis unit) to its gyro, ``rates`` each
+    axis to its constant input rate [°/h], ``names`` the run's columns in order and
+    ``states`` each axis to its thermal network's state at the end of the last chunk.
+    """
+
+    profile: Profile
+    times: np.ndarray
+    temps: np.ndarray
+    gyros: dict[str | None, Unit]
+    rates: Mapping[str | None, float]
+    fs: float
+    names: tuple[str, ...]
+    metadata: Metadata
+    states: dict[str | None, Any]
+
+
+def _noise_streams(unit: AnyUnit, gyros: dict[str | None, Unit], fs: float, seed: Seed,
+                   ) -> tuple[dict[str | None, tuple[Any, WhiteNoiseStream]], WhiteNoiseStream]:
+    """Each axis's (gyro noise, frequency noise) streams and the housing thermistor's."""
+    if isinstance(unit, MultiAxisUnit):
+        # the housing thermistor, then (white, slow, frequency) per axis
+        housing_rng, *rngs = _generators(seed, 1 + 3 * len(gyros))
+    else:  # the order of the first single-axis runs
+        white, slow, freq_rng, housing_rng = _generators(seed, 4)
+        rngs = [white, slow, freq_rng]
+    streams = {
+        axis: (
+            gyro.gyro_noise.stream(fs, rngs[3 * k], rngs[3 * k + 1]),
+            WhiteNoiseStream(gyro.frequency_noise_hz, rngs[3 * k + 2]),
+        )
+        for k, (axis, gyro) in enumerate(gyros.items())
+    }
+    return streams, WhiteNoiseStream(unit.housing_noise_c, housing_rng)
+
+
+def _chunk(run: _Run, start: int, stop: int, noise: Future[Any]) -> Recording:
+    """Rows ``start:stop`` of the run: the physics here, the noise from ``noise``."""
+    profile, fs = run.profile, run.fs
+    table = profile.has_rate_table
+    dt = 1.0 / fs
+    time_s = np.arange(start, stop, dtype=np.float64) / fs
+    chamber = np.interp(time_s, run.times, run.temps)
+    physics = {}
+    for axis, gyro in run.gyros.items():
+        housing, resonator, run.states[axis] = gyro.thermal.response(chamber, dt,
+                                                                     run.states[axis])
+        bias = gyro.bias_law.bias_dph(resonator, housing)
+        freq = gyro.frequency_law.frequency_hz(resonator)
+        physics[axis] = (housing, resonator, bias, freq)
+    drawn, housing_logged = noise.result()
+    housing_logged += physics[next(iter(run.gyros))][0]  # the axes share the housing
+    axis_columns: dict[str, np.ndarray] = {}
+    for axis, gyro in run.gyros.items():
+        _, resonator, bias, freq = physics[axis]
+        rate, freq_error = drawn[axis]
+        freq += freq_error
+        rate += bias
+        suffix = "" if axis is None else f"_{axis}"
+        axis_columns[f"freq_hz{suffix}"] = freq
+        axis_columns[f"rate_dph{suffix}"] = rate
+        axis_columns[f"resonator_c{suffix}"] = resonator
+        axis_columns[f"bias_dph{suffix}"] = bias
+        applied: float | np.ndarray = run.rates[axis]
+        if table:
+            applied = profile.table_rate_dps(time_s, axis) * _SECONDS_PER_HOUR
+            applied += run.rates[axis]
+        if gyro.scale_factor_law is not None:
+            # rate = input (1 + k 1e-6) + bias + noise
+            scale = gyro.scale_factor_law.ppm(resonator)
+            axis_columns[f"scale_ppm{suffix}"] = scale
+            rate += applied * (1.0 + scale * 1e-6)
+        else:
+            rate += applied
+        if table:
+            axis_columns[f"input_rate_dph{suffix}"] = np.asarray(applied)
+    axis_columns.update(time_s=time_s, chamber_c=chamber, housing_c=housing_logged)
+    return Recording({name: axis_columns[name] for name in run.names}, run.metadata)
 
 
 def simulate_run(

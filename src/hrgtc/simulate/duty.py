@@ -23,7 +23,8 @@ from hrgtc.simulate.campaign import Seed, iter_run_chunks, row_count
 from hrgtc.simulate.profiles import Profile
 from hrgtc.simulate.units import MultiAxisUnit, Unit
 
-__all__ = ["TRACK_HZ", "DutyCycle", "KeptRun", "duplicate_rows", "simulate_kept"]
+__all__ = ["TRACK_HZ", "DutyCycle", "KeptRun", "duplicate_rows", "segment_index", "simulate_kept",
+           "track_derivative"]
 
 #: Rate of the slow track of the continuous run. [Hz]
 TRACK_HZ = 1.0
@@ -195,3 +196,18 @@ def duplicate_rows(
         restart["row"] = int(shifted[restart["row"]])
     info["rows"] = int(take.size)
     info["duplicates"] = [int(shifted[r]) + 1 for r in rows.tolist()]
+
+
+def segment_index(r: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Segment index of each kept row (run ``r``, burst ``b``): a new one at each burst or run."""
+    new = np.ones(r.size, dtype=bool)
+    new[1:] = (r[1:] != r[:-1]) | (b[1:] != b[:-1])
+    return np.cumsum(new) - 1
+
+
+def track_derivative(track: Mapping[str, np.ndarray], name: str, time_s: np.ndarray) -> np.ndarray:
+    """d(track[name])/dt at ``time_s`` (the slow track's central differences, interpolated)."""
+    t = track["time_s"]
+    if t.size < 2:
+        return np.zeros(np.shape(time_s))
+    return np.interp(time_s, t, np.gradient(track[name], t))

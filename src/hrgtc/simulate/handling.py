@@ -33,10 +33,10 @@ from msgspec import Meta
 from hrgtc.core import records
 from hrgtc.core.errors import InputError
 from hrgtc.settings.simulation import PLAIN_LOGGER as _PLAIN
-from hrgtc.simulate.units import EARTH_RATE_DPH
+from hrgtc.simulate.units import EARTH_RATE_DPH, MultiAxisUnit, Unit
 
 __all__ = ["Handling", "HandlingRecord", "HandlingTruth", "hand_warming", "handling_truth",
-           "orientation_matrix"]
+           "orientation_matrix", "warm_by_hand"]
 
 _BODY = {"x": 0, "y": 1, "z": 2}
 _SECONDS_PER_HOUR = 3600.0
@@ -239,6 +239,27 @@ def _orientation_offsets(handling: Handling, axes: Sequence[str]) -> list[dict[s
     return out
 
 
+def _rate_pulses(tw: np.ndarray, start: float, end: float, max_rate_dps: float,
+                 rng: np.random.Generator) -> np.ndarray:
+    """The body rates of one handling window: three cosine pulses per body axis. [°/s]
+
+    ``tw`` holds the window's sample times; the result is ``(3, tw.size)``, scaled so that
+    its peak is 80 to 100 % of ``max_rate_dps``.
+    """
+    pulses = np.zeros((3, tw.size))
+    for i in range(3):  # body axes x, y, z
+        for _ in range(3):
+            half = rng.uniform(0.5, 3.0)
+            centre = rng.uniform(start + half, max(start + half, end - half))
+            shape = np.where(np.abs(tw - centre) < half,
+                             np.cos(0.5 * np.pi * (tw - centre) / half), 0.0)
+            pulses[i] += rng.choice((-1.0, 1.0)) * rng.uniform(0.3, 1.0) * shape
+    peak = float(np.max(np.abs(pulses))) if tw.size else 0.0
+    if peak > 0.0:
+        pulses *= max_rate_dps * rng.uniform(0.8, 1.0) / peak
+    return pulses
+
+
 def handling_truth(
     time_s: np.ndarray,
     axes: Sequence[str],
@@ -295,17 +316,7 @@ def handling_truth(
         motion[rows] = True
         orientation[rows] = -1
         tw = t[rows]
-        pulses = np.zeros((3, rows.size))
-        for i in range(3):  # body axes x, y, z
-            for _ in range(3):
-                half = rng.uniform(0.5, 3.0)
-                centre = rng.uniform(start + half, max(start + half, end - half))
-                shape = np.where(np.abs(tw - centre) < half,
-                                 np.cos(0.5 * np.pi * (tw - centre) / half), 0.0)
-                pulses[i] += rng.choice((-1.0, 1.0)) * rng.uniform(0.3, 1.0) * shape
-        peak = float(np.max(np.abs(pulses))) if rows.size else 0.0
-        if peak > 0.0:
-            pulses *= handling.max_rate_dps * rng.uniform(0.8, 1.0) / peak
+        pulses = _rate_pulses(tw, start, end, handling.max_rate_dps, rng)
         for a in axes:
             motion_dph[a][rows] = pulses[_BODY[a]] * _SECONDS_PER_HOUR
         s = np.clip((tw - start) / handling.handling_s, 0.0, 1.0)
@@ -323,3 +334,29 @@ def handling_truth(
         for k in range(handling.orientations)
     ]
     return HandlingTruth(orientation, motion, motion_dph, offset_dph, accel, windows, table)
+
+
+def warm_by_hand(gyro: Unit | MultiAxisUnit, axes: tuple[str | None, ...], handling: Handling,
+                 rec: dict[str, np.ndarray], track: dict[str, np.ndarray],
+                 duration: float) -> None:
+    """The sensor warmed by the handling hands (in place): resonator temperature, its thermal
+    bias through the unit's bias law, the rate, and the slow track (scale factor unchanged)."""
+    warming = hand_warming(rec["time_s"], handling, duration)
+    warming_track = hand_warming(track["time_s"], handling, duration)
+    for axis in axes:
+        key = "" if axis is None else f"_{axis}"
+        law = (gyro.axes[axis] if isinstance(gyro, MultiAxisUnit) else gyro).bias_law
+        resonator = rec[f"resonator_c{key}"]
+        change = (law.bias_dph(resonator + warming, rec["housing_c"])
+                  - law.bias_dph(resonator, rec["housing_c"]))
+        rec[f"resonator_c{key}"] = resonator + warming
+        rec[f"bias_dph{key}"] = rec[f"bias_dph{key}"] + change
+        rec[f"rate_dph{key}"] = rec[f"rate_dph{key}"] + change
+        axis_unit = gyro.axes[axis] if isinstance(gyro, MultiAxisUnit) else gyro
+        if f"freq_hz{key}" in rec:  # a resonator's frequency follows its temperature
+            law_f = axis_unit.frequency_law.frequency_hz
+            rec[f"freq_hz{key}"] = rec[f"freq_hz{key}"] + (
+                np.asarray(law_f(resonator + warming)) - np.asarray(law_f(resonator)))
+        track[f"resonator_c{key}"] = track[f"resonator_c{key}"] + warming_track
+        track[f"freq_true_hz{key}"] = np.asarray(
+            axis_unit.frequency_law.frequency_hz(track[f"resonator_c{key}"]), dtype=np.float64)

@@ -45,12 +45,24 @@ from hrgtc.settings.simulation import LOGGER_RATE_UNITS, LOGGER_TIME_UNITS
 from hrgtc.settings.simulation import PLAIN_LOGGER as _PLAIN
 from hrgtc.simulate import units as _units
 from hrgtc.simulate.clock import unwrap_counter, wall_clock
-from hrgtc.simulate.duty import DutyCycle, duplicate_rows, simulate_kept
-from hrgtc.simulate.handling import Handling, hand_warming, handling_truth
+from hrgtc.simulate.duty import (
+    DutyCycle,
+    KeptRun,
+    duplicate_rows,
+    segment_index,
+    simulate_kept,
+    track_derivative,
+)
+from hrgtc.simulate.handling import Handling, HandlingTruth, handling_truth, warm_by_hand
 from hrgtc.simulate.logger_options import reading_options
 from hrgtc.simulate.logger_records import LoggedRunRecord, LoggerRecord
 from hrgtc.simulate.profiles import Profile
-from hrgtc.simulate.reflog import ReferenceLog, TemperatureChannel, reference_log_text
+from hrgtc.simulate.reflog import (
+    ReferenceLog,
+    TemperatureChannel,
+    reference_log_info,
+    reference_log_text,
+)
 from hrgtc.simulate.units import MultiAxisUnit, Unit
 
 __all__ = [
@@ -285,47 +297,6 @@ def _round_significant(value: np.ndarray, digits: int) -> np.ndarray:
     return np.round(value * scale) / scale
 
 
-def _segments(r: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Segment index of each kept row (run ``r``, burst ``b``): a new one at each burst or run."""
-    new = np.ones(r.size, dtype=bool)
-    new[1:] = (r[1:] != r[:-1]) | (b[1:] != b[:-1])
-    return np.cumsum(new) - 1
-
-
-def _warm_by_hand(gyro: Unit | MultiAxisUnit, axes: tuple[str | None, ...], handling: Handling,
-                  rec: dict[str, np.ndarray], track: dict[str, np.ndarray],
-                  duration: float) -> None:
-    """The sensor warmed by the handling hands (in place): resonator temperature, its thermal
-    bias through the unit's bias law, the rate, and the slow track (scale factor unchanged)."""
-    warming = hand_warming(rec["time_s"], handling, duration)
-    warming_track = hand_warming(track["time_s"], handling, duration)
-    for axis in axes:
-        key = "" if axis is None else f"_{axis}"
-        law = (gyro.axes[axis] if isinstance(gyro, MultiAxisUnit) else gyro).bias_law
-        resonator = rec[f"resonator_c{key}"]
-        change = (law.bias_dph(resonator + warming, rec["housing_c"])
-                  - law.bias_dph(resonator, rec["housing_c"]))
-        rec[f"resonator_c{key}"] = resonator + warming
-        rec[f"bias_dph{key}"] = rec[f"bias_dph{key}"] + change
-        rec[f"rate_dph{key}"] = rec[f"rate_dph{key}"] + change
-        axis_unit = gyro.axes[axis] if isinstance(gyro, MultiAxisUnit) else gyro
-        if f"freq_hz{key}" in rec:  # a resonator's frequency follows its temperature
-            law_f = axis_unit.frequency_law.frequency_hz
-            rec[f"freq_hz{key}"] = rec[f"freq_hz{key}"] + (
-                np.asarray(law_f(resonator + warming)) - np.asarray(law_f(resonator)))
-        track[f"resonator_c{key}"] = track[f"resonator_c{key}"] + warming_track
-        track[f"freq_true_hz{key}"] = np.asarray(
-            axis_unit.frequency_law.frequency_hz(track[f"resonator_c{key}"]), dtype=np.float64)
-
-
-def _derivative(track: Mapping[str, np.ndarray], name: str, time_s: np.ndarray) -> np.ndarray:
-    """d(track[name])/dt at ``time_s`` (the slow track's central differences, interpolated)."""
-    t = track["time_s"]
-    if t.size < 2:
-        return np.zeros(np.shape(time_s))
-    return np.interp(time_s, t, np.gradient(track[name], t))
-
-
 def log_run(
     profile: Profile,
     unit: str | Unit | MultiAxisUnit,
@@ -365,214 +336,21 @@ def log_run(
                      logger.period_s if burst_logger else None,
                      logger.restarts_s, logger.restart_off_s)
     kept = simulate_kept(profile, gyro, duty, sim_seed, input_rate_dph)
-    rec, track = kept.columns, kept.track
-    t = rec["time_s"]
-    rows = np.arange(t.size)  # every kept row
-    run, since_on, burst = kept.run, kept.since_on_s, kept.burst
-    power_on = duty.power_on_s
-    duration = kept.duration_s
-    n = kept.simulated_rows
     if logger.handling is not None and logger.handling.hand_warming_c:
-        _warm_by_hand(gyro, axes, logger.handling, rec, track, duration)
-
+        warm_by_hand(gyro, axes, logger.handling, kept.columns, kept.track, kept.duration_s)
+    t = kept.columns["time_s"]
     body = {a: (a if a is not None else "z") for a in axes}
-    handled = (handling_truth(t, list(body.values()), logger.handling, rng, duration)
+    handled = (handling_truth(t, list(body.values()), logger.handling, rng, kept.duration_s)
                if logger.handling is not None else None)
-    run_offsets = rng.normal(0.0, logger.run_offset_dph, size=power_on.size)
-    warmup = logger.warmup_dph * np.exp(-since_on / logger.warmup_tau_s)
-
-    truth: dict[str, np.ndarray] = {
-        "time_s": t[rows],
-        "run": run[rows],
-        "segment": _segments(run, burst),
-        "motion": (handled.motion[rows] if handled else np.zeros(rows.size, dtype=bool)),
-        "orientation": (handled.orientation[rows] if handled
-                        else np.zeros(rows.size, dtype=np.int64)),
-        "chamber_c": rec["chamber_c"][rows],
-        "housing_c": rec["housing_c"][rows],
-    }
-    restart = np.zeros(rows.size, dtype=bool)
-    restart[0] = True
-    restart[1:] = truth["run"][1:] != truth["run"][:-1]
-    truth["restart"] = restart
-
-    columns: dict[str, np.ndarray] = {}
-    kinds: dict[str, str] = {}
-    # The clock: time since power-on from clock_start_s, jitter, unit, counter wrap;
-    # or the wall clock, which runs on through restarts.
-    jitter = (rng.normal(0.0, logger.jitter_s, size=rows.size) if logger.jitter_s > 0.0
-              else np.zeros(rows.size))
-    if logger.time_unit == "timestamp":
-        clock_s = np.round(t + jitter, 3)
-        written_time = wall_clock(logger.start, clock_s, logger.timezone)
-        kinds[names["time"]] = "str"
-        truth["clock_s"] = clock_s
-    else:
-        clock_s = logger.clock_start_s + since_on[rows] + jitter
-        factor = TIME_FACTORS[logger.time_unit]
-        if logger.time_unit == "s":
-            written_time = np.round(clock_s, 6)
-            kinds[names["time"]] = "float:.6f"
-        else:
-            written_time = np.round(clock_s * factor)
-            kinds[names["time"]] = "int"
-        truth["clock_s"] = written_time / factor
-        if logger.counter_bits is not None:
-            written_time = np.mod(written_time, 2.0 ** int(logger.counter_bits))
-    columns[names["time"]] = written_time
-
-    motion_rate_max = 0.0
-    spike_rows = np.array([], dtype=np.int64)
-    spike_axes: list[str | None] = []
-    if logger.spikes:
-        candidates = np.flatnonzero(~truth["motion"])
-        if int(logger.spikes) > candidates.size // 10:
-            raise InputError(f"{logger.spikes} spikes in {candidates.size} still rows: give at "
-                             "most one per ten rows (single-sample spikes)")
-        spike_rows = np.sort(rng.choice(candidates, size=int(logger.spikes), replace=False))
-        spike_axes = [axes[int(i)] for i in rng.integers(0, len(axes), size=spike_rows.size)]
-    truth["spike"] = np.isin(np.arange(rows.size), spike_rows)
-    spikes_info = []
-    dfdt_info: dict[str, Any] = {}
-    still = ~truth["motion"]
-    for axis in axes:
-        key = "" if axis is None else f"_{axis}"
-        offset = run_offsets[run[rows]] + warmup[rows]
-        motion_dph = np.zeros(rows.size)
-        if handled is not None:
-            offset = offset + handled.offset_dph[body[axis]][rows]
-            motion_dph = handled.motion_dph[body[axis]][rows]
-            motion_rate_max = max(motion_rate_max, float(np.max(np.abs(motion_dph))) / 3600.0)
-        rate = rec[f"rate_dph{key}"][rows] + offset + motion_dph
-        truth[f"rate_dph{key}"] = rate.copy()
-        truth[f"bias_dph{key}"] = rec[f"bias_dph{key}"][rows]
-        truth[f"offset_dph{key}"] = offset
-        truth[f"motion_dph{key}"] = motion_dph
-        truth[f"resonator_c{key}"] = rec[f"resonator_c{key}"][rows]
-        if f"scale_ppm{key}" in rec:
-            truth[f"scale_ppm{key}"] = rec[f"scale_ppm{key}"][rows]
-        # The true rate of change of the thermometer, from the continuous run's slow track.
-        dtdt = _derivative(track, f"resonator_c{key}", t)
-        truth[f"dtdt_c_per_s{key}"] = dtdt
-        dfdt = _derivative(track, f"freq_true_hz{key}", t)
-        truth[f"dfdt_hz_per_s{key}"] = dfdt
-        head = rec[f"rate_dph{key}"][:20000]
-        same = np.diff(truth["segment"][:20000]) == 0
-        sigma = float(np.std(np.diff(head)[same])) / math.sqrt(2.0) if same.any() else 0.0
-        size = logger.spike_dph or -50.0 * sigma
-        for r, a in zip(spike_rows, spike_axes, strict=True):
-            if a == axis:
-                rate[r] += size
-                spikes_info.append({"row": int(r), "axis": axis, "column": names[f"rate{key}"],
-                                    "size_dph": size, "size_written": size *
-                                    RATE_FACTORS[logger.rate_unit]})
-        written = rate * RATE_FACTORS[logger.rate_unit]
-        if logger.rate_digits is not None:
-            written = _round_significant(written, int(logger.rate_digits))
-            kinds[names[f"rate{key}"]] = f"float:.{int(logger.rate_digits) - 1}E"
-        else:
-            kinds[names[f"rate{key}"]] = "float:.17g"
-        if logger.frequency:
-            columns[names[f"freq{key}"]] = rec[f"freq_hz{key}"][rows]
-            kinds[names[f"freq{key}"]] = "float:.6f"
-            truth[f"freq_hz{key}"] = rec[f"freq_hz{key}"][rows]
-        columns[names[f"rate{key}"]] = written
-        label = "x" if axis is None else axis
-        for what, values in (("dtdt_c_per_s", dtdt[rows]), ("dfdt_hz_per_s", dfdt[rows])):
-            kept = values[still]
-            dfdt_info.setdefault(what, {})[label] = {
-                "min": float(kept.min()), "max": float(kept.max()),
-                "p01": float(np.percentile(kept, 1)), "p99": float(np.percentile(kept, 99)),
-            }
-
-    temperature_info = None
-    reference_text = None
-    first = axes[0]
-    die = "resonator_c" + ("" if first is None else f"_{first}")
-    if logger.temperature is not None:
-        channel = logger.temperature
-        source = rec[die] if channel.source == "die" else rec["housing_c"]
-        written = channel.written(source[rows], rng)
-        if channel.rate_hz is not None:
-            tick = np.floor(t[rows] * channel.rate_hz + 1e-9)
-            fresh = np.ones(rows.size, dtype=bool)
-            fresh[1:] = tick[1:] != tick[:-1]
-            written = np.where(fresh, written, np.nan)
-            truth["temperature_fresh"] = fresh
-        columns[names["temperature"]] = written
-        kinds[names["temperature"]] = ("int" if channel.lsb_c is not None
-                                       else f"float:.{int(channel.decimals)}f")
-        truth["sensor_c"] = source[rows]
-        temperature_info = {"column": names["temperature"], "source": channel.source,
-                            "map": channel.map(), "rate_hz": channel.rate_hz,
-                            "range_c": [float(source[rows].min()), float(source[rows].max())]}
-        if logger.reference_log is not None:
-            reference_text, readings = reference_log_text(
-                logger.reference_log, track["time_s"],
-                track[die] if channel.source == "die" else track["housing_c"],
-                track["housing_c"], track["chamber_c"], rng)
-            log = logger.reference_log
-            # The wall-clock time at which the logger's clock read 0: hrgtc's t = 0 of a file
-            # in s/ms/µs since power-on (the first run's, without a counter wrap).
-            zero = (datetime.fromisoformat(log.start) - timedelta(seconds=logger.clock_start_s)
-                    if logger.time_unit != "timestamp" else datetime.fromisoformat(logger.start))
-            zero_text = zero.isoformat(timespec="milliseconds")
-            temperature_info["reference_log"] = {
-                "probe_column": log.probe_column, "start": log.start, "lag_s": log.lag_s,
-                "recording_clock_zero": zero_text,
-                "hrgtc_options": [
-                    "--temp-ref-col", "time_s=Time", "--temp-ref-col",
-                    f"temperature_c={log.probe_column}", "--temp-ref-start",
-                    zero_text if log.dates else zero_text[11:].removesuffix(".000"),
-                ],
-                "readings": readings,
-            }
-    if logger.accelerometer:
-        accel = (handled.accel_g[rows] if handled is not None
-                 else np.tile([0.0, 0.0, 1.0], (rows.size, 1))
-                 + rng.normal(0.0, 0.002, size=(rows.size, 3)))
-        scale = 1.0 if logger.accel_unit == "g" else 9.80665
-        for i, a in enumerate("xyz"):
-            columns[names[f"accel_{a}"]] = np.round(accel[:, i] * scale, 4)
-            kinds[names[f"accel_{a}"]] = "float:.4f"
-    digits = logger.rate_digits
-    for name, (mean, rms) in logger.extra_columns.items():
-        values = mean + rng.normal(0.0, rms, size=rows.size)
-        columns[name] = values if digits is None else _round_significant(values, int(digits))
-        kinds[name] = "float:.17g" if digits is None else f"float:.{int(digits) - 1}E"
-    columns = {name: columns[name] for name in names.values() if name in columns}
-
-    segment_first = np.flatnonzero(np.diff(truth["segment"], prepend=-1))
-    segment_last = np.concatenate((segment_first[1:] - 1, [rows.size - 1]))
-    info: dict[str, Any] = {
-        "simulated": True,
-        "seed": int(seed),
-        "unit": gyro.name,
-        "profile": profile.description,
-        "chamber_program": profile.to_dict(),
-        "logger": logger.to_dict(),
-        "rows": int(rows.size),
-        "simulated_rows": int(n),
-        "duration_s": duration,
-        "columns": {role: name for role, name in names.items()},
-        "rate_unit": logger.rate_unit,
-        "time_unit": logger.time_unit,
-        "segments": [
-            {"first_row": int(a), "last_row": int(b), "run": int(truth["run"][a]),
-             "start_s": float(truth["time_s"][a]), "end_s": float(truth["time_s"][b])}
-            for a, b in zip(segment_first, segment_last, strict=True)
-        ],
-        "restarts": [{"row": int(r), "time_s": float(truth["time_s"][r]),
-                      "run_offset_dph": float(run_offsets[truth["run"][r]])}
-                     for r in np.flatnonzero(restart)],
-        "spikes": spikes_info,
-        "temperature": temperature_info,
-        "dfdt_still": dfdt_info,
-        "motion_rows": int(truth["motion"].sum()),
-        "motion_peak_dps": motion_rate_max,
-        "orientations": handled.table if handled is not None else [],
-        "handling_windows": handled.windows if handled is not None else [],
-    }
+    run_offsets = rng.normal(0.0, logger.run_offset_dph, size=duty.power_on_s.size)
+    log = _Log(logger, axes, names, rng, kept, handled, run_offsets)
+    _write_clock(log)
+    _write_rates(log, *_draw_spikes(log))
+    temperature_info, reference_text = _write_temperature(log)
+    _write_accel_and_extra(log)
+    columns = {name: log.columns[name] for name in names.values() if name in log.columns}
+    info = _sidecar(log, profile, gyro.name, int(seed), temperature_info)
+    rows, truth = log.rows, log.truth
     info["duplicates"] = []
     truth["duplicate"] = np.zeros(rows.size, dtype=bool)
     if logger.duplicates:
@@ -583,4 +361,239 @@ def log_run(
                        rng.choice(rows.size, size=int(logger.duplicates), replace=False))
     info["hrgtc_options"] = reading_options(info, axes, logger)
     info = records.dump(None, LoggedRunRecord, **info)  # its record's order, types and checks
-    return LoggedRun(columns, kinds, truth, info, reference_text)
+    return LoggedRun(columns, log.kinds, truth, info, reference_text)
+
+
+@dataclass
+class _Log:
+    """What the stages of :func:`log_run` read (``kept``: the simulated run at the kept
+    rows; ``handled``: the handling's truth or None; ``run_offsets``: each power-on's rate
+    offset [°/h]) and write: ``columns`` and ``kinds`` as written, ``truth`` per row, and
+    what the sidecar reports of spikes, rates of change and motion."""
+
+    logger: Logger
+    axes: tuple[str | None, ...]
+    names: dict[str, str]
+    rng: np.random.Generator
+    kept: KeptRun
+    handled: HandlingTruth | None
+    run_offsets: np.ndarray
+    t: np.ndarray = field(init=False)  # time of each kept row [s]
+    rows: np.ndarray = field(init=False)  # every kept row
+    truth: dict[str, np.ndarray] = field(init=False)
+    columns: dict[str, np.ndarray] = field(default_factory=dict)
+    kinds: dict[str, str] = field(default_factory=dict)
+    spikes_info: list[dict[str, Any]] = field(default_factory=list)
+    dfdt_info: dict[str, Any] = field(default_factory=dict)
+    motion_rate_max: float = 0.0
+
+    def __post_init__(self) -> None:
+        self.t = self.kept.columns["time_s"]
+        self.rows = rows = np.arange(self.t.size)
+        run, handled = self.kept.run, self.handled
+        truth: dict[str, np.ndarray] = {
+            "time_s": self.t[rows],
+            "run": run[rows],
+            "segment": segment_index(run, self.kept.burst),
+            "motion": (handled.motion[rows] if handled else np.zeros(rows.size, dtype=bool)),
+            "orientation": (handled.orientation[rows] if handled
+                            else np.zeros(rows.size, dtype=np.int64)),
+            "chamber_c": self.kept.columns["chamber_c"][rows],
+            "housing_c": self.kept.columns["housing_c"][rows],
+        }
+        restart = np.zeros(rows.size, dtype=bool)
+        restart[0] = True
+        restart[1:] = truth["run"][1:] != truth["run"][:-1]
+        truth["restart"] = restart
+        self.truth = truth
+
+
+def _write_clock(log: _Log) -> None:
+    """The time column: time since power-on from clock_start_s, jitter, unit, counter wrap;
+    or the wall clock, which runs on through restarts."""
+    logger, names, rows, t = log.logger, log.names, log.rows, log.t
+    jitter = (log.rng.normal(0.0, logger.jitter_s, size=rows.size) if logger.jitter_s > 0.0
+              else np.zeros(rows.size))
+    if logger.time_unit == "timestamp":
+        clock_s = np.round(t + jitter, 3)
+        written_time = wall_clock(logger.start, clock_s, logger.timezone)
+        log.kinds[names["time"]] = "str"
+        log.truth["clock_s"] = clock_s
+    else:
+        clock_s = logger.clock_start_s + log.kept.since_on_s[rows] + jitter
+        factor = TIME_FACTORS[logger.time_unit]
+        if logger.time_unit == "s":
+            written_time = np.round(clock_s, 6)
+            log.kinds[names["time"]] = "float:.6f"
+        else:
+            written_time = np.round(clock_s * factor)
+            log.kinds[names["time"]] = "int"
+        log.truth["clock_s"] = written_time / factor
+        if logger.counter_bits is not None:
+            written_time = np.mod(written_time, 2.0 ** int(logger.counter_bits))
+    log.columns[names["time"]] = written_time
+
+
+def _draw_spikes(log: _Log) -> tuple[np.ndarray, list[str | None]]:
+    """The rows and axes of the single-sample spikes (among the still rows)."""
+    spike_rows = np.array([], dtype=np.int64)
+    spike_axes: list[str | None] = []
+    if log.logger.spikes:
+        count = int(log.logger.spikes)
+        candidates = np.flatnonzero(~log.truth["motion"])
+        if count > candidates.size // 10:
+            raise InputError(f"{log.logger.spikes} spikes in {candidates.size} still rows: "
+                             "give at most one per ten rows (single-sample spikes)")
+        spike_rows = np.sort(log.rng.choice(candidates, size=count, replace=False))
+        spike_axes = [log.axes[int(i)]
+                      for i in log.rng.integers(0, len(log.axes), size=spike_rows.size)]
+    log.truth["spike"] = np.isin(log.rows, spike_rows)
+    return spike_rows, spike_axes
+
+
+def _write_rates(log: _Log, spike_rows: np.ndarray, spike_axes: list[str | None]) -> None:
+    """Each axis's rate column (offsets, warm-up, motion and spikes added, in the rate unit
+    and digits written), its frequency column, and their truth."""
+    logger, names, rows, truth = log.logger, log.names, log.rows, log.truth
+    rec, track, t, handled = log.kept.columns, log.kept.track, log.t, log.handled
+    warmup = logger.warmup_dph * np.exp(-log.kept.since_on_s / logger.warmup_tau_s)
+    still = ~truth["motion"]
+    for axis in log.axes:
+        key = "" if axis is None else f"_{axis}"
+        offset = log.run_offsets[log.kept.run[rows]] + warmup[rows]
+        motion_dph = np.zeros(rows.size)
+        if handled is not None:
+            body = axis if axis is not None else "z"
+            offset = offset + handled.offset_dph[body][rows]
+            motion_dph = handled.motion_dph[body][rows]
+            log.motion_rate_max = max(log.motion_rate_max,
+                                      float(np.max(np.abs(motion_dph))) / 3600.0)
+        rate = rec[f"rate_dph{key}"][rows] + offset + motion_dph
+        truth[f"rate_dph{key}"] = rate.copy()
+        truth[f"bias_dph{key}"] = rec[f"bias_dph{key}"][rows]
+        truth[f"offset_dph{key}"] = offset
+        truth[f"motion_dph{key}"] = motion_dph
+        truth[f"resonator_c{key}"] = rec[f"resonator_c{key}"][rows]
+        if f"scale_ppm{key}" in rec:
+            truth[f"scale_ppm{key}"] = rec[f"scale_ppm{key}"][rows]
+        # The true rate of change of the thermometer, from the continuous run's slow track.
+        dtdt = track_derivative(track, f"resonator_c{key}", t)
+        truth[f"dtdt_c_per_s{key}"] = dtdt
+        dfdt = track_derivative(track, f"freq_true_hz{key}", t)
+        truth[f"dfdt_hz_per_s{key}"] = dfdt
+        head = rec[f"rate_dph{key}"][:20000]
+        same = np.diff(truth["segment"][:20000]) == 0
+        sigma = float(np.std(np.diff(head)[same])) / math.sqrt(2.0) if same.any() else 0.0
+        size = logger.spike_dph or -50.0 * sigma
+        for r, a in zip(spike_rows, spike_axes, strict=True):
+            if a == axis:
+                rate[r] += size
+                log.spikes_info.append({"row": int(r), "axis": axis,
+                                        "column": names[f"rate{key}"], "size_dph": size,
+                                        "size_written": size * RATE_FACTORS[logger.rate_unit]})
+        written = rate * RATE_FACTORS[logger.rate_unit]
+        if logger.rate_digits is not None:
+            written = _round_significant(written, int(logger.rate_digits))
+            log.kinds[names[f"rate{key}"]] = f"float:.{int(logger.rate_digits) - 1}E"
+        else:
+            log.kinds[names[f"rate{key}"]] = "float:.17g"
+        if logger.frequency:
+            log.columns[names[f"freq{key}"]] = rec[f"freq_hz{key}"][rows]
+            log.kinds[names[f"freq{key}"]] = "float:.6f"
+            truth[f"freq_hz{key}"] = rec[f"freq_hz{key}"][rows]
+        log.columns[names[f"rate{key}"]] = written
+        label = "x" if axis is None else axis
+        for what, values in (("dtdt_c_per_s", dtdt[rows]), ("dfdt_hz_per_s", dfdt[rows])):
+            kept = values[still]
+            log.dfdt_info.setdefault(what, {})[label] = {
+                "min": float(kept.min()), "max": float(kept.max()),
+                "p01": float(np.percentile(kept, 1)), "p99": float(np.percentile(kept, 99)),
+            }
+
+
+def _write_temperature(log: _Log) -> tuple[dict[str, Any] | None, str | None]:
+    """The logged temperature column and its truth; the sidecar's temperature entry and
+    the reference log's text (None without them)."""
+    logger, names, rows, truth = log.logger, log.names, log.rows, log.truth
+    rec, track, t = log.kept.columns, log.kept.track, log.t
+    die = "resonator_c" + ("" if log.axes[0] is None else f"_{log.axes[0]}")
+    if logger.temperature is None:
+        return None, None
+    channel = logger.temperature
+    source = rec[die] if channel.source == "die" else rec["housing_c"]
+    written = channel.written(source[rows], log.rng)
+    if channel.rate_hz is not None:
+        tick = np.floor(t[rows] * channel.rate_hz + 1e-9)
+        fresh = np.ones(rows.size, dtype=bool)
+        fresh[1:] = tick[1:] != tick[:-1]
+        written = np.where(fresh, written, np.nan)
+        truth["temperature_fresh"] = fresh
+    log.columns[names["temperature"]] = written
+    log.kinds[names["temperature"]] = ("int" if channel.lsb_c is not None
+                                       else f"float:.{int(channel.decimals)}f")
+    truth["sensor_c"] = source[rows]
+    temperature_info = {"column": names["temperature"], "source": channel.source,
+                        "map": channel.map(), "rate_hz": channel.rate_hz,
+                        "range_c": [float(source[rows].min()), float(source[rows].max())]}
+    if logger.reference_log is None:
+        return temperature_info, None
+    reference_text, readings = reference_log_text(
+        logger.reference_log, track["time_s"],
+        track[die] if channel.source == "die" else track["housing_c"],
+        track["housing_c"], track["chamber_c"], log.rng)
+    # The wall-clock time at which the logger's clock read 0: hrgtc's t = 0 of a file
+    # in s/ms/µs since power-on (the first run's, without a counter wrap).
+    zero = (datetime.fromisoformat(logger.reference_log.start)
+            - timedelta(seconds=logger.clock_start_s)
+            if logger.time_unit != "timestamp" else datetime.fromisoformat(logger.start))
+    temperature_info["reference_log"] = reference_log_info(logger.reference_log, zero, readings)
+    return temperature_info, reference_text
+
+
+def _write_accel_and_extra(log: _Log) -> None:
+    """The accelerometer columns (gravity and handling, or level and still) and the extra
+    columns (a mean and white noise)."""
+    logger, names, rows, handled = log.logger, log.names, log.rows, log.handled
+    if logger.accelerometer:
+        accel = (handled.accel_g[rows] if handled is not None
+                 else np.tile([0.0, 0.0, 1.0], (rows.size, 1))
+                 + log.rng.normal(0.0, 0.002, size=(rows.size, 3)))
+        scale = 1.0 if logger.accel_unit == "g" else 9.80665
+        for i, a in enumerate("xyz"):
+            log.columns[names[f"accel_{a}"]] = np.round(accel[:, i] * scale, 4)
+            log.kinds[names[f"accel_{a}"]] = "float:.4f"
+    digits = logger.rate_digits
+    for name, (mean, rms) in logger.extra_columns.items():
+        values = mean + log.rng.normal(0.0, rms, size=rows.size)
+        log.columns[name] = values if digits is None else _round_significant(values,
+                                                                             int(digits))
+        log.kinds[name] = "float:.17g" if digits is None else f"float:.{int(digits) - 1}E"
+
+
+def _sidecar(log: _Log, profile: Profile, unit_name: str, seed: int,
+             temperature_info: dict[str, Any] | None) -> dict[str, Any]:
+    """The sidecar's entries (before the duplicates and the reading options)."""
+    truth, rows, handled, logger = log.truth, log.rows, log.handled, log.logger
+    segment_first = np.flatnonzero(np.diff(truth["segment"], prepend=-1))
+    segment_last = np.concatenate((segment_first[1:] - 1, [rows.size - 1]))
+    return {
+        "simulated": True, "seed": seed, "unit": unit_name, "profile": profile.description,
+        "chamber_program": profile.to_dict(), "logger": logger.to_dict(),
+        "rows": int(rows.size), "simulated_rows": int(log.kept.simulated_rows),
+        "duration_s": log.kept.duration_s,
+        "columns": {role: name for role, name in log.names.items()},
+        "rate_unit": logger.rate_unit, "time_unit": logger.time_unit,
+        "segments": [
+            {"first_row": int(a), "last_row": int(b), "run": int(truth["run"][a]),
+             "start_s": float(truth["time_s"][a]), "end_s": float(truth["time_s"][b])}
+            for a, b in zip(segment_first, segment_last, strict=True)
+        ],
+        "restarts": [{"row": int(r), "time_s": float(truth["time_s"][r]),
+                      "run_offset_dph": float(log.run_offsets[truth["run"][r]])}
+                     for r in np.flatnonzero(truth["restart"])],
+        "spikes": log.spikes_info, "temperature": temperature_info,
+        "dfdt_still": log.dfdt_info, "motion_rows": int(truth["motion"].sum()),
+        "motion_peak_dps": log.motion_rate_max,
+        "orientations": handled.table if handled is not None else [],
+        "handling_windows": handled.windows if handled is not None else [],
+    }

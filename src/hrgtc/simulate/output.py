@@ -11,7 +11,7 @@ from __future__ import annotations
 import threading
 from collections.abc import Mapping, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, fields, replace
 from pathlib import Path
 from typing import Any
 
@@ -37,7 +37,8 @@ from hrgtc.simulate.campaign import (
 from hrgtc.simulate.profiles import Profile
 from hrgtc.simulate.units import MultiAxisUnit, Unit
 
-__all__ = ["WrittenFile", "WrittenFileRecord", "output_paths", "simulate_files", "simulate_to_file"]
+__all__ = ["SimulatedRun", "WrittenFile", "WrittenFileRecord", "output_paths", "simulate_files",
+           "simulate_to_file"]
 
 
 @dataclass(frozen=True)
@@ -180,18 +181,42 @@ def output_paths(
     return [output / f"{name}{chosen}" for name in names]
 
 
+@dataclass(frozen=True)
+class SimulatedRun:
+    """How each run of :func:`simulate_files` is simulated (as for :func:`iter_run_chunks`).
+
+    Attributes
+    ----------
+    unit
+        A unit name, a :class:`Unit` or a :class:`MultiAxisUnit`.
+    sample_rate_hz
+        Sample rate. [Hz]
+    seed
+        Non-negative integer seed of the campaign (run ``k`` draws from
+        ``SeedSequence(seed, spawn_key=(k,))``).
+    input_rate_dph
+        Known constant input rate, per axis for a multi-axis unit; None: the unit's. [°/h]
+    chunk_rows
+        Rows per chunk.
+    """
+
+    unit: str | Unit | MultiAxisUnit = _units.DEFAULT_UNIT
+    sample_rate_hz: float = 200.0
+    seed: int = 0
+    input_rate_dph: float | Mapping[str, float] | None = None
+    chunk_rows: int = DEFAULT_CHUNK_ROWS
+
+
 def simulate_files(
     profiles: Sequence[Profile],
     output: str | Path,
     file_format: str | None = None,
-    unit: str | Unit | MultiAxisUnit = _units.DEFAULT_UNIT,
-    sample_rate_hz: float = 200.0,
-    seed: int = 0,
-    input_rate_dph: float | Mapping[str, float] | None = None,
-    chunk_rows: int = DEFAULT_CHUNK_ROWS,
+    run: SimulatedRun | None = None,
+    *,
     force: bool = False,
     progress: Progress | None = None,
     workers: int = 2,
+    **run_options: Any,
 ) -> list[WrittenFile]:
     """Simulate one file per profile (a soak campaign, a cool-down, ...).
 
@@ -209,16 +234,17 @@ def simulate_files(
         A directory (created if missing), or a file for a single run.
     file_format
         ``"parquet"``, ``"csv"`` or ``"h5"``; None: from ``output``'s suffix, else Parquet.
-    unit, sample_rate_hz, input_rate_dph, chunk_rows
-        As for :func:`iter_run_chunks`.
-    seed
-        Non-negative integer seed of the campaign.
+    run
+        Unit, sample rate, seed, input rate and chunk rows (:class:`SimulatedRun`);
+        None: its defaults.
     force
         Overwrite existing files.
     progress
         Called as ``progress(rows_done, rows_total)`` over all runs (from worker threads).
     workers
         Number of files in flight at once (each holds a few chunks in memory).
+    **run_options
+        Fields of :class:`SimulatedRun` by keyword (``unit="imu-3", seed=4``), over ``run``'s.
 
     Returns
     -------
@@ -232,42 +258,22 @@ def simulate_files(
     """
     if not profiles:
         raise InputError("no runs to simulate; give at least one profile")
+    settings = _run_settings(run, run_options)
+    unit = settings.unit
     unit = unit if isinstance(unit, Unit | MultiAxisUnit) else _units.get(unit)
-    fs = check_rate(sample_rate_hz)
-    seed = check_seed(seed)
+    fs = check_rate(settings.sample_rate_hz)
+    seed = check_seed(settings.seed)
     if not isinstance(seed, int):
         raise InputError(f"a campaign's seed must be a non-negative integer, got {seed!r}")
     paths = output_paths(profiles, output, file_format)
     refuse_existing(paths, force, "nothing was written")
     paths[0].parent.mkdir(parents=True, exist_ok=True)
-    counts = [row_count(p, fs) for p in profiles]
-    total = float(sum(counts))
-    done = [0.0] * len(profiles)
-    lock = threading.Lock()
-
-    def reporter(k: int) -> Progress:
-        def report(rows: float, _total: float) -> None:
-            with lock:  # one call at a time, rows_done never decreasing
-                done[k] = rows
-                if progress is not None:
-                    progress(sum(done), total)
-
-        return report
-
+    shared = _SharedProgress([row_count(p, fs) for p in profiles], progress)
     with ThreadPoolExecutor(max_workers=max(1, min(int(workers), len(profiles)))) as pool:
         futures = [
-            pool.submit(
-                simulate_to_file,
-                profile,
-                path,
-                unit,
-                fs,
-                np.random.SeedSequence(seed, spawn_key=(k,)),
-                input_rate_dph,
-                chunk_rows,
-                force,
-                reporter(k),
-            )
+            pool.submit(simulate_to_file, profile, path, unit, fs,
+                        np.random.SeedSequence(seed, spawn_key=(k,)), settings.input_rate_dph,
+                        settings.chunk_rows, force, shared.reporter(k))
             for k, (profile, path) in enumerate(zip(profiles, paths, strict=True))
         ]
         try:
@@ -276,3 +282,33 @@ def simulate_files(
             for future in futures:
                 future.cancel()
             raise
+
+
+def _run_settings(run: SimulatedRun | None, options: Mapping[str, Any]) -> SimulatedRun:
+    """``run`` (None: the defaults) with the fields given by keyword replaced."""
+    known = {f.name for f in fields(SimulatedRun)}
+    unknown = sorted(set(options) - known)
+    if unknown:
+        raise TypeError(f"simulate_files() got unexpected keyword argument(s) {unknown}; "
+                        f"the run's options are {sorted(known)}")
+    return replace(run or SimulatedRun(), **options)
+
+
+class _SharedProgress:
+    """One ``progress(rows_done, rows_total)`` over every run, fed from worker threads."""
+
+    def __init__(self, counts: Sequence[int], progress: Progress | None) -> None:
+        self.total = float(sum(counts))
+        self.done = [0.0] * len(counts)
+        self.lock = threading.Lock()
+        self.progress = progress
+
+    def reporter(self, k: int) -> Progress:
+        """The progress callback of run ``k``."""
+        def report(rows: float, _total: float) -> None:
+            with self.lock:  # one call at a time, rows_done never decreasing
+                self.done[k] = rows
+                if self.progress is not None:
+                    self.progress(sum(self.done), self.total)
+
+        return report

@@ -34,6 +34,7 @@ __all__ = [
     "TemperatureChannelRecord",
     "count_to_celsius",
     "first_order_lag",
+    "reference_log_info",
     "reference_log_text",
 ]
 
@@ -331,3 +332,21 @@ def reference_log_text(
     newline = "\r\n" if log.crlf else "\n"
     text = newline.join(lines) + newline
     return ("\ufeff" if log.bom else "") + text, readings
+
+
+def reference_log_info(log: ReferenceLog, clock_zero: datetime,
+                       readings: list[dict[str, Any]]) -> dict[str, Any]:
+    """The sidecar's entry of a reference log: its columns, the wall-clock time
+    ``clock_zero`` at which the recording's clock read 0, the ``hrgtc`` options that
+    read it, and its true readings (from :func:`reference_log_text`)."""
+    zero_text = clock_zero.isoformat(timespec="milliseconds")
+    return {
+        "probe_column": log.probe_column, "start": log.start, "lag_s": log.lag_s,
+        "recording_clock_zero": zero_text,
+        "hrgtc_options": [
+            "--temp-ref-col", "time_s=Time", "--temp-ref-col",
+            f"temperature_c={log.probe_column}", "--temp-ref-start",
+            zero_text if log.dates else zero_text[11:].removesuffix(".000"),
+        ],
+        "readings": readings,
+    }

@@ -22,8 +22,10 @@
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 from hrgtc.core.errors import InputError
 from hrgtc.settings.simulation import (
@@ -32,6 +34,7 @@ from hrgtc.settings.simulation import (
     PROFILE_DEFAULTS,
     PROFILE_KINDS,
     REQUIRED,
+    SimulationSettings,
 )
 from hrgtc.simulate.profiles import (
     CHAMBER_MAX_C_PER_MIN,
@@ -48,6 +51,7 @@ __all__ = [
     "DEFAULT_PLATEAUS_C",
     "DEFAULT_TABLE_RATES_DPS",
     "KINDS",
+    "PROFILE_OPTIONS",
     "build",
     "constant",
     "cooldown",
@@ -383,20 +387,14 @@ def rate_table(
 KINDS = PROFILE_KINDS
 
 
-def build(
-    kind: str,
-    *,
-    setpoints_c: Sequence[float] | None = None,
-    hours: float | None = None,
-    start_c: float | None = None,
-    end_c: float | None = None,
-    temperature_c: float | None = None,
-    ramp_c_per_min: float | None = None,
-    single_file: bool = False,
-    rates_dps: Sequence[float] | None = None,
-    rate_hold_s: float | None = None,
-    axes: Sequence[str] | None = None,
-) -> list[Profile]:
+#: The profile's parameters that :func:`build` takes by keyword: the profile fields of
+#: :class:`~hrgtc.settings.simulation.SimulationSettings` (all but ``profile``, the kind).
+PROFILE_OPTIONS = ("setpoints_c", "hours", "start_c", "end_c", "temperature_c",
+                   "ramp_c_per_min", "single_file", "rates_dps", "rate_hold_s")
+
+
+def build(kind: str, settings: SimulationSettings | None = None, *,
+          axes: Sequence[str] | None = None, **options: Any) -> list[Profile]:
     """The runs of one command line: a kind of profile (or a profile file) and its options.
 
     Parameters
@@ -404,27 +402,33 @@ def build(
     kind
         ``"soak"``, ``"cooldown"``, ``"warmup"``, ``"constant"``, ``"ramp"``,
         ``"ratetable"``, or the path of a JSON/YAML profile file.
-    setpoints_c
-        Soak set-points, or the plateaus of a rate table. [°C]
-    hours
-        Hours per soak (also at each rate-table plateau), or duration of a
-        cool-down/warm-up/constant run; hold after a ramp. [h]
-    start_c, end_c
-        Start and end temperatures of a cool-down, warm-up or ramp (the start of a rate
-        table too). [°C]
-    temperature_c
-        Temperature of a constant run. [°C]
-    ramp_c_per_min
-        Ramp rate of a cool-down, warm-up or ramp. [°C/min]
-    single_file
-        Soaks: one run visiting all set-points instead of one run per set-point.
-    rates_dps
-        Rate table: the rates. [°/s]
-    rate_hold_s
-        Rate table: time each rate is held. [s]
+    settings
+        The profile's parameters: the fields of :data:`PROFILE_OPTIONS` (its other
+        fields, the run's, are not read); None: every field None (its kind's default).
     axes
         Rate table: the axes of a multi-axis unit, turned one at a time (ignored
         by the other kinds); None for a single-axis unit.
+    **options
+        Any field of :data:`PROFILE_OPTIONS` by keyword, over ``settings``'s:
+
+        ``setpoints_c``
+            Soak set-points, or the plateaus of a rate table. [°C]
+        ``hours``
+            Hours per soak (also at each rate-table plateau), or duration of a
+            cool-down/warm-up/constant run; hold after a ramp. [h]
+        ``start_c``, ``end_c``
+            Start and end temperatures of a cool-down, warm-up or ramp (the start of a
+            rate table too). [°C]
+        ``temperature_c``
+            Temperature of a constant run. [°C]
+        ``ramp_c_per_min``
+            Ramp rate of a cool-down, warm-up or ramp. [°C/min]
+        ``single_file``
+            Soaks: one run visiting all set-points instead of one run per set-point.
+        ``rates_dps``
+            Rate table: the rates. [°/s]
+        ``rate_hold_s``
+            Rate table: time each rate is held. [s]
 
     A parameter None takes its kind's default, written once in
     :data:`hrgtc.settings.simulation.PROFILE_DEFAULTS` (the help of ``hrgtc simulate``
@@ -434,16 +438,35 @@ def build(
     -------
     list of Profile
         One profile per output file.
+
+    Raises
+    ------
+    TypeError
+        For a keyword that is not one of :data:`PROFILE_OPTIONS`.
     """
-    given = {
-        "setpoints_c": setpoints_c,
-        "start_c": start_c,
-        "end_c": end_c,
-        "temperature_c": temperature_c,
-        "ramp_c_per_min": ramp_c_per_min,
-        "rates_dps": rates_dps,
-        "rate_hold_s": rate_hold_s,
-    }
+    unknown = sorted(set(options) - set(PROFILE_OPTIONS))
+    if unknown:
+        raise TypeError(f"build() got unexpected keyword argument(s) {unknown}; "
+                        f"the profile's options are {list(PROFILE_OPTIONS)}")
+    chosen = dataclasses.replace(settings or SimulationSettings(), **options)
+    given = {name: getattr(chosen, name) for name in PROFILE_OPTIONS
+             if name not in ("hours", "single_file")}
+    _refuse_options(kind, given, chosen.single_file)
+    if kind in PROFILE_DEFAULTS:
+        value = {**PROFILE_DEFAULTS[kind],
+                 **{k: v for k, v in {**given, "hours": chosen.hours}.items() if v is not None}}
+        missing = [name for name, v in value.items() if v == REQUIRED]
+        if missing:
+            options_text = ", ".join("--" + name.removesuffix("_c") for name in missing)
+            raise InputError(f"a {kind} needs {' and '.join(missing)} ({options_text})")
+        return _runs(kind, value, chosen.single_file, axes)
+    if chosen.hours is not None:
+        raise InputError(f"option hours does not apply to the profile file {kind}")
+    return [load(kind)]
+
+
+def _refuse_options(kind: str, given: dict[str, Any], single_file: bool) -> None:
+    """Refuse an unknown kind, a missing profile file, or options ``kind`` does not take."""
     allowed = {kind: set(defaults) - {"hours"} for kind, defaults in PROFILE_DEFAULTS.items()}
     if kind not in KINDS:
         path = Path(kind)
@@ -459,13 +482,11 @@ def build(
     if extra or (single_file and kind != "soak"):
         names = extra + (["single_file"] if single_file and kind != "soak" else [])
         raise InputError(f"option(s) {names} do not apply to profile {kind!r}")
-    if kind in PROFILE_DEFAULTS:
-        value = {**PROFILE_DEFAULTS[kind],
-                 **{k: v for k, v in {**given, "hours": hours}.items() if v is not None}}
-        missing = [name for name, v in value.items() if v == REQUIRED]
-        if missing:
-            options = ", ".join("--" + name.removesuffix("_c") for name in missing)
-            raise InputError(f"a {kind} needs {' and '.join(missing)} ({options})")
+
+
+def _runs(kind: str, value: dict[str, Any], single_file: bool,
+          axes: Sequence[str] | None) -> list[Profile]:
+    """The profiles of a standard ``kind`` from its parameters, defaults filled in."""
     if kind == "soak":
         points, hold = list(value["setpoints_c"]), value["hours"]
         return [soak_series(points, hold)] if single_file else soak_campaign(points, hold)
@@ -478,10 +499,6 @@ def build(
     if kind == "ramp":
         return [ramp(value["start_c"], value["end_c"], value["ramp_c_per_min"],
                      value["hours"])]
-    if kind == "ratetable":
-        return [rate_table(list(value["setpoints_c"]), list(value["rates_dps"]),
-                           value["rate_hold_s"], value["hours"], axes=axes,
-                           start_c=value["start_c"])]
-    if hours is not None:
-        raise InputError(f"option hours does not apply to the profile file {kind}")
-    return [load(kind)]
+    return [rate_table(list(value["setpoints_c"]), list(value["rates_dps"]),
+                       value["rate_hold_s"], value["hours"], axes=axes,
+                       start_c=value["start_c"])]

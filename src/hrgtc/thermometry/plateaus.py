@@ -413,7 +413,12 @@ def find_plateaus(
         hz_per_c=hz_per_c, max_fit_std_c=max_fit_std_c)
     if not isinstance(recording, Recording):
         return plateaus_from_recordings(recording, chosen, progress=progress)
-    settings = _settings(dataclasses.asdict(chosen))
+    return _recording_plateaus(recording, _settings(dataclasses.asdict(chosen)), progress)
+
+
+def _recording_plateaus(recording: Recording, settings: _Settings,
+                        progress: Progress | None) -> list[Plateau]:
+    """:func:`find_plateaus` of one recording: a plateau per stable chamber stretch."""
     blocks = _blocks(recording, settings.block_s)
     segments = _chamber_segments(blocks.chamber_c, settings.tolerance_c, settings.window)
     if not segments:

@@ -372,16 +372,8 @@ def fit_with_prior(temperatures_c: Any, frequencies_hz: Any, prior: ThermometerP
             f"{prior.n_units} units at {prior.nominal_freq_hz:.2f} ± "
             f"{prior.nominal_freq_std_hz:.2f} Hz: they differ in kind (another design or "
             "mode), so their prior does not apply; calibrate with 4 or more soaks")
-    precision_b = np.linalg.inv(cov_b)
-    for _ in range(2):  # a0 fixed at its estimate, refined once
-        prior_precision = np.zeros((k + 1, k + 1))
-        prior_precision[1:, 1:] = precision_b / a0**2
-        prior_mean = np.concatenate([[0.0], a0 * mean_b])
-        precision = prior_precision + x.T @ (w[:, None] * x)
-        covariance = np.linalg.inv(precision)
-        covariance = 0.5 * (covariance + covariance.T)
-        a = covariance @ (prior_precision @ prior_mean + x.T @ (w * f))
-        a0 = float(a[0])
+    a, covariance = _posterior(x, w, f, a0, mean_b, cov_b)
+    a0 = float(a[0])
     # Distance of each point from the prior's prediction (a0 from the data).
     predicted_var = a0**2 * np.einsum("ij,jk,ik->i", x[:, 1:], cov_b, x[:, 1:]) + s**2
     sigma = np.abs(f - a0 * shape) / np.sqrt(predicted_var)
@@ -398,6 +390,27 @@ def fit_with_prior(temperatures_c: Any, frequencies_hz: Any, prior: ThermometerP
                                "check the soaks")
     return PriorFit(thermometer, prior, tuple(map(float, t)), tuple(map(float, f)),
                     tuple(map(float, s)), float(sigma.max()))
+
+
+def _posterior(x: np.ndarray, w: np.ndarray, f: np.ndarray, a0: float, mean_b: np.ndarray,
+               cov_b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Posterior mean and covariance of the scaled coefficients (module docstring).
+
+    The prior on the relative coefficients ``b`` becomes one on ``a = a0 * (1, b)`` with
+    ``a0`` fixed at its estimate, refined once from the first posterior.
+    """
+    k = x.shape[1] - 1
+    precision_b = np.linalg.inv(cov_b)
+    for _ in range(2):  # a0 fixed at its estimate, refined once
+        prior_precision = np.zeros((k + 1, k + 1))
+        prior_precision[1:, 1:] = precision_b / a0**2
+        prior_mean = np.concatenate([[0.0], a0 * mean_b])
+        precision = prior_precision + x.T @ (w[:, None] * x)
+        covariance = np.linalg.inv(precision)
+        covariance = 0.5 * (covariance + covariance.T)
+        a = covariance @ (prior_precision @ prior_mean + x.T @ (w * f))
+        a0 = float(a[0])
+    return a, covariance
 
 
 def _thermometer(a: np.ndarray, covariance: np.ndarray, prior: ThermometerPrior,

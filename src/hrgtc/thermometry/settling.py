@@ -235,6 +235,42 @@ def fit_transient(time_s: Any, freq_hz: Any) -> TransientFit:
     >>> round(fit.f_inf_hz, 6), fit.usable
     (4417.0, True)
     """
+    tb, fb = _checked(time_s, freq_hz)
+    tt, n = tb - tb[0], tb.size
+    span = float(tt[-1])
+    ref = float(np.median(fb))
+    best = _least_aic(tt, fb - ref)
+    model, projection, coef, rss, aic = best
+    common = {
+        "start_s": float(tb[0]), "end_s": float(tb[-1]), "n_blocks": int(n),
+        "rms_hz": math.sqrt(rss / n), "aic": float(aic),
+    }  # fmt: skip
+    if model == "constant":
+        std = math.sqrt(rss / (n - 1) / n)
+        return TransientFit(model, ref + float(coef[0]), std, (), (), (), usable=True, **common)
+    exps, params = _MODELS[model][0], projection.params
+    std = projection.constant_std(rss)
+    taus, weights = [math.exp(params[0])], [1.0]
+    if exps == 2:
+        taus.append(math.exp(params[0] + params[1]))
+        weights.append(float(params[2]))
+    reason = ""
+    if taus[0] >= span:
+        reason = (
+            f"its time constant {taus[0]:.0f} s is not shorter than the {span:.0f} s fitted, "
+            "the curve has not shown where it settles"
+        )
+    elif not math.isfinite(std):
+        reason = "its settled frequency is not determined (singular fit)"
+    poly = tuple(float(c) for c in coef[1:])
+    return TransientFit(
+        model, ref + float(coef[0]), std, tuple(taus), tuple(weights), poly,
+        usable=not reason, reason=reason, **common,
+    )  # fmt: skip
+
+
+def _checked(time_s: Any, freq_hz: Any) -> tuple[np.ndarray, np.ndarray]:
+    """``time_s`` and ``freq_hz`` as flat float arrays, refused unless fit for a transient."""
     tb = np.asarray(time_s, dtype=np.float64).ravel()
     fb = np.asarray(freq_hz, dtype=np.float64).ravel()
     if tb.size != fb.size or tb.size < MIN_FIT_POINTS:
@@ -244,10 +280,18 @@ def fit_transient(time_s: Any, freq_hz: Any) -> TransientFit:
         )
     if not (np.all(np.isfinite(tb)) and np.all(np.isfinite(fb)) and np.all(np.diff(tb) > 0)):
         raise InputError("fit_transient needs finite freq_hz and finite, increasing time_s")
-    tt, n = tb - tb[0], tb.size
+    return tb, fb
+
+
+def _least_aic(tt: np.ndarray, y: np.ndarray) -> tuple[str, Any, np.ndarray, float, float]:
+    """The model of least AIC for ``y`` at times ``tt`` (from 0): its name, projection
+    (None for the constant), linear coefficients, residual sum of squares and AIC.
+
+    The models of the module docstring are tried in order, each started from the last;
+    one with more parameters than a third of the points is not tried.
+    """
+    n = tt.size
     span = float(tt[-1])
-    ref = float(np.median(fb))
-    y = fb - ref
     rss = float(np.sum((y - y.mean()) ** 2))
     best = ("constant", None, np.array([y.mean()]), rss, n * math.log(rss / n + 1e-300) + 2)
     log_tau = (math.log(2.0 * float(np.median(np.diff(tt)))), math.log(100.0 * span))
@@ -279,30 +323,4 @@ def fit_transient(time_s: Any, freq_hz: Any) -> TransientFit:
         aic = n * math.log(rss / n + 1e-300) + 2 * (fitted[name].size + degree + 1)
         if aic < best[4]:
             best = (name, projection, projection.coef, rss, aic)
-    model, projection, coef, rss, aic = best
-    common = {
-        "start_s": float(tb[0]), "end_s": float(tb[-1]), "n_blocks": int(n),
-        "rms_hz": math.sqrt(rss / n), "aic": float(aic),
-    }  # fmt: skip
-    if model == "constant":
-        std = math.sqrt(rss / (n - 1) / n)
-        return TransientFit(model, ref + float(coef[0]), std, (), (), (), usable=True, **common)
-    exps, params = _MODELS[model][0], projection.params
-    std = projection.constant_std(rss)
-    taus, weights = [math.exp(params[0])], [1.0]
-    if exps == 2:
-        taus.append(math.exp(params[0] + params[1]))
-        weights.append(float(params[2]))
-    reason = ""
-    if taus[0] >= span:
-        reason = (
-            f"its time constant {taus[0]:.0f} s is not shorter than the {span:.0f} s fitted, "
-            "the curve has not shown where it settles"
-        )
-    elif not math.isfinite(std):
-        reason = "its settled frequency is not determined (singular fit)"
-    poly = tuple(float(c) for c in coef[1:])
-    return TransientFit(
-        model, ref + float(coef[0]), std, tuple(taus), tuple(weights), poly,
-        usable=not reason, reason=reason, **common,
-    )  # fmt: skip
+    return best

@@ -471,6 +471,51 @@ def fit(temperatures_c: Any, frequencies_hz: Any, order: int = 3) -> Thermometer
     >>> round(float(th.temperature(4421.05)), 3)
     -10.058
     """
+    t, f, order = _checked_points(temperatures_c, frequencies_hz, order)
+    t_low, t_high = float(t.min()), float(t.max())
+    centre = 0.5 * (t_low + t_high)
+    scale = 0.5 * (t_high - t_low)
+    z = (t - centre) / scale
+    f_mean = float(np.mean(f))
+    y = f - f_mean
+
+    vandermonde = np.vander(z, order + 1, increasing=True)
+    a, r = _least_squares(vandermonde, y)
+    a[0] += f_mean
+    fitted = vandermonde @ a
+    residual = f - fitted
+    n = t.size
+    dof = n - (order + 1)
+    rss = float(residual @ residual)
+    tss = float(np.sum((f - f_mean) ** 2))
+    rsquared = 1.0 - rss / tss if tss > 0 else float("nan")
+
+    matrix = _scaled_to_raw_matrix(order, centre, scale)
+    scaled_exact = [Fraction(float(v)) for v in a]
+    raw = tuple(
+        float(sum((matrix[j][k] * scaled_exact[k] for k in range(order + 1)), Fraction(0)))
+        for j in range(order + 1)
+    )
+    standard_errors, residual_std, covariance = _errors(r, matrix, rss, dof)
+    return Thermometer(
+        coefficients=raw,
+        standard_errors=standard_errors,
+        residual_std_hz=residual_std,
+        rsquared=rsquared,
+        temperature_range_c=(t_low, t_high),
+        order=order,
+        n_points=n,
+        centre_c=centre,
+        scale_c=scale,
+        scaled_coefficients=tuple(float(v) for v in a),
+        scaled_covariance=covariance,
+    )
+
+
+def _checked_points(temperatures_c: Any, frequencies_hz: Any,
+                    order: Any) -> tuple[np.ndarray, np.ndarray, int]:
+    """The points of :func:`fit` as flat float arrays and the order as an int, refused
+    unless they determine a polynomial of that order."""
     t = np.asarray(temperatures_c, dtype=np.float64).ravel()
     f = np.asarray(frequencies_hz, dtype=np.float64).ravel()
     if not isinstance(order, (int, np.integer)) or order < 1:
@@ -492,14 +537,13 @@ def fit(temperatures_c: Any, frequencies_hz: Any, order: int = 3) -> Thermometer
             f"(it needs at least {order + 1}, and {order + 2} or more to estimate its errors); "
             "add soaks or lower the order"
         )
-    t_low, t_high = float(t.min()), float(t.max())
-    centre = 0.5 * (t_low + t_high)
-    scale = 0.5 * (t_high - t_low)
-    z = (t - centre) / scale
-    f_mean = float(np.mean(f))
-    y = f - f_mean
+    return t, f, order
 
-    vandermonde = np.vander(z, order + 1, increasing=True)
+
+def _least_squares(vandermonde: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Coefficients of ``vandermonde @ a = y`` by QR with one step of iterative
+    refinement, and the factor ``r``; refused when the design is numerically singular."""
+    order = vandermonde.shape[1] - 1
     q, r = np.linalg.qr(vandermonde)
     diag = np.abs(np.diag(r))
     if diag.min() <= diag.max() * 1e-13:
@@ -512,21 +556,15 @@ def fit(temperatures_c: Any, frequencies_hz: Any, order: int = 3) -> Thermometer
     # One step of iterative refinement on the residual.
     residual = y - vandermonde @ a
     a = a + np.linalg.solve(r, q.T @ residual)
-    a[0] += f_mean
-    fitted = vandermonde @ a
-    residual = f - fitted
-    n = t.size
-    dof = n - (order + 1)
-    rss = float(residual @ residual)
-    tss = float(np.sum((f - f_mean) ** 2))
-    rsquared = 1.0 - rss / tss if tss > 0 else float("nan")
+    return a, r
 
-    matrix = _scaled_to_raw_matrix(order, centre, scale)
-    scaled_exact = [Fraction(float(v)) for v in a]
-    raw = tuple(
-        float(sum((matrix[j][k] * scaled_exact[k] for k in range(order + 1)), Fraction(0)))
-        for j in range(order + 1)
-    )
+
+def _errors(r: np.ndarray, matrix: list[list[Fraction]], rss: float, dof: int,
+            ) -> tuple[tuple[float, ...], float, tuple[tuple[float, ...], ...] | None]:
+    """Standard errors of the raw coefficients, residual standard deviation and covariance
+    of the scaled ones, from the QR factor ``r`` of the scaled design; NaN (None for the
+    covariance) when no degree of freedom is left. [Hz]"""
+    order = r.shape[0] - 1
     if dof > 0:
         sigma2 = rss / dof
         r_inv = np.linalg.solve(r, np.eye(order + 1))
@@ -542,16 +580,4 @@ def fit(temperatures_c: Any, frequencies_hz: Any, order: int = 3) -> Thermometer
         standard_errors = tuple(float("nan") for _ in range(order + 1))
         residual_std = float("nan")
         covariance = None
-    return Thermometer(
-        coefficients=raw,
-        standard_errors=standard_errors,
-        residual_std_hz=residual_std,
-        rsquared=rsquared,
-        temperature_range_c=(t_low, t_high),
-        order=order,
-        n_points=n,
-        centre_c=centre,
-        scale_c=scale,
-        scaled_coefficients=tuple(float(v) for v in a),
-        scaled_covariance=covariance,
-    )
+    return standard_errors, residual_std, covariance
