@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from hrgtc.core.errors import InputError
+from hrgtc.settings.compensation import ONE_SIGMA  # erf(1/√2), written once
 
 #: Power-law noise exponents α of S_y(f) ∝ f^α with a simple edf, SP 1065 Table 5 [3].
 NOISE_ALPHAS = {
@@ -33,8 +34,6 @@ GREENHALL_KINDS = {"allan": (2, False), "modified": (2, True), "time": (2, True)
                    "hadamard": (3, False)}
 #: Largest number of terms of Greenhall's basic sum before his asymptotic tables take over [4].
 GREENHALL_J_MAX = 100
-#: One-sigma confidence, erf(1/√2).
-ONE_SIGMA = 0.6826894921370859
 
 
 def equivalent_degrees_of_freedom(n_phase: int, m: int, noise_alpha: int = 0) -> float:
