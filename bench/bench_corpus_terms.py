@@ -29,18 +29,18 @@ def run(real, path: Path, directory: Path, terms: tuple[str, ...] | None) -> dic
     import pyarrow.parquet as pq
     from typer.testing import CliRunner
 
-    import hrgtc.drift.drift_model as drift_model
+    import hrgtc.drift.fit_stages as fit_stages
     from hrgtc.cli import app
 
     from real_corpus import line_figures, ratio_bound, split_s
 
-    guard = drift_model.guard_selection
+    guard = fit_stages.guard_selection
 
     def forced(*args, **kwargs):
         _, record = guard(*args, **kwargs)
         return terms, record
 
-    drift_model.guard_selection = guard if terms is None else forced
+    fit_stages.guard_selection = guard if terms is None else forced
     model, output = directory / "model.json", directory / "held.parquet"
     reading = real.read(path)
     cut = split_s(reading)
@@ -55,7 +55,7 @@ def run(real, path: Path, directory: Path, terms: tuple[str, ...] | None) -> dic
                 if result.exit_code != 0:
                     raise RuntimeError(result.output)
     finally:
-        drift_model.guard_selection = guard
+        fit_stages.guard_selection = guard
     document = json.loads(model.read_text())
     table = pq.read_table(output)
     time_s = table.column("time_s").to_numpy() - reading.origin_s

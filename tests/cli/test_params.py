@@ -213,11 +213,14 @@ def test_library_defaults_come_from_the_dataclasses():
     import inspect
 
     from hrgtc.drift import FeatureSettings, fit
+    from hrgtc.drift.fit_stages import drift_settings
     from hrgtc.recording import ReadOptions, describe, iter_chunks, read
 
-    fit_defaults = inspect.signature(fit).parameters
-    for name in ("window_s", "penter", "rate_tau_s", "select", "offsets"):
-        assert fit_defaults[name].default == getattr(DriftSettings(), name)
+    parameters = inspect.signature(fit).parameters  # one settings object, no field repeated
+    assert parameters["settings"].default is None
+    assert not {f.name for f in dataclasses.fields(DriftSettings)} & set(parameters)
+    assert drift_settings(None, {})[0] == DriftSettings()  # None: the fields' defaults
+    assert drift_settings(None, {"premove": 0.2})[0] == DriftSettings(premove=0.2)
     assert FeatureSettings(1.0, 1.0).rate_tau_s == DriftSettings().rate_tau_s
     fields = {f.name for f in dataclasses.fields(ReadSettings)}
     for function in (read, iter_chunks, describe):  # one options object, no field repeated

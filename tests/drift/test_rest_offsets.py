@@ -13,6 +13,7 @@ import pytest
 
 from hrgtc import drift
 from hrgtc.core.errors import CalibrationError
+from hrgtc.drift.fit_stages import TrainingReading
 from hrgtc.recording import Metadata, Recording
 from hrgtc.thermometry import identity
 
@@ -79,11 +80,11 @@ def test_a_recording_with_handling_gives_the_model_of_its_still_samples():
     top = model.ranges["f"][1] + model.settings.reference_freq_hz
     assert top == pytest.approx(25.0, abs=0.05)
     # the same file without the check: the handling drives the fit and the range
-    kept = quiet_fit([handled], THERMOMETER, terms=TERMS, motion="keep")
+    kept = quiet_fit([handled], THERMOMETER, terms=TERMS, reading=TrainingReading(motion="keep"))
     assert kept.ranges["f"][1] + kept.settings.reference_freq_hz > 27.0
     assert abs(kept.coefficients.get("f", 0.0) - 36.0) > 10 * model.standard_errors["f"]
     with pytest.raises(CalibrationError, match="not at rest"):
-        quiet_fit([handled], THERMOMETER, terms=TERMS, motion="error")
+        quiet_fit([handled], THERMOMETER, terms=TERMS, reading=TrainingReading(motion="error"))
 
 
 def test_the_still_model_matches_the_fit_of_the_same_run_without_handling():

@@ -11,7 +11,7 @@ fitted model (Eq. 22). ``rate_segments`` finds the holds of rate-table runs and
 [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
 """
 
-from hrgtc.drift.drift_model import DriftModel, fit, window_means
+from hrgtc.drift.drift_model import DriftModel, fit
 from hrgtc.drift.features import (
     EQ21,
     EQ21_TERMS,
@@ -41,7 +41,7 @@ from hrgtc.drift.scale_factor import (
     group_segments,
 )
 from hrgtc.drift.stepwise import Step, StepwiseResult, stepwise, stepwise_from_accumulator
-from hrgtc.drift.windows import TrainingWindows
+from hrgtc.drift.windows import TrainingWindows, window_means
 
 __all__ = [
     "EQ21",

@@ -29,6 +29,7 @@ from hrgtc.core import records
 from hrgtc.core.errors import CalibrationError, ExtrapolationWarning, HrgtcWarning, InputError
 from hrgtc.core.progress import StageProgress, for_stage
 from hrgtc.core.summary import Summary
+from hrgtc.drift.fit_stages import TrainingReading
 from hrgtc.drift.rest import run_rest
 from hrgtc.drift.training import (
     ChannelShape,
@@ -361,16 +362,11 @@ def _record(settings: CalibrationSettings, aux: Mapping[str, str] | None,
 def _fit(runs: Sequence[Any], thermometer: Any, drift: DriftSettings,
          aux: Mapping[str, str] | None, options: ReadOptions, progress: Any,
          excitation_runs: int = 0, rest_cache: dict[Any, Any] | None = None) -> Any:
-    """:func:`hrgtc.drift.fit` with ``drift``'s settings on the runs read by ``options``
+    """:func:`hrgtc.drift.fit` with ``drift`` whole on the runs read by ``options``
     (``rest_cache``: the at-rest passes shared by fits on the same runs)."""
-    return drift_model.fit(
-        runs, thermometer, terms=drift.terms or drift_model.EQ21, window_s=drift.window_s,
-        penter=drift.penter, premove=drift.premove, reference_c=drift.reference_c,
-        rate_tau_s=drift.rate_tau_s, options=drift.variable_options(), warmup_s=drift.warmup_s,
-        select=drift.select, offsets=drift.offsets, autocorrelation=drift.autocorrelation,
-        hierarchical=drift.hierarchical, aux_columns=aux,
-        excitation_runs=excitation_runs, progress=progress, motion=options.motion,
-        gaps=options.gaps, rest_cache=rest_cache)
+    reading = TrainingReading(motion=options.motion, gaps=options.gaps, rest_cache=rest_cache)
+    return drift_model.fit(runs, thermometer, drift, reading=reading, aux_columns=aux,
+                           excitation_runs=excitation_runs, progress=progress)
 
 
 class _CountedRun:
