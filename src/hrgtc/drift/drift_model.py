@@ -364,7 +364,7 @@ def fit(
         Time constant of each stage of the causal df/dt filter. [s]
     options
         The options the drift variables declare (the fields of
-        :data:`~hrgtc.settings.drift.DriftSettings` from their modules' ``Options``), by
+        :data:`~hrgtc.settings.drift.DriftSettings` from :mod:`hrgtc.settings.drift_variables`), by
         name: ``{"rate_tau2_s": 120.0}`` for the second df/dt filter of ``d2`` (default
         ``TAU2_FACTOR`` × ``rate_tau_s``); an option not given takes its default. Each
         variable the candidates use takes its settings from them (its ``derive``).
