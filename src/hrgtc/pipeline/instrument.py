@@ -559,9 +559,9 @@ def evaluate_instrument(
     model_source
         The model file's name, for the messages.
     """
-    from hrgtc.compensate.model_fit import check_thermometer_kind
     from hrgtc.compensate.multi_axis import match_axes, recording_axes
     from hrgtc.evaluation.instrument_pass import evaluate_axes
+    from hrgtc.model_fit import check_thermometer_kind
     from hrgtc.thermometry.reference import options_with_map
 
     options = options_with_map(read_options or ReadOptions(), model.temperature_map)

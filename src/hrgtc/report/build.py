@@ -18,7 +18,6 @@ from html import escape
 from pathlib import Path
 from typing import Any
 
-from hrgtc.compensate.model_fit import check_thermometer_kind
 from hrgtc.compensate.multi_axis import match_axes, recording_axes
 from hrgtc.core.errors import InputError
 from hrgtc.core.files import refuse_existing, write_text_atomic
@@ -32,6 +31,7 @@ from hrgtc.evaluation.calibration_figures import (
 from hrgtc.evaluation.glance_figures import GLANCE, instrument_glance_summary
 from hrgtc.evaluation.instrument_pass import evaluate_axes
 from hrgtc.model import InstrumentModel, UnitModel, load_instrument
+from hrgtc.model_fit import check_thermometer_kind
 from hrgtc.recording import ReadOptions, count_rows
 from hrgtc.report.figures import SoakTrace, trace_soak_axes
 from hrgtc.report.html import (
