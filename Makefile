@@ -41,8 +41,8 @@ lint: $(STAMP)
 docs: $(STAMP)
 	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict
 
-# Mutation testing of recording/, compensate/, export/ and files.py (pyproject's [tool.mutmut]); not
-# run by CI: the full set takes hours on 2 cores. MUTANTS narrows it, e.g.
+# Mutation testing of recording/, compensate/, export/, model_fit.py and files.py (pyproject's
+# [tool.mutmut]); not run by CI: the full set takes hours on 2 cores. MUTANTS narrows it, e.g.
 # make mutation MUTANTS='hrgtc.core.files.*' (JOBS: parallel mutants, default 2)
 MUTANTS ?=
 JOBS ?= 2

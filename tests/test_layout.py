@@ -9,8 +9,8 @@ inside functions and under ``TYPE_CHECKING``, which the ast check this file held
 - runs the contracts on ``src/hrgtc`` (so ``pytest`` alone checks them too),
 - makes sure every top-level module or package is placed in the layers contract (import-linter
   itself says nothing about a module that no contract names),
-- shows that the contracts can fail: an upward import, a lazy circle and an import of
-  ``hrgtc.cli`` planted in a copy of the package are each reported.
+- shows that the contracts can fail: an upward import, a lazy circle, an import of
+  ``hrgtc.cli`` and numpy in the settings planted in a copy of the package are each reported.
 """
 
 from __future__ import annotations
@@ -89,6 +89,9 @@ def test_the_package_root_imports_only_the_version():
     # the library importing the command line
     ("evaluation/_planted.py", "from hrgtc.cli import options\n",
      "Nothing imports the command line"),
+    # numpy in the settings, which hrgtc --help imports (lazily too)
+    ("settings/_planted.py", "def f():\n    import numpy\n",
+     "The settings import only the standard library"),
 ])
 def test_the_contracts_catch_a_planted_import(tmp_path, module, text, broken):
     copy = tmp_path / "hrgtc"

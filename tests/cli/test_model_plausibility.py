@@ -15,7 +15,6 @@ import re
 import pytest
 from typer.testing import CliRunner
 
-import hrgtc.cli.export_cmd  # noqa: F401  (registers the command)
 from hrgtc.cli import app
 from hrgtc.model import save_model
 from hrgtc.model_schema import derived_coefficients

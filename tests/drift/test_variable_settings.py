@@ -1,11 +1,12 @@
-"""A drift variable's settings live in its module: its command-line options (``Options``,
-read without importing the module) and where the fit gives its settings their values
-(``derive`` from the options, ``first_pass`` from the training runs).
+"""A drift variable's settings: its command-line options (declared with the other
+variables' in ``hrgtc.settings.drift_variables``, which imports no numpy) and where the fit
+gives its settings their values (``derive`` from the options, ``first_pass`` from the
+training runs, in its module).
 
-Generated from the registry where it can be: every module's declaration is compared with
-what ``DriftSettings`` got from its text, so a new variable's option is covered without a
-line here. The derivations are checked against their definitions computed independently
-(numpy on the same window means, the documented defaults).
+Generated from the declarations and the registry where it can be: every declared options
+class is compared with what ``DriftSettings`` got, so a new variable's option is covered
+without a line here. The derivations are checked against their definitions computed
+independently (numpy on the same window means, the documented defaults).
 """
 
 from __future__ import annotations
@@ -24,33 +25,31 @@ from hrgtc.core.errors import InputError
 from hrgtc.drift.variables import DRIFT_VARIABLES
 from hrgtc.drift.variables.d2 import TAU2_FACTOR
 from hrgtc.drift.variables.dpos import SWITCH_FRACTION
+from hrgtc.drift.variables.registry import check_declared, variable_modules
+from hrgtc.settings import setting
 from hrgtc.settings.drift import (
     VARIABLE_OPTIONS,
     WARMUP_FACTOR,
     DriftSettings,
-    declared_variables,
-    variable_modules,
     variable_options,
 )
+from hrgtc.settings.drift_variables import DECLARATIONS, Declaration
 
 from synthetic import THERMOMETER, lagged_run
 
+FOLDER = importlib.import_module("hrgtc.drift.variables").__path__[0]
 MODULES = {importlib.import_module(f"hrgtc.drift.variables.{name}").VARIABLE.name:
            importlib.import_module(f"hrgtc.drift.variables.{name}")
-           for name in variable_modules()}
+           for name in variable_modules(FOLDER)}
 
 
-def test_drift_settings_take_each_modules_declared_options():
-    """Each variable module's ``Options``, imported, is what ``DriftSettings`` read from its
-    text: the same fields, types, defaults and metadata (the panel filled), in grammar order,
-    after ``--rate-tau-s``."""
+def test_drift_settings_take_each_declared_option():
+    """Each declared options class is in ``DriftSettings``: the same fields, types, defaults
+    and metadata (the panel filled), in grammar order, after ``--rate-tau-s``."""
     declared = []
-    for v in DRIFT_VARIABLES:
-        options = getattr(MODULES[v.name], "Options", None)
-        if options is None:
-            continue
-        for name, kind in typing.get_type_hints(options).items():
-            declared.append((name, kind, getattr(options, name)))
+    for d in DECLARATIONS:
+        for name, kind in typing.get_type_hints(d.options or object).items():
+            declared.append((name, kind, getattr(d.options, name)))
     assert [name for name, _, _ in declared] == list(VARIABLE_OPTIONS) == ["rate_tau2_s"]
     fields = {f.name: f for f in dataclasses.fields(DriftSettings)}
     hints = typing.get_type_hints(DriftSettings)
@@ -63,20 +62,35 @@ def test_drift_settings_take_each_modules_declared_options():
     assert order[start:start + len(declared)] == [name for name, _, _ in declared]
 
 
-def test_the_text_declares_what_the_registry_holds():
-    """Each module's name and order as read from its text are its ``VARIABLE``'s, and the
-    ``--terms`` help lists the variables from them, in grammar order."""
+def test_the_declarations_are_what_the_registry_holds():
+    """The declared names are the modules' ``VARIABLE`` names in grammar order, and the
+    ``--terms`` help lists them in that order."""
     from hrgtc.settings import settings_of
 
-    read = [(d.name, d.order) for d in declared_variables()]
-    assert read == [(v.name, v.order) for v in DRIFT_VARIABLES]
+    assert [d.name for d in DECLARATIONS] == [v.name for v in DRIFT_VARIABLES]
+    assert [v.order for v in DRIFT_VARIABLES] == sorted(v.order for v in DRIFT_VARIABLES)
     (terms,) = [s for s in settings_of(DriftSettings) if s.name == "terms"]
     listed = terms.help.split("Variables: ")[1].rstrip(".").replace(" (--aux)", "")
     assert listed.split(", ") == [v.name for v in DRIFT_VARIABLES]
 
 
-def test_the_settings_read_no_variable_module():
-    """``hrgtc.settings.drift`` reads the declarations as text: neither numpy nor a variable
+def test_an_undeclared_or_misplaced_variable_is_refused():
+    """The registry refuses a module without a declaration, a declaration without a module
+    and the two in different orders, naming the file to edit."""
+    found = DRIFT_VARIABLES
+    check_declared(found)
+    new = dataclasses.replace(found[0], name="d3", order=99)
+    with pytest.raises(RuntimeError, match=r"settings/drift_variables\.py: not declared: "
+                                           r"\['d3'\]; add a Declaration\(name, options\)"):
+        check_declared((*found, new))
+    with pytest.raises(RuntimeError, match=r"declared without a module: \['a_NAME'\]"):
+        check_declared(found[:-1])
+    with pytest.raises(RuntimeError, match="the order differs"):
+        check_declared(found[::-1])
+
+
+def test_the_settings_import_no_variable_module():
+    """``hrgtc.settings.drift`` imports the declarations: neither numpy nor a variable
     module is imported (so ``hrgtc --help`` stays quick)."""
     code = ("import sys, hrgtc.settings.drift as d; assert d.VARIABLE_OPTIONS; "
             "print(sorted(m for m in sys.modules if m == 'numpy' or "
@@ -86,27 +100,19 @@ def test_the_settings_read_no_variable_module():
     assert out.stdout.strip() == "[]"
 
 
-def _module(folder, name, options, order, before=""):
-    (folder / f"{name}.py").write_text(
-        f"import numpy as np\n\nfrom hrgtc.settings import setting\n{before}\n\n"
-        f"class Options:\n{options}\n\nVARIABLE = make(name={name!r}, order={order})\n",
-        encoding="utf-8")
+def test_declared_options_in_grammar_order():
+    """Two declarations' options, in the declarations' order, the panel the drift model's
+    unless one is named; a declaration without options gives none."""
 
+    class Zeta:
+        zeta_s: float = setting(1.0, "Z.", unit="s")
 
-def test_declarations_are_read_in_grammar_order_from_text(tmp_path):
-    """Two modules (one importing numpy that is never run, one a constant it uses): their
-    options in the order of their ``order=``, the panel the drift model's; the registry's
-    other modules and those without ``Options`` give none."""
-    _module(tmp_path, "zeta", '    zeta_s: float = setting(1.0, "Z.", unit="s")', 2)
-    _module(tmp_path, "alpha", '    alpha_s: float | None = setting(\n        None, "A.", '
-            'default_text=f"{FACTOR:g} × --rate-tau-s", panel="Mine")', 9,
-            before="FACTOR = 3.0\nNOT_LITERAL = np.pi")
-    (tmp_path / "spec.py").write_text("class Options:\n    x: int = 1\n", encoding="utf-8")
-    (tmp_path / "plain.py").write_text("import numpy\n\nVARIABLE = make(name='plain', order=5)\n",
-                                       encoding="utf-8")
-    assert [(d.name, d.order) for d in declared_variables(tmp_path)] == [
-        ("zeta", 2), ("plain", 5), ("alpha", 9)]
-    found = variable_options(tmp_path)
+    class Alpha:
+        alpha_s: float | None = setting(None, "A.", default_text="3 × --rate-tau-s",
+                                        panel="Mine")
+
+    found = variable_options((Declaration("zeta", Zeta), Declaration("plain"),
+                              Declaration("alpha", Alpha)))
     assert [(name, kind) for name, kind, _ in found] == [("zeta_s", float),
                                                          ("alpha_s", float | None)]
     assert found[0][2].metadata["panel"] == "Drift model" and found[0][2].default == 1.0
@@ -114,16 +120,13 @@ def test_declarations_are_read_in_grammar_order_from_text(tmp_path):
     assert found[1][2].metadata["panel"] == "Mine"
 
 
-def test_a_declaration_that_needs_the_module_is_refused(tmp_path):
-    _module(tmp_path, "bad", '    bad_s: float = setting(float(np.pi), "B.")', 3)
-    with pytest.raises(RuntimeError, match=r"bad\.py: its Options declaration uses 'np'"):
-        variable_options(tmp_path)
-    _module(tmp_path, "bad", '    bad_s: float = 3.0', 3)
-    with pytest.raises(RuntimeError, match=r"bad\.py: Options\.bad_s is not a setting"):
-        variable_options(tmp_path)
-    (tmp_path / "bad.py").write_text("import numpy\n", encoding="utf-8")
-    with pytest.raises(RuntimeError, match=r"bad\.py: .*VARIABLE = DriftVariable.*literal name"):
-        variable_options(tmp_path)
+def test_an_option_that_is_not_a_setting_is_refused():
+    class Bad:
+        bad_s: float = 3.0
+
+    with pytest.raises(RuntimeError, match=r"Bad\.bad_s \(drift variable bad\) is not a "
+                                           r"setting"):
+        variable_options((Declaration("bad", Bad),))
 
 
 def test_derivations_from_the_options():

@@ -379,3 +379,38 @@ def test_both_builds_declare_the_same_interface_from_one_template(kind, models, 
     assert "float" not in double.split("#ifndef")[1] and "double" not in re.sub(
         r"/\*.*?\*/", "", single.split("#ifndef")[1].replace("((float)((freq_hz)", ""),
         flags=re.S)
+
+
+AUX_MODEL = (Path(__file__).parents[1] / "data" / "golden-models" / "v2"
+             / "unit-g-d2-aux-ee60050.json")
+
+
+@pytest.mark.parametrize("kind", ["frequency", "housing", "gradient", "aux"])
+def test_both_builds_write_one_body(kind, models, tmp_path):
+    """The double and the float ``.c`` are one body printed in two types
+    (``export.c.source``): the same constants, functions and statements of ``step()``, in
+    the same order, besides what float32 needs (the frequency centred by the caller, so no
+    REFERENCE_FREQ_HZ; the filters' time constants in float too, RATE_TAU and d2's
+    RATE2_TAU). Before, two
+    copies had drifted: the float build named an extra channel's ranges RANGE_A_CHAMBER_*
+    beside its own CLAMP_A_chamber_* and the double build's RANGE_A_chamber_*."""
+    model = AUX_MODEL if kind == "aux" else models[kind]
+    double = export_c(model, tmp_path / "d")[1].read_text()
+    single = export_c(model, tmp_path / "s", precision="single")[1].read_text()
+
+    def body(text: str) -> tuple[list[str], list[str], list[str]]:
+        constants = re.findall(r"^static const \w+ (\w+)", text, flags=re.M)
+        functions = re.findall(r"^(?:static )?\w+ \**(\w+)\(", text, flags=re.M)
+        step = text[text.index("_step("):]
+        statements = re.findall(r"^    +(\w+(?:->\w+)*) [+-]?= ", step, flags=re.M)
+        return constants, functions, statements
+
+    d_constants, d_functions, d_statements = body(double)
+    s_constants, s_functions, s_statements = body(single)
+    assert [c for c in d_constants if c != "REFERENCE_FREQ_HZ"] == [
+        c for c in s_constants if not re.fullmatch(r"RATE2?_TAU", c)]
+    assert "REFERENCE_FREQ_HZ" in d_constants and "RATE_TAU" in s_constants
+    assert [f.replace("centred_", "") for f in s_functions] == d_functions
+    assert s_statements == d_statements
+    if kind == "aux":
+        assert "RANGE_A_chamber_LOW" in double and "RANGE_A_chamber_LOW" in single

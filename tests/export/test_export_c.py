@@ -24,9 +24,8 @@ import pytest
 from scipy import signal
 from typer.testing import CliRunner
 
-import hrgtc.cli.export_cmd  # noqa: F401  (registers the command)
 from hrgtc import drift, thermometry
-from hrgtc.cli._app import app
+from hrgtc.cli import app
 from hrgtc.compensate import Compensator
 from hrgtc.core.errors import CalibrationError, InputError, OutputExistsError
 from hrgtc.core.timeline import settle_threshold_s

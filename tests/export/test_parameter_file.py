@@ -241,8 +241,7 @@ def test_params_export_of_every_model_the_demo_writes(paper_campaign, imu_campai
 
     from typer.testing import CliRunner
 
-    import hrgtc.cli.export_cmd  # noqa: F401  (registers the command)
-    from hrgtc.cli._app import app
+    from hrgtc.cli import app
     from hrgtc.core.errors import HrgtcWarning
     from hrgtc.model import save_instrument, save_model
     from hrgtc.pipeline.calibration import calibrate

@@ -145,7 +145,7 @@ def test_single_axis_model_is_the_one_axis_case(calibration):
 
 def test_axis_read_options_check_that_axis_only(calibration, imu_campaign):
     """The plausible band of axis y's model is checked on freq_hz_y, not on x's column."""
-    from hrgtc.compensate.model_fit import plausible_frequency_band
+    from hrgtc.model_fit import plausible_frequency_band
 
     band = plausible_frequency_band(calibration.model.axes["y"])
     options = ReadOptions(axis="y", freq_band_hz=band, freq_span_hz=band)

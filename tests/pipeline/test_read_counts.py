@@ -144,6 +144,35 @@ def test_calibrate_reads_each_file_once_for_every_axis(campaign):
         assert passes == ([6, 7, 2] if rate_free else [4, 5, 2])
 
 
+def test_calibrate_checks_each_training_file_for_a_mark_once(campaign, monkeypatch):
+    """Whether a training file is a compensated output is asked once per command, whatever
+    the number of axes (``refuse_compensated_training`` in ``calibrate_instrument``, then
+    ``calibrate(..., marks_checked=True)`` for each axis); before: once more per axis (2
+    for one axis, 4 for three, each an open of the file's metadata). With three axes a
+    soak file is opened twice: that check and the one reading every axis shares."""
+    import hrgtc.recording.marks as marks
+
+    checked: list[str] = []
+    real = marks.refuse_compensated
+
+    def counted(path, training=False):
+        checked.append(Path(path).name)
+        return real(path, training)
+
+    monkeypatch.setattr(marks, "refuse_compensated", counted)
+    args = ["calibrate", "--soak", *campaign["soaks"], "--drift", campaign["cool"],
+            "--validate", campaign["warm"], "-o", campaign["model"].with_name("m.json"),
+            "--force"]
+    counts = _counts(args)
+    files = [*campaign["soaks"], campaign["cool"], campaign["warm"]]
+    assert sorted(checked) == sorted(f.name for f in files)
+    if "imu" in str(campaign["cool"]):
+        assert counts.of(campaign["soaks"][0])[0] == 2
+        checked.clear()
+        _counts([*args, "--cross-axis"])
+        assert sorted(checked) == sorted(f.name for f in files)
+
+
 def test_reading_once_gives_the_same_instrument_model(campaign, monkeypatch):
     """The model from one reading of each file equals the model from reading them per
     axis, as before (the cached chunks are the streamed chunks)."""

@@ -1,24 +1,20 @@
 """The ``hrgtc`` command: thin commands over the library.
 
-Each command module registers itself on :data:`hrgtc.cli._app.app` when imported.
+The commands are the entry points of the group ``hrgtc.commands`` (hrgtc's own are
+declared in ``pyproject.toml``, one function of a ``*_cmd`` module each, ``fleet`` a
+``typer.Typer``), added to :data:`hrgtc.cli._app.app` when this package is imported
+(:mod:`hrgtc.cli.commands`). Each command imports the library inside its function, so
+``hrgtc --help`` loads no stage.
 """
 
 from __future__ import annotations
 
-from hrgtc.cli import (
-    calibrate_cmd,  # noqa: F401
-    compensate_cmd,  # noqa: F401
-    demo_cmd,  # noqa: F401
-    export_cmd,  # noqa: F401
-    fleet_cmd,  # noqa: F401
-    info_cmd,  # noqa: F401
-    paper_cmd,  # noqa: F401  (registers commands)
-    report_cmd,  # noqa: F401
-    simulate_cmd,  # noqa: F401
-)
 from hrgtc.cli._app import app
+from hrgtc.cli.commands import register_commands
 
 __all__ = ["app", "main"]
+
+register_commands(app)
 
 
 def main() -> None:

@@ -1,7 +1,8 @@
 """The Typer application object and the helpers every command shares.
 
-Commands live in their own modules of this package and register themselves on
-:data:`app`; library errors are turned into a one-line message and exit code 2.
+Commands live in their own modules of this package, as plain functions that
+:mod:`hrgtc.cli.commands` adds to :data:`app` (the entry points ``hrgtc.commands``);
+library errors are turned into a one-line message and exit code 2.
 """
 
 from __future__ import annotations

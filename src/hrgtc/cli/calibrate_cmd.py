@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from hrgtc.cli._app import app, console, error_console, fail, library_errors, print_json
+from hrgtc.cli._app import console, error_console, fail, library_errors, print_json
 from hrgtc.cli.compensate_cmd import warn_ranges
 from hrgtc.cli.options import (
     STRICT_EXIT,
@@ -43,7 +43,6 @@ def render(result: CalibrationResult, temperature_map: dict[str, Any] | None = N
     print_summary(result.summary(warnings=False, temperature_map=temperature_map), console)
 
 
-@app.command("calibrate")
 @reading_options
 @settings_options(CalibrationSettings)
 @settings_options(CalibrationInputs, "given")

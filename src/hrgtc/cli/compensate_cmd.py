@@ -8,7 +8,6 @@ from typing import TYPE_CHECKING
 import typer
 
 from hrgtc.cli._app import (
-    app,
     console,
     error_console,
     library_errors,
@@ -72,7 +71,6 @@ def warn_ranges(reports: list[RangeReport | None], json_output: bool, strict: bo
         raise typer.Exit(STRICT_EXIT)
 
 
-@app.command("compensate")
 @reading_options
 def compensate_command(
     run: Path = typer.Argument(..., help="Recording to compensate (.parquet, .csv, .h5)."),
@@ -143,7 +141,6 @@ def render_evaluation(result: Evaluation, sensor: bool = False) -> None:
                       f"{paper.BIAS_STABILITY_COMPENSATED_DPH} °/h", markup=False)
 
 
-@app.command("evaluate")
 @reading_options
 def evaluate_command(
     run: Path = typer.Argument(..., help="Recording to evaluate."),

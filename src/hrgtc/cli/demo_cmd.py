@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from hrgtc.cli._app import app, console, error_console, library_errors, print_json
+from hrgtc.cli._app import console, error_console, library_errors, print_json
 from hrgtc.cli.calibrate_cmd import render, render_instrument
 from hrgtc.cli.compensate_cmd import render_evaluation
 from hrgtc.cli.options import ForceOption, JsonOption
@@ -14,7 +14,6 @@ from hrgtc.cli.params import option
 from hrgtc.settings.fleet import DemoSettings
 
 
-@app.command("demo")
 def demo_command(
     output: Path = typer.Option(Path("demo-out"), "-o", "--output", help="Folder to write into."),
     quick: bool = typer.Option(

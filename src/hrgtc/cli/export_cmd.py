@@ -7,13 +7,12 @@ from pathlib import Path
 
 import typer
 
-from hrgtc.cli._app import app, console, library_errors, print_json
+from hrgtc.cli._app import console, library_errors, print_json
 from hrgtc.cli.options import ForceOption, JsonOption
 from hrgtc.cli.params import option
 from hrgtc.settings.export import ExportSettings
 
 
-@app.command("export-c")
 def export_c_command(
     model: Path = typer.Argument(
         ..., help="Model file written by 'hrgtc calibrate' (one gyro, or every axis of an "

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from hrgtc.cli._app import app, console, error_console, library_errors, print_json, progress_bar
+from hrgtc.cli._app import console, error_console, library_errors, print_json, progress_bar
 from hrgtc.cli.options import ForceOption, JsonOption, reading_options
 from hrgtc.cli.params import option, settings_options, split_values
 from hrgtc.settings.calibration import CalibrationSettings, ThermometerSettings
@@ -28,7 +28,6 @@ fleet_app = typer.Typer(
     name="fleet", no_args_is_help=True, rich_markup_mode=None,
     help="Many units: simulate, calibrate, evaluate and report them as tasks on Dask, and "
     "build the population prior that cuts chamber time.")
-app.add_typer(fleet_app)
 
 def _models_folder_inputs(models: Path) -> list[Path]:
     """The files of a models folder that fleet commands read (never an output, see -o)."""

@@ -7,14 +7,13 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from hrgtc.cli._app import app, console, fail, library_errors, print_json
+from hrgtc.cli._app import console, fail, library_errors, print_json
 from hrgtc.cli.options import JsonOption, reading_options
 
 if TYPE_CHECKING:
     from hrgtc.recording import ReadOptions
 
 
-@app.command("info")
 @reading_options
 def info(
     file: Annotated[Path, typer.Argument(help="Recording (.parquet, .pq, .csv, .h5, .hdf5).")],

@@ -4,10 +4,9 @@ from __future__ import annotations
 
 import typer
 
-from hrgtc.cli._app import app, console, library_errors, print_json
+from hrgtc.cli._app import console, library_errors, print_json
 
 
-@app.command("paper")
 def paper_command(
     json_output: bool = typer.Option(False, "--json", help="Print JSON instead of tables."),
 ) -> None:

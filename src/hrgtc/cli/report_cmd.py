@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from hrgtc.cli._app import app, console, library_errors, print_json, progress_bar
+from hrgtc.cli._app import console, library_errors, print_json, progress_bar
 from hrgtc.cli.options import AxesOption, ForceOption, JsonOption, reading_options
 from hrgtc.cli.params import option
 from hrgtc.settings.compensation import ReportSettings
@@ -16,7 +16,6 @@ if TYPE_CHECKING:
     from hrgtc.recording import ReadOptions
 
 
-@app.command("report")
 @reading_options
 def report_command(
     runs: list[Path] = typer.Argument(

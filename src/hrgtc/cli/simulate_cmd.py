@@ -9,7 +9,7 @@ from typing import Annotated
 
 import typer
 
-from hrgtc.cli._app import app, console, library_errors, print_json, progress_bar
+from hrgtc.cli._app import console, library_errors, print_json, progress_bar
 from hrgtc.cli.options import ForceOption, JsonOption, OutputFormat
 from hrgtc.cli.params import settings_options
 from hrgtc.settings.simulation import (
@@ -21,7 +21,6 @@ from hrgtc.settings.simulation import (
 )
 
 
-@app.command("simulate")
 @settings_options(LoggerSettings, "logger_settings")
 @settings_options(SimulationSettings, "settings")
 def simulate_command(

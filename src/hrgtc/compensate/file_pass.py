@@ -22,7 +22,6 @@ import numpy as np
 from hrgtc import recording as rec_io
 from hrgtc.compensate.at_rest import DETECTOR_COLUMNS, FlagsMisaligned, RestFlags
 from hrgtc.compensate.compensator import Compensator, output_columns
-from hrgtc.compensate.model_fit import check_recording_noise, with_model_band
 from hrgtc.compensate.ranges import RangeReport
 from hrgtc.core.accounting import Accounting
 from hrgtc.core.errors import InputError
@@ -31,6 +30,7 @@ from hrgtc.core.progress import Progress
 from hrgtc.core.time_steps import TimeRepairStream
 from hrgtc.core.timeline import RESTARTS_KEY
 from hrgtc.model import InstrumentModel, UnitModel
+from hrgtc.model_fit import check_recording_noise, with_model_band
 from hrgtc.recording import Recording
 from hrgtc.recording.marks import COMPENSATED_KEY, mark, refuse_compensated
 from hrgtc.recording.spikes import SPIKE_COLUMN

@@ -19,11 +19,11 @@ import numpy as np
 from hrgtc import recording as rec_io
 from hrgtc.compensate.compensator import Compensator, output_columns
 from hrgtc.compensate.file_pass import CompensationSummary, compensate_file
-from hrgtc.compensate.model_fit import check_thermometer_kind, plausible_frequency_band
 from hrgtc.compensate.ranges import RangeReport
 from hrgtc.core.errors import InputError, RecordingError
 from hrgtc.core.progress import Progress
 from hrgtc.model import InstrumentModel, UnitModel, axis_suffix
+from hrgtc.model_fit import check_thermometer_kind, plausible_frequency_band
 from hrgtc.recording import Recording, axis_names, axis_view
 from hrgtc.recording.axes import AXIS_PATTERN
 from hrgtc.settings.compensation import CompensateSettings
@@ -50,7 +50,7 @@ class InstrumentCompensator:
         As :class:`~hrgtc.compensate.compensator.Compensator`, for every axis.
     bands_hz
         Axis -> plausible frequency band (see
-        :func:`~hrgtc.compensate.model_fit.plausible_frequency_band`): a sample
+        :func:`~hrgtc.model_fit.plausible_frequency_band`): a sample
         outside is an error naming its column and row, as the reader does for a
         single-axis file. None: not checked here.
     partial

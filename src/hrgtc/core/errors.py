@@ -107,3 +107,8 @@ class SlowChannelWarning(HrgtcWarning):
 class FormatPluginWarning(HrgtcWarning):
     """A file format of another package (entry point ``hrgtc.formats``) could not be loaded
     and was left out; the other formats are read as usual."""
+
+
+class CommandPluginWarning(HrgtcWarning):
+    """A command of another package (entry point ``hrgtc.commands``) could not be loaded, or
+    takes a name already taken, and was left out; the other commands run as usual."""

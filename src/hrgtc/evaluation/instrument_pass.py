@@ -19,18 +19,18 @@ from pathlib import Path
 
 import numpy as np
 
-from hrgtc.compensate.model_fit import (
-    check_recording_noise,
-    check_thermometer_kind,
-    plausible_frequency_band,
-    with_model_band,
-)
 from hrgtc.core.progress import Progress
 from hrgtc.drift.rest import run_rest
 from hrgtc.evaluation.evaluation_result import Evaluation
 from hrgtc.evaluation.plot_blocks import block_rows
 from hrgtc.evaluation.run_pass import RunPass, RunPlan, count_dropped
 from hrgtc.model import InstrumentModel
+from hrgtc.model_fit import (
+    check_recording_noise,
+    check_thermometer_kind,
+    plausible_frequency_band,
+    with_model_band,
+)
 from hrgtc.recording import ReadOptions, Recording, axis_view, count_rows
 from hrgtc.recording.io import check_axis_band
 from hrgtc.recording.marks import refuse_compensated

@@ -29,7 +29,6 @@ from typing import Any
 import numpy as np
 
 from hrgtc.compensate import Compensator
-from hrgtc.compensate.model_fit import check_recording_noise, with_model_band
 from hrgtc.core.accounting import Accounting
 from hrgtc.core.errors import HrgtcError, InputError, RecordingError
 from hrgtc.core.progress import Progress
@@ -51,6 +50,7 @@ from hrgtc.evaluation.plot_blocks import BlockMeans, block_rows
 from hrgtc.evaluation.series_stats import SeriesStatistics
 from hrgtc.evaluation.settling_cut import SettlingCut
 from hrgtc.model import UnitModel
+from hrgtc.model_fit import check_recording_noise, with_model_band
 from hrgtc.recording import ReadOptions, Recording, count_rows
 from hrgtc.recording.marks import compensation_mark, describe_mark, refuse_compensated
 from hrgtc.settings.compensation import EvaluationSettings

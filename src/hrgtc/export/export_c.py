@@ -30,11 +30,12 @@ With ``-ffp-contract=off`` (GCC's default under ``-std=c99``) the filter, the
 thermometer polynomial and the terms round exactly as NumPy does; what remains
 (the order of the final sum, the Newton iteration's last step) is at the
 rounding level: about 1e-14 °/h and 3e-12 °C. The C text is printed by
-:mod:`hrgtc.export.c.text`.
+:mod:`hrgtc.export.c.text` (the header) and :mod:`hrgtc.export.c.source` (the ``.c``
+file: one body, in double or in float).
 
 ``precision="single"`` writes the float32 build for FPU-only microcontrollers
-(:mod:`hrgtc.export.c.single`; centred frequency input), whose worst error against
-the double model is measured at export by its numpy float32 mirror
+(centred frequency input; :mod:`hrgtc.export.c.single` writes its header's own sections),
+whose worst error against the double model is measured at export by its numpy float32 mirror
 (:mod:`hrgtc.export.c.float32`) and stated in the header. ``output_format="params"``
 writes the plain parameter file of :mod:`hrgtc.export.parameter_file` instead.
 
@@ -54,7 +55,8 @@ from hrgtc.core.files import file_sha256, refuse_existing, refuse_input, write_t
 from hrgtc.export.c import single as c_single
 from hrgtc.export.c.float32 import float_accuracy, float_constants
 from hrgtc.export.c.plan import PRECISIONS, plan_for
-from hrgtc.export.c.text import _comment, header, source, title
+from hrgtc.export.c.source import source
+from hrgtc.export.c.text import _comment, header, title
 from hrgtc.export.parameter_file import instrument_parameter_text, parameter_text
 from hrgtc.model import InstrumentModel, UnitModel, load_instrument
 from hrgtc.settings.export import EXPORT_FORMATS, ExportSettings
@@ -206,7 +208,7 @@ def _c_texts(model: UnitModel, prefix: str, origin: str, sha256: str,
         constants = float_constants(model, plan)
         accuracy = float_accuracy(model, plan, constants)
         return (c_single.header(model, plan, prefix, origin, sha256, constants, accuracy),
-                c_single.source(model, plan, prefix, constants))
+                source(model, plan, prefix, constants))
     return header(model, plan, prefix, origin, sha256), source(model, plan, prefix)
 
 

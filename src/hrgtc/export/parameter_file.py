@@ -25,7 +25,8 @@ from hrgtc.drift.features import settle_rows
 from hrgtc.drift.variables import DRIFT_VARIABLES, ascii_unit, refusal, variable
 from hrgtc.export.c.header import sensor_words
 from hrgtc.export.c.plan import CPlan
-from hrgtc.export.c.text import NEWTON_MAX_ITER, offsets_note, sensor_note, title
+from hrgtc.export.c.text import offsets_note, sensor_note, title
+from hrgtc.export.c.thermometer import NEWTON_MAX_ITER
 from hrgtc.export.c.types import DOUBLE
 from hrgtc.model import UnitModel
 

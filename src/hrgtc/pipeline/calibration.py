@@ -180,6 +180,7 @@ def calibrate(
     prior: ThermometerPrior | PathLike | None = None,
     thermometer: str = ReadSettings.thermometer,
     soak_fit: SoakFit | None = None,
+    marks_checked: bool = False,
 ) -> CalibrationResult:
     """Calibrate a unit: thermometer from soaks, drift model from ramps, held-out validation.
 
@@ -231,12 +232,16 @@ def calibrate(
         :func:`fit_soaks`): its plateaus, Tables 1-2 and thermometer are reused and only
         the drift model is fitted (``--cross-axis`` refits the drift model with more
         candidate terms on the same files).
+    marks_checked
+        The caller refused compensated outputs among these files already (once per
+        command: :func:`~hrgtc.pipeline.instrument.calibrate_instrument`, for every axis).
     """
     options = read_options or ReadOptions()
     settings = settings or CalibrationSettings()
     if not drifts:
         raise InputError("no drift recordings given; pass --drift FILE (a cool-down or warm-up)")
-    refuse_compensated_training([*soaks, *drifts, *validate])
+    if not marks_checked:
+        refuse_compensated_training([*soaks, *drifts, *validate])
     if thermometer == "sensor":
         return _calibrate_sensor(soaks, drifts, validate, options, progress, settings, aux,
                                  housing_terms, soak_fit)
@@ -265,8 +270,7 @@ def calibrate(
             f"{len(soaks) - len(extra)} soak file(s) are not at the drift runs' "
             f"{drift_rate:g} Hz and are left out of the drift fit (its windows and settling "
             "time are counted in samples at one rate); they still calibrate the thermometer",
-            HrgtcWarning, stacklevel=2,
-        )
+            HrgtcWarning, stacklevel=2)
     training = [*drifts, *(extra if settings.drift_from_soaks else ())]
     training_heads = [heads[str(p)] for p in training]
     settings = _with_terms(settings, resolve_terms(settings.drift.terms, aux, training_heads))
@@ -279,22 +283,15 @@ def calibrate(
                              "range_c": list(prior_fit.prior.temperature_range_c),
                              "max_temperature_std_c": prior_fit.max_temperature_std_c}
     unit_model = UnitModel(
-        thermometer=thermometer_fit,
-        drift=model,
-        housing=housing,
-        unit=unit,
+        thermometer=thermometer_fit, drift=model, housing=housing, unit=unit,
         training=TrainingStatistics.from_runs(training_heads),
         plateaus=tuple(p.to_dict() for p in plateaus),
         provenance=provenance(
             {"soak": [str(p) for p in soaks], "drift": [str(p) for p in drifts],
-             "validate": [str(p) for p in validate]},
-            record,
-        ),
+             "validate": [str(p) for p in validate]}, record),
     )
-    validation = tuple(
-        evaluate(path, unit_model, settings=BIAS_ONLY, read_options=options)
-        for path in validate
-    )
+    validation = tuple(evaluate(path, unit_model, settings=BIAS_ONLY, read_options=options)
+                       for path in validate)
     return CalibrationResult(unit_model, tuple(plateaus), table, validation, prior_fit,
                              fitted)
 

@@ -256,7 +256,7 @@ def calibrate_instrument(
         staged = None if progress is None else _prefixed(progress, axis)
         result = calibrate(soaks, drifts, (), settings=settings, aux=aux,
                            housing_terms=housing_terms, prior=prior, read_options=axis_read,
-                           progress=staged, thermometer=thermometer)
+                           progress=staged, thermometer=thermometer, marks_checked=True)
         if cross_axis and len(axes) > 1:
             result, crossed[axis] = _cross_axis(result, axis, axes, soaks, drifts, validate,
                                                 axis_read, staged, thermometer, fit)
@@ -341,7 +341,8 @@ def _cross_axis(result: CalibrationResult, axis: str, axes: Sequence[str],
     trial = calibrate(soaks, drifts, (), settings=fit["settings"], aux=aux,
                       housing_terms=fit["housing_terms"], prior=fit["prior"],
                       read_options=options, progress=progress, thermometer=thermometer,
-                      soak_fit=result.soak_fit)  # the same thermometer: the drift fit only
+                      soak_fit=result.soak_fit,  # the same thermometer: the drift fit only
+                      marks_checked=True)
 
     def held_out(model: UnitModel) -> float:
         return float(np.median([evaluate(path, model, settings=BIAS_ONLY, read_options=options)
@@ -559,9 +560,9 @@ def evaluate_instrument(
     model_source
         The model file's name, for the messages.
     """
-    from hrgtc.compensate.model_fit import check_thermometer_kind
     from hrgtc.compensate.multi_axis import match_axes, recording_axes
     from hrgtc.evaluation.instrument_pass import evaluate_axes
+    from hrgtc.model_fit import check_thermometer_kind
     from hrgtc.thermometry.reference import options_with_map
 
     options = options_with_map(read_options or ReadOptions(), model.temperature_map)

@@ -60,35 +60,46 @@ def describe_mark(found: Mapping[str, Any]) -> str:
     return f"model {sha} (unit {unit}, hrgtc {version})"
 
 
-def refuse_compensated(path: str | Path) -> None:
-    """Raise RecordingError if the file at ``path`` is the output of a compensation."""
+#: What compensating twice would do, by what the file was given for.
+_CONSEQUENCE = {
+    False: "compensating or evaluating it again would subtract the drift twice: use the "
+           "original recording",
+    True: "a model trained on it would fit what that compensation left, not the gyro's "
+          "drift: calibrate on the original (raw) recording",
+}
+
+
+def refuse_compensated(path: str | Path, training: bool = False) -> None:
+    """Raise RecordingError if the file at ``path`` is the output of a compensation.
+
+    Opens the file for its metadata and column names only. ``training``: the file was
+    given to train a model (the message says what that would fit); else to be
+    compensated or evaluated.
+    """
     from hrgtc.recording.io import open_source
 
     with open_source(path) as source:
         found = compensation_mark(source.metadata, list(source.names))
     if found is not None:
-        raise RecordingError(
-            f"{path} is already compensated, by {describe_mark(found)}; compensating or "
-            "evaluating it again would subtract the drift twice: use the original recording")
+        raise RecordingError(f"{path} is already compensated, by {describe_mark(found)}; "
+                             f"{_CONSEQUENCE[training]}")
 
 
 def refuse_compensated_training(paths: Iterable[str | Path | None]) -> None:
-    """Raise RecordingError if a file given to train a model is a compensated output.
+    """Raise RecordingError if a file given to train a model is a compensated output
+    (:func:`refuse_compensated` of each, ``training=True``).
 
     A model trained on a compensated run fits what the first model left (its rate
     column may even be ``rate_comp_dph`` under another name), not the gyro's drift;
     the thermometer of its soaks would be the same as the raw run's, so nothing
-    later would show it.
+    later would show it. A file given twice (a soak that is also a drift run) is opened
+    once; call it once per command (``calibrate(..., marks_checked=True)`` after).
     """
-    from hrgtc.recording.io import open_source
-
+    seen = set()
     for path in paths:
         if path is None or not Path(path).is_file():
             continue  # a missing file is named by the reading that follows
-        with open_source(path) as source:
-            found = compensation_mark(source.metadata, list(source.names))
-        if found is not None:
-            raise RecordingError(
-                f"{path} is already compensated, by {describe_mark(found)}; a model trained "
-                "on it would fit what that compensation left, not the gyro's drift: "
-                "calibrate on the original (raw) recording")
+        key = Path(path).resolve()
+        if key not in seen:
+            seen.add(key)
+            refuse_compensated(path, training=True)

@@ -16,13 +16,13 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from hrgtc.compensate.model_fit import check_thermometer_kind
 from hrgtc.compensate.multi_axis import match_axes, recording_axes
 from hrgtc.core.errors import InputError
 from hrgtc.core.progress import Progress
 from hrgtc.evaluation import Evaluation
 from hrgtc.evaluation.instrument_pass import evaluate_axes
 from hrgtc.model import InstrumentModel, UnitModel, load_instrument
+from hrgtc.model_fit import check_thermometer_kind
 from hrgtc.recording import ReadOptions, count_rows
 from hrgtc.report.figures import SoakTrace, trace_soak_axes
 from hrgtc.settings.compensation import ReportSettings

@@ -5,6 +5,10 @@ and a slow rate (a thermal lag between the resonator and the part of the gyro wh
 temperature drives the bias). In C the same ``rate_update`` as df's filter, its own state
 ``f2_filter`` and constant ``RATE2_TAU_S``, so the rounding is hrgtc's; the float32 build
 runs the float filter of df (differences, compensated sums) with ``RATE2_TAU``.
+
+Its command-line option, ``--rate-tau2-s``, is declared with the other variables' in
+:mod:`hrgtc.settings.drift_variables` (``D2Options``), which ``hrgtc --help`` reads without
+loading numpy; :func:`derive` gives it its value.
 """
 
 from __future__ import annotations
@@ -16,23 +20,7 @@ import numpy as np
 
 from hrgtc.core import records
 from hrgtc.drift.variables.spec import DriftVariable, Inputs, Put
-from hrgtc.settings import setting
-
-#: The second filter is this many times slower than the first by default.
-TAU2_FACTOR = 6.0
-
-
-class Options:
-    """d2's command-line option, a field of ``DriftSettings`` (``hrgtc calibrate
-    --rate-tau2-s``).
-
-    :mod:`hrgtc.settings.drift` runs this class statement alone, from this file's text
-    (``hrgtc --help`` loads no numpy): it may use ``setting`` and literal constants above.
-    """
-
-    rate_tau2_s: float | None = setting(
-        None, "Time constant of the second df/dt filter, variable d2 (terms like d2, f*d2).",
-        unit="s", default_text=f"{TAU2_FACTOR:g} × --rate-tau-s")
+from hrgtc.settings.drift_variables import TAU2_FACTOR
 
 
 def compute(inputs: Inputs, name: str) -> np.ndarray:

@@ -3,7 +3,7 @@
 f_ref is the thermometer's frequency at ``reference_c``. With the gyro's temperature
 sensor as thermometer (``calibrate --thermometer sensor``) the sensor's reading takes the
 frequency's place, so f is in °C. Its C code is the export's skeleton
-(:mod:`hrgtc.export.c.text`), its kernel row the first of :mod:`hrgtc.compensate._kernel`.
+(:mod:`hrgtc.export.c.source`), its kernel row the first of :mod:`hrgtc.compensate._kernel`.
 
 [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
 """

@@ -34,13 +34,15 @@ that sensor in the place of the frequency, so f is in °C and its rates in °C/s
 from __future__ import annotations
 
 import importlib
+import os
 import re
 import sys
+from pathlib import Path
 from typing import Any
 
 from hrgtc.drift.variables.aux import AUX_PREFIX
 from hrgtc.drift.variables.spec import BACKENDS, DriftVariable
-from hrgtc.settings.drift import variable_modules
+from hrgtc.settings.drift_variables import DECLARATIONS, Declaration
 
 __all__ = ["AUX_PREFIX", "BACKENDS", "BACKEND_NAMES", "DRIFT_VARIABLES", "FIXED",
            "DriftVariable", "ascii_unit", "docs_table", "is_aux", "refusal",
@@ -62,9 +64,43 @@ _INSTEAD = {
 }
 
 
+#: Modules of this package that are not variables.
+NOT_VARIABLES = frozenset({"registry", "spec"})
+
+
+def variable_modules(directory: Path | str) -> list[str]:
+    """Names of the drift variables' modules in ``directory``, sorted: every ``NAME.py``
+    but ``_*``, ``registry`` and ``spec``."""
+    names = (name[:-3] for name in os.listdir(directory) if name.endswith(".py"))
+    return sorted(n for n in names if n not in NOT_VARIABLES and not n.startswith("_"))
+
+
+def check_declared(found: tuple[DriftVariable, ...],
+                   declarations: tuple[Declaration, ...] = DECLARATIONS) -> None:
+    """Refuse variables that :mod:`hrgtc.settings.drift_variables` does not declare, in
+    the same order (the command line reads the names and options there, without numpy).
+
+    Raises
+    ------
+    RuntimeError
+        Naming the variables missing from the declarations, or declared and missing
+        here, or the two orders.
+    """
+    names, declared = [v.name for v in found], [d.name for d in declarations]
+    if names == declared:
+        return
+    missing, extra = sorted(set(names) - set(declared)), sorted(set(declared) - set(names))
+    what = (f"not declared: {missing}; " if missing else "") + (
+        f"declared without a module: {extra}; " if extra else "") or "the order differs; "
+    raise RuntimeError(
+        f"the drift variables {names} (in the order of their modules' order=) are not the "
+        f"declarations {declared} of hrgtc/settings/drift_variables.py: {what}add a "
+        "Declaration(name, options) there for each variable module, in the grammar's order")
+
+
 def _discover() -> tuple[DriftVariable, ...]:
-    """The ``VARIABLE`` of every module of this package, in grammar order (the modules
-    :func:`hrgtc.settings.drift.variable_modules` lists, which also reads their options)."""
+    """The ``VARIABLE`` of every module of this package, in grammar order, checked against
+    the declarations (:func:`check_declared`)."""
     package = sys.modules[__package__]
     found = []
     for directory in package.__path__:
@@ -75,6 +111,7 @@ def _discover() -> tuple[DriftVariable, ...]:
     orders = [v.order for v in found]
     if len(set(orders)) != len(orders) or len({v.name for v in found}) != len(found):
         raise RuntimeError(f"drift variables with the same order or name: {found}")
+    check_declared(tuple(found))
     return tuple(found)
 
 

@@ -7,7 +7,8 @@ settings and the other variables), what it needs of the settings (``check``), th
 settings it owns in the model file (``settings_fields``: their types, bounds and defaults,
 from which the model file's record and JSON Schema are generated), where the fit gives
 them their values (``derive`` from the fit's options, ``first_pass`` from the training
-runs; a command-line option of its own is its module's ``class Options``),
+runs; a command-line option of its own is declared in
+:mod:`hrgtc.settings.drift_variables`),
 and, for the variables beyond the paper's f, df, h and dh, its pieces of the C export
 (``c_code``, in double and in float32) and its keys of the parameter file (``params``).
 The registry (:mod:`hrgtc.drift.variables.registry`)
@@ -103,7 +104,7 @@ Put = Callable[[str, Any, str], None]
 #: ``derive(names, given)``: the feature settings a variable takes from the fit's options.
 #: ``names`` are the candidates' variables of this entry (``a_drive``, ``a_tilt``),
 #: ``given`` the fit's options by name: ``rate_tau_s``, ``aux_columns`` (``--aux``) and
-#: the options the variables declare (their modules' ``Options``: ``rate_tau2_s``).
+#: the options the variables declare (:mod:`hrgtc.settings.drift_variables`: ``rate_tau2_s``).
 Derive = Callable[[tuple[str, ...], Mapping[str, Any]], dict[str, Any]]
 
 

@@ -1,9 +1,10 @@
 """C expressions shared by the export's text modules: array initialisers, drift terms and
 comment text.
 
-:mod:`hrgtc.export.c.text` (header, source) and :mod:`hrgtc.export.c.scale`
-(the scale-factor pieces that ``text`` inserts) both print these; they live here so
-that ``scale`` does not import ``text`` back (no import circle).
+:mod:`hrgtc.export.c.text` (the header), :mod:`hrgtc.export.c.source` (the ``.c``
+file) and :mod:`hrgtc.export.c.scale` (the scale-factor pieces that ``source`` inserts)
+print these; they live here so that ``scale`` does not import ``source`` back (no import
+circle).
 """
 
 from __future__ import annotations

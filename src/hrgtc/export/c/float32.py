@@ -16,7 +16,7 @@ does not accumulate over the filter's tau/dt samples of memory. It is the filter
 weights are computed in double and rounded to float once per distinct Δt).
 
 :func:`float_constants` rounds every constant once, so the C text
-(:mod:`hrgtc.export.c.single`) prints exactly these float32 values and the
+(:mod:`hrgtc.export.c.source`) prints exactly these float32 values and the
 mirror below computes with them; :func:`mirror_bias`, :func:`mirror_temperature`
 and :func:`mirror_rate` evaluate the generated code's operations one by one in
 ``numpy.float32`` (the order of the C statements), :func:`mirror_gradient` the
@@ -38,7 +38,7 @@ from hrgtc.drift.features import Term
 from hrgtc.drift.rate_filter import DT_REL_TOLERANCE, SERIES_LIMIT, series_coefficients
 from hrgtc.drift.variables import variable
 from hrgtc.export.c.plan import CPlan
-from hrgtc.export.c.text import NEWTON_MAX_ITER
+from hrgtc.export.c.thermometer import NEWTON_MAX_ITER
 from hrgtc.model import UnitModel
 
 F32 = np.float32

@@ -1,8 +1,8 @@
 """The header ``<prefix>_model.h`` of the firmware export, one template for both builds.
 
-The double build (:mod:`hrgtc.export.c.text`) and the float32 build
-(:mod:`hrgtc.export.c.single`) declare the same defines, state, output and functions;
-they differ in the C type (:class:`~hrgtc.export.c.types.CType`), in the float build's
+The double build (README by :mod:`hrgtc.export.c.text`) and the float32 build (its
+sections by :mod:`hrgtc.export.c.single`) declare the same defines, state, output and
+functions; they differ in the C type (:class:`~hrgtc.export.c.types.CType`), in the float build's
 own defines (its centre and error bounds) and in its frequency input, which enters
 centred (``f_hz = freq_hz - CENTRE_HZ``). :func:`header` writes both, so a change of
 the interface is one edit.

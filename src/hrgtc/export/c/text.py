@@ -1,12 +1,12 @@
-"""C text of the firmware export: the README block, the header and the source.
+"""C text of the firmware export: the README block and the double build's header.
 
-The header is the template both builds share (:mod:`hrgtc.export.c.header`).
+The header is the template both builds share (:mod:`hrgtc.export.c.header`); the
+``.c`` file is one body for both builds (:mod:`hrgtc.export.c.source`).
 
 :mod:`hrgtc.export.export_c` decides what to export (the validated numbers of a
-:class:`~hrgtc.model.UnitModel`); this module prints them as C99. Constants are
-printed with ``%.17g`` so they read back to the same double. Products and sums are
-separate statements, so a compiler that contracts ``a*b + c`` within an expression
-(C99 ``FP_CONTRACT``) cannot fuse them and the rounding stays that of NumPy.
+:class:`~hrgtc.model.UnitModel`); this module says in words what the code computes, with
+which numbers and how to use it (the float32 build replaces the UNITS and USAGE
+sections with its own, :mod:`hrgtc.export.c.single`).
 
 [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
 """
@@ -17,35 +17,18 @@ import re
 import textwrap
 from pathlib import Path
 
-from hrgtc.export.c.expr import array as _array
 from hrgtc.export.c.expr import comment as _comment
-from hrgtc.export.c.expr import term_expression as _term_expression
 from hrgtc.export.c.header import header as template
-from hrgtc.export.c.header import sensor_words
-from hrgtc.export.c.plan import TABLE_POINTS, CPlan
-from hrgtc.export.c.rate_filter import filter_functions
-from hrgtc.export.c.step import step_tail
-from hrgtc.export.c.thermometer import thermometer_functions
-from hrgtc.export.c.types import DOUBLE, ctype
+from hrgtc.export.c.plan import CPlan
 from hrgtc.export.c.variables import (
     RATES,
-    bias_params,
-    cname,
-    extra_variables,
     levels,
     readme_lines,
     step_inputs,
 )
 from hrgtc.model import UnitModel
 
-#: Iteration cap of the thermometer inverse (as :meth:`Thermometer.temperature`).
-NEWTON_MAX_ITER = 60
 _WIDTH = 92
-
-
-def _literal(value: float, name: str) -> str:
-    """``%.17g`` text of a finite double as a C double literal (reads back exactly)."""
-    return DOUBLE.literal(value, name)
 
 
 def sensor_note(model: UnitModel) -> list[str]:
@@ -249,188 +232,3 @@ def header(model: UnitModel, plan: CPlan, prefix: str, origin: str,
     """Text of ``<prefix>_model.h``: README block, state and output structs, prototypes
     (the template both builds share, :func:`hrgtc.export.c.header.header`)."""
     return template(model, plan, prefix, readme(model, plan, prefix, origin, sha256), sha256)
-
-
-def _bias_function(model: UnitModel, plan: CPlan, prefix: str) -> str:
-    drift = model.drift
-    names = dict(bias_params(plan))
-    params = list(names.values())
-    used = [v for v in names if v in drift.variables and drift.selected]
-    body = []
-    t = ctype(plan)  # the C type: every declaration, literal and math call below
-    real, lit, zero = t.name, t.literal, t.literal(0.0, "zero")
-    for v in names:
-        if v not in used:
-            body.append(f"    (void){names[v]};")
-    for v in used:
-        # held at the edge of the training range; the tangent there continues the model
-        # beyond it, as DriftModel.predict(extrapolation="tangent")
-        u = cname(v)
-        body.append(f"    const {real} c_{v} = {names[v]} < CLAMP_{u}_LOW ? CLAMP_{u}_LOW : "
-                    f"({names[v]} > CLAMP_{u}_HIGH ? CLAMP_{u}_HIGH : {names[v]});")
-        body.append(f"    const {real} x_{v} = c_{v} / SCALE_{u};")
-    body.append(f"    {real} sum = {zero};")
-    body.append(f"    {real} term;")
-    for k, term in enumerate(drift.terms):
-        body.append(f"    term = {_term_expression(term, t)};  /* {term.name} */")
-        body.append(f"    term = COEFFICIENTS[{k}] * term;")
-        body.append("    sum = sum + term;")
-    for v in used:
-        u = cname(v)
-        body.append(f"    if ({names[v]} < CLAMP_{u}_LOW || {names[v]} > CLAMP_{u}_HIGH) {{"
-                    f"  /* beyond the training range of {v} */")
-        body.append(f"        {real} gradient = {zero};")
-        for k, term in enumerate(drift.terms):
-            multiplier, rest = term.derivative(v)
-            if not multiplier:
-                continue
-            factor = f"COEFFICIENTS[{k}] * {lit(multiplier, 'multiplier')} / SCALE_{u}"
-            expression = factor if rest is None else f"{factor} * {_term_expression(rest, t)}"
-            body.append(f"        gradient = gradient + {expression};  /* d({term.name})/d{v} */")
-        body.append(f"        sum = sum + gradient * ({names[v]} - c_{v});")
-        body.append("    }")
-    body.append("    return INTERCEPT_DPH + sum;")
-    if not drift.terms:
-        body = [line for line in body if "term" not in line]
-    signature = ", ".join(f"{real} {name}" for name in params)
-    constants = [f"static const {real} INTERCEPT_DPH = "
-                 f"{lit(drift.intercept_dph, 'intercept_dph')};"]
-    for v in used:
-        u = cname(v)
-        constants.append(f"static const {real} SCALE_{u} = "
-                         f"{lit(drift.settings.scales[v], f'scales[{v}]')};")
-        low, high = drift.ranges[v]
-        constants.append(f"static const {real} CLAMP_{u}_LOW = "
-                         f"{lit(low, f'ranges[{v}][0]')};")
-        constants.append(f"static const {real} CLAMP_{u}_HIGH = "
-                         f"{lit(high, f'ranges[{v}][1]')};")
-    if drift.terms:
-        listed = ", ".join(drift.selected)
-        constants.append(f"/* Coefficients on scaled variables, in this order: {listed} */")
-        constants.append(f"static const {real} COEFFICIENTS[{len(drift.terms)}] = "
-                         f"{_array(drift.scaled_coefficients, 'scaled_coefficients', t)};")
-    return "\n".join(constants) + f"""
-
-{real} {prefix}_bias_dph({signature})
-{{
-""" + "\n".join(body) + "\n}\n"
-
-
-def source(model: UnitModel, plan: CPlan, prefix: str) -> str:
-    """Text of ``<prefix>_model.c``: filter, drift model, thermometer inverse, step()."""
-    from hrgtc.export.c.scale import scale_pieces
-
-    p, up = prefix, prefix.upper()
-    drift, th = model.drift, model.thermometer
-    settings = drift.settings
-    ranges = []
-    for v in plan.computed:
-        if v in drift.ranges:
-            low, high = drift.ranges[v]
-            ranges.append((v, _literal(low, f"ranges[{v}][0]"), _literal(high, f"ranges[{v}][1]")))
-    def checks(kind: tuple[str, ...]) -> str:
-        return "".join(
-            f"\n        && {v}_value >= RANGE_{u}_LOW && {v}_value <= RANGE_{u}_HIGH"
-            for v, u in ((v, cname(v)) for v, _, _ in ranges) if v in kind
-        )
-
-    range_constants = "".join(
-        f"static const double RANGE_{cname(v)}_LOW = {low};\n"
-        f"static const double RANGE_{cname(v)}_HIGH = {high};\n"
-        for v, low, high in ranges
-    )
-    above = "residual > 0.0" if plan.increasing else "!(residual > 0.0)"
-    # the housing thermistor's pieces, empty when the terms do not use h or dh
-    reference_c = _literal(settings.reference_c, "reference_c")
-    h = {
-        "constants": f"static const double REFERENCE_C = {reference_c};\n",
-        "start": "        rate_start(&state->h_filter, h_value);\n",
-        "values": "    const double h_value = housing_c - REFERENCE_C;\n"
-                  "    double dh_value = 0.0;\n",
-        "rate": "        dh_value = rate_update(&state->h_filter, h_value, dt_s, RATE_TAU_S);\n",
-        "out": "        out->h_c = h_value;\n        out->dh_c_per_s = dh_value;\n",
-        "arg": ", double housing_c",
-        "bias": ", h_value, dh_value",
-        "reset": "    rate_start(&state->h_filter, 0.0);\n",
-    }
-    if not plan.housing:
-        h = dict.fromkeys(h, "")
-    h["arg"] = "".join(f", double {name}" for name in step_inputs(plan))
-    extra = extra_variables(plan, settings, _literal, _comment, prefix=p)
-    n_th = len(plan.th_coefficients)
-    thermometer_text = thermometer_functions(
-        p=p, n_th=n_th, above=above, real="double", fabs="fabs", half="0.5",
-        fn=f"{p}_frequency_hz", arg="freq_hz")
-    k = scale_pieces(model, plan, prefix)
-    level_test = f"{p}_frequency_in_range(freq_hz)" + checks(levels(plan))
-    tail = step_tail(up=up, level_test=level_test, rate_test="1" + checks(RATES), h=h, k=k)
-    text = f"""/* {p}_model.c -- generated by hrgtc export-c for unit {_comment(model.unit)};
- * see {p}_model.h for what it computes, its provenance and its use. Do not edit.
- * Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
- */
-#include "{p}_model.h"
-
-#include <math.h>
-
-/* ---- frequency change and the causal df/dt filter (hrgtc.drift.rate_filter) ---- */
-static const double REFERENCE_FREQ_HZ = \
-{_literal(settings.reference_freq_hz, 'reference_freq_hz')};
-{h['constants']}{extra['constants']}\
-/* time constant of each stage of the df/dt filter [s] */
-static const double RATE_TAU_S = {_literal(plan.tau_s, 'rate_tau_s')};
-
-{filter_functions(p, False)}{extra['functions']}
-/* ---- the drift model, Eq. (22) of [1] (hrgtc.drift.DriftModel.predict) ---- */
-{_bias_function(model, plan, p)}{k['function']}
-/* ---- the thermometer, Eq. (18) of [1] (hrgtc.thermometry.Thermometer) ---- */
-static const double TH_CENTRE_C = {_literal(th.centre_c, 'centre_c')};
-static const double TH_SCALE_C = {_literal(th.scale_c, 'scale_c')};
-/* f(T) = sum_k TH_COEFFICIENTS[k] z^k, z = (T - TH_CENTRE_C) / TH_SCALE_C [Hz] */
-static const double TH_COEFFICIENTS[{n_th}] = \
-{_array(plan.th_coefficients, 'scaled_coefficients')};
-/* d f / d z, ascending */
-static const double TH_DERIVATIVE[{n_th - 1}] = {_array(plan.th_derivative, 'derivative')};
-/* calibrated frequency range [Hz] */
-static const double TH_F_LOW_HZ = {_literal(plan.f_range[0], 'f_low')};
-static const double TH_F_HIGH_HZ = {_literal(plan.f_range[1], 'f_high')};
-/* table of f(T) over the monotonic extension, ascending in f: starts the Newton iteration */
-#define TH_TABLE_POINTS {TABLE_POINTS}
-static const double TH_TABLE_F[TH_TABLE_POINTS] = {_array(plan.grid_f, 'table_f')};
-static const double TH_TABLE_T[TH_TABLE_POINTS] = {_array(plan.grid_t, 'table_t')};
-static const double TH_TOLERANCE_C = {_literal(plan.tolerance, 'tolerance')};
-#define TH_MAX_ITER {NEWTON_MAX_ITER}
-
-{thermometer_text}/* ---- streaming compensation (hrgtc.compensate.Compensator) ---- */
-/* training ranges of the drift model's variables (as the model file stores them) */
-{range_constants}
-void {p}_reset({p}_state *state)
-{{
-    rate_start(&state->f_filter, 0.0);
-{h['reset']}{extra['reset']}    state->started = 0;
-    state->samples = 0UL;
-    state->elapsed_s = 0.0;
-    state->out_of_range = 0UL;
-    state->rate_out_of_range = 0UL;
-}}
-
-void {p}_init({p}_state *state)
-{{
-    {p}_reset(state);
-}}
-
-double {p}_step({p}_state *state, double dt_s, double freq_hz, double rate_dph{h['arg']}, \
-{p}_output *out)
-{{
-    const double f_value = freq_hz - REFERENCE_FREQ_HZ;
-{h['values']}{extra['values']}    double df_value = 0.0, bias, compensated, temperature;
-    int in_range, rate_in_range, level_in_range, settled;
-{k['declare']}    if (!state->started) {{  /* the filters start at rest on the first sample */
-        rate_start(&state->f_filter, f_value);
-{h['start']}{extra['start']}        state->started = 1;
-    }} else {{  /* each filter steps over this sample's dt_s */
-        df_value = rate_update(&state->f_filter, f_value, dt_s, RATE_TAU_S);
-{h['rate']}{extra['rate']}    }}
-    temperature = {p}_temperature_c(freq_hz);
-{extra['gradient']}    bias = {p}_bias_dph(f_value, df_value{h['bias']}{extra['bias']});
-{tail}"""
-    return sensor_words(model, text)

@@ -7,7 +7,10 @@ safeguarded Newton inverse T(f) started from a table (as
 
 from __future__ import annotations
 
-__all__ = ["thermometer_functions"]
+__all__ = ["NEWTON_MAX_ITER", "thermometer_functions"]
+
+#: Iteration cap of the thermometer inverse (as :meth:`Thermometer.temperature`).
+NEWTON_MAX_ITER = 60
 
 
 def thermometer_functions(*, p: str, n_th: int, above: str, real: str, fabs: str, half: str,

@@ -1,8 +1,8 @@
 """The C floating type of the firmware export: double, or float32 for FPU-only MCUs.
 
 Every constant, variable declaration and ``math.h`` call that
-:mod:`hrgtc.export.c.text` and :mod:`hrgtc.export.c.single` print goes
-through one :class:`CType`, so a term is written once for both builds.
+:mod:`hrgtc.export.c.source` and :mod:`hrgtc.export.c.header` print goes
+through one :class:`CType`, so the body is written once for both builds.
 """
 
 from __future__ import annotations

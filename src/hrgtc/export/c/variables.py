@@ -1,10 +1,10 @@
 """C text of the drift-model variables beyond f, df, h and dh, gathered from their modules.
 
-:mod:`hrgtc.export.c.text` (double) and :mod:`hrgtc.export.c.single` (float32) print the
-firmware export's skeleton (f, df and the housing's h, dh); every other variable writes
-its own pieces in its module of :mod:`hrgtc.drift.variables` (its ``c_code``: constants,
-state, filter steps, ``step()`` inputs, the argument of ``bias_dph()``, its README line),
-in both precisions, and this module puts them together in grammar order:
+:mod:`hrgtc.export.c.source` prints the firmware export's skeleton, in double or float32
+(f, df and the housing's h, dh); every other variable writes its own pieces in its module
+of :mod:`hrgtc.drift.variables` (its ``c_code``: constants, state, filter steps, ``step()``
+inputs, the argument of ``bias_dph()``, its README line), in both precisions, and this
+module puts them together in grammar order:
 
 * ``d2``: the causal df/dt filter with its own time constant (``rate_tau2_s``) and its
   own state in the state struct (``f2_filter``), the same ``rate_update`` as the first
@@ -75,7 +75,7 @@ def extra_variables(plan: CPlan, settings: Any, _literal: Callable[[float, str],
 
     Each variable's module in :mod:`hrgtc.drift.variables` writes its own pieces
     (``c_code``), in grammar order; ``_literal`` and ``_comment`` print a constant and a
-    comment as :mod:`hrgtc.export.c.text` does.
+    comment in the export's type, as :mod:`hrgtc.export.c.source` does.
     """
     out = dict.fromkeys(SLOTS, "")
     for v in variables_for_c(set(plan.computed)):

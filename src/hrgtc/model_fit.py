@@ -1,6 +1,11 @@
 """Does a recording fit a model? The checks made before a run is compensated with it: the
 kind of thermometer, the rate noise against the training data's (a unit mistake), and
-the band of plausible frequencies the reader enforces."""
+the band of plausible frequencies the reader enforces.
+
+A layer of its own, just above :mod:`hrgtc.model`: the compensator
+(:mod:`hrgtc.compensate.file_pass`, ``multi_axis``) and the evaluation
+(:mod:`hrgtc.evaluation.run_pass`, ``instrument_pass``), the report and the instrument
+chain all ask it, and none of them may import another's stage."""
 
 from __future__ import annotations
 

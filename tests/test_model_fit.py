@@ -1,4 +1,4 @@
-"""Tests of hrgtc.compensate.model_fit.check_recording_noise: a unit factor on any axis is
+"""Tests of hrgtc.model_fit.check_recording_noise: a unit factor on any axis is
 refused naming the file and the column, whether the model is one unit's or an instrument's.
 
 Written for mutants that no test of the compensate package killed (make mutation, issue 21;
@@ -11,9 +11,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from hrgtc.compensate.model_fit import check_recording_noise
 from hrgtc.core.errors import InputError
 from hrgtc.model import InstrumentModel
+from hrgtc.model_fit import check_recording_noise
 from hrgtc.recording import Metadata, Recording
 
 from fuzzing import make_model, make_run
@@ -118,7 +118,7 @@ def test_swapped_headers_on_an_axis_of_an_instrument_are_named(model):
 def test_the_calibrated_span_covers_the_thermometer_and_the_trained_f(model):
     import dataclasses
 
-    from hrgtc.compensate.model_fit import frequency_span
+    from hrgtc.model_fit import frequency_span
 
     thermometer_span = model.thermometer.frequency_range_hz
     assert frequency_span(model) == thermometer_span  # the training stayed inside
@@ -132,7 +132,7 @@ def test_the_calibrated_span_covers_the_thermometer_and_the_trained_f(model):
 
 
 def test_the_plausible_band_is_the_span_widened_by_100_c_at_the_steepest_slope(model):
-    from hrgtc.compensate.model_fit import plausible_frequency_band
+    from hrgtc.model_fit import plausible_frequency_band
 
     thermometer = model.thermometer
     low, high = thermometer.frequency_range_hz
@@ -150,7 +150,7 @@ def test_the_plausible_band_is_the_span_widened_by_100_c_at_the_steepest_slope(m
 def test_a_model_of_the_other_thermometer_kind_is_refused_naming_the_file_and_option(model):
     import dataclasses
 
-    from hrgtc.compensate.model_fit import check_thermometer_kind, with_model_band
+    from hrgtc.model_fit import check_thermometer_kind, with_model_band
     from hrgtc.recording.io import ReadOptions
 
     resonator, sensor = ReadOptions(), ReadOptions(thermometer="sensor")
