@@ -68,7 +68,7 @@ from hrgtc.drift.offsets import fit_offsets, offset_groups, orientation_offset, 
 from hrgtc.drift.regression import EXTENDED_PRECISION, newey_west_inflation
 from hrgtc.drift.rest import check_policy, reference_point, run_rest
 from hrgtc.drift.stepwise import StepwiseRecord, StepwiseResult, stepwise
-from hrgtc.drift.windows import RunSource, _iter_run, window_means
+from hrgtc.drift.windows import RunSource, _iter_run, window_means, window_means_at
 from hrgtc.recording import Recording
 from hrgtc.recording.motion import MotionSettings
 from hrgtc.settings.drift import SELECTIONS, WARMUP_FACTOR, DriftSettings
@@ -478,8 +478,12 @@ def fit(
         settings = FeatureSettings(**{**settings.to_dict(), **update})
     # df/dt's training range is kept for the range warnings even when no candidate uses it
     tracked = ("df",) if "f" in variables else ()
-    windows = window_means(runs, settings, candidates, window_s, progress, thermometer, tracked,
-                           keep=keep, gaps=gaps, restart_each_segment=restart_each_segment)
+    # the rate-free refit's windows (warm-up 0, below) come from the same reading
+    refit = warmup_s is None and settings.warmup_s > 0
+    windows, *rate_free = window_means_at(
+        runs, settings, candidates, window_s, progress, thermometer, tracked, keep=keep,
+        gaps=gaps, restart_each_segment=restart_each_segment,
+        warmups_s=(settings.warmup_s, 0.0) if refit else None)
     for run in range(min(excitation_runs, len(windows.sources))):
         check_excitation(windows, thermometer, variables, run)
     check_excitation(windows, thermometer, variables)
@@ -530,7 +534,7 @@ def fit(
         if select == "guarded":  # the F-test steps stay on record; the pruning is in `pruning`
             result = dataclasses.replace(result, history=history)
     chosen_terms = [t for t in candidates if t.name in result.selected]
-    if warmup_s is None and settings.warmup_s > 0 and not any(
+    if refit and not any(
             entry.rate_of for entry, _ in registry_entries(variables_for(chosen_terms))):
         # no rate term chosen: nothing waits for the df/dt filter to settle, so the run's
         # first warmup_s (at rest, and often its most extreme temperature) is trained on
@@ -538,9 +542,7 @@ def fit(
         # (df/dt's range, kept for the warnings, then spans the filter's start too: the
         # model's own file stays inside it)
         settings = FeatureSettings(**{**settings.to_dict(), "warmup_s": 0.0})
-        windows = window_means(runs, settings, candidates, window_s, progress, thermometer,
-                               tracked, keep=keep, gaps=gaps,
-                               restart_each_segment=restart_each_segment)
+        windows = rate_free[0]
         groups, x_full, x_scaled, bias = _design(windows, offsets, factors)
         history = result.history
         result = dataclasses.replace(
