@@ -306,14 +306,21 @@ def model_sha256(model: UnitModel) -> str:
     return parameters_sha256(model.to_dict())
 
 
-def provenance(inputs: Mapping[str, list[str]], settings: Mapping[str, Any]) -> dict[str, Any]:
-    """Provenance record: input files (role, path, SHA-256), settings, version, UTC time."""
+def provenance(inputs: Mapping[str, list[str]], settings: Mapping[str, Any],
+               hashed: Mapping[str, str] | None = None) -> dict[str, Any]:
+    """Provenance record: input files (role, path, SHA-256), settings, version, UTC time.
+
+    ``hashed``: path -> SHA-256 of files hashed by the same command a moment ago (an
+    instrument's record repeats its axes' inputs), not read again.
+    """
     from hrgtc.core.meta import __version__
 
     files = []
+    known = dict(hashed or {})
     for role, paths in inputs.items():
         for path in paths:
-            files.append({"role": role, "path": str(path), "sha256": file_sha256(path)})
+            digest = known.get(str(path)) or file_sha256(path)
+            files.append({"role": role, "path": str(path), "sha256": digest})
     return {
         "inputs": files,
         "settings": dict(settings),

@@ -24,6 +24,8 @@ It also holds what every stage needs and that depends on nothing else of hrgtc:
 * :mod:`hrgtc.core.files` -- atomic output files, never overwritten without ``force``;
 * :mod:`hrgtc.core.progress` -- the progress callback of long library functions;
 * :mod:`hrgtc.core.process` -- facts about the running process (peak memory).
+* :mod:`hrgtc.core.student_t` -- Student's t tail (the regressions' p-values) without
+  importing ``scipy.stats``.
 
 ``core`` imports nothing from the other hrgtc stages. Its names are loaded on first use
 (PEP 562), so ``from hrgtc.core.errors import HrgtcError`` costs no numpy import and the

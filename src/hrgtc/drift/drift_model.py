@@ -348,7 +348,7 @@ def fit(
     made = design(training, drift, thermometer, progress, excitation_runs)
     chosen = select(training, made, drift, thermometer, initial)
     first = made
-    made = refit_rate_free(training, made, chosen, drift, thermometer, progress)
+    made = refit_rate_free(training, made, chosen, drift)
     result, windows, names = chosen.result, made.windows, training.names
     ols = result.result
     selected = result.selected

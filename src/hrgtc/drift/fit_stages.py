@@ -32,7 +32,7 @@ from hrgtc.drift.offsets import offset_groups, project_off
 from hrgtc.drift.regression import EXTENDED_PRECISION, newey_west_inflation
 from hrgtc.drift.rest import check_policy, reference_point, run_rest
 from hrgtc.drift.stepwise import StepwiseResult, stepwise
-from hrgtc.drift.windows import RunSource, _iter_run, window_means
+from hrgtc.drift.windows import RunSource, _iter_run, window_means_at
 from hrgtc.recording.motion import MotionSettings
 from hrgtc.settings.drift import SELECTIONS, WARMUP_FACTOR, DriftSettings
 
@@ -110,11 +110,14 @@ class Training:
         return tuple(t.name for t in self.candidates)
 
     def windows(self, drift: DriftSettings, terms: Sequence[Term], progress: Progress | None = None,
-                thermometer: Any = None, tracked: Sequence[str] = ()) -> Any:
-        """The window means of ``terms`` over the runs (at rest, after the warm-up)."""
-        return window_means(self.runs, self.features, terms, drift.window_s, progress,
-                            thermometer, tracked, keep=self.keep, gaps=self.reading.gaps,
-                            restart_each_segment=self.reading.restart_each_segment)
+                thermometer: Any = None, tracked: Sequence[str] = (),
+                warmups_s: Sequence[float] | None = None) -> tuple[Any, ...]:
+        """The window means of ``terms`` over the runs (at rest, after the warm-up), one
+        result per warm-up of ``warmups_s`` from one reading (default: the settings')."""
+        return window_means_at(self.runs, self.features, terms, drift.window_s, progress,
+                               thermometer, tracked, keep=self.keep, gaps=self.reading.gaps,
+                               restart_each_segment=self.reading.restart_each_segment,
+                               warmups_s=warmups_s)
 
 
 def prepare(runs: Sequence[RunSource], thermometer: Any, drift: DriftSettings,
@@ -153,7 +156,7 @@ def prepare(runs: Sequence[RunSource], thermometer: Any, drift: DriftSettings,
     passes = [(e.first_pass, own) for e, own in used if e.first_pass is not None]
     if passes:  # what the variables learn from the runs (dpos's switch, the channels' centres)
         reads = tuple(dict.fromkeys(v for p, own in passes for v in p.reads(own)))
-        means = training.windows(drift, parse_terms(reads)).variables
+        means = training.windows(drift, parse_terms(reads))[0].variables
         update: dict[str, Any] = {}
         for first_pass, own in passes:
             update.update(first_pass.derive(own, means))
@@ -188,6 +191,8 @@ class Design:
     x_full: np.ndarray
     x_scaled: np.ndarray
     bias: np.ndarray
+    #: The windows with no warm-up (for stage 5), from the same reading; None: not needed.
+    rate_free: Any = None
 
 
 def design_matrix(windows: Any, offsets: str, factors: np.ndarray) -> tuple[
@@ -211,7 +216,11 @@ def design(training: Training, drift: DriftSettings, thermometer: Any,
     variables = training.variables
     # df/dt's training range is kept for the range warnings even when no candidate uses it
     tracked = ("df",) if "f" in variables else ()
-    windows = training.windows(drift, training.candidates, progress, thermometer, tracked)
+    # the rate-free refit's windows (warm-up 0, stage 5) come from the same reading
+    refit = drift.warmup_s is None and training.features.warmup_s > 0
+    windows, *rate_free = training.windows(
+        drift, training.candidates, progress, thermometer, tracked,
+        (training.features.warmup_s, 0.0) if refit else None)
     for run in range(min(excitation_runs, len(windows.sources))):
         check_excitation(windows, thermometer, variables, run)
     check_excitation(windows, thermometer, variables)
@@ -221,8 +230,8 @@ def design(training: Training, drift: DriftSettings, thermometer: Any,
         scales[v] = magnitude if magnitude > 0 else 1.0
     training.features = FeatureSettings(**{**training.features.to_dict(), "scales": scales})
     factors = np.array([t.scale_factor(scales) for t in training.candidates])
-    return Design(windows, scales, factors,
-                  *design_matrix(windows, drift.offsets, factors))
+    return Design(windows, scales, factors, *design_matrix(windows, drift.offsets, factors),
+                  rate_free=rate_free[0] if rate_free else None)
 
 
 @dataclass
@@ -281,21 +290,21 @@ def select(training: Training, made: Design, drift: DriftSettings, thermometer: 
     return Selection(result, pruning, inflation, bandwidth, slope_sign, rate)
 
 
-def refit_rate_free(training: Training, made: Design, chosen: Selection, drift: DriftSettings,
-                    thermometer: Any, progress: Progress | None) -> Design:
+def refit_rate_free(training: Training, made: Design, chosen: Selection,
+                    drift: DriftSettings) -> Design:
     """Stage 5: with no rate term chosen nothing waits for the df/dt filter to settle, so
     the run's first ``warmup_s`` (at rest, and often its most extreme temperature) is
     trained on too and the compensation flags no settling (docs/real-loggers/corpus.md);
     df/dt's range, kept for the warnings, then spans the filter's start too (the model's
-    own file stays inside it). ``made`` unchanged when a rate term is chosen, the warm-up
+    own file stays inside it). Its windows came from stage 3's reading
+    (:attr:`Design.rate_free`); ``made`` unchanged when a rate term is chosen, the warm-up
     was given, or it is zero."""
     chosen_terms = [t for t in training.candidates if t.name in chosen.result.selected]
-    if drift.warmup_s is not None or training.features.warmup_s <= 0 or any(
+    if made.rate_free is None or any(
             entry.rate_of for entry, _ in registry_entries(variables_for(chosen_terms))):
         return made
     training.features = FeatureSettings(**{**training.features.to_dict(), "warmup_s": 0.0})
-    tracked = ("df",) if "f" in training.variables else ()
-    windows = training.windows(drift, training.candidates, progress, thermometer, tracked)
+    windows = made.rate_free
     history = chosen.result.history
     refit = Design(windows, made.scales, made.factors,
                    *design_matrix(windows, drift.offsets, made.factors))

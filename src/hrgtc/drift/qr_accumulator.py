@@ -36,6 +36,7 @@ import numpy as np
 
 from hrgtc.core import records
 from hrgtc.core.errors import InputError, RankDeficientError
+from hrgtc.core.student_t import t_sf
 
 COLLINEARITY_TOL = 1e-12
 """Default ``tol``: smallest allowed reciprocal condition number (2-norm) of the
@@ -549,9 +550,7 @@ def _solve(acc: QRAccumulator, idx: list[int], names: tuple[str, ...], tol: floa
     params = np.concatenate([[intercept], slopes])
     with np.errstate(divide="ignore", invalid="ignore"):
         tvalues = params / bse
-    from scipy import stats  # imported on first use: a faster start
-
-    pvalues = 2.0 * stats.t.sf(np.abs(tvalues), df)
+    pvalues = 2.0 * t_sf(np.abs(tvalues), df)
     return OLSResult(names=("const", *(names[j] for j in idx)), params=_readonly(params),
                      bse=_readonly(bse), tvalues=_readonly(tvalues), pvalues=_readonly(pvalues),
                      cov_params=_readonly(cov), residual_std=sy * math.sqrt(sigma2),

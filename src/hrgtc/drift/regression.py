@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from hrgtc.core.errors import InputError, PrecisionWarning
+from hrgtc.core.student_t import t_sf
 from hrgtc.drift.qr_accumulator import (
     COLLINEARITY_TOL,
     OLSResult,
@@ -272,9 +273,7 @@ def refine(result: OLSResult, X: Any, y: Any, weights: Any = None, *,
     params = np.concatenate([[intercept], slopes]).astype(np.float64)
     with np.errstate(divide="ignore", invalid="ignore"):
         tvalues = params / result.bse
-    from scipy import stats  # imported on first use: a faster start
-
-    pvalues = 2.0 * stats.t.sf(np.abs(tvalues), result.df_resid)
+    pvalues = 2.0 * t_sf(np.abs(tvalues), result.df_resid)
     return dataclasses.replace(result, params=_readonly(params), tvalues=_readonly(tvalues),
                                pvalues=_readonly(pvalues))
 

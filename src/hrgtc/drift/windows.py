@@ -135,8 +135,8 @@ class _WindowMeans:
         self._carry: np.ndarray | None = None  # rows of the open window, from earlier chunks
         self.partial_dropped_rows = 0
 
-    def transform(self, block: np.ndarray, breaks: Sequence[int] | np.ndarray = (),
-                  cuts: Sequence[int] | np.ndarray = ()) -> np.ndarray:
+    def partial_fit(self, block: np.ndarray, breaks: Sequence[int] | np.ndarray = (),
+                    cuts: Sequence[int] | np.ndarray = ()) -> np.ndarray:
         """Window means of ``block``; ``breaks``: its rows that start a new segment,
         ``cuts``: its rows that follow left-out samples (a row that is both is a break)."""
         n, width = block.shape
@@ -284,39 +284,71 @@ def window_means(
     restart_each_segment
         Each segment is a power-on: the warm-up is skipped after every gap.
     """
+    return window_means_at(runs, settings, terms, window_s, progress, thermometer,
+                           extra_variables, keep, gaps=gaps,
+                           restart_each_segment=restart_each_segment)[0]
+
+
+class _Windows:
+    """What one warm-up keeps of the pass of :func:`window_means_at`: its windows, its
+    trained ranges and its counts (the rows it uses differ only by the warm-up)."""
+
+    def __init__(self, warmup_s: float, n_variables: int) -> None:
+        self.threshold_s = settle_threshold_s(warmup_s)
+        self.time: list[np.ndarray] = []
+        self.power: list[np.ndarray] = []
+        self.means: list[np.ndarray] = []  # columns bias, variables, extra, terms
+        self.run: list[np.ndarray] = []
+        # per variable: smallest and largest used sample (the trained ranges)
+        self.lowest = np.full(n_variables, np.inf)
+        self.highest = np.full(n_variables, -np.inf)
+        self.warm = self.partial = self.left_out = 0
+        self.averager: _WindowMeans | None = None
+
+    def collect(self, means: np.ndarray, index: int) -> None:
+        """Keep window means: columns time, power-on run, then the rest."""
+        if means.shape[0]:
+            self.time.append(means[:, 0])
+            self.power.append(np.round(means[:, 1]).astype(np.int64))
+            self.means.append(means[:, 2:])
+            self.run.append(np.full(means.shape[0], index))
+
+
+def window_means_at(
+    runs: Sequence[RunSource],
+    settings: FeatureSettings,
+    terms: Sequence[Term],
+    window_s: float = 10.0,
+    progress: Progress | None = None,
+    thermometer: Any = None,
+    extra_variables: Sequence[str] = (),
+    keep: Sequence[np.ndarray | None] | None = None,
+    *,
+    gaps: str = "bridge",
+    restart_each_segment: bool = False,
+    warmups_s: Sequence[float] | None = None,
+) -> tuple[TrainingWindows, ...]:
+    """:func:`window_means` for each warm-up of ``warmups_s`` (default
+    ``(settings.warmup_s,)``) from one reading of the runs: the variables do not depend
+    on the warm-up, only which rows are settled does, so each result is what
+    :func:`window_means` gives with ``settings.warmup_s`` set to that warm-up (the drift
+    fit's rate-free refit, ``warmup_s=0``, costs no second pass)."""
     variables = variables_for(terms)
     variables += tuple(v for v in extra_variables if v not in variables)
     if not window_s > 0:
         raise InputError(f"window_s must be a positive number of seconds, got {window_s!r}")
+    warmups = (settings.warmup_s,) if warmups_s is None else tuple(warmups_s)
     split = gaps == "split"
-    out_terms, out_bias, out_time, out_run, out_power = [], [], [], [], []
     power_names: list[str] = []
-    out_vars: dict[str, list[np.ndarray]] = {v: [] for v in variables}
-    out_extra: list[np.ndarray] = []
-    # per variable: smallest and largest used sample (the trained ranges)
-    lowest = np.full(len(variables), np.inf)
-    highest = np.full(len(variables), -np.inf)
-    total = warm = segments = partial = 0
-    left_out = 0
+    kept_by = [_Windows(w, len(variables)) for w in warmups]
+    total = segments = 0
     sources: list[str] = []
     extra: tuple[str, ...] | None = None
     problems: list[str] = []
 
-    def collect(means: np.ndarray, index: int) -> None:
-        """Keep window means: columns time, power-on run, bias, variables, extra, terms."""
-        out_time.append(means[:, 0])
-        out_power.append(np.round(means[:, 1]).astype(np.int64))
-        out_bias.append(means[:, 2])
-        for k, v in enumerate(variables):
-            out_vars[v].append(means[:, 3 + k])
-        first = 3 + len(variables)
-        out_extra.append(means[:, first:first + len(extra or ())])
-        out_terms.append(means[:, first + len(extra or ()):])
-        out_run.append(np.full(means.shape[0], index))
-
     for index, source in enumerate(runs):
         stream = FeatureStream(settings, variables, thermometer)
-        averager: _WindowMeans | None = None  # windows in rows at this run's own rate
+        window_rows = 0  # windows in rows at this run's own rate
         input_rate = None
         run_keep = None if keep is None else keep[index]
         row = 0
@@ -326,14 +358,15 @@ def window_means(
         power = len(power_names)  # index of the power-on run of the next row
         first_power = power
         for chunk in _iter_run(source):
-            if averager is None:
+            if not window_rows:
                 rate_hz = chunk.metadata.sample_rate_hz
                 window_rows = round(window_s * rate_hz)
                 if window_rows < 1:
                     raise InputError(f"window_s={window_s:g} s holds no sample at {rate_hz:g} Hz "
                                      f"({chunk.source or 'run ' + str(index)}); pass a longer "
                                      "--window-s")
-                averager = _WindowMeans(window_rows)
+                for kept_windows in kept_by:
+                    kept_windows.averager = _WindowMeans(window_rows)
                 period = 1.0 / rate_hz
             if input_rate is None:
                 input_rate = chunk.metadata.input_rate_dph
@@ -386,7 +419,7 @@ def window_means(
                 lengths = np.diff(np.append(power_starts, len(time)))
                 origin[power_starts[0]:] = np.repeat(time[power_starts], lengths)
                 power_on = float(time[power_starts[-1]])
-            settled = time - origin >= settle_threshold_s(settings.warmup_s)
+            elapsed = time - origin
             # the power-on run of each row (a new one at each restart)
             run_of_row = power + np.cumsum(np.bincount(power_starts, minlength=len(time)))
             power += power_starts.size
@@ -394,76 +427,88 @@ def window_means(
                 power_names.append(f"{sources[-1]} run {len(power_names) - first_power + 1}")
             rate = chunk["input_rate_dph"] if "input_rate_dph" in chunk else input_rate
             kept = None if run_keep is None else run_keep[row:row + len(chunk)]
-            if kept is not None:
-                left_out += int(np.count_nonzero(~kept & settled))
             row += len(chunk)
             rested = np.ones(len(chunk), dtype=bool) if kept is None else kept.astype(bool)
-            use = settled & rested
-            before = np.cumsum(use) - use  # rows used before each row
             previous = np.concatenate([[last_used], rested[:-1]])
-            cuts = before[np.flatnonzero(rested & ~previous)]
+            resumed = np.flatnonzero(rested & ~previous)
             last_used = bool(rested[-1])
-            warm += int(np.count_nonzero(~settled))
             cache: dict[tuple[str, int], np.ndarray] = {}
-            block = _used_rows(
-                use,
-                [
-                    chunk.time_s,
-                    run_of_row,
-                    chunk.rate_dph - rate,
-                    *(values[v] for v in variables),
-                    *(chunk[c] if c in chunk else np.nan for c in extra),
-                ],
-                (t.evaluate(values, cache) for t in terms),  # the design matrix's columns
-                len(terms),
-            )
-            if block.shape[0]:  # down the block's contiguous columns; NaN ignored
-                columns = block[:, 3:3 + len(variables)]
-                np.fmin(lowest, np.fmin.reduce(columns, axis=0), out=lowest)
-                np.fmax(highest, np.fmax.reduce(columns, axis=0), out=highest)
-            means = averager.transform(block, before[starts], cuts)
-            if means.shape[0]:
-                collect(means, index)
+            columns = [
+                chunk.time_s,
+                run_of_row,
+                chunk.rate_dph - rate,
+                *(values[v] for v in variables),
+                *(chunk[c] if c in chunk else np.nan for c in extra),
+                *(t.evaluate(values, cache) for t in terms),  # the design matrix's columns
+            ]
+            for windows in kept_by:
+                settled = elapsed >= windows.threshold_s
+                if kept is not None:
+                    windows.left_out += int(np.count_nonzero(~kept & settled))
+                use = settled & rested
+                before = np.cumsum(use) - use  # rows used before each row
+                windows.warm += int(np.count_nonzero(~settled))
+                block = _used_rows(use, columns, iter(()), 0)
+                if block.shape[0]:  # down the block's contiguous columns; NaN ignored
+                    used = block[:, 3:3 + len(variables)]
+                    np.fmin(windows.lowest, np.fmin.reduce(used, axis=0), out=windows.lowest)
+                    np.fmax(windows.highest, np.fmax.reduce(used, axis=0), out=windows.highest)
+                assert windows.averager is not None
+                windows.collect(windows.averager.transform(block, before[starts],
+                                                           before[resumed]), index)
             total += len(chunk)
             if progress is not None:
                 progress(total, 0)
-        if averager is None:  # a run without rows
+        if not window_rows:  # a run without rows
             continue
-        means = averager.flush()
-        if means.shape[0]:
-            collect(means, index)
+        for windows in kept_by:
+            assert windows.averager is not None
+            windows.collect(windows.averager.flush(), index)
+            windows.partial += windows.averager.partial_dropped_rows
         if power > first_power:  # the file restarted: name its first run too
             power_names[first_power] = f"{sources[-1]} run 1"
-        partial += averager.partial_dropped_rows
     warn_rate_filter(problems)
-    if not out_time:
+    return tuple(_training_windows(w, warmup, window_s, split, variables, extra or (), total,
+                                   sources, segments, power_names)
+                 for w, warmup in zip(kept_by, warmups, strict=True))
+
+
+def _training_windows(windows: _Windows, warmup_s: float, window_s: float, split: bool,
+                      variables: tuple[str, ...], extra: tuple[str, ...], total: int,
+                      sources: list[str], segments: int,
+                      power_names: list[str]) -> TrainingWindows:
+    """The :class:`TrainingWindows` of one warm-up's windows."""
+    if not windows.time:
         restart = " after every gap (--gaps split restarts the filter)" if split else ""
         raise CalibrationError(
             f"the drift runs hold no complete {window_s:g} s window after the "
-            f"{settings.warmup_s:g} s filter warm-up{restart}; give longer runs"
+            f"{warmup_s:g} s filter warm-up{restart}; give longer runs"
             + (", or --gaps bridge for a burst logger" if split else "")
         )
-    dropped = {k: v for k, v in (("warmup", warm), ("partial_windows", partial)) if v}
-    columns = np.concatenate(out_extra) if out_extra else np.empty((0, 0))
-    named = {c: columns[:, k] for k, c in enumerate(extra or ())
-             if np.all(np.isfinite(columns[:, k]))}
+    dropped = {k: v for k, v in (("warmup", windows.warm), ("partial_windows", windows.partial))
+               if v}
+    means = np.concatenate(windows.means)
+    first = 1 + len(variables)
+    columns = means[:, first:first + len(extra)]
+    named = {c: columns[:, k] for k, c in enumerate(extra) if np.all(np.isfinite(columns[:, k]))}
     accel = None
     if all(c in named for c in _EXTRA_COLUMNS[:3]):
         accel = np.column_stack([named[c] for c in _EXTRA_COLUMNS[:3]])
     return TrainingWindows(
-        n_not_at_rest=left_out,
+        n_not_at_rest=windows.left_out,
         accel=accel,
         orientation=named.get("orientation"),
-        time_s=np.concatenate(out_time),
-        run=np.concatenate(out_run),
-        terms=np.concatenate(out_terms),
-        bias_dph=np.concatenate(out_bias),
-        variables={v: np.concatenate(x) for v, x in out_vars.items()},
+        time_s=np.concatenate(windows.time),
+        run=np.concatenate(windows.run),
+        terms=np.ascontiguousarray(means[:, first + len(extra):]),
+        bias_dph=np.ascontiguousarray(means[:, 0]),
+        variables={v: np.ascontiguousarray(means[:, 1 + k]) for k, v in enumerate(variables)},
         n_samples=total,
         sources=tuple(sources),
         dropped=dropped,
         segments=segments,
-        power_run=np.concatenate(out_power),
+        power_run=np.concatenate(windows.power),
         power_runs=tuple(power_names),
-        extremes={v: (float(lowest[k]), float(highest[k])) for k, v in enumerate(variables)},
+        extremes={v: (float(windows.lowest[k]), float(windows.highest[k]))
+                  for k, v in enumerate(variables)},
     )

@@ -275,11 +275,13 @@ def calibrate_instrument(
     first = next(iter(results.values())).model.provenance.get("settings", {})
     reference = {} if temperature_reference is None else {
         "temperature_reference": temperature_reference.to_dict()}
+    hashed = {f["path"]: f["sha256"] for r in results.values()  # the axes' records
+              for f in r.model.provenance.get("inputs", ())}
     record = provenance(inputs, {**first, "axes": list(axes), "thermometer": thermometer,
                                  "scale_terms": list(scale_terms),
                                  "segment_table": None if segment_table is None
                                  else str(segment_table), "holdout_s": holdout_s,
-                                 "holdout_fraction": holdout_fraction, **reference})
+                                 "holdout_fraction": holdout_fraction, **reference}, hashed)
     models = {axis: dataclasses.replace(m, provenance=record) for axis, m in models.items()}
     instrument = InstrumentModel(models, unit, record, None if temperature_map is None
                                  else temperature_map.to_dict())

@@ -46,7 +46,9 @@ and the motion detector marks it (docs/real-loggers/motion.md).
 
 from __future__ import annotations
 
+import os
 import warnings
+from collections import OrderedDict
 from collections.abc import Mapping
 
 import numpy as np
@@ -246,6 +248,34 @@ def find_spikes(time_s: np.ndarray, values: np.ndarray, *, k: float = SPIKE_K,
     return _channel_mask("spike", time_s, values, k, lsb_multiple, window_s, lsb)
 
 
+#: The masks :func:`find_spikes` gave this process, by file piece: the drift fit reads a
+#: run several times (the at-rest pass, the window passes of the model and of the housing
+#: baseline) and each pass would test the same rows again. A piece is known by its file
+#: (path, modification time, size), first file row, column, the filter's settings and a
+#: fingerprint of its times and values (first, last, sum); the spikes' rows are kept,
+#: the :data:`_MEMO_PIECES` most recent pieces (a few MB).
+_MEMO: OrderedDict[tuple[object, ...], np.ndarray] = OrderedDict()
+_MEMO_PIECES = 4096
+
+
+def _file_identity(source: str | None) -> tuple[str, int, int] | None:
+    """(path, mtime, size) of the file ``source`` (None for none or a stream)."""
+    if not source:
+        return None
+    try:
+        stat = os.stat(source)
+    except (OSError, TypeError, ValueError):
+        return None
+    return os.path.realpath(source), stat.st_mtime_ns, stat.st_size
+
+
+def _fingerprint(values: np.ndarray) -> bytes:
+    """First, last value and sum of ``values`` as bytes (a NaN equals itself)."""
+    if not len(values):
+        return b""
+    return np.array([values[0], values[-1], np.sum(values)], dtype=np.float64).tobytes()
+
+
 def _filtered_columns(columns: Mapping[str, np.ndarray], axes: tuple[str, ...],
                       sensor: bool) -> list[str]:
     """The columns the robust filter tests: rates and the thermometer (not twice)."""
@@ -304,6 +334,7 @@ class RobustSpikeFilter:
         self.in_motion = 0
         self.first: tuple[str, int, float] | None = None
         self._lsb: dict[str, float | None] = {}
+        self._file = _file_identity(source)
 
     def apply(self, columns: Mapping[str, np.ndarray], row_offset: int) -> dict[str, np.ndarray]:
         """``columns`` without the rows of spikes (drop), or with a ``spike`` column (flag)."""
@@ -318,8 +349,7 @@ class RobustSpikeFilter:
             values = columns[name]
             if name not in self._lsb:  # the resolution of the first rows holds for the file
                 self._lsb[name] = resolution(values[:RESOLUTION_ROWS])
-            mask = find_spikes(time_s, values, k=self.k, lsb_multiple=self.lsb_multiple,
-                               window_s=self.window_s, lsb=self._lsb[name])
+            mask = self._spikes(name, time_s, values, row_offset)
             if turning is not None and base_name(name, axes) == "rate_dph" and mask.any():
                 self.in_motion += int(np.count_nonzero(mask & turning))
                 mask &= ~turning  # a rotation caught by one sample: the motion detector's
@@ -343,6 +373,28 @@ class RobustSpikeFilter:
             return out
         keep = ~marked
         return {name: values[keep] for name, values in out.items()}
+
+    def _spikes(self, name: str, time_s: np.ndarray, values: np.ndarray,
+                row_offset: int) -> np.ndarray:
+        """:func:`find_spikes` of one column of the piece at ``row_offset``, from
+        :data:`_MEMO` when this process has tested the same piece already."""
+        key = None
+        if self._file is not None:
+            key = (self._file, row_offset, name, len(values), self.k, self.lsb_multiple,
+                   self.window_s, self._lsb[name], _fingerprint(time_s), _fingerprint(values))
+            rows = _MEMO.get(key)
+            if rows is not None:
+                _MEMO.move_to_end(key)
+                mask = np.zeros(len(values), dtype=bool)
+                mask[rows] = True
+                return mask
+        mask = find_spikes(time_s, values, k=self.k, lsb_multiple=self.lsb_multiple,
+                           window_s=self.window_s, lsb=self._lsb[name])
+        if key is not None:
+            _MEMO[key] = np.flatnonzero(mask)
+            while len(_MEMO) > _MEMO_PIECES:
+                _MEMO.popitem(last=False)
+        return mask
 
     def _turning(self, columns: Mapping[str, np.ndarray], time_s: np.ndarray
                  ) -> np.ndarray | None:

@@ -32,6 +32,7 @@ from msgspec import Meta
 
 from hrgtc.core import records
 from hrgtc.core.errors import CalibrationError, ExtrapolationWarning, InputError
+from hrgtc.core.student_t import t_sf
 
 _GRID_POINTS = 2049
 _NEWTON_MAX_ITER = 60
@@ -141,15 +142,13 @@ class Thermometer:
 
         NaN where the fit has no residual degrees of freedom (as ``standard_errors``).
         """
-        from scipy import stats  # imported on first use: a faster start
-
         dof = self.n_points - self.order - 1
         out = []
         for c, se in zip(self.coefficients, self.standard_errors, strict=True):
             if dof <= 0 or not np.isfinite(se) or se == 0:
                 out.append(float("nan"))
             else:
-                out.append(float(2 * stats.t.sf(abs(c / se), dof)))
+                out.append(float(2 * t_sf(abs(c / se), dof)))
         return tuple(out)
 
     @property
