@@ -135,8 +135,8 @@ class _WindowMeans:
         self._carry: np.ndarray | None = None  # rows of the open window, from earlier chunks
         self.partial_dropped_rows = 0
 
-    def partial_fit(self, block: np.ndarray, breaks: Sequence[int] | np.ndarray = (),
-                    cuts: Sequence[int] | np.ndarray = ()) -> np.ndarray:
+    def transform(self, block: np.ndarray, breaks: Sequence[int] | np.ndarray = (),
+                  cuts: Sequence[int] | np.ndarray = ()) -> np.ndarray:
         """Window means of ``block``; ``breaks``: its rows that start a new segment,
         ``cuts``: its rows that follow left-out samples (a row that is both is a break)."""
         n, width = block.shape
