@@ -345,14 +345,20 @@ def fit(
     drift, candidates, options = drift_settings(settings, overrides)
     training = prepare(runs, thermometer, drift, candidates, options,
                        reading or TrainingReading(), aux_columns)
-    made = design(training, drift, thermometer, progress, excitation_runs)
-    chosen = select(training, made, drift, thermometer, initial)
-    first = made
-    made = refit_rate_free(training, made, chosen, drift)
+    first = design(training, drift, thermometer, progress, excitation_runs)
+    chosen = select(training, first, drift, thermometer, initial)
+    return _model(training, first, refit_rate_free(training, first, chosen, drift), chosen,
+                  drift)
+
+
+def _model(training: Any, first: Any, made: Any, chosen: Any, drift: DriftSettings,
+           ) -> DriftModel:
+    """The fitted model from the stages of :func:`fit` (``first``: the F-tests' design,
+    ``made``: the final one, the rate-free refit's when there was one)."""
     result, windows, names = chosen.result, made.windows, training.names
     ols = result.result
     selected = result.selected
-    selected_factor = {t.name: t.scale_factor(made.scales) for t in candidates}
+    selected_factor = {t.name: t.scale_factor(made.scales) for t in training.candidates}
     params = np.asarray(ols.params)
     bse = np.asarray(ols.bse)
     pvalues = np.asarray(ols.pvalues)
