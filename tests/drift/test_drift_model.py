@@ -183,3 +183,23 @@ def test_heating_switch_dpos_carries_a_heating_only_rate_term(cooldown):
     assert heating_part(np.array([-5.0 * delta]), delta)[0] == pytest.approx(0.0, abs=1e-3 * delta)
     with pytest.raises(InputError, match="switch_hz_per_s"):
         drift.features.FeatureStream(plain.settings, ("f", "dpos")).transform(cooldown)
+
+
+def test_the_model_keeps_what_an_update_needs(model):
+    """The coefficient prior in user units agrees with the fit's figures and, propagated
+    through the terms in user units, with :meth:`DriftModel.prediction_std`, which works
+    on the scaled variables (two routes to one covariance)."""
+    names, mean, covariance = model.coefficient_prior()
+    assert names == ("const", *model.selected)
+    for k, name in enumerate(model.selected, start=1):
+        assert mean[k] == pytest.approx(model.coefficients[name], rel=1e-12)
+        assert np.sqrt(covariance[k, k]) == pytest.approx(model.standard_errors[name],
+                                                          rel=1e-12)
+    np.testing.assert_allclose(covariance, covariance.T, rtol=0, atol=0)
+    assert np.all(np.linalg.eigvalsh(covariance) > 0)
+    # inside the trained ranges the model is linear in its coefficients: J Σ Jᵀ
+    rng = np.random.default_rng(4)
+    values = {v: rng.uniform(*model.ranges[v], 50) for v in model.variables}
+    jacobian = np.column_stack([np.ones(50), *(t.evaluate(values) for t in model.terms)])
+    expected = np.sqrt(np.einsum("ij,jk,ik->i", jacobian, covariance, jacobian))
+    np.testing.assert_allclose(model.prediction_std(values), expected, rtol=1e-9)

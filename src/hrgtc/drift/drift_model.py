@@ -212,6 +212,19 @@ class DriftModel(ParsedTerms):
         variance = np.einsum("ij,jk,ik->i", jacobian, cov, jacobian)
         return np.sqrt(np.maximum(variance, 0.0))
 
+    def coefficient_prior(self) -> tuple[tuple[str, ...], np.ndarray, np.ndarray]:
+        """What an update of the model starts from (issue 29's ``update``, a method of the
+        fitted model): the names (``"const"`` and the selected terms), the fit's
+        coefficients in user units (B0 before the nuisance offsets, then each term's °/h per
+        term unit) and their covariance in user units, the final fit's scaled covariance
+        (with its Newey-West inflation) unscaled by each term's factor: Σ = D⁻¹ Σₛ D⁻¹,
+        D = diag(1, the scale factors of :attr:`settings`)."""
+        factors = np.array([1.0, *(t.scale_factor(self.settings.scales) for t in self._terms)])
+        ols = self.stepwise.result
+        mean = np.asarray(ols.params, dtype=np.float64) / factors
+        covariance = np.asarray(ols.cov_params, dtype=np.float64) / np.outer(factors, factors)
+        return ("const", *self.selected), mean, covariance
+
     def predict_recording(self, recording: Recording, thermometer: Any = None) -> np.ndarray:
         """Bias of a whole recording, filter started at its first sample. [°/h]
 
