@@ -135,8 +135,12 @@ def classify(expect: Expect, code: int, text: str, crashed: bool, inputs: Iterab
         if expect.outcome == "correct" and not all(n in output for n in expect.names):
             return "silent"  # accepted, but what it left out is not reported
         return "correct"
-    if code != expect.code or not text.startswith("error:"):
+    # the error is judged; warnings the command printed before it (shown as on a terminal)
+    # are not the error
+    start = 0 if text.startswith("error:") else text.find("\nerror:") + 1
+    if code != expect.code or not text[start:].startswith("error:"):
         return "misleading"
+    text = text[start:]
     if expect.outcome == "correct":
         return "misleading"  # a valid file refused
     named = any(p.name in text for p in inputs)

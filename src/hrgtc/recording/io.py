@@ -242,7 +242,6 @@ def read(path: str | Path, options: ReadSettings | None = None, *, validate: boo
         meta = _metadata(plan, opts.metadata, arrays.get("time_s"))
     if repairer.events or repairer.duplicates:
         meta = replace(meta, extra={**meta.extra, **_repair_extra(repairer)})
-    warn_restarts(repairer)
     warn_alignment(source)
     slow.warn()
     if spike_filter is not None and spike_filter.dropped:
@@ -259,6 +258,7 @@ def read(path: str | Path, options: ReadSettings | None = None, *, validate: boo
                            freq_span_hz=opts.freq_span_hz, thermometer=opts.thermometer,
                            file_rows=file_rows, dropout_s=opts.dropout_s,
                            temperature_counts=robust.counts).warn_bridged()
+        warn_restarts(repairer)  # a file that passes: a wrong diagnosis never precedes an error
     return recording
 
 
@@ -438,7 +438,7 @@ def iter_chunks(path: str | Path, options: ReadSettings | None = None, *,
             report = validator.finish()
             report.raise_for_problems()
             report.warn_bridged()
-        warn_restarts(repairer)
+            warn_restarts(repairer)
         if spike_filter is not None:
             spike_filter.warn()
         robust.warn()
