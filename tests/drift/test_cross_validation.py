@@ -9,7 +9,12 @@ import pytest
 
 from hrgtc import drift
 from hrgtc.core.errors import InputError
-from hrgtc.drift.cross_validation import CrossValidation, cross_validate, select_terms
+from hrgtc.drift.cross_validation import (
+    CrossValidation,
+    Windowed,
+    cross_validate,
+    select_terms,
+)
 from hrgtc.drift.stepwise import stepwise
 
 from synthetic import THERMOMETER, ramp_run
@@ -47,12 +52,13 @@ def test_cross_validation_equals_refits_by_hand():
 
 def test_selection_by_cross_validation_finds_the_law():
     x, y, run, rate = _runs(seed=42)
-    assert select_terms(x, y, run, NAMES, ("r0", "r1", "r2", "r3"), rate) == ("a", "b")
+    runs = ("r0", "r1", "r2", "r3")
+    assert select_terms(Windowed(x, y, run, NAMES, runs, rate)) == ("a", "b")
     # a slope that only run 0 shows does not carry over to the others: the F-test keeps
     # it (in-sample), cross-validation does not
     y2 = y + np.where(run == 0, 3.0 * x[:, 2], 0.0)
     assert "c" in stepwise(x, y2, names=NAMES).selected
-    assert "c" not in select_terms(x, y2, run, NAMES, ("r0", "r1", "r2", "r3"), rate,
+    assert "c" not in select_terms(Windowed(x, y2, run, NAMES, runs, rate),
                                    initial=("a", "b", "c"))
 
 

@@ -163,9 +163,36 @@ def cross_validate(x_scaled: np.ndarray, bias_dph: np.ndarray, run: np.ndarray,
                            score)
 
 
-def select_terms(x_scaled: np.ndarray, bias_dph: np.ndarray, run: np.ndarray,
-                 names: Sequence[str], sources: Sequence[str], rate: np.ndarray,
-                 slope_sign: float = 1.0, min_gain: float = 0.01,
+@dataclass(frozen=True)
+class Windowed:
+    """The training windows a choice of terms is judged on.
+
+    Attributes
+    ----------
+    x_scaled, bias_dph
+        The scaled design matrix (a column per candidate) and the bias of each window
+        (offsets projected off). [°/h]
+    run, names
+        Each window's run index and the candidates' names (the columns' order).
+    sources
+        The runs' names (for the per-run figures of :func:`cross_validate`).
+    rate
+        df/dt of each window (the heating/cooling split of :func:`cross_validate`).
+    time_s, temperature
+        Each window's time and thermometer variable (the time blocks of a single run).
+    """
+
+    x_scaled: np.ndarray
+    bias_dph: np.ndarray
+    run: np.ndarray
+    names: tuple[str, ...]
+    sources: tuple[str, ...] = ()
+    rate: np.ndarray | None = None
+    time_s: np.ndarray | None = None
+    temperature: np.ndarray | None = None
+
+
+def select_terms(data: Windowed, slope_sign: float = 1.0, min_gain: float = 0.01,
                  parents: Mapping[str, Sequence[str]] | None = None,
                  initial: Sequence[str] = ()) -> tuple[str, ...]:
     """Terms chosen by leave-one-run-out cross-validated bias stability.
@@ -177,9 +204,11 @@ def select_terms(x_scaled: np.ndarray, bias_dph: np.ndarray, run: np.ndarray,
     child is in. The result is never worse by this figure than ``initial``. Needs at
     least two runs. Returns the terms in candidate order.
     """
+    names = data.names
+
     def score(terms: Sequence[str]) -> float:
-        value = cross_validate(x_scaled, bias_dph, run, names, terms, sources, rate,
-                               slope_sign).score_dph
+        value = cross_validate(data.x_scaled, data.bias_dph, data.run, names, terms,
+                               data.sources, data.rate, slope_sign).score_dph
         return value if math.isfinite(value) else math.inf
 
     chosen = [n for n in names if n in set(initial)]
@@ -441,14 +470,12 @@ def _line_admitted(x_scaled: np.ndarray, bias_dph: np.ndarray, names: Sequence[s
                     premove=premove).selected == (LINE_TERM,)
 
 
-def guard_selection(x_scaled: np.ndarray, bias_dph: np.ndarray, run: np.ndarray,
-                    time_s: np.ndarray, names: Sequence[str], selected: Sequence[str],
+def guard_selection(data: Windowed, selected: Sequence[str],
                     parents: Mapping[str, Sequence[str]] | None = None,
-                    keep: Sequence[str] = (), temperature: np.ndarray | None = None,
-                    line_test: tuple[float, float] | None = None,
+                    keep: Sequence[str] = (), line_test: tuple[float, float] | None = None,
                     ) -> tuple[tuple[str, ...] | None, dict[str, Any]]:
     """The guarded selection: :func:`prune_terms` on the folds of :func:`folds_of`
-    (``temperature``: the window means of the thermometer variable, which pick the
+    (``data.temperature``: the window means of the thermometer variable, which pick the
     coldest and the hottest block of a single run). ``line_test``: ``(penter, premove)``
     of a plain F-test of the line in the thermometer variable (:data:`LINE_TERM`) on its
     own; on a single run, a line it admits is kept whatever the other terms.
@@ -456,7 +483,8 @@ def guard_selection(x_scaled: np.ndarray, bias_dph: np.ndarray, run: np.ndarray,
     Returns the terms to refit (None when nothing was dropped) and the record of the check
     (``folds``, ``dropped``, ``before_dph``, ``after_dph``) stored in the model.
     """
-    folds, kind = folds_of(run, time_s, temperature)
+    x_scaled, bias_dph, names, time_s = data.x_scaled, data.bias_dph, data.names, data.time_s
+    folds, kind = folds_of(data.run, time_s, data.temperature)
     original = set(selected)
     if kind != "runs" and _line_admitted(x_scaled, bias_dph, names, line_test):
         # one long run: a line in the thermometer variable that is significant on its own

@@ -25,7 +25,7 @@ import numpy as np
 
 from hrgtc.core.errors import InputError
 from hrgtc.core.progress import Progress
-from hrgtc.drift.cross_validation import guard_selection, select_terms
+from hrgtc.drift.cross_validation import Windowed, guard_selection, select_terms
 from hrgtc.drift.features import EQ21, FeatureSettings, Term, hierarchy, parse_terms, variables_for
 from hrgtc.drift.fit_checks import check_excitation, given_options, registry_entries
 from hrgtc.drift.offsets import offset_groups, project_off
@@ -271,15 +271,15 @@ def select(training: Training, made: Design, drift: DriftSettings, thermometer: 
                       initial=initial, variance_inflation=inflation, parents=parents,
                       refine=EXTENDED_PRECISION)  # quietly unrefined without long double
     chosen, pruning = None, None
+    data = Windowed(x_scaled, bias, windows.run, names, tuple(windows.sources), rate,
+                    windows.time_s, windows.variables.get("f"))
     if drift.select == "cv":  # from the stepwise terms, one-term changes that cross-validate
-        chosen = select_terms(x_scaled, bias, windows.run, names, windows.sources, rate,
-                              slope_sign, parents=parents, initial=result.selected)
+        chosen = select_terms(data, slope_sign, parents=parents, initial=result.selected)
     elif drift.select == "guarded" and (result.selected or np.unique(windows.run).size == 1):
         chosen, pruning = guard_selection(
-            x_scaled, bias, windows.run, windows.time_s, names, result.selected,
-            parents=hierarchy(training.candidates),
+            data, result.selected, parents=hierarchy(training.candidates),
             keep=[parse_terms([t])[0].name for t in initial or ()],
-            temperature=windows.variables.get("f"), line_test=(drift.penter, drift.premove))
+            line_test=(drift.penter, drift.premove))
     if chosen is not None:
         history = result.history
         result = stepwise(x_scaled, bias, names=names, penter=drift.penter,
