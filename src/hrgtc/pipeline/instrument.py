@@ -37,6 +37,7 @@ from hrgtc.drift import (
 from hrgtc.drift.scale_factor import TOLERANCE_SHARE
 from hrgtc.evaluation import Evaluation, evaluate
 from hrgtc.evaluation.calibration_figures import instrument_summary
+from hrgtc.evaluation.instrument_pass import evaluate_axes
 from hrgtc.model import InstrumentModel, UnitModel, provenance
 from hrgtc.pipeline import documents
 from hrgtc.pipeline.calibration import HOUSING_TERMS, CalibrationResult, calibrate
@@ -287,9 +288,10 @@ def calibrate_instrument(
                                  else temperature_map.to_dict())
     held_out = options if validate_options is None else _same_cache(dataclasses.replace(
         validate_options, thermometer=thermometer), options)
-    validation = {axis: tuple(evaluate(path, models[axis], settings=BIAS_ONLY,
-                                       read_options=axis_options(held_out, axis))
-                              for path in validate) for axis in axes}
+    # each held-out run read once for every axis (evaluation.instrument_pass)
+    runs = [evaluate_axes(path, instrument, settings=BIAS_ONLY, read_options=held_out)
+            for path in validate]
+    validation = {axis: tuple(run[axis] for run in runs) for axis in axes}
     checks = tuple(check_scale_factor(path, instrument, options, table)
                    for path in validate_rate_tables)
     return InstrumentCalibration(instrument, results, validation,
@@ -563,7 +565,6 @@ def evaluate_instrument(
         The model file's name, for the messages.
     """
     from hrgtc.compensate.multi_axis import match_axes, recording_axes
-    from hrgtc.evaluation.instrument_pass import evaluate_axes
     from hrgtc.model_fit import check_thermometer_kind
     from hrgtc.thermometry.reference import options_with_map
 
