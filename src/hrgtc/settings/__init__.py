@@ -33,15 +33,32 @@ field in one of these classes (docs/architecture.md, "Adding a parameter").
 from __future__ import annotations
 
 import dataclasses
-from typing import Any
+from typing import Any, TypedDict, Unpack
 
-__all__ = ["Setting", "build", "format_value", "setting", "settings_of", "to_dict"]
+__all__ = ["Setting", "Shown", "build", "format_value", "setting", "settings_of", "to_dict"]
 
 
-def setting(default: Any, help: str, *, unit: str | None = None, cli: str | None = "",
-            choices: tuple[str, ...] | None = None, default_text: str | None = None,
-            metavar: str | None = None, panel: str | None = None, min: float | None = None,
-            max: float | None = None, multiple: bool = False) -> Any:
+class Shown(TypedDict, total=False):
+    """What the command line and docs say of a setting besides its help (see :func:`setting`)."""
+
+    unit: str | None
+    cli: str | None
+    choices: tuple[str, ...] | None
+    default_text: str | None
+    metavar: str | None
+    panel: str | None
+    min: float | None
+    max: float | None
+    multiple: bool
+
+
+#: What :func:`setting` assumes of what it is not told.
+_SHOWN_DEFAULTS: Shown = {"unit": None, "cli": "", "choices": None, "default_text": None,
+                          "metavar": None, "panel": None, "min": None, "max": None,
+                          "multiple": False}
+
+
+def setting(default: Any, help: str, **shown: Unpack[Shown]) -> Any:
     """A dataclass field with its default and what the command line and docs say of it.
 
     Parameters
@@ -70,9 +87,10 @@ def setting(default: Any, help: str, *, unit: str | None = None, cli: str | None
         A tuple field whose option is given once per item (``--aux a=x --aux b=y``), not
         comma separated; its default is ``()``.
     """
-    meta = {"help": help, "unit": unit, "cli": cli, "choices": choices,
-            "default_text": default_text, "metavar": metavar, "panel": panel,
-            "min": min, "max": max, "multiple": multiple}
+    unknown = set(shown) - set(_SHOWN_DEFAULTS)
+    if unknown:
+        raise TypeError(f"setting() got unknown keywords {sorted(unknown)}")
+    meta = {"help": help, **_SHOWN_DEFAULTS, **shown}
     return dataclasses.field(default=default, metadata=meta)
 
 
