@@ -4,6 +4,7 @@ other options validated anew."""
 
 from __future__ import annotations
 
+import os
 import warnings
 from unittest import mock
 
@@ -97,3 +98,18 @@ def test_the_warnings_of_the_validation_are_said_on_every_pass(tmp_path):
             list(iter_chunks(path, ReadOptions(), rows=700))
         gaps = [str(w.message) for w in caught if issubclass(w.category, GapWarning)]
         assert len(gaps) == 1 and "1 dropout(s) no longer than 5 s" in gaps[0]
+
+
+def test_a_file_rewritten_in_place_with_its_time_and_size_is_validated_again(tmp_path):
+    path = tmp_path / "run.csv"
+    good = "time_s,freq_hz,rate_dph\n" + "".join(
+        f"{k / RATE_HZ:.3f},4425.000,10.000\n" for k in range(400))
+    path.write_text(good)
+    stat = path.stat()
+    list(iter_chunks(path, ReadOptions(), rows=100))
+    bad = good[:-len("4425.000,10.000\n")] + "4425.000,   nan\n"  # same size, last row NaN
+    assert len(bad) == len(good)
+    path.write_text(bad)
+    os.utime(path, ns=(stat.st_atime_ns, stat.st_mtime_ns))  # the same modification time
+    with pytest.raises(RecordingError, match="rate_dph"):
+        list(iter_chunks(path, ReadOptions(), rows=100))

@@ -7,13 +7,15 @@ pass, the window means of the drift model and of the housing baseline,
 result. :func:`iter_chunks <hrgtc.recording.io.iter_chunks>` remembers the
 :class:`~hrgtc.recording.checks.ValidationReport` of a pass that ran to the file's end
 without a problem, keyed on the file's identity (resolved path, inode, modification time
-in ns, size: a file rewritten is another file) and on the whole reading options, and a
+in ns, size, a digest of its first and last 4 KiB: a file rewritten is another file) and on
+the whole reading options, and a
 later pass with the same key says the report's warnings again instead of validating. A
 pass that stopped early (a head) or raised remembers nothing.
 """
 
 from __future__ import annotations
 
+import hashlib
 import os
 from collections import OrderedDict
 from collections.abc import Collection
@@ -24,6 +26,8 @@ from hrgtc.recording.checks import ValidationReport
 
 #: the most recent reports kept (one per file and reading options)
 _KEPT = 64
+#: bytes of each end of a file in its key
+_END_BYTES = 4096
 _REPORTS: OrderedDict[tuple[object, ...], ValidationReport] = OrderedDict()
 
 
@@ -39,7 +43,20 @@ def validation_key(path: str | Path, options: Any,
         return None
     columns = None if only is None else tuple(sorted(only))
     return (os.path.realpath(path), stat.st_ino, stat.st_mtime_ns, stat.st_size,
-            repr(options), columns)
+            _ends(path, stat.st_size), repr(options), columns)
+
+
+def _ends(path: str | Path, size: int) -> bytes:
+    """A digest of the file's first and last :data:`_END_BYTES` bytes (a file rewritten in
+    place within the clock's tick, same size, still differs in its header or footer: a
+    Parquet footer holds every column chunk's offsets, a CSV its last rows)."""
+    digest = hashlib.blake2b(digest_size=16)
+    with open(path, "rb") as handle:
+        digest.update(handle.read(_END_BYTES))
+        if size > _END_BYTES:
+            handle.seek(max(size - _END_BYTES, _END_BYTES))
+            digest.update(handle.read(_END_BYTES))
+    return digest.digest()
 
 
 def known_report(key: tuple[object, ...] | None) -> ValidationReport | None:
