@@ -46,7 +46,8 @@ from hrgtc.core.errors import InputError, RecordingError
 from hrgtc.core.progress import Progress
 from hrgtc.core.time_steps import TimeRepairStream
 from hrgtc.recording.align import align, warn_alignment
-from hrgtc.recording.axes import axis_view
+from hrgtc.recording.axis_views import axis_views
+from hrgtc.recording.axis_views import check_axis_band as check_axis_band  # its old home
 from hrgtc.recording.file_rows import RemovedInSlice, take_file_rows, with_file_rows
 from hrgtc.recording.formats.base import Source
 from hrgtc.recording.formats.registry import open_streams
@@ -74,6 +75,7 @@ from hrgtc.recording.time_axis import (
     warn_restarts,
     with_restarts,
 )
+from hrgtc.recording.validated import known_report, remember, validation_key
 from hrgtc.recording.validation import (
     HEURISTIC_ROWS,
     RecordingValidator,
@@ -341,7 +343,7 @@ def iter_chunks(path: str | Path, options: ReadSettings | None = None, *,
     rows = opts.chunk_rows if rows is None else rows
     if opts.axis is not None:  # the views of one axis, the file validated as a whole
         whole = replace(opts, axis=None, freq_band_hz=None, freq_span_hz=None)
-        yield from _axis_views(iter_chunks(path, whole, rows=rows, validate=validate,
+        yield from axis_views(iter_chunks(path, whole, rows=rows, validate=validate,
                                            progress=progress, time_repair=time_repair,
                                            dropped=dropped, file_rows=file_rows,
                                            only=only),
@@ -351,8 +353,11 @@ def iter_chunks(path: str | Path, options: ReadSettings | None = None, *,
     if int(rows) < 1:
         raise InputError(f"rows must be a positive number of rows per chunk, got {rows!r}")
     rows = int(rows)
+    key = validation_key(path, opts, only) if validate else None
+    known = known_report(key)  # this file passed with these options: not again
     validator = (RecordingValidator(opts.gaps, opts.freq_band_hz, opts.freq_span_hz,
-                                    opts.thermometer, opts.dropout_s) if validate else None)
+                                    opts.thermometer, opts.dropout_s)
+                 if validate and known is None else None)
     slow = SlowChannels(opts.slow_channels, opts.hold_max_s, str(path))
     with open_source(path, opts.slow_channels, opts.hold_max_s) as source:
         plan = _plan(source, opts, robust, spike_filter)
@@ -368,7 +373,7 @@ def iter_chunks(path: str | Path, options: ReadSettings | None = None, *,
             time_repair.source = repairer.source
             repairer = time_repair
         cut = _TimeSlice(opts.start, opts.end, plan)
-        numbered = validator is not None or file_rows is not None
+        numbered = validate or file_rows is not None
         in_slice = RemovedInSlice()  # the spikes inside --start/--end, for the accounting
 
         def converted() -> Iterator[dict[str, np.ndarray]]:
@@ -435,9 +440,11 @@ def iter_chunks(path: str | Path, options: ReadSettings | None = None, *,
             if progress is not None:
                 progress(*source.position())
         if validator is not None:
-            report = validator.finish()
-            report.raise_for_problems()
-            report.warn_bridged()
+            known = validator.finish()
+            known.raise_for_problems()
+            remember(key, known)
+        if known is not None:  # validated now or by an earlier pass: the same warnings
+            known.warn_bridged()
             warn_restarts(repairer)
         if spike_filter is not None:
             spike_filter.warn()
@@ -564,36 +571,4 @@ class ReadOptions(ReadSettings):
         return parse_columns(self.columns).get(name, name), np.asarray(head[name])
 
     def _axis_chunks(self, chunks: Iterator[Recording], path: str) -> Iterator[Recording]:
-        return _axis_views(chunks, str(self.axis), self.freq_band_hz, path)
-
-
-def _axis_views(chunks: Iterator[Recording], axis: str, band: tuple[float, float] | None,
-                path: str) -> Iterator[Recording]:
-    """The view of ``axis`` of each of ``chunks`` (read from ``path``), its frequency
-    checked against the plausible ``band`` of that axis of a model (None: unchecked)."""
-    row = 0
-    try:
-        for chunk in chunks:
-            view = axis_view(chunk, axis)
-            if band is not None:
-                check_axis_band(view, axis, band, row, path)
-            row += len(chunk)
-            yield view
-    finally:
-        chunks.close()  # type: ignore[attr-defined]
-
-
-def check_axis_band(view: Recording, axis: str, band: tuple[float, float], row: int,
-                    path: str) -> None:
-    """Refuse a frequency of ``axis``'s view (whose first row is ``row`` of ``path``)
-    outside the ``band`` that axis of a model can reach."""
-    if not len(view):
-        return
-    freq = view.freq_hz
-    bad = np.flatnonzero(~((freq >= band[0]) & (freq <= band[1])))
-    if bad.size:
-        raise RecordingError(
-            f"{path}: column freq_hz_{axis}, row {row + int(bad[0])}: "
-            f"{float(freq[bad[0]])!r} is outside the band {band[0]:.6g} to {band[1]:.6g} this "
-            f"axis of the model can reach ({bad.size} such rows in the chunk); is it another "
-            "unit's file, or the wrong column?")
+        return axis_views(chunks, str(self.axis), self.freq_band_hz, path)
