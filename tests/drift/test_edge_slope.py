@@ -68,3 +68,22 @@ def test_a_known_edge_slope_or_an_unknown_line_changes_nothing():
     assert unknown_edge_slope(flat, kept) == (kept, None)
     # nothing beyond the line
     assert unknown_edge_slope(flat, ("f", "df")) == (("f", "df"), None)
+
+
+def test_the_model_s_notes_say_why_the_bend_went():
+    from types import SimpleNamespace
+
+    from hrgtc.drift.drift_text import drift_notes
+
+    edge = {"line": [8.51, 1.37], "cold": [-3.54, 4.72], "hot": [21.1, 3.22], "z": 2.0,
+            "dropped": ["f^2", "f^3"]}
+    model = SimpleNamespace(variance_inflation=1.0, bandwidth_windows=0, cross_validation=None,
+                            n_not_at_rest=0, offsets_dph={}, pruning={
+                                "folds": "coldest and hottest time blocks",
+                                "dropped": ["f^2", "f^3"], "before_dph": 9.94,
+                                "after_dph": 21.1, "edge_slope": edge})
+    notes = drift_notes(model)
+    assert notes[0].startswith("guarded selection: dropped f^2, f^3")
+    assert notes[1] == ("  f^2, f^3: the slope at an edge of the trained range unknown "
+                        "(cold -3.54 ± 4.7, hot 21.1 ± 3.2) where the line's is known "
+                        "(8.51 ± 1.4) [°/h per unit of f]")
