@@ -7,6 +7,7 @@ the guarded selection keeps, then with each ``--terms`` set put in their place (
 is refitted with those terms, the rest unchanged)::
 
     PYTHONPATH=src python bench/bench_corpus_terms.py vn100 --terms f f,df f,f^2 f,f^2,f^3
+    PYTHONPATH=src python bench/bench_corpus_terms.py --json   # every file, guarded terms
 
 A ratio below 1 is better than the line; the bound is the 95 % χ² interval's upper end of
 :func:`real_corpus.ratio_bound`.
@@ -71,18 +72,29 @@ def main(argv: list[str] | None = None) -> int:
     from real_corpus import CORPUS
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("file", help="start of a corpus file's name (vn100, tofupilot, cats)")
+    parser.add_argument("file", nargs="?", default="",
+                        help="start of a corpus file's name (vn100, tofupilot, cats; "
+                             "default: every file)")
     parser.add_argument("--terms", nargs="*", default=[],
                         help="term sets to force, comma-separated (f,f^2,df)")
+    parser.add_argument("--json", action="store_true",
+                        help="one JSON line per file and term set instead of the text")
     args = parser.parse_args(argv)
-    real = next(r for r in CORPUS if r.name.startswith(args.file))
-    with tempfile.TemporaryDirectory() as directory:
-        path = real.unpacked(Path(directory))
-        for terms in [None, *(tuple(t.split(",")) for t in args.terms)]:
-            label = "guarded" if terms is None else ",".join(terms)
-            for axis, row in run(real, path, Path(directory), terms).items():
-                print(f"{real.name} {label:>24} {axis}: {row['ratio']:.3f} "
-                      f"(bound {row['bound']:.3f}) {','.join(row['terms'])}", flush=True)
+    for real in (r for r in CORPUS if r.name.startswith(args.file)):
+        with tempfile.TemporaryDirectory() as directory:
+            path = real.unpacked(Path(directory))
+            for terms in [None, *(tuple(t.split(",")) for t in args.terms)]:
+                label = "guarded" if terms is None else ",".join(terms)
+                rows = run(real, path, Path(directory), terms)
+                if args.json:
+                    print(json.dumps({"file": real.name, "terms": label, "axes": {
+                        axis: {"ratio": round(row["ratio"], 4), "bound": round(row["bound"], 4),
+                               "terms": list(row["terms"])} for axis, row in rows.items()}}),
+                          flush=True)
+                    continue
+                for axis, row in rows.items():
+                    print(f"{real.name} {label:>24} {axis}: {row['ratio']:.3f} "
+                          f"(bound {row['bound']:.3f}) {','.join(row['terms'])}", flush=True)
     return 0
 
 

@@ -76,9 +76,6 @@ class RealFile:
     args: tuple[str, ...]
     still: tuple[tuple[float, float], ...]
     read: Callable[[Path], Reading]
-    #: Axes known to miss :data:`LINE_RATIO`, with why (docs/real-loggers/corpus.md): they
-    #: must still lie within the 95 % interval of the line's RMS.
-    known: tuple[tuple[str, str], ...] = ()
 
     def unpacked(self, directory: Path) -> Path:
         """The data file, unpacked into ``directory`` when it is a ``.gz``."""
@@ -143,10 +140,7 @@ CORPUS = (
          "--rate-unit", "radps", "--thermometer", "sensor"),
         # the README's (seconds of millis / 1000) less the first sample's 7.985 s
         ((40.0, 1074.0), (1107.0, 1286.0), (1821.0, 3279.0), (3432.0, 4493.0)),
-        _vn100,
-        known=(("x", "nearly flat in T (1.8 °/h/°C): the guarded selection keeps a cubic in "
-                "T and two rate terms that win on the training part's coldest block and "
-                "lose 4.5 °C beyond it"),)),
+        _vn100),
 )
 
 
@@ -215,8 +209,9 @@ def line_figures(reading: Reading, periods, compensated_time_s: np.ndarray,
 
 def ratio_bound(figures: dict[str, float], level: float = 0.95) -> float:
     """Upper end of the two-sided ``level`` interval of an RMS ratio that chance alone gives
-    a model as good as the line: χ² with the held-out means' degrees of freedom (their
-    number less one per still period, whose mean was taken off)."""
+    a model as good as the line (bench/bench_corpus_terms.py prints it): χ² with the
+    held-out means' degrees of freedom (their number less one per still period, whose mean
+    was taken off)."""
     from scipy.stats import chi2
 
     dof = max(figures["n_means"] - figures["periods"], 1)

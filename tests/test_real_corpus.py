@@ -39,7 +39,6 @@ from real_corpus import (
     RealFile,
     at_rest_extremes,
     line_figures,
-    ratio_bound,
     split_s,
 )
 
@@ -112,9 +111,5 @@ def test_a_newcomer_s_run_on_a_real_file(real: RealFile, tmp_path):
     ratios = {axis: f["ratio"] for axis, f in figures.items()}
     assert _table_row(real.name) == {a: round(r, 2) for a, r in ratios.items()}, figures
     assert all(np.isfinite(list(ratios.values())))
-    known = dict(real.known)
-    for axis, ratio in ratios.items():
-        if axis in known:  # named in the docs with why: within chance of the line at least
-            assert LINE_RATIO < ratio <= ratio_bound(figures[axis]), (axis, figures[axis])
-        else:
-            assert ratio <= LINE_RATIO, (axis, figures[axis])
+    for axis, ratio in ratios.items():  # every axis, vn100's nearly flat x too (issue 27)
+        assert ratio <= LINE_RATIO, (axis, figures[axis])

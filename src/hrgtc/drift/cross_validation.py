@@ -30,6 +30,7 @@ import numpy as np
 
 from hrgtc.core import records
 from hrgtc.core.timeline import time_blocks
+from hrgtc.drift.edge_slope import unknown_edge_slope
 from hrgtc.drift.regression import newey_west_inflation
 from hrgtc.drift.slow_noise import SLOW_NOISE_LEVEL, beyond_slow_noise
 from hrgtc.drift.stepwise import stepwise
@@ -180,6 +181,10 @@ class Windowed:
         df/dt of each window (the heating/cooling split of :func:`cross_validate`).
     time_s, temperature
         Each window's time and thermometer variable (the time blocks of a single run).
+    variables, scales
+        Each window's mean of every variable, and each variable's scale (the slope a
+        single run's model leaves at the edges of its range,
+        :func:`hrgtc.drift.edge_slope.unknown_edge_slope`); None: not tested.
     """
 
     x_scaled: np.ndarray
@@ -190,6 +195,8 @@ class Windowed:
     rate: np.ndarray | None = None
     time_s: np.ndarray | None = None
     temperature: np.ndarray | None = None
+    variables: Mapping[str, np.ndarray] | None = None
+    scales: Mapping[str, float] | None = None
 
 
 def select_terms(data: Windowed, slope_sign: float = 1.0, min_gain: float = 0.01,
@@ -499,14 +506,21 @@ def guard_selection(data: Windowed, selected: Sequence[str],
     # term when the one warm-up is left out): there, stop at the first rise
     kept, before, after = prune_terms(x_scaled, bias_dph, folds, names, selected,
                                       parents=parents, keep=keep, through=kind != "runs")
-    tests = None
+    tests, edge = None, None
     if kind != "runs" and kept:  # one ramp: the extreme blocks are its ends, walk and all
         # the line in the thermometer variable stays: the test is of what goes beyond it
         kept, tests = prune_slow_noise(x_scaled, bias_dph, folds, time_s, names, kept,
                                        parents=parents, keep=[*keep, LINE_TERM])
+        if data.variables is not None and data.scales is not None:
+            # the blocks cannot tell whether a bend carries on beyond the run's ends: the
+            # slope compensation continues with there must stay known where the line's is
+            kept, edge = unknown_edge_slope(data, kept, parents=parents, keep=keep,
+                                            line=LINE_TERM)
         after = held_out_rms(x_scaled, bias_dph, folds, names, kept)
     record = {"folds": kind, "dropped": [t for t in selected if t not in kept],
               "before_dph": before, "after_dph": after}
     if tests:
         record["slow_noise"] = tests
+    if edge and edge["dropped"]:
+        record["edge_slope"] = edge
     return (tuple(kept) if set(kept) != original else None), record

@@ -78,6 +78,12 @@ def drift_notes(model: Any) -> list[str]:
         p = model.pruning
         lines.append(f"guarded selection: dropped {', '.join(p['dropped'])} (held-out RMS "
                      f"over {p['folds']} {p['before_dph']:.4g} -> {p['after_dph']:.4g} °/h)")
+        if p.get("edge_slope"):  # drift/edge_slope.py: why a single run's bend went
+            e = p["edge_slope"]
+            lines.append(f"  {', '.join(e['dropped'])}: the slope at an edge of the trained "
+                         f"range unknown (cold {e['cold'][0]:.3g} ± {e['cold'][1]:.2g}, hot "
+                         f"{e['hot'][0]:.3g} ± {e['hot'][1]:.2g}) where the line's is known "
+                         f"({e['line'][0]:.3g} ± {e['line'][1]:.2g}) [°/h per unit of f]")
     if model.n_not_at_rest:
         lines.append(f"{model.n_not_at_rest} training samples not at rest were left out")
     if model.offsets_dph:

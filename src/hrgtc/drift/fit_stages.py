@@ -272,7 +272,7 @@ def select(training: Training, made: Design, drift: DriftSettings, thermometer: 
                       refine=EXTENDED_PRECISION)  # quietly unrefined without long double
     chosen, pruning = None, None
     data = Windowed(x_scaled, bias, windows.run, names, tuple(windows.sources), rate,
-                    windows.time_s, windows.variables.get("f"))
+                    windows.time_s, windows.variables.get("f"), windows.variables, made.scales)
     if drift.select == "cv":  # from the stepwise terms, one-term changes that cross-validate
         chosen = select_terms(data, slope_sign, parents=parents, initial=result.selected)
     elif drift.select == "guarded" and (result.selected or np.unique(windows.run).size == 1):
