@@ -28,14 +28,14 @@ from pathlib import Path
 from types import ModuleType
 
 from hrgtc.core.errors import FormatPluginWarning, RecordingError
-from hrgtc.recording.formats import csv, dataflash, hdf5, parquet, tdms, ulog
+from hrgtc.recording.formats import csv, dataflash, hdf5, matlab, mdf, parquet, tdms, ulog
 from hrgtc.recording.formats.base import SNIFF_BYTES, Format, Source
 
 #: Entry point group of the file formats of other packages.
 ENTRY_POINT_GROUP = "hrgtc.formats"
 #: The built-in formats, in the order they are listed.
 BUILTIN: tuple[Format, ...] = (parquet.FORMAT, csv.FORMAT, hdf5.FORMAT, tdms.FORMAT,
-                               ulog.FORMAT, dataflash.FORMAT)
+                               matlab.FORMAT, ulog.FORMAT, dataflash.FORMAT, mdf.FORMAT)
 
 _formats: dict[str, Format] = {}
 _plugins_loaded = False
