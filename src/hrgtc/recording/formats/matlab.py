@@ -70,7 +70,7 @@ def _v73_value(obj: Any, root: Any) -> Any:
         return {k: _v73_value(v, root) for k, v in obj.items()}
     kind = obj.attrs.get("MATLAB_class", b"")
     kind = kind.decode() if isinstance(kind, bytes) else str(kind)
-    if "MATLAB_empty" in obj.attrs and obj.attrs["MATLAB_empty"]:
+    if obj.attrs.get("MATLAB_empty"):
         return np.zeros(0)
     data = np.asarray(obj[()])
     if kind == "char":

@@ -16,7 +16,7 @@ Large groups are read in batches of records, never whole.
 from __future__ import annotations
 
 from collections.abc import Iterator, Sequence
-from datetime import timezone
+from datetime import UTC
 from pathlib import Path
 from typing import Any
 
@@ -64,7 +64,7 @@ class MdfGroupSource(Source):
         start = getattr(mdf.header, "start_time", None)
         if start is not None and self._timed:
             extra["time_origin"] = np.datetime_as_string(
-                np.datetime64(start.astimezone(timezone.utc).replace(tzinfo=None), "us"))
+                np.datetime64(start.astimezone(UTC).replace(tzinfo=None), "us"))
         self.metadata: dict[str, Any] = {"extra": extra}
         self._kinds: dict[str, str] | None = None
         self._done = 0
