@@ -24,7 +24,14 @@ from typing import Any
 import numpy as np
 
 from hrgtc.recording.formats.base import Format, Source
-from hrgtc.recording.formats.logs import Stream, check_exists, require, streams, unreadable
+from hrgtc.recording.formats.logs import (
+    Stream,
+    check_exists,
+    quiet,
+    require,
+    streams,
+    unreadable,
+)
 
 #: The head of every DataFlash message: 0xA3 0x95, then the message id (128: FMT first).
 HEAD = b"\xa3\x95"
@@ -79,14 +86,24 @@ def read_dataflash(path: Path) -> list[Source]:
         raise unreadable(path, "DataFlash", ValueError(
             f"the file starts with {head!r}, not a DataFlash message (0xA3 0x95 0x80)"),
             "is it an ArduPilot .bin log (a .tlog is a MAVLink telemetry log)?")
-    try:
-        reader = DFReader.DFReader_binary(str(path), zero_time_base=False)
-        tables, texts = _collect(reader)
-    except Exception as exc:  # DFReader raises what its parsing meets
-        raise unreadable(path, "DataFlash", exc, "download the log from the flight "
-                         "controller again") from None
+    failure: Exception | None = None
+    with quiet() as said:
+        try:
+            reader = DFReader.DFReader_binary(str(path), zero_time_base=False)
+            tables, texts = _collect(reader)
+        except Exception as exc:  # DFReader raises what its parsing meets
+            failure = exc
+    bad = [line for line in said if "bad" in line.lower() or "unknown msg" in line.lower()]
+    if failure is None and bad:
+        failure = ValueError(f"{bad[-1]} ({len(bad)} such report(s))")
+    if failure is not None:
+        raise unreadable(path, "DataFlash", failure, "download the log from the flight "
+                         "controller again")
     firmware = next((t for t in texts if t.startswith(("Ardu", "APM"))), None)
-    extra: dict[str, Any] = {"dataflash_messages": texts[:20]}
+    # a log whose logger stopped inside a message (power off) ends with a part of one:
+    # read up to the last whole message, as mavlogdump does, and say how many bytes were left
+    extra: dict[str, Any] = {"dataflash_messages": texts[:20],
+                             "dataflash_trailing_bytes": int(reader.data_len - reader.offset)}
     if firmware:
         extra["firmware"] = firmware
     found = [Stream(name, _columns(table)) for name, table in sorted(tables.items())]

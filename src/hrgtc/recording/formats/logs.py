@@ -14,8 +14,12 @@ and :mod:`hrgtc.recording.align` puts them on one time axis.
 
 from __future__ import annotations
 
+import contextlib
 import importlib
-from collections.abc import Mapping, Sequence
+import io
+import logging
+import sys
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
@@ -61,6 +65,41 @@ def unreadable(path: Path, what: str, exc: BaseException, fix: str = "") -> Reco
         f"{path}: not a readable {what} file ({type(exc).__name__}: {detail[:200]}); it may be "
         f"truncated or corrupt, or another format under this suffix: "
         f"{fix or 'export it again from the software that wrote it'}")
+
+
+@contextlib.contextmanager
+def quiet(loggers: Sequence[str] = (), collect: bool = False) -> Iterator[list[str]]:
+    """What a library prints, logs (``loggers``) or reports from ``__del__`` while it reads,
+    gathered into the list yielded instead of reaching the user's terminal (hrgtc reports
+    it in its own words; a half-built reader object of a corrupt file must not print a
+    traceback when it is collected)."""
+    said: list[str] = []
+    text = io.StringIO()
+
+    class Gather(logging.Handler):
+        def emit(self, record: logging.LogRecord) -> None:
+            said.append(record.getMessage())
+
+    gather = Gather(logging.WARNING)
+    hook = sys.unraisablehook
+    saved = []
+    for name in loggers:
+        logger = logging.getLogger(name)
+        saved.append((logger, logger.handlers, logger.propagate))
+        logger.handlers, logger.propagate = [gather], False
+    sys.unraisablehook = lambda unraisable: said.append(str(unraisable.exc_value))
+    try:
+        with contextlib.redirect_stdout(text), contextlib.redirect_stderr(text):
+            yield said
+    finally:
+        if collect:  # a half-built object's __del__ runs now, under the quiet hook
+            import gc
+
+            gc.collect()
+        sys.unraisablehook = hook
+        for logger, handlers, propagate in saved:
+            logger.handlers, logger.propagate = handlers, propagate
+        said[:0] = [line for line in text.getvalue().splitlines() if line.strip()]
 
 
 def check_exists(path: Path) -> None:

@@ -25,7 +25,7 @@ import pyarrow as pa
 
 from hrgtc.core.errors import RecordingError
 from hrgtc.recording.formats.base import Format, Source
-from hrgtc.recording.formats.logs import check_exists, require, unreadable
+from hrgtc.recording.formats.logs import check_exists, quiet, require, unreadable
 
 #: The identification block of MDF 3 and 4 ("MDF     "; "UnFinMF " for an unfinished one).
 MAGICS = (b"MDF     ", b"UnFinMF ")
@@ -134,12 +134,16 @@ def read_mdf(path: Path) -> list[Source]:
     """The channel groups of an MDF file that hold records, one stream each."""
     check_exists(path)
     asammdf = require("asammdf", "mdf", "MDF", path)
-    try:
-        mdf = asammdf.MDF(str(path))
-        kept = [i for i, g in enumerate(mdf.groups) if g.channel_group.cycles_nr > 0]
-    except Exception as exc:  # asammdf raises what the blocks give
-        raise unreadable(path, "MDF", exc, "save the measurement again (CANape, INCA) or "
-                         "check that the logger finished writing it") from None
+    failure: RecordingError | None = None
+    with quiet(("asammdf",), collect=True):  # a half-read MDF4 object complains when collected
+        try:
+            mdf = asammdf.MDF(str(path))
+            kept = [i for i, g in enumerate(mdf.groups) if g.channel_group.cycles_nr > 0]
+        except Exception as exc:  # asammdf raises what the blocks give
+            failure = unreadable(path, "MDF", exc, "save the measurement again (CANape, "
+                                 "INCA) or check that the logger finished writing it")
+    if failure is not None:
+        raise failure
     try:
         if not kept:
             raise RecordingError(f"{path}: the MDF file holds no channel group with records; "

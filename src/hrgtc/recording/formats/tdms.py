@@ -23,6 +23,7 @@ group). Conventions handled:
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
@@ -32,7 +33,7 @@ import pyarrow as pa
 
 from hrgtc.core.errors import RecordingError
 from hrgtc.recording.formats.base import Format, Source
-from hrgtc.recording.formats.logs import check_exists, require, unreadable
+from hrgtc.recording.formats.logs import check_exists, quiet, require, unreadable
 
 #: The lead-in tag of a TDMS segment ("TDSm"; "TDSh" in the .tdms_index file).
 TAG = b"TDSm"
@@ -122,10 +123,14 @@ class TdmsGroupSource(Source):
                 arrays[name] = pa.array(offset + increment * np.arange(start, stop,
                                                                         dtype=np.float64))
                 continue
-            try:
-                values = self._channels[name].read_data(start, stop - start)
-            except Exception as exc:  # npTDMS raises what the bytes give
-                raise unreadable(self.path, "TDMS", exc) from None
+            failure: Exception | None = None
+            with quiet(_loggers(sys.modules["nptdms"])) as said:
+                try:
+                    values = self._channels[name].read_data(start, stop - start)
+                except Exception as exc:  # npTDMS raises what the bytes give
+                    failure = exc
+            if failure is not None or said:
+                raise unreadable(self.path, "TDMS", failure or ValueError(said[0]))
             values = np.asarray(values)
             if values.dtype.kind == "M":
                 values = values.astype("datetime64[ns]")
@@ -150,16 +155,29 @@ class TdmsGroupSource(Source):
             self._file.close()
 
 
+def _loggers(nptdms: Any) -> list[str]:
+    """npTDMS's loggers (each with its own console handler)."""
+    manager = getattr(getattr(nptdms, "log", None), "log_manager", None)
+    return [*getattr(manager, "loggers", {}), "nptdms"]
+
+
 def read_tdms(path: Path) -> list[Source]:
     """The groups of a TDMS file that hold samples, one stream each."""
     check_exists(path)
     nptdms = require("nptdms", "tdms", "TDMS", path)
-    try:
-        handle = nptdms.TdmsFile.open(str(path))
-        groups = [g for g in handle.groups() if g.channels() and len(g.channels()[0]) > 0]
-    except Exception as exc:  # npTDMS raises what the bytes give
-        raise unreadable(path, "TDMS", exc, "copy the .tdms (and its .tdms_index) from the "
-                         "logging PC again") from None
+    fix = "copy the .tdms (and its .tdms_index) from the logging PC again"
+    failure: Exception | None = None
+    with quiet(_loggers(nptdms)) as said:
+        try:
+            handle = nptdms.TdmsFile.open(str(path))
+            groups = [g for g in handle.groups() if g.channels() and len(g.channels()[0]) > 0]
+        except Exception as exc:  # npTDMS raises what the bytes give
+            failure = exc
+    if failure is None and said:  # npTDMS reads a cut file up to the cut, with a warning
+        handle.close()
+        failure = ValueError(f"npTDMS: {said[0]}")
+    if failure is not None:
+        raise unreadable(path, "TDMS", failure, fix)
     try:
         if not groups:
             raise RecordingError(f"{path}: the TDMS file holds no channel with samples; "

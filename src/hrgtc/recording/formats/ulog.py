@@ -26,7 +26,14 @@ from typing import Any
 import numpy as np
 
 from hrgtc.recording.formats.base import Format, Source
-from hrgtc.recording.formats.logs import Stream, check_exists, require, streams, unreadable
+from hrgtc.recording.formats.logs import (
+    Stream,
+    check_exists,
+    quiet,
+    require,
+    streams,
+    unreadable,
+)
 
 #: The ULog file magic: "ULog" and the bytes 0x01 0x12 0x35 (then the version).
 MAGIC = b"ULog\x01\x12\x35"
@@ -76,11 +83,17 @@ def read_ulog(path: Path) -> list[Source]:
     if head != MAGIC:
         raise unreadable(path, "ULog", ValueError(f"the file starts with {head!r}, not the "
                                                   "ULog magic"), "is it a PX4 .ulg log?")
-    try:
-        log = pyulog.ULog(str(path))
-    except Exception as exc:  # pyulog raises what its parsing meets
-        raise unreadable(path, "ULog", exc, "copy the .ulg from the flight controller's SD "
-                         "card again") from None
+    fix = "copy the .ulg from the flight controller's SD card again"
+    failure: Exception | None = None
+    with quiet() as said:
+        try:
+            log = pyulog.ULog(str(path))
+        except Exception as exc:  # pyulog raises what its parsing meets
+            failure = exc
+    if failure is None and log.file_corruption:
+        failure = ValueError("; ".join(said[:2]) or "pyulog found corrupt records")
+    if failure is not None:
+        raise unreadable(path, "ULog", failure, fix)
     data = sorted(log.data_list, key=lambda d: (d.name, d.multi_id))
     names = stream_names([(d.name, d.multi_id) for d in data])
     if len(set(names)) != len(names):  # two formats of one topic instance (never seen)
