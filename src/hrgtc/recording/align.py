@@ -153,10 +153,35 @@ class AlignedSource(Source):
             return
         asked = {id(self.owner[n]) for n in names if n in self.owner and n != self.time_column}
         candidates = [s for s in self.streams if id(s) in asked]
+        if not candidates and all(s.on_request for s in self.streams):
+            self.close()
+            raise RecordingError(self._nothing_named())
         if candidates:
             base = max(candidates, key=lambda s: s.count_rows())
             if base is not self.base:
                 self._use_base(base)
+
+    def _nothing_named(self) -> str:
+        """The refusal of a read that names no column of a log of streams on request."""
+        def listed(stream: Source) -> str:
+            columns = [n for n in stream.names if n != stream.time_column]
+            shown = ", ".join(columns[:8]) + (", ..." if len(columns) > 8 else "")
+            return f"{stream.stream} ({stream.count_rows()} rows: {shown})"
+
+        sensors = [s for s in self.streams
+                   if any(k in s.stream.lower() for k in ("gyr", "imu", "temp", "baro"))]
+        others = [s.stream for s in self.streams if s not in sensors]
+        shown = [listed(s) for s in sensors[:8]]
+        if others:
+            shown.append(f"{f'and {len(others)} more: ' if shown else ''}"
+                         f"{', '.join(others[:40])}{', ...' if len(others) > 40 else ''}")
+        names = [n for s in [*sensors, *self.streams] for n in s.names if n != s.time_column]
+        example = next((n for n in names if n.lower().endswith(("gyrx", ".x", "/x",
+                                                                  "gyro_rad[0]"))), names[0])
+        return (f"{self.path}: the file holds {len(self.streams)} streams on their own time "
+                "axes, read when the column mapping names their columns, and none is named; "
+                f"map yours with --col, e.g. --col rate_dph={example}. "
+                f"Streams: {'; '.join(shown)}")
 
     def kinds(self) -> dict[str, str]:
         kinds: dict[str, str] = {}

@@ -107,3 +107,14 @@ def test_help_and_reading_a_csv_import_none_of_the_libraries(tmp_path):
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True, timeout=120)
     assert out.stdout.strip() == "[]"
+
+
+@pytest.mark.parametrize(("key", "example", "listed"), [
+    ("ulog", "sensor_gyro_0.x", "sensor_gyro_1 (6 rows: "),
+    ("dataflash", "IMU.GyrX", "IMU2 (45 rows: IMU2.GyrX"),
+])
+def test_a_log_read_without_a_mapping_lists_its_streams_and_an_example(data, run_info, key,
+                                                                       example, listed):
+    code, _, output = run_info(data / SAMPLES[key])
+    text = " ".join(output.split())
+    assert code == 2 and f"e.g. --col rate_dph={example}" in text and listed in text, output
