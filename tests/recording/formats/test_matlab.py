@@ -38,6 +38,14 @@ def test_the_v73_file_stores_the_row_transposed_and_is_read_back_as_a_row(data):
     assert format_for(path).name == "matlab"  # not hdf5: the MAT-file header decides
 
 
+def test_a_v73_file_of_unknown_suffix_is_matlab_though_hdf5_knows_it_too(data, tmp_path):
+    renamed = tmp_path / "run.dat"
+    renamed.write_bytes((data / "matlab" / "testhdf5_7.4_GLNX86.mat").read_bytes())
+    assert format_for(renamed).name == "matlab"
+    renamed.write_bytes((data / "matlab" / "testdouble_7.4_GLNX86.mat").read_bytes())
+    assert format_for(renamed).name == "matlab"
+
+
 def test_a_matrix_becomes_numbered_columns(data):
     rec = read(data / "matlab" / "testmatrix_7.4_GLNX86.mat",
                columns={"time_s": "testmatrix_1"}, validate=False)

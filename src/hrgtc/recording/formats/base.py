@@ -245,6 +245,9 @@ class Format:
         (``"h5"`` for HDF5); default :attr:`name`.
     description
         One line for listings.
+    within
+        The name of the format this one is a kind of, whose sniff also accepts its files
+        (``"hdf5"`` for MATLAB v7.3): of the two, a file of unknown suffix is read by this one.
     """
 
     name: str
@@ -254,6 +257,7 @@ class Format:
     sink: type[Sink] | None = None
     output_name: str = ""
     description: str = ""
+    within: str = ""
 
     def __post_init__(self) -> None:
         if not self.name or not self.suffixes:

@@ -229,4 +229,5 @@ def sniff(head: bytes) -> bool:
 
 
 FORMAT = Format("matlab", (".mat",), read_matlab, sniff,
-                description="MATLAB .mat v4/v5/v7 (scipy) and v7.3 (h5py), a stream per table")
+                description="MATLAB .mat v4/v5/v7 (scipy) and v7.3 (h5py), a stream per table",
+                within="hdf5")

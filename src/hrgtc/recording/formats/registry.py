@@ -185,6 +185,7 @@ def format_for(path: str | Path) -> Format:
     head = _head(path) if path.is_file() else None
     if head:
         found = [fmt for fmt in formats() if fmt.accepts(head)]
+        found = [f for f in found if not any(g.within == f.name for g in found)]
         if len(found) == 1:
             return found[0]
     known = ", ".join(suffixes())
