@@ -80,38 +80,70 @@ class MdfGroupSource(Source):
             raise unreadable(self.path, "MDF", exc) from None
         return np.asarray(signal.samples)
 
+    def _record_bytes(self) -> int:
+        group = self._mdf.groups[self._index].channel_group
+        return max(int(group.samples_byte_nr) + int(getattr(group, "invalidation_bytes_nr", 0)),
+                   1)
+
+    def _first(self, name: str) -> np.ndarray:
+        """The first few samples of a column, from the first fragment only."""
+        self._mdf.configure(read_fragment_size=16 * self._record_bytes())
+        master = self._mdf.masters_db.get(self._index)
+        part = self._mdf.iter_get(group=self._index, samples_only=True,
+                                  index=master if name == "time_s" else self._columns[name])
+        try:
+            with quiet(("asammdf",)):
+                return np.asarray(next(part)[0])
+        except StopIteration:
+            return np.zeros(0)
+        except Exception as exc:  # asammdf raises what the blocks give
+            raise unreadable(self.path, "MDF", exc) from None
+        finally:
+            part.close()
+
     def kinds(self) -> dict[str, str]:
         if self._kinds is None:
             self._kinds = {}
             for name in self.names:
-                first = self._values(name, 0, 1)
+                first = self._first(name)  # a get() of one record reads them all
                 char = first.dtype.kind
                 self._kinds[name] = ("numeric" if char in "fiub" and first.ndim == 1 else
                                      "string" if char in "SUO" else "other")
         return self._kinds
 
     def _table(self, names: Sequence[str], start: int, stop: int) -> pa.Table:
-        arrays = {}
-        for name in names:
-            values = self._values(name, start, stop - start)
-            if values.ndim != 1:
-                raise RecordingError(f"{self.path}: MDF channel {name!r} holds arrays of shape "
-                                     f"{values.shape[1:]} per record, not one value; map "
-                                     "another channel")
-            if values.dtype.kind == "S":
-                values = np.char.decode(values, "latin-1")
-            arrays[name] = pa.array(values)
-        return pa.table(arrays)
+        return pa.table({name: pa.array(_one_value_per_record(
+            self.path, name, self._values(name, start, stop - start))) for name in names})
 
     def read(self, names: Sequence[str], as_text: set[str]) -> pa.Table:
         self._done = int(self.total_rows or 0)
         return self._table(names, 0, self._done)
 
     def iter_tables(self, names: Sequence[str], as_text: set[str], rows: int) -> Iterator[pa.Table]:
-        total = int(self.total_rows or 0)
-        for start in range(0, total, max(int(rows), 1)):
-            self._done = min(start + rows, total)
-            yield self._table(names, start, self._done)
+        """Tables of the records of each fragment of about ``rows`` records that asammdf
+        reads (``read_fragment_size``), every column from the same fragment: the memory of
+        one fragment, never of the file (a ``get`` with ``record_offset`` reads the records
+        before the offset too)."""
+        self._mdf.configure(read_fragment_size=max(int(rows), 1) * self._record_bytes())
+        master = self._mdf.masters_db.get(self._index)
+        indexes = [master if name == "time_s" else self._columns[name] for name in names]
+        parts = [self._mdf.iter_get(group=self._index, index=j, samples_only=True)
+                 for j in indexes]
+        self._done = 0
+        while True:
+            try:
+                with quiet(("asammdf",)):
+                    fragment = [next(part)[0] for part in parts]
+            except StopIteration:
+                return
+            except Exception as exc:  # asammdf raises what the blocks give
+                raise unreadable(self.path, "MDF", exc) from None
+            arrays = {}
+            for name, values in zip(names, fragment, strict=True):
+                values = np.asarray(values)
+                arrays[name] = pa.array(_one_value_per_record(self.path, name, values))
+            self._done += len(fragment[0]) if fragment else 0
+            yield pa.table(arrays)
 
     def position(self) -> tuple[float, float]:
         return (float(self._done), float(self.total_rows or 0))
@@ -119,6 +151,15 @@ class MdfGroupSource(Source):
     def close(self) -> None:
         if self._owner:
             self._mdf.close()
+
+
+def _one_value_per_record(path: Path, name: str, values: np.ndarray) -> np.ndarray:
+    """A channel's samples as one value per record (text decoded), or RecordingError."""
+    if values.ndim != 1:
+        raise RecordingError(f"{path}: MDF channel {name!r} holds arrays of shape "
+                             f"{values.shape[1:]} per record, not one value; map another "
+                             "channel")
+    return np.char.decode(values, "latin-1") if values.dtype.kind == "S" else values
 
 
 def group_prefixes(names: Sequence[str]) -> list[str]:
