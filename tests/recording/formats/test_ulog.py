@@ -108,3 +108,13 @@ def test_the_log_is_known_by_its_magic_under_another_suffix(data, tmp_path):
     renamed = tmp_path / "flight.log"
     renamed.write_bytes((data / LOG).read_bytes()[:4096])
     assert format_for(renamed).name == "ulog"
+
+
+def test_the_sampling_time_in_us_is_a_column_the_time_options_take(data):
+    rec = read(data / LOG, columns={"time_s": "sensor_gyro_2.timestamp_sample",
+                                    "rate_dph": "sensor_gyro_2.y"},
+               units={"time": "us", "rate": "radps"}, validate=False,
+               metadata={"sample_rate_hz": 1.0})
+    truth = export(data, "sensor_gyro_2")
+    np.testing.assert_array_equal(rec["time_s"], truth["timestamp_sample"] / 1e6)
+    np.testing.assert_allclose(rec["rate_dph"], truth["y"] * RAD_S_TO_DPH, rtol=1e-7)
