@@ -24,6 +24,12 @@ channel is empty between its values.
 One stream is returned as it is: the single-stream case costs nothing. The fastest
 stream is read in chunks as usual; the others (the slow ones) are read whole when the
 first rows are asked for.
+
+A log of many streams (the topics of a ULog, the messages of a DataFlash log, the groups
+of a TDMS or MDF4 file) marks them *on request* (:attr:`Source.on_request`): their
+columns are read only when the column mapping names them, and the time axis is that of
+the stream with the most rows among the streams whose columns are asked for (the gyro's
+topic when its rate and temperature are mapped), not of the log's busiest topic.
 """
 
 from __future__ import annotations
@@ -35,7 +41,7 @@ import numpy as np
 import pyarrow as pa
 
 from hrgtc.core.errors import RecordingError
-from hrgtc.recording.formats.base import Source
+from hrgtc.recording.formats.base import ON_REQUEST, Source
 from hrgtc.recording.resample import (
     DEFAULT_MAX_AGE_PERIODS,
     ChannelFill,
@@ -99,12 +105,10 @@ class AlignedSource(Source):
         self.base = base
         self.others = [s for s in streams if s is not base]
         label = {id(s): s.stream or f"stream {i + 1}" for i, s in enumerate(streams)}
-        if mode == "error":
+        self._label = label
+        if mode == "error" and not any(s.on_request for s in streams):
             self.close()
-            raise RecordingError(
-                f"{base.path}: the file holds {len(streams)} streams on their own time axes "
-                f"({', '.join(label[id(s)] for s in streams)}) and --slow-channels is 'error'; "
-                "pass --slow-channels hold or interpolate to put them on one time axis")
+            self._refuse(streams)
         self.owner: dict[str, Source] = {name: base for name in base.names}
         for other in self.others:
             for name in other.names:
@@ -119,20 +123,73 @@ class AlignedSource(Source):
                         "rename one of them")
                 self.owner[name] = other
         self.names = list(self.owner)
+        self.skipped = {k: v for s in streams for k, v in getattr(s, "skipped", {}).items()}
+        self._mode, self._max_age_s = mode, max_age_s
+        self._use_base(base)
+        self._offset = 0
+
+    def _use_base(self, base: Source) -> None:
+        """Put the others on the time axis of ``base`` (the one stream whose time is kept)."""
+        self.owner.pop(self.base.time_column, None)
+        self.owner[base.time_column] = base
+        self.base, self.others = base, [s for s in self.streams if s is not base]
+        self.format = base.format
         self.metadata = dict(base.metadata)
         self.total_rows = base.total_rows
         self.stream, self.time_column, self.time_unit_s = "", base.time_column, base.time_unit_s
-        self.skipped = {k: v for s in streams for k, v in getattr(s, "skipped", {}).items()}
-        self.slow = SlowChannels(mode, max_age_s, str(base.path))
-        self._max_age_s = max_age_s
+        self.slow = SlowChannels(self._mode, self._max_age_s, str(base.path))
         self._samples: dict[str, tuple[np.ndarray, np.ndarray]] = {}
-        self._offset = 0
+
+    def _refuse(self, streams: Sequence[Source]) -> None:
+        raise RecordingError(
+            f"{self.path}: the file holds {len(streams)} streams on their own time axes "
+            f"({', '.join(self._label[id(s)] for s in streams)}) and --slow-channels is "
+            "'error'; pass --slow-channels hold or interpolate to put them on one time axis")
+
+    def _choose_base(self, names: Sequence[str]) -> None:
+        """With streams on request: the base is the stream of most rows among those whose
+        columns are asked for (the first of equal lengths)."""
+        if not any(s.on_request for s in self.streams):
+            return
+        asked = {id(self.owner[n]) for n in names if n in self.owner and n != self.time_column}
+        candidates = [s for s in self.streams if id(s) in asked]
+        if not candidates and all(s.on_request for s in self.streams):
+            self.close()
+            raise RecordingError(self._nothing_named())
+        if candidates:
+            base = max(candidates, key=lambda s: s.count_rows())
+            if base is not self.base:
+                self._use_base(base)
+
+    def _nothing_named(self) -> str:
+        """The refusal of a read that names no column of a log of streams on request."""
+        def listed(stream: Source) -> str:
+            columns = [n for n in stream.names if n != stream.time_column]
+            shown = ", ".join(columns[:8]) + (", ..." if len(columns) > 8 else "")
+            return f"{stream.stream} ({stream.count_rows()} rows: {shown})"
+
+        sensors = [s for s in self.streams
+                   if any(k in s.stream.lower() for k in ("gyr", "imu", "temp", "baro"))]
+        others = [s.stream for s in self.streams if s not in sensors]
+        shown = [listed(s) for s in sensors[:8]]
+        if others:
+            shown.append(f"{f'and {len(others)} more: ' if shown else ''}"
+                         f"{', '.join(others[:40])}{', ...' if len(others) > 40 else ''}")
+        names = [n for s in [*sensors, *self.streams] for n in s.names if n != s.time_column]
+        example = next((n for n in names if n.lower().endswith(("gyrx", ".x", "/x",
+                                                                  "gyro_rad[0]"))), names[0])
+        return (f"{self.path}: the file holds {len(self.streams)} streams on their own time "
+                "axes, read when the column mapping names their columns, and none is named; "
+                f"map yours with --col, e.g. --col rate_dph={example}. "
+                f"Streams: {'; '.join(shown)}")
 
     def kinds(self) -> dict[str, str]:
         kinds: dict[str, str] = {}
         for stream in self.streams:
             stream_kinds = stream.kinds()
-            kinds.update({n: k for n, k in stream_kinds.items() if self.owner.get(n) is stream})
+            kinds.update({n: (ON_REQUEST if stream.on_request and k == "numeric"
+                              and n != stream.time_column else k)
+                          for n, k in stream_kinds.items() if self.owner.get(n) is stream})
         return kinds
 
     # -- the slower streams, read whole --------------------------------------------------
@@ -179,6 +236,8 @@ class AlignedSource(Source):
         if not slow:
             self._offset += n
             return table.select(list(names))
+        if self._mode == "error":  # streams on request, columns of several asked for
+            self._refuse([self.base, *dict.fromkeys(self.owner[n] for n in slow)])
         self._load(slow)
         time_s = self._seconds(self.base, table.column(self.base.time_column))
         keep = np.ones(n, dtype=bool)
@@ -209,10 +268,12 @@ class AlignedSource(Source):
 
     def read(self, names: Sequence[str], as_text: set[str]) -> pa.Table:
         self._offset = 0
+        self._choose_base(names)
         return self._joined(self.base.read(self._base_names(names), as_text), names)
 
     def iter_tables(self, names: Sequence[str], as_text: set[str], rows: int) -> Iterator[pa.Table]:
         self._offset = 0
+        self._choose_base(names)
         for table in self.base.iter_tables(self._base_names(names), as_text, rows):
             yield self._joined(table, names)
 

@@ -4,7 +4,11 @@
   stream reader :class:`Source`, the writer :class:`Sink`, :class:`TableSource`);
 * :mod:`~hrgtc.recording.formats.parquet`, :mod:`~hrgtc.recording.formats.csv`,
   :mod:`~hrgtc.recording.formats.hdf5`: the built-in formats, each declaring its
-  ``FORMAT``;
+  ``FORMAT``; read only: :mod:`~hrgtc.recording.formats.tdms`,
+  :mod:`~hrgtc.recording.formats.matlab`, :mod:`~hrgtc.recording.formats.ulog`,
+  :mod:`~hrgtc.recording.formats.dataflash`, :mod:`~hrgtc.recording.formats.mdf` (their
+  libraries imported when a file is read; what they share in
+  :mod:`~hrgtc.recording.formats.logs`);
 * :mod:`~hrgtc.recording.formats.registry`: the registry (built-in formats and those
   of the ``hrgtc.formats`` entry points); every choice of a format goes through it.
 

@@ -36,6 +36,9 @@ from hrgtc.recording.schema import COLUMNS, Metadata
 
 #: Bytes of the head of a file given to each format's sniff.
 SNIFF_BYTES = 4096
+#: The kind of a numeric column of a stream that is read only when the column mapping names
+#: it (:attr:`Source.on_request`): not taken in among "the file's other numeric columns".
+ON_REQUEST = "numeric on request"
 
 
 def kind_of(dtype: pa.DataType) -> str:
@@ -111,6 +114,11 @@ class Source:
         self.time_column = "time_s"
         #: Seconds per unit of :attr:`time_column` (1e-6 for a logger's µs counter).
         self.time_unit_s = 1.0
+        #: True for one stream of a log of many (a ULog topic, a DataFlash message, a TDMS
+        #: or MDF group): its columns are read only when the column mapping names one, and
+        #: the alignment takes its time axis from the streams so named
+        #: (:mod:`hrgtc.recording.align`).
+        self.on_request = False
 
     def kinds(self) -> dict[str, str]:
         """Column name -> kind (see :func:`kind_of`)."""
@@ -168,7 +176,7 @@ class TableSource(Source):
         or a :class:`pyarrow.Table`.
     metadata
         The file's raw metadata (``sample_rate_hz``, ``unit``, ``extra`` ...).
-    stream, time_column, time_unit_s
+    stream, time_column, time_unit_s, on_request
         See :class:`Source`.
     """
 
@@ -176,7 +184,8 @@ class TableSource(Source):
 
     def __init__(self, path: str | Path, columns: Mapping[str, Any] | pa.Table,
                  metadata: Mapping[str, Any] | None = None, *, stream: str = "",
-                 time_column: str = "time_s", time_unit_s: float = 1.0) -> None:
+                 time_column: str = "time_s", time_unit_s: float = 1.0,
+                 on_request: bool = False) -> None:
         super().__init__(Path(path))
         self._table = columns if isinstance(columns, pa.Table) else pa.table(
             {name: pa.array(np.asarray(values) if not isinstance(values, pa.Array) else values)
@@ -185,6 +194,7 @@ class TableSource(Source):
         self.metadata = dict(metadata or {})
         self.total_rows = self._table.num_rows
         self.stream, self.time_column, self.time_unit_s = stream, time_column, float(time_unit_s)
+        self.on_request = on_request
         self._done = 0
 
     def kinds(self) -> dict[str, str]:
@@ -235,6 +245,9 @@ class Format:
         (``"h5"`` for HDF5); default :attr:`name`.
     description
         One line for listings.
+    within
+        The name of the format this one is a kind of, whose sniff also accepts its files
+        (``"hdf5"`` for MATLAB v7.3): of the two, a file of unknown suffix is read by this one.
     """
 
     name: str
@@ -244,6 +257,7 @@ class Format:
     sink: type[Sink] | None = None
     output_name: str = ""
     description: str = ""
+    within: str = ""
 
     def __post_init__(self) -> None:
         if not self.name or not self.suffixes:

@@ -28,13 +28,14 @@ from pathlib import Path
 from types import ModuleType
 
 from hrgtc.core.errors import FormatPluginWarning, RecordingError
-from hrgtc.recording.formats import csv, hdf5, parquet
+from hrgtc.recording.formats import csv, dataflash, hdf5, matlab, mdf, parquet, tdms, ulog
 from hrgtc.recording.formats.base import SNIFF_BYTES, Format, Source
 
 #: Entry point group of the file formats of other packages.
 ENTRY_POINT_GROUP = "hrgtc.formats"
 #: The built-in formats, in the order they are listed.
-BUILTIN: tuple[Format, ...] = (parquet.FORMAT, csv.FORMAT, hdf5.FORMAT)
+BUILTIN: tuple[Format, ...] = (parquet.FORMAT, csv.FORMAT, hdf5.FORMAT, tdms.FORMAT,
+                               matlab.FORMAT, ulog.FORMAT, dataflash.FORMAT, mdf.FORMAT)
 
 _formats: dict[str, Format] = {}
 _plugins_loaded = False
@@ -184,6 +185,7 @@ def format_for(path: str | Path) -> Format:
     head = _head(path) if path.is_file() else None
     if head:
         found = [fmt for fmt in formats() if fmt.accepts(head)]
+        found = [f for f in found if not any(g.within == f.name for g in found)]
         if len(found) == 1:
             return found[0]
     known = ", ".join(suffixes())

@@ -1,0 +1,202 @@
+"""NI TDMS files (``.tdms``, LabVIEW and DAQmx data logging), read with npTDMS
+(``pip install 'hrgtc[tdms]'``).
+
+A TDMS file holds groups of channels. Each group is one stream; its channels are its
+columns, named as in the file for a file of one group and ``<group>/<channel>`` for a
+file of several, whose groups are then read when the column mapping names one of their
+channels and put on one time axis by :mod:`hrgtc.recording.align` (a LabVIEW log of the
+full-rate data beside its decimated levels, a fast gyro group beside a slow temperature
+group). Conventions handled:
+
+* **waveform timing**: a group whose channels carry ``wf_increment`` (the sample period,
+  s) has ``time_s = wf_start_offset + i * wf_increment`` plus its ``wf_start_time`` after
+  the earliest ``wf_start_time`` of the file, which is kept as ``extra["time_origin"]``
+  (LabVIEW's zero time, 1904-01-01, marks a relative time: no origin); the sample rate
+  is ``1 / wf_increment``. A group without waveform timing has no ``time_s``: map its
+  time channel (``--col time_s=Time``, with ``--time-unit``), which a timestamp channel
+  needs no unit for;
+* **DAQmx raw data and NI scaling**: channels stored as raw counts with ``NI_Scale``
+  properties are read scaled (npTDMS applies the scales), so values are in the
+  channel's ``unit_string`` (kept in ``extra["tdms_units"]``);
+* large files are read in batches (``TdmsFile.open``), never whole.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pyarrow as pa
+
+from hrgtc.core.errors import RecordingError
+from hrgtc.recording.formats.base import Format, Source
+from hrgtc.recording.formats.logs import check_exists, quiet, require, unreadable
+
+#: The lead-in tag of a TDMS segment ("TDSm"; "TDSh" in the .tdms_index file).
+TAG = b"TDSm"
+#: LabVIEW's zero time: a ``wf_start_time`` there is a relative time axis.
+LABVIEW_EPOCH = np.datetime64("1904-01-01T00:00:00", "us")
+
+
+def _timing(channel: Any) -> tuple[float, float, np.datetime64 | None] | None:
+    """``(wf_increment, wf_start_offset, wf_start_time or None)`` of a waveform channel."""
+    props = channel.properties
+    increment = props.get("wf_increment")
+    if increment is None or not float(increment) > 0:
+        return None
+    start = props.get("wf_start_time")
+    start = np.datetime64(start, "us") if start is not None else None
+    if start is not None and start == LABVIEW_EPOCH:
+        start = None
+    return float(increment), float(props.get("wf_start_offset", 0.0) or 0.0), start
+
+
+class TdmsGroupSource(Source):
+    """One group of a TDMS file, read in batches.
+
+    Parameters
+    ----------
+    path
+        The file.
+    handle
+        The open ``nptdms.TdmsFile`` (closed by the first stream of the file).
+    group
+        The group.
+    prefix
+        ``"<group>/"`` in a file of several groups, else ``""``.
+    origin
+        The file's earliest absolute ``wf_start_time`` (None: times are relative).
+    """
+
+    format = "tdms"
+
+    def __init__(self, path: Path, handle: Any, group: Any, prefix: str,
+                 origin: np.datetime64 | None, owner: bool) -> None:
+        super().__init__(path)
+        self._file, self._owner = handle, owner
+        channels = list(group.channels())
+        lengths = {c.name: len(c) for c in channels}
+        if len(set(lengths.values())) > 1:
+            raise RecordingError(
+                f"{path}: the channels of the TDMS group {group.name!r} have different lengths "
+                f"{lengths}; hrgtc reads a group as one table: log the channels of each rate "
+                "in a group of their own")
+        self._channels = {f"{prefix}{c.name}": c for c in channels}
+        self.total_rows = next(iter(lengths.values()), 0)
+        self.stream = group.name
+        self.on_request = bool(prefix)
+        timings = {_timing(c) for c in channels}
+        self._time: tuple[float, float] | None = None
+        units = {name: str(c.properties["unit_string"]) for name, c in self._channels.items()
+                 if c.properties.get("unit_string")}
+        extra: dict[str, Any] = {"tdms_group": group.name}
+        if units:
+            extra["tdms_units"] = units
+        self.metadata: dict[str, Any] = {"extra": extra}
+        if len(timings) == 1 and None not in timings:
+            increment, offset, start = next(iter(timings))
+            shift = 0.0 if start is None or origin is None else float(
+                (start - origin) / np.timedelta64(1, "us")) * 1e-6
+            self._time = (increment, offset + shift)
+            self.metadata["sample_rate_hz"] = 1.0 / increment
+            if origin is not None:
+                extra["time_origin"] = str(origin)
+        self.names = (["time_s"] if self._time else []) + list(self._channels)
+        self._done = 0
+
+    def kinds(self) -> dict[str, str]:
+        kinds = {"time_s": "numeric"} if self._time else {}
+        for name, channel in self._channels.items():
+            dtype = np.dtype(channel.dtype) if channel.dtype is not None else np.dtype("O")
+            kinds[name] = ("numeric" if dtype.kind in "fiub" else "timestamp"
+                           if dtype.kind == "M" else "string" if dtype.kind in "OSU" else "other")
+        return kinds
+
+    def _table(self, names: Sequence[str], start: int, stop: int) -> pa.Table:
+        arrays = {}
+        for name in names:
+            if name == "time_s" and self._time:
+                increment, offset = self._time
+                arrays[name] = pa.array(offset + increment * np.arange(start, stop,
+                                                                        dtype=np.float64))
+                continue
+            failure: Exception | None = None
+            with quiet(_loggers(sys.modules["nptdms"])) as said:
+                try:
+                    values = self._channels[name].read_data(start, stop - start)
+                except Exception as exc:  # npTDMS raises what the bytes give
+                    failure = exc
+            if failure is not None or said:
+                raise unreadable(self.path, "TDMS", failure or ValueError(said[0]))
+            values = np.asarray(values)
+            if values.dtype.kind == "M":
+                values = values.astype("datetime64[ns]")
+            arrays[name] = pa.array(values if values.dtype.kind != "O" else list(values))
+        return pa.table(arrays)
+
+    def read(self, names: Sequence[str], as_text: set[str]) -> pa.Table:
+        self._done = int(self.total_rows or 0)
+        return self._table(names, 0, self._done)
+
+    def iter_tables(self, names: Sequence[str], as_text: set[str], rows: int) -> Iterator[pa.Table]:
+        total = int(self.total_rows or 0)
+        for start in range(0, total, max(int(rows), 1)):
+            self._done = min(start + rows, total)
+            yield self._table(names, start, self._done)
+
+    def position(self) -> tuple[float, float]:
+        return (float(self._done), float(self.total_rows or 0))
+
+    def close(self) -> None:
+        if self._owner:
+            self._file.close()
+
+
+def _loggers(nptdms: Any) -> list[str]:
+    """npTDMS's loggers (each with its own console handler)."""
+    manager = getattr(getattr(nptdms, "log", None), "log_manager", None)
+    return [*getattr(manager, "loggers", {}), "nptdms"]
+
+
+def read_tdms(path: Path) -> list[Source]:
+    """The groups of a TDMS file that hold samples, one stream each."""
+    check_exists(path)
+    nptdms = require("nptdms", "tdms", "TDMS", path)
+    fix = "copy the .tdms (and its .tdms_index) from the logging PC again"
+    failure: Exception | None = None
+    with quiet(_loggers(nptdms)) as said:
+        try:
+            handle = nptdms.TdmsFile.open(str(path))
+            groups = [g for g in handle.groups() if g.channels() and len(g.channels()[0]) > 0]
+        except Exception as exc:  # npTDMS raises what the bytes give
+            failure = exc
+    if failure is None and said:  # npTDMS reads a cut file up to the cut, with a warning
+        handle.close()
+        failure = ValueError(f"npTDMS: {said[0]}")
+    if failure is not None:
+        raise unreadable(path, "TDMS", failure, fix)
+    try:
+        if not groups:
+            raise RecordingError(f"{path}: the TDMS file holds no channel with samples; "
+                                 "nothing to read")
+        starts = [t[2] for g in groups for t in map(_timing, g.channels())
+                  if t is not None and t[2] is not None]
+        origin = min(starts) if starts else None
+        prefix = len(groups) > 1
+        return [TdmsGroupSource(path, handle, g, f"{g.name}/" if prefix else "", origin,
+                                owner=i == 0) for i, g in enumerate(groups)]
+    except BaseException:
+        handle.close()
+        raise
+
+
+def sniff(head: bytes) -> bool:
+    """True for a TDMS segment's lead-in."""
+    return head.startswith(TAG)
+
+
+FORMAT = Format("tdms", (".tdms",), read_tdms, sniff,
+                description="NI TDMS (LabVIEW, DAQmx), a stream per group (npTDMS)")
