@@ -14,7 +14,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from hrgtc.core.errors import SlowChannelWarning
+from hrgtc.core.errors import HrgtcWarning, SlowChannelWarning
 from hrgtc.recording import read
 from hrgtc.recording.formats import format_for, open_streams
 from hrgtc.recording.formats.dataflash import stream_name
@@ -83,3 +83,9 @@ def test_the_log_is_known_by_its_first_message_under_another_suffix(data, tmp_pa
     renamed = tmp_path / "00000042.dat"
     renamed.write_bytes((data / LOG).read_bytes())
     assert format_for(renamed).name == "dataflash"
+
+
+def test_a_log_cut_inside_a_message_is_read_to_its_last_whole_one_and_said(data):
+    with pytest.warns(HrgtcWarning, match=r"test\.BIN: the log ends inside a message \(21 byte"):
+        streams = open_streams(data / LOG)
+    assert "IMU" in {s.stream for s in streams}

@@ -18,11 +18,13 @@ radps``), its temperature ``T`` in °C::
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from hrgtc.core.errors import HrgtcWarning
 from hrgtc.recording.formats.base import Format, Source
 from hrgtc.recording.formats.logs import (
     Stream,
@@ -102,8 +104,13 @@ def read_dataflash(path: Path) -> list[Source]:
     firmware = next((t for t in texts if t.startswith(("Ardu", "APM"))), None)
     # a log whose logger stopped inside a message (power off) ends with a part of one:
     # read up to the last whole message, as mavlogdump does, and say how many bytes were left
+    left = int(reader.data_len - reader.offset)
     extra: dict[str, Any] = {"dataflash_messages": texts[:20],
-                             "dataflash_trailing_bytes": int(reader.data_len - reader.offset)}
+                             "dataflash_trailing_bytes": left}
+    if left:
+        warnings.warn(f"{path}: the log ends inside a message ({left} byte(s) after the last "
+                      "whole one: the logger stopped while writing); read up to the last whole "
+                      "message", HrgtcWarning, stacklevel=2)
     if firmware:
         extra["firmware"] = firmware
     found = [Stream(name, _columns(table)) for name, table in sorted(tables.items())]
