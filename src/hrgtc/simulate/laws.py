@@ -30,6 +30,7 @@ from typing import Annotated, Any, Protocol
 
 import numpy as np
 from msgspec import Meta
+from numba import njit
 from numpy.polynomial import Polynomial
 
 from hrgtc.core import records
@@ -39,10 +40,12 @@ from hrgtc.simulate.shell import Shell, ShellRecord
 __all__ = [
     "BiasLaw",
     "FrequencyLaw",
+    "PlayLaw",
     "PolynomialFrequencyLaw",
     "ScaleFactorLaw",
     "ShellFrequencyLaw",
     "frequency_law_from_dict",
+    "play_operator",
     "table1_frequency_law",
 ]
 
@@ -365,3 +368,133 @@ class BiasLawRecord(records.Record, kw_only=True):
     gradient_temperature_dph_per_c2: float = 0.0
     hysteresis_dph: float = 0.0
     hysteresis_width_c: records.Positive = 1.0
+
+
+@njit(cache=True, nogil=True)
+def _play_loop(x, half_width, state, out):  # pragma: no cover - compiled
+    p = state
+    for i in range(x.size):
+        low = x[i] - half_width
+        high = x[i] + half_width
+        if p < low:
+            p = low
+        elif p > high:
+            p = high
+        out[i] = p
+    return p
+
+
+def play_operator(x: np.ndarray, width: float, state: float) -> tuple[np.ndarray, float]:
+    """The play (backlash) operator of width ``w`` over a sequence, from a state.
+
+    ``p[k] = min(max(p[k-1], x[k] - w/2), x[k] + w/2)``: the output stays where it
+    was until the input pushes it from one side, so it remembers which way the input
+    came from (rate-independent memory, unlike a lag). A settled input ``x`` reads
+    ``p = x + w/2`` when it came down to ``x`` (by at least ``w``) and ``x - w/2``
+    when it came up.
+
+    Parameters
+    ----------
+    x
+        The input (a temperature). [°C]
+    width
+        The play's width w >= 0. [°C]
+    state
+        The output before the first sample (``p[-1]``). [°C]
+
+    Returns
+    -------
+    out, last : numpy.ndarray, float
+        The output at each sample and the state after the last (carried to the next chunk).
+
+    Examples
+    --------
+    >>> out, last = play_operator(np.array([0.0, 1.0, 3.0, 2.5, 1.0]), 2.0, 0.0)
+    >>> out.tolist(), last
+    ([0.0, 0.0, 2.0, 2.0, 2.0], 2.0)
+    """
+    x = np.ascontiguousarray(x, dtype=np.float64)
+    out = np.empty_like(x)
+    last = _play_loop(x, 0.5 * float(width), float(state), out)
+    return out, float(last)
+
+
+@dataclass(frozen=True)
+class PlayLaw:
+    """A bias with true thermal memory: a play (backlash) operator on the resonator temperature.
+
+    .. math::
+
+        B_{play} = s\\,(p - T_r), \\qquad
+        p_k = \\min(\\max(p_{k-1}, T_{r,k} - w/2), T_{r,k} + w/2)
+
+    (:func:`play_operator`). Unlike a lag (the gradient terms of :class:`BiasLaw`,
+    which vanish when the temperature settles), the play keeps the direction the
+    resonator came from: settled at a set-point after coming down by at least ``w``
+    the term is ``+s w/2``, after coming up ``-s w/2``, at any ramp rate. Its state
+    at power-on is ``p = T_r(0) + initial_offset_c`` (the unit's past, unknown to a
+    model; ``|initial_offset_c| <= w/2``).
+
+    Parameters
+    ----------
+    slope_dph_per_c
+        s: bias per °C of play lag. [°/h/°C]
+    width_c
+        w: the play's width. [°C]
+    initial_offset_c
+        p - T_r at power-on, in [-w/2, w/2]. [°C]
+    """
+
+    slope_dph_per_c: float
+    width_c: float
+    initial_offset_c: float = 0.0
+
+    def __post_init__(self) -> None:
+        slope, width, offset = (float(v) for v in (self.slope_dph_per_c, self.width_c,
+                                                   self.initial_offset_c))
+        if not (math.isfinite(slope) and math.isfinite(width) and width > 0.0):
+            raise InputError(f"PlayLaw needs a finite slope_dph_per_c and width_c > 0 [°C], "
+                             f"got {self.slope_dph_per_c!r}, {self.width_c!r}")
+        if not (math.isfinite(offset) and abs(offset) <= 0.5 * width):
+            raise InputError(f"initial_offset_c must be within ±width_c/2 = ±{0.5 * width:g} "
+                             f"°C, got {self.initial_offset_c!r}")
+        object.__setattr__(self, "slope_dph_per_c", slope)
+        object.__setattr__(self, "width_c", width)
+        object.__setattr__(self, "initial_offset_c", offset)
+
+    def initial_state(self, resonator_c: float) -> float:
+        """The play's state at power-on, at the first resonator temperature. [°C]"""
+        return float(resonator_c) + self.initial_offset_c
+
+    def bias_dph(self, resonator_c: np.ndarray, state: float) -> tuple[np.ndarray, float]:
+        """The play's part of the bias over a chunk, and the state after it. [°/h], [°C]
+
+        Parameters
+        ----------
+        resonator_c
+            Resonator temperature. [°C]
+        state
+            The play's output before the chunk (:meth:`initial_state` at power-on). [°C]
+        """
+        resonator = np.asarray(resonator_c, dtype=np.float64)
+        played, last = play_operator(resonator, self.width_c, state)
+        played -= resonator
+        played *= self.slope_dph_per_c
+        return played, last
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types, as :class:`PlayLawRecord` writes them."""
+        return records.dump(self, PlayLawRecord)
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> PlayLaw:
+        """Inverse of :meth:`to_dict` (checked against its record)."""
+        return cls(**records.load(data, PlayLawRecord, "play law"))
+
+
+class PlayLawRecord(records.Record, kw_only=True):
+    """A :class:`PlayLaw` in the simulator's ground truth."""
+
+    slope_dph_per_c: float
+    width_c: records.Positive
+    initial_offset_c: float = 0.0

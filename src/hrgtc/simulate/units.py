@@ -23,7 +23,14 @@ temperature coefficients, faster thermal constants (housing 7 min, resonator
 30 min: within 0.1 °C ~11,000 s after a 30 °C step), a bias rising as the
 unit cools and with the opposite gradient sign, a temperature-dependent
 gradient sensitivity, a small cooling/heating hysteresis (0.2 °/h, which the
-polynomial model of Eq. 21 cannot represent), and lower noise.
+polynomial model of Eq. 21 cannot represent), and lower noise. That term is
+``h tanh(G/G_h)`` of the gradient: no memory, a lag that saturates
+(:mod:`hrgtc.simulate.history` tells the two apart; docs/history.md).
+
+``unit-play`` is ``unit-b`` with a true thermal memory in the place of its tanh term: a
+play (backlash) operator of width 2 °C on the resonator temperature
+(:class:`~hrgtc.simulate.laws.PlayLaw`, slope 0.4 °/h/°C), so that a soak settled after
+coming down reads 0.8 °/h above one settled after coming up, at any ramp rate.
 
 Neither has a scale-factor law (``scale_factor_law`` None: ``rate = input +
 bias + noise``, as before the law existed).
@@ -47,7 +54,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cache
 from typing import Annotated, Any
 
@@ -61,6 +68,8 @@ from hrgtc.simulate.laws import (
     BiasLawRecord,
     FrequencyLaw,
     FrequencyLawRecord,
+    PlayLaw,
+    PlayLawRecord,
     ScaleFactorLaw,
     ScaleFactorLawRecord,
     ShellFrequencyLaw,
@@ -115,6 +124,9 @@ class Unit:
     scale_factor_law
         Scale-factor error against resonator temperature; None for none
         (``rate = input + bias + noise``).
+    play_law
+        A bias term with true thermal memory (a play operator on the resonator
+        temperature, added to ``bias_law``); None for none.
     """
 
     name: str
@@ -126,6 +138,7 @@ class Unit:
     frequency_noise_hz: float
     housing_noise_c: float
     scale_factor_law: ScaleFactorLaw | None = None
+    play_law: PlayLaw | None = None
 
     def __post_init__(self) -> None:
         for attribute in ("frequency_noise_hz", "housing_noise_c"):
@@ -143,14 +156,15 @@ class Unit:
     def from_dict(cls, data: Mapping[str, Any]) -> Unit:
         """Inverse of :meth:`to_dict` (checked against :class:`UnitRecord`)."""
         values = records.load(data, UnitRecord, "simulated unit")
-        law = values["scale_factor_law"]
+        law, play = values["scale_factor_law"], values["play_law"]
         return cls(
             **{**values,
                "thermal": ThermalNetwork(**values["thermal"]),
                "frequency_law": frequency_law_from_dict(data["frequency_law"]),
                "bias_law": BiasLaw(**values["bias_law"]),
                "gyro_noise": GyroNoise(**values["gyro_noise"]),
-               "scale_factor_law": None if law is None else ScaleFactorLaw(**law)},
+               "scale_factor_law": None if law is None else ScaleFactorLaw(**law),
+               "play_law": None if play is None else PlayLaw(**play)},
         )
 
     def summary(self) -> str:
@@ -176,6 +190,12 @@ class Unit:
             lines.append(
                 f"  scale factor: k0..kn {sf.coefficients_ppm} ppm/°C^j about "
                 f"T0 {sf.reference_c:g} °C"
+            )
+        if self.play_law is not None:
+            play = self.play_law
+            lines.append(
+                f"  play memory: {play.slope_dph_per_c:g} °/h/°C × (p - T_r), width "
+                f"{play.width_c:g} °C, p - T_r at power-on {play.initial_offset_c:g} °C"
             )
         return "\n".join(lines)
 
@@ -286,8 +306,9 @@ class UnitRecord(records.Record, kw_only=True):
     frequency_noise_hz: records.NonNegative
     housing_noise_c: records.NonNegative
     scale_factor_law: ScaleFactorLawRecord | None = None
+    play_law: PlayLawRecord | None = None
 
-    omit_when_default = ("scale_factor_law",)
+    omit_when_default = ("scale_factor_law", "play_law")
 
 
 class MultiAxisUnitRecord(records.Record, kw_only=True):
@@ -355,6 +376,18 @@ def _unit_b() -> Unit:
     )
 
 
+def _unit_play() -> Unit:
+    """unit-b with a true play-type memory (:class:`PlayLaw`) instead of its tanh term."""
+    base = _unit_b()
+    return replace(
+        base, name="unit-play",
+        description="unit-b with a true thermal memory: a play operator of width 2 °C on the "
+        "resonator temperature (0.8 °/h between coming down and coming up), no tanh term",
+        bias_law=replace(base.bias_law, hysteresis_dph=0.0),
+        play_law=PlayLaw(slope_dph_per_c=0.4, width_c=2.0),
+    )
+
+
 def _imu3() -> MultiAxisUnit:
     housing_s = 600.0
     latitude = math.radians(40.0)
@@ -409,6 +442,7 @@ def _imu3() -> MultiAxisUnit:
 _FACTORIES: dict[str, Callable[[], Unit | MultiAxisUnit]] = {
     "paper-unit": _paper_unit,
     "unit-b": _unit_b,
+    "unit-play": _unit_play,
     "imu-3": _imu3,
     # "mems-3" is registered by hrgtc.simulate.mems (imported by the package), which builds on
     # this module's types: importing it from here would close an import circle.
