@@ -15,7 +15,13 @@ interval (seeds resampled, 2000 draws); with ``--terms=...`` (candidates beyond 
 default, e.g. ``--terms=f,f^2,f^3,df,f*df,g,play``) also the paired line: the median over
 seeds of (ratio with the terms) / (ratio with the default candidates), with its interval.
 
-Usage: ``python bench/bench_history_heldout.py --seeds=20 [--terms=...]``.
+With ``--history``: today's candidates plus ``gsat`` and ``play``, the play's width learned
+per seed from a grid (``--widths=1,2,4``; default
+:data:`hrgtc.drift.variables.play.WIDTHS_C`) by the fits' leave-one-run-out score, and the
+model with them kept only where that score beats today's model's (the rows say
+``play_width_c``, ``kept`` and both scores); the paired line compares the two.
+
+Usage: ``python bench/bench_history_heldout.py --seeds=20 [--terms=... | --history]``.
 """
 
 from __future__ import annotations
@@ -32,7 +38,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from bench_heldout import CYCLE, SETPOINTS_C, _calibrate_keywords, _measure  # noqa: E402
+from bench_heldout import CYCLE, SETPOINTS_C, _calibrate_keywords, _measure
 
 RUNS = ("heating", "fast_cooling", "cycle")
 TARGET = 1.15
@@ -74,17 +80,53 @@ def _campaign(seed: int, folder: Path, fs: float, hours: float) -> dict:
     }
 
 
-def _fit_and_measure(files: dict, options: dict, fs: float, seed: int) -> list[dict]:
+def _fit(files: dict, options: dict):
     from hrgtc.pipeline.calibration import calibrate
 
-    result = calibrate(files["soaks"], files["training"], **_calibrate_keywords(options))
+    return calibrate(files["soaks"], files["training"], **_calibrate_keywords(options)).model
+
+
+def _loro(model) -> float:
+    """The fit's leave-one-run-out score (RMS over training runs of the held-out 10 s
+    stability of the window residuals, :class:`hrgtc.drift.cross_validation.CrossValidation`)."""
+    validation = model.drift.cross_validation
+    return float("inf") if validation is None else float(validation.score_dph)
+
+
+def _rows(model, files: dict, fs: float, seed: int, **extra) -> list[dict]:
     rows = []
     for name, path in files["heldout"].items():
-        row = {"seed": seed, "run": name, **_measure(path, result.model, fs)}
+        row = {"seed": seed, "run": name, **_measure(path, model, fs)}
         row["ratio"] = row["comp"] / row["floor"]
-        row["terms"] = list(result.model.drift.selected)
-        rows.append(row)
+        row["terms"] = list(model.drift.selected)
+        rows.append({**row, **extra})
     return rows
+
+
+def _fit_and_measure(files: dict, options: dict, fs: float, seed: int) -> list[dict]:
+    return _rows(_fit(files, options), files, fs, seed)
+
+
+def _history_fits(files: dict, terms: tuple[str, ...], widths: tuple[float, ...], fs: float,
+                  seed: int) -> tuple[list[dict], list[dict]]:
+    """Rows of today's model and of the model with the history terms offered: the play's
+    width learned from ``widths`` by leave-one-run-out (:func:`learn_width`), the model
+    kept only when its leave-one-run-out score beats today's."""
+    from hrgtc.drift.variables.play import learn_width
+
+    today = _fit(files, {})
+    models = {}
+
+    def score(width: float) -> float:
+        models[width] = _fit(files, {"terms": terms, "play_width_c": width})
+        return _loro(models[width])
+
+    width, scores = learn_width(score, widths)
+    kept = scores[width] < _loro(today)
+    chosen = models[width] if kept else today
+    extra = {"play_width_c": width, "kept": kept, "loro_today": round(_loro(today), 4),
+             "loro_history": round(scores[width], 4)}
+    return _rows(today, files, fs, seed), _rows(chosen, files, fs, seed, **extra)
 
 
 def _interval(values: list[float], rng: np.random.Generator, draws: int = 2000
@@ -123,6 +165,10 @@ def _summary(rows: list[dict], label: str, seconds: float) -> list[dict]:
             for term in r["terms"]:
                 terms[term] = terms.get(term, 0) + 1
         line["terms_selected"] = dict(sorted(terms.items(), key=lambda kv: -kv[1]))
+        if any("kept" in r for r in sel):
+            line["history_kept"] = sum(bool(r["kept"]) for r in sel)
+            widths = [r["play_width_c"] for r in sel if r["kept"]]
+            line["play_width_c_kept"] = sorted(set(widths))
         out.append(line)
     return out
 
@@ -141,6 +187,21 @@ def _paired(before: list[dict], after: list[dict], label: str) -> list[dict]:
                     "after_over_before_ci95": [round(low, 3), round(high, 3)],
                     "better_in": sum(p < 1.0 for p in pairs)})
     return out
+
+
+def history(seeds: tuple[int, ...], terms: tuple[str, ...], widths: tuple[float, ...],
+            fs: float = 1.0, hours: float = 5.0) -> dict[str, tuple[list[dict], float]]:
+    """Rows of today's model and of the history terms' (see :func:`_history_fits`)."""
+    rows: dict[str, list[dict]] = {"default": [], "history": []}
+    start = time.perf_counter()
+    with tempfile.TemporaryDirectory() as tmp:
+        for seed in seeds:
+            files = _campaign(seed, Path(tmp), fs, hours)
+            today, after = _history_fits(files, terms, widths, fs, seed)
+            rows["default"].extend(today)
+            rows["history"].extend(after)
+    seconds = time.perf_counter() - start
+    return {label: (values, seconds) for label, values in rows.items()}
 
 
 def heldout(seeds: tuple[int, ...], option_sets: dict[str, dict], fs: float = 1.0,
@@ -172,7 +233,16 @@ if __name__ == "__main__":
             terms = tuple(arg.split("=", 1)[1].split(","))
             option_sets["terms_" + "_".join(terms).replace("*", "").replace("^", "")] = {
                 "terms": terms}
-    results = heldout(tuple(range(1, count + 1)), option_sets)
+    if "--history" in sys.argv:  # today's candidates + gsat + play, the width learned
+        from hrgtc.drift.variables.play import WIDTHS_C
+        from hrgtc.settings.drift import GRADIENT_TERMS
+
+        widths = next((tuple(float(w) for w in a.split("=", 1)[1].split(","))
+                       for a in sys.argv if a.startswith("--widths=")), WIDTHS_C)
+        results = history(tuple(range(1, count + 1)), (*GRADIENT_TERMS, "gsat", "play"),
+                          widths)
+    else:
+        results = heldout(tuple(range(1, count + 1)), option_sets)
     for label, (rows, seconds) in results.items():
         for line in _summary(rows, label, seconds):
             print(json.dumps(line), flush=True)

@@ -18,8 +18,8 @@ from hrgtc.simulate import units
 from hrgtc.simulate.laws import (
     BiasLaw,
     BiasLawRecord,
-    PolynomialFrequencyLawRecord,
     PlayLawRecord,
+    PolynomialFrequencyLawRecord,
     ScaleFactorLawRecord,
     ShellFrequencyLawRecord,
 )
