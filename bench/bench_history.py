@@ -1,7 +1,7 @@
 """Lag or hysteresis (issue 29, item 1): the experiment of :mod:`hrgtc.simulate.history`.
 
 On ``unit-b`` (its heating/cooling term is ``h tanh(G/G_h)`` of the gradient: no memory),
-on ``unit-play`` (a true play memory, :class:`hrgtc.simulate.laws.PlayLaw`) and on
+on ``unit-play`` (a true play memory, the play of :class:`hrgtc.simulate.laws.BiasLaw`) and on
 ``unit-b`` without its tanh term (a pure lag): the heating - cooling split of the bias at
 20 °C for ramps of 1 ... 0.01 °C/min (and its line to rate 0), and the settled bias after
 approaching 20 °C from 30 °C and from 10 °C. One JSON line per unit (docs/history.md).

@@ -49,9 +49,9 @@ def _unit(seed: int, k: int):
     from hrgtc.simulate import units
 
     base = units.get("unit-play")
-    half = 0.5 * base.play_law.width_c
+    half = 0.5 * base.bias_law.play_width_c
     offset = float(np.random.default_rng([seed, k]).uniform(-half, half))
-    return replace(base, play_law=replace(base.play_law, initial_offset_c=offset))
+    return replace(base, bias_law=replace(base.bias_law, play_initial_offset_c=offset))
 
 
 def _campaign(seed: int, folder: Path, fs: float, hours: float) -> dict:

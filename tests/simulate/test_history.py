@@ -1,4 +1,4 @@
-"""The play memory of the simulator (laws.PlayLaw, unit-play) and the lag-or-hysteresis
+"""The play memory of the simulator (the play of laws.BiasLaw, unit-play) and the lag-or-hysteresis
 experiment (hrgtc.simulate.history): issue 29, item 1."""
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ import pytest
 from hrgtc.core.errors import InputError
 from hrgtc.simulate import campaign, standard_profiles, units
 from hrgtc.simulate.history import HistoryExperiment, classify, settle_bound
-from hrgtc.simulate.laws import PlayLaw, play_operator
+from hrgtc.simulate.laws import BiasLaw, play_operator
 
 FAST = HistoryExperiment(rates_c_per_min=(1.0, 0.1, 0.01))
 
@@ -42,20 +42,22 @@ def test_play_operator_is_its_definition_and_chunk_invariant():
 
 
 def test_play_law_checks_its_power_on_state():
-    with pytest.raises(InputError, match="initial_offset_c must be within"):
-        PlayLaw(0.4, 2.0, initial_offset_c=1.5)
-    with pytest.raises(InputError, match="width_c > 0"):
-        PlayLaw(0.4, 0.0)
+    with pytest.raises(InputError, match="play_initial_offset_c must be within"):
+        BiasLaw(4.0, play_dph_per_c=0.4, play_width_c=2.0, play_initial_offset_c=1.5)
+    with pytest.raises(InputError, match="play_width_c >= 0"):
+        BiasLaw(4.0, play_dph_per_c=0.4, play_width_c=-1.0)
 
 
-def test_unit_play_round_trips_and_other_units_write_no_play_law():
+def test_unit_play_round_trips_and_other_units_write_no_play():
     unit = units.get("unit-play")
     data = json.loads(json.dumps(unit.to_dict()))
-    assert data["play_law"] == {"slope_dph_per_c": 0.4, "width_c": 2.0, "initial_offset_c": 0.0}
+    law = data["bias_law"]
+    assert (law["play_dph_per_c"], law["play_width_c"]) == (0.4, 2.0)
+    assert "play_initial_offset_c" not in law  # its default, 0, is not written
     assert units.unit_from_dict(data) == unit
     assert unit.bias_law.hysteresis_dph == 0.0  # the memory is the play, not the tanh
     for name in ("paper-unit", "unit-b"):
-        assert "play_law" not in units.get(name).to_dict()  # their ground truth unchanged
+        assert not any(k.startswith("play") for k in units.get(name).to_dict()["bias_law"])
 
 
 def test_play_state_is_carried_from_chunk_to_chunk_and_power_on_is_bounded():
@@ -67,7 +69,7 @@ def test_play_state_is_carried_from_chunk_to_chunk_and_power_on_is_bounded():
     # another power-on history (the play at T_r + w/2 instead of T_r) changes the bias by
     # at most s * w/2, and by nothing once the warm-up has pushed the play from below
     base = units.get("unit-play")
-    other = replace(base, play_law=replace(base.play_law, initial_offset_c=1.0))
+    other = replace(base, bias_law=replace(base.bias_law, play_initial_offset_c=1.0))
     moved = campaign.simulate_run(profile, other, 0.1, seed=2)["bias_dph"] - whole["bias_dph"]
     assert np.abs(moved).max() == pytest.approx(0.4 * 1.0, rel=1e-12)
     assert np.all(np.abs(moved) <= 0.4 * 1.0 + 1e-12)
@@ -77,12 +79,12 @@ def test_play_state_is_carried_from_chunk_to_chunk_and_power_on_is_bounded():
 
 def test_experiment_calls_the_play_unit_hysteresis_of_slope_times_width():
     verdict = classify("unit-play", FAST)
-    law = units.get("unit-play").play_law
+    law = units.get("unit-play").bias_law
     assert verdict.verdict == "hysteresis"
     # settled from above - from below = s w (engaged on both approaches), up to what the
     # lag leaves after the hold (settle_bound); that bound is small, so the test is sharp
     assert verdict.tolerance_dph < 1e-4
-    assert abs(verdict.settled_difference_dph - law.slope_dph_per_c * law.width_c) \
+    assert abs(verdict.settled_difference_dph - law.play_dph_per_c * law.play_width_c) \
         <= verdict.tolerance_dph
     # the heating - cooling split does not vanish at rate 0: it goes to -s w
     assert verdict.split_at_zero_rate_dph == pytest.approx(-0.8, abs=0.01)

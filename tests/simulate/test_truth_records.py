@@ -18,7 +18,6 @@ from hrgtc.simulate import units
 from hrgtc.simulate.laws import (
     BiasLaw,
     BiasLawRecord,
-    PlayLawRecord,
     PolynomialFrequencyLawRecord,
     ScaleFactorLawRecord,
     ShellFrequencyLawRecord,
@@ -50,8 +49,7 @@ def test_truth_round_trips_and_fits_the_records_schemas(name):
                              (axis["bias_law"], BiasLawRecord),
                              (axis["gyro_noise"], GyroNoiseRecord),
                              (axis["frequency_law"], law_records[axis["frequency_law"]["kind"]]),
-                             (axis.get("scale_factor_law"), ScaleFactorLawRecord),
-                             (axis.get("play_law"), PlayLawRecord)):
+                             (axis.get("scale_factor_law"), ScaleFactorLawRecord)):
             if part is not None:
                 schema = records.json_schema(record, "t", "https://hrgtc.invalid/t.json")
                 jsonschema.Draft202012Validator(schema).validate(part)

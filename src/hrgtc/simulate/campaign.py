@@ -327,7 +327,7 @@ class _Run:
     axis to its constant input rate [°/h], ``names`` the run's columns in order and
     ``states`` each axis to its thermal network's state at the end of the last chunk,
     ``plays`` each axis to the state of its play memory
-    (:class:`~hrgtc.simulate.laws.PlayLaw`, if it has one) likewise.
+    (the play of its :class:`~hrgtc.simulate.laws.BiasLaw`, if it has one) likewise.
     """
 
     profile: Profile
@@ -373,11 +373,11 @@ def _chunk(run: _Run, start: int, stop: int, noise: Future[Any]) -> Recording:
         housing, resonator, run.states[axis] = gyro.thermal.response(chamber, dt,
                                                                      run.states[axis])
         bias = gyro.bias_law.bias_dph(resonator, housing)
-        if gyro.play_law is not None:  # a memory: its state carried from chunk to chunk
+        if gyro.bias_law.has_play:  # a memory: its state carried from chunk to chunk
             state = run.plays.get(axis)
             if state is None:
-                state = gyro.play_law.initial_state(resonator[0])
-            played, run.plays[axis] = gyro.play_law.bias_dph(resonator, state)
+                state = gyro.bias_law.play_state(resonator[0])
+            played, run.plays[axis] = gyro.bias_law.play_dph(resonator, state)
             bias += played
         freq = gyro.frequency_law.frequency_hz(resonator)
         physics[axis] = (housing, resonator, bias, freq)

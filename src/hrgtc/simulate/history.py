@@ -8,7 +8,7 @@ must treat differently (docs/history.md):
   saturating ``h tanh(G/G_h)`` term). It has no memory: the difference between heating
   and cooling shrinks as the ramp rate goes to 0, and a soak settles to the same bias
   from above and from below.
-* a **hysteresis** (a rate-independent memory, :class:`~hrgtc.simulate.laws.PlayLaw`):
+* a **hysteresis** (a rate-independent memory, the play of :class:`~hrgtc.simulate.laws.BiasLaw`):
   the difference stays as the rate goes to 0, and a soak settles to a bias that depends
   on the side it was approached from (``s w`` for a play of width ``w`` and slope ``s``).
 
@@ -219,7 +219,7 @@ def settle_bound(unit: str | Unit, experiment: HistoryExperiment = HistoryExperi
     ``L_T ε_r + L_G |G|`` on each side, with ``L_T`` the largest ``|dB/dT_r|`` over
     ``centre ± span`` (and that ``|G|``) and ``L_G = |g| + |g_T| span + |h|/G_h``; the
     bound is twice that (both sides) plus :data:`ROUNDING_DPH`. A play
-    (:class:`~hrgtc.simulate.laws.PlayLaw`) with ``span_c >= w`` is engaged on both
+    (of :class:`~hrgtc.simulate.laws.BiasLaw`) with ``span_c >= w`` is engaged on both
     monotone approaches, so it adds exactly ``s w`` to the difference.
 
     Returns

@@ -29,7 +29,7 @@ polynomial model of Eq. 21 cannot represent), and lower noise. That term is
 
 ``unit-play`` is ``unit-b`` with a true thermal memory in the place of its tanh term: a
 play (backlash) operator of width 2 °C on the resonator temperature
-(:class:`~hrgtc.simulate.laws.PlayLaw`, slope 0.4 °/h/°C), so that a soak settled after
+(the play of :class:`~hrgtc.simulate.laws.BiasLaw`, slope 0.4 °/h/°C), so that a soak settled after
 coming down reads 0.8 °/h above one settled after coming up, at any ramp rate.
 
 Neither has a scale-factor law (``scale_factor_law`` None: ``rate = input +
@@ -68,8 +68,6 @@ from hrgtc.simulate.laws import (
     BiasLawRecord,
     FrequencyLaw,
     FrequencyLawRecord,
-    PlayLaw,
-    PlayLawRecord,
     ScaleFactorLaw,
     ScaleFactorLawRecord,
     ShellFrequencyLaw,
@@ -124,9 +122,6 @@ class Unit:
     scale_factor_law
         Scale-factor error against resonator temperature; None for none
         (``rate = input + bias + noise``).
-    play_law
-        A bias term with true thermal memory (a play operator on the resonator
-        temperature, added to ``bias_law``); None for none.
     """
 
     name: str
@@ -138,7 +133,6 @@ class Unit:
     frequency_noise_hz: float
     housing_noise_c: float
     scale_factor_law: ScaleFactorLaw | None = None
-    play_law: PlayLaw | None = None
 
     def __post_init__(self) -> None:
         for attribute in ("frequency_noise_hz", "housing_noise_c"):
@@ -156,15 +150,14 @@ class Unit:
     def from_dict(cls, data: Mapping[str, Any]) -> Unit:
         """Inverse of :meth:`to_dict` (checked against :class:`UnitRecord`)."""
         values = records.load(data, UnitRecord, "simulated unit")
-        law, play = values["scale_factor_law"], values["play_law"]
+        law = values["scale_factor_law"]
         return cls(
             **{**values,
                "thermal": ThermalNetwork(**values["thermal"]),
                "frequency_law": frequency_law_from_dict(data["frequency_law"]),
                "bias_law": BiasLaw(**values["bias_law"]),
                "gyro_noise": GyroNoise(**values["gyro_noise"]),
-               "scale_factor_law": None if law is None else ScaleFactorLaw(**law),
-               "play_law": None if play is None else PlayLaw(**play)},
+               "scale_factor_law": None if law is None else ScaleFactorLaw(**law)},
         )
 
     def summary(self) -> str:
@@ -191,11 +184,10 @@ class Unit:
                 f"  scale factor: k0..kn {sf.coefficients_ppm} ppm/°C^j about "
                 f"T0 {sf.reference_c:g} °C"
             )
-        if self.play_law is not None:
-            play = self.play_law
+        if law.has_play:
             lines.append(
-                f"  play memory: {play.slope_dph_per_c:g} °/h/°C × (p - T_r), width "
-                f"{play.width_c:g} °C, p - T_r at power-on {play.initial_offset_c:g} °C"
+                f"  play memory: {law.play_dph_per_c:g} °/h/°C × (p - T_r), width "
+                f"{law.play_width_c:g} °C, p - T_r at power-on {law.play_initial_offset_c:g} °C"
             )
         return "\n".join(lines)
 
@@ -306,9 +298,8 @@ class UnitRecord(records.Record, kw_only=True):
     frequency_noise_hz: records.NonNegative
     housing_noise_c: records.NonNegative
     scale_factor_law: ScaleFactorLawRecord | None = None
-    play_law: PlayLawRecord | None = None
 
-    omit_when_default = ("scale_factor_law", "play_law")
+    omit_when_default = ("scale_factor_law",)
 
 
 class MultiAxisUnitRecord(records.Record, kw_only=True):
@@ -377,14 +368,15 @@ def _unit_b() -> Unit:
 
 
 def _unit_play() -> Unit:
-    """unit-b with a true play-type memory (:class:`PlayLaw`) instead of its tanh term."""
+    """unit-b with a true play-type memory (the play of its :class:`BiasLaw`) instead of
+    its tanh term."""
     base = _unit_b()
     return replace(
         base, name="unit-play",
         description="unit-b with a true thermal memory: a play operator of width 2 °C on the "
         "resonator temperature (0.8 °/h between coming down and coming up), no tanh term",
-        bias_law=replace(base.bias_law, hysteresis_dph=0.0),
-        play_law=PlayLaw(slope_dph_per_c=0.4, width_c=2.0),
+        bias_law=replace(base.bias_law, hysteresis_dph=0.0, play_dph_per_c=0.4,
+                         play_width_c=2.0),
     )
 
 
