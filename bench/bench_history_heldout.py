@@ -19,7 +19,9 @@ With ``--history``: today's candidates plus ``gsat`` and ``play``, the play's wi
 per seed from a grid (``--widths=1,2,4``; default
 :data:`hrgtc.drift.variables.play.WIDTHS_C`) by the fits' leave-one-run-out score, and the
 model with them kept only where that score beats today's model's (the rows say
-``play_width_c``, ``kept`` and both scores); the paired line compares the two.
+``play_width_c``, ``kept`` and both scores); the paired line compares the two. With
+``--train-cycle`` the training runs also hold a cycle that turns round
+(:data:`TRAIN_CYCLE`), which shows the play's width whatever the history.
 
 Usage: ``python bench/bench_history_heldout.py --seeds=20 [--terms=... | --history]``.
 """
@@ -41,6 +43,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_heldout import CYCLE, SETPOINTS_C, _calibrate_keywords, _measure
 
 RUNS = ("heating", "fast_cooling", "cycle")
+#: A training run that turns round (``--train-cycle``): 20 -> 0 -> 30 -> 20 °C at 1 °C/min.
+TRAIN_CYCLE = {"name": "train_cycle", "start_c": 20.0, "segments": [
+    {"setpoint_c": 0.0, "ramp_c_per_min": 1.0}, {"setpoint_c": 0.0, "hold_h": 1.0},
+    {"setpoint_c": 30.0, "ramp_c_per_min": 1.0}, {"setpoint_c": 30.0, "hold_h": 1.0},
+    {"setpoint_c": 20.0, "ramp_c_per_min": 1.0}, {"setpoint_c": 20.0, "hold_h": 0.5}]}
 TARGET = 1.15
 
 
@@ -54,8 +61,10 @@ def _unit(seed: int, k: int):
     return replace(base, bias_law=replace(base.bias_law, play_initial_offset_c=offset))
 
 
-def _campaign(seed: int, folder: Path, fs: float, hours: float) -> dict:
-    """The seed's files: soaks, training runs, held-out runs."""
+def _campaign(seed: int, folder: Path, fs: float, hours: float,
+              train_cycle: bool = False) -> dict:
+    """The seed's files: soaks, training runs (with :data:`TRAIN_CYCLE` if asked), held-out
+    runs."""
     from hrgtc.simulate import simulate_files
     from hrgtc.simulate import standard_profiles as profiles
     from hrgtc.simulate.profiles import from_mapping
@@ -67,10 +76,13 @@ def _campaign(seed: int, folder: Path, fs: float, hours: float) -> dict:
 
     soaks = [sim(profiles.soak(sp, hours), f"soak{k}", 10 + k)
              for k, sp in enumerate(SETPOINTS_C)]
+    training = [sim(profiles.cooldown(20.0, -20.0, 5.0), "cool", 1),
+                sim(profiles.warmup(-20.0, 20.0, 5.0), "warm", 2)]
+    if train_cycle:
+        training.append(sim(from_mapping(TRAIN_CYCLE), "train_cycle", 6))
     return {
         "soaks": soaks,
-        "training": [sim(profiles.cooldown(20.0, -20.0, 5.0), "cool", 1),
-                     sim(profiles.warmup(-20.0, 20.0, 5.0), "warm", 2)],
+        "training": training,
         "heldout": {
             "heating": sim(profiles.warmup(-10.0, 40.0, 5.0, ramp_c_per_min=0.5), "heat", 3),
             "fast_cooling": sim(profiles.cooldown(40.0, -20.0, 4.0, ramp_c_per_min=2.0),
@@ -190,13 +202,14 @@ def _paired(before: list[dict], after: list[dict], label: str) -> list[dict]:
 
 
 def history(seeds: tuple[int, ...], terms: tuple[str, ...], widths: tuple[float, ...],
-            fs: float = 1.0, hours: float = 5.0) -> dict[str, tuple[list[dict], float]]:
+            fs: float = 1.0, hours: float = 5.0, train_cycle: bool = False,
+            ) -> dict[str, tuple[list[dict], float]]:
     """Rows of today's model and of the history terms' (see :func:`_history_fits`)."""
     rows: dict[str, list[dict]] = {"default": [], "history": []}
     start = time.perf_counter()
     with tempfile.TemporaryDirectory() as tmp:
         for seed in seeds:
-            files = _campaign(seed, Path(tmp), fs, hours)
+            files = _campaign(seed, Path(tmp), fs, hours, train_cycle)
             today, after = _history_fits(files, terms, widths, fs, seed)
             rows["default"].extend(today)
             rows["history"].extend(after)
@@ -240,7 +253,7 @@ if __name__ == "__main__":
         widths = next((tuple(float(w) for w in a.split("=", 1)[1].split(","))
                        for a in sys.argv if a.startswith("--widths=")), WIDTHS_C)
         results = history(tuple(range(1, count + 1)), (*GRADIENT_TERMS, "gsat", "play"),
-                          widths)
+                          widths, train_cycle="--train-cycle" in sys.argv)
     else:
         results = heldout(tuple(range(1, count + 1)), option_sets)
     for label, (rows, seconds) in results.items():
