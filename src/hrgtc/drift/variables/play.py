@@ -27,7 +27,6 @@ from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
-from numba import njit
 
 from hrgtc.core import records
 from hrgtc.core.errors import InputError
@@ -38,24 +37,6 @@ DEFAULT_WIDTH_C = 2.0
 #: The grid :func:`learn_width` judges by default. [°C]
 WIDTHS_C = (0.5, 1.0, 2.0, 4.0, 8.0)
 _STATE = "play"
-
-
-@njit(cache=True, nogil=True)
-def _play_run(x, half_width, restart, state, out):  # pragma: no cover - compiled
-    """``out[i] = p[i] - x[i]`` from ``state`` (NaN: not started: p = the first finite x)."""
-    has_restart = restart.size > 0
-    p = state
-    for i in range(x.size):
-        xi = x[i]
-        if (has_restart and restart[i]) or p != p:
-            p = xi  # power-on (or restart): the state starts at the temperature
-        elif xi == xi:
-            if p < xi - half_width:
-                p = xi - half_width
-            elif p > xi + half_width:
-                p = xi + half_width
-        out[i] = p - xi
-    return p
 
 
 def play_lag(temperature_c: np.ndarray, width_c: float, state: float = math.nan,
@@ -84,11 +65,13 @@ def play_lag(temperature_c: np.ndarray, width_c: float, state: float = math.nan,
     >>> values.tolist(), last
     ([0.0, -1.0, -1.0, 0.0, 1.0], 20.0)
     """
+    from hrgtc.drift.variables._play_kernel import play_run  # compiled on first use
+
     x = np.ascontiguousarray(temperature_c, dtype=np.float64)
     mask = (np.zeros(0, dtype=np.bool_) if restart is None
             else np.ascontiguousarray(restart, dtype=np.bool_))
     out = np.empty_like(x)
-    last = _play_run(x, 0.5 * float(width_c), mask, float(state), out)
+    last = play_run(x, 0.5 * float(width_c), mask, float(state), out)
     return out, float(last)
 
 
