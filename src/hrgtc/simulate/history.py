@@ -214,7 +214,8 @@ def settle_bound(unit: str | Unit, experiment: HistoryExperiment = HistoryExperi
     an average of steps that started earlier), the resonator is
     ``ε_r = span (tau_r e^(-t/tau_r) - tau_h e^(-t/tau_h)) / (tau_r - tau_h)`` from the
     set-point and the gradient is ``|G| <= span tau_r |e^(-t/tau_r) - e^(-t/tau_h)| /
-    |tau_r - tau_h|`` (:func:`hrgtc.simulate.thermal.step_response`), ``t = hold_h``. The
+    |tau_r - tau_h|`` (:func:`hrgtc.simulate.thermal.step_response`), ``t = hold_h`` (for the
+    gradient, which rises to a peak before it falls, ``t`` no earlier than that peak). The
     lag part of :class:`~hrgtc.simulate.laws.BiasLaw` moves at most
     ``L_T ε_r + L_G |G|`` on each side, with ``L_T`` the largest ``|dB/dT_r|`` over
     ``centre ± span`` (and that ``|G|``) and ``L_G = |g| + |g_T| span + |h|/G_h``; the
@@ -234,8 +235,11 @@ def settle_bound(unit: str | Unit, experiment: HistoryExperiment = HistoryExperi
         raise InputError("settle_bound needs tau_resonator_s != tau_housing_s")
     resonator = e.span_c * abs(tau_r * math.exp(-t / tau_r) - tau_h * math.exp(-t / tau_h)) \
         / abs(tau_r - tau_h)
-    gradient = e.span_c * tau_r * abs(math.exp(-t / tau_r) - math.exp(-t / tau_h)) \
-        / abs(tau_r - tau_h)
+    # the gradient's step response rises to a peak, then falls: its largest value from t on
+    peak = math.log(tau_r / tau_h) * tau_r * tau_h / (tau_r - tau_h)
+    t_gradient = max(t, peak)
+    gradient = e.span_c * tau_r * abs(math.exp(-t_gradient / tau_r)
+                                      - math.exp(-t_gradient / tau_h)) / abs(tau_r - tau_h)
     law = gyro.bias_law
     c1, c2, c3 = law.temperature_dph
     dt = np.linspace(-e.span_c, e.span_c, 2001) + (e.centre_c - law.reference_c)
