@@ -116,7 +116,8 @@ def test_profile_file_and_unit_b(tmp_path):
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        (["--unit", "unit-z"], "'unit-z' is not one of 'paper-unit', 'unit-b', 'imu-3', 'mems-3'"),
+        (["--unit", "unit-z"],
+         "'unit-z' is not one of 'paper-unit', 'unit-b', 'unit-play', 'imu-3', 'mems-3'"),
         (["--profile", "sock"], "unknown profile 'sock'"),
         (["--profile", "soak", "--temperature", "3"], "do not apply to profile 'soak'"),
         (["--profile", "cooldown", "--start", "-20", "--end", "20"], "needs end_c < start_c"),

@@ -50,7 +50,8 @@ def test_drift_settings_take_each_declared_option():
     for d in DECLARATIONS:
         for name, kind in typing.get_type_hints(d.options or object).items():
             declared.append((name, kind, getattr(d.options, name)))
-    assert [name for name, _, _ in declared] == list(VARIABLE_OPTIONS) == ["rate_tau2_s"]
+    assert [name for name, _, _ in declared] == list(VARIABLE_OPTIONS) == [
+        "rate_tau2_s", "gradient_saturation_c", "play_width_c"]
     fields = {f.name: f for f in dataclasses.fields(DriftSettings)}
     hints = typing.get_type_hints(DriftSettings)
     order = list(fields)

@@ -146,7 +146,8 @@ def test_the_model_schema_takes_each_variables_settings():
 
     text = repr(MODEL_SCHEMA)
     owned = settings_schema()
-    assert set(owned) == {"switch_hz_per_s", "rate_tau2_s", "aux_columns", "aux_centres"}
+    assert set(owned) == {"switch_hz_per_s", "rate_tau2_s", "gradient_saturation_c",
+                          "play_width_c", "aux_columns", "aux_centres"}
     for v in DRIFT_VARIABLES:
         for key, _, _ in v.settings_fields:
             assert key in FeatureSettingsRecord.__struct_fields__, (v.name, key)

@@ -405,7 +405,10 @@ FeatureSettingsRecord = msgspec.defstruct(
     ],
     bases=(records.Record,), kw_only=True, module=__name__,
     namespace={"__doc__": ":class:`FeatureSettings` in a file (the drift model's "
-               "``settings``)."})
+               "``settings``).",
+               "omit_when_default": tuple(name for v in DRIFT_VARIABLES
+                                          if v.omit_default_settings
+                                          for name, _, _ in v.settings_fields)})
 
 
 def settle_rows(settings: FeatureSettings) -> int:
@@ -458,6 +461,7 @@ class FeatureStream:
     def reset(self) -> None:
         """Forget the filter state (start of a new run)."""
         self._states: dict[str, RateFilterState] = {}
+        self._memory: dict[str, Any] = {}  # the remembering variables' state (the play's)
         self.samples_seen = 0
 
     def _rate(self, key: str, level: np.ndarray, tau_s: float, time_s: np.ndarray,
@@ -477,7 +481,8 @@ class FeatureStream:
         time_s = chunk.time_s
         # each variable's numpy reference (its module's compute), sharing levels and filters
         inputs = Inputs(chunk, self.settings, self.thermometer, _registered,
-                        lambda key, level, tau: self._rate(key, level, tau, time_s, restart))
+                        lambda key, level, tau: self._rate(key, level, tau, time_s, restart),
+                        self._memory, restart)
         out = {v: inputs.value(v) for v in self.variables}
         self.samples_seen += len(chunk)
         return out

@@ -32,6 +32,26 @@ class D2Options:
         unit="s", default_text=f"{TAU2_FACTOR:g} × --rate-tau-s")
 
 
+class GsatOptions:
+    """gsat's command-line option, a field of ``DriftSettings`` (``hrgtc calibrate
+    --gradient-saturation-c``); :func:`hrgtc.drift.variables.gsat.derive` gives the default."""
+
+    gradient_saturation_c: float | None = setting(
+        None, "Gradient at which the saturating gradient term gsat = tanh(g / this) bends "
+        "(terms like gsat, f*gsat).", unit="°C", default_text="1 °C")
+
+
+class PlayOptions:
+    """play's command-line option, a field of ``DriftSettings`` (``hrgtc calibrate
+    --play-width-c``); :func:`hrgtc.drift.variables.play.derive` gives the default."""
+
+    play_width_c: float | None = setting(
+        None, "Width of the play (backlash) operator on the thermometer's temperature, "
+        "variable play (terms like play); learn it with "
+        "hrgtc.drift.variables.play.learn_width (a grid judged by leave-one-run-out).",
+        unit="°C", default_text="2 °C")
+
+
 @dataclass(frozen=True)
 class Declaration:
     """One drift variable as the settings see it.
@@ -58,5 +78,7 @@ DECLARATIONS = (
     Declaration("dpos"),
     Declaration("d2", D2Options),
     Declaration("g"),
+    Declaration("gsat", GsatOptions),
+    Declaration("play", PlayOptions),
     Declaration("a_NAME"),
 )

@@ -25,7 +25,7 @@ from hrgtc.settings import format_value, setting
 from hrgtc.settings.fleet import SETPOINTS_C
 
 #: The simulated gyros (:mod:`hrgtc.simulate.units`) and the default one.
-UNIT_NAMES = ("paper-unit", "unit-b", "imu-3", "mems-3")
+UNIT_NAMES = ("paper-unit", "unit-b", "unit-play", "imu-3", "mems-3")
 DEFAULT_UNIT = "paper-unit"
 #: Known constant input rate of a single-axis run (e.g. the Earth-rate component). [°/h]
 DEFAULT_INPUT_RATE_DPH = 10.0

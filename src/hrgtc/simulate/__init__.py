@@ -13,10 +13,12 @@ the shared ``time_s``, ``chamber_c`` and ``housing_c``
   rate table;
 - :mod:`~hrgtc.simulate.thermal`: chamber -> housing -> resonator network;
 - :mod:`~hrgtc.simulate.laws`: frequency law (Table 1 / Eq. 18 of [1], or the
-  shell model), bias law and scale-factor law in physical variables;
+  shell model), bias law, play memory and scale-factor law in physical variables;
 - :mod:`~hrgtc.simulate.noise_sources`: ARW, bias instability, rate random walk;
-- :mod:`~hrgtc.simulate.units`: named simulated gyros (``paper-unit``, ``unit-b``) and
-  the three-axis ``imu-3``;
+- :mod:`~hrgtc.simulate.units`: named simulated gyros (``paper-unit``, ``unit-b``,
+  ``unit-play`` with a play memory) and the three-axis ``imu-3``;
+- :mod:`~hrgtc.simulate.history`: the experiment that tells a thermal lag from a
+  hysteresis (ramp-rate sweep, soaks approached from above and below);
 - :mod:`~hrgtc.simulate.campaign`: runs in chunks, with ground truth;
 - :mod:`~hrgtc.simulate.output`: runs written to files, atomically;
 - :mod:`~hrgtc.simulate.mems`: a three-axis MEMS gyro (``mems-3``) for the real-logger cases;

@@ -39,7 +39,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterator, Mapping
 from concurrent.futures import Future, ThreadPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -325,7 +325,9 @@ class _Run:
     ``times``, ``temps`` are the chamber program's corners (:meth:`Profile.breakpoints`),
     ``gyros`` maps each axis (None for a single-axis unit) to its gyro, ``rates`` each
     axis to its constant input rate [°/h], ``names`` the run's columns in order and
-    ``states`` each axis to its thermal network's state at the end of the last chunk.
+    ``states`` each axis to its thermal network's state at the end of the last chunk,
+    ``plays`` each axis to the state of its play memory
+    (the play of its :class:`~hrgtc.simulate.laws.BiasLaw`, if it has one) likewise.
     """
 
     profile: Profile
@@ -337,6 +339,7 @@ class _Run:
     names: tuple[str, ...]
     metadata: Metadata
     states: dict[str | None, Any]
+    plays: dict[str | None, float] = field(default_factory=dict)
 
 
 def _noise_streams(unit: AnyUnit, gyros: dict[str | None, Unit], fs: float, seed: Seed,
@@ -370,6 +373,12 @@ def _chunk(run: _Run, start: int, stop: int, noise: Future[Any]) -> Recording:
         housing, resonator, run.states[axis] = gyro.thermal.response(chamber, dt,
                                                                      run.states[axis])
         bias = gyro.bias_law.bias_dph(resonator, housing)
+        if gyro.bias_law.has_play:  # a memory: its state carried from chunk to chunk
+            state = run.plays.get(axis)
+            if state is None:
+                state = gyro.bias_law.play_state(resonator[0])
+            played, run.plays[axis] = gyro.bias_law.play_dph(resonator, state)
+            bias += played
         freq = gyro.frequency_law.frequency_hz(resonator)
         physics[axis] = (housing, resonator, bias, freq)
     drawn, housing_logged = noise.result()

@@ -30,6 +30,7 @@ from typing import Annotated, Any, Protocol
 
 import numpy as np
 from msgspec import Meta
+from numba import njit
 from numpy.polynomial import Polynomial
 
 from hrgtc.core import records
@@ -43,6 +44,7 @@ __all__ = [
     "ScaleFactorLaw",
     "ShellFrequencyLaw",
     "frequency_law_from_dict",
+    "play_operator",
     "table1_frequency_law",
 ]
 
@@ -258,12 +260,17 @@ class BiasLaw:
     .. math::
 
         B = B_0 + \\sum_{k=1}^{3} c_k (T_r - T_0)^k + g\\,G + g_T (T_r - T_0)\\,G
-            + h \\tanh(G / G_h), \\qquad G = T_h - T_r
+            + h \\tanh(G / G_h) + s\\,(p - T_r), \\qquad G = T_h - T_r
 
     The gradient terms make the bias depend on the rate of change of the
     resonator temperature (``G = tau_r dT_r/dt``); the tanh term is a
     heating/cooling hysteresis (a different offset while warming, G > 0, than
-    while cooling, G < 0).
+    while cooling, G < 0) that saturates: a lag, no memory. The play term is a true
+    memory: ``p`` is a play (backlash) operator of width ``w`` on the resonator
+    temperature (:func:`play_operator`), whose state a chunk hands to the next
+    (:meth:`play_dph`): settled after coming down by at least ``w`` it reads ``+s w/2``,
+    after coming up ``-s w/2``, at any ramp rate. Its state at power-on is
+    ``p = T_r(0) + play_initial_offset_c`` (the unit's past, which a model does not know).
 
     Parameters
     ----------
@@ -281,6 +288,12 @@ class BiasLaw:
         h: half the heating - cooling offset. [°/h]
     hysteresis_width_c
         G_h: gradient over which the hysteresis switches. [°C]
+    play_dph_per_c
+        s: bias per °C of the play's lag p - T_r. [°/h/°C]
+    play_width_c
+        w: the play's width; 0 for no play. [°C]
+    play_initial_offset_c
+        p - T_r at power-on, within ±w/2. [°C]
     """
 
     bias0_dph: float
@@ -290,6 +303,9 @@ class BiasLaw:
     gradient_temperature_dph_per_c2: float = 0.0
     hysteresis_dph: float = 0.0
     hysteresis_width_c: float = 1.0
+    play_dph_per_c: float = 0.0
+    play_width_c: float = 0.0
+    play_initial_offset_c: float = 0.0
 
     def __post_init__(self) -> None:
         temperature = tuple(float(c) for c in self.temperature_dph)
@@ -312,6 +328,14 @@ class BiasLaw:
             raise InputError(
                 f"hysteresis_width_c must be > 0 [°C], got {self.hysteresis_width_c!r}"
             )
+        slope, width, offset = (float(v) for v in (self.play_dph_per_c, self.play_width_c,
+                                                   self.play_initial_offset_c))
+        if not (math.isfinite(slope) and math.isfinite(width) and width >= 0.0):
+            raise InputError(f"the play needs a finite play_dph_per_c and play_width_c >= 0 "
+                             f"[°C], got {self.play_dph_per_c!r}, {self.play_width_c!r}")
+        if not (math.isfinite(offset) and abs(offset) <= 0.5 * width):
+            raise InputError(f"play_initial_offset_c must be within ±play_width_c/2 = "
+                             f"±{0.5 * width:g} °C, got {self.play_initial_offset_c!r}")
 
     def bias_dph(self, resonator_c: np.ndarray, housing_c: np.ndarray) -> np.ndarray:
         """Thermal bias (noise-free), B0 included. [°/h]
@@ -345,6 +369,32 @@ class BiasLaw:
             out += self.hysteresis_dph * np.tanh(gradient, out=gradient)
         return out
 
+    @property
+    def has_play(self) -> bool:
+        """Whether the law has a play memory (``play_width_c`` > 0)."""
+        return self.play_width_c > 0.0
+
+    def play_state(self, resonator_c: float) -> float:
+        """The play's state at power-on, at the first resonator temperature. [°C]"""
+        return float(resonator_c) + self.play_initial_offset_c
+
+    def play_dph(self, resonator_c: np.ndarray, state: float) -> tuple[np.ndarray, float]:
+        """The play's part ``s (p - T_r)`` of the bias over a chunk (not in
+        :meth:`bias_dph`, which has no memory), and the state after it. [°/h], [°C]
+
+        Parameters
+        ----------
+        resonator_c
+            Resonator temperature. [°C]
+        state
+            The play's output before the chunk (:meth:`play_state` at power-on). [°C]
+        """
+        resonator = np.asarray(resonator_c, dtype=np.float64)
+        played, last = play_operator(resonator, self.play_width_c, state)
+        played -= resonator
+        played *= self.play_dph_per_c
+        return played, last
+
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types, as :class:`BiasLawRecord` writes them."""
         return records.dump(self, BiasLawRecord)
@@ -365,3 +415,58 @@ class BiasLawRecord(records.Record, kw_only=True):
     gradient_temperature_dph_per_c2: float = 0.0
     hysteresis_dph: float = 0.0
     hysteresis_width_c: records.Positive = 1.0
+    play_dph_per_c: float = 0.0
+    play_width_c: records.NonNegative = 0.0
+    play_initial_offset_c: float = 0.0
+
+    # written only by a unit with a play (the other units' ground truth unchanged)
+    omit_when_default = ("play_dph_per_c", "play_width_c", "play_initial_offset_c")
+
+
+@njit(cache=True, nogil=True)
+def _play_loop(x, half_width, state, out):  # pragma: no cover - compiled
+    p = state
+    for i in range(x.size):
+        low = x[i] - half_width
+        high = x[i] + half_width
+        if p < low:
+            p = low
+        elif p > high:
+            p = high
+        out[i] = p
+    return p
+
+
+def play_operator(x: np.ndarray, width: float, state: float) -> tuple[np.ndarray, float]:
+    """The play (backlash) operator of width ``w`` over a sequence, from a state.
+
+    ``p[k] = min(max(p[k-1], x[k] - w/2), x[k] + w/2)``: the output stays where it
+    was until the input pushes it from one side, so it remembers which way the input
+    came from (rate-independent memory, unlike a lag). A settled input ``x`` reads
+    ``p = x + w/2`` when it came down to ``x`` (by at least ``w``) and ``x - w/2``
+    when it came up.
+
+    Parameters
+    ----------
+    x
+        The input (a temperature). [°C]
+    width
+        The play's width w >= 0. [°C]
+    state
+        The output before the first sample (``p[-1]``). [°C]
+
+    Returns
+    -------
+    out, last : numpy.ndarray, float
+        The output at each sample and the state after the last (carried to the next chunk).
+
+    Examples
+    --------
+    >>> out, last = play_operator(np.array([0.0, 1.0, 3.0, 2.5, 1.0]), 2.0, 0.0)
+    >>> out.tolist(), last
+    ([0.0, 0.0, 2.0, 2.0, 2.0], 2.0)
+    """
+    x = np.ascontiguousarray(x, dtype=np.float64)
+    out = np.empty_like(x)
+    last = _play_loop(x, 0.5 * float(width), float(state), out)
+    return out, float(last)

@@ -23,7 +23,14 @@ temperature coefficients, faster thermal constants (housing 7 min, resonator
 30 min: within 0.1 °C ~11,000 s after a 30 °C step), a bias rising as the
 unit cools and with the opposite gradient sign, a temperature-dependent
 gradient sensitivity, a small cooling/heating hysteresis (0.2 °/h, which the
-polynomial model of Eq. 21 cannot represent), and lower noise.
+polynomial model of Eq. 21 cannot represent), and lower noise. That term is
+``h tanh(G/G_h)`` of the gradient: no memory, a lag that saturates
+(:mod:`hrgtc.simulate.history` tells the two apart; docs/history.md).
+
+``unit-play`` is ``unit-b`` with a true thermal memory in the place of its tanh term: a
+play (backlash) operator of width 2 °C on the resonator temperature
+(the play of :class:`~hrgtc.simulate.laws.BiasLaw`, slope 0.4 °/h/°C), so that a soak settled after
+coming down reads 0.8 °/h above one settled after coming up, at any ramp rate.
 
 Neither has a scale-factor law (``scale_factor_law`` None: ``rate = input +
 bias + noise``, as before the law existed).
@@ -47,7 +54,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cache
 from typing import Annotated, Any
 
@@ -176,6 +183,11 @@ class Unit:
             lines.append(
                 f"  scale factor: k0..kn {sf.coefficients_ppm} ppm/°C^j about "
                 f"T0 {sf.reference_c:g} °C"
+            )
+        if law.has_play:
+            lines.append(
+                f"  play memory: {law.play_dph_per_c:g} °/h/°C × (p - T_r), width "
+                f"{law.play_width_c:g} °C, p - T_r at power-on {law.play_initial_offset_c:g} °C"
             )
         return "\n".join(lines)
 
@@ -355,6 +367,19 @@ def _unit_b() -> Unit:
     )
 
 
+def _unit_play() -> Unit:
+    """unit-b with a true play-type memory (the play of its :class:`BiasLaw`) instead of
+    its tanh term."""
+    base = _unit_b()
+    return replace(
+        base, name="unit-play",
+        description="unit-b with a true thermal memory: a play operator of width 2 °C on the "
+        "resonator temperature (0.8 °/h between coming down and coming up), no tanh term",
+        bias_law=replace(base.bias_law, hysteresis_dph=0.0, play_dph_per_c=0.4,
+                         play_width_c=2.0),
+    )
+
+
 def _imu3() -> MultiAxisUnit:
     housing_s = 600.0
     latitude = math.radians(40.0)
@@ -409,6 +434,7 @@ def _imu3() -> MultiAxisUnit:
 _FACTORIES: dict[str, Callable[[], Unit | MultiAxisUnit]] = {
     "paper-unit": _paper_unit,
     "unit-b": _unit_b,
+    "unit-play": _unit_play,
     "imu-3": _imu3,
     # "mems-3" is registered by hrgtc.simulate.mems (imported by the package), which builds on
     # this module's types: importing it from here would close an import circle.

@@ -120,7 +120,7 @@ VARIABLE = DriftVariable(
     name="a_NAME", unit="unit of its column", sensor_unit="unit of its column", kind="level",
     description="an extra logged channel (--aux NAME=COLUMN) minus its training mean",
     backends=frozenset({"numpy", "c_double", "c_float32", "params"}), columns=(),
-    compute=compute, order=7, check=check, c_code=CCode(),
+    compute=compute, order=9, check=check, c_code=CCode(),
     settings_fields=(("aux_columns", dict[str, str], records.empty()),
                      ("aux_centres", dict[str, float], records.empty())), params=params,
     derive=columns, first_pass=FirstPass(reads=lambda names: names, derive=centres))

@@ -44,12 +44,21 @@ class Inputs:
     rate
         ``rate(key, level, tau_s)``: the stream's causal rate filter ``key`` (its state
         carried across chunks) run over the level's values. [unit/s]
+    memory
+        The stream's own state of the variables that remember (the play's output), by
+        key, carried across the chunks of one run and emptied at its start; None: a new one.
+    restart
+        Boolean mask of the chunk's rows where the stream restarts (a segment start), or
+        None.
     """
 
     def __init__(self, chunk: Any, settings: Any, thermometer: Any,
                  lookup: Callable[[str], DriftVariable],
-                 rate: Callable[[str, np.ndarray, float], np.ndarray]):
+                 rate: Callable[[str, np.ndarray, float], np.ndarray],
+                 memory: dict[str, Any] | None = None, restart: np.ndarray | None = None):
         self.chunk, self.settings, self.thermometer = chunk, settings, thermometer
+        self.memory: dict[str, Any] = {} if memory is None else memory
+        self.restart = restart
         self._lookup, self._rate = lookup, rate
         self._values: dict[str, np.ndarray] = {}
         self._rates: dict[str, np.ndarray] = {}
@@ -180,6 +189,10 @@ class DriftVariable:
         What it learns from a first pass over the runs (:class:`FirstPass`): dpos's
         ``switch_hz_per_s``, the extra channels' ``aux_centres``; one pass serves every
         variable that has one.
+    omit_default_settings
+        Its settings are written to the model file only when they differ from their
+        defaults (a variable added after model files were written: those files, and the
+        models that do not use it, keep their text and hash).
     """
 
     name: str
@@ -198,6 +211,7 @@ class DriftVariable:
     params: Callable[[tuple[str, ...], Any, Put], None] | None = None
     derive: Derive | None = None
     first_pass: FirstPass | None = None
+    omit_default_settings: bool = False
 
     def unit_for(self, thermometer_source: str = "resonator") -> str:
         """The unit for a model whose thermometer is ``"resonator"`` or ``"sensor"``."""
