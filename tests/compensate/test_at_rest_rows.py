@@ -16,7 +16,7 @@ from hrgtc import recording as recording_io
 from hrgtc.compensate import compensate_file
 from hrgtc.compensate.at_rest import FlagsMisaligned, RestFlags
 from hrgtc.drift.rest import run_rest
-from hrgtc.model import UnitModel
+from hrgtc.model import AxisModel, Model
 from hrgtc.recording import Recording
 
 from synthetic import THERMOMETER, ramp_run
@@ -26,7 +26,8 @@ CHUNK = 7_000
 
 @pytest.fixture(scope="module")
 def unit_model():
-    return UnitModel(THERMOMETER, drift.fit([ramp_run(seed=21, hours=3.0)], THERMOMETER))
+    return Model.single(
+        AxisModel(THERMOMETER, drift.fit([ramp_run(seed=21, hours=3.0)], THERMOMETER)))
 
 
 def handled(seed: int = 23) -> Recording:

@@ -24,7 +24,7 @@ from hrgtc.compensate import (
     compensate_instrument_file,
 )
 from hrgtc.core.errors import InputError, RecordingError
-from hrgtc.model import InstrumentModel, UnitModel
+from hrgtc.model import AxisModel, Model
 from hrgtc.recording import concatenate
 
 from synthetic import THERMOMETER, ramp_run, with_heating_extra
@@ -32,7 +32,8 @@ from synthetic import THERMOMETER, ramp_run, with_heating_extra
 
 @pytest.fixture(scope="module")
 def unit_model():
-    return UnitModel(THERMOMETER, drift.fit([ramp_run(seed=21, hours=3.0)], THERMOMETER))
+    return Model.single(
+        AxisModel(THERMOMETER, drift.fit([ramp_run(seed=21, hours=3.0)], THERMOMETER)))
 
 
 @pytest.fixture(scope="module")
@@ -168,7 +169,7 @@ def test_fused_engine_is_generic_over_the_term_grammar(unit_model, hot_housing_r
         unit_model.drift, selected=tuple(selected), settings=settings_, ranges=ranges,
         scaled_coefficients=tuple(coefficients[: len(selected)]),
         coefficients=dict.fromkeys(selected, 1.0))
-    assert_engines_agree(UnitModel(THERMOMETER, fitted), hot_housing_run)
+    assert_engines_agree(Model.single(AxisModel(THERMOMETER, fitted)), hot_housing_run)
 
 
 @pytest.fixture(scope="module")
@@ -185,7 +186,7 @@ def test_fused_streaming_is_exact_across_any_chunk_boundaries(unit_model, hot_ho
                                  settings=dataclasses.replace(
                                      unit_model.drift.settings,
                                      scales={"f": 10.0, "df": 1e-3, "h": 20.0, "dh": 1e-2}))
-    model = UnitModel(THERMOMETER, fitted)
+    model = Model.single(AxisModel(THERMOMETER, fitted))
     batch = compensate(hot_housing_run, model)
     compensator = Compensator(model)
     bounds = [0, *sorted(cuts), len(hot_housing_run)]
@@ -225,7 +226,7 @@ def gradient_model():
                        THERMOMETER, terms=GRADIENT_TERMS, initial=GRADIENT_TERMS,
                        premove=0.999999)
     assert fitted.selected == GRADIENT_TERMS and "g" in fitted.ranges
-    return UnitModel(THERMOMETER, fitted)
+    return Model.single(AxisModel(THERMOMETER, fitted))
 
 
 @pytest.fixture(scope="module")
@@ -341,7 +342,7 @@ def test_file_to_file_refuses_to_drop_spikes(unit_model, run, tmp_path):
     for compensate_any in (compensate_file, compensate_instrument_file):
         with pytest.raises(InputError, match="never drops a row: use --spike-filter flag"):
             compensate_any(source, tmp_path / "out.parquet",
-                           InstrumentModel.single(unit_model)
+                           Model.single(unit_model)
                            if compensate_any is compensate_instrument_file else unit_model,
                            read_options=recording_io.ReadOptions(spike_filter="drop"))
     assert sorted(p.name for p in tmp_path.iterdir()) == ["run.parquet"]
@@ -375,7 +376,7 @@ def test_two_threads_give_the_bits_of_one_call(unit_model, monkeypatch):
                                  settings=dataclasses.replace(
                                      unit_model.drift.settings,
                                      scales={"f": 10.0, "df": 1e-3, "h": 20.0, "dh": 1e-2}))
-    model = UnitModel(THERMOMETER, fitted)
+    model = Model.single(AxisModel(THERMOMETER, fitted))
     split = assert_engines_agree(model, long_run)
     a = Compensator(model).transform(long_run)
     monkeypatch.setattr(kernel, "PARALLEL_ROWS", len(long_run) + 1)
@@ -405,7 +406,7 @@ def test_a_model_with_the_heating_switch_runs_on_numpy_in_both_engines(run):
             with_heating_extra(ramp_run(seed=32, start_c=-20.0, end_c=20.0, hours=3.0))]
     fitted = drift.fit(runs, THERMOMETER, terms=(*EQ21_TERMS, "dpos", "f*dpos"))
     assert "dpos" in fitted.variables
-    model = UnitModel(THERMOMETER, fitted)
+    model = Model.single(AxisModel(THERMOMETER, fitted))
     fused, numpy_engine = Compensator(model), Compensator(model, engine="numpy")
     a, b = fused.transform(run), numpy_engine.transform(run)
     assert fused._plan is None  # fell back: the kernel does not compute dpos

@@ -15,14 +15,15 @@ import pytest
 from hrgtc import drift
 from hrgtc.compensate import Compensator
 from hrgtc.core.errors import ExtrapolationWarning
-from hrgtc.model import UnitModel
+from hrgtc.model import AxisModel, Model
 
 from synthetic import THERMOMETER, ramp_run
 
 
 @pytest.mark.parametrize("engine", ["fused", "numpy"])
 def test_nan_temperature_estimate_warns_once_and_is_counted(engine):
-    model = UnitModel(THERMOMETER, drift.fit([ramp_run(seed=21, hours=3.0)], THERMOMETER))
+    model = Model.single(
+        AxisModel(THERMOMETER, drift.fit([ramp_run(seed=21, hours=3.0)], THERMOMETER)))
     hot = ramp_run(seed=23, start_c=95.0, end_c=140.0, hours=1.0, ramp_hours=0.3)  # > 100 °C
     compensator = Compensator(model, engine=engine)
     with warnings.catch_warnings(record=True) as caught:

@@ -172,12 +172,13 @@ def test_guarded_selection_does_not_extrapolate_high_order_terms():
 def test_compensation_applies_known_orientations_and_reports_an_unknown_one():
     from hrgtc.compensate import Compensator
     from hrgtc.core.errors import HrgtcWarning
-    from hrgtc.model import UnitModel
+    from hrgtc.model import AxisModel, Model
 
     orientations = ([300.0, -200.0, 100.0], [[0, 0, 1], [1, 0, 0], [0, -1, 0]])
     run, _ = mems_run(2, orientations=orientations)
-    model = UnitModel(thermometer=THERMOMETER, unit="mems",
-                      drift=quiet_fit([run], THERMOMETER, terms=("f", "f^2", "df")))
+    model = Model.single(
+        AxisModel(thermometer=THERMOMETER, drift=quiet_fit([run], THERMOMETER, terms=("f", "f^2",
+            "df"))), unit="mems")
     later, _ = mems_run(7, orientations=orientations)
     out = Compensator(model).transform(later)
     residual = out["bias_model_dph"] - later["bias_dph"]
@@ -253,9 +254,9 @@ def test_user_orientation_labels_give_an_offset_each_like_an_hrg_turned_on_its_t
         pytest.approx(12.0, abs=0.2)
     # compensation reads the label; a label never trained is unknown, counted, not guessed
     from hrgtc.compensate import Compensator
-    from hrgtc.model import UnitModel
+    from hrgtc.model import AxisModel, Model
 
-    unit = UnitModel(thermometer=THERMOMETER, drift=model, unit="hrg")
+    unit = Model.single(AxisModel(thermometer=THERMOMETER, drift=model), unit="hrg")
     out = Compensator(unit).transform(run)
     step = out["rate_comp_dph"][label == 2.0].mean() - out["rate_comp_dph"][label == 1.0].mean()
     assert abs(step) < 0.2  # the 12 °/h step is taken out

@@ -1,9 +1,9 @@
 """Compensation: stage 4, a unit model applied to any later run.
 
-Takes a :class:`~hrgtc.model.UnitModel` and a recording and gives the
+Takes a :class:`~hrgtc.model.Model` and a recording and gives the
 compensated output: batch or streaming (``compensator``: :class:`Compensator`
 keeps the df/dt filter state across chunks; ``file_pass``: :func:`compensate_file`
-works file to file in bounded memory). A whole instrument (:class:`~hrgtc.model.InstrumentModel`,
+works file to file in bounded memory). A whole instrument (:class:`~hrgtc.model.Model`,
 every axis, bias and scale factor) is compensated by ``instrument``'s
 :class:`InstrumentCompensator`. The same model as dependency-free C99 for on-board
 use, or as a documented parameter file, is :mod:`hrgtc.export`.

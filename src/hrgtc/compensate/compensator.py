@@ -37,7 +37,7 @@ from hrgtc.drift.features import (
 from hrgtc.drift.offsets import label_offsets, sample_offsets
 from hrgtc.drift.rate_checks import filtered_levels, rate_filter_problems, warn_rate_filter
 from hrgtc.drift.rate_filter import check_time, restart_mask
-from hrgtc.model import UnitModel
+from hrgtc.model import Model
 from hrgtc.recording import Recording
 from hrgtc.recording.gaps import check_gap_policy
 
@@ -51,7 +51,7 @@ SCALE_COLUMN = "scale_model_ppm"
 ENGINES = ("fused", "numpy")
 
 
-def output_columns(model: UnitModel) -> tuple[str, ...]:
+def output_columns(model: Model) -> tuple[str, ...]:
     """Columns compensation with ``model`` adds (:data:`OUTPUT_COLUMNS`, and
     :data:`SCALE_COLUMN` when the model has a scale factor)."""
     return OUTPUT_COLUMNS if model.scale_factor is None else (*OUTPUT_COLUMNS, SCALE_COLUMN)
@@ -99,7 +99,7 @@ class Compensator:
     >>> # for chunk in iter_chunks("run.parquet"): out = comp.transform(chunk)
     """
 
-    def __init__(self, model: UnitModel, drift: str = "frequency", engine: str = "fused",
+    def __init__(self, model: Model, drift: str = "frequency", engine: str = "fused",
                  gaps: str = "ignore") -> None:
         self.gaps = check_gap_policy(gaps)
         if engine not in ENGINES:
@@ -403,7 +403,7 @@ class Compensator:
                             self._extremes, self.variable_ranges)
 
 
-def compensate(recording: Recording, model: UnitModel, drift: str = "frequency",
+def compensate(recording: Recording, model: Model, drift: str = "frequency",
                engine: str = "fused") -> Recording:
     """Batch compensation of a whole run: a new :class:`Compensator`, one chunk."""
     return Compensator(model, drift, engine).transform(recording)

@@ -29,7 +29,7 @@ from hrgtc.core.files import check_writable, refuse_input
 from hrgtc.core.progress import Progress
 from hrgtc.core.time_steps import TimeRepairStream
 from hrgtc.core.timeline import RESTARTS_KEY
-from hrgtc.model import InstrumentModel, UnitModel
+from hrgtc.model import Model
 from hrgtc.model_fit import check_recording_noise, with_model_band
 from hrgtc.recording import Recording
 from hrgtc.recording.marks import COMPENSATED_KEY, mark, refuse_compensated
@@ -71,7 +71,7 @@ class CompensationSummary:
 def compensate_file(
     source: str | os.PathLike[str],
     output: str | os.PathLike[str],
-    model: UnitModel,
+    model: Model,
     *,
     force: bool = False,
     read_options: rec_io.ReadOptions | None = None,
@@ -136,7 +136,7 @@ def compensate_file(
 
 
 def _compensate(source: str | os.PathLike[str], output: str | os.PathLike[str],
-                model: UnitModel, options: rec_io.ReadOptions, added: tuple[str, ...],
+                model: Model, options: rec_io.ReadOptions, added: tuple[str, ...],
                 force: bool, chunk_rows: int, drift: str, progress: Progress | None,
                 compensator: Any, only: tuple[str, ...] | None) -> CompensationSummary:
     """One run of :func:`compensate_file`, the detector's pass reading ``only`` those
@@ -156,7 +156,7 @@ def _compensate(source: str | os.PathLike[str], output: str | os.PathLike[str],
             quick = dataclasses.replace(options, spike_filter="off")
             flags = RestFlags(rec_io.iter_chunks(source, quick, rows=chunk_rows,
                                                  validate=False, only=only),
-                              list(getattr(model, "axes", None) or [""]), options.motion,
+                              list(model.axes), options.motion,
                               os.path.basename(os.fspath(source)),
                               validated=lambda: options.chunks(source, rows=chunk_rows),
                               rows=total)
@@ -246,7 +246,7 @@ def compensation_accounting(compensator: Any, spikes: int = 0,
     return accounting
 
 
-def compensated_metadata(metadata: rec_io.Metadata, model: UnitModel | InstrumentModel,
+def compensated_metadata(metadata: rec_io.Metadata, model: Model,
                          drift: str = "frequency") -> rec_io.Metadata:
     """``metadata`` with the mark of compensation by ``model`` (:mod:`hrgtc.recording.marks`).
 
@@ -254,7 +254,7 @@ def compensated_metadata(metadata: rec_io.Metadata, model: UnitModel | Instrumen
     temperature"`` (a model of the gyro's temperature sensor, ``--thermometer sensor``) or
     ``"housing"`` (the housing-thermistor baseline).
     """
-    units = model.axes.values() if isinstance(model, InstrumentModel) else [model]
+    units = model.axes.values()
     if drift == "frequency" and all(u.thermometer.source == "sensor" for u in units):
         drift = "sensor temperature"
     extra = {**metadata.extra, COMPENSATED_KEY: mark(model.sha256, model.unit, drift)}

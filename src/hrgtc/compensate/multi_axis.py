@@ -22,7 +22,7 @@ from hrgtc.compensate.file_pass import CompensationSummary, compensate_file
 from hrgtc.compensate.ranges import RangeReport
 from hrgtc.core.errors import InputError, RecordingError
 from hrgtc.core.progress import Progress
-from hrgtc.model import InstrumentModel, UnitModel, axis_suffix
+from hrgtc.model import Model, axis_suffix
 from hrgtc.model_fit import check_thermometer_kind, plausible_frequency_band
 from hrgtc.recording import Recording, axis_names, axis_view
 from hrgtc.recording.axes import AXIS_PATTERN
@@ -32,7 +32,7 @@ __all__ = ["InstrumentCompensator", "compensate_instrument_file",
            "instrument_output_columns", "match_axes", "parse_axes", "recording_axes"]
 
 
-def instrument_output_columns(model: InstrumentModel) -> tuple[str, ...]:
+def instrument_output_columns(model: Model) -> tuple[str, ...]:
     """Columns compensation adds for ``model``: each axis's outputs under its suffix."""
     return tuple(f"{name}{axis_suffix(axis)}" for axis, unit in model.axes.items()
                  for name in output_columns(unit))
@@ -44,8 +44,7 @@ class InstrumentCompensator:
     Parameters
     ----------
     model
-        The instrument's model (:class:`~hrgtc.model.InstrumentModel`; a
-        :class:`~hrgtc.model.UnitModel` is the one-axis case).
+        The model (:class:`~hrgtc.model.Model`; a single-axis unit is the one-axis case).
     drift, engine, gaps
         As :class:`~hrgtc.compensate.compensator.Compensator`, for every axis.
     bands_hz
@@ -58,13 +57,11 @@ class InstrumentCompensator:
         the recording pass through. False: a recording axis the model lacks is an error.
     """
 
-    def __init__(self, model: InstrumentModel | UnitModel, drift: str = "frequency",
+    def __init__(self, model: Model, drift: str = "frequency",
                  engine: str = "fused", gaps: str = "ignore",
                  bands_hz: dict[str, tuple[float, float]] | None = None,
                  partial: bool = False) -> None:
         self.partial = partial
-        if isinstance(model, UnitModel):
-            model = InstrumentModel.single(model)
         self.model = model
         self.axes = {axis: Compensator(unit, drift, engine, gaps)
                      for axis, unit in model.axes.items()}
@@ -198,9 +195,9 @@ def parse_axes(text: str | Sequence[str] | None) -> tuple[str, ...] | None:
     return names or None
 
 
-def match_axes(model: InstrumentModel, recording_axes: Sequence[str] | None,
+def match_axes(model: Model, recording_axes: Sequence[str] | None,
                axes: Sequence[str] | None = None, source: str = "",
-               model_source: str = "") -> InstrumentModel:
+               model_source: str = "") -> Model:
     """The model's axes to apply to a recording with ``recording_axes``: all of each, or
     those ``axes`` names.
 
@@ -233,13 +230,13 @@ def match_axes(model: InstrumentModel, recording_axes: Sequence[str] | None,
             if len(axes) != 1:
                 raise InputError(f"--axes {','.join(axes)}: {of_model} is single-axis; name "
                                  "the one recording axis to compensate with it")
-            return InstrumentModel({axes[0]: model.axes[""]}, model.unit,
+            return Model({axes[0]: model.axes[""]}, model.unit,
                                    dict(model.provenance), model.temperature_map)
         unknown = [a for a in axes if a not in named]
         if unknown:
             raise InputError(f"--axes {','.join(axes)}: {of_model} has no axis "
                              f"{', '.join(unknown)} (its axes: {', '.join(named)})")
-        return InstrumentModel({a: model.axes[a] for a in axes}, model.unit,
+        return Model({a: model.axes[a] for a in axes}, model.unit,
                                dict(model.provenance), model.temperature_map)
     if model.is_single_axis and not found:
         return model
@@ -267,7 +264,7 @@ def match_axes(model: InstrumentModel, recording_axes: Sequence[str] | None,
 def compensate_instrument_file(
     source: str | os.PathLike[str],
     output: str | os.PathLike[str],
-    model: InstrumentModel,
+    model: Model,
     *,
     drift: str = "frequency",
     read_options: rec_io.ReadOptions | None = None,
@@ -294,14 +291,14 @@ def compensate_instrument_file(
     chunk_rows = (settings or CompensateSettings()).chunk_rows
     read_options = options_with_map(read_options, model.temperature_map)
     reading = read_options or rec_io.ReadOptions()
-    for unit in model.axes.values():  # before reading: a model of the other thermometer kind
-        check_thermometer_kind(reading, unit, model_source or None)
+    # before reading: a model of the other thermometer kind
+    check_thermometer_kind(reading, model, model_source or None)
     found = recording_axes(source, reading)
     partial = bool(axes)
     if found is not None:
         model = match_axes(model, found, axes, str(source), model_source)
     if model.is_single_axis:
-        return compensate_file(source, output, model.axes[""], drift=drift,
+        return compensate_file(source, output, model, drift=drift,
                                read_options=read_options, force=force,
                                chunk_rows=chunk_rows, progress=progress)
     compensator = InstrumentCompensator(

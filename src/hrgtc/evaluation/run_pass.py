@@ -49,7 +49,7 @@ from hrgtc.evaluation.noise import NoiseTerms, noise_terms
 from hrgtc.evaluation.plot_blocks import BlockMeans, block_rows
 from hrgtc.evaluation.series_stats import SeriesStatistics
 from hrgtc.evaluation.settling_cut import SettlingCut
-from hrgtc.model import UnitModel
+from hrgtc.model import Model
 from hrgtc.model_fit import check_recording_noise, with_model_band
 from hrgtc.recording import ReadOptions, Recording, count_rows
 from hrgtc.recording.marks import compensation_mark, describe_mark, refuse_compensated
@@ -97,7 +97,7 @@ class RunPlan:
 
 
 def run_pass(
-    model: UnitModel,
+    model: Model,
     chunks: Iterable[Recording],
     plan: RunPlan | str,
     settings: EvaluationSettings | None = None,
@@ -150,7 +150,7 @@ class RunPass:
     (:func:`hrgtc.evaluation.instrument_pass.evaluate_axes`). The parameters are those of
     :func:`run_pass`."""
 
-    def __init__(self, model: UnitModel, plan: RunPlan | str,
+    def __init__(self, model: Model, plan: RunPlan | str,
                  settings: EvaluationSettings | None = None, *,
                  on_output: Callable[[Recording], None] | None = None,
                  progress: Progress | None = None) -> None:
@@ -331,7 +331,7 @@ def _accounting(read: int, settling: int, frequency: Compensator,
 
 def evaluate(
     run: Recording | str | os.PathLike[str],
-    model: UnitModel,
+    model: Model,
     *,
     settings: EvaluationSettings | None = None,
     read_options: ReadOptions | None = None,

@@ -25,7 +25,7 @@ from hrgtc.core.files import refuse_existing
 from hrgtc.core.progress import StageProgress, for_stage
 from hrgtc.evaluation import Evaluation, evaluate
 from hrgtc.export.export_c import export_c
-from hrgtc.model import save_instrument, save_model
+from hrgtc.model import save_model
 from hrgtc.pipeline.calibration import CalibrationResult, calibrate
 from hrgtc.pipeline.instrument import InstrumentCalibration, calibrate_instrument
 from hrgtc.recording import ReadOptions, RecordingWriter
@@ -168,7 +168,7 @@ def run_instrument_demo(folder: Path, s: DemoSettings, *, force: bool = False,
         calibration = calibrate_instrument(soaks, cool, warm, rate_tables=table,
                                            validate_rate_tables=heldout,
                                            progress=calibration_stage)
-    model_file = save_instrument(calibration.model, folder / "imu-3.json", force=force)
+    model_file = save_model(calibration.model, folder / "imu-3.json", force=force)
     compensated = compensate_instrument_file(
         warm[0], folder / "runs" / "warmup_compensated.parquet", calibration.model, force=force,
         progress=for_stage(progress, "imu-3: compensate warm-up"))
