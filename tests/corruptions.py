@@ -256,13 +256,13 @@ def parquet_list_column(name: str, axes: str) -> Callable:
 def compensated(fmt: str, axes: str) -> Callable:
     """The compensation of the run (by the library), as a file a user could train on."""
     def make(material: Material, folder: Path) -> Path:
-        from hrgtc.compensate import compensate_instrument_file
+        from hrgtc.compensate import compensate_file
         from hrgtc.model import load_model
 
         path = folder / f"case{fmt}"
         path.unlink(missing_ok=True)
-        compensate_instrument_file(material.paths[(axes, fmt)], path,
-                                   load_model(material.model_for(axes)), force=True)
+        compensate_file(material.paths[(axes, fmt)], path,
+                        load_model(material.model_for(axes)), force=True)
         return path
     return make
 

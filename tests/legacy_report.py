@@ -5,7 +5,6 @@ Not maintained: it renders what the report showed then."""
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import os
 from collections.abc import Iterable, Mapping, Sequence
@@ -425,16 +424,16 @@ def legacy_html(inputs: ReportInputs) -> str:
               if m.thermometer.source != "sensor"}
     title = inputs.title
     page = _Page()
-    _header(page, dataclasses.replace(first, unit=instrument.unit), title
+    _header(page, instrument.of_axis(next(iter(instrument.axes))), title
             or f"Temperature compensation report — unit {instrument.unit}", inputs.model_path,
             "" if instrument.is_single_axis else next(iter(instrument.axes)))
     evaluations = evaluate_runs(inputs, lambda rows: None)
     traces = trace_soaks(inputs, traced, lambda rows: None)
     sections: dict[str, list[str]] = {}
-    for axis, unit_model in instrument.axes.items():
+    for axis in instrument.axes:
         axis_page = _Page()
         axis_page.count = page.count
-        _unit_sections(axis_page, unit_model, evaluations[axis], traces.get(axis, []),
+        _unit_sections(axis_page, instrument.of_axis(axis), evaluations[axis], traces.get(axis, []),
                        list(inputs.missing_soaks), instrument.temperature_map)
         page.count = axis_page.count
         sections[axis] = axis_page.parts

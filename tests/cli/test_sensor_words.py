@@ -71,7 +71,7 @@ def test_a_sensor_thermometer_shows_no_cubic_fit():
     assert f"{high - low:.4g}" in str(rows["trained temperatures"][0])
 
     pan = load_model(PAN_MODEL)
-    mapped = _section(calibration_summary(pan.axes["x"], temperature_map=pan.temperature_map),
+    mapped = _section(calibration_summary(pan.of_axis("x"), temperature_map=pan.temperature_map),
                       SENSOR_THERMOMETER)
     assert mapped["thermometer"][0] == "sensor count, mapped to °C"
     assert mapped["reference log"][0] == pan.temperature_map["reference"]

@@ -18,6 +18,7 @@ from hrgtc.compensate.at_rest import FlagsMisaligned, RestFlags
 from hrgtc.drift.rest import run_rest
 from hrgtc.model import AxisModel, Model
 from hrgtc.recording import Recording
+from hrgtc.settings.compensation import CompensateSettings
 
 from synthetic import THERMOMETER, ramp_run
 
@@ -56,7 +57,8 @@ def compensated(source, out, model, options, monkeypatch) -> tuple[object, list]
         return original(*args, **kwargs)
 
     monkeypatch.setattr(recording_io, "iter_chunks", spy)
-    return compensate_file(source, out, model, chunk_rows=CHUNK, read_options=options), passes
+    return compensate_file(source, out, model, settings=CompensateSettings(chunk_rows=CHUNK),
+                           read_options=options), passes
 
 
 def test_a_slow_channels_gap_the_detectors_pass_does_not_read(unit_model, tmp_path,

@@ -125,6 +125,7 @@ def test_trained_ranges_are_the_extremes_of_the_used_samples(seed):
     for engine in ("fused", "numpy"):
         compensator = Compensator(model, engine=engine)
         out = compensator.transform(run)
-        assert compensator.out_of_range == 0 and compensator.rate_out_of_range == 0, engine
-        assert compensator.settling == int(np.count_nonzero(~used))
+        assert compensator.axis.out_of_range == 0, engine
+        assert compensator.axis.rate_out_of_range == 0, engine
+        assert compensator.axis.settling == int(np.count_nonzero(~used))
         assert np.array_equal(out["in_range"] == 1.0, used), engine

@@ -91,11 +91,11 @@ def test_the_engines_count_every_variable_alike(gradient_model, hours):
     for c in (a, b):
         c.transform(run.slice(0, 20_000))
         c.transform(run.slice(20_000, len(run)))
-    assert a._plan is not None  # the kernel did run
-    assert a.temperature_out == b.temperature_out
-    for name, (outside, low, high) in b.variable_ranges.items():
-        assert a.variable_ranges[name][0] == outside, name
-        assert a.variable_ranges[name][1:] == pytest.approx([low, high], rel=1e-12), name
+    assert a.axis._plan is not None  # the kernel did run
+    assert a.axis.temperature_out == b.axis.temperature_out
+    for name, (outside, low, high) in b.axis.variable_ranges.items():
+        assert a.axis.variable_ranges[name][0] == outside, name
+        assert a.axis.variable_ranges[name][1:] == pytest.approx([low, high], rel=1e-12), name
 
 
 def test_rates_in_degrees_per_hour_are_the_simulated_ones(unit_model):
@@ -154,8 +154,9 @@ def test_samples_at_the_lower_calibration_edge_are_flagged_in_range(unit_model, 
         out = compensator.transform(run)
         assert (out["in_range"][-100:] == expected).all(), (freq, expected)
         # counted on the settled samples only (the settling ones as such)
-        assert compensator.temperature_out == (0 if expected else rows - compensator.settling)
-        assert 0 < compensator.settling < rows
+        settling = compensator.axis.settling
+        assert compensator.axis.temperature_out == (0 if expected else rows - settling)
+        assert 0 < compensator.axis.settling < rows
 
 
 # -- mutants of ranges.py that no test killed (make mutation, issue 21) ----------------------

@@ -31,7 +31,7 @@ def test_nan_temperature_estimate_warns_once_and_is_counted(engine):
         parts = [compensator.transform(hot.slice(a, a + 9000)) for a in range(0, len(hot), 9000)]
     estimate = np.concatenate([p["resonator_c_est"] for p in parts])
     nan = np.isnan(estimate)
-    assert nan.any() and compensator.temperature_nan == int(nan.sum())
+    assert nan.any() and compensator.axis.temperature_nan == int(nan.sum())
     said = [w for w in caught if issubclass(w.category, ExtrapolationWarning)
             and "is NaN from sample" in str(w.message)]
     assert len(said) == 1

@@ -190,14 +190,14 @@ def test_compensation_applies_known_orientations_and_reports_an_unknown_one():
     compensator = Compensator(model)
     with pytest.warns(HrgtcWarning, match="never seen in training"):
         compensator.transform(turned)
-    assert compensator.unknown_orientation == len(turned)
+    assert compensator.axis.unknown_orientation == len(turned)
     # a mask of the samples at rest (the motion detector's) leaves the others out of the
     # count: a unit mid-rotation is in no orientation; the rest are still reported
     at_rest = np.arange(len(turned)) % 3 != 0
     compensator = Compensator(model)
     with pytest.warns(HrgtcWarning, match="never seen in training"):
         masked = compensator.transform(turned, at_rest)
-    assert compensator.unknown_orientation == np.count_nonzero(at_rest)
+    assert compensator.axis.unknown_orientation == np.count_nonzero(at_rest)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", HrgtcWarning)
         unmasked = Compensator(model).transform(turned)
@@ -207,7 +207,7 @@ def test_compensation_applies_known_orientations_and_reports_an_unknown_one():
     with warnings.catch_warnings():
         warnings.simplefilter("error", HrgtcWarning)
         compensator.transform(turned, np.zeros(len(turned), dtype=bool))
-    assert compensator.unknown_orientation == 0
+    assert compensator.axis.unknown_orientation == 0
 
 
 def test_windows_never_span_left_out_samples_across_chunks():
@@ -265,4 +265,4 @@ def test_user_orientation_labels_give_an_offset_each_like_an_hrg_turned_on_its_t
     compensator = Compensator(unit)
     with pytest.warns(UserWarning, match="never seen in training"):
         compensator.transform(relabelled)
-    assert compensator.unknown_orientation == len(run)
+    assert compensator.axis.unknown_orientation == len(run)

@@ -253,8 +253,8 @@ def test_float_build_streams_like_the_double_compensator(kind, models, tmp_path)
 
     # against the double compensator: counters, flags, and the values within the bounds
     assert counters[0] == compensator.samples
-    assert abs(counters[1] - compensator.out_of_range) <= 2  # a sample at a rounded edge
-    assert abs(counters[2] - compensator.rate_out_of_range) <= 2
+    assert abs(counters[1] - compensator.axis.out_of_range) <= 2  # a sample at a rounded edge
+    assert abs(counters[2] - compensator.axis.rate_out_of_range) <= 2
     flags = out[:, 3] * out[:, 7]
     assert 0.05 < flags.mean() < 0.95
     assert np.count_nonzero(flags != expected["in_range"]) <= 4

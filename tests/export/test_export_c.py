@@ -197,18 +197,18 @@ def test_c_matches_the_python_compensator(kind, request, tmp_path):
     out, counters = run_driver(exe, inputs, tmp_path, "run", recording.time_s)
 
     assert out.shape[0] == len(recording)
-    assert counters == [compensator.samples, compensator.out_of_range,
-                        compensator.rate_out_of_range]
+    assert counters == [compensator.samples, compensator.axis.out_of_range,
+                        compensator.axis.rate_out_of_range]
     in_range = expected["in_range"]
     assert 0.05 < in_range.mean() < 0.95  # both branches of the flag are exercised
-    assert 0 < compensator.rate_out_of_range < len(recording)
+    assert 0 < compensator.axis.rate_out_of_range < len(recording)
     np.testing.assert_array_equal(out[:, 3] * out[:, 7], in_range)  # the file's flag: both
     assert set(np.unique(out[:, 7])) <= {0.0, 1.0}
     # counted once settled (issue 20: a settling sample is counted as such only)
     settled = recording.time_s - recording.time_s[0] >= settle_threshold_s(
         model.drift.settings.warmup_s)
-    assert compensator.settling == int(np.count_nonzero(~settled)) > 0
-    assert int(np.count_nonzero((out[:, 7] == 0.0) & settled)) == compensator.rate_out_of_range
+    assert compensator.axis.settling == int(np.count_nonzero(~settled)) > 0
+    assert int(np.count_nonzero((out[:, 7] == 0.0) & settled)) == compensator.axis.rate_out_of_range
     np.testing.assert_allclose(out[:, 0], expected["rate_comp_dph"], rtol=0, atol=1e-9)
     np.testing.assert_array_equal(out[:, 6], out[:, 0])  # return value == out->rate_comp_dph
     np.testing.assert_allclose(out[:, 1], expected["bias_model_dph"], rtol=0, atol=1e-9)
@@ -236,8 +236,8 @@ def test_edge_models_compile_cleanly_and_agree(selected, housing_model, tmp_path
     expected = compensator.transform(recording)
     out, counters = run_driver(build(model, tmp_path, "edge"), columns, tmp_path, "run",
                                recording.time_s)
-    assert counters == [compensator.samples, compensator.out_of_range,
-                        compensator.rate_out_of_range]
+    assert counters == [compensator.samples, compensator.axis.out_of_range,
+                        compensator.axis.rate_out_of_range]
     np.testing.assert_array_equal(out[:, 3] * out[:, 7], expected["in_range"])
     np.testing.assert_allclose(out[:, 0], expected["rate_comp_dph"], rtol=0, atol=1e-9)
 
@@ -366,9 +366,9 @@ def test_c_computes_d2_g_and_the_extra_channel_as_python_does(tmp_path):
     compensator = Compensator(model)
     expected = compensator.transform(recording)
     out, counters = run_driver(exe, inputs, tmp_path, "run", recording.time_s)
-    assert counters == [compensator.samples, compensator.out_of_range,
-                        compensator.rate_out_of_range]
-    assert 0 < compensator.out_of_range < len(recording)
+    assert counters == [compensator.samples, compensator.axis.out_of_range,
+                        compensator.axis.rate_out_of_range]
+    assert 0 < compensator.axis.out_of_range < len(recording)
     np.testing.assert_array_equal(out[:, 3] * out[:, 7], expected["in_range"])
     np.testing.assert_allclose(out[:, 1], expected["bias_model_dph"], rtol=0, atol=1e-9)
     np.testing.assert_allclose(out[:, 0], expected["rate_comp_dph"], rtol=0, atol=1e-9)

@@ -12,7 +12,7 @@ import json
 import numpy as np
 import pytest
 
-from hrgtc.compensate import Compensator, InstrumentCompensator, compensate_instrument_file
+from hrgtc.compensate import Compensator, compensate_file
 from hrgtc.core.errors import InputError, ModelFileError, RecordingError
 from hrgtc.drift import find_rate_segments
 from hrgtc.model import Model, load_model, save_model
@@ -81,10 +81,9 @@ def test_scale_factor_model_against_the_simulators_truth(calibration, imu_campai
 
 def test_instrument_compensator_equals_each_axis_alone(calibration, imu_campaign):
     run = read(imu_campaign.warmup)
-    together = InstrumentCompensator(calibration.model).transform(run)
+    together = Compensator(calibration.model).transform(run)
     for axis in AXES:
-        unit = calibration.model.axes[axis]
-        alone = Compensator(unit).transform(axis_view(run, axis))
+        alone = Compensator(calibration.model.of_axis(axis)).transform(axis_view(run, axis))
         for name in ("rate_comp_dph", "bias_model_dph", "resonator_c_est", "in_range",
                      "scale_model_ppm"):
             np.testing.assert_array_equal(together[f"{name}_{axis}"], alone[name])
@@ -97,10 +96,10 @@ def test_instrument_compensator_equals_each_axis_alone(calibration, imu_campaign
 
 def test_file_to_file_in_chunks_equals_batch(calibration, imu_campaign, tmp_path):
     output = tmp_path / "warm_comp.parquet"
-    summary = compensate_instrument_file(imu_campaign.warmup, output, calibration.model,
+    summary = compensate_file(imu_campaign.warmup, output, calibration.model,
                                          settings=CompensateSettings(chunk_rows=7_001))
     written = read(output)
-    batch = InstrumentCompensator(calibration.model).transform(read(imu_campaign.warmup))
+    batch = Compensator(calibration.model).transform(read(imu_campaign.warmup))
     assert summary.rows == len(batch)
     for name in batch.names:
         np.testing.assert_array_equal(written[name], batch[name])
@@ -109,7 +108,7 @@ def test_file_to_file_in_chunks_equals_batch(calibration, imu_campaign, tmp_path
 def test_a_single_axis_file_is_refused_by_a_three_axis_model(calibration, campaign_factory):
     single = campaign_factory("paper-unit", sample_rate_hz=2.0)
     with pytest.raises(RecordingError, match="no columns of axis x, y, z"):
-        InstrumentCompensator(calibration.model).transform(read(single.warmup))
+        Compensator(calibration.model).transform(read(single.warmup))
 
 
 def test_model_file_round_trip_and_checks(calibration, tmp_path):

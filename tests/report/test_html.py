@@ -184,7 +184,7 @@ def test_bias_stability_table_against_numpy(unit, report):
     files, model, _ = unit
     _, _, page, _ = report
     run = recording.read(files.cooldown)
-    compensated = compensate(run, model)
+    compensated = compensate(model, run)
     m = round(10 * run.sample_rate_hz)
     settle = round(model.drift.settings.warmup_s * run.sample_rate_hz)  # the filter settling
     n = (len(run) - settle) // m

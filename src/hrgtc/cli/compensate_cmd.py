@@ -91,7 +91,7 @@ def compensate_command(
 
     Example: hrgtc compensate warmup.parquet --model unit.json -o warmup_comp.parquet
     """
-    from hrgtc.compensate import compensate_instrument_file
+    from hrgtc.compensate import compensate_file
     from hrgtc.compensate.multi_axis import parse_axes
     from hrgtc.core.files import refuse_input
     from hrgtc.model import load_model
@@ -101,11 +101,9 @@ def compensate_command(
     with library_errors(), progress_bar("compensating", enabled=not json_output) as progress:
         refuse_input(output, [run, model_path])
         model = load_model(model_path)
-        summary = compensate_instrument_file(run, output, model, force=force,
-                                             settings=CompensateSettings(chunk_rows),
-                                             progress=progress,
-                                             read_options=inputs, axes=parse_axes(axes),
-                                             model_source=str(model_path))
+        summary = compensate_file(run, output, model_path, force=force,
+                                  settings=CompensateSettings(chunk_rows), progress=progress,
+                                  read_options=inputs, axes=parse_axes(axes))
     if json_output:
         print_json(summary.to_dict())
     else:

@@ -76,7 +76,7 @@ def evaluate_axes(
     check_thermometer_kind(options, model)
     single = model.is_single_axis
     if single:  # the reader checks the plausible band of the one frequency
-        options = with_model_band(dataclasses.replace(options, axis=None), model.axes[""])
+        options = with_model_band(dataclasses.replace(options, axis=None), model)
     else:  # each axis's band on its view, below
         options = dataclasses.replace(options, axis=None, freq_band_hz=None,
                                       freq_span_hz=None)

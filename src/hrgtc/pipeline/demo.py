@@ -18,7 +18,7 @@ import warnings
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from hrgtc.compensate import OUTPUT_COLUMNS, CompensationSummary, compensate_instrument_file
+from hrgtc.compensate import OUTPUT_COLUMNS, CompensationSummary, compensate_file
 from hrgtc.compensate.file_pass import compensated_metadata
 from hrgtc.core.errors import HrgtcWarning
 from hrgtc.core.files import refuse_existing
@@ -169,7 +169,7 @@ def run_instrument_demo(folder: Path, s: DemoSettings, *, force: bool = False,
                                            validate_rate_tables=heldout,
                                            progress=calibration_stage)
     model_file = save_model(calibration.model, folder / "imu-3.json", force=force)
-    compensated = compensate_instrument_file(
+    compensated = compensate_file(
         warm[0], folder / "runs" / "warmup_compensated.parquet", calibration.model, force=force,
         progress=for_stage(progress, "imu-3: compensate warm-up"))
     report_file = build_report(calibration.model, [*cool, *warm], folder / "report.html",

@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from hrgtc.compensate import InstrumentCompensator
+from hrgtc.compensate import Compensator
 from hrgtc.compensate.ranges import RangeReport
 from hrgtc.core import records
 from hrgtc.core.errors import InputError
@@ -223,7 +223,9 @@ def calibrate_instrument(
     """
     settings = settings or CalibrationSettings()
     scale_terms, cross_axis = settings.scale_terms, settings.cross_axis
-    fit = {"settings": settings, "aux": aux, "housing_terms": housing_terms, "prior": prior}
+    # what the cross-axis trial passes to calibrate again (with the axis's read options)
+    fit = {"soaks": soaks, "drifts": drifts, "settings": settings, "aux": aux,
+           "housing_terms": housing_terms, "prior": prior, "thermometer": thermometer}
     if thermometer not in ("resonator", "sensor"):
         raise InputError(f"thermometer must be 'resonator' or 'sensor', got {thermometer!r}")
     options = dataclasses.replace(read_options or ReadOptions(), thermometer=thermometer)
@@ -259,8 +261,8 @@ def calibrate_instrument(
                            housing_terms=housing_terms, prior=prior, read_options=axis_read,
                            progress=staged, thermometer=thermometer, marks_checked=True)
         if cross_axis and len(axes) > 1:
-            result, crossed[axis] = _cross_axis(result, axis, axes, soaks, drifts, validate,
-                                                axis_read, staged, thermometer, fit)
+            result, crossed[axis] = _cross_axis(result, axis, axes, validate, axis_read,
+                                                staged, fit)
         model = result.model.axis
         if rate_tables:
             model = dataclasses.replace(model, scale_factor=fit_axis_scale_factor(
@@ -327,10 +329,8 @@ def _same_cache(options: ReadOptions, cached: ReadOptions) -> ReadOptions:
 
 
 def _cross_axis(result: CalibrationResult, axis: str, axes: Sequence[str],
-                soaks: Sequence[PathLike], drifts: Sequence[PathLike],
                 validate: Sequence[PathLike], options: ReadOptions, progress: Any,
-                thermometer: str, fit: Mapping[str, Any]
-                ) -> tuple[CalibrationResult, dict[str, Any]]:
+                fit: Mapping[str, Any]) -> tuple[CalibrationResult, dict[str, Any]]:
     """Refit ``axis`` with the other resonators' frequencies as candidates (``a_f<other>``:
     each a thermometer of its own part of the unit, so their differences are the gradients
     across it) and keep that model only if it lowers the median held-out 10 s bias
@@ -341,9 +341,9 @@ def _cross_axis(result: CalibrationResult, axis: str, axes: Sequence[str],
         return result, {"kept": False, "why": "no held-out run (--validate) to judge by",
                         "channels": others}
     aux = {**dict(fit["aux"] or {}), **others}
-    trial = calibrate(soaks, drifts, (), settings=fit["settings"], aux=aux,
+    trial = calibrate(fit["soaks"], fit["drifts"], (), settings=fit["settings"], aux=aux,
                       housing_terms=fit["housing_terms"], prior=fit["prior"],
-                      read_options=options, progress=progress, thermometer=thermometer,
+                      read_options=options, progress=progress, thermometer=fit["thermometer"],
                       soak_fit=result.soak_fit,  # the same thermometer: the drift fit only
                       marks_checked=True)
 
@@ -404,7 +404,7 @@ def check_scale_factor(path: PathLike, model: Model, options: ReadOptions,
                        table: Any = None) -> tuple[ScaleFactorCheck, ...]:
     """Scale-factor error of a held-out rate-table run, each axis, before and after."""
     checks = []
-    compensated = InstrumentCompensator(model).transform(options.read(path))
+    compensated = Compensator(model).transform(options.read(path))
     for axis, unit_model in model.axes.items():
         sf = unit_model.scale_factor
         if sf is None:
