@@ -151,7 +151,7 @@ def test_compensate_flags_the_first_warmup_seconds_not_samples_on_a_burst_file(t
     text = runner.invoke(app, ["compensate", str(PAN), "--model", str(model), *ARGS, "--gaps",
                                "bridge", "-o", str(tmp_path / "t.parquet")]).stdout
     assert "samples: 6250 read, 6250 used, flagged 250 warm-up" in " ".join(text.split())
-    unit = load_model(model).axes["x"]
+    unit = load_model(model).of_axis("x")
     for engine in ("fused", "numpy"):  # the kernel and the numpy reference agree
         compensator = Compensator(unit, engine=engine, gaps="bridge")
         flags = compensator.transform(run)["in_range"]

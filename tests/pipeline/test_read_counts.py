@@ -94,8 +94,8 @@ def test_evaluate_instrument_equals_the_per_axis_evaluation(campaign):
     together = evaluate_instrument(campaign["warm"], model, read_options=options,
                                    max_points=2000)
     assert list(together.axes) == list(model.axes)
-    for axis, unit in model.axes.items():
-        alone = evaluate(campaign["warm"], unit, max_points=2000,
+    for axis in model.axes:
+        alone = evaluate(campaign["warm"], model.of_axis(axis), max_points=2000,
                          read_options=dataclasses.replace(options, axis=axis or None))
         one = together.axes[axis]
         assert one.n_samples == alone.n_samples and one.n_not_at_rest == alone.n_not_at_rest
