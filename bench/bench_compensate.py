@@ -66,10 +66,10 @@ def _warm(model_path: str) -> None:
 
     model = load_model(model_path)
     f = np.full(16, model.thermometer.frequency(20.0))
-    compensate(Recording({"time_s": np.arange(16.0) / model.drift.settings.sample_rate_hz,
-                          "freq_hz": f, "rate_dph": np.zeros(16),
-                          "housing_c": np.full(16, 20.0)},
-                         Metadata(sample_rate_hz=model.drift.settings.sample_rate_hz)), model)
+    compensate(model, Recording({"time_s": np.arange(16.0) / model.drift.settings.sample_rate_hz,
+                                 "freq_hz": f, "rate_dph": np.zeros(16),
+                                 "housing_c": np.full(16, 20.0)},
+                                Metadata(sample_rate_hz=model.drift.settings.sample_rate_hz)))
 
 
 def _hrgtc_file(model_path: str, source: str, output: str,
@@ -130,7 +130,7 @@ def _first_call(model_path: str, cache_dir: str) -> float:
                            "rate_dph": np.zeros(16), "housing_c": np.full(16, 20.0)},
                           Metadata(sample_rate_hz=rate))
     start = time.perf_counter()
-    compensate(recording, model)
+    compensate(model, recording)
     return time.perf_counter() - start
 
 
@@ -208,15 +208,15 @@ def run(quick: bool = False) -> list[dict]:
                      for name, h in (("short", max(hours / 4, 1.0)), ("run", hours))]
         recording = read(run_files[1].path)
         n = len(recording)
-        compensate(recording.slice(0, 1000), model)  # load the kernel
+        compensate(model, recording.slice(0, 1000))  # load the kernel
         fused_times, numpy_times, pass_times, fused_cpu, numpy_cpu = [], [], [], [], []
         for _ in range(MEMORY_REPEATS):  # alternated: a busy neighbour slows both alike
             start, cpu = time.perf_counter(), time.process_time()
-            batch = compensate(recording, model)
+            batch = compensate(model, recording)
             fused_times.append(time.perf_counter() - start)
             fused_cpu.append(time.process_time() - cpu)
             start, cpu = time.perf_counter(), time.process_time()
-            reference = compensate(recording, model, engine="numpy")
+            reference = compensate(model, recording, engine="numpy")
             numpy_times.append(time.perf_counter() - start)
             numpy_cpu.append(time.process_time() - cpu)
             start = time.perf_counter()

@@ -36,7 +36,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from hrgtc.model import InstrumentModel, save_instrument, save_model
+from hrgtc.model import Model, save_model
 from hrgtc.recording import Recording, write
 
 from fuzzing import make_model
@@ -105,8 +105,8 @@ class Material:
         folder.mkdir(parents=True, exist_ok=True)
         self.model = make_model()
         self.model_path = save_model(self.model, folder / "model.json", force=True)
-        instrument = InstrumentModel({a: self.model for a in "xyz"}, unit="FZ-3")
-        self.model3_path = save_instrument(instrument, folder / "model3.json", force=True)
+        instrument = Model({a: self.model.axis for a in "xyz"}, unit="FZ-3")
+        self.model3_path = save_model(instrument, folder / "model3.json", force=True)
         self.runs = {axes: base_run(axes) for axes in ("1", "3")}
         self.paths = {(axes, fmt): write(run, folder / f"run{axes}{fmt}", force=True)
                       for axes, run in self.runs.items() for fmt in FORMATS}
@@ -256,13 +256,13 @@ def parquet_list_column(name: str, axes: str) -> Callable:
 def compensated(fmt: str, axes: str) -> Callable:
     """The compensation of the run (by the library), as a file a user could train on."""
     def make(material: Material, folder: Path) -> Path:
-        from hrgtc.compensate import compensate_instrument_file
-        from hrgtc.model import load_instrument
+        from hrgtc.compensate import compensate_file
+        from hrgtc.model import load_model
 
         path = folder / f"case{fmt}"
         path.unlink(missing_ok=True)
-        compensate_instrument_file(material.paths[(axes, fmt)], path,
-                                   load_instrument(material.model_for(axes)), force=True)
+        compensate_file(material.paths[(axes, fmt)], path,
+                        load_model(material.model_for(axes)), force=True)
         return path
     return make
 

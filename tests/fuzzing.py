@@ -36,7 +36,7 @@ from typer.testing import CliRunner
 from hrgtc import drift
 from hrgtc.cli import app
 from hrgtc.compensate import Compensator
-from hrgtc.model import UnitModel, save_model
+from hrgtc.model import AxisModel, Model, save_model
 from hrgtc.recording import Metadata, Recording, write
 
 from synthetic import THERMOMETER, ramp_run
@@ -46,14 +46,15 @@ REQUIRED = COLUMNS[:3]
 runner = CliRunner()
 
 
-def make_model() -> UnitModel:
+def make_model() -> Model:
     """A model of the synthetic unit at 10 Hz (cool-down 20 -> -20 °C), with the statistics
     of its training data as ``calibrate`` writes them (the noise-ratio unit checks use them)."""
     from hrgtc.drift.training import TrainingStatistics
 
     run = ramp_run(seed=11, hours=3.0)
-    return UnitModel(thermometer=THERMOMETER, drift=drift.fit([run], THERMOMETER), unit="FZ-1",
-                     training=TrainingStatistics.from_runs([run]))
+    return Model.single(
+        AxisModel(thermometer=THERMOMETER, drift=drift.fit([run], THERMOMETER),
+            training=TrainingStatistics.from_runs([run])), unit="FZ-1")
 
 
 def make_run(rows: int = 1200) -> Recording:

@@ -5,7 +5,6 @@ Not maintained: it renders what the report showed then."""
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import os
 from collections.abc import Iterable, Mapping, Sequence
@@ -31,7 +30,7 @@ from hrgtc.evaluation.calibration_figures import (
     thermometer_tables,
 )
 from hrgtc.evaluation.glance_figures import GLANCE, glance_summary, instrument_glance_summary
-from hrgtc.model import InstrumentModel, UnitModel
+from hrgtc.model import Model
 from hrgtc.report.figures import SoakTrace
 from hrgtc.report.inputs import ReportInputs, evaluate_runs, trace_soaks
 from hrgtc.report.tables import INPUTS, SOAK_ERROR, provenance_summary, soak_error_summary
@@ -145,7 +144,7 @@ _SECTIONS = (("settling", "Settling of the soaks (Fig. 3)", None),
               "Drift model: stepwise regression"))
 
 
-def _header(page: _Page, model: UnitModel, title: str, model_path: str | None,
+def _header(page: _Page, model: Model, title: str, model_path: str | None,
             axis: str = "") -> None:
     """Title, provenance and the contents: the sections the axes have (a sensor model has
     no Figs. 3-5), linked to the first axis's (``axis``: its id prefix) when there are
@@ -230,7 +229,7 @@ def _settling(page: _Page, plateaus: Sequence[Plateau], traces: Sequence[SoakTra
              "</section>")
 
 
-def _table_rows(model: UnitModel, plateaus: Sequence[Plateau]) -> list[dict[str, float]]:
+def _table_rows(model: Model, plateaus: Sequence[Plateau]) -> list[dict[str, float]]:
     t = np.array([p.chamber_c for p in plateaus])
     f = np.array([p.settled_freq_hz for p in plateaus])
     estimate = model.thermometer.temperature(f, warn=False) if f.size else f
@@ -238,7 +237,7 @@ def _table_rows(model: UnitModel, plateaus: Sequence[Plateau]) -> list[dict[str,
             for a, b, c in zip(t, f, estimate, strict=True)]
 
 
-def _thermometer(page: _Page, model: UnitModel, plateaus: Sequence[Plateau],
+def _thermometer(page: _Page, model: Model, plateaus: Sequence[Plateau],
                  table: Sequence[Mapping[str, float]], tables: Summary) -> None:
     """Fig. 4, Table 1, the thermometer's figures and Eq. 18 beside the paper's
     (``tables``: :func:`thermometer_tables` of the unit)."""
@@ -303,7 +302,7 @@ def _recorded(run: Evaluation) -> str:
     return text
 
 
-def _run(page: _Page, k: int, run: Evaluation, model: UnitModel) -> None:
+def _run(page: _Page, k: int, run: Evaluation, model: Model) -> None:
     page.add(f'<section id="run-{k}"><h3>4.{k} Run <code>{escape(run.name)}</code></h3>',
              f'<p class="muted">{escape(run.source)}: unit {escape(run.unit)}, {run.n_samples} '
              f"samples at {run.sample_rate_hz:g} Hz ({_recorded(run)}), input "
@@ -361,7 +360,7 @@ def _excluded(d: Any) -> str:
         for n, p in pairs) + "."
 
 
-def _drift_model(page: _Page, model: UnitModel) -> None:
+def _drift_model(page: _Page, model: Model) -> None:
     """The drift model: its candidates, steps and coefficients; on a resonator beside the
     paper's Eq. 21-22, on a temperature sensor in its own words."""
     d = model.drift
@@ -394,7 +393,7 @@ def _drift_model(page: _Page, model: UnitModel) -> None:
     page.add("</section>")
 
 
-def _scale_factor(page: _Page, model: UnitModel) -> None:
+def _scale_factor(page: _Page, model: Model) -> None:
     """The scale-factor model: per-temperature k from the rate-table holds and k(f)."""
     sf = model.scale_factor
     if sf is None:
@@ -425,16 +424,16 @@ def legacy_html(inputs: ReportInputs) -> str:
               if m.thermometer.source != "sensor"}
     title = inputs.title
     page = _Page()
-    _header(page, dataclasses.replace(first, unit=instrument.unit), title
+    _header(page, instrument.of_axis(next(iter(instrument.axes))), title
             or f"Temperature compensation report — unit {instrument.unit}", inputs.model_path,
             "" if instrument.is_single_axis else next(iter(instrument.axes)))
     evaluations = evaluate_runs(inputs, lambda rows: None)
     traces = trace_soaks(inputs, traced, lambda rows: None)
     sections: dict[str, list[str]] = {}
-    for axis, unit_model in instrument.axes.items():
+    for axis in instrument.axes:
         axis_page = _Page()
         axis_page.count = page.count
-        _unit_sections(axis_page, unit_model, evaluations[axis], traces.get(axis, []),
+        _unit_sections(axis_page, instrument.of_axis(axis), evaluations[axis], traces.get(axis, []),
                        list(inputs.missing_soaks), instrument.temperature_map)
         page.count = axis_page.count
         sections[axis] = axis_page.parts
@@ -458,7 +457,7 @@ def legacy_html(inputs: ReportInputs) -> str:
             "hrgtc.</p></footer></body></html>\n")
 
 
-def _unit_sections(page: _Page, model: UnitModel, evaluations: Sequence[Evaluation],
+def _unit_sections(page: _Page, model: Model, evaluations: Sequence[Evaluation],
                    traces: Sequence[SoakTrace], missing: list[str],
                    temperature_map: dict[str, Any] | None = None) -> None:
     """One axis's sections: Figs. 3-5 and Tables 1-2 (a sensor thermometer: what it is and
@@ -490,7 +489,7 @@ def _unit_sections(page: _Page, model: UnitModel, evaluations: Sequence[Evaluati
     _scale_factor(page, model)
 
 
-def _instrument_summary(page: _Page, model: InstrumentModel,
+def _instrument_summary(page: _Page, model: Model,
                         evaluations: dict[str, list[Evaluation]]) -> None:
     """The instrument at a glance: each axis's 10 s bias stability per run, scale factor."""
     page.add(f'<section id="instrument"><h2>Instrument {escape(model.unit)}: '

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from hrgtc import drift
-from hrgtc.model import InstrumentModel, UnitModel, save_instrument, save_model
+from hrgtc.model import AxisModel, Model, save_model
 from hrgtc.model_schema import derived_coefficients
 from hrgtc.recording import Recording
 
@@ -139,17 +139,17 @@ def trained_in(factor: float) -> Callable:
 
         trained = Recording(columns, meta)
         # what calibrate writes: the model carries the statistics of its training data
-        model = UnitModel(thermometer=THERMOMETER, unit="FZ-1",
-                          drift=drift.fit([trained], THERMOMETER),
-                          training=TrainingStatistics.from_runs([trained]))
+        model = Model.single(
+            AxisModel(thermometer=THERMOMETER, drift=drift.fit([trained], THERMOMETER),
+                training=TrainingStatistics.from_runs([trained])), unit="FZ-1")
         return save_model(model, folder / "case.json", force=True)
     return make
 
 
 def instrument(axes: str) -> Callable:
     def make(material: Material, folder: Path) -> Path:
-        model = InstrumentModel({a: material.model for a in axes}, unit="FZ-3")
-        return save_instrument(model, folder / "case.json", force=True)
+        model = Model({a: material.model.axis for a in axes}, unit="FZ-3")
+        return save_model(model, folder / "case.json", force=True)
     return make
 
 

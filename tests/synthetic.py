@@ -8,7 +8,7 @@ import numpy as np
 from scipy import signal
 
 from hrgtc.drift.scale_factor import ScaleFactorModel, ScaleGroup
-from hrgtc.model import UnitModel
+from hrgtc.model import AxisModel, Model
 from hrgtc.recording import Metadata, Recording
 from hrgtc.thermometry import fit
 
@@ -74,9 +74,12 @@ def scale_factor(reference_hz: float) -> ScaleFactorModel:
                      for f in THERMOMETER.frequency(np.array([-10.0, 10.0, 30.0]))))
 
 
-def with_scale_factor(model: UnitModel, sf: ScaleFactorModel) -> UnitModel:
-    """The model with a scale factor."""
-    return dataclasses.replace(model, scale_factor=sf)
+def with_scale_factor(model: Model | AxisModel, sf: ScaleFactorModel) -> Model | AxisModel:
+    """The model (every axis) or the axis with a scale factor."""
+    if isinstance(model, AxisModel):
+        return dataclasses.replace(model, scale_factor=sf)
+    return dataclasses.replace(model, axes={a: dataclasses.replace(p, scale_factor=sf)
+                                            for a, p in model.axes.items()})
 
 
 def with_heating_extra(run, per_hz_per_s=2000.0, tau_s=2600.0):
@@ -108,9 +111,9 @@ def lagged_run(seed, start_c=20.0, end_c=-20.0, hours=3.0, drive_amplitude_v=0.0
 def lagged_model():
     """A unit model whose drift terms use d2, g and a_drive (all of :data:`LAGGED_TERMS`)."""
     from hrgtc import drift
-    from hrgtc.model import UnitModel
+    from hrgtc.model import Model
 
     fitted = drift.fit([lagged_run(seed=5), lagged_run(seed=6, start_c=-20.0, end_c=20.0)],
                        THERMOMETER, terms=LAGGED_TERMS, initial=LAGGED_TERMS, premove=0.999999,
                        options={"rate_tau2_s": 120.0}, aux_columns={"drive": "drive_v"})
-    return UnitModel(thermometer=THERMOMETER, drift=fitted, unit="synthetic-lagged")
+    return Model.single(AxisModel(thermometer=THERMOMETER, drift=fitted), unit="synthetic-lagged")

@@ -27,7 +27,7 @@ from hrgtc import drift
 from hrgtc.cli import app
 from hrgtc.evaluation import evaluate
 from hrgtc.evaluation.metrics import bias_stability_interval
-from hrgtc.model import UnitModel
+from hrgtc.model import AxisModel, Model
 from hrgtc.recording import Metadata, Recording
 from hrgtc.settings.compensation import BIAS_ONLY
 from hrgtc.thermometry import identity
@@ -80,7 +80,8 @@ def _held_out(seed: int, curve: float, walk: float = 0.03) -> dict[str, float]:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # beyond the trained temperatures, by design
         model = drift.fit([train], THERMOMETER)
-        figures = evaluate(held, UnitModel(thermometer=THERMOMETER, unit="mems", drift=model),
+        figures = evaluate(held, Model.single(
+            AxisModel(thermometer=THERMOMETER, drift=model), unit="mems"),
                            settings=BIAS_ONLY)
     from_s = held.time_s[0] + model.settings.warmup_s
     raw = _burst_means(held.time_s, held.rate_dph, from_s)

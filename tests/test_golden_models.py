@@ -13,7 +13,7 @@ import json
 import pytest
 
 from golden_models import EXPORTS, expected_dir, export, golden_files, refusal, resaved
-from hrgtc.model import load_instrument, load_model
+from hrgtc.model import load_model
 from hrgtc.model_schema import SCHEMA_VERSION
 
 FILES = golden_files()
@@ -30,7 +30,7 @@ def test_every_released_schema_version_has_golden_files():
 @pytest.mark.parametrize("path", FILES, ids=IDS)
 def test_golden_file_loads(path):
     document = json.loads(path.read_text())
-    model = load_instrument(path)
+    model = load_model(path)
     names = sorted(document.get("axes", {"": None}))
     assert sorted(model.names) == names
     assert model.unit == document["unit"]

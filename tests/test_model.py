@@ -9,18 +9,16 @@ import pytest
 
 from hrgtc import drift
 from hrgtc.core.errors import ModelFileError, OutputExistsError
-from hrgtc.model import SCHEMA_VERSION, UnitModel, load_model, provenance, save_model
+from hrgtc.model import SCHEMA_VERSION, AxisModel, Model, load_model, provenance, save_model
 
 from synthetic import THERMOMETER, ramp_run
 
 
 @pytest.fixture(scope="module")
 def unit_model():
-    return UnitModel(
-        thermometer=THERMOMETER,
-        drift=drift.fit([ramp_run(seed=11, hours=3.0)], THERMOMETER),
-        unit="SN-001",
-    )
+    return Model.single(
+        AxisModel(thermometer=THERMOMETER, drift=drift.fit([ramp_run(seed=11, hours=3.0)],
+            THERMOMETER)), unit="SN-001")
 
 
 def test_round_trip_is_exact(tmp_path, unit_model):

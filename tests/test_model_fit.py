@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from hrgtc.core.errors import InputError
-from hrgtc.model import InstrumentModel
+from hrgtc.model import Model
 from hrgtc.model_fit import check_recording_noise
 from hrgtc.recording import Metadata, Recording
 
@@ -35,7 +35,7 @@ def _three_axis(run: Recording, factors: dict[str, float]) -> Recording:
 def test_a_recording_in_the_training_unit_passes(model):
     run = make_run()
     check_recording_noise(model, run, "run.csv")
-    check_recording_noise(InstrumentModel({a: model for a in "xy"}, unit="FZ-3"),
+    check_recording_noise(Model({a: model.axis for a in "xy"}, unit="FZ-3"),
                           _three_axis(run, {}), "run.csv")
 
 
@@ -51,7 +51,7 @@ def test_a_unit_factor_on_a_single_axis_recording_names_the_file_and_column(mode
 
 @pytest.mark.parametrize("axis", ["x", "y"])
 def test_a_unit_factor_on_one_axis_of_an_instrument_names_that_axis(model, axis):
-    instrument = InstrumentModel({a: model for a in "xy"}, unit="FZ-3")
+    instrument = Model({a: model.axis for a in "xy"}, unit="FZ-3")
     run = _three_axis(make_run(), {axis: 3600.0, "z": 3600.0})  # z: not in the model
     with pytest.raises(InputError, match=rf"^run\.csv: column 'rate_dph_{axis}': its noise"):
         check_recording_noise(instrument, run, "run.csv")
@@ -92,14 +92,13 @@ def test_the_swapped_headers_message_names_both_columns_their_noise_and_the_fix(
 
 
 def test_a_quiet_rate_alone_or_a_model_without_statistics_is_not_refused(model):
-    import dataclasses
 
     run = make_run()
     rng = np.random.default_rng(3)
     quiet_rate = 10.0 + rng.normal(0.0, 0.1, len(run))  # 1/20 the noise: no unit factor
     housing_c = 20.0 + np.cumsum(rng.normal(0.0, 1e-4, len(run)))
     check_recording_noise(model, _swapped(run, quiet_rate, housing_c), "run.csv")
-    bare = dataclasses.replace(model, training=None)  # a model written before the statistics
+    bare = model.with_parts(training=None)  # a model written before the statistics
     check_recording_noise(bare, _swapped(run, housing_c, run.rate_dph), "run.csv")
 
 
@@ -109,7 +108,7 @@ def test_swapped_headers_on_an_axis_of_an_instrument_are_named(model):
     three = _three_axis(run, {})
     columns = {n: three[n] for n in three.names}
     columns["rate_dph_y"], columns["housing_c"] = housing_c, run.rate_dph
-    instrument = InstrumentModel({a: model for a in "xyz"}, unit="FZ-3")
+    instrument = Model({a: model.axis for a in "xyz"}, unit="FZ-3")
     with pytest.raises(InputError, match=r"the headers rate_dph_y and housing_c look swapped"):
         check_recording_noise(instrument, Recording(columns, run.metadata), "run.csv")
 
@@ -124,11 +123,11 @@ def test_the_calibrated_span_covers_the_thermometer_and_the_trained_f(model):
     assert frequency_span(model) == thermometer_span  # the training stayed inside
     reference = model.drift.settings.reference_freq_hz
     wider = dataclasses.replace(model.drift, ranges={**model.drift.ranges, "f": (-20.0, 20.0)})
-    assert frequency_span(dataclasses.replace(model, drift=wider)) == (
+    assert frequency_span(model.with_parts(drift=wider)) == (
         reference - 20.0, reference + 20.0)
     no_f = dataclasses.replace(model.drift, ranges={k: v for k, v in model.drift.ranges.items()
                                                     if k != "f"})
-    assert frequency_span(dataclasses.replace(model, drift=no_f)) == thermometer_span
+    assert frequency_span(model.with_parts(drift=no_f)) == thermometer_span
 
 
 def test_the_plausible_band_is_the_span_widened_by_100_c_at_the_steepest_slope(model):
@@ -162,8 +161,8 @@ def test_a_model_of_the_other_thermometer_kind_is_refused_naming_the_file_and_op
         "turns the resonator frequency into temperature), but the recording is read with "
         "--thermometer sensor (a temperature sensor in the place of freq_hz); drop "
         "--thermometer sensor for this model, or calibrate one with --thermometer sensor")
-    sensor_model = dataclasses.replace(
-        model, thermometer=dataclasses.replace(model.thermometer, source="sensor"))
+    sensor_model = model.with_parts(
+        thermometer=dataclasses.replace(model.thermometer, source="sensor"))
     check_thermometer_kind(sensor, sensor_model)
     with pytest.raises(InputError) as caught:
         check_thermometer_kind(resonator, sensor_model)
@@ -181,7 +180,7 @@ def test_a_model_of_the_other_thermometer_kind_is_refused_naming_the_file_and_op
 
 
 def test_the_noise_check_skips_axes_the_recording_lacks_and_checks_the_others(model):
-    instrument = InstrumentModel({a: model for a in "xyz"}, unit="FZ-3")
+    instrument = Model({a: model.axis for a in "xyz"}, unit="FZ-3")
     three = _three_axis(make_run(), {"z": 3600.0})
     yz = Recording({n: three[n] for n in three.names if not n.endswith("_x")}, three.metadata)
     with pytest.raises(InputError, match=r"column 'rate_dph_z': its noise"):
@@ -210,7 +209,7 @@ def test_swapped_headers_without_a_file_name_and_at_other_noise_levels(model):
     with pytest.raises(InputError, match=r"headers rate_dph_z and housing_c look swapped"):
         check_recording_noise(model, _swapped(run, constant, run.rate_dph), "run.csv", axis="z")
     # a quiet gyro (0.5 °/h of training noise, below 1 °/h) is checked all the same
-    quiet = dataclasses.replace(model, training=dataclasses.replace(
+    quiet = model.with_parts(training=dataclasses.replace(
         model.training, rate_noise_dph=model.training.rate_noise_dph / 4.0))
     with pytest.raises(InputError, match=r"look swapped"):
         check_recording_noise(quiet, _swapped(run, housing_c / 10.0, 0.25 * run.rate_dph),

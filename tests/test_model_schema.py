@@ -11,7 +11,7 @@ import pytest
 
 from hrgtc import drift
 from hrgtc.core.errors import ModelFileError
-from hrgtc.model import SCHEMA_VERSION, UnitModel, load_model, save_model
+from hrgtc.model import SCHEMA_VERSION, AxisModel, Model, load_model, save_model
 from hrgtc.model_schema import MODEL_SCHEMA, derived_coefficients
 
 from synthetic import THERMOMETER, ramp_run
@@ -19,8 +19,9 @@ from synthetic import THERMOMETER, ramp_run
 
 @pytest.fixture(scope="module")
 def unit_model():
-    return UnitModel(thermometer=THERMOMETER,
-                     drift=drift.fit([ramp_run(seed=11, hours=3.0)], THERMOMETER), unit="SN-1")
+    return Model.single(
+        AxisModel(thermometer=THERMOMETER, drift=drift.fit([ramp_run(seed=11, hours=3.0)],
+            THERMOMETER)), unit="SN-1")
 
 
 @pytest.fixture()
@@ -41,8 +42,9 @@ def test_the_schema_is_a_valid_json_schema():
 
 
 def test_written_file_is_strict_json_and_loads_back(tmp_path, unit_model):
-    model = UnitModel(unit_model.thermometer, unit_model.drift, unit="SN-1",
-                      provenance={"note": math.nan})  # a statistic-like NaN anywhere
+    model = Model.single(
+        AxisModel(unit_model.thermometer, unit_model.drift), unit="SN-1",
+            provenance={"note": math.nan})  # a statistic-like NaN anywhere
     path = save_model(model, tmp_path / "unit.json")
     text = path.read_text()
 
@@ -145,10 +147,10 @@ def test_foreign_and_future_files_say_what_they_are(tmp_path, document):
 
 
 def test_a_model_that_cannot_be_valid_is_never_saved(tmp_path, unit_model):
-    broken = UnitModel(unit_model.thermometer, unit_model.drift.__class__(**{
+    broken = Model.single(AxisModel(unit_model.thermometer, unit_model.drift.__class__(**{
         **{f: getattr(unit_model.drift, f) for f in unit_model.drift.__dataclass_fields__
            if f != "_terms"},
-        "intercept_dph": math.nan}))
+        "intercept_dph": math.nan})))
     with pytest.raises(ModelFileError, match=r"drift.intercept_dph: None is not of type"):
         save_model(broken, tmp_path / "unit.json")
     assert list(tmp_path.iterdir()) == []

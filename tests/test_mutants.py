@@ -175,6 +175,6 @@ def test_the_training_range_includes_its_lower_edge_in_compensation(model):
         freq[: n // 2] = reference + 0.5 * (low + high)
         run = Recording({"time_s": np.arange(n) / 10.0, "freq_hz": freq,
                          "rate_dph": np.full(n, 10.0)}, Metadata(sample_rate_hz=10.0))
-        compensator = Compensator(dataclasses.replace(model, drift=drift), engine="numpy")
+        compensator = Compensator(model.with_parts(drift=drift), engine="numpy")
         compensator.transform(run)
         assert compensator.ranges().temperature_fraction == outside

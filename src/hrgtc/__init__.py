@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 from hrgtc.core.meta import PAPER_REFERENCE
 
 if TYPE_CHECKING:
-    from hrgtc.model import UnitModel
+    from hrgtc.model import Model
 
 __all__ = ["PAPER_REFERENCE", "__version__", "load_model"]
 
@@ -39,7 +39,7 @@ def __getattr__(name: str) -> Any:
     return meta.__version__
 
 
-def load_model(path: str | os.PathLike[str]) -> UnitModel:
+def load_model(path: str | os.PathLike[str]) -> Model:
     """Read a model file: :func:`hrgtc.model.load_model`, imported when first called."""
     from hrgtc.model import load_model as _load_model
 

@@ -1,5 +1,9 @@
 """The model file: one JSON document holding everything a unit's compensation needs.
 
+:class:`Model` is the model of a unit or instrument, one :class:`AxisModel` per axis
+(a single-axis unit is the one-axis case); :func:`load_model` reads every model file,
+:func:`save_model` writes one. This is the one module that tells one axis from many.
+
 Thermometer (Eq. 18 form), feature settings (reference, causal df/dt filter,
 scales), drift model (Eq. 22 form), the optional classical housing-thermistor
 baseline, the unit's plateau table, and provenance (input files with SHA-256,
@@ -22,10 +26,11 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from datetime import UTC, datetime
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any
 
 from hrgtc.core import records
-from hrgtc.core.errors import HrgtcError, ModelFileError
+from hrgtc.core.errors import HrgtcError, InputError, ModelFileError
 from hrgtc.core.files import file_sha256, write_text_atomic
 from hrgtc.drift import DriftModel
 from hrgtc.drift.scale_factor import ScaleFactorModel
@@ -45,17 +50,21 @@ from hrgtc.model_schema import (
 )
 from hrgtc.thermometry import Thermometer
 
-__all__ = ["SCHEMA_NAME", "SCHEMA_VERSION", "InstrumentModel", "UnitModel", "axis_suffix",
-           "load_instrument", "load_model", "model_sha256", "provenance", "save_instrument",
-           "save_model"]
+__all__ = ["SCHEMA_NAME", "SCHEMA_VERSION", "AxisModel", "Model", "axis_suffix",
+           "load_model", "model_sha256", "provenance", "save_model"]
 
 #: Schema version of files with one axis and no scale factor (unchanged since version 2).
 _PLAIN_VERSION = 2
+#: The parts of an axis a one-axis :class:`Model` reads through (``model.thermometer``).
+_PART_NAMES = ("thermometer", "drift", "housing", "plateaus", "scale_factor", "training")
 
 
 @dataclass(frozen=True)
-class UnitModel:
-    """A calibrated unit: thermometer, drift model and where they came from.
+class AxisModel:
+    """One axis's parts of a model: thermometer, drift model, baseline, scale factor.
+
+    Not a model of its own: a :class:`Model` holds one per axis (a single-axis unit is
+    ``Model.single(part)``, the axis ``""``).
 
     Attributes
     ----------
@@ -66,12 +75,8 @@ class UnitModel:
     housing
         Classical baseline: bias model in housing temperature (None when the
         training runs had no ``housing_c``).
-    unit
-        Serial or name of the gyro.
     plateaus
-        The unit's Table 1: one record per soak plateau (plain JSON).
-    provenance
-        Inputs with SHA-256, settings, package version, creation time.
+        The axis's Table 1: one record per soak plateau (plain JSON).
     scale_factor
         Scale-factor error against frequency from rate-table runs (None: not
         calibrated; compensation then removes the bias only).
@@ -83,9 +88,7 @@ class UnitModel:
     thermometer: Thermometer
     drift: DriftModel
     housing: DriftModel | None = None
-    unit: str = "unknown"
     plateaus: tuple[dict[str, Any], ...] = ()
-    provenance: dict[str, Any] = field(default_factory=dict)
     scale_factor: ScaleFactorModel | None = None
     training: TrainingStatistics | None = None
 
@@ -94,16 +97,8 @@ class UnitModel:
         :class:`hrgtc.model_schema.AxisRecord` writes them."""
         return records.dump(self, AxisRecord)
 
-    def to_dict(self) -> dict[str, Any]:
-        """The model file's JSON document: :class:`~hrgtc.model_schema.FileRecord`'s fields
-        with the axis's parts (:class:`~hrgtc.model_schema.AxisRecord`) at the top level."""
-        parts = self.parts()
-        version = SCHEMA_VERSION if "scale_factor" in parts else _PLAIN_VERSION
-        return file_document(_head(self, version), parts)
-
     @classmethod
-    def from_parts(cls, data: Mapping[str, Any], unit: str,
-                   provenance: Mapping[str, Any]) -> UnitModel:
+    def from_parts(cls, data: Mapping[str, Any]) -> AxisModel:
         """One axis from its checked parts (see :func:`model_schema.check_document`)."""
         housing = data.get("housing")
         scale_factor = data.get("scale_factor")
@@ -112,16 +107,133 @@ class UnitModel:
             thermometer=Thermometer.from_dict(data["thermometer"]),
             drift=DriftModel.from_dict(data["drift"]),
             housing=None if housing is None else DriftModel.from_dict(housing),
-            unit=unit,
             plateaus=tuple(data.get("plateaus", ())),
-            provenance=dict(provenance),
             scale_factor=None if scale_factor is None else ScaleFactorModel.from_dict(scale_factor),
             training=None if training is None else TrainingStatistics.from_dict(training),
         )
 
+
+def axis_suffix(axis: str) -> str:
+    """Column suffix of an axis: ``"_x"`` for axis ``"x"``, ``""`` for a single-axis model."""
+    return f"_{axis}" if axis else ""
+
+
+def _one_axis(name: str) -> property:
+    """A read-only property of a one-axis model: the only axis's part ``name``."""
+
+    def read(self: Model) -> Any:
+        return getattr(self._only(name), name)
+
+    read.__doc__ = (f"The only axis's ``{name}`` (:class:`AxisModel`); a multi-axis model "
+                    f"raises :class:`~hrgtc.core.errors.InputError`: pick one with "
+                    f"``model.axes[name].{name}``.")
+    return property(read)
+
+
+@dataclass(frozen=True)
+class Model:
+    """A calibrated unit or instrument: one :class:`AxisModel` per axis, in one model file.
+
+    A single-axis unit is the one-axis case: ``axes == {"": part}``
+    (:meth:`single`), and its file is the single-axis model file (the parts at the
+    top level). A multi-axis file (schema version 3) holds each axis's thermometer,
+    drift model, housing baseline, plateaus and scale factor under ``axes``. For the
+    one-axis case the parts read through: ``model.thermometer`` is
+    ``model.axes[""].thermometer`` (on a multi-axis model they raise, naming the axes).
+
+    Attributes
+    ----------
+    axes
+        Axis name -> that axis's parts (names as the recording's column suffixes,
+        ``""`` for a single-axis unit).
+    unit
+        Serial or name of the unit or instrument.
+    provenance
+        Inputs with SHA-256, settings, package version, creation time.
+    temperature_map
+        The count -> °C map of a raw temperature sensor fitted to a reference log
+        (``calibrate --temp-ref``, :class:`hrgtc.thermometry.reference.TemperatureMap`
+        as a dict), applied to the raw count at compensation; None without one.
+    """
+
+    axes: dict[str, AxisModel]
+    unit: str = "unknown"
+    provenance: dict[str, Any] = field(default_factory=dict)
+    temperature_map: dict[str, Any] | None = None
+
+    def __post_init__(self) -> None:
+        if not self.axes:
+            raise ModelFileError("a model needs at least one axis")
+        if "" in self.axes and len(self.axes) > 1:
+            raise ModelFileError("the unnamed axis is the single-axis case; name every axis")
+
+    @classmethod
+    def single(cls, part: AxisModel, unit: str = "unknown",
+               provenance: Mapping[str, Any] | None = None,
+               temperature_map: Mapping[str, Any] | None = None) -> Model:
+        """The one-axis model (axis ``""``) of ``part``."""
+        return cls({"": part}, unit, dict(provenance or {}),
+                   None if temperature_map is None else dict(temperature_map))
+
+    @property
+    def is_single_axis(self) -> bool:
+        """True for the one-axis case (plain single-axis columns and file)."""
+        return list(self.axes) == [""]
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """Axis names in file order (``("",)`` for a single-axis model)."""
+        return tuple(self.axes)
+
+    def of_axis(self, name: str) -> Model:
+        """The one-axis model of axis ``name`` (its parts as the axis ``""``; the unit,
+        provenance and temperature map of this model)."""
+        if name not in self.axes:
+            raise InputError(f"the model of {self.unit!r} has no axis {name!r} (its axes: "
+                             f"{', '.join(a or '-' for a in self.axes)})")
+        return Model.single(self.axes[name], self.unit, self.provenance, self.temperature_map)
+
+    def with_parts(self, **parts: Any) -> Model:
+        """This one-axis model with parts of its axis replaced (``model.with_parts(drift=d)``,
+        as :func:`dataclasses.replace` on the axis); a multi-axis model raises."""
+        part = self._only()  # a multi-axis model raises
+        (name,) = self.axes
+        return replace(self, axes={name: replace(part, **parts)})
+
+    @property
+    def axis(self) -> AxisModel:
+        """The only axis's parts; a multi-axis model raises, naming its axes."""
+        return self._only()
+
+    def _only(self, part: str = "") -> AxisModel:
+        if len(self.axes) == 1:
+            return next(iter(self.axes.values()))
+        first = next(iter(self.axes))
+        raise InputError(
+            f"the model of {self.unit!r} has axes {', '.join(self.axes)}: pick one: "
+            f"model.axes[{first!r}]{'.' + part if part else ''}")
+
+    thermometer = _one_axis("thermometer")
+    drift = _one_axis("drift")
+    housing = _one_axis("housing")
+    plateaus = _one_axis("plateaus")
+    scale_factor = _one_axis("scale_factor")
+    training = _one_axis("training")
+
+    def to_dict(self) -> dict[str, Any]:
+        """The model file's JSON document (:class:`~hrgtc.model_schema.FileRecord`): one
+        axis's parts at the top level, or each axis's under ``axes``; the temperature map
+        as it was read or fitted (keys a newer version wrote are kept)."""
+        if self.is_single_axis:
+            parts = self.axes[""].parts()
+            version = SCHEMA_VERSION if "scale_factor" in parts else _PLAIN_VERSION
+            return file_document(_head(self, version, single=True), parts,
+                                 self.temperature_map)
+        return file_document(_head(self, SCHEMA_VERSION), None, self.temperature_map)
+
     @classmethod
     def from_dict(cls, data: Mapping[str, Any], source: str = "model",
-                  non_standard: bool = False) -> UnitModel:
+                  non_standard: bool = False) -> Model:
         """Inverse of :meth:`to_dict`, with schema checks (:func:`model_schema.check_document`).
 
         ``non_standard``: the document's text held ``NaN``/``Infinity``.
@@ -140,139 +252,40 @@ class UnitModel:
                 f"{source}: model schema version {version} is newer than this hrgtc "
                 f"understands ({SCHEMA_VERSION}); upgrade hrgtc"
             )
-        if "axes" in data:
-            names = ", ".join(data["axes"]) if isinstance(data["axes"], Mapping) else "?"
-            raise ModelFileError(
-                f"{source}: a multi-axis model file (axes {names}); load it with "
-                "hrgtc.model.load_instrument, or pick one axis with InstrumentModel.axes[name]"
-            )
-        data = check_document(strict(dict(data)), source, non_standard)
-        head = _read_head(data, source)
-        try:
-            return cls.from_parts(data, head["unit"], head["provenance"])
-        except KeyError as exc:
-            raise ModelFileError(f"{source}: model file is missing {exc}; it is corrupt") from exc
-        except HrgtcError as exc:
-            raise ModelFileError(f"{source}: model file is corrupt: {exc}") from exc
-
-    @property
-    def sha256(self) -> str:
-        """SHA-256 of the model's canonical JSON (independent of file layout and provenance)."""
-        return model_sha256(self)
-
-
-def axis_suffix(axis: str) -> str:
-    """Column suffix of an axis: ``"_x"`` for axis ``"x"``, ``""`` for a single-axis model."""
-    return f"_{axis}" if axis else ""
-
-
-@dataclass(frozen=True)
-class InstrumentModel:
-    """A calibrated instrument: one :class:`UnitModel` per axis, in one model file.
-
-    A single-axis model is the one-axis case: ``axes == {"": model}``, and its file is
-    exactly a single-axis model file. A multi-axis file (schema version 3) holds each
-    axis's thermometer, drift model, housing baseline, plateaus and scale factor under
-    ``axes``.
-
-    Attributes
-    ----------
-    axes
-        Axis name -> that axis's model (names as the recording's column suffixes).
-    unit
-        Serial or name of the instrument.
-    provenance
-        Inputs with SHA-256, settings, package version, creation time.
-    temperature_map
-        The count -> °C map of a raw temperature sensor fitted to a reference log
-        (``calibrate --temp-ref``, :class:`hrgtc.thermometry.reference.TemperatureMap`
-        as a dict), applied to the raw count at compensation; None without one.
-    """
-
-    axes: dict[str, UnitModel]
-    unit: str = "unknown"
-    provenance: dict[str, Any] = field(default_factory=dict)
-    temperature_map: dict[str, Any] | None = None
-
-    def __post_init__(self) -> None:
-        if not self.axes:
-            raise ModelFileError("an instrument model needs at least one axis")
-        if "" in self.axes and len(self.axes) > 1:
-            raise ModelFileError("the unnamed axis is the single-axis case; name every axis")
-
-    @classmethod
-    def single(cls, model: UnitModel) -> InstrumentModel:
-        """The one-axis instrument of a single-axis model."""
-        return cls({"": model}, model.unit, dict(model.provenance))
-
-    @property
-    def is_single_axis(self) -> bool:
-        """True for the one-axis case (plain single-axis columns and file)."""
-        return list(self.axes) == [""]
-
-    @property
-    def names(self) -> tuple[str, ...]:
-        """Axis names in file order (``("",)`` for a single-axis model)."""
-        return tuple(self.axes)
-
-    def to_dict(self) -> dict[str, Any]:
-        """The model file's JSON document (:class:`~hrgtc.model_schema.FileRecord`): one
-        axis's parts at the top level, or each axis's under ``axes``; the temperature map
-        as it was read or fitted (keys a newer version wrote are kept)."""
-        if self.is_single_axis:
-            axis = replace(self.axes[""], unit=self.unit, provenance=self.provenance)
-            parts = axis.parts()
-            version = SCHEMA_VERSION if "scale_factor" in parts else _PLAIN_VERSION
-            return file_document(_head(axis, version), parts, self.temperature_map)
-        return file_document(_head(self, SCHEMA_VERSION), None, self.temperature_map)
-
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any], source: str = "model",
-                  non_standard: bool = False) -> InstrumentModel:
-        """Inverse of :meth:`to_dict`, with the checks of :meth:`UnitModel.from_dict`."""
         temperature_map = _temperature_map(data, source)
-        if not (isinstance(data, Mapping) and "axes" in data):
-            single = cls.single(UnitModel.from_dict(data, source, non_standard))
-            return single if temperature_map is None else replace(
-                single, temperature_map=temperature_map)
-        if data.get("schema") != SCHEMA_NAME:
-            raise ModelFileError(f"{source}: not an hrgtc model file (schema "
-                                 f"{data.get('schema')!r}, expected {SCHEMA_NAME!r})")
-        version = data.get("schema_version")
-        if isinstance(version, int) and version > SCHEMA_VERSION:
-            raise ModelFileError(
-                f"{source}: model schema version {version} is newer than this hrgtc "
-                f"understands ({SCHEMA_VERSION}); upgrade hrgtc"
-            )
         checked = check_document(strict(dict(data)), source, non_standard)
         head = _read_head(checked, source)
-        unit, provenance = head["unit"], head["provenance"]
         try:
-            axes = {name: UnitModel.from_parts(part, unit, provenance)
-                    for name, part in axis_parts(checked).items()}
+            if "axes" in checked:
+                axes = {name: AxisModel.from_parts(part)
+                        for name, part in axis_parts(checked).items()}
+            else:
+                axes = {"": AxisModel.from_parts(checked)}
         except KeyError as exc:
             raise ModelFileError(f"{source}: model file is missing {exc}; it is corrupt") from exc
         except HrgtcError as exc:
             raise ModelFileError(f"{source}: model file is corrupt: {exc}") from exc
-        return cls(axes, unit, provenance, temperature_map)
+        return cls(axes, head["unit"], dict(head["provenance"]), temperature_map)
 
     @property
     def sha256(self) -> str:
         """SHA-256 of the parameters as canonical JSON (see :func:`model_sha256`)."""
-        return parameters_sha256(self.to_dict())
+        return model_sha256(self)
 
 
-def _head(model: UnitModel | InstrumentModel, version: int) -> dict[str, Any]:
+def _head(model: Model, version: int, single: bool = False) -> dict[str, Any]:
     """The file's own fields (:class:`~hrgtc.model_schema.FileRecord`) of ``model``: a
-    :class:`UnitModel` has no ``axes``; an instrument's axes are dumped by their record
-    (:class:`~hrgtc.model_schema.AxisRecord`)."""
-    return records.dump(model, FileRecord, schema=SCHEMA_NAME, schema_version=version,
+    single-axis file has no ``axes`` (its parts sit at the top level); an instrument's
+    axes are dumped by their record (:class:`~hrgtc.model_schema.AxisRecord`)."""
+    source: Any = SimpleNamespace(unit=model.unit, provenance=model.provenance) if single \
+        else model
+    return records.dump(source, FileRecord, schema=SCHEMA_NAME, schema_version=version,
                         temperature_map=None)
 
 
 def _read_head(checked: Mapping[str, Any], source: str) -> dict[str, Any]:
     """The file's own fields of a checked document, read by :class:`FileRecord` (each
-    axis's parts are read by the records of the parts, :meth:`UnitModel.from_parts`)."""
+    axis's parts are read by the records of the parts, :meth:`AxisModel.from_parts`)."""
     try:
         return records.load({k: checked[k] for k in ("schema", "schema_version", "unit",
                                                      "provenance") if k in checked},
@@ -297,7 +310,7 @@ def _temperature_map(data: Any, source: str) -> dict[str, Any] | None:
     return dict(raw)
 
 
-def model_sha256(model: UnitModel) -> str:
+def model_sha256(model: Model) -> str:
     """SHA-256 of the model's parameters as canonical JSON (sorted keys, strict, no provenance).
 
     Written into the model file as ``parameters_sha256`` and into the mark of every
@@ -329,14 +342,9 @@ def provenance(inputs: Mapping[str, list[str]], settings: Mapping[str, Any],
     }
 
 
-def save_instrument(model: InstrumentModel, path: str | os.PathLike[str],
-                    force: bool = False) -> Path:
-    """Write an instrument's model file (one file, every axis); as :func:`save_model`."""
-    return _save_document(model.to_dict(), path, force)
-
-
-def save_model(model: UnitModel, path: str | os.PathLike[str], force: bool = False) -> Path:
-    """Write the model file atomically as strict JSON (refuses to overwrite without ``force``).
+def save_model(model: Model, path: str | os.PathLike[str], force: bool = False) -> Path:
+    """Write the model file atomically as strict JSON (refuses to overwrite without ``force``):
+    one file for every axis (a single-axis model writes the single-axis file).
 
     Raises
     ------
@@ -355,29 +363,17 @@ def _save_document(document: dict[str, Any], path: str | os.PathLike[str], force
     return write_text_atomic(path, text + "\n", force=force)
 
 
-def load_model(path: str | os.PathLike[str]) -> UnitModel:
-    """Read a single-axis model file written by :func:`save_model` (or ``hrgtc calibrate``).
+def load_model(path: str | os.PathLike[str]) -> Model:
+    """Read any model file written by :func:`save_model` (or ``hrgtc calibrate``): single-
+    or multi-axis, of every schema version.
 
     Raises
     ------
     ModelFileError
-        Unreadable, not JSON, foreign, corrupt, of a newer schema, or multi-axis
-        (read those with :func:`load_instrument`).
+        Unreadable, not JSON, foreign, corrupt or of a newer schema.
     """
     data, non_standard = _read_document(path)
-    return UnitModel.from_dict(data, source=str(path), non_standard=non_standard)
-
-
-def load_instrument(path: str | os.PathLike[str]) -> InstrumentModel:
-    """Read any model file, single- or multi-axis, as an :class:`InstrumentModel`.
-
-    Raises
-    ------
-    ModelFileError
-        As :func:`load_model`.
-    """
-    data, non_standard = _read_document(path)
-    return InstrumentModel.from_dict(data, source=str(path), non_standard=non_standard)
+    return Model.from_dict(data, source=str(path), non_standard=non_standard)
 
 
 def _read_document(path: str | os.PathLike[str]) -> tuple[Any, bool]:

@@ -17,16 +17,16 @@ import numpy as np
 
 from hrgtc import recording as rec_io
 from hrgtc.core.errors import InputError
-from hrgtc.model import UnitModel
+from hrgtc.model import AxisModel, Model
 from hrgtc.recording import Recording
 
 
-def check_recording_noise(model: Any, chunk: Recording, source: str = "",
+def check_recording_noise(model: Model, chunk: Recording, source: str = "",
                           axis: str | None = None) -> None:
     """Refuse a recording whose rate noise is a unit factor off the model's training data
     (:func:`hrgtc.drift.training.check_noise`), every axis of an instrument's.
 
-    ``model`` is a :class:`UnitModel` or an :class:`~hrgtc.model.InstrumentModel`; axes
+    Every axis of ``model`` is checked (a single-axis model's on the plain columns); axes
     the chunk lacks are left to the compensator's own error. ``axis``: the file's axis
     a single-axis ``chunk`` (an axis view) was read from, named in the message.
     """
@@ -34,8 +34,7 @@ def check_recording_noise(model: Any, chunk: Recording, source: str = "",
     from hrgtc.recording import axis_names, axis_view
 
     axis_of_view = axis
-    axes = getattr(model, "axes", None)
-    units = {"": model} if axes is None else dict(axes)
+    units = dict(model.axes)
     found = axis_names(chunk.names)
     fs = chunk.metadata.sample_rate_hz
     for axis, unit in units.items():
@@ -103,7 +102,7 @@ def check_swapped_rate(statistics: Any, chunk: Recording, column: str, ratio: fl
 PLAUSIBLE_MARGIN_C = 100.0
 
 
-def frequency_span(model: UnitModel) -> tuple[float, float]:
+def frequency_span(model: AxisModel | Model) -> tuple[float, float]:
     """The frequencies the model was calibrated on: thermometer and drift training ranges. [Hz]"""
     low, high = model.thermometer.frequency_range_hz
     if "f" in model.drift.ranges:
@@ -113,7 +112,7 @@ def frequency_span(model: UnitModel) -> tuple[float, float]:
     return float(low), float(high)
 
 
-def plausible_frequency_band(model: UnitModel,
+def plausible_frequency_band(model: AxisModel | Model,
                              margin_c: float = PLAUSIBLE_MARGIN_C) -> tuple[float, float]:
     """The calibrated span widened by ``margin_c`` of temperature at the steepest slope. [Hz]
 
@@ -127,9 +126,9 @@ def plausible_frequency_band(model: UnitModel,
     return low - margin, high + margin
 
 
-def check_thermometer_kind(options: rec_io.ReadOptions, model: UnitModel,
+def check_thermometer_kind(options: rec_io.ReadOptions, model: Model,
                            model_file: object = None) -> None:
-    """Refuse to read a recording as the other kind of thermometer than the model's.
+    """Refuse to read a recording as the other kind of thermometer than the model's (any axis's).
 
     A sensor-thermometer model (``calibrate --thermometer sensor``) reads the gyro's
     temperature sensor [°C] in the place of the frequency; applied to a frequency
@@ -142,11 +141,12 @@ def check_thermometer_kind(options: rec_io.ReadOptions, model: UnitModel,
         The kinds differ: says which the model is (naming ``model_file`` when given)
         and which option to pass.
     """
-    model_kind = model.thermometer.source
     reading = options.thermometer
-    if model_kind == reading:
+    other = [part for part in model.axes.values() if part.thermometer.source != reading]
+    if not other:
         return
-    low, high = model.thermometer.temperature_range_c
+    model_kind = other[0].thermometer.source
+    low, high = other[0].thermometer.temperature_range_c
     named = f"{model_file}: " if model_file is not None else ""
     if model_kind == "sensor":
         raise InputError(
@@ -162,8 +162,8 @@ def check_thermometer_kind(options: rec_io.ReadOptions, model: UnitModel,
         "--thermometer sensor for this model, or calibrate one with --thermometer sensor")
 
 
-def with_model_band(options: rec_io.ReadOptions, model: UnitModel) -> rec_io.ReadOptions:
-    """``options`` that check every frequency against the model's plausible band.
+def with_model_band(options: rec_io.ReadOptions, model: Model) -> rec_io.ReadOptions:
+    """``options`` that check every frequency against a single-axis model's plausible band.
 
     Raises
     ------

@@ -16,7 +16,7 @@ from typer.testing import CliRunner
 from hrgtc import drift
 from hrgtc.cli import app
 from hrgtc.export.export_c import export_c
-from hrgtc.model import InstrumentModel, UnitModel, save_instrument, save_model
+from hrgtc.model import AxisModel, Model, save_model
 
 from synthetic import THERMOMETER, ramp_run
 
@@ -25,8 +25,9 @@ runner = CliRunner()
 
 @pytest.fixture(scope="module")
 def model_file(tmp_path_factory):
-    model = UnitModel(thermometer=THERMOMETER, drift=drift.fit([ramp_run(seed=1)], THERMOMETER),
-                      unit="synthetic-1")
+    model = Model.single(
+        AxisModel(thermometer=THERMOMETER, drift=drift.fit([ramp_run(seed=1)], THERMOMETER)),
+            unit="synthetic-1")
     return save_model(model, tmp_path_factory.mktemp("model") / "unit.json")
 
 
@@ -78,8 +79,8 @@ def test_bad_options_exit_2_and_say_why(options, message, model_file, tmp_path):
 
 def test_an_instrument_file_exports_every_axis(tmp_path):
     fitted = drift.fit([ramp_run(seed=1)], THERMOMETER)
-    axes = {name: UnitModel(thermometer=THERMOMETER, drift=fitted, unit="imu") for name in "ab"}
-    path = save_instrument(InstrumentModel(axes, "imu", {}), tmp_path / "imu.json")
+    axes = {name: AxisModel(thermometer=THERMOMETER, drift=fitted) for name in "ab"}
+    path = save_model(Model(axes, "imu", {}), tmp_path / "imu.json")
     result = runner.invoke(app, ["export-c", str(path), "-o", str(tmp_path / "c"), "--json",
                                  "--precision", "single"])
     assert result.exit_code == 0, result.output

@@ -16,7 +16,7 @@ import pytest
 from typer.testing import CliRunner
 
 from hrgtc.cli import app
-from hrgtc.model import save_model
+from hrgtc.model import AxisModel, save_model
 from hrgtc.model_schema import derived_coefficients
 from hrgtc.recording import write
 
@@ -120,7 +120,7 @@ def sensor_model_path(tmp_path_factory):
     import numpy as np
 
     from hrgtc import drift
-    from hrgtc.model import UnitModel
+    from hrgtc.model import Model
     from hrgtc.thermometry.sensor import identity
 
     from synthetic import ramp_run
@@ -129,8 +129,8 @@ def sensor_model_path(tmp_path_factory):
     rng = np.random.default_rng(0)
     reading = run.with_columns(freq_hz=run["resonator_c"] + rng.normal(0.0, 0.01, len(run)))
     thermometer = identity((-20.0, 40.0))
-    model = UnitModel(thermometer=thermometer, drift=drift.fit([reading], thermometer),
-                      unit="MEMS-1")
+    model = Model.single(
+        AxisModel(thermometer=thermometer, drift=drift.fit([reading], thermometer)), unit="MEMS-1")
     return save_model(model, tmp_path_factory.mktemp("sensor") / "sensor.json")
 
 
@@ -161,7 +161,7 @@ def test_a_resonator_model_read_as_a_sensor_recording_says_so(files, tmp_path):
 def axis_files(tmp_path_factory):
     """A three-axis recording (x, y, z: the same run on each axis), a two-axis model (x, y)
     and a single-axis model."""
-    from hrgtc.model import InstrumentModel, save_instrument
+    from hrgtc.model import Model, save_model
     from hrgtc.recording import Recording
 
     folder = tmp_path_factory.mktemp("axes")
@@ -172,7 +172,7 @@ def axis_files(tmp_path_factory):
         columns[f"freq_hz_{axis}"] = run.freq_hz
         columns[f"rate_dph_{axis}"] = run.rate_dph
     xyz = write(Recording(columns, run.metadata), folder / "xyz.parquet")
-    xy = save_instrument(InstrumentModel({"x": unit, "y": unit}, "imu"), folder / "xy.json")
+    xy = save_model(Model({"x": unit.axis, "y": unit.axis}, "imu"), folder / "xy.json")
     single = save_model(unit, folder / "single.json")
     return folder, xyz, xy, single
 
@@ -232,18 +232,18 @@ def test_the_report_s_library_call_checks_the_axes_itself(axis_files, sensor_mod
     kind before reading (the command used to do it before the call): an in-memory model
     gets the command's refusals, and ``axes`` picks the axes to show."""
     from hrgtc.core.errors import InputError
-    from hrgtc.model import load_instrument
+    from hrgtc.model import load_model
     from hrgtc.report import build_report
 
     _, xyz, xy, _ = axis_files
-    model = load_instrument(xy)
+    model = load_model(xy)
     with pytest.raises(InputError, match="pass --axes x,y"):
         build_report(model, [xyz], tmp_path / "r.html")
     assert not (tmp_path / "r.html").exists()
     page = build_report(model, [xyz], tmp_path / "r.html", axes=("x",)).read_text()
     assert 'id="axis-x"' in page and 'id="axis-y"' not in page  # the x axis alone
     with pytest.raises(InputError, match="is a sensor-thermometer model"):
-        build_report(load_instrument(sensor_model_path), [files[2]], tmp_path / "s.html")
+        build_report(load_model(sensor_model_path), [files[2]], tmp_path / "s.html")
 
 
 @pytest.mark.parametrize("axes, match", [
@@ -259,11 +259,11 @@ def test_wrong_axes_are_named(axis_files, axes, match):
 
 
 def test_a_model_with_more_axes_than_the_recording(axis_files, tmp_path):
-    from hrgtc.model import InstrumentModel, save_instrument
+    from hrgtc.model import Model, save_model
 
     _, xyz, _, _ = axis_files
     unit = make_model()
-    xyzw = save_instrument(InstrumentModel({a: unit for a in "xyzw"}, "imu4"),
+    xyzw = save_model(Model({a: unit.axis for a in "xyzw"}, "imu4"),
                            tmp_path / "xyzw.json")
     code, _, stderr = invoke("compensate", xyz, "-m", xyzw, "-o", tmp_path / "o.parquet")
     message = squash(stderr)
@@ -280,12 +280,12 @@ def test_a_header_less_multi_axis_csv_says_it_has_no_header_line(axis_files, tmp
     """A 3-axis CSV whose header line is gone read as a single-axis file against a 3-axis
     model ("the recording is single-axis (freq_hz, rate_dph) and the model has axes x, y,
     z"): the axis mismatch is not the problem, the missing header is."""
-    from hrgtc.model import InstrumentModel, save_instrument
+    from hrgtc.model import Model, save_model
     from hrgtc.recording import read
 
     _, xyz, _, _ = axis_files
     unit = make_model()
-    model = save_instrument(InstrumentModel({a: unit for a in "xyz"}, "imu"),
+    model = save_model(Model({a: unit.axis for a in "xyz"}, "imu"),
                             tmp_path / "xyz.json")
     csv = write(read(xyz), tmp_path / "xyz.csv")
     lines = csv.read_text().split("\n")
@@ -302,13 +302,12 @@ def test_a_header_less_multi_axis_csv_says_it_has_no_header_line(axis_files, tmp
 @pytest.fixture(scope="module")
 def checked_model(tmp_path_factory):
     """make_model() with the statistics of its training run, as calibrate records them."""
-    import dataclasses
 
     from hrgtc.drift.training import TrainingStatistics
 
     from synthetic import ramp_run
 
-    model = dataclasses.replace(make_model(), training=TrainingStatistics.from_runs(
+    model = make_model().with_parts(training=TrainingStatistics.from_runs(
         [ramp_run(seed=11, hours=3.0)]))
     return save_model(model, tmp_path_factory.mktemp("checked") / "checked.json")
 
@@ -366,7 +365,7 @@ def test_swapped_rate_and_temperature_headers_are_named(checked_model, tmp_path,
     """Issue 21's audit: with the headers rate_dph and temperature_c swapped, a temperature
     was compensated as the rate (exit 0): its noise, 5e-5 of the training rate's, is no
     unit factor. The temperature column has the rate's noise: the swap is named."""
-    from hrgtc.model import InstrumentModel, load_model, save_instrument
+    from hrgtc.model import Model, load_model, save_model
     from hrgtc.recording import Recording
 
     run = _with_temperature(axes)
@@ -377,7 +376,7 @@ def test_swapped_rate_and_temperature_headers_are_named(checked_model, tmp_path,
     model = checked_model
     if axes == "3":
         unit = load_model(checked_model)
-        model = save_instrument(InstrumentModel({a: unit for a in "xyz"}, "imu"),
+        model = save_model(Model({a: unit.axis for a in "xyz"}, "imu"),
                                 tmp_path / "xyz.json")
     code, stdout, stderr = invoke(*COMMANDS[command](run_path, model, tmp_path))
     message = squash(stderr)

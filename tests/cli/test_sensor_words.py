@@ -22,7 +22,7 @@ from hrgtc.evaluation.calibration_figures import (
     THERMOMETER,
     calibration_summary,
 )
-from hrgtc.model import load_instrument, load_model
+from hrgtc.model import load_model
 from hrgtc.recording import Metadata
 
 GOLDEN = Path(__file__).parents[1] / "data" / "golden-models"
@@ -47,7 +47,7 @@ def test_the_compensated_mark_says_what_drove_the_model():
     assert sensor.extra["compensated_by"]["drift"] == "sensor temperature"
     resonator = compensated_metadata(metadata, load_model(RESONATOR))
     assert resonator.extra["compensated_by"]["drift"] == "frequency"
-    instrument = compensated_metadata(metadata, load_instrument(PAN_MODEL))
+    instrument = compensated_metadata(metadata, load_model(PAN_MODEL))
     assert instrument.extra["compensated_by"]["drift"] == "sensor temperature"
     housing = compensated_metadata(metadata, load_model(RESONATOR), "housing")
     assert housing.extra["compensated_by"]["drift"] == "housing"
@@ -70,8 +70,8 @@ def test_a_sensor_thermometer_shows_no_cubic_fit():
     assert "trained temperatures" in rows
     assert f"{high - low:.4g}" in str(rows["trained temperatures"][0])
 
-    pan = load_instrument(PAN_MODEL)
-    mapped = _section(calibration_summary(pan.axes["x"], temperature_map=pan.temperature_map),
+    pan = load_model(PAN_MODEL)
+    mapped = _section(calibration_summary(pan.of_axis("x"), temperature_map=pan.temperature_map),
                       SENSOR_THERMOMETER)
     assert mapped["thermometer"][0] == "sensor count, mapped to °C"
     assert mapped["reference log"][0] == pan.temperature_map["reference"]

@@ -110,7 +110,7 @@ def test_the_library_call_gives_the_cli_s_model_with_its_reference_log(tmp_path)
     """``calibrate_instrument`` fits the ``--temp-ref`` map itself (a
     :class:`TemperatureReference`), on the whole drift file before the hold-out split:
     one library call writes the model file the command writes, map and all."""
-    from hrgtc.model import save_instrument
+    from hrgtc.model import save_model
     from hrgtc.pipeline.instrument import calibrate_instrument
     from hrgtc.recording import ReadOptions
     from hrgtc.settings.calibration import CalibrationSettings
@@ -132,7 +132,7 @@ def test_the_library_call_gives_the_cli_s_model_with_its_reference_log(tmp_path)
         [], [RUN], thermometer="sensor", read_options=options, holdout_fraction=0.4,
         settings=CalibrationSettings(drift=DriftSettings(rate_tau_s=1.0, window_s=5.0)),
         temperature_reference=reference)
-    save_instrument(calibration.model, tmp_path / "library.json")
+    save_model(calibration.model, tmp_path / "library.json")
     cli, library = (json.loads((tmp_path / name).read_text())
                     for name in ("cli.json", "library.json"))
     for document in (cli, library):

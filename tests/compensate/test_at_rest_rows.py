@@ -16,8 +16,9 @@ from hrgtc import recording as recording_io
 from hrgtc.compensate import compensate_file
 from hrgtc.compensate.at_rest import FlagsMisaligned, RestFlags
 from hrgtc.drift.rest import run_rest
-from hrgtc.model import UnitModel
+from hrgtc.model import AxisModel, Model
 from hrgtc.recording import Recording
+from hrgtc.settings.compensation import CompensateSettings
 
 from synthetic import THERMOMETER, ramp_run
 
@@ -26,7 +27,8 @@ CHUNK = 7_000
 
 @pytest.fixture(scope="module")
 def unit_model():
-    return UnitModel(THERMOMETER, drift.fit([ramp_run(seed=21, hours=3.0)], THERMOMETER))
+    return Model.single(
+        AxisModel(THERMOMETER, drift.fit([ramp_run(seed=21, hours=3.0)], THERMOMETER)))
 
 
 def handled(seed: int = 23) -> Recording:
@@ -55,7 +57,8 @@ def compensated(source, out, model, options, monkeypatch) -> tuple[object, list]
         return original(*args, **kwargs)
 
     monkeypatch.setattr(recording_io, "iter_chunks", spy)
-    return compensate_file(source, out, model, chunk_rows=CHUNK, read_options=options), passes
+    return compensate_file(source, out, model, settings=CompensateSettings(chunk_rows=CHUNK),
+                           read_options=options), passes
 
 
 def test_a_slow_channels_gap_the_detectors_pass_does_not_read(unit_model, tmp_path,

@@ -21,18 +21,19 @@ from hrgtc.compensate import (
     Compensator,
     compensate,
     compensate_file,
-    compensate_instrument_file,
 )
 from hrgtc.core.errors import InputError, RecordingError
-from hrgtc.model import InstrumentModel, UnitModel
+from hrgtc.model import AxisModel, Model
 from hrgtc.recording import concatenate
+from hrgtc.settings.compensation import CompensateSettings
 
 from synthetic import THERMOMETER, ramp_run, with_heating_extra
 
 
 @pytest.fixture(scope="module")
 def unit_model():
-    return UnitModel(THERMOMETER, drift.fit([ramp_run(seed=21, hours=3.0)], THERMOMETER))
+    return Model.single(
+        AxisModel(THERMOMETER, drift.fit([ramp_run(seed=21, hours=3.0)], THERMOMETER)))
 
 
 @pytest.fixture(scope="module")
@@ -43,7 +44,7 @@ def run():
 @settings(max_examples=25, deadline=None)
 @given(cuts=st.lists(st.integers(1, 35_999), min_size=1, max_size=8, unique=True))
 def test_any_chunking_equals_batch(unit_model, run, cuts):
-    batch = compensate(run, unit_model)
+    batch = compensate(unit_model, run)
     compensator = Compensator(unit_model)
     bounds = [0, *sorted(cuts), len(run)]
     parts = [compensator.transform(run.slice(a, b)) for a, b in itertools.pairwise(bounds)]
@@ -53,7 +54,7 @@ def test_any_chunking_equals_batch(unit_model, run, cuts):
 
 
 def test_compensated_is_raw_minus_model(unit_model, run):
-    out = compensate(run, unit_model)
+    out = compensate(unit_model, run)
     np.testing.assert_array_equal(out["rate_comp_dph"], run.rate_dph - out["bias_model_dph"])
     # frequency noise 2 mHz at 0.37 Hz/°C is 0.0054 °C per sample: 6 sigma
     np.testing.assert_allclose(out["resonator_c_est"], run["resonator_c"], atol=0.033)
@@ -65,12 +66,13 @@ def test_out_of_range_samples_are_counted(unit_model):
     compensator = Compensator(unit_model)
     out = compensator.transform(hot)
     assert compensator.out_of_range_fraction > 0.2
-    assert compensator.settling == round(unit_model.drift.settings.warmup_s * hot.sample_rate_hz)
+    assert compensator.axis.settling == round(unit_model.drift.settings.warmup_s
+                                              * hot.sample_rate_hz)
     # in_range is 0 beyond the trained temperature, beyond the trained df/dt, and while
     # the filter settles; the kinds are counted apart
     assert 1 - out["in_range"].mean() >= max(compensator.out_of_range_fraction,
                                              compensator.rate_out_of_range_fraction)
-    assert not out["in_range"][: compensator.settling].any()
+    assert not out["in_range"][: compensator.axis.settling].any()
     report = compensator.ranges()
     assert report.temperature_fraction == compensator.out_of_range_fraction
     assert report.seen_c[1] > 25.0 and report.temperature_excess_c > 5.0
@@ -106,8 +108,8 @@ def test_samples_beyond_the_df_range_are_never_in_range(unit_model, engine):
     assert beyond.mean() > 0.5
     # counted on the settled samples (a settling one is counted as such only, issue 20)
     settled = fast.time_s - fast.time_s[0] >= unit_model.drift.settings.warmup_s
-    assert compensator.rate_out_of_range == int(np.count_nonzero(beyond & settled))
-    assert compensator.settling == int(np.count_nonzero(~settled))
+    assert compensator.axis.rate_out_of_range == int(np.count_nonzero(beyond & settled))
+    assert compensator.axis.settling == int(np.count_nonzero(~settled))
     assert not np.any(out["in_range"][beyond])
 
 
@@ -134,8 +136,8 @@ def assert_engines_agree(model, recording, drift_kind="frequency", temperature_a
     np.testing.assert_allclose(a["resonator_c_est"], b["resonator_c_est"], rtol=0,
                                atol=temperature_atol)
     np.testing.assert_array_equal(a["in_range"], b["in_range"])
-    assert (fused.samples, fused.out_of_range, fused.rate_out_of_range) == (
-        numpy_.samples, numpy_.out_of_range, numpy_.rate_out_of_range)
+    assert (fused.samples, fused.axis.out_of_range, fused.axis.rate_out_of_range) == (
+        numpy_.samples, numpy_.axis.out_of_range, numpy_.axis.rate_out_of_range)
     return fused
 
 
@@ -168,7 +170,7 @@ def test_fused_engine_is_generic_over_the_term_grammar(unit_model, hot_housing_r
         unit_model.drift, selected=tuple(selected), settings=settings_, ranges=ranges,
         scaled_coefficients=tuple(coefficients[: len(selected)]),
         coefficients=dict.fromkeys(selected, 1.0))
-    assert_engines_agree(UnitModel(THERMOMETER, fitted), hot_housing_run)
+    assert_engines_agree(Model.single(AxisModel(THERMOMETER, fitted)), hot_housing_run)
 
 
 @pytest.fixture(scope="module")
@@ -185,8 +187,8 @@ def test_fused_streaming_is_exact_across_any_chunk_boundaries(unit_model, hot_ho
                                  settings=dataclasses.replace(
                                      unit_model.drift.settings,
                                      scales={"f": 10.0, "df": 1e-3, "h": 20.0, "dh": 1e-2}))
-    model = UnitModel(THERMOMETER, fitted)
-    batch = compensate(hot_housing_run, model)
+    model = Model.single(AxisModel(THERMOMETER, fitted))
+    batch = compensate(model, hot_housing_run)
     compensator = Compensator(model)
     bounds = [0, *sorted(cuts), len(hot_housing_run)]
     streamed = concatenate([compensator.transform(hot_housing_run.slice(a, b))
@@ -202,10 +204,10 @@ def test_fused_slow_path_of_the_thermometer(unit_model, run):
     from hrgtc.compensate import _kernel as kernel
 
     compensator = Compensator(unit_model)
-    plan = kernel.plan(unit_model.drift, THERMOMETER, compensator._variables)
+    plan = kernel.plan(unit_model.drift, THERMOMETER, compensator.axis._variables)
     strict = plan.thermometer.copy()
     strict[10:12] = 0.0  # one_step_limit, tolerance
-    compensator._plan = dataclasses.replace(plan, thermometer=strict)
+    compensator.axis._plan = dataclasses.replace(plan, thermometer=strict)
     out = compensator.transform(run.slice(0, 2000))
     np.testing.assert_allclose(out["resonator_c_est"],
                                THERMOMETER.temperature(run.freq_hz[:2000], warn=False),
@@ -225,7 +227,7 @@ def gradient_model():
                        THERMOMETER, terms=GRADIENT_TERMS, initial=GRADIENT_TERMS,
                        premove=0.999999)
     assert fitted.selected == GRADIENT_TERMS and "g" in fitted.ranges
-    return UnitModel(THERMOMETER, fitted)
+    return Model.single(AxisModel(THERMOMETER, fitted))
 
 
 @pytest.fixture(scope="module")
@@ -252,8 +254,8 @@ def test_fused_engine_computes_the_gradient_as_numpy(gradient_model, steep_gradi
     # polishes every sample of the block once more, the kernel only those samples; both are
     # within the inverse's tolerance (5e-11 °C), as with a model without g
     fused = assert_engines_agree(gradient_model, steep_gradient_run, temperature_atol=5e-11)
-    assert fused._plan is not None and fused._plan.uses_gradient  # no fallback
-    out = compensate(steep_gradient_run, gradient_model)
+    assert fused.axis._plan is not None and fused.axis._plan.uses_gradient  # no fallback
+    out = compensate(gradient_model, steep_gradient_run)
     assert np.all(out["in_range"][(g < low) | (g > high)] == 0.0)
     # the bias law has 0.4 (housing - resonator): the model follows it beyond the range too
     assert np.all(np.isfinite(out["bias_model_dph"]))
@@ -262,7 +264,7 @@ def test_fused_engine_computes_the_gradient_as_numpy(gradient_model, steep_gradi
 @settings(max_examples=15, deadline=None)
 @given(cuts=st.lists(st.integers(1, 71_999), min_size=1, max_size=8, unique=True))
 def test_fused_gradient_chunked_equals_batch(gradient_model, steep_gradient_run, cuts):
-    batch = compensate(steep_gradient_run, gradient_model)
+    batch = compensate(gradient_model, steep_gradient_run)
     compensator = Compensator(gradient_model)
     bounds = [0, *sorted(cuts), len(steep_gradient_run)]
     streamed = concatenate([compensator.transform(steep_gradient_run.slice(a, b))
@@ -276,9 +278,9 @@ def test_fused_gradient_on_two_threads_gives_the_bits_of_one_call(gradient_model
                                                                   monkeypatch):
     from hrgtc.compensate import _kernel as kernel
 
-    whole = compensate(steep_gradient_run, gradient_model)
+    whole = compensate(gradient_model, steep_gradient_run)
     monkeypatch.setattr(kernel, "PARALLEL_ROWS", 1 << 12)
-    split = compensate(steep_gradient_run, gradient_model)
+    split = compensate(gradient_model, steep_gradient_run)
     for name in OUTPUT_COLUMNS:
         np.testing.assert_array_equal(split[name], whole[name])
 
@@ -289,13 +291,13 @@ def test_fused_gradient_through_the_slow_path_of_the_thermometer(gradient_model,
     from hrgtc.compensate import _kernel as kernel
 
     compensator = Compensator(gradient_model)
-    plan = kernel.plan(gradient_model.drift, THERMOMETER, compensator._variables)
+    plan = kernel.plan(gradient_model.drift, THERMOMETER, compensator.axis._variables)
     strict = plan.thermometer.copy()
     strict[10:12] = 0.0  # one_step_limit, tolerance
-    compensator._plan = dataclasses.replace(plan, thermometer=strict)
+    compensator.axis._plan = dataclasses.replace(plan, thermometer=strict)
     part = steep_gradient_run.slice(0, 3000)
     out = compensator.transform(part)
-    reference = compensate(part, gradient_model, engine="numpy")
+    reference = compensate(gradient_model, part, engine="numpy")
     np.testing.assert_allclose(out["resonator_c_est"], reference["resonator_c_est"],
                                rtol=0, atol=1e-11)
     np.testing.assert_allclose(out["bias_model_dph"], reference["bias_model_dph"],
@@ -320,8 +322,9 @@ def test_import_loads_neither_numba_nor_scipy_signal():
 def test_file_to_file_equals_batch_and_leaves_no_temporary(unit_model, run, tmp_path):
     source = recording_io.write(run, tmp_path / "run.parquet")
     output = tmp_path / "out.parquet"
-    summary = compensate_file(source, output, unit_model, chunk_rows=7_001)
-    batch = compensate(run, unit_model)
+    summary = compensate_file(source, output, unit_model,
+                              settings=CompensateSettings(chunk_rows=7_001))
+    batch = compensate(unit_model, run)
     written = recording_io.read(output)
     assert written.names == (*run.names, *OUTPUT_COLUMNS, "at_rest")  # at rest: all 1
     for name in batch.names:
@@ -338,12 +341,9 @@ def test_file_to_file_refuses_to_drop_spikes(unit_model, run, tmp_path):
     """Compensation writes every row it reads: the library refuses ``spike_filter="drop"``
     as the command does (it used to drop the spikes' rows from a library call)."""
     source = recording_io.write(run, tmp_path / "run.parquet")
-    for compensate_any in (compensate_file, compensate_instrument_file):
-        with pytest.raises(InputError, match="never drops a row: use --spike-filter flag"):
-            compensate_any(source, tmp_path / "out.parquet",
-                           InstrumentModel.single(unit_model)
-                           if compensate_any is compensate_instrument_file else unit_model,
-                           read_options=recording_io.ReadOptions(spike_filter="drop"))
+    with pytest.raises(InputError, match="never drops a row: use --spike-filter flag"):
+        compensate_file(source, tmp_path / "out.parquet", unit_model,
+                        read_options=recording_io.ReadOptions(spike_filter="drop"))
     assert sorted(p.name for p in tmp_path.iterdir()) == ["run.parquet"]
 
 
@@ -357,7 +357,8 @@ def test_file_to_file_bad_row_late_in_the_file_leaves_nothing(unit_model, tmp_pa
     source = recording_io.write(long_run.with_columns(rate_dph=rate), tmp_path / "bad.parquet")
     written = []
     with pytest.raises(RecordingError, match="rate_dph"):
-        compensate_file(source, tmp_path / "out.parquet", unit_model, chunk_rows=20_000,
+        compensate_file(source, tmp_path / "out.parquet", unit_model,
+                        settings=CompensateSettings(chunk_rows=20_000),
                         progress=lambda done, total: written.append(done),
                         read_options=recording_io.ReadOptions(motion="keep"))
     assert written and max(written) >= 120_000
@@ -375,7 +376,7 @@ def test_two_threads_give_the_bits_of_one_call(unit_model, monkeypatch):
                                  settings=dataclasses.replace(
                                      unit_model.drift.settings,
                                      scales={"f": 10.0, "df": 1e-3, "h": 20.0, "dh": 1e-2}))
-    model = UnitModel(THERMOMETER, fitted)
+    model = Model.single(AxisModel(THERMOMETER, fitted))
     split = assert_engines_agree(model, long_run)
     a = Compensator(model).transform(long_run)
     monkeypatch.setattr(kernel, "PARALLEL_ROWS", len(long_run) + 1)
@@ -383,8 +384,8 @@ def test_two_threads_give_the_bits_of_one_call(unit_model, monkeypatch):
     b = whole.transform(long_run)
     for name in OUTPUT_COLUMNS:
         np.testing.assert_array_equal(a[name], b[name])
-    assert (split.out_of_range, split.rate_out_of_range) == (whole.out_of_range,
-                                                             whole.rate_out_of_range)
+    assert (split.axis.out_of_range, split.axis.rate_out_of_range) == (
+        whole.axis.out_of_range, whole.axis.rate_out_of_range)
 
 
 def test_thermometer_beyond_the_kernel_series_falls_back_to_numpy(unit_model, run, monkeypatch):
@@ -392,8 +393,8 @@ def test_thermometer_beyond_the_kernel_series_falls_back_to_numpy(unit_model, ru
 
     monkeypatch.setattr(kernel, "POLY_SIZE", 3)  # as if the order-3 fit were order 5+
     assert not kernel.supports(THERMOMETER)
-    out = compensate(run, unit_model)
-    reference = compensate(run, unit_model, engine="numpy")
+    out = compensate(unit_model, run)
+    reference = compensate(unit_model, run, engine="numpy")
     for name in OUTPUT_COLUMNS:
         np.testing.assert_array_equal(out[name], reference[name])
 
@@ -405,10 +406,10 @@ def test_a_model_with_the_heating_switch_runs_on_numpy_in_both_engines(run):
             with_heating_extra(ramp_run(seed=32, start_c=-20.0, end_c=20.0, hours=3.0))]
     fitted = drift.fit(runs, THERMOMETER, terms=(*EQ21_TERMS, "dpos", "f*dpos"))
     assert "dpos" in fitted.variables
-    model = UnitModel(THERMOMETER, fitted)
+    model = Model.single(AxisModel(THERMOMETER, fitted))
     fused, numpy_engine = Compensator(model), Compensator(model, engine="numpy")
     a, b = fused.transform(run), numpy_engine.transform(run)
-    assert fused._plan is None  # fell back: the kernel does not compute dpos
+    assert fused.axis._plan is None  # fell back: the kernel does not compute dpos
     for name in OUTPUT_COLUMNS:
         np.testing.assert_array_equal(a[name], b[name])
     settle = round(fitted.settings.warmup_s * run.sample_rate_hz)
@@ -424,7 +425,7 @@ def test_models_with_d2_and_aux_run_on_numpy_in_both_engines():
     model = lagged_model()
     run = lagged_run(seed=12, start_c=25.0, end_c=-25.0, hours=1.0, drive_amplitude_v=0.2)
     fused = assert_engines_agree(model, run)
-    assert fused._plan is None  # it did fall back
+    assert fused.axis._plan is None  # it did fall back
     later = run.with_columns(time_s=run.time_s + run.time_s[-1] + run.time_s[1])
     out = fused.transform(later)  # a second chunk, one step later: filter states carried
     assert np.all(np.isfinite(out["rate_comp_dph"]))
@@ -457,7 +458,7 @@ def test_a_gap_exactly_on_a_chunk_boundary(unit_model, run, engine):
         for name in OUTPUT_COLUMNS:
             np.testing.assert_array_equal(np.concatenate([p[name] for p in parts]), batch[name])
         if gaps == "split":
-            assert streaming.segments == 2
+            assert streaming.axis.segments == 2
             split = batch
         else:
             bridged = batch
@@ -476,7 +477,7 @@ def test_a_step_of_exactly_two_periods_is_not_a_gap(unit_model, run):
     dropped = run.with_columns(time_s=times)
     compensator = Compensator(unit_model, gaps="split")
     compensator.transform(dropped)
-    assert compensator.segments == 1
+    assert compensator.axis.segments == 1
 
 
 @pytest.mark.parametrize("engine", ["fused", "numpy"])
@@ -494,7 +495,7 @@ def test_the_seen_f_and_df_extremes_are_those_of_the_variables(unit_model, run, 
     compensator.transform(run.slice(0, 12_345))
     compensator.transform(run.slice(12_345, len(run)))
     expected = [values["f"].min(), values["f"].max(), values["df"].min(), values["df"].max()]
-    np.testing.assert_allclose(compensator._extremes, expected, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(compensator.axis._extremes, expected, rtol=1e-12, atol=1e-15)
 
 
 @pytest.mark.parametrize("suffix", ["parquet", "csv", "h5"])
@@ -509,7 +510,7 @@ def test_the_output_carries_the_restarts_of_every_chunk(unit_model, run, tmp_pat
     restarts = recording_io.read(source, gaps="bridge").metadata.extra["restarts_s"]
     assert len(restarts) == 1
     out = tmp_path / f"out.{suffix}"
-    compensate_file(source, out, unit_model, chunk_rows=10_000,
+    compensate_file(source, out, unit_model, settings=CompensateSettings(chunk_rows=10_000),
                     read_options=recording_io.ReadOptions(gaps="bridge"))
     written = recording_io.read(out, gaps="bridge")
     assert written.metadata.extra["restarts_s"] == pytest.approx(restarts, rel=0, abs=1e-9)
@@ -538,7 +539,8 @@ def test_samples_not_at_rest_are_flagged_as_run_rest_finds_them(unit_model, run,
         rate[inside] += 40_000.0 * np.sin(np.pi * (t[inside] - start_s) / 5.0)
         truth |= inside
     source = recording_io.write(run.with_columns(rate_dph=rate), tmp_path / "handled.parquet")
-    summary = compensate_file(source, tmp_path / "out.parquet", unit_model, chunk_rows=7_000)
+    summary = compensate_file(source, tmp_path / "out.parquet", unit_model,
+                              settings=CompensateSettings(chunk_rows=7_000))
     out = recording_io.read(tmp_path / "out.parquet")
     expected = run_rest(recording_io.ReadOptions().chunks(source), "exclude").keep
     assert len(out) == len(run)  # nothing dropped
@@ -564,7 +566,8 @@ def test_a_bad_sample_gets_the_validators_error_whatever_the_motion_pass(unit_mo
     errors = []
     for motion in ("keep", "exclude"):
         with pytest.raises(RecordingError) as caught:
-            compensate_file(source, tmp_path / f"{motion}.parquet", unit_model, chunk_rows=7_000,
+            compensate_file(source, tmp_path / f"{motion}.parquet", unit_model,
+                            settings=CompensateSettings(chunk_rows=7_000),
                             read_options=recording_io.ReadOptions(motion=motion))
         errors.append(str(caught.value))
     assert errors[0] == errors[1]

@@ -25,7 +25,7 @@ from hrgtc import drift
 from hrgtc.cli import app
 from hrgtc.compensate import Compensator
 from hrgtc.drift.features import FeatureStream
-from hrgtc.model import UnitModel
+from hrgtc.model import AxisModel, Model
 from hrgtc.simulate import cooldown
 from hrgtc.simulate.logged_files import write_logged
 from hrgtc.simulate.logger import Logger, log_run
@@ -116,7 +116,7 @@ def test_trained_ranges_are_the_extremes_of_the_used_samples(seed):
     """f's and df's ranges are the extremes of the samples after the warm-up (not of window
     means), so the model's own run is inside them to the last bit, in both engines."""
     run = ramp_run(seed=seed)
-    model = UnitModel(thermometer=THERMOMETER, drift=drift.fit([run], THERMOMETER))
+    model = Model.single(AxisModel(thermometer=THERMOMETER, drift=drift.fit([run], THERMOMETER)))
     fitted = model.drift
     values = FeatureStream(fitted.settings, ("f", "df")).transform(run)
     used = run.time_s - run.time_s[0] >= fitted.settings.warmup_s
@@ -125,6 +125,7 @@ def test_trained_ranges_are_the_extremes_of_the_used_samples(seed):
     for engine in ("fused", "numpy"):
         compensator = Compensator(model, engine=engine)
         out = compensator.transform(run)
-        assert compensator.out_of_range == 0 and compensator.rate_out_of_range == 0, engine
-        assert compensator.settling == int(np.count_nonzero(~used))
+        assert compensator.axis.out_of_range == 0, engine
+        assert compensator.axis.rate_out_of_range == 0, engine
+        assert compensator.axis.settling == int(np.count_nonzero(~used))
         assert np.array_equal(out["in_range"] == 1.0, used), engine

@@ -19,7 +19,7 @@ from hrgtc import drift
 from hrgtc.compensate import Compensator
 from hrgtc.compensate.ranges import RangeReport
 from hrgtc.drift.features import FeatureStream
-from hrgtc.model import UnitModel
+from hrgtc.model import AxisModel, Model
 
 from synthetic import THERMOMETER, lagged_run, ramp_run
 
@@ -29,12 +29,13 @@ def gradient_model():
     terms = ("f", "df", "g")
     runs = [lagged_run(seed=5), lagged_run(seed=6, start_c=-20.0, end_c=20.0)]
     fitted = drift.fit(runs, THERMOMETER, terms=terms, initial=terms, premove=0.999999)
-    return UnitModel(thermometer=THERMOMETER, drift=fitted, unit="gradient")
+    return Model.single(AxisModel(thermometer=THERMOMETER, drift=fitted), unit="gradient")
 
 
 @pytest.fixture(scope="module")
 def unit_model():
-    return UnitModel(thermometer=THERMOMETER, drift=drift.fit([ramp_run(seed=1)], THERMOMETER))
+    return Model.single(
+        AxisModel(thermometer=THERMOMETER, drift=drift.fit([ramp_run(seed=1)], THERMOMETER)))
 
 
 def hot_housing(model, hours=1.5):
@@ -90,11 +91,11 @@ def test_the_engines_count_every_variable_alike(gradient_model, hours):
     for c in (a, b):
         c.transform(run.slice(0, 20_000))
         c.transform(run.slice(20_000, len(run)))
-    assert a._plan is not None  # the kernel did run
-    assert a.temperature_out == b.temperature_out
-    for name, (outside, low, high) in b.variable_ranges.items():
-        assert a.variable_ranges[name][0] == outside, name
-        assert a.variable_ranges[name][1:] == pytest.approx([low, high], rel=1e-12), name
+    assert a.axis._plan is not None  # the kernel did run
+    assert a.axis.temperature_out == b.axis.temperature_out
+    for name, (outside, low, high) in b.axis.variable_ranges.items():
+        assert a.axis.variable_ranges[name][0] == outside, name
+        assert a.axis.variable_ranges[name][1:] == pytest.approx([low, high], rel=1e-12), name
 
 
 def test_rates_in_degrees_per_hour_are_the_simulated_ones(unit_model):
@@ -142,7 +143,7 @@ def test_samples_at_the_lower_calibration_edge_are_flagged_in_range(unit_model, 
     settings = unit_model.drift.settings
     # f's training range widened past the calibration, so the calibrated edge decides
     f_range = (f_low - settings.reference_freq_hz - 1.0, unit_model.drift.ranges["f"][1])
-    wide = dataclasses.replace(unit_model, drift=dataclasses.replace(
+    wide = unit_model.with_parts(drift=dataclasses.replace(
         unit_model.drift, ranges={**unit_model.drift.ranges, "f": f_range,
                                   "df": (-1.0, 1.0)}))
     for freq, expected in ((f_low, 1.0), (np.nextafter(f_low, -np.inf), 0.0)):
@@ -153,8 +154,9 @@ def test_samples_at_the_lower_calibration_edge_are_flagged_in_range(unit_model, 
         out = compensator.transform(run)
         assert (out["in_range"][-100:] == expected).all(), (freq, expected)
         # counted on the settled samples only (the settling ones as such)
-        assert compensator.temperature_out == (0 if expected else rows - compensator.settling)
-        assert 0 < compensator.settling < rows
+        settling = compensator.axis.settling
+        assert compensator.axis.temperature_out == (0 if expected else rows - settling)
+        assert 0 < compensator.axis.settling < rows
 
 
 # -- mutants of ranges.py that no test killed (make mutation, issue 21) ----------------------

@@ -50,9 +50,9 @@ def test_plain_leaves_other_text_alone():
 def test_a_sample_of_real_errors_has_no_numpy_repr():
     """Errors of the reading, drift, compensation and simulation packages raised with numpy
     scalars where users pass them (a value from an array) say plain numbers."""
-    from hrgtc.compensate.multi_axis import InstrumentCompensator
+    from hrgtc.compensate import Compensator
     from hrgtc.drift.features import parse_term
-    from hrgtc.model import InstrumentModel
+    from hrgtc.model import Model
     from hrgtc.recording import Metadata, Recording
     from hrgtc.simulate.standard_profiles import cooldown
 
@@ -69,7 +69,7 @@ def test_a_sample_of_real_errors_has_no_numpy_repr():
         messages.append(str(raised.value))
     run = make_run(rows=200)
     columns = {"time_s": run.time_s, "freq_hz_x": run.freq_hz * 3.0, "rate_dph_x": run.rate_dph}
-    compensator = InstrumentCompensator(InstrumentModel({"x": make_model()}),
+    compensator = Compensator(Model({"x": make_model().axis}),
                                         bands_hz={"x": (4000.0, 5000.0)})
     with pytest.raises(HrgtcError) as raised:
         compensator.transform(Recording(columns, run.metadata))

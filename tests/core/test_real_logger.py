@@ -19,7 +19,7 @@ from hrgtc.core.errors import CalibrationError
 from hrgtc.core.timeline import Timeline
 from hrgtc.drift.features import FeatureSettings, parse_terms
 from hrgtc.drift.windows import window_means
-from hrgtc.model import load_instrument
+from hrgtc.model import load_model
 from hrgtc.recording import ReadOptions
 
 PAN = Path(__file__).resolve().parents[1] / "data" / "pan-cold-test" / "pan_tvc_cold_2020-03-07.csv"
@@ -151,9 +151,9 @@ def test_compensate_flags_the_first_warmup_seconds_not_samples_on_a_burst_file(t
     text = runner.invoke(app, ["compensate", str(PAN), "--model", str(model), *ARGS, "--gaps",
                                "bridge", "-o", str(tmp_path / "t.parquet")]).stdout
     assert "samples: 6250 read, 6250 used, flagged 250 warm-up" in " ".join(text.split())
-    unit = load_instrument(model).axes["x"]
+    unit = load_model(model).of_axis("x")
     for engine in ("fused", "numpy"):  # the kernel and the numpy reference agree
         compensator = Compensator(unit, engine=engine, gaps="bridge")
         flags = compensator.transform(run)["in_range"]
-        assert compensator.settling == by_hand, engine
+        assert compensator.axis.settling == by_hand, engine
         assert not flags[:by_hand].any()

@@ -148,7 +148,7 @@ def _pairs():
     from hrgtc.drift.scale_factor import ScaleFactorRecord, ScaleGroup, ScaleGroupRecord
     from hrgtc.drift.stepwise import Step, StepRecord, StepwiseRecord, StepwiseResult
     from hrgtc.drift.training import TrainingStatistics, TrainingStatisticsRecord
-    from hrgtc.model import UnitModel
+    from hrgtc.model import Model
     from hrgtc.model_schema import AxisRecord
 
     # (result, record, the result's fields a file does not hold)
@@ -162,7 +162,7 @@ def _pairs():
             (StepwiseResult, StepwiseRecord, set()),
             (OLSResult, OLSResultRecord, set()),
             (CrossValidation, CrossValidationRecord, {"sources"}),  # the keys of per_run_dph
-            (UnitModel, AxisRecord, {"unit", "provenance"})]  # the file's, not the axis's
+            (Model, AxisRecord, {"unit", "provenance"})]  # the file's, not the axis's
 
 
 @pytest.mark.parametrize("result, record, left_out", _pairs(),

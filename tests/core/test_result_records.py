@@ -22,7 +22,7 @@ import pytest
 from hrgtc.core import records
 from hrgtc.core.errors import InputError, RecordingError
 from hrgtc.fleet.tasks import ErrorRecord, UnitOutcome, UnitOutcomeRecord, failed
-from hrgtc.model import InstrumentModel, load_instrument
+from hrgtc.model import Model, load_model
 from hrgtc.model_schema import FileRecord, axis_parts
 from hrgtc.thermometry import fit, paper
 from hrgtc.thermometry.paper import ReproductionRecord
@@ -76,7 +76,7 @@ def test_golden_plateaus_and_map_round_trip_exactly(path):
 @pytest.mark.parametrize("path", GOLDEN, ids=IDS)
 def test_model_file_fields_come_from_the_file_record(path):
     document = json.loads(path.read_text())
-    model = load_instrument(path)
+    model = load_model(path)
     written = model.to_dict()
     # the file's own fields in FileRecord's order, one axis at the place of axes
     own = [k for k in written if k in FileRecord.__struct_fields__]
@@ -85,7 +85,7 @@ def test_model_file_fields_come_from_the_file_record(path):
     assert list(written)[-1] == ("temperature_map" if "temperature_map" in document
                                  else "provenance")
     assert written["provenance"] == document["provenance"]
-    again = InstrumentModel.from_dict(written)
+    again = Model.from_dict(written)
     assert again.to_dict() == written
 
 

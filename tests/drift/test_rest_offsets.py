@@ -172,12 +172,13 @@ def test_guarded_selection_does_not_extrapolate_high_order_terms():
 def test_compensation_applies_known_orientations_and_reports_an_unknown_one():
     from hrgtc.compensate import Compensator
     from hrgtc.core.errors import HrgtcWarning
-    from hrgtc.model import UnitModel
+    from hrgtc.model import AxisModel, Model
 
     orientations = ([300.0, -200.0, 100.0], [[0, 0, 1], [1, 0, 0], [0, -1, 0]])
     run, _ = mems_run(2, orientations=orientations)
-    model = UnitModel(thermometer=THERMOMETER, unit="mems",
-                      drift=quiet_fit([run], THERMOMETER, terms=("f", "f^2", "df")))
+    model = Model.single(
+        AxisModel(thermometer=THERMOMETER, drift=quiet_fit([run], THERMOMETER, terms=("f", "f^2",
+            "df"))), unit="mems")
     later, _ = mems_run(7, orientations=orientations)
     out = Compensator(model).transform(later)
     residual = out["bias_model_dph"] - later["bias_dph"]
@@ -189,14 +190,14 @@ def test_compensation_applies_known_orientations_and_reports_an_unknown_one():
     compensator = Compensator(model)
     with pytest.warns(HrgtcWarning, match="never seen in training"):
         compensator.transform(turned)
-    assert compensator.unknown_orientation == len(turned)
+    assert compensator.axis.unknown_orientation == len(turned)
     # a mask of the samples at rest (the motion detector's) leaves the others out of the
     # count: a unit mid-rotation is in no orientation; the rest are still reported
     at_rest = np.arange(len(turned)) % 3 != 0
     compensator = Compensator(model)
     with pytest.warns(HrgtcWarning, match="never seen in training"):
         masked = compensator.transform(turned, at_rest)
-    assert compensator.unknown_orientation == np.count_nonzero(at_rest)
+    assert compensator.axis.unknown_orientation == np.count_nonzero(at_rest)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", HrgtcWarning)
         unmasked = Compensator(model).transform(turned)
@@ -206,7 +207,7 @@ def test_compensation_applies_known_orientations_and_reports_an_unknown_one():
     with warnings.catch_warnings():
         warnings.simplefilter("error", HrgtcWarning)
         compensator.transform(turned, np.zeros(len(turned), dtype=bool))
-    assert compensator.unknown_orientation == 0
+    assert compensator.axis.unknown_orientation == 0
 
 
 def test_windows_never_span_left_out_samples_across_chunks():
@@ -253,9 +254,9 @@ def test_user_orientation_labels_give_an_offset_each_like_an_hrg_turned_on_its_t
         pytest.approx(12.0, abs=0.2)
     # compensation reads the label; a label never trained is unknown, counted, not guessed
     from hrgtc.compensate import Compensator
-    from hrgtc.model import UnitModel
+    from hrgtc.model import AxisModel, Model
 
-    unit = UnitModel(thermometer=THERMOMETER, drift=model, unit="hrg")
+    unit = Model.single(AxisModel(thermometer=THERMOMETER, drift=model), unit="hrg")
     out = Compensator(unit).transform(run)
     step = out["rate_comp_dph"][label == 2.0].mean() - out["rate_comp_dph"][label == 1.0].mean()
     assert abs(step) < 0.2  # the 12 °/h step is taken out
@@ -264,4 +265,4 @@ def test_user_orientation_labels_give_an_offset_each_like_an_hrg_turned_on_its_t
     compensator = Compensator(unit)
     with pytest.warns(UserWarning, match="never seen in training"):
         compensator.transform(relabelled)
-    assert compensator.unknown_orientation == len(run)
+    assert compensator.axis.unknown_orientation == len(run)

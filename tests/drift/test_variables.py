@@ -40,7 +40,7 @@ from hrgtc.export.c.plan import plan_for
 from hrgtc.export.c.variables import step_inputs
 from hrgtc.export.export_c import export_c
 from hrgtc.export.parameter_file import parameter_text
-from hrgtc.model import UnitModel
+from hrgtc.model import AxisModel, Model
 
 from synthetic import THERMOMETER, lagged_run, with_heating_extra
 
@@ -60,10 +60,10 @@ def _terms(name: str) -> tuple[str, ...]:
     return ("f", "f^2", "df") if used in ("f", "df") else ("f", "df", used)
 
 
-_MODELS: dict[str, UnitModel] = {}
+_MODELS: dict[str, Model] = {}
 
 
-def model_using(name: str) -> UnitModel:
+def model_using(name: str) -> Model:
     """A unit model fitted on a cool-down and a warm-up whose terms use ``name``."""
     if name not in _MODELS:
         runs = [lagged_run(seed=5), lagged_run(seed=6, start_c=-20.0, end_c=20.0)]
@@ -73,7 +73,8 @@ def model_using(name: str) -> UnitModel:
         fitted = drift.fit(runs, THERMOMETER, terms=terms, initial=terms, premove=0.999999,
                            options={"rate_tau2_s": 120.0}, aux_columns={"drive": "drive_v"})
         assert set(fitted.selected) == set(terms)
-        _MODELS[name] = UnitModel(thermometer=THERMOMETER, drift=fitted, unit=f"uses-{name}")
+        _MODELS[name] = Model.single(
+            AxisModel(thermometer=THERMOMETER, drift=fitted), unit=f"uses-{name}")
     return _MODELS[name]
 
 
@@ -225,7 +226,7 @@ def test_the_numba_kernel_computes_or_hands_over_to_numpy(name):
     fused = Compensator(model, engine="fused")
     got = fused.transform(held_out())
     # the kernel ran exactly when the list says it computes the variable
-    assert (fused._plan is not None) == variable(name).supports("numba")
+    assert (fused.axis._plan is not None) == variable(name).supports("numba")
     np.testing.assert_allclose(got["bias_model_dph"], expected["bias_model_dph"], rtol=1e-9,
                                atol=1e-9 * np.max(np.abs(expected["bias_model_dph"])))
     np.testing.assert_array_equal(got["in_range"], expected["in_range"])

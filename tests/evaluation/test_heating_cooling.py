@@ -10,7 +10,7 @@ from hrgtc import drift
 from hrgtc.drift.features import FeatureStream, causal_rate
 from hrgtc.evaluation import evaluate
 from hrgtc.evaluation.heating_cooling import DirectionSplit
-from hrgtc.model import UnitModel
+from hrgtc.model import AxisModel, Model
 from hrgtc.recording import Metadata, Recording
 from hrgtc.settings.compensation import EvaluationSettings
 
@@ -42,7 +42,7 @@ def cycle_run(seed, heating_extra_dph_per_c_per_h=0.0):
 def model():
     runs = [ramp_run(seed=31, hours=4.0, sample_rate_hz=FS),
             ramp_run(seed=32, start_c=-20.0, end_c=20.0, hours=4.0, sample_rate_hz=FS)]
-    return UnitModel(THERMOMETER, drift.fit(runs, THERMOMETER), unit="synthetic")
+    return Model.single(AxisModel(THERMOMETER, drift.fit(runs, THERMOMETER)), unit="synthetic")
 
 
 def test_split_by_hand_and_by_the_resonator_temperature(model):

@@ -11,7 +11,7 @@ from hrgtc import drift
 from hrgtc.compensate import Compensator
 from hrgtc.drift.features import settle_rows
 from hrgtc.evaluation import evaluate
-from hrgtc.model import UnitModel
+from hrgtc.model import AxisModel, Model
 from hrgtc.recording import ReadOptions, Recording
 from hrgtc.settings.compensation import BIAS_ONLY
 
@@ -23,7 +23,7 @@ def model():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         fitted = drift.fit([ramp_run(seed=1)], THERMOMETER)
-    return UnitModel(thermometer=THERMOMETER, drift=fitted, unit="synthetic")
+    return Model.single(AxisModel(thermometer=THERMOMETER, drift=fitted), unit="synthetic")
 
 
 def test_a_constant_offset_shows_in_the_mean_not_in_the_bias_stability(model):

@@ -100,7 +100,7 @@ def test_text_rich_html_and_json_show_the_same_figures(run, monkeypatch):
     compensate_cmd.render_evaluation(result)
     rich = {cells[0]: cells[1:] for line in out.getvalue().splitlines()
             if len(cells := [c.strip() for c in line.split("│")[1:-1]]) == 4}
-    page = one_axis_page(model.axes[""] if hasattr(model, "axes") else model, [result])
+    page = one_axis_page(model, [result])
     (section,) = re.findall(r'<section id="run-1">(.*?)</section>', page, flags=re.S)
     html = {row[0]: row[1:] for row in _Tables(section).rows if len(row) == 4}
     document = result.to_dict()

@@ -79,8 +79,8 @@ def test_a_sensor_thermometer_has_no_tables(result, monkeypatch):
     import dataclasses
 
     sensor = dataclasses.replace(result.model.thermometer, source="sensor")
-    tables = dataclasses.replace(result, model=dataclasses.replace(
-        result.model, thermometer=sensor)).tables()
+    tables = dataclasses.replace(result, model=result.model.with_parts(
+        thermometer=sensor)).tables()
     assert tables.sections == () and "no Table 1" in tables.text()
 
 

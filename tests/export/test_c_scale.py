@@ -20,7 +20,7 @@ from hrgtc.compensate import Compensator
 from hrgtc.export.c.float32 import float_accuracy, float_constants, mirror_scale
 from hrgtc.export.c.plan import plan_for
 from hrgtc.export.export_c import export_c
-from hrgtc.model import UnitModel
+from hrgtc.model import AxisModel, Model
 
 from synthetic import THERMOMETER, ramp_run, scale_factor, with_scale_factor
 
@@ -61,7 +61,8 @@ def model():
     fitted = drift.fit([ramp_run(seed=1)], THERMOMETER)
     # k's own reference 0.5 Hz off the drift model's: the float build shifts f by it
     sf = scale_factor(fitted.settings.reference_freq_hz + 0.5)
-    return with_scale_factor(UnitModel(thermometer=THERMOMETER, drift=fitted, unit="sf"), sf)
+    return with_scale_factor(Model.single(
+        AxisModel(thermometer=THERMOMETER, drift=fitted), unit="sf"), sf)
 
 
 def run(model, tmp_path: Path, precision: str, columns, time_s):

@@ -34,7 +34,7 @@ from hrgtc.export.c.float32 import (
 )
 from hrgtc.export.c.plan import plan_for
 from hrgtc.export.export_c import export_c
-from hrgtc.model import UnitModel
+from hrgtc.model import AxisModel, Model
 from hrgtc.thermometry import paper
 
 from synthetic import THERMOMETER, lagged_run, ramp_run
@@ -120,8 +120,9 @@ def housing_run(seed, **kwargs):
 
 @pytest.fixture(scope="module")
 def models():
-    frequency = UnitModel(thermometer=THERMOMETER, unit="synthetic-1",
-                          drift=drift.fit([ramp_run(seed=1)], THERMOMETER))
+    frequency = Model.single(
+        AxisModel(thermometer=THERMOMETER, drift=drift.fit([ramp_run(seed=1)], THERMOMETER)),
+            unit="synthetic-1")
     fitted = drift.fit([housing_run(seed=3)], THERMOMETER,
                        terms=("f", "f^2", "df", "h", "dh", "f*dh", "f^3"))
     # the default candidates with a housing thermistor (hrgtc.pipeline.calibration.GRADIENT_TERMS),
@@ -134,8 +135,10 @@ def models():
                          THERMOMETER, terms=terms, initial=terms, premove=0.999999,
                          reference_c=20.0)
     return {"frequency": frequency,
-            "housing": UnitModel(thermometer=THERMOMETER, drift=fitted, unit="synthetic-h"),
-            "gradient": UnitModel(thermometer=THERMOMETER, drift=gradient, unit="synthetic-g")}
+            "housing": Model.single(
+                AxisModel(thermometer=THERMOMETER, drift=fitted), unit="synthetic-h"),
+            "gradient": Model.single(
+                AxisModel(thermometer=THERMOMETER, drift=gradient), unit="synthetic-g")}
 
 
 def build(model, folder: Path, prefix: str) -> Path:
@@ -250,8 +253,8 @@ def test_float_build_streams_like_the_double_compensator(kind, models, tmp_path)
 
     # against the double compensator: counters, flags, and the values within the bounds
     assert counters[0] == compensator.samples
-    assert abs(counters[1] - compensator.out_of_range) <= 2  # a sample at a rounded edge
-    assert abs(counters[2] - compensator.rate_out_of_range) <= 2
+    assert abs(counters[1] - compensator.axis.out_of_range) <= 2  # a sample at a rounded edge
+    assert abs(counters[2] - compensator.axis.rate_out_of_range) <= 2
     flags = out[:, 3] * out[:, 7]
     assert 0.05 < flags.mean() < 0.95
     assert np.count_nonzero(flags != expected["in_range"]) <= 4
@@ -278,8 +281,9 @@ def test_float_filter_is_the_double_filter(jitter):
         t = t + np.random.default_rng(4).uniform(0.0, 0.4 / fs, t.size)
         t[t > 200.0] += 5.0
     f = -3.0 + np.minimum(t, 300.0) * -4e-3
-    model = UnitModel(thermometer=THERMOMETER,
-                      drift=drift.fit([ramp_run(seed=1, hours=3.0)], THERMOMETER))
+    model = Model.single(
+        AxisModel(thermometer=THERMOMETER, drift=drift.fit([ramp_run(seed=1, hours=3.0)],
+            THERMOMETER)))
     plan = plan_for(model, "single")
     constants = float_constants(model, plan)
     from dataclasses import replace

@@ -30,7 +30,7 @@ from hrgtc.compensate import Compensator
 from hrgtc.core.errors import CalibrationError, InputError, OutputExistsError
 from hrgtc.core.timeline import settle_threshold_s
 from hrgtc.export.export_c import export_c
-from hrgtc.model import UnitModel, save_model
+from hrgtc.model import AxisModel, Model, save_model
 from hrgtc.thermometry import paper
 
 from synthetic import THERMOMETER, block_std, ramp_run, with_heating_extra
@@ -159,15 +159,16 @@ def run_driver(exe: Path, columns: list[np.ndarray], folder: Path, name: str,
 
 @pytest.fixture(scope="module")
 def frequency_model():
-    return UnitModel(thermometer=THERMOMETER, drift=drift.fit([ramp_run(seed=1)], THERMOMETER),
-                     unit="synthetic-1")
+    return Model.single(
+        AxisModel(thermometer=THERMOMETER, drift=drift.fit([ramp_run(seed=1)], THERMOMETER)),
+            unit="synthetic-1")
 
 
 @pytest.fixture(scope="module")
 def housing_model():
     terms = ("f", "f^2", "df", "h", "dh", "f*dh")
     fitted = drift.fit([housing_run(seed=3)], THERMOMETER, terms=terms)
-    return UnitModel(thermometer=THERMOMETER, drift=fitted, unit="synthetic-housing")
+    return Model.single(AxisModel(thermometer=THERMOMETER, drift=fitted), unit="synthetic-housing")
 
 
 @pytest.fixture(scope="module")
@@ -196,18 +197,18 @@ def test_c_matches_the_python_compensator(kind, request, tmp_path):
     out, counters = run_driver(exe, inputs, tmp_path, "run", recording.time_s)
 
     assert out.shape[0] == len(recording)
-    assert counters == [compensator.samples, compensator.out_of_range,
-                        compensator.rate_out_of_range]
+    assert counters == [compensator.samples, compensator.axis.out_of_range,
+                        compensator.axis.rate_out_of_range]
     in_range = expected["in_range"]
     assert 0.05 < in_range.mean() < 0.95  # both branches of the flag are exercised
-    assert 0 < compensator.rate_out_of_range < len(recording)
+    assert 0 < compensator.axis.rate_out_of_range < len(recording)
     np.testing.assert_array_equal(out[:, 3] * out[:, 7], in_range)  # the file's flag: both
     assert set(np.unique(out[:, 7])) <= {0.0, 1.0}
     # counted once settled (issue 20: a settling sample is counted as such only)
     settled = recording.time_s - recording.time_s[0] >= settle_threshold_s(
         model.drift.settings.warmup_s)
-    assert compensator.settling == int(np.count_nonzero(~settled)) > 0
-    assert int(np.count_nonzero((out[:, 7] == 0.0) & settled)) == compensator.rate_out_of_range
+    assert compensator.axis.settling == int(np.count_nonzero(~settled)) > 0
+    assert int(np.count_nonzero((out[:, 7] == 0.0) & settled)) == compensator.axis.rate_out_of_range
     np.testing.assert_allclose(out[:, 0], expected["rate_comp_dph"], rtol=0, atol=1e-9)
     np.testing.assert_array_equal(out[:, 6], out[:, 0])  # return value == out->rate_comp_dph
     np.testing.assert_allclose(out[:, 1], expected["bias_model_dph"], rtol=0, atol=1e-9)
@@ -226,7 +227,7 @@ def test_edge_models_compile_cleanly_and_agree(selected, housing_model, tmp_path
     fitted = dataclasses.replace(housing_model.drift, selected=selected,
                                  scaled_coefficients=(0.7,) * len(selected),
                                  coefficients=dict.fromkeys(selected, 1.0))
-    model = UnitModel(thermometer=THERMOMETER, drift=fitted)
+    model = Model.single(AxisModel(thermometer=THERMOMETER, drift=fitted))
     recording = housing_run(seed=9, start_c=25.0, end_c=-25.0, hours=1.0)
     columns = [recording.freq_hz, recording.rate_dph]
     if model.drift.variables != ("f",):
@@ -235,8 +236,8 @@ def test_edge_models_compile_cleanly_and_agree(selected, housing_model, tmp_path
     expected = compensator.transform(recording)
     out, counters = run_driver(build(model, tmp_path, "edge"), columns, tmp_path, "run",
                                recording.time_s)
-    assert counters == [compensator.samples, compensator.out_of_range,
-                        compensator.rate_out_of_range]
+    assert counters == [compensator.samples, compensator.axis.out_of_range,
+                        compensator.axis.rate_out_of_range]
     np.testing.assert_array_equal(out[:, 3] * out[:, 7], expected["in_range"])
     np.testing.assert_allclose(out[:, 0], expected["rate_comp_dph"], rtol=0, atol=1e-9)
 
@@ -303,7 +304,7 @@ def test_bad_prefix_and_non_monotonic_thermometer(frequency_model, tmp_path):
         export_c(frequency_model, tmp_path, prefix="9lives")
     # a quadratic with its turning point at 20 °C: one frequency, two temperatures
     bent = thermometry.fit([0, 10, 20, 30, 40], [4400.0, 4401.5, 4402.0, 4401.5, 4400.0], order=2)
-    model = UnitModel(thermometer=bent, drift=frequency_model.drift)
+    model = Model.single(AxisModel(thermometer=bent, drift=frequency_model.drift))
     with pytest.raises(CalibrationError, match="not monotonic"):
         export_c(model, tmp_path)
     assert not list(tmp_path.iterdir())
@@ -342,7 +343,7 @@ def test_refuses_a_model_with_the_heating_switch(tmp_path):
     fitted = drift.fit(runs, THERMOMETER, terms=(*EQ21_TERMS, "dpos"))
     assert "dpos" in fitted.selected
     with pytest.raises(InputError, match=r"uses dpos .*heating/cooling switch"):
-        export_c(UnitModel(THERMOMETER, fitted), tmp_path / "c")
+        export_c(Model.single(AxisModel(THERMOMETER, fitted)), tmp_path / "c")
     assert not (tmp_path / "c").exists() or not any((tmp_path / "c").iterdir())
 
 
@@ -365,9 +366,9 @@ def test_c_computes_d2_g_and_the_extra_channel_as_python_does(tmp_path):
     compensator = Compensator(model)
     expected = compensator.transform(recording)
     out, counters = run_driver(exe, inputs, tmp_path, "run", recording.time_s)
-    assert counters == [compensator.samples, compensator.out_of_range,
-                        compensator.rate_out_of_range]
-    assert 0 < compensator.out_of_range < len(recording)
+    assert counters == [compensator.samples, compensator.axis.out_of_range,
+                        compensator.axis.rate_out_of_range]
+    assert 0 < compensator.axis.out_of_range < len(recording)
     np.testing.assert_array_equal(out[:, 3] * out[:, 7], expected["in_range"])
     np.testing.assert_allclose(out[:, 1], expected["bias_model_dph"], rtol=0, atol=1e-9)
     np.testing.assert_allclose(out[:, 0], expected["rate_comp_dph"], rtol=0, atol=1e-9)
@@ -387,7 +388,7 @@ def test_c_on_bursts_bridges_each_gap_with_its_dt(tmp_path):
     from hrgtc.recording import Recording
 
     fitted = drift.fit([ramp_run(seed=1, hours=8.0)], THERMOMETER, rate_tau_s=300.0)
-    model = UnitModel(thermometer=THERMOMETER, drift=fitted, unit="bursts")
+    model = Model.single(AxisModel(thermometer=THERMOMETER, drift=fitted), unit="bursts")
     continuous = ramp_run(seed=7, hours=6.0)
     continuous = continuous.with_columns(freq_hz=THERMOMETER.frequency(continuous["resonator_c"]))
     rows = np.flatnonzero(np.mod(continuous.time_s, 300.0) < 5.0 - 1e-9)

@@ -19,7 +19,7 @@ from hrgtc import drift
 from hrgtc.compensate import Compensator
 from hrgtc.core.errors import InputError
 from hrgtc.export.export_c import export_c
-from hrgtc.model import InstrumentModel, UnitModel, save_instrument
+from hrgtc.model import AxisModel, Model, save_model
 
 from synthetic import THERMOMETER, ramp_run, scale_factor, with_scale_factor
 
@@ -61,10 +61,10 @@ def imu():
     for k, name in enumerate(AXES):
         fitted = drift.fit([ramp_run(seed=11 + k)], THERMOMETER,
                            terms=("f", "f^2", "df") if k == 1 else ("f", "f^2", "df", "f*df"))
-        models[name] = UnitModel(thermometer=THERMOMETER, drift=fitted, unit="imu")
+        models[name] = AxisModel(thermometer=THERMOMETER, drift=fitted)
     models["y"] = with_scale_factor(models["y"],
                                     scale_factor(models["y"].drift.settings.reference_freq_hz))
-    return InstrumentModel(models, "imu", {})
+    return Model(models, "imu", {})
 
 
 def runs():
@@ -146,7 +146,7 @@ def test_long_axis_prefix_is_refused(imu, tmp_path):
 
 
 def test_from_the_instrument_file(imu, tmp_path):
-    path = save_instrument(imu, tmp_path / "imu.json")
+    path = save_model(imu, tmp_path / "imu.json")
     files = export_c(path, tmp_path / "c", prefix="imu")
     digest = hashlib.sha256(path.read_bytes()).hexdigest()
     for name in AXES:

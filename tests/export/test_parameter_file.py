@@ -21,7 +21,7 @@ from hrgtc import drift
 from hrgtc.compensate import Compensator
 from hrgtc.core.errors import InputError, OutputExistsError
 from hrgtc.export.export_c import export_c
-from hrgtc.model import UnitModel
+from hrgtc.model import AxisModel, Model
 from hrgtc.thermometry import paper
 
 from synthetic import THERMOMETER, ramp_run, scale_factor, with_scale_factor
@@ -126,7 +126,7 @@ def test_parameters_evaluated_by_hand_equal_the_compensator(kind, tmp_path):
     else:
         fitted = drift.fit([ramp_run(seed=1)], THERMOMETER)
         recording = ramp_run(seed=7, start_c=25.0, end_c=-25.0, hours=3.0)
-    model = UnitModel(thermometer=THERMOMETER, drift=fitted, unit="u1")
+    model = Model.single(AxisModel(thermometer=THERMOMETER, drift=fitted), unit="u1")
     (path,) = export_c(model, tmp_path, prefix="u1", output_format="params")
     assert path.name == "u1_params.txt"
     text = path.read_text()
@@ -167,7 +167,8 @@ def test_parameters_evaluated_by_hand_equal_the_compensator(kind, tmp_path):
 
 
 def test_parameter_thermometer_gives_table2(tmp_path):
-    model = UnitModel(thermometer=THERMOMETER, drift=drift.fit([ramp_run(seed=1)], THERMOMETER))
+    model = Model.single(
+        AxisModel(thermometer=THERMOMETER, drift=drift.fit([ramp_run(seed=1)], THERMOMETER)))
     (path,) = export_c(model, tmp_path, output_format="params")
     p = parse(path.read_text())
     # Table 2 of [1], printed to 3 decimals
@@ -211,7 +212,7 @@ def scale_from(p, freq_hz):
 def test_parameters_with_a_scale_factor(tmp_path):
     fitted = drift.fit([ramp_run(seed=1)], THERMOMETER)
     sf = scale_factor(fitted.settings.reference_freq_hz + 0.5)
-    model = with_scale_factor(UnitModel(thermometer=THERMOMETER, drift=fitted), sf)
+    model = with_scale_factor(Model.single(AxisModel(thermometer=THERMOMETER, drift=fitted)), sf)
     (path,) = export_c(model, tmp_path, output_format="params")
     p = parse(path.read_text())
     assert p["uses_scale_factor"] == 1.0
@@ -227,7 +228,8 @@ def test_parameters_with_a_scale_factor(tmp_path):
     np.testing.assert_allclose((recording.rate_dph - bias) / (1 + 1e-6 * k),
                                (recording.rate_dph - expected_bias) / (1 + 1e-6 * sf.ppm(
                                    recording.freq_hz)), rtol=1e-12)
-    plain = parse(export_c(UnitModel(thermometer=THERMOMETER, drift=fitted), tmp_path / "plain",
+    plain = parse(export_c(Model.single(
+        AxisModel(thermometer=THERMOMETER, drift=fitted)), tmp_path / "plain",
                            output_format="params")[0].read_text())
     assert plain["uses_scale_factor"] == 0.0 and "sf_intercept_ppm" not in plain
 
@@ -243,7 +245,7 @@ def test_params_export_of_every_model_the_demo_writes(paper_campaign, imu_campai
 
     from hrgtc.cli import app
     from hrgtc.core.errors import HrgtcWarning
-    from hrgtc.model import save_instrument, save_model
+    from hrgtc.model import save_model
     from hrgtc.pipeline.calibration import calibrate
     from hrgtc.pipeline.instrument import calibrate_instrument
 
@@ -256,7 +258,7 @@ def test_params_export_of_every_model_the_demo_writes(paper_campaign, imu_campai
                                           rate_tables=[imu.rate_table],
                                           validate_rate_tables=[imu.rate_table_heldout]).model
     paths = [save_model(unit, tmp_path / "paper-unit.json"),
-             save_instrument(instrument, tmp_path / "imu-3.json")]
+             save_model(instrument, tmp_path / "imu-3.json")]
     used = set(unit.drift.variables).union(*(a.drift.variables for a in instrument.axes.values()))
     # calibration records its training data's statistics, per axis (issue 21, Deliver 2)
     for model in (unit, *instrument.axes.values()):
@@ -288,7 +290,7 @@ def test_exports_say_the_orientation_offsets_they_do_not_apply(tmp_path):
               / "unit-sensor-thermometer-ee60050.json")
     model = load_model(golden)
     offsets = {"orientation 0": 136.5, "orientation 1": -96.9, "orientation 2": -399.6}
-    turned = dataclasses.replace(model, drift=dataclasses.replace(
+    turned = model.with_parts(drift=dataclasses.replace(
         model.drift, offset_mode="orientation", offsets_dph=offsets,
         orientations=((0.0, 0.0, 1.0), (0.0, 1.0, 0.0), (-1.0, 0.0, 0.0))))
     path = save_model(turned, tmp_path / "turned.json")

@@ -274,7 +274,7 @@ def test_sensor_thermometer_on_a_messy_imu_log(campaign_factory, tmp_path):
     result = calibrate_instrument([tmp_path / f"soak{k}.csv" for k in range(len(soaks))],
                                   [tmp_path / "cool.csv"], [tmp_path / "warm.csv"],
                                   thermometer="sensor", read_options=options)
-    model = result.model.axes[""]
+    model = result.model
     assert model.thermometer.source == "sensor"
     low, high = model.thermometer.temperature_range_c
     assert -20.5 < low < -19.5 and 39.5 < high < 40.5  # the training runs' temperatures

@@ -19,7 +19,7 @@ from typer.testing import CliRunner
 
 from hrgtc.cli import app
 from hrgtc.evaluation import evaluate
-from hrgtc.model import load_instrument
+from hrgtc.model import load_model
 from hrgtc.pipeline.instrument import calibrate_instrument, evaluate_instrument
 from hrgtc.recording import ReadOptions
 from hrgtc.simulate import simulate_files
@@ -40,9 +40,9 @@ def _campaign(folder: Path, unit: str) -> dict:
              "warm": Path(warm[0].path)}
     calibration = calibrate_instrument(files["soaks"], [files["cool"]], [files["warm"]])
     files["model"] = folder / "model.json"
-    from hrgtc.model import save_instrument
+    from hrgtc.model import save_model
 
-    save_instrument(calibration.model, files["model"])
+    save_model(calibration.model, files["model"])
     return files
 
 
@@ -89,13 +89,13 @@ def test_compensate_reads_the_run_once(campaign):
 def test_evaluate_instrument_equals_the_per_axis_evaluation(campaign):
     """The one reading gives each axis the figures of the old per-axis evaluate (which
     read the axis's view of the file), to 1e-12."""
-    model = load_instrument(campaign["model"])
+    model = load_model(campaign["model"])
     options = ReadOptions().with_spike_default("drop")
     together = evaluate_instrument(campaign["warm"], model, read_options=options,
                                    max_points=2000)
     assert list(together.axes) == list(model.axes)
-    for axis, unit in model.axes.items():
-        alone = evaluate(campaign["warm"], unit, max_points=2000,
+    for axis in model.axes:
+        alone = evaluate(campaign["warm"], model.of_axis(axis), max_points=2000,
                          read_options=dataclasses.replace(options, axis=axis or None))
         one = together.axes[axis]
         assert one.n_samples == alone.n_samples and one.n_not_at_rest == alone.n_not_at_rest

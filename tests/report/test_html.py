@@ -184,7 +184,7 @@ def test_bias_stability_table_against_numpy(unit, report):
     files, model, _ = unit
     _, _, page, _ = report
     run = recording.read(files.cooldown)
-    compensated = compensate(run, model)
+    compensated = compensate(model, run)
     m = round(10 * run.sample_rate_hz)
     settle = round(model.drift.settings.warmup_s * run.sample_rate_hz)  # the filter settling
     n = (len(run) - settle) // m
@@ -234,7 +234,7 @@ def test_block_means_do_not_depend_on_chunking(unit):
 
 
 def test_refuses_to_overwrite_without_force(unit, tmp_path):
-    model = dataclasses.replace(unit[1], plateaus=())  # no figures: fast
+    model = unit[1].with_parts(plateaus=())  # no figures: fast
     output = tmp_path / "report.html"
     output.write_text("keep me")
     with pytest.raises(OutputExistsError, match="--force"):

@@ -123,7 +123,7 @@ def test_what_the_page_shows_is_escaped(unit, tmp_path):
     evil = "<script>alert(1)<script>"
     run = tmp_path / f"{evil}.parquet"
     run.write_bytes(files.warmup.read_bytes())
-    model = dataclasses.replace(model, unit=f"{evil}&", plateaus=())
+    model = dataclasses.replace(model.with_parts(plateaus=()), unit=f"{evil}&")
     output = build_report(model, [run], tmp_path / "report.html", soaks=[],
                           title=f"{evil} report")
     text = output.read_text(encoding="utf-8")

@@ -94,7 +94,7 @@ def calibrate_command(
     hrgtc calibrate --thermometer sensor --drift cooldown.csv --drift warmup.csv -o imu.json
     """
     from hrgtc.core.files import check_writable, refuse_existing, refuse_input
-    from hrgtc.model import save_instrument
+    from hrgtc.model import save_model
     from hrgtc.pipeline.instrument import calibrate_instrument
     from hrgtc.pipeline.terms import parse_aux
     from hrgtc.recording import ReadOptions
@@ -132,7 +132,7 @@ def calibrate_command(
             rate_tables=rate_table or (), validate_rate_tables=validate_rate_table or (),
             segment_table=segments, temperature_reference=reference,
         )
-        save_instrument(calibration.model, output, force=force)
+        save_model(calibration.model, output, force=force)
     if json_output:
         print_json({**calibration.document(), "model_file": str(output)})
     else:
@@ -172,7 +172,8 @@ def render_instrument(calibration: InstrumentCalibration) -> None:
         if axis:
             console.rule(f"axis {axis}")
         model = calibration.model.axes[axis]
-        render(replace(result, model=model, validation=calibration.validation.get(axis, ())),
+        render(replace(result, model=calibration.model.of_axis(axis),
+                       validation=calibration.validation.get(axis, ())),
                calibration.model.temperature_map)
         if model.scale_factor is not None:
             print_summary(model.scale_factor.summary(), console)

@@ -28,12 +28,12 @@ from hrgtc.settings.compensation import CompensateSettings, EvaluationSettings
 if TYPE_CHECKING:
     from hrgtc.compensate.ranges import RangeReport
     from hrgtc.evaluation import Evaluation
-    from hrgtc.model import InstrumentModel
+    from hrgtc.model import Model
     from hrgtc.pipeline.instrument import InstrumentEvaluation
     from hrgtc.recording import ReadOptions
 
 
-def note_unchecked(model: InstrumentModel, model_path: Path) -> None:
+def note_unchecked(model: Model, model_path: Path) -> None:
     """Say once, on stderr after the work, that an older model file has no training
     statistics, so the recording's rate unit was not checked against them."""
     if any(unit.training is None for unit in model.axes.values()):
@@ -91,21 +91,19 @@ def compensate_command(
 
     Example: hrgtc compensate warmup.parquet --model unit.json -o warmup_comp.parquet
     """
-    from hrgtc.compensate import compensate_instrument_file
+    from hrgtc.compensate import compensate_file
     from hrgtc.compensate.multi_axis import parse_axes
     from hrgtc.core.files import refuse_input
-    from hrgtc.model import load_instrument
+    from hrgtc.model import load_model
     from hrgtc.recording import ReadOptions
 
     inputs = (inputs or ReadOptions()).with_spike_default("flag")
     with library_errors(), progress_bar("compensating", enabled=not json_output) as progress:
         refuse_input(output, [run, model_path])
-        model = load_instrument(model_path)
-        summary = compensate_instrument_file(run, output, model, force=force,
-                                             settings=CompensateSettings(chunk_rows),
-                                             progress=progress,
-                                             read_options=inputs, axes=parse_axes(axes),
-                                             model_source=str(model_path))
+        model = load_model(model_path)
+        summary = compensate_file(run, output, model_path, force=force,
+                                  settings=CompensateSettings(chunk_rows), progress=progress,
+                                  read_options=inputs, axes=parse_axes(axes))
     if json_output:
         print_json(summary.to_dict())
     else:
@@ -165,7 +163,7 @@ def evaluate_command(
     from hrgtc.compensate.multi_axis import parse_axes
     from hrgtc.core.files import refuse_existing, refuse_input, write_text_atomic
     from hrgtc.evaluation.run_pass import DEVIATIONS
-    from hrgtc.model import load_instrument
+    from hrgtc.model import load_model
     from hrgtc.pipeline.instrument import evaluate_instrument
     from hrgtc.recording import ReadOptions
 
@@ -178,7 +176,7 @@ def evaluate_command(
         if allan_csv is not None:
             refuse_input(allan_csv, [run, model_path])
             refuse_existing(allan_csv, force)
-        model = load_instrument(model_path)
+        model = load_model(model_path)
         with progress_bar("evaluating", enabled=not json_output) as progress:
             result = evaluate_instrument(
                 run, model, axes=parse_axes(axes), read_options=inputs,

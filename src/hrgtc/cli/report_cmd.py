@@ -42,7 +42,7 @@ def report_command(
     from hrgtc.cli.compensate_cmd import note_unchecked
     from hrgtc.compensate.multi_axis import parse_axes
     from hrgtc.core.files import check_writable, refuse_existing, refuse_input
-    from hrgtc.model import load_instrument
+    from hrgtc.model import load_model
     from hrgtc.report import build_report
 
     with library_errors(), progress_bar("report", enabled=not json_output) as progress:
@@ -52,7 +52,7 @@ def report_command(
         path = build_report(model, runs, output, soaks=soak or None, title=title,
                             force=force, max_points=max_points, progress=progress,
                             read_options=inputs, axes=parse_axes(axes))
-        loaded = load_instrument(model)
+        loaded = load_model(model)
     note_unchecked(loaded, model)
     size = path.stat().st_size
     if json_output:

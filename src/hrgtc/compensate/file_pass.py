@@ -1,18 +1,17 @@
 """Compensation of a file into a new file, chunk by chunk in bounded memory.
 
 :func:`compensate_file` streams a recording through a
-:class:`~hrgtc.compensate.compensator.Compensator` (or an instrument's
-:class:`~hrgtc.compensate.multi_axis.InstrumentCompensator`) with reading, compensating
-and writing overlapped; the output is marked as compensated by its model
+:class:`~hrgtc.compensate.compensator.Compensator` (every axis of the model) with
+reading, compensating and writing overlapped; the output is marked as compensated by its model
 (:func:`compensated_metadata`), carries the restarts of every chunk, and what was read,
 dropped and flagged is counted (:func:`compensation_accounting`).
 """
 
 from __future__ import annotations
 
-import copy
 import dataclasses
 import os
+from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Any
@@ -21,7 +20,8 @@ import numpy as np
 
 from hrgtc import recording as rec_io
 from hrgtc.compensate.at_rest import DETECTOR_COLUMNS, FlagsMisaligned, RestFlags
-from hrgtc.compensate.compensator import Compensator, output_columns
+from hrgtc.compensate.compensator import Compensator
+from hrgtc.compensate.multi_axis import match_axes, recording_axes
 from hrgtc.compensate.ranges import RangeReport
 from hrgtc.core.accounting import Accounting
 from hrgtc.core.errors import InputError
@@ -29,8 +29,13 @@ from hrgtc.core.files import check_writable, refuse_input
 from hrgtc.core.progress import Progress
 from hrgtc.core.time_steps import TimeRepairStream
 from hrgtc.core.timeline import RESTARTS_KEY
-from hrgtc.model import InstrumentModel, UnitModel
-from hrgtc.model_fit import check_recording_noise, with_model_band
+from hrgtc.model import Model, load_model
+from hrgtc.model_fit import (
+    check_recording_noise,
+    check_thermometer_kind,
+    plausible_frequency_band,
+    with_model_band,
+)
 from hrgtc.recording import Recording
 from hrgtc.recording.marks import COMPENSATED_KEY, mark, refuse_compensated
 from hrgtc.recording.spikes import SPIKE_COLUMN
@@ -71,22 +76,25 @@ class CompensationSummary:
 def compensate_file(
     source: str | os.PathLike[str],
     output: str | os.PathLike[str],
-    model: UnitModel,
+    model: Model | str | os.PathLike[str],
     *,
-    force: bool = False,
-    read_options: rec_io.ReadOptions | None = None,
-    chunk_rows: int = FILE_CHUNK_ROWS,
     drift: str = "frequency",
+    read_options: rec_io.ReadOptions | None = None,
+    axes: Sequence[str] | None = None,
+    force: bool = False,
+    settings: CompensateSettings | None = None,
     progress: Progress | None = None,
-    compensator: Any = None,
 ) -> CompensationSummary:
-    """Compensate a recording file into a new file, chunk by chunk (bounded memory).
+    """Compensate every axis of a recording file into a new file, chunk by chunk (bounded
+    memory).
 
-    ``compensator``: another streaming compensator with the interface of
-    :class:`Compensator` and a ``columns`` attribute (e.g. the
-    :class:`~hrgtc.compensate.multi_axis.InstrumentCompensator` of every axis, see
-    :func:`~hrgtc.compensate.multi_axis.compensate_instrument_file`); ``model`` then
-    only marks the output.
+    ``model``: the :class:`~hrgtc.model.Model` (one axis or several) or its model file
+    (then named in the errors). Its temperature map (a raw count's map to °C from
+    ``calibrate --temp-ref``) is applied unless ``read_options`` give their own scale and
+    offset. The model's and the recording's axes must agree unless ``axes`` names those to
+    compensate (:func:`~hrgtc.compensate.multi_axis.match_axes`); each frequency is
+    checked against its axis's plausible band. ``settings``: the chunk size
+    (:class:`~hrgtc.settings.compensation.CompensateSettings` defaults when None).
 
     The output is written atomically in the format of its suffix; it is never
     overwritten without ``force``. ``read_options`` says how to read ``source``
@@ -101,47 +109,71 @@ def compensate_file(
     before the atomic rename finds one chunk left to wait for. At most three chunks
     are held at a time.
     """
-    if read_options is not None and read_options.spike_filter == "drop":
+    from hrgtc.thermometry.reference import options_with_map
+
+    model_source = ""
+    if isinstance(model, str | os.PathLike):
+        model_source, model = str(model), load_model(model)
+    chunk_rows = (settings or CompensateSettings()).chunk_rows
+    reading = options_with_map(read_options, model.temperature_map) or rec_io.ReadOptions()
+    # before reading: a model of the other thermometer kind
+    check_thermometer_kind(reading, model, model_source or None)
+    found = recording_axes(source, reading)
+    if found is not None:
+        model = match_axes(model, found, axes, str(source), model_source)
+    if reading.spike_filter == "drop":
         raise InputError("compensate flags spikes, it never drops a row: use --spike-filter "
                          "flag (a 'spike' column marks them) or off")
-    if compensator is None:
-        options = with_model_band(read_options or rec_io.ReadOptions(), model)
-        compensator = Compensator(model, drift, gaps=options.gaps)
-        added = output_columns(model)
+    bands: dict[str, tuple[float, float]] = {}
+    if "" in model.axes:  # the plain columns: the reader checks the one frequency's band
+        reading = with_model_band(reading, model)
+    else:  # each axis's band on its view, by the compensator
+        bands = {axis: plausible_frequency_band(part) for axis, part in model.axes.items()}
 
-        def spare() -> Any:
-            return Compensator(model, drift, gaps=options.gaps)
-    else:
-        options = read_options or rec_io.ReadOptions()
-        added = compensator.columns
-        # its state before any chunk, for a second run (below)
-        copied = copy.deepcopy(compensator) if options.motion == "exclude" else None
+    def fresh() -> Compensator:
+        return Compensator(model, drift, gaps=reading.gaps, bands_hz=bands, partial=bool(axes))
 
-        def spare() -> Any:
-            return copied
+    compensator = fresh()
+    job = _Job(source, output, model, reading, compensator.columns, force, chunk_rows, drift,
+               progress)
     refuse_input(output, [source])
     refuse_compensated(source)
-    check_writable(output, estimated_output_bytes(source, output, len(added)))
+    check_writable(output, estimated_output_bytes(source, output, len(job.added)))
     # the detector's pass reads its columns only, unless rows may be dropped because of
     # others (--spikes drop); --motion error names a row: read as the compensation reads
-    only = DETECTOR_COLUMNS if options.motion == "exclude" and options.spikes != "drop" else None
-    run = (source, output, model, options, added, force, chunk_rows, drift, progress)
+    only = DETECTOR_COLUMNS if reading.motion == "exclude" and reading.spikes != "drop" else None
     try:
-        return _compensate(*run, compensator, only)
+        return _compensate(job, compensator, only)
     except FlagsMisaligned:
         if only is None:
             raise
     # the rows differed (at_rest.py): none were kept; again, the pass reading every column
-    return _compensate(*run, spare(), None)
+    return _compensate(job, fresh(), None)
 
 
-def _compensate(source: str | os.PathLike[str], output: str | os.PathLike[str],
-                model: UnitModel, options: rec_io.ReadOptions, added: tuple[str, ...],
-                force: bool, chunk_rows: int, drift: str, progress: Progress | None,
-                compensator: Any, only: tuple[str, ...] | None) -> CompensationSummary:
+@dataclass(frozen=True)
+class _Job:
+    """What one pass of :func:`compensate_file` reads, writes and counts."""
+
+    source: str | os.PathLike[str]
+    output: str | os.PathLike[str]
+    model: Model
+    options: rec_io.ReadOptions
+    added: tuple[str, ...]
+    force: bool
+    chunk_rows: int
+    drift: str
+    progress: Progress | None
+
+
+def _compensate(job: _Job, compensator: Compensator,
+                only: tuple[str, ...] | None) -> CompensationSummary:
     """One run of :func:`compensate_file`, the detector's pass reading ``only`` those
     columns (None: all); raises :class:`FlagsMisaligned` before the output is kept if
     its rows were not those compensated."""
+    source, output, model, options = job.source, job.output, job.model, job.options
+    added, force, chunk_rows, drift, progress = (job.added, job.force, job.chunk_rows,
+                                                 job.drift, job.progress)
     repair = TimeRepairStream()  # what the reader dropped (duplicated rows)
     chunks = options.chunks(source, rows=chunk_rows, time_repair=repair)
     spikes = 0
@@ -156,7 +188,7 @@ def _compensate(source: str | os.PathLike[str], output: str | os.PathLike[str],
             quick = dataclasses.replace(options, spike_filter="off")
             flags = RestFlags(rec_io.iter_chunks(source, quick, rows=chunk_rows,
                                                  validate=False, only=only),
-                              list(getattr(model, "axes", None) or [""]), options.motion,
+                              list(model.axes), options.motion,
                               os.path.basename(os.fspath(source)),
                               validated=lambda: options.chunks(source, rows=chunk_rows),
                               rows=total)
@@ -175,7 +207,7 @@ def _compensate(source: str | os.PathLike[str], output: str | os.PathLike[str],
             while chunk is not None:
                 restarts.update(chunk.metadata.extra.get(RESTARTS_KEY) or ())
                 taken = None if flags is None else flags.take(chunk)
-                result = compensator.transform(chunk, _at_rest(flags, taken, compensator))
+                result = compensator.transform(chunk, _at_rest(flags, taken))
                 if taken is not None:
                     result = result.with_columns(**taken)
                 if SPIKE_COLUMN in chunk:
@@ -208,20 +240,17 @@ def _compensate(source: str | os.PathLike[str], output: str | os.PathLike[str],
                                accounting)
 
 
-def _at_rest(flags: RestFlags | None, taken: dict[str, np.ndarray] | None,
-             compensator: Any) -> Any:
-    """The at-rest mask of a chunk as ``compensator.transform`` takes it: one array for a
-    :class:`Compensator`, axis -> array for an instrument's (None without flags)."""
+def _at_rest(flags: RestFlags | None, taken: dict[str, np.ndarray] | None
+             ) -> dict[str, np.ndarray] | None:
+    """The at-rest masks of a chunk as :meth:`Compensator.transform` takes them: axis ->
+    array (None without flags)."""
     if flags is None or taken is None:
         return None
-    masks = {axis: taken[column] > 0.5 for axis, column in zip(flags.axes, flags.columns,
-                                                               strict=True)}
-    if isinstance(compensator, Compensator):
-        return masks.get("", None if len(masks) != 1 else next(iter(masks.values())))
-    return masks
+    return {axis: taken[column] > 0.5 for axis, column in zip(flags.axes, flags.columns,
+                                                              strict=True)}
 
 
-def compensation_accounting(compensator: Any, spikes: int = 0,
+def compensation_accounting(compensator: Compensator, spikes: int = 0,
                             duplicates: int = 0, not_at_rest: int = 0) -> Accounting:
     """Samples read, dropped (duplicated rows, by the reader) and flagged by reason.
 
@@ -232,21 +261,19 @@ def compensation_accounting(compensator: Any, spikes: int = 0,
     several axes, the axis with the most samples beyond its ranges (the one the
     summary line names).
     """
-    axes = getattr(compensator, "axes", None)
-    if axes:
-        compensator = max(axes.values(), key=lambda c: sum(c.ranges().shares().values()))
-    accounting = Accounting(read=compensator.samples + duplicates)
+    worst = compensator.worst()
+    accounting = Accounting(read=worst.samples + duplicates)
     accounting.drop("duplicates", duplicates)
-    accounting.flag("warmup", compensator.settling)
+    accounting.flag("warmup", worst.settling)
     accounting.flag("spikes", spikes)
     accounting.flag("motion", not_at_rest)
-    accounting.flag("out_of_range", compensator.temperature_out)
+    accounting.flag("out_of_range", worst.temperature_out)
     accounting.flag("rate_out_of_range",
-                    compensator.variable_ranges.get("df", [compensator.rate_out_of_range])[0])
+                    worst.variable_ranges.get("df", [worst.rate_out_of_range])[0])
     return accounting
 
 
-def compensated_metadata(metadata: rec_io.Metadata, model: UnitModel | InstrumentModel,
+def compensated_metadata(metadata: rec_io.Metadata, model: Model,
                          drift: str = "frequency") -> rec_io.Metadata:
     """``metadata`` with the mark of compensation by ``model`` (:mod:`hrgtc.recording.marks`).
 
@@ -254,7 +281,7 @@ def compensated_metadata(metadata: rec_io.Metadata, model: UnitModel | Instrumen
     temperature"`` (a model of the gyro's temperature sensor, ``--thermometer sensor``) or
     ``"housing"`` (the housing-thermistor baseline).
     """
-    units = model.axes.values() if isinstance(model, InstrumentModel) else [model]
+    units = model.axes.values()
     if drift == "frequency" and all(u.thermometer.source == "sensor" for u in units):
         drift = "sensor temperature"
     extra = {**metadata.extra, COMPENSATED_KEY: mark(model.sha256, model.unit, drift)}

@@ -53,7 +53,7 @@ def calibration_summary(model: Any, table: Sequence[Mapping[str, float]] = (),
                         validation: Sequence[Any] = (), prior_fit: Any = None,
                         warnings: bool = True,
                         temperature_map: Mapping[str, Any] | None = None) -> Summary:
-    """The figures of a calibration: a :class:`~hrgtc.model.UnitModel`, its Table 2 rows
+    """The figures of a calibration: a :class:`~hrgtc.model.Model`, its Table 2 rows
     (``error_c``), the held-out :class:`~hrgtc.evaluation.Evaluation` s and the prior's fit
     (what :meth:`hrgtc.pipeline.calibration.CalibrationResult.summary` holds; the report
     passes a model file's). ``warnings``: the held-out runs' range warnings among the notes

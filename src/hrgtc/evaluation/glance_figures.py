@@ -82,7 +82,7 @@ def instrument_glance_summary(model: Any, runs: Mapping[str, Sequence[Any]]) -> 
     """An instrument's runs at a glance: one row per axis and run (``axes.<axis>.runs[i]``)
     as :func:`glance_summary` without the housing baseline, with each axis's scale-factor
     fit residual (``axes.<axis>.scale_factor.residual_ppm``); an axis without runs has a
-    row of its own. ``model``: the :class:`~hrgtc.model.InstrumentModel`."""
+    row of its own. ``model``: the :class:`~hrgtc.model.Model`."""
     columns = [column for _, column in _COLUMNS if column != "housing baseline"]
     cells: list[Figure] = []
     for axis, found in runs.items():

@@ -47,7 +47,7 @@ from hrgtc.core.timeline import (
 )
 from hrgtc.drift.cross_validation import RATE_DEADBAND, heating_mask
 from hrgtc.drift.features import FeatureStream
-from hrgtc.model import UnitModel
+from hrgtc.model import Model
 
 #: The block length of the split. [s]
 BLOCK_S = 10.0
@@ -154,7 +154,7 @@ class DirectionSplit:
         [Hz]
     """
 
-    def __init__(self, model: UnitModel, sample_rate_hz: float) -> None:
+    def __init__(self, model: Model, sample_rate_hz: float) -> None:
         settings = model.drift.settings
         self.rows = max(round(BLOCK_S * sample_rate_hz), 1)
         self.block_s = self.rows / sample_rate_hz

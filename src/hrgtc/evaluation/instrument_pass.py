@@ -24,7 +24,7 @@ from hrgtc.drift.rest import run_rest
 from hrgtc.evaluation.evaluation_result import Evaluation
 from hrgtc.evaluation.plot_blocks import block_rows
 from hrgtc.evaluation.run_pass import RunPass, RunPlan, count_dropped
-from hrgtc.model import InstrumentModel
+from hrgtc.model import Model
 from hrgtc.model_fit import (
     check_recording_noise,
     check_thermometer_kind,
@@ -45,7 +45,7 @@ REST_COLUMNS = ("time_s", "rate_dph", "freq_hz", "input_rate_dph", *ACCEL_COLUMN
 
 def evaluate_axes(
     run: str | os.PathLike[str],
-    model: InstrumentModel,
+    model: Model,
     *,
     settings: EvaluationSettings | None = None,
     read_options: ReadOptions | None = None,
@@ -73,17 +73,16 @@ def evaluate_axes(
         Axis (``""`` for a single-axis model) -> :class:`Evaluation`.
     """
     options = read_options or ReadOptions()
-    for unit in model.axes.values():
-        check_thermometer_kind(options, unit)
+    check_thermometer_kind(options, model)
     single = model.is_single_axis
     if single:  # the reader checks the plausible band of the one frequency
-        options = with_model_band(dataclasses.replace(options, axis=None), model.axes[""])
+        options = with_model_band(dataclasses.replace(options, axis=None), model)
     else:  # each axis's band on its view, below
         options = dataclasses.replace(options, axis=None, freq_band_hz=None,
                                       freq_span_hz=None)
     refuse_compensated(run)
     head = options.head(run)
-    check_recording_noise(model if not single else model.axes[""], head, str(run))
+    check_recording_noise(model, head, str(run))
     rows = count_rows(run)  # cheap (metadata, or a scan of a CSV's bytes); plans the pass
     name, source = Path(run).name, str(run)
     fs = head.sample_rate_hz
@@ -107,7 +106,7 @@ def evaluate_axes(
     return {axis: count_dropped(state.finish(), dropped) for axis, state in passes.items()}
 
 
-def _rest_masks(chunks: Iterator[Recording], model: InstrumentModel, motion: str,
+def _rest_masks(chunks: Iterator[Recording], model: Model, motion: str,
                 name: str) -> dict[str, np.ndarray]:
     """Each axis's samples at rest, from one pass over the detector's columns (none with
     ``motion="keep"``)."""

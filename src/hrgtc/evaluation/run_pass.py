@@ -49,7 +49,7 @@ from hrgtc.evaluation.noise import NoiseTerms, noise_terms
 from hrgtc.evaluation.plot_blocks import BlockMeans, block_rows
 from hrgtc.evaluation.series_stats import SeriesStatistics
 from hrgtc.evaluation.settling_cut import SettlingCut
-from hrgtc.model import UnitModel
+from hrgtc.model import AxisModel, Model
 from hrgtc.model_fit import check_recording_noise, with_model_band
 from hrgtc.recording import ReadOptions, Recording, count_rows
 from hrgtc.recording.marks import compensation_mark, describe_mark, refuse_compensated
@@ -97,7 +97,7 @@ class RunPlan:
 
 
 def run_pass(
-    model: UnitModel,
+    model: AxisModel,
     chunks: Iterable[Recording],
     plan: RunPlan | str,
     settings: EvaluationSettings | None = None,
@@ -113,7 +113,8 @@ def run_pass(
     Parameters
     ----------
     model
-        The unit's model.
+        The axis's parts (:class:`~hrgtc.model.AxisModel`; ``model.axis`` of a
+        single-axis :class:`~hrgtc.model.Model`).
     chunks
         The run, as consecutive chunks (e.g. :func:`hrgtc.recording.iter_chunks`).
     plan
@@ -150,7 +151,7 @@ class RunPass:
     (:func:`hrgtc.evaluation.instrument_pass.evaluate_axes`). The parameters are those of
     :func:`run_pass`."""
 
-    def __init__(self, model: UnitModel, plan: RunPlan | str,
+    def __init__(self, model: AxisModel, plan: RunPlan | str,
                  settings: EvaluationSettings | None = None, *,
                  on_output: Callable[[Recording], None] | None = None,
                  progress: Progress | None = None) -> None:
@@ -165,7 +166,7 @@ class RunPass:
         self.deviation, self.confidence, self.keep = deviation, settings.confidence, plan.keep
         self.on_output, self.progress, self.total_rows = on_output, progress, plan.total_rows
         gaps, block_rows = plan.gaps, plan.block_rows
-        self.frequency = Compensator(model, gaps=gaps)
+        self.frequency = Compensator(Model.single(model), gaps=gaps)
         self.features = None
         if block_rows:
             self.features = FeatureStream(model.drift.settings, model.drift.variables,
@@ -193,7 +194,7 @@ class RunPass:
             self.metadata = metadata = chunk.metadata
             self.truth = "bias_dph" in chunk
             if model.housing is not None and "housing_c" in chunk:
-                self.housing = Compensator(model, "housing", gaps=gaps)
+                self.housing = Compensator(Model.single(model), "housing", gaps=gaps)
             keys = SERIES if self.housing is not None else SERIES[:2]
             self.full = {key: SeriesStatistics(metadata.sample_rate_hz, self.taus_s, allan,
                                                expected_samples=self.total_rows)
@@ -293,8 +294,9 @@ class RunPass:
                     terms[key] = noise_terms(deviations[key])
             except HrgtcError as exc:
                 notes.append(f"{key}: no Allan noise terms ({exc})")
-        if frequency.unknown_orientation:
-            notes.append(f"{frequency.unknown_orientation} samples in an orientation the model was "
+        unknown = frequency.axis.unknown_orientation
+        if unknown:
+            notes.append(f"{unknown} samples in an orientation the model was "
                          "not trained in: their offset is unknown (the training mean is used)")
         if allan and deviation not in ("adev", "oadev"):
             notes.append(f"noise terms are read off the Allan deviation; --deviation {deviation} "
@@ -331,7 +333,7 @@ def _accounting(read: int, settling: int, frequency: Compensator,
 
 def evaluate(
     run: Recording | str | os.PathLike[str],
-    model: UnitModel,
+    model: Model,
     *,
     settings: EvaluationSettings | None = None,
     read_options: ReadOptions | None = None,
@@ -390,7 +392,8 @@ def evaluate(
             fs = options.head(run).sample_rate_hz  # (tiny chunks would each be validated)
         blocks = block_rows(rows, fs, max_points)
     plan = RunPlan(name, source, rows, gaps, blocks, keep)
-    result = run_pass(model, chunks, plan, settings, on_output=on_output, progress=progress)
+    result = run_pass(model.axis, chunks, plan, settings, on_output=on_output,
+                      progress=progress)
     return count_dropped(result, dropped)
 
 

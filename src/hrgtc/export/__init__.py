@@ -1,6 +1,6 @@
 """Export: a unit's or instrument's model written out for use outside Python.
 
-Takes a :class:`~hrgtc.model.UnitModel` or :class:`~hrgtc.model.InstrumentModel` and
+Takes a :class:`~hrgtc.model.Model` (one axis or several) and
 gives files that compute, sample by sample, what :class:`hrgtc.compensate.Compensator`
 computes: dependency-free C99 for on-board use, in double or float32
 (:func:`export_c`, ``output_format="c"``; the text modules in :mod:`hrgtc.export.c`),

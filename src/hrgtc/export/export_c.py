@@ -58,7 +58,7 @@ from hrgtc.export.c.plan import PRECISIONS, plan_for
 from hrgtc.export.c.source import source
 from hrgtc.export.c.text import _comment, header, title
 from hrgtc.export.parameter_file import instrument_parameter_text, parameter_text
-from hrgtc.model import InstrumentModel, UnitModel, load_instrument
+from hrgtc.model import Model, load_model
 from hrgtc.settings.export import EXPORT_FORMATS, ExportSettings
 
 #: What the export writes: C99 files, or the plain parameter file.
@@ -69,7 +69,7 @@ _PREFIX = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,31}$")
 
 # -- public API ---------------------------------------------------------------------------
 def export_c(
-    model: UnitModel | InstrumentModel | str | os.PathLike[str],
+    model: Model | str | os.PathLike[str],
     outdir: str | os.PathLike[str],
     prefix: str = _EXPORT.prefix,
     force: bool = False,
@@ -87,8 +87,8 @@ def export_c(
     Parameters
     ----------
     model
-        The unit's model (a :class:`UnitModel`, or an :class:`InstrumentModel` with one
-        model per axis), or the path of its model file (then the header
+        The unit's or instrument's model (:class:`~hrgtc.model.Model`, one or several
+        axes), or the path of its model file (then the header
         records the file's SHA-256; for an in-memory model, the SHA-256 of the
         JSON document :func:`hrgtc.model.save_model` would write).
     outdir
@@ -183,24 +183,22 @@ def export_c(
             for path, text in zip(files, texts, strict=True)]
 
 
-def _axes_of(model: UnitModel | InstrumentModel | str | os.PathLike[str],
-             ) -> tuple[dict[str, UnitModel], str, str]:
-    """Axis name -> model ('' for a single gyro), the model's origin and SHA-256."""
-    if isinstance(model, (UnitModel, InstrumentModel)):
+def _axes_of(model: Model | str | os.PathLike[str]) -> tuple[dict[str, Model], str, str]:
+    """Axis name -> its one-axis model ('' for a single gyro), the model's origin and
+    SHA-256."""
+    if isinstance(model, str | os.PathLike):
+        path = Path(model)
+        loaded = load_model(path)
+        origin, sha256 = path.name, file_sha256(path)
+    else:
         document = json.dumps(model.to_dict(), indent=2, allow_nan=True) + "\n"
         sha256 = hashlib.sha256(document.encode("utf-8")).hexdigest()
         origin = "in memory (SHA-256 of its JSON document as hrgtc writes it)"
         loaded = model
-    else:
-        path = Path(model)
-        loaded = load_instrument(path)
-        origin, sha256 = path.name, file_sha256(path)
-    if isinstance(loaded, UnitModel):
-        return {"": loaded}, origin, sha256
-    return dict(loaded.axes), origin, sha256
+    return {axis: loaded.of_axis(axis) for axis in loaded.axes}, origin, sha256
 
 
-def _c_texts(model: UnitModel, prefix: str, origin: str, sha256: str,
+def _c_texts(model: Model, prefix: str, origin: str, sha256: str,
              precision: str) -> tuple[str, str]:
     """Header and source of one gyro (one axis)."""
     plan = plan_for(model, precision)
@@ -212,7 +210,7 @@ def _c_texts(model: UnitModel, prefix: str, origin: str, sha256: str,
     return header(model, plan, prefix, origin, sha256), source(model, plan, prefix)
 
 
-def umbrella_header(axes: dict[str, UnitModel], prefix: str, origin: str, sha256: str,
+def umbrella_header(axes: dict[str, Model], prefix: str, origin: str, sha256: str,
                     precision: str) -> str:
     """``<prefix>_model.h`` of an instrument: includes every axis's header."""
     up = prefix.upper()

@@ -28,13 +28,13 @@ from hrgtc.export.c.plan import CPlan
 from hrgtc.export.c.text import offsets_note, sensor_note, title
 from hrgtc.export.c.thermometer import NEWTON_MAX_ITER
 from hrgtc.export.c.types import DOUBLE
-from hrgtc.model import UnitModel
+from hrgtc.model import Model
 
 #: Version of the file's layout (a key of the file).
 FORMAT_VERSION = 1
 
 
-def _unit(model: UnitModel, name: str) -> str:
+def _unit(model: Model, name: str) -> str:
     """A variable's unit as this file writes it (from :mod:`hrgtc.drift.variables`)."""
     if name.startswith("a_"):
         column = model.drift.settings.aux_columns.get(name[2:], "?")
@@ -103,7 +103,7 @@ def formula(key: str = "", sensor: bool = False) -> list[str]:
     return [line.replace("{k}", key) for line in lines]
 
 
-def parameter_lines(model: UnitModel, plan: CPlan, key: str = "") -> list[str]:
+def parameter_lines(model: Model, plan: CPlan, key: str = "") -> list[str]:
     """``key = value`` lines of one unit's compensation, each documented by a comment above.
 
     Parameters
@@ -137,7 +137,7 @@ def parameter_lines(model: UnitModel, plan: CPlan, key: str = "") -> list[str]:
     return lines
 
 
-def _settings_lines(model: UnitModel, plan: CPlan, put: Any) -> None:
+def _settings_lines(model: Model, plan: CPlan, put: Any) -> None:
     """The keys of the drift settings the compensation needs: rate, references, filter."""
     settings = model.drift.settings
     put("sample_rate_hz", settings.sample_rate_hz,
@@ -158,7 +158,7 @@ def _settings_lines(model: UnitModel, plan: CPlan, put: Any) -> None:
         "settle_s in samples at the training rate (a continuous run). [1]")
 
 
-def _scale_and_range_lines(model: UnitModel, plan: CPlan, put: Any) -> None:
+def _scale_and_range_lines(model: Model, plan: CPlan, put: Any) -> None:
     """The scale of each computed variable, then its training range."""
     drift = model.drift
     settings = drift.settings
@@ -177,7 +177,7 @@ def _scale_and_range_lines(model: UnitModel, plan: CPlan, put: Any) -> None:
                 f"[{_unit(model, v)}]")
 
 
-def _term_lines(model: UnitModel, put: Any) -> None:
+def _term_lines(model: Model, put: Any) -> None:
     """B0 and each selected term of Eq. (22): its name, scaled and raw coefficients."""
     drift, th = model.drift, model.thermometer
     put("intercept_dph", drift.intercept_dph, "B0: the bias at f = df = 0 (h = dh = 0). [deg/h]")
@@ -196,7 +196,7 @@ def _term_lines(model: UnitModel, put: Any) -> None:
             f"[deg/h per {term.unit_for(th.source)}]".replace("·", " "))
 
 
-def _thermometer_lines(model: UnitModel, plan: CPlan, put: Any) -> None:
+def _thermometer_lines(model: Model, plan: CPlan, put: Any) -> None:
     """The thermometer F(T) (Eq. 18), its calibrated ranges and its inverse's interval."""
     th = model.thermometer
     put("thermometer_order", th.order, "Order of the thermometer polynomial F(T) (Eq. 18).")
@@ -228,7 +228,7 @@ def _thermometer_lines(model: UnitModel, plan: CPlan, put: Any) -> None:
     put("inverse_max_iterations", NEWTON_MAX_ITER, "Iteration cap of the inverse. [1]")
 
 
-def _extra_variable_lines(model: UnitModel, plan: CPlan, put: Any) -> None:
+def _extra_variable_lines(model: Model, plan: CPlan, put: Any) -> None:
     """The keys of the variables beyond f, df, h and dh the terms use (d2, g, a_NAME), in
     grammar order, each written by its module's ``params`` (:mod:`hrgtc.drift.variables`);
     a model without them has none of these keys (older files' keys unchanged)."""
@@ -238,7 +238,7 @@ def _extra_variable_lines(model: UnitModel, plan: CPlan, put: Any) -> None:
             entry.params(names, model.drift.settings, put)
 
 
-def _scale_factor_lines(model: UnitModel, put: Any) -> None:
+def _scale_factor_lines(model: Model, put: Any) -> None:
     """The scale factor's keys (``uses_scale_factor`` 0 and nothing else without one)."""
     sf = model.scale_factor
     put("uses_scale_factor", int(sf is not None),
@@ -263,7 +263,7 @@ def _scale_factor_lines(model: UnitModel, put: Any) -> None:
             f"Coefficient of term {j} ({term.name}) on g itself. [ppm per {term.unit}]")
 
 
-def _head(model: UnitModel, origin: str, sha256: str, key: str = "") -> list[str]:
+def _head(model: Model, origin: str, sha256: str, key: str = "") -> list[str]:
     from hrgtc.core.meta import PAPER_CITATION, PAPER_REFERENCE, __version__
 
     prov = model.provenance
@@ -289,7 +289,7 @@ def _head(model: UnitModel, origin: str, sha256: str, key: str = "") -> list[str
     ]
 
 
-def parameter_text(model: UnitModel, plan: CPlan, origin: str, sha256: str) -> str:
+def parameter_text(model: Model, plan: CPlan, origin: str, sha256: str) -> str:
     """The whole parameter file of one unit."""
     lines = [("# " + line).rstrip() for line in _head(model, origin, sha256)]
     lines += ["", "# Layout version of this file.", f"format_version = {FORMAT_VERSION}", ""]
@@ -297,7 +297,7 @@ def parameter_text(model: UnitModel, plan: CPlan, origin: str, sha256: str) -> s
     return "\n".join(lines).rstrip() + "\n"
 
 
-def instrument_parameter_text(axes: dict[str, UnitModel], plans: dict[str, CPlan],
+def instrument_parameter_text(axes: dict[str, Model], plans: dict[str, CPlan],
                               origin: str, sha256: str) -> str:
     """The parameter file of an instrument: every axis's keys, prefixed ``<axis>_``."""
     names = list(axes)

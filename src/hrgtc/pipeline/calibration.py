@@ -3,7 +3,7 @@
 Soak recordings -> plateaus -> the unit's Table 1 -> thermometer (Eq. 18 form)
 -> its Table 2; ramp recordings -> stepwise drift model (Eq. 22 form); held-out
 runs -> bias stability raw and compensated. Everything is gathered into one
-:class:`~hrgtc.model.UnitModel` with provenance.
+:class:`~hrgtc.model.Model` with provenance.
 
 Files are streamed chunk by chunk for the drift fit and the validation, so
 memory stays bounded whatever their length; each soak file is read whole
@@ -41,7 +41,7 @@ from hrgtc.drift.training import (
 )
 from hrgtc.evaluation import Evaluation, evaluate
 from hrgtc.evaluation.calibration_figures import calibration_summary, thermometer_tables
-from hrgtc.model import UnitModel, provenance
+from hrgtc.model import AxisModel, Model, provenance
 from hrgtc.pipeline.documents import CalibrationDriftRecord, CalibrationRecord
 from hrgtc.pipeline.terms import resolve_terms
 from hrgtc.recording import ReadOptions
@@ -112,7 +112,7 @@ class CalibrationResult:
         One :class:`~hrgtc.evaluation.Evaluation` per held-out run.
     """
 
-    model: UnitModel
+    model: Model
     plateaus: tuple[Plateau, ...]
     table: tuple[dict[str, float], ...]
     validation: tuple[Evaluation, ...] = field(default=())
@@ -282,10 +282,11 @@ def calibrate(
         record["prior"] = {"units": prior_fit.prior.n_units,
                              "range_c": list(prior_fit.prior.temperature_range_c),
                              "max_temperature_std_c": prior_fit.max_temperature_std_c}
-    unit_model = UnitModel(
-        thermometer=thermometer_fit, drift=model, housing=housing, unit=unit,
-        training=TrainingStatistics.from_runs(training_heads),
-        plateaus=tuple(p.to_dict() for p in plateaus),
+    unit_model = Model.single(
+        AxisModel(thermometer=thermometer_fit, drift=model, housing=housing,
+                  training=TrainingStatistics.from_runs(training_heads),
+                  plateaus=tuple(p.to_dict() for p in plateaus)),
+        unit=unit,
         provenance=provenance(
             {"soak": [str(p) for p in soaks], "drift": [str(p) for p in drifts],
              "validate": [str(p) for p in validate]}, record),
@@ -467,10 +468,10 @@ def _calibrate_sensor(soaks: Sequence[PathLike], drifts: Sequence[PathLike],
                                                    [heads[str(p)] for p in training]))
     model, housing = _fit_drift(training, heads, thermometer, options, progress, len(drifts),
                                 settings.drift, aux, housing_terms)
-    unit_model = UnitModel(
-        thermometer=thermometer, drift=model, housing=housing,
+    unit_model = Model.single(
+        AxisModel(thermometer=thermometer, drift=model, housing=housing,
+                  training=TrainingStatistics.from_runs([heads[str(p)] for p in training])),
         unit=heads[str(drifts[0])].metadata.unit,
-        training=TrainingStatistics.from_runs([heads[str(p)] for p in training]),
         provenance=provenance(
             {"soak": [str(p) for p in soaks], "drift": [str(p) for p in drifts],
              "validate": [str(p) for p in validate]},

@@ -18,14 +18,14 @@ import warnings
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from hrgtc.compensate import OUTPUT_COLUMNS, CompensationSummary, compensate_instrument_file
+from hrgtc.compensate import OUTPUT_COLUMNS, CompensationSummary, compensate_file
 from hrgtc.compensate.file_pass import compensated_metadata
 from hrgtc.core.errors import HrgtcWarning
 from hrgtc.core.files import refuse_existing
 from hrgtc.core.progress import StageProgress, for_stage
 from hrgtc.evaluation import Evaluation, evaluate
 from hrgtc.export.export_c import export_c
-from hrgtc.model import save_instrument, save_model
+from hrgtc.model import save_model
 from hrgtc.pipeline.calibration import CalibrationResult, calibrate
 from hrgtc.pipeline.instrument import InstrumentCalibration, calibrate_instrument
 from hrgtc.recording import ReadOptions, RecordingWriter
@@ -168,8 +168,8 @@ def run_instrument_demo(folder: Path, s: DemoSettings, *, force: bool = False,
         calibration = calibrate_instrument(soaks, cool, warm, rate_tables=table,
                                            validate_rate_tables=heldout,
                                            progress=calibration_stage)
-    model_file = save_instrument(calibration.model, folder / "imu-3.json", force=force)
-    compensated = compensate_instrument_file(
+    model_file = save_model(calibration.model, folder / "imu-3.json", force=force)
+    compensated = compensate_file(
         warm[0], folder / "runs" / "warmup_compensated.parquet", calibration.model, force=force,
         progress=for_stage(progress, "imu-3: compensate warm-up"))
     report_file = build_report(calibration.model, [*cool, *warm], folder / "report.html",

@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from hrgtc.compensate import InstrumentCompensator
+from hrgtc.compensate import Compensator
 from hrgtc.compensate.ranges import RangeReport
 from hrgtc.core import records
 from hrgtc.core.errors import InputError
@@ -38,7 +38,7 @@ from hrgtc.drift.scale_factor import TOLERANCE_SHARE
 from hrgtc.evaluation import Evaluation, evaluate
 from hrgtc.evaluation.calibration_figures import instrument_summary
 from hrgtc.evaluation.instrument_pass import evaluate_axes
-from hrgtc.model import InstrumentModel, UnitModel, provenance
+from hrgtc.model import AxisModel, Model, provenance
 from hrgtc.pipeline import documents
 from hrgtc.pipeline.calibration import HOUSING_TERMS, CalibrationResult, calibrate
 from hrgtc.pipeline.holdout import holdout_split
@@ -95,7 +95,7 @@ class ScaleFactorCheck:
 class InstrumentCalibration:
     """What :func:`calibrate_instrument` produced: the model and each axis's evidence."""
 
-    model: InstrumentModel
+    model: Model
     axes: dict[str, CalibrationResult]
     validation: dict[str, tuple[Evaluation, ...]] = field(default_factory=dict)
     scale_checks: tuple[ScaleFactorCheck, ...] = ()
@@ -223,7 +223,9 @@ def calibrate_instrument(
     """
     settings = settings or CalibrationSettings()
     scale_terms, cross_axis = settings.scale_terms, settings.cross_axis
-    fit = {"settings": settings, "aux": aux, "housing_terms": housing_terms, "prior": prior}
+    # what the cross-axis trial passes to calibrate again (with the axis's read options)
+    fit = {"soaks": soaks, "drifts": drifts, "settings": settings, "aux": aux,
+           "housing_terms": housing_terms, "prior": prior, "thermometer": thermometer}
     if thermometer not in ("resonator", "sensor"):
         raise InputError(f"thermometer must be 'resonator' or 'sensor', got {thermometer!r}")
     options = dataclasses.replace(read_options or ReadOptions(), thermometer=thermometer)
@@ -250,7 +252,7 @@ def calibrate_instrument(
                               for f in dataclasses.fields(ReadOptions)})
     table = read_segment_table(segment_table) if segment_table is not None else None
     results: dict[str, CalibrationResult] = {}
-    models: dict[str, UnitModel] = {}
+    models: dict[str, AxisModel] = {}
     crossed: dict[str, dict[str, Any]] = {}
     for axis in axes:
         axis_read = axis_options(options, axis)
@@ -259,14 +261,14 @@ def calibrate_instrument(
                            housing_terms=housing_terms, prior=prior, read_options=axis_read,
                            progress=staged, thermometer=thermometer, marks_checked=True)
         if cross_axis and len(axes) > 1:
-            result, crossed[axis] = _cross_axis(result, axis, axes, soaks, drifts, validate,
-                                                axis_read, staged, thermometer, fit)
-        model = result.model
+            result, crossed[axis] = _cross_axis(result, axis, axes, validate, axis_read,
+                                                staged, fit)
+        model = result.model.axis
         if rate_tables:
             model = dataclasses.replace(model, scale_factor=fit_axis_scale_factor(
                 model, rate_tables, axis_read, table, scale_terms))
         results[axis], models[axis] = result, model
-    unit = next(iter(models.values())).unit
+    unit = next(iter(results.values())).model.unit
     inputs = {"soak": [str(p) for p in soaks], "drift": [str(p) for p in drifts],
               "validate": [str(p) for p in validate],
               "rate_table": [str(p) for p in rate_tables],
@@ -283,8 +285,7 @@ def calibrate_instrument(
                                  "segment_table": None if segment_table is None
                                  else str(segment_table), "holdout_s": holdout_s,
                                  "holdout_fraction": holdout_fraction, **reference}, hashed)
-    models = {axis: dataclasses.replace(m, provenance=record) for axis, m in models.items()}
-    instrument = InstrumentModel(models, unit, record, None if temperature_map is None
+    instrument = Model(models, unit, record, None if temperature_map is None
                                  else temperature_map.to_dict())
     held_out = options if validate_options is None else _same_cache(dataclasses.replace(
         validate_options, thermometer=thermometer), options)
@@ -328,10 +329,8 @@ def _same_cache(options: ReadOptions, cached: ReadOptions) -> ReadOptions:
 
 
 def _cross_axis(result: CalibrationResult, axis: str, axes: Sequence[str],
-                soaks: Sequence[PathLike], drifts: Sequence[PathLike],
                 validate: Sequence[PathLike], options: ReadOptions, progress: Any,
-                thermometer: str, fit: Mapping[str, Any]
-                ) -> tuple[CalibrationResult, dict[str, Any]]:
+                fit: Mapping[str, Any]) -> tuple[CalibrationResult, dict[str, Any]]:
     """Refit ``axis`` with the other resonators' frequencies as candidates (``a_f<other>``:
     each a thermometer of its own part of the unit, so their differences are the gradients
     across it) and keep that model only if it lowers the median held-out 10 s bias
@@ -342,13 +341,13 @@ def _cross_axis(result: CalibrationResult, axis: str, axes: Sequence[str],
         return result, {"kept": False, "why": "no held-out run (--validate) to judge by",
                         "channels": others}
     aux = {**dict(fit["aux"] or {}), **others}
-    trial = calibrate(soaks, drifts, (), settings=fit["settings"], aux=aux,
+    trial = calibrate(fit["soaks"], fit["drifts"], (), settings=fit["settings"], aux=aux,
                       housing_terms=fit["housing_terms"], prior=fit["prior"],
-                      read_options=options, progress=progress, thermometer=thermometer,
+                      read_options=options, progress=progress, thermometer=fit["thermometer"],
                       soak_fit=result.soak_fit,  # the same thermometer: the drift fit only
                       marks_checked=True)
 
-    def held_out(model: UnitModel) -> float:
+    def held_out(model: Model) -> float:
         return float(np.median([evaluate(path, model, settings=BIAS_ONLY, read_options=options)
                                 .compensated_10s for path in validate]))
 
@@ -361,7 +360,7 @@ def _cross_axis(result: CalibrationResult, axis: str, axes: Sequence[str],
     return (trial if kept else result), record
 
 
-def fit_axis_scale_factor(model: UnitModel, rate_tables: Sequence[PathLike],
+def fit_axis_scale_factor(model: AxisModel, rate_tables: Sequence[PathLike],
                           options: ReadOptions, table: Any,
                           terms: Sequence[str]) -> ScaleFactorModel:
     """One axis's scale factor from its view of the rate-table runs."""
@@ -382,7 +381,7 @@ def fit_axis_scale_factor(model: UnitModel, rate_tables: Sequence[PathLike],
 STEADY_CHANGE_C = 0.2
 
 
-def steady_segments(run: Recording, segments: Sequence[Any], model: UnitModel,
+def steady_segments(run: Recording, segments: Sequence[Any], model: AxisModel,
                     max_change_c: float = STEADY_CHANGE_C) -> list[Any]:
     """The holds of ``run`` at a steady temperature: the resonator temperature (from the
     thermometer) of the first and last tenth of the hold differ by at most
@@ -401,11 +400,11 @@ def steady_segments(run: Recording, segments: Sequence[Any], model: UnitModel,
     return kept
 
 
-def check_scale_factor(path: PathLike, model: InstrumentModel, options: ReadOptions,
+def check_scale_factor(path: PathLike, model: Model, options: ReadOptions,
                        table: Any = None) -> tuple[ScaleFactorCheck, ...]:
     """Scale-factor error of a held-out rate-table run, each axis, before and after."""
     checks = []
-    compensated = InstrumentCompensator(model).transform(options.read(path))
+    compensated = Compensator(model).transform(options.read(path))
     for axis, unit_model in model.axes.items():
         sf = unit_model.scale_factor
         if sf is None:
@@ -483,7 +482,7 @@ class InstrumentEvaluation:
         (empty unless the run has ``input_rate_dph`` columns and the model a scale factor).
     """
 
-    model: InstrumentModel
+    model: Model
     axes: dict[str, Evaluation]
     scale_checks: tuple[ScaleFactorCheck, ...] = ()
 
@@ -526,7 +525,7 @@ class InstrumentEvaluation:
 
 def evaluate_instrument(
     run: PathLike,
-    model: InstrumentModel,
+    model: Model,
     *,
     axes: Sequence[str] | None = None,
     read_options: ReadOptions | None = None,
@@ -569,8 +568,7 @@ def evaluate_instrument(
     from hrgtc.thermometry.reference import options_with_map
 
     options = options_with_map(read_options or ReadOptions(), model.temperature_map)
-    for unit_model in model.axes.values():  # before reading the recording's axes
-        check_thermometer_kind(options, unit_model, model_source or None)
+    check_thermometer_kind(options, model, model_source or None)  # before the recording's axes
     model = match_axes(model, recording_axes(run, options), axes, str(run), model_source)
     results = evaluate_axes(run, model, settings=settings, read_options=options,
                             max_points=max_points, progress=progress)

@@ -16,7 +16,7 @@ from pathlib import Path
 from hrgtc.core.files import refuse_existing, write_text_atomic
 from hrgtc.core.progress import Progress
 from hrgtc.evaluation import Evaluation
-from hrgtc.model import InstrumentModel, UnitModel
+from hrgtc.model import Model
 from hrgtc.recording import ReadOptions
 from hrgtc.report.inputs import report_inputs
 from hrgtc.report.kinds import kind as report_kind
@@ -29,7 +29,7 @@ PathLike = str | os.PathLike[str]
 
 
 def build_report(
-    model: UnitModel | InstrumentModel | PathLike,
+    model: Model | PathLike,
     runs: Sequence[PathLike | Evaluation],
     output: PathLike,
     *,

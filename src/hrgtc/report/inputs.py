@@ -21,7 +21,7 @@ from hrgtc.core.errors import InputError
 from hrgtc.core.progress import Progress
 from hrgtc.evaluation import Evaluation
 from hrgtc.evaluation.instrument_pass import evaluate_axes
-from hrgtc.model import InstrumentModel, UnitModel, load_instrument
+from hrgtc.model import Model, load_model
 from hrgtc.model_fit import check_thermometer_kind
 from hrgtc.recording import ReadOptions, count_rows
 from hrgtc.report.figures import SoakTrace, trace_soak_axes
@@ -58,7 +58,7 @@ class ReportInputs:
         Optional ``callback(rows_done, rows_total)``.
     """
 
-    instrument: InstrumentModel
+    instrument: Model
     model_path: str | None
     runs: tuple[PathLike | Evaluation, ...]
     soaks: tuple[str, ...]
@@ -71,7 +71,7 @@ class ReportInputs:
 
 
 def report_inputs(
-    model: UnitModel | InstrumentModel | PathLike,
+    model: Model | PathLike,
     runs: Sequence[PathLike | Evaluation],
     *,
     soaks: Sequence[PathLike] | None = None,
@@ -85,18 +85,16 @@ def report_inputs(
     """The inputs of :func:`hrgtc.report.build_report` checked, before any run is read
     (its parameters say what each is)."""
     model_path = None
-    if isinstance(model, UnitModel):
-        instrument = InstrumentModel.single(model)
-    elif isinstance(model, InstrumentModel):
-        instrument = model
+    if isinstance(model, str | os.PathLike):
+        model_path, instrument = str(model), load_model(model)
     else:
-        model_path, instrument = str(model), load_instrument(model)
+        instrument = model
     options = options_with_map(read_options or ReadOptions(), instrument.temperature_map)
     instrument = _check_axes(instrument, runs, options, axes, model_source or model_path or "")
-    first = next(iter(instrument.axes.values()))
-    soak_paths, missing = _soak_files(first) if soaks is None else ([str(p) for p in soaks], [])
+    soak_paths, missing = (_soak_files(instrument) if soaks is None
+                           else ([str(p) for p in soaks], []))
     if soaks is None:
-        settings = first.provenance.get("settings", {})
+        settings = instrument.provenance.get("settings", {})
         soak_options = ReadOptions(columns=settings.get("columns") or None,
                                    units=settings.get("units") or None)
     else:
@@ -154,21 +152,20 @@ def trace_soaks(inputs: ReportInputs, thermometers: Mapping[str, Thermometer],
     return traces
 
 
-def _soak_files(model: UnitModel) -> tuple[list[str], list[str]]:
+def _soak_files(model: Model) -> tuple[list[str], list[str]]:
     """(existing, missing) soak files named in the model's provenance."""
     paths = [str(i["path"]) for i in model.provenance.get("inputs", [])
              if i.get("role") == "soak" and i.get("path")]
     return [p for p in paths if Path(p).is_file()], [p for p in paths if not Path(p).is_file()]
 
 
-def _check_axes(model: InstrumentModel, runs: Sequence[PathLike | Evaluation],
+def _check_axes(model: Model, runs: Sequence[PathLike | Evaluation],
                 options: ReadOptions, axes: Sequence[str] | None,
-                model_source: str) -> InstrumentModel:
+                model_source: str) -> Model:
     """The model's axes to show, checked against every run file (its thermometer kind,
     then its axes: :func:`hrgtc.compensate.multi_axis.match_axes`); the first run's
     match."""
-    for unit_model in model.axes.values():  # before reading the recordings' axes
-        check_thermometer_kind(options, unit_model, model_source or None)
+    check_thermometer_kind(options, model, model_source or None)  # before the recordings' axes
     matched = [match_axes(model, recording_axes(run, options), axes, str(run), model_source)
                for run in runs if not isinstance(run, Evaluation)]
     return matched[0] if matched else model

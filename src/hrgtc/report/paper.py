@@ -41,7 +41,7 @@ from hrgtc.evaluation.calibration_figures import (
     thermometer_tables,
 )
 from hrgtc.evaluation.glance_figures import GLANCE, glance_summary, instrument_glance_summary
-from hrgtc.model import UnitModel
+from hrgtc.model import Model
 from hrgtc.report.figures import Plot, SoakTrace, plot
 from hrgtc.report.inputs import ReportInputs, RowCounter, evaluate_runs, trace_soaks
 from hrgtc.report.tables import (
@@ -116,7 +116,7 @@ class AxisReport:
 
     name: str
     prefix: str
-    model: UnitModel
+    model: Model
     sensor: bool
     sensor_table: Table | None  # a sensor thermometer: what it is
     thermometry: Thermometry | None  # a resonator: Figs. 3-5
@@ -161,10 +161,10 @@ def paper_report(inputs: ReportInputs) -> PaperReport:
     evaluations = evaluate_runs(inputs, counter.advance)
     traces = trace_soaks(inputs, traced, counter.advance)
     single = instrument.is_single_axis
-    axes = tuple(axis_report(axis, "" if single else f"{axis}-", model, evaluations[axis],
-                             traces.get(axis, []), inputs.missing_soaks,
+    axes = tuple(axis_report(axis, "" if single else f"{axis}-", instrument.of_axis(axis),
+                             evaluations[axis], traces.get(axis, []), inputs.missing_soaks,
                              instrument.temperature_map)
-                 for axis, model in instrument.axes.items())
+                 for axis in instrument.axes)
     sensor = first.thermometer.source == "sensor"
     if single:
         glance = (grid_table(glance_summary(evaluations[""], paper_row=not sensor), GLANCE,
@@ -173,21 +173,22 @@ def paper_report(inputs: ReportInputs) -> PaperReport:
     else:
         glance = grid_table(instrument_glance_summary(instrument, evaluations), GLANCE,
                             "At a glance: 10 s bias stability per axis and run")
-    provenance = provenance_summary(first.provenance)
+    provenance = provenance_summary(instrument.provenance)
     counter.finish()
     return PaperReport(
         inputs.title or f"Temperature compensation report — unit {instrument.unit}",
-        instrument.unit, inputs.model_path, str(first.provenance.get("hrgtc_version", "?")),
-        str(first.provenance.get("created_utc", "?")), generated, sensor,
+        instrument.unit, inputs.model_path, str(instrument.provenance.get("hrgtc_version", "?")),
+        str(instrument.provenance.get("created_utc", "?")), generated, sensor,
         grid_table(provenance, INPUTS, INPUTS) if provenance.sections else None, single,
         glance, axes)
 
 
-def axis_report(name: str, prefix: str, model: UnitModel,
+def axis_report(name: str, prefix: str, model: Model,
                 evaluations: Sequence[Evaluation] = (), traces: Sequence[SoakTrace] = (),
                 missing: Sequence[str] = (),
                 temperature_map: dict[str, Any] | None = None) -> AxisReport:
-    """One axis ``name`` (its ids start with ``prefix``): Figs. 3-5 and Tables 1-2 (a sensor
+    """One axis ``name`` (its ids start with ``prefix``; ``model``: its one-axis model, see
+    :meth:`hrgtc.model.Model.of_axis`): Figs. 3-5 and Tables 1-2 (a sensor
     thermometer: what it is and the map of its count, ``temperature_map``), its runs
     (``evaluations``, with plotting blocks), drift and scale factor; ``traces``: its soaks,
     ``missing``: soak files no longer on disk."""
@@ -217,7 +218,7 @@ def axis_report(name: str, prefix: str, model: UnitModel,
         "" if model.housing is None else model.housing.equation(), _scale_factor(model))
 
 
-def _scale_factor(model: UnitModel) -> ScaleFactor | None:
+def _scale_factor(model: Model) -> ScaleFactor | None:
     """The scale-factor model's groups, k(f) and fit; None without one."""
     sf = model.scale_factor
     if sf is None:
@@ -240,7 +241,7 @@ def _match(plateaus: Sequence[Plateau], source: str) -> list[Plateau]:
     return same or [p for p in plateaus if p.source and Path(p.source).name == Path(source).name]
 
 
-def table_rows(model: UnitModel, plateaus: Sequence[Plateau]) -> list[dict[str, float]]:
+def table_rows(model: Model, plateaus: Sequence[Plateau]) -> list[dict[str, float]]:
     """Each plateau's chamber temperature, settled frequency, the temperature from it and its
     error (Table 2 of [1])."""
     t = np.array([p.chamber_c for p in plateaus])
@@ -250,7 +251,7 @@ def table_rows(model: UnitModel, plateaus: Sequence[Plateau]) -> list[dict[str, 
             for a, b, c in zip(t, f, estimate, strict=True)]
 
 
-def _thermometry(model: UnitModel, traces: Sequence[SoakTrace],
+def _thermometry(model: Model, traces: Sequence[SoakTrace],
                  missing: Sequence[str]) -> Thermometry:
     """Fig. 3 and the plateaus, Fig. 4, Table 1 and Eq. 18 beside the paper's, Fig. 5(a),
     Table 2 and Fig. 5(b) with the soaks' error against the truth."""
@@ -303,7 +304,7 @@ def _recorded(run: Evaluation) -> str:
     return text
 
 
-def _run(k: int, run: Evaluation, model: UnitModel) -> RunReport:
+def _run(k: int, run: Evaluation, model: Model) -> RunReport:
     """Run ``k``: Fig. 6, its figures as tables, the Allan deviation (before the noise
     terms), its warnings and notes."""
     hrg = model.thermometer.source != "sensor"  # the paper's figures are an HRG's

@@ -39,7 +39,7 @@ from hrgtc.drift.rate_filter import DT_REL_TOLERANCE, SERIES_LIMIT, series_coeff
 from hrgtc.drift.variables import variable
 from hrgtc.export.c.plan import CPlan
 from hrgtc.export.c.thermometer import NEWTON_MAX_ITER
-from hrgtc.model import UnitModel
+from hrgtc.model import Model
 
 F32 = np.float32
 SERIES = series_coefficients()
@@ -98,7 +98,7 @@ class FloatConstants:
     ranges: dict[str, tuple[np.float32, np.float32]]
 
 
-def float_constants(model: UnitModel, plan: CPlan) -> FloatConstants:
+def float_constants(model: Model, plan: CPlan) -> FloatConstants:
     """The float build's constants from the double plan, centred on f_ref."""
     drift, thermometer = model.drift, model.thermometer
     settings = drift.settings
@@ -152,7 +152,7 @@ def _term(term: Term, x: dict[str, np.ndarray]) -> np.ndarray:
     return out
 
 
-def mirror_bias(model: UnitModel, c: FloatConstants,
+def mirror_bias(model: Model, c: FloatConstants,
                 values: dict[str, np.ndarray]) -> np.ndarray:
     """``<prefix>_bias_dph()`` of the float build. [°/h]
 
@@ -188,7 +188,7 @@ def mirror_bias(model: UnitModel, c: FloatConstants,
     return (c.intercept + total).astype(F32)
 
 
-def mirror_scale(model: UnitModel, f_hz: np.ndarray) -> np.ndarray:
+def mirror_scale(model: Model, f_hz: np.ndarray) -> np.ndarray:
     """``<prefix>_scale_ppm()`` of the float build, from the centred frequency. [ppm]"""
     sf = model.scale_factor
     assert sf is not None
@@ -374,7 +374,7 @@ def _round_up(value: float) -> float:
     return float(np.ceil(value * 10.0**digits) / 10.0**digits)
 
 
-def float_accuracy(model: UnitModel, plan: CPlan, c: FloatConstants) -> FloatAccuracy:
+def float_accuracy(model: Model, plan: CPlan, c: FloatConstants) -> FloatAccuracy:
     """Evaluate the float build's arithmetic against the double model over the trained ranges.
 
     The double side is hrgtc's model at the exact inputs; the float side gets the same
@@ -425,7 +425,7 @@ def _firmware(name: str, value: np.ndarray, settings: Any) -> np.ndarray:
     return code.firmware_value(value, name, settings)
 
 
-def _gradient_inputs(model: UnitModel, plan: CPlan, c: FloatConstants,
+def _gradient_inputs(model: Model, plan: CPlan, c: FloatConstants,
                      values: dict[str, np.ndarray], inputs: dict[str, np.ndarray]
                      ) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
     """g of the double model and of the float build at the same f and housing_c.
@@ -443,7 +443,7 @@ def _gradient_inputs(model: UnitModel, plan: CPlan, c: FloatConstants,
     return values, inputs
 
 
-def _ramp_error(model: UnitModel, plan: CPlan, c: FloatConstants) -> float:
+def _ramp_error(model: Model, plan: CPlan, c: FloatConstants) -> float:
     """Worst |B32 - B64| on steady ramps through the float and the double filters.
 
     Nine ramps with rates spread over the trained df/dt range (and dh/dt, when the model

@@ -21,13 +21,13 @@ from hrgtc.export.c.rate_filter import filter_struct
 from hrgtc.export.c.scale import scale_pieces
 from hrgtc.export.c.types import DOUBLE, SINGLE, CType
 from hrgtc.export.c.variables import bias_params, extra_variables, step_inputs
-from hrgtc.model import UnitModel
+from hrgtc.model import Model
 
 #: Column of the field comments in the state and output structs.
 _FIELD_WIDTH = 28
 
 
-def header(model: UnitModel, plan: CPlan, prefix: str, readme: str, sha256: str,
+def header(model: Model, plan: CPlan, prefix: str, readme: str, sha256: str,
            t: CType = DOUBLE, *,
            centre_hz: float | None = None,
            bounds: tuple[float, float] | None = None) -> str:
@@ -209,7 +209,7 @@ _SENSOR_WORDS = (
 )
 
 
-def sensor_words(model: UnitModel, text: str) -> str:
+def sensor_words(model: Model, text: str) -> str:
     """``text`` (a C header or source, a parameter file's lines) in the words of a model of
     the gyro's temperature sensor (``--thermometer sensor``); a resonator's model keeps the
     paper's words, unchanged."""

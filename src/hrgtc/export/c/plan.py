@@ -15,7 +15,7 @@ from hrgtc.core.errors import CalibrationError, InputError
 from hrgtc.drift.features import is_aux, variable_key
 from hrgtc.drift.rate_filter import check_tau
 from hrgtc.drift.variables import refusal, supported, variable
-from hrgtc.model import UnitModel
+from hrgtc.model import Model
 from hrgtc.settings import export as settings_export
 
 #: Points of the embedded table that starts the thermometer's Newton iteration.
@@ -87,7 +87,7 @@ PRECISIONS = settings_export.PRECISIONS
 SINGLE_VARIABLES = supported("c_float32")
 
 
-def plan_for(model: UnitModel, precision: str = "double") -> CPlan:
+def plan_for(model: Model, precision: str = "double") -> CPlan:
     """The numbers the C code needs beyond the model's own, computed as hrgtc computes them.
 
     Raises

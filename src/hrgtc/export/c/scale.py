@@ -16,17 +16,17 @@ from hrgtc.export.c.expr import array as _array
 from hrgtc.export.c.expr import term_expression as _term_expression
 from hrgtc.export.c.plan import CPlan
 from hrgtc.export.c.types import CType, ctype
-from hrgtc.model import UnitModel
+from hrgtc.model import Model
 
 PIECES = ("define", "field", "prototype", "function", "declare", "apply", "out", "readme")
 
 
-def scale_factor_of(model: UnitModel) -> ScaleFactorModel | None:
+def scale_factor_of(model: Model) -> ScaleFactorModel | None:
     """The model's scale factor, or None."""
     return model.scale_factor
 
 
-def _function(model: UnitModel, prefix: str, t: CType) -> str:
+def _function(model: Model, prefix: str, t: CType) -> str:
     sf = scale_factor_of(model)
     assert sf is not None
     real, lit = t.name, t.literal
@@ -83,7 +83,7 @@ def _function(model: UnitModel, prefix: str, t: CType) -> str:
     return "\n".join(line for line in lines if line is not None) + "\n"
 
 
-def scale_pieces(model: UnitModel, plan: CPlan, prefix: str) -> dict[str, str]:
+def scale_pieces(model: Model, plan: CPlan, prefix: str) -> dict[str, str]:
     """Text the header and source templates insert for the scale factor ('' without one)."""
     if scale_factor_of(model) is None:
         return dict.fromkeys(PIECES, "")

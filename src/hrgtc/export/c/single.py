@@ -20,10 +20,10 @@ from hrgtc.export.c.scale import scale_factor_of
 from hrgtc.export.c.text import readme
 from hrgtc.export.c.types import SINGLE
 from hrgtc.export.c.variables import step_inputs
-from hrgtc.model import UnitModel
+from hrgtc.model import Model
 
 
-def _sections(model: UnitModel, plan: CPlan, prefix: str, accuracy: FloatAccuracy) -> list[str]:
+def _sections(model: Model, plan: CPlan, prefix: str, accuracy: FloatAccuracy) -> list[str]:
     """UNITS, USAGE and ACCURACY of the float build's README block."""
     p, up = prefix, prefix.upper()
     settings = model.drift.settings
@@ -96,7 +96,7 @@ def _sections(model: UnitModel, plan: CPlan, prefix: str, accuracy: FloatAccurac
     ]
 
 
-def header(model: UnitModel, plan: CPlan, prefix: str, origin: str, sha256: str,
+def header(model: Model, plan: CPlan, prefix: str, origin: str, sha256: str,
            constants: FloatConstants, accuracy: FloatAccuracy) -> str:
     """Text of the float build's ``<prefix>_model.h`` (the template both builds share,
     :func:`hrgtc.export.c.header.header`, in float, with the centre and error bounds)."""

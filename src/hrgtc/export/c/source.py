@@ -29,7 +29,7 @@ from hrgtc.export.c.step import step_tail
 from hrgtc.export.c.thermometer import NEWTON_MAX_ITER, thermometer_functions
 from hrgtc.export.c.types import DOUBLE, SINGLE, CType, ctype
 from hrgtc.export.c.variables import RATES, bias_params, cname, extra_variables, levels, step_inputs
-from hrgtc.model import UnitModel
+from hrgtc.model import Model
 
 __all__ = ["BodyNumbers", "PlanNumbers", "bias_function", "source"]
 
@@ -69,14 +69,14 @@ class PlanNumbers:
     tolerance: float
 
     @classmethod
-    def of(cls, model: UnitModel, plan: CPlan) -> PlanNumbers:
+    def of(cls, model: Model, plan: CPlan) -> PlanNumbers:
         th = model.thermometer
         return cls(model.drift.settings.reference_c, plan.tau_s, th.centre_c, th.scale_c,
                    plan.th_coefficients, plan.th_derivative, plan.grid_f, plan.grid_t,
                    plan.f_range[0], plan.f_range[1], plan.tolerance)
 
 
-def bias_function(model: UnitModel, plan: CPlan, prefix: str) -> str:
+def bias_function(model: Model, plan: CPlan, prefix: str) -> str:
     """``<prefix>_bias_dph()`` and its constants: Eq. (22) of [1] on the scaled variables,
     each held at the edge of its training range and continued along the tangent there (as
     ``DriftModel.predict(extrapolation="tangent")``), in the plan's C type."""
@@ -163,7 +163,7 @@ def _housing(plan: CPlan, t: CType, reference_c: float, tau: str) -> dict[str, s
     return h
 
 
-def source(model: UnitModel, plan: CPlan, prefix: str,
+def source(model: Model, plan: CPlan, prefix: str,
            numbers: BodyNumbers | None = None) -> str:
     """Text of ``<prefix>_model.c`` in the plan's precision: filter, drift model,
     thermometer inverse, ``step()``.

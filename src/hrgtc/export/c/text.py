@@ -4,7 +4,7 @@ The header is the template both builds share (:mod:`hrgtc.export.c.header`); the
 ``.c`` file is one body for both builds (:mod:`hrgtc.export.c.source`).
 
 :mod:`hrgtc.export.export_c` decides what to export (the validated numbers of a
-:class:`~hrgtc.model.UnitModel`); this module says in words what the code computes, with
+:class:`~hrgtc.model.Model`); this module says in words what the code computes, with
 which numbers and how to use it (the float32 build replaces the UNITS and USAGE
 sections with its own, :mod:`hrgtc.export.c.single`).
 
@@ -26,12 +26,12 @@ from hrgtc.export.c.variables import (
     readme_lines,
     step_inputs,
 )
-from hrgtc.model import UnitModel
+from hrgtc.model import Model
 
 _WIDTH = 92
 
 
-def sensor_note(model: UnitModel) -> list[str]:
+def sensor_note(model: Model) -> list[str]:
     """Lines that say, for a model whose thermometer is the gyro's temperature sensor
     (``calibrate --thermometer sensor``), that every "Hz" of the export means °C.
 
@@ -50,7 +50,7 @@ def sensor_note(model: UnitModel) -> list[str]:
     ]
 
 
-def title(model: UnitModel) -> str:
+def title(model: Model) -> str:
     """What an export compensates, for its first line: an HRG's drift (a resonator
     thermometer), or a gyro's by its temperature sensor (``--thermometer sensor``)."""
     if model.thermometer.source == "sensor":
@@ -58,7 +58,7 @@ def title(model: UnitModel) -> str:
     return "HRG temperature-drift compensation"
 
 
-def offsets_note(model: UnitModel) -> list[str]:
+def offsets_note(model: Model) -> list[str]:
     """Lines that say the export applies none of the model's per-run or per-orientation
     offsets (``calibrate --offsets``): its intercept is their mean over the training
     samples. Empty when the model has none."""
@@ -82,7 +82,7 @@ def offsets_note(model: UnitModel) -> list[str]:
     return [*lines, ""]
 
 
-def readme(model: UnitModel, plan: CPlan, prefix: str, origin: str,
+def readme(model: Model, plan: CPlan, prefix: str, origin: str,
             sha256: str, sections: list[str] | None = None) -> str:
     """The README comment block at the top of the header: what, provenance, Eq. (22), units, use.
 
@@ -227,7 +227,7 @@ def readme(model: UnitModel, plan: CPlan, prefix: str, origin: str,
     return "/*\n" + "\n".join((" * " + line).rstrip() for line in wrapped) + "\n */\n"
 
 
-def header(model: UnitModel, plan: CPlan, prefix: str, origin: str,
+def header(model: Model, plan: CPlan, prefix: str, origin: str,
            sha256: str) -> str:
     """Text of ``<prefix>_model.h``: README block, state and output structs, prototypes
     (the template both builds share, :func:`hrgtc.export.c.header.header`)."""
