@@ -116,7 +116,7 @@ def compensate_command(
             f"beyond the trained ranges: {summary.ranges.shares_text()}"
         console.print(f"wrote {summary.output}: {summary.rows} rows; {shares}{axes}")
         if summary.accounting is not None:  # flagged, never dropped
-            console.print(summary.accounting.summary(), markup=False)
+            console.print(summary.accounting.summary().text(), markup=False)
     note_unchecked(model, model_path)
     warn_ranges([summary.ranges], json_output, strict)
 

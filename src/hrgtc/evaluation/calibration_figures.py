@@ -74,7 +74,7 @@ def calibration_summary(model: Any, table: Sequence[Mapping[str, float]] = (),
     else:
         notes.append(thermometer_equation(th))
     if model.drift.accounting is not None:
-        notes.append("drift training " + model.drift.accounting.summary())
+        notes.append("drift training " + model.drift.accounting.summary().text())
     notes += [*drift_notes(model.drift), drift_form(model.drift, sensor)]
     if model.housing is not None:
         sections.append(("housing-thermistor baseline",
