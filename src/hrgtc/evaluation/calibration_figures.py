@@ -94,7 +94,7 @@ def thermometer_equation(thermometer: Any) -> str:
         c3, c2, c1, c0 = thermometer.coefficients_high_first
         return (f"Eq. (18) form: f = {c3:.4e}·T³ {c2:+.4e}·T² {c1:+.6f}·T {c0:+.4f}  "
                 "[Hz, T in °C]")
-    return thermometer.summary().splitlines()[-1]
+    return thermometer.summary().text().splitlines()[-1]
 
 
 def thermometer_tables(thermometer: Any, plateaus: Sequence[Any]) -> Summary:
