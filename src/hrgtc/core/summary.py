@@ -195,6 +195,13 @@ class Summary:
                                                         for line in self.layout)
         return Summary(self.title, sections, self.notes, layout)
 
+    def referenced(self) -> set[str]:
+        """The names of the figures the layout shows (all of them without a layout)."""
+        if self.layout is None:
+            return set(self.figures())
+        return {name for line in self.layout for _, name, _, _ in _BY_NAME.parse(line)
+                if name is not None}
+
     def lines(self, indent: str = "") -> tuple[str, ...]:
         """The layout's lines (the generic text's, escaped, without one), each after
         ``indent``: the part this summary is of a larger one's layout."""
