@@ -1,13 +1,14 @@
 """One real object of every class with a ``summary()``, built from the shared campaigns.
 
 ``every_result(paper, imu, folder)`` -> {name: object}: the paper-unit's calibration (its
-thermometer, drift model, stepwise result, final fit, training accounting, plateaus), an
-evaluation of its held-out warm-up (Allan curves, noise terms, heating/cooling), the
-three-axis imu-3's calibration (scale factor, rate-table segments, an instrument
-compensator), a recording's info (validation, time axis), the simulator's units, profile and
-written files, and the small results built from arrays (Hald's data for the stepwise
-regression, a spike, a slow channel, a temperature map, a thermometer prior, a transient).
-``tests/test_summaries.py`` checks each ``summary()``.
+thermometer, drift model, training accounting, plateaus), an evaluation of its held-out
+warm-up (Allan curves, noise terms, heating/cooling) and of its cool-down (the demo's
+table), the three-axis imu-3's calibration (scale factor, rate-table segments, an
+instrument compensator) and an evaluation of its held-out rate table, a recording's info
+(validation, time axis), the simulator's units, profile and written files, and the small
+results built from arrays (Hald's data for the stepwise regression, a spike, a slow
+channel, a temperature map, a thermometer prior, a transient). ``tests/test_summaries.py``
+checks each ``summary()``.
 """
 
 from __future__ import annotations
@@ -38,25 +39,30 @@ def every_result(paper: Any, imu: Any, folder: Path) -> dict[str, Any]:
 def _paper(paper: Any) -> dict[str, Any]:
     from hrgtc.evaluation.run_pass import evaluate
     from hrgtc.pipeline.calibration import calibrate
+    from hrgtc.pipeline.demo import DemoResult
     from hrgtc.recording import read
     from hrgtc.thermometry.plateaus import find_plateaus
 
     result = calibrate(paper.soaks, [paper.cooldown], [paper.warmup])
     model = result.model
     evaluation = evaluate(paper.warmup, model)
+    training = evaluate(paper.cooldown, model)
     plateau = find_plateaus(read(paper.soaks[0]))[0]
     return {"CalibrationResult": result, "DriftModel": model.drift,
             "Thermometer": model.thermometer, "Accounting": model.drift.accounting,
             "Plateau": plateau, "Evaluation": evaluation,
             "AllanResult": evaluation.allan["compensated"],
             "NoiseTerms": evaluation.noise["compensated"],
-            "DirectionStats": evaluation.directions}
+            "DirectionStats": evaluation.directions,
+            # the demo's figures (its files are the demo's business, not the summary's)
+            "DemoResult": DemoResult(Path("demo-out"), result, training, evaluation, None,
+                                     Path("model.json"), Path("report.html"), ())}
 
 
 def _instrument(imu: Any) -> dict[str, Any]:
     from hrgtc.compensate.multi_axis import InstrumentCompensator
     from hrgtc.drift.rate_segments import segment_scale_errors
-    from hrgtc.pipeline.instrument import calibrate_instrument
+    from hrgtc.pipeline.instrument import calibrate_instrument, evaluate_instrument
     from hrgtc.recording import axis_view, read
 
     calibration = calibrate_instrument(imu.soaks, [imu.cooldown], [imu.warmup],
@@ -66,6 +72,8 @@ def _instrument(imu: Any) -> dict[str, Any]:
     compensator.transform(read(imu.warmup))
     table = axis_view(read(imu.rate_table), "x")
     return {"InstrumentCalibration": calibration,
+            "InstrumentEvaluation": evaluate_instrument(imu.rate_table_heldout,
+                                                        calibration.model),
             "ScaleFactorModel": calibration.model.axes["x"].scale_factor,
             "SegmentScaleErrors": segment_scale_errors(table),
             "InstrumentCompensator": compensator}

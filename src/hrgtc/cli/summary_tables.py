@@ -63,11 +63,11 @@ def print_summary(summary: Summary, console: Console, notes: bool = True) -> Non
             console.print(table)
         text = summary.text()
         if text:
-            console.print(text, markup=False, highlight=False)
+            console.print(text, markup=False, highlight=False, emoji=False)
         return
     if summary.title:
-        console.print(summary.title, markup=False, highlight=False)
+        console.print(summary.title, markup=False, highlight=False, emoji=False)
     for table in summary_tables(summary):
         console.print(table)
     for note in summary.notes if notes else ():
-        console.print(note, markup=False)
+        console.print(note, markup=False, emoji=False)
