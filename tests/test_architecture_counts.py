@@ -23,6 +23,13 @@ def test_the_counts_do_not_grow():
     assert not over, (over, found["long_function_names"], found["many_parameter_names"])
 
 
+def test_every_summary_returns_a_summary():
+    """Issue 28, item 3: ``summary()`` means one thing, a ``core.summary.Summary`` (that the
+    objects are Summaries, not only annotated so: tests/test_summaries.py)."""
+    types = architecture_counts.counts()["summary_return_types"]
+    assert list(types) == ["Summary"] and types["Summary"] >= 31, types
+
+
 def test_the_counter_counts(tmp_path):
     """A planted long function with many parameters and an accumulator without finish()
     are each counted (the counts could be wrong)."""
@@ -31,8 +38,10 @@ def test_the_counter_counts(tmp_path):
     body = "\n".join(f"    x{k} = {k}" for k in range(85))
     (package / "planted.py").write_text(
         f"def long(a, b, c, d, e, f, g, h, i, j):\n{body}\n\n\n"
-        "class Acc:\n    def partial_fit(self, chunk):\n        return self\n",
+        "class Acc:\n    def partial_fit(self, chunk):\n        return self\n\n"
+        "    def summary(self) -> str:\n        return ''\n",
         encoding="utf-8")
     found = architecture_counts.counts(package)
     assert (found["long_functions"], found["many_parameters"],
             found["partial_fit_without_finish"]) == (1, 1, 1)
+    assert found["summary_return_types"] == {"str": 1}

@@ -28,7 +28,8 @@ def test_counts_used_fraction_and_the_warning_above_ten_percent():
     assert a.warning is None  # 10 % exactly is not more than 10 %
     a.drop("warmup", 1)
     assert a.warning.startswith("10% of the samples dropped (most for warm-up")
-    assert "-- warning:" in a.summary() and "7 out of the calibrated range" in a.summary()
+    text = a.summary().text()
+    assert "-- warning:" in text and "7 out of the calibrated range" in text
     assert Accounting.from_dict(json.loads(json.dumps(a.to_dict()))) == a
     other = Accounting(read=10)
     other.drop("spikes", 3)

@@ -45,3 +45,28 @@ def test_a_table_cell_keeps_its_place_and_format_in_json():
     # the JSON form gives the same cell back
     again = Figure(**{k: v for k, v in data.items() if k != "interval"})
     assert again == cell and again.number() == "4416.97"
+
+
+def test_a_layout_renders_the_figures_and_survives_renaming():
+    """A layout line is a format string over the figures' names (dots and brackets in a
+    name included); renamed() moves the names and the layout's references together; str()
+    is the text; a definition is in the JSON and the HTML title, only when set."""
+    from hrgtc.core.summary import Figure, Summary, escape
+
+    figures = (Figure("runs[0].rms_dph", "rms", 0.012345, "°/h",
+                      definition="RMS of the residual."),
+               Figure("name", "unit", "SN-{1}"))
+    summary = Summary("t", (("s", figures),),
+                      layout=(escape("{literal}") + " {name}: rms {runs[0].rms_dph:.3g} °/h",))
+    assert summary.text() == "{literal} SN-{1}: rms 0.0123 °/h" == str(summary)
+    inner = summary.renamed("axes.x.")
+    assert inner.text() == summary.text()
+    assert set(inner.figures()) == {"axes.x.runs[0].rms_dph", "axes.x.name"}
+    assert Summary("u", inner.sections, layout=("> " + inner.lines()[0],)).text() == (
+        "> {literal} SN-{1}: rms 0.0123 °/h")
+    assert summary["runs[0].rms_dph"].to_dict()["definition"] == "RMS of the residual."
+    assert "definition" not in summary["name"].to_dict()
+    assert '<td title="RMS of the residual.">rms</td>' in summary.html()
+    assert Summary("empty", layout=()).text() == ""
+    assert Summary("plain", (("s", figures),)).lines() == (
+        "plain", "s:", "  rms: 0.012345 °/h", "  unit: SN-{{1}}")

@@ -49,7 +49,7 @@ def test_burst_axis_gives_its_segments_span_and_recorded_duration():
     assert line.burst_length_s == pytest.approx(5.0)
     assert line.burst_period_s == pytest.approx(300.0)
     assert line.is_bursty
-    assert "recorded 125 s in 25 segment(s)" in line.summary()
+    assert "recorded 125 s in 25 segment(s)" in line.summary().text()
 
 
 def test_the_builder_chunk_by_chunk_gives_the_whole_timeline():

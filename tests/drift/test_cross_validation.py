@@ -70,7 +70,7 @@ def test_drift_fit_reports_cross_validation_per_run():
     assert cv is not None and len(cv.per_run_dph) == 2
     assert all(np.isfinite(v) and v > 0 for v in cv.per_run_dph.values())
     assert np.isfinite(cv.heating_dph) and np.isfinite(cv.cooling_dph)
-    assert "cross-validation" in model.summary()
+    assert "cross-validation" in model.summary().text()
     by_cv = drift.fit([cool, warm], THERMOMETER, select="cv")
     assert by_cv.selection == "cv" and by_cv.selected
     assert by_cv.cross_validation.score_dph <= cv.score_dph  # never worse than stepwise

@@ -73,7 +73,7 @@ def test_json_round_trip(model, cooldown):
     np.testing.assert_array_equal(
         again.predict_recording(cooldown), model.predict_recording(cooldown)
     )
-    assert "B = " in again.summary()
+    assert "B = " in again.summary().text()
 
 
 def test_constant_temperature_run_is_refused():

@@ -127,6 +127,6 @@ def test_scale_errors_before_and_after():
     after = segment_scale_errors(compensated, segments=raw.segments)
     np.testing.assert_allclose(after.error_ppm, 0.0, atol=1e-6)
     assert after.max_abs_ppm < 1e-6 and raw.rms_ppm == pytest.approx(250.0)
-    assert "2 segments" in raw.summary() and len(raw.to_dict()["error_ppm"]) == 2
+    assert "2 segments" in raw.summary().text() and len(raw.to_dict()["error_ppm"]) == 2
     with pytest.raises(InputError, match="bias_dph has shape"):
         segment_scale_errors(run, np.zeros(3))

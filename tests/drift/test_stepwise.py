@@ -335,7 +335,7 @@ def test_stepwise_options_and_serialisation():
     assert back.history == res.history and back.selected == res.selected
     np.testing.assert_array_equal(back.result.params, res.result.params)
     assert OLSResult.from_dict(res.result.to_dict()).names == res.result.names
-    assert "removed x4" in res.summary() and "const" in res.result.summary()
+    assert "removed x4" in res.summary().text() and "const" in res.result.summary().text()
 
 
 def test_variance_inflation_scales_errors_and_f_statistics():

@@ -186,11 +186,11 @@ def test_result_with_interval_round_trips_and_reports():
     np.testing.assert_array_equal(back.lower, result.lower)
     np.testing.assert_array_equal(back.upper, result.upper)
     assert back.confidence == 0.95 and back.kind == "allan"
-    assert "lower" in result.summary() and "0.95 confidence" in result.summary()
+    assert "lower" in result.summary().text() and "0.95 confidence" in result.summary().text()
     plain = allan_deviation(rate, 10.0, kind="hadamard")
     assert plain.lower is None
     assert AllanResult.from_dict(json.loads(json.dumps(plain.to_dict()))).kind == "hadamard"
-    assert "Hadamard deviation" in plain.summary()
+    assert "Hadamard deviation" in plain.summary().text()
 
 
 def test_errors():

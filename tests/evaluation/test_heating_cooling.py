@@ -74,7 +74,7 @@ def test_split_by_hand_and_by_the_resonator_temperature(model):
     d = result.to_dict()["heating_cooling"]
     assert d["heating"]["blocks"] == split.blocks["heating"]
     assert d["cooling"]["compensated_dph"] == pytest.approx(split.compensated_dph["cooling"])
-    assert "heating:" in result.summary() and "cooling:" in result.summary()
+    assert "heating:" in result.summary().text() and "cooling:" in result.summary().text()
 
 
 def test_chunking_does_not_change_the_split(model):
@@ -138,7 +138,7 @@ def test_blocks_never_span_a_gap_and_match_the_burst_means_by_hand(model, burst_
         assert found.raw_dph[name] == pytest.approx(np.std(raw_means[mask], ddof=1), rel=1e-9)
         assert found.compensated_dph[name] == pytest.approx(
             np.std(comp_means[mask], ddof=1), rel=1e-9)
-    assert f"{partial} blocks cut short by a gap" in found.summary()
+    assert f"{partial} blocks cut short by a gap" in found.summary().text()
 
 
 def test_no_block_is_said_once_with_the_reason(model):
@@ -151,7 +151,7 @@ def test_no_block_is_said_once_with_the_reason(model):
     found = split.finish()
     assert found.blocks == {"heating": 0, "cooling": 0}
     assert found.reason == "bursts of at most 3 s are shorter than half the 10 s block (4.8 s)"
-    text = found.summary()
+    text = found.summary().text()
     assert text.count("\n") == 0 and "no 10 s block (bursts of at most 3 s" in text
     assert found.to_dict()["reason"] == found.reason
 

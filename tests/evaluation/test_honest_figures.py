@@ -44,7 +44,7 @@ def test_a_constant_offset_shows_in_the_mean_not_in_the_bias_stability(model):
     assert moved.rms_dph["compensated"] > 136.0 > 10 * moved.compensated_10s
     data = moved.to_dict()
     assert data["mean_dph"]["compensated"] == pytest.approx(moved.mean_dph["compensated"])
-    assert "compensated (frequency, Eq. 22) mean: 136" in moved.summary()
+    assert "compensated (frequency, Eq. 22) mean: 136" in moved.summary().text()
 
 
 def test_handling_is_left_out_of_the_figures_and_counted(model):
@@ -64,4 +64,4 @@ def test_handling_is_left_out_of_the_figures_and_counted(model):
     assert kept.n_not_at_rest == 0
     assert excluded.compensated_10s == pytest.approx(clean.compensated_10s, rel=0.1)
     assert kept.compensated_10s > 100 * clean.compensated_10s
-    assert "not at rest" in excluded.summary()
+    assert "not at rest" in excluded.summary().text()

@@ -255,11 +255,11 @@ def test_allan_progress_and_round_trips():
     np.testing.assert_array_equal(back.deviation, result.deviation)
     np.testing.assert_array_equal(back.counts, result.counts)
     assert back.n_samples == 5000 and back.sample_rate_hz == 50.0
-    assert "overlapping" in result.summary()
+    assert "overlapping" in result.summary().text()
 
     terms = noise_terms(result)
     assert NoiseTerms.from_dict(json.loads(json.dumps(terms.to_dict()))) == terms
-    assert "angle random walk" in terms.summary()
+    assert "angle random walk" in terms.summary().text()
 
 
 def test_residual_against_truth():
@@ -280,7 +280,7 @@ def test_residual_against_truth():
     assert data["bias_stability_dph"]["1000"] is None
     back = ResidualResult.from_dict(data)
     assert back.rms_dph == result.rms_dph and math.isnan(back.bias_stability_dph[1000.0])
-    assert "rms" in result.summary()
+    assert "rms" in result.summary().text()
     with pytest.raises(InputError, match="samples but true_bias_dph"):
         residual_against_truth(bias_model_dph=truth, true_bias_dph=truth[:-1], sample_rate_hz=fs)
     with pytest.raises(TypeError):

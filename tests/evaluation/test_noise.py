@@ -56,7 +56,7 @@ def test_a_pure_ramp_has_no_arw():
     assert terms.arw_reason.startswith("no −½ slope")
     back = NoiseTerms.from_dict(json.loads(json.dumps(terms.to_dict())))
     assert back == terms
-    assert "n/a (no −½ slope" in terms.summary()
+    assert "n/a (no −½ slope" in terms.summary().text()
 
 
 def test_too_few_points_on_a_slope_say_how_many():

@@ -94,7 +94,7 @@ def test_text_rich_html_and_json_show_the_same_figures(run, monkeypatch):
                  "accounting.read", "prediction_std_dph.median", "mean_dph.compensated"):
         assert f"evaluation.{part}" in names
 
-    text = [line.strip() for line in result.summary().splitlines()]
+    text = [line.strip() for line in result.summary().text().splitlines()]
     out = io.StringIO()
     monkeypatch.setattr(compensate_cmd, "console", Console(file=out, width=400))
     compensate_cmd.render_evaluation(result)

@@ -140,7 +140,7 @@ def test_evaluation_ranges_cover_temperature_and_df_dt(setup):
     assert data["rate_fraction"] == pytest.approx(result.rate_out_of_range_fraction)
     assert data["rate_fraction"] > 0.0 and data["rate_excess_ratio"] > 1.0
     assert data["seen_rate_c_per_h"][1] > 0.0 >= data["trained_rate_c_per_h"][0]
-    assert any("df/dt" in line for line in result.summary().splitlines())
+    assert any("df/dt" in line for line in result.summary().text().splitlines())
 
 
 def test_intervals_deviation_kinds_and_allan_csv(setup, tmp_path):

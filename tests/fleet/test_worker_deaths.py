@@ -38,13 +38,13 @@ def test_a_worker_that_dies_is_reported_with_the_unit_run_again(tmp_path):
     assert run.counts() == {"ok": 3, "skipped": 0, "failed": 0}  # Dask ran it again
     assert run.workers_died == 1
     assert run.retried == ("u1",)
-    assert "1 worker process(es) died during the run" in run.summary()
-    assert "run again: u1" in run.summary()
+    assert "1 worker process(es) died during the run" in run.summary().text()
+    assert "run again: u1" in run.summary().text()
 
 
 def test_without_deaths_the_summary_says_nothing_of_them():
     run = FleetRun((UnitOutcome("a", "ok"),), 1.0, "sequential")
-    assert "died" not in run.summary() and run.workers_died == 0 and run.retried == ()
+    assert "died" not in run.summary().text() and run.workers_died == 0 and run.retried == ()
 
 
 def test_worker_deaths_reads_the_scheduler_events():

@@ -307,7 +307,7 @@ def test_clean_recording_validates():
     assert isinstance(report, ValidationReport) and report.ok and report.problems == ()
     assert report.measured_sample_rate_hz == pytest.approx(RATE_HZ)
     assert ValidationReport.from_dict(report.to_dict()) == report
-    assert "ok" in report.summary()
+    assert "ok" in report.summary().text()
 
 
 @pytest.mark.parametrize(

@@ -32,7 +32,7 @@ def test_hold_takes_the_last_value_and_interpolate_the_line():
     # linear in time between the 1 Hz values: exact for this ramp; the last 9 rows held
     np.testing.assert_allclose(interpolated["housing_c"][:991], truth[:991], rtol=0, atol=1e-12)
     np.testing.assert_array_equal(interpolated["housing_c"][991:], truth[990])
-    assert "column 'housing_c' is logged every 1 s" in slow.summary()[0]
+    assert "column 'housing_c' is logged every 1 s" in slow.summary().text().splitlines()[0]
 
 
 def test_older_than_the_maximum_age_is_a_gap_and_dropped():
@@ -46,7 +46,7 @@ def test_older_than_the_maximum_age_is_a_gap_and_dropped():
     assert state.first_dropped_row == 311
     assert np.all(np.isfinite(out["housing_c"]))
     assert np.max(np.diff(kept)) > 25.0  # the gap shows in the time axis
-    assert "dropped as a gap" in slow.summary()[0]
+    assert "dropped as a gap" in slow.summary().text().splitlines()[0]
 
 
 @pytest.mark.parametrize("mode", ["hold", "interpolate"])
@@ -138,7 +138,7 @@ def test_one_column_under_two_names_is_filled_under_both_and_reported_once(chunk
     held = truth[(np.arange(1000) // 10) * 10]
     for name in ("temperature_c", "freq_hz_x", "freq_hz_y"):
         np.testing.assert_array_equal(out[name], held)
-    (line,) = slow.summary()
+    (line,) = slow.summary().text().splitlines()
     assert "column 'temperature_c'" in line and "900 cells filled" in line
     assert [c["column"] for c in slow.to_dict()["channels"]] == ["temperature_c"]
     with pytest.warns(SlowChannelWarning) as caught:

@@ -50,7 +50,7 @@ def test_imu3_axes_are_different_resonators_in_one_housing():
     assert math.hypot(rates["x"], rates["z"]) == pytest.approx(EARTH_RATE_DPH, rel=1e-6)
     assert rates["y"] == 0.0
     assert math.degrees(math.atan2(rates["z"], rates["x"])) == pytest.approx(40.0)
-    assert "axis y" in imu.summary() and "scale factor" in imu.summary()
+    assert "axis y" in imu.summary().text() and "scale factor" in imu.summary().text()
 
 
 def test_multi_axis_unit_checks():

@@ -235,7 +235,7 @@ def test_round_trip_summary_and_progress():
         data = json.loads(json.dumps(plateau.to_dict()))
         assert Plateau.from_dict(data) == plateau
         assert TransientFit.from_dict(data["fit"]) == plateau.fit
-        assert f"{plateau.settled_freq_hz:.5f}" in plateau.summary()
+        assert f"{plateau.settled_freq_hz:.5f}" in plateau.summary().text()
     with pytest.raises(InputError, match="plateau record"):
         Plateau.from_dict({"chamber_c": 1.0})
     temperatures, frequencies = plateau_table(plateaus)

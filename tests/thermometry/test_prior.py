@@ -76,7 +76,7 @@ def test_prior_file_round_trip(tmp_path):
                                                [f"u{k}" for k in range(8)])
     path = save_prior(prior, tmp_path / "prior.json")
     assert load_prior(path) == prior
-    assert "prior of 8 units" in prior.summary()
+    assert "prior of 8 units" in prior.summary().text()
     with pytest.raises(InputError, match="not an hrgtc prior file"):
         (tmp_path / "other.json").write_text('{"schema": "hrgtc.model"}')
         load_prior(tmp_path / "other.json")

@@ -153,5 +153,5 @@ def test_dict_round_trip_through_json_is_exact():
 
 
 def test_summary_names_the_coefficients():
-    text = fit(TABLE1_T, TABLE1_F, order=3).summary()
+    text = fit(TABLE1_T, TABLE1_F, order=3).summary().text()
     assert "T^3" in text and "R²" in text

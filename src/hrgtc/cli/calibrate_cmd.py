@@ -157,7 +157,7 @@ def render_map(stored: dict[str, Any] | None) -> None:
     from hrgtc.thermometry.reference import TemperatureMap
 
     temperature_map = TemperatureMap.from_dict(stored)
-    console.print("Temperature map: " + temperature_map.summary())
+    console.print("Temperature map: " + temperature_map.summary().text())
     if temperature_map.extra.get("note"):
         console.print(f"[yellow]note:[/] {temperature_map.extra['note']}")
 

@@ -114,7 +114,7 @@ def compensate_command(
             f"beyond the trained ranges: {summary.ranges.shares_text()}"
         console.print(f"wrote {summary.output}: {summary.rows} rows; {shares}{axes}")
         if summary.accounting is not None:  # flagged, never dropped
-            console.print(summary.accounting.summary(), markup=False)
+            console.print(summary.accounting.summary().text(), markup=False)
     note_unchecked(model, model_path)
     warn_ranges([summary.ranges], json_output, strict)
 
@@ -191,8 +191,11 @@ def evaluate_command(
 
 
 def render_instrument_evaluation(result: InstrumentEvaluation, json_output: bool) -> None:
-    """``hrgtc evaluate``'s output: each axis's table, the instrument's summary and the
-    scale-factor check (or the JSON document, the scale check on stderr)."""
+    """``hrgtc evaluate``'s output: each axis's table, then the instrument's summary (the
+    axes side by side, the scale-factor check: :meth:`InstrumentEvaluation.summary`), or the
+    JSON document (the scale check on stderr)."""
+    from hrgtc.cli.summary_tables import print_summary
+
     model = result.model
     sensor = {axis: m.thermometer.source == "sensor" for axis, m in model.axes.items()}
     if json_output:
@@ -203,41 +206,10 @@ def render_instrument_evaluation(result: InstrumentEvaluation, json_output: bool
         for axis, evaluation in result.axes.items():
             console.rule(f"axis {axis}")
             render_evaluation(evaluation, sensor[axis])
-        render_axis_summary(model.unit, result)
     checks = result.scale_checks
     if checks and json_output:
         error_console.print("scale factor: " + "; ".join(
             f"axis {c.axis or '-'} {c.raw_max_ppm:.1f} → {c.compensated_max_ppm:.1f} ppm"
             for c in checks))
-    elif checks:
-        render_scale_checks(checks)
-
-
-def render_scale_checks(checks: tuple) -> None:
-    """Scale-factor error at each temperature of a rate-table run, raw → compensated."""
-    from rich.table import Table  # imported by the command, not by --help
-    table = Table(title="Scale-factor error (ppm) at each temperature of the rate table "
-                  "(slope of rate − Ω against Ω, IEEE Std 1431), raw → compensated")
-    for column in ("axis", "frequency (Hz)", "holds", "raw", "compensated"):
-        table.add_column(column, justify="right")
-    for check in checks:
-        for f, n, raw, comp in zip(check.freq_hz, check.holds, check.raw_ppm,
-                                   check.compensated_ppm, strict=True):
-            table.add_row(check.axis or "-", f"{f:.4f}", str(n), f"{raw:+.2f}", f"{comp:+.2f}")
-    console.print(table)
-
-
-def render_axis_summary(unit: str, result: InstrumentEvaluation) -> None:
-    """The instrument's summary table: one row per axis."""
-    from rich.table import Table  # imported by the command, not by --help
-    table = Table(title=f"{unit}: 10 s bias stability per axis (°/h)")
-    for column in ("axis", "raw", "compensated", "improvement", "comp. mean", "comp. RMS",
-                   "beyond T", "beyond df/dt"):
-        table.add_column(column, justify="right")
-    for row in result.axis_summary():
-        table.add_row(str(row["axis"]), f"{row['raw_10s_dph']:.4f}",
-                      f"{row['compensated_10s_dph']:.4f}", f"{row['improvement_10s']:.2f}×",
-                      f"{row['compensated_mean_dph']:+.4g}", f"{row['compensated_rms_dph']:.4g}",
-                      f"{row['out_of_range_fraction']:.1%}",
-                      f"{row['rate_out_of_range_fraction']:.1%}")
-    console.print(table)
+    elif not json_output:
+        print_summary(result.summary(), console)

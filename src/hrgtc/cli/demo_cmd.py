@@ -28,8 +28,8 @@ def demo_command(
 
     Example: hrgtc demo -o demo-out --force
     """
+    from hrgtc.cli.summary_tables import print_summary
     from hrgtc.pipeline.demo import run_demo
-    from hrgtc.thermometry import paper
 
     settings = DemoSettings.quick(seed) if quick else DemoSettings(seed=seed)
     seen: set[str] = set()
@@ -60,18 +60,7 @@ def demo_command(
     render(result.calibration)
     render_evaluation(result.training)
     render_evaluation(result.validation)
-    from rich.table import Table  # imported by the command, not by --help
-    table = Table(title="10 s bias stability, raw → compensated (°/h)")
-    for column in ("run", "raw", "compensated", "improvement"):
-        table.add_column(column, justify="right")
-    table.add_row("paper (Section 4.2, cool-down, fitted on itself)",
-                  f"{paper.BIAS_STABILITY_RAW_DPH}", f"{paper.BIAS_STABILITY_COMPENSATED_DPH}",
-                  f"{paper.BIAS_STABILITY_RAW_DPH / paper.BIAS_STABILITY_COMPENSATED_DPH:.2f}×")
-    for label, ev in (("paper-unit cool-down (training)", result.training),
-                      ("paper-unit warm-up (held out)", result.validation)):
-        table.add_row(label, f"{ev.raw_10s:.4f}", f"{ev.compensated_10s:.4f}",
-                      f"{ev.improvement_10s:.2f}×")
-    console.print(table)
+    print_summary(result.summary(), console)
     console.print(f"model: {result.model_file}")
     console.print(f"report: {result.report_file}")
     console.print("C: " + ", ".join(str(p) for p in result.c_files))

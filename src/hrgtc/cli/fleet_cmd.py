@@ -39,24 +39,16 @@ def _models_folder_inputs(models: Path) -> list[Path]:
 def _finish(run: FleetRun, json_output: bool, written: str) -> None:
     """Print the outcome per unit (or JSON) and exit 1 when some units failed."""
     if json_output:
-        print_json({"summary": run.summary(), "counts": run.counts(), "seconds": run.seconds,
+        print_json({"summary": run.summary().text(), "counts": run.counts(),
+                    "seconds": run.seconds,
                     "where": run.where, "written": written,
                     "workers_died": run.workers_died, "retried": list(run.retried),
                     "units": [{"unit": o.unit, "status": o.status, "error": o.error,
                                "seconds": o.seconds} for o in run.outcomes]})
-    else:
-        if run.failed:
-            from rich.table import Table  # imported by the command, not by --help
-            table = Table(title="Failed units")
-            for column in ("unit", "error", "file", "column", "row", "message"):
-                table.add_column(column)
-            for o in run.failed:
-                e = o.error or {}
-                table.add_row(o.unit, str(e.get("type")), str(e.get("file") or "–"),
-                              str(e.get("column") or "–"), str(e.get("row") or "–"),
-                              str(e.get("message", "")).splitlines()[0][:200])
-            console.print(table)
-        console.print(run.summary())
+    else:  # the failed units' table, then the line
+        from hrgtc.cli.summary_tables import print_summary
+
+        print_summary(run.summary(), console)
         console.print(f"Written: {written}")
     if run.failed:
         raise typer.Exit(1)
@@ -220,5 +212,5 @@ def prior_command(
     if json_output:
         print_json(prior.to_dict())
         return
-    console.print(prior.summary())
+    console.print(prior.summary().text(), markup=False)
     error_console.print(f"Prior written to {output}")

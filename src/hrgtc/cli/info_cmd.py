@@ -32,6 +32,6 @@ def info(
     if json_output:
         print_json(result.to_dict())
     else:
-        console.print(result.summary(), markup=False)
+        console.print(result.summary().text(), markup=False)
     if not result.ok:
         raise fail(result.validation.message)

@@ -103,15 +103,11 @@ def simulate_command(
             if json_output:
                 print_json([w.to_dict() for w in logged])
                 return
-            from rich.table import Table  # imported by the command, not by --help
-            table = Table(title=f"simulated {unit} through a {logger} logger, "
-                          f"{spec.sample_rate_hz:g} Hz, seed {seed}")
-            for column in ("file", "rows", "truth"):
-                table.add_column(column, justify="right" if column == "rows" else "left")
-            for w in logged:
-                truth = w.truth_json + (f", {w.reference_log}" if w.reference_log else "")
-                table.add_row(w.path, f"{w.rows:,}", truth)
-            console.print(table)
+            from hrgtc.cli.summary_tables import print_summary
+            from hrgtc.simulate.logged_files import logged_summary
+
+            print_summary(logged_summary(logged, unit, logger, spec.sample_rate_hz, seed),
+                          console)
             first = json.loads(Path(logged[0].truth_json).read_text())["hrgtc_options"]
             console.print("read it with: hrgtc info " + shlex.quote(logged[0].path) + " "
                           + " ".join(shlex.quote(o) for o in first), markup=False,
@@ -133,13 +129,10 @@ def simulate_command(
     if json_output:
         print_json([w.to_dict() for w in written])
         return
-    from rich.table import Table  # imported by the command, not by --help
-    table = Table(title=f"simulated {unit}, {sample_rate_hz:g} Hz, seed {seed}")
-    for column in ("file", "rows", "profile"):
-        table.add_column(column, justify="right" if column == "rows" else "left")
-    for w in written:
-        table.add_row(w.path, f"{w.rows:,}", w.profile)
-    console.print(table)
+    from hrgtc.cli.summary_tables import print_summary
+    from hrgtc.simulate.output import written_summary
+
+    print_summary(written_summary(written, unit, sample_rate_hz, seed), console)
 
 
 

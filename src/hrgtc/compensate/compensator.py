@@ -20,7 +20,6 @@ Section 4.2 (Fig. 6).
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any
 
 import numpy as np
 
@@ -28,6 +27,7 @@ from hrgtc.compensate.axis import ENGINES, OUTPUT_COLUMNS, SCALE_COLUMN, AxisCom
 from hrgtc.compensate.axis import output_columns as axis_output_columns
 from hrgtc.compensate.ranges import RangeReport
 from hrgtc.core.errors import InputError, RecordingError
+from hrgtc.core.summary import Figure, Summary
 from hrgtc.model import Model, axis_suffix
 from hrgtc.recording import Recording, axis_names, axis_view
 
@@ -183,9 +183,30 @@ class Compensator:
         """Each axis's range report."""
         return {axis: c.ranges() for axis, c in self.axes.items()}
 
-    def summary(self) -> dict[str, Any]:
-        """Per-axis shares beyond the trained ranges (plain JSON)."""
-        return {axis or "-": c.ranges().to_dict() for axis, c in self.axes.items()}
+    def summary(self) -> Summary:
+        """Each axis's samples so far and their shares beyond the trained temperature and
+        df/dt (and still settling), with the trained and seen ranges; a section per axis."""
+        sections = []
+        for axis, compensator in self.axes.items():
+            r = compensator.ranges()
+            figures = (
+                Figure("samples", "samples", r.samples),
+                Figure("temperature_fraction", "beyond the trained temperatures",
+                       r.temperature_fraction, spec=".2%", definition="Share of the samples "
+                       "whose temperature is outside the trained range."),
+                Figure("rate_fraction", "beyond the trained df/dt", r.rate_fraction, spec=".2%",
+                       definition="Share of the samples whose df/dt is outside the trained "
+                       "range."),
+                Figure("settling_fraction", "df/dt filter settling", r.settling_fraction,
+                       spec=".2%"),
+                Figure("seen_c", "temperatures seen", r.seen_c[1] - r.seen_c[0], "°C",
+                       tuple(r.seen_c), "range"),
+                Figure("trained_c", "temperatures trained", r.trained_c[1] - r.trained_c[0],
+                       "°C", tuple(r.trained_c), "range"))
+            one = Summary("", ((f"axis {axis or '-'}", figures),))
+            sections += one.renamed(f"axes.{axis or '-'}.").sections
+        return Summary(f"instrument {self.model.unit}: shares beyond the trained ranges",
+                       tuple(sections))
 
 
 def compensate(model: Model, recording: Recording, drift: str = "frequency",

@@ -18,6 +18,7 @@ from typing import Any
 from hrgtc.core import records
 from hrgtc.core.errors import InputError
 from hrgtc.core.records import Count, Record
+from hrgtc.core.summary import Figure, Summary, escape
 
 #: Reason -> how it reads in a report. One line per reason.
 REASONS: dict[str, str] = {
@@ -113,17 +114,26 @@ class Accounting:
         return (f"{self.dropped_fraction:.0%} of the samples dropped (most for "
                 f"{REASONS[top]}: {self.dropped[top]})")
 
-    def summary(self) -> str:
-        """One line: read, used, dropped and flagged by reason."""
-        line = f"samples: {self.read} read, {self.used} used"
-        if self.dropped:
-            line += ", dropped " + ", ".join(f"{count} {REASONS[reason]}"
-                                             for reason, count in self.dropped.items())
-        if self.flagged:
-            line += ", flagged " + ", ".join(f"{count} {REASONS[reason]}"
-                                             for reason, count in self.flagged.items())
+    def summary(self) -> Summary:
+        """Read, used, dropped and flagged by reason (its text one line, with the warning
+        when more than 10 % were dropped)."""
+        figures = [Figure("read", "samples read", self.read,
+                          definition="Samples read from the recording(s)."),
+                   Figure("used", "samples used", self.used,
+                          definition="Samples read and not dropped by any stage.")]
+        line = "samples: {read} read, {used} used"
+        for verb, counts in (("dropped", self.dropped), ("flagged", self.flagged)):
+            if counts:
+                figures += [Figure(f"{verb}.{reason}", f"{verb}: {REASONS[reason]}", count,
+                                   definition=f"Samples {verb} for {REASONS[reason]}.")
+                            for reason, count in counts.items()]
+                line += f", {verb} " + ", ".join("{" + f"{verb}.{reason}" + "} "
+                                                 + escape(REASONS[reason]) for reason in counts)
         warning = self.warning
-        return f"{line} -- warning: {warning}" if warning else line
+        if warning:
+            line += " -- warning: " + escape(warning)
+        return Summary("samples", (("samples", tuple(figures)),),
+                       (warning,) if warning else (), (line,))
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types (:class:`AccountingRecord`)."""

@@ -6,19 +6,23 @@ any text; the renderers format that one structure: :meth:`Summary.text` (plain t
 section, figure, value, unit, interval), :meth:`Summary.grid` (a section whose figures are
 the cells of a table, Table 1 or a list of temperature groups: its columns and rows) and
 :meth:`Summary.html` (a table for the report). :meth:`Summary.to_dict` is the ``--json``
-form. See docs/architecture.md ("One result
-contract"), after statsmodels' ``summary()``, which returns tables its renderers format.
+form. A summary whose text has its own shape (an aligned table, one line) carries a
+``layout``: its lines as format strings over the figures' names (``"rms {rms_dph:.4g}"``),
+so the text is rendered from the same figures the tables and the JSON show. ``str()`` of a
+summary is its text. See docs/architecture.md ("One result contract"), after statsmodels'
+``summary()``, which returns tables its renderers format.
 """
 
 from __future__ import annotations
 
 import html
 import math
+import string
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
-__all__ = ["Figure", "Summary"]
+__all__ = ["Figure", "Summary", "escape"]
 
 
 def _number(value: float, digits: int, spec: str = "") -> str:
@@ -29,6 +33,34 @@ def _number(value: float, digits: int, spec: str = "") -> str:
     if math.isnan(value):
         return "-"
     return f"{value:{spec or f'.{digits}g'}}"
+
+
+def escape(text: str) -> str:
+    """``text`` as a literal of a :attr:`Summary.layout` line (its braces doubled)."""
+    return text.replace("{", "{{").replace("}", "}}")
+
+
+class _ByName(string.Formatter):
+    """``{name:spec}`` with the whole field name a figure's name (dots and brackets
+    included: ``{validation[0].rms_dph:.4g}``)."""
+
+    def get_field(self, field_name: str, args: Sequence[Any],
+                  kwargs: Any) -> tuple[Any, str]:
+        return kwargs[field_name], field_name
+
+
+_BY_NAME = _ByName()
+
+
+def _renamed(line: str, prefix: str) -> str:
+    """A layout line whose figure references are after ``prefix``."""
+    out = []
+    for literal, name, spec, conversion in _BY_NAME.parse(line):
+        out.append(escape(literal))
+        if name is not None:
+            out.append("{" + prefix + name + (f"!{conversion}" if conversion else "")
+                       + (f":{spec}" if spec else "") + "}")
+    return "".join(out)
 
 
 @dataclass(frozen=True)
@@ -58,6 +90,9 @@ class Figure:
     row, column
         The figure's place in a table (:meth:`Summary.grid`): which row (a key, not shown)
         and which column (its header; the unit is added in brackets). Empty: not a cell.
+    definition
+        One sentence saying what the figure is (``"1σ of the 10 s means of the compensated
+        rate"``); the JSON and the HTML title of its label. Empty: the label says it.
     """
 
     name: str
@@ -70,13 +105,15 @@ class Figure:
     spec: str = ""
     row: str = ""
     column: str = ""
+    definition: str = ""
 
     @classmethod
     def with_error(cls, name: str, label: str, value: float, error: float, unit: str = "",
-                   digits: int = 6) -> Figure:
+                   digits: int = 6, definition: str = "") -> Figure:
         """A value ± one standard error (no interval when the error is not finite)."""
         interval = (value - error, value + error) if math.isfinite(error) else None
-        return cls(name, label, value, unit, interval, "±1σ" if interval else "", digits)
+        return cls(name, label, value, unit, interval, "±1σ" if interval else "", digits,
+                   definition=definition)
 
     def number(self) -> str:
         """The value as a table shows it (``spec`` or ``digits``; NaN: ``"-"``)."""
@@ -107,8 +144,8 @@ class Figure:
         return f"{self.label}: {self.value_text()}" + (f" {interval}" if interval else "")
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (NaN -> None); ``spec``, ``row`` and ``column`` only when set
-        (a figure that is no table cell keeps the keys it always had)."""
+        """Plain JSON types (NaN -> None); ``spec``, ``row``, ``column`` and ``definition``
+        only when set (a figure that is no table cell keeps the keys it always had)."""
         def clean(v: Any) -> Any:
             return None if isinstance(v, float) and not math.isfinite(v) else v
 
@@ -117,7 +154,8 @@ class Figure:
                "interval": None if self.interval is None else [clean(v) for v in self.interval],
                "interval_kind": self.interval_kind}
         out.update({key: value for key, value in (("spec", self.spec), ("row", self.row),
-                                                  ("column", self.column)) if value})
+                                                  ("column", self.column),
+                                                  ("definition", self.definition)) if value})
         return out
 
 
@@ -133,11 +171,43 @@ class Summary:
         (heading, figures) in reading order.
     notes
         Lines the figures cannot say (warnings, why a figure is missing).
+    layout
+        The lines of :meth:`text`, each a format string over the figures' names
+        (``"rms {residual.rms_dph:.4g} °/h"``; a literal brace doubled, :func:`escape`),
+        for a result whose text has its own shape; None: the title, then each section's
+        figures one per line, then the notes.
     """
 
     title: str
     sections: tuple[tuple[str, tuple[Figure, ...]], ...] = ()
     notes: tuple[str, ...] = field(default=())
+    layout: tuple[str, ...] | None = None
+
+    def __str__(self) -> str:
+        return self.text()
+
+    def renamed(self, prefix: str) -> Summary:
+        """The same summary with every figure's name (and the layout's references to it)
+        after ``prefix`` (``"axes.x."``), to be part of a larger one."""
+        sections = tuple((h, tuple(replace(f, name=prefix + f.name) for f in fs))
+                         for h, fs in self.sections)
+        layout = None if self.layout is None else tuple(_renamed(line, prefix)
+                                                        for line in self.layout)
+        return Summary(self.title, sections, self.notes, layout)
+
+    def referenced(self) -> set[str]:
+        """The names of the figures the layout shows (all of them without a layout)."""
+        if self.layout is None:
+            return set(self.figures())
+        return {name for line in self.layout for _, name, _, _ in _BY_NAME.parse(line)
+                if name is not None}
+
+    def lines(self, indent: str = "") -> tuple[str, ...]:
+        """The layout's lines (the generic text's, escaped, without one), each after
+        ``indent``: the part this summary is of a larger one's layout."""
+        lines = self.layout if self.layout is not None else tuple(
+            escape(line) for line in self.text().splitlines())
+        return tuple(escape(indent) + line for line in lines)
 
     def figures(self) -> dict[str, Figure]:
         """Every figure by its name."""
@@ -173,7 +243,11 @@ class Summary:
         return headers, list(rows.values())
 
     def text(self) -> str:
-        """Plain text: the title, then each section's figures one per line."""
+        """Plain text: the :attr:`layout` rendered with the figures' values, or the title,
+        then each section's figures one per line, then the notes."""
+        if self.layout is not None:
+            values = {f.name: f.value for _, figures in self.sections for f in figures}
+            return "\n".join(_BY_NAME.vformat(line, (), values) for line in self.layout)
         lines = [self.title]
         for heading, figures in self.sections:
             lines.append(f"{heading}:")
@@ -190,9 +264,10 @@ class Summary:
                 continue
             out.append(f"<tr><th colspan=\"4\">{html.escape(heading)}</th></tr>")
             for f in figures:
-                cells = (f.label, f.number(), f.unit, f.interval_text())
-                out.append("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in cells)
-                           + "</tr>")
+                title = f" title=\"{html.escape(f.definition)}\"" if f.definition else ""
+                cells = (f.number(), f.unit, f.interval_text())
+                out.append(f"<tr><td{title}>{html.escape(f.label)}</td>"
+                           + "".join(f"<td>{html.escape(c)}</td>" for c in cells) + "</tr>")
         out.append("</table>")
         out.extend(f"<p>{html.escape(n)}</p>" for n in self.notes)
         return "\n".join(out)

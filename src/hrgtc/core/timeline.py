@@ -35,6 +35,7 @@ import numpy as np
 from hrgtc.core import records
 from hrgtc.core.errors import InputError
 from hrgtc.core.records import Count, Record
+from hrgtc.core.summary import Figure, Summary, escape
 
 GAP_FACTOR = 2.0  # a time step longer than this many sample periods is a gap
 #: Relative slack of the gap threshold: one missing sample (a step of exactly 2 periods)
@@ -234,14 +235,26 @@ class Timeline:
         return records.dump(self, TimelineRecord, segments=self.n_segments,
                             samples=self.n_samples, bursty=self.is_bursty)
 
-    def summary(self) -> str:
-        """One line: span, recorded duration, segments and the burst structure."""
-        line = (f"span {_duration(self.span_s)}, recorded {_duration(self.recorded_s)} "
-                f"in {self.n_segments} segment(s)")
+    def summary(self) -> Summary:
+        """Span, recorded duration, segments and the burst structure (its text one line)."""
+        figures = [Figure("span_s", "span", self.span_s, "s",
+                          definition="Time from the first to the last sample."),
+                   Figure("recorded_s", "recorded", self.recorded_s, "s",
+                          definition="Samples times the sample period."),
+                   Figure("segments", "segments", self.n_segments,
+                          definition="Contiguous runs of samples between gaps.")]
+        line = (f"span {_duration_field('span_s', self.span_s)}, recorded "
+                f"{_duration_field('recorded_s', self.recorded_s)} in {{segments}} segment(s)")
         if self.n_segments > 1:
-            line += (f"; segments of {_duration(self.burst_length_s)} (median) every "
-                     f"{_duration(self.burst_period_s)}")
-        return line
+            figures += [Figure("burst_length_s", "segment length (median)",
+                               self.burst_length_s, "s",
+                               definition="Median recorded duration of a segment."),
+                        Figure("burst_period_s", "segment period (median)",
+                               self.burst_period_s, "s", definition="Median time from a "
+                               "segment's start to the next one's.")]
+            line += (f"; segments of {_duration_field('burst_length_s', self.burst_length_s)}"
+                     f" (median) every {_duration_field('burst_period_s', self.burst_period_s)}")
+        return Summary("time axis", (("time axis", tuple(figures)),), layout=(line,))
 
 
 class TimelineRecord(Record, kw_only=True):
@@ -259,12 +272,13 @@ class TimelineRecord(Record, kw_only=True):
     bursty: bool
 
 
-def _duration(seconds: float) -> str:
+def _duration_field(name: str, seconds: float) -> str:
+    """A duration figure in a layout: ``{name:.6g} s``, hours beside it from an hour on,
+    ``?`` when it is not finite."""
     if not math.isfinite(seconds):
         return "?"
-    if seconds >= 3600.0:
-        return f"{seconds:.6g} s ({seconds / 3600.0:.3g} h)"
-    return f"{seconds:.6g} s"
+    hours = escape(f" ({seconds / 3600.0:.3g} h)") if seconds >= 3600.0 else ""
+    return "{" + name + ":.6g} s" + hours
 
 
 #: Key of a recording's ``metadata.extra`` listing the times [s] where the logger restarted

@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from hrgtc.core import records
+from hrgtc.core.summary import Figure, Summary, escape
 from hrgtc.core.timeline import time_blocks
 from hrgtc.drift.edge_slope import unknown_edge_slope
 from hrgtc.drift.regression import newey_west_inflation
@@ -76,16 +77,29 @@ class CrossValidation:
         values = records.load(data, CrossValidationRecord, "cross-validation")
         return cls(sources=tuple(values["per_run_dph"]), **values)
 
-    def summary(self) -> str:
-        """The per-run table as text."""
-        lines = [f"Leave-one-run-out cross-validation ({len(self.terms)} terms): "
-                 "std of held-out window residuals [°/h]"]
+    def summary(self) -> Summary:
+        """The held-out residual of each run and over heating, cooling and all runs (its
+        text: the per-run table)."""
+        runs = tuple(Figure(f"per_run_dph.{name}", name, value, "°/h", digits=4,
+                            definition=f"Standard deviation of the held-out window residuals "
+                            f"of {name} when the model is refitted without it.")
+                     for name, value in self.per_run_dph.items())
+        totals = (Figure("heating_dph", "heating", self.heating_dph, "°/h", digits=4,
+                         definition="The same over every held-out window while heating."),
+                  Figure("cooling_dph", "cooling", self.cooling_dph, "°/h", digits=4,
+                         definition="The same over every held-out window while cooling."),
+                  Figure("score_dph", "RMS over runs", self.score_dph, "°/h", digits=4,
+                         definition="Root mean square of the finite per-run values."))
         width = max((len(s) for s in self.sources), default=4)
-        for name, value in self.per_run_dph.items():
-            lines.append(f"  {name:<{width}}  {value:8.4f}")
-        lines.append(f"  heating {self.heating_dph:.4f}, cooling {self.cooling_dph:.4f}, "
-                     f"RMS over runs {self.score_dph:.4f}")
-        return "\n".join(lines)
+        title = (f"Leave-one-run-out cross-validation ({len(self.terms)} terms): "
+                 "std of held-out window residuals [°/h]")
+        layout = (escape(title),
+                  *(f"  {escape(f'{name:<{width}}')}  {{per_run_dph.{name}:8.4f}}"
+                    for name in self.per_run_dph),
+                  "  heating {heating_dph:.4f}, cooling {cooling_dph:.4f}, "
+                  "RMS over runs {score_dph:.4f}")
+        return Summary(title, (("held-out runs", runs), ("held-out windows", totals)),
+                       layout=layout)
 
 
 

@@ -35,6 +35,7 @@ from hrgtc.core import records
 from hrgtc.core.accounting import Accounting
 from hrgtc.core.errors import InputError
 from hrgtc.core.progress import Progress
+from hrgtc.core.summary import Summary
 from hrgtc.drift.cross_validation import (
     CrossValidation,
     CrossValidationRecord,
@@ -246,8 +247,9 @@ class DriftModel(ParsedTerms):
         """
         return drift_equation(self, sensor)
 
-    def summary(self, sensor: bool = False) -> str:
-        """Stepwise history, coefficient table and fit statistics as text.
+    def summary(self, sensor: bool = False) -> Summary:
+        """Stepwise history, coefficient table and fit statistics
+        (:class:`~hrgtc.core.summary.Summary`; ``.text()`` the plain text).
 
         ``sensor``: the equation's units are those of a temperature sensor (see
         :meth:`equation`).

@@ -37,6 +37,7 @@ import numpy as np
 from hrgtc.core import records
 from hrgtc.core.errors import InputError, RankDeficientError
 from hrgtc.core.student_t import t_sf
+from hrgtc.core.summary import Figure, Summary
 
 COLLINEARITY_TOL = 1e-12
 """Default ``tol``: smallest allowed reciprocal condition number (2-norm) of the
@@ -446,15 +447,37 @@ class OLSResult:
                              f"{list(self.names[1:])}, got {X.shape}")
         return self.params[0] + X @ self.params[1:]
 
-    def summary(self) -> str:
-        """Coefficient table and fit statistics as text."""
-        lines = [f"OLS: {self.nobs} rows, {self.df_resid} residual dof, "
-                 f"R^2 = {self.rsquared:.6g}, residual std = {self.residual_std:.6g}",
-                 f"{'term':<14}{'coef':>14}{'std err':>12}{'t':>10}{'P>|t|':>11}"]
-        for name, b, s, t, p in zip(self.names, self.params, self.bse, self.tvalues,
-                                    self.pvalues, strict=True):
-            lines.append(f"{name:<14}{b:>14.6g}{s:>12.4g}{t:>10.3f}{p:>11.3g}")
-        return "\n".join(lines)
+    def summary(self) -> Summary:
+        """The coefficient table (coefficient, standard error, t, p of each term) and the
+        fit statistics (its text: the table as statsmodels prints it, shortened)."""
+        stats = (Figure("nobs", "rows", self.nobs, definition="Rows of the regression."),
+                 Figure("df_resid", "residual dof", self.df_resid,
+                        definition="Rows minus fitted coefficients."),
+                 Figure("rsquared", "R²", self.rsquared,
+                        definition="Share of the variance of y the fit explains."),
+                 Figure("residual_std", "residual std", self.residual_std,
+                        definition="Standard deviation of the residuals (dof-corrected)."))
+        cells: list[Figure] = []
+        rows = []
+        for k, (name, b, s, t, p) in enumerate(zip(self.names, self.params, self.bse,
+                                                   self.tvalues, self.pvalues, strict=True)):
+            cells += [Figure(f"names[{k}]", f"term {k}", name, row=name, column="term"),
+                      Figure(f"params[{k}]", f"coef of {name}", float(b), row=name,
+                             column="coef", definition=f"The fitted coefficient of {name}."),
+                      Figure(f"bse[{k}]", f"std err of {name}", float(s), digits=4,
+                             row=name, column="std err"),
+                      Figure(f"tvalues[{k}]", f"t of {name}", float(t), digits=4, row=name,
+                             column="t"),
+                      Figure(f"pvalues[{k}]", f"P>|t| of {name}", float(p), digits=3,
+                             row=name, column="P>|t|")]
+            rows.append(f"{{names[{k}]:<14}}{{params[{k}]:>14.6g}}{{bse[{k}]:>12.4g}}"
+                        f"{{tvalues[{k}]:>10.3f}}{{pvalues[{k}]:>11.3g}}")
+        layout = ("OLS: {nobs} rows, {df_resid} residual dof, R^2 = {rsquared:.6g}, "
+                  "residual std = {residual_std:.6g}",
+                  f"{'term':<14}{'coef':>14}{'std err':>12}{'t':>10}{'P>|t|':>11}", *rows)
+        return Summary(f"OLS: {self.nobs} rows", (("fit", stats), ("coefficients",
+                                                                     tuple(cells))),
+                       layout=layout)
 
     def to_dict(self) -> dict[str, Any]:
         """Plain-JSON form (NaN -> null), as :class:`OLSResultRecord`."""

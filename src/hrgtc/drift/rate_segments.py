@@ -26,6 +26,7 @@ import numpy as np
 from hrgtc.core import records
 from hrgtc.core.errors import InputError
 from hrgtc.core.records import Count, Record
+from hrgtc.core.summary import Figure, Summary
 from hrgtc.recording import Recording
 
 __all__ = [
@@ -287,15 +288,34 @@ class SegmentScaleErrors:
         """Largest error magnitude. [ppm]"""
         return float(np.max(np.abs(self.error_ppm))) if self.error_ppm.size else math.nan
 
-    def summary(self) -> str:
-        """One line per segment and the totals, as text."""
-        lines = [f"{'start_s':>10}{'input °/s':>12}{'freq_hz':>14}{'error ppm':>12}"]
-        for seg, err in zip(self.segments, self.error_ppm, strict=True):
-            lines.append(f"{seg.start_s:>10.6g}{seg.input_rate_dph / 3600.0:>12.6g}"
-                         f"{seg.freq_hz:>14.8g}{err:>12.4g}")
-        lines.append(f"{len(self.segments)} segments: rms {self.rms_ppm:.4g} ppm, "
-                     f"max |error| {self.max_abs_ppm:.4g} ppm")
-        return "\n".join(lines)
+    def summary(self) -> Summary:
+        """Each segment (start, input rate, frequency, scale-factor error) as a table, and
+        the RMS and largest error (its text: the table and one line of totals)."""
+        cells: list[Figure] = []
+        rows = []
+        for k, (seg, err) in enumerate(zip(self.segments, self.error_ppm, strict=True)):
+            key = f"segments[{k}]"
+            cells += [Figure(f"{key}.start_s", f"segment {k + 1} start", seg.start_s, "s",
+                             row=str(k), column="start"),
+                      Figure(f"{key}.input_rate_dps", f"segment {k + 1} input rate",
+                             seg.input_rate_dph / 3600.0, "°/s", row=str(k),
+                             column="input rate"),
+                      Figure(f"{key}.freq_hz", f"segment {k + 1} frequency", seg.freq_hz, "Hz",
+                             digits=8, row=str(k), column="frequency"),
+                      Figure(f"error_ppm[{k}]", f"segment {k + 1} error", float(err), "ppm",
+                             digits=4, row=str(k), column="error", definition="Scale-factor "
+                             "error of the segment: (mean rate − bias − Ω) / Ω.")]
+            rows.append(f"{{{key}.start_s:>10.6g}}{{{key}.input_rate_dps:>12.6g}}"
+                        f"{{{key}.freq_hz:>14.8g}}{{error_ppm[{k}]:>12.4g}}")
+        totals = (Figure("segments", "segments", len(self.segments)),
+                  Figure("rms_ppm", "RMS error", self.rms_ppm, "ppm", digits=4,
+                         definition="Root mean square of the segments' scale-factor errors."),
+                  Figure("max_abs_ppm", "largest |error|", self.max_abs_ppm, "ppm", digits=4,
+                         definition="Largest absolute scale-factor error of a segment."))
+        layout = (f"{'start_s':>10}{'input °/s':>12}{'freq_hz':>14}{'error ppm':>12}", *rows,
+                  "{segments} segments: rms {rms_ppm:.4g} ppm, max |error| {max_abs_ppm:.4g} ppm")
+        return Summary("scale-factor error per rate segment",
+                       (("segments", tuple(cells)), ("totals", totals)), layout=layout)
 
     def to_dict(self) -> dict[str, Any]:
         """Plain-JSON form (:class:`SegmentScaleErrorsRecord`)."""

@@ -33,6 +33,7 @@ import numpy as np
 
 from hrgtc.core import records
 from hrgtc.core.errors import HrgtcWarning, InputError, RankDeficientError
+from hrgtc.core.summary import Figure, Summary, escape
 from hrgtc.drift.qr_accumulator import OLSResultRecord, _check_names, _resolve_terms, _solve
 from hrgtc.drift.regression import (
     COLLINEARITY_TOL,
@@ -109,19 +110,28 @@ class StepwiseResult:
     stop_reason: str
     variance_inflation: float = 1.0
 
-    def summary(self) -> str:
-        """Steps, stopping reason and final fit as text."""
-        lines = [f"Stepwise regression (penter={self.penter:g}, premove={self.premove:g}), "
-                 f"{len(self.history)} steps, stopped: {self.stop_reason}"]
-        for n, step in enumerate(self.history, start=1):
-            lines.append(f"  {n:>3}. {step.action:<8}{step.term:<14}F = {step.fstat:.6g}, "
-                         f"p = {step.pvalue:.6g}")
+    def summary(self) -> Summary:
+        """The steps (term, F, p), the excluded terms' p-values and the final fit
+        (:meth:`OLSResult.summary`, its figures after ``result.``)."""
+        steps = step_figures(self.history)
         excluded = [c for c in self.candidates if c not in self.selected]
+        left = tuple(Figure(f"excluded_pvalues[{k}]", f"p of {c} if added", p, digits=3,
+                            definition=f"The p-value {c} would have if added to the final "
+                            "model (NaN: collinear with it).")
+                     for k, (c, p) in enumerate(zip(excluded, self.excluded_pvalues,
+                                                    strict=True)))
+        title = (f"Stepwise regression (penter={self.penter:g}, premove={self.premove:g}), "
+                 f"{len(self.history)} steps, stopped: {self.stop_reason}")
+        layout = [escape(title)]
+        layout += [f"  {n:>3}. {{history[{n - 1}].action:<8}}{{history[{n - 1}].term:<14}}"
+                   f"F = {{history[{n - 1}].fstat:.6g}}, p = {{history[{n - 1}].pvalue:.6g}}"
+                   for n in range(1, len(self.history) + 1)]
         if excluded:
-            lines.append("Excluded (p-value if added): " + ", ".join(
-                f"{c} {p:.3g}" for c, p in zip(excluded, self.excluded_pvalues, strict=True)))
-        lines.append(self.result.summary())
-        return "\n".join(lines)
+            layout.append("Excluded (p-value if added): " + ", ".join(
+                f"{escape(c)} {{excluded_pvalues[{k}]:.3g}}" for k, c in enumerate(excluded)))
+        fit = self.result.summary().renamed("result.")
+        return Summary(title, (("steps", steps), ("excluded", left), *fit.sections),
+                       layout=(*layout, *fit.lines()))
 
     def to_dict(self) -> dict[str, Any]:
         """Plain-JSON form (NaN p-values become null), as :class:`StepwiseRecord`."""
@@ -347,3 +357,20 @@ def _parent_index(parents: Mapping[str, Iterable[str]] | None,
         raise InputError(f"parents names terms that are not candidates: {unknown}; "
                          f"candidates are {list(cand)}")
     return [{cand.index(p) for p in parents.get(name, ())} for name in cand]
+
+
+def step_figures(history: Sequence[Step]) -> tuple[Figure, ...]:
+    """The steps of a stepwise history as a table (action, term, F, p), after
+    ``history[n].``: the summaries of :class:`StepwiseResult` and the drift model."""
+    out: list[Figure] = []
+    for n, step in enumerate(history):
+        key, label = f"history[{n}]", f"step {n + 1}"
+        out += [Figure(f"{key}.action", f"{label}, action", step.action, row=str(n),
+                       column="action"),
+                Figure(f"{key}.term", f"{label}, term", step.term, row=str(n), column="term"),
+                Figure(f"{key}.fstat", f"{label}, F", step.fstat, row=str(n), column="F",
+                       definition="Partial F statistic of the term when it was added or "
+                       "removed."),
+                Figure(f"{key}.pvalue", f"{label}, p", step.pvalue, digits=3, row=str(n),
+                       column="p", definition="p-value of that F statistic.")]
+    return tuple(out)

@@ -52,6 +52,7 @@ from hrgtc.core import records
 from hrgtc.core.errors import InputError
 from hrgtc.core.progress import Progress
 from hrgtc.core.records import Count, Positive, Record, Statistic
+from hrgtc.core.summary import Figure, Summary, escape
 from hrgtc.evaluation._allan_edf import (
     NOISE_ALPHAS,
     ONE_SIGMA,
@@ -198,8 +199,9 @@ class AllanResult:
         """Inverse of :meth:`to_dict` (optional fields may be missing)."""
         return cls(**records.load(data, AllanResultRecord, "Allan deviation"))
 
-    def summary(self) -> str:
-        """A text table of τ, deviation, confidence interval (if any) and the number of terms."""
+    def summary(self) -> Summary:
+        """The curve as a table: τ, deviation, the terms averaged and (if any) the
+        confidence interval of each point (its text: the aligned table)."""
         spacing = "overlapping" if self.overlapping else "normal (non-overlapping)"
         name = {"allan": "Allan", "modified": "modified Allan", "hadamard": "Hadamard",
                 "time": "time"}.get(self.kind, self.kind)
@@ -207,18 +209,32 @@ class AllanResult:
         header = f"{'tau [s]':>12}  {'deviation':>12}  {'terms':>10}"
         if ci:
             header += f"  {'lower':>12}  {'upper':>12}   ({self.confidence:.3g} confidence)"
-        lines = [
-            f"{name} deviation, {spacing}; {self.n_samples} samples at "
-            f"{self.sample_rate_hz:g} Hz"
-            + (f", pooled within {self.segments} segments" if self.segments > 1 else ""),
-            header,
-        ]
+        title = (f"{name} deviation, {spacing}; {self.n_samples} samples at "
+                 f"{self.sample_rate_hz:g} Hz"
+                 + (f", pooled within {self.segments} segments" if self.segments > 1 else ""))
+        unit = "°/h·s" if self.kind == "time" else "°/h"
+        cells: list[Figure] = []
+        layout = [escape(title), escape(header)]
         for k, (t, d, c) in enumerate(zip(self.taus_s, self.deviation, self.counts, strict=True)):
-            line = f"{t:12.6g}  {d:12.6g}  {c:10d}"
+            interval = (float(self.lower[k]), float(self.upper[k])) if ci else None
+            cells += [Figure(f"taus_s[{k}]", f"τ {k + 1}", float(t), "s", row=str(k),
+                             column="tau"),
+                      Figure(f"deviation[{k}]", f"deviation at τ {float(t):g} s", float(d),
+                             unit, interval,
+                             f"{self.confidence:.3g} CI" if ci else "", row=str(k),
+                             column="deviation", definition=f"{name} deviation of the rate "
+                             f"at τ = {float(t):g} s."),
+                      Figure(f"counts[{k}]", f"terms at τ {float(t):g} s", int(c), row=str(k),
+                             column="terms", definition="Terms averaged into the point.")]
+            line = f"{{taus_s[{k}]:12.6g}}  {{deviation[{k}]:12.6g}}  {{counts[{k}]:10d}}"
             if ci:
-                line += f"  {self.lower[k]:12.6g}  {self.upper[k]:12.6g}"
-            lines.append(line)
-        return "\n".join(lines)
+                cells += [Figure(f"lower[{k}]", f"lower at τ {float(t):g} s", interval[0],
+                                 unit, row=str(k), column="lower"),
+                          Figure(f"upper[{k}]", f"upper at τ {float(t):g} s", interval[1],
+                                 unit, row=str(k), column="upper")]
+                line += f"  {{lower[{k}]:12.6g}}  {{upper[{k}]:12.6g}}"
+            layout.append(line)
+        return Summary(title, (("curve", tuple(cells)),), layout=tuple(layout))
 
 
 

@@ -74,7 +74,7 @@ def calibration_summary(model: Any, table: Sequence[Mapping[str, float]] = (),
     else:
         notes.append(thermometer_equation(th))
     if model.drift.accounting is not None:
-        notes.append("drift training " + model.drift.accounting.summary())
+        notes.append("drift training " + model.drift.accounting.summary().text())
     notes += [*drift_notes(model.drift), drift_form(model.drift, sensor)]
     if model.housing is not None:
         sections.append(("housing-thermistor baseline",
@@ -94,7 +94,7 @@ def thermometer_equation(thermometer: Any) -> str:
         c3, c2, c1, c0 = thermometer.coefficients_high_first
         return (f"Eq. (18) form: f = {c3:.4e}·T³ {c2:+.4e}·T² {c1:+.6f}·T {c0:+.4f}  "
                 "[Hz, T in °C]")
-    return thermometer.summary().splitlines()[-1]
+    return thermometer.summary().text().splitlines()[-1]
 
 
 def thermometer_tables(thermometer: Any, plateaus: Sequence[Any]) -> Summary:

@@ -242,9 +242,10 @@ class Evaluation:
         """
         return run_figures(self, key, sensor=sensor, warnings=warnings)
 
-    def summary(self) -> str:
-        """The figures as plain text (:meth:`figures` rendered by ``Summary.text``)."""
-        return self.figures().text()
+    def summary(self, sensor: bool = False, warnings: bool = True) -> Summary:
+        """The figures (:meth:`figures`: value, unit, interval); ``.text()`` the plain
+        text, ``print_summary`` the CLI's tables, ``.html()`` the report's."""
+        return self.figures(sensor=sensor, warnings=warnings)
 
 
 #: A share of the samples.

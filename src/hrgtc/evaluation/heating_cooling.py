@@ -38,6 +38,7 @@ import numpy as np
 
 from hrgtc.core import records
 from hrgtc.core.records import Count, Positive, Record, Statistic
+from hrgtc.core.summary import Figure, Summary, escape
 from hrgtc.core.timeline import (
     RESTARTS_KEY,
     is_gap,
@@ -97,28 +98,49 @@ class DirectionStats:
             "residual_rms_dph": None if self.residual_rms_dph is None
             else self.residual_rms_dph[d]} for d in DIRECTIONS})
 
-    def summary(self, sensor: bool = False) -> str:
-        """One line per direction (``sensor``: the thermometer is a temperature sensor)."""
+    def summary(self, sensor: bool = False) -> Summary:
+        """Each direction's blocks, raw and compensated bias stability, improvement and
+        (a simulated run) residual against the true bias (its text: one line per
+        direction; ``sensor``: the thermometer is a temperature sensor)."""
         what = "temperature" if sensor else "resonator temperature"
         title = f"heating and cooling apart (sign of the {what} rate)"
         if self.reason is not None:
-            return f"{title}: no {self.block_s:g} s block ({self.reason})"
-        lines = []
+            return Summary(title, (), (self.reason,), (escape(
+                f"{title}: no {self.block_s:g} s block ({self.reason})"),))
+        sections, layout = [], [escape(title) + ":"]
         for d in DIRECTIONS:
+            block = f"{self.block_s:g} s"
+            figures = [Figure(f"{d}.blocks", "blocks", self.blocks[d],
+                              definition=f"{block} blocks of the run while {d}.")]
             if not self.blocks[d]:
                 total = sum(self.blocks.values())
-                lines.append(f"  {d}: none of the {total} blocks of {self.block_s:g} s")
+                layout.append(f"  {d}: none of the {total} blocks of {block}")
+                sections.append((d, tuple(figures)))
                 continue
-            line = (f"  {d}: {self.blocks[d]} blocks, {self.block_s:g} s bias stability raw "
-                    f"{self.raw_dph[d]:.4g} -> compensated {self.compensated_dph[d]:.4g} °/h "
-                    f"({self.improvement(d):.2f}×)")
+            figures += [Figure(f"{d}.raw_dph", "raw", self.raw_dph[d], "°/h", digits=4,
+                               definition=f"1σ of the {block} means of the raw rate while {d}."),
+                        Figure(f"{d}.compensated_dph", "compensated", self.compensated_dph[d],
+                               "°/h", digits=4, definition=f"1σ of the {block} means of the "
+                               f"compensated rate while {d}."),
+                        Figure(f"{d}.improvement", "improvement", self.improvement(d),
+                               spec=".2f", definition="raw / compensated.")]
+            line = (f"  {d}: {{{d}.blocks}} blocks, {block} bias stability raw "
+                    f"{{{d}.raw_dph:.4g}} -> compensated {{{d}.compensated_dph:.4g}} °/h "
+                    f"({{{d}.improvement:.2f}}×)")
             if self.residual_rms_dph is not None:
-                line += f", RMS model - true bias {self.residual_rms_dph[d]:.4g} °/h"
-            lines.append(line)
+                figures.append(Figure(f"{d}.residual_rms_dph", "RMS model - true bias",
+                                      self.residual_rms_dph[d], "°/h", digits=4,
+                                      definition=f"RMS of the {block} means of model minus "
+                                      "true bias."))
+                line += f", RMS model - true bias {{{d}.residual_rms_dph:.4g}} °/h"
+            layout.append(line)
+            sections.append((d, tuple(figures)))
         if self.partial_blocks:
-            lines.append(f"  ({self.partial_blocks} blocks cut short by a gap, kept from half "
-                         "a block)")
-        return f"{title}:\n" + "\n".join(lines)
+            sections.append(("gaps", (Figure("partial_blocks", "blocks cut short by a gap",
+                                             self.partial_blocks),)))
+            layout.append("  ({partial_blocks} blocks cut short by a gap, kept from half "
+                          "a block)")
+        return Summary(title, tuple(sections), layout=tuple(layout))
 
 
 class DirectionRecord(Record):

@@ -25,6 +25,7 @@ import numpy as np
 from hrgtc.core import records
 from hrgtc.core.errors import InputError
 from hrgtc.core.records import Count, Record, Statistic
+from hrgtc.core.summary import Figure, Summary
 from hrgtc.evaluation.allan import (
     FLICKER_FLOOR_FACTOR,
     ONE_SIGMA,
@@ -217,16 +218,27 @@ class ResidualResult:
         return cls(**{**values, "bias_stability_dph": table_from_json(
             values["bias_stability_dph"])})
 
-    def summary(self) -> str:
-        """One line with RMS, mean and maximum, one with the bias stabilities."""
-        stability = ", ".join(
-            f"{tau:g} s: {value:.4g}" for tau, value in self.bias_stability_dph.items()
-        )
-        return (
-            f"model - true bias over {self.n_samples} samples: rms {self.rms_dph:.4g} deg/h, "
-            f"mean {self.mean_dph:.4g} deg/h, max |.| {self.max_abs_dph:.4g} deg/h\n"
-            f"bias stability of the residual [deg/h]: {stability}"
-        )
+    def summary(self) -> Summary:
+        """RMS, mean and largest model − true bias, and its bias stability at each τ
+        (its text: two lines)."""
+        error = (Figure("n_samples", "samples", self.n_samples),
+                 Figure("rms_dph", "RMS", self.rms_dph, "deg/h", digits=4,
+                        definition="Root mean square of bias model − true bias."),
+                 Figure("mean_dph", "mean", self.mean_dph, "deg/h", digits=4,
+                        definition="Mean of bias model − true bias."),
+                 Figure("max_abs_dph", "max |.|", self.max_abs_dph, "deg/h", digits=4,
+                        definition="Largest |bias model − true bias|."))
+        stability = tuple(Figure(f"bias_stability_dph.{tau:g}", f"{tau:g} s", value, "deg/h",
+                                 digits=4, definition=f"1σ of the {tau:g} s means of bias "
+                                 "model − true bias.")
+                          for tau, value in self.bias_stability_dph.items())
+        return Summary("model - true bias", (("model - true bias", error),
+                                             ("bias stability of the residual", stability)),
+                       layout=("model - true bias over {n_samples} samples: rms {rms_dph:.4g} "
+                               "deg/h, mean {mean_dph:.4g} deg/h, max |.| {max_abs_dph:.4g} deg/h",
+                               "bias stability of the residual [deg/h]: " + ", ".join(
+                                   f"{tau:g} s: {{bias_stability_dph.{tau:g}:.4g}}"
+                                   for tau in self.bias_stability_dph)))
 
 
 #: A bias-stability table as JSON: τ as text (``"10"``) -> 1σ, null where not estimable. [°/h]

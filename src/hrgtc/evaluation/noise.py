@@ -27,6 +27,7 @@ import numpy as np
 from hrgtc.core import records
 from hrgtc.core.errors import InputError
 from hrgtc.core.records import Record, Statistic
+from hrgtc.core.summary import Figure, Summary, escape
 from hrgtc.evaluation.allan import FLICKER_FLOOR_FACTOR, SECONDS_PER_HOUR, AllanResult
 
 __all__ = ["RAMP_SLOPE", "NoiseTerms", "noise_terms"]
@@ -113,29 +114,37 @@ class NoiseTerms:
         return (f"{value:.{digits}g} ({bounds[0]:.{digits - 1}g}–{bounds[1]:.{digits - 1}g}"
                 f", N {n})")
 
-    def summary(self) -> str:
-        """Three lines, one per noise term, with the τ range each was read from."""
-
-        def fmt(value: float | None, taus: tuple[float, float] | None, unit: str,
-                reason: str | None) -> str:
+    def summary(self) -> Summary:
+        """The three noise terms, each with the τ range (or the minimum) it was read from,
+        or why it is missing (its text: three lines)."""
+        figures, lines = [], []
+        for key, label, value, taus, unit, reason in (
+                ("arw_deg_per_rt_h", "angle random walk", self.arw_deg_per_rt_h,
+                 self.arw_taus_s, "deg/rt-h", self.arw_reason),
+                ("rrw_dph_per_rt_h", "rate random walk", self.rrw_dph_per_rt_h,
+                 self.rrw_taus_s, "deg/h/rt-h", self.rrw_reason)):
             if value is None or taus is None:
-                return f"n/a ({reason})"
-            return f"{value:.4g} {unit}  (fit over tau {taus[0]:g}-{taus[1]:g} s)"
-
+                lines.append(escape(f"n/a ({reason})"))
+                continue
+            figures += [Figure(key, label, value, unit, digits=4,
+                               definition=f"The {label} read off the Allan deviation's slope "
+                               f"over τ {taus[0]:g}-{taus[1]:g} s."),
+                        Figure(key.split("_")[0] + "_taus_s", f"{label}: τ range",
+                               taus[1] - taus[0], "s", (taus[0], taus[1]), "range")]
+            lines.append(f"{{{key}:.4g}} {unit}  (fit over tau {taus[0]:g}-{taus[1]:g} s)")
         if self.bias_instability_dph is None:
-            bias = f"n/a ({self.bias_instability_reason})"
+            bias = escape(f"n/a ({self.bias_instability_reason})")
         else:
-            bias = (f"{self.bias_instability_dph:.4g} deg/h  "
-                    f"(minimum at tau {self.bias_instability_tau_s:g} s)")
-        return "\n".join(
-            [
-                "angle random walk  " + fmt(self.arw_deg_per_rt_h, self.arw_taus_s, "deg/rt-h",
-                                            self.arw_reason),
-                f"bias instability   {bias}",
-                "rate random walk   " + fmt(self.rrw_dph_per_rt_h, self.rrw_taus_s,
-                                            "deg/h/rt-h", self.rrw_reason),
-            ]
-        )
+            figures += [Figure("bias_instability_dph", "bias instability",
+                               self.bias_instability_dph, "deg/h", digits=4,
+                               definition="The flat minimum of the Allan deviation over "
+                               "0.664."),
+                        Figure("bias_instability_tau_s", "bias instability: τ",
+                               self.bias_instability_tau_s, "s")]
+            bias = "{bias_instability_dph:.4g} deg/h  (minimum at tau {bias_instability_tau_s:g} s)"
+        return Summary("noise terms", (("noise terms", tuple(figures)),), layout=(
+            "angle random walk  " + lines[0], f"bias instability   {bias}",
+            "rate random walk   " + lines[1]))
 
 
 

@@ -31,8 +31,12 @@ from typing import Any
 
 from hrgtc.core.process import peak_rss_mb
 from hrgtc.core.progress import Progress
+from hrgtc.core.summary import Figure, Summary, escape
 from hrgtc.fleet.tasks import UnitOutcome, error_record
 from hrgtc.settings.fleet import FleetCluster
+
+#: The heading of a fleet run's table of failed units.
+FAILED = "Failed units"
 
 __all__ = ["FleetRun", "Task", "run_tasks", "scheduler_address", "worker_deaths"]
 
@@ -81,16 +85,35 @@ class FleetRun:
             out[o.status] = out.get(o.status, 0) + 1
         return out
 
-    def summary(self) -> str:
-        """One line."""
+    def summary(self) -> Summary:
+        """Units done, skipped and failed, the wall time, the workers that died, and each
+        failed unit's error (type, file, column, row, message) as a table; its text one
+        line (the table is the CLI's, before it)."""
         c = self.counts()
-        line = (f"{len(self.outcomes)} units in {self.seconds:.1f} s ({self.where}): "
-                f"{c['ok']} done, {c['skipped']} skipped (unchanged), {c['failed']} failed")
+        figures = [Figure("units", "units", len(self.outcomes)),
+                   Figure("seconds", "wall time", self.seconds, "s",
+                          definition="Wall time of the run, cluster start included."),
+                   Figure("where", "where", self.where),
+                   *(Figure(f"counts.{status}", status, c[status])
+                     for status in ("ok", "skipped", "failed"))]
+        line = ("{units} units in {seconds:.1f} s ({where}): {counts.ok} done, "
+                "{counts.skipped} skipped (unchanged), {counts.failed} failed")
         if self.workers_died:
             units = ", ".join(self.retried) if self.retried else "none"
-            line += (f"; {self.workers_died} worker process(es) died during the run and "
-                     f"{len(self.retried)} unit(s) were run again: {units}")
-        return line
+            figures.append(Figure("workers_died", "worker processes died", self.workers_died))
+            line += ("; {workers_died} worker process(es) died during the run and "
+                     f"{len(self.retried)} unit(s) were run again: {escape(units)}")
+        failed: list[Figure] = []
+        for k, o in enumerate(self.failed):
+            e = o.error or {}
+            cells = (("unit", o.unit), ("error", str(e.get("type"))),
+                     ("file", str(e.get("file") or "–")), ("column", str(e.get("column") or "–")),
+                     ("row", str(e.get("row") or "–")),
+                     ("message", (str(e.get("message", "")).splitlines() or [""])[0][:200]))
+            failed += [Figure(f"failed[{k}].{column}", f"{o.unit}: {column}", value, row=o.unit,
+                              column=column) for column, value in cells]
+        return Summary("fleet run", (("run", tuple(figures)), (FAILED, tuple(failed))),
+                       layout=(line,))
 
 
 def scheduler_address(scheduler: str | None = None) -> str | None:

@@ -92,5 +92,5 @@ def measure_prior(n_prior: int, n_held_out: int, seed: int = 1, sample_rate_hz: 
             result = fit_with_prior(t[keep], f[keep], prior, s[keep])
             errors[n].append(_max_error(result.thermometer, unit["truth"], grid))
             band[n].append(result.max_temperature_std_c)
-    return {"max_error_c": errors, "band_c": band, "prior": prior.summary(),
+    return {"max_error_c": errors, "band_c": band, "prior": prior.summary().text(),
             "n_prior": n_prior, "n_held_out": n_held_out}

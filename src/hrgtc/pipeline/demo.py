@@ -23,7 +23,9 @@ from hrgtc.compensate.file_pass import compensated_metadata
 from hrgtc.core.errors import HrgtcWarning
 from hrgtc.core.files import refuse_existing
 from hrgtc.core.progress import StageProgress, for_stage
+from hrgtc.core.summary import Summary
 from hrgtc.evaluation import Evaluation, evaluate
+from hrgtc.evaluation.instrument_figures import stability_table
 from hrgtc.export.export_c import export_c
 from hrgtc.model import save_model
 from hrgtc.pipeline.calibration import CalibrationResult, calibrate
@@ -52,6 +54,13 @@ class DemoResult:
     report_file: Path
     c_files: tuple[Path, ...]
     instrument: InstrumentDemo | None = None
+
+    def summary(self) -> Summary:
+        """10 s bias stability raw → compensated: the paper's, the training cool-down's
+        and the held-out warm-up's
+        (:func:`hrgtc.evaluation.instrument_figures.stability_table`)."""
+        return stability_table((("paper-unit cool-down (training)", self.training),
+                                ("paper-unit warm-up (held out)", self.validation)))
 
 
 @dataclass(frozen=True)

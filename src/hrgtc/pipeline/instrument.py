@@ -37,6 +37,7 @@ from hrgtc.drift import (
 from hrgtc.drift.scale_factor import TOLERANCE_SHARE
 from hrgtc.evaluation import Evaluation, evaluate
 from hrgtc.evaluation.calibration_figures import instrument_summary
+from hrgtc.evaluation.instrument_figures import evaluation_tables
 from hrgtc.evaluation.instrument_pass import evaluate_axes
 from hrgtc.model import AxisModel, Model, provenance
 from hrgtc.pipeline import documents
@@ -485,6 +486,11 @@ class InstrumentEvaluation:
     model: Model
     axes: dict[str, Evaluation]
     scale_checks: tuple[ScaleFactorCheck, ...] = ()
+
+    def summary(self) -> Summary:
+        """The axes side by side and the scale-factor check, beside each axis's own
+        (:func:`hrgtc.evaluation.instrument_figures.evaluation_tables`)."""
+        return evaluation_tables(self)
 
     def axis_summary(self) -> list[dict[str, float | str]]:
         """One row per axis: 10 s bias stability raw and compensated, improvement, mean and

@@ -20,6 +20,7 @@ import numpy as np
 from hrgtc.core import records
 from hrgtc.core.errors import GapWarning, InputError, RecordingError
 from hrgtc.core.records import Count, Record
+from hrgtc.core.summary import Figure, Summary, escape
 from hrgtc.recording.gaps import Gap, GapPolicy, GapRecord
 
 SAMPLE_RATE_TOLERANCE = 0.01  # relative disagreement of measured and nominal rate
@@ -171,34 +172,54 @@ class ValidationReport:
                 "across each gap with its duration (--gaps bridge, the default for such a "
                 "logger); pass --gaps split to restart them after each"), stacklevel=3)
 
-    def summary(self) -> str:
-        """Human-readable text (does not print)."""
-        where = self.source or "recording"
-        lines = [f"validation of {where}: {'ok' if self.ok else 'FAILED'} ({self.rows} rows)"]
+    def summary(self) -> Summary:
+        """Rows, measured rate, problems, dropouts and gaps (the first ten); its text the
+        report ``hrgtc info`` prints."""
+        where = escape(self.source or "recording")
+        figures = [Figure("ok", "validation", "ok" if self.ok else "FAILED"),
+                   Figure("rows", "rows", self.rows)]
+        lines = [f"validation of {where}: {{ok}} ({{rows}} rows)"]
         if self.measured_sample_rate_hz is not None:
-            lines.append(f"  measured sample rate: {self.measured_sample_rate_hz:.6g} Hz")
-        lines += [f"  problem: {p.message}" for p in self.problems]
+            figures.append(Figure("measured_sample_rate_hz", "measured sample rate",
+                                  self.measured_sample_rate_hz, "Hz",
+                                  definition="1 / the median time step."))
+            lines.append("  measured sample rate: {measured_sample_rate_hz:.6g} Hz")
+        for p in self.problems:  # a message of several lines stays several lines
+            first, *rest = escape(p.message).split("\n")
+            lines += [f"  problem: {first}", *rest]
+        gaps: list[Figure] = []
         if self.n_dropouts:
-            lines.append(f"  dropouts: {self.n_dropouts} gap(s) no longer than "
+            figures.append(Figure("n_dropouts", "dropouts", self.n_dropouts,
+                                  definition=f"Gaps no longer than {self.dropout_s:g} s, "
+                                  "bridged."))
+            lines.append("  dropouts: {n_dropouts} gap(s) no longer than "
                          f"{self.dropout_s:g} s, bridged (they change no result)")
         if self.n_gaps:
             longer = self.n_gaps - self.n_dropouts
+            figures.append(Figure("n_gaps", "gaps", self.n_gaps,
+                                  definition="Time steps longer than a gap."))
             if self.duty_cycled and self.gap_policy == "error":
                 lines.append("  a duty-cycled logger (bursts much shorter than their period): "
                              "its gaps are bridged, the filters carry across each with its "
                              "duration (--gaps split restarts them)")
-            lines.append(f"  gaps: {self.n_gaps} " + (
+            lines.append("  gaps: {n_gaps} " + (
                 "(all dropouts)" if not longer else
                 f"(policy {self.gap_policy} for the {longer} longer than {self.dropout_s:g} s)"
                 if self.n_dropouts else f"(policy {self.gap_policy})"))
-            lines += [
-                f"    row {g.row}: {g.duration_s:.6g} s without samples after t = "
-                f"{g.start_time_s:.6g} s"
-                for g in self.gaps[:10]
-            ]
+            for k, g in enumerate(self.gaps[:10]):
+                gaps += [Figure(f"gaps[{k}].row", f"gap {k + 1}: row", g.row, row=str(k),
+                                column="row"),
+                         Figure(f"gaps[{k}].duration_s", f"gap {k + 1}: duration",
+                                g.duration_s, "s", row=str(k), column="duration"),
+                         Figure(f"gaps[{k}].start_time_s", f"gap {k + 1}: after t",
+                                g.start_time_s, "s", row=str(k), column="after t")]
+                lines.append(f"    row {{gaps[{k}].row}}: {{gaps[{k}].duration_s:.6g}} s "
+                             f"without samples after t = {{gaps[{k}].start_time_s:.6g}} s")
             if self.n_gaps > 10:
                 lines.append(f"    ... {self.n_gaps - 10} more")
-        return "\n".join(lines)
+        return Summary(f"validation of {self.source or 'recording'}",
+                       (("validation", tuple(figures)), ("gaps", tuple(gaps))),
+                       tuple(p.message for p in self.problems), tuple(lines))
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types (:class:`ValidationReportRecord`)."""

@@ -20,6 +20,7 @@ from hrgtc.core import records
 from hrgtc.core.errors import RecordingError
 from hrgtc.core.progress import Progress
 from hrgtc.core.records import Count, Record
+from hrgtc.core.summary import Figure, Summary, escape
 from hrgtc.core.time_steps import TimeRepairStream
 from hrgtc.core.timeline import Timeline
 from hrgtc.core.timeline_builder import TimelineBuilder
@@ -148,64 +149,36 @@ class RecordingInfo:
         """The summary of column ``name``, None if absent."""
         return next((c for c in self.columns if c.name == name), None)
 
-    def summary(self) -> str:
-        """Human-readable text (does not print)."""
-        lines = [f"{self.path} ({self.format or 'unknown format'})"]
-        meta = self.metadata or {}
-        if meta:
-            # a field the file does not set (a plain CSV's empty profile) is not shown
-            parts = [f"unit {meta.get('unit')!s}"]
-            if meta.get("profile"):
-                parts.append(f"profile {meta['profile']!r}")
-            if meta.get("profile") or meta.get("input_rate_dph"):
-                parts.append(f"input rate {_num(meta.get('input_rate_dph'))} °/h")
-            lines.append("  " + ", ".join(parts))
-        lines.append(f"  rows: {self.rows}")
-        if self.axes:
-            lines.append(f"  axes: {', '.join(self.axes)} ({len(self.axes)}-axis recording; "
-                         "per-axis columns <name>_<axis>)")
-        timeline = self.timeline or {}
-        if timeline.get("segments"):
-            lines.append(f"  duration: span {_num(self.duration_s)} s ({_hours(self.duration_s)}), "
-                         f"recorded {_num(timeline['recorded_s'])} s "
-                         f"({_hours(timeline['recorded_s'])}) in {timeline['segments']} "
-                         "segment(s)")
-            if timeline["segments"] > 1:
-                lines.append(
-                    f"  segments: {_num(timeline['burst_length_s'])} s long (median), one every "
-                    f"{_num(timeline['burst_period_s'])} s (median); "
-                    + ("a burst (duty-cycled) logger" if timeline.get("bursty")
-                       else "a logger with pauses")
-                    + f"; median period {_num(timeline['period_s'])} s")
-        else:
-            lines.append(f"  duration: {_num(self.duration_s)} s ({_hours(self.duration_s)})")
-        for repair in timeline.get("repairs", []):
-            lines.append(f"  time: {repair}")
-        inferred = " (inferred from the time steps)" if self.sample_rate_inferred else ""
-        lines.append(
-            f"  sample rate: {_num(self.sample_rate_hz)} Hz in the metadata{inferred}, "
-            f"{_num(self.measured_sample_rate_hz)} Hz measured"
-        )
-        lines.append("  columns:")
-        for col in self.columns:
-            unit = f"[{col.unit}]" if col.unit else "[?]"
-            step = "" if col.resolution is None else f"  (steps of {col.resolution:.3g})"
-            lines.append(f"    {col.name:<16} {unit:<8} {_num(col.minimum)} .. "
-                         f"{_num(col.maximum)}{step}")
+    def summary(self) -> Summary:
+        """The file at a glance: rows, axes, duration and segments, sample rates, each
+        column's unit and range, spikes, spans and the validation report (its figures after
+        ``validation.``); its text what ``hrgtc info`` prints."""
+        figures, lines = self._file_figures()
+        columns, column_lines = self._column_figures()
+        lines += column_lines
         found = (self.metadata or {}).get("extra", {}).get("columns_found") or {}
         if found:
-            lines.append("  found by name: " + ", ".join(
+            lines.append(escape("  found by name: " + ", ".join(
                 f"{theirs!r} as {name}" for name, theirs in found.items())
-                + " (the accelerometer: motion and orientation; --col accel_x=... to choose)")
+                + " (the accelerometer: motion and orientation; --col accel_x=... to choose)"))
         if self.spike_rows is not None:
-            lines.append(f"  single-sample spikes: {self.spike_rows} row(s) (calibrate and "
+            figures.append(Figure("spike_rows", "rows with single-sample spikes",
+                                  self.spike_rows))
+            lines.append("  single-sample spikes: {spike_rows} row(s) (calibrate and "
                          "evaluate remove them, compensate flags them; --spike-filter)")
         for col in self._span_columns():
             if col.minimum is not None:
                 unit = {"Hz": "Hz", "count": "counts"}.get(col.unit, "°C")
-                lines.append(f"  {col.name} span: {col.maximum - col.minimum:.6g} {unit}")
-        lines.append(self.validation.summary().replace("\n", "\n  ").join(["  ", ""]))
-        return "\n".join(lines)
+                figures.append(Figure(f"spans.{col.name}", f"{col.name} span",
+                                      col.maximum - col.minimum, unit,
+                                      definition="Largest minus smallest value."))
+                lines.append(f"  {escape(col.name)} span: {{spans.{col.name}:.6g}} "
+                             f"{escape(unit)}")
+        validation = self.validation.summary().renamed("validation.")
+        return Summary(f"{self.path} ({self.format or 'unknown format'})",
+                       (("recording", tuple(figures)), ("columns", tuple(columns)),
+                        *validation.sections), validation.notes,
+                       (*lines, *validation.lines("  ")))
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types (:class:`RecordingInfoRecord`)."""
@@ -213,6 +186,89 @@ class RecordingInfo:
             self, RecordingInfoRecord, columns=[c.to_dict() for c in self.columns],
             spans={col.name: [col.minimum, col.maximum] for col in self._span_columns()},
             validation=self.validation.to_dict())
+
+    def _file_figures(self) -> tuple[list[Figure], list[str]]:
+        """The summary's figures and lines of the file: metadata, rows, axes, duration and
+        segments, time repairs, sample rates."""
+        figures: list[Figure] = [Figure("rows", "rows", self.rows)]
+        lines = [escape(f"{self.path} ({self.format or 'unknown format'})")]
+        meta = self.metadata or {}
+        if meta:
+            # a field the file does not set (a plain CSV's empty profile) is not shown
+            parts = [escape(f"unit {meta.get('unit')!s}")]
+            if meta.get("profile"):
+                parts.append(escape(f"profile {meta['profile']!r}"))
+            if meta.get("profile") or meta.get("input_rate_dph"):
+                figures.append(_figure("input_rate_dph", "input rate",
+                                       meta.get("input_rate_dph"), "°/h"))
+                parts.append(f"input rate {_field('input_rate_dph', meta.get('input_rate_dph'))}"
+                             " °/h")
+            lines.append("  " + ", ".join(parts))
+        lines.append("  rows: {rows}")
+        if self.axes:
+            lines.append(escape(f"  axes: {', '.join(self.axes)} ({len(self.axes)}-axis "
+                                "recording; per-axis columns <name>_<axis>)"))
+        figures.append(_figure("duration_s", "duration", self.duration_s, "s"))
+        duration = f"{_field('duration_s', self.duration_s)} s ({_hours(self.duration_s)})"
+        timeline = self.timeline or {}
+        if timeline.get("segments"):
+            recorded = timeline["recorded_s"]
+            figures += [_figure("timeline.recorded_s", "recorded", recorded, "s"),
+                        Figure("timeline.segments", "segments", timeline["segments"])]
+            lines.append(f"  duration: span {duration}, recorded "
+                         f"{_field('timeline.recorded_s', recorded)} s ({_hours(recorded)}) in "
+                         "{timeline.segments} segment(s)")
+            if timeline["segments"] > 1:
+                figures += [_figure(f"timeline.{k}", label, timeline[k], "s")
+                            for k, label in (("burst_length_s", "segment length (median)"),
+                                             ("burst_period_s", "segment period (median)"),
+                                             ("period_s", "sample period (median)"))]
+                lines.append(
+                    f"  segments: {_field('timeline.burst_length_s', timeline['burst_length_s'])}"
+                    " s long (median), one every "
+                    f"{_field('timeline.burst_period_s', timeline['burst_period_s'])} s "
+                    "(median); " + ("a burst (duty-cycled) logger" if timeline.get("bursty")
+                                    else "a logger with pauses")
+                    + f"; median period {_field('timeline.period_s', timeline['period_s'])} s")
+        else:
+            lines.append(f"  duration: {duration}")
+        lines += [escape(f"  time: {repair}") for repair in timeline.get("repairs", [])]
+        inferred = " (inferred from the time steps)" if self.sample_rate_inferred else ""
+        figures += [_figure("sample_rate_hz", "sample rate (metadata)", self.sample_rate_hz,
+                            "Hz"),
+                    _figure("measured_sample_rate_hz", "sample rate (measured)",
+                            self.measured_sample_rate_hz, "Hz")]
+        lines.append(f"  sample rate: {_field('sample_rate_hz', self.sample_rate_hz)} Hz in the "
+                     f"metadata{inferred}, "
+                     f"{_field('measured_sample_rate_hz', self.measured_sample_rate_hz)} Hz "
+                     "measured")
+        return figures, lines
+
+    def _column_figures(self) -> tuple[list[Figure], list[str]]:
+        """The summary's table of the columns (unit, range, steps) and its lines."""
+        lines = ["  columns:"]
+        columns: list[Figure] = []
+        for col in self.columns:
+            unit = f"[{col.unit}]" if col.unit else "[?]"
+            key = f"columns.{col.name}"
+            columns += [Figure(f"{key}.name", f"{col.name}", col.name, row=col.name,
+                               column="column"),
+                        Figure(f"{key}.unit", f"{col.name} unit", col.unit or "?", row=col.name,
+                               column="unit"),
+                        _figure(f"{key}.minimum", f"{col.name} minimum", col.minimum,
+                                row=col.name, column="minimum"),
+                        _figure(f"{key}.maximum", f"{col.name} maximum", col.maximum,
+                                row=col.name, column="maximum")]
+            step = ""
+            if col.resolution is not None:
+                columns.append(Figure(f"{key}.resolution", f"{col.name} steps", col.resolution,
+                                      row=col.name, column="steps",
+                                      definition="The smallest step between its values."))
+                step = f"  (steps of {{{key}.resolution:.3g}})"
+            lines.append(f"    {{{key}.name:<16}} {escape(f'{unit:<8}')} "
+                         f"{_field(f'{key}.minimum', col.minimum)} .. "
+                         f"{_field(f'{key}.maximum', col.maximum)}{step}")
+        return columns, lines
 
     def _span_columns(self) -> list[ColumnSummary]:
         """Temperature and frequency columns (per axis too), in the order of SPAN_COLUMNS."""
@@ -251,8 +307,14 @@ class RecordingInfoRecord(Record, kw_only=True):
     timeline: dict[str, Any] | None = None
 
 
-def _num(value: Any) -> str:
-    return "?" if value is None else f"{value:.6g}"
+def _field(name: str, value: Any) -> str:
+    """A figure in a summary's layout as :func:`_num` writes it (``?``: not known)."""
+    return "?" if value is None else "{" + name + ":.6g}"
+
+
+def _figure(name: str, label: str, value: Any, unit: str = "", **cells: str) -> Figure:
+    """A figure that may not be known (None: NaN, shown as ``-``)."""
+    return Figure(name, label, math.nan if value is None else value, unit, **cells)
 
 
 def _hours(seconds: float | None) -> str:

@@ -45,6 +45,7 @@ from typing import Any
 import numpy as np
 
 from hrgtc.core.errors import InputError
+from hrgtc.core.summary import Figure, Summary, escape
 from hrgtc.settings.reading import DROPOUT_S
 
 #: A gap: a time step larger than this many median periods.
@@ -219,11 +220,21 @@ class MotionMask:
                 "fraction": self.fraction, "reasons": self.counts(),
                 "noise": dict(self.noise), "settings": self.settings.to_dict()}
 
-    def summary(self) -> str:
-        """One line: how many samples were found moving, and why."""
-        why = ", ".join(f"{r} {n}" for r, n in self.counts().items() if n)
-        return (f"motion: {self.n_moving} of {self.n_samples} samples not at rest "
-                f"({self.fraction:.1%})" + (f" [{why}]" if why else ""))
+    def summary(self) -> Summary:
+        """Samples not at rest, their share and the count of each reason (its text: one
+        line)."""
+        counts = {r: n for r, n in self.counts().items() if n}
+        figures = (Figure("n_moving", "samples not at rest", self.n_moving,
+                          definition="Samples marked as moving for any reason."),
+                   Figure("n_samples", "samples", self.n_samples),
+                   Figure("fraction", "share not at rest", self.fraction, spec=".1%"),
+                   *(Figure(f"counts.{r}", f"marked by {r}", n,
+                            definition=f"Samples marked by the {r} test (a sample may count "
+                            "under several).") for r, n in counts.items()))
+        why = ", ".join(f"{escape(r)} {{counts.{r}}}" for r in counts)
+        return Summary("motion", (("motion", figures),), layout=(
+            "motion: {n_moving} of {n_samples} samples not at rest ({fraction:.1%})"
+            + (f" [{why}]" if why else ""),))
 
 
 # --------------------------------------------------------------------------- helpers

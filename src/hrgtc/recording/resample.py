@@ -38,6 +38,7 @@ import numpy as np
 from hrgtc.core import records
 from hrgtc.core.errors import InputError, SlowChannelWarning
 from hrgtc.core.records import Count, Positive, Record
+from hrgtc.core.summary import Figure, Summary, escape
 from hrgtc.settings.reading import DEFAULT_MAX_AGE_PERIODS
 
 #: What to do with a slow channel's empty cells.
@@ -221,21 +222,34 @@ class SlowChannels:
         return {k: v[keep] for k, v in out.items()}
 
     # -- reporting --------------------------------------------------------------------
-    def summary(self) -> list[str]:
-        """One line per slow channel: its period, the choice and the rows filled/dropped."""
-        where = f"{self.source}: " if self.source else ""
-        lines = []
+    def summary(self) -> Summary:
+        """Each slow channel's period, how long a value is used, the cells filled and the
+        rows dropped (its text: one line per channel, each a warning)."""
+        where = escape(f"{self.source}: ") if self.source else ""
+        how = "held (last value)" if self.mode == "hold" else "interpolated linearly in time"
+        sections, lines = [], []
         for s in self._reported():
-            how = ("held (last value)" if self.mode == "hold" else
-                   "interpolated linearly in time")
-            line = (f"{where}column '{s.column}' is logged every {s.period_s:g} s, slower than "
-                    f"the file's rows: {how} for up to {s.max_age_s:g} s (--slow-channels "
-                    f"{self.mode}, --hold-max-s); {s.filled} cells filled")
+            key = f"channels.{s.column}"
+            figures = [Figure(f"{key}.period_s", "logged every", s.period_s, "s",
+                              definition="Median time between the channel's values."),
+                       Figure(f"{key}.max_age_s", "used for up to", s.max_age_s, "s",
+                              definition=f"Longest time a value is {how} (--hold-max-s)."),
+                       Figure(f"{key}.filled", "cells filled", s.filled)]
+            line = (f"{where}column '{escape(s.column)}' is logged every {{{key}.period_s:g}} s, "
+                    f"slower than the file's rows: {how} for up to {{{key}.max_age_s:g}} s "
+                    f"(--slow-channels {self.mode}, --hold-max-s); {{{key}.filled}} cells filled")
             if s.dropped:
-                line += (f", {s.dropped} rows dropped as a gap in the channel (farther than "
-                         f"{s.max_age_s:g} s from a value; first at row {s.first_dropped_row})")
+                figures += [Figure(f"{key}.dropped", "rows dropped", s.dropped,
+                                   definition="Rows farther than that from a value, dropped "
+                                   "as a gap in the channel."),
+                            Figure(f"{key}.first_dropped_row", "first dropped row",
+                                   s.first_dropped_row)]
+                line += (f", {{{key}.dropped}} rows dropped as a gap in the channel (farther "
+                         f"than {{{key}.max_age_s:g}} s from a value; first at row "
+                         f"{{{key}.first_dropped_row}})")
+            sections.append((f"column {s.column}", tuple(figures)))
             lines.append(line)
-        return lines
+        return Summary(f"slow channels ({self.mode})", tuple(sections), layout=tuple(lines))
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types: the mode and each slow channel's figures
@@ -249,7 +263,7 @@ class SlowChannels:
 
     def warn(self) -> None:
         """Report each slow channel once as a :class:`~hrgtc.core.errors.SlowChannelWarning`."""
-        for line in self.summary():
+        for line in self.summary().text().splitlines():
             warnings.warn(line, SlowChannelWarning, stacklevel=3)
 
 

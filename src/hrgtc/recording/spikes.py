@@ -54,6 +54,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from hrgtc.core.errors import InputError, SpikeWarning
+from hrgtc.core.summary import Figure, Summary, escape
 from hrgtc.recording.axes import axis_names, base_name
 from hrgtc.recording.checks import _BOUNDS, FREQ_JUMP_FRACTION, TEMPERATURE_RANGE_C
 from hrgtc.recording.gaps import GAP_PERIODS, GAP_TOLERANCE
@@ -422,21 +423,34 @@ class RobustSpikeFilter:
         bounds = _BOUNDS.get(base)
         return None if bounds is None else (bounds[0], bounds[1])
 
-    def summary(self) -> str:
-        """One line: how many spikes, where, what was done (empty without any)."""
+    def summary(self) -> Summary:
+        """How many rows had spikes, per column, the threshold, what was done and the first
+        (its text: one line; empty without any)."""
         if not self.rows or self.first is None:
-            return ""
+            return Summary("single-sample spikes", layout=("",))
         done = "removed" if self.mode == "drop" else f"flagged in column '{SPIKE_COLUMN}'"
-        per = ", ".join(f"{name} {count}" for name, count in self.found.items())
         name, row, value = self.first
-        where = f"{self.source}: " if self.source else ""
-        return (f"{where}{self.rows} row(s) with single-sample spikes {done} ({per}; threshold "
-                f"max({self.k:g}·σ_MAD, {self.lsb_multiple:g}·LSB) over {self.window_s:g} s "
-                f"windows); the first: column '{name}', row {row}, value {value:.6g}")
+        figures = (Figure("rows", "rows with spikes", self.rows,
+                          definition=f"Rows with a single-sample spike, {done}."),
+                   *(Figure(f"found.{column}", f"spikes in {column}", count)
+                     for column, count in self.found.items()),
+                   Figure("k", "threshold, σ_MAD", self.k), Figure("lsb_multiple",
+                                                                   "threshold, LSB",
+                                                                   self.lsb_multiple),
+                   Figure("window_s", "window", self.window_s, "s"),
+                   Figure("first.column", "first: column", name),
+                   Figure("first.row", "first: row", row),
+                   Figure("first.value", "first: value", value))
+        per = ", ".join(f"{escape(column)} {{found.{column}}}" for column in self.found)
+        where = escape(f"{self.source}: ") if self.source else ""
+        return Summary("single-sample spikes", (("spikes", figures),), layout=(
+            f"{where}{{rows}} row(s) with single-sample spikes {escape(done)} ({per}; "
+            "threshold max({k:g}·σ_MAD, {lsb_multiple:g}·LSB) over {window_s:g} s windows); "
+            "the first: column '{first.column}', row {first.row}, value {first.value:.6g}",))
 
     def warn(self) -> None:
         """One :class:`~hrgtc.core.errors.SpikeWarning` for the whole file (none without spikes)."""
-        text = self.summary()
+        text = self.summary().text()
         if text:
             warnings.warn(text, SpikeWarning, stacklevel=3)
 

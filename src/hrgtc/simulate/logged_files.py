@@ -20,6 +20,7 @@ without ``force``.
 from __future__ import annotations
 
 import json
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -36,6 +37,7 @@ from hrgtc.core.files import (
     temporary_beside,
     write_text_atomic,
 )
+from hrgtc.core.summary import Figure, Summary
 from hrgtc.recording import Metadata, Recording, RecordingWriter
 from hrgtc.recording.formats.registry import formats, is_recording, output_suffixes
 from hrgtc.simulate.logger import LoggedRun, Logger, log_run
@@ -47,6 +49,7 @@ __all__ = [
     "LoggedFiles",
     "LoggedFilesRecord",
     "csv_text",
+    "logged_summary",
     "sidecar_paths",
     "simulate_logged_files",
     "write_logged",
@@ -263,3 +266,18 @@ def simulate_logged_files(
         write_logged(log_run(profile, unit, logger, s, input_rate_dph), path, force=force)
         for profile, path, s in zip(profiles, paths, seeds, strict=True)
     ]
+
+
+def logged_summary(logged: Sequence[LoggedFiles], unit: str, logger: str,
+                   sample_rate_hz: float, seed: int) -> Summary:
+    """The files ``hrgtc simulate --logger`` wrote, as a table: file, rows, its truth (and
+    the reference log, if any)."""
+    cells: list[Figure] = []
+    for k, w in enumerate(logged):
+        truth = w.truth_json + (f", {w.reference_log}" if w.reference_log else "")
+        cells += [Figure(f"files[{k}].path", "file", w.path, row=str(k), column="file"),
+                  Figure(f"files[{k}].rows", "rows", w.rows, spec=",", row=str(k),
+                         column="rows"),
+                  Figure(f"files[{k}].truth", "truth", truth, row=str(k), column="truth")]
+    return Summary("", ((f"simulated {unit} through a {logger} logger, {sample_rate_hz:g} Hz, "
+                         f"seed {seed}", tuple(cells)),))

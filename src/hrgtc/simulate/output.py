@@ -21,6 +21,7 @@ from hrgtc.core import records
 from hrgtc.core.errors import InputError
 from hrgtc.core.files import refuse_existing
 from hrgtc.core.progress import Progress
+from hrgtc.core.summary import Figure, Summary
 from hrgtc.recording import RecordingWriter
 from hrgtc.recording.formats.registry import formats, output_suffixes
 from hrgtc.simulate import units as _units
@@ -38,7 +39,7 @@ from hrgtc.simulate.profiles import Profile
 from hrgtc.simulate.units import MultiAxisUnit, Unit
 
 __all__ = ["SimulatedRun", "WrittenFile", "WrittenFileRecord", "output_paths", "simulate_files",
-           "simulate_to_file"]
+           "simulate_to_file", "written_summary"]
 
 
 @dataclass(frozen=True)
@@ -68,9 +69,12 @@ class WrittenFile:
         """Inverse of :meth:`to_dict` (checked against its record)."""
         return cls(**records.load(data, WrittenFileRecord, "written file"))
 
-    def summary(self) -> str:
-        """One line."""
-        return f"{self.path}: {self.rows} rows ({self.profile})"
+    def summary(self) -> Summary:
+        """The file, its rows and its profile (its text: one line)."""
+        return Summary(self.path, (("written", (Figure("path", "file", self.path),
+                                                Figure("rows", "rows", self.rows),
+                                                Figure("profile", "profile", self.profile))),),
+                       layout=("{path}: {rows} rows ({profile})",))
 
 
 class WrittenFileRecord(records.Record, kw_only=True):
@@ -312,3 +316,17 @@ class _SharedProgress:
                     self.progress(sum(self.done), self.total)
 
         return report
+
+
+def written_summary(written: Sequence[WrittenFile], unit: str, sample_rate_hz: float,
+                    seed: int) -> Summary:
+    """The files ``hrgtc simulate`` wrote, as a table: file, rows, profile."""
+    cells: list[Figure] = []
+    for k, w in enumerate(written):
+        cells += [Figure(f"files[{k}].path", "file", w.path, row=str(k), column="file"),
+                  Figure(f"files[{k}].rows", "rows", w.rows, spec=",", row=str(k),
+                         column="rows"),
+                  Figure(f"files[{k}].profile", "profile", w.profile, row=str(k),
+                         column="profile")]
+    return Summary("", ((f"simulated {unit}, {sample_rate_hz:g} Hz, seed {seed}",
+                         tuple(cells)),))

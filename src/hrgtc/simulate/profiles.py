@@ -63,6 +63,7 @@ import yaml
 import hrgtc.settings.simulation as _settings
 from hrgtc.core import records
 from hrgtc.core.errors import InputError
+from hrgtc.core.summary import Figure, Summary, escape
 
 __all__ = [
     "AXIS_NAME",
@@ -356,14 +357,23 @@ class Profile:
         records.load(data, ProfileRecord, "profile")
         return from_mapping(data)
 
-    def summary(self) -> str:
-        """One line per segment, as text."""
+    def summary(self) -> Summary:
+        """The chamber temperature at each breakpoint and the duration (its text: one line
+        per breakpoint)."""
         times, temps = self.breakpoints()
-        lines = [f"profile {self.name}: {self.description}", f"  duration {times[-1]:.0f} s"]
-        lines += [
-            f"  t = {t:9.0f} s  chamber {c:8.3f} °C" for t, c in zip(times, temps, strict=True)
-        ]
-        return "\n".join(lines)
+        cells: list[Figure] = []
+        for k, (t, c) in enumerate(zip(times, temps, strict=True)):
+            cells += [Figure(f"breakpoints[{k}].time_s", f"breakpoint {k + 1}: t", float(t), "s",
+                             row=str(k), column="t"),
+                      Figure(f"breakpoints[{k}].chamber_c", f"breakpoint {k + 1}: chamber",
+                             float(c), "°C", row=str(k), column="chamber")]
+        duration = Figure("duration_s", "duration", float(times[-1]), "s")
+        layout = (escape(f"profile {self.name}: {self.description}"),
+                  "  duration {duration_s:.0f} s",
+                  *(f"  t = {{breakpoints[{k}].time_s:9.0f}} s  chamber "
+                    f"{{breakpoints[{k}].chamber_c:8.3f}} °C" for k in range(len(times))))
+        return Summary(f"profile {self.name}", (("profile", (duration,)),
+                                                ("breakpoints", tuple(cells))), layout=layout)
 
 
 def from_mapping(data: Any, source: str = "profile", name: str = "profile") -> Profile:

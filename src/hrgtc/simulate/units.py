@@ -63,6 +63,7 @@ from msgspec import Meta
 import hrgtc.settings.simulation as _settings
 from hrgtc.core import records
 from hrgtc.core.errors import InputError
+from hrgtc.core.summary import Figure, Summary, escape
 from hrgtc.simulate.laws import (
     BiasLaw,
     BiasLawRecord,
@@ -160,36 +161,70 @@ class Unit:
                "scale_factor_law": None if law is None else ScaleFactorLaw(**law)},
         )
 
-    def summary(self) -> str:
-        """The unit's parameters as text."""
+    def summary(self) -> Summary:
+        """The unit's parameters (thermal time constants, noise, bias and scale-factor
+        laws); its text the description ``hrgtc simulate --list`` prints."""
         law = self.bias_law
         noise = self.gyro_noise
-        lines = [
-            f"unit {self.name}: {self.description}",
-            f"  thermal: tau_housing {self.thermal.tau_housing_s:g} s, "
-            f"tau_resonator {self.thermal.tau_resonator_s:g} s",
-            f"  frequency law: {self.frequency_law.to_dict()}",
-            f"  frequency noise {self.frequency_noise_hz:g} Hz rms/sample, "
-            f"housing thermistor noise {self.housing_noise_c:g} °C rms/sample",
-            f"  bias law: B0 {law.bias0_dph:g} °/h, T0 {law.reference_c:g} °C, "
-            f"c1..c3 {law.temperature_dph}, gradient {law.gradient_dph_per_c:g} °/h/°C, "
-            f"gradient x T {law.gradient_temperature_dph_per_c2:g} °/h/°C², "
-            f"hysteresis {law.hysteresis_dph:g} °/h over {law.hysteresis_width_c:g} °C",
-            f"  noise: ARW {noise.arw_deg_per_sqrt_h:g} °/√h, bias instability "
-            f"{noise.bias_instability_dph:g} °/h, RRW {noise.rrw_dph_per_sqrt_h:g} °/h/√h",
+        figures = (
+            Figure("thermal.tau_housing_s", "housing time constant",
+                   self.thermal.tau_housing_s, "s"),
+            Figure("thermal.tau_resonator_s", "resonator time constant",
+                   self.thermal.tau_resonator_s, "s"),
+            Figure("frequency_noise_hz", "frequency noise", self.frequency_noise_hz, "Hz",
+                   definition="RMS frequency noise per sample."),
+            Figure("housing_noise_c", "housing thermistor noise", self.housing_noise_c, "°C",
+                   definition="RMS housing thermistor noise per sample."),
+            Figure("bias_law.bias0_dph", "B0", law.bias0_dph, "°/h",
+                   definition="True bias at the reference temperature."),
+            Figure("bias_law.reference_c", "T0", law.reference_c, "°C"),
+            Figure("bias_law.gradient_dph_per_c", "gradient", law.gradient_dph_per_c,
+                   "°/h/°C", definition="Bias per °C of housing minus resonator temperature."),
+            Figure("bias_law.gradient_temperature_dph_per_c2", "gradient x T",
+                   law.gradient_temperature_dph_per_c2, "°/h/°C²"),
+            Figure("bias_law.hysteresis_dph", "hysteresis", law.hysteresis_dph, "°/h"),
+            Figure("bias_law.hysteresis_width_c", "hysteresis width", law.hysteresis_width_c,
+                   "°C"),
+            Figure("gyro_noise.arw_deg_per_sqrt_h", "ARW", noise.arw_deg_per_sqrt_h, "°/√h",
+                   definition="Angle random walk of the simulated rate."),
+            Figure("gyro_noise.bias_instability_dph", "bias instability",
+                   noise.bias_instability_dph, "°/h"),
+            Figure("gyro_noise.rrw_dph_per_sqrt_h", "RRW", noise.rrw_dph_per_sqrt_h, "°/h/√h",
+                   definition="Rate random walk of the simulated rate."))
+        layout = [
+            escape(f"unit {self.name}: {self.description}"),
+            "  thermal: tau_housing {thermal.tau_housing_s:g} s, "
+            "tau_resonator {thermal.tau_resonator_s:g} s",
+            escape(f"  frequency law: {self.frequency_law.to_dict()}"),
+            "  frequency noise {frequency_noise_hz:g} Hz rms/sample, "
+            "housing thermistor noise {housing_noise_c:g} °C rms/sample",
+            "  bias law: B0 {bias_law.bias0_dph:g} °/h, T0 {bias_law.reference_c:g} °C, "
+            + escape(f"c1..c3 {law.temperature_dph}")
+            + ", gradient {bias_law.gradient_dph_per_c:g} °/h/°C, "
+            "gradient x T {bias_law.gradient_temperature_dph_per_c2:g} °/h/°C², "
+            "hysteresis {bias_law.hysteresis_dph:g} °/h over {bias_law.hysteresis_width_c:g} °C",
+            "  noise: ARW {gyro_noise.arw_deg_per_sqrt_h:g} °/√h, bias instability "
+            "{gyro_noise.bias_instability_dph:g} °/h, RRW {gyro_noise.rrw_dph_per_sqrt_h:g} "
+            "°/h/√h",
         ]
         if self.scale_factor_law is not None:
             sf = self.scale_factor_law
-            lines.append(
-                f"  scale factor: k0..kn {sf.coefficients_ppm} ppm/°C^j about "
-                f"T0 {sf.reference_c:g} °C"
-            )
+            figures += (Figure("scale_factor_law.reference_c", "scale factor T0",
+                               sf.reference_c, "°C"),)
+            layout.append(escape(f"  scale factor: k0..kn {sf.coefficients_ppm} ppm/°C^j about ")
+                          + "T0 {scale_factor_law.reference_c:g} °C")
         if law.has_play:
-            lines.append(
-                f"  play memory: {law.play_dph_per_c:g} °/h/°C × (p - T_r), width "
-                f"{law.play_width_c:g} °C, p - T_r at power-on {law.play_initial_offset_c:g} °C"
-            )
-        return "\n".join(lines)
+            figures += (
+                Figure("bias_law.play_dph_per_c", "play slope", law.play_dph_per_c, "°/h/°C",
+                       definition="Bias per °C of the play state minus the resonator "
+                       "temperature."),
+                Figure("bias_law.play_width_c", "play width", law.play_width_c, "°C"),
+                Figure("bias_law.play_initial_offset_c", "play state at power-on",
+                       law.play_initial_offset_c, "°C"))
+            layout.append("  play memory: {bias_law.play_dph_per_c:g} °/h/°C × (p - T_r), "
+                          "width {bias_law.play_width_c:g} °C, p - T_r at power-on "
+                          "{bias_law.play_initial_offset_c:g} °C")
+        return Summary(f"unit {self.name}", (("parameters", figures),), layout=tuple(layout))
 
 
 @dataclass(frozen=True)
@@ -277,13 +312,19 @@ class MultiAxisUnit:
         return cls(**{**values, "axes": {str(a): Unit.from_dict(g)
                                          for a, g in data["axes"].items()}})
 
-    def summary(self) -> str:
-        """The unit's parameters as text, axis by axis."""
-        lines = [f"unit {self.name}: {self.description}"]
+    def summary(self) -> Summary:
+        """Each axis's parameters (:meth:`Unit.summary`, after ``axes.<axis>.``) and input
+        rate; its text axis by axis."""
+        sections: list[tuple[str, tuple[Figure, ...]]] = []
+        layout = [escape(f"unit {self.name}: {self.description}")]
         for axis, gyro in self.axes.items():
-            lines.append(f"axis {axis} (input {self.input_rate_dph[axis]:g} °/h):")
-            lines += ["  " + line for line in gyro.summary().splitlines()]
-        return "\n".join(lines)
+            key = f"axes.{axis}."
+            inner = gyro.summary().renamed(key)
+            rate = Figure(f"{key}input_rate_dph", "input rate", self.input_rate_dph[axis], "°/h")
+            sections += [(f"axis {axis}", (rate, *inner.sections[0][1]))]
+            layout.append(f"axis {escape(axis)} (input {{{key}input_rate_dph:g}} °/h):")
+            layout += inner.lines("  ")
+        return Summary(f"unit {self.name}", tuple(sections), layout=tuple(layout))
 
 
 class UnitRecord(records.Record, kw_only=True):

@@ -44,6 +44,7 @@ from numpy.lib.stride_tricks import sliding_window_view
 from hrgtc.core import records
 from hrgtc.core.errors import CalibrationError, InputError, RecordingError
 from hrgtc.core.progress import Progress
+from hrgtc.core.summary import Figure, Summary, escape
 from hrgtc.recording import Recording
 from hrgtc.settings.calibration import PlateauSettings
 from hrgtc.thermometry.settling import (
@@ -137,22 +138,44 @@ class Plateau:
         """Final slope in resonator temperature, ``slope_hz_per_h / hz_per_c``. [°C/h]"""
         return self.slope_hz_per_h / self.hz_per_c
 
-    def summary(self) -> str:
-        """A few lines of text."""
-        where = f" [{self.source}]" if self.source else ""
+    def summary(self) -> Summary:
+        """The settled frequency, the final stretch's mean, std and slopes, the residual
+        unsettled temperature and the transient fit (its figures after ``fit.``); its text
+        a few lines."""
+        where = escape(f" [{self.source}]") if self.source else ""
         state = "settled" if self.settled else "not settled by slope"
+        figures = (
+            Figure("chamber_c", "chamber", self.chamber_c, "°C"),
+            Figure.with_error("settled_freq_hz", "settled frequency", self.settled_freq_hz,
+                              self.settled_freq_std_hz, "Hz", definition="The resonator's "
+                              f"frequency once settled at the plateau ({self.method})."),
+            Figure("settled_freq_std_hz", "its standard error", self.settled_freq_std_hz, "Hz"),
+            Figure("start_h", "final stretch from", self.start_s / 3600, "h"),
+            Figure("end_h", "final stretch to", self.end_s / 3600, "h"),
+            Figure("n_samples", "samples", self.n_samples),
+            Figure("freq_hz", "mean frequency", self.freq_hz, "Hz",
+                   definition="Mean frequency of the final stretch."),
+            Figure("freq_std_hz", "frequency std", self.freq_std_hz, "Hz"),
+            Figure("slope_hz_per_h", "slope", self.slope_hz_per_h, "Hz/h"),
+            Figure("slope_c_per_h", "slope in temperature", self.slope_c_per_h, "°C/h"),
+            Figure("residual_unsettled_c", "residual unsettled temperature",
+                   self.residual_unsettled_c, "°C", definition="How far from settled the "
+                   "resonator still was, in °C, at the end of the plateau."))
         lines = [
-            f"plateau at chamber {self.chamber_c:.3f} °C{where}: settled frequency "
-            f"{self.settled_freq_hz:.5f} ± {self.settled_freq_std_hz:.2g} Hz ({self.method})",
-            f"  final stretch {self.start_s / 3600:.2f}-{self.end_s / 3600:.2f} h "
-            f"({self.n_samples} samples): mean {self.freq_hz:.5f} Hz, std "
-            f"{self.freq_std_hz:.2g} Hz, slope {self.slope_hz_per_h:+.3g} Hz/h "
-            f"({self.slope_c_per_h:+.3g} °C/h), {state}",
-            f"  residual unsettled temperature {self.residual_unsettled_c:+.4f} °C",
+            "plateau at chamber {chamber_c:.3f} °C" + where + ": settled frequency "
+            "{settled_freq_hz:.5f} ± {settled_freq_std_hz:.2g} Hz " + escape(f"({self.method})"),
+            "  final stretch {start_h:.2f}-{end_h:.2f} h ({n_samples} samples): mean "
+            "{freq_hz:.5f} Hz, std {freq_std_hz:.2g} Hz, slope {slope_hz_per_h:+.3g} Hz/h "
+            f"({{slope_c_per_h:+.3g}} °C/h), {state}",
+            "  residual unsettled temperature {residual_unsettled_c:+.4f} °C",
         ]
+        sections = [("plateau", figures)]
         if self.fit is not None:
-            lines.append("  " + self.fit.summary())
-        return "\n".join(lines)
+            fit = self.fit.summary().renamed("fit.")
+            sections += fit.sections
+            lines += fit.lines("  ")
+        return Summary(f"plateau at chamber {self.chamber_c:.3f} °C", tuple(sections),
+                       layout=tuple(lines))
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types (the fit nested), as :class:`PlateauRecord` writes them

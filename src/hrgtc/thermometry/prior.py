@@ -42,6 +42,7 @@ from msgspec import Meta
 
 from hrgtc.core import records
 from hrgtc.core.errors import CalibrationError, InputError
+from hrgtc.core.summary import Figure, Summary
 from hrgtc.thermometry.thermometer import Thermometer, _scaled_to_raw_matrix
 
 __all__ = ["PriorFit", "ThermometerPrior", "fit_with_prior", "load_prior", "relative_coefficients"]
@@ -182,15 +183,31 @@ class ThermometerPrior:
             values.pop(derived)
         return cls(**values)
 
-    def summary(self) -> str:
-        """A few lines of text."""
+    def summary(self) -> Summary:
+        """The units, order and range, the nominal frequency ± its spread and each
+        normalised coefficient's mean ± its relative spread (its text: one line)."""
         sd = np.sqrt(np.diag(np.asarray(self.covariance)))
-        rel = ", ".join(f"b{k + 1} {m:.6g} ± {s / abs(m):.2%}"
-                        for k, (m, s) in enumerate(zip(self.mean, sd, strict=True)))
-        return (f"prior of {self.n_units} units, order {self.order}, "
-                f"{self.temperature_range_c[0]:g} to {self.temperature_range_c[1]:g} °C: "
-                f"f({self.centre_c:g} °C) {self.nominal_freq_hz:.3f} ± "
-                f"{self.nominal_freq_std_hz:.3f} Hz; {rel}")
+        figures = [Figure("n_units", "units", self.n_units), Figure("order", "order", self.order),
+                   Figure("temperature_range_c", "temperatures",
+                          self.temperature_range_c[1] - self.temperature_range_c[0], "°C",
+                          tuple(self.temperature_range_c), "range"),
+                   Figure("centre_c", "centre", self.centre_c, "°C"),
+                   Figure("nominal_freq_hz", "f at the centre", self.nominal_freq_hz, "Hz",
+                          definition="Mean over the units of their frequency at the centre."),
+                   Figure("nominal_freq_std_hz", "its spread", self.nominal_freq_std_hz, "Hz",
+                          definition="Standard deviation over the units of that frequency.")]
+        for k, (m, s) in enumerate(zip(self.mean, sd, strict=True)):
+            figures += [Figure(f"mean[{k}]", f"b{k + 1}", float(m),
+                               definition=f"Mean over the units of the normalised "
+                               f"coefficient b{k + 1}."),
+                        Figure(f"relative_sd[{k}]", f"b{k + 1} relative spread",
+                               float(s / abs(m)), spec=".2%")]
+        rel = ", ".join(f"b{k + 1} {{mean[{k}]:.6g}} ± {{relative_sd[{k}]:.2%}}"
+                        for k in range(len(self.mean)))
+        low, high = self.temperature_range_c
+        return Summary(f"prior of {self.n_units} units", (("prior", tuple(figures)),), layout=(
+            f"prior of {{n_units}} units, order {{order}}, {low:g} to {high:g} °C: "
+            "f({centre_c:g} °C) {nominal_freq_hz:.3f} ± {nominal_freq_std_hz:.3f} Hz; " + rel,))
 
 
 def save_prior(prior: ThermometerPrior, path: str | os.PathLike[str],

@@ -46,6 +46,7 @@ import numpy as np
 
 from hrgtc.core import records
 from hrgtc.core.errors import CalibrationError, InputError, RecordingError
+from hrgtc.core.summary import Figure, Summary, escape
 from hrgtc.settings.inputs import MAX_LAG_S
 
 __all__ = ["ReferenceLog", "TemperatureMap", "TemperatureReference", "fit_count_map",
@@ -127,12 +128,23 @@ class TemperatureMap:
         """°C of raw counts (already unwrapped). [°C]"""
         return np.asarray(count, dtype=np.float64) * self.scale_c_per_count + self.offset_c
 
-    def summary(self) -> str:
-        """One line: the map, its residual, the points and the lag (does not print)."""
-        return (f"temperature_c = {self.scale_c_per_count:.6g} × count + {self.offset_c:.6g} "
-                f"°C from {self.reference or 'the reference log'}: {self.points} points, "
-                f"residual RMS {self.residual_rms_c:.3g} °C (largest {self.residual_max_c:.3g} "
-                f"°C), reference lag {self.lag_s:+.0f} s")
+    def summary(self) -> Summary:
+        """The map's scale and offset, the points, the residual and the reference's lag
+        (its text: one line)."""
+        figures = (Figure("scale_c_per_count", "scale", self.scale_c_per_count, "°C/count"),
+                   Figure("offset_c", "offset", self.offset_c, "°C"),
+                   Figure("points", "points", self.points,
+                          definition="Settled stretches the map is fitted on."),
+                   Figure("residual_rms_c", "residual RMS", self.residual_rms_c, "°C",
+                          definition="RMS of the map's residuals at its points."),
+                   Figure("residual_max_c", "largest residual", self.residual_max_c, "°C"),
+                   Figure("lag_s", "reference lag", self.lag_s, "s",
+                          definition="Delay of the reference log against the sensor."))
+        return Summary("temperature map", (("temperature map", figures),), layout=(
+            "temperature_c = {scale_c_per_count:.6g} × count + {offset_c:.6g} °C from "
+            + escape(self.reference or "the reference log") + ": {points} points, residual "
+            "RMS {residual_rms_c:.3g} °C (largest {residual_max_c:.3g} °C), reference lag "
+            "{lag_s:+.0f} s",))
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types (the model file's ``temperature_map``), as

@@ -34,6 +34,7 @@ import numpy as np
 
 from hrgtc.core import records
 from hrgtc.core.errors import InputError
+from hrgtc.core.summary import Figure, Summary, escape
 
 __all__ = ["MIN_FIT_POINTS", "TransientFit", "fit_transient"]
 
@@ -106,15 +107,25 @@ class TransientFit:
             out += q * u**k
         return out
 
-    def summary(self) -> str:
-        """One line of text."""
+    def summary(self) -> Summary:
+        """The settled frequency ± its standard error, the time constants, the RMS residual
+        and whether it is usable (its text: one line)."""
         taus = ", ".join(f"{t:.0f}" for t in self.tau_s) or "-"
         state = "usable" if self.usable else f"not usable: {self.reason}"
-        return (
-            f"{self.model} fit over {self.start_s / 3600:.2f}-{self.end_s / 3600:.2f} h: "
-            f"f_inf {self.f_inf_hz:.5f} ± {self.f_inf_std_hz:.2g} Hz, tau {taus} s, "
-            f"rms {self.rms_hz:.2g} Hz ({state})"
-        )
+        figures = (Figure("start_h", "from", self.start_s / 3600, "h"),
+                   Figure("end_h", "to", self.end_s / 3600, "h"),
+                   Figure.with_error("f_inf_hz", "settled frequency", self.f_inf_hz,
+                                     self.f_inf_std_hz, "Hz", definition="The frequency the "
+                                     "fitted transient settles to (t → ∞)."),
+                   Figure("f_inf_std_hz", "its standard error", self.f_inf_std_hz, "Hz"),
+                   *(Figure(f"tau_s[{k}]", f"time constant {k + 1}", t, "s")
+                     for k, t in enumerate(self.tau_s)),
+                   Figure("rms_hz", "RMS residual", self.rms_hz, "Hz"))
+        return Summary(f"{self.model} transient fit", (("transient fit", figures),),
+                       (state,), (escape(self.model) + " fit over {start_h:.2f}-{end_h:.2f} h: "
+                                  "f_inf {f_inf_hz:.5f} ± {f_inf_std_hz:.2g} Hz, "
+                                  f"tau {escape(taus)} s, rms {{rms_hz:.2g}} Hz "
+                                  f"({escape(state)})",))
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types, as :class:`TransientFitRecord` writes them (NaN -> None)."""

@@ -33,6 +33,7 @@ from msgspec import Meta
 from hrgtc.core import records
 from hrgtc.core.errors import CalibrationError, ExtrapolationWarning, InputError
 from hrgtc.core.student_t import t_sf
+from hrgtc.core.summary import Figure, Summary, escape
 
 _GRID_POINTS = 2049
 _NEWTON_MAX_ITER = 60
@@ -385,23 +386,39 @@ class Thermometer:
         return float(lo), float(hi)
 
     # -- reporting -----------------------------------------------------------------
-    def summary(self) -> str:
-        """Coefficients with standard errors and fit statistics, as text."""
-        lines = [
-            f"Thermometer: order-{self.order} polynomial f(T) from {self.n_points} points, "
-            f"{self.temperature_range_c[0]:g} to {self.temperature_range_c[1]:g} °C",
-            f"{'power':>6} {'coefficient':>18} {'std error':>12} {'p-value':>10}",
-        ]
+    def summary(self) -> Summary:
+        """The coefficients with standard errors and p-values, the residual and R² (its
+        text: the table and the polynomial, Eq. 18's form)."""
+        cells: list[Figure] = []
+        layout = [escape(f"Thermometer: order-{self.order} polynomial f(T) from "
+                         f"{self.n_points} points, {self.temperature_range_c[0]:g} to "
+                         f"{self.temperature_range_c[1]:g} °C"),
+                  escape(f"{'power':>6} {'coefficient':>18} {'std error':>12} {'p-value':>10}")]
         rows = zip(self.coefficients, self.standard_errors, self.pvalues, strict=True)
         for k, (c, se, pvalue) in enumerate(rows):
-            lines.append(f"{'T^' + str(k):>6} {c:>18.10g} {se:>12.4g} {pvalue:>10.3g}")
-        lines.append(f"residual std {self.residual_std_hz:.4g} Hz, R² {self.rsquared:.10f}")
+            power = "T^" + str(k)
+            unit = "Hz" if k == 0 else f"Hz/°C^{k}"
+            cells += [Figure(f"coefficients[{k}]", f"coefficient of {power}", float(c), unit,
+                             digits=10, row=power, column="coefficient",
+                             definition=f"The fitted coefficient of T^{k} in f(T)."),
+                      Figure(f"standard_errors[{k}]", f"std error of {power}", float(se), unit,
+                             digits=4, row=power, column="std error"),
+                      Figure(f"pvalues[{k}]", f"p of {power}", float(pvalue), digits=3,
+                             row=power, column="p-value")]
+            layout.append(f"{escape(f'{power:>6}')} {{coefficients[{k}]:>18.10g}} "
+                          f"{{standard_errors[{k}]:>12.4g}} {{pvalues[{k}]:>10.3g}}")
+        fit = (Figure("n_points", "points", self.n_points),
+               Figure("residual_std_hz", "residual std", self.residual_std_hz, "Hz", digits=4,
+                      definition="Standard deviation of the fit's residuals."),
+               Figure("rsquared", "R²", self.rsquared, spec=".10f"))
+        layout.append("residual std {residual_std_hz:.4g} Hz, R² {rsquared:.10f}")
         terms = []
-        for k, c in reversed(list(enumerate(self.coefficients))):
+        for k in reversed(range(len(self.coefficients))):
             power = "" if k == 0 else ("·T" if k == 1 else f"·T^{k}")
-            terms.append(f"{c:+.6g}{power}")
-        lines.append("f = " + " ".join(terms) + " Hz")
-        return "\n".join(lines)
+            terms.append(f"{{coefficients[{k}]:+.6g}}{power}")
+        layout.append("f = " + " ".join(terms) + " Hz")
+        return Summary(f"thermometer: order-{self.order} polynomial f(T)",
+                       (("coefficients", tuple(cells)), ("fit", fit)), layout=tuple(layout))
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types, as :class:`ThermometerRecord` writes them (NaN -> None)."""

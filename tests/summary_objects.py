@@ -1,0 +1,143 @@
+"""One real object of every class with a ``summary()``, built from the shared campaigns.
+
+``every_result(paper, imu, folder)`` -> {name: object}: the paper-unit's calibration (its
+thermometer, drift model, training accounting, plateaus), an evaluation of its held-out
+warm-up (Allan curves, noise terms, heating/cooling) and of its cool-down (the demo's
+table), the three-axis imu-3's calibration (scale factor, rate-table segments, an
+instrument compensator) and an evaluation of its held-out rate table, a recording's info
+(validation, time axis), the simulator's units, profile and written files, and the small
+results built from arrays (Hald's data for the stepwise regression, a spike, a slow
+channel, a temperature map, a thermometer prior, a transient). ``tests/test_summaries.py``
+checks each ``summary()``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+HALD = np.array([
+    [7, 26, 6, 60, 78.5], [1, 29, 15, 52, 74.3], [11, 56, 8, 20, 104.3],
+    [11, 31, 8, 47, 87.6], [7, 52, 6, 33, 95.9], [11, 55, 9, 22, 109.2],
+    [3, 71, 17, 6, 102.7], [1, 31, 22, 44, 72.5], [2, 54, 18, 22, 93.1],
+    [21, 47, 4, 26, 115.9], [1, 40, 23, 34, 83.8], [11, 66, 9, 12, 113.3],
+    [10, 68, 8, 12, 109.4]], dtype=np.float64)
+
+
+def every_result(paper: Any, imu: Any, folder: Path) -> dict[str, Any]:
+    """Every result kind with a ``summary()``, by a name saying what it is."""
+    out: dict[str, Any] = {}
+    out.update(_paper(paper))
+    out.update(_instrument(imu))
+    out.update(_recording(paper, folder))
+    out.update(_small())
+    return out
+
+
+def _paper(paper: Any) -> dict[str, Any]:
+    from hrgtc.evaluation.run_pass import evaluate
+    from hrgtc.pipeline.calibration import calibrate
+    from hrgtc.pipeline.demo import DemoResult
+    from hrgtc.recording import read
+    from hrgtc.thermometry.plateaus import find_plateaus
+
+    result = calibrate(paper.soaks, [paper.cooldown], [paper.warmup])
+    model = result.model
+    evaluation = evaluate(paper.warmup, model)
+    training = evaluate(paper.cooldown, model)
+    plateau = find_plateaus(read(paper.soaks[0]))[0]
+    return {"CalibrationResult": result, "DriftModel": model.drift,
+            "Thermometer": model.thermometer, "Accounting": model.drift.accounting,
+            "Plateau": plateau, "Evaluation": evaluation,
+            "AllanResult": evaluation.allan["compensated"],
+            "NoiseTerms": evaluation.noise["compensated"],
+            "DirectionStats": evaluation.directions,
+            # the demo's figures (its files are the demo's business, not the summary's)
+            "DemoResult": DemoResult(Path("demo-out"), result, training, evaluation, None,
+                                     Path("model.json"), Path("report.html"), ())}
+
+
+def _instrument(imu: Any) -> dict[str, Any]:
+    from hrgtc.compensate import Compensator
+    from hrgtc.drift.rate_segments import segment_scale_errors
+    from hrgtc.pipeline.instrument import calibrate_instrument, evaluate_instrument
+    from hrgtc.recording import axis_view, read
+
+    calibration = calibrate_instrument(imu.soaks, [imu.cooldown], [imu.warmup],
+                                       rate_tables=[imu.rate_table],
+                                       validate_rate_tables=[imu.rate_table_heldout])
+    compensator = Compensator(calibration.model)
+    compensator.transform(read(imu.warmup))
+    table = axis_view(read(imu.rate_table), "x")
+    return {"InstrumentCalibration": calibration,
+            "InstrumentEvaluation": evaluate_instrument(imu.rate_table_heldout,
+                                                        calibration.model),
+            "ScaleFactorModel": calibration.model.axes["x"].scale_factor,
+            "SegmentScaleErrors": segment_scale_errors(table),
+            "Compensator": compensator}
+
+
+def _recording(paper: Any, folder: Path) -> dict[str, Any]:
+    from hrgtc.core.timeline import Timeline
+    from hrgtc.recording import describe, read
+    from hrgtc.recording.motion import recording_motion
+    from hrgtc.simulate import simulate_files, units
+    from hrgtc.simulate import standard_profiles as profiles
+
+    info = describe(paper.warmup)
+    run = read(paper.warmup)
+    burst = np.concatenate([np.arange(5.0) + 60.0 * k for k in range(25)])
+    written = simulate_files([profiles.soak(20.0, 0.05)], folder / "written", "csv",
+                             unit="paper-unit", sample_rate_hz=1.0, seed=3)
+    return {"RecordingInfo": info, "ValidationReport": info.validation,
+            "Timeline": Timeline.from_time(burst), "MotionMask": recording_motion(run),
+            "Unit": units.get("paper-unit"), "MultiAxisUnit": units.get("imu-3"),
+            "Profile": profiles.warmup(-20.0, 20.0, 5.0), "WrittenFile": written[0]}
+
+
+def _small() -> dict[str, Any]:
+    from hrgtc.drift.cross_validation import CrossValidation
+    from hrgtc.drift.stepwise import stepwise
+    from hrgtc.evaluation.metrics import residual_against_truth
+    from hrgtc.fleet.run import FleetRun
+    from hrgtc.fleet.tasks import UnitOutcome
+    from hrgtc.recording.resample import fill_slow_channels
+    from hrgtc.recording.spikes import RobustSpikeFilter
+    from hrgtc.thermometry.prior import ThermometerPrior
+    from hrgtc.thermometry.reference import TemperatureMap
+    from hrgtc.thermometry.settling import fit_transient
+    from hrgtc.thermometry.thermometer import fit
+
+    hald = stepwise(HALD[:, :4], HALD[:, 4], penter=0.06)
+    t = np.arange(1000) / 10.0
+    housing = 20.0 - 0.01 * t
+    housing[np.arange(1000) % 10 != 0] = np.nan
+    _, slow = fill_slow_channels({"time_s": t, "rate_dph": np.sin(t), "freq_hz": 4424.0 + 0 * t,
+                                  "housing_c": housing}, "hold")
+    rng = np.random.default_rng(5)
+    truth = rng.normal(size=4000)
+    residual = residual_against_truth(bias_model_dph=truth + 0.01 * rng.normal(size=4000),
+                                      true_bias_dph=truth, sample_rate_hz=10.0)
+    spikes = RobustSpikeFilter("drop", source="run.csv")
+    freq = 4424.0 + 0.001 * rng.normal(size=2000)
+    freq[700] += 5.0
+    spikes.apply({"time_s": np.arange(2000) / 10.0, "freq_hz": freq}, 0)
+    setpoints = np.array([-20.0, -10.0, 0.0, 10.0, 20.0, 30.0, 40.0])
+    thermometers = [fit(setpoints, 4424.0 - (0.5 + 0.01 * k) * setpoints
+                        + 1e-4 * k * setpoints ** 2) for k in range(8)]
+    tau = np.arange(0.0, 20000.0, 10.0)
+    return {
+        "StepwiseResult": hald, "OLSResult": hald.result,
+        "CrossValidation": CrossValidation(("f", "df"), ("cool", "warm"),
+                                           {"cool": 0.0123, "warm": 0.0456}, 0.02, 0.03,
+                                           0.0333),
+        "ResidualResult": residual, "SlowChannels": slow, "RobustSpikeFilter": spikes,
+        "TemperatureMap": TemperatureMap(0.005, 24.0, 16, 120.0, 0.2, 0.4, 25,
+                                         (-2400.0, -300.0), "log.csv"),
+        "ThermometerPrior": ThermometerPrior.from_thermometers(thermometers),
+        "TransientFit": fit_transient(tau, 4424.0 + 0.2 * np.exp(-tau / 3000.0)),
+        "FleetRun": FleetRun((UnitOutcome("a", "ok"), UnitOutcome("b", "failed")), 12.5,
+                             "local cluster of 2 workers", workers_died=1, retried=("b",)),
+    }
