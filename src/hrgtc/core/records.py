@@ -148,44 +148,51 @@ _RECORDS: dict[type, type[Record]] = {}
 _RESULTS: dict[type, type] = {}
 
 
-def record_of(result: type) -> type[Record]:
+def record_of(result: type, name: str | None = None) -> type[Record]:
     """The record of a result class, generated from its fields (cached).
 
     ``result`` is a dataclass (or a :class:`msgspec.Struct`) whose annotations are the
     declaration: ``Annotated[float, Meta(gt=0)]`` (:data:`Positive`), :data:`Statistic`,
     :class:`Array` for numpy arrays, nested results. Its fields are the record's, in
-    their order, with their defaults; left out are those named in its ``not_written``
+    their order, with their defaults (a default that is not finite, NaN, is ``null`` as in
+    the file); left out are those named in its ``not_written``
     and those with ``init=False`` (derived). The record is named ``<result>Record`` (the
-    name of its definition in a JSON Schema) and described by the first paragraph of
-    the result's docstring. A :class:`Record` subclass is its own record.
+    name of its definition in a JSON Schema; ``name`` gives another, at the first call:
+    ``BurstAllanRecord = records.record_of(BurstAllanResult, "BurstAllanRecord")`` beside
+    the result, where another record nests it); its docstring (the JSON Schema's
+    ``description``) names the result. A :class:`Record` subclass is its own record.
     """
     if isinstance(result, type) and issubclass(result, Record):
         return result
     found = _RECORDS.get(result)
     if found is not None:
+        if name is not None and found.__name__ != name:
+            raise TypeError(f"{result.__name__}'s record is {found.__name__}, not {name}")
         return found
     hints = typing.get_type_hints(result, include_extras=True)
     skip = set(getattr(result, "not_written", ()))
     fields: list[Any] = []
     arrays: dict[str, Any] = {}
-    for name, default, factory in _fields(result):
-        if name in skip:
+    for field, default, factory in _fields(result):
+        if field in skip:
             continue
-        kind = _wire(hints[name])
-        dtype = _array_dtype(hints[name])
+        kind = _wire(hints[field])
+        dtype = _array_dtype(hints[field])
         if dtype is not None:
-            arrays[name] = dtype
+            arrays[field] = dtype
         if factory is not None:
-            fields.append((name, kind, msgspec.field(default_factory=factory)))
+            fields.append((field, kind, msgspec.field(default_factory=factory)))
+        elif isinstance(default, float) and not math.isfinite(default):
+            fields.append((field, kind, None))  # as the file spells it (a Statistic)
         elif default is not msgspec.NODEFAULT:
-            fields.append((name, kind, default))
+            fields.append((field, kind, default))
         else:
-            fields.append((name, kind))
-    doc = (result.__doc__ or "").strip().split("\n\n")[0]
+            fields.append((field, kind))
     found = msgspec.defstruct(
-        f"{result.__name__}Record", fields, bases=(Record,), kw_only=True,
+        name or f"{result.__name__}Record", fields, bases=(Record,), kw_only=True,
         module=result.__module__,
-        namespace={"__doc__": re.sub(r"\s*\n\s*", "\n    ", doc),
+        namespace={"__doc__": f"The record of :class:`{result.__name__}` (its ``to_dict``, "
+                              "``from_dict``).",
                    "omit_when_default": tuple(getattr(result, "omit_when_default", ())),
                    "arrays": arrays})
     _RECORDS[result], _RESULTS[found] = found, result
