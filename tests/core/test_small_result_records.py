@@ -27,7 +27,7 @@ from hrgtc.core.time_steps import (
 from hrgtc.core.timeline import Timeline, TimelineRecord
 from hrgtc.drift.qr_accumulator import QRAccumulator, QRAccumulatorRecord
 from hrgtc.drift.rate_segments import RateSegment, SegmentScaleErrors, SegmentScaleErrorsRecord
-from hrgtc.recording.checks import Problem, ValidationReport, ValidationReportRecord
+from hrgtc.recording.checks import Problem, ValidationReport
 from hrgtc.recording.gaps import Gap
 from hrgtc.recording.resample import ChannelFill, SlowChannels, SlowChannelsRecord
 from hrgtc.thermometry.reference import TemperatureReference, TemperatureReferenceRecord
@@ -87,7 +87,7 @@ def test_validation_report_layout_round_trip_and_refusals():
         '"row": 9}], "n_gaps": 2, "rows": 12, "source": "run.csv", '
         '"measured_sample_rate_hz": null, "gap_policy": "split", "n_dropouts": 0, '
         '"dropout_s": 0.0, "duty_cycled": false}')
-    _valid(written, ValidationReportRecord)
+    _valid(written, ValidationReport)
     again = ValidationReport.from_dict(json.loads(json.dumps(written)))
     assert again == report and again.to_dict() == written
     assert Problem.from_dict(written["problems"][1]) == report.problems[1]
