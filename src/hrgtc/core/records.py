@@ -127,11 +127,14 @@ class Written:
         (they need a default, or ``init=False``).
     ``omit_when_default``
         Fields written only when they differ from their default.
+    ``forbid_unknown_fields``
+        True: a key the record does not know is refused (a misspelt input), not ignored.
     """
 
     __slots__ = ()
     not_written: ClassVar[tuple[str, ...]] = ()
     omit_when_default: ClassVar[tuple[str, ...]] = ()
+    forbid_unknown_fields: ClassVar[bool] = False
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types (lists, ``None`` for what is not finite): :func:`dump`."""
@@ -190,6 +193,7 @@ def record_of(result: type, name: str | None = None) -> type[Record]:
             fields.append((field, kind))
     found = msgspec.defstruct(
         name or f"{result.__name__}Record", fields, bases=(Record,), kw_only=True,
+        forbid_unknown_fields=getattr(result, "forbid_unknown_fields", False),
         module=result.__module__,
         namespace={"__doc__": f"The record of :class:`{result.__name__}` (its ``to_dict``, "
                               "``from_dict``).",

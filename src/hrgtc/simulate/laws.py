@@ -179,7 +179,7 @@ def frequency_law_from_dict(data: Mapping[str, Any]) -> FrequencyLaw:
 
 
 @dataclass(frozen=True)
-class ScaleFactorLaw:
+class ScaleFactorLaw(records.Written):
     """Scale-factor error against resonator temperature, a polynomial in ``T_r - T0``.
 
     .. math::
@@ -204,7 +204,7 @@ class ScaleFactorLaw:
     [120.0, 165.0]
     """
 
-    coefficients_ppm: tuple[float, ...]
+    coefficients_ppm: Annotated[tuple[float, ...], Meta(min_length=1)]
     reference_c: float = 20.0
 
     def __post_init__(self) -> None:
@@ -234,25 +234,13 @@ class ScaleFactorLaw:
             out += c
         return out
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types, as :class:`ScaleFactorLawRecord` writes them."""
-        return records.dump(self, ScaleFactorLawRecord)
 
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> ScaleFactorLaw:
-        """Inverse of :meth:`to_dict` (checked against its record)."""
-        return cls(**records.load(data, ScaleFactorLawRecord, "scale-factor law"))
-
-
-class ScaleFactorLawRecord(records.Record, kw_only=True):
-    """A :class:`ScaleFactorLaw` in the simulator's ground truth."""
-
-    coefficients_ppm: Annotated[tuple[float, ...], Meta(min_length=1)]
-    reference_c: float = 20.0
+#: The record of :class:`ScaleFactorLaw` (nested in other records).
+ScaleFactorLawRecord = records.record_of(ScaleFactorLaw)
 
 
 @dataclass(frozen=True)
-class BiasLaw:
+class BiasLaw(records.Written):
     """Thermal bias in resonator temperature and housing - resonator gradient.
 
     .. math::
@@ -289,7 +277,7 @@ class BiasLaw:
     gradient_dph_per_c: float = 0.0
     gradient_temperature_dph_per_c2: float = 0.0
     hysteresis_dph: float = 0.0
-    hysteresis_width_c: float = 1.0
+    hysteresis_width_c: records.Positive = 1.0
 
     def __post_init__(self) -> None:
         temperature = tuple(float(c) for c in self.temperature_dph)
@@ -345,23 +333,7 @@ class BiasLaw:
             out += self.hysteresis_dph * np.tanh(gradient, out=gradient)
         return out
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types, as :class:`BiasLawRecord` writes them."""
-        return records.dump(self, BiasLawRecord)
 
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> BiasLaw:
-        """Inverse of :meth:`to_dict` (checked against its record)."""
-        return cls(**records.load(data, BiasLawRecord, "bias law"))
+#: The record of :class:`BiasLaw` (nested in other records).
+BiasLawRecord = records.record_of(BiasLaw)
 
-
-class BiasLawRecord(records.Record, kw_only=True):
-    """A :class:`BiasLaw` in the simulator's ground truth."""
-
-    bias0_dph: float
-    reference_c: float = 20.0
-    temperature_dph: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    gradient_dph_per_c: float = 0.0
-    gradient_temperature_dph_per_c2: float = 0.0
-    hysteresis_dph: float = 0.0
-    hysteresis_width_c: records.Positive = 1.0

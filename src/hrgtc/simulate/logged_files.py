@@ -22,7 +22,6 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
@@ -45,7 +44,7 @@ from hrgtc.simulate.units import MultiAxisUnit, Unit
 
 __all__ = [
     "LoggedFiles",
-    "LoggedFilesRecord",
+
     "csv_text",
     "sidecar_paths",
     "simulate_logged_files",
@@ -54,7 +53,7 @@ __all__ = [
 
 
 @dataclass(frozen=True)
-class LoggedFiles:
+class LoggedFiles(records.Written):
     """Paths written for a logged run.
 
     Attributes
@@ -66,25 +65,6 @@ class LoggedFiles:
     rows
         Rows of the recording.
     """
-
-    path: str
-    truth_json: str
-    truth_csv: str
-    reference_log: str | None
-    rows: int
-
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types, as :class:`LoggedFilesRecord` writes them."""
-        return records.dump(self, LoggedFilesRecord)
-
-    @classmethod
-    def from_dict(cls, data: Any) -> LoggedFiles:
-        """Inverse of :meth:`to_dict` (checked against its record)."""
-        return cls(**records.load(data, LoggedFilesRecord, "logged files"))
-
-
-class LoggedFilesRecord(records.Record, kw_only=True):
-    """A :class:`LoggedFiles` (``hrgtc simulate --logger ... --json``)."""
 
     path: str
     truth_json: str
