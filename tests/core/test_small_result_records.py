@@ -26,7 +26,7 @@ from hrgtc.core.time_steps import (
 )
 from hrgtc.core.timeline import Timeline, TimelineRecord
 from hrgtc.drift.qr_accumulator import QRAccumulator, QRAccumulatorRecord
-from hrgtc.drift.rate_segments import RateSegment, SegmentScaleErrors, SegmentScaleErrorsRecord
+from hrgtc.drift.rate_segments import RateSegment, SegmentScaleErrors
 from hrgtc.recording.checks import Problem, ValidationReport
 from hrgtc.recording.gaps import Gap
 from hrgtc.recording.resample import ChannelFill, SlowChannels, SlowChannelsRecord
@@ -127,7 +127,7 @@ def test_segment_scale_errors_layout_and_round_trip():
         '{"start_s": 70.0, "end_s": 119.0, "input_rate_dph": -36000.0, "rate_dph": '
         '-35990.0, "freq_hz": 5432.2, "rows": 980, "first_row": 0}], '
         '"error_ppm": [347.2, -277.8]}')
-    _valid(written, SegmentScaleErrorsRecord)
+    _valid(written, SegmentScaleErrors)
     again = SegmentScaleErrors.from_dict(json.loads(json.dumps(written)))
     assert again.segments == errors.segments
     np.testing.assert_array_equal(again.error_ppm, errors.error_ppm)

@@ -108,8 +108,8 @@ class Array:
 
     ``Array[item, Meta(...)]`` is ``Annotated[np.ndarray, ...]`` (an ndarray to the code
     and to a type checker); in the file it is ``Annotated[list[item], Meta(...)]``
-    (the Meta bounds the list: ``Meta(min_length=2)``). Read back as a float64 array
-    (an ``int64`` one for ``Array[Count]``/``Array[int]``).
+    (the Meta bounds the list: ``Meta(min_length=2)``). Read back as a read-only float64
+    array (an ``int64`` one for ``Array[Count]``/``Array[int]``).
     """
 
     def __class_getitem__(cls, params: Any) -> Any:
@@ -381,7 +381,8 @@ def _values(value: Any, kind: Any) -> Any:
             return fields
         for name, dtype in getattr(record, "arrays", {}).items():
             if fields[name] is not None:
-                fields[name] = np.asarray(fields[name], dtype=dtype)
+                fields[name] = np.array(fields[name], dtype=dtype)
+                fields[name].setflags(write=False)  # a result read back is a value
         return result(**fields)
     if kind == Statistic:
         return statistic(value)
