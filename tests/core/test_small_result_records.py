@@ -21,7 +21,6 @@ from hrgtc.core.errors import InputError
 from hrgtc.core.time_steps import (
     TimeDiagnosisRecord,
     TimeEvent,
-    TimeEventRecord,
     classify_time_steps,
 )
 from hrgtc.core.timeline import Timeline, TimelineRecord
@@ -56,7 +55,7 @@ def test_time_diagnosis_layout():
     assert TimeEvent.from_dict(event).to_dict() == event
     with pytest.raises(InputError, match=r"at `\$.row`"):
         TimeEvent.from_dict({**event, "row": -1})
-    _valid(event, TimeEventRecord)
+    _valid(event, TimeEvent)
 
 
 @pytest.mark.parametrize(("time_s", "expected"), [
