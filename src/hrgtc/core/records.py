@@ -1,17 +1,29 @@
-"""Typed records: one definition per result gives its JSON form, its checks and its JSON Schema.
+"""Typed records: one declaration per result gives its JSON form, its checks and its JSON Schema.
 
-A *record* is a :class:`msgspec.Struct` that names the fields a result writes to a file,
-with their types and bounds (``Annotated[float, Meta(gt=0)]``). From that one definition:
+The declaration is the result itself: a dataclass (or :class:`msgspec.Struct`) whose
+fields carry their types and bounds (``Annotated[float, Meta(gt=0)]``, :data:`Positive`,
+:data:`Count`, :data:`Statistic`, ``Array[Statistic]`` for a numpy array written as a
+list, nested results). :func:`record_of` generates its *record*, the
+:class:`msgspec.Struct` that names what the file holds (``<Result>Record``); fields that
+are derived or runtime-only are left out by one declaration, the result's class attribute
+``not_written`` (they need a default, or ``init=False``). The mixin :class:`Written` gives
+a result ``to_dict``/``from_dict`` once. From the declaration:
 
-* :func:`dump` writes a result as plain, strict JSON types (the result's ``to_dict``):
-  the fields are read off the result by name, so the record and the result cannot
-  disagree on a name without a test failing;
+* :func:`dump` writes a result as plain, strict JSON types: the fields are read off the
+  result by name (numpy arrays and scalars by ``tolist``: the one numpy hook), NaN as
+  ``null``;
 * :func:`load` validates plain JSON types against the record (msgspec's messages name
-  the place: ``Expected `int` >= 1 - at `$.order```) and returns the field values, the
-  statistics as floats (``null`` -> NaN), ready for the result's constructor (its
-  ``from_dict``);
+  the place: ``Expected `int` >= 1 - at `$.order```) and builds the result, nested
+  results too, arrays read-only, statistics as floats (``null`` -> NaN);
 * :func:`json_schema` gives the JSON Schema (Draft 2020-12), which
   :mod:`hrgtc.model_schema` assembles into the model file's schema.
+
+msgspec encodes and decodes dataclasses itself, honouring their ``Meta`` bounds; the
+generated Struct is what lets a result hold numpy arrays and runtime state and keeps each
+definition's name in the published schemas. A :class:`Record` written by hand remains
+where a file's part is not one dataclass's fields (a document of several results, renamed
+or computed fields, a constant ``kind`` written first); :func:`dump` and :func:`load`
+take it in place of a result (``load`` then returns its values as a dict).
 
 Numbers: a parameter is a finite ``float`` (JSON has no NaN; a file that holds one is
 refused where the record says ``float``); a :data:`Statistic` may also be ``null`` or,
