@@ -60,7 +60,7 @@ def test_foreign_corrupt_and_newer_files(tmp_path, unit_model):
     del data["drift"]["selected"]
     broken.write_text(json.dumps(data))
     with pytest.raises(ModelFileError, match=r"broken.json: model file is invalid at drift: "
-                       r"'selected' is a required property"):
+                       r"Object missing required field `selected`"):
         load_model(broken)
     with pytest.raises(ModelFileError, match="no such model file"):
         load_model(tmp_path / "missing.json")

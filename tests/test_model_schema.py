@@ -59,14 +59,16 @@ def test_written_file_is_strict_json_and_loads_back(tmp_path, unit_model):
 
 
 @pytest.mark.parametrize("where, value, match", [
-    (("drift", "scaled_coefficients", 0), math.nan, r"drift.scaled_coefficients\[0\]: 'NaN'"),
+    (("drift", "scaled_coefficients", 0), math.nan, r"drift.scaled_coefficients\[0\]: 'NaN' does"),
     (("drift", "scaled_coefficients", 0), math.inf, r"drift.scaled_coefficients\[0\]: "
-                                                      r"'Infinity'"),
-    (("drift", "intercept_dph"), math.nan, r"drift.intercept_dph: 'NaN' is not of type"),
+                                                      r"'Infinity' does not fit"),
+    (("drift", "intercept_dph"), math.nan, r"drift.intercept_dph: 'NaN' does not fit: "
+                                            r"Expected `float`"),
     (("thermometer", "scaled_coefficients", 1), math.nan,
-     r"thermometer.scaled_coefficients\[1\]: 'NaN'"),
-    (("thermometer", "coefficients", 0), math.nan, r"thermometer.coefficients\[0\]: 'NaN'"),
-    (("drift", "settings", "scales", "f"), -1.0, r"drift.settings.scales.f: -1.0 is less"),
+     r"thermometer.scaled_coefficients\[1\]: 'NaN' does"),
+    (("thermometer", "coefficients", 0), math.nan, r"thermometer.coefficients\[0\]: 'NaN' does"),
+    (("drift", "settings", "scales", "f"), -1.0, r"drift.settings.scales.f: -1.0 does not fit: "
+                                                    r"Expected `float` > 0.0"),
 ])
 def test_non_finite_parameters_are_refused(tmp_path, document, where, value, match):
     # old files (version 1) were written with allow_nan: a bare NaN must be named, not used
@@ -151,7 +153,8 @@ def test_a_model_that_cannot_be_valid_is_never_saved(tmp_path, unit_model):
         **{f: getattr(unit_model.drift, f) for f in unit_model.drift.__dataclass_fields__
            if f != "_terms"},
         "intercept_dph": math.nan})))
-    with pytest.raises(ModelFileError, match=r"drift.intercept_dph: None is not of type"):
+    with pytest.raises(ModelFileError, match=r"drift.intercept_dph: None does not fit: "
+                                                    r"Expected `float`, got `null`"):
         save_model(broken, tmp_path / "unit.json")
     assert list(tmp_path.iterdir()) == []
 

@@ -5,11 +5,13 @@ records of the file's parts (:class:`FileRecord`, :class:`AxisRecord` and the re
 beside each result: ``ThermometerRecord``, ``DriftModelRecord``, ``ScaleFactorRecord``,
 ...; see :mod:`hrgtc.core.records`), the same definitions that write and read them.
 
-A model file is trusted by nothing: :func:`check_document` validates it with
-``jsonschema`` (Draft 2020-12) against :data:`MODEL_SCHEMA` and then checks what
-a schema cannot say: every term is known and parsable, the selected terms are
-among the candidates with one coefficient each, every range is ordered, the
-user-unit coefficients agree with the scaled ones they are derived from.
+A model file is trusted by nothing: :func:`check_document` validates it once, with
+msgspec against the records :data:`MODEL_SCHEMA` is generated from (the tests prove
+with ``jsonschema``, Draft 2020-12, that the published schema accepts and refuses the
+same files), and then checks what a schema cannot say: every term is known and
+parsable, the selected terms are among the candidates with one coefficient each, every
+range is ordered, the user-unit coefficients agree with the scaled ones they are derived
+from.
 
 Numbers: the *parameters* (coefficients, ranges, scales, settings) must be finite
 numbers; the *statistics* (standard errors, p-values, R², the stepwise record)
@@ -38,10 +40,13 @@ from __future__ import annotations
 
 import json
 import math
+import re
+import types
 from collections.abc import Mapping
 from fractions import Fraction
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any, Literal, Union, get_args, get_origin
 
+import msgspec
 from msgspec import Meta
 
 from hrgtc.core import records
@@ -220,34 +225,111 @@ def _fail(source: str, where: str, message: str) -> ModelFileError:
                           "corrupt or was edited: recreate it with 'hrgtc calibrate'")
 
 
+#: A single-axis file: the file's own fields and one axis's parts at the top level (the
+#: records of :data:`MODEL_SCHEMA`'s first alternative; :class:`FileRecord` is the other).
+_SINGLE_AXIS = msgspec.defstruct(
+    "SingleAxisFileRecord",
+    [(f.name, f.type, f.default if f.default_factory is msgspec.NODEFAULT
+      else msgspec.field(default_factory=f.default_factory)) if not f.required
+     else (f.name, f.type)
+     for record in (FileRecord, AxisRecord) for f in msgspec.structs.fields(record)
+     if f.name != "axes"],
+    bases=(records.Record,), kw_only=True, module=__name__)
+
+
 def check_schema(data: Any, source: str) -> None:
-    """Validate ``data`` against :data:`MODEL_SCHEMA`; the first error names its place.
+    """Validate ``data`` against the records of :data:`MODEL_SCHEMA` (msgspec, one pass);
+    the first error names its place (``drift.settings.scales.f``).
 
-    A missing section of a single-axis file (``thermometer``, ``drift``) is named as such
-    (the schema's "one axis or several" alternative would only quote the whole document),
-    and a key the schema does not know is refused (:func:`unknown_key`).
+    A missing section of a single-axis file (``thermometer``, ``drift``) is named as such,
+    a file holding both ``axes`` and one axis's parts is refused (the schema's "one axis
+    or several"), and a key the schema does not know is refused (:func:`unknown_key`).
+    ``tests/test_model_schema_agreement.py`` proves that the published JSON Schema
+    (checked with ``jsonschema``) accepts and refuses the same files.
     """
-    import jsonschema
-
-    if isinstance(data, dict) and "axes" not in data and data.get("schema") == "hrgtc.model":
-        for section in ("thermometer", "drift"):
-            if section not in data:
+    if isinstance(data, dict) and data.get("schema") == "hrgtc.model":
+        if "axes" not in data:
+            for section in ("thermometer", "drift"):
+                if section not in data:
+                    raise _fail(source, "(top level)",
+                                f"the required section {section!r} is missing (a single-axis "
+                                "model holds 'thermometer' and 'drift', a multi-axis one "
+                                "'axes')")
+        else:
+            both = [k for k in ("thermometer", "drift") if k in data]
+            if both:
                 raise _fail(source, "(top level)",
-                            f"the required section {section!r} is missing (a single-axis "
-                            "model holds 'thermometer' and 'drift', a multi-axis one 'axes')")
-    validator = jsonschema.Draft202012Validator(MODEL_SCHEMA)
-    error = jsonschema.exceptions.best_match(validator.iter_errors(data))
-    if error is not None:
-        message = error.message
-        if len(message) > 200:
-            message = message[:200] + "..."
-        raise _fail(source, _path(error.absolute_path), message)
+                            f"it holds 'axes' and also {both[0]!r}: a model holds one axis's "
+                            "parts at the top level or several under 'axes', never both")
+    record = FileRecord if isinstance(data, dict) and "axes" in data else _SINGLE_AXIS
+    try:
+        msgspec.convert(data, record, strict=True)
+    except msgspec.ValidationError as exc:
+        message, _, at = str(exc).partition(" - at `")
+        where, value = _place(data, record, at.rstrip("`")) if at else ((), data)
+        if value is None or isinstance(value, str | int | float):  # the value, as jsonschema
+            message = f"{value!r} does not fit: {message}"
+        raise _fail(source, _path(where), message) from None
     found = unknown_key(data, MODEL_SCHEMA, ())
     if found is not None:
         where, key, known = found
         raise _fail(source, _path(where) if where else "(top level)",
                     f"unknown key {key!r} (known here: {', '.join(known)}); a misspelt "
                     "key is ignored by hrgtc but not by the reader of the file")
+
+
+def _place(data: Any, kind: Any, at: str) -> tuple[list[Any], Any]:
+    """msgspec's place (``$.drift.settings.scales[...]``) with each ``[...]`` (a mapping's
+    value, unnamed by msgspec) replaced by the key that does not fit
+    (``drift.settings.scales.f``), and the value there."""
+    parts: list[Any] = []
+    for name, index, _ in re.findall(r"\.([^.\[]+)|\[(\d+)\]|(\[\.\.\.\])", at[1:]):
+        kind = _member(kind, data)
+        if name:
+            fields = {f.name: f.type for f in msgspec.structs.fields(kind)} if isinstance(
+                kind, type) and issubclass(kind, msgspec.Struct) else {}
+            parts.append(name)
+            data, kind = (data.get(name) if isinstance(data, dict) else None,
+                          fields.get(name, Any))
+        elif index:
+            args = [a for a in get_args(kind) if a is not Ellipsis]
+            item = args[min(int(index), len(args) - 1)] if args else Any
+            parts.append(int(index))
+            data = data[int(index)] if isinstance(data, list) and int(index) < len(data) else None
+            kind = item
+        else:  # a mapping's value: the first key whose value (or the key itself) fails
+            key_type, value_type = (*get_args(kind), Any, Any)[:2]
+            bad = next((k for k, v in (data.items() if isinstance(data, dict) else ())
+                        if not _fits(v, value_type) or not _fits(k, key_type)), "[...]")
+            parts.append(bad)
+            data, kind = (data.get(bad) if isinstance(data, dict) else None), value_type
+    return parts, data
+
+
+def _member(kind: Any, value: Any) -> Any:
+    """``kind`` without ``Annotated`` and, in a union, the member ``value`` is meant as."""
+    while get_origin(kind) is Annotated:
+        kind = get_args(kind)[0]
+    args = get_args(kind)
+    if get_origin(kind) in (Union, types.UnionType):
+        wanted = dict if isinstance(value, dict) else list if isinstance(value, list) else None
+        for member in args:
+            plain = _member(member, value)
+            if wanted is dict and (get_origin(plain) is dict or (
+                    isinstance(plain, type) and issubclass(plain, msgspec.Struct))):
+                return plain
+            if wanted is list and get_origin(plain) in (list, tuple):
+                return plain
+        return Any
+    return kind
+
+
+def _fits(value: Any, kind: Any) -> bool:
+    try:
+        msgspec.convert(value, kind, strict=True)
+    except msgspec.ValidationError:
+        return False
+    return True
 
 
 #: Objects whose keys are free: the provenance (free-form) and the temperature map (keys

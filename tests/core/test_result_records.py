@@ -26,7 +26,7 @@ from hrgtc.model import Model, load_model
 from hrgtc.model_schema import FileRecord, axis_parts
 from hrgtc.thermometry import fit, paper
 from hrgtc.thermometry.paper import ReproductionRecord
-from hrgtc.thermometry.plateaus import Plateau, PlateauRecord, TransientFit
+from hrgtc.thermometry.plateaus import Plateau
 from hrgtc.thermometry.prior import (
     PRIOR_JSON_SCHEMA,
     PriorFitRecord,
@@ -35,7 +35,7 @@ from hrgtc.thermometry.prior import (
     fit_with_prior,
 )
 from hrgtc.thermometry.reference import TemperatureMap, TemperatureMapRecord
-from hrgtc.thermometry.settling import TransientFitRecord
+from hrgtc.thermometry.settling import TransientFit
 
 GOLDEN = sorted((Path(__file__).parents[1] / "data" / "golden-models").glob("v*/*.json"))
 IDS = [f"{p.parent.name}/{p.stem}" for p in GOLDEN]
@@ -64,7 +64,7 @@ def test_golden_plateaus_and_map_round_trip_exactly(path):
         for plateau in part.get("plateaus", ()):
             again = Plateau.from_dict(plateau)
             assert json.dumps(again.to_dict()) == json.dumps(plateau)
-            _valid(plateau, PlateauRecord)
+            _valid(plateau, Plateau)
             if plateau["fit"] is not None:
                 assert again.fit == TransientFit.from_dict(plateau["fit"])
     if document.get("temperature_map") is not None:
@@ -169,7 +169,7 @@ def test_plateau_round_trip_and_statistics_that_are_not_finite():
     assert list(written) == [f.name for f in dataclasses.fields(Plateau)]
     assert list(written["fit"]) == [f.name for f in dataclasses.fields(TransientFit)]
     assert Plateau.from_dict(json.loads(json.dumps(written))) == plateau
-    _valid(written, PlateauRecord)
+    _valid(written, Plateau)
     unsettled = dataclasses.replace(plateau, residual_unsettled_c=math.nan, source=None,
                                     fit=dataclasses.replace(plateau.fit, aic=-math.inf,
                                                             tau_s=(math.nan,)))
@@ -183,7 +183,7 @@ def test_plateau_round_trip_and_statistics_that_are_not_finite():
         Plateau.from_dict({**plateau.to_dict(), "n_samples": -1})
     with pytest.raises(InputError, match=r"transient-fit record.*`\$.n_blocks`"):
         TransientFit.from_dict({**plateau.fit.to_dict(), "n_blocks": 1.5})
-    _valid(plateau.fit.to_dict(), TransientFitRecord)
+    _valid(plateau.fit.to_dict(), TransientFit)
 
 
 # -- the paper's reproduction -----------------------------------------------------------

@@ -21,13 +21,12 @@ from hrgtc.core.errors import InputError
 from hrgtc.core.time_steps import (
     TimeDiagnosisRecord,
     TimeEvent,
-    TimeEventRecord,
     classify_time_steps,
 )
 from hrgtc.core.timeline import Timeline, TimelineRecord
 from hrgtc.drift.qr_accumulator import QRAccumulator, QRAccumulatorRecord
-from hrgtc.drift.rate_segments import RateSegment, SegmentScaleErrors, SegmentScaleErrorsRecord
-from hrgtc.recording.checks import Problem, ValidationReport, ValidationReportRecord
+from hrgtc.drift.rate_segments import RateSegment, SegmentScaleErrors
+from hrgtc.recording.checks import Problem, ValidationReport
 from hrgtc.recording.gaps import Gap
 from hrgtc.recording.resample import ChannelFill, SlowChannels, SlowChannelsRecord
 from hrgtc.thermometry.reference import TemperatureReference, TemperatureReferenceRecord
@@ -56,7 +55,7 @@ def test_time_diagnosis_layout():
     assert TimeEvent.from_dict(event).to_dict() == event
     with pytest.raises(InputError, match=r"at `\$.row`"):
         TimeEvent.from_dict({**event, "row": -1})
-    _valid(event, TimeEventRecord)
+    _valid(event, TimeEvent)
 
 
 @pytest.mark.parametrize(("time_s", "expected"), [
@@ -87,7 +86,7 @@ def test_validation_report_layout_round_trip_and_refusals():
         '"row": 9}], "n_gaps": 2, "rows": 12, "source": "run.csv", '
         '"measured_sample_rate_hz": null, "gap_policy": "split", "n_dropouts": 0, '
         '"dropout_s": 0.0, "duty_cycled": false}')
-    _valid(written, ValidationReportRecord)
+    _valid(written, ValidationReport)
     again = ValidationReport.from_dict(json.loads(json.dumps(written)))
     assert again == report and again.to_dict() == written
     assert Problem.from_dict(written["problems"][1]) == report.problems[1]
@@ -127,7 +126,7 @@ def test_segment_scale_errors_layout_and_round_trip():
         '{"start_s": 70.0, "end_s": 119.0, "input_rate_dph": -36000.0, "rate_dph": '
         '-35990.0, "freq_hz": 5432.2, "rows": 980, "first_row": 0}], '
         '"error_ppm": [347.2, -277.8]}')
-    _valid(written, SegmentScaleErrorsRecord)
+    _valid(written, SegmentScaleErrors)
     again = SegmentScaleErrors.from_dict(json.loads(json.dumps(written)))
     assert again.segments == errors.segments
     np.testing.assert_array_equal(again.error_ppm, errors.error_ppm)

@@ -141,7 +141,7 @@ def test_parts_validate_and_round_trip():
     assert back.to_dict() == document
     np.testing.assert_array_equal(back.deviation, bursts.deviation)
     assert back.counts.dtype.kind == "i"
-    with pytest.raises(InputError, match=r"burst-mean Allan deviation record: .*`\$.runs`"):
+    with pytest.raises(InputError, match=r"burst-allan-result record: .*`\$.runs`"):
         BurstAllanResult.from_dict({**document, "runs": 0})
 
     for stats in _directions():

@@ -16,15 +16,13 @@ import simulate_inputs
 from hrgtc.core import records
 from hrgtc.core.errors import InputError
 from hrgtc.simulate import profiles
-from hrgtc.simulate.handling import Handling, HandlingRecord
-from hrgtc.simulate.logged_files import LoggedFiles, LoggedFilesRecord
+from hrgtc.simulate.handling import Handling
+from hrgtc.simulate.logged_files import LoggedFiles
 from hrgtc.simulate.logger import Logger
 from hrgtc.simulate.logger_records import LoggerRecord
 from hrgtc.simulate.reflog import (
     ReferenceLog,
-    ReferenceLogRecord,
     TemperatureChannel,
-    TemperatureChannelRecord,
 )
 
 TRUTH = Path(__file__).parents[1] / "data" / "simulate-truth" / "inputs.json"
@@ -56,9 +54,9 @@ def test_a_logger_round_trips_and_fits_its_schema(name):
     again = Logger.from_dict(written)
     assert again == logger and again.to_dict() == written
     _schema(LoggerRecord).validate(written)
-    for part, kind, record in (("temperature", TemperatureChannel, TemperatureChannelRecord),
-                               ("reference_log", ReferenceLog, ReferenceLogRecord),
-                               ("handling", Handling, HandlingRecord)):
+    for part, kind, record in (("temperature", TemperatureChannel, TemperatureChannel),
+                               ("reference_log", ReferenceLog, ReferenceLog),
+                               ("handling", Handling, Handling)):
         if written[part] is not None:
             assert kind.from_dict(written[part]).to_dict() == written[part]
             _schema(record).validate(written[part])
@@ -68,7 +66,7 @@ def test_logged_files_round_trip_and_fit_their_schema():
     for files in simulate_inputs.logged_files().values():
         written = json.loads(json.dumps(files.to_dict()))
         assert LoggedFiles.from_dict(written) == files
-        _schema(LoggedFilesRecord).validate(written)
+        _schema(LoggedFiles).validate(written)
 
 
 def test_input_refusals_name_the_place():

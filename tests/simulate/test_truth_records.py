@@ -17,13 +17,12 @@ from hrgtc.core.errors import InputError
 from hrgtc.simulate import units
 from hrgtc.simulate.laws import (
     BiasLaw,
-    BiasLawRecord,
     PolynomialFrequencyLawRecord,
-    ScaleFactorLawRecord,
+    ScaleFactorLaw,
     ShellFrequencyLawRecord,
 )
-from hrgtc.simulate.noise_sources import GyroNoise, GyroNoiseRecord
-from hrgtc.simulate.thermal import ThermalNetwork, ThermalNetworkRecord
+from hrgtc.simulate.noise_sources import GyroNoise
+from hrgtc.simulate.thermal import ThermalNetwork
 
 TRUTH = Path(__file__).parents[1] / "data" / "simulate-truth" / "units.json"
 
@@ -45,11 +44,11 @@ def test_truth_round_trips_and_fits_the_records_schemas(name):
     axes = written["axes"].values() if "axes" in written else [written]
     law_records = {"polynomial": PolynomialFrequencyLawRecord, "shell": ShellFrequencyLawRecord}
     for axis in axes:
-        for part, record in ((axis["thermal"], ThermalNetworkRecord),
-                             (axis["bias_law"], BiasLawRecord),
-                             (axis["gyro_noise"], GyroNoiseRecord),
+        for part, record in ((axis["thermal"], ThermalNetwork),
+                             (axis["bias_law"], BiasLaw),
+                             (axis["gyro_noise"], GyroNoise),
                              (axis["frequency_law"], law_records[axis["frequency_law"]["kind"]]),
-                             (axis.get("scale_factor_law"), ScaleFactorLawRecord)):
+                             (axis.get("scale_factor_law"), ScaleFactorLaw)):
             if part is not None:
                 schema = records.json_schema(record, "t", "https://hrgtc.invalid/t.json")
                 jsonschema.Draft202012Validator(schema).validate(part)
@@ -95,14 +94,14 @@ def test_unit_refusals_name_the_place():
 
 
 def test_a_written_file_round_trips_and_refuses_a_negative_row_count():
-    from hrgtc.simulate.output import WrittenFile, WrittenFileRecord
+    from hrgtc.simulate.output import WrittenFile
 
     written = WrittenFile(path="runs/soak.parquet", rows=1200, profile="soak 20 C, 5 h")
     document = written.to_dict()
     assert json.dumps(document) == ('{"path": "runs/soak.parquet", "rows": 1200, '
                                     '"profile": "soak 20 C, 5 h"}')
     assert WrittenFile.from_dict(json.loads(json.dumps(document))) == written
-    schema = records.json_schema(WrittenFileRecord, "w", "https://hrgtc.invalid/w.json")
+    schema = records.json_schema(WrittenFile, "w", "https://hrgtc.invalid/w.json")
     jsonschema.Draft202012Validator(schema).validate(document)
     with pytest.raises(InputError, match=r"`\$.rows`"):
         WrittenFile.from_dict({**document, "rows": -1})

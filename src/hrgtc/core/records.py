@@ -1,17 +1,29 @@
-"""Typed records: one definition per result gives its JSON form, its checks and its JSON Schema.
+"""Typed records: one declaration per result gives its JSON form, its checks and its JSON Schema.
 
-A *record* is a :class:`msgspec.Struct` that names the fields a result writes to a file,
-with their types and bounds (``Annotated[float, Meta(gt=0)]``). From that one definition:
+The declaration is the result itself: a dataclass (or :class:`msgspec.Struct`) whose
+fields carry their types and bounds (``Annotated[float, Meta(gt=0)]``, :data:`Positive`,
+:data:`Count`, :data:`Statistic`, ``Array[Statistic]`` for a numpy array written as a
+list, nested results). :func:`record_of` generates its *record*, the
+:class:`msgspec.Struct` that names what the file holds (``<Result>Record``); fields that
+are derived or runtime-only are left out by one declaration, the result's class attribute
+``not_written`` (they need a default, or ``init=False``). The mixin :class:`Written` gives
+a result ``to_dict``/``from_dict`` once. From the declaration:
 
-* :func:`dump` writes a result as plain, strict JSON types (the result's ``to_dict``):
-  the fields are read off the result by name, so the record and the result cannot
-  disagree on a name without a test failing;
+* :func:`dump` writes a result as plain, strict JSON types: the fields are read off the
+  result by name (numpy arrays and scalars by ``tolist``: the one numpy hook), NaN as
+  ``null``;
 * :func:`load` validates plain JSON types against the record (msgspec's messages name
-  the place: ``Expected `int` >= 1 - at `$.order```) and returns the field values, the
-  statistics as floats (``null`` -> NaN), ready for the result's constructor (its
-  ``from_dict``);
+  the place: ``Expected `int` >= 1 - at `$.order```) and builds the result, nested
+  results too, arrays read-only, statistics as floats (``null`` -> NaN);
 * :func:`json_schema` gives the JSON Schema (Draft 2020-12), which
   :mod:`hrgtc.model_schema` assembles into the model file's schema.
+
+msgspec encodes and decodes dataclasses itself, honouring their ``Meta`` bounds; the
+generated Struct is what lets a result hold numpy arrays and runtime state and keeps each
+definition's name in the published schemas. A :class:`Record` written by hand remains
+where a file's part is not one dataclass's fields (a document of several results, renamed
+or computed fields, a constant ``kind`` written first); :func:`dump` and :func:`load`
+take it in place of a result (``load`` then returns its values as a dict).
 
 Numbers: a parameter is a finite ``float`` (JSON has no NaN; a file that holds one is
 refused where the record says ``float``); a :data:`Statistic` may also be ``null`` or,
@@ -24,25 +36,35 @@ never from the CLI's start-up path.
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 import math
-from typing import Annotated, Any, Literal, TypeVar, get_args, get_origin
+import operator
+import re
+import types
+import typing
+from typing import Annotated, Any, ClassVar, Literal, TypeVar, get_args, get_origin
 
 import msgspec
+import numpy as np
 
 from hrgtc.core.errors import InputError
 
 __all__ = [
     "NOT_FINITE",
+    "Array",
     "Count",
     "NonNegative",
     "Positive",
     "Range",
     "Record",
     "Statistic",
+    "Written",
     "dump",
     "empty",
     "json_schema",
     "load",
+    "record_of",
     "schema_components",
     "statistic",
 ]
@@ -75,6 +97,8 @@ class Record(msgspec.Struct, kw_only=True):
     """
 
     omit_when_default = ()  # type: tuple[str, ...]
+    #: Generated records (:func:`record_of`): field -> dtype of the :class:`Array` fields.
+    arrays = {}  # type: dict[str, Any]
 
 
 def empty() -> Any:
@@ -82,13 +106,176 @@ def empty() -> Any:
     return msgspec.field(default_factory=dict)
 
 
-def dump(result: Any, record: type[Record], /, **given: Any) -> dict[str, Any]:
+class _Items:
+    """The marker of an :class:`Array` field: what the file holds of each item."""
+
+    __slots__ = ("item", "metas")
+
+    def __init__(self, item: Any, metas: tuple[Any, ...]) -> None:
+        self.item, self.metas = item, metas
+
+
+class Array:
+    """A numpy array field of a result, written as a list: ``Array[Statistic]``.
+
+    ``Array[item, Meta(...)]`` is ``Annotated[np.ndarray, ...]`` (an ndarray to the code
+    and to a type checker); in the file it is ``Annotated[list[item], Meta(...)]``
+    (the Meta bounds the list: ``Meta(min_length=2)``). Read back as a read-only float64
+    array (an ``int64`` one for ``Array[Count]``/``Array[int]``).
+    """
+
+    def __class_getitem__(cls, params: Any) -> Any:
+        item, *metas = params if isinstance(params, tuple) else (params,)
+        return Annotated[np.ndarray, _Items(item, tuple(metas))]
+
+
+class Written:
+    """Mixin of a result whose fields are its record: ``to_dict``/``from_dict`` once.
+
+    Class attributes a result may set (see :func:`record_of`):
+
+    ``not_written``
+        Fields that are derived or runtime-only: not in the file, not in the schema
+        (they need a default, or ``init=False``).
+    ``omit_when_default``
+        Fields written only when they differ from their default.
+    ``forbid_unknown_fields``
+        True: a key the record does not know is refused (a misspelt input), not ignored.
+    """
+
+    __slots__ = ()
+    not_written: ClassVar[tuple[str, ...]] = ()
+    omit_when_default: ClassVar[tuple[str, ...]] = ()
+    forbid_unknown_fields: ClassVar[bool] = False
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON types (lists, ``None`` for what is not finite): :func:`dump`."""
+        return dump(self)
+
+    @classmethod
+    def from_dict(cls, data: Any) -> Any:
+        """Inverse of :meth:`to_dict` (optional fields may be missing): :func:`load`."""
+        return load(data, cls)
+
+
+#: result class -> its record, and back (:func:`record_of`).
+_RECORDS: dict[type, type[Record]] = {}
+_RESULTS: dict[type, type] = {}
+
+
+def record_of(result: type, name: str | None = None) -> type[Record]:
+    """The record of a result class, generated from its fields (cached).
+
+    ``result`` is a dataclass (or a :class:`msgspec.Struct`) whose annotations are the
+    declaration: ``Annotated[float, Meta(gt=0)]`` (:data:`Positive`), :data:`Statistic`,
+    :class:`Array` for numpy arrays, nested results. Its fields are the record's, in
+    their order, with their defaults (a default that is not finite, NaN, is ``null`` as in
+    the file); left out are those named in its ``not_written``
+    and those with ``init=False`` (derived). The record is named ``<result>Record`` (the
+    name of its definition in a JSON Schema; ``name`` gives another, at the first call:
+    ``BurstAllanRecord = records.record_of(BurstAllanResult, "BurstAllanRecord")`` beside
+    the result, where another record nests it); its docstring (the JSON Schema's
+    ``description``) names the result. A :class:`Record` subclass is its own record.
+    """
+    if isinstance(result, type) and issubclass(result, Record):
+        return result
+    found = _RECORDS.get(result)
+    if found is not None:
+        if name is not None and found.__name__ != name:
+            raise TypeError(f"{result.__name__}'s record is {found.__name__}, not {name}")
+        return found
+    hints = typing.get_type_hints(result, include_extras=True)
+    skip = set(getattr(result, "not_written", ()))
+    fields: list[Any] = []
+    arrays: dict[str, Any] = {}
+    for field, default, factory in _fields(result):
+        if field in skip:
+            continue
+        kind = _wire(hints[field])
+        dtype = _array_dtype(hints[field])
+        if dtype is not None:
+            arrays[field] = dtype
+        if factory is not None:
+            fields.append((field, kind, msgspec.field(default_factory=factory)))
+        elif isinstance(default, float) and not math.isfinite(default):
+            fields.append((field, kind, None))  # as the file spells it (a Statistic)
+        elif default is not msgspec.NODEFAULT:
+            fields.append((field, kind, default))
+        else:
+            fields.append((field, kind))
+    found = msgspec.defstruct(
+        name or f"{result.__name__}Record", fields, bases=(Record,), kw_only=True,
+        forbid_unknown_fields=getattr(result, "forbid_unknown_fields", False),
+        module=result.__module__,
+        namespace={"__doc__": f"The record of :class:`{result.__name__}` (its ``to_dict``, "
+                              "``from_dict``).",
+                   "omit_when_default": tuple(getattr(result, "omit_when_default", ())),
+                   "arrays": arrays})
+    _RECORDS[result], _RESULTS[found] = found, result
+    return found
+
+
+def _fields(result: type) -> list[tuple[str, Any, Any]]:
+    """``(name, default, default factory)`` of each field a result's constructor takes."""
+    if dataclasses.is_dataclass(result):
+        return [(f.name,
+                 msgspec.NODEFAULT if f.default is dataclasses.MISSING else f.default,
+                 None if f.default_factory is dataclasses.MISSING else f.default_factory)
+                for f in dataclasses.fields(result) if f.init]
+    if issubclass(result, msgspec.Struct):
+        return [(f.name, f.default, None if f.default_factory is msgspec.NODEFAULT
+                 else f.default_factory) for f in msgspec.structs.fields(result)]
+    raise TypeError(f"{result.__name__} is neither a dataclass nor a msgspec Struct")
+
+
+def _wire(kind: Any) -> Any:
+    """The type a file holds for a field of type ``kind``: arrays as lists, nested
+    results as their records."""
+    origin, args = get_origin(kind), get_args(kind)
+    if origin is Annotated:
+        metas = kind.__metadata__
+        items = [m for m in metas if isinstance(m, _Items)]
+        if items:
+            listed = list[_wire(items[0].item)]  # type: ignore[misc]
+            return Annotated[(listed, *items[0].metas)] if items[0].metas else listed
+        inner = _wire(args[0])
+        return kind if inner is args[0] else Annotated[(inner, *metas)]
+    if isinstance(kind, type) and (dataclasses.is_dataclass(kind)
+                                   or (issubclass(kind, msgspec.Struct)
+                                       and not issubclass(kind, Record))):
+        return record_of(kind)
+    if not args or origin is Literal:
+        return kind
+    wired = tuple(a if a is Ellipsis else _wire(a) for a in args)
+    if wired == args:
+        return kind
+    if origin in (typing.Union, types.UnionType):
+        return functools.reduce(operator.or_, wired)
+    return origin[wired]
+
+
+def _array_dtype(kind: Any) -> Any:
+    """The dtype a field of type ``kind`` is read back as, if it is an :class:`Array`."""
+    for member in (kind, *get_args(kind)):  # Array[...] | None
+        if get_origin(member) is Annotated:
+            items = [m for m in member.__metadata__ if isinstance(m, _Items)]
+            if items:
+                item = items[0].item
+                while get_origin(item) is Annotated:
+                    item = get_args(item)[0]
+                return np.int64 if item is int else np.float64
+    return None
+
+
+def dump(result: Any, record: type[Record] | None = None, /, **given: Any) -> dict[str, Any]:
     """A result's record as strict JSON types (lists, ``None`` for what is not finite).
 
+    ``record``: the record to write (default: the result's own, :func:`record_of`).
     Each field of ``record`` is read off ``result`` by name (a field the result lacks
-    takes the record's default, e.g. the constant ``kind``); nested records likewise.
+    takes the record's default, e.g. the constant ``kind``); nested results likewise.
     ``given``: field values to use instead (a part that serialises itself).
     """
+    record = record_of(type(result)) if record is None else record
     try:
         value = msgspec.convert(_View(result, given), record, from_attributes=True)
     except msgspec.ValidationError as exc:
@@ -167,17 +354,24 @@ def _plain_value(value: Any) -> Any:
     return value
 
 
-def load(data: Any, record: type[Record], what: str) -> dict[str, Any]:
-    """Validate ``data`` against ``record``; the field values, statistics as floats.
+def load(data: Any, kind: type[Any], what: str | None = None) -> Any:
+    """Validate ``data`` against ``kind``'s record: the result, or a record's field values.
 
-    Nested records come back as dicts of their values, lists as tuples, statistics
-    as floats (``null`` -> NaN): what the results' constructors take.
+    ``kind`` is a result class (its record: :func:`record_of`): the result is built
+    from the values, nested results too, :class:`Array` fields as numpy arrays. Or
+    ``kind`` is a :class:`Record` (a part with no result class of its own): its field
+    values as a dict. Lists come back as tuples and statistics as floats (``null`` ->
+    NaN). ``what`` names the record in a message (default: ``kind``'s name, ``DriftModel``
+    -> ``drift-model``).
 
     Raises
     ------
     InputError
         ``data`` does not fit, naming the place (``- at `$.settings.rate_tau_s```).
     """
+    record = record_of(kind)
+    if what is None:
+        what = re.sub(r"(?<=[a-z0-9])(?=[A-Z])", "-", kind.__name__).lower()
     try:
         value = msgspec.convert(data, record, strict=False)
     except msgspec.ValidationError as exc:
@@ -186,12 +380,22 @@ def load(data: Any, record: type[Record], what: str) -> dict[str, Any]:
 
 
 def _values(value: Any, kind: Any) -> Any:
-    """``value`` (of the record type ``kind``) as constructor arguments."""
+    """``value`` (of the record type ``kind``) as constructor arguments; a generated
+    record's value as its result."""
     while get_origin(kind) is Annotated:
         kind = get_args(kind)[0]
     if isinstance(value, Record):
-        return {f.name: _values(getattr(value, f.name), f.type)
-                for f in msgspec.structs.fields(type(value))}
+        record = type(value)
+        fields = {f.name: _values(getattr(value, f.name), f.type)
+                  for f in msgspec.structs.fields(record)}
+        result = _RESULTS.get(record)
+        if result is None:
+            return fields
+        for name, dtype in getattr(record, "arrays", {}).items():
+            if fields[name] is not None:
+                fields[name] = np.array(fields[name], dtype=dtype)
+                fields[name].setflags(write=False)  # a result read back is a value
+        return result(**fields)
     if kind == Statistic:
         return statistic(value)
     if value is None or kind is Any:  # free-form parts (a stepwise record) are kept as read
@@ -229,14 +433,18 @@ def _strict(value: Any) -> Any:
     return value
 
 
-def schema_components(records: list[type[Record]]) -> tuple[list[dict[str, Any]],
-                                                            dict[str, Any]]:
-    """The JSON Schemas of ``records`` and their shared definitions (``#/$defs/NAME``)."""
-    return msgspec.json.schema_components(records, ref_template="#/$defs/{name}")
+def schema_components(records: list[type[Any]]) -> tuple[list[dict[str, Any]],
+                                                         dict[str, Any]]:
+    """The JSON Schemas of ``records`` (or results: their records) and their shared
+    definitions (``#/$defs/NAME``)."""
+    return msgspec.json.schema_components([record_of(r) for r in records],
+                                          ref_template="#/$defs/{name}")
 
 
-def json_schema(record: type[Record], title: str, schema_id: str) -> dict[str, Any]:
-    """The JSON Schema (Draft 2020-12) of one record, with its definitions."""
+def json_schema(record: type[Any], title: str, schema_id: str) -> dict[str, Any]:
+    """The JSON Schema (Draft 2020-12) of one record (or result: its record), with its
+    definitions."""
+    record = record_of(record)
     _, definitions = schema_components([record])
     return {"$schema": "https://json-schema.org/draft/2020-12/schema", "$id": schema_id,
             **definitions[record.__name__], "title": title, "$defs": definitions}

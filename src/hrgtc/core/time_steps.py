@@ -40,7 +40,6 @@ Every command reads this one diagnosis (through the recording validator), so
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -66,7 +65,7 @@ REPAIRED = ("wrap", "reset", "duplicate")
 
 
 @dataclass(frozen=True)
-class TimeEvent:
+class TimeEvent(records.Written):
     """One kind of odd time step found in a recording.
 
     Attributes
@@ -85,29 +84,14 @@ class TimeEvent:
     """
 
     kind: str
-    row: int
-    count: int
-    message: str
-    repaired: bool
-
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (:class:`TimeEventRecord`)."""
-        return records.dump(self, TimeEventRecord)
-
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> TimeEvent:
-        """Inverse of :meth:`to_dict`."""
-        return cls(**records.load(data, TimeEventRecord, "time event"))
-
-
-class TimeEventRecord(Record):
-    """The record of :class:`TimeEvent`."""
-
-    kind: str
     row: Count
     count: Count
     message: str
     repaired: bool
+
+
+#: The record of :class:`TimeEvent` (nested in :class:`TimeDiagnosisRecord`).
+TimeEventRecord = records.record_of(TimeEvent)
 
 
 @dataclass(frozen=True)

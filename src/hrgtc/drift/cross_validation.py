@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -41,7 +41,7 @@ RATE_DEADBAND = 0.05
 
 
 @dataclass(frozen=True)
-class CrossValidation:
+class CrossValidation(records.Written):
     """Leave-one-run-out residuals of one term set.
 
     Attributes
@@ -49,7 +49,7 @@ class CrossValidation:
     terms
         The terms refitted on each fold.
     sources
-        Name of each run, in run order.
+        Name of each run, in run order (not written: the keys of ``per_run_dph``).
     per_run_dph
         Run name -> standard deviation of its held-out window residuals (its
         cross-validated bias stability at the window length), NaN where the run
@@ -60,22 +60,18 @@ class CrossValidation:
         Root mean square of the finite per-run values (what :func:`select_terms` lowers).
     """
 
+    not_written = ("sources",)
+
     terms: tuple[str, ...]
-    sources: tuple[str, ...]
-    per_run_dph: dict[str, float]
-    heating_dph: float
-    cooling_dph: float
-    score_dph: float
+    sources: tuple[str, ...] = field(default=(), kw_only=True)
+    per_run_dph: dict[str, records.Statistic]
+    heating_dph: records.Statistic
+    cooling_dph: records.Statistic
+    score_dph: records.Statistic
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (NaN -> null), as :class:`CrossValidationRecord`."""
-        return records.dump(self, CrossValidationRecord)
-
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> CrossValidation:
-        """Inverse of :meth:`to_dict` (the sources are the keys of ``per_run_dph``)."""
-        values = records.load(data, CrossValidationRecord, "cross-validation")
-        return cls(sources=tuple(values["per_run_dph"]), **values)
+    def __post_init__(self) -> None:
+        if not self.sources:
+            object.__setattr__(self, "sources", tuple(self.per_run_dph))
 
     def summary(self) -> Summary:
         """The held-out residual of each run and over heating, cooling and all runs (its
@@ -102,15 +98,9 @@ class CrossValidation:
                        layout=layout)
 
 
+#: The record of :class:`CrossValidation` (nested in other records).
+CrossValidationRecord = records.record_of(CrossValidation)
 
-class CrossValidationRecord(records.Record, kw_only=True):
-    """A :class:`CrossValidation` in a file (the drift model's ``cross_validation``)."""
-
-    terms: tuple[str, ...]
-    per_run_dph: dict[str, records.Statistic]
-    heating_dph: records.Statistic
-    cooling_dph: records.Statistic
-    score_dph: records.Statistic
 
 def _std(values: np.ndarray) -> float:
     return float(np.std(values, ddof=1)) if values.size > 2 else math.nan
@@ -173,9 +163,8 @@ def cross_validate(x_scaled: np.ndarray, bias_dph: np.ndarray, run: np.ndarray,
     finite = np.isfinite(residual)
     values = np.array([v for v in per_run.values() if math.isfinite(v)])
     score = float(np.sqrt(np.mean(values ** 2))) if values.size else math.nan
-    return CrossValidation(tuple(terms), tuple(sources), per_run,
-                           _std(residual[heating & finite]), _std(residual[cooling & finite]),
-                           score)
+    return CrossValidation(tuple(terms), per_run, _std(residual[heating & finite]),
+                           _std(residual[cooling & finite]), score, sources=tuple(sources))
 
 
 @dataclass(frozen=True)

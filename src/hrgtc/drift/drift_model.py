@@ -74,7 +74,6 @@ from hrgtc.thermometry import Thermometer
 _DRIFT = DriftSettings
 
 
-
 @dataclass(frozen=True)
 class DriftModel(ParsedTerms):
     """A fitted bias model B = B0 + sum k_i term_i (Eq. 22 of [1]).
@@ -265,13 +264,8 @@ class DriftModel(ParsedTerms):
         """Inverse of :meth:`to_dict` (checked against :class:`DriftModelRecord`)."""
         values = records.load(data, DriftModelRecord, "drift-model")
         values.pop("kind")
-        validation = values["cross_validation"]
-        try:
+        try:  # the stepwise record and the cross-validation come back built
             return cls(**{**values, "settings": FeatureSettings(**values["settings"]),
-                          "stepwise": StepwiseResult.from_dict(values["stepwise"]),
-                          "cross_validation": None if validation is None
-                          else CrossValidation(sources=tuple(validation["per_run_dph"]),
-                                               **validation),
                           "pruning": None if values["pruning"] is None
                           else dict(values["pruning"])})
         except (KeyError, TypeError, ValueError, IndexError) as exc:

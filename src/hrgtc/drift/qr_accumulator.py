@@ -401,7 +401,7 @@ def _resolve_terms(terms: Any, names: tuple[str, ...], argument: str) -> set[int
 
 # --------------------------------------------------------------------------- OLS
 @dataclass(frozen=True, eq=False)
-class OLSResult:
+class OLSResult(records.Written):
     """Least-squares fit with a constant, Eq. (19)-(20) of [1].
 
     Attributes
@@ -429,14 +429,14 @@ class OLSResult:
     """
 
     names: tuple[str, ...]
-    params: np.ndarray
-    bse: np.ndarray
-    tvalues: np.ndarray
-    pvalues: np.ndarray
-    cov_params: np.ndarray
-    residual_std: float
-    rsquared: float
-    nobs: int
+    params: records.Array[records.Statistic]
+    bse: records.Array[records.Statistic]
+    tvalues: records.Array[records.Statistic]
+    pvalues: records.Array[records.Statistic]
+    cov_params: records.Array[tuple[records.Statistic, ...]]
+    residual_std: records.Statistic
+    rsquared: records.Statistic
+    nobs: records.Count
     df_resid: int
 
     def predict(self, X: Any) -> np.ndarray:
@@ -479,32 +479,9 @@ class OLSResult:
                                                                      tuple(cells))),
                        layout=layout)
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain-JSON form (NaN -> null), as :class:`OLSResultRecord`."""
-        return records.dump(self, OLSResultRecord)
 
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> OLSResult:
-        """Inverse of :meth:`to_dict` (checked against :class:`OLSResultRecord`)."""
-        values = records.load(data, OLSResultRecord, "least-squares fit")
-        arrays = {k: _readonly(values[k]) for k in ("params", "bse", "tvalues", "pvalues",
-                                                     "cov_params")}
-        return cls(**{**values, **arrays})
-
-
-class OLSResultRecord(records.Record, kw_only=True):
-    """An :class:`OLSResult` in a file (the final fit of a stepwise record)."""
-
-    names: tuple[str, ...]
-    params: tuple[records.Statistic, ...]
-    bse: tuple[records.Statistic, ...]
-    tvalues: tuple[records.Statistic, ...]
-    pvalues: tuple[records.Statistic, ...]
-    cov_params: tuple[tuple[records.Statistic, ...], ...]
-    residual_std: records.Statistic
-    rsquared: records.Statistic
-    nobs: records.Count
-    df_resid: int
+#: The record of :class:`OLSResult` (nested in other records).
+OLSResultRecord = records.record_of(OLSResult)
 
 
 def _solve(acc: QRAccumulator, idx: list[int], names: tuple[str, ...], tol: float,

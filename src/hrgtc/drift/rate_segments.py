@@ -25,7 +25,7 @@ import numpy as np
 
 from hrgtc.core import records
 from hrgtc.core.errors import InputError
-from hrgtc.core.records import Count, Record
+from hrgtc.core.records import Count
 from hrgtc.core.summary import Figure, Summary
 from hrgtc.recording import Recording
 
@@ -64,7 +64,7 @@ class RateStep:
 
 
 @dataclass(frozen=True)
-class RateSegment:
+class RateSegment(records.Written):
     """A stretch of a run at a constant, known input rate, and its means.
 
     Attributes
@@ -82,27 +82,6 @@ class RateSegment:
     first_row
         Index of the first row used in the recording (rows ``first_row:first_row + rows``).
     """
-
-    start_s: float
-    end_s: float
-    input_rate_dph: float
-    rate_dph: float
-    freq_hz: float
-    rows: int
-    first_row: int = 0
-
-    def to_dict(self) -> dict[str, Any]:
-        """Plain-JSON form (:class:`RateSegmentRecord`)."""
-        return records.dump(self, RateSegmentRecord)
-
-    @classmethod
-    def from_dict(cls, data: Any) -> RateSegment:
-        """Inverse of :meth:`to_dict`."""
-        return cls(**records.load(data, RateSegmentRecord, "rate segment"))
-
-
-class RateSegmentRecord(Record):
-    """The record of :class:`RateSegment`."""
 
     start_s: float
     end_s: float
@@ -264,7 +243,7 @@ def find_rate_segments(recording: Recording, table: Sequence[RateStep] | None = 
 
 
 @dataclass(frozen=True, eq=False)
-class SegmentScaleErrors:
+class SegmentScaleErrors(records.Written):
     """Scale-factor error of each segment with a non-zero input rate.
 
     Attributes
@@ -276,7 +255,7 @@ class SegmentScaleErrors:
     """
 
     segments: tuple[RateSegment, ...]
-    error_ppm: np.ndarray
+    error_ppm: records.Array[records.Statistic]
 
     @property
     def rms_ppm(self) -> float:
@@ -316,25 +295,6 @@ class SegmentScaleErrors:
                   "{segments} segments: rms {rms_ppm:.4g} ppm, max |error| {max_abs_ppm:.4g} ppm")
         return Summary("scale-factor error per rate segment",
                        (("segments", tuple(cells)), ("totals", totals)), layout=layout)
-
-    def to_dict(self) -> dict[str, Any]:
-        """Plain-JSON form (:class:`SegmentScaleErrorsRecord`)."""
-        return records.dump(self, SegmentScaleErrorsRecord)
-
-    @classmethod
-    def from_dict(cls, data: Any) -> SegmentScaleErrors:
-        """Inverse of :meth:`to_dict`."""
-        values = records.load(data, SegmentScaleErrorsRecord, "segment scale errors")
-        return cls(tuple(RateSegment(**s) for s in values["segments"]),
-                   np.asarray(values["error_ppm"], dtype=np.float64))
-
-
-class SegmentScaleErrorsRecord(Record):
-    """The record of :class:`SegmentScaleErrors` (``error_ppm``: one per segment, ``null``
-    where not finite)."""
-
-    segments: list[RateSegmentRecord]
-    error_ppm: list[records.Statistic]
 
 
 def segment_scale_errors(recording: Recording, bias_dph: Any = None, *,

@@ -64,9 +64,8 @@ SCALE_TERMS = ("f", "f^2", "f^3")
 TOLERANCE_SHARE = 0.02
 
 
-
 @dataclass(frozen=True)
-class ScaleGroup:
+class ScaleGroup(records.Written):
     """Segments at one temperature and their scale-factor error.
 
     Attributes
@@ -84,21 +83,18 @@ class ScaleGroup:
         Number of samples in the segments.
     """
 
+    forbid_unknown_fields = True
+
     freq_hz: float
     k_ppm: float
-    k_se_ppm: float
+    k_se_ppm: records.Statistic
     bias_dph: float
-    n: int
-    rows: int
+    n: Annotated[int, Meta(ge=2)]
+    rows: Annotated[int, Meta(ge=1)]
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain-JSON form (a NaN standard error becomes null), as :class:`ScaleGroupRecord`."""
-        return records.dump(self, ScaleGroupRecord)
 
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> ScaleGroup:
-        """Inverse of :meth:`to_dict`."""
-        return cls(**records.load(data, ScaleGroupRecord, "scale-group"))
+#: The record of :class:`ScaleGroup` (nested in :class:`ScaleFactorRecord`).
+ScaleGroupRecord = records.record_of(ScaleGroup)
 
 
 @dataclass(frozen=True, eq=False)
@@ -263,25 +259,13 @@ class ScaleFactorModel(ParsedTerms):
         """Inverse of :meth:`to_dict` (checked against :class:`ScaleFactorRecord`)."""
         values = records.load(data, ScaleFactorRecord, "scale-factor")
         values.pop("kind")
-        return cls(**{**values, "groups": tuple(ScaleGroup(**g) for g in values["groups"]),
-                      "history": tuple(Step(**h) for h in values["history"])})
+        return cls(**{**values, "history": tuple(Step(**h) for h in values["history"])})
 
 
 #: A term of k(f): a power of f.
 _FTerm = Annotated[str, Meta(pattern=r"^f(\^[0-9]+)?$")]
 #: A stepwise threshold, a p-value strictly between 0 and 1.
 _Threshold = Annotated[float, Meta(gt=0, lt=1)]
-
-
-class ScaleGroupRecord(records.Record, kw_only=True, forbid_unknown_fields=True):
-    """A :class:`ScaleGroup` in a file."""
-
-    freq_hz: float
-    k_ppm: float
-    k_se_ppm: records.Statistic
-    bias_dph: float
-    n: Annotated[int, Meta(ge=2)]
-    rows: Annotated[int, Meta(ge=1)]
 
 
 class ScaleStepRecord(records.Record, kw_only=True, forbid_unknown_fields=True):

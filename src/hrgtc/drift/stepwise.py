@@ -34,7 +34,7 @@ import numpy as np
 from hrgtc.core import records
 from hrgtc.core.errors import HrgtcWarning, InputError, RankDeficientError
 from hrgtc.core.summary import Figure, Summary, escape
-from hrgtc.drift.qr_accumulator import OLSResultRecord, _check_names, _resolve_terms, _solve
+from hrgtc.drift.qr_accumulator import _check_names, _resolve_terms, _solve
 from hrgtc.drift.regression import (
     COLLINEARITY_TOL,
     GramAccumulator,
@@ -60,25 +60,21 @@ __all__ = [
 
 # --------------------------------------------------------------------------- stepwise
 @dataclass(frozen=True)
-class Step:
+class Step(records.Written):
     """One step of a stepwise regression.
 
     ``fstat`` is the partial F statistic of the term (the square of its t statistic
     in the larger of the two models) and ``pvalue`` its p-value F(1, df_resid).
     """
 
-    action: str
+    action: Literal["added", "removed"]
     term: str
-    fstat: float
-    pvalue: float
-
-    def to_dict(self) -> dict[str, Any]:
-        """Plain-JSON form (:class:`StepRecord`)."""
-        return records.dump(self, StepRecord)
+    fstat: records.Statistic
+    pvalue: records.Statistic
 
 
 @dataclass(frozen=True, eq=False)
-class StepwiseResult:
+class StepwiseResult(records.Written):
     """Outcome of :func:`stepwise`, Section 4.1 of [1].
 
     Attributes
@@ -104,11 +100,11 @@ class StepwiseResult:
     selected: tuple[str, ...]
     result: OLSResult
     candidates: tuple[str, ...]
-    excluded_pvalues: tuple[float, ...]
+    excluded_pvalues: tuple[records.Statistic, ...]
     penter: float
     premove: float
-    stop_reason: str
-    variance_inflation: float = 1.0
+    stop_reason: Literal["converged", "max_steps", "cycle"]
+    variance_inflation: records.Statistic = 1.0
 
     def summary(self) -> Summary:
         """The steps (term, F, p), the excluded terms' p-values and the final fit
@@ -133,39 +129,13 @@ class StepwiseResult:
         return Summary(title, (("steps", steps), ("excluded", left), *fit.sections),
                        layout=(*layout, *fit.lines()))
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain-JSON form (NaN p-values become null), as :class:`StepwiseRecord`."""
-        return records.dump(self, StepwiseRecord)
 
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> StepwiseResult:
-        """Inverse of :meth:`to_dict` (checked against :class:`StepwiseRecord`)."""
-        values = records.load(data, StepwiseRecord, "stepwise")
-        return cls(**{**values, "history": tuple(Step(**s) for s in values["history"]),
-                      "result": OLSResult.from_dict(values["result"])})
+#: The record of :class:`Step` (nested in other records).
+StepRecord = records.record_of(Step)
 
 
-class StepRecord(records.Record, kw_only=True):
-    """A :class:`Step` in a file."""
-
-    action: Literal["added", "removed"]
-    term: str
-    fstat: records.Statistic
-    pvalue: records.Statistic
-
-
-class StepwiseRecord(records.Record, kw_only=True):
-    """A :class:`StepwiseResult` in a file (the drift model's ``stepwise``)."""
-
-    history: tuple[StepRecord, ...]
-    selected: tuple[str, ...]
-    result: OLSResultRecord
-    candidates: tuple[str, ...]
-    excluded_pvalues: tuple[records.Statistic, ...]
-    penter: float
-    premove: float
-    stop_reason: Literal["converged", "max_steps", "cycle"]
-    variance_inflation: records.Statistic = 1.0
+#: The record of :class:`StepwiseResult` (nested in other records).
+StepwiseRecord = records.record_of(StepwiseResult, "StepwiseRecord")
 
 
 def stepwise(X: Any, y: Any, names: Sequence[str] | None = None, penter: float = PENTER,

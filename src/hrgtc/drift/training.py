@@ -25,7 +25,7 @@ says so once).
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, Self
 
@@ -70,7 +70,7 @@ def rate_noise_dph(rate_dph: Any) -> float:
 
 
 @dataclass(frozen=True)
-class TrainingStatistics:
+class TrainingStatistics(records.Written):
     """What the model's training data looked like, per axis (plain JSON in the model file).
 
     Attributes
@@ -87,11 +87,11 @@ class TrainingStatistics:
         Training runs they were taken on.
     """
 
-    sample_rate_hz: float
-    rate_noise_dph: float
+    sample_rate_hz: records.Positive
+    rate_noise_dph: records.NonNegative
     rate_level_dph: float
-    samples: int
-    runs: int
+    samples: records.Count
+    runs: records.Count
 
     @classmethod
     def from_runs(cls, heads: Sequence[Any]) -> TrainingStatistics | None:
@@ -110,15 +110,6 @@ class TrainingStatistics:
         return cls(float(rate), float(np.median(noises)), float(np.median(levels)), n,
                    len(noises))
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types, as :class:`TrainingStatisticsRecord` writes them."""
-        return records.dump(self, TrainingStatisticsRecord)
-
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> TrainingStatistics:
-        """Inverse of :meth:`to_dict` (checked against :class:`TrainingStatisticsRecord`)."""
-        return cls(**records.load(data, TrainingStatisticsRecord, "training-statistics"))
-
     def noise_ratio(self, rate_dph: Any, sample_rate_hz: float) -> float:
         """The recording's rate noise over the training data's, at the training rate (NaN
         when either is 0 or unknown: a quantised or constant rate)."""
@@ -128,15 +119,8 @@ class TrainingStatistics:
         return noise * math.sqrt(self.sample_rate_hz / sample_rate_hz) / self.rate_noise_dph
 
 
-class TrainingStatisticsRecord(records.Record, kw_only=True):
-    """:class:`TrainingStatistics` in a file (the model file's ``training``, optional: files
-    written before it still load; the noise check is then skipped)."""
-
-    sample_rate_hz: records.Positive
-    rate_noise_dph: records.NonNegative
-    rate_level_dph: float
-    samples: records.Count
-    runs: records.Count
+#: The record of :class:`TrainingStatistics` (nested in other records).
+TrainingStatisticsRecord = records.record_of(TrainingStatistics)
 
 
 def unit_mistake(ratio: float) -> tuple[float, str] | None:

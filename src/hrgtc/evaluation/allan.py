@@ -42,7 +42,7 @@ References
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -51,7 +51,7 @@ import numpy as np
 from hrgtc.core import records
 from hrgtc.core.errors import InputError
 from hrgtc.core.progress import Progress
-from hrgtc.core.records import Count, Positive, Record, Statistic
+from hrgtc.core.records import Count, Positive, Statistic
 from hrgtc.core.summary import Figure, Summary, escape
 from hrgtc.evaluation._allan_edf import (
     NOISE_ALPHAS,
@@ -127,7 +127,7 @@ def _block_length(tau_s: float, sample_rate_hz: float) -> int:
 
 # --------------------------------------------------------------------------- Allan deviation
 @dataclass(frozen=True, eq=False)
-class AllanResult:
+class AllanResult(records.Written):
     """Allan deviation of a rate record.
 
     Attributes
@@ -160,18 +160,18 @@ class AllanResult:
         Equivalent degrees of freedom of each τ behind ``lower`` / ``upper``, or None.
     """
 
-    taus_s: np.ndarray
-    deviation: np.ndarray
-    counts: np.ndarray
+    taus_s: records.Array[float]
+    deviation: records.Array[Statistic]
+    counts: records.Array[Count]
     overlapping: bool
-    sample_rate_hz: float
-    n_samples: int
+    sample_rate_hz: Positive
+    n_samples: Count
     kind: str = "allan"
-    lower: np.ndarray | None = None
-    upper: np.ndarray | None = None
+    lower: records.Array[Statistic] | None = None
+    upper: records.Array[Statistic] | None = None
     confidence: float | None = None
     segments: int = 1
-    edf: np.ndarray | None = None
+    edf: records.Array[Statistic] | None = None
 
     def __post_init__(self) -> None:
         for name, dtype in (
@@ -189,15 +189,6 @@ class AllanResult:
         """Number of whole, non-overlapping τ-blocks in the record at each τ."""
         m = np.rint(self.taus_s * self.sample_rate_hz).astype(np.int64)
         return self.n_samples // np.maximum(m, 1)
-
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (:class:`AllanResultRecord`; arrays as lists, NaN as null)."""
-        return records.dump(self, AllanResultRecord)
-
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> AllanResult:
-        """Inverse of :meth:`to_dict` (optional fields may be missing)."""
-        return cls(**records.load(data, AllanResultRecord, "Allan deviation"))
 
     def summary(self) -> Summary:
         """The curve as a table: τ, deviation, the terms averaged and (if any) the
@@ -237,22 +228,6 @@ class AllanResult:
         return Summary(title, (("curve", tuple(cells)),), layout=tuple(layout))
 
 
-
-class AllanResultRecord(Record):
-    """The record of :class:`AllanResult` (its ``to_dict``, ``from_dict``)."""
-
-    taus_s: list[float]
-    deviation: list[Statistic]
-    counts: list[Count]
-    overlapping: bool
-    sample_rate_hz: Positive
-    n_samples: Count
-    kind: str = "allan"
-    lower: list[Statistic] | None = None
-    upper: list[Statistic] | None = None
-    confidence: float | None = None
-    segments: int = 1
-    edf: list[Statistic] | None = None
 
 def _averaging_factors(taus: str | Sequence[float] | np.ndarray, n: int, fs: float) -> np.ndarray:
     """Integer averaging factors m (τ = m / fs) the way ``allantools.tau_generator`` makes them.

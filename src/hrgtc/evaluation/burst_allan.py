@@ -44,7 +44,6 @@ estimable (an :class:`~hrgtc.core.errors.InputError` saying why).
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Annotated, Any
 
@@ -53,7 +52,7 @@ from msgspec import Meta
 
 from hrgtc.core import records
 from hrgtc.core.errors import InputError
-from hrgtc.core.records import Count, Positive, Record, Statistic
+from hrgtc.core.records import Count, Positive, Statistic
 from hrgtc.evaluation._allan_edf import ONE_SIGMA
 from hrgtc.evaluation.allan_segments import pooled_deviation
 
@@ -112,7 +111,7 @@ def dead_time_bias(averaged: int, ratio: float, mu: int) -> float:
 
 
 @dataclass(frozen=True, eq=False)
-class BurstAllanResult:
+class BurstAllanResult(records.Written):
     """Allan deviation of burst means at τ = M·T (module docstring).
 
     Attributes
@@ -137,32 +136,21 @@ class BurstAllanResult:
         rate noise at each τ (1 for white rate noise).
     """
 
-    taus_s: np.ndarray
-    deviation: np.ndarray
-    raw_deviation: np.ndarray
-    lower: np.ndarray
-    upper: np.ndarray
-    counts: np.ndarray
-    edf: np.ndarray
-    confidence: float
-    period_s: float
-    burst_s: float
-    dead_time_ratio: float
-    bursts: int
-    runs: int
-    bias_flicker: np.ndarray
-    bias_random_walk: np.ndarray
-
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (:class:`BurstAllanRecord`; arrays as lists, NaN as None)."""
-        return records.dump(self, BurstAllanRecord)
-
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> BurstAllanResult:
-        """Inverse of :meth:`to_dict` (lists as arrays, null as NaN)."""
-        values = records.load(data, BurstAllanRecord, "burst-mean Allan deviation")
-        return cls(**{k: np.array(v) if isinstance(v, tuple) else v
-                      for k, v in values.items()})
+    taus_s: records.Array[Positive]
+    deviation: records.Array[Statistic]
+    raw_deviation: records.Array[Statistic]
+    lower: records.Array[Statistic]
+    upper: records.Array[Statistic]
+    counts: records.Array[Count]
+    edf: records.Array[Statistic]
+    confidence: Annotated[float, Meta(gt=0, lt=1)]
+    period_s: Positive
+    burst_s: Positive
+    dead_time_ratio: Annotated[float, Meta(ge=1)]
+    bursts: Count
+    runs: Annotated[int, Meta(ge=1)]
+    bias_flicker: records.Array[Statistic]
+    bias_random_walk: records.Array[Statistic]
 
     def lines(self, unit: str = "°/h") -> list[str]:
         """One line per τ: value, interval, N and the bias statement."""
@@ -184,24 +172,8 @@ class BurstAllanResult:
         return out
 
 
-class BurstAllanRecord(Record):
-    """The record of :class:`BurstAllanResult` (its ``to_dict``, ``from_dict``)."""
-
-    taus_s: list[Positive]
-    deviation: list[Statistic]
-    raw_deviation: list[Statistic]
-    lower: list[Statistic]
-    upper: list[Statistic]
-    counts: list[Count]
-    edf: list[Statistic]
-    confidence: Annotated[float, Meta(gt=0, lt=1)]
-    period_s: Positive
-    burst_s: Positive
-    dead_time_ratio: Annotated[float, Meta(ge=1)]
-    bursts: Count
-    runs: Annotated[int, Meta(ge=1)]
-    bias_flicker: list[Statistic]
-    bias_random_walk: list[Statistic]
+#: The record of :class:`BurstAllanResult` (nested in other records).
+BurstAllanRecord = records.record_of(BurstAllanResult, "BurstAllanRecord")
 
 
 def burst_mean_allan(means: Any, durations_s: Any, starts_s: Any, *,

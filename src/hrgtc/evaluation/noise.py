@@ -18,7 +18,6 @@ References
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -26,7 +25,7 @@ import numpy as np
 
 from hrgtc.core import records
 from hrgtc.core.errors import InputError
-from hrgtc.core.records import Record, Statistic
+from hrgtc.core.records import Statistic
 from hrgtc.core.summary import Figure, Summary, escape
 from hrgtc.evaluation.allan import FLICKER_FLOOR_FACTOR, SECONDS_PER_HOUR, AllanResult
 
@@ -38,7 +37,7 @@ RAMP_SLOPE = 0.75
 
 
 @dataclass(frozen=True)
-class NoiseTerms:
+class NoiseTerms(records.Written):
     """Allan noise terms of a gyro, IEEE Std 952-1997 Annex C conventions [2].
 
     Attributes
@@ -76,28 +75,19 @@ class NoiseTerms:
     bias_instability_dph: float | None
     rrw_dph_per_rt_h: float | None
     arw_taus_s: tuple[float, float] | None
-    bias_instability_tau_s: float
+    bias_instability_tau_s: Statistic
     rrw_taus_s: tuple[float, float] | None
     floor_reached: bool
-    minimum_dph: float = math.nan
+    minimum_dph: Statistic = math.nan
     arw_reason: str | None = None
     bias_instability_reason: str | None = None
     rrw_reason: str | None = None
-    arw_interval: tuple[float, float] | None = None
-    bias_instability_interval: tuple[float, float] | None = None
-    rrw_interval: tuple[float, float] | None = None
+    arw_interval: tuple[Statistic, Statistic] | None = None
+    bias_instability_interval: tuple[Statistic, Statistic] | None = None
+    rrw_interval: tuple[Statistic, Statistic] | None = None
     arw_n: int | None = None
     bias_instability_n: int | None = None
     rrw_n: int | None = None
-
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (:class:`NoiseTermsRecord`; τ ranges as lists, NaN as null)."""
-        return records.dump(self, NoiseTermsRecord)
-
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> NoiseTerms:
-        """Inverse of :meth:`to_dict`."""
-        return cls(**records.load(data, NoiseTermsRecord, "noise terms"))
 
     def text(self, term: str, digits: int = 4) -> str:
         """One term as text: the number, or the reason it is missing.
@@ -147,27 +137,9 @@ class NoiseTerms:
             "rate random walk   " + lines[1]))
 
 
+#: The record of :class:`NoiseTerms` (nested in other records).
+NoiseTermsRecord = records.record_of(NoiseTerms)
 
-class NoiseTermsRecord(Record):
-    """The record of :class:`NoiseTerms` (its ``to_dict``, ``from_dict``)."""
-
-    arw_deg_per_rt_h: float | None
-    bias_instability_dph: float | None
-    rrw_dph_per_rt_h: float | None
-    arw_taus_s: tuple[float, float] | None
-    bias_instability_tau_s: Statistic
-    rrw_taus_s: tuple[float, float] | None
-    floor_reached: bool
-    minimum_dph: Statistic = None
-    arw_reason: str | None = None
-    bias_instability_reason: str | None = None
-    rrw_reason: str | None = None
-    arw_interval: tuple[Statistic, Statistic] | None = None
-    bias_instability_interval: tuple[Statistic, Statistic] | None = None
-    rrw_interval: tuple[Statistic, Statistic] | None = None
-    arw_n: int | None = None
-    bias_instability_n: int | None = None
-    rrw_n: int | None = None
 
 def _law(slope: float) -> str:
     """A local log-log slope as a power of τ, e.g. ``τ^1.0``."""

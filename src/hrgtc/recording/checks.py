@@ -11,17 +11,15 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
 from hrgtc.core import records
 from hrgtc.core.errors import GapWarning, InputError, RecordingError
-from hrgtc.core.records import Count, Record
+from hrgtc.core.records import Count
 from hrgtc.core.summary import Figure, Summary, escape
-from hrgtc.recording.gaps import Gap, GapPolicy, GapRecord
+from hrgtc.recording.gaps import Gap, GapPolicy
 
 SAMPLE_RATE_TOLERANCE = 0.01  # relative disagreement of measured and nominal rate
 KHZ_BELOW_HZ = 100.0
@@ -55,7 +53,7 @@ _BOUNDS: dict[str, tuple[float, float, str]] = {
 
 
 @dataclass(frozen=True)
-class Problem:
+class Problem(records.Written):
     """One way in which a recording breaks the contract.
 
     Parameters
@@ -80,33 +78,13 @@ class Problem:
     kind: str
     message: str
     column: str | None = None
-    row: int | None = None
-    value: str | None = None
-    count: int = 1
-
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (:class:`ProblemRecord`)."""
-        return records.dump(self, ProblemRecord)
-
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> Problem:
-        """Inverse of :meth:`to_dict`."""
-        return cls(**records.load(data, ProblemRecord, "problem"))
-
-
-class ProblemRecord(Record):
-    """The record of :class:`Problem`."""
-
-    kind: str
-    message: str
-    column: str | None = None
     row: Count | None = None
     value: str | None = None
     count: Count = 1
 
 
 @dataclass(frozen=True)
-class ValidationReport:
+class ValidationReport(records.Written):
     """Outcome of validating a recording.
 
     Parameters
@@ -138,12 +116,12 @@ class ValidationReport:
     ok: bool
     problems: tuple[Problem, ...]
     gaps: tuple[Gap, ...]
-    n_gaps: int
-    rows: int
+    n_gaps: Count
+    rows: Count
     source: str | None
     measured_sample_rate_hz: float | None
     gap_policy: GapPolicy = "error"
-    n_dropouts: int = 0
+    n_dropouts: Count = 0
     dropout_s: float = 0.0
     duty_cycled: bool = False
 
@@ -220,33 +198,6 @@ class ValidationReport:
         return Summary(f"validation of {self.source or 'recording'}",
                        (("validation", tuple(figures)), ("gaps", tuple(gaps))),
                        tuple(p.message for p in self.problems), tuple(lines))
-
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (:class:`ValidationReportRecord`)."""
-        return records.dump(self, ValidationReportRecord)
-
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> ValidationReport:
-        """Inverse of :meth:`to_dict`."""
-        values = records.load(data, ValidationReportRecord, "validation report")
-        return cls(**values | {"problems": tuple(Problem(**p) for p in values["problems"]),
-                               "gaps": tuple(Gap(**g) for g in values["gaps"])})
-
-
-class ValidationReportRecord(Record, kw_only=True):
-    """The record of :class:`ValidationReport`."""
-
-    ok: bool
-    problems: list[ProblemRecord]
-    gaps: list[GapRecord]
-    n_gaps: Count
-    rows: Count
-    source: str | None = None
-    measured_sample_rate_hz: float | None = None
-    gap_policy: GapPolicy = "error"
-    n_dropouts: Count = 0
-    dropout_s: float = 0.0
-    duty_cycled: bool = False
 
 
 def problems_message(source: str | None, problems: tuple[Problem, ...] | list[Problem]) -> str:

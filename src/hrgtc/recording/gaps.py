@@ -24,16 +24,15 @@ of the whole package):
 from __future__ import annotations
 
 import itertools
-from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Annotated, Any, Literal
+from typing import Annotated, Literal
 
 import numpy as np
 from msgspec import Meta
 
 from hrgtc.core import records
 from hrgtc.core.errors import RecordingError
-from hrgtc.core.records import Count, Record
+from hrgtc.core.records import Count
 from hrgtc.core.timeline import GAP_FACTOR, GAP_TOLERANCE, is_gap
 from hrgtc.recording.schema import Recording
 
@@ -47,7 +46,6 @@ __all__ = [
     "MAX_LISTED_GAPS",
     "Gap",
     "GapPolicy",
-    "GapRecord",
     "check_gap_policy",
     "filter_restarts_at_gaps",
     "split_at_gaps",
@@ -56,7 +54,7 @@ MAX_LISTED_GAPS = 1000
 
 
 @dataclass(frozen=True)
-class Gap:
+class Gap(records.Written):
     """A time step longer than :data:`GAP_PERIODS` sample periods.
 
     Parameters
@@ -68,23 +66,6 @@ class Gap:
     row
         First row after the gap (0 = first data row).
     """
-
-    start_time_s: float
-    duration_s: float
-    row: int
-
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (:class:`GapRecord`)."""
-        return records.dump(self, GapRecord)
-
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> Gap:
-        """Inverse of :meth:`to_dict`."""
-        return cls(**records.load(data, GapRecord, "gap"))
-
-
-class GapRecord(Record):
-    """The record of :class:`Gap`."""
 
     start_time_s: float
     duration_s: Annotated[float, Meta(ge=0)]

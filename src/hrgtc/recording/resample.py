@@ -61,26 +61,10 @@ def _eligible(name: str) -> bool:
 
 
 @dataclass
-class ChannelFill:
-    """What was done to one slow channel."""
+class ChannelFill(records.Written):
+    """What was done to one slow channel (the figures are written, not the state)."""
 
-    column: str
-    period_s: float
-    max_age_s: float
-    filled: int = 0
-    dropped: int = 0
-    first_dropped_row: int | None = None
-    last_time: float = -math.inf
-    last_value: float = math.nan
-    alias_of: str | None = None  # the same cells under another name (a sensor's freq_hz)
-
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (:class:`ChannelFillRecord`: the figures, not the state)."""
-        return records.dump(self, ChannelFillRecord)
-
-
-class ChannelFillRecord(Record):
-    """The record of :class:`ChannelFill`."""
+    not_written = ("last_time", "last_value", "alias_of")
 
     column: str
     period_s: Positive
@@ -88,6 +72,13 @@ class ChannelFillRecord(Record):
     filled: Count = 0
     dropped: Count = 0
     first_dropped_row: Count | None = None
+    last_time: float = -math.inf
+    last_value: float = math.nan
+    alias_of: str | None = None  # the same cells under another name (a sensor's freq_hz)
+
+
+#: The record of :class:`ChannelFill` (nested in :class:`SlowChannelsRecord`).
+ChannelFillRecord = records.record_of(ChannelFill)
 
 
 @dataclass

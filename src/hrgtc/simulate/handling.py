@@ -23,7 +23,7 @@ body ``z`` (vertical in orientation 0).
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Annotated, Any
 
@@ -66,7 +66,7 @@ def orientation_matrix(k: int) -> np.ndarray:
 
 
 @dataclass(frozen=True)
-class Handling:
+class Handling(records.Written):
     """A schedule of orientations with handling between them.
 
     Parameters
@@ -94,12 +94,14 @@ class Handling:
         Time constant of that cooling. [s]
     """
 
-    orientations: int = 3
-    handling_s: float = 60.0
-    max_rate_dps: float = _PLAIN["handling_max_dps"]
+    forbid_unknown_fields = True  # a misspelt key of a hand-written input is refused
+
+    orientations: Annotated[int, Meta(ge=1)] = 3
+    handling_s: records.Positive = 60.0
+    max_rate_dps: records.Positive = _PLAIN["handling_max_dps"]
     change_times_s: tuple[float, ...] | None = None
     latitude_deg: float = 40.0
-    g_sensitivity_dph_per_g: Mapping[str, tuple[float, float, float]] = field(
+    g_sensitivity_dph_per_g: dict[str, tuple[float, float, float]] = field(
         default_factory=dict
     )
     accel_noise_g: float = 0.002
@@ -141,28 +143,9 @@ class Handling:
                 )
         return starts
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types, as :class:`HandlingRecord` writes them."""
-        return records.dump(self, HandlingRecord)
 
-    @classmethod
-    def from_dict(cls, data: Any) -> Handling:
-        """Inverse of :meth:`to_dict` (checked against its record)."""
-        return cls(**records.load(data, HandlingRecord, "handling"))
-
-
-class HandlingRecord(records.Record, kw_only=True, forbid_unknown_fields=True):
-    """A :class:`Handling` in a logger's sidecar."""
-
-    orientations: Annotated[int, Meta(ge=1)]
-    handling_s: records.Positive
-    max_rate_dps: records.Positive
-    change_times_s: tuple[float, ...] | None
-    latitude_deg: float
-    g_sensitivity_dph_per_g: dict[str, tuple[float, float, float]]
-    accel_noise_g: float
-    hand_warming_c: float
-    hand_warming_tau_s: float
+#: The record of :class:`Handling` (nested in other records).
+HandlingRecord = records.record_of(Handling)
 
 
 def hand_warming(time_s: np.ndarray, handling: Handling, duration_s: float) -> np.ndarray:

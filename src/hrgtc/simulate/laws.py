@@ -26,7 +26,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Annotated, Any, Protocol
+from typing import Annotated, Any, ClassVar, Protocol
 
 import numpy as np
 from msgspec import Meta
@@ -181,7 +181,7 @@ def frequency_law_from_dict(data: Mapping[str, Any]) -> FrequencyLaw:
 
 
 @dataclass(frozen=True)
-class ScaleFactorLaw:
+class ScaleFactorLaw(records.Written):
     """Scale-factor error against resonator temperature, a polynomial in ``T_r - T0``.
 
     .. math::
@@ -206,7 +206,7 @@ class ScaleFactorLaw:
     [120.0, 165.0]
     """
 
-    coefficients_ppm: tuple[float, ...]
+    coefficients_ppm: Annotated[tuple[float, ...], Meta(min_length=1)]
     reference_c: float = 20.0
 
     def __post_init__(self) -> None:
@@ -236,25 +236,13 @@ class ScaleFactorLaw:
             out += c
         return out
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types, as :class:`ScaleFactorLawRecord` writes them."""
-        return records.dump(self, ScaleFactorLawRecord)
 
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> ScaleFactorLaw:
-        """Inverse of :meth:`to_dict` (checked against its record)."""
-        return cls(**records.load(data, ScaleFactorLawRecord, "scale-factor law"))
-
-
-class ScaleFactorLawRecord(records.Record, kw_only=True):
-    """A :class:`ScaleFactorLaw` in the simulator's ground truth."""
-
-    coefficients_ppm: Annotated[tuple[float, ...], Meta(min_length=1)]
-    reference_c: float = 20.0
+#: The record of :class:`ScaleFactorLaw` (nested in other records).
+ScaleFactorLawRecord = records.record_of(ScaleFactorLaw)
 
 
 @dataclass(frozen=True)
-class BiasLaw:
+class BiasLaw(records.Written):
     """Thermal bias in resonator temperature and housing - resonator gradient.
 
     .. math::
@@ -302,10 +290,14 @@ class BiasLaw:
     gradient_dph_per_c: float = 0.0
     gradient_temperature_dph_per_c2: float = 0.0
     hysteresis_dph: float = 0.0
-    hysteresis_width_c: float = 1.0
+    hysteresis_width_c: records.Positive = 1.0
     play_dph_per_c: float = 0.0
-    play_width_c: float = 0.0
+    play_width_c: records.NonNegative = 0.0
     play_initial_offset_c: float = 0.0
+
+    # written only by a unit with a play (the other units' ground truth unchanged)
+    omit_when_default: ClassVar[tuple[str, ...]] = (
+        "play_dph_per_c", "play_width_c", "play_initial_offset_c")
 
     def __post_init__(self) -> None:
         temperature = tuple(float(c) for c in self.temperature_dph)
@@ -395,32 +387,8 @@ class BiasLaw:
         played *= self.play_dph_per_c
         return played, last
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types, as :class:`BiasLawRecord` writes them."""
-        return records.dump(self, BiasLawRecord)
-
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> BiasLaw:
-        """Inverse of :meth:`to_dict` (checked against its record)."""
-        return cls(**records.load(data, BiasLawRecord, "bias law"))
-
-
-class BiasLawRecord(records.Record, kw_only=True):
-    """A :class:`BiasLaw` in the simulator's ground truth."""
-
-    bias0_dph: float
-    reference_c: float = 20.0
-    temperature_dph: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    gradient_dph_per_c: float = 0.0
-    gradient_temperature_dph_per_c2: float = 0.0
-    hysteresis_dph: float = 0.0
-    hysteresis_width_c: records.Positive = 1.0
-    play_dph_per_c: float = 0.0
-    play_width_c: records.NonNegative = 0.0
-    play_initial_offset_c: float = 0.0
-
-    # written only by a unit with a play (the other units' ground truth unchanged)
-    omit_when_default = ("play_dph_per_c", "play_width_c", "play_initial_offset_c")
+#: The record of :class:`BiasLaw` (nested in other records).
+BiasLawRecord = records.record_of(BiasLaw)
 
 
 @njit(cache=True, nogil=True)

@@ -23,7 +23,6 @@ import json
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
@@ -47,7 +46,7 @@ from hrgtc.simulate.units import MultiAxisUnit, Unit
 
 __all__ = [
     "LoggedFiles",
-    "LoggedFilesRecord",
+
     "csv_text",
     "logged_summary",
     "sidecar_paths",
@@ -57,7 +56,7 @@ __all__ = [
 
 
 @dataclass(frozen=True)
-class LoggedFiles:
+class LoggedFiles(records.Written):
     """Paths written for a logged run.
 
     Attributes
@@ -69,25 +68,6 @@ class LoggedFiles:
     rows
         Rows of the recording.
     """
-
-    path: str
-    truth_json: str
-    truth_csv: str
-    reference_log: str | None
-    rows: int
-
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types, as :class:`LoggedFilesRecord` writes them."""
-        return records.dump(self, LoggedFilesRecord)
-
-    @classmethod
-    def from_dict(cls, data: Any) -> LoggedFiles:
-        """Inverse of :meth:`to_dict` (checked against its record)."""
-        return cls(**records.load(data, LoggedFilesRecord, "logged files"))
-
-
-class LoggedFilesRecord(records.Record, kw_only=True):
-    """A :class:`LoggedFiles` (``hrgtc simulate --logger ... --json``)."""
 
     path: str
     truth_json: str

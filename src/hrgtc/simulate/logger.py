@@ -252,11 +252,7 @@ class Logger:
     @classmethod
     def from_dict(cls, data: Any) -> Logger:
         """Inverse of :meth:`to_dict` (checked against its record)."""
-        values = records.load(data, LoggerRecord, "logger")
-        parts = {"temperature": TemperatureChannel, "reference_log": ReferenceLog,
-                 "handling": Handling}
-        return cls(**{**values, **{name: None if values[name] is None else part(**values[name])
-                                   for name, part in parts.items()}})
+        return cls(**records.load(data, LoggerRecord, "logger"))  # the parts built
 
 
 @dataclass

@@ -31,7 +31,6 @@ run is the same whatever the chunk size.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Annotated, Any
 
@@ -63,7 +62,7 @@ def _gauss_markov_mean_variance(tau_s: np.ndarray, tau_c: float, variance: float
 
 
 @dataclass(frozen=True)
-class GyroNoise:
+class GyroNoise(records.Written):
     """Noise terms of a gyro's rate output.
 
     Parameters
@@ -80,12 +79,14 @@ class GyroNoise:
         Number of Gauss-Markov processes per decade of correlation time.
     """
 
-    arw_deg_per_sqrt_h: float
-    bias_instability_dph: float
-    rrw_dph_per_sqrt_h: float
-    flicker_tau_min_s: float = 1.0
-    flicker_tau_max_s: float = 1.0e5
-    flicker_per_decade: int = 2
+    forbid_unknown_fields = True  # a misspelt key of a hand-written input is refused
+
+    arw_deg_per_sqrt_h: records.NonNegative
+    bias_instability_dph: records.NonNegative
+    rrw_dph_per_sqrt_h: records.NonNegative
+    flicker_tau_min_s: records.Positive = 1.0
+    flicker_tau_max_s: records.Positive = 1.0e5
+    flicker_per_decade: Annotated[int, Meta(ge=1)] = 2
 
     def __post_init__(self) -> None:
         for name in ("arw_deg_per_sqrt_h", "bias_instability_dph", "rrw_dph_per_sqrt_h"):
@@ -156,25 +157,9 @@ class GyroNoise:
         """A stateful generator of this noise at a sample rate (see :class:`GyroNoiseStream`)."""
         return GyroNoiseStream(self, sample_rate_hz, white_rng, slow_rng)
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types, as :class:`GyroNoiseRecord` writes them."""
-        return records.dump(self, GyroNoiseRecord)
 
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> GyroNoise:
-        """Inverse of :meth:`to_dict` (checked against its record)."""
-        return cls(**records.load(data, GyroNoiseRecord, "gyro noise"))
-
-
-class GyroNoiseRecord(records.Record, kw_only=True, forbid_unknown_fields=True):
-    """A :class:`GyroNoise` in the simulator's ground truth."""
-
-    arw_deg_per_sqrt_h: records.NonNegative
-    bias_instability_dph: records.NonNegative
-    rrw_dph_per_sqrt_h: records.NonNegative
-    flicker_tau_min_s: records.Positive = 1.0
-    flicker_tau_max_s: records.Positive = 1.0e5
-    flicker_per_decade: Annotated[int, Meta(ge=1)] = 2
+#: The record of :class:`GyroNoise` (nested in other records).
+GyroNoiseRecord = records.record_of(GyroNoise)
 
 
 class WhiteNoiseStream:

@@ -38,12 +38,12 @@ from hrgtc.simulate.campaign import (
 from hrgtc.simulate.profiles import Profile
 from hrgtc.simulate.units import MultiAxisUnit, Unit
 
-__all__ = ["SimulatedRun", "WrittenFile", "WrittenFileRecord", "output_paths", "simulate_files",
+__all__ = ["SimulatedRun", "WrittenFile", "output_paths", "simulate_files",
            "simulate_to_file", "written_summary"]
 
 
 @dataclass(frozen=True)
-class WrittenFile:
+class WrittenFile(records.Written):
     """A recording written by the simulator.
 
     Attributes
@@ -57,17 +57,8 @@ class WrittenFile:
     """
 
     path: str
-    rows: int
+    rows: records.Count
     profile: str
-
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types, as :class:`WrittenFileRecord` writes them."""
-        return records.dump(self, WrittenFileRecord)
-
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> WrittenFile:
-        """Inverse of :meth:`to_dict` (checked against its record)."""
-        return cls(**records.load(data, WrittenFileRecord, "written file"))
 
     def summary(self) -> Summary:
         """The file, its rows and its profile (its text: one line)."""
@@ -75,14 +66,6 @@ class WrittenFile:
                                                 Figure("rows", "rows", self.rows),
                                                 Figure("profile", "profile", self.profile))),),
                        layout=("{path}: {rows} rows ({profile})",))
-
-
-class WrittenFileRecord(records.Record, kw_only=True):
-    """A :class:`WrittenFile` (``hrgtc simulate --json``)."""
-
-    path: str
-    rows: records.Count
-    profile: str
 
 
 def simulate_to_file(

@@ -40,7 +40,7 @@ __all__ = [
 
 
 @dataclass(frozen=True)
-class TemperatureChannel:
+class TemperatureChannel(records.Written):
     """A logged temperature: in °C, or a raw count; at every row or slower.
 
     Parameters
@@ -64,13 +64,15 @@ class TemperatureChannel:
         the housing thermistor.
     """
 
+    forbid_unknown_fields = True  # a misspelt key of a hand-written input is refused
+
     lsb_c: float | None = _PLAIN["temp_lsb"]
     offset_c: float = _PLAIN["temp_offset"]
-    bits: int | None = _PLAIN["temp_bits"]
+    bits: Annotated[int, Meta(ge=2, le=64)] | None = _PLAIN["temp_bits"]
     decimals: int = 2
-    rate_hz: float | None = _PLAIN["temp_rate_hz"]
+    rate_hz: records.Positive | None = _PLAIN["temp_rate_hz"]
     noise_c: float = 0.0
-    source: str = "die"
+    source: Literal["die", "housing"] = "die"
 
     def __post_init__(self) -> None:
         if self.lsb_c is not None and not (math.isfinite(self.lsb_c) and self.lsb_c != 0.0):
@@ -111,26 +113,9 @@ class TemperatureChannel:
             "signed_count_stored_unsigned_bits": self.bits,
         }
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types, as :class:`TemperatureChannelRecord` writes them."""
-        return records.dump(self, TemperatureChannelRecord)
 
-    @classmethod
-    def from_dict(cls, data: Any) -> TemperatureChannel:
-        """Inverse of :meth:`to_dict` (checked against its record)."""
-        return cls(**records.load(data, TemperatureChannelRecord, "temperature channel"))
-
-
-class TemperatureChannelRecord(records.Record, kw_only=True, forbid_unknown_fields=True):
-    """A :class:`TemperatureChannel` in a logger's sidecar."""
-
-    lsb_c: float | None
-    offset_c: float
-    bits: Annotated[int, Meta(ge=2, le=64)] | None
-    decimals: int
-    rate_hz: records.Positive | None
-    noise_c: float
-    source: Literal["die", "housing"]
+#: The record of :class:`TemperatureChannel` (nested in other records).
+TemperatureChannelRecord = records.record_of(TemperatureChannel)
 
 
 def count_to_celsius(written: np.ndarray, lsb_c: float, offset_c: float = 0.0,
@@ -171,7 +156,7 @@ def first_order_lag(time_s: np.ndarray, value: np.ndarray, tau_s: float) -> np.n
 
 
 @dataclass(frozen=True)
-class ReferenceLog:
+class ReferenceLog(records.Written):
     """A sparse hand-written log of reference temperatures, with a real log's quirks.
 
     Parameters
@@ -198,11 +183,13 @@ class ReferenceLog:
         A UTF-8 byte-order mark; CRLF line ends.
     """
 
-    every_s: float = 300.0
+    forbid_unknown_fields = True  # a misspelt key of a hand-written input is refused
+
+    every_s: Annotated[float, Meta(ge=60.0)] = 300.0
     start: str = "2020-03-07T15:43:00"
     dates: bool = False
     fahrenheit: bool = False
-    lag_s: float = _PLAIN["reference_lag_s"]
+    lag_s: records.NonNegative = _PLAIN["reference_lag_s"]
     decimals: int = 1
     blank_fraction: float = 0.05
     trailing_rows: int = 5
@@ -227,30 +214,9 @@ class ReferenceLog:
         """Header of the reference probe's column."""
         return "C1 (F)" if self.fahrenheit else "C1 (C)"
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types, as :class:`ReferenceLogRecord` writes them."""
-        return records.dump(self, ReferenceLogRecord)
 
-    @classmethod
-    def from_dict(cls, data: Any) -> ReferenceLog:
-        """Inverse of :meth:`to_dict` (checked against its record)."""
-        return cls(**records.load(data, ReferenceLogRecord, "reference log"))
-
-
-class ReferenceLogRecord(records.Record, kw_only=True, forbid_unknown_fields=True):
-    """A :class:`ReferenceLog` in a logger's sidecar."""
-
-    every_s: Annotated[float, Meta(ge=60.0)]
-    start: str
-    dates: bool
-    fahrenheit: bool
-    lag_s: records.NonNegative
-    decimals: int
-    blank_fraction: float
-    trailing_rows: int
-    empty_columns: int
-    bom: bool
-    crlf: bool
+#: The record of :class:`ReferenceLog` (nested in other records).
+ReferenceLogRecord = records.record_of(ReferenceLog)
 
 
 def _fahrenheit(celsius: np.ndarray) -> np.ndarray:

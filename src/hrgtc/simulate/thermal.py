@@ -27,7 +27,6 @@ carrying the filter state from chunk to chunk. No Python loop per sample.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -91,7 +90,7 @@ class ThermalState:
 
 
 @dataclass(frozen=True)
-class ThermalNetwork:
+class ThermalNetwork(records.Written):
     """Chamber -> housing -> resonator, two first-order lags in cascade.
 
     Parameters
@@ -110,8 +109,10 @@ class ThermalNetwork:
     -10.0
     """
 
-    tau_housing_s: float
-    tau_resonator_s: float
+    forbid_unknown_fields = True  # a misspelt key of a hand-written input is refused
+
+    tau_housing_s: records.Positive
+    tau_resonator_s: records.Positive
 
     def __post_init__(self) -> None:
         for name in ("tau_housing_s", "tau_resonator_s"):
@@ -188,21 +189,9 @@ class ThermalNetwork:
         )
         return housing, resonator, new_state
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types, as :class:`ThermalNetworkRecord` writes them."""
-        return records.dump(self, ThermalNetworkRecord)
 
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> ThermalNetwork:
-        """Inverse of :meth:`to_dict` (checked against its record)."""
-        return cls(**records.load(data, ThermalNetworkRecord, "thermal network"))
-
-
-class ThermalNetworkRecord(records.Record, kw_only=True, forbid_unknown_fields=True):
-    """A :class:`ThermalNetwork` in the simulator's ground truth."""
-
-    tau_housing_s: records.Positive
-    tau_resonator_s: records.Positive
+#: The record of :class:`ThermalNetwork` (nested in other records).
+ThermalNetworkRecord = records.record_of(ThermalNetwork)
 
 
 def step_response(network: ThermalNetwork, step_c: float, time_s: Any) -> np.ndarray:

@@ -50,7 +50,6 @@ from hrgtc.settings.calibration import PlateauSettings
 from hrgtc.thermometry.settling import (
     MIN_FIT_POINTS,
     TransientFit,
-    TransientFitRecord,
     fit_transient,
 )
 
@@ -81,7 +80,7 @@ DEFAULT_MAX_FIT_STD_C = _PLATEAU.max_fit_std_c
 
 
 @dataclass(frozen=True)
-class Plateau:
+class Plateau(records.Written):
     """One soak: its final stretch, settled frequency and settling-curve fit.
 
     Attributes
@@ -117,18 +116,18 @@ class Plateau:
     """
 
     chamber_c: float
-    freq_hz: float
-    freq_std_hz: float
-    n_samples: int
+    freq_hz: records.Statistic
+    freq_std_hz: records.Statistic
+    n_samples: records.Count
     start_s: float
     end_s: float
-    slope_hz_per_h: float
+    slope_hz_per_h: records.Statistic
     settled: bool
-    settled_freq_hz: float
-    settled_freq_std_hz: float
+    settled_freq_hz: records.Statistic
+    settled_freq_std_hz: records.Statistic
     method: str
-    residual_unsettled_c: float
-    hz_per_c: float
+    residual_unsettled_c: records.Statistic
+    hz_per_c: records.Statistic
     segment_start_s: float
     fit: TransientFit | None = None
     source: str | None = None
@@ -176,41 +175,6 @@ class Plateau:
             lines += fit.lines("  ")
         return Summary(f"plateau at chamber {self.chamber_c:.3f} °C", tuple(sections),
                        layout=tuple(lines))
-
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (the fit nested), as :class:`PlateauRecord` writes them
-        (NaN -> None)."""
-        return records.dump(self, PlateauRecord)
-
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> Plateau:
-        """Inverse of :meth:`to_dict` (checked against :class:`PlateauRecord`)."""
-        values = records.load(data, PlateauRecord, "plateau")
-        fit = values.pop("fit")
-        return cls(**values, fit=None if fit is None else TransientFit(**fit))
-
-
-class PlateauRecord(records.Record, kw_only=True):
-    """A :class:`Plateau` in a file (one row of a model file's ``plateaus``, the unit's
-    Table 1): field names and bounds, from which its ``to_dict``/``from_dict`` and JSON
-    Schema are generated. Its measured numbers are ``null`` when not finite."""
-
-    chamber_c: float
-    freq_hz: records.Statistic
-    freq_std_hz: records.Statistic
-    n_samples: records.Count
-    start_s: float
-    end_s: float
-    slope_hz_per_h: records.Statistic
-    settled: bool
-    settled_freq_hz: records.Statistic
-    settled_freq_std_hz: records.Statistic
-    method: str
-    residual_unsettled_c: records.Statistic
-    hz_per_c: records.Statistic
-    segment_start_s: float
-    fit: TransientFitRecord | None = None
-    source: str | None = None
 
 
 # -- block means, chamber segments and slopes -----------------------------------------

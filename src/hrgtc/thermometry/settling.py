@@ -26,7 +26,6 @@ of a 2.5 h soak then misses f_inf by ~0.1 °C.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -45,7 +44,7 @@ _RATIO_BOUNDS = (1e-2, 0.9)  # tau2 / tau1
 
 
 @dataclass(frozen=True)
-class TransientFit:
+class TransientFit(records.Written):
     """Settling curve ``f = f_inf + sum_k q_k u^k``, ``u = sum_j w_j exp(-(t - start_s)/tau_j)``.
 
     Attributes
@@ -73,16 +72,16 @@ class TransientFit:
     """
 
     model: str
-    f_inf_hz: float
-    f_inf_std_hz: float
-    tau_s: tuple[float, ...]
-    weights: tuple[float, ...]
-    poly_hz: tuple[float, ...]
+    f_inf_hz: records.Statistic
+    f_inf_std_hz: records.Statistic
+    tau_s: tuple[records.Statistic, ...]
+    weights: tuple[records.Statistic, ...]
+    poly_hz: tuple[records.Statistic, ...]
     start_s: float
     end_s: float
-    n_blocks: int
-    rms_hz: float
-    aic: float
+    n_blocks: records.Count
+    rms_hz: records.Statistic
+    aic: records.Statistic
     usable: bool
     reason: str = ""
 
@@ -126,35 +125,6 @@ class TransientFit:
                                   "f_inf {f_inf_hz:.5f} ± {f_inf_std_hz:.2g} Hz, "
                                   f"tau {escape(taus)} s, rms {{rms_hz:.2g}} Hz "
                                   f"({escape(state)})",))
-
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types, as :class:`TransientFitRecord` writes them (NaN -> None)."""
-        return records.dump(self, TransientFitRecord)
-
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> TransientFit:
-        """Inverse of :meth:`to_dict` (checked against :class:`TransientFitRecord`)."""
-        return cls(**records.load(data, TransientFitRecord, "transient-fit"))
-
-
-class TransientFitRecord(records.Record, kw_only=True):
-    """A :class:`TransientFit` in a file (each plateau of a model file's ``plateaus``):
-    field names and bounds, from which its ``to_dict``/``from_dict`` and JSON Schema come.
-    Its numbers are statistics of a fit (``null`` when not finite: an unusable fit)."""
-
-    model: str
-    f_inf_hz: records.Statistic
-    f_inf_std_hz: records.Statistic
-    tau_s: tuple[records.Statistic, ...]
-    weights: tuple[records.Statistic, ...]
-    poly_hz: tuple[records.Statistic, ...]
-    start_s: float
-    end_s: float
-    n_blocks: records.Count
-    rms_hz: records.Statistic
-    aic: records.Statistic
-    usable: bool
-    reason: str = ""
 
 
 def _basis(tt: np.ndarray, params: np.ndarray, exps: int) -> tuple[np.ndarray, np.ndarray]:
