@@ -130,9 +130,8 @@ def _small() -> dict[str, Any]:
     tau = np.arange(0.0, 20000.0, 10.0)
     return {
         "StepwiseResult": hald, "OLSResult": hald.result,
-        "CrossValidation": CrossValidation(("f", "df"), ("cool", "warm"),
-                                           {"cool": 0.0123, "warm": 0.0456}, 0.02, 0.03,
-                                           0.0333),
+        "CrossValidation": CrossValidation(("f", "df"), {"cool": 0.0123, "warm": 0.0456}, 0.02,
+                                           0.03, 0.0333, sources=("cool", "warm")),
         "ResidualResult": residual, "SlowChannels": slow, "RobustSpikeFilter": spikes,
         "TemperatureMap": TemperatureMap(0.005, 24.0, 16, 120.0, 0.2, 0.4, 25,
                                          (-2400.0, -300.0), "log.csv"),

@@ -41,7 +41,7 @@ def test_the_counter_counts(tmp_path):
         "class Acc:\n    def partial_fit(self, chunk):\n        return self\n\n\n"
         "class R:\n    def to_dict(self):\n        return records.dump(self, RRecord)\n\n"
         "    def from_dict(cls, data):\n        return cls(**records.load(data, RRecord))\n\n"
-        "    def summary(self):\n        return records.dump(self, RRecord, x=1)\n",
+        "    def summary(self) -> str:\n        return records.dump(self, RRecord, x=1)\n",
         encoding="utf-8")
     found = architecture_counts.counts(package)
     assert (found["long_functions"], found["many_parameters"],

@@ -38,7 +38,9 @@ SCHEMAS = {
     "fleet_row": row_json_schema,
 }
 PINNED = {
-    "model": "d0c6e4ec60eec1b53fb0e9142babb6ba28766cdb6ddc6a3612c363c491dc0858",
+    # model: + the optional settings gradient_saturation_c and play_width_c of the history
+    # variables gsat and play (docs/history.md; written only by a model that uses them)
+    "model": "34703cb6dae23cb34419db6c7d4c688640f5d5dcf26642b5ff145bbd6246da3f",
     "calibrate": "3feb7ee4e3340125520d501187eb664dde638b270a4dd9000fff8bdb33f09204",
     "evaluate": "c9c03afd3898465a481e56641354e86ba22feaf297a02471b1fba15aaa65c9c5",
     "evaluation": "8fba06d9309193c8af030c809a9c2a9999b7e8b5de117708bd08fdd25f789419",

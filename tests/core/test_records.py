@@ -148,7 +148,7 @@ def _pairs():
     from hrgtc.drift.scale_factor import ScaleFactorRecord, ScaleGroup
     from hrgtc.drift.stepwise import Step, StepwiseResult
     from hrgtc.drift.training import TrainingStatistics
-    from hrgtc.model import Model
+    from hrgtc.model import AxisModel
     from hrgtc.model_schema import AxisRecord
 
     # (result, record, the result's fields a file does not hold)
@@ -162,7 +162,7 @@ def _pairs():
             (StepwiseResult, StepwiseResult, set()),
             (OLSResult, OLSResult, set()),
             (CrossValidation, CrossValidation, {"sources"}),  # the keys of per_run_dph
-            (Model, AxisRecord, {"unit", "provenance"})]  # the file's, not the axis's
+            (AxisModel, AxisRecord, set())]  # one axis's parts (unit, provenance: the file's)
 
 
 @pytest.mark.parametrize("result, record, left_out", _pairs(),

@@ -248,9 +248,9 @@ class RecordingInfo:
         """The summary's table of the columns (unit, range, steps) and its lines."""
         lines = ["  columns:"]
         columns: list[Figure] = []
-        for col in self.columns:
+        for k, col in enumerate(self.columns):
             unit = f"[{col.unit}]" if col.unit else "[?]"
-            key = f"columns.{col.name}"
+            key = f"columns[{k}]"  # by place: a file's column name may hold ':' or braces
             columns += [Figure(f"{key}.name", f"{col.name}", col.name, row=col.name,
                                column="column"),
                         Figure(f"{key}.unit", f"{col.name} unit", col.unit or "?", row=col.name,

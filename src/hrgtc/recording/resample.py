@@ -219,9 +219,12 @@ class SlowChannels:
         where = escape(f"{self.source}: ") if self.source else ""
         how = "held (last value)" if self.mode == "hold" else "interpolated linearly in time"
         sections, lines = [], []
-        for s in self._reported():
-            key = f"channels.{s.column}"
-            figures = [Figure(f"{key}.period_s", "logged every", s.period_s, "s",
+        for k, s in enumerate(self._reported()):
+            # by place, not by name: a column's name may hold ':' or braces (a TDMS channel
+            # named by its clock time), which a layout field cannot
+            key = f"channels[{k}]"
+            figures = [Figure(f"{key}.column", "column", s.column),
+                       Figure(f"{key}.period_s", "logged every", s.period_s, "s",
                               definition="Median time between the channel's values."),
                        Figure(f"{key}.max_age_s", "used for up to", s.max_age_s, "s",
                               definition=f"Longest time a value is {how} (--hold-max-s)."),
