@@ -103,7 +103,8 @@ def test_the_texts_name_figures_that_could_be_wrong(results):
     prior = results["ThermometerPrior"].summary()
     assert prior.text().startswith("prior of 8 units") and prior["n_units"].value == 8
     slow = results["SlowChannels"].summary()
-    assert slow["channels.housing_c.filled"].value == 900
+    assert slow["channels[0].column"].value == "housing_c"
+    assert slow["channels[0].filled"].value == 900
     assert "900 cells filled" in slow.text()
     spikes = results["RobustSpikeFilter"].summary()
     assert "row 700" in spikes.text() and spikes["first.row"].value == 700
