@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import inspect
 import math
 import operator
 import re
@@ -437,8 +438,18 @@ def schema_components(records: list[type[Any]]) -> tuple[list[dict[str, Any]],
                                                          dict[str, Any]]:
     """The JSON Schemas of ``records`` (or results: their records) and their shared
     definitions (``#/$defs/NAME``)."""
-    return msgspec.json.schema_components([record_of(r) for r in records],
-                                          ref_template="#/$defs/{name}")
+    references, definitions = msgspec.json.schema_components(
+        [record_of(r) for r in records], ref_template="#/$defs/{name}")
+    return references, {name: _cleaned(d) for name, d in definitions.items()}
+
+
+def _cleaned(definition: dict[str, Any]) -> dict[str, Any]:
+    """``definition`` with its description dedented as :func:`inspect.cleandoc` does: msgspec
+    0.23 dedents a docstring, 0.22 kept its indent; the published schema is the same for
+    both."""
+    if "description" not in definition:
+        return definition
+    return {**definition, "description": inspect.cleandoc(definition["description"])}
 
 
 def json_schema(record: type[Any], title: str, schema_id: str) -> dict[str, Any]:
