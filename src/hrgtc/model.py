@@ -49,9 +49,10 @@ from hrgtc.model_schema import (
     strict,
 )
 from hrgtc.thermometry import Thermometer
+from hrgtc.update import Lineage, UpdateResult, UpdateSettings, update_model
 
 __all__ = ["SCHEMA_NAME", "SCHEMA_VERSION", "AxisModel", "Model", "axis_suffix",
-           "load_model", "model_sha256", "provenance", "save_model"]
+           "load_model", "model_sha256", "model_text", "provenance", "save_model"]
 
 #: Schema version of files with one axis and no scale factor (unchanged since version 2).
 _PLAIN_VERSION = 2
@@ -154,12 +155,17 @@ class Model:
         The count -> °C map of a raw temperature sensor fitted to a reference log
         (``calibrate --temp-ref``, :class:`hrgtc.thermometry.reference.TemperatureMap`
         as a dict), applied to the raw count at compensation; None without one.
+    lineage
+        An in-field update's parent, data and changes
+        (:class:`~hrgtc.update.lineage.Lineage`, :meth:`update`); None for a calibrated
+        model.
     """
 
     axes: dict[str, AxisModel]
     unit: str = "unknown"
     provenance: dict[str, Any] = field(default_factory=dict)
     temperature_map: dict[str, Any] | None = None
+    lineage: Lineage | None = None
 
     def __post_init__(self) -> None:
         if not self.axes:
@@ -265,20 +271,38 @@ class Model:
             raise ModelFileError(f"{source}: model file is missing {exc}; it is corrupt") from exc
         except HrgtcError as exc:
             raise ModelFileError(f"{source}: model file is corrupt: {exc}") from exc
-        return cls(axes, head["unit"], dict(head["provenance"]), temperature_map)
+        return cls(axes, head["unit"], dict(head["provenance"]), temperature_map,
+                   head.get("lineage"))
 
     @property
     def sha256(self) -> str:
         """SHA-256 of the parameters as canonical JSON (see :func:`model_sha256`)."""
         return model_sha256(self)
 
+    def update(self, recordings: Any, settings: UpdateSettings | None = None, *,
+               still_s: Any = None, parent: str | os.PathLike[str] | None = None,
+               read_options: Any = None) -> UpdateResult:
+        """An in-field update from the still periods of new recordings (issue 29):
+        :func:`hrgtc.update.update_model` with this model as the prior.
+
+        ``parent``: the file this model was read from (its bytes go into the lineage, so
+        that a rollback restores it byte for byte); None: the bytes :func:`save_model`
+        writes of this model. The result's ``model`` is the updated model (None when the
+        recordings changed nothing); refusals raise
+        :class:`~hrgtc.update.UpdateRefused`. See docs/guide/update.md.
+        """
+        content = (Path(parent).read_bytes() if parent is not None
+                   else model_text(self).encode("utf-8"))
+        return update_model(self, recordings, settings, still_s=still_s, parent_bytes=content,
+                            parent_path=str(parent or "<model>"), read_options=read_options)
+
 
 def _head(model: Model, version: int, single: bool = False) -> dict[str, Any]:
     """The file's own fields (:class:`~hrgtc.model_schema.FileRecord`) of ``model``: a
     single-axis file has no ``axes`` (its parts sit at the top level); an instrument's
     axes are dumped by their record (:class:`~hrgtc.model_schema.AxisRecord`)."""
-    source: Any = SimpleNamespace(unit=model.unit, provenance=model.provenance) if single \
-        else model
+    source: Any = SimpleNamespace(unit=model.unit, provenance=model.provenance,
+                                  lineage=model.lineage) if single else model
     return records.dump(source, FileRecord, schema=SCHEMA_NAME, schema_version=version,
                         temperature_map=None)
 
@@ -288,7 +312,8 @@ def _read_head(checked: Mapping[str, Any], source: str) -> dict[str, Any]:
     axis's parts are read by the records of the parts, :meth:`AxisModel.from_parts`)."""
     try:
         return records.load({k: checked[k] for k in ("schema", "schema_version", "unit",
-                                                     "provenance") if k in checked},
+                                                     "provenance", "lineage")
+                                if k in checked},
                             FileRecord, "model file")
     except HrgtcError as exc:
         raise ModelFileError(f"{source}: {exc}") from None
@@ -356,11 +381,19 @@ def save_model(model: Model, path: str | os.PathLike[str], force: bool = False) 
 
 
 def _save_document(document: dict[str, Any], path: str | os.PathLike[str], force: bool) -> Path:
+    return write_text_atomic(path, _document_text(document, str(path)), force=force)
+
+
+def _document_text(document: dict[str, Any], source: str) -> str:
     document = strict(document)
     document["parameters_sha256"] = parameters_sha256(document)
-    check_document(document, str(path))
-    text = json.dumps(document, indent=2, allow_nan=False)
-    return write_text_atomic(path, text + "\n", force=force)
+    check_document(document, source)
+    return json.dumps(document, indent=2, allow_nan=False) + "\n"
+
+
+def model_text(model: Model) -> str:
+    """The text :func:`save_model` writes of ``model`` (checked as on loading)."""
+    return _document_text(model.to_dict(), "model")
 
 
 def load_model(path: str | os.PathLike[str]) -> Model:

@@ -57,6 +57,7 @@ from hrgtc.drift.scale_factor import ScaleFactorRecord
 from hrgtc.drift.training import TrainingStatisticsRecord
 from hrgtc.thermometry.reference import TemperatureMapRecord
 from hrgtc.thermometry.thermometer import ThermometerRecord
+from hrgtc.update.lineage import LineageRecord
 
 SCHEMA_NAME = "hrgtc.model"
 #: 2: strict JSON (statistics that are not finite are written ``null``).
@@ -97,7 +98,7 @@ class FileRecord(records.Record, kw_only=True):
     """
 
     # absent unless used: a single-axis file, a file before it is hashed, no map
-    omit_when_default = ("axes", "parameters_sha256", "temperature_map")
+    omit_when_default = ("axes", "parameters_sha256", "temperature_map", "lineage")
 
     schema: Literal["hrgtc.model"]
     schema_version: Annotated[int, Meta(ge=1, le=SCHEMA_VERSION)]
@@ -108,6 +109,8 @@ class FileRecord(records.Record, kw_only=True):
     parameters_sha256: Annotated[str, Meta(pattern="^[0-9a-f]{64}$")] = ""
     #: Optional: a raw temperature count's map to °C (calibrate --temp-ref).
     temperature_map: TemperatureMapRecord | None = None
+    #: Optional: an in-field update's parent, data and changes (``hrgtc update``).
+    lineage: LineageRecord | None = None
 
 
 def file_document(head: Mapping[str, Any], parts: Mapping[str, Any] | None = None,

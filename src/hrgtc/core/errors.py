@@ -61,6 +61,11 @@ class ModelFileError(HrgtcError):
     """A model file that is unreadable, corrupt, foreign or of a newer schema."""
 
 
+class UpdateRefusedError(InputError):
+    """An in-field update of a model that must not be applied (another unit's file, a jump,
+    a ramp, no held-out gain, a step too far from the prior); the message says which."""
+
+
 class OutputExistsError(HrgtcError, FileExistsError):
     """An output file exists and overwriting it was not allowed (pass force=True / --force)."""
 

@@ -1,0 +1,340 @@
+"""An in-field update of a fitted model from the still periods of new recordings (issue 29).
+
+:func:`update_model` (what :meth:`hrgtc.model.Model.update` calls) reads the recordings,
+refuses another unit's file and an output compensated by another model, finds the still
+periods (the motion detector, or given intervals), cuts them into blocks
+(:mod:`hrgtc.update.observations`) and runs the Kalman filter (:mod:`hrgtc.update.kalman`)
+on the drift model's offset B0 (only with a known input rate) and slope (the term ``f``,
+only over ``min_span_c``), the calibration's coefficient covariance
+(:meth:`hrgtc.drift.DriftModel.coefficient_prior`) plus an ageing allowance as the prior.
+
+It never applies an update that is refused (:class:`~hrgtc.core.errors.UpdateRefusedError`,
+naming the file and the reason): thermally unsettled still data (a ramp posing as
+ageing), a step within a run (a jump), a step further from the prior than
+``max_step_sigma``, no gain on the recording's own held-out still blocks. A recording
+without still periods, or with nothing observable, changes nothing and says so.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+from collections.abc import Sequence
+from dataclasses import replace
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from hrgtc.core.errors import InputError, UpdateRefusedError
+from hrgtc.recording import Recording
+from hrgtc.settings import to_dict
+from hrgtc.settings.update import EARTH_RATE_BOUND_DPH, UpdateSettings
+from hrgtc.update.kalman import (
+    bootstrap_rms,
+    heldout_rms,
+    jump_statistic,
+    mahalanobis,
+    run_filter,
+    split_heldout,
+)
+from hrgtc.update.lineage import AxisChange, Lineage, LineageData, pack
+from hrgtc.update.observations import (
+    StillBlock,
+    block_noise_dph,
+    describe_blocks,
+    index_periods,
+    still_blocks,
+)
+from hrgtc.update.result import AxisUpdate, FilterProblem, UpdateResult
+
+__all__ = ["update_model"]
+
+
+def update_model(model: Any, recordings: Any, settings: UpdateSettings | None = None, *,
+                 still_s: Sequence[tuple[float, float]] | None = None,
+                 parent_bytes: bytes, parent_path: str = "<model>",
+                 read_options: Any = None) -> UpdateResult:
+    """Update ``model`` (a single-axis :class:`hrgtc.model.Model`) from ``recordings``.
+
+    Parameters
+    ----------
+    model
+        The parent model (its drift model's coefficients and covariance are the prior).
+    recordings
+        A recording file, a :class:`~hrgtc.recording.Recording`, or a sequence of them
+        (each its own run: its own turn-on shift).
+    settings
+        :class:`~hrgtc.settings.update.UpdateSettings` (its defaults when None).
+    still_s
+        Still intervals ``(start, end)`` in each recording's time, instead of the motion
+        detector's still periods. [s]
+    parent_bytes, parent_path
+        The parent file's bytes and name, kept in the lineage for a rollback.
+    read_options
+        How to read the files (:class:`~hrgtc.recording.ReadOptions`).
+
+    Raises
+    ------
+    UpdateRefusedError
+        Another unit's file, a ramp, a jump, a step too far, no held-out gain.
+    """
+    settings = settings or UpdateSettings()
+    if not model.is_single_axis:
+        raise InputError(f"the model of {model.unit!r} has axes {', '.join(model.names)}: an "
+                         "in-field update of a multi-axis model is not available yet; "
+                         "update a single-axis model")
+    runs = [_read(item, read_options, model) for item in _items(recordings)]
+    part = model.axis
+    blocks: list[StillBlock] = []
+    data = []
+    for index, (label, digest, recording) in enumerate(runs):
+        found, intervals, source = _run_blocks(index, recording, part, settings, still_s, label)
+        blocks += found
+        data.append(LineageData(label, digest, intervals, source))
+    labels = [label for label, _, _ in runs]
+    if not any(d.intervals_s for d in data):
+        return UpdateResult(None, False, f"{', '.join(labels)}: no still period (the unit "
+                            "moved throughout): nothing changed")
+    settled = [b for b in blocks
+               if abs(b.temperature_rate_c_per_h) <= settings.max_temperature_rate_c_per_h]
+    if len(settled) < min(len(blocks), 2 * settings.holdout_every):
+        fastest = describe_blocks(blocks)["max_rate_c_per_h"]
+        raise UpdateRefusedError(
+            f"{', '.join(labels)}: {len(blocks) - len(settled)} of {len(blocks)} still blocks "
+            f"are on a temperature ramp (up to {fastest:.3g} °C/h, limit "
+            f"{settings.max_temperature_rate_c_per_h:g} °C/h) and too few are settled: their "
+            "residual is the model's thermal transient, not ageing (a ramp posing as "
+            "ageing); update from still periods at a settled temperature")
+    if not settled:
+        return UpdateResult(None, False, f"{', '.join(labels)}: every still period is shorter "
+                            f"than a block ({settings.block_s:g} s): nothing changed")
+    terms, notes = _observable(part, settled, settings)
+    if not terms:
+        return UpdateResult(None, False, f"{', '.join(labels)}: nothing observable ("
+                            f"{'; '.join(notes)}): nothing changed", notes=tuple(notes))
+    axis = _filter_axis(model, part, settled, terms, settings, labels)
+    drift = _updated_drift(part.drift, terms, axis.after)
+    lineage = Lineage(
+        parent_sha256=hashlib.sha256(parent_bytes).hexdigest(),
+        parent_parameters_sha256=model.sha256, parent_path=parent_path,
+        parent_unit=model.unit, parent_content=pack(parent_bytes), data=tuple(data),
+        changes=(AxisChange("", terms, axis.before, axis.after,
+                            _matrix(axis.covariance_before), _matrix(axis.covariance_after)),),
+        settings=to_dict(settings), mahalanobis=axis.mahalanobis,
+        heldout_rms_before_dph=axis.heldout_before_dph,
+        heldout_rms_after_dph=axis.heldout_after_dph, hrgtc_version=_version(),
+        created_utc=datetime.now(UTC).isoformat(timespec="seconds"))
+    updated = replace(model, axes={"": replace(part, drift=drift)}, lineage=lineage)
+    return UpdateResult(updated, True, "", {"": axis}, lineage, tuple(notes))
+
+
+def _items(recordings: Any) -> list[Any]:
+    if isinstance(recordings, str | Path | Recording):
+        return [recordings]
+    items = list(recordings)
+    if not items:
+        raise InputError("no recording given: pass a field recording with still periods")
+    return items
+
+
+def _read(item: Any, read_options: Any, model: Any) -> tuple[str, str, Recording]:
+    """(name, SHA-256, recording) of a file or an in-memory recording, its unit checked."""
+    from hrgtc.core.files import file_sha256
+    from hrgtc.recording import read
+    from hrgtc.recording.marks import compensation_mark
+
+    if isinstance(item, Recording):
+        label, recording = "<recording>", item
+        digest = hashlib.sha256(np.ascontiguousarray(item.time_s).tobytes()
+                                + np.ascontiguousarray(item.rate_dph).tobytes()).hexdigest()
+    else:
+        label = str(item)
+        recording = read(item, read_options)
+        digest = file_sha256(item)
+    unit = recording.metadata.unit
+    if unit not in ("", "unknown", None) and model.unit not in ("", "unknown") \
+            and unit != model.unit:
+        raise UpdateRefusedError(
+            f"{label}: recorded by unit {unit!r}, but the model is of {model.unit!r}: "
+            "another unit's file is refused (an update applies to the unit it was "
+            "calibrated for)")
+    found = compensation_mark(recording.metadata.extra, recording.names)
+    if found is not None and found.get("model_sha256") not in (None, model.sha256):
+        raise UpdateRefusedError(
+            f"{label}: compensated with another model (parameters_sha256 "
+            f"{found.get('model_sha256')}, unit {found.get('model_unit')!r}), not the parent "
+            f"{model.sha256}: parent model hash mismatch; update from the raw recording")
+    return label, digest, recording
+
+
+def _run_blocks(index: int, recording: Recording, part: Any, settings: UpdateSettings,
+                still_s: Sequence[tuple[float, float]] | None, label: str
+                ) -> tuple[list[StillBlock], tuple[tuple[float, float], ...], str]:
+    """The still blocks of one recording, its still intervals [s] and where they came from."""
+    from hrgtc.recording.motion import recording_motion
+
+    time_s = np.asarray(recording.time_s, dtype=np.float64)
+    if still_s:
+        periods, source = index_periods(time_s, still_s, label), "given"
+    else:
+        mask = recording_motion(recording)
+        periods = mask.still_periods(settings.block_s, time_s)
+        source = "motion"
+    intervals = tuple((float(time_s[a]), float(time_s[b - 1])) for a, b in periods)
+    if not periods:
+        return [], intervals, source
+    drift, thermometer = part.drift, part.thermometer
+    bias = drift.predict_recording(recording, thermometer)
+    rate = recording.rate_dph - (settings.input_rate_dph or 0.0)
+    f = recording.freq_hz - drift.settings.reference_freq_hz
+    temperature = thermometer.temperature(recording.freq_hz, warn=False)
+    return (still_blocks(index, time_s, rate, bias, f, temperature, periods, settings),
+            intervals, source)
+
+
+def _observable(part: Any, blocks: list[StillBlock],
+                settings: UpdateSettings) -> tuple[tuple[str, ...], list[str]]:
+    """The terms the blocks can update, and what the reader should know of the others."""
+    terms, notes = [], []
+    if settings.input_rate_dph is not None:
+        terms.append("const")
+    else:
+        notes.append("offset B0 not updated: the input rate is unknown (a still mean is "
+                     "bias + Earth-rate projection + turn-on shift); give input_rate_dph")
+    span = describe_blocks(blocks)["span_c"]
+    if "f" not in part.drift.selected:
+        notes.append("slope not updated: the model has no term f")
+    elif span < settings.min_span_c:
+        notes.append(f"slope not updated: the still blocks span {span:.3g} °C, less than "
+                     f"min_span_c {settings.min_span_c:g} °C")
+    else:
+        terms.append("f")
+    return tuple(terms), notes
+
+
+def _prior(model: Any, part: Any, terms: tuple[str, ...],
+           settings: UpdateSettings) -> tuple[np.ndarray, np.ndarray]:
+    """The updated terms' values and covariance before the update: the calibration's (or the
+    last update's posterior) plus the ageing allowance."""
+    drift = part.drift
+    names, _, covariance = drift.coefficient_prior()
+    index = [names.index(t) for t in terms]
+    prior = covariance[np.ix_(index, index)]
+    kept = [c for c in (model.lineage.changes if model.lineage else ()) if c.terms == terms]
+    if kept:
+        prior = np.array(kept[0].covariance_after, dtype=np.float64)
+    values = np.array([drift.intercept_dph if t == "const" else drift.coefficients[t]
+                       for t in terms])
+    slope_hz_per_c = abs(float(np.asarray(part.thermometer.slope_hz_per_c(
+        drift.settings.reference_c))))
+    ageing = {"const": settings.ageing_offset_dph ** 2,
+              "f": (settings.ageing_slope_dph_per_c / slope_hz_per_c) ** 2}
+    return values, prior + np.diag([ageing[t] for t in terms])
+
+
+def _filter_axis(model: Any, part: Any, blocks: list[StillBlock], terms: tuple[str, ...],
+                 settings: UpdateSettings, labels: list[str]) -> AxisUpdate:
+    """The filter over the blocks, its guards, and the axis's figures."""
+    values, prior = _prior(model, part, terms, settings)
+    problem = _problem(part, blocks, terms, prior, settings)
+    n_model, runs = problem.n_model, np.array([b.run for b in blocks])
+    fit, held = split_heldout(len(blocks), settings.holdout_every)
+    if held.size < 2 or fit.size < 2:
+        raise UpdateRefusedError(
+            f"{', '.join(labels)}: {len(blocks)} still block(s) of {settings.block_s:g} s are "
+            "too few to judge an update on held-out blocks (at least "
+            f"{2 * settings.holdout_every}); record longer still periods")
+    whole = _solve(problem, slice(None))
+    sigma = math.sqrt(float(np.median(problem.r)))
+    jump, where = jump_statistic(problem.z - problem.rows @ whole.mean, runs, sigma)
+    if jump > settings.jump_sigma:
+        block = blocks[where]
+        raise UpdateRefusedError(
+            f"{labels[block.run]}: the still residual steps by {jump:.3g} standard errors "
+            f"within the run near t = {block.start_s:g} s (limit {settings.jump_sigma:g}): a "
+            "jump is not ageing; update from a recording without it")
+    step = mahalanobis(whole.mean[:n_model], prior)
+    if step > settings.max_step_sigma:
+        raise UpdateRefusedError(
+            f"{', '.join(labels)}: the update would move {', '.join(terms)} by {step:.3g} σ "
+            f"of the prior (limit max_step_sigma {settings.max_step_sigma:g}): further than "
+            "ageing goes; check the unit and the input rate, or recalibrate")
+    trained = _solve(problem, fit)
+    centred = "const" not in terms
+    before = problem.z[held]
+    after = before - problem.rows[held, :n_model] @ trained.mean[:n_model]
+    rms_before = heldout_rms(before, runs[held], centred)
+    rms_after = heldout_rms(after, runs[held], centred)
+    if not rms_after < rms_before:
+        raise UpdateRefusedError(
+            f"{', '.join(labels)}: no gain on the held-out still blocks (rms {rms_before:.4g} "
+            f"°/h before, {rms_after:.4g} °/h after): the update is not applied")
+    return AxisUpdate(
+        terms, tuple(float(v) for v in values), tuple(float(v) for v in values
+                                                      + whole.mean[:n_model]),
+        prior, whole.covariance[:n_model, :n_model], len(blocks), int(fit.size),
+        int(held.size), rms_before, rms_after, bootstrap_rms(before, runs[held], centred),
+        bootstrap_rms(after, runs[held], centred), step, jump,
+        describe_blocks(blocks)["span_c"], sigma, problem, whole.traces)
+
+
+def _problem(part: Any, blocks: list[StillBlock], terms: tuple[str, ...], prior: np.ndarray,
+             settings: UpdateSettings) -> FilterProblem:
+    """The filter's prior, rows, residuals, variances and times of ``blocks``."""
+    n_model, n_runs = len(terms), max(b.run for b in blocks) + 1
+    drift = part.drift
+    fallback = drift.residual_std_dph * math.sqrt(drift.window_s / settings.block_s)
+    noise = block_noise_dph(blocks, fallback if math.isfinite(fallback) else 0.0)
+    nuisance = settings.turn_on_dph ** 2
+    if "const" not in terms:  # the constant holds the Earth rate and the offset's change
+        nuisance += EARTH_RATE_BOUND_DPH ** 2 + settings.ageing_offset_dph ** 2
+    covariance = np.zeros((n_model + n_runs, n_model + n_runs))
+    covariance[:n_model, :n_model] = prior
+    covariance[n_model:, n_model:] = np.eye(n_runs) * nuisance
+    rows = np.zeros((len(blocks), n_model + n_runs))
+    for k, block in enumerate(blocks):
+        rows[k, :n_model] = [1.0 if t == "const" else block.f for t in terms]
+        rows[k, n_model + block.run] = 1.0
+    ends = np.zeros(n_runs)
+    for block in blocks:  # each run's times after the runs before it
+        ends[block.run] = max(ends[block.run], block.time_h)
+    starts = np.concatenate([[0.0], np.cumsum(ends)[:-1]])
+    return FilterProblem(
+        np.zeros(n_model + n_runs), covariance, rows,
+        np.array([b.residual_dph for b in blocks]),
+        np.array([max(noise, b.white_sigma_dph) ** 2 for b in blocks]),
+        np.array([starts[b.run] + b.time_h for b in blocks]), n_model, settings.ageing_tau_h)
+
+
+def _solve(problem: FilterProblem, which: Any) -> Any:
+    return run_filter(problem.mean, problem.covariance, problem.rows[which], problem.z[which],
+                      problem.r[which], problem.times_h[which], problem.n_model, problem.tau_h)
+
+
+def _updated_drift(drift: Any, terms: tuple[str, ...], after: tuple[float, ...]) -> Any:
+    """``drift`` with the updated intercept and slope (the scaled coefficient the model
+    predicts with, and the user-unit one derived from it)."""
+    values = dict(zip(terms, after, strict=True))
+    intercept = values.get("const", drift.intercept_dph)
+    scaled = list(drift.scaled_coefficients)
+    coefficients = dict(drift.coefficients)
+    if "f" in values:
+        term = drift.selected.index("f")
+        factor = drift.terms[term].scale_factor(drift.settings.scales)
+        scaled[term] = values["f"] * factor
+        coefficients["f"] = scaled[term] / factor
+    return replace(drift, intercept_dph=float(intercept), scaled_coefficients=tuple(scaled),
+                   coefficients=coefficients)
+
+
+def _matrix(covariance: np.ndarray) -> tuple[tuple[float, ...], ...]:
+    return tuple(tuple(float(v) for v in row) for row in np.asarray(covariance))
+
+
+def _version() -> str:
+    from hrgtc.core.meta import __version__
+
+    return __version__
+

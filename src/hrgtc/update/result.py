@@ -1,0 +1,158 @@
+"""What an in-field update gives: the updated model, each axis's figures, the lineage."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from hrgtc.core.summary import Figure, Summary
+from hrgtc.update.lineage import Lineage
+
+__all__ = ["AxisUpdate", "FilterProblem", "UpdateResult"]
+
+#: Units of the updated terms in the summary (f is a frequency, or a temperature for a
+#: gyro whose thermometer is its temperature sensor).
+_TERM_UNITS = {"const": "°/h", "f": "°/h per unit of f"}
+
+
+@dataclass(frozen=True)
+class FilterProblem:
+    """The filter's inputs, kept so that a second method can be held to it: the prior
+    (``mean``, ``covariance``; the first ``n_model`` states are the model's corrections),
+    one measurement row per still block (``rows``), the blocks' residuals ``z`` [°/h],
+    their variances ``r`` [(°/h)²] and times [h]."""
+
+    mean: np.ndarray
+    covariance: np.ndarray
+    rows: np.ndarray
+    z: np.ndarray
+    r: np.ndarray
+    times_h: np.ndarray
+    n_model: int
+    tau_h: float
+
+
+@dataclass(frozen=True)
+class AxisUpdate:
+    """One axis's update.
+
+    Attributes
+    ----------
+    terms
+        The updated coefficients: ``"const"`` (B0) and/or ``"f"`` (the slope).
+    before, after
+        Their values before and after. [°/h, °/h per unit of f]
+    covariance_before, covariance_after
+        Their covariance: the prior (the calibration's, plus the ageing allowance) and
+        the filter's posterior.
+    n_blocks, n_fit, n_heldout
+        Still blocks used, fitted on, held out.
+    heldout_before_dph, heldout_after_dph
+        Rms of the held-out blocks' residuals with the parent model and with the update
+        fitted on the other blocks (each run's mean removed when the offset is not
+        updated). [°/h]
+    heldout_before_interval, heldout_after_interval
+        Their 95 % bootstrap intervals (over the held-out blocks). [°/h]
+    mahalanobis
+        Length of the step from the prior in the prior's metric.
+    jump_sigma
+        Largest step of the residuals within a run, in standard errors.
+    span_c
+        Temperature span of the still blocks. [°C]
+    block_noise_dph
+        1σ of one block's mean (from the data). [°/h]
+    problem
+        The filter's inputs (:class:`FilterProblem`).
+    traces
+        Trace of the corrections' covariance after each block.
+    """
+
+    terms: tuple[str, ...]
+    before: tuple[float, ...]
+    after: tuple[float, ...]
+    covariance_before: np.ndarray
+    covariance_after: np.ndarray
+    n_blocks: int
+    n_fit: int
+    n_heldout: int
+    heldout_before_dph: float
+    heldout_after_dph: float
+    heldout_before_interval: tuple[float, float]
+    heldout_after_interval: tuple[float, float]
+    mahalanobis: float
+    jump_sigma: float
+    span_c: float
+    block_noise_dph: float
+    problem: FilterProblem
+    traces: np.ndarray
+
+
+@dataclass(frozen=True)
+class UpdateResult:
+    """An in-field update (:func:`hrgtc.update.update_model`, :meth:`hrgtc.model.Model.update`).
+
+    Attributes
+    ----------
+    model
+        The updated model (its ``lineage`` set), or None when nothing changed.
+    applied
+        Whether the recordings changed the model.
+    reason
+        Why nothing changed (no still period, nothing observable), empty when applied.
+    axes
+        Axis name -> :class:`AxisUpdate` (``""`` for a single-axis model).
+    lineage
+        The lineage written into the updated model (None when nothing changed).
+    notes
+        What the reader should know (what was not updated and why).
+    """
+
+    model: Any
+    applied: bool
+    reason: str = ""
+    axes: dict[str, AxisUpdate] = field(default_factory=dict)
+    lineage: Lineage | None = None
+    notes: tuple[str, ...] = ()
+
+    def summary(self) -> Summary:
+        """The updated coefficients with ±1σ (before and after), the held-out still residual
+        before and after with its 95 % bootstrap interval, the step and jump statistics."""
+        sections = []
+        for axis, part in self.axes.items():
+            prefix = f"axes.{axis}." if axis else ""
+            where = f" ({axis})" if axis else ""
+            figures = []
+            for k, term in enumerate(part.terms):
+                unit = _TERM_UNITS.get(term, "")
+                figures.append(Figure.with_error(
+                    f"{prefix}before.{term}", f"{term} before", part.before[k],
+                    math.sqrt(part.covariance_before[k, k]), unit,
+                    definition="The parent's coefficient, ±1σ of the prior (calibration "
+                    "covariance plus the ageing allowance)."))
+                figures.append(Figure.with_error(
+                    f"{prefix}after.{term}", f"{term} after", part.after[k],
+                    math.sqrt(part.covariance_after[k, k]), unit,
+                    definition="The updated coefficient, ±1σ of the filter's posterior."))
+            sections.append((f"updated coefficients{where}", tuple(figures)))
+            sections.append((f"held-out still residual{where}", (
+                Figure(f"{prefix}heldout_before_dph", "rms before", part.heldout_before_dph,
+                       "°/h", part.heldout_before_interval, "95 % bootstrap", 4,
+                       definition="Rms of the held-out still blocks' residuals with the "
+                       "parent model."),
+                Figure(f"{prefix}heldout_after_dph", "rms after", part.heldout_after_dph,
+                       "°/h", part.heldout_after_interval, "95 % bootstrap", 4,
+                       definition="The same with the update fitted on the other blocks."),
+                Figure(f"{prefix}n_heldout", "held-out blocks", part.n_heldout),
+                Figure(f"{prefix}n_blocks", "still blocks", part.n_blocks),
+                Figure(f"{prefix}span_c", "temperature span", part.span_c, "°C", digits=3),
+                Figure(f"{prefix}mahalanobis", "step from the prior", part.mahalanobis, "σ",
+                       digits=3, definition="Mahalanobis length of the update's step in "
+                       "the prior's metric."),
+                Figure(f"{prefix}jump_sigma", "largest step within a run",
+                       part.jump_sigma, "σ", digits=3))))
+        notes = (*((self.reason,) if self.reason else ()), *self.notes)
+        title = "in-field update" + ("" if self.applied else ": nothing changed")
+        return Summary(title, tuple(sections), notes)
