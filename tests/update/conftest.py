@@ -3,6 +3,8 @@ paper-unit campaign), a model freshly calibrated on the aged unit, field recordi
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from campaign import SETPOINTS_C
@@ -61,7 +63,7 @@ def field_file(tmp_path_factory):
 
     written = simulate_files([field_profile()], tmp_path_factory.mktemp("field") / "field.parquet",
                              unit=aged_unit(), sample_rate_hz=FIELD_RATE_HZ, seed=7)
-    return written[0].path
+    return Path(written[0].path)
 
 
 @pytest.fixture(scope="session")

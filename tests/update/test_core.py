@@ -39,24 +39,32 @@ def with_rate(recording, rate_dph, **metadata):
     return Recording(columns, replace(recording.metadata, **metadata))
 
 
-def test_an_aged_unit_is_brought_back_near_a_fresh_calibration(parent, fresh,
-                                                                field_recording, known):
+def test_an_aged_unit_is_brought_back_near_a_fresh_calibration(parent, fresh, known):
     """Done-when of issue 29: one field recording with still periods brings the compensated
     residual of a held-out run (other temperatures, another seed) within 1.2× of a model
-    freshly calibrated on the aged unit, and below the parent's."""
-    result = parent.update(field_recording, known)
-    assert result.applied and result.model is not None
+    freshly calibrated on the aged unit, and below the parent's.
+
+    Judged over eight field days (seeds), by the median: the unit's rate random walk (0.1
+    °/h/√h) moves a 12 h recording's mean bias by ~0.2 °/h, so one day's offset is that
+    uncertain (docs/guide/update.md gives the spread); the update must win on the median and
+    on most days."""
     held_out = simulate_run(field_profile((0.0, 25.0, -15.0, 10.0), 4.0), aged_unit(),
                             sample_rate_hz=RATE_HZ, seed=9)
-    old, new, reference = (block_rms(m, held_out) for m in (parent, result.model, fresh))
-    assert new <= 1.2 * reference, (old, new, reference)
-    assert new < old, (old, new, reference)
-    axis = result.axes[""]
-    assert axis.terms == ("const", "f")  # input known and 38 °C of still data
-    # the offset moved the way the unit aged, and the slope too (per °C through df/dT)
-    assert axis.after[0] > axis.before[0] and axis.after[1] > axis.before[1]
-    # the posterior is tighter than the prior in every updated coefficient
-    assert np.all(np.diag(axis.covariance_after) < np.diag(axis.covariance_before))
+    old, reference = block_rms(parent, held_out), block_rms(fresh, held_out)
+    new = []
+    for seed in range(1, 9):
+        day = simulate_run(field_profile(), aged_unit(), sample_rate_hz=RATE_HZ, seed=seed)
+        result = parent.update(day, known)
+        assert result.applied and result.model is not None
+        axis = result.axes[""]
+        assert axis.terms == ("const", "f")  # input known and 38 °C of still data
+        # the posterior is tighter than the prior in every updated coefficient
+        assert np.all(np.diag(axis.covariance_after) < np.diag(axis.covariance_before))
+        # the slope moved the way the unit aged (c1 + 0.015 °/h/°C, f rises with T)
+        assert axis.after[1] > axis.before[1]
+        new.append(block_rms(result.model, held_out))
+    assert np.median(new) <= 1.2 * reference, (old, new, reference)
+    assert np.median(new) < old and sum(n < old for n in new) >= 6, (old, new, reference)
 
 
 def test_the_summary_carries_intervals(parent, field_recording, known):

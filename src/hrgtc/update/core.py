@@ -46,6 +46,7 @@ from hrgtc.update.observations import (
     describe_blocks,
     index_periods,
     still_blocks,
+    stretches,
 )
 from hrgtc.update.result import AxisUpdate, FilterProblem, UpdateResult
 
@@ -248,7 +249,8 @@ def _filter_axis(model: Any, part: Any, blocks: list[StillBlock], terms: tuple[s
             f"{2 * settings.holdout_every}); record longer still periods")
     whole = _solve(problem, slice(None))
     sigma = math.sqrt(float(np.median(problem.r)))
-    jump, where = jump_statistic(problem.z - problem.rows @ whole.mean, runs, sigma)
+    jump, where = jump_statistic(problem.z - problem.rows @ whole.mean,
+                                 stretches(blocks, settings.block_s), sigma)
     if jump > settings.jump_sigma:
         block = blocks[where]
         raise UpdateRefusedError(

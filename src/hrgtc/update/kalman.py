@@ -91,12 +91,12 @@ def run_filter(mean: np.ndarray, covariance: np.ndarray, rows: np.ndarray, z: np
     return FilterRun(x, p, traces)
 
 
-def jump_statistic(residuals: np.ndarray, runs: np.ndarray, sigma: float,
+def jump_statistic(residuals: np.ndarray, stretches: np.ndarray, sigma: float,
                    side: int = 3) -> tuple[float, int]:
-    """The largest step within a run of the residuals, in standard errors, and the index of
-    the first block after it (-1: no step tested).
+    """The largest step of the residuals within a stretch of consecutive still blocks, in
+    standard errors, and the index of the first block after it (-1: no step tested).
 
-    At each split of a run's blocks (time order) the difference of the means of the
+    At each split of a stretch's blocks (time order) the difference of the means of the
     ``side`` blocks after and the ``side`` blocks before, over its standard error
     ``σ √(2 / side)``: local, so that the slow wander of a gyro's bias (its flicker) is not
     taken for a step while a step stands out of it.
@@ -105,8 +105,8 @@ def jump_statistic(residuals: np.ndarray, runs: np.ndarray, sigma: float,
     if not sigma > 0.0:
         return best, where
     error = sigma * math.sqrt(2.0 / side)
-    for run in np.unique(runs):
-        index = np.flatnonzero(runs == run)
+    for stretch in np.unique(stretches):
+        index = np.flatnonzero(stretches == stretch)
         values = residuals[index]
         for m in range(side, values.size - side + 1):
             t = abs(values[m:m + side].mean() - values[m - side:m].mean()) / error

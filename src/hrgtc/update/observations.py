@@ -27,7 +27,7 @@ import numpy as np
 from hrgtc.core.errors import InputError
 from hrgtc.settings.update import UpdateSettings
 
-__all__ = ["StillBlock", "index_periods", "still_blocks"]
+__all__ = ["StillBlock", "index_periods", "still_blocks", "stretches"]
 
 _SECONDS_PER_HOUR = 3600.0
 
@@ -40,6 +40,8 @@ class StillBlock:
     ----------
     run
         Index of the recording among those given (its nuisance constant).
+    period
+        Index of the still period in the recording.
     start_s, end_s
         The block's first and last sample times. [s]
     residual_dph
@@ -55,6 +57,7 @@ class StillBlock:
     """
 
     run: int
+    period: int
     start_s: float
     end_s: float
     residual_dph: float
@@ -102,7 +105,7 @@ def still_blocks(run: int, time_s: np.ndarray, rate_dph: np.ndarray, bias_dph: n
     """
     residual = np.asarray(rate_dph, dtype=np.float64) - np.asarray(bias_dph, dtype=np.float64)
     blocks = []
-    for a, b in periods:
+    for period, (a, b) in enumerate(periods):
         t = time_s[a:b]
         count = int((t[-1] - t[0]) // settings.block_s) if b - a > 1 else 0
         edges = np.searchsorted(t, t[0] + settings.block_s * np.arange(count + 1))
@@ -110,22 +113,34 @@ def still_blocks(run: int, time_s: np.ndarray, rate_dph: np.ndarray, bias_dph: n
             lo, hi = a + int(lo), a + int(hi)
             if hi - lo < 3:
                 continue
-            blocks.append(_block(run, time_s[lo:hi], residual[lo:hi], f[lo:hi],
+            blocks.append(_block(run, period, time_s[lo:hi], residual[lo:hi], f[lo:hi],
                                  temperature_c[lo:hi]))
     return blocks
 
 
-def _block(run: int, t: np.ndarray, residual: np.ndarray, f: np.ndarray,
+def _block(run: int, period: int, t: np.ndarray, residual: np.ndarray, f: np.ndarray,
            temperature: np.ndarray) -> StillBlock:
     centred = t - t.mean()
     good = np.isfinite(temperature)
     rate = (float(np.polyfit(centred[good], temperature[good], 1)[0]) * _SECONDS_PER_HOUR
             if np.count_nonzero(good) > 2 else math.nan)
-    return StillBlock(run=run, start_s=float(t[0]), end_s=float(t[-1]),
+    return StillBlock(run=run, period=period, start_s=float(t[0]), end_s=float(t[-1]),
                       residual_dph=float(residual.mean()), f=float(f.mean()),
                       temperature_c=float(np.nanmean(temperature)) if good.any() else math.nan,
                       temperature_rate_c_per_h=rate,
                       white_sigma_dph=float(residual.std(ddof=1) / math.sqrt(residual.size)))
+
+
+def stretches(blocks: Sequence[StillBlock], block_s: float) -> np.ndarray:
+    """A number per block, the same for blocks that follow each other in one still period
+    (a block left out, a new period or a new run starts another stretch): where a jump is
+    looked for (a step between two temperatures may be the model's misfit between them)."""
+    out = np.zeros(len(blocks), dtype=np.int64)
+    for k in range(1, len(blocks)):
+        a, b = blocks[k - 1], blocks[k]
+        apart = (a.run, a.period) != (b.run, b.period) or b.start_s - a.start_s > 1.5 * block_s
+        out[k] = out[k - 1] + int(apart)
+    return out
 
 
 def block_noise_dph(blocks: Sequence[StillBlock], fallback_dph: float) -> float:
