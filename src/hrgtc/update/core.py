@@ -57,7 +57,7 @@ def update_model(model: Any, recordings: Any, settings: UpdateSettings | None = 
                  still_s: Sequence[tuple[float, float]] | None = None,
                  parent_bytes: bytes, parent_path: str = "<model>",
                  read_options: Any = None) -> UpdateResult:
-    """Update ``model`` (a single-axis :class:`hrgtc.model.Model`) from ``recordings``.
+    """Update ``model`` (a :class:`hrgtc.model.Model`, each axis in turn) from ``recordings``.
 
     Parameters
     ----------
@@ -82,22 +82,62 @@ def update_model(model: Any, recordings: Any, settings: UpdateSettings | None = 
         Another unit's file, a ramp, a jump, a step too far, no held-out gain.
     """
     settings = settings or UpdateSettings()
-    if not model.is_single_axis:
-        raise InputError(f"the model of {model.unit!r} has axes {', '.join(model.names)}: an "
-                         "in-field update of a multi-axis model is not available yet; "
-                         "update a single-axis model")
+    if settings.input_rate_dph is not None and "" not in model.axes:
+        raise InputError(f"the model of {model.unit!r} has axes {', '.join(model.axes)}: one "
+                         "known input rate cannot hold for every axis, and the offsets of a "
+                         "triad from its |Ω| are not available yet; update without "
+                         "input_rate_dph (each axis's slope)")
     runs = [_read(item, read_options, model) for item in _items(recordings)]
-    part = model.axis
-    blocks: list[StillBlock] = []
-    data = []
-    for index, (label, digest, recording) in enumerate(runs):
-        found, intervals, source = _run_blocks(index, recording, part, settings, still_s, label)
-        blocks += found
-        data.append(LineageData(label, digest, intervals, source))
     labels = [label for label, _, _ in runs]
+    found = [_periods(recording, model.axes, settings, still_s, label)
+             for label, _, recording in runs]
+    data = tuple(LineageData(label, digest, intervals, source) for (label, digest, _),
+                 (_, intervals, source) in zip(runs, found, strict=True))
     if not any(d.intervals_s for d in data):
         return UpdateResult(None, False, f"{', '.join(labels)}: no still period (the unit "
                             "moved throughout): nothing changed")
+    axes, notes, parts = {}, [], dict(model.axes)
+    for name, part in model.axes.items():
+        blocks = [b for index, ((_, _, recording), (periods, _, _)) in enumerate(
+                      zip(runs, found, strict=True))
+                  for b in _axis_blocks(index, _view(recording, name), part, periods, settings)]
+        settled = _settled(blocks, settings, labels)
+        terms, said = _observable(part, settled, settings) if settled else ((), [
+            f"every still period is shorter than a block ({settings.block_s:g} s)"])
+        notes += [f"{name}: {n}" if name else n for n in said]
+        if terms:
+            axes[name] = _filter_axis(model, name, settled, terms, settings, labels)
+            parts[name] = replace(part, drift=_updated_drift(part.drift, terms,
+                                                             axes[name].after))
+    if not axes:
+        return UpdateResult(None, False, f"{', '.join(labels)}: nothing observable ("
+                            f"{'; '.join(notes)}): nothing changed", notes=tuple(notes))
+    lineage = Lineage(
+        parent_sha256=hashlib.sha256(parent_bytes).hexdigest(),
+        parent_parameters_sha256=model.sha256, parent_path=parent_path,
+        parent_unit=model.unit, parent_content=pack(parent_bytes), data=data,
+        changes=tuple(AxisChange(name, a.terms, a.before, a.after,
+                                 _matrix(a.covariance_before), _matrix(a.covariance_after))
+                      for name, a in axes.items()),
+        settings=to_dict(settings), mahalanobis=max(a.mahalanobis for a in axes.values()),
+        heldout_rms_before_dph=max(a.heldout_before_dph for a in axes.values()),
+        heldout_rms_after_dph=max(a.heldout_after_dph for a in axes.values()),
+        hrgtc_version=_version(), created_utc=datetime.now(UTC).isoformat(timespec="seconds"))
+    updated = replace(model, axes=parts, lineage=lineage)
+    return UpdateResult(updated, True, "", axes, lineage, tuple(notes))
+
+
+def _view(recording: Recording, axis: str) -> Recording:
+    """The recording of one axis of a model (``""``: the recording itself)."""
+    from hrgtc.recording import axis_view
+
+    return axis_view(recording, axis) if axis else recording
+
+
+def _settled(blocks: list[StillBlock], settings: UpdateSettings,
+             labels: list[str]) -> list[StillBlock]:
+    """The blocks at a settled temperature; refuses a recording whose still data are
+    (nearly) all on a ramp."""
     settled = [b for b in blocks
                if abs(b.temperature_rate_c_per_h) <= settings.max_temperature_rate_c_per_h]
     if len(settled) < min(len(blocks), 2 * settings.holdout_every):
@@ -108,27 +148,7 @@ def update_model(model: Any, recordings: Any, settings: UpdateSettings | None = 
             f"{settings.max_temperature_rate_c_per_h:g} °C/h) and too few are settled: their "
             "residual is the model's thermal transient, not ageing (a ramp posing as "
             "ageing); update from still periods at a settled temperature")
-    if not settled:
-        return UpdateResult(None, False, f"{', '.join(labels)}: every still period is shorter "
-                            f"than a block ({settings.block_s:g} s): nothing changed")
-    terms, notes = _observable(part, settled, settings)
-    if not terms:
-        return UpdateResult(None, False, f"{', '.join(labels)}: nothing observable ("
-                            f"{'; '.join(notes)}): nothing changed", notes=tuple(notes))
-    axis = _filter_axis(model, part, settled, terms, settings, labels)
-    drift = _updated_drift(part.drift, terms, axis.after)
-    lineage = Lineage(
-        parent_sha256=hashlib.sha256(parent_bytes).hexdigest(),
-        parent_parameters_sha256=model.sha256, parent_path=parent_path,
-        parent_unit=model.unit, parent_content=pack(parent_bytes), data=tuple(data),
-        changes=(AxisChange("", terms, axis.before, axis.after,
-                            _matrix(axis.covariance_before), _matrix(axis.covariance_after)),),
-        settings=to_dict(settings), mahalanobis=axis.mahalanobis,
-        heldout_rms_before_dph=axis.heldout_before_dph,
-        heldout_rms_after_dph=axis.heldout_after_dph, hrgtc_version=_version(),
-        created_utc=datetime.now(UTC).isoformat(timespec="seconds"))
-    updated = replace(model, axes={"": replace(part, drift=drift)}, lineage=lineage)
-    return UpdateResult(updated, True, "", {"": axis}, lineage, tuple(notes))
+    return settled
 
 
 def _items(recordings: Any) -> list[Any]:
@@ -148,8 +168,9 @@ def _read(item: Any, read_options: Any, model: Any) -> tuple[str, str, Recording
 
     if isinstance(item, Recording):
         label, recording = "<recording>", item
-        digest = hashlib.sha256(np.ascontiguousarray(item.time_s).tobytes()
-                                + np.ascontiguousarray(item.rate_dph).tobytes()).hexdigest()
+        digest = hashlib.sha256(b"".join(
+            name.encode("utf-8") + np.ascontiguousarray(item[name]).tobytes()
+            for name in item.names)).hexdigest()
     else:
         label = str(item)
         recording = read(item, read_options)
@@ -170,29 +191,39 @@ def _read(item: Any, read_options: Any, model: Any) -> tuple[str, str, Recording
     return label, digest, recording
 
 
-def _run_blocks(index: int, recording: Recording, part: Any, settings: UpdateSettings,
-                still_s: Sequence[tuple[float, float]] | None, label: str
-                ) -> tuple[list[StillBlock], tuple[tuple[float, float], ...], str]:
-    """The still blocks of one recording, its still intervals [s] and where they came from."""
-    from hrgtc.recording.motion import recording_motion
+def _periods(recording: Recording, axes: Any, settings: UpdateSettings,
+             still_s: Sequence[tuple[float, float]] | None, label: str
+             ) -> tuple[list[tuple[int, int]], tuple[tuple[float, float], ...], str]:
+    """The still periods of one recording (index ranges, shared by every axis: motion on
+    any axis is motion), their times [s] and where they came from."""
+    from hrgtc.recording.motion import ACCEL_COLUMNS, detect_motion
 
     time_s = np.asarray(recording.time_s, dtype=np.float64)
     if still_s:
         periods, source = index_periods(time_s, still_s, label), "given"
     else:
-        mask = recording_motion(recording)
-        periods = mask.still_periods(settings.block_s, time_s)
-        source = "motion"
-    intervals = tuple((float(time_s[a]), float(time_s[b - 1])) for a, b in periods)
+        views = {name: _view(recording, name) for name in axes}
+        rates = {f"rate_dph{'_' + name if name else ''}": view.rate_dph - (
+            view["input_rate_dph"] if "input_rate_dph" in view.names
+            else view.metadata.input_rate_dph) for name, view in views.items()}
+        accel = {c: recording[c] for c in ACCEL_COLUMNS if c in recording.names}
+        mask = detect_motion(time_s, rates, accel=accel or None)
+        periods, source = mask.still_periods(settings.block_s, time_s), "motion"
+    return periods, tuple((float(time_s[a]), float(time_s[b - 1])) for a, b in periods), source
+
+
+def _axis_blocks(index: int, recording: Recording, part: Any, periods: list[tuple[int, int]],
+                 settings: UpdateSettings) -> list[StillBlock]:
+    """The still blocks of one axis of one recording (its view)."""
     if not periods:
-        return [], intervals, source
+        return []
     drift, thermometer = part.drift, part.thermometer
     bias = drift.predict_recording(recording, thermometer)
     rate = recording.rate_dph - (settings.input_rate_dph or 0.0)
     f = recording.freq_hz - drift.settings.reference_freq_hz
     temperature = thermometer.temperature(recording.freq_hz, warn=False)
-    return (still_blocks(index, time_s, rate, bias, f, temperature, periods, settings),
-            intervals, source)
+    return still_blocks(index, np.asarray(recording.time_s, dtype=np.float64), rate, bias, f,
+                        temperature, periods, settings)
 
 
 def _observable(part: Any, blocks: list[StillBlock],
@@ -215,15 +246,17 @@ def _observable(part: Any, blocks: list[StillBlock],
     return tuple(terms), notes
 
 
-def _prior(model: Any, part: Any, terms: tuple[str, ...],
+def _prior(model: Any, name: str, terms: tuple[str, ...],
            settings: UpdateSettings) -> tuple[np.ndarray, np.ndarray]:
     """The updated terms' values and covariance before the update: the calibration's (or the
     last update's posterior) plus the ageing allowance."""
+    part = model.axes[name]
     drift = part.drift
     names, _, covariance = drift.coefficient_prior()
     index = [names.index(t) for t in terms]
     prior = covariance[np.ix_(index, index)]
-    kept = [c for c in (model.lineage.changes if model.lineage else ()) if c.terms == terms]
+    kept = [c for c in (model.lineage.changes if model.lineage else ())
+            if c.axis == name and c.terms == terms]
     if kept:
         prior = np.array(kept[0].covariance_after, dtype=np.float64)
     values = np.array([drift.intercept_dph if t == "const" else drift.coefficients[t]
@@ -235,11 +268,11 @@ def _prior(model: Any, part: Any, terms: tuple[str, ...],
     return values, prior + np.diag([ageing[t] for t in terms])
 
 
-def _filter_axis(model: Any, part: Any, blocks: list[StillBlock], terms: tuple[str, ...],
+def _filter_axis(model: Any, name: str, blocks: list[StillBlock], terms: tuple[str, ...],
                  settings: UpdateSettings, labels: list[str]) -> AxisUpdate:
-    """The filter over the blocks, its guards, and the axis's figures."""
-    values, prior = _prior(model, part, terms, settings)
-    problem = _problem(part, blocks, terms, prior, settings)
+    """The filter over the blocks of axis ``name``, its guards, and the axis's figures."""
+    values, prior = _prior(model, name, terms, settings)
+    problem = _problem(model.axes[name], blocks, terms, prior, settings)
     n_model, runs = problem.n_model, np.array([b.run for b in blocks])
     fit, held = split_heldout(len(blocks), settings.holdout_every)
     if held.size < 2 or fit.size < 2:

@@ -40,7 +40,7 @@ class LineageData(records.Written):
     path
         The file as it was given (or ``"<recording>"`` for an in-memory recording).
     sha256
-        SHA-256 of the file's bytes (of the time and rate arrays for an in-memory one).
+        SHA-256 of the file's bytes (of the columns of an in-memory one, names and bytes).
     intervals_s
         The still intervals used, ``(start, end)`` in the recording's time. [s]
     source
