@@ -4,11 +4,11 @@
 thermometer, drift model, training accounting, plateaus), an evaluation of its held-out
 warm-up (Allan curves, noise terms, heating/cooling) and of its cool-down (the demo's
 table), the three-axis imu-3's calibration (scale factor, rate-table segments, an
-instrument compensator) and an evaluation of its held-out rate table, a recording's info
-(validation, time axis), the simulator's units, profile and written files, and the small
-results built from arrays (Hald's data for the stepwise regression, a spike, a slow
-channel, a temperature map, a thermometer prior, a transient). ``tests/test_summaries.py``
-checks each ``summary()``.
+instrument compensator) and an evaluation of its held-out rate table, an in-field update of
+the paper-unit's model, a recording's info (validation, time axis), the simulator's units,
+profile and written files, and the small results built from arrays (Hald's data for the
+stepwise regression, a spike, a slow channel, a temperature map, a thermometer prior, a
+transient). ``tests/test_summaries.py`` checks each ``summary()``.
 """
 
 from __future__ import annotations
@@ -56,7 +56,19 @@ def _paper(paper: Any) -> dict[str, Any]:
             "DirectionStats": evaluation.directions,
             # the demo's figures (its files are the demo's business, not the summary's)
             "DemoResult": DemoResult(Path("demo-out"), result, training, evaluation, None,
-                                     Path("model.json"), Path("report.html"), ())}
+                                     Path("model.json"), Path("report.html"), ()),
+            "UpdateResult": _update(model)}
+
+
+def _update(model: Any) -> Any:
+    """An in-field update of the paper-unit's model from a field day of the aged unit."""
+    from hrgtc.simulate import simulate_run
+    from hrgtc.update import UpdateSettings
+
+    from field_ageing import INPUT_RATE_DPH, aged_unit, field_profile
+
+    day = simulate_run(field_profile(), aged_unit(), sample_rate_hz=2.0, seed=7)
+    return model.update(day, UpdateSettings(input_rate_dph=INPUT_RATE_DPH))
 
 
 def _instrument(imu: Any) -> dict[str, Any]:
