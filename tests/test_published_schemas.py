@@ -38,9 +38,11 @@ print(json.dumps({name: hashlib.sha256(json.dumps(schema, sort_keys=True,
                   for name, schema in schemas.items()}))
 """
 PINNED = {
-    # model: + the optional settings gradient_saturation_c and play_width_c of the history
-    # variables gsat and play (docs/history.md; written only by a model that uses them)
-    "model": "26c70cb52c900d18220d200f56e29916f78266c65f240fc5dc120efd27d46611",
+    # model: + the optional lineage of an in-field update (hrgtc update, issue 29: parent
+    # hash and content, data used, coefficients before/after; written only by an update,
+    # files without it load as before); before it, the optional settings
+    # gradient_saturation_c and play_width_c of the history variables gsat and play
+    "model": "0e74e1aafcea183ec33816bca775536d6e3b8ec1a9d4edb95584c781b8823ffb",
     "calibrate": "5db364b62efe89ac7c086bee61b169993b938c9180a2915b3589da28ea1f9bae",
     "evaluate": "60cbf2ab0d8601ca7654cfaae8502335398ef45cffe0df3cb87aeb01be7ed572",
     "evaluation": "8b433192253e7115f99051897e6091877716dd4198c2027d495473d53032d99b",

@@ -139,3 +139,32 @@ def test_a_recording_without_still_periods_writes_nothing(parent_file, tmp_path)
     assert result.exit_code == 0, result.output
     assert "no still period" in result.output and "not written" in result.output
     assert not output.exists()
+
+
+def test_the_published_schema_takes_an_updated_file(updated):
+    """The lineage is part of the model file's JSON Schema (jsonschema, Draft 2020-12): the
+    updated file validates, and a lineage with a misspelt key or a bad hash does not."""
+    import jsonschema
+
+    from hrgtc.model_schema import MODEL_SCHEMA
+
+    output, _ = updated
+    document = json.loads(output.read_text())
+    jsonschema.validate(document, MODEL_SCHEMA)
+    document["lineage"]["parent_sha256"] = "not a hash"
+    with pytest.raises(jsonschema.ValidationError):
+        jsonschema.validate(document, MODEL_SCHEMA)
+
+
+def test_an_edited_lineage_is_refused_on_loading(updated, tmp_path):
+    """The lineage is hashed with the parameters: an edit of it is a damaged file."""
+    from hrgtc.core.errors import ModelFileError
+    from hrgtc.model import load_model
+
+    output, _ = updated
+    document = json.loads(output.read_text())
+    document["lineage"]["parent_path"] = "elsewhere.json"
+    edited = tmp_path / "edited.json"
+    edited.write_text(json.dumps(document))
+    with pytest.raises(ModelFileError, match="changed after it was written"):
+        load_model(edited)
