@@ -34,19 +34,20 @@ PAGES = {"calibrate": DOCS / "guide" / "calibrate.md", "reading": DOCS / "guide"
          "fleet_evaluate": DOCS / "guide" / "fleet.md",
          "fleet_cluster": DOCS / "guide" / "fleet.md",
          "simulate": DOCS / "guide" / "simulate.md",
-         "simulate_logger": DOCS / "real-loggers" / "simulate.md"}
+         "simulate_logger": DOCS / "real-loggers" / "simulate.md",
+         "update": DOCS / "guide" / "update.md"}
 #: The commands whose options each settings class generates.
 COMMANDS = {"calibrate": ["calibrate"], "calibrate_inputs": ["calibrate"],
             "temperature_reference": ["calibrate"], "holdout": ["calibrate"],
             "reading": ["info", "calibrate", "compensate", "evaluate", "report",
-                        "fleet calibrate", "fleet evaluate", "fleet report"],
+                        "fleet calibrate", "fleet evaluate", "fleet report", "update"],
             "compensate": ["compensate"], "evaluate": ["evaluate"], "report": ["report"],
             "export": ["export-c"], "demo": ["demo"], "fleet_simulate": ["fleet simulate"],
             "fleet_evaluate": ["fleet evaluate"],
             "fleet_cluster": ["fleet simulate", "fleet calibrate", "fleet evaluate",
                               "fleet report"],
             "simulate": ["simulate"],
-            "simulate_logger": ["simulate"]}
+            "simulate_logger": ["simulate"], "update": ["update"]}
 CASES = [(key, s) for key in DOCUMENTED for s in option_settings(settings_class(key))]
 
 

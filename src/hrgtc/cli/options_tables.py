@@ -35,6 +35,7 @@ DOCUMENTED = {
     "demo": ("hrgtc.settings.fleet", "DemoSettings"),
     "simulate": ("hrgtc.settings.simulation", "SimulationSettings"),
     "simulate_logger": ("hrgtc.settings.simulation", "LoggerSettings"),
+    "update": ("hrgtc.settings.update", "UpdateSettings"),
 }
 
 #: The tables a registry writes, by key: (module, function returning the Markdown).

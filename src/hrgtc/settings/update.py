@@ -53,8 +53,9 @@ class UpdateSettings:
         5.0, "Refuse an update whose step from the prior is longer than this (Mahalanobis "
         "distance in the prior's metric).", min=0.0)
     jump_sigma: float = setting(
-        8.0, "Refuse a recording whose still residuals step within a run by more than this "
-        "many standard errors (a jump is not ageing).", min=0.0)
+        8.0, "Refuse a recording whose still residual steps within a stretch of "
+        "consecutive still blocks by more than this many standard errors (a jump is not "
+        "ageing).", min=0.0)
     holdout_every: int = setting(
         3, "Every n-th still block (in time) is held out to judge the update, the others "
         "fit it; no update is applied without a gain on the held-out blocks.", min=2)
