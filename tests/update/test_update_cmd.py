@@ -168,3 +168,16 @@ def test_an_edited_lineage_is_refused_on_loading(updated, tmp_path):
     edited.write_text(json.dumps(document))
     with pytest.raises(ModelFileError, match="changed after it was written"):
         load_model(edited)
+
+
+def test_files_of_every_schema_version_load_without_a_lineage():
+    """The lineage is optional: every golden model file (versions 1 to 3, written before it
+    existed) loads, has none, and writes none."""
+    from golden_models import golden_files
+    from hrgtc.model import load_model
+
+    paths = golden_files()
+    assert len(paths) >= 3
+    for path in paths:
+        model = load_model(path)
+        assert model.lineage is None and "lineage" not in model.to_dict(), path
