@@ -279,3 +279,12 @@ def test_a_recording_of_unknown_unit_is_not_refused_as_another_unit(parent, fiel
     anonymous = Recording({k: np.array(field_recording[k]) for k in field_recording.names},
                           Metadata(sample_rate_hz=RATE_HZ))
     assert parent.update(anonymous, known).applied
+
+
+def test_a_recording_counts_once(parent, field_recording, known):
+    """The lineage names the data an update used: the same recording cannot feed the next
+    update of the model it made (its information would count twice)."""
+    first = parent.update(field_recording, known)
+    with pytest.raises(UpdateRefusedError, match=r"<recording>: already used by the update "
+                       r"that made this model .* a recording counts once"):
+        first.model.update(field_recording, known)

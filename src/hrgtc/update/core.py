@@ -89,6 +89,12 @@ def update_model(model: Any, recordings: Any, settings: UpdateSettings | None = 
                          "input_rate_dph (each axis's slope)")
     runs = [_read(item, read_options, model) for item in _items(recordings)]
     labels = [label for label, _, _ in runs]
+    used = {d.sha256: d.path for d in (model.lineage.data if model.lineage else ())}
+    for label, digest, _ in runs:
+        if digest in used:
+            raise UpdateRefusedError(
+                f"{label}: already used by the update that made this model (as {used[digest]}, "
+                "same SHA-256): a recording counts once")
     found = [_periods(recording, model.axes, settings, still_s, label)
              for label, _, recording in runs]
     data = tuple(LineageData(label, digest, intervals, source) for (label, digest, _),
