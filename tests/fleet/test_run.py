@@ -10,28 +10,10 @@ from pathlib import Path
 
 import pytest
 
-from hrgtc.fleet import calibrate_fleet, load_fleet, report_fleet, simulate_fleet
+from hrgtc.fleet import calibrate_fleet, load_fleet, report_fleet
 from hrgtc.fleet.report import outliers, robust_z
 from hrgtc.fleet.results import read_table
-from hrgtc.settings.fleet import FleetCluster, FleetSimulation
-
-# Tiny rates and short soaks: the physics does not depend on the rate.
-SMALL = {"sample_rate_hz": 1.0, "soak_hours": 2.5, "ramp_hours": 2.0,
-         "setpoints_c": (-20.0, 0.0, 10.0, 20.0, 40.0)}
-
-
-@pytest.fixture(scope="module")
-def fleet_root(tmp_path_factory) -> Path:
-    """Three simulated units and a fourth whose first soak is a corrupt file, in a manifest."""
-    root = tmp_path_factory.mktemp("fleet")
-    run = simulate_fleet(root / "data", FleetSimulation(units=3, seed=5, **SMALL),
-                         cluster=FleetCluster(workers=0))
-    assert run.counts()["ok"] == 3
-    bad = root / "data" / "s5-bad"
-    shutil.copytree(root / "data" / "s5-u0000", bad)
-    corrupt = sorted((bad / "soaks").glob("*.parquet"))[0]
-    corrupt.write_bytes(b"PAR1 this is not a parquet file")
-    return root / "data"
+from hrgtc.settings.fleet import FleetCluster
 
 
 def _models(folder: Path) -> dict[str, dict]:

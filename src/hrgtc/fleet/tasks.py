@@ -32,7 +32,7 @@ from hrgtc.fleet.manifest import UnitFiles
 from hrgtc.recording import ReadOptions
 from hrgtc.settings.calibration import CalibrationSettings
 from hrgtc.settings.compensation import EvaluationSettings
-from hrgtc.settings.fleet import FleetEvaluation
+from hrgtc.settings.fleet import FleetEvaluation, FleetSimulation
 
 __all__ = ["UnitOutcome", "calibrate_unit", "evaluate_unit", "report_unit", "simulate_unit"]
 
@@ -315,38 +315,46 @@ def report_unit(files: UnitFiles, models_dir: str, output_dir: str,
         return failed(files.unit, exc, files.paths, start)
 
 
-def simulate_unit(seed: int, index: int, root: str, sample_rate_hz: float, soak_hours: float,
-                  setpoints_c: tuple[float, ...], ramp_hours: float, file_format: str,
+def simulate_unit(settings: FleetSimulation, index: int, root: str,
                   force: bool) -> UnitOutcome:
-    """Simulate one unit of the population: soaks, a cool-down, a warm-up and ``truth.json``.
+    """Simulate unit ``index`` of the population (:mod:`hrgtc.fleet.population`; an
+    instrument of ``settings.axes`` axes when more than one): soaks, a cool-down, a
+    warm-up and the ground truth.
 
-    Files: ``ROOT/<unit>/soaks/soak_<T>C``, ``drift/cooldown``, ``validate/warmup``.
+    Files: ``ROOT/<unit>/soaks/soak_<T>C``, ``drift/cooldown``, ``validate/warmup`` and
+    ``truth.json`` (an instrument: ``truth-<axis>.json``, each axis's resonator and draw).
     """
     start = time.perf_counter()
+    seed = settings.seed
     name = f"s{seed}-u{index:04d}"
     try:
         from hrgtc.core.files import write_text_atomic
-        from hrgtc.fleet.population import draw_unit, truth
+        from hrgtc.fleet.population import draw_instrument, draw_unit, truth
         from hrgtc.simulate import simulate_files
         from hrgtc.simulate import standard_profiles as profiles
 
-        unit, draw = draw_unit(seed, index)
+        if settings.axes > 1:
+            unit, draws = draw_instrument(seed, index, settings.axes)
+            truths = {f"truth-{axis}.json": truth(unit.axes[axis], draw)
+                      for axis, draw in draws.items()}
+        else:
+            unit, draw = draw_unit(seed, index)
+            truths = {"truth.json": truth(unit, draw)}
         folder = Path(root) / unit.name
         base = 1_000_003 * seed + 8 * index  # distinct campaign seeds per unit and role
-        high, low = max(setpoints_c), min(setpoints_c)
-        written = simulate_files([profiles.soak(t, soak_hours) for t in setpoints_c],
-                                 folder / "soaks", file_format, unit=unit,
-                                 sample_rate_hz=sample_rate_hz, seed=base + 1, force=force,
-                                 workers=1)
-        written += simulate_files([profiles.cooldown(20.0, low, ramp_hours)], folder / "drift",
-                                  file_format, unit=unit, sample_rate_hz=sample_rate_hz,
-                                  seed=base + 2, force=force, workers=1)
-        written += simulate_files([profiles.warmup(low, min(high, 20.0), ramp_hours)],
-                                  folder / "validate", file_format, unit=unit,
-                                  sample_rate_hz=sample_rate_hz, seed=base + 3, force=force,
-                                  workers=1)
-        write_text_atomic(folder / "truth.json", json.dumps(truth(unit, draw), indent=1) + "\n",
-                          force=force)
+        setpoints_c = tuple(float(t) for t in settings.setpoints_c)
+        high, low, ramp_hours = max(setpoints_c), min(setpoints_c), settings.ramp_hours
+        runs = (("soaks", [profiles.soak(t, settings.soak_hours) for t in setpoints_c]),
+                ("drift", [profiles.cooldown(20.0, low, ramp_hours)]),
+                ("validate", [profiles.warmup(low, min(high, 20.0), ramp_hours)]))
+        written = []
+        for k, (role, campaign) in enumerate(runs, start=1):
+            written += simulate_files(campaign, folder / role, settings.file_format, unit=unit,
+                                      sample_rate_hz=settings.sample_rate_hz, seed=base + k,
+                                      force=force, workers=1)
+        for file, document in truths.items():
+            write_text_atomic(folder / file, json.dumps(document, indent=1) + "\n",
+                              force=force)
         return UnitOutcome(unit.name, "ok", {"unit": unit.name, "files": len(written),
                                              "rows": sum(w.rows for w in written)},
                            None, time.perf_counter() - start)

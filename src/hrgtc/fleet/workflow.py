@@ -44,12 +44,12 @@ def simulate_fleet(output: PathLike, settings: FleetSimulation | None = None, *,
                    force: bool = False, cluster: FleetCluster | None = None,
                    progress: Progress | None = None) -> FleetRun:
     """Simulate ``settings.units`` units of the population of ``settings.seed`` under
-    ``output/<unit>/``.
+    ``output/<unit>/`` (instruments of ``settings.axes`` axes when more than one).
 
     Unit k gets soaks at ``settings.setpoints_c`` (``soaks/``), a cool-down (``drift/``),
-    a warm-up (``validate/``) and its ground truth (``truth.json``): the drawn
-    frequency law, thermal constants, bias law and noise
-    (:mod:`hrgtc.fleet.population`). ``cluster``: where the units run (default: a local
+    a warm-up (``validate/``) and its ground truth (``truth.json``; an instrument's
+    ``truth-<axis>.json`` per axis): the drawn frequency law, thermal constants, bias law
+    and noise (:mod:`hrgtc.fleet.population`). ``cluster``: where the units run (default: a local
     Dask cluster, one worker per core).
     """
     settings = settings or FleetSimulation()
@@ -60,11 +60,7 @@ def simulate_fleet(output: PathLike, settings: FleetSimulation | None = None, *,
     if not force and root.is_dir() and any(root.iterdir()):
         raise InputError(f"{root} is not empty; pass --force to overwrite or give a new folder")
     root.mkdir(parents=True, exist_ok=True)
-    seed = settings.seed
-    work = [(f"s{seed}-u{k:04d}", tasks.simulate_unit,
-             (seed, k, str(root), settings.sample_rate_hz, settings.soak_hours,
-              tuple(float(t) for t in settings.setpoints_c), settings.ramp_hours,
-              settings.file_format, force))
+    work = [(f"s{settings.seed}-u{k:04d}", tasks.simulate_unit, (settings, k, str(root), force))
             for k in range(units)]
     return run_tasks(work, cluster=cluster, progress=progress, label="simulate")
 
