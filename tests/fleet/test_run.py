@@ -65,6 +65,13 @@ def test_resume_skips_unchanged_units_and_redoes_changed_ones(fleet_root, tmp_pa
         calibrate_fleet(data, tmp_path / "models", cluster=FleetCluster(workers=0))
     again = calibrate_fleet(data, tmp_path / "models", cluster=FleetCluster(workers=0), resume=True)
     assert again.counts() == {"ok": 0, "skipped": 3, "failed": 1}
+    # an outcome written before the long form (the unit's one row, no axes) is redone
+    record = tmp_path / "models" / "s5-u0003.outcome.json"
+    shutil.copytree(data / "s5-u0002", data / "s5-u0003")
+    calibrate_fleet(data, tmp_path / "models", cluster=FleetCluster(workers=0), resume=True)
+    stored = json.loads(record.read_text())
+    (axis,) = stored.pop("axes")
+    record.write_text(json.dumps({**stored, "row": {**stored["row"], **axis, "axis": None}}))
     # repair the bad unit's file and change another unit's drift run
     shutil.copy(fleet_root / "s5-u0000" / "soaks" / "soak_-20C.parquet",
                 data / "s5-bad" / "soaks" / "soak_-20C.parquet")
@@ -73,8 +80,9 @@ def test_resume_skips_unchanged_units_and_redoes_changed_ones(fleet_root, tmp_pa
     third = calibrate_fleet(data, tmp_path / "models", cluster=FleetCluster(workers=0), resume=True)
     status = {o.unit: o.status for o in third.outcomes}
     assert status == {"s5-bad": "ok", "s5-u0000": "skipped", "s5-u0001": "ok",
-                      "s5-u0002": "skipped"}
-    assert len(read_table(tmp_path / "models" / "fleet.parquet")) == 4
+                      "s5-u0002": "skipped", "s5-u0003": "ok"}
+    rows = read_table(tmp_path / "models" / "fleet.parquet")
+    assert [(r["unit"], r["axis"]) for r in rows] == [(u, "") for u in sorted(status)]
     assert [u.unit for u in load_fleet(data)] == sorted(status)
 
 
