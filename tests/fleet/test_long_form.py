@@ -12,6 +12,7 @@ single-axis fleet's tables are those of before the long form
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from pathlib import Path
@@ -22,9 +23,10 @@ from hrgtc.core.errors import InputError
 from hrgtc.fleet import build_prior, calibrate_fleet, evaluate_fleet, report_fleet
 from hrgtc.fleet.population import true_frequency_hz
 from hrgtc.fleet.results import read_table
-from hrgtc.model import load_model
+from hrgtc.model import load_model, save_model
 from hrgtc.pipeline.instrument import calibrate_instrument
 from hrgtc.settings.fleet import FleetCluster
+from hrgtc.thermometry.prior import ThermometerPrior
 
 TABLES = Path(__file__).parents[1] / "data" / "fleet-single-axis" / "tables.json"
 UNITS = ("s3-u0000", "s3-u0001")
@@ -120,6 +122,27 @@ def test_the_report_and_the_prior_are_per_axis(instrument_models, tmp_path):
         build_prior(instrument_models)
     with pytest.raises(InputError, match="no model file has the axis 'w'"):
         build_prior(instrument_models, axis="w")
+    with pytest.raises(InputError, match="2 unit"):  # the two x thermometers, not six
+        build_prior(instrument_models, axis="x")
+    # six instruments whose x axes are the six resonators of the two: the prior of axis x
+    # is that of the six thermometers
+    folder = tmp_path / "models"
+    folder.mkdir()
+    parts = [(unit, load_model(instrument_models / f"{unit}.json")) for unit in UNITS]
+    thermometers = []
+    for unit, model in parts:
+        for k, axis in enumerate("xyz"):
+            others = [a for a in "xyz" if a != axis]
+            turned = dataclasses.replace(model, unit=f"{unit}-{axis}", axes={
+                "x": model.axes[axis], "y": model.axes[others[0]], "z": model.axes[others[1]]})
+            save_model(turned, folder / f"{unit}-{k}.json")
+            thermometers.append(model.axes[axis].thermometer)
+    prior = build_prior(folder, axis="x")
+    expected = ThermometerPrior.from_thermometers(
+        thermometers, [f"{u}-{a}" for u in UNITS for a in "xyz"])
+    assert prior.n_units == 6
+    assert prior.mean == pytest.approx(expected.mean, rel=1e-12)
+    assert prior.nominal_freq_hz == pytest.approx(expected.nominal_freq_hz, rel=1e-12)
 
 
 def _same(row: dict, expected: dict) -> None:
