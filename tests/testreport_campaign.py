@@ -1,4 +1,4 @@
-"""A simulated test campaign with known truth, written to files with its manifest.
+"""Simulated test campaigns with known truth, written to files with their manifests.
 
 The paper-unit (src/hrgtc/simulate/units.py) at 1 Hz: turn-ons at 20 °C on five days,
 each with its own turn-on offset and a warm-up transient added to the output and to the
@@ -11,6 +11,7 @@ input of 10 °/h, the component on an up axis at latitude asin(10 / 15.041067 °
 from __future__ import annotations
 
 import math
+import shutil
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -45,7 +46,7 @@ def _with_offset(recording: Recording, offset: np.ndarray) -> Recording:
 
 
 def write_campaign(folder: Path, *, hours: float = 1.5, with_table: bool = False,
-                   spec: str | None = None, settings: str = "") -> CampaignFiles:
+                   model: Path | None = None, settings: str = "") -> CampaignFiles:
     folder.mkdir(parents=True, exist_ok=True)
     turn_ons = []
     for day, offset in enumerate(TURN_ON_OFFSETS_DPH):
@@ -71,13 +72,17 @@ def write_campaign(folder: Path, *, hours: float = 1.5, with_table: bool = False
             f'[[runs]]\nfile = "{sweep.name}"\nrole = "sweep"\n']
     if table is not None:
         runs.append(f'[[runs]]\nfile = "{table.name}"\nrole = "rate-table"\n')
+    model_line = ""
+    if model is not None:
+        shutil.copyfile(model, folder / "model.json")
+        model_line = 'model = "model.json"\n'
     manifest = folder / "campaign.toml"
     manifest.write_text(f'''title = "Acceptance test <simulated>"
 [unit]
 serial = "SN-0042"
 firmware = "2.3.1"
 type = "HRG (simulated paper-unit)"
-[site]
+{model_line}[site]
 latitude_deg = {LATITUDE_DEG!r}
 axis = "up"
 [conditions]
