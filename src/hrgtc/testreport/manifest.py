@@ -23,6 +23,10 @@ A manifest is a small TOML file the user writes (docs/guide/test-report.md)::
     file = "turnon_day1.parquet"         # relative to the manifest's folder
     role = "turn-on"                     # turn-on, soak, sweep or rate-table
     day = "2026-11-02"
+    [[runs]]
+    file = "soak_-20C.parquet"
+    role = "soak"
+    settle_s = 14400                     # this run's own settling time (default: [settings])
 
 The roles say what each run is, so nothing is guessed from a file's name or contents:
 a turn-on is recorded from power-on at a constant temperature; a soak holds one
@@ -86,7 +90,7 @@ class CampaignSettings:
         Length of the block means every figure but the Allan deviation is computed from. [s]
     settle_s
         Time left out at the start of each turn-on and soak before its bias is measured
-        (the warm-up, the chamber's settling). [s]
+        (the warm-up, the chamber's settling); a run's own ``settle_s`` replaces it. [s]
     turn_on_tolerance_dph
         Band around the settled bias a turn-on must stay within (turn-on time); None: the
         turn-on time is not measured. [°/h]
@@ -138,12 +142,14 @@ class Equipment:
 
 @dataclass(frozen=True)
 class RunEntry:
-    """One run of the campaign: its file, its role and an optional day label."""
+    """One run of the campaign: its file, its role, an optional day label and its own
+    ``settle_s`` (None: the campaign's)."""
 
     path: Path
     role: str
     day: str = ""
     label: str = ""
+    settle_s: float | None = None
 
     @property
     def name(self) -> str:
@@ -263,7 +269,12 @@ def _runs(data: dict[str, Any], folder: Path, where: str) -> tuple[RunEntry, ...
         if not path.is_file():
             raise InputError(f"{here}: file {str(path)!r} does not exist; paths are relative "
                              "to the manifest's folder")
-        entries.append(RunEntry(path, role, _text(run, "day", here), _text(run, "label", here)))
+        settle = run.get("settle_s")
+        if settle is not None and not (isinstance(settle, int | float) and math.isfinite(settle)
+                                       and settle >= 0):
+            raise InputError(f"{here}: settle_s = {settle!r} must be a number of seconds >= 0")
+        entries.append(RunEntry(path, role, _text(run, "day", here), _text(run, "label", here),
+                                None if settle is None else float(settle)))
     return tuple(entries)
 
 

@@ -62,16 +62,17 @@ def turn_ons(runs: Sequence[RunSeries], settings: CampaignSettings) -> list[Turn
     time and warm-up drift."""
     out = []
     for series in runs:
-        tail = series.after(settings.settle_s)
+        settle = series.settle_s(settings.settle_s)
+        tail = series.after(settle)
         if tail.size < 2:
             raise InputError(f"{series.entry.path}: fewer than two {settings.block_s:g} s blocks "
-                             f"after settle_s = {settings.settle_s:g} s; the turn-on is too short "
-                             "for its bias, or lower settle_s")
+                             f"after settle_s = {settle:g} s; the turn-on is too short for its "
+                             "bias, or lower settle_s")
         settled = float(np.mean(tail))
         sigma = float(np.std(tail, ddof=1))
-        warm = series.bias_dph[series.time_s < settings.settle_s]
+        warm = series.bias_dph[series.time_s < settle]
         comp = (None if series.compensated_dph is None
-                else float(np.mean(series.after(settings.settle_s, compensated=True))))
+                else float(np.mean(series.after(settle, compensated=True))))
         out.append(TurnOn(
             series.entry.name, series.entry.day, settled, sigma / math.sqrt(tail.size), comp,
             _turn_on_time(series, settled, settings.turn_on_tolerance_dph, settings.block_s),
@@ -155,12 +156,16 @@ def _sensitivities(soaks: Sequence[RunSeries], sweeps: Sequence[RunSeries],
     k = settings.coverage_k
     temperature_name = f"bias_temperature_sensitivity{suffix}_dph_per_c"
     gradient_name = f"bias_gradient_sensitivity{suffix}_dph_per_c_per_min"
-    points = [SoakPoint(s.entry.name,
-                        float(np.mean(s.temperature_c[s.time_s >= settings.settle_s])),
-                        float(np.mean(s.after(settings.settle_s))),
-                        None if s.compensated_dph is None
-                        else float(np.mean(s.after(settings.settle_s, compensated=True))))
-              for s in soaks if np.any(s.time_s >= settings.settle_s)]
+    points = []
+    for s in soaks:
+        settle = s.settle_s(settings.settle_s)
+        if not np.any(s.time_s >= settle):
+            raise InputError(f"{s.entry.path}: nothing left after settle_s = {settle:g} s; "
+                             "the soak is too short, or lower its settle_s")
+        points.append(SoakPoint(
+            s.entry.name, float(np.mean(s.temperature_c[s.time_s >= settle])),
+            float(np.mean(s.after(settle))), None if s.compensated_dph is None
+            else float(np.mean(s.after(settle, compensated=True)))))
     out, slope = [], None
     if len(points) >= 3:
         t = np.array([p.temperature_c for p in points])
@@ -270,7 +275,7 @@ def noise_figures(series: RunSeries | None, settings: CampaignSettings
     if series is None or series.samples_dph is None:
         return [not_measured(n, "no turn-on or soak run for the Allan deviation", k)
                 for n in names], {}
-    start = round(settings.settle_s * series.sample_rate_hz)
+    start = round(series.settle_s(settings.settle_s) * series.sample_rate_hz)
     probability = coverage_probability(k)
     curves = {"raw": allan_deviation(series.samples_dph[start:], series.sample_rate_hz,
                                       confidence=probability)}

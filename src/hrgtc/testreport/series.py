@@ -66,6 +66,10 @@ class RunSeries:
     segment_temperature_c: tuple[float, ...] = ()
     segment_span_c: tuple[float, ...] = ()
 
+    def settle_s(self, default_s: float) -> float:
+        """The time left out at the run's start: its own ``settle_s`` or ``default_s``. [s]"""
+        return default_s if self.entry.settle_s is None else self.entry.settle_s
+
     def after(self, start_s: float, compensated: bool = False) -> np.ndarray:
         """Block means of the bias from ``start_s`` on (raw or compensated). [°/h]"""
         values = self.compensated_dph if compensated else self.bias_dph
