@@ -111,15 +111,13 @@ class TestReport:
 
     @property
     def verdict(self) -> str:
-        """The test's verdict: reject if a figure is rejected, else indeterminate if one is,
-        else accept if a limited figure was accepted; "not measured" if a limited figure was
-        not measured and none was rejected or indeterminate; "no limit" without a spec."""
-        found = {f.verdict for f in self.figures}
-        for verdict in (REJECT, INDETERMINATE, NOT_MEASURED, ACCEPT):
-            if verdict in found and (verdict != NOT_MEASURED or any(
-                    f.limit is not None and f.verdict == NOT_MEASURED for f in self.figures)):
-                return verdict
-        return NO_LIMIT
+        """The test's verdict over the figures with a limit: reject if one is rejected, else
+        indeterminate if one is, else "not measured" if one was not measured, else accept;
+        "no limit" when no figure has one."""
+        found = [f.verdict for f in self.figures if f.limit is not None]
+        if not found:
+            return NO_LIMIT
+        return next((v for v in (REJECT, INDETERMINATE, NOT_MEASURED) if v in found), ACCEPT)
 
     def sections(self) -> list[tuple[str, list[TestFigure]]]:
         """The figures by section (turn-on, temperature, scale factor, noise)."""
