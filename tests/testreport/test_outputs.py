@@ -27,13 +27,17 @@ max = 100
 """
 
 _CHECK = """<script>
-window.addEventListener("load", () => {
+window.addEventListener("load", async () => {
+  const images = Array.from(document.images);
+  await Promise.allSettled(images.map((image) => image.decode()));
+  const loaded = images.filter((image) => image.complete && image.naturalWidth > 0).length;
   const rows = document.querySelectorAll("tr[id^='figure-']").length;
   const verdict = document.getElementById("verdict").textContent;
   const title = document.querySelector("h1").textContent;
   const marker = document.createElement("p");
   marker.id = "hrgtc-check";
-  marker.textContent = `rows=${rows} verdict=${verdict} title=${title}`;
+  marker.textContent = `images=${images.length} loaded=${loaded} rows=${rows} ` +
+    `verdict=${verdict} title=${title}`;
   document.body.appendChild(marker);
 });
 </script>"""
@@ -48,8 +52,9 @@ def written(campaign, tmp_path_factory):
 
 
 def test_the_page_opens_in_headless_chromium(written, tmp_path):
-    """A real browser parses the page: a row per figure, the verdict, the title's markup
-    shown as text (escaped: the manifest's title is "Acceptance test <simulated>")."""
+    """A real browser parses the page: both figures load, a row per figure, the verdict, the
+    title's markup shown as text (escaped: the manifest's title is "Acceptance test
+    <simulated>")."""
     assert shutil.which("chromium"), "chromium is not installed: run 'make test' (it installs it)"
     files, _ = written
     probe = tmp_path / "probe.html"
@@ -62,11 +67,13 @@ def test_the_page_opens_in_headless_chromium(written, tmp_path):
         "--virtual-time-budget=10000", "--dump-dom", probe.as_uri(),
     ]
     dom = subprocess.run(command, capture_output=True, text=True, timeout=120, check=True).stdout
-    found = re.search(r'id="hrgtc-check">rows=(\d+) verdict=([a-z ]+) title=([^<]*)<', dom)
+    found = re.search(r'id="hrgtc-check">images=(\d+) loaded=(\d+) rows=(\d+) '
+                      r'verdict=([a-z ]+) title=([^<]*)<', dom)
     assert found, dom[-2000:]
-    assert int(found.group(1)) == len(FIGURES)
-    assert found.group(2) == files.report.verdict
-    assert found.group(3) == "Acceptance test &lt;simulated&gt;"  # text, not a tag
+    assert int(found.group(1)) == int(found.group(2)) == 2  # bias against T, Allan deviation
+    assert int(found.group(3)) == len(FIGURES)
+    assert found.group(4) == files.report.verdict
+    assert found.group(5) == "Acceptance test &lt;simulated&gt;"  # text, not a tag
 
 
 def test_the_pdf_is_printed(written):

@@ -18,9 +18,12 @@ import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
 from hrgtc.core.errors import InputError
 from hrgtc.core.files import refuse_existing, write_text_atomic
 from hrgtc.recording import ReadOptions
+from hrgtc.report.figures import COMPENSATED, RAW, Plot, plot
 from hrgtc.report.kinds import kind as report_kind
 from hrgtc.report.render import number, render
 from hrgtc.report.tables import Table
@@ -28,8 +31,8 @@ from hrgtc.testreport.manifest import Campaign, load_campaign
 from hrgtc.testreport.result import TestReport, TestReportInputs
 from hrgtc.testreport.spec import load_spec
 
-__all__ = ["BROWSERS", "TestReportFiles", "outputs", "print_pdf", "test_report_tables",
-           "write_test_report"]
+__all__ = ["BROWSERS", "TestReportFiles", "outputs", "print_pdf", "test_report_plots",
+           "test_report_tables", "write_test_report"]
 
 PathLike = str | os.PathLike[str]
 
@@ -86,6 +89,60 @@ def test_report_tables(report: TestReport) -> dict[str, object]:
                   for i, (t, d) in enumerate(zip(curve.taus_s, curve.deviation, strict=True)))))
     tables["allan_tables"] = allan
     return tables
+
+
+def _allan_plot(report: TestReport) -> Plot:
+    from matplotlib.figure import Figure
+
+    figure = Figure(figsize=(6.6, 3.4), layout="constrained")
+    ax = figure.subplots()
+    for key, curve in report.allan.items():
+        colour = RAW if key == "raw" else COMPENSATED
+        ax.loglog(curve.taus_s, curve.deviation, "-o", ms=2.5, color=colour, label=key)
+        if curve.lower is not None and curve.upper is not None:
+            ax.fill_between(curve.taus_s, curve.lower, curve.upper, color=colour, alpha=0.15,
+                            lw=0)
+    ax.set_xlabel("averaging time τ [s]")
+    ax.set_ylabel("Allan deviation [°/h]")
+    ax.legend(loc="best")
+    return plot(figure, f"Overlapping Allan deviation of {report.allan_run} against τ, log-log, "
+                "with its χ² interval as a band")
+
+
+def _soak_plot(report: TestReport) -> Plot:
+    from matplotlib.figure import Figure
+
+    figure = Figure(figsize=(6.6, 3.4), layout="constrained")
+    ax = figure.subplots()
+    t = np.array([p.temperature_c for p in report.soaks])
+    for key, colour, values in (
+            ("raw", RAW, [p.bias_dph for p in report.soaks]),
+            ("compensated", COMPENSATED, [p.compensated_dph for p in report.soaks])):
+        if any(v is None for v in values):
+            continue
+        y = np.array(values, dtype=np.float64)
+        ax.plot(t, y, "o", color=colour, label=key)
+        slope, intercept = np.polyfit(t, y, 1)
+        line = np.array([t.min(), t.max()])
+        ax.plot(line, intercept + slope * line, "-", color=colour, lw=0.8)
+    ax.set_xlabel(f"{report.campaign.settings.temperature_column} [°C]")
+    ax.set_ylabel("settled bias [°/h]")
+    ax.legend(loc="best")
+    return plot(figure, "The soaks' settled biases against their temperatures, raw and "
+                "compensated, with their least-squares lines")
+
+
+def test_report_plots(report: TestReport) -> list[tuple[Plot, str]]:
+    """The page's figures and their captions: the soaks' biases against temperature (three
+    soaks or more), the Allan deviation."""
+    out = []
+    if len(report.soaks) >= 3:
+        out.append((_soak_plot(report), "Bias against temperature: each soak's settled bias "
+                    "and the least-squares line whose slope is the bias temperature sensitivity."))
+    if report.allan:
+        out.append((_allan_plot(report), f"Overlapping Allan deviation of {report.allan_run} "
+                    "after settle_s; the band is its χ² interval at the coverage of k."))
+    return out
 
 
 def _browser(browser: PathLike | None) -> str:
@@ -181,8 +238,8 @@ def write_test_report(
     chosen = report_kind("test-report")
     data = chosen.data(TestReportInputs(campaign, limits, None if spec is None else Path(spec),
                                         read_options))
-    write_text_atomic(html, render(chosen.template, report=data, **test_report_tables(data)),
-                      force=force)
+    write_text_atomic(html, render(chosen.template, report=data, plots=test_report_plots(data),
+                                   **test_report_tables(data)), force=force)
     write_text_atomic(paths[1], json.dumps(data.to_dict(), indent=2, ensure_ascii=False) + "\n",
                       force=force)
     printed = print_pdf(html, paths[2], force=force, browser=browser) if pdf else None
