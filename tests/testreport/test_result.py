@@ -126,3 +126,29 @@ def test_allan_figures_carry_the_chi_squared_interval_at_ks_coverage(report):
     assert report.allan["raw"].confidence == pytest.approx(math.erf(2.0 / math.sqrt(2.0)))
     # the simulator's ARW (units.py: 0.024 °/√h) inside the interval
     assert low <= get("paper-unit").gyro_noise.arw_deg_per_sqrt_h <= high
+
+
+def test_one_axis_of_a_multi_axis_file(tmp_path):
+    """``file_axis`` reads one axis of the imu-3 (x north at 40° N: Ω cos 40°); its turn-on
+    biases are that axis's true bias."""
+    from hrgtc.recording import write
+    from hrgtc.simulate import simulate_run
+    from hrgtc.simulate.standard_profiles import constant
+
+    runs = []
+    for seed in (1, 2):
+        path = write(simulate_run(constant(20.0, 1.0), "imu-3", sample_rate_hz=1.0, seed=seed),
+                     tmp_path / f"day{seed}.parquet")
+        runs.append(f'[[runs]]\nfile = "{path.name}"\nrole = "turn-on"\n')
+    manifest = tmp_path / "campaign.toml"
+    manifest.write_text('[unit]\nserial = "IMU-1"\nfirmware = "1"\nfile_axis = "x"\n'
+                        '[site]\nlatitude_deg = 40.0\naxis = "north"\n[settings]\n'
+                        'settle_s = 600\n' + "".join(runs), encoding="utf-8")
+    report = test_report(manifest)
+    assert report.earth_rate_dph == pytest.approx(15.041067 * math.cos(math.radians(40.0)),
+                                                  rel=1e-6)
+    for turn_on, seed in zip(report.turn_ons, (1, 2), strict=True):
+        run = read(tmp_path / f"day{seed}.parquet")
+        time = run.time_s - run.time_s[0]
+        truth = float(np.mean(run["bias_dph_x"][time >= 600.0]))
+        assert turn_on.bias_dph == pytest.approx(truth, abs=1.0)

@@ -77,7 +77,8 @@ FIGURES: dict[str, FigureInfo] = {name: FigureInfo(*info) for name, info in {
         "rate test series (bias temperature-gradient sensitivity)",
         "Least-squares slope of the sweeps' block means, less the temperature sensitivity "
         "times temperature, against the temperature's rate of change; u: the slope's "
-        "standard error, widened for the block means' lag-1 autocorrelation.",
+        "standard error, widened for the block means' lag-1 autocorrelation (the "
+        "temperature sensitivity's own uncertainty is not propagated).",
         "temperature"),
     "bias_gradient_sensitivity_compensated_dph_per_c_per_min": (
         "bias temperature-gradient sensitivity, compensated", "°/h/(°C/min)",
