@@ -61,7 +61,7 @@ def test_report_tables(report: TestReport) -> dict[str, object]:
     tables: dict[str, object] = {
         "turn_on_table": Table(
             "Turn-ons: settled bias (after settle_s, Earth rate subtracted)",
-            ("run", "day", "bias [°/h]", "its standard error [°/h]", "compensated [°/h]",
+            ("run", "day", "bias [°/h]", "σ/√N of its block means [°/h]", "compensated [°/h]",
              "turn-on time [s]", "warm-up drift [°/h]"),
             tuple((t.name, t.day or "–", _cell(t.bias_dph), _cell(t.bias_se_dph, 3),
                    _cell(t.compensated_dph), _cell(t.turn_on_time_s),
