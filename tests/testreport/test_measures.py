@@ -111,3 +111,13 @@ def test_scale_factor_per_plateau_and_its_slope():
     assert found["scale_factor_error_ppm"].value == pytest.approx(100.0, abs=1e-6)
     assert found["scale_factor_temperature_sensitivity_ppm_per_c"].value == pytest.approx(
         2.0, rel=1e-9)
+
+
+def test_no_warm_up_period_leaves_the_warm_up_drift_not_measured():
+    time = np.arange(30) * 60.0
+    runs = [_series("turn-on", time, np.full(30, b), np.full(30, 20.0)) for b in (1.0, 2.0)]
+    settings = CampaignSettings(settle_s=0.0)
+    figures = {f.name: f for f in turn_on_figures(turn_ons(runs, settings), settings, False)}
+    assert figures["warm_up_drift_dph"].value is None
+    assert figures["turn_on_time_s"].reason == "no turn_on_tolerance_dph in [settings]"
+    assert figures["bias_repeatability_dph"].value == pytest.approx(np.std([1.0, 2.0], ddof=1))

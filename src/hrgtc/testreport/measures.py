@@ -34,7 +34,8 @@ def coverage_probability(k: float) -> float:
 
 @dataclass(frozen=True)
 class TurnOn:
-    """One turn-on: its settled bias (raw, compensated), turn-on time and warm-up drift."""
+    """One turn-on: its settled bias (raw, compensated), turn-on time and warm-up drift (NaN
+    without a warm-up period)."""
 
     name: str
     day: str
@@ -76,7 +77,8 @@ def turn_ons(runs: Sequence[RunSeries], settings: CampaignSettings) -> list[Turn
         out.append(TurnOn(
             series.entry.name, series.entry.day, settled, sigma / math.sqrt(tail.size), comp,
             _turn_on_time(series, settled, settings.turn_on_tolerance_dph, settings.block_s),
-            float(np.max(np.abs(warm - settled))) if warm.size else 0.0, sigma, int(tail.size)))
+            float(np.max(np.abs(warm - settled))) if warm.size else math.nan, sigma,
+            int(tail.size)))
     return out
 
 
@@ -96,12 +98,19 @@ def turn_on_figures(found: Sequence[TurnOn], settings: CampaignSettings,
         worst = max(t.turn_on_time_s for t in found if t.turn_on_time_s is not None)
         out.append(measured("turn_on_time_s", worst, settings.block_s / math.sqrt(12.0), k,
                             basis=f"U = k·u, k = {k:g}; u: block_s/√12"))
-    worst = max(found, key=lambda t: t.warm_up_drift_dph)
-    out.append(measured("warm_up_drift_dph", worst.warm_up_drift_dph, worst.block_sigma_dph, k))
+    warming = [t for t in found if math.isfinite(t.warm_up_drift_dph)]
+    if warming:
+        worst = max(warming, key=lambda t: t.warm_up_drift_dph)
+        out.append(measured("warm_up_drift_dph", worst.warm_up_drift_dph,
+                            worst.block_sigma_dph, k))
+    else:
+        out.append(not_measured("warm_up_drift_dph", "settle_s = 0: no warm-up period", k))
     biases = np.array([t.bias_dph for t in found])
     n = biases.size
     if n < 2:
-        out.append(measured("bias_dph", float(biases[0]), found[0].bias_se_dph, k))
+        out.append(measured("bias_dph", float(biases[0]), found[0].bias_se_dph, k,
+                            basis=f"U = k·u, k = {k:g}; u: σ/√N of the one turn-on's block "
+                            "means (optimistic where the noise is correlated)"))
         reason = "one turn-on; the repeatability needs two or more"
         out.extend(not_measured(name, reason, k) for name in names[3:])
         return out

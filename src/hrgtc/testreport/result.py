@@ -154,7 +154,8 @@ class TestReport:
             "turn_ons": [{"run": t.name, "day": t.day, "bias_dph": t.bias_dph,
                           "bias_se_dph": t.bias_se_dph, "compensated_dph": t.compensated_dph,
                           "turn_on_time_s": t.turn_on_time_s,
-                          "warm_up_drift_dph": t.warm_up_drift_dph} for t in self.turn_ons],
+                          "warm_up_drift_dph": (t.warm_up_drift_dph if math.isfinite(
+                              t.warm_up_drift_dph) else None)} for t in self.turn_ons],
             "soaks": [{"run": p.name, "temperature_c": p.temperature_c, "bias_dph": p.bias_dph,
                        "compensated_dph": p.compensated_dph} for p in self.soaks],
             "plateaus": [{"temperature_c": p.temperature_c, "k_ppm": p.k_ppm,
