@@ -106,7 +106,24 @@ def _recording(paper: Any, folder: Path) -> dict[str, Any]:
     return {"RecordingInfo": info, "ValidationReport": info.validation,
             "Timeline": Timeline.from_time(burst), "MotionMask": recording_motion(run),
             "Unit": units.get("paper-unit"), "MultiAxisUnit": units.get("imu-3"),
-            "Profile": profiles.warmup(-20.0, 20.0, 5.0), "WrittenFile": written[0]}
+            "Profile": profiles.warmup(-20.0, 20.0, 5.0), "WrittenFile": written[0],
+            "TestReport": _test_report(paper, folder)}
+
+
+def _test_report(paper: Any, folder: Path) -> Any:
+    """A test report of the paper campaign's files: a soak at 20 °C as the turn-on, three
+    soaks, the cool-down as the sweep (docs/guide/test-report.md)."""
+    from hrgtc.testreport import test_report
+
+    runs = [(paper.soaks[4], "turn-on", 1200), *((paper.soaks[k], "soak", 14400)
+                                                 for k in (0, 2, 4)),
+            (paper.cooldown, "sweep", 0)]
+    manifest = folder / "campaign.toml"
+    manifest.write_text('[unit]\nserial = "SN-1"\nfirmware = "1"\n[site]\nlatitude_deg = '
+                        '41.6705\naxis = "up"\n' + "".join(
+                            f'[[runs]]\nfile = "{path}"\nrole = "{role}"\nsettle_s = {settle}\n'
+                            for path, role, settle in runs), encoding="utf-8")
+    return test_report(manifest)
 
 
 def _small() -> dict[str, Any]:

@@ -6,7 +6,10 @@ is generated from the results' declarations (:mod:`hrgtc.core.records`); a chang
 result's fields changes it. The SHA-256 of each one's canonical JSON is pinned here: a
 change that is meant updates the figure, with its reason in the commit message.
 
-Last change: each definition's ``description`` is dedented as :func:`inspect.cleandoc`
+Last change: the fleet row gained the column ``axis`` (the fleet table is long-form, a row
+per unit × axis, issue 28): its pin moved, no other.
+
+The change before: each definition's ``description`` is dedented as :func:`inspect.cleandoc`
 does (msgspec 0.23 dedents class docstrings, 0.22 kept their indent; a fresh install took
 0.23 and every hash moved). The text, types, bounds, defaults and names are unchanged.
 """
@@ -48,7 +51,10 @@ PINNED = {
     "evaluation": "8b433192253e7115f99051897e6091877716dd4198c2027d495473d53032d99b",
     "prior": "2732b64c049600755e46251cf1d866b5571c9ccc95f1845473b13ffa6ad39c49",
     "scale_factor": "a67300581f757b5e8dd1ea8f80429bd0a7760d8d7c5e2e244ff4f338e675a520",
-    "fleet_row": "107b738be29bcfc7ddc4ccb5a81e0712a9cf6b88e080ce8cec70654c60b38ff1",
+    # fleet_row: + the column axis (second; "" for a single-axis unit, x, y, ... for an
+    # instrument's, null for a failed unit): the fleet table is long-form, a row per unit ×
+    # axis (issue 28; docs/guide/fleet.md)
+    "fleet_row": "48b74198732d83745bdc3d5cd26bc9f5e0ef068a7352a414284cbe9c4af7631f",
 }
 
 

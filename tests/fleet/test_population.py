@@ -5,9 +5,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from hrgtc.core.errors import InputError
 from hrgtc.fleet.population import (
+    AXES,
     F20_HZ,
     SPREAD,
+    draw_instrument,
     draw_unit,
     draw_units,
     relative_law,
@@ -45,3 +48,24 @@ def test_spread_is_the_documented_one():
     unit, draw = draw_unit(11, 0)
     record = truth(unit, draw)
     assert float(true_frequency_hz(record, 20.0)) == pytest.approx(draw["f20_hz"], rel=1e-12)
+
+
+def test_an_instruments_axes_are_drawn_units_in_one_housing():
+    instrument, draws = draw_instrument(7, 3)
+    assert instrument.name == "s7-u0003" and instrument.axis_names == AXES
+    assert draw_instrument(7, 3, 2)[0].axes["y"] == instrument.axes["y"]  # axis j alone
+    housing = {u.thermal.tau_housing_s for u in instrument.axes.values()}
+    resonators = {u.thermal.tau_resonator_s for u in instrument.axes.values()}
+    assert len(housing) == 1 and len(resonators) == 3
+    # each axis is drawn as a unit is, from its own seed: other laws than unit 3's
+    unit, _ = draw_unit(7, 3)
+    f20 = {axis: draws[axis]["f20_hz"] for axis in AXES}
+    assert len({*f20.values(), unit.frequency_law.frequency_hz(np.array(20.0)).item()}) == 4
+    for axis, gyro in instrument.axes.items():
+        record = truth(gyro, draws[axis])
+        assert record["unit"]["name"] == f"s7-u0003:{axis}"
+        assert float(true_frequency_hz(record, 20.0)) == pytest.approx(f20[axis], rel=1e-12)
+    spread = np.array([d["f20_hz"] for k in range(60) for d in draw_instrument(11, k)[1].values()])
+    assert spread.std() == pytest.approx(SPREAD["f20_hz"], rel=0.2)
+    with pytest.raises(InputError, match="1 to 3 axes"):
+        draw_instrument(7, 3, 4)

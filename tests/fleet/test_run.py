@@ -10,28 +10,10 @@ from pathlib import Path
 
 import pytest
 
-from hrgtc.fleet import calibrate_fleet, load_fleet, report_fleet, simulate_fleet
+from hrgtc.fleet import calibrate_fleet, load_fleet, report_fleet
 from hrgtc.fleet.report import outliers, robust_z
 from hrgtc.fleet.results import read_table
-from hrgtc.settings.fleet import FleetCluster, FleetSimulation
-
-# Tiny rates and short soaks: the physics does not depend on the rate.
-SMALL = {"sample_rate_hz": 1.0, "soak_hours": 2.5, "ramp_hours": 2.0,
-         "setpoints_c": (-20.0, 0.0, 10.0, 20.0, 40.0)}
-
-
-@pytest.fixture(scope="module")
-def fleet_root(tmp_path_factory) -> Path:
-    """Three simulated units and a fourth whose first soak is a corrupt file, in a manifest."""
-    root = tmp_path_factory.mktemp("fleet")
-    run = simulate_fleet(root / "data", FleetSimulation(units=3, seed=5, **SMALL),
-                         cluster=FleetCluster(workers=0))
-    assert run.counts()["ok"] == 3
-    bad = root / "data" / "s5-bad"
-    shutil.copytree(root / "data" / "s5-u0000", bad)
-    corrupt = sorted((bad / "soaks").glob("*.parquet"))[0]
-    corrupt.write_bytes(b"PAR1 this is not a parquet file")
-    return root / "data"
+from hrgtc.settings.fleet import FleetCluster
 
 
 def _models(folder: Path) -> dict[str, dict]:
@@ -83,6 +65,13 @@ def test_resume_skips_unchanged_units_and_redoes_changed_ones(fleet_root, tmp_pa
         calibrate_fleet(data, tmp_path / "models", cluster=FleetCluster(workers=0))
     again = calibrate_fleet(data, tmp_path / "models", cluster=FleetCluster(workers=0), resume=True)
     assert again.counts() == {"ok": 0, "skipped": 3, "failed": 1}
+    # an outcome written before the long form (the unit's one row, no axes) is redone
+    record = tmp_path / "models" / "s5-u0003.outcome.json"
+    shutil.copytree(data / "s5-u0002", data / "s5-u0003")
+    calibrate_fleet(data, tmp_path / "models", cluster=FleetCluster(workers=0), resume=True)
+    stored = json.loads(record.read_text())
+    (axis,) = stored.pop("axes")
+    record.write_text(json.dumps({**stored, "row": {**stored["row"], **axis, "axis": None}}))
     # repair the bad unit's file and change another unit's drift run
     shutil.copy(fleet_root / "s5-u0000" / "soaks" / "soak_-20C.parquet",
                 data / "s5-bad" / "soaks" / "soak_-20C.parquet")
@@ -91,8 +80,9 @@ def test_resume_skips_unchanged_units_and_redoes_changed_ones(fleet_root, tmp_pa
     third = calibrate_fleet(data, tmp_path / "models", cluster=FleetCluster(workers=0), resume=True)
     status = {o.unit: o.status for o in third.outcomes}
     assert status == {"s5-bad": "ok", "s5-u0000": "skipped", "s5-u0001": "ok",
-                      "s5-u0002": "skipped"}
-    assert len(read_table(tmp_path / "models" / "fleet.parquet")) == 4
+                      "s5-u0002": "skipped", "s5-u0003": "ok"}
+    rows = read_table(tmp_path / "models" / "fleet.parquet")
+    assert [(r["unit"], r["axis"]) for r in rows] == [(u, "") for u in sorted(status)]
     assert [u.unit for u in load_fleet(data)] == sorted(status)
 
 

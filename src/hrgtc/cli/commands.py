@@ -44,7 +44,8 @@ OWN_DISTRIBUTION = "hrgtc"
 #: tools and the fleet (typer lists a group after the commands). One not listed comes after
 #: them; ``tests/cli/test_commands.py`` checks the list against ``pyproject.toml``.
 HELP_ORDER = ("compensate", "evaluate", "calibrate", "demo", "export-c", "info", "paper",
-              "report", "simulate", "update", "fleet")
+              "report", "simulate", "test-report", "update",
+              "fleet")
 _SECTION = re.compile(r"^\[(.+)\]\s*$")
 
 

@@ -101,7 +101,8 @@ def calibrate_command(
     inputs: ReadOptions | None = None,
     cluster: FleetCluster | None = None,
 ) -> None:
-    """Calibrate every unit of a fleet: a model per unit and the fleet table (fleet.parquet).
+    """Calibrate every unit of a fleet, every axis of it: a model per unit and the fleet
+    table (fleet.parquet, a row per unit and axis).
 
     Example: hrgtc fleet calibrate fleet/ -o models/ --workers 4
     """
@@ -195,10 +196,14 @@ def prior_command(
         "prior.json"),
     exclude: Annotated[list[str] | None, typer.Option(
         "--exclude", help="Leave this unit out (repeat for more).")] = None,
+    axis: Annotated[str, typer.Option(
+        "--axis", help="The axis of instruments whose thermometers make the prior (x, y, "
+        "...); none for single-axis units.")] = "",
     force: ForceOption = False,
     json_output: JsonOption = False,
 ) -> None:
-    """Population prior of the thermometer: mean and covariance of the relative coefficients.
+    """Population prior of the thermometer: mean and covariance of the relative coefficients
+    (of one axis of a fleet of instruments: --axis).
 
     Example: hrgtc fleet prior models/ -o prior.json, then
     hrgtc calibrate --prior prior.json --soak s-20.parquet --soak s40.parquet --drift ...
@@ -208,7 +213,7 @@ def prior_command(
 
     with library_errors():
         refuse_input(output, _models_folder_inputs(models))
-        prior = build_prior(models, output, force=force, exclude=exclude or ())
+        prior = build_prior(models, output, force=force, exclude=exclude or (), axis=axis)
     if json_output:
         print_json(prior.to_dict())
         return

@@ -26,6 +26,12 @@ comes from:
 Each unit's draw is seeded by ``SeedSequence(seed, spawn_key=(k,))``, so unit k
 is the same whatever the size of the fleet.
 
+An **instrument** of the population (:func:`draw_instrument`, ``hrgtc fleet simulate
+--axes 3``) holds one resonator per axis (x, y, z), each drawn as a unit is (axis j
+of instrument k from ``SeedSequence(seed, spawn_key=(k, j))``) around the same design,
+all in one housing: the first axis's drawn housing time constant is every axis's,
+their resonator constants their own. The axes sense no rate but their bias.
+
 [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
 """
 
@@ -43,10 +49,10 @@ from hrgtc.simulate import units as simulated_units
 from hrgtc.simulate.laws import BiasLaw, PolynomialFrequencyLaw, table1_frequency_law
 from hrgtc.simulate.noise_sources import GyroNoise
 from hrgtc.simulate.thermal import ThermalNetwork
-from hrgtc.simulate.units import Unit, UnitRecord
+from hrgtc.simulate.units import MultiAxisUnit, Unit, UnitRecord
 
-__all__ = ["SPREAD", "DrawRecord", "FleetTruthRecord", "draw_unit", "draw_units",
-           "relative_law"]
+__all__ = ["AXES", "SPREAD", "DrawRecord", "FleetTruthRecord", "draw_instrument", "draw_unit",
+           "draw_units", "relative_law"]
 
 #: 1-sigma unit-to-unit spread (module docstring for the sources).
 SPREAD: dict[str, float] = {
@@ -62,6 +68,8 @@ SPREAD: dict[str, float] = {
 #: f at 20 °C of the unit of [1] (Table 1). [Hz]
 F20_HZ = 4432.07
 REFERENCE_C = 20.0
+#: The axes of a simulated instrument, in column order.
+AXES = ("x", "y", "z")
 
 
 def relative_law() -> np.ndarray:
@@ -75,8 +83,39 @@ def draw_unit(seed: int, k: int, spread: dict[str, float] | None = None) -> tupl
     """Unit ``k`` of the population of ``seed``: ``(unit, draw)``, the draw in plain JSON."""
     if not isinstance(seed, int) or seed < 0 or not isinstance(k, int) or k < 0:
         raise InputError(f"seed and unit index must be non-negative integers, got {seed}, {k}")
+    return _draw(seed, k, (k,), f"s{seed}-u{k:04d}",
+                 f"unit {k} of the simulated population of seed {seed}", spread)
+
+
+def draw_instrument(seed: int, k: int, n_axes: int = len(AXES),
+                    spread: dict[str, float] | None = None) -> tuple[MultiAxisUnit,
+                                                                     dict[str, dict]]:
+    """Instrument ``k`` of the population of ``seed`` (module docstring): ``(instrument,
+    draws)``, each axis's draw in plain JSON by axis."""
+    if not isinstance(seed, int) or seed < 0 or not isinstance(k, int) or k < 0:
+        raise InputError(f"seed and unit index must be non-negative integers, got {seed}, {k}")
+    if not isinstance(n_axes, int) or not 1 <= n_axes <= len(AXES):
+        raise InputError(f"an instrument has 1 to {len(AXES)} axes, got {n_axes!r}")
+    name = f"s{seed}-u{k:04d}"
+    drawn = {axis: _draw(seed, k, (k, j), f"{name}:{axis}",
+                         f"axis {axis} of instrument {k} of the simulated population of seed "
+                         f"{seed}", spread)
+             for j, axis in enumerate(AXES[:n_axes])}
+    housing_s = drawn[AXES[0]][0].thermal.tau_housing_s  # one housing for every axis
+    axes = {axis: replace(unit, thermal=replace(unit.thermal, tau_housing_s=housing_s))
+            for axis, (unit, _) in drawn.items()}
+    instrument = MultiAxisUnit(
+        name=name, description=f"instrument {k} of the simulated population of seed {seed}: "
+        f"{n_axes} drawn resonators in one housing", axes=axes,
+        housing_noise_c=axes[AXES[0]].housing_noise_c)
+    return instrument, {axis: draw for axis, (_, draw) in drawn.items()}
+
+
+def _draw(seed: int, k: int, key: tuple[int, ...], name: str, description: str,
+          spread: dict[str, float] | None) -> tuple[Unit, dict]:
+    """A unit drawn from ``SeedSequence(seed, spawn_key=key)`` (index ``k`` in its draw)."""
     s = {**SPREAD, **(spread or {})}
-    rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(k,)))
+    rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=key))
     base = simulated_units.get("paper-unit")
     f20 = F20_HZ + s["f20_hz"] * rng.standard_normal()
     scale = 1.0 + s["tc_scale"] * rng.standard_normal()
@@ -112,11 +151,8 @@ def draw_unit(seed: int, k: int, spread: dict[str, float] | None = None) -> tupl
     gyro_noise = GyroNoise(arw_deg_per_sqrt_h=noise.arw_deg_per_sqrt_h * lognormal(),
                            bias_instability_dph=noise.bias_instability_dph * lognormal(),
                            rrw_dph_per_sqrt_h=noise.rrw_dph_per_sqrt_h * lognormal())
-    name = f"s{seed}-u{k:04d}"
     unit = replace(
-        base, name=name,
-        description=f"unit {k} of the simulated population of seed {seed}",
-        thermal=thermal,
+        base, name=name, description=description, thermal=thermal,
         frequency_law=PolynomialFrequencyLaw(
             tuple(float(c) for c in coefficients),
             source=f"population draw around Eq. (18) of [1] (seed {seed}, unit {k})"),

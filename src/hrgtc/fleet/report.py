@@ -1,12 +1,14 @@
 """The fleet report: one self-contained HTML file over the fleet table.
 
-Distributions of the units' f at 20 °C, temperature coefficient of frequency,
-relative thermometer coefficients (the basis of the population prior) and
-improvement of the 10 s bias stability (Section 4.2 of [1]); outliers by a
-robust z-score, z = 0.6745 (x - median) / MAD (Iglewicz and Hoaglin's modified
-z-score, flagged beyond 3.5), on each relative coefficient and on the
-improvement; and the units that failed, with the error and its file, column
-and row.
+Per axis (the fleet table is long-form, a row per unit × axis; the x axes of a
+fleet of instruments are one population, their y axes another): distributions of
+the units' f at 20 °C, temperature coefficient of frequency, relative thermometer
+coefficients (the basis of the population prior) and improvement of the 10 s bias
+stability (Section 4.2 of [1]); outliers by a robust z-score, z = 0.6745 (x -
+median) / MAD (Iglewicz and Hoaglin's modified z-score, flagged beyond 3.5), on
+each relative coefficient and on the improvement, within the axis's population;
+and the units that failed, with the error and its file, column and row. A fleet of
+single-axis units is the one population of axis "".
 
 [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
 """
@@ -27,7 +29,7 @@ from matplotlib.figure import Figure
 from hrgtc.core.files import refuse_existing, write_text_atomic
 from hrgtc.report.figures import svg_data_uri
 
-__all__ = ["OUTLIER_Z", "build_fleet_report", "outliers", "robust_z"]
+__all__ = ["OUTLIER_Z", "build_fleet_report", "by_axis", "outliers", "robust_z"]
 
 #: Modified z-score beyond which a unit is flagged (Iglewicz and Hoaglin, 1993).
 OUTLIER_Z = 3.5
@@ -64,17 +66,28 @@ def _quantities(rows: Sequence[dict[str, Any]]) -> dict[str, list[float | None]]
     return out
 
 
+def by_axis(rows: Sequence[dict[str, Any]]) -> dict[str, list[dict[str, Any]]]:
+    """The calibrated rows (status ok or skipped) of each axis, axes in order of appearance
+    (a table written before the long form, without ``axis``: the one axis "")."""
+    groups: dict[str, list[dict[str, Any]]] = {}
+    for row in rows:
+        if row.get("status") in ("ok", "skipped"):
+            groups.setdefault(row.get("axis") or "", []).append(row)
+    return groups
+
+
 def outliers(rows: Sequence[dict[str, Any]], limit: float = OUTLIER_Z) -> list[dict[str, Any]]:
-    """Units whose relative coefficients or improvement have |robust z| > ``limit``."""
-    done = [r for r in rows if r.get("status") in ("ok", "skipped")]
+    """Units whose relative coefficients or improvement have |robust z| > ``limit`` among
+    the units' same axis (``axis`` of each flag: "" for single-axis units)."""
     flagged = []
-    for name, values in _quantities(done).items():
-        if name in ("f20_hz", "tcf_ppm_per_c"):
-            continue  # b1 carries the TCF; f20 spread is geometry, not a fault
-        for row, value, z in zip(done, values, robust_z(values), strict=True):
-            if math.isfinite(z) and abs(z) > limit:
-                flagged.append({"unit": row["unit"], "quantity": name, "value": value,
-                                "z": float(z)})
+    for axis, done in by_axis(rows).items():
+        for name, values in _quantities(done).items():
+            if name in ("f20_hz", "tcf_ppm_per_c"):
+                continue  # b1 carries the TCF; f20 spread is geometry, not a fault
+            for row, value, z in zip(done, values, robust_z(values), strict=True):
+                if math.isfinite(z) and abs(z) > limit:
+                    flagged.append({"unit": row["unit"], "axis": axis, "quantity": name,
+                                    "value": value, "z": float(z)})
     return flagged
 
 
@@ -116,36 +129,48 @@ def _html_table(headers: Sequence[str], rows: Sequence[Sequence[Any]]) -> str:
     return f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
 
 
+def _distributions(axis: str, done: Sequence[dict[str, Any]]) -> list[str]:
+    """The summary table and histograms of one axis's population."""
+    quantities = _quantities(done)
+    summary = []
+    for name, values in quantities.items():
+        v = np.array([x for x in values if x is not None], dtype=float)
+        if v.size:
+            summary.append((name, float(np.median(v)), float(v.mean()),
+                            float(v.std(ddof=1)) if v.size > 1 else None,
+                            float(v.min()), float(v.max())))
+    which = f", axis {axis}" if axis else ""
+    uri = svg_data_uri(_histograms(quantities))
+    return [f"<h2>Distributions{escape(which)}</h2>",
+            _html_table(("quantity", "median", "mean", "std", "min", "max"), summary),
+            f'<figure><img alt="distributions{escape(which)}" src="{uri}">'
+            f"<figcaption>Distributions over the calibrated units{escape(which)}; red lines "
+            f"mark outliers (|robust z| > {OUTLIER_Z}).</figcaption></figure>"]
+
+
 def build_fleet_report(rows: Sequence[dict[str, Any]], output: str | os.PathLike[str], *,
                        title: str = "Fleet calibration report", force: bool = False) -> Path:
-    """Write the fleet report (one self-contained HTML file) from the fleet table's rows."""
+    """Write the fleet report (one self-contained HTML file) from the fleet table's rows
+    (a row per unit × axis; each axis's distributions and outliers apart)."""
     target = Path(output)
     refuse_existing(target, force)
-    done = [r for r in rows if r.get("status") in ("ok", "skipped")]
+    groups = by_axis(rows)
     failed = [r for r in rows if r.get("status") == "failed"]
-    quantities = _quantities(done)
+    units = {r["unit"] for r in rows}
+    done = {r["unit"] for group in groups.values() for r in group}
+    axes = f" of {len(groups)} axes ({', '.join(groups)})" if len(groups) > 1 else ""
     parts = [f"<h1>{escape(title)}</h1>",
              f'<p class="muted">hrgtc fleet report, {datetime.now(UTC):%Y-%m-%d %H:%M} UTC. '
-             f"{len(rows)} units: {len(done)} calibrated, "
-             f'<span class="{"bad" if failed else ""}">{len(failed)} failed</span>.</p>']
-    if done:
-        parts.append("<h2>Distributions</h2>")
-        summary = []
-        for name, values in quantities.items():
-            v = np.array([x for x in values if x is not None], dtype=float)
-            if v.size:
-                summary.append((name, float(np.median(v)), float(v.mean()),
-                                float(v.std(ddof=1)) if v.size > 1 else None,
-                                float(v.min()), float(v.max())))
-        parts.append(_html_table(("quantity", "median", "mean", "std", "min", "max"), summary))
-        uri = svg_data_uri(_histograms(quantities))
-        parts.append(f'<figure><img alt="distributions" src="{uri}">'
-                     "<figcaption>Distributions over the calibrated units; red lines mark "
-                     f"outliers (|robust z| > {OUTLIER_Z}).</figcaption></figure>")
+             f"{len(units)} units{escape(axes)}: {len(done)} calibrated, "
+             f'<span class="{"bad" if failed else ""}">'
+             f"{len({r['unit'] for r in failed})} failed</span>.</p>"]
+    for axis, group in groups.items():
+        parts += _distributions(axis, group)
     flagged = outliers(rows)
     parts.append("<h2>Outliers</h2>")
-    parts.append(_html_table(("unit", "quantity", "value", "robust z"),
-                             [(f["unit"], f["quantity"], f["value"], f["z"]) for f in flagged])
+    parts.append(_html_table(("unit", "axis", "quantity", "value", "robust z"),
+                             [(f["unit"], f["axis"], f["quantity"], f["value"], f["z"])
+                              for f in flagged])
                  if flagged else "<p>None: every unit within "
                  f"|robust z| ≤ {OUTLIER_Z} on its relative coefficients and improvement.</p>")
     parts.append("<h2>Failed units</h2>")
@@ -156,10 +181,10 @@ def build_fleet_report(rows: Sequence[dict[str, Any]], output: str | os.PathLike
                  if failed else "<p>None.</p>")
     parts.append("<h2>Units</h2>")
     parts.append(_html_table(
-        ("unit", "status", "f20 [Hz]", "TCF [ppm/°C]", "soaks", "max table error [°C]",
+        ("unit", "axis", "status", "f20 [Hz]", "TCF [ppm/°C]", "soaks", "max table error [°C]",
          "terms kept", "raw 10 s [°/h]", "compensated 10 s [°/h]", "improvement [×]"),
-        [(r["unit"], r["status"], r.get("f20_hz"), r.get("tcf_ppm_per_c"), r.get("n_soaks"),
-          r.get("table_max_error_c"), ", ".join(r.get("terms_kept") or []),
+        [(r["unit"], r.get("axis"), r["status"], r.get("f20_hz"), r.get("tcf_ppm_per_c"),
+          r.get("n_soaks"), r.get("table_max_error_c"), ", ".join(r.get("terms_kept") or []),
           _join(r.get("raw_10s_dph")), _join(r.get("compensated_10s_dph")),
           r.get("median_improvement_10s")) for r in rows]))
     html = (f'<!DOCTYPE html><html lang="en"><head><meta charset="utf-8"><title>'

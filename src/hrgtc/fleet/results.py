@@ -1,11 +1,14 @@
-"""The fleet table: one Parquet row per unit.
+"""The fleet table: long form, one Parquet row per unit × axis.
 
-A row holds the unit's thermometer (coefficients, Eq. 18 form of [1], and the
-relative scaled coefficients a prior is built from), its Table 1 (soak
+A unit of one axis has one row (``axis`` ""), an instrument of three axes three
+(``axis`` x, y, z), and a unit that failed one row (``axis`` None: its axes were
+not known). A row holds the axis's thermometer (coefficients, Eq. 18 form of [1],
+and the relative scaled coefficients a prior is built from), its Table 1 (soak
 temperatures and settled frequencies), the temperature coefficient of frequency
 at 20 °C, the drift terms kept (Eq. 22 form), the raw and compensated 10 s bias
 stability of each held-out run with the shares of samples out of the calibrated
-ranges, and the status with, for a failed unit, the error and where it was.
+ranges; and the unit's status, wall time, model file and, for a failed unit, the
+error and where it was (the same on each of the unit's rows).
 
 [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
 """
@@ -39,13 +42,13 @@ from hrgtc.core.files import publish, refuse_existing, temporary_beside
 
 if TYPE_CHECKING:
     from hrgtc.evaluation import Evaluation
-    from hrgtc.pipeline.calibration import CalibrationResult
+    from hrgtc.pipeline.instrument import InstrumentCalibration
 
 __all__ = [
     "SCHEMA",
     "FleetRowRecord",
     "arrow_schema",
-    "calibration_row",
+    "calibration_rows",
     "evaluation_row",
     "read_table",
     "row_json_schema",
@@ -68,12 +71,14 @@ class Outcome(Protocol):
     @property
     def row(self) -> dict[str, Any]: ...
     @property
+    def axes(self) -> tuple[dict[str, Any], ...]: ...
+    @property
     def error(self) -> dict[str, Any] | None: ...
     @property
     def seconds(self) -> float: ...
 
 class FleetRowRecord(records.Record, kw_only=True):
-    """A unit's row of the fleet table: its columns in order, their types and bounds.
+    """A row of the fleet table, one unit's axis: its columns in order, their types and bounds.
 
     The one definition of the table: :data:`SCHEMA` (the Arrow schema, every column
     nullable) and the table's JSON Schema (:func:`row_json_schema`) come from it, and
@@ -82,6 +87,9 @@ class FleetRowRecord(records.Record, kw_only=True):
     """
 
     unit: str
+    #: The axis of the row: "" for a single-axis unit, else its name (x, y, z, ...) as the
+    #: recording's column suffix; None for a unit that failed before its axes were known.
+    axis: str | None = None
     status: Literal["ok", "skipped", "failed"]
     seconds: records.NonNegative
     error_type: str | None = None
@@ -169,43 +177,51 @@ def evaluation_row(evaluations: Sequence[Evaluation]) -> dict[str, Any]:
     }
 
 
-def calibration_row(result: CalibrationResult, model_file: str) -> dict[str, Any]:
-    """A calibrated unit's row (thermometer, Table 1, drift terms, validation)."""
+def calibration_rows(calibration: InstrumentCalibration) -> tuple[dict[str, Any], ...]:
+    """A calibrated unit's rows, one per axis: the axis's thermometer, Table 1, drift terms
+    and held-out runs (``calibration.validation``)."""
     from hrgtc.thermometry.prior import relative_coefficients
 
-    model = result.model
-    th = model.thermometer
-    a0, relative = relative_coefficients(th, th.centre_c, th.scale_c)
-    f20 = float(th.frequency(20.0))
-    return {
-        "unit": model.unit, "model_file": model_file, "n_soaks": len(result.plateaus),
-        "temperature_low_c": th.temperature_range_c[0],
-        "temperature_high_c": th.temperature_range_c[1],
-        "centre_c": th.centre_c, "scale_c": th.scale_c,
-        "coefficients_high_first": list(th.coefficients_high_first),
-        "freq_centre_hz": a0, "relative_coefficients": [float(v) for v in relative],
-        "f20_hz": f20, "tcf_ppm_per_c": float(th.slope_hz_per_c(20.0)) / f20 * 1e6,
-        "soak_temperatures_c": [r["chamber_c"] for r in result.table],
-        "settled_freqs_hz": [r["freq_hz"] for r in result.table],
-        "table_max_error_c": max((abs(r["error_c"]) for r in result.table), default=None),
-        "terms_kept": list(model.drift.selected), "n_terms": len(model.drift.selected),
-        **evaluation_row(result.validation),
-    }
+    rows = []
+    for axis, result in calibration.axes.items():
+        part = calibration.model.axes[axis]
+        th = part.thermometer
+        a0, relative = relative_coefficients(th, th.centre_c, th.scale_c)
+        f20 = float(th.frequency(20.0))
+        rows.append({
+            "axis": axis, "n_soaks": len(result.plateaus),
+            "temperature_low_c": th.temperature_range_c[0],
+            "temperature_high_c": th.temperature_range_c[1],
+            "centre_c": th.centre_c, "scale_c": th.scale_c,
+            "coefficients_high_first": list(th.coefficients_high_first),
+            "freq_centre_hz": a0, "relative_coefficients": [float(v) for v in relative],
+            "f20_hz": f20, "tcf_ppm_per_c": float(th.slope_hz_per_c(20.0)) / f20 * 1e6,
+            "soak_temperatures_c": [r["chamber_c"] for r in result.table],
+            "settled_freqs_hz": [r["freq_hz"] for r in result.table],
+            "table_max_error_c": max((abs(r["error_c"]) for r in result.table), default=None),
+            "terms_kept": list(part.drift.selected), "n_terms": len(part.drift.selected),
+            **evaluation_row(calibration.validation.get(axis, ())),
+        })
+    return tuple(rows)
 
 
 def table(outcomes: Sequence[Outcome]) -> pa.Table:
-    """The fleet table of some outcomes, a row per unit in name order."""
+    """The fleet table of some outcomes: a row per unit × axis, units in name order and each
+    unit's axes in its model's order (an outcome without axes: one row, its ``row``)."""
     rows = []
     for outcome in sorted(outcomes, key=lambda o: o.unit):
         error = outcome.error or {}
-        row = {name: None for name in SCHEMA.names}
-        row.update({k: v for k, v in outcome.row.items() if k in row})
-        row.update(unit=outcome.unit, status=outcome.status, seconds=outcome.seconds,
-                   error_type=error.get("type"), error_message=error.get("message"),
-                   error_file=error.get("file"), error_column=error.get("column"),
-                   error_row=error.get("row"))
-        records.load(row, FleetRowRecord, f"fleet table row of unit {outcome.unit!r}")
-        rows.append(row)
+        for part in outcome.axes or ({},):
+            row = {name: None for name in SCHEMA.names}
+            row.update({k: v for k, v in outcome.row.items() if k in row})
+            row.update({k: v for k, v in part.items() if k in row})
+            row.update(unit=outcome.unit, status=outcome.status, seconds=outcome.seconds,
+                       error_type=error.get("type"), error_message=error.get("message"),
+                       error_file=error.get("file"), error_column=error.get("column"),
+                       error_row=error.get("row"))
+            where = f"unit {outcome.unit!r}" + (f", axis {row['axis']!r}" if part else "")
+            records.load(row, FleetRowRecord, f"fleet table row of {where}")
+            rows.append(row)
     return pa.Table.from_pylist(rows, schema=SCHEMA)
 
 

@@ -1,12 +1,16 @@
 """One unit's work as a task: paths in, a small picklable :class:`UnitOutcome` out.
 
-Each function runs the single-unit library function (``simulate_files``,
-``calibrate``, ``evaluate``, ``build_report``) on one unit. The worker reads the
-unit's files from their paths and writes its outputs itself; only paths,
-settings and the outcome (a row of plain numbers) travel between the client and
-the workers. A task never raises: whatever goes wrong becomes a failed outcome
-with the error's type, message and, where the message names them, the file,
-column and row, so one unit's bad input never stops the others.
+Each function runs the library function of one unit (``simulate_files``, the
+calibration chain, the evaluation, ``build_report``) on one unit, of one axis or
+several: a unit whose files hold the columns of several axes (``freq_hz_x``, ...)
+is calibrated and evaluated on every axis, each axis a row of the fleet table. The
+calibration chain is called in one place, :func:`_calibrate_unit`, the evaluation in
+one, :func:`_evaluate_run`. The worker reads the unit's files from their paths and
+writes its outputs itself; only paths, settings and the outcome (rows of plain
+numbers) travel between the client and the workers. A task never raises: whatever
+goes wrong becomes a failed outcome with the error's type, message and, where the
+message names them, the file, column and row, so one unit's bad input never stops
+the others.
 """
 
 from __future__ import annotations
@@ -18,8 +22,9 @@ import traceback
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import TYPE_CHECKING, Annotated, Any, Literal
 
+import msgspec
 from msgspec import Meta
 
 from hrgtc.core import records
@@ -27,9 +32,14 @@ from hrgtc.fleet.manifest import UnitFiles
 from hrgtc.recording import ReadOptions
 from hrgtc.settings.calibration import CalibrationSettings
 from hrgtc.settings.compensation import EvaluationSettings
-from hrgtc.settings.fleet import FleetEvaluation
+from hrgtc.settings.fleet import FleetEvaluation, FleetSimulation
 
 __all__ = ["UnitOutcome", "calibrate_unit", "evaluate_unit", "report_unit", "simulate_unit"]
+
+if TYPE_CHECKING:
+    from hrgtc.evaluation import Evaluation
+    from hrgtc.model import Model
+    from hrgtc.pipeline.instrument import InstrumentCalibration
 
 #: Recording columns an error message may name.
 _COLUMNS = ("time_s", "freq_hz", "rate_dph", "chamber_c", "housing_c", "resonator_c",
@@ -49,7 +59,8 @@ class UnitOutcome:
     status
         ``"ok"``, ``"skipped"`` (resumed: inputs unchanged) or ``"failed"``.
     row
-        The unit's row of the fleet table (plain JSON types).
+        The unit's columns of the fleet table, the same on each of its axes' rows
+        (plain JSON types; without ``axes``, the unit's one row).
     error
         ``{"type", "message", "file", "column", "row"}`` for a failed unit.
     seconds
@@ -57,6 +68,9 @@ class UnitOutcome:
     cpu_seconds
         CPU time of the task's process while it ran (tasks are single-threaded, so
         the work itself, whatever else the machine runs). [s]
+    axes
+        The columns of each of the unit's axes, one row of the fleet table each, in the
+        model's axis order (``axis`` "" for a single-axis unit; empty for a failed unit).
     """
 
     unit: str
@@ -65,6 +79,7 @@ class UnitOutcome:
     error: dict[str, Any] | None = None
     seconds: float = 0.0
     cpu_seconds: float = 0.0
+    axes: tuple[dict[str, Any], ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types (the unit's outcome file), as :class:`UnitOutcomeRecord` writes
@@ -79,7 +94,7 @@ class UnitOutcome:
         if error is not None:  # as error_record gives it: a traceback only when there is one
             values["error"] = {k: v for k, v in error.items()
                                if k != "traceback" or v is not None}
-        return cls(**values)
+        return cls(**{**values, "axes": tuple(values["axes"])})
 
 
 class ErrorRecord(records.Record, kw_only=True):
@@ -101,13 +116,17 @@ class UnitOutcomeRecord(records.Record, kw_only=True):
     """A :class:`UnitOutcome` in its file (``<unit>.outcome.json`` beside the model): field
     names and bounds, from which its ``to_dict``/``from_dict`` and JSON Schema come."""
 
+    omit_when_default = ("axes",)
+
     unit: str
     status: Literal["ok", "skipped", "failed"]
-    #: The unit's row of the fleet table (:mod:`hrgtc.fleet.results`).
+    #: The unit's columns of the fleet table (:mod:`hrgtc.fleet.results`).
     row: dict[str, Any] = records.empty()
     error: ErrorRecord | None = None
     seconds: records.NonNegative = 0.0
     cpu_seconds: records.NonNegative = 0.0
+    #: The columns of each axis, a row of the fleet table each (none: the one ``row``).
+    axes: list[dict[str, Any]] = msgspec.field(default_factory=list)
 
 
 def error_record(exc: BaseException, paths: tuple[str, ...] = ()) -> dict[str, Any]:
@@ -162,20 +181,49 @@ def _resumable(files: UnitFiles, output_dir: str) -> UnitOutcome | None:
         outcome = UnitOutcome.from_dict(json.loads(record.read_text(encoding="utf-8")))
     except Exception:  # a damaged model or record is calibrated again
         return None
-    if outcome.status != "ok" or stored != _input_hashes(files):
-        return None
-    return UnitOutcome(files.unit, "skipped", outcome.row, None, 0.0)
+    if outcome.status != "ok" or not outcome.axes or stored != _input_hashes(files):
+        return None  # (an outcome without axes: written before the long form)
+    return UnitOutcome(files.unit, "skipped", outcome.row, None, 0.0, axes=outcome.axes)
+
+
+def _calibrate_unit(files: UnitFiles, settings: CalibrationSettings,
+                    read_options: ReadOptions | None,
+                    prior_path: str | None) -> InstrumentCalibration:
+    """The one call of the calibration chain for a unit, every axis of it.
+
+    A unit whose first drift run holds the columns of several axes is an instrument
+    (:func:`hrgtc.pipeline.instrument.calibrate_instrument`); one of a single axis is
+    calibrated by :func:`hrgtc.pipeline.calibration.calibrate`, its result as the
+    one-axis instrument (axis ""). Warnings are silenced: the table reports the shares
+    out of the calibrated ranges.
+    """
+    import warnings
+
+    from hrgtc.compensate.multi_axis import recording_axes
+    from hrgtc.pipeline.calibration import calibrate
+    from hrgtc.pipeline.instrument import InstrumentCalibration, calibrate_instrument
+
+    axes = recording_axes(files.drifts[0], read_options) if files.drifts else None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        if axes is not None and len(axes) > 1:
+            return calibrate_instrument(files.soaks, files.drifts, files.validate,
+                                        read_options=read_options, prior=prior_path,
+                                        settings=settings)
+        result = calibrate(files.soaks, files.drifts, files.validate,
+                           read_options=read_options, prior=prior_path, settings=settings)
+    return InstrumentCalibration(result.model, {"": result}, {"": result.validation})
 
 
 def calibrate_unit(files: UnitFiles, output_dir: str, settings: CalibrationSettings,
                    read_options: ReadOptions | None = None, resume: bool = False,
                    prior_path: str | None = None) -> UnitOutcome:
-    """Calibrate one unit (:func:`hrgtc.pipeline.calibration.calibrate`) and write its model file.
+    """Calibrate one unit, every axis of it (:func:`_calibrate_unit`), and write its model file.
 
-    Writes ``<output_dir>/<unit>.json`` (the model) and ``<unit>.outcome.json``
-    (its row), overwriting them: the driver has checked what may be overwritten.
-    With ``resume``, a unit whose model exists and whose inputs' SHA-256 equal
-    those in the model's provenance is skipped (its stored row returned).
+    Writes ``<output_dir>/<unit>.json`` (the model, one file for every axis) and
+    ``<unit>.outcome.json`` (its rows), overwriting them: the driver has checked what may
+    be overwritten. With ``resume``, a unit whose model exists and whose inputs' SHA-256
+    equal those in the model's provenance is skipped (its stored rows returned).
     """
     start, cpu = time.perf_counter(), time.process_time()
     try:
@@ -183,20 +231,15 @@ def calibrate_unit(files: UnitFiles, output_dir: str, settings: CalibrationSetti
             previous = _resumable(files, output_dir)
             if previous is not None:
                 return previous
-        import warnings
-
-        from hrgtc.fleet.results import calibration_row
+        from hrgtc.fleet.results import calibration_rows
         from hrgtc.model import save_model
-        from hrgtc.pipeline.calibration import calibrate
 
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")  # the table reports out-of-range shares
-            result = calibrate(files.soaks, files.drifts, files.validate,
-                               read_options=read_options, prior=prior_path, settings=settings)
+        calibration = _calibrate_unit(files, settings, read_options, prior_path)
         target = model_path(output_dir, files.unit)
-        save_model(result.model, target, force=True)
-        outcome = UnitOutcome(files.unit, "ok", calibration_row(result, str(target)), None,
-                              time.perf_counter() - start, time.process_time() - cpu)
+        save_model(calibration.model, target, force=True)
+        outcome = UnitOutcome(files.unit, "ok", {"unit": files.unit, "model_file": str(target)},
+                              None, time.perf_counter() - start, time.process_time() - cpu,
+                              calibration_rows(calibration))
         _write_outcome(output_dir, outcome)
         return outcome
     except Exception as exc:
@@ -215,26 +258,39 @@ def _write_outcome(output_dir: str, outcome: UnitOutcome) -> None:
                       json.dumps(outcome.to_dict(), indent=1, allow_nan=True) + "\n", force=True)
 
 
+def _evaluate_run(run: str, model: Model, settings: EvaluationSettings,
+                  read_options: ReadOptions | None) -> dict[str, Evaluation]:
+    """The one call of the evaluation for a run: axis ("" for a single-axis model) -> its
+    evaluation (:func:`hrgtc.pipeline.instrument.evaluate_instrument`, each axis's figures
+    those of :func:`hrgtc.evaluation.evaluate` on its view). Warnings are silenced: the
+    table reports the shares out of the calibrated ranges."""
+    import warnings
+
+    from hrgtc.pipeline.instrument import evaluate_instrument
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return evaluate_instrument(run, model, settings=settings,
+                                   read_options=read_options).axes
+
+
 def evaluate_unit(files: UnitFiles, models_dir: str, read_options: ReadOptions | None = None,
                   allan: bool = FleetEvaluation.allan) -> UnitOutcome:
-    """Evaluate one unit's validation runs (or its drift runs without any) with its model."""
+    """Evaluate one unit's validation runs (or its drift runs without any) with its model,
+    every axis of it: a row per axis."""
     start = time.perf_counter()
     try:
-        import warnings
-
-        from hrgtc.evaluation import evaluate
         from hrgtc.fleet.results import evaluation_row
         from hrgtc.model import load_model
 
         model = load_model(model_path(models_dir, files.unit))
-        runs = files.validate or files.drifts
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            settings = EvaluationSettings(allan=allan)
-            evaluations = [evaluate(run, model, settings=settings, read_options=read_options)
-                           for run in runs]
-        return UnitOutcome(files.unit, "ok", evaluation_row(evaluations), None,
-                           time.perf_counter() - start)
+        settings = EvaluationSettings(allan=allan)
+        runs = [_evaluate_run(run, model, settings, read_options)
+                for run in files.validate or files.drifts]
+        rows = tuple({"axis": axis, **evaluation_row([run[axis] for run in runs])}
+                     for axis in model.axes)
+        return UnitOutcome(files.unit, "ok", {"unit": files.unit}, None,
+                           time.perf_counter() - start, axes=rows)
     except Exception as exc:
         return failed(files.unit, exc, files.paths, start)
 
@@ -259,38 +315,46 @@ def report_unit(files: UnitFiles, models_dir: str, output_dir: str,
         return failed(files.unit, exc, files.paths, start)
 
 
-def simulate_unit(seed: int, index: int, root: str, sample_rate_hz: float, soak_hours: float,
-                  setpoints_c: tuple[float, ...], ramp_hours: float, file_format: str,
+def simulate_unit(settings: FleetSimulation, index: int, root: str,
                   force: bool) -> UnitOutcome:
-    """Simulate one unit of the population: soaks, a cool-down, a warm-up and ``truth.json``.
+    """Simulate unit ``index`` of the population (:mod:`hrgtc.fleet.population`; an
+    instrument of ``settings.axes`` axes when more than one): soaks, a cool-down, a
+    warm-up and the ground truth.
 
-    Files: ``ROOT/<unit>/soaks/soak_<T>C``, ``drift/cooldown``, ``validate/warmup``.
+    Files: ``ROOT/<unit>/soaks/soak_<T>C``, ``drift/cooldown``, ``validate/warmup`` and
+    ``truth.json`` (an instrument: ``truth-<axis>.json``, each axis's resonator and draw).
     """
     start = time.perf_counter()
+    seed = settings.seed
     name = f"s{seed}-u{index:04d}"
     try:
         from hrgtc.core.files import write_text_atomic
-        from hrgtc.fleet.population import draw_unit, truth
+        from hrgtc.fleet.population import draw_instrument, draw_unit, truth
         from hrgtc.simulate import simulate_files
         from hrgtc.simulate import standard_profiles as profiles
 
-        unit, draw = draw_unit(seed, index)
+        if settings.axes > 1:
+            unit, draws = draw_instrument(seed, index, settings.axes)
+            truths = {f"truth-{axis}.json": truth(unit.axes[axis], draw)
+                      for axis, draw in draws.items()}
+        else:
+            unit, draw = draw_unit(seed, index)
+            truths = {"truth.json": truth(unit, draw)}
         folder = Path(root) / unit.name
         base = 1_000_003 * seed + 8 * index  # distinct campaign seeds per unit and role
-        high, low = max(setpoints_c), min(setpoints_c)
-        written = simulate_files([profiles.soak(t, soak_hours) for t in setpoints_c],
-                                 folder / "soaks", file_format, unit=unit,
-                                 sample_rate_hz=sample_rate_hz, seed=base + 1, force=force,
-                                 workers=1)
-        written += simulate_files([profiles.cooldown(20.0, low, ramp_hours)], folder / "drift",
-                                  file_format, unit=unit, sample_rate_hz=sample_rate_hz,
-                                  seed=base + 2, force=force, workers=1)
-        written += simulate_files([profiles.warmup(low, min(high, 20.0), ramp_hours)],
-                                  folder / "validate", file_format, unit=unit,
-                                  sample_rate_hz=sample_rate_hz, seed=base + 3, force=force,
-                                  workers=1)
-        write_text_atomic(folder / "truth.json", json.dumps(truth(unit, draw), indent=1) + "\n",
-                          force=force)
+        setpoints_c = tuple(float(t) for t in settings.setpoints_c)
+        high, low, ramp_hours = max(setpoints_c), min(setpoints_c), settings.ramp_hours
+        runs = (("soaks", [profiles.soak(t, settings.soak_hours) for t in setpoints_c]),
+                ("drift", [profiles.cooldown(20.0, low, ramp_hours)]),
+                ("validate", [profiles.warmup(low, min(high, 20.0), ramp_hours)]))
+        written = []
+        for k, (role, campaign) in enumerate(runs, start=1):
+            written += simulate_files(campaign, folder / role, settings.file_format, unit=unit,
+                                      sample_rate_hz=settings.sample_rate_hz, seed=base + k,
+                                      force=force, workers=1)
+        for file, document in truths.items():
+            write_text_atomic(folder / file, json.dumps(document, indent=1) + "\n",
+                              force=force)
         return UnitOutcome(unit.name, "ok", {"unit": unit.name, "files": len(written),
                                              "rows": sum(w.rows for w in written)},
                            None, time.perf_counter() - start)

@@ -4,7 +4,7 @@ Each function builds one task per unit (:mod:`hrgtc.fleet.tasks`), runs them
 with :func:`hrgtc.fleet.run.run_tasks` (sequentially, on a local Dask cluster
 or on an existing one) and writes the fleet's outputs: the models and the
 fleet table (``fleet.parquet``), the evaluation table, the fleet report, the
-prior.
+prior. The tables are long-form: a row per unit × axis (:mod:`hrgtc.fleet.results`).
 """
 
 from __future__ import annotations
@@ -44,12 +44,12 @@ def simulate_fleet(output: PathLike, settings: FleetSimulation | None = None, *,
                    force: bool = False, cluster: FleetCluster | None = None,
                    progress: Progress | None = None) -> FleetRun:
     """Simulate ``settings.units`` units of the population of ``settings.seed`` under
-    ``output/<unit>/``.
+    ``output/<unit>/`` (instruments of ``settings.axes`` axes when more than one).
 
     Unit k gets soaks at ``settings.setpoints_c`` (``soaks/``), a cool-down (``drift/``),
-    a warm-up (``validate/``) and its ground truth (``truth.json``): the drawn
-    frequency law, thermal constants, bias law and noise
-    (:mod:`hrgtc.fleet.population`). ``cluster``: where the units run (default: a local
+    a warm-up (``validate/``) and its ground truth (``truth.json``; an instrument's
+    ``truth-<axis>.json`` per axis): the drawn frequency law, thermal constants, bias law
+    and noise (:mod:`hrgtc.fleet.population`). ``cluster``: where the units run (default: a local
     Dask cluster, one worker per core).
     """
     settings = settings or FleetSimulation()
@@ -60,11 +60,7 @@ def simulate_fleet(output: PathLike, settings: FleetSimulation | None = None, *,
     if not force and root.is_dir() and any(root.iterdir()):
         raise InputError(f"{root} is not empty; pass --force to overwrite or give a new folder")
     root.mkdir(parents=True, exist_ok=True)
-    seed = settings.seed
-    work = [(f"s{seed}-u{k:04d}", tasks.simulate_unit,
-             (seed, k, str(root), settings.sample_rate_hz, settings.soak_hours,
-              tuple(float(t) for t in settings.setpoints_c), settings.ramp_hours,
-              settings.file_format, force))
+    work = [(f"s{settings.seed}-u{k:04d}", tasks.simulate_unit, (settings, k, str(root), force))
             for k in range(units)]
     return run_tasks(work, cluster=cluster, progress=progress, label="simulate")
 
@@ -75,10 +71,12 @@ def calibrate_fleet(source: PathLike | Sequence[UnitFiles], output: PathLike, *,
                     force: bool = False, prior: PathLike | None = None,
                     cluster: FleetCluster | None = None,
                     progress: Progress | None = None) -> FleetRun:
-    """Calibrate every unit (:func:`hrgtc.pipeline.calibration.calibrate` as one task per unit).
+    """Calibrate every unit, every axis of it, as one task per unit
+    (:func:`hrgtc.fleet.tasks.calibrate_unit`).
 
-    Writes ``output/<unit>.json`` (models), ``output/<unit>.outcome.json`` and the
-    fleet table ``output/fleet.parquet``. Existing models are refused unless
+    Writes ``output/<unit>.json`` (models: one file per unit, for every axis),
+    ``output/<unit>.outcome.json`` and the fleet table ``output/fleet.parquet`` (a row per
+    unit × axis). Existing models are refused unless
     ``force`` (recalibrate all) or ``resume`` (skip units whose model exists and
     whose inputs' SHA-256 are unchanged, recalibrate the others).
 
@@ -115,7 +113,8 @@ def evaluate_fleet(source: PathLike | Sequence[UnitFiles], models: PathLike,
                    settings: FleetEvaluation | None = None, force: bool = False,
                    cluster: FleetCluster | None = None,
                    progress: Progress | None = None) -> FleetRun:
-    """Evaluate each unit's held-out runs with its model; write the evaluation table.
+    """Evaluate each unit's held-out runs with its model, every axis of it; write the
+    evaluation table (a row per unit × axis).
 
     ``output`` defaults to ``<models>/evaluation.parquet``; ``settings``: what is computed
     (default: the Allan noise terms too).
@@ -168,11 +167,13 @@ def report_fleet(models: PathLike, output: PathLike, *, table: PathLike | None =
 
 
 def build_prior(models: PathLike, output: PathLike | None = None, *, force: bool = False,
-                exclude: Sequence[str] = ()) -> Any:
+                exclude: Sequence[str] = (), axis: str = "") -> Any:
     """The population prior of a models folder (every ``<unit>.json`` model file).
 
-    Units whose model was fitted with a prior themselves are left out (they would
-    feed the prior back into itself), as are those in ``exclude``.
+    ``axis``: the axis whose thermometers make the prior ("" : single-axis units; the x
+    axes of a fleet of instruments are one population, their y axes another). Models
+    without that axis are left out, as are units whose model was fitted with a prior
+    themselves (they would feed the prior back into itself) and those in ``exclude``.
     """
     from hrgtc.model import load_model
     from hrgtc.thermometry.prior import ThermometerPrior, save_prior
@@ -180,7 +181,7 @@ def build_prior(models: PathLike, output: PathLike | None = None, *, force: bool
     folder = Path(models)
     if not folder.is_dir():
         raise InputError(f"{folder}: no such models folder")
-    thermometers, names = [], []
+    thermometers, names, other_axes = [], [], set()
     for path in sorted(folder.glob("*.json")):
         if path.name.endswith(".outcome.json"):
             continue
@@ -191,11 +192,18 @@ def build_prior(models: PathLike, output: PathLike | None = None, *, force: bool
         if not isinstance(head, dict) or head.get("schema") != "hrgtc.model":
             continue
         model = load_model(path)
+        if axis not in model.axes:
+            other_axes.update(model.axes)
+            continue
         if model.unit in exclude or "prior" in model.provenance.get("settings", {}):
             continue
-        thermometers.append(model.thermometer)
+        thermometers.append(model.axes[axis].thermometer)
         names.append(model.unit)
     if not thermometers:
+        if other_axes:
+            raise InputError(
+                f"{folder}: no model file has the axis {axis!r}; the models' axes are "
+                f"{', '.join(sorted(a or repr('') for a in other_axes))}: pass --axis")
         raise InputError(f"{folder}: no model files; run 'hrgtc fleet calibrate' first")
     prior = ThermometerPrior.from_thermometers(thermometers, names)
     if output is not None:

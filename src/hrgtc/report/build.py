@@ -13,12 +13,13 @@ import os
 from collections.abc import Sequence
 from pathlib import Path
 
+from hrgtc.core.errors import InputError
 from hrgtc.core.files import refuse_existing, write_text_atomic
 from hrgtc.core.progress import Progress
 from hrgtc.evaluation import Evaluation
 from hrgtc.model import Model
 from hrgtc.recording import ReadOptions
-from hrgtc.report.inputs import report_inputs
+from hrgtc.report.inputs import ReportInputs, report_inputs
 from hrgtc.report.kinds import kind as report_kind
 from hrgtc.report.render import render
 from hrgtc.settings.compensation import ReportSettings
@@ -96,6 +97,9 @@ def build_report(
     target = Path(output)
     refuse_existing(target, force)
     chosen = report_kind(kind)
+    if chosen.takes is not ReportInputs:
+        raise InputError(f"kind={kind!r} is not made from a model and runs; use "
+                         "hrgtc.report.test_report.write_test_report (hrgtc test-report)")
     inputs = report_inputs(model, runs, soaks=soaks, title=title, max_points=max_points,
                            read_options=read_options, progress=progress, axes=axes,
                            model_source=model_source)

@@ -17,17 +17,21 @@ from typing import Any
 from hrgtc.core.errors import InputError
 from hrgtc.report.inputs import ReportInputs
 from hrgtc.report.paper import paper_report
+from hrgtc.testreport.result import TestReportInputs, campaign_report
 
 __all__ = ["KINDS", "ReportKind", "kind"]
 
 
 @dataclass(frozen=True)
 class ReportKind:
-    """A kind of report: its name (and template folder), its data function and what it is."""
+    """A kind of report: its name (and template folder), its data function and what it is;
+    ``takes``: what its data function reads (the model's :class:`ReportInputs`, or a test
+    campaign's :class:`~hrgtc.testreport.result.TestReportInputs`)."""
 
     name: str
-    data: Callable[[ReportInputs], Any]
+    data: Callable[[Any], Any]
     description: str
+    takes: type = ReportInputs
 
     @property
     def template(self) -> str:
@@ -40,6 +44,10 @@ KINDS: dict[str, ReportKind] = {kind.name: kind for kind in (
     ReportKind("paper", paper_report,
                "the calibration's evidence laid out like [1]: Figs. 3-6, Tables 1-2, Eq. 18 and "
                "Eq. 22, each run's bias stability and Allan deviation"),
+    ReportKind("test-report", campaign_report,
+               "a test campaign's IEEE-style figures (turn-on, bias repeatability, temperature "
+               "sensitivities, scale factor, Allan noise terms) judged against a spec",
+               TestReportInputs),
 )}
 
 

@@ -28,6 +28,8 @@ class FleetSimulation:
         SETPOINTS_C, "Soak set-points, comma separated.", unit="°C", cli="--setpoints")
     file_format: str = setting("parquet", "File format.", cli="--format",
                                choices=FILE_FORMATS)
+    axes: int = setting(1, "Axes per unit: 1, or 2-3 for instruments whose resonators (x, y, "
+                        "z), each drawn as a unit is, share one housing.", min=1, max=3)
 
 
 @dataclass(frozen=True)
