@@ -160,6 +160,8 @@ class Dumped:
         constants, then the fields, then the :func:`derived` properties).
     ``renamed``
         Old key -> field: a key older files wrote under another name, read as the field.
+    ``required``
+        Fields a file must hold although the constructor has a default for them.
     """
 
     __slots__ = ()
@@ -170,6 +172,7 @@ class Dumped:
     tag: ClassVar[tuple[str, str] | None] = None
     record_order: ClassVar[tuple[str, ...]] = ()
     renamed: ClassVar[dict[str, str]] = {}
+    required: ClassVar[tuple[str, ...]] = ()
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types (lists, ``None`` for what is not finite): :func:`dump`."""
@@ -241,12 +244,14 @@ def record_of(result: type, name: str | None = None, doc: str | None = None) -> 
     return found
 
 
-def variant(result: type, name: str, doc: str | None = None, **types_: Any) -> type[Record]:
+def variant(result: type, name: str, doc: str | None = None, *,
+            forbid_unknown_fields: bool | None = None, **types_: Any) -> type[Record]:
     """A record of ``result`` other than its own (:func:`record_of`): the same fields, some
     of another type (``term=FTerm``), reading back as ``result``. A field of another
     result nests it as ``Annotated[Step, ScaleStepRecord]``."""
     hints = {**typing.get_type_hints(result, include_extras=True), **types_}
     skip = set(getattr(result, "not_written", ()))
+    required = set(getattr(result, "required", ()))
     fields = {key: (key, Literal[value], value)  # type: ignore[valid-type]
               for key, value in getattr(result, "constants", {}).items()}
     arrays: dict[str, Any] = {}
@@ -257,7 +262,9 @@ def variant(result: type, name: str, doc: str | None = None, **types_: Any) -> t
         dtype = _array_dtype(hints[field])
         if dtype is not None:
             arrays[field] = dtype
-        if factory is not None:
+        if field in required:
+            fields[field] = (field, kind)
+        elif factory is not None:
             fields[field] = (field, kind, msgspec.field(default_factory=factory))
         elif isinstance(default, float) and not math.isfinite(default):
             fields[field] = (field, kind, None)  # as the file spells it (a Statistic)
@@ -275,7 +282,8 @@ def variant(result: type, name: str, doc: str | None = None, **types_: Any) -> t
     tag = getattr(result, "tag", None)
     found = msgspec.defstruct(
         name, [fields[f] for f in order], bases=(Record,), kw_only=True,
-        forbid_unknown_fields=getattr(result, "forbid_unknown_fields", False),
+        forbid_unknown_fields=getattr(result, "forbid_unknown_fields", False)
+        if forbid_unknown_fields is None else forbid_unknown_fields,
         module=result.__module__, **({} if tag is None else {"tag_field": tag[0], "tag": tag[1]}),
         namespace={"__doc__": doc or f"The record of :class:`{result.__name__}` (its "
                                      "``to_dict``, ``from_dict``).",
