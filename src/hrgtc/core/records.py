@@ -71,6 +71,7 @@ __all__ = [
     "record_of",
     "schema_components",
     "statistic",
+    "strict",
     "variant",
 ]
 
@@ -151,7 +152,7 @@ class Dumped:
         True: a key the record does not know is refused (a misspelt input), not ignored.
     ``constants``
         Fields of a fixed value, written first and checked on reading, not the result's:
-        ``{"kind": "hrgtc.Thermometer"}`` (a ``Literal`` in the record and the schema).
+        ``(("kind", "hrgtc.Thermometer"),)`` (a ``Literal`` in the record and schema).
     ``tag``
         ``(field, value)``: the record is a tagged struct, a member of a msgspec tagged
         union told by ``field`` (``("kind", "shell")``).
@@ -159,7 +160,7 @@ class Dumped:
         The record's fields in file order, when it is not the declaration's (the
         constants, then the fields, then the :func:`derived` properties).
     ``renamed``
-        Old key -> field: a key older files wrote under another name, read as the field.
+        ``(old key, field)`` pairs: a key older files wrote under another name.
     ``required``
         Fields a file must hold although the constructor has a default for them.
     """
@@ -168,10 +169,10 @@ class Dumped:
     not_written: ClassVar[tuple[str, ...]] = ()
     omit_when_default: ClassVar[tuple[str, ...]] = ()
     forbid_unknown_fields: ClassVar[bool] = False
-    constants: ClassVar[dict[str, str]] = {}
+    constants: ClassVar[tuple[tuple[str, str], ...]] = ()
     tag: ClassVar[tuple[str, str] | None] = None
     record_order: ClassVar[tuple[str, ...]] = ()
-    renamed: ClassVar[dict[str, str]] = {}
+    renamed: ClassVar[tuple[tuple[str, str], ...]] = ()
     required: ClassVar[tuple[str, ...]] = ()
 
     def to_dict(self) -> dict[str, Any]:
@@ -253,7 +254,7 @@ def variant(result: type, name: str, doc: str | None = None, *,
     skip = set(getattr(result, "not_written", ()))
     required = set(getattr(result, "required", ()))
     fields = {key: (key, Literal[value], value)  # type: ignore[valid-type]
-              for key, value in getattr(result, "constants", {}).items()}
+              for key, value in getattr(result, "constants", ())}
     arrays: dict[str, Any] = {}
     for field, default, factory in _fields(result):
         if field in skip:
@@ -289,8 +290,8 @@ def variant(result: type, name: str, doc: str | None = None, *,
                                      "``to_dict``, ``from_dict``).",
                    "omit_when_default": tuple(getattr(result, "omit_when_default", ())),
                    "arrays": arrays,
-                   "unread": (*getattr(result, "constants", {}), *computed),
-                   "renamed": dict(getattr(result, "renamed", {}))})
+                   "unread": (*dict(getattr(result, "constants", ())), *computed),
+                   "renamed": dict(getattr(result, "renamed", ()))})
     _RESULTS[found] = result
     return found
 
@@ -375,7 +376,7 @@ def dump(result: Any, record: type[Record] | None = None, /, **given: Any) -> di
     except msgspec.ValidationError as exc:
         raise InputError(f"{type(result).__name__} does not fit its record "
                          f"{record.__name__}: {exc}") from exc
-    document = _strict(msgspec.to_builtins(value, enc_hook=_plain))
+    document = strict(msgspec.to_builtins(value, enc_hook=_plain))
     _omit_defaults(document, record)
     return document
 
@@ -390,7 +391,7 @@ def _omit_defaults(document: Any, kind: Any) -> None:
         for field in msgspec.structs.fields(kind):
             if field.name not in document:
                 continue
-            if field.name in kind.omit_when_default and document[field.name] == _strict(
+            if field.name in kind.omit_when_default and document[field.name] == strict(
                     _default(field)):
                 del document[field.name]
             else:
@@ -536,11 +537,12 @@ def statistic(value: Any) -> float:
     return float(value)
 
 
-def _strict(value: Any) -> Any:
+def strict(value: Any) -> Any:
+    """``value`` with every float that is not finite replaced by None (strict JSON)."""
     if isinstance(value, dict):
-        return {k: _strict(v) for k, v in value.items()}
+        return {k: strict(v) for k, v in value.items()}
     if isinstance(value, list | tuple):
-        return [_strict(v) for v in value]
+        return [strict(v) for v in value]
     if isinstance(value, float) and not math.isfinite(value):
         return None
     return value

@@ -26,7 +26,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Annotated, Any, ClassVar
+from typing import Annotated, Any
 
 import numpy as np
 from msgspec import Meta
@@ -124,7 +124,7 @@ class DriftModel(ParsedTerms, records.Written):
 
     #: Its record (the model file's ``drift`` and ``housing``) is generated from these
     #: fields; the parsed terms and the training's accounting are not in the file.
-    constants: ClassVar[dict[str, str]] = {"kind": "hrgtc.DriftModel"}
+    constants = (("kind", "hrgtc.DriftModel"),)
     not_written = ("_terms", "accounting")
 
     settings: FeatureSettings

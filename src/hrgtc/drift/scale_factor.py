@@ -30,7 +30,7 @@ import math
 import warnings
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
-from typing import Annotated, Any, ClassVar
+from typing import Annotated, Any
 
 import numpy as np
 from msgspec import Meta
@@ -145,7 +145,7 @@ class ScaleFactorModel(ParsedTerms, records.Written):
     """
 
     #: Its record (the model file's ``scale_factor``) is generated from these fields.
-    constants: ClassVar[dict[str, str]] = {"kind": "hrgtc.ScaleFactorModel"}
+    constants = (("kind", "hrgtc.ScaleFactorModel"),)
     not_written = ("_terms",)
     forbid_unknown_fields = True
 

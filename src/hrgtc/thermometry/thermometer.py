@@ -24,7 +24,7 @@ from dataclasses import dataclass
 from fractions import Fraction
 from functools import cached_property
 from math import comb
-from typing import Annotated, Any, ClassVar, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
 from msgspec import Meta
@@ -123,9 +123,9 @@ class Thermometer(records.Written):
     """
 
     #: Its record (the model file's ``thermometer``) is generated from these fields.
-    constants: ClassVar[dict[str, str]] = {"kind": "hrgtc.Thermometer"}
+    constants = (("kind", "hrgtc.Thermometer"),)
     omit_when_default = ("source",)  # written only for a sensor: older files hash alike
-    renamed: ClassVar[dict[str, str]] = {"residual_std": "residual_std_hz"}  # before 0.1
+    renamed = (("residual_std", "residual_std_hz"),)  # before 0.1
 
     order: Annotated[int, Meta(ge=1, le=12)]
     n_points: Annotated[int, Meta(ge=2)]
