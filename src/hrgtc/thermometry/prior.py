@@ -35,7 +35,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any
 
 import numpy as np
 from msgspec import Meta
@@ -83,7 +83,7 @@ def relative_coefficients(thermometer: Thermometer, centre_c: float,
 
 
 @dataclass(frozen=True)
-class ThermometerPrior:
+class ThermometerPrior(records.Written):
     """Mean and covariance of the relative scaled thermometer coefficients of a population.
 
     Attributes
@@ -105,19 +105,36 @@ class ThermometerPrior:
         Names of the units the prior was built from.
     """
 
-    order: int
+    #: Its record (:data:`ThermometerPriorRecord`, the prior file): ``schema`` first, the
+    #: version and basis written for the reader (not read back), ``n_units`` derived.
+    constants = (("schema", SCHEMA_NAME),)
+    record_order = ("schema", "schema_version", "order", "centre_c", "scale_c",
+                    "temperature_range_c", "basis", "mean", "covariance", "nominal_freq_hz",
+                    "nominal_freq_std_hz", "point_std_hz", "n_units", "units")
+
+    order: Annotated[int, Meta(ge=1, le=12)]
     centre_c: float
-    scale_c: float
-    temperature_range_c: tuple[float, float]
+    scale_c: records.Positive
+    temperature_range_c: records.Range
     mean: tuple[float, ...]
     covariance: tuple[tuple[float, ...], ...]
     nominal_freq_hz: float
-    nominal_freq_std_hz: float
-    point_std_hz: float
+    nominal_freq_std_hz: records.NonNegative
+    point_std_hz: records.NonNegative
     units: tuple[str, ...] = field(default=())
 
-    @property
-    def n_units(self) -> int:
+    @records.derived(default=SCHEMA_VERSION)
+    def schema_version(self) -> Annotated[int, Meta(ge=1, le=SCHEMA_VERSION)]:
+        """The prior file's schema version."""
+        return SCHEMA_VERSION
+
+    @records.derived(default=BASIS)
+    def basis(self) -> str:
+        """What ``mean`` and ``covariance`` are coefficients of (text for the reader)."""
+        return BASIS
+
+    @records.derived(default=0)
+    def n_units(self) -> records.Count:
         """Number of units behind the prior."""
         return len(self.units)
 
@@ -165,10 +182,6 @@ class ThermometerPrior:
             units=tuple(str(u) for u in units),
         )
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (the prior file), as :class:`ThermometerPriorRecord` writes them."""
-        return records.dump(self, ThermometerPriorRecord)
-
     @classmethod
     def from_dict(cls, data: Mapping[str, Any], source: str = "prior") -> ThermometerPrior:
         """Inverse of :meth:`to_dict` (checked against :class:`ThermometerPriorRecord`)."""
@@ -176,12 +189,9 @@ class ThermometerPrior:
             raise InputError(f"{source}: not an hrgtc prior file; create one with "
                              "'hrgtc fleet prior MODELS -o prior.json'")
         try:
-            values = records.load(data, ThermometerPriorRecord, "thermometer-prior")
+            return records.load(data, cls)  # type: ignore[no-any-return]
         except InputError as exc:
             raise InputError(f"{source}: prior file is corrupt: {exc}") from None
-        for derived in ("schema", "schema_version", "basis", "n_units"):
-            values.pop(derived)
-        return cls(**values)
 
     def summary(self) -> Summary:
         """The units, order and range, the nominal frequency ± its spread and each
@@ -278,25 +288,11 @@ class PriorFit:
                             temperature_band=self.band(13))
 
 
-class ThermometerPriorRecord(records.Record, kw_only=True):
-    """A :class:`ThermometerPrior` in its file (``hrgtc fleet prior``): field names and
-    bounds, from which its ``to_dict``/``from_dict`` and its JSON Schema are generated."""
-
-    schema: Literal["hrgtc.thermometer-prior"] = SCHEMA_NAME
-    schema_version: Annotated[int, Meta(ge=1, le=SCHEMA_VERSION)] = SCHEMA_VERSION
-    order: Annotated[int, Meta(ge=1, le=12)]
-    centre_c: float
-    scale_c: records.Positive
-    temperature_range_c: records.Range
-    #: What ``mean`` and ``covariance`` are coefficients of (text for the reader).
-    basis: str = BASIS
-    mean: tuple[float, ...]
-    covariance: tuple[tuple[float, ...], ...]
-    nominal_freq_hz: float
-    nominal_freq_std_hz: records.NonNegative
-    point_std_hz: records.NonNegative
-    n_units: records.Count = 0
-    units: tuple[str, ...] = ()
+#: The record of :class:`ThermometerPrior` (its file), generated from its fields.
+ThermometerPriorRecord = records.record_of(
+    ThermometerPrior, doc="A :class:`ThermometerPrior` in its file (``hrgtc fleet prior``): "
+    "field names and\nbounds, from which its ``to_dict``/``from_dict`` and its JSON Schema "
+    "are generated.")
 
 
 class PriorFitRecord(records.Record, kw_only=True):
