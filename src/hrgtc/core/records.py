@@ -163,6 +163,9 @@ class Dumped:
         ``(old key, field)`` pairs: a key older files wrote under another name.
     ``required``
         Fields a file must hold although the constructor has a default for them.
+    ``written_by``
+        Its record when it cannot be generated beside it: a :class:`Record` of a module
+        below the result's, where a document nests it (it is read back as the result).
     """
 
     __slots__ = ()
@@ -174,6 +177,7 @@ class Dumped:
     record_order: ClassVar[tuple[str, ...]] = ()
     renamed: ClassVar[tuple[tuple[str, str], ...]] = ()
     required: ClassVar[tuple[str, ...]] = ()
+    written_by: ClassVar[type[Record] | None] = None
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types (lists, ``None`` for what is not finite): :func:`dump`."""
@@ -240,8 +244,11 @@ def record_of(result: type, name: str | None = None, doc: str | None = None) -> 
             raise TypeError(f"{result.__name__}'s record is {found.__name__} "
                             f"({found.__doc__!r}), not {name} ({doc!r})")
         return found
-    found = variant(result, name or f"{result.__name__}Record", doc)
+    given = getattr(result, "written_by", None)
+    found = given if given is not None else variant(result, name or f"{result.__name__}Record",
+                                                    doc)
     _RECORDS[result] = found
+    _RESULTS.setdefault(found, result)
     return found
 
 
