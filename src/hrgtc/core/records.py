@@ -451,8 +451,9 @@ def _plain_value(value: Any) -> Any:
         return {k: _plain_value(v) for k, v in value.items()}
     if isinstance(value, list | tuple):
         return [_plain_value(v) for v in value]
-    if hasattr(value, "__dataclass_fields__"):
-        return _View(value, {})
+    if hasattr(value, "__dataclass_fields__"):  # a tagged result shows its tag (a union's)
+        tag = getattr(value, "tag", None)
+        return _View(value, {} if tag is None else {tag[0]: tag[1]})
     return value
 
 
