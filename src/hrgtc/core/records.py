@@ -163,6 +163,8 @@ class Dumped:
         ``(old key, field)`` pairs: a key older files wrote under another name.
     ``required``
         Fields a file must hold although the constructor has a default for them.
+    ``file_names``
+        ``(field, key)`` pairs: a field the file writes under another key.
     ``written_by``
         Its record when it cannot be generated beside it: a :class:`Record` of a module
         below the result's, where a document nests it (it is read back as the result).
@@ -177,6 +179,7 @@ class Dumped:
     record_order: ClassVar[tuple[str, ...]] = ()
     renamed: ClassVar[tuple[tuple[str, str], ...]] = ()
     required: ClassVar[tuple[str, ...]] = ()
+    file_names: ClassVar[tuple[tuple[str, str], ...]] = ()
     written_by: ClassVar[type[Record] | None] = None
 
     def to_dict(self) -> dict[str, Any]:
@@ -260,30 +263,22 @@ def variant(result: type, name: str, doc: str | None = None, *,
     hints = {**typing.get_type_hints(result, include_extras=True), **types_}
     skip = set(getattr(result, "not_written", ()))
     required = set(getattr(result, "required", ()))
+    names = dict(getattr(result, "file_names", ()))
     fields = {key: (key, Literal[value], value)  # type: ignore[valid-type]
               for key, value in getattr(result, "constants", ())}
     arrays: dict[str, Any] = {}
     for field, default, factory in _fields(result):
         if field in skip:
             continue
-        kind = _wire(hints[field])
         dtype = _array_dtype(hints[field])
         if dtype is not None:
             arrays[field] = dtype
         if field in required:
-            fields[field] = (field, kind)
-        elif factory is not None:
-            fields[field] = (field, kind, msgspec.field(default_factory=factory))
-        elif isinstance(default, float) and not math.isfinite(default):
-            fields[field] = (field, kind, None)  # as the file spells it (a Statistic)
-        elif default is not msgspec.NODEFAULT:
-            fields[field] = (field, kind, default)
-        else:
-            fields[field] = (field, kind)
+            default, factory = msgspec.NODEFAULT, None
+        fields[field] = _spec(field, _wire(hints[field]), default, factory, names.get(field))
     computed = _derived_fields(result)
     for field, (kind, default) in computed.items():
-        fields[field] = (field, _wire(kind)) if default is msgspec.NODEFAULT else (
-            field, _wire(kind), default)
+        fields[field] = _spec(field, _wire(kind), default, None, names.get(field))
     order = tuple(getattr(result, "record_order", ())) or tuple(fields)
     if sorted(order) != sorted(fields):
         raise TypeError(f"{result.__name__}.record_order {order} is not its fields {tuple(fields)}")
@@ -301,6 +296,22 @@ def variant(result: type, name: str, doc: str | None = None, *,
                    "renamed": dict(getattr(result, "renamed", ()))})
     _RESULTS[found] = result
     return found
+
+
+def _spec(field: str, kind: Any, default: Any, factory: Any, name: str | None) -> tuple[Any, ...]:
+    """A field of :func:`msgspec.defstruct`: its default as the file spells it (NaN as
+    ``null``), its name in the file (``file_names``) when it is not the attribute's."""
+    default = _file_default(default)
+    if name is None and factory is None:
+        return (field, kind) if default is msgspec.NODEFAULT else (field, kind, default)
+    return (field, kind, msgspec.field(default=default, name=name,
+                                       default_factory=factory or msgspec.NODEFAULT))
+
+
+def _file_default(default: Any) -> Any:
+    if isinstance(default, float) and not math.isfinite(default):
+        return None  # as the file spells it (a Statistic)
+    return tuple(_file_default(d) for d in default) if isinstance(default, tuple) else default
 
 
 def _derived_fields(result: type) -> dict[str, tuple[Any, Any]]:
@@ -396,13 +407,13 @@ def _omit_defaults(document: Any, kind: Any) -> None:
         if not isinstance(document, dict):
             return
         for field in msgspec.structs.fields(kind):
-            if field.name not in document:
+            if field.encode_name not in document:
                 continue
-            if field.name in kind.omit_when_default and document[field.name] == strict(
+            if field.name in kind.omit_when_default and document[field.encode_name] == strict(
                     _default(field)):
-                del document[field.name]
+                del document[field.encode_name]
             else:
-                _omit_defaults(document[field.name], field.type)
+                _omit_defaults(document[field.encode_name], field.type)
         return
     args = [a for a in get_args(kind) if a is not Ellipsis]
     if isinstance(document, dict) and get_origin(kind) is dict:
