@@ -240,7 +240,7 @@ def load_prior(path: str | os.PathLike[str]) -> ThermometerPrior:
 
 
 @dataclass(frozen=True)
-class PriorFit:
+class PriorFit(records.Dumped):
     """A thermometer fitted with a population prior (the result of :func:`fit_with_prior`).
 
     Attributes
@@ -256,12 +256,28 @@ class PriorFit:
         Largest standardised distance of a soak point from the prior's prediction.
     """
 
+    #: Its record (:data:`PriorFitRecord`, in ``calibrate --prior --json``; written only):
+    #: the prior's size, the points and the uncertainty they leave, not the two fits.
+    not_written = ("thermometer", "prior")
+    record_order = ("prior_units", "temperatures_c", "frequencies_hz", "point_std_hz",
+                    "max_sigma", "max_temperature_std_c", "temperature_band")
+
     thermometer: Thermometer
     prior: ThermometerPrior
     temperatures_c: tuple[float, ...]
     frequencies_hz: tuple[float, ...]
     point_std_hz: tuple[float, ...]
-    max_sigma: float
+    max_sigma: records.Statistic
+
+    @records.derived
+    def prior_units(self) -> records.Count:
+        """Units behind the prior."""
+        return self.prior.n_units
+
+    @records.derived
+    def temperature_band(self) -> dict[str, tuple[records.Statistic, ...]]:
+        """:meth:`band` at 13 temperatures (what the JSON document shows). [°C]"""
+        return self.band(13)
 
     def temperature_std_c(self, temperature_c: Any) -> np.ndarray:
         """1-sigma uncertainty of the temperature read from frequency (delta method). [°C]"""
@@ -277,15 +293,11 @@ class PriorFit:
         t = np.linspace(*self.prior.temperature_range_c, points)
         return {"temperature_c": t.tolist(), "std_c": self.temperature_std_c(t).tolist()}
 
-    @property
-    def max_temperature_std_c(self) -> float:
+    @records.derived
+    def max_temperature_std_c(self) -> records.Statistic:
         """Largest 1-sigma temperature uncertainty over the prior's range. [°C]"""
         return float(np.max(self.band()["std_c"]))
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types, as :class:`PriorFitRecord` writes them (NaN -> None)."""
-        return records.dump(self, PriorFitRecord, prior_units=self.prior.n_units,
-                            temperature_band=self.band(13))
 
 
 #: The record of :class:`ThermometerPrior` (its file), generated from its fields.
@@ -295,16 +307,10 @@ ThermometerPriorRecord = records.record_of(
     "are generated.")
 
 
-class PriorFitRecord(records.Record, kw_only=True):
-    """A :class:`PriorFit` in a JSON document (``calibrate --prior --json``); written only."""
-
-    prior_units: records.Count
-    temperatures_c: tuple[float, ...]
-    frequencies_hz: tuple[float, ...]
-    point_std_hz: tuple[float, ...]
-    max_sigma: records.Statistic
-    max_temperature_std_c: records.Statistic
-    temperature_band: dict[str, tuple[records.Statistic, ...]]
+#: The record of :class:`PriorFit`, generated from its fields and figures.
+PriorFitRecord = records.record_of(
+    PriorFit, doc="A :class:`PriorFit` in a JSON document (``calibrate --prior --json``); "
+    "written only.")
 
 
 #: JSON Schema (Draft 2020-12) of the prior file, generated from :class:`ThermometerPriorRecord`.
