@@ -6,8 +6,10 @@ fields carry their types and bounds (``Annotated[float, Meta(gt=0)]``, :data:`Po
 list, nested results). :func:`record_of` generates its *record*, the
 :class:`msgspec.Struct` that names what the file holds (``<Result>Record``); fields that
 are derived or runtime-only are left out by one declaration, the result's class attribute
-``not_written`` (they need a default, or ``init=False``). The mixin :class:`Written` gives
-a result ``to_dict``/``from_dict`` once. From the declaration:
+``not_written`` (they need a default, or ``init=False``); what else a file's part needs
+(a constant ``kind``, a tag, keys of another name, computed fields: :func:`derived`) is a
+class attribute beside them (:class:`Dumped`). The mixin :class:`Written` gives a result
+``to_dict``/``from_dict`` once (:class:`Dumped`: ``to_dict``). From the declaration:
 
 * :func:`dump` writes a result as plain, strict JSON types: the fields are read off the
   result by name (numpy arrays and scalars by ``tolist``: the one numpy hook), NaN as
@@ -21,9 +23,9 @@ a result ``to_dict``/``from_dict`` once. From the declaration:
 msgspec encodes and decodes dataclasses itself, honouring their ``Meta`` bounds; the
 generated Struct is what lets a result hold numpy arrays and runtime state and keeps each
 definition's name in the published schemas. A :class:`Record` written by hand remains
-where a file's part is not one dataclass's fields (a document of several results, renamed
-or computed fields, a constant ``kind`` written first); :func:`dump` and :func:`load`
-take it in place of a result (``load`` then returns its values as a dict).
+where a file's part is not one dataclass's fields (a document of several results);
+:func:`dump` and :func:`load` take it in place of a result (``load`` then returns its
+values as a dict).
 
 Numbers: a parameter is a finite ``float`` (JSON has no NaN; a file that holds one is
 refused where the record says ``float``); a :data:`Statistic` may also be ``null`` or,
