@@ -250,8 +250,8 @@ class Model:
                 f"{source}: model schema version {version} is newer than this hrgtc "
                 f"understands ({SCHEMA_VERSION}); upgrade hrgtc"
             )
-        temperature_map = _temperature_map(data, source)
         checked = check_document(strict(dict(data)), source, non_standard)
+        temperature_map = _temperature_map(data, checked, source)
         try:
             axes = {name: AxisModel.from_record(part)
                     for name, part in axis_records(checked).items()}
@@ -293,20 +293,19 @@ def _head(model: Model, version: int, single: bool = False) -> dict[str, Any]:
                         temperature_map=None)
 
 
-def _temperature_map(data: Any, source: str) -> dict[str, Any] | None:
-    """The document's ``temperature_map``, checked (None without one)."""
-    if not isinstance(data, Mapping) or data.get("temperature_map") is None:
+def _temperature_map(data: Mapping[str, Any], checked: Any,
+                     source: str) -> dict[str, Any] | None:
+    """The document's ``temperature_map`` as written (None without one), checked from its
+    converted record (:func:`model_schema.check_document`), not converted again."""
+    if checked.temperature_map is None:
         return None
     from hrgtc.thermometry.reference import TemperatureMap
 
-    raw = data["temperature_map"]
-    if not isinstance(raw, Mapping):
-        raise ModelFileError(f"{source}: temperature_map is {raw!r}, not an object")
     try:
-        TemperatureMap.from_dict(raw)
+        TemperatureMap.from_values(records.built(checked.temperature_map))
     except HrgtcError as exc:
         raise ModelFileError(f"{source}: {exc}") from None
-    return dict(raw)
+    return dict(data["temperature_map"])
 
 
 def model_sha256(model: Model) -> str:

@@ -158,15 +158,22 @@ class TemperatureMap:
         refused."""
         if not isinstance(data, Mapping):
             raise InputError(f"temperature_map is {data!r}, not an object")
-        values = records.load(data, TemperatureMapRecord, "temperature_map")
+        known = {f.name for f in msgspec.structs.fields(TemperatureMapRecord)}
+        return cls.from_values(records.load(data, TemperatureMapRecord, "temperature_map"),
+                               {k: v for k, v in data.items() if k not in known})
+
+    @classmethod
+    def from_values(cls, values: Mapping[str, Any],
+                    extra: Mapping[str, Any] | None = None) -> TemperatureMap:
+        """The map of its record's values (:func:`hrgtc.core.records.built` of a converted
+        :class:`TemperatureMapRecord`), checked: a scale of 0 or a non-finite number is
+        refused."""
         scale, offset = values["scale_c_per_count"], values["offset_c"]
         if not (math.isfinite(scale) and math.isfinite(offset) and scale != 0.0):
             raise InputError(f"temperature_map scale {scale!r} / offset {offset!r}: a finite "
                              "scale other than 0 and a finite offset are needed")
-        if values["count_range"] is None:
-            values["count_range"] = (math.nan, math.nan)
-        known = {f.name for f in msgspec.structs.fields(TemperatureMapRecord)}
-        return cls(**values, extra={k: v for k, v in data.items() if k not in known})
+        count_range = values["count_range"] or (math.nan, math.nan)
+        return cls(**{**values, "count_range": count_range}, extra=dict(extra or {}))
 
 
 class TemperatureMapRecord(records.Record, kw_only=True):
