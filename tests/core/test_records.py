@@ -10,6 +10,7 @@ import copy
 import json
 import math
 import re
+from dataclasses import dataclass
 from pathlib import Path
 
 import jsonschema
@@ -175,3 +176,53 @@ def test_a_result_and_its_record_have_the_same_fields(result, record, left_out):
     fields = {f.name for f in dataclasses.fields(result)} - left_out
     written = {f.name for f in msgspec.structs.fields(records.record_of(record))} - {"kind"}
     assert fields == written
+
+
+
+@dataclass(frozen=True)
+class _Part(records.Written):
+    constants = (("kind", "test.Part"),)
+    file_names = (("low", "min"),)
+    renamed = (("old_width", "width"),)
+    required = ("width",)
+    record_order = ("kind", "low", "area", "width")
+
+    low: float
+    width: records.Positive = 1.0
+
+    @records.derived(default=0.0)
+    def area(self) -> float:
+        return self.low * self.width
+
+
+@dataclass(frozen=True)
+class _Tagged(records.Written):
+    tag = ("kind", "tagged")
+    value: int
+
+
+@dataclass(frozen=True)
+class _Holder(records.Written):
+    part: _Tagged
+
+
+def test_what_a_file_part_needs_beyond_its_fields_is_declared_beside_them():
+    """records' class attributes: a constant written first, a key of another name, an old
+    key, a field required though defaulted, a derived figure, the file's order, a tag."""
+    record = records.record_of(_Part, "PartRecord", "A part.")
+    assert record.__struct_fields__ == ("kind", "low", "area", "width")
+    written = _Part(2.0, 3.0).to_dict()
+    assert list(written.items()) == [("kind", "test.Part"), ("min", 2.0), ("area", 6.0),
+                                     ("width", 3.0)]
+    assert _Part.from_dict(written) == _Part(2.0, 3.0)  # area and kind not passed back
+    assert _Part.from_dict({"kind": "test.Part", "min": 2.0, "old_width": 5.0}).width == 5.0
+    with pytest.raises(InputError, match="width"):
+        _Part.from_dict({"min": 2.0})  # required in the file
+    with pytest.raises(InputError, match=r"\$.kind"):
+        _Part.from_dict({**written, "kind": "test.Other"})
+    schema = records.json_schema(_Part, "part", "https://hrgtc.invalid/part.json")
+    assert schema["description"] == "A part."
+    assert schema["properties"]["kind"] == {"enum": ["test.Part"], "default": "test.Part"}
+    assert schema["required"] == ["min", "width"]
+    assert _Holder(_Tagged(4)).to_dict() == {"part": {"kind": "tagged", "value": 4}}
+    assert _Holder.from_dict({"part": {"kind": "tagged", "value": 4}}) == _Holder(_Tagged(4))

@@ -465,7 +465,7 @@ def _plain_value(value: Any) -> Any:
     if isinstance(value, list | tuple):
         return [_plain_value(v) for v in value]
     if hasattr(value, "__dataclass_fields__"):  # a tagged result shows its tag (a union's)
-        tag = getattr(value, "tag", None)
+        tag = value.tag if isinstance(value, Dumped) else None
         return _View(value, {} if tag is None else {tag[0]: tag[1]})
     return value
 
