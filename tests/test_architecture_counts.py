@@ -14,7 +14,7 @@ import architecture_counts  # noqa: E402
 
 #: The figures of the docs' table (a refactor lowers them; nothing may raise them).
 CEILINGS = {"long_functions": 20, "many_parameters": 22, "model_kind_branches": 11,
-            "partial_fit_without_finish": 0, "record_classes": 63, "stub_to_from_dict": 19}
+            "partial_fit_without_finish": 0, "record_classes": 41, "stub_to_from_dict": 0}
 
 
 def test_the_counts_do_not_grow():

@@ -41,7 +41,7 @@ from hrgtc.model_schema import (
     AxisRecord,
     DuplicateKeyError,
     FileRecord,
-    axis_parts,
+    axis_records,
     check_document,
     file_document,
     parameters_sha256,
@@ -99,19 +99,11 @@ class AxisModel:
         return records.dump(self, AxisRecord)
 
     @classmethod
-    def from_parts(cls, data: Mapping[str, Any]) -> AxisModel:
-        """One axis from its checked parts (see :func:`model_schema.check_document`)."""
-        housing = data.get("housing")
-        scale_factor = data.get("scale_factor")
-        training = data.get("training")
-        return cls(
-            thermometer=Thermometer.from_dict(data["thermometer"]),
-            drift=DriftModel.from_dict(data["drift"]),
-            housing=None if housing is None else DriftModel.from_dict(housing),
-            plateaus=tuple(data.get("plateaus", ())),
-            scale_factor=None if scale_factor is None else ScaleFactorModel.from_dict(scale_factor),
-            training=None if training is None else TrainingStatistics.from_dict(training),
-        )
+    def from_record(cls, record: Any) -> AxisModel:
+        """One axis from its parts as :func:`model_schema.check_document` converted them
+        (the records of the parts' results: each part is built, not converted again)."""
+        parts = records.built(record)
+        return cls(**{name: parts[name] for name in _PART_NAMES})
 
 
 def axis_suffix(axis: str) -> str:
@@ -258,21 +250,15 @@ class Model:
                 f"{source}: model schema version {version} is newer than this hrgtc "
                 f"understands ({SCHEMA_VERSION}); upgrade hrgtc"
             )
-        temperature_map = _temperature_map(data, source)
         checked = check_document(strict(dict(data)), source, non_standard)
-        head = _read_head(checked, source)
+        temperature_map = _temperature_map(data, checked, source)
         try:
-            if "axes" in checked:
-                axes = {name: AxisModel.from_parts(part)
-                        for name, part in axis_parts(checked).items()}
-            else:
-                axes = {"": AxisModel.from_parts(checked)}
-        except KeyError as exc:
-            raise ModelFileError(f"{source}: model file is missing {exc}; it is corrupt") from exc
+            axes = {name: AxisModel.from_record(part)
+                    for name, part in axis_records(checked).items()}
+            lineage = None if checked.lineage is None else records.built(checked.lineage)
         except HrgtcError as exc:
             raise ModelFileError(f"{source}: model file is corrupt: {exc}") from exc
-        return cls(axes, head["unit"], dict(head["provenance"]), temperature_map,
-                   head.get("lineage"))
+        return cls(axes, checked.unit, dict(checked.provenance), temperature_map, lineage)
 
     @property
     def sha256(self) -> str:
@@ -307,32 +293,19 @@ def _head(model: Model, version: int, single: bool = False) -> dict[str, Any]:
                         temperature_map=None)
 
 
-def _read_head(checked: Mapping[str, Any], source: str) -> dict[str, Any]:
-    """The file's own fields of a checked document, read by :class:`FileRecord` (each
-    axis's parts are read by the records of the parts, :meth:`AxisModel.from_parts`)."""
-    try:
-        return records.load({k: checked[k] for k in ("schema", "schema_version", "unit",
-                                                     "provenance", "lineage")
-                                if k in checked},
-                            FileRecord, "model file")
-    except HrgtcError as exc:
-        raise ModelFileError(f"{source}: {exc}") from None
-
-
-def _temperature_map(data: Any, source: str) -> dict[str, Any] | None:
-    """The document's ``temperature_map``, checked (None without one)."""
-    if not isinstance(data, Mapping) or data.get("temperature_map") is None:
+def _temperature_map(data: Mapping[str, Any], checked: Any,
+                     source: str) -> dict[str, Any] | None:
+    """The document's ``temperature_map`` as written (None without one), checked from its
+    converted record (:func:`model_schema.check_document`), not converted again."""
+    if checked.temperature_map is None:
         return None
     from hrgtc.thermometry.reference import TemperatureMap
 
-    raw = data["temperature_map"]
-    if not isinstance(raw, Mapping):
-        raise ModelFileError(f"{source}: temperature_map is {raw!r}, not an object")
     try:
-        TemperatureMap.from_dict(raw)
+        TemperatureMap.from_values(records.built(checked.temperature_map))
     except HrgtcError as exc:
         raise ModelFileError(f"{source}: {exc}") from None
-    return dict(raw)
+    return dict(data["temperature_map"])
 
 
 def model_sha256(model: Model) -> str:

@@ -39,7 +39,6 @@ the derived values are the ones kept.
 from __future__ import annotations
 
 import json
-import math
 import re
 import types
 from collections.abc import Mapping
@@ -240,9 +239,11 @@ _SINGLE_AXIS = msgspec.defstruct(
     bases=(records.Record,), kw_only=True, module=__name__)
 
 
-def check_schema(data: Any, source: str) -> None:
-    """Validate ``data`` against the records of :data:`MODEL_SCHEMA` (msgspec, one pass);
-    the first error names its place (``drift.settings.scales.f``).
+def check_schema(data: Any, source: str) -> Any:
+    """Validate ``data`` against the records of :data:`MODEL_SCHEMA` (msgspec, one pass) and
+    return it converted (a :class:`FileRecord`, or the single-axis file's record: each
+    part the record of its result, which :func:`hrgtc.core.records.built` turns into the
+    result); the first error names its place (``drift.settings.scales.f``).
 
     A missing section of a single-axis file (``thermometer``, ``drift``) is named as such,
     a file holding both ``axes`` and one axis's parts is refused (the schema's "one axis
@@ -266,7 +267,7 @@ def check_schema(data: Any, source: str) -> None:
                             "parts at the top level or several under 'axes', never both")
     record = FileRecord if isinstance(data, dict) and "axes" in data else _SINGLE_AXIS
     try:
-        msgspec.convert(data, record, strict=True)
+        value = msgspec.convert(data, record, strict=True)
     except msgspec.ValidationError as exc:
         message, _, at = str(exc).partition(" - at `")
         where, value = _place(data, record, at.rstrip("`")) if at else ((), data)
@@ -279,6 +280,7 @@ def check_schema(data: Any, source: str) -> None:
         raise _fail(source, _path(where) if where else "(top level)",
                     f"unknown key {key!r} (known here: {', '.join(known)}); a misspelt "
                     "key is ignored by hrgtc but not by the reader of the file")
+    return value
 
 
 def _place(data: Any, kind: Any, at: str) -> tuple[list[Any], Any]:
@@ -380,15 +382,8 @@ def axis_parts(data: Mapping[str, Any]) -> dict[str, Any]:
     return {"": data} if axes is None else dict(axes)
 
 
-def strict(value: Any) -> Any:
-    """``value`` with every float that is not finite replaced by None (strict JSON)."""
-    if isinstance(value, dict):
-        return {k: strict(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [strict(v) for v in value]
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value
+#: ``value`` with every float that is not finite replaced by None (strict JSON).
+strict = records.strict
 
 
 def _agree(stored: float, derived: float, magnitude: float) -> bool:
@@ -553,8 +548,10 @@ def _check_scale_bounds(sf: Mapping[str, Any], where: str, source: str) -> None:
                         f"beyond any gyro's (bound {SCALE_BOUND_PPM:.3g} ppm = 100 %)")
 
 
-def check_document(data: Any, source: str, non_standard: bool = False) -> dict[str, Any]:
-    """Validate a parsed model file; return a copy with the coefficients derived.
+def check_document(data: Any, source: str, non_standard: bool = False) -> Any:
+    """Validate a parsed model file; return it converted once (:func:`check_schema`), each
+    axis's parts the records of their results (:func:`axis_records`), the drift models'
+    coefficients the derived ones (:func:`hrgtc.core.records.built` gives the results).
 
     Parameters
     ----------
@@ -575,25 +572,28 @@ def check_document(data: Any, source: str, non_standard: bool = False) -> dict[s
         raise ModelFileError(f"{source}: model file holds NaN or Infinity, which is not JSON "
                              f"(schema version {version} is strict JSON); it is corrupt or was "
                              "edited: recreate it with 'hrgtc calibrate'")
-    check_schema(data, source)
+    value = check_schema(data, source)
     stored = data.get("parameters_sha256")
     if stored is not None and stored != parameters_sha256(data):
         raise ModelFileError(
             f"{source}: model file was changed after it was written (its content no longer "
             "matches its parameters_sha256): damaged or edited; recreate it with 'hrgtc "
             "calibrate' (after a deliberate edit, delete the parameters_sha256 line)")
-    # a copy; the statistics ("NaN", null) are read as floats by the parts' records
-    restored = json.loads(json.dumps(data))
-    kept = axis_parts(restored)
+    converted = axis_records(value)
     for axis, part in axis_parts(data).items():
         at = f"axes.{axis}." if axis else ""
         _check_thermometer(part["thermometer"], source, at)
-        kept[axis]["drift"]["coefficients"] = _check_drift(part["drift"], f"{at}drift", source)
+        converted[axis].drift.coefficients = _check_drift(part["drift"], f"{at}drift", source)
         _check_reference(part["drift"], part["thermometer"], f"{at}drift", source)
         if part.get("housing") is not None:
-            kept[axis]["housing"]["coefficients"] = _check_drift(part["housing"],
-                                                                  f"{at}housing", source)
+            converted[axis].housing.coefficients = _check_drift(part["housing"],
+                                                                 f"{at}housing", source)
         if part.get("scale_factor") is not None:
             _check_scale_bounds(part["scale_factor"], f"{at}scale_factor", source)
-    restored.pop("parameters_sha256", None)
-    return restored
+    return value
+
+
+def axis_records(value: Any) -> dict[str, Any]:
+    """Axis name -> the converted record holding its parts (``""`` -> the file's own
+    for a single-axis file), of :func:`read_document`'s value."""
+    return {"": value} if isinstance(value, _SINGLE_AXIS) else dict(value.axes)

@@ -10,6 +10,7 @@ import copy
 import json
 import math
 import re
+from dataclasses import dataclass
 from pathlib import Path
 
 import jsonschema
@@ -20,7 +21,7 @@ from hrgtc.core import records
 from hrgtc.core.errors import InputError
 from hrgtc.drift import DriftModel
 from hrgtc.drift.scale_factor import ScaleFactorModel
-from hrgtc.model_schema import MODEL_SCHEMA, check_document
+from hrgtc.model_schema import MODEL_SCHEMA, axis_records, check_document
 from hrgtc.thermometry import Thermometer
 from hrgtc.thermometry.thermometer import ThermometerRecord
 
@@ -50,8 +51,9 @@ def test_a_statistic_that_is_not_finite_is_written_null_and_read_back_nan():
 def test_round_trips_are_exact_for_every_part():
     document = _document(IMU)["axes"]["x"]
     assert Thermometer.from_dict(document["thermometer"]).to_dict() == document["thermometer"]
-    checked = check_document(_document(IMU), "imu")["axes"]["x"]
-    drift = DriftModel.from_dict(checked["drift"])
+    checked = axis_records(check_document(_document(IMU), "imu"))["x"]
+    drift = records.built(checked.drift)  # converted once, the coefficients derived
+    assert isinstance(drift, DriftModel)
     assert drift.to_dict()["coefficients"] == document["drift"]["coefficients"]
     assert drift.to_dict()["settings"] == document["drift"]["settings"]
     assert ScaleFactorModel.from_dict(document["scale_factor"]).to_dict() == (
@@ -174,3 +176,53 @@ def test_a_result_and_its_record_have_the_same_fields(result, record, left_out):
     fields = {f.name for f in dataclasses.fields(result)} - left_out
     written = {f.name for f in msgspec.structs.fields(records.record_of(record))} - {"kind"}
     assert fields == written
+
+
+
+@dataclass(frozen=True)
+class _Part(records.Written):
+    constants = (("kind", "test.Part"),)
+    file_names = (("low", "min"),)
+    renamed = (("old_width", "width"),)
+    required = ("width",)
+    record_order = ("kind", "low", "area", "width")
+
+    low: float
+    width: records.Positive = 1.0
+
+    @records.derived(default=0.0)
+    def area(self) -> float:
+        return self.low * self.width
+
+
+@dataclass(frozen=True)
+class _Tagged(records.Written):
+    tag = ("kind", "tagged")
+    value: int
+
+
+@dataclass(frozen=True)
+class _Holder(records.Written):
+    part: _Tagged
+
+
+def test_what_a_file_part_needs_beyond_its_fields_is_declared_beside_them():
+    """records' class attributes: a constant written first, a key of another name, an old
+    key, a field required though defaulted, a derived figure, the file's order, a tag."""
+    record = records.record_of(_Part, "PartRecord", "A part.")
+    assert record.__struct_fields__ == ("kind", "low", "area", "width")
+    written = _Part(2.0, 3.0).to_dict()
+    assert list(written.items()) == [("kind", "test.Part"), ("min", 2.0), ("area", 6.0),
+                                     ("width", 3.0)]
+    assert _Part.from_dict(written) == _Part(2.0, 3.0)  # area and kind not passed back
+    assert _Part.from_dict({"kind": "test.Part", "min": 2.0, "old_width": 5.0}).width == 5.0
+    with pytest.raises(InputError, match="width"):
+        _Part.from_dict({"min": 2.0})  # required in the file
+    with pytest.raises(InputError, match=r"\$.kind"):
+        _Part.from_dict({**written, "kind": "test.Other"})
+    schema = records.json_schema(_Part, "part", "https://hrgtc.invalid/part.json")
+    assert schema["description"] == "A part."
+    assert schema["properties"]["kind"] == {"enum": ["test.Part"], "default": "test.Part"}
+    assert schema["required"] == ["min", "width"]
+    assert _Holder(_Tagged(4)).to_dict() == {"part": {"kind": "tagged", "value": 4}}
+    assert _Holder.from_dict({"part": {"kind": "tagged", "value": 4}}) == _Holder(_Tagged(4))

@@ -159,7 +159,7 @@ def test_round_trip_and_schema(model):
     broken = {**data, "scale_hz": -1.0}
     with pytest.raises(jsonschema.ValidationError):
         jsonschema.validate(broken, SCALE_FACTOR_JSON_SCHEMA)
-    with pytest.raises(InputError, match="scale-factor record"):
+    with pytest.raises(InputError, match="scale-factor-model record"):
         ScaleFactorModel.from_dict({k: v for k, v in data.items() if k != "groups"})
     assert "temperature groups" in model.summary().text()
 

@@ -158,7 +158,7 @@ def test_the_model_schema_takes_each_variables_settings():
     base = {"reference_freq_hz": 4425.0, "sample_rate_hz": 200.0, "reference_c": 20.0,
             "rate_tau_s": 10.0, "warmup_s": 50.0}
     assert records.load({**base, "rate_tau2_s": 60.0}, FeatureSettingsRecord,
-                        "feature-settings")["rate_tau2_s"] == 60.0
+                        "feature-settings").rate_tau2_s == 60.0  # the settings, built
     with pytest.raises(HrgtcError, match="rate_tau2_s"):
         records.load({**base, "rate_tau2_s": -1.0}, FeatureSettingsRecord, "feature-settings")
 

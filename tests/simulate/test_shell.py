@@ -300,7 +300,7 @@ def test_bad_material_and_shell():
         Shell(15e-3, 0.0)
     with pytest.raises(InputError, match=r"material must be a hrgtc\.simulate\.shell\.Material"):
         Shell(15e-3, 0.78e-3, material={"youngs_modulus_pa": 72e9})
-    with pytest.raises(InputError, match="unknown Material field"):
+    with pytest.raises(InputError, match="unknown field `colour`"):
         Material.from_dict({**FUSED_QUARTZ.to_dict(), "colour": "clear"})
 
 

@@ -19,19 +19,21 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-import msgspec
 import numpy as np
 
 from hrgtc.core import records
 from hrgtc.core.errors import ExtrapolationWarning
-from hrgtc.core.records import Count, Record, Statistic
+from hrgtc.core.records import Count, Statistic
 from hrgtc.drift import DriftModel
 from hrgtc.drift.variables import is_aux, unit, variable
 from hrgtc.thermometry import Thermometer
 
+#: (min, max) of a range; either may be null (not finite).
+Pair = tuple[Statistic, Statistic]
+
 
 @dataclass(frozen=True)
-class VariableRange:
+class VariableRange(records.Written):
     """How far one drift variable (beyond f and df) went beyond its training range.
 
     Attributes
@@ -48,14 +50,17 @@ class VariableRange:
         issue 20) and of the settled samples seen. [unit]
     """
 
+    #: Its record (:data:`VariableRangeRecord`): the name written as ``variable``.
+    file_names = (("name", "variable"),)
+
     name: str
     unit: str
     fraction: float
-    trained: tuple[float, float]
-    seen: tuple[float, float]
+    trained: Pair
+    seen: Pair
 
-    @property
-    def excess(self) -> float:
+    @records.derived(default=None)
+    def excess(self) -> Statistic:
         """Farthest seen value beyond the trained range (0 inside). [unit]"""
         low, high = self.trained
         beyond = [0.0, low - self.seen[0], self.seen[1] - high]
@@ -70,35 +75,14 @@ class VariableRange:
                 f"{self.excess:.4g} {self.unit} beyond (seen {self.seen[0]:.4g} to "
                 f"{self.seen[1]:.4g} {self.unit})")
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (:class:`VariableRangeRecord`)."""
-        return records.dump(self, VariableRangeRecord, variable=self.name)
-
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> VariableRange:
-        """Inverse of :meth:`to_dict`."""
-        values = records.load(data, VariableRangeRecord, "variable range")
-        return cls(values["variable"], values["unit"], values["fraction"], values["trained"],
-                   values["seen"])
-
-
-#: (min, max) of a range; either may be null (not finite).
-Pair = tuple[Statistic, Statistic]
-
-
-class VariableRangeRecord(Record):
-    """The record of :class:`VariableRange` (``excess`` written, not read back)."""
-
-    variable: str
-    unit: str
-    fraction: float
-    trained: Pair
-    seen: Pair
-    excess: Statistic = None
+#: The record of :class:`VariableRange`, generated from its fields and ``excess``.
+VariableRangeRecord = records.record_of(
+    VariableRange, doc="The record of :class:`VariableRange` (``excess`` written, not read "
+    "back).")
 
 
 @dataclass(frozen=True)
-class RangeReport:
+class RangeReport(records.Written):
     """Shares of samples beyond the trained ranges, and how far (one run).
 
     Attributes
@@ -125,24 +109,29 @@ class RangeReport:
         calibrated frequencies and f's range, ``rate_fraction`` only df/dt's).
     """
 
-    samples: int
+    #: Its record (:data:`RangeReportRecord`): the excesses written, not read back.
+    record_order = ("samples", "temperature_fraction", "rate_fraction", "settling_fraction",
+                    "trained_c", "seen_c", "temperature_excess_c", "trained_rate_c_per_h",
+                    "seen_rate_c_per_h", "rate_excess_ratio", "variables")
+
+    samples: Count
     temperature_fraction: float
     rate_fraction: float
     settling_fraction: float
-    trained_c: tuple[float, float]
-    seen_c: tuple[float, float]
-    trained_rate_c_per_h: tuple[float, float]
-    seen_rate_c_per_h: tuple[float, float]
+    trained_c: Pair
+    seen_c: Pair
+    trained_rate_c_per_h: Pair = (math.nan, math.nan)
+    seen_rate_c_per_h: Pair = (math.nan, math.nan)
     variables: tuple[VariableRange, ...] = ()
 
-    @property
-    def temperature_excess_c(self) -> float:
+    @records.derived(default=None)
+    def temperature_excess_c(self) -> Statistic:
         """Farthest seen temperature beyond the trained range (0 inside). [°C]"""
         low, high = self.trained_c
         return max(0.0, low - self.seen_c[0], self.seen_c[1] - high)
 
-    @property
-    def rate_excess_ratio(self) -> float:
+    @records.derived(default=None)
+    def rate_excess_ratio(self) -> Statistic:
         """Largest seen |df/dt| beyond the range over the trained one on its side (0 inside)."""
         low, high = self.trained_rate_c_per_h
         ratios = [0.0]
@@ -193,19 +182,10 @@ class RangeReport:
         lines += [v.warning() for v in self.variables if v.fraction > 0.0]
         return lines
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (:class:`RangeReportRecord`; what is not finite as null)."""
-        return records.dump(self, RangeReportRecord,
-                            variables=[v.to_dict() for v in self.variables])
-
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> RangeReport:
-        """Inverse of :meth:`to_dict`."""
-        values = records.load(data, RangeReportRecord, "range report")
-        return cls(values["samples"], values["temperature_fraction"], values["rate_fraction"],
-                   values["settling_fraction"], values["trained_c"], values["seen_c"],
-                   values["trained_rate_c_per_h"], values["seen_rate_c_per_h"],
-                   tuple(VariableRange.from_dict(v) for v in data.get("variables", ())))
+#: The record of :class:`RangeReport`, generated from its fields and the excesses.
+RangeReportRecord = records.record_of(
+    RangeReport, doc="The record of :class:`RangeReport` (the excesses written, not read "
+    "back).")
 
 
 def _temperature(thermometer: Thermometer, freq_hz: np.ndarray) -> np.ndarray:
@@ -285,19 +265,3 @@ def variable_unit(name: str, source: str, aux_columns: Mapping[str, str]) -> str
     if is_aux(name):
         return f"(unit of {aux_columns.get(name[2:], name[2:])})"
     return unit(name, source)
-
-
-class RangeReportRecord(Record):
-    """The record of :class:`RangeReport` (the excesses written, not read back)."""
-
-    samples: Count
-    temperature_fraction: float
-    rate_fraction: float
-    settling_fraction: float
-    trained_c: Pair
-    seen_c: Pair
-    temperature_excess_c: Statistic = None
-    trained_rate_c_per_h: Pair = (None, None)
-    seen_rate_c_per_h: Pair = (None, None)
-    rate_excess_ratio: Statistic = None
-    variables: list[VariableRangeRecord] = msgspec.field(default_factory=list)

@@ -11,13 +11,11 @@ Adding a reason is one line in :data:`REASONS`.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any
 
 from hrgtc.core import records
 from hrgtc.core.errors import InputError
-from hrgtc.core.records import Count, Record
+from hrgtc.core.records import Count
 from hrgtc.core.summary import Figure, Summary, escape
 
 #: Reason -> how it reads in a report. One line per reason.
@@ -42,7 +40,7 @@ def _check_reason(reason: str) -> None:
 
 
 @dataclass
-class Accounting:
+class Accounting(records.Written):
     """Samples read, used, and dropped or flagged by reason, for one command.
 
     Attributes
@@ -62,9 +60,20 @@ class Accounting:
     (6000, '0.04')
     """
 
-    read: int = 0
-    dropped: dict[str, int] = field(default_factory=dict)
-    flagged: dict[str, int] = field(default_factory=dict)
+    #: Its record (:data:`AccountingRecord`): what it holds, then what follows from it.
+    record_order = ("read", "used", "dropped", "flagged", "dropped_fraction", "warning")
+    required = ("read",)
+
+    read: Count = 0
+    dropped: dict[str, Count] = field(default_factory=dict)
+    flagged: dict[str, Count] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        for counts in (self.dropped, self.flagged):  # each reason checked (a file's too)
+            for reason in counts:
+                _check_reason(reason)
+        self.dropped = {reason: int(n) for reason, n in self.dropped.items() if n}
+        self.flagged = {reason: int(n) for reason, n in self.flagged.items() if n}
 
     def add_read(self, count: int) -> None:
         """``count`` more samples read."""
@@ -95,17 +104,17 @@ class Accounting:
         """Samples dropped for any reason."""
         return sum(self.dropped.values())
 
-    @property
-    def used(self) -> int:
+    @records.derived(default=0)
+    def used(self) -> Count:
         """Samples read and not dropped."""
         return self.read - self.n_dropped
 
-    @property
+    @records.derived(default=0.0)
     def dropped_fraction(self) -> float:
         """Share of the samples read that were dropped (0 when nothing was read)."""
         return self.n_dropped / self.read if self.read else 0.0
 
-    @property
+    @records.derived(default=None)
     def warning(self) -> str | None:
         """The summary-line warning when more than 10 % were dropped, else None."""
         if self.dropped_fraction <= DROPPED_WARNING_FRACTION:
@@ -135,29 +144,8 @@ class Accounting:
         return Summary("samples", (("samples", tuple(figures)),),
                        (warning,) if warning else (), (line,))
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (:class:`AccountingRecord`)."""
-        return records.dump(self, AccountingRecord)
 
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> Accounting:
-        """Inverse of :meth:`to_dict` (each reason checked by :meth:`drop` / :meth:`flag`)."""
-        values = records.load(data, AccountingRecord, "sample accounting")
-        out = cls(read=values["read"])
-        for reason, count in values["dropped"].items():
-            out.drop(reason, count)
-        for reason, count in values["flagged"].items():
-            out.flag(reason, count)
-        return out
-
-
-class AccountingRecord(Record):
-    """The record of :class:`Accounting`: what it holds, then what follows from it
-    (``used``, ``dropped_fraction``, ``warning``: written, not read back)."""
-
-    read: Count
-    used: Count = 0
-    dropped: dict[str, Count] = records.empty()
-    flagged: dict[str, Count] = records.empty()
-    dropped_fraction: float = 0.0
-    warning: str | None = None
+#: The record of :class:`Accounting`, generated from its fields and derived properties.
+AccountingRecord = records.record_of(
+    Accounting, doc="The record of :class:`Accounting`: what it holds, then what follows "
+    "from it\n(``used``, ``dropped_fraction``, ``warning``: written, not read back).")

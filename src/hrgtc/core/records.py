@@ -6,8 +6,10 @@ fields carry their types and bounds (``Annotated[float, Meta(gt=0)]``, :data:`Po
 list, nested results). :func:`record_of` generates its *record*, the
 :class:`msgspec.Struct` that names what the file holds (``<Result>Record``); fields that
 are derived or runtime-only are left out by one declaration, the result's class attribute
-``not_written`` (they need a default, or ``init=False``). The mixin :class:`Written` gives
-a result ``to_dict``/``from_dict`` once. From the declaration:
+``not_written`` (they need a default, or ``init=False``); what else a file's part needs
+(a constant ``kind``, a tag, keys of another name, computed fields: :func:`derived`) is a
+class attribute beside them (:class:`Dumped`). The mixin :class:`Written` gives a result
+``to_dict``/``from_dict`` once (:class:`Dumped`: ``to_dict``). From the declaration:
 
 * :func:`dump` writes a result as plain, strict JSON types: the fields are read off the
   result by name (numpy arrays and scalars by ``tolist``: the one numpy hook), NaN as
@@ -21,9 +23,9 @@ a result ``to_dict``/``from_dict`` once. From the declaration:
 msgspec encodes and decodes dataclasses itself, honouring their ``Meta`` bounds; the
 generated Struct is what lets a result hold numpy arrays and runtime state and keeps each
 definition's name in the published schemas. A :class:`Record` written by hand remains
-where a file's part is not one dataclass's fields (a document of several results, renamed
-or computed fields, a constant ``kind`` written first); :func:`dump` and :func:`load`
-take it in place of a result (``load`` then returns its values as a dict).
+where a file's part is not one dataclass's fields (a document of several results);
+:func:`dump` and :func:`load` take it in place of a result (``load`` then returns its
+values as a dict).
 
 Numbers: a parameter is a finite ``float`` (JSON has no NaN; a file that holds one is
 refused where the record says ``float``); a :data:`Statistic` may also be ``null`` or,
@@ -55,12 +57,15 @@ __all__ = [
     "NOT_FINITE",
     "Array",
     "Count",
+    "Dumped",
     "NonNegative",
     "Positive",
     "Range",
     "Record",
     "Statistic",
     "Written",
+    "built",
+    "derived",
     "dump",
     "empty",
     "json_schema",
@@ -68,6 +73,8 @@ __all__ = [
     "record_of",
     "schema_components",
     "statistic",
+    "strict",
+    "variant",
 ]
 
 #: A number that must be > 0.
@@ -98,8 +105,11 @@ class Record(msgspec.Struct, kw_only=True):
     """
 
     omit_when_default = ()  # type: tuple[str, ...]
-    #: Generated records (:func:`record_of`): field -> dtype of the :class:`Array` fields.
+    #: Generated records (:func:`record_of`): field -> dtype of the :class:`Array` fields,
+    #: the fields not passed to the result (constants, derived), old key -> field.
     arrays = {}  # type: dict[str, Any]
+    unread = ()  # type: tuple[str, ...]
+    renamed = {}  # type: dict[str, str]
 
 
 def empty() -> Any:
@@ -130,28 +140,60 @@ class Array:
         return Annotated[np.ndarray, _Items(item, tuple(metas))]
 
 
-class Written:
-    """Mixin of a result whose fields are its record: ``to_dict``/``from_dict`` once.
+class Dumped:
+    """Mixin of a result that is written, not read back: ``to_dict`` once (:func:`dump`).
 
     Class attributes a result may set (see :func:`record_of`):
 
     ``not_written``
         Fields that are derived or runtime-only: not in the file, not in the schema
-        (they need a default, or ``init=False``).
+        (they need a default, or ``init=False``, when the result is read back).
     ``omit_when_default``
         Fields written only when they differ from their default.
     ``forbid_unknown_fields``
         True: a key the record does not know is refused (a misspelt input), not ignored.
+    ``constants``
+        Fields of a fixed value, written first and checked on reading, not the result's:
+        ``(("kind", "hrgtc.Thermometer"),)`` (a ``Literal`` in the record and schema).
+    ``tag``
+        ``(field, value)``: the record is a tagged struct, a member of a msgspec tagged
+        union told by ``field`` (``("kind", "shell")``).
+    ``record_order``
+        The record's fields in file order, when it is not the declaration's (the
+        constants, then the fields, then the :func:`derived` properties).
+    ``renamed``
+        ``(old key, field)`` pairs: a key older files wrote under another name.
+    ``required``
+        Fields a file must hold although the constructor has a default for them.
+    ``file_names``
+        ``(field, key)`` pairs: a field the file writes under another key.
+    ``written_by``
+        Its record when it cannot be generated beside it: a :class:`Record` of a module
+        below the result's, where a document nests it (it is read back as the result).
     """
 
     __slots__ = ()
     not_written: ClassVar[tuple[str, ...]] = ()
     omit_when_default: ClassVar[tuple[str, ...]] = ()
     forbid_unknown_fields: ClassVar[bool] = False
+    constants: ClassVar[tuple[tuple[str, str], ...]] = ()
+    tag: ClassVar[tuple[str, str] | None] = None
+    record_order: ClassVar[tuple[str, ...]] = ()
+    renamed: ClassVar[tuple[tuple[str, str], ...]] = ()
+    required: ClassVar[tuple[str, ...]] = ()
+    file_names: ClassVar[tuple[tuple[str, str], ...]] = ()
+    written_by: ClassVar[type[Record] | None] = None
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON types (lists, ``None`` for what is not finite): :func:`dump`."""
         return dump(self)
+
+
+class Written(Dumped):
+    """Mixin of a result whose fields are its record: ``to_dict``/``from_dict`` once (the
+    class attributes of :class:`Dumped`)."""
+
+    __slots__ = ()
 
     @classmethod
     def from_dict(cls, data: Any) -> Any:
@@ -159,60 +201,129 @@ class Written:
         return load(data, cls)
 
 
+class _Derived(property):
+    """A property written as a field of its result's record (:func:`derived`)."""
+
+    default: Any = msgspec.NODEFAULT
+
+
+def derived(fget: Any = None, *, default: Any = msgspec.NODEFAULT) -> Any:
+    """A property of a result that its record writes (computed, not read back): its return
+    annotation is the field's type, ``default`` the schema's default. ``@records.derived``
+    or ``@records.derived(default=0)``."""
+    def make(function: Any) -> _Derived:
+        found = _Derived(function)
+        found.default = default
+        return found
+    return make if fget is None else make(fget)
+
+
 #: result class -> its record, and back (:func:`record_of`).
 _RECORDS: dict[type, type[Record]] = {}
 _RESULTS: dict[type, type] = {}
 
 
-def record_of(result: type, name: str | None = None) -> type[Record]:
+def record_of(result: type, name: str | None = None, doc: str | None = None) -> type[Record]:
     """The record of a result class, generated from its fields (cached).
 
     ``result`` is a dataclass (or a :class:`msgspec.Struct`) whose annotations are the
     declaration: ``Annotated[float, Meta(gt=0)]`` (:data:`Positive`), :data:`Statistic`,
-    :class:`Array` for numpy arrays, nested results. Its fields are the record's, in
-    their order, with their defaults (a default that is not finite, NaN, is ``null`` as in
-    the file); left out are those named in its ``not_written``
-    and those with ``init=False`` (derived). The record is named ``<result>Record`` (the
-    name of its definition in a JSON Schema; ``name`` gives another, at the first call:
-    ``BurstAllanRecord = records.record_of(BurstAllanResult, "BurstAllanRecord")`` beside
-    the result, where another record nests it); its docstring (the JSON Schema's
-    ``description``) names the result. A :class:`Record` subclass is its own record.
+    :class:`Array` for numpy arrays, nested results (``Annotated[Step, ScaleStepRecord]``
+    nests a :func:`variant`). Its fields are the record's, in their order, with their
+    defaults (a default that is not finite, NaN, is ``null`` as in the file); left out are
+    those named in its ``not_written`` and those with ``init=False`` (derived). Its
+    ``constants`` come first and its :func:`derived` properties last, unless its
+    ``record_order`` says otherwise (the class attributes of :class:`Dumped`). The record
+    is named ``<result>Record`` (the name of its definition in a JSON Schema; ``name``
+    gives another, at the first call: ``BurstAllanRecord =
+    records.record_of(BurstAllanResult, "BurstAllanRecord")`` beside the result, where
+    another record nests it); its docstring (the JSON Schema's ``description``) names the
+    result, or is ``doc``. A :class:`Record` subclass is its own record.
     """
     if isinstance(result, type) and issubclass(result, Record):
         return result
     found = _RECORDS.get(result)
     if found is not None:
-        if name is not None and found.__name__ != name:
-            raise TypeError(f"{result.__name__}'s record is {found.__name__}, not {name}")
+        if (name is not None and found.__name__ != name) or (
+                doc is not None and found.__doc__ != doc):
+            raise TypeError(f"{result.__name__}'s record is {found.__name__} "
+                            f"({found.__doc__!r}), not {name} ({doc!r})")
         return found
-    hints = typing.get_type_hints(result, include_extras=True)
+    given = getattr(result, "written_by", None)
+    found = given if given is not None else variant(result, name or f"{result.__name__}Record",
+                                                    doc)
+    _RECORDS[result] = found
+    _RESULTS.setdefault(found, result)
+    return found
+
+
+def variant(result: type, name: str, doc: str | None = None, *,
+            forbid_unknown_fields: bool | None = None, **types_: Any) -> type[Record]:
+    """A record of ``result`` other than its own (:func:`record_of`): the same fields, some
+    of another type (``term=FTerm``), reading back as ``result``. A field of another
+    result nests it as ``Annotated[Step, ScaleStepRecord]``."""
+    hints = {**typing.get_type_hints(result, include_extras=True), **types_}
     skip = set(getattr(result, "not_written", ()))
-    fields: list[Any] = []
+    required = set(getattr(result, "required", ()))
+    names = dict(getattr(result, "file_names", ()))
+    fields = {key: (key, Literal[value], value)  # type: ignore[valid-type]
+              for key, value in getattr(result, "constants", ())}
     arrays: dict[str, Any] = {}
     for field, default, factory in _fields(result):
         if field in skip:
             continue
-        kind = _wire(hints[field])
         dtype = _array_dtype(hints[field])
         if dtype is not None:
             arrays[field] = dtype
-        if factory is not None:
-            fields.append((field, kind, msgspec.field(default_factory=factory)))
-        elif isinstance(default, float) and not math.isfinite(default):
-            fields.append((field, kind, None))  # as the file spells it (a Statistic)
-        elif default is not msgspec.NODEFAULT:
-            fields.append((field, kind, default))
-        else:
-            fields.append((field, kind))
+        if field in required:
+            default, factory = msgspec.NODEFAULT, None
+        fields[field] = _spec(field, _wire(hints[field]), default, factory, names.get(field))
+    computed = _derived_fields(result)
+    for field, (kind, default) in computed.items():
+        fields[field] = _spec(field, _wire(kind), default, None, names.get(field))
+    order = tuple(getattr(result, "record_order", ())) or tuple(fields)
+    if sorted(order) != sorted(fields):
+        raise TypeError(f"{result.__name__}.record_order {order} is not its fields {tuple(fields)}")
+    tag = getattr(result, "tag", None)
     found = msgspec.defstruct(
-        name or f"{result.__name__}Record", fields, bases=(Record,), kw_only=True,
-        forbid_unknown_fields=getattr(result, "forbid_unknown_fields", False),
-        module=result.__module__,
-        namespace={"__doc__": f"The record of :class:`{result.__name__}` (its ``to_dict``, "
-                              "``from_dict``).",
+        name, [fields[f] for f in order], bases=(Record,), kw_only=True,
+        forbid_unknown_fields=getattr(result, "forbid_unknown_fields", False)
+        if forbid_unknown_fields is None else forbid_unknown_fields,
+        module=result.__module__, **({} if tag is None else {"tag_field": tag[0], "tag": tag[1]}),
+        namespace={"__doc__": doc or f"The record of :class:`{result.__name__}` (its "
+                                     "``to_dict``, ``from_dict``).",
                    "omit_when_default": tuple(getattr(result, "omit_when_default", ())),
-                   "arrays": arrays})
-    _RECORDS[result], _RESULTS[found] = found, result
+                   "arrays": arrays,
+                   "unread": (*dict(getattr(result, "constants", ())), *computed),
+                   "renamed": dict(getattr(result, "renamed", ()))})
+    _RESULTS[found] = result
+    return found
+
+
+def _spec(field: str, kind: Any, default: Any, factory: Any, name: str | None) -> tuple[Any, ...]:
+    """A field of :func:`msgspec.defstruct`: its default as the file spells it (NaN as
+    ``null``), its name in the file (``file_names``) when it is not the attribute's."""
+    default = _file_default(default)
+    if name is None and factory is None:
+        return (field, kind) if default is msgspec.NODEFAULT else (field, kind, default)
+    return (field, kind, msgspec.field(default=default, name=name,
+                                       default_factory=factory or msgspec.NODEFAULT))
+
+
+def _file_default(default: Any) -> Any:
+    if isinstance(default, float) and not math.isfinite(default):
+        return None  # as the file spells it (a Statistic)
+    return tuple(_file_default(d) for d in default) if isinstance(default, tuple) else default
+
+
+def _derived_fields(result: type) -> dict[str, tuple[Any, Any]]:
+    """``name -> (type, default)`` of the :func:`derived` properties of ``result``."""
+    found: dict[str, tuple[Any, Any]] = {}
+    for klass in reversed(result.__mro__):
+        for key, value in vars(klass).items():
+            if isinstance(value, _Derived):
+                hint = typing.get_type_hints(value.fget, include_extras=True)["return"]
+                found[key] = (hint, value.default)
     return found
 
 
@@ -235,6 +346,9 @@ def _wire(kind: Any) -> Any:
     origin, args = get_origin(kind), get_args(kind)
     if origin is Annotated:
         metas = kind.__metadata__
+        given = [m for m in metas if isinstance(m, type) and issubclass(m, Record)]
+        if given:  # Annotated[Step, ScaleStepRecord]: a variant (its record)
+            return given[0]
         items = [m for m in metas if isinstance(m, _Items)]
         if items:
             listed = list[_wire(items[0].item)]  # type: ignore[misc]
@@ -282,7 +396,7 @@ def dump(result: Any, record: type[Record] | None = None, /, **given: Any) -> di
     except msgspec.ValidationError as exc:
         raise InputError(f"{type(result).__name__} does not fit its record "
                          f"{record.__name__}: {exc}") from exc
-    document = _strict(msgspec.to_builtins(value, enc_hook=_plain))
+    document = strict(msgspec.to_builtins(value, enc_hook=_plain))
     _omit_defaults(document, record)
     return document
 
@@ -295,13 +409,13 @@ def _omit_defaults(document: Any, kind: Any) -> None:
         if not isinstance(document, dict):
             return
         for field in msgspec.structs.fields(kind):
-            if field.name not in document:
+            if field.encode_name not in document:
                 continue
-            if field.name in kind.omit_when_default and document[field.name] == _strict(
+            if field.name in kind.omit_when_default and document[field.encode_name] == strict(
                     _default(field)):
-                del document[field.name]
+                del document[field.encode_name]
             else:
-                _omit_defaults(document[field.name], field.type)
+                _omit_defaults(document[field.encode_name], field.type)
         return
     args = [a for a in get_args(kind) if a is not Ellipsis]
     if isinstance(document, dict) and get_origin(kind) is dict:
@@ -350,8 +464,9 @@ def _plain_value(value: Any) -> Any:
         return {k: _plain_value(v) for k, v in value.items()}
     if isinstance(value, list | tuple):
         return [_plain_value(v) for v in value]
-    if hasattr(value, "__dataclass_fields__"):
-        return _View(value, {})
+    if hasattr(value, "__dataclass_fields__"):  # a tagged result shows its tag (a union's)
+        tag = value.tag if isinstance(value, Dumped) else None
+        return _View(value, {} if tag is None else {tag[0]: tag[1]})
     return value
 
 
@@ -373,11 +488,28 @@ def load(data: Any, kind: type[Any], what: str | None = None) -> Any:
     record = record_of(kind)
     if what is None:
         what = re.sub(r"(?<=[a-z0-9])(?=[A-Z])", "-", kind.__name__).lower()
+    if record.renamed and isinstance(data, dict):
+        data = {record.renamed.get(k, k) if record.renamed.get(k, k) not in data else k: v
+                for k, v in data.items()}
     try:
         value = msgspec.convert(data, record, strict=False)
     except msgspec.ValidationError as exc:
         raise InputError(f"not a valid {what} record: {exc}") from exc
-    return _values(value, record)
+    return built(value, what)
+
+
+def built(value: Any, what: str | None = None) -> Any:
+    """A converted record's value (``msgspec.convert(data, record)``, or a part of a
+    document converted once) as its result: :func:`load` after the conversion. A result's
+    own check that refuses the values (its ``__post_init__``) is an :class:`InputError`
+    naming ``what`` (default: the record)."""
+    try:
+        return _values(value, type(value))
+    except InputError:
+        raise
+    except (KeyError, TypeError, ValueError, IndexError) as exc:
+        raise InputError(f"not a valid {what or type(value).__name__} record: "
+                         f"{exc!r}") from exc
 
 
 def _values(value: Any, kind: Any) -> Any:
@@ -392,6 +524,8 @@ def _values(value: Any, kind: Any) -> Any:
         result = _RESULTS.get(record)
         if result is None:
             return fields
+        for name in record.unread:
+            del fields[name]
         for name, dtype in getattr(record, "arrays", {}).items():
             if fields[name] is not None:
                 fields[name] = np.array(fields[name], dtype=dtype)
@@ -424,11 +558,12 @@ def statistic(value: Any) -> float:
     return float(value)
 
 
-def _strict(value: Any) -> Any:
+def strict(value: Any) -> Any:
+    """``value`` with every float that is not finite replaced by None (strict JSON)."""
     if isinstance(value, dict):
-        return {k: _strict(v) for k, v in value.items()}
+        return {k: strict(v) for k, v in value.items()}
     if isinstance(value, list | tuple):
-        return [_strict(v) for v in value]
+        return [strict(v) for v in value]
     if isinstance(value, float) and not math.isfinite(value):
         return None
     return value

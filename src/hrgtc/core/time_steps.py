@@ -46,7 +46,7 @@ from typing import Any
 import numpy as np
 
 from hrgtc.core import records
-from hrgtc.core.records import Count, Record
+from hrgtc.core.records import Count
 from hrgtc.core.timeline import GAP_FACTOR, gap_limit_s, median_period_s
 
 #: Modulus of a 32-bit counter in seconds, per time unit of the raw column.
@@ -95,7 +95,7 @@ TimeEventRecord = records.record_of(TimeEvent)
 
 
 @dataclass(frozen=True)
-class TimeDiagnosis:
+class TimeDiagnosis(records.Dumped):
     """The classifier's verdict on a time column.
 
     Attributes
@@ -114,11 +114,16 @@ class TimeDiagnosis:
         Shift added to each input row's time by the repair (unwraps, resets). [s]
     """
 
+    #: Its record (:data:`TimeDiagnosisRecord`; written, not read back: the arrays are not
+    #: in it).
+    not_written = ("time_s", "keep", "offset_s")
+    record_order = ("events", "restarts", "duplicates", "period_s")
+
     time_s: np.ndarray
     keep: np.ndarray
-    restarts: tuple[int, ...]
+    restarts: tuple[Count, ...]
     events: tuple[TimeEvent, ...] = field(default_factory=tuple)
-    period_s: float = math.nan
+    period_s: records.Statistic = math.nan
     offset_s: np.ndarray | None = None
 
     @property
@@ -126,8 +131,8 @@ class TimeDiagnosis:
         """Events the repair cannot fix (the user must)."""
         return tuple(e for e in self.events if not e.repaired)
 
-    @property
-    def duplicates(self) -> int:
+    @records.derived
+    def duplicates(self) -> Count:
         """Rows dropped as duplicates."""
         return int((~self.keep).sum())
 
@@ -135,20 +140,11 @@ class TimeDiagnosis:
         """The event of one kind, or None."""
         return next((e for e in self.events if e.kind == kind), None)
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types, without the arrays (:class:`TimeDiagnosisRecord`; written,
-        not read back: the arrays are not in it)."""
-        return records.dump(self, TimeDiagnosisRecord)
 
-
-class TimeDiagnosisRecord(Record):
-    """The record of :class:`TimeDiagnosis` (``duplicates``: rows dropped; ``period_s``
-    ``null`` when unknown)."""
-
-    events: list[TimeEventRecord]
-    restarts: list[Count]
-    duplicates: Count
-    period_s: float | None = None
+#: The record of :class:`TimeDiagnosis`, generated from its fields and ``duplicates``.
+TimeDiagnosisRecord = records.record_of(
+    TimeDiagnosis, doc="The record of :class:`TimeDiagnosis` (``duplicates``: rows dropped; "
+    "``period_s``\n``null`` when unknown).")
 
 
 def _same_rows(values: np.ndarray | None, a: np.ndarray, b: np.ndarray) -> np.ndarray:

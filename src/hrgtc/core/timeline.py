@@ -34,7 +34,7 @@ import numpy as np
 
 from hrgtc.core import records
 from hrgtc.core.errors import InputError
-from hrgtc.core.records import Count, Record
+from hrgtc.core.records import Count
 from hrgtc.core.summary import Figure, Summary, escape
 
 GAP_FACTOR = 2.0  # a time step longer than this many sample periods is a gap
@@ -144,7 +144,7 @@ def segment_bounds(time_s: np.ndarray, period_s: float | None = None,
 
 
 @dataclass(frozen=True)
-class Timeline:
+class Timeline(records.Dumped):
     """The time axis of one recording: its segments, span and burst structure.
 
     Attributes
@@ -159,10 +159,19 @@ class Timeline:
         A step longer than this many periods is a gap.
     """
 
+    #: Its record (:data:`TimelineRecord`): the summary, not every bound (written, not
+    #: read back).
+    not_written = ("bounds", "start_s", "stop_s")
+    required = ("gap_factor",)
+    file_names = (("n_segments", "segments"), ("n_samples", "samples"),
+                  ("is_bursty", "bursty"))
+    record_order = ("n_segments", "n_samples", "period_s", "gap_factor", "span_s",
+                    "recorded_s", "burst_length_s", "burst_period_s", "is_bursty")
+
     bounds: np.ndarray
     start_s: np.ndarray
     stop_s: np.ndarray
-    period_s: float
+    period_s: float | None = math.nan
     gap_factor: float = GAP_FACTOR
 
     @classmethod
@@ -177,13 +186,13 @@ class Timeline:
             return cls(bounds, np.empty(0), np.empty(0), period, gap_factor)
         return cls(bounds, time_s[bounds[:, 0]], time_s[bounds[:, 1] - 1], period, gap_factor)
 
-    @property
-    def n_segments(self) -> int:
+    @records.derived
+    def n_segments(self) -> Count:
         """Number of contiguous segments."""
         return int(self.bounds.shape[0])
 
-    @property
-    def n_samples(self) -> int:
+    @records.derived
+    def n_samples(self) -> Count:
         """Number of samples."""
         return int(self.bounds[-1, 1]) if self.n_segments else 0
 
@@ -197,30 +206,30 @@ class Timeline:
         """Recorded duration of each segment: its samples times the period. [s]"""
         return self.samples_per_segment * self.period_s
 
-    @property
+    @records.derived
     def span_s(self) -> float:
         """Time from the first to the last sample. [s]"""
         return float(self.stop_s[-1] - self.start_s[0]) if self.n_segments else 0.0
 
-    @property
+    @records.derived
     def recorded_s(self) -> float:
         """Time covered by samples: their number times the period (a burst file: far less
         than the span). [s]"""
         return float(self.n_samples * self.period_s) if math.isfinite(self.period_s) else 0.0
 
-    @property
-    def burst_length_s(self) -> float:
+    @records.derived(default=None)
+    def burst_length_s(self) -> float | None:
         """Median recorded duration of a segment. [s]"""
         return float(np.median(self.durations_s)) if self.n_segments else math.nan
 
-    @property
-    def burst_period_s(self) -> float:
+    @records.derived(default=None)
+    def burst_period_s(self) -> float | None:
         """Median time from a segment's start to the next one's (NaN for one segment). [s]"""
         if self.n_segments < 2:
             return math.nan
         return float(np.median(np.diff(self.start_s)))
 
-    @property
+    @records.derived
     def is_bursty(self) -> bool:
         """Several segments, each much shorter than the time between their starts."""
         return is_bursty(self.n_segments, self.burst_length_s, self.burst_period_s)
@@ -228,12 +237,6 @@ class Timeline:
     def segment_of(self, rows: np.ndarray) -> np.ndarray:
         """Index of the segment of each row."""
         return np.searchsorted(self.bounds[:, 0], np.asarray(rows), side="right") - 1
-
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types: the summary, not every bound (:class:`TimelineRecord`; written,
-        not read back: the bounds are not in it)."""
-        return records.dump(self, TimelineRecord, segments=self.n_segments,
-                            samples=self.n_samples, bursty=self.is_bursty)
 
     def summary(self) -> Summary:
         """Span, recorded duration, segments and the burst structure (its text one line)."""
@@ -257,19 +260,10 @@ class Timeline:
         return Summary("time axis", (("time axis", tuple(figures)),), layout=(line,))
 
 
-class TimelineRecord(Record, kw_only=True):
-    """The record of :class:`Timeline` (``null``: a figure that is not defined, e.g. the
-    burst period of one segment)."""
-
-    segments: Count
-    samples: Count
-    period_s: float | None = None
-    gap_factor: float
-    span_s: float
-    recorded_s: float
-    burst_length_s: float | None = None
-    burst_period_s: float | None = None
-    bursty: bool
+#: The record of :class:`Timeline`, generated from its fields and figures.
+TimelineRecord = records.record_of(
+    Timeline, doc="The record of :class:`Timeline` (``null``: a figure that is not defined, "
+    "e.g. the\nburst period of one segment).")
 
 
 def _duration_field(name: str, seconds: float) -> str:

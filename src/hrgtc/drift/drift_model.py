@@ -26,7 +26,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any
 
 import numpy as np
 from msgspec import Meta
@@ -38,13 +38,11 @@ from hrgtc.core.progress import Progress
 from hrgtc.core.summary import Summary
 from hrgtc.drift.cross_validation import (
     CrossValidation,
-    CrossValidationRecord,
     cross_validate,
 )
 from hrgtc.drift.drift_text import drift_equation, drift_summary
 from hrgtc.drift.features import (
     FeatureSettings,
-    FeatureSettingsRecord,
     FeatureStream,
     ParsedTerms,
     Term,
@@ -65,7 +63,7 @@ from hrgtc.drift.fit_stages import (
     select,
 )
 from hrgtc.drift.offsets import fit_offsets, orientation_offset
-from hrgtc.drift.stepwise import StepwiseRecord, StepwiseResult
+from hrgtc.drift.stepwise import StepwiseResult
 from hrgtc.drift.windows import RunSource
 from hrgtc.recording import Recording
 from hrgtc.settings.drift import DriftSettings
@@ -75,7 +73,7 @@ _DRIFT = DriftSettings
 
 
 @dataclass(frozen=True)
-class DriftModel(ParsedTerms):
+class DriftModel(ParsedTerms, records.Written):
     """A fitted bias model B = B0 + sum k_i term_i (Eq. 22 of [1]).
 
     Attributes
@@ -124,23 +122,28 @@ class DriftModel(ParsedTerms):
         The guarded selection's held-out check (folds, terms dropped, scores), or None.
     """
 
+    #: Its record (the model file's ``drift`` and ``housing``) is generated from these
+    #: fields; the parsed terms and the training's accounting are not in the file.
+    constants = (("kind", "hrgtc.DriftModel"),)
+    not_written = ("_terms", "accounting")
+
     settings: FeatureSettings
-    candidates: tuple[str, ...]
-    selected: tuple[str, ...]
+    candidates: Annotated[tuple[TermName, ...], Meta(min_length=1)]
+    selected: tuple[TermName, ...]
     intercept_dph: float
     coefficients: dict[str, float]
-    standard_errors: dict[str, float]
-    pvalues: dict[str, float]
+    standard_errors: dict[str, records.Statistic]
+    pvalues: dict[str, records.Statistic]
     scaled_coefficients: tuple[float, ...]
     stepwise: StepwiseResult
-    ranges: dict[str, tuple[float, float]]
-    window_s: float
-    n_windows: int
-    n_samples: int
-    residual_std_dph: float
-    rsquared: float
-    variance_inflation: float = 1.0
-    bandwidth_windows: int = 0
+    ranges: dict[str, records.Range]
+    window_s: records.Positive
+    n_windows: records.Count
+    n_samples: records.Count
+    residual_std_dph: records.Statistic
+    rsquared: records.Statistic
+    variance_inflation: records.Statistic = 1.0
+    bandwidth_windows: records.Count = 0
     selection: str = "stepwise"
     cross_validation: CrossValidation | None = None
     n_not_at_rest: int = 0
@@ -255,51 +258,11 @@ class DriftModel(ParsedTerms):
         """
         return drift_summary(self, sensor)
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types, as :class:`DriftModelRecord` writes them (NaN -> None)."""
-        return records.dump(self, DriftModelRecord)
 
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> DriftModel:
-        """Inverse of :meth:`to_dict` (checked against :class:`DriftModelRecord`)."""
-        values = records.load(data, DriftModelRecord, "drift-model")
-        values.pop("kind")
-        try:  # the stepwise record and the cross-validation come back built
-            return cls(**{**values, "settings": FeatureSettings(**values["settings"]),
-                          "pruning": None if values["pruning"] is None
-                          else dict(values["pruning"])})
-        except (KeyError, TypeError, ValueError, IndexError) as exc:
-            raise InputError(f"not a valid drift-model record: {exc!r}") from exc
-
-
-class DriftModelRecord(records.Record, kw_only=True):
-    """A :class:`DriftModel` in a file (the model file's ``drift`` and ``housing``)."""
-
-    kind: Literal["hrgtc.DriftModel"] = "hrgtc.DriftModel"
-    settings: FeatureSettingsRecord
-    candidates: Annotated[tuple[TermName, ...], Meta(min_length=1)]
-    selected: tuple[TermName, ...]
-    intercept_dph: float
-    coefficients: dict[str, float]
-    standard_errors: dict[str, records.Statistic]
-    pvalues: dict[str, records.Statistic]
-    scaled_coefficients: tuple[float, ...]
-    stepwise: StepwiseRecord
-    ranges: dict[str, records.Range]
-    window_s: records.Positive
-    n_windows: records.Count
-    n_samples: records.Count
-    residual_std_dph: records.Statistic
-    rsquared: records.Statistic
-    variance_inflation: records.Statistic = 1.0
-    bandwidth_windows: records.Count = 0
-    selection: str = "stepwise"
-    cross_validation: CrossValidationRecord | None = None
-    n_not_at_rest: int = 0
-    offset_mode: str = "none"
-    offsets_dph: dict[str, float] = records.empty()
-    orientations: tuple[tuple[float, ...], ...] = ()
-    pruning: dict[str, Any] | None = None
+#: :class:`DriftModel` in a file, generated from its fields.
+DriftModelRecord = records.record_of(
+    DriftModel, doc="A :class:`DriftModel` in a file (the model file's ``drift`` and "
+    "``housing``).")
 
 
 def fit(

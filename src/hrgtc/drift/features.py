@@ -299,31 +299,24 @@ def required_columns(terms: Sequence[Term]) -> tuple[str, ...]:
 
 
 # -- feature settings and computation ---------------------------------------------------
-class _FeatureSettingsMethods:
-    """What :class:`FeatureSettings` does beyond holding its fields."""
+class _FeatureSettingsMethods(records.Written):
+    """What :class:`FeatureSettings` does beyond holding its fields (``to_dict``/``from_dict``
+    by its record, :data:`FeatureSettingsRecord`, generated from them)."""
 
+    __slots__ = ()
     reference_freq_hz: float
     sample_rate_hz: float
-
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types, as :class:`FeatureSettingsRecord` writes them."""
-        return records.dump(self, FeatureSettingsRecord)
-
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> FeatureSettings:
-        """Inverse of :meth:`to_dict` (checked against :class:`FeatureSettingsRecord`)."""
-        return cls(**records.load(data, FeatureSettingsRecord,  # type: ignore[no-any-return]
-                                  "feature-settings"))
 
 
 #: The settings every model has, as fields of :func:`dataclasses.make_dataclass`.
 _COMMON_SETTINGS: tuple[tuple[str, Any] | tuple[str, Any, Any], ...] = (
+    # A sensor thermometer reads °C in the place of f: any finite reference.
     ("reference_freq_hz", float),
-    ("sample_rate_hz", float),
+    ("sample_rate_hz", records.Positive),
     ("reference_c", float, 20.0),
-    ("rate_tau_s", float, DriftSettings.rate_tau_s),
-    ("warmup_s", float, 600.0),
-    ("scales", dict[str, float], field(default_factory=dict)),
+    ("rate_tau_s", records.Positive, DriftSettings.rate_tau_s),
+    ("warmup_s", records.NonNegative, 600.0),
+    ("scales", dict[str, records.Positive], field(default_factory=dict)),
 )
 #: The type of msgspec's ``field(default_factory=...)`` (``records.empty()``).
 _MSGSPEC_FIELD = type(msgspec.field())
@@ -380,7 +373,12 @@ FeatureSettings = make_dataclass(
     [*_COMMON_SETTINGS, *(_variable_setting(*entry) for entry in variable_settings_fields())],
     bases=(_FeatureSettingsMethods,), frozen=True,
     namespace={"__module__": __name__, "__qualname__": "FeatureSettings",
-               "__doc__": _feature_settings_doc()})
+               "__doc__": _feature_settings_doc(),
+               "required": ("reference_c", "rate_tau_s", "warmup_s"),  # in every file
+               # a variable added after model files were written: only when not its default
+               "omit_when_default": tuple(name for v in DRIFT_VARIABLES
+                                          if v.omit_default_settings
+                                          for name, _, _ in v.settings_fields)})
 
 
 #: A drift term as the model file writes it (``f^2*df``, ``a_drive``); parsed on loading.
@@ -388,27 +386,11 @@ _VARIABLE = r"(?:[a-z][a-z0-9]*|a_[A-Za-z][A-Za-z0-9]*)"
 TermName = Annotated[str, Meta(pattern=rf"^{_VARIABLE}(\^[0-9]+)?(\*{_VARIABLE}(\^[0-9]+)?)*$")]
 
 
-#: :class:`FeatureSettings` in a file (the drift model's ``settings``): the settings every
-#: model has, then those the drift variables own (each variable's ``settings_fields`` in
-#: :mod:`hrgtc.drift.variables`), so a variable's setting is declared once, in its module.
-FeatureSettingsRecord = msgspec.defstruct(
-    "FeatureSettingsRecord",
-    [
-        # A sensor thermometer reads °C in the place of f: any finite reference.
-        ("reference_freq_hz", float),
-        ("sample_rate_hz", records.Positive),
-        ("reference_c", float),
-        ("rate_tau_s", records.Positive),
-        ("warmup_s", records.NonNegative),
-        ("scales", dict[str, records.Positive], records.empty()),
-        *variable_settings_fields(),
-    ],
-    bases=(records.Record,), kw_only=True, module=__name__,
-    namespace={"__doc__": ":class:`FeatureSettings` in a file (the drift model's "
-               "``settings``).",
-               "omit_when_default": tuple(name for v in DRIFT_VARIABLES
-                                          if v.omit_default_settings
-                                          for name, _, _ in v.settings_fields)})
+#: :class:`FeatureSettings` in a file (the drift model's ``settings``), generated from its
+#: fields: the settings every model has, then those the drift variables own.
+FeatureSettingsRecord = records.record_of(
+    FeatureSettings, "FeatureSettingsRecord",
+    ":class:`FeatureSettings` in a file (the drift model's ``settings``).")
 
 
 def settle_rows(settings: FeatureSettings) -> int:

@@ -28,9 +28,9 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any
 
 import numpy as np
 from msgspec import Meta
@@ -97,8 +97,19 @@ class ScaleGroup(records.Written):
 ScaleGroupRecord = records.record_of(ScaleGroup)
 
 
+#: A term of k(f): a power of f.
+_FTerm = Annotated[str, Meta(pattern=r"^f(\^[0-9]+)?$")]
+#: A stepwise threshold, a p-value strictly between 0 and 1.
+_Threshold = Annotated[float, Meta(gt=0, lt=1)]
+#: One step of the scale factor's stepwise selection in a file (a :class:`Step` of a term
+#: of k(f)).
+ScaleStepRecord = records.variant(
+    Step, "ScaleStepRecord", "One step of the scale factor's stepwise selection in a file.",
+    forbid_unknown_fields=True, term=_FTerm)
+
+
 @dataclass(frozen=True, eq=False)
-class ScaleFactorModel(ParsedTerms):
+class ScaleFactorModel(ParsedTerms, records.Written):
     """A fitted scale-factor error k_ppm = c0 + sum c_i term_i(f).
 
     Attributes
@@ -133,24 +144,29 @@ class ScaleFactorModel(ParsedTerms):
         Stepwise thresholds used.
     """
 
+    #: Its record (the model file's ``scale_factor``) is generated from these fields.
+    constants = (("kind", "hrgtc.ScaleFactorModel"),)
+    not_written = ("_terms",)
+    forbid_unknown_fields = True
+
     reference_hz: float
-    scale_hz: float
-    candidates: tuple[str, ...]
-    selected: tuple[str, ...]
+    scale_hz: records.Positive
+    candidates: Annotated[tuple[_FTerm, ...], Meta(min_length=1)]
+    selected: tuple[_FTerm, ...]
     intercept_ppm: float
     coefficients_ppm: dict[str, float]
-    standard_errors_ppm: dict[str, float]
-    pvalues: dict[str, float]
+    standard_errors_ppm: dict[str, records.Statistic]
+    pvalues: dict[str, records.Statistic]
     scaled_coefficients: tuple[float, ...]
-    covariance: tuple[tuple[float, ...], ...]
-    freq_range_hz: tuple[float, float]
-    input_rate_range_dph: tuple[float, float]
-    residual_ppm: float
-    groups: tuple[ScaleGroup, ...]
-    history: tuple[Step, ...] = ()
+    covariance: tuple[tuple[records.Statistic, ...], ...]
+    freq_range_hz: records.Range
+    input_rate_range_dph: records.Range
+    residual_ppm: records.Statistic
+    groups: Annotated[tuple[ScaleGroup, ...], Meta(min_length=1)]
+    history: tuple[Annotated[Step, ScaleStepRecord], ...] = ()
     weighted: bool = False
-    penter: float = PENTER
-    premove: float = 0.10
+    penter: _Threshold = PENTER
+    premove: _Threshold = 0.10
     _terms: tuple[Term, ...] = field(default=(), repr=False, compare=False)
 
     def _args(self, freq_hz: Any) -> tuple[dict[str, np.ndarray], dict[str, float],
@@ -249,56 +265,11 @@ class ScaleFactorModel(ParsedTerms):
                                ("scale-factor model k(f)", tuple(fit))),
                        (self.equation(),))
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (statistics that are not finite become null), as
-        :class:`ScaleFactorRecord` writes them."""
-        return records.dump(self, ScaleFactorRecord)
 
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> ScaleFactorModel:
-        """Inverse of :meth:`to_dict` (checked against :class:`ScaleFactorRecord`)."""
-        values = records.load(data, ScaleFactorRecord, "scale-factor")
-        values.pop("kind")
-        return cls(**{**values, "history": tuple(Step(**h) for h in values["history"])})
-
-
-#: A term of k(f): a power of f.
-_FTerm = Annotated[str, Meta(pattern=r"^f(\^[0-9]+)?$")]
-#: A stepwise threshold, a p-value strictly between 0 and 1.
-_Threshold = Annotated[float, Meta(gt=0, lt=1)]
-
-
-class ScaleStepRecord(records.Record, kw_only=True, forbid_unknown_fields=True):
-    """One step of the scale factor's stepwise selection in a file."""
-
-    action: Literal["added", "removed"]
-    term: _FTerm
-    fstat: records.Statistic
-    pvalue: records.Statistic
-
-
-class ScaleFactorRecord(records.Record, kw_only=True, forbid_unknown_fields=True):
-    """A :class:`ScaleFactorModel` in a file (the model file's ``scale_factor``)."""
-
-    kind: Literal["hrgtc.ScaleFactorModel"] = "hrgtc.ScaleFactorModel"
-    reference_hz: float
-    scale_hz: records.Positive
-    candidates: Annotated[tuple[_FTerm, ...], Meta(min_length=1)]
-    selected: tuple[_FTerm, ...]
-    intercept_ppm: float
-    coefficients_ppm: dict[str, float]
-    standard_errors_ppm: dict[str, records.Statistic]
-    pvalues: dict[str, records.Statistic]
-    scaled_coefficients: tuple[float, ...]
-    covariance: tuple[tuple[records.Statistic, ...], ...]
-    freq_range_hz: records.Range
-    input_rate_range_dph: records.Range
-    residual_ppm: records.Statistic
-    groups: Annotated[tuple[ScaleGroupRecord, ...], Meta(min_length=1)]
-    history: tuple[ScaleStepRecord, ...] = ()
-    weighted: bool = False
-    penter: _Threshold = PENTER
-    premove: _Threshold = 0.10
+#: :class:`ScaleFactorModel` in a file, generated from its fields.
+ScaleFactorRecord = records.record_of(
+    ScaleFactorModel, "ScaleFactorRecord",
+    "A :class:`ScaleFactorModel` in a file (the model file's ``scale_factor``).")
 
 
 def group_segments(segments: Sequence[RateSegment],

@@ -19,12 +19,10 @@ import json
 import re
 import time
 import traceback
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any, Literal
 
-import msgspec
 from msgspec import Meta
 
 from hrgtc.core import records
@@ -49,7 +47,7 @@ _QUOTED_COLUMN = re.compile(r"column '([^']+)'")
 
 
 @dataclass(frozen=True)
-class UnitOutcome:
+class UnitOutcome(records.Written):
     """What a task did for one unit.
 
     Attributes
@@ -73,28 +71,22 @@ class UnitOutcome:
         model's axis order (``axis`` "" for a single-axis unit; empty for a failed unit).
     """
 
+    omit_when_default = ("axes",)  # a unit's outcome written before the long form
+
     unit: str
-    status: str
+    status: Literal["ok", "skipped", "failed"]
+    #: The unit's columns of the fleet table (:mod:`hrgtc.fleet.results`).
     row: dict[str, Any] = field(default_factory=dict)
-    error: dict[str, Any] | None = None
-    seconds: float = 0.0
-    cpu_seconds: float = 0.0
+    error: Annotated[dict[str, Any], ErrorRecord] | None = None
+    seconds: records.NonNegative = 0.0
+    cpu_seconds: records.NonNegative = 0.0
+    #: The columns of each axis, a row of the fleet table each (none: the one ``row``).
     axes: tuple[dict[str, Any], ...] = ()
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (the unit's outcome file), as :class:`UnitOutcomeRecord` writes
-        them (strict JSON: a number that is not finite becomes None)."""
-        return records.dump(self, UnitOutcomeRecord)
-
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> UnitOutcome:
-        """Inverse of :meth:`to_dict` (checked against :class:`UnitOutcomeRecord`)."""
-        values = records.load(data, UnitOutcomeRecord, "unit-outcome")
-        error = values["error"]
-        if error is not None:  # as error_record gives it: a traceback only when there is one
-            values["error"] = {k: v for k, v in error.items()
-                               if k != "traceback" or v is not None}
-        return cls(**{**values, "axes": tuple(values["axes"])})
+    def __post_init__(self) -> None:
+        if self.error is not None:  # as error_record gives it: a traceback only when known
+            object.__setattr__(self, "error", {k: v for k, v in self.error.items()
+                                               if k != "traceback" or v is not None})
 
 
 class ErrorRecord(records.Record, kw_only=True):
@@ -112,21 +104,12 @@ class ErrorRecord(records.Record, kw_only=True):
     traceback: tuple[str, ...] | None = None
 
 
-class UnitOutcomeRecord(records.Record, kw_only=True):
-    """A :class:`UnitOutcome` in its file (``<unit>.outcome.json`` beside the model): field
-    names and bounds, from which its ``to_dict``/``from_dict`` and JSON Schema come."""
-
-    omit_when_default = ("axes",)
-
-    unit: str
-    status: Literal["ok", "skipped", "failed"]
-    #: The unit's columns of the fleet table (:mod:`hrgtc.fleet.results`).
-    row: dict[str, Any] = records.empty()
-    error: ErrorRecord | None = None
-    seconds: records.NonNegative = 0.0
-    cpu_seconds: records.NonNegative = 0.0
-    #: The columns of each axis, a row of the fleet table each (none: the one ``row``).
-    axes: list[dict[str, Any]] = msgspec.field(default_factory=list)
+#: :class:`UnitOutcome` in its file (``<unit>.outcome.json`` beside the model), generated
+#: from its fields.
+UnitOutcomeRecord = records.record_of(
+    UnitOutcome, doc="A :class:`UnitOutcome` in its file (``<unit>.outcome.json`` beside the "
+    "model): field\nnames and bounds, from which its ``to_dict``/``from_dict`` and JSON Schema "
+    "come.")
 
 
 def error_record(exc: BaseException, paths: tuple[str, ...] = ()) -> dict[str, Any]:

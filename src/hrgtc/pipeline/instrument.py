@@ -60,7 +60,7 @@ PathLike = str | os.PathLike[str]
 
 
 @dataclass(frozen=True)
-class ScaleFactorCheck:
+class ScaleFactorCheck(records.Dumped):
     """Scale-factor error of a held-out rate-table run, one axis, before and after.
 
     At each temperature (the run's holds grouped as in the fit), the least-squares slope
@@ -68,6 +68,8 @@ class ScaleFactorCheck:
     of a group, drops out): ``raw_ppm`` of the gyro's output, ``compensated_ppm`` of the
     compensated output (bias and scale factor removed).
     """
+
+    written_by = documents.ScaleFactorCheckRecord  # the calibrate --json document's part
 
     file: str
     axis: str
@@ -86,10 +88,6 @@ class ScaleFactorCheck:
         """Largest |compensated| error over the temperatures. [ppm]"""
         return (float(np.max(np.abs(self.compensated_ppm))) if self.compensated_ppm
                 else float("nan"))
-
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (:class:`ScaleFactorCheckRecord`; NaN as null)."""
-        return records.dump(self, documents.ScaleFactorCheckRecord)
 
 
 @dataclass(frozen=True)

@@ -43,7 +43,7 @@ SPAN_COLUMNS = (*TEMPERATURE_COLUMNS, "freq_hz")
 
 
 @dataclass(frozen=True)
-class ColumnSummary:
+class ColumnSummary(records.Written):
     """Name, unit and range of the finite values of one column.
 
     Parameters
@@ -60,32 +60,20 @@ class ColumnSummary:
         None if unknown. [unit]
     """
 
-    name: str
-    unit: str
-    minimum: float | None
-    maximum: float | None
-    resolution: float | None = None
-
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (:class:`ColumnSummaryRecord`)."""
-        return records.dump(self, ColumnSummaryRecord, min=self.minimum, max=self.maximum)
-
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> ColumnSummary:
-        """Inverse of :meth:`to_dict`."""
-        values = records.load(data, ColumnSummaryRecord, "column summary")
-        return cls(values["name"], values["unit"], values["min"], values["max"],
-                   values["resolution"])
-
-
-class ColumnSummaryRecord(Record):
-    """The record of :class:`ColumnSummary` (``min`` / ``max``: its minimum, maximum)."""
+    #: Its record (:data:`ColumnSummaryRecord`): ``min`` and ``max`` in the file.
+    file_names = (("minimum", "min"), ("maximum", "max"))
 
     name: str
     unit: str
-    min: float | None = None
-    max: float | None = None
+    minimum: float | None = None
+    maximum: float | None = None
     resolution: float | None = None
+
+
+#: The record of :class:`ColumnSummary`, generated from its fields.
+ColumnSummaryRecord = records.record_of(
+    ColumnSummary, doc="The record of :class:`ColumnSummary` (``min`` / ``max``: its minimum, "
+    "maximum).")
 
 
 @dataclass(frozen=True)
@@ -281,7 +269,7 @@ class RecordingInfo:
         values = records.load(data, RecordingInfoRecord, "recording info")
         values.pop("spans")
         return cls(**values | {
-            "columns": tuple(ColumnSummary.from_dict(c) for c in data["columns"]),
+            "columns": tuple(values["columns"]),
             "validation": ValidationReport.from_dict(data["validation"])})
 
 

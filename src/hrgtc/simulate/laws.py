@@ -35,7 +35,7 @@ from numpy.polynomial import Polynomial
 
 from hrgtc.core import records
 from hrgtc.core.errors import InputError
-from hrgtc.simulate.shell import Shell, ShellRecord
+from hrgtc.simulate.shell import Shell
 
 __all__ = [
     "BiasLaw",
@@ -62,7 +62,7 @@ class FrequencyLaw(Protocol):
 
 
 @dataclass(frozen=True)
-class PolynomialFrequencyLaw:
+class PolynomialFrequencyLaw(records.Written):
     """``f(T) = sum_k c_k T^k``, the Taylor form of Eq. (17) of [1].
 
     Parameters
@@ -74,7 +74,10 @@ class PolynomialFrequencyLaw:
         Where the coefficients come from.
     """
 
-    coefficients: tuple[float, ...]
+    #: Its record: a member of :data:`FrequencyLawRecord`, told by ``kind`` (written first).
+    tag = ("kind", "polynomial")
+
+    coefficients: Annotated[tuple[float, ...], Meta(min_length=1)]
     source: str = ""
 
     def __post_init__(self) -> None:
@@ -92,24 +95,11 @@ class PolynomialFrequencyLaw:
             out += c
         return out
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types, as :class:`PolynomialFrequencyLawRecord` writes them."""
-        return records.dump(self, PolynomialFrequencyLawRecord)
 
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> PolynomialFrequencyLaw:
-        """Inverse of :meth:`to_dict` (checked against its record)."""
-        return cls(**records.load(data, PolynomialFrequencyLawRecord,
-                                  "polynomial frequency law"))
-
-
-class PolynomialFrequencyLawRecord(records.Record, kw_only=True, tag_field="kind",
-                                   tag="polynomial"):
-    """A :class:`PolynomialFrequencyLaw` in the simulator's ground truth (``kind``
-    ``polynomial``, written first: the tag of :data:`FrequencyLawRecord`)."""
-
-    coefficients: Annotated[tuple[float, ...], Meta(min_length=1)]
-    source: str = ""
+#: The record of :class:`PolynomialFrequencyLaw`, generated from its fields.
+PolynomialFrequencyLawRecord = records.record_of(
+    PolynomialFrequencyLaw, doc="A :class:`PolynomialFrequencyLaw` in the simulator's ground "
+    "truth (``kind``\n``polynomial``, written first: the tag of :data:`FrequencyLawRecord`).")
 
 
 def table1_frequency_law() -> PolynomialFrequencyLaw:
@@ -130,7 +120,7 @@ def table1_frequency_law() -> PolynomialFrequencyLaw:
 
 
 @dataclass(frozen=True)
-class ShellFrequencyLaw:
+class ShellFrequencyLaw(records.Written):
     """Natural frequency from the shell model, Eq. (15) of [1] (:class:`~.shell.Shell`).
 
     Parameters
@@ -139,27 +129,20 @@ class ShellFrequencyLaw:
         Geometry and material (with its temperature coefficients).
     """
 
+    #: Its record: a member of :data:`FrequencyLawRecord`, told by ``kind``.
+    tag = ("kind", "shell")
+
     shell: Shell
 
     def frequency_hz(self, temperature_c: np.ndarray) -> np.ndarray:
         """Natural frequency at a resonator temperature, Eq. (15) of [1]. [Hz]"""
         return np.asarray(self.shell.frequency_hz(np.asarray(temperature_c, dtype=np.float64)))
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types, as :class:`ShellFrequencyLawRecord` writes them."""
-        return records.dump(self, ShellFrequencyLawRecord)
 
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> ShellFrequencyLaw:
-        """Inverse of :meth:`to_dict` (the shell checked by its record)."""
-        records.load(data, ShellFrequencyLawRecord, "shell frequency law")
-        return cls(Shell.from_dict(data["shell"]))
-
-
-class ShellFrequencyLawRecord(records.Record, kw_only=True, tag_field="kind", tag="shell"):
-    """A :class:`ShellFrequencyLaw` in the simulator's ground truth (``kind`` ``shell``)."""
-
-    shell: ShellRecord
+#: The record of :class:`ShellFrequencyLaw`, generated from its fields.
+ShellFrequencyLawRecord = records.record_of(
+    ShellFrequencyLaw, doc="A :class:`ShellFrequencyLaw` in the simulator's ground truth "
+    "(``kind`` ``shell``).")
 
 
 #: A frequency law in a unit's ground truth: one of the two kinds, told by its ``kind``

@@ -88,7 +88,7 @@ _RATE_LABELS = {"dph": "deg/h", "dps": "deg/s", "radps": "rad/s", "mradps": "mra
 
 
 @dataclass(frozen=True)
-class Logger:
+class Logger(records.Written):
     """A data logger: what it keeps of a run and how it writes it.
 
     Parameters
@@ -151,6 +151,9 @@ class Logger:
         Channels the logger also writes that hrgtc does not use (a magnetometer): name ->
         (mean, rms) of a white noise, written right after the time (as the PAN file does).
     """
+
+    #: Its record: the sidecar's part (LoggedRunRecord) in the module below nests it.
+    written_by = LoggerRecord
 
     kind: str = "continuous"
     sample_rate_hz: float = 50.0
@@ -244,15 +247,6 @@ class Logger:
             raise InputError(f"logger column names must be distinct, got {list(names.values())}")
         return names
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types, as :class:`~hrgtc.simulate.logger_records.LoggerRecord`
-        writes them."""
-        return records.dump(self, LoggerRecord)
-
-    @classmethod
-    def from_dict(cls, data: Any) -> Logger:
-        """Inverse of :meth:`to_dict` (checked against its record)."""
-        return cls(**records.load(data, LoggerRecord, "logger"))  # the parts built
 
 
 @dataclass

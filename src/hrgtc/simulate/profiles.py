@@ -88,34 +88,6 @@ DEFAULT_RAMP_C_PER_MIN = _settings.DEFAULT_RAMP_C_PER_MIN
 AXIS_NAME = re.compile(r"[A-Za-z][A-Za-z0-9]*")
 
 
-class SegmentRecord(records.Record, kw_only=True, forbid_unknown_fields=True):
-    """A :class:`Segment` in a profile file: ``setpoint_c`` and one of ``hold_h`` and
-    ``ramp_c_per_min`` (the segment checks which), the others written only when given."""
-
-    setpoint_c: float
-    hold_h: records.Positive | None = None
-    ramp_c_per_min: records.Positive | None = None
-    table_rate_dps: float | None = None
-    axis: Annotated[str, msgspec.Meta(pattern=r"^[A-Za-z][A-Za-z0-9]*$")] | None = None
-
-    omit_when_default = ("hold_h", "ramp_c_per_min", "table_rate_dps", "axis")
-
-
-class ProfileRecord(records.Record, kw_only=True, forbid_unknown_fields=True):
-    """A :class:`Profile` (a profile file's mapping form, a recording's ``chamber_program``)."""
-
-    name: str = "profile"
-    description: str = ""
-    start_c: float = ROOM_TEMPERATURE_C
-    chamber_max_c_per_min: records.Positive = CHAMBER_MAX_C_PER_MIN
-    setpoint_c: float | None = None
-    segments: Annotated[list[SegmentRecord], msgspec.Meta(min_length=1)]
-
-
-#: Keys of a segment in a profile file (:class:`SegmentRecord`'s fields).
-SEGMENT_KEYS = tuple(f.name for f in msgspec.structs.fields(SegmentRecord))
-
-
 def finite_number(name: str, value: Any, unit: str, where: str = "") -> float:
     try:
         out = float(value)
@@ -131,7 +103,7 @@ def format_temperature(value: float) -> str:
 
 
 @dataclass(frozen=True)
-class Segment:
+class Segment(records.Written):
     """One step of a chamber program: hold a set-point, or ramp to it.
 
     Parameters
@@ -150,11 +122,16 @@ class Segment:
         for a single-axis unit.
     """
 
+    #: Its record (:data:`SegmentRecord`): the keys of a profile file's segment, the
+    #: optional ones written only when given.
+    forbid_unknown_fields = True
+    omit_when_default = ("hold_h", "ramp_c_per_min", "table_rate_dps", "axis")
+
     setpoint_c: float
-    hold_h: float | None = None
-    ramp_c_per_min: float | None = None
+    hold_h: records.Positive | None = None
+    ramp_c_per_min: records.Positive | None = None
     table_rate_dps: float | None = None
-    axis: str | None = None
+    axis: Annotated[str, msgspec.Meta(pattern=r"^[A-Za-z][A-Za-z0-9]*$")] | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "setpoint_c", finite_number("setpoint_c", self.setpoint_c, "°C"))
@@ -190,13 +167,17 @@ class Segment:
                 )
             object.__setattr__(self, "ramp_c_per_min", rate)
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types, the schema of profile files (:class:`SegmentRecord`)."""
-        return records.dump(self, SegmentRecord)
+
+#: The record of :class:`Segment`, generated from its fields.
+SegmentRecord = records.record_of(
+    Segment, doc="A :class:`Segment` in a profile file: ``setpoint_c`` and one of ``hold_h`` "
+    "and\n``ramp_c_per_min`` (the segment checks which), the others written only when given.")
+#: Keys of a segment in a profile file (:class:`SegmentRecord`'s fields).
+SEGMENT_KEYS = tuple(f.name for f in msgspec.structs.fields(SegmentRecord))
 
 
 @dataclass(frozen=True)
-class Profile:
+class Profile(records.Written):
     """A chamber program: start temperature, segments, chamber rate limit.
 
     Parameters
@@ -215,9 +196,15 @@ class Profile:
         The set-point a soak calibrates (None for other profiles). [°C]
     """
 
-    segments: tuple[Segment, ...]
+    #: Its record (:data:`ProfileRecord`: a profile file's mapping form, a recording's
+    #: ``chamber_program``; :func:`from_mapping` reads the file's other forms).
+    forbid_unknown_fields = True
+    record_order = ("name", "description", "start_c", "chamber_max_c_per_min", "setpoint_c",
+                    "segments")
+
+    segments: Annotated[tuple[Segment, ...], msgspec.Meta(min_length=1)]
     start_c: float = ROOM_TEMPERATURE_C
-    chamber_max_c_per_min: float = CHAMBER_MAX_C_PER_MIN
+    chamber_max_c_per_min: records.Positive = CHAMBER_MAX_C_PER_MIN
     name: str = "profile"
     description: str = ""
     setpoint_c: float | None = field(default=None)
@@ -345,18 +332,6 @@ class Profile:
         times, temps = self.breakpoints()
         return np.interp(np.asarray(time_s, dtype=np.float64), times, temps)
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types, as :class:`ProfileRecord` writes them; :func:`from_mapping`
-        reads it back."""
-        return records.dump(self, ProfileRecord)
-
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> Profile:
-        """Inverse of :meth:`to_dict` (checked against :class:`ProfileRecord`, then built
-        by :func:`from_mapping`, which checks what a segment needs)."""
-        records.load(data, ProfileRecord, "profile")
-        return from_mapping(data)
-
     def summary(self) -> Summary:
         """The chamber temperature at each breakpoint and the duration (its text: one line
         per breakpoint)."""
@@ -374,6 +349,12 @@ class Profile:
                     f"{{breakpoints[{k}].chamber_c:8.3f}} °C" for k in range(len(times))))
         return Summary(f"profile {self.name}", (("profile", (duration,)),
                                                 ("breakpoints", tuple(cells))), layout=layout)
+
+
+#: The record of :class:`Profile`, generated from its fields.
+ProfileRecord = records.record_of(
+    Profile, doc="A :class:`Profile` (a profile file's mapping form, a recording's "
+    "``chamber_program``).")
 
 
 def from_mapping(data: Any, source: str = "profile", name: str = "profile") -> Profile:

@@ -24,7 +24,6 @@ from __future__ import annotations
 import dataclasses
 import math
 import numbers
-from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any
@@ -264,7 +263,7 @@ def natural_frequency(
 
 
 @dataclass(frozen=True)
-class Material:
+class Material(records.Written):
     """An isotropic resonator material with linear temperature laws.
 
     Parameters
@@ -286,6 +285,9 @@ class Material:
     name
         Free-text name of the material.
     """
+
+    #: Its record (:data:`MaterialRecord`): a key it does not know is refused.
+    forbid_unknown_fields = True
 
     youngs_modulus_pa: float
     poisson: float
@@ -313,32 +315,11 @@ class Material:
         object.__setattr__(self, "reference_temperature_c", t_ref)
         object.__setattr__(self, "name", str(self.name))
 
-    def to_dict(self) -> dict[str, Any]:
-        """Return the material as a dict of JSON types (:class:`MaterialRecord`)."""
-        return records.dump(self, MaterialRecord)
 
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> Material:
-        """Build a material from :meth:`to_dict` output (unknown keys are an error)."""
-        known = {f.name for f in dataclasses.fields(cls)}
-        unknown = sorted(set(data) - known)
-        if unknown:
-            raise InputError(f"unknown Material field(s) {unknown}; allowed: {sorted(known)}")
-        return cls(**records.load(data, MaterialRecord, "material"))
-
-
-class MaterialRecord(records.Record, kw_only=True):
-    """A :class:`Material` in the simulator's ground truth (its bounds are the material's
-    own checks)."""
-
-    youngs_modulus_pa: float
-    poisson: float
-    density_kg_m3: float
-    youngs_tc_per_c: float = 0.0
-    poisson_tc_per_c: float = 0.0
-    expansion_per_c: float = 0.0
-    reference_temperature_c: float = 20.0
-    name: str = "custom"
+#: The record of :class:`Material`, generated from its fields.
+MaterialRecord = records.record_of(
+    Material, doc="A :class:`Material` in the simulator's ground truth (its bounds are the "
+    "material's\nown checks).")
 
 
 #: Fused quartz (vitreous silica) near room temperature.
@@ -468,7 +449,7 @@ def _temperature_offset(material: Material, temperature_c: ArrayLike) -> np.ndar
 
 
 @dataclass(frozen=True)
-class Shell:
+class Shell(records.Written):
     """A hemispherical resonator shell: geometry, material and mode number.
 
     Parameters
@@ -482,6 +463,9 @@ class Shell:
     n
         Circumferential mode number, integer >= 2. [-]
     """
+
+    #: Its record (:data:`ShellRecord`): a file names the material.
+    required = ("material",)
 
     radius_m: float
     thickness_m: float
@@ -548,30 +532,10 @@ class Shell:
         )
         return _as_output(np.asarray(freq))
 
-    def to_dict(self) -> dict[str, Any]:
-        """Return the shell as a dict of JSON types (material nested), as
-        :class:`ShellRecord` writes it."""
-        return records.dump(self, ShellRecord)
 
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> Shell:
-        """Build a shell from :meth:`to_dict` output."""
-        if not isinstance(data.get("material"), Mapping):
-            raise InputError(
-                "Shell dict lacks a 'material' mapping; expected Shell.to_dict() output"
-            )
-        material = Material.from_dict(data["material"])
-        values = records.load({**data, "material": material.to_dict()}, ShellRecord, "shell")
-        return cls(**{**values, "material": material})
-
-
-class ShellRecord(records.Record, kw_only=True):
-    """A :class:`Shell` in the simulator's ground truth (a ``shell`` frequency law)."""
-
-    radius_m: float
-    thickness_m: float
-    material: MaterialRecord
-    n: int = 2
+#: The record of :class:`Shell`, generated from its fields.
+ShellRecord = records.record_of(
+    Shell, doc="A :class:`Shell` in the simulator's ground truth (a ``shell`` frequency law).")
 
 
 #: Geometry of the documented example (DESIGN.md): r = 15 mm, h = 0.78 mm. With

@@ -66,19 +66,15 @@ from hrgtc.core.errors import InputError
 from hrgtc.core.summary import Figure, Summary, escape
 from hrgtc.simulate.laws import (
     BiasLaw,
-    BiasLawRecord,
-    FrequencyLaw,
-    FrequencyLawRecord,
+    PolynomialFrequencyLaw,
     ScaleFactorLaw,
-    ScaleFactorLawRecord,
     ShellFrequencyLaw,
-    frequency_law_from_dict,
     table1_frequency_law,
 )
-from hrgtc.simulate.noise_sources import GyroNoise, GyroNoiseRecord
+from hrgtc.simulate.noise_sources import GyroNoise
 from hrgtc.simulate.profiles import AXIS_NAME
 from hrgtc.simulate.shell import FUSED_QUARTZ, Shell
-from hrgtc.simulate.thermal import ThermalNetwork, ThermalNetworkRecord
+from hrgtc.simulate.thermal import ThermalNetwork
 
 __all__ = [
     "AXIS_NAME",
@@ -99,7 +95,7 @@ EARTH_RATE_DPH = 360.0 / 23.9344696
 
 
 @dataclass(frozen=True)
-class Unit:
+class Unit(records.Written):
     """A simulated gyro.
 
     Parameters
@@ -125,14 +121,18 @@ class Unit:
         (``rate = input + bias + noise``).
     """
 
+    #: Its record (:data:`UnitRecord`, a recording's ``unit_parameters``); the frequency
+    #: law is told by its ``kind`` (:data:`~hrgtc.simulate.laws.FrequencyLawRecord`).
+    omit_when_default = ("scale_factor_law",)
+
     name: str
     description: str
     thermal: ThermalNetwork
-    frequency_law: FrequencyLaw
+    frequency_law: PolynomialFrequencyLaw | ShellFrequencyLaw
     bias_law: BiasLaw
     gyro_noise: GyroNoise
-    frequency_noise_hz: float
-    housing_noise_c: float
+    frequency_noise_hz: records.NonNegative
+    housing_noise_c: records.NonNegative
     scale_factor_law: ScaleFactorLaw | None = None
 
     def __post_init__(self) -> None:
@@ -141,17 +141,6 @@ class Unit:
             if not (math.isfinite(value) and value >= 0.0):
                 raise InputError(f"{attribute} must be finite and >= 0, got {value!r}")
             object.__setattr__(self, attribute, value)
-
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (the simulator's ground truth for a recording), as
-        :class:`UnitRecord` writes them (no ``scale_factor_law`` when None)."""
-        return records.dump(self, UnitRecord, frequency_law=self.frequency_law.to_dict())
-
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> Unit:
-        """Inverse of :meth:`to_dict` (checked against :class:`UnitRecord`)."""
-        values = records.load(data, UnitRecord, "simulated unit")  # the parts built
-        return cls(**{**values, "frequency_law": frequency_law_from_dict(data["frequency_law"])})
 
     def summary(self) -> Summary:
         """The unit's parameters (thermal time constants, noise, bias and scale-factor
@@ -220,7 +209,7 @@ class Unit:
 
 
 @dataclass(frozen=True)
-class MultiAxisUnit:
+class MultiAxisUnit(records.Written):
     """A unit of several gyros (axes) sharing one housing in the chamber.
 
     Parameters
@@ -242,9 +231,9 @@ class MultiAxisUnit:
 
     name: str
     description: str
-    axes: dict[str, Unit]
+    axes: Annotated[dict[str, Unit], Meta(min_length=1)]
     input_rate_dph: dict[str, float] = field(default_factory=dict)
-    housing_noise_c: float = 0.01
+    housing_noise_c: records.NonNegative = 0.01
 
     def __post_init__(self) -> None:
         axes = dict(self.axes)
@@ -287,22 +276,14 @@ class MultiAxisUnit:
         """The first axis's network (its housing is every axis's housing)."""
         return next(iter(self.axes.values())).thermal
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (the simulator's ground truth for a recording), as
-        :class:`MultiAxisUnitRecord` writes them."""
-        return records.dump(self, MultiAxisUnitRecord,
-                            axes={axis: gyro.to_dict() for axis, gyro in self.axes.items()})
-
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> MultiAxisUnit:
         """Inverse of :meth:`to_dict` (checked against :class:`MultiAxisUnitRecord`; an
         axis's refusal names the axis, which msgspec's place ``$.axes[...]`` does not)."""
         axes = data.get("axes") if isinstance(data, Mapping) else None
         for axis, gyro in (axes.items() if isinstance(axes, Mapping) else ()):
-            records.load(gyro, UnitRecord, f"simulated unit's axis {axis!r}")
-        values = records.load(data, MultiAxisUnitRecord, "simulated multi-axis unit")
-        return cls(**{**values, "axes": {str(a): Unit.from_dict(g)
-                                         for a, g in data["axes"].items()}})
+            records.load(gyro, Unit, f"simulated unit's axis {axis!r}")
+        return records.load(data, cls, "simulated multi-axis unit")  # type: ignore[no-any-return]
 
     def summary(self) -> Summary:
         """Each axis's parameters (:meth:`Unit.summary`, after ``axes.<axis>.``) and input
@@ -319,30 +300,13 @@ class MultiAxisUnit:
         return Summary(f"unit {self.name}", tuple(sections), layout=tuple(layout))
 
 
-class UnitRecord(records.Record, kw_only=True):
-    """A :class:`Unit` in the simulator's ground truth (a recording's ``unit_parameters``)."""
-
-    name: str
-    description: str
-    thermal: ThermalNetworkRecord
-    frequency_law: FrequencyLawRecord
-    bias_law: BiasLawRecord
-    gyro_noise: GyroNoiseRecord
-    frequency_noise_hz: records.NonNegative
-    housing_noise_c: records.NonNegative
-    scale_factor_law: ScaleFactorLawRecord | None = None
-
-    omit_when_default = ("scale_factor_law",)
-
-
-class MultiAxisUnitRecord(records.Record, kw_only=True):
-    """A :class:`MultiAxisUnit` in the simulator's ground truth."""
-
-    name: str
-    description: str
-    axes: Annotated[dict[str, UnitRecord], Meta(min_length=1)]
-    input_rate_dph: dict[str, float] = records.empty()
-    housing_noise_c: records.NonNegative = 0.01
+#: The record of :class:`Unit`, generated from its fields.
+UnitRecord = records.record_of(
+    Unit, doc="A :class:`Unit` in the simulator's ground truth (a recording's "
+    "``unit_parameters``).")
+#: The record of :class:`MultiAxisUnit`, generated from its fields.
+MultiAxisUnitRecord = records.record_of(
+    MultiAxisUnit, doc="A :class:`MultiAxisUnit` in the simulator's ground truth.")
 
 
 def unit_from_dict(data: Mapping[str, Any]) -> Unit | MultiAxisUnit:

@@ -35,7 +35,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any
 
 import numpy as np
 from msgspec import Meta
@@ -83,7 +83,7 @@ def relative_coefficients(thermometer: Thermometer, centre_c: float,
 
 
 @dataclass(frozen=True)
-class ThermometerPrior:
+class ThermometerPrior(records.Written):
     """Mean and covariance of the relative scaled thermometer coefficients of a population.
 
     Attributes
@@ -105,19 +105,36 @@ class ThermometerPrior:
         Names of the units the prior was built from.
     """
 
-    order: int
+    #: Its record (:data:`ThermometerPriorRecord`, the prior file): ``schema`` first, the
+    #: version and basis written for the reader (not read back), ``n_units`` derived.
+    constants = (("schema", SCHEMA_NAME),)
+    record_order = ("schema", "schema_version", "order", "centre_c", "scale_c",
+                    "temperature_range_c", "basis", "mean", "covariance", "nominal_freq_hz",
+                    "nominal_freq_std_hz", "point_std_hz", "n_units", "units")
+
+    order: Annotated[int, Meta(ge=1, le=12)]
     centre_c: float
-    scale_c: float
-    temperature_range_c: tuple[float, float]
+    scale_c: records.Positive
+    temperature_range_c: records.Range
     mean: tuple[float, ...]
     covariance: tuple[tuple[float, ...], ...]
     nominal_freq_hz: float
-    nominal_freq_std_hz: float
-    point_std_hz: float
+    nominal_freq_std_hz: records.NonNegative
+    point_std_hz: records.NonNegative
     units: tuple[str, ...] = field(default=())
 
-    @property
-    def n_units(self) -> int:
+    @records.derived(default=SCHEMA_VERSION)
+    def schema_version(self) -> Annotated[int, Meta(ge=1, le=SCHEMA_VERSION)]:
+        """The prior file's schema version."""
+        return SCHEMA_VERSION
+
+    @records.derived(default=BASIS)
+    def basis(self) -> str:
+        """What ``mean`` and ``covariance`` are coefficients of (text for the reader)."""
+        return BASIS
+
+    @records.derived(default=0)
+    def n_units(self) -> records.Count:
         """Number of units behind the prior."""
         return len(self.units)
 
@@ -165,10 +182,6 @@ class ThermometerPrior:
             units=tuple(str(u) for u in units),
         )
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (the prior file), as :class:`ThermometerPriorRecord` writes them."""
-        return records.dump(self, ThermometerPriorRecord)
-
     @classmethod
     def from_dict(cls, data: Mapping[str, Any], source: str = "prior") -> ThermometerPrior:
         """Inverse of :meth:`to_dict` (checked against :class:`ThermometerPriorRecord`)."""
@@ -176,12 +189,9 @@ class ThermometerPrior:
             raise InputError(f"{source}: not an hrgtc prior file; create one with "
                              "'hrgtc fleet prior MODELS -o prior.json'")
         try:
-            values = records.load(data, ThermometerPriorRecord, "thermometer-prior")
+            return records.load(data, cls)  # type: ignore[no-any-return]
         except InputError as exc:
             raise InputError(f"{source}: prior file is corrupt: {exc}") from None
-        for derived in ("schema", "schema_version", "basis", "n_units"):
-            values.pop(derived)
-        return cls(**values)
 
     def summary(self) -> Summary:
         """The units, order and range, the nominal frequency ± its spread and each
@@ -230,7 +240,7 @@ def load_prior(path: str | os.PathLike[str]) -> ThermometerPrior:
 
 
 @dataclass(frozen=True)
-class PriorFit:
+class PriorFit(records.Dumped):
     """A thermometer fitted with a population prior (the result of :func:`fit_with_prior`).
 
     Attributes
@@ -246,12 +256,28 @@ class PriorFit:
         Largest standardised distance of a soak point from the prior's prediction.
     """
 
+    #: Its record (:data:`PriorFitRecord`, in ``calibrate --prior --json``; written only):
+    #: the prior's size, the points and the uncertainty they leave, not the two fits.
+    not_written = ("thermometer", "prior")
+    record_order = ("prior_units", "temperatures_c", "frequencies_hz", "point_std_hz",
+                    "max_sigma", "max_temperature_std_c", "temperature_band")
+
     thermometer: Thermometer
     prior: ThermometerPrior
     temperatures_c: tuple[float, ...]
     frequencies_hz: tuple[float, ...]
     point_std_hz: tuple[float, ...]
-    max_sigma: float
+    max_sigma: records.Statistic
+
+    @records.derived
+    def prior_units(self) -> records.Count:
+        """Units behind the prior."""
+        return self.prior.n_units
+
+    @records.derived
+    def temperature_band(self) -> dict[str, tuple[records.Statistic, ...]]:
+        """:meth:`band` at 13 temperatures (what the JSON document shows). [°C]"""
+        return self.band(13)
 
     def temperature_std_c(self, temperature_c: Any) -> np.ndarray:
         """1-sigma uncertainty of the temperature read from frequency (delta method). [°C]"""
@@ -267,48 +293,24 @@ class PriorFit:
         t = np.linspace(*self.prior.temperature_range_c, points)
         return {"temperature_c": t.tolist(), "std_c": self.temperature_std_c(t).tolist()}
 
-    @property
-    def max_temperature_std_c(self) -> float:
+    @records.derived
+    def max_temperature_std_c(self) -> records.Statistic:
         """Largest 1-sigma temperature uncertainty over the prior's range. [°C]"""
         return float(np.max(self.band()["std_c"]))
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types, as :class:`PriorFitRecord` writes them (NaN -> None)."""
-        return records.dump(self, PriorFitRecord, prior_units=self.prior.n_units,
-                            temperature_band=self.band(13))
 
 
-class ThermometerPriorRecord(records.Record, kw_only=True):
-    """A :class:`ThermometerPrior` in its file (``hrgtc fleet prior``): field names and
-    bounds, from which its ``to_dict``/``from_dict`` and its JSON Schema are generated."""
-
-    schema: Literal["hrgtc.thermometer-prior"] = SCHEMA_NAME
-    schema_version: Annotated[int, Meta(ge=1, le=SCHEMA_VERSION)] = SCHEMA_VERSION
-    order: Annotated[int, Meta(ge=1, le=12)]
-    centre_c: float
-    scale_c: records.Positive
-    temperature_range_c: records.Range
-    #: What ``mean`` and ``covariance`` are coefficients of (text for the reader).
-    basis: str = BASIS
-    mean: tuple[float, ...]
-    covariance: tuple[tuple[float, ...], ...]
-    nominal_freq_hz: float
-    nominal_freq_std_hz: records.NonNegative
-    point_std_hz: records.NonNegative
-    n_units: records.Count = 0
-    units: tuple[str, ...] = ()
+#: The record of :class:`ThermometerPrior` (its file), generated from its fields.
+ThermometerPriorRecord = records.record_of(
+    ThermometerPrior, doc="A :class:`ThermometerPrior` in its file (``hrgtc fleet prior``): "
+    "field names and\nbounds, from which its ``to_dict``/``from_dict`` and its JSON Schema "
+    "are generated.")
 
 
-class PriorFitRecord(records.Record, kw_only=True):
-    """A :class:`PriorFit` in a JSON document (``calibrate --prior --json``); written only."""
-
-    prior_units: records.Count
-    temperatures_c: tuple[float, ...]
-    frequencies_hz: tuple[float, ...]
-    point_std_hz: tuple[float, ...]
-    max_sigma: records.Statistic
-    max_temperature_std_c: records.Statistic
-    temperature_band: dict[str, tuple[records.Statistic, ...]]
+#: The record of :class:`PriorFit`, generated from its fields and figures.
+PriorFitRecord = records.record_of(
+    PriorFit, doc="A :class:`PriorFit` in a JSON document (``calibrate --prior --json``); "
+    "written only.")
 
 
 #: JSON Schema (Draft 2020-12) of the prior file, generated from :class:`ThermometerPriorRecord`.

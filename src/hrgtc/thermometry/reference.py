@@ -158,15 +158,22 @@ class TemperatureMap:
         refused."""
         if not isinstance(data, Mapping):
             raise InputError(f"temperature_map is {data!r}, not an object")
-        values = records.load(data, TemperatureMapRecord, "temperature_map")
+        known = {f.name for f in msgspec.structs.fields(TemperatureMapRecord)}
+        return cls.from_values(records.load(data, TemperatureMapRecord, "temperature_map"),
+                               {k: v for k, v in data.items() if k not in known})
+
+    @classmethod
+    def from_values(cls, values: Mapping[str, Any],
+                    extra: Mapping[str, Any] | None = None) -> TemperatureMap:
+        """The map of its record's values (:func:`hrgtc.core.records.built` of a converted
+        :class:`TemperatureMapRecord`), checked: a scale of 0 or a non-finite number is
+        refused."""
         scale, offset = values["scale_c_per_count"], values["offset_c"]
         if not (math.isfinite(scale) and math.isfinite(offset) and scale != 0.0):
             raise InputError(f"temperature_map scale {scale!r} / offset {offset!r}: a finite "
                              "scale other than 0 and a finite offset are needed")
-        if values["count_range"] is None:
-            values["count_range"] = (math.nan, math.nan)
-        known = {f.name for f in msgspec.structs.fields(TemperatureMapRecord)}
-        return cls(**values, extra={k: v for k, v in data.items() if k not in known})
+        count_range = values["count_range"] or (math.nan, math.nan)
+        return cls(**{**values, "count_range": count_range}, extra=dict(extra or {}))
 
 
 class TemperatureMapRecord(records.Record, kw_only=True):
@@ -472,7 +479,7 @@ def map_from_reference(recording: str | Path, reference: str | Path,
 
 
 @dataclass(frozen=True)
-class TemperatureReference:
+class TemperatureReference(records.Written):
     """A reference log of the temperature and how to read it (``hrgtc calibrate
     --temp-ref`` and its ``--temp-ref-*`` options): what
     :func:`hrgtc.pipeline.instrument.calibrate_instrument` fits the count's map from.
@@ -480,10 +487,10 @@ class TemperatureReference:
     Attributes
     ----------
     path
-        The reference log (CSV), written beside the first drift recording.
+        The reference log (CSV), written beside the first drift recording (kept as text).
     columns
         Its columns by our names (``{"time_s": "Time", "temperature_c": "C1 (C)"}``);
-        None: ``time_s`` and ``temperature_c``.
+        empty (or None): ``time_s`` and ``temperature_c``.
     unit
         ``"C"`` or ``"F"``; None: F when the temperature column's header says so.
     start
@@ -495,43 +502,31 @@ class TemperatureReference:
         The reference's lag behind the sensor; None: fitted. [s]
     """
 
-    path: str | Path
-    columns: Mapping[str, str] | None = None
+    path: str
+    columns: dict[str, str] = field(default_factory=dict)
     unit: str | None = None
     start: str | None = None
     tz: str | None = None
     lag_s: float | None = None
 
-    def to_dict(self) -> dict[str, Any]:
-        """How the log was read, as plain JSON types (a model file's provenance;
-        :class:`TemperatureReferenceRecord`)."""
-        return records.dump(self, TemperatureReferenceRecord, path=str(self.path),
-                            columns=dict(self.columns or {}))
-
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> TemperatureReference:
-        """Inverse of :meth:`to_dict` (no columns: None, the default names)."""
-        values = records.load(data, TemperatureReferenceRecord, "temperature reference")
-        return cls(**values | {"columns": values["columns"] or None})
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "path", str(self.path))
+        object.__setattr__(self, "columns", dict(self.columns or {}))
 
     def fit(self, recording: str | Path, read_options: Any = None) -> TemperatureMap:
         """The count → °C map of ``recording``'s raw temperature
         (:func:`map_from_reference`)."""
-        return map_from_reference(recording, self.path, read_options, columns=self.columns,
+        return map_from_reference(recording, self.path, read_options,
+                                  columns=self.columns or None,
                                   unit=self.unit, start=self.start, tz=self.tz,
                                   lag_s=self.lag_s)
 
 
-class TemperatureReferenceRecord(records.Record, kw_only=True):
-    """The record of :class:`TemperatureReference` (``columns``: ours -> the log's;
-    empty for the default names)."""
-
-    path: str
-    columns: dict[str, str] = records.empty()
-    unit: str | None = None
-    start: str | None = None
-    tz: str | None = None
-    lag_s: float | None = None
+#: The record of :class:`TemperatureReference` (a model file's provenance: how the log was
+#: read), generated from its fields.
+TemperatureReferenceRecord = records.record_of(
+    TemperatureReference, doc="The record of :class:`TemperatureReference` (``columns``: "
+    "ours -> the log's;\nempty for the default names).")
 
 
 def _read_raw(options: Any, recording: str | Path) -> Any:

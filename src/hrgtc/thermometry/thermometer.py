@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Mapping
 from dataclasses import dataclass
 from fractions import Fraction
 from functools import cached_property
@@ -87,8 +86,8 @@ def _horner(coefficients: np.ndarray, z: np.ndarray) -> np.ndarray:
     return result
 
 
-@dataclass(frozen=True)
-class Thermometer:
+@dataclass(frozen=True, kw_only=True)
+class Thermometer(records.Written):
     """A fitted frequency-temperature polynomial f(T) and its inverse T(f).
 
     Build it with :func:`fit`. Eq. (17)-(18) of [1].
@@ -123,18 +122,23 @@ class Thermometer:
         is read in place of f (:func:`identity`: f = T, in °C).
     """
 
-    coefficients: tuple[float, ...]
-    standard_errors: tuple[float, ...]
-    residual_std_hz: float
-    rsquared: float
-    temperature_range_c: tuple[float, float]
-    order: int
-    n_points: int
+    #: Its record (the model file's ``thermometer``) is generated from these fields.
+    constants = (("kind", "hrgtc.Thermometer"),)
+    omit_when_default = ("source",)  # written only for a sensor: older files hash alike
+    renamed = (("residual_std", "residual_std_hz"),)  # before 0.1
+
+    order: Annotated[int, Meta(ge=1, le=12)]
+    n_points: Annotated[int, Meta(ge=2)]
+    coefficients: Annotated[tuple[float, ...], Meta(min_length=2)]
+    standard_errors: tuple[records.Statistic, ...]
+    residual_std_hz: records.Statistic = math.nan
+    rsquared: records.Statistic
+    temperature_range_c: records.Range
     centre_c: float
-    scale_c: float
-    scaled_coefficients: tuple[float, ...]
-    scaled_covariance: tuple[tuple[float, ...], ...] | None = None
-    source: str = "resonator"
+    scale_c: records.Positive
+    scaled_coefficients: Annotated[tuple[float, ...], Meta(min_length=2)]
+    scaled_covariance: tuple[tuple[records.Statistic, ...], ...] | None = None
+    source: Literal["resonator", "sensor"] = "resonator"
 
     # -- derived -------------------------------------------------------------------
     @property
@@ -420,39 +424,13 @@ class Thermometer:
         return Summary(f"thermometer: order-{self.order} polynomial f(T)",
                        (("coefficients", tuple(cells)), ("fit", fit)), layout=tuple(layout))
 
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types, as :class:`ThermometerRecord` writes them (NaN -> None)."""
-        return records.dump(self, ThermometerRecord)
 
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> Thermometer:
-        """Inverse of :meth:`to_dict` (checked against :class:`ThermometerRecord`)."""
-        if isinstance(data, Mapping) and "residual_std" in data and "residual_std_hz" not in data:
-            data = {**data, "residual_std_hz": data["residual_std"]}  # its name before 0.1
-        values = records.load(data, ThermometerRecord, "thermometer")
-        values.pop("kind")
-        return cls(**values)
-
-
-class ThermometerRecord(records.Record, kw_only=True):
-    """A :class:`Thermometer` in a file (the model file's ``thermometer``): field names and
-    bounds, from which its ``to_dict``/``from_dict`` and its JSON Schema are generated."""
-
-    omit_when_default = ("source",)  # written only for a sensor: older files hash alike
-
-    kind: Literal["hrgtc.Thermometer"] = "hrgtc.Thermometer"
-    order: Annotated[int, Meta(ge=1, le=12)]
-    n_points: Annotated[int, Meta(ge=2)]
-    coefficients: Annotated[tuple[float, ...], Meta(min_length=2)]
-    standard_errors: tuple[records.Statistic, ...]
-    residual_std_hz: records.Statistic = None
-    rsquared: records.Statistic
-    temperature_range_c: records.Range
-    centre_c: float
-    scale_c: records.Positive
-    scaled_coefficients: Annotated[tuple[float, ...], Meta(min_length=2)]
-    scaled_covariance: tuple[tuple[records.Statistic, ...], ...] | None = None
-    source: Literal["resonator", "sensor"] = "resonator"
+#: :class:`Thermometer` in a file (the model file's ``thermometer``), generated from its
+#: fields.
+ThermometerRecord = records.record_of(
+    Thermometer, doc="A :class:`Thermometer` in a file (the model file's ``thermometer``): "
+    "field names and\nbounds, from which its ``to_dict``/``from_dict`` and its JSON Schema "
+    "are generated.")
 
 
 def fit(temperatures_c: Any, frequencies_hz: Any, order: int = 3) -> Thermometer:
