@@ -231,8 +231,8 @@ def evaluate_unit(files: UnitFiles, models_dir: str, read_options: ReadOptions |
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             settings = EvaluationSettings(allan=allan)
-            evaluations = [evaluate(run, model, settings=settings, read_options=read_options)
-                           for run in runs]
+            evaluations = [evaluate(model, run, settings=settings,
+                                    read_options=read_options).axis for run in runs]
         return UnitOutcome(files.unit, "ok", evaluation_row(evaluations), None,
                            time.perf_counter() - start)
     except Exception as exc:
