@@ -200,11 +200,10 @@ def render_instrument_evaluation(result: RunEvaluation, json_output: bool) -> No
     sensor = {axis: m.thermometer.source == "sensor" for axis, m in model.axes.items()}
     if json_output:
         print_json(result.to_dict())
-    elif model.is_single_axis:
-        render_evaluation(result.axes[""], sensor[""])
-    else:
+    else:  # a heading per named axis (the one axis of a single-axis model has none)
         for axis, evaluation in result.axes.items():
-            console.rule(f"axis {axis}")
+            if axis:
+                console.rule(f"axis {axis}")
             render_evaluation(evaluation, sensor[axis])
     checks = result.scale_checks
     if checks and json_output:

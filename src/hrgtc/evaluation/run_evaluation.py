@@ -213,6 +213,14 @@ def evaluate(
         from hrgtc.compensate.multi_axis import match_axes, recording_axes
 
         model = match_axes(model, recording_axes(run, options), axes, str(run), model_source)
+    return _evaluate_file(model, run, options, settings, max_points, on_output, progress)
+
+
+def _evaluate_file(model: Model, run: str | os.PathLike[str], options: ReadOptions,
+                   settings: EvaluationSettings | None, max_points: int | None,
+                   on_output: Callable[[Recording], None] | None,
+                   progress: Progress | None) -> RunEvaluation:
+    """:func:`evaluate` of a file, once its model's axes are matched to the run's."""
     if model.is_single_axis:  # the reader checks the plausible band of the one frequency
         options = with_model_band(options, model)
     else:  # each axis's band on its view, below

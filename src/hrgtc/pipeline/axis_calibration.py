@@ -180,52 +180,25 @@ def fit_axis(
 ) -> AxisCalibration:
     """One axis: its thermometer from the soaks, its drift model from the ramps.
 
-    The caller (:func:`hrgtc.pipeline.calibration.calibrate`, whose parameters these are)
-    has refused compensated outputs among the files and reads the axis's view of them
-    (``read_options.axis``); the held-out runs are evaluated there, every axis at once.
-
-    Parameters
-    ----------
-    soaks
-        Soak recordings (one per set-point, or files holding several).
-    drifts
-        Ramp recordings to fit the drift model on (cool-down, warm-up, cycles); with
-        two training runs or more (the soaks count) the fit reports each run's
-        leave-one-run-out cross-validated bias stability, heating and cooling apart.
-    settings
-        The thermometer's order, the drift fit (candidate terms, window, stepwise
-        thresholds, df/dt filters, term selection, offsets) and whether the soaks join
-        the drift fit (:class:`~hrgtc.settings.calibration.CalibrationSettings`; its
-        defaults when None). The candidate terms default to :data:`GRADIENT_TERMS` when
-        every training run logs ``housing_c``, else the nine of Eq. (21). Soaks join the
-        drift fit by default: a single cool-down covers one curve in the (temperature,
-        rate) plane, along which the polynomial in f and the df/dt terms are confounded;
-        the soaks' warming and cooling transients add curves of both signs of df/dt.
-    aux
-        Extra logged channels, name -> column (``--aux NAME=COLUMN``): each becomes the
-        variable ``a_NAME`` (the column minus its training mean) and the term
-        ``a_NAME`` is added to the candidates unless ``terms`` already use it;
-        compensation reads the same column.
-    read_options
-        Column mapping, units and metadata overrides for every file; its
-        ``thermometer``: ``"resonator"`` ([1]: the thermometer from the soaks'
-        plateaus) or ``"sensor"``: a gyro without a frequency output, whose temperature
-        sensor (``temperature_c``, read in the place of ``freq_hz``) is the thermometer
-        (:func:`hrgtc.thermometry.identity`); soaks are then optional training runs.
-    progress
-        Optional ``callback(stage, done, total)``.
-    prior
-        A population prior (:class:`~hrgtc.thermometry.prior.ThermometerPrior` or
-        its file, ``hrgtc fleet prior``): the thermometer is then the posterior of
-        the prior and the soaks (two or three suffice), valid over the prior's
-        range, and ``order`` is the prior's. A prior of units of another kind is
-        refused.
-    soak_fit
-        The thermometer already fitted on these soaks (and drift runs) with these
-        settings (:attr:`AxisCalibration.soak_fit` of an earlier fit, or
-        :func:`fit_soaks`): its plateaus, Tables 1-2 and thermometer are reused and only
-        the drift model is fitted (``--cross-axis`` refits the drift model with more
-        candidate terms on the same files).
+    The parameters are those of :func:`hrgtc.pipeline.calibration.calibrate`, which has
+    refused compensated outputs among the files, reads this axis's view of them
+    (``read_options.axis``) and evaluates the held-out runs, every axis at once. ``aux``:
+    extra logged channels, name -> column (``--aux NAME=COLUMN``), each the variable
+    ``a_NAME`` (the column minus its training mean) and a candidate term; ``soak_fit``:
+    the thermometer already fitted on these soaks (and drift runs) with these settings
+    (:attr:`AxisCalibration.soak_fit` of an earlier fit, or :func:`fit_soaks`), whose
+    plateaus, Tables 1-2 and thermometer are reused, only the drift model being fitted
+    (``--cross-axis`` refits it with more candidate terms on the same files). With two
+    training runs or more (the soaks count) the drift fit reports each run's
+    leave-one-run-out cross-validated bias stability, heating and cooling apart. The
+    candidate terms default to :data:`GRADIENT_TERMS` when every training run logs
+    ``housing_c``, else the nine of Eq. (21); soaks join the drift fit by default: a single
+    cool-down covers one curve in the (temperature, rate) plane, along which the polynomial
+    in f and the df/dt terms are confounded, and the soaks' warming and cooling transients
+    add curves of both signs of df/dt. ``read_options.thermometer="sensor"``: a gyro
+    without a frequency output, its temperature sensor (``temperature_c``, read in the
+    place of ``freq_hz``) the thermometer (:func:`hrgtc.thermometry.identity`), the soaks
+    optional training runs.
     """
     options = read_options or ReadOptions()
     settings = settings or CalibrationSettings()
@@ -252,15 +225,8 @@ def fit_axis(
     prior_fit, soak_rates = fitted.prior_fit, fitted.sample_rates_hz
 
     heads.update({str(path): options.head(path) for path in soaks if str(path) not in heads})
-    drift_rate = heads[str(drifts[0])].metadata.sample_rate_hz
-    extra = [p for p, r in zip(soaks, soak_rates, strict=True) if math.isclose(r, drift_rate)]
-    if settings.drift_from_soaks and len(extra) < len(soaks):
-        warnings.warn(
-            f"{len(soaks) - len(extra)} soak file(s) are not at the drift runs' "
-            f"{drift_rate:g} Hz and are left out of the drift fit (its windows and settling "
-            "time are counted in samples at one rate); they still calibrate the thermometer",
-            HrgtcWarning, stacklevel=2)
-    training = [*drifts, *(extra if settings.drift_from_soaks else ())]
+    training = [*drifts, *_soaks_for_drift(soaks, soak_rates, settings,
+                                           heads[str(drifts[0])].metadata.sample_rate_hz)]
     training_heads = [heads[str(p)] for p in training]
     settings = _with_terms(settings, resolve_terms(settings.drift.terms, aux, training_heads))
     model, housing = _fit_drift(training, heads, thermometer_fit, options, progress,
@@ -280,6 +246,22 @@ def fit_axis(
             {"soak": [str(p) for p in soaks], "drift": [str(p) for p in drifts]}, record),
     )
     return AxisCalibration(unit_model, tuple(plateaus), table, (), prior_fit, fitted)
+
+
+def _soaks_for_drift(soaks: Sequence[PathLike], soak_rates: Sequence[float],
+                     settings: CalibrationSettings, drift_rate: float) -> list[PathLike]:
+    """The soaks that join the drift fit: none unless ``settings.drift_from_soaks``, and
+    only those at the drift runs' sample rate (the others are named in a warning)."""
+    if not settings.drift_from_soaks:
+        return []
+    extra = [p for p, r in zip(soaks, soak_rates, strict=True) if math.isclose(r, drift_rate)]
+    if len(extra) < len(soaks):
+        warnings.warn(
+            f"{len(soaks) - len(extra)} soak file(s) are not at the drift runs' "
+            f"{drift_rate:g} Hz and are left out of the drift fit (its windows and settling "
+            "time are counted in samples at one rate); they still calibrate the thermometer",
+            HrgtcWarning, stacklevel=3)
+    return extra
 
 
 def fit_soaks(soaks: Sequence[PathLike], *, settings: CalibrationSettings | None = None,

@@ -233,11 +233,49 @@ def calibrate(
     settings = settings or CalibrationSettings()
     inputs = inputs or CalibrationInputs()
     tables = rate_tables or RateTables()
-    options = read_options or ReadOptions()
+    aux = parse_aux(inputs.aux)
+    reading = _reading(soaks, drifts, validate, inputs, tables, read_options or ReadOptions(),
+                       progress)
+    fitted, models, crossed = _fit_axes(soaks, drifts, reading, settings, aux, prior, tables,
+                                        progress)
+    temperature_map = reading.temperature_map
+    instrument = Model(models, next(iter(fitted.values())).model.unit,
+                       _provenance(soaks, drifts, tables, fitted, settings, inputs, reading),
+                       None if temperature_map is None else temperature_map.to_dict())
+    # each held-out run read once for every axis
+    runs = [evaluate(instrument, path, settings=BIAS_ONLY, read_options=reading.held_out).axes
+            for path in reading.validate]
+    checks = tuple(check for path in tables.validate for check in check_scale_factor(
+        path, instrument, reading.options, reading.segments))
+    return Calibration(instrument, {axis: dataclasses.replace(
+        fitted[axis], model=instrument.of_axis(axis),
+        validation=tuple(run[axis] for run in runs)) for axis in reading.axes}, checks, crossed)
+
+
+@dataclass(frozen=True)
+class _Reading:
+    """How :func:`calibrate` reads its files, after the temperature map and the hold-out
+    split: the training files' options (every axis from one reading: a
+    :class:`~hrgtc.recording.read_once.ReadOnce`), the held-out runs' and which they are,
+    the axes, the map and its reference log, the rate tables' segments."""
+
+    options: ReadOptions
+    held_out: ReadOptions
+    validate: Sequence[PathLike]
+    axes: tuple[str, ...]
+    temperature_map: TemperatureMap | None
+    reference: TemperatureReference | None
+    segments: Any
+
+
+def _reading(soaks: Sequence[PathLike], drifts: Sequence[PathLike],
+             validate: Sequence[PathLike], inputs: CalibrationInputs, tables: RateTables,
+             options: ReadOptions, progress: StageProgress | None) -> _Reading:
+    """The reading of :func:`calibrate`'s files (the parameters are its own), every file
+    refused when it is a compensated output."""
     if options.thermometer not in ("resonator", "sensor"):
         raise InputError("thermometer must be 'resonator' or 'sensor', got "
                          f"{options.thermometer!r}")
-    aux = parse_aux(inputs.aux)
     reference = temperature_reference(inputs.reference)
     temperature_map = None
     if reference is not None and drifts:  # all of the first run, before a split
@@ -258,37 +296,40 @@ def calibrate(
     if len(axes) > 1:  # every axis calibrated from one reading of each file
         options = ReadOnce(**{f.name: getattr(options, f.name)
                               for f in dataclasses.fields(ReadOptions)})
-    table = (read_segment_table(tables.segment_table) if tables.segment_table is not None
-             else None)
+    held_out = options if validate_options is None else _same_cache(validate_options, options)
+    segments = (read_segment_table(tables.segment_table) if tables.segment_table is not None
+                else None)
+    return _Reading(options, held_out, tuple(validate), axes, temperature_map, reference,
+                    segments)
+
+
+def _fit_axes(soaks: Sequence[PathLike], drifts: Sequence[PathLike], reading: _Reading,
+              settings: CalibrationSettings, aux: Mapping[str, str],
+              prior: ThermometerPrior | PathLike | None, tables: RateTables,
+              progress: StageProgress | None) -> tuple[dict[str, AxisCalibration],
+                                                       dict[str, AxisModel],
+                                                       dict[str, dict[str, Any]]]:
+    """Each axis's fit (:func:`~hrgtc.pipeline.axis_calibration.fit_axis` on its view of the
+    files), its cross-axis trial and its scale factor: the axes' calibrations, their parts
+    and the trials."""
     fitted: dict[str, AxisCalibration] = {}
     models: dict[str, AxisModel] = {}
     crossed: dict[str, dict[str, Any]] = {}
+    axes = reading.axes
     for axis in axes:
-        axis_read = dataclasses.replace(options, axis=axis or options.axis)
+        axis_read = dataclasses.replace(reading.options, axis=axis or reading.options.axis)
         staged = None if progress is None else _prefixed(progress, axis)
         fit = {"soaks": soaks, "drifts": drifts, "settings": settings, "prior": prior,
                "read_options": axis_read, "progress": staged}
         result = fit_axis(**fit, aux=aux)
         if settings.cross_axis and len(axes) > 1:
-            result, crossed[axis] = _cross_axis(result, axis, axes, validate, aux, fit)
+            result, crossed[axis] = _cross_axis(result, axis, axes, reading.validate, aux, fit)
         model = result.model.axis
         if tables.runs:
             model = dataclasses.replace(model, scale_factor=fit_axis_scale_factor(
-                model, tables.runs, axis_read, table, settings.scale_terms))
+                model, tables.runs, axis_read, reading.segments, settings.scale_terms))
         fitted[axis], models[axis] = result, model
-    instrument = Model(models, next(iter(fitted.values())).model.unit,
-                       _provenance(soaks, drifts, validate, tables, fitted, settings, options,
-                                   axes, inputs, reference),
-                       None if temperature_map is None else temperature_map.to_dict())
-    held_out = options if validate_options is None else _same_cache(validate_options, options)
-    # each held-out run read once for every axis
-    runs = [evaluate(instrument, path, settings=BIAS_ONLY, read_options=held_out).axes
-            for path in validate]
-    checks = tuple(check for path in tables.validate
-                   for check in check_scale_factor(path, instrument, options, table))
-    return Calibration(instrument, {axis: dataclasses.replace(
-        fitted[axis], model=instrument.of_axis(axis),
-        validation=tuple(run[axis] for run in runs)) for axis in axes}, checks, crossed)
+    return fitted, models, crossed
 
 
 def temperature_reference(settings: TemperatureReferenceSettings) -> TemperatureReference | None:
@@ -307,16 +348,15 @@ def temperature_reference(settings: TemperatureReferenceSettings) -> Temperature
         lag_s=settings.reference_lag_s)
 
 
-def _provenance(soaks: Sequence[PathLike], drifts: Sequence[PathLike],
-                validate: Sequence[PathLike], tables: RateTables,
+def _provenance(soaks: Sequence[PathLike], drifts: Sequence[PathLike], tables: RateTables,
                 fitted: Mapping[str, AxisCalibration], settings: CalibrationSettings,
-                options: ReadOptions, axes: Sequence[str], inputs: CalibrationInputs,
-                reference: TemperatureReference | None) -> dict[str, Any]:
+                inputs: CalibrationInputs, reading: _Reading) -> dict[str, Any]:
     """The model's provenance: every input file (hashed once) and the settings of the
     axes' fits with what the chain adds (axes, scale terms, segment table, hold-out, the
     reference log)."""
+    reference = reading.reference
     files = {"soak": [str(p) for p in soaks], "drift": [str(p) for p in drifts],
-             "validate": [str(p) for p in validate],
+             "validate": [str(p) for p in reading.validate],
              "rate_table": [str(p) for p in tables.runs],
              "validate_rate_table": [str(p) for p in tables.validate],
              "temperature_reference": [] if reference is None else [str(reference.path)]}
@@ -324,7 +364,7 @@ def _provenance(soaks: Sequence[PathLike], drifts: Sequence[PathLike],
     hashed = {f["path"]: f["sha256"] for r in fitted.values()  # the axes' records
               for f in r.model.provenance.get("inputs", ())}
     return provenance(files, {
-        **first, "axes": list(axes), "thermometer": options.thermometer,
+        **first, "axes": list(reading.axes), "thermometer": reading.options.thermometer,
         "scale_terms": list(settings.scale_terms),
         "segment_table": None if tables.segment_table is None else str(tables.segment_table),
         "holdout_s": inputs.holdout.holdout_s, "holdout_fraction": inputs.holdout.holdout_fraction,
