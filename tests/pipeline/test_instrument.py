@@ -8,6 +8,7 @@ warm-up and a rate table at two temperatures between the training ones.
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -233,3 +234,24 @@ def test_the_instrument_summary_shows_the_rate_tables_and_the_axes(calibration, 
     lines = [[c.strip() for c in line.split("│")[1:-1]] for line in out.getvalue().splitlines()]
     for heading, label, value, unit, interval in summary.rows():
         assert [label, value, unit, interval] in lines, (heading, label)
+
+
+def test_the_one_axis_readings_name_the_axes_of_an_instrument(calibration, imu_campaign):
+    """``calibrate`` and ``evaluate`` return one type for one axis or many: the readings of
+    the only axis (``.axis``, ``.validation``, ...) raise on three axes, naming them, and
+    the axis's own is in ``.axes``; one axis evaluated (``--axes y``) is the ``.axis``."""
+    from hrgtc.evaluation import evaluate
+    from hrgtc.settings.compensation import BIAS_ONLY
+
+    for reading in ("axis", "plateaus", "table", "validation", "prior_fit"):
+        with pytest.raises(InputError, match=r"has axes x, y, z: pick one: "
+                                             r"calibration.axes\['x'\]"):
+            getattr(calibration, reading)
+    assert calibration.axes["y"].model.axis is calibration.model.axes["y"]
+    assert calibration.axes["y"].validation[0].file == Path(imu_campaign.warmup).name
+    run = evaluate(calibration.model, imu_campaign.warmup, settings=BIAS_ONLY)  # as held out
+    with pytest.raises(InputError, match=r"axes x, y, z: pick one: result.axes\['x'\]"):
+        run.axis  # noqa: B018 (the property raises)
+    assert run.axes["y"].to_dict() == calibration.axes["y"].validation[0].to_dict()
+    alone = evaluate(calibration.model, imu_campaign.warmup, settings=BIAS_ONLY, axes=("y",))
+    assert list(alone.axes) == ["y"] and alone.axis.to_dict() == run.axes["y"].to_dict()
