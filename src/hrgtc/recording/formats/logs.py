@@ -35,8 +35,10 @@ DATENUM_UNIX_EPOCH_DAYS = 719529.0
 SECONDS_PER_DAY = 86400.0
 
 
-def require(module: str, extra: str, what: str, path: Path) -> ModuleType:
-    """Import ``module`` for reading ``path``, or RecordingError naming the extra to install.
+def require(module: str, extra: str, what: str, path: Path,
+            action: str = "reading") -> ModuleType:
+    """Import ``module`` for reading (or writing) ``path``, or RecordingError naming the
+    extra to install.
 
     Parameters
     ----------
@@ -48,12 +50,14 @@ def require(module: str, extra: str, what: str, path: Path) -> ModuleType:
         The format's name for the message (``"TDMS"``).
     path
         The file being read (named in the message).
+    action
+        ``"reading"`` or ``"writing"``, for the message.
     """
     try:
         return importlib.import_module(module)
     except ImportError as exc:
         raise RecordingError(
-            f"{path}: reading {what} files needs the Python package {module!r}, which is not "
+            f"{path}: {action} {what} files needs the Python package {module!r}, which is not "
             f"installed ({exc}); install it with pip install 'hrgtc[{extra}]' (or "
             "'hrgtc[formats]' for every file format)") from None
 
