@@ -8,6 +8,7 @@ the file (its variables, their MATLAB class and shape), which is not hrgtc's rea
 from __future__ import annotations
 
 import json
+import re
 import sys
 
 import numpy as np
@@ -73,7 +74,8 @@ def test_metadata_set_at_the_end_and_text_of_any_script(tmp_path):
 
 
 def test_a_column_that_is_not_a_matlab_name_is_refused(tmp_path):
-    with pytest.raises(RecordingError, match=r"\['2nd_rate'\] cannot be MATLAB variable names"):
+    with pytest.raises(RecordingError, match=rf"^{re.escape(str(tmp_path / 'x.mat'))}: column\(s\) "
+                       r"\['2nd_rate'\] cannot be MATLAB variable names"):
         RecordingWriter(tmp_path / "x.mat", Metadata(sample_rate_hz=1.0), ["time_s", "2nd_rate"])
     assert list(tmp_path.iterdir()) == []
 
@@ -90,6 +92,8 @@ def test_more_than_a_v5_variable_holds_is_refused(tmp_path, monkeypatch):
 
 def test_writing_without_scipy_names_the_extra(tmp_path, monkeypatch):
     monkeypatch.setitem(sys.modules, "scipy.io", None)  # import raises ImportError
-    with pytest.raises(RecordingError, match=r"writing MATLAB files needs the Python package "
+    target = re.escape(str(tmp_path / "x.mat"))
+    with pytest.raises(RecordingError, match=rf"^{target}: writing MATLAB files "
+                       r"needs the Python package "
                        r"'scipy.io'.*pip install 'hrgtc\[matlab\]'"):
         RecordingWriter(tmp_path / "x.mat", Metadata(sample_rate_hz=1.0), ["rate_dph"])

@@ -8,6 +8,7 @@ the file (its channels, master, units and header comment), which is not hrgtc's 
 from __future__ import annotations
 
 import json
+import re
 import sys
 import xml.etree.ElementTree as ElementTree
 
@@ -78,7 +79,9 @@ def test_metadata_set_at_the_end_and_a_clock_origin(tmp_path):
 
 def test_writing_without_asammdf_names_the_extra(tmp_path, monkeypatch):
     monkeypatch.setitem(sys.modules, "asammdf", None)  # import raises ImportError
-    with pytest.raises(RecordingError, match=r"writing MDF files needs the Python package "
+    target = re.escape(str(tmp_path / "x.mf4"))
+    with pytest.raises(RecordingError, match=rf"^{target}: writing MDF files "
+                       r"needs the Python package "
                        r"'asammdf'.*pip install 'hrgtc\[mdf\]'"):
         RecordingWriter(tmp_path / "x.mf4", Metadata(sample_rate_hz=1.0), ["rate_dph"])
     assert list(tmp_path.iterdir()) == []

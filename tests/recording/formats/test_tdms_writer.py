@@ -8,6 +8,7 @@ the file (its channels, properties and ``time_track()``), which is not hrgtc's r
 from __future__ import annotations
 
 import json
+import re
 import sys
 
 import numpy as np
@@ -102,7 +103,9 @@ def test_metadata_set_at_the_end_replaces_the_first(tmp_path):
 
 def test_writing_without_nptdms_names_the_extra(tmp_path, monkeypatch):
     monkeypatch.setitem(sys.modules, "nptdms", None)  # import raises ImportError
-    with pytest.raises(RecordingError, match=r"writing TDMS files needs the Python package "
+    target = re.escape(str(tmp_path / "x.tdms"))
+    with pytest.raises(RecordingError, match=rf"^{target}: writing TDMS files "
+                       r"needs the Python package "
                        r"'nptdms'.*pip install 'hrgtc\[tdms\]'"):
         RecordingWriter(tmp_path / "x.tdms", Metadata(sample_rate_hz=1.0), ["rate_dph"])
     assert list(tmp_path.iterdir()) == []  # no temporary file left behind

@@ -56,6 +56,7 @@ from hrgtc.recording.formats.logs import (
     check_exists,
     datenum_to_datetime,
     numeric,
+    output_path,
     require,
     streams,
     unreadable,
@@ -299,12 +300,12 @@ class MatlabSink(Sink):
 
     def __init__(self, path: Path, metadata: Metadata, names: Sequence[str]) -> None:
         super().__init__(path, metadata, names)
-        self._scipy_io = require("scipy.io", "matlab", "MATLAB", path, "writing")
+        self._scipy_io = require("scipy.io", "matlab", "MATLAB", output_path(path), "writing")
         bad = [n for n in names if not VARIABLE_NAME.fullmatch(n) or n == METADATA_VARIABLE]
         if bad:
             raise RecordingError(
-                f"{path}: column(s) {bad} cannot be MATLAB variable names (a letter, then "
-                "letters, digits or underscores, at most 63 characters; not "
+                f"{output_path(path)}: column(s) {bad} cannot be MATLAB variable names (a "
+                "letter, then letters, digits or underscores, at most 63 characters; not "
                 f"{METADATA_VARIABLE!r}); rename them or write .parquet or .h5")
         self._order = "<" if sys.byteorder == "little" else ">"
         self.set_metadata(metadata)
@@ -322,7 +323,7 @@ class MatlabSink(Sink):
         rows = len(columns[self.names[0]])
         if 8 * (self._rows + rows) + 64 > V5_VARIABLE_BYTES:
             raise RecordingError(
-                f"{self.path}: a MATLAB v5 variable holds at most 2^31 bytes "
+                f"{output_path(self.path)}: a MATLAB v5 variable holds at most 2^31 bytes "
                 f"({V5_VARIABLE_BYTES // 8 - 8:,} rows of doubles); write .h5 or .parquet")
         for name, spill in self._spills.items():
             np.asarray(columns[name], dtype=f"{self._order}f8").tofile(spill)

@@ -41,7 +41,7 @@ from hrgtc.recording.formats.base import (
     loads_json,
     metadata_json,
 )
-from hrgtc.recording.formats.logs import check_exists, quiet, require, unreadable
+from hrgtc.recording.formats.logs import check_exists, output_path, quiet, require, unreadable
 from hrgtc.recording.schema import Metadata
 
 #: The identification block of MDF 3 and 4 ("MDF     "; "UnFinMF " for an unfinished one).
@@ -263,7 +263,7 @@ class MdfSink(Sink):
 
     def __init__(self, path: Path, metadata: Metadata, names: Sequence[str]) -> None:
         super().__init__(path, metadata, names)
-        self._asammdf = require("asammdf", "mdf", "MDF", path, "writing")
+        self._asammdf = require("asammdf", "mdf", "MDF", output_path(path), "writing")
         self._rate_hz = float(metadata.sample_rate_hz)
         axes = axis_names(names)
         self._channels = [n for n in names if n != "time_s"]

@@ -49,7 +49,7 @@ from hrgtc.recording.formats.base import (
     loads_json,
     metadata_json,
 )
-from hrgtc.recording.formats.logs import check_exists, quiet, require, unreadable
+from hrgtc.recording.formats.logs import check_exists, output_path, quiet, require, unreadable
 from hrgtc.recording.schema import Metadata
 
 #: The lead-in tag of a TDMS segment ("TDSm"; "TDSh" in the .tdms_index file).
@@ -251,7 +251,7 @@ class TdmsSink(Sink):
 
     def __init__(self, path: Path, metadata: Metadata, names: Sequence[str]) -> None:
         super().__init__(path, metadata, names)
-        self._nptdms = require("nptdms", "tdms", "TDMS", path, "writing")
+        self._nptdms = require("nptdms", "tdms", "TDMS", output_path(path), "writing")
         self._metadata = metadata_json(metadata)
         self._increment = 1.0 / float(metadata.sample_rate_hz)
         origin = metadata.extra.get("time_origin") if isinstance(metadata.extra, dict) else None
