@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from hrgtc import simulate
-from hrgtc.core.errors import RecordingError
+from hrgtc.core.errors import RecordingError, SlowChannelWarning
 from hrgtc.recording import Metadata, RecordingWriter, read
 from hrgtc.simulate.campaign import run_metadata
 
@@ -109,3 +109,21 @@ def test_writing_without_nptdms_names_the_extra(tmp_path, monkeypatch):
                        r"'nptdms'.*pip install 'hrgtc\[tdms\]'"):
         RecordingWriter(tmp_path / "x.tdms", Metadata(sample_rate_hz=1.0), ["rate_dph"])
     assert list(tmp_path.iterdir()) == []  # no temporary file left behind
+
+
+def test_in_a_file_of_several_groups_time_s_is_each_groups_waveform_timing(tmp_path):
+    """Only a file of one group is read on a ``time_s`` channel; groups of a file of several
+    keep their waveform timing (a channel ``time_s`` stays one of their columns)."""
+    path = tmp_path / "two.tdms"
+    fast = {"wf_increment": 0.1, "wf_start_offset": 0.0}
+    slow = {"wf_increment": 1.0, "wf_start_offset": 0.0}
+    with nptdms.TdmsWriter(str(path)) as out:
+        out.write_segment([
+            nptdms.ChannelObject("fast", "rate", np.arange(50.0), properties=fast),
+            nptdms.ChannelObject("fast", "time_s", 100.0 + np.arange(50.0), properties=fast),
+            nptdms.ChannelObject("slow", "temp", 20.0 + np.arange(5.0), properties=slow)])
+    with pytest.warns(SlowChannelWarning, match="'slow/temp' is logged every 1 s"):
+        back = read(path, columns={"freq_hz": "fast/rate", "rate_dph": "fast/time_s",
+                                   "temperature_c": "slow/temp"}, thermometer="sensor")
+    assert np.array_equal(back["time_s"], np.arange(50) * 0.1)
+    assert np.array_equal(back["rate_dph"], 100.0 + np.arange(50.0))

@@ -18,8 +18,8 @@ group). Conventions handled:
 * **DAQmx raw data and NI scaling**: channels stored as raw counts with ``NI_Scale``
   properties are read scaled (npTDMS applies the scales), so values are in the
   channel's ``unit_string`` (kept in ``extra["tdms_units"]``);
-* a group holding a channel named ``time_s`` is read on that channel (the times as
-  logged), its waveform timing giving the sample rate;
+* a file of one group holding a channel named ``time_s`` is read on that channel (the
+  times as logged), its waveform timing giving the sample rate;
 * large files are read in batches (``TdmsFile.open``), never whole.
 
 Files written by hrgtc (:class:`TdmsSink`, ``hrgtc simulate --format tdms``) hold one
@@ -126,7 +126,7 @@ class TdmsGroupSource(Source):
             self.metadata["sample_rate_hz"] = 1.0 / increment
             if origin is not None:
                 extra["time_origin"] = str(origin)
-        if f"{prefix}time_s" in self._channels:
+        if not prefix and "time_s" in self._channels:
             self._time = None  # the times as logged, not rebuilt from the waveform timing
         if written is not None:  # a file hrgtc wrote: its metadata as it was written
             self.metadata = dict(written)
