@@ -269,14 +269,27 @@ def _expand(names: Sequence[str], values: np.ndarray) -> np.ndarray:
     return out
 
 
-def _simulate(full: np.ndarray, draws: int, n: int, sample_rate_hz: float,
-              rng: np.random.Generator) -> np.ndarray:
-    """``draws`` records of the model with the five C_k ``full``. [°/h]"""
+#: Samples simulated at once by the bootstrap (rows × record length): bounds its memory
+#: (~0.3 GB with the flicker's FFT) whatever the record's length.
+BATCH_SAMPLES = 1 << 22
+
+
+def _bootstrap_avar(full: np.ndarray, draws: int, lengths: tuple[int, ...],
+                    factors: np.ndarray, sample_rate_hz: float,
+                    rng: np.random.Generator) -> np.ndarray:
+    """The pooled Allan variances of ``draws`` records of the model with the five C_k
+    ``full``, simulated :data:`BATCH_SAMPLES` at a time. [(°/h)²]"""
+    n = sum(lengths)
     names = [k for k, c in zip(_NAMES, full, strict=True) if c > 0]
-    records = np.zeros((draws, n))
-    for name, unit in unit_noises(draws, n, sample_rate_hz, rng, names).items():
-        records += math.sqrt(full[_NAMES.index(name)]) * unit
-    return records
+    rows = max(1, BATCH_SAMPLES // n)
+    out = np.empty((draws, factors.size))
+    for start in range(0, draws, rows):
+        batch = min(rows, draws - start)
+        records = np.zeros((batch, n))
+        for name, unit in unit_noises(batch, n, sample_rate_hz, rng, names).items():
+            records += math.sqrt(full[_NAMES.index(name)]) * unit
+        out[start:start + batch] = pooled_avar(records, lengths, factors)
+    return out
 
 
 def _ratio_interval(value: float, draws: np.ndarray,
@@ -373,10 +386,9 @@ def fit_noise_model(allan: AllanResult, *, terms: Sequence[str] | None = None,
     avar = allan.deviation[keep] ** 2
     pilot = _expand(names, _pilot(taus, avar, allan.edf[keep], names))
     rng = np.random.default_rng(seed)
-    n = int(allan.n_samples)
     reference = _design(taus, _NAMES) @ pilot
-    pilot_records = _simulate(pilot, bootstrap, n, allan.sample_rate_hz, rng)
-    gls = _Gls(taus, reference, pooled_avar(pilot_records, lengths, factors) / reference)
+    pilot_avar = _bootstrap_avar(pilot, bootstrap, lengths, factors, allan.sample_rate_hz, rng)
+    gls = _Gls(taus, reference, pilot_avar / reference)
     columns = tuple(_NAMES.index(k) for k in names)
     candidates = [columns] if terms is not None else [
         s for r in range(1, len(columns) + 1) for s in itertools.combinations(columns, r)]
@@ -385,9 +397,9 @@ def fit_noise_model(allan: AllanResult, *, terms: Sequence[str] | None = None,
         k for k, c in zip(_NAMES, full, strict=True) if c > 0)
     coefficients = dict(zip(_NAMES, map(float, full), strict=True))
     term_values = {k: float(TERMS[k][2](c)) for k, c in coefficients.items()}
-    records = _simulate(full, bootstrap, n, allan.sample_rate_hz, rng)
     draws = np.zeros((bootstrap, len(_NAMES)))
-    for b, row in enumerate(pooled_avar(records, lengths, factors)):
+    for b, row in enumerate(_bootstrap_avar(full, bootstrap, lengths, factors,
+                                            allan.sample_rate_hz, rng)):
         c, _ = gls.select(row, candidates)
         draws[b] = [TERMS[k][2](v) for k, v in zip(_NAMES, c, strict=True)]
     intervals = dict.fromkeys(_NAMES)
