@@ -89,6 +89,21 @@ def test_arw_agrees_with_allantools_on_white_noise():
     assert model.summary()["noise_model.angle_random_walk"].unit == "°/√h"
 
 
+def test_a_ramp_is_read_in_degrees_per_hour_per_hour():
+    """A rate rising 0.01 °/h each second is a ramp of 36 °/h/h, with white noise beside it
+    (ARW σ/√fs/60); on a ramp alone the covariance has no scatter and the fit still runs."""
+    t = np.arange(4096.0)
+    alone = fit_noise_model(allan_deviation(0.01 * t, 1.0, confidence=0.683), bootstrap=50)
+    assert alone.fitted == ("rate_ramp",)
+    assert alone.terms["rate_ramp"] == pytest.approx(36.0, rel=1e-9)
+    noisy = 0.01 * t + np.random.default_rng(0).standard_normal(t.size)
+    model = fit_noise_model(allan_deviation(noisy, 1.0, confidence=0.683), bootstrap=50)
+    assert model.terms["rate_ramp"] == pytest.approx(36.0, rel=0.01)
+    assert model.terms["angle_random_walk"] == pytest.approx(1.0 / 60.0, rel=0.05)
+    text = model.summary().text()
+    assert "°/h/h" in text and "°/√h" in text
+
+
 def test_gaps_are_fitted_within_segments():
     """Segments at different offsets: pooled within them the fit sees only the noise (ARW of
     the white noise recovered); a deviation across the steps would be far off."""

@@ -238,6 +238,8 @@ class _Gls:
         cov = np.cov(relative, rowvar=False)
         # shrink the sample covariance a little towards its diagonal (p τ from B draws)
         cov = 0.9 * cov + 0.1 * np.diag(np.diag(cov))
+        # a term without scatter (a ramp alone) leaves the covariance singular: a floor
+        cov += np.eye(cov.shape[0]) * (1e-12 + 1e-9 * float(np.max(np.diag(cov))))
         self.whiten = np.linalg.inv(np.linalg.cholesky(cov)) / reference[None, :]
         design = self.whiten @ _design(taus, _NAMES)
         self.scale = 1.0 / np.maximum(np.max(np.abs(design), axis=0), 1e-300)
