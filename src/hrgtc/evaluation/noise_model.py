@@ -23,7 +23,7 @@ rate ramp           +2   R² τ² / 2        R = 3600 √(2 C)                  
    together. ``bootstrap`` records of the recording's length (its segments cut apart as in
    :mod:`hrgtc.evaluation.allan_segments`: gap-aware) are drawn from the pilot model, each
    term an independent power-law noise (white angle, white rate, Kasdin-Walter flicker rate
-   [4], random-walk rate, a ramp of random sign), and the covariance of their relative Allan
+   [1], random-walk rate, a ramp of random sign), and the covariance of their relative Allan
    variances is the weight of a generalised least squares (GLS) fit with C_k ≥ 0.
 3. **Terms.** Unless the caller names them, the terms are those of the subset with the
    smallest GLS χ² + 2·(terms) (Akaike's criterion): a term the data cannot tell apart from
@@ -37,7 +37,7 @@ rate ramp           +2   R² τ² / 2        R = 3600 √(2 C)                  
 Coverage over 200 seeds of allantools' Kasdin noise, and what is not claimed (terms chosen by
 AIC on a short record): docs/noise-model.md.
 
-[4] N. J. Kasdin, T. Walter, "Discrete simulation of power law noise", Proc. 1992 IEEE
+[1] N. J. Kasdin, T. Walter, "Discrete simulation of power law noise", Proc. 1992 IEEE
     Frequency Control Symposium, 274-283. doi:10.1109/FREQ.1992.270003
 """
 
@@ -149,7 +149,7 @@ def _design(taus_s: np.ndarray, names: Sequence[str]) -> np.ndarray:
 
 def _kasdin_flicker(shape: tuple[int, int], rng: np.random.Generator) -> np.ndarray:
     """Rows of flicker noise from unit white noise by Kasdin and Walter's filter
-    h_0 = 1, h_j = h_{j−1}(j − ½)/j [4] (FFT, zero-padded: no wrap-around). Its Allan
+    h_0 = 1, h_j = h_{j−1}(j − ½)/j [1] (FFT, zero-padded: no wrap-around). Its Allan
     variance at fs = 1 is 2 ln 2/π (two-sided PSD 1/(2π f)) for τ ≫ 1 s, and more at
     τ of a few samples (1.44 times at τ = 1/fs, 1.05 times at 4/fs), as allantools'
     ``Noise(b=-3)``; the bootstrap reproduces that excess of a sampled flicker noise."""
