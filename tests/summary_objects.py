@@ -128,7 +128,9 @@ def _test_report(paper: Any, folder: Path) -> Any:
 def _small() -> dict[str, Any]:
     from hrgtc.drift.cross_validation import CrossValidation
     from hrgtc.drift.stepwise import stepwise
+    from hrgtc.evaluation.allan import allan_deviation
     from hrgtc.evaluation.metrics import residual_against_truth
+    from hrgtc.evaluation.noise_model import fit_noise_model
     from hrgtc.fleet.run import FleetRun
     from hrgtc.fleet.tasks import UnitOutcome
     from hrgtc.recording.resample import fill_slow_channels
@@ -167,4 +169,6 @@ def _small() -> dict[str, Any]:
         "TransientFit": fit_transient(tau, 4424.0 + 0.2 * np.exp(-tau / 3000.0)),
         "FleetRun": FleetRun((UnitOutcome("a", "ok"), UnitOutcome("b", "failed")), 12.5,
                              "local cluster of 2 workers", workers_died=1, retried=("b",)),
+        "NoiseModel": fit_noise_model(allan_deviation(rng.normal(size=4096), 1.0,
+                                                      confidence=0.683), bootstrap=50),
     }
