@@ -163,6 +163,7 @@ def evaluate_command(
     from hrgtc.compensate.multi_axis import parse_axes
     from hrgtc.core.files import refuse_existing, refuse_input, write_text_atomic
     from hrgtc.evaluation import evaluate
+    from hrgtc.evaluation.run_evaluation import warn_worse_than_raw
     from hrgtc.evaluation.run_pass import DEVIATIONS
     from hrgtc.model import load_model
     from hrgtc.recording import ReadOptions
@@ -185,6 +186,7 @@ def evaluate_command(
         if allan_csv is not None:
             write_text_atomic(allan_csv, result.allan_csv(), force=force)
     render_instrument_evaluation(result, json_output)
+    warn_worse_than_raw(result)
     note_unchecked(model, model_path)
     warn_ranges([r.ranges for r in result.axes.values()], json_output, strict,
                 list(result.axes))

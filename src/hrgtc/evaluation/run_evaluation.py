@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from hrgtc.core import records
-from hrgtc.core.errors import InputError, RecordingError
+from hrgtc.core.errors import CompensationWarning, InputError, RecordingError
 from hrgtc.core.progress import Progress
 from hrgtc.core.records import Record, Statistic
 from hrgtc.core.summary import Summary
@@ -48,7 +48,8 @@ from hrgtc.recording.marks import compensation_mark, describe_mark, refuse_compe
 from hrgtc.recording.motion import ACCEL_COLUMNS
 from hrgtc.settings.compensation import EvaluationSettings
 
-__all__ = ["AxisSummaryRecord", "InstrumentEvaluationRecord", "RunEvaluation", "evaluate"]
+__all__ = ["AxisSummaryRecord", "InstrumentEvaluationRecord", "RunEvaluation", "evaluate",
+           "warn_worse_than_raw", "worse_than_raw"]
 
 #: The columns the at-rest detector reads (:func:`hrgtc.drift.rest.run_rest`).
 REST_COLUMNS = ("time_s", "rate_dph", "freq_hz", "input_rate_dph", *ACCEL_COLUMNS)
@@ -147,6 +148,45 @@ class RunEvaluation:
                 lines.append("axis," + header)
             lines.extend(f"{axis},{row}" for row in rows)
         return "\n".join(lines) + "\n"
+
+
+def worse_than_raw(evaluation: Evaluation, axis: str = "") -> str | None:
+    """What to say when compensation made ``evaluation``'s run worse: its 10 s bias
+    stability compensated above the raw one, their 1σ intervals apart (None otherwise).
+
+    The intervals of the two are each a χ² interval of their own series; raw and
+    compensated share the run's noise, so intervals that are apart are a difference the
+    run's noise does not explain."""
+    raw, compensated = evaluation.stability("raw", 10.0), evaluation.stability("compensated",
+                                                                               10.0)
+    if raw is None or compensated is None or not compensated > raw:
+        return None
+    raw_bounds = evaluation.stability_interval("raw", 10.0)
+    bounds = evaluation.stability_interval("compensated", 10.0)
+    if raw_bounds is not None and bounds is not None and bounds[0] <= raw_bounds[1]:
+        return None
+    where = f"{evaluation.file}" + (f", axis {axis}" if axis else "")
+    shares = {"of it lies beyond the trained temperatures": evaluation.out_of_range_fraction,
+              "beyond the trained df/dt": evaluation.rate_out_of_range_fraction}
+    why = [f"{100 * share:.1f}% {what}" for what, share in shares.items()
+           if round(100 * share, 1) > 0]
+    return (f"{where}: compensated, the 10 s bias stability is worse than raw "
+            f"({compensated:.4g} against {raw:.4g} °/h, apart beyond their intervals): the "
+            "model does not hold on this run"
+            + (f" ({'; '.join(why)})" if why else "")
+            + "; train on runs that cover its temperatures and rates, or do not apply the "
+              "model to it")
+
+
+def warn_worse_than_raw(result: RunEvaluation) -> None:
+    """A :class:`~hrgtc.core.errors.CompensationWarning` for each axis of ``result`` that
+    compensation made worse (:func:`worse_than_raw`)."""
+    import warnings
+
+    for axis, evaluation in result.axes.items():
+        said = worse_than_raw(evaluation, axis)
+        if said is not None:
+            warnings.warn(said, CompensationWarning, stacklevel=2)
 
 
 def evaluate(

@@ -32,6 +32,7 @@ from hrgtc.core.summary import Summary
 from hrgtc.drift import ScaleFactorModel, find_rate_segments, fit_scale_factor, read_segment_table
 from hrgtc.evaluation import Evaluation, evaluate
 from hrgtc.evaluation.calibration_figures import instrument_summary
+from hrgtc.evaluation.run_evaluation import warn_worse_than_raw
 from hrgtc.evaluation.scale_check import ScaleFactorCheck, check_scale_factor, steady_segments
 from hrgtc.model import AxisModel, Model, provenance
 from hrgtc.pipeline import documents
@@ -243,8 +244,11 @@ def calibrate(
                        _provenance(soaks, drifts, tables, fitted, settings, inputs, reading),
                        None if temperature_map is None else temperature_map.to_dict())
     # each held-out run read once for every axis
-    runs = [evaluate(instrument, path, settings=BIAS_ONLY, read_options=reading.held_out).axes
-            for path in reading.validate]
+    held_out = [evaluate(instrument, path, settings=BIAS_ONLY, read_options=reading.held_out)
+                for path in reading.validate]
+    for run in held_out:  # a model worse than raw on its own held-out part is said
+        warn_worse_than_raw(run)
+    runs = [run.axes for run in held_out]
     checks = tuple(check for path in tables.validate for check in check_scale_factor(
         path, instrument, reading.options, reading.segments))
     return Calibration(instrument, {axis: dataclasses.replace(
