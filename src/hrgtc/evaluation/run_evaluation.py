@@ -178,15 +178,16 @@ def worse_than_raw(evaluation: Evaluation, axis: str = "") -> str | None:
               "model to it")
 
 
-def warn_worse_than_raw(result: RunEvaluation) -> None:
+def warn_worse_than_raw(result: RunEvaluation) -> RunEvaluation:
     """A :class:`~hrgtc.core.errors.CompensationWarning` for each axis of ``result`` that
-    compensation made worse (:func:`worse_than_raw`)."""
+    compensation made worse (:func:`worse_than_raw`); ``result`` returned."""
     import warnings
 
     for axis, evaluation in result.axes.items():
         said = worse_than_raw(evaluation, axis)
         if said is not None:
             warnings.warn(said, CompensationWarning, stacklevel=2)
+    return result
 
 
 def evaluate(

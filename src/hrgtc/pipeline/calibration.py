@@ -244,11 +244,10 @@ def calibrate(
                        _provenance(soaks, drifts, tables, fitted, settings, inputs, reading),
                        None if temperature_map is None else temperature_map.to_dict())
     # each held-out run read once for every axis
-    held_out = [evaluate(instrument, path, settings=BIAS_ONLY, read_options=reading.held_out)
-                for path in reading.validate]
-    for run in held_out:  # a model worse than raw on its own held-out part is said
-        warn_worse_than_raw(run)
-    runs = [run.axes for run in held_out]
+    # (a model worse than raw on its own held-out part is said)
+    runs = [warn_worse_than_raw(evaluate(instrument, path, settings=BIAS_ONLY,
+                                         read_options=reading.held_out)).axes
+            for path in reading.validate]
     checks = tuple(check for path in tables.validate for check in check_scale_factor(
         path, instrument, reading.options, reading.segments))
     return Calibration(instrument, {axis: dataclasses.replace(
