@@ -4,13 +4,18 @@ PDF and JSON."""
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
 from hrgtc.cli._app import console, library_errors, print_json
-from hrgtc.cli.options import ForceOption, JsonOption
+from hrgtc.cli.options import ForceOption, JsonOption, reading_options
+
+if TYPE_CHECKING:
+    from hrgtc.recording import ReadOptions
 
 
+@reading_options
 def test_report_command(
     manifest: Path = typer.Argument(
         ..., metavar="MANIFEST", help="The campaign manifest (TOML): unit, site, equipment and "
@@ -25,11 +30,15 @@ def test_report_command(
         True, "--pdf/--no-pdf", help="Print the PDF with headless Chromium."),
     force: ForceOption = False,
     json_output: JsonOption = False,
+    inputs: ReadOptions | None = None,
 ) -> None:
     """Write the test report of a campaign: turn-on time, warm-up drift, bias repeatability,
     bias temperature and gradient sensitivity before and after compensation, scale factor
     (with a rate table), Allan noise terms; each with its clause, definition, uncertainty
     and coverage factor, and a verdict per figure of the spec.
+
+    Your own files are read with the column mapping and units of every command (--col,
+    --time-unit, --rate-unit, ...), the same for every run of the manifest.
 
     Example: hrgtc test-report campaign.toml --spec spec.toml -o report.html
     """
@@ -40,7 +49,8 @@ def test_report_command(
         written = outputs(output, pdf)
         refuse_input(written, [manifest, *([spec] if spec else [])])
         check_writable(output, 5e6)
-        files = write_test_report(manifest, output, spec=spec, force=force, pdf=pdf)
+        files = write_test_report(manifest, output, spec=spec, force=force, pdf=pdf,
+                                  read_options=inputs)
     if json_output:
         print_json({"html": str(files.html), "json": str(files.json),
                     "pdf": None if files.pdf is None else str(files.pdf),

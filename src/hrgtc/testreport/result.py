@@ -12,6 +12,7 @@ are its text and JSON.
 
 from __future__ import annotations
 
+import dataclasses
 import datetime as _dt
 import math
 import os
@@ -192,7 +193,9 @@ def campaign_report(inputs: TestReportInputs) -> TestReport:
     campaign = inputs.campaign
     settings = campaign.settings
     model: Model | None = None if campaign.model is None else load_model(campaign.model)
-    options = inputs.read_options or ReadOptions(axis=campaign.axis)
+    options = inputs.read_options or ReadOptions()  # the column mapping, units, ...
+    if campaign.axis is not None:  # the manifest's file_axis
+        options = dataclasses.replace(options, axis=campaign.axis)
     allan_path = _allan_entry(campaign)
     earth = campaign.earth_rate_dph
     series: dict[str, list[RunSeries]] = {}
