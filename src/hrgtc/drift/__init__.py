@@ -41,7 +41,7 @@ from hrgtc.drift.scale_factor import (
     group_segments,
 )
 from hrgtc.drift.stepwise import Step, StepwiseResult, stepwise, stepwise_from_accumulator
-from hrgtc.drift.windows import TrainingWindows, window_means
+from hrgtc.drift.windows import TrainingWindows, Windowing, window_means
 
 __all__ = [
     "EQ21",
@@ -62,6 +62,7 @@ __all__ = [
     "StepwiseResult",
     "Term",
     "TrainingWindows",
+    "Windowing",
     "causal_rate",
     "find_rate_segments",
     "fit",

@@ -32,7 +32,7 @@ from hrgtc.drift.offsets import offset_groups, project_off
 from hrgtc.drift.regression import EXTENDED_PRECISION, newey_west_inflation
 from hrgtc.drift.rest import check_policy, reference_point, run_rest
 from hrgtc.drift.stepwise import StepwiseResult, stepwise
-from hrgtc.drift.windows import RunSource, _iter_run, window_means_at
+from hrgtc.drift.windows import RunSource, Windowing, _iter_run, window_means_at
 from hrgtc.recording.motion import MotionSettings
 from hrgtc.settings.drift import SELECTIONS, WARMUP_FACTOR, DriftSettings
 
@@ -114,10 +114,10 @@ class Training:
                 warmups_s: Sequence[float] | None = None) -> tuple[Any, ...]:
         """The window means of ``terms`` over the runs (at rest, after the warm-up), one
         result per warm-up of ``warmups_s`` from one reading (default: the settings')."""
-        return window_means_at(self.runs, self.features, terms, drift.window_s, progress,
-                               thermometer, tracked, keep=self.keep, gaps=self.reading.gaps,
-                               restart_each_segment=self.reading.restart_each_segment,
-                               warmups_s=warmups_s)
+        windowing = Windowing(drift.window_s, tuple(tracked), self.reading.gaps,
+                              self.reading.restart_each_segment)
+        return window_means_at(self.runs, self.features, terms, windowing, progress,
+                               thermometer, self.keep, warmups_s)
 
 
 def prepare(runs: Sequence[RunSource], thermometer: Any, drift: DriftSettings,
