@@ -40,7 +40,13 @@ from hrgtc.drift.scale_factor import (
     fit_scale_factor,
     group_segments,
 )
-from hrgtc.drift.stepwise import Step, StepwiseResult, stepwise, stepwise_from_accumulator
+from hrgtc.drift.stepwise import (
+    Step,
+    StepwiseResult,
+    StepwiseRules,
+    stepwise,
+    stepwise_from_accumulator,
+)
 from hrgtc.drift.windows import TrainingWindows, Windowing, window_means
 
 __all__ = [
@@ -60,6 +66,7 @@ __all__ = [
     "SegmentScaleErrors",
     "Step",
     "StepwiseResult",
+    "StepwiseRules",
     "Term",
     "TrainingWindows",
     "Windowing",
