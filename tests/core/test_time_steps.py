@@ -46,7 +46,7 @@ def test_a_wrapped_microsecond_counter_reads_as_the_clean_file(clean, tmp_path):
     assert "wrapped (2 time(s)" in run.metadata.extra["time_repairs"][0]
     # streamed in chunks of any size: the same times, a wrap on a chunk boundary included
     for rows in (1000, 2950, 49_999):
-        streamed = np.concatenate([c.time_s for c in iter_chunks(path, rows=rows,
+        streamed = np.concatenate([c.time_s for c in iter_chunks(path, chunk_rows=rows,
                                                                  units={"time": "us"}, **READ)])
         np.testing.assert_array_equal(streamed, run.time_s)
     # the training windows are those of the clean file
@@ -120,7 +120,7 @@ def test_a_rate_that_really_changes_names_the_row(tmp_path):
     for rows in (1000, 777, 6000):
         with pytest.raises(RecordingError, match=r"row 4320: the time step changes to 100 Hz.*"
                                                  r"split it at row 4320"):
-            list(iter_chunks(path, rows=rows))
+            list(iter_chunks(path, chunk_rows=rows))
 
 
 def test_classifier_cases_directly():
@@ -173,7 +173,7 @@ def test_a_reset_is_a_new_run_its_own_warm_up_filter_and_offset_group(clean, tmp
     (restart,) = run.metadata.extra["restarts_s"]
     assert restart == run.time_s[36_000]
     for rows in (1000, 36_000, 50_000):
-        chunks = list(iter_chunks(path, rows=rows, gaps="bridge", **READ))
+        chunks = list(iter_chunks(path, chunk_rows=rows, gaps="bridge", **READ))
         holding = [c for c in chunks if c.time_s[-1] >= restart]
         assert all(c.metadata.extra["restarts_s"] == [restart] for c in holding)
     windows = _windows(run)
@@ -229,7 +229,7 @@ def test_clock_times_read_in_their_zone_are_the_clean_file(tmp_path, utc_start, 
     if rows is None:
         run = read(path, tz="Europe/Berlin", **options)
     else:
-        chunks = list(iter_chunks(path, rows=rows, tz="Europe/Berlin", **options))
+        chunks = list(iter_chunks(path, chunk_rows=rows, tz="Europe/Berlin", **options))
         run = Recording({k: np.concatenate([c[k] for c in chunks]) for k in chunks[0].names},
                         chunks[0].metadata)
     np.testing.assert_array_equal(run.time_s, clean_s)
