@@ -135,16 +135,19 @@ def _summaries(rows: list[dict], label: str, seconds: float) -> list[dict]:
 
 def _calibrate_keywords(options: dict) -> dict:
     """``calibrate``'s keywords from the options given here: the drift fit's settings
-    (terms, rate_tau2_s, select, ...) into its ``settings``, the rest (aux, ...) as they are."""
+    (terms, rate_tau2_s, select, ...) into its ``settings``, the aux channels (name ->
+    column) into its ``inputs``."""
     import dataclasses
 
     from hrgtc.settings.calibration import CalibrationSettings
     from hrgtc.settings.drift import DriftSettings
+    from hrgtc.settings.inputs import CalibrationInputs
 
     names = {f.name for f in dataclasses.fields(DriftSettings)}
     drift = DriftSettings(**{k: v for k, v in options.items() if k in names})
+    aux = tuple(f"{name}={column}" for name, column in options.get("aux", {}).items())
     return {"settings": CalibrationSettings(drift=drift),
-            **{k: v for k, v in options.items() if k not in names}}
+            "inputs": CalibrationInputs(aux=aux)}
 
 
 def heldout(calibrate_options: dict | None = None, seeds: tuple[int, ...] = (1, 2, 3, 4, 5),

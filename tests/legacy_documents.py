@@ -1,7 +1,7 @@
 """The hand-written JSON documents of the evaluation and calibration results, as they were
 before their records (``Evaluation``, ``BurstAllanResult``, ``DirectionStats``,
-``ResidualResult``, ``ScaleFactorCheck``, ``CalibrationResult``, ``InstrumentCalibration``,
-``InstrumentEvaluation``): the reference the records' documents must equal, key for key and
+``ResidualResult``, ``ScaleFactorCheck``, ``AxisCalibration``, ``Calibration``,
+``RunEvaluation``): the reference the records' documents must equal, key for key and
 in order (tests/evaluation/test_result_records.py, tests/pipeline/test_calibration_records.py).
 
 The only difference allowed: a number that is not finite, which these wrote as NaN (not
@@ -148,7 +148,7 @@ def instrument(self) -> dict[str, Any]:
     axes = {}
     for axis, result in self.axes.items():
         entry = calibration(result)
-        entry["validation"] = [evaluation(v) for v in self.validation.get(axis, ())]
+        entry["validation"] = [evaluation(v) for v in self.axes[axis].validation]
         sf = self.model.axes[axis].scale_factor
         entry["scale_factor"] = None if sf is None else sf.to_dict()
         axes[axis or "-"] = entry
@@ -164,7 +164,7 @@ def instrument_document(self) -> dict[str, Any]:
     else:
         document = instrument(self)
     if single:
-        document["validation"] = [evaluation(v) for v in self.validation[""]]
+        document["validation"] = [evaluation(v) for v in self.axes[""].validation]
     if self.model.temperature_map is not None:
         document["temperature_map"] = dict(self.model.temperature_map)
     return document

@@ -21,7 +21,7 @@ import numpy as np
 from hrgtc import drift
 from hrgtc.model import AxisModel, Model, save_model
 from hrgtc.model_schema import derived_coefficients
-from hrgtc.recording import Recording
+from hrgtc.recording import ReadOptions, Recording
 
 from corruptions import CORRECT, Case, Expect, Material, error
 from synthetic import THERMOMETER, ramp_run
@@ -157,7 +157,7 @@ def sensor_model(material: Material, folder: Path) -> Path:
     """A sensor-thermometer model (calibrated on the recording's temperature_c)."""
     from hrgtc.pipeline.calibration import calibrate
 
-    result = calibrate([], [material.run_path("1")], thermometer="sensor")
+    result = calibrate([], [material.run_path("1")], read_options=ReadOptions(thermometer="sensor"))
     return save_model(result.model, folder / "case.json", force=True)
 
 

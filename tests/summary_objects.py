@@ -37,7 +37,7 @@ def every_result(paper: Any, imu: Any, folder: Path) -> dict[str, Any]:
 
 
 def _paper(paper: Any) -> dict[str, Any]:
-    from hrgtc.evaluation.run_pass import evaluate
+    from hrgtc.evaluation import evaluate
     from hrgtc.pipeline.calibration import calibrate
     from hrgtc.pipeline.demo import DemoResult
     from hrgtc.recording import read
@@ -45,10 +45,10 @@ def _paper(paper: Any) -> dict[str, Any]:
 
     result = calibrate(paper.soaks, [paper.cooldown], [paper.warmup])
     model = result.model
-    evaluation = evaluate(paper.warmup, model)
-    training = evaluate(paper.cooldown, model)
+    evaluation = evaluate(model, paper.warmup).axis
+    training = evaluate(model, paper.cooldown).axis
     plateau = find_plateaus(read(paper.soaks[0]))[0]
-    return {"CalibrationResult": result, "DriftModel": model.drift,
+    return {"AxisCalibration": result.axis, "DriftModel": model.drift,
             "Thermometer": model.thermometer, "Accounting": model.drift.accounting,
             "Plateau": plateau, "Evaluation": evaluation,
             "AllanResult": evaluation.allan["compensated"],
@@ -74,18 +74,17 @@ def _update(model: Any) -> Any:
 def _instrument(imu: Any) -> dict[str, Any]:
     from hrgtc.compensate import Compensator
     from hrgtc.drift.rate_segments import segment_scale_errors
-    from hrgtc.pipeline.instrument import calibrate_instrument, evaluate_instrument
+    from hrgtc.evaluation import evaluate
+    from hrgtc.pipeline.calibration import RateTables, calibrate
     from hrgtc.recording import axis_view, read
 
-    calibration = calibrate_instrument(imu.soaks, [imu.cooldown], [imu.warmup],
-                                       rate_tables=[imu.rate_table],
-                                       validate_rate_tables=[imu.rate_table_heldout])
+    calibration = calibrate(imu.soaks, [imu.cooldown], [imu.warmup],
+                            rate_tables=RateTables([imu.rate_table], [imu.rate_table_heldout]))
     compensator = Compensator(calibration.model)
     compensator.transform(read(imu.warmup))
     table = axis_view(read(imu.rate_table), "x")
-    return {"InstrumentCalibration": calibration,
-            "InstrumentEvaluation": evaluate_instrument(imu.rate_table_heldout,
-                                                        calibration.model),
+    return {"Calibration": calibration,
+            "RunEvaluation": evaluate(calibration.model, imu.rate_table_heldout),
             "ScaleFactorModel": calibration.model.axes["x"].scale_factor,
             "SegmentScaleErrors": segment_scale_errors(table),
             "Compensator": compensator}
@@ -129,7 +128,9 @@ def _test_report(paper: Any, folder: Path) -> Any:
 def _small() -> dict[str, Any]:
     from hrgtc.drift.cross_validation import CrossValidation
     from hrgtc.drift.stepwise import StepwiseRules, stepwise
+    from hrgtc.evaluation.allan import allan_deviation
     from hrgtc.evaluation.metrics import residual_against_truth
+    from hrgtc.evaluation.noise_model import fit_noise_model
     from hrgtc.fleet.run import FleetRun
     from hrgtc.fleet.tasks import UnitOutcome
     from hrgtc.recording.resample import fill_slow_channels
@@ -168,4 +169,6 @@ def _small() -> dict[str, Any]:
         "TransientFit": fit_transient(tau, 4424.0 + 0.2 * np.exp(-tau / 3000.0)),
         "FleetRun": FleetRun((UnitOutcome("a", "ok"), UnitOutcome("b", "failed")), 12.5,
                              "local cluster of 2 workers", workers_died=1, retried=("b",)),
+        "NoiseModel": fit_noise_model(allan_deviation(rng.normal(size=4096), 1.0,
+                                                      confidence=0.683), bootstrap=50),
     }

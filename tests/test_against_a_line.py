@@ -80,9 +80,8 @@ def _held_out(seed: int, curve: float, walk: float = 0.03) -> dict[str, float]:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # beyond the trained temperatures, by design
         model = drift.fit([train], THERMOMETER)
-        figures = evaluate(held, Model.single(
-            AxisModel(thermometer=THERMOMETER, drift=model), unit="mems"),
-                           settings=BIAS_ONLY)
+        fitted = Model.single(AxisModel(thermometer=THERMOMETER, drift=model), unit="mems")
+        figures = evaluate(fitted, held, settings=BIAS_ONLY).axis
     from_s = held.time_s[0] + model.settings.warmup_s
     raw = _burst_means(held.time_s, held.rate_dph, from_s)
     assert np.std(raw, ddof=1) == pytest.approx(figures.raw_10s, rel=1e-9)  # the same part

@@ -6,12 +6,15 @@ is generated from the results' declarations (:mod:`hrgtc.core.records`); a chang
 result's fields changes it. The SHA-256 of each one's canonical JSON is pinned here: a
 change that is meant updates the figure, with its reason in the commit message.
 
-Last change: the fleet row gained the column ``axis`` (the fleet table is long-form, a row
-per unit × axis, issue 28): its pin moved, no other.
-
-The change before: each definition's ``description`` is dedented as :func:`inspect.cleandoc`
-does (msgspec 0.23 dedents class docstrings, 0.22 kept their indent; a fresh install took
-0.23 and every hash moved). The text, types, bounds, defaults and names are unchanged.
+Last changes: the fleet row gained the column ``axis`` (the fleet table is long-form, a row
+per unit × axis, issue 28); the model file the optional ``lineage`` of ``hrgtc update``.
+Before them (calibrate and evaluate, issue 28 item 1): three ``description`` texts of the
+calibrate and evaluate schemas name the classes of the one chain
+(``hrgtc.pipeline.calibration.Calibration``, ``hrgtc.evaluation.scale_check.ScaleFactorCheck``,
+``hrgtc.evaluation.run_evaluation.RunEvaluation``) in the place of the removed
+``hrgtc.pipeline.instrument`` ones; types, bounds, defaults and names are unchanged.
+Before it: each definition's ``description`` dedented as :func:`inspect.cleandoc` does
+(msgspec 0.23 dedents class docstrings, 0.22 kept their indent).
 """
 
 from __future__ import annotations
@@ -46,8 +49,8 @@ PINNED = {
     # files without it load as before); before it, the optional settings
     # gradient_saturation_c and play_width_c of the history variables gsat and play
     "model": "0e74e1aafcea183ec33816bca775536d6e3b8ec1a9d4edb95584c781b8823ffb",
-    "calibrate": "5db364b62efe89ac7c086bee61b169993b938c9180a2915b3589da28ea1f9bae",
-    "evaluate": "60cbf2ab0d8601ca7654cfaae8502335398ef45cffe0df3cb87aeb01be7ed572",
+    "calibrate": "48987dea66cbcb55e54cd3302ed88cafe6f6f6098a173bb44a07557a8519d6a2",
+    "evaluate": "f9748e0a8f8cad510195e43cf3776c562fb6b7f8b16987ac3037dfc630916aae",
     "evaluation": "8b433192253e7115f99051897e6091877716dd4198c2027d495473d53032d99b",
     "prior": "2732b64c049600755e46251cf1d866b5571c9ccc95f1845473b13ffa6ad39c49",
     "scale_factor": "a67300581f757b5e8dd1ea8f80429bd0a7760d8d7c5e2e244ff4f338e675a520",

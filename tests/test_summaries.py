@@ -121,7 +121,7 @@ def test_the_instrument_summaries_are_tables(results):
     the sections of the evaluation's summary (a grid: their cells by row and column)."""
     from hrgtc.evaluation.instrument_figures import SCALE_CHECKS, scale_check_figures
 
-    calibration = results["InstrumentCalibration"]
+    calibration = results["Calibration"]
     check = calibration.scale_checks[0]
     summary = Summary("", ((SCALE_CHECKS, scale_check_figures(calibration.scale_checks)),))
     headers, rows = summary.grid(SCALE_CHECKS)
@@ -131,7 +131,7 @@ def test_the_instrument_summaries_are_tables(results):
     out = io.StringIO()
     print_summary(summary, Console(file=out, width=400))
     assert f"{check.compensated_ppm[0]:+.2f}" in out.getvalue()
-    evaluated = results["InstrumentEvaluation"]
+    evaluated = results["RunEvaluation"]
     tables = evaluated.summary()
     assert [h for h, _ in tables.sections] == [f"{evaluated.model.unit}: 10 s bias stability "
                                                "per axis", SCALE_CHECKS]

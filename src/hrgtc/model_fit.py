@@ -4,7 +4,7 @@ the band of plausible frequencies the reader enforces.
 
 A layer of its own, just above :mod:`hrgtc.model`: the compensator
 (:mod:`hrgtc.compensate.file_pass`, ``multi_axis``) and the evaluation
-(:mod:`hrgtc.evaluation.run_pass`, ``instrument_pass``), the report and the instrument
+(:mod:`hrgtc.evaluation.run_evaluation`), the report and the calibration
 chain all ask it, and none of them may import another's stage."""
 
 from __future__ import annotations

@@ -57,3 +57,15 @@ def test_written_out_defaults_equal_the_library():
     assert list(UNIT_NAMES) == units.names()
     assert DEFAULT_UNIT == units.DEFAULT_UNIT
     assert DEFAULT_INPUT_RATE_DPH == campaign.DEFAULT_INPUT_RATE_DPH
+
+
+def test_an_error_naming_a_column_with_brackets_prints_the_brackets(tmp_path):
+    """A column named like a logger's (``gyro_x [deg/h]``) is text in an error, not rich
+    markup: the message names it whole."""
+    run = tmp_path / "run.csv"
+    run.write_text("time_s,freq_hz,rate_dph\n0,4424.9,9.7\n1,4424.9,9.7\n2,4424.9,9.7\n")
+    result = CliRunner().invoke(app, ["info", str(run), "--col", "rate_dph=gyro_x [deg/h]"])
+    assert result.exit_code == 2
+    assert "error: " in result.output
+    assert "column 'gyro_x [deg/h]' (given for rate_dph) not found" in result.output.replace(
+        "\n", " ").split("error: ")[-1]

@@ -35,21 +35,26 @@ def test_unwritable_output_fails_at_once_not_after_the_fit(tmp_path, monkeypatch
 
 def test_input_options_reach_the_library_as_typed_objects(tmp_path, monkeypatch):
     """``--aux`` (repeated), ``--temp-ref*`` and ``--holdout-*``, generated from
-    :class:`~hrgtc.settings.inputs.CalibrationInputs`, reach ``calibrate_instrument`` as
-    the aux mapping, one :class:`TemperatureReference` and the holdout; not given, the
-    fields' defaults (no channel, no log, no holdout)."""
+    :class:`~hrgtc.settings.inputs.CalibrationInputs`, reach ``calibrate`` whole, which
+    reads them as the aux mapping, one :class:`TemperatureReference` and the holdout; not
+    given, the fields' defaults (no channel, no log, no holdout)."""
     import pytest
 
-    from hrgtc.pipeline import instrument
+    from hrgtc.pipeline import calibration
+    from hrgtc.pipeline.terms import parse_aux
     from hrgtc.thermometry.reference import TemperatureReference
 
     seen: list[dict] = []
 
-    def calibrate_instrument(soaks, drifts, validate, **kwargs):
-        seen.append(kwargs)
+    def calibrate(soaks, drifts, validate, **kwargs):
+        inputs = kwargs["inputs"]
+        seen.append({"aux": parse_aux(inputs.aux),
+                     "temperature_reference": calibration.temperature_reference(
+                         inputs.reference), "holdout_s": inputs.holdout.holdout_s,
+                     "holdout_fraction": inputs.holdout.holdout_fraction})
         raise KeyboardInterrupt  # stop before the fit: only the arguments matter
 
-    monkeypatch.setattr(instrument, "calibrate_instrument", calibrate_instrument)
+    monkeypatch.setattr(calibration, "calibrate", calibrate)
     log = tmp_path / "hand.csv"
     args = ["calibrate", "--drift", str(tmp_path / "run.csv"), "-o", str(tmp_path / "m.json")]
     runner.invoke(app, [*args, "--aux", "drive=drive_v", "--aux", " quad = quad_v ",

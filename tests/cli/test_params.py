@@ -240,10 +240,10 @@ REFERENCE_FIELDS = {"reference_log": "path", "reference_columns": "columns",
 def test_reference_defaults_are_the_libraries():
     """What a model file records of a reference log given alone (``--temp-ref LOG``) holds
     the other fields' defaults; the lag's default text names the library's search range;
-    ``calibrate_instrument`` defaults to no channel, no log and no holdout."""
+    ``calibrate`` defaults to no channel, no log and no holdout."""
     import inspect
 
-    from hrgtc.pipeline.instrument import calibrate_instrument
+    from hrgtc.pipeline.calibration import calibrate, temperature_reference
     from hrgtc.pipeline.terms import parse_aux
     from hrgtc.settings.inputs import TemperatureReferenceSettings
     from hrgtc.thermometry.reference import (
@@ -268,12 +268,11 @@ def test_reference_defaults_are_the_libraries():
     assert inspect.signature(fit_count_map).parameters["max_lag_s"].default == MAX_LAG_S
     by_name = {s.name: s for s in settings_of(TemperatureReferenceSettings)}
     assert by_name["reference_lag_s"].default_text == f"fitted within ±{MAX_LAG_S:g} s"
-    library_defaults = inspect.signature(calibrate_instrument).parameters
+    assert inspect.signature(calibrate).parameters["inputs"].default is None  # the defaults:
     given = CalibrationInputs()
-    assert parse_aux(given.aux) == dict(library_defaults["aux"].default or {})
-    assert library_defaults["temperature_reference"].default is given.reference.reference_log
-    for name in ("holdout_s", "holdout_fraction"):
-        assert library_defaults[name].default == getattr(given.holdout, name)
+    assert parse_aux(given.aux) == {}
+    assert temperature_reference(given.reference) is None
+    assert (given.holdout.holdout_s, given.holdout.holdout_fraction) == (None, None)
 
 
 @pytest.mark.slow

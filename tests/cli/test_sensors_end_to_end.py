@@ -107,15 +107,19 @@ def test_calibrate_prints_a_range_warning_common_to_the_axes_once(tmp_path, monk
 
 
 def test_the_library_call_gives_the_cli_s_model_with_its_reference_log(tmp_path):
-    """``calibrate_instrument`` fits the ``--temp-ref`` map itself (a
-    :class:`TemperatureReference`), on the whole drift file before the hold-out split:
+    """``calibrate`` fits the ``--temp-ref`` map itself (from the inputs' reference log,
+    a :class:`TemperatureReference`), on the whole drift file before the hold-out split:
     one library call writes the model file the command writes, map and all."""
     from hrgtc.model import save_model
-    from hrgtc.pipeline.instrument import calibrate_instrument
+    from hrgtc.pipeline.calibration import calibrate
     from hrgtc.recording import ReadOptions
     from hrgtc.settings.calibration import CalibrationSettings
     from hrgtc.settings.drift import DriftSettings
-    from hrgtc.thermometry.reference import TemperatureReference
+    from hrgtc.settings.inputs import (
+        CalibrationInputs,
+        HoldoutSettings,
+        TemperatureReferenceSettings,
+    )
 
     result = runner.invoke(app, ["calibrate", "--drift", str(RUN), *READ, *REF,
                                  "--rate-tau-s", "1", "--window-s", "5",
@@ -125,13 +129,15 @@ def test_the_library_call_gives_the_cli_s_model_with_its_reference_log(tmp_path)
         columns={"time_s": "time (ms)", "rate_dph_x": "gyrox rad/s",
                  "rate_dph_y": "gyroy rad/s", "rate_dph_z": "gyroz rad/s",
                  "temperature_c": "temp"},
-        units={"time": "ms", "rate": "radps"}, gaps="bridge", spike_filter="drop")
-    reference = TemperatureReference(LOG, {"time_s": "Time", "temperature_c": "C1 (C)"},
-                                     start="15:45")
-    calibration = calibrate_instrument(
-        [], [RUN], thermometer="sensor", read_options=options, holdout_fraction=0.4,
+        units={"time": "ms", "rate": "radps"}, gaps="bridge", spike_filter="drop",
+        thermometer="sensor")
+    reference = TemperatureReferenceSettings(
+        LOG, ("time_s=Time", "temperature_c=C1 (C)"), reference_start="15:45")
+    calibration = calibrate(
+        [], [RUN], read_options=options,
         settings=CalibrationSettings(drift=DriftSettings(rate_tau_s=1.0, window_s=5.0)),
-        temperature_reference=reference)
+        inputs=CalibrationInputs(reference=reference,
+                                 holdout=HoldoutSettings(holdout_fraction=0.4)))
     save_model(calibration.model, tmp_path / "library.json")
     cli, library = (json.loads((tmp_path / name).read_text())
                     for name in ("cli.json", "library.json"))
@@ -149,10 +155,9 @@ def test_the_library_call_gives_the_cli_s_model_with_its_reference_log(tmp_path)
     settings = library["provenance"]["settings"]
     assert (settings["holdout_s"], settings["holdout_fraction"]) == (None, 0.4)
 
-    with pytest.raises(InputError, match="a temperature map or a reference log"):
-        calibrate_instrument([], [RUN], thermometer="sensor", read_options=options,
-                             temperature_reference=reference,
-                             temperature_map=reference.fit(RUN, options))
+    with pytest.raises(InputError, match="--temp-ref-start describes a reference log"):
+        calibrate([], [RUN], read_options=options, inputs=CalibrationInputs(
+            reference=TemperatureReferenceSettings(reference_start="15:45")))
 
 
 def test_one_cause_per_warning_whatever_the_axis():

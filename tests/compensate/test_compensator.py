@@ -498,7 +498,7 @@ def test_the_seen_f_and_df_extremes_are_those_of_the_variables(unit_model, run, 
     np.testing.assert_allclose(compensator.axis._extremes, expected, rtol=1e-12, atol=1e-15)
 
 
-@pytest.mark.parametrize("suffix", ["parquet", "csv", "h5"])
+@pytest.mark.parametrize("suffix", ["parquet", "csv", "h5", "tdms", "mat", "mf4"])
 def test_the_output_carries_the_restarts_of_every_chunk(unit_model, run, tmp_path, suffix):
     """A clock reset to about zero (a logger restart) in the third chunk: the compensated
     file lists it in its metadata (written at close), so that a reading of the output knows

@@ -234,7 +234,7 @@ def test_a_chamber_set_point_taken_for_the_thermometer_is_refused(tmp_path):
     by calibrate --thermometer sensor (the set-point runs ahead of the gyro)."""
     from hrgtc.drift.training import check_setpoint_thermometer, is_setpoint_ramp
     from hrgtc.pipeline.calibration import calibrate
-    from hrgtc.recording import Recording, write
+    from hrgtc.recording import ReadOptions, Recording, write
 
     from corruptions import base_run
 
@@ -252,4 +252,4 @@ def test_a_chamber_set_point_taken_for_the_thermometer_is_refused(tmp_path):
     with pytest.raises(InputError, match=r"swapped.csv: the headers chamber_c and temperature_c "
                                          r"look swapped: .*noise-free straight ramps.*"
                                          r"--col temperature_c=chamber_c"):
-        calibrate([], [path], thermometer="sensor")
+        calibrate([], [path], read_options=ReadOptions(thermometer="sensor"))

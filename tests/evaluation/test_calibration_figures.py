@@ -1,9 +1,9 @@
 """Tests of hrgtc.evaluation.calibration_figures: a calibration's figures, the same in every
 renderer.
 
-The plain text (``CalibrationResult.summary().text()``), the CLI's rich tables
+The plain text (``AxisCalibration.summary().text()``), the CLI's rich tables
 (``hrgtc calibrate``), the HTML (``Summary.html()``) and the ``--json`` document
-(``CalibrationResult.to_dict()``, where a figure's name is a place in it) are parsed back
+(``AxisCalibration.to_dict()``, where a figure's name is a place in it) are parsed back
 and must give every figure of the calibration's :class:`~hrgtc.core.summary.Summary`, in
 its section, with the same value, unit and interval, like ``test_run_figures`` for a run.
 """
@@ -36,7 +36,7 @@ def _agrees(figure, cell: str) -> bool:
 @pytest.fixture(scope="module")
 def result(paper_campaign):
     files = paper_campaign
-    return calibrate(files.soaks, [files.cooldown], [files.warmup])
+    return calibrate(files.soaks, [files.cooldown], [files.warmup]).axis
 
 
 def _rich_tables(text: str) -> dict[tuple[str, str], list[str]]:

@@ -47,7 +47,7 @@ def model():
 
 def test_split_by_hand_and_by_the_resonator_temperature(model):
     run = cycle_run(seed=3, heating_extra_dph_per_c_per_h=0.8)
-    result = evaluate(run, model, settings=EvaluationSettings(allan=False))
+    result = evaluate(model, run, settings=EvaluationSettings(allan=False)).axis
     split = result.directions
     assert split is not None
     # by hand: 10 s block means after the settling, df/dt from the filter, 5 % dead band

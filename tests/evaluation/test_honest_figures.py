@@ -30,8 +30,8 @@ def test_a_constant_offset_shows_in_the_mean_not_in_the_bias_stability(model):
     run = ramp_run(seed=2)
     shifted = Recording({**run.columns, "rate_dph": run.rate_dph + 136.0}, run.metadata,
                         run.source)
-    plain = evaluate(run, model, settings=BIAS_ONLY)
-    moved = evaluate(shifted, model, settings=BIAS_ONLY)
+    plain = evaluate(model, run, settings=BIAS_ONLY).axis
+    moved = evaluate(model, shifted, settings=BIAS_ONLY).axis
     assert moved.compensated_10s == pytest.approx(plain.compensated_10s, rel=1e-9)
     assert moved.mean_dph["compensated"] - plain.mean_dph["compensated"] == \
         pytest.approx(136.0, rel=1e-9)
@@ -57,9 +57,9 @@ def test_handling_is_left_out_of_the_figures_and_counted(model):
         rate[inside] += 3600.0 * 200.0 * np.sin(np.linspace(0, 2 * np.pi, inside.sum()))
         handled |= inside
     moved = Recording({**run.columns, "rate_dph": rate}, run.metadata, run.source)
-    clean = evaluate(run, model, settings=BIAS_ONLY)
-    excluded = evaluate(moved, model, settings=BIAS_ONLY)
-    kept = evaluate(moved, model, settings=BIAS_ONLY, read_options=ReadOptions(motion="keep"))
+    clean = evaluate(model, run, settings=BIAS_ONLY).axis
+    excluded = evaluate(model, moved, settings=BIAS_ONLY).axis
+    kept = evaluate(model, moved, settings=BIAS_ONLY, read_options=ReadOptions(motion="keep")).axis
     assert handled.sum() <= excluded.n_not_at_rest <= handled.sum() + 3 * 10 * (6 + 2 * 3.2)
     assert kept.n_not_at_rest == 0
     assert excluded.compensated_10s == pytest.approx(clean.compensated_10s, rel=0.1)

@@ -45,9 +45,9 @@ def same(document, reference):
 def evaluations(paper_campaign):
     files = paper_campaign
     model = calibrate(files.soaks, [files.cooldown]).model
-    whole = evaluate(files.warmup, model, max_points=300)
+    whole = evaluate(model, files.warmup, max_points=300).axis
     run = cut_bursts(recording.read(files.warmup), burst_s=60.0, period_s=600.0)
-    bursts = evaluate(run, model, settings=EvaluationSettings(deviation="mdev"))
+    bursts = evaluate(model, run, settings=EvaluationSettings(deviation="mdev")).axis
     return {"whole": whole, "bursts": bursts}
 
 

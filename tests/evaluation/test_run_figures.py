@@ -26,7 +26,7 @@ from hrgtc.pipeline.calibration import calibrate
 def run(paper_campaign):
     files = paper_campaign
     model = calibrate(files.soaks, [files.cooldown]).model
-    return evaluate(files.warmup, model, max_points=300), model
+    return evaluate(model, files.warmup, max_points=300).axis, model
 
 
 def _agrees(figure: Figure, cell: str) -> bool:

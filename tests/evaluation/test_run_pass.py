@@ -29,7 +29,7 @@ def setup(tmp_path_factory, paper_campaign):
 
 def test_evaluation_against_metrics_by_hand(setup):
     files, model, _ = setup
-    result = evaluate(files.warmup, model)
+    result = evaluate(model, files.warmup).axis
     run = recording.read(files.warmup)
     raw = run.rate_dph - run.metadata.input_rate_dph
     settle = round(model.drift.settings.warmup_s * run.sample_rate_hz)  # left out, as in training
@@ -51,7 +51,7 @@ def test_figures_carry_the_runs_numbers_with_units_and_intervals(setup):
     """The structured summary holds the same bias stabilities, intervals and levels as
     the result's fields, and its text carries them."""
     files, model, _ = setup
-    result = evaluate(files.warmup, model)
+    result = evaluate(model, files.warmup).axis
     figures = result.figures()
     for series, row in result.bias_stability_dph.items():
         for tau_s, value in row.items():
@@ -135,7 +135,7 @@ def test_range_warnings_in_plain_output_and_strict_exit(setup, tmp_path, command
 
 def test_evaluation_ranges_cover_temperature_and_df_dt(setup):
     files, model, _ = setup
-    result = evaluate(files.warmup, model, settings=EvaluationSettings(allan=False))
+    result = evaluate(model, files.warmup, settings=EvaluationSettings(allan=False)).axis
     data = result.to_dict()["ranges"]
     assert data["rate_fraction"] == pytest.approx(result.rate_out_of_range_fraction)
     assert data["rate_fraction"] > 0.0 and data["rate_excess_ratio"] > 1.0
@@ -145,7 +145,7 @@ def test_evaluation_ranges_cover_temperature_and_df_dt(setup):
 
 def test_intervals_deviation_kinds_and_allan_csv(setup, tmp_path):
     files, model, model_path = setup
-    result = evaluate(files.warmup, model, max_points=500)
+    result = evaluate(model, files.warmup, max_points=500).axis
     for series in ("raw", "compensated"):
         value = result.stability(series, 10.0)
         low, high = result.stability_interval(series, 10.0)
@@ -205,7 +205,7 @@ def test_allan_csv_carries_the_pooled_edf_behind_its_intervals(setup):
     run = recording.read(files.warmup)
     keep = np.arange(len(run)) % 1000 < 400
     bursts = Recording({k: run[k][keep] for k in run.columns}, run.metadata, source="bursts")
-    result = evaluate(bursts, model, max_points=500)
+    result = evaluate(model, bursts, max_points=500).axis
     header, *rows = result.allan_csv().splitlines()
     assert header == "series,tau_s,deviation,lower,upper,n,edf"
     table = [r.split(",") for r in rows if r.startswith("compensated,")]

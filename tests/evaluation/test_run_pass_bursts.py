@@ -36,7 +36,7 @@ def bursts(tmp_path_factory, paper_campaign):
 @pytest.mark.parametrize("deviation", ["oadev", "mdev", "hdev", "tdev", "adev"])
 def test_every_deviation_is_pooled_within_bursts(bursts, deviation):
     run, model, _, _ = bursts
-    result = evaluate(run, model, settings=EvaluationSettings(deviation=deviation))
+    result = evaluate(model, run, settings=EvaluationSettings(deviation=deviation)).axis
     curve = result.allan["raw"]
     assert curve.segments > 10
     # no τ longer than a burst (120 samples at 2 Hz): no term reaches across a gap

@@ -1,5 +1,5 @@
 """Tables as summaries: the unit's Table 1/2, plateaus and Eq. 18 beside the paper's
-(``CalibrationResult.tables()``), the runs at a glance (``evaluation.glance_figures``) and
+(``AxisCalibration.tables()``), the runs at a glance (``evaluation.glance_figures``) and
 the report's tables made from them.
 
 Each is a :class:`~hrgtc.core.summary.Summary` of table cells (``Summary.grid``); its plain
@@ -31,7 +31,7 @@ from summary_checks import check_renderings
 @pytest.fixture(scope="module")
 def result(paper_campaign):
     files = paper_campaign
-    return calibrate(files.soaks, [files.cooldown], [files.warmup])
+    return calibrate(files.soaks, [files.cooldown], [files.warmup]).axis
 
 
 def _printed(result, monkeypatch) -> str:

@@ -246,17 +246,16 @@ def test_params_export_of_every_model_the_demo_writes(paper_campaign, imu_campai
     from hrgtc.cli import app
     from hrgtc.core.errors import HrgtcWarning
     from hrgtc.model import save_model
-    from hrgtc.pipeline.calibration import calibrate
-    from hrgtc.pipeline.instrument import calibrate_instrument
+    from hrgtc.pipeline.calibration import RateTables, calibrate
 
     files = paper_campaign
     unit = calibrate(files.soaks, [files.cooldown]).model
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", HrgtcWarning)
         imu = imu_campaign
-        instrument = calibrate_instrument(imu.soaks, [imu.cooldown], [imu.warmup],
-                                          rate_tables=[imu.rate_table],
-                                          validate_rate_tables=[imu.rate_table_heldout]).model
+        instrument = calibrate(imu.soaks, [imu.cooldown], [imu.warmup],
+                               rate_tables=RateTables([imu.rate_table],
+                                                      [imu.rate_table_heldout])).model
     paths = [save_model(unit, tmp_path / "paper-unit.json"),
              save_model(instrument, tmp_path / "imu-3.json")]
     used = set(unit.drift.variables).union(*(a.drift.variables for a in instrument.axes.values()))

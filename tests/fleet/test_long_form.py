@@ -1,7 +1,7 @@
 """The fleet tables are long-form, a row per unit × axis (issue 28), on a real Dask cluster.
 
 A fleet of two simulated three-axis instruments gives six rows whose figures are those of
-calibrating each instrument alone (:func:`hrgtc.pipeline.instrument.calibrate_instrument`
+calibrating each instrument alone (:func:`hrgtc.pipeline.calibration.calibrate`
 called here, in this process, against the fleet's tasks on the cluster's workers) and
 whose thermometers read each axis's true frequency law (its ``truth-<axis>.json``); the
 fleet's evaluation gives each axis's held-out figures again by another path. A
@@ -24,7 +24,7 @@ from hrgtc.fleet import build_prior, calibrate_fleet, evaluate_fleet, report_fle
 from hrgtc.fleet.population import true_frequency_hz
 from hrgtc.fleet.results import read_table
 from hrgtc.model import load_model, save_model
-from hrgtc.pipeline.instrument import calibrate_instrument
+from hrgtc.pipeline.calibration import calibrate
 from hrgtc.settings.fleet import FleetCluster
 from hrgtc.thermometry.prior import ThermometerPrior
 
@@ -44,9 +44,9 @@ def instrument_models(instrument_root, cluster, tmp_path_factory) -> Path:
 
 def _alone(folder: Path):
     """One instrument calibrated here, by the library call a single instrument takes."""
-    return calibrate_instrument(sorted((folder / "soaks").glob("*.parquet")),
-                                sorted((folder / "drift").glob("*.parquet")),
-                                sorted((folder / "validate").glob("*.parquet")))
+    return calibrate(sorted((folder / "soaks").glob("*.parquet")),
+                     sorted((folder / "drift").glob("*.parquet")),
+                     sorted((folder / "validate").glob("*.parquet")))
 
 
 def test_a_fleet_of_instruments_has_a_row_per_axis_equal_to_each_calibrated_alone(
@@ -70,7 +70,7 @@ def test_a_fleet_of_instruments_has_a_row_per_axis_equal_to_each_calibrated_alon
             assert row["f20_hz"] == float(part.thermometer.frequency(20.0))
             assert row["terms_kept"] == list(part.drift.selected)
             assert row["soak_temperatures_c"] == [r["chamber_c"] for r in alone.axes[axis].table]
-            held_out = alone.validation[axis]
+            held_out = alone.axes[axis].validation
             assert row["raw_10s_dph"] == [v.raw_10s for v in held_out]
             assert row["compensated_10s_dph"] == [v.compensated_10s for v in held_out]
             # the ground truth: the axis's drawn frequency law, read at 20 °C
@@ -91,7 +91,7 @@ def test_the_fleets_evaluation_gives_each_axis_its_held_out_figures_again(
     calibrated = read_table(instrument_models / "fleet.parquet")
     assert [(r["unit"], r["axis"]) for r in evaluated] == [(u, a) for u in UNITS for a in "xyz"]
     for again, first in zip(evaluated, calibrated, strict=True):
-        # evaluate_instrument with the Allan terms against the calibration's own held-out
+        # evaluate with the Allan terms against the calibration's own held-out
         # pass (bias only): the same 10 s figures
         assert again["runs"] == first["runs"]
         assert again["raw_10s_dph"] == pytest.approx(first["raw_10s_dph"], rel=1e-12)

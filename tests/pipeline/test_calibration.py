@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 import json
 
 import numpy as np
@@ -15,7 +14,7 @@ from hrgtc.core.errors import CalibrationError, InputError
 from hrgtc.evaluation import evaluate
 from hrgtc.model import load_model
 from hrgtc.pipeline.calibration import calibrate
-from hrgtc.recording import Metadata, Recording
+from hrgtc.recording import Metadata, ReadOptions, Recording
 from hrgtc.thermometry import fit
 from hrgtc.thermometry.plateaus import find_plateaus
 
@@ -89,7 +88,7 @@ def test_summary_gives_each_figure_its_value_unit_and_interval(calibrated):
     """The structured summary carries the model's own numbers, ±1σ from the standard
     errors, the bias stabilities with their intervals; all three renderings show them."""
     _, _, result = calibrated
-    summary = result.summary()
+    summary = result.axis.summary()
     model, (validation,) = result.model, result.validation
     c1 = summary["thermometer.coefficients[1]"]
     se = model.thermometer.standard_errors[1]
@@ -118,7 +117,7 @@ def test_summary_gives_each_figure_its_value_unit_and_interval(calibrated):
 
 def test_validation_of_the_training_run_is_the_papers_shape(calibrated):
     unit, files, result = calibrated
-    run = evaluate(files.cooldown, result.model)
+    run = evaluate(result.model, files.cooldown).axis
     if unit == "paper-unit":  # built to look like Section 4.2 of [1]: 3.0143 -> 0.5848 °/h
         assert 2.5 < run.raw_10s < 3.5
         assert run.compensated_10s < 0.8
@@ -256,7 +255,6 @@ def _imu_log(path, run) -> None:
 
 
 def test_sensor_thermometer_on_a_messy_imu_log(campaign_factory, tmp_path):
-    from hrgtc.pipeline.instrument import calibrate_instrument
     from hrgtc.recording import ReadOptions
 
     files = campaign_factory("paper-unit")
@@ -268,22 +266,22 @@ def test_sensor_thermometer_on_a_messy_imu_log(campaign_factory, tmp_path):
                                    "temperature_c": "temp_raw"},
                           units={"time": "ms", "rate": "radps"},
                           metadata={"sample_rate_hz": 5.0, "input_rate_dph": 10.0},
-                          temp_scale=1.0 / COUNTS_PER_C, temp_offset_c=25.0)
+                          temp_scale=1.0 / COUNTS_PER_C, temp_offset_c=25.0,
+                          thermometer="sensor")
     # The soaks' warming and cooling transients train the drift model too (both signs of
     # dT/dt), as for a resonator thermometer.
-    result = calibrate_instrument([tmp_path / f"soak{k}.csv" for k in range(len(soaks))],
-                                  [tmp_path / "cool.csv"], [tmp_path / "warm.csv"],
-                                  thermometer="sensor", read_options=options)
+    result = calibrate([tmp_path / f"soak{k}.csv" for k in range(len(soaks))],
+                       [tmp_path / "cool.csv"], [tmp_path / "warm.csv"], read_options=options)
     model = result.model
     assert model.thermometer.source == "sensor"
     low, high = model.thermometer.temperature_range_c
     assert -20.5 < low < -19.5 and 39.5 < high < 40.5  # the training runs' temperatures
     # the reading: counts * scale + offset is the resonator temperature to within a count
-    rec = dataclasses.replace(options, thermometer="sensor").read(tmp_path / "warm.csv")
+    rec = options.read(tmp_path / "warm.csv")
     truth = recording.read(files.warmup)
     np.testing.assert_allclose(rec.freq_hz, truth["resonator_c"], atol=0.5 / COUNTS_PER_C)
     np.testing.assert_allclose(rec.rate_dph, truth.rate_dph, rtol=1e-12)
-    (held_out,) = result.validation[""]
+    (held_out,) = result.validation
     assert held_out.raw_10s / held_out.compensated_10s > 2.5  # no frequency needed
     # the firmware export says that its "Hz" are degrees here (its text is the resonator's)
     from hrgtc.export.export_c import export_c
@@ -347,7 +345,7 @@ def test_sensor_thermometer_on_an_hrg_file_refuses_a_mems_noise(tmp_path, factor
     columns["rate_dph"] = columns["rate_dph"] * factor
     path = recording.write(Recording(columns, run.metadata), tmp_path / "hrg.parquet")
     with pytest.raises(InputError) as raised:
-        calibrate([], [path], thermometer="sensor")
+        calibrate([], [path], read_options=ReadOptions(thermometer="sensor"))
     message = str(raised.value)
     assert message.startswith(f"{path}: column 'rate_dph': a noise density of")
     assert "the file logs a resonator frequency (column 'freq_hz', median 4428" in message
@@ -355,7 +353,7 @@ def test_sensor_thermometer_on_an_hrg_file_refuses_a_mems_noise(tmp_path, factor
     # the level of a biased run may differ: a 4 °/s offset alone is no unit mistake
     columns["rate_dph"] = np.array(run["rate_dph"]) + 4 * 3600.0
     biased = recording.write(Recording(columns, run.metadata), tmp_path / "biased.parquet")
-    assert calibrate([], [biased], thermometer="sensor").model is not None
+    assert calibrate([], [biased], read_options=ReadOptions(thermometer="sensor")).model is not None
 
 
 def test_sensor_thermometer_on_an_hrg_file_refuses_swapped_frequency_and_rate(tmp_path):
@@ -367,7 +365,7 @@ def test_sensor_thermometer_on_an_hrg_file_refuses_swapped_frequency_and_rate(tm
     path = recording.write(Recording(columns, run.metadata), tmp_path / "swapped.parquet")
     with pytest.raises(InputError, match=r"swapped.parquet: columns 'freq_hz' .* and 'rate_dph' "
                                          r".* look swapped.*--col freq_hz=rate_dph"):
-        calibrate([], [path], thermometer="sensor")
+        calibrate([], [path], read_options=ReadOptions(thermometer="sensor"))
 
 
 @pytest.mark.parametrize("rows", [2, 5, 10])
@@ -380,7 +378,7 @@ def test_a_drift_run_shorter_than_the_warm_up_is_called_too_short(tmp_path, rows
     columns = {k: np.array(run[k])[:rows] for k in run.names}
     path = recording.write(Recording(columns, run.metadata), tmp_path / "short.csv")
     with pytest.raises(CalibrationError) as raised:
-        calibrate([], [path], thermometer="sensor")
+        calibrate([], [path], read_options=ReadOptions(thermometer="sensor"))
     assert str(raised.value).startswith(
         f"{path}: {rows} rows ({(rows - 1) / 10:g} s) is too short to train on; at its 10 Hz, "
         "more than 501 rows: a drift run must last longer than the 50 s warm-up")

@@ -16,8 +16,9 @@ import jsonschema
 import pytest
 from tests import legacy_documents as legacy
 
+from hrgtc.evaluation import evaluate
+from hrgtc.pipeline.calibration import RateTables, calibrate
 from hrgtc.pipeline.documents import calibrate_json_schema, evaluate_json_schema
-from hrgtc.pipeline.instrument import calibrate_instrument, evaluate_instrument
 
 # the imu campaign's 4 rate-table temperatures leave a term out; not what these tests are about
 pytestmark = pytest.mark.filterwarnings("ignore::hrgtc.core.errors.HrgtcWarning")
@@ -32,15 +33,14 @@ def same(document, reference):
 @pytest.fixture(scope="module")
 def single(paper_campaign):
     files = paper_campaign
-    return calibrate_instrument(files.soaks, [files.cooldown], [files.warmup])
+    return calibrate(files.soaks, [files.cooldown], [files.warmup])
 
 
 @pytest.fixture(scope="module")
 def imu(imu_campaign):
     files = imu_campaign
-    return calibrate_instrument(files.soaks, [files.cooldown], [files.warmup],
-                                rate_tables=[files.rate_table],
-                                validate_rate_tables=[files.rate_table_heldout])
+    return calibrate(files.soaks, [files.cooldown], [files.warmup],
+                     rate_tables=RateTables([files.rate_table], [files.rate_table_heldout]))
 
 
 def _mapped(calibration):
@@ -53,23 +53,22 @@ def _mapped(calibration):
 
 
 def test_single_axis_documents_are_the_hand_written_ones(single, paper_campaign):
-    assert single.model.is_single_axis and single.validation[""]
+    assert single.model.is_single_axis and single.validation
     for calibration in (single, _mapped(single)):
-        same(calibration.document(), legacy.instrument_document(calibration))
-        same(calibration.to_dict(), legacy.instrument(calibration))
+        same(calibration.to_dict(), legacy.instrument_document(calibration))
     result = single.axes[""]
     same(result.to_dict(), legacy.calibration(result))
-    evaluation = evaluate_instrument(paper_campaign.warmup, single.model)
+    evaluation = evaluate(single.model, paper_campaign.warmup)
     same(evaluation.to_dict(), legacy.instrument_evaluation(evaluation))
 
 
 def test_instrument_documents_are_the_hand_written_ones(imu, imu_campaign):
     assert imu.scale_checks and not imu.model.is_single_axis
     for calibration in (imu, _mapped(imu)):
-        same(calibration.document(), legacy.instrument_document(calibration))
+        same(calibration.to_dict(), legacy.instrument_document(calibration))
     for check in imu.scale_checks:
         same(check.to_dict(), legacy.scale_check(check))
-    evaluation = evaluate_instrument(imu_campaign.rate_table_heldout, imu.model)
+    evaluation = evaluate(imu.model, imu_campaign.rate_table_heldout)
     assert evaluation.scale_checks
     same(evaluation.to_dict(), legacy.instrument_evaluation(evaluation))
 
@@ -84,10 +83,10 @@ def test_documents_validate_against_their_schemas(single, imu, imu_campaign):
     schema = calibrate_json_schema()
     jsonschema.Draft202012Validator.check_schema(schema)
     for calibration in (single, _mapped(single), imu, _mapped(imu)):
-        _checked(calibration.document(), schema)
-    assert "temperature_map" not in single.document()
-    assert _mapped(single).document()["temperature_map"]["probe"] == "PT100"  # kept as is
-    document = _checked(imu.document(), schema)
+        _checked(calibration.to_dict(), schema)
+    assert "temperature_map" not in single.to_dict()
+    assert _mapped(single).to_dict()["temperature_map"]["probe"] == "PT100"  # kept as is
+    document = _checked(imu.to_dict(), schema)
     assert "validation" not in document  # only a single axis has it at the top
     assert {"ScaleFactorRecord", "StepRecord", "EvaluationRecord", "Table1Row"} <= set(
         schema["$defs"])
@@ -101,10 +100,10 @@ def test_documents_validate_against_their_schemas(single, imu, imu_campaign):
         jsonschema.validate(broken, schema)
 
     schema = evaluate_json_schema()
-    evaluation = evaluate_instrument(imu_campaign.warmup, imu.model)
+    evaluation = evaluate(imu.model, imu_campaign.warmup)
     document = _checked(evaluation.to_dict(), schema)
     assert [row["axis"] for row in document["summary"]] == ["x", "y", "z"]
-    _checked(single.validation[""][0].to_dict(), schema)
+    _checked(single.validation[0].to_dict(), schema)
     broken = copy.deepcopy(document)
     broken["summary"][0]["out_of_range_fraction"] = -0.1
     with pytest.raises(jsonschema.ValidationError):

@@ -8,6 +8,7 @@ warm-up and a rate table at two temperatures between the training ones.
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,9 +16,10 @@ import pytest
 from hrgtc.compensate import Compensator, compensate_file
 from hrgtc.core.errors import InputError, ModelFileError, RecordingError
 from hrgtc.drift import find_rate_segments
+from hrgtc.evaluation.scale_check import steady_segments
 from hrgtc.model import Model, load_model, save_model
 from hrgtc.model_schema import strict
-from hrgtc.pipeline.instrument import calibrate_instrument, steady_segments, summary_rows
+from hrgtc.pipeline.calibration import RateTables, calibrate, summary_rows
 from hrgtc.recording import ReadOptions, axis_view, read
 from hrgtc.settings.calibration import CalibrationSettings
 from hrgtc.settings.compensation import CompensateSettings
@@ -29,9 +31,8 @@ AXES = ("x", "y", "z")
 @pytest.fixture(scope="module")
 def calibration(imu_campaign):
     files = imu_campaign
-    return calibrate_instrument(files.soaks, [files.cooldown], [files.warmup],
-                                rate_tables=[files.rate_table],
-                                validate_rate_tables=[files.rate_table_heldout])
+    return calibrate(files.soaks, [files.cooldown], [files.warmup],
+                     rate_tables=RateTables([files.rate_table], [files.rate_table_heldout]))
 
 
 def test_every_axis_has_its_own_thermometer_drift_and_scale_factor(calibration):
@@ -158,14 +159,14 @@ def test_cross_axis_candidates_are_judged_on_held_out_runs(imu_campaign):
     """Each axis is refitted with the other resonators' frequencies as candidates; the
     trial is kept only if the held-out warm-up improves by more than 2 %."""
     files = imu_campaign
-    result = calibrate_instrument(files.soaks, [files.cooldown], [files.warmup],
-                                  settings=CalibrationSettings(cross_axis=True))
+    result = calibrate(files.soaks, [files.cooldown], [files.warmup],
+                       settings=CalibrationSettings(cross_axis=True))
     assert set(result.cross_axis) == set(AXES)
     for axis, trial in result.cross_axis.items():
         assert trial["channels"] == {f"f{b}": f"freq_hz_{b}" for b in AXES if b != axis}
         gain = trial["held_out_10s_dph_with"] < 0.98 * trial["held_out_10s_dph_without"]
         assert trial["kept"] == gain
-        (held_out,) = result.validation[axis]
+        (held_out,) = result.axes[axis].validation
         chosen = trial["held_out_10s_dph_with" if gain else "held_out_10s_dph_without"]
         assert held_out.compensated_10s == pytest.approx(chosen, rel=1e-12)
         uses = any("a_f" in t for t in result.model.axes[axis].drift.selected)
@@ -180,13 +181,14 @@ def test_cross_axis_candidates_are_judged_on_held_out_runs(imu_campaign):
 def test_an_axis_model_reads_another_axis_frequency(imu_campaign):
     """A model of axis x with y's frequency as a term compensates from the instrument's
     file: the view of axis x keeps freq_hz_y, the numpy and fused engines agree."""
-    from hrgtc.pipeline.calibration import calibrate
+    from hrgtc.settings.inputs import CalibrationInputs
 
     files = imu_campaign
     options = ReadOptions(axis="x")
     drift = DriftSettings(terms=("f", "f^2", "g", "a_fy", "f*a_fy"), penter=0.5, premove=0.6)
     result = calibrate(files.soaks, [files.cooldown], read_options=options,
-                       settings=CalibrationSettings(drift=drift), aux={"fy": "freq_hz_y"})
+                       settings=CalibrationSettings(drift=drift),
+                       inputs=CalibrationInputs(aux=("fy=freq_hz_y",)))
     assert any("a_fy" in t for t in result.model.drift.selected)
     run = read(files.warmup)
     view = axis_view(run, "x")
@@ -198,7 +200,7 @@ def test_an_axis_model_reads_another_axis_frequency(imu_campaign):
 
 
 def test_the_instrument_summary_shows_the_rate_tables_and_the_axes(calibration, monkeypatch):
-    """``InstrumentCalibration.summary()``: the held-out rate tables' errors (places of the
+    """``Calibration.summary()``: the held-out rate tables' errors (places of the
     ``--json`` document), each axis's held-out medians (``summary_rows``), and
     ``hrgtc calibrate`` prints every one of its figures in its table."""
     import io
@@ -232,3 +234,24 @@ def test_the_instrument_summary_shows_the_rate_tables_and_the_axes(calibration, 
     lines = [[c.strip() for c in line.split("│")[1:-1]] for line in out.getvalue().splitlines()]
     for heading, label, value, unit, interval in summary.rows():
         assert [label, value, unit, interval] in lines, (heading, label)
+
+
+def test_the_one_axis_readings_name_the_axes_of_an_instrument(calibration, imu_campaign):
+    """``calibrate`` and ``evaluate`` return one type for one axis or many: the readings of
+    the only axis (``.axis``, ``.validation``, ...) raise on three axes, naming them, and
+    the axis's own is in ``.axes``; one axis evaluated (``--axes y``) is the ``.axis``."""
+    from hrgtc.evaluation import evaluate
+    from hrgtc.settings.compensation import BIAS_ONLY
+
+    for reading in ("axis", "plateaus", "table", "validation", "prior_fit"):
+        with pytest.raises(InputError, match=r"has axes x, y, z: pick one: "
+                                             r"calibration.axes\['x'\]"):
+            getattr(calibration, reading)
+    assert calibration.axes["y"].model.axis is calibration.model.axes["y"]
+    assert calibration.axes["y"].validation[0].file == Path(imu_campaign.warmup).name
+    run = evaluate(calibration.model, imu_campaign.warmup, settings=BIAS_ONLY)  # as held out
+    with pytest.raises(InputError, match=r"axes x, y, z: pick one: result.axes\['x'\]"):
+        run.axis  # noqa: B018 (the property raises)
+    assert run.axes["y"].to_dict() == calibration.axes["y"].validation[0].to_dict()
+    alone = evaluate(calibration.model, imu_campaign.warmup, settings=BIAS_ONLY, axes=("y",))
+    assert list(alone.axes) == ["y"] and alone.axis.to_dict() == run.axes["y"].to_dict()

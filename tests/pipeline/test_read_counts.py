@@ -1,6 +1,6 @@
 """Reads per file per command (issue 22, Deliver 4): a file is read once per command
-whatever the number of axes, and evaluate_instrument's figures are those of the per-axis
-evaluation it replaces.
+whatever the number of axes, and the figures of every axis from one reading are those of
+each axis's view read alone.
 
 The counts come from :mod:`read_counter` (opens, full passes, heads). On these small
 files (fewer rows than the validation's heuristic rows) a head reads the whole file; a
@@ -20,7 +20,7 @@ from typer.testing import CliRunner
 from hrgtc.cli import app
 from hrgtc.evaluation import evaluate
 from hrgtc.model import load_model
-from hrgtc.pipeline.instrument import calibrate_instrument, evaluate_instrument
+from hrgtc.pipeline.calibration import calibrate
 from hrgtc.recording import ReadOptions
 from hrgtc.simulate import simulate_files
 from hrgtc.simulate import standard_profiles as profiles
@@ -38,7 +38,7 @@ def _campaign(folder: Path, unit: str) -> dict:
                           unit=unit, sample_rate_hz=1.0, seed=3)
     files = {"soaks": [Path(w.path) for w in soaks], "cool": Path(cool[0].path),
              "warm": Path(warm[0].path)}
-    calibration = calibrate_instrument(files["soaks"], [files["cool"]], [files["warm"]])
+    calibration = calibrate(files["soaks"], [files["cool"]], [files["warm"]])
     files["model"] = folder / "model.json"
     from hrgtc.model import save_model
 
@@ -86,17 +86,16 @@ def test_compensate_reads_the_run_once(campaign):
     assert passes == 2 and counts.heads[str(campaign["warm"].resolve())] == 0
 
 
-def test_evaluate_instrument_equals_the_per_axis_evaluation(campaign):
-    """The one reading gives each axis the figures of the old per-axis evaluate (which
-    read the axis's view of the file), to 1e-12."""
+def test_evaluate_of_every_axis_equals_each_axis_view_alone(campaign):
+    """The one reading gives each axis the figures of that axis's model evaluated on the
+    axis's view of the file (``read_options.axis``), to 1e-12."""
     model = load_model(campaign["model"])
     options = ReadOptions().with_spike_default("drop")
-    together = evaluate_instrument(campaign["warm"], model, read_options=options,
-                                   max_points=2000)
+    together = evaluate(model, campaign["warm"], read_options=options, max_points=2000)
     assert list(together.axes) == list(model.axes)
     for axis in model.axes:
-        alone = evaluate(campaign["warm"], model.of_axis(axis), max_points=2000,
-                         read_options=dataclasses.replace(options, axis=axis or None))
+        alone = evaluate(model.of_axis(axis), campaign["warm"], max_points=2000,
+                         read_options=dataclasses.replace(options, axis=axis or None)).axis
         one = together.axes[axis]
         assert one.n_samples == alone.n_samples and one.n_not_at_rest == alone.n_not_at_rest
         for series, row in alone.bias_stability_dph.items():
@@ -144,8 +143,8 @@ def test_calibrate_reads_each_file_once_for_every_axis(campaign):
 
 def test_calibrate_checks_each_training_file_for_a_mark_once(campaign, monkeypatch):
     """Whether a training file is a compensated output is asked once per command, whatever
-    the number of axes (``refuse_compensated_training`` in ``calibrate_instrument``, then
-    ``calibrate(..., marks_checked=True)`` for each axis); before: once more per axis (2
+    the number of axes (``refuse_compensated_training`` in ``calibrate``, then no check in
+    ``fit_axis`` for each axis); before: once more per axis (2
     for one axis, 4 for three, each an open of the file's metadata). With three axes a
     soak file is opened twice: that check and the one reading every axis shares."""
     import hrgtc.recording.marks as marks
@@ -174,11 +173,11 @@ def test_calibrate_checks_each_training_file_for_a_mark_once(campaign, monkeypat
 def test_reading_once_gives_the_same_instrument_model(campaign, monkeypatch):
     """The model from one reading of each file equals the model from reading them per
     axis, as before (the cached chunks are the streamed chunks)."""
-    import hrgtc.pipeline.instrument as instrument
+    import hrgtc.pipeline.calibration as chain
 
-    once = calibrate_instrument(campaign["soaks"], [campaign["cool"]], [campaign["warm"]])
-    monkeypatch.setattr(instrument, "ReadOnce", lambda **words: ReadOptions(**words))
-    streamed = calibrate_instrument(campaign["soaks"], [campaign["cool"]],
+    once = calibrate(campaign["soaks"], [campaign["cool"]], [campaign["warm"]])
+    monkeypatch.setattr(chain, "ReadOnce", lambda **words: ReadOptions(**words))
+    streamed = calibrate(campaign["soaks"], [campaign["cool"]],
                                     [campaign["warm"]])
 
     def plain(model):
@@ -189,14 +188,14 @@ def test_reading_once_gives_the_same_instrument_model(campaign, monkeypatch):
         return data
 
     assert plain(once.model) == plain(streamed.model)
-    for axis in once.validation:
-        assert [v.to_dict() for v in once.validation[axis]] == \
-            [v.to_dict() for v in streamed.validation[axis]]
+    for axis, result in once.axes.items():
+        assert [v.to_dict() for v in result.validation] == \
+            [v.to_dict() for v in streamed.axes[axis].validation]
 
 
 def test_report_reads_each_run_and_soak_once(campaign):
     """``hrgtc report`` evaluates every axis of a run from one reading
-    (:func:`hrgtc.evaluation.instrument_pass.evaluate_axes`) and traces every axis of a soak
+    (:func:`hrgtc.evaluation.evaluate`) and traces every axis of a soak
     from one reading: two passes over a run (the at-rest detector's columns, then the
     measuring pass) and one over a soak; before: 2 passes and 2 heads of a run per axis
     (6 and 6 for three axes), one pass of a soak per axis (3 for three axes)."""
@@ -220,8 +219,8 @@ def test_cross_axis_fits_the_thermometer_once(imu_campaign, monkeypatch):
     with the other resonators' frequencies: one thermometer fit and one plateau search per
     axis and soak (before: two), and the same model as the old path that calibrated each
     axis twice from scratch (coefficients to 1e-12)."""
-    import hrgtc.pipeline.calibration as calibration
-    import hrgtc.pipeline.instrument as instrument
+    import hrgtc.pipeline.axis_calibration as calibration
+    import hrgtc.pipeline.calibration as chain
     from hrgtc.settings.calibration import CalibrationSettings
 
     campaign = imu_campaign
@@ -239,16 +238,16 @@ def test_cross_axis_fits_the_thermometer_once(imu_campaign, monkeypatch):
                         counted("plateaus", calibration.plateaus_from_recordings))
     settings = CalibrationSettings(cross_axis=True)
     args = (campaign["soaks"], [campaign["cool"]], [campaign["warm"]])
-    once = calibrate_instrument(*args, settings=settings)
+    once = calibrate(*args, settings=settings)
     axes = len(once.model.axes)
     assert calls == {"thermometer": axes, "plateaus": axes * len(campaign["soaks"])}
-    plain = instrument.calibrate
+    plain = chain.fit_axis
 
     def from_scratch(*words, soak_fit=None, **more):  # the old path: calibrate everything
         return plain(*words, **more)
 
-    monkeypatch.setattr(instrument, "calibrate", from_scratch)
-    twice = calibrate_instrument(*args, settings=settings)
+    monkeypatch.setattr(chain, "fit_axis", from_scratch)
+    twice = calibrate(*args, settings=settings)
     assert calls["thermometer"] == 3 * axes
     assert once.cross_axis == twice.cross_axis
     for axis, model in once.model.axes.items():

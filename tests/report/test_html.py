@@ -208,7 +208,7 @@ def test_numbers_agree_with_hrgtc_evaluate(unit, report):
     _, _, page, _ = report
     glance = {row[0]: row for row in page.table("At a glance")}
     for path in (files.cooldown, files.warmup):
-        result = evaluate(path, model).to_dict()
+        result = evaluate(model, path).axis.to_dict()
         row = glance[path.name]
         for column, key in ((1, "raw"), (2, "compensated"), (4, "housing")):
             assert _number(row[column]) == pytest.approx(
@@ -222,8 +222,8 @@ def test_block_means_do_not_depend_on_chunking(unit):
     from hrgtc.evaluation import evaluate
 
     files, model, _ = unit
-    trace = evaluate(files.cooldown, model, max_points=500,
-                     read_options=recording.ReadOptions(chunk_rows=777))
+    trace = evaluate(model, files.cooldown, max_points=500,
+                     read_options=recording.ReadOptions(chunk_rows=777)).axis
     run = recording.read(files.cooldown)
     rows = len(run) // 500  # 72 rows (36 s) per block: more than 10 s, 500 blocks
     assert trace.block_s == pytest.approx(rows / run.sample_rate_hz)
@@ -315,7 +315,7 @@ def test_intervals_and_noise_reasons_in_the_tables(unit, report):
 
     files, model, _ = unit
     _, _, page, _ = report
-    result = evaluate(files.cooldown, model)
+    result = evaluate(model, files.cooldown).axis
     row10 = next(row for row in page.table(f"Bias stability of {files.cooldown.name}")
                  if row[0] == "raw, τ = 10 s")
     low, high = result.stability_interval("raw", 10.0)

@@ -111,7 +111,7 @@ def unit(paper_campaign):
 def test_a_unit_s_page_with_runs_and_soaks_is_the_one_the_f_strings_wrote(unit):
     """Figs. 3-6 from the soaks and two runs, every table and caption: the same page."""
     files, model = unit
-    runs = [evaluate(path, model, max_points=ReportSettings.max_points)
+    runs = [evaluate(model, path, max_points=ReportSettings.max_points).axis
             for path in (files.cooldown, files.warmup)]
     page = _same_page(report_inputs(model, runs))
     assert page.count("<img ") == 4 + 2 * 2 and page.count("<table>") > 20

@@ -191,13 +191,13 @@ def instrument(imu_campaign):
     import warnings
 
     from hrgtc.core.errors import HrgtcWarning
-    from hrgtc.pipeline.instrument import calibrate_instrument
+    from hrgtc.pipeline.calibration import RateTables, calibrate
 
     files = imu_campaign
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", HrgtcWarning)
-        return calibrate_instrument(files.soaks, [files.cooldown], [files.warmup],
-                                    rate_tables=[files.rate_table]).model
+        return calibrate(files.soaks, [files.cooldown], [files.warmup],
+                         rate_tables=RateTables(runs=(files.rate_table,))).model
 
 
 def test_each_axis_of_an_instrument_is_updated_in_the_same_chain(instrument, tmp_path):

@@ -109,7 +109,10 @@ def _strict(value: Any) -> Any:
 
 def fail(message: str, code: int = 2) -> typer.Exit:
     """Print ``message`` as an error and return the Exit to raise."""
-    error_console.print(f"[bold red]error:[/] {message}")
+    from rich.markup import escape
+
+    # the message is text (a column named "gyro_x [deg/h]" is not markup)
+    error_console.print(f"[bold red]error:[/] {escape(message)}")
     return typer.Exit(code)
 
 

@@ -23,18 +23,18 @@ from hrgtc.settings.drift import EQ21_TERMS
 from hrgtc.settings.inputs import CalibrationInputs
 
 if TYPE_CHECKING:
-    from hrgtc.pipeline.calibration import CalibrationResult
-    from hrgtc.pipeline.instrument import InstrumentCalibration
+    from hrgtc.pipeline.axis_calibration import AxisCalibration
+    from hrgtc.pipeline.calibration import Calibration
     from hrgtc.recording import ReadOptions
 
 #: The nine candidate terms of Eq. (21) of [1], as the default of --terms.
 EQ21_DEFAULT = ",".join(EQ21_TERMS)
 
 
-def render(result: CalibrationResult, temperature_map: dict[str, Any] | None = None) -> None:
-    """Print the unit's Table 1, Table 2 and plateaus (a frequency thermometer:
-    :meth:`CalibrationResult.tables`), then the calibration's summary
-    (:meth:`CalibrationResult.summary`: thermometer, drift model, stepwise steps, housing
+def render(result: AxisCalibration, temperature_map: dict[str, Any] | None = None) -> None:
+    """Print the axis's Table 1, Table 2 and plateaus (a frequency thermometer:
+    :meth:`AxisCalibration.tables`), then its calibration's summary
+    (:meth:`AxisCalibration.summary`: thermometer, drift model, stepwise steps, housing
     baseline and held-out runs, a table each, and the Eq. 18 and Eq. 22 forms); the range
     warnings are printed apart. ``temperature_map``: the instrument's map of a sensor's raw
     count (``--temp-ref``), shown as the sensor thermometer's figures."""
@@ -95,10 +95,8 @@ def calibrate_command(
     """
     from hrgtc.core.files import check_writable, refuse_existing, refuse_input
     from hrgtc.model import save_model
-    from hrgtc.pipeline.instrument import calibrate_instrument
-    from hrgtc.pipeline.terms import parse_aux
+    from hrgtc.pipeline.calibration import RateTables, calibrate
     from hrgtc.recording import ReadOptions
-    from hrgtc.thermometry.reference import TemperatureReference, parse_reference_columns
 
     inputs = (inputs or ReadOptions()).with_spike_default("drop")
     given = given or CalibrationInputs()
@@ -114,27 +112,19 @@ def calibrate_command(
         if ref.reference_log is None and ref.described():
             raise fail(f"{ref.described()[0]} describes a reference log: give the log with "
                        "--temp-ref")
-        reference = None if ref.reference_log is None else TemperatureReference(
-            ref.reference_log, parse_reference_columns(list(ref.reference_columns)),
-            unit=ref.reference_unit, start=ref.reference_start, tz=ref.reference_tz,
-            lag_s=ref.reference_lag_s)
 
         def progress(stage: str, done: float, total: float) -> None:
             if not json_output and stage not in stages:
                 stages[stage] = True
                 error_console.print(f"[dim]… {stage}[/]")
 
-        calibration = calibrate_instrument(
-            soaks, drift, validate or (), holdout_s=given.holdout.holdout_s,
-            holdout_fraction=given.holdout.holdout_fraction, settings=settings,
-            aux=parse_aux(given.aux), read_options=inputs,
-            progress=progress, prior=prior, thermometer=inputs.thermometer,
-            rate_tables=rate_table or (), validate_rate_tables=validate_rate_table or (),
-            segment_table=segments, temperature_reference=reference,
-        )
+        calibration = calibrate(
+            soaks, drift, validate or (), settings=settings, inputs=given,
+            rate_tables=RateTables(rate_table or (), validate_rate_table or (), segments),
+            prior=prior, read_options=inputs, progress=progress)
         save_model(calibration.model, output, force=force)
     if json_output:
-        print_json({**calibration.document(), "model_file": str(output)})
+        print_json({**calibration.to_dict(), "model_file": str(output)})
     else:
         render_map(calibration.model.temperature_map)
         render_instrument(calibration)
@@ -162,19 +152,15 @@ def render_map(stored: dict[str, Any] | None) -> None:
         console.print(f"[yellow]note:[/] {temperature_map.extra['note']}")
 
 
-def render_instrument(calibration: InstrumentCalibration) -> None:
+def render_instrument(calibration: Calibration) -> None:
     """Each axis as :func:`render`, its scale factor, then the instrument's summary
-    (:meth:`InstrumentCalibration.summary`: held-out rate tables, cross-axis trials and
-    each axis's held-out medians)."""
-    from dataclasses import replace
-
+    (:meth:`Calibration.summary`: held-out rate tables, cross-axis trials and each axis's
+    held-out medians)."""
     for axis, result in calibration.axes.items():
         if axis:
             console.rule(f"axis {axis}")
         model = calibration.model.axes[axis]
-        render(replace(result, model=calibration.model.of_axis(axis),
-                       validation=calibration.validation.get(axis, ())),
-               calibration.model.temperature_map)
+        render(result, calibration.model.temperature_map)
         if model.scale_factor is not None:
             print_summary(model.scale_factor.summary(), console)
     summary = calibration.summary()

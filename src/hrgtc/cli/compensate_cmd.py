@@ -28,8 +28,8 @@ from hrgtc.settings.compensation import CompensateSettings, EvaluationSettings
 if TYPE_CHECKING:
     from hrgtc.compensate.ranges import RangeReport
     from hrgtc.evaluation import Evaluation
+    from hrgtc.evaluation.run_evaluation import RunEvaluation
     from hrgtc.model import Model
-    from hrgtc.pipeline.instrument import InstrumentEvaluation
     from hrgtc.recording import ReadOptions
 
 
@@ -162,9 +162,10 @@ def evaluate_command(
     """
     from hrgtc.compensate.multi_axis import parse_axes
     from hrgtc.core.files import refuse_existing, refuse_input, write_text_atomic
+    from hrgtc.evaluation import evaluate
+    from hrgtc.evaluation.run_evaluation import warn_worse_than_raw
     from hrgtc.evaluation.run_pass import DEVIATIONS
     from hrgtc.model import load_model
-    from hrgtc.pipeline.instrument import evaluate_instrument
     from hrgtc.recording import ReadOptions
 
     inputs = (inputs or ReadOptions()).with_spike_default("drop")
@@ -178,21 +179,22 @@ def evaluate_command(
             refuse_existing(allan_csv, force)
         model = load_model(model_path)
         with progress_bar("evaluating", enabled=not json_output) as progress:
-            result = evaluate_instrument(
-                run, model, axes=parse_axes(axes), read_options=inputs,
+            result = evaluate(
+                model, run, axes=parse_axes(axes), read_options=inputs,
                 settings=EvaluationSettings(deviation=deviation),
                 max_points=PREDICTION_BLOCKS, progress=progress, model_source=str(model_path))
         if allan_csv is not None:
             write_text_atomic(allan_csv, result.allan_csv(), force=force)
     render_instrument_evaluation(result, json_output)
+    warn_worse_than_raw(result)
     note_unchecked(model, model_path)
     warn_ranges([r.ranges for r in result.axes.values()], json_output, strict,
                 list(result.axes))
 
 
-def render_instrument_evaluation(result: InstrumentEvaluation, json_output: bool) -> None:
+def render_instrument_evaluation(result: RunEvaluation, json_output: bool) -> None:
     """``hrgtc evaluate``'s output: each axis's table, then the instrument's summary (the
-    axes side by side, the scale-factor check: :meth:`InstrumentEvaluation.summary`), or the
+    axes side by side, the scale-factor check: :meth:`RunEvaluation.summary`), or the
     JSON document (the scale check on stderr)."""
     from hrgtc.cli.summary_tables import print_summary
 
@@ -200,11 +202,10 @@ def render_instrument_evaluation(result: InstrumentEvaluation, json_output: bool
     sensor = {axis: m.thermometer.source == "sensor" for axis, m in model.axes.items()}
     if json_output:
         print_json(result.to_dict())
-    elif model.is_single_axis:
-        render_evaluation(result.axes[""], sensor[""])
-    else:
+    else:  # a heading per named axis (the one axis of a single-axis model has none)
         for axis, evaluation in result.axes.items():
-            console.rule(f"axis {axis}")
+            if axis:
+                console.rule(f"axis {axis}")
             render_evaluation(evaluation, sensor[axis])
     checks = result.scale_checks
     if checks and json_output:

@@ -57,7 +57,7 @@ def demo_command(
                 "c_files": [str(p) for p in result.instrument.c_files]},
         })
         return
-    render(result.calibration)
+    render(result.calibration.axis)
     render_evaluation(result.training)
     render_evaluation(result.validation)
     print_summary(result.summary(), console)

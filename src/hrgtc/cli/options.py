@@ -60,11 +60,16 @@ def _unit_callback(kind: str) -> Any:
 
 
 class OutputFormat(StrEnum):
-    """Output file format (suffixes .parquet, .csv, .h5)."""
+    """Output file format (suffixes .parquet, .csv, .h5, .tdms, .mat, .mf4): the formats of
+    the registry that have a writer, written out so that ``--help`` loads no format (a test
+    checks that they agree with ``output_suffixes()``)."""
 
     parquet = "parquet"
     csv = "csv"
     h5 = "h5"
+    tdms = "tdms"
+    mat = "mat"
+    mf4 = "mf4"
 
     @property
     def suffix(self) -> str:
@@ -72,6 +77,27 @@ class OutputFormat(StrEnum):
         from hrgtc.recording.formats.registry import output_suffixes
 
         return output_suffixes()[self.value]
+
+
+def output_format_callback(value: str | None) -> str | None:
+    """``--format``: the output name of a format with a writer (a lab's own included), or an
+    error naming those that write (and, for a format hrgtc only reads, that it has no writer).
+    """
+    if value is None or value in OutputFormat.__members__:
+        return value
+    from hrgtc.core.errors import RecordingError
+    from hrgtc.recording.formats.registry import get, output_suffixes
+
+    can = ", ".join(output_suffixes())
+    try:
+        fmt = get(value)
+    except RecordingError:
+        raise typer.BadParameter(f"unknown format {value!r}; the formats that write are "
+                                 f"{can}") from None
+    if fmt.sink is not None:
+        return fmt.output_name
+    raise typer.BadParameter(f"hrgtc has no writer for {fmt.name} files ({fmt.description}; "
+                             f"its library reads them only); the formats that write are {can}")
 
 
 _INPUT = "Input recordings"

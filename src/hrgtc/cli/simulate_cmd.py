@@ -10,7 +10,7 @@ from typing import Annotated
 import typer
 
 from hrgtc.cli._app import console, library_errors, print_json, progress_bar
-from hrgtc.cli.options import ForceOption, JsonOption, OutputFormat
+from hrgtc.cli.options import ForceOption, JsonOption, OutputFormat, output_format_callback
 from hrgtc.cli.params import settings_options
 from hrgtc.settings.simulation import (
     DEFAULT_SAMPLE_RATE_HZ,
@@ -34,10 +34,12 @@ def simulate_command(
         ),
     ] = Path("."),
     file_format: Annotated[
-        OutputFormat | None,
+        str | None,
         typer.Option(
-            "--format", help="Output file format (default: from the -o suffix, else parquet; "
-            "csv with --logger)."
+            "--format", metavar="[" + "|".join(OutputFormat) + "]",
+            callback=output_format_callback,
+            help="Output file format (default: from the -o suffix, else parquet; "
+            "csv with --logger). ulog and dataflash have no writer."
         ),
     ] = None,
     force: ForceOption = False,
@@ -97,7 +99,7 @@ def simulate_command(
                                              "sample_rate_hz": sample_rate_hz})
             logged = simulate_logged_files(
                 runs, output, spec, unit=gyro, seed=seed,
-                file_format=None if file_format is None else file_format.value,
+                file_format=file_format,
                 input_rate_dph=input_rate_dph, force=force,
             )
             if json_output:
@@ -118,7 +120,7 @@ def simulate_command(
             written = simulate_files(
                 runs,
                 output,
-                None if file_format is None else file_format.value,
+                file_format,
                 unit=gyro,
                 sample_rate_hz=sample_rate_hz,
                 seed=seed,

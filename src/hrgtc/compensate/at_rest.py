@@ -11,7 +11,7 @@ local. Its level and variance tests compare a sample with the at-rest noise of t
 of block medians centred on it; a streamed flag with a bounded delay would have to
 estimate that noise from the samples seen so far, and its verdicts would differ from
 those of calibration and evaluation on the same file. So, as ``evaluate`` does
-(:func:`hrgtc.evaluation.instrument_pass.evaluate_axes`), one pass keeps only the
+(:func:`hrgtc.evaluation.evaluate`), one pass keeps only the
 detector's columns (time, rate, known input rate, accelerometer axes),
 :class:`hrgtc.drift.rest.RestPass` (:func:`~hrgtc.drift.rest.run_rest` a chunk at a
 time) marks the samples, and the compensating pass then writes the flags: equal to

@@ -77,6 +77,11 @@ class HrgtcWarning(UserWarning):
         super().__init__(*_cleaned(args))
 
 
+class CompensationWarning(HrgtcWarning):
+    """Compensation made a run's bias stability worse than the raw output's, beyond their
+    intervals: the model does not hold on that run."""
+
+
 class ExtrapolationWarning(HrgtcWarning):
     """Input is valid but outside the range a model was calibrated on."""
 

@@ -1,6 +1,7 @@
 """Evaluation: stage 5, how much better the gyro got.
 
-Takes a unit model and a run and gives, in one pass (``run_pass``), the raw
+Takes a model (one axis or many) and a run and gives, in one pass (``evaluate``: a
+``run_pass`` per axis, the run read once), the raw
 and compensated bias stability (Section 4.2 of [1]: 3.0143 -> 0.5848 °/h),
 Allan deviations and noise terms (``allan``), the out-of-range shares and the
 residual against the simulator's true bias; ``metrics`` holds the figures of
@@ -21,7 +22,7 @@ _NAMES = {
     "bias_stability_table": "metrics", "residual_against_truth": "metrics",
     "NoiseTerms": "noise", "noise_terms": "noise",
     "BlockMeans": "plot_blocks", "block_rows": "plot_blocks",
-    "evaluate": "run_pass", "run_pass": "run_pass",
+    "run_pass": "run_pass", "RunEvaluation": "run_evaluation", "evaluate": "run_evaluation",
 }
 
 
@@ -35,6 +36,7 @@ __all__ = [
     "Evaluation",
     "NoiseTerms",
     "ResidualResult",
+    "RunEvaluation",
     "allan_deviation",
     "bias_stability",
     "bias_stability_table",

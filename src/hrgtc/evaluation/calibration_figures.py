@@ -55,7 +55,7 @@ def calibration_summary(model: Any, table: Sequence[Mapping[str, float]] = (),
                         temperature_map: Mapping[str, Any] | None = None) -> Summary:
     """The figures of a calibration: a :class:`~hrgtc.model.Model`, its Table 2 rows
     (``error_c``), the held-out :class:`~hrgtc.evaluation.Evaluation` s and the prior's fit
-    (what :meth:`hrgtc.pipeline.calibration.CalibrationResult.summary` holds; the report
+    (what :meth:`hrgtc.pipeline.axis_calibration.AxisCalibration.summary` holds; the report
     passes a model file's). ``warnings``: the held-out runs' range warnings among the notes
     (the CLI prints them apart). ``temperature_map``: the instrument's map of a raw sensor
     count to °C (a model file's ``temperature_map``, ``--temp-ref``), shown as the sensor
@@ -108,7 +108,7 @@ def thermometer_tables(thermometer: Any, plateaus: Sequence[Any]) -> Summary:
     model file); ``Eq. 18 beside the paper's``: the coefficients, highest power first,
     beside Eq. (18) of [1] as printed. No sections for the gyro's own temperature sensor.
     ``plateaus``: :class:`~hrgtc.thermometry.plateaus.Plateau` s, in the thermometer's
-    Table 1 order (``CalibrationResult.plateaus``, a model file's ``plateaus``).
+    Table 1 order (``AxisCalibration.plateaus``, a model file's ``plateaus``).
     """
     title = "the unit's Table 1 and Table 2"
     if thermometer.source == "sensor":
@@ -340,7 +340,7 @@ def _step_figures(key: str, model: Any) -> tuple[Figure, ...]:
 
 
 def instrument_summary(calibration: Any) -> Summary:
-    """What an :class:`~hrgtc.pipeline.instrument.InstrumentCalibration` shows beside its
+    """What a :class:`~hrgtc.pipeline.calibration.Calibration` shows beside its
     axes' own summaries: each held-out rate table's scale-factor error at each temperature
     raw and compensated (``scale_factor_checks[i]`` of ``--json``), each cross-axis trial
     (``cross_axis.<axis>``) and, for several axes, each axis's held-out median 10 s bias
@@ -386,7 +386,7 @@ def instrument_summary(calibration: Any) -> Summary:
 
 def _axis_figures(calibration: Any, axis: str, unit_model: Any) -> tuple[Figure, ...]:
     key = f"axes.{axis or '-'}"
-    runs = calibration.validation.get(axis, ())
+    runs = calibration.axes[axis].validation
     checks = [c for c in calibration.scale_checks if c.axis == axis]
 
     def median(values: list[float]) -> float:

@@ -1,7 +1,7 @@
 """An instrument's evaluation as figures: its axes side by side and its scale-factor check.
 
 :func:`evaluation_tables` builds the :class:`~hrgtc.core.summary.Summary` of an
-:class:`~hrgtc.pipeline.instrument.InstrumentEvaluation` (``hrgtc evaluate`` of a
+:class:`~hrgtc.evaluation.run_evaluation.RunEvaluation` (``hrgtc evaluate`` of a
 multi-axis model or a rate-table run): each axis's 10 s bias stability raw and compensated,
 the improvement, the compensated output's mean and RMS and the shares beyond the trained
 ranges (the rows of ``--json``'s ``summary``), and each rate-table temperature's

@@ -11,8 +11,9 @@ thermistor method). Simulated runs carry the true bias; the model's residual
 against it is reported too. On request the pass also keeps block means for
 plotting (the report's Fig. 6) and hands each compensated chunk to a writer. The
 result, :class:`~hrgtc.evaluation.evaluation_result.Evaluation` (re-exported here), is
-in :mod:`hrgtc.evaluation.evaluation_result`.
-``hrgtc evaluate``, ``calibrate --validate``, the report and the demo all use it.
+in :mod:`hrgtc.evaluation.evaluation_result`. :func:`hrgtc.evaluation.evaluate` reads a run
+once for every axis of a model and runs a :class:`RunPass` per axis
+(:mod:`hrgtc.evaluation.run_evaluation`).
 
 [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
 """
@@ -20,21 +21,18 @@ in :mod:`hrgtc.evaluation.evaluation_result`.
 from __future__ import annotations
 
 import math
-import os
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from hrgtc.compensate import Compensator
 from hrgtc.core.accounting import Accounting
-from hrgtc.core.errors import HrgtcError, InputError, RecordingError
+from hrgtc.core.errors import HrgtcError, InputError
 from hrgtc.core.progress import Progress
 from hrgtc.core.timeline import RESTARTS_KEY
 from hrgtc.drift.features import FeatureStream
-from hrgtc.drift.rest import run_rest
 from hrgtc.evaluation.allan import AllanResult
 from hrgtc.evaluation.burst_allan import BurstAllanResult
 from hrgtc.evaluation.deviation_curves import (
@@ -46,13 +44,11 @@ from hrgtc.evaluation.deviation_curves import (
 from hrgtc.evaluation.evaluation_result import Evaluation
 from hrgtc.evaluation.heating_cooling import DirectionSplit
 from hrgtc.evaluation.noise import NoiseTerms, noise_terms
-from hrgtc.evaluation.plot_blocks import BlockMeans, block_rows
+from hrgtc.evaluation.plot_blocks import BlockMeans
 from hrgtc.evaluation.series_stats import SeriesStatistics
 from hrgtc.evaluation.settling_cut import SettlingCut
 from hrgtc.model import AxisModel, Model
-from hrgtc.model_fit import check_recording_noise, with_model_band
-from hrgtc.recording import ReadOptions, Recording, count_rows
-from hrgtc.recording.marks import compensation_mark, describe_mark, refuse_compensated
+from hrgtc.recording import Recording
 from hrgtc.settings.compensation import EvaluationSettings
 
 #: Series measured by a pass: output minus input rate, compensated by the
@@ -148,7 +144,7 @@ class RunPass:
     """The state of one pass over a run: :meth:`partial_fit` each consecutive chunk, then
     :meth:`finish`. :func:`run_pass` is "a new pass, then every chunk"; a pass per axis of a
     multi-axis recording lets one reading of the file feed every axis
-    (:func:`hrgtc.evaluation.instrument_pass.evaluate_axes`). The parameters are those of
+    (:func:`hrgtc.evaluation.evaluate`). The parameters are those of
     :func:`run_pass`."""
 
     def __init__(self, model: AxisModel, plan: RunPlan | str,
@@ -329,72 +325,6 @@ def _accounting(read: int, settling: int, frequency: Compensator,
     accounting.drop("motion", not_at_rest)
     accounting.flag("out_of_range", round(frequency.out_of_range_fraction * read))
     return accounting
-
-
-def evaluate(
-    run: Recording | str | os.PathLike[str],
-    model: Model,
-    *,
-    settings: EvaluationSettings | None = None,
-    read_options: ReadOptions | None = None,
-    max_points: int | None = None,
-    on_output: Callable[[Recording], None] | None = None,
-    progress: Progress | None = None,
-) -> Evaluation:
-    """Raw vs compensated bias stability, Allan noise terms and range shares of one run.
-
-    Parameters
-    ----------
-    run
-        A :class:`~hrgtc.recording.Recording` or a file, read chunk by chunk.
-    model
-        The unit's model.
-    settings
-        What is measured (:class:`~hrgtc.settings.compensation.EvaluationSettings`; the
-        defaults: bias stability at 1, 10 and 100 s, the overlapping Allan deviation and
-        its noise terms, 1σ intervals).
-    read_options
-        How to read a file (column mapping, units, metadata, chunk size).
-    max_points
-        Keep at most this many plotting blocks (of at least 10 s); None keeps none.
-    on_output, progress
-        As for :func:`run_pass`.
-    """
-    gaps = (read_options or ReadOptions()).gaps
-    motion = (read_options or ReadOptions()).motion
-    if isinstance(run, Recording):
-        found = compensation_mark(run.metadata.to_dict(), list(run.names))
-        if found is not None:
-            raise RecordingError(f"{run.source or 'recording'} is already compensated, by "
-                                 f"{describe_mark(found)}; evaluate the original recording")
-        check_recording_noise(model, run, run.source or "")
-        rows = len(run)
-        name, source, chunks = Path(run.source or "recording").name, run.source or "", [run]
-        fs = run.sample_rate_hz
-        extra = run.metadata.extra
-        dropped = {"spikes": int(extra.get("spikes_dropped", 0))
-                   + int(extra.get("spikes_removed", 0))}
-    else:
-        options = with_model_band(read_options or ReadOptions(), model)
-        refuse_compensated(run)
-        check_recording_noise(model, options.head(run), str(run), options.axis)
-        rows = count_rows(run)  # cheap (metadata, or a scan of a CSV's bytes); plans the pass
-        dropped = {}  # filled by the reading: the rows of spikes removed
-        name, source, chunks = Path(run).name, str(run), options.chunks(run, dropped=dropped)
-        fs = None
-    keep = None
-    if motion != "keep":  # one pass of the detector's columns first
-        keep = run_rest(options.chunks(run) if not isinstance(run, Recording) else [run],
-                        motion, name=name).keep
-    blocks = None
-    if max_points is not None:
-        if fs is None:
-            fs = options.head(run).sample_rate_hz  # (tiny chunks would each be validated)
-        blocks = block_rows(rows, fs, max_points)
-    plan = RunPlan(name, source, rows, gaps, blocks, keep)
-    result = run_pass(model.axis, chunks, plan, settings, on_output=on_output,
-                      progress=progress)
-    return count_dropped(result, dropped)
 
 
 def count_dropped(result: Evaluation, dropped: dict[str, int]) -> Evaluation:

@@ -42,7 +42,7 @@ from hrgtc.core.files import publish, refuse_existing, temporary_beside
 
 if TYPE_CHECKING:
     from hrgtc.evaluation import Evaluation
-    from hrgtc.pipeline.instrument import InstrumentCalibration
+    from hrgtc.pipeline.calibration import Calibration
 
 __all__ = [
     "SCHEMA",
@@ -177,9 +177,9 @@ def evaluation_row(evaluations: Sequence[Evaluation]) -> dict[str, Any]:
     }
 
 
-def calibration_rows(calibration: InstrumentCalibration) -> tuple[dict[str, Any], ...]:
+def calibration_rows(calibration: Calibration) -> tuple[dict[str, Any], ...]:
     """A calibrated unit's rows, one per axis: the axis's thermometer, Table 1, drift terms
-    and held-out runs (``calibration.validation``)."""
+    and held-out runs (each axis's ``validation``)."""
     from hrgtc.thermometry.prior import relative_coefficients
 
     rows = []
@@ -200,7 +200,7 @@ def calibration_rows(calibration: InstrumentCalibration) -> tuple[dict[str, Any]
             "settled_freqs_hz": [r["freq_hz"] for r in result.table],
             "table_max_error_c": max((abs(r["error_c"]) for r in result.table), default=None),
             "terms_kept": list(part.drift.selected), "n_terms": len(part.drift.selected),
-            **evaluation_row(calibration.validation.get(axis, ())),
+            **evaluation_row(result.validation),
         })
     return tuple(rows)
 

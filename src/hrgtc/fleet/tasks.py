@@ -37,7 +37,7 @@ __all__ = ["UnitOutcome", "calibrate_unit", "evaluate_unit", "report_unit", "sim
 if TYPE_CHECKING:
     from hrgtc.evaluation import Evaluation
     from hrgtc.model import Model
-    from hrgtc.pipeline.instrument import InstrumentCalibration
+    from hrgtc.pipeline.calibration import Calibration
 
 #: Recording columns an error message may name.
 _COLUMNS = ("time_s", "freq_hz", "rate_dph", "chamber_c", "housing_c", "resonator_c",
@@ -171,31 +171,20 @@ def _resumable(files: UnitFiles, output_dir: str) -> UnitOutcome | None:
 
 def _calibrate_unit(files: UnitFiles, settings: CalibrationSettings,
                     read_options: ReadOptions | None,
-                    prior_path: str | None) -> InstrumentCalibration:
-    """The one call of the calibration chain for a unit, every axis of it.
-
-    A unit whose first drift run holds the columns of several axes is an instrument
-    (:func:`hrgtc.pipeline.instrument.calibrate_instrument`); one of a single axis is
-    calibrated by :func:`hrgtc.pipeline.calibration.calibrate`, its result as the
-    one-axis instrument (axis ""). Warnings are silenced: the table reports the shares
-    out of the calibrated ranges.
+                    prior_path: str | None) -> Calibration:
+    """The one call of the calibration chain for a unit, every axis of it
+    (:func:`hrgtc.pipeline.calibration.calibrate`: a single-axis unit is the one-axis
+    case, axis ""). Warnings are silenced: the table reports the shares out of the
+    calibrated ranges.
     """
     import warnings
 
-    from hrgtc.compensate.multi_axis import recording_axes
     from hrgtc.pipeline.calibration import calibrate
-    from hrgtc.pipeline.instrument import InstrumentCalibration, calibrate_instrument
 
-    axes = recording_axes(files.drifts[0], read_options) if files.drifts else None
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        if axes is not None and len(axes) > 1:
-            return calibrate_instrument(files.soaks, files.drifts, files.validate,
-                                        read_options=read_options, prior=prior_path,
-                                        settings=settings)
-        result = calibrate(files.soaks, files.drifts, files.validate,
-                           read_options=read_options, prior=prior_path, settings=settings)
-    return InstrumentCalibration(result.model, {"": result}, {"": result.validation})
+        return calibrate(files.soaks, files.drifts, files.validate, read_options=read_options,
+                         prior=prior_path, settings=settings)
 
 
 def calibrate_unit(files: UnitFiles, output_dir: str, settings: CalibrationSettings,
@@ -244,17 +233,15 @@ def _write_outcome(output_dir: str, outcome: UnitOutcome) -> None:
 def _evaluate_run(run: str, model: Model, settings: EvaluationSettings,
                   read_options: ReadOptions | None) -> dict[str, Evaluation]:
     """The one call of the evaluation for a run: axis ("" for a single-axis model) -> its
-    evaluation (:func:`hrgtc.pipeline.instrument.evaluate_instrument`, each axis's figures
-    those of :func:`hrgtc.evaluation.evaluate` on its view). Warnings are silenced: the
-    table reports the shares out of the calibrated ranges."""
+    evaluation (:func:`hrgtc.evaluation.evaluate`). Warnings are silenced: the table
+    reports the shares out of the calibrated ranges."""
     import warnings
 
-    from hrgtc.pipeline.instrument import evaluate_instrument
+    from hrgtc.evaluation import evaluate
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return evaluate_instrument(run, model, settings=settings,
-                                   read_options=read_options).axes
+        return evaluate(model, run, settings=settings, read_options=read_options).axes
 
 
 def evaluate_unit(files: UnitFiles, models_dir: str, read_options: ReadOptions | None = None,

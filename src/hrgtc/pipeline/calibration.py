@@ -1,13 +1,15 @@
-"""Calibrate a gyro from its recordings: Sections 3 and 4 of [1] run on files.
+"""Calibrate a gyro or a whole instrument: one chain for one axis or many.
 
-Soak recordings -> plateaus -> the unit's Table 1 -> thermometer (Eq. 18 form)
--> its Table 2; ramp recordings -> stepwise drift model (Eq. 22 form); held-out
-runs -> bias stability raw and compensated. Everything is gathered into one
-:class:`~hrgtc.model.Model` with provenance.
-
-Files are streamed chunk by chunk for the drift fit and the validation, so
-memory stays bounded whatever their length; each soak file is read whole
-(one soak at a time).
+Sections 3 and 4 of [1] run on files, for every axis of the recordings: a multi-axis
+recording holds one resonator per axis (``freq_hz_x``, ``rate_dph_x``, ...), a single-axis
+file is the one-axis case (as pvlib's ``ModelChain`` serves one array or several with one
+result type). Each axis gets its own thermometer and drift model
+(:func:`hrgtc.pipeline.axis_calibration.fit_axis` on its view of the files), then, given
+rate-table runs, its scale-factor error against frequency
+(:func:`hrgtc.drift.scale_factor.fit_scale_factor`); the held-out runs are evaluated every
+axis at once (:func:`hrgtc.evaluation.evaluate`), held-out rate-table runs give the
+scale-factor error before and after. Gyros without a frequency output
+(``read_options.thermometer="sensor"``) run the same chain on their temperature sensor.
 
 [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
 """
@@ -15,156 +17,160 @@ memory stays bounded whatever their length; each soak file is read whole
 from __future__ import annotations
 
 import dataclasses
-import math
 import os
-import warnings
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from hrgtc import drift as drift_model
+from hrgtc.compensate.ranges import RangeReport
 from hrgtc.core import records
-from hrgtc.core.errors import CalibrationError, ExtrapolationWarning, HrgtcWarning, InputError
-from hrgtc.core.progress import StageProgress, for_stage
+from hrgtc.core.errors import InputError
+from hrgtc.core.progress import StageProgress
 from hrgtc.core.summary import Summary
-from hrgtc.drift.fit_stages import TrainingReading
-from hrgtc.drift.rest import run_rest
-from hrgtc.drift.training import (
-    ChannelShape,
-    TrainingStatistics,
-    check_resonator_gyro,
-    check_sensor_swap,
-    check_setpoint_thermometer,
-    implausible_for_any_gyro,
-)
+from hrgtc.drift import ScaleFactorModel, find_rate_segments, fit_scale_factor, read_segment_table
 from hrgtc.evaluation import Evaluation, evaluate
-from hrgtc.evaluation.calibration_figures import calibration_summary, thermometer_tables
+from hrgtc.evaluation.calibration_figures import instrument_summary
+from hrgtc.evaluation.run_evaluation import warn_worse_than_raw
+from hrgtc.evaluation.scale_check import ScaleFactorCheck, check_scale_factor, steady_segments
 from hrgtc.model import AxisModel, Model, provenance
-from hrgtc.pipeline.documents import CalibrationDriftRecord, CalibrationRecord
-from hrgtc.pipeline.terms import resolve_terms
-from hrgtc.recording import ReadOptions
-from hrgtc.recording.mapping import parse_columns, scales_temperature
+from hrgtc.pipeline import documents
+from hrgtc.pipeline.axis_calibration import HOUSING_TERMS, AxisCalibration, fit_axis
+from hrgtc.pipeline.holdout import holdout_split
+from hrgtc.pipeline.terms import parse_aux
+from hrgtc.recording import ReadOptions, Recording, axis_names
 from hrgtc.recording.marks import refuse_compensated_training
-from hrgtc.settings import to_dict
-from hrgtc.settings.calibration import CalibrationSettings
+from hrgtc.recording.read_once import ReadOnce
+from hrgtc.settings.calibration import CROSS_AXIS_GAIN, CalibrationSettings
 from hrgtc.settings.compensation import BIAS_ONLY
-from hrgtc.settings.drift import DriftSettings
+from hrgtc.settings.inputs import CalibrationInputs, TemperatureReferenceSettings
 from hrgtc.settings.reading import ReadSettings
-from hrgtc.thermometry import fit as fit_thermometer
-from hrgtc.thermometry import identity
-from hrgtc.thermometry.plateaus import Plateau, plateau_table, plateaus_from_recordings
-from hrgtc.thermometry.prior import PriorFit, ThermometerPrior, fit_with_prior, load_prior
+from hrgtc.thermometry.prior import ThermometerPrior
+from hrgtc.thermometry.reference import TemperatureMap, TemperatureReference
+
+__all__ = ["HOUSING_TERMS", "AxisCalibration", "Calibration", "RateTables", "calibrate",
+           "fit_axis_scale_factor", "summary_rows"]
 
 PathLike = str | os.PathLike[str]
 
-#: Columns plateau detection needs from a soak.
-SOAK_COLUMNS = ("time_s", "freq_hz", "chamber_c")
-#: Classical baseline: cubic in housing temperature.
-HOUSING_TERMS = ("h", "h^2", "h^3")
-
 
 @dataclass(frozen=True)
-class SoakFit:
-    """The thermometer of a unit and its evidence (:func:`fit_soaks`).
+class RateTables:
+    """The rate-table runs of a calibration (known input rates at several temperatures).
 
     Attributes
     ----------
-    thermometer
-        Frequency -> temperature (Eq. 18 form), or the identity of a gyro without a
-        frequency output (its range that of the training runs).
-    plateaus
-        One per soak, in input order (none for a sensor thermometer).
-    table
-        The unit's Tables 1 and 2 (see :class:`CalibrationResult`).
-    prior_fit
-        The posterior when a population prior was given.
-    order
-        The thermometer polynomial's order (None for a sensor thermometer).
-    sample_rates_hz
-        Each soak file's sample rate (a soak joins the drift fit only at the drift
-        runs' rate).
+    runs
+        Runs to fit each axis's scale factor against frequency on; the input rate as the
+        ``input_rate_dph`` column or ``segment_table``. None given: bias only.
+    validate
+        Held-out rate-table runs: scale-factor error before and after, per axis.
+    segment_table
+        CSV ``start_s,end_s,input_rate_dph`` of the runs' segments, for files without an
+        input-rate column.
     """
 
-    thermometer: Any
-    plateaus: tuple[Plateau, ...] = ()
-    table: tuple[dict[str, float], ...] = ()
-    prior_fit: PriorFit | None = None
-    order: int | None = None
-    sample_rates_hz: tuple[float, ...] = ()
+    runs: Sequence[PathLike] = ()
+    validate: Sequence[PathLike] = ()
+    segment_table: PathLike | None = None
 
 
 @dataclass(frozen=True)
-class CalibrationResult:
-    """What :func:`calibrate` produced: the model and the evidence.
+class Calibration:
+    """What :func:`calibrate` produced: the model and each axis's evidence.
+
+    For a single-axis unit (``axes == {"": ...}``) ``plateaus``, ``table``,
+    ``validation`` and ``prior_fit`` read the only axis's (a multi-axis calibration
+    raises, naming its axes: ``calibration.axes['x'].validation``), as
+    :class:`~hrgtc.model.Model` does for its parts.
 
     Attributes
     ----------
     model
-        Thermometer, drift model, housing baseline, provenance.
-    plateaus
-        One per soak, in input order.
-    table
-        The unit's Tables 1 and 2: chamber_c, freq_hz, temperature_from_freq_c,
-        error_c (= temperature from frequency minus chamber temperature).
-    validation
-        One :class:`~hrgtc.evaluation.Evaluation` per held-out run.
+        The model of every axis, with provenance.
+    axes
+        Axis (``""`` for a single-axis unit) -> :class:`AxisCalibration`: the axis as a
+        one-axis model, its plateaus, Tables 1-2 and held-out runs.
+    scale_checks
+        The held-out rate-table runs' scale-factor error, each axis.
+    cross_axis
+        Axis -> the cross-axis trial (channels, held-out figures with and without, kept).
     """
 
     model: Model
-    plateaus: tuple[Plateau, ...]
-    table: tuple[dict[str, float], ...]
-    validation: tuple[Evaluation, ...] = field(default=())
-    prior_fit: PriorFit | None = None
-    #: The thermometer fit this calibration used (``calibrate(soak_fit=...)`` reuses it).
-    soak_fit: SoakFit | None = field(default=None, compare=False, repr=False)
+    axes: dict[str, AxisCalibration]
+    scale_checks: tuple[ScaleFactorCheck, ...] = ()
+    cross_axis: dict[str, dict[str, Any]] = field(default_factory=dict)
+
+    @property
+    def axis(self) -> AxisCalibration:
+        """The only axis's calibration; a multi-axis calibration raises, naming its axes."""
+        if len(self.axes) != 1:
+            first = next(iter(self.axes))
+            raise InputError(f"the calibration of {self.model.unit!r} has axes "
+                             f"{', '.join(self.axes)}: pick one: calibration.axes[{first!r}]")
+        return next(iter(self.axes.values()))
+
+    @property
+    def plateaus(self) -> tuple[Any, ...]:
+        """The only axis's plateaus (:attr:`AxisCalibration.plateaus`)."""
+        return self.axis.plateaus
+
+    @property
+    def table(self) -> tuple[dict[str, float], ...]:
+        """The only axis's Tables 1 and 2 (:attr:`AxisCalibration.table`)."""
+        return self.axis.table
+
+    @property
+    def validation(self) -> tuple[Evaluation, ...]:
+        """The only axis's held-out runs (:attr:`AxisCalibration.validation`)."""
+        return self.axis.validation
+
+    @property
+    def prior_fit(self) -> Any:
+        """The only axis's posterior under a population prior, if any."""
+        return self.axis.prior_fit
+
+    def summary(self) -> Summary:
+        """The instrument's figures beside its axes' own (held-out rate tables, cross-axis
+        trials, each axis's held-out medians; each axis's own: ``axes[a].summary()``); see
+        :func:`hrgtc.evaluation.calibration_figures.instrument_summary`."""
+        return instrument_summary(self)
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON types (:class:`CalibrationRecord`, the layout of ``hrgtc calibrate
-        --json``; what is not finite as null)."""
-        return records.dump(self, CalibrationRecord, **self.document_parts())
+        """The document of ``hrgtc calibrate --json``: a single-axis unit without a scale
+        factor as :meth:`AxisCalibration.to_dict` with its held-out runs
+        (:class:`~hrgtc.pipeline.documents.CalibrationDocumentRecord`), else one entry per
+        axis (``"-"`` for a single axis) with the held-out runs of a single axis
+        (:class:`~hrgtc.pipeline.documents.InstrumentCalibrationRecord`); the temperature
+        map (``--temp-ref``) when the model has one. Its JSON Schema:
+        :func:`hrgtc.pipeline.documents.calibrate_json_schema`."""
+        single = self.model.is_single_axis
+        validation = [v.to_dict() for v in self.axes[""].validation] if single else None
+        if single and not self.scale_checks and self.model.axes[""].scale_factor is None:
+            return records.dump(self.axes[""], documents.CalibrationDocumentRecord,
+                                **{**self.axes[""].document_parts(), "validation": validation},
+                                temperature_map=self.model.temperature_map)
+        axes = {}
+        for axis, result in self.axes.items():
+            sf = self.model.axes[axis].scale_factor
+            axes[axis or "-"] = {**result.document_parts(),
+                                 "scale_factor": None if sf is None else sf.to_dict()}
+        return records.dump(self, documents.InstrumentCalibrationRecord, unit=self.model.unit,
+                            axes=axes, scale_factor_checks=[c.to_dict()
+                                                            for c in self.scale_checks],
+                            validation=validation, temperature_map=self.model.temperature_map)
 
-    def document_parts(self) -> dict[str, Any]:
-        """The parts of :class:`CalibrationRecord` that are not attributes of the result
-        (the thermometer, drift-model and housing sections, the held-out runs, the prior)."""
-        thermometer, d, housing = self.model.thermometer, self.model.drift, self.model.housing
-        return {
-            "thermometer": {
-                "coefficients_high_first": thermometer.coefficients_high_first,
-                "standard_errors_high_first": list(reversed(thermometer.standard_errors)),
-                "table": self.table},
-            "drift": records.dump(
-                d, CalibrationDriftRecord, selected_terms=d.selected,
-                history=[s.to_dict() for s in d.history],
-                cross_validation=None if d.cross_validation is None
-                else d.cross_validation.to_dict(),
-                accounting=None if d.accounting is None else d.accounting.to_dict()),
-            "housing": None if housing is None else {"selected_terms": housing.selected,
-                                                     "coefficients": housing.coefficients},
-            "validation": [v.to_dict() for v in self.validation],
-            "prior": None if self.prior_fit is None else self.prior_fit.to_dict(),
-        }
-
-    def summary(self, warnings: bool = True,
-                temperature_map: Mapping[str, Any] | None = None) -> Summary:
-        """The calibration's figures, each a value, a unit and an interval (±1σ of a
-        coefficient, the confidence interval of a bias stability, the span of the data).
-
-        Render it with ``.text()``, ``.rows()`` (a table) or ``.html()``; ``.to_dict()`` is
-        plain JSON. ``warnings``: the held-out runs' range warnings among its notes (see
-        :func:`hrgtc.evaluation.calibration_figures.calibration_summary`);
-        ``temperature_map``: the instrument's map of a sensor's raw count, if any.
-        """
-        return calibration_summary(self.model, self.table, self.validation, self.prior_fit,
-                                   warnings, temperature_map)
-
-    def tables(self) -> Summary:
-        """The unit's Table 1, Table 2, plateaus and Eq. 18 beside the paper's as table
-        cells (:func:`hrgtc.evaluation.calibration_figures.thermometer_tables`), what
-        ``hrgtc calibrate`` prints and the report shows; Table 2's figures are the places
-        ``thermometer.table[k]`` of :meth:`to_dict`."""
-        return thermometer_tables(self.model.thermometer, self.plateaus)
+    def range_reports(self) -> dict[str, dict[str, RangeReport]]:
+        """Held-out file -> axis -> its range report, where any axis went beyond the
+        trained temperature or df/dt (``--strict`` fails then)."""
+        out: dict[str, dict[str, RangeReport]] = {}
+        for axis, result in self.axes.items():
+            for run in result.validation:
+                if run.ranges is not None and run.range_warnings():
+                    out.setdefault(run.file, {})[axis] = run.ranges
+        return out
 
 
 def calibrate(
@@ -173,371 +179,301 @@ def calibrate(
     validate: Sequence[PathLike] = (),
     *,
     settings: CalibrationSettings | None = None,
-    aux: Mapping[str, str] | None = None,
-    housing_terms: Iterable[str] | None = HOUSING_TERMS,
+    inputs: CalibrationInputs | None = None,
+    rate_tables: RateTables | None = None,
+    prior: ThermometerPrior | PathLike | None = None,
     read_options: ReadOptions | None = None,
     progress: StageProgress | None = None,
-    prior: ThermometerPrior | PathLike | None = None,
-    thermometer: str = ReadSettings.thermometer,
-    soak_fit: SoakFit | None = None,
-    marks_checked: bool = False,
-) -> CalibrationResult:
-    """Calibrate a unit: thermometer from soaks, drift model from ramps, held-out validation.
+) -> Calibration:
+    """Calibrate a gyro or every axis of an instrument (a single-axis file: the one axis).
 
     Parameters
     ----------
     soaks
-        Soak recordings (one per set-point, or files holding several).
+        Soak recordings (one per set-point, or files holding several); a multi-axis file
+        holds every axis's columns.
     drifts
-        Ramp recordings to fit the drift model on (cool-down, warm-up, cycles); with
-        two training runs or more (the soaks count) the fit reports each run's
+        Ramp recordings to fit each axis's drift model on (cool-down, warm-up, cycles);
+        with two training runs or more (the soaks count) the fit reports each run's
         leave-one-run-out cross-validated bias stability, heating and cooling apart.
     validate
-        Held-out runs: bias stability raw and compensated is reported for each.
+        Held-out runs: bias stability raw and compensated, each axis.
     settings
-        The thermometer's order, the drift fit (candidate terms, window, stepwise
-        thresholds, df/dt filters, term selection, offsets) and whether the soaks join
-        the drift fit (:class:`~hrgtc.settings.calibration.CalibrationSettings`; its
-        defaults when None). The candidate terms default to :data:`GRADIENT_TERMS` when
-        every training run logs ``housing_c``, else the nine of Eq. (21). Soaks join the
-        drift fit by default: a single cool-down covers one curve in the (temperature,
-        rate) plane, along which the polynomial in f and the df/dt terms are confounded;
-        the soaks' warming and cooling transients add curves of both signs of df/dt.
-    aux
-        Extra logged channels, name -> column (``--aux NAME=COLUMN``): each becomes the
-        variable ``a_NAME`` (the column minus its training mean) and the term
-        ``a_NAME`` is added to the candidates unless ``terms`` already use it;
-        compensation reads the same column.
-    housing_terms
-        Terms of the classical housing-thermistor baseline, fitted when every
-        drift run has ``housing_c``; None to skip.
-    read_options
-        Column mapping, units and metadata overrides for every file.
-    progress
-        Optional ``callback(stage, done, total)``.
+        The thermometer's order, the drift fit, whether the soaks join it
+        (:func:`hrgtc.pipeline.axis_calibration.fit_axis`), ``scale_terms`` (candidate
+        terms of the scale-factor model, in f as the drift model's) and ``cross_axis``:
+        also try the other resonators' frequencies as candidate terms of each axis's drift
+        model (a temperature difference across the unit is a gradient one resonator alone
+        cannot see); kept per axis only where the held-out ``validate`` runs' 10 s bias
+        stability improves by more than :data:`CROSS_AXIS_GAIN` (the decision is in
+        :attr:`Calibration.cross_axis`). Its defaults when None.
+    inputs
+        What the calibration takes beside its recordings and its tuning
+        (:class:`~hrgtc.settings.inputs.CalibrationInputs`, as ``hrgtc calibrate``'s
+        options give them): extra logged channels as drift variables (``aux``,
+        ``NAME=COLUMN``), a reference log of the temperature to fit the raw count's map
+        from on the whole first drift run, stored in the model and applied to every file
+        (``reference``), and the held-out end of the one drift file (``holdout``,
+        :func:`~hrgtc.pipeline.holdout.holdout_split`).
+    rate_tables
+        Rate-table runs for each axis's scale factor and held-out ones to check it
+        (:class:`RateTables`); None: bias only.
     prior
-        A population prior (:class:`~hrgtc.thermometry.prior.ThermometerPrior` or
-        its file, ``hrgtc fleet prior``): the thermometer is then the posterior of
-        the prior and the soaks (two or three suffice), valid over the prior's
-        range, and ``order`` is the prior's. A prior of units of another kind is
-        refused.
-    thermometer
-        ``"resonator"`` ([1]: the thermometer from the soaks' plateaus) or
-        ``"sensor"``: a gyro without a frequency output, whose temperature sensor
-        (``temperature_c``, read in the place of ``freq_hz``) is the thermometer
-        (:func:`hrgtc.thermometry.identity`); soaks are then optional training runs.
-    soak_fit
-        The thermometer already fitted on these soaks (and drift runs) with these
-        settings (:attr:`CalibrationResult.soak_fit` of an earlier calibration, or
-        :func:`fit_soaks`): its plateaus, Tables 1-2 and thermometer are reused and only
-        the drift model is fitted (``--cross-axis`` refits the drift model with more
-        candidate terms on the same files).
-    marks_checked
-        The caller refused compensated outputs among these files already (once per
-        command: :func:`~hrgtc.pipeline.instrument.calibrate_instrument`, for every axis).
+        A population prior (:class:`~hrgtc.thermometry.prior.ThermometerPrior` or its
+        file, ``hrgtc fleet prior``): each thermometer is the posterior of the prior and
+        the soaks (two or three suffice).
+    read_options
+        Column mapping, units, metadata overrides for every file; its ``thermometer``:
+        ``"resonator"`` (the resonator's frequency, [1]) or ``"sensor"`` (a gyro without a
+        frequency output: its temperature sensor, ``temperature_c``, is the thermometer;
+        no soaks needed); its ``axis``: calibrate that axis of multi-axis files alone, as
+        a single-axis model (None: every axis of the files).
+    progress
+        Optional ``callback(stage, done, total)``; stages are prefixed with the axis.
     """
-    options = read_options or ReadOptions()
     settings = settings or CalibrationSettings()
+    inputs = inputs or CalibrationInputs()
+    tables = rate_tables or RateTables()
+    aux = parse_aux(inputs.aux)
+    reading = _reading(soaks, drifts, validate, inputs, tables, read_options or ReadOptions(),
+                       progress)
+    fitted, models, crossed = _fit_axes(soaks, drifts, reading, settings, aux, prior, tables,
+                                        progress)
+    temperature_map = reading.temperature_map
+    instrument = Model(models, next(iter(fitted.values())).model.unit,
+                       _provenance(soaks, drifts, tables, fitted, settings, inputs, reading),
+                       None if temperature_map is None else temperature_map.to_dict())
+    # each held-out run read once for every axis
+    # (a model worse than raw on its own held-out part is said)
+    runs = [warn_worse_than_raw(evaluate(instrument, path, settings=BIAS_ONLY,
+                                         read_options=reading.held_out)).axes
+            for path in reading.validate]
+    checks = tuple(check for path in tables.validate for check in check_scale_factor(
+        path, instrument, reading.options, reading.segments))
+    return Calibration(instrument, {axis: dataclasses.replace(
+        fitted[axis], model=instrument.of_axis(axis),
+        validation=tuple(run[axis] for run in runs)) for axis in reading.axes}, checks, crossed)
+
+
+@dataclass(frozen=True)
+class _Reading:
+    """How :func:`calibrate` reads its files, after the temperature map and the hold-out
+    split: the training files' options (every axis from one reading: a
+    :class:`~hrgtc.recording.read_once.ReadOnce`), the held-out runs' and which they are,
+    the axes, the map and its reference log, the rate tables' segments."""
+
+    options: ReadOptions
+    held_out: ReadOptions
+    validate: Sequence[PathLike]
+    axes: tuple[str, ...]
+    temperature_map: TemperatureMap | None
+    reference: TemperatureReference | None
+    segments: Any
+
+
+def _reading(soaks: Sequence[PathLike], drifts: Sequence[PathLike],
+             validate: Sequence[PathLike], inputs: CalibrationInputs, tables: RateTables,
+             options: ReadOptions, progress: StageProgress | None) -> _Reading:
+    """The reading of :func:`calibrate`'s files (the parameters are its own), every file
+    refused when it is a compensated output."""
+    if options.thermometer not in ("resonator", "sensor"):
+        raise InputError("thermometer must be 'resonator' or 'sensor', got "
+                         f"{options.thermometer!r}")
+    reference = temperature_reference(inputs.reference)
+    temperature_map = None
+    if reference is not None and drifts:  # all of the first run, before a split
+        temperature_map = reference.fit(drifts[0], options)
+        options = _through_map(options, temperature_map)
+    validate_options = None
+    holdout = inputs.holdout
+    if holdout.holdout_s is not None or holdout.holdout_fraction is not None:
+        options, validate_options, validate = holdout_split(
+            options, soaks, drifts, validate, holdout.holdout_s, holdout.holdout_fraction)
+        if progress is not None:
+            progress(f"held out {drifts[0]} from {options.end} s on", 1.0, 1.0)
     if not drifts:
         raise InputError("no drift recordings given; pass --drift FILE (a cool-down or warm-up)")
-    if not marks_checked:
-        refuse_compensated_training([*soaks, *drifts, *validate])
-    if thermometer == "sensor":
-        return _calibrate_sensor(soaks, drifts, validate, options, progress, settings, aux,
-                                 housing_terms, soak_fit)
-    if thermometer != "resonator":
-        raise InputError(f"thermometer must be 'resonator' or 'sensor', got {thermometer!r}")
-    # the drifts' heads first: a file's own reading problem (time in ms, a wrong unit) is
-    # named before what is missing beside it
-    heads = {str(path): options.head(path) for path in drifts}
-    if not soaks:
-        raise InputError("no soak recordings given; pass --soak FILE for each soak "
-                         "(a gyro without a frequency output: --thermometer sensor)")
-    for path in drifts:  # an HRG: a noise or bias only a MEMS gyro has is a unit mistake
-        head = heads[str(path)]
-        check_resonator_gyro(head.rate_dph, head.metadata.sample_rate_hz,
-                             head.metadata.input_rate_dph or 0.0, str(path))
-    fitted = soak_fit or fit_soaks(soaks, settings=settings, prior=prior,
-                                   read_options=options, progress=progress)
-    thermometer_fit, plateaus, table = fitted.thermometer, fitted.plateaus, fitted.table
-    prior_fit, soak_rates = fitted.prior_fit, fitted.sample_rates_hz
-
-    heads.update({str(path): options.head(path) for path in soaks if str(path) not in heads})
-    drift_rate = heads[str(drifts[0])].metadata.sample_rate_hz
-    extra = [p for p, r in zip(soaks, soak_rates, strict=True) if math.isclose(r, drift_rate)]
-    if settings.drift_from_soaks and len(extra) < len(soaks):
-        warnings.warn(
-            f"{len(soaks) - len(extra)} soak file(s) are not at the drift runs' "
-            f"{drift_rate:g} Hz and are left out of the drift fit (its windows and settling "
-            "time are counted in samples at one rate); they still calibrate the thermometer",
-            HrgtcWarning, stacklevel=2)
-    training = [*drifts, *(extra if settings.drift_from_soaks else ())]
-    training_heads = [heads[str(p)] for p in training]
-    settings = _with_terms(settings, resolve_terms(settings.drift.terms, aux, training_heads))
-    model, housing = _fit_drift(training, heads, thermometer_fit, options, progress,
-                                len(drifts), settings.drift, aux, housing_terms)
-    unit = heads[str(drifts[0])].metadata.unit
-    record = _record(settings, aux, housing_terms, options, order=fitted.order)
-    if prior_fit is not None:
-        record["prior"] = {"units": prior_fit.prior.n_units,
-                             "range_c": list(prior_fit.prior.temperature_range_c),
-                             "max_temperature_std_c": prior_fit.max_temperature_std_c}
-    unit_model = Model.single(
-        AxisModel(thermometer=thermometer_fit, drift=model, housing=housing,
-                  training=TrainingStatistics.from_runs(training_heads),
-                  plateaus=tuple(p.to_dict() for p in plateaus)),
-        unit=unit,
-        provenance=provenance(
-            {"soak": [str(p) for p in soaks], "drift": [str(p) for p in drifts],
-             "validate": [str(p) for p in validate]}, record),
-    )
-    validation = tuple(evaluate(path, unit_model, settings=BIAS_ONLY, read_options=options)
-                       for path in validate)
-    return CalibrationResult(unit_model, tuple(plateaus), table, validation, prior_fit,
-                             fitted)
+    refuse_compensated_training([*soaks, *drifts, *validate, *tables.runs, *tables.validate])
+    # every axis of the files, or the one axis the reading names (``read_options.axis``)
+    axes = ("",) if options.axis else _axes_of(drifts[0], options)
+    if len(axes) > 1:  # every axis calibrated from one reading of each file
+        options = ReadOnce(**{f.name: getattr(options, f.name)
+                              for f in dataclasses.fields(ReadOptions)})
+    held_out = options if validate_options is None else _same_cache(validate_options, options)
+    segments = (read_segment_table(tables.segment_table) if tables.segment_table is not None
+                else None)
+    return _Reading(options, held_out, tuple(validate), axes, temperature_map, reference,
+                    segments)
 
 
-def fit_soaks(soaks: Sequence[PathLike], *, settings: CalibrationSettings | None = None,
-              prior: ThermometerPrior | PathLike | None = None,
-              read_options: ReadOptions | None = None,
-              progress: StageProgress | None = None) -> SoakFit:
-    """The thermometer from the soaks: plateaus -> Table 1 -> Eq. 18 form -> Table 2.
-
-    Parameters are those of :func:`calibrate` (``settings.plateaus`` finds the plateaus,
-    ``settings.thermometer.order`` is the polynomial's order unless a prior gives it).
-    """
-    options = read_options or ReadOptions()
-    settings = settings or CalibrationSettings()
-    plateaus: list[Plateau] = []
-    soak_rates: list[float] = []
-    for number, path in enumerate(soaks):
-        soak = options.read(path, keep=SOAK_COLUMNS)
-        soak_rates.append(soak.metadata.sample_rate_hz)
-        plateaus.extend(plateaus_from_recordings([soak], settings.plateaus))
-        if progress is not None:
-            progress("soaks", number + 1, len(soaks))
-    temperatures, frequencies = plateau_table(plateaus)
-    prior_fit = None
-    if prior is None:
-        order = settings.thermometer.order
-        thermometer = fit_thermometer(temperatures, frequencies, order=order)
-    else:
-        if not isinstance(prior, ThermometerPrior):
-            prior = load_prior(prior)
-        prior_fit = fit_with_prior(temperatures, frequencies, prior,
-                                   [p.settled_freq_std_hz for p in plateaus])
-        thermometer, order = prior_fit.thermometer, prior.order
-    if not thermometer.is_monotonic:
-        thermometer.temperature(frequencies)  # raises the explanatory CalibrationError
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", ExtrapolationWarning)
-        from_freq = thermometer.temperature(frequencies)
-    table = tuple(
-        {"chamber_c": float(t), "freq_hz": float(f), "temperature_from_freq_c": float(e),
-         "error_c": float(e - t)}
-        for t, f, e in zip(temperatures, frequencies, from_freq, strict=True)
-    )
-    return SoakFit(thermometer, tuple(plateaus), table, prior_fit, order, tuple(soak_rates))
+def _fit_axes(soaks: Sequence[PathLike], drifts: Sequence[PathLike], reading: _Reading,
+              settings: CalibrationSettings, aux: Mapping[str, str],
+              prior: ThermometerPrior | PathLike | None, tables: RateTables,
+              progress: StageProgress | None) -> tuple[dict[str, AxisCalibration],
+                                                       dict[str, AxisModel],
+                                                       dict[str, dict[str, Any]]]:
+    """Each axis's fit (:func:`~hrgtc.pipeline.axis_calibration.fit_axis` on its view of the
+    files), its cross-axis trial and its scale factor: the axes' calibrations, their parts
+    and the trials."""
+    fitted: dict[str, AxisCalibration] = {}
+    models: dict[str, AxisModel] = {}
+    crossed: dict[str, dict[str, Any]] = {}
+    axes = reading.axes
+    for axis in axes:
+        axis_read = dataclasses.replace(reading.options, axis=axis or reading.options.axis)
+        staged = None if progress is None else _prefixed(progress, axis)
+        fit = {"soaks": soaks, "drifts": drifts, "settings": settings, "prior": prior,
+               "read_options": axis_read, "progress": staged}
+        result = fit_axis(**fit, aux=aux)
+        if settings.cross_axis and len(axes) > 1:
+            result, crossed[axis] = _cross_axis(result, axis, axes, reading.validate, aux, fit)
+        model = result.model.axis
+        if tables.runs:
+            model = dataclasses.replace(model, scale_factor=fit_axis_scale_factor(
+                model, tables.runs, axis_read, reading.segments, settings.scale_terms))
+        fitted[axis], models[axis] = result, model
+    return fitted, models, crossed
 
 
-def _with_terms(settings: CalibrationSettings, terms: Iterable[str]) -> CalibrationSettings:
-    """``settings`` with the drift fit's candidate terms resolved."""
-    drift = dataclasses.replace(settings.drift, terms=tuple(terms))
-    return dataclasses.replace(settings, drift=drift)
+def temperature_reference(settings: TemperatureReferenceSettings) -> TemperatureReference | None:
+    """The reference log of ``--temp-ref`` and how to read it, as the library's type (None
+    when no log is given)."""
+    from hrgtc.thermometry.reference import parse_reference_columns
+
+    if settings.reference_log is None:
+        if settings.described():
+            raise InputError(f"{settings.described()[0]} describes a reference log: give the "
+                             "log with --temp-ref")
+        return None
+    return TemperatureReference(
+        settings.reference_log, parse_reference_columns(list(settings.reference_columns)),
+        unit=settings.reference_unit, start=settings.reference_start, tz=settings.reference_tz,
+        lag_s=settings.reference_lag_s)
 
 
-def _record(settings: CalibrationSettings, aux: Mapping[str, str] | None,
-            housing_terms: Iterable[str] | None, options: ReadOptions,
-            **extra: Any) -> dict[str, Any]:
-    """What a model file's provenance records of the settings: every field of ``settings``
-    (:func:`hrgtc.settings.to_dict`), the channels, the baseline and the reading."""
-    return {**to_dict(settings), **extra, "aux": dict(aux or {}),
-            "housing_terms": None if housing_terms is None else list(housing_terms),
-            "motion": options.motion,
-            "columns": dict(options.columns or {}), "units": dict(options.units or {})}
+def _provenance(soaks: Sequence[PathLike], drifts: Sequence[PathLike], tables: RateTables,
+                fitted: Mapping[str, AxisCalibration], settings: CalibrationSettings,
+                inputs: CalibrationInputs, reading: _Reading) -> dict[str, Any]:
+    """The model's provenance: every input file (hashed once) and the settings of the
+    axes' fits with what the chain adds (axes, scale terms, segment table, hold-out, the
+    reference log)."""
+    reference = reading.reference
+    files = {"soak": [str(p) for p in soaks], "drift": [str(p) for p in drifts],
+             "validate": [str(p) for p in reading.validate],
+             "rate_table": [str(p) for p in tables.runs],
+             "validate_rate_table": [str(p) for p in tables.validate],
+             "temperature_reference": [] if reference is None else [str(reference.path)]}
+    first = next(iter(fitted.values())).model.provenance.get("settings", {})
+    hashed = {f["path"]: f["sha256"] for r in fitted.values()  # the axes' records
+              for f in r.model.provenance.get("inputs", ())}
+    return provenance(files, {
+        **first, "axes": list(reading.axes), "thermometer": reading.options.thermometer,
+        "scale_terms": list(settings.scale_terms),
+        "segment_table": None if tables.segment_table is None else str(tables.segment_table),
+        "holdout_s": inputs.holdout.holdout_s, "holdout_fraction": inputs.holdout.holdout_fraction,
+        **({} if reference is None else {"temperature_reference": reference.to_dict()})},
+        hashed)
 
 
-def _fit(runs: Sequence[Any], thermometer: Any, drift: DriftSettings,
-         aux: Mapping[str, str] | None, options: ReadOptions, progress: Any,
-         excitation_runs: int = 0, rest_cache: dict[Any, Any] | None = None) -> Any:
-    """:func:`hrgtc.drift.fit` with ``drift`` whole on the runs read by ``options``
-    (``rest_cache``: the at-rest passes shared by fits on the same runs)."""
-    reading = TrainingReading(motion=options.motion, gaps=options.gaps, rest_cache=rest_cache)
-    return drift_model.fit(runs, thermometer, drift, reading=reading, aux_columns=aux,
-                           excitation_runs=excitation_runs, progress=progress)
+def _through_map(options: ReadOptions, temperature_map: TemperatureMap) -> ReadOptions:
+    """``options`` reading the raw count through ``temperature_map`` (in the place of the
+    reading's temperature scale and offset)."""
+    from hrgtc.thermometry.reference import options_with_map
+
+    return options_with_map(dataclasses.replace(
+        options, temp_scale=ReadSettings.temp_scale,
+        temp_offset_c=ReadSettings.temp_offset_c), temperature_map)
 
 
-class _CountedRun:
-    """A training run's chunks, counting the rows the spike filters removed in the last
-    pass over it (the fit reads a run several times)."""
+def _axes_of(path: PathLike, options: ReadOptions) -> tuple[str, ...]:
+    """The axes of a recording (``("",)``: single-axis), from its column names."""
+    from hrgtc.compensate.multi_axis import recording_axes
 
-    def __init__(self, options: ReadOptions, path: PathLike) -> None:
-        self.options, self.path, self._dropped = options, path, {}
-
-    def __call__(self) -> Any:
-        self._dropped = {}
-        return self.options.chunks(self.path, dropped=self._dropped)
-
-    @property
-    def spikes(self) -> int:
-        return int(self._dropped.get("spikes", 0))
+    found = recording_axes(path, options)
+    if found is None:  # the file cannot be opened: reading it says why
+        found = tuple(axis_names(options.head(path).names))
+    return found or ("",)
 
 
-def _fit_drift(training: Sequence[PathLike], heads: Mapping[str, Any], thermometer: Any,
-               options: ReadOptions, progress: StageProgress | None, excitation_runs: int,
-               drift: DriftSettings, aux: Mapping[str, str] | None,
-               housing_terms: Iterable[str] | None) -> tuple[Any, Any]:
-    """The drift model on ``training`` and the housing baseline when every run has
-    ``housing_c`` (None otherwise, or when its fit fails: the baseline is optional)."""
-    runs = [_CountedRun(options, path) for path in training]
-    rest_cache: dict[Any, Any] = {}  # one pass of the at-rest detector per run, not per fit
-    model = _fit(runs, thermometer, drift, aux, options, for_stage(progress, "drift"),
-                 excitation_runs, rest_cache)
-    spikes = sum(run.spikes for run in runs)
-    if spikes and model.accounting is not None:  # the accounting starts from the file's rows
-        model.accounting.add_read(spikes)
-        model.accounting.drop("spikes", spikes)
-    housing = None
-    if housing_terms is not None and all("housing_c" in heads[str(p)] for p in training):
-        # the baseline's own terms in h and dh/dt, with the default selection and the
-        # variables' default options (d2's filter)
-        baseline = dataclasses.replace(drift, terms=tuple(housing_terms),
-                                       select=DriftSettings.select,
-                                       **DriftSettings().variable_options())
-        try:
-            housing = _fit(runs, thermometer, baseline, None, options,
-                           for_stage(progress, "housing baseline"), rest_cache=rest_cache)
-        except CalibrationError as exc:  # the baseline is optional: say why it is missing
-            warnings.warn(f"no housing-thermistor baseline: {exc}", HrgtcWarning, stacklevel=2)
-    return model, housing
+def _same_cache(options: ReadOptions, cached: ReadOptions) -> ReadOptions:
+    """``options`` reading through the files already read by ``cached`` (a
+    :class:`ReadOnce`), if it is one."""
+    if not isinstance(cached, ReadOnce) or isinstance(options, ReadOnce):
+        return options
+    return ReadOnce(**{f.name: getattr(options, f.name)
+                       for f in dataclasses.fields(ReadOptions)}, cache=cached.cache)
 
 
-def _sensor_columns(path: PathLike, options: ReadOptions) -> tuple[str, str]:
-    """The file's names of the sensor thermometer and of the rate (of ``options.axis``)."""
-    from hrgtc.recording import open_source
-    from hrgtc.recording.mapping import parse_columns
+def _cross_axis(result: AxisCalibration, axis: str, axes: Sequence[str],
+                validate: Sequence[PathLike], aux: Mapping[str, str],
+                fit: Mapping[str, Any]) -> tuple[AxisCalibration, dict[str, Any]]:
+    """Refit ``axis`` with the other resonators' frequencies as candidates (``a_f<other>``:
+    each a thermometer of its own part of the unit, so their differences are the gradients
+    across it) and keep that model only if it lowers the median held-out 10 s bias
+    stability by more than :data:`CROSS_AXIS_GAIN`. The thermometer (plateaus, Tables 1-2)
+    is ``result``'s: only the drift model is fitted again (``fit``: the arguments of the
+    axis's :func:`~hrgtc.pipeline.axis_calibration.fit_axis`)."""
+    others = {f"f{b}": f"freq_hz_{b}" for b in axes if b != axis}
+    if not validate:
+        return result, {"kept": False, "why": "no held-out run (--validate) to judge by",
+                        "channels": others}
+    # the same thermometer: the drift fit only
+    trial = fit_axis(**fit, aux={**aux, **others}, soak_fit=result.soak_fit)
 
-    axis = options.axis
-    mapping = parse_columns(options.columns)
-    rate = f"rate_dph_{axis}" if axis else "rate_dph"
-    ours = [f"temperature_c_{axis}", "temperature_c"] if axis else ["temperature_c"]
-    try:
-        with open_source(path) as source:
-            names = set(source.names)
-    except (OSError, ValueError):
-        names = set()
-    temperature = next((mapping.get(n, n) for n in ours if n in mapping or n in names),
-                       "temperature_c")
-    return temperature, mapping.get(rate, rate)
+    def held_out(model: Model) -> float:  # the axis's view, as it was fitted on
+        return float(np.median([
+            evaluate(model, path, settings=BIAS_ONLY, read_options=fit["read_options"])
+            .axis.compensated_10s for path in validate]))
+
+    without, with_ = held_out(result.model), held_out(trial.model)
+    kept = with_ < without * (1.0 - CROSS_AXIS_GAIN)
+    record = {"kept": bool(kept), "channels": others, "held_out_10s_dph_without": without,
+              "held_out_10s_dph_with": with_,
+              "selected": [t for t in trial.model.drift.selected if t.startswith("a_")
+                           or "*a_" in t]}
+    return (trial if kept else result), record
 
 
-def _calibrate_sensor(soaks: Sequence[PathLike], drifts: Sequence[PathLike],
-                      validate: Sequence[PathLike], options: ReadOptions,
-                      progress: StageProgress | None, settings: CalibrationSettings,
-                      aux: Mapping[str, str] | None, housing_terms: Iterable[str] | None,
-                      soak_fit: SoakFit | None = None) -> CalibrationResult:
-    """A gyro without a frequency output: its temperature sensor is the thermometer.
-
-    Every run (soaks included) trains the drift model in (T, dT/dt); the identity
-    thermometer's range is that of the training runs' temperatures.
-    """
-    options = dataclasses.replace(options, thermometer="sensor")
-    if (dict(options.units or {}).get("temp") == "count"
-            and not scales_temperature(options.temp_scale, options.temp_offset_c)):
+def fit_axis_scale_factor(model: AxisModel, rate_tables: Sequence[PathLike],
+                          options: ReadOptions, table: Any,
+                          terms: Sequence[str]) -> ScaleFactorModel:
+    """One axis's scale factor from its view of the rate-table runs."""
+    segments = []
+    for path in rate_tables:
+        run: Recording = options.read(path)
+        segments.extend(steady_segments(run, find_rate_segments(run, table), model))
+    if not segments:
         raise InputError(
-            f"{drifts[0] if drifts else soaks[0]}: the temperature is a raw count "
-            "(--temp-unit count) with no map to °C, and a model's thermometer, ranges and "
-            "exports are in °C: give the datasheet's --temp-scale K --temp-offset C, or "
-            "fit the map to a reference log written beside the run with --temp-ref LOG")
-    training = [*drifts, *soaks]
-    fitted = soak_fit or _sensor_thermometer(training, options)
-    thermometer = fitted.thermometer
-    heads = {str(path): options.head(path) for path in training}
-    for path in drifts:  # any gyro: only a density beyond every gyro's can be told
-        head = heads[str(path)]
-        _check_logged_resonator(path, head, options)
-        chamber = head["chamber_c"] if "chamber_c" in head else None
-        check_setpoint_thermometer(head.freq_hz, chamber, str(path),
-                                   *_sensor_columns(path, options)[:1],
-                                   parse_columns(options.columns).get("chamber_c",
-                                                                      "chamber_c"))
-        message = implausible_for_any_gyro(head.rate_dph, head.metadata.sample_rate_hz)
-        if message is not None:
-            warnings.warn(f"{path}: column 'rate_dph': {message}", HrgtcWarning, stacklevel=3)
-    settings = _with_terms(settings, resolve_terms(settings.drift.terms, aux,
-                                                   [heads[str(p)] for p in training]))
-    model, housing = _fit_drift(training, heads, thermometer, options, progress, len(drifts),
-                                settings.drift, aux, housing_terms)
-    unit_model = Model.single(
-        AxisModel(thermometer=thermometer, drift=model, housing=housing,
-                  training=TrainingStatistics.from_runs([heads[str(p)] for p in training])),
-        unit=heads[str(drifts[0])].metadata.unit,
-        provenance=provenance(
-            {"soak": [str(p) for p in soaks], "drift": [str(p) for p in drifts],
-             "validate": [str(p) for p in validate]},
-            _record(settings, aux, housing_terms, options, thermometer="sensor"),
-        ),
-    )
-    validation = tuple(evaluate(path, unit_model, settings=BIAS_ONLY, read_options=options)
-                       for path in validate)
-    return CalibrationResult(unit_model, (), (), validation, None, fitted)
+            f"no rate-table segments found in {', '.join(map(str, rate_tables))}: give the "
+            "input rate as an input_rate_dph column or a --segments table"
+        )
+    return fit_scale_factor(segments, model.drift.settings, terms=tuple(terms))
 
 
-def _check_logged_resonator(path: PathLike, head: Any, options: ReadOptions) -> None:
-    """A file that logs a resonator frequency beside the temperature sensor is an HRG's:
-    its rate must have an HRG's noise and bias (a rate ×3600, ×1000 or ×57.3 has a MEMS
-    gyro's, issue 27), and its frequency and rate columns must not be swapped."""
-    from hrgtc.recording.checks import FREQ_SAMPLE_RANGE_HZ, _check_swapped
-
-    logged = options.logged_frequency(path)
-    if logged is None:
-        return
-    name, freq = logged
-    rate = f"rate_dph_{options.axis}" if options.axis else "rate_dph"
-    rate = dict(_sensor_rate_mapping(options)).get(rate, rate)
-    swapped = _check_swapped(freq, np.asarray(head.rate_dph), name, rate)
-    if swapped is not None:
-        raise InputError(f"{path}: {swapped.message}")
-    finite = freq[np.isfinite(freq)]
-    median = float(np.median(finite)) if finite.size else math.nan
-    if not FREQ_SAMPLE_RANGE_HZ[0] <= median <= FREQ_SAMPLE_RANGE_HZ[1]:
-        return
-    check_resonator_gyro(
-        head.rate_dph, head.metadata.sample_rate_hz, head.metadata.input_rate_dph or 0.0,
-        str(path), rate,
-        hrg=(f"the file logs a resonator frequency (column {name!r}, median {median:.6g} Hz: "
-             "an HRG)", f"if {name!r} is not this gyro's resonator, rename that column"),
-        levels=False)
+def _prefixed(progress: StageProgress, axis: str) -> StageProgress:
+    def report(stage: str, done: float, total: float) -> None:
+        progress(f"axis {axis}: {stage}" if axis else stage, done, total)
+    return report
 
 
-def _sensor_rate_mapping(options: ReadOptions) -> dict[str, str]:
-    return parse_columns(options.columns)
-
-
-def _sensor_thermometer(training: Sequence[PathLike], options: ReadOptions) -> SoakFit:
-    """The identity thermometer over the training runs' temperatures at rest (each run's
-    sensor and rate columns checked for a swap on the way)."""
-    low, high = math.inf, -math.inf
-    why = []
-    for path in training:  # the range of the samples the fit uses: those at rest
-        rest = run_rest(options.chunks(path), options.motion)
-        keep = rest.keep
-        if rest.mask is not None and not keep.any():
-            why.append(f"{path}: {rest.mask.summary()}")
-        row = 0
-        temperature, rate = ChannelShape(), ChannelShape()
-        for chunk in options.chunks(path):
-            used = chunk.freq_hz[keep[row:row + len(chunk)]]
-            row += len(chunk)
-            temperature.partial_fit(chunk.freq_hz)
-            rate.partial_fit(chunk.rate_dph)
-            if used.size:
-                low = min(low, float(np.min(used)))
-                high = max(high, float(np.max(used)))
-        check_sensor_swap(temperature, rate, str(path), *_sensor_columns(path, options))
-    if why and not math.isfinite(low):
-        raise CalibrationError(
-            "no sample of the training runs is at rest, so there is nothing to train on ("
-            + "; ".join(why) + "); if the gyro was still, its rate may be too coarse for the "
-            "motion detector (a few LSB of noise): check --rate-unit, or pass --motion keep")
-    return SoakFit(identity((low, high)))
+def summary_rows(calibration: Calibration) -> list[Mapping[str, Any]]:
+    """One row per axis for the unit's summary: held-out raw/compensated 10 s bias
+    stability (median over the held-out runs) and the scale-factor residual."""
+    rows = []
+    for axis, unit_model in calibration.model.axes.items():
+        runs = calibration.axes[axis].validation
+        raw = [v.raw_10s for v in runs]
+        comp = [v.compensated_10s for v in runs]
+        checks = [c for c in calibration.scale_checks if c.axis == axis]
+        rows.append({
+            "axis": axis or "-",
+            "terms": list(unit_model.drift.selected),
+            "raw_10s_dph": float(np.median(raw)) if raw else None,
+            "compensated_10s_dph": float(np.median(comp)) if comp else None,
+            "scale_terms": None if unit_model.scale_factor is None
+            else list(unit_model.scale_factor.selected),
+            "scale_raw_max_ppm": max((c.raw_max_ppm for c in checks), default=None),
+            "scale_residual_max_ppm": max((c.compensated_max_ppm for c in checks),
+                                          default=None),
+        })
+    return rows

@@ -28,8 +28,7 @@ from hrgtc.evaluation import Evaluation, evaluate
 from hrgtc.evaluation.instrument_figures import stability_table
 from hrgtc.export.export_c import export_c
 from hrgtc.model import save_model
-from hrgtc.pipeline.calibration import CalibrationResult, calibrate
-from hrgtc.pipeline.instrument import InstrumentCalibration, calibrate_instrument
+from hrgtc.pipeline.calibration import Calibration, RateTables, calibrate
 from hrgtc.recording import ReadOptions, RecordingWriter
 from hrgtc.report import build_report
 from hrgtc.settings.compensation import ReportSettings
@@ -46,7 +45,7 @@ class DemoResult:
     """Files written and figures computed by :func:`run_demo`."""
 
     folder: Path
-    calibration: CalibrationResult
+    calibration: Calibration
     training: Evaluation
     validation: Evaluation
     compensated: CompensationSummary
@@ -67,7 +66,7 @@ class DemoResult:
 class InstrumentDemo:
     """The three-axis part of the demo: files and figures."""
 
-    calibration: InstrumentCalibration
+    calibration: Calibration
     model_file: Path
     compensated: CompensationSummary
     report_file: Path
@@ -115,20 +114,21 @@ def run_demo(
     save_model(result.model, model_file, force=force)
     # Each run is compensated once: the pass that evaluates the warm-up also writes its
     # compensated file, and both passes keep the plotting blocks the report draws.
-    training = evaluate(cool.path, result.model, max_points=REPORT_POINTS,
-                        progress=for_stage(progress, "evaluate cool-down"))
+    training = evaluate(result.model, cool.path, max_points=REPORT_POINTS,
+                        progress=for_stage(progress, "evaluate cool-down")).axis
     compensated_path = root / "runs" / "warmup_compensated.parquet"
     head = ReadOptions().head(warm.path, rows=1)
     names = (*head.names, *OUTPUT_COLUMNS)
     with RecordingWriter(compensated_path, compensated_metadata(head.metadata, result.model),
                          names, force=force) as writer:
-        validation = evaluate(warm.path, result.model, max_points=REPORT_POINTS,
+        validation = evaluate(result.model, warm.path, max_points=REPORT_POINTS,
                               on_output=writer.write,
-                              progress=for_stage(progress, "compensate and evaluate warm-up"))
+                              progress=for_stage(progress, "compensate and evaluate warm-up")
+                              ).axis
     compensated = CompensationSummary(
         str(warm.path), str(compensated_path), validation.n_samples,
         validation.out_of_range_fraction, validation.rate_out_of_range_fraction)
-    result = replace(result, validation=(validation,))
+    result = replace(result, axes={"": replace(result.axis, validation=(validation,))})
     report_file = build_report(
         result.model, [training, validation], root / "report.html", soaks=soak_paths,
         force=force, progress=for_stage(progress, "report"),
@@ -174,9 +174,8 @@ def run_instrument_demo(folder: Path, s: DemoSettings, *, force: bool = False,
 
     with warnings.catch_warnings():  # four table temperatures: the cubic is left out, known
         warnings.simplefilter("ignore", HrgtcWarning)
-        calibration = calibrate_instrument(soaks, cool, warm, rate_tables=table,
-                                           validate_rate_tables=heldout,
-                                           progress=calibration_stage)
+        calibration = calibrate(soaks, cool, warm, rate_tables=RateTables(table, heldout),
+                                progress=calibration_stage)
     model_file = save_model(calibration.model, folder / "imu-3.json", force=force)
     compensated = compensate_file(
         warm[0], folder / "runs" / "warmup_compensated.parquet", calibration.model, force=force,

@@ -1,14 +1,13 @@
-"""The records of ``hrgtc calibrate --json`` and of an instrument's ``hrgtc evaluate --json``,
-and their JSON Schemas.
+"""The records of ``hrgtc calibrate --json`` and the JSON Schemas of ``calibrate --json`` and
+``evaluate --json``.
 
-One record per document part (:mod:`hrgtc.core.records`): :class:`CalibrationRecord` (a
-unit's calibration, :meth:`~hrgtc.pipeline.calibration.CalibrationResult.to_dict`),
-:class:`InstrumentCalibrationRecord` (every axis,
-:meth:`~hrgtc.pipeline.instrument.InstrumentCalibration.to_dict`),
-:class:`InstrumentEvaluationRecord` (every axis of ``hrgtc evaluate``) and their parts.
-``hrgtc calibrate --json`` writes one of two documents
-(:meth:`~hrgtc.pipeline.instrument.InstrumentCalibration.document`) and ``hrgtc evaluate
---json`` one of two (a single-axis evaluation or every axis): their schemas
+One record per document part (:mod:`hrgtc.core.records`): :class:`CalibrationRecord` (one
+axis's calibration, :meth:`~hrgtc.pipeline.axis_calibration.AxisCalibration.to_dict`),
+:class:`InstrumentCalibrationRecord` (every axis) and their parts. ``hrgtc calibrate
+--json`` writes one of two documents
+(:meth:`~hrgtc.pipeline.calibration.Calibration.to_dict`) and ``hrgtc evaluate --json`` one
+of two (a single-axis evaluation or every axis,
+:meth:`~hrgtc.evaluation.run_evaluation.RunEvaluation.to_dict`): their schemas
 (:func:`calibrate_json_schema`, :func:`evaluate_json_schema`) are the one of the two
 records each. See docs/architecture.md ("One result contract").
 """
@@ -24,12 +23,13 @@ from hrgtc.core.records import Count, Positive, Record, Statistic
 from hrgtc.drift.cross_validation import CrossValidationRecord
 from hrgtc.drift.scale_factor import ScaleFactorRecord
 from hrgtc.drift.stepwise import StepRecord
-from hrgtc.evaluation.evaluation_result import EvaluationRecord, Fraction
+from hrgtc.evaluation.evaluation_result import EvaluationRecord
+from hrgtc.evaluation.run_evaluation import InstrumentEvaluationRecord
+from hrgtc.evaluation.scale_check import ScaleFactorCheckRecord
 
-__all__ = ["AxisSummaryRecord", "CalibrationDocumentRecord", "CalibrationDriftRecord",
-           "CalibrationRecord", "CalibrationThermometerRecord", "HousingRecord",
-           "InstrumentAxisRecord", "InstrumentCalibrationRecord", "InstrumentEvaluationRecord",
-           "ScaleFactorCheckRecord", "Table1Row", "calibrate_json_schema",
+__all__ = ["CalibrationDocumentRecord", "CalibrationDriftRecord", "CalibrationRecord",
+           "CalibrationThermometerRecord", "HousingRecord", "InstrumentAxisRecord",
+           "InstrumentCalibrationRecord", "Table1Row", "calibrate_json_schema",
            "evaluate_json_schema"]
 
 
@@ -79,8 +79,9 @@ class HousingRecord(Record):
 
 
 class CalibrationRecord(Record):
-    """The record of :class:`CalibrationResult` (its ``to_dict``: ``hrgtc calibrate --json``
-    of a single-axis unit); ``prior`` is :meth:`~hrgtc.thermometry.prior.PriorFit.to_dict`."""
+    """The record of :class:`~hrgtc.pipeline.axis_calibration.AxisCalibration` (its
+    ``to_dict``; ``hrgtc calibrate --json`` of a single-axis unit); ``prior`` is
+    :meth:`~hrgtc.thermometry.prior.PriorFit.to_dict`."""
 
     thermometer: CalibrationThermometerRecord
     drift: CalibrationDriftRecord
@@ -106,26 +107,11 @@ class InstrumentAxisRecord(CalibrationRecord):
     scale_factor: ScaleFactorRecord | None
 
 
-class ScaleFactorCheckRecord(Record):
-    """The record of :class:`~hrgtc.pipeline.instrument.ScaleFactorCheck`: at each
-    temperature of a held-out rate-table run, the scale-factor error raw and compensated,
-    and the largest of each. [Hz, -, ppm]"""
-
-    file: str
-    axis: str
-    freq_hz: list[Positive]
-    holds: list[Count]
-    raw_ppm: list[Statistic]
-    compensated_ppm: list[Statistic]
-    raw_max_ppm: Statistic
-    compensated_max_ppm: Statistic
-
-
 class InstrumentCalibrationRecord(Record):
-    """The record of :class:`~hrgtc.pipeline.instrument.InstrumentCalibration` (its
-    ``to_dict``): the axes (``"-"`` for a single axis), the held-out rate-table checks and
-    the cross-axis trials; in ``hrgtc calibrate --json`` also the held-out runs of a single
-    axis and the temperature map, each only when there is one."""
+    """:class:`~hrgtc.pipeline.calibration.Calibration` of an instrument, or of a unit with
+    a scale factor (its ``to_dict``, ``hrgtc calibrate --json``): the axes (``"-"`` for a
+    single axis), the held-out rate-table checks, the cross-axis trials, the held-out runs
+    of a single axis and the temperature map, each of the last two only when there is one."""
 
     omit_when_default = ("validation", "temperature_map")
 
@@ -138,30 +124,6 @@ class InstrumentCalibrationRecord(Record):
     temperature_map: dict[str, Any] | None = None
 
 
-class AxisSummaryRecord(Record):
-    """One axis of an instrument's evaluation: 10 s bias stability raw and compensated,
-    the improvement, mean and RMS of the compensated output, shares beyond the trained
-    ranges. [°/h]"""
-
-    axis: str
-    raw_10s_dph: Statistic
-    compensated_10s_dph: Statistic
-    improvement_10s: Statistic
-    compensated_mean_dph: Statistic
-    compensated_rms_dph: Statistic
-    out_of_range_fraction: Fraction
-    rate_out_of_range_fraction: Fraction
-
-
-class InstrumentEvaluationRecord(Record):
-    """The record of :class:`~hrgtc.pipeline.instrument.InstrumentEvaluation` of a
-    multi-axis model (its ``to_dict``): the unit, each axis's evaluation and a summary."""
-
-    unit: str
-    axes: dict[str, EvaluationRecord]
-    summary: list[AxisSummaryRecord]
-
-
 def _either(title: str, schema_id: str, choices: list[type[Record]]) -> dict[str, Any]:
     """The JSON Schema of a document that is one of ``choices``."""
     references, definitions = records.schema_components(choices)
@@ -172,8 +134,8 @@ def _either(title: str, schema_id: str, choices: list[type[Record]]) -> dict[str
 @cache
 def calibrate_json_schema() -> dict[str, Any]:
     """JSON Schema (Draft 2020-12) of ``hrgtc calibrate --json``
-    (:meth:`~hrgtc.pipeline.instrument.InstrumentCalibration.document`): a single-axis
-    calibration or an instrument's."""
+    (:meth:`~hrgtc.pipeline.calibration.Calibration.to_dict`): a single-axis calibration or
+    an instrument's."""
     return _either("hrgtc calibrate --json", "https://hrgtc.invalid/schema/calibration.json",
                    [CalibrationDocumentRecord, InstrumentCalibrationRecord])
 
@@ -181,7 +143,7 @@ def calibrate_json_schema() -> dict[str, Any]:
 @cache
 def evaluate_json_schema() -> dict[str, Any]:
     """JSON Schema (Draft 2020-12) of ``hrgtc evaluate --json``
-    (:meth:`~hrgtc.pipeline.instrument.InstrumentEvaluation.to_dict`): a single-axis
+    (:meth:`~hrgtc.evaluation.run_evaluation.RunEvaluation.to_dict`): a single-axis
     evaluation or an instrument's."""
     return _either("hrgtc evaluate --json", "https://hrgtc.invalid/schema/evaluate.json",
                    [EvaluationRecord, InstrumentEvaluationRecord])

@@ -1,7 +1,7 @@
 """Hold out the end of a drift file: train on its first part, validate on the rest.
 
 The split ``hrgtc calibrate --holdout-s/--holdout-fraction`` makes before
-:func:`hrgtc.pipeline.instrument.calibrate_instrument` fits anything: one file, cut by
+:func:`hrgtc.pipeline.calibration.calibrate` fits anything: one file, cut by
 recorded time at a segment start (:func:`hrgtc.core.timeline.holdout_rows`).
 """
 
@@ -34,8 +34,8 @@ def holdout_split(read_options: ReadOptions, soaks: Sequence[PathLike],
     tuple
         The training reading options (``end`` at the cut), the held-out run's
         (``start`` at the cut) and the held-out runs (the drift file), for
-        :func:`~hrgtc.pipeline.instrument.calibrate_instrument`'s ``read_options``,
-        ``validate_options`` and ``validate``.
+        :func:`~hrgtc.pipeline.calibration.calibrate`'s training reading, its held-out
+        runs' reading and its held-out runs.
     """
     from hrgtc.core.timeline import holdout_rows
 

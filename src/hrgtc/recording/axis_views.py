@@ -1,6 +1,6 @@
 """One axis of a multi-axis file, chunk by chunk: its views and the check of its frequency
 against the band a model's axis can reach (:func:`hrgtc.recording.io.iter_chunks` with
-``axis``, and :mod:`hrgtc.evaluation.instrument_pass` for every axis of one reading)."""
+``axis``, and :mod:`hrgtc.evaluation.run_evaluation` for every axis of one reading)."""
 
 from __future__ import annotations
 

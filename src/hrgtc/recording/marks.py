@@ -93,7 +93,8 @@ def refuse_compensated_training(paths: Iterable[str | Path | None]) -> None:
     column may even be ``rate_comp_dph`` under another name), not the gyro's drift;
     the thermometer of its soaks would be the same as the raw run's, so nothing
     later would show it. A file given twice (a soak that is also a drift run) is opened
-    once; call it once per command (``calibrate(..., marks_checked=True)`` after).
+    once; call it once per command (:func:`hrgtc.pipeline.calibration.calibrate` does, for
+    every axis).
     """
     seen = set()
     for path in paths:

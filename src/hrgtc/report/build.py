@@ -49,8 +49,9 @@ def build_report(
         The unit's or instrument's model, or the path of its model file.
     runs
         Recordings to compensate and evaluate (Fig. 6 of [1]), one section each, or
-        evaluations already made with plotting blocks (:func:`hrgtc.evaluation.evaluate`
-        with ``max_points``; single-axis models only), which are not computed again.
+        evaluations already made with plotting blocks (``.axis`` of
+        :func:`hrgtc.evaluation.evaluate` with ``max_points``; single-axis models only),
+        which are not computed again.
     output
         The HTML file; written atomically, never overwritten without ``force``.
     settings

@@ -3,7 +3,7 @@
 :func:`report_inputs` resolves the model (a path, a unit or an instrument), applies its
 temperature map to the reading options, matches its axes to every run file and finds the
 soaks; :func:`evaluate_runs` and :func:`trace_soaks` then read each file once for all the axes
-(:func:`hrgtc.evaluation.instrument_pass.evaluate_axes`,
+(:func:`hrgtc.evaluation.evaluate`,
 :func:`hrgtc.report.figures.trace_soak_axes`), counting the rows read for the progress
 callback (:class:`RowCounter`). A report kind's data function (:mod:`hrgtc.report.kinds`)
 takes the :class:`ReportInputs` and reads what it shows.
@@ -20,7 +20,7 @@ from hrgtc.compensate.multi_axis import match_axes, recording_axes
 from hrgtc.core.errors import InputError
 from hrgtc.core.progress import Progress
 from hrgtc.evaluation import Evaluation
-from hrgtc.evaluation.instrument_pass import evaluate_axes
+from hrgtc.evaluation.run_evaluation import evaluate
 from hrgtc.model import Model, load_model
 from hrgtc.model_fit import check_thermometer_kind
 from hrgtc.recording import ReadOptions, count_rows
@@ -174,7 +174,7 @@ def _check_axes(model: Model, runs: Sequence[PathLike | Evaluation],
 def _evaluate_run(path: PathLike, inputs: ReportInputs,
                   advance: Callable[[int], None]) -> dict[str, Evaluation]:
     """Every axis of a run from one reading
-    (:func:`hrgtc.evaluation.instrument_pass.evaluate_axes`), with plotting blocks."""
+    (:func:`hrgtc.evaluation.evaluate`), with plotting blocks."""
     seen = 0
 
     def progress(done: float, _total: float) -> None:
@@ -182,5 +182,6 @@ def _evaluate_run(path: PathLike, inputs: ReportInputs,
         advance(int(done) - seen)
         seen = int(done)
 
-    return evaluate_axes(path, inputs.instrument, read_options=inputs.read_options,
-                         max_points=inputs.max_points, progress=progress)
+    named = tuple(axis for axis in inputs.instrument.axes if axis)  # those matched already
+    return evaluate(inputs.instrument, path, read_options=inputs.read_options,
+                    axes=named or None, max_points=inputs.max_points, progress=progress).axes

@@ -3,11 +3,10 @@
 An extra logged channel as a drift variable (``--aux``), a reference log of the
 temperature to fit a raw count's map from (``--temp-ref`` and its ``--temp-ref-*``
 options) and the held-out end of the one drift file (``--holdout-*``). The fields hold
-what the user gave, as plain values; ``hrgtc calibrate`` turns them into the library's
-types (:func:`hrgtc.pipeline.terms.parse_aux`,
-:class:`hrgtc.thermometry.reference.TemperatureReference`) and hands them to
-:func:`hrgtc.pipeline.instrument.calibrate_instrument` (``aux=``,
-``temperature_reference=``, ``holdout_s=``, ``holdout_fraction=``).
+what the user gave, as plain values; ``hrgtc calibrate`` hands them whole to
+:func:`hrgtc.pipeline.calibration.calibrate` (``inputs=``), which turns them into the
+library's types (:func:`hrgtc.pipeline.terms.parse_aux`,
+:class:`hrgtc.thermometry.reference.TemperatureReference`).
 """
 
 from __future__ import annotations

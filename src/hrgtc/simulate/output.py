@@ -1,7 +1,8 @@
 """Simulated runs written to files: one file per run, chunk by chunk, atomically.
 
 The recording files follow the recording contract of :mod:`hrgtc.recording`
-(Parquet, CSV or HDF5 by suffix) with the simulator's ground truth columns and
+(Parquet, CSV, HDF5, TDMS, MATLAB v5 or MDF4 by suffix: the formats of the registry with a
+writer) with the simulator's ground truth columns and
 metadata (:func:`hrgtc.simulate.campaign.run_metadata`). Nothing is
 overwritten without ``force``; a campaign checks all its targets first.
 """
@@ -86,7 +87,8 @@ def simulate_to_file(
     profile
         The chamber program.
     path
-        Output file, ``.parquet``, ``.csv`` or ``.h5``; its directory must exist.
+        Output file, ``.parquet``, ``.csv``, ``.h5``, ``.tdms``, ``.mat`` or ``.mf4``; its
+        directory must exist.
     unit, sample_rate_hz, seed, input_rate_dph, chunk_rows, progress
         As for :func:`hrgtc.simulate.campaign.iter_run_chunks`.
     force
@@ -130,7 +132,7 @@ def output_paths(
 ) -> list[Path]:
     """Where :func:`simulate_files` writes each profile.
 
-    ``output`` with a recording suffix (``.parquet``, ``.csv``, ``.h5``) is the
+    ``output`` with a recording suffix (``.parquet``, ``.csv``, ``.h5``, ``.tdms`` ...) is the
     file itself (one profile only); otherwise it is a directory and each file
     is named ``<profile.name><suffix>``, the suffix from ``file_format``
     (default Parquet).
@@ -138,9 +140,10 @@ def output_paths(
     output = Path(output)
     writers = output_suffixes()
     if file_format is not None and file_format not in writers:
-        raise InputError(
-            f"unknown format {file_format!r}; choose one of {', '.join(writers)}"
-        )
+        named = [f.name for f in formats() if file_format in (f.name, f.output_name)]
+        why = f"the {named[0]} format has no writer" if named else "unknown format"
+        raise InputError(f"{why} ({file_format!r}); the formats that write are "
+                         f"{', '.join(writers)}")
     suffix = output.suffix.lower()
     by_suffix = {s: fmt.output_name for fmt in formats() for s in fmt.suffixes}
     if suffix in by_suffix:
@@ -220,7 +223,9 @@ def simulate_files(
     output
         A directory (created if missing), or a file for a single run.
     file_format
-        ``"parquet"``, ``"csv"`` or ``"h5"``; None: from ``output``'s suffix, else Parquet.
+        ``"parquet"``, ``"csv"``, ``"h5"``, ``"tdms"``, ``"mat"`` or ``"mf4"`` (a key of
+        :func:`~hrgtc.recording.formats.registry.output_suffixes`); None: from ``output``'s
+        suffix, else Parquet.
     run
         Unit, sample rate, seed, input rate and chunk rows (:class:`SimulatedRun`);
         None: its defaults.

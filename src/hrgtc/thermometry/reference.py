@@ -482,7 +482,9 @@ def map_from_reference(recording: str | Path, reference: str | Path,
 class TemperatureReference(records.Written):
     """A reference log of the temperature and how to read it (``hrgtc calibrate
     --temp-ref`` and its ``--temp-ref-*`` options): what
-    :func:`hrgtc.pipeline.instrument.calibrate_instrument` fits the count's map from.
+    :func:`hrgtc.pipeline.calibration.calibrate` fits the count's map from (built from
+    :class:`hrgtc.settings.inputs.TemperatureReferenceSettings` by
+    :func:`hrgtc.pipeline.calibration.temperature_reference`).
 
     Attributes
     ----------

@@ -18,6 +18,7 @@ import contextlib
 import importlib
 import io
 import logging
+import re
 import sys
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -35,8 +36,10 @@ DATENUM_UNIX_EPOCH_DAYS = 719529.0
 SECONDS_PER_DAY = 86400.0
 
 
-def require(module: str, extra: str, what: str, path: Path) -> ModuleType:
-    """Import ``module`` for reading ``path``, or RecordingError naming the extra to install.
+def require(module: str, extra: str, what: str, path: Path,
+            action: str = "reading") -> ModuleType:
+    """Import ``module`` for reading (or writing) ``path``, or RecordingError naming the
+    extra to install.
 
     Parameters
     ----------
@@ -48,14 +51,28 @@ def require(module: str, extra: str, what: str, path: Path) -> ModuleType:
         The format's name for the message (``"TDMS"``).
     path
         The file being read (named in the message).
+    action
+        ``"reading"`` or ``"writing"``, for the message.
     """
     try:
         return importlib.import_module(module)
     except ImportError as exc:
         raise RecordingError(
-            f"{path}: reading {what} files needs the Python package {module!r}, which is not "
+            f"{path}: {action} {what} files needs the Python package {module!r}, which is not "
             f"installed ({exc}); install it with pip install 'hrgtc[{extra}]' (or "
             "'hrgtc[formats]' for every file format)") from None
+
+
+#: The name of a temporary file :func:`hrgtc.core.files.temporary_beside` makes for a target:
+#: ``.<target name>.<pid>.<random>.tmp``.
+_TEMPORARY = re.compile(r"\.(?P<name>.+)\.\d+\.\w+\.tmp")
+
+
+def output_path(path: Path) -> Path:
+    """The file a sink writes ``path`` for: the target of hrgtc's temporary file (named in
+    messages, as the user gave it), else ``path`` itself."""
+    found = _TEMPORARY.fullmatch(path.name)
+    return path.with_name(found["name"]) if found else path
 
 
 def unreadable(path: Path, what: str, exc: BaseException, fix: str = "") -> RecordingError:

@@ -27,27 +27,41 @@ MATLAB conventions handled:
   ``sample_rate_hz`` is the sample rate. Text, cells of numbers, sparse and complex
   arrays and MATLAB objects (``datetime``, ``table``) are not columns: save a table with
   ``s = table2struct(T, 'ToScalar', true)`` and datetimes with ``datenum``.
+
+Files written by hrgtc (:class:`MatlabSink`, ``hrgtc simulate --format mat``) are MAT v5
+files of one column vector (N×1 double) per column, named by the column (``load run.mat;
+plot(time_s, rate_dph)``), and a struct ``hrgtc_metadata`` of the recording's metadata
+(``sample_rate_hz``, ``unit``, ``input_rate_dph``, ``profile``, ``schema`` and
+``extra_json``, its extra as JSON text), which the reader takes as the file's metadata.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+import json
+import re
+import shutil
+import struct
+import sys
+import tempfile
+from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import IO, Any
 
 import numpy as np
 
 from hrgtc.core.errors import RecordingError
-from hrgtc.recording.formats.base import Format, Source
+from hrgtc.recording.formats.base import Format, Sink, Source, loads_json, metadata_json
 from hrgtc.recording.formats.logs import (
     Stream,
     check_exists,
     datenum_to_datetime,
     numeric,
+    output_path,
     require,
     streams,
     unreadable,
 )
+from hrgtc.recording.schema import Metadata
 
 #: Names of a names variable of a matrix, after ``<matrix>_names``.
 NAMES_VARIABLES = ("names", "columns", "colnames", "labels", "header", "headers")
@@ -57,6 +71,15 @@ TIME_NAMES = ("time_s", "time", "t", "Time", "timestamp", "Timestamp")
 DATENUM_RANGE = (693962.0, 803535.0)
 #: The text at the start of a v5 or v7.3 MAT-file header.
 HEADER = b"MATLAB "
+#: The struct of the recording's metadata in the files hrgtc writes.
+METADATA_VARIABLE = "hrgtc_metadata"
+#: A MATLAB variable name (``isvarname``: a letter, then letters, digits, underscores;
+#: at most ``namelengthmax`` = 63 characters).
+VARIABLE_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,62}")
+#: MATLAB's limit on the bytes of one variable of a v5 (``-v7``) file: 2^31. [bytes]
+V5_VARIABLE_BYTES = 2**31
+#: MAT v5 data types and the class of a double array (MATLAB's "MAT-File Format", 2024).
+MI_INT8, MI_INT32, MI_UINT32, MI_DOUBLE, MI_MATRIX, MX_DOUBLE_CLASS = 1, 5, 6, 9, 14, 6
 
 
 # -- variables of the file -----------------------------------------------------
@@ -195,10 +218,34 @@ def _timed(path: Path, stream: Stream, origin_ns: int | None) -> None:
         stream.columns["time_s"] = np.asarray(stream.columns.pop(named[0]), dtype=np.float64)
 
 
+def _written_metadata(path: Path, found: dict[str, Any]) -> dict[str, Any] | None:
+    """The metadata hrgtc wrote as the struct ``hrgtc_metadata`` (removed from ``found``)."""
+    struct_ = found.get(METADATA_VARIABLE)
+    if not isinstance(struct_, dict) or "sample_rate_hz" not in struct_:
+        return None
+    del found[METADATA_VARIABLE]
+
+    def text(key: str) -> str:
+        value = struct_.get(key, "")
+        return value if isinstance(value, str) else ""  # an empty char array: ""
+
+    try:
+        extra = loads_json(text("extra_json") or "{}")
+    except ValueError:
+        raise RecordingError(f"{path}: {METADATA_VARIABLE}.extra_json (hrgtc's metadata) is "
+                             "not valid JSON") from None
+    return {"sample_rate_hz": float(struct_["sample_rate_hz"]), "unit": text("unit"),
+            "input_rate_dph": float(struct_.get("input_rate_dph", 0.0)),
+            "profile": text("profile"), "schema": int(struct_.get("schema", 1)),
+            "extra": extra}
+
+
 def read_matlab(path: Path) -> list[Source]:
     """The tables of a .mat file: one stream, or one per table of a file of several."""
     check_exists(path)
-    found, scalars = tables(variables(path))
+    found_variables = variables(path)
+    written = _written_metadata(path, found_variables)
+    found, scalars = tables(found_variables)
     if not found:
         raise RecordingError(
             f"{path}: no column vectors, struct of column vectors or N×k matrix of numbers "
@@ -220,7 +267,93 @@ def read_matlab(path: Path) -> list[Source]:
         for stream in found:
             _timed(path, stream, origin)
         metadata.pop("sample_rate_hz", None)  # of which table?
-    return streams(path, found, "matlab", ".", metadata)
+    return streams(path, found, "matlab", ".", metadata if written is None else written)
+
+
+# -- writing -------------------------------------------------------------------
+def _element(kind: int, data: bytes, order: str) -> bytes:
+    """A MAT v5 data element (tag and data padded to 8 bytes; 'small' when ≤ 4 bytes)."""
+    if len(data) <= 4:
+        return struct.pack(f"{order}HH", kind, len(data)) + data.ljust(4, b"\0")
+    return struct.pack(f"{order}II", kind, len(data)) + data + b"\0" * (-len(data) % 8)
+
+
+def column_header(name: str, rows: int, order: str) -> bytes:
+    """The bytes of a MAT v5 N×1 double variable ``name`` before its ``8 * rows`` bytes of
+    values (array flags, dimensions, name, the tag of the real part)."""
+    body = (_element(MI_UINT32, struct.pack(f"{order}II", MX_DOUBLE_CLASS, 0), order)
+            + _element(MI_INT32, struct.pack(f"{order}ii", rows, 1), order)
+            + _element(MI_INT8, name.encode("ascii"), order)
+            + struct.pack(f"{order}II", MI_DOUBLE, 8 * rows))
+    return struct.pack(f"{order}II", MI_MATRIX, len(body) + 8 * rows) + body
+
+
+class MatlabSink(Sink):
+    """Writes a recording as a MAT v5 file MATLAB loads (``load run.mat``): a column vector
+    per column and the struct ``hrgtc_metadata``.
+
+    A v5 variable's bytes are one block whose length comes first, so each chunk's values go
+    to a temporary file per column beside ``path``; :meth:`close` writes the header and the
+    metadata struct with ``scipy.io.savemat``, then each column's header and its values
+    copied from its temporary file in blocks: memory of one chunk, never of the file.
+    """
+
+    def __init__(self, path: Path, metadata: Metadata, names: Sequence[str]) -> None:
+        super().__init__(path, metadata, names)
+        self._scipy_io = require("scipy.io", "matlab", "MATLAB", output_path(path), "writing")
+        bad = [n for n in names if not VARIABLE_NAME.fullmatch(n) or n == METADATA_VARIABLE]
+        if bad:
+            raise RecordingError(
+                f"{output_path(path)}: column(s) {bad} cannot be MATLAB variable names (a "
+                "letter, then letters, digits or underscores, at most 63 characters; not "
+                f"{METADATA_VARIABLE!r}); rename them or write .parquet or .h5")
+        self._order = "<" if sys.byteorder == "little" else ">"
+        self.set_metadata(metadata)
+        self._rows = 0
+        self._spills: dict[str, IO[bytes]] = {}
+        try:
+            for name in names:
+                self._spills[name] = tempfile.TemporaryFile(dir=path.parent,
+                                                            prefix=f".{path.name}.")
+        except BaseException:
+            self.abort()
+            raise
+
+    def write(self, columns: Mapping[str, np.ndarray]) -> None:
+        rows = len(columns[self.names[0]])
+        if 8 * (self._rows + rows) + 64 > V5_VARIABLE_BYTES:
+            raise RecordingError(
+                f"{output_path(self.path)}: a MATLAB v5 variable holds at most 2^31 bytes "
+                f"({V5_VARIABLE_BYTES // 8 - 8:,} rows of doubles); write .h5 or .parquet")
+        for name, spill in self._spills.items():
+            np.asarray(columns[name], dtype=f"{self._order}f8").tofile(spill)
+        self._rows += rows
+
+    def set_metadata(self, metadata: Metadata) -> None:
+        metadata_json(metadata)  # refuses an extra that is not JSON
+        data = metadata.to_dict()
+        self._struct = {"sample_rate_hz": float(data["sample_rate_hz"]), "unit": data["unit"],
+                        "input_rate_dph": float(data["input_rate_dph"]),
+                        "profile": data["profile"], "schema": float(data["schema"]),
+                        "extra_json": json.dumps(data["extra"], allow_nan=False)}
+
+    def close(self) -> None:
+        try:
+            with open(self.path, "wb") as out:
+                self._scipy_io.savemat(out, {METADATA_VARIABLE: self._struct}, format="5",
+                                       oned_as="column")
+                for name, spill in self._spills.items():
+                    out.write(column_header(name, self._rows, self._order))
+                    spill.seek(0)
+                    shutil.copyfileobj(spill, out, 1 << 20)
+        finally:
+            self.abort()
+
+    def abort(self) -> None:
+        for spill in self._spills.values():
+            spill.close()
+        self._spills = {}
+
 
 
 def sniff(head: bytes) -> bool:
@@ -228,6 +361,6 @@ def sniff(head: bytes) -> bool:
     return head.startswith(HEADER) and b"MAT-file" in head[:116]
 
 
-FORMAT = Format("matlab", (".mat",), read_matlab, sniff,
+FORMAT = Format("matlab", (".mat",), read_matlab, sniff, MatlabSink, output_name="mat",
                 description="MATLAB .mat v4/v5/v7 (scipy) and v7.3 (h5py), a stream per table",
                 within="hdf5")

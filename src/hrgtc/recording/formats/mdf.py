@@ -11,26 +11,49 @@ and put on one time axis by :mod:`hrgtc.recording.align`. Values are physical (a
 applies the channels' conversions); a channel converted to text, an array channel and a
 group whose master is not a time (an angle, a distance) are listed but not numbers.
 Large groups are read in batches of records, never whole.
+
+Files written by hrgtc (:class:`MdfSink`, ``hrgtc simulate --format mf4``) are MDF 4.10
+with one channel group ``recording``: ``time_s`` its master channel (``time``, s), the
+other columns float64 channels with their units; the header's comment holds the profile
+as its text and the recording's metadata as JSON in the property ``hrgtc`` of its
+``common_properties``, which the reader takes as the file's metadata.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Sequence
+import xml.etree.ElementTree as ElementTree
+from collections.abc import Iterator, Mapping, Sequence
 from datetime import UTC
 from pathlib import Path
 from typing import Any
+from xml.sax.saxutils import escape
 
 import numpy as np
 import pyarrow as pa
 
 from hrgtc.core.errors import RecordingError
-from hrgtc.recording.formats.base import Format, Source
-from hrgtc.recording.formats.logs import check_exists, quiet, require, unreadable
+from hrgtc.recording.axes import axis_names
+from hrgtc.recording.formats.base import (
+    Format,
+    Sink,
+    Source,
+    column_unit,
+    loads_json,
+    metadata_json,
+)
+from hrgtc.recording.formats.logs import check_exists, output_path, quiet, require, unreadable
+from hrgtc.recording.schema import Metadata
 
 #: The identification block of MDF 3 and 4 ("MDF     "; "UnFinMF " for an unfinished one).
 MAGICS = (b"MDF     ", b"UnFinMF ")
 #: ``sync_type`` of a master channel that is a time.
 SYNC_TIME = 1
+#: The property of the header's comment that holds hrgtc's metadata (JSON).
+METADATA_PROPERTY = "hrgtc"
+#: The channel group of the files hrgtc writes.
+GROUP = "recording"
+#: The MDF version written.
+VERSION = "4.10"
 
 
 class MdfGroupSource(Source):
@@ -38,7 +61,8 @@ class MdfGroupSource(Source):
 
     format = "mdf"
 
-    def __init__(self, path: Path, mdf: Any, index: int, prefix: str, owner: bool) -> None:
+    def __init__(self, path: Path, mdf: Any, index: int, prefix: str, owner: bool,
+                 written: Mapping[str, Any] | None = None) -> None:
         super().__init__(path)
         self._mdf, self._index, self._owner = mdf, index, owner
         group = mdf.groups[index]
@@ -65,7 +89,7 @@ class MdfGroupSource(Source):
         if start is not None and self._timed:
             extra["time_origin"] = np.datetime_as_string(
                 np.datetime64(start.astimezone(UTC).replace(tzinfo=None), "us"))
-        self.metadata: dict[str, Any] = {"extra": extra}
+        self.metadata: dict[str, Any] = {"extra": extra} if written is None else dict(written)
         self._kinds: dict[str, str] | None = None
         self._done = 0
 
@@ -190,11 +214,102 @@ def read_mdf(path: Path) -> list[Source]:
             raise RecordingError(f"{path}: the MDF file holds no channel group with records; "
                                  "nothing to read")
         names = [str(mdf.groups[i].channel_group.acq_name or "") for i in kept]
-        return [MdfGroupSource(path, mdf, i, prefix, owner=k == 0)
+        written = _written_metadata(path, getattr(mdf.header, "comment", ""))
+        return [MdfGroupSource(path, mdf, i, prefix, owner=k == 0, written=written)
                 for k, (i, prefix) in enumerate(zip(kept, group_prefixes(names), strict=True))]
     except BaseException:
         mdf.close()
         raise
+
+
+def _written_metadata(path: Path, comment: str) -> dict[str, Any] | None:
+    """The metadata hrgtc wrote in the header's comment; None in other files."""
+    if not comment or METADATA_PROPERTY not in comment:
+        return None
+    try:
+        found = ElementTree.fromstring(comment).find(
+            f"common_properties/e[@name='{METADATA_PROPERTY}']")
+    except ElementTree.ParseError:
+        return None  # a comment of plain text that mentions hrgtc
+    if found is None:
+        return None
+    try:
+        written = loads_json(found.text or "")
+    except ValueError:
+        raise RecordingError(f"{path}: the header comment's property {METADATA_PROPERTY!r} "
+                             "(hrgtc's metadata) is not valid JSON") from None
+    if not isinstance(written, dict):
+        raise RecordingError(f"{path}: the header comment's property {METADATA_PROPERTY!r} "
+                             "(hrgtc's metadata) is not a JSON object")
+    return written
+
+
+def header_comment(metadata: Metadata) -> str:
+    """The MDF4 header comment (``HDcomment`` XML) of a recording: its profile as the text,
+    its metadata as JSON in the property ``hrgtc``."""
+    return (f"<HDcomment><TX>{escape(metadata.profile or 'hrgtc recording')}</TX>"
+            f"<common_properties><e name=\"{METADATA_PROPERTY}\" type=\"string\">"
+            f"{escape(metadata_json(metadata))}</e></common_properties></HDcomment>")
+
+
+class MdfSink(Sink):
+    """Writes a recording as an MDF 4.10 file (asammdf): one channel group, its master the
+    ``time_s`` column (``i / sample rate`` without one), the other columns float64 channels.
+
+    asammdf appends each chunk's records to the group (``MDF.extend``) in a temporary file
+    of its own, and :meth:`close` saves the measurement: the rows are never in memory
+    together.
+    """
+
+    def __init__(self, path: Path, metadata: Metadata, names: Sequence[str]) -> None:
+        super().__init__(path, metadata, names)
+        self._asammdf = require("asammdf", "mdf", "MDF", output_path(path), "writing")
+        self._rate_hz = float(metadata.sample_rate_hz)
+        axes = axis_names(names)
+        self._channels = [n for n in names if n != "time_s"]
+        self._units = {n: column_unit(n, axes) or "" for n in self._channels}
+        self._mdf = self._asammdf.MDF(version=VERSION)
+        self._index: int | None = None
+        self._rows = 0
+        self.set_metadata(metadata)
+
+    def write(self, columns: Mapping[str, np.ndarray]) -> None:
+        rows = len(columns[self.names[0]])
+        time = (np.asarray(columns["time_s"], dtype=np.float64) if "time_s" in columns else
+                np.arange(self._rows, self._rows + rows, dtype=np.float64) / self._rate_hz)
+        with quiet(("asammdf",)):
+            if self._index is None:
+                signals = [self._asammdf.Signal(np.asarray(columns[n], dtype=np.float64), time,
+                                                name=n, unit=self._units[n])
+                           for n in self._channels]
+                self._index = self._mdf.append(signals, acq_name=GROUP,
+                                               comment="hrgtc recording")
+            else:
+                self._mdf.extend(self._index, [(time, None)] + [
+                    (np.asarray(columns[n], dtype=np.float64), None) for n in self._channels])
+        self._rows += rows
+
+    def set_metadata(self, metadata: Metadata) -> None:
+        self._mdf.header.comment = header_comment(metadata)
+        origin = metadata.extra.get("time_origin")
+        if isinstance(origin, str):
+            try:
+                start = np.datetime64(origin, "us").astype(object)
+            except ValueError:
+                return
+            self._mdf.header.start_time = start.replace(tzinfo=UTC)
+
+    def close(self) -> None:
+        if self._index is None:
+            self.write({n: np.zeros(0) for n in self.names})
+        try:
+            with open(self.path, "wb") as handle, quiet(("asammdf",)):
+                self._mdf.save(handle, overwrite=True)
+        finally:
+            self._mdf.close()
+
+    def abort(self) -> None:
+        self._mdf.close()
 
 
 def sniff(head: bytes) -> bool:
@@ -202,5 +317,5 @@ def sniff(head: bytes) -> bool:
     return head.startswith(MAGICS)
 
 
-FORMAT = Format("mdf", (".mf4", ".mdf"), read_mdf, sniff,
+FORMAT = Format("mdf", (".mf4", ".mdf"), read_mdf, sniff, MdfSink, output_name="mf4",
                 description="ASAM MDF 3/4, a stream per channel group (asammdf)")

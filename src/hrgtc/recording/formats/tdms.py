@@ -18,13 +18,21 @@ group). Conventions handled:
 * **DAQmx raw data and NI scaling**: channels stored as raw counts with ``NI_Scale``
   properties are read scaled (npTDMS applies the scales), so values are in the
   channel's ``unit_string`` (kept in ``extra["tdms_units"]``);
+* a file of one group holding a channel named ``time_s`` is read on that channel (the
+  times as logged), its waveform timing giving the sample rate;
 * large files are read in batches (``TdmsFile.open``), never whole.
+
+Files written by hrgtc (:class:`TdmsSink`, ``hrgtc simulate --format tdms``) hold one
+group ``recording`` of float64 channels, each with LabVIEW's waveform properties
+(``wf_start_time``, ``wf_start_offset``, ``wf_increment``, ``wf_samples``) and its unit
+(``unit_string``), and the recording's metadata as JSON in the file property ``hrgtc``
+(as Parquet's), which the reader takes as the file's metadata.
 """
 
 from __future__ import annotations
 
 import sys
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -32,13 +40,26 @@ import numpy as np
 import pyarrow as pa
 
 from hrgtc.core.errors import RecordingError
-from hrgtc.recording.formats.base import Format, Source
-from hrgtc.recording.formats.logs import check_exists, quiet, require, unreadable
+from hrgtc.recording.axes import axis_names
+from hrgtc.recording.formats.base import (
+    Format,
+    Sink,
+    Source,
+    column_unit,
+    loads_json,
+    metadata_json,
+)
+from hrgtc.recording.formats.logs import check_exists, output_path, quiet, require, unreadable
+from hrgtc.recording.schema import Metadata
 
 #: The lead-in tag of a TDMS segment ("TDSm"; "TDSh" in the .tdms_index file).
 TAG = b"TDSm"
 #: LabVIEW's zero time: a ``wf_start_time`` there is a relative time axis.
 LABVIEW_EPOCH = np.datetime64("1904-01-01T00:00:00", "us")
+#: The file property of hrgtc's metadata (JSON) in the files it writes.
+METADATA_PROPERTY = "hrgtc"
+#: The group of the files hrgtc writes.
+GROUP = "recording"
 
 
 def _timing(channel: Any) -> tuple[float, float, np.datetime64 | None] | None:
@@ -74,7 +95,8 @@ class TdmsGroupSource(Source):
     format = "tdms"
 
     def __init__(self, path: Path, handle: Any, group: Any, prefix: str,
-                 origin: np.datetime64 | None, owner: bool) -> None:
+                 origin: np.datetime64 | None, owner: bool,
+                 written: Mapping[str, Any] | None = None) -> None:
         super().__init__(path)
         self._file, self._owner = handle, owner
         channels = list(group.channels())
@@ -104,6 +126,10 @@ class TdmsGroupSource(Source):
             self.metadata["sample_rate_hz"] = 1.0 / increment
             if origin is not None:
                 extra["time_origin"] = str(origin)
+        if not prefix and "time_s" in self._channels:
+            self._time = None  # the times as logged, not rebuilt from the waveform timing
+        if written is not None:  # a file hrgtc wrote: its metadata as it was written
+            self.metadata = dict(written)
         self.names = (["time_s"] if self._time else []) + list(self._channels)
         self._done = 0
 
@@ -182,15 +208,95 @@ def read_tdms(path: Path) -> list[Source]:
         if not groups:
             raise RecordingError(f"{path}: the TDMS file holds no channel with samples; "
                                  "nothing to read")
+        written = _written_metadata(path, handle)
         starts = [t[2] for g in groups for t in map(_timing, g.channels())
                   if t is not None and t[2] is not None]
         origin = min(starts) if starts else None
         prefix = len(groups) > 1
         return [TdmsGroupSource(path, handle, g, f"{g.name}/" if prefix else "", origin,
-                                owner=i == 0) for i, g in enumerate(groups)]
+                                owner=i == 0, written=written) for i, g in enumerate(groups)]
     except BaseException:
         handle.close()
         raise
+
+
+def _written_metadata(path: Path, handle: Any) -> dict[str, Any] | None:
+    """The metadata hrgtc wrote in the file property ``hrgtc``; None in other files."""
+    raw = handle.properties.get(METADATA_PROPERTY)
+    if raw is None:
+        return None
+    try:
+        found = loads_json(str(raw))
+    except ValueError:
+        raise RecordingError(f"{path}: the file property {METADATA_PROPERTY!r} (hrgtc's "
+                             "metadata) is not valid JSON") from None
+    if not isinstance(found, dict):
+        raise RecordingError(f"{path}: the file property {METADATA_PROPERTY!r} (hrgtc's "
+                             "metadata) is not a JSON object")
+    return found
+
+
+class TdmsSink(Sink):
+    """Writes a recording as a TDMS file LabVIEW reads: one group ``recording`` of float64
+    waveform channels, a segment per chunk (never the whole table in memory).
+
+    Each channel carries LabVIEW's waveform timing: ``wf_increment`` = 1 / the sample
+    rate, ``wf_start_offset`` = the first ``time_s`` (0 without one), ``wf_start_time`` =
+    ``extra["time_origin"]`` where the metadata has one, else LabVIEW's zero time
+    (1904-01-01: a relative time axis), ``wf_samples`` the samples of the first write, and
+    ``unit_string`` its unit. The metadata is the file property ``hrgtc`` (JSON); a
+    :meth:`set_metadata` appends a segment of the file object alone, whose property
+    replaces the first (TDMS readers take a property's last value).
+    """
+
+    def __init__(self, path: Path, metadata: Metadata, names: Sequence[str]) -> None:
+        super().__init__(path, metadata, names)
+        self._nptdms = require("nptdms", "tdms", "TDMS", output_path(path), "writing")
+        self._metadata = metadata_json(metadata)
+        self._increment = 1.0 / float(metadata.sample_rate_hz)
+        origin = metadata.extra.get("time_origin") if isinstance(metadata.extra, dict) else None
+        try:
+            self._start = np.datetime64(origin, "us") if origin else LABVIEW_EPOCH
+        except ValueError:
+            self._start = LABVIEW_EPOCH
+        self._units = {n: column_unit(n, axis_names(names)) for n in names}
+        self._writer = self._nptdms.TdmsWriter(str(path))
+        self._writer.open()
+        self._first = True
+
+    def _objects(self, columns: Mapping[str, np.ndarray]) -> list[Any]:
+        nptdms = self._nptdms
+        if not self._first:
+            return [nptdms.ChannelObject(GROUP, n, columns[n]) for n in self.names]
+        self._first = False
+        rows = len(columns[self.names[0]])
+        offset = float(columns["time_s"][0]) if "time_s" in columns and rows else 0.0
+        wave = {"wf_start_time": self._start, "wf_start_offset": offset,
+                "wf_increment": self._increment, "wf_samples": np.int32(rows),
+                "wf_xname": "Time", "wf_xunit_string": "s"}
+        root = nptdms.RootObject(properties={"name": self.path.stem,
+                                             METADATA_PROPERTY: self._metadata})
+        channels = [nptdms.ChannelObject(GROUP, n, columns[n], properties={
+            **wave, **({"unit_string": self._units[n]} if self._units[n] else {})})
+            for n in self.names]
+        return [root, nptdms.GroupObject(GROUP), *channels]
+
+    def write(self, columns: Mapping[str, np.ndarray]) -> None:
+        self._writer.write_segment(self._objects(columns))
+
+    def set_metadata(self, metadata: Metadata) -> None:
+        self._metadata = metadata_json(metadata)
+        if not self._first:
+            self._writer.write_segment([self._nptdms.RootObject(
+                properties={METADATA_PROPERTY: self._metadata})])
+
+    def close(self) -> None:
+        if self._first:  # no rows: the channels, empty, and the metadata
+            self.write({n: np.zeros(0) for n in self.names})
+        self._writer.close()
+
+    def abort(self) -> None:
+        self._writer.close()
 
 
 def sniff(head: bytes) -> bool:
@@ -198,5 +304,5 @@ def sniff(head: bytes) -> bool:
     return head.startswith(TAG)
 
 
-FORMAT = Format("tdms", (".tdms",), read_tdms, sniff,
+FORMAT = Format("tdms", (".tdms",), read_tdms, sniff, TdmsSink,
                 description="NI TDMS (LabVIEW, DAQmx), a stream per group (npTDMS)")
