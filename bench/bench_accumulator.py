@@ -24,7 +24,7 @@ import numpy as np
 
 from bench_stepwise import NAMES, PENTER, PREMOVE, chunks
 from gram_accumulator import OldGramAccumulator
-from hrgtc.drift.stepwise import GramAccumulator, stepwise_from_accumulator
+from hrgtc.drift.stepwise import GramAccumulator, StepwiseRules, stepwise_from_accumulator
 
 FULL_ROWS = 10_000_000  # 10 chunks of 1 M per repetition (25 M took 40 s of make bench)
 QUICK_ROWS = 2_000_000
@@ -58,7 +58,7 @@ def accumulate_both(n: int, repeats: int = REPEATS) -> dict:
                 seconds[name][rep] += time.perf_counter() - t1
         t0 = time.perf_counter()
     t1 = time.perf_counter()
-    result = stepwise_from_accumulator(pairs[0][0], penter=PENTER, premove=PREMOVE)
+    result = stepwise_from_accumulator(pairs[0][0], rules=StepwiseRules(PENTER, PREMOVE))
     select = time.perf_counter() - t1
     return {"qr": float(np.median(seconds["qr"])), "gram": float(np.median(seconds["gram"])),
             "qr_runs": seconds["qr"], "gram_runs": seconds["gram"], "select": select,

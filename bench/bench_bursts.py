@@ -92,12 +92,12 @@ def _compensate(model, recording, gaps):
 def _features(model, recording):
     import warnings
 
-    from hrgtc.drift import window_means
+    from hrgtc.drift import Windowing, window_means
     from hrgtc.drift.features import EQ21
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the burst run warns about tau (reported once)
-        window_means([recording], model.drift.settings, EQ21, window_s=BURST_S)
+        window_means([recording], model.drift.settings, EQ21, Windowing(BURST_S))
 
 
 def _pairs(function, model, continuous, bursts, *extra) -> dict:

@@ -47,7 +47,9 @@ def anon():
             return int(line.split()[1]) / 1024
 baseline = anon()
 peak, rows, start = baseline, 0, time.perf_counter()
-for chunk in iter_chunks(sys.argv[1], validate=False, rows=int(sys.argv[2]), spike_filter='off'):
+chunks = iter_chunks(sys.argv[1], validate=False, chunk_rows=int(sys.argv[2]),
+                     spike_filter='off')
+for chunk in chunks:
     rows += len(chunk)
     peak = max(peak, anon())
 seconds = time.perf_counter() - start

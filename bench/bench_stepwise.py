@@ -28,7 +28,12 @@ from pathlib import Path
 import numpy as np
 
 from hrgtc.drift.regression import EXTENDED_PRECISION
-from hrgtc.drift.stepwise import GramAccumulator, stepwise, stepwise_from_accumulator
+from hrgtc.drift.stepwise import (
+    GramAccumulator,
+    StepwiseRules,
+    stepwise,
+    stepwise_from_accumulator,
+)
 
 FULL_ROWS = 1_000_000  # the naive loop refits statsmodels per candidate: 1 M keeps make bench short
 QUICK_ROWS = 250_000
@@ -79,7 +84,7 @@ def run_ours(n: int) -> dict:
         t0 = time.perf_counter()
         fit_seconds += t0 - t1
     t1 = time.perf_counter()
-    result = stepwise_from_accumulator(acc, penter=PENTER, premove=PREMOVE)
+    result = stepwise_from_accumulator(acc, rules=StepwiseRules(PENTER, PREMOVE))
     fit_seconds += time.perf_counter() - t1
     return {"seconds": fit_seconds, "generate_seconds": generate_seconds,
             "peak_rss_mb": _peak_rss_mb(), "selected": list(result.selected),
@@ -96,12 +101,12 @@ def run_in_memory(n: int, repeat: int = 3) -> dict:
     ``repeat`` timed calls.
     """
     X, y = _matrix(n)
-    stepwise(X[:1000], y[:1000], names=NAMES, penter=PENTER, premove=PREMOVE,
+    stepwise(X[:1000], y[:1000], names=NAMES, rules=StepwiseRules(PENTER, PREMOVE),
              refine=EXTENDED_PRECISION)
     times = []
     for _ in range(repeat):
         t0 = time.perf_counter()
-        result = stepwise(X, y, names=NAMES, penter=PENTER, premove=PREMOVE,
+        result = stepwise(X, y, names=NAMES, rules=StepwiseRules(PENTER, PREMOVE),
                           refine=EXTENDED_PRECISION)
         times.append(time.perf_counter() - t0)
     seconds = float(np.median(times))

@@ -36,9 +36,10 @@ def plain_script(model_path: str, source: str, output: str, rows: int = 1 << 20)
     for batch in pq.ParquetFile(source).iter_batches(batch_size=rows):
         out = {name: np.empty(batch.num_rows) for name in OUTPUT_COLUMNS}
         housing = batch.column("housing_c").to_numpy() if plan.needs_housing else None
-        kernel.run(plan, state, batch.column("time_s").to_numpy(),
-                   batch.column("freq_hz").to_numpy(),
-                   batch.column("rate_dph").to_numpy(), housing, out, counts, extremes)
+        kernel.run(plan, state, (batch.column("time_s").to_numpy(),
+                                 batch.column("freq_hz").to_numpy(),
+                                 batch.column("rate_dph").to_numpy(), housing),
+                   out, counts, extremes)
         table = pa.Table.from_batches([batch])
         for name in OUTPUT_COLUMNS:
             table = table.append_column(name, pa.array(out[name]))

@@ -127,7 +127,7 @@ def _test_report(paper: Any, folder: Path) -> Any:
 
 def _small() -> dict[str, Any]:
     from hrgtc.drift.cross_validation import CrossValidation
-    from hrgtc.drift.stepwise import stepwise
+    from hrgtc.drift.stepwise import StepwiseRules, stepwise
     from hrgtc.evaluation.allan import allan_deviation
     from hrgtc.evaluation.metrics import residual_against_truth
     from hrgtc.evaluation.noise_model import fit_noise_model
@@ -140,7 +140,7 @@ def _small() -> dict[str, Any]:
     from hrgtc.thermometry.settling import fit_transient
     from hrgtc.thermometry.thermometer import fit
 
-    hald = stepwise(HALD[:, :4], HALD[:, 4], penter=0.06)
+    hald = stepwise(HALD[:, :4], HALD[:, 4], rules=StepwiseRules(penter=0.06))
     t = np.arange(1000) / 10.0
     housing = 20.0 - 0.01 * t
     housing[np.arange(1000) % 10 != 0] = np.nan

@@ -13,7 +13,7 @@ sys.path.insert(0, str(ROOT / "bench"))
 import architecture_counts  # noqa: E402
 
 #: The figures of the docs' table (a refactor lowers them; nothing may raise them).
-CEILINGS = {"long_functions": 18, "many_parameters": 20, "model_kind_branches": 10,
+CEILINGS = {"long_functions": 18, "many_parameters": 1, "model_kind_branches": 10,
             "partial_fit_without_finish": 0, "record_classes": 41, "stub_to_from_dict": 0}
 
 

@@ -234,13 +234,14 @@ def test_the_report_s_library_call_checks_the_axes_itself(axis_files, sensor_mod
     from hrgtc.core.errors import InputError
     from hrgtc.model import load_model
     from hrgtc.report import build_report
+    from hrgtc.settings.compensation import ReportSettings
 
     _, xyz, xy, _ = axis_files
     model = load_model(xy)
     with pytest.raises(InputError, match="pass --axes x,y"):
         build_report(model, [xyz], tmp_path / "r.html")
     assert not (tmp_path / "r.html").exists()
-    page = build_report(model, [xyz], tmp_path / "r.html", axes=("x",)).read_text()
+    page = build_report(model, [xyz], tmp_path / "r.html", ReportSettings(axes=("x",))).read_text()
     assert 'id="axis-x"' in page and 'id="axis-y"' not in page  # the x axis alone
     with pytest.raises(InputError, match="is a sensor-thermometer model"):
         build_report(load_model(sensor_model_path), [files[2]], tmp_path / "s.html")

@@ -168,7 +168,7 @@ def test_only_reads_the_detectors_columns_of_every_axis(tmp_path):
                "chamber_c": run["chamber_c"]}
     source = recording_io.write(Recording(columns, run.metadata), tmp_path / "xy.parquet")
     whole = recording_io.read(source)
-    parts = list(recording_io.iter_chunks(source, rows=CHUNK, only=DETECTOR_COLUMNS,
+    parts = list(recording_io.iter_chunks(source, chunk_rows=CHUNK, only=DETECTOR_COLUMNS,
                                           validate=False))
     assert parts[0].names == ("time_s", "rate_dph_x", "rate_dph_y", "accel_x", "accel_y",
                               "accel_z")
@@ -178,6 +178,6 @@ def test_only_reads_the_detectors_columns_of_every_axis(tmp_path):
                                            "temperature_c": run["resonator_c"],
                                            "chamber_c": run["chamber_c"]}, run.metadata),
                                 tmp_path / "sensor.parquet")
-    part = next(recording_io.iter_chunks(sensor, rows=CHUNK, only=DETECTOR_COLUMNS,
+    part = next(recording_io.iter_chunks(sensor, chunk_rows=CHUNK, only=DETECTOR_COLUMNS,
                                          thermometer="sensor", validate=False))
     assert set(part.names) == {"time_s", "rate_dph", "freq_hz", "temperature_c"}

@@ -18,7 +18,7 @@ from hrgtc.compensate import Compensator
 from hrgtc.core.errors import CalibrationError
 from hrgtc.core.timeline import Timeline
 from hrgtc.drift.features import FeatureSettings, parse_terms
-from hrgtc.drift.windows import window_means
+from hrgtc.drift.windows import Windowing, window_means
 from hrgtc.model import load_model
 from hrgtc.recording import ReadOptions
 
@@ -56,7 +56,7 @@ def test_the_bursts_are_segments_and_the_warm_up_is_seconds_from_power_on():
     assert line.n_segments == 25 and line.samples_per_segment.tolist() == [250] * 25
     settings = FeatureSettings(reference_freq_hz=20.0, sample_rate_hz=50.0, rate_tau_s=1.0,
                                warmup_s=3.0)  # shorter than the first burst's 5 s
-    windows = window_means([run], settings, parse_terms(["f", "df"]), 4.0)
+    windows = window_means([run], settings, parse_terms(["f", "df"]), Windowing(4.0))
     # the warm-up drops 3 s of the first burst (150 samples), nothing of the other 24; the
     # 1 s remainders of 24 bursts are under half a window: dropped and counted
     assert windows.dropped == {"warmup": 150, "partial_windows": 24 * 50}
@@ -75,8 +75,9 @@ def test_split_restarts_the_filter_per_burst_and_says_so_bridge_carries_on():
     settings = FeatureSettings(reference_freq_hz=20.0, sample_rate_hz=50.0, rate_tau_s=10.0,
                                warmup_s=50.0)
     with pytest.raises(CalibrationError, match=r"after every gap .*--gaps bridge"):
-        window_means([run], settings, parse_terms(["f", "df"]), 10.0, gaps="split")
-    bridged = window_means([run], settings, parse_terms(["f", "df"]), 10.0, gaps="bridge")
+        window_means([run], settings, parse_terms(["f", "df"]), Windowing(10.0, gaps="split"))
+    bridged = window_means([run], settings, parse_terms(["f", "df"]),
+                           Windowing(10.0, gaps="bridge"))
     assert bridged.dropped["warmup"] == 250  # the first burst (15 s to 20 s) only
     assert bridged.time_s.size == 24
 

@@ -9,7 +9,7 @@ from bursts import cut_bursts, duplicated_rows, with_time, wrapped_counter_s
 from hrgtc.core.errors import InputError, RecordingError
 from hrgtc.core.time_steps import WRAP_MODULUS_S, TimeRepairStream, classify_time_steps
 from hrgtc.drift.features import EQ21, FeatureSettings
-from hrgtc.drift.windows import window_means
+from hrgtc.drift.windows import Windowing, window_means
 from hrgtc.recording import Metadata, Recording, iter_chunks, read, write
 from hrgtc.recording.validation import validate
 
@@ -34,7 +34,7 @@ READ = {"columns": {"time_s": "t", "freq_hz": "f", "rate_dph": "w"},
 
 def _windows(run: Recording):
     settings = FeatureSettings(reference_freq_hz=4432.0, sample_rate_hz=10.0, warmup_s=100.0)
-    return window_means([run], settings, list(EQ21[:4]), 10.0)
+    return window_means([run], settings, list(EQ21[:4]), Windowing(10.0))
 
 
 def test_a_wrapped_microsecond_counter_reads_as_the_clean_file(clean, tmp_path):
@@ -46,7 +46,7 @@ def test_a_wrapped_microsecond_counter_reads_as_the_clean_file(clean, tmp_path):
     assert "wrapped (2 time(s)" in run.metadata.extra["time_repairs"][0]
     # streamed in chunks of any size: the same times, a wrap on a chunk boundary included
     for rows in (1000, 2950, 49_999):
-        streamed = np.concatenate([c.time_s for c in iter_chunks(path, rows=rows,
+        streamed = np.concatenate([c.time_s for c in iter_chunks(path, chunk_rows=rows,
                                                                  units={"time": "us"}, **READ)])
         np.testing.assert_array_equal(streamed, run.time_s)
     # the training windows are those of the clean file
@@ -120,7 +120,7 @@ def test_a_rate_that_really_changes_names_the_row(tmp_path):
     for rows in (1000, 777, 6000):
         with pytest.raises(RecordingError, match=r"row 4320: the time step changes to 100 Hz.*"
                                                  r"split it at row 4320"):
-            list(iter_chunks(path, rows=rows))
+            list(iter_chunks(path, chunk_rows=rows))
 
 
 def test_classifier_cases_directly():
@@ -173,21 +173,22 @@ def test_a_reset_is_a_new_run_its_own_warm_up_filter_and_offset_group(clean, tmp
     (restart,) = run.metadata.extra["restarts_s"]
     assert restart == run.time_s[36_000]
     for rows in (1000, 36_000, 50_000):
-        chunks = list(iter_chunks(path, rows=rows, gaps="bridge", **READ))
+        chunks = list(iter_chunks(path, chunk_rows=rows, gaps="bridge", **READ))
         holding = [c for c in chunks if c.time_s[-1] >= restart]
         assert all(c.metadata.extra["restarts_s"] == [restart] for c in holding)
     windows = _windows(run)
     first, second = clean.slice(0, 36_000), clean.slice(36_000, len(clean))
     settings = FeatureSettings(reference_freq_hz=4432.0, sample_rate_hz=10.0, warmup_s=100.0)
-    apart = window_means([first, second], settings, list(EQ21[:4]), 10.0)
+    apart = window_means([first, second], settings, list(EQ21[:4]), Windowing(10.0))
     assert windows.dropped["warmup"] == 2 * 1000  # 100 s at 10 Hz after each power-on
     np.testing.assert_allclose(windows.terms, apart.terms, rtol=1e-9, atol=1e-15)
     np.testing.assert_array_equal(windows.power_run, apart.run)
     assert windows.power_runs == (f"{path} run 1", f"{path} run 2")
     # bursts: one power-on run, unless each segment is a restart
     bursts = cut_bursts(clean, burst_s=600.0, period_s=1200.0)
-    one = window_means([bursts], settings, list(EQ21[:4]), 10.0)
-    each = window_means([bursts], settings, list(EQ21[:4]), 10.0, restart_each_segment=True)
+    one = window_means([bursts], settings, list(EQ21[:4]), Windowing(10.0))
+    each = window_means([bursts], settings, list(EQ21[:4]),
+                        Windowing(10.0, restart_each_segment=True))
     assert set(one.power_run.tolist()) == {0}
     assert sorted(set(each.power_run.tolist())) == list(range(6))
     assert each.dropped["warmup"] == 6 * 1000
@@ -228,7 +229,7 @@ def test_clock_times_read_in_their_zone_are_the_clean_file(tmp_path, utc_start, 
     if rows is None:
         run = read(path, tz="Europe/Berlin", **options)
     else:
-        chunks = list(iter_chunks(path, rows=rows, tz="Europe/Berlin", **options))
+        chunks = list(iter_chunks(path, chunk_rows=rows, tz="Europe/Berlin", **options))
         run = Recording({k: np.concatenate([c[k] for c in chunks]) for k in chunks[0].names},
                         chunks[0].metadata)
     np.testing.assert_array_equal(run.time_s, clean_s)

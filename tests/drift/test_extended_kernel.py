@@ -43,7 +43,8 @@ def test_residual_pass_matches_exact_rationals(weighted):
     r_hi, r_lo = np.empty(n), np.empty(n)
     f = np.zeros(n)
     g_hi, g_lo = np.empty(k + 1), np.empty(k + 1)
-    residual_pass(X, y, shift, inverse, weights, x_hi, x_lo, r_hi, r_lo, f, g_hi, g_lo, True)
+    residual_pass(X, y, (shift, inverse), weights, (x_hi, x_lo), (r_hi, r_lo), f, (g_hi, g_lo),
+                  True)
 
     x = [Fraction(a) + Fraction(b) for a, b in zip(x_hi, x_lo, strict=True)]
     rows = []
@@ -70,7 +71,8 @@ def test_residual_pass_matches_exact_rationals(weighted):
     # a later pass: f = b - r - A x of a perturbed r is the perturbation, to double-double
     delta = 1e-3 * rng.standard_normal(n)
     add_to(r_hi, r_lo, -delta)
-    residual_pass(X, y, shift, inverse, weights, x_hi, x_lo, r_hi, r_lo, f, g_hi, g_lo, False)
+    residual_pass(X, y, (shift, inverse), weights, (x_hi, x_lo), (r_hi, r_lo), f, (g_hi, g_lo),
+                  False)
     np.testing.assert_allclose(f, delta, rtol=1e-15, atol=2.0**-95 * size)
 
 

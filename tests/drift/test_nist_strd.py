@@ -18,7 +18,7 @@ import statsmodels.api as sm
 import nist_strd_data as nist
 from hrgtc.core.errors import InputError, PrecisionWarning, RankDeficientError
 from hrgtc.drift.regression import EXTENDED_PRECISION, GramAccumulator, ols, refine
-from hrgtc.drift.stepwise import stepwise
+from hrgtc.drift.stepwise import StepwiseRules, stepwise
 
 from exact import exact_least_squares
 
@@ -134,10 +134,11 @@ def test_weighted_refinement_matches_the_exact_weighted_solution():
 def test_stepwise_refines_the_selected_model():
     X, y, params, _, _ = PROBLEMS["Wampler5"]
     names = [f"x{k}" for k in range(1, 6)]
-    kept = stepwise(X, y, initial=names, max_steps=0)  # the full model, as certified
+    full = StepwiseRules(initial=names, max_steps=0)  # the full model, as certified
+    kept = stepwise(X, y, rules=full)
     assert kept.selected == tuple(names)
     assert lre(kept.result.params, params).min() >= 8
-    assert lre(stepwise(X, y, initial=names, max_steps=0, refine=False).result.params,
+    assert lre(stepwise(X, y, rules=full, refine=False).result.params,
                params).min() < 7
     # a free selection keeps few terms (their p-values are near 1): exact fit of those
     found = stepwise(X, y)

@@ -11,7 +11,7 @@ import pytest
 from hrgtc.core.errors import RateFilterWarning
 from hrgtc.drift.features import FeatureSettings, parse_terms
 from hrgtc.drift.rate_checks import burst_period_s, rate_filter_problems, resolution
-from hrgtc.drift.windows import window_means
+from hrgtc.drift.windows import Windowing, window_means
 
 from synthetic import ramp_run
 
@@ -62,14 +62,14 @@ def test_training_on_bursts_with_a_short_tau_warns_once():
     settings = FeatureSettings(reference_freq_hz=4432.0, sample_rate_hz=10.0, rate_tau_s=10.0,
                                warmup_s=0.0)
     with pytest.warns(RateFilterWarning, match="shorter than the 300 s burst period") as caught:
-        window_means([cut, cut], settings, terms, window_s=5.0)
+        window_means([cut, cut], settings, terms, Windowing(5.0))
     assert len([w for w in caught if issubclass(w.category, RateFilterWarning)]) == 1
     with warnings.catch_warnings():
         warnings.simplefilter("error", RateFilterWarning)
-        window_means([run], settings, terms, window_s=5.0)  # continuous: silent
+        window_means([run], settings, terms, Windowing(5.0))  # continuous: silent
         slow = FeatureSettings(reference_freq_hz=4432.0, sample_rate_hz=10.0,
                                rate_tau_s=300.0, warmup_s=0.0)
-        window_means([cut], slow, terms, window_s=5.0)
+        window_means([cut], slow, terms, Windowing(5.0))
 
 
 def test_the_pan_cold_test_triggers_both_warnings_where_it_should():

@@ -12,7 +12,7 @@ import pytest
 
 from hrgtc.core.errors import InputError
 from hrgtc.drift.regression import EXTENDED_PRECISION, QRAccumulator, ols, refine
-from hrgtc.drift.stepwise import stepwise
+from hrgtc.drift.stepwise import StepwiseRules, stepwise
 
 
 def _data(weighted: bool):
@@ -53,7 +53,7 @@ def test_refine_with_the_selections_factor_equals_refine_alone(weighted):
     reused = refine(fit, X[:, columns], y, w,
                     factor=QRAccumulator().partial_fit(X, y, w).select(columns))
     np.testing.assert_allclose(reused.params, alone.params, rtol=1e-13, atol=0)
-    chosen = stepwise(X, y, weights=w, penter=1e-3, premove=1e-2)
+    chosen = stepwise(X, y, weights=w, rules=StepwiseRules(penter=1e-3, premove=1e-2))
     assert chosen.selected == ("x1", "x2", "x3")
     np.testing.assert_allclose(chosen.result.params, alone.params, rtol=1e-13, atol=0)
 

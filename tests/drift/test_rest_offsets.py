@@ -212,7 +212,7 @@ def test_compensation_applies_known_orientations_and_reports_an_unknown_one():
 
 def test_windows_never_span_left_out_samples_across_chunks():
     from hrgtc.drift.features import FeatureSettings, parse_terms
-    from hrgtc.drift.windows import window_means
+    from hrgtc.drift.windows import Windowing, window_means
 
     run, _ = mems_run(9, hours=1.0)
     n = len(run)
@@ -221,7 +221,7 @@ def test_windows_never_span_left_out_samples_across_chunks():
     keep[2995:3005] = False  # across the 30th/31st boundary
     settings = FeatureSettings(reference_freq_hz=15.0, sample_rate_hz=1.0, warmup_s=0.0)
     chunks = [run.slice(a, a + 777) for a in range(0, n, 777)]
-    windows = window_means([lambda: iter(chunks)], settings, parse_terms(["f"]), 100.0,
+    windows = window_means([lambda: iter(chunks)], settings, parse_terms(["f"]), Windowing(100.0),
                            keep=[keep])
     t = run.time_s
     # the run ends in a partial window of 95 samples (3505 to 3599 s): at least half a

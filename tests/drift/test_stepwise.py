@@ -23,6 +23,7 @@ from hrgtc.drift.stepwise import (
     GramAccumulator,
     OLSResult,
     StepwiseResult,
+    StepwiseRules,
     ols,
     ols_from_accumulator,
     stepwise,
@@ -210,7 +211,7 @@ def test_hald_stepwise_matlab_example():
     # 3. Adding x2, FStat = 5.0259, pValue = 0.051687
     # 4. Removing x4, FStat = 1.8633, pValue = 0.2054
     # final heat ~ 52.5773 + 1.4683 x1 + 0.6623 x2 (Draper & Smith 1998 give the same model).
-    res = stepwise(HALD[:, :4], HALD[:, 4], penter=0.06)
+    res = stepwise(HALD[:, :4], HALD[:, 4], rules=StepwiseRules(penter=0.06))
     assert [(s.action, s.term) for s in res.history] == [
         ("added", "x4"), ("added", "x1"), ("added", "x2"), ("removed", "x4")]
     # (F, p, half a unit of the last printed digit of p)
@@ -235,7 +236,7 @@ def test_hald_stepwise_default_thresholds():
 
 def test_hald_backward_from_full_model():
     # Draper & Smith (1998), backward elimination on the Hald data: drop x3, then x4.
-    res = stepwise(HALD[:, :4], HALD[:, 4], initial=["x1", "x2", "x3", "x4"])
+    res = stepwise(HALD[:, :4], HALD[:, 4], rules=StepwiseRules(initial=["x1", "x2", "x3", "x4"]))
     assert [(s.action, s.term) for s in res.history] == [("removed", "x3"), ("removed", "x4")]
     assert res.selected == ("x1", "x2")
     assert res.history[0].pvalue == pytest.approx(0.8959, abs=1e-4)
@@ -274,7 +275,7 @@ def test_stepwise_matches_naive_statsmodels_refits(seed):
     X = rng.normal(size=(120, 7))
     X[:, 3] = X[:, 1] + 0.3 * rng.normal(size=120)
     y = 0.4 * X[:, 1] + 0.25 * X[:, 3] - 0.3 * X[:, 5] + rng.normal(size=120)
-    ours = stepwise(X, y, penter=0.05, premove=0.10)
+    ours = stepwise(X, y, rules=StepwiseRules(penter=0.05, premove=0.10))
     ref = _reference_stepwise(X, y, 0.05, 0.10)
     assert [(s.action, f"x{j + 1}") for s, (_, j, _) in zip(ours.history, ref, strict=True)] \
         == [(a, f"x{j + 1}") for a, j, _ in ref]
@@ -293,7 +294,7 @@ def test_stepwise_recovers_true_subset(subset, coefficients, signs, seed):
     for j in subset:
         beta[j] = coefficients[j] * signs[j]
     y = 2.0 + X @ beta + rng.normal(0.0, 1e-3, 150)
-    res = stepwise(X, y, penter=1e-6, premove=1e-5)
+    res = stepwise(X, y, rules=StepwiseRules(penter=1e-6, premove=1e-5))
     assert set(res.selected) == {f"x{j + 1}" for j in subset}
     # within 6 standard errors of the truth (noise 1e-3: a fixed rtol would be flaky)
     error = np.abs(res.result.params[1:] - beta[sorted(subset)])
@@ -324,13 +325,13 @@ def test_stepwise_from_accumulator_equals_stepwise():
 def test_stepwise_options_and_serialisation():
     X, y = HALD[:, :4], HALD[:, 4]
     with pytest.raises(InputError, match=r"penter \(0.2\) must not exceed premove \(0.1\)"):
-        stepwise(X, y, penter=0.2, premove=0.1)
+        stepwise(X, y, rules=StepwiseRules(penter=0.2, premove=0.1))
     with pytest.raises(InputError, match="unknown term 'x9'"):
-        stepwise(X, y, initial=["x9"])
-    assert stepwise(X, y, penter=0.2).premove == 0.2
-    short = stepwise(X, y, max_steps=1)
+        stepwise(X, y, rules=StepwiseRules(initial=["x9"]))
+    assert stepwise(X, y, rules=StepwiseRules(penter=0.2)).premove == 0.2
+    short = stepwise(X, y, rules=StepwiseRules(max_steps=1))
     assert len(short.history) == 1 and short.stop_reason == "max_steps"
-    res = stepwise(X, y, penter=0.06)
+    res = stepwise(X, y, rules=StepwiseRules(penter=0.06))
     back = StepwiseResult.from_dict(json.loads(json.dumps(res.to_dict())))
     assert back.history == res.history and back.selected == res.selected
     np.testing.assert_array_equal(back.result.params, res.result.params)
@@ -350,12 +351,12 @@ def test_variance_inflation_scales_errors_and_f_statistics():
     np.testing.assert_array_equal(inflated.params, plain.params)
     assert inflated.residual_std == plain.residual_std
     first_plain = stepwise(X, y).history[0]
-    first_inflated = stepwise(X, y, variance_inflation=4.0).history[0]
+    first_inflated = stepwise(X, y, rules=StepwiseRules(variance_inflation=4.0)).history[0]
     assert first_inflated.term == first_plain.term
     assert first_inflated.fstat == pytest.approx(first_plain.fstat / 4.0, rel=1e-12)
     # the weak term x3 enters at c = 1 but stays out once F is deflated 25-fold
     assert stepwise(X, y).selected == ("x1", "x3")
-    assert stepwise(X, y, variance_inflation=25.0).selected == ("x1",)
+    assert stepwise(X, y, rules=StepwiseRules(variance_inflation=25.0)).selected == ("x1",)
     with pytest.raises(InputError, match="variance_inflation must be a finite number >= 1"):
         acc.fit(variance_inflation=0.5)
 
@@ -477,7 +478,7 @@ def test_hierarchy_keeps_parents_in_and_changes_the_selection():
         "f": set(), "f^2": {"f"}, "df": set(), "f*df": {"f", "df"}}
     free = stepwise(X, y, names=names)
     assert "f^2" in free.selected and "f*df" in free.selected and "f" not in free.selected
-    marginal = stepwise(X, y, names=names, parents=parents)
+    marginal = stepwise(X, y, names=names, rules=StepwiseRules(parents=parents))
     for name in marginal.selected:
         assert set(parents[name]) <= set(marginal.selected), (name, marginal.selected)
     assert marginal.selected != free.selected

@@ -7,7 +7,7 @@ import pytest
 
 from hrgtc.core.timeline import min_partial_rows
 from hrgtc.drift.features import FeatureSettings, parse_terms
-from hrgtc.drift.windows import window_means
+from hrgtc.drift.windows import Windowing, window_means
 from hrgtc.recording import Recording
 
 from synthetic import ramp_run
@@ -24,15 +24,15 @@ def test_each_run_starts_its_own_filter_even_with_a_short_warm_up():
     settings = FeatureSettings(reference_freq_hz=4432.0, sample_rate_hz=10.0, rate_tau_s=5.0,
                                warmup_s=0.1)
     terms = parse_terms(["f", "df"])
-    both = window_means([first, second], settings, terms, window_s=10.0)
-    alone = window_means([second], settings, terms, window_s=10.0)
+    both = window_means([first, second], settings, terms, Windowing(10.0))
+    alone = window_means([second], settings, terms, Windowing(10.0))
     mine = both.run == 1
     np.testing.assert_array_equal(both.variables["df"][mine], alone.variables["df"])
     np.testing.assert_array_equal(both.terms[mine], alone.terms)
     # the test has power: one filter over both runs (shared state) reads the jump
     joined = Recording({n: np.concatenate([first[n], second[n]]) for n in first.names},
                        first.metadata, "joined")
-    shared = window_means([joined], settings, terms, window_s=10.0)
+    shared = window_means([joined], settings, terms, Windowing(10.0))
     leaked = shared.variables["df"][np.searchsorted(shared.time_s, second.time_s[0])]
     assert abs(leaked - alone.variables["df"][0]) > 10 * np.std(alone.variables["df"][-20:])
 

@@ -84,7 +84,7 @@ def test_two_streams_equal_the_slow_channel_path(tmp_path, mode, gap):
     assert first == second
     # streamed in chunks: the same rows
     with pytest.warns(SlowChannelWarning):
-        chunks = list(iter_chunks(streams, rows=97, **words))
+        chunks = list(iter_chunks(streams, chunk_rows=97, **words))
     assert np.array_equal(np.concatenate([c["housing_c"] for c in chunks]),
                           expected["housing_c"])
 

@@ -130,7 +130,7 @@ def test_multi_axis_round_trip_views_equal_single_axis_files(tmp_path, suffix):
 def test_multi_axis_streamed_in_chunks_equals_whole(tmp_path):
     path = write(multi_axis(), tmp_path / "imu.parquet")
     whole = read(path)
-    chunks = list(iter_chunks(path, rows=70))
+    chunks = list(iter_chunks(path, chunk_rows=70))
     assert len(chunks) == 5
     for name in whole.names:
         np.testing.assert_array_equal(np.concatenate([c[name] for c in chunks]), whole[name])

@@ -77,7 +77,7 @@ def test_every_writable_format_round_trips_table_and_metadata(fmt, tmp_path):
         tables = list(stream.iter_tables(["time_s", "rate_dph"], set(), 64))
     joined = np.concatenate([t.column("rate_dph").to_numpy() for t in tables])
     assert np.array_equal(joined, original.rate_dph)
-    chunks = list(iter_chunks(path, rows=64))
+    chunks = list(iter_chunks(path, chunk_rows=64))
     assert [len(c) for c in chunks] == [64, 64, 64, 64, 44]
     assert np.array_equal(np.concatenate([c["housing_c"] for c in chunks]), original["housing_c"])
 

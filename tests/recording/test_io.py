@@ -94,7 +94,7 @@ def test_chunked_read_equals_whole_read(tmp_path, suffix, rows):
     recording = make_recording(n=400)
     path = write(recording, tmp_path / f"run{suffix}")
     whole = read(path)
-    chunks = list(iter_chunks(path, rows=rows))
+    chunks = list(iter_chunks(path, chunk_rows=rows))
     assert [len(c) for c in chunks][:-1] == [rows] * (len(chunks) - 1)
     assert all(c.metadata == whole.metadata for c in chunks)
     joined = concatenate(chunks)
@@ -122,7 +122,7 @@ def test_one_options_object_or_its_fields_by_name(tmp_path):
     assert len(by_object) == len(by_name) == 300 and len(overridden) == 200  # 200 Hz
     assert np.allclose(by_object.rate_dph, recording.rate_dph[100:] * 3600.0, rtol=1e-12)
     assert same_bits(by_object.rate_dph, by_name.rate_dph)
-    chunks = list(iter_chunks(path, options, rows=64))
+    chunks = list(iter_chunks(path, options, chunk_rows=64))
     assert [len(c) for c in chunks] == [64] * 4 + [44]
     assert same_bits(concatenate(chunks).freq_hz, by_object.freq_hz)
     assert describe(path, options).rows == describe(path, options, start=None).rows - 100
@@ -289,7 +289,7 @@ def test_foreign_hdf5_at_root_and_chunked(tmp_path):
         "units": {"time": "ms", "freq": "kHz", "rate": "dps"},
     }
     whole = read(path, **options)
-    joined = concatenate(list(iter_chunks(path, rows=64, **options)))
+    joined = concatenate(list(iter_chunks(path, chunk_rows=64, **options)))
     assert same_bits(whole.freq_hz, joined.freq_hz)
     np.testing.assert_allclose(whole.freq_hz, rows[:, 1] * 1000, rtol=1e-15)
     assert "sample_rate_inferred" not in whole.metadata.extra
@@ -473,7 +473,7 @@ def test_csv_parse_errors_name_line_row_and_value(tmp_path):
     with pytest.raises(RecordingError, match=r"column 'rate_dph', row 30: '5xoops' is not a n"):
         read(tmp_path / "garbage.csv")
     with pytest.raises(RecordingError, match=r"row 30: '5xoops' is not a number"):
-        list(iter_chunks(tmp_path / "garbage.csv", rows=7))
+        list(iter_chunks(tmp_path / "garbage.csv", chunk_rows=7))
 
 
 # -- chunked validation carries state ------------------------------------------------
@@ -481,16 +481,16 @@ def test_chunked_validation_numbers_rows_globally_and_checks_boundaries(tmp_path
     recording = make_recording(n=400)
     path = write(corrupt(recording, "freq_hz", 250, np.nan), tmp_path / "nan.parquet")
     with pytest.raises(RecordingError, match=r"column 'freq_hz', row 250: value nan"):
-        list(iter_chunks(path, rows=100))
+        list(iter_chunks(path, chunk_rows=100))
     path = write(corrupt(recording, "time_s", 200, 0.5), tmp_path / "back.parquet")
     with pytest.raises(RecordingError, match=r"row 200: 0\.5 s after 0\.995 s is a step back"):
-        list(iter_chunks(path, rows=100))  # the bad step straddles two chunks
+        list(iter_chunks(path, chunk_rows=100))  # the bad step straddles two chunks
     time = recording.time_s.copy()
     time[300:] += 10.0
     path = write(recording.with_columns(time_s=time), tmp_path / "gap.h5")
     with pytest.raises(RecordingError, match=r"row 300: 1 gap"):
-        list(iter_chunks(path, rows=100))
-    assert len(concatenate(list(iter_chunks(path, rows=100, gaps="split")))) == 400
+        list(iter_chunks(path, chunk_rows=100))
+    assert len(concatenate(list(iter_chunks(path, chunk_rows=100, gaps="split")))) == 400
 
 
 def test_no_chunk_escapes_before_the_unit_heuristics(tmp_path):
@@ -498,7 +498,7 @@ def test_no_chunk_escapes_before_the_unit_heuristics(tmp_path):
     path = write(recording.with_columns(freq_hz=recording.freq_hz / 1000), tmp_path / "k.h5")
     seen = []
     with pytest.raises(RecordingError, match="looks like kHz"):
-        for chunk in iter_chunks(path, rows=50):
+        for chunk in iter_chunks(path, chunk_rows=50):
             seen.append(chunk)
     assert seen == []
 

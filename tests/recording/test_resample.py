@@ -103,7 +103,7 @@ def test_a_decimated_temperature_channel_gives_the_same_model(tmp_path):
         held = read(decimated)
     assert len(held) == len(run) and np.all(np.isfinite(held.freq_hz))
     with pytest.warns(SlowChannelWarning):
-        streamed = np.concatenate([c.freq_hz for c in iter_chunks(decimated, rows=7777)])
+        streamed = np.concatenate([c.freq_hz for c in iter_chunks(decimated, chunk_rows=7777)])
     np.testing.assert_array_equal(streamed, held.freq_hz)
     model_full = drift.fit([read(full)], THERMOMETER)
     model_held = drift.fit([held], THERMOMETER)

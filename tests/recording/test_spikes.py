@@ -65,7 +65,7 @@ def test_spikes_drop_removes_exactly_those_rows(tmp_path):
     for name, values in clean.items():
         np.testing.assert_array_equal(rec[name], values[keep])
     with pytest.warns(SpikeWarning, match=r"dropped 4 row\(s\)"):
-        chunks = list(iter_chunks(path, rows=64, spikes="drop"))
+        chunks = list(iter_chunks(path, chunk_rows=64, spikes="drop"))
     for name, values in clean.items():
         np.testing.assert_array_equal(np.concatenate([c[name] for c in chunks]), values[keep])
 
@@ -106,7 +106,7 @@ def test_a_later_error_names_the_file_row_after_spikes_were_dropped(tmp_path, ro
             if rows is None:
                 read(path, spikes="drop")
             else:
-                list(iter_chunks(path, rows=rows, spikes="drop"))
+                list(iter_chunks(path, chunk_rows=rows, spikes="drop"))
     message = " ".join(str(info.value).split())
     assert "column 'time_s', row 470:" in message, message
     assert "row 466" not in message  # the row among the rows kept (four spikes before it)

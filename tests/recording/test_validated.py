@@ -49,7 +49,7 @@ def _passes(path, options, times=2):
     with mock.patch.object(RecordingValidator, "partial_fit", counted):
         for _ in range(times):
             before = len(seen)
-            chunks = list(iter_chunks(path, options, rows=700))
+            chunks = list(iter_chunks(path, options, chunk_rows=700))
             out.append((chunks, len(seen) - before))
     return out
 
@@ -82,7 +82,7 @@ def test_other_options_or_a_changed_file_are_validated_again(tmp_path):
 def test_a_pass_left_early_or_refused_remembers_nothing(tmp_path):
     path = tmp_path / "run.parquet"
     write(_recording(n=HEURISTIC_ROWS + 20_000), path)  # more rows than the first look
-    chunks = iter_chunks(path, ReadOptions(), rows=HEURISTIC_ROWS)
+    chunks = iter_chunks(path, ReadOptions(), chunk_rows=HEURISTIC_ROWS)
     next(chunks)
     chunks.close()  # a head: the rest of the file was never checked
     [(_, checked)] = _passes(path, ReadOptions(), times=1)
@@ -95,7 +95,7 @@ def test_the_warnings_of_the_validation_are_said_on_every_pass(tmp_path):
     for _ in range(2):
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            list(iter_chunks(path, ReadOptions(), rows=700))
+            list(iter_chunks(path, ReadOptions(), chunk_rows=700))
         gaps = [str(w.message) for w in caught if issubclass(w.category, GapWarning)]
         assert len(gaps) == 1 and "1 dropout(s) no longer than 5 s" in gaps[0]
 
@@ -106,10 +106,10 @@ def test_a_file_rewritten_in_place_with_its_time_and_size_is_validated_again(tmp
         f"{k / RATE_HZ:.3f},4425.000,10.000\n" for k in range(400))
     path.write_text(good)
     stat = path.stat()
-    list(iter_chunks(path, ReadOptions(), rows=100))
+    list(iter_chunks(path, ReadOptions(), chunk_rows=100))
     bad = good[:-len("4425.000,10.000\n")] + "4425.000,   nan\n"  # same size, last row NaN
     assert len(bad) == len(good)
     path.write_text(bad)
     os.utime(path, ns=(stat.st_atime_ns, stat.st_mtime_ns))  # the same modification time
     with pytest.raises(RecordingError, match="rate_dph"):
-        list(iter_chunks(path, ReadOptions(), rows=100))
+        list(iter_chunks(path, ReadOptions(), chunk_rows=100))

@@ -50,7 +50,7 @@ def test_a_defect_is_reported_at_its_row_whatever_the_chunking(tmp_path_factory,
     path = write(Recording(columns, Metadata(sample_rate_hz=RATE_HZ)),
                  tmp_path_factory.mktemp("v") / "run.parquet")
     with pytest.raises(RecordingError, match=message.format(row=row)):
-        list(iter_chunks(path, rows=rows))
+        list(iter_chunks(path, chunk_rows=rows))
 
 
 @pytest.mark.parametrize("rows", [700, 1500, N])
@@ -59,9 +59,9 @@ def test_a_sample_rate_change_late_in_the_run_is_found(tmp_path, rows):
     columns["time_s"][4000:] = columns["time_s"][4000] + (np.arange(N - 4000) / (RATE_HZ * 1.05))
     path = write(Recording(columns, Metadata(sample_rate_hz=RATE_HZ)), tmp_path / "run.parquet")
     with pytest.raises(RecordingError, match=r"row 4000"):
-        list(iter_chunks(path, rows=rows))
+        list(iter_chunks(path, chunk_rows=rows))
     assert sum(len(c) for c in iter_chunks(write(Recording(clean(), Metadata(
-        sample_rate_hz=RATE_HZ)), tmp_path / "clean.parquet"), rows=rows)) == N
+        sample_rate_hz=RATE_HZ)), tmp_path / "clean.parquet"), chunk_rows=rows)) == N
 
 
 @settings(max_examples=40, deadline=None)

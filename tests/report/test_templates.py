@@ -124,8 +124,8 @@ def test_what_the_page_shows_is_escaped(unit, tmp_path):
     run = tmp_path / f"{evil}.parquet"
     run.write_bytes(files.warmup.read_bytes())
     model = dataclasses.replace(model.with_parts(plateaus=()), unit=f"{evil}&")
-    output = build_report(model, [run], tmp_path / "report.html", soaks=[],
-                          title=f"{evil} report")
+    output = build_report(model, [run], tmp_path / "report.html",
+                          ReportSettings(title=f"{evil} report"), soaks=[])
     text = output.read_text(encoding="utf-8")
     assert "<script" not in text
     assert "&lt;script&gt;alert(1)&lt;script&gt;.parquet" in text  # the run's name
@@ -141,7 +141,7 @@ def test_a_kind_is_a_data_function_and_a_folder_of_templates(tmp_path):
         assert callable(kind.data) and kind.description
     model = GOLDEN / "v2" / "unit-resonator-254ab6c.json"
     with pytest.raises(InputError, match=r"kind='ieee'.*the kinds are paper"):
-        build_report(model, [], tmp_path / "r.html", soaks=[], kind="ieee")
+        build_report(model, [], tmp_path / "r.html", ReportSettings(kind="ieee"), soaks=[])
     assert not (tmp_path / "r.html").exists()
 
 

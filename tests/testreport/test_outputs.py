@@ -15,6 +15,7 @@ from hrgtc.cli import app
 from hrgtc.core.errors import InputError, OutputExistsError
 from hrgtc.report import build_report
 from hrgtc.report.test_report import write_test_report
+from hrgtc.settings.compensation import ReportSettings
 from hrgtc.testreport import FIGURES
 
 SPEC = """[limits.bias_repeatability_dph]
@@ -126,8 +127,8 @@ def test_no_browser_is_an_error_naming_the_fix(campaign, tmp_path, monkeypatch):
 
 def test_build_report_refuses_the_test_report_kind(campaign, tmp_path):
     with pytest.raises(InputError, match="hrgtc test-report"):
-        build_report(campaign.folder / "model.json", [], tmp_path / "r.html", soaks=[],
-                     kind="test-report")
+        build_report(campaign.folder / "model.json", [], tmp_path / "r.html",
+                     ReportSettings(kind="test-report"), soaks=[])
 
 
 def test_the_command_writes_the_files_and_its_json(campaign, tmp_path):

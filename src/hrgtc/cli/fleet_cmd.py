@@ -18,7 +18,12 @@ from hrgtc.cli.options import ForceOption, JsonOption, reading_options
 from hrgtc.cli.params import option, settings_options, split_values
 from hrgtc.settings.calibration import CalibrationSettings, ThermometerSettings
 from hrgtc.settings.drift import DriftSettings
-from hrgtc.settings.fleet import FleetCluster, FleetEvaluation, FleetSimulation
+from hrgtc.settings.fleet import (
+    FleetCalibration,
+    FleetCluster,
+    FleetEvaluation,
+    FleetSimulation,
+)
 
 if TYPE_CHECKING:
     from hrgtc.fleet import FleetRun
@@ -80,6 +85,7 @@ def simulate_command(
 
 @fleet_app.command("calibrate")
 @reading_options
+@settings_options(FleetCalibration, "which")
 @settings_options(FleetCluster, "cluster")
 def calibrate_command(
     root: Annotated[Path, typer.Argument(
@@ -88,17 +94,10 @@ def calibrate_command(
         "models"),
     order: int = option(ThermometerSettings, "order"),
     terms: str | None = option(DriftSettings, "terms"),
-    prior: Annotated[Path | None, typer.Option(
-        "--prior", help="Population prior (hrgtc fleet prior): fit each thermometer with it.")
-    ] = None,
-    unit: Annotated[list[str] | None, typer.Option(
-        "--unit", help="Only this unit (repeat for more).")] = None,
-    resume: Annotated[bool, typer.Option(
-        "--resume", help="Skip units whose model exists and whose inputs are unchanged "
-        "(SHA-256).")] = False,
     force: ForceOption = False,
     json_output: JsonOption = False,
     inputs: ReadOptions | None = None,
+    which: FleetCalibration | None = None,
     cluster: FleetCluster | None = None,
 ) -> None:
     """Calibrate every unit of a fleet, every axis of it: a model per unit and the fleet
@@ -111,12 +110,13 @@ def calibrate_command(
     settings = CalibrationSettings(
         thermometer=ThermometerSettings(order=order),
         drift=DriftSettings(terms=None if terms is None else split_values(terms, str)))
+    which = which or FleetCalibration()
     with library_errors():
-        fleet = load_fleet(root, unit)
+        fleet = load_fleet(root, list(which.units) or None)
         with progress_bar("units", enabled=not json_output) as progress:
             run = calibrate_fleet(fleet, output, settings=settings, read_options=inputs,
-                                  resume=resume, force=force, prior=prior, cluster=cluster,
-                                  progress=progress)
+                                  resume=which.resume, force=force, prior=which.prior,
+                                  cluster=cluster, progress=progress)
     _finish(run, json_output, f"{output}/<unit>.json, {output}/fleet.parquet")
 
 

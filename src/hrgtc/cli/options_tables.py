@@ -30,6 +30,7 @@ DOCUMENTED = {
     "report": ("hrgtc.settings.compensation", "ReportSettings"),
     "export": ("hrgtc.settings.export", "ExportSettings"),
     "fleet_simulate": ("hrgtc.settings.fleet", "FleetSimulation"),
+    "fleet_calibrate": ("hrgtc.settings.fleet", "FleetCalibration"),
     "fleet_evaluate": ("hrgtc.settings.fleet", "FleetEvaluation"),
     "fleet_cluster": ("hrgtc.settings.fleet", "FleetCluster"),
     "demo": ("hrgtc.settings.fleet", "DemoSettings"),

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -9,7 +10,7 @@ import typer
 
 from hrgtc.cli._app import console, library_errors, print_json, progress_bar
 from hrgtc.cli.options import AxesOption, ForceOption, JsonOption, reading_options
-from hrgtc.cli.params import option
+from hrgtc.cli.params import settings_options
 from hrgtc.settings.compensation import ReportSettings
 
 if TYPE_CHECKING:
@@ -17,6 +18,7 @@ if TYPE_CHECKING:
 
 
 @reading_options
+@settings_options(ReportSettings)
 def report_command(
     runs: list[Path] = typer.Argument(
         ..., metavar="RUN...", help="Runs to compensate and show (Fig. 6), one section each."),
@@ -26,12 +28,11 @@ def report_command(
     soak: list[Path] = typer.Option(
         None, "--soak", help="Soak recording for Figs. 3 and 5 (repeat); default: the soaks "
         "named in the model file, where they still exist."),
-    title: str = typer.Option(None, "--title", help="Page title (default: names the unit)."),
-    max_points: int = option(ReportSettings, "max_points"),
     force: ForceOption = False,
     json_output: JsonOption = False,
     axes: AxesOption = None,
     inputs: ReadOptions | None = None,
+    settings: ReportSettings | None = None,
 ) -> None:
     """Write the HTML report: settling of the soaks (Fig. 3), T-f fit (Fig. 4, Table 1),
     temperature from frequency (Fig. 5, Table 2), raw and compensated output with bias
@@ -49,9 +50,9 @@ def report_command(
         refuse_input(output, [*runs, model, *(soak or [])])
         refuse_existing(output, force)
         check_writable(output, 20e6)  # before the passes over the runs
-        path = build_report(model, runs, output, soaks=soak or None, title=title,
-                            force=force, max_points=max_points, progress=progress,
-                            read_options=inputs, axes=parse_axes(axes))
+        settings = dataclasses.replace(settings or ReportSettings(), axes=parse_axes(axes))
+        path = build_report(model, runs, output, settings, soaks=soak or None, force=force,
+                            progress=progress, read_options=inputs)
         loaded = load_model(model)
     note_unchecked(loaded, model)
     size = path.stat().st_size

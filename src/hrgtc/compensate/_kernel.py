@@ -42,6 +42,7 @@ from __future__ import annotations
 import os
 import threading
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -288,20 +289,43 @@ def _term(exponents, k, x, m, out, factor):  # pragma: no cover - compiled
         first = False
 
 
+class DriftArrays(NamedTuple):
+    """A :class:`KernelPlan`'s drift arrays, one argument of :func:`compensate_block`."""
+
+    filter: np.ndarray
+    uses_housing: bool
+    uses_gradient: bool
+    exponents: np.ndarray
+    coefficients: np.ndarray
+    intercept: float
+    scales: np.ndarray
+    tangent: np.ndarray
+    low: np.ndarray
+    high: np.ndarray
+    flagged: np.ndarray
+    d_factor: np.ndarray
+    d_exponents: np.ndarray
+    d_constant: np.ndarray
+
+
 @njit(cache=True, nogil=True, error_model="numpy")
-def compensate_block(time_s, restart, freq_hz, rate_dph, housing_c, filt, uses_housing,
-                     uses_gradient, state,
-                     exponents, coefficients, intercept, scales, tangent, low, high, flagged,
-                     d_factor, d_exponents, d_constant, therm, poly, slope, chebyshev,
-                     grid_t, grid_f, out_rate, out_bias, out_temp, out_in_range, counts,
+def compensate_block(columns, drift, inverse, state, outputs, counts,
                      extremes):  # pragma: no cover
     """Compensate one block in place; see the module docstring for what is computed.
 
+    ``columns``: ``(time_s, restart, freq_hz, rate_dph, housing_c)``; ``drift``: a
+    :class:`DriftArrays`; ``inverse``: ``(thermometer, poly, slope, chebyshev, grid_t,
+    grid_f)`` of a :class:`KernelPlan`; ``outputs``: ``(rate, bias, temperature, in_range)``.
     ``state`` (filter, samples seen), ``counts`` (int64, see :data:`OUT_OF_RANGE`) and
     ``extremes`` (see :data:`F_MIN`) are updated. ``restart`` (int8 per sample, or empty:
     none) restarts the filters at rest on those samples and the settling time with them
     (the segment starts of ``gaps="split"``, and restarts of the logger).
     """
+    time_s, restart, freq_hz, rate_dph, housing_c = columns
+    (filt, uses_housing, uses_gradient, exponents, coefficients, intercept, scales, tangent, low,
+     high, flagged, d_factor, d_exponents, d_constant) = drift
+    therm, poly, slope, chebyshev, grid_t, grid_f = inverse
+    out_rate, out_bias, out_temp, out_in_range = outputs
     has_restart = restart.size > 0
     tau, ref_f, ref_h = filt[0], filt[3], filt[4]
     centre, scale_c, map_offset, map_scale = therm[0], therm[1], therm[2], therm[3]
@@ -333,8 +357,8 @@ def compensate_block(time_s, restart, freq_hz, rate_dph, housing_c, filt, uses_h
         n_lost = 0
         for i in range(m):
             fi = freq[i]
-            t, step = _start_and_step(fi, f_low, f_high, map_offset, map_scale, chebyshev,
-                                      t_low, t_high, centre, scale_c, poly, slope)
+            t, step = _start_and_step(fi, (f_low, f_high), (map_offset, map_scale),
+                                      (t_low, t_high), chebyshev, centre, scale_c, poly, slope)
             inside = (fi >= f_low) & (fi <= f_high)
             more = abs(step) > one_step_limit
             converged = (abs(step) <= one_step_limit) & (t >= t_low) & (t <= t_high)
@@ -347,8 +371,9 @@ def compensate_block(time_s, restart, freq_hz, rate_dph, housing_c, filt, uses_h
                 fi = freq[i]
                 if not ((fi >= f_low) & (fi <= f_high)):
                     continue
-                t, step = _start_and_step(fi, f_low, f_high, map_offset, map_scale,
-                                          chebyshev, t_low, t_high, centre, scale_c, poly, slope)
+                t, step = _start_and_step(fi, (f_low, f_high), (map_offset, map_scale),
+                                          (t_low, t_high), chebyshev, centre, scale_c, poly,
+                                          slope)
                 limit = one_step_limit
                 if abs(step) > one_step_limit:
                     clipped = min(max(fi, f_low), f_high)
@@ -515,26 +540,27 @@ def advance_filter(time_s, restart, freq_hz, housing_c, filt, uses_housing,
 PARALLEL_ROWS = 1 << 18
 
 
-def run(block_plan: KernelPlan, state: np.ndarray, time_s: np.ndarray, freq_hz: np.ndarray,
-        rate_dph: np.ndarray,
-        housing_c: np.ndarray | None, out: dict[str, np.ndarray], counts: np.ndarray,
+def run(block_plan: KernelPlan, state: np.ndarray, columns: tuple[np.ndarray | None, ...],
+        out: dict[str, np.ndarray], counts: np.ndarray,
         extremes: np.ndarray | None = None, restart: np.ndarray | None = None) -> None:
     """Compensate a chunk with a plan's arrays (outputs in ``out``, ``state`` advanced).
 
-    ``restart``: a boolean mask of the rows where the filters restart at rest (segment
+    ``columns``: ``(time_s, freq_hz, rate_dph, housing_c)`` (``housing_c`` None when not
+    read). ``restart``: a boolean mask of the rows where the filters restart at rest (segment
     starts of ``gaps="split"``), or None. A long chunk is cut in two: the filter alone
     runs over the first half to give the state at the cut, then both halves are
     compensated at once on two threads (the kernel releases the GIL). Results are the
     same bits as one call.
     """
+    time_s, freq_hz, rate_dph, housing_c = columns
     housing = freq_hz if housing_c is None else housing_c
     mask = (np.zeros(0, dtype=np.int8) if restart is None
             else np.ascontiguousarray(restart, dtype=np.int8))
     extremes = new_extremes() if extremes is None else extremes
     n = freq_hz.size
+    arrays = (time_s, mask, freq_hz, rate_dph, housing)
     if n < PARALLEL_ROWS or (os.cpu_count() or 1) < 2:
-        _call(block_plan, state, time_s, mask, freq_hz, rate_dph, housing, out, counts,
-              extremes, 0, n)
+        _call(block_plan, state, arrays, out, counts, extremes, 0, n)
         return
     middle = n // 2
     second = state.copy()
@@ -542,13 +568,11 @@ def run(block_plan: KernelPlan, state: np.ndarray, time_s: np.ndarray, freq_hz: 
                    block_plan.filter, block_plan.uses_housing, second)
     second_counts = np.zeros_like(counts)
     second_extremes = new_extremes()
-    worker = threading.Thread(target=_call, args=(block_plan, second, time_s, mask, freq_hz,
-                                                  rate_dph, housing, out, second_counts,
-                                                  second_extremes, middle, n))
+    worker = threading.Thread(target=_call, args=(block_plan, second, arrays, out,
+                                                  second_counts, second_extremes, middle, n))
     worker.start()
     try:
-        _call(block_plan, state, time_s, mask, freq_hz, rate_dph, housing, out, counts,
-              extremes, 0, middle)
+        _call(block_plan, state, arrays, out, counts, extremes, 0, middle)
     finally:
         worker.join()
     state[:] = second
@@ -557,17 +581,20 @@ def run(block_plan: KernelPlan, state: np.ndarray, time_s: np.ndarray, freq_hz: 
     extremes[1::2] = np.maximum(extremes[1::2], second_extremes[1::2])
 
 
-def _call(p: KernelPlan, state: np.ndarray, time_s: np.ndarray, restart: np.ndarray,
-          freq_hz: np.ndarray, rate_dph: np.ndarray,
-          housing_c: np.ndarray, out: dict[str, np.ndarray], counts: np.ndarray,
-          extremes: np.ndarray, start: int, stop: int) -> None:
+def _call(p: KernelPlan, state: np.ndarray, columns: tuple[np.ndarray, ...],
+          out: dict[str, np.ndarray], counts: np.ndarray, extremes: np.ndarray, start: int,
+          stop: int) -> None:
+    """:func:`compensate_block` of the rows ``start:stop`` of ``columns`` into ``out``."""
     part = slice(start, stop)
+    time_s, restart, freq_hz, rate_dph, housing_c = columns
     compensate_block(
-        time_s[part], restart[part] if restart.size else restart, freq_hz[part],
-        rate_dph[part], housing_c[part], p.filter, p.uses_housing,
-        p.uses_gradient, state, p.exponents, p.coefficients, p.intercept, p.scales, p.tangent,
-        p.low, p.high, p.flagged, p.d_factor, p.d_exponents, p.d_constant, p.thermometer,
-        p.poly, p.slope, p.chebyshev, p.grid_t, p.grid_f, out["rate_comp_dph"][part],
-        out["bias_model_dph"][part], out["resonator_c_est"][part], out["in_range"][part],
+        (time_s[part], restart[part] if restart.size else restart, freq_hz[part],
+         rate_dph[part], housing_c[part]),
+        DriftArrays(p.filter, p.uses_housing, p.uses_gradient, p.exponents, p.coefficients,
+                    p.intercept, p.scales, p.tangent, p.low, p.high, p.flagged, p.d_factor,
+                    p.d_exponents, p.d_constant),
+        (p.thermometer, p.poly, p.slope, p.chebyshev, p.grid_t, p.grid_f), state,
+        (out["rate_comp_dph"][part], out["bias_model_dph"][part],
+         out["resonator_c_est"][part], out["in_range"][part]),
         counts, extremes,
     )

@@ -22,9 +22,14 @@ CHEBYSHEV_SIZE = 10
 
 
 @njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _start_and_step(f, f_low, f_high, map_offset, map_scale, chebyshev, t_low, t_high, centre,
-                    scale_c, poly, slope):  # pragma: no cover - compiled
-    """Chebyshev start and one Newton step of one sample: (t after the step, the step)."""
+def _start_and_step(f, f_bracket, start_map, t_bracket, chebyshev, centre, scale_c, poly,
+                    slope):  # pragma: no cover - compiled
+    """Chebyshev start and one Newton step of one sample: (t after the step, the step).
+    ``f_bracket``, ``start_map``, ``t_bracket``: the pairs (f_low, f_high), (map offset,
+    map scale), (t_low, t_high) of the inverse."""
+    f_low, f_high = f_bracket
+    map_offset, map_scale = start_map
+    t_low, t_high = t_bracket
     c = f
     c = f_low if c < f_low else c
     c = f_high if c > f_high else c

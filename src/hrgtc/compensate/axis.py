@@ -299,7 +299,7 @@ class AxisCompensator:
         time_s = np.ascontiguousarray(chunk.time_s, dtype=np.float64)
         check_time(time_s, self._state[kernel.F_STATE])
         extremes = kernel.new_extremes()
-        kernel.run(self._plan, self._state, time_s, freq, chunk.rate_dph, housing, out, counts,
+        kernel.run(self._plan, self._state, (time_s, freq, chunk.rate_dph, housing), out, counts,
                    extremes, restart)
         self.samples += len(chunk)
         self._origin_s = float(self._state[kernel.ORIGIN])

@@ -185,8 +185,8 @@ def _compensate(job: _Job, compensator: Compensator,
             # duplicated rows in the first chunk: told apart by all the columns
             only = None if repair.duplicates else only
             # the spike filter's flags change no row: not computed in the detector's pass
-            quick = dataclasses.replace(options, spike_filter="off")
-            flags = RestFlags(rec_io.iter_chunks(source, quick, rows=chunk_rows,
+            quick = dataclasses.replace(options, spike_filter="off", chunk_rows=chunk_rows)
+            flags = RestFlags(rec_io.iter_chunks(source, quick,
                                                  validate=False, only=only),
                               list(model.axes), options.motion,
                               os.path.basename(os.fspath(source)),

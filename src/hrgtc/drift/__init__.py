@@ -40,8 +40,14 @@ from hrgtc.drift.scale_factor import (
     fit_scale_factor,
     group_segments,
 )
-from hrgtc.drift.stepwise import Step, StepwiseResult, stepwise, stepwise_from_accumulator
-from hrgtc.drift.windows import TrainingWindows, window_means
+from hrgtc.drift.stepwise import (
+    Step,
+    StepwiseResult,
+    StepwiseRules,
+    stepwise,
+    stepwise_from_accumulator,
+)
+from hrgtc.drift.windows import TrainingWindows, Windowing, window_means
 
 __all__ = [
     "EQ21",
@@ -60,8 +66,10 @@ __all__ = [
     "SegmentScaleErrors",
     "Step",
     "StepwiseResult",
+    "StepwiseRules",
     "Term",
     "TrainingWindows",
+    "Windowing",
     "causal_rate",
     "find_rate_segments",
     "fit",

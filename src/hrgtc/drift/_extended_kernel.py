@@ -51,15 +51,19 @@ def _two_product(a, a_hi, a_lo, b, b_hi, b_lo):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def residual_pass(X, y, shift, inverse, weights, x_hi, x_lo, r_hi, r_lo, f, g_hi, g_lo,
-                  first):  # pragma: no cover - compiled
+def residual_pass(X, y, scaling, weights, x, r, f, g, first):  # pragma: no cover - compiled
     """One pass over the rows in double-double arithmetic.
 
-    ``first``: r = b - A x is written to (r_hi, r_lo) and f is left alone; otherwise
-    f = b - r - A x of the current (r, x) is written to ``f`` (rounded to float64). In
-    both cases g = -A' r, with the r after the pass, goes to (g_hi, g_lo). ``weights``
-    is empty for an unweighted fit.
+    ``scaling`` is ``(shift, inverse)``; ``x``, ``r`` and ``g`` are the (hi, lo) pairs of
+    arrays of x, r and g. ``first``: r = b - A x is written to (r_hi, r_lo) and f is left
+    alone; otherwise f = b - r - A x of the current (r, x) is written to ``f`` (rounded to
+    float64). In both cases g = -A' r, with the r after the pass, goes to (g_hi, g_lo).
+    ``weights`` is empty for an unweighted fit.
     """
+    shift, inverse = scaling
+    x_hi, x_lo = x
+    r_hi, r_lo = r
+    g_hi, g_lo = g
     n, k = X.shape
     weighted = weights.size > 0
     xs_hi = np.empty(k + 1)

@@ -34,7 +34,7 @@ from hrgtc.core.timeline import time_blocks
 from hrgtc.drift.edge_slope import unknown_edge_slope
 from hrgtc.drift.regression import newey_west_inflation
 from hrgtc.drift.slow_noise import SLOW_NOISE_LEVEL, beyond_slow_noise
-from hrgtc.drift.stepwise import stepwise
+from hrgtc.drift.stepwise import StepwiseRules, stepwise
 
 #: Windows whose |df/dt| is below this share of the largest are neither heating nor cooling.
 RATE_DEADBAND = 0.05
@@ -476,8 +476,8 @@ def _line_admitted(x_scaled: np.ndarray, bias_dph: np.ndarray, names: Sequence[s
         return False
     k = list(names).index(LINE_TERM)
     penter, premove = line_test
-    return stepwise(x_scaled[:, [k]], bias_dph, names=[LINE_TERM], penter=penter,
-                    premove=premove).selected == (LINE_TERM,)
+    return stepwise(x_scaled[:, [k]], bias_dph, names=[LINE_TERM],
+                    rules=StepwiseRules(penter, premove)).selected == (LINE_TERM,)
 
 
 def guard_selection(data: Windowed, selected: Sequence[str],

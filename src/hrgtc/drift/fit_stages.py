@@ -31,8 +31,8 @@ from hrgtc.drift.fit_checks import check_excitation, given_options, registry_ent
 from hrgtc.drift.offsets import offset_groups, project_off
 from hrgtc.drift.regression import EXTENDED_PRECISION, newey_west_inflation
 from hrgtc.drift.rest import check_policy, reference_point, run_rest
-from hrgtc.drift.stepwise import StepwiseResult, stepwise
-from hrgtc.drift.windows import RunSource, _iter_run, window_means_at
+from hrgtc.drift.stepwise import StepwiseResult, StepwiseRules, stepwise
+from hrgtc.drift.windows import RunSource, Windowing, _iter_run, window_means_at
 from hrgtc.recording.motion import MotionSettings
 from hrgtc.settings.drift import SELECTIONS, WARMUP_FACTOR, DriftSettings
 
@@ -114,10 +114,10 @@ class Training:
                 warmups_s: Sequence[float] | None = None) -> tuple[Any, ...]:
         """The window means of ``terms`` over the runs (at rest, after the warm-up), one
         result per warm-up of ``warmups_s`` from one reading (default: the settings')."""
-        return window_means_at(self.runs, self.features, terms, drift.window_s, progress,
-                               thermometer, tracked, keep=self.keep, gaps=self.reading.gaps,
-                               restart_each_segment=self.reading.restart_each_segment,
-                               warmups_s=warmups_s)
+        windowing = Windowing(drift.window_s, tuple(tracked), self.reading.gaps,
+                              self.reading.restart_each_segment)
+        return window_means_at(self.runs, self.features, terms, windowing, progress,
+                               thermometer, self.keep, warmups_s)
 
 
 def prepare(runs: Sequence[RunSource], thermometer: Any, drift: DriftSettings,
@@ -267,8 +267,9 @@ def select(training: Training, made: Design, drift: DriftSettings, thermometer: 
     slope_sign = 1.0 if thermometer.slope_hz_per_c(training.reference_c) >= 0 else -1.0
     rate = windows.variables.get("df", np.zeros(windows.bias_dph.size))
     parents = hierarchy(training.candidates) if drift.hierarchical else None
-    result = stepwise(x_scaled, bias, names=names, penter=drift.penter, premove=drift.premove,
-                      initial=initial, variance_inflation=inflation, parents=parents,
+    rules = StepwiseRules(penter=drift.penter, premove=drift.premove, initial=initial,
+                          variance_inflation=inflation, parents=parents)
+    result = stepwise(x_scaled, bias, names=names, rules=rules,
                       refine=EXTENDED_PRECISION)  # quietly unrefined without long double
     chosen, pruning = None, None
     data = Windowed(x_scaled, bias, windows.run, names, tuple(windows.sources), rate,
@@ -282,9 +283,9 @@ def select(training: Training, made: Design, drift: DriftSettings, thermometer: 
             line_test=(drift.penter, drift.premove))
     if chosen is not None:
         history = result.history
-        result = stepwise(x_scaled, bias, names=names, penter=drift.penter,
-                          premove=drift.premove, initial=chosen, variance_inflation=inflation,
-                          max_steps=0, refine=EXTENDED_PRECISION)
+        rules = StepwiseRules(penter=drift.penter, premove=drift.premove, initial=chosen,
+                              variance_inflation=inflation, max_steps=0)
+        result = stepwise(x_scaled, bias, names=names, rules=rules, refine=EXTENDED_PRECISION)
         if drift.select == "guarded":  # the F-test steps stay on record; pruning apart
             result = dataclasses.replace(result, history=history)
     return Selection(result, pruning, inflation, bandwidth, slope_sign, rate)
@@ -309,8 +310,9 @@ def refit_rate_free(training: Training, made: Design, chosen: Selection,
     refit = Design(windows, made.scales, made.factors,
                    *design_matrix(windows, drift.offsets, made.factors))
     chosen.result = dataclasses.replace(
-        stepwise(refit.x_scaled, refit.bias, names=training.names, penter=drift.penter,
-                 premove=drift.premove, initial=chosen.result.selected,
-                 variance_inflation=chosen.inflation, max_steps=0,
+        stepwise(refit.x_scaled, refit.bias, names=training.names,
+                 rules=StepwiseRules(penter=drift.penter, premove=drift.premove,
+                                     initial=chosen.result.selected,
+                                     variance_inflation=chosen.inflation, max_steps=0),
                  refine=EXTENDED_PRECISION), history=history)
     return refit

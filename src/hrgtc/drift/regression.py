@@ -240,12 +240,13 @@ def refine(result: OLSResult, X: Any, y: Any, weights: Any = None, *,
     r_hi, r_lo = np.empty(n), np.empty(n)
     f = np.zeros(n)
     g_hi, g_lo = np.empty(k + 1), np.empty(k + 1)
-    residual_pass(X_c, y_c, shift, inverse, w_c, x_hi, x_lo, r_hi, r_lo, f, g_hi, g_lo, True)
+    residual_pass(X_c, y_c, (shift, inverse), w_c, (x_hi, x_lo), (r_hi, r_lo), f,
+                  (g_hi, g_lo), True)
     previous = np.inf
     for step in range(max_steps):
         if step:
-            residual_pass(X_c, y_c, shift, inverse, w_c, x_hi, x_lo, r_hi, r_lo, f, g_hi, g_lo,
-                          False)
+            residual_pass(X_c, y_c, (shift, inverse), w_c, (x_hi, x_lo), (r_hi, r_lo), f,
+                          (g_hi, g_lo), False)
         h = solve_triangular(r_factor, g_hi + g_lo, trans="T")
         if q is None:  # Q' f = R^-T A' f
             d = solve_triangular(r_factor, _design_t(X_c, shift[:k], inverse[:k], root_w, f),

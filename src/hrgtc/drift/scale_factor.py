@@ -47,7 +47,7 @@ from hrgtc.drift.features import (
     tangent_extension,
 )
 from hrgtc.drift.rate_segments import RateSegment
-from hrgtc.drift.stepwise import Step, stepwise
+from hrgtc.drift.stepwise import Step, StepwiseRules, stepwise
 from hrgtc.settings.drift import PENTER, PREMOVE_FLOOR
 
 __all__ = [
@@ -388,7 +388,7 @@ def fit_scale_factor(segments: Iterable[RateSegment], settings: FeatureSettings,
             candidates = [t for t in candidates if t in usable]
             names = tuple(t.name for t in candidates)
         design = np.column_stack([t.evaluate({"f": x_f}, {}) for t in candidates])
-        found = stepwise(design, k, names=names, penter=penter, premove=premove,
+        found = stepwise(design, k, names=names, rules=StepwiseRules(penter, premove),
                          weights=w if use_weights else None)
         result = found.result
         selected, history = found.selected, found.history

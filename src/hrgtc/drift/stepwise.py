@@ -138,23 +138,12 @@ StepRecord = records.record_of(Step)
 StepwiseRecord = records.record_of(StepwiseResult, "StepwiseRecord")
 
 
-def stepwise(X: Any, y: Any, names: Sequence[str] | None = None, penter: float = PENTER,
-             premove: float | None = None, initial: Iterable[str | int | bool] | None = None,
-             max_steps: int | None = None, *, weights: Any = None,
-             tol: float = COLLINEARITY_TOL,
-             variance_inflation: float = 1.0,
-             parents: Mapping[str, Iterable[str]] | None = None,
-             refine: bool = True) -> StepwiseResult:
-    """Stepwise linear regression with MATLAB ``stepwisefit`` semantics, Section 4.1 of [1].
+@dataclass(frozen=True)
+class StepwiseRules:
+    """The rules of a stepwise search (one settings object, passed whole).
 
-    Parameters
+    Attributes
     ----------
-    X
-        Candidate terms, shape (rows, p); no column of ones (the constant is always in).
-    y
-        Response, shape (rows,). [units of y]
-    names
-        Name of each candidate (default ``x1, x2, ...``).
     penter
         A term enters if its partial-F p-value is below this.
     premove
@@ -166,8 +155,6 @@ def stepwise(X: Any, y: Any, names: Sequence[str] | None = None, penter: float =
         Most steps to take; default no limit. A step that would return to a
         model already visited stops the search (``stop_reason == "cycle"``, with
         an :class:`~hrgtc.core.errors.HrgtcWarning`), so it always ends.
-    weights
-        Optional non-negative weight per row.
     tol
         Collinearity tolerance; a candidate collinear with the current model is
         not eligible to enter.
@@ -180,6 +167,35 @@ def stepwise(X: Any, y: Any, names: Sequence[str] | None = None, penter: float =
         terms it contains (``"f^2*df"`` -> ``["f*df", "f^2"]``). A term may enter
         only when all its parents are in, and may leave only when none of its
         children is in. None (default) gives ``stepwisefit`` exactly.
+    """
+
+    penter: float = PENTER
+    premove: float | None = None
+    initial: Iterable[str | int | bool] | None = None
+    max_steps: int | None = None
+    tol: float = COLLINEARITY_TOL
+    variance_inflation: float = 1.0
+    parents: Mapping[str, Iterable[str]] | None = None
+
+
+def stepwise(X: Any, y: Any, names: Sequence[str] | None = None,
+             rules: StepwiseRules = StepwiseRules(), *, weights: Any = None,
+             refine: bool = True) -> StepwiseResult:
+    """Stepwise linear regression with MATLAB ``stepwisefit`` semantics, Section 4.1 of [1].
+
+    Parameters
+    ----------
+    X
+        Candidate terms, shape (rows, p); no column of ones (the constant is always in).
+    y
+        Response, shape (rows,). [units of y]
+    names
+        Name of each candidate (default ``x1, x2, ...``).
+    rules
+        Entry and removal thresholds, starting model, step limit, collinearity
+        tolerance, variance inflation and hierarchy (:class:`StepwiseRules`).
+    weights
+        Optional non-negative weight per row.
     refine
         Polish the coefficients of the selected model by extended-precision
         refinement of the augmented system on the rows
@@ -196,15 +212,13 @@ def stepwise(X: Any, y: Any, names: Sequence[str] | None = None, penter: float =
     >>> rng = np.random.default_rng(1)
     >>> X = rng.normal(size=(500, 5))
     >>> y = 1 + 2 * X[:, 1] - 3 * X[:, 3] + rng.normal(size=500)
-    >>> stepwise(X, y, penter=0.001, premove=0.01).selected
+    >>> stepwise(X, y, rules=StepwiseRules(penter=0.001, premove=0.01)).selected
     ('x2', 'x4')
     """
     X = np.asarray(X, dtype=np.float64)
     acc = GramAccumulator(_check_names(names, X.shape[1]) if X.ndim == 2 else names)
     acc.partial_fit(X, y, weights)
-    found = stepwise_from_accumulator(acc, penter=penter, premove=premove, initial=initial,
-                                      max_steps=max_steps, tol=tol,
-                                      variance_inflation=variance_inflation, parents=parents)
+    found = stepwise_from_accumulator(acc, rules=rules)
     if not refine:
         return found
     columns = [found.candidates.index(name) for name in found.selected]
@@ -216,12 +230,7 @@ _refine = refine  # ``stepwise`` has a parameter of the same name
 
 
 def stepwise_from_accumulator(acc: GramAccumulator, names: Sequence[str] | None = None,
-                              penter: float = PENTER, premove: float | None = None,
-                              initial: Iterable[str | int | bool] | None = None,
-                              max_steps: int | None = None, *,
-                              tol: float = COLLINEARITY_TOL,
-             variance_inflation: float = 1.0,
-             parents: Mapping[str, Iterable[str]] | None = None) -> StepwiseResult:
+                              rules: StepwiseRules = StepwiseRules()) -> StepwiseResult:
     """Stepwise regression from accumulated statistics, without the raw rows.
 
     For data too large to hold: feed the rows chunk by chunk (or per file, per
@@ -237,6 +246,8 @@ def stepwise_from_accumulator(acc: GramAccumulator, names: Sequence[str] | None 
         Statistics of all rows.
     names
         Override of the candidate names (default ``acc.names_``).
+    rules
+        The rules of the search (:class:`StepwiseRules`).
 
     Examples
     --------
@@ -246,9 +257,12 @@ def stepwise_from_accumulator(acc: GramAccumulator, names: Sequence[str] | None 
     >>> for _ in range(10):  # e.g. one chunk per file
     ...     X = rng.normal(size=(10_000, 3))
     ...     _ = acc.partial_fit(X, 0.5 + 3 * X[:, 0] + rng.normal(size=10_000))
-    >>> stepwise_from_accumulator(acc, penter=1e-4, premove=1e-3).selected
+    >>> stepwise_from_accumulator(acc, rules=StepwiseRules(penter=1e-4, premove=1e-3)).selected
     ('f',)
     """
+    penter, premove, initial, max_steps = rules.penter, rules.premove, rules.initial, \
+        rules.max_steps
+    tol, variance_inflation, parents = rules.tol, rules.variance_inflation, rules.parents
     cand = _check_names(names, len(acc._require_data())) if names is not None \
         else acc._require_data()
     premove = max(penter, PREMOVE_FLOOR) if premove is None else premove

@@ -239,18 +239,39 @@ def _iter_run(source: RunSource) -> Iterator[Recording]:
         yield from source()
 
 
+@dataclass(frozen=True)
+class Windowing:
+    """How the training runs are cut into windows (one settings object, passed whole).
+
+    Attributes
+    ----------
+    window_s
+        Window length. [s]
+    extra_variables
+        Variables whose window means are kept although no term uses them (their
+        training ranges: ``df`` for the range warnings of a model without df terms).
+    gaps
+        ``"split"``: the df/dt filter restarts after every gap (and settles for
+        ``warmup_s`` again); otherwise (``"bridge"``, ``"ignore"``, ``"error"``) it
+        carries across. Windows never span a gap either way.
+    restart_each_segment
+        Each segment is a power-on: the warm-up is skipped after every gap.
+    """
+
+    window_s: float = 10.0
+    extra_variables: Sequence[str] = ()
+    gaps: str = "bridge"
+    restart_each_segment: bool = False
+
+
 def window_means(
     runs: Sequence[RunSource],
     settings: FeatureSettings,
     terms: Sequence[Term],
-    window_s: float = 10.0,
+    windowing: Windowing = Windowing(),
     progress: Progress | None = None,
     thermometer: Any = None,
-    extra_variables: Sequence[str] = (),
     keep: Sequence[np.ndarray | None] | None = None,
-    *,
-    gaps: str = "bridge",
-    restart_each_segment: bool = False,
 ) -> TrainingWindows:
     """Window means of candidate terms and measured bias over training runs.
 
@@ -263,30 +284,19 @@ def window_means(
         Feature settings (reference frequency, rate filter, warm-up).
     terms
         Candidate terms.
-    window_s
-        Window length. [s]
+    windowing
+        Window length, extra variables and gap handling (:class:`Windowing`).
     progress
         Optional ``callback(samples_done, samples_total_or_0)``.
     thermometer
         The unit's thermometer, for the gradient ``g`` (see :class:`FeatureStream`).
-    extra_variables
-        Variables whose window means are kept although no term uses them (their
-        training ranges: ``df`` for the range warnings of a model without df terms).
     keep
         Per run, True for each sample at rest (:func:`hrgtc.drift.rest.run_rest`) or
         None to use every sample: the windows are means of kept samples only and never
         reach across a left-out stretch, so every trained range comes from the samples
         actually used.
-    gaps
-        ``"split"``: the df/dt filter restarts after every gap (and settles for
-        ``warmup_s`` again); otherwise (``"bridge"``, ``"ignore"``, ``"error"``) it
-        carries across. Windows never span a gap either way.
-    restart_each_segment
-        Each segment is a power-on: the warm-up is skipped after every gap.
     """
-    return window_means_at(runs, settings, terms, window_s, progress, thermometer,
-                           extra_variables, keep, gaps=gaps,
-                           restart_each_segment=restart_each_segment)[0]
+    return window_means_at(runs, settings, terms, windowing, progress, thermometer, keep)[0]
 
 
 class _Windows:
@@ -294,6 +304,7 @@ class _Windows:
     trained ranges and its counts (the rows it uses differ only by the warm-up)."""
 
     def __init__(self, warmup_s: float, n_variables: int) -> None:
+        self.warmup_s = warmup_s
         self.threshold_s = settle_threshold_s(warmup_s)
         self.time: list[np.ndarray] = []
         self.power: list[np.ndarray] = []
@@ -318,14 +329,10 @@ def window_means_at(
     runs: Sequence[RunSource],
     settings: FeatureSettings,
     terms: Sequence[Term],
-    window_s: float = 10.0,
+    windowing: Windowing = Windowing(),
     progress: Progress | None = None,
     thermometer: Any = None,
-    extra_variables: Sequence[str] = (),
     keep: Sequence[np.ndarray | None] | None = None,
-    *,
-    gaps: str = "bridge",
-    restart_each_segment: bool = False,
     warmups_s: Sequence[float] | None = None,
 ) -> tuple[TrainingWindows, ...]:
     """:func:`window_means` for each warm-up of ``warmups_s`` (default
@@ -333,12 +340,14 @@ def window_means_at(
     on the warm-up, only which rows are settled does, so each result is what
     :func:`window_means` gives with ``settings.warmup_s`` set to that warm-up (the drift
     fit's rate-free refit, ``warmup_s=0``, costs no second pass)."""
+    window_s = windowing.window_s
+    restart_each_segment = windowing.restart_each_segment
     variables = variables_for(terms)
-    variables += tuple(v for v in extra_variables if v not in variables)
+    variables += tuple(v for v in windowing.extra_variables if v not in variables)
     if not window_s > 0:
         raise InputError(f"window_s must be a positive number of seconds, got {window_s!r}")
     warmups = (settings.warmup_s,) if warmups_s is None else tuple(warmups_s)
-    split = gaps == "split"
+    split = windowing.gaps == "split"
     power_names: list[str] = []
     kept_by = [_Windows(w, len(variables)) for w in warmups]
     total = segments = 0
@@ -468,16 +477,17 @@ def window_means_at(
         if power > first_power:  # the file restarted: name its first run too
             power_names[first_power] = f"{sources[-1]} run 1"
     warn_rate_filter(problems)
-    return tuple(_training_windows(w, warmup, window_s, split, variables, extra or (), total,
+    return tuple(_training_windows(w, windowing, variables, extra or (), total,
                                    sources, segments, power_names)
-                 for w, warmup in zip(kept_by, warmups, strict=True))
+                 for w in kept_by)
 
 
-def _training_windows(windows: _Windows, warmup_s: float, window_s: float, split: bool,
+def _training_windows(windows: _Windows, windowing: Windowing,
                       variables: tuple[str, ...], extra: tuple[str, ...], total: int,
                       sources: list[str], segments: int,
                       power_names: list[str]) -> TrainingWindows:
     """The :class:`TrainingWindows` of one warm-up's windows."""
+    split, window_s, warmup_s = windowing.gaps == "split", windowing.window_s, windows.warmup_s
     if not windows.time:
         restart = " after every gap (--gaps split restarts the filter)" if split else ""
         raise CalibrationError(

@@ -22,10 +22,36 @@ comparison); ``fastmath`` is off, so no product is fused into an add.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 
 _JIT = {"cache": True, "nogil": True, "fastmath": False}
+
+
+class ChannelTests(NamedTuple):
+    """The constants of :func:`segment_tests` for one channel, one argument of the kernel
+    (numba takes a namedtuple): the baseline's blocks, the variance test's rows, the
+    shortest run, the level limit, the first differences' σ and centre, the MAD-to-σ
+    factor, the variance and clipping limits, the channel's maximum (``high``) and
+    minimum (``low``) over the whole recording, the samples a clip needs, whether the
+    channel's σ is positive, and ``held`` (see :func:`segment_tests`)."""
+
+    baseline_blocks: int
+    var_rows: int
+    min_run: int
+    level_limit: float
+    diff_sigma: float
+    diff_centre: float
+    mad_to_sigma: float
+    variance_limit: float
+    clip_limit: float
+    high: float
+    low: float
+    clip_samples: int
+    sigma_positive: bool
+    held: bool
 
 #: The differences ``d = x[i + 1] - x[i]`` that :func:`bracket` and :func:`gather` select.
 FORWARD = 0  # d where d > 0
@@ -322,22 +348,24 @@ def _variance_test(values: np.ndarray, var_rows: int, centre: float, mad_to_sigm
 
 
 @njit(**_JIT)
-def segment_tests(t: np.ndarray, values: np.ndarray, edges: np.ndarray, baseline_blocks: int,
-                  var_rows: int, min_run: int, level_limit: float, diff_sigma: float,
-                  diff_centre: float, mad_to_sigma: float, variance_limit: float,
-                  clip_limit: float, extremes: np.ndarray, clip_samples: int,
-                  sigma_positive: bool, level: np.ndarray, variance: np.ndarray,
-                  clipped: np.ndarray, stepped: np.ndarray, held: bool = False) -> None:
+def segment_tests(t: np.ndarray, values: np.ndarray, edges: np.ndarray, tests: ChannelTests,
+                  out: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]) -> None:
     """Level, variance and clipping tests of one channel over one segment, OR-ed into
-    ``level``, ``variance`` and ``clipped`` (views of the segment). ``extremes``: the
-    channel's maximum and minimum over the whole recording. ``stepped``: the runs off the
-    interpolated baseline alone (a step of the still level bends it; see
+    ``level``, ``variance`` and ``clipped`` (views of the segment; ``out`` is
+    ``(level, variance, clipped, stepped)``), with the constants ``tests``. ``stepped``:
+    the runs off the interpolated baseline alone (a step of the still level bends it; see
     :func:`isolated_runs`). ``held``: a channel whose still level never drifts between two
     anchors (an accelerometer: gravity), so anchors that disagree are a step and a sample
     between them is at rest only near one of them (a tilt along the interpolation is not)."""
+    level, variance, clipped, stepped = out
+    baseline_blocks, var_rows, min_run = tests.baseline_blocks, tests.var_rows, tests.min_run
+    level_limit, diff_sigma, diff_centre = tests.level_limit, tests.diff_sigma, tests.diff_centre
+    mad_to_sigma, variance_limit = tests.mad_to_sigma, tests.variance_limit
+    clip_limit, high, low, clip_samples = tests.clip_limit, tests.high, tests.low, \
+        tests.clip_samples
+    sigma_positive, held = tests.sigma_positive, tests.held
     m = values.size
     medians, centres, slopes = _anchors(t, values, edges, baseline_blocks)
-    high, low = extremes[0], extremes[1]
     j = 0
     run_level = run_high = run_low = run_step = -1
     for i in range(m + 1):
@@ -363,11 +391,13 @@ def segment_tests(t: np.ndarray, values: np.ndarray, edges: np.ndarray, baseline
 
 
 @njit(**_JIT)
-def guard(level: np.ndarray, variance: np.ndarray, clipped: np.ndarray, accel: np.ndarray,
-          starts: np.ndarray, stops: np.ndarray, after: int, before: int, moving: np.ndarray,
+def guard(found: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray], starts: np.ndarray,
+          stops: np.ndarray, after: int, before: int, moving: np.ndarray,
           guarded: np.ndarray) -> None:
-    """``moving``: the samples found by any test, each run extended by the guard inside its
-    segment (``starts``, ``stops``); ``guarded``: those marked by the guard alone."""
+    """``moving``: the samples found by any test (``found``: the level, variance, clipping
+    and accelerometer masks), each run extended by the guard inside its segment
+    (``starts``, ``stops``); ``guarded``: those marked by the guard alone."""
+    level, variance, clipped, accel = found
     for k in range(starts.size):
         a, b = starts[k], stops[k]
         start = -1

@@ -22,12 +22,31 @@ it; they are taken of absolute values and positive steps, so no zero's sign can 
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 
 from hrgtc.recording._motion_kernel import median as _long_median
 
 _JIT = {"cache": True, "nogil": True, "fastmath": False}
+
+
+class SpikeRule(NamedTuple):
+    """The filter's constants, one argument of the kernels (numba takes a namedtuple):
+    the threshold ``max(k·σ_MAD, floor)`` over ``window_s`` windows of at least
+    ``min_window`` finite second differences (σ_MAD = ``mad_to_sigma`` × median /
+    ``second_diff``), segments cut at a step beyond ``gap_periods`` median periods
+    (times ``tolerance``)."""
+
+    k: float
+    floor: float
+    window_s: float
+    gap_periods: float
+    tolerance: float
+    min_window: int
+    mad_to_sigma: float
+    second_diff: float
 
 
 @njit(**_JIT)
@@ -210,8 +229,7 @@ def _test(xs: np.ndarray, i: int, n: int, q: float, mode: int) -> bool:
 
 
 @njit(**_JIT)
-def segment_tests(ts: np.ndarray, xs: np.ndarray, k: float, floor: float, window_s: float,
-                  min_window: int, mad_to_sigma: float, second_diff: float, mode: int,
+def segment_tests(ts: np.ndarray, xs: np.ndarray, rule: SpikeRule, mode: int,
                   out: np.ndarray) -> None:
     """The test ``mode`` of every sample of one segment of at least 3 samples, into ``out``.
 
@@ -220,6 +238,8 @@ def segment_tests(ts: np.ndarray, xs: np.ndarray, k: float, floor: float, window
     ``max(k·σ_MAD, floor)``, then the test of each of its samples; no array as long as
     the segment is filled (a fresh array costs its page faults).
     """
+    k, floor, window_s, min_window = rule.k, rule.floor, rule.window_s, rule.min_window
+    mad_to_sigma, second_diff = rule.mad_to_sigma, rule.second_diff
     n = xs.size
     # the window origin: the smallest time that is not NaN (0 without a finite one)
     any_finite = False
@@ -273,32 +293,23 @@ def segment_tests(ts: np.ndarray, xs: np.ndarray, k: float, floor: float, window
 
 
 @njit(**_JIT)
-def _channel_test(t: np.ndarray, x: np.ndarray, k: float, floor: float, window_s: float,
-                  gap_periods: float, tolerance: float, min_window: int, mad_to_sigma: float,
-                  second_diff: float, mode: int) -> np.ndarray:
+def _channel_test(t: np.ndarray, x: np.ndarray, rule: SpikeRule, mode: int) -> np.ndarray:
     out = np.zeros(x.size, dtype=np.bool_)
     start = 0
-    for stop in segment_stops(t, gap_periods, tolerance):
+    for stop in segment_stops(t, rule.gap_periods, rule.tolerance):
         if stop - start >= 3:
-            segment_tests(t[start:stop], x[start:stop], k, floor, window_s, min_window,
-                          mad_to_sigma, second_diff, mode, out[start:stop])
+            segment_tests(t[start:stop], x[start:stop], rule, mode, out[start:stop])
         start = stop
     return out
 
 
 @njit(**_JIT)
-def spike_mask(t: np.ndarray, x: np.ndarray, k: float, floor: float, window_s: float,
-               gap_periods: float, tolerance: float, min_window: int, mad_to_sigma: float,
-               second_diff: float) -> np.ndarray:
+def spike_mask(t: np.ndarray, x: np.ndarray, rule: SpikeRule) -> np.ndarray:
     """:func:`hrgtc.recording.spikes.find_spikes` of one channel, given its LSB floor."""
-    return _channel_test(t, x, k, floor, window_s, gap_periods, tolerance, min_window,
-                         mad_to_sigma, second_diff, SPIKE)
+    return _channel_test(t, x, rule, SPIKE)
 
 
 @njit(**_JIT)
-def across_mask(t: np.ndarray, x: np.ndarray, k: float, floor: float, window_s: float,
-                gap_periods: float, tolerance: float, min_window: int, mad_to_sigma: float,
-                second_diff: float) -> np.ndarray:
+def across_mask(t: np.ndarray, x: np.ndarray, rule: SpikeRule) -> np.ndarray:
     """:func:`hrgtc.recording.spikes.moving_across` of one channel, given its LSB floor."""
-    return _channel_test(t, x, k, floor, window_s, gap_periods, tolerance, min_window,
-                         mad_to_sigma, second_diff, ACROSS)
+    return _channel_test(t, x, rule, ACROSS)

@@ -334,7 +334,8 @@ def describe(path: str | Path, options: ReadSettings | None = None, *,
         problem is in ``validation`` with ``ok=False``.
     """
     opts = with_fields(options, fields, "describe")
-    opts = replace(opts, spike_filter=opts.spike_filter or "flag")
+    opts = replace(opts, spike_filter=opts.spike_filter or "flag",
+                   chunk_rows=opts.chunk_rows if rows is None else rows)
     thermometer = opts.thermometer
     check_gap_policy(opts.gaps)
     validator = RecordingValidator(opts.gaps, thermometer=thermometer, dropout_s=opts.dropout_s)
@@ -355,7 +356,7 @@ def describe(path: str | Path, options: ReadSettings | None = None, *,
     file_rows: list[Any] = []  # the file row of each row of the chunk (messages name them)
     try:
         fmt = format_of(path)
-        for chunk in iter_chunks(path, opts, rows=rows, validate=False, progress=progress,
+        for chunk in iter_chunks(path, opts, validate=False, progress=progress,
                                  time_repair=repairer, file_rows=file_rows.append):
             meta = chunk.metadata
             names = names or [n for n in chunk.names if n != SPIKE_COLUMN

@@ -291,7 +291,7 @@ def _plan(source: Source, opts: ReadSettings, robust: RobustSpikeFilter,
 
 
 def iter_chunks(path: str | Path, options: ReadSettings | None = None, *,
-                rows: int | None = None, validate: bool = True,
+                validate: bool = True,
                 progress: Progress | None = None, time_repair: TimeRepairStream | None = None,
                 dropped: dict[str, int] | None = None,
                 file_rows: Callable[[np.ndarray | None], None] | None = None,
@@ -300,10 +300,9 @@ def iter_chunks(path: str | Path, options: ReadSettings | None = None, *,
     """Stream a recording in chunks of ``rows`` rows without loading the file.
 
     Parameters are those of :func:`read` (``options``, ``validate`` and any field of
-    :class:`ReadOptions` by name), plus:
+    :class:`ReadOptions` by name: ``chunk_rows`` is the rows per chunk, the last chunk
+    may be shorter), plus:
 
-    rows
-        Rows per chunk (the last chunk may be shorter); None: ``options.chunk_rows``.
     file_rows
         Called with the file rows of the next chunk's rows before it is yielded.
     progress
@@ -340,10 +339,10 @@ def iter_chunks(path: str | Path, options: ReadSettings | None = None, *,
         (the rows of later problems then count the rows kept).
     """
     opts = with_fields(options, fields, "iter_chunks")
-    rows = opts.chunk_rows if rows is None else rows
+    rows = opts.chunk_rows
     if opts.axis is not None:  # the views of one axis, the file validated as a whole
         whole = replace(opts, axis=None, freq_band_hz=None, freq_span_hz=None)
-        yield from axis_views(iter_chunks(path, whole, rows=rows, validate=validate,
+        yield from axis_views(iter_chunks(path, whole, validate=validate,
                                            progress=progress, time_repair=time_repair,
                                            dropped=dropped, file_rows=file_rows,
                                            only=only),
@@ -353,7 +352,8 @@ def iter_chunks(path: str | Path, options: ReadSettings | None = None, *,
     if int(rows) < 1:
         raise InputError(f"rows must be a positive number of rows per chunk, got {rows!r}")
     rows = int(rows)
-    key = validation_key(path, opts, only) if validate else None
+    # the chunk size changes no check: one key for every chunk size
+    key = validation_key(path, replace(opts, chunk_rows=1), only) if validate else None
     known = known_report(key)  # this file passed with these options: not again
     validator = (RecordingValidator(opts.gaps, opts.freq_band_hz, opts.freq_span_hz,
                                     opts.thermometer, opts.dropout_s)
@@ -550,7 +550,8 @@ class ReadOptions(ReadSettings):
         """Stream the file in chunks (:func:`iter_chunks`); with ``axis``, that axis's view.
         ``dropped``: filled with the rows the spike filters removed (see there);
         ``time_repair``: a stream whose counts (duplicates dropped) the caller reads after."""
-        return iter_chunks(path, self, rows=rows, dropped=dropped, time_repair=time_repair)
+        own = self if rows is None else replace(self, chunk_rows=rows)
+        return iter_chunks(path, own, dropped=dropped, time_repair=time_repair)
 
     def logged_frequency(self, path: str | Path) -> tuple[str, np.ndarray] | None:
         """The resonator frequency the file logs for this axis (its first rows), also
@@ -558,9 +559,9 @@ class ReadOptions(ReadSettings):
         ``temperature_c``): ``(column, values)``, None without one. A file that logs a
         resonator frequency is an HRG's, whatever the thermometer chosen."""
         own = replace(self, thermometer="resonator", axis=None, spike_filter="off",
-                      spikes="error", start=None, end=None)
+                      spikes="error", start=None, end=None, chunk_rows=HEURISTIC_ROWS)
         name = f"freq_hz_{self.axis}" if self.axis else "freq_hz"
-        chunks = iter_chunks(path, own, rows=HEURISTIC_ROWS, validate=False,
+        chunks = iter_chunks(path, own, validate=False,
                              only=("time_s", "freq_hz", "rate_dph"))
         try:
             head = next(chunks, None)

@@ -451,31 +451,33 @@ def detect_motion(
         kind = "accelerometer" if channel.name in accel_names else "level"
         outputs = ((reasons["accelerometer"],) * 3 if kind == "accelerometer" else
                    (reasons["level"], reasons["variance"], reasons["clipped"]))
+        tests = kernel.ChannelTests(
+            int(BASELINE_BLOCKS), int(var_rows), int(min_run),
+            float(s.threshold * channel.sigma), float(channel.diff_sigma),
+            float(channel.diff_centre), float(MAD_TO_SIGMA),
+            float(s.variance_ratio * channel.diff_sigma),
+            float(s.threshold * max(channel.sigma, channel.lsb)), float(extremes[0]),
+            float(extremes[1]), int(s.clip_samples), bool(channel.sigma > 0),
+            kind == "accelerometer")
         for a, b in bounds:
-            kernel.segment_tests(
-                time_s[a:b], channel.values[a:b], _block_edges(b - a, base_rows),
-                BASELINE_BLOCKS, var_rows, min_run, s.threshold * channel.sigma,
-                channel.diff_sigma, channel.diff_centre, MAD_TO_SIGMA,
-                s.variance_ratio * channel.diff_sigma,
-                s.threshold * max(channel.sigma, channel.lsb), extremes, int(s.clip_samples),
-                channel.sigma > 0, *(o[a:b] for o in outputs), stepped[kind][a:b],
-                kind == "accelerometer")
+            kernel.segment_tests(time_s[a:b], channel.values[a:b],
+                                 _block_edges(b - a, base_rows), tests,
+                                 (*(o[a:b] for o in outputs), stepped[kind][a:b]))
     starts, stops = (np.array(side, dtype=np.int64) for side in zip(*bounds, strict=True))
     # a step of the still level (a new orientation's offset) bends the interpolated
     # baseline for up to a block either side; within a block of motion found it is what
     # that motion left, at rest; a step with no motion near (a rate table starting, which
     # a gyro alone cannot tell from a new offset) stays motion
     near = np.zeros(n, dtype=bool)
-    kernel.guard(reasons["level"], reasons["variance"], reasons["clipped"],
-                 reasons["accelerometer"], starts, stops, base_rows, base_rows, near,
-                 np.zeros(n, dtype=bool))
+    found = (reasons["level"], reasons["variance"], reasons["clipped"],
+             reasons["accelerometer"])
+    kernel.guard(found, starts, stops, base_rows, base_rows, near, np.zeros(n, dtype=bool))
     for kind, runs in stepped.items():
         kernel.isolated_runs(runs, near, reasons[kind])
     after, before = _rows(s.guard_s, period, 0), _rows(s.guard_before_s, period, 0)
     moving = np.zeros(n, dtype=bool)
-    kernel.guard(reasons["level"], reasons["variance"], reasons["clipped"],  # never across
-                 reasons["accelerometer"], starts, stops, after, before, moving,  # a gap
-                 reasons["guard"])
+    kernel.guard(found, starts, stops, after, before, moving, reasons["guard"])  # never
+    # across a gap
     # stretches judged across dropouts (a lost record is no pause between handlings)
     joined = np.flatnonzero(np.diff(time_s) > max(GAP_FACTOR * period, DROPOUT_S)) + 1
     _short_still(time_s, moving, np.r_[0, joined], np.r_[joined, n], s.min_still_s,

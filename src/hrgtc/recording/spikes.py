@@ -198,8 +198,10 @@ def _channel_mask(which: str, time_s: np.ndarray, values: np.ndarray, k: float,
         lsb = resolution(x[:RESOLUTION_ROWS])
     floor = lsb_multiple * float(lsb or 0.0)
     test = kernel.spike_mask if which == "spike" else kernel.across_mask
-    return test(t, x, float(k), floor, float(window_s), float(GAP_PERIODS),
-                1.0 + GAP_TOLERANCE, MIN_WINDOW_SAMPLES, _MAD_TO_SIGMA, _SECOND_DIFF)
+    rule = kernel.SpikeRule(float(k), floor, float(window_s), float(GAP_PERIODS),
+                            1.0 + GAP_TOLERANCE, int(MIN_WINDOW_SAMPLES), float(_MAD_TO_SIGMA),
+                            float(_SECOND_DIFF))
+    return test(t, x, rule)
 
 
 def moving_across(time_s: np.ndarray, values: np.ndarray, *, k: float = SPIKE_K,

@@ -33,16 +33,13 @@ def build_report(
     model: Model | PathLike,
     runs: Sequence[PathLike | Evaluation],
     output: PathLike,
+    settings: ReportSettings | None = None,
     *,
     soaks: Sequence[PathLike] | None = None,
-    title: str | None = None,
     force: bool = False,
-    max_points: int = ReportSettings.max_points,
     read_options: ReadOptions | None = None,
     progress: Progress | None = None,
-    axes: Sequence[str] | None = None,
     model_source: str = "",
-    kind: str = "paper",
 ) -> Path:
     """Write the report: one self-contained HTML file with Figs. 3-6 and Tables 1-2 of [1].
 
@@ -57,28 +54,25 @@ def build_report(
         which are not computed again.
     output
         The HTML file; written atomically, never overwritten without ``force``.
+    settings
+        The page's settings (:class:`~hrgtc.settings.compensation.ReportSettings`): most
+        points per plotted curve (plots use block means of at least 10 s), title (default
+        names the unit), the kind of report (:data:`hrgtc.report.kinds.KINDS`: its data
+        and its templates; "paper" lays the calibration's evidence out like [1]) and the
+        axes to show (None: all; the model's and each run's axes must agree unless
+        ``axes`` names those to show, :func:`hrgtc.compensate.multi_axis.match_axes`).
+        Default: the defaults.
     soaks
         Soak recordings for Figs. 3 and 5(b); default: the model's soak inputs that
         still exist on disk (read with the column mapping stored in the model).
-    title
-        Page title (default names the unit).
-    max_points
-        Most points per plotted curve; plots use block means of at least 10 s.
     read_options
         How to read the runs and the given soaks (column mapping, units, metadata); the
         model's temperature map (``--temp-ref``) applies unless they give their own
         scale and offset.
     progress
         Optional ``callback(rows_done, rows_total)``.
-    axes
-        The axes to show (``--axes``); None: all. The model's and each run's axes must
-        agree unless ``axes`` names those to show
-        (:func:`hrgtc.compensate.multi_axis.match_axes`).
     model_source
         The model's name in messages (default: its path when ``model`` is one).
-    kind
-        The kind of report (:data:`hrgtc.report.kinds.KINDS`): its data and its templates;
-        "paper" lays the calibration's evidence out like [1].
 
     Returns
     -------
@@ -95,14 +89,15 @@ def build_report(
         model's; the model's and a run's axes differ (checked before any run is read); no
         such ``kind``.
     """
+    settings = settings or ReportSettings()
     target = Path(output)
     refuse_existing(target, force)
-    chosen = report_kind(kind)
+    chosen = report_kind(settings.kind)
     if chosen.takes is not ReportInputs:
-        raise InputError(f"kind={kind!r} is not made from a model and runs; use "
+        raise InputError(f"kind={settings.kind!r} is not made from a model and runs; use "
                          "hrgtc.report.test_report.write_test_report (hrgtc test-report)")
-    inputs = report_inputs(model, runs, soaks=soaks, title=title, max_points=max_points,
-                           read_options=read_options, progress=progress, axes=axes,
-                           model_source=model_source)
+    inputs = report_inputs(model, runs, soaks=soaks, title=settings.title,
+                           max_points=settings.max_points, read_options=read_options,
+                           progress=progress, axes=settings.axes, model_source=model_source)
     return write_text_atomic(target, render(chosen.template, report=chosen.data(inputs)),
                              force=force)

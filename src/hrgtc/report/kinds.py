@@ -1,9 +1,10 @@
 """The registry of report kinds: what a report shows is one data function and one folder of
 templates.
 
-A kind is one line of :data:`KINDS`: its name (``build_report(kind=...)``), its data function
-(:class:`~hrgtc.report.inputs.ReportInputs` in, a plain dataclass out: it reads the runs and
-soaks it shows and computes every figure, table and plot) and, by its name, its templates,
+A kind is one line of :data:`KINDS`: its name (``ReportSettings(kind=...)`` of
+``build_report``), its data function (:class:`~hrgtc.report.inputs.ReportInputs` in, a
+plain dataclass out: it reads the runs and soaks it shows and computes every figure, table
+and plot) and, by its name, its templates,
 ``templates/<name>/report.html.j2`` (package data), which receive the data as ``report``.
 Adding a kind is a module with its data function, a folder of templates and a line here.
 """

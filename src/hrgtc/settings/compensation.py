@@ -50,7 +50,14 @@ BIAS_ONLY = EvaluationSettings(allan=False)
 
 @dataclass(frozen=True)
 class ReportSettings:
-    """How ``hrgtc report`` draws its figures (:func:`hrgtc.report.build_report`)."""
+    """How ``hrgtc report`` draws its page (:func:`hrgtc.report.build_report`)."""
 
     max_points: int = setting(
         20_000, "Most points per plotted curve (block means of 10 s or more).")
+    title: str | None = setting(None, "Page title.", default_text="names the unit")
+    kind: str = setting(
+        "paper", "The kind of report (hrgtc.report.kinds.KINDS): its data and its templates; "
+        "paper lays the calibration's evidence out like the paper.", cli=None)
+    axes: tuple[str, ...] | None = setting(
+        None, "The axes to show; None: all. The model's and each run's axes must agree "
+        "unless this names those to show.", cli=None)

@@ -45,6 +45,21 @@ class FleetCluster:
 
 
 @dataclass(frozen=True)
+class FleetCalibration:
+    """Which units ``hrgtc fleet calibrate`` calibrates, and with what prior
+    (:func:`hrgtc.fleet.calibrate_fleet`)."""
+
+    units: tuple[str, ...] = setting(
+        (), "Only this unit (repeat for more); none: every unit.", cli="--unit",
+        multiple=True, metavar="UNIT")
+    resume: bool = setting(
+        False, "Skip units whose model exists and whose inputs are unchanged (SHA-256).")
+    prior: str | None = setting(
+        None, "Population prior (hrgtc fleet prior): fit each thermometer with it.",
+        metavar="PRIOR.json", default_text="none")
+
+
+@dataclass(frozen=True)
 class FleetEvaluation:
     """What ``hrgtc fleet evaluate`` computes (:func:`hrgtc.fleet.evaluate_fleet`)."""
 

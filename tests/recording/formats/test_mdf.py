@@ -81,7 +81,7 @@ def test_round_trip_of_two_rates_through_mdf_append(tmp_path):
     np.testing.assert_array_equal(rec["rate_dph"], rate)
     np.testing.assert_allclose(rec["temperature_c"], np.interp(t_fast, t_slow, temp),
                                rtol=1e-12)
-    parts = list(iter_chunks(path, columns={"rate_dph": "fast/GyroZ"}, rows=700,
+    parts = list(iter_chunks(path, columns={"rate_dph": "fast/GyroZ"}, chunk_rows=700,
                              validate=False))
     assert [len(p) for p in parts] == [700, 700, 600]
     np.testing.assert_array_equal(np.concatenate([p["rate_dph"] for p in parts]), rate)

@@ -125,7 +125,7 @@ def test_round_trip_scaling_and_two_rates_through_tdmswriter(tmp_path):
 
 def test_batches_give_what_one_read_gives(data):
     whole = read(data / RAW, columns={"rate_dph": "First  Channel"}, validate=False)
-    parts = list(iter_chunks(data / RAW, columns={"rate_dph": "First  Channel"}, rows=300,
+    parts = list(iter_chunks(data / RAW, columns={"rate_dph": "First  Channel"}, chunk_rows=300,
                              validate=False))
     assert [len(p) for p in parts][:2] == [300, 300]
     np.testing.assert_array_equal(np.concatenate([p["rate_dph"] for p in parts]),
