@@ -326,6 +326,8 @@ def _run(page: _Page, k: int, run: Evaluation, model: Model) -> None:
                 "Allan noise terms": " (IEEE Std 952-1997, Annex C)"}
     rows = summary.rows()
     for heading, _ in summary.sections:
+        if heading.startswith("heating and cooling apart"):  # added after 8b58650: below
+            continue
         if heading.startswith("Allan") and run.allan:
             _allan_figure(page, run)
         head, _, detail = heading.partition(" (")
@@ -335,11 +337,39 @@ def _run(page: _Page, k: int, run: Evaluation, model: Model) -> None:
                         [row[1:] for row in rows if row[0] == heading], caption))
     if run.allan and not run.noise:
         _allan_figure(page, run)
+    _heating_cooling(page, run, hrg)
     if model.housing is not None and "housing" not in run.bias_stability_dph:
         page.note("Housing baseline not applied: the run has no housing_c column.")
     for note in summary.notes:
         page.note(escape(note))
     page.add("</section>")
+
+
+def _heating_cooling(page: _Page, run: Evaluation, hrg: bool) -> None:
+    """Added after 8b58650 (issue 29, item 3), as an f-string reference of the template's
+    table: a row per direction with a block, a sentence per direction without one."""
+    split = run.directions
+    if split is None:
+        return
+    what, block = "resonator temperature" if hrg else "temperature", f"{split.block_s:g} s"
+    if split.reason is not None:
+        page.note(escape(f"Heating and cooling apart: no {block} block ({split.reason})."))
+        return
+    truth = split.residual_rms_dph is not None
+    rows = [[d, str(split.blocks[d]), _number(split.raw_dph[d]),
+             _number(split.compensated_dph[d]), _number(split.improvement(d), 3)]
+            + ([_number(split.residual_rms_dph[d])] if truth else [])
+            for d in ("heating", "cooling") if split.blocks[d]]
+    if rows:
+        page.add(_table(["direction", f"{block} blocks", "raw (°/h)", "compensated (°/h)",
+                         "improvement (×)"] + (["RMS model − true bias (°/h)"] if truth else []),
+                        rows, f"Heating and cooling apart of {run.name}: {block} bias stability "
+                        f"by the sign of the {what} rate, raw and compensated"))
+    total = sum(split.blocks.values())
+    for d, other in (("heating", "cooling"), ("cooling", "heating")):
+        if not split.blocks[d]:
+            page.note(escape(f"No {d} block: the run's {total} blocks of {block} outside the "
+                             f"dead band of the {what} rate were all {other}."))
 
 
 def _allan_figure(page: _Page, run: Evaluation) -> None:

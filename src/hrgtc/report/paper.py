@@ -41,6 +41,7 @@ from hrgtc.evaluation.calibration_figures import (
     thermometer_tables,
 )
 from hrgtc.evaluation.glance_figures import GLANCE, glance_summary, instrument_glance_summary
+from hrgtc.evaluation.heating_cooling import DIRECTIONS, DirectionStats
 from hrgtc.model import Model
 from hrgtc.report.figures import Plot, SoakTrace, plot
 from hrgtc.report.inputs import ReportInputs, RowCounter, evaluate_runs, trace_soaks
@@ -57,8 +58,8 @@ from hrgtc.report.tables import (
 from hrgtc.thermometry import paper
 from hrgtc.thermometry.plateaus import Plateau
 
-__all__ = ["AxisReport", "PaperReport", "RunReport", "ScaleFactor", "Thermometry", "axis_report",
-           "paper_report", "table_rows"]
+__all__ = ["AxisReport", "Direction", "HeatingCooling", "PaperReport", "RunReport", "ScaleFactor",
+           "Thermometry", "axis_report", "heating_cooling", "paper_report", "table_rows"]
 
 
 @dataclass(frozen=True)
@@ -83,6 +84,32 @@ class Thermometry:
 
 
 @dataclass(frozen=True)
+class Direction:
+    """One direction's row of :class:`HeatingCooling` (the numbers of
+    :class:`~hrgtc.evaluation.heating_cooling.DirectionStats`; NaN: fewer than three
+    blocks). [°/h]"""
+
+    direction: str  # "heating" or "cooling"
+    blocks: int
+    raw_dph: float
+    compensated_dph: float
+    improvement: float  # raw / compensated
+    residual_rms_dph: float | None  # RMS of model minus true bias (None: not simulated)
+
+
+@dataclass(frozen=True)
+class HeatingCooling:
+    """A run's bias stability with heating and cooling apart: a row per direction with a
+    block, a sentence per direction without one (or why neither has one)."""
+
+    caption: str
+    block_s: float  # [s]
+    rows: tuple[Direction, ...]
+    truth: bool  # the run is simulated: the residual against the true bias is shown
+    notes: tuple[str, ...]
+
+
+@dataclass(frozen=True)
 class RunReport:
     """One run: Fig. 6, its tables (the Allan figure before table ``allan_at``; after the
     last when it equals their number), warnings beyond the calibration and notes."""
@@ -97,6 +124,7 @@ class RunReport:
     warnings: tuple[str, ...]
     housing_not_applied: bool
     notes: tuple[str, ...]
+    heating_cooling: HeatingCooling | None = None  # None: the run was not split
 
 
 @dataclass(frozen=True)
@@ -311,6 +339,8 @@ def _run(k: int, run: Evaluation, model: Model) -> RunReport:
     summary = run.figures(sensor=not hrg, warnings=False)
     tables, allan_at = [], None
     for heading, _ in summary.sections:
+        if heading.startswith(HEATING_COOLING):  # its own table, a row per direction
+            continue
         if heading.startswith("Allan") and run.allan and allan_at is None:
             allan_at = len(tables)
         tables.append(_run_table(run, summary, heading, hrg))
@@ -325,7 +355,41 @@ def _run(k: int, run: Evaluation, model: Model) -> RunReport:
         len(tables) if allan_at is None else allan_at,
         tuple(line.removeprefix("warning: ") for line in run.range_warnings()),
         model.housing is not None and "housing" not in run.bias_stability_dph,
-        tuple(summary.notes))
+        tuple(summary.notes),
+        None if run.directions is None else heating_cooling(run.directions, run.name, not hrg))
+
+
+#: The start of the heading of a run's heating and cooling figures
+#: (:func:`hrgtc.evaluation.run_figures.run_figures`).
+HEATING_COOLING = "heating and cooling apart"
+
+
+def heating_cooling(directions: DirectionStats, name: str, sensor: bool) -> HeatingCooling:
+    """Run ``name``'s heating and cooling apart (``directions``: its
+    :attr:`~hrgtc.evaluation.Evaluation.directions`; ``sensor``: the thermometer is a
+    temperature sensor, its words)."""
+    what = "temperature" if sensor else "resonator temperature"
+    block = f"{directions.block_s:g} s"
+    caption = (f"Heating and cooling apart of {name}: {block} bias stability by the sign of "
+               f"the {what} rate, raw and compensated")
+    truth = directions.residual_rms_dph is not None
+    if directions.reason is not None:
+        return HeatingCooling(caption, directions.block_s, (), truth,
+                              (f"Heating and cooling apart: no {block} block "
+                               f"({directions.reason}).",))
+    total = sum(directions.blocks.values())
+    rows, notes = [], []
+    for d in DIRECTIONS:
+        if not directions.blocks[d]:
+            other = next(o for o in DIRECTIONS if o != d)
+            notes.append(f"No {d} block: the run's {total} blocks of {block} outside the "
+                         f"dead band of the {what} rate were all {other}.")
+            continue
+        rows.append(Direction(
+            d, directions.blocks[d], directions.raw_dph[d], directions.compensated_dph[d],
+            directions.improvement(d),
+            directions.residual_rms_dph[d] if directions.residual_rms_dph is not None else None))
+    return HeatingCooling(caption, directions.block_s, tuple(rows), truth, tuple(notes))
 
 
 def _run_table(run: Evaluation, summary: Summary, heading: str, hrg: bool) -> Table:
