@@ -64,10 +64,9 @@ def update_command(
 
     Back to the parent: hrgtc update --rollback unit-2.json -o unit-restored.json
     """
-    from hrgtc.core.files import refuse_existing, refuse_input
+    from hrgtc.core.files import refuse_existing, refuse_input, write_bytes_atomic
     from hrgtc.model import load_model, save_model
     from hrgtc.update import rollback_bytes
-    from hrgtc.update.lineage import write_bytes_atomic
 
     with library_errors():
         refuse_input(output, [model, *(recordings or [])])

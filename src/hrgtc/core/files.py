@@ -463,13 +463,26 @@ def write_text_atomic(path: PathLike, text: str, force: bool = False) -> Path:
     OutputExistsError
         When ``path`` exists and ``force`` is False.
     """
+    return _write_atomic(path, text, force)
+
+
+def write_bytes_atomic(path: PathLike, content: bytes, force: bool = False) -> Path:
+    """Write ``content`` to ``path`` exactly (no newline translation), as
+    :func:`write_text_atomic` writes text."""
+    return _write_atomic(path, content, force)
+
+
+def _write_atomic(path: PathLike, content: str | bytes, force: bool) -> Path:
+    """Write text (UTF-8) or bytes to ``path`` via a synced temporary file and a rename."""
     target = Path(path)
     refuse_existing(target, force)
     target.parent.mkdir(parents=True, exist_ok=True)
     temporary = temporary_beside(target)
+    text = isinstance(content, str)
     try:
-        with naming_os_errors(target), open(temporary, "w", encoding="utf-8") as stream:
-            stream.write(text)
+        with naming_os_errors(target), open(temporary, "w" if text else "wb",
+                                            encoding="utf-8" if text else None) as stream:
+            stream.write(content)
             stream.flush()
             os.fsync(stream.fileno())
         publish(temporary, target, force)

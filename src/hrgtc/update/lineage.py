@@ -13,20 +13,17 @@ from __future__ import annotations
 
 import base64
 import hashlib
-import os
 import zlib
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Annotated, Any
 
 from msgspec import Meta
 
 from hrgtc.core import records
 from hrgtc.core.errors import ModelFileError
-from hrgtc.core.files import PathLike, forget_temporary, publish, refuse_existing, temporary_beside
 
 __all__ = ["AxisChange", "Lineage", "LineageData", "LineageRecord", "pack", "rollback_bytes",
-           "unpack", "write_bytes_atomic"]
+           "unpack"]
 
 Sha256 = Annotated[str, Meta(pattern="^[0-9a-f]{64}$")]
 
@@ -148,23 +145,3 @@ def rollback_bytes(lineage: Lineage, source: str) -> bytes:
                              f"the parent's {lineage.parent_sha256}; the file is damaged, no "
                              "rollback")
     return content
-
-
-def write_bytes_atomic(path: PathLike, content: bytes, force: bool = False) -> Path:
-    """Write ``content`` to ``path`` exactly (no newline translation) via a synced temporary
-    file and a rename; refuses to overwrite without ``force``."""
-    target = Path(path)
-    refuse_existing(target, force)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    temporary = temporary_beside(target)
-    try:
-        with open(temporary, "wb") as stream:
-            stream.write(content)
-            stream.flush()
-            os.fsync(stream.fileno())
-        publish(temporary, target, force)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        forget_temporary(temporary)
-        raise
-    return target
