@@ -75,6 +75,19 @@ def loads_json(text: str | bytes) -> Any:
     return json.loads(text, parse_constant=_reject_constant)
 
 
+def metadata_object(text: str | bytes, where: str) -> dict[str, Any]:
+    """hrgtc's metadata as a format keeps it (JSON text in a property or comment): the
+    object, or a :class:`RecordingError` naming ``where`` (file and place) and what is
+    wrong."""
+    try:
+        found = loads_json(text)
+    except ValueError:
+        raise RecordingError(f"{where} (hrgtc's metadata) is not valid JSON") from None
+    if not isinstance(found, dict):
+        raise RecordingError(f"{where} (hrgtc's metadata) is not a JSON object")
+    return found
+
+
 def first_failing(array: pa.Array | pa.ChunkedArray, convert: Callable[[Any], Any]) -> int:
     """Index of the first element for which ``convert`` raises (bisection on prefixes)."""
     low, high = 0, len(array)  # prefix [:low] converts, [:high] fails

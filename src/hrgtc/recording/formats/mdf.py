@@ -38,8 +38,8 @@ from hrgtc.recording.formats.base import (
     Sink,
     Source,
     column_unit,
-    loads_json,
     metadata_json,
+    metadata_object,
 )
 from hrgtc.recording.formats.logs import check_exists, output_path, quiet, require, unreadable
 from hrgtc.recording.schema import Metadata
@@ -233,15 +233,8 @@ def _written_metadata(path: Path, comment: str) -> dict[str, Any] | None:
         return None  # a comment of plain text that mentions hrgtc
     if found is None:
         return None
-    try:
-        written = loads_json(found.text or "")
-    except ValueError:
-        raise RecordingError(f"{path}: the header comment's property {METADATA_PROPERTY!r} "
-                             "(hrgtc's metadata) is not valid JSON") from None
-    if not isinstance(written, dict):
-        raise RecordingError(f"{path}: the header comment's property {METADATA_PROPERTY!r} "
-                             "(hrgtc's metadata) is not a JSON object")
-    return written
+    return metadata_object(found.text or "",
+                           f"{path}: the header comment's property {METADATA_PROPERTY!r}")
 
 
 def header_comment(metadata: Metadata) -> str:

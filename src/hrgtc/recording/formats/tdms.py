@@ -46,8 +46,8 @@ from hrgtc.recording.formats.base import (
     Sink,
     Source,
     column_unit,
-    loads_json,
     metadata_json,
+    metadata_object,
 )
 from hrgtc.recording.formats.logs import check_exists, output_path, quiet, require, unreadable
 from hrgtc.recording.schema import Metadata
@@ -225,15 +225,7 @@ def _written_metadata(path: Path, handle: Any) -> dict[str, Any] | None:
     raw = handle.properties.get(METADATA_PROPERTY)
     if raw is None:
         return None
-    try:
-        found = loads_json(str(raw))
-    except ValueError:
-        raise RecordingError(f"{path}: the file property {METADATA_PROPERTY!r} (hrgtc's "
-                             "metadata) is not valid JSON") from None
-    if not isinstance(found, dict):
-        raise RecordingError(f"{path}: the file property {METADATA_PROPERTY!r} (hrgtc's "
-                             "metadata) is not a JSON object")
-    return found
+    return metadata_object(str(raw), f"{path}: the file property {METADATA_PROPERTY!r}")
 
 
 class TdmsSink(Sink):
