@@ -18,7 +18,6 @@ from hrgtc import simulate
 from hrgtc.core.errors import RecordingError
 from hrgtc.recording import Metadata, RecordingWriter, read
 from hrgtc.recording.formats import matlab
-from hrgtc.simulate.campaign import run_metadata
 
 scipy_io = pytest.importorskip("scipy.io")
 
@@ -27,20 +26,13 @@ PROFILE = simulate.cooldown(20.0, 10.0, 0.2)  # 7200 rows
 
 
 @pytest.fixture(scope="module")
-def run(tmp_path_factory):
+def run(tmp_path_factory, simulated_file):
     """(path, the simulator's recording): written in chunks of 1000 rows."""
-    path = tmp_path_factory.mktemp("mat") / "cool.mat"
-    simulate.simulate_to_file(PROFILE, path, sample_rate_hz=RATE_HZ, seed=5, chunk_rows=1000)
-    return path, simulate.simulate_run(PROFILE, sample_rate_hz=RATE_HZ, seed=5)
+    return simulated_file(tmp_path_factory.mktemp("mat"), "cool.mat", PROFILE, 5, RATE_HZ)
 
 
-def test_hrgtc_reads_back_the_simulators_arrays_and_metadata(run):
-    path, truth = run
-    back = read(path)
-    assert back.names == truth.names
-    for name in truth.names:
-        assert np.array_equal(back[name].view(np.int64), truth[name].view(np.int64)), name
-    assert back.metadata == run_metadata(PROFILE, sample_rate_hz=RATE_HZ, seed=5)
+def test_hrgtc_reads_back_the_simulators_arrays_and_metadata(run, check_read_back):
+    check_read_back(*run, PROFILE, 5)
 
 
 def test_scipy_loads_column_vectors_and_the_metadata_struct(run):

@@ -18,7 +18,6 @@ import pytest
 from hrgtc import simulate
 from hrgtc.core.errors import RecordingError
 from hrgtc.recording import Metadata, RecordingWriter, read
-from hrgtc.simulate.campaign import run_metadata
 
 asammdf = pytest.importorskip("asammdf")
 
@@ -27,20 +26,13 @@ PROFILE = simulate.warmup(-10.0, 0.0, 0.2)  # 7200 rows
 
 
 @pytest.fixture(scope="module")
-def run(tmp_path_factory):
+def run(tmp_path_factory, simulated_file):
     """(path, the simulator's recording): written in chunks of 1000 rows."""
-    path = tmp_path_factory.mktemp("mdf") / "warm.mf4"
-    simulate.simulate_to_file(PROFILE, path, sample_rate_hz=RATE_HZ, seed=7, chunk_rows=1000)
-    return path, simulate.simulate_run(PROFILE, sample_rate_hz=RATE_HZ, seed=7)
+    return simulated_file(tmp_path_factory.mktemp("mdf"), "warm.mf4", PROFILE, 7, RATE_HZ)
 
 
-def test_hrgtc_reads_back_the_simulators_arrays_and_metadata(run):
-    path, truth = run
-    back = read(path)
-    assert back.names == truth.names
-    for name in truth.names:
-        assert np.array_equal(back[name].view(np.int64), truth[name].view(np.int64)), name
-    assert back.metadata == run_metadata(PROFILE, sample_rate_hz=RATE_HZ, seed=7)
+def test_hrgtc_reads_back_the_simulators_arrays_and_metadata(run, check_read_back):
+    check_read_back(*run, PROFILE, 7)
 
 
 def test_asammdf_reads_the_same_channels_on_the_time_master(run):

@@ -17,7 +17,6 @@ import pytest
 from hrgtc import simulate
 from hrgtc.core.errors import RecordingError, SlowChannelWarning
 from hrgtc.recording import Metadata, RecordingWriter, read
-from hrgtc.simulate.campaign import run_metadata
 
 nptdms = pytest.importorskip("nptdms")
 
@@ -26,20 +25,13 @@ PROFILE = simulate.soak(-10.0, 0.2)  # 7200 rows
 
 
 @pytest.fixture(scope="module")
-def run(tmp_path_factory):
+def run(tmp_path_factory, simulated_file):
     """(path, the simulator's recording): written in chunks of 1000 rows (8 segments)."""
-    path = tmp_path_factory.mktemp("tdms") / "soak.tdms"
-    simulate.simulate_to_file(PROFILE, path, sample_rate_hz=RATE_HZ, seed=3, chunk_rows=1000)
-    return path, simulate.simulate_run(PROFILE, sample_rate_hz=RATE_HZ, seed=3)
+    return simulated_file(tmp_path_factory.mktemp("tdms"), "soak.tdms", PROFILE, 3, RATE_HZ)
 
 
-def test_hrgtc_reads_back_the_simulators_arrays_and_metadata(run):
-    path, truth = run
-    back = read(path)
-    assert back.names == truth.names
-    for name in truth.names:
-        assert np.array_equal(back[name].view(np.int64), truth[name].view(np.int64)), name
-    assert back.metadata == run_metadata(PROFILE, sample_rate_hz=RATE_HZ, seed=3)
+def test_hrgtc_reads_back_the_simulators_arrays_and_metadata(run, check_read_back):
+    back = check_read_back(*run, PROFILE, 3)
     assert back.metadata.profile == "soak -10 C, 0.2 h from 20 C"
 
 
