@@ -119,3 +119,17 @@ def test_in_a_file_of_several_groups_time_s_is_each_groups_waveform_timing(tmp_p
                                    "temperature_c": "slow/temp"}, thermometer="sensor")
     assert np.array_equal(back["time_s"], np.arange(50) * 0.1)
     assert np.array_equal(back["rate_dph"], 100.0 + np.arange(50.0))
+
+
+@pytest.mark.parametrize(("stored", "said"), [("{not json", "is not valid JSON"),
+                                              ("[1, 2]", "is not a JSON object")])
+def test_a_damaged_metadata_property_is_named_with_what_is_wrong(tmp_path, stored, said):
+    """The file property ``hrgtc`` that is not a JSON object is refused naming the file,
+    the property and the fault."""
+    path = tmp_path / "damaged.tdms"
+    channel = nptdms.ChannelObject("recording", "time_s", np.arange(5.0))
+    with nptdms.TdmsWriter(str(path)) as writer:
+        writer.write_segment([nptdms.RootObject(properties={"hrgtc": stored}), channel])
+    with pytest.raises(RecordingError, match=re.escape(
+            f"{path}: the file property 'hrgtc' (hrgtc's metadata) {said}")):
+        read(path)
