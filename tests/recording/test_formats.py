@@ -52,7 +52,7 @@ def test_the_built_in_formats_are_registered_once_with_their_suffixes():
     names = [fmt.name for fmt in formats()]
     assert names[:3] == ["parquet", "csv", "hdf5"]
     assert registry.suffixes() == {".parquet": "parquet", ".pq": "parquet", ".csv": "csv",
-                                   ".h5": "hdf5", ".hdf5": "hdf5",
+                                   ".csv.gz": "csv", ".h5": "hdf5", ".hdf5": "hdf5",
                                    **{s: f.name for f in formats()[3:] for s in f.suffixes}}
     assert registry.output_suffixes()["h5"] == ".h5"
     with pytest.raises(ValueError, match=r"suffix '\.csv' is already the format 'csv'"):
@@ -88,8 +88,10 @@ def test_unknown_suffix_lists_the_registered_formats(tmp_path):
     with pytest.raises(RecordingError) as caught:
         read(path)
     message = str(caught.value)
-    assert "unknown file type '.txt'; use one of .parquet, .pq, .csv, .h5, .hdf5" in message
-    assert "registered formats: parquet (.parquet, .pq); csv (.csv); hdf5 (.h5, .hdf5)" in message
+    assert ("unknown file type '.txt'; use one of .parquet, .pq, .csv, .csv.gz, .h5, "
+            ".hdf5") in message
+    assert ("registered formats: parquet (.parquet, .pq); csv (.csv, .csv.gz); hdf5 (.h5, "
+            ".hdf5)") in message
     with pytest.raises(RecordingError, match=r"unknown file type '\.txt'"):
         RecordingWriter(tmp_path / "out.txt", recording().metadata, ["time_s"])
 

@@ -27,17 +27,20 @@ Delimiters at the end of the lines (empty trailing columns) are left out. Refuse
 each with its own message: lines ending in CR alone, values separated by spaces,
 a column without a name, two columns of the same name (issue 21).
 A sidecar ``<file>.json`` (e.g. ``run.csv.json``) adds to or overrides the header.
+A gzip-compressed file (``run.csv.gz``) is read through a decompressor, with the same
+checks and messages; it is never written (compress a written ``.csv`` afterwards).
 """
 
 from __future__ import annotations
 
+import gzip
 import json
 import os
 import re
 import shutil
 from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, BinaryIO
 
 import numpy as np
 import pyarrow as pa
@@ -101,11 +104,11 @@ class CsvSource(Source):
             if not isinstance(extra, dict):
                 raise RecordingError(f"{sidecar}: expected a JSON object of metadata")
             self.metadata.update(extra)
-        self._size = path.stat().st_size
+        self._size = text_bytes(path)
         _refuse_cut_tail(path, self.delimiter, self._offset)
         self._streams: list[pa.NativeFile] = []
         self._rows_done = 0
-        with open(path, "rb") as handle:  # bytes per row from the first MiB, for progress
+        with open_bytes(path) as handle:  # bytes per row from the first MiB, for progress
             handle.seek(self._offset)
             sample = handle.read(SAMPLE_BYTES)
         self._bytes_per_row = len(sample) / max(sample.count(b"\n"), 1)
@@ -123,8 +126,12 @@ class CsvSource(Source):
         }
 
     def _open(self) -> pa.NativeFile:
-        stream = pa.OSFile(str(self.path))  # not a memory map: its pages would count as RSS
-        stream.seek(self._offset)
+        if is_gzip(self.path):
+            stream = pa.input_stream(str(self.path), compression="gzip")
+            stream.read(self._offset)  # a compressed stream cannot seek: read past the head
+        else:
+            stream = pa.OSFile(str(self.path))  # not a memory map: its pages count as RSS
+            stream.seek(self._offset)
         self._streams.append(stream)
         return stream
 
@@ -160,7 +167,7 @@ class CsvSource(Source):
 
     def count_rows(self) -> int:
         rows, last = 0, b"\n"  # non-empty lines; "\r" is not content
-        with open(self.path, "rb") as handle:
+        with open_bytes(self.path) as handle:
             handle.seek(self._offset)
             while block := handle.read(COUNT_BLOCK_BYTES):
                 block = block.replace(b"\r", b"")
@@ -235,7 +242,7 @@ class CsvSource(Source):
         line_no = 0
         row = -self._header_rows
         delimiter = self.delimiter.encode()
-        with open(self.path, "rb") as handle:
+        with open_bytes(self.path) as handle:
             handle.seek(self._offset)
             line_no = _count_lines(self.path, self._offset)
             for raw in handle:
@@ -266,7 +273,7 @@ TRAILING_COLUMN = "\x00trailing delimiter"
 
 def _refuse_cr_only(path: Path) -> None:
     """Refuse a file whose lines end in a carriage return alone (classic Mac OS)."""
-    with open(path, "rb") as handle:
+    with open_bytes(path) as handle:
         head = handle.read(1 << 16)
     if b"\r" in head and b"\n" not in head:
         raise RecordingError(
@@ -317,11 +324,7 @@ def _refuse_cut_tail(path: Path, delimiter: str, offset: int) -> None:
     whose last field has fewer than half the characters of the same field in the lines
     before is taken as cut.
     """
-    size = path.stat().st_size
-    with open(path, "rb") as handle:
-        start = max(offset, size - 64 * 1024)
-        handle.seek(start)
-        tail = handle.read()
+    start, tail = _tail(path, offset, 64 * 1024)
     if not tail or tail.endswith((b"\n", b"\r")):
         return
     lines = tail.decode("utf-8", "replace").splitlines()
@@ -341,15 +344,49 @@ def _refuse_cut_tail(path: Path, delimiter: str, offset: int) -> None:
             "characters): the file looks cut while it was written; remove the last line")
 
 
-def _count_data_rows_before_end(path: Path, offset: int) -> int:
+def is_gzip(path: Path) -> bool:
+    """True for a gzip-compressed CSV (``run.csv.gz``), read through a decompressor."""
+    return path.name.lower().endswith(".gz")
+
+
+def open_bytes(path: Path) -> BinaryIO:
+    """The file's text bytes: decompressed on the fly for ``.csv.gz``."""
+    return gzip.open(path, "rb") if is_gzip(path) else open(path, "rb")
+
+
+def text_bytes(path: Path) -> int:
+    """Bytes of the file's text (of a ``.csv.gz``, its gzip trailer's size, modulo 4 GiB)."""
+    if not is_gzip(path):
+        return path.stat().st_size
     with open(path, "rb") as handle:
+        handle.seek(-4, os.SEEK_END)
+        return int.from_bytes(handle.read(4), "little")
+
+
+def _tail(path: Path, offset: int, size: int) -> tuple[int, bytes]:
+    """``(start, bytes)`` of the last ``size`` bytes of the text after ``offset``."""
+    with open_bytes(path) as handle:
+        handle.seek(offset)
+        if not is_gzip(path):
+            start = max(offset, handle.seek(0, os.SEEK_END) - size)
+            handle.seek(start)
+            return start, handle.read()
+        tail, done = b"", offset
+        while block := handle.read(COUNT_BLOCK_BYTES):
+            done += len(block)
+            tail = (tail + block)[-size:]
+        return max(offset, done - len(tail)), tail
+
+
+def _count_data_rows_before_end(path: Path, offset: int) -> int:
+    with open_bytes(path) as handle:
         handle.seek(offset)
         return max(handle.read().count(b"\n") - 1, 0)
 
 
 def _first_invalid_utf8(path: Path, offset: int) -> tuple[int, int] | None:
     """(data row, byte) of the first line after ``offset`` that is not UTF-8, or None."""
-    with open(path, "rb") as handle:
+    with open_bytes(path) as handle:
         handle.seek(offset)
         for row, raw in enumerate(handle, start=-1):
             try:
@@ -363,7 +400,7 @@ def _csv_head(path: Path) -> tuple[int, str, list[str]]:
     """Byte offset of the header line, the header line and the comment lines."""
     comments: list[str] = []
     offset = 0
-    with open(path, "rb") as handle:
+    with open_bytes(path) as handle:
         for line, raw in enumerate(handle, start=1):
             try:
                 text = raw.decode("utf-8")
@@ -383,7 +420,7 @@ def _csv_head(path: Path) -> tuple[int, str, list[str]]:
 
 
 def _count_lines(path: Path, offset: int) -> int:
-    with open(path, "rb") as handle:
+    with open_bytes(path) as handle:
         return handle.read(offset).count(b"\n")
 
 
@@ -497,5 +534,5 @@ def sniff(head: bytes) -> bool:
     return head.removeprefix(b"\xef\xbb\xbf").startswith(b"# hrgtc recording")
 
 
-FORMAT = Format("csv", (".csv",), CsvSource, sniff, CsvSink,
+FORMAT = Format("csv", (".csv", ".csv.gz"), CsvSource, sniff, CsvSink,
                 description="text, one column per channel, '# key: value' metadata lines")

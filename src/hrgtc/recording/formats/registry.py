@@ -139,9 +139,21 @@ def output_suffixes() -> dict[str, str]:
     return {fmt.output_name: fmt.suffixes[0] for fmt in formats() if fmt.sink is not None}
 
 
+def path_suffix(path: str | Path) -> str:
+    """The suffix that names a file's format, lower case: ``.csv.gz`` for ``run.CSV.gz``.
+
+    A compressed file's suffix is its last two (a format that reads it registers
+    ``.csv.gz``); any other file's is its last.
+    """
+    path = Path(path)
+    if path.suffix.lower() == ".gz" and len(path.suffixes) >= 2:
+        return "".join(path.suffixes[-2:]).lower()
+    return path.suffix.lower()
+
+
 def is_recording(path: str | Path) -> bool:
     """True when the suffix of ``path`` is that of a registered format."""
-    return _by_suffix(Path(path).suffix.lower()) is not None
+    return _by_suffix(path_suffix(path)) is not None
 
 
 def _listing() -> str:
@@ -169,7 +181,7 @@ def format_for(path: str | Path) -> Format:
         registered formats and their suffixes.
     """
     path = Path(path)
-    suffix = path.suffix.lower()
+    suffix = path_suffix(path)
     fmt = _by_suffix(suffix)
     if fmt is not None:
         head = _head(path) if path.is_file() else None
@@ -213,7 +225,11 @@ def writable(path: str | Path) -> Format:
         No registered format has the suffix, or its format cannot be written.
     """
     path = Path(path)
-    suffix = path.suffix.lower()
+    suffix = path_suffix(path)
+    if suffix.endswith(".gz"):
+        raise RecordingError(
+            f"{path}: hrgtc does not write compressed files ({suffix}); write "
+            f"{path.name[:-3]} and compress it afterwards (gzip {path.name[:-3]})")
     fmt = _by_suffix(suffix)
     if fmt is not None and fmt.sink is not None:
         return fmt
