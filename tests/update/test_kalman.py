@@ -14,13 +14,32 @@ from field_ageing import aged_unit
 def batch_wls(mean, covariance, rows, z, r):
     """The posterior of a linear Gaussian model by one weighted least-squares solve of the
     stacked, whitened system [L⁻¹; R^-½ H] x = [L⁻¹ m; R^-½ z] (L the prior's Cholesky
-    factor): an independent second method (no recursion, no gain)."""
+    factor): an independent second method (no recursion, no gain). ``r``: the measurements'
+    variances, or their whole covariance matrix (generalised least squares)."""
     whiten = np.linalg.inv(np.linalg.cholesky(covariance))
-    weights = 1.0 / np.sqrt(r)
-    a = np.vstack([whiten, rows * weights[:, None]])
-    b = np.concatenate([whiten @ mean, z * weights])
+    noise = np.diag(r) if np.ndim(r) == 1 else np.asarray(r)
+    weights = np.linalg.inv(np.linalg.cholesky(noise))
+    a = np.vstack([whiten, weights @ rows])
+    b = np.concatenate([whiten @ mean, weights @ z])
     x, *_ = np.linalg.lstsq(a, b, rcond=None)
     return x, np.linalg.inv(a.T @ a)
+
+
+def walk_covariance(problem):
+    """Covariance of the blocks' random walks, q·(min(t_i, t_j) - start) within a run, 0
+    across runs: the walk of :class:`hrgtc.update.kalman.Walk` written as one matrix."""
+    walk = problem.walk
+    start = walk.start_h[walk.state]
+    t = problem.times_h - start
+    same = walk.state[:, None] == walk.state[None, :]
+    return walk.q_per_h * np.where(same, np.minimum(t[:, None], t[None, :]), 0.0)
+
+
+def without_walk_states(problem):
+    """The states of the problem less the walks' (which the batch method integrates out)."""
+    keep = np.setdiff1d(np.arange(problem.mean.size), np.unique(problem.walk.state))
+    return keep, problem.mean[keep], problem.covariance[np.ix_(keep, keep)], \
+        problem.rows[:, keep]
 
 
 def test_one_update_without_process_noise_is_the_batch_least_squares(parent, field_recording,
@@ -33,14 +52,23 @@ def test_one_update_without_process_noise_is_the_batch_least_squares(parent, fie
     axis = result.axes[""]
     p = axis.problem
     assert p.tau_h == 0.0 and p.rows.shape[0] == axis.n_blocks > 20
-    x, covariance = batch_wls(p.mean, p.covariance, p.rows, p.z, p.r)
+    # the day's bias wanders: the likelihood chose a walk (the simulated unit's rate random
+    # walk is 0.1 °/h/√h, q = 0.01 (°/h)²/h), and the batch method takes it as the
+    # covariance of the measurements
+    assert 1e-3 <= p.walk.q_per_h <= 0.1
+    keep, mean, prior, rows = without_walk_states(p)
+    x, covariance = batch_wls(mean, prior, rows, p.z, np.diag(p.r) + walk_covariance(p))
     np.testing.assert_allclose(np.subtract(axis.after, axis.before), x[:p.n_model],
                                rtol=0.0, atol=1e-9)
     np.testing.assert_allclose(axis.covariance_after, covariance[:p.n_model, :p.n_model],
                                rtol=1e-9, atol=1e-15)
-    # and the filter alone on the same inputs, nuisance constants included
+    # and the filter alone on the same inputs, nuisance constants included; without the
+    # walk, it is the weighted least squares of independent blocks
+    run = run_filter(p.mean, p.covariance, p.rows, p.z, p.r, p.times_h, p.n_model, 0.0, p.walk)
+    np.testing.assert_allclose(run.mean[keep], x, rtol=0.0, atol=1e-9)
+    x, _ = batch_wls(p.mean[keep], p.covariance[np.ix_(keep, keep)], rows, p.z, p.r)
     run = run_filter(p.mean, p.covariance, p.rows, p.z, p.r, p.times_h, p.n_model, 0.0)
-    np.testing.assert_allclose(run.mean, x, rtol=0.0, atol=1e-9)
+    np.testing.assert_allclose(run.mean[keep], x, rtol=0.0, atol=1e-9)
 
 
 def test_72_hours_at_constant_temperature_keep_the_covariance_bounded(parent, known):

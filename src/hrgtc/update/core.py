@@ -32,12 +32,14 @@ from hrgtc.recording import Recording
 from hrgtc.settings import to_dict
 from hrgtc.settings.update import EARTH_RATE_BOUND_DPH, UpdateSettings
 from hrgtc.update.kalman import (
+    Walk,
     bootstrap_rms,
     heldout_rms,
     jump_statistic,
     mahalanobis,
     run_filter,
     split_heldout,
+    walk_rate,
 )
 from hrgtc.update.lineage import AxisChange, Lineage, LineageData, pack
 from hrgtc.update.observations import (
@@ -331,27 +333,37 @@ def _problem(part: Any, blocks: list[StillBlock], terms: tuple[str, ...], prior:
     nuisance = settings.turn_on_dph ** 2
     if "const" not in terms:  # the constant holds the Earth rate and the offset's change
         nuisance += EARTH_RATE_BOUND_DPH ** 2 + settings.ageing_offset_dph ** 2
-    covariance = np.zeros((n_model + n_runs, n_model + n_runs))
+    n_state = n_model + 2 * n_runs  # the corrections, each run's constant and its walk
+    covariance = np.zeros((n_state, n_state))
     covariance[:n_model, :n_model] = prior
-    covariance[n_model:, n_model:] = np.eye(n_runs) * nuisance
-    rows = np.zeros((len(blocks), n_model + n_runs))
+    covariance[n_model:n_model + n_runs, n_model:n_model + n_runs] = np.eye(n_runs) * nuisance
+    rows = np.zeros((len(blocks), n_state))
     for k, block in enumerate(blocks):
         rows[k, :n_model] = [1.0 if t == "const" else block.f for t in terms]
-        rows[k, n_model + block.run] = 1.0
+        rows[k, n_model + block.run] = rows[k, n_model + n_runs + block.run] = 1.0
     ends = np.zeros(n_runs)
     for block in blocks:  # each run's times after the runs before it
         ends[block.run] = max(ends[block.run], block.time_h)
     starts = np.concatenate([[0.0], np.cumsum(ends)[:-1]])
-    return FilterProblem(
-        np.zeros(n_model + n_runs), covariance, rows,
-        np.array([b.residual_dph for b in blocks]),
-        np.array([max(noise, b.white_sigma_dph) ** 2 for b in blocks]),
-        np.array([starts[b.run] + b.time_h for b in blocks]), n_model, settings.ageing_tau_h)
+    times_h = np.array([starts[b.run] + b.time_h for b in blocks])
+    start_h = np.zeros(n_state)  # each walk from 0 at its run's first still block
+    for block in reversed(blocks):
+        start_h[n_model + n_runs + block.run] = starts[block.run] + block.start_s / 3600.0
+    walk = Walk(np.array([n_model + n_runs + b.run for b in blocks]), start_h, 0.0)
+    problem = FilterProblem(
+        np.zeros(n_state), covariance, rows, np.array([b.residual_dph for b in blocks]),
+        np.array([max(noise, b.white_sigma_dph) ** 2 for b in blocks]), times_h, n_model,
+        settings.ageing_tau_h, walk)
+    rate = walk_rate(lambda q: _solve(replace(problem, walk=walk._replace(q_per_h=q)),
+                                      slice(None)))
+    return replace(problem, walk=walk._replace(q_per_h=rate))
 
 
 def _solve(problem: FilterProblem, which: Any) -> Any:
+    walk = None if problem.walk is None else problem.walk.subset(which)
     return run_filter(problem.mean, problem.covariance, problem.rows[which], problem.z[which],
-                      problem.r[which], problem.times_h[which], problem.n_model, problem.tau_h)
+                      problem.r[which], problem.times_h[which], problem.n_model, problem.tau_h,
+                      walk)
 
 
 def _updated_drift(drift: Any, terms: tuple[str, ...], after: tuple[float, ...]) -> Any:

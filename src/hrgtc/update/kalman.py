@@ -17,17 +17,47 @@ stay at their prior. The estimate itself is held (the filter does not forget an 
 has seen); the nuisance constants do not age. ``τ = 0`` switches the process noise off:
 the filter is then the batch weighted least squares with the same prior, exactly
 (``tests/update/test_kalman.py`` compares them).
+
+Random walk of the bias (:class:`Walk`): a gyro's bias wanders within a recording (its rate
+random walk), so the blocks of one run are not independent: a day's still means share the
+wander since the run began. Each run then has a second nuisance, a random walk that starts
+at 0 at the run's first still block and whose variance grows by ``q`` per hour between the
+run's blocks. Without it the filter takes the wander between the temperatures of a field
+day for a change of slope, and is sure of it; with it, the slope is read from the steps
+between neighbouring blocks, where the wander is small. ``q`` is chosen by the likelihood
+of the filter's innovations (:func:`walk_rate`, ``docs/guide/update.md``). The filter is
+still the batch generalised least squares with the walk's covariance ``q·min(t_i, t_j)``
+(tested to 1e-9).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
-__all__ = ["FilterRun", "heldout_rms", "jump_statistic", "run_filter"]
+__all__ = ["FilterRun", "Walk", "heldout_rms", "jump_statistic", "run_filter", "walk_rate"]
+
+#: Rates of the random walk tried by :func:`walk_rate`: 0 and 10⁻⁴ … 1 (°/h)²/h, i.e. a
+#: rate random walk of 0.01 … 1 °/h/√h.
+WALK_RATES_PER_H = (0.0, *np.logspace(-4.0, 0.0, 17))
+
+
+class Walk(NamedTuple):
+    """The runs' random walks: ``state[k]``, the index in the state of block ``k``'s walk;
+    ``start_h[j]``, the time walk state ``j`` starts from 0 [h]; ``q_per_h``, the variance
+    it gains per hour [(°/h)²/h]."""
+
+    state: np.ndarray
+    start_h: np.ndarray
+    q_per_h: float
+
+    def subset(self, which: object) -> Walk:
+        """The walk of the blocks ``which`` (an index or a slice of the blocks)."""
+        return Walk(self.state[which], self.start_h, self.q_per_h)
 
 
 @dataclass(frozen=True)
@@ -41,15 +71,19 @@ class FilterRun:
     traces
         Trace of the model corrections' covariance after each block (the process noise
         and the measurement included).
+    log_likelihood
+        Log-likelihood of the blocks under the filter's model (of its innovations).
     """
 
     mean: np.ndarray
     covariance: np.ndarray
     traces: np.ndarray
+    log_likelihood: float = 0.0
 
 
 def run_filter(mean: np.ndarray, covariance: np.ndarray, rows: np.ndarray, z: np.ndarray,
-               r: np.ndarray, times_h: np.ndarray, n_model: int, tau_h: float) -> FilterRun:
+               r: np.ndarray, times_h: np.ndarray, n_model: int, tau_h: float,
+               walk: Walk | None = None) -> FilterRun:
     """Filter the measurements ``z = rows · x + v`` (``v`` of variances ``r``) in order.
 
     Parameters
@@ -67,6 +101,8 @@ def run_filter(mean: np.ndarray, covariance: np.ndarray, rows: np.ndarray, z: np
         How many leading states are model corrections (the others are nuisances).
     tau_h
         Time constant of the process noise (0: none). [h]
+    walk
+        The runs' random walks (none: the nuisances are constants).
     """
     x = np.array(mean, dtype=np.float64)
     p = np.array(covariance, dtype=np.float64)
@@ -74,7 +110,13 @@ def run_filter(mean: np.ndarray, covariance: np.ndarray, rows: np.ndarray, z: np
     traces = np.empty(len(z))
     identity = np.eye(x.size)
     last = times_h[0] if len(times_h) else 0.0
+    walked = None if walk is None or not walk.q_per_h > 0.0 else np.array(walk.start_h)
+    log_likelihood = 0.0
     for k, (h, value, variance, time) in enumerate(zip(rows, z, r, times_h, strict=True)):
+        if walked is not None:
+            j = walk.state[k]
+            p[j, j] += walk.q_per_h * max(time - walked[j], 0.0)
+            walked[j] = max(time, walked[j])
         if tau_h > 0.0 and n_model:
             phi = math.exp(-max(time - last, 0.0) / tau_h)
             p[:n_model, :n_model] = phi * phi * p[:n_model, :n_model] + (1.0 - phi * phi) * ceiling
@@ -83,12 +125,20 @@ def run_filter(mean: np.ndarray, covariance: np.ndarray, rows: np.ndarray, z: np
         last = time
         s = float(h @ p @ h) + float(variance)
         gain = p @ h / s
-        x = x + gain * (float(value) - float(h @ x))
+        innovation = float(value) - float(h @ x)
+        log_likelihood -= 0.5 * (math.log(2.0 * math.pi * s) + innovation * innovation / s)
+        x = x + gain * innovation
         a = identity - np.outer(gain, h)
         p = a @ p @ a.T + float(variance) * np.outer(gain, gain)
         p = 0.5 * (p + p.T)
         traces[k] = float(np.trace(p[:n_model, :n_model]))
-    return FilterRun(x, p, traces)
+    return FilterRun(x, p, traces, log_likelihood)
+
+
+def walk_rate(solve: Callable[[float], FilterRun]) -> float:
+    """The walk rate ``q`` of :data:`WALK_RATES_PER_H` under which the blocks are most
+    likely (``solve(q)``: the filter run with that rate). [(°/h)²/h]"""
+    return max(WALK_RATES_PER_H, key=lambda q: solve(float(q)).log_likelihood)
 
 
 def jump_statistic(residuals: np.ndarray, stretches: np.ndarray, sigma: float,

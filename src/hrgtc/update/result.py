@@ -23,7 +23,8 @@ class FilterProblem:
     """The filter's inputs, kept so that a second method can be held to it: the prior
     (``mean``, ``covariance``; the first ``n_model`` states are the model's corrections),
     one measurement row per still block (``rows``), the blocks' residuals ``z`` [°/h],
-    their variances ``r`` [(°/h)²] and times [h]."""
+    their variances ``r`` [(°/h)²] and times [h], and the runs' random walks (``walk``,
+    :class:`hrgtc.update.kalman.Walk`, its rate chosen by likelihood)."""
 
     mean: np.ndarray
     covariance: np.ndarray
@@ -33,6 +34,7 @@ class FilterProblem:
     times_h: np.ndarray
     n_model: int
     tau_h: float
+    walk: Any = None
 
 
 @dataclass(frozen=True)
