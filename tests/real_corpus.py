@@ -62,7 +62,8 @@ class RealFile:
     name
         Its folder under the tests' data.
     source
-        The data file (a ``.gz`` is unpacked first, as a user would).
+        The data file, as committed (hrgtc reads a ``.csv.gz`` as it is; numpy's reading
+        unpacks it first).
     args
         The column mapping and units: all a newcomer passes.
     still
