@@ -56,6 +56,8 @@ def test_one_update_without_process_noise_is_the_batch_least_squares(parent, fie
     # walk is 0.1 °/h/√h, q = 0.01 (°/h)²/h), and the batch method takes it as the
     # covariance of the measurements
     assert 1e-3 <= p.walk.q_per_h <= 0.1
+    figures = {f.name: f.value for _, fs in result.summary().sections for f in fs}
+    assert figures["walk_dph_per_sqrt_h"] == np.sqrt(p.walk.q_per_h)
     keep, mean, prior, rows = without_walk_states(p)
     x, covariance = batch_wls(mean, prior, rows, p.z, np.diag(p.r) + walk_covariance(p))
     np.testing.assert_allclose(np.subtract(axis.after, axis.before), x[:p.n_model],

@@ -154,7 +154,12 @@ class UpdateResult:
                        digits=3, definition="Mahalanobis length of the update's step in "
                        "the prior's metric."),
                 Figure(f"{prefix}jump_sigma", "largest step within a run",
-                       part.jump_sigma, "σ", digits=3))))
+                       part.jump_sigma, "σ", digits=3),
+                Figure(f"{prefix}walk_dph_per_sqrt_h", "bias wander (random walk)",
+                       math.sqrt(part.problem.walk.q_per_h if part.problem.walk else 0.0),
+                       "°/h/√h", digits=3, definition="The random walk of each recording's "
+                       "bias the filter allows for, the rate under which the blocks are "
+                       "most likely (docs/guide/update.md)."))))
         notes = (*((self.reason,) if self.reason else ()), *self.notes)
         title = "in-field update" + ("" if self.applied else ": nothing changed")
         return Summary(title, tuple(sections), notes)
