@@ -67,7 +67,8 @@ def _update(model: Any) -> Any:
 
     from field_ageing import INPUT_RATE_DPH, aged_unit, field_profile
 
-    day = simulate_run(field_profile(), aged_unit(), sample_rate_hz=2.0, seed=7)
+    # seed 8: a day whose update is applied
+    day = simulate_run(field_profile(), aged_unit(), sample_rate_hz=2.0, seed=8)
     return model.update(day, UpdateSettings(input_rate_dph=INPUT_RATE_DPH))
 
 
