@@ -219,7 +219,7 @@ def _station_sigma(blocks: dict[str, list[StillBlock]], means: np.ndarray,
         fallback = drift.residual_std_dph * math.sqrt(drift.window_s / settings.block_s)
         white = max(b.white_sigma_dph for b in blocks[axis])
         noise.append(max(block_noise_dph(blocks[axis], fallback if math.isfinite(fallback)
-                                         else 0.0), white))
+                                         else 0.0), white, _wander_dph(blocks[axis])))
     # a block's noise beyond white is mostly the bias's flicker and random walk, which a
     # longer mean does not average down: a period's mean is given a block's noise, not
     # that over the square root of its blocks (which would state intervals several times
@@ -228,6 +228,18 @@ def _station_sigma(blocks: dict[str, list[StillBlock]], means: np.ndarray,
     per_axis = np.array(noise)[None, :] * np.ones((means.shape[0], 1))
     u = means / np.linalg.norm(means, axis=1)[:, None]
     return np.sqrt(np.sum((u * per_axis) ** 2, axis=1))
+
+
+def _wander_dph(blocks: list[StillBlock]) -> float:
+    """How far a still period's mean wanders from the data: the rms over the periods of
+    the difference between the means of its second and its first half (a random walk of
+    the bias moves a period's mean by about that; white noise by far less). [°/h]"""
+    periods: dict[tuple[int, int], list[float]] = {}
+    for b in blocks:
+        periods.setdefault((b.run, b.period), []).append(b.residual_dph)
+    steps = [np.mean(v[len(v) // 2:]) - np.mean(v[:len(v) // 2])
+             for v in periods.values() if len(v) >= 4]
+    return float(np.sqrt(np.mean(np.square(steps)))) if steps else 0.0
 
 
 def _condition(means: np.ndarray, sigma: np.ndarray) -> float:
