@@ -109,20 +109,21 @@ def update_model(model: Any, recordings: Any, settings: UpdateSettings | None = 
                    zip(runs, found, strict=True)) for b in _axis_blocks(
                        index, _view(recording, name), part, periods, settings)],
                    settings, labels) for name, part in model.axes.items()}
-    triad, notes = _triad(model, settled, settings, labels)
-    axes, parts, groups = {}, dict(model.axes), labels
+    axes, notes, parts, grouped, groups = {}, [], dict(model.axes), settled, labels
     is_triad = triad_axes(model, settings) is not None
     if is_triad:  # a nuisance constant per orientation, not per run
-        settled, groups = by_orientation(settled, labels)
+        grouped, groups = by_orientation(settled, labels)
     for name, part in model.axes.items():
-        terms, said = _observable(part, settled[name], settings, is_triad) \
-            if settled[name] else ((), [f"every still period is shorter than a block "
+        terms, said = _observable(part, grouped[name], settings, is_triad) \
+            if grouped[name] else ((), [f"every still period is shorter than a block "
                                          f"({settings.block_s:g} s)"])
         notes += [f"{name}: {n}" if name else n for n in said]
         if terms:
-            axes[name] = _filter_axis(model, name, settled[name], terms, settings, groups)
+            axes[name] = _filter_axis(model, name, grouped[name], terms, settings, groups)
             parts[name] = replace(part, drift=_updated_drift(part.drift, terms,
                                                              axes[name].after))
+    triad, said = _triad(model, _slope_removed(settled, axes), settings, labels)
+    notes = said + notes
     if triad is not None:
         for k, name in enumerate(triad.axes):
             parts[name] = replace(parts[name], drift=_updated_drift(
@@ -143,6 +144,22 @@ def _triad(model: Any, settled: dict[str, list[StillBlock]], settings: UpdateSet
         return None, []
     triad, why = triad_offsets(model, settled, settings, labels)
     return triad, [why] if why else []
+
+
+def _slope_removed(blocks: dict[str, list[StillBlock]], axes: dict[str, AxisUpdate]
+                   ) -> dict[str, list[StillBlock]]:
+    """The blocks' residuals with each axis's slope update taken out (the triad's offsets
+    are then those of the updated slopes)."""
+    out = {}
+    for name, items in blocks.items():
+        update = axes.get(name)
+        if update is None or "f" not in update.terms:
+            out[name] = items
+            continue
+        k = update.terms.index("f")
+        step = update.after[k] - update.before[k]
+        out[name] = [replace(b, residual_dph=b.residual_dph - step * b.f) for b in items]
+    return out
 
 
 def _lineage(model: Any, parent_bytes: bytes, parent_path: str, data: tuple[LineageData, ...],
@@ -276,10 +293,14 @@ def _observable(part: Any, blocks: list[StillBlock], settings: UpdateSettings,
         notes.append("offset B0 not updated: the input rate is unknown (a still mean is "
                      "bias + Earth-rate projection + turn-on shift); give input_rate_dph")
     span = describe_blocks(blocks)["span_c"]
+    if triad:  # a nuisance per orientation: only the temperatures within one tell the slope
+        span = max(describe_blocks([b for b in blocks if b.run == run])["span_c"]
+                   for run in {b.run for b in blocks})
     if "f" not in part.drift.selected:
         notes.append("slope not updated: the model has no term f")
     elif span < settings.min_span_c:
-        notes.append(f"slope not updated: the still blocks span {span:.3g} °C, less than "
+        notes.append(f"slope not updated: the still blocks span {span:.3g} °C"
+                     f"{' within one orientation' if triad else ''}, less than "
                      f"min_span_c {settings.min_span_c:g} °C")
     else:
         terms.append("f")
@@ -311,13 +332,14 @@ def _prior(model: Any, name: str, terms: tuple[str, ...],
 def _filter_axis(model: Any, name: str, blocks: list[StillBlock], terms: tuple[str, ...],
                  settings: UpdateSettings, labels: list[str]) -> AxisUpdate:
     """The filter over the blocks of axis ``name``, its guards, and the axis's figures."""
+    where = ", ".join(dict.fromkeys(labels))  # a recording's orientations share its name
     values, prior = _prior(model, name, terms, settings)
     problem = _problem(model.axes[name], blocks, terms, prior, settings)
     n_model, runs = problem.n_model, np.array([b.run for b in blocks])
     fit, held = split_heldout(len(blocks), settings.holdout_every)
     if held.size < 2 or fit.size < 2:
         raise UpdateRefusedError(
-            f"{', '.join(labels)}: {len(blocks)} still block(s) of {settings.block_s:g} s are "
+            f"{where}: {len(blocks)} still block(s) of {settings.block_s:g} s are "
             "too few to judge an update on held-out blocks (at least "
             f"{2 * settings.holdout_every}); record longer still periods")
     whole = _solve(problem, slice(None))
@@ -333,7 +355,7 @@ def _filter_axis(model: Any, name: str, blocks: list[StillBlock], terms: tuple[s
     step = mahalanobis(whole.mean[:n_model], prior)
     if step > settings.max_step_sigma:
         raise UpdateRefusedError(
-            f"{', '.join(labels)}: the update would move {', '.join(terms)} by {step:.3g} σ "
+            f"{where}: the update would move {', '.join(terms)} by {step:.3g} σ "
             f"of the prior (limit max_step_sigma {settings.max_step_sigma:g}): further than "
             "ageing goes; check the unit and the input rate, or recalibrate")
     trained = _solve(problem, fit)
@@ -344,7 +366,7 @@ def _filter_axis(model: Any, name: str, blocks: list[StillBlock], terms: tuple[s
     rms_after = heldout_rms(after, runs[held], centred)
     if not rms_after < rms_before:
         raise UpdateRefusedError(
-            f"{', '.join(labels)}: no gain on the held-out still blocks (rms {rms_before:.4g} "
+            f"{where}: no gain on the held-out still blocks (rms {rms_before:.4g} "
             f"°/h before, {rms_after:.4g} °/h after): the update is not applied")
     return AxisUpdate(
         terms, tuple(float(v) for v in values), tuple(float(v) for v in values
