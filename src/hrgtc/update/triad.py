@@ -123,16 +123,18 @@ def orientation_groups(vectors: Sequence[np.ndarray],
 
 def _stations(joint: list[tuple[StillBlock, np.ndarray]], fit: np.ndarray
               ) -> tuple[np.ndarray, np.ndarray]:
-    """Mean residual vector and fitted block count of each still period (run, period)."""
+    """Mean residual vector and mean temperature of each still period (run, period), over
+    its fitted blocks. [°/h], [°C]"""
     sums: dict[tuple[int, int], list[Any]] = {}
     for k in fit:
         block, vector = joint[k]
-        entry = sums.setdefault((block.run, block.period), [np.zeros(3), 0])
+        entry = sums.setdefault((block.run, block.period), [np.zeros(3), 0.0, 0])
         entry[0] = entry[0] + vector
-        entry[1] += 1
-    means = np.array([total / count for total, count in sums.values()])
-    counts = np.array([count for _, count in sums.values()], dtype=np.float64)
-    return means.reshape(-1, 3), counts
+        entry[1] += block.temperature_c
+        entry[2] += 1
+    means = np.array([total / count for total, _, count in sums.values()])
+    temperatures = np.array([t / count for _, t, count in sums.values()], dtype=np.float64)
+    return means.reshape(-1, 3), temperatures
 
 
 def _prior(model: Any, axes: tuple[str, ...], settings: UpdateSettings
@@ -170,7 +172,7 @@ def triad_offsets(model: Any, blocks: dict[str, list[StillBlock]], settings: Upd
         return None, (f"offsets not updated: {len(joint)} still block(s) shared by the three "
                       f"axes, too few to fit and judge them (at least "
                       f"{2 * settings.holdout_every})")
-    means, counts = _stations(joint, fit)
+    means, temperatures = _stations(joint, fit)
     groups = orientation_groups(means)
     found = max(groups) + 1
     if found < settings.triad_min_orientations:
@@ -178,7 +180,7 @@ def triad_offsets(model: Any, blocks: dict[str, list[StillBlock]], settings: Upd
                       f"orientation(s), at least {settings.triad_min_orientations} are "
                       "needed (only |Ω| is known, not its direction: turn the unit between "
                       "still periods, or give the input rate)")
-    sigma = _station_sigma(blocks, means, counts, model, axes, settings)
+    sigma = _station_sigma(blocks, means, temperatures, model, axes, settings)
     values, prior = _prior(model, axes, settings)
     condition = _condition(means, sigma)
     if not condition <= settings.triad_max_condition:
@@ -209,10 +211,13 @@ def triad_offsets(model: Any, blocks: dict[str, list[StillBlock]], settings: Upd
 
 
 def _station_sigma(blocks: dict[str, list[StillBlock]], means: np.ndarray,
-                   counts: np.ndarray, model: Any, axes: tuple[str, ...],
+                   temperatures: np.ndarray, model: Any, axes: tuple[str, ...],
                    settings: UpdateSettings) -> np.ndarray:
-    """1σ of the norm residual of each still period: the blocks' noise per axis (see
-    below), projected on the period's Earth-rate direction. [°/h]"""
+    """1σ of the norm residual of each still period: per axis, the blocks' noise (see
+    below) and the slope's ageing allowance times the period's distance from the periods'
+    mean temperature (still periods at several temperatures see a slope's error as offsets
+    that differ between orientations), projected on the period's Earth-rate direction.
+    [°/h]"""
     noise = []
     for axis in axes:
         drift = model.axes[axis].drift
@@ -223,9 +228,9 @@ def _station_sigma(blocks: dict[str, list[StillBlock]], means: np.ndarray,
     # a block's noise beyond white is mostly the bias's flicker and random walk, which a
     # longer mean does not average down: a period's mean is given a block's noise, not
     # that over the square root of its blocks (which would state intervals several times
-    # too narrow; tests/update/test_triad.py holds the offsets to their intervals)
-    del counts
-    per_axis = np.array(noise)[None, :] * np.ones((means.shape[0], 1))
+    # too narrow; bench/update_triad.py measures how honest they are)
+    slope = settings.ageing_slope_dph_per_c * np.abs(temperatures - np.nanmean(temperatures))
+    per_axis = np.sqrt(np.square(np.array(noise))[None, :] + np.square(slope)[:, None])
     u = means / np.linalg.norm(means, axis=1)[:, None]
     return np.sqrt(np.sum((u * per_axis) ** 2, axis=1))
 
