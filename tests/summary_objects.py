@@ -40,6 +40,7 @@ def _paper(paper: Any) -> dict[str, Any]:
     from hrgtc.evaluation import evaluate
     from hrgtc.pipeline.calibration import calibrate
     from hrgtc.pipeline.demo import DemoResult
+    from hrgtc.pipeline.demo_history import HistoryDemo
     from hrgtc.recording import read
     from hrgtc.thermometry.plateaus import find_plateaus
 
@@ -57,6 +58,11 @@ def _paper(paper: Any) -> dict[str, Any]:
             # the demo's figures (its files are the demo's business, not the summary's)
             "DemoResult": DemoResult(Path("demo-out"), result, training, evaluation, None,
                                      Path("model.json"), Path("report.html"), ()),
+            # the demo's history part: two fits and the held-out run evaluated with each
+            # (here the paper-unit's: the summary's figures, not unit-play's campaign)
+            "HistoryDemo": HistoryDemo(result, result, True, 2.0, {"2": 0.3, "without": 0.4},
+                                       training, evaluation, Path("unit-play.json"),
+                                       Path("report.html")),
             "UpdateResult": _update(model)}
 
 

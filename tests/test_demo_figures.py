@@ -82,7 +82,8 @@ def test_the_demo_gives_its_recorded_figures(tmp_path):
     from hrgtc.pipeline.demo import run_demo
     from hrgtc.settings.fleet import DemoSettings
 
-    result = run_demo(tmp_path / "demo", DemoSettings(instrument_rate_hz=None))
+    result = run_demo(tmp_path / "demo", DemoSettings(instrument_rate_hz=None,
+                                                      history_rate_hz=None))
     for run, evaluation in (("training", result.training), ("validation", result.validation)):
         figures = RECORD[run]
         assert evaluation.n_samples == figures["n_samples"]
@@ -91,3 +92,68 @@ def test_the_demo_gives_its_recorded_figures(tmp_path):
                 figures[series], rel=1e-6), (run, series)
             interval = evaluation.stability_interval(series, 10.0)
             assert interval == pytest.approx(figures[f"{series}_interval"], rel=1e-6)
+
+
+HISTORY = RECORD["history"]
+
+
+def test_the_readme_quotes_the_recorded_history_part():
+    """README's demo lines: the held-out cycle's heating and cooling, without → with the
+    history terms, as recorded."""
+    text = " ".join((ROOT / "README.md").read_text(encoding="utf-8").split())
+    found = re.search(rf"heating {NUMBER} → {NUMBER}, cooling {NUMBER} → {NUMBER} °/h", text)
+    assert found, "README's demo lines lost the history figures"
+    quoted = dict(zip(("heating", "cooling"), (found.groups()[:2], found.groups()[2:]),
+                      strict=True))
+    for direction, (without, with_history) in quoted.items():
+        figures = HISTORY["figures"][direction]
+        assert _quoted(figures["without"], without), (direction, without)
+        assert _quoted(figures["with"], with_history), (direction, with_history)
+
+
+def test_the_demo_guide_quotes_the_recorded_history_part():
+    """docs/guide/demo.md's table of the held-out cycle, every cell, and the width."""
+    text = (ROOT / "docs" / "guide" / "demo.md").read_text(encoding="utf-8")
+    columns = ("raw", "without", "with", "without_residual", "with_residual")
+    for direction in ("heating", "cooling", "whole run"):
+        row = next(line for line in text.splitlines() if line.startswith(f"| {direction} |"))
+        cells = [c.strip() for c in row.strip("|").split("|")[1:]]
+        figures = HISTORY["figures"][direction.replace(" ", "_")]
+        assert len(cells) == len(columns), row
+        for column, cell in zip(columns, cells, strict=True):
+            assert _quoted(figures[column], cell), (direction, column, cell)
+    assert f"width learned is {HISTORY['play_width_c']:g} °C" in text
+    assert (f"leave-one-run-out {HISTORY['scores_dph']['2']:.4f} against "
+            f"{HISTORY['scores_dph']['without']:.4f} °/h") in text
+
+
+def test_the_recorded_history_part_shows_the_memory_modelled():
+    """What the quotes claim: on the held-out cycle the history model is closer to the true
+    bias than today's while heating and while cooling, and compensates better both ways."""
+    assert HISTORY["kept"] and "play" in HISTORY["terms_with_history"]
+    for direction in ("heating", "cooling", "whole_run"):
+        figures = HISTORY["figures"][direction]
+        assert figures["with_residual"] < 0.7 * figures["without_residual"], direction
+        assert figures["with"] < figures["without"] < figures["raw"], direction
+
+
+@pytest.mark.slow
+def test_the_demo_gives_its_recorded_history_figures(tmp_path):
+    """The unit-play part of ``hrgtc demo`` (its settings, seed 2012; the same with
+    ``--quick``) gives the recorded figures: the quotes come from a run this test checks."""
+    from hrgtc.pipeline.demo import HISTORY_SOAK_HOURS
+    from hrgtc.pipeline.demo_history import run_history_demo
+    from hrgtc.settings.fleet import DemoSettings
+
+    settings = DemoSettings()
+    assert DemoSettings.quick().history_rate_hz == settings.history_rate_hz
+    demo = run_history_demo(tmp_path / "unit-play", settings.history_rate_hz,
+                            HISTORY_SOAK_HOURS, settings.seed)
+    assert demo.kept == HISTORY["kept"]
+    assert demo.play_width_c == HISTORY["play_width_c"]
+    assert list(demo.with_history.model.drift.selected) == HISTORY["terms_with_history"]
+    assert list(demo.without.model.drift.selected) == HISTORY["terms_without"]
+    assert demo.scores_dph == pytest.approx(HISTORY["scores_dph"], rel=1e-6)
+    for direction, figures in demo.figures().items():
+        assert figures == pytest.approx(HISTORY["figures"][direction], rel=1e-6), direction
+    assert demo.report_file.exists() and demo.model_file.exists()

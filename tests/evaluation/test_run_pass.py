@@ -111,6 +111,14 @@ def test_demo_quick_end_to_end(tmp_path):
     for key in ("model_file", "report_file"):
         assert (tmp_path / "demo" / data[key].split("/")[-1]).exists()
     assert len(data["c_files"]) == 2
+    # the unit with a thermal memory: on its held-out cycle the history model is closer to
+    # the true bias than today's, heating and cooling alike (the figures: test_demo_figures)
+    history = data["history"]
+    assert history["kept"] and "play" in history["terms_with_history"]
+    for direction in ("heating", "cooling"):
+        figures = history["figures"][direction]
+        assert figures["with_residual"] < figures["without_residual"], direction
+    assert (tmp_path / "demo" / "unit-play" / "report.html").exists()
     again = CliRunner().invoke(app, ["demo", "--quick", "-o", str(tmp_path / "demo")])
     assert again.exit_code == 2 and "--force" in again.output
 

@@ -78,3 +78,18 @@ def known():
     from hrgtc.update import UpdateSettings
 
     return UpdateSettings(input_rate_dph=INPUT_RATE_DPH)
+
+
+@pytest.fixture(scope="session")
+def instrument(imu_campaign):
+    """The three-axis ``imu-3`` calibrated on the shared campaign (as the demo does)."""
+    import warnings
+
+    from hrgtc.core.errors import HrgtcWarning
+    from hrgtc.pipeline.calibration import RateTables, calibrate
+
+    files = imu_campaign
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", HrgtcWarning)
+        return calibrate(files.soaks, [files.cooldown], [files.warmup],
+                         rate_tables=RateTables(runs=(files.rate_table,))).model

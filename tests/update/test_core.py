@@ -198,21 +198,6 @@ def test_a_second_update_starts_from_the_first_ones_posterior(parent, field_reco
     assert second.lineage.parent_parameters_sha256 == first.model.sha256
 
 
-@pytest.fixture(scope="module")
-def instrument(imu_campaign):
-    """The three-axis ``imu-3`` calibrated on the shared campaign (as the demo does)."""
-    import warnings
-
-    from hrgtc.core.errors import HrgtcWarning
-    from hrgtc.pipeline.calibration import RateTables, calibrate
-
-    files = imu_campaign
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", HrgtcWarning)
-        return calibrate(files.soaks, [files.cooldown], [files.warmup],
-                         rate_tables=RateTables(runs=(files.rate_table,))).model
-
-
 def test_each_axis_of_an_instrument_is_updated_in_the_same_chain(instrument, tmp_path):
     """One chain for one axis or many: every axis of an aged three-axis unit gets its slope
     (the input rates unknown: slope only), each moved by about the ageing, c1 + 0.05

@@ -24,12 +24,15 @@ def demo_command(
 ) -> None:
     """Simulate the paper's campaign (7 soaks, a cool-down, a warm-up), calibrate, compensate,
     evaluate, report and export C, and compare with the paper's figures; then the same for
-    the three-axis imu-3 with rate tables (bias and scale factor, every axis).
+    the three-axis imu-3 with rate tables (bias and scale factor, every axis); then unit-play,
+    a unit with a thermal memory, held out on a cycle with and without the history variables
+    (heating and cooling apart).
 
     Example: hrgtc demo -o demo-out --force
     """
     from hrgtc.cli.summary_tables import print_summary
     from hrgtc.pipeline.demo import run_demo
+    from hrgtc.pipeline.demo_history import to_dict as history_dict
 
     settings = DemoSettings.quick(seed) if quick else DemoSettings(seed=seed)
     seen: set[str] = set()
@@ -55,6 +58,7 @@ def demo_command(
                 "model_file": str(result.instrument.model_file),
                 "report_file": str(result.instrument.report_file),
                 "c_files": [str(p) for p in result.instrument.c_files]},
+            "history": None if result.history is None else history_dict(result.history),
         })
         return
     render(result.calibration.axis)
@@ -72,3 +76,10 @@ def demo_command(
         console.print(f"compensated warm-up: {demo.compensated.output}")
         console.print(f"report: {demo.report_file}")
         console.print("C: " + ", ".join(str(p) for p in demo.c_files))
+    if result.history is not None:
+        history = result.history
+        console.rule("unit-play, a true thermal memory: held-out cycle with and without "
+                     "the history variables")
+        print_summary(history.summary(), console)
+        console.print(f"model: {history.model_file}")
+        console.print(f"report: {history.report_file}")

@@ -56,9 +56,11 @@ def update_command(
     settings: UpdateSettings | None = None,
 ) -> None:
     """Update a model from the still periods of a field recording: a Kalman filter on the
-    drift model's offset (with a known --input-rate-dph) and slope (over --min-span-c),
-    refused with its reason for another unit's file, a jump, a ramp, a step too far or no
-    gain on held-out still blocks. The new file records its lineage.
+    drift model's offset (with a known --input-rate-dph; a three-axis model's offsets
+    without it, from the Earth rate's magnitude and still periods in several orientations)
+    and slope (over --min-span-c), refused with its reason for another unit's file, a jump,
+    a ramp, a step too far or no gain on held-out still blocks. The new file records its
+    lineage.
 
     Example: hrgtc update unit.json field.parquet --input-rate-dph 9.67 -o unit-2.json
 

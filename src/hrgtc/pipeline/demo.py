@@ -6,7 +6,10 @@ and a warm-up with another seed to validate (Section 4.2, Fig. 6); calibrate;
 compensate; evaluate; write the model, the compensated warm-up, the HTML report
 and the C files into one folder. Then the same for the three-axis ``imu-3`` with
 rate tables (bias and scale factor of every axis, held-out warm-up and rate table),
-into ``imu-3/``. What ``hrgtc demo`` and ``make demo`` run.
+into ``imu-3/``; then ``unit-play``, a unit with a true thermal memory, trained on a
+cool-down and a warm-up with and without the history variables and held out on a cycle
+(:mod:`hrgtc.pipeline.demo_history`), into ``unit-play/``. What ``hrgtc demo`` and
+``make demo`` run.
 
 [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
 """
@@ -29,6 +32,7 @@ from hrgtc.evaluation.instrument_figures import stability_table
 from hrgtc.export.export_c import export_c
 from hrgtc.model import save_model
 from hrgtc.pipeline.calibration import Calibration, RateTables, calibrate
+from hrgtc.pipeline.demo_history import HistoryDemo, run_history_demo
 from hrgtc.recording import ReadOptions, RecordingWriter
 from hrgtc.report import build_report
 from hrgtc.settings.compensation import ReportSettings
@@ -53,6 +57,7 @@ class DemoResult:
     report_file: Path
     c_files: tuple[Path, ...]
     instrument: InstrumentDemo | None = None
+    history: HistoryDemo | None = None
 
     def summary(self) -> Summary:
         """10 s bias stability raw → compensated: the paper's, the training cool-down's
@@ -137,10 +142,16 @@ def run_demo(
     instrument = None
     if s.instrument_rate_hz is not None:
         instrument = run_instrument_demo(root / "imu-3", s, force=force, progress=progress)
+    history = None
+    if s.history_rate_hz is not None:
+        history = run_history_demo(root / "unit-play", s.history_rate_hz, HISTORY_SOAK_HOURS,
+                                   s.seed, force=force, progress=progress)
     return DemoResult(root, result, training, validation, compensated, model_file,
-                      report_file, c_files, instrument)
+                      report_file, c_files, instrument, history)
 
 
+#: Soak length of the thermal-history part, the same in ``--quick``. [h]
+HISTORY_SOAK_HOURS = 5.0
 #: Rate-table plateaus of the three-axis demo: training, and held out between them. [°C]
 TABLE_PLATEAUS_C = (-15.0, 0.0, 15.0, 30.0)
 HELDOUT_TABLE_C = (-5.0, 22.0)

@@ -76,6 +76,9 @@ class DemoSettings:
     seed: int = setting(2012, "Seed of the simulated campaign.")
     #: Sample rate of the three-axis part (None: skip it). [Hz]
     instrument_rate_hz: float | None = 10.0
+    #: Sample rate of the thermal-history part, unit-play (None: skip it); the same in
+    #: ``quick``, so that its figures are those of ``make demo``. [Hz]
+    history_rate_hz: float | None = 1.0
 
     @classmethod
     def quick(cls, seed: int | None = None) -> DemoSettings:

@@ -11,6 +11,9 @@ from dataclasses import dataclass
 
 from hrgtc.settings import setting
 
+#: The Earth's rotation rate, 7.2921159e-5 rad/s (IERS), in °/h: the magnitude of the input
+#: rate vector of a triad at rest.
+EARTH_RATE_DPH = 15.0410687
 #: Largest Earth-rate projection on an HRG's sensitive axis (15.04 °/h at the poles):
 #: the bound of the constant a still mean holds beside the bias when the input is unknown.
 EARTH_RATE_BOUND_DPH = 15.0
@@ -56,6 +59,19 @@ class UpdateSettings:
         8.0, "Refuse a recording whose still residual steps within a stretch of "
         "consecutive still blocks by more than this many standard errors (a jump is not "
         "ageing).", min=0.0)
+    triad_rate_norm_dph: float = setting(
+        EARTH_RATE_DPH, "A model of three orthogonal axes (a triad) without a known input "
+        "rate: the magnitude of the rate vector during the still periods, whose direction "
+        "is not known; the offsets are updated from it when the still periods hold enough "
+        "orientations (the Earth rate at rest; 0: never).", unit="°/h", min=0.0)
+    triad_min_orientations: int = setting(
+        3, "A triad's offsets are updated from |Ω| only when the still periods hold at "
+        "least this many distinct orientations.", min=3)
+    triad_max_condition: float = setting(
+        100.0, "A triad's offsets are updated from |Ω| only when the condition number of the "
+        "still periods' information about them is at most this (orientations about one "
+        "axis leave a direction unknown).",
+        min=1.0)
     holdout_every: int = setting(
         3, "Every n-th still block (in time) is held out to judge the update, the others "
         "fit it; no update is applied without a gain on the held-out blocks.", min=2)

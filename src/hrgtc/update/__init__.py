@@ -1,5 +1,6 @@
 """In-field update of a fitted model (issue 29): still periods of a new recording -> a Kalman
-filter on the drift model's offset and slope -> an updated model file with its lineage.
+filter on the drift model's offset and slope (a triad's offsets from |Ω|,
+:mod:`hrgtc.update.triad`) -> an updated model file with its lineage.
 
 Takes a :class:`hrgtc.model.Model` (its drift model's coefficients and covariance,
 :meth:`hrgtc.drift.DriftModel.coefficient_prior`) and field recordings; gives an

@@ -6,7 +6,9 @@ periods (the motion detector, or given intervals), cuts them into blocks
 (:mod:`hrgtc.update.observations`) and runs the Kalman filter (:mod:`hrgtc.update.kalman`)
 on the drift model's offset B0 (only with a known input rate) and slope (the term ``f``,
 only over ``min_span_c``), the calibration's coefficient covariance
-(:meth:`hrgtc.drift.DriftModel.coefficient_prior`) plus an ageing allowance as the prior.
+(:meth:`hrgtc.drift.DriftModel.coefficient_prior`) plus an ageing allowance as the prior;
+a triad's three offsets without a known input rate come from the magnitude of the Earth
+rate (:mod:`hrgtc.update.triad`) when its still periods hold enough orientations.
 
 It never applies an update that is refused (:class:`~hrgtc.core.errors.UpdateRefusedError`,
 naming the file and the reason): thermally unsettled still data (a ramp posing as
@@ -51,6 +53,7 @@ from hrgtc.update.observations import (
     stretches,
 )
 from hrgtc.update.result import AxisUpdate, FilterProblem, UpdateResult
+from hrgtc.update.triad import TRIAD_CHANGE, TriadUpdate, by_orientation, triad_axes, triad_offsets
 
 __all__ = ["update_model"]
 
@@ -86,9 +89,9 @@ def update_model(model: Any, recordings: Any, settings: UpdateSettings | None = 
     settings = settings or UpdateSettings()
     if settings.input_rate_dph is not None and "" not in model.axes:
         raise InputError(f"the model of {model.unit!r} has axes {', '.join(model.axes)}: one "
-                         "known input rate cannot hold for every axis, and the offsets of a "
-                         "triad from its |Ω| are not available yet; update without "
-                         "input_rate_dph (each axis's slope)")
+                         "known input rate cannot hold for every axis; update without "
+                         "input_rate_dph (each axis's slope, and a triad's offsets from the "
+                         "Earth rate's magnitude, triad_rate_norm_dph)")
     runs = [_read(item, read_options, model) for item in _items(recordings)]
     labels = [label for label, _, _ in runs]
     used = {d.sha256: d.path for d in (model.lineage.data if model.lineage else ())}
@@ -104,35 +107,83 @@ def update_model(model: Any, recordings: Any, settings: UpdateSettings | None = 
     if not any(d.intervals_s for d in data):
         return UpdateResult(None, False, f"{', '.join(labels)}: no still period (the unit "
                             "moved throughout): nothing changed")
-    axes, notes, parts = {}, [], dict(model.axes)
+    settled = {name: _settled([b for index, ((_, _, recording), (periods, _, _)) in enumerate(
+                   zip(runs, found, strict=True)) for b in _axis_blocks(
+                       index, _view(recording, name), part, periods, settings)],
+                   settings, labels) for name, part in model.axes.items()}
+    axes, notes, parts, grouped, groups = {}, [], dict(model.axes), settled, labels
+    is_triad = triad_axes(model, settings) is not None
+    if is_triad:  # a nuisance constant per orientation, not per run
+        grouped, groups = by_orientation(settled, labels)
     for name, part in model.axes.items():
-        blocks = [b for index, ((_, _, recording), (periods, _, _)) in enumerate(
-                      zip(runs, found, strict=True))
-                  for b in _axis_blocks(index, _view(recording, name), part, periods, settings)]
-        settled = _settled(blocks, settings, labels)
-        terms, said = _observable(part, settled, settings) if settled else ((), [
-            f"every still period is shorter than a block ({settings.block_s:g} s)"])
+        terms, said = _observable(part, grouped[name], settings, is_triad) \
+            if grouped[name] else ((), [f"every still period is shorter than a block "
+                                         f"({settings.block_s:g} s)"])
         notes += [f"{name}: {n}" if name else n for n in said]
         if terms:
-            axes[name] = _filter_axis(model, name, settled, terms, settings, labels)
+            axes[name] = _filter_axis(model, name, grouped[name], terms, settings, groups)
             parts[name] = replace(part, drift=_updated_drift(part.drift, terms,
                                                              axes[name].after))
-    if not axes:
+    triad, said = _triad(model, _slope_removed(settled, axes), settings, labels)
+    notes = said + notes
+    if triad is not None:
+        for k, name in enumerate(triad.axes):
+            parts[name] = replace(parts[name], drift=_updated_drift(
+                parts[name].drift, ("const",), (triad.after[k],)))
+    if not axes and triad is None:
         return UpdateResult(None, False, f"{', '.join(labels)}: nothing observable ("
                             f"{'; '.join(notes)}): nothing changed", notes=tuple(notes))
-    lineage = Lineage(
+    lineage = _lineage(model, parent_bytes, parent_path, data, axes, triad, settings)
+    updated = replace(model, axes=parts, lineage=lineage)
+    return UpdateResult(updated, True, "", axes, lineage, tuple(notes), triad)
+
+
+def _triad(model: Any, settled: dict[str, list[StillBlock]], settings: UpdateSettings,
+           labels: list[str]) -> tuple[TriadUpdate | None, list[str]]:
+    """The triad's offsets from |Ω| (:mod:`hrgtc.update.triad`) when the model is a triad
+    and no input rate is given, and the note of why not."""
+    if triad_axes(model, settings) is None or not all(settled.values()):
+        return None, []
+    triad, why = triad_offsets(model, settled, settings, labels)
+    return triad, [why] if why else []
+
+
+def _slope_removed(blocks: dict[str, list[StillBlock]], axes: dict[str, AxisUpdate]
+                   ) -> dict[str, list[StillBlock]]:
+    """The blocks' residuals with each axis's slope update taken out (the triad's offsets
+    are then those of the updated slopes)."""
+    out = {}
+    for name, items in blocks.items():
+        update = axes.get(name)
+        if update is None or "f" not in update.terms:
+            out[name] = items
+            continue
+        k = update.terms.index("f")
+        step = update.after[k] - update.before[k]
+        out[name] = [replace(b, residual_dph=b.residual_dph - step * b.f) for b in items]
+    return out
+
+
+def _lineage(model: Any, parent_bytes: bytes, parent_path: str, data: tuple[LineageData, ...],
+             axes: dict[str, AxisUpdate], triad: TriadUpdate | None,
+             settings: UpdateSettings) -> Lineage:
+    """The lineage of the updated model: parent, data, every change and its figures."""
+    changes = [AxisChange(name, a.terms, a.before, a.after, _matrix(a.covariance_before),
+                          _matrix(a.covariance_after)) for name, a in axes.items()]
+    steps = [(a.mahalanobis, a.heldout_before_dph, a.heldout_after_dph) for a in axes.values()]
+    if triad is not None:
+        changes.append(AxisChange(TRIAD_CHANGE, tuple(f"const.{a}" for a in triad.axes),
+                                  triad.before, triad.after, _matrix(triad.covariance_before),
+                                  _matrix(triad.covariance_after)))
+        steps.append((triad.mahalanobis, triad.heldout_before_dph, triad.heldout_after_dph))
+    return Lineage(
         parent_sha256=hashlib.sha256(parent_bytes).hexdigest(),
         parent_parameters_sha256=model.sha256, parent_path=parent_path,
         parent_unit=model.unit, parent_content=pack(parent_bytes), data=data,
-        changes=tuple(AxisChange(name, a.terms, a.before, a.after,
-                                 _matrix(a.covariance_before), _matrix(a.covariance_after))
-                      for name, a in axes.items()),
-        settings=to_dict(settings), mahalanobis=max(a.mahalanobis for a in axes.values()),
-        heldout_rms_before_dph=max(a.heldout_before_dph for a in axes.values()),
-        heldout_rms_after_dph=max(a.heldout_after_dph for a in axes.values()),
+        changes=tuple(changes), settings=to_dict(settings),
+        mahalanobis=max(s[0] for s in steps), heldout_rms_before_dph=max(s[1] for s in steps),
+        heldout_rms_after_dph=max(s[2] for s in steps),
         hrgtc_version=_version(), created_utc=datetime.now(UTC).isoformat(timespec="seconds"))
-    updated = replace(model, axes=parts, lineage=lineage)
-    return UpdateResult(updated, True, "", axes, lineage, tuple(notes))
 
 
 def _view(recording: Recording, axis: str) -> Recording:
@@ -234,20 +285,24 @@ def _axis_blocks(index: int, recording: Recording, part: Any, periods: list[tupl
                         temperature, periods, settings)
 
 
-def _observable(part: Any, blocks: list[StillBlock],
-                settings: UpdateSettings) -> tuple[tuple[str, ...], list[str]]:
+def _observable(part: Any, blocks: list[StillBlock], settings: UpdateSettings,
+                triad: bool = False) -> tuple[tuple[str, ...], list[str]]:
     """The terms the blocks can update, and what the reader should know of the others."""
     terms, notes = [], []
     if settings.input_rate_dph is not None:
         terms.append("const")
-    else:
+    elif not triad:
         notes.append("offset B0 not updated: the input rate is unknown (a still mean is "
                      "bias + Earth-rate projection + turn-on shift); give input_rate_dph")
     span = describe_blocks(blocks)["span_c"]
+    if triad:  # a nuisance per orientation: only the temperatures within one tell the slope
+        span = max(describe_blocks([b for b in blocks if b.run == run])["span_c"]
+                   for run in {b.run for b in blocks})
     if "f" not in part.drift.selected:
         notes.append("slope not updated: the model has no term f")
     elif span < settings.min_span_c:
-        notes.append(f"slope not updated: the still blocks span {span:.3g} °C, less than "
+        notes.append(f"slope not updated: the still blocks span {span:.3g} °C"
+                     f"{' within one orientation' if triad else ''}, less than "
                      f"min_span_c {settings.min_span_c:g} °C")
     else:
         terms.append("f")
@@ -279,13 +334,14 @@ def _prior(model: Any, name: str, terms: tuple[str, ...],
 def _filter_axis(model: Any, name: str, blocks: list[StillBlock], terms: tuple[str, ...],
                  settings: UpdateSettings, labels: list[str]) -> AxisUpdate:
     """The filter over the blocks of axis ``name``, its guards, and the axis's figures."""
+    where = ", ".join(dict.fromkeys(labels))  # a recording's orientations share its name
     values, prior = _prior(model, name, terms, settings)
     problem = _problem(model.axes[name], blocks, terms, prior, settings)
     n_model, runs = problem.n_model, np.array([b.run for b in blocks])
     fit, held = split_heldout(len(blocks), settings.holdout_every)
     if held.size < 2 or fit.size < 2:
         raise UpdateRefusedError(
-            f"{', '.join(labels)}: {len(blocks)} still block(s) of {settings.block_s:g} s are "
+            f"{where}: {len(blocks)} still block(s) of {settings.block_s:g} s are "
             "too few to judge an update on held-out blocks (at least "
             f"{2 * settings.holdout_every}); record longer still periods")
     whole = _solve(problem, slice(None))
@@ -301,7 +357,7 @@ def _filter_axis(model: Any, name: str, blocks: list[StillBlock], terms: tuple[s
     step = mahalanobis(whole.mean[:n_model], prior)
     if step > settings.max_step_sigma:
         raise UpdateRefusedError(
-            f"{', '.join(labels)}: the update would move {', '.join(terms)} by {step:.3g} σ "
+            f"{where}: the update would move {', '.join(terms)} by {step:.3g} σ "
             f"of the prior (limit max_step_sigma {settings.max_step_sigma:g}): further than "
             "ageing goes; check the unit and the input rate, or recalibrate")
     trained = _solve(problem, fit)
@@ -312,7 +368,7 @@ def _filter_axis(model: Any, name: str, blocks: list[StillBlock], terms: tuple[s
     rms_after = heldout_rms(after, runs[held], centred)
     if not rms_after < rms_before:
         raise UpdateRefusedError(
-            f"{', '.join(labels)}: no gain on the held-out still blocks (rms {rms_before:.4g} "
+            f"{where}: no gain on the held-out still blocks (rms {rms_before:.4g} "
             f"°/h before, {rms_after:.4g} °/h after): the update is not applied")
     return AxisUpdate(
         terms, tuple(float(v) for v in values), tuple(float(v) for v in values

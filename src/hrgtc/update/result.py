@@ -110,6 +110,9 @@ class UpdateResult:
         The lineage written into the updated model (None when nothing changed).
     notes
         What the reader should know (what was not updated and why).
+    triad
+        A triad's offsets updated from the magnitude of the Earth rate
+        (:class:`hrgtc.update.triad.TriadUpdate`), or None.
     """
 
     model: Any
@@ -118,6 +121,7 @@ class UpdateResult:
     axes: dict[str, AxisUpdate] = field(default_factory=dict)
     lineage: Lineage | None = None
     notes: tuple[str, ...] = ()
+    triad: Any = None
 
     def summary(self) -> Summary:
         """The updated coefficients with ±1σ (before and after), the held-out still residual
@@ -160,6 +164,38 @@ class UpdateResult:
                        "°/h/√h", digits=3, definition="The random walk of each recording's "
                        "bias the filter allows for, the rate under which the blocks are "
                        "most likely (docs/guide/update.md)."))))
+        if self.triad is not None:
+            sections += _triad_sections(self.triad)
         notes = (*((self.reason,) if self.reason else ()), *self.notes)
         title = "in-field update" + ("" if self.applied else ": nothing changed")
         return Summary(title, tuple(sections), notes)
+
+
+def _triad_sections(triad: Any) -> list[tuple[str, tuple[Figure, ...]]]:
+    """The offsets of a triad from |Ω|: each before and after with ±1σ, and the figures
+    that judge them."""
+    figures = []
+    for k, axis in enumerate(triad.axes):
+        figures += [Figure.with_error(
+                        f"triad.before.{axis}", f"offset {axis} before", triad.before[k],
+                        math.sqrt(triad.covariance_before[k, k]), "°/h",
+                        definition="The parent's intercept B0, ±1σ of the prior (calibration, "
+                        "ageing allowance, turn-on shift)."),
+                    Figure.with_error(
+                        f"triad.after.{axis}", f"offset {axis} after", triad.after[k],
+                        math.sqrt(triad.covariance_after[k, k]), "°/h",
+                        definition="The updated intercept, ±1σ of the posterior.")]
+    judged = (
+        Figure("triad.rate_norm_dph", "|Ω| used", triad.rate_norm_dph, "°/h", digits=6),
+        Figure("triad.n_orientations", "orientations", triad.n_orientations),
+        Figure("triad.n_periods", "still periods", triad.n_periods),
+        Figure("triad.condition", "condition number", triad.condition, digits=3,
+               definition="Of the still periods' information about the three offsets."),
+        Figure("triad.heldout_before_dph", "held-out rms of |m| - |Ω| before",
+               triad.heldout_before_dph, "°/h", digits=4),
+        Figure("triad.heldout_after_dph", "held-out rms of |m| - |Ω| after",
+               triad.heldout_after_dph, "°/h", digits=4),
+        Figure("triad.n_heldout", "held-out blocks", triad.n_heldout),
+        Figure("triad.mahalanobis", "step from the prior", triad.mahalanobis, "σ", digits=3))
+    return [("offsets of the triad from |Ω| (updated coefficients)", tuple(figures)),
+            ("offsets of the triad: how they are known", judged)]
