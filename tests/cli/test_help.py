@@ -132,3 +132,20 @@ def test_cleandoc_is_inspects(doc):
     import inspect
 
     assert _help.cleandoc(doc) == inspect.cleandoc(doc)
+
+
+def test_a_closed_pipe_ends_as_typers_does():
+    """The reader gone before the page is written (``hrgtc --help | true``): exit code 1 and
+    nothing on standard error, as click's standalone mode does, not a traceback."""
+    ended = []
+    for code in (FAST.format(name="hrgtc"), TYPER.format(name="hrgtc")):
+        read, write = os.pipe()
+        os.close(read)
+        try:
+            done = subprocess.run([sys.executable, "-c", code, "--help"], stdout=write,
+                                  stderr=subprocess.PIPE, text=True, timeout=120)
+        finally:
+            os.close(write)
+        ended.append((done.returncode, done.stderr.replace("True", "").replace("False", "")
+                      .strip()))
+    assert ended[0] == ended[1] == (1, "")

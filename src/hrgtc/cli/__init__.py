@@ -9,6 +9,7 @@ function, and ``hrgtc --help`` alone is written without Typer (:mod:`hrgtc.cli._
 
 from __future__ import annotations
 
+import os
 import sys
 from typing import Any
 
@@ -33,8 +34,12 @@ def main() -> None:
 
     text = top_help(sys.argv[1:])
     if text is not None:  # what Typer would print, without building the application
-        sys.stdout.write(text + "\n")
-        sys.stdout.flush()
+        try:
+            sys.stdout.write(text + "\n")
+            sys.stdout.flush()
+        except BrokenPipeError:  # as click: a reader gone (| head) ends it quietly, code 1
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+            sys.exit(1)
         return
     application = globals().get("app") or __getattr__("app")
     application()
