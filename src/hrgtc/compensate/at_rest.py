@@ -22,11 +22,8 @@ columns, without their validation (the compensating pass validates every sample;
 pass fails, the file is read again validated, so a bad file gets the validator's
 error), and the detector's columns in memory, once (time and rate: 16 bytes a sample
 and axis; a 3-day 1 Hz file: 260,000 rows, 4 MB). The detector's loops are compiled
-(:mod:`hrgtc.recording._motion_kernel`), and the pass runs in a thread beside the
-compensating pass (:func:`~hrgtc.compensate.file_pass.compensate_file`), which waits for
-the flags only to write its first chunk. ``--motion keep`` skips the pass and writes no
-flag; ``--motion error`` stops at the first moving sample, naming it, before anything is
-compensated.
+(:mod:`hrgtc.recording._motion_kernel`). ``--motion keep`` skips the pass and writes
+no flag; ``--motion error`` stops at the first moving sample, naming it.
 
 The pass reads only the detector's columns (:data:`DETECTOR_COLUMNS`, ``iter_chunks(...,
 only=)``), and the spike filter's flags, which change no row, are not computed in it.

@@ -98,12 +98,6 @@ class Compensator:
         raise InputError(f"the model of {self.model.unit!r} has axes "
                          f"{', '.join(self.axes)}: pick one, compensator.axes[name]")
 
-    @property
-    def needs_rest(self) -> bool:
-        """Whether :meth:`transform`'s output depends on ``at_rest`` (the orientation
-        offsets of an axis count the samples at rest; nothing else reads the mask)."""
-        return any("orientation" in axis.drift.offset_mode for axis in self.axes.values())
-
     def transform(self, chunk: Recording,
                   at_rest: Mapping[str, np.ndarray] | np.ndarray | None = None) -> Recording:
         """The next chunk with every axis's output columns added.

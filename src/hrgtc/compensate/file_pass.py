@@ -12,14 +12,14 @@ from __future__ import annotations
 import dataclasses
 import os
 from collections.abc import Sequence
-from concurrent.futures import Future, ThreadPoolExecutor
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from hrgtc import recording as rec_io
-from hrgtc.compensate.at_rest import DETECTOR_COLUMNS, FlagsMisaligned, RestFlags, rest_columns
+from hrgtc.compensate.at_rest import DETECTOR_COLUMNS, FlagsMisaligned, RestFlags
 from hrgtc.compensate.compensator import Compensator
 from hrgtc.compensate.multi_axis import match_axes, recording_axes
 from hrgtc.compensate.ranges import RangeReport
@@ -107,9 +107,7 @@ def compensate_file(
     one, starts its write to disk and waits for the one before
     (:meth:`~hrgtc.recording.RecordingWriter.start_writeback`), so that the fsync
     before the atomic rename finds one chunk left to wait for. At most three chunks
-    are held at a time. The motion detector's pass over the file (the ``at_rest`` flags,
-    :mod:`hrgtc.compensate.at_rest`) runs in a fourth thread from the first chunk on: the
-    first chunk is compensated while it runs and waits for the flags to be written.
+    are held at a time.
     """
     from hrgtc.thermometry.reference import options_with_map
 
@@ -174,100 +172,72 @@ def _compensate(job: _Job, compensator: Compensator,
     columns (None: all); raises :class:`FlagsMisaligned` before the output is kept if
     its rows were not those compensated."""
     source, output, model, options = job.source, job.output, job.model, job.options
+    added, force, chunk_rows, drift, progress = (job.added, job.force, job.chunk_rows,
+                                                 job.drift, job.progress)
     repair = TimeRepairStream()  # what the reader dropped (duplicated rows)
-    chunks = options.chunks(source, rows=job.chunk_rows, time_repair=repair)
+    chunks = options.chunks(source, rows=chunk_rows, time_repair=repair)
     spikes = 0
     try:
         first = next(chunks)
         total = rec_io.count_rows(source)
-        added = job.added if options.motion == "keep" else (
-            *job.added, *rest_columns(list(model.axes)))
+        flags = None  # samples not at rest: flagged, found in one pass first (at_rest.py)
+        if options.motion != "keep":
+            # duplicated rows in the first chunk: told apart by all the columns
+            only = None if repair.duplicates else only
+            # the spike filter's flags change no row: not computed in the detector's pass
+            quick = dataclasses.replace(options, spike_filter="off", chunk_rows=chunk_rows)
+            flags = RestFlags(rec_io.iter_chunks(source, quick,
+                                                 validate=False, only=only),
+                              list(model.axes), options.motion,
+                              os.path.basename(os.fspath(source)),
+                              validated=lambda: options.chunks(source, rows=chunk_rows),
+                              rows=total)
+            added = (*added, *flags.columns)
         copies = sensor_copies((*first.names, *added), first.metadata)
         names = tuple(n for n in (*first.names, *added) if n not in copies)
-        metadata = compensated_metadata(first.metadata, model, job.drift)
-        with ThreadPoolExecutor(max_workers=1) as detecting:
-            flags = _rest_flags(job, only, repair.duplicates, total, detecting,
-                                compensator.needs_rest)
-            check_recording_noise(model, first, str(source))
-            with rec_io.RecordingWriter(output, metadata, names, force=job.force) as writer, \
-                    ThreadPoolExecutor(max_workers=1) as reading, \
-                    ThreadPoolExecutor(max_workers=1) as writing:
-                ahead = reading.submit(next, chunks, None)
-                pending = None
-                chunk: Recording | None = first
-                restarts: set[float] = set()  # every chunk's restarts, written at close
-                while chunk is not None:
-                    restarts.update(chunk.metadata.extra.get(RESTARTS_KEY) or ())
-                    result = _flagged(compensator, chunk, flags)
-                    if SPIKE_COLUMN in chunk:
-                        spikes += int(np.count_nonzero(chunk[SPIKE_COLUMN]))
-                    if copies:
-                        result = Recording({n: result[n] for n in names}, result.metadata,
-                                           result.source)
-                    if pending is not None:
-                        pending.result()
-                    pending = writing.submit(_write, writer, result)
-                    if job.progress is not None:
-                        job.progress(compensator.samples, total)
-                    chunk = ahead.result()
-                    if chunk is not None:
-                        ahead = reading.submit(next, chunks, None)
+        check_recording_noise(model, first, str(source))
+        metadata = compensated_metadata(first.metadata, model, drift)
+        with rec_io.RecordingWriter(output, metadata, names, force=force) as writer, \
+                ThreadPoolExecutor(max_workers=1) as reading, \
+                ThreadPoolExecutor(max_workers=1) as writing:
+            ahead = reading.submit(next, chunks, None)
+            pending = None
+            chunk: Recording | None = first
+            restarts: set[float] = set()  # every chunk's restarts, written at close
+            while chunk is not None:
+                restarts.update(chunk.metadata.extra.get(RESTARTS_KEY) or ())
+                taken = None if flags is None else flags.take(chunk)
+                result = compensator.transform(chunk, _at_rest(flags, taken))
+                if taken is not None:
+                    result = result.with_columns(**taken)
+                if SPIKE_COLUMN in chunk:
+                    spikes += int(np.count_nonzero(chunk[SPIKE_COLUMN]))
+                if copies:
+                    result = Recording({n: result[n] for n in names}, result.metadata,
+                                       result.source)
                 if pending is not None:
                     pending.result()
-                if flags is not None:
-                    flags.result().finish()  # every row the detector saw compensated, or none
-                if restarts:
-                    writer.set_metadata(dataclasses.replace(metadata, extra={
-                        **metadata.extra, RESTARTS_KEY: sorted(restarts)}))
+                pending = writing.submit(_write, writer, result)
+                if progress is not None:
+                    progress(compensator.samples, total)
+                chunk = ahead.result()
+                if chunk is not None:
+                    ahead = reading.submit(next, chunks, None)
+            if pending is not None:
+                pending.result()
+            if flags is not None:
+                flags.finish()  # every row the detector saw compensated, or no output
+            if restarts:
+                writer.set_metadata(dataclasses.replace(metadata, extra={
+                    **metadata.extra, RESTARTS_KEY: sorted(restarts)}))
     finally:
         chunks.close()
     accounting = compensation_accounting(compensator, spikes, repair.duplicates,
-                                         0 if flags is None else flags.result().n_not_at_rest)
+                                         0 if flags is None else flags.n_not_at_rest)
     return CompensationSummary(str(source), str(output), compensator.samples,
                                compensator.out_of_range_fraction,
                                compensator.rate_out_of_range_fraction, compensator.ranges(),
                                accounting)
-
-
-def _rest_flags(job: _Job, only: tuple[str, ...] | None, duplicates: int, total: int,
-                detecting: ThreadPoolExecutor, needs_rest: bool) -> Future[RestFlags] | None:
-    """The file's at-rest flags (:class:`RestFlags`, one pass of the detector's columns),
-    found in the thread ``detecting``; None with ``--motion keep``.
-
-    The detector's pass overlaps the compensation of the first chunks (issue 27): the
-    flags are taken when a chunk is written. ``--motion error`` (which stops at the first
-    moving sample, before anything is compensated) and a model whose output depends on
-    the flags (orientation offsets) wait for them here.
-    """
-    options = job.options
-    if options.motion == "keep":
-        return None
-    # duplicated rows in the first chunk: told apart by all the columns
-    only = None if duplicates else only
-    # the spike filter's flags change no row: not computed in the detector's pass
-    quick = dataclasses.replace(options, spike_filter="off", chunk_rows=job.chunk_rows)
-    found = detecting.submit(
-        RestFlags, rec_io.iter_chunks(job.source, quick, validate=False, only=only),
-        list(job.model.axes), options.motion, os.path.basename(os.fspath(job.source)),
-        validated=lambda: options.chunks(job.source, rows=job.chunk_rows), rows=total)
-    if options.motion != "exclude" or needs_rest:
-        found.result()
-    return found
-
-
-def _flagged(compensator: Compensator, chunk: Recording,
-             flags: Future[RestFlags] | None) -> Recording:
-    """``chunk`` compensated, with its at-rest flags (waited for only now unless the
-    compensation needs them)."""
-    if flags is None:
-        return compensator.transform(chunk)
-    if compensator.needs_rest:
-        taken = flags.result().take(chunk)
-        result = compensator.transform(chunk, _at_rest(flags.result(), taken))
-    else:  # the output does not depend on the flags: compensated while they are found
-        result = compensator.transform(chunk)
-        taken = flags.result().take(chunk)
-    return result.with_columns(**taken)
 
 
 def _at_rest(flags: RestFlags | None, taken: dict[str, np.ndarray] | None
