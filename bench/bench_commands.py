@@ -10,7 +10,10 @@ process's own (``wait4``).
 * ``command_allan_oadev``: a script that loads 10^7 samples (``.npy``) and calls
   :func:`hrgtc.evaluation.allan.allan_deviation` against the same script calling
   ``allantools.oadev`` (goal: allantools / ours >= 8; ``speed_ratio`` is allantools'
-  seconds over ours); the deviations must agree to 1e-9;
+  seconds over ours); the deviations must agree to 1e-9. Alternated with them, the
+  script's floor (interpreter, numpy, ``np.load``, ``np.save``: ``floor_*``) and the floor
+  with numba's start (its import and the first cached kernel loaded: ``numba_start_*``);
+  ``*_speed_ratio`` is allantools' seconds over each, the most any such script can reach;
 * ``command_calibrate_demo``: ``hrgtc calibrate`` on the demo campaign (7 soaks of 5 h
   and a 5 h cool-down at 200 Hz, ``hrgtc demo``'s files) against
   ``bench/plain_calibrate.py``, the paper's method in plain numpy on the same files
@@ -51,10 +54,19 @@ def before(argv: list[str]) -> list[str]:
     return ["env", f"PYTHONPATH={BEFORE}", *argv]
 
 
+#: The commands' environment: Python writes its bytecode (``__pycache__``), as a user's
+#: install has it after the first run; with ``PYTHONDONTWRITEBYTECODE`` set (as in some
+#: sandboxes) every run of a command would compile hrgtc's modules from source again
+#: (0.2-0.3 s of CPU for ``compensate``, most of ``hrgtc --help``'s own time), while the
+#: scripts' numpy, pyarrow and allantools come with theirs.
+ENV = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+
+
 def _run(argv: list[str]) -> tuple[float, float]:
     """Wall seconds and peak RSS [MB] of one command (its output discarded)."""
     start = time.perf_counter()
-    process = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    process = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                               env=ENV)
     _, status, usage = os.wait4(process.pid, 0)
     seconds = time.perf_counter() - start
     process.returncode = os.waitstatus_to_exitcode(status)
@@ -126,6 +138,22 @@ rate = np.load(sys.argv[1])
 result = allan_deviation(rate, 200.0, taus="octave")
 np.save(sys.argv[2], np.stack([result.taus_s, result.deviation]))
 """
+#: The parts of the whole script's time that no Allan code can remove: the interpreter,
+#: numpy's import, loading the .npy and saving a result ("floor"), and the same with the
+#: start of a compiled numba kernel (numba's import and the first load of a cached kernel,
+#: "numba_start"): allantools' seconds over the floor's bound any speed ratio.
+_ALLAN_FLOOR = """
+import sys, numpy as np
+rate = np.load(sys.argv[1])
+np.save(sys.argv[2], np.stack([rate[:24], rate[:24]]))
+"""
+_ALLAN_NUMBA_START = """
+import sys, numpy as np
+from hrgtc.evaluation import _allan_kernels
+rate = np.load(sys.argv[1])
+_allan_kernels.checkpoints(rate[:64], 0.0, 1)
+np.save(sys.argv[2], np.stack([rate[:24], rate[:24]]))
+"""
 _ALLAN_THEIRS = """
 import sys, numpy as np
 import allantools
@@ -144,9 +172,13 @@ def allan_line(folder: Path, n: int, repeats: int) -> dict:
     data = folder / "rate.npy"
     np.save(data, gyro_rate(n))
     ours, theirs = folder / "ours.npy", folder / "theirs.npy"
+    parts = {key: [PYTHON, "-c", script, str(data), str(folder / f"{key}.npy")]
+             for key, script in (("floor", _ALLAN_FLOOR), ("numba_start", _ALLAN_NUMBA_START))}
     line = compare("command_allan_oadev", [PYTHON, "-c", _ALLAN_OURS, str(data), str(ours)],
                    [PYTHON, "-c", _ALLAN_THEIRS, str(data), str(theirs)], repeats,
-                   samples=n, goal_speed_ratio=8.0)
+                   more=parts, samples=n, goal_speed_ratio=8.0)
+    for key in parts:  # the best speed ratio a script with this start could reach
+        line[f"{key}_speed_ratio"] = round(1.0 / line[f"{key}_ratio"], 2)
     a, b = np.load(ours), np.load(theirs)
     same = a.shape == b.shape and bool(np.array_equal(a[0], b[0]))
     line["speed_ratio"] = round(1.0 / line["ratio"], 2)

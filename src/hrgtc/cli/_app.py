@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
+from hrgtc.cli._help import APP_HELP, VERSION_HELP
 from hrgtc.core.errors import HrgtcError
 
 if TYPE_CHECKING:
@@ -27,8 +28,7 @@ if TYPE_CHECKING:
 
 app = typer.Typer(
     name="hrgtc",
-    help="Temperature-drift compensation of hemispherical resonator gyros from the "
-    "resonator's natural frequency (Wang et al., Sensors 2012, doi:10.3390/s120506434).",
+    help=APP_HELP,  # hrgtc --help writes it without Typer (_help.py)
     no_args_is_help=True,
     add_completion=False,
     # Help texts are plain text: with Rich markup, units like "[s]" and "[°C]" vanish.
@@ -248,7 +248,7 @@ def print_warnings_once(context: typer.Context) -> None:
 @app.callback(invoke_without_command=True)
 def _root(
     context: typer.Context,
-    version: bool = typer.Option(False, "--version", help="Print the version and exit."),
+    version: bool = typer.Option(False, "--version", help=VERSION_HELP),
 ) -> None:
     """Temperature-drift compensation of HRGs from the resonator's natural frequency."""
     if version:
