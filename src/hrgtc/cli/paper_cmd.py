@@ -10,7 +10,9 @@ from hrgtc.cli._app import console, library_errors, print_json
 def paper_command(
     json_output: bool = typer.Option(False, "--json", help="Print JSON instead of tables."),
 ) -> None:
-    """Reproduce Eq. (18) from Table 1 and Table 2 from Eq. (18) of Wang et al. (2012).
+    """Reproduce the paper's thermometer: its cubic from Table 1, then Table 2 from the cubic.
+
+    The paper: Wang et al. (2012), Table 1 -> Eq. (18) -> Table 2.
 
     Example: hrgtc paper --json
     """
