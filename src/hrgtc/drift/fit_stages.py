@@ -32,12 +32,19 @@ from hrgtc.drift.offsets import offset_groups, project_off
 from hrgtc.drift.regression import EXTENDED_PRECISION, newey_west_inflation
 from hrgtc.drift.rest import check_policy, reference_point, run_rest
 from hrgtc.drift.stepwise import StepwiseResult, StepwiseRules, stepwise
-from hrgtc.drift.windows import RunSource, Windowing, _iter_run, window_means_at
+from hrgtc.drift.windows import (
+    RunSource,
+    Windowing,
+    WindowJob,
+    _iter_run,
+    window_means_at,
+    window_means_jointly,
+)
 from hrgtc.recording.motion import MotionSettings
 from hrgtc.settings.drift import SELECTIONS, WARMUP_FACTOR, DriftSettings
 
 __all__ = ["Design", "Selection", "Training", "TrainingReading", "design", "drift_settings",
-           "prepare", "refit_rate_free", "select"]
+           "prepare", "refit_rate_free", "select", "window_job"]
 
 
 @dataclass(frozen=True)
@@ -210,17 +217,30 @@ def design_matrix(windows: Any, offsets: str, factors: np.ndarray) -> tuple[
     return groups, x_full, x_scaled, bias
 
 
-def design(training: Training, drift: DriftSettings, thermometer: Any,
-           progress: Progress | None, excitation_runs: int) -> Design:
-    """Stage 3: window means, excitation checks, scales and the design matrix."""
-    variables = training.variables
+def window_job(training: Training, drift: DriftSettings, thermometer: Any,
+               progress: Progress | None) -> WindowJob:
+    """Stage 3's window means as a job of one pass over the runs
+    (:func:`~hrgtc.drift.windows.window_means_jointly`: fits on the same runs share it)."""
     # df/dt's training range is kept for the range warnings even when no candidate uses it
-    tracked = ("df",) if "f" in variables else ()
+    tracked = ("df",) if "f" in training.variables else ()
     # the rate-free refit's windows (warm-up 0, stage 5) come from the same reading
     refit = drift.warmup_s is None and training.features.warmup_s > 0
-    windows, *rate_free = training.windows(
-        drift, training.candidates, progress, thermometer, tracked,
-        (training.features.warmup_s, 0.0) if refit else None)
+    windowing = Windowing(drift.window_s, tracked, training.reading.gaps,
+                          training.reading.restart_each_segment)
+    return WindowJob(training.features, training.candidates, windowing, progress, thermometer,
+                     training.keep, (training.features.warmup_s, 0.0) if refit else None)
+
+
+def design(training: Training, drift: DriftSettings, thermometer: Any,
+           progress: Progress | None, excitation_runs: int,
+           read: tuple[Any, ...] | None = None) -> Design:
+    """Stage 3: window means, excitation checks, scales and the design matrix (``read``:
+    the window means of :func:`window_job`, already read; None: read them here)."""
+    variables = training.variables
+    if read is None:
+        read = window_means_jointly(training.runs,
+                                    [window_job(training, drift, thermometer, progress)])[0]
+    windows, *rate_free = read
     for run in range(min(excitation_runs, len(windows.sources))):
         check_excitation(windows, thermometer, variables, run)
     check_excitation(windows, thermometer, variables)

@@ -323,16 +323,6 @@ def _record(settings: CalibrationSettings, aux: Mapping[str, str] | None,
             "columns": dict(options.columns or {}), "units": dict(options.units or {})}
 
 
-def _fit(runs: Sequence[Any], thermometer: Any, drift: DriftSettings,
-         aux: Mapping[str, str] | None, options: ReadOptions, progress: Any,
-         excitation_runs: int = 0, rest_cache: dict[Any, Any] | None = None) -> Any:
-    """:func:`hrgtc.drift.fit` with ``drift`` whole on the runs read by ``options``
-    (``rest_cache``: the at-rest passes shared by fits on the same runs)."""
-    reading = TrainingReading(motion=options.motion, gaps=options.gaps, rest_cache=rest_cache)
-    return drift_model.fit(runs, thermometer, drift, reading=reading, aux_columns=aux,
-                           excitation_runs=excitation_runs, progress=progress)
-
-
 class _CountedRun:
     """A training run's chunks, counting the rows the spike filters removed in the last
     pass over it (the fit reads a run several times)."""
@@ -357,24 +347,30 @@ def _fit_drift(training: Sequence[PathLike], heads: Mapping[str, Any], thermomet
     is optional)."""
     runs = [_CountedRun(options, path) for path in training]
     rest_cache: dict[Any, Any] = {}  # one pass of the at-rest detector per run, not per fit
-    model = _fit(runs, thermometer, drift, aux, options, for_stage(progress, "drift"),
-                 excitation_runs, rest_cache)
+    reading = TrainingReading(motion=options.motion, gaps=options.gaps, rest_cache=rest_cache)
+    requests = [drift_model.FitRequest(drift, aux, excitation_runs,
+                                       for_stage(progress, "drift"))]
+    if all("housing_c" in heads[str(p)] for p in training):
+        # the baseline's own terms in h and dh/dt, with the default selection and the
+        # variables' default options (d2's filter); its windows from the drift fit's pass
+        baseline = dataclasses.replace(drift, terms=HOUSING_TERMS,
+                                       select=DriftSettings.select,
+                                       **DriftSettings().variable_options())
+        requests.append(drift_model.FitRequest(baseline,
+                                               progress=for_stage(progress, "housing baseline")))
+    model, *rest = drift_model.fit_jointly(runs, thermometer, requests, reading=reading)
+    assert isinstance(model, drift_model.DriftModel)
     spikes = sum(run.spikes for run in runs)
     if spikes and model.accounting is not None:  # the accounting starts from the file's rows
         model.accounting.add_read(spikes)
         model.accounting.drop("spikes", spikes)
     housing = None
-    if all("housing_c" in heads[str(p)] for p in training):
-        # the baseline's own terms in h and dh/dt, with the default selection and the
-        # variables' default options (d2's filter)
-        baseline = dataclasses.replace(drift, terms=HOUSING_TERMS,
-                                       select=DriftSettings.select,
-                                       **DriftSettings().variable_options())
-        try:
-            housing = _fit(runs, thermometer, baseline, None, options,
-                           for_stage(progress, "housing baseline"), rest_cache=rest_cache)
-        except CalibrationError as exc:  # the baseline is optional: say why it is missing
-            warnings.warn(f"no housing-thermistor baseline: {exc}", HrgtcWarning, stacklevel=2)
+    if rest and isinstance(rest[0], CalibrationError):  # the baseline is optional: say why
+        warnings.warn(f"no housing-thermistor baseline: {rest[0]}", HrgtcWarning, stacklevel=2)
+    elif rest and isinstance(rest[0], Exception):
+        raise rest[0]
+    elif rest:
+        housing = rest[0]
     return model, housing
 
 
