@@ -417,18 +417,23 @@ class WindowJob:
             *(chunk[c] if c in chunk else np.nan for c in self.extra or ()),
             *(t.evaluate(values, cache) for t in self.terms),  # the design matrix's columns
         ]
+        shared: tuple[Any, ...] = ()  # the last warm-up's rows used, block and extremes
         for windows in self.kept_by:
             settled = elapsed >= windows.threshold_s
             if kept is not None:
                 windows.left_out += int(np.count_nonzero(~kept & settled))
             use = settled & rested
-            before = np.cumsum(use) - use  # rows used before each row
             windows.warm += int(np.count_nonzero(~settled))
-            block = _used_rows(use, columns, iter(()), 0)
-            if block.shape[0]:  # down the block's contiguous columns; NaN ignored
-                used = block[:, 3:3 + len(self.variables)]
-                np.fmin(windows.lowest, np.fmin.reduce(used, axis=0), out=windows.lowest)
-                np.fmax(windows.highest, np.fmax.reduce(used, axis=0), out=windows.highest)
+            if not shared or not np.array_equal(use, shared[0]):  # else the same rows
+                block = _used_rows(use, columns, iter(()), 0)
+                used = block[:, 3:3 + len(self.variables)]  # down contiguous columns
+                shared = (use, np.cumsum(use) - use, block,  # rows used before each row
+                          *((np.fmin.reduce(used, axis=0), np.fmax.reduce(used, axis=0))
+                            if block.shape[0] else ()))  # NaN ignored
+            before, block = shared[1], shared[2]
+            if block.shape[0]:
+                np.fmin(windows.lowest, shared[3], out=windows.lowest)
+                np.fmax(windows.highest, shared[4], out=windows.highest)
             assert windows.averager is not None
             windows.collect(windows.averager.transform(block, before[starts],
                                                        before[resumed]), run.index)
