@@ -78,7 +78,8 @@ class RestPass:
     its page faults, ``docs/benchmarks.md``). Parameters as :func:`run_rest`'s.
     """
 
-    _WANTED = ("time_s", "rate_dph", "freq_hz", "input_rate_dph", *ACCEL_COLUMNS)
+    #: The columns gathered (those of them a chunk has).
+    WANTED = ("time_s", "rate_dph", "freq_hz", "input_rate_dph", *ACCEL_COLUMNS)
 
     def __init__(self, policy: str = "exclude", settings: MotionSettings | None = None,
                  warmup_s: float = 0.0, name: str = "", rows: int | None = None) -> None:
@@ -95,7 +96,7 @@ class RestPass:
             self.source = chunk.source or "run"
         if not self._buffers:
             self.input_rate = chunk.metadata.input_rate_dph
-        for column in self._WANTED:
+        for column in self.WANTED:
             if column not in chunk:
                 continue
             values = np.asarray(chunk[column], dtype=np.float64)

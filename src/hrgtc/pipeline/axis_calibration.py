@@ -295,17 +295,23 @@ class _SoakRests:
         if type(options).read is not ReadOptions.read or not self.warmups_s:
             return options.read(path, keep=SOAK_COLUMNS)  # a reading held in memory
         rest = RestPass(self.motion)
-        parts = []
+        first, others = None, []  # the first chunk; the columns the detector does not take
         for chunk in options.chunks(path):
             rest.partial_fit(chunk)
-            parts.append(Recording({k: chunk[k] for k in SOAK_COLUMNS if k in chunk},
-                                   chunk.metadata, chunk.source))
+            first = chunk if first is None else first
+            others.append({k: chunk[k] for k in SOAK_COLUMNS
+                           if k in chunk and k not in RestPass.WANTED})
+        if first is None:
+            return concatenate([])  # refused as the plain reading refuses it
+        gathered = rest.columns  # the detector's buffers hold time_s and freq_hz whole
         try:
             found = rest.finish_each(self.warmups_s)
         except (InputError, CalibrationError):  # said by the fit's own pass, if it joins
             found = []
         self.found[str(path)] = dict(zip(self.warmups_s, found, strict=False))
-        return concatenate(parts)
+        return Recording({k: gathered[k] if k in RestPass.WANTED else
+                          np.concatenate([part[k] for part in others])
+                          for k in SOAK_COLUMNS if k in first}, first.metadata, first.source)
 
     def cache(self, training: Sequence[PathLike], first: int,
               options: ReadOptions) -> dict[Any, Any]:
