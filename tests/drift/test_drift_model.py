@@ -203,3 +203,40 @@ def test_the_model_keeps_what_an_update_needs(model):
     jacobian = np.column_stack([np.ones(50), *(t.evaluate(values) for t in model.terms)])
     expected = np.sqrt(np.einsum("ij,jk,ik->i", jacobian, covariance, jacobian))
     np.testing.assert_allclose(model.prediction_std(values), expected, rtol=1e-9)
+
+
+def test_fits_sharing_one_window_pass_are_the_fits_alone(cooldown):
+    """``fit_jointly`` (the drift model and the housing baseline of ``calibrate``: their
+    window means from one reading of the runs) gives each fit's own model, field for
+    field, on two streamed runs; the runs are read once for the windows of both; a later
+    fit that fails gives its error in its place, the others go on."""
+    from hrgtc.drift.fit_stages import TrainingReading
+    from hrgtc.settings.drift import DriftSettings
+
+    warm = ramp_run(seed=2, start_c=-20.0, end_c=20.0)
+    reads = []
+
+    def streamed(run, label):
+        def chunks():
+            reads.append(label)
+            for start in range(0, len(run), 50_000):
+                yield run.slice(start, start + 50_000)
+        return chunks
+
+    runs = [streamed(cooldown, "cool"), streamed(warm, "warm")]
+    first = DriftSettings()
+    second = DriftSettings(terms=("f", "f^2", "df"), select="cv", window_s=10.0)
+    failing = DriftSettings(terms=("f",), window_s=1e-6)  # no sample in a window
+    alone = [drift.fit(runs, THERMOMETER, s) for s in (first, second)]
+    reads.clear()
+    joint = drift.fit_jointly(runs, THERMOMETER, [drift.FitRequest(first),
+                                                  drift.FitRequest(failing),
+                                                  drift.FitRequest(second)],
+                              reading=TrainingReading(rest_cache={}))
+    assert isinstance(joint[1], InputError) and "window_s" in str(joint[1])
+    for mine, own in zip((joint[0], joint[2]), alone, strict=True):
+        assert json.dumps(mine.to_dict(), sort_keys=True) == json.dumps(own.to_dict(),
+                                                                        sort_keys=True)
+    # each run read whole twice for the three fits: the at-rest pass (shared through the
+    # cache) and one window pass; the first run's head once more per fit
+    assert reads.count("warm") == 2 and reads.count("cool") == 3 + 2

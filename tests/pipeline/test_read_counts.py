@@ -125,7 +125,9 @@ def test_calibrate_reads_each_file_once_for_every_axis(campaign):
     holding none of them whole; the housing baseline takes the drift fit's at-rest pass
     (issue 27: one pass fewer of each training file than the 5 and 6 before), and the
     rate-free refit's window means come from the fit's own window pass (issue 27 item 8:
-    6 and 7 before when the terms chosen use no rate)."""
+    6 and 7 before when the terms chosen use no rate), and the housing baseline's window
+    means from the drift fit's window pass (issue 27 item 8: 4 and 5 before), and a soak's
+    at-rest pass is run on its plateaus' reading (3 before)."""
     args = ["calibrate", "--soak", *campaign["soaks"], "--drift", campaign["cool"],
             "--validate", campaign["warm"], "-o", campaign["model"].with_name("m.json"),
             "--force"]
@@ -138,7 +140,7 @@ def test_calibrate_reads_each_file_once_for_every_axis(campaign):
         assert [counts.of(f)[1] for f in files] == [1, 1, 1]
     else:  # also when the terms chosen use no rate and the warm-up samples are trained
         # on too (docs/real-loggers/corpus.md): those windows come from the same pass
-        assert passes == [4, 5, 2]
+        assert passes == [2, 4, 2]
 
 
 def test_calibrate_checks_each_training_file_for_a_mark_once(campaign, monkeypatch):
@@ -260,3 +262,27 @@ def test_cross_axis_fits_the_thermometer_once(imu_campaign, monkeypatch):
         assert model.drift.intercept_dph == pytest.approx(other.drift.intercept_dph,
                                                           rel=1e-12)
     assert once.to_dict() == twice.to_dict()
+
+
+def test_soak_at_rest_passes_on_the_plateau_reading_change_no_figure(campaign, monkeypatch):
+    """A single-axis calibration runs the drift fit's at-rest detector on each soak's
+    plateau reading (one pass fewer per soak): the model is the one of the fit's own
+    passes, every field (the provenance's creation time apart), and the drift fit then
+    reads each soak once (its window pass), the plateaus once."""
+    from hrgtc.pipeline import axis_calibration
+
+    if "imu" in str(campaign["cool"]):
+        pytest.skip("a multi-axis calibration reads each file once, held in memory")
+
+    def model_of() -> tuple[dict, object]:
+        with count_reads() as counts:
+            found = calibrate(campaign["soaks"], [campaign["cool"]]).model.to_dict()
+        found["provenance"].pop("created_utc", None)
+        return found, counts
+
+    fused, counts = model_of()
+    assert counts.of(campaign["soaks"][0])[1] == 2
+    monkeypatch.setattr(axis_calibration, "_likely_warmups", lambda *args: ())
+    alone, counts = model_of()
+    assert counts.of(campaign["soaks"][0])[1] == 3
+    assert fused == alone

@@ -11,7 +11,7 @@ fitted model (Eq. 22). ``rate_segments`` finds the holds of rate-table runs and
 [1] X. Wang et al., Sensors 12(5), 6434-6446, 2012. doi:10.3390/s120506434
 """
 
-from hrgtc.drift.drift_model import DriftModel, fit
+from hrgtc.drift.drift_model import DriftModel, FitRequest, fit, fit_jointly
 from hrgtc.drift.features import (
     EQ21,
     EQ21_TERMS,
@@ -56,6 +56,7 @@ __all__ = [
     "DriftModel",
     "FeatureSettings",
     "FeatureStream",
+    "FitRequest",
     "GramAccumulator",
     "OLSResult",
     "QRAccumulator",
@@ -74,6 +75,7 @@ __all__ = [
     "find_rate_segments",
     "fit",
     "fit_group",
+    "fit_jointly",
     "fit_scale_factor",
     "group_segments",
     "ols",

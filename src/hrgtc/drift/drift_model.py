@@ -61,10 +61,11 @@ from hrgtc.drift.fit_stages import (
     prepare,
     refit_rate_free,
     select,
+    window_job,
 )
 from hrgtc.drift.offsets import fit_offsets, orientation_offset
 from hrgtc.drift.stepwise import StepwiseResult
-from hrgtc.drift.windows import RunSource
+from hrgtc.drift.windows import RunSource, window_means_jointly
 from hrgtc.recording import Recording
 from hrgtc.settings.drift import DriftSettings
 from hrgtc.thermometry import Thermometer
@@ -321,6 +322,61 @@ def fit(
     chosen = select(training, first, drift, thermometer, initial)
     return _model(training, first, refit_rate_free(training, first, chosen, drift), chosen,
                   drift)
+
+
+@dataclass(frozen=True)
+class FitRequest:
+    """One fit of :func:`fit_jointly`: the arguments of :func:`fit` that differ between fits
+    on the same runs."""
+
+    settings: DriftSettings
+    aux_columns: Mapping[str, str] | None = None
+    excitation_runs: int = 0
+    progress: Progress | None = None
+
+
+def fit_jointly(runs: Sequence[RunSource], thermometer: Thermometer,
+                requests: Sequence[FitRequest], *, reading: TrainingReading | None = None,
+                ) -> list[DriftModel | Exception]:
+    """:func:`fit` of each request on the same runs, their window means from one reading of
+    the runs (the drift model and the housing baseline of a calibration: one pass, not one
+    per fit). Each model is the one its own :func:`fit` gives; a fit after the first that
+    fails gives its error in its place (the first fit's error is raised)."""
+    reading = reading or TrainingReading()
+    staged: list[Any] = []
+    for k, request in enumerate(requests):  # the runs' first look, each fit's own
+        try:
+            drift, candidates, options = drift_settings(request.settings, {})
+            training = prepare(runs, thermometer, drift, candidates, options, reading,
+                               request.aux_columns)
+            staged.append((drift, training, window_job(training, drift, thermometer,
+                                                       request.progress)))
+        except Exception as exc:  # a later fit's own failure, given back
+            if k == 0:
+                raise
+            staged.append(exc)
+    ready = [s for s in staged if not isinstance(s, Exception)]
+    read = iter(window_means_jointly(runs, [job for _, _, job in ready]))
+    out: list[DriftModel | Exception] = []
+    for k, (request, stage) in enumerate(zip(requests, staged, strict=True)):
+        if isinstance(stage, Exception):
+            out.append(stage)
+            continue
+        windows = next(read)
+        try:
+            if isinstance(windows, Exception):
+                raise windows
+            drift, training, _ = stage
+            first = design(training, drift, thermometer, request.progress,
+                           request.excitation_runs, windows)
+            chosen = select(training, first, drift, thermometer, None)
+            out.append(_model(training, first, refit_rate_free(training, first, chosen, drift),
+                              chosen, drift))
+        except Exception as exc:  # a later fit's own failure, given back
+            if k == 0:
+                raise
+            out.append(exc)
+    return out
 
 
 def _model(training: Any, first: Any, made: Any, chosen: Any, drift: DriftSettings,

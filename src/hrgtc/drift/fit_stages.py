@@ -32,12 +32,20 @@ from hrgtc.drift.offsets import offset_groups, project_off
 from hrgtc.drift.regression import EXTENDED_PRECISION, newey_west_inflation
 from hrgtc.drift.rest import check_policy, reference_point, run_rest
 from hrgtc.drift.stepwise import StepwiseResult, StepwiseRules, stepwise
-from hrgtc.drift.windows import RunSource, Windowing, _iter_run, window_means_at
+from hrgtc.drift.windows import (
+    RunSource,
+    Windowing,
+    WindowJob,
+    _iter_run,
+    window_means_at,
+    window_means_jointly,
+)
 from hrgtc.recording.motion import MotionSettings
 from hrgtc.settings.drift import SELECTIONS, WARMUP_FACTOR, DriftSettings
 
 __all__ = ["Design", "Selection", "Training", "TrainingReading", "design", "drift_settings",
-           "prepare", "refit_rate_free", "select"]
+           "fit_warmup", "prepare", "refit_rate_free", "rest_key", "select",
+           "window_job"]
 
 
 @dataclass(frozen=True)
@@ -135,15 +143,7 @@ def prepare(runs: Sequence[RunSource], thermometer: Any, drift: DriftSettings,
     finally:
         head.close()
     variables = variables_for(candidates)
-    given = given_options(options, drift.rate_tau_s, aux_columns)
-    used = registry_entries(variables)
-    derived: dict[str, Any] = {}
-    for entry, own in used:  # the settings each variable takes from the options
-        if entry.derive is not None:
-            derived.update(entry.derive(own, given))
-    taus = [derived[e.rate_of[1]] for e, _ in used if e.rate_of and e.rate_of[1] in derived]
-    warmup = (WARMUP_FACTOR * max([drift.rate_tau_s, *taus]) if drift.warmup_s is None
-              else drift.warmup_s)
+    warmup, derived, used = _warmup(drift, candidates, options, aux_columns)
     rests = _rests(runs, reading, float(warmup))
     keep = None if reading.motion == "keep" else [r.keep for r in rests]
     reference_freq, reference_c = reference_point(rests, thermometer, drift.reference_c, warmup)
@@ -164,12 +164,42 @@ def prepare(runs: Sequence[RunSource], thermometer: Any, drift: DriftSettings,
     return training
 
 
+def _warmup(drift: DriftSettings, candidates: tuple[Term, ...], options: Mapping[str, Any],
+            aux_columns: Mapping[str, str] | None) -> tuple[float, dict[str, Any], Any]:
+    """The fit's warm-up [s], the settings the variables derive from the options, and the
+    registry entries of the variables."""
+    given = given_options(options, drift.rate_tau_s, aux_columns)
+    used = registry_entries(variables_for(candidates))
+    derived: dict[str, Any] = {}
+    for entry, own in used:  # the settings each variable takes from the options
+        if entry.derive is not None:
+            derived.update(entry.derive(own, given))
+    taus = [derived[e.rate_of[1]] for e, _ in used if e.rate_of and e.rate_of[1] in derived]
+    warmup = (WARMUP_FACTOR * max([drift.rate_tau_s, *taus]) if drift.warmup_s is None
+              else drift.warmup_s)
+    return warmup, derived, used
+
+
+def fit_warmup(settings: DriftSettings, aux_columns: Mapping[str, str] | None = None) -> float:
+    """The warm-up [s] a fit with ``settings`` leaves out (the df/dt filters' settling)."""
+    drift, candidates, options = drift_settings(settings, {})
+    return float(_warmup(drift, candidates, options, aux_columns)[0])
+
+
+def rest_key(number: int, reading: TrainingReading, warmup: float) -> tuple[Any, ...]:
+    """The key of run ``number``'s at-rest pass in ``reading.rest_cache`` for a fit whose
+    warm-up is ``warmup`` (:func:`fit_warmup`): a caller that met the run's rows before the
+    fit (``calibrate``'s soak plateaus) puts its :func:`~hrgtc.drift.rest.run_rest` there,
+    and the fit reads the run once fewer."""
+    return (number, reading.motion, reading.motion_settings, float(warmup))
+
+
 def _rests(runs: list[RunSource], reading: TrainingReading, warmup: float) -> list[Any]:
     """Each run's samples at rest (from ``reading.rest_cache`` where a fit saw them)."""
     check_policy(reading.motion)
     rests = []
     for number, run in enumerate(runs):
-        key = (number, reading.motion, reading.motion_settings, warmup)
+        key = rest_key(number, reading, warmup)
         cache = reading.rest_cache
         if cache is not None and key in cache:
             rests.append(cache[key])
@@ -210,17 +240,30 @@ def design_matrix(windows: Any, offsets: str, factors: np.ndarray) -> tuple[
     return groups, x_full, x_scaled, bias
 
 
-def design(training: Training, drift: DriftSettings, thermometer: Any,
-           progress: Progress | None, excitation_runs: int) -> Design:
-    """Stage 3: window means, excitation checks, scales and the design matrix."""
-    variables = training.variables
+def window_job(training: Training, drift: DriftSettings, thermometer: Any,
+               progress: Progress | None) -> WindowJob:
+    """Stage 3's window means as a job of one pass over the runs
+    (:func:`~hrgtc.drift.windows.window_means_jointly`: fits on the same runs share it)."""
     # df/dt's training range is kept for the range warnings even when no candidate uses it
-    tracked = ("df",) if "f" in variables else ()
+    tracked = ("df",) if "f" in training.variables else ()
     # the rate-free refit's windows (warm-up 0, stage 5) come from the same reading
     refit = drift.warmup_s is None and training.features.warmup_s > 0
-    windows, *rate_free = training.windows(
-        drift, training.candidates, progress, thermometer, tracked,
-        (training.features.warmup_s, 0.0) if refit else None)
+    windowing = Windowing(drift.window_s, tracked, training.reading.gaps,
+                          training.reading.restart_each_segment)
+    return WindowJob(training.features, training.candidates, windowing, progress, thermometer,
+                     training.keep, (training.features.warmup_s, 0.0) if refit else None)
+
+
+def design(training: Training, drift: DriftSettings, thermometer: Any,
+           progress: Progress | None, excitation_runs: int,
+           read: tuple[Any, ...] | None = None) -> Design:
+    """Stage 3: window means, excitation checks, scales and the design matrix (``read``:
+    the window means of :func:`window_job`, already read; None: read them here)."""
+    variables = training.variables
+    if read is None:
+        read = window_means_jointly(training.runs,
+                                    [window_job(training, drift, thermometer, progress)])[0]
+    windows, *rate_free = read
     for run in range(min(excitation_runs, len(windows.sources))):
         check_excitation(windows, thermometer, variables, run)
     check_excitation(windows, thermometer, variables)

@@ -78,7 +78,8 @@ class RestPass:
     its page faults, ``docs/benchmarks.md``). Parameters as :func:`run_rest`'s.
     """
 
-    _WANTED = ("time_s", "rate_dph", "freq_hz", "input_rate_dph", *ACCEL_COLUMNS)
+    #: The columns gathered (those of them a chunk has).
+    WANTED = ("time_s", "rate_dph", "freq_hz", "input_rate_dph", *ACCEL_COLUMNS)
 
     def __init__(self, policy: str = "exclude", settings: MotionSettings | None = None,
                  warmup_s: float = 0.0, name: str = "", rows: int | None = None) -> None:
@@ -95,7 +96,7 @@ class RestPass:
             self.source = chunk.source or "run"
         if not self._buffers:
             self.input_rate = chunk.metadata.input_rate_dph
-        for column in self._WANTED:
+        for column in self.WANTED:
             if column not in chunk:
                 continue
             values = np.asarray(chunk[column], dtype=np.float64)
@@ -119,9 +120,14 @@ class RestPass:
 
     def finish(self) -> RunRest:
         """The run's still samples and still ``freq_hz`` centre (see :func:`run_rest`)."""
+        return self.finish_each((self.warmup_s,))[0]
+
+    def finish_each(self, warmups_s: Sequence[float]) -> list[RunRest]:
+        """:meth:`finish` for each warm-up of ``warmups_s`` (the detector runs once: only
+        the centre depends on the warm-up)."""
         columns = self.columns
         self._buffers, self._filled = {}, {}
-        return _run_rest(columns, self.policy, self.settings, self.warmup_s, self.source,
+        return _run_rest(columns, self.policy, self.settings, warmups_s, self.source,
                          self.input_rate)
 
 
@@ -150,9 +156,9 @@ def run_rest(chunks: Any, policy: str = "exclude", settings: MotionSettings | No
 
 
 def _run_rest(columns: dict[str, np.ndarray], policy: str, settings: MotionSettings | None,
-              warmup_s: float, source: str, input_rate: float) -> RunRest:
+              warmups_s: Sequence[float], source: str, input_rate: float) -> list[RunRest]:
     if not columns:
-        return RunRest(source, np.zeros(0, dtype=bool))
+        return [RunRest(source, np.zeros(0, dtype=bool)) for _ in warmups_s]
     time_s = columns["time_s"]
     accel = all(c in columns for c in ACCEL_COLUMNS)
     mask = None
@@ -170,14 +176,17 @@ def _run_rest(columns: dict[str, np.ndarray], policy: str, settings: MotionSetti
                 f"(first at row {first}, t = {time_s[first]:g} s; {mask.summary()}); the drift "
                 "model is a law of the gyro at rest: cut the handling out, or pass --motion "
                 "exclude (leave them out, counted) or --motion keep (train on them)")
-    after = time_s >= time_s[0] + warmup_s
-    used = keep & after
+    out = []
     freq = columns.get("freq_hz")
-    total = float(np.sum(freq[used])) if freq is not None else 0.0
     counts = {} if mask is None else mask.counts()
-    return RunRest(source, keep, mask, total, int(np.count_nonzero(used)) if freq is not None
-                   else 0, accel, counts,
-                   float(time_s[-1] - time_s[0]) if time_s.size else math.nan)
+    for warmup_s in warmups_s:
+        after = time_s >= time_s[0] + warmup_s
+        used = keep & after
+        total = float(np.sum(freq[used])) if freq is not None else 0.0
+        out.append(RunRest(source, keep, mask, total, int(np.count_nonzero(used))
+                           if freq is not None else 0, accel, dict(counts),
+                           float(time_s[-1] - time_s[0]) if time_s.size else math.nan))
+    return out
 
 
 def training_centre(rests: Sequence[RunRest]) -> float | None:

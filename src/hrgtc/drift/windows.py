@@ -42,12 +42,12 @@ from hrgtc.core.progress import Progress
 from hrgtc.core.timeline import (
     RESTARTS_KEY,
     is_gap,
-    min_partial_rows,
     restart_rows,
     settle_threshold_s,
 )
 from hrgtc.drift.features import FeatureSettings, FeatureStream, Term, variables_for
 from hrgtc.drift.rate_checks import filtered_levels, rate_filter_problems, warn_rate_filter
+from hrgtc.drift.window_averager import _WindowMeans
 from hrgtc.recording import Recording
 
 RunSource = Recording | Callable[[], Iterator[Recording]]
@@ -114,105 +114,6 @@ class TrainingWindows:
     power_run: np.ndarray | None = None
     power_runs: tuple[str, ...] = ()
     extremes: dict[str, tuple[float, float]] = field(default_factory=dict)
-
-
-class _WindowMeans:
-    """Means of non-overlapping windows of ``rows`` samples over consecutive chunks.
-
-    A window never spans a segment break (a gap): the partial window before it is kept
-    when it holds at least :data:`PARTIAL_WINDOW_FRACTION` of ``rows``, else dropped and
-    counted. At a cut (samples left out as not at rest) the partial window is dropped.
-
-    Each chunk is averaged at once, whatever its number of segments (a burst file has
-    thousands per chunk): the window bounds come from array arithmetic and the sums of
-    every window from one ``numpy.add.reduceat``, which runs down contiguous columns
-    when the block is column-major (as :func:`window_means` builds it).
-    """
-
-    def __init__(self, rows: int) -> None:
-        self.rows = rows
-        self.min_rows = min(rows, min_partial_rows(rows))
-        self._carry: np.ndarray | None = None  # rows of the open window, from earlier chunks
-        self.partial_dropped_rows = 0
-
-    def transform(self, block: np.ndarray, breaks: Sequence[int] | np.ndarray = (),
-                  cuts: Sequence[int] | np.ndarray = ()) -> np.ndarray:
-        """Window means of ``block``; ``breaks``: its rows that start a new segment,
-        ``cuts``: its rows that follow left-out samples (a row that is both is a break)."""
-        n, width = block.shape
-        breaks = _rows_inside(breaks, n)
-        cuts = _rows_inside(cuts, n)
-        if cuts.size:
-            cuts = cuts[~np.isin(cuts, breaks, assume_unique=True)]
-            starts = _rows_inside(np.concatenate([breaks, cuts]), n)
-            at_break = np.isin(starts, breaks, assume_unique=True)
-        else:
-            starts, at_break = breaks, np.ones(breaks.size, dtype=bool)
-        out = []
-        if starts.size and starts[0] == 0:  # the carry's segment ends before the block
-            out.append(self.flush() if at_break[0] else self.drop())
-            starts, at_break = starts[1:], at_break[1:]
-        carry = self._carry if self._carry is not None else np.empty((0, width))
-        # segment k holds rows [begin[k], end[k]) of the block; the first starts with the
-        # carry (at a negative row)
-        begin = np.concatenate([[-carry.shape[0]], starts])
-        end = np.append(starts, n)
-        complete = (end - begin) // self.rows
-        tail = begin + complete * self.rows  # the partial window at each segment's end
-        # the partial windows before a break are kept when long enough, else counted;
-        # those before a cut are counted; the last segment's is the new carry
-        tail_rows = end[:-1] - tail[:-1]
-        kept = at_break & (tail_rows > 0) & (tail_rows >= self.min_rows)
-        self.partial_dropped_rows += int(tail_rows[~kept].sum())
-        windows = int(complete.sum())
-        offset = np.arange(windows) - np.repeat(np.cumsum(complete) - complete, complete)
-        first = np.repeat(begin, complete) + offset * self.rows
-        low = np.concatenate([first, tail[:-1][kept]])
-        high = np.concatenate([first + self.rows, end[:-1][kept]])
-        order = np.argsort(low, kind="stable")
-        low, high = low[order], high[order]
-        if tail[-1] >= 0:
-            self._carry = block[tail[-1]:].copy()
-        else:  # no window closed: the block joins the carry
-            self._carry = np.concatenate([carry, block])
-        if low.size:
-            bounds = np.column_stack([np.maximum(low, 0), high]).ravel()
-            sums = np.add.reduceat(block, bounds[bounds < n], axis=0)[::2]
-            if low[0] < 0:  # the first window began in the carry
-                sums[0] += carry.sum(axis=0)
-            out.append(sums / (high - low)[:, None])
-        out = [o for o in out if o.shape[0]]
-        return np.concatenate(out) if out else np.empty((0, width))
-
-    def drop(self) -> np.ndarray:
-        """A cut: the partial window is dropped (counted); no window."""
-        width = 0
-        if self._carry is not None:
-            self.partial_dropped_rows += self._carry.shape[0]
-            width = self._carry.shape[1]
-        self._carry = None
-        return np.empty((0, width))
-
-    def flush(self) -> np.ndarray:
-        """End of a segment: the partial window, kept when long enough, else counted."""
-        carry, self._carry = self._carry, None
-        if carry is None or carry.shape[0] == 0:
-            return np.empty((0, 0 if carry is None else carry.shape[1]))
-        if carry.shape[0] >= self.min_rows:
-            return carry.mean(axis=0, keepdims=True)
-        self.partial_dropped_rows += carry.shape[0]
-        return np.empty((0, carry.shape[1]))
-
-
-def _rows_inside(rows: Sequence[int] | np.ndarray, n: int) -> np.ndarray:
-    """The distinct ``rows`` in ``[0, n)``, sorted (without ``numpy.unique``'s hashing,
-    milliseconds for the thousands of breaks of a burst file)."""
-    rows = np.asarray(rows, dtype=np.int64).ravel()
-    rows = rows[(rows >= 0) & (rows < n)]
-    if rows.size > 1 and not np.all(rows[1:] > rows[:-1]):
-        rows = np.sort(rows)
-        rows = rows[np.concatenate([[True], rows[1:] != rows[:-1]])]
-    return rows
 
 
 def _used_rows(use: np.ndarray, columns: Sequence[Any], more: Iterator[Any],
@@ -340,146 +241,246 @@ def window_means_at(
     on the warm-up, only which rows are settled does, so each result is what
     :func:`window_means` gives with ``settings.warmup_s`` set to that warm-up (the drift
     fit's rate-free refit, ``warmup_s=0``, costs no second pass)."""
-    window_s = windowing.window_s
-    restart_each_segment = windowing.restart_each_segment
-    variables = variables_for(terms)
-    variables += tuple(v for v in windowing.extra_variables if v not in variables)
-    if not window_s > 0:
-        raise InputError(f"window_s must be a positive number of seconds, got {window_s!r}")
-    warmups = (settings.warmup_s,) if warmups_s is None else tuple(warmups_s)
-    split = windowing.gaps == "split"
-    power_names: list[str] = []
-    kept_by = [_Windows(w, len(variables)) for w in warmups]
-    total = segments = 0
-    sources: list[str] = []
-    extra: tuple[str, ...] | None = None
-    problems: list[str] = []
+    job = WindowJob(settings, terms, windowing, progress, thermometer, keep, warmups_s)
+    result = window_means_jointly(runs, [job])[0]
+    if isinstance(result, BaseException):
+        raise result
+    return result
+
+
+def window_means_jointly(runs: Sequence[RunSource], jobs: Sequence[WindowJob]
+                         ) -> list[tuple[TrainingWindows, ...] | Exception]:
+    """The results of several :func:`window_means_at` on the same runs from one reading of
+    them (the drift model and the housing baseline: one pass, not one per fit). Each job's
+    result is what its own :func:`window_means_at` gives, or the error it raised (the
+    first job's error is raised at once: the later ones are never needed without it)."""
+    out: list[tuple[TrainingWindows, ...] | Exception | None] = [None] * len(jobs)
+    live = list(range(len(jobs)))
+
+    def each(step: Callable[[WindowJob], None]) -> None:
+        for k in list(live):
+            try:
+                step(jobs[k])
+            except Exception as exc:  # the job's own error, given back
+                if k == 0:
+                    raise
+                out[k] = exc
+                live.remove(k)
 
     for index, source in enumerate(runs):
-        stream = FeatureStream(settings, variables, thermometer)
-        window_rows = 0  # windows in rows at this run's own rate
-        input_rate = None
-        run_keep = None if keep is None else keep[index]
-        row = 0
-        last_time: float | None = None
-        power_on: float | None = None  # time the warm-up counts from
-        last_used = True  # the previous row was used (not left out as not at rest)
-        power = len(power_names)  # index of the power-on run of the next row
-        first_power = power
+        each(lambda job, index=index: job.start_run(index))
         for chunk in _iter_run(source):
-            if not window_rows:
-                rate_hz = chunk.metadata.sample_rate_hz
-                window_rows = round(window_s * rate_hz)
-                if window_rows < 1:
-                    raise InputError(f"window_s={window_s:g} s holds no sample at {rate_hz:g} Hz "
-                                     f"({chunk.source or 'run ' + str(index)}); pass a longer "
-                                     "--window-s")
-                for kept_windows in kept_by:
-                    kept_windows.averager = _WindowMeans(window_rows)
-                period = 1.0 / rate_hz
-            if input_rate is None:
-                input_rate = chunk.metadata.input_rate_dph
-                sources.append(chunk.source or f"run {index}")
-                power_names.append(sources[-1])
-                levels = filtered_levels(chunk, variables_for(terms))
-                if levels and not split:  # the terms use a rate: can the filter follow?
-                    # (up to a logger restart: the filter restarts there)
-                    head = restart_rows(chunk.time_s, chunk.metadata.extra.get(RESTARTS_KEY))
-                    stop = int(head[0]) if head.size else len(chunk)
-                    problems += rate_filter_problems(
-                        chunk.time_s[:stop], {k: v[:stop] for k, v in levels.items()},
-                        settings.rate_tau_s, where=chunk.source or "",
-                        thermometer_source=getattr(thermometer, "source", "resonator"))
-            if extra is None:  # the accelerometer and label columns, where every run has them
-                extra = tuple(c for c in _EXTRA_COLUMNS if c in chunk)
-            time = chunk.time_s
-            if not len(time):
-                continue
-            starts = np.flatnonzero(is_gap(np.diff(time), period)) + 1
-            if last_time is None:
-                power_on = float(time[0])
-                segments += 1
-            elif is_gap(time[0] - last_time, period):
-                starts = np.concatenate([[0], starts])
-            # logger restarts (new runs): always; every segment when each is a restart
-            restarts = restart_rows(time, chunk.metadata.extra.get(RESTARTS_KEY))
-            if last_time is None:
-                restarts = restarts[restarts > 0]
-            if restarts.size:
-                starts = np.union1d(starts, restarts)
-            starts = starts.astype(np.int64)
-            segments += starts.size
-            last_time = float(time[-1])
-            power_starts = starts if (split or restart_each_segment) else restarts
-            fresh = starts if split else restarts  # rows where the filter restarts at rest
-            if fresh.size:
-                edges = [0, *fresh[fresh > 0].tolist(), len(chunk)]
-                parts = []
-                for k in range(len(edges) - 1):
-                    if k > 0 or fresh[0] == 0:
-                        stream = FeatureStream(settings, variables, thermometer)
-                    parts.append(stream.transform(chunk.slice(edges[k], edges[k + 1])))
-                values = {v: np.concatenate([p[v] for p in parts]) for v in parts[0]}
-            else:
-                values = stream.transform(chunk)
-            # seconds since power-on (or since the filter restarted): the warm-up skip
-            origin = np.full(len(time), power_on)
-            if power_starts.size:
-                lengths = np.diff(np.append(power_starts, len(time)))
-                origin[power_starts[0]:] = np.repeat(time[power_starts], lengths)
-                power_on = float(time[power_starts[-1]])
-            elapsed = time - origin
-            # the power-on run of each row (a new one at each restart)
-            run_of_row = power + np.cumsum(np.bincount(power_starts, minlength=len(time)))
-            power += power_starts.size
-            while len(power_names) <= power:
-                power_names.append(f"{sources[-1]} run {len(power_names) - first_power + 1}")
-            rate = chunk["input_rate_dph"] if "input_rate_dph" in chunk else input_rate
-            kept = None if run_keep is None else run_keep[row:row + len(chunk)]
-            row += len(chunk)
-            rested = np.ones(len(chunk), dtype=bool) if kept is None else kept.astype(bool)
-            previous = np.concatenate([[last_used], rested[:-1]])
-            resumed = np.flatnonzero(rested & ~previous)
-            last_used = bool(rested[-1])
-            cache: dict[tuple[str, int], np.ndarray] = {}
-            columns = [
-                chunk.time_s,
-                run_of_row,
-                chunk.rate_dph - rate,
-                *(values[v] for v in variables),
-                *(chunk[c] if c in chunk else np.nan for c in extra),
-                *(t.evaluate(values, cache) for t in terms),  # the design matrix's columns
-            ]
-            for windows in kept_by:
-                settled = elapsed >= windows.threshold_s
-                if kept is not None:
-                    windows.left_out += int(np.count_nonzero(~kept & settled))
-                use = settled & rested
-                before = np.cumsum(use) - use  # rows used before each row
-                windows.warm += int(np.count_nonzero(~settled))
+            each(lambda job, chunk=chunk: job.add(chunk))
+            if not live:
+                break
+        each(lambda job: job.end_run())
+    each(lambda job: out.__setitem__(jobs.index(job), job.finish()))
+    return out  # type: ignore[return-value]
+
+
+class WindowJob:
+    """One :func:`window_means_at` fed a chunk at a time (:func:`window_means_jointly`):
+    parameters as :func:`window_means_at`'s."""
+
+    def __init__(self, settings: FeatureSettings, terms: Sequence[Term],
+                 windowing: Windowing = Windowing(), progress: Progress | None = None,
+                 thermometer: Any = None, keep: Sequence[np.ndarray | None] | None = None,
+                 warmups_s: Sequence[float] | None = None) -> None:
+        window_s = windowing.window_s
+        variables = variables_for(terms)
+        variables += tuple(v for v in windowing.extra_variables if v not in variables)
+        if not window_s > 0:
+            raise InputError(f"window_s must be a positive number of seconds, got {window_s!r}")
+        warmups = (settings.warmup_s,) if warmups_s is None else tuple(warmups_s)
+        self.settings, self.terms, self.windowing = settings, terms, windowing
+        self.progress, self.thermometer, self.keep = progress, thermometer, keep
+        self.variables = variables
+        self.split = windowing.gaps == "split"
+        self.power_names: list[str] = []
+        self.kept_by = [_Windows(w, len(variables)) for w in warmups]
+        self.total = self.segments = 0
+        self.sources: list[str] = []
+        self.extra: tuple[str, ...] | None = None
+        self.problems: list[str] = []
+        self.run = _RunState(0, FeatureStream(settings, variables, thermometer), None, 0)
+
+    def start_run(self, index: int) -> None:
+        """Before the first chunk of run ``index``."""
+        self.run = _RunState(index, FeatureStream(self.settings, self.variables,
+                                                  self.thermometer),
+                             None if self.keep is None else self.keep[index],
+                             len(self.power_names))
+
+    def _first_chunk(self, chunk: Recording) -> None:
+        """The run's rate, windows in rows, input rate, name and rate-filter checks."""
+        run = self.run
+        if not run.window_rows:
+            rate_hz = chunk.metadata.sample_rate_hz
+            window_s = self.windowing.window_s
+            run.window_rows = round(window_s * rate_hz)
+            if run.window_rows < 1:
+                raise InputError(f"window_s={window_s:g} s holds no sample at {rate_hz:g} Hz "
+                                 f"({chunk.source or 'run ' + str(run.index)}); pass a longer "
+                                 "--window-s")
+            for kept_windows in self.kept_by:
+                kept_windows.averager = _WindowMeans(run.window_rows)
+            run.period = 1.0 / rate_hz
+        if run.input_rate is None:
+            run.input_rate = chunk.metadata.input_rate_dph
+            self.sources.append(chunk.source or f"run {run.index}")
+            self.power_names.append(self.sources[-1])
+            levels = filtered_levels(chunk, variables_for(self.terms))
+            if levels and not self.split:  # the terms use a rate: can the filter follow?
+                # (up to a logger restart: the filter restarts there)
+                head = restart_rows(chunk.time_s, chunk.metadata.extra.get(RESTARTS_KEY))
+                stop = int(head[0]) if head.size else len(chunk)
+                self.problems += rate_filter_problems(
+                    chunk.time_s[:stop], {k: v[:stop] for k, v in levels.items()},
+                    self.settings.rate_tau_s, where=chunk.source or "",
+                    thermometer_source=getattr(self.thermometer, "source", "resonator"))
+        if self.extra is None:  # the accelerometer and label columns, where every run has them
+            self.extra = tuple(c for c in _EXTRA_COLUMNS if c in chunk)
+
+    def _starts(self, chunk: Recording) -> tuple[np.ndarray, np.ndarray]:
+        """The chunk's rows that start a segment, and those of logger restarts."""
+        run, time = self.run, chunk.time_s
+        starts = np.flatnonzero(is_gap(np.diff(time), run.period)) + 1
+        if run.last_time is None:
+            run.power_on = float(time[0])
+            self.segments += 1
+        elif is_gap(time[0] - run.last_time, run.period):
+            starts = np.concatenate([[0], starts])
+        # logger restarts (new runs): always; every segment when each is a restart
+        restarts = restart_rows(time, chunk.metadata.extra.get(RESTARTS_KEY))
+        if run.last_time is None:
+            restarts = restarts[restarts > 0]
+        if restarts.size:
+            starts = np.union1d(starts, restarts)
+        starts = starts.astype(np.int64)
+        self.segments += starts.size
+        run.last_time = float(time[-1])
+        return starts, restarts
+
+    def _values(self, chunk: Recording, fresh: np.ndarray) -> dict[str, np.ndarray]:
+        """The variables of the chunk (the df/dt filter restarted at ``fresh`` rows)."""
+        run = self.run
+        if not fresh.size:
+            return run.stream.transform(chunk)
+        edges = [0, *fresh[fresh > 0].tolist(), len(chunk)]
+        parts = []
+        for k in range(len(edges) - 1):
+            if k > 0 or fresh[0] == 0:
+                run.stream = FeatureStream(self.settings, self.variables, self.thermometer)
+            parts.append(run.stream.transform(chunk.slice(edges[k], edges[k + 1])))
+        return {v: np.concatenate([p[v] for p in parts]) for v in parts[0]}
+
+    def _elapsed(self, time: np.ndarray, power_starts: np.ndarray) -> tuple[np.ndarray,
+                                                                              np.ndarray]:
+        """Seconds since power-on (or since the filter restarted: the warm-up skip) and
+        the power-on run of each row (a new one at each restart)."""
+        run = self.run
+        origin = np.full(len(time), run.power_on)
+        if power_starts.size:
+            lengths = np.diff(np.append(power_starts, len(time)))
+            origin[power_starts[0]:] = np.repeat(time[power_starts], lengths)
+            run.power_on = float(time[power_starts[-1]])
+        run_of_row = run.power + np.cumsum(np.bincount(power_starts, minlength=len(time)))
+        run.power += power_starts.size
+        while len(self.power_names) <= run.power:
+            self.power_names.append(
+                f"{self.sources[-1]} run {len(self.power_names) - run.first_power + 1}")
+        return time - origin, run_of_row
+
+    def add(self, chunk: Recording) -> None:
+        """The window means of the next chunk of the run."""
+        self._first_chunk(chunk)
+        run, time = self.run, chunk.time_s
+        if not len(time):
+            return
+        starts, restarts = self._starts(chunk)
+        power_starts = starts if (self.split or self.windowing.restart_each_segment) else restarts
+        values = self._values(chunk, starts if self.split else restarts)
+        elapsed, run_of_row = self._elapsed(time, power_starts)
+        rate = chunk["input_rate_dph"] if "input_rate_dph" in chunk else run.input_rate
+        kept = None if run.keep is None else run.keep[run.row:run.row + len(chunk)]
+        run.row += len(chunk)
+        rested = np.ones(len(chunk), dtype=bool) if kept is None else kept.astype(bool)
+        previous = np.concatenate([[run.last_used], rested[:-1]])
+        resumed = np.flatnonzero(rested & ~previous)
+        run.last_used = bool(rested[-1])
+        cache: dict[tuple[str, int], np.ndarray] = {}
+        columns = [
+            chunk.time_s,
+            run_of_row,
+            chunk.rate_dph - rate,
+            *(values[v] for v in self.variables),
+            *(chunk[c] if c in chunk else np.nan for c in self.extra or ()),
+            *(t.evaluate(values, cache) for t in self.terms),  # the design matrix's columns
+        ]
+        shared: tuple[Any, ...] = ()  # the last warm-up's rows used, block and extremes
+        for windows in self.kept_by:
+            settled = elapsed >= windows.threshold_s
+            if kept is not None:
+                windows.left_out += int(np.count_nonzero(~kept & settled))
+            use = settled & rested
+            windows.warm += int(np.count_nonzero(~settled))
+            if not shared or not np.array_equal(use, shared[0]):  # else the same rows
                 block = _used_rows(use, columns, iter(()), 0)
-                if block.shape[0]:  # down the block's contiguous columns; NaN ignored
-                    used = block[:, 3:3 + len(variables)]
-                    np.fmin(windows.lowest, np.fmin.reduce(used, axis=0), out=windows.lowest)
-                    np.fmax(windows.highest, np.fmax.reduce(used, axis=0), out=windows.highest)
-                assert windows.averager is not None
-                windows.collect(windows.averager.transform(block, before[starts],
-                                                           before[resumed]), index)
-            total += len(chunk)
-            if progress is not None:
-                progress(total, 0)
-        if not window_rows:  # a run without rows
-            continue
-        for windows in kept_by:
+                used = block[:, 3:3 + len(self.variables)]  # down contiguous columns
+                shared = (use, np.cumsum(use) - use, block,  # rows used before each row
+                          *((np.fmin.reduce(used, axis=0), np.fmax.reduce(used, axis=0))
+                            if block.shape[0] else ()))  # NaN ignored
+            before, block = shared[1], shared[2]
+            if block.shape[0]:
+                np.fmin(windows.lowest, shared[3], out=windows.lowest)
+                np.fmax(windows.highest, shared[4], out=windows.highest)
             assert windows.averager is not None
-            windows.collect(windows.averager.flush(), index)
+            windows.collect(windows.averager.transform(block, before[starts],
+                                                       before[resumed]), run.index)
+        self.total += len(chunk)
+        if self.progress is not None:
+            self.progress(self.total, 0)
+
+    def end_run(self) -> None:
+        """After the last chunk of the run."""
+        run = self.run
+        if not run.window_rows:  # a run without rows
+            return
+        for windows in self.kept_by:
+            assert windows.averager is not None
+            windows.collect(windows.averager.flush(), run.index)
             windows.partial += windows.averager.partial_dropped_rows
-        if power > first_power:  # the file restarted: name its first run too
-            power_names[first_power] = f"{sources[-1]} run 1"
-    warn_rate_filter(problems)
-    return tuple(_training_windows(w, windowing, variables, extra or (), total,
-                                   sources, segments, power_names)
-                 for w in kept_by)
+        if run.power > run.first_power:  # the file restarted: name its first run too
+            self.power_names[run.first_power] = f"{self.sources[-1]} run 1"
+
+    def finish(self) -> tuple[TrainingWindows, ...]:
+        """Each warm-up's :class:`TrainingWindows` (the rate filter's problems warned)."""
+        warn_rate_filter(self.problems)
+        return tuple(_training_windows(w, self.windowing, self.variables, self.extra or (),
+                                       self.total, self.sources, self.segments,
+                                       self.power_names)
+                     for w in self.kept_by)
+
+
+@dataclass
+class _RunState:
+    """What a :class:`WindowJob` carries from one chunk of a run to the next."""
+
+    index: int
+    stream: FeatureStream
+    keep: np.ndarray | None
+    power: int  # index of the power-on run of the next row
+    first_power: int = 0
+    window_rows: int = 0  # windows in rows at this run's own rate
+    period: float = 0.0
+    input_rate: float | None = None
+    row: int = 0
+    last_time: float | None = None
+    power_on: float | None = None  # time the warm-up counts from
+    last_used: bool = True  # the previous row was used (not left out as not at rest)
+
+    def __post_init__(self) -> None:
+        self.first_power = self.power
 
 
 def _training_windows(windows: _Windows, windowing: Windowing,

@@ -30,8 +30,9 @@ from hrgtc.core import records
 from hrgtc.core.errors import CalibrationError, ExtrapolationWarning, HrgtcWarning, InputError
 from hrgtc.core.progress import StageProgress, for_stage
 from hrgtc.core.summary import Summary
-from hrgtc.drift.fit_stages import TrainingReading
-from hrgtc.drift.rest import run_rest
+from hrgtc.drift.features import EQ21
+from hrgtc.drift.fit_stages import TrainingReading, fit_warmup, rest_key
+from hrgtc.drift.rest import RestPass, run_rest
 from hrgtc.drift.training import (
     ChannelShape,
     TrainingStatistics,
@@ -45,11 +46,12 @@ from hrgtc.evaluation.calibration_figures import calibration_summary, thermomete
 from hrgtc.model import AxisModel, Model, provenance
 from hrgtc.pipeline.documents import CalibrationDriftRecord, CalibrationRecord
 from hrgtc.pipeline.terms import resolve_terms
-from hrgtc.recording import ReadOptions
+from hrgtc.recording import ReadOptions, Recording
 from hrgtc.recording.mapping import parse_columns, scales_temperature
+from hrgtc.recording.schema import concatenate
 from hrgtc.settings import to_dict
 from hrgtc.settings.calibration import CalibrationSettings
-from hrgtc.settings.drift import DriftSettings
+from hrgtc.settings.drift import GRADIENT_TERMS, DriftSettings
 from hrgtc.thermometry import fit as fit_thermometer
 from hrgtc.thermometry import identity
 from hrgtc.thermometry.plateaus import Plateau, plateau_table, plateaus_from_recordings
@@ -219,8 +221,13 @@ def fit_axis(
         head = heads[str(path)]
         check_resonator_gyro(head.rate_dph, head.metadata.sample_rate_hz,
                              head.metadata.input_rate_dph or 0.0, str(path))
+    # the soaks that join the drift fit are read once for the plateaus and its at-rest pass
+    # (not with --motion error: a soak's motion is then the fit's error, said where it was)
+    joins = settings.drift_from_soaks and options.motion != "error"
+    soak_rests = _SoakRests(options.motion,
+                            _likely_warmups(settings.drift, aux) if joins else ())
     fitted = soak_fit or fit_soaks(soaks, settings=settings, prior=prior,
-                                   read_options=options, progress=progress)
+                                   read_options=options, progress=progress, rests=soak_rests)
     thermometer_fit, plateaus, table = fitted.thermometer, fitted.plateaus, fitted.table
     prior_fit, soak_rates = fitted.prior_fit, fitted.sample_rates_hz
 
@@ -230,7 +237,8 @@ def fit_axis(
     training_heads = [heads[str(p)] for p in training]
     settings = _with_terms(settings, resolve_terms(settings.drift.terms, aux, training_heads))
     model, housing = _fit_drift(training, heads, thermometer_fit, options, progress,
-                                len(drifts), settings.drift, aux)
+                                len(drifts), settings.drift, aux,
+                                soak_rests.cache(training, len(drifts), options))
     unit = heads[str(drifts[0])].metadata.unit
     record = _record(settings, aux, options, order=fitted.order)
     if prior_fit is not None:
@@ -246,6 +254,73 @@ def fit_axis(
             {"soak": [str(p) for p in soaks], "drift": [str(p) for p in drifts]}, record),
     )
     return AxisCalibration(unit_model, tuple(plateaus), table, (), prior_fit, fitted)
+
+
+def _baseline_settings(drift: DriftSettings) -> DriftSettings:
+    """The housing baseline's fit: its own terms in h and dh/dt, with the default selection
+    and the variables' default options (d2's filter)."""
+    return dataclasses.replace(drift, terms=HOUSING_TERMS, select=DriftSettings.select,
+                               **DriftSettings().variable_options())
+
+
+def _likely_warmups(drift: DriftSettings, aux: Mapping[str, str] | None) -> tuple[float, ...]:
+    """The warm-ups the drift fit and the housing baseline will likely take: their terms
+    are resolved from the training files later (:func:`~hrgtc.pipeline.terms.resolve_terms`);
+    a warm-up not among these only costs its fit a pass of its own."""
+    terms = [drift.terms] if drift.terms is not None else [
+        GRADIENT_TERMS, tuple(t.name for t in EQ21)]
+    settings = [*(dataclasses.replace(drift, terms=t) for t in terms),
+                _baseline_settings(drift)]
+    found = []
+    for each in settings:
+        try:
+            found.append(fit_warmup(each, aux))
+        except (InputError, CalibrationError, TypeError, ValueError):
+            continue  # the fit itself will say what is wrong
+    return tuple(dict.fromkeys(found))
+
+
+class _SoakRests:
+    """The drift fit's at-rest passes over the soaks, run on the soak plateaus' reading of
+    each file (each soak read once fewer): the detector's columns gathered from the same
+    chunks (:class:`~hrgtc.drift.rest.RestPass`), one result per likely warm-up."""
+
+    def __init__(self, motion: str, warmups_s: Sequence[float]) -> None:
+        self.motion, self.warmups_s = motion, tuple(warmups_s)
+        self.found: dict[str, dict[float, Any]] = {}
+
+    def read(self, options: ReadOptions, path: PathLike) -> Any:
+        """The soak's :data:`SOAK_COLUMNS` (as ``options.read(path, keep=SOAK_COLUMNS)``),
+        its at-rest passes kept."""
+        if type(options).read is not ReadOptions.read or not self.warmups_s:
+            return options.read(path, keep=SOAK_COLUMNS)  # a reading held in memory
+        rest = RestPass(self.motion)
+        first, others = None, []  # the first chunk; the columns the detector does not take
+        for chunk in options.chunks(path):
+            rest.partial_fit(chunk)
+            first = chunk if first is None else first
+            others.append({k: chunk[k] for k in SOAK_COLUMNS
+                           if k in chunk and k not in RestPass.WANTED})
+        if first is None:
+            return concatenate([])  # refused as the plain reading refuses it
+        gathered = rest.columns  # the detector's buffers hold time_s and freq_hz whole
+        try:
+            found = rest.finish_each(self.warmups_s)
+        except (InputError, CalibrationError):  # said by the fit's own pass, if it joins
+            found = []
+        self.found[str(path)] = dict(zip(self.warmups_s, found, strict=False))
+        return Recording({k: gathered[k] if k in RestPass.WANTED else
+                          np.concatenate([part[k] for part in others])
+                          for k in SOAK_COLUMNS if k in first}, first.metadata, first.source)
+
+    def cache(self, training: Sequence[PathLike], first: int,
+              options: ReadOptions) -> dict[Any, Any]:
+        """A rest cache for the drift fit on ``training``, whose runs from ``first`` on are
+        the soaks (keyed as :func:`~hrgtc.drift.fit_stages.rest_key`)."""
+        reading = TrainingReading(motion=options.motion, gaps=options.gaps)
+        return {rest_key(number, reading, warmup): rest
+                for number, path in enumerate(training) if number >= first
+                for warmup, rest in self.found.get(str(path), {}).items()}
 
 
 def _soaks_for_drift(soaks: Sequence[PathLike], soak_rates: Sequence[float],
@@ -267,18 +342,21 @@ def _soaks_for_drift(soaks: Sequence[PathLike], soak_rates: Sequence[float],
 def fit_soaks(soaks: Sequence[PathLike], *, settings: CalibrationSettings | None = None,
               prior: ThermometerPrior | PathLike | None = None,
               read_options: ReadOptions | None = None,
-              progress: StageProgress | None = None) -> SoakFit:
+              progress: StageProgress | None = None,
+              rests: _SoakRests | None = None) -> SoakFit:
     """The thermometer from the soaks: plateaus -> Table 1 -> Eq. 18 form -> Table 2.
 
     Parameters are those of :func:`fit_axis` (``settings.plateaus`` finds the plateaus,
-    ``settings.thermometer.order`` is the polynomial's order unless a prior gives it).
+    ``settings.thermometer.order`` is the polynomial's order unless a prior gives it);
+    ``rests``: also run the at-rest detector of the drift fit on each soak's reading.
     """
     options = read_options or ReadOptions()
     settings = settings or CalibrationSettings()
     plateaus: list[Plateau] = []
     soak_rates: list[float] = []
     for number, path in enumerate(soaks):
-        soak = options.read(path, keep=SOAK_COLUMNS)
+        soak = (options.read(path, keep=SOAK_COLUMNS) if rests is None
+                else rests.read(options, path))
         soak_rates.append(soak.metadata.sample_rate_hz)
         plateaus.extend(plateaus_from_recordings([soak], settings.plateaus))
         if progress is not None:
@@ -323,16 +401,6 @@ def _record(settings: CalibrationSettings, aux: Mapping[str, str] | None,
             "columns": dict(options.columns or {}), "units": dict(options.units or {})}
 
 
-def _fit(runs: Sequence[Any], thermometer: Any, drift: DriftSettings,
-         aux: Mapping[str, str] | None, options: ReadOptions, progress: Any,
-         excitation_runs: int = 0, rest_cache: dict[Any, Any] | None = None) -> Any:
-    """:func:`hrgtc.drift.fit` with ``drift`` whole on the runs read by ``options``
-    (``rest_cache``: the at-rest passes shared by fits on the same runs)."""
-    reading = TrainingReading(motion=options.motion, gaps=options.gaps, rest_cache=rest_cache)
-    return drift_model.fit(runs, thermometer, drift, reading=reading, aux_columns=aux,
-                           excitation_runs=excitation_runs, progress=progress)
-
-
 class _CountedRun:
     """A training run's chunks, counting the rows the spike filters removed in the last
     pass over it (the fit reads a run several times)."""
@@ -351,30 +419,33 @@ class _CountedRun:
 
 def _fit_drift(training: Sequence[PathLike], heads: Mapping[str, Any], thermometer: Any,
                options: ReadOptions, progress: StageProgress | None, excitation_runs: int,
-               drift: DriftSettings, aux: Mapping[str, str] | None) -> tuple[Any, Any]:
+               drift: DriftSettings, aux: Mapping[str, str] | None,
+               rest_cache: dict[Any, Any] | None = None) -> tuple[Any, Any]:
     """The drift model on ``training`` and the housing baseline (:data:`HOUSING_TERMS`)
     when every run has ``housing_c`` (None otherwise, or when its fit fails: the baseline
-    is optional)."""
+    is optional). ``rest_cache``: at-rest passes met before (:class:`_SoakRests`)."""
     runs = [_CountedRun(options, path) for path in training]
-    rest_cache: dict[Any, Any] = {}  # one pass of the at-rest detector per run, not per fit
-    model = _fit(runs, thermometer, drift, aux, options, for_stage(progress, "drift"),
-                 excitation_runs, rest_cache)
+    rest_cache = {} if rest_cache is None else rest_cache  # one at-rest pass per run
+    reading = TrainingReading(motion=options.motion, gaps=options.gaps, rest_cache=rest_cache)
+    requests = [drift_model.FitRequest(drift, aux, excitation_runs,
+                                       for_stage(progress, "drift"))]
+    if all("housing_c" in heads[str(p)] for p in training):
+        # its windows from the drift fit's pass
+        requests.append(drift_model.FitRequest(_baseline_settings(drift),
+                                               progress=for_stage(progress, "housing baseline")))
+    model, *rest = drift_model.fit_jointly(runs, thermometer, requests, reading=reading)
+    assert isinstance(model, drift_model.DriftModel)
     spikes = sum(run.spikes for run in runs)
     if spikes and model.accounting is not None:  # the accounting starts from the file's rows
         model.accounting.add_read(spikes)
         model.accounting.drop("spikes", spikes)
     housing = None
-    if all("housing_c" in heads[str(p)] for p in training):
-        # the baseline's own terms in h and dh/dt, with the default selection and the
-        # variables' default options (d2's filter)
-        baseline = dataclasses.replace(drift, terms=HOUSING_TERMS,
-                                       select=DriftSettings.select,
-                                       **DriftSettings().variable_options())
-        try:
-            housing = _fit(runs, thermometer, baseline, None, options,
-                           for_stage(progress, "housing baseline"), rest_cache=rest_cache)
-        except CalibrationError as exc:  # the baseline is optional: say why it is missing
-            warnings.warn(f"no housing-thermistor baseline: {exc}", HrgtcWarning, stacklevel=2)
+    if rest and isinstance(rest[0], CalibrationError):  # the baseline is optional: say why
+        warnings.warn(f"no housing-thermistor baseline: {rest[0]}", HrgtcWarning, stacklevel=2)
+    elif rest and isinstance(rest[0], Exception):
+        raise rest[0]
+    elif rest:
+        housing = rest[0]
     return model, housing
 
 

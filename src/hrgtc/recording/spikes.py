@@ -256,7 +256,8 @@ def find_spikes(time_s: np.ndarray, values: np.ndarray, *, k: float = SPIKE_K,
 #: baseline) and each pass would test the same rows again. A piece is known by its file
 #: (path, modification time, size), first file row, column, the filter's settings and a
 #: fingerprint of its times and values (first, last, sum); the spikes' rows are kept,
-#: the :data:`_MEMO_PIECES` most recent pieces (a few MB).
+#: the :data:`_MEMO_PIECES` most recent pieces (a few MB). A column's resolution (LSB),
+#: taken from a file's first piece, is kept here too, keyed the same way.
 _MEMO: OrderedDict[tuple[object, ...], np.ndarray] = OrderedDict()
 _MEMO_PIECES = 4096
 
@@ -351,7 +352,7 @@ class RobustSpikeFilter:
         for name in _filtered_columns(columns, axes, self.sensor):
             values = columns[name]
             if name not in self._lsb:  # the resolution of the first rows holds for the file
-                self._lsb[name] = resolution(values[:RESOLUTION_ROWS])
+                self._lsb[name] = self._resolution(name, values, row_offset)
             mask = self._spikes(name, time_s, values, row_offset)
             if turning is not None and base_name(name, axes) == "rate_dph" and mask.any():
                 self.in_motion += int(np.count_nonzero(mask & turning))
@@ -376,6 +377,22 @@ class RobustSpikeFilter:
             return out
         keep = ~marked
         return {name: values[keep] for name, values in out.items()}
+
+    def _resolution(self, name: str, values: np.ndarray, row_offset: int) -> float | None:
+        """The resolution of a column's first rows, from :data:`_MEMO` when this process
+        found it for the same piece of the same file (each pass over a file makes a new
+        filter; the resolution scans and sorts :data:`RESOLUTION_ROWS` values)."""
+        first = values[:RESOLUTION_ROWS]
+        key = None
+        if self._file is not None:
+            key = ("resolution", self._file, row_offset, name, len(first), _fingerprint(first))
+            if key in _MEMO:
+                _MEMO.move_to_end(key)
+                return _MEMO[key]  # type: ignore[return-value]
+        lsb = resolution(first)
+        if key is not None:
+            _MEMO[key] = lsb  # type: ignore[assignment]
+        return lsb
 
     def _spikes(self, name: str, time_s: np.ndarray, values: np.ndarray,
                 row_offset: int) -> np.ndarray:

@@ -219,24 +219,26 @@ def _blocks(recording: Recording, block_s: float) -> _Blocks:
             f"time_s{_where(recording)} must increase over at least 2 rows; it does not at "
             f"row {row}: sort the rows or remove duplicated samples"
         )
+    from hrgtc.thermometry._plateau_kernel import block_sums  # numba: loaded when used
+
     idx = np.floor_divide(time - time[0], block_s).astype(np.intp)
-    count_all = np.bincount(idx)
+    ref = float(recording.freq_hz[0])
+    count_all, time_sum, dev_sum, dev_sq_sum, chamber_sum = block_sums(
+        idx, np.ascontiguousarray(time, dtype=np.float64),
+        np.ascontiguousarray(recording.freq_hz, dtype=np.float64), ref,
+        np.ascontiguousarray(recording["chamber_c"], dtype=np.float64))
     ids = np.flatnonzero(count_all >= max(1.0, 0.5 * np.median(count_all[count_all > 0])))
     count = count_all[ids].astype(np.float64)
-    ref = float(recording.freq_hz[0])
-    dev = recording.freq_hz - ref
-    dev_sum = np.bincount(idx, dev)[ids]
-    dev_sq_sum = np.bincount(idx, dev * dev)[ids]
     first = np.searchsorted(idx, ids, side="left")
     last = np.searchsorted(idx, ids, side="right") - 1
     return _Blocks(
         count=count,
-        time_s=np.bincount(idx, time)[ids] / count,
+        time_s=time_sum[ids] / count,
         first_s=time[first],
         last_s=time[last],
-        freq_hz=ref + dev_sum / count,
-        chamber_c=np.bincount(idx, recording["chamber_c"])[ids] / count,
-        dev_sq_sum=dev_sq_sum,
+        freq_hz=ref + dev_sum[ids] / count,
+        chamber_c=chamber_sum[ids] / count,
+        dev_sq_sum=dev_sq_sum[ids],
         ref_hz=ref,
     )
 
