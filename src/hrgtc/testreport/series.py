@@ -49,6 +49,10 @@ class RunSeries:
         The samples of the same (``keep_samples`` only). [°/h]
     segments, segment_temperature_c, segment_span_c
         A rate-table run's holds, the mean temperature of each and its span (max − min). [°C]
+    mean_time_s
+        Mean time of each block's samples, since the run's first sample (None: the block's
+        middle): a rate of change of the block means is taken against it, so that a block
+        a burst fills only in part is placed where its samples are. [s]
     """
 
     entry: RunEntry
@@ -65,6 +69,14 @@ class RunSeries:
     segments: tuple[RateSegment, ...] = ()
     segment_temperature_c: tuple[float, ...] = ()
     segment_span_c: tuple[float, ...] = ()
+    mean_time_s: np.ndarray | None = None
+
+    def sample_times_s(self) -> np.ndarray:
+        """Where each block's samples are: their mean time (else the block's middle). [s]"""
+        if self.mean_time_s is not None:
+            return self.mean_time_s
+        width = float(self.time_s[1] - self.time_s[0]) if self.time_s.size > 1 else 0.0
+        return self.time_s + 0.5 * width
 
     def settle_s(self, default_s: float) -> float:
         """The time left out at the run's start: its own ``settle_s`` or ``default_s``. [s]"""
@@ -134,7 +146,7 @@ def read_series(entry: RunEntry, *, earth_rate_dph: float, block_s: float,
     if entry.role == "rate-table":
         return _rate_table(entry, options, earth_rate_dph, block_s, temperature_column)
     compensator = None if model is None else Compensator(model)
-    names = ("bias", "temperature") + (("compensated",) if model is not None else ())
+    names = ("bias", "temperature", "time") + (("compensated",) if model is not None else ())
     blocks, kept, kept_comp = _Blocks(names), [], []
     first, n, metadata = None, 0, None
     for chunk in options.chunks(entry.path):
@@ -142,7 +154,8 @@ def read_series(entry: RunEntry, *, earth_rate_dph: float, block_s: float,
         if first is None:
             first, metadata = float(time[0]), chunk.metadata
         bias = np.asarray(chunk.rate_dph, dtype=np.float64) - earth_rate_dph
-        columns = {"bias": bias, "temperature": _temperature(chunk, temperature_column, entry)}
+        columns = {"bias": bias, "temperature": _temperature(chunk, temperature_column, entry),
+                   "time": time - first}
         if compensator is not None:
             out = compensator.transform(chunk)
             columns["compensated"] = np.asarray(out["rate_comp_dph"], np.float64) - earth_rate_dph
@@ -161,7 +174,7 @@ def read_series(entry: RunEntry, *, earth_rate_dph: float, block_s: float,
         metadata_input_rate_dph=float(metadata.input_rate_dph),
         time_s=index * float(block_s), bias_dph=means["bias"],
         compensated_dph=means.get("compensated"), temperature_c=means["temperature"],
-        samples_dph=np.concatenate(kept) if keep_samples else None,
+        mean_time_s=means["time"], samples_dph=np.concatenate(kept) if keep_samples else None,
         compensated_samples_dph=(np.concatenate(kept_comp) if keep_samples and kept_comp
                                  else None))
 
