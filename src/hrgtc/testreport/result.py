@@ -224,6 +224,10 @@ def campaign_report(inputs: TestReportInputs) -> TestReport:
                             temperature_column=settings.temperature_column, model=model,
                             read_options=options, keep_samples=str(entry.path) == allan_path)
         series.setdefault(entry.role, []).append(found)
+        if found.n_moving:
+            notes.append(f"{entry.name}: {found.n_moving} of {found.n_samples} samples not at "
+                         "rest (handling; the motion detector of calibrate) left out of its "
+                         "block means; --motion keep uses them")
         if entry.role != "rate-table" and abs(found.metadata_input_rate_dph - earth) > 1e-3 \
                 and found.metadata_input_rate_dph != 0.0:
             notes.append(f"{entry.name}: its metadata state an input rate of "
