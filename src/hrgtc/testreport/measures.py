@@ -183,7 +183,7 @@ def _sensitivities(soaks: Sequence[RunSeries], sweeps: Sequence[RunSeries],
         slope = float(b[1])
         out.append(measured(temperature_name, slope, float(se[1]), k, dof,
                             f"U = k·u, k = {k:g}; u: OLS standard error over {len(points)} soaks"))
-    blocks = [(s.temperature_c, np.gradient(s.temperature_c, s.time_s / 60.0),
+    blocks = [(s.temperature_c, np.gradient(s.temperature_c, s.sample_times_s() / 60.0),
                s.compensated_dph if compensated else s.bias_dph)
               for s in sweeps if s.time_s.size >= 4]
     if blocks:

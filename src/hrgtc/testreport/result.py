@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from hrgtc.core.errors import InputError
 from hrgtc.core.files import file_sha256
 from hrgtc.core.summary import Summary
 from hrgtc.evaluation.allan import AllanResult
@@ -185,15 +186,33 @@ def _allan_entry(campaign: Campaign) -> str | None:
     return None
 
 
+def _campaign_model(campaign: Campaign) -> Model | None:
+    """The manifest's model; of an instrument, the axis the manifest's ``file_axis`` reads
+    (its runs are read as that axis's single-axis view)."""
+    if campaign.model is None:
+        return None
+    model = load_model(campaign.model)
+    if campaign.axis is None or "" in model.axes:
+        return model
+    if campaign.axis not in model.axes:
+        raise InputError(f"{campaign.source}: [unit] file_axis = {campaign.axis!r}, but the "
+                         f"model {campaign.model.name} has axes {', '.join(model.axes)}: "
+                         "name one of them, or the model of that axis")
+    return model.of_axis(campaign.axis)
+
+
 def campaign_report(inputs: TestReportInputs) -> TestReport:
     """The data function of the ``test-report`` kind: read every run once, compute and
     judge every figure."""
     from hrgtc.core.meta import __version__
+    from hrgtc.thermometry.reference import options_with_map
 
     campaign = inputs.campaign
     settings = campaign.settings
-    model: Model | None = None if campaign.model is None else load_model(campaign.model)
-    options = inputs.read_options or ReadOptions()  # the column mapping, units, ...
+    model = _campaign_model(campaign)
+    # the column mapping, units, ...; a raw count read through the model's map to °C
+    options = options_with_map(inputs.read_options or ReadOptions(),
+                               None if model is None else model.temperature_map)
     if campaign.axis is not None:  # the manifest's file_axis
         options = dataclasses.replace(options, axis=campaign.axis)
     allan_path = _allan_entry(campaign)
@@ -205,6 +224,10 @@ def campaign_report(inputs: TestReportInputs) -> TestReport:
                             temperature_column=settings.temperature_column, model=model,
                             read_options=options, keep_samples=str(entry.path) == allan_path)
         series.setdefault(entry.role, []).append(found)
+        if found.n_moving:
+            notes.append(f"{entry.name}: {found.n_moving} of {found.n_samples} samples not at "
+                         "rest (handling; the motion detector of calibrate) left out of its "
+                         "block means; --motion keep uses them")
         if entry.role != "rate-table" and abs(found.metadata_input_rate_dph - earth) > 1e-3 \
                 and found.metadata_input_rate_dph != 0.0:
             notes.append(f"{entry.name}: its metadata state an input rate of "

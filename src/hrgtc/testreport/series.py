@@ -12,6 +12,7 @@ with the mean temperature of each.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -19,6 +20,7 @@ from hrgtc.compensate import Compensator
 from hrgtc.core.errors import InputError
 from hrgtc.core.files import file_sha256
 from hrgtc.drift.rate_segments import RateSegment, find_rate_segments
+from hrgtc.drift.rest import RestPass, RunRest
 from hrgtc.model import Model
 from hrgtc.recording import ReadOptions, Recording
 from hrgtc.testreport.manifest import RunEntry
@@ -49,6 +51,13 @@ class RunSeries:
         The samples of the same (``keep_samples`` only). [°/h]
     segments, segment_temperature_c, segment_span_c
         A rate-table run's holds, the mean temperature of each and its span (max − min). [°C]
+    mean_time_s
+        Mean time of each block's samples, since the run's first sample (None: the block's
+        middle): a rate of change of the block means is taken against it, so that a block
+        a burst fills only in part is placed where its samples are. [s]
+    n_moving
+        Samples the motion detector found not at rest (``--motion exclude``, the default),
+        left out of the block means (the samples kept for the Allan deviation keep them).
     """
 
     entry: RunEntry
@@ -65,6 +74,15 @@ class RunSeries:
     segments: tuple[RateSegment, ...] = ()
     segment_temperature_c: tuple[float, ...] = ()
     segment_span_c: tuple[float, ...] = ()
+    mean_time_s: np.ndarray | None = None
+    n_moving: int = 0
+
+    def sample_times_s(self) -> np.ndarray:
+        """Where each block's samples are: their mean time (else the block's middle). [s]"""
+        if self.mean_time_s is not None:
+            return self.mean_time_s
+        width = float(self.time_s[1] - self.time_s[0]) if self.time_s.size > 1 else 0.0
+        return self.time_s + 0.5 * width
 
     def settle_s(self, default_s: float) -> float:
         """The time left out at the run's start: its own ``settle_s`` or ``default_s``. [s]"""
@@ -133,37 +151,50 @@ def read_series(entry: RunEntry, *, earth_rate_dph: float, block_s: float,
     options = read_options or ReadOptions()
     if entry.role == "rate-table":
         return _rate_table(entry, options, earth_rate_dph, block_s, temperature_column)
-    compensator = None if model is None else Compensator(model)
-    names = ("bias", "temperature") + (("compensated",) if model is not None else ())
-    blocks, kept, kept_comp = _Blocks(names), [], []
-    first, n, metadata = None, 0, None
-    for chunk in options.chunks(entry.path):
-        time = np.asarray(chunk.time_s, dtype=np.float64)
-        if first is None:
-            first, metadata = float(time[0]), chunk.metadata
-        bias = np.asarray(chunk.rate_dph, dtype=np.float64) - earth_rate_dph
-        columns = {"bias": bias, "temperature": _temperature(chunk, temperature_column, entry)}
-        if compensator is not None:
-            out = compensator.transform(chunk)
-            columns["compensated"] = np.asarray(out["rate_comp_dph"], np.float64) - earth_rate_dph
-            if keep_samples:
-                kept_comp.append(columns["compensated"])
-        if keep_samples:
-            kept.append(bias)
-        blocks.add(np.floor((time - first) / block_s).astype(np.int64), columns)
-        n += len(chunk)
-    if metadata is None:
-        raise InputError(f"{entry.path}: the recording holds no rows")
+    columns, metadata, rest = _read_run(entry, options, earth_rate_dph, temperature_column,
+                                        model)
+    keep = rest.keep
+    blocks = _Blocks(tuple(columns))
+    blocks.add(np.floor(columns["time"][keep] / block_s).astype(np.int64),
+               {name: values[keep] for name, values in columns.items()})
     index, means = blocks.means()
     return RunSeries(
-        entry=entry, sha256=file_sha256(entry.path), n_samples=n,
+        entry=entry, sha256=file_sha256(entry.path), n_samples=int(keep.size),
         sample_rate_hz=float(metadata.sample_rate_hz),
         metadata_input_rate_dph=float(metadata.input_rate_dph),
         time_s=index * float(block_s), bias_dph=means["bias"],
         compensated_dph=means.get("compensated"), temperature_c=means["temperature"],
-        samples_dph=np.concatenate(kept) if keep_samples else None,
-        compensated_samples_dph=(np.concatenate(kept_comp) if keep_samples and kept_comp
-                                 else None))
+        mean_time_s=means["time"], n_moving=rest.n_moving,
+        samples_dph=columns["bias"] if keep_samples else None,
+        compensated_samples_dph=columns.get("compensated") if keep_samples else None)
+
+
+def _read_run(entry: RunEntry, options: ReadOptions, earth_rate_dph: float,
+              temperature_column: str, model: Model | None
+              ) -> tuple[dict[str, np.ndarray], Any, RunRest]:
+    """A run's samples (time since its first, bias, temperature, compensated) and the
+    motion detector's verdict on them (``--motion``, as calibration and evaluation judge
+    a run: handling is not the bias)."""
+    compensator = None if model is None else Compensator(model)
+    rest = RestPass(options.motion or "exclude", name=str(entry.path))
+    parts: dict[str, list[np.ndarray]] = {}
+    first, metadata = None, None
+    for chunk in options.chunks(entry.path):
+        time = np.asarray(chunk.time_s, dtype=np.float64)
+        if first is None:
+            first, metadata = float(time[0]), chunk.metadata
+        rest.partial_fit(chunk)
+        found = {"time": time - first, "temperature": _temperature(chunk, temperature_column,
+                                                                   entry),
+                 "bias": np.asarray(chunk.rate_dph, dtype=np.float64) - earth_rate_dph}
+        if compensator is not None:
+            found["compensated"] = np.asarray(compensator.transform(chunk)["rate_comp_dph"],
+                                              np.float64) - earth_rate_dph
+        for name, values in found.items():
+            parts.setdefault(name, []).append(values)
+    if metadata is None:
+        raise InputError(f"{entry.path}: the recording holds no rows")
+    return {k: np.concatenate(v) for k, v in parts.items()}, metadata, rest.finish()
 
 
 def _rate_table(entry: RunEntry, options: ReadOptions, earth_rate_dph: float, block_s: float,

@@ -15,7 +15,9 @@ from __future__ import annotations
 
 import re
 import textwrap
+from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
 from hrgtc.export.c.expr import comment as _comment
 from hrgtc.export.c.header import header as template
@@ -46,8 +48,27 @@ def sensor_note(model: Model) -> list[str]:
         "  sensor's reading [degC], not a frequency: wherever this file says Hz or Hz/s",
         "  for freq_hz, f, df/dt, f_ref or their ranges, read degC and degC/s. The",
         "  thermometer is the identity, so resonator_c_est is that reading.",
+        *_count_map_note(model.temperature_map),
         "",
     ]
+
+
+def _count_map_note(temperature_map: Mapping[str, Any] | None) -> list[str]:
+    """Lines that say the sensor logged a raw count, mapped to degC by the model's map
+    (``calibrate --temp-ref``): freq_hz is the mapped count, not the count itself."""
+    if not temperature_map:
+        return []
+    scale, offset = temperature_map["scale_c_per_count"], temperature_map["offset_c"]
+    bits = temperature_map.get("count_bits")
+    lines = ["  The sensor logs a raw count, which calibrate --temp-ref mapped to degC (fitted",
+             f"  on the reference log {temperature_map.get('reference') or '?'}): pass",
+             "  freq_hz = T = S*count + O, not the count itself, with",
+             f"    S = {scale:.17g} degC per count",
+             f"    O = {offset:.17g} degC"]
+    if bits:
+        lines.append(f"  (a signed {bits}-bit count stored unsigned: a count of 2^{bits - 1} or "
+                     f"more is taken minus 2^{bits} first).")
+    return lines
 
 
 def title(model: Model) -> str:

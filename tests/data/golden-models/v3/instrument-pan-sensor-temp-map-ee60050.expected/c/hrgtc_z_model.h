@@ -24,6 +24,13 @@
  *   sensor's reading [degC], not a frequency: wherever this file says Hz or Hz/s
  *   for freq_hz, f, df/dt, f_ref or their ranges, read degC and degC/s. The
  *   thermometer is the identity, so resonator_c_est is that reading.
+ *   The sensor logs a raw count, which calibrate --temp-ref mapped to degC (fitted
+ *   on the reference log pan_etu_cold_handlog_2020-03-07.csv): pass
+ *   freq_hz = T = S*count + O, not the count itself, with
+ *     S = 0.0058699367927804282 degC per count
+ *     O = 24.278675562847848 degC
+ *   (a signed 16-bit count stored unsigned: a count of 2^15 or more is taken minus 2^16
+ *   first).
  *
  * THE MODEL (coefficients rounded here for reading)
  *   B = 5977.622559 + 6.630196531*f - 1.673337498*f^2   [deg/h]
