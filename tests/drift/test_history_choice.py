@@ -11,7 +11,7 @@ import pytest
 
 from hrgtc.pipeline.terms import ALL_IN, add_history
 
-CANDIDATES = ("f", "f^2", "f^3", "g", "f*g")
+CANDIDATES = ("f", "f^2", "f^3", "g", "f*g", "f^2*g")
 
 
 def _model(selected, score, width=0.0, candidates=CANDIDATES):
@@ -46,9 +46,10 @@ class _Fits:
         return _model(terms, score, width, self.candidates)
 
 
-def test_play_goes_on_top_of_both_selections_at_the_width_that_scores_lowest():
-    # the selection with play offered drops f^3 (play stands in for it) and finds f*g
-    fits = _Fits(("f", "f^2", "f^3", "g"), 0.33, {1.0: 0.32, 2.0: 0.30, 4.0: 0.31},
+def test_play_with_the_base_powers_of_f_and_the_rest_chosen_with_play_offered():
+    # offered play, the selection drops f^3 (play stands in for it) and f^2*g (which
+    # stood in for the memory without play) and finds f*g
+    fits = _Fits(("f", "f^2", "f^3", "g", "f^2*g"), 0.33, {1.0: 0.32, 2.0: 0.30, 4.0: 0.31},
                  offered=("f", "f^2", "g", "f*g", "play"))
     choice = add_history(fits, (1.0, 2.0, 4.0))
     assert choice.added == ("play",)

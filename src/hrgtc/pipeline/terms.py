@@ -117,19 +117,21 @@ def add_history(fit: Callable[[Mapping[str, Any]], Any],
     leave-one-run-out (docs/history.md, "Why the worst runs").
 
     The base model is ``fit({})``. At each play width of ``widths``
-    (:func:`hrgtc.drift.variables.play.learn_width`), the terms are chosen again with
+    (:func:`hrgtc.drift.variables.play.learn_width`) the terms are chosen again with
     ``play`` among the candidates, and the model refitted (:data:`ALL_IN`: no third
-    choice) on every term either choice kept, and ``play``; the width whose model has the
-    lowest leave-one-run-out score is taken, and its model kept if that score beats the
-    base model's. ``gsat`` is then tried on top of the model kept, on the same rule,
-    where the base fit had the gradient ``g`` among its candidates (every run logs
-    ``housing_c``).
+    choice) on those terms, the powers of ``f`` the base model chose, and ``play``; the
+    width whose model has the lowest leave-one-run-out score is taken, and its model kept
+    if that score beats the base model's. ``gsat`` is then tried on top of the model kept,
+    on the same rule, where the base fit had the gradient ``g`` among its candidates
+    (every run logs ``housing_c``).
 
-    Why both choices: on a campaign of soaks that all start at one temperature and ramps
-    at one rate, ``play`` is nearly ``-w/2 sign(T - T_start)`` on the soaks and
-    ``-w/2 sign(dT/dt)`` on the ramps; the choice with ``play`` offered lets it stand in
-    for ``f^3`` (which held-out runs at other rates then punish), and the base choice,
-    without ``play``, may miss a term that ``play`` reveals (``f*g``).
+    Why the powers of ``f`` of the base choice: on a campaign of soaks that all start at
+    one temperature and ramps at one rate, ``play`` is nearly ``-w/2 sign(T - T_start)``
+    on the soaks and ``-w/2 sign(dT/dt)`` on the ramps. Offered with the others, it stands
+    in for an odd power of ``f`` (``f^3`` dropped), which held-out runs at other rates then
+    punish; chosen without it, the gradient terms stand in for the memory (a spurious
+    ``f^2*g``). So the level in ``f`` comes from the choice without ``play``, the rest
+    from the choice with it.
 
     Parameters
     ----------
@@ -157,10 +159,11 @@ def add_history(fit: Callable[[Mapping[str, Any]], Any],
     models: dict[float, Any] = {}
 
     candidates = (*drift(base).candidates, "play")
+    powers = {t.name for t in parse_terms(selected) if set(t.variables) == {"f"}}
 
     def score(width: float) -> float:
         offered = drift(fit({"terms": candidates, "play_width_c": width})).selected
-        keep = {*selected, *offered, "play"}
+        keep = {*offered, *powers, "play"}
         terms = tuple(t for t in candidates if t in keep)
         models[width] = fit({**ALL_IN, "terms": terms, "play_width_c": width})
         scores[f"play w={width:g}"] = _score(drift(models[width]))
