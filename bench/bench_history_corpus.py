@@ -4,9 +4,10 @@ held out, and no real file's held-out figure worse than without it.
 For each file of ``tests/real_corpus.py`` the path of ``tests/test_real_corpus.py`` (calibrate
 on the first 60 % of the time, compensate the rest, the held-out still periods' 60 s means
 less each period's mean, as a ratio to the numpy line): today's model, then
-:func:`hrgtc.pipeline.terms.add_history` on each axis (``play`` on top of the axis's
-selection, kept only where the leave-one-run-out score beats today's), and, to show what the
-keep rule decides, ``play`` forced on top of today's terms at the default width::
+:func:`hrgtc.pipeline.terms.add_history` on each axis (a history term kept only where the
+leave-one-run-out score beats today's; with one training run there is none, and nothing is
+kept), and, to show what the keep rule decides, ``play`` forced on top of today's terms at
+the default width::
 
     PYTHONPATH=src python bench/bench_history_corpus.py            # every file
     PYTHONPATH=src python bench/bench_history_corpus.py vn100      # one
