@@ -15,11 +15,12 @@ interval (seeds resampled, 2000 draws); with ``--terms=...`` (candidates beyond 
 default, e.g. ``--terms=f,f^2,f^3,df,f*df,g,play``) also the paired line: the median over
 seeds of (ratio with the terms) / (ratio with the default candidates), with its interval.
 
-With ``--history``: today's candidates plus ``gsat`` and ``play``, the play's width learned
-per seed from a grid (``--widths=1,2,4``; default
-:data:`hrgtc.drift.variables.play.WIDTHS_C`) by the fits' leave-one-run-out score, and the
-model with them kept only where that score beats today's model's (the rows say
-``play_width_c``, ``kept`` and both scores); the paired line compares the two. With
+With ``--history``: :func:`hrgtc.pipeline.terms.add_history`, the estimator's history
+step: ``play`` added on top of today's selection, its width learned per seed from a grid
+(``--widths=1,2,4``; default :data:`hrgtc.drift.variables.play.WIDTHS_C`) by the fits'
+leave-one-run-out score, then ``gsat``, each kept only where that score beats the model
+without it (the rows say ``play_width_c``, ``kept``, ``added`` and both scores); the
+paired line compares it with today's model. With
 ``--train-cycle`` the training runs also hold a cycle that turns round
 (:data:`TRAIN_CYCLE`), which shows the play's width whatever the history.
 
@@ -51,27 +52,35 @@ TRAIN_CYCLE = {"name": "train_cycle", "start_c": 20.0, "segments": [
 TARGET = 1.15
 
 
-def _unit(seed: int, k: int):
-    """unit-play with the play's power-on state drawn for run ``k`` of ``seed``."""
+#: Run keys of :func:`_campaign`: the held-out runs, and every run (soaks 10-16).
+HELDOUT_KEYS = (3, 4, 5)
+ALL_KEYS = (1, 2, 3, 4, 5, 6, *range(10, 17))
+
+
+def _unit(seed: int, k: int, known: bool = False):
+    """unit-play with the play's power-on state drawn for run ``k`` of ``seed`` (``known``:
+    at the run's first temperature, where the model's power-on rule puts it)."""
     from hrgtc.simulate import units
 
     base = units.get("unit-play")
     half = 0.5 * base.bias_law.play_width_c
     offset = float(np.random.default_rng([seed, k]).uniform(-half, half))
-    return replace(base, bias_law=replace(base.bias_law, play_initial_offset_c=offset))
+    return replace(base, bias_law=replace(base.bias_law,
+                                          play_initial_offset_c=0.0 if known else offset))
 
 
 def _campaign(seed: int, folder: Path, fs: float, hours: float,
-              train_cycle: bool = False) -> dict:
+              train_cycle: bool = False, known: tuple[int, ...] = ()) -> dict:
     """The seed's files: soaks, training runs (with :data:`TRAIN_CYCLE` if asked), held-out
-    runs."""
+    runs; the runs whose key is in ``known`` start with the play's state known (the same
+    noise: a paired comparison)."""
     from hrgtc.simulate import simulate_files
     from hrgtc.simulate import standard_profiles as profiles
     from hrgtc.simulate.profiles import from_mapping
 
     def sim(profile, name, k):
         return Path(simulate_files([profile], folder / f"{seed}-{name}", "parquet",
-                                   unit=_unit(seed, k), sample_rate_hz=fs,
+                                   unit=_unit(seed, k, k in known), sample_rate_hz=fs,
                                    seed=100 * seed + k)[0].path)
 
     soaks = [sim(profiles.soak(sp, hours), f"soak{k}", 10 + k)
@@ -119,26 +128,19 @@ def _fit_and_measure(files: dict, options: dict, fs: float, seed: int) -> list[d
     return _rows(_fit(files, options), files, fs, seed)
 
 
-def _history_fits(files: dict, terms: tuple[str, ...], widths: tuple[float, ...], fs: float,
-                  seed: int) -> tuple[list[dict], list[dict]]:
-    """Rows of today's model and of the model with the history terms offered: the play's
-    width learned from ``widths`` by leave-one-run-out (:func:`learn_width`), the model
-    kept only when its leave-one-run-out score beats today's."""
-    from hrgtc.drift.variables.play import learn_width
+def _history_fits(files: dict, widths: tuple[float, ...], fs: float, seed: int
+                  ) -> tuple[list[dict], list[dict]]:
+    """Rows of today's model and of the model with the history terms added on top of its
+    selection, each kept only where it wins leave-one-run-out
+    (:func:`hrgtc.pipeline.terms.add_history`, the play's width learned from ``widths``)."""
+    from hrgtc.pipeline.terms import add_history
 
-    today = _fit(files, {})
-    models = {}
-
-    def score(width: float) -> float:
-        models[width] = _fit(files, {"terms": terms, "play_width_c": width})
-        return _loro(models[width])
-
-    width, scores = learn_width(score, widths)
-    kept = scores[width] < _loro(today)
-    chosen = models[width] if kept else today
-    extra = {"play_width_c": width, "kept": kept, "loro_today": round(_loro(today), 4),
-             "loro_history": round(scores[width], 4)}
-    return _rows(today, files, fs, seed), _rows(chosen, files, fs, seed, **extra)
+    choice = add_history(lambda options: _fit(files, options), widths)
+    extra = {"play_width_c": choice.play_width_c, "kept": bool(choice.added),
+             "added": list(choice.added), "loro_today": round(choice.scores["base"], 4),
+             "loro_history": round(_loro(choice.model), 4)}
+    return (_rows(choice.base, files, fs, seed),
+            _rows(choice.model, files, fs, seed, **extra))
 
 
 def _interval(values: list[float], rng: np.random.Generator, draws: int = 2000
@@ -201,7 +203,7 @@ def _paired(before: list[dict], after: list[dict], label: str) -> list[dict]:
     return out
 
 
-def history(seeds: tuple[int, ...], terms: tuple[str, ...], widths: tuple[float, ...],
+def history(seeds: tuple[int, ...], widths: tuple[float, ...],
             fs: float = 1.0, hours: float = 5.0, train_cycle: bool = False,
             ) -> dict[str, tuple[list[dict], float]]:
     """Rows of today's model and of the history terms' (see :func:`_history_fits`)."""
@@ -210,7 +212,7 @@ def history(seeds: tuple[int, ...], terms: tuple[str, ...], widths: tuple[float,
     with tempfile.TemporaryDirectory() as tmp:
         for seed in seeds:
             files = _campaign(seed, Path(tmp), fs, hours, train_cycle)
-            today, after = _history_fits(files, terms, widths, fs, seed)
+            today, after = _history_fits(files, widths, fs, seed)
             rows["default"].extend(today)
             rows["history"].extend(after)
     seconds = time.perf_counter() - start
@@ -248,12 +250,11 @@ if __name__ == "__main__":
                 "terms": terms}
     if "--history" in sys.argv:  # today's candidates + gsat + play, the width learned
         from hrgtc.drift.variables.play import WIDTHS_C
-        from hrgtc.settings.drift import GRADIENT_TERMS
 
         widths = next((tuple(float(w) for w in a.split("=", 1)[1].split(","))
                        for a in sys.argv if a.startswith("--widths=")), WIDTHS_C)
-        results = history(tuple(range(1, count + 1)), (*GRADIENT_TERMS, "gsat", "play"),
-                          widths, train_cycle="--train-cycle" in sys.argv)
+        results = history(tuple(range(1, count + 1)), widths,
+                          train_cycle="--train-cycle" in sys.argv)
     else:
         results = heldout(tuple(range(1, count + 1)), option_sets)
     for label, (rows, seconds) in results.items():
