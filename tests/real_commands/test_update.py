@@ -1,13 +1,12 @@
 """``hrgtc update`` on real files, with the column mapping and units only.
 
-* The cold test (a chamber cooling; 5 s bursts every 5 min): with the model's map to °C given
-  by hand, the update is refused for the true reason, a ramp (numpy finds the chamber cooling
-  faster than the limit between nearly every pair of bursts). Without it -- the model file
-  holds the map, as ``compensate`` reads it -- the update reads the raw count as °C: a known
-  defect of ``hrgtc.update`` (strict xfail, see the reason).
+* The cold test (a chamber cooling; 5 s bursts every 5 min): the update reads the raw count
+  through the model file's map to °C (as ``compensate`` does) and is refused for the true
+  reason, a ramp (numpy finds the chamber cooling faster than the limit between nearly
+  every pair of bursts).
 * The VN-100 file (at rest for 1000 s and more at a time, its README): the update must not
-  say that the unit moved throughout (strict xfail: the motion detector's still periods are
-  cut at every late record, each piece shorter than a 600 s block).
+  say that the unit moved throughout (the motion detector's still periods were once cut at
+  every late record, each piece shorter than a 600 s block).
 """
 
 from __future__ import annotations
@@ -16,7 +15,6 @@ import json
 from pathlib import Path
 
 import numpy as np
-import pytest
 from typer.testing import CliRunner
 
 from hrgtc.cli import app
@@ -58,19 +56,11 @@ def test_a_cooling_chamber_is_refused_as_a_ramp(pan_model, tmp_path):
     assert float(said.split("(up to ")[1].split(" °C/h")[0]) > 2.0, said
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "hrgtc.update reads the recordings without the model's temperature_map (update/core.py "
-    "_read: read(item, read_options), not thermometry.reference.options_with_map as compensate "
-    "and evaluate do): a raw count is refused as '65236 °C is outside -200 to 500 °C'"))
 def test_the_update_reads_the_count_through_the_model_s_map(pan_model, tmp_path):
     code, said = _update(pan_model, RUN, *MAPPING, *BLOCK, "-o", tmp_path / "pan-2.json")
     assert code == 2 and "a ramp posing as ageing" in said, said
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "MotionMask.still_periods cuts a still period at every segment break (a time step over "
-    "2 median periods: the VN-100's late records), and update/core.py calls the pieces "
-    "shorter than --block-s 'no still period (the unit moved throughout)'"))
 def test_a_logger_at_rest_for_an_hour_is_not_said_to_move_throughout(pan_model, tmp_path):
     # any three-axis sensor model will do: the still periods are the file's
     _, said = _update(pan_model, VN100, *VN100_MAPPING, "-o", tmp_path / "vn-2.json")

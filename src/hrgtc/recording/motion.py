@@ -193,15 +193,18 @@ class MotionMask:
         """Samples marked for each reason (a sample may count under several)."""
         return {r: int(np.count_nonzero(m)) for r, m in self.reasons.items()}
 
-    def still_periods(self, min_s: float = 0.0, time_s: np.ndarray | None = None
-                      ) -> list[tuple[int, int]]:
+    def still_periods(self, min_s: float = 0.0, time_s: np.ndarray | None = None,
+                      join_gap_s: float = 0.0) -> list[tuple[int, int]]:
         """Index ranges ``[start, stop)`` of contiguous still samples inside one segment.
 
-        With ``time_s``, periods shorter than ``min_s`` seconds are left out. This is
-        what an in-field update of the bias uses.
+        With ``time_s``, periods shorter than ``min_s`` seconds are left out, and a break
+        of the time axis no longer than ``join_gap_s`` (a dropout: a late or lost record)
+        does not cut a period. This is what an in-field update of the bias uses.
         """
         still = self.still.astype(np.int8)
         breaks = np.flatnonzero(self.breaks) + 1
+        if time_s is not None and join_gap_s > 0.0 and breaks.size:
+            breaks = breaks[time_s[breaks] - time_s[breaks - 1] > join_gap_s]
         edges = np.diff(np.concatenate([[0], still, [0]]))
         starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
         out: list[tuple[int, int]] = []

@@ -32,6 +32,7 @@ import numpy as np
 from hrgtc.core.errors import InputError, UpdateRefusedError
 from hrgtc.recording import Recording
 from hrgtc.settings import to_dict
+from hrgtc.settings.reading import DROPOUT_S
 from hrgtc.settings.update import EARTH_RATE_BOUND_DPH, UpdateSettings
 from hrgtc.update.kalman import (
     Walk,
@@ -100,13 +101,15 @@ def update_model(model: Any, recordings: Any, settings: UpdateSettings | None = 
             raise UpdateRefusedError(
                 f"{label}: already used by the update that made this model (as {used[digest]}, "
                 "same SHA-256): a recording counts once")
-    found = [_periods(recording, model.axes, settings, still_s, label)
+    dropout_s = getattr(read_options, "dropout_s", DROPOUT_S)
+    found = [_periods(recording, model.axes, settings, still_s, label, dropout_s)
              for label, _, recording in runs]
     data = tuple(LineageData(label, digest, intervals, source) for (label, digest, _),
                  (_, intervals, source) in zip(runs, found, strict=True))
     if not any(d.intervals_s for d in data):
-        return UpdateResult(None, False, f"{', '.join(labels)}: no still period (the unit "
-                            "moved throughout): nothing changed")
+        return UpdateResult(None, False, f"{', '.join(labels)}: no still period of a block "
+                            f"(block_s {settings.block_s:g} s) or longer: the unit moved "
+                            "throughout, or was still only for shorter times; nothing changed")
     settled = {name: _settled([b for index, ((_, _, recording), (periods, _, _)) in enumerate(
                    zip(runs, found, strict=True)) for b in _axis_blocks(
                        index, _view(recording, name), part, periods, settings)],
@@ -231,8 +234,10 @@ def _read(item: Any, read_options: Any, model: Any) -> tuple[str, str, Recording
             name.encode("utf-8") + np.ascontiguousarray(item[name]).tobytes()
             for name in item.names)).hexdigest()
     else:
-        label = str(item)
-        recording = read(item, read_options)
+        from hrgtc.thermometry.reference import options_with_map
+
+        label = str(item)  # a raw count read through the model's map to °C, as compensate
+        recording = read(item, options_with_map(read_options, model.temperature_map))
         digest = file_sha256(item)
     unit = recording.metadata.unit
     if unit not in ("", "unknown", None) and model.unit not in ("", "unknown") \
@@ -251,7 +256,7 @@ def _read(item: Any, read_options: Any, model: Any) -> tuple[str, str, Recording
 
 
 def _periods(recording: Recording, axes: Any, settings: UpdateSettings,
-             still_s: Sequence[tuple[float, float]] | None, label: str
+             still_s: Sequence[tuple[float, float]] | None, label: str, dropout_s: float
              ) -> tuple[list[tuple[int, int]], tuple[tuple[float, float], ...], str]:
     """The still periods of one recording (index ranges, shared by every axis: motion on
     any axis is motion), their times [s] and where they came from."""
@@ -267,7 +272,8 @@ def _periods(recording: Recording, axes: Any, settings: UpdateSettings,
             else view.metadata.input_rate_dph) for name, view in views.items()}
         accel = {c: recording[c] for c in ACCEL_COLUMNS if c in recording.names}
         mask = detect_motion(time_s, rates, accel=accel or None)
-        periods, source = mask.still_periods(settings.block_s, time_s), "motion"
+        # a dropout (a late record) does not end a still period
+        periods, source = mask.still_periods(settings.block_s, time_s, dropout_s), "motion"
     return periods, tuple((float(time_s[a]), float(time_s[b - 1])) for a, b in periods), source
 
 
@@ -334,7 +340,8 @@ def _prior(model: Any, name: str, terms: tuple[str, ...],
 def _filter_axis(model: Any, name: str, blocks: list[StillBlock], terms: tuple[str, ...],
                  settings: UpdateSettings, labels: list[str]) -> AxisUpdate:
     """The filter over the blocks of axis ``name``, its guards, and the axis's figures."""
-    where = ", ".join(dict.fromkeys(labels))  # a recording's orientations share its name
+    on = f" (axis {name})" if name else ""
+    where = ", ".join(dict.fromkeys(labels)) + on  # a recording's orientations share its name
     values, prior = _prior(model, name, terms, settings)
     problem = _problem(model.axes[name], blocks, terms, prior, settings)
     n_model, runs = problem.n_model, np.array([b.run for b in blocks])
@@ -346,12 +353,12 @@ def _filter_axis(model: Any, name: str, blocks: list[StillBlock], terms: tuple[s
             f"{2 * settings.holdout_every}); record longer still periods")
     whole = _solve(problem, slice(None))
     sigma = math.sqrt(float(np.median(problem.r)))
-    jump, where = jump_statistic(problem.z - problem.rows @ whole.mean,
-                                 stretches(blocks, settings.block_s), sigma)
+    jump, at = jump_statistic(problem.z - problem.rows @ whole.mean,
+                              stretches(blocks, settings.block_s), sigma)
     if jump > settings.jump_sigma:
-        block = blocks[where]
+        block = blocks[at]
         raise UpdateRefusedError(
-            f"{labels[block.run]}: the still residual steps by {jump:.3g} standard errors "
+            f"{labels[block.run]}{on}: the still residual steps by {jump:.3g} standard errors "
             f"within the run near t = {block.start_s:g} s (limit {settings.jump_sigma:g}): a "
             "jump is not ageing; update from a recording without it")
     step = mahalanobis(whole.mean[:n_model], prior)
