@@ -181,3 +181,36 @@ def test_only_reads_the_detectors_columns_of_every_axis(tmp_path):
     part = next(recording_io.iter_chunks(sensor, chunk_rows=CHUNK, only=DETECTOR_COLUMNS,
                                          thermometer="sensor", validate=False))
     assert set(part.names) == {"time_s", "rate_dph", "freq_hz", "temperature_c"}
+
+
+@pytest.mark.parametrize("column", [False, True])
+def test_take_with_a_known_input_rate(column):
+    """A known input rate (the metadata's, or an ``input_rate_dph`` column) is subtracted
+    in the detector's own buffer (no second array of the run's length): the flags are
+    ``run_rest``'s, the chunks handed in are not changed, equal chunks pass and a changed
+    rate is still refused."""
+    import dataclasses
+
+    run = handled()
+    if column:
+        run = run.with_columns(input_rate_dph=np.where(run.time_s > run.time_s[0] + 900.0,
+                                                       54.0, 0.0))
+    else:
+        run = Recording(dict(run.columns), dataclasses.replace(run.metadata,
+                                                               input_rate_dph=15.0))
+    run = run.with_columns(rate_dph=run.rate_dph + (run["input_rate_dph"] if column else 15.0))
+    kept = run.rate_dph.copy()
+    expected = run_rest(chunks_of(run), "exclude").keep
+    flags = RestFlags(chunks_of(run), [""], "exclude", "run.parquet")
+    assert np.array_equal(run.rate_dph, kept)  # the pass's own copy was changed
+    assert np.array_equal(flags.still[""], expected) and np.count_nonzero(~expected) > 3 * 50
+    np.testing.assert_array_equal(
+        np.concatenate([flags.take(c)["at_rest"] for c in chunks_of(run)]),
+        expected.astype(float))
+    flags.finish()
+    changed = run.rate_dph.copy()
+    changed[CHUNK + 5] += 1e-9
+    flags = RestFlags(chunks_of(run), [""], "exclude", "run.parquet")
+    flags.take(run.slice(0, CHUNK))
+    with pytest.raises(FlagsMisaligned, match="rate_dph"):
+        flags.take(run.with_columns(rate_dph=changed).slice(CHUNK, 2 * CHUNK))

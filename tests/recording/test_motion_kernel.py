@@ -173,3 +173,36 @@ def test_difference_medians_are_numpys(mode):
         value, count = _difference_median(x, breaks, mode, 0.25)
         assert count == selected.size
         assert value == np.median(selected)
+
+
+def test_steps_over_is_numpys():
+    """The dropouts (steps longer than a limit) as ``np.flatnonzero(np.diff(t) > limit)``,
+    with backward steps, repeated times and a NaN time."""
+    rng = np.random.default_rng(11)
+    time_s = np.cumsum(rng.exponential(0.01, 200_000))
+    time_s[[50, 9_000, 150_000]] += [5.0, -3.0, 0.0]
+    time_s[77] = time_s[76]
+    time_s[120_000] = np.nan
+    for limit in (0.0, 0.02, 0.05, 1.0, 10.0):
+        expected = np.flatnonzero(np.diff(time_s) > limit)
+        found = kernel.steps_over(time_s, limit)
+        assert found.dtype == expected.dtype and np.array_equal(found, expected), limit
+    for short in (np.zeros(0), np.ones(1), np.array([0.0, 7.0])):
+        assert np.array_equal(kernel.steps_over(short, 1.0),
+                              np.flatnonzero(np.diff(short) > 1.0))
+
+
+@pytest.mark.parametrize("input_rate", ["table", 10.0])
+def test_the_input_rate_subtracted_in_place(input_rate):
+    """``overwrite=True`` subtracts the known input rate in the caller's array (which then
+    holds the rate the level test reads) and finds the masks of the reference."""
+    t, rate, _, _ = handled(bursts=3)
+    table = np.where(t > 3600.0, 36.0, 0.0) if input_rate == "table" else input_rate
+    mine = rate + table
+    expected = same_masks(t, mine, input_rate=table)
+    found = detect_motion(t, mine, input_rate=table, overwrite=True)
+    assert found.n_moving == expected.n_moving > 0
+    assert np.array_equal(found.moving, expected.moving)
+    for reason in expected.reasons:
+        assert np.array_equal(found.reasons[reason], expected.reasons[reason]), reason
+    np.testing.assert_array_equal(mine, (rate + table) - table)  # bit for bit

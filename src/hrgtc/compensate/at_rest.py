@@ -32,8 +32,9 @@ the pass does not read (a gap of a slow channel, ``--spikes drop``, a duplicated
 told from a duplicated time by its other values). So the flags are never trusted to
 line up: :meth:`RestFlags.take` compares the detector's columns of each chunk the
 compensating pass reads with those the detector saw at the same rows, bit for bit, and
-the row counts at the end; equal columns give the detector the same input, hence the
-same flags. A difference raises :class:`FlagsMisaligned`, on which
+the row counts at the end (the rate as the detector read it: minus the known input rate,
+which the pass subtracts in place); equal columns give the detector the same input,
+hence the same flags. A difference raises :class:`FlagsMisaligned`, on which
 :func:`~hrgtc.compensate.file_pass.compensate_file` discards its output and starts again
 with the pass reading every column (a slower, correct run, never misaligned flags).
 """
@@ -47,7 +48,7 @@ import numpy as np
 from hrgtc.core.errors import CalibrationError, InputError
 from hrgtc.drift.rest import RestPass
 from hrgtc.recording import Recording, axis_view
-from hrgtc.recording.motion import ACCEL_COLUMNS
+from hrgtc.recording.motion import ACCEL_COLUMNS, detector_rate
 
 __all__ = ["AT_REST_COLUMN", "DETECTOR_COLUMNS", "FlagsMisaligned", "RestFlags", "rest_columns"]
 
@@ -107,14 +108,15 @@ class RestFlags:
         self.rows = 0  # rows handed out so far
 
     def _find(self, chunks: Iterable[Recording]) -> dict[str, np.ndarray]:
-        passes = {axis: RestPass(self._policy, name=self._name, rows=self._rows)
-                  for axis in self.axes}
+        passes = {axis: RestPass(self._policy, name=self._name, rows=self._rows,
+                                 in_place=True) for axis in self.axes}
         for chunk in chunks:
             for axis, rest in passes.items():
                 view = axis_view(chunk, axis) if axis else chunk
                 rest.partial_fit(Recording({k: view[k] for k in DETECTOR_COLUMNS if k in view},
                                            view.metadata, view.source))
         self._seen = {axis: rest.columns for axis, rest in passes.items()}  # for take()
+        self._input = {axis: rest.input_rate for axis, rest in passes.items()}
         return {axis: rest.finish().keep for axis, rest in passes.items()}
 
     @property
@@ -141,11 +143,22 @@ class RestFlags:
                 self._misaligned(f"columns {sorted(theirs)} to compensate but {sorted(seen)} "
                                  "to the detector")
             for name, values in seen.items():
-                if (name != "time_s" or i == 0) and not _same(view[name], values[start:stop]):
+                if (name != "time_s" or i == 0) and not _same(
+                        self._read(view, name, axis, start), values[start:stop]):
                     self._misaligned(f"other values of {name} in rows {start}-{stop - 1}")
             flags[column] = still[start:stop].astype(np.float64)
         self.rows = stop
         return flags
+
+    def _read(self, view: Recording, name: str, axis: str, start: int) -> np.ndarray:
+        """A detector column of the chunk as the detector read it: the rate minus the input
+        rate (the pass subtracted it in place, ``RestPass(in_place=True)``)."""
+        if name != "rate_dph":
+            return view[name]
+        seen = self._seen[axis].get("input_rate_dph")
+        known = self._input[axis] if seen is None else seen[start:start + len(view)]
+        rate = np.asarray(view[name], dtype=np.float64)
+        return detector_rate(rate, known)
 
     def finish(self) -> None:
         """Check that every row the detector saw was compensated (after the last

@@ -75,16 +75,21 @@ class RestPass:
 
     The columns go into buffers of ``rows`` samples (grown if a run has more), so the
     chunks are not held: the memory is the columns once (a fresh large array costs
-    its page faults, ``docs/benchmarks.md``). Parameters as :func:`run_rest`'s.
+    its page faults, ``docs/benchmarks.md``). Parameters as :func:`run_rest`'s, and
+    ``in_place``: the detector subtracts the input rate from the ``rate_dph`` buffer itself
+    (no second array of the run's length), so that :attr:`columns` then holds the rate the
+    detector read (:func:`hrgtc.recording.motion.detector_rate`), not the file's.
     """
 
     #: The columns gathered (those of them a chunk has).
     WANTED = ("time_s", "rate_dph", "freq_hz", "input_rate_dph", *ACCEL_COLUMNS)
 
     def __init__(self, policy: str = "exclude", settings: MotionSettings | None = None,
-                 warmup_s: float = 0.0, name: str = "", rows: int | None = None) -> None:
+                 warmup_s: float = 0.0, name: str = "", rows: int | None = None,
+                 in_place: bool = False) -> None:
         self.policy = check_policy(policy)
         self.settings, self.warmup_s, self.source = settings, warmup_s, name
+        self.in_place = in_place
         self.rows = max(int(rows or 0), 0)
         self.input_rate = 0.0
         self._buffers: dict[str, np.ndarray] = {}
@@ -128,7 +133,7 @@ class RestPass:
         columns = self.columns
         self._buffers, self._filled = {}, {}
         return _run_rest(columns, self.policy, self.settings, warmups_s, self.source,
-                         self.input_rate)
+                         self.input_rate, self.in_place)
 
 
 def run_rest(chunks: Any, policy: str = "exclude", settings: MotionSettings | None = None,
@@ -156,7 +161,8 @@ def run_rest(chunks: Any, policy: str = "exclude", settings: MotionSettings | No
 
 
 def _run_rest(columns: dict[str, np.ndarray], policy: str, settings: MotionSettings | None,
-              warmups_s: Sequence[float], source: str, input_rate: float) -> list[RunRest]:
+              warmups_s: Sequence[float], source: str, input_rate: float,
+              in_place: bool = False) -> list[RunRest]:
     if not columns:
         return [RunRest(source, np.zeros(0, dtype=bool)) for _ in warmups_s]
     time_s = columns["time_s"]
@@ -167,7 +173,8 @@ def _run_rest(columns: dict[str, np.ndarray], policy: str, settings: MotionSetti
         mask = detect_motion(
             time_s, {"rate_dph": columns["rate_dph"]},
             accel={c: columns[c] for c in ACCEL_COLUMNS if c in columns} or None,
-            input_rate=columns.get("input_rate_dph", input_rate), settings=settings)
+            input_rate=columns.get("input_rate_dph", input_rate), settings=settings,
+            overwrite=in_place)
         keep = mask.still
         if policy == "error" and mask.n_moving:
             first = int(np.flatnonzero(mask.moving)[0])

@@ -12,7 +12,8 @@ or two passes over the samples instead of a numpy temporary per step:
 - :func:`segment_tests`: the level, variance and clipping tests of one channel over
   one segment (block medians, their running median, the interpolated baseline, the
   runs of at least ``min_run`` samples), OR-ed into the reason masks;
-- :func:`guard`: the guard around each run, inside its segment.
+- :func:`guard`: the guard around each run, inside its segment;
+- :func:`steps_over`: the time steps longer than a limit (the dropouts).
 
 The median of an even count is the mean of the two middle values, ``(a + b) / 2``,
 as ``np.median`` computes it (a zero's sign may differ where both middle values are
@@ -205,6 +206,17 @@ def find_breaks(time_s: np.ndarray, gap_s: float) -> np.ndarray:
         step = time_s[i + 1] - time_s[i]
         out[i] = (step > gap_s) | (step <= 0)
     return out
+
+
+@njit(**_JIT)
+def steps_over(time_s: np.ndarray, limit: float) -> np.ndarray:
+    """``np.flatnonzero(np.diff(time_s) > limit)`` without the differences' array."""
+    out = np.empty(max(time_s.size - 1, 0), dtype=np.int64)  # touched only as far as kept
+    kept = 0
+    for i in range(out.size):
+        out[kept] = i
+        kept += (time_s[i + 1] - time_s[i]) > limit
+    return out[:kept].copy()
 
 
 @njit(**_JIT)

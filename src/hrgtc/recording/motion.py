@@ -375,6 +375,16 @@ def _prepare(name: str, values: np.ndarray, breaks: np.ndarray) -> _Channel:
 
 
 # --------------------------------------------------------------------------- detection
+def detector_rate(rate: np.ndarray, input_rate: Any, out: np.ndarray | None = None
+                  ) -> np.ndarray:
+    """The rate the level test reads: ``rate`` minus the known ``input_rate`` (a number or
+    one per sample; ``rate`` itself when None or 0), into ``out`` if given (it may be
+    ``rate``)."""
+    if input_rate is None or (np.ndim(input_rate) == 0 and input_rate == 0):
+        return rate
+    return np.subtract(rate, np.asarray(input_rate, dtype=np.float64), out=out)
+
+
 def detect_motion(
     time_s: Any,
     rates: Mapping[str, Any] | Any,
@@ -382,6 +392,7 @@ def detect_motion(
     accel: Mapping[str, Any] | None = None,
     input_rate: Any = None,
     settings: MotionSettings | None = None,
+    overwrite: bool = False,
 ) -> MotionMask:
     """Mark the samples of a recording that are not at rest.
 
@@ -399,6 +410,10 @@ def detect_motion(
         before the level test: a rate table's steps are not motion. [unit of ``rates``]
     settings
         Thresholds and windows (:class:`MotionSettings`).
+    overwrite
+        The rate arrays (float64, contiguous) are the caller's to change: the input rate
+        is subtracted in place (:func:`detector_rate`) instead of into a new array (a
+        fresh array of a long recording costs its page faults, ``docs/benchmarks.md``).
 
     Returns
     -------
@@ -423,9 +438,8 @@ def detect_motion(
     channels = dict(rates) if isinstance(rates, Mapping) else {"rate": rates}
     arrays: dict[str, np.ndarray] = {}
     for name, values in channels.items():
-        arrays[name] = np.ascontiguousarray(values, dtype=np.float64)
-        if input_rate is not None and not (np.ndim(input_rate) == 0 and input_rate == 0):
-            arrays[name] = arrays[name] - np.asarray(input_rate, dtype=np.float64)
+        values = np.ascontiguousarray(values, dtype=np.float64)
+        arrays[name] = detector_rate(values, input_rate, values if overwrite else None)
     accel_names = []
     for name, values in dict(accel or {}).items():
         arrays[name] = np.ascontiguousarray(values, dtype=np.float64)
@@ -482,7 +496,7 @@ def detect_motion(
     kernel.guard(found, starts, stops, after, before, moving, reasons["guard"])  # never
     # across a gap
     # stretches judged across dropouts (a lost record is no pause between handlings)
-    joined = np.flatnonzero(np.diff(time_s) > max(GAP_FACTOR * period, DROPOUT_S)) + 1
+    joined = kernel.steps_over(time_s, max(GAP_FACTOR * period, DROPOUT_S)) + 1
     _short_still(time_s, moving, np.r_[0, joined], np.r_[joined, n], s.min_still_s,
                  s.guard_s + s.guard_before_s + HANDLING_S, reasons["short_still"])
     noise = {c.name: c.sigma for c in prepared}
