@@ -22,8 +22,10 @@ process's own (``wait4``).
   default options and with ``--motion keep`` against ``bench/plain_compensate.py``, a
   pyarrow streaming script (goal <= 1).
 
-``--quick``: small sizes, 3 repeats. With ``HRGTC_BENCH_BEFORE=/path/to/src`` (the ``src``
-folder of an earlier checkout, e.g. ``git archive COMMIT src | tar -x -C /tmp/before``)
+``--quick``: small sizes, 3 repeats; ``--only help,allan,calibrate,compensate`` runs those
+lines only (``--repeats N`` sets the compensate line's repeats). With
+``HRGTC_BENCH_BEFORE=/path/to/src`` (the ``src`` folder of an earlier checkout, e.g.
+``git archive COMMIT src | tar -x -C /tmp/before``)
 every hrgtc command is also run from that tree in the same alternation, and each line
 gains ``before_seconds`` and ``before_ratio`` (and ``before_motion_keep_*``): before and
 after against the same reference in the same run.
@@ -239,17 +241,37 @@ def compensate_line(folder: Path, quick: bool, repeats: int) -> dict:
         samples=pq.ParquetFile(run.path).metadata.num_rows, goal_ratio=1.0)
 
 
-def run(quick: bool = False) -> list[dict]:
-    out = [help_line(7 if quick else 15)]
-    with tempfile.TemporaryDirectory() as tmp:
-        out.append(allan_line(Path(tmp), 1_000_000 if quick else 10_000_000, 3 if quick else 5))
-    with tempfile.TemporaryDirectory() as tmp:
-        out.append(calibrate_line(Path(tmp), quick, 3))
-    with tempfile.TemporaryDirectory() as tmp:
-        out.append(compensate_line(Path(tmp), quick, 3 if quick else 5))
+LINES = ("help", "allan", "calibrate", "compensate")
+
+
+def run(quick: bool = False, only: tuple[str, ...] = LINES,
+        compensate_repeats: int | None = None) -> list[dict]:
+    out = []
+    if "help" in only:
+        out.append(help_line(7 if quick else 15))
+    if "allan" in only:
+        with tempfile.TemporaryDirectory() as tmp:
+            out.append(allan_line(Path(tmp), 1_000_000 if quick else 10_000_000,
+                                  3 if quick else 5))
+    if "calibrate" in only:
+        with tempfile.TemporaryDirectory() as tmp:
+            out.append(calibrate_line(Path(tmp), quick, 3))
+    if "compensate" in only:
+        with tempfile.TemporaryDirectory() as tmp:
+            out.append(compensate_line(Path(tmp), quick, compensate_repeats
+                                       or (3 if quick else 5)))
     return out
 
 
+def _option(name: str) -> str | None:
+    return sys.argv[sys.argv.index(name) + 1] if name in sys.argv[:-1] else None
+
+
 if __name__ == "__main__":
-    for line in run(quick="--quick" in sys.argv):
+    only = tuple((_option("--only") or ",".join(LINES)).split(","))
+    if set(only) - set(LINES):
+        sys.exit(f"--only takes {', '.join(LINES)}, not {only}")
+    repeats = _option("--repeats")
+    for line in run(quick="--quick" in sys.argv, only=only,
+                    compensate_repeats=int(repeats) if repeats else None):
         print(json.dumps(line), flush=True)
