@@ -278,8 +278,8 @@ def _overlapping_deviation(
     values: np.ndarray, kind: str, factors: np.ndarray, fs: float,
     progress: Progress | None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Kept factors, deviations and term counts of an overlapping statistic (numba kernels)."""
-    from hrgtc.evaluation import _allan_kernels  # numba is imported on first use only
+    """Kept factors, deviations and term counts of an overlapping statistic."""
+    from hrgtc.evaluation import _allan_sums
 
     extra, span = _TERMS[kind]
     counts = values.size + extra - span * factors
@@ -294,9 +294,8 @@ def _overlapping_deviation(
     if progress is not None:
         for done in range(1, skipped + 1):
             progress(float(done), float(total))
-    sums = _allan_kernels.sums_of_squares(
-        np.ascontiguousarray(values), "modified" if kind == "time" else kind, kept, report
-    )
+    sums = _allan_sums.sums_of_squares(values, "modified" if kind == "time" else kind, kept,
+                                       report)
     counts = counts[counts > 1]
     return kept, deviation_from_sums(kind, sums, counts, kept, fs), counts
 
@@ -305,7 +304,7 @@ def deviation_from_sums(kind: str, sums: np.ndarray, counts: np.ndarray, factors
                         fs: float) -> np.ndarray:
     """The deviation of ``kind`` from its sums of squared stencil terms and their counts.
 
-    ``sums`` are those of :func:`_allan_kernels.sums_of_squares` (of ``"modified"`` for
+    ``sums`` are those of :func:`_allan_sums.sums_of_squares` (of ``"modified"`` for
     the time deviation); a pooled sum over segments divided by its pooled count gives the
     pooled deviation.
     """
