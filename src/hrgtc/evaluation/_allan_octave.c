@@ -28,6 +28,7 @@
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
+#include <limits.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdlib.h>
@@ -36,10 +37,10 @@
 #include <sys/mman.h>
 #endif
 
-#ifndef GROUP           /* octave levels fused into one pass over the work array (1-3) */
-#define GROUP 2
-#endif
+#define GROUP 2          /* octave levels fused into one pass over the work array (1 or 2;
+                            2 was faster than 1 and 3 at 10^7 samples, docs/benchmarks.md) */
 #define CHUNK 32768L     /* terms per partial sum: fixed, so the sums ignore the threads */
+#define SWEEP_M 4096L    /* groups from factors up to this one are swept together */
 #define MAX_THREADS 2
 #define MAX_LEVELS 62
 
@@ -58,7 +59,8 @@ typedef double v4 __attribute__((vector_size(32), aligned(8), may_alias));
  * `dst` point at the chunk's first term; dst (if not NULL) receives S_{2^L m}. */
 #define SPAN(L)                                                                         \
     static inline __attribute__((always_inline)) void span##L(                          \
-        const double *src, double *dst, double mu, long m, long count, double *out)     \
+        const double *src, double *dst, double mu, long m, long count, double *out,     \
+        const int shift)                                                                \
     {                                                                                   \
         v4 acc[L][2];                                                                   \
         double rest[L];                                                                 \
@@ -72,7 +74,8 @@ typedef double v4 __attribute__((vector_size(32), aligned(8), may_alias));
             for (int a = 0; a < 2; a++) {                                               \
                 v4 v[1 << L];                                                           \
                 for (int j = 0; j < (1 << L); j++)                                      \
-                    v[j] = *(const v4 *)(src + i + 4 * a + j * m) - vmu;                \
+                    v[j] = *(const v4 *)(src + i + 4 * a + j * m);                      \
+                for (int j = 0; j < (1 << L) && shift; j++) v[j] -= vmu;                \
                 for (int l = 0, n = 1 << L; l < L; l++) {                               \
                     v4 d = v[1] - v[0];                                                 \
                     acc[l][a] += d * d;                                                 \
@@ -84,7 +87,8 @@ typedef double v4 __attribute__((vector_size(32), aligned(8), may_alias));
         }                                                                               \
         for (; i < count; i++) {                                                        \
             double v[1 << L];                                                           \
-            for (int j = 0; j < (1 << L); j++) v[j] = src[i + j * m] - mu;              \
+            for (int j = 0; j < (1 << L); j++) v[j] = shift ? src[i + j * m] - mu       \
+                                                            : src[i + j * m];           \
             for (int l = 0, n = 1 << L; l < L; l++) {                                   \
                 double d = v[1] - v[0];                                                 \
                 rest[l] += d * d;                                                       \
@@ -101,17 +105,19 @@ typedef double v4 __attribute__((vector_size(32), aligned(8), may_alias));
 
 SPAN(1)
 SPAN(2)
-SPAN(3)
 
 CLONES static void chunk(const double *src, double *dst, double mu, long m, long count,
                          int levels, double *out)
 {
-    if (levels == 3)
-        span3(src, dst, mu, m, count, out);
+    /* mu = 0 (the groups after the first): no subtraction at all, 4 vector ops fewer */
+    if (levels == 2 && mu != 0.0)
+        span2(src, dst, mu, m, count, out, 1);
     else if (levels == 2)
-        span2(src, dst, mu, m, count, out);
+        span2(src, dst, mu, m, count, out, 0);
+    else if (mu != 0.0)
+        span1(src, dst, mu, m, count, out, 1);
     else
-        span1(src, dst, mu, m, count, out);
+        span1(src, dst, mu, m, count, out, 0);
 }
 
 /* One worker's share of a pass: chunks [c0, c1) of the terms [i0, i1). */
@@ -156,56 +162,105 @@ static void neumaier_add(Compensated *acc, double value)
     acc->sum = t;
 }
 
-/* The terms [i0, i1) of `levels` levels (from factor m) in one pass; their chunk sums
- * added to acc[0..levels). dst == src: in place. Returns 0, or -1 if out of memory. */
-static int pass(const double *src, double *dst, double mu, long m, long i0, long i1,
-                int levels, int threads, Compensated *acc)
+/* A span of one group: the terms [i0, i1) of `levels` levels from factor m, cut into
+ * chunks; part[l * nchunks + c] holds chunk c's sum of level l. */
+typedef struct {
+    const double *src;
+    double *dst;          /* the group's S_{2^levels m} (the next group's input), or NULL */
+    double mu;
+    long m, i0, i1, nchunks;
+    int levels, group, first;  /* first: the index of the span's level 0 among all levels */
+    double *part;
+} Span;
+
+static void run_chunks(const Span *p, long c0, long c1)
 {
-    long nchunks = (i1 - i0 + CHUNK - 1) / CHUNK;
-    double *part = malloc(sizeof(double) * (size_t)(levels * nchunks));
-    if (!part) return -1;
-    Share share[MAX_THREADS];
-    long half = threads > 1 ? nchunks / 2 : 0;
-    share[0] = (Share){src, dst, NULL, mu, m, i0, i1, 0, nchunks, 0, 0, nchunks, levels, part};
-    pthread_t thread;
-    int spawned = 0;
+    Share share = {p->src, p->dst, NULL, p->mu, p->m, p->i0, p->i1, c0, c1, 0, 0, p->nchunks,
+                   p->levels, p->part};
+    run_share(&share);
+}
+
+/* A whole span in one pass over the work array, its chunks shared by `threads` threads.
+ * dst == src: in place. Returns 0, or -1 if out of memory. */
+static int pass(const Span *p, int threads)
+{
+    long half = threads > 1 ? p->nchunks / 2 : 0;
+    if (half == 0) {
+        run_chunks(p, 0, p->nchunks);
+        return 0;
+    }
+    Share share[2];
+    share[0] = (Share){p->src, p->dst, NULL, p->mu, p->m, p->i0, p->i1, 0, half, 0, 0,
+                       p->nchunks, p->levels, p->part};
+    share[1] = share[0];
+    share[1].c0 = half;
+    share[1].c1 = p->nchunks;
     double *side = NULL;
     long side_chunks = 0;
-    if (half > 0) {
-        share[0].c1 = half;
-        share[1] = share[0];
-        share[1].c0 = half;
-        share[1].c1 = nchunks;
-        if (dst && dst == src) {  /* the first share reads up to (2^levels - 1) m ahead */
-            long ahead = ((1L << levels) - 1) * m;
-            side_chunks = (ahead + CHUNK - 1) / CHUNK;
-            if (side_chunks > nchunks - half) side_chunks = nchunks - half;
-            side = malloc(sizeof(double) * (size_t)(side_chunks * CHUNK));
-            if (!side) {
-                free(part);
-                return -1;
-            }
-            share[1].side = side;
-            share[1].c_side = half;
-            share[1].c_side_end = half + side_chunks;
-        }
-        spawned = pthread_create(&thread, NULL, run_share, &share[1]) == 0;
+    if (p->dst && p->dst == p->src) {  /* the first share reads (2^levels - 1) m ahead */
+        long ahead = ((1L << p->levels) - 1) * p->m;
+        side_chunks = (ahead + CHUNK - 1) / CHUNK;
+        if (side_chunks > p->nchunks - half) side_chunks = p->nchunks - half;
+        if (!(side = malloc(sizeof(double) * (size_t)(side_chunks * CHUNK)))) return -1;
+        share[1].side = side;
+        share[1].c_side = half;
+        share[1].c_side_end = half + side_chunks;
     }
+    pthread_t thread;
+    int spawned = pthread_create(&thread, NULL, run_share, &share[1]) == 0;
     run_share(&share[0]);
-    if (half > 0 && spawned)
+    if (spawned)
         pthread_join(thread, NULL);
-    else if (half > 0)
+    else
         run_share(&share[1]);  /* no thread: the same chunks, the same sums */
     if (side) {
-        long start = i0 + half * CHUNK;
-        long stop = start + side_chunks * CHUNK < i1 ? start + side_chunks * CHUNK : i1;
-        memcpy(dst + start, side, sizeof(double) * (size_t)(stop - start));
+        long start = p->i0 + half * CHUNK;
+        long stop = start + side_chunks * CHUNK < p->i1 ? start + side_chunks * CHUNK : p->i1;
+        memcpy(p->dst + start, side, sizeof(double) * (size_t)(stop - start));
         free(side);
     }
-    for (int l = 0; l < levels; l++)
-        for (long c = 0; c < nchunks; c++) neumaier_add(&acc[l], part[l * nchunks + c]);
-    free(part);
     return 0;
+}
+
+/* The spans of the groups [0, groups) in one sweep, one chunk of group 0 at a time, each
+ * later group as far as its input (the group before's output) is written: the work array
+ * is read and written once for all of them while its values are in the cache (the
+ * groups' look-ahead, 3 m each, and a chunk stay within a core's L2). One thread. */
+static void sweep(const Span *spans, int count, int groups)
+{
+    long frontier[MAX_LEVELS];  /* the group's S is written below this index */
+    int next[MAX_LEVELS];       /* the group's next span (spans are in group order) */
+    long chunk[MAX_LEVELS];     /* and its next chunk there */
+    int left = 0;
+    for (int g = 0; g < groups; g++) {
+        frontier[g] = 0;
+        next[g] = count;
+        chunk[g] = 0;
+    }
+    for (int s = count - 1; s >= 0; s--)
+        if (spans[s].group < groups) {
+            next[spans[s].group] = s;
+            left++;
+        }
+    while (left > 0) {
+        for (int g = 0; g < groups; g++) {
+            for (int budget = g == 0 ? 1 : 1 << 30; budget > 0 && next[g] < count &&
+                                                    spans[next[g]].group == g; budget--) {
+                const Span *p = &spans[next[g]];
+                long a = p->i0 + chunk[g] * CHUNK;
+                long b = a + CHUNK < p->i1 ? a + CHUNK : p->i1;
+                if (g > 0 && b - 1 + ((1L << p->levels) - 1) * p->m >= frontier[g - 1]) break;
+                run_chunks(p, chunk[g], chunk[g] + 1);
+                if (p->dst) frontier[g] = b;
+                if (++chunk[g] == p->nchunks) {
+                    if (p->dst) frontier[g] = LONG_MAX;  /* all of the group's S written */
+                    next[g]++;
+                    chunk[g] = 0;
+                    left--;
+                }
+            }
+        }
+    }
 }
 
 /* The work array: 2 MiB-aligned and backed by huge pages where Linux offers them (one
@@ -224,36 +279,46 @@ static double *work_array(long n)
 /* Sums of d^2 at m = 1, 2, ..., 2^(levels-1) of the n values y (y' = y - mu). */
 static int octave(const double *y, long n, double mu, int levels, int threads, double *sums)
 {
+    Span spans[MAX_LEVELS];
     Compensated acc[MAX_LEVELS] = {{0.0, 0.0}};
-    double *work = NULL;
-    const double *src = y;
-    double shift = mu;
+    int count = 0, swept = 0, status = -1;
+    double *work = levels > GROUP ? work_array(n) : NULL;
+    if (levels > GROUP && !work) return -1;
     long m = 1;
-    for (int first = 0; first < levels; first += GROUP) {
+    for (int first = 0, g = 0; first < levels; first += GROUP, g++, m <<= GROUP) {
         int group = levels - first < GROUP ? levels - first : GROUP;
         int last = first + group == levels;
-        if (!last && !work && !(work = work_array(n))) return -1;
+        if (m <= SWEEP_M) swept = g + 1;
         /* level l of the group has terms i <= n - 2^(l+1) m; the group's S_{2^group m}
          * (the next group's input) is needed for i <= n - 2^group m: the full-group span */
         long done = 0;
         for (int l = group; l >= 1; l--) {
             long end = n - (1L << l) * m + 1;
             if (end > done) {
-                double *dst = l == group && !last ? work : NULL;
-                if (pass(src, dst, shift, m, done, end, l, threads, acc + first) != 0) {
-                    free(work);
-                    return -1;
-                }
+                spans[count++] = (Span){first ? work : y, l == group && !last ? work : NULL,
+                                        first ? 0.0 : mu, m, done, end,
+                                        (end - done + CHUNK - 1) / CHUNK, l, g, first, NULL};
                 done = end;
             }
         }
-        src = work;
-        shift = 0.0;
-        m <<= group;
     }
-    free(work);
+    for (int s = 0; s < count; s++)
+        if (!(spans[s].part = malloc(sizeof(double) * (size_t)(spans[s].levels *
+                                                                spans[s].nchunks))))
+            goto out;
+    sweep(spans, count, swept);
+    for (int s = 0; s < count; s++)
+        if (spans[s].group >= swept && pass(&spans[s], threads) != 0) goto out;
+    for (int s = 0; s < count; s++)  /* in span order: each level's chunks in index order */
+        for (int l = 0; l < spans[s].levels; l++)
+            for (long c = 0; c < spans[s].nchunks; c++)
+                neumaier_add(&acc[spans[s].first + l], spans[s].part[l * spans[s].nchunks + c]);
     for (int l = 0; l < levels; l++) sums[l] = acc[l].sum + acc[l].compensation;
-    return 0;
+    status = 0;
+out:
+    for (int s = 0; s < count; s++) free(spans[s].part);
+    free(work);
+    return status;
 }
 
 static PyObject *octave_sums(PyObject *self, PyObject *args)
