@@ -9,7 +9,7 @@ import sys
 from setuptools import Extension, setup
 
 # The rounding as written (no FMA contraction, no fast-math); -O3 for the vector loops.
-FLAGS = [] if sys.platform == "win32" else ["-O3", "-ffp-contract=off", "-pthread"]
+FLAGS = [] if sys.platform == "win32" else ["-O3", "-ffp-contract=off"]
 
 setup(
     ext_modules=[
@@ -17,7 +17,6 @@ setup(
             "hrgtc.evaluation._allan_octave",
             ["src/hrgtc/evaluation/_allan_octave.c"],
             extra_compile_args=FLAGS,
-            extra_link_args=[] if sys.platform == "win32" else ["-pthread"],
         )
     ]
 )

@@ -26,9 +26,9 @@ def octave_factors(n: int) -> np.ndarray:
     return np.array([2**k for k in range(64) if n + 1 - 2 * 2**k > 1], dtype=np.int64)
 
 
-def native(y: np.ndarray, threads: int = 1) -> np.ndarray:
+def native(y: np.ndarray) -> np.ndarray:
     levels = octave_factors(y.size).size
-    return np.array(_allan_octave.octave_sums(y, float(np.mean(y)), levels, threads))
+    return np.array(_allan_octave.octave_sums(y, float(np.mean(y)), levels))
 
 
 def drifting(n: int, seed: int) -> np.ndarray:
@@ -62,9 +62,10 @@ def exact_sums(y: np.ndarray, factors: np.ndarray) -> list[float]:
     return out
 
 
-# sizes around the chunk (32768 terms) and the octaves, and several chunks per pass
+# sizes around the chunk (32768 terms) and the octaves, several chunks per pass, and
+# factors beyond the sweep's (m > 65536: one plain pass per two octaves from 524_289 on)
 @pytest.mark.parametrize("n", [3, 4, 5, 6, 7, 8, 9, 17, 1000, 32_769, 65_537, 70_001,
-                               262_144, 300_007])
+                               262_144, 300_007, 600_001, 2_100_003])
 @pytest.mark.parametrize("data", [white, drifting])
 def test_equals_the_numba_kernels(n, data):
     y = data(n, seed=n)
@@ -106,9 +107,9 @@ def test_a_float64_phase_is_less_accurate_on_the_same_data():
     assert np.max(np.abs(native(y) / exact - 1.0)) < 2e-15
 
 
-def test_the_same_bits_on_one_or_two_threads():
-    y = drifting(300_007, seed=3)  # 9 chunks in the first pass: both threads, a side buffer
-    assert native(y, threads=1).tobytes() == native(y, threads=2).tobytes()
+def test_the_same_bits_from_call_to_call():
+    y = drifting(300_007, seed=3)  # 10 chunks in the first pass, swept and plain passes
+    assert native(y).tobytes() == native(y).tobytes()
 
 
 def test_allan_deviation_takes_the_native_path_for_power_of_two_factors(monkeypatch):
@@ -159,10 +160,8 @@ def test_a_missing_build_says_how_to_build_it(monkeypatch):
 def test_the_module_refuses_what_it_cannot_sum():
     y = white(100, seed=1)
     with pytest.raises(TypeError, match="float64"):
-        _allan_octave.octave_sums(y.astype(np.float32), 0.0, 2, 1)
+        _allan_octave.octave_sums(y.astype(np.float32), 0.0, 2)
     with pytest.raises(ValueError, match="contiguous"):
-        _allan_octave.octave_sums(y[::2], 0.0, 2, 1)
+        _allan_octave.octave_sums(y[::2], 0.0, 2)
     with pytest.raises(ValueError, match="no term"):
-        _allan_octave.octave_sums(y, 0.0, 8, 1)  # m = 128 > 100 / 2
-    with pytest.raises(ValueError, match="threads"):
-        _allan_octave.octave_sums(y, 0.0, 2, 3)
+        _allan_octave.octave_sums(y, 0.0, 8)  # m = 128 > 100 / 2

@@ -17,10 +17,9 @@
  * S is overwritten in place (ascending i reads each value before it is replaced).
  *
  * The squares d_i^2 are summed in float64 in 2 x 4 lanes over fixed chunks of CHUNK
- * terms; the chunk sums are added in index order with Neumaier's compensated sum. The
- * chunks do not depend on the number of threads, so neither do the sums (bit for bit).
- * Two threads share the chunks of each pass; the second writes the values the first
- * still reads into a side buffer, copied in place after both are done.
+ * terms; the chunk sums are added in index order with Neumaier's compensated sum [2].
+ * One thread: two (each taking half of the chunks of the passes after the sweep) were
+ * slower at 10^7 samples on a shared two-core machine and no faster at 10^8.
  *
  * [1] W. J. Riley, "Handbook of Frequency Stability Analysis", NIST SP 1065, 2008.
  * [2] A. Neumaier, "Rundungsfehleranalyse einiger Verfahren zur Summation endlicher
@@ -30,7 +29,6 @@
 #include <Python.h>
 #include <limits.h>
 #include <math.h>
-#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 #ifdef __linux__
@@ -39,9 +37,8 @@
 
 #define GROUP 2          /* octave levels fused into one pass over the work array (1 or 2;
                             2 was faster than 1 and 3 at 10^7 samples, docs/benchmarks.md) */
-#define CHUNK 32768L     /* terms per partial sum: fixed, so the sums ignore the threads */
-#define SWEEP_M 4096L    /* groups from factors up to this one are swept together */
-#define MAX_THREADS 2
+#define CHUNK 32768L     /* terms per partial sum (float64), the partial sums compensated */
+#define SWEEP_M 65536L   /* groups from factors up to this one are swept together */
 #define MAX_LEVELS 62
 
 /* The AVX2 clone where the CPU has it (picked at load time), SSE2 otherwise; no FMA is
@@ -120,34 +117,6 @@ CLONES static void chunk(const double *src, double *dst, double mu, long m, long
         span1(src, dst, mu, m, count, out, 0);
 }
 
-/* One worker's share of a pass: chunks [c0, c1) of the terms [i0, i1). */
-typedef struct {
-    const double *src;
-    double *dst;          /* NULL: nothing stored */
-    double *side;         /* stores of chunks [c_side, c_side_end) go to the side buffer */
-    double mu;
-    long m, i0, i1, c0, c1, c_side, c_side_end, nchunks;
-    int levels;
-    double *part;         /* part[l * nchunks + c]: chunk c's sum of level l */
-} Share;
-
-static void *run_share(void *arg)
-{
-    Share *s = arg;
-    double out[GROUP];
-    long side_start = s->i0 + s->c_side * CHUNK;
-    for (long c = s->c0; c < s->c1; c++) {
-        long a = s->i0 + c * CHUNK;
-        long b = a + CHUNK < s->i1 ? a + CHUNK : s->i1;
-        double *dst = NULL;
-        if (s->dst)
-            dst = s->side && c >= s->c_side && c < s->c_side_end ? s->side + (a - side_start) : s->dst + a;
-        chunk(s->src + a, dst, s->mu, s->m, b - a, s->levels, out);
-        for (int l = 0; l < s->levels; l++) s->part[l * s->nchunks + c] = out[l];
-    }
-    return NULL;
-}
-
 typedef struct {
     double sum, compensation;
 } Compensated;
@@ -173,59 +142,23 @@ typedef struct {
     double *part;
 } Span;
 
+/* The chunks [c0, c1) of a span (dst == src: in place, ascending). */
 static void run_chunks(const Span *p, long c0, long c1)
 {
-    Share share = {p->src, p->dst, NULL, p->mu, p->m, p->i0, p->i1, c0, c1, 0, 0, p->nchunks,
-                   p->levels, p->part};
-    run_share(&share);
-}
-
-/* A whole span in one pass over the work array, its chunks shared by `threads` threads.
- * dst == src: in place. Returns 0, or -1 if out of memory. */
-static int pass(const Span *p, int threads)
-{
-    long half = threads > 1 ? p->nchunks / 2 : 0;
-    if (half == 0) {
-        run_chunks(p, 0, p->nchunks);
-        return 0;
+    double out[GROUP];
+    for (long c = c0; c < c1; c++) {
+        long a = p->i0 + c * CHUNK;
+        long b = a + CHUNK < p->i1 ? a + CHUNK : p->i1;
+        chunk(p->src + a, p->dst ? p->dst + a : NULL, p->mu, p->m, b - a, p->levels, out);
+        for (int l = 0; l < p->levels; l++) p->part[l * p->nchunks + c] = out[l];
     }
-    Share share[2];
-    share[0] = (Share){p->src, p->dst, NULL, p->mu, p->m, p->i0, p->i1, 0, half, 0, 0,
-                       p->nchunks, p->levels, p->part};
-    share[1] = share[0];
-    share[1].c0 = half;
-    share[1].c1 = p->nchunks;
-    double *side = NULL;
-    long side_chunks = 0;
-    if (p->dst && p->dst == p->src) {  /* the first share reads (2^levels - 1) m ahead */
-        long ahead = ((1L << p->levels) - 1) * p->m;
-        side_chunks = (ahead + CHUNK - 1) / CHUNK;
-        if (side_chunks > p->nchunks - half) side_chunks = p->nchunks - half;
-        if (!(side = malloc(sizeof(double) * (size_t)(side_chunks * CHUNK)))) return -1;
-        share[1].side = side;
-        share[1].c_side = half;
-        share[1].c_side_end = half + side_chunks;
-    }
-    pthread_t thread;
-    int spawned = pthread_create(&thread, NULL, run_share, &share[1]) == 0;
-    run_share(&share[0]);
-    if (spawned)
-        pthread_join(thread, NULL);
-    else
-        run_share(&share[1]);  /* no thread: the same chunks, the same sums */
-    if (side) {
-        long start = p->i0 + half * CHUNK;
-        long stop = start + side_chunks * CHUNK < p->i1 ? start + side_chunks * CHUNK : p->i1;
-        memcpy(p->dst + start, side, sizeof(double) * (size_t)(stop - start));
-        free(side);
-    }
-    return 0;
 }
 
 /* The spans of the groups [0, groups) in one sweep, one chunk of group 0 at a time, each
  * later group as far as its input (the group before's output) is written: the work array
  * is read and written once for all of them while its values are in the cache (the
- * groups' look-ahead, 3 m each, and a chunk stay within a core's L2). One thread. */
+ * groups' look-ahead, 3 m each, ~2 MB up to SWEEP_M, stays in L2 and L3; SWEEP_M 4096
+ * took 18% longer at 10^7 samples, 2^18 and 2^20 no less). One thread. */
 static void sweep(const Span *spans, int count, int groups)
 {
     long frontier[MAX_LEVELS];  /* the group's S is written below this index */
@@ -277,7 +210,7 @@ static double *work_array(long n)
 }
 
 /* Sums of d^2 at m = 1, 2, ..., 2^(levels-1) of the n values y (y' = y - mu). */
-static int octave(const double *y, long n, double mu, int levels, int threads, double *sums)
+static int octave(const double *y, long n, double mu, int levels, double *sums)
 {
     Span spans[MAX_LEVELS];
     Compensated acc[MAX_LEVELS] = {{0.0, 0.0}};
@@ -307,8 +240,8 @@ static int octave(const double *y, long n, double mu, int levels, int threads, d
                                                                 spans[s].nchunks))))
             goto out;
     sweep(spans, count, swept);
-    for (int s = 0; s < count; s++)
-        if (spans[s].group >= swept && pass(&spans[s], threads) != 0) goto out;
+    for (int s = 0; s < count; s++)  /* the larger factors: one pass over the array each */
+        if (spans[s].group >= swept) run_chunks(&spans[s], 0, spans[s].nchunks);
     for (int s = 0; s < count; s++)  /* in span order: each level's chunks in index order */
         for (int l = 0; l < spans[s].levels; l++)
             for (long c = 0; c < spans[s].nchunks; c++)
@@ -325,9 +258,9 @@ static PyObject *octave_sums(PyObject *self, PyObject *args)
 {
     PyObject *data;
     double mu;
-    int levels, threads;
+    int levels;
     (void)self;
-    if (!PyArg_ParseTuple(args, "Odii", &data, &mu, &levels, &threads)) return NULL;
+    if (!PyArg_ParseTuple(args, "Odi", &data, &mu, &levels)) return NULL;
     Py_buffer view;
     if (PyObject_GetBuffer(data, &view, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) != 0) return NULL;
     PyObject *result = NULL;
@@ -338,13 +271,11 @@ static PyObject *octave_sums(PyObject *self, PyObject *args)
     } else if (levels < 1 || levels > MAX_LEVELS || n + 1 - 2 * (1L << (levels - 1)) < 1) {
         PyErr_Format(PyExc_ValueError,
                      "%d octave levels leave no term in %ld samples", levels, n);
-    } else if (threads < 1 || threads > MAX_THREADS) {
-        PyErr_Format(PyExc_ValueError, "threads must be 1..%d, got %d", MAX_THREADS, threads);
     } else {
         double sums[MAX_LEVELS];
         int status;
         Py_BEGIN_ALLOW_THREADS
-        status = octave((const double *)view.buf, n, mu, levels, threads, sums);
+        status = octave((const double *)view.buf, n, mu, levels, sums);
         Py_END_ALLOW_THREADS
         if (status != 0) {
             PyErr_NoMemory();
@@ -358,7 +289,7 @@ static PyObject *octave_sums(PyObject *self, PyObject *args)
 
 static PyMethodDef methods[] = {
     {"octave_sums", octave_sums, METH_VARARGS,
-     "octave_sums(y, mean, levels, threads) -> list of float\n\n"
+     "octave_sums(y, mean, levels) -> list of float\n\n"
      "Sum over i of (X[i+2m] - 2X[i+m] + X[i])^2 for m = 1, 2, ..., 2**(levels-1), X the\n"
      "phase of y - mean (SP 1065 Eq. 11); y a contiguous 1-D float64 buffer."},
     {NULL, NULL, 0, NULL},

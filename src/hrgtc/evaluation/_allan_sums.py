@@ -19,9 +19,6 @@ from collections.abc import Callable
 
 import numpy as np
 
-#: Threads of the compiled module (it has at most two; the sums do not depend on it).
-THREADS = 1
-
 _MISSING = (
     "hrgtc's compiled Allan module (hrgtc.evaluation._allan_octave, from "
     "src/hrgtc/evaluation/_allan_octave.c) is not built; build it with "
@@ -45,7 +42,7 @@ def octave_sums(y: np.ndarray, factors: np.ndarray, levels: int) -> np.ndarray:
     except ImportError as error:
         raise ImportError(_MISSING) from error
     mean = float(np.mean(y))  # pairwise, as allantools' frequency2phase and the kernels
-    every = np.array(_allan_octave.octave_sums(y, mean, levels, THREADS))
+    every = np.array(_allan_octave.octave_sums(y, mean, levels))
     return every[np.log2(factors).astype(np.int64)]
 
 
