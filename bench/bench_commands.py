@@ -22,7 +22,8 @@ process's own (``wait4``).
   default options and with ``--motion keep`` against ``bench/plain_compensate.py``, a
   pyarrow streaming script (goal <= 1).
 
-``--quick``: small sizes, 3 repeats. With ``HRGTC_BENCH_BEFORE=/path/to/src`` (the ``src``
+``--quick``: small sizes, 3 repeats; ``--only NAME`` runs one line (help, allan,
+calibrate, compensate). With ``HRGTC_BENCH_BEFORE=/path/to/src`` (the ``src``
 folder of an earlier checkout, e.g. ``git archive COMMIT src | tar -x -C /tmp/before``)
 every hrgtc command is also run from that tree in the same alternation, and each line
 gains ``before_seconds`` and ``before_ratio`` (and ``before_motion_keep_*``): before and
@@ -239,17 +240,26 @@ def compensate_line(folder: Path, quick: bool, repeats: int) -> dict:
         samples=pq.ParquetFile(run.path).metadata.num_rows, goal_ratio=1.0)
 
 
-def run(quick: bool = False) -> list[dict]:
-    out = [help_line(7 if quick else 15)]
-    with tempfile.TemporaryDirectory() as tmp:
-        out.append(allan_line(Path(tmp), 1_000_000 if quick else 10_000_000, 3 if quick else 5))
-    with tempfile.TemporaryDirectory() as tmp:
-        out.append(calibrate_line(Path(tmp), quick, 3))
-    with tempfile.TemporaryDirectory() as tmp:
-        out.append(compensate_line(Path(tmp), quick, 3 if quick else 5))
+def run(quick: bool = False, only: str | None = None) -> list[dict]:
+    """Every line, or the one named ``only`` (help, allan, calibrate, compensate)."""
+    lines = {
+        "help": lambda tmp: help_line(7 if quick else 15),
+        "allan": lambda tmp: allan_line(tmp, 1_000_000 if quick else 10_000_000,
+                                        3 if quick else 5),
+        "calibrate": lambda tmp: calibrate_line(tmp, quick, 3),
+        "compensate": lambda tmp: compensate_line(tmp, quick, 3 if quick else 5),
+    }
+    if only is not None and only not in lines:
+        raise SystemExit(f"--only {only}: no such line; use one of {', '.join(lines)}")
+    out = []
+    for name, line in lines.items():
+        if only in (None, name):
+            with tempfile.TemporaryDirectory() as tmp:
+                out.append(line(Path(tmp)))
     return out
 
 
 if __name__ == "__main__":
-    for line in run(quick="--quick" in sys.argv):
+    only = sys.argv[sys.argv.index("--only") + 1] if "--only" in sys.argv else None
+    for line in run(quick="--quick" in sys.argv, only=only):
         print(json.dumps(line), flush=True)
