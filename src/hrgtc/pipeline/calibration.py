@@ -27,6 +27,7 @@ import numpy as np
 from hrgtc.compensate.ranges import RangeReport
 from hrgtc.core import records
 from hrgtc.core.errors import InputError
+from hrgtc.core.files import hash_ahead
 from hrgtc.core.progress import StageProgress
 from hrgtc.core.summary import Summary
 from hrgtc.drift import ScaleFactorModel, find_rate_segments, fit_scale_factor, read_segment_table
@@ -234,6 +235,8 @@ def calibrate(
     settings = settings or CalibrationSettings()
     inputs = inputs or CalibrationInputs()
     tables = rate_tables or RateTables()
+    # the provenance's SHA-256 of every input, on the second core while the fits read them
+    hash_ahead([*soaks, *drifts, *validate, *tables.runs, *tables.validate])
     aux = parse_aux(inputs.aux)
     reading = _reading(soaks, drifts, validate, inputs, tables, read_options or ReadOptions(),
                        progress)
