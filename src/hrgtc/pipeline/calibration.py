@@ -235,8 +235,6 @@ def calibrate(
     settings = settings or CalibrationSettings()
     inputs = inputs or CalibrationInputs()
     tables = rate_tables or RateTables()
-    # the provenance's SHA-256 of every input, on the second core while the fits read them
-    hash_ahead([*soaks, *drifts, *validate, *tables.runs, *tables.validate])
     aux = parse_aux(inputs.aux)
     reading = _reading(soaks, drifts, validate, inputs, tables, read_options or ReadOptions(),
                        progress)
@@ -279,6 +277,8 @@ def _reading(soaks: Sequence[PathLike], drifts: Sequence[PathLike],
              options: ReadOptions, progress: StageProgress | None) -> _Reading:
     """The reading of :func:`calibrate`'s files (the parameters are its own), every file
     refused when it is a compensated output."""
+    # the provenance's SHA-256 of every input, on the second core while the fits read them
+    hash_ahead([*soaks, *drifts, *validate, *tables.runs, *tables.validate])
     if options.thermometer not in ("resonator", "sensor"):
         raise InputError("thermometer must be 'resonator' or 'sensor', got "
                          f"{options.thermometer!r}")
