@@ -22,8 +22,9 @@ process's own (``wait4``).
   default options and with ``--motion keep`` against ``bench/plain_compensate.py``, a
   pyarrow streaming script (goal <= 1).
 
-``--quick``: small sizes, 3 repeats. With ``HRGTC_BENCH_BEFORE=/path/to/src`` (the ``src``
-folder of an earlier checkout, e.g. ``git archive COMMIT src | tar -x -C /tmp/before``)
+``--quick``: small sizes, 3 repeats; ``--calibrate``: the calibrate line alone. With
+``HRGTC_BENCH_BEFORE=/path/to/src`` (the ``src`` folder of an earlier checkout, e.g.
+``git archive COMMIT src | tar -x -C /tmp/before``)
 every hrgtc command is also run from that tree in the same alternation, and each line
 gains ``before_seconds`` and ``before_ratio`` (and ``before_motion_keep_*``): before and
 after against the same reference in the same run.
@@ -250,6 +251,13 @@ def run(quick: bool = False) -> list[dict]:
     return out
 
 
+def calibrate_only(quick: bool) -> list[dict]:
+    """``--calibrate``: the calibrate line alone."""
+    with tempfile.TemporaryDirectory() as tmp:
+        return [calibrate_line(Path(tmp), quick, 3)]
+
+
 if __name__ == "__main__":
-    for line in run(quick="--quick" in sys.argv):
+    quick = "--quick" in sys.argv
+    for line in calibrate_only(quick) if "--calibrate" in sys.argv else run(quick=quick):
         print(json.dumps(line), flush=True)
