@@ -1,5 +1,6 @@
 # Every target does its own set-up on a fresh machine: the venv is created and the
-# package installed (with its test and docs extras) when missing or when pyproject.toml changed.
+# package installed (with its test and docs extras, its C module compiled) when missing or
+# when pyproject.toml, setup.py or a C source changed.
 PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
@@ -8,10 +9,14 @@ STAMP := $(VENV)/.installed
 .PHONY: demo test lint docs bench clean system mutation
 
 # Debian packages the tests exercise for real: headless Chromium opens the HTML report,
-# gcc compiles the C export. Installed with apt-get when missing (CI runs as root).
+# gcc compiles the C export and hrgtc's own C module (setup.py). Installed with apt-get
+# when missing (CI runs as root).
 SYSTEM_COMMANDS := chromium gcc
 
-$(STAMP): pyproject.toml
+# setup.py compiles the C sources (NATIVE) in place: gcc must be there first (system).
+NATIVE := src/hrgtc/evaluation/_allan_octave.c
+
+$(STAMP): pyproject.toml setup.py $(NATIVE) | system
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[test,docs]'
@@ -56,3 +61,4 @@ bench: $(STAMP)
 
 clean:
 	rm -rf $(VENV) build dist site src/*.egg-info .pytest_cache .ruff_cache
+	find src -name '*.so' -delete

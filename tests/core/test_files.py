@@ -618,3 +618,43 @@ def test_stale_temporaries_of_older_versions_are_counted_and_three_named(tmp_pat
     listed = re.search(r"4 temporary file\(s\) of an interrupted earlier write of out\.csv "
                        r"remain \((.*)\); remove them", message).group(1).split(", ")
     assert len(listed) == 3 and set(listed) < set(names)
+
+
+def test_a_file_hashed_ahead_gives_its_digest_without_being_read_again(tmp_path, monkeypatch):
+    import hashlib
+
+    from hrgtc.core import files
+
+    path = tmp_path / "soak.bin"
+    data = bytes(range(256)) * 5000
+    path.write_bytes(data)
+    files.hash_ahead([path, str(path)])  # the same file twice: hashed once
+    entry = files._AHEAD[os.path.realpath(path)]
+    assert entry.done.wait(10)
+    opened = []
+    monkeypatch.setattr(files, "open", lambda *a, **k: opened.append(a) or open(*a, **k),
+                        raising=False)
+    assert files.file_sha256(path) == hashlib.sha256(data).hexdigest()
+    assert opened == []
+
+
+def test_a_file_changed_after_it_was_hashed_ahead_is_hashed_again(tmp_path):
+    import hashlib
+
+    from hrgtc.core import files
+
+    path = tmp_path / "drift.bin"
+    path.write_bytes(b"before" * 1000)
+    files.hash_ahead([path])
+    assert files._AHEAD[os.path.realpath(path)].done.wait(10)
+    path.write_bytes(b"after, longer" * 1000)
+    assert files.file_sha256(path) == hashlib.sha256(b"after, longer" * 1000).hexdigest()
+
+
+def test_a_missing_file_hashed_ahead_is_refused_as_before(tmp_path):
+    from hrgtc.core import files
+
+    path = tmp_path / "missing.bin"
+    files.hash_ahead([path])
+    with pytest.raises(FileNotFoundError):
+        files.file_sha256(path)

@@ -135,7 +135,7 @@ def _take(run, rows):
 def test_bursts_cut_from_a_continuous_recording_give_its_df_dt():
     # issue 20 item 2: in bridge mode, after the filter has settled (10 tau past a 600 s
     # warm-up), the df/dt of 5 s bursts every 300 s is the continuous recording's, with
-    # tau = 300 s (not shorter than the burst period, see RateFilterWarning). Noise-free,
+    # tau = 300 s (the same filter on both; docs/real-loggers/dfdt.md, "Bursts"). Noise-free,
     # the only difference is the temperature's curvature over a 295 s gap (taken as a
     # straight line): measured 0.6 % of the df/dt range at most; stated bound 1 %. With the
     # simulator's 2 mHz frequency noise (1/60 of the samples in the bursts): RMS 0.3 %,

@@ -5,6 +5,7 @@ and units only (no ``--temp-ref``: the model file holds the count's map to °C).
 from __future__ import annotations
 
 import json
+import re
 import shutil
 
 import numpy as np
@@ -116,3 +117,30 @@ def test_a_sweep_with_handling_is_judged_on_its_samples_at_rest(tmp_path):
     assert figures["bias_gradient_sensitivity_dph_per_c_per_min"] == pytest.approx(gradient,
                                                                                  rel=0.05)
     assert any("not at rest" in note for note in document["notes"]), document["notes"]
+
+
+def test_the_noise_figures_of_a_run_with_handling_come_from_its_longest_stretch_at_rest(
+        tmp_path):
+    """The VN-100 as a turn-on: its Allan deviation is of the longest stretch at rest (the
+    cool-down, about 1435 s), not of samples that include 9 minutes of carrying about
+    (with them the angle random walk read 447 °/√h). The angle random walk is numpy's white
+    noise of the README's still cool-down, within 5 %."""
+    shutil.copy(VN100, tmp_path / VN100.name)
+    manifest = MANIFEST.replace('model = "pan.json"\n', "").replace(
+        'file_axis = "y"', 'file_axis = "z"').replace(RUN.name, VN100.name).replace(
+        'role = "sweep"', 'role = "turn-on"')
+    (tmp_path / "campaign.toml").write_text(manifest, encoding="utf-8")
+    result = CliRunner().invoke(app, ["test-report", str(tmp_path / "campaign.toml"), "-o",
+                                      str(tmp_path / "r.html"), "--no-pdf", *VN100_MAPPING])
+    assert result.exit_code == 0, result.output
+    figures = {f["name"]: f for f in json.loads((tmp_path / "r.json").read_text())["figures"]}
+    arw = figures["angle_random_walk_deg_per_rt_h"]
+    c = np.genfromtxt(VN100, delimiter=",", names=True, usecols=("millis", "GyroZ"))
+    s = c["millis"] / 1000.0
+    a, b = VN100_AT_REST[2]
+    still = np.degrees(c["GyroZ"][(s >= a) & (s < b)]) * 3600.0
+    white_dph = np.std(np.diff(still)) / np.sqrt(2.0)
+    assert arw["value"] == pytest.approx(white_dph * np.sqrt(0.1) / 60.0, rel=0.05), arw
+    stretch_s = float(re.search(r"longest stretch at rest after the settling, (\S+) s",
+                                arw["uncertainty_basis"]).group(1))
+    assert abs(stretch_s - (b - a)) < 60.0, arw["uncertainty_basis"]

@@ -99,9 +99,8 @@ class UnitWarning(HrgtcWarning):
 
 
 class RateFilterWarning(HrgtcWarning):
-    """The causal df/dt filter cannot follow the recording: its time constant is shorter
-    than the burst period of a duty-cycled logger, or the thermometer's quantisation
-    makes the df/dt noise larger than the df/dt signal."""
+    """The causal df/dt filter cannot follow the recording: the thermometer's quantisation
+    makes the df/dt noise larger than the df/dt signal at its time constant."""
 
 
 class GapWarning(HrgtcWarning):

@@ -498,9 +498,92 @@ HASH_BLOCK_BYTES = 1 << 20
 
 
 def file_sha256(path: PathLike, block_bytes: int = HASH_BLOCK_BYTES) -> str:
-    """SHA-256 of a file, read in blocks."""
+    """SHA-256 of a file, read in blocks (the digest :func:`hash_ahead` found, when the
+    file is the same file, unchanged: device, inode, size and modification time)."""
+    entry = _AHEAD.get(os.path.realpath(path)) if _AHEAD else None
+    if entry is not None:
+        digest = entry.result(path)
+        if digest is not None:
+            return digest
+    return _sha256(path, block_bytes)
+
+
+def _sha256(path: PathLike, block_bytes: int = HASH_BLOCK_BYTES) -> str:
     digest = hashlib.sha256()
     with open(path, "rb") as handle:
         while block := handle.read(block_bytes):
             digest.update(block)
     return digest.hexdigest()
+
+
+def _identity(path: PathLike) -> tuple[int, int, int, int] | None:
+    """(device, inode, size, modification time) of a file; None when it cannot be read."""
+    try:
+        stat = os.stat(path)
+    except (OSError, ValueError):
+        return None
+    return stat.st_dev, stat.st_ino, stat.st_size, stat.st_mtime_ns
+
+
+class _Ahead:
+    """A file's hash begun by :func:`hash_ahead`: whoever comes first (the background
+    thread or :func:`file_sha256`) hashes it; the digest counts while the file keeps the
+    identity it had before and after it was hashed."""
+
+    def __init__(self) -> None:
+        self.claimed = False
+        self.done = threading.Event()
+        self.digest: str | None = None
+        self.identity: tuple[int, int, int, int] | None = None
+
+    def run(self, path: PathLike) -> None:
+        """Hash the file unless another thread began (a failure leaves no digest)."""
+        with _AHEAD_LOCK:
+            if self.claimed:
+                return
+            self.claimed = True
+        try:
+            before = _identity(path)
+            digest = _sha256(path)
+            if before is not None and before == _identity(path):
+                self.identity, self.digest = before, digest
+        except OSError:
+            pass  # file_sha256 reads it again and says why
+        finally:
+            self.done.set()
+
+    def result(self, path: PathLike) -> str | None:
+        """The digest, waiting for it if it is being computed; None when it does not hold
+        for the file as it is now."""
+        self.run(path)
+        self.done.wait()
+        if self.digest is None or self.identity != _identity(path):
+            return None
+        return self.digest
+
+
+_AHEAD_LOCK = threading.Lock()
+#: The files :func:`hash_ahead` was given, by resolved path.
+_AHEAD: dict[str, _Ahead] = {}
+
+
+def hash_ahead(paths: Iterable[PathLike]) -> None:
+    """Begin hashing ``paths`` in a background thread, for a later :func:`file_sha256`
+    (a model's provenance) of the same files. The thread reads and hashes with the GIL
+    released: on a second core while the caller reads the same files for their numbers
+    (``calibrate``). A file already given is not hashed again."""
+    todo = []
+    with _AHEAD_LOCK:
+        for path in paths:
+            key = os.path.realpath(path)
+            if key not in _AHEAD:
+                _AHEAD[key] = _Ahead()
+                todo.append((path, _AHEAD[key]))
+    if todo:
+        threading.Thread(target=_hash_each, args=(todo,), name="hrgtc-sha256",
+                         daemon=True).start()
+
+
+def _hash_each(todo: list[tuple[PathLike, _Ahead]]) -> None:
+    for path, entry in todo:
+        entry.run(path)

@@ -1,20 +1,18 @@
 """Checks that the causal df/dt filter can follow a recording (issue 20 item 2).
 
-Two ways a valid recording defeats the filter of :mod:`hrgtc.drift.rate_filter`:
+One way a valid recording defeats the filter of :mod:`hrgtc.drift.rate_filter`:
+**quantisation**. A temperature (or a raw count) that moves in steps of one LSB q is a
+staircase; each step is a step input of size q to D(s) = s/(tau s + 1)^2, whose rate
+response peaks at q/(e tau) (at t = tau). When the recording's own df/dt, estimated as
+its span over its duration, is below that, the df/dt the model sees is mostly the
+quantisation's. :func:`resolution` estimates q as the smallest step between distinct
+values that recurs (not one rounding accident).
 
-* **Bursts** (a duty-cycled logger: a few seconds of samples every few minutes). Across
-  a gap the filter takes the temperature as moving in a straight line, which is right
-  only if the filter's memory spans the gaps: with a time constant tau shorter than the
-  burst period, each burst's df/dt is the noisy rate of its own few seconds, and the
-  straight line across the gap is weighted as much as the whole recording's trend.
-  :func:`burst_period_s` finds the period from the gaps (time steps longer than
-  :data:`GAP_FACTOR` times the median step).
-* **Quantisation**. A temperature (or a raw count) that moves in steps of one LSB q is a
-  staircase; each step is a step input of size q to D(s) = s/(tau s + 1)^2, whose rate
-  response peaks at q/(e tau) (at t = tau). When the recording's own df/dt, estimated as
-  its span over its duration, is below that, the df/dt the model sees is mostly the
-  quantisation's. :func:`resolution` estimates q as the smallest step between distinct
-  values that recurs (not one rounding accident).
+A duty-cycled logger's bursts are not such a case. Across a gap the filter's step takes
+the input as a straight line from the last sample to the next (a first-order hold), so
+after a gap much longer than tau it reads the chord's slope, the gap's mean rate: a
+short tau follows the trend of bursts better than a tau as long as their period, whose
+own lag (2 tau) is then minutes (docs/real-loggers/dfdt.md, "Bursts").
 
 :func:`rate_filter_problems` returns the messages; :func:`warn_rate_filter` issues each
 as a :class:`~hrgtc.core.errors.RateFilterWarning`, once per message.
@@ -31,8 +29,6 @@ import numpy as np
 
 from hrgtc.core.errors import RateFilterWarning
 
-#: A time step longer than this many median steps is a gap between bursts.
-GAP_FACTOR = 2.0
 #: Fewer distinct values than this and no resolution is estimated.
 MIN_DISTINCT = 3
 #: The staircase's peak rate response to one LSB step: q / (e tau).
@@ -41,34 +37,6 @@ STEP_PEAK = 1.0 / math.e
 CHECK_ROWS = 100_000
 #: Rows whose distinct values tell a continuous channel at once (most of them distinct).
 QUICK_ROWS = 4096
-
-
-#: A gap no longer than this fraction of the df/dt filter's time constant is a dropout: the
-#: filter carries across it with its Δt and df/dt moves by less than its noise (the default
-#: of ``--dropout-s``, :data:`hrgtc.settings.reading.DROPOUT_S`, is this of the default τ).
-DROPOUT_FRACTION_OF_TAU = 0.5
-
-
-def burst_period_s(time_s: np.ndarray, min_gap_s: float = 0.0) -> float | None:
-    """Median time between the starts of consecutive bursts, or None without gaps. [s]
-
-    With a single gap, the gap itself (plus one step) is the period. Gaps no longer than
-    ``min_gap_s`` (dropouts of a continuous logger) start no burst. [s]
-    """
-    time_s = np.asarray(time_s, dtype=np.float64)
-    if time_s.size < 3:
-        return None
-    steps = np.diff(time_s)
-    positive = steps[steps > 0]
-    if not positive.size:
-        return None
-    median = float(np.median(positive))
-    starts = np.flatnonzero(steps > max(GAP_FACTOR * median, min_gap_s)) + 1
-    if not starts.size:
-        return None
-    if starts.size == 1:
-        return float(steps[starts[0] - 1] + median)
-    return float(np.median(np.diff(time_s[starts])))
 
 
 def resolution(values: np.ndarray) -> float | None:
@@ -125,19 +93,6 @@ def rate_filter_problems(time_s: np.ndarray, levels: Mapping[str, np.ndarray], t
     time_s = np.asarray(time_s, dtype=np.float64)[:CHECK_ROWS]
     levels = {name: np.asarray(values)[:CHECK_ROWS] for name, values in levels.items()}
     out = []
-    # a dropout shorter than half of tau moves the filter by less than its noise
-    period = burst_period_s(time_s, DROPOUT_FRACTION_OF_TAU * tau_s)
-    if period is not None and tau_s < period:
-        steps = np.diff(time_s)
-        single = np.count_nonzero(steps > max(GAP_FACTOR * np.median(steps[steps > 0]),
-                                              DROPOUT_FRACTION_OF_TAU * tau_s)) == 1
-        what = (f"{period:g} s gap (with its last step) in this recording" if single else
-                f"{period:g} s burst period of this duty-cycled recording")
-        out.append(
-            f"{prefix}the df/dt filter's time constant {tau_s:g} s is shorter than the "
-            f"{what}, so df/dt cannot be followed across the gaps (the samples after a gap "
-            f"read the rate of their own few seconds); pass --rate-tau-s "
-            f"{_round_up(period)} or more, or --gaps split to restart the filter after each")
     duration = float(time_s[-1] - time_s[0]) if time_s.size > 1 else 0.0
     for name, values in levels.items():
         q = resolution(values)

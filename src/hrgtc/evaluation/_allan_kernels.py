@@ -1,7 +1,9 @@
 """Fused numba kernels of the overlapping Allan, modified Allan and Hadamard variances.
 
-Private to :mod:`hrgtc.evaluation.allan`, which imports this module on first use so that
-``import hrgtc.evaluation.allan`` (and the CLI start) does not pay numba's import.
+Private to :mod:`hrgtc.evaluation._allan_sums`, which imports this module on first use so
+that ``import hrgtc.evaluation.allan`` (and the CLI start) does not pay numba's import; the
+overlapping Allan sums at power-of-two factors (``taus="octave"``) come from the C module
+``_allan_octave`` instead, and never import numba.
 
 How the kernels work
 --------------------

@@ -19,15 +19,18 @@ Eq. 14: the m second differences from j to j+m−1 summed before squaring, divid
 2·n·m⁴, n = N+2−3m), ``"hadamard"`` (Eq. 20: third differences x[i+3m] − 3x[i+2m] +
 3x[i+m] − x[i], divided by 6·n·m², n = N+1−3m) and ``"time"`` (Eq. 15: τ·mod σ/√3).
 
-The overlapping statistics run in fused numba kernels (``_allan_kernels``)
-that never store the phase: extra memory is ~1/32 of the input, the values
-are exact to ~1e-14 relative also at 10^8 samples (compensated
-arithmetic; ``allantools`` itself drifts to ~1e-12 there), 7-9× faster
-than ``allantools.oadev`` at 10^8 samples on two threads (5× and more with
-``taus="all"`` on records of 10^4 to 4·10^4 samples), identical bit
-for bit from run to run. The first call of a statistic in a fresh
-environment compiles its kernels (~10 s, and ~6 s more for the many-τ
-kernel; cached in ``__pycache__`` afterwards).
+The overlapping Allan deviation at octave τ (``taus="octave"``, or any power-of-two
+factors) runs in a small C module (``_allan_octave.c``: pairwise block sums, no phase,
+one work array the size of the input, no numba import; docs/architecture.md, "The native
+Allan module"). The other overlapping statistics and factor lists run in fused numba
+kernels (``_allan_kernels``) that never store the phase: extra memory is ~1/32 of the
+input. Both are accurate to ~1e-14 relative (the tests hold them to rational and
+extended-precision sums; ``allantools`` drifts to ~1e-12 at 10^8 samples) and identical
+bit for bit from run to run; the numba kernels are
+5× and more faster than allantools with ``taus="all"`` on records of 10^4 to 4·10^4
+samples. The first call of a numba statistic in a fresh environment compiles its
+kernels (~10 s, and ~6 s more for the many-τ kernel; cached in ``__pycache__``
+afterwards).
 
 References
 ----------
@@ -278,8 +281,8 @@ def _overlapping_deviation(
     values: np.ndarray, kind: str, factors: np.ndarray, fs: float,
     progress: Progress | None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Kept factors, deviations and term counts of an overlapping statistic (numba kernels)."""
-    from hrgtc.evaluation import _allan_kernels  # numba is imported on first use only
+    """Kept factors, deviations and term counts of an overlapping statistic."""
+    from hrgtc.evaluation import _allan_sums
 
     extra, span = _TERMS[kind]
     counts = values.size + extra - span * factors
@@ -294,9 +297,8 @@ def _overlapping_deviation(
     if progress is not None:
         for done in range(1, skipped + 1):
             progress(float(done), float(total))
-    sums = _allan_kernels.sums_of_squares(
-        np.ascontiguousarray(values), "modified" if kind == "time" else kind, kept, report
-    )
+    sums = _allan_sums.sums_of_squares(values, "modified" if kind == "time" else kind, kept,
+                                       report)
     counts = counts[counts > 1]
     return kept, deviation_from_sums(kind, sums, counts, kept, fs), counts
 
@@ -305,7 +307,7 @@ def deviation_from_sums(kind: str, sums: np.ndarray, counts: np.ndarray, factors
                         fs: float) -> np.ndarray:
     """The deviation of ``kind`` from its sums of squared stencil terms and their counts.
 
-    ``sums`` are those of :func:`_allan_kernels.sums_of_squares` (of ``"modified"`` for
+    ``sums`` are those of :func:`_allan_sums.sums_of_squares` (of ``"modified"`` for
     the time deviation); a pooled sum over segments divided by its pooled count gives the
     pooled deviation.
     """

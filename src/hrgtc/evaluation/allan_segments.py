@@ -181,10 +181,10 @@ def _segment_sums(values: np.ndarray, kind: str, overlapping: bool,
             out[k] = float(np.dot(term, term))
         return out
     if overlapping:
-        from hrgtc.evaluation import _allan_kernels  # numba on first use only
+        from hrgtc.evaluation import _allan_sums
 
-        return _allan_kernels.sums_of_squares(
-            np.ascontiguousarray(values), "modified" if kind == "time" else kind, factors)
+        return _allan_sums.sums_of_squares(values, "modified" if kind == "time" else kind,
+                                           factors)
     phase = np.empty(values.size + 1)
     phase[0] = 0.0
     np.cumsum(values - values.mean(), out=phase[1:])

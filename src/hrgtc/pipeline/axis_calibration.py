@@ -45,6 +45,7 @@ from hrgtc.evaluation import Evaluation
 from hrgtc.evaluation.calibration_figures import calibration_summary, thermometer_tables
 from hrgtc.model import AxisModel, Model, provenance
 from hrgtc.pipeline.documents import CalibrationDriftRecord, CalibrationRecord
+from hrgtc.pipeline.narrow_reading import PassPrints
 from hrgtc.pipeline.terms import resolve_terms
 from hrgtc.recording import ReadOptions, Recording
 from hrgtc.recording.mapping import parse_columns, scales_temperature
@@ -237,8 +238,7 @@ def fit_axis(
     training_heads = [heads[str(p)] for p in training]
     settings = _with_terms(settings, resolve_terms(settings.drift.terms, aux, training_heads))
     model, housing = _fit_drift(training, heads, thermometer_fit, options, progress,
-                                len(drifts), settings.drift, aux,
-                                soak_rests.cache(training, len(drifts), options))
+                                len(drifts), settings.drift, aux, soak_rests)
     unit = heads[str(drifts[0])].metadata.unit
     record = _record(settings, aux, options, order=fitted.order)
     if prior_fit is not None:
@@ -288,6 +288,7 @@ class _SoakRests:
     def __init__(self, motion: str, warmups_s: Sequence[float]) -> None:
         self.motion, self.warmups_s = motion, tuple(warmups_s)
         self.found: dict[str, dict[float, Any]] = {}
+        self.prints = PassPrints()  # the drift fit's window pass reads fewer columns
 
     def read(self, options: ReadOptions, path: PathLike) -> Any:
         """The soak's :data:`SOAK_COLUMNS` (as ``options.read(path, keep=SOAK_COLUMNS)``),
@@ -296,7 +297,7 @@ class _SoakRests:
             return options.read(path, keep=SOAK_COLUMNS)  # a reading held in memory
         rest = RestPass(self.motion)
         first, others = None, []  # the first chunk; the columns the detector does not take
-        for chunk in options.chunks(path):
+        for chunk in self.prints.whole(path, options.chunks(path)):
             rest.partial_fit(chunk)
             first = chunk if first is None else first
             others.append({k: chunk[k] for k in SOAK_COLUMNS
@@ -403,13 +404,17 @@ def _record(settings: CalibrationSettings, aux: Mapping[str, str] | None,
 
 class _CountedRun:
     """A training run's chunks, counting the rows the spike filters removed in the last
-    pass over it (the fit reads a run several times)."""
+    pass over it (the fit reads a run several times); with ``prints``, a pass after a
+    whole one reads only the columns the fit takes (:mod:`~hrgtc.pipeline.narrow_reading`)."""
 
-    def __init__(self, options: ReadOptions, path: PathLike) -> None:
-        self.options, self.path, self._dropped = options, path, {}
+    def __init__(self, options: ReadOptions, path: PathLike,
+                 prints: PassPrints | None = None) -> None:
+        self.options, self.path, self._dropped, self.prints = options, path, {}, prints
 
     def __call__(self) -> Any:
         self._dropped = {}
+        if self.prints is not None:
+            return self.prints.chunks(self.options, self.path, self._dropped)
         return self.options.chunks(self.path, dropped=self._dropped)
 
     @property
@@ -420,12 +425,15 @@ class _CountedRun:
 def _fit_drift(training: Sequence[PathLike], heads: Mapping[str, Any], thermometer: Any,
                options: ReadOptions, progress: StageProgress | None, excitation_runs: int,
                drift: DriftSettings, aux: Mapping[str, str] | None,
-               rest_cache: dict[Any, Any] | None = None) -> tuple[Any, Any]:
+               soaks: _SoakRests | None = None) -> tuple[Any, Any]:
     """The drift model on ``training`` and the housing baseline (:data:`HOUSING_TERMS`)
     when every run has ``housing_c`` (None otherwise, or when its fit fails: the baseline
-    is optional). ``rest_cache``: at-rest passes met before (:class:`_SoakRests`)."""
-    runs = [_CountedRun(options, path) for path in training]
-    rest_cache = {} if rest_cache is None else rest_cache  # one at-rest pass per run
+    is optional). ``soaks``: the soaks' passes met before (their at-rest passes and
+    fingerprints, :class:`_SoakRests`); an extra channel (``aux``) reads every column."""
+    prints = None if aux else soaks.prints if soaks is not None else PassPrints()
+    runs = [_CountedRun(options, path, prints) for path in training]
+    # one at-rest pass per run
+    rest_cache = {} if soaks is None else soaks.cache(training, excitation_runs, options)
     reading = TrainingReading(motion=options.motion, gaps=options.gaps, rest_cache=rest_cache)
     requests = [drift_model.FitRequest(drift, aux, excitation_runs,
                                        for_stage(progress, "drift"))]

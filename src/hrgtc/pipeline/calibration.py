@@ -27,6 +27,7 @@ import numpy as np
 from hrgtc.compensate.ranges import RangeReport
 from hrgtc.core import records
 from hrgtc.core.errors import InputError
+from hrgtc.core.files import hash_ahead
 from hrgtc.core.progress import StageProgress
 from hrgtc.core.summary import Summary
 from hrgtc.drift import ScaleFactorModel, find_rate_segments, fit_scale_factor, read_segment_table
@@ -276,6 +277,8 @@ def _reading(soaks: Sequence[PathLike], drifts: Sequence[PathLike],
              options: ReadOptions, progress: StageProgress | None) -> _Reading:
     """The reading of :func:`calibrate`'s files (the parameters are its own), every file
     refused when it is a compensated output."""
+    # the provenance's SHA-256 of every input, on the second core while the fits read them
+    hash_ahead([*soaks, *drifts, *validate, *tables.runs, *tables.validate])
     if options.thermometer not in ("resonator", "sensor"):
         raise InputError("thermometer must be 'resonator' or 'sensor', got "
                          f"{options.thermometer!r}")

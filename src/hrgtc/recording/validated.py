@@ -9,8 +9,10 @@ result. :func:`iter_chunks <hrgtc.recording.io.iter_chunks>` remembers the
 without a problem, keyed on the file's identity (resolved path, inode, modification time
 in ns, size, a digest of its first and last 4 KiB: a file rewritten is another file) and on
 the whole reading options, and a
-later pass with the same key says the report's warnings again instead of validating. A
-pass that stopped early (a head) or raised remembers nothing.
+later pass with the same key says the report's warnings again instead of validating (a
+pass over some of the columns, too: ``calibrate``'s window pass,
+:mod:`hrgtc.pipeline.narrow_reading`). A pass that stopped early (a head) or raised
+remembers nothing.
 """
 
 from __future__ import annotations
@@ -60,13 +62,17 @@ def _ends(path: str | Path, size: int) -> bytes:
 
 
 def known_report(key: tuple[object, ...] | None) -> ValidationReport | None:
-    """The report of an earlier complete pass with ``key`` (None: validate)."""
+    """The report of an earlier complete pass with ``key`` (None: validate); for a pass
+    over some of the file's columns (``only``), also that of a pass over all of them with
+    the same options: every column passed its checks, these among them."""
     if key is None:
         return None
-    report = _REPORTS.get(key)
-    if report is not None:
-        _REPORTS.move_to_end(key)
-    return report
+    for each in (key, (*key[:-1], None)):
+        report = _REPORTS.get(each)
+        if report is not None:
+            _REPORTS.move_to_end(each)
+            return report
+    return None
 
 
 def remember(key: tuple[object, ...] | None, report: ValidationReport) -> None:

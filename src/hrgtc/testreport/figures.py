@@ -97,7 +97,8 @@ FIGURES: dict[str, FigureInfo] = {name: FigureInfo(*info) for name, info in {
     "angle_random_walk_deg_per_rt_h": (
         "angle random walk", "°/√h", "IEEE Std 952-1997, Annex C",
         "The −½-slope line of the overlapping Allan deviation read at τ = 1 h, on the "
-        "longest turn-on after settle_s; U: its χ² interval at k's coverage.", "noise"),
+        "longest stretch at rest of the longest turn-on after settle_s; U: its χ² interval "
+        "at k's coverage.", "noise"),
     "bias_instability_dph": (
         "bias instability", "°/h", "IEEE Std 952-1997, Annex C",
         "The flat minimum of the Allan deviation over 0.664; U: its χ² interval at k's "

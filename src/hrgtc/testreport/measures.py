@@ -26,6 +26,10 @@ __all__ = ["Plateau", "SoakPoint", "TurnOn", "coverage_probability", "line_fit",
            "noise_figures", "scale_factor_figures", "temperature_figures", "turn_on_figures",
            "turn_ons"]
 
+#: Fewest samples at rest the Allan deviation is computed on (a shorter stretch gives no
+#: noise figure, and says why).
+MIN_ALLAN_SAMPLES = 100
+
 
 def coverage_probability(k: float) -> float:
     """The two-sided probability of ±k σ of a normal distribution (k = 2: 0.9545)."""
@@ -284,15 +288,24 @@ def noise_figures(series: RunSeries | None, settings: CampaignSettings
     if series is None or series.samples_dph is None:
         return [not_measured(n, "no turn-on or soak run for the Allan deviation", k)
                 for n in names], {}
-    start = round(series.settle_s(settings.settle_s) * series.sample_rate_hz)
+    fs = series.sample_rate_hz
+    settled = round(series.settle_s(settings.settle_s) * fs)
+    start, stop = series.still_stretch(settled)
+    if stop - start < MIN_ALLAN_SAMPLES:
+        return [not_measured(n, f"no stretch at rest of {MIN_ALLAN_SAMPLES} samples after the "
+                             f"settling in {series.entry.name} (the motion detector's verdict; "
+                             "--motion keep uses every sample)", k) for n in names], {}
     probability = coverage_probability(k)
-    curves = {"raw": allan_deviation(series.samples_dph[start:], series.sample_rate_hz,
+    curves = {"raw": allan_deviation(series.samples_dph[start:stop], fs,
                                       confidence=probability)}
     if series.compensated_samples_dph is not None:
-        curves["compensated"] = allan_deviation(series.compensated_samples_dph[start:],
-                                                series.sample_rate_hz, confidence=probability)
+        curves["compensated"] = allan_deviation(series.compensated_samples_dph[start:stop], fs,
+                                                confidence=probability)
     out = []
     basis = f"χ² interval at {probability:.4g} (k = {k:g})"
+    if stop - start < series.samples_dph.size - settled:
+        basis += (f"; the longest stretch at rest after the settling, {(stop - start) / fs:g} s "
+                  f"of {(series.samples_dph.size - settled) / fs:g} s")
     for key, terms in (("raw", ("arw", "bias_instability", "rrw")),
                        ("compensated", ("bias_instability",))):
         if key not in curves:

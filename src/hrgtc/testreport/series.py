@@ -57,7 +57,10 @@ class RunSeries:
         a burst fills only in part is placed where its samples are. [s]
     n_moving
         Samples the motion detector found not at rest (``--motion exclude``, the default),
-        left out of the block means (the samples kept for the Allan deviation keep them).
+        left out of the block means.
+    samples_at_rest
+        True for each kept sample the motion detector found at rest (``keep_samples``
+        only): the Allan deviation takes the longest stretch of them, :meth:`still_stretch`.
     """
 
     entry: RunEntry
@@ -76,6 +79,21 @@ class RunSeries:
     segment_span_c: tuple[float, ...] = ()
     mean_time_s: np.ndarray | None = None
     n_moving: int = 0
+    samples_at_rest: np.ndarray | None = None
+
+    def still_stretch(self, first: int) -> tuple[int, int]:
+        """Rows [start, stop) of the longest run of samples at rest from row ``first`` on
+        (all of them without the detector's verdict; (first, first) if none is at rest)."""
+        n = 0 if self.samples_dph is None else self.samples_dph.size
+        if self.samples_at_rest is None:
+            return first, max(first, n)
+        padded = np.concatenate(([False], self.samples_at_rest[first:], [False]))
+        edges = np.flatnonzero(padded[1:] != padded[:-1])
+        if not edges.size:
+            return first, first
+        starts, stops = edges[0::2], edges[1::2]
+        k = int(np.argmax(stops - starts))
+        return first + int(starts[k]), first + int(stops[k])
 
     def sample_times_s(self) -> np.ndarray:
         """Where each block's samples are: their mean time (else the block's middle). [s]"""
@@ -166,7 +184,8 @@ def read_series(entry: RunEntry, *, earth_rate_dph: float, block_s: float,
         compensated_dph=means.get("compensated"), temperature_c=means["temperature"],
         mean_time_s=means["time"], n_moving=rest.n_moving,
         samples_dph=columns["bias"] if keep_samples else None,
-        compensated_samples_dph=columns.get("compensated") if keep_samples else None)
+        compensated_samples_dph=columns.get("compensated") if keep_samples else None,
+        samples_at_rest=keep if keep_samples else None)
 
 
 def _read_run(entry: RunEntry, options: ReadOptions, earth_rate_dph: float,

@@ -219,9 +219,10 @@ def _blocks(recording: Recording, block_s: float) -> _Blocks:
             f"time_s{_where(recording)} must increase over at least 2 rows; it does not at "
             f"row {row}: sort the rows or remove duplicated samples"
         )
-    from hrgtc.thermometry._plateau_kernel import block_sums  # numba: loaded when used
+    from hrgtc.thermometry._plateau_kernel import block_index, block_sums  # numba: when used
 
-    idx = np.floor_divide(time - time[0], block_s).astype(np.intp)
+    idx = (block_index(np.ascontiguousarray(time, dtype=np.float64), float(block_s))
+           if block_s > 0 else np.floor_divide(time - time[0], block_s).astype(np.intp))
     ref = float(recording.freq_hz[0])
     count_all, time_sum, dev_sum, dev_sq_sum, chamber_sum = block_sums(
         idx, np.ascontiguousarray(time, dtype=np.float64),
