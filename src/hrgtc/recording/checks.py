@@ -148,7 +148,9 @@ class ValidationReport(records.Written):
                 f"{self.source or 'recording'}: a duty-cycled logger (bursts much shorter "
                 f"than their period, {self.n_gaps - self.n_dropouts} gaps): the filters carry "
                 "across each gap with its duration (--gaps bridge, the default for such a "
-                "logger); pass --gaps split to restart them after each"), stacklevel=3)
+                "logger: after a gap the df/dt filter reads the gap's mean rate); pass --gaps "
+                "split only if the temperature does not move in a straight line across the "
+                "gaps (a unit powered off between bursts)"), stacklevel=3)
 
     def summary(self) -> Summary:
         """Rows, measured rate, problems, dropouts and gaps (the first ten); its text the
