@@ -124,6 +124,17 @@ def chunks_of(recording: Recording, rows: int = CHUNK) -> list[Recording]:
     return [recording.slice(a, a + rows) for a in range(0, len(recording), rows)]
 
 
+def _refuses_a_rate_changed_by_a_nanodegree(run: Recording) -> None:
+    """:meth:`RestFlags.take` refuses the second chunk of ``run`` with one rate 1e-9 °/h
+    off what the detector saw."""
+    changed = run.rate_dph.copy()
+    changed[CHUNK + 5] += 1e-9
+    flags = RestFlags(chunks_of(run), [""], "exclude", "run.parquet")
+    flags.take(run.slice(0, CHUNK))
+    with pytest.raises(FlagsMisaligned, match="rate_dph"):
+        flags.take(run.with_columns(rate_dph=changed).slice(CHUNK, 2 * CHUNK))
+
+
 def test_take_refuses_other_rows_than_the_detector_saw():
     """:meth:`RestFlags.take` and :meth:`RestFlags.finish` raise on a chunk whose detector
     columns differ from those the detector saw at the same rows (a row more, a value
@@ -137,12 +148,7 @@ def test_take_refuses_other_rows_than_the_detector_saw():
     flags = RestFlags(chunks_of(run), [""], "exclude", "run.parquet")
     with pytest.raises(FlagsMisaligned, match=r"run\.parquet.*time_s.*rows 0-6999"):
         flags.take(shifted.slice(0, CHUNK))
-    changed = run.rate_dph.copy()
-    changed[CHUNK + 5] += 1e-9
-    flags = RestFlags(chunks_of(run), [""], "exclude", "run.parquet")
-    flags.take(run.slice(0, CHUNK))
-    with pytest.raises(FlagsMisaligned, match="rate_dph"):
-        flags.take(run.with_columns(rate_dph=changed).slice(CHUNK, 2 * CHUNK))
+    _refuses_a_rate_changed_by_a_nanodegree(run)
     flags = RestFlags(chunks_of(run), [""], "exclude", "run.parquet")
     flags.take(run.slice(0, CHUNK))
     with pytest.raises(FlagsMisaligned, match="7000 rows compensated but 36000"):
@@ -208,9 +214,4 @@ def test_take_with_a_known_input_rate(column):
         np.concatenate([flags.take(c)["at_rest"] for c in chunks_of(run)]),
         expected.astype(float))
     flags.finish()
-    changed = run.rate_dph.copy()
-    changed[CHUNK + 5] += 1e-9
-    flags = RestFlags(chunks_of(run), [""], "exclude", "run.parquet")
-    flags.take(run.slice(0, CHUNK))
-    with pytest.raises(FlagsMisaligned, match="rate_dph"):
-        flags.take(run.with_columns(rate_dph=changed).slice(CHUNK, 2 * CHUNK))
+    _refuses_a_rate_changed_by_a_nanodegree(run)
