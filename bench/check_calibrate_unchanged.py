@@ -15,7 +15,8 @@ interpreter) on
 * the PAN cold test as ``tests/test_against_a_line.py`` calls it;
 
 and writes into ``OUT_DIR`` each case's ``--json`` document and model file with
-``created_utc`` taken out, plus ``hashes.json``: one SHA-256 per case and file. The files
+``created_utc`` taken out, its messages (standard error: the warnings, in their order),
+plus ``hashes.json``: one SHA-256 per case and file. The files
 are written into :data:`WORK` (emptied first): a model names its files, so the folder
 must be the same before and after. Run it on the checkout before a change and after it, and
 ``diff -r`` the two folders: any difference is a changed figure to explain.
@@ -35,8 +36,9 @@ BENCH = Path(__file__).resolve().parent
 ROOT = BENCH.parent
 HRGTC = str(Path(sys.executable).with_name("hrgtc"))
 SRC = os.environ.get("HRGTC_CHECK_SRC")
-#: Where the demo campaigns and models are written (the same folder every run).
-WORK = Path("/tmp/hrgtc-check-calibrate")
+#: Where the demo campaigns and models are written (the same folder every run;
+#: ``HRGTC_CHECK_WORK`` names another, for two checks on one machine at once).
+WORK = Path(os.environ.get("HRGTC_CHECK_WORK", "/tmp/hrgtc-check-calibrate"))
 PAN = ROOT / "tests" / "data" / "pan-cold-test"
 PAN_ARGS = (
     "--thermometer", "sensor", "--gaps", "bridge", "--time-unit", "ms", "--rate-unit", "radps",
@@ -78,6 +80,8 @@ def calibrate(name: str, args: list[str], folder: Path, out: Path) -> dict[str, 
         canonical = _canonical(text)
         (out / f"{name}.{kind}.json").write_text(canonical, encoding="utf-8")
         hashes[kind] = hashlib.sha256(canonical.encode()).hexdigest()
+    (out / f"{name}.stderr.txt").write_text(result.stderr, encoding="utf-8")
+    hashes["stderr"] = hashlib.sha256(result.stderr.encode()).hexdigest()
     print(name, hashes, flush=True)
     return hashes
 

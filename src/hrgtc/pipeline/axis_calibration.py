@@ -26,13 +26,13 @@ from typing import Any
 import numpy as np
 
 from hrgtc import drift as drift_model
-from hrgtc.core import records
+from hrgtc.core import forked, records
 from hrgtc.core.errors import CalibrationError, ExtrapolationWarning, HrgtcWarning, InputError
 from hrgtc.core.progress import StageProgress, for_stage
 from hrgtc.core.summary import Summary
 from hrgtc.drift.features import EQ21
-from hrgtc.drift.fit_stages import TrainingReading, fit_warmup, rest_key
-from hrgtc.drift.rest import RestPass, run_rest
+from hrgtc.drift.fit_stages import TrainingReading, fit_warmup
+from hrgtc.drift.rest import run_rest
 from hrgtc.drift.training import (
     ChannelShape,
     TrainingStatistics,
@@ -46,22 +46,20 @@ from hrgtc.evaluation.calibration_figures import calibration_summary, thermomete
 from hrgtc.model import AxisModel, Model, provenance
 from hrgtc.pipeline.documents import CalibrationDriftRecord, CalibrationRecord
 from hrgtc.pipeline.narrow_reading import PassPrints
+from hrgtc.pipeline.soak_pass import SoakPass, SoakRests
 from hrgtc.pipeline.terms import resolve_terms
-from hrgtc.recording import ReadOptions, Recording
+from hrgtc.recording import ReadOptions
 from hrgtc.recording.mapping import parse_columns, scales_temperature
-from hrgtc.recording.schema import concatenate
 from hrgtc.settings import to_dict
 from hrgtc.settings.calibration import CalibrationSettings
 from hrgtc.settings.drift import GRADIENT_TERMS, DriftSettings
 from hrgtc.thermometry import fit as fit_thermometer
 from hrgtc.thermometry import identity
-from hrgtc.thermometry.plateaus import Plateau, plateau_table, plateaus_from_recordings
+from hrgtc.thermometry.plateaus import Plateau, plateau_table
 from hrgtc.thermometry.prior import PriorFit, ThermometerPrior, fit_with_prior, load_prior
 
 PathLike = str | os.PathLike[str]
 
-#: Columns plateau detection needs from a soak.
-SOAK_COLUMNS = ("time_s", "freq_hz", "chamber_c")
 #: Classical baseline: cubic in housing temperature.
 HOUSING_TERMS = ("h", "h^2", "h^3")
 
@@ -225,7 +223,7 @@ def fit_axis(
     # the soaks that join the drift fit are read once for the plateaus and its at-rest pass
     # (not with --motion error: a soak's motion is then the fit's error, said where it was)
     joins = settings.drift_from_soaks and options.motion != "error"
-    soak_rests = _SoakRests(options.motion,
+    soak_rests = SoakRests(options.motion,
                             _likely_warmups(settings.drift, aux) if joins else ())
     fitted = soak_fit or fit_soaks(soaks, settings=settings, prior=prior,
                                    read_options=options, progress=progress, rests=soak_rests)
@@ -280,50 +278,6 @@ def _likely_warmups(drift: DriftSettings, aux: Mapping[str, str] | None) -> tupl
     return tuple(dict.fromkeys(found))
 
 
-class _SoakRests:
-    """The drift fit's at-rest passes over the soaks, run on the soak plateaus' reading of
-    each file (each soak read once fewer): the detector's columns gathered from the same
-    chunks (:class:`~hrgtc.drift.rest.RestPass`), one result per likely warm-up."""
-
-    def __init__(self, motion: str, warmups_s: Sequence[float]) -> None:
-        self.motion, self.warmups_s = motion, tuple(warmups_s)
-        self.found: dict[str, dict[float, Any]] = {}
-        self.prints = PassPrints()  # the drift fit's window pass reads fewer columns
-
-    def read(self, options: ReadOptions, path: PathLike) -> Any:
-        """The soak's :data:`SOAK_COLUMNS` (as ``options.read(path, keep=SOAK_COLUMNS)``),
-        its at-rest passes kept."""
-        if type(options).read is not ReadOptions.read or not self.warmups_s:
-            return options.read(path, keep=SOAK_COLUMNS)  # a reading held in memory
-        rest = RestPass(self.motion)
-        first, others = None, []  # the first chunk; the columns the detector does not take
-        for chunk in self.prints.whole(path, options.chunks(path)):
-            rest.partial_fit(chunk)
-            first = chunk if first is None else first
-            others.append({k: chunk[k] for k in SOAK_COLUMNS
-                           if k in chunk and k not in RestPass.WANTED})
-        if first is None:
-            return concatenate([])  # refused as the plain reading refuses it
-        gathered = rest.columns  # the detector's buffers hold time_s and freq_hz whole
-        try:
-            found = rest.finish_each(self.warmups_s)
-        except (InputError, CalibrationError):  # said by the fit's own pass, if it joins
-            found = []
-        self.found[str(path)] = dict(zip(self.warmups_s, found, strict=False))
-        return Recording({k: gathered[k] if k in RestPass.WANTED else
-                          np.concatenate([part[k] for part in others])
-                          for k in SOAK_COLUMNS if k in first}, first.metadata, first.source)
-
-    def cache(self, training: Sequence[PathLike], first: int,
-              options: ReadOptions) -> dict[Any, Any]:
-        """A rest cache for the drift fit on ``training``, whose runs from ``first`` on are
-        the soaks (keyed as :func:`~hrgtc.drift.fit_stages.rest_key`)."""
-        reading = TrainingReading(motion=options.motion, gaps=options.gaps)
-        return {rest_key(number, reading, warmup): rest
-                for number, path in enumerate(training) if number >= first
-                for warmup, rest in self.found.get(str(path), {}).items()}
-
-
 def _soaks_for_drift(soaks: Sequence[PathLike], soak_rates: Sequence[float],
                      settings: CalibrationSettings, drift_rate: float) -> list[PathLike]:
     """The soaks that join the drift fit: none unless ``settings.drift_from_soaks``, and
@@ -344,7 +298,7 @@ def fit_soaks(soaks: Sequence[PathLike], *, settings: CalibrationSettings | None
               prior: ThermometerPrior | PathLike | None = None,
               read_options: ReadOptions | None = None,
               progress: StageProgress | None = None,
-              rests: _SoakRests | None = None) -> SoakFit:
+              rests: SoakRests | None = None) -> SoakFit:
     """The thermometer from the soaks: plateaus -> Table 1 -> Eq. 18 form -> Table 2.
 
     Parameters are those of :func:`fit_axis` (``settings.plateaus`` finds the plateaus,
@@ -355,11 +309,16 @@ def fit_soaks(soaks: Sequence[PathLike], *, settings: CalibrationSettings | None
     settings = settings or CalibrationSettings()
     plateaus: list[Plateau] = []
     soak_rates: list[float] = []
-    for number, path in enumerate(soaks):
-        soak = (options.read(path, keep=SOAK_COLUMNS) if rests is None
-                else rests.read(options, path))
-        soak_rates.append(soak.metadata.sample_rate_hz)
-        plateaus.extend(plateaus_from_recordings([soak], settings.plateaus))
+    # the soaks are independent until their plateaus are combined: on every core
+    # (hrgtc.core.forked), unless a reading held in memory serves them
+    workers = (forked.processes(len(soaks), soaks)
+               if type(options).read is ReadOptions.read else 1)
+    each = SoakPass(options, settings, rests)
+    for number, (rate, found, passed) in enumerate(forked.map_in_order(each, soaks, workers)):
+        soak_rates.append(rate)
+        plateaus.extend(found)
+        if rests is not None:
+            rests.keep(soaks[number], passed)
         if progress is not None:
             progress("soaks", number + 1, len(soaks))
     temperatures, frequencies = plateau_table(plateaus)
@@ -425,11 +384,11 @@ class _CountedRun:
 def _fit_drift(training: Sequence[PathLike], heads: Mapping[str, Any], thermometer: Any,
                options: ReadOptions, progress: StageProgress | None, excitation_runs: int,
                drift: DriftSettings, aux: Mapping[str, str] | None,
-               soaks: _SoakRests | None = None) -> tuple[Any, Any]:
+               soaks: SoakRests | None = None) -> tuple[Any, Any]:
     """The drift model on ``training`` and the housing baseline (:data:`HOUSING_TERMS`)
     when every run has ``housing_c`` (None otherwise, or when its fit fails: the baseline
     is optional). ``soaks``: the soaks' passes met before (their at-rest passes and
-    fingerprints, :class:`_SoakRests`); an extra channel (``aux``) reads every column."""
+    fingerprints, :class:`SoakRests`); an extra channel (``aux``) reads every column."""
     prints = None if aux else soaks.prints if soaks is not None else PassPrints()
     runs = [_CountedRun(options, path, prints) for path in training]
     # one at-rest pass per run

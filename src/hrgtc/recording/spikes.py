@@ -50,10 +50,12 @@ import os
 import warnings
 from collections import OrderedDict
 from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 
 from hrgtc.core.errors import InputError, SpikeWarning
+from hrgtc.core.forked import share_memo
 from hrgtc.core.summary import Figure, Summary, escape
 from hrgtc.recording.axes import axis_names, base_name
 from hrgtc.recording.checks import _BOUNDS, FREQ_JUMP_FRACTION, TEMPERATURE_RANGE_C
@@ -262,6 +264,18 @@ _MEMO: OrderedDict[tuple[object, ...], np.ndarray] = OrderedDict()
 _MEMO_PIECES = 4096
 
 
+def _keep(key: tuple[object, ...], value: Any) -> None:
+    """Keep ``value`` in :data:`_MEMO`, the oldest pieces forgotten beyond its size."""
+    _MEMO[key] = value
+    _MEMO.move_to_end(key)
+    while len(_MEMO) > _MEMO_PIECES:
+        _MEMO.popitem(last=False)
+
+
+# a worker process's pieces come back to the command (hrgtc.core.forked)
+share_memo(_MEMO, _keep)
+
+
 def _file_identity(source: str | None) -> tuple[str, int, int] | None:
     """(path, mtime, size) of the file ``source`` (None for none or a stream)."""
     if not source:
@@ -411,9 +425,7 @@ class RobustSpikeFilter:
         mask = find_spikes(time_s, values, k=self.k, lsb_multiple=self.lsb_multiple,
                            window_s=self.window_s, lsb=self._lsb[name])
         if key is not None:
-            _MEMO[key] = np.flatnonzero(mask)
-            while len(_MEMO) > _MEMO_PIECES:
-                _MEMO.popitem(last=False)
+            _keep(key, np.flatnonzero(mask))
         return mask
 
     def _turning(self, columns: Mapping[str, np.ndarray], time_s: np.ndarray

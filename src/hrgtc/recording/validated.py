@@ -24,6 +24,7 @@ from collections.abc import Collection
 from pathlib import Path
 from typing import Any
 
+from hrgtc.core.forked import share_memo
 from hrgtc.recording.checks import ValidationReport
 
 #: the most recent reports kept (one per file and reading options)
@@ -83,6 +84,10 @@ def remember(key: tuple[object, ...] | None, report: ValidationReport) -> None:
     _REPORTS.move_to_end(key)
     while len(_REPORTS) > _KEPT:
         _REPORTS.popitem(last=False)
+
+
+# a worker process's reports come back to the command (hrgtc.core.forked)
+share_memo(_REPORTS, remember)
 
 
 def forget() -> None:
