@@ -223,6 +223,7 @@ def test_cross_axis_fits_the_thermometer_once(imu_campaign, monkeypatch):
     axis twice from scratch (coefficients to 1e-12)."""
     import hrgtc.pipeline.axis_calibration as calibration
     import hrgtc.pipeline.calibration as chain
+    import hrgtc.pipeline.soak_pass as soak_pass
     from hrgtc.settings.calibration import CalibrationSettings
 
     campaign = imu_campaign
@@ -236,8 +237,8 @@ def test_cross_axis_fits_the_thermometer_once(imu_campaign, monkeypatch):
 
     monkeypatch.setattr(calibration, "fit_thermometer",
                         counted("thermometer", calibration.fit_thermometer))
-    monkeypatch.setattr(calibration, "plateaus_from_recordings",
-                        counted("plateaus", calibration.plateaus_from_recordings))
+    monkeypatch.setattr(soak_pass, "plateaus_from_recordings",  # each soak's pass
+                        counted("plateaus", soak_pass.plateaus_from_recordings))
     settings = CalibrationSettings(cross_axis=True)
     args = (campaign["soaks"], [campaign["cool"]], [campaign["warm"]])
     once = calibrate(*args, settings=settings)

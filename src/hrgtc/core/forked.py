@@ -148,7 +148,10 @@ def _run_piece(index: int) -> bytes:
     said = [(_portable(w.message), w.category, w.filename, w.lineno) for w in caught]
     added = [[(k, v) for k, v in memo.items() if k not in seen]
              for (memo, _), seen in zip(_MEMOS, before, strict=True)]
-    return _dumps((result, said, added, failed))
+    try:
+        return _dumps((result, said, added, failed))
+    except Exception:  # a result that cannot travel: the piece is run in the command
+        return _dumps((None, [], [[] for _ in _MEMOS], True))
 
 
 class _Compact(pickle.Pickler):

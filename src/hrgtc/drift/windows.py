@@ -47,6 +47,7 @@ from hrgtc.core.timeline import (
 )
 from hrgtc.drift.features import FeatureSettings, FeatureStream, Term, variables_for
 from hrgtc.drift.rate_checks import filtered_levels, rate_filter_problems, warn_rate_filter
+from hrgtc.drift.run_windows import read_in_workers, workers_for
 from hrgtc.drift.window_averager import _WindowMeans
 from hrgtc.recording import Recording
 
@@ -253,7 +254,9 @@ def window_means_jointly(runs: Sequence[RunSource], jobs: Sequence[WindowJob]
     """The results of several :func:`window_means_at` on the same runs from one reading of
     them (the drift model and the housing baseline: one pass, not one per fit). Each job's
     result is what its own :func:`window_means_at` gives, or the error it raised (the
-    first job's error is raised at once: the later ones are never needed without it)."""
+    first job's error is raised at once: the later ones are never needed without it).
+    Runs read from large files are read in worker processes, one run each
+    (:mod:`hrgtc.drift.run_windows`), with the same result."""
     out: list[tuple[TrainingWindows, ...] | Exception | None] = [None] * len(jobs)
     live = list(range(len(jobs)))
 
@@ -267,7 +270,10 @@ def window_means_jointly(runs: Sequence[RunSource], jobs: Sequence[WindowJob]
                 out[k] = exc
                 live.remove(k)
 
-    for index, source in enumerate(runs):
+    workers = workers_for(runs)
+    if workers > 1:  # each run's pass in a worker process (every core)
+        read_in_workers(runs, jobs, live, out, workers, _iter_run)
+    for index, source in enumerate(runs if workers < 2 else ()):
         each(lambda job, index=index: job.start_run(index))
         for chunk in _iter_run(source):
             each(lambda job, chunk=chunk: job.add(chunk))

@@ -380,6 +380,20 @@ class _CountedRun:
     def spikes(self) -> int:
         return int(self._dropped.get("spikes", 0))
 
+    @property
+    def worker_path(self) -> PathLike | None:
+        """The file, when a worker process may read it (not a reading held in memory:
+        :class:`~hrgtc.drift.run_windows.ForkableRun`)."""
+        return self.path if type(self.options).read is ReadOptions.read else None
+
+    def passed(self) -> dict[str, int]:
+        """What the last pass counted (the rows the spike filters removed)."""
+        return dict(self._dropped)
+
+    def restore(self, state: dict[str, int]) -> None:
+        """Take the count of a pass made in a worker process."""
+        self._dropped = dict(state)
+
 
 def _fit_drift(training: Sequence[PathLike], heads: Mapping[str, Any], thermometer: Any,
                options: ReadOptions, progress: StageProgress | None, excitation_runs: int,
