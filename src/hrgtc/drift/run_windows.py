@@ -75,6 +75,11 @@ class _RunPass:
     jobs: Sequence[Any]
     iterate: Callable[[Any], Any]
 
+    @staticmethod
+    def prepare() -> None:
+        """Load the df/dt filter's compiled loops once, before worker processes fork."""
+        import hrgtc.drift._rate_kernel  # noqa: F401
+
     def __call__(self, index: int) -> tuple[list[RunPart | Exception], Any]:
         copies = [_blank(job) for job in self.jobs]
         failed: list[Exception | None] = [None] * len(copies)

@@ -102,6 +102,8 @@ class SoakPass:
         """Load what every soak's pass loads on first use (before worker processes fork)."""
         import scipy.optimize  # noqa: F401  (the settling transients' fits)
 
+        import hrgtc.thermometry._plateau_kernel  # noqa: F401  (the plateaus' block sums)
+
     def __call__(self, path: PathLike) -> tuple[float, list[Plateau], Any]:
         rests = self.rests
         soak = (self.options.read(path, keep=SOAK_COLUMNS) if rests is None
