@@ -112,8 +112,12 @@ def test_processes_are_used_only_for_pieces_worth_a_fork(tmp_path, monkeypatch):
     big = tmp_path / "big.bin"
     with open(big, "wb") as handle:
         handle.truncate(forked.MIN_BYTES_PER_PIECE)  # sparse: its size is what counts
+    assert forked.processes(3, [big] * 3) == min(forked.idle_cores(), 3)
+    monkeypatch.setattr(os, "getloadavg", lambda: (0.0, 0.0, 0.0))  # an idle machine
     cores = len(os.sched_getaffinity(0))
     assert forked.processes(3, [big] * 3) == min(cores, 3)
+    monkeypatch.setattr(os, "getloadavg", lambda: (float(cores), 0.0, 0.0))  # a busy one
+    assert forked.processes(3, [big] * 3) == 1
     monkeypatch.setenv(forked.ENVIRONMENT, "1")
     assert forked.processes(3, [big] * 3) == 1
     monkeypatch.setenv(forked.ENVIRONMENT, "8")

@@ -22,8 +22,8 @@ What the result is, and what the command sees, does not depend on the workers:
   a worker gives its in-process result).
 
 Workers are used on Linux only (``fork``), when :func:`processes` says the pieces are
-worth it; ``HRGTC_PROCESSES=1`` runs everything in-process, ``HRGTC_PROCESSES=N`` sets the
-workers (a test forces them on small files).
+worth it and cores are idle; ``HRGTC_PROCESSES=1`` runs everything in-process,
+``HRGTC_PROCESSES=N`` sets the workers (a test forces them on small files).
 """
 
 from __future__ import annotations
@@ -67,8 +67,9 @@ def share_memo(memo: MutableMapping[Any, Any], keep: Callable[[Any, Any], None])
 
 def processes(pieces: int, paths: Sequence[Any] = ()) -> int:
     """How many worker processes :func:`map_in_order` should use for ``pieces`` pieces of
-    work over the files ``paths``: ``HRGTC_PROCESSES`` if set, else one per core (at most
-    one per piece) when the files hold :data:`MIN_BYTES_PER_PIECE` per piece, else 1."""
+    work over the files ``paths``: ``HRGTC_PROCESSES`` if set, else one per idle core
+    (:func:`idle_cores`, at most one per piece) when the files hold
+    :data:`MIN_BYTES_PER_PIECE` per piece, else 1."""
     if _IN_WORKER or pieces < 2 or not sys.platform.startswith("linux"):
         return 1
     given = os.environ.get(ENVIRONMENT, "").strip()
@@ -85,7 +86,19 @@ def processes(pieces: int, paths: Sequence[Any] = ()) -> int:
             continue
     if size < MIN_BYTES_PER_PIECE * pieces:
         return 1
-    return max(1, min(len(os.sched_getaffinity(0)), pieces))
+    return max(1, min(idle_cores(), pieces))
+
+
+def idle_cores() -> int:
+    """The cores this command may take: those of its CPU set the last minute's load average
+    leaves idle, plus its own (on a machine busy with other work, workers only add the
+    cost of starting them: ``docs/benchmarks.md``)."""
+    cores = len(os.sched_getaffinity(0))
+    try:
+        busy = os.getloadavg()[0]
+    except OSError:
+        busy = 0.0
+    return max(1, min(cores, 1 + int(max(cores - busy, 0.0))))
 
 
 def map_in_order(work: Callable[[T], R], items: Sequence[T], workers: int) -> Iterator[R]:
