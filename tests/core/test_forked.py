@@ -116,7 +116,9 @@ def test_processes_are_used_only_for_pieces_worth_a_fork(tmp_path, monkeypatch):
     monkeypatch.setattr(os, "getloadavg", lambda: (0.0, 0.0, 0.0))  # an idle machine
     cores = len(os.sched_getaffinity(0))
     assert forked.processes(3, [big] * 3) == min(cores, 3)
-    monkeypatch.setattr(os, "getloadavg", lambda: (float(cores), 0.0, 0.0))  # a busy one
+    monkeypatch.setattr(os, "getloadavg", lambda: (cores + 0.5, 0.0, 0.0))  # busy: still
+    assert forked.processes(3, [big] * 3) == min(cores, 3)
+    monkeypatch.setattr(os, "getloadavg", lambda: (2.0 * cores, 0.0, 0.0))  # overloaded
     assert forked.processes(3, [big] * 3) == 1
     monkeypatch.setenv(forked.ENVIRONMENT, "1")
     assert forked.processes(3, [big] * 3) == 1

@@ -22,7 +22,7 @@ What the result is, and what the command sees, does not depend on the workers:
   a worker gives its in-process result).
 
 Workers are used on Linux only (``fork``), when :func:`processes` says the pieces are
-worth it and cores are idle; ``HRGTC_PROCESSES=1`` runs everything in-process,
+worth it and the machine is not overloaded; ``HRGTC_PROCESSES=1`` runs everything in-process,
 ``HRGTC_PROCESSES=N`` sets the workers (a test forces them on small files).
 """
 
@@ -67,7 +67,7 @@ def share_memo(memo: MutableMapping[Any, Any], keep: Callable[[Any, Any], None])
 
 def processes(pieces: int, paths: Sequence[Any] = ()) -> int:
     """How many worker processes :func:`map_in_order` should use for ``pieces`` pieces of
-    work over the files ``paths``: ``HRGTC_PROCESSES`` if set, else one per idle core
+    work over the files ``paths``: ``HRGTC_PROCESSES`` if set, else one per core
     (:func:`idle_cores`, at most one per piece) when the files hold
     :data:`MIN_BYTES_PER_PIECE` per piece, else 1."""
     if _IN_WORKER or pieces < 2 or not sys.platform.startswith("linux"):
@@ -90,15 +90,17 @@ def processes(pieces: int, paths: Sequence[Any] = ()) -> int:
 
 
 def idle_cores() -> int:
-    """The cores this command may take: those of its CPU set the last minute's load average
-    leaves idle, plus its own (on a machine busy with other work, workers only add the
-    cost of starting them: ``docs/benchmarks.md``)."""
+    """The cores of this command's CPU set, or 1 on a machine whose last minute's load
+    average is twice its cores or more. Beside other work a command's workers still get it
+    more of the machine than one process (the scheduler shares it per process; measured,
+    ``docs/benchmarks.md``), at the cost of their start-up; on an overloaded machine that
+    cost is taken from everyone else."""
     cores = len(os.sched_getaffinity(0))
     try:
         busy = os.getloadavg()[0]
     except OSError:
         busy = 0.0
-    return max(1, min(cores, 1 + int(max(cores - busy, 0.0))))
+    return 1 if busy >= 2 * cores else cores
 
 
 def map_in_order(work: Callable[[T], R], items: Sequence[T], workers: int) -> Iterator[R]:
