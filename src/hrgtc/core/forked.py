@@ -91,10 +91,10 @@ def processes(pieces: int, paths: Sequence[Any] = ()) -> int:
 
 def idle_cores() -> int:
     """The cores of this command's CPU set, or 1 on a machine whose last minute's load
-    average is twice its cores or more. Beside other work a command's workers still get it
-    more of the machine than one process (the scheduler shares it per process; measured,
-    ``docs/benchmarks.md``), at the cost of their start-up; on an overloaded machine that
-    cost is taken from everyone else."""
+    average is twice its cores or more. The workers cost CPU (their start-up, their first
+    pieces' memory): they pay where a core is free and cost some 10-17 % of wall time where
+    it is not (``docs/benchmarks.md``); the load average lags too much to tell which, so
+    only an overloaded machine is spared them (``HRGTC_PROCESSES=1`` spares any)."""
     cores = len(os.sched_getaffinity(0))
     try:
         busy = os.getloadavg()[0]
