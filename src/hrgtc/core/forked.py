@@ -104,17 +104,19 @@ def idle_cores() -> int:
 
 
 def map_in_order(work: Callable[[T], R], items: Sequence[T], workers: int) -> Iterator[R]:
-    """``work(item)`` for each of ``items``, in order; with ``workers`` > 1 computed in that
-    many forked processes (see the module docstring for what stays the same). A ``work``
-    with a ``prepare()`` method has it called first, in the command: what every piece
-    imports or loads (scipy, compiled kernels) is then loaded once, not in each worker."""
-    if workers < 2 or len(items) < 2:
+    """``work(item)`` for each of ``items``, in order; with ``workers`` > 1 the first in the
+    command, the others in that many forked processes (see the module docstring for what
+    stays the same). What the first piece loads (imports, compiled kernels) the workers
+    inherit instead of loading it each; a ``work`` with a ``prepare()`` method has it
+    called before the fork too."""
+    if workers < 2 or len(items) < 3:
         for item in items:
             yield work(item)
         return
     import multiprocessing
 
     global _WORK
+    yield work(items[0])
     prepare = getattr(work, "prepare", None)
     if prepare is not None:
         prepare()
@@ -122,11 +124,12 @@ def map_in_order(work: Callable[[T], R], items: Sequence[T], workers: int) -> It
     sys.stderr.flush()
     _WORK = (work, items)
     try:
-        pool = multiprocessing.get_context("fork").Pool(workers, initializer=_start_worker)
+        pool = multiprocessing.get_context("fork").Pool(min(workers, len(items) - 1),
+                                                        initializer=_start_worker)
     finally:
         _WORK = None
     with pool:
-        for index, sent in enumerate(pool.imap(_run_piece, range(len(items)))):
+        for index, sent in enumerate(pool.imap(_run_piece, range(1, len(items))), start=1):
             result, said, memos, failed = pickle.loads(sent)
             if failed:  # its error raised here (its warnings said once, from here)
                 yield work(items[index])
