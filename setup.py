@@ -1,7 +1,9 @@
-"""The compiled part of hrgtc: the octave Allan sums (src/hrgtc/evaluation/_allan_octave.c).
+"""The compiled part of hrgtc: the octave Allan sums (src/hrgtc/evaluation/_allan_octave.c)
+and the at-rest detector's loops (src/hrgtc/recording/_motion_native.c).
 
 Everything else is in pyproject.toml; ``pip install -e .`` (``make .venv/.installed``)
-builds the module in place. Why C: docs/architecture.md, "The native Allan module".
+builds the modules in place. Why C: docs/architecture.md, "The native Allan module" and
+"The native at-rest detector".
 """
 
 import sys
@@ -17,6 +19,11 @@ setup(
             "hrgtc.evaluation._allan_octave",
             ["src/hrgtc/evaluation/_allan_octave.c"],
             extra_compile_args=FLAGS,
-        )
+        ),
+        Extension(
+            "hrgtc.recording._motion_native",
+            ["src/hrgtc/recording/_motion_native.c"],
+            extra_compile_args=FLAGS,
+        ),
     ]
 )

@@ -27,7 +27,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from hrgtc.recording._motion_kernel import median as _long_median
+from hrgtc.recording._median_numba import median as _long_median
 
 _JIT = {"cache": True, "nogil": True, "fastmath": False}
 
