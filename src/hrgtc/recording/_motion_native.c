@@ -274,17 +274,20 @@ static idx sample_differences(const double *x, const uint8_t *breaks, idx n, int
     return s;
 }
 
-static void bracket_differences(const double *x, const uint8_t *breaks, idx n, int mode,
-                                double centre, double lo, double hi, idx counts[4],
-                                double *inside)
+/* one mode's loop: `mode` a constant in each call of bracket_differences, so the
+ * selection compiles to selects (no branch) and the loop is specialised */
+static inline __attribute__((always_inline)) void bracket_mode(
+    const double *x, const uint8_t *breaks, idx n, const int mode, double centre, double lo,
+    double hi, idx counts[4], double *inside)
 {
     idx below = 0, equal_lo = 0, equal_hi = 0, kept = 0;
+    const int distinct = hi != lo;
     for (idx i = 0; i < n; i++) {
         int ok = valid(x, breaks, i, mode);
         double v = value(x, i, mode, centre);
         below += ok & (v < lo);
         equal_lo += ok & (v == lo);
-        equal_hi += ok & (v == hi) & (hi != lo);
+        equal_hi += ok & (v == hi) & distinct;
         inside[kept] = v;
         kept += ok & (lo < v) & (v < hi);
     }
@@ -292,6 +295,18 @@ static void bracket_differences(const double *x, const uint8_t *breaks, idx n, i
     counts[1] = equal_lo;
     counts[2] = kept;
     counts[3] = equal_hi;
+}
+
+static void bracket_differences(const double *x, const uint8_t *breaks, idx n, int mode,
+                                double centre, double lo, double hi, idx counts[4],
+                                double *inside)
+{
+    switch (mode) {
+    case FORWARD: bracket_mode(x, breaks, n, FORWARD, centre, lo, hi, counts, inside); break;
+    case INSIDE: bracket_mode(x, breaks, n, INSIDE, centre, lo, hi, counts, inside); break;
+    case DEVIATION: bracket_mode(x, breaks, n, DEVIATION, centre, lo, hi, counts, inside); break;
+    default: bracket_mode(x, breaks, n, INSIDE_FORWARD, centre, lo, hi, counts, inside);
+    }
 }
 
 static idx gather_differences(const double *x, const uint8_t *breaks, idx n, int mode,
