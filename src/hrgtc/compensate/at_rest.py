@@ -41,7 +41,8 @@ with the pass reading every column (a slower, correct run, never misaligned flag
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -110,7 +111,7 @@ class RestFlags:
     def _find(self, chunks: Iterable[Recording]) -> dict[str, np.ndarray]:
         passes = {axis: RestPass(self._policy, name=self._name, rows=self._rows,
                                  in_place=True) for axis in self.axes}
-        for chunk in chunks:
+        for chunk in _read_ahead(chunks):
             for axis, rest in passes.items():
                 view = axis_view(chunk, axis) if axis else chunk
                 rest.partial_fit(Recording({k: view[k] for k in DETECTOR_COLUMNS if k in view},
@@ -172,6 +173,17 @@ class RestFlags:
             f"{self._name}: the motion detector's pass and the compensating pass read other "
             f"rows ({what}); the at_rest flags would not line up, none are written. Was the "
             "file changed while it was read?")
+
+
+def _read_ahead(chunks: Iterable[Recording]) -> Iterator[Recording]:
+    """``chunks``, the next one read on a thread while this one's columns are gathered
+    (pyarrow and h5py release the GIL), as the compensating pass reads ahead."""
+    iterator = iter(chunks)
+    with ThreadPoolExecutor(max_workers=1) as reading:
+        ahead = reading.submit(next, iterator, None)
+        while (chunk := ahead.result()) is not None:
+            ahead = reading.submit(next, iterator, None)
+            yield chunk
 
 
 def _same(a: np.ndarray, b: np.ndarray) -> bool:
