@@ -21,7 +21,8 @@ The cost (issue 20, ``docs/benchmarks.md``): a second reading of the detector's
 columns, without their validation (the compensating pass validates every sample; if the unvalidated
 pass fails, the file is read again validated, so a bad file gets the validator's
 error), and the detector's columns in memory, once (time and rate: 16 bytes a sample
-and axis; a 3-day 1 Hz file: 260,000 rows, 4 MB). The detector's loops are compiled
+and axis; a 3-day 1 Hz file: 260,000 rows, 4 MB). The pass reads the next chunk on a
+thread while it gathers this one; the detector's loops are C
 (:mod:`hrgtc.recording._motion_kernel`). ``--motion keep`` skips the pass and writes
 no flag; ``--motion error`` stops at the first moving sample, naming it.
 
