@@ -158,3 +158,25 @@ def guard(found: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray], starts: 
 def isolated_runs(stepped: np.ndarray, near: np.ndarray, out: np.ndarray) -> None:
     """OR into ``out`` each run of ``stepped`` none of whose samples is ``near``."""
     _native.isolated_runs(stepped, near, out)
+
+
+#: xxHash64's first two primes: the lanes' starting values (:func:`digest_start`).
+_P1, _P2 = 11400714785074694791, 14029467366897019727
+
+
+def digest_start() -> np.ndarray:
+    """A fresh digest state (four lanes and a count of words, as int64)."""
+    lanes = [(_P1 + _P2) % 2**64, _P2, 0, 2**64 - _P1, 0]
+    return np.array(lanes, dtype=np.uint64).view(np.int64)
+
+
+def digest_update(state: np.ndarray, values: np.ndarray) -> None:
+    """Feed the bits of ``values`` (float64, contiguous) into ``state``; feeding an array in
+    pieces gives the digest of the whole."""
+    _native.digest_update(state, values)
+
+
+def digest(state: np.ndarray) -> int:
+    """The 64-bit digest of the values fed so far: a change of one value always changes
+    it, more changes with a chance of about 2^-64 (``_motion_native.c``)."""
+    return _native.digest(state)
