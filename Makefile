@@ -14,7 +14,7 @@ STAMP := $(VENV)/.installed
 SYSTEM_COMMANDS := chromium gcc
 
 # setup.py compiles the C sources (NATIVE) in place: gcc must be there first (system).
-NATIVE := src/hrgtc/evaluation/_allan_octave.c src/hrgtc/recording/_motion_native.c
+NATIVE := src/hrgtc/evaluation/_allan_octave.c $(wildcard src/hrgtc/recording/_motion_*.[ch])
 
 $(STAMP): pyproject.toml setup.py $(NATIVE) | system
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)

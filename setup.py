@@ -23,6 +23,8 @@ setup(
         Extension(
             "hrgtc.recording._motion_native",
             ["src/hrgtc/recording/_motion_native.c"],
+            depends=[f"src/hrgtc/recording/_motion_{part}.h"
+                     for part in ("order", "segment", "digest")],
             extra_compile_args=FLAGS,
         ),
     ]

@@ -8,6 +8,8 @@ no output at all: never flags shifted by the rows the two passes disagree on.
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -224,7 +226,7 @@ def test_take_checks_rows_cut_otherwise_than_the_detector_read_them():
     run = handled()
     cuts = [0, 3_000, 12_500, 13_000, 29_000, len(run)]
     flags = RestFlags(chunks_of(run), [""], "exclude", "run.parquet")
-    for a, b in zip(cuts[:-1], cuts[1:], strict=True):
+    for a, b in itertools.pairwise(cuts):
         flags.take(run.slice(a, b))
     flags.finish()
     changed = run.time_s.copy()
