@@ -191,8 +191,9 @@ def test_guard_and_isolated_runs_are_numbas(n):
     stops = np.r_[cuts, n].astype(np.int64)
     for after, before in ((0, 0), (3, 2), (500, 100)):
         seed = rng.random(n) < 0.01
-        ours = [seed.copy(), np.zeros(n, dtype=bool)]
-        theirs = [seed.copy(), np.zeros(n, dtype=bool)]
+        stale = rng.random(n) < 0.5  # guarded is overwritten, whatever it held
+        ours = [seed.copy(), stale.copy()]
+        theirs = [seed.copy(), stale.copy()]
         kernel.guard(found, starts, stops, after, before, *ours)
         ref.guard(found, starts, stops, after, before, *theirs)
         assert np.array_equal(ours[0], theirs[0]) and np.array_equal(ours[1], theirs[1])
