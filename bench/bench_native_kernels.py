@@ -1,0 +1,85 @@
+"""The C kernels against the numba kernels they replaced, each alone, in steady state.
+
+Per kernel: the spike filter's two tests over one channel (``recording/_spike_native.c``;
+numba: ``tests/recording/_spike_numba_reference.py``), a 200 Hz stream with spikes, the
+command's settings (60 s windows).
+
+Both sides run in this process on the same arrays; each is called once first (numba loads
+or compiles its kernel then), then the two are timed alternately, ``--repeats`` times
+(default 9), and the medians are reported with their ratio (numba / C: above 1, C is
+faster). CPU seconds of this process (``time.process_time``: the machine is shared).
+Prints one JSON line per kernel and size. ``--quick``: the smaller size only.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+
+SIZES = (1_000_000, 4_000_000)
+QUICK_SIZES = (1_000_000,)
+
+
+def _spike_cases(n: int):
+    from hrgtc.recording import _spike_kernel as c
+    from hrgtc.recording import spikes
+    from recording import _spike_numba_reference as numba
+
+    rng = np.random.default_rng(5)
+    t = np.arange(n) / 200.0 + 1.7e9
+    x = np.cumsum(rng.standard_normal(n)) * 1e-3 + rng.standard_normal(n)
+    x[rng.integers(0, n, n // 1000)] += 30.0
+    values = (spikes.SPIKE_K, 1e-3, spikes.SPIKE_WINDOW_S, float(spikes.GAP_PERIODS),
+              1.0 + spikes.GAP_TOLERANCE, spikes.MIN_WINDOW_SAMPLES, spikes._MAD_TO_SIGMA,
+              spikes._SECOND_DIFF)
+    mine, theirs = c.SpikeRule(*values), numba.SpikeRule(*values)
+    for test in ("spike_mask", "across_mask"):
+        yield test, _bound(getattr(c, test), t, x, mine), _bound(getattr(numba, test), t, x,
+                                                                 theirs)
+
+
+def _bound(function: Callable, *args: object) -> Callable[[], object]:
+    return lambda: function(*args)
+
+
+CASES: dict[str, Callable] = {"spike": _spike_cases}
+
+
+def _seconds(call: Callable[[], object]) -> float:
+    start = time.process_time()
+    call()
+    return time.process_time() - start
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true")
+    parser.add_argument("--repeats", type=int, default=9)
+    parser.add_argument("--only", nargs="*", choices=sorted(CASES), default=sorted(CASES))
+    args = parser.parse_args()
+    for kernel in args.only:
+        for n in QUICK_SIZES if args.quick else SIZES:
+            for name, c_call, numba_call in CASES[kernel](n):
+                c_call(), numba_call()  # numba loads (or compiles) its kernel here
+                c_s, numba_s = [], []
+                for _ in range(args.repeats):
+                    c_s.append(_seconds(c_call))
+                    numba_s.append(_seconds(numba_call))
+                c_median, numba_median = statistics.median(c_s), statistics.median(numba_s)
+                print(json.dumps({"name": f"native_{kernel}_{name}", "n": n,
+                                  "c_s": round(c_median, 5), "numba_s": round(numba_median, 5),
+                                  "numba_over_c": round(numba_median / c_median, 2)}),
+                      flush=True)
+
+
+if __name__ == "__main__":
+    main()
