@@ -31,5 +31,6 @@ setup(
             extra_compile_args=FLAGS,
         ),
         kernel("recording/_spike_native"),
+        kernel("drift/_rate_native"),
     ]
 )

@@ -2,7 +2,8 @@
 
 Per kernel: the spike filter's two tests over one channel (``recording/_spike_native.c``;
 numba: ``tests/recording/_spike_numba_reference.py``), a 200 Hz stream with spikes, the
-command's settings (60 s windows).
+command's settings (60 s windows); the df/dt filter's pass (``drift/_rate_native.c``;
+numba: ``drift/_rate_numba.filter_run``) over a jittered 200 Hz clock.
 
 Both sides run in this process on the same arrays; each is called once first (numba loads
 or compiles its kernel then), then the two are timed alternately, ``--repeats`` times
@@ -51,7 +52,20 @@ def _bound(function: Callable, *args: object) -> Callable[[], object]:
     return lambda: function(*args)
 
 
-CASES: dict[str, Callable] = {"spike": _spike_cases}
+def _rate_cases(n: int):
+    from hrgtc.drift import _rate_kernel as c
+    from hrgtc.drift import _rate_numba as numba
+    from hrgtc.drift.rate_filter import new_state
+
+    rng = np.random.default_rng(6)
+    x = np.cumsum(rng.standard_normal(n)) * 1e-3
+    t = 1.7e9 + np.cumsum(rng.uniform(0.004, 0.006, n))  # a jittered 200 Hz clock
+    rate, lag, none = np.empty(n), np.empty(n), np.zeros(0, np.int8)
+    yield "rate_pass", (lambda: c.rate_pass(x, t, 30.0, none, new_state(), rate, lag)), (
+        lambda: numba.filter_run(x, t, 30.0, none, new_state(), rate, lag))
+
+
+CASES: dict[str, Callable] = {"spike": _spike_cases, "rate": _rate_cases}
 
 
 def _seconds(call: Callable[[], object]) -> float:
