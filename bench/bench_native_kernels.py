@@ -3,7 +3,9 @@
 Per kernel: the spike filter's two tests over one channel (``recording/_spike_native.c``;
 numba: ``tests/recording/_spike_numba_reference.py``), a 200 Hz stream with spikes, the
 command's settings (60 s windows); the df/dt filter's pass (``drift/_rate_native.c``;
-numba: ``drift/_rate_numba.filter_run``) over a jittered 200 Hz clock.
+numba: ``drift/_rate_numba.filter_run``) over a jittered 200 Hz clock; the soak
+plateaus' block index and sums (``thermometry/_plateau_native.c``; numba:
+``tests/thermometry/_plateau_numba_reference.py``), 10 s blocks.
 
 Both sides run in this process on the same arrays; each is called once first (numba loads
 or compiles its kernel then), then the two are timed alternately, ``--repeats`` times
@@ -65,7 +67,21 @@ def _rate_cases(n: int):
         lambda: numba.filter_run(x, t, 30.0, none, new_state(), rate, lag))
 
 
-CASES: dict[str, Callable] = {"spike": _spike_cases, "rate": _rate_cases}
+def _plateau_cases(n: int):
+    from hrgtc.thermometry import _plateau_kernel as c
+    from thermometry import _plateau_numba_reference as numba
+
+    rng = np.random.default_rng(7)
+    t = 1.7e9 + np.cumsum(rng.uniform(0.004, 0.006, n))
+    freq, chamber = 4417.0 + rng.standard_normal(n), 20.0 + rng.standard_normal(n)
+    block = c.block_index(t, 10.0)
+    yield "block_index", (lambda: c.block_index(t, 10.0)), (lambda: numba.block_index(t, 10.0))
+    yield "block_sums", (lambda: c.block_sums(block, t, freq, 4417.0, chamber)), (
+        lambda: numba.block_sums(block, t, freq, 4417.0, chamber))
+
+
+CASES: dict[str, Callable] = {"spike": _spike_cases, "rate": _rate_cases,
+                              "plateau": _plateau_cases}
 
 
 def _seconds(call: Callable[[], object]) -> float:
