@@ -33,5 +33,6 @@ setup(
         kernel("recording/_spike_native"),
         kernel("drift/_rate_native"),
         kernel("thermometry/_plateau_native"),
+        kernel("drift/_extended_native"),
     ]
 )

@@ -5,7 +5,9 @@ numba: ``tests/recording/_spike_numba_reference.py``), a 200 Hz stream with spik
 command's settings (60 s windows); the df/dt filter's pass (``drift/_rate_native.c``;
 numba: ``drift/_rate_numba.filter_run``) over a jittered 200 Hz clock; the soak
 plateaus' block index and sums (``thermometry/_plateau_native.c``; numba:
-``tests/thermometry/_plateau_numba_reference.py``), 10 s blocks.
+``tests/thermometry/_plateau_numba_reference.py``), 10 s blocks; the refinement's
+weighted double-double pass over 6 columns (``drift/_extended_native.c``; numba:
+``tests/drift/_extended_numba_reference.py``).
 
 Both sides run in this process on the same arrays; each is called once first (numba loads
 or compiles its kernel then), then the two are timed alternately, ``--repeats`` times
@@ -80,8 +82,24 @@ def _plateau_cases(n: int):
         lambda: numba.block_sums(block, t, freq, 4417.0, chamber))
 
 
+def _extended_cases(n: int):
+    from drift import _extended_numba_reference as numba
+    from hrgtc.drift import _extended_kernel as c
+
+    rng = np.random.default_rng(8)
+    k = 6
+    X = rng.standard_normal((n, k)) + np.arange(k) * 1e3
+    y = X @ rng.standard_normal(k) + 4417.0
+    scaling = (np.append(np.arange(k) * 1e3, 4417.0), np.full(k + 1, 0.5))
+    weights = rng.uniform(0.5, 2.0, n)
+    x = (rng.standard_normal(k + 1), np.zeros(k + 1))
+    r, f, g = (np.empty(n), np.empty(n)), np.empty(n), (np.empty(k + 1), np.empty(k + 1))
+    yield "residual_pass", (lambda: c.residual_pass(X, y, scaling, weights, x, r, f, g, False)), (
+        lambda: numba.residual_pass(X, y, scaling, weights, x, r, f, g, False))
+
+
 CASES: dict[str, Callable] = {"spike": _spike_cases, "rate": _rate_cases,
-                              "plateau": _plateau_cases}
+                              "plateau": _plateau_cases, "extended": _extended_cases}
 
 
 def _seconds(call: Callable[[], object]) -> float:
