@@ -121,6 +121,22 @@ def test_long_segments_bracket_the_steps_median():
     same(t, rng.standard_normal(n))
 
 
+@pytest.mark.parametrize("n", [64 * 300 + 1, 64 * 301 + 1])
+def test_steps_that_mislead_the_bracket(n):
+    """Every step the bracket's sample looks at is short, most are long: the bracket
+    misses the middle ranks and the steps are gathered whole; and a window whose sampled
+    second differences are all zero."""
+    stride = (n - 1) // 64
+    steps = np.full(n - 1, 1.0)
+    steps[::stride] = 0.001
+    t = np.concatenate([[0.0], np.cumsum(steps)])
+    rng = np.random.default_rng(n)
+    same(t, rng.standard_normal(n))
+    x = np.zeros(n)
+    x[1::2] = rng.standard_normal(x[1::2].size)  # ties at zero and noise, interleaved
+    same(np.arange(n) / 100.0, x)
+
+
 def test_the_module_does_not_import_numba():
     code = ("import sys; import hrgtc.recording._spike_kernel; "
             "import hrgtc.recording.spikes; print('numba' in sys.modules)")

@@ -20,6 +20,7 @@
  * setup.py passes -ffp-contract=off: no product is fused into an add.
  */
 #include "../_buffers.h"
+#include <float.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -96,6 +97,45 @@ static int by_value(const void *p, const void *q)
     return (a > b) - (a < b);
 }
 
+/* What one pass counted against a bracket [lo, hi] of the middle ranks: the values below
+ * it, equal to lo, equal to hi (if hi != lo), and those strictly inside (kept, in order of
+ * the pass, in `between`). */
+typedef struct {
+    double lo, hi;
+    long below, equal_lo, equal_hi, kept;
+} Bracket;
+
+/* The median of `count` values from what the pass counted into *out (`between`
+ * reordered); 0 if the middle ranks are not inside the bracket. The lower middle value is
+ * selected among the kept ones; the upper one, when it is the next rank among them, is
+ * their smallest after it (the selection left every value after it at least as large). */
+static int bracket_median(const Bracket *b, double *between, long count, double *out)
+{
+    long k_lo = (count - 1) / 2, k_hi = count / 2;
+    long r_lo = k_lo - b->below, r_hi = k_hi - b->below;
+    if (count < 1 || r_lo < 0 || r_hi >= b->equal_lo + b->kept + b->equal_hi) return 0;
+    double picked[2];
+    long selected = -1;
+    for (int j = 0; j < (k_lo == k_hi ? 1 : 2); j++) {
+        long r = j == 0 ? r_lo : r_hi;
+        if (r < b->equal_lo) {
+            picked[j] = b->lo;
+        } else if (r < b->equal_lo + b->kept && selected >= 0) {
+            double least = between[selected + 1];
+            for (long i = selected + 2; i < b->kept; i++)
+                least = between[i] < least ? between[i] : least;
+            picked[j] = least;
+        } else if (r < b->equal_lo + b->kept) {
+            selected = r - b->equal_lo;
+            picked[j] = select_kth(between, b->kept, selected);
+        } else {
+            picked[j] = b->hi;
+        }
+    }
+    *out = k_lo == k_hi ? picked[0] : (picked[0] + picked[1]) / 2;
+    return 1;
+}
+
 /* np.median(a[:n]) of n >= 1 values (no NaN; a reordered), mostly without branches: a
  * sorted sample of about SAMPLE values brackets the middle ranks, one pass counts what
  * lies below the bracket and keeps what lies inside it (in `between`, room for n), and the
@@ -123,20 +163,56 @@ static double median(double *a, long n, double *between)
         between[kept] = v;
         kept += (lo < v) & (v < hi);
     }
-    long r_lo = k_lo - below, r_hi = k_hi - below;
-    if (r_lo < 0 || r_hi >= equal_lo + kept + equal_hi) return plain_median(a, n);
-    double picked[2];
-    for (int j = 0; j < 2; j++) {
-        long r = j == 0 ? r_lo : r_hi;
-        if (r < equal_lo)
-            picked[j] = lo;
-        else if (r < equal_lo + kept)
-            picked[j] = select_kth(between, kept, r - equal_lo);
-        else
-            picked[j] = hi;
+    Bracket bracket = {lo, hi, below, equal_lo, equal_hi, kept};
+    double middle;
+    return bracket_median(&bracket, between, n, &middle) ? middle : plain_median(a, n);
+}
+
+/* Is step i of t (t[i + 1] - t[i]) positive and finite? */
+static inline int positive_step(const double *t, long i, double *step)
+{
+    *step = t[i + 1] - t[i];
+    return isfinite(*step) && *step > 0;
+}
+
+/* The median of the positive finite steps of t[:n] (n >= 2) into *out; 0 if there is
+ * none. For a long record, without writing the steps out: a sample of the steps at a
+ * regular stride brackets the middle ranks, one pass over t counts the steps below the
+ * bracket and keeps those inside it (in `between`; a regular clock has few), and the middle
+ * values are selected among those. Otherwise (a short record, or a bracket that missed)
+ * the steps are gathered into `work` and their median taken. Both have room for n. */
+static int steps_median(const double *t, long n, double *work, double *between, double *out)
+{
+    double step, sample[2 * SAMPLE + 2];
+    long size = 0, stride = (n - 1) / SAMPLE;
+    if (n - 1 > 4 * SAMPLE) {
+        for (long i = 0; i < n - 1 && size < 2 * SAMPLE + 2; i += stride)
+            if (positive_step(t, i, &step)) sample[size++] = step;
     }
-    if (k_lo == k_hi) return picked[0];
-    return (picked[0] + picked[1]) / 2;
+    if (size > 2 * MARGIN) {
+        qsort(sample, (size_t)size, sizeof(double), by_value);
+        double lo = sample[(size - 1) / 2 - MARGIN], hi = sample[size / 2 + MARGIN];
+        long count = 0, below = 0, equal_lo = 0, equal_hi = 0, kept = 0;
+        const long distinct = hi != lo;
+        for (long i = 0; i < n - 1; i++) {
+            double v = t[i + 1] - t[i];
+            long valid = isfinite(v) && v > 0;
+            count += valid;
+            below += valid & (v < lo);
+            equal_lo += v == lo;
+            equal_hi += (v == hi) & distinct;
+            between[kept] = v;
+            kept += (lo < v) & (v < hi);
+        }
+        Bracket bracket = {lo, hi, below, equal_lo, equal_hi, kept};
+        if (bracket_median(&bracket, between, count, out)) return 1;
+    }
+    long count = 0;
+    for (long i = 0; i < n - 1; i++)
+        if (positive_step(t, i, &step)) work[count++] = step;
+    if (!count) return 0;
+    *out = median(work, count, between);
+    return 1;
 }
 
 /* End (exclusive) of each contiguous segment of t[:n] into stops (room for n + 1), their
@@ -150,14 +226,10 @@ static long segment_stops(const double *t, long n, const Rule *rule, long *stops
         if (n) stops[0] = n;
         return n;
     }
-    long count = 0;
-    for (long i = 0; i < n - 1; i++) {
-        double step = t[i + 1] - t[i];
-        if (isfinite(step) && step > 0) work[count++] = step;
-    }
+    double middle;
     long s = 0;
-    if (count) {
-        double limit = rule->gap_periods * median(work, count, between) * rule->tolerance;
+    if (steps_median(t, n, work, between, &middle)) {
+        double limit = rule->gap_periods * middle * rule->tolerance;
         for (long i = 0; i < n - 1; i++)
             if (!(t[i + 1] - t[i] <= limit)) stops[s++] = i + 1;
     }
@@ -196,6 +268,80 @@ static inline int test(const double *x, long i, long n, double q, int mode)
             across = wide;
     }
     return across > q;
+}
+
+/* The samples of a..b (in a segment of n >= 3) whose second difference is x[i]'s own,
+ * [*lo, *hi): all but the segment's first and last. */
+static inline void interior(long a, long b, long n, long *lo, long *hi)
+{
+    *lo = a < 1 ? 1 : a;
+    *hi = b > n - 1 ? n - 1 : b;
+    if (*hi < *lo) *hi = *lo;
+}
+
+/* The absolute finite second differences of samples a..b into work, their count
+ * returned. The interior is one straight loop (vectorised) that also counts the finite
+ * ones; only a window with a value that is not goes through the compacting loop. */
+static long window_seconds(const double *x, long a, long b, long n, double *work)
+{
+    long lo, hi, m = 0;
+    interior(a, b, n, &lo, &hi);
+    if (a == 0) {
+        double d = second(x, 0, n);
+        work[m] = fabs(d);
+        m += isfinite(d) != 0;
+    }
+    long finite = 0;
+    double *into = work + m;
+    for (long i = lo; i < hi; i++) {
+        double v = fabs(x[i] - 0.5 * (x[i - 1] + x[i + 1]));
+        into[i - lo] = v;
+        finite += v <= DBL_MAX;
+    }
+    if (finite == hi - lo) {
+        m += hi - lo;
+    } else {
+        for (long i = lo; i < hi; i++) {
+            double d = x[i] - 0.5 * (x[i - 1] + x[i + 1]);
+            work[m] = fabs(d);
+            m += isfinite(d) != 0;
+        }
+    }
+    if (b == n) {
+        double d = second(x, n - 1, n);
+        work[m] = fabs(d);
+        m += isfinite(d) != 0;
+    }
+    return m;
+}
+
+/* The test `mode` of samples a..b of a segment of n >= 3 samples, threshold q, into out:
+ * test() at the segment's edges, its interior cases in straight loops. ACROSS: NaN if
+ * either distance is NaN (np.maximum), so the larger beyond q is both not NaN and one of
+ * them beyond q. */
+static void window_tests(const double *x, long a, long b, long n, double q, int mode,
+                         uint8_t *out)
+{
+    long lo, hi;
+    interior(a, b, n, &lo, &hi);
+    if (a == 0) out[0] = (uint8_t)test(x, 0, n, q, mode);
+    if (mode == SPIKE) {
+        for (long i = lo; i < hi; i++)
+            out[i] = (uint8_t)((fabs(x[i] - x[i - 1]) > q) & (fabs(x[i + 1] - x[i]) > q) &
+                               (fabs(x[i] - 0.5 * (x[i - 1] + x[i + 1])) > q) &
+                               (fabs(x[i + 1] - x[i - 1]) <= q));
+    } else {
+        long wide_lo = lo > 2 ? lo : 2, wide_hi = hi < n - 2 ? hi : n - 2;
+        if (n < 5 || wide_hi < wide_lo) wide_lo = wide_hi = hi;
+        for (long i = lo; i < wide_lo; i++) out[i] = (uint8_t)test(x, i, n, q, mode);
+        for (long i = wide_lo; i < wide_hi; i++) {
+            double across = fabs(x[i + 1] - x[i - 1]), wide = fabs(x[i + 2] - x[i - 2]);
+            out[i] = (uint8_t)((across == across) & (wide == wide) &
+                               ((across > q) | (wide > q)));
+        }
+        for (long i = wide_hi; i < hi; i++) out[i] = (uint8_t)test(x, i, n, q, mode);
+    }
+    if (b == n) out[n - 1] = (uint8_t)test(x, n - 1, n, q, mode);
 }
 
 /* sigma_MAD of the segment x[:n]'s absolute finite second differences (0 without one). */
@@ -242,12 +388,7 @@ static void segment_tests(const double *t, const double *x, long n, const Rule *
             previous = block;
             if (!(step != 0.0)) continue;
         }
-        long m = 0;
-        for (long i = a; i < b; i++) {
-            double d = second(x, i, n);
-            work[m] = fabs(d);
-            m += isfinite(d) != 0;
-        }
+        long m = window_seconds(x, a, b, n, work);
         double sigma;
         if (m >= rule->min_window) {
             sigma = rule->mad_to_sigma * median(work, m, between) / rule->second_diff;
@@ -260,7 +401,7 @@ static void segment_tests(const double *t, const double *x, long n, const Rule *
             threshold = NAN;
         else
             threshold = value >= rule->floor ? value : rule->floor;
-        for (long i = a; i < b; i++) out[i] = (uint8_t)test(x, i, n, threshold, mode);
+        window_tests(x, a, b, n, threshold, mode, out);
         a = b;
     }
 }
