@@ -20,7 +20,9 @@
 
 /* The value of v as it is, from here on: without this, gcc rewrites r - (-e) as r + e and
  * may then add e first, which gives a NaN r the sign of e's NaN (numba keeps r's). */
-#if defined(__GNUC__)
+#if defined(__GNUC__) && defined(__x86_64__)
+#define OPAQUE(v) __asm__("" : "+x"(v)) /* in its SSE register: no store and load */
+#elif defined(__GNUC__)
 #define OPAQUE(v) __asm__ volatile("" : "+m"(v))
 #else
 #define OPAQUE(v) ((void)0)
