@@ -28,6 +28,15 @@
 #define SPIKE 0
 #define ACROSS 1
 
+/* The AVX2 clone where the CPU has it (picked at load time), SSE2 otherwise: floor() is
+ * then one instruction instead of SSE2's sequence (the value is the same; floor is exact).
+ * No FMA is enabled in either, and setup.py passes -ffp-contract=off. */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && defined(__linux__)
+#define CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define CLONES
+#endif
+
 /* A window of more values than this has its median bracketed by a sorted sample of about
  * SAMPLE values, MARGIN sample ranks either side of the middle (about 2.5 standard errors
  * of a sample quantile); a smaller one is selected directly. */
@@ -374,8 +383,9 @@ static double window_origin(const double *t, long n)
 /* The test `mode` of every sample of one segment (t, x)[:n], n >= 3, into out: window by
  * window, the window's sigma_MAD (the segment's when it has fewer than min_window finite
  * second differences), the threshold max(k sigma_MAD, floor), the test of each sample. */
-static void segment_tests(const double *t, const double *x, long n, const Rule *rule,
-                          int mode, uint8_t *out, double *work, double *between)
+CLONES static void segment_tests(const double *t, const double *x, long n,
+                                 const Rule *rule, int mode, uint8_t *out, double *work,
+                                 double *between)
 {
     const double origin = window_origin(t, n);
     double whole = -1.0; /* the segment's sigma, computed when a window needs it */
