@@ -14,7 +14,10 @@ STAMP := $(VENV)/.installed
 SYSTEM_COMMANDS := chromium gcc
 
 # setup.py compiles the C sources (NATIVE) in place: gcc must be there first (system).
-NATIVE := src/hrgtc/evaluation/_allan_octave.c
+NATIVE := src/hrgtc/evaluation/_allan_octave.c src/hrgtc/_buffers.h \
+  src/hrgtc/recording/_spike_native.c src/hrgtc/drift/_rate_native.c \
+  src/hrgtc/thermometry/_plateau_native.c src/hrgtc/drift/_extended_native.c \
+  $(wildcard src/hrgtc/recording/_motion_*.[ch])
 
 $(STAMP): pyproject.toml setup.py $(NATIVE) | system
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)

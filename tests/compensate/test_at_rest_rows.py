@@ -8,6 +8,8 @@ no output at all: never flags shifted by the rows the two passes disagree on.
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -215,3 +217,23 @@ def test_take_with_a_known_input_rate(column):
         expected.astype(float))
     flags.finish()
     _refuses_a_rate_changed_by_a_nanodegree(run)
+
+
+def test_take_checks_rows_cut_otherwise_than_the_detector_read_them():
+    """The compensating pass's chunks need not be the detector's: rows cut elsewhere pass;
+    one value changed inside a detector chunk that two of its chunks straddle is refused,
+    naming the detector chunk's rows (the digests of its columns, bit for bit)."""
+    run = handled()
+    cuts = [0, 3_000, 12_500, 13_000, 29_000, len(run)]
+    flags = RestFlags(chunks_of(run), [""], "exclude", "run.parquet")
+    for a, b in itertools.pairwise(cuts):
+        flags.take(run.slice(a, b))
+    flags.finish()
+    changed = run.time_s.copy()
+    changed[CHUNK + 100] = np.nextafter(changed[CHUNK + 100], np.inf)
+    other = run.with_columns(time_s=changed)
+    flags = RestFlags(chunks_of(run), [""], "exclude", "run.parquet")
+    flags.take(other.slice(0, 3_000))
+    flags.take(other.slice(3_000, 12_500))  # rows 7000-13999 are not complete yet
+    with pytest.raises(FlagsMisaligned, match=r"other values of time_s in rows 7000-13999"):
+        flags.take(other.slice(12_500, 20_000))

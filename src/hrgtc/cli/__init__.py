@@ -41,5 +41,8 @@ def main() -> None:
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
             sys.exit(1)
         return
+    from hrgtc.core.process import keep_freed_memory
+
+    keep_freed_memory()  # chunk buffers reused, not zeroed afresh by the kernel
     application = globals().get("app") or __getattr__("app")
     application()

@@ -7,7 +7,7 @@ and order as the numpy reference path (so results agree to rounding):
 * the causal df/dt (dh/dt) filter of :func:`hrgtc.drift.features.causal_rate`, two
   first-order stages updated exactly over each sample's own Δt (the samples'
   times), by the very function the numpy path runs
-  (:func:`hrgtc.drift._rate_kernel.filter_run`), state carried across calls;
+  (:func:`hrgtc.drift._rate_numba.filter_run`), state carried across calls;
 * the drift model of :func:`hrgtc.drift.features.tangent_extension`: each term a
   product of powers of the scaled variables, summed in term order, and beyond
   the training ranges the gradient at the clipped point times the excess;
@@ -56,7 +56,7 @@ from hrgtc.compensate._kernel_thermometer import (
 )
 from hrgtc.core.timeline import settle_threshold_s
 from hrgtc.drift import DriftModel
-from hrgtc.drift._rate_kernel import filter_run
+from hrgtc.drift._rate_numba import filter_run
 from hrgtc.drift.rate_filter import STATE_SIZE, check_tau
 from hrgtc.drift.rate_filter import new_state as new_filter_state
 from hrgtc.drift.variables import unsupported

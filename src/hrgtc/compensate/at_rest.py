@@ -20,8 +20,10 @@ time) marks the samples, and the compensating pass then writes the flags: equal 
 The cost (issue 20, ``docs/benchmarks.md``): a second reading of the detector's
 columns, without their validation (the compensating pass validates every sample; if the unvalidated
 pass fails, the file is read again validated, so a bad file gets the validator's
-error), and the detector's columns in memory, once (time and rate: 16 bytes a sample
-and axis; a 3-day 1 Hz file: 260,000 rows, 4 MB). The detector's loops are compiled
+error), and the detector's columns in memory, once, while it runs (time and rate: 16
+bytes a sample and axis; a 3-day 1 Hz file: 260,000 rows, 4 MB; dropped before the
+compensating pass, which holds only the flags: 150 MB less at 10 M rows). The pass
+reads the next chunk on a thread while it gathers this one; the detector's loops are C
 (:mod:`hrgtc.recording._motion_kernel`). ``--motion keep`` skips the pass and writes
 no flag; ``--motion error`` stops at the first moving sample, naming it.
 
@@ -30,25 +32,29 @@ only=)``), and the spike filter's flags, which change no row, are not computed i
 Reading fewer columns can give other rows: the reader drops a row because of a column
 the pass does not read (a gap of a slow channel, ``--spikes drop``, a duplicated row
 told from a duplicated time by its other values). So the flags are never trusted to
-line up: :meth:`RestFlags.take` compares the detector's columns of each chunk the
-compensating pass reads with those the detector saw at the same rows, bit for bit, and
-the row counts at the end (the rate as the detector read it: minus the known input rate,
-which the pass subtracts in place); equal columns give the detector the same input,
-hence the same flags. A difference raises :class:`FlagsMisaligned`, on which
+line up: :meth:`RestFlags.take` compares a digest of the bits of each detector column over
+each block of rows the detector's pass read (its chunks; 64 bits, computed in C,
+:func:`hrgtc.recording._motion_kernel.digest`) with the same digest of the rows the
+compensating pass reads, however it cuts them, and the row counts at the end; equal
+columns give the detector the same input, hence the same flags. One changed value
+always changes the digest; more (a shifted row) escape it with a chance of about 2^-64
+per block. A difference raises :class:`FlagsMisaligned`, on which
 :func:`~hrgtc.compensate.file_pass.compensate_file` discards its output and starts again
 with the pass reading every column (a slower, correct run, never misaligned flags).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
 from hrgtc.core.errors import CalibrationError, InputError
 from hrgtc.drift.rest import RestPass
 from hrgtc.recording import Recording, axis_view
-from hrgtc.recording.motion import ACCEL_COLUMNS, detector_rate
+from hrgtc.recording import _motion_kernel as kernel
+from hrgtc.recording.motion import ACCEL_COLUMNS
 
 __all__ = ["AT_REST_COLUMN", "DETECTOR_COLUMNS", "FlagsMisaligned", "RestFlags", "rest_columns"]
 
@@ -95,7 +101,8 @@ class RestFlags:
         self.axes = tuple(axes)
         self.columns = rest_columns(self.axes)
         self._policy, self._name, self._rows = policy, name, rows
-        self._seen: dict[str, dict[str, np.ndarray]] = {}  # the detector's columns by axis
+        self._names: dict[str, set[str]] = {}  # the detector's columns by axis
+        self._digests = _RowDigests()
         try:
             self.still = self._find(chunks)
         except CalibrationError:  # --motion error: a moving sample
@@ -110,13 +117,17 @@ class RestFlags:
     def _find(self, chunks: Iterable[Recording]) -> dict[str, np.ndarray]:
         passes = {axis: RestPass(self._policy, name=self._name, rows=self._rows,
                                  in_place=True) for axis in self.axes}
-        for chunk in chunks:
-            for axis, rest in passes.items():
+        self._digests = digests = _RowDigests()  # for take()
+        for chunk in _read_ahead(chunks):
+            digests.stops.append((digests.stops[-1] if digests.stops else 0) + len(chunk))
+            for i, (axis, rest) in enumerate(passes.items()):
                 view = axis_view(chunk, axis) if axis else chunk
-                rest.partial_fit(Recording({k: view[k] for k in DETECTOR_COLUMNS if k in view},
-                                           view.metadata, view.source))
-        self._seen = {axis: rest.columns for axis, rest in passes.items()}  # for take()
-        self._input = {axis: rest.input_rate for axis, rest in passes.items()}
+                columns = {k: view[k] for k in DETECTOR_COLUMNS if k in view}
+                for name, values in columns.items():
+                    if name != "time_s" or i == 0:
+                        digests.add((axis, name), values)
+                self._names[axis] = set(columns)
+                rest.partial_fit(Recording(columns, view.metadata, view.source))
         return {axis: rest.finish().keep for axis, rest in passes.items()}
 
     @property
@@ -129,36 +140,27 @@ class RestFlags:
         """The flags (1.0 at rest, 0.0 not) of the next chunk's samples, by column.
 
         Raises :class:`FlagsMisaligned` unless the chunk's detector columns are, bit for
-        bit, those the detector saw at the same rows.
+        bit (by their digests), those the detector saw at the same rows.
         """
         start, stop = self.rows, self.rows + len(chunk)
         flags = {}
         for i, (axis, column) in enumerate(zip(self.axes, self.columns, strict=True)):
-            still, seen = self.still[axis], self._seen[axis]
+            still, seen = self.still[axis], self._names.get(axis, set())
             view = axis_view(chunk, axis) if axis else chunk
             if stop > still.size:
                 self._misaligned(f"{stop} rows to compensate but {still.size} to the detector")
             theirs = {k for k in DETECTOR_COLUMNS if k in view}
-            if theirs != set(seen):
+            if theirs != seen:
                 self._misaligned(f"columns {sorted(theirs)} to compensate but {sorted(seen)} "
                                  "to the detector")
-            for name, values in seen.items():
-                if (name != "time_s" or i == 0) and not _same(
-                        self._read(view, name, axis, start), values[start:stop]):
-                    self._misaligned(f"other values of {name} in rows {start}-{stop - 1}")
+            for name in DETECTOR_COLUMNS:
+                if name in theirs and (name != "time_s" or i == 0):
+                    problem = self._digests.check((axis, name), view[name], start)
+                    if problem:
+                        self._misaligned(problem)
             flags[column] = still[start:stop].astype(np.float64)
         self.rows = stop
         return flags
-
-    def _read(self, view: Recording, name: str, axis: str, start: int) -> np.ndarray:
-        """A detector column of the chunk as the detector read it: the rate minus the input
-        rate (the pass subtracted it in place, ``RestPass(in_place=True)``)."""
-        if name != "rate_dph":
-            return view[name]
-        seen = self._seen[axis].get("input_rate_dph")
-        known = self._input[axis] if seen is None else seen[start:start + len(view)]
-        rate = np.asarray(view[name], dtype=np.float64)
-        return detector_rate(rate, known)
 
     def finish(self) -> None:
         """Check that every row the detector saw was compensated (after the last
@@ -174,9 +176,48 @@ class RestFlags:
             "file changed while it was read?")
 
 
-def _same(a: np.ndarray, b: np.ndarray) -> bool:
-    """Whether two float64 columns hold the same bits (NaN included)."""
-    a = np.ascontiguousarray(a, dtype=np.float64)
-    b = np.ascontiguousarray(b, dtype=np.float64)
-    return a.shape == b.shape and bool(np.array_equal(a.view(np.int64), b.view(np.int64)))
+def _read_ahead(chunks: Iterable[Recording]) -> Iterator[Recording]:
+    """``chunks``, the next one read on a thread while this one's columns are gathered
+    (pyarrow and h5py release the GIL), as the compensating pass reads ahead."""
+    iterator = iter(chunks)
+    with ThreadPoolExecutor(max_workers=1) as reading:
+        ahead = reading.submit(next, iterator, None)
+        while (chunk := ahead.result()) is not None:
+            ahead = reading.submit(next, iterator, None)
+            yield chunk
 
+
+class _RowDigests:
+    """A digest of each detector column over each block of rows the detector's pass read
+    (``stops``: the end of each block, its chunks), and the same digests of the rows the
+    compensating pass reads, however it cuts them (a digest fed in pieces is the digest of
+    the whole)."""
+
+    def __init__(self) -> None:
+        self.stops: list[int] = []
+        self._seen: dict[tuple[str, str], list[int]] = {}  # (axis, column) -> per block
+        self._fed: dict[tuple[str, str], tuple[int, np.ndarray]] = {}  # next block, state
+
+    def add(self, key: tuple[str, str], values: np.ndarray) -> None:
+        """The detector's pass: the digest of the column ``key`` over the next block."""
+        state = kernel.digest_start()
+        kernel.digest_update(state, np.ascontiguousarray(values, dtype=np.float64))
+        self._seen.setdefault(key, []).append(kernel.digest(state))
+
+    def check(self, key: tuple[str, str], values: np.ndarray, start: int) -> str | None:
+        """Feed the compensating pass's rows ``start``, ... of the column ``key``: what
+        differs (a block of other bits, named by its rows), or None."""
+        values = np.ascontiguousarray(values, dtype=np.float64)
+        block, state = self._fed.get(key, (0, kernel.digest_start()))
+        row, end = start, start + values.size
+        while row < end:
+            stop = min(self.stops[block], end)
+            kernel.digest_update(state, values[row - start:stop - start])
+            if stop == self.stops[block]:
+                if kernel.digest(state) != self._seen[key][block]:
+                    first = self.stops[block - 1] if block else 0
+                    return f"other values of {key[1]} in rows {first}-{stop - 1}"
+                block, state = block + 1, kernel.digest_start()
+            row = stop
+        self._fed[key] = (block, state)
+        return None

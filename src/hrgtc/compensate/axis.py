@@ -317,6 +317,38 @@ class AxisCompensator:
             e[2], e[3] = min(e[2], extremes[2]), max(e[3], extremes[3])
         return True
 
+    def warm(self, chunk: Recording) -> None:
+        """Load the fused kernel's compiled code for the types of ``chunk``'s columns,
+        compensating nothing (their first 0 rows) and changing no state.
+
+        :func:`~hrgtc.compensate.file_pass.compensate_file` calls it on a thread while the
+        at-rest pass reads the file: numba's import and the loading of its cached
+        dispatchers (some 0.5 s of CPU) then overlap that pass instead of delaying the
+        first compensated chunk. The arrays are those :meth:`_fused` passes, so the types
+        are the same and the first real call finds its code loaded
+        (``tests/compensate/test_warm.py``). Does nothing where :meth:`_fused` would not
+        run the kernel; raises what the kernel would raise on the chunk.
+        """
+        from hrgtc.compensate import _kernel as kernel
+
+        thermometer = self.model.thermometer
+        if (self.engine != "fused" or thermometer._monotonic_violation() is not None
+                or not kernel.supports(thermometer)
+                or not kernel.supports_variables(self._variables)):
+            return
+        block_plan = self._plan or kernel.plan(self.drift, thermometer, self._variables)
+        none = slice(0, 0)
+        freq = chunk.freq_hz[none]
+        housing = chunk["housing_c"][none] if block_plan.needs_housing else freq
+        time_s = np.ascontiguousarray(chunk.time_s, dtype=np.float64)[none]
+        mask = np.zeros(0, dtype=np.int8)
+        out = {name: np.empty(0) for name in OUTPUT_COLUMNS}
+        columns = (time_s, mask, freq, chunk.rate_dph[none], housing)
+        kernel._call(block_plan, kernel.new_state(), columns, out,
+                     np.zeros(kernel.N_COUNTS, dtype=np.int64), kernel.new_extremes(), 0, 0)
+        kernel.advance_filter(time_s, mask, freq, housing, block_plan.filter,
+                              block_plan.uses_housing, kernel.new_state())
+
     def _settled(self, time_s: np.ndarray, restart: np.ndarray | None) -> np.ndarray:
         """True where the df/dt filter has settled: ``warmup_s`` seconds on the time axis since
         it (re)started (the run's first sample, or a restart row), as training's warm-up skip."""

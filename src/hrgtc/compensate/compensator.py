@@ -122,6 +122,12 @@ class Compensator:
         self._rows += len(chunk)
         return chunk.with_columns(**added)
 
+    def warm(self, chunk: Recording) -> None:
+        """Load the fused kernel for ``chunk``'s column types, compensating nothing
+        (:meth:`AxisCompensator.warm`, each axis on its view)."""
+        for axis, compensator in self.axes.items():
+            compensator.warm(axis_view(chunk, axis) if axis else chunk)
+
     def _check_axes(self, chunk: Recording) -> None:
         found = axis_names(chunk.names)
         missing = [axis for axis in self.axes if axis not in found]

@@ -186,12 +186,16 @@ def _compensate(job: _Job, compensator: Compensator,
             only = None if repair.duplicates else only
             # the spike filter's flags change no row: not computed in the detector's pass
             quick = dataclasses.replace(options, spike_filter="off", chunk_rows=chunk_rows)
-            flags = RestFlags(rec_io.iter_chunks(source, quick,
-                                                 validate=False, only=only),
-                              list(model.axes), options.motion,
-                              os.path.basename(os.fspath(source)),
-                              validated=lambda: options.chunks(source, rows=chunk_rows),
-                              rows=total)
+            with ThreadPoolExecutor(max_workers=1) as warming:
+                # the kernel's start (numba's) on a thread while the detector's pass reads
+                warmed = warming.submit(compensator.warm, first)
+                flags = RestFlags(rec_io.iter_chunks(source, quick,
+                                                     validate=False, only=only),
+                                  list(model.axes), options.motion,
+                                  os.path.basename(os.fspath(source)),
+                                  validated=lambda: options.chunks(source, rows=chunk_rows),
+                                  rows=total)
+                warmed.result()
             added = (*added, *flags.columns)
         copies = sensor_copies((*first.names, *added), first.metadata)
         names = tuple(n for n in (*first.names, *added) if n not in copies)

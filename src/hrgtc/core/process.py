@@ -1,10 +1,49 @@
-"""Facts about the running process that benchmarks and fleet reports give."""
+"""Facts about the running process that benchmarks and fleet reports give, and how a
+command's process keeps its freed memory."""
 
 from __future__ import annotations
 
+import os
 import resource
 
-__all__ = ["peak_rss_mb"]
+__all__ = ["keep_freed_memory", "peak_rss_mb"]
+
+#: ``mallopt`` parameters of glibc's ``malloc.h``.
+_M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD = -1, -3
+#: Blocks up to this size come from the heap, and are reused once freed (glibc's largest
+#: mmap threshold on a 64-bit system). [bytes]
+MMAP_THRESHOLD_BYTES = 32 << 20
+#: Freed memory at the heap's top kept for the next chunk, up to this much. [bytes]
+TRIM_THRESHOLD_BYTES = 256 << 20
+
+
+def keep_freed_memory() -> bool:
+    """Let glibc's ``malloc`` keep and reuse the buffers of one chunk for the next.
+
+    A command reads, filters and writes a recording chunk by chunk: arrays of a few
+    megabytes, each freed before the next chunk asks for the same again. By default glibc
+    serves such blocks with their own ``mmap`` and returns them to the kernel on ``free``,
+    so every chunk's arrays are new pages that the kernel zeroes on first touch (about a
+    fifth of ``compensate``'s CPU on a 10 M-row file: ``docs/benchmarks.md``). With a fixed
+    mmap threshold of 32 MiB and a trim threshold of 256 MiB they come from the heap and are
+    reused. Called by the ``hrgtc`` command only (a library leaves its host's allocator
+    alone); no effect but on glibc. Returns whether both settings were taken.
+    """
+    try:
+        glibc = os.confstr("CS_GNU_LIBC_VERSION") or ""
+    except (ValueError, OSError):  # not a glibc system
+        return False
+    if not glibc.startswith("glibc"):
+        return False
+    import ctypes
+
+    try:
+        mallopt = ctypes.CDLL(None).mallopt
+    except (OSError, AttributeError):
+        return False
+    mallopt.argtypes, mallopt.restype = [ctypes.c_int, ctypes.c_int], ctypes.c_int
+    return bool(mallopt(_M_MMAP_THRESHOLD, MMAP_THRESHOLD_BYTES)
+                and mallopt(_M_TRIM_THRESHOLD, TRIM_THRESHOLD_BYTES))
 
 
 def peak_rss_mb() -> float:

@@ -1,113 +1,54 @@
-"""The rate filter's step, compiled (numba): what :func:`hrgtc.drift.rate_filter.causal_rate`
-and the fused compensation kernel both call, so they compute the same bits.
+"""The rate filter's step over whole arrays, in C: what
+:func:`hrgtc.drift.rate_filter.causal_rate` and its checks call.
+
+The loops are the compiled module ``_rate_native`` (``_rate_native.c``, built by
+``pip install -e .``): the statements of the numba :func:`hrgtc.drift._rate_numba.filter_run`
+that the fused compensation kernel calls, in the same order, so the two compute the same
+bits (``tests/drift/test_rate_native.py``). numba is not imported: its import and start
+cost a command more than the pass (docs/architecture.md, "The native kernels"). When the
+module is missing this raises ``ImportError`` saying how to build it.
 
 See :mod:`hrgtc.drift.rate_filter` for the update and its derivation.
 """
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
-from numba import njit
 
 from hrgtc.drift.rate_weights import DT_REL_TOLERANCE, SERIES_LIMIT, series_coefficients
 
-_S1, _S2, _S3, _S4, _S5, _S6, _S7, _S8, _S9 = series_coefficients()  # compiled in as constants
-_LIMIT = SERIES_LIMIT
-_TOLERANCE = DT_REL_TOLERANCE
+try:
+    from hrgtc.drift import _rate_native as _native
+except ImportError as error:  # pragma: no cover - a source checkout not built
+    raise ImportError(
+        "hrgtc's compiled df/dt filter (hrgtc.drift._rate_native, from "
+        "src/hrgtc/drift/_rate_native.c) is not built; build it with "
+        "`make .venv/.installed` or `pip install -e .` (a C compiler is needed)") from error
+
+#: The constants of the step: p's Taylor coefficients, the series' limit and the relative
+#: change of Δt that keeps the cached (a, p).
+_SERIES = (*series_coefficients(), SERIES_LIMIT, DT_REL_TOLERANCE)
 
 
-@njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def step_weights(dt_s, tau_s):  # pragma: no cover - compiled
+def step_weights(dt_s: float, tau_s: float) -> tuple[float, float]:
     """(a, p) of one step of length ``dt_s``: a = 1 - exp(-r), p = 1 - a/r, r = dt/tau."""
-    r = dt_s / tau_s
-    a = -math.expm1(-r)
-    if r < _LIMIT:  # Taylor series of p, Horner, highest power first
-        p = _S9
-        p = p * r + _S8
-        p = p * r + _S7
-        p = p * r + _S6
-        p = p * r + _S5
-        p = p * r + _S4
-        p = p * r + _S3
-        p = p * r + _S2
-        p = p * r + _S1
-        p = p * r
-    else:
-        p = (r - a) / r
-    return a, p
+    return _native.step_weights(dt_s, tau_s, _SERIES)
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
-def filter_run(x, time_s, tau_s, restart, state, out_rate, out_lag):  # pragma: no cover
+def rate_pass(x: np.ndarray, time_s: np.ndarray, tau_s: float, restart: np.ndarray,
+              state: np.ndarray, out_rate: np.ndarray, out_lag: np.ndarray) -> None:
     """Advance ``state`` (the slots of :data:`hrgtc.drift.rate_filter.LAG`) over the samples
     ``x`` at ``time_s``, writing each rate (and, unless ``out_lag`` is empty, the lag
-    x - y1 after the step).
+    x - y1 after the step); contiguous float64 arrays, ``restart`` int8 (or empty: none).
 
-    ``restart`` (int8 per sample, or empty: none), or a state never started, puts the
-    filter at rest on that sample (rate 0) with no cached step. A step of zero or
-    negative Δt moves nothing but the previous input. The state is held in locals over
-    the loop (registers), written back at the end.
+    ``restart``, or a state never started, puts the filter at rest on that sample (rate 0)
+    with no cached step. A step of zero or negative Δt moves nothing but the previous
+    input.
     """
-    has_restart = restart.size > 0
-    keep_lag = out_lag.size > 0
-    lag, difference, previous, t_prev = state[0], state[1], state[2], state[3]
-    started, dt_c, a, p = state[4], state[5], state[6], state[7]
-    for i in range(x.size):
-        xi = x[i]
-        ti = time_s[i]
-        if (has_restart and restart[i] != 0) or started == 0.0:
-            lag = 0.0
-            difference = 0.0
-            previous = xi
-            t_prev = ti
-            started = 1.0
-            dt_c = -1.0  # no cached step: a restarted filter is a new one
-            a = 0.0
-            p = 0.0
-            out_rate[i] = 0.0
-        else:
-            dt = ti - t_prev
-            dt = 0.0 if not dt > 0.0 else dt
-            if not abs(dt - dt_c) <= _TOLERANCE * dt_c:
-                a, p = step_weights(dt, tau_s)
-                dt_c = dt
-            delta = xi - previous
-            c1 = a * lag
-            c1 = c1 + p * delta
-            lag = lag + delta
-            lag = lag - c1
-            c2 = a * difference
-            c2 = c2 + p * c1
-            difference = difference + c1
-            difference = difference - c2
-            previous = xi
-            t_prev = ti
-            out_rate[i] = difference / tau_s
-        if keep_lag:
-            out_lag[i] = lag
-    state[0], state[1], state[2], state[3] = lag, difference, previous, t_prev
-    state[4], state[5], state[6], state[7] = started, dt_c, a, p
+    _native.rate_pass(x, time_s, tau_s, restart, state, out_rate, out_lag, _SERIES)
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
-def rate_pass(x, time_s, tau_s, restart, state, out_rate, out_lag):  # pragma: no cover
-    """:func:`filter_run` over whole arrays (``causal_rate``)."""
-    filter_run(x, time_s, tau_s, restart, state, out_rate, out_lag)
-
-
-@njit(cache=True, nogil=True, error_model="numpy")
-def first_time_problem(time_s, t_prev, started):  # pragma: no cover - compiled
+def first_time_problem(time_s: np.ndarray, t_prev: float, started: float) -> tuple[int, int]:
     """(kind, row) of the first time the filter cannot step to: kind 1 not finite, 2 a
     step back, 3 a step back from the previous chunk (``t_prev``); (0, -1) if none."""
-    for i in range(time_s.size):
-        t = time_s[i]
-        if not np.isfinite(t):
-            return 1, i
-        if i == 0:
-            if started != 0.0 and t < t_prev:
-                return 3, 0
-        elif t < time_s[i - 1]:
-            return 2, i
-    return 0, -1
+    return _native.first_time_problem(time_s, t_prev, started)

@@ -187,11 +187,11 @@ def _run_rest(columns: dict[str, np.ndarray], policy: str, settings: MotionSetti
     freq = columns.get("freq_hz")
     counts = {} if mask is None else mask.counts()
     for warmup_s in warmups_s:
-        after = time_s >= time_s[0] + warmup_s
-        used = keep & after
-        total = float(np.sum(freq[used])) if freq is not None else 0.0
-        out.append(RunRest(source, keep, mask, total, int(np.count_nonzero(used))
-                           if freq is not None else 0, accel, dict(counts),
+        total, used = 0.0, 0
+        if freq is not None:  # no centre to measure (compensate): no masks of the run's length
+            still = keep & (time_s >= time_s[0] + warmup_s)
+            total, used = float(np.sum(freq[still])), int(np.count_nonzero(still))
+        out.append(RunRest(source, keep, mask, total, used, accel, dict(counts),
                            float(time_s[-1] - time_s[0]) if time_s.size else math.nan))
     return out
 

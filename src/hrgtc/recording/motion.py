@@ -241,9 +241,9 @@ class MotionMask:
 
 
 # --------------------------------------------------------------------------- helpers
-# The loops are compiled (hrgtc.recording._motion_kernel, imported when first used: numba
-# is slow to import); their numpy definitions are kept beside the tests that compare
-# them (tests/motion_reference.py).
+# The loops are in C (hrgtc.recording._motion_kernel wraps _motion_native.c; no numba);
+# their numpy definitions are kept beside the tests that compare them
+# (tests/motion_reference.py).
 #: Differences sampled to bracket the middle ranks of their median.
 _SAMPLE = 65_536
 

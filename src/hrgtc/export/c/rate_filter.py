@@ -3,7 +3,7 @@
 The generated ``step()`` takes the time since the previous sample, ``dt_s``, and
 advances each filter by the exact first-order-hold update over that step
 (:mod:`hrgtc.drift.rate_filter`): the statements below are those of
-:func:`hrgtc.drift._rate_kernel.filter_run`, one operation per statement so no
+:func:`hrgtc.drift._rate_numba.filter_run`, one operation per statement so no
 fused multiply-add changes the rounding. A gap is bridged by passing the gap's Δt;
 ``reset()`` restarts the filters at rest (a new run, or a segment start of
 ``--gaps split``).
