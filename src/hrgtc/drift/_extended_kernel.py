@@ -28,13 +28,9 @@ from __future__ import annotations
 
 import numpy as np
 
-try:
-    from hrgtc.drift import _extended_native as _native
-except ImportError as error:  # pragma: no cover - a source checkout not built
-    raise ImportError(
-        "hrgtc's compiled double-double pass (hrgtc.drift._extended_native, from "
-        "src/hrgtc/drift/_extended_native.c) is not built; build it with "
-        "`make .venv/.installed` or `pip install -e .` (a C compiler is needed)") from error
+from hrgtc.core.native import native_module
+
+_native = native_module("hrgtc.drift._extended_native", "double-double pass")
 
 
 def residual_pass(X: np.ndarray, y: np.ndarray, scaling: tuple, weights: np.ndarray,

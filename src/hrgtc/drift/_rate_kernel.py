@@ -15,15 +15,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from hrgtc.core.native import native_module
 from hrgtc.drift.rate_weights import DT_REL_TOLERANCE, SERIES_LIMIT, series_coefficients
 
-try:
-    from hrgtc.drift import _rate_native as _native
-except ImportError as error:  # pragma: no cover - a source checkout not built
-    raise ImportError(
-        "hrgtc's compiled df/dt filter (hrgtc.drift._rate_native, from "
-        "src/hrgtc/drift/_rate_native.c) is not built; build it with "
-        "`make .venv/.installed` or `pip install -e .` (a C compiler is needed)") from error
+_native = native_module("hrgtc.drift._rate_native", "df/dt filter")
 
 #: The constants of the step: p's Taylor coefficients, the series' limit and the relative
 #: change of Δt that keeps the cached (a, p).

@@ -19,11 +19,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-_MISSING = (
-    "hrgtc's compiled Allan module (hrgtc.evaluation._allan_octave, from "
-    "src/hrgtc/evaluation/_allan_octave.c) is not built; build it with "
-    "`make .venv/.installed` or `pip install -e .` (a C compiler is needed)"
-)
+from hrgtc.core.native import native_module
 
 
 def octave_levels(factors: np.ndarray) -> int | None:
@@ -37,10 +33,7 @@ def octave_levels(factors: np.ndarray) -> int | None:
 
 def octave_sums(y: np.ndarray, factors: np.ndarray, levels: int) -> np.ndarray:
     """Σ_i (X[i+2m] − 2X[i+m] + X[i])² at each factor m (powers of two) of ``factors``."""
-    try:
-        from hrgtc.evaluation import _allan_octave
-    except ImportError as error:
-        raise ImportError(_MISSING) from error
+    _allan_octave = native_module("hrgtc.evaluation._allan_octave", "Allan sums")
     mean = float(np.mean(y))  # pairwise, as allantools' frequency2phase and the kernels
     every = np.array(_allan_octave.octave_sums(y, mean, levels))
     return every[np.log2(factors).astype(np.int64)]

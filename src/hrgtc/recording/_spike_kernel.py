@@ -27,13 +27,9 @@ from typing import NamedTuple
 
 import numpy as np
 
-try:
-    from hrgtc.recording import _spike_native as _native
-except ImportError as error:  # pragma: no cover - a source checkout not built
-    raise ImportError(
-        "hrgtc's compiled spike filter (hrgtc.recording._spike_native, from "
-        "src/hrgtc/recording/_spike_native.c) is not built; build it with "
-        "`make .venv/.installed` or `pip install -e .` (a C compiler is needed)") from error
+from hrgtc.core.native import native_module
+
+_native = native_module("hrgtc.recording._spike_native", "spike filter")
 
 
 class SpikeRule(NamedTuple):

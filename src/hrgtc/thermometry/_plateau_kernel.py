@@ -18,13 +18,9 @@ from __future__ import annotations
 
 import numpy as np
 
-try:
-    from hrgtc.thermometry import _plateau_native as _native
-except ImportError as error:  # pragma: no cover - a source checkout not built
-    raise ImportError(
-        "hrgtc's compiled plateau statistics (hrgtc.thermometry._plateau_native, from "
-        "src/hrgtc/thermometry/_plateau_native.c) are not built; build them with "
-        "`make .venv/.installed` or `pip install -e .` (a C compiler is needed)") from error
+from hrgtc.core.native import native_module
+
+_native = native_module("hrgtc.thermometry._plateau_native", "plateau statistics")
 
 #: A quotient this close to an integer (relative) takes numpy's own floor division.
 _NEAR = 1e-9
