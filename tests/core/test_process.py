@@ -39,3 +39,26 @@ def test_freed_chunk_buffers_are_reused_without_new_page_faults():
     default, kept = _faults("default"), _faults("keep")
     assert default > 20 * 39
     assert kept * 10 < default
+
+
+_POOL = """
+import sys
+from hrgtc.core.process import keep_freed_memory
+keep_freed_memory()
+import pyarrow as pa
+print(pa.default_memory_pool().backend_name)
+"""
+
+
+def _pool(environment: dict[str, str]) -> str:
+    import os
+
+    env = {k: v for k, v in os.environ.items() if k != "ARROW_DEFAULT_MEMORY_POOL"}
+    done = subprocess.run([sys.executable, "-c", _POOL], capture_output=True, text=True,
+                          check=True, env={**env, **environment})
+    return done.stdout.strip()
+
+
+def test_arrow_takes_its_buffers_from_the_same_heap_unless_the_user_chose_a_pool():
+    assert _pool({}) == "system"
+    assert _pool({"ARROW_DEFAULT_MEMORY_POOL": "mimalloc"}) == "mimalloc"

@@ -15,6 +15,8 @@ _M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD = -1, -3
 MMAP_THRESHOLD_BYTES = 32 << 20
 #: Freed memory at the heap's top kept for the next chunk, up to this much. [bytes]
 TRIM_THRESHOLD_BYTES = 256 << 20
+#: Arrow's choice of memory pool, read when pyarrow first allocates.
+ARROW_POOL_VARIABLE = "ARROW_DEFAULT_MEMORY_POOL"
 
 
 def keep_freed_memory() -> bool:
@@ -26,8 +28,12 @@ def keep_freed_memory() -> bool:
     so every chunk's arrays are new pages that the kernel zeroes on first touch (about a
     fifth of ``compensate``'s CPU on a 10 M-row file: ``docs/benchmarks.md``). With a fixed
     mmap threshold of 32 MiB and a trim threshold of 256 MiB they come from the heap and are
-    reused. Called by the ``hrgtc`` command only (a library leaves its host's allocator
-    alone); no effect but on glibc. Returns whether both settings were taken.
+    reused. Arrow's decoded columns are taken from the same heap (its ``system`` pool, set
+    through ``ARROW_DEFAULT_MEMORY_POOL`` unless the environment names a pool): its default
+    pool, mimalloc, gives freed segments back and faults them in again as huge pages, each
+    zeroed. Called by the ``hrgtc`` command only, before pyarrow is imported (a library
+    leaves its host's allocator alone); no effect but on glibc. Returns whether both
+    ``mallopt`` settings were taken.
     """
     try:
         glibc = os.confstr("CS_GNU_LIBC_VERSION") or ""
@@ -42,8 +48,11 @@ def keep_freed_memory() -> bool:
     except (OSError, AttributeError):
         return False
     mallopt.argtypes, mallopt.restype = [ctypes.c_int, ctypes.c_int], ctypes.c_int
-    return bool(mallopt(_M_MMAP_THRESHOLD, MMAP_THRESHOLD_BYTES)
+    kept = bool(mallopt(_M_MMAP_THRESHOLD, MMAP_THRESHOLD_BYTES)
                 and mallopt(_M_TRIM_THRESHOLD, TRIM_THRESHOLD_BYTES))
+    if kept:  # Arrow's decoded buffers from the same heap (unless the user chose a pool)
+        os.environ.setdefault(ARROW_POOL_VARIABLE, "system")
+    return kept
 
 
 def peak_rss_mb() -> float:
