@@ -125,3 +125,19 @@ def test_processes_are_used_only_for_pieces_worth_a_fork(tmp_path, monkeypatch):
     assert forked.processes(3, [big] * 3) == 1
     monkeypatch.setenv(forked.ENVIRONMENT, "8")
     assert forked.processes(3, [small] * 3) == 3  # forced, at most one per piece
+
+
+_COMMAND = os.getpid()
+
+
+def _killed_in_a_worker(n: int) -> int:
+    """Piece 2 dies in a worker (as the kernel's OOM killer ends it), not in the command."""
+    if n == 2 and os.getpid() != _COMMAND:
+        os.kill(os.getpid(), 9)
+    return n * 10
+
+
+def test_a_worker_killed_mid_piece_neither_hangs_nor_loses_a_piece():
+    # multiprocessing.Pool would wait forever for the lost piece; the rest run here
+    assert list(forked.map_in_order(_killed_in_a_worker, list(range(6)), 2)) == [
+        0, 10, 20, 30, 40, 50]

@@ -114,6 +114,8 @@ def map_in_order(work: Callable[[T], R], items: Sequence[T], workers: int) -> It
             yield work(item)
         return
     import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+    from concurrent.futures.process import BrokenProcessPool
 
     global _WORK
     yield work(items[0])
@@ -122,23 +124,32 @@ def map_in_order(work: Callable[[T], R], items: Sequence[T], workers: int) -> It
         prepare()
     sys.stdout.flush()  # a worker must not write the command's buffered output again
     sys.stderr.flush()
+    pool = ProcessPoolExecutor(min(workers, len(items) - 1),
+                               mp_context=multiprocessing.get_context("fork"),
+                               initializer=_start_worker)
     _WORK = (work, items)
-    try:
-        pool = multiprocessing.get_context("fork").Pool(min(workers, len(items) - 1),
-                                                        initializer=_start_worker)
+    try:  # with fork, every worker starts at the first submission
+        sent_back = pool.map(_run_piece, range(1, len(items)))
     finally:
         _WORK = None
+    index = 1
     with pool:
-        for index, sent in enumerate(pool.imap(_run_piece, range(1, len(items))), start=1):
-            result, said, memos, failed = pickle.loads(sent)
-            if failed:  # its error raised here (its warnings said once, from here)
-                yield work(items[index])
-                continue
-            _say_again(said)
-            for (_, keep), added in zip(_MEMOS, memos, strict=True):
-                for key, value in added:
-                    keep(key, value)
-            yield result
+        try:
+            for sent in sent_back:
+                result, said, memos, failed = pickle.loads(sent)
+                if failed:  # its error raised here (its warnings said once, from here)
+                    result = work(items[index])
+                else:
+                    _say_again(said)
+                    for (_, keep), added in zip(_MEMOS, memos, strict=True):
+                        for key, value in added:
+                            keep(key, value)
+                index += 1
+                yield result
+        except BrokenProcessPool:  # a worker killed (out of memory): the rest run here
+            pool.shutdown(wait=False, cancel_futures=True)
+            for item in items[index:]:
+                yield work(item)
 
 
 def _start_worker() -> None:
